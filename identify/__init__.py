@@ -1,0 +1,11 @@
+"""Identifiers: they fit what a lab would measure and never see the truth.
+
+Every module of this package is imported on first lookup of :data:`IDENTIFIERS`.
+``identify`` never imports ``models``.
+"""
+
+from testbed.registry import Registry
+
+IDENTIFIERS = Registry("identifier", package="identify")
+
+__all__ = ["IDENTIFIERS"]

@@ -1,0 +1,211 @@
+"""One simulated run: measured signals, noise-free reference signals, exact truth, provenance.
+
+Stored as one HDF5 file (h5py), data apart from code and config stored with data,
+as PDEBench does.  Layout::
+
+    /                       attrs: format, rig, seed, fs [Hz], scenario (canonical JSON),
+                                   versions (JSON), git_commit, gravity, content_hash, ...
+    /measured/<name>        (channels, samples) what a lab records (noisy if noise was asked)
+    /reference/<name>       (channels, samples) the same quantities, noise-free, and the
+                            true states (e.g. sensor displacements) no lab would have
+    /truth/<name>           exact truth arrays (M, K, frequencies, ...); attr ``unit``
+    /prior                  attrs: prior knowledge an identifier may be given (e.g. total mass)
+
+Every signal dataset carries attrs ``unit``, ``channels`` and, where defined,
+``positions`` [m].  Writes are atomic: the file appears whole or not at all.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import h5py
+import numpy as np
+
+FORMAT = "sysid-testbed-dataset/1"
+
+
+@dataclass
+class Signal:
+    """A group of sampled channels sharing a unit.
+
+    Parameters
+    ----------
+    data : ndarray, shape (n_channels, n_samples)
+    channels : tuple of str
+        One name per row.
+    unit : str
+        SI unit of every channel, e.g. ``"m/s^2"``.
+    positions : ndarray, shape (n_channels,), optional
+        Position of each channel along the structure [m], where defined.
+    """
+
+    data: np.ndarray
+    channels: tuple[str, ...]
+    unit: str
+    positions: np.ndarray | None = None
+
+    def __post_init__(self) -> None:
+        self.data = np.asarray(self.data, dtype=float)
+        if self.data.ndim == 1:
+            self.data = self.data[None, :]
+        self.channels = tuple(self.channels)
+        if self.data.shape[0] != len(self.channels):
+            raise ValueError(f"{self.data.shape[0]} rows but {len(self.channels)} channel names")
+        if self.positions is not None:
+            self.positions = np.asarray(self.positions, dtype=float)
+
+
+@dataclass
+class Dataset:
+    """Signals, truth and provenance of one run.  See the module docstring for the layout.
+
+    Attributes
+    ----------
+    fs : float
+        Sample rate [Hz].
+    measured, reference : dict of str to Signal
+    truth : dict of str to ndarray (or list of str)
+    truth_units : dict of str to str
+    prior : dict of str to float
+        Prior knowledge an identifier may use (never the answer itself).
+    attrs : dict
+        Provenance: ``rig``, ``seed``, ``scenario`` (canonical JSON), ``versions``,
+        ``git_commit``, ``gravity`` and anything else the rig records.
+    """
+
+    fs: float
+    measured: dict[str, Signal]
+    reference: dict[str, Signal] = field(default_factory=dict)
+    truth: dict[str, Any] = field(default_factory=dict)
+    truth_units: dict[str, str] = field(default_factory=dict)
+    prior: dict[str, float] = field(default_factory=dict)
+    attrs: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def n_samples(self) -> int:
+        return next(iter(self.measured.values())).data.shape[1]
+
+    @property
+    def t(self) -> np.ndarray:
+        """Sample times [s], shape (n_samples,)."""
+        return np.arange(self.n_samples) / self.fs
+
+    def content_hash(self) -> str:
+        """SHA-256 of everything that is data (signals, truth, prior, scenario, seed).
+
+        Versions, commit and the hash itself are left out, so the hash names the
+        content: the same scenario and seed give the same hash on any machine
+        whose physics engine gives the same numbers.
+        """
+        h = hashlib.sha256()
+        meta = {k: v for k, v in self.attrs.items()
+                if k not in ("versions", "git_commit", "content_hash", "created")}
+        h.update(json.dumps({"fs": self.fs, "prior": self.prior, "attrs": meta},
+                            sort_keys=True, default=str).encode())
+        for group, signals in (("measured", self.measured), ("reference", self.reference)):
+            for name in sorted(signals):
+                s = signals[name]
+                h.update(f"{group}/{name}|{s.unit}|{','.join(s.channels)}".encode())
+                h.update(np.ascontiguousarray(s.data, dtype="<f8").tobytes())
+                if s.positions is not None:
+                    h.update(np.ascontiguousarray(s.positions, dtype="<f8").tobytes())
+        for name in sorted(self.truth):
+            h.update(f"truth/{name}|{self.truth_units.get(name, '')}".encode())
+            v = self.truth[name]
+            if isinstance(v, (list, tuple)) and v and isinstance(v[0], str):
+                h.update("\x1f".join(v).encode())
+            else:
+                h.update(np.ascontiguousarray(np.asarray(v, dtype=float), dtype="<f8").tobytes())
+        return h.hexdigest()
+
+    # ------------------------------------------------------------------ HDF5
+    def save(self, path: str | os.PathLike) -> Path:
+        """Write atomically to ``path`` (a temporary file in the same folder, then rename)."""
+        path = Path(path)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        self.attrs["content_hash"] = self.content_hash()
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+        os.close(fd)
+        try:
+            with h5py.File(tmp, "w", track_order=True) as f:
+                self._write(f)
+            with open(tmp, "rb") as fh:
+                os.fsync(fh.fileno())
+            os.replace(tmp, path)
+        except BaseException:
+            Path(tmp).unlink(missing_ok=True)
+            raise
+        return path
+
+    def _write(self, f: h5py.File) -> None:
+        f.attrs["format"] = FORMAT
+        f.attrs["fs"] = float(self.fs)
+        f.attrs["fs_unit"] = "Hz"
+        for k, v in self.attrs.items():
+            f.attrs[k] = v if isinstance(v, (str, int, float, np.integer, np.floating)) \
+                else json.dumps(v, sort_keys=True)
+        for group, signals in (("measured", self.measured), ("reference", self.reference)):
+            g = f.create_group(group)
+            for name, s in signals.items():
+                d = g.create_dataset(name, data=s.data, track_times=False)
+                d.attrs["unit"] = s.unit
+                d.attrs["channels"] = list(s.channels)
+                d.attrs["layout"] = "channels x samples"
+                if s.positions is not None:
+                    d.attrs["positions"] = s.positions
+                    d.attrs["positions_unit"] = "m"
+        g = f.create_group("truth")
+        for name, v in self.truth.items():
+            if isinstance(v, (list, tuple)) and v and isinstance(v[0], str):
+                d = g.create_dataset(name, data=np.array(v, dtype=h5py.string_dtype()),
+                                     track_times=False)
+            else:
+                d = g.create_dataset(name, data=np.asarray(v), track_times=False)
+            d.attrs["unit"] = self.truth_units.get(name, "")
+        p = f.create_group("prior")
+        for k, v in self.prior.items():
+            p.attrs[k] = v
+
+    @classmethod
+    def load(cls, path: str | os.PathLike) -> Dataset:
+        """Read a file written by :meth:`save`; the result equals the saved object."""
+        with h5py.File(path, "r") as f:
+            if f.attrs.get("format") != FORMAT:
+                raise ValueError(f"{path}: not a {FORMAT} file (format={f.attrs.get('format')!r})")
+            attrs: dict[str, Any] = {}
+            for k, v in f.attrs.items():
+                if k in ("format", "fs", "fs_unit"):
+                    continue
+                if isinstance(v, bytes):
+                    v = v.decode()
+                if isinstance(v, str) and k in ("scenario", "versions") or (
+                        isinstance(v, str) and v[:1] in "[{"):
+                    v = json.loads(v)
+                elif isinstance(v, np.generic):
+                    v = v.item()
+                attrs[k] = v
+            groups: dict[str, dict[str, Signal]] = {}
+            for group in ("measured", "reference"):
+                groups[group] = {}
+                for name, d in f[group].items():
+                    pos = d.attrs.get("positions")
+                    groups[group][name] = Signal(d[()], tuple(str(c) for c in d.attrs["channels"]),
+                                                 str(d.attrs["unit"]),
+                                                 None if pos is None else np.asarray(pos))
+            truth, units = {}, {}
+            for name, d in f["truth"].items():
+                v = d[()]
+                if d.dtype.kind in "OS":
+                    v = [x.decode() if isinstance(x, bytes) else str(x) for x in v]
+                truth[name] = v
+                units[name] = str(d.attrs["unit"])
+            prior = {k: (v.item() if isinstance(v, np.generic) else v) for k, v in f["prior"].attrs.items()}
+            return cls(float(f.attrs["fs"]), groups["measured"], groups["reference"], truth, units,
+                       prior, attrs)

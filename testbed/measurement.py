@@ -1,0 +1,65 @@
+"""What an identifier is given: measured signals after the lab's signal chain, nothing else."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, NamedTuple
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class Measurement:
+    """Signals an identifier may fit, in channels x samples layout.
+
+    Attributes
+    ----------
+    fs : float
+        Sample rate [Hz].
+    x, xd, xdd : ndarray, shape (n_channels, n_samples)
+        Coordinate (sensor displacement [m] or joint angle [rad]) and its first
+        and second time derivatives, as the signal chain estimated them.
+    channels : tuple of str
+        Name of each coordinate.
+    u : ndarray, shape (n_inputs, n_samples), optional
+        Measured inputs (force [N] at a sensor, joint torque [N m]).
+    inputs : tuple of str
+        Name of each input row.
+    input_map : ndarray, shape (n_channels, n_inputs), optional
+        Which coordinate each input acts on (e.g. impact at the tip sensor).
+    prior : dict
+        Declared prior knowledge (e.g. ``total_mass`` [kg]); never the answer.
+    free_start : int
+        First sample after the excitation pulse (0 if the input is continuous).
+    """
+
+    fs: float
+    x: np.ndarray
+    xd: np.ndarray
+    xdd: np.ndarray
+    channels: tuple[str, ...]
+    u: np.ndarray | None = None
+    inputs: tuple[str, ...] = ()
+    input_map: np.ndarray | None = None
+    prior: dict[str, Any] = field(default_factory=dict)
+    free_start: int = 0
+
+    @property
+    def n_channels(self) -> int:
+        return self.x.shape[0]
+
+    @property
+    def n_samples(self) -> int:
+        return self.x.shape[1]
+
+    @property
+    def t(self) -> np.ndarray:
+        return np.arange(self.n_samples) / self.fs
+
+
+class Trajectory(NamedTuple):
+    """A simulated response: each array has shape (n_channels, n_samples)."""
+
+    x: np.ndarray
+    xd: np.ndarray
+    xdd: np.ndarray
