@@ -1,0 +1,70 @@
+"""Content-keyed dataset cache shared by ``testbed run`` and ``testbed sweep``.
+
+A dataset is determined by the scenario's data sections and seed
+(:meth:`Scenario.data_hash`) and by the versions of the code and engines that
+simulate it; the cache key hashes both.  Files are written atomically, so a
+killed process never leaves a half-written entry.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+from collections.abc import Callable
+from pathlib import Path
+
+from testbed.dataset import Dataset
+from testbed.provenance import versions
+from testbed.scenario import Scenario
+
+
+def default_cache_dir() -> Path:
+    """``$TESTBED_CACHE``, else ``.cache/datasets`` under the current directory."""
+    return Path(os.environ.get("TESTBED_CACHE", Path.cwd() / ".cache" / "datasets"))
+
+
+def cache_key(scenario: Scenario) -> str:
+    blob = json.dumps({"data": scenario.data_hash(), "versions": versions()}, sort_keys=True)
+    return hashlib.sha256(blob.encode()).hexdigest()[:32]
+
+
+class DatasetCache:
+    """Datasets on disk, one HDF5 file per key.
+
+    Parameters
+    ----------
+    directory : path, optional
+        Where the files live (default :func:`default_cache_dir`).
+    """
+
+    def __init__(self, directory: str | os.PathLike | None = None) -> None:
+        self.directory = Path(directory) if directory is not None else default_cache_dir()
+
+    def path(self, scenario: Scenario) -> Path:
+        return self.directory / f"{scenario.rig}-{cache_key(scenario)}.h5"
+
+    def get(self, scenario: Scenario, progress: Callable[[float], None] | None = None) -> Dataset:
+        """The cached dataset of ``scenario``, generating and storing it if absent."""
+        from testbed.generate import generate
+
+        p = self.path(scenario)
+        if p.is_file():
+            return Dataset.load(p)
+        ds = generate(scenario, progress=progress)
+        ds.save(p)
+        return ds
+
+    def entries(self) -> list[tuple[Path, int]]:
+        """(path, size in bytes) of every cached file, sorted by name."""
+        if not self.directory.is_dir():
+            return []
+        return [(p, p.stat().st_size) for p in sorted(self.directory.glob("*.h5"))]
+
+    def clear(self) -> int:
+        """Delete every cached file; return how many were removed."""
+        n = 0
+        for p, _ in self.entries():
+            p.unlink(missing_ok=True)
+            n += 1
+        return n

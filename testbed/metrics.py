@@ -1,0 +1,349 @@
+"""Scores of an identified model against the truth, as /work/shared/reference/metrics.md defines.
+
+Metrics take arrays, never rigs or identifiers.  Signals are ``(n_channels, n_samples)``;
+mode-shape matrices hold one mode per column, ``(n_dof, n_modes)``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy import linalg, optimize
+
+
+def trac(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """Time response assurance criterion per channel.
+
+    Parameters
+    ----------
+    x : ndarray, shape (n_channels, n_samples)
+        Reference signal (truth or measurement), real or complex; 1-D is one channel.
+    y : ndarray, shape (n_channels, n_samples)
+        The identified model's counterpart.  Over frequency lines of FRFs this is FRAC.
+
+    Returns
+    -------
+    ndarray, shape (n_channels,)
+        ``|x_j^H y_j|^2 / ((x_j^H x_j)(y_j^H y_j))`` in [0, 1]; 1 for proportional signals
+        (any nonzero scale), 0 for orthogonal ones.  NaN where either channel is all zero
+        (undefined), so a threshold on it fails rather than passes.
+    """
+    x, y = np.atleast_2d(np.asarray(x)), np.atleast_2d(np.asarray(y))
+    if x.shape != y.shape:
+        raise ValueError(f"shapes differ: {x.shape} vs {y.shape}")
+    num = np.abs(np.sum(np.conj(x) * y, axis=-1)) ** 2
+    den = np.sum(np.abs(x) ** 2, axis=-1) * np.sum(np.abs(y) ** 2, axis=-1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        out = np.where(den > 0, num / np.where(den > 0, den, 1.0), np.nan)
+    return np.minimum(out, 1.0)  # rounding can push the ratio of equal numbers to 1 + 1e-16
+
+
+def mac_matrix(phi_a: np.ndarray, phi_b: np.ndarray) -> np.ndarray:
+    """Modal assurance criterion between every pair of mode shapes.
+
+    Parameters
+    ----------
+    phi_a : ndarray, shape (n_dof, n_a)
+        Mode shapes, one per column (real or complex); 1-D is one mode.
+    phi_b : ndarray, shape (n_dof, n_b)
+
+    Returns
+    -------
+    ndarray, shape (n_a, n_b)
+        ``MAC[i, j] = |a_i^H b_j|^2 / ((a_i^H a_i)(b_j^H b_j))`` in [0, 1]; NaN for a zero shape.
+    """
+    a, b = np.asarray(phi_a), np.asarray(phi_b)
+    a = a[:, None] if a.ndim == 1 else a
+    b = b[:, None] if b.ndim == 1 else b
+    if a.shape[0] != b.shape[0]:
+        raise ValueError(f"mode shapes have {a.shape[0]} and {b.shape[0]} DOFs")
+    num = np.abs(np.conj(a).T @ b) ** 2
+    den = np.outer(np.sum(np.abs(a) ** 2, axis=0), np.sum(np.abs(b) ** 2, axis=0))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        out = np.where(den > 0, num / np.where(den > 0, den, 1.0), np.nan)
+    return np.minimum(out, 1.0)
+
+
+def pair_modes(mac: np.ndarray) -> np.ndarray:
+    """Pair modes by maximum total MAC, each mode used at most once.
+
+    Parameters
+    ----------
+    mac : ndarray, shape (n_a, n_b)
+        E.g. ``mac_matrix(phi_true, phi_id)``.
+
+    Returns
+    -------
+    ndarray of int, shape (n_a,)
+        ``pair[i]`` is the column paired with row ``i``, or -1 where ``n_a > n_b`` leaves row
+        ``i`` unpaired.  The assignment maximises the summed MAC
+        (``scipy.optimize.linear_sum_assignment``), so two true modes never claim the same
+        identified mode, unlike a row-wise argmax.  NaN entries count as 0.
+    """
+    mac = np.nan_to_num(np.asarray(mac, dtype=float), nan=0.0)
+    if mac.ndim != 2:
+        raise ValueError(f"expected a 2-D MAC matrix, got shape {mac.shape}")
+    rows, cols = optimize.linear_sum_assignment(mac, maximize=True)
+    pair = np.full(mac.shape[0], -1, dtype=int)
+    pair[rows] = cols
+    return pair
+
+
+def frequency_error(f_id: np.ndarray, f_true: np.ndarray) -> np.ndarray:
+    """Relative natural-frequency error of paired modes, ``|f_id - f_true| / f_true``.
+
+    Parameters
+    ----------
+    f_id, f_true : ndarray, shape (n_modes,)
+        Paired frequencies [Hz] (pair first, e.g. with :func:`pair_modes`).
+
+    Returns
+    -------
+    ndarray, shape (n_modes,)
+        Dimensionless; inf where ``f_true`` is 0 and ``f_id`` is not, NaN where both are 0.
+    """
+    f_id, f_true = np.asarray(f_id, dtype=float), np.asarray(f_true, dtype=float)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.abs(f_id - f_true) / np.abs(f_true)
+
+
+def damping_error(z_id: np.ndarray, z_true: np.ndarray) -> np.ndarray:
+    """Relative damping-ratio error of paired modes, ``|z_id - z_true| / z_true``.
+
+    Parameters
+    ----------
+    z_id, z_true : ndarray, shape (n_modes,)
+        Paired damping ratios [-].
+
+    Returns
+    -------
+    ndarray, shape (n_modes,)
+        Dimensionless; undefined (inf/NaN) for an undamped true mode.
+    """
+    return frequency_error(z_id, z_true)
+
+
+def relative_error(a_id: np.ndarray, a_true: np.ndarray) -> float:
+    """Relative Frobenius error ``||A_id - A_true||_F / ||A_true||_F``.
+
+    Parameters
+    ----------
+    a_id, a_true : ndarray, same shape
+        Matrices (M, C, K, K3, ...) in the same coordinates and units.
+
+    Returns
+    -------
+    float
+        Dimensionless.  If ``A_true`` is zero: 0.0 when ``A_id`` is zero too, else inf.
+    """
+    a_id, a_true = np.asarray(a_id, dtype=float), np.asarray(a_true, dtype=float)
+    if a_id.shape != a_true.shape:
+        raise ValueError(f"shapes differ: {a_id.shape} vs {a_true.shape}")
+    num, den = np.linalg.norm(a_id - a_true), np.linalg.norm(a_true)
+    if den == 0:
+        return 0.0 if num == 0 else float("inf")
+    return float(num / den)
+
+
+def cross_orthogonality(phi_id: np.ndarray, phi_true: np.ndarray, m: np.ndarray) -> np.ndarray:
+    """Mass-weighted cross-orthogonality ``Phi_id^H M Phi_true`` of mass-normalised modes.
+
+    Parameters
+    ----------
+    phi_id : ndarray, shape (n_dof, n_id)
+        Identified mode shapes (any scaling; they are mass-normalised here).
+    phi_true : ndarray, shape (n_dof, n_true)
+        True mode shapes (any scaling).
+    m : ndarray, shape (n_dof, n_dof)
+        The known mass matrix [kg] in the same coordinates.
+
+    Returns
+    -------
+    ndarray, shape (n_id, n_true)
+        The identity for a perfect identification.  Each identified mode's sign is flipped so
+        that its diagonal entry (same index) is nonnegative; off the diagonal compare absolute
+        values.
+    """
+    m = np.asarray(m)
+
+    def normalise(phi: np.ndarray) -> np.ndarray:
+        phi = np.asarray(phi)
+        phi = phi[:, None] if phi.ndim == 1 else phi
+        scale = np.sqrt(np.real(np.einsum("ij,ik,kj->j", np.conj(phi), m, phi)))
+        if np.any(~(scale > 0)):
+            raise ValueError("a mode shape has zero or negative modal mass; is M positive definite?")
+        return phi / scale
+
+    a, b = normalise(phi_id), normalise(phi_true)
+    xo = np.conj(a).T @ m @ b
+    k = min(xo.shape)
+    d = np.diag(xo)[:k]
+    flip = np.ones(xo.shape[0])
+    flip[:k] = np.where(np.real(d) < 0, -1.0, 1.0)
+    return flip[:, None] * xo
+
+
+def support_scores(coef_id: np.ndarray, coef_true: np.ndarray, tol: float = 0.0) -> dict[str, float]:
+    """Precision, recall and F1 of the identified nonzero pattern.
+
+    Parameters
+    ----------
+    coef_id, coef_true : ndarray, same shape
+        Coefficient arrays; an entry counts as nonzero when ``|c| > tol``.
+    tol : float
+        Magnitude at or below which a coefficient counts as zero.
+
+    Returns
+    -------
+    dict
+        ``precision = tp / (tp + fp)``, ``recall = tp / (tp + fn)``,
+        ``f1 = 2 p r / (p + r)``, and the counts ``tp``, ``fp``, ``fn``.
+        Degenerate cases: no true and no identified nonzeros is a perfect answer (all 1.0);
+        no identified nonzeros against some true ones gives precision 0 and recall 0;
+        some identified nonzeros against no true ones gives precision 0 and recall 0;
+        F1 is 0 whenever precision + recall is 0.
+    """
+    ci, ct = np.asarray(coef_id, dtype=float), np.asarray(coef_true, dtype=float)
+    if ci.shape != ct.shape:
+        raise ValueError(f"shapes differ: {ci.shape} vs {ct.shape}")
+    pi, pt = np.abs(ci) > tol, np.abs(ct) > tol
+    tp, fp, fn = int(np.sum(pi & pt)), int(np.sum(pi & ~pt)), int(np.sum(~pi & pt))
+    if tp + fp + fn == 0:
+        return {"precision": 1.0, "recall": 1.0, "f1": 1.0, "tp": 0, "fp": 0, "fn": 0}
+    precision = tp / (tp + fp) if tp + fp else 0.0
+    recall = tp / (tp + fn) if tp + fn else 0.0
+    f1 = 2 * precision * recall / (precision + recall) if precision + recall else 0.0
+    return {"precision": precision, "recall": recall, "f1": f1, "tp": tp, "fp": fp, "fn": fn}
+
+
+def coefficient_error(coef_id: np.ndarray, coef_true: np.ndarray) -> float:
+    """Largest relative error over the true terms, ``max_k |c_id,k - c_true,k| / |c_true,k|``.
+
+    Parameters
+    ----------
+    coef_id, coef_true : ndarray, same shape
+        Coefficients in the same library and units.
+
+    Returns
+    -------
+    float
+        Dimensionless; the max over the entries where ``coef_true`` is nonzero (a dropped
+        true term scores 1).  NaN when the truth has no nonzero term.  Spurious terms are
+        scored by :func:`support_scores`; the overall relative error is :func:`relative_error`.
+    """
+    ci, ct = np.asarray(coef_id, dtype=float), np.asarray(coef_true, dtype=float)
+    if ci.shape != ct.shape:
+        raise ValueError(f"shapes differ: {ci.shape} vs {ct.shape}")
+    nz = ct != 0
+    if not nz.any():
+        return float("nan")
+    return float(np.max(np.abs(ci[nz] - ct[nz]) / np.abs(ct[nz])))
+
+
+def rmse(x: np.ndarray, y: np.ndarray, axis: int = -1) -> np.ndarray:
+    """Root-mean-square difference ``sqrt(mean((x - y)^2))`` along ``axis``.
+
+    Parameters
+    ----------
+    x, y : ndarray, shape (n_channels, n_samples)
+        E.g. true and simulated joint angles [rad].
+    axis : int
+        Axis to average over (time by default).
+
+    Returns
+    -------
+    ndarray, shape (n_channels,)
+        In the unit of ``x``.
+    """
+    x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+    return np.sqrt(np.mean((x - y) ** 2, axis=axis))
+
+
+def modal_from_matrices(m: np.ndarray, c: np.ndarray | None, k: np.ndarray, *, strict: bool = True
+                        ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Natural frequencies, damping ratios and mass-normalised modes of ``M x'' + C x' + K x = 0``.
+
+    Parameters
+    ----------
+    m : ndarray, shape (n, n)
+        Mass matrix [kg]; must be symmetric positive definite.
+    c : ndarray, shape (n, n), or None
+        Damping matrix [N s/m]; None means undamped.
+    k : ndarray, shape (n, n)
+        Stiffness matrix [N/m]; symmetric.
+    strict : bool
+        If True (default) a mass matrix that is not symmetric positive definite, or a negative
+        stiffness eigenvalue, raises ValueError.  If False, the same cases return all-NaN
+        arrays (non-PD M) or NaN frequencies for the unstable modes, so a scorer can record a
+        failed identification without a try block.
+
+    Returns
+    -------
+    freqs_hz : ndarray, shape (n,)
+        Undamped natural frequencies ``w_n / 2 pi`` [Hz], ascending.
+    damping_ratios : ndarray, shape (n,)
+        Damping ratios [-] (zeros when ``c`` is None); above 1 for an overdamped mode.
+    modes : ndarray, shape (n, n)
+        Real mode shapes of ``(K, M)``, one per column, ``modes^T M modes = I``, largest
+        component of each positive.
+
+    Notes
+    -----
+    Modes come from the generalised symmetric eigenproblem ``K phi = w^2 M phi``.  With
+    damping, the 2n eigenvalues ``lambda`` of the first-order system
+    ``[[0, I], [-M^-1 K, -M^-1 C]]`` are assigned two per real mode by maximum MAC of their
+    displacement parts (one column per slot, :func:`pair_modes` style), and each pair gives
+    ``w_n^2 = lambda_1 lambda_2`` and ``2 zeta w_n = -(lambda_1 + lambda_2)``: for an
+    underdamped mode ``lambda_2 = conj(lambda_1)``, so ``w_n = |lambda|`` and
+    ``zeta = -Re(lambda) / |lambda|``; an overdamped mode's two real eigenvalues give
+    ``zeta > 1``.  Exact for proportional damping; for non-proportional damping the
+    frequencies are the complex modes' and the shapes stay the undamped ones.
+    """
+    m, k = np.asarray(m, dtype=float), np.asarray(k, dtype=float)
+    n = m.shape[0]
+    if m.shape != (n, n) or k.shape != (n, n):
+        raise ValueError(f"M and K must be square and alike, got {m.shape} and {k.shape}")
+    nan = (np.full(n, np.nan), np.full(n, np.nan), np.full((n, n), np.nan))
+    if not (np.all(np.isfinite(m)) and np.all(np.isfinite(k))
+            and (c is None or np.all(np.isfinite(c)))):
+        if strict:
+            raise ValueError("M, C or K holds non-finite entries")
+        return nan
+    if not np.allclose(m, m.T, rtol=1e-10, atol=1e-14 * np.abs(m).max()):
+        if strict:
+            raise ValueError("mass matrix is not symmetric")
+        return nan
+    try:
+        linalg.cholesky(m, lower=True)
+    except linalg.LinAlgError:
+        if strict:
+            raise ValueError("mass matrix is not positive definite") from None
+        return nan
+    ks = 0.5 * (k + k.T)
+    lam, modes = linalg.eigh(ks, m)
+    if np.any(lam < -1e-12 * max(1.0, np.abs(lam).max())):
+        if strict:
+            raise ValueError(f"stiffness has negative eigenvalues {lam[lam < 0]} (unstable model)")
+    big = np.argmax(np.abs(modes), axis=0)
+    modes = modes * np.sign(modes[big, np.arange(n)])
+    with np.errstate(invalid="ignore"):
+        omega = np.where(lam >= 0, np.sqrt(np.abs(lam)), np.nan)
+    zeta = np.zeros(n)
+    if c is not None:
+        c = np.asarray(c, dtype=float)
+        if c.shape != (n, n):
+            raise ValueError(f"C must be {(n, n)}, got {c.shape}")
+        minv = linalg.solve(m, np.eye(n), assume_a="pos")
+        a = np.block([[np.zeros((n, n)), np.eye(n)], [-minv @ k, -minv @ c]])
+        ev, vec = linalg.eig(a)
+        shapes = vec[:n]
+        # Two slots per real mode; assign the 2n eigenvalues to slots by maximum MAC.
+        mac = np.nan_to_num(np.abs(np.conj(np.repeat(modes, 2, axis=1)).T @ m @ shapes) ** 2)
+        slot, which = optimize.linear_sum_assignment(mac, maximize=True)
+        lam_pair = np.empty((n, 2), dtype=complex)
+        lam_pair[slot // 2, slot % 2] = ev[which]
+        w2 = np.real(lam_pair[:, 0] * lam_pair[:, 1])
+        with np.errstate(invalid="ignore", divide="ignore"):
+            omega = np.where(w2 >= 0, np.sqrt(np.abs(w2)), np.nan)
+            zeta = -np.real(lam_pair.sum(axis=1)) / (2.0 * omega)
+    order = np.argsort(omega)  # NaN (unstable) modes last
+    return omega[order] / (2.0 * np.pi), zeta[order], modes[:, order]

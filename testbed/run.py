@@ -1,0 +1,84 @@
+"""Run a scenario end to end: dataset (cached) -> signal chain -> identify -> score.
+
+The identifier is given only the :class:`~testbed.measurement.Measurement` of the
+measured signals; scoring alone opens the truth.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, replace
+from typing import Any
+
+from testbed.cache import DatasetCache
+from testbed.dataset import Dataset
+from testbed.generate import generate
+from testbed.measurement import Measurement
+from testbed.preprocess import measure
+from testbed.scenario import Scenario
+from testbed.scoring import Check, Scores, check_thresholds, score
+
+
+@dataclass
+class RunResult:
+    """Everything one scenario run produced."""
+
+    scenario: Scenario
+    dataset: Dataset
+    data: Measurement
+    model: Any
+    scores: Scores
+    checks: list[Check]
+    fit_time: float
+
+    @property
+    def passed(self) -> bool:
+        return all(c.passed for c in self.checks)
+
+
+def noise_free(dataset: Dataset) -> Dataset:
+    """The dataset with every measured signal replaced by its noise-free reference."""
+    measured = {k: dataset.reference.get(k, s) for k, s in dataset.measured.items()}
+    return replace(dataset, measured=measured)
+
+
+def make_identifier(scenario: Scenario) -> Any:
+    """A fresh identifier of the scenario's ``[identify]`` table."""
+    from identify import IDENTIFIERS
+
+    if scenario.identify is None:
+        raise ValueError(f"scenario {scenario.name!r} has no [identify] table")
+    params = {k: v for k, v in scenario.identify.items() if k != "method"}
+    return IDENTIFIERS.get(scenario.identify["method"])(**params)
+
+
+def run_scenario(scenario: Scenario, *, cache: DatasetCache | None = None,
+                 dataset: Dataset | None = None, model: Any = None,
+                 progress: Callable[[float], None] | None = None) -> RunResult:
+    """Generate (or reuse) the data, identify, and score against the truth.
+
+    Parameters
+    ----------
+    scenario : Scenario
+    cache : DatasetCache, optional
+        Reuse / store the dataset there; without it the data are generated afresh.
+    dataset : Dataset, optional
+        Use these data instead (must belong to ``scenario``).
+    model : Identifier, optional
+        Use this (unfitted) identifier instead of the scenario's ``[identify]``.
+    """
+    from models import RIGS
+
+    if dataset is None:
+        dataset = cache.get(scenario, progress) if cache is not None else generate(scenario, progress)
+    kind = RIGS.get(scenario.rig).kind
+    data = measure(dataset, scenario.signal, kind)
+    clean = measure(noise_free(dataset), scenario.signal, kind)
+    model = model if model is not None else make_identifier(scenario)
+    t0 = time.perf_counter()
+    model.fit(data)
+    fit_time = time.perf_counter() - t0
+    scores = score(kind, dataset, data, clean, model)
+    return RunResult(scenario, dataset, data, model, scores,
+                     check_thresholds(scores.values, scenario.score), fit_time)

@@ -1,0 +1,237 @@
+"""What a lab does to raw sampled signals: integration, zero-phase filters, derivatives.
+
+Every function works along the last axis of an array of shape ``(n_channels, n_samples)``
+(a 1-D array is one channel) and returns arrays of the same shape, vectorised over channels.
+Filters are zero-phase (forward-backward, ``scipy.signal.sosfiltfilt``): the magnitude
+response is that of the designed filter squared and there is no phase shift, so the
+filtered acceleration, velocity and displacement stay aligned in time.
+
+The chain follows the SGD-SINDy cantilever paper (seed 000, "Experimental Setup and Data
+Processing"): trapezoid integration, with an elliptic high-pass of 0.1 dB pass-band ripple
+and 30 dB stop-band attenuation after each integration to remove drift.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy import integrate
+from scipy import signal as ss
+
+
+def _as_signal(x: np.ndarray) -> np.ndarray:
+    x = np.asarray(x, dtype=float)
+    if x.ndim not in (1, 2):
+        raise ValueError(f"expected shape (n_channels, n_samples) or (n_samples,), got {x.shape}")
+    if x.shape[-1] < 2:
+        raise ValueError(f"need at least 2 samples, got {x.shape[-1]}")
+    return x
+
+
+def _check_cutoff(cutoff_hz: float, fs: float, what: str) -> None:
+    if not fs > 0:
+        raise ValueError(f"sample rate must be > 0 Hz, got {fs}")
+    nyq = fs / 2.0
+    if not 0.0 < cutoff_hz < nyq:
+        raise ValueError(f"{what} cut-off {cutoff_hz} Hz must lie strictly between 0 Hz and the "
+                         f"Nyquist frequency {nyq:g} Hz (fs = {fs:g} Hz)")
+
+
+def _filtfilt(sos: np.ndarray, x: np.ndarray) -> np.ndarray:
+    padlen = 3 * (2 * len(sos) + 1)
+    if x.shape[-1] <= padlen:
+        raise ValueError(f"signal of {x.shape[-1]} samples is too short for a zero-phase filter of "
+                         f"order {2 * len(sos)} (needs more than {padlen} samples)")
+    return ss.sosfiltfilt(sos, x, axis=-1)
+
+
+def trapezoid(x: np.ndarray, fs: float) -> np.ndarray:
+    """Cumulative trapezoid integral, starting at 0.
+
+    Parameters
+    ----------
+    x : ndarray, shape (n_channels, n_samples)
+        Signal in any unit ``[U]``.
+    fs : float
+        Sample rate [Hz].
+
+    Returns
+    -------
+    ndarray, shape (n_channels, n_samples)
+        ``y[..., k] = sum_{i<k} (x[i] + x[i+1]) / (2 fs)`` in ``[U s]``; ``y[..., 0] = 0``.
+
+    Notes
+    -----
+    The trapezoid rule's frequency response is ``(w T / 2) / tan(w T / 2)`` times that of
+    exact integration (no phase error): 0.66 % low at 576 Hz for fs = 12.8 kHz, 2.6 % low at
+    a tenth of the sample rate.  Each integration multiplies the bias.
+    """
+    x = _as_signal(x)
+    return integrate.cumulative_trapezoid(x, dx=1.0 / fs, axis=-1, initial=0.0)
+
+
+def elliptic_highpass(x: np.ndarray, fs: float, cutoff_hz: float, order: int = 4,
+                      ripple_db: float = 0.1, stop_db: float = 30.0) -> np.ndarray:
+    """Zero-phase elliptic high-pass filter.
+
+    Parameters
+    ----------
+    x : ndarray, shape (n_channels, n_samples)
+        Signal in any unit.
+    fs : float
+        Sample rate [Hz].
+    cutoff_hz : float
+        Pass-band edge [Hz] (where the single-pass gain leaves the ripple band), in (0, fs/2).
+    order : int
+        Order of the elliptic design (the zero-phase response has twice this order).
+    ripple_db : float
+        Peak-to-peak pass-band ripple of one pass [dB] (0.2 dB after forward-backward).
+    stop_db : float
+        Minimum stop-band attenuation of one pass [dB] (twice that after forward-backward).
+
+    Returns
+    -------
+    ndarray, shape (n_channels, n_samples)
+        The filtered signal, same unit.
+
+    Notes
+    -----
+    The mean of each channel is subtracted first.  An even-order elliptic high-pass does not
+    have a zero at DC: its DC gain is the stop-band level (-30 dB per pass), so without the
+    mean removal an offset would pass at -60 dB and integrate into drift.  Mean removal is an
+    affine step that commutes with differentiation, so it does not disturb the consistency
+    of acceleration, velocity and displacement.
+    """
+    x = _as_signal(x)
+    _check_cutoff(cutoff_hz, fs, "high-pass")
+    if int(order) < 1:
+        raise ValueError(f"filter order must be >= 1, got {order}")
+    if not (0 < ripple_db < stop_db):
+        raise ValueError(f"need 0 < ripple_db < stop_db, got ripple_db={ripple_db}, stop_db={stop_db}")
+    sos = ss.ellip(int(order), ripple_db, stop_db, cutoff_hz, btype="highpass", output="sos", fs=fs)
+    return _filtfilt(sos, x - x.mean(axis=-1, keepdims=True))
+
+
+def lowpass(x: np.ndarray, fs: float, cutoff_hz: float, order: int = 8) -> np.ndarray:
+    """Zero-phase Butterworth low-pass filter.
+
+    Parameters
+    ----------
+    x : ndarray, shape (n_channels, n_samples)
+        Signal in any unit.
+    fs : float
+        Sample rate [Hz].
+    cutoff_hz : float
+        -3 dB frequency of one pass [Hz] (-6 dB after forward-backward), in (0, fs/2).
+    order : int
+        Butterworth order of one pass.
+
+    Returns
+    -------
+    ndarray, shape (n_channels, n_samples)
+
+    Notes
+    -----
+    Butterworth rather than elliptic: its pass band is maximally flat, so modes well below
+    the cut-off keep their relative amplitudes exactly (an elliptic pass-band ripple would
+    weight modes differently), and a low-pass here only suppresses broadband noise above the
+    modes of interest, where a sharp transition is not needed.
+    """
+    x = _as_signal(x)
+    _check_cutoff(cutoff_hz, fs, "low-pass")
+    if int(order) < 1:
+        raise ValueError(f"filter order must be >= 1, got {order}")
+    sos = ss.butter(int(order), cutoff_hz, btype="lowpass", output="sos", fs=fs)
+    return _filtfilt(sos, x)
+
+
+def integrate_acceleration(acc: np.ndarray, fs: float, highpass_hz: float, order: int = 4,
+                           ripple_db: float = 0.1, stop_db: float = 30.0
+                           ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Velocity and displacement from acceleration, all three filtered alike.
+
+    Parameters
+    ----------
+    acc : ndarray, shape (n_channels, n_samples)
+        Measured acceleration [m/s^2].
+    fs : float
+        Sample rate [Hz].
+    highpass_hz, order, ripple_db, stop_db
+        The elliptic high-pass (see :func:`elliptic_highpass`): cut-off [Hz], order,
+        pass-band ripple [dB], stop-band attenuation [dB].
+
+    Returns
+    -------
+    acc_f : ndarray, shape (n_channels, n_samples)
+        Acceleration [m/s^2] passed through the high-pass twice.
+    vel : ndarray, shape (n_channels, n_samples)
+        Velocity [m/s]: high-pass of the trapezoid integral of ``acc``, then high-passed again.
+    disp : ndarray, shape (n_channels, n_samples)
+        Displacement [m]: high-pass of the trapezoid integral of the first velocity.
+
+    Notes
+    -----
+    The paper high-passes after each integration: ``v1 = H I a`` and ``d = H I H I a = H^2 I^2 a``
+    (``I`` integration, ``H`` the zero-phase high-pass).  Used as is, the three signals would
+    carry different filters (``a``: none, ``v1``: ``H``, ``d``: ``H^2``), and near the cut-off the
+    gain mismatch biases a regression of acceleration on velocity and displacement.  Because
+    ``H`` is linear and time-invariant it commutes with integration and differentiation in the
+    steady state, so we give every signal the same total filter ``H^2``: ``acc_f = H^2 a``,
+    ``vel = H v1 = H^2 I a``, ``disp = H^2 I^2 a``.  Then ``d/dt disp = vel`` and
+    ``d/dt vel = acc_f`` hold (up to the trapezoid bias and the end transients of the filter),
+    and the equation of motion ``M a + C v + K d = f`` holds for the filtered signals when the
+    force is filtered with ``H^2`` too.  The price is a 0.4 dB pass-band ripple shared by all
+    three signals (harmless to the regression) and a slightly wider transition band.
+    """
+    acc = _as_signal(acc)
+
+    def hp(z: np.ndarray) -> np.ndarray:
+        return elliptic_highpass(z, fs, highpass_hz, order, ripple_db, stop_db)
+
+    v1 = hp(trapezoid(acc, fs))
+    disp = hp(trapezoid(v1, fs))
+    return hp(hp(acc)), hp(v1), disp
+
+
+def differentiate(x: np.ndarray, fs: float, window: int, polyorder: int
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Savitzky-Golay smoothing and first and second derivatives.
+
+    Parameters
+    ----------
+    x : ndarray, shape (n_channels, n_samples)
+        Noisy coordinate, e.g. joint angles [rad].
+    fs : float
+        Sample rate [Hz].
+    window : int
+        Window length [samples]; odd, greater than ``polyorder`` and at most ``n_samples``.
+    polyorder : int
+        Polynomial order of the local fit; at least 2 so that the second derivative exists.
+
+    Returns
+    -------
+    xs : ndarray, shape (n_channels, n_samples)
+        Smoothed ``x`` [unit of x].
+    xd : ndarray, shape (n_channels, n_samples)
+        First derivative [unit of x / s].
+    xdd : ndarray, shape (n_channels, n_samples)
+        Second derivative [unit of x / s^2].
+
+    Notes
+    -----
+    The same local polynomial gives all three, so they are mutually consistent.  The ends use
+    ``mode="interp"`` (a polynomial fitted to the first/last window), which has no padding
+    artefacts but is noisier over the last ``window // 2`` samples.
+    """
+    x = _as_signal(x)
+    window, polyorder = int(window), int(polyorder)
+    if window % 2 == 0 or window < 3:
+        raise ValueError(f"Savitzky-Golay window must be odd and >= 3 samples, got {window}")
+    if not 2 <= polyorder < window:
+        raise ValueError(f"Savitzky-Golay polyorder must satisfy 2 <= polyorder < window ({window}), "
+                         f"got {polyorder}")
+    if window > x.shape[-1]:
+        raise ValueError(f"Savitzky-Golay window {window} exceeds the signal length {x.shape[-1]}")
+    dt = 1.0 / fs
+    out = [ss.savgol_filter(x, window, polyorder, deriv=d, delta=dt, axis=-1, mode="interp")
+           for d in (0, 1, 2)]
+    return out[0], out[1], out[2]

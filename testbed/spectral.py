@@ -1,0 +1,147 @@
+"""Spectra of measured signals, and natural frequencies read from their peaks.
+
+This is how an identifier obtains "measured natural frequencies": from the data, the way a
+lab reads them off an FFT, never from the truth.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy import fft as sfft
+from scipy import signal as ss
+
+# Half-width of each window's main lobe in bins of the unpadded transform: peaks closer than
+# this are one lobe, not two modes.
+_MAIN_LOBE_BINS = {"boxcar": 1.0, "rectangular": 1.0, "hann": 2.0, "hamming": 2.0,
+                   "blackman": 3.0, "flattop": 5.0}
+
+
+def fft_resolution(n: int, fs: float) -> float:
+    """Frequency spacing of an ``n``-point DFT [Hz].
+
+    Parameters
+    ----------
+    n : int
+        Number of samples (record length ``n / fs`` [s]).
+    fs : float
+        Sample rate [Hz].
+
+    Returns
+    -------
+    float
+        ``fs / n`` [Hz], the inverse of the record length.
+    """
+    if n < 1 or not fs > 0:
+        raise ValueError(f"need n >= 1 and fs > 0, got n={n}, fs={fs}")
+    return fs / n
+
+
+def amplitude_spectrum(x: np.ndarray, fs: float) -> tuple[np.ndarray, np.ndarray]:
+    """Single-sided amplitude spectrum (rectangular window).
+
+    Parameters
+    ----------
+    x : ndarray, shape (n_channels, n_samples)
+        Signal in any unit ``[U]``; a 1-D array is one channel.
+    fs : float
+        Sample rate [Hz].
+
+    Returns
+    -------
+    freqs : ndarray, shape (n_samples // 2 + 1,)
+        Frequencies [Hz].
+    amp : ndarray, shape (n_channels, n_samples // 2 + 1)
+        Amplitude [U]: a sine of amplitude A on a bin frequency gives A at that bin; the DC
+        (and, for even n, the Nyquist) line is the mean (the alternating component) itself.
+    """
+    x = np.atleast_2d(np.asarray(x, dtype=float))
+    n = x.shape[-1]
+    amp = np.abs(sfft.rfft(x, axis=-1)) / n
+    amp[:, 1:(n + 1) // 2] *= 2.0
+    return sfft.rfftfreq(n, 1.0 / fs), amp
+
+
+def peak_frequencies(x: np.ndarray, fs: float, n_peaks: int, fmin: float = 0.0,
+                     fmax: float | None = None, window: str = "hann", pad: int = 4,
+                     min_prominence_db: float = 6.0) -> np.ndarray:
+    """Natural frequencies from the peaks of the summed power spectrum of measured signals.
+
+    Parameters
+    ----------
+    x : ndarray, shape (n_channels, n_samples)
+        Measured responses (e.g. free-decay accelerations); a 1-D array is one channel.
+    fs : float
+        Sample rate [Hz].
+    n_peaks : int
+        Number of frequencies wanted.
+    fmin, fmax : float
+        Search band [Hz]; ``fmax=None`` means the Nyquist frequency.
+    window : str
+        ``scipy.signal.get_window`` name.  ``"hann"`` for steady responses; ``"boxcar"`` for a
+        transient that has decayed within the record (no leakage, finest resolution).
+    pad : int
+        Zero-padding factor: the transform length is at least ``pad * n_samples``; it
+        interpolates the spectrum (resolution stays ``fs / n_samples``).
+    min_prominence_db : float
+        A candidate must rise at least this much [dB] above its surroundings
+        (``scipy.signal.find_peaks`` prominence on the dB spectrum), so noise ripples do
+        not count.
+
+    Returns
+    -------
+    ndarray, shape (n_peaks,)
+        Frequencies [Hz], ascending.  Each is the highest power among candidates, refined by a
+        parabola through the peak bin and its neighbours on the dB spectrum.
+
+    Raises
+    ------
+    ValueError
+        If fewer than ``n_peaks`` peaks are found in the band, or the band is empty.
+
+    Notes
+    -----
+    The channel power spectra are summed, so a mode with a node at one sensor still shows at
+    the others.  Candidates closer than a main-lobe half-width (in unpadded bins) are merged,
+    keeping the higher, so window side lobes next to a strong peak are not taken for modes.
+    Among the remaining candidates the ``n_peaks`` highest are chosen (not the most prominent:
+    the side lobes of a rectangular window sit between deep nulls and can be very prominent).
+    """
+    x = np.atleast_2d(np.asarray(x, dtype=float))
+    n = x.shape[-1]
+    n_peaks = int(n_peaks)
+    if n_peaks < 1:
+        raise ValueError(f"n_peaks must be >= 1, got {n_peaks}")
+    if int(pad) < 1:
+        raise ValueError(f"pad must be >= 1, got {pad}")
+    nyq = fs / 2.0
+    fmax = nyq if fmax is None else float(fmax)
+    if not 0.0 <= fmin < fmax <= nyq:
+        raise ValueError(f"need 0 <= fmin < fmax <= Nyquist ({nyq:g} Hz), got fmin={fmin}, fmax={fmax}")
+    w = ss.get_window(window, n, fftbins=True)
+    nfft = sfft.next_fast_len(int(pad) * n, real=True)
+    power = (np.abs(sfft.rfft((x - x.mean(axis=-1, keepdims=True)) * w, n=nfft, axis=-1)) ** 2).sum(0)
+    freqs = sfft.rfftfreq(nfft, 1.0 / fs)
+    floor = power.max() * 1e-30 if power.max() > 0 else 1e-300
+    db = 10.0 * np.log10(power + floor)
+    band = np.flatnonzero((freqs >= fmin) & (freqs <= fmax))
+    if band.size < 3:
+        raise ValueError(f"band [{fmin}, {fmax}] Hz holds fewer than 3 spectral lines")
+    lo, hi = band[0], band[-1] + 1
+    lobe = _MAIN_LOBE_BINS.get(window, 2.0) * nfft / n
+    idx, _ = ss.find_peaks(db[lo:hi], prominence=min_prominence_db, distance=max(1.0, lobe))
+    idx = idx + lo
+    if idx.size < n_peaks:
+        raise ValueError(f"found {idx.size} spectral peak(s) with prominence >= {min_prominence_db} dB "
+                         f"in [{fmin:g}, {fmax:g}] Hz, asked for {n_peaks}")
+    chosen = idx[np.argsort(power[idx])[::-1][:n_peaks]]
+    df = freqs[1] - freqs[0]
+    out = np.empty(n_peaks)
+    for i, k in enumerate(chosen):
+        if 0 < k < len(db) - 1:
+            a, b, c = db[k - 1], db[k], db[k + 1]
+            den = a - 2.0 * b + c
+            p = 0.5 * (a - c) / den if den != 0 else 0.0
+            out[i] = freqs[k] + float(np.clip(p, -0.5, 0.5)) * df
+        else:
+            out[i] = freqs[k]
+    return np.sort(out)

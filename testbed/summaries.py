@@ -1,0 +1,62 @@
+"""Console summaries: the truth of a dataset and the score table of a run."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+from rich.console import Console
+from rich.table import Table
+
+if TYPE_CHECKING:
+    from testbed.dataset import Dataset
+    from testbed.run import RunResult
+
+
+def truth_rows(ds: Dataset) -> list[tuple[str, str]]:
+    """(label, value) pairs summarising a dataset's truth."""
+    rows = [("rig", str(ds.attrs.get("rig", "?"))), ("samples", f"{ds.n_samples} at {ds.fs:g} Hz")]
+    tr = ds.truth
+    if "frequencies_hz" in tr:
+        f = np.asarray(tr["frequencies_hz"])
+        eb = np.asarray(tr.get("eb_frequencies_hz", []))
+        for i in range(min(4, len(f))):
+            cell = f"{f[i]:9.2f} Hz"
+            if i < len(eb):
+                cell += f"   Euler-Bernoulli {eb[i]:9.2f} Hz   ({100 * (f[i] / eb[i] - 1):+.3f} %)"
+            rows.append((f"mode {i + 1}", cell))
+        if "damping_ratios" in tr:
+            z = np.asarray(tr["damping_ratios"])[:3]
+            rows.append(("damping ratios", ", ".join(f"{x:.4f}" for x in z)))
+    if "equation_terms" in tr:
+        rows.append(("true equation terms", str(len(tr["equation_terms"]))))
+    for k, v in ds.prior.items():
+        rows.append((f"prior {k}", f"{v}"))
+    return rows
+
+
+def print_truth_summary(ds: Dataset, console: Console | None = None) -> None:
+    t = Table(title="truth", show_header=False)
+    t.add_column("")
+    t.add_column("")
+    for a, b in truth_rows(ds):
+        t.add_row(a, b)
+    (console or Console()).print(t)
+
+
+def print_score_table(result: RunResult, console: Console | None = None) -> None:
+    """Metric, value, threshold, pass — then every other score reported."""
+    t = Table(title=f"{result.scenario.name}: {result.scenario.identify['method']} "
+                    f"(fit {result.fit_time:.2f} s)")
+    for c in ("metric", "value", "threshold", "pass"):
+        t.add_column(c)
+    checked = set()
+    for c in result.checks:
+        checked.add(c.metric)
+        op = ">=" if c.bound == "min" else "<="
+        t.add_row(c.metric, f"{c.value:.5g}", f"{op} {c.threshold:g}",
+                  "[green]pass[/]" if c.passed else "[red]FAIL[/]")
+    for k, v in sorted(result.scores.values.items()):
+        if k not in checked:
+            t.add_row(k, f"{v:.5g}", "-", "reported")
+    (console or Console()).print(t)

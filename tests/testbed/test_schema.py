@@ -1,0 +1,59 @@
+"""Schema validation: each bad value gives one message naming file, key, value and what is allowed."""
+
+import pytest
+
+from testbed.errors import ScenarioError
+from testbed.schema import Field, validate_table, validate_variant
+
+SCHEMA = {
+    "length": Field(float, 1.0, unit="m", min=0.0, min_inclusive=False),
+    "n": Field(int, 3, min=2),
+    "base": Field(str, "stiff", choices=("stiff", "soft")),
+    "where": Field(list, [], item_type=float, min=0.0),
+}
+
+
+def test_defaults_filled_and_ints_widened():
+    out = validate_table({"length": 2, "n": 4}, SCHEMA, file="f.toml", section="rig")
+    assert out == {"length": 2.0, "n": 4, "base": "stiff", "where": []}
+    assert isinstance(out["length"], float)
+
+
+@pytest.mark.parametrize(("table", "key", "fragment"), [
+    ({"lenght": 1.0}, "rig.lenght", "unknown key; allowed keys in [rig]: base, length, n, where"),
+    ({"length": -1.0}, "rig.length", "> 0 [m]"),
+    ({"length": 0.0}, "rig.length", "> 0 [m]"),
+    ({"length": "long"}, "rig.length", "expected a number"),
+    ({"n": True}, "rig.n", "expected an integer"),
+    ({"n": 1}, "rig.n", ">= 2"),
+    ({"n": 2.5}, "rig.n", "expected an integer"),
+    ({"base": "wobbly"}, "rig.base", "one of 'stiff', 'soft'"),
+    ({"where": [0.1, -2.0]}, "rig.where[1]", ">= 0"),
+    ({"length": float("nan")}, "rig.length", "> 0"),
+])
+def test_bad_values_name_file_key_value_and_allowed(table, key, fragment):
+    with pytest.raises(ScenarioError) as e:
+        validate_table(table, SCHEMA, file="f.toml", section="rig")
+    msg = str(e.value)
+    assert msg.startswith("f.toml: ")
+    assert f"key '{key}'" in msg
+    assert fragment in msg
+    bad = table[key.split(".")[1].split("[")[0]] if "[" not in key else -2.0
+    if key != "rig.lenght":
+        assert repr(bad) in msg or "nan" in msg
+
+
+def test_required_key_missing():
+    schema = {"n": Field(int)}
+    with pytest.raises(ScenarioError, match=r"key 'rig.n': missing; expected an integer"):
+        validate_table({}, schema, file="f.toml", section="rig")
+
+
+def test_variant_selects_schema_by_type():
+    variants = {"impact": {"peak": Field(float, 1.0, unit="N")}, "sine": {"freq": Field(float, 1.0)}}
+    assert validate_variant({"type": "sine", "freq": 3}, variants, file="f", section="excitation") == \
+        {"type": "sine", "freq": 3.0}
+    with pytest.raises(ScenarioError, match="key 'excitation.type': value 'hammer': expected one of"):
+        validate_variant({"type": "hammer"}, variants, file="f", section="excitation")
+    with pytest.raises(ScenarioError, match="unknown key"):
+        validate_variant({"type": "sine", "peak": 1.0}, variants, file="f", section="excitation")
