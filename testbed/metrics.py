@@ -291,7 +291,7 @@ def modal_from_matrices(m: np.ndarray, c: np.ndarray | None, k: np.ndarray, *, s
     Modes come from the generalised symmetric eigenproblem ``K phi = w^2 M phi``.  With
     damping, the 2n eigenvalues ``lambda`` of the first-order system
     ``[[0, I], [-M^-1 K, -M^-1 C]]`` are assigned two per real mode by maximum MAC of their
-    displacement parts (one column per slot, :func:`pair_modes` style), and each pair gives
+    displacement parts (mass-weighted MAC, two slots per mode), and each pair gives
     ``w_n^2 = lambda_1 lambda_2`` and ``2 zeta w_n = -(lambda_1 + lambda_2)``: for an
     underdamped mode ``lambda_2 = conj(lambda_1)``, so ``w_n = |lambda|`` and
     ``zeta = -Re(lambda) / |lambda|``; an overdamped mode's two real eigenvalues give
@@ -337,7 +337,9 @@ def modal_from_matrices(m: np.ndarray, c: np.ndarray | None, k: np.ndarray, *, s
         ev, vec = linalg.eig(a)
         shapes = vec[:n]
         # Two slots per real mode; assign the 2n eigenvalues to slots by maximum MAC.
-        mac = np.nan_to_num(np.abs(np.conj(np.repeat(modes, 2, axis=1)).T @ m @ shapes) ** 2)
+        proj = np.abs(np.conj(np.repeat(modes, 2, axis=1)).T @ m @ shapes) ** 2
+        with np.errstate(invalid="ignore", divide="ignore"):
+            mac = np.nan_to_num(proj / proj.sum(axis=0, keepdims=True) * 2.0)  # mass-weighted MAC
         slot, which = optimize.linear_sum_assignment(mac, maximize=True)
         lam_pair = np.empty((n, 2), dtype=complex)
         lam_pair[slot // 2, slot % 2] = ev[which]

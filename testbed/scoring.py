@@ -120,16 +120,21 @@ def score_structural(dataset: Dataset, data: Measurement, clean: Measurement, mo
     d: dict[str, Any] = {"trac": trac, "t": t, "simulated_xdd": sim.xdd, "reference_xdd": ref,
                          "channels": data.channels}
 
-    f_id, z_id, phi_id = metrics.modal_from_matrices(model.M_, model.C_, model.K_)
+    # strict=False: an identified M that is not positive definite scores NaN (a fail), not a crash.
+    f_id, z_id, phi_id = metrics.modal_from_matrices(model.M_, model.C_, model.K_, strict=False)
     m = min(SCORED_MODES, len(truth["frequencies_hz"]), len(f_id))
     f_true = np.asarray(truth["frequencies_hz"])[: data.n_channels]
     z_true = np.asarray(truth["damping_ratios"])[: data.n_channels]
     phi_true = np.asarray(truth["sensor_modes"])[:, : data.n_channels]
     mac = metrics.mac_matrix(phi_id, phi_true)
     pair = metrics.pair_modes(mac.T)  # pair[j] = identified mode matched to true mode j
-    v["mac"] = float(min(mac[pair[j], j] for j in range(m)))
-    v["freq_error"] = float(max(metrics.frequency_error(f_id[pair[j]], f_true[j]) for j in range(m)))
-    v["damping_error"] = float(max(metrics.damping_error(z_id[pair[j]], z_true[j]) for j in range(m)))
+    paired = [j for j in range(m) if pair[j] >= 0]
+    if len(paired) < m or not np.all(np.isfinite(mac)):  # a true mode without partner fails
+        v["mac"] = v["freq_error"] = v["damping_error"] = float("nan")
+    else:
+        v["mac"] = float(min(mac[pair[j], j] for j in paired))
+        v["freq_error"] = float(max(metrics.frequency_error(f_id[pair[j]], f_true[j]) for j in paired))
+        v["damping_error"] = float(max(metrics.damping_error(z_id[pair[j]], z_true[j]) for j in paired))
     d.update(mac=mac, pair=pair, f_id=f_id, f_true=f_true, z_id=z_id, z_true=z_true)
 
     Mr, Kr, Cr = (np.asarray(truth[k]) for k in ("Mr", "Kr", "Cr"))

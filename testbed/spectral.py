@@ -62,8 +62,8 @@ def amplitude_spectrum(x: np.ndarray, fs: float) -> tuple[np.ndarray, np.ndarray
 
 
 def peak_frequencies(x: np.ndarray, fs: float, n_peaks: int, fmin: float = 0.0,
-                     fmax: float | None = None, window: str = "hann", pad: int = 4,
-                     min_prominence_db: float = 6.0) -> np.ndarray:
+                     fmax: float | None = None, window: str = "boxcar", pad: int = 4,
+                     min_prominence_db: float = 6.0, dynamic_range_db: float = 40.0) -> np.ndarray:
     """Natural frequencies from the peaks of the summed power spectrum of measured signals.
 
     Parameters
@@ -77,8 +77,10 @@ def peak_frequencies(x: np.ndarray, fs: float, n_peaks: int, fmin: float = 0.0,
     fmin, fmax : float
         Search band [Hz]; ``fmax=None`` means the Nyquist frequency.
     window : str
-        ``scipy.signal.get_window`` name.  ``"hann"`` for steady responses; ``"boxcar"`` for a
-        transient that has decayed within the record (no leakage, finest resolution).
+        ``scipy.signal.get_window`` name.  The default ``"boxcar"`` suits the free decay after
+        an impact: the transient dies within the record (no leakage) and is largest at its
+        start, which a Hann window would suppress (a fast-decaying high mode then vanishes).
+        Use ``"hann"`` for steady (e.g. sine or random) responses.
     pad : int
         Zero-padding factor: the transform length is at least ``pad * n_samples``; it
         interpolates the spectrum (resolution stays ``fs / n_samples``).
@@ -86,6 +88,8 @@ def peak_frequencies(x: np.ndarray, fs: float, n_peaks: int, fmin: float = 0.0,
         A candidate must rise at least this much [dB] above its surroundings
         (``scipy.signal.find_peaks`` prominence on the dB spectrum), so noise ripples do
         not count.
+    dynamic_range_db : float
+        Candidates more than this [dB] below the highest one are dropped.
 
     Returns
     -------
@@ -101,10 +105,15 @@ def peak_frequencies(x: np.ndarray, fs: float, n_peaks: int, fmin: float = 0.0,
     Notes
     -----
     The channel power spectra are summed, so a mode with a node at one sensor still shows at
-    the others.  Candidates closer than a main-lobe half-width (in unpadded bins) are merged,
-    keeping the higher, so window side lobes next to a strong peak are not taken for modes.
-    Among the remaining candidates the ``n_peaks`` highest are chosen (not the most prominent:
-    the side lobes of a rectangular window sit between deep nulls and can be very prominent).
+    the others.  Candidates closer than the window's main-lobe half-width plus two bins (of the
+    unpadded transform) are merged, keeping the higher: the first two side lobes of a steady
+    sine are not taken for modes, and with ``dynamic_range_db = 40`` the further Hann side
+    lobes (below -46 dB) are dropped too.  Two modes closer than that (4 bins, ``4 fs / n`` Hz,
+    for Hann) are not resolved.  Among the remaining candidates the ``n_peaks`` highest are
+    chosen, not the most prominent: side lobes sit between deep nulls and can be very
+    prominent.  A rectangular window's side lobes (-13 dB, 6 dB per octave) survive these
+    rules, so use it only for transients that decay within the record.  Asking for more peaks
+    than the signal has modes returns noise peaks or side lobes, or raises.
     """
     x = np.atleast_2d(np.asarray(x, dtype=float))
     n = x.shape[-1]
@@ -127,12 +136,15 @@ def peak_frequencies(x: np.ndarray, fs: float, n_peaks: int, fmin: float = 0.0,
     if band.size < 3:
         raise ValueError(f"band [{fmin}, {fmax}] Hz holds fewer than 3 spectral lines")
     lo, hi = band[0], band[-1] + 1
-    lobe = _MAIN_LOBE_BINS.get(window, 2.0) * nfft / n
+    lobe = (_MAIN_LOBE_BINS.get(window, 2.0) + 2.0) * nfft / n
     idx, _ = ss.find_peaks(db[lo:hi], prominence=min_prominence_db, distance=max(1.0, lobe))
     idx = idx + lo
+    if idx.size:
+        idx = idx[db[idx] >= db[idx].max() - dynamic_range_db]
     if idx.size < n_peaks:
         raise ValueError(f"found {idx.size} spectral peak(s) with prominence >= {min_prominence_db} dB "
-                         f"in [{fmin:g}, {fmax:g}] Hz, asked for {n_peaks}")
+                         f"within {dynamic_range_db} dB of the highest in [{fmin:g}, {fmax:g}] Hz, "
+                         f"asked for {n_peaks}")
     chosen = idx[np.argsort(power[idx])[::-1][:n_peaks]]
     df = freqs[1] - freqs[0]
     out = np.empty(n_peaks)

@@ -1,5 +1,7 @@
 """Scenario loading: every malformed field gives one clear message; extends; CLI exit code."""
 
+import re
+
 import pytest
 
 from testbed.cli import main
@@ -50,7 +52,10 @@ def test_good_file_loads_with_defaults(tmp_path):
 def test_each_malformed_field_gives_its_clear_error(tmp_path, extra, key, fragment):
     text = GOOD
     section = extra.split("]")[0] + "]"
-    if section in text:  # merge into the existing table
+    if section in text:  # merge into the existing table, replacing a key it sets again
+        for line in extra.splitlines()[1:]:
+            key_set = line.split("=")[0].strip()
+            text = re.sub(rf"^{key_set} = .*\n", "", text, flags=re.M)
         text = text.replace(section + "\n", extra)
     else:
         text = text + extra

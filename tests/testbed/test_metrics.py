@@ -1,0 +1,194 @@
+"""Metrics on cases computed by hand, plus a few properties."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from hypothesis.extra.numpy import arrays
+
+from testbed import metrics as mt
+
+finite = st.floats(-1e3, 1e3, allow_nan=False, allow_infinity=False)
+
+
+# ------------------------------------------------------------------ TRAC
+def test_trac_hand_cases():
+    t = np.linspace(0, 1, 1000, endpoint=False)
+    s, c = np.sin(2 * np.pi * 3 * t), np.cos(2 * np.pi * 3 * t)
+    x = np.stack([s, s, s, s])
+    y = np.stack([2 * s, -0.5 * s, c, s + c])
+    # x vs 2x: 1; vs -x/2: 1 (squared); orthogonal sines over whole periods: 0;
+    # s vs s + c: (s.s)^2 / (s.s * 2 s.s) = 1/2
+    np.testing.assert_allclose(mt.trac(x, y), [1.0, 1.0, 0.0, 0.5], atol=1e-12)
+    assert mt.trac(s, 2 * s).shape == (1,)
+
+
+def test_trac_complex_and_zero():
+    x = np.array([1 + 1j, 2 - 1j, 0.5j])
+    np.testing.assert_allclose(mt.trac(x, (3 - 2j) * x), [1.0], atol=1e-12)  # complex scale
+    np.testing.assert_allclose(mt.trac(np.array([1.0, 0]), np.array([0, 1j])), [0.0])
+    assert np.isnan(mt.trac(np.zeros(5), np.ones(5))[0])
+    with pytest.raises(ValueError):
+        mt.trac(np.ones((2, 5)), np.ones((2, 6)))
+
+
+@settings(max_examples=60, deadline=None)
+@given(arrays(float, (3, 20), elements=finite), arrays(float, (3, 20), elements=finite),
+       st.floats(0.01, 100.0), st.floats(0.01, 100.0))
+def test_trac_bounded_and_scale_invariant(x, y, a, b):
+    r = mt.trac(x, y)
+    ok = ~np.isnan(r)
+    assert np.all((r[ok] >= 0) & (r[ok] <= 1))
+    # scale invariance up to rounding, where both channels are clearly nonzero
+    big = (np.abs(x).max(axis=1) > 1e-3) & (np.abs(y).max(axis=1) > 1e-3)
+    np.testing.assert_allclose(mt.trac(a * x, -b * y)[big], r[big], atol=1e-9)
+
+
+# ------------------------------------------------------------------ MAC and pairing
+def test_mac_hand_cases():
+    phi = np.array([[1.0, 1.0], [1.0, -1.0]])
+    np.testing.assert_allclose(mt.mac_matrix(phi, phi), np.eye(2), atol=1e-15)  # orthogonal shapes
+    np.testing.assert_allclose(mt.mac_matrix(phi, -3 * phi), np.eye(2), atol=1e-15)
+    # [1, 0] vs [1, 1]: 1 / (1 * 2)
+    np.testing.assert_allclose(mt.mac_matrix(np.array([1.0, 0.0]), phi), [[0.5, 0.5]])
+    assert mt.mac_matrix(np.ones((4, 3)), np.ones((4, 2))).shape == (3, 2)
+    z = np.array([1.0, 1j])
+    np.testing.assert_allclose(mt.mac_matrix(z, (2 + 1j) * z), [[1.0]], atol=1e-15)
+
+
+@settings(max_examples=60, deadline=None)
+@given(arrays(float, (4, 3), elements=finite), arrays(float, (4, 2), elements=finite))
+def test_mac_symmetric_and_bounded(a, b):
+    m = mt.mac_matrix(a, b)
+    np.testing.assert_array_equal(np.isnan(m), np.isnan(mt.mac_matrix(b, a).T))
+    np.testing.assert_allclose(m, mt.mac_matrix(b, a).T, atol=1e-12)
+    ok = ~np.isnan(m)
+    assert np.all((m[ok] >= 0) & (m[ok] <= 1))
+
+
+def test_pair_modes_beats_greedy():
+    mac = np.array([[0.9, 0.8], [0.85, 0.1]])
+    # row-wise argmax gives [0, 0] (reuse); the best assignment is 0.8 + 0.85 = 1.65 > 0.9 + 0.1
+    np.testing.assert_array_equal(mt.pair_modes(mac), [1, 0])
+    np.testing.assert_array_equal(mt.pair_modes(np.array([[0.1, 0.9, 0.0], [0.95, 0.2, 0.3]])), [1, 0])
+    np.testing.assert_array_equal(mt.pair_modes(np.array([[0.9], [0.2], [0.95]])), [-1, -1, 0])
+    np.testing.assert_array_equal(mt.pair_modes(np.array([[np.nan, 0.5], [0.7, np.nan]])), [1, 0])
+
+
+# ------------------------------------------------------------------ relative errors
+def test_frequency_and_damping_errors():
+    np.testing.assert_allclose(mt.frequency_error([89.7, 591.2], [89.6, 576.3]),
+                               [0.1 / 89.6, 14.9 / 576.3])  # the paper's Table 2: 0.1 %, 2.6 %
+    np.testing.assert_allclose(mt.damping_error([0.011, 0.018], [0.01, 0.02]), [0.1, 0.1])
+    assert np.isinf(mt.frequency_error([1.0], [0.0]))[0]
+
+
+def test_relative_error():
+    a = np.array([[3.0, 0.0], [0.0, 4.0]])
+    assert mt.relative_error(a, a) == 0.0
+    assert mt.relative_error(a + np.array([[0.0, 0.5], [0.0, 0.0]]), a) == pytest.approx(0.5 / 5.0)
+    assert mt.relative_error(np.zeros(2), np.zeros(2)) == 0.0
+    assert mt.relative_error(np.ones(2), np.zeros(2)) == np.inf
+
+
+def test_rmse():
+    x = np.array([[0.0, 0.0, 0.0, 0.0], [1.0, 1.0, 1.0, 1.0]])
+    y = np.array([[1.0, -1.0, 1.0, -1.0], [1.0, 1.0, 1.0, 3.0]])
+    np.testing.assert_allclose(mt.rmse(x, y), [1.0, 1.0])  # sqrt(4/4), sqrt(4/4)
+    np.testing.assert_allclose(mt.rmse(x, y, axis=0), np.sqrt([0.5, 0.5, 0.5, 2.5]))
+
+
+# ------------------------------------------------------------------ sparse support
+def test_support_scores_counted_by_hand():
+    true = np.array([[1.0, 0.0, -2.0], [0.0, 0.0, 3.0]])
+    ident = np.array([[0.9, 0.1, 0.0], [0.0, 0.0, 2.5]])
+    # nonzero true: (0,0) (0,2) (1,2); identified: (0,0) (0,1) (1,2)
+    # tp = 2 [(0,0) (1,2)], fp = 1 [(0,1)], fn = 1 [(0,2)] -> p = r = 2/3, F1 = 2/3
+    s = mt.support_scores(ident, true)
+    assert (s["tp"], s["fp"], s["fn"]) == (2, 1, 1)
+    assert s["precision"] == pytest.approx(2 / 3) and s["recall"] == pytest.approx(2 / 3)
+    assert s["f1"] == pytest.approx(2 / 3)
+    # with tol = 0.2 the 0.1 entry counts as zero: tp 2, fp 0, fn 1 -> p 1, r 2/3, F1 0.8
+    s = mt.support_scores(ident, true, tol=0.2)
+    assert (s["precision"], s["recall"], s["f1"]) == pytest.approx((1.0, 2 / 3, 0.8))
+
+
+def test_support_scores_degenerate():
+    z, o = np.zeros(4), np.array([0.0, 1.0, 0.0, 0.0])
+    assert mt.support_scores(z, z) == {"precision": 1.0, "recall": 1.0, "f1": 1.0,
+                                       "tp": 0, "fp": 0, "fn": 0}
+    for ident, true in ((z, o), (o, z)):
+        s = mt.support_scores(ident, true)
+        assert (s["precision"], s["recall"], s["f1"]) == (0.0, 0.0, 0.0)
+
+
+def test_coefficient_error():
+    true = np.array([2.0, 0.0, -4.0])
+    assert mt.coefficient_error(np.array([2.2, 5.0, -4.0]), true) == pytest.approx(0.1)
+    assert mt.coefficient_error(np.array([2.0, 0.0, 0.0]), true) == 1.0  # dropped term
+    assert np.isnan(mt.coefficient_error(np.ones(3), np.zeros(3)))
+
+
+# ------------------------------------------------------------------ modal analysis
+M2 = np.eye(2) * 2.0
+K2 = np.array([[2.0, -1.0], [-1.0, 2.0]]) * 800.0  # chain of two 2 kg masses, springs 800 N/m
+
+
+def test_two_dof_undamped_by_hand():
+    # det(K - w^2 M) = 0 with M = 2 I, K = 800 [[2, -1], [-1, 2]]: w^2 = 400 (in phase), 1200
+    f, z, phi = mt.modal_from_matrices(M2, None, K2)
+    np.testing.assert_allclose(f, np.sqrt([400.0, 1200.0]) / (2 * np.pi), rtol=1e-12)
+    np.testing.assert_array_equal(z, [0.0, 0.0])
+    # mass-normalised: [1, 1] / sqrt(2 * 2) and [1, -1] / 2, largest entry positive
+    np.testing.assert_allclose(np.abs(phi), 0.5, rtol=1e-12)
+    np.testing.assert_allclose(phi[:, 0], [0.5, 0.5], rtol=1e-12)
+    np.testing.assert_allclose(phi.T @ M2 @ phi, np.eye(2), atol=1e-12)
+
+
+def test_two_dof_proportional_damping_by_hand():
+    alpha, beta = 2.0, 1e-3
+    f, z, _ = mt.modal_from_matrices(M2, alpha * M2 + beta * K2, K2)
+    w = np.sqrt([400.0, 1200.0])
+    # Rayleigh damping: zeta_i = alpha / (2 w_i) + beta w_i / 2, frequencies unchanged
+    np.testing.assert_allclose(f, w / (2 * np.pi), rtol=1e-10)
+    np.testing.assert_allclose(z, alpha / (2 * w) + beta * w / 2, rtol=1e-10)
+
+
+def test_overdamped_and_nonproportional():
+    # SDOF k = 100, m = 1, c = 2 * 2 * 10: zeta = 2, two real eigenvalues
+    f, z, _ = mt.modal_from_matrices(np.eye(1), np.array([[40.0]]), np.array([[100.0]]))
+    np.testing.assert_allclose(f, [10 / (2 * np.pi)], rtol=1e-10)
+    np.testing.assert_allclose(z, [2.0], rtol=1e-10)
+    # a damper on DOF 1 only: frequencies and damping from the complex eigenvalues directly
+    c = np.array([[4.0, 0.0], [0.0, 0.0]])
+    f, z, _ = mt.modal_from_matrices(M2, c, K2)
+    a = np.block([[np.zeros((2, 2)), np.eye(2)], [-K2 / 2.0, -c / 2.0]])
+    lam = np.linalg.eigvals(a)
+    lam = np.sort_complex(lam[lam.imag > 0])
+    lam = lam[np.argsort(np.abs(lam))]
+    np.testing.assert_allclose(f, np.abs(lam) / (2 * np.pi), rtol=1e-10)
+    np.testing.assert_allclose(z, -lam.real / np.abs(lam), rtol=1e-10)
+
+
+def test_bad_mass_matrix():
+    bad = np.array([[1.0, 0.0], [0.0, -1.0]])
+    with pytest.raises(ValueError, match="positive definite"):
+        mt.modal_from_matrices(bad, None, K2)
+    f, z, phi = mt.modal_from_matrices(bad, None, K2, strict=False)
+    assert np.all(np.isnan(f)) and np.all(np.isnan(z)) and np.all(np.isnan(phi))
+    with pytest.raises(ValueError, match="negative"):
+        mt.modal_from_matrices(M2, None, -K2)
+    f, _, _ = mt.modal_from_matrices(M2, None, np.diag([800.0, -800.0]), strict=False)
+    assert np.isnan(f[-1]) and np.isfinite(f[0])  # the unstable mode is NaN and sorted last
+
+
+def test_cross_orthogonality_identity_for_perfect_modes():
+    _, _, phi = mt.modal_from_matrices(M2, None, K2)
+    ident = phi * np.array([-7.0, 0.3])  # arbitrary scale and sign
+    np.testing.assert_allclose(mt.cross_orthogonality(ident, phi, M2), np.eye(2), atol=1e-12)
+    # a mode mixing both true modes equally: off-diagonals 1/sqrt(2) in magnitude
+    mixed = np.stack([phi[:, 0] + phi[:, 1], phi[:, 1]], axis=1)
+    xo = mt.cross_orthogonality(mixed, phi, M2)
+    np.testing.assert_allclose(np.abs(xo), [[2**-0.5, 2**-0.5], [0.0, 1.0]], atol=1e-12)

@@ -1,0 +1,234 @@
+"""The signal chain against signals whose integrals and derivatives are known exactly."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy import signal as ss
+
+from testbed import signal as sig
+
+FS = 12800.0  # the paper's sample rate [Hz]
+MODES = ((89.6, 0.01, 1e-4), (576.3, 0.01, 1e-5))  # (f [Hz], zeta, amplitude [m]): the paper's beam
+T0, TR = 0.1, 0.002  # onset time and rise time [s] of the smooth start
+
+
+def decay_from_rest(t: np.ndarray, n_channels: int = 2):
+    """Sum of decaying sines times a smooth onset g = (1 - exp(-tau/TR))^3, with exact derivatives.
+
+    g, g', g'' vanish at the onset, so the motion starts from rest like an impact response
+    and integrating the exact acceleration from t = 0 needs no integration constants.
+    """
+    tau = np.maximum(t - T0, 0.0)
+    on = t > T0
+    e = np.exp(-tau / TR)
+    q = 1.0 - e
+    g, g1, g2 = q**3 * on, 3 * q**2 * e / TR * on, (6 * q * e**2 - 3 * q**2 * e) / TR**2 * on
+    d, v, a = (np.zeros((n_channels, t.size)) for _ in range(3))
+    for ch in range(n_channels):
+        for k, (f, z, amp) in enumerate(MODES):
+            w = 2 * np.pi * f
+            s = -z * w + 1j * w * np.sqrt(1 - z * z)
+            ex = amp * (1 + ch) * (-1) ** (k * ch) * np.exp(s * tau)
+            s0, s1, s2 = ex.imag, (s * ex).imag, (s * s * ex).imag
+            d[ch] += g * s0
+            v[ch] += g1 * s0 + g * s1
+            a[ch] += g2 * s0 + 2 * g1 * s1 + g * s2
+    return d, v, a
+
+
+def trapezoid_bias(f: float, fs: float) -> float:
+    """Relative amplitude loss of one trapezoid integration at f: 1 - x / tan x, x = pi f / fs."""
+    x = np.pi * f / fs
+    return 1.0 - x / np.tan(x)
+
+
+def rel_err(got: np.ndarray, ref: np.ndarray) -> np.ndarray:
+    return np.abs(got - ref).max(axis=-1) / np.abs(ref).max(axis=-1)
+
+
+def test_trapezoid_exact_on_linear_and_starts_at_zero():
+    t = np.arange(1000) / FS
+    x = np.stack([np.full_like(t, 3.0), 2.0 * t])
+    y = sig.trapezoid(x, FS)
+    assert y.shape == x.shape and np.all(y[:, 0] == 0.0)
+    np.testing.assert_allclose(y[0], 3.0 * t, rtol=1e-12, atol=1e-15)  # trapezoid exact for linear
+    np.testing.assert_allclose(y[1], t**2, rtol=1e-2, atol=1e-12)  # quadratic: error dt^2 / 6 per unit
+    np.testing.assert_allclose(sig.trapezoid(x[1], FS), y[1])  # 1-D is one channel
+
+
+def test_trapezoid_of_cosine_within_known_bias():
+    t = np.arange(int(FS)) / FS
+    f = 576.3
+    y = sig.trapezoid(np.cos(2 * np.pi * f * t)[None], FS)[0]
+    exact = np.sin(2 * np.pi * f * t) / (2 * np.pi * f)
+    # the local error of the trapezoid rule is at most the per-integration bias of a sine
+    # (x^2 / 3, 0.67 % here) of the amplitude, plus rounding
+    assert np.abs(y - exact).max() <= 1.1 * trapezoid_bias(f, FS) / (2 * np.pi * f)
+
+
+def test_highpass_passes_band_removes_offset_and_slow_drift_zero_phase():
+    t = np.arange(int(4 * FS)) / FS
+    fast = np.sin(2 * np.pi * 200.0 * t)
+    x = np.stack([fast + 5.0 + 2.0 * np.sin(2 * np.pi * 1.0 * t), fast])
+    y = sig.elliptic_highpass(x, FS, 10.0, order=5)
+    # the end transients of a drifting record ring for ~10 cut-off periods (the elliptic
+    # poles near the cut-off have a high Q): judge the middle second only
+    mid = slice(int(1.5 * FS), int(2.5 * FS))
+    # 1 Hz lies deep in the stop band (>= 30 dB per pass, 60 dB forward-backward): the drift
+    # of amplitude 2 leaves at most 2e-3; the 200 Hz line is in the pass band (<= 0.2 dB zero-phase
+    # ripple, 2.3 %) and keeps its phase (zero-phase), so y ~ g * fast with g in [0.977, 1]
+    for ch in range(2):
+        g = np.dot(y[ch, mid], fast[mid]) / np.dot(fast[mid], fast[mid])
+        assert 0.977 <= g <= 1.0 + 1e-6
+        assert np.abs(y[ch, mid] - g * fast[mid]).max() < 3e-3
+
+
+def test_even_order_highpass_still_removes_dc():
+    # an even-order elliptic high-pass passes DC at the stop-band level; the mean removal fixes it
+    s = np.sin(2 * np.pi * 500.0 * np.arange(4000) / FS)[None]
+    with_offset = sig.elliptic_highpass(s + 7.0, FS, 10.0, order=4)
+    # without the mean removal the offset would leak at the -60 dB DC gain: 7e-3
+    np.testing.assert_allclose(with_offset, sig.elliptic_highpass(s, FS, 10.0, order=4), atol=1e-9)
+
+
+@pytest.mark.parametrize("cutoff", [0.0, -1.0, FS / 2, FS])
+def test_filters_reject_bad_cutoff(cutoff):
+    x = np.zeros((1, 1000))
+    with pytest.raises(ValueError, match="Nyquist"):
+        sig.elliptic_highpass(x, FS, cutoff)
+    with pytest.raises(ValueError, match="Nyquist"):
+        sig.lowpass(x, FS, cutoff)
+
+
+def test_filters_reject_short_signal_and_bad_design():
+    with pytest.raises(ValueError, match="too short"):
+        sig.elliptic_highpass(np.zeros((1, 10)), FS, 10.0, order=4)
+    with pytest.raises(ValueError, match="ripple"):
+        sig.elliptic_highpass(np.zeros((1, 1000)), FS, 10.0, ripple_db=40.0, stop_db=30.0)
+
+
+def test_lowpass_keeps_band_kills_noise():
+    t = np.arange(8000) / FS
+    low, high = np.sin(2 * np.pi * 50.0 * t), 0.5 * np.sin(2 * np.pi * 4000.0 * t)
+    y = sig.lowpass(np.stack([low + high, low]), FS, 1000.0, order=8)
+    mid = slice(1000, 7000)
+    # Butterworth |H|^2 at f/fc = 0.05 is 1 - O(0.05^16): exact to rounding; at f/fc = 4 the
+    # zero-phase gain is 4^-16 ~ 2e-10, so the 4 kHz line leaves < 1e-9
+    np.testing.assert_allclose(y[:, mid], np.stack([low, low])[:, mid], atol=1e-8)
+
+
+def test_integrate_acceleration_matches_filtered_exact_integrals():
+    t = np.arange(int(2 * FS)) / FS
+    d, v, a = decay_from_rest(t)
+    acc_f, vel, disp = sig.integrate_acceleration(a, FS, 10.0, order=5)
+    assert acc_f.shape == vel.shape == disp.shape == a.shape
+
+    def h2(z):
+        return sig.elliptic_highpass(sig.elliptic_highpass(z, FS, 10.0, 5), FS, 10.0, 5)
+
+    # The filters commute with exact integration, so the chain must equal H^2 applied to the
+    # exact signals up to the trapezoid bias: per integration at most 1 - x/tan x at the highest
+    # mode (0.67 % at 576.3 Hz), i.e. 0.67 % for velocity and 1.34 % for displacement.
+    b = trapezoid_bias(MODES[-1][0], FS)
+    np.testing.assert_allclose(acc_f, h2(a), rtol=0, atol=1e-12 * np.abs(a).max())
+    assert np.all(rel_err(vel, h2(v)) <= b)
+    assert np.all(rel_err(disp, h2(d)) <= 2 * b)
+    # Against the raw exact signals add the filter's own effect: the zero-phase gain |H|^4 at
+    # the modes (0.07 dB at 89.6 Hz for order 5) and the removed static (DC) part of the decay,
+    # whose area A / w spread over ~1 / f_c is below 0.5 % of the amplitude here.
+    _, h = ss.sosfreqz(ss.ellip(5, 0.1, 30.0, 10.0, "highpass", output="sos", fs=FS),
+                       worN=[m[0] for m in MODES], fs=FS)
+    gain_loss = 1.0 - np.min(np.abs(h) ** 4)
+    assert np.all(rel_err(acc_f, a) <= gain_loss + 0.005)
+    assert np.all(rel_err(vel, v) <= gain_loss + b + 0.005)
+    assert np.all(rel_err(disp, d) <= gain_loss + 2 * b + 0.005)
+
+
+def test_integrate_acceleration_vectorised_over_channels():
+    t = np.arange(int(0.5 * FS)) / FS
+    _, _, a = decay_from_rest(t, n_channels=3)
+    together = sig.integrate_acceleration(a, FS, 10.0, 5)
+    for ch in range(3):
+        alone = sig.integrate_acceleration(a[ch:ch + 1], FS, 10.0, 5)
+        for x, y in zip(together, alone, strict=True):
+            np.testing.assert_allclose(x[ch:ch + 1], y, rtol=1e-12, atol=1e-18)
+
+
+def test_noise_does_not_drift():
+    rng = np.random.default_rng(0)
+    sigma, fc, n = 0.01, 10.0, int(2 * FS)
+    acc = rng.normal(0.0, sigma, (3, n))
+    _, _, disp = sig.integrate_acceleration(acc, FS, fc, 5)
+    # White noise of one-sided PSD S = sigma^2 / (fs/2), integrated twice and high-passed at fc,
+    # has variance ~ int_fc^inf S / (2 pi f)^4 df = S / (3 (2 pi)^4 fc^3); allow 3x for the
+    # transition band and the sampling spread of a 1 s estimate.  Unfiltered, the double
+    # integral wanders ~ sigma t^1.5 / sqrt(3 fs), three orders of magnitude more.
+    s = sigma**2 / (FS / 2)
+    expected = np.sqrt(s / (3 * (2 * np.pi) ** 4 * fc**3))
+    assert np.all(disp[:, n // 4:-n // 4].std(axis=1) < 3 * expected)
+    raw = sig.trapezoid(sig.trapezoid(acc, FS), FS)
+    assert np.abs(raw).max() > 100 * expected
+
+
+@pytest.mark.parametrize("fc,order", [(5.0, 4), (8.0, 5), (10.0, 5)])
+def test_consistent_filtering_removes_regression_bias(fc, order):
+    """Regress a on (v, d) with the force: consistent filtering recovers k and c, the raw chain not."""
+    fs, f0, zeta = 2000.0, 14.0, 0.02  # a mode 1.4-2.8 x the cut-off, where the mismatch shows
+    w = 2 * np.pi * f0
+    k, c = w * w, 2 * zeta * w  # per unit mass
+    t = np.arange(int(4 * fs)) / fs
+    force = np.where((t >= 0.2) & (t < 0.21), np.sin(np.pi * (t - 0.2) / 0.01), 0.0)
+    sdof = ss.lti([[0, 1], [-k, -c]], [[0], [1]], [[0, 0]], [[0]])
+    _, _, state = ss.lsim(sdof, force, t)  # exact for the piecewise-linear force
+    a = (force - c * state[:, 1] - k * state[:, 0])[None]
+
+    def hp(z):
+        return sig.elliptic_highpass(z, fs, fc, order)
+
+    def fit(acc, vel, disp, f):
+        sl = slice(int(0.3 * fs), int(3.5 * fs))
+        coef = np.linalg.lstsq(np.stack([vel[0, sl], disp[0, sl]], 1), f[0, sl] - acc[0, sl], rcond=None)[0]
+        return abs(coef[0] / c - 1), abs(coef[1] / k - 1)
+
+    acc_f, vel, disp = sig.integrate_acceleration(a, fs, fc, order)
+    c_err, k_err = fit(acc_f, vel, disp, hp(hp(force[None])))
+    # left: the trapezoid bias x^2/3 ~ 2e-4 per integration at 14 Hz; 2e-3 is 4x that
+    assert c_err < 2e-3 and k_err < 2e-3
+    v1 = hp(sig.trapezoid(a, fs))  # the paper's chain: raw a, v filtered once, d twice
+    c_raw, k_raw = fit(a, v1, hp(sig.trapezoid(v1, fs)), force[None])
+    assert max(c_raw, k_raw) > 5 * max(c_err, k_err)
+
+
+def test_differentiate_exact_on_polynomials():
+    fs = 100.0
+    t = np.arange(400) / fs
+    x = np.stack([1.0 + 2.0 * t - 3.0 * t**2 + 0.5 * t**3, t**4])
+    xs, xd, xdd = sig.differentiate(x, fs, window=31, polyorder=4)
+    # a local polynomial of order 4 reproduces any polynomial up to order 4 exactly
+    np.testing.assert_allclose(xs, x, atol=1e-9)
+    np.testing.assert_allclose(xd[0], 2.0 - 6.0 * t + 1.5 * t**2, atol=1e-8)
+    np.testing.assert_allclose(xdd[0], -6.0 + 3.0 * t, atol=1e-6)
+    np.testing.assert_allclose(xd[1], 4 * t**3, atol=1e-8)
+    np.testing.assert_allclose(xdd[1], 12 * t**2, atol=1e-6)
+
+
+def test_differentiate_noisy_sine():
+    fs = 1e4  # the five-bar's dt = 1e-4 s and its 1 rad/s drive
+    t = np.arange(int(10 * fs)) / fs
+    rng = np.random.default_rng(1)
+    x = 0.0698 * np.sin(t + np.pi / 2) + rng.normal(0, 1e-4, t.size)
+    xs, xd, xdd = sig.differentiate(x[None], fs, window=2001, polyorder=4)
+    mid = slice(2000, -2000)
+    # noise 1e-4 rad through a 0.2 s quartic window: derivative noise ~ sigma / T^k times a
+    # filter factor of order 10 (k = 1, 2); the sine's own curvature over 0.2 s is fit exactly
+    assert np.abs(xs[0, mid] - 0.0698 * np.cos(t[mid])).max() < 5e-5
+    assert np.abs(xd[0, mid] + 0.0698 * np.sin(t[mid])).max() < 5e-3
+    assert np.abs(xdd[0, mid] + 0.0698 * np.cos(t[mid])).max() < 0.1
+
+
+@pytest.mark.parametrize("window,polyorder,match", [(30, 4, "odd"), (31, 1, "polyorder"),
+                                                     (31, 31, "polyorder"), (501, 4, "exceeds")])
+def test_differentiate_rejects_bad_settings(window, polyorder, match):
+    with pytest.raises(ValueError, match=match):
+        sig.differentiate(np.zeros((2, 400)), 100.0, window, polyorder)
