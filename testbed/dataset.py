@@ -148,9 +148,14 @@ class Dataset:
         f.attrs["format"] = FORMAT
         f.attrs["fs"] = float(self.fs)
         f.attrs["fs_unit"] = "Hz"
+        json_keys = []
         for k, v in self.attrs.items():
-            f.attrs[k] = v if isinstance(v, (str, int, float, np.integer, np.floating)) \
-                else json.dumps(v, sort_keys=True)
+            if isinstance(v, (str, int, float, np.integer, np.floating)):
+                f.attrs[k] = v
+            else:
+                f.attrs[k] = json.dumps(v, sort_keys=True)
+                json_keys.append(k)
+        f.attrs["json_attrs"] = json.dumps(json_keys)
         for group, signals in (("measured", self.measured), ("reference", self.reference)):
             g = f.create_group(group)
             for name, s in signals.items():
@@ -180,13 +185,13 @@ class Dataset:
             if f.attrs.get("format") != FORMAT:
                 raise ValueError(f"{path}: not a {FORMAT} file (format={f.attrs.get('format')!r})")
             attrs: dict[str, Any] = {}
+            json_keys = set(json.loads(f.attrs.get("json_attrs", "[]")))
             for k, v in f.attrs.items():
-                if k in ("format", "fs", "fs_unit"):
+                if k in ("format", "fs", "fs_unit", "json_attrs"):
                     continue
                 if isinstance(v, bytes):
                     v = v.decode()
-                if isinstance(v, str) and k in ("scenario", "versions") or (
-                        isinstance(v, str) and v[:1] in "[{"):
+                if k in json_keys:
                     v = json.loads(v)
                 elif isinstance(v, np.generic):
                     v = v.item()

@@ -104,7 +104,7 @@ def test_extends_cycle(tmp_path):
 
 
 def test_dict_form_validates_too():
-    with pytest.raises(ScenarioError, match="<dict>: key 'rig.n_segments'"):
+    with pytest.raises(ScenarioError, match=r"<dict>: key 'rig.n_segments'"):
         scenario_from_dict({"scenario": {"name": "x", "rig": "cantilever"}, "rig": {"n_segments": 0}})
 
 

@@ -53,7 +53,7 @@ def test_variant_selects_schema_by_type():
     variants = {"impact": {"peak": Field(float, 1.0, unit="N")}, "sine": {"freq": Field(float, 1.0)}}
     assert validate_variant({"type": "sine", "freq": 3}, variants, file="f", section="excitation") == \
         {"type": "sine", "freq": 3.0}
-    with pytest.raises(ScenarioError, match="key 'excitation.type': value 'hammer': expected one of"):
+    with pytest.raises(ScenarioError, match=r"key 'excitation.type': value 'hammer': expected one of"):
         validate_variant({"type": "hammer"}, variants, file="f", section="excitation")
     with pytest.raises(ScenarioError, match="unknown key"):
         validate_variant({"type": "sine", "peak": 1.0}, variants, file="f", section="excitation")
