@@ -20,6 +20,7 @@ REQUIRED = object()
 
 _TYPE_NAMES = {bool: "a boolean", int: "an integer", float: "a number", str: "a string",
                list: "a list", dict: "a table"}
+_ITEM_NAMES = {bool: "booleans", int: "integers", float: "numbers", str: "strings"}
 
 
 @dataclass(frozen=True)
@@ -68,7 +69,7 @@ class Field:
         """What is allowed, in words (used in error messages and the guide)."""
         what = _TYPE_NAMES.get(self.type, self.type.__name__)
         if self.type is list and self.item_type is not None:
-            what = f"a list of {_TYPE_NAMES.get(self.item_type, self.item_type.__name__)}s"
+            what = f"a list of {_ITEM_NAMES.get(self.item_type, self.item_type.__name__)}"
         if self.choices is not None:
             return "one of " + ", ".join(repr(c) for c in self.choices)
         bounds = []

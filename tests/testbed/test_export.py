@@ -1,0 +1,176 @@
+"""UFF 58/55 and SEP-005 exports: round trips through pyuff and the SEP-005 rules."""
+
+from __future__ import annotations
+
+import datetime
+import json
+
+import numpy as np
+import pytest
+import pyuff
+
+from testbed.dataset import Dataset, Signal
+from testbed.export import export_dataset, node_numbers, read_sep005, to_sep005
+
+FS = 1024.0
+N = 512
+
+
+def cantilever_dataset() -> Dataset:
+    rng = np.random.default_rng(3)
+    pos = np.array([0.15, 0.35, 0.5])
+    acc = rng.standard_normal((3, N)) * 20.0
+    force = np.zeros((1, N))
+    force[0, :4] = [5.0, 40.0, 40.0, 5.0]
+    phi = np.array([[0.1, -0.5, 0.8], [0.5, -0.2, -0.6], [1.0, 0.9, 0.4]])
+    return Dataset(FS, {"acceleration": Signal(acc, ("acc1", "acc2", "acc3"), "m/s^2", pos),
+                        "force": Signal(force, ("impact",), "N", pos[2:])},
+                   {"acceleration": Signal(acc * 0.9, ("acc1", "acc2", "acc3"), "m/s^2", pos)},
+                   {"frequencies_hz": np.array([82.9, 519.9, 1455.0]),
+                    "damping_ratios": np.array([0.01, 0.02, 0.03]), "sensor_modes": phi},
+                   {"frequencies_hz": "Hz"}, {"total_mass": 0.4},
+                   {"rig": "cantilever", "seed": 7, "scenario_name": "cantilever_stiff_impact"})
+
+
+def fivebar_dataset() -> Dataset:
+    t = np.arange(N) / FS
+    th = np.array([np.sin(2 * np.pi * (k + 1) * t) for k in range(4)])
+    tau = np.array([np.cos(2 * np.pi * t), 0.5 * np.sin(2 * np.pi * t)])
+    return Dataset(FS, {"angles": Signal(th, ("th1", "th2", "th3", "th4"), "rad"),
+                        "torques": Signal(tau, ("tau1", "tau2"), "N m")},
+                   truth={"equation_terms": ["ddth1", "u1"], "equation_coef": np.array([[1.0, -1.0]])},
+                   attrs={"rig": "fivebar", "seed": 0})
+
+
+@pytest.fixture
+def saved(tmp_path):
+    def save(ds: Dataset):
+        return ds.save(tmp_path / "data.h5")
+    return save
+
+
+def spec(s):
+    """(specific data type, length exponent, force exponent) of a UFF58 ordinate."""
+    return s["ordinate_spec_data_type"], s["ordinate_len_unit_exp"], s["ordinate_force_unit_exp"]
+
+
+def read_uff(path):
+    u = pyuff.UFF(str(path))
+    return [u.read_sets(i) for i in range(u.get_n_sets())]
+
+
+def test_uff_cantilever_round_trip(saved, tmp_path):
+    ds = cantilever_dataset()
+    (out,) = export_dataset(saved(ds), "uff", tmp_path / "beam.uff")
+    sets = read_uff(out)
+    s58 = [s for s in sets if s["type"] == 58]
+    s55 = [s for s in sets if s["type"] == 55]
+    assert len(s58) == 4 and len(s55) == 3
+    ds = Dataset.load(tmp_path / "data.h5")
+    for k, s in enumerate(s58[:3]):
+        np.testing.assert_allclose(s["data"], ds.measured["acceleration"].data[k], rtol=0, atol=1e-12)
+        # the UFF58 header holds the sample interval to 6 significant digits (format E13.5) ...
+        np.testing.assert_allclose(s["x"], np.arange(N) / FS, rtol=1e-5)
+        assert float(s["id5"].split()[1]) == FS  # ... so ID line 5 carries the exact rate
+        assert (s["func_type"], s["rsp_node"], s["rsp_dir"]) == (1, k + 1, 3)
+        assert spec(s) == (12, 1, 0)
+        assert s["ordinate_axis_units_lab"] == "m/s^2"
+        assert (s["abscissa_spec_data_type"], s["abscissa_axis_units_lab"]) == (17, "s")
+        assert s["abscissa_inc"] == pytest.approx(1 / FS, rel=1e-6)
+        assert s["id1"] == f"acceleration/acc{k + 1}"
+    force = s58[3]
+    np.testing.assert_allclose(force["data"], ds.measured["force"].data[0], atol=1e-12)
+    assert force["rsp_node"] == 3, "the impact acts at the tip sensor: same node"
+    assert (force["ordinate_spec_data_type"], force["ordinate_len_unit_exp"],
+            force["ordinate_force_unit_exp"], force["ordinate_axis_units_lab"]) == (13, 0, 1, "N")
+    for k, m in enumerate(s55):
+        assert m["analysis_type"] == 2 and m["mode_n"] == k + 1
+        assert m["freq"] == pytest.approx(ds.truth["frequencies_hz"][k], rel=1e-6)
+        assert m["modal_damp_vis"] == pytest.approx(ds.truth["damping_ratios"][k], rel=1e-4)
+        assert list(m["node_nums"]) == [1, 2, 3]
+        np.testing.assert_allclose(m["r3"], ds.truth["sensor_modes"][:, k], rtol=1e-5)
+        np.testing.assert_array_equal(m["r1"], 0.0)
+
+
+def test_uff_fivebar_angles_and_torques(saved, tmp_path):
+    ds = fivebar_dataset()
+    (out,) = export_dataset(saved(ds), "uff", None)
+    assert out == tmp_path / "data.uff"
+    sets = read_uff(out)
+    assert [s["type"] for s in sets] == [58] * 6, "no modal truth for a mechanism"
+    for k, s in enumerate(sets[:4]):
+        np.testing.assert_allclose(s["data"], ds.measured["angles"].data[k], atol=1e-14)
+        assert (s["rsp_node"], s["rsp_dir"], s["ordinate_axis_units_lab"]) == (k + 1, 6, "rad")
+        assert spec(s) == (8, 0, 0)
+    for k, s in enumerate(sets[4:]):
+        np.testing.assert_allclose(s["data"], ds.measured["torques"].data[k], atol=1e-14)
+        assert (s["rsp_node"], s["rsp_dir"], s["ordinate_axis_units_lab"]) == (k + 1, 6, "N m")
+        assert spec(s) == (13, 1, 1)
+
+
+def test_node_numbers_by_position_and_name():
+    nodes = node_numbers(cantilever_dataset())
+    assert [nodes[("acceleration", i)] for i in range(3)] == [1, 2, 3]
+    assert nodes[("force", 0)] == 3
+    nodes = node_numbers(fivebar_dataset())
+    assert nodes[("angles", 3)] == 4 and nodes[("torques", 1)] == 2
+
+
+# SEP 5 (SDyPy unified timeseries): compulsory, optional and prohibited fields
+COMPULSORY = ("data", "name", "unit_str")
+PROHIBITED = ("unit", "timestamp", "signal", "sample_frequency")
+KNOWN = ("data", "name", "unit_str", "fs", "time", "unit_tex", "start_timestamp", "start_timestamp_format")
+
+
+def assert_sep005(channels) -> None:
+    """The rules of SEP 5, checked directly."""
+    assert isinstance(channels, list) and channels
+    names = [c["name"] for c in channels]
+    assert len(set(names)) == len(names), "names must be unique within the list"
+    for c in channels:
+        assert isinstance(c, dict)
+        for key in COMPULSORY:
+            assert key in c, f"missing compulsory {key!r}"
+        assert "fs" in c or "time" in c, "either fs or time is compulsory"
+        assert isinstance(c["data"], np.ndarray) and c["data"].ndim in (1, 2)
+        assert isinstance(c["name"], str) and (c["unit_str"] is None or isinstance(c["unit_str"], str))
+        if "fs" in c:
+            assert isinstance(c["fs"], (int, float)) and c["fs"] > 0
+        if "time" in c:
+            assert len(c["time"]) == len(c["data"])
+        for key in c:
+            assert key.lower() not in PROHIBITED, f"prohibited field {key!r}"
+            for k in KNOWN:  # variations of the standard names in case or underscores
+                assert key == k or key.lower().replace("_", "") != k.replace("_", ""), key
+            if "timestamp" in key and key != "start_timestamp_format":
+                datetime.datetime.fromisoformat(c[key])
+
+
+@pytest.mark.parametrize("make", [cantilever_dataset, fivebar_dataset])
+def test_sep005_file_is_compliant_and_exact(make, saved, tmp_path):
+    ds = make()
+    (out,) = export_dataset(saved(ds), "sep005", tmp_path / "x.json")
+    raw = json.loads(out.read_text())
+    assert isinstance(raw, list) and isinstance(raw[0]["data"], list)
+    channels = read_sep005(out)
+    assert_sep005(channels)
+    assert_sep005(to_sep005(ds))
+    rows = [(n, i, s) for n, s in ds.measured.items() for i in range(len(s.channels))]
+    assert len(channels) == len(rows)
+    for c, (n, i, s) in zip(channels, rows, strict=True):
+        assert c["name"] == f"{n}/{s.channels[i]}" and c["unit_str"] == s.unit and c["fs"] == FS
+        np.testing.assert_array_equal(c["data"], s.data[i])  # JSON floats round-trip exactly
+
+
+def test_sep005_quantities_and_positions():
+    ch = {c["name"]: c for c in to_sep005(cantilever_dataset())}
+    assert ch["acceleration/acc2"]["quantity"] == "acceleration"
+    assert ch["acceleration/acc2"]["position_m"] == 0.35
+    assert ch["force/impact"]["quantity"] == "force" and ch["force/impact"]["node"] == 3
+    ch = {c["name"]: c for c in to_sep005(fivebar_dataset())}
+    assert ch["torques/tau2"]["quantity"] == "torque" and ch["angles/th1"]["unit_tex"] == "rad"
+
+
+def test_unknown_format(saved):
+    with pytest.raises(ValueError, match="sep005"):
+        export_dataset(saved(fivebar_dataset()), "csv")

@@ -1,0 +1,133 @@
+"""Figures: the right panels, labelled axes with units, readable size, PNGs that decode."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import matplotlib.image as mpimg
+import numpy as np
+import pytest
+from matplotlib.figure import Figure
+
+sys.path.insert(0, str(Path(__file__).parent))
+import _synthetic_runs as synth
+
+from testbed import figures
+from testbed.runstore import load_run, save_run
+
+
+def labelled(fig: Figure) -> list[tuple[str, str]]:
+    """(xlabel, ylabel) of every visible data axes (colour bars and tables excluded)."""
+    return [(a.get_xlabel(), a.get_ylabel()) for a in fig.axes
+            if a.axison and a.get_label() != "<colorbar>" and (a.lines or a.images or a.patches)]
+
+
+def assert_units(fig: Figure) -> None:
+    pairs = labelled(fig)
+    assert pairs
+    for _, y in pairs:
+        assert y and "[" in y, f"y label without unit: {y!r}"
+    assert any("[" in x for x, _ in pairs) or all(x for x, _ in pairs)
+
+
+@pytest.fixture(scope="module")
+def runs(tmp_path_factory):
+    d = tmp_path_factory.mktemp("runs")
+    return {k: load_run(save_run(f(), d / k, figures=False))
+            for k, f in (("structural", lambda: synth.structural_result(n_samples=1000)),
+                         ("mechanical", lambda: synth.mechanical_result(n_samples=400)))}
+
+
+def test_reconstruction_has_zoom_and_units():
+    t = np.linspace(0, 1, 500)
+    ref = np.vstack([np.sin(20 * t), np.cos(20 * t)])
+    fig = figures.reconstruction(t, ref, ref * 0.9, ["acc1", "acc2"], trac=[0.99, 0.98], zoom=(0.2, 0.3))
+    assert len(fig.axes) == 4
+    assert_units(fig)
+    assert "m/s^2" in fig.axes[0].get_ylabel() and fig.axes[-1].get_xlabel() == "time [s]"
+    zoom_line = fig.axes[1].lines[0].get_xdata()
+    assert zoom_line.min() >= 0.2 and zoom_line.max() <= 0.3
+    assert "TRAC 0.990" in fig.axes[0].get_title()
+
+
+def test_mac_matrix_writes_values():
+    mac = np.array([[0.98, 0.1], [0.05, 0.91]])
+    fig = figures.mac_matrix(mac, pair=[0, 1])
+    texts = {t.get_text() for t in fig.axes[0].texts}
+    assert {"0.98", "0.10", "0.05", "0.91"} <= texts
+    assert fig.axes[0].get_xlabel().startswith("true mode")
+
+
+def test_penalty_weights_split_weights_and_losses():
+    assert figures.penalty_weights({}) is None
+    h = {"alpha": {"eig": [1, 2, 3], "mass": [3, 2, 1]}, "loss_total": [5, 4, 3],
+         "alpha_vec": np.array([[1, 2], [2, 3], [3, 4]])}
+    fig = figures.penalty_weights(h)
+    left, right = fig.axes
+    assert {ln.get_label() for ln in left.lines} == {"alpha/eig", "alpha/mass", "alpha_vec[0]",
+                                                     "alpha_vec[1]"}
+    assert [ln.get_label() for ln in right.lines] == ["loss_total"]
+    assert left.get_xlabel() == "epoch" and left.get_yscale() == "log"
+
+
+def test_frequency_rows_pair_and_error():
+    rows = figures.frequency_rows(np.array([80.0, 500.0]), np.array([505.0, 79.0]), pair=[1, 0])
+    assert rows[0]["f_id"] == 79.0 and rows[0]["error_pct"] == pytest.approx(-1.25)
+    assert rows[1]["f_id"] == 505.0 and rows[1]["error_pct"] == pytest.approx(1.0)
+    table = figures.frequency_table(rows).axes[0].tables[0]
+    cells = [c.get_text().get_text() for c in table.get_celld().values()]
+    assert "-1.25" in cells and "+1.00" in cells
+
+
+def test_true_cubic_only_when_it_exists_in_the_basis():
+    tr = {"k3": 2.0, "cubic_map": np.array([[0, 3.0, 0]]), "cubic_direction": np.array([1.0, -1.0, 0])}
+    K3 = figures.true_cubic(tr, 3)
+    x = np.array([0.1, 0.2, 0.3])
+    np.testing.assert_allclose(K3 @ x**3, tr["cubic_direction"] * 2.0 * (3.0 * 0.2) ** 3)
+    assert figures.true_cubic({**tr, "cubic_map": np.array([[1.0, -1.0, 0]])}, 3) is None
+    assert figures.true_cubic({}, 3) is None
+
+
+def test_structural_run_figures(runs, tmp_path):
+    figs = figures.run_figures(runs["structural"])
+    assert list(figs) == ["reconstruction", "mac", "frequencies", "matrices", "penalty_weights"]
+    assert [a.get_title() for a in figs["matrices"].axes if a.get_title()][-2:] == \
+        ["K3 identified (rel. error 10.00%)", "K3 true"]
+    for name in ("reconstruction", "penalty_weights"):
+        assert_units(figs[name])
+    bars = [a.get_ylabel() for a in figs["matrices"].axes if a.get_label() == "<colorbar>"]
+    assert bars == ["M [kg]", "K [N/m]", "K3 [N/m^3]"]
+    paths = figures.save_run_figures(runs["structural"], tmp_path)
+    for p in paths:
+        img = mpimg.imread(p)
+        assert 350 <= img.shape[1] <= 1300 and img.shape[0] >= 200, f"{p.name}: {img.shape} px"
+        assert img[..., :3].std() > 0.01, f"{p.name} is blank"
+
+
+def test_mechanical_run_figures(runs):
+    figs = figures.run_figures(runs["mechanical"])
+    assert list(figs) == ["joint_angles", "coefficients"]
+    ja = figs["joint_angles"]
+    panels = [a for a in ja.axes if a.lines]
+    assert len(panels) == 4 and all("[rad]" in a.get_ylabel() for a in panels)
+    assert "RMSE 0.0141 rad" in panels[0].get_title()
+    co = figs["coefficients"].axes
+    assert len(co) == 2
+    assert [t.get_text() for t in co[0].get_xticklabels()] == runs["mechanical"].details["terms"]
+    heights = [p.get_height() for p in co[0].patches]
+    np.testing.assert_allclose(heights[:5], runs["mechanical"].details["coef_true"][0])
+
+
+def test_sweep_figures():
+    rows = synth.sweep_rows()
+    fig = figures.score_vs_noise([r for r in rows if r["status"] == "ok"], "trac")
+    ax = fig.axes[0]
+    lines = {ln.get_label(): ln for ln in ax.lines}
+    assert set(lines) == {"sindy_ls", "sgd_sindy"}
+    np.testing.assert_allclose(lines["sgd_sindy"].get_xdata(), [0, 1, 5])
+    np.testing.assert_allclose(lines["sgd_sindy"].get_ydata(), [0.9675, 0.9575, 0.9175])
+    assert "noise [%" in ax.get_xlabel()
+    ft = figures.fit_times(rows)
+    assert ft.axes[0].get_xlabel() == "fit time [s]"
+    assert [t.get_text() for t in ft.axes[0].get_yticklabels()] == ["sgd_sindy", "sindy_ls"]
