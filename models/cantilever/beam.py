@@ -201,7 +201,7 @@ def build_mjcf(params: BeamParams, sensors: np.ndarray, hit: float, *, timestep:
         body_xml = (
             f'<body name="b{j}" pos="{float(pos)!r} 0 0">'
             f'<joint name="q{j}" type="hinge" axis="0 -1 0" stiffness="{stiff}" '
-            f'damping="{beta * k1!r}" armature="0" frictionloss="0"/>'
+            f'damping="{float(beta * k1)!r}" armature="0" frictionloss="0"/>'
             f'<inertial pos="{seg / 2!r} 0 0" mass="{m!r}" '
             f'diaginertia="{ixx!r} {iyy!r} {ixx + iyy!r}"/>'
             + "".join(sites.get(j, [])) + body_xml + "</body>")

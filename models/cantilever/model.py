@@ -1,0 +1,177 @@
+"""A compiled cantilever: MuJoCo model, stepping choice and every truth array.
+
+:func:`build_model` turns validated scenario tables into a :class:`CantileverModel`;
+the rig simulates it, the tests and the benchmark reuse it.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import mujoco
+import numpy as np
+
+from models.cantilever import truth as tr
+from models.cantilever.beam import BeamParams, build_mjcf
+from models.cantilever.euler_bernoulli import eb_frequencies
+from models.cantilever.simulate import Stepping, choose_stepping
+
+N_EB = 4  # Euler-Bernoulli frequencies reported
+
+
+def sensor_positions(rig: dict[str, Any]) -> np.ndarray:
+    """Sensor positions [m], shape (n_sensors,): the given list, or L/3, 2L/3, L."""
+    if rig["sensors"]:
+        return np.asarray(rig["sensors"], float)
+    return rig["length"] * np.array([1.0, 2.0, 3.0]) / 3.0
+
+
+def hit_position(rig: dict[str, Any], excitation: dict[str, Any]) -> float:
+    """Impact position [m]: ``excitation.location``, or the tip when it is 0."""
+    loc = float(excitation.get("location", 0.0))
+    return float(rig["length"]) if loc == 0.0 else loc
+
+
+def beam_params(rig: dict[str, Any], beta: float = 0.0) -> BeamParams:
+    """:class:`BeamParams` from a validated ``[rig]`` table and a damping coefficient [s]."""
+    return BeamParams(E=rig["E"], rho=rig["rho"], width=rig["width"], thickness=rig["thickness"],
+                      length=rig["length"], n_segments=rig["n_segments"], base=rig["base"],
+                      base_k1=rig["base_k1"], base_k3=rig["base_k3"] if rig["base"] == "soft" else 0.0,
+                      beta=beta, joint_offset=rig["joint_offset"])
+
+
+@dataclass
+class CantileverModel:
+    """The compiled model with its truth (all at the reference pose ``q = 0``).
+
+    Attributes
+    ----------
+    params : BeamParams
+    model : mujoco.MjModel
+    xml : str
+        The MJCF the model was compiled from.
+    stepping : Stepping
+    sensors : ndarray, shape (n_s,)
+        Sensor positions [m].
+    hit : float
+        Impact position [m].
+    M, C, K : ndarray, shape (n, n)
+        Joint-space mass [kg m^2], damping [N m s/rad], stiffness [N m/rad].
+    freqs, zetas : ndarray, shape (n,)
+        Undamped frequencies [Hz] and damping ratios [-].
+    modes : ndarray, shape (n, n)
+        Mass-normalised modes (columns).
+    Js : ndarray, shape (n_s, n)
+        Vertical Jacobian rows of the sensors [m/rad].
+    j_hit : ndarray, shape (n,)
+        Vertical Jacobian row of the hit point [m/rad].
+    red : truth.Serep
+        SEREP reduction to the sensors.
+    """
+
+    params: BeamParams
+    model: mujoco.MjModel
+    xml: str
+    stepping: Stepping
+    sensors: np.ndarray
+    hit: float
+    M: np.ndarray
+    C: np.ndarray
+    K: np.ndarray
+    freqs: np.ndarray
+    zetas: np.ndarray
+    modes: np.ndarray
+    Js: np.ndarray
+    j_hit: np.ndarray
+    red: tr.Serep
+
+    @property
+    def force_map(self) -> np.ndarray:
+        """How the hammer force enters the reduced equations, ``T^T j_hit^T``, shape (n_s,)."""
+        return self.red.T.T @ self.j_hit
+
+    @property
+    def k3(self) -> float:
+        """Cubic base stiffness [N m/rad^3] (0 for a stiff base)."""
+        return float(self.params.base_k3) if self.params.base == "soft" else 0.0
+
+    def truth(self) -> tuple[dict[str, Any], dict[str, str]]:
+        """Truth arrays and their units, as stored in ``Dataset.truth``."""
+        p, red = self.params, self.red
+        e0_row = red.T[0]  # e0^T T: root (base) joint angle per unit sensor displacement
+        eb_clamped = eb_frequencies(p.E, p.width * p.thickness**3 / 12, p.mass_per_length,
+                                    p.length, N_EB)
+        eb = eb_clamped if p.base == "stiff" else eb_frequencies(
+            p.E, p.width * p.thickness**3 / 12, p.mass_per_length, p.length, N_EB, k_r=p.base_k1)
+        joint_x, _ = p.hinges()
+        t = {
+            "M": self.M, "C": self.C, "K": self.K,
+            "frequencies_hz": self.freqs,
+            "damped_frequencies_hz": tr.damped_frequencies(self.freqs, self.zetas),
+            "damping_ratios": self.zetas,
+            "modes": self.modes,
+            "sensor_modes": red.Pa,
+            "Mr": red.Mr, "Cr": red.Cr, "Kr": red.Kr, "T": red.T,
+            "k3": np.float64(self.k3),
+            "cubic_direction": e0_row.copy(),
+            "cubic_map": e0_row.copy(),
+            "force_map": self.force_map,
+            "beta": np.float64(p.beta),
+            "eb_frequencies_hz": eb,
+            "eb_frequencies_clamped_hz": eb_clamped,
+            "sensor_positions": self.sensors,
+            "joint_positions": joint_x,
+        }
+        units = {
+            "M": "kg m^2", "C": "N m s/rad", "K": "N m/rad", "frequencies_hz": "Hz",
+            "damped_frequencies_hz": "Hz", "damping_ratios": "", "modes": "rad/sqrt(kg m^2)",
+            "sensor_modes": "m/sqrt(kg m^2)", "Mr": "kg", "Cr": "N s/m", "Kr": "N/m", "T": "rad/m",
+            "k3": "N m/rad^3", "cubic_direction": "rad/m", "cubic_map": "rad/m", "force_map": "",
+            "beta": "s", "eb_frequencies_hz": "Hz", "eb_frequencies_clamped_hz": "Hz",
+            "sensor_positions": "m", "joint_positions": "m",
+        }
+        return t, units
+
+
+def _compile(params: BeamParams, sensors: np.ndarray, hit: float, stepping: Stepping,
+             gravity: bool) -> tuple[mujoco.MjModel, str]:
+    xml = build_mjcf(params, sensors, hit, timestep=stepping.timestep,
+                     integrator=stepping.integrator, gravity=gravity)
+    return mujoco.MjModel.from_xml_string(xml), xml
+
+
+def build_model(rig: dict[str, Any], simulation: dict[str, Any],
+                excitation: dict[str, Any]) -> CantileverModel:
+    """Compile the beam of validated scenario tables and compute its truth.
+
+    The mass matrix does not depend on damping or timestep, so a first compile
+    gives ``M``; from it the damping coefficient ``beta = 2 zeta_1 / omega_1``
+    (unless ``damping_beta`` is given) and the stepping follow, and the final
+    model is compiled with them.
+    """
+    sensors = sensor_positions(rig)
+    hit = hit_position(rig, excitation)
+    gravity = simulation["gravity"] == "removed"
+    probe = Stepping("RK4", 1e-5, 1)
+    params0 = beam_params(rig)
+    model0, _ = _compile(params0, sensors, hit, probe, gravity)
+    M = tr.mass_matrix(model0)
+    K = np.diag(params0.hinges()[1])
+    f0, _, _ = tr.modal(M, K, 0.0)
+    beta = rig["damping_beta"] or 2.0 * rig["damping_ratio"] / (2.0 * math.pi * f0[0])
+    params = dataclasses.replace(params0, beta=float(beta))
+    C = beta * K
+    stepping = choose_stepping(M, C, K, simulation["sample_rate"], simulation["integrator"],
+                               simulation["timestep"])
+    model, xml = _compile(params, sensors, hit, stepping, gravity)
+    freqs, zetas, modes = tr.modal(M, K, beta)
+    names = [f"s{i + 1}" for i in range(len(sensors))]
+    Js = tr.vertical_jacobian(model, names)
+    j_hit = tr.vertical_jacobian(model, ["hit"])[0]
+    red = tr.serep(M, C, K, Js, modes)
+    return CantileverModel(params=params, model=model, xml=xml, stepping=stepping, sensors=sensors,
+                           hit=hit, M=M, C=C, K=K, freqs=freqs, zetas=zetas, modes=modes, Js=Js,
+                           j_hit=j_hit, red=red)

@@ -1,0 +1,209 @@
+"""The ``cantilever`` rig: a steel beam as a MuJoCo hinge chain, struck by a hammer.
+
+Measured: vertical accelerations at the sensors [m/s^2] and the hammer force [N].
+Reference (no lab has them): sensor displacements [m] and velocities [m/s],
+noise-free accelerations.  Truth: full joint-space M, C, K, modes, SEREP-reduced
+Mr, Cr, Kr at the sensors, the soft base's cubic stiffness and its reduced form,
+Euler-Bernoulli frequencies.  See :mod:`models.cantilever.beam` for the
+discretisation and :mod:`models.cantilever.simulate` for the timestep.
+
+Default soft-base cubic: the default impact (50 N, 0.3 ms at the tip) turns the
+base by about 4e-4 rad at most (measured); ``k3 = 2.5e9 N m/rad^3`` makes the
+cubic moment ``k3 q^3`` about 20 % of ``k1 q = 2000 q`` there
+(``2.5e9 * (4e-4)^2 / 2000 = 0.2``): clearly measurable, yet a perturbation of
+the linear beam (the tests check the measured ratio).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any, ClassVar
+
+import numpy as np
+
+from models import RIGS
+from models._base import ErrorFn, Rig
+from models.cantilever.beam import BeamParams
+from models.cantilever.model import CantileverModel, build_model, sensor_positions
+from models.cantilever.simulate import half_sine, rollout_sensors, static_equilibrium
+from testbed.dataset import Dataset, Signal
+from testbed.errors import RigError
+from testbed.schema import Field
+
+RIG_SCHEMA = {
+    "E": Field(float, 210e9, unit="Pa", min=0.0, min_inclusive=False, doc="Young's modulus"),
+    "rho": Field(float, 7850.0, unit="kg/m^3", min=0.0, min_inclusive=False, doc="density"),
+    "width": Field(float, 0.03, unit="m", min=0.0, min_inclusive=False,
+                   doc="cross-section width (along the bending axis)"),
+    "thickness": Field(float, 0.01, unit="m", min=0.0, min_inclusive=False,
+                       doc="cross-section thickness (the bending depth)"),
+    "length": Field(float, 0.3175, unit="m", min=0.0, min_inclusive=False, doc="beam length"),
+    "n_segments": Field(int, 10, min=2, max=400, doc="rigid segments of the hinge chain"),
+    "joint_offset": Field(float, 1.0 / 3.0, min=0.0, max=0.5,
+                          doc="first hinge at joint_offset * L / n_segments (1/3 minimises the "
+                              "discretisation error; 0 = hinge at the wall, needs a stiff base)"),
+    "damping_ratio": Field(float, 0.01, min=0.0, max=1.0, max_inclusive=False,
+                           doc="damping ratio of mode 1 (C = beta K, beta = 2 zeta_1 / omega_1)"),
+    "damping_beta": Field(float, 0.0, unit="s", min=0.0,
+                          doc="stiffness-proportional damping C = beta K; 0 = derive from "
+                              "damping_ratio (set damping_ratio = 0 to give this)"),
+    "base": Field(str, "stiff", choices=("stiff", "soft"),
+                  doc="clamped base, or a base hinge on a nonlinear rotational spring"),
+    "base_k1": Field(float, 2000.0, unit="N m/rad", min=0.0, min_inclusive=False,
+                     doc="linear stiffness of the soft base spring"),
+    "base_k3": Field(float, 2.5e9, unit="N m/rad^3", min=0.0,
+                     doc="cubic stiffness of the soft base spring (moment k1 q + k3 q^3)"),
+    "sensors": Field(list, [], unit="m", item_type=float, min=0.0, min_inclusive=False,
+                     doc="accelerometer positions along the beam; empty = L/3, 2L/3, L"),
+}
+
+SIMULATION_SCHEMA = {
+    "duration": Field(float, 1.0, unit="s", min=0.0, min_inclusive=False, doc="record length"),
+    "sample_rate": Field(float, 12800.0, unit="Hz", min=0.0, min_inclusive=False,
+                         doc="sample rate of every signal"),
+    "integrator": Field(str, "auto", choices=("auto", "RK4", "implicitfast"),
+                        doc="MuJoCo integrator (auto = RK4)"),
+    "timestep": Field(float, 0.0, unit="s", min=0.0,
+                      doc="integration step, rounded to sample period / integer; 0 = chosen "
+                          "from the model's fastest mode"),
+    "gravity": Field(str, "off", choices=("off", "removed"),
+                     doc="off = no gravity in the model; removed = gravity on, start at the sagged "
+                         "rest pose, static accelerometer reading subtracted"),
+}
+
+IMPACT_SCHEMA = {
+    "peak_force": Field(float, 50.0, unit="N", min=0.0, min_inclusive=False,
+                        doc="peak of the half-sine hammer force (world +z)"),
+    "pulse_duration": Field(float, 3e-4, unit="s", min=0.0, min_inclusive=False,
+                            doc="half-sine duration (0.3 ms: flat spectrum to ~2 kHz)"),
+    "location": Field(float, 0.0, unit="m", min=0.0,
+                      doc="impact position along the beam; 0 = the tip"),
+    "start": Field(float, 0.005, unit="s", min=0.0, doc="time the pulse begins"),
+}
+
+
+def _root_hinge(rig: dict[str, Any]) -> float:
+    """Position [m] of the first moving hinge (0 for a soft base)."""
+    if rig["base"] == "soft":
+        return 0.0
+    return rig["joint_offset"] * rig["length"] / rig["n_segments"]
+
+
+@RIGS.register("cantilever", tags=("structural", "mujoco", "beam"))
+class CantileverRig(Rig):
+    """Steel cantilever (hinge chain in MuJoCo) under a hammer impact.  See the module docs."""
+
+    kind: ClassVar[str] = "structural"
+    rig_schema: ClassVar[dict[str, Field]] = RIG_SCHEMA
+    simulation_schema: ClassVar[dict[str, Field]] = SIMULATION_SCHEMA
+    excitation_schemas: ClassVar[dict[str, dict[str, Field]]] = {"impact": IMPACT_SCHEMA}
+    default_excitation: ClassVar[str] = "impact"
+    measured_signals: ClassVar[tuple[str, ...]] = ("acceleration", "force")
+    noisy_signals: ClassVar[tuple[str, ...]] = ("acceleration",)
+
+    @classmethod
+    def check(cls, rig: dict[str, Any], simulation: dict[str, Any], excitation: dict[str, Any],
+              error: ErrorFn) -> None:
+        """Cross-field checks (positions on the beam, damping, pulse, stepping, gravity)."""
+        length = rig["length"]
+        x0 = _root_hinge(rig)
+        where = f"positions in ({x0:.6g}, length={length:.6g}] m" + (
+            f" (points inboard of the root hinge at {x0:.6g} m do not move)" if x0 > 0 else "")
+        sensors = rig["sensors"]
+        for s in sensors:
+            if not x0 < s <= length:
+                error("rig.sensors", sensors, f"allowed: {where}")
+        if len(set(sensors)) != len(sensors):
+            error("rig.sensors", sensors, "allowed: distinct positions (one accelerometer each)")
+        n_dof = rig["n_segments"] + (rig["base"] == "soft")
+        if len(sensor_positions(rig)) > n_dof:
+            error("rig.sensors", sensors, f"allowed: at most {n_dof} sensors (the model's degrees "
+                                          "of freedom, for the SEREP reduction)")
+        if rig["damping_ratio"] > 0 and rig["damping_beta"] > 0:
+            error("rig.damping_beta", rig["damping_beta"],
+                  "allowed: only one damping form; set rig.damping_ratio = 0 to give damping_beta")
+        if rig["base"] == "soft" and rig["joint_offset"] == 0:
+            error("rig.joint_offset", rig["joint_offset"],
+                  "allowed: > 0 with base = 'soft' (the base hinge needs a stub of beam to move)")
+        if simulation["gravity"] == "removed" and rig["base"] == "soft" and rig["base_k3"] > 0:
+            error("simulation.gravity", "removed",
+                  "allowed: 'off' with a cubic soft base (the sag would add a quadratic term "
+                  "the cubic truth does not describe)")
+        period = 1.0 / simulation["sample_rate"]
+        if simulation["timestep"] > period:
+            error("simulation.timestep", simulation["timestep"],
+                  f"allowed: at most the sample period {period:.6g} s")
+        if simulation["duration"] * simulation["sample_rate"] < 2:
+            error("simulation.duration", simulation["duration"], "allowed: at least two samples")
+        loc = excitation["location"]
+        if loc != 0.0 and not x0 < loc <= length:
+            error("excitation.location", loc, f"allowed: 0 (= tip) or {where}")
+        end = excitation["start"] + excitation["pulse_duration"]
+        if end >= simulation["duration"]:
+            error("excitation.pulse_duration", excitation["pulse_duration"],
+                  f"allowed: start + pulse_duration < duration ({simulation['duration']:g} s)")
+
+    def __init__(self, scenario: Any) -> None:
+        super().__init__(scenario)
+        self._built: CantileverModel | None = None
+
+    @property
+    def built(self) -> CantileverModel:
+        """The compiled model and its truth (built once)."""
+        if self._built is None:
+            sc = self.scenario
+            self._built = build_model(sc.rig_params, sc.simulation, sc.excitation)
+        return self._built
+
+    @property
+    def params(self) -> BeamParams:
+        return self.built.params
+
+    def simulate(self, progress: Callable[[float], None] | None = None) -> Dataset:
+        """Roll the model out under the impact; see :mod:`models.cantilever.simulate`."""
+        sc, b = self.scenario, self.built
+        fs = float(sc.simulation["sample_rate"])
+        n = round(sc.simulation["duration"] * fs)
+        st = b.stepping
+        exc = sc.excitation
+        force = half_sine(exc["peak_force"], exc["pulse_duration"], exc["start"])
+        control = force((np.arange(n * st.substeps) + 0.5) * st.timestep)  # mid-step values
+        q0 = static_equilibrium(b.model, b.K) if sc.simulation["gravity"] == "removed" \
+            else np.zeros(b.model.nq)
+        sens = rollout_sensors(b.model, q0, control, st.substeps, progress)
+        if not np.all(np.isfinite(sens)):
+            raise RigError(f"cantilever simulation diverged with {st.integrator} at dt = "
+                           f"{st.timestep:.3g} s; use simulation.timestep = 0 (automatic)")
+        rest = rollout_sensors(b.model, q0, np.zeros(st.substeps), st.substeps)[0]
+        adr = b.model.sensor_adr  # per sensor i: acc (site frame), pos, vel (world); z = index 2
+        ns = len(b.sensors)
+        acc_z, pos_z, vel_z = (np.array([adr[3 * i + k] + 2 for i in range(ns)]) for k in range(3))
+        acc = sens[:, acc_z].T - rest[acc_z][:, None]  # static reading: 0, or gravity's
+        pos = sens[:, pos_z].T - rest[pos_z][:, None]  # displacement from the rest pose
+        vel = sens[:, vel_z].T
+        labels = [str(i + 1) for i in range(ns)]
+        t = np.arange(n) / fs
+        ds = Dataset(
+            fs=fs,
+            measured={
+                "acceleration": Signal(acc, tuple("acc" + s for s in labels), "m/s^2", b.sensors),
+                "force": Signal(force(t)[None, :], ("force",), "N", np.array([b.hit])),
+            },
+            reference={
+                "displacement": Signal(pos, tuple("disp" + s for s in labels), "m", b.sensors),
+                "velocity": Signal(vel, tuple("vel" + s for s in labels), "m/s", b.sensors),
+                "acceleration": Signal(acc.copy(), tuple("acc" + s for s in labels), "m/s^2",
+                                       b.sensors),
+            },
+        )
+        ds.truth, ds.truth_units = b.truth()
+        # Prior knowledge an identifier may be given: the beam's weighed mass, and the
+        # trace of the SEREP mass matrix, the scale an identifier of a sensor-coordinate
+        # model (Mr, Cr, Kr) can normalise to (free vibration fixes only Mr^-1 Kr).
+        ds.prior = {"total_mass": float(b.params.total_mass),
+                    "reduced_mass_trace": float(np.trace(b.red.Mr))}
+        ds.attrs.update(gravity=sc.simulation["gravity"], integrator=st.integrator,
+                        timestep=float(st.timestep), substeps=int(st.substeps),
+                        n_dof=int(b.model.nv), free_start=int(np.ceil(
+                            (exc["start"] + exc["pulse_duration"]) * fs)) + 1)
+        return ds
