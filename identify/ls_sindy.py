@@ -1,0 +1,101 @@
+"""Conventional least-squares SINDy for structures: the SGD-SINDy paper's Eq. 1 baseline."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from identify import IDENTIFIERS
+from identify.structural import (
+    StructuralIdentifier,
+    build_library,
+    mass_prior_value,
+    matrices_from_coef,
+)
+from testbed.measurement import Measurement
+
+
+@IDENTIFIERS.register("ls_sindy", tags=("structural", "baseline", "paper:000"))
+class LeastSquaresSINDy(StructuralIdentifier):
+    """Least-squares SINDy, ``x'' = Theta Xi`` with ``Theta = [x', x (, x^3)]`` (Eq. 1).
+
+    Each channel's acceleration is regressed on all channels' velocities and displacements
+    (and cubes), independently per channel, over the free-vibration window
+    ``data.free_start:``.  If the window holds a nonzero measured input, the channel's own
+    forcing ``(B u)_i`` [N] is one more feature (its coefficient estimates ``1 / M_ii``).
+
+    Parameters
+    ----------
+    cubic : bool
+        Add the cubic displacement features ``x_j^3``.
+    mass_prior : {"reduced_mass_trace", "total_mass"}
+        Key of ``data.prior`` giving the mass scale [kg] (see
+        :func:`identify.structural.mass_prior_value`); same option as ``sgd_sindy``.
+    rcond : float
+        Relative singular-value cut-off of the least-squares solve (``numpy.linalg.lstsq``)
+        on column-standardised features.
+
+    Attributes
+    ----------
+    M_, C_, K_ : ndarray, shape (n, n)
+        ``M_ = (m_hat / n) I`` [kg], ``C_ = -M_ Xi_v`` [N s/m], ``K_ = -M_ Xi_d`` [N/m].
+    K3_ : ndarray, shape (n, n) or None
+        ``-M_ Xi_c`` [N/m^3] if ``cubic``.
+    coef_ : ndarray, shape (n, n_features)
+        Regression coefficients in SI units, row i predicts ``x''_i``.
+    feature_names_ : list of str
+    natural_frequencies_ : ndarray, shape (n,)
+        [Hz] from ``eig(K_, M_)``.
+    modes_ : ndarray, shape (n, n)
+    input_map_ : ndarray or None
+        ``data.input_map``.
+    n_steps_ : int
+        0 (closed form).
+
+    Notes
+    -----
+    What it can represent: any ``M^-1 K`` and ``M^-1 C`` (the identifiable part of a linear
+    model); on noise-free free-vibration data it recovers them exactly.  What it cannot: the
+    mass coupling.  With no acceleration features the implied mass matrix is diagonal, so the
+    reported ``M_`` is the identity times ``m_hat / n`` (trace = the prior) and ``K_ = M_ M^-1 K``
+    is in general *not* symmetric; it equals the true K only for a diagonal, uniform true M.
+    The paper attributes its poor TRAC (68 %) and mode-2 MAC (75 %) to this assumption.
+    """
+
+    name = "ls_sindy"
+
+    def __init__(self, cubic: bool = False, mass_prior: str = "reduced_mass_trace", rcond: float = 1e-10):
+        self.cubic = cubic
+        self.mass_prior = mass_prior
+        self.rcond = rcond
+
+    def fit(self, data: Measurement) -> LeastSquaresSINDy:
+        """Fit on ``data`` (signals only; the mass prior from ``data.prior``).
+
+        Parameters
+        ----------
+        data : Measurement
+
+        Returns
+        -------
+        self
+        """
+        m_hat = mass_prior_value(data, self.mass_prior)
+        lib = build_library(data, coupled_mass=False, cubic=bool(self.cubic))
+        n, p = lib.target.shape[0], lib.theta.shape[0]
+        scale = np.sqrt(np.mean(lib.theta**2, axis=1))
+        scale[scale == 0] = 1.0
+        phi = (lib.theta / scale[:, None]).T
+        coef = np.zeros((n, p))
+        for i in range(n):
+            cols = np.flatnonzero(lib.mask[i])
+            sol, *_ = np.linalg.lstsq(phi[:, cols], lib.target[i], rcond=self.rcond)
+            coef[i, cols] = sol / scale[cols]
+        masses = np.full(n, m_hat / n)
+        self.coef_ = coef
+        self.feature_names_ = lib.names
+        self.channels_ = tuple(data.channels)
+        self.M_, self.C_, self.K_, self.K3_ = matrices_from_coef(coef, lib.blocks, masses)
+        self.input_map_ = None if data.input_map is None else np.asarray(data.input_map, dtype=float)
+        self.n_steps_ = 0
+        self._finish_fit()
+        return self

