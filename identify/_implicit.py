@@ -1,0 +1,235 @@
+"""Shared machinery of the implicit (SINDy-PI) identifiers: the shared-Gram sequentially
+thresholded least-squares sweep, held-out model selection, and equation selection.
+
+All regressions run in *normalised* units: column c of the library is divided by its training
+norm ``s_c``, so a coefficient is the share of a unit-norm column and one threshold means the
+same for every term.  An implicit model for left-hand side j is a row ``W`` (n_terms,) with
+``W[j] = 1`` and ``Theta_n @ W ~ 0``; its held-out error is the normalised residual
+``||Theta_val,n W||^2 / ||Theta_val,n[:, j]||^2 = W^T G_v W / G_v[j, j]``, computed from the
+validation Gram matrix ``G_v`` for every model at once.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from testbed.errors import IdentificationError
+
+DEFAULT_THRESHOLDS = np.r_[0.0, np.logspace(-6, -0.5, 12)]
+
+
+def split_index(n_samples: int, val_fraction: float) -> int:
+    """Index of the first validation sample: the last ``val_fraction`` of the record in time."""
+    if not 0.0 < val_fraction < 1.0:
+        raise ValueError(f"val_fraction must lie in (0, 1), got {val_fraction}")
+    n_tr = round(n_samples * (1.0 - val_fraction))
+    if n_tr < 2 or n_samples - n_tr < 2:
+        raise IdentificationError(f"{n_samples} samples are too few to split for validation")
+    return n_tr
+
+
+def grams(Theta: np.ndarray, n_train: int) -> tuple[np.ndarray, np.ndarray]:
+    """Training and validation Gram matrices ``Theta^T Theta``, each (p, p)."""
+    T = np.ascontiguousarray(Theta.T)
+    return T[:, :n_train] @ T[:, :n_train].T, T[:, n_train:] @ T[:, n_train:].T
+
+
+@dataclass
+class Sweep:
+    """Every (threshold, candidate) model of a SINDy-PI sweep.
+
+    Attributes
+    ----------
+    scale : ndarray, shape (p,)
+        Training norm of each column (1 for all-zero columns).
+    candidates : ndarray of int, shape (C,)
+        Left-hand-side column of each model.
+    thresholds : ndarray, shape (T,)
+        Thresholds on normalised coefficients.
+    W : ndarray, shape (T, C, p)
+        Implicit coefficients in normalised units, ``W[t, c, candidates[c]] = 1``.
+    val_error, train_error : ndarray, shape (T, C)
+        Normalised squared residuals on the validation and training samples.
+    nnz : ndarray of int, shape (T, C)
+        Number of terms of each model (left-hand side included).
+    """
+
+    scale: np.ndarray
+    candidates: np.ndarray
+    thresholds: np.ndarray
+    W: np.ndarray
+    val_error: np.ndarray
+    train_error: np.ndarray
+    nnz: np.ndarray
+
+    def coef(self, t: int, c: int) -> np.ndarray:
+        """Model (t, c) in original units, scaled to max |coef| = 1 with that entry positive."""
+        w = self.W[t, c] / self.scale
+        return w / w[np.argmax(np.abs(w))]
+
+
+def _errors(W: np.ndarray, G: np.ndarray, cand: np.ndarray) -> np.ndarray:
+    num = np.einsum("tcp,tcp->tc", W @ G, W)
+    den = G[cand, cand]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(den > 0, np.maximum(num, 0.0) / np.where(den > 0, den, 1.0), np.inf)
+
+
+def _solve_masked(Gn: np.ndarray, cand: np.ndarray, mask: np.ndarray, ridge: float) -> np.ndarray:
+    """Batched least squares of column cand[k] on the columns mask[k], all k at once."""
+    m = mask.astype(float)
+    A = Gn[None, :, :] * (m[:, :, None] * m[:, None, :])
+    d = np.arange(Gn.shape[0])
+    A[:, d, d] += np.where(mask, ridge, 1.0)
+    rhs = Gn[cand] * m
+    try:
+        return np.linalg.solve(A, rhs[..., None])[..., 0]
+    except np.linalg.LinAlgError:  # an exactly singular support: minimum-norm solution instead
+        return (np.linalg.pinv(A, hermitian=True) @ rhs[..., None])[..., 0] * m
+
+
+def stlsq_sweep(G_train: np.ndarray, G_val: np.ndarray, candidates: Sequence[int],
+                thresholds: Sequence[float], ridge: float = 1e-14, max_iter: int = 20) -> Sweep:
+    """SINDy-PI by sequentially thresholded least squares, all candidates on one Gram matrix.
+
+    For left-hand side j the regression ``Theta_j ~ Theta_{-j} xi`` has normal equations
+    ``G_{-j,-j} xi = G_{-j,j}``.  The first (unthresholded) solutions of all candidates come
+    from one inverse, ``B = (G + ridge I)^-1``: ``xi = -B[:, j] / B[j, j]`` (the Schur
+    complement identity).  Then, threshold by threshold (ascending, warm-started from the
+    previous threshold's models), coefficients with ``|xi| < threshold`` are zeroed and the
+    models whose support changed are refitted on their support in one batched solve, until no
+    support changes (at most ``max_iter`` rounds).
+
+    Parameters
+    ----------
+    G_train, G_val : ndarray, shape (p, p)
+        Gram matrices of the training and validation samples.
+    candidates : sequence of int
+        Left-hand-side columns.
+    thresholds : sequence of float
+        Thresholds on normalised coefficients, ascending.
+    ridge : float
+        Added to the unit diagonal of the normalised Gram matrix.  The default 1e-14 is a
+        numerical safeguard at the level of the Gram matrix's own round-off (it biases a
+        coefficient by about ridge / smallest eigenvalue); raise it for ridge regression.
+    max_iter : int
+        Thresholding rounds per threshold.
+
+    Returns
+    -------
+    Sweep
+    """
+    p = G_train.shape[0]
+    s = np.sqrt(np.clip(np.diag(G_train), 0.0, None))
+    dead = s <= 1e-300 + 1e-150 * s.max(initial=0.0)
+    s = np.where(dead, 1.0, s)
+    Gn = G_train / np.outer(s, s)
+    Gv = G_val / np.outer(s, s)
+    cand = np.asarray(candidates, dtype=np.intp)
+    cand = cand[~dead[cand]]
+    if cand.size == 0:
+        raise IdentificationError("every candidate left-hand-side column is zero on the data")
+    thr = np.asarray(thresholds, dtype=float)
+    if np.any(np.diff(thr) < 0):
+        raise ValueError("thresholds must be ascending")
+    n_c, idx = cand.size, np.arange(cand.size)
+    A = Gn + ridge * np.eye(p)
+    A[dead, dead] = 1.0
+    B = np.linalg.inv(A)
+    xi = -(B[:, cand] / B[cand, cand]).T
+    base = ~dead[None, :].repeat(n_c, axis=0)
+    base[idx, cand] = False
+    xi[~base] = 0.0
+    mask = base.copy()
+    models = np.empty((thr.size, n_c, p))
+    for t, lam in enumerate(thr):
+        for _ in range(max_iter):
+            new = base & (np.abs(xi) >= lam)
+            changed = np.flatnonzero((new != mask).any(axis=1))
+            if changed.size == 0:
+                break
+            mask[changed] = new[changed]
+            xi[changed] = _solve_masked(Gn, cand[changed], mask[changed], ridge)
+        models[t] = xi
+    if not np.all(np.isfinite(models)):
+        raise IdentificationError("the thresholded least-squares sweep produced non-finite "
+                                  "coefficients (library columns exactly dependent?)")
+    W = -models
+    W[:, idx, cand] = 1.0
+    return Sweep(scale=s, candidates=cand, thresholds=thr, W=W, val_error=_errors(W, Gv, cand),
+                 train_error=_errors(W, Gn, cand), nnz=np.count_nonzero(W, axis=2))
+
+
+def input_shares(W: np.ndarray, input_cols: Sequence[np.ndarray]) -> np.ndarray:
+    """Largest |normalised coefficient| of each input's terms, shape (n_inputs,) + W.shape[:-1]."""
+    return np.stack([np.abs(W[..., c]).max(axis=-1) if c.size else np.zeros(W.shape[:-1])
+                     for c in input_cols])
+
+
+def rank_models(sw: Sweep, elig: np.ndarray, rtol: float, atol: float) -> np.ndarray:
+    """Flat (threshold, candidate) indices of the eligible models, best first.
+
+    A model whose held-out error is within ``best * (1 + rtol) + atol`` counts as equally good
+    as the best; those come first, fewest terms first, then smaller held-out error, then index
+    (deterministic).  The others follow by held-out error.  Ineligible models are left out.
+    """
+    err = np.where(elig & np.isfinite(sw.val_error), sw.val_error, np.inf)
+    if not np.isfinite(err).any():
+        return np.zeros(0, dtype=np.intp)
+    good = err <= err.min() * (1.0 + rtol) + atol
+    order = np.lexsort((np.arange(err.size), err.ravel(),
+                        np.where(good, sw.nnz, np.iinfo(np.int64).max).ravel(), ~good.ravel()))
+    return order[np.isfinite(err.ravel()[order])]
+
+
+def select_models(sw: Sweep, input_cols: Sequence[np.ndarray], rtol: float = 0.1,
+                  atol: float = 1e-12, top: int = 1) -> list[list[tuple[int, int]]]:
+    """Pick the implicit equation of each input by held-out error, then parsimony.
+
+    Models eligible for input k are those whose input-k terms carry a larger normalised
+    coefficient than every other input's terms (so a sparse model contains u_k and no other
+    input, and the equations picked for different inputs are distinct).  They are ranked by
+    :func:`rank_models`.
+
+    Parameters
+    ----------
+    sw : Sweep
+    input_cols : sequence of ndarray of int
+        Library columns carrying each input.
+    rtol : float
+        Relative tolerance on the held-out error; 0.1 because the held-out residual of models
+        differing by noise-level terms varies by about that much between validation windows.
+    atol : float
+        Absolute floor of the normalised squared residual: 1e-12 (a relative residual norm
+        of 1e-6) is where the Gram-based residual of an exact model loses its digits.
+    top : int
+        Number of models returned per input (distinct supports, best first).
+
+    Returns
+    -------
+    list (one per input) of list of (threshold index, candidate index)
+    """
+    shares = input_shares(sw.W, input_cols)
+    out = []
+    for k in range(len(input_cols)):
+        others = np.delete(shares, k, axis=0)
+        other = others.max(axis=0) if others.size else np.zeros_like(shares[k])
+        order = rank_models(sw, (shares[k] > 0) & (shares[k] > other), rtol, atol)
+        if order.size == 0:
+            raise IdentificationError(f"no implicit model contains input {k + 1} as its dominant "
+                                      "input: the library lacks its terms or the input is zero")
+        picked: list[tuple[int, int]] = []
+        seen: set[bytes] = set()
+        for flat in order:
+            t, c = np.unravel_index(flat, sw.val_error.shape)
+            key = np.flatnonzero(sw.W[t, c]).tobytes()
+            if key not in seen:
+                seen.add(key)
+                picked.append((int(t), int(c)))
+            if len(picked) == top:
+                break
+        out.append(picked)
+    return out
