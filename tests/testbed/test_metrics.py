@@ -192,3 +192,22 @@ def test_cross_orthogonality_identity_for_perfect_modes():
     mixed = np.stack([phi[:, 0] + phi[:, 1], phi[:, 1]], axis=1)
     xo = mt.cross_orthogonality(mixed, phi, M2)
     np.testing.assert_allclose(np.abs(xo), [[2**-0.5, 2**-0.5], [0.0, 1.0]], atol=1e-12)
+
+
+def test_modes_of_a_nonsymmetric_identified_stiffness_are_the_right_eigenvectors():
+    """A model with diagonal M and K = M A (A = M_true^-1 K_true, not symmetric in these coordinates)
+    vibrates in the eigenvectors of A; symmetrising K would report other shapes."""
+    import numpy as np
+
+    from testbed.metrics import mac_matrix, modal_from_matrices
+
+    m_true = np.array([[2.0, 0.5], [0.5, 1.0]])
+    k_true = np.array([[300.0, -100.0], [-100.0, 200.0]])
+    a = np.linalg.solve(m_true, k_true)
+    m_id = np.eye(2) * 1.5
+    k_id = m_id @ a
+    assert not np.allclose(k_id, k_id.T)
+    f_true, _, phi_true = modal_from_matrices(m_true, None, k_true)
+    f_id, _, phi_id = modal_from_matrices(m_id, None, k_id)
+    np.testing.assert_allclose(f_id, f_true, rtol=1e-12)
+    np.testing.assert_allclose(np.diag(mac_matrix(phi_id, phi_true)), 1.0, rtol=1e-12)

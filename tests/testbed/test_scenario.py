@@ -114,3 +114,20 @@ def test_cli_prints_one_line_and_exits_2(tmp_path, capsys):
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "Traceback" not in err
     assert "rig.n_segments" in err and "-4" in err
+
+
+def test_extends_replaces_identify_and_score_whole(tmp_path):
+    parent = GOOD + '[identify]\nmethod = "sgd_sindy"\nepochs = 7\n[score]\ntrac_min = 0.9\nmac_min = 0.9\n'
+    _write(tmp_path, parent, name="base")
+    own = _write(tmp_path, '[scenario]\nname = "own"\nextends = "base.toml"\n'
+                 '[identify]\nmethod = "ls_sindy"\n[score]\ntrac_min = 0.5\n', name="own")
+    sc = load_scenario(own)
+    assert sc.identify == {"method": "ls_sindy"}  # no epochs inherited from sgd_sindy
+    assert sc.score == {"trac": {"min": 0.5}}  # no mac_min inherited
+    bare = _write(tmp_path, '[scenario]\nname = "bare"\nextends = "base.toml"\n'
+                  '[identify]\nmethod = "ls_sindy"\n', name="bare")
+    assert load_scenario(bare).score == {}
+    noisy = _write(tmp_path, '[scenario]\nname = "noisy"\nextends = "base.toml"\n[noise]\nrms_percent = 1\n',
+                   name="noisy")
+    sc = load_scenario(noisy)
+    assert sc.identify == {"method": "sgd_sindy", "epochs": 7} and set(sc.score) == {"trac", "mac"}

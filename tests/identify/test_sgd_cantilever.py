@@ -1,0 +1,64 @@
+"""SGD-SINDy and its helpers on the real cantilever data (scenario ``cantilever_stiff_impact``).
+
+The stiff cantilever: true modes 82.77 / 517.4 / 1447 Hz, damping ratios 0.010 / 0.063 / 0.175
+(``C = beta K``), 3 sensors at L/3, 2L/3, L, 12.8 kHz, 1 s, tip impact.  Mode 2 lives in the
+first ~30 ms of the free decay and mode 3 in the first ~3 ms, which is what makes this case hard.
+The dataset is generated once per session through the shared ``dataset_cache`` fixture.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from identify.sgd_sindy import SGDSINDy
+from identify.structural import measured_frequencies
+from testbed.preprocess import measure
+from testbed.run import noise_free
+from testbed.scenario import load_scenario
+from testbed.scoring import score_structural
+
+
+@pytest.fixture(scope="module")
+def stiff(dataset_cache):
+    sc = load_scenario("cantilever_stiff_impact")
+    ds = dataset_cache.get(sc)
+    return ds, measure(ds, sc.signal, "structural"), measure(noise_free(ds), sc.signal, "structural")
+
+
+def test_measured_frequencies_find_modes_1_and_2(stiff):
+    """The rectangular window keeps mode 2 (a Hann window suppressed it: only 82.76 Hz was found).
+
+    Measured: 82.767 Hz (true 82.766, 1e-5) and 515.88 Hz (true 517.40, -0.29 %: the peak of a
+    mode damped at zeta 0.063 in the spectrum of a decay that starts 1 ms after the pulse).
+    Mode 3 (zeta 0.175, ~40 samples of ringing) gives no peak 6 dB above its surroundings.
+    """
+    ds, data, _ = stiff
+    f_true = np.asarray(ds.truth["frequencies_hz"])[:2]
+    f = measured_frequencies(data, 3)
+    assert f.size == 2
+    assert np.all(np.abs(f / f_true - 1) < 0.005)  # measured 1e-5 and 2.9e-3
+
+
+def test_deterministic_and_finite_on_real_data(stiff):
+    _, data, _ = stiff
+    a = SGDSINDy(epochs=2, steps_per_epoch=20).fit(data)
+    b = SGDSINDy(epochs=2, steps_per_epoch=20).fit(data)
+    assert np.array_equal(a.coef_, b.coef_)
+    assert np.all(np.isfinite(a.coef_)) and np.all(np.isfinite(a.M_))
+    assert a.n_steps_ == 40
+
+
+def test_stiff_targets_at_reduced_budget(stiff):
+    """The issue's stiff targets after 20 epochs (2,000 gradient steps, 0.2 % of the paper's budget).
+
+    Measured: TRAC >= 0.966, MAC 1.000, frequency error 0.57 %; the paper-literal coefficient
+    parametrisation diverges here (its null space, see identify/_sgd_matrix.py).
+    """
+    ds, data, clean = stiff
+    model = SGDSINDy(epochs=20).fit(data)
+    assert model.n_steps_ == 2000
+    v = score_structural(ds, data, clean, model).values
+    assert v["trac"] >= 0.95 and v["mac"] >= 0.95 and v["freq_error"] <= 0.01
+    assert np.all(np.linalg.eigvalsh(model.M_) > 0)  # symmetric positive definite by construction
+    np.testing.assert_allclose(np.trace(model.M_), data.prior["reduced_mass_trace"], rtol=1e-12)
