@@ -63,7 +63,8 @@ def amplitude_spectrum(x: np.ndarray, fs: float) -> tuple[np.ndarray, np.ndarray
 
 def peak_frequencies(x: np.ndarray, fs: float, n_peaks: int, fmin: float = 0.0,
                      fmax: float | None = None, window: str = "boxcar", pad: int = 4,
-                     min_prominence_db: float = 6.0, dynamic_range_db: float = 40.0) -> np.ndarray:
+                     min_prominence_db: float = 6.0, dynamic_range_db: float = 40.0,
+                     min_rel_separation: float = 0.0) -> np.ndarray:
     """Natural frequencies from the peaks of the summed power spectrum of measured signals.
 
     Parameters
@@ -90,6 +91,10 @@ def peak_frequencies(x: np.ndarray, fs: float, n_peaks: int, fmin: float = 0.0,
         not count.
     dynamic_range_db : float
         Candidates more than this [dB] below the highest one are dropped.
+    min_rel_separation : float
+        Keep only the highest of candidates closer than this fraction of their frequency
+        (0 = off): the peak of a nonlinear mode, whose frequency drifts as it decays, smears
+        into neighbouring maxima.
 
     Returns
     -------
@@ -145,6 +150,17 @@ def peak_frequencies(x: np.ndarray, fs: float, n_peaks: int, fmin: float = 0.0,
         raise ValueError(f"found {idx.size} spectral peak(s) with prominence >= {min_prominence_db} dB "
                          f"within {dynamic_range_db} dB of the highest in [{fmin:g}, {fmax:g}] Hz, "
                          f"asked for {n_peaks}")
+    if min_rel_separation > 0 and idx.size:
+        # One mode of a nonlinear structure sweeps in frequency as its amplitude decays and its
+        # peak smears into neighbours: keep only the highest peak within the relative band.
+        kept: list[int] = []
+        for k in idx[np.argsort(power[idx])[::-1]]:
+            if all(abs(freqs[k] - freqs[j]) > min_rel_separation * freqs[j] for j in kept):
+                kept.append(k)
+        idx = np.sort(np.asarray(kept))
+        if idx.size < n_peaks:
+            raise ValueError(f"found {idx.size} spectral peak(s) at least {min_rel_separation:.0%} apart in "
+                             f"[{fmin:g}, {fmax:g}] Hz, asked for {n_peaks}")
     chosen = idx[np.argsort(power[idx])[::-1][:n_peaks]]
     df = freqs[1] - freqs[0]
     out = np.empty(n_peaks)

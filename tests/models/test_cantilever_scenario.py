@@ -21,7 +21,8 @@ def test_scenario_files_load(name):
     sc = load_scenario(name)
     assert sc.name == name and sc.rig == "cantilever"
     assert sc.rig_params["base"] == name.split("_")[1]
-    assert sc.noise["rms_percent"] == 0.0 and sc.identify is None
+    assert sc.noise["rms_percent"] == 0.0
+    assert sc.identify is not None and sc.identify["method"] == "sgd_sindy"  # the paper's method
 
 
 @pytest.fixture(scope="module")
