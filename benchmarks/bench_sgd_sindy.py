@@ -255,7 +255,8 @@ def run(default_epochs: int | None = None) -> list[dict]:
     model = SGDSINDy(epochs=epochs).fit(data)
     t_sgd = time.perf_counter() - t0
     s = scorer(model)
-    rows.append({"name": "wall_time_scenario_fit", "value": t_sgd, "unit": "s", "target": "report", "ok": None,
+    rows.append({"name": "wall_time_scenario_fit", "value": t_sgd, "unit": "s", "target": "report",
+                 "ok": None,
                  "note": f"SGDSINDy(epochs={epochs}) = {model.n_steps_} steps, "
                          f"{1e6 * t_sgd / max(model.n_steps_, 1):.0f} us/step; TRAC {s['trac']:.4f}, "
                          f"MAC {s['mac']:.4f}, freq error {100 * s['freq_error']:.3f} %; the paper's full "
