@@ -61,24 +61,30 @@ class LoopClosure:
     def from_prior(cls, prior: dict[str, Any], passive: np.ndarray) -> LoopClosure | None:
         """Paper convention (its Eqs. 2-3): ``l1 e1 + l2 e2 - l3 e3 - l4 e4 = (L0, 0)``.
 
-        Keys: ``link_lengths`` [l1, l2, l3, l4] [m] (or ``l1``..``l4``) and ``base_length``
-        L0 [m] (or ``l0``).  None if absent.
+        Keys: ``l1``..``l4`` and ``L0`` [m] (what the five-bar rig declares), or
+        ``link_lengths`` [l1, l2, l3, l4] and ``base_length`` (``l0`` also accepted).  None if
+        the link lengths or the base length are absent.
         """
-        if "link_lengths" in prior:
-            ll = np.asarray(prior["link_lengths"], dtype=float).ravel()
-        elif all(f"l{i}" in prior for i in range(1, 5)):
-            ll = np.array([float(prior[f"l{i}"]) for i in range(1, 5)])
+        if all(f"l{i}" in prior for i in range(1, 5)):
+            ll, src = np.array([float(prior[f"l{i}"]) for i in range(1, 5)]), "l1..l4"
+        elif "link_lengths" in prior:
+            ll, src = np.asarray(prior["link_lengths"], dtype=float).ravel(), "link_lengths"
         else:
             return None
-        base = prior.get("base_length", prior.get("l0"))
-        if base is None or ll.size != 4:
+        key = next((k for k in ("L0", "base_length", "l0") if k in prior), None)
+        if key is None or ll.size != 4:
             return None
-        return cls(ll * np.array([1.0, 1.0, -1.0, -1.0]), np.array([float(base), 0.0]),
-                   np.asarray(passive), "prior (link_lengths, base_length)")
+        return cls(ll * np.array([1.0, 1.0, -1.0, -1.0]), np.array([float(prior[key]), 0.0]),
+                   np.asarray(passive), f"prior ({src}, {key})")
 
     @classmethod
-    def from_data(cls, x: np.ndarray, passive: np.ndarray) -> LoopClosure:
-        """Fit ``a`` and ``b`` (up to scale) as the null vector of the stacked closure rows."""
+    def from_data(cls, x: np.ndarray, passive: np.ndarray, strict: bool = True) -> LoopClosure:
+        """Fit ``a`` and ``b`` (up to scale) as the null vector of the stacked closure rows.
+
+        With ``strict`` (default) raise unless the smallest singular value is below 1e-3 of the
+        next (a clear null direction); ``strict=False`` returns the least-squares fit anyway (to
+        measure the noise floor of the closure residual).
+        """
         n, N = x.shape
         stride = max(1, N // 20000)  # 20k samples determine 6 numbers amply
         xs = x[:, ::stride]
@@ -87,10 +93,10 @@ class LoopClosure:
                                np.hstack([np.sin(xs).T, np.zeros((xs.shape[1], 1)),
                                           -np.ones((xs.shape[1], 1))])])
         _, sv, Vt = np.linalg.svd(rows, full_matrices=False)
-        if sv[-1] > 1e-3 * sv[-2]:
+        if strict and sv[-1] > 1e-3 * sv[-2]:
             raise IdentificationError(
                 "no loop closure fits the measured angles (smallest singular values "
-                f"{sv[-2]:.3g}, {sv[-1]:.3g}) and data.prior has no link_lengths/base_length")
+                f"{sv[-2]:.3g}, {sv[-1]:.3g})")
         v = Vt[-1] / np.abs(Vt[-1, :n]).max()
         v = v * np.sign(v[0])  # sign convention: first link positive
         return cls(v[:n], v[n:], np.asarray(passive), "data (null vector of the closure rows)")
@@ -98,10 +104,13 @@ class LoopClosure:
     def __post_init__(self) -> None:
         self.active = np.setdiff1d(np.arange(self.a.size), self.passive)
 
-    def residual(self, x: np.ndarray) -> float:
-        """Largest closure error on the samples, relative to the longest link."""
+    def residual(self, x: np.ndarray, rms: bool = False) -> float:
+        """Largest (or with ``rms`` the RMS) closure error on the samples, relative to the
+        longest link."""
         gx = self.a @ np.cos(x) - self.b[0]
         gy = self.a @ np.sin(x) - self.b[1]
+        if rms:
+            return float(np.sqrt(np.mean(gx**2 + gy**2)) / np.abs(self.a).max())
         return float(max(np.abs(gx).max(), np.abs(gy).max()) / np.abs(self.a).max())
 
     def _jac(self, q: np.ndarray) -> tuple[np.ndarray, ...]:
@@ -131,6 +140,23 @@ class LoopClosure:
         dq[p0], dq[p1] = _solve2(jx[p0], jx[p1], jy[p0], jy[p1], -(jx[act] * dq[act]).sum(0),
                                  -(jy[act] * dq[act]).sum(0))
         return dq
+
+    def reconcile(self, q: np.ndarray, dq: np.ndarray, ddq: np.ndarray
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Measured (n, N) angles, rates, accelerations with the passive rows replaced by those
+        the closure implies from the actuated rows (measured passive angles as Newton guess).
+
+        Data reconciliation with the known geometry: the returned samples lie exactly on the
+        loop manifold, so its kinematic identities hold exactly among library columns again
+        (on noisy, smoothed angles they hold only to the noise level and cannot be told apart
+        from genuine near-dependencies).
+        """
+        q = self.solve(q)
+        dq = self.velocity(q, dq)
+        ddq = np.array(ddq, dtype=float)
+        P, r = self.acceleration_map(q, dq)
+        ddq[self.passive] = ((P @ ddq[self.active].T[..., None])[..., 0] + r).T
+        return q, dq, ddq
 
     def acceleration_map(self, q: np.ndarray, dq: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """``ddq_p = P ddq_a + r``: P (N, 2, n_a), r (N, 2)."""
@@ -206,13 +232,27 @@ class ImplicitModel:
         return q, self.closure.velocity(q, dq)
 
     def simulate(self, x0: np.ndarray, xd0: np.ndarray, t: np.ndarray, u: np.ndarray | None,
-                 dt: float) -> Trajectory:
-        """Free simulation by RK4 with step <= dt [s]; output at the times t (cubic Hermite)."""
+                 dt: float, input_hold: str = "linear") -> Trajectory:
+        """Free simulation by RK4 with step <= dt [s]; output at the times t (cubic Hermite).
+
+        ``input_hold`` says what the sampled inputs stand for: ``"linear"`` a continuous signal
+        (linear interpolation between samples); ``"zoh"`` a zero-order hold (each sample held
+        until the next, as an actuator driven by a DAC does).  A hold of a smooth signal is
+        that signal delayed by half a sample plus zero-mean ripple, so ``"zoh"`` interpolates
+        the samples delayed by half an interval: the input's integral over every RK4 step is
+        then right to O(interval^2), whatever the step.  Taking a held input for a linear one
+        adds an impulse ``u(0) / (2 fs)`` at the start; on the five-bar multisine record
+        (10 kHz) the exact equations then drift by 5e-4 rad over 10 s; with ``"zoh"`` they stay
+        within 6e-7 rad at dt = 1 ms (8e-8 rad at 0.25 ms: what is left is RK4 sampling the input).
+        """
         t = np.asarray(t, dtype=float)
         n_steps = max(1, int(np.ceil((t[-1] - t[0]) / dt - 1e-9)))
         h = (t[-1] - t[0]) / n_steps
         tt = t[0] + 0.5 * h * np.arange(2 * n_steps + 1)
-        uu = None if u is None else np.stack([np.interp(tt, t, row) for row in np.atleast_2d(u)])
+        if input_hold not in ("linear", "zoh"):
+            raise ValueError(f"input_hold must be 'linear' or 'zoh', got {input_hold!r}")
+        delay = 0.5 * (t[1] - t[0]) if input_hold == "zoh" and t.size > 1 else 0.0
+        uu = None if u is None else np.stack([np.interp(tt - delay, t, row) for row in np.atleast_2d(u)])
         act = self.actuated
         q, dq = self._complete(np.array(x0, float)[:, None], np.array(xd0, float)[:, None])
         Q = np.empty((n_steps + 1, q.shape[0]))

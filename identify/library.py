@@ -22,8 +22,9 @@ chain term, and the Fourier modes ``x +- y`` of ``sin(x)cos(y)`` only collide fo
 (the same column).  Single-angle products (``sin(th1)*cos(th2)``) are never generated: they
 are exactly dependent on the difference terms.  Data on the five-bar's loop-closure manifold
 add *kinematic* identities no builder can rule out (the loop constraint and its derivatives,
-times trig factors): measured on a 20 s loop-closed record, 2 among the 24 input-free columns
-of the reduced library and more than 40 in the full one.  They contain no input, so
+times trig factors): measured on 10 s loop-closed records (the rig's multisine, the synthetic
+five-bar), 2 among the 30 input-free columns of the reduced library (eigenvalues ~1e-16 of the
+unit-diagonal Gram matrix, the next one 2.6e-7..4.5e-6) and more than 20 in the full one.  They contain no input, so
 :func:`near_dependencies` on the input-free columns finds them, and
 ``SINDyPI(prune_tol=...)`` drops them in library order (``pruned_terms_``).
 """
@@ -250,11 +251,16 @@ def _pairs(n: int) -> list[tuple[int, int]]:
 
 
 def _chain_terms(a: int, b: int) -> tuple[list[str], list[str]]:
-    """Open-chain Lagrange terms of base joint a and distal joint b (1-based, absolute angles)."""
+    """Open-chain Lagrange terms of base joint a and distal joint b (1-based, absolute angles).
+
+    Both expressions carry both rates: the elbow joint's damping acts on the RELATIVE rate
+    ``dth_b - dth_a`` (a joint between two links), so in absolute angles R_a has ``(c_a + c_e)
+    dth_a - c_e dth_b`` and R_b has ``c_e (dth_b - dth_a)``.  The own rate comes first.
+    """
     lo, hi = min(a, b), max(a, b)
     cos_, sin_ = f"cos(th{lo}-th{hi})", f"sin(th{lo}-th{hi})"
-    return ([f"ddth{a}", f"{cos_}*ddth{b}", f"{sin_}*dth{b}^2", f"dth{a}"],
-            [f"ddth{b}", f"{cos_}*ddth{a}", f"{sin_}*dth{a}^2", f"dth{b}"])
+    return ([f"ddth{a}", f"{cos_}*ddth{b}", f"{sin_}*dth{b}^2", f"dth{a}", f"dth{b}"],
+            [f"ddth{b}", f"{cos_}*ddth{a}", f"{sin_}*dth{a}^2", f"dth{b}", f"dth{a}"])
 
 
 def fivebar_library(kind: str = "reduced", chains: Sequence[tuple[int, int]] = ((1, 2), (4, 3)),
@@ -262,8 +268,9 @@ def fivebar_library(kind: str = "reduced", chains: Sequence[tuple[int, int]] = (
     """Library of the five-bar's reduced implicit equations (see the module docstring).
 
     With R_i the open-chain Lagrange terms of joint i (chain (a, b), a at the base, b distal:
-    R_a ~ ``ddth_a, cos(th_a-th_b)*ddth_b, sin(th_a-th_b)*dth_b^2, dth_a``, R_b ~ ``ddth_b,
-    cos(th_a-th_b)*ddth_a, sin(th_a-th_b)*dth_a^2, dth_b``) and p, q the distal (passive)
+    R_a ~ ``ddth_a, cos(th_a-th_b)*ddth_b, sin(th_a-th_b)*dth_b^2, dth_a, dth_b``, R_b ~
+    ``ddth_b, cos(th_a-th_b)*ddth_a, sin(th_a-th_b)*dth_a^2, dth_b, dth_a``: both rates, as the
+    elbow joint damps the relative rate) and p, q the distal (passive)
     joints, eliminating the loop forces gives for actuated joint k
     ``a_p a_q sin(th_p-th_q) (R_k - u_k) = a_k a_q sin(th_k-th_q) R_p - a_k a_p sin(th_k-th_p) R_q``.
 
@@ -271,7 +278,8 @@ def fivebar_library(kind: str = "reduced", chains: Sequence[tuple[int, int]] = (
     ----------
     kind : {"reduced", "full"}
         ``"reduced"``: exactly those products for both actuated joints, with every input
-        times ``sin(th_p-th_q)`` (26 columns for the default chains).  ``"full"``: every
+        times ``sin(th_p-th_q)`` (32 columns for the default chains: exactly the terms of
+        the rig's true equations without gravity).  ``"full"``: every
         ``sin(th_i-th_j)`` (six pairs) times every chain term (``ddth_a``, ``ddth_b``,
         ``cos*ddth_a``, ``cos*ddth_b``, ``sin*dth_a^2``, ``sin*dth_b^2`` per chain, ``dth_1..4``,
         ``u_1..m``): 108 columns, free of functional identities but with dozens of kinematic
@@ -285,7 +293,7 @@ def fivebar_library(kind: str = "reduced", chains: Sequence[tuple[int, int]] = (
     -----
     Even the reduced library has two kinematic identities on loop-closed data (the
     acceleration-level loop constraint times trig factors, measured: eigenvalues 1e-16 of
-    the unit-diagonal Gram matrix of its 24 input-free columns on a 20 s record), and they lie
+    the unit-diagonal Gram matrix of its 30 input-free columns on 10 s records), and they lie
     within the support of each reduced equation: the implicit equations are unique only up to
     them.  ``SINDyPI(prune_tol=...)`` removes them; score against a truth modulo them.
     """

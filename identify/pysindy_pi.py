@@ -74,7 +74,7 @@ class PySINDyPI(_ImplicitMechanical):
     Parameters
     ----------
     library, lhs, val_fraction, selection, selection_rtol, selection_atol, n_rollout,
-    prune_tol, sim_dt
+    prune_tol, sim_dt, reconcile, column_lowpass_hz, column_lowpass_order, edge_trim, input_hold
         As :class:`~identify.sindy_pi.SINDyPI`.
     reg_weight_lam : float
         L1 weight of pysindy's objective.  1e-6 is the value of pysindy's SINDy-PI example; on
@@ -95,17 +95,24 @@ class PySINDyPI(_ImplicitMechanical):
     support_tol : float
         A coefficient counts as nonzero if above ``support_tol`` times the row's largest
         (L1 via OSQP gives no exact zeros); 0 keeps pysindy's result as it is.
+    stride : int
+        Give pysindy every ``stride``-th training sample only (its cost grows with the samples:
+        one OSQP problem per candidate, each carrying all of them).  The held-out selection
+        still uses every sample.  1 (default) gives it all; ignored with ``qr=True``, whose
+        problems are p x p whatever the samples.
     """
 
     name = "pysindy_pi"
 
     def __init__(self, library: Any = "fivebar", lhs: Sequence[str] | None = None,
                  reg_weight_lam: float = 1e-6, tol: float = 1e-5, max_iter: int = 10000,
-                 qr: bool = False, normalize: bool = True, support_tol: float = 0.0,
+                 qr: bool = False, normalize: bool = True, support_tol: float = 0.0, stride: int = 1,
                  val_fraction: float = 0.2,
                  selection: str = "holdout", selection_rtol: float = 0.1,
                  selection_atol: float = 1e-12, n_rollout: int = 3,
-                 prune_tol: float | None = 1e-9, sim_dt: float = 1e-3):
+                 prune_tol: float | None = 1e-9, sim_dt: float = 1e-3, reconcile: bool = True,
+                 column_lowpass_hz: float | None = None, column_lowpass_order: int = 4,
+                 edge_trim: float = 0.0, input_hold: str = "linear"):
         self.library = library
         self.lhs = lhs
         self.reg_weight_lam = reg_weight_lam
@@ -114,6 +121,7 @@ class PySINDyPI(_ImplicitMechanical):
         self.qr = qr
         self.normalize = normalize
         self.support_tol = support_tol
+        self.stride = stride
         self.val_fraction = val_fraction
         self.selection = selection
         self.selection_rtol = selection_rtol
@@ -121,11 +129,18 @@ class PySINDyPI(_ImplicitMechanical):
         self.n_rollout = n_rollout
         self.prune_tol = prune_tol
         self.sim_dt = sim_dt
+        self.reconcile = reconcile
+        self.column_lowpass_hz = column_lowpass_hz
+        self.column_lowpass_order = column_lowpass_order
+        self.edge_trim = edge_trim
+        self.input_hold = input_hold
 
     def _sweep(self, G_train, G_val, cand, Theta_train):
         s = np.sqrt(np.clip(np.diag(G_train), 1e-300, None))
         X = Theta_train / s if self.normalize else Theta_train
-        X = np.linalg.qr(X, mode="r") if self.qr else np.ascontiguousarray(X)
+        if int(self.stride) < 1:
+            raise ValueError(f"stride must be a positive integer, got {self.stride}")
+        X = np.linalg.qr(X, mode="r") if self.qr else np.ascontiguousarray(X[::int(self.stride)])
         xi = pysindy_pi_coef(X, cand, self.reg_weight_lam, self.tol, self.max_iter)
         idx = np.arange(cand.size)
         w = -xi

@@ -16,10 +16,16 @@ residual is within tolerance of the best (:func:`identify._implicit.select_model
 combination whose free simulation over the validation window has the smallest angle RMSE.
 
 Simulation: the equations are solved for the actuated accelerations; passive coordinates of a
-closed chain come from the loop closure, taken (b) from ``data.prior`` (``link_lengths``
-[l1..l4] and ``base_length`` L0 [m], paper convention
-``l1 e1 + l2 e2 - l3 e3 - l4 e4 = (L0, 0)``) if it closes the measured loop, else (a) fitted to
-the measured angles (:class:`identify._mechsim.LoopClosure`).
+closed chain come from the loop closure, taken (b) from ``data.prior`` (``l1``..``l4`` and
+``L0`` [m] as the five-bar rig declares them, or ``link_lengths`` / ``base_length``; paper
+convention ``l1 e1 + l2 e2 - l3 e3 - l4 e4 = (L0, 0)``) if it closes the measured loop (to the
+noise floor on noisy angles), else (a) fitted to the measured angles
+(:class:`identify._mechsim.LoopClosure`).  Sampled inputs are interpolated linearly or, with
+``input_hold="zoh"``, as zero-order holds.
+
+Noisy data: ``reconcile`` (default on) replaces the passive angles, rates and accelerations by
+those the closure implies, so the kinematic identities hold exactly again; ``column_lowpass_hz``
+filters every library column alike (the equations stay exact) to cut derivative noise.
 
 Kinematic identities: on loop-closed data, products of trig factors with accelerations and
 velocities obey exact linear relations that contain no input (loop constraint times trig
@@ -43,6 +49,7 @@ from identify._mechsim import CLOSURE_RTOL, ImplicitModel, LoopClosure
 from identify.library import Library, fivebar_library, generic_mechanical_library
 from testbed.errors import IdentificationError
 from testbed.measurement import Measurement, Trajectory
+from testbed.signal import lowpass
 
 #: Rollout angle-RMSE differences below 1e-4 rad [rad] count as ties (then fewer terms win):
 #: far below the 0.05 rad the paper reports and below what chaos-sensitive rollouts resolve.
@@ -91,7 +98,14 @@ def prune_dependent(G: np.ndarray, protected: np.ndarray, tol: float) -> np.ndar
 
 
 def find_closure(data: Measurement, passive: np.ndarray) -> LoopClosure | None:
-    """Loop closure for the passive coordinates: prior (b) if it fits the data, else fitted (a)."""
+    """Loop closure for the passive coordinates: prior (b) if it fits the data, else fitted (a).
+
+    The declared prior is used if it closes the measured loop to ``CLOSURE_RTOL`` (largest
+    error) or, on noisy angles, if its RMS closure error is within twice that of the
+    least-squares closure fitted to the same angles (the noise floor: any closure, the true one
+    included, leaves that much).  A wrong convention or a link length wrong by a few percent
+    leaves an error of that order, far above the floor of smoothed angles (~1e-3).
+    """
     if passive.size == 0:
         return None
     if passive.size != 2 or data.n_channels != 4:
@@ -99,13 +113,21 @@ def find_closure(data: Measurement, passive: np.ndarray) -> LoopClosure | None:
                                   "the planar single-loop closure (2 of 4) is supported")
     cl = LoopClosure.from_prior(data.prior, passive)
     if cl is not None:
-        res = cl.residual(data.x)
-        if res <= CLOSURE_RTOL:
+        if cl.residual(data.x) <= CLOSURE_RTOL:
             return cl
-        note = f"; the prior link lengths leave a closure residual of {res:.3g} of a link"
+        res = cl.residual(data.x, rms=True)
+        floor = LoopClosure.from_data(data.x, passive, strict=False).residual(data.x, rms=True)
+        if res <= 2.0 * floor:
+            cl.source += f"; RMS closure error {res:.3g} of a link, noise floor {floor:.3g}"
+            return cl
+        note = (f"; the prior link lengths leave an RMS closure error of {res:.3g} of a link "
+                f"(noise floor {floor:.3g})")
     else:
-        note = "; data.prior has no link_lengths/base_length"
-    cl = LoopClosure.from_data(data.x, passive)
+        note = "; data.prior has no link lengths (l1..l4, L0)"
+    try:
+        cl = LoopClosure.from_data(data.x, passive)
+    except IdentificationError as exc:
+        raise IdentificationError(f"{exc}{note}") from exc
     cl.source += note
     return cl
 
@@ -119,6 +141,28 @@ class _ImplicitMechanical(Identifier):
                Theta_train: np.ndarray) -> Sweep:
         raise NotImplementedError
 
+    def _library_matrix(self, lib: Library, data: Measurement) -> tuple[np.ndarray, int]:
+        """Library matrix of the (reconciled) data, column-filtered and trimmed; first sample.
+
+        Every column obeys the same linear equations at every sample, so a linear
+        time-invariant filter applied to all columns alike keeps them exact: the column
+        low-pass removes the broadband noise of estimated derivatives (whose products with
+        slow trig factors stay broadband) without biasing the equations.
+        """
+        x, xd, xdd = data.x, data.xd, data.xdd
+        if self.reconcile and self.closure_ is not None:
+            x, xd, xdd = self.closure_.reconcile(x, xd, xdd)
+        Theta = lib.evaluate(x, xd, xdd, data.u)
+        if self.column_lowpass_hz:
+            Theta = lowpass(np.ascontiguousarray(Theta.T), data.fs, self.column_lowpass_hz,
+                            self.column_lowpass_order).T
+        i0 = round(self.edge_trim * data.fs)
+        if i0:
+            if 2 * i0 >= data.n_samples:
+                raise IdentificationError(f"edge_trim {self.edge_trim} s leaves no samples")
+            Theta = Theta[i0:data.n_samples - i0]
+        return Theta, i0
+
     def fit(self, data: Measurement) -> _ImplicitMechanical:
         if data.u is None or data.input_map is None:
             raise IdentificationError(f"{self.name} needs measured inputs and their input_map")
@@ -127,8 +171,8 @@ class _ImplicitMechanical(Identifier):
         passive = np.flatnonzero(~imap.any(axis=1))
         self.closure_ = find_closure(data, passive)
         lib = make_library(self.library, data)
-        Theta = lib.evaluate(data.x, data.xd, data.xdd, data.u)
-        n_tr = split_index(data.n_samples, self.val_fraction)
+        Theta, i0 = self._library_matrix(lib, data)
+        n_tr = split_index(Theta.shape[0], self.val_fraction)
         G_tr, G_v = grams(Theta, n_tr)
         in_cols = [lib.input_columns(k) for k in range(data.u.shape[0])]
         has_u = np.zeros(len(lib), dtype=bool)
@@ -167,13 +211,14 @@ class _ImplicitMechanical(Identifier):
 
         best = [p[0] for p in picks]
         if self.selection == "rollout":
-            sl = slice(n_tr, None)
+            v0 = i0 + n_tr  # first validation sample of the record
+            sl = slice(v0, data.n_samples - i0)
             scores = []
             for combo in product(*picks):
                 try:
                     m = ImplicitModel(lib, build(combo), actuated, self.closure_)
-                    tr = m.simulate(data.x[:, n_tr], data.xd[:, n_tr], data.t[sl], data.u[:, sl],
-                                    self.sim_dt)
+                    tr = m.simulate(data.x[:, v0], data.xd[:, v0], data.t[sl], data.u[:, sl],
+                                    self.sim_dt, self.input_hold)
                     scores.append(float(np.sqrt(np.mean((tr.x - data.x[:, sl]) ** 2))))
                 except IdentificationError:
                     scores.append(np.inf)
@@ -197,7 +242,7 @@ class _ImplicitMechanical(Identifier):
         """Free simulation from (x0, xd0) under inputs u (n_inputs, len(t)) at times t [s]."""
         if not hasattr(self, "model_"):
             raise IdentificationError(f"{self.name}: fit before simulate")
-        return self.model_.simulate(x0, xd0, t, u, self.sim_dt)
+        return self.model_.simulate(x0, xd0, t, u, self.sim_dt, self.input_hold)
 
     def equations(self, precision: int = 4) -> list[str]:
         """One line per identified implicit equation, ``0 = c1*term1 + ...``."""
@@ -241,6 +286,26 @@ class SINDyPI(_ImplicitMechanical):
     sim_dt : float
         RK4 step of the simulation [s]; 1e-3 s resolves motions up to ~20 Hz to 1e-8 (RK4
         error ~ (h w)^4 / 120).
+    reconcile : bool
+        Replace the passive angles, rates and accelerations by those the loop closure implies
+        from the actuated ones before building the library
+        (:meth:`identify._mechsim.LoopClosure.reconcile`).  No effect on exact data; on noisy
+        angles it restores the exact kinematic identities, so ``prune_tol`` can remove them.
+    column_lowpass_hz : float or None
+        Cut-off [Hz] of a zero-phase Butterworth low-pass applied to every library column
+        before the regression (None: off).  The equations hold for filtered columns exactly
+        (one linear filter for all), while the noise of estimated derivatives, broadband, is
+        cut; set it above the band of the motion's products (the implicit equations need
+        excitation, not fidelity to the raw signals).
+    column_lowpass_order : int
+        Order of that filter (one pass).
+    edge_trim : float
+        Seconds dropped at each end of the record before the regression (edge effects of the
+        derivative estimate and of the column filter); 0 keeps every sample.
+    input_hold : {"linear", "zoh"}
+        What the sampled inputs stand for in simulations: a continuous signal or a zero-order
+        hold (see :meth:`identify._mechsim.ImplicitModel.simulate`).  Actuators driven by a
+        DAC (the five-bar rig) hold; the wrong choice costs an impulse of half a sample.
 
     Attributes
     ----------
@@ -256,7 +321,9 @@ class SINDyPI(_ImplicitMechanical):
                  thresholds: Sequence[float] | None = None, ridge: float = 1e-14, max_iter: int = 20,
                  val_fraction: float = 0.2, selection: str = "holdout", selection_rtol: float = 0.1,
                  selection_atol: float = 1e-12, n_rollout: int = 3, prune_tol: float | None = 1e-9,
-                 sim_dt: float = 1e-3):
+                 sim_dt: float = 1e-3, reconcile: bool = True,
+                 column_lowpass_hz: float | None = None, column_lowpass_order: int = 4,
+                 edge_trim: float = 0.0, input_hold: str = "linear"):
         self.library = library
         self.lhs = lhs
         self.thresholds = thresholds
@@ -269,6 +336,11 @@ class SINDyPI(_ImplicitMechanical):
         self.n_rollout = n_rollout
         self.prune_tol = prune_tol
         self.sim_dt = sim_dt
+        self.reconcile = reconcile
+        self.column_lowpass_hz = column_lowpass_hz
+        self.column_lowpass_order = column_lowpass_order
+        self.edge_trim = edge_trim
+        self.input_hold = input_hold
 
     def _sweep(self, G_train, G_val, cand, Theta_train):
         thr = DEFAULT_THRESHOLDS if self.thresholds is None else np.asarray(self.thresholds)

@@ -164,16 +164,29 @@ def score_structural(dataset: Dataset, data: Measurement, clean: Measurement, mo
 
 
 def score_mechanical(dataset: Dataset, data: Measurement, clean: Measurement, model: Any) -> Scores:
-    """Joint-angle RMSE of the free simulation, coefficient error and support recovery.
+    """Joint-angle RMSE of the free simulation, and coefficient and support scores modulo the
+    kinematic identities of the loop.
 
-    The identified model is simulated from the true initial state (noise-free
-    angles and rates at sample 0) under the recorded torques for the whole
-    record; RMSE per joint against the noise-free angles.  Coefficients are
-    compared by term name with the truth's implicit equations: each true equation
-    is matched with the identified equation of largest support overlap, both are
-    scaled so that the coefficient of the true equation's largest term is 1, and
-    the error is ``||c_id - c_true|| / ||c_true||`` over the union of terms.
+    ``angle_rmse``: the identified model is simulated from the true initial state (noise-free
+    angles and rates at sample 0) under the recorded torques for the whole record; the largest
+    per-joint RMSE against the noise-free angles.
+
+    Coefficients (:func:`testbed.equation_basis.compare_equations`): on loop-closed data the
+    true implicit equations are not unique (the loop constraint and its derivatives times trig
+    factors are exact linear identities among the library columns), so the truth
+    (``equation_terms`` / ``equation_coef``) and the identified equations are both put in the
+    canonical basis of the identifier's library: its columns (plus any true term it lacks) are
+    evaluated on the NOISE-FREE reference signals (the scorer's privilege; the identifier never
+    sees them), input-free columns dependent on earlier ones (unit-norm residual variance
+    <= ``DEPENDENCE_TOL``) are dropped in library order, and dropped columns are substituted by
+    their unique expression in the kept ones.  The identifier is not told this basis: the
+    scorer adapts the truth to the library.  Rows are paired, both divided by their coefficient
+    on the true row's largest term; ``coef_error`` is the largest relative error over the true
+    (canonical) terms, ``support_*`` compare the canonical nonzero patterns.  Equal canonical
+    forms mean equal equations on the loop manifold; a wrong equation keeps a wrong form.
     """
+    from testbed.equation_basis import compare_equations
+
     t = np.arange(data.n_samples) / data.fs
     sim: Trajectory = model.simulate(clean.x[:, 0], clean.xd[:, 0], t, data.u)
     rmse = metrics.rmse(clean.x, sim.x)
@@ -181,29 +194,17 @@ def score_mechanical(dataset: Dataset, data: Measurement, clean: Measurement, mo
     d: dict[str, Any] = {"angle_rmse": rmse, "t": t, "simulated_x": sim.x, "reference_x": clean.x,
                          "channels": data.channels}
 
-    true_terms = list(dataset.truth["equation_terms"])
-    true_coef = np.atleast_2d(np.asarray(dataset.truth["equation_coef"], dtype=float))
-    names = list(model.feature_names_)
-    coef = np.atleast_2d(np.asarray(model.coef_, dtype=float))
-    union = sorted(set(true_terms) | set(names))
-    T = np.zeros((true_coef.shape[0], len(union)))
-    I = np.zeros((coef.shape[0], len(union)))
-    for j, n in enumerate(true_terms):
-        T[:, union.index(n)] = true_coef[:, j]
-    for j, n in enumerate(names):
-        I[:, union.index(n)] = coef[:, j]
-    errors, matched = [], []
-    for row in T:
-        overlap = [np.sum((row != 0) & (r != 0)) for r in I]
-        k = int(np.argmax(overlap))
-        lead = int(np.argmax(np.abs(row)))
-        scale = I[k, lead] / row[lead] if I[k, lead] != 0 else np.nan
-        errors.append(np.linalg.norm(I[k] / scale - row) / np.linalg.norm(row) if np.isfinite(scale)
-                      else np.inf)
-        matched.append(k)
-    sup = metrics.support_scores(I[matched], T)
-    v["coef_error"] = float(max(errors))
+    def ref(name: str) -> np.ndarray:  # noise-free raw signal (reference if noise was added)
+        return np.asarray(dataset.reference.get(name, dataset.measured[name]).data, dtype=float)
+
+    signals = {"th": ref("theta"), "dth": ref("dtheta"), "ddth": ref("ddtheta"), "u": ref("torque")}
+    cmp = compare_equations(list(model.feature_names_), np.asarray(model.coef_, dtype=float),
+                            list(dataset.truth["equation_terms"]),
+                            np.asarray(dataset.truth["equation_coef"], dtype=float), signals)
+    v["coef_error"] = float(cmp["coef_error"])
     v["support_precision"], v["support_recall"], v["support_f1"] = (
-        float(sup["precision"]), float(sup["recall"]), float(sup["f1"]))
-    d.update(terms=union, coef_true=T, coef_id=I[matched], coef_errors=np.asarray(errors))
+        float(cmp["precision"]), float(cmp["recall"]), float(cmp["f1"]))
+    d.update(terms=cmp["names"], coef_true=cmp["coef_true"], coef_id=cmp["coef_id"],
+             coef_errors=cmp["coef_errors"], coef_error_norm=cmp["coef_error_norm"],
+             dependent_terms=cmp["dependent"], truth_residual=cmp["truth_residual"])
     return Scores(v, d)
