@@ -83,7 +83,7 @@ def fit_matrix_sgd(data: Measurement, est: Any, m_hat: float, lam_hat: np.ndarra
     """
     i0 = int(data.free_start)
     i1 = data.n_samples if not est.fit_duration else min(data.n_samples,
-                                                          i0 + int(round(est.fit_duration * data.fs)))
+                                                          i0 + round(est.fit_duration * data.fs))
     xdd, xd, x = data.xdd[:, i0:i1], data.xd[:, i0:i1], data.x[:, i0:i1]
     n, N = x.shape
     x3 = x**3 if est.cubic else None

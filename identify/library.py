@@ -24,7 +24,8 @@ are exactly dependent on the difference terms.  Data on the five-bar's loop-clos
 add *kinematic* identities no builder can rule out (the loop constraint and its derivatives,
 times trig factors): measured on 10 s loop-closed records (the rig's multisine, the synthetic
 five-bar), 2 among the 30 input-free columns of the reduced library (eigenvalues ~1e-16 of the
-unit-diagonal Gram matrix, the next one 2.6e-7..4.5e-6) and more than 20 in the full one.  They contain no input, so
+unit-diagonal Gram matrix, the next one 2.6e-7..4.5e-6) and more than 20 in the full one.  They
+contain no input, so
 :func:`near_dependencies` on the input-free columns finds them, and
 ``SINDyPI(prune_tol=...)`` drops them in library order (``pruned_terms_``).
 """
