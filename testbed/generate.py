@@ -14,16 +14,21 @@ from testbed.scenario import Scenario
 def add_noise(data: np.ndarray, rms_percent: float, rng: np.random.Generator) -> np.ndarray:
     """White Gaussian noise with standard deviation ``rms_percent`` % of each row's RMS.
 
+    The RMS is taken about the channel's mean: an absolute joint angle's offset depends only on
+    where its zero is put (1.78 rad for the five-bar's th1 against a +-0.4 rad motion), so noise
+    scaled with the total RMS would depend on a coordinate choice.  For zero-mean signals such
+    as accelerations the two are the same.
+
     Parameters
     ----------
     data : ndarray, shape (n_channels, n_samples)
     rms_percent : float
-        Noise standard deviation as a percentage of the noise-free channel RMS.
+        Noise standard deviation as a percentage of the noise-free channel's RMS about its mean.
     rng : numpy Generator
     """
     if rms_percent == 0:
         return data.copy()
-    rms = np.sqrt(np.mean(data**2, axis=1, keepdims=True))
+    rms = np.std(data, axis=1, keepdims=True)
     return data + rng.standard_normal(data.shape) * (rms_percent / 100.0) * rms
 
 

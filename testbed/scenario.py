@@ -48,7 +48,7 @@ HEADER_SCHEMA = {
 NOISE_SCHEMA = {
     "rms_percent": Field(float, 0.0, unit="% of channel RMS", min=0.0, max=100.0,
                          doc="white Gaussian sensor noise, standard deviation as % of each "
-                             "channel's noise-free RMS"),
+                             "channel's noise-free RMS about its mean"),
     "signals": Field(list, None, item_type=str,
                      doc="measured signals that get noise (default: the rig's sensors)"),
 }
