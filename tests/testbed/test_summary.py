@@ -1,0 +1,54 @@
+"""Summary: median and interquartile range per identifier and noise level, pass rate, rich table."""
+
+from __future__ import annotations
+
+import io
+import math
+
+import numpy as np
+from rich.console import Console
+
+from testbed.results import write_part, write_rows
+from testbed.summary import print_summary, summarize
+
+
+def row(cell, identifier, noise, seed, status="ok", passed=True, **scores):
+    return {"study": "t", "cell": cell, "scenario": "s", "rig": "r", "noise": noise, "seed": seed,
+            "identifier": identifier, "params": "{}", "status": status,
+            "error": "" if status == "ok" else "RuntimeError: diverged", "fit_time": 1.0,
+            "data_time": 0.0, "cell_time": 1.0, "passed": passed, "checks": "[]", "versions": "{}",
+            "commit": "x", "dataset_hash": "h", **scores}
+
+
+def test_median_iqr_and_pass_rate(tmp_path):
+    res = tmp_path / "r.parquet"
+    trac = [0.9, 0.8, 0.95, 0.7]
+    rows = [row(f"a{i}", "ls", 1.0, i, passed=v > 0.75, trac=v, mac=1.0) for i, v in enumerate(trac)]
+    rows.append(row("a9", "ls", 1.0, 9, status="failed", passed=False, trac=float("nan"), mac=float("nan")))
+    rows += [row("b0", "ls", 0.0, 0, trac=1.0, mac=1.0)]
+    write_rows(res, rows)
+    write_part(res, row("p0", "pi", 5.0, 0, angle_rmse=0.2))  # an unconsolidated row counts too
+    s = {(x["identifier"], x["noise"]): x for x in summarize(res)}
+    assert list(s) == [("ls", 0.0), ("ls", 1.0), ("pi", 5.0)]
+    g = s[("ls", 1.0)]
+    assert (g["cells"], g["ok"], g["failed"]) == (5, 4, 1)
+    assert g["pass_rate"] == 3 / 5  # 0.9, 0.8 and 0.95 pass; the failed cell counts as not passed
+    q25, med, q75 = np.percentile(trac, [25, 50, 75])  # over the ok cells only
+    assert (g["trac_q25"], g["trac_median"], g["trac_q75"], g["trac_n"]) == (q25, med, q75, 4)
+    assert math.isnan(s[("pi", 5.0)]["trac_median"]) and s[("pi", 5.0)]["trac_n"] == 0
+    assert s[("pi", 5.0)]["angle_rmse_median"] == 0.2
+
+    buf = io.StringIO()
+    print_summary(res, console=Console(file=buf, width=100))
+    out = buf.getvalue()
+    assert "noise 1 %" in out and "60 %" in out and "5 (1)" in out
+    assert f"{med:.3g}" in out and f"[{q25:.3g}, {q75:.3g}]" in out
+    assert "RuntimeError: diverged" in out
+    pi_table = out[out.index("pi  (s)"):]
+    assert "angle_rmse" in pi_table and "trac" not in pi_table.split("failed cell")[0]
+
+
+def test_no_results(tmp_path):
+    buf = io.StringIO()
+    assert print_summary(tmp_path / "none.parquet", console=Console(file=buf)) == []
+    assert "no results" in buf.getvalue()

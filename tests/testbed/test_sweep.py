@@ -1,0 +1,323 @@
+"""Sweeps: the same rows sequentially, with loky and on a Dask cluster; kill and resume; failures.
+
+The cells run a toy rig and toy identifiers (registered by a plugin file the
+study names, so worker processes and a ``testbed sweep`` subprocess know them
+too), fast and deterministic, independent of the real rigs being written.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+from pathlib import Path
+
+import pytest
+
+from testbed.results import parts_dir, read_results
+from testbed.study import load_study
+from testbed.sweep import SweepStats, cell_key, expand, run_sweep
+
+ROOT = Path(__file__).resolve().parents[2]
+
+# A "mechanical" toy: four undamped oscillators th_i'' = -w_i^2 th_i (what measure_mechanical
+# expects: theta, dtheta, ddtheta 4 x n, torque 2 x n).  The identifier fits k_i by least
+# squares of ddth_i on th_i; noise on theta and ddtheta makes the scores depend on the seed.
+TOYS = '''
+import time
+import numpy as np
+from identify import IDENTIFIERS
+from identify._base import Identifier
+from models import RIGS
+from models._base import Rig
+from testbed.dataset import Dataset, Signal
+from testbed.measurement import Trajectory
+from testbed.schema import Field
+
+NAMES = ["th1", "ddth1", "th2", "ddth2", "th3", "ddth3", "th4", "ddth4"]
+
+
+@RIGS.register("toy_osc")
+class ToyOscillators(Rig):
+    kind = "mechanical"
+    rig_schema = {"omega": Field(float, 3.0, min=0.1)}
+    simulation_schema = {"n_samples": Field(int, 400, min=10), "fs": Field(float, 100.0)}
+    excitation_schemas = {"none": {}}
+    default_excitation = "none"
+    measured_signals = ("theta", "dtheta", "ddtheta", "torque")
+    noisy_signals = ("theta", "ddtheta")
+
+    def simulate(self, progress=None):
+        sc = self.scenario
+        n, fs = sc.simulation["n_samples"], sc.simulation["fs"]
+        w = sc.rig_params["omega"] * np.arange(1, 5)[:, None]
+        t = np.arange(n) / fs
+        th = np.sin(w * t + 0.3)
+        ch = ("th1", "th2", "th3", "th4")
+        measured = {"theta": Signal(th, ch, "rad"), "dtheta": Signal(w * np.cos(w * t + 0.3), ch, "rad/s"),
+                    "ddtheta": Signal(-w**2 * th, ch, "rad/s^2"),
+                    "torque": Signal(np.zeros((2, n)), ("u1", "u2"), "N m")}
+        coef = np.zeros((4, 8))
+        for i in range(4):
+            coef[i, 2 * i], coef[i, 2 * i + 1] = w[i, 0] ** 2, 1.0
+        return Dataset(fs, measured, truth={"equation_terms": NAMES, "equation_coef": coef})
+
+
+class ToyFit(Identifier):
+    kind = "mechanical"
+    fail = ""
+
+    def __init__(self, delay: float = 0.0, scale: float = 1.0):
+        self.delay, self.scale = delay, scale
+
+    def fit(self, data):
+        time.sleep(self.delay)
+        if self.fail == "raise":
+            raise ValueError("toy identifier told to fail")
+        x, xdd = data.x, data.xdd
+        k = -np.sum(x * xdd, axis=1) / np.sum(x * x, axis=1) * self.scale
+        if self.fail == "nan":
+            k = k * np.nan
+        self.k_ = k
+        self.feature_names_ = NAMES
+        coef = np.zeros((4, 8))
+        for i in range(4):
+            coef[i, 2 * i], coef[i, 2 * i + 1] = k[i], 1.0
+        self.coef_ = coef
+        return self
+
+    def simulate(self, x0, xd0, t, u=None):
+        w = np.sqrt(np.abs(self.k_))[:, None]
+        x = x0[:, None] * np.cos(w * t) + (xd0[:, None] / w) * np.sin(w * t)
+        xd = -x0[:, None] * w * np.sin(w * t) + xd0[:, None] * np.cos(w * t)
+        return Trajectory(x, xd, -w**2 * x)
+
+    def equations(self, precision=4):
+        return [f"ddth{i + 1} = {-k:.{precision}g} th{i + 1}" for i, k in enumerate(self.k_)]
+
+
+IDENTIFIERS.register("toy_fit")(ToyFit)
+
+
+@IDENTIFIERS.register("toy_raise")
+class ToyRaise(ToyFit):
+    fail = "raise"
+
+
+@IDENTIFIERS.register("toy_nan")
+class ToyNaN(ToyFit):
+    fail = "nan"
+'''
+
+SCENARIO = """
+[scenario]
+name = "{name}"
+rig = "toy_osc"
+[simulation]
+n_samples = 400
+[score]
+angle_rmse_max = 0.05
+"""
+
+# Columns that legitimately differ between two runs of the same cell.
+TIMING = ("fit_time", "data_time", "cell_time")
+
+
+@pytest.fixture(scope="module")
+def toy_dir(tmp_path_factory) -> Path:
+    """One folder (one plugin path, so one registration per process) for the module's studies."""
+    d = tmp_path_factory.mktemp("toys")
+    (d / "toys.py").write_text(TOYS)
+    for name in ("toy_a", "toy_b"):
+        (d / f"{name}.toml").write_text(SCENARIO.format(name=name))
+    return d
+
+
+def write_study(d: Path, name: str, identifiers: list[str], *, seeds=(0, 1), noise=(0.0, 2.0),
+                scenarios=("toy_a.toml",), params: dict | None = None) -> Path:
+    lines = ["[study]", f'name = "{name}"', f"scenarios = {json.dumps(list(scenarios))}",
+             f"noise = {json.dumps(list(noise))}", f"seeds = {json.dumps(list(seeds))}",
+             f"identifiers = {json.dumps(identifiers)}", 'plugins = ["toys.py"]']
+    for ident, p in (params or {}).items():
+        lines.append(f"[identifiers.{ident}]")
+        lines += [f"{k} = {json.dumps(v)}" for k, v in p.items()]
+    path = d / f"{name}.toml"
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+def comparable(rows: list[dict]) -> list[dict]:
+    """Rows without the timing columns, NaN made comparable."""
+    out = []
+    for r in rows:
+        out.append({k: ("nan" if isinstance(v, float) and math.isnan(v) else v)
+                    for k, v in r.items() if k not in TIMING})
+    return sorted(out, key=lambda r: r["cell"])
+
+
+def test_expand_cells_and_keys(toy_dir):
+    study = load_study(write_study(toy_dir, "grid", ["toy_fit", "toy_nan"], scenarios=("toy_a.toml",
+                                                                                       "toy_b.toml")))
+    cells = expand(study)
+    assert len(cells) == study.n_cells() == 2 * 2 * 2 * 2
+    assert len({c.key for c in cells}) == len(cells)
+    c = cells[0]
+    assert c.scenario.identify == {"method": c.identifier, **c.params}
+    assert c.scenario.noise["rms_percent"] == c.noise and c.scenario.seed == c.seed
+    # stable: the same cell of a reloaded study has the same key; hyperparameters change it
+    assert cell_key(expand(load_study(study.path))[0].scenario) == c.key
+    other = c.scenario.replace(identify={"method": "toy_fit", "delay": 0.0, "scale": 2.0})
+    assert cell_key(other) != c.key
+
+
+@pytest.mark.slow
+def test_sequential_loky_dask_give_identical_rows(toy_dir, tmp_path):
+    from distributed import LocalCluster
+
+    study = load_study(write_study(toy_dir, "same", ["toy_fit"], seeds=(0, 1, 2)))
+    cache = tmp_path / "cache"
+    seq = read_results(run_sweep(study, jobs=1, results=tmp_path / "seq.parquet", cache_dir=cache,
+                                 verbose=False))
+    loky = read_results(run_sweep(study, jobs=2, results=tmp_path / "loky.parquet", cache_dir=cache,
+                                  verbose=False))
+    with LocalCluster(n_workers=1, threads_per_worker=2, processes=False, dashboard_address=None) as cl:
+        dask = read_results(run_sweep(study, dask_address=cl.scheduler_address,
+                                      results=tmp_path / "dask.parquet", cache_dir=cache, verbose=False))
+    assert len(seq) == study.n_cells() == 6
+    assert all(r["status"] == "ok" for r in seq), [r["error"] for r in seq]
+    assert comparable(seq) == comparable(loky) == comparable(dask)
+    # noise and seed reach the data: three seeds give three errors at 2 % noise, one at 0 %
+    # (angle_rmse: the toy's k fitted on noisy data drives its simulation off the clean angles)
+    assert len({r["angle_rmse"] for r in seq if r["noise"] == 2.0}) == 3
+    assert len({r["angle_rmse"] for r in seq if r["noise"] == 0.0}) == 1
+    assert {r["passed"] for r in seq if r["noise"] == 0.0} == {True}
+
+
+def test_failing_cells_are_recorded_and_the_rest_goes_on(toy_dir, tmp_path):
+    study = load_study(write_study(toy_dir, "fails", ["toy_fit", "toy_raise", "toy_nan"], seeds=(0,),
+                                   noise=(1.0,)))
+    rows = read_results(run_sweep(study, results=tmp_path / "r.parquet", cache_dir=tmp_path / "c",
+                                  verbose=False))
+    by = {r["identifier"]: r for r in rows}
+    assert len(rows) == 3
+    assert by["toy_fit"]["status"] == "ok" and by["toy_fit"]["error"] == ""
+    assert by["toy_raise"]["status"] == "failed"
+    assert by["toy_raise"]["error"].startswith("ValueError: toy identifier told to fail (toys.py:")
+    assert math.isnan(by["toy_raise"]["fit_time"]) and by["toy_raise"]["dataset_hash"]
+    assert by["toy_nan"]["status"] == "failed" and "non-finite scores" in by["toy_nan"]["error"]
+    assert "angle_rmse" in by["toy_nan"]["error"]
+    assert not by["toy_raise"]["passed"] and not by["toy_nan"]["passed"]
+    # failed cells are finished: a rerun runs nothing (rows unchanged, timings included) ...
+    stats = SweepStats()
+    rerun = read_results(run_sweep(study, results=tmp_path / "r.parquet", cache_dir=tmp_path / "c",
+                                   verbose=False, stats=stats))
+    assert stats.run == 0 and [r["cell_time"] for r in rerun] == [r["cell_time"] for r in rows]
+    # ... unless asked to retry them: the two failed cells run again, with the same outcome
+    again = read_results(run_sweep(study, results=tmp_path / "r.parquet", cache_dir=tmp_path / "c",
+                                   retry_failed=True, verbose=False, stats=stats))
+    assert (stats.run, stats.failed) == (2, 2)
+    assert comparable(again) == comparable(rows)
+
+
+def test_rerun_after_editing_the_study_runs_only_new_cells(toy_dir, tmp_path):
+    res, cache = tmp_path / "r.parquet", tmp_path / "c"
+    first = read_results(run_sweep(load_study(write_study(toy_dir, "edit", ["toy_fit"], seeds=(0,))),
+                                   results=res, cache_dir=cache, verbose=False))
+    grown = load_study(write_study(toy_dir, "edit", ["toy_fit"], seeds=(0, 1)))
+    second = read_results(run_sweep(grown, results=res, cache_dir=cache, verbose=False))
+    assert len(first) == 2 and len(second) == 4
+    kept = {r["cell"]: r for r in second}
+    for r in first:  # the old rows are kept as they were, timings included (not rerun)
+        assert kept[r["cell"]]["cell_time"] == r["cell_time"]
+    shrunk = load_study(write_study(toy_dir, "edit", ["toy_fit"], seeds=(1,)))
+    third = read_results(run_sweep(shrunk, results=res, cache_dir=cache, verbose=False))
+    assert {r["seed"] for r in third} == {1} and len(third) == 2
+
+
+def _finished_cells(results: Path) -> int:
+    return len(list(parts_dir(results).glob("*.json"))) if parts_dir(results).is_dir() else 0
+
+
+@pytest.mark.slow
+def test_killed_sweep_resumes_without_losing_or_duplicating_cells(toy_dir, tmp_path):
+    """SIGKILL a `testbed sweep` subprocess after some cells, rerun; compare with an unbroken run."""
+    # 12 cells of 0.4 s each; the toy data take milliseconds, so the fit sleep dominates
+    study_path = write_study(toy_dir, "killme", ["toy_fit"], seeds=(0, 1, 2), noise=(0.0, 1.0),
+                             scenarios=("toy_a.toml", "toy_b.toml"), params={"toy_fit": {"delay": 0.4}})
+    res, cache = tmp_path / "killed.parquet", tmp_path / "cache"
+    cmd = [sys.executable, "-m", "testbed.cli", "sweep", str(study_path), "--results", str(res),
+           "--cache", str(cache)]
+    env = {**os.environ, "OMP_NUM_THREADS": "1"}
+    proc = subprocess.Popen(cmd, cwd=ROOT, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    deadline = time.monotonic() + 60
+    while _finished_cells(res) < 3 and time.monotonic() < deadline and proc.poll() is None:
+        time.sleep(0.05)
+    proc.send_signal(signal.SIGKILL)
+    proc.wait(timeout=30)
+    n_before = _finished_cells(res)
+    assert 3 <= n_before < 12, proc.stderr.read().decode()
+    assert not res.exists()  # killed before consolidating
+    partial = read_results(res)
+    assert len(partial) == n_before
+
+    out = subprocess.run(cmd, cwd=ROOT, env=env, capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0, out.stderr
+    assert f"{n_before} already done, {12 - n_before} to run" in out.stderr
+    resumed = read_results(res)
+    assert not parts_dir(res).exists()
+    keys = [r["cell"] for r in resumed]
+    assert len(keys) == len(set(keys)) == 12
+    for r in partial:  # finished cells were not rerun
+        assert next(x for x in resumed if x["cell"] == r["cell"])["cell_time"] == r["cell_time"]
+
+    whole = read_results(run_sweep(study_path, jobs=2, results=tmp_path / "whole.parquet",
+                                   cache_dir=cache, verbose=False))
+    assert comparable(resumed) == comparable(whole)
+
+
+def test_cli_summary_of_a_sweep(toy_dir, tmp_path, capsys):
+    from testbed.cli import main
+
+    study = write_study(toy_dir, "cli", ["toy_fit", "toy_raise"], seeds=(0,), noise=(0.0,))
+    res = tmp_path / "cli.parquet"
+    assert main(["sweep", str(study), "--results", str(res), "--cache", str(tmp_path / "c")]) == 0
+    assert main(["summary", str(res)]) == 0
+    out = capsys.readouterr().out
+    assert "toy_fit" in out and "toy_raise" in out and "told to fail" in out
+    bad = toy_dir / "bad.toml"
+    bad.write_text(textwrap.dedent("""
+        [study]
+        name = "bad"
+        scenarios = ["toy_a.toml"]
+        noise = [-1.0]
+        seeds = [0]
+        identifiers = ["toy_fit"]
+        plugins = ["toys.py"]
+    """))
+    assert main(["sweep", str(bad)]) == 2
+    err = capsys.readouterr().err
+    assert "key 'study.noise[0]'" in err and "-1.0" in err
+
+
+@pytest.mark.slow
+def test_smoke_study_on_the_real_rigs(tmp_path):
+    """studies/smoke.toml end to end: one row per cell, each rig kind with its own scores."""
+    from testbed.scoring import metric_names
+
+    study = load_study("smoke")
+    rows = read_results(run_sweep(study, results=tmp_path / "smoke.parquet", cache_dir=tmp_path / "c",
+                                  verbose=False))
+    assert sorted(r["cell"] for r in rows) == sorted(c.key for c in expand(study))
+    for r in rows:
+        assert r["status"] in ("ok", "failed") and (r["status"] == "ok") == (r["error"] == "")
+        assert r["dataset_hash"] and json.loads(r["versions"])["numpy"] != "not installed"
+        kind = "structural" if r["rig"] == "cantilever" else "mechanical"
+        other = metric_names("mechanical" if kind == "structural" else "structural")
+        assert all(math.isnan(r[m]) for m in other if m in r)  # no score of the other kind
+        if r["status"] == "ok":
+            assert all(math.isfinite(r[m]) for m in metric_names(kind) if m in r and m != "K3_force_error")
