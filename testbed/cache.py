@@ -45,13 +45,21 @@ class DatasetCache:
         return self.directory / f"{scenario.rig}-{cache_key(scenario)}.h5"
 
     def get(self, scenario: Scenario, progress: Callable[[float], None] | None = None) -> Dataset:
-        """The cached dataset of ``scenario``, generating and storing it if absent."""
-        from testbed.generate import generate
+        """The cached dataset of ``scenario``, generating and storing it if absent.
+
+        A noisy scenario is derived from the cached noise-free simulation of the same rig and
+        excitation, so noise levels and seeds of a study simulate each configuration once.
+        """
+        from testbed.generate import generate, noise_free_scenario
 
         p = self.path(scenario)
         if p.is_file():
             return Dataset.load(p)
-        ds = generate(scenario, progress=progress)
+        clean_sc = noise_free_scenario(scenario)
+        if clean_sc.data_hash() != scenario.data_hash():  # noisy: simulate once, add noise
+            ds = generate(scenario, clean=self.get(clean_sc, progress))
+        else:
+            ds = generate(scenario, progress=progress)
         ds.save(p)
         return ds
 

@@ -86,11 +86,15 @@ def expand(study: Study) -> list[Cell]:
     """Every runnable cell of ``study`` in grid order (scenario, identifier, noise, seed).
 
     Pairs whose identifier kind differs from the rig kind are left out (see
-    :meth:`Study.skipped`).
+    :meth:`Study.skipped`).  An identifier that is the scenario's own ``[identify]`` method
+    starts from that table's hyperparameters; the study's table for it overrides them.
     """
     cells = []
     for sc, method in study.combinations():
-        params = study.params.get(method, {})
+        # The scenario's own [identify] hyperparameters hold for its own method (they were chosen
+        # for its data); the study's [identifiers.<name>] table overrides them.
+        own = sc.identify if sc.identify and sc.identify.get("method") == method else {}
+        params = {**{k: v for k, v in own.items() if k != "method"}, **study.params.get(method, {})}
         for noise in study.noise:
             for seed in study.seeds:
                 csc = sc.with_noise(noise).replace(seed=seed, identify={"method": method, **params})

@@ -50,5 +50,5 @@ def test_median_iqr_and_pass_rate(tmp_path):
 
 def test_no_results(tmp_path):
     buf = io.StringIO()
-    assert print_summary(tmp_path / "none.parquet", console=Console(file=buf)) == []
+    assert print_summary(tmp_path / "none.parquet", console=Console(file=buf, width=400)) == []
     assert "no results" in buf.getvalue()

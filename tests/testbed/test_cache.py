@@ -1,0 +1,38 @@
+"""The dataset cache: content-keyed, atomic, and noisy data derived from one clean simulation."""
+
+import numpy as np
+
+from testbed.cache import DatasetCache
+from testbed.generate import generate
+from testbed.scenario import load_scenario
+
+
+def _short():
+    sc = load_scenario("cantilever_stiff_impact")
+    return sc.replace(simulation={**sc.simulation, "duration": 0.05}).with_noise(2.0).replace(seed=7)
+
+
+def test_noisy_dataset_from_cached_clean_simulation_is_bit_identical(tmp_path):
+    sc = _short()
+    cache = DatasetCache(tmp_path)
+    derived = cache.get(sc)
+    direct = generate(sc)
+    assert derived.content_hash() == direct.content_hash()
+    for name, s in direct.measured.items():
+        np.testing.assert_array_equal(derived.measured[name].data, s.data)
+    # one clean and one noisy file; a second noisy seed adds a file but no simulation
+    assert len(cache.entries()) == 2
+    other = cache.get(sc.replace(seed=8))
+    assert len(cache.entries()) == 3
+    assert not np.array_equal(other.measured["acceleration"].data, derived.measured["acceleration"].data)
+    np.testing.assert_array_equal(other.reference["acceleration"].data,
+                                  derived.reference["acceleration"].data)
+
+
+def test_cache_hit_loads_and_clear_removes(tmp_path):
+    sc = _short()
+    cache = DatasetCache(tmp_path)
+    first = cache.get(sc)
+    again = cache.get(sc)
+    assert again.content_hash() == first.content_hash()
+    assert cache.clear() == 2 and cache.entries() == []
