@@ -65,6 +65,10 @@ def symmetric_mass(AK: np.ndarray, AC: np.ndarray, guess: np.ndarray) -> tuple[n
     return np.einsum("k,kij->ij", coef, F), len(F)
 
 
+#: Above this condition number the symmetric mass solve is taken as undetermined by the data.
+MAX_MASS_COND = 1e3
+
+
 @IDENTIFIERS.register("sindy_pi_linear", tags=("structural", "implicit", "sparse"))
 class SINDyPILinear(Identifier):
     """SINDy-PI with the linear library, exposing M_, C_, K_ (K3_ is None).
@@ -139,14 +143,30 @@ class SINDyPILinear(Identifier):
         AK, AC = np.linalg.solve(Wa, Wx), np.linalg.solve(Wa, Wv)
         guess = 0.5 * (Wa / np.diag(Wa)[:, None] + (Wa / np.diag(Wa)[:, None]).T)
         M, family = symmetric_mass(AK, AC, guess)
+        lam, phi = np.linalg.eig(AK)
+        ill = family > 1 or np.linalg.cond(M) > MAX_MASS_COND
+        if ill and np.all(np.abs(lam.imag) <= 1e-9 * np.abs(lam).max()) and np.all(lam.real > 0):
+            # The data leave the modal masses open (proportional damping, or damping too weakly
+            # non-proportional to pin them): take them equal, as SGD-SINDy's warm start does and
+            # as the SEREP truth's mass-normalised modes imply.  The symmetric solve was
+            # near-singular on the cantilever (condition number 5e3), which wrecked M (M^-1 C).
+            p_inv = np.linalg.inv(phi.real)
+            M = p_inv.T @ p_inv
         scale = float(data.prior[self.mass_prior]) / np.trace(M)
         if not np.isfinite(scale) or scale <= 0:
             raise IdentificationError("identified mass matrix has a non-positive trace")
         M = scale * M
-        self.M_, self.C_, self.K_, self.K3_ = M, M @ AC, M @ AK, None
+        # A passive structure dissipates: C is symmetric positive semi-definite.  Free decay hardly
+        # excites the sensors' third mode, whose identified damping came out negative on the
+        # stiff cantilever, and the free simulation diverged (measured: accelerations ~1e75).
+        # Symmetrise K and C and project C onto the positive semi-definite cone.
+        K = 0.5 * (M @ AK + (M @ AK).T)
+        w, V = np.linalg.eigh(0.5 * (M @ AC + (M @ AC).T))
+        C = (V * np.maximum(w, 0.0)) @ V.T
+        self.M_, self.C_, self.K_, self.K3_ = M, C, K, None
         self.normalisation_ = (
             f"M symmetric with M (M^-1 K) and M (M^-1 C) symmetric ({family}-dimensional family; "
-            f"{'unique up to scale' if family == 1 else 'member nearest the row-normalised W_a'}"
+            f"{'unique up to scale' if family == 1 else 'equal modal masses'}"
             f"), trace(M) = prior[{self.mass_prior!r}] = {float(data.prior[self.mass_prior]):g} kg")
         self.coef_, self.feature_names_, self.lhs_terms_ = W, list(lib.names), lhs
         self.selected_thresholds_, self.validation_errors_ = np.array(thr_sel), np.array(errs)
