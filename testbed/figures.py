@@ -134,6 +134,10 @@ def is_weight(name: str) -> bool:
 def penalty_weights(history: dict[str, Any]) -> Figure | None:
     """Penalty weights vs epoch (left) and loss terms vs epoch (right); None without a history."""
     series = _series(history or {})
+    # the x axis and step counts are no loss terms; the mass residual is enforced to round-off
+    counters = {"epoch", "n_steps", "step", "steps", "mass_residual"}
+    series = {k: v for k, v in series.items()
+              if k.lower() not in counters and np.any(np.isfinite(v)) and np.any(v != 0)}
     groups = [(t, {k: v for k, v in series.items() if is_weight(k) == w})
               for t, w in (("penalty weights", True), ("loss terms", False))]
     groups = [(t, g) for t, g in groups if g]
