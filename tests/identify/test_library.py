@@ -1,13 +1,12 @@
 """Library builders: canonical names, column values against hand-evaluated terms, the
 acceleration split, and detection of linear dependence."""
 
-import importlib.util
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 
+from benchmarks import sindy_pi_problems
 from identify.library import (
     Library,
     fivebar_library,
@@ -19,14 +18,6 @@ from testbed.terms import canonical
 
 ROOT = Path(__file__).resolve().parents[2]
 
-
-def _problems():
-    name = "sindy_pi_problems"
-    if name not in sys.modules:
-        spec = importlib.util.spec_from_file_location(name, ROOT / "benchmarks" / f"{name}.py")
-        sys.modules[name] = importlib.util.module_from_spec(spec)
-        spec.loader.exec_module(sys.modules[name])
-    return sys.modules[name]
 
 
 @pytest.fixture(scope="module")
@@ -126,7 +117,7 @@ def test_near_dependencies_finds_a_trig_identity(signals):
 def test_reduced_fivebar_library_has_two_kinematic_identities():
     """On loop-closed data the 30 input-free reduced columns have exactly two null directions
     (acceleration-level loop constraint times trig factors), the full 108 dozens."""
-    P = _problems()
+    P = sindy_pi_problems
     # 10 s: on 4 s the elbow cross-damping columns leave near-dependencies at 1e-11..1e-8; on 10 s
     # the two exact ones (~1e-16) are 9 decades below the next direction (2.6e-7)
     d = P.fivebar(duration=10.0, fs=500.0, amp=1.0).data

@@ -6,20 +6,13 @@ The synthetic 3-DOF chain and its exact data come from ``benchmarks/bench_sgd_si
 
 from __future__ import annotations
 
-import importlib.util
-from pathlib import Path
-
 import numpy as np
 import pytest
 
+from benchmarks import bench_sgd_sindy as bench
 from identify import IDENTIFIERS
 from identify.ls_sindy import LeastSquaresSINDy
 from identify.structural import modal, simulate_structural
-
-_spec = importlib.util.spec_from_file_location(
-    "bench_sgd_sindy", Path(__file__).resolve().parents[2] / "benchmarks" / "bench_sgd_sindy.py")
-bench = importlib.util.module_from_spec(_spec)
-_spec.loader.exec_module(bench)
 
 
 @pytest.fixture(scope="module")

@@ -7,21 +7,14 @@ well under a minute on one core; the benchmark shows the targets are met far ear
 
 from __future__ import annotations
 
-import importlib.util
-from pathlib import Path
-
 import numpy as np
 import pytest
 
+from benchmarks import bench_sgd_sindy as bench
 from identify import IDENTIFIERS
 from identify.sgd_sindy import SGDSINDy
 from identify.structural import modal
 from testbed.metrics import mac_matrix, pair_modes, trac
-
-_spec = importlib.util.spec_from_file_location(
-    "bench_sgd_sindy", Path(__file__).resolve().parents[2] / "benchmarks" / "bench_sgd_sindy.py")
-bench = importlib.util.module_from_spec(_spec)
-_spec.loader.exec_module(bench)
 
 EPOCHS = 400
 K3_TRUE = 2.0e12  # N/m^3 at DOF 1: cubic force ~10 % of the linear one at the peak (x1 ~ 7e-5 m)

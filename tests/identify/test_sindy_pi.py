@@ -3,14 +3,13 @@ problems with exact truth (benchmarks/sindy_pi_problems.py): exact recovery on n
 data, selection, simulation, closure handling, determinism, and no silent zeros."""
 
 import dataclasses
-import importlib.util
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 from scipy.linalg import expm
 
+from benchmarks import sindy_pi_problems
 from identify import IDENTIFIERS
 from identify._mechsim import LoopClosure
 from identify.pysindy_pi import PySINDyPI
@@ -22,16 +21,8 @@ from testbed.measurement import Measurement
 ROOT = Path(__file__).resolve().parents[2]
 
 
-def _problems():
-    name = "sindy_pi_problems"
-    if name not in sys.modules:
-        spec = importlib.util.spec_from_file_location(name, ROOT / "benchmarks" / f"{name}.py")
-        sys.modules[name] = importlib.util.module_from_spec(spec)
-        spec.loader.exec_module(sys.modules[name])
-    return sys.modules[name]
 
-
-P = _problems()
+P = sindy_pi_problems
 
 
 @pytest.fixture(scope="module")

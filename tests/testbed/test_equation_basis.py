@@ -1,26 +1,17 @@
 """Canonical-basis scoring: equations compared modulo the identities of the data.  The truth
 itself and any identity-equivalent form score F1 = 1 and error ~0; wrong equations score badly."""
 
-import importlib.util
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 
+from benchmarks import sindy_pi_problems
 from identify.library import fivebar_library
 from testbed.equation_basis import CanonicalBasis, compare_equations, evaluate_terms, has_input
 
 ROOT = Path(__file__).resolve().parents[2]
 
-
-def _problems():
-    name = "sindy_pi_problems"
-    if name not in sys.modules:
-        spec = importlib.util.spec_from_file_location(name, ROOT / "benchmarks" / f"{name}.py")
-        sys.modules[name] = importlib.util.module_from_spec(spec)
-        spec.loader.exec_module(sys.modules[name])
-    return sys.modules[name]
 
 
 @pytest.fixture(scope="module")
@@ -34,7 +25,7 @@ def toy():
 
 @pytest.fixture(scope="module")
 def fivebar():
-    P = _problems()
+    P = sindy_pi_problems
     return P.fivebar(duration=4.0, fs=500.0, amp=1.0)
 
 
