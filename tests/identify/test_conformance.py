@@ -1,0 +1,77 @@
+"""One conformance test of the estimator contract, parametrised over every registered identifier.
+
+The contract (identify/_base.py): ``__init__`` only stores hyperparameters under their own names;
+``fit(data)`` returns ``self``; learned attributes end in ``_`` and exist only after ``fit``;
+fitting is deterministic; ``clone`` gives an unfitted twin; ``simulate`` returns a Trajectory of
+the data's shape; ``equations`` returns text.  Structural identifiers expose ``M_``, ``C_``,
+``K_``; mechanical ones ``coef_`` and ``feature_names_``.
+"""
+
+import inspect
+
+import numpy as np
+import pytest
+
+from benchmarks import bench_sgd_sindy, sindy_pi_problems
+from identify import IDENTIFIERS
+from identify._base import Identifier
+from testbed.measurement import Trajectory
+
+# Small budgets so each identifier fits in seconds: the contract does not depend on them.
+FAST = {"sgd_sindy": {"epochs": 2}, "pysindy_pi": {"stride": 4}}
+
+
+@pytest.fixture(scope="module")
+def structural_data():
+    return bench_sgd_sindy.chain_measurement(bench_sgd_sindy.chain_system(), duration=0.1)
+
+
+@pytest.fixture(scope="module")
+def pendulum():
+    return sindy_pi_problems.double_pendulum(duration=3.0, fs=1e3, amp=10.0)
+
+
+def _make(name, pendulum):
+    cls = IDENTIFIERS.get(name)
+    params = dict(FAST.get(name, {}))
+    if cls.kind == "mechanical":
+        params["library"] = list(pendulum.truth_terms)  # the problem's own terms: small and exact
+    return cls(**params)
+
+
+@pytest.mark.parametrize("name", IDENTIFIERS.names())
+def test_identifier_follows_the_estimator_contract(name, structural_data, pendulum):
+    cls = IDENTIFIERS.get(name)
+    assert issubclass(cls, Identifier) and cls.name in ("", name) and cls.kind in ("structural",
+                                                                                   "mechanical")
+    est = _make(name, pendulum)
+    # __init__ stores every hyperparameter under its own name and learns nothing
+    init_names = [p for p in inspect.signature(cls.__init__).parameters if p != "self"]
+    assert sorted(est.get_params()) == sorted(init_names)
+    assert not [k for k in vars(est) if k.endswith("_") and not k.startswith("_")]
+    data = structural_data if cls.kind == "structural" else pendulum.data
+    assert est.fit(data) is est
+    learned = {k for k in vars(est) if k.endswith("_") and not k.startswith("_")}
+    need = {"M_", "C_", "K_"} if cls.kind == "structural" else {"coef_", "feature_names_"}
+    assert need <= learned, f"{name} lacks {need - learned}"
+    # clone: same hyperparameters, nothing learned; refitting gives identical results
+    twin = est.clone()
+    assert twin.get_params() == est.get_params()
+    assert not [k for k in vars(twin) if k.endswith("_") and not k.startswith("_")]
+    twin.fit(data)
+    for k in need:
+        a, b = getattr(est, k), getattr(twin, k)
+        if isinstance(a, np.ndarray):
+            np.testing.assert_array_equal(a, b)
+        else:
+            assert a == b
+    # simulate from the data's initial state, with its inputs where it has some
+    n = min(data.n_samples, 200)
+    t = np.arange(n) / data.fs
+    u = None if data.u is None else data.u[:, :n]
+    traj = est.simulate(data.x[:, 0], data.xd[:, 0], t, u)
+    assert isinstance(traj, Trajectory)
+    for arr in traj:
+        assert arr.shape == (data.n_channels, n)
+    eqs = est.equations()
+    assert isinstance(eqs, list) and eqs and all(isinstance(e, str) and e for e in eqs)
