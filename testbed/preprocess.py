@@ -54,12 +54,26 @@ SIGNAL_SCHEMAS: dict[str, dict[str, Field]] = {
                                   "so the equation of motion holds for the filtered signals"),
     },
     "mechanical": {
-        "derivatives": Field(str, "recorded", choices=("recorded", "estimated"),
+        "derivatives": Field(str, "recorded", choices=("recorded", "estimated", "lowpass"),
                              doc="use the recorded joint rates and accelerations, or estimate "
-                                 "them from the measured angles"),
+                                 "them from the measured angles: 'estimated' by a Savitzky-Golay "
+                                 "filter (window, polyorder), 'lowpass' by a zero-phase "
+                                 "Butterworth low-pass and central differences (cutoff_hz, "
+                                 "filter_order, edge_fit_s, edge_fit_order)"),
         "window": Field(int, 201, min=5, doc="Savitzky-Golay window [samples] for estimated "
                                              "derivatives (odd)"),
         "polyorder": Field(int, 4, min=2, max=8, doc="Savitzky-Golay polynomial order"),
+        "cutoff_hz": Field(float, 4.0, unit="Hz", min=0.0, min_inclusive=False,
+                           doc="'lowpass': -3 dB frequency of one pass of the zero-phase "
+                               "Butterworth; just above the band of the motion (noise in the "
+                               "acceleration grows as cutoff^2.5)"),
+        "filter_order": Field(int, 8, min=1, max=16,
+                              doc="'lowpass': Butterworth order of one pass"),
+        "edge_fit_s": Field(float, 0.1, unit="s", min=0.0, min_inclusive=False,
+                            doc="'lowpass': length of the end windows whose polynomial fits "
+                                "anchor the record's ends (value, rate, acceleration)"),
+        "edge_fit_order": Field(int, 5, min=2, max=8,
+                                doc="'lowpass': order of the end-window polynomial fits"),
     },
 }
 
@@ -222,7 +236,10 @@ def measure_mechanical(dataset: Dataset, cfg: Mapping[str, Any]) -> Measurement:
     cfg : mapping
         A validated ``SIGNAL_SCHEMAS["mechanical"]`` table.  ``derivatives = "recorded"``
         uses the recorded rates; ``"estimated"`` smooths and differentiates the angles with a
-        Savitzky-Golay filter (``window``, ``polyorder``) and ignores the recorded rates.
+        Savitzky-Golay filter (``window``, ``polyorder``; :func:`testbed.signal.differentiate`),
+        ``"lowpass"`` with a zero-phase Butterworth low-pass and central differences
+        (``cutoff_hz``, ``filter_order``, ``edge_fit_s``, ``edge_fit_order``;
+        :func:`testbed.signal.lowpass_differentiate`); both ignore the recorded rates.
 
     Returns
     -------
@@ -235,6 +252,9 @@ def measure_mechanical(dataset: Dataset, cfg: Mapping[str, Any]) -> Measurement:
     torque = _get(dataset, "torque", 2)
     if cfg["derivatives"] == "recorded":
         x, xd, xdd = theta, _get(dataset, "dtheta", 4), _get(dataset, "ddtheta", 4)
+    elif cfg["derivatives"] == "lowpass":
+        x, xd, xdd = sig.lowpass_differentiate(theta, fs, cfg["cutoff_hz"], cfg["filter_order"],
+                                               cfg["edge_fit_s"], cfg["edge_fit_order"])
     else:
         x, xd, xdd = sig.differentiate(theta, fs, cfg["window"], cfg["polyorder"])
     input_map = np.zeros((4, 2))
