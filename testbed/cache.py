@@ -1,13 +1,15 @@
 """Content-keyed dataset cache shared by ``testbed run`` and ``testbed sweep``.
 
 A dataset is determined by the scenario's data sections and seed
-(:meth:`Scenario.data_hash`) and by the versions of the code and engines that
-simulate it; the cache key hashes both.  Files are written atomically, so a
+(:meth:`Scenario.data_hash`), by the versions of the engines that simulate it and
+by this project's generating source (the rigs and the noise model); the cache key
+hashes all three.  Files are written atomically, so a
 killed process never leaves a half-written entry.
 """
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import json
 import os
@@ -24,8 +26,27 @@ def default_cache_dir() -> Path:
     return Path(os.environ.get("TESTBED_CACHE", Path.cwd() / ".cache" / "datasets"))
 
 
+@functools.cache
+def generator_code_hash() -> str:
+    """SHA-256 of the source that turns a scenario into data: the rigs and the noise model.
+
+    Package versions alone miss a change to this project's own code (a developer's stale cache
+    would survive it); the source hash does not.
+    """
+    root = Path(__file__).resolve().parent.parent
+    h = hashlib.sha256()
+    files = sorted((root / "models").rglob("*.py")) + [root / "testbed" / n for n in
+                                                       ("generate.py", "dataset.py")]
+    for f in files:
+        h.update(f.relative_to(root).as_posix().encode())
+        h.update(f.read_bytes())
+    return h.hexdigest()
+
+
 def cache_key(scenario: Scenario) -> str:
-    blob = json.dumps({"data": scenario.data_hash(), "versions": versions()}, sort_keys=True)
+    """Key of a scenario's dataset: its data sections and seed, package versions, generator code."""
+    blob = json.dumps({"data": scenario.data_hash(), "versions": versions(),
+                       "code": generator_code_hash()}, sort_keys=True)
     return hashlib.sha256(blob.encode()).hexdigest()[:32]
 
 
