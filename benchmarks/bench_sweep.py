@@ -128,8 +128,8 @@ def run(study: str = "default", seeds: int | None = 1,
                   f"{sorted(loads)[len(loads) // 2] if loads else math.nan:.3f} s); whole run "
                   f"{t_warm:.1f} s vs {t_par:.1f} s cold"),
         dict(name="identical rows seq / loky / warm", value=float(same), unit="bool", target=1.0, ok=same,
-             note="every column but the timings and the commit" + (f"; differ: {diff} (was the code edited during "
-                                                     "the bench?)" if diff else "")),
+             note="every column but the timings and the commit"
+             + (f"; differ: {diff} (was the code edited during the bench?)" if diff else "")),
     ]
 
 
