@@ -33,17 +33,23 @@ def main(argv: list[str]) -> int:
             print(f"  {r['name']}: {r['value']:.4g} {r.get('unit', '')}  target {r.get('target', '-')}  "
                   f"[{mark}]  {r.get('note', '')}", flush=True)
         print(f"  ({time.perf_counter() - t0:.1f} s)")
-    lines = ["# Benchmark results", "",
-             f"Measured by `make bench` on {platform.machine()} / Python {platform.python_version()}, "
-             f"{time.strftime('%Y-%m-%d')}; one BLAS thread.", "",
-             "| benchmark | measure | value | target | met | note |", "|---|---|---|---|---|---|"]
+    table = []
     for r in rows:
         met = {True: "yes", False: "**no**", None: "-"}[r.get("ok")]
-        lines.append(f"| {r['bench']} | {r['name']} | {r['value']:.4g} {r.get('unit', '')} | "
+        table.append(f"| {r['bench']} | {r['name']} | {r['value']:.4g} {r.get('unit', '')} | "
                      f"{r.get('target', '-')} | {met} | {r.get('note', '')} |")
-    if not only:
-        (HERE / "RESULTS.md").write_text("\n".join(lines) + "\n")
-        print(f"wrote {HERE / 'RESULTS.md'}")
+    out = HERE / "RESULTS.md"
+    if only and out.is_file():  # keep the other benchmarks' rows, replace these
+        kept = [ln for ln in out.read_text().splitlines()
+                if ln.startswith("| bench_") and ln.split("|")[1].strip() not in only]
+        table = sorted(kept + table, key=lambda ln: ln.split("|")[1].strip())
+    lines = ["# Benchmark results", "",
+             f"Measured by `make bench` on {platform.machine()} / Python {platform.python_version()}, "
+             f"{time.strftime('%Y-%m-%d')}; one BLAS thread; `python -m benchmarks NAME` re-measures "
+             "one benchmark and keeps the others' rows.", "",
+             "| benchmark | measure | value | target | met | note |", "|---|---|---|---|---|---|", *table]
+    out.write_text("\n".join(lines) + "\n")
+    print(f"wrote {out}")
     return 0
 
 
