@@ -31,7 +31,7 @@ from pathlib import Path
 from typing import Any
 
 from testbed.errors import ScenarioError
-from testbed.schema import Field, validate_table
+from testbed.schema import Field, validate_header, validate_table
 
 SCENARIO_DIR = Path(os.environ.get("TESTBED_SCENARIOS",
                                    Path(__file__).resolve().parent.parent / "scenarios"))
@@ -160,16 +160,8 @@ def scenario_from_dict(raw: dict[str, Any], *, file: str = "<dict>",
     """Validate a scenario given as a dict of TOML tables."""
     from models import RIGS  # the rig owns the schema of its sections
 
-    for section in raw:
-        if section not in SECTIONS:
-            raise ScenarioError(file, section, raw[section],
-                                "unknown section; allowed: " + ", ".join(f"[{s}]" for s in SECTIONS))
-    if "scenario" not in raw:
-        raise ScenarioError(file, "scenario", allowed="missing [scenario] table")
-    head = validate_table(raw["scenario"], HEADER_SCHEMA, file=file, section="scenario")
-    if stem is not None and head["name"] != stem:
-        raise ScenarioError(file, "scenario.name", head["name"],
-                            f"must equal the file name without .toml ({stem!r})")
+    head = validate_header(raw, sections=SECTIONS, header="scenario", schema=HEADER_SCHEMA, file=file,
+                           stem=stem)
     try:
         rig_cls = RIGS.get(head["rig"])
     except KeyError as e:

@@ -168,4 +168,24 @@ def validate_variant(table: Mapping[str, Any], variants: Mapping[str, Mapping[st
     return {selector: kind, **out}
 
 
+def validate_header(raw: Mapping[str, Any], *, sections: tuple[str, ...], header: str,
+                    schema: Mapping[str, Field], file: str, stem: str | None) -> dict[str, Any]:
+    """Check a TOML document's sections and validate its header table.
+
+    Every top-level table must be one of ``sections``; the ``[header]`` table must be present
+    and valid; its ``name`` must equal ``stem`` (the file name without ``.toml``) when given.
+    """
+    for section in raw:
+        if section not in sections:
+            raise ScenarioError(file, section, raw[section],
+                                "unknown section; allowed: " + ", ".join(f"[{s}]" for s in sections))
+    if header not in raw:
+        raise ScenarioError(file, header, allowed=f"missing [{header}] table")
+    head = validate_table(raw[header], schema, file=file, section=header)
+    if stem is not None and head["name"] != stem:
+        raise ScenarioError(file, f"{header}.name", head["name"],
+                            f"must equal the file name without .toml ({stem!r})")
+    return head
+
+
 Checker = Callable[[dict[str, Any]], None]

@@ -38,7 +38,7 @@ from typing import Any
 
 from testbed.errors import ScenarioError
 from testbed.scenario import SCENARIO_DIR, Scenario, _validate_identify, load_scenario, resolve_path
-from testbed.schema import Field, validate_table
+from testbed.schema import Field, validate_header
 
 STUDY_DIR = Path(__file__).resolve().parent.parent / "studies"
 
@@ -195,16 +195,8 @@ def study_from_dict(raw: dict[str, Any], *, file: str = "<dict>", base: Path | N
                     stem: str | None = None) -> Study:
     """Validate a study given as a dict of TOML tables (paths relative to ``base``)."""
     base = base if base is not None else Path.cwd()
-    for section in raw:
-        if section not in SECTIONS:
-            raise ScenarioError(file, section, raw[section],
-                                "unknown section; allowed: " + ", ".join(f"[{s}]" for s in SECTIONS))
-    if "study" not in raw:
-        raise ScenarioError(file, "study", allowed="missing [study] table")
-    head = validate_table(raw["study"], STUDY_SCHEMA, file=file, section="study")
-    if stem is not None and head["name"] != stem:
-        raise ScenarioError(file, "study.name", head["name"],
-                            f"must equal the file name without .toml ({stem!r})")
+    head = validate_header(raw, sections=SECTIONS, header="study", schema=STUDY_SCHEMA, file=file,
+                           stem=stem)
     for key in ("scenarios", "noise", "seeds", "identifiers", "plugins"):
         _no_duplicates(head[key], file, f"study.{key}")
 
