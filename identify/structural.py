@@ -26,9 +26,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import linalg, signal
+from scipy import linalg
 
 from identify._base import Identifier
+from identify._structural_sim import simulate_structural
 from testbed.measurement import Measurement, Trajectory
 
 #: Keys of ``Measurement.prior`` a structural identifier may take the mass scale from.
@@ -256,130 +257,6 @@ def modal(M: np.ndarray, K: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         if vec[imax, k] < 0:
             vec[:, k] *= -1.0
     return freqs, vec
-
-
-def _zoh_free_and_forced(A: np.ndarray, Bz: np.ndarray | None, z0: np.ndarray, dt: float, n_t: int,
-                         w: np.ndarray | None) -> np.ndarray:
-    """Exact ZOH discretisation of ``z' = A z + Bz w``, propagated in modal coordinates.
-
-    Returns the states, shape (2n, n_t), at the sample times ``k dt``.
-    """
-    nz = A.shape[0]
-    if Bz is None or w is None:
-        aug = A
-    else:
-        aug = np.zeros((nz + Bz.shape[1], nz + Bz.shape[1]))
-        aug[:nz, :nz], aug[:nz, nz:] = A, Bz
-    E = linalg.expm(aug * dt)
-    Phi = E[:nz, :nz]
-    d, V = linalg.eig(Phi)
-    if np.linalg.cond(V) > 1e10:  # defective (repeated) modes: step the recursion directly
-        Z = np.empty((nz, n_t))
-        Z[:, 0] = z0
-        G = E[:nz, nz:] if w is not None else None
-        for k in range(1, n_t):
-            Z[:, k] = Phi @ Z[:, k - 1] + (G @ w[:, k - 1] if G is not None else 0.0)
-        return Z
-    q0 = linalg.solve(V, z0.astype(complex))
-    q = q0[:, None] * d[:, None] ** np.arange(n_t)[None, :]
-    if w is not None:
-        G = E[:nz, nz:]
-        r = linalg.solve(V, G @ w.astype(complex))  # modal input, (nz, n_t)
-        for i in range(nz):  # q_k = d q_{k-1} + r_{k-1}: a first-order IIR filter per mode
-            q[i] += signal.lfilter([0.0, 1.0], [1.0, -d[i]], r[i])
-    return (V @ q).real
-
-
-def simulate_structural(M: np.ndarray, C: np.ndarray, K: np.ndarray, K3: np.ndarray | None,
-                        B: np.ndarray | None, x0: np.ndarray, xd0: np.ndarray, t: np.ndarray,
-                        u: np.ndarray | None = None, max_omega_h: float = 0.1) -> Trajectory:
-    """Integrate ``M x'' + C x' + K x + K3 x^3 = B u`` from ``(x0, xd0)`` at the times ``t``.
-
-    Parameters
-    ----------
-    M, C, K : ndarray, shape (n, n)
-        [kg], [N s/m], [N/m].
-    K3 : ndarray, shape (n, n) or None
-        Cubic stiffness [N/m^3]; None or all zero gives the linear model.
-    B : ndarray, shape (n, n_inputs) or None
-        Input map; required when ``u`` is given.
-    x0, xd0 : ndarray, shape (n,)
-        Initial displacement [m] and velocity [m/s] at ``t[0]``.
-    t : ndarray, shape (n_t,)
-        Equally spaced sample times [s].
-    u : ndarray, shape (n_inputs, n_t), optional
-        Input [N], held constant over each sample interval (zero-order hold).
-    max_omega_h : float
-        Cubic model only: RK4 sub-steps are chosen so that ``h * max|eig(A)| <= max_omega_h``
-        (phase error per step ~ (omega h)^5 / 120).
-
-    Returns
-    -------
-    Trajectory
-        ``x`` [m], ``xd`` [m/s], ``xdd`` [m/s^2], each (n, n_t); ``xdd`` is evaluated from the
-        equation of motion at each sample.
-
-    Notes
-    -----
-    The linear model is discretised exactly (matrix exponential with a zero-order-hold input)
-    and propagated in the eigenbasis of the transition matrix, vectorised over time (no
-    per-sample Python loop).  With a cubic term the full model is integrated with classical
-    RK4 at sub-steps of the sample interval; the input is held over each interval.
-    """
-    M, C, K = (np.asarray(a, dtype=float) for a in (M, C, K))
-    n = M.shape[0]
-    t = np.asarray(t, dtype=float)
-    n_t = t.size
-    x0 = np.asarray(x0, dtype=float).reshape(n)
-    xd0 = np.asarray(xd0, dtype=float).reshape(n)
-    dt = float(t[1] - t[0]) if n_t > 1 else 1.0
-    if n_t > 2 and not np.allclose(np.diff(t), dt, rtol=1e-6, atol=0.0):
-        raise ValueError("t must be equally spaced")
-    Minv = np.linalg.inv(M)
-    f = None
-    if u is not None:
-        if B is None:
-            raise ValueError("the model has no input map (no input in the fitted data); cannot apply u")
-        u = np.atleast_2d(np.asarray(u, dtype=float))
-        if u.shape != (B.shape[1], n_t):
-            raise ValueError(f"u must have shape {(B.shape[1], n_t)}, got {u.shape}")
-        f = np.asarray(B, dtype=float) @ u  # (n, n_t) force [N]
-    A = np.block([[np.zeros((n, n)), np.eye(n)], [-Minv @ K, -Minv @ C]])
-    z0 = np.concatenate([x0, xd0])
-    nonlinear = K3 is not None and np.any(np.asarray(K3) != 0.0)
-    if not nonlinear:
-        Bz = np.vstack([np.zeros((n, n)), Minv]) if f is not None else None
-        Z = _zoh_free_and_forced(A, Bz, z0, dt, n_t, f)
-        x, xd = Z[:n], Z[n:]
-        xdd = -Minv @ (C @ xd + K @ x) + (Minv @ f if f is not None else 0.0)
-        return Trajectory(x, xd, xdd)
-    MK3 = Minv @ np.asarray(K3, dtype=float)
-    MF = Minv @ f if f is not None else np.zeros((n, n_t))
-    rho = float(np.max(np.abs(np.linalg.eigvals(A)))) if n_t > 1 else 0.0
-    sub = max(1, int(np.ceil(rho * dt / max_omega_h)))
-    h = dt / sub
-    Z = np.empty((2 * n, n_t))
-    Z[:, 0] = z0
-    z = z0.copy()
-
-    def rhs(z: np.ndarray, fk: np.ndarray) -> np.ndarray:
-        return A @ z + np.concatenate([np.zeros(n), fk - MK3 @ z[:n] ** 3])
-
-    for k in range(1, n_t):
-        fk = MF[:, k - 1]
-        for _ in range(sub):
-            k1 = rhs(z, fk)
-            k2 = rhs(z + 0.5 * h * k1, fk)
-            k3 = rhs(z + 0.5 * h * k2, fk)
-            k4 = rhs(z + h * k3, fk)
-            z = z + (h / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
-        if not np.all(np.isfinite(z)):
-            Z[:, k:] = np.nan
-            break
-        Z[:, k] = z
-    x, xd = Z[:n], Z[n:]
-    xdd = -Minv @ (C @ xd + K @ x) - MK3 @ x**3 + MF
-    return Trajectory(x, xd, xdd)
 
 
 # --------------------------------------------------------------------------------------------

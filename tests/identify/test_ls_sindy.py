@@ -12,7 +12,8 @@ import pytest
 from benchmarks import bench_sgd_sindy as bench
 from identify import IDENTIFIERS
 from identify.ls_sindy import LeastSquaresSINDy
-from identify.structural import modal, simulate_structural
+from identify._structural_sim import simulate_structural
+from identify.structural import modal
 
 
 @pytest.fixture(scope="module")
