@@ -11,8 +11,8 @@ import pytest
 
 from benchmarks import bench_sgd_sindy as bench
 from identify import IDENTIFIERS
-from identify.ls_sindy import LeastSquaresSINDy
 from identify._structural_sim import simulate_structural
+from identify.ls_sindy import LeastSquaresSINDy
 from identify.structural import modal
 
 
