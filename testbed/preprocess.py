@@ -13,6 +13,7 @@ from typing import Any
 
 import numpy as np
 
+from testbed import derivatives
 from testbed import signal as sig
 from testbed.dataset import Dataset
 from testbed.measurement import Measurement
@@ -236,10 +237,10 @@ def measure_mechanical(dataset: Dataset, cfg: Mapping[str, Any]) -> Measurement:
     cfg : mapping
         A validated ``SIGNAL_SCHEMAS["mechanical"]`` table.  ``derivatives = "recorded"``
         uses the recorded rates; ``"estimated"`` smooths and differentiates the angles with a
-        Savitzky-Golay filter (``window``, ``polyorder``; :func:`testbed.signal.differentiate`),
+        Savitzky-Golay filter (``window``, ``polyorder``; :func:`testbed.derivatives.differentiate`),
         ``"lowpass"`` with a zero-phase Butterworth low-pass and central differences
         (``cutoff_hz``, ``filter_order``, ``edge_fit_s``, ``edge_fit_order``;
-        :func:`testbed.signal.lowpass_differentiate`); both ignore the recorded rates.
+        :func:`testbed.derivatives.lowpass_differentiate`); both ignore the recorded rates.
 
     Returns
     -------
@@ -253,10 +254,10 @@ def measure_mechanical(dataset: Dataset, cfg: Mapping[str, Any]) -> Measurement:
     if cfg["derivatives"] == "recorded":
         x, xd, xdd = theta, _get(dataset, "dtheta", 4), _get(dataset, "ddtheta", 4)
     elif cfg["derivatives"] == "lowpass":
-        x, xd, xdd = sig.lowpass_differentiate(theta, fs, cfg["cutoff_hz"], cfg["filter_order"],
+        x, xd, xdd = derivatives.lowpass_differentiate(theta, fs, cfg["cutoff_hz"], cfg["filter_order"],
                                                cfg["edge_fit_s"], cfg["edge_fit_order"])
     else:
-        x, xd, xdd = sig.differentiate(theta, fs, cfg["window"], cfg["polyorder"])
+        x, xd, xdd = derivatives.differentiate(theta, fs, cfg["window"], cfg["polyorder"])
     input_map = np.zeros((4, 2))
     input_map[0, 0] = input_map[3, 1] = 1.0
     return Measurement(fs=fs, x=x, xd=xd, xdd=xdd, channels=MECHANICAL_CHANNELS, u=torque,

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 from scipy import signal as ss
 
+from testbed import derivatives as der
 from testbed import signal as sig
 
 FS = 12800.0  # the paper's sample rate [Hz]
@@ -204,7 +205,7 @@ def test_differentiate_exact_on_polynomials():
     fs = 100.0
     t = np.arange(400) / fs
     x = np.stack([1.0 + 2.0 * t - 3.0 * t**2 + 0.5 * t**3, t**4])
-    xs, xd, xdd = sig.differentiate(x, fs, window=31, polyorder=4)
+    xs, xd, xdd = der.differentiate(x, fs, window=31, polyorder=4)
     # a local polynomial of order 4 reproduces any polynomial up to order 4 exactly
     np.testing.assert_allclose(xs, x, atol=1e-9)
     np.testing.assert_allclose(xd[0], 2.0 - 6.0 * t + 1.5 * t**2, atol=1e-8)
@@ -218,7 +219,7 @@ def test_differentiate_noisy_sine():
     t = np.arange(int(10 * fs)) / fs
     rng = np.random.default_rng(1)
     x = 0.0698 * np.sin(t + np.pi / 2) + rng.normal(0, 1e-4, t.size)
-    xs, xd, xdd = sig.differentiate(x[None], fs, window=2001, polyorder=4)
+    xs, xd, xdd = der.differentiate(x[None], fs, window=2001, polyorder=4)
     mid = slice(2000, -2000)
     # noise 1e-4 rad through a 0.2 s quartic window: derivative noise ~ sigma / T^k times a
     # filter factor of order 10 (k = 1, 2); the sine's own curvature over 0.2 s is fit exactly
@@ -231,7 +232,7 @@ def test_differentiate_noisy_sine():
                                                      (31, 31, "polyorder"), (501, 4, "exceeds")])
 def test_differentiate_rejects_bad_settings(window, polyorder, match):
     with pytest.raises(ValueError, match=match):
-        sig.differentiate(np.zeros((2, 400)), 100.0, window, polyorder)
+        der.differentiate(np.zeros((2, 400)), 100.0, window, polyorder)
 
 
 @pytest.mark.parametrize("window,polyorder", [(3001, 4), (6001, 4), (1001, 6), (301, 8), (2001, 8)])
@@ -241,7 +242,7 @@ def test_differentiate_long_windows_and_high_orders_keep_the_offset(window, poly
     fs = 1e4
     t = np.arange(20000) / fs
     x = np.stack([1.78 + 0.3 * np.sin(2 * np.pi * 0.5 * t), 1.36 + 0.2 * np.cos(2 * np.pi * 0.3 * t)])
-    xs, xd, xdd = sig.differentiate(x, fs, window, polyorder)
+    xs, xd, xdd = der.differentiate(x, fs, window, polyorder)
     w = 2 * np.pi * 0.5
     # the local fit's own bias: at most (w T)^(p+1)-order terms of the slow sines; the bounds
     # are 10x the worst measured (window 6001, order 4: 9e-4 rad, 0.04 rad/s, 0.4 rad/s^2)
@@ -250,7 +251,7 @@ def test_differentiate_long_windows_and_high_orders_keep_the_offset(window, poly
     assert np.abs(xdd[0] + 0.3 * w**2 * np.sin(w * t)).max() < 5.0
     # a constant is reproduced exactly by any order, whatever the window
     c = np.full((1, 20000), 1.78)
-    cs, cd, cdd = sig.differentiate(c, fs, window, polyorder)
+    cs, cd, cdd = der.differentiate(c, fs, window, polyorder)
     np.testing.assert_allclose(cs, c, rtol=0, atol=1e-12)
     assert np.abs(cd).max() < 1e-8 and np.abs(cdd).max() < 1e-4
 
@@ -259,7 +260,7 @@ def test_differentiate_matches_scipy_where_scipy_is_well_conditioned():
     fs = 100.0
     rng = np.random.default_rng(3)
     x = rng.normal(size=(2, 500)).cumsum(axis=1)
-    ours = sig.differentiate(x, fs, 31, 3)
+    ours = der.differentiate(x, fs, 31, 3)
     for d, got in enumerate(ours):
         ref = ss.savgol_filter(x, 31, 3, deriv=d, delta=1 / fs, axis=-1, mode="interp")
         np.testing.assert_allclose(got, ref, rtol=0, atol=1e-9 * fs**d * np.abs(x).max())
@@ -277,7 +278,7 @@ def test_lowpass_differentiate_clean_signal_cut_mid_motion():
     fs = 1e4
     t = np.arange(int(10 * fs)) / fs
     x, v, a = sines(t)
-    xs, xd, xdd = sig.lowpass_differentiate(x, fs, 6.0)
+    xs, xd, xdd = der.lowpass_differentiate(x, fs, 6.0)
     mid = slice(int(1.5 * fs), -int(1.5 * fs))
     # interior: pass-band gain 1 - (1/6)^16 / 2 per pass and central differences (w/fs)^2 / 6:
     # both ~1e-9 relative; 1e-6 leaves room for the filter's round-off
@@ -295,7 +296,7 @@ def test_lowpass_differentiate_clean_signal_cut_mid_motion():
                       1 / fs, axis=-1, edge_order=2)
     assert np.abs(raw - v)[:, 0].max() > 10 * np.abs(xd - v)[:, 0].max()
     # one channel in, one channel out
-    one = sig.lowpass_differentiate(x[0], fs, 6.0)
+    one = der.lowpass_differentiate(x[0], fs, 6.0)
     assert one[1].shape == (t.size,)
     # same numbers up to round-off (the end fits' slope weights carry a factor fs = 1e4)
     np.testing.assert_allclose(one[1], xd[0], rtol=0, atol=1e-7)
@@ -308,8 +309,8 @@ def test_lowpass_differentiate_beats_savitzky_golay_on_noise():
     rng = np.random.default_rng(5)
     noisy = x + rng.normal(0.0, 2e-3, x.shape)  # ~1 % of the angles' RMS, as on the five-bar
     mid = slice(int(1.5 * fs), -int(1.5 * fs))
-    _, xd, xdd = sig.lowpass_differentiate(noisy, fs, 4.0)
-    _, _, sdd = sig.differentiate(noisy, fs, 1001, 2)
+    _, xd, xdd = der.lowpass_differentiate(noisy, fs, 4.0)
+    _, _, sdd = der.differentiate(noisy, fs, 1001, 2)
     # predicted noise RMS, brick-wall at fc: sigma (2 pi)^k sqrt(fc^(2k+1) / ((2k+1) fs / 2)):
     # 8.2e-4 rad/s (k = 1), 1.6e-2 rad/s^2 (k = 2) at 4 Hz; measured 7.4e-4 and 1.4e-2;
     # bounds 2x the prediction
@@ -326,4 +327,4 @@ def test_lowpass_differentiate_beats_savitzky_golay_on_noise():
 def test_lowpass_differentiate_rejects_bad_settings(kw, match):
     args = {"cutoff_hz": 4.0} | kw
     with pytest.raises(ValueError, match=match):
-        sig.lowpass_differentiate(np.zeros((2, 5000)), 1e4, **args)
+        der.lowpass_differentiate(np.zeros((2, 5000)), 1e4, **args)
