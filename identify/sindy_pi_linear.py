@@ -1,19 +1,41 @@
 """SINDy-PI on a linear structural library: ``M a + C v + K x = B u`` from free vibration.
 
-The shared-Gram sweep of :mod:`identify.sindy_pi` runs on the columns ``x_i, v_i, a_i`` of
-the free-vibration part of the record (from ``data.free_start``), with the accelerations as
-candidate left-hand sides.  One implicit equation is picked per channel (left-hand side
-``a_i``; held-out error, then parsimony; an equation is skipped if it would make the stacked
-acceleration block rank-deficient).  The stacked rows ``[W_x W_v W_a]`` are any invertible
-row-combination ``T [K C M]`` of the truth; ``W_a^-1 W_x = M^-1 K`` and ``W_a^-1 W_v = M^-1 C``
-are what free vibration identifies, and they are kept exactly.
+Implicit rows, one per channel
+------------------------------
+Row ``i`` has left-hand side ``a_i`` and is regressed, over the free-vibration part of the record
+(from ``data.free_start``), on ``[x, v]`` only; the *other* channels' accelerations are not
+candidates.  With them (the coupled library ``[x, v, a]`` of every channel) the regression is
+ill-posed: the data satisfy all ``n`` equations of motion, so every row's solution set has an
+``n - 1`` dimensional null space (the other rows' equations hold among its columns; see
+:mod:`identify._sgd_matrix`), and on the cantilever, where the third sensor mode is barely
+excited, the near-null space is larger still.  The coupled sweep then returned an arbitrary
+member of it, thresholding pruned the small velocity (damping) terms of that member, and
+``W_a^-1 W_v`` came out wrong (measured on ``cantilever_stiff_impact``: damping ratios
+0.22 / 0.11 against 0.010 / 0.063, TRAC 0.26; with no thresholding M was indefinite).  Free
+vibration identifies ``M^-1 K`` and ``M^-1 C`` and nothing else, and the decoupled rows
+``a_i + (M^-1 K)_i x + (M^-1 C)_i v = 0`` determine them uniquely, so nothing identifiable is
+lost.  **This makes the regression step least-squares SINDy (``ls_sindy``) written in implicit
+form**; the shared-Gram thresholded sweep of :mod:`identify._implicit` with held-out selection
+(last ``val_fraction`` of the window) is kept per row, and on the cantilever data it selects
+the unthresholded model (threshold 0), so no velocity term is pruned there.  What this
+identifier adds over ``ls_sindy`` is the physical normalisation below: a symmetric positive
+definite M and symmetric K and C.
 
-Normalisation (reported in ``normalisation_``): M is the symmetric matrix for which
-``M (M^-1 K)`` and ``M (M^-1 C)`` are symmetric (:func:`symmetric_mass`; unique up to scale
-unless the damping is proportional, then the member nearest the row-normalised ``W_a``),
-scaled so that ``trace(M) = data.prior[mass_prior]`` [kg]; ``K = M (M^-1 K)``,
-``C = M (M^-1 C)``.  Simulation: exact zero-order-hold
-discretisation (matrix exponential) of the identified linear model.
+Normalisation (reported in ``normalisation_``)
+----------------------------------------------
+M is the symmetric matrix for which ``M (M^-1 K)`` and ``M (M^-1 C)`` are symmetric
+(:func:`symmetric_mass`; unique up to scale for non-proportional damping), with the sign that
+makes its trace positive.  If that solve is ill-posed (a family of solutions, condition number
+above :data:`MAX_MASS_COND`, or an M that is not positive definite) the modal masses are taken
+equal, ``M = Phi^-T Phi^-1`` with ``Phi`` the eigenvectors of ``M^-1 K`` (as SGD-SINDy's warm
+start); on the cantilever data the solve gives an indefinite M and this fallback is used.
+M is scaled so that ``trace(M) = data.prior[mass_prior]`` [kg].  Given M, the symmetric K and
+C are refitted by least squares on the equation error ``M a + C v + K x`` over the
+free-vibration window (:func:`symmetric_stiffness_damping`), rather than symmetrising
+``M (M^-1 K)`` and ``M (M^-1 C)``: on exact data the two coincide; on the 1 %-noise cantilever
+the symmetrised damping kept a strongly wrong mode-2 damping (TRAC 0.61) where the refit gives
+TRAC 0.94.  C is then projected onto the positive semi-definite cone (a passive structure
+dissipates).  Simulation: exact zero-order-hold discretisation (matrix exponential).
 """
 
 from __future__ import annotations
@@ -65,6 +87,32 @@ def symmetric_mass(AK: np.ndarray, AC: np.ndarray, guess: np.ndarray) -> tuple[n
     return np.einsum("k,kij->ij", coef, F), len(F)
 
 
+def symmetric_stiffness_damping(M: np.ndarray, x: np.ndarray, v: np.ndarray,
+                                a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Symmetric K and C minimising ``||M a + C v + K x||`` over the samples, given M.
+
+    Parameters
+    ----------
+    M : ndarray, shape (n, n)
+        Mass matrix [kg].
+    x, v, a : ndarray, shape (n, N)
+        Displacements [m], velocities [m/s], accelerations [m/s^2].
+
+    Returns
+    -------
+    K, C : ndarray, shape (n, n)
+        Stiffness [N/m] and damping [N s/m], symmetric.
+    """
+    S = _sym_basis(M.shape[0])
+    A = np.array([(E @ s).ravel() for s in (v, x) for E in S]).T
+    scale = np.linalg.norm(A, axis=0)
+    scale[scale == 0] = 1.0
+    # columns standardised: stiffness columns are ~1e3 x the damping ones on the cantilever
+    c = np.linalg.lstsq(A / scale, -(M @ a).ravel(), rcond=1e-12)[0] / scale
+    m = len(S)
+    return np.einsum("k,kij->ij", c[m:], S), np.einsum("k,kij->ij", c[:m], S)
+
+
 #: Above this condition number the symmetric mass solve is taken as undetermined by the data.
 MAX_MASS_COND = 1e3
 
@@ -78,9 +126,9 @@ class SINDyPILinear(Identifier):
     thresholds : sequence of float, optional
         As :class:`~identify.sindy_pi.SINDyPI`.
     ridge : float
-        Ridge on the normalised Gram matrix; 1e-10 because the linear library is rank-deficient
-        by construction for a left-hand side a_i (any row combination eliminating a_i is also
-        exact), and the minimum-norm first solution is the stable one.
+        Ridge on the normalised Gram matrix of row i's columns ``[x, v, a_i]``; 1e-10 because
+        a weakly excited mode makes that matrix near-singular (the third sensor mode of the
+        cantilever), and the damped first solution is the stable one.
     max_iter, val_fraction, selection_rtol, selection_atol
         As :class:`~identify.sindy_pi.SINDyPI`.
     mass_prior : str
@@ -93,7 +141,14 @@ class SINDyPILinear(Identifier):
         Mass [kg], damping [N s/m], stiffness [N/m] in sensor coordinates.
     K3_ : None
     coef_ : ndarray, shape (n, 3n)
-        Selected implicit equations over ``feature_names_`` (x_i, v_i, a_i), max |coef| = 1.
+        Selected implicit equations over ``feature_names_`` (x_i, v_i, a_i), max |coef| = 1;
+        row i has zeros on every acceleration but ``a_i`` (see the module docstring).
+    lhs_terms_ : list of str
+        Left-hand side of each row (``a_i``).
+    selected_thresholds_, validation_errors_ : ndarray, shape (n,)
+        Threshold and normalised held-out error of each selected row.
+    normalisation_ : str
+        How M, K and C were fixed.
     """
 
     name = "sindy_pi_linear"
@@ -120,54 +175,56 @@ class SINDyPILinear(Identifier):
         Theta = lib.evaluate(data.x[:, s0:], data.xd[:, s0:], data.xdd[:, s0:])
         G_tr, G_v = grams(Theta, split_index(Theta.shape[0], self.val_fraction))
         thr = DEFAULT_THRESHOLDS if self.thresholds is None else np.asarray(self.thresholds)
-        sw = stlsq_sweep(G_tr, G_v, np.arange(2 * n, 3 * n), thr, self.ridge, self.max_iter)
-        rows, lhs, thr_sel, errs = [], [], [], []
+        W = np.zeros((n, 3 * n))
+        lhs, thr_sel, errs = [], [], []
         for i in range(n):
-            elig = np.zeros(sw.val_error.shape, dtype=bool)
-            elig[:, sw.candidates == 2 * n + i] = True
-            for flat in rank_models(sw, elig, self.selection_rtol, self.selection_atol):
-                t, c = np.unravel_index(flat, sw.val_error.shape)
-                w = sw.coef(t, c)
-                trial = np.array([*rows, w])[:, 2 * n:]
-                if np.linalg.svd(trial / np.abs(trial).max(), compute_uv=False)[-1] > 1e-8:
-                    rows.append(w)
-                    lhs.append(lib.names[2 * n + i])
-                    thr_sel.append(sw.thresholds[t])
-                    errs.append(sw.val_error[t, c])
-                    break
-            else:
-                raise IdentificationError(f"no implicit equation independent of the others has "
-                                          f"left-hand side {lib.names[2 * n + i]}")
-        W = np.array(rows)
+            cols = np.r_[np.arange(2 * n), 2 * n + i]
+            sub = np.ix_(cols, cols)
+            sw = stlsq_sweep(G_tr[sub], G_v[sub], [2 * n], thr, self.ridge, self.max_iter)
+            order = rank_models(sw, np.ones(sw.val_error.shape, dtype=bool), self.selection_rtol,
+                                self.selection_atol)
+            if order.size == 0:
+                raise IdentificationError(f"no finite implicit equation has left-hand side "
+                                          f"{lib.names[2 * n + i]}")
+            t, c = np.unravel_index(order[0], sw.val_error.shape)
+            W[i, cols] = sw.coef(t, c)
+            lhs.append(lib.names[2 * n + i])
+            thr_sel.append(sw.thresholds[t])
+            errs.append(sw.val_error[t, c])
         Wx, Wv, Wa = W[:, :n], W[:, n:2 * n], W[:, 2 * n:]
         AK, AC = np.linalg.solve(Wa, Wx), np.linalg.solve(Wa, Wv)
-        guess = 0.5 * (Wa / np.diag(Wa)[:, None] + (Wa / np.diag(Wa)[:, None]).T)
-        M, family = symmetric_mass(AK, AC, guess)
+        M, family = symmetric_mass(AK, AC, np.eye(n))  # W_a is diagonal: rows normalised, I
         lam, phi = np.linalg.eig(AK)
-        ill = family > 1 or np.linalg.cond(M) > MAX_MASS_COND
+        if np.trace(M) < 0:
+            M = -M  # the symmetric solutions form a linear space: the sign is free
+        ill = (family > 1 or np.linalg.cond(M) > MAX_MASS_COND
+               or not np.all(np.linalg.eigvalsh(M) > 0))
         if ill and np.all(np.abs(lam.imag) <= 1e-9 * np.abs(lam).max()) and np.all(lam.real > 0):
             # The data leave the modal masses open (proportional damping, or damping too weakly
             # non-proportional to pin them): take them equal, as SGD-SINDy's warm start does and
-            # as the SEREP truth's mass-normalised modes imply.  The symmetric solve was
-            # near-singular on the cantilever (condition number 5e3), which wrecked M (M^-1 C).
+            # as the SEREP truth's mass-normalised modes imply.  On the stiff cantilever the
+            # symmetric solve gave an indefinite M (eigenvalues -0.0015 / 0.045 / 0.96 of trace).
             p_inv = np.linalg.inv(phi.real)
             M = p_inv.T @ p_inv
-        scale = float(data.prior[self.mass_prior]) / np.trace(M)
-        if not np.isfinite(scale) or scale <= 0:
-            raise IdentificationError("identified mass matrix has a non-positive trace")
-        M = scale * M
+            how = "equal modal masses (the symmetric solve was ill-posed)"
+        elif ill:
+            raise IdentificationError("no positive definite mass matrix: the symmetric solve is "
+                                      "ill-posed and M^-1 K has complex or non-positive eigenvalues")
+        else:
+            how = "unique up to scale"
+        M = float(data.prior[self.mass_prior]) / np.trace(M) * M
+        K, C = symmetric_stiffness_damping(M, data.x[:, s0:], data.xd[:, s0:], data.xdd[:, s0:])
         # A passive structure dissipates: C is symmetric positive semi-definite.  Free decay hardly
         # excites the sensors' third mode, whose identified damping came out negative on the
         # stiff cantilever, and the free simulation diverged (measured: accelerations ~1e75).
-        # Symmetrise K and C and project C onto the positive semi-definite cone.
-        K = 0.5 * (M @ AK + (M @ AK).T)
-        w, V = np.linalg.eigh(0.5 * (M @ AC + (M @ AC).T))
+        w, V = np.linalg.eigh(C)
         C = (V * np.maximum(w, 0.0)) @ V.T
+        M, C = 0.5 * (M + M.T), 0.5 * (C + C.T)  # exactly symmetric (round-off of the products)
         self.M_, self.C_, self.K_, self.K3_ = M, C, K, None
         self.normalisation_ = (
             f"M symmetric with M (M^-1 K) and M (M^-1 C) symmetric ({family}-dimensional family; "
-            f"{'unique up to scale' if family == 1 else 'equal modal masses'}"
-            f"), trace(M) = prior[{self.mass_prior!r}] = {float(data.prior[self.mass_prior]):g} kg")
+            f"{how}), K and C symmetric least squares given M, "
+            f"trace(M) = prior[{self.mass_prior!r}] = {float(data.prior[self.mass_prior]):g} kg")
         self.coef_, self.feature_names_, self.lhs_terms_ = W, list(lib.names), lhs
         self.selected_thresholds_, self.validation_errors_ = np.array(thr_sel), np.array(errs)
         self.input_map_ = (np.zeros((n, 0)) if data.input_map is None
