@@ -27,6 +27,11 @@ Noisy data: ``reconcile`` (default on) replaces the passive angles, rates and ac
 those the closure implies, so the kinematic identities hold exactly again; ``column_lowpass_hz``
 filters every library column alike (the equations stay exact) to cut derivative noise.
 
+Weak form (``formulation="weak"``): the rows of the regression are integrals of the library
+against smooth compactly supported test functions instead of samples, with the acceleration
+terms integrated by parts (:mod:`identify._weak`): angles and rates suffice, so the noise of
+estimated accelerations never enters.
+
 Kinematic identities: on loop-closed data, products of trig factors with accelerations and
 velocities obey exact linear relations that contain no input (loop constraint times trig
 factors).  They make the implicit equations non-unique.  With ``prune_tol`` set, input-free
@@ -46,6 +51,7 @@ from identify import IDENTIFIERS
 from identify._base import Identifier
 from identify._implicit import DEFAULT_THRESHOLDS, Sweep, grams, select_models, split_index, stlsq_sweep
 from identify._mechsim import CLOSURE_RTOL, ImplicitModel, LoopClosure
+from identify._weak import weak_matrix
 from identify.library import Library, fivebar_library, generic_mechanical_library
 from testbed.errors import IdentificationError
 from testbed.measurement import Measurement, Trajectory
@@ -163,6 +169,46 @@ class _ImplicitMechanical(Identifier):
             Theta = Theta[i0:data.n_samples - i0]
         return Theta, i0
 
+    def _regression_matrix(self, lib: Library, data: Measurement) -> tuple[np.ndarray, int, int, int]:
+        """Rows of the regression, training rows first: (matrix, n_train, i0, v0).
+
+        ``i0`` is the edge trim [samples], ``v0`` the first sample of the validation part of
+        the record.  Strong form: the library's samples (:meth:`_library_matrix`).  Weak form
+        (``formulation="weak"``): test-function integrals over the trimmed record
+        (:func:`identify._weak.weak_matrix`); windows wholly before the split time are
+        training rows, wholly after it validation rows, those straddling it are dropped.
+        """
+        form = getattr(self, "formulation", "strong")
+        if form == "strong":
+            Theta, i0 = self._library_matrix(lib, data)
+            n_tr = split_index(Theta.shape[0], self.val_fraction)
+            return Theta, n_tr, i0, i0 + n_tr
+        if form != "weak":
+            raise ValueError(f"formulation must be 'strong' or 'weak', got {form!r}")
+        if self.column_lowpass_hz:
+            raise ValueError("column_lowpass_hz applies to the strong form only (the weak form's "
+                             "test functions filter; integration by parts needs unfiltered columns)")
+        x, xd, xdd = data.x, data.xd, data.xdd
+        if self.reconcile and self.closure_ is not None:
+            x, xd, xdd = self.closure_.reconcile(x, xd, xdd)
+        i0 = round(self.edge_trim * data.fs)
+        n = data.n_samples - 2 * i0
+        if n < 2:
+            raise IdentificationError(f"edge_trim {self.edge_trim} s leaves no samples")
+        sl = slice(i0, data.n_samples - i0)
+        u = None if data.u is None else data.u[:, sl]
+        xdd = None if xdd is None else xdd[:, sl]
+        wf = weak_matrix(lib, x[:, sl], xd[:, sl], xdd, u, data.fs, self.weak_window_s,
+                         self.weak_n_windows, self.weak_degree)
+        split = split_index(n, self.val_fraction)
+        tr = wf.starts + wf.length <= split
+        va = wf.starts >= split
+        if tr.sum() < 2 or va.sum() < 2:
+            raise IdentificationError(f"{tr.sum()} training and {va.sum()} validation windows: "
+                                      "shorten weak_window_s or add weak_n_windows")
+        self.weak_strong_columns_ = wf.strong_columns
+        return np.concatenate([wf.V[tr], wf.V[va]]), int(tr.sum()), i0, i0 + split
+
     def fit(self, data: Measurement) -> _ImplicitMechanical:
         if data.u is None or data.input_map is None:
             raise IdentificationError(f"{self.name} needs measured inputs and their input_map")
@@ -171,8 +217,7 @@ class _ImplicitMechanical(Identifier):
         passive = np.flatnonzero(~imap.any(axis=1))
         self.closure_ = find_closure(data, passive)
         lib = make_library(self.library, data)
-        Theta, i0 = self._library_matrix(lib, data)
-        n_tr = split_index(Theta.shape[0], self.val_fraction)
+        Theta, n_tr, i0, v0 = self._regression_matrix(lib, data)
         G_tr, G_v = grams(Theta, n_tr)
         in_cols = [lib.input_columns(k) for k in range(data.u.shape[0])]
         has_u = np.zeros(len(lib), dtype=bool)
@@ -211,7 +256,6 @@ class _ImplicitMechanical(Identifier):
 
         best = [p[0] for p in picks]
         if self.selection == "rollout":
-            v0 = i0 + n_tr  # first validation sample of the record
             sl = slice(v0, data.n_samples - i0)
             scores = []
             for combo in product(*picks):
@@ -306,6 +350,19 @@ class SINDyPI(_ImplicitMechanical):
         What the sampled inputs stand for in simulations: a continuous signal or a zero-order
         hold (see :meth:`identify._mechsim.ImplicitModel.simulate`).  Actuators driven by a
         DAC (the five-bar rig) hold; the wrong choice costs an impulse of half a sample.
+    formulation : {"strong", "weak"}
+        ``"strong"``: one regression row per sample of the library.  ``"weak"``: one row per
+        test function, ``int phi_k Theta dt`` (:func:`identify._weak.weak_matrix`), with the
+        acceleration terms integrated by parts so that only angles and rates enter (no second
+        derivative of noisy angles); the held-out split is by time windows (windows
+        straddling the split are dropped).  ``column_lowpass_hz`` must then be None.
+    weak_window_s : float
+        Support of each test function [s] (weak form); a few times the shortest period of
+        the motion's products is a good start (1 s on the five-bar's 0.1-1.5 Hz multisine).
+    weak_n_windows : int
+        Number of equally spaced, overlapping test functions over the trimmed record.
+    weak_degree : int
+        Exponent p of the test function ``(1 - s^2)^p`` (>= 2).
 
     Attributes
     ----------
@@ -313,6 +370,9 @@ class SINDyPI(_ImplicitMechanical):
         One implicit equation per input, scaled to max |coef| = 1 (that entry positive).
     feature_names_, lhs_terms_, selected_thresholds_, validation_errors_, pruned_terms_,
     closure_, sweep_, model_
+    weak_strong_columns_ : list of str
+        Weak form only: acceleration terms integrated with the measured accelerations (no
+        exact integration by parts; :class:`identify._weak.WeakForm`).
     """
 
     name = "sindy_pi"
@@ -323,7 +383,8 @@ class SINDyPI(_ImplicitMechanical):
                  selection_atol: float = 1e-12, n_rollout: int = 3, prune_tol: float | None = 1e-9,
                  sim_dt: float = 1e-3, reconcile: bool = True,
                  column_lowpass_hz: float | None = None, column_lowpass_order: int = 4,
-                 edge_trim: float = 0.0, input_hold: str = "linear"):
+                 edge_trim: float = 0.0, input_hold: str = "linear", formulation: str = "strong",
+                 weak_window_s: float = 0.5, weak_n_windows: int = 400, weak_degree: int = 4):
         self.library = library
         self.lhs = lhs
         self.thresholds = thresholds
@@ -341,6 +402,10 @@ class SINDyPI(_ImplicitMechanical):
         self.column_lowpass_order = column_lowpass_order
         self.edge_trim = edge_trim
         self.input_hold = input_hold
+        self.formulation = formulation
+        self.weak_window_s = weak_window_s
+        self.weak_n_windows = weak_n_windows
+        self.weak_degree = weak_degree
 
     def _sweep(self, G_train, G_val, cand, Theta_train):
         thr = DEFAULT_THRESHOLDS if self.thresholds is None else np.asarray(self.thresholds)
