@@ -30,18 +30,13 @@ def cmd_list(args: argparse.Namespace) -> int:
     from testbed.scenario import list_scenarios
 
     con = Console()
-    t = Table(title="rigs")
-    for c in ("name", "kind", "tags"):
-        t.add_column(c)
-    for n in RIGS.names():
-        t.add_row(n, RIGS.get(n).kind, ", ".join(sorted(RIGS.tags(n))))
-    con.print(t)
-    t = Table(title="identifiers")
-    for c in ("name", "kind", "tags"):
-        t.add_column(c)
-    for n in IDENTIFIERS.names():
-        t.add_row(n, IDENTIFIERS.get(n).kind, ", ".join(sorted(IDENTIFIERS.tags(n))))
-    con.print(t)
+    for title, registry in (("rigs", RIGS), ("identifiers", IDENTIFIERS)):
+        t = Table(title=title)
+        for c in ("name", "kind", "tags"):
+            t.add_column(c)
+        for n in registry.names():
+            t.add_row(n, registry.get(n).kind, ", ".join(sorted(registry.tags(n))))
+        con.print(t)
     t = Table(title="scenarios")
     for c in ("name", "rig", "identifier", "noise %", "description"):
         t.add_column(c)
