@@ -24,12 +24,61 @@ Loss (the paper's terms, Eqs 2-18)
 - eigenvalues (Eqs 8-13): relative squared error of the lowest generalised eigenvalues of
   ``(K, M)`` against ``(2 pi f)^2`` of the measured spectral peaks, with the exact first-order
   sensitivity ``d lambda = u^T (dK - lambda dM) u`` (``u`` mass-normalised);
-- L1 (Eqs 14-15) on the cubic block, applied as a proximal (soft-threshold) step of size
-  ``learning_rate * alpha_l1`` after each Adam step: Adam normalises every gradient, so a
-  sign gradient fed through it would shrink the cubic block as fast as the data can grow it
-  (measured: K3 driven to ~0 on a Duffing chain);
-- learning-rate annealing of the penalty weights (Eqs 17-18) once per epoch, capped at
-  ``alpha_max``.
+- L1 (Eqs 14-15) on the cubic block, as a lasso on *standardised* cubic coefficients (see
+  below), with a proximal step in Adam's metric, then a debiasing stage;
+- learning-rate annealing of the eigenvalue weight (Eqs 17-18) once per epoch, capped at
+  ``alpha_max``; the L1 weight is a declared selection threshold and is not annealed (below).
+
+The L1 penalty: what it compares, and why it is not the paper's literal form
+---------------------------------------------------------------------------
+Eq. 14 adds ``alpha_l1 * sum |Xi|`` on raw coefficients.  A raw cubic coefficient
+[N/m^3 / kg] says nothing about whether the term is needed: on the clamped beam the sensors
+move ~3x less than on the soft base, so an irrelevant cubic term needs a ~30x *larger*
+coefficient than a relevant one, and the paper's Eq. 21 contrast inverts (measured before
+this design: clamped 2e14, soft 3e13 N/m^3).  What decides whether a nonlinear term belongs
+in the model is how much of what the *linear* model leaves unexplained it explains.  So:
+
+1. *Standardised coefficients.*  The cubic block is parametrised as
+   ``K3_ij = R_ij * M0_ii * rms(x''_i) / rms(x_j^3)`` (``M0`` the warm start's masses), so
+   ``R_ij`` is the coefficient of the unit-RMS column ``x_j^3`` in row ``i``'s standardised
+   residual, the quantity the data loss sees.
+2. *The threshold is a partial correlation.*  The L1 weight on ``|R_ij|`` is
+   ``lam_ij = (2 / n) * l1_threshold * rho_i * sigma_j``, with ``rho_i`` the RMS residual of
+   the least-squares linear model of row ``i`` (standardised) and ``sigma_j`` the RMS of
+   ``x_j^3`` after removing its projection on the linear features (:func:`cubic_profile`).
+   At ``R = 0`` with the linear terms at their optimum, ``dL/dR_ij = (2 / n) mean(E_i z_j)``,
+   so the lasso leaves a term out exactly when its partial correlation with the linear
+   model's residual is at most ``l1_threshold`` (the square of the partial correlation is the
+   share of that residual's variance the term would explain).  Scale-free, and it works for a
+   weak nonlinearity on exact data as well as for a strong one.  Measured largest partial
+   correlations (noise-free, seed 0): clamped beam 0.066, soft base 0.99 (its weakest row
+   0.74), synthetic linear chain 0.031, synthetic Duffing chain 1.00; the default 0.2 sits
+   3x above the clamped beam, and at 0.5 the soft base loses terms it needs (TRAC 0.64).
+   With 1 % noise the clamped beam's x^3 columns correlate up to 0.26 with the residual
+   (integrated noise at the high-pass cut-off), so the selection is for clean data or
+   thresholds above the noise's correlation.
+3. *Where the selection happens.*  The warm start solves this lasso in closed form
+   (:func:`warm_start`; scikit-learn's coordinate descent on the profiled problem), and the
+   terms it rejects stay at zero in the SGD: the SGD's own residual, ~1e-3 of the response
+   from its step noise, is not the data's, and a threshold scaled by the data's residual
+   (1e-15 on exact linear data) cannot hold a zero against it.  With ``init="zeros"`` the SGD
+   does the selection alone.
+4. *A proximal step in Adam's metric.*  Adam divides each gradient by its running RMS, so a
+   step is ~``learning_rate`` however small the gradient: a fixed shrink per step (or a sign
+   gradient, Eq. 15) fights the data at a rate that has nothing to do with how much a term
+   explains (measured before this design: no weight from 0.01 to 10 separated the clamped
+   beam from the soft base).  Here the soft threshold is ``lam_ij`` times Adam's own
+   per-entry step size ``learning_rate / (sqrt(v_hat) + eps)``, so an entry stays at zero
+   exactly when ``|m_hat| <= lam_ij`` (its averaged data gradient lies in the lasso's
+   subdifferential): the fixed points are the lasso's, whatever Adam's scaling.
+5. *Annealing.*  Eq. 17 would set ``alpha_l1`` to the largest data-gradient entry; at a
+   lasso fixed point that entry equals the weight itself on the active terms, so *every*
+   weight is a fixed point and annealing cannot choose it.  The threshold is therefore
+   declared; the history records the largest ``lam_ij`` as ``alpha_l1`` (0 once debiasing).
+6. *Debiasing.*  The lasso shrinks the terms it keeps (measured with the former fixed L1:
+   soft-base cubic restoring-force error 0.22, against 0.05 without L1).  After a fraction
+   ``1 - l1_debias`` of the epochs the zero pattern is frozen and the remaining epochs run
+   without L1 on the selected terms (the "relaxed lasso").
 """
 
 from __future__ import annotations
@@ -47,21 +96,64 @@ def _sym(a: np.ndarray) -> np.ndarray:
     return 0.5 * (a + a.T)
 
 
+def cubic_profile(xdd: np.ndarray, xd: np.ndarray, x: np.ndarray, x3: np.ndarray) -> dict[str, Any]:
+    """The standardised regression of ``x''`` with the linear terms profiled out.
+
+    Returns ``s_a`` (n,) RMS of each ``x''_i``, ``s3`` (n,) RMS of each ``x_j^3``, ``F`` (N, 2n)
+    the unit-RMS linear features [x', x], ``Q`` an orthonormal basis of their span, ``Z`` (N, n)
+    the unit-RMS cubic columns, ``Zr`` those with the linear span removed, ``Er`` (N, n) the
+    residual of the least-squares linear model of each ``x''_i / s_a_i``, and ``rho`` (n,),
+    ``sigma`` (n,) the RMS of ``Er`` and ``Zr``: the partial correlation of cubic term ``j``
+    with row ``i`` at the linear model is ``mean(Er_i Zr_j) / (rho_i sigma_j)``.
+    """
+    def rms(a: np.ndarray, axis: int) -> np.ndarray:
+        r = np.sqrt(np.mean(a**2, axis=axis))
+        r[r == 0] = 1.0
+        return r
+
+    lin = np.vstack([xd, x])
+    F = (lin / rms(lin, 1)[:, None]).T  # x^3 ~ 1e-13 m^3 beside x' ~ 1e-2 m/s: rcond would cut
+    Q = np.linalg.qr(F)[0]              # unstandardised cubic columns
+    s_a, s3 = rms(xdd, 1), rms(x3, 1)
+    Y, Z = (xdd / s_a[:, None]).T, (x3 / s3[:, None]).T
+    Er, Zr = Y - Q @ (Q.T @ Y), Z - Q @ (Q.T @ Z)
+    return {"s_lin": rms(lin, 1), "s_a": s_a, "s3": s3, "F": F, "Q": Q, "Y": Y, "Z": Z,
+            "Er": Er, "Zr": Zr, "rho": rms(Er, 0), "sigma": rms(Zr, 0)}
+
+
 def warm_start(xdd: np.ndarray, xd: np.ndarray, x: np.ndarray, x3: np.ndarray | None,
-               m_hat: float) -> tuple[np.ndarray, ...]:
-    """Symmetric (M, C, K, K3) from the unique least-squares fit of ``x''`` on [x', x, x^3].
+               m_hat: float, l1_threshold: float = 0.0) -> tuple[np.ndarray, ...]:
+    """Symmetric (M, C, K, K3) from the uncoupled regression of ``x''`` on [x', x, x^3].
 
     The uncoupled regression determines ``A = M^-1 K`` and ``B = M^-1 C`` uniquely.  With ``Phi``
     the eigenvectors of ``A``, ``M0 = Phi^-T Phi^-1`` (equal modal masses) makes ``M0 A``
     symmetric; scaled to ``trace = m_hat``.  Falls back to ``m_hat / n * I`` if ``A`` has complex
     eigenvalues.
+
+    With ``l1_threshold > 0`` the cubic block is the lasso solution of the problem the SGD's L1
+    then holds (module docstring, L1): per row, the linear terms are profiled out and
+    scikit-learn's ``Lasso(alpha=l1_threshold)`` runs on the residual scaled to unit RMS
+    against the residualised cubic columns scaled to unit RMS, so a term stays at zero
+    exactly when its partial correlation is at most ``l1_threshold``.  The SGD thus starts on
+    the selected support instead of walking a spurious term to zero.
     """
     n = xdd.shape[0]
-    feats = [xd, x] + ([x3] if x3 is not None else [])
-    theta = np.vstack(feats)
-    scale = np.sqrt(np.mean(theta**2, axis=1))  # x^3 ~ 1e-13 m^3 beside x' ~ 1e-2 m/s: rcond would
-    scale[scale == 0] = 1.0                      # cut the cubic columns without standardising
-    coef = np.linalg.lstsq((theta / scale[:, None]).T, xdd.T, rcond=1e-10)[0].T / scale[None, :]
+    if x3 is None or not l1_threshold > 0:
+        theta = np.vstack([xd, x] + ([x3] if x3 is not None else []))
+        scale = np.sqrt(np.mean(theta**2, axis=1))
+        scale[scale == 0] = 1.0
+        coef = np.linalg.lstsq((theta / scale[:, None]).T, xdd.T, rcond=1e-10)[0].T / scale[None, :]
+    else:
+        from sklearn.linear_model import Lasso
+
+        pr = cubic_profile(xdd, xd, x, x3)
+        coef = np.zeros((n, 3 * n))
+        for i in range(n):
+            u = Lasso(alpha=float(l1_threshold), fit_intercept=False, tol=1e-12,
+                      max_iter=100_000).fit(pr["Zr"] / pr["sigma"], pr["Er"][:, i] / pr["rho"][i]).coef_
+            w = u * pr["rho"][i] / pr["sigma"]  # coefficients of the unit-RMS cubic columns
+            a = np.linalg.lstsq(pr["F"], pr["Y"][:, i] - pr["Z"] @ w, rcond=1e-10)[0]
+            coef[i] = pr["s_a"][i] * np.concatenate([a / pr["s_lin"], w / pr["s3"]])
     Bv, A = -coef[:, :n], -coef[:, n:2 * n]
     A3 = -coef[:, 2 * n:] if x3 is not None else None
     lam, phi = np.linalg.eig(A)
@@ -91,7 +183,9 @@ def fit_matrix_sgd(data: Measurement, est: Any, m_hat: float, lam_hat: np.ndarra
         bu = np.asarray(data.input_map, dtype=float) @ data.u[:, i0:i1]
     else:
         bu = np.zeros_like(x)
-    M0, C0, K0, K30 = warm_start(xdd, xd, x, x3, m_hat) if est.init == "lstsq" else (
+    l1_on = est.cubic and est.l1 != "none"
+    M0, C0, K0, K30 = warm_start(xdd, xd, x, x3, m_hat,
+                                 float(est.l1_threshold) if l1_on else 0.0) if est.init == "lstsq" else (
         np.eye(n) * m_hat / n, np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n)) if est.cubic else None)
     # parameter scales (Adam steps are relative to these)
     m0 = m_hat / n
@@ -99,18 +193,20 @@ def fit_matrix_sgd(data: Measurement, est: Any, m_hat: float, lam_hat: np.ndarra
     c0 = max(np.abs(np.diag(C0)).max(), 1e-12) if est.init == "lstsq" else m0 * 10.0
     L = np.linalg.cholesky(M0 / m0)
     P, Q = K0 / k0, C0 / c0
-    k30 = 1.0
-    R = None
-    if est.cubic:
-        k30 = max(np.abs(K30).max(), 1e-12) if K30 is not None and np.abs(K30).max() > 0 else 1.0
-        R = K30 / k30 if K30 is not None else np.zeros((n, n))
     s_a = np.sqrt(np.mean(xdd**2, axis=1))
     s_a[s_a == 0] = 1.0
+    sc3, R, lam_l1 = 1.0, None, 0.0
+    if est.cubic:  # standardised cubic coefficients (module docstring, L1 item 1)
+        pr = cubic_profile(xdd, xd, x, x3)
+        sc3 = (np.diag(M0) * s_a)[:, None] / pr["s3"][None, :]
+        R = K30 / sc3 if K30 is not None else np.zeros((n, n))
+        if l1_on:  # per-entry lasso weight: partial correlation above l1_threshold (L1 item 2)
+            lam_l1 = (2.0 / n) * float(est.l1_threshold) * np.outer(pr["rho"], pr["sigma"])
     tril = np.tril(np.ones((n, n)))
 
     def mats(L, P, Q, R):
         M = m0 * (L @ L.T)
-        return M, c0 * _sym(Q), k0 * _sym(P), (k30 * R if R is not None else None)
+        return M, c0 * _sym(Q), k0 * _sym(P), (sc3 * R if R is not None else None)
 
     def data_loss_grad(L, P, Q, R, idx):
         M, C, K, K3 = mats(L, P, Q, R)
@@ -129,7 +225,7 @@ def fit_matrix_sgd(data: Measurement, est: Any, m_hat: float, lam_hat: np.ndarra
         gL = m0 * ((gM + gM.T) @ L) * tril
         gP = k0 * _sym(G @ d.T)
         gQ = c0 * _sym(G @ v.T)
-        gR = k30 * (G @ x3[:, idx].T) if R is not None else None
+        gR = sc3 * (G @ x3[:, idx].T) if R is not None else None
         return loss, gL, gP, gQ, gR
 
     def eig_loss_grad(L, P):
@@ -153,8 +249,13 @@ def fit_matrix_sgd(data: Measurement, est: Any, m_hat: float, lam_hat: np.ndarra
     L, P, Q, R = project(L, P, Q, R)
     shapes = [L.shape, P.shape, Q.shape] + ([R.shape] if R is not None else [])
     opts = [Adam(s, float(est.learning_rate)) for s in shapes]
-    alpha = {"sym": float(est.alpha_init), "eig": float(est.alpha_init), "l1": float(est.alpha_init)}
-    use_eig, use_l1 = bool(est.eigen) and lam_hat.size > 0, R is not None and est.l1 != "none"
+    use_eig, use_l1 = bool(est.eigen) and lam_hat.size > 0, R is not None and l1_on
+    alpha = {"sym": float(est.alpha_init), "eig": float(est.alpha_init),
+             "l1": float(np.max(lam_l1)) if use_l1 else 0.0}
+    l1_epochs = int(np.ceil((1.0 - float(est.l1_debias)) * int(est.epochs))) if use_l1 else 0  # item 6
+    # the cubic terms still in play: the warm start's lasso has already rejected the others
+    # (L1 item 3); after the lasso epochs, the terms kept, frozen for the debiasing epochs
+    support = (R != 0).astype(float) if use_l1 and est.init == "lstsq" else None
     hist: dict[str, list[float]] = {k: [] for k in (
         "epoch", "n_steps", "loss_data", "loss_sym", "loss_eig", "loss_l1", "mass_residual",
         "alpha_sym", "alpha_eig", "alpha_l1")}
@@ -169,7 +270,7 @@ def fit_matrix_sgd(data: Measurement, est: Any, m_hat: float, lam_hat: np.ndarra
         hist["loss_data"].append(loss)
         hist["loss_sym"].append(0.0)
         hist["loss_eig"].append(le)
-        hist["loss_l1"].append(float(np.sum(np.abs(R))) if use_l1 else np.nan)
+        hist["loss_l1"].append(float(np.sum(np.abs(R))) if use_l1 else np.nan)  # standardised
         hist["mass_residual"].append(float(np.trace(M)) / m_hat - 1.0)
         for k in alpha:
             hist[f"alpha_{k}"].append(alpha[k])
@@ -196,11 +297,18 @@ def fit_matrix_sgd(data: Measurement, est: Any, m_hat: float, lam_hat: np.ndarra
             P = P + opts[1].step(gP)
             Q = Q + opts[2].step(gQ)
             if R is not None:
+                if support is not None:
+                    gR = gR * support
                 R = R + opts[3].step(gR)
-                if use_l1:  # Eqs 14-15 as a proximal step: Adam would normalise a sign gradient
-                    R = np.sign(R) * np.maximum(np.abs(R) - float(est.learning_rate) * alpha["l1"], 0.0)
+                if use_l1 and epoch <= l1_epochs:  # lasso prox in Adam's metric (L1 item 4)
+                    R = np.sign(R) * np.maximum(np.abs(R) - lam_l1 * opts[3].scale, 0.0)
+                if support is not None:
+                    R = R * support
             L, P, Q, R = project(L, P, Q, R)
             n_steps += 1
+        if use_l1 and epoch == l1_epochs and epoch < int(est.epochs):  # L1 item 5: debias
+            support = (R != 0).astype(float)
+            alpha["l1"] = 0.0
         g_data, eL, eP = record(epoch, n_steps)
         if est.anneal:  # Eqs 17-18, capped
             gmax = float(np.max(np.abs(g_data)))
@@ -209,9 +317,6 @@ def fit_matrix_sgd(data: Measurement, est: Any, m_hat: float, lam_hat: np.ndarra
                 if ge.mean() > 0:
                     hat = gmax / ge.mean()
                     alpha["eig"] = min((1 - est.beta) * alpha["eig"] + est.beta * hat, float(est.alpha_max))
-            if use_l1:
-                hat = gmax / 1.0  # |sign| has mean 1 on nonzero entries
-                alpha["l1"] = min((1 - est.beta) * alpha["l1"] + est.beta * hat, float(est.alpha_max))
     M, C, K, K3 = mats(L, P, Q, R)
     return {"M": _sym(M), "C": C, "K": K, "K3": K3, "n_steps": n_steps, "alphas": alpha,
             "history": {k: np.asarray(v) for k, v in hist.items()}}

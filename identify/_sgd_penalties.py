@@ -171,7 +171,10 @@ class Adam:
         self.v = self.b2 * self.v + (1.0 - self.b2) * g * g
         mh = self.m / (1.0 - self.b1**self.t)
         vh = self.v / (1.0 - self.b2**self.t)
-        return -self.lr * mh / (np.sqrt(vh) + self.eps)
+        #: per-entry step size of the last step (Adam's preconditioner): a proximal step in
+        #: the same metric uses it as its threshold scale
+        self.scale = self.lr / (np.sqrt(vh) + self.eps)
+        return -self.scale * mh
 
 
 class PlainSGD:

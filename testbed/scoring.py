@@ -20,6 +20,8 @@ METRICS: dict[str, dict[str, str]] = {
         "K3_force_error": "relative RMS error of the identified cubic restoring force along the "
                           "measured motion (soft base)",
         "K3_norm": "Frobenius norm of the identified cubic matrix [N/m^3]",
+        "K3_force_ratio": "RMS of the identified cubic restoring force over that of the identified "
+                          "linear one, along the measured motion (scale-free size of K3)",
         "cross_orth": "largest off-diagonal of Phi_id^T Mr Phi_true (mass-normalised modes)",
     },
     "mechanical": {
@@ -152,6 +154,12 @@ def score_structural(dataset: Dataset, data: Measurement, clean: Measurement, mo
 
     K3 = getattr(model, "K3_", None)
     v["K3_norm"] = float(np.linalg.norm(K3)) if K3 is not None else 0.0
+    if K3 is not None:
+        x_ref = clean.x[:, i0:]
+        lin = np.linalg.norm(model.K_ @ x_ref)
+        v["K3_force_ratio"] = float(np.linalg.norm(K3 @ x_ref**3) / lin) if lin > 0 else float("nan")
+    else:
+        v["K3_force_ratio"] = 0.0
     k3 = float(np.asarray(truth.get("k3", 0.0)))
     if K3 is not None and k3 != 0.0:
         x_ref = clean.x[:, i0:]
