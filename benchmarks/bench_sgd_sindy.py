@@ -220,14 +220,25 @@ def cantilever_case():
     return sc, data, scorer
 
 
+#: Adam step for SGD from zero coefficients.  Table 1's 1.5e-4 is a step on the paper's raw
+#: coefficients; here steps are relative to the data's own scale of each matrix, and from zero
+#: the stiffness must travel ~(f3 / f1)^2 ~ 300 of those units (measured on the stiff scenario:
+#: 1.5e-4 leaves mode 2 at 315 Hz after 100,000 steps; 3e-3 meets the targets; 1.5e-2 stalls
+#: at TRAC 0.46).
+ZERO_INIT_LR = 3e-3
+
+
 def run(default_epochs: int | None = None) -> list[dict]:
     """Gradient steps to the stiff-scenario scores, and wall time against least squares.
 
     On the stiff cantilever scenario (its data, signal chain and scoring: TRAC >= 0.95 at every
     sensor, MAC >= 0.95 and frequency error <= 1 % on modes 1-2).  The paper's budget is
     10,000 epochs at batch 128; an epoch here is one pass over the fit window, so the budget is
-    10,000 x ceil(N / 128) gradient steps.  ``init="zeros"`` is SGD from nothing;
-    ``init="lstsq"`` (the default) starts from the symmetric least-squares warm start.
+    10,000 x ceil(N / 128) gradient steps.  ``init="zeros"`` is SGD from nothing, at Table 1's
+    step and at ``ZERO_INIT_LR``; ``init="lstsq"`` (the default) starts from the symmetric
+    least-squares warm start.  The search (doubling, then bisection) finds a fit that meets the
+    targets, not necessarily the earliest (SGD scores are not monotone in the steps), so where
+    it finds one the note also gives the scores at 10 % of the budget.
 
     Returns
     -------
@@ -239,17 +250,23 @@ def run(default_epochs: int | None = None) -> list[dict]:
     n_samp = data.n_samples - data.free_start
     budget_pass = 10000 * int(np.ceil(n_samp / 128))
     rows = []
-    for init in ("zeros", "lstsq"):
-        steps, s = steps_to_targets(data, None, None, init=init, scorer=scorer,
-                                    max_epochs=budget_pass // int(np.ceil(n_samp / 128)) // 10)
+    tenth = budget_pass // int(np.ceil(n_samp / 128)) // 10  # epochs in 10 % of the budget
+    for init, lr in (("zeros", 1.5e-4), ("zeros", ZERO_INIT_LR), ("lstsq", 1.5e-4)):
+        steps, s = steps_to_targets(data, None, None, init=init, scorer=scorer, max_epochs=tenth,
+                                    learning_rate=lr)
         val = float("nan") if steps is None else float(steps)
         frac = val / budget_pass
-        rows.append({"name": f"steps_to_targets_init_{init}", "value": val, "unit": "gradient steps",
+        note = ("not reached within 10 % of the budget (scores there): " if steps is None else
+                f"{100 * frac:.2f} % of the paper's budget: ")
+        note += f"TRAC {s['trac']:.4f}, MAC {s['mac']:.4f}, freq error {100 * s['freq_error']:.3f} %"
+        if steps is not None and steps > 0:  # SGD scores move: say where they are at 10 %
+            s10 = scorer(SGDSINDy(epochs=tenth, init=init, learning_rate=lr).fit(data))
+            note += (f"; at 10 % of the budget TRAC {s10['trac']:.4f}, MAC {s10['mac']:.4f}, "
+                     f"freq error {100 * s10['freq_error']:.3f} %")
+        rows.append({"name": f"steps_to_targets_init_{init}_lr_{lr:g}", "value": val,
+                     "unit": "gradient steps",
                      "target": f"<= 10 % of {budget_pass} (10000 epochs x ceil({n_samp}/128))",
-                     "ok": bool(steps is not None and frac <= 0.10),
-                     "note": ("not reached within 10 % of the budget; " if steps is None else
-                              f"{100 * frac:.2f} % of the paper's budget; ")
-                     + f"TRAC {s['trac']:.4f}, MAC {s['mac']:.4f}, freq error {100 * s['freq_error']:.3f} %"})
+                     "ok": bool(steps is not None and frac <= 0.10), "note": note})
     t_ls = _median_time(lambda: LeastSquaresSINDy().fit(data), 7)
     t0 = time.perf_counter()
     model = SGDSINDy(epochs=epochs).fit(data)

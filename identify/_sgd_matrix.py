@@ -92,6 +92,12 @@ from identify._sgd_penalties import Adam
 from testbed.measurement import Measurement
 
 
+def _rms(a: np.ndarray) -> np.ndarray:
+    r = np.sqrt(np.mean(a**2, axis=1))
+    r[r == 0] = 1.0
+    return r
+
+
 def _sym(a: np.ndarray) -> np.ndarray:
     return 0.5 * (a + a.T)
 
@@ -189,8 +195,12 @@ def fit_matrix_sgd(data: Measurement, est: Any, m_hat: float, lam_hat: np.ndarra
         np.eye(n) * m_hat / n, np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n)) if est.cubic else None)
     # parameter scales (Adam steps are relative to these)
     m0 = m_hat / n
-    k0 = max(np.abs(np.diag(K0)).max(), 1e-12) if est.init == "lstsq" else m0 * (2 * np.pi * 100.0) ** 2
-    c0 = max(np.abs(np.diag(C0)).max(), 1e-12) if est.init == "lstsq" else m0 * 10.0
+    if est.init == "lstsq":
+        k0 = max(np.abs(np.diag(K0)).max(), 1e-12)
+        c0 = max(np.abs(np.diag(C0)).max(), 1e-12)
+    else:  # the data's own scales, as standardised features have: K ~ M x''/x, C ~ M x''/x'
+        k0 = m0 * float(np.max(_rms(xdd) / _rms(x)))
+        c0 = m0 * float(np.max(_rms(xdd) / _rms(xd)))
     L = np.linalg.cholesky(M0 / m0)
     P, Q = K0 / k0, C0 / c0
     s_a = np.sqrt(np.mean(xdd**2, axis=1))

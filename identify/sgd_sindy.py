@@ -82,7 +82,9 @@ class SGDSINDy(StructuralIdentifier):
         Adam on the standardised coefficients, or plain SGD (Eq. 3).
     init : {"lstsq", "zeros"}
         Start from the minimum-norm least-squares solution of the coupled library (a warm
-        start, not in the paper) or from zero.
+        start, not in the paper) or from zero.  From zero, the matrix parametrisation takes
+        its Adam step scales from the data (``K ~ m x''/x``, ``C ~ m x''/x'``) and needs a
+        larger ``learning_rate`` than Table 1's (``benchmarks/bench_sgd_sindy.py``: 3e-3).
     mass_prior : {"reduced_mass_trace", "total_mass"}
         Key of ``data.prior`` equated with ``sum_i M_ii`` (Eq. 4).
     mass_update : {"lstsq", "symmetry", "eq6"}
