@@ -316,7 +316,7 @@ def fit_matrix_sgd(data: Measurement, est: Any, m_hat: float, lam_hat: np.ndarra
                     R = R * support
             L, P, Q, R = project(L, P, Q, R)
             n_steps += 1
-        if use_l1 and epoch == l1_epochs and epoch < int(est.epochs):  # L1 item 5: debias
+        if use_l1 and epoch == l1_epochs and epoch < int(est.epochs):  # L1 item 6: debias
             support = (R != 0).astype(float)
             alpha["l1"] = 0.0
         g_data, eL, eP = record(epoch, n_steps)
