@@ -92,8 +92,9 @@ from identify._sgd_penalties import Adam
 from testbed.measurement import Measurement
 
 
-def _rms(a: np.ndarray) -> np.ndarray:
-    r = np.sqrt(np.mean(a**2, axis=1))
+def _rms(a: np.ndarray, axis: int = 1) -> np.ndarray:
+    """RMS along ``axis``, with 1 where it is zero (a safe divisor)."""
+    r = np.sqrt(np.mean(a**2, axis=axis))
     r[r == 0] = 1.0
     return r
 
@@ -112,23 +113,20 @@ def cubic_profile(xdd: np.ndarray, xd: np.ndarray, x: np.ndarray, x3: np.ndarray
     ``sigma`` (n,) the RMS of ``Er`` and ``Zr``: the partial correlation of cubic term ``j``
     with row ``i`` at the linear model is ``mean(Er_i Zr_j) / (rho_i sigma_j)``.
     """
-    def rms(a: np.ndarray, axis: int) -> np.ndarray:
-        r = np.sqrt(np.mean(a**2, axis=axis))
-        r[r == 0] = 1.0
-        return r
-
     lin = np.vstack([xd, x])
-    F = (lin / rms(lin, 1)[:, None]).T  # x^3 ~ 1e-13 m^3 beside x' ~ 1e-2 m/s: rcond would cut
-    Q = np.linalg.qr(F)[0]              # unstandardised cubic columns
-    s_a, s3 = rms(xdd, 1), rms(x3, 1)
+    s_lin = _rms(lin)
+    F = (lin / s_lin[:, None]).T  # x^3 ~ 1e-13 m^3 beside x' ~ 1e-2 m/s: rcond would cut
+    Q = np.linalg.qr(F)[0]        # unstandardised cubic columns
+    s_a, s3 = _rms(xdd), _rms(x3)
     Y, Z = (xdd / s_a[:, None]).T, (x3 / s3[:, None]).T
     Er, Zr = Y - Q @ (Q.T @ Y), Z - Q @ (Q.T @ Z)
-    return {"s_lin": rms(lin, 1), "s_a": s_a, "s3": s3, "F": F, "Q": Q, "Y": Y, "Z": Z,
-            "Er": Er, "Zr": Zr, "rho": rms(Er, 0), "sigma": rms(Zr, 0)}
+    return {"s_lin": s_lin, "s_a": s_a, "s3": s3, "F": F, "Q": Q, "Y": Y, "Z": Z,
+            "Er": Er, "Zr": Zr, "rho": _rms(Er, 0), "sigma": _rms(Zr, 0)}
 
 
 def warm_start(xdd: np.ndarray, xd: np.ndarray, x: np.ndarray, x3: np.ndarray | None,
-               m_hat: float, l1_threshold: float = 0.0) -> tuple[np.ndarray, ...]:
+               m_hat: float, l1_threshold: float = 0.0,
+               profile: dict[str, Any] | None = None) -> tuple[np.ndarray, ...]:
     """Symmetric (M, C, K, K3) from the uncoupled regression of ``x''`` on [x', x, x^3].
 
     The uncoupled regression determines ``A = M^-1 K`` and ``B = M^-1 C`` uniquely.  With ``Phi``
@@ -141,18 +139,18 @@ def warm_start(xdd: np.ndarray, xd: np.ndarray, x: np.ndarray, x3: np.ndarray | 
     scikit-learn's ``Lasso(alpha=l1_threshold)`` runs on the residual scaled to unit RMS
     against the residualised cubic columns scaled to unit RMS, so a term stays at zero
     exactly when its partial correlation is at most ``l1_threshold``.  The SGD thus starts on
-    the selected support instead of walking a spurious term to zero.
+    the selected support instead of walking a spurious term to zero.  ``profile`` is
+    :func:`cubic_profile` of the same signals, if the caller already has it.
     """
     n = xdd.shape[0]
     if x3 is None or not l1_threshold > 0:
         theta = np.vstack([xd, x] + ([x3] if x3 is not None else []))
-        scale = np.sqrt(np.mean(theta**2, axis=1))
-        scale[scale == 0] = 1.0
+        scale = _rms(theta)
         coef = np.linalg.lstsq((theta / scale[:, None]).T, xdd.T, rcond=1e-10)[0].T / scale[None, :]
     else:
         from sklearn.linear_model import Lasso
 
-        pr = cubic_profile(xdd, xd, x, x3)
+        pr = profile if profile is not None else cubic_profile(xdd, xd, x, x3)
         coef = np.zeros((n, 3 * n))
         for i in range(n):
             u = Lasso(alpha=float(l1_threshold), fit_intercept=False, tol=1e-12,
@@ -190,8 +188,9 @@ def fit_matrix_sgd(data: Measurement, est: Any, m_hat: float, lam_hat: np.ndarra
     else:
         bu = np.zeros_like(x)
     l1_on = est.cubic and est.l1 != "none"
-    M0, C0, K0, K30 = warm_start(xdd, xd, x, x3, m_hat,
-                                 float(est.l1_threshold) if l1_on else 0.0) if est.init == "lstsq" else (
+    pr = cubic_profile(xdd, xd, x, x3) if est.cubic else None
+    M0, C0, K0, K30 = warm_start(xdd, xd, x, x3, m_hat, float(est.l1_threshold) if l1_on else 0.0,
+                                 pr) if est.init == "lstsq" else (
         np.eye(n) * m_hat / n, np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n)) if est.cubic else None)
     # parameter scales (Adam steps are relative to these)
     m0 = m_hat / n
@@ -203,11 +202,9 @@ def fit_matrix_sgd(data: Measurement, est: Any, m_hat: float, lam_hat: np.ndarra
         c0 = m0 * float(np.max(_rms(xdd) / _rms(xd)))
     L = np.linalg.cholesky(M0 / m0)
     P, Q = K0 / k0, C0 / c0
-    s_a = np.sqrt(np.mean(xdd**2, axis=1))
-    s_a[s_a == 0] = 1.0
+    s_a = _rms(xdd)
     sc3, R, lam_l1 = 1.0, None, 0.0
-    if est.cubic:  # standardised cubic coefficients (module docstring, L1 item 1)
-        pr = cubic_profile(xdd, xd, x, x3)
+    if pr is not None:  # standardised cubic coefficients (module docstring, L1 item 1)
         sc3 = (np.diag(M0) * s_a)[:, None] / pr["s3"][None, :]
         R = K30 / sc3 if K30 is not None else np.zeros((n, n))
         if l1_on:  # per-entry lasso weight: partial correlation above l1_threshold (L1 item 2)
