@@ -20,13 +20,14 @@ from __future__ import annotations
 import hashlib
 import json
 import os
-import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import h5py
 import numpy as np
+
+from testbed.atomic import atomic_write
 
 FORMAT = "sysid-testbed-dataset/1"
 
@@ -128,21 +129,13 @@ class Dataset:
     # ------------------------------------------------------------------ HDF5
     def save(self, path: str | os.PathLike) -> Path:
         """Write atomically to ``path`` (a temporary file in the same folder, then rename)."""
-        path = Path(path)
-        path.parent.mkdir(parents=True, exist_ok=True)
         self.attrs["content_hash"] = self.content_hash()
-        fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-        os.close(fd)
-        try:
+
+        def write(tmp: str) -> None:
             with h5py.File(tmp, "w", track_order=True) as f:
                 self._write(f)
-            with open(tmp, "rb") as fh:
-                os.fsync(fh.fileno())
-            os.replace(tmp, path)
-        except BaseException:
-            Path(tmp).unlink(missing_ok=True)
-            raise
-        return path
+
+        return atomic_write(path, write)
 
     def _write(self, f: h5py.File) -> None:
         f.attrs["format"] = FORMAT

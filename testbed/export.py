@@ -33,6 +33,7 @@ from typing import Any
 
 import numpy as np
 
+from testbed.atomic import atomic_write, atomic_write_text
 from testbed.dataset import Dataset, Signal
 
 #: unit -> (quantity, UFF specific data type, length exponent, force exponent, rotational, LaTeX)
@@ -136,20 +137,14 @@ def write_uff(ds: Dataset, out: str | os.PathLike) -> Path:
     """Write every measured channel as UFF58 (and the true modes as UFF55) to ``out``."""
     import pyuff
 
-    out = Path(out)
-    out.parent.mkdir(parents=True, exist_ok=True)
     nodes = node_numbers(ds)
     sets = [_uff58(ds, name, i, s, nodes[(name, i)]) for name, i, s in _channels(ds)]
     sensor_nodes = _sensor_nodes(ds, nodes)
     if sensor_nodes is not None:
         sets += _uff55(ds, sensor_nodes)
-    tmp = out.with_name(f".{out.name}.tmp")
     # pyuff 2.5 truncates the header of a binary 58 written in "overwrite" mode (it reopens the
-    # file "wb" for the data), so start from an empty file and add every set.
-    tmp.write_bytes(b"")
-    pyuff.UFF(str(tmp)).write_sets(sets, mode="add")
-    os.replace(tmp, out)
-    return out
+    # file "wb" for the data), so start from an empty file (the temporary one) and add every set.
+    return atomic_write(out, lambda tmp: pyuff.UFF(tmp).write_sets(sets, mode="add"))
 
 
 def to_sep005(ds: Dataset) -> list[dict[str, Any]]:
@@ -171,13 +166,8 @@ def to_sep005(ds: Dataset) -> list[dict[str, Any]]:
 
 def write_sep005(ds: Dataset, out: str | os.PathLike) -> Path:
     """Write :func:`to_sep005` of ``ds`` as JSON (``data`` as lists of float) to ``out``."""
-    out = Path(out)
-    out.parent.mkdir(parents=True, exist_ok=True)
     channels = [{**c, "data": c["data"].tolist()} for c in to_sep005(ds)]
-    tmp = out.with_name(f".{out.name}.tmp")
-    tmp.write_text(json.dumps(channels))
-    os.replace(tmp, out)
-    return out
+    return atomic_write_text(out, json.dumps(channels))
 
 
 def read_sep005(path: str | os.PathLike) -> list[dict[str, Any]]:

@@ -22,6 +22,7 @@ from typing import Any
 import numpy as np
 
 from testbed import figures as figs
+from testbed.atomic import atomic_write_text
 from testbed.runstore import SavedRun, load_run
 from testbed.scoring import METRICS
 
@@ -127,15 +128,9 @@ class Page:
                f"<title>{html.escape(self.title)}</title><style>{CSS}</style></head>\n<body>\n"
                f"<h1>{html.escape(self.title)}</h1>\n" + "\n".join(self.html) + "\n</body></html>\n")
         out = self.out_dir / "report.html"
-        _atomic_write(out, doc)
-        _atomic_write(self.out_dir / "report.md", "\n".join(self.md).rstrip() + "\n")
+        atomic_write_text(out, doc)
+        atomic_write_text(self.out_dir / "report.md", "\n".join(self.md).rstrip() + "\n")
         return out
-
-
-def _atomic_write(path: Path, text: str) -> None:
-    tmp = path.with_name(f".{path.name}.tmp")
-    tmp.write_text(text, encoding="utf-8")
-    os.replace(tmp, path)
 
 
 # ----------------------------------------------------------------------------- run report

@@ -39,13 +39,14 @@ from __future__ import annotations
 import json
 import math
 import os
-import tempfile
 from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
 
 import pyarrow as pa
 import pyarrow.parquet as pq
+
+from testbed.atomic import atomic_write, atomic_write_text
 
 FORMAT = "sysid-testbed-results/1"
 
@@ -78,29 +79,10 @@ def _sort_key(row: dict[str, Any]) -> tuple:
     return tuple(row.get(k) if row.get(k) is not None else "" for k in SORT_KEYS)
 
 
-def _atomic_write_bytes(path: Path, write) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    os.close(fd)
-    try:
-        write(tmp)
-        with open(tmp, "rb") as fh:
-            os.fsync(fh.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-
-
 def write_part(path: str | os.PathLike, row: dict[str, Any]) -> Path:
     """Write one finished row atomically as ``<path>.parts/<cell>.json``; return the file."""
     out = parts_dir(path) / f"{row['cell']}.json"
-    text = json.dumps(row, sort_keys=True)  # NaN is written as the JSON extension NaN
-
-    def write(tmp: str) -> None:
-        Path(tmp).write_text(text)
-
-    _atomic_write_bytes(out, write)
+    atomic_write_text(out, json.dumps(row, sort_keys=True))  # NaN as the JSON extension NaN
     return out
 
 
@@ -143,7 +125,7 @@ def write_rows(path: str | os.PathLike, rows: Iterable[dict[str, Any]], *,
         raise ValueError("write_rows: a cell appears more than once")
     table = _to_table(rows, study)
     path = Path(path)
-    _atomic_write_bytes(path, lambda tmp: pq.write_table(table, tmp))
+    atomic_write(path, lambda tmp: pq.write_table(table, tmp))
     return path
 
 
