@@ -54,6 +54,7 @@ from identify._mechsim import CLOSURE_RTOL, ImplicitModel, LoopClosure
 from identify._weak import weak_matrix
 from identify.library import Library, fivebar_library, generic_mechanical_library
 from testbed.errors import IdentificationError
+from testbed.gram import normalized_gram, ordered_independent
 from testbed.measurement import Measurement, Trajectory
 from testbed.signal import lowpass
 
@@ -87,19 +88,9 @@ def prune_dependent(G: np.ndarray, protected: np.ndarray, tol: float) -> np.ndar
     column is dropped if its residual variance (unit-norm column) after projection on the kept
     earlier ones is below ``tol``.
     """
-    s = np.sqrt(np.clip(np.diag(G), 1e-300, None))
-    Gn = G / np.outer(s, s)
+    kept, _, _ = ordered_independent(normalized_gram(G)[0], np.flatnonzero(~protected), tol)
     keep = protected.copy()
-    kept: list[int] = []
-    L = np.zeros((0, 0))
-    for c in np.flatnonzero(~protected):
-        g = Gn[kept, c]
-        y = np.linalg.solve(L, g) if kept else g
-        r = Gn[c, c] - y @ y
-        if r > tol:
-            keep[c] = True
-            kept.append(c)
-            L = np.block([[L, np.zeros((L.shape[0], 1))], [y[None, :], np.array([[np.sqrt(r)]])]])
+    keep[kept] = True
     return keep
 
 

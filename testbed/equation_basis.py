@@ -32,6 +32,7 @@ from itertools import permutations
 import numpy as np
 
 from testbed import metrics
+from testbed.gram import normalized_gram, ordered_independent
 
 #: Residual variance (of a unit-norm column, after projection on the earlier kept columns)
 #: at or below which a column counts as an exact combination of them.  Exact identities on the
@@ -127,22 +128,9 @@ class CanonicalBasis:
         """Find the identities of ``Theta`` (n_samples, p) and the canonical basis (see module)."""
         names = list(names)
         G = np.ascontiguousarray(Theta.T) @ Theta
-        s = np.sqrt(np.clip(np.diag(G), 1e-300, None))
-        Gn = G / np.outer(s, s)
+        Gn, s = normalized_gram(G)
         protected = np.array([has_input(nm) for nm in names], dtype=bool)
-        kept_free: list[int] = []
-        dep, res = [], []
-        L = np.zeros((0, 0))
-        for c in np.flatnonzero(~protected):
-            g = Gn[kept_free, c]
-            y = np.linalg.solve(L, g) if kept_free else g
-            r = Gn[c, c] - y @ y
-            if r > tol:
-                kept_free.append(c)
-                L = np.block([[L, np.zeros((L.shape[0], 1))], [y[None, :], np.array([[np.sqrt(r)]])]])
-            else:
-                dep.append(c)
-                res.append(max(r, 0.0))
+        kept_free, dep, res = ordered_independent(Gn, np.flatnonzero(~protected), tol)
         kept = np.sort(np.r_[np.flatnonzero(protected), kept_free].astype(np.intp))
         dependent = np.array(dep, dtype=np.intp)
         beta = np.zeros((kept.size, dependent.size))
