@@ -66,9 +66,30 @@ class Sweep:
     nnz: np.ndarray
 
     def coef(self, t: int, c: int) -> np.ndarray:
-        """Model (t, c) in original units, scaled to max |coef| = 1 with that entry positive."""
-        w = self.W[t, c] / self.scale
-        return w / w[np.argmax(np.abs(w))]
+        """Model (t, c) in original units, scaled to max |coef| = 1, sign by :func:`canonical_scale`."""
+        return canonical_scale(self.W[t, c] / self.scale)
+
+
+#: Coefficients below this share of the largest one do not decide an equation's sign: they are
+#: at most round-off residue of a threshold-0 fit (1e-6 is ten orders above float64's 1e-16).
+SIGN_RTOL = 1e-6
+
+
+def canonical_scale(w: np.ndarray) -> np.ndarray:
+    """An implicit equation scaled by the declared convention: ``max |coef| = 1`` and the first
+    term in library order whose ``|coef|`` exceeds ``SIGN_RTOL`` of the largest is positive.
+
+    The magnitude is tie-proof; the sign is not taken from the largest entry, because by the
+    rig's symmetry several entries can be exactly +-1 and which is "largest" is then decided by
+    rounding (it differed between OpenBLAS kernels).
+    """
+    w = np.asarray(w, dtype=float)
+    big = np.abs(w).max(initial=0.0)
+    if not np.isfinite(big) or big == 0.0:
+        return w.copy()
+    w = w / big
+    first = np.flatnonzero(np.abs(w) > SIGN_RTOL)[0]
+    return w if w[first] > 0 else -w
 
 
 def _errors(W: np.ndarray, G: np.ndarray, cand: np.ndarray) -> np.ndarray:
@@ -173,16 +194,37 @@ def rank_models(sw: Sweep, elig: np.ndarray, rtol: float, atol: float) -> np.nda
     """Flat (threshold, candidate) indices of the eligible models, best first.
 
     A model whose held-out error is within ``best * (1 + rtol) + atol`` counts as equally good
-    as the best; those come first, fewest terms first, then smaller held-out error, then index
-    (deterministic).  The others follow by held-out error.  Ineligible models are left out.
+    as the best; those come first, ordered by the declared rule:
+
+    1. fewest terms;
+    2. smaller held-out error, where errors at or below ``atol`` count as exactly equal (they
+       are all "exact to the digits the Gram-based residual has", and ordering them would
+       let rounding, i.e. the CPU's BLAS kernel, decide);
+    3. the support in library order (lexicographically smallest set of column indices);
+    4. the left-hand-side column in library order, then the threshold index.
+
+    On exact data many candidates share one support (the same equation normalised on different
+    left-hand sides); rules 3-4 pick the same representative on every machine.  The others
+    follow by held-out error.  Ineligible models are left out.
     """
     err = np.where(elig & np.isfinite(sw.val_error), sw.val_error, np.inf)
     if not np.isfinite(err).any():
         return np.zeros(0, dtype=np.intp)
-    good = err <= err.min() * (1.0 + rtol) + atol
-    order = np.lexsort((np.arange(err.size), err.ravel(),
-                        np.where(good, sw.nnz, np.iinfo(np.int64).max).ravel(), ~good.ravel()))
-    return order[np.isfinite(err.ravel()[order])]
+    good = (err <= err.min() * (1.0 + rtol) + atol).ravel()
+    flat_err = err.ravel()
+    n_t, n_c = err.shape
+    support = (sw.W != 0).reshape(n_t * n_c, -1)
+    # rank of each support among all supports in lexicographic library order (rule 3): the
+    # support read as a bit string, first library column most significant
+    _, sup_rank = np.unique(~support, axis=0, return_inverse=True)
+    cand = np.tile(sw.candidates, n_t)
+    thr = np.repeat(np.arange(n_t), n_c)
+    tied_err = np.where(flat_err <= atol, 0.0, flat_err)
+    big = np.iinfo(np.int64).max
+    order = np.lexsort((thr, cand, np.where(good, sup_rank.ravel(), big),
+                        np.where(good, tied_err, flat_err),
+                        np.where(good, sw.nnz.ravel(), big), ~good))
+    return order[np.isfinite(flat_err[order])]
 
 
 def select_models(sw: Sweep, input_cols: Sequence[np.ndarray], rtol: float = 0.1,

@@ -358,7 +358,8 @@ class SINDyPI(_ImplicitMechanical):
     Attributes
     ----------
     coef_ : ndarray, shape (n_inputs, n_terms)
-        One implicit equation per input, scaled to max |coef| = 1 (that entry positive).
+        One implicit equation per input, scaled to max |coef| = 1, the first non-negligible term
+        in library order positive (:func:`identify._implicit.canonical_scale`).
     feature_names_, lhs_terms_, selected_thresholds_, validation_errors_, pruned_terms_,
     closure_, sweep_, model_
     weak_strong_columns_ : list of str

@@ -179,3 +179,26 @@ def test_linear_structural_variant():
     assert rel(tr.x, x) < 1e-5
     with pytest.raises(IdentificationError, match="prior"):
         SINDyPILinear().fit(dataclasses.replace(d, prior={}))
+
+
+def test_exact_ties_broken_by_declared_rule_not_rounding():
+    """Models tied below ``atol`` are ordered by fewest terms, support in library order, then
+    left-hand side in library order; perturbing their errors at 1e-15 changes nothing."""
+    from identify._implicit import Sweep, canonical_scale, rank_models
+
+    rng = np.random.default_rng(0)
+    p, cand = 5, np.arange(5)
+    W = np.zeros((1, 5, p))
+    W[0, :3, :3] = [1.0, -1.0, 1.0]         # candidates 0-2: one support {0, 1, 2}
+    W[0, 3, [0, 3]] = 1.0                    # candidate 3: support {0, 3}
+    W[0, 4, [0, 4]] = 1.0                    # candidate 4: support {0, 4}
+    nnz = np.count_nonzero(W, axis=2)
+    picks = set()
+    for _ in range(20):
+        err = np.abs(1e-15 * rng.standard_normal((1, 5)))
+        sw = Sweep(np.ones(p), cand, np.zeros(1), W, err, err, nnz)
+        picks.add(int(rank_models(sw, np.ones((1, 5), bool), 0.1, 1e-12)[0]))
+    assert picks == {3}  # two terms beat three; {0, 3} precedes {0, 4} in library order
+    # the sign convention ignores which of several exact +-1 entries rounding made largest
+    row = np.array([0.0, -1.0, 1.0 - 1e-16, 1.0])
+    assert canonical_scale(row)[1] == 1.0 and canonical_scale(-row)[1] == 1.0
