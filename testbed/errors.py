@@ -43,3 +43,20 @@ class RigError(TestbedError):
 
 class IdentificationError(TestbedError):
     """An identifier could not produce a model from the data given."""
+
+
+class DivergenceError(IdentificationError):
+    """A simulation of an identified model failed: non-finite state, blow-up, or a loop closure
+    that no longer solves.  Scoring turns it into a failed score with its reason and time.
+
+    Parameters
+    ----------
+    message : str
+        What went wrong.
+    time : float, optional
+        Simulation time [s] at which it happened (NaN if unknown).
+    """
+
+    def __init__(self, message: str, time: float = float("nan")):
+        self.time = float(time)
+        super().__init__(message if time != time else f"{message} (at t = {time:.4g} s)")
