@@ -225,7 +225,10 @@ def compare_equations(id_names: Sequence[str], id_coef: np.ndarray, true_names: 
     best = None
     for perm in permutations(range(Id.shape[0]), T.shape[0]):
         errs = [row_errors(Id[k], T[j]) for j, k in enumerate(perm)]
-        total = sum(e[1] for e in errs)
+        # A NaN row error (non-finite identified coefficients) makes the pairing worst of all,
+        # never unbeatable: ``total < nan`` is always False, so NaN is ranked as +inf here.
+        total = float(np.sum([e[1] for e in errs]))
+        total = np.inf if np.isnan(total) else total
         if best is None or total < best[0]:
             best = (total, perm, errs)
     if best is None:
@@ -234,7 +237,8 @@ def compare_equations(id_names: Sequence[str], id_coef: np.ndarray, true_names: 
     Ip = Id[list(perm)]
     sup = metrics.support_scores(Ip, T)
     lead = np.argmax(np.abs(T), axis=1)
-    return {"coef_error": max(e[0] for e in errs), "coef_error_norm": max(e[1] for e in errs),
+    return {"coef_error": metrics.worst([e[0] for e in errs], "max"),
+            "coef_error_norm": metrics.worst([e[1] for e in errs], "max"),
             "coef_errors": np.array([e[0] for e in errs]),
             "precision": float(sup["precision"]), "recall": float(sup["recall"]),
             "f1": float(sup["f1"]), "names": basis.kept_names,

@@ -10,6 +10,37 @@ import numpy as np
 from scipy import linalg, optimize
 
 
+def worst(values, how: str) -> float:
+    """The worst of some scores, NaN if any is NaN (or if there are none).
+
+    The one reduction of scores to a verdict: Python's ``max``/``min`` drop a NaN that is
+    not first (``max(1.0, nan)`` is 1.0) and ``np.nanmax`` drops every NaN, so a mode that
+    could not be scored would vanish from its aggregate and the aggregate could pass.
+
+    Parameters
+    ----------
+    values : array_like or iterable of float
+        Scores (any shape; a generator is consumed).
+    how : {"max", "min"}
+        ``"max"`` for errors (larger is worse), ``"min"`` for agreements such as MAC or TRAC
+        (smaller is worse).
+
+    Returns
+    -------
+    float
+        ``max`` or ``min`` of ``values``; NaN if any value is NaN or ``values`` is empty.
+        Infinities are ordinary values (an infinite error is the worst error).
+    """
+    if how not in ("max", "min"):
+        raise ValueError(f"how must be 'max' or 'min', got {how!r}")
+    if not isinstance(values, np.ndarray):
+        values = list(values)
+    a = np.asarray(values, dtype=float)
+    if a.size == 0 or np.any(np.isnan(a)):
+        return float("nan")
+    return float(np.max(a) if how == "max" else np.min(a))
+
+
 def trac(x: np.ndarray, y: np.ndarray) -> np.ndarray:
     """Time response assurance criterion per channel.
 
@@ -236,7 +267,7 @@ def coefficient_error(coef_id: np.ndarray, coef_true: np.ndarray) -> float:
     nz = ct != 0
     if not nz.any():
         return float("nan")
-    return float(np.max(np.abs(ci[nz] - ct[nz]) / np.abs(ct[nz])))
+    return worst(np.abs(ci[nz] - ct[nz]) / np.abs(ct[nz]), "max")
 
 
 def rmse(x: np.ndarray, y: np.ndarray, axis: int = -1) -> np.ndarray:

@@ -35,6 +35,7 @@ text-align:left;font-variant-numeric:tabular-nums}th{background:#f3f3f3}
 td.num{text-align:right}.pass{color:#137333;font-weight:600}.fail{color:#c5221f;font-weight:600}
 .badge{display:inline-block;padding:.1em .6em;border-radius:.3em;color:#fff;font-size:.8em;
 vertical-align:middle}.badge.pass{background:#137333;color:#fff}.badge.fail{background:#c5221f;color:#fff}
+.badge.none{background:#777;color:#fff}
 figure{margin:1em 0}figure img{max-width:100%;height:auto;border:1px solid #eee}
 figcaption{color:#555;font-size:.9em}pre{background:#f7f7f7;padding:.6em;overflow-x:auto}
 .muted{color:#666;font-size:.9em}
@@ -175,7 +176,12 @@ def _scores_section(page: Page, run: SavedRun) -> None:
         if k not in checked:
             rows.append([k, doc.get(k, ""), v, "–", "reported"])
             classes.append(None)
+    for k, why in run.failures.items():  # a scored failure: diverged, fit failed, non-physical
+        rows.append([f"failure: {k}", why, None, "–", "FAIL"])
+        classes.append("fail")
     page.table(["metric", "meaning", "value", "threshold", "result"], rows, classes)
+    if not run.checks:
+        page.para("No thresholds declared in the scenario's [score] table: no verdict (not a pass).")
 
 
 def run_report(run: SavedRun, out_dir: str | os.PathLike) -> Path:
@@ -183,10 +189,13 @@ def run_report(run: SavedRun, out_dir: str | os.PathLike) -> Path:
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     page = Page(f"Run {run.name}: {run.identifier}", out_dir)
-    status = "pass" if run.passed else "fail"
+    label = run.verdict.upper()  # PASS, FAIL or NO VERDICT
+    status = {"PASS": "pass", "FAIL": "fail"}.get(label, "none")
     params = ", ".join(f"{k}={v}" for k, v in run.meta["identifier"].get("params", {}).items())
-    text = (f"{status.upper()}: identifier {run.identifier} ({params}) fitted in {run.fit_time:.3g} s.")
-    page.para(text, f'<span class="badge {status}">{status.upper()}</span> {html.escape(text[6:])}')
+    body = f"identifier {run.identifier} ({params}) fitted in {run.fit_time:.3g} s."
+    if run.failure:
+        body += f" Failed: {run.failure}."
+    page.para(f"{label}: {body}", f'<span class="badge {status}">{label}</span> {html.escape(body)}')
     _truth_section(page, run)
     _scores_section(page, run)
     d = run.details

@@ -13,16 +13,28 @@ from typing import Any
 
 from testbed.cache import DatasetCache
 from testbed.dataset import Dataset
+from testbed.errors import IdentificationError, ScenarioError
 from testbed.generate import generate
 from testbed.measurement import Measurement
 from testbed.preprocess import measure
 from testbed.scenario import Scenario
-from testbed.scoring import Check, Scores, check_thresholds, score
+from testbed.scoring import PASS, Check, Scores, check_thresholds, failed_scores, score, verdict
 
 
 @dataclass
 class RunResult:
-    """Everything one scenario run produced."""
+    """Everything one scenario run produced.
+
+    Attributes
+    ----------
+    scores : Scores
+        Its ``failures`` say why the model fails whatever its scores (fit failed, diverged,
+        non-physical); empty for a model that was scored normally.
+    checks : list of Check
+        The scenario's ``[score]`` thresholds against the scores; empty if it declares none.
+    fit_time : float
+        Wall time of the fit [s] (up to the failure for a failed fit).
+    """
 
     scenario: Scenario
     dataset: Dataset
@@ -33,8 +45,19 @@ class RunResult:
     fit_time: float
 
     @property
+    def failure(self) -> str | None:
+        """Why the model failed whatever its scores (one line), or None."""
+        return self.scores.failure
+
+    @property
+    def verdict(self) -> str:
+        """:data:`~testbed.scoring.PASS`, ``FAIL`` or ``NO_VERDICT`` (no thresholds declared)."""
+        return verdict(self.checks, self.scores.failures)
+
+    @property
     def passed(self) -> bool:
-        return all(c.passed for c in self.checks)
+        """True only when thresholds were declared, all are met, and nothing failed."""
+        return self.verdict == PASS
 
 
 def noise_free(dataset: Dataset) -> Dataset:
@@ -67,6 +90,20 @@ def run_scenario(scenario: Scenario, *, cache: DatasetCache | None = None,
         Use these data instead (must belong to ``scenario``).
     model : Identifier, optional
         Use this (unfitted) identifier instead of the scenario's ``[identify]``.
+
+    Returns
+    -------
+    RunResult
+        Always scored: a fit that raises :class:`~testbed.errors.IdentificationError` ("fit
+        failed: <reason>", every score NaN), a model that diverges, blows up, loses its loop
+        closure or is physically impossible are failures in ``result.scores.failures``, and
+        ``result.passed`` is False.  ``result.passed`` is also False without thresholds
+        (``result.verdict`` is then "no verdict").
+
+    Raises
+    ------
+    ScenarioError
+        A configuration error of the user's (never scored).
     """
     from models import RIGS
 
@@ -77,8 +114,16 @@ def run_scenario(scenario: Scenario, *, cache: DatasetCache | None = None,
     clean = measure(noise_free(dataset), scenario.signal, kind)
     model = model if model is not None else make_identifier(scenario)
     t0 = time.perf_counter()
-    model.fit(data)
+    try:
+        model.fit(data)
+    except ScenarioError:  # the user's configuration: raised, not scored
+        raise
+    except IdentificationError as e:  # data the identifier cannot handle: a scored failure
+        scores = failed_scores(kind, f"fit failed: {e}")
+    else:
+        scores = None
     fit_time = time.perf_counter() - t0
-    scores = score(kind, dataset, data, clean, model)
+    if scores is None:
+        scores = score(kind, dataset, data, clean, model)
     return RunResult(scenario, dataset, data, model, scores,
                      check_thresholds(scores.values, scenario.score), fit_time)

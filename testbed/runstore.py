@@ -3,7 +3,8 @@
 Layout of a run folder::
 
     run.json     format, scenario (dict), kind, identifier {name, class, params}, equations,
-                 scores, checks, passed, fit_time [s], dataset {fs, n_samples, signals,
+                 scores, failures {aspect: reason}, checks, verdict ("pass", "FAIL" or
+                 "no verdict"), passed, fit_time [s], dataset {fs, n_samples, signals,
                  prior, hash}, truth_units, rig_units, versions, commit, created, figures
     run.npz      details/<name>  arrays behind the scores (TRAC, MAC, simulated signals ...)
                  model/<name>    identified arrays (M_, C_, K_, K3_, coef_, ...)
@@ -28,7 +29,7 @@ from typing import Any
 
 import numpy as np
 
-from testbed.scoring import Check
+from testbed.scoring import PASS, Check, verdict
 
 FORMAT = "sysid-testbed-run/1"
 #: Truth arrays larger than this many elements are not copied into the run.
@@ -81,8 +82,22 @@ class SavedRun:
                 for c in self.meta["checks"]]
 
     @property
+    def failures(self) -> dict[str, str]:
+        """Why the model failed whatever its scores (``Scores.failures``); empty if nothing did."""
+        return {str(k): str(v) for k, v in self.meta.get("failures", {}).items()}
+
+    @property
+    def failure(self) -> str | None:
+        return "; ".join(self.failures.values()) if self.failures else None
+
+    @property
+    def verdict(self) -> str:
+        """``"pass"``, ``"FAIL"`` or ``"no verdict"`` (:func:`testbed.scoring.verdict`)."""
+        return verdict(self.checks, self.failures)
+
+    @property
     def passed(self) -> bool:
-        return all(c.passed for c in self.checks)
+        return self.verdict == PASS
 
     @property
     def fit_time(self) -> float:
@@ -206,9 +221,11 @@ def build_meta(result: Any) -> dict[str, Any]:
         "equations": _equations(result.model),
         "model_lists": model_lists,
         "scores": result.scores.values,
+        "failures": result.scores.failures,
         "checks": [{"metric": c.metric, "value": c.value, "bound": c.bound, "threshold": c.threshold,
                     "passed": c.passed} for c in result.checks],
-        "passed": all(c.passed for c in result.checks),
+        "verdict": verdict(result.checks, result.scores.failures),
+        "passed": verdict(result.checks, result.scores.failures) == PASS,
         "fit_time": float(result.fit_time),
         "dataset": {"fs": ds.fs, "n_samples": ds.n_samples, "signals": signals, "prior": ds.prior,
                     "hash": ds.attrs.get("content_hash") or ds.content_hash(),

@@ -40,6 +40,7 @@ def metric_names(kind: str) -> set[str]:
     return set(METRICS[kind])
 
 # --------------------------------------------------------------------------- scoring
+from collections.abc import Callable  # noqa: E402
 from dataclasses import dataclass, field  # noqa: E402
 from typing import Any  # noqa: E402
 
@@ -47,11 +48,48 @@ import numpy as np  # noqa: E402
 
 from testbed import metrics  # noqa: E402
 from testbed.dataset import Dataset  # noqa: E402
+from testbed.errors import DivergenceError, IdentificationError  # noqa: E402
 from testbed.measurement import Measurement, Trajectory  # noqa: E402
+from testbed.metrics import worst  # noqa: E402
 
 #: Modes whose MAC, frequency and damping are scored (the paper scores modes 1-2;
 #: mode 3 of a 3-sensor cantilever sits near 1.45 kHz and is barely excited by the impact).
 SCORED_MODES = 2
+
+# --------------------------------------------------------------------------- physical checks
+#: Relative asymmetry ``|M - M^T|`` (entrywise, against ``max|M|``) above which an identified
+#: mass matrix is not symmetric: the identifiers that impose symmetry do so by construction,
+#: leaving round-off of ~1e-16 of the largest entry; 1e-10 is six decades above it (the same
+#: rule :func:`testbed.metrics.modal_from_matrices` applies).
+SYMMETRY_RTOL = 1e-10
+#: Smallest eigenvalue of the (symmetric) identified mass matrix, relative to its largest,
+#: below which M is not positive definite.  ``eigvalsh`` resolves eigenvalues to ~n eps ||M||
+#: (~1e-15 relative for these <= 10-DOF models); a mass matrix conditioned beyond 1e12 is
+#: numerically singular anyway (``M^-1 K`` keeps no digit), so 1e-12 separates both.
+MASS_PD_RTOL = 1e-12
+#: Negative damping: smallest eigenvalue of ``(C + C^T) / 2`` below ``-DAMPING_RTOL`` times its
+#: largest magnitude (a velocity direction along which the damper does positive work, i.e.
+#: feeds energy into a passive structure).  Eigenvalue round-off is ~n eps ||C|| (~1e-15
+#: relative); 1e-9 is six decades above it, so only an identified sign counts, not rounding.
+DAMPING_RTOL = 1e-9
+#: Identified damping ratios below ``-ZETA_TOL`` [-] are negative damping.  A ratio comes from
+#: eigenvalues resolved to ~eps |lambda|_max, i.e. to ~1e-15 x (highest / lowest natural
+#: frequency) <= 1e-12 for the rigs' modes; 1e-9 is three decades above that.
+ZETA_TOL = 1e-9
+#: A pole of the first-order system ``[[0, I], [-M^-1 K, -M^-1 C]]`` with real part above
+#: ``STABILITY_RTOL * max|lambda|`` [1/s] is unstable (a mode grows).  The poles of an
+#: undamped but stable model sit on the imaginary axis up to round-off of ~eps |lambda|_max
+#: times the eigenvector condition (<= 1e3 here): ~1e-13; 1e-9 is four decades above it.
+STABILITY_RTOL = 1e-9
+#: A simulated signal whose magnitude exceeds this multiple of the largest magnitude of its
+#: reference has blown up (a divergence, scored with its time), even while still finite.
+#: It is a declaration, not a measurement: a response a thousand times larger than anything
+#: in the record reproduces nothing of it, and any model that still tracks the record (amplitude
+#: errors of a factor of a few) stays three decades below the cut.
+BLOWUP_FACTOR = 1e3
+
+#: Verdicts of a run (:func:`verdict`).
+PASS, FAIL, NO_VERDICT = "pass", "FAIL", "no verdict"
 
 
 @dataclass
@@ -72,16 +110,183 @@ class Check:
 
 @dataclass
 class Scores:
-    """Scalar scores (names in :data:`METRICS`) plus the arrays behind them for figures."""
+    """Scalar scores (names in :data:`METRICS`) plus the arrays behind them for figures.
+
+    Attributes
+    ----------
+    values : dict of str to float
+        The scores; NaN where a score could not be computed (never a pass).
+    details : dict
+        Arrays behind the scores.
+    failures : dict of str to str
+        Why the identified model fails whatever its scores, by aspect: ``"fit"`` (the fit
+        raised), ``"simulation"`` (diverged, blew up, or lost its loop closure; with the time
+        where known), ``"mass"`` (M not symmetric positive definite), ``"damping"`` (negative
+        damping), ``"stability"`` (a pole in the right half-plane), ``"model"`` (non-finite
+        learned values).  Empty for a physically admissible model whose simulation ran.
+    """
 
     values: dict[str, float]
     details: dict[str, Any] = field(default_factory=dict)
+    failures: dict[str, str] = field(default_factory=dict)
+
+    @property
+    def failure(self) -> str | None:
+        """The failure reasons as one line, or None."""
+        return "; ".join(self.failures.values()) if self.failures else None
+
+
+def verdict(checks: list[Check], failures: dict[str, str] | None = None) -> str:
+    """The verdict of a run: :data:`FAIL`, :data:`NO_VERDICT` or :data:`PASS`.
+
+    A scored failure (``failures``) or any failed check is :data:`FAIL`; otherwise a run with
+    no thresholds has :data:`NO_VERDICT` (nothing was asked of it, so it did not pass); only
+    thresholds all met give :data:`PASS`.
+    """
+    if failures or any(not c.passed for c in checks):
+        return FAIL
+    return PASS if checks else NO_VERDICT
 
 
 def check_thresholds(values: dict[str, float], thresholds: dict[str, dict[str, float]]) -> list[Check]:
     """Compare scores with ``{metric: {"min"|"max": threshold}}``; a missing score fails."""
     return [Check(m, float(values.get(m, np.nan)), b, t)
             for m, bounds in sorted(thresholds.items()) for b, t in sorted(bounds.items())]
+
+
+def failed_scores(kind: str, reason: str, key: str = "fit") -> Scores:
+    """Scores of a run whose model could not be scored at all: every score NaN, one failure."""
+    return Scores({m: float("nan") for m in METRICS[kind]}, {}, {key: reason})
+
+
+def physical_failures(M: np.ndarray, C: np.ndarray, K: np.ndarray) -> dict[str, str]:
+    """What makes a structural model ``M x'' + C x' + K x = f`` physically impossible.
+
+    Parameters
+    ----------
+    M, C, K : ndarray, shape (n, n)
+        Identified mass [kg], damping [N s/m] and stiffness [N/m] matrices.
+
+    Returns
+    -------
+    dict of str to str
+        ``"model"``: non-finite entries; ``"mass"``: M not symmetric (:data:`SYMMETRY_RTOL`)
+        or not positive definite (:data:`MASS_PD_RTOL`); ``"damping"``: a negative
+        eigenvalue of the symmetric part of C (:data:`DAMPING_RTOL`) or a negative damping
+        ratio (:data:`ZETA_TOL`); ``"stability"``: a pole with positive real part
+        (:data:`STABILITY_RTOL`), the fastest growth rate [1/s] given.  Empty if none.
+    """
+    M, C, K = (np.asarray(a, dtype=float) for a in (M, C, K))
+    if not all(np.all(np.isfinite(a)) for a in (M, C, K)):
+        return {"model": "non-physical: M, C or K holds non-finite entries"}
+    out: dict[str, str] = {}
+    scale = np.abs(M).max()
+    if np.abs(M - M.T).max() > SYMMETRY_RTOL * scale:
+        out["mass"] = (f"non-physical: identified M is not symmetric (|M - M^T| = "
+                       f"{np.abs(M - M.T).max():.3g} of max|M| {scale:.3g})")
+    else:
+        lm = np.linalg.eigvalsh(0.5 * (M + M.T))
+        if not lm[0] > MASS_PD_RTOL * abs(lm[-1]):
+            out["mass"] = (f"non-physical: identified M is not positive definite (eigenvalues "
+                           f"{lm[0]:.3g} .. {lm[-1]:.3g} kg)")
+    damping = []
+    lc = np.linalg.eigvalsh(0.5 * (C + C.T))
+    if lc.size and lc[0] < -DAMPING_RTOL * np.abs(lc).max():
+        damping.append(f"symmetric part of C has eigenvalue {lc[0]:.3g} N s/m")
+    if "mass" not in out:
+        _, zeta, _ = metrics.modal_from_matrices(M, C, K, strict=False)
+        neg = zeta[np.isfinite(zeta) & (zeta < -ZETA_TOL)]
+        if neg.size:
+            damping.append(f"identified damping ratio {neg.min():.3g}")
+        n = M.shape[0]
+        A = np.block([[np.zeros((n, n)), np.eye(n)],
+                      [-np.linalg.solve(M, K), -np.linalg.solve(M, C)]])
+        lam = np.linalg.eigvals(A)
+        growth = float(lam.real.max())
+        if growth > STABILITY_RTOL * np.abs(lam).max():
+            out["stability"] = (f"unstable: pole with real part {growth:+.4g} 1/s "
+                                f"(a mode grows as exp({growth:.3g} t))")
+    if damping:
+        out["damping"] = f"non-physical: negative damping ({', '.join(damping)})"
+    return out
+
+
+def divergence(t: np.ndarray, y: np.ndarray, ref: np.ndarray | None = None) -> tuple[str, float] | None:
+    """Where a simulated signal stops being a response: non-finite or blown up.
+
+    Parameters
+    ----------
+    t : ndarray, shape (n_samples,)
+        Times [s].
+    y : ndarray, shape (n_channels, n_samples)
+        Simulated signal.
+    ref : ndarray, shape (n_channels, n_samples), optional
+        Its reference; ``|y| > BLOWUP_FACTOR * max|ref|`` counts as a blow-up.
+
+    Returns
+    -------
+    (reason, time [s]) or None
+        The first offending sample's time.
+    """
+    y = np.atleast_2d(np.asarray(y, dtype=float))
+    bad = ~np.isfinite(y).all(axis=0)
+    what = "non-finite"
+    if ref is not None:
+        lim = BLOWUP_FACTOR * float(np.max(np.abs(ref))) if np.size(ref) else np.inf
+        with np.errstate(invalid="ignore"):
+            big = (np.abs(y) > lim).any(axis=0) & ~bad
+        if big.any() and (not bad.any() or np.argmax(big) < np.argmax(bad)):
+            bad, what = big, f"blew up (beyond {BLOWUP_FACTOR:g} x the reference's largest value)"
+    if not bad.any():
+        return None
+    k = int(np.argmax(bad))
+    return f"{what} simulation", float(t[k])
+
+
+def simulate_scored(sim: Callable[[], Trajectory], t: np.ndarray, check: str,
+                    ref: np.ndarray) -> tuple[Trajectory | None, str | None, float]:
+    """Run an identified model's simulation; a failure is returned, not raised.
+
+    Parameters
+    ----------
+    sim : callable
+        ``model.simulate`` with its arguments bound.
+    t : ndarray
+        Its times [s].
+    check : {"x", "xd", "xdd"}
+        The trajectory field compared with ``ref`` for a blow-up (all are checked for
+        non-finite values).
+    ref : ndarray
+        Reference of that field.
+
+    Returns
+    -------
+    (trajectory or None, reason or None, time [s])
+        The trajectory is None if the simulation raised; its samples from the failure on are
+        NaN otherwise.  ``time`` is NaN where unknown (no failure, or an error without time).
+    """
+    try:
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+            traj = sim()
+    except DivergenceError as e:
+        return None, f"diverged: {e}", e.time
+    except IdentificationError as e:
+        return None, f"diverged: {e}", float("nan")
+    except np.linalg.LinAlgError as e:  # e.g. a singular identified M
+        return None, f"simulation failed: {e}", float("nan")
+    found = None
+    for name in ("x", "xd", "xdd"):
+        hit = divergence(t, getattr(traj, name), ref if name == check else None)
+        if hit is not None and (found is None or hit[1] < found[1]):
+            found = hit
+    if found is None:
+        return traj, None, float("nan")
+    why, when = found
+    k = int(np.searchsorted(t, when))
+    cut = [np.array(a, dtype=float) for a in (traj.x, traj.xd, traj.xdd)]
+    for a in cut:
+        a[:, k:] = np.nan
+    return Trajectory(*cut), f"diverged: {why} (at t = {when:.4g} s)", when
 
 
 def score(kind: str, dataset: Dataset, data: Measurement, clean: Measurement, model: Any) -> Scores:
@@ -99,6 +304,13 @@ def score(kind: str, dataset: Dataset, data: Measurement, clean: Measurement, mo
         simulated model is compared with.
     model : Identifier
         Fitted.
+
+    Returns
+    -------
+    Scores
+        A model that diverges, blows up, loses its loop closure or is physically impossible
+        is scored, not raised: its affected scores are NaN and :attr:`Scores.failures` holds
+        the reasons (with the time of a divergence where known).
     """
     return (score_structural if kind == "structural" else score_mechanical)(dataset, data, clean, model)
 
@@ -110,19 +322,31 @@ def score_structural(dataset: Dataset, data: Measurement, clean: Measurement, mo
     impact pulse (``data.free_start``) to the end of the record under the
     measured force, and its accelerations are compared with the noise-free
     accelerations passed through the same signal chain.
+
+    A physically impossible model (:func:`physical_failures`: M not symmetric positive
+    definite, negative damping, an unstable pole) and a simulation that raises, turns
+    non-finite or blows up (:func:`simulate_scored`) are recorded in ``Scores.failures``;
+    the TRAC of a failed simulation is NaN.  The other scores are still computed (NaN where
+    the model gives no modes), as diagnostics of what went wrong.
     """
     truth = dataset.truth
     i0 = data.free_start
     t = np.arange(data.n_samples - i0) / data.fs
     u = None if data.u is None else data.u[:, i0:]
-    sim: Trajectory = model.simulate(data.x[:, i0], data.xd[:, i0], t, u)
     ref = clean.xdd[:, i0:]
-    trac = metrics.trac(ref, sim.xdd)
-    v: dict[str, float] = {"trac": float(np.min(trac))}
-    d: dict[str, Any] = {"trac": trac, "t": t, "simulated_xdd": sim.xdd, "reference_xdd": ref,
-                         "channels": data.channels}
+    failures = physical_failures(model.M_, model.C_, model.K_)
+    sim, why, when = simulate_scored(lambda: model.simulate(data.x[:, i0], data.xd[:, i0], t, u),
+                                     t, "xdd", ref)
+    d: dict[str, Any] = {"t": t, "reference_xdd": ref, "channels": data.channels}
+    if why is not None:
+        failures["simulation"] = why
+        d["divergence_time"] = when
+    sim_xdd = sim.xdd if sim is not None else np.full_like(ref, np.nan)
+    # A failed simulation has no TRAC (NaN, never a pass), whatever its finite beginning matched.
+    trac = metrics.trac(ref, sim_xdd) if why is None else np.full(ref.shape[0], np.nan)
+    v: dict[str, float] = {"trac": worst(trac, "min")}
+    d.update(trac=trac, simulated_xdd=sim_xdd)
 
-    # strict=False: an identified M that is not positive definite scores NaN (a fail), not a crash.
     f_id, z_id, phi_id = metrics.modal_from_matrices(model.M_, model.C_, model.K_, strict=False)
     m = min(SCORED_MODES, len(truth["frequencies_hz"]), len(f_id))
     f_true = np.asarray(truth["frequencies_hz"])[: data.n_channels]
@@ -134,19 +358,23 @@ def score_structural(dataset: Dataset, data: Measurement, clean: Measurement, mo
     if len(paired) < m or not np.all(np.isfinite(mac)):  # a true mode without partner fails
         v["mac"] = v["freq_error"] = v["damping_error"] = float("nan")
     else:
-        v["mac"] = float(min(mac[pair[j], j] for j in paired))
-        v["freq_error"] = float(max(metrics.frequency_error(f_id[pair[j]], f_true[j]) for j in paired))
-        v["damping_error"] = float(max(metrics.damping_error(z_id[pair[j]], z_true[j]) for j in paired))
+        v["mac"] = worst([mac[pair[j], j] for j in paired], "min")
+        v["freq_error"] = worst([metrics.frequency_error(f_id[pair[j]], f_true[j]) for j in paired], "max")
+        v["damping_error"] = worst([metrics.damping_error(z_id[pair[j]], z_true[j]) for j in paired], "max")
     d.update(mac=mac, pair=pair, f_id=f_id, f_true=f_true, z_id=z_id, z_true=z_true)
 
     Mr, Kr, Cr = (np.asarray(truth[k]) for k in ("Mr", "Kr", "Cr"))
     v["Mr_error"] = metrics.relative_error(model.M_, Mr)
     v["Kr_error"] = metrics.relative_error(model.K_, Kr)
     v["Cr_error"] = metrics.relative_error(model.C_, Cr)
-    v["MinvK_error"] = metrics.relative_error(np.linalg.solve(model.M_, model.K_), np.linalg.solve(Mr, Kr))
+    try:
+        v["MinvK_error"] = metrics.relative_error(np.linalg.solve(model.M_, model.K_),
+                                                  np.linalg.solve(Mr, Kr))
+    except np.linalg.LinAlgError:  # a singular identified M (a "mass" failure): no M^-1 K
+        v["MinvK_error"] = float("nan")
     if np.all(np.isfinite(phi_id)) and np.all(pair >= 0):  # identified modes in paired order
         xo = np.abs(metrics.cross_orthogonality(phi_id[:, pair], phi_true, Mr))
-        v["cross_orth"] = float(np.max(xo - np.diag(np.diag(xo)))) if xo.shape[0] > 1 else 0.0
+        v["cross_orth"] = worst(xo - np.diag(np.diag(xo)), "max") if xo.shape[0] > 1 else 0.0
     else:  # identified M not positive definite: no modes to compare
         xo = np.full((data.n_channels, data.n_channels), np.nan)
         v["cross_orth"] = float("nan")
@@ -168,7 +396,7 @@ def score_structural(dataset: Dataset, data: Measurement, clean: Measurement, mo
         f_id = K3 @ x_ref**3
         v["K3_force_error"] = float(np.linalg.norm(f_id - f_true) / np.linalg.norm(f_true))
         d.update(cubic_force_true=f_true, cubic_force_id=f_id)
-    return Scores({k: float(x) for k, x in v.items()}, d)
+    return Scores({k: float(x) for k, x in v.items()}, d, failures)
 
 
 def score_mechanical(dataset: Dataset, data: Measurement, clean: Measurement, model: Any) -> Scores:
@@ -192,6 +420,10 @@ def score_mechanical(dataset: Dataset, data: Measurement, clean: Measurement, mo
     on the true row's largest term; ``coef_error`` is the largest relative error over the true
     (canonical) terms, ``support_*`` compare the canonical nonzero patterns.  Equal canonical
     forms mean equal equations on the loop manifold; a wrong equation keeps a wrong form.
+
+    A simulation that raises (e.g. a loop closure that no longer solves), turns non-finite or
+    blows up is a failure in ``Scores.failures`` with its time where known, and its
+    ``angle_rmse`` is NaN; non-finite coefficients are a failure with NaN coefficient scores.
     """
     from testbed.equation_basis import compare_equations
 
@@ -204,14 +436,26 @@ def score_mechanical(dataset: Dataset, data: Measurement, clean: Measurement, mo
     x0 = np.asarray(dataset.truth.get("theta0", theta[:, 0]), dtype=float)
     xd0 = np.asarray(dataset.truth.get("dtheta0", ref("dtheta")[:, 0]), dtype=float)
     t = np.arange(data.n_samples) / data.fs
-    sim: Trajectory = model.simulate(x0, xd0, t, data.u)
-    rmse = metrics.rmse(theta, sim.x)
-    v: dict[str, float] = {"angle_rmse": float(np.max(rmse))}
-    d: dict[str, Any] = {"angle_rmse": rmse, "t": t, "simulated_x": sim.x, "reference_x": theta,
-                         "channels": data.channels}
+    failures: dict[str, str] = {}
+    sim, why, when = simulate_scored(lambda: model.simulate(x0, xd0, t, data.u), t, "x", theta)
+    d: dict[str, Any] = {"t": t, "reference_x": theta, "channels": data.channels}
+    if why is not None:
+        failures["simulation"] = why
+        d["divergence_time"] = when
+    sim_x = sim.x if sim is not None else np.full_like(theta, np.nan)
+    # A failed simulation has no RMSE (NaN, never a pass), however close its beginning was.
+    rmse = metrics.rmse(theta, sim_x) if why is None else np.full(theta.shape[0], np.nan)
+    v: dict[str, float] = {"angle_rmse": worst(rmse, "max")}
+    d.update(angle_rmse=rmse, simulated_x=sim_x)
 
+    coef = np.asarray(model.coef_, dtype=float)
+    if not np.all(np.isfinite(coef)):
+        failures["model"] = "non-physical: identified coefficients hold non-finite entries"
+        v.update(coef_error=float("nan"), support_precision=float("nan"),
+                 support_recall=float("nan"), support_f1=float("nan"))
+        return Scores(v, d, failures)
     signals = {"th": ref("theta"), "dth": ref("dtheta"), "ddth": ref("ddtheta"), "u": ref("torque")}
-    cmp = compare_equations(list(model.feature_names_), np.asarray(model.coef_, dtype=float),
+    cmp = compare_equations(list(model.feature_names_), coef,
                             list(dataset.truth["equation_terms"]),
                             np.asarray(dataset.truth["equation_coef"], dtype=float), signals)
     v["coef_error"] = float(cmp["coef_error"])
@@ -220,4 +464,4 @@ def score_mechanical(dataset: Dataset, data: Measurement, clean: Measurement, mo
     d.update(terms=cmp["names"], coef_true=cmp["coef_true"], coef_id=cmp["coef_id"],
              coef_errors=cmp["coef_errors"], coef_error_norm=cmp["coef_error_norm"],
              dependent_terms=cmp["dependent"], truth_residual=cmp["truth_residual"])
-    return Scores(v, d)
+    return Scores(v, d, failures)

@@ -44,10 +44,36 @@ def print_truth_summary(ds: Dataset, console: Console | None = None) -> None:
     (console or Console()).print(t)
 
 
+def verdict_line(verdict: str, failure: str | None, n_checks: int) -> str:
+    """One line saying what a run's verdict is and why (console markup).
+
+    Parameters
+    ----------
+    verdict : {"pass", "FAIL", "no verdict"}
+        :func:`testbed.scoring.verdict` of the run.
+    failure : str or None
+        Its failure reasons (``Scores.failure``).
+    n_checks : int
+        Thresholds declared.
+    """
+    from testbed.scoring import FAIL, PASS
+
+    if verdict == PASS:
+        return f"[green]PASS[/]: all {n_checks} threshold(s) met"
+    if verdict == FAIL:
+        return f"[red]FAIL[/]: {failure}" if failure else "[red]FAIL[/]: threshold(s) not met"
+    return "[yellow]no verdict[/]: no thresholds declared in the scenario's [score] table (not a pass)"
+
+
 def print_score_table(result: RunResult, console: Console | None = None) -> None:
-    """Metric, value, threshold, pass — then every other score reported."""
-    t = Table(title=f"{result.scenario.name}: {result.scenario.identify['method']} "
-                    f"(fit {result.fit_time:.2f} s)")
+    """Metric, value, threshold, pass — then every other score reported, each failure reason,
+    and the verdict line (PASS, FAIL with its reason, or no verdict without thresholds)."""
+    from rich.markup import escape
+
+    t = Table(title=f"{result.scenario.name}: {(result.scenario.identify or {}).get('method', '?')} "
+                    f"(fit {result.fit_time:.2f} s)",
+              caption=verdict_line(result.verdict, result.failure and escape(result.failure),
+                                   len(result.checks)))
     for c in ("metric", "value", "threshold", "pass"):
         t.add_column(c)
     checked = set()
@@ -59,4 +85,8 @@ def print_score_table(result: RunResult, console: Console | None = None) -> None
     for k, v in sorted(result.scores.values.items()):
         if k not in checked:
             t.add_row(k, f"{v:.5g}", "-", "reported")
+    for k, why in result.scores.failures.items():
+        t.add_row(f"[red]failure: {k}[/]", escape(why), "-", "[red]FAIL[/]")
+    if not result.checks:
+        t.add_row("[yellow]thresholds[/]", "none declared", "-", "[yellow]no verdict[/]")
     (console or Console()).print(t)
