@@ -71,6 +71,11 @@ MASS_PD_RTOL = 1e-12
 #: largest magnitude (a velocity direction along which the damper does positive work, i.e.
 #: feeds energy into a passive structure).  Eigenvalue round-off is ~n eps ||C|| (~1e-15
 #: relative); 1e-9 is six decades above it, so only an identified sign counts, not rounding.
+#: Applied when M and K are symmetric (:data:`SYMMETRY_RTOL`): only then is
+#: ``E = x'^T M x' / 2 + x^T K x / 2`` an energy with ``dE/dt = -x'^T C x'`` (free motion), so
+#: the symmetric part of C is a dissipation.  A model with a non-symmetric K (e.g. least-squares
+#: SINDy in sensor coordinates) has no such energy, and its C is judged by what it does: its
+#: damping ratios (:data:`ZETA_TOL`) and poles (:data:`STABILITY_RTOL`).
 DAMPING_RTOL = 1e-9
 #: Identified damping ratios below ``-ZETA_TOL`` [-] are negative damping.  A ratio comes from
 #: eigenvalues resolved to ~eps |lambda|_max, i.e. to ~1e-15 x (highest / lowest natural
@@ -172,9 +177,10 @@ def physical_failures(M: np.ndarray, C: np.ndarray, K: np.ndarray) -> dict[str, 
     dict of str to str
         ``"model"``: non-finite entries; ``"mass"``: M not symmetric (:data:`SYMMETRY_RTOL`)
         or not positive definite (:data:`MASS_PD_RTOL`); ``"damping"``: a negative
-        eigenvalue of the symmetric part of C (:data:`DAMPING_RTOL`) or a negative damping
-        ratio (:data:`ZETA_TOL`); ``"stability"``: a pole with positive real part
-        (:data:`STABILITY_RTOL`), the fastest growth rate [1/s] given.  Empty if none.
+        eigenvalue of the symmetric part of C when M and K are symmetric (:data:`DAMPING_RTOL`
+        says why only then) or a negative damping ratio (:data:`ZETA_TOL`); ``"stability"``:
+        a pole with positive real part (:data:`STABILITY_RTOL`), the fastest growth rate
+        [1/s] given.  Empty if none.
     """
     M, C, K = (np.asarray(a, dtype=float) for a in (M, C, K))
     if not all(np.all(np.isfinite(a)) for a in (M, C, K)):
@@ -190,8 +196,9 @@ def physical_failures(M: np.ndarray, C: np.ndarray, K: np.ndarray) -> dict[str, 
             out["mass"] = (f"non-physical: identified M is not positive definite (eigenvalues "
                            f"{lm[0]:.3g} .. {lm[-1]:.3g} kg)")
     damping = []
+    k_sym = np.abs(K - K.T).max() <= SYMMETRY_RTOL * np.abs(K).max()
     lc = np.linalg.eigvalsh(0.5 * (C + C.T))
-    if lc.size and lc[0] < -DAMPING_RTOL * np.abs(lc).max():
+    if "mass" not in out and k_sym and lc.size and lc[0] < -DAMPING_RTOL * np.abs(lc).max():
         damping.append(f"symmetric part of C has eigenvalue {lc[0]:.3g} N s/m")
     if "mass" not in out:
         _, zeta, _ = metrics.modal_from_matrices(M, C, K, strict=False)

@@ -17,3 +17,5 @@ def test_scenario_meets_its_thresholds(scenario, dataset_cache):
     failed = [f"{c.metric} = {c.value:.5g} (needs {'>=' if c.bound == 'min' else '<='} {c.threshold:g})"
               for c in result.checks if not c.passed]
     assert not failed, f"{scenario.name}: " + "; ".join(failed)
+    assert not result.scores.failures, f"{scenario.name}: {result.failure}"
+    assert result.passed

@@ -1,0 +1,277 @@
+"""Trustworthy verdicts: NaN never passes; a model that diverges, blows up or is physically
+impossible is a scored failure with its reason (never a crash, never a pass); a run without
+thresholds has no verdict.
+
+The failing models are real fitted identifiers (least-squares SINDy on the stiff cantilever,
+SINDy-PI on the five-bar sine replay) whose learned matrices are altered after the fit, so the
+whole path (run_scenario -> score -> table -> run folder) is exercised.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from rich.console import Console
+
+from identify.ls_sindy import LeastSquaresSINDy
+from identify.sindy_pi import SINDyPI
+from testbed import metrics
+from testbed.errors import DivergenceError, IdentificationError, ScenarioError
+from testbed.measurement import Trajectory
+from testbed.run import run_scenario
+from testbed.runstore import load_run, save_run
+from testbed.scenario import load_scenario
+from testbed.scoring import (
+    BLOWUP_FACTOR,
+    FAIL,
+    NO_VERDICT,
+    PASS,
+    Check,
+    physical_failures,
+    simulate_scored,
+    verdict,
+)
+from testbed.summaries import print_score_table
+
+
+def table_text(result) -> str:
+    con = Console(record=True, width=200)
+    print_score_table(result, con)
+    return con.export_text()
+
+
+def params_of(scenario) -> dict:
+    return {k: v for k, v in scenario.identify.items() if k != "method"}
+
+
+# ------------------------------------------------------------------ NaN never passes
+@pytest.mark.parametrize("values", [[1.0, math.nan], [math.nan, 1.0], [0.5, 2.0, math.nan]])
+def test_worst_is_nan_wherever_the_nan_is(values):
+    assert math.isnan(metrics.worst(values, "max")) and math.isnan(metrics.worst(values, "min"))
+    assert math.isnan(metrics.worst(np.array(values), "max"))
+
+
+def test_worst_of_finite_values_empty_and_infinite():
+    assert max(1.0, math.nan) == 1.0  # the pitfall worst() exists for
+    assert metrics.worst([0.2, 0.7, 0.1], "max") == 0.7
+    assert metrics.worst((x for x in [0.2, 0.7, 0.1]), "min") == 0.1
+    assert math.isnan(metrics.worst([], "max"))
+    assert metrics.worst([1.0, math.inf], "max") == math.inf
+    with pytest.raises(ValueError):
+        metrics.worst([1.0], "mean")
+
+
+def test_coefficient_error_with_a_nan_second_is_nan():
+    assert math.isnan(metrics.coefficient_error(np.array([1.0, math.nan]), np.array([1.0, 2.0])))
+
+
+def test_verdict_states():
+    ok, bad = Check("trac", 0.99, "min", 0.9), Check("trac", math.nan, "min", 0.9)
+    assert verdict([ok]) == PASS
+    assert verdict([ok, bad]) == FAIL
+    assert verdict([]) == NO_VERDICT
+    assert verdict([ok], {"simulation": "diverged"}) == FAIL
+    assert verdict([], {"fit": "fit failed: x"}) == FAIL
+
+
+# ------------------------------------------------------------------ physical checks by hand
+def _two_dof():
+    M = np.diag([2.0, 1.0])
+    K = np.array([[300.0, -100.0], [-100.0, 100.0]])
+    return M, 1e-3 * K, K
+
+
+def test_physical_model_has_no_failures():
+    assert physical_failures(*_two_dof()) == {}
+    M, _, K = _two_dof()
+    assert physical_failures(M, np.zeros((2, 2)), K) == {}  # undamped: marginally stable, not unstable
+
+
+@pytest.mark.parametrize("case, key, words", [
+    ("mass_indefinite", "mass", "not positive definite"),
+    ("mass_asymmetric", "mass", "not symmetric"),
+    ("negative_damping", "damping", "negative damping"),
+    ("negative_damping", "stability", "unstable"),
+    ("negative_stiffness", "stability", "unstable"),
+    ("nonfinite", "model", "non-finite"),
+])
+def test_physically_impossible_models(case, key, words):
+    M, C, K = _two_dof()
+    if case == "mass_indefinite":
+        M = np.diag([2.0, -1.0])
+    elif case == "mass_asymmetric":
+        M = np.array([[2.0, 0.5], [0.0, 1.0]])
+    elif case == "negative_damping":
+        C = -C
+    elif case == "negative_stiffness":
+        K = K - 200.0 * np.eye(2)
+    elif case == "nonfinite":
+        K = K.copy()
+        K[0, 1] = math.nan
+    f = physical_failures(M, C, K)
+    assert key in f and words in f[key], f
+
+
+def test_indefinite_symmetric_damping_fails_with_symmetric_model():
+    M, _, K = _two_dof()
+    C = np.array([[1.0, 1.5], [1.5, 1.0]])  # eigenvalues -0.5 and 2.5 N s/m
+    assert "symmetric part of C" in physical_failures(M, C, K)["damping"]
+
+
+# ------------------------------------------------------------------ simulations that fail
+def test_divergence_error_keeps_its_time():
+    t = np.linspace(0.0, 2.0, 21)
+
+    def boom():
+        raise DivergenceError("loop closure no longer solves", 1.25)
+
+    traj, why, when = simulate_scored(boom, t, "x", np.ones((1, 21)))
+    assert traj is None and when == 1.25 and why.startswith("diverged:") and "1.25" in why
+
+    def plain():
+        raise IdentificationError("loop closure Newton solve did not converge (no assembly)")
+
+    _, why, when = simulate_scored(plain, t, "x", np.ones((1, 21)))
+    assert "Newton" in why and math.isnan(when)
+
+
+def test_blow_up_and_nonfinite_are_found_with_their_time():
+    t = np.arange(10) * 0.1
+    ref = np.ones((2, 10))
+    x = np.ones((2, 10))
+    x[1, 6:] = 2 * BLOWUP_FACTOR  # finite but beyond the blow-up bound from t = 0.6 s
+    x[0, 8:] = math.inf
+    traj, why, when = simulate_scored(lambda: Trajectory(x, x, x), t, "x", ref)
+    assert when == pytest.approx(0.6) and "blew up" in why
+    assert np.all(np.isnan(traj.x[:, 6:])) and np.all(traj.x[:, :6] == 1.0)
+    traj, why, when = simulate_scored(lambda: Trajectory(ref, ref, x), t, "x", ref)
+    assert when == pytest.approx(0.8) and "non-finite" in why  # xdd checked for non-finite only
+    traj, why, when = simulate_scored(lambda: Trajectory(ref, ref, ref), t, "x", ref)
+    assert why is None and traj is not None
+
+
+# ------------------------------------------------------------------ structural: real fitted models
+class UnstableMode2(LeastSquaresSINDy):
+    """Least-squares SINDy whose fitted K is altered so that mode 2's eigenvalue of M^-1 K is
+    negated (a diverging mode); everything else is the real fit."""
+
+    def fit(self, data):
+        super().fit(data)
+        lam, V = np.linalg.eig(np.linalg.solve(self.M_, self.K_))
+        order = np.argsort(lam.real)
+        lam, V = lam[order].real, V[:, order].real
+        lam[1] = -lam[1]
+        self.K_ = self.M_ @ V @ np.diag(lam) @ np.linalg.inv(V)
+        self._finish_fit()
+        return self
+
+
+class NegativeDamping(LeastSquaresSINDy):
+    """Least-squares SINDy with its fitted damping matrix negated (every mode grows)."""
+
+    def fit(self, data):
+        super().fit(data)
+        self.C_ = -self.C_
+        return self
+
+
+class ConfigError(LeastSquaresSINDy):
+    def fit(self, data):
+        raise ScenarioError("cantilever_stiff_impact_lsq.toml", "identify.method", "x", "a user error")
+
+
+@pytest.fixture(scope="module")
+def lsq():
+    return load_scenario("cantilever_stiff_impact_lsq")
+
+
+def test_unstable_second_mode_fails_with_nan_not_the_first_modes_score(lsq, dataset_cache):
+    result = run_scenario(lsq, cache=dataset_cache, model=UnstableMode2(**params_of(lsq)))
+    # mode 1 still matches; mode 2 has no frequency.  max() would have kept mode 1's error.
+    assert math.isnan(result.scores.values["freq_error"])
+    assert "stability" in result.scores.failures
+    assert not result.passed and result.verdict == FAIL
+    text = table_text(result)
+    assert "unstable: pole with real part" in text and "FAIL" in text
+
+
+def test_negative_damping_is_a_scored_failure_with_its_reason(lsq, dataset_cache, tmp_path):
+    result = run_scenario(lsq, cache=dataset_cache, model=NegativeDamping(**params_of(lsq)))
+    f = result.scores.failures
+    assert "negative damping" in f["damping"] and "identified damping ratio" in f["damping"]
+    assert "unstable" in f["stability"]
+    assert not result.passed
+    text = table_text(result)
+    assert "failure: damping" in text and "negative damping" in text
+    # the failed run is stored with its reasons and still renders (figures included)
+    run = load_run(save_run(result, tmp_path / "run", figures=True))
+    assert run.failures == f and run.verdict == FAIL and not run.passed
+    assert run.meta["passed"] is False and run.meta["verdict"] == FAIL
+    assert run.figures
+
+
+def test_no_thresholds_is_no_verdict(lsq, dataset_cache, tmp_path):
+    result = run_scenario(lsq.replace(score={}), cache=dataset_cache)
+    assert result.checks == [] and not result.scores.failures
+    assert result.verdict == NO_VERDICT and not result.passed
+    assert "no thresholds declared" in table_text(result)
+    run = load_run(save_run(result, tmp_path / "run", figures=False))
+    assert run.verdict == NO_VERDICT and not run.passed
+
+
+def test_cli_run_without_thresholds_does_not_exit_as_a_pass(tmp_path, dataset_cache):
+    from testbed.cli import EXIT_FAIL, main
+
+    base = load_scenario("cantilever_stiff_impact_lsq").path
+    # an [identify] table without [score] drops the parent's thresholds (scenario.extends)
+    (tmp_path / "nothr.toml").write_text(f'[scenario]\nname = "nothr"\nextends = "{base}"\n'
+                                         '[identify]\nmethod = "ls_sindy"\n')
+    code = main(["run", str(tmp_path / "nothr.toml"), "--cache", str(dataset_cache.directory),
+                 "-o", str(tmp_path / "out"), "--no-figures"])
+    assert code == EXIT_FAIL
+
+
+def test_configuration_error_in_fit_is_still_raised(lsq, dataset_cache):
+    with pytest.raises(ScenarioError):
+        run_scenario(lsq, cache=dataset_cache, model=ConfigError(**params_of(lsq)))
+
+
+# ------------------------------------------------------------------ five-bar
+class LoudInputs(SINDyPI):
+    """SINDy-PI whose fitted input coefficients are scaled by 100 after the fit: the simulated
+    linkage is driven far from the recorded motion until its loop can no longer close."""
+
+    def fit(self, data):
+        super().fit(data)
+        inputs = [i for i, n in enumerate(self.feature_names_) if "*u" in n]
+        self.coef_[:, inputs] *= 100.0
+        self.model_ = type(self.model_)(self._library_, self.coef_, self.actuated_, self.closure_)
+        return self
+
+
+def test_fivebar_diverging_model_is_scored_not_raised(dataset_cache):
+    sc = load_scenario("fivebar_sine_replay")
+    result = run_scenario(sc, cache=dataset_cache, model=LoudInputs(**params_of(sc)))
+    assert result.scores.failures["simulation"].startswith("diverged:")
+    assert math.isnan(result.scores.values["angle_rmse"])
+    assert not result.passed
+    assert "failure: simulation" in table_text(result)
+
+
+def test_fivebar_noisy_sine_replay_fit_failure_is_scored(tmp_path, dataset_cache):
+    from testbed.cli import EXIT_FAIL, main
+
+    base = load_scenario("fivebar_sine_replay").path
+    path = tmp_path / "noisy_sine.toml"
+    path.write_text(f'[scenario]\nname = "noisy_sine"\nextends = "{base}"\n[noise]\nrms_percent = 2\n')
+    result = run_scenario(load_scenario(str(path)), cache=dataset_cache)
+    assert result.failure.startswith("fit failed: no loop closure fits the measured angles")
+    assert all(math.isnan(v) for v in result.scores.values.values())
+    assert result.verdict == FAIL and "fit failed" in table_text(result)
+    run = load_run(save_run(result, tmp_path / "run", figures=True))  # renders without a fit
+    assert run.failure == result.failure and not run.passed
+    code = main(["run", str(path), "--cache", str(dataset_cache.directory), "-o", str(tmp_path / "out"),
+                 "--no-figures"])
+    assert code == EXIT_FAIL  # a scored failure, not the usage/error exit
