@@ -342,15 +342,18 @@ def score_structural(dataset: Dataset, data: Measurement, clean: Measurement, mo
     u = None if data.u is None else data.u[:, i0:]
     ref = clean.xdd[:, i0:]
     failures = physical_failures(model.M_, model.C_, model.K_)
-    sim, why, when = simulate_scored(lambda: model.simulate(data.x[:, i0], data.xd[:, i0], t, u),
-                                     t, "xdd", ref)
     d: dict[str, Any] = {"t": t, "reference_xdd": ref, "channels": data.channels}
-    if why is not None:
-        failures["simulation"] = why
-        d["divergence_time"] = when
+    sim = None
+    if "model" not in failures:  # non-finite matrices: nothing to simulate (the failure says so)
+        sim, why, when = simulate_scored(
+            lambda: model.simulate(data.x[:, i0], data.xd[:, i0], t, u), t, "xdd", ref)
+        if why is not None:
+            failures["simulation"] = why
+            d["divergence_time"] = when
     sim_xdd = sim.xdd if sim is not None else np.full_like(ref, np.nan)
     # A failed simulation has no TRAC (NaN, never a pass), whatever its finite beginning matched.
-    trac = metrics.trac(ref, sim_xdd) if why is None else np.full(ref.shape[0], np.nan)
+    trac = (metrics.trac(ref, sim_xdd) if sim is not None and "simulation" not in failures
+            else np.full(ref.shape[0], np.nan))
     v: dict[str, float] = {"trac": worst(trac, "min")}
     d.update(trac=trac, simulated_xdd=sim_xdd)
 
@@ -444,20 +447,24 @@ def score_mechanical(dataset: Dataset, data: Measurement, clean: Measurement, mo
     xd0 = np.asarray(dataset.truth.get("dtheta0", ref("dtheta")[:, 0]), dtype=float)
     t = np.arange(data.n_samples) / data.fs
     failures: dict[str, str] = {}
-    sim, why, when = simulate_scored(lambda: model.simulate(x0, xd0, t, data.u), t, "x", theta)
+    coef = np.asarray(model.coef_, dtype=float)
     d: dict[str, Any] = {"t": t, "reference_x": theta, "channels": data.channels}
-    if why is not None:
-        failures["simulation"] = why
-        d["divergence_time"] = when
+    sim = None
+    if not np.all(np.isfinite(coef)):  # nothing to simulate (the failure says so)
+        failures["model"] = "non-physical: identified coefficients hold non-finite entries"
+    else:
+        sim, why, when = simulate_scored(lambda: model.simulate(x0, xd0, t, data.u), t, "x", theta)
+        if why is not None:
+            failures["simulation"] = why
+            d["divergence_time"] = when
     sim_x = sim.x if sim is not None else np.full_like(theta, np.nan)
     # A failed simulation has no RMSE (NaN, never a pass), however close its beginning was.
-    rmse = metrics.rmse(theta, sim_x) if why is None else np.full(theta.shape[0], np.nan)
+    rmse = (metrics.rmse(theta, sim_x) if sim is not None and "simulation" not in failures
+            else np.full(theta.shape[0], np.nan))
     v: dict[str, float] = {"angle_rmse": worst(rmse, "max")}
     d.update(angle_rmse=rmse, simulated_x=sim_x)
 
-    coef = np.asarray(model.coef_, dtype=float)
-    if not np.all(np.isfinite(coef)):
-        failures["model"] = "non-physical: identified coefficients hold non-finite entries"
+    if "model" in failures:
         v.update(coef_error=float("nan"), support_precision=float("nan"),
                  support_recall=float("nan"), support_f1=float("nan"))
         return Scores(v, d, failures)
