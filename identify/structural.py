@@ -31,6 +31,7 @@ from scipy import linalg
 from identify._base import Identifier
 from identify._structural_sim import simulate_structural
 from testbed.measurement import Measurement, Trajectory
+from testbed.errors import IdentificationError
 
 #: Keys of ``Measurement.prior`` a structural identifier may take the mass scale from.
 MASS_PRIORS = ("reduced_mass_trace", "total_mass")
@@ -91,7 +92,7 @@ def build_library(data: Measurement, *, coupled_mass: bool, cubic: bool, start: 
     x, xd, xdd = (np.asarray(a, dtype=float)[:, s:] for a in (data.x, data.xd, data.xdd))
     n = x.shape[0]
     if x.shape[1] < 4:
-        raise ValueError(f"fit window from sample {s} holds {x.shape[1]} samples; need more")
+        raise IdentificationError(f"fit window from sample {s} holds {x.shape[1]} samples; need more")
     rows, names, blocks = [], [], {}
     mask_blocks = []
 
@@ -170,11 +171,11 @@ def mass_prior_value(data: Measurement, key: str) -> float:
     if key not in MASS_PRIORS:
         raise ValueError(f"mass_prior must be one of {MASS_PRIORS}, got {key!r}")
     if key not in data.prior:
-        raise ValueError(f"Measurement.prior has no {key!r} (has: {sorted(data.prior)}); the mass "
+        raise IdentificationError(f"Measurement.prior has no {key!r} (has: {sorted(data.prior)}); the mass "
                          f"scale cannot be identified from free vibration without it")
     val = float(data.prior[key])
     if not val > 0:
-        raise ValueError(f"prior {key!r} must be > 0 kg, got {val}")
+        raise IdentificationError(f"prior {key!r} must be > 0 kg, got {val}")
     return val
 
 
@@ -221,7 +222,7 @@ def measured_frequencies(data: Measurement, n_modes: int, freq_range: tuple[floa
                                     min_rel_separation=MODE_SEPARATION)
         except ValueError as exc:  # fewer clear peaks than asked for
             last = exc
-    raise ValueError(f"no spectral peak found in the measured accelerations: {last}")
+    raise IdentificationError(f"no spectral peak found in the measured accelerations: {last}")
 
 
 # --------------------------------------------------------------------------------------------
