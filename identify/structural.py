@@ -30,8 +30,8 @@ from scipy import linalg
 
 from identify._base import Identifier
 from identify._structural_sim import simulate_structural
-from testbed.measurement import Measurement, Trajectory
 from testbed.errors import IdentificationError
+from testbed.measurement import Measurement, Trajectory
 
 #: Keys of ``Measurement.prior`` a structural identifier may take the mass scale from.
 MASS_PRIORS = ("reduced_mass_trace", "total_mass")
