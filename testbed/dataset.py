@@ -12,7 +12,9 @@ as PDEBench does.  Layout::
     /prior                  attrs: prior knowledge an identifier may be given (e.g. total mass)
 
 Every signal dataset carries attrs ``unit``, ``channels`` and, where defined,
-``positions`` [m].  Writes are atomic: the file appears whole or not at all.
+``positions`` [m].  Writes are atomic: the file appears whole or not at all.  Reads are
+verified: :meth:`Dataset.load` recomputes the content hash and compares it with the stored
+one, and an unreadable, foreign or altered file raises :class:`DatasetError` naming the file.
 """
 
 from __future__ import annotations
@@ -28,8 +30,32 @@ import h5py
 import numpy as np
 
 from testbed.atomic import atomic_write
+from testbed.errors import TestbedError
 
 FORMAT = "sysid-testbed-dataset/1"
+
+#: Keys of the ``scenario`` attribute that decide the data (as :meth:`Scenario.data_dict`); the
+#: name, description, tags, signal chain, ``[identify]`` and ``[score]`` do not.
+DATA_KEYS = ("rig", "rig_params", "simulation", "excitation", "noise", "seed")
+#: Attributes that describe how or where the data were made or by which scenario file, not what
+#: they are: left out of the content hash.
+_NOT_CONTENT = ("versions", "git_commit", "content_hash", "created", "scenario", "scenario_name")
+
+
+class DatasetError(TestbedError, ValueError):
+    """A dataset file cannot be read, is not a dataset, or its content does not match its hash.
+
+    Parameters
+    ----------
+    path : path-like
+        The offending file.
+    reason : str
+        What is wrong with it.
+    """
+
+    def __init__(self, path: str | os.PathLike, reason: str) -> None:
+        self.path, self.reason = Path(path), reason
+        super().__init__(f"{path}: {reason}")
 
 
 @dataclass
@@ -53,7 +79,9 @@ class Signal:
     positions: np.ndarray | None = None
 
     def __post_init__(self) -> None:
-        self.data = np.asarray(self.data, dtype=float)
+        # C order always: a reduction over a row (e.g. the noise's RMS) then sums in one fixed
+        # order whether the array came from a rig (often a transposed view) or from a file
+        self.data = np.ascontiguousarray(self.data, dtype=float)
         if self.data.ndim == 1:
             self.data = self.data[None, :]
         self.channels = tuple(self.channels)
@@ -99,15 +127,21 @@ class Dataset:
         return np.arange(self.n_samples) / self.fs
 
     def content_hash(self) -> str:
-        """SHA-256 of everything that is data (signals, truth, prior, scenario, seed).
+        """SHA-256 of everything that is data: signals, truth, prior, sample rate, and the
+        data-defining attributes (rig, seed, the scenario's :data:`DATA_KEYS` sections, what
+        the rig records, e.g. ``gravity``).
 
-        Versions, commit and the hash itself are left out, so the hash names the
-        content: the same scenario and seed give the same hash on any machine
+        Left out: versions, commit, the hash itself, and what only names or judges the data
+        (the scenario's name, description, tags, signal chain, ``[identify]``, ``[score]``).
+        The hash thus names the content: two scenarios that differ only in identifier or
+        thresholds give the same hash, and so does the same scenario and seed on any machine
         whose physics engine gives the same numbers.
         """
         h = hashlib.sha256()
-        meta = {k: v for k, v in self.attrs.items()
-                if k not in ("versions", "git_commit", "content_hash", "created")}
+        meta = {k: v for k, v in self.attrs.items() if k not in _NOT_CONTENT}
+        scenario = self.attrs.get("scenario")
+        if isinstance(scenario, dict):
+            meta["scenario"] = {k: scenario[k] for k in DATA_KEYS if k in scenario}
         h.update(json.dumps({"fs": self.fs, "prior": self.prior, "attrs": meta},
                             sort_keys=True, default=str).encode())
         for group, signals in (("measured", self.measured), ("reference", self.reference)):
@@ -172,11 +206,45 @@ class Dataset:
             p.attrs[k] = v
 
     @classmethod
-    def load(cls, path: str | os.PathLike) -> Dataset:
-        """Read a file written by :meth:`save`; the result equals the saved object."""
+    def load(cls, path: str | os.PathLike, *, verify: bool = True) -> Dataset:
+        """Read a file written by :meth:`save`; the result equals the saved object.
+
+        Parameters
+        ----------
+        path : path-like
+        verify : bool
+            Recompute the content hash and compare it with the stored one.
+
+        Raises
+        ------
+        DatasetError
+            If the file is missing, not HDF5, truncated or otherwise unreadable, not a
+            dataset of this format, or (``verify``) its content does not match its hash.
+        """
+        try:
+            ds = cls._read(path)
+        except DatasetError:
+            raise
+        except FileNotFoundError:
+            raise DatasetError(path, "no such file") from None
+        except Exception as e:  # h5py raises OSError, KeyError, ValueError ... for damaged files
+            raise DatasetError(path, f"unreadable dataset file ({type(e).__name__}: {e})") from None
+        if verify:
+            stored = ds.attrs.get("content_hash")
+            if not stored:
+                raise DatasetError(path, "no content hash stored; cannot verify")
+            if ds.content_hash() != stored:
+                raise DatasetError(path, "content does not match its stored content hash "
+                                         "(the file was altered or damaged)")
+        return ds
+
+    @classmethod
+    def _read(cls, path: str | os.PathLike) -> Dataset:
+        if not Path(path).is_file():
+            raise FileNotFoundError(path)
         with h5py.File(path, "r") as f:
             if f.attrs.get("format") != FORMAT:
-                raise ValueError(f"{path}: not a {FORMAT} file (format={f.attrs.get('format')!r})")
+                raise DatasetError(path, f"not a {FORMAT} file (format={f.attrs.get('format')!r})")
             attrs: dict[str, Any] = {}
             json_keys = set(json.loads(f.attrs.get("json_attrs", "[]")))
             for k, v in f.attrs.items():
