@@ -119,9 +119,13 @@ class DatasetCache:
         return [(p, p.stat().st_size) for p in sorted(self.directory.glob("*.h5"))]
 
     def clear(self) -> int:
-        """Delete every cached file; return how many were removed."""
+        """Delete every cached file and any temporary file a killed writer left; return how many
+        cached files were removed."""
         n = 0
         for p, _ in self.entries():
             p.unlink(missing_ok=True)
             n += 1
+        if self.directory.is_dir():
+            for tmp in self.directory.glob(".*.h5.*.tmp"):  # testbed.atomic's temporary names
+                tmp.unlink(missing_ok=True)
         return n

@@ -32,7 +32,11 @@ import numpy as np
 from testbed.atomic import atomic_write
 from testbed.errors import TestbedError
 
-FORMAT = "sysid-testbed-dataset/1"
+#: Format written.  /2: the content hash covers the data-defining attributes only (see
+#: :meth:`Dataset.content_hash`); /1 files hashed every attribute but versions and commit.
+FORMAT = "sysid-testbed-dataset/2"
+#: Formats read (a /1 file is verified against the hash it was written with).
+READ_FORMATS = ("sysid-testbed-dataset/1", FORMAT)
 
 #: Keys of the ``scenario`` attribute that decide the data (as :meth:`Scenario.data_dict`); the
 #: name, description, tags, signal chain, ``[identify]`` and ``[score]`` do not.
@@ -137,11 +141,19 @@ class Dataset:
         thresholds give the same hash, and so does the same scenario and seed on any machine
         whose physics engine gives the same numbers.
         """
-        h = hashlib.sha256()
         meta = {k: v for k, v in self.attrs.items() if k not in _NOT_CONTENT}
         scenario = self.attrs.get("scenario")
         if isinstance(scenario, dict):
             meta["scenario"] = {k: scenario[k] for k in DATA_KEYS if k in scenario}
+        return self._hash(meta)
+
+    def _legacy_content_hash(self) -> str:
+        """The hash a format /1 file was written with (every attribute but versions and commit)."""
+        return self._hash({k: v for k, v in self.attrs.items()
+                           if k not in ("versions", "git_commit", "content_hash", "created")})
+
+    def _hash(self, meta: dict[str, Any]) -> str:
+        h = hashlib.sha256()
         h.update(json.dumps({"fs": self.fs, "prior": self.prior, "attrs": meta},
                             sort_keys=True, default=str).encode())
         for group, signals in (("measured", self.measured), ("reference", self.reference)):
@@ -222,7 +234,7 @@ class Dataset:
             dataset of this format, or (``verify``) its content does not match its hash.
         """
         try:
-            ds = cls._read(path)
+            ds, fmt = cls._read(path)
         except DatasetError:
             raise
         except FileNotFoundError:
@@ -233,18 +245,24 @@ class Dataset:
             stored = ds.attrs.get("content_hash")
             if not stored:
                 raise DatasetError(path, "no content hash stored; cannot verify")
-            if ds.content_hash() != stored:
+            actual = ds._legacy_content_hash() if fmt != FORMAT else ds.content_hash()
+            if actual != stored:
                 raise DatasetError(path, "content does not match its stored content hash "
                                          "(the file was altered or damaged)")
+            if fmt != FORMAT:  # verified as written; in memory it carries this format's hash
+                ds.attrs["content_hash"] = ds.content_hash()
         return ds
 
     @classmethod
-    def _read(cls, path: str | os.PathLike) -> Dataset:
+    def _read(cls, path: str | os.PathLike) -> tuple[Dataset, str]:
+        """(the dataset, its file's format) without verification."""
         if not Path(path).is_file():
             raise FileNotFoundError(path)
         with h5py.File(path, "r") as f:
-            if f.attrs.get("format") != FORMAT:
-                raise DatasetError(path, f"not a {FORMAT} file (format={f.attrs.get('format')!r})")
+            fmt = f.attrs.get("format")
+            fmt = fmt.decode() if isinstance(fmt, bytes) else fmt
+            if fmt not in READ_FORMATS:
+                raise DatasetError(path, f"not a {FORMAT} file (format={fmt!r})")
             attrs: dict[str, Any] = {}
             json_keys = set(json.loads(f.attrs.get("json_attrs", "[]")))
             for k, v in f.attrs.items():
@@ -273,5 +291,6 @@ class Dataset:
                 truth[name] = v
                 units[name] = str(d.attrs["unit"])
             prior = {k: (v.item() if isinstance(v, np.generic) else v) for k, v in f["prior"].attrs.items()}
-            return cls(float(f.attrs["fs"]), groups["measured"], groups["reference"], truth, units,
-                       prior, attrs)
+            ds = cls(float(f.attrs["fs"]), groups["measured"], groups["reference"], truth, units,
+                     prior, attrs)
+            return ds, fmt
