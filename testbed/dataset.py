@@ -240,7 +240,8 @@ class Dataset:
         except FileNotFoundError:
             raise DatasetError(path, "no such file") from None
         except Exception as e:  # h5py raises OSError, KeyError, ValueError ... for damaged files
-            raise DatasetError(path, f"unreadable dataset file ({type(e).__name__}: {e})") from None
+            why = " ".join(str(e).split())  # one line, whatever the HDF5 library's message
+            raise DatasetError(path, f"unreadable dataset file ({type(e).__name__}: {why})") from None
         if verify:
             stored = ds.attrs.get("content_hash")
             if not stored:
