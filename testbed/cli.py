@@ -79,9 +79,10 @@ def cmd_run(args: argparse.Namespace) -> int:
         sc = load_scenario(name)
         if args.seed is not None:
             sc = sc.replace(seed=args.seed)
+        run_dir = run_folder(args.out, sc.name)  # refused before the work, not after
         with _progress()(f"{sc.name}: data") as bar:
             result = run_scenario(sc, cache=cache, progress=bar)
-        run_dir = save_run(result, run_folder(args.out, sc.name), figures=not args.no_figures)
+        run_dir = save_run(result, run_dir, figures=not args.no_figures)
         print_score_table(result)
         print(f"run written to {run_dir}")
         ok &= result.passed

@@ -451,6 +451,20 @@ def test_a_run_named_dot_or_dotdot_never_touches_the_output_folder(mechanical, t
     assert run_folder(out, "fine_name") == out / "fine_name"
 
 
+def test_cli_run_of_a_scenario_named_dot_leaves_every_other_run(mechanical, tmp_path, capsys):
+    """`testbed run ..toml` (name ".") once replaced the whole output folder; now it is refused."""
+    from testbed.cli import main
+
+    out = tmp_path / "runs"
+    save_run(mechanical, out / "other", figures=False)
+    dot = tmp_path / "..toml"
+    dot.write_text(f'[scenario]\nextends = "{ROOT / "scenarios" / "cantilever_stiff_impact_lsq.toml"}"\n'
+                   'name = "."\n')
+    assert main(["run", str(dot), "--no-figures", "--no-cache", "-o", str(out)]) == 2
+    assert "error:" in capsys.readouterr().err
+    assert [p.name for p in out.iterdir()] == ["other"] and load_run(out / "other")
+
+
 def test_concurrent_writers_of_one_run_folder_leave_one_complete_run(mechanical, tmp_path):
     """Eight threads save the same run at once (distinct fit times): each succeeds, one wins whole."""
     from concurrent.futures import ThreadPoolExecutor
