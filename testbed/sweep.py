@@ -4,11 +4,13 @@ A *cell* is one (scenario, noise level, seed, identifier) of a
 :class:`~testbed.study.Study`.  :func:`run_sweep` sends every cell through one
 joblib seam (:func:`parallel`): sequential for ``jobs=1``, loky processes for
 ``jobs>1``, and a ``distributed.Client`` with joblib's ``"dask"`` backend when a
-scheduler address is given.  It first generates the datasets the cells need,
-one task per distinct dataset (cells that differ only in the identifier share
-their data through the :class:`~testbed.cache.DatasetCache`), then runs the
-cells, writing each row as it arrives (:mod:`testbed.results`).  A rerun skips
-every cell already in the results; a killed sweep loses only the cells in flight.
+scheduler address is given.  It first simulates the clean datasets the cells
+need, one task per distinct rig configuration (cells that differ only in
+identifier, noise level or seed share one simulation through the
+:class:`~testbed.cache.DatasetCache`, which derives each cell's noisy data on
+load), then runs the cells, writing each row as it arrives (:mod:`testbed.results`).
+A rerun skips every cell already in the results; a killed sweep loses only the
+cells in flight.
 
 Faults: a damaged row file (e.g. truncated by a full disk) is named in a warning, set
 aside as ``*.bad`` and its cell run again; ``retry_failed`` runs the cells recorded as
@@ -348,7 +350,7 @@ class SweepStats:
     failed_total : int
         Cells recorded as failed in the results at the end (now or by an earlier run).
     datasets : int
-        Datasets generated (absent from the cache).
+        Clean simulations run (absent from the cache); noisy datasets are derived, not counted.
     data_seconds, cells_seconds : float
         Wall time of the dataset phase and of the cell phase [s].
     """
