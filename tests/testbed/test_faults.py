@@ -351,6 +351,32 @@ def test_retry_failed_flag_reruns_failed_cells_and_exit_status(fault_dir, tmp_pa
     assert all(r["status"] == "ok" for r in read_results(res))
 
 
+def test_sweep_interrupted_by_an_error_keeps_the_rows_that_finished(fault_dir, tmp_path, monkeypatch):
+    """A lost worker (here: an error after two rows) ends the sweep; the two rows are consolidated."""
+    import testbed.sweep as sw
+
+    real = sw.parallel
+
+    def lossy(fn, args, n_jobs):
+        for i, out in enumerate(real(fn, args, n_jobs)):
+            if fn is sw.run_cell and i == 2:
+                raise RuntimeError("worker lost")
+            yield out
+
+    monkeypatch.setattr(sw, "parallel", lossy)
+    study = load_study(_study(fault_dir, "lossy", ["fault_fit"]))
+    res = tmp_path / "r.parquet"
+    with pytest.raises(RuntimeError, match="worker lost"):
+        run_sweep(study, results=res, cache_dir=tmp_path / "c", verbose=False)
+    assert res.is_file() and not parts_dir(res).exists()
+    assert len(read_results(res)) == 2
+    monkeypatch.setattr(sw, "parallel", real)
+    stats = SweepStats()
+    assert len(read_results(run_sweep(study, results=res, cache_dir=tmp_path / "c", verbose=False,
+                                      stats=stats))) == 4
+    assert stats.run == 2
+
+
 def _group_alive(pgid: int) -> list[int]:
     """Pids of live (not zombie) processes in process group ``pgid``."""
     try:
