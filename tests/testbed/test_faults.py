@@ -143,6 +143,35 @@ def test_noisy_fivebar_from_the_cache_is_bit_identical_to_a_fresh_one(tmp_path):
     assert derived.content_hash() == fresh.attrs["content_hash"]
 
 
+def test_concurrent_writers_and_readers_of_one_cache_entry(tmp_path):
+    """Processes filling one key at once all finish; a reader never meets a half-written file."""
+    from concurrent.futures import ProcessPoolExecutor
+
+    sc = _short()
+    cache = DatasetCache(tmp_path)
+    want = generate(sc)
+    with ProcessPoolExecutor(3) as ex:  # three cold processes race for the same entry
+        got = list(ex.map(_fill_and_read, [(str(tmp_path), sc)] * 3))
+    assert got == [(want.content_hash(), 0)] * 3  # 0: no reader found a damaged entry
+    assert [p for p, _ in cache.entries()] == [cache.path(sc)]
+    assert [p.name for p in tmp_path.iterdir()] == [cache.path(sc).name], "no temporary file left"
+
+
+def _fill_and_read(args) -> tuple[str, int]:
+    """Fill the entry, then rewrite and read it back 5 times: (content hash, warnings logged)."""
+    directory, sc = args
+    warned: list[logging.LogRecord] = []
+    handler = logging.Handler(logging.WARNING)
+    handler.emit = warned.append
+    logging.getLogger("testbed.cache").addHandler(handler)
+    cache = DatasetCache(directory)
+    ds = cache.get(sc)
+    for _ in range(5):
+        cache.clean(sc).save(cache.path(sc))  # another writer's atomic replace, over and over
+        assert cache.get(sc).content_hash() == ds.content_hash()
+    return ds.content_hash(), len(warned)
+
+
 def test_generate_to_a_file_fills_the_run_cache(tmp_path):
     from testbed.cli import main
 
