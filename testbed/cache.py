@@ -1,10 +1,20 @@
-"""Content-keyed dataset cache shared by ``testbed run`` and ``testbed sweep``.
+"""Content-keyed dataset cache shared by ``testbed run``, ``testbed generate`` and ``testbed sweep``.
 
-A dataset is determined by the scenario's data sections and seed
-(:meth:`Scenario.data_hash`), by the versions of the engines that simulate it and
-by this project's generating source (the rigs and the noise model); the cache key
-hashes all three.  Files are written atomically, so a
-killed process never leaves a half-written entry.
+The cache holds each *clean* simulation once: one HDF5 file per rig configuration
+(:func:`~testbed.generate.noise_free_scenario` of a scenario: its data sections with
+the noise level and seed set aside), named ``<rig>-<key>.h5``.  The key hashes that
+configuration (:meth:`Scenario.data_hash`), the versions of the engines that simulate it
+and this project's generating source (the rigs and the noise model).  A scenario's
+dataset, noisy or not, is :func:`~testbed.generate.derive` of the clean entry with the
+scenario's noise spec and seed, made on load: bit-identical to a fresh
+:func:`~testbed.generate.generate`, and no noisy copy is stored.
+
+Stored data defend themselves: every load recomputes the content hash and compares it
+with the stored one; an unreadable (e.g. truncated) or altered entry is reported in one
+warning line naming the file and simulated again.  Files are written atomically
+(temporary file, then rename), so a killed process never leaves a half-written entry,
+a reader never sees one, and two processes filling the same entry at once both finish
+(the last rename wins; both wrote the same content).
 """
 
 from __future__ import annotations
@@ -12,13 +22,16 @@ from __future__ import annotations
 import functools
 import hashlib
 import json
+import logging
 import os
 from collections.abc import Callable
 from pathlib import Path
 
-from testbed.dataset import Dataset
+from testbed.dataset import Dataset, DatasetError
 from testbed.provenance import versions
 from testbed.scenario import Scenario
+
+log = logging.getLogger(__name__)
 
 
 def default_cache_dir() -> Path:
@@ -63,26 +76,41 @@ class DatasetCache:
         self.directory = Path(directory) if directory is not None else default_cache_dir()
 
     def path(self, scenario: Scenario) -> Path:
-        return self.directory / f"{scenario.rig}-{cache_key(scenario)}.h5"
+        """The file of ``scenario``'s clean simulation (shared by all its noise levels and seeds)."""
+        from testbed.generate import noise_free_scenario
 
-    def get(self, scenario: Scenario, progress: Callable[[float], None] | None = None) -> Dataset:
-        """The cached dataset of ``scenario``, generating and storing it if absent.
+        clean_sc = noise_free_scenario(scenario)
+        return self.directory / f"{clean_sc.rig}-{cache_key(clean_sc)}.h5"
 
-        A noisy scenario is derived from the cached noise-free simulation of the same rig and
-        excitation, so noise levels and seeds of a study simulate each configuration once.
+    def clean(self, scenario: Scenario, progress: Callable[[float], None] | None = None) -> Dataset:
+        """The clean dataset of ``scenario``'s simulation, verified, simulated and stored if absent.
+
+        An entry that cannot be read or whose content does not match its stored hash is
+        reported (one warning line on the ``testbed.cache`` logger, naming the file) and
+        simulated again; the new file replaces it atomically.
         """
-        from testbed.generate import generate, noise_free_scenario
+        from testbed.generate import simulate_clean
 
         p = self.path(scenario)
         if p.is_file():
-            return Dataset.load(p)
-        clean_sc = noise_free_scenario(scenario)
-        if clean_sc.data_hash() != scenario.data_hash():  # noisy: simulate once, add noise
-            ds = generate(scenario, clean=self.get(clean_sc, progress))
-        else:
-            ds = generate(scenario, progress=progress)
+            try:
+                return Dataset.load(p)
+            except DatasetError as e:
+                if p.is_file():  # else another process cleared it meanwhile: a plain miss
+                    log.warning("dataset cache: %s; simulating it again", e)
+        ds = simulate_clean(scenario, progress)
         ds.save(p)
         return ds
+
+    def get(self, scenario: Scenario, progress: Callable[[float], None] | None = None) -> Dataset:
+        """The dataset of ``scenario``: its clean simulation (:meth:`clean`) with its noise added.
+
+        Bit-identical to :func:`testbed.generate.generate` of ``scenario``; noise levels and
+        seeds of a study share one simulation per configuration.
+        """
+        from testbed.generate import derive
+
+        return derive(self.clean(scenario, progress), scenario)
 
     def entries(self) -> list[tuple[Path, int]]:
         """(path, size in bytes) of every cached file, sorted by name."""
@@ -91,9 +119,13 @@ class DatasetCache:
         return [(p, p.stat().st_size) for p in sorted(self.directory.glob("*.h5"))]
 
     def clear(self) -> int:
-        """Delete every cached file; return how many were removed."""
+        """Delete every cached file and any temporary file a killed writer left; return how many
+        cached files were removed."""
         n = 0
         for p, _ in self.entries():
             p.unlink(missing_ok=True)
             n += 1
+        if self.directory.is_dir():
+            for tmp in self.directory.glob(".*.h5.*.tmp"):  # testbed.atomic's temporary names
+                tmp.unlink(missing_ok=True)
         return n

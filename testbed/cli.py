@@ -48,6 +48,7 @@ def cmd_list(args: argparse.Namespace) -> int:
 
 
 def cmd_generate(args: argparse.Namespace) -> int:
+    from testbed.cache import DatasetCache
     from testbed.generate import generate
     from testbed.scenario import load_scenario
     from testbed.summaries import print_truth_summary
@@ -56,7 +57,8 @@ def cmd_generate(args: argparse.Namespace) -> int:
     if args.seed is not None:
         sc = sc.replace(seed=args.seed)
     with _progress()(f"generating {sc.name}") as bar:
-        ds = generate(sc, progress=bar)
+        # through the run cache unless --no-cache: a later `testbed run` of it simulates nothing
+        ds = generate(sc, progress=bar) if args.no_cache else DatasetCache(args.cache).get(sc, bar)
     out = Path(args.output or f"{sc.name}-seed{sc.seed}.h5")
     ds.save(out)
     print_truth_summary(ds)
@@ -67,7 +69,7 @@ def cmd_generate(args: argparse.Namespace) -> int:
 def cmd_run(args: argparse.Namespace) -> int:
     from testbed.cache import DatasetCache
     from testbed.run import run_scenario
-    from testbed.runstore import save_run
+    from testbed.runstore import run_folder, save_run
     from testbed.scenario import load_scenario
     from testbed.summaries import print_score_table
 
@@ -77,9 +79,10 @@ def cmd_run(args: argparse.Namespace) -> int:
         sc = load_scenario(name)
         if args.seed is not None:
             sc = sc.replace(seed=args.seed)
+        run_dir = run_folder(args.out, sc.name)  # refused before the work, not after
         with _progress()(f"{sc.name}: data") as bar:
             result = run_scenario(sc, cache=cache, progress=bar)
-        run_dir = save_run(result, Path(args.out) / sc.name, figures=not args.no_figures)
+        run_dir = save_run(result, run_dir, figures=not args.no_figures)
         print_score_table(result)
         print(f"run written to {run_dir}")
         ok &= result.passed
@@ -104,14 +107,15 @@ def cmd_export(args: argparse.Namespace) -> int:
 
 def cmd_sweep(args: argparse.Namespace) -> int:
     from testbed.study import load_study
-    from testbed.sweep import run_sweep
+    from testbed.sweep import SweepStats, run_sweep
 
     study = load_study(args.study)
+    stats = SweepStats()
     results = run_sweep(study, jobs=args.jobs, dask_address=args.dask,
                         results=Path(args.results) if args.results else None,
-                        cache_dir=args.cache)
+                        cache_dir=args.cache, retry_failed=args.retry_failed, stats=stats)
     print(f"results: {results}")
-    return 0
+    return EXIT_FAIL if stats.failed_total else 0
 
 
 def cmd_summary(args: argparse.Namespace) -> int:
@@ -150,6 +154,8 @@ def build_parser() -> argparse.ArgumentParser:
     g.add_argument("scenario", help="scenario name or .toml path")
     g.add_argument("-o", "--output", help="output file (default <scenario>-seed<N>.h5)")
     g.add_argument("--seed", type=int, help="override the scenario's seed")
+    g.add_argument("--cache", help="dataset cache folder it also fills (default .cache/datasets)")
+    g.add_argument("--no-cache", action="store_true", help="generate afresh, fill no cache")
     g.set_defaults(fn=cmd_generate)
 
     r = sub.add_parser("run", help="generate or reuse data, identify, score, write figures")
@@ -178,6 +184,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--dask", help="dask.distributed scheduler address (runs through joblib's dask backend)")
     s.add_argument("--results", help="results file (default out/studies/<study>.parquet)")
     s.add_argument("--cache", help="dataset cache folder")
+    s.add_argument("--retry-failed", action="store_true", help="run the cells recorded as failed again")
     s.set_defaults(fn=cmd_sweep)
 
     sm = sub.add_parser("summary", help="median, spread and pass rate per identifier and noise level")

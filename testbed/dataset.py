@@ -12,7 +12,9 @@ as PDEBench does.  Layout::
     /prior                  attrs: prior knowledge an identifier may be given (e.g. total mass)
 
 Every signal dataset carries attrs ``unit``, ``channels`` and, where defined,
-``positions`` [m].  Writes are atomic: the file appears whole or not at all.
+``positions`` [m].  Writes are atomic: the file appears whole or not at all.  Reads are
+verified: :meth:`Dataset.load` recomputes the content hash and compares it with the stored
+one, and an unreadable, foreign or altered file raises :class:`DatasetError` naming the file.
 """
 
 from __future__ import annotations
@@ -28,8 +30,36 @@ import h5py
 import numpy as np
 
 from testbed.atomic import atomic_write
+from testbed.errors import TestbedError
 
-FORMAT = "sysid-testbed-dataset/1"
+#: Format written.  /2: the content hash covers the data-defining attributes only (see
+#: :meth:`Dataset.content_hash`); /1 files hashed every attribute but versions and commit.
+FORMAT = "sysid-testbed-dataset/2"
+#: Formats read (a /1 file is verified against the hash it was written with).
+READ_FORMATS = ("sysid-testbed-dataset/1", FORMAT)
+
+#: Keys of the ``scenario`` attribute that decide the data (as :meth:`Scenario.data_dict`); the
+#: name, description, tags, signal chain, ``[identify]`` and ``[score]`` do not.
+DATA_KEYS = ("rig", "rig_params", "simulation", "excitation", "noise", "seed")
+#: Attributes that describe how or where the data were made or by which scenario file, not what
+#: they are: left out of the content hash.
+_NOT_CONTENT = ("versions", "git_commit", "content_hash", "created", "scenario", "scenario_name")
+
+
+class DatasetError(TestbedError, ValueError):
+    """A dataset file cannot be read, is not a dataset, or its content does not match its hash.
+
+    Parameters
+    ----------
+    path : path-like
+        The offending file.
+    reason : str
+        What is wrong with it.
+    """
+
+    def __init__(self, path: str | os.PathLike, reason: str) -> None:
+        self.path, self.reason = Path(path), reason
+        super().__init__(f"{path}: {reason}")
 
 
 @dataclass
@@ -53,7 +83,9 @@ class Signal:
     positions: np.ndarray | None = None
 
     def __post_init__(self) -> None:
-        self.data = np.asarray(self.data, dtype=float)
+        # C order always: a reduction over a row (e.g. the noise's RMS) then sums in one fixed
+        # order whether the array came from a rig (often a transposed view) or from a file
+        self.data = np.ascontiguousarray(self.data, dtype=float)
         if self.data.ndim == 1:
             self.data = self.data[None, :]
         self.channels = tuple(self.channels)
@@ -99,15 +131,29 @@ class Dataset:
         return np.arange(self.n_samples) / self.fs
 
     def content_hash(self) -> str:
-        """SHA-256 of everything that is data (signals, truth, prior, scenario, seed).
+        """SHA-256 of everything that is data: signals, truth, prior, sample rate, and the
+        data-defining attributes (rig, seed, the scenario's :data:`DATA_KEYS` sections, what
+        the rig records, e.g. ``gravity``).
 
-        Versions, commit and the hash itself are left out, so the hash names the
-        content: the same scenario and seed give the same hash on any machine
+        Left out: versions, commit, the hash itself, and what only names or judges the data
+        (the scenario's name, description, tags, signal chain, ``[identify]``, ``[score]``).
+        The hash thus names the content: two scenarios that differ only in identifier or
+        thresholds give the same hash, and so does the same scenario and seed on any machine
         whose physics engine gives the same numbers.
         """
+        meta = {k: v for k, v in self.attrs.items() if k not in _NOT_CONTENT}
+        scenario = self.attrs.get("scenario")
+        if isinstance(scenario, dict):
+            meta["scenario"] = {k: scenario[k] for k in DATA_KEYS if k in scenario}
+        return self._hash(meta)
+
+    def _legacy_content_hash(self) -> str:
+        """The hash a format /1 file was written with (every attribute but versions and commit)."""
+        return self._hash({k: v for k, v in self.attrs.items()
+                           if k not in ("versions", "git_commit", "content_hash", "created")})
+
+    def _hash(self, meta: dict[str, Any]) -> str:
         h = hashlib.sha256()
-        meta = {k: v for k, v in self.attrs.items()
-                if k not in ("versions", "git_commit", "content_hash", "created")}
         h.update(json.dumps({"fs": self.fs, "prior": self.prior, "attrs": meta},
                             sort_keys=True, default=str).encode())
         for group, signals in (("measured", self.measured), ("reference", self.reference)):
@@ -172,11 +218,52 @@ class Dataset:
             p.attrs[k] = v
 
     @classmethod
-    def load(cls, path: str | os.PathLike) -> Dataset:
-        """Read a file written by :meth:`save`; the result equals the saved object."""
+    def load(cls, path: str | os.PathLike, *, verify: bool = True) -> Dataset:
+        """Read a file written by :meth:`save`; the result equals the saved object.
+
+        Parameters
+        ----------
+        path : path-like
+        verify : bool
+            Recompute the content hash and compare it with the stored one.
+
+        Raises
+        ------
+        DatasetError
+            If the file is missing, not HDF5, truncated or otherwise unreadable, not a
+            dataset of this format, or (``verify``) its content does not match its hash.
+        """
+        try:
+            ds, fmt = cls._read(path)
+        except DatasetError:
+            raise
+        except FileNotFoundError:
+            raise DatasetError(path, "no such file") from None
+        except Exception as e:  # h5py raises OSError, KeyError, ValueError ... for damaged files
+            why = " ".join(str(e).split())  # one line, whatever the HDF5 library's message
+            raise DatasetError(path, f"unreadable dataset file ({type(e).__name__}: {why})") from None
+        if verify:
+            stored = ds.attrs.get("content_hash")
+            if not stored:
+                raise DatasetError(path, "no content hash stored; cannot verify")
+            actual = ds._legacy_content_hash() if fmt != FORMAT else ds.content_hash()
+            if actual != stored:
+                raise DatasetError(path, "content does not match its stored content hash "
+                                         "(the file was altered or damaged)")
+            if fmt != FORMAT:  # verified as written; in memory it carries this format's hash
+                ds.attrs["content_hash"] = ds.content_hash()
+        return ds
+
+    @classmethod
+    def _read(cls, path: str | os.PathLike) -> tuple[Dataset, str]:
+        """(the dataset, its file's format) without verification."""
+        if not Path(path).is_file():
+            raise FileNotFoundError(path)
         with h5py.File(path, "r") as f:
-            if f.attrs.get("format") != FORMAT:
-                raise ValueError(f"{path}: not a {FORMAT} file (format={f.attrs.get('format')!r})")
+            fmt = f.attrs.get("format")
+            fmt = fmt.decode() if isinstance(fmt, bytes) else fmt
+            if fmt not in READ_FORMATS:
+                raise DatasetError(path, f"not a {FORMAT} file (format={fmt!r})")
             attrs: dict[str, Any] = {}
             json_keys = set(json.loads(f.attrs.get("json_attrs", "[]")))
             for k, v in f.attrs.items():
@@ -205,5 +292,6 @@ class Dataset:
                 truth[name] = v
                 units[name] = str(d.attrs["unit"])
             prior = {k: (v.item() if isinstance(v, np.generic) else v) for k, v in f["prior"].attrs.items()}
-            return cls(float(f.attrs["fs"]), groups["measured"], groups["reference"], truth, units,
-                       prior, attrs)
+            ds = cls(float(f.attrs["fs"]), groups["measured"], groups["reference"], truth, units,
+                     prior, attrs)
+            return ds, fmt

@@ -12,6 +12,12 @@ A sweep killed at any moment therefore leaves only whole rows (in ``R`` or in
 ``R.parts``) and loses just the cells in flight; :func:`read_results` reads both
 places and keeps one row per cell, so a rerun skips every finished cell.
 
+A row file damaged all the same (a full disk, a copy cut short, an edit by hand) is
+not trusted: :func:`read_results` names it in a warning and skips it, and with
+``set_aside=True`` (what a sweep does) renames it ``<cell>.json.bad``, so its cell runs
+again and the evidence stays; consolidation leaves ``*.bad`` files in place.  A damaged
+``R`` raises :class:`ResultsError` naming the file.
+
 Columns (:data:`BASE_COLUMNS`, then one float column per score name):
 
 ======================  =========  ===================================================
@@ -36,7 +42,9 @@ dataset_hash            str        content hash of the dataset the cell used
 
 from __future__ import annotations
 
+import contextlib
 import json
+import logging
 import math
 import os
 from collections.abc import Iterable
@@ -47,8 +55,15 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from testbed.atomic import atomic_write, atomic_write_text
+from testbed.errors import TestbedError
 
 FORMAT = "sysid-testbed-results/1"
+
+log = logging.getLogger(__name__)
+
+
+class ResultsError(TestbedError, ValueError):
+    """A results file cannot be read or is not a results file of :data:`FORMAT`; names the file."""
 
 BASE_COLUMNS: dict[str, pa.DataType] = {
     "study": pa.string(), "cell": pa.string(), "scenario": pa.string(), "rig": pa.string(),
@@ -86,13 +101,40 @@ def write_part(path: str | os.PathLike, row: dict[str, Any]) -> Path:
     return out
 
 
-def _read_parts(path: str | os.PathLike) -> list[dict[str, Any]]:
+def _read_part(p: Path) -> dict[str, Any]:
+    """One row file; ValueError if it is not a whole row written by :func:`write_part`."""
+    try:
+        row = json.loads(p.read_text(encoding="utf-8"))
+    except UnicodeDecodeError as e:
+        raise ValueError(f"not UTF-8 text: {e}") from None
+    except json.JSONDecodeError as e:
+        raise ValueError(f"not valid JSON ({e})") from None
+    if not isinstance(row, dict) or not all(isinstance(row.get(k), str) for k in ("cell", "status")):
+        raise ValueError("not a results row (no cell and status)")
+    if row["cell"] != p.stem:
+        raise ValueError(f"holds the row of cell {row['cell']!r}")
+    return row
+
+
+def _read_parts(path: str | os.PathLike, set_aside: bool = False) -> list[dict[str, Any]]:
     d = parts_dir(path)
     if not d.is_dir():
         return []
     rows = []
     for p in sorted(d.glob("*.json")):  # temporary files (.*.tmp) of a killed write are skipped
-        rows.append(json.loads(p.read_text()))
+        try:
+            rows.append(_read_part(p))
+        except (OSError, ValueError) as e:
+            if not set_aside:
+                log.warning("results: %s is damaged (%s); skipped", p, e)
+                continue
+            bad = p.with_name(p.name + ".bad")
+            try:
+                os.replace(p, bad)
+            except FileNotFoundError:  # set aside by another reader meanwhile
+                continue
+            log.warning("results: %s is damaged (%s); set aside as %s, its cell will run again",
+                        p, e, bad.name)
     return rows
 
 
@@ -132,20 +174,26 @@ def write_rows(path: str | os.PathLike, rows: Iterable[dict[str, Any]], *,
 def _read_parquet(path: Path) -> list[dict[str, Any]]:
     if not path.is_file():
         return []
-    table = pq.read_table(path)
+    try:
+        table = pq.read_table(path)
+    except Exception as e:  # pyarrow raises ArrowInvalid, OSError ... for a damaged file
+        raise ResultsError(f"{path}: unreadable results file ({type(e).__name__}: {e})") from None
     meta = table.schema.metadata or {}
     if meta.get(b"format", b"").decode() != FORMAT:
-        raise ValueError(f"{path}: not a {FORMAT} file")
+        raise ResultsError(f"{path}: not a {FORMAT} file")
     return table.to_pylist()
 
 
-def read_results(path: str | os.PathLike) -> list[dict[str, Any]]:
+def read_results(path: str | os.PathLike, *, set_aside: bool = False) -> list[dict[str, Any]]:
     """Every row of a results file, including rows not yet consolidated.
 
     Parameters
     ----------
     path : path
         The results file; ``<path>.parts/`` is read too.
+    set_aside : bool
+        Rename a damaged row file ``<cell>.json.bad`` (else it is only skipped); either
+        way a warning names it.
 
     Returns
     -------
@@ -153,10 +201,15 @@ def read_results(path: str | os.PathLike) -> list[dict[str, Any]]:
         One row per cell (a row in both places counts once; the part wins, being
         the newer), sorted by scenario, noise, seed and identifier.  Every row has
         every score column found in any row (NaN where it has no such score).
+
+    Raises
+    ------
+    ResultsError
+        If ``path`` exists but is not a readable results file.
     """
     path = Path(path)
     by_cell: dict[str, dict[str, Any]] = {r["cell"]: r for r in _read_parquet(path)}
-    for r in _read_parts(path):
+    for r in _read_parts(path, set_aside):
         by_cell[r["cell"]] = r
     rows = sorted(by_cell.values(), key=_sort_key)
     scores = score_columns(rows)
@@ -191,8 +244,10 @@ def consolidate(path: str | os.PathLike, *, keep: set[str] | None = None,
         rows = kept
     write_rows(path, rows, study=study)
     d = parts_dir(path)
-    if d.is_dir():  # only after the Parquet file holds every row
+    if d.is_dir():  # only after the Parquet file holds every row; set-aside *.bad files stay
         for p in d.iterdir():
-            p.unlink(missing_ok=True)
-        d.rmdir()
+            if not p.name.endswith(".bad"):
+                p.unlink(missing_ok=True)
+        with contextlib.suppress(OSError):  # not empty: it keeps the *.bad files
+            d.rmdir()
     return len(rows), dropped

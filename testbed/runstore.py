@@ -12,16 +12,26 @@ Layout of a run folder::
                  truth/<name>    the dataset's truth arrays
     *.png        the run figures (:mod:`testbed.figures`)
 
-The folder is written beside its final place and renamed into it, so a reader
-sees the old run or the new one, never half of one.
+The folder is written beside its final place (a private temporary folder) and renamed
+into it, so a reader sees the old run or the new one, never half of one; on Linux the old
+and new folders are swapped in one atomic ``renameat2(RENAME_EXCHANGE)``.  Two processes
+saving the same run at once both succeed, and the folder holds the last complete one.
+
+A run never touches a folder other than its own: :func:`run_folder` accepts only a plain
+name that stays strictly inside the output folder, and :func:`save_run` refuses a target
+named ``.`` or ``..`` and refuses to replace an existing folder that is not a run folder
+(no ``run.json``), e.g. the output folder itself with every other run in it.
 """
 
 from __future__ import annotations
 
+import ctypes
 import datetime as _dt
+import errno
 import json
 import os
 import shutil
+import sys
 import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -29,11 +39,69 @@ from typing import Any
 
 import numpy as np
 
+from testbed.errors import TestbedError
 from testbed.scoring import PASS, Check, verdict
 
 FORMAT = "sysid-testbed-run/1"
 #: Truth arrays larger than this many elements are not copied into the run.
 MAX_TRUTH_SIZE = 1_000_000
+
+
+class RunStoreError(TestbedError, ValueError):
+    """A run folder that would leave the output folder, or replace something that is not a run."""
+
+
+def run_folder(out_dir: str | os.PathLike, name: str) -> Path:
+    """The folder of run ``name`` in ``out_dir``, checked to be strictly inside it.
+
+    Parameters
+    ----------
+    out_dir : path-like
+        The output folder (e.g. ``out/runs``).
+    name : str
+        The run's name (the scenario name): one path component, not empty, not starting
+        with ``.`` (``.`` and ``..`` would name the output folder or its parent; other dot
+        names are kept for the temporary folders of :func:`save_run`).
+
+    Returns
+    -------
+    Path
+        ``out_dir / name``.
+
+    Raises
+    ------
+    RunStoreError
+        If ``name`` is not such a component, or ``out_dir / name`` resolves (e.g. through a
+        symbolic link) to anything but a direct child of ``out_dir``.
+    """
+    if (not isinstance(name, str) or not name or name.startswith(".")
+            or any(c in name for c in ("/", "\\", "\0"))):
+        raise RunStoreError(f"run name {name!r}: expected a plain folder name (no path separator, "
+                            "not starting with '.'), so that the run stays inside "
+                            f"{os.fspath(out_dir)}")
+    out = Path(out_dir)
+    if (out / name).resolve().parent != out.resolve():
+        raise RunStoreError(f"run folder {out / name} resolves to {(out / name).resolve()}, "
+                            f"outside the output folder {out.resolve()}")
+    return out / name
+
+
+def _is_run_folder(p: Path) -> bool:
+    """A folder :func:`save_run` may replace: a real (not linked) folder holding a ``run.json``."""
+    return p.is_dir() and not p.is_symlink() and (p / "run.json").is_file()
+
+
+def _check_target(run_dir: str | os.PathLike) -> Path:
+    """``run_dir`` as a Path, refused if it names ``.``/``..`` or an existing non-run folder."""
+    last = os.path.basename(os.fspath(run_dir).rstrip("/" + os.sep))
+    if last in ("", ".", ".."):
+        raise RunStoreError(f"{os.fspath(run_dir)}: a run folder cannot be named {last!r}")
+    run_dir = Path(run_dir)
+    if (run_dir.exists() or run_dir.is_symlink()) and not _is_run_folder(run_dir) \
+            and not (run_dir.is_dir() and not run_dir.is_symlink() and not any(run_dir.iterdir())):
+        raise RunStoreError(f"{run_dir}: exists and is not a run folder (no run.json); "
+                            "refusing to replace it")
+    return run_dir
 
 
 @dataclass
@@ -262,7 +330,7 @@ def save_run(result: Any, run_dir: str | os.PathLike, figures: bool = True) -> P
     ----------
     result : RunResult
     run_dir : path
-        The folder to (re)place.
+        The folder to (re)place; see :func:`run_folder` for one inside an output folder.
     figures : bool
         Also render the run figures as PNGs.
 
@@ -270,8 +338,14 @@ def save_run(result: Any, run_dir: str | os.PathLike, figures: bool = True) -> P
     -------
     Path
         ``run_dir``.
+
+    Raises
+    ------
+    RunStoreError
+        If ``run_dir`` is named ``.`` or ``..``, or exists and is neither a run folder nor
+        empty (it is then left untouched).
     """
-    run_dir = Path(run_dir)
+    run_dir = _check_target(run_dir)
     run_dir.parent.mkdir(parents=True, exist_ok=True)
     tmp = Path(tempfile.mkdtemp(prefix=f".{run_dir.name}.", suffix=".tmp", dir=run_dir.parent))
     umask = os.umask(0)
@@ -294,16 +368,59 @@ def save_run(result: Any, run_dir: str | os.PathLike, figures: bool = True) -> P
     return run_dir
 
 
+#: renameat2 flag (linux/fs.h): swap the two paths atomically.
+_RENAME_EXCHANGE = 2
+_AT_FDCWD = -100
+
+
+def _exchange(a: Path, b: Path) -> bool:
+    """Swap folders ``a`` and ``b`` in one atomic step (Linux); False where unsupported."""
+    if not sys.platform.startswith("linux"):
+        return False
+    fn = getattr(ctypes.CDLL(None, use_errno=True), "renameat2", None)
+    if fn is None:  # a C library older than glibc 2.28
+        return False
+    if fn(_AT_FDCWD, os.fsencode(a), _AT_FDCWD, os.fsencode(b), _RENAME_EXCHANGE) == 0:
+        return True
+    err = ctypes.get_errno()
+    if err in (errno.EINVAL, errno.ENOSYS, errno.ENOENT, errno.EPERM):
+        return False  # file system without exchange, or b gone meanwhile: rename instead
+    raise OSError(err, os.strerror(err), str(b))
+
+
 def _replace_dir(new: Path, target: Path) -> None:
-    """Move folder ``new`` to ``target``, replacing an old ``target`` with two renames."""
-    old = None
-    if target.exists():
+    """Move folder ``new`` to ``target``, replacing an old run folder ``target``.
+
+    Safe against a concurrent writer of the same ``target``: each attempt either renames
+    ``new`` into an absent (or empty) ``target``, or swaps it atomically with the run there,
+    or moves that run aside and tries again; the last complete run wins.  Only ``new`` and
+    folders this call moved aside (all beside ``target``) are ever deleted.
+    """
+    # 100 attempts: each fails only if another writer renamed a run in between, which takes
+    # microseconds; a hundred such collisions in a row means something else is wrong
+    for _ in range(100):
+        try:
+            os.rename(new, target)  # POSIX: succeeds onto an absent or empty folder
+            return
+        except OSError as e:
+            if e.errno not in (errno.ENOTEMPTY, errno.EEXIST, errno.ENOTDIR, errno.EISDIR):
+                raise
+        if not _is_run_folder(target):
+            if not target.exists():
+                continue  # removed meanwhile: try the rename again
+            raise RunStoreError(f"{target}: exists and is not a run folder (no run.json); "
+                                "refusing to replace it")
+        if _exchange(new, target):  # new now holds the old run
+            shutil.rmtree(new, ignore_errors=True)
+            return
         old = Path(tempfile.mkdtemp(prefix=f".{target.name}.", suffix=".old", dir=target.parent))
         os.rmdir(old)
-        os.replace(target, old)
-    os.replace(new, target)
-    if old is not None:
+        try:
+            os.rename(target, old)
+        except FileNotFoundError:
+            continue
         shutil.rmtree(old, ignore_errors=True)
+    raise RunStoreError(f"{target}: could not be replaced (another process keeps writing it)")
 
 
 def _unflatten(arrays: dict[str, np.ndarray], group: str) -> dict[str, Any]:

@@ -22,14 +22,16 @@ from testbed.results import read_results, score_columns
 GROUP_KEYS = ("identifier", "noise")
 
 
-def summarize(path: str | os.PathLike) -> list[dict[str, Any]]:
+def summarize(path: str | os.PathLike, rows: list[dict[str, Any]] | None = None) -> list[dict[str, Any]]:
     """Per (identifier, noise) statistics of a results file.
 
     Parameters
     ----------
     path : path
         Results file of :func:`testbed.sweep.run_sweep` (its unconsolidated parts
-        are read too).
+        are read too; a damaged row file is named in a warning and left out).
+    rows : list of dict, optional
+        Its rows as :func:`~testbed.results.read_results` gave them (not read again).
 
     Returns
     -------
@@ -40,7 +42,7 @@ def summarize(path: str | os.PathLike) -> list[dict[str, Any]]:
         ``<score>_q25``, ``<score>_q75`` and ``<score>_n`` (finite values used);
         NaN where the group has no finite value of that score.
     """
-    rows = read_results(path)
+    rows = read_results(path) if rows is None else rows
     scores = score_columns(rows)
     groups: dict[tuple, list[dict[str, Any]]] = defaultdict(list)
     for r in rows:
@@ -84,7 +86,7 @@ def print_summary(path: str | os.PathLike, console: Any = None) -> list[dict[str
     console = console or Console()
     path = Path(path)
     rows = read_results(path)
-    summary = summarize(path)
+    summary = summarize(path, rows)
     if not rows:
         console.print(f"{path}: no results")
         return summary

@@ -4,11 +4,19 @@ A *cell* is one (scenario, noise level, seed, identifier) of a
 :class:`~testbed.study.Study`.  :func:`run_sweep` sends every cell through one
 joblib seam (:func:`parallel`): sequential for ``jobs=1``, loky processes for
 ``jobs>1``, and a ``distributed.Client`` with joblib's ``"dask"`` backend when a
-scheduler address is given.  It first generates the datasets the cells need,
-one task per distinct dataset (cells that differ only in the identifier share
-their data through the :class:`~testbed.cache.DatasetCache`), then runs the
-cells, writing each row as it arrives (:mod:`testbed.results`).  A rerun skips
-every cell already in the results; a killed sweep loses only the cells in flight.
+scheduler address is given.  It first simulates the clean datasets the cells
+need, one task per distinct rig configuration (cells that differ only in
+identifier, noise level or seed share one simulation through the
+:class:`~testbed.cache.DatasetCache`, which derives each cell's noisy data on
+load), then runs the cells, writing each row as it arrives (:mod:`testbed.results`).
+A rerun skips every cell already in the results; a killed sweep loses only the
+cells in flight.
+
+Faults: a damaged row file (e.g. truncated by a full disk) is named in a warning, set
+aside as ``*.bad`` and its cell run again; ``retry_failed`` runs the cells recorded as
+failed again.  Worker processes watch the sweep's main process and exit within
+:data:`WATCHDOG_PERIOD` seconds of its death (a ``kill -9`` of the sweep included), so no
+worker computes on as an orphan.
 
 With a Dask cluster on several machines, the dataset cache folder must be one
 all workers see (a shared file system); the results are written by the caller.
@@ -19,6 +27,7 @@ from __future__ import annotations
 import contextlib
 import hashlib
 import json
+import logging
 import math
 import os
 import sys
@@ -33,11 +42,16 @@ from typing import Any
 from joblib import Parallel, delayed, parallel_config
 
 from testbed.generate import noise_free_scenario
-from testbed.results import consolidate, parts_dir, read_results, write_part
+from testbed.results import ResultsError, consolidate, parts_dir, read_results, write_part
 from testbed.scenario import Scenario
 from testbed.study import Study, import_plugins, load_study
 
 DEFAULT_RESULTS_DIR = Path("out") / "studies"
+#: How often a worker checks that the sweep's main process is alive [s]: an orphaned worker
+#: stops within this time; a check is one getppid call, so polling costs nothing measurable.
+WATCHDOG_PERIOD = 0.5
+
+log = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True)
@@ -151,25 +165,76 @@ def _error_text(e: BaseException) -> str:
 
 
 _WORKER_LOCK = threading.Lock()
+_WATCHED: set[int] = set()
 
 
-def _prepare_worker(plugins: tuple[str, ...]) -> None:
-    """Import the plugins and load both registries, once per process.
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # exists, owned by someone else (a recycled pid): not our sweep
+        return False
+    return True
+
+
+def watch_parent(parent: int | None, period: float = WATCHDOG_PERIOD) -> None:
+    """In a worker process: exit at once when the sweep's main process ``parent`` is gone.
+
+    Starts one daemon thread per process (later calls do nothing).  A loky worker is a
+    child of the main process, so its parent pid changes the moment the main process dies
+    (the orphan is adopted by init or a subreaper), even while the dead main process is a
+    zombie not yet reaped; a worker that is not a direct child polls ``parent`` itself.  The
+    thread ends the process with ``os._exit``, in the middle of a fit if need be: its cell
+    was not written and a rerun runs it.
+
+    Parameters
+    ----------
+    parent : int or None
+        Pid of the sweep's main process; None (a Dask worker, owned by its cluster) or this
+        process's own pid (a sequential sweep) starts nothing.
+    period : float
+        Seconds between checks.
+    """
+    if parent is None or parent == os.getpid():
+        return
+    with _WORKER_LOCK:
+        if _WATCHED:
+            return
+        _WATCHED.add(parent)
+    ppid = os.getppid()
+    direct = ppid == parent
+
+    def watch() -> None:
+        while (os.getppid() == ppid) if direct else _alive(parent):
+            time.sleep(period)
+        os._exit(3)  # 3: an exit status of its own, distinct from a failing cell's exception
+
+    threading.Thread(target=watch, name="testbed-parent-watchdog", daemon=True).start()
+
+
+def _prepare_worker(plugins: tuple[str, ...], parent: int | None = None) -> None:
+    """Import the plugins and load both registries, once per process; watch ``parent``.
 
     The registries import their packages lazily on first lookup; a Dask worker
     runs tasks in several threads, so the first load is serialised here.
+    See :func:`watch_parent` for ``parent``.
     """
     from identify import IDENTIFIERS
     from models import RIGS
 
+    watch_parent(parent)
     with _WORKER_LOCK:
         import_plugins(plugins)
         RIGS.names()
         IDENTIFIERS.names()
 
 
-def ensure_dataset(scenario: Scenario, cache_dir: str, plugins: tuple[str, ...]) -> tuple[str, float, str]:
-    """Generate ``scenario``'s dataset into the cache unless present.
+def ensure_dataset(scenario: Scenario, cache_dir: str, plugins: tuple[str, ...],
+                   parent: int | None = None) -> tuple[str, float, str]:
+    """Simulate ``scenario``'s clean dataset into the cache unless present (and intact).
+
+    ``parent``: the sweep's main process (see :func:`watch_parent`).
 
     Returns
     -------
@@ -178,21 +243,23 @@ def ensure_dataset(scenario: Scenario, cache_dir: str, plugins: tuple[str, ...])
     """
     from testbed.cache import DatasetCache
 
-    _prepare_worker(plugins)
+    _prepare_worker(plugins, parent)
     t0 = time.perf_counter()
     try:
-        DatasetCache(cache_dir).get(scenario)
+        DatasetCache(cache_dir).clean(scenario)
         err = ""
     except Exception as e:
         err = _error_text(e)
     return scenario.data_hash(), time.perf_counter() - t0, err
 
 
-def run_cell(cell: Cell, cache_dir: str, plugins: tuple[str, ...]) -> dict[str, Any]:
+def run_cell(cell: Cell, cache_dir: str, plugins: tuple[str, ...],
+             parent: int | None = None) -> dict[str, Any]:
     """Run one cell (dataset from the cache, identify, score) and return its results row.
 
     Never raises for a failing cell: an exception, or a non-finite score, gives
-    ``status = "failed"`` with the error text, so the sweep goes on.
+    ``status = "failed"`` with the error text, so the sweep goes on.  ``parent``: the
+    sweep's main process (see :func:`watch_parent`).
     """
     from testbed.cache import DatasetCache
     from testbed.provenance import git_commit, versions
@@ -207,7 +274,7 @@ def run_cell(cell: Cell, cache_dir: str, plugins: tuple[str, ...]) -> dict[str, 
         "dataset_hash": "",
     }
     try:
-        _prepare_worker(plugins)
+        _prepare_worker(plugins, parent)
         from testbed.run import run_scenario
 
         dataset = DatasetCache(cache_dir).get(sc)
@@ -218,12 +285,14 @@ def run_cell(cell: Cell, cache_dir: str, plugins: tuple[str, ...]) -> dict[str, 
         row.update({k: float(v) for k, v in result.scores.values.items()})
         row["checks"] = json.dumps([{**asdict(c), "passed": c.passed} for c in result.checks])
         bad = sorted(k for k, v in result.scores.values.items() if not math.isfinite(v))
-        if bad:
-            row["status"], row["error"] = "failed", "non-finite scores: " + ", ".join(bad)
-        elif not result.scores.values:
-            row["status"], row["error"] = "failed", "no scores"
-        else:
-            row["passed"] = result.passed
+        # a scored failure (fit failed, diverged, non-physical) keeps its reason; non-finite
+        # scores without one are named
+        reasons = [result.failure, bad and "non-finite scores: " + ", ".join(bad),
+                   not result.scores.values and "no scores"]
+        reason = "; ".join(r for r in reasons if r)
+        if reason:
+            row["status"], row["error"] = "failed", reason
+        row["passed"] = result.passed
     except Exception as e:
         row["status"], row["error"] = "failed", _error_text(e)
     row["versions"] = json.dumps(versions(), sort_keys=True)
@@ -280,8 +349,10 @@ class SweepStats:
     ----------
     cells, skipped_done, run, failed : int
         Cells in the grid, already in the results, run now, failed now.
+    failed_total : int
+        Cells recorded as failed in the results at the end (now or by an earlier run).
     datasets : int
-        Datasets generated (absent from the cache).
+        Clean simulations run (absent from the cache); noisy datasets are derived, not counted.
     data_seconds, cells_seconds : float
         Wall time of the dataset phase and of the cell phase [s].
     """
@@ -290,6 +361,7 @@ class SweepStats:
     skipped_done: int = 0
     run: int = 0
     failed: int = 0
+    failed_total: int = 0
     datasets: int = 0
     data_seconds: float = 0.0
     cells_seconds: float = 0.0
@@ -322,7 +394,8 @@ def run_sweep(study: Study | str | os.PathLike, jobs: int = 1, dask_address: str
     cache_dir : path, optional
         Dataset cache folder (default :func:`testbed.cache.default_cache_dir`).
     retry_failed : bool
-        Run the cells recorded as failed again.
+        Run the cells recorded as failed again.  (Cells whose row file is damaged run
+        again anyway: the file is named in a warning and set aside as ``*.bad``.)
     verbose : bool
         One line on stderr about what is skipped and run.
     stats : SweepStats, optional
@@ -332,7 +405,10 @@ def run_sweep(study: Study | str | os.PathLike, jobs: int = 1, dask_address: str
     -------
     Path
         The consolidated results file: one row per cell of the study's grid (rows of
-        cells no longer in the grid, e.g. after editing the study, are dropped).
+        cells no longer in the grid, e.g. after editing the study, are dropped).  Failed
+        cells do not raise; see ``stats.failed_total``.  If the sweep itself is interrupted
+        by an exception (e.g. a worker killed from outside), the rows that finished are
+        consolidated before it propagates.
     """
     from testbed.cache import DatasetCache
 
@@ -347,7 +423,14 @@ def run_sweep(study: Study | str | os.PathLike, jobs: int = 1, dask_address: str
     if parts_dir(results).is_dir():  # temporary files of a write that was killed
         for tmp in parts_dir(results).glob(".*.tmp"):
             tmp.unlink(missing_ok=True)
-    done = {r["cell"] for r in read_results(results) if not (retry_failed and r["status"] == "failed")}
+    try:
+        previous = read_results(results, set_aside=True)
+    except ResultsError as e:  # a damaged consolidated file: keep it aside, rerun its cells
+        bad = results.with_name(results.name + ".bad")
+        os.replace(results, bad)
+        log.warning("%s; set aside as %s, its cells will run again", e, bad.name)
+        previous = read_results(results, set_aside=True)
+    done = {r["cell"] for r in previous if not (retry_failed and r["status"] == "failed")}
     todo = [c for c in cells if c.key not in done]
     skipped = study.skipped()
     _say(f"sweep {study.name}: {len(cells)} cells ({len(skipped) * len(study.noise) * len(study.seeds)} "
@@ -357,45 +440,52 @@ def run_sweep(study: Study | str | os.PathLike, jobs: int = 1, dask_address: str
     stats = stats if stats is not None else SweepStats()
     stats.cells, stats.skipped_done, stats.run = len(cells), len(cells) - len(todo), len(todo)
     stats.failed = 0
-    missing: dict[str, Scenario] = {}
+    # Every dataset derives from its configuration's clean simulation, the one file the cache
+    # holds for it (testbed.cache): simulate each missing one once, in parallel, before the
+    # cells, so that two workers never simulate the same configuration.
+    missing: dict[Path, Scenario] = {}
     for c in todo:
-        if c.scenario.data_hash() not in missing and not cache.path(c.scenario).is_file():
-            missing[c.scenario.data_hash()] = c.scenario
-    # Noisy datasets derive from their configuration's noise-free simulation (testbed.cache):
-    # simulate each of those once, in parallel, before deriving the rest, so that two workers
-    # never simulate the same configuration.
-    clean: dict[str, Scenario] = {}
-    for s in missing.values():
-        cs = noise_free_scenario(s)
-        if not cache.path(cs).is_file():
-            clean.setdefault(cs.data_hash(), cs)
-    stages = [list(clean.values()), [s for h, s in missing.items() if h not in clean]]
+        p = cache.path(c.scenario)
+        if p not in missing and not p.is_file():
+            missing[p] = noise_free_scenario(c.scenario)
     stats.datasets = len(missing)
     # Longest-processing-time-first: dispatch the cells expected to take longest first, so that
     # no worker is left with a long cell at the end.  The order changes no row.
     todo = sorted(todo, key=_expected_cost, reverse=True)
-    with _backend(jobs, dask_address) as n_jobs:
-        t0 = time.perf_counter()
-        if missing:
-            bar = _Progress("datasets", len(missing) + len(clean) - len(set(clean) & set(missing)))
-            try:
-                for stage in stages:
-                    for _, _, err in parallel(ensure_dataset, [(s, cache_path, study.plugins)
-                                                               for s in stage], n_jobs):
+    # workers of a local pool watch this process; Dask workers belong to their cluster
+    parent = os.getpid() if not dask_address and jobs > 1 else None
+    try:
+        with _backend(jobs, dask_address) as n_jobs:
+            t0 = time.perf_counter()
+            if missing:
+                bar = _Progress("datasets", len(missing))
+                try:
+                    for _, _, err in parallel(ensure_dataset, [(s, cache_path, study.plugins, parent)
+                                                               for s in missing.values()], n_jobs):
                         bar.advance(bool(err))
+                finally:
+                    bar.close()
+            t1 = time.perf_counter()
+            bar = _Progress(f"{study.name}", len(todo))
+            try:
+                for row in parallel(run_cell, [(c, cache_path, study.plugins, parent) for c in todo],
+                                    n_jobs):
+                    write_part(results, row)
+                    stats.failed += row["status"] != "ok"
+                    bar.advance(row["status"] != "ok")
             finally:
                 bar.close()
-        t1 = time.perf_counter()
-        bar = _Progress(f"{study.name}", len(todo))
-        try:
-            for row in parallel(run_cell, [(c, cache_path, study.plugins) for c in todo], n_jobs):
-                write_part(results, row)
-                stats.failed += row["status"] != "ok"
-                bar.advance(row["status"] != "ok")
-        finally:
-            bar.close()
-        stats.data_seconds, stats.cells_seconds = t1 - t0, time.perf_counter() - t1
+            stats.data_seconds, stats.cells_seconds = t1 - t0, time.perf_counter() - t1
+    except Exception:
+        # keep what finished in the results file (atomically), then report the interruption
+        with contextlib.suppress(Exception):
+            consolidate(results, keep={c.key for c in cells}, study=study.name)
+        raise
     _, dropped = consolidate(results, keep={c.key for c in cells}, study=study.name)
     if dropped:
         _say(f"dropped {dropped} row(s) of cells no longer in study {study.name}", verbose)
+    stats.failed_total = sum(r["status"] != "ok" for r in read_results(results))
+    if stats.failed_total:
+        _say(f"{stats.failed_total} cell(s) failed; `testbed sweep --retry-failed` runs them again",
+             verbose)
     return results

@@ -20,10 +20,13 @@ def test_noisy_dataset_from_cached_clean_simulation_is_bit_identical(tmp_path):
     assert derived.content_hash() == direct.content_hash()
     for name, s in direct.measured.items():
         np.testing.assert_array_equal(derived.measured[name].data, s.data)
-    # one clean and one noisy file; a second noisy seed adds a file but no simulation
-    assert len(cache.entries()) == 2
+    # the cache holds the clean simulation only; noisy copies are derived on load, so a second
+    # noisy seed (or noise level) adds neither a file nor a simulation
+    assert len(cache.entries()) == 1
     other = cache.get(sc.replace(seed=8))
-    assert len(cache.entries()) == 3
+    assert len(cache.entries()) == 1
+    assert cache.get(sc.with_noise(0.0)).content_hash() == generate(sc.with_noise(0.0)).content_hash()
+    assert len(cache.entries()) == 1
     assert not np.array_equal(other.measured["acceleration"].data, derived.measured["acceleration"].data)
     np.testing.assert_array_equal(other.reference["acceleration"].data,
                                   derived.reference["acceleration"].data)
@@ -35,4 +38,4 @@ def test_cache_hit_loads_and_clear_removes(tmp_path):
     first = cache.get(sc)
     again = cache.get(sc)
     assert again.content_hash() == first.content_hash()
-    assert cache.clear() == 2 and cache.entries() == []
+    assert cache.clear() == 1 and cache.entries() == []

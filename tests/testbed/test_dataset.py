@@ -95,3 +95,22 @@ def test_failed_overwrite_keeps_the_old_file(tmp_path, monkeypatch):
     with pytest.raises(OSError):
         _dataset(seed=1).save(target)
     assert target.read_bytes() == before
+
+
+def test_format_1_file_still_loads_and_is_verified_with_its_own_hash(tmp_path):
+    """A file written before the hash covered data only (format /1) is read, not called altered."""
+    from testbed.dataset import DatasetError
+
+    ds = _dataset()
+    p = ds.save(tmp_path / "old.h5")
+    legacy = ds._legacy_content_hash()
+    assert legacy != ds.content_hash()  # the /1 hash also covered the scenario's name
+    with h5py.File(p, "r+") as f:
+        f.attrs["format"] = "sysid-testbed-dataset/1"
+        f.attrs["content_hash"] = legacy
+    back = Dataset.load(p)
+    assert back.attrs["content_hash"] == ds.content_hash()
+    with h5py.File(p, "r+") as f:
+        f.attrs["content_hash"] = "0" * 64
+    with pytest.raises(DatasetError, match="does not match its stored content hash"):
+        Dataset.load(p)

@@ -285,7 +285,9 @@ def test_cli_summary_of_a_sweep(toy_dir, tmp_path, capsys):
 
     study = write_study(toy_dir, "cli", ["toy_fit", "toy_raise"], seeds=(0,), noise=(0.0,))
     res = tmp_path / "cli.parquet"
-    assert main(["sweep", str(study), "--results", str(res), "--cache", str(tmp_path / "c")]) == 0
+    # toy_raise fails its cell: the sweep writes every row, then exits with status 1
+    assert main(["sweep", str(study), "--results", str(res), "--cache", str(tmp_path / "c")]) == 1
+    assert len(read_results(res)) == 2
     assert main(["summary", str(res)]) == 0
     out = capsys.readouterr().out
     assert "toy_fit" in out and "toy_raise" in out and "told to fail" in out

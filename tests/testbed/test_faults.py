@@ -1,0 +1,556 @@
+"""Fault injection: damaged stored data, a killed sweep, concurrent runs, run names that escape.
+
+Each test breaks something the way the world does (a file cut short, a flipped bit, a
+``kill -9``, two users at once, a hostile file name) and asserts the testbed notices,
+says which file, repairs what it can and never loses or mixes up finished work.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import math
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+from dataclasses import replace
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+
+sys.path.insert(0, str(Path(__file__).parent))
+import _synthetic_runs as synth
+
+from testbed.cache import DatasetCache
+from testbed.dataset import Dataset, DatasetError
+from testbed.generate import generate
+from testbed.results import ResultsError, parts_dir, read_results, write_part
+from testbed.runstore import RunStoreError, load_run, run_folder, save_run
+from testbed.scenario import load_scenario
+from testbed.study import load_study
+from testbed.summary import summarize
+from testbed.sweep import SweepStats, run_sweep
+
+ROOT = Path(__file__).resolve().parents[2]
+# Columns that legitimately differ between two runs of the same cell.
+TIMING = ("fit_time", "data_time", "cell_time")
+
+
+def _env(**extra: str) -> dict[str, str]:
+    """The environment of a subprocess: this checkout first on the import path, one thread."""
+    path = os.pathsep.join(p for p in (str(ROOT), os.environ.get("PYTHONPATH", "")) if p)
+    return {**os.environ, "PYTHONPATH": path, "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1",
+            **extra}
+
+
+def _short(noise: float = 2.0, seed: int = 7):
+    """The stiff cantilever over 0.05 s (a fraction of a second to simulate)."""
+    sc = load_scenario("cantilever_stiff_impact")
+    return sc.replace(simulation={**sc.simulation, "duration": 0.05}).with_noise(noise).replace(seed=seed)
+
+
+def _assert_same_data(a: Dataset, b: Dataset) -> None:
+    assert a.content_hash() == b.content_hash()
+    for group in ("measured", "reference"):
+        ga, gb = getattr(a, group), getattr(b, group)
+        assert ga.keys() == gb.keys()
+        for name in ga:
+            np.testing.assert_array_equal(ga[name].data, gb[name].data)
+
+
+# --------------------------------------------------------------------------- stored datasets
+def test_truncated_cache_entry_is_simulated_again_with_a_warning(tmp_path, caplog):
+    sc = _short()
+    cache = DatasetCache(tmp_path)
+    first = cache.get(sc)
+    (path, size), = cache.entries()
+    with open(path, "r+b") as f:  # a copy cut short, a full disk
+        f.truncate(size // 2)
+    with pytest.raises(DatasetError, match="unreadable dataset file") as e:
+        Dataset.load(path)
+    assert str(path) in str(e.value)
+    with caplog.at_level(logging.WARNING, logger="testbed.cache"):
+        again = cache.get(sc)
+    warnings = [r.getMessage() for r in caplog.records if r.name == "testbed.cache"]
+    assert len(warnings) == 1 and str(path) in warnings[0] and "\n" not in warnings[0]
+    _assert_same_data(again, first)
+    Dataset.load(path)  # repaired in place
+    assert [p for p, _ in cache.entries()] == [path]
+
+
+def test_flipped_bits_in_a_cached_array_are_caught_by_the_content_hash(tmp_path, caplog):
+    sc = _short()
+    cache = DatasetCache(tmp_path)
+    first = cache.get(sc)
+    path = cache.path(sc)
+    with h5py.File(path, "r") as f:  # where the raw samples of one signal sit in the file
+        offset = f["measured/acceleration"].id.get_offset()
+    assert offset is not None
+    with open(path, "r+b") as f:
+        f.seek(offset + 8 * 10)  # the 11th sample, last byte of its mantissa's low end
+        byte = f.read(1)
+        f.seek(offset + 8 * 10)
+        f.write(bytes([byte[0] ^ 0x01]))
+    with pytest.raises(DatasetError, match="does not match its stored content hash"):
+        Dataset.load(path)
+    assert Dataset.load(path, verify=False).measured  # still readable: only the hash can tell
+    with caplog.at_level(logging.WARNING, logger="testbed.cache"):
+        again = cache.get(sc)
+    assert any(str(path) in r.getMessage() for r in caplog.records if r.name == "testbed.cache")
+    _assert_same_data(again, first)
+
+
+def test_loading_a_file_that_is_not_a_dataset_names_it(tmp_path):
+    junk = tmp_path / "notes.h5"
+    junk.write_text("not HDF5 at all\n")
+    with pytest.raises(DatasetError, match="unreadable dataset file") as e:
+        Dataset.load(junk)
+    assert str(junk) in str(e.value)
+    other = tmp_path / "other.h5"
+    with h5py.File(other, "w") as f:
+        f.attrs["format"] = "something-else"
+    with pytest.raises(DatasetError, match="not a sysid-testbed-dataset"):
+        Dataset.load(other)
+    with pytest.raises(DatasetError, match="no such file"):
+        Dataset.load(tmp_path / "absent.h5")
+
+
+def test_content_hash_names_the_data_not_the_identifier_or_thresholds(tmp_path):
+    sc = _short()
+    cache = DatasetCache(tmp_path)
+    a = cache.get(sc)
+    b = cache.get(sc.replace(name="renamed", description="x", identify={"method": "lsq_structural"},
+                             score={"mac_min": 0.5}, signal={**sc.signal}))
+    assert a.content_hash() == b.content_hash()
+    assert a.attrs["scenario"] != b.attrs["scenario"]  # the provenance still tells them apart
+    assert cache.get(sc.replace(seed=8)).content_hash() != a.content_hash()
+
+
+def test_noisy_fivebar_from_the_cache_is_bit_identical_to_a_fresh_one(tmp_path):
+    """The five-bar's rig returns transposed arrays; the noise's RMS must not depend on that."""
+    sc = load_scenario("fivebar_multisine_noise1")
+    sc = sc.replace(simulation={**sc.simulation, "duration": 0.5}, seed=3)
+    cache = DatasetCache(tmp_path)
+    cache.get(sc.with_noise(0.0))  # the clean entry, stored and then read back from HDF5
+    derived = cache.get(sc)
+    fresh = generate(sc)
+    _assert_same_data(derived, fresh)
+    assert derived.content_hash() == fresh.attrs["content_hash"]
+
+
+def test_concurrent_writers_and_readers_of_one_cache_entry(tmp_path):
+    """Processes filling one key at once all finish; a reader never meets a half-written file."""
+    from concurrent.futures import ProcessPoolExecutor
+
+    sc = _short()
+    cache = DatasetCache(tmp_path)
+    want = generate(sc)
+    with ProcessPoolExecutor(3) as ex:  # three cold processes race for the same entry
+        got = list(ex.map(_fill_and_read, [(str(tmp_path), sc)] * 3))
+    assert got == [(want.content_hash(), 0)] * 3  # 0: no reader found a damaged entry
+    assert [p for p, _ in cache.entries()] == [cache.path(sc)]
+    assert [p.name for p in tmp_path.iterdir()] == [cache.path(sc).name], "no temporary file left"
+
+
+def _fill_and_read(args) -> tuple[str, int]:
+    """Fill the entry, then rewrite and read it back 5 times: (content hash, warnings logged)."""
+    directory, sc = args
+    warned: list[logging.LogRecord] = []
+    handler = logging.Handler(logging.WARNING)
+    handler.emit = warned.append
+    logging.getLogger("testbed.cache").addHandler(handler)
+    cache = DatasetCache(directory)
+    ds = cache.get(sc)
+    for _ in range(5):
+        cache.clean(sc).save(cache.path(sc))  # another writer's atomic replace, over and over
+        assert cache.get(sc).content_hash() == ds.content_hash()
+    return ds.content_hash(), len(warned)
+
+
+def test_generate_to_a_file_fills_the_run_cache(tmp_path):
+    from testbed.cli import main
+
+    variant = tmp_path / "short.toml"
+    variant.write_text(textwrap.dedent(f"""
+        [scenario]
+        extends = "{ROOT / 'scenarios' / 'cantilever_stiff_impact.toml'}"
+        name = "short"
+        [simulation]
+        duration = 0.05
+        [noise]
+        rms_percent = 1.0
+    """))
+    out, cache_dir = tmp_path / "d.h5", tmp_path / "cache"
+    assert main(["generate", str(variant), "-o", str(out), "--cache", str(cache_dir)]) == 0
+    cache = DatasetCache(cache_dir)
+    assert len(cache.entries()) == 1
+    sc = load_scenario(variant)
+    _assert_same_data(Dataset.load(out), cache.get(sc))
+    assert len(cache.entries()) == 1
+
+
+# --------------------------------------------------------------------------- sweeps
+# A "mechanical" toy, as in test_sweep.py but under names of its own (one registration per
+# process): four undamped oscillators, an identifier fitting k_i by least squares.
+# fault_slow sleeps $FAULT_SLOW_SECONDS per fit: long while a sweep is to be killed, zero
+# when it resumes (the rows do not depend on it).
+PLUGIN = '''
+import os
+import time
+import numpy as np
+from identify import IDENTIFIERS
+from identify._base import Identifier
+from models import RIGS
+from models._base import Rig
+from testbed.dataset import Dataset, Signal
+from testbed.measurement import Trajectory
+from testbed.schema import Field
+
+NAMES = ["th1", "ddth1", "th2", "ddth2", "th3", "ddth3", "th4", "ddth4"]
+
+
+@RIGS.register("fault_osc")
+class FaultOscillators(Rig):
+    kind = "mechanical"
+    rig_schema = {"omega": Field(float, 3.0, min=0.1)}
+    simulation_schema = {"n_samples": Field(int, 400, min=10), "fs": Field(float, 100.0)}
+    excitation_schemas = {"none": {}}
+    default_excitation = "none"
+    measured_signals = ("theta", "dtheta", "ddtheta", "torque")
+    noisy_signals = ("theta", "ddtheta")
+
+    def simulate(self, progress=None):
+        sc = self.scenario
+        n, fs = sc.simulation["n_samples"], sc.simulation["fs"]
+        w = sc.rig_params["omega"] * np.arange(1, 5)[:, None]
+        t = np.arange(n) / fs
+        th = np.sin(w * t + 0.3)
+        ch = ("th1", "th2", "th3", "th4")
+        measured = {"theta": Signal(th, ch, "rad"), "dtheta": Signal(w * np.cos(w * t + 0.3), ch, "rad/s"),
+                    "ddtheta": Signal(-w**2 * th, ch, "rad/s^2"),
+                    "torque": Signal(np.zeros((2, n)), ("u1", "u2"), "N m")}
+        coef = np.zeros((4, 8))
+        for i in range(4):
+            coef[i, 2 * i], coef[i, 2 * i + 1] = w[i, 0] ** 2, 1.0
+        return Dataset(fs, measured, truth={"equation_terms": NAMES, "equation_coef": coef})
+
+
+@IDENTIFIERS.register("fault_fit")
+class FaultFit(Identifier):
+    kind = "mechanical"
+
+    def __init__(self, delay: float = 0.0):
+        self.delay = delay
+
+    def pause(self):
+        time.sleep(self.delay)
+
+    def fit(self, data):
+        self.pause()
+        x, xdd = data.x, data.xdd
+        k = -np.sum(x * xdd, axis=1) / np.sum(x * x, axis=1)
+        self.k_ = k
+        self.feature_names_ = NAMES
+        coef = np.zeros((4, 8))
+        for i in range(4):
+            coef[i, 2 * i], coef[i, 2 * i + 1] = k[i], 1.0
+        self.coef_ = coef
+        return self
+
+    def simulate(self, x0, xd0, t, u=None):
+        w = np.sqrt(np.abs(self.k_))[:, None]
+        x = x0[:, None] * np.cos(w * t) + (xd0[:, None] / w) * np.sin(w * t)
+        xd = -x0[:, None] * w * np.sin(w * t) + xd0[:, None] * np.cos(w * t)
+        return Trajectory(x, xd, -w**2 * x)
+
+    def equations(self, precision=4):
+        return [f"ddth{i + 1} = {-k:.{precision}g} th{i + 1}" for i, k in enumerate(self.k_)]
+
+
+@IDENTIFIERS.register("fault_slow")
+class FaultSlow(FaultFit):
+    def pause(self):
+        time.sleep(float(os.environ.get("FAULT_SLOW_SECONDS", "0")))
+'''
+
+SCENARIO = """
+[scenario]
+name = "fault_a"
+rig = "fault_osc"
+[simulation]
+n_samples = 400
+[score]
+angle_rmse_max = 0.05
+"""
+
+
+@pytest.fixture(scope="module")
+def fault_dir(tmp_path_factory) -> Path:
+    d = tmp_path_factory.mktemp("faults")
+    (d / "faults.py").write_text(PLUGIN)
+    (d / "fault_a.toml").write_text(SCENARIO)
+    return d
+
+
+def _study(d: Path, name: str, identifiers: list[str], *, seeds=(0, 1), noise=(0.0, 2.0),
+           delay: float = 0.0) -> Path:
+    path = d / f"{name}.toml"
+    path.write_text("\n".join([
+        "[study]", f'name = "{name}"', 'scenarios = ["fault_a.toml"]', f"noise = {json.dumps(list(noise))}",
+        f"seeds = {json.dumps(list(seeds))}", f"identifiers = {json.dumps(identifiers)}",
+        'plugins = ["faults.py"]', "[identifiers.fault_fit]", f"delay = {delay}"]) + "\n")
+    return path
+
+
+def _comparable(rows: list[dict]) -> list[dict]:
+    """Rows without the timing columns, NaN made comparable."""
+    return sorted(({k: ("nan" if isinstance(v, float) and math.isnan(v) else v)
+                    for k, v in r.items() if k not in TIMING} for r in rows), key=lambda r: r["cell"])
+
+
+def _as_killed(results: Path) -> None:
+    """Turn a finished results file back into what a killed sweep leaves: row files only."""
+    for row in read_results(results):
+        write_part(results, row)
+    results.unlink()
+
+
+def test_truncated_row_file_is_named_set_aside_and_its_cell_run_again(fault_dir, tmp_path, caplog):
+    study = load_study(_study(fault_dir, "parts", ["fault_fit"]))
+    res, cache = tmp_path / "r.parquet", tmp_path / "c"
+    whole = read_results(run_sweep(study, results=res, cache_dir=cache, verbose=False))
+    _as_killed(res)
+    victim = sorted(parts_dir(res).glob("*.json"))[1]
+    victim.write_bytes(victim.read_bytes()[:40])  # cut short mid-row
+
+    # summary reads what it can, naming the file it skips, and changes nothing on disk
+    with caplog.at_level(logging.WARNING, logger="testbed.results"):
+        summary = summarize(res)
+    assert sum(s["cells"] for s in summary) == 3
+    assert any(str(victim) in r.getMessage() for r in caplog.records)
+    assert victim.is_file()
+
+    caplog.clear()
+    stats = SweepStats()
+    with caplog.at_level(logging.WARNING, logger="testbed.results"):
+        rows = read_results(run_sweep(study, results=res, cache_dir=cache, verbose=False, stats=stats))
+    named = [r.getMessage() for r in caplog.records if str(victim) in r.getMessage()]
+    assert len(named) == 1 and "set aside" in named[0]
+    assert (stats.skipped_done, stats.run) == (3, 1)
+    assert _comparable(rows) == _comparable(whole)
+    assert [p.name for p in parts_dir(res).iterdir()] == [victim.name + ".bad"]  # evidence kept
+
+
+def test_damaged_results_file_is_named_by_summary_and_set_aside_by_sweep(fault_dir, tmp_path):
+    from testbed.cli import main
+
+    study = load_study(_study(fault_dir, "whole", ["fault_fit"], seeds=(0,)))
+    res, cache = tmp_path / "r.parquet", tmp_path / "c"
+    whole = read_results(run_sweep(study, results=res, cache_dir=cache, verbose=False))
+    res.write_bytes(res.read_bytes()[:100])
+    with pytest.raises(ResultsError, match="unreadable results file"):
+        read_results(res)
+    assert main(["summary", str(res)]) == 2  # one clear line naming the file, no traceback
+    stats = SweepStats()
+    rows = read_results(run_sweep(study, results=res, cache_dir=cache, verbose=False, stats=stats))
+    assert stats.run == 2 and _comparable(rows) == _comparable(whole)
+    assert res.with_name(res.name + ".bad").is_file()
+
+
+def test_retry_failed_flag_reruns_failed_cells_and_exit_status(fault_dir, tmp_path, capsys):
+    from testbed.cli import main
+
+    study = _study(fault_dir, "retry", ["fault_fit"], seeds=(0,))
+    res = tmp_path / "r.parquet"
+    args = ["sweep", str(study), "--results", str(res), "--cache", str(tmp_path / "c")]
+    assert main(args) == 0
+    rows = read_results(res)
+    # mark one cell failed, as a crash in an earlier run would have
+    rows[0].update(status="failed", error="RuntimeError: earlier crash", passed=False)
+    _as_killed(res)
+    write_part(res, rows[0])
+    assert main(args) == 1  # still failed: reported, not rerun
+    assert "1 cell(s) failed" in capsys.readouterr().err
+    assert main([*args, "--retry-failed"]) == 0
+    assert all(r["status"] == "ok" for r in read_results(res))
+
+
+def test_sweep_interrupted_by_an_error_keeps_the_rows_that_finished(fault_dir, tmp_path, monkeypatch):
+    """A lost worker (here: an error after two rows) ends the sweep; the two rows are consolidated."""
+    import testbed.sweep as sw
+
+    real = sw.parallel
+
+    def lossy(fn, args, n_jobs):
+        for i, out in enumerate(real(fn, args, n_jobs)):
+            if fn is sw.run_cell and i == 2:
+                raise RuntimeError("worker lost")
+            yield out
+
+    monkeypatch.setattr(sw, "parallel", lossy)
+    study = load_study(_study(fault_dir, "lossy", ["fault_fit"]))
+    res = tmp_path / "r.parquet"
+    with pytest.raises(RuntimeError, match="worker lost"):
+        run_sweep(study, results=res, cache_dir=tmp_path / "c", verbose=False)
+    assert res.is_file() and not parts_dir(res).exists()
+    assert len(read_results(res)) == 2
+    monkeypatch.setattr(sw, "parallel", real)
+    stats = SweepStats()
+    assert len(read_results(run_sweep(study, results=res, cache_dir=tmp_path / "c", verbose=False,
+                                      stats=stats))) == 4
+    assert stats.run == 2
+
+
+def _group_alive(pgid: int) -> list[int]:
+    """Pids of live (not zombie) processes in process group ``pgid``."""
+    try:
+        import psutil
+    except ImportError:
+        psutil = None
+    out = []
+    if psutil is not None:
+        for p in psutil.process_iter(["pid", "status"]):
+            try:
+                if os.getpgid(p.info["pid"]) == pgid and p.info["status"] != psutil.STATUS_ZOMBIE:
+                    out.append(p.info["pid"])
+            except (ProcessLookupError, psutil.Error):
+                continue
+        return out
+    for d in Path("/proc").iterdir():
+        if not d.name.isdigit():
+            continue
+        try:
+            fields = (d / "stat").read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        if int(fields[2]) == pgid and fields[0] != "Z":  # fields: state, ppid, pgrp, ...
+            out.append(int(d.name))
+    return out
+
+
+@pytest.mark.slow
+def test_kill_9_of_a_two_worker_sweep_leaves_no_worker_and_resumes_exactly(fault_dir, tmp_path,
+                                                                           monkeypatch):
+    """SIGKILL `testbed sweep --jobs 2` while both workers are in a long fit; nothing survives."""
+    # 4 quick cells (0.2 s fits) run first (grid order), then 4 cells whose fit sleeps 600 s: the
+    # kill lands mid-fit, where a worker that does not watch its parent would sleep on for minutes
+    study = _study(fault_dir, "kill2", ["fault_fit", "fault_slow"], delay=0.2)
+    res, cache = tmp_path / "killed.parquet", tmp_path / "cache"
+    cmd = [sys.executable, "-m", "testbed.cli", "sweep", str(study), "--jobs", "2", "--results", str(res),
+           "--cache", str(cache)]
+    proc = subprocess.Popen(cmd, cwd=ROOT, env=_env(FAULT_SLOW_SECONDS="600"), start_new_session=True,
+                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    try:
+        deadline = time.monotonic() + 90
+        while (len(list(parts_dir(res).glob("*.json"))) if parts_dir(res).is_dir() else 0) < 4:
+            assert proc.poll() is None and time.monotonic() < deadline, proc.stderr.read().decode()
+            time.sleep(0.05)
+        time.sleep(1.0)  # both workers are now inside a 600 s fit
+        assert len(_group_alive(proc.pid)) >= 3, "expected the main process and two workers"
+        os.kill(proc.pid, signal.SIGKILL)
+        proc.wait(timeout=10)
+        t_kill = time.monotonic()
+        while _group_alive(proc.pid) and time.monotonic() < t_kill + 10:
+            time.sleep(0.1)
+        left = _group_alive(proc.pid)
+        assert not left, f"processes still running 10 s after the kill: {left}"
+    finally:
+        with __import__("contextlib").suppress(ProcessLookupError):
+            os.killpg(proc.pid, signal.SIGKILL)  # whatever the assertion found, stop it
+        proc.stderr.close()
+
+    n_before = len(read_results(res))
+    assert n_before == 4 and not res.exists()
+    out = subprocess.run(cmd, cwd=ROOT, env=_env(FAULT_SLOW_SECONDS="0"), capture_output=True, text=True,
+                         timeout=120)
+    assert out.returncode == 0, out.stderr
+    assert "4 already done, 4 to run" in out.stderr
+    resumed = read_results(res)
+    monkeypatch.setenv("FAULT_SLOW_SECONDS", "0")
+    whole = read_results(run_sweep(load_study(study), results=tmp_path / "whole.parquet", cache_dir=cache,
+                                   verbose=False))
+    assert len(resumed) == 8 and all(r["status"] == "ok" for r in resumed)
+    assert _comparable(resumed) == _comparable(whole)
+
+
+# --------------------------------------------------------------------------- run folders
+@pytest.fixture(scope="module")
+def mechanical():
+    return synth.mechanical_result(n_samples=400)
+
+
+def test_a_run_named_dot_or_dotdot_never_touches_the_output_folder(mechanical, tmp_path):
+    out = tmp_path / "runs"
+    save_run(mechanical, out / "other", figures=False)
+    (tmp_path / "keep.txt").write_text("not a run")
+    for name in (".", "..", "", ".hidden", "a/b", "../escape"):
+        with pytest.raises(RunStoreError):
+            run_folder(out, name)
+    # save_run called directly with such names: refused, nothing replaced or deleted
+    for target in (out / ".", out / "..", f"{out}/.", f"{out}/..", tmp_path):
+        with pytest.raises(RunStoreError):
+            save_run(mechanical, target, figures=False)
+    assert sorted(p.name for p in out.iterdir()) == ["other"]
+    assert load_run(out / "other").fit_time == mechanical.fit_time
+    assert (tmp_path / "keep.txt").read_text() == "not a run"
+    # a link inside the output folder that points out of it is not a way out either
+    (tmp_path / "elsewhere").mkdir()
+    (out / "sneaky").symlink_to(tmp_path / "elsewhere")
+    with pytest.raises(RunStoreError, match="outside the output folder"):
+        run_folder(out, "sneaky")
+    assert run_folder(out, "fine_name") == out / "fine_name"
+
+
+def test_cli_run_of_a_scenario_named_dot_leaves_every_other_run(mechanical, tmp_path, capsys):
+    """`testbed run ..toml` (name ".") once replaced the whole output folder; now it is refused."""
+    from testbed.cli import main
+
+    out = tmp_path / "runs"
+    save_run(mechanical, out / "other", figures=False)
+    dot = tmp_path / "..toml"
+    dot.write_text(f'[scenario]\nextends = "{ROOT / "scenarios" / "cantilever_stiff_impact_lsq.toml"}"\n'
+                   'name = "."\n')
+    assert main(["run", str(dot), "--no-figures", "--no-cache", "-o", str(out)]) == 2
+    assert "error:" in capsys.readouterr().err
+    assert [p.name for p in out.iterdir()] == ["other"] and load_run(out / "other")
+
+
+def test_concurrent_writers_of_one_run_folder_leave_one_complete_run(mechanical, tmp_path):
+    """Eight threads save the same run at once (distinct fit times): each succeeds, one wins whole."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    d = tmp_path / "runs" / "same"
+    save_run(mechanical, d, figures=False)
+    with ThreadPoolExecutor(8) as ex:
+        done = list(ex.map(lambda i: save_run(replace(mechanical, fit_time=100.0 + i), d, figures=False),
+                           range(8)))
+    assert done == [d] * 8
+    run = load_run(d)
+    assert run.fit_time in {100.0 + i for i in range(8)}
+    assert sorted(p.name for p in d.iterdir()) == ["run.json", "run.npz"]
+    assert [p.name for p in d.parent.iterdir()] == ["same"], "no temporary folders left"
+
+
+@pytest.mark.slow
+def test_two_concurrent_testbed_runs_of_one_scenario(tmp_path):
+    """Two `testbed run` processes of one scenario and cache: both give a verdict, one run stays."""
+    cache, out = tmp_path / "cache", tmp_path / "runs"
+    cmd = [sys.executable, "-m", "testbed.cli", "run", "cantilever_stiff_impact_lsq", "--no-figures",
+           "--cache", str(cache), "-o", str(out)]
+    procs = [subprocess.Popen(cmd, cwd=ROOT, env=_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                              text=True) for _ in range(2)]
+    results = [p.communicate(timeout=300) for p in procs]
+    for p, (stdout, stderr) in zip(procs, results, strict=True):
+        assert p.returncode in (0, 1) and "Traceback" not in stderr, stderr
+        assert "run written to" in stdout
+    assert [p.name for p in out.iterdir()] == ["cantilever_stiff_impact_lsq"]
+    run = load_run(out / "cantilever_stiff_impact_lsq")
+    assert sorted(p.name for p in run.path.iterdir()) == ["run.json", "run.npz"]
+    assert run.scenario["name"] == "cantilever_stiff_impact_lsq"
+    assert [p.name for p in cache.iterdir()] == [DatasetCache(cache).path(
+        load_scenario("cantilever_stiff_impact_lsq")).name], "one whole cache entry, no temporary file"
