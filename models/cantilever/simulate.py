@@ -79,7 +79,7 @@ IMPLICIT_MARGIN = 0.8      # fraction of implicitfast's per-mode stability limit
 IMPLICIT_ACCURACY = 0.109  # omega_Nyquist dt: (0.109)^2 / 24 = 5.0e-4 (undamped frequency error)
 RK4_STEP_COST = 2.8        # one RK4 step in implicitfast steps (2.7-2.9 measured at N = 10-60)
 AUTO_RK4_PREMIUM = 2.0     # auto keeps RK4 (4th order) while it costs at most 2x implicitfast
-CHUNK_STEPS = 1 << 16      # integration steps per rollout call (bounds the state buffer)
+CHUNK_BYTES = 1 << 26      # rollout output per call, 64 MiB (states + sensors of every step)
 PROPORTIONAL_TOL = 1e-9    # off-diagonal / diagonal of Phi^T C Phi below this: modal damping
 
 
@@ -314,7 +314,7 @@ def rollout_sensors(model: mujoco.MjModel, qpos0: np.ndarray, control: np.ndarra
     ------
     RigError
         If MuJoCo reset the simulation or refused the control (:func:`check_warnings`,
-        after every rollout call of at most :data:`CHUNK_STEPS` steps), or the
+        after every rollout call, whose output is at most :data:`CHUNK_BYTES`), or the
         readings are not finite.
     """
     nstep = control.size
@@ -327,7 +327,8 @@ def rollout_sensors(model: mujoco.MjModel, qpos0: np.ndarray, control: np.ndarra
     spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
     state = np.zeros(mujoco.mj_stateSize(model, spec))
     mujoco.mj_getState(model, data, state, spec)
-    chunk = max(1, CHUNK_STEPS // substeps) * substeps  # whole samples per call
+    per_step = 8 * (state.size + model.nsensordata)  # bytes of rollout output per step
+    chunk = max(1, CHUNK_BYTES // (per_step * substeps)) * substeps  # whole samples per call
     out = np.empty((nstep // substeps, model.nsensordata))
     for start in range(0, nstep, chunk):
         ctrl = control[start:start + chunk]
