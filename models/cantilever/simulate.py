@@ -24,7 +24,7 @@ the overdamped top modes (``zeta = beta omega / 2`` makes every step
 step keeps 80 % of the most restrictive mode's limit and ``omega_Ny dt <= 0.109``
 (undamped frequency error ``(omega dt)^2 / 24 = 5e-4`` at the Nyquist frequency).
 Damping enters to first order: a mode's eigenvalue moves by about
-``zeta omega dt`` relative (0.03 %, 0.2 %, 0.7 % on modes 2, 3, 4 of the default
+``zeta omega dt`` relative (0.03 %, 0.2 %, 0.9 % on modes 2, 3, 4 of the default
 beam at 29 substeps); :func:`mode_errors` gives the exact figure per mode and
 the rig stores it.
 
