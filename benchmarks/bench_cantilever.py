@@ -168,5 +168,5 @@ def run(repeats: int = REPEATS) -> list[dict]:
 if __name__ == "__main__":
     for row in run():
         target = "" if row["target"] is None else f" (target <= {row['target']})"
-        flag = "ok" if row["ok"] else "MISSED"
+        flag = "-" if row["ok"] is None else ("ok" if row["ok"] else "MISSED")
         print(f"{row['name']:32s} {row['value']:10.4g} {row['unit']:2s}{target} {flag}  {row['note']}")
