@@ -16,6 +16,7 @@ the linear beam (the tests check the measured ratio).
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Callable
 from typing import Any, ClassVar
 
@@ -25,10 +26,18 @@ from models import RIGS
 from models._base import ErrorFn, Rig
 from models.cantilever.beam import BeamParams
 from models.cantilever.model import CantileverModel, build_model, sensor_positions
-from models.cantilever.simulate import half_sine, rollout_sensors, static_equilibrium
+from models.cantilever.simulate import (
+    half_sine,
+    mode_errors,
+    rollout_sensors,
+    static_equilibrium,
+    unstable_modes,
+)
 from testbed.dataset import Dataset, Signal
 from testbed.errors import RigError
 from testbed.schema import Field
+
+LOG = logging.getLogger(__name__)
 
 RIG_SCHEMA = {
     "E": Field(float, 210e9, unit="Pa", min=0.0, min_inclusive=False, doc="Young's modulus"),
@@ -62,7 +71,8 @@ SIMULATION_SCHEMA = {
     "sample_rate": Field(float, 12800.0, unit="Hz", min=0.0, min_inclusive=False,
                          doc="sample rate of every signal"),
     "integrator": Field(str, "auto", choices=("auto", "RK4", "implicitfast"),
-                        doc="MuJoCo integrator (auto = RK4)"),
+                        doc="MuJoCo integrator; auto = RK4 while it costs at most twice "
+                            "implicitfast, else implicitfast (models/cantilever/simulate.py)"),
     "timestep": Field(float, 0.0, unit="s", min=0.0,
                       doc="integration step, rounded to sample period / integer; 0 = chosen "
                           "from the model's fastest mode"),
@@ -170,10 +180,15 @@ class CantileverRig(Rig):
         control = force((np.arange(n * st.substeps) + 0.5) * st.timestep)  # mid-step values
         q0 = static_equilibrium(b.model, b.K) if sc.simulation["gravity"] == "removed" \
             else np.zeros(b.model.nq)
+        where = (f"with {st.integrator} at timestep {st.timestep:.4g} s "
+                 f"({st.substeps} per sample)")
+        if sc.simulation["timestep"] > 0:  # a requested step: refuse it if the linear model blows up
+            why = unstable_modes(b.M, b.C, b.K, st.integrator, st.timestep)
+            if why:
+                raise RigError(f"cantilever: unstable {where}: {why}; set simulation.timestep = 0 "
+                               "(automatic) or a smaller one")
+        LOG.info("cantilever %s: %s", sc.name, st.rule)
         sens = rollout_sensors(b.model, q0, control, st.substeps, progress)
-        if not np.all(np.isfinite(sens)):
-            raise RigError(f"cantilever simulation diverged with {st.integrator} at dt = "
-                           f"{st.timestep:.3g} s; use simulation.timestep = 0 (automatic)")
         rest = rollout_sensors(b.model, q0, np.zeros(st.substeps), st.substeps)[0]
         adr = b.model.sensor_adr  # per sensor i: acc (site frame), pos, vel (world); z = index 2
         ns = len(b.sensors)
@@ -181,6 +196,9 @@ class CantileverRig(Rig):
         acc = sens[:, acc_z].T - rest[acc_z][:, None]  # static reading: 0, or gravity's
         pos = sens[:, pos_z].T - rest[pos_z][:, None]  # displacement from the rest pose
         vel = sens[:, vel_z].T
+        if exc["peak_force"] > 0 and not np.any(acc) and not np.any(pos):
+            raise RigError(f"cantilever: the beam did not move under a {exc['peak_force']:g} N impact "
+                           f"{where}: the data would be all zeros; check excitation.peak_force")
         labels = [str(i + 1) for i in range(ns)]
         t = np.arange(n) / fs
         ds = Dataset(
@@ -203,7 +221,9 @@ class CantileverRig(Rig):
         ds.prior = {"total_mass": float(b.params.total_mass),
                     "reduced_mass_trace": float(np.trace(b.red.Mr))}
         ds.attrs.update(gravity=sc.simulation["gravity"], integrator=st.integrator,
-                        timestep=float(st.timestep), substeps=int(st.substeps),
+                        timestep=float(st.timestep), substeps=int(st.substeps), stepping=st.rule,
+                        integration_error=[float(e) for e in mode_errors(
+                            b.M, b.C, b.K, st, len(b.sensors))],
                         n_dof=int(b.model.nv), free_start=int(np.ceil(
                             (exc["start"] + exc["pulse_duration"]) * fs)) + 1)
         return ds

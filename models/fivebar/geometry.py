@@ -6,6 +6,9 @@ columns ``th1..th4`` [rad].  See :mod:`models.fivebar.params` for the convention
 
 from __future__ import annotations
 
+import functools
+import math
+
 import numpy as np
 
 from models.fivebar.params import FiveBarParams
@@ -150,3 +153,63 @@ def complete_rates(theta: np.ndarray, dth_act: np.ndarray, ddth_act: np.ndarray 
     ddtheta[..., list(ACTUATED)] = ddth_act
     ddtheta[..., list(PASSIVE)] = -np.linalg.solve(Jp, rhs[..., None])[..., 0]
     return dtheta, ddtheta
+
+
+#: Grid step [deg] of :func:`auto_start_pose` over the actuated angles.
+AUTO_POSE_STEP_DEG = 1.0
+
+
+def usable(th1: np.ndarray, th4: np.ndarray, p: FiveBarParams) -> np.ndarray:
+    """Whether each pose (broadcast ``th1``, ``th4`` [rad]) closes on ``p.branch`` with the
+    transmission angle in :data:`TRANSMISSION_RANGE_DEG`; boolean array of the broadcast shape."""
+    with np.errstate(invalid="ignore"):
+        mu = np.degrees(transmission_angle(assemble(th1, th4, p)))
+        lo, hi = TRANSMISSION_RANGE_DEG
+        return np.isfinite(mu) & (mu >= lo) & (mu <= hi)
+
+
+@functools.lru_cache(maxsize=64)
+def _auto_pose(l: tuple[float, ...], L0: float, branch: str, step_deg: float) -> tuple[float, float, float]:
+    from scipy.ndimage import distance_transform_edt
+
+    p = FiveBarParams(l=np.array(l), L0=L0, m=np.ones(4), inertia=np.ones(4), com=np.array(l) / 2,
+                      damping=np.zeros(4), branch=branch)
+    n = round(360.0 / step_deg)
+    grid = np.arange(n) * (2.0 * np.pi / n)
+    ok = usable(grid[:, None], grid[None, :], p)  # ok[i, j]: th1 = grid[i], th4 = grid[j]
+    if not ok.any():
+        return math.nan, math.nan, 0.0
+    # Angles are periodic: the distance to the nearest unusable pose on a 3 x 3 tiling,
+    # read on the centre tile (exact Euclidean distances in grid steps).
+    dist = distance_transform_edt(np.tile(ok, (3, 3)))[n:2 * n, n:2 * n]
+    i, j = np.unravel_index(int(np.argmax(dist)), dist.shape)  # first maximum in (th1, th4) order
+    return float(grid[i]), float(grid[j]), float(dist[i, j] * 2.0 * np.pi / n)
+
+
+def auto_start_pose(p: FiveBarParams, step_deg: float = AUTO_POSE_STEP_DEG) -> tuple[float, float, float]:
+    """The start pose chosen when a scenario gives none: the most central usable pose.
+
+    Rule: over a grid of actuated angles ``th1, th4`` in ``[0, 2 pi)`` with step
+    ``step_deg``, mark the usable poses (the loop closes on ``p.branch`` and the
+    transmission angle lies in :data:`TRANSMISSION_RANGE_DEG`), and take the usable
+    pose farthest, in the ``(th1, th4)`` plane [rad] (periodic), from every unusable
+    one: the pose with the most room to move before a closure failure or a Type II
+    singularity.  Ties go to the smallest ``th1``, then the smallest ``th4``.  The
+    distances are exact multiples of the grid step (a Euclidean distance transform),
+    so the choice is deterministic.
+
+    Parameters
+    ----------
+    p : FiveBarParams
+    step_deg : float
+        Grid step [deg]; the chosen pose is within half a step of the grid's best.
+
+    Returns
+    -------
+    th1, th4 : float
+        Actuated start angles [rad] in ``[0, 2 pi)``; NaN if no pose is usable.
+    margin : float
+        Distance [rad] in the ``(th1, th4)`` plane from the pose to the nearest unusable
+        grid pose (0 if none is usable).
+    """
+    return _auto_pose(tuple(float(x) for x in p.l), float(p.L0), p.branch, float(step_deg))

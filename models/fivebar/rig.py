@@ -2,9 +2,16 @@
 
 Default geometry: four 1 kg, 1 m uniform rods (the paper) on a base L0 = 1 m.  The
 paper's figure does not fix L0; 1 m keeps every length equal, and with it the start
-pose th1_0 = 1.78 rad, th4_0 = 1.36 rad (symmetric about x = L0/2, |CD| = 1.417 m)
-gives a transmission angle of 90.2 deg, the best-conditioned pose (force transmission
-through links 2-3 is perpendicular); L0 = 1 m at th1 = th4 would give only 60 deg.
+pose th1_0 = 1.78 rad, th4_0 = 1.36 rad of the shipped scenarios (symmetric about
+x = L0/2, |CD| = 1.417 m) gives a transmission angle of 90.2 deg, the best-conditioned
+pose (force transmission through links 2-3 is perpendicular); L0 = 1 m at th1 = th4
+would give only 60 deg.
+
+Start pose: a scenario that leaves out ``th1_0`` and ``th4_0`` gets
+:func:`models.fivebar.geometry.auto_start_pose`, the usable pose (loop closed,
+transmission angle in 30-150 deg) farthest in the actuated angles from every
+unusable one, so any geometry runs without a hand-found pose.  The chosen angles
+and the rule are stored in the dataset attributes.
 """
 
 from __future__ import annotations
@@ -40,8 +47,12 @@ RIG_SCHEMA: dict[str, Field] = {
     "gravity": Field(bool, False, doc="gravity along -y of the plane (false: horizontal plane)"),
     "branch": Field(str, "up", choices=("up", "down"),
                     doc="assembly branch: E left of (up) or right of (down) the direction C->D"),
-    "th1_0": Field(float, 1.78, unit="rad", doc="start angle of link 1 at A (centre of sine_replay)"),
-    "th4_0": Field(float, 1.36, unit="rad", doc="start angle of link 4 at B (centre of sine_replay)"),
+    "th1_0": Field(float, None, unit="rad",
+                   doc="start angle of link 1 at A (centre of sine_replay); left out with th4_0: the "
+                       "most central usable pose (models/fivebar/geometry.py auto_start_pose)"),
+    "th4_0": Field(float, None, unit="rad",
+                   doc="start angle of link 4 at B (centre of sine_replay); left out with th1_0: "
+                       "chosen automatically"),
     "dth1_0": Field(float, 0.0, unit="rad/s", doc="start rate of joint A (not with sine_replay)"),
     "dth4_0": Field(float, 0.0, unit="rad/s", doc="start rate of joint B (not with sine_replay)"),
 }
@@ -77,6 +88,18 @@ def _pose_problem(th1: np.ndarray, th4: np.ndarray, p: FiveBarParams) -> str | N
                 f"th4 = {np.atleast_1d(th4)[k]:.4g} rad: near a Type II singularity (links 2 and 3 "
                 f"collinear); allowed {lo_mu:g}-{hi_mu:g} deg")
     return None
+
+
+def start_pose(rig: dict[str, Any], p: FiveBarParams) -> np.ndarray:
+    """Actuated start (or sine_replay centre) pose ``(th1_0, th4_0)`` [rad], shape (2,).
+
+    The scenario's angles, or, when it leaves both out, :func:`geometry.auto_start_pose`
+    (NaN if the geometry has no usable pose).
+    """
+    if rig["th1_0"] is None or rig["th4_0"] is None:
+        th1, th4, _ = geo.auto_start_pose(p)
+        return np.array([th1, th4])
+    return np.array([rig["th1_0"], rig["th4_0"]], dtype=float)
 
 
 @RIGS.register("fivebar", tags=("mechanical", "pinocchio", "closed-loop"))
@@ -126,7 +149,15 @@ class FiveBarRig(Rig):
         if kind == "sine_replay" and (rig["dth1_0"] != 0.0 or rig["dth4_0"] != 0.0):
             error("rig.dth1_0, rig.dth4_0", [rig["dth1_0"], rig["dth4_0"]],
                   "expected 0 with excitation 'sine_replay' (the prescribed motion sets the start rates)")
-        th0 = np.array([rig["th1_0"], rig["th4_0"]])
+        if (rig["th1_0"] is None) != (rig["th4_0"] is None):
+            error("rig.th1_0, rig.th4_0", [rig["th1_0"], rig["th4_0"]],
+                  "both angles, or neither (a start pose chosen automatically)")
+        th0 = start_pose(rig, p)
+        if not np.isfinite(th0).all():
+            lo_mu, hi_mu = geo.TRANSMISSION_RANGE_DEG
+            error("rig.th1_0, rig.th4_0", None,
+                  f"a start pose, but this geometry has none: no pose closes the loop with a "
+                  f"transmission angle in {lo_mu:g}-{hi_mu:g} deg; change the link lengths or L0")
         start, _ = start_actuated(excitation, th0, np.zeros(2))
         why = _pose_problem(start[0], start[1], p)
         if why:
@@ -149,7 +180,7 @@ class FiveBarRig(Rig):
     def start_state(self) -> tuple[np.ndarray, np.ndarray]:
         """Consistent absolute start angles [rad] and rates [rad/s], shape (4,) each."""
         rig, p = self.scenario.rig_params, self.params
-        th_a, dth_a = start_actuated(self.scenario.excitation, np.array([rig["th1_0"], rig["th4_0"]]),
+        th_a, dth_a = start_actuated(self.scenario.excitation, start_pose(rig, p),
                                      np.array([rig["dth1_0"], rig["dth4_0"]]))
         theta0 = geo.assemble(th_a[0], th_a[1], p)
         dtheta0, _ = geo.complete_rates(theta0, dth_a, None, p)
@@ -163,7 +194,7 @@ class FiveBarRig(Rig):
         n = round(sim["duration"] * fs)
         t = np.arange(n) / fs
         theta0, dtheta0 = self.start_state()
-        program, extra = build_program(sc.excitation, np.array([rig["th1_0"], rig["th4_0"]]), t, fs,
+        program, extra = build_program(sc.excitation, start_pose(rig, p), t, fs,
                                        inverse_dynamics=dyn.inverse_dynamics)
         if sim["engine"] == "mujoco":
             from models.fivebar.twin import MujocoTwin
@@ -205,5 +236,11 @@ class FiveBarRig(Rig):
                  "engine": self.scenario.simulation["engine"], "branch": p.branch,
                  "angles": "absolute th1..th4 from the world x axis, counter-clockwise",
                  "torque_hold": "zero-order hold over each sample interval"}
+        rig = self.scenario.rig_params
+        th0 = start_pose(rig, p)
+        attrs.update(th1_0=float(th0[0]), th4_0=float(th0[1]), start_pose="given" if rig["th1_0"] is not None
+                     else "auto: the usable pose farthest from the closure and transmission-angle limits "
+                          f"in (th1, th4) on a {geo.AUTO_POSE_STEP_DEG:g} deg grid "
+                          f"(margin {geo.auto_start_pose(p)[2]:.3f} rad)")
         return Dataset(fs=fs, measured=measured, reference=reference, truth=truth, truth_units=units,
                        prior=prior, attrs=attrs)

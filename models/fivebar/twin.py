@@ -22,8 +22,9 @@ import numpy as np
 from models.fivebar import geometry as geo
 from models.fivebar.dynamics import link_inertia_diag
 from models.fivebar.excitation import TorqueProgram
-from models.fivebar.integrate import CHECK_EVERY, check_transmission
+from models.fivebar.integrate import CHECK_EVERY, check_finite, check_transmission
 from models.fivebar.params import FiveBarParams
+from testbed.errors import RigError
 
 #: Constraint impedance: (dmin, dmax, width).  Close to 1 = nearly hard constraint.
 SOLIMP = (0.9999, 0.9999, 0.001)
@@ -78,6 +79,25 @@ def mjcf(p: FiveBarParams, dt: float) -> str:
 </mujoco>"""
 
 
+_RESETS = (mujoco.mjtWarning.mjWARN_BADQACC, mujoco.mjtWarning.mjWARN_BADQVEL,
+           mujoco.mjtWarning.mjWARN_BADQPOS, mujoco.mjtWarning.mjWARN_BADCTRL)
+
+
+def check_resets(m: mujoco.MjModel, d: mujoco.MjData, t: float) -> None:
+    """Raise :class:`RigError` (one line) if MuJoCo reset the state or zeroed a control.
+
+    MuJoCo answers a huge or non-finite acceleration, state or control by resetting
+    (or zeroing) it and carrying on; the record would go on from the reset pose.
+    """
+    for w in _RESETS:
+        n = d.warning[w].number
+        if n:
+            what = mujoco.mjtWarning(w).name.removeprefix("mjWARN_BAD").lower()
+            raise RigError(f"fivebar (mujoco): the simulation is unstable, MuJoCo reset it {n} time(s) "
+                           f"after a huge or non-finite {what} by t = {t:.4f} s (RK4, timestep "
+                           f"{m.opt.timestep:g} s); reduce the excitation amplitude or simulation.dt")
+
+
 class MujocoTwin:
     """The compiled MuJoCo model and data of one linkage."""
 
@@ -120,7 +140,11 @@ class MujocoTwin:
             LAM[k] = d.efc_force[:2]
             if (k + 1) % CHECK_EVERY == 0 or k == n_samples - 1:
                 k0 = (k // CHECK_EVERY) * CHECK_EVERY
-                check_transmission(geo.to_absolute(Q[k0:k + 1]), t[k0:k + 1], "mujoco")
+                blk = slice(k0, k + 1)
+                check_resets(m, d, t[k])
+                check_finite(t[blk], "mujoco", m.opt.timestep, torque=U[blk], angles=Q[blk],
+                             rates=V[blk], accelerations=A[blk], constraint_force=LAM[blk])
+                check_transmission(geo.to_absolute(Q[blk]), t[blk], "mujoco")
                 if progress is not None:
                     progress((k + 1) / n_samples)
             if k == n_samples - 1:

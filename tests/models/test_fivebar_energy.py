@@ -12,7 +12,8 @@ from testbed.scenario import load_scenario, scenario_from_dict
 
 def _free(duration, **rig):
     sc = scenario_from_dict({"scenario": {"name": "free", "rig": "fivebar"},
-                             "rig": {"damping": 0.0, **rig}, "simulation": {"duration": duration},
+                             "rig": {"damping": 0.0, "th1_0": 1.78, "th4_0": 1.36, **rig},
+                             "simulation": {"duration": duration},
                              "excitation": {"type": "multisine", "amplitude": 0.0}})
     r = FiveBarRig(sc)
     return r, r.simulate()
