@@ -32,6 +32,9 @@ def truth_rows(ds: Dataset) -> list[tuple[str, str]]:
         rows.append(("true equation terms", str(len(tr["equation_terms"]))))
     for k, v in ds.prior.items():
         rows.append((f"prior {k}", f"{v}"))
+    for key in ("stepping", "start_pose"):  # what the rig chose automatically, and why
+        if key in ds.attrs:
+            rows.append((key.replace("_", " "), str(ds.attrs[key])))
     return rows
 
 
