@@ -23,6 +23,7 @@ import numpy as np
 
 from testbed import figures as figs
 from testbed.atomic import atomic_write_text
+from testbed.results import read_results, score_columns
 from testbed.runstore import SavedRun, load_run
 from testbed.scoring import METRICS
 
@@ -55,9 +56,6 @@ CAPTIONS = {
     "coefficients": "Coefficients of the library terms per equation: truth vs identified "
                     "(scaled so that the leading true term matches).",
 }
-#: Row keys of a sweep results file that are not scores.
-ROW_KEYS = {"study", "cell", "scenario", "rig", "noise", "seed", "identifier", "status", "error",
-            "fit_time", "passed", "checks", "versions", "commit", "dataset_hash"}
 
 
 def fmt(v: Any, digits: int = 4) -> str:
@@ -224,13 +222,10 @@ def run_report(run: SavedRun, out_dir: str | os.PathLike) -> Path:
 
 # ----------------------------------------------------------------------------- sweep report
 def score_names(rows: Sequence[dict[str, Any]]) -> list[str]:
-    """Score columns of sweep rows: numeric values under keys outside :data:`ROW_KEYS`."""
-    names = set()
-    for r in rows:
-        for k, v in r.items():
-            if k not in ROW_KEYS and isinstance(v, (int, float, np.number)) and not isinstance(v, bool):
-                names.add(k)
-    return sorted(names)
+    """Score columns of sweep rows (:func:`testbed.results.score_columns`) holding numbers."""
+    return [k for k in score_columns(rows)
+            if any(isinstance(r.get(k), (int, float, np.number)) and not isinstance(r.get(k), bool)
+                   for r in rows)]
 
 
 def _ok(r: dict[str, Any]) -> bool:
@@ -306,6 +301,5 @@ def write_report(source: str | os.PathLike, out_dir: str | os.PathLike) -> Path:
         return run_report(load_run(source), out_dir)
     if not source.is_file():
         raise FileNotFoundError(f"{source}: neither a run folder nor a results file")
-    from testbed.results import read_results
 
     return sweep_report(read_results(source), out_dir, title=source.stem)

@@ -147,3 +147,12 @@ def test_report_in_headless_chromium(chromium, reports, name, n_figures, tmp_pat
     assert all(i["ok"] and i["w"] > 300 for i in imgs), imgs
     console = [ln for ln in r.stderr.splitlines() if ":CONSOLE" in ln]
     assert not console, "console messages:\n" + "\n".join(console)
+
+
+def test_sweep_report_scores_are_not_wall_times():
+    """Timing and bookkeeping columns of a results row are never plotted as scores."""
+    from testbed.report import score_names
+    from testbed.results import BASE_COLUMNS, TAIL_COLUMNS
+
+    row = {k: 1.0 for k in (*BASE_COLUMNS, *TAIL_COLUMNS)} | {"trac": 0.9, "mac": 0.99}
+    assert score_names([row]) == ["mac", "trac"]
