@@ -118,11 +118,6 @@ class BeamParams:
         """Number of hinges (= degrees of freedom)."""
         return self.n_segments + (self.base == "soft")
 
-    @property
-    def first_moving_x(self) -> float:
-        """Position of the root hinge [m]: points inboard of it do not move."""
-        return float(self.hinges()[0][0])
-
 
 def body_of(params: BeamParams, x: float) -> tuple[int, float]:
     """The moving body holding the beam point at ``x`` and the point's local offset.
@@ -130,7 +125,7 @@ def body_of(params: BeamParams, x: float) -> tuple[int, float]:
     Parameters
     ----------
     x : float
-        Position along the beam [m], ``first_moving_x <= x <= length``.
+        Position along the beam [m], from the root hinge (``hinges()[0][0]``) to ``length``.
 
     Returns
     -------

@@ -77,32 +77,6 @@ class FiveBarDynamics:
         self.prox = pin.ProximalSettings(*PROX)
         self.damping = np.asarray(p.damping, float)
 
-    # ------------------------------------------------------------ forward dynamics
-    def acceleration(self, q: np.ndarray, v: np.ndarray, u: np.ndarray) -> np.ndarray:
-        """Constrained joint accelerations [rad/s^2], shape (4,), tree order.
-
-        Parameters
-        ----------
-        q, v : ndarray, shape (4,)
-            Relative joint angles [rad] and rates [rad/s].
-        u : ndarray, shape (2,)
-            Actuator torques at A and B [N m].
-        """
-        tau = -self.damping * v
-        tau[0] += u[0]
-        tau[2] += u[1]
-        return pin.constraintDynamics(self.model, self.data, q, v, tau, self.cmodels, self.cdatas,
-                                      self.prox).copy()
-
-    def constraint_force(self) -> np.ndarray:
-        """Force on link 2 from link 3 at E [N] (world x, y) of the last :meth:`acceleration` call.
-
-        Pinocchio's multiplier of the constraint ``p_E2 - p_E3 = 0`` (LOCAL_WORLD_ALIGNED)
-        is the force on the constraint's first joint (link 2); the tests check it equals
-        the Lagrange multiplier of the absolute-angle equations.
-        """
-        return np.array(self.data.lambda_c[:2])
-
     # ------------------------------------------------------------ matrices
     def mass_matrix(self, q: np.ndarray) -> np.ndarray:
         """Joint-space mass matrix (4, 4) [kg m^2] in relative coordinates, tree order."""

@@ -23,10 +23,6 @@ import numpy as np
 #: Standard gravity [m/s^2], acting along -y of the linkage plane when switched on.
 G0 = 9.80665
 
-#: Pinocchio / MuJoCo joint order (tree order) and the link each joint drives.
-JOINTS = ("A", "C", "B", "D")
-
-
 @dataclass(frozen=True)
 class FiveBarParams:
     """Geometry, inertia and damping of the linkage.
