@@ -132,11 +132,11 @@ def node_numbers(ds: Dataset) -> dict[tuple[str, int], int]:
     (:func:`input_nodes`).  See the module docstring.
     """
     nodes: dict[tuple[str, int], int] = {}
-    positions = node_positions(ds)
+    keys = [round(p, 12) for p in node_positions(ds)]
     for name, s in ds.measured.items():
         for i, ch in enumerate(s.channels):
             if s.positions is not None:
-                nodes[(name, i)] = positions.index(round(float(s.positions[i]), 12)) + 1
+                nodes[(name, i)] = keys.index(round(float(s.positions[i]), 12)) + 1
             else:
                 m = re.search(r"(\d+)$", ch)
                 nodes[(name, i)] = int(m.group(1)) if m else i + 1
@@ -146,8 +146,11 @@ def node_numbers(ds: Dataset) -> dict[tuple[str, int], int]:
 
 def node_positions(ds: Dataset) -> list[float]:
     """Distinct positions [m] of the positioned measured channels, ascending: node k at ``[k - 1]``."""
-    return sorted({round(float(p), 12) for s in ds.measured.values() if s.positions is not None
-                   for p in s.positions})
+    first: dict[float, float] = {}  # positions equal to 12 decimals share a node
+    for s in ds.measured.values():
+        for p in (s.positions if s.positions is not None else ()):
+            first.setdefault(round(float(p), 12), float(p))
+    return [first[k] for k in sorted(first)]
 
 
 def _channels(ds: Dataset) -> list[tuple[str, int, Signal]]:
