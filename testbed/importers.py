@@ -16,7 +16,8 @@ Formats (``format=`` or from the file's suffix)
         the ordinate's axis label, else the one its specific data type and unit exponents
         name.  Nodes and directions come from the response node and direction; positions
         [m] from the x coordinate of that node in a UFF2411 or UFF15 record.  A UFF164 record
-        must be SI (all factors 1).  Other records (55, 82, ...) are ignored.
+        must be SI (all factors 1).  Other records (55, 82, ...) are ignored.  A file
+        whose last block is unfinished (no closing ``-1``) is refused as truncated.
     ``"sep005"`` (``.json``)
         A JSON list of SEP-005 channel dicts (``name``, ``data``, ``unit_str`` and ``fs`` or
         ``time``), as :func:`testbed.export.write_sep005` writes, with the optional
@@ -59,6 +60,7 @@ import numpy as np
 
 from testbed.dataset import Dataset, DatasetError, Signal
 from testbed.errors import TestbedError
+from testbed.measurement import Measurement
 
 FORMATS = ("uff", "sep005", "csv", "hdf5")
 SUFFIXES = {".uff": "uff", ".unv": "uff", ".json": "sep005", ".csv": "csv", ".tsv": "csv",
@@ -246,6 +248,55 @@ def read_measured(path: str | os.PathLike, *, format: str | None = None, fs: flo
     reader = {"uff": _read_uff, "sep005": _read_sep005_file, "csv": _read_csv, "hdf5": _read_hdf5}[format]
     raw = reader(path, fs)
     return _finish(raw, fs, units, channels)
+
+
+def measurement_from_file(path: str | os.PathLike, kind: str, signal: Mapping[str, Any] | None = None, *,
+                          format: str | None = None, fs: float | None = None,
+                          units: str | Mapping[str, str] | None = None,
+                          channels: Sequence[str] | None = None,
+                          groups: Mapping[str, Sequence[str]] | None = None,
+                          prior: Mapping[str, float] | None = None) -> Measurement:
+    """Read measured data and run the rig kind's signal chain: what an identifier fits.
+
+    ``measure(read_measured(path, ...).to_dataset(groups, prior), signal or {}, kind)``.
+
+    Parameters
+    ----------
+    path, format, fs, units, channels
+        As for :func:`read_measured`.
+    kind : {"structural", "mechanical"}
+        The rig kind whose chain to run (:data:`testbed.preprocess.SIGNAL_SCHEMAS`).
+    signal : mapping, optional
+        The ``[signal]`` table (a scenario's ``scenario.signal``); default: the kind's defaults.
+    groups, prior
+        As for :meth:`ImportedData.to_dataset`.
+
+    Returns
+    -------
+    Measurement
+        ``x``, ``xd``, ``xdd`` of shape (n_channels, n_samples), inputs ``u``, ``input_map``.
+
+    Raises
+    ------
+    MeasuredDataError
+        The file or the arguments (see :func:`read_measured`), or data the chain cannot take
+        (wrong signal names or channel counts, no positions for a structural record).
+    ScenarioError
+        A bad ``signal`` table.
+    """
+    from testbed.preprocess import SIGNAL_SCHEMAS, measure
+
+    if kind not in SIGNAL_SCHEMAS:
+        raise MeasuredDataError(path, f"unknown rig kind {kind!r}; allowed: {', '.join(SIGNAL_SCHEMAS)}")
+    data = read_measured(path, format=format, fs=fs, units=units, channels=channels)
+    ds = data.to_dataset(groups, prior)
+    try:
+        return measure(ds, dict(signal or {}), kind)
+    except TestbedError:
+        raise
+    except ValueError as e:  # the chain's own checks: signal names, channel counts, positions
+        raise MeasuredDataError(data.source, f"cannot run the {kind} signal chain: {e}; "
+                                             f"signals {', '.join(ds.measured)}") from None
 
 
 def from_sep005(channel_dicts: Sequence[Mapping[str, Any]], *, source: str | os.PathLike = "<sep005>",
@@ -530,6 +581,13 @@ def _is_float(s: str) -> bool:
 def _read_uff(path: Path, fs: float | None) -> _Raw:
     import pyuff
 
+    # every UFF block ends with a line "    -1"; pyuff silently drops an unfinished last block
+    with path.open("rb") as fh:
+        fh.seek(max(0, path.stat().st_size - 64))
+        tail = fh.read().rstrip()
+    if not re.search(rb"(^|\s)-1$", tail):
+        raise MeasuredDataError(path, "not a complete UFF file: it does not end with a block end "
+                                      "'-1' (truncated, or not UFF)")
     try:
         uff = pyuff.UFF(str(path))
         types = list(uff.get_set_types())

@@ -11,7 +11,7 @@ import pyuff
 from testbed.dataset import Dataset, Signal
 from testbed.errors import TestbedError
 from testbed.export import export_dataset, to_sep005
-from testbed.importers import MeasuredDataError, from_sep005, read_measured
+from testbed.importers import MeasuredDataError, from_sep005, measurement_from_file, read_measured
 from testbed.preprocess import measure
 from testbed.scenario import load_scenario
 
@@ -163,6 +163,13 @@ def frf_uff(path):
     return path
 
 
+def units_only_uff(path):
+    pyuff.UFF(str(path)).write_sets([pyuff.prepare_164(units_code=1, units_description="SI", temp_mode=1,
+                                                       length=1.0, force=1.0, temp=1.0, temp_offset=0.0)],
+                                    mode="add")
+    return path
+
+
 MALFORMED = [
     ("missing file", lambda d: d / "nope.csv", {}, "no such file"),
     ("unknown suffix", lambda d: write(d, "x.dat", "a\n1\n"), {}, "suffix"),
@@ -194,7 +201,8 @@ MALFORMED = [
     ("SEP-005 null", lambda d: write(d, "x.json", json.dumps(
         [{"name": "a", "data": [1, None], "unit_str": "m", "fs": 10}])), {}, "NaN"),
     ("garbage UFF", lambda d: write(d, "x.uff", "    -1\n    58\nnot a record\n    -1\n"), {}, "UFF"),
-    ("UFF without 58", lambda d: write(d, "x.uff", "hello\n"), {}, "no UFF58"),
+    ("not UFF", lambda d: write(d, "x.uff", "hello\n"), {}, "not a complete UFF file"),
+    ("UFF without 58", lambda d: units_only_uff(d / "u.uff"), {}, "no UFF58"),
     ("UFF frequency response", lambda d: frf_uff(d / "frf.uff"), {}, "not a time response"),
     ("not HDF5", lambda d: write(d, "x.h5", "plain text"), {}, "unreadable dataset file"),
 ]
@@ -221,3 +229,42 @@ def test_to_dataset_group_errors():
         data.to_dataset({"x": ["a", "f"]})
     with pytest.raises(MeasuredDataError, match="unknown channel"):
         data.to_dataset({"x": ["b"]})
+
+
+def test_measurement_from_file_runs_the_kinds_chain(beam, tmp_path):
+    path, ds = beam
+    (out,) = export_dataset(path, "sep005", tmp_path / "beam.json")
+    m = measurement_from_file(out, "structural", {"highpass_hz": 20.0}, prior={"total_mass": 0.7})
+    ref = measure(ds, {"highpass_hz": 20.0}, "structural")
+    np.testing.assert_array_equal(m.x, ref.x)
+    assert m.prior == {"total_mass": 0.7}
+    with pytest.raises(MeasuredDataError, match="cannot run the mechanical signal chain"):
+        measurement_from_file(out, "mechanical")
+    with pytest.raises(MeasuredDataError, match="unknown rig kind"):
+        measurement_from_file(out, "optical")
+
+
+def test_generic_ascii_uff58_units_from_data_types(tmp_path):
+    """A time record from another tool: ASCII, no rate in ID line 5, no unit label, rotation."""
+    path = tmp_path / "other.unv"
+    x = np.sin(np.arange(64) / 5.0)
+    sets = [pyuff.prepare_58(binary=0, func_type=1, rsp_node=12, rsp_dir=-6, ref_node=0, ref_dir=0,
+                             id1="", data=x, x=np.arange(64) / 256.0, abscissa_spacing=1,
+                             abscissa_spec_data_type=17, ordinate_spec_data_type=8,
+                             ordinate_len_unit_exp=0, ordinate_force_unit_exp=0,
+                             ordinate_axis_units_lab="", orddenom_spec_data_type=0, z_axis_spec_data_type=0,
+                             z_axis_value=0.0, rsp_ent_name="a", ref_ent_name="NONE")]
+    pyuff.UFF(str(path)).write_sets(sets, mode="add")
+    data = read_measured(path)
+    assert list(data.signals) == ["node12:-6"] and data.signals["node12:-6"][0] == "rad"
+    assert data.fs == pytest.approx(256.0, rel=1e-5) and data.directions == {"node12:-6": -6}
+    np.testing.assert_allclose(data.signals["node12:-6"][1], x, rtol=1e-5)  # ASCII: E13.5
+
+
+def test_truncated_uff_export(beam, tmp_path):
+    path, _ = beam
+    (out,) = export_dataset(path, "uff", tmp_path / "beam.uff")
+    cut = tmp_path / "cut.uff"
+    cut.write_bytes(out.read_bytes()[: out.stat().st_size // 2])
+    with pytest.raises(MeasuredDataError, match=r"cut\.uff: not a complete UFF file"):
+        read_measured(cut)
