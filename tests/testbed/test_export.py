@@ -214,3 +214,22 @@ def test_sep005_quantities_and_positions():
 def test_unknown_format(saved):
     with pytest.raises(ValueError, match="sep005"):
         export_dataset(saved(fivebar_dataset()), "csv")
+
+
+def test_uff_real_cantilever_modes_are_mass_normalised(dataset_cache, tmp_path):
+    """The simulated beam's SEREP shapes: phi^T Mr phi = 1 for every mode, plain id2 text."""
+    from testbed.scenario import load_scenario
+
+    ds = dataset_cache.get(load_scenario("cantilever_stiff_impact"))
+    (out,) = export_dataset(ds.save(tmp_path / "beam.h5"), "uff")
+    sets = read_uff(out)
+    nodes = next(s for s in sets if s["type"] == 2411)
+    np.testing.assert_array_equal(nodes["x"], ds.measured["acceleration"].positions)
+    modes = [s for s in sets if s["type"] == 55]
+    assert len(modes) == ds.truth["sensor_modes"].shape[1], "the modes the sensors resolve"
+    for k, m in enumerate(modes):
+        assert m["modal_m"] == pytest.approx(1.0, rel=1e-6)
+        f, zeta = ds.truth["frequencies_hz"][k], ds.truth["damping_ratios"][k]
+        assert m["id2"].strip() == f"{f:.4f} Hz, zeta {zeta:.6f}"
+    force = next(s for s in sets if s["type"] == 58 and s["id1"] == "force/force")
+    assert force["rsp_node"] == 3, "hit at the tip sensor"
