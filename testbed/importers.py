@@ -246,7 +246,7 @@ def read_measured(path: str | os.PathLike, *, format: str | None = None, fs: flo
     if fs is not None and not (isinstance(fs, (int, float)) and math.isfinite(fs) and fs > 0):
         raise MeasuredDataError(path, f"sample rate fs={fs!r} must be a finite number > 0 Hz")
     reader = {"uff": _read_uff, "sep005": _read_sep005_file, "csv": _read_csv, "hdf5": _read_hdf5}[format]
-    raw = reader(path, fs)
+    raw = reader(path)
     return _finish(raw, fs, units, channels)
 
 
@@ -426,7 +426,7 @@ def uniform_rate(path: Path, t: np.ndarray, what: str = "time column") -> float:
 
 
 # --------------------------------------------------------------------------- readers
-def _read_hdf5(path: Path, fs: float | None) -> _Raw:
+def _read_hdf5(path: Path) -> _Raw:
     try:
         ds = Dataset.load(path)
     except DatasetError as e:
@@ -441,7 +441,7 @@ def _read_hdf5(path: Path, fs: float | None) -> _Raw:
     return raw
 
 
-def _read_sep005_file(path: Path, fs: float | None) -> _Raw:
+def _read_sep005_file(path: Path) -> _Raw:
     try:
         content = json.loads(path.read_text())
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
@@ -526,7 +526,7 @@ def _common_rate(path: Path, rates: dict[str, float], rtol: float) -> float:
 _HEADER = re.compile(r"^\s*(?P<name>.*?)\s*(?:[\[(](?P<unit>[^\])]*)[\])])?\s*$")
 
 
-def _read_csv(path: Path, fs: float | None) -> _Raw:
+def _read_csv(path: Path) -> _Raw:
     try:
         text = path.read_text()
     except (OSError, UnicodeDecodeError) as e:
@@ -578,7 +578,7 @@ def _is_float(s: str) -> bool:
     return True
 
 
-def _read_uff(path: Path, fs: float | None) -> _Raw:
+def _read_uff(path: Path) -> _Raw:
     import pyuff
 
     # every UFF block ends with a line "    -1"; pyuff silently drops an unfinished last block
