@@ -10,7 +10,7 @@ import pytest
 import pyuff
 
 from testbed.dataset import Dataset, Signal
-from testbed.export import export_dataset, node_numbers, read_sep005, to_sep005
+from testbed.export import export_dataset, modal_masses, node_numbers, read_sep005, to_sep005
 
 FS = 1024.0
 N = 512
@@ -23,21 +23,28 @@ def cantilever_dataset() -> Dataset:
     force = np.zeros((1, N))
     force[0, :4] = [5.0, 40.0, 40.0, 5.0]
     phi = np.array([[0.1, -0.5, 0.8], [0.5, -0.2, -0.6], [1.0, 0.9, 0.4]])
+    inv = np.linalg.inv(phi)
     return Dataset(FS, {"acceleration": Signal(acc, ("acc1", "acc2", "acc3"), "m/s^2", pos),
                         "force": Signal(force, ("impact",), "N", pos[2:])},
                    {"acceleration": Signal(acc * 0.9, ("acc1", "acc2", "acc3"), "m/s^2", pos)},
-                   {"frequencies_hz": np.array([82.9, 519.9, 1455.0]),
-                    "damping_ratios": np.array([0.01, 0.02, 0.03]), "sensor_modes": phi},
-                   {"frequencies_hz": "Hz"}, {"total_mass": 0.4},
+                   {"frequencies_hz": np.array([82.76612345678, 519.9, 1455.0]),
+                    "damping_ratios": np.array([0.01, 0.02, 0.03]), "sensor_modes": phi,
+                    "Mr": inv.T @ inv},  # mass-normalised shapes: phi^T Mr phi = I
+                   {"frequencies_hz": "Hz", "sensor_modes": "m/sqrt(kg m^2)", "Mr": "kg"},
+                   {"total_mass": 0.4},
                    {"rig": "cantilever", "seed": 7, "scenario_name": "cantilever_stiff_impact"})
 
 
 def fivebar_dataset() -> Dataset:
+    """The five-bar rig's measured signals (names, units, channels) on made-up motion."""
     t = np.arange(N) / FS
-    th = np.array([np.sin(2 * np.pi * (k + 1) * t) for k in range(4)])
+    w = 2 * np.pi * np.arange(1, 5)[:, None]
+    th = np.sin(w * t)
     tau = np.array([np.cos(2 * np.pi * t), 0.5 * np.sin(2 * np.pi * t)])
-    return Dataset(FS, {"angles": Signal(th, ("th1", "th2", "th3", "th4"), "rad"),
-                        "torques": Signal(tau, ("tau1", "tau2"), "N m")},
+    return Dataset(FS, {"theta": Signal(th, ("th1", "th2", "th3", "th4"), "rad"),
+                        "dtheta": Signal(w * np.cos(w * t), ("dth1", "dth2", "dth3", "dth4"), "rad/s"),
+                        "ddtheta": Signal(-w**2 * th, ("ddth1", "ddth2", "ddth3", "ddth4"), "rad/s^2"),
+                        "torque": Signal(tau, ("u1", "u2"), "N m")},
                    truth={"equation_terms": ["ddth1", "u1"], "equation_coef": np.array([[1.0, -1.0]])},
                    attrs={"rig": "fivebar", "seed": 0})
 
@@ -63,9 +70,18 @@ def test_uff_cantilever_round_trip(saved, tmp_path):
     ds = cantilever_dataset()
     (out,) = export_dataset(saved(ds), "uff", tmp_path / "beam.uff")
     sets = read_uff(out)
+    assert [s["type"] for s in sets] == [164, 2411, 82] + [58] * 4 + [55] * 3
+    units, nodes, trace = sets[:3]
+    assert (units["units_code"], units["length"], units["force"], units["temp"]) == (1, 1.0, 1.0, 1.0)
+    assert units["units_description"].strip() == "SI"
+    # geometry: one node per sensor at its position along the beam [m]
+    assert list(nodes["node_nums"]) == [1, 2, 3]
+    np.testing.assert_array_equal(nodes["x"], [0.15, 0.35, 0.5])
+    np.testing.assert_array_equal(nodes["y"], 0.0)
+    np.testing.assert_array_equal(nodes["z"], 0.0)
+    assert list(trace["nodes"]) == [1, 2, 3]
     s58 = [s for s in sets if s["type"] == 58]
     s55 = [s for s in sets if s["type"] == 55]
-    assert len(s58) == 4 and len(s55) == 3
     ds = Dataset.load(tmp_path / "data.h5")
     for k, s in enumerate(s58[:3]):
         np.testing.assert_allclose(s["data"], ds.measured["acceleration"].data[k], rtol=0, atol=1e-12)
@@ -87,33 +103,55 @@ def test_uff_cantilever_round_trip(saved, tmp_path):
         assert m["analysis_type"] == 2 and m["mode_n"] == k + 1
         assert m["freq"] == pytest.approx(ds.truth["frequencies_hz"][k], rel=1e-6)
         assert m["modal_damp_vis"] == pytest.approx(ds.truth["damping_ratios"][k], rel=1e-4)
+        assert m["modal_m"] == pytest.approx(1.0, rel=1e-9), "mass-normalised shapes"
         assert list(m["node_nums"]) == [1, 2, 3]
         np.testing.assert_allclose(m["r3"], ds.truth["sensor_modes"][:, k], rtol=1e-5)
         np.testing.assert_array_equal(m["r1"], 0.0)
+        assert "np." not in m["id2"] and "(" not in m["id2"]
+    assert s55[0]["id2"].strip() == "82.7661 Hz, zeta 0.010000"
 
 
 def test_uff_fivebar_angles_and_torques(saved, tmp_path):
-    ds = fivebar_dataset()
-    (out,) = export_dataset(saved(ds), "uff", None)
+    (out,) = export_dataset(saved(fivebar_dataset()), "uff", None)
     assert out == tmp_path / "data.uff"
+    ds = Dataset.load(tmp_path / "data.h5")
     sets = read_uff(out)
-    assert [s["type"] for s in sets] == [58] * 6, "no modal truth for a mechanism"
-    for k, s in enumerate(sets[:4]):
-        np.testing.assert_allclose(s["data"], ds.measured["angles"].data[k], atol=1e-14)
-        assert (s["rsp_node"], s["rsp_dir"], s["ordinate_axis_units_lab"]) == (k + 1, 6, "rad")
-        assert spec(s) == (8, 0, 0)
-    for k, s in enumerate(sets[4:]):
-        np.testing.assert_allclose(s["data"], ds.measured["torques"].data[k], atol=1e-14)
-        assert (s["rsp_node"], s["rsp_dir"], s["ordinate_axis_units_lab"]) == (k + 1, 6, "N m")
+    assert [s["type"] for s in sets] == [164] + [58] * 14, "no geometry, no modal truth for a mechanism"
+    s58 = {s["id1"]: s for s in sets[1:]}
+    for group, unit in (("theta", "rad"), ("dtheta", "rad/s"), ("ddtheta", "rad/s^2")):
+        sig = ds.measured[group]
+        for k, ch in enumerate(sig.channels):
+            s = s58[f"{group}/{ch}"]
+            np.testing.assert_allclose(s["data"], sig.data[k], atol=1e-14)
+            assert (s["rsp_node"], s["rsp_dir"], s["ordinate_axis_units_lab"]) == (k + 1, 6, unit)
+    assert spec(s58["theta/th1"]) == (8, 0, 0)
+    torques = [s58["torque/u1"], s58["torque/u2"]]
+    for k, s in enumerate(torques):
+        np.testing.assert_allclose(s["data"], ds.measured["torque"].data[k], atol=1e-14)
+        assert (s["rsp_dir"], s["ordinate_axis_units_lab"]) == (6, "N m")
         assert spec(s) == (13, 1, 1)
+    # the signal chain's input map: u1 drives th1, u2 drives th4 (not "node 2" from its name)
+    assert [s["rsp_node"] for s in torques] == [1, 4]
 
 
-def test_node_numbers_by_position_and_name():
+def test_node_numbers_by_position_and_input_map():
     nodes = node_numbers(cantilever_dataset())
     assert [nodes[("acceleration", i)] for i in range(3)] == [1, 2, 3]
     assert nodes[("force", 0)] == 3
     nodes = node_numbers(fivebar_dataset())
-    assert nodes[("angles", 3)] == 4 and nodes[("torques", 1)] == 2
+    assert [nodes[("theta", i)] for i in range(4)] == [1, 2, 3, 4]
+    assert nodes[("ddtheta", 2)] == 3
+    assert (nodes[("torque", 0)], nodes[("torque", 1)]) == (1, 4)
+
+
+def test_modal_mass_unknown_without_mass_matrix_or_normalisation():
+    ds = cantilever_dataset()
+    phi = ds.truth["sensor_modes"]
+    assert modal_masses(ds, phi) == pytest.approx([1.0, 1.0, 1.0], rel=1e-12)
+    del ds.truth["Mr"]
+    assert list(modal_masses(ds, phi)) == [1.0, 1.0, 1.0]  # declared mass-normalised by its unit
+    ds.truth_units["sensor_modes"] = "m"
+    assert list(modal_masses(ds, phi)) == [0.0, 0.0, 0.0]
 
 
 # SEP 5 (SDyPy unified timeseries): compulsory, optional and prohibited fields
@@ -148,8 +186,9 @@ def assert_sep005(channels) -> None:
 
 @pytest.mark.parametrize("make", [cantilever_dataset, fivebar_dataset])
 def test_sep005_file_is_compliant_and_exact(make, saved, tmp_path):
-    ds = make()
-    (out,) = export_dataset(saved(ds), "sep005", tmp_path / "x.json")
+    path = saved(make())
+    ds = Dataset.load(path)  # HDF5 lists the signals by name
+    (out,) = export_dataset(path, "sep005", tmp_path / "x.json")
     raw = json.loads(out.read_text())
     assert isinstance(raw, list) and isinstance(raw[0]["data"], list)
     channels = read_sep005(out)
@@ -168,9 +207,29 @@ def test_sep005_quantities_and_positions():
     assert ch["acceleration/acc2"]["position_m"] == 0.35
     assert ch["force/impact"]["quantity"] == "force" and ch["force/impact"]["node"] == 3
     ch = {c["name"]: c for c in to_sep005(fivebar_dataset())}
-    assert ch["torques/tau2"]["quantity"] == "torque" and ch["angles/th1"]["unit_tex"] == "rad"
+    assert ch["torque/u2"]["quantity"] == "torque" and ch["theta/th1"]["unit_tex"] == "rad"
+    assert ch["torque/u2"]["node"] == 4
 
 
 def test_unknown_format(saved):
     with pytest.raises(ValueError, match="sep005"):
         export_dataset(saved(fivebar_dataset()), "csv")
+
+
+def test_uff_real_cantilever_modes_are_mass_normalised(dataset_cache, tmp_path):
+    """The simulated beam's SEREP shapes: phi^T Mr phi = 1 for every mode, plain id2 text."""
+    from testbed.scenario import load_scenario
+
+    ds = dataset_cache.get(load_scenario("cantilever_stiff_impact"))
+    (out,) = export_dataset(ds.save(tmp_path / "beam.h5"), "uff")
+    sets = read_uff(out)
+    nodes = next(s for s in sets if s["type"] == 2411)
+    np.testing.assert_array_equal(nodes["x"], ds.measured["acceleration"].positions)
+    modes = [s for s in sets if s["type"] == 55]
+    assert len(modes) == ds.truth["sensor_modes"].shape[1], "the modes the sensors resolve"
+    for k, m in enumerate(modes):
+        assert m["modal_m"] == pytest.approx(1.0, rel=1e-6)
+        f, zeta = ds.truth["frequencies_hz"][k], ds.truth["damping_ratios"][k]
+        assert m["id2"].strip() == f"{f:.4f} Hz, zeta {zeta:.6f}"
+    force = next(s for s in sets if s["type"] == 58 and s["id1"] == "force/force")
+    assert force["rsp_node"] == 3, "hit at the tip sensor"
