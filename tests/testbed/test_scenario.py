@@ -116,7 +116,7 @@ def test_cli_prints_one_line_and_exits_2(tmp_path, capsys):
     assert "rig.n_segments" in err and "-4" in err
 
 
-def test_extends_replaces_identify_and_score_whole(tmp_path):
+def test_extends_replaces_identify_whole_and_keeps_the_parents_score(tmp_path):
     parent = GOOD + '[identify]\nmethod = "sgd_sindy"\nepochs = 7\n[score]\ntrac_min = 0.9\nmac_min = 0.9\n'
     _write(tmp_path, parent, name="base")
     own = _write(tmp_path, '[scenario]\nname = "own"\nextends = "base.toml"\n'
@@ -124,9 +124,11 @@ def test_extends_replaces_identify_and_score_whole(tmp_path):
     sc = load_scenario(own)
     assert sc.identify == {"method": "ls_sindy"}  # no epochs inherited from sgd_sindy
     assert sc.score == {"trac": {"min": 0.5}}  # no mac_min inherited
+    # a child that replaces [identify] but states no [score] keeps its parent's bars (it must
+    # never pass with no bars at all)
     bare = _write(tmp_path, '[scenario]\nname = "bare"\nextends = "base.toml"\n'
                   '[identify]\nmethod = "ls_sindy"\n', name="bare")
-    assert load_scenario(bare).score == {}
+    assert load_scenario(bare).score == {"trac": {"min": 0.9}, "mac": {"min": 0.9}}
     noisy = _write(tmp_path, '[scenario]\nname = "noisy"\nextends = "base.toml"\n[noise]\nrms_percent = 1\n',
                    name="noisy")
     sc = load_scenario(noisy)
