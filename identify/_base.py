@@ -21,7 +21,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from testbed.errors import IdentificationError, ScenarioError
+from testbed.errors import HyperparameterError, ScenarioError
 from testbed.measurement import Measurement, Trajectory
 from testbed.schema import ErrorFn, Field, validate_table
 
@@ -103,8 +103,9 @@ class Identifier:
 
         Raises
         ------
-        IdentificationError
-            Naming the hyperparameter, its value and what is allowed.
+        HyperparameterError
+            (an IdentificationError and a ValueError) naming the hyperparameter, its value
+            and what is allowed.
         """
         given = {}
         for k, v in self.get_params().items():
@@ -117,7 +118,7 @@ class Identifier:
         try:
             self.validate_hyperparameters(given, file=type(self).__name__, section=self.name or "params")
         except ScenarioError as e:
-            raise IdentificationError(str(e)) from None
+            raise HyperparameterError(str(e)) from None
 
     @classmethod
     def _param_names(cls) -> list[str]:

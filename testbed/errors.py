@@ -76,6 +76,12 @@ class IdentificationError(TestbedError):
     """An identifier could not produce a model from the data given."""
 
 
+class HyperparameterError(IdentificationError, ValueError):
+    """An identifier was constructed with a hyperparameter its declaration refuses (checked
+    at fit time for estimators built in Python; scenario files are checked at load).  A
+    ValueError too, as scikit-learn estimators raise for bad parameters."""
+
+
 class DivergenceError(IdentificationError):
     """A simulation of an identified model failed: non-finite state, blow-up, or a loop closure
     that no longer solves.  Scoring turns it into a failed score with its reason and time.

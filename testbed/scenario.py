@@ -190,6 +190,16 @@ def read_toml_file(path: Path, what: str) -> dict:
     if "\x00" in text:
         raise ScenarioError(file, allowed=f"contains NUL bytes (a binary file?); a {what} file is "
                                           "UTF-8 TOML")
+    for n, line in enumerate(text.splitlines(), 1):
+        # a dotted key of thousands of parts nests thousands of tables, and tomllib takes
+        # seconds (quadratic) to build them: refuse it before parsing
+        stripped = line.lstrip()
+        if stripped.startswith("#") or ("=" not in stripped and not stripped.startswith("[")):
+            continue
+        head = stripped.split("=", 1)[0].split("#", 1)[0]
+        if head.count(".") > MAX_DEPTH:
+            raise ScenarioError(file, allowed=f"not a {what} file: a key on line {n} is nested "
+                                              f"deeper than {MAX_DEPTH}")
     try:
         raw = tomllib.loads(text)
     except tomllib.TOMLDecodeError as e:
@@ -224,7 +234,11 @@ def _read_toml(path: Path, chain: tuple[Path, ...] = ()) -> dict:
             raise ScenarioError(str(path), "scenario.extends", parent, "extends itself (a cycle)")
         if not ppath.is_file():
             raise ScenarioError(str(path), "scenario.extends", parent, f"no such file {ppath}")
-        base = _read_toml(ppath, (*chain, path.resolve()))
+        try:
+            base = _read_toml(ppath, (*chain, path.resolve()))
+        except ScenarioError as e:
+            raise type(e)(e.file, e.key, e.value,
+                          f"{e.allowed + ' ' if e.allowed else ''}(extended by {path})") from None
         if not isinstance(base.get("scenario", {}), dict):
             raise ScenarioError(str(ppath), "scenario", base["scenario"], "expected a table")
         base.setdefault("scenario", {}).pop("extends", None)
