@@ -230,9 +230,16 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     study = load_study(args.study)
     if args.dask:
         check_dask_address(args.dask)
-    results = run_sweep(study, jobs=args.jobs, dask_address=args.dask,
-                        results=Path(args.results) if args.results else None,
-                        cache_dir=args.cache)
+    try:
+        results = run_sweep(study, jobs=args.jobs, dask_address=args.dask,
+                            results=Path(args.results) if args.results else None,
+                            cache_dir=args.cache)
+    except (OSError, TimeoutError) as e:
+        if not args.dask:
+            raise
+        # the port answered but no scheduler served it (or it went away): the address is wrong
+        raise InputError(f"--dask {args.dask!r}: the Dask scheduler failed: "
+                         f"{type(e).__name__}: {e}") from None
     print(f"results: {results}")
     return 0
 

@@ -204,7 +204,7 @@ def validate_variant(table: Mapping[str, Any], variants: Mapping[str, Mapping[st
     if kind is REQUIRED:
         raise ScenarioError(file, f"{section}.{selector}",
                             allowed="missing; expected one of " + ", ".join(map(repr, variants)))
-    if kind not in variants:
+    if not isinstance(kind, str) or kind not in variants:
         raise ScenarioError(file, f"{section}.{selector}", kind,
                             "expected one of " + ", ".join(map(repr, variants)))
     rest = {k: v for k, v in table.items() if k != selector}

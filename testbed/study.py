@@ -269,8 +269,7 @@ def _check_cells(study: Study, file: str) -> None:
             check_identifier_for_rig(RIGS.get(sc.rig), sc.rig_params, sc.simulation, params,
                                      file=file, section=f"identifiers.{m}")
         except ScenarioError as e:
-            raise ScenarioError(file, e.key, e.value,
-                                f"{e.allowed} (for scenario {sc.name!r})") from None
+            raise type(e)(file, e.key, e.value, f"{e.allowed} (for scenario {sc.name!r})") from None
 
 
 def _validate_params(table: Any, identifiers: list[str], file: str) -> dict[str, dict[str, Any]]:

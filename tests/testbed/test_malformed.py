@@ -85,8 +85,6 @@ def base_raw(name: str) -> dict:
 
 def bad_values(f) -> list:
     """Values a field must refuse: the wrong type, non-finite, out of its bounds."""
-    from testbed.schema import REQUIRED  # noqa: F401  (the Field API this relies on)
-
     if f.also is not None:
         return [5, True]
     if f.type is bool:
@@ -365,6 +363,9 @@ def test_a_scenario_passed_as_study_names_the_command():
 # ------------------------------------------------------------------------ property test
 _VALUES = st.one_of(
     st.none(), st.booleans(), st.integers(min_value=-10**20, max_value=10**20),
+    st.integers(min_value=-3, max_value=500), st.floats(min_value=-10.0, max_value=2e4),
+    st.floats(min_value=0.0, max_value=1.0), st.sampled_from(["fivebar", "generic", "zoh", "weak",
+                                                               "estimated", "lowpass", "soft"]),
     st.floats(allow_nan=True, allow_infinity=True), st.text(max_size=20),
     st.lists(st.one_of(st.floats(), st.integers(-5, 5), st.text(max_size=5)), max_size=4),
     st.dictionaries(st.text(max_size=5), st.integers(), max_size=2),
