@@ -45,7 +45,8 @@ With `extends`, tables are merged key by key, so a variant states only what diff
 Two tables are replaced whole instead: `[identify]` (a new identifier does not inherit
 another's hyperparameters) and `[score]`.  A child keeps its parent's `[score]` unless it
 declares its own, even when it replaces `[identify]`: it is held to its parent's bars until
-it states new ones.  `[score]` without `[identify]` is an error.
+it states new ones.  `[score]` without `[identify]` is an error when the scenario is run
+on its own; a study may list such a scenario, holding the study's identifiers to its bars.
 
 Everything is checked when the file loads, before anything is simulated: unknown keys,
 wrong types and values out of bounds, and rules across keys (filter cut-offs below the

@@ -18,7 +18,9 @@ state only what differs.  Two tables are replaced whole rather than merged:
 ``[score]``.  **A child keeps its parent's ``[score]`` unless it declares its own**
 (even when it replaces ``[identify]``): a variant is held to its parent's bars until
 it states new ones, and never passes with no bars at all.  ``[score]`` without
-``[identify]`` is an error (there would be nothing to score).
+``[identify]`` is an error in a scenario run on its own (there would be nothing to
+score); a study may use such a scenario, its identifiers being held to the scenario's
+bars.
 
 Everything is checked when the file loads, before anything is simulated: every key's
 type and range (the rig's, the signal chain's and the identifier's declared
@@ -268,8 +270,11 @@ def _check_stem(path: Path, what: str, directory: Path) -> None:
                                                + (", ".join(known) or f"(none in {directory})"))
 
 
-def load_scenario(name_or_path: str | os.PathLike) -> Scenario:
+def load_scenario(name_or_path: str | os.PathLike, *, standalone: bool = True) -> Scenario:
     """Read and validate a scenario file (a path, or a name in ``scenarios/``).
+
+    ``standalone=False`` (a study's scenario, whose identifiers come from the study) allows
+    ``[score]`` without ``[identify]``.
 
     Raises
     ------
@@ -280,12 +285,13 @@ def load_scenario(name_or_path: str | os.PathLike) -> Scenario:
     path = resolve_path(name_or_path)
     _check_stem(path, "scenario", SCENARIO_DIR)
     raw = _read_toml(path)
-    return scenario_from_dict(raw, file=str(path), stem=path.stem)
+    return scenario_from_dict(raw, file=str(path), stem=path.stem, standalone=standalone)
 
 
-def scenario_from_dict(raw: dict[str, Any], *, file: str = "<dict>",
-                       stem: str | None = None) -> Scenario:
-    """Validate a scenario given as a dict of TOML tables."""
+def scenario_from_dict(raw: dict[str, Any], *, file: str = "<dict>", stem: str | None = None,
+                       standalone: bool = True) -> Scenario:
+    """Validate a scenario given as a dict of TOML tables (``standalone``: see
+    :func:`load_scenario`)."""
     from models import RIGS  # the rig owns the schema of its sections
 
     if not isinstance(raw, dict):
@@ -327,7 +333,7 @@ def scenario_from_dict(raw: dict[str, Any], *, file: str = "<dict>",
     identify = _validate_identify(raw.get("identify"), file, kind=rig_cls.kind,
                                   rig_kind_source=f"rig {head['rig']!r}")
     score = _validate_score(raw.get("score", {}), rig_cls.kind, file)
-    if score and identify is None:
+    if score and identify is None and standalone:
         raise ScenarioError(file, "score", allowed="[score] needs an [identify] table: there is no "
                                                    "identified model to score")
     if identify is not None:

@@ -243,7 +243,7 @@ def study_from_dict(raw: dict[str, Any], *, file: str = "<dict>", base: Path | N
                                 f"no scenario file {spath}; expected a name among "
                                 f"{', '.join(known) or '(none in ' + str(SCENARIO_DIR) + ')'} "
                                 "or a .toml path relative to the study file")
-        scenarios.append(load_scenario(spath))
+        scenarios.append(load_scenario(spath, standalone=False))  # bars for the study's identifiers
 
     params = _validate_params(raw.get("identifiers", {}), head["identifiers"], file)
     study = Study(name=head["name"], description=head["description"], scenarios=tuple(scenarios),

@@ -127,9 +127,11 @@ class FiveBarRig(Rig):
         if round(simulation["duration"] * simulation["sample_rate"]) < 2:
             error("simulation.duration", simulation["duration"], "expected at least two samples")
         nyquist = simulation["sample_rate"] / 2.0
-        if excitation.get("amplitude", 1.0) == 0.0:
-            error("excitation.amplitude", 0.0, "expected > 0: without excitation the linkage "
-                  "rests and there is nothing to identify (all-zero records)")
+        at_rest = rig["dth1_0"] == 0.0 and rig["dth4_0"] == 0.0 and not rig["gravity"]
+        if excitation.get("amplitude", 1.0) == 0.0 and (at_rest or excitation["type"] == "sine_replay"):
+            error("excitation.amplitude", 0.0,
+                  "expected > 0: with no input, no start rates and no gravity the linkage rests "
+                  "and every record is zero (nothing to identify)")
         if excitation["type"] == "multisine":
             if not excitation["f_min"] < excitation["f_max"]:
                 error("excitation.f_min", excitation["f_min"],

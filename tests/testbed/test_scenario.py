@@ -185,6 +185,9 @@ def test_every_shipped_scenario_is_within_budget_with_room():
 def test_score_without_identify_and_contradictory_bars_are_refused(tmp_path):
     with pytest.raises(ScenarioError, match=r"'score'.*needs an \[identify\]"):
         load_scenario(_write(tmp_path, GOOD + "[score]\ntrac_min = 0.9\n"))
+    # a study's scenario: the study's identifiers are held to its bars
+    bars = load_scenario(tmp_path / "s.toml", standalone=False)
+    assert bars.identify is None and bars.score == {"trac": {"min": 0.9}}
     text = GOOD + '[identify]\nmethod = "ls_sindy"\n[score]\ntrac_min = 0.9\ntrac_max = 0.8\n'
     with pytest.raises(ScenarioError, match=r"'score\.trac_min'.*no score could pass"):
         load_scenario(_write(tmp_path, text))
