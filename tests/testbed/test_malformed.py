@@ -12,9 +12,11 @@ before any simulation.  A hypothesis property test draws random values for rando
 
 from __future__ import annotations
 
+import contextlib
 import copy
 import json
 import math
+import signal
 import statistics
 import time
 from pathlib import Path
@@ -210,11 +212,32 @@ BUDGET = {"duration_1e6.toml", "sample_rate_1e9.toml", "timestep_1e-12.toml", "s
           "fivebar_one_hour.toml"}
 
 
+class Hang(Exception):
+    """A load took longer than HANG_S."""
+
+
+@contextlib.contextmanager
+def no_hang(seconds: float = HANG_S):
+    """Interrupt the block after ``seconds`` (SIGALRM: the test fails instead of hanging)."""
+    def alarm(signum, frame):
+        raise Hang(f"no answer within {seconds} s")
+
+    previous = signal.signal(signal.SIGALRM, alarm)
+    signal.setitimer(signal.ITIMER_REAL, seconds)
+    try:
+        yield
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, previous)
+
+
 def refuse(load, path: Path) -> tuple[ScenarioError, float]:
-    """Load ``path``; return the ScenarioError and the seconds it took (fail on anything else)."""
+    """Load ``path``; return the ScenarioError and the seconds it took (fail on anything else,
+    and on a load that takes more than HANG_S)."""
     t0 = time.perf_counter()
     try:
-        result = load(path)
+        with no_hang():
+            result = load(path)
     except ScenarioError as e:
         return e, time.perf_counter() - t0
     pytest.fail(f"{path.name} was accepted as {type(result).__name__}")
@@ -400,7 +423,8 @@ def test_random_values_give_a_scenario_or_a_scenario_error(changes):
         else:
             table[key] = value
     try:
-        scenario_from_dict(raw, file="<random>", stem=raw["scenario"]["name"])
+        with no_hang():
+            scenario_from_dict(raw, file="<random>", stem=raw["scenario"]["name"])
     except ScenarioError as e:
         msg = str(e)
         assert msg.startswith("<random>") and "\n" not in msg, msg
