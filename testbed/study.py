@@ -134,12 +134,6 @@ def _identifier_kind(name: str) -> str:
     return IDENTIFIERS.get(name).kind
 
 
-def _defaults(name: str) -> dict[str, Any]:
-    from identify import IDENTIFIERS
-
-    return {k: f.default for k, f in IDENTIFIERS.get(name).declared_hyperparameters().items()}
-
-
 def import_plugins(plugins: tuple[str, ...] | list[str]) -> None:
     """Import each plugin once (a dotted module name, or a ``.py`` file path).
 

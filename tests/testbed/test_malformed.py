@@ -407,7 +407,7 @@ def _keys():
 KEYS = _keys()
 
 
-@settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(changes=st.lists(st.tuples(st.sampled_from(KEYS), _VALUES), min_size=1, max_size=3))
 def test_random_values_give_a_scenario_or_a_scenario_error(changes):
     """Whatever values the keys take, loading gives a Scenario or a ScenarioError naming a
