@@ -314,10 +314,12 @@ def scenario_from_dict(raw: dict[str, Any], *, file: str = "<dict>", stem: str |
     noise = validate_table(raw.get("noise", {}), NOISE_SCHEMA, file=file, section="noise")
     if noise["signals"] is None:
         noise["signals"] = list(rig_cls.noisy_signals)
-    for s in noise["signals"]:
+    for i, s in enumerate(noise["signals"]):
         if s not in rig_cls.measured_signals:
             raise ScenarioError(file, "noise.signals", s,
                                 "expected measured signals among " + ", ".join(rig_cls.measured_signals))
+        if s in noise["signals"][:i]:
+            raise ScenarioError(file, f"noise.signals[{i}]", s, "duplicate; each signal gets noise once")
 
     def error(key: str, value: Any, allowed: str) -> None:
         raise ScenarioError(file, key, value, allowed)

@@ -43,6 +43,7 @@ def test_good_file_loads_with_defaults(tmp_path):
     ('[rig]\nbase = "wobbly"\n', "rig.base", "'stiff', 'soft'"),
     ("[noise]\nrms_percent = -1.0\n", "noise.rms_percent", ">= 0"),
     ('[noise]\nsignals = ["force", "strain"]\n', "noise.signals", "strain"),
+    ('[noise]\nsignals = ["force", "force"]\n', "noise.signals[1]", "duplicate"),
     ("[wind]\nspeed = 3\n", "wind", "unknown section"),
     ('[identify]\nmethod = "magic"\n', "identify.method", "expected one of"),
     ('[identify]\nmethod = "ls_sindy"\nwarp = 9\n', "identify.warp", "unknown hyperparameter"),
