@@ -215,7 +215,10 @@ class CantileverRig(Rig):
             raise RigError(f"the beam cannot be built from these parameters: {e}") from None
         if simulation["timestep"] > 0:
             step_key, step_value = "simulation.timestep", simulation["timestep"]
-        elif stepping.substeps > 64:  # the stiffest mode, not the sample rate, sets the step
+        # accuracy alone asks ceil(pi / 0.49) = 7 substeps (RK4) or ceil(pi / 0.109) = 29
+        # (implicitfast) per sample; far more means stability, i.e. the stiffest mode of the
+        # chain, sets the step
+        elif stepping.substeps > 64:
             step_key, step_value = "rig.n_segments", rig["n_segments"]
         else:
             step_key, step_value = key, value
