@@ -342,7 +342,7 @@ def main(argv: list[str] | None = None) -> int:
         return EXIT_USAGE
     except KeyError as e:
         text = str(e.args[0]) if e.args else ""
-        if not text.startswith("unknown ") or args.debug:  # registries: "unknown rig 'x'; ..."
+        if not text.startswith("unknown "):  # the registries' own: "unknown rig 'x'; allowed: ..."
             return _internal(e, args)
         print(f"error: {_one_line(text)}", file=sys.stderr)
         return EXIT_USAGE
