@@ -61,6 +61,13 @@ def _existing_file(path: Path, what: str) -> Path:
     return path
 
 
+def _cache_folder(cache: str | None) -> str | None:
+    """A ``--cache`` folder (created on use) must not be an existing file."""
+    if cache is not None and Path(cache).exists() and not Path(cache).is_dir():
+        raise InputError(f"--cache {cache}: not a folder")
+    return cache
+
+
 def _dataset_file(path: Path) -> Path:
     """A dataset file written by ``testbed generate`` (HDF5 of this format), else InputError."""
     import h5py
@@ -184,7 +191,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     from testbed.scenario import load_scenario
     from testbed.summaries import print_score_table
 
-    cache = None if args.no_cache else DatasetCache(args.cache)
+    cache = None if args.no_cache else DatasetCache(_cache_folder(args.cache))
     ok = True
     for name in args.scenario:
         sc = load_scenario(name)
@@ -233,7 +240,7 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     try:
         results = run_sweep(study, jobs=args.jobs, dask_address=args.dask,
                             results=Path(args.results) if args.results else None,
-                            cache_dir=args.cache)
+                            cache_dir=_cache_folder(args.cache))
     except (OSError, TimeoutError) as e:
         if not args.dask:
             raise
@@ -254,7 +261,7 @@ def cmd_summary(args: argparse.Namespace) -> int:
 def cmd_cache(args: argparse.Namespace) -> int:
     from testbed.cache import DatasetCache
 
-    cache = DatasetCache(args.cache)
+    cache = DatasetCache(_cache_folder(args.cache))
     if args.action == "ls":
         entries = cache.entries()
         for p, size in entries:

@@ -260,7 +260,9 @@ def resolve_path(name_or_path: str | os.PathLike) -> Path:
 
 
 def _check_stem(path: Path, what: str, directory: Path) -> None:
-    """Refuse a file whose stem is not a safe name (e.g. ``..toml``, stem ``.``)."""
+    """Refuse a folder, and a file whose stem is not a safe name (e.g. ``..toml``, stem ``.``)."""
+    if path.is_dir():
+        raise ScenarioError(str(path), allowed=f"is a folder; expected a {what} .toml file")
     if not re.fullmatch(NAME_PATTERN, path.stem):
         raise ScenarioError(str(path), f"{what}.name", path.stem,
                             f"the file name without .toml must be {NAME_PATTERN_DOC}")

@@ -55,6 +55,10 @@ def one_error_line(err: str) -> str:
     (["sweep", "smoke", "--dask", "tcp://127.0.0.1:1"], "cannot reach a Dask scheduler"),
     (["sweep", "smoke", "--dask", "not an address"], "expected a scheduler address"),
     (["no-such-command"], "invalid choice"),
+    (["run", "{tmp}"], "is a folder"),
+    (["sweep", "no_such_study"], "no study named 'no_such_study'; known: "),
+    (["cache", "ls", "--cache", "{tmp}/text.txt"], "--cache"),
+    (["run", "cantilever_stiff_impact", "--cache", "{tmp}/text.txt"], "not a folder"),
 ])
 def test_user_mistakes_give_one_line_and_status_2(tmp_path, capsys, argv, fragment):
     (tmp_path / "text.txt").write_text("not a dataset\n")
