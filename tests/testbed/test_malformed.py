@@ -75,7 +75,7 @@ def dumps(raw: dict) -> str:
 # ------------------------------------------------------------------------ the mutations
 #: Standalone bases for the mutations: every identifier and both rigs are covered.
 BASES = ("cantilever_stiff_impact", "cantilever_stiff_impact_lsq", "cantilever_stiff_impact_sindy_pi",
-         "fivebar_multisine", "fivebar_multisine_pysindy")
+         "fivebar_multisine", "fivebar_multisine_pysindy", "fivebar_sine_replay")
 
 
 def base_raw(name: str) -> dict:
