@@ -5,7 +5,13 @@
 - learned results end in ``_`` (``M_``, ``C_``, ``K_``, ``K3_``, ``coef_``) and exist
   only after ``fit``;
 - ``simulate(x0, xd0, t, u=None)`` integrates the identified model;
-- ``equations()`` returns the identified equations as text.
+- ``equations()`` returns the identified equations as text;
+- every ``__init__`` parameter is *declared* in the class attribute ``hyperparameters``
+  (a :class:`testbed.schema.Field` per name: type, default, bounds, unit, meaning), and
+  nothing else is; scenario and study files are checked against it when they load, the
+  scenario guide lists it, and a conformance test keeps it equal to ``__init__``.
+  Cross-key checks go in :meth:`Identifier.check_hyperparameters`, checks against the
+  shape of the data (channels, inputs, sample rate) in :meth:`Identifier.check_data_shape`.
 """
 
 from __future__ import annotations
@@ -15,7 +21,9 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from testbed.errors import HyperparameterError, ScenarioError
 from testbed.measurement import Measurement, Trajectory
+from testbed.schema import ErrorFn, Field, validate_table
 
 
 class Identifier:
@@ -24,6 +32,93 @@ class Identifier:
     name: ClassVar[str] = ""
     #: "structural" identifiers expose M_, C_, K_ (and K3_); "mechanical" ones coef_.
     kind: ClassVar[str] = ""
+    #: Declared hyperparameters: one Field per ``__init__`` argument, same default.
+    hyperparameters: ClassVar[dict[str, Field]] = {}
+
+    @classmethod
+    def declared_hyperparameters(cls) -> dict[str, Field]:
+        """``hyperparameters`` if the class declares them; else (an undeclared plugin) fields
+        derived from ``__init__``: the type of each default (any value for a None default).
+
+        Every identifier of this package declares its own (a conformance test checks it).
+        """
+        if cls.hyperparameters:
+            return cls.hyperparameters
+        out = {}
+        for k, p in inspect.signature(cls.__init__).parameters.items():
+            if k == "self" or p.kind in (p.VAR_POSITIONAL, p.VAR_KEYWORD):
+                continue
+            d = None if p.default is p.empty else p.default
+            typ = {bool: bool, int: int, float: float, str: str, list: list, tuple: list}.get(
+                type(d), object)
+            out[k] = Field(typ, list(d) if isinstance(d, tuple) else d)
+        return out
+
+    @classmethod
+    def check_hyperparameters(cls, params: dict[str, Any], error: ErrorFn) -> None:
+        """Cross-key checks of a complete, field-validated hyperparameter dict.
+
+        Call ``error(name, value, allowed)`` (it raises) on the first problem; ``name`` is
+        the bare hyperparameter name.  The default checks nothing.
+        """
+
+    @classmethod
+    def check_data_shape(cls, params: dict[str, Any], n_channels: int, n_inputs: int, fs: float,
+                         n_samples: int, error: ErrorFn) -> None:
+        """Checks that need the data's shape but not its values (term names against the
+        number of channels and inputs, frequencies against the Nyquist frequency, windows
+        against the record).  ``fs`` [Hz]; the default checks nothing."""
+
+    @classmethod
+    def simulation_steps(cls, params: dict[str, Any], record_s: float) -> tuple[float, str]:
+        """Integration steps scoring's simulation of the identified model would take over a
+        record of ``record_s`` seconds, and the hyperparameter that sets them (0, "" if the
+        identifier's simulation is not stepped)."""
+        return 0.0, ""
+
+    @classmethod
+    def validate_hyperparameters(cls, params: dict[str, Any], *, file: str = "<identifier>",
+                                 section: str = "identify") -> dict[str, Any]:
+        """Field and cross-key checks of ``params`` (a partial dict); return it complete.
+
+        Raises
+        ------
+        ScenarioError
+            Naming ``file``, ``section.<name>``, the value and what is allowed.
+        """
+        full = validate_table(params, cls.declared_hyperparameters(), file=file, section=section)
+
+        def error(name: str, value: Any, allowed: str) -> None:
+            raise ScenarioError(file, f"{section}.{name}", value, allowed)
+
+        cls.check_hyperparameters(full, error)
+        return full
+
+    def check_params(self) -> None:
+        """Validate this estimator's hyperparameters against the declaration (at fit time).
+
+        Only values that can come from a scenario file are checked (a Python object such as
+        a :class:`~identify.library.Library` is left to the algorithm); a tuple counts as a
+        list.
+
+        Raises
+        ------
+        HyperparameterError
+            (an IdentificationError and a ValueError) naming the hyperparameter, its value
+            and what is allowed.
+        """
+        given = {}
+        for k, v in self.get_params().items():
+            v = list(v) if isinstance(v, tuple) else v
+            f = self.declared_hyperparameters().get(k)
+            if v is None and f is not None and f.default is None:
+                continue  # "not given"
+            if isinstance(v, (bool, int, float, str, list)):
+                given[k] = v
+        try:
+            self.validate_hyperparameters(given, file=type(self).__name__, section=self.name or "params")
+        except ScenarioError as e:
+            raise HyperparameterError(str(e)) from None
 
     @classmethod
     def _param_names(cls) -> list[str]:

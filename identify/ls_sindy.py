@@ -2,16 +2,26 @@
 
 from __future__ import annotations
 
+from typing import ClassVar
+
 import numpy as np
 
 from identify import IDENTIFIERS
 from identify.structural import (
+    MASS_PRIORS,
     StructuralIdentifier,
     build_library,
     mass_prior_value,
     matrices_from_coef,
 )
 from testbed.measurement import Measurement
+from testbed.schema import Field
+
+#: The mass prior: which key of ``data.prior`` gives the mass scale [kg] (shared with
+#: sgd_sindy and sindy_pi_linear).
+MASS_PRIOR_FIELD = Field(str, "reduced_mass_trace", choices=MASS_PRIORS,
+                         doc="key of the data's prior knowledge giving the mass scale: the trace "
+                             "of the sensor-coordinate mass matrix, or the structure's total mass")
 
 
 @IDENTIFIERS.register("ls_sindy", tags=("structural", "baseline", "paper:000"))
@@ -62,6 +72,14 @@ class LeastSquaresSINDy(StructuralIdentifier):
     """
 
     name = "ls_sindy"
+    hyperparameters: ClassVar[dict[str, Field]] = {
+        "cubic": Field(bool, False, doc="add the cubic displacement features x_j^3"),
+        "mass_prior": MASS_PRIOR_FIELD,
+        # [0, 1): a relative cut-off of 1 or more would discard every singular value;
+        # numpy's legacy -1 (machine precision) is not a documented choice here
+        "rcond": Field(float, 1e-10, min=0.0, max=1.0, max_inclusive=False,
+                       doc="relative singular-value cut-off of the least-squares solve"),
+    }
 
     def __init__(self, cubic: bool = False, mass_prior: str = "reduced_mass_trace", rcond: float = 1e-10):
         self.cubic = cubic
@@ -79,6 +97,7 @@ class LeastSquaresSINDy(StructuralIdentifier):
         -------
         self
         """
+        self.check_params()
         m_hat = mass_prior_value(data, self.mass_prior)
         lib = build_library(data, coupled_mass=False, cubic=bool(self.cubic))
         n, p = lib.target.shape[0], lib.theta.shape[0]

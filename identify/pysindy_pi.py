@@ -23,14 +23,15 @@ import contextlib
 import io
 import warnings
 from collections.abc import Sequence
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
 from identify import IDENTIFIERS
 from identify._implicit import Sweep, _errors
-from identify.sindy_pi import _ImplicitMechanical
+from identify.sindy_pi import COMMON_HYPERPARAMETERS, _ImplicitMechanical, ordered_fields
 from testbed.errors import IdentificationError
+from testbed.schema import Field
 
 
 def pysindy_pi_coef(X: np.ndarray, cand: np.ndarray, reg_weight_lam: float, tol: float,
@@ -103,6 +104,26 @@ class PySINDyPI(_ImplicitMechanical):
     """
 
     name = "pysindy_pi"
+    hyperparameters: ClassVar[dict[str, Field]] = ordered_fields({
+        **COMMON_HYPERPARAMETERS,
+        "reg_weight_lam": Field(float, 1e-6, min=0.0, doc="L1 weight of pysindy's objective"),
+        # OSQP's tolerances are relative and absolute: above 1 they accept anything
+        "tol": Field(float, 1e-5, min=0.0, min_inclusive=False, max=1.0,
+                     doc="OSQP absolute and relative tolerance"),
+        # 1e6: 100x pysindy's default; each iteration of 32 problems costs milliseconds
+        "max_iter": Field(int, 10000, min=1, max=1000000, doc="OSQP iteration limit"),
+        "qr": Field(bool, False, doc="feed the p x p R factor instead of the samples"),
+        "normalize": Field(bool, True, doc="divide the columns by their training norms first"),
+        # [0, 1): relative to the row's largest coefficient; 1 would keep none but it
+        "support_tol": Field(float, 0.0, min=0.0, max=1.0, max_inclusive=False,
+                             doc="coefficients above support_tol times the row's largest count "
+                                 "as nonzero"),
+        "stride": Field(int, 1, min=1, doc="give pysindy every stride-th training sample"),
+    }, (
+        "library", "lhs", "reg_weight_lam", "tol", "max_iter", "qr", "normalize", "support_tol",
+        "stride", "val_fraction", "selection", "selection_rtol", "selection_atol", "n_rollout",
+        "prune_tol", "sim_dt", "reconcile", "column_lowpass_hz", "column_lowpass_order",
+        "edge_trim", "input_hold"))  # __init__ order, for the guide
 
     def __init__(self, library: Any = "fivebar", lhs: Sequence[str] | None = None,
                  reg_weight_lam: float = 1e-6, tol: float = 1e-5, max_iter: int = 10000,

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import ClassVar
+
 import numpy as np
 
 from identify import IDENTIFIERS
@@ -13,6 +15,7 @@ from identify._sgd_penalties import (
     symmetric_mass_ratios,
     symmetry_penalty,
 )
+from identify.ls_sindy import MASS_PRIOR_FIELD
 from identify.structural import (
     StructuralIdentifier,
     build_library,
@@ -21,6 +24,7 @@ from identify.structural import (
     measured_frequencies,
 )
 from testbed.measurement import Measurement
+from testbed.schema import ErrorFn, Field
 
 _TERMS = ("sym", "eig", "l1")
 
@@ -201,6 +205,72 @@ class SGDSINDy(StructuralIdentifier):
 
     name = "sgd_sindy"
 
+    hyperparameters: ClassVar[dict[str, Field]] = {
+        # 1e6 epochs: 100x the paper's 10,000 (about 1e8 gradient steps on the cantilever)
+        "epochs": Field(int, 10000, min=0, max=1000000, doc="passes over the fit window"),
+        "batch_size": Field(int, 128, min=1, max=10**7, doc="samples per mini-batch"),
+        # (0, 1]: a step of the order of the standardised coefficients themselves diverges
+        "learning_rate": Field(float, 1.5e-4, min=0.0, min_inclusive=False, max=1.0,
+                               doc="step size of the coefficient optimiser (standardised units)"),
+        "mass_learning_rate": Field(float, 1.5e-4, min=0.0, min_inclusive=False, max=1.0,
+                                    doc="step size of the mass update"),
+        "alpha_init": Field(float, 0.1, min=0.0, doc="initial weight of every penalty"),
+        "epsilon": Field(float, 0.01, min=0.0, min_inclusive=False,
+                         doc="gain of the eigenvalue gradient (Eqs 12-13)"),
+        # [0, 1]: the annealing update (Eq. 18) is a convex blend of old and new weights
+        "beta": Field(float, 0.1, min=0.0, max=1.0, doc="annealing stabilisation coefficient"),
+        "cubic": Field(bool, False, doc="add the cubic features x_j^3 (identifies K3_)"),
+        "l1": Field(str, "cubic", choices=("cubic", "all", "none"),
+                    doc="which coefficients the L1 penalty acts on"),
+        "symmetry": Field(str, "MCK", pattern="[MCK]*", pattern_doc="made of the letters M, C, K",
+                          doc="matrices whose asymmetry is penalised; '' disables"),
+        "eigen": Field(bool, True, doc="eigenvalue penalty against the measured frequencies"),
+        # 1000 modes: far beyond any sensor count; the peaks are searched in one spectrum
+        "n_modes": Field(int, None, min=1, max=1000,
+                         doc="number of measured frequencies; default the number of channels"),
+        "freq_range": Field(list, None, item_type=float, min=0.0, min_items=2, max_items=2,
+                            unit="Hz", doc="peak search band [low, high], high below the Nyquist "
+                                           "frequency; default 5 bins to 0.45 fs"),
+        "steps_per_epoch": Field(int, None, min=1, max=10**7,
+                                 doc="gradient steps per epoch; default a full pass"),
+        "optimizer": Field(str, "adam", choices=("adam", "sgd"), doc="Adam or plain SGD"),
+        "init": Field(str, "lstsq", choices=("lstsq", "zeros"), doc="warm start or zero start"),
+        "mass_prior": MASS_PRIOR_FIELD,
+        "mass_update": Field(str, "lstsq", choices=("lstsq", "symmetry", "eq6"),
+                             doc="how the diagonal masses are learned"),
+        "anneal": Field(bool, True, doc="learning-rate annealing of the penalty weights"),
+        "alpha_max": Field(float, 1.0, min=0.0, min_inclusive=False,
+                           doc="upper bound of every annealed weight"),
+        "random_state": Field(int, 0, min=0, doc="seed of the mini-batch order"),
+        "parametrization": Field(str, "matrices", choices=("matrices", "coefficients"),
+                                 doc="symmetric-matrix form, or the paper's coefficient form"),
+        "fit_duration": Field(float, 0.0, unit="s", min=0.0,
+                              doc="length of the fit window after the free-vibration start; 0 = "
+                                  "to the end"),
+        "l1_threshold": Field(float, 0.2, min=0.0, max=1.0,
+                              doc="smallest partial correlation a cubic term needs to be kept"),
+        "l1_debias": Field(float, 0.5, min=0.0, max=1.0, max_inclusive=False,
+                           doc="fraction of the epochs, at the end, run without L1 on kept terms"),
+    }
+
+    @classmethod
+    def check_hyperparameters(cls, params: dict, error: ErrorFn) -> None:
+        """``freq_range`` low below high."""
+        fr = params["freq_range"]
+        if fr is not None and not fr[0] < fr[1]:
+            error("freq_range", fr, "expected [low, high] with low < high [Hz]")
+
+    @classmethod
+    def check_data_shape(cls, params: dict, n_channels: int, n_inputs: int, fs: float,
+                         n_samples: int, error: ErrorFn) -> None:
+        """``freq_range`` below the Nyquist frequency, ``fit_duration`` within the record."""
+        fr = params["freq_range"]
+        if fr is not None and not fr[1] <= fs / 2:
+            error("freq_range", fr, f"expected high <= the Nyquist frequency {fs / 2:g} Hz")
+        if not params["fit_duration"] < n_samples / fs:
+            error("fit_duration", params["fit_duration"],
+                  f"expected shorter than the record ({n_samples / fs:g} s)")
+
     def __init__(self, epochs: int = 10000, batch_size: int = 128, learning_rate: float = 1.5e-4,
                  mass_learning_rate: float = 1.5e-4, alpha_init: float = 0.1, epsilon: float = 0.01,
                  beta: float = 0.1, cubic: bool = False, l1: str = "cubic", symmetry: str = "MCK",
@@ -238,6 +308,7 @@ class SGDSINDy(StructuralIdentifier):
 
     # ----------------------------------------------------------------------------------------
     def _check_params(self) -> None:
+        self.check_params()
         if self.l1 not in ("cubic", "all", "none"):
             raise ValueError(f"l1 must be 'cubic', 'all' or 'none', got {self.l1!r}")
         if set(self.symmetry) - set("MCK"):

@@ -42,8 +42,8 @@ dropped (ordered pivoted Cholesky; library order is priority) and listed in ``pr
 from __future__ import annotations
 
 from collections.abc import Sequence
-from itertools import product
-from typing import Any
+from itertools import pairwise, product
+from typing import Any, ClassVar
 
 import numpy as np
 
@@ -56,6 +56,7 @@ from identify.library import Library, fivebar_library, generic_mechanical_librar
 from testbed.errors import IdentificationError
 from testbed.gram import normalized_gram, ordered_independent
 from testbed.measurement import Measurement, Trajectory
+from testbed.schema import ErrorFn, Field
 from testbed.signal import lowpass
 
 #: Rollout angle-RMSE differences below 1e-4 rad [rad] count as ties (then fewer terms win):
@@ -63,21 +64,163 @@ from testbed.signal import lowpass
 ROLLOUT_ATOL = 1e-4
 
 
-def make_library(spec: Any, data: Measurement) -> Library:
-    """``"fivebar"``, ``"fivebar_full"``, ``"generic"``, a Library, or a list of term names."""
-    n_in = 0 if data.u is None else data.u.shape[0]
+NAMED_LIBRARIES = ("fivebar", "fivebar_full", "generic")
+
+# Hyperparameter declarations shared by the SINDy-PI identifiers (sindy_pi, pysindy_pi,
+# sindy_pi_linear); each bound carries its reason.
+LIBRARY_FIELD = Field(str, "fivebar", choices=NAMED_LIBRARIES,
+                      also=Field(list, item_type=str, min_items=1),
+                      doc="candidate terms: a named library ('fivebar': the reduced five-bar "
+                          "equations' terms) or a list of term names such as 'sin(th2-th3)*u1'")
+LHS_FIELD = Field(list, None, item_type=str, min_items=1,
+                  doc="candidate left-hand-side terms (library term names); default every kept "
+                      "column")
+THRESHOLDS_FIELD = Field(list, None, item_type=float, min=0.0, min_items=1,
+                         doc="ascending thresholds on normalised coefficients; default 0 and 12 "
+                             "values log-spaced over 1e-6..0.32")
+# <= 1: a ridge of the order of the unit diagonal of the normalised Gram matrix swamps the data
+RIDGE_FIELD = Field(float, 1e-14, min=0.0, max=1.0,
+                    doc="ridge added to the unit-diagonal normalised Gram matrix")
+# 1000 rounds: thresholding converges in a few; more only burns time
+MAX_ITER_FIELD = Field(int, 20, min=1, max=1000, doc="thresholding rounds per threshold")
+# (0, 1): both the training and the held-out part must hold samples
+VAL_FRACTION_FIELD = Field(float, 0.2, min=0.0, max=1.0, min_inclusive=False, max_inclusive=False,
+                           doc="held-out fraction at the end of the record")
+SELECTION_FIELD = Field(str, "holdout", choices=("holdout", "rollout"),
+                        doc="model selection by held-out residual, or by simulating shortlisted "
+                            "models over the held-out window")
+SELECTION_RTOL_FIELD = Field(float, 0.1, min=0.0,
+                             doc="relative held-out error tolerance of the parsimony rule")
+SELECTION_ATOL_FIELD = Field(float, 1e-12, min=0.0,
+                             doc="absolute held-out error tolerance of the parsimony rule")
+# 10 per input: the rollout tries n_rollout^n_inputs combinations (100 for two inputs)
+N_ROLLOUT_FIELD = Field(int, 3, min=1, max=10, doc="models shortlisted per input for rollout selection")
+# [0, 1): the residual variance of a unit-norm column is at most 1
+PRUNE_TOL_FIELD = Field(float, 1e-9, min=0.0, max=1.0, max_inclusive=False,
+                        doc="residual variance below which an input-free column counts as a "
+                            "combination of earlier ones")
+# (0, 1] s: the five-bar's motion is below 2 Hz; a step above 1 s resolves nothing
+SIM_DT_FIELD = Field(float, 1e-3, unit="s", min=0.0, min_inclusive=False, max=1.0,
+                     doc="RK4 step of the identified model's simulation")
+RECONCILE_FIELD = Field(bool, True, doc="replace passive angles, rates and accelerations by those "
+                                        "the loop closure implies")
+COLUMN_LOWPASS_FIELD = Field(float, None, unit="Hz", min=0.0, min_inclusive=False,
+                             doc="zero-phase low-pass cut-off applied to every library column "
+                                 "(below the Nyquist frequency); default off")
+COLUMN_LOWPASS_ORDER_FIELD = Field(int, 4, min=1, max=16,
+                                   doc="Butterworth order of the column low-pass (one pass)")
+EDGE_TRIM_FIELD = Field(float, 0.0, unit="s", min=0.0,
+                        doc="seconds dropped at each end of the record (less than half of it)")
+INPUT_HOLD_FIELD = Field(str, "linear", choices=("linear", "zoh"),
+                         doc="sampled inputs in simulations: continuous (linear) or zero-order hold")
+
+COMMON_HYPERPARAMETERS = {
+    "library": LIBRARY_FIELD, "lhs": LHS_FIELD, "val_fraction": VAL_FRACTION_FIELD,
+    "selection": SELECTION_FIELD, "selection_rtol": SELECTION_RTOL_FIELD,
+    "selection_atol": SELECTION_ATOL_FIELD, "n_rollout": N_ROLLOUT_FIELD,
+    "prune_tol": PRUNE_TOL_FIELD, "sim_dt": SIM_DT_FIELD, "reconcile": RECONCILE_FIELD,
+    "column_lowpass_hz": COLUMN_LOWPASS_FIELD, "column_lowpass_order": COLUMN_LOWPASS_ORDER_FIELD,
+    "edge_trim": EDGE_TRIM_FIELD, "input_hold": INPUT_HOLD_FIELD,
+}
+
+
+def ordered_fields(fields: dict[str, Field], order: tuple[str, ...]) -> dict[str, Field]:
+    """``fields`` in the given key order (that of ``__init__``, for the guide)."""
+    return {k: fields[k] for k in order}
+
+
+def check_thresholds(params: dict[str, Any], error: ErrorFn) -> None:
+    """``thresholds`` (if given) must be ascending and distinct."""
+    thr = params.get("thresholds")
+    if thr is not None and any(b <= a for a, b in pairwise(thr)):
+        error("thresholds", thr, "expected strictly ascending values")
+
+
+def library_for(spec: Any, n_channels: int, n_inputs: int) -> Library:
+    """The library a ``library`` hyperparameter names, for data of this shape.
+
+    Parameters
+    ----------
+    spec : str, Library or sequence of str
+        ``"fivebar"``, ``"fivebar_full"``, ``"generic"``, a Library, or term names.
+    n_channels, n_inputs : int
+        Coordinates and inputs of the data.
+
+    Raises
+    ------
+    ValueError
+        For an unknown name, an unknown term or a term the data's shape cannot provide.
+    """
     if isinstance(spec, Library):
         return spec
     if spec == "fivebar":
-        return fivebar_library(n_inputs=n_in)
+        return fivebar_library(n_inputs=n_inputs)
     if spec == "fivebar_full":
-        return fivebar_library(kind="full", n_inputs=n_in)
+        return fivebar_library(kind="full", n_inputs=n_inputs)
     if spec == "generic":
-        return generic_mechanical_library(data.n_channels, n_in)
+        return generic_mechanical_library(n_channels, n_inputs)
     if isinstance(spec, Sequence) and not isinstance(spec, str):
-        return Library(list(spec), data.n_channels, n_in)
+        return Library(list(spec), n_channels, n_inputs)
     raise ValueError(f"library must be 'fivebar', 'fivebar_full', 'generic', a Library or a list "
                      f"of term names, got {spec!r}")
+
+
+def make_library(spec: Any, data: Measurement) -> Library:
+    """``"fivebar"``, ``"fivebar_full"``, ``"generic"``, a Library, or a list of term names.
+
+    Raises
+    ------
+    IdentificationError
+        If the library does not fit the data (unknown terms, more coordinates or inputs than
+        the data have).
+    """
+    n_in = 0 if data.u is None else data.u.shape[0]
+    try:
+        return library_for(spec, data.n_channels, n_in)
+    except ValueError as e:
+        raise IdentificationError(f"library {spec!r} does not fit the data ({data.n_channels} "
+                                  f"channels, {n_in} inputs): {e}") from None
+
+
+def check_terms(params: dict[str, Any], n_channels: int, n_inputs: int, error: ErrorFn) -> None:
+    """``library`` and ``lhs`` against the data's shape: every term known, every ``lhs`` term in
+    the library (before data-dependent pruning)."""
+    try:
+        lib = library_for(params["library"], n_channels, n_inputs)
+    except (ValueError, TypeError) as e:
+        error("library", params["library"], f"a library for {n_channels} channels and {n_inputs} "
+                                            f"inputs: {e}")
+        return
+    if params.get("lhs") is None:
+        return
+    try:
+        wanted = Library(list(params["lhs"]), lib.n_coords, lib.n_inputs).names
+    except (ValueError, TypeError) as e:
+        error("lhs", params["lhs"], f"term names of the library: {e}")
+        return
+    missing = [w for w in wanted if w not in set(lib.names)]
+    if missing:
+        error("lhs", params["lhs"], f"terms of the library; not in it: {', '.join(missing)}")
+
+
+def check_record(params: dict[str, Any], fs: float, n_samples: int, error: ErrorFn) -> None:
+    """Column low-pass below Nyquist and an edge trim that leaves samples."""
+    cut = params.get("column_lowpass_hz")
+    if cut is not None and not cut < fs / 2:
+        error("column_lowpass_hz", cut, f"expected below the Nyquist frequency {fs / 2:g} Hz")
+    record_s = n_samples / fs
+    if not 2 * params["edge_trim"] < record_s:
+        error("edge_trim", params["edge_trim"], f"expected less than half the record "
+                                               f"({record_s:g} s)")
+
+
+def rollout_steps(params: dict[str, Any], record_s: float) -> tuple[float, str]:
+    """RK4 steps of scoring's simulation over the record, plus the rollout selection's
+    simulations of up to ``n_rollout^2`` model pairs (two inputs) over the held-out part."""
+    steps = record_s / params["sim_dt"]
+    if params["selection"] == "rollout":
+        steps *= 1 + params["n_rollout"] ** 2 * params["val_fraction"]
+    return steps, "sim_dt"
 
 
 def prune_dependent(G: np.ndarray, protected: np.ndarray, tol: float) -> np.ndarray:
@@ -200,7 +343,19 @@ class _ImplicitMechanical(Identifier):
         self.weak_strong_columns_ = wf.strong_columns
         return np.concatenate([wf.V[tr], wf.V[va]]), int(tr.sum()), i0, i0 + split
 
+    @classmethod
+    def check_data_shape(cls, params, n_channels, n_inputs, fs, n_samples, error):
+        """Library and lhs terms, column low-pass and edge trim against the data's shape."""
+        check_terms(params, n_channels, n_inputs, error)
+        check_record(params, fs, n_samples, error)
+
+    @classmethod
+    def simulation_steps(cls, params, record_s):
+        """See :func:`rollout_steps`."""
+        return rollout_steps(params, record_s)
+
     def fit(self, data: Measurement) -> _ImplicitMechanical:
+        self.check_params()
         if data.u is None or data.input_map is None:
             raise IdentificationError(f"{self.name} needs measured inputs and their input_map")
         imap = np.abs(np.asarray(data.input_map)) > 0
@@ -368,6 +523,46 @@ class SINDyPI(_ImplicitMechanical):
     """
 
     name = "sindy_pi"
+    hyperparameters: ClassVar[dict[str, Field]] = ordered_fields({
+        **COMMON_HYPERPARAMETERS,
+        "thresholds": THRESHOLDS_FIELD,
+        "ridge": RIDGE_FIELD,
+        "max_iter": MAX_ITER_FIELD,
+        "formulation": Field(str, "strong", choices=("strong", "weak"),
+                             doc="one regression row per sample, or per test-function integral"),
+        "weak_window_s": Field(float, 0.5, unit="s", min=0.0, min_inclusive=False,
+                               doc="support of each test function (weak form; shorter than the "
+                                   "record)"),
+        # >= 4: the held-out split needs at least 2 training and 2 validation windows
+        "weak_n_windows": Field(int, 400, min=4, max=100000,
+                                doc="number of overlapping test functions (weak form)"),
+        # >= 2: the test function (1 - s^2)^p and its first derivative must vanish at the ends;
+        # 16: higher powers concentrate the support to a fraction of the window
+        "weak_degree": Field(int, 4, min=2, max=16, doc="exponent p of the test function (1 - s^2)^p"),
+    }, (
+        "library", "lhs", "thresholds", "ridge", "max_iter", "val_fraction", "selection",
+        "selection_rtol", "selection_atol", "n_rollout", "prune_tol", "sim_dt", "reconcile",
+        "column_lowpass_hz", "column_lowpass_order", "edge_trim", "input_hold", "formulation",
+        "weak_window_s", "weak_n_windows", "weak_degree"))  # __init__ order, for the guide
+
+    @classmethod
+    def check_hyperparameters(cls, params, error):
+        """Ascending thresholds; the weak form filters itself (no column low-pass)."""
+        check_thresholds(params, error)
+        if params["formulation"] == "weak" and params["column_lowpass_hz"] is not None:
+            error("column_lowpass_hz", params["column_lowpass_hz"],
+                  "not with formulation = 'weak' (its test functions filter; integration by "
+                  "parts needs unfiltered columns)")
+
+    @classmethod
+    def check_data_shape(cls, params, n_channels, n_inputs, fs, n_samples, error):
+        """As the shared checks, plus a weak window shorter than the record."""
+        super().check_data_shape(params, n_channels, n_inputs, fs, n_samples, error)
+        if params["formulation"] == "weak":
+            span = n_samples / fs - 2 * params["edge_trim"]
+            if not params["weak_window_s"] < span:
+                error("weak_window_s", params["weak_window_s"],
+                      f"expected shorter than the trimmed record ({span:g} s)")
 
     def __init__(self, library: Any = "fivebar", lhs: Sequence[str] | None = None,
                  thresholds: Sequence[float] | None = None, ridge: float = 1e-14, max_iter: int = 20,

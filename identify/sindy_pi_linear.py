@@ -41,6 +41,7 @@ dissipates).  Simulation: exact zero-order-hold discretisation (matrix exponenti
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import ClassVar
 
 import numpy as np
 from scipy.linalg import expm
@@ -49,8 +50,18 @@ from identify import IDENTIFIERS
 from identify._base import Identifier
 from identify._implicit import DEFAULT_THRESHOLDS, grams, rank_models, split_index, stlsq_sweep
 from identify.library import linear_structural_library
+from identify.ls_sindy import MASS_PRIOR_FIELD
+from identify.sindy_pi import (
+    MAX_ITER_FIELD,
+    SELECTION_ATOL_FIELD,
+    SELECTION_RTOL_FIELD,
+    THRESHOLDS_FIELD,
+    VAL_FRACTION_FIELD,
+    check_thresholds,
+)
 from testbed.errors import IdentificationError
 from testbed.measurement import Measurement, Trajectory
+from testbed.schema import Field
 
 
 def _sym_basis(n: int) -> np.ndarray:
@@ -153,6 +164,21 @@ class SINDyPILinear(Identifier):
 
     name = "sindy_pi_linear"
     kind = "structural"
+    hyperparameters: ClassVar[dict[str, Field]] = {
+        "thresholds": THRESHOLDS_FIELD,
+        "ridge": Field(float, 1e-10, min=0.0, max=1.0,
+                       doc="ridge on the unit-diagonal normalised Gram matrix of each row"),
+        "max_iter": MAX_ITER_FIELD,
+        "val_fraction": VAL_FRACTION_FIELD,
+        "selection_rtol": SELECTION_RTOL_FIELD,
+        "selection_atol": SELECTION_ATOL_FIELD,
+        "mass_prior": MASS_PRIOR_FIELD,
+    }
+
+    @classmethod
+    def check_hyperparameters(cls, params, error):
+        """Thresholds ascending (see :func:`identify.sindy_pi.check_thresholds`)."""
+        check_thresholds(params, error)
 
     def __init__(self, thresholds: Sequence[float] | None = None, ridge: float = 1e-10,
                  max_iter: int = 20, val_fraction: float = 0.2, selection_rtol: float = 0.1,
@@ -166,6 +192,7 @@ class SINDyPILinear(Identifier):
         self.mass_prior = mass_prior
 
     def fit(self, data: Measurement) -> SINDyPILinear:
+        self.check_params()
         n = data.n_channels
         if self.mass_prior not in data.prior:
             raise IdentificationError(f"data.prior has no {self.mass_prior!r} (has "

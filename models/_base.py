@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING, Any, ClassVar
 from testbed.schema import Field
 
 if TYPE_CHECKING:
+    from testbed.budget import Cost
     from testbed.dataset import Dataset
     from testbed.scenario import Scenario
 
@@ -51,6 +52,35 @@ class Rig:
     def check(cls, rig: dict[str, Any], simulation: dict[str, Any], excitation: dict[str, Any],
               error: ErrorFn) -> None:
         """Cross-field checks; call ``error(key, value, allowed)`` on the first problem."""
+
+    @classmethod
+    def record(cls, simulation: dict[str, Any]) -> tuple[float, int] | None:
+        """Sample rate [Hz] and number of samples of the record a ``[simulation]`` table asks for.
+
+        The default reads ``sample_rate`` and ``duration`` (None if the rig has no such keys;
+        a rig with other keys overrides it).  Used to check the signal chain against the
+        record (cut-offs below Nyquist, windows shorter than the record) before anything is
+        simulated.
+        """
+        if "sample_rate" not in simulation or "duration" not in simulation:
+            return None
+        fs = float(simulation["sample_rate"])
+        return fs, int(min(round(simulation["duration"] * fs), 2**62))
+
+    @classmethod
+    def measurement_shape(cls, rig: dict[str, Any]) -> tuple[int, int] | None:
+        """Channels and inputs of the measurement the signal chain makes of this rig's data
+        (checked against an identifier's terms at load); None = unknown."""
+        return None
+
+    @classmethod
+    def cost(cls, rig: dict[str, Any], simulation: dict[str, Any],
+             excitation: dict[str, Any]) -> Cost | None:
+        """Estimated memory and integration steps of a run (:class:`testbed.budget.Cost`).
+
+        Called after :meth:`check`, before anything is simulated; None = no estimate.
+        """
+        return None
 
     def __init__(self, scenario: Scenario) -> None:
         self.scenario = scenario

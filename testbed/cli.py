@@ -1,18 +1,138 @@
 """The ``testbed`` command: a thin face over the library (no logic of its own).
 
-Every command maps to one library call; user errors (bad scenario or study
-files, unknown names) print one clear line and exit with status 2.
+Every command maps to one library call.  A user's mistake (a bad scenario or study file,
+an unknown name, a missing folder, a file that is not a dataset, a bad option value, an
+unreachable Dask scheduler) prints one line ``error: ...`` and exits with status 2, never
+a traceback.  A bug prints one line saying it is an internal error and exits with status
+3; the global ``--debug`` flag re-raises it with its traceback.
 """
 
 from __future__ import annotations
 
 import argparse
+import socket
 import sys
 from pathlib import Path
+from urllib.parse import urlsplit
 
-from testbed.errors import TestbedError
+from testbed.errors import InputError, TestbedError
 
-EXIT_FAIL, EXIT_USAGE = 1, 2
+EXIT_FAIL, EXIT_USAGE, EXIT_INTERNAL, EXIT_INTERRUPTED = 1, 2, 3, 130
+#: Seconds to wait for a Dask scheduler to accept a connection before calling it
+#: unreachable: a live scheduler on a LAN answers in milliseconds.
+DASK_CONNECT_TIMEOUT_S = 5.0
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse with one-line errors (``error: ...``, status 2) instead of usage + message."""
+
+    def error(self, message: str) -> None:  # type: ignore[override]
+        print(f"error: {self.prog}: {message} (see {self.prog} --help)", file=sys.stderr)
+        sys.exit(EXIT_USAGE)
+
+
+def _seed(text: str) -> int:
+    """A noise seed: an integer >= 0 (numpy's generators take no negative seeds)."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected an integer >= 0, got {text!r}") from None
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"expected an integer >= 0, got {value}")
+    return value
+
+
+def _jobs(text: str) -> int:
+    """A worker count: an integer >= 1."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected an integer >= 1, got {text!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"expected an integer >= 1, got {value}")
+    return value
+
+
+def _existing_file(path: Path, what: str) -> Path:
+    if path.is_dir():
+        raise InputError(f"{path}: is a folder; expected {what}")
+    if not path.is_file():
+        raise InputError(f"{path}: no such file; expected {what}")
+    return path
+
+
+def _cache_folder(cache: str | None) -> str | None:
+    """A ``--cache`` folder (created on use) must not be an existing file."""
+    if cache is not None and Path(cache).exists() and not Path(cache).is_dir():
+        raise InputError(f"--cache {cache}: not a folder")
+    return cache
+
+
+def _dataset_file(path: Path) -> Path:
+    """A dataset file written by ``testbed generate`` (HDF5 of this format), else InputError."""
+    import h5py
+
+    from testbed.dataset import FORMAT
+
+    _existing_file(path, "a dataset .h5 file written by `testbed generate`")
+    if not h5py.is_hdf5(path):
+        raise InputError(f"{path}: not an HDF5 file; expected a dataset written by `testbed generate`")
+    try:
+        with h5py.File(path, "r") as f:
+            fmt = f.attrs.get("format")
+    except OSError as e:
+        raise InputError(f"{path}: cannot be read as HDF5: {e}") from None
+    if fmt != FORMAT:
+        raise InputError(f"{path}: an HDF5 file but not a testbed dataset (format {fmt!r}, "
+                         f"expected {FORMAT!r})")
+    return path
+
+
+def _results_file(path: Path) -> Path:
+    """A sweep results file that :func:`testbed.results.read_results` can read, else InputError."""
+    from testbed.results import read_results
+
+    _existing_file(path, "a sweep results file (from `testbed sweep`)")
+    try:
+        read_results(path)
+    except Exception as e:  # any failure to parse the user's file is a property of the file
+        raise InputError(f"{path}: not a sweep results file ({type(e).__name__})") from None
+    return path
+
+
+def _run_folder(path: Path) -> Path:
+    from testbed.runstore import load_run
+
+    try:
+        load_run(path)
+    except Exception as e:  # any failure to read the user's folder is a property of the folder
+        raise InputError(f"{path}: not a run folder written by `testbed run` "
+                         f"({type(e).__name__})") from None
+    return path
+
+
+def check_dask_address(address: str) -> None:
+    """Refuse a malformed or unreachable scheduler address before the sweep starts.
+
+    Raises
+    ------
+    InputError
+        If the address is not ``[tcp://]host:port`` or no scheduler accepts a TCP connection
+        there within :data:`DASK_CONNECT_TIMEOUT_S` seconds.
+    """
+    parts = urlsplit(address if "://" in address else f"tcp://{address}")
+    try:
+        host, port = parts.hostname, parts.port
+    except ValueError:
+        host = port = None
+    if parts.scheme not in ("tcp", "tls") or not host or port is None:
+        raise InputError(f"--dask {address!r}: expected a scheduler address tcp://host:port")
+    try:
+        with socket.create_connection((host, port), timeout=DASK_CONNECT_TIMEOUT_S):
+            pass
+    except OSError as e:
+        raise InputError(f"--dask {address!r}: cannot reach a Dask scheduler there "
+                         f"({e.strerror or type(e).__name__})") from None
 
 
 def _progress():
@@ -58,7 +178,7 @@ def cmd_generate(args: argparse.Namespace) -> int:
         sc = sc.replace(seed=args.seed)
     with _progress()(f"generating {sc.name}") as bar:
         # through the run cache unless --no-cache: a later `testbed run` of it simulates nothing
-        ds = generate(sc, progress=bar) if args.no_cache else DatasetCache(args.cache).get(sc, bar)
+        ds = generate(sc, progress=bar) if args.no_cache else DatasetCache(_cache_folder(args.cache)).get(sc, bar)
     out = Path(args.output or f"{sc.name}-seed{sc.seed}.h5")
     ds.save(out)
     print_truth_summary(ds)
@@ -73,7 +193,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     from testbed.scenario import load_scenario
     from testbed.summaries import print_score_table
 
-    cache = None if args.no_cache else DatasetCache(args.cache)
+    cache = None if args.no_cache else DatasetCache(_cache_folder(args.cache))
     ok = True
     for name in args.scenario:
         sc = load_scenario(name)
@@ -92,7 +212,14 @@ def cmd_run(args: argparse.Namespace) -> int:
 def cmd_report(args: argparse.Namespace) -> int:
     from testbed.report import write_report
 
-    html = write_report(Path(args.source), Path(args.output))
+    source = Path(args.source)
+    if source.is_dir():
+        _run_folder(source)
+    elif source.is_file():
+        _results_file(source)
+    else:
+        raise InputError(f"{source}: no such run folder or results file")
+    html = write_report(source, Path(args.output))
     print(f"report: {html.resolve()}")
     return 0
 
@@ -100,7 +227,8 @@ def cmd_report(args: argparse.Namespace) -> int:
 def cmd_export(args: argparse.Namespace) -> int:
     from testbed.export import export_dataset
 
-    for p in export_dataset(Path(args.dataset), args.format, Path(args.output) if args.output else None):
+    out = Path(args.output) if args.output else None
+    for p in export_dataset(_dataset_file(Path(args.dataset)), args.format, out):
         print(f"wrote {p}")
     return 0
 
@@ -111,9 +239,19 @@ def cmd_sweep(args: argparse.Namespace) -> int:
 
     study = load_study(args.study)
     stats = SweepStats()
-    results = run_sweep(study, jobs=args.jobs, dask_address=args.dask,
-                        results=Path(args.results) if args.results else None,
-                        cache_dir=args.cache, retry_failed=args.retry_failed, stats=stats)
+    if args.dask:
+        check_dask_address(args.dask)
+    try:
+        results = run_sweep(study, jobs=args.jobs, dask_address=args.dask,
+                            results=Path(args.results) if args.results else None,
+                            cache_dir=_cache_folder(args.cache), retry_failed=args.retry_failed,
+                            stats=stats)
+    except (OSError, TimeoutError) as e:
+        if not args.dask:
+            raise
+        # the port answered but no scheduler served it (or it went away): the address is wrong
+        raise InputError(f"--dask {args.dask!r}: the Dask scheduler failed: "
+                         f"{type(e).__name__}: {e}") from None
     print(f"results: {results}")
     return EXIT_FAIL if stats.failed_total else 0
 
@@ -121,14 +259,14 @@ def cmd_sweep(args: argparse.Namespace) -> int:
 def cmd_summary(args: argparse.Namespace) -> int:
     from testbed.summary import print_summary
 
-    print_summary(Path(args.results))
+    print_summary(_results_file(Path(args.results)))
     return 0
 
 
 def cmd_cache(args: argparse.Namespace) -> int:
     from testbed.cache import DatasetCache
 
-    cache = DatasetCache(args.cache)
+    cache = DatasetCache(_cache_folder(args.cache))
     if args.action == "ls":
         entries = cache.entries()
         for p, size in entries:
@@ -146,14 +284,16 @@ def cmd_demo(args: argparse.Namespace) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="testbed", description=__doc__.splitlines()[0])
+    p = _Parser(prog="testbed", description=__doc__.splitlines()[0])
+    p.add_argument("--debug", action="store_true",
+                   help="show the traceback of an internal error instead of one line")
     sub = p.add_subparsers(dest="command", required=True)
     sub.add_parser("list", help="registered rigs, identifiers and scenarios").set_defaults(fn=cmd_list)
 
     g = sub.add_parser("generate", help="simulate a scenario and write its dataset (HDF5)")
     g.add_argument("scenario", help="scenario name or .toml path")
     g.add_argument("-o", "--output", help="output file (default <scenario>-seed<N>.h5)")
-    g.add_argument("--seed", type=int, help="override the scenario's seed")
+    g.add_argument("--seed", type=_seed, help="override the scenario's seed")
     g.add_argument("--cache", help="dataset cache folder it also fills (default .cache/datasets)")
     g.add_argument("--no-cache", action="store_true", help="generate afresh, fill no cache")
     g.set_defaults(fn=cmd_generate)
@@ -161,7 +301,7 @@ def build_parser() -> argparse.ArgumentParser:
     r = sub.add_parser("run", help="generate or reuse data, identify, score, write figures")
     r.add_argument("scenario", nargs="+", help="scenario names or .toml paths")
     r.add_argument("-o", "--out", default="out/runs", help="folder for run results (default out/runs)")
-    r.add_argument("--seed", type=int, help="override the scenario's seed")
+    r.add_argument("--seed", type=_seed, help="override the scenario's seed")
     r.add_argument("--cache", help="dataset cache folder (default .cache/datasets or $TESTBED_CACHE)")
     r.add_argument("--no-cache", action="store_true", help="generate afresh, store nothing")
     r.add_argument("--no-figures", action="store_true", help="skip the figures")
@@ -180,7 +320,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     s = sub.add_parser("sweep", help="run a method-comparison study (scenarios x noise x seeds x methods)")
     s.add_argument("study", help="study .toml file")
-    s.add_argument("--jobs", type=int, default=1, help="parallel worker processes (joblib loky)")
+    s.add_argument("--jobs", type=_jobs, default=1, help="parallel worker processes (joblib loky)")
     s.add_argument("--dask", help="dask.distributed scheduler address (runs through joblib's dask backend)")
     s.add_argument("--results", help="results file (default out/studies/<study>.parquet)")
     s.add_argument("--cache", help="dataset cache folder")
@@ -202,16 +342,46 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
+def _one_line(text: object) -> str:
+    return " ".join(str(text).split())
+
+
 def main(argv: list[str] | None = None) -> int:
+    """Run one command; return the exit status (0 ok, 1 a run failed its bars, 2 a user's
+    mistake, 3 an internal error, 130 interrupted)."""
     args = build_parser().parse_args(argv)
     try:
         return args.fn(args)
     except TestbedError as e:
-        print(f"error: {e}", file=sys.stderr)
+        print(f"error: {_one_line(e)}", file=sys.stderr)
         return EXIT_USAGE
-    except KeyError as e:  # unknown registered name
-        print(f"error: {e.args[0]}", file=sys.stderr)
+    except KeyError as e:
+        text = str(e.args[0]) if e.args else ""
+        if not text.startswith("unknown "):  # the registries' own: "unknown rig 'x'; allowed: ..."
+            return _internal(e, args)
+        print(f"error: {_one_line(text)}", file=sys.stderr)
         return EXIT_USAGE
+    except (FileNotFoundError, PermissionError, IsADirectoryError, NotADirectoryError,
+            FileExistsError) as e:  # a path the user gave (an output folder, a file)
+        if args.debug:
+            raise
+        print(f"error: {_one_line(e)}", file=sys.stderr)
+        return EXIT_USAGE
+    except KeyboardInterrupt:
+        print("error: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
+    except Exception as e:
+        return _internal(e, args)
+
+
+def _internal(e: BaseException, args: argparse.Namespace) -> int:
+    """One line for a bug (status 3); with ``--debug`` re-raise it for its traceback."""
+    if args.debug:
+        raise e
+    print(f"internal error (a bug, not your input): {type(e).__name__}: {_one_line(e)[:300]}; "
+          f"rerun as `testbed --debug {args.command} ...` for the traceback, and please report it",
+          file=sys.stderr)
+    return EXIT_INTERNAL
 
 
 if __name__ == "__main__":

@@ -4,6 +4,27 @@ from __future__ import annotations
 
 from typing import Any
 
+#: Longest rendering of an offending value in a message [characters]: a message stays one
+#: readable line even for a 10,000-item list or a megabyte string.
+MAX_VALUE_CHARS = 120
+
+
+def _one_line(text: str) -> str:
+    """``text`` with control characters escaped, so a message is always one line."""
+    return "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
+
+
+def show_value(value: Any) -> str:
+    """``repr(value)`` on one line, cut to :data:`MAX_VALUE_CHARS` characters."""
+    try:
+        text = repr(value)
+    except Exception:  # a broken __repr__ must not hide the real error
+        text = f"<{type(value).__name__}>"
+    text = _one_line(text)
+    if len(text) > MAX_VALUE_CHARS:
+        text = text[:MAX_VALUE_CHARS - 5] + "[...]"
+    return text
+
 
 class TestbedError(Exception):
     """Base of the errors the CLI prints as one line, without a traceback."""
@@ -28,13 +49,23 @@ class ScenarioError(TestbedError):
 
     def __init__(self, file: str, key: str | None = None, value: Any = ..., allowed: str = ""):
         self.file, self.key, self.value, self.allowed = str(file), key, value, allowed
-        parts = [self.file]
+        parts = [_one_line(self.file)]
         if key is not None:
-            parts.append(f"key '{key}'")
+            parts.append(f"key '{_one_line(str(key))}'")
         if value is not ...:
-            parts.append(f"value {value!r}")
+            parts.append(f"value {show_value(value)}")
         msg = ": ".join(parts)
-        super().__init__(f"{msg}: {allowed}" if allowed else msg)
+        super().__init__(f"{msg}: {_one_line(allowed)}" if allowed else msg)
+
+
+class BudgetError(ScenarioError):
+    """A scenario would need more memory or integration steps than the declared budget
+    (:mod:`testbed.budget`); raised at load, before anything is simulated."""
+
+
+class InputError(TestbedError):
+    """A command-line input a user gave cannot be used (a missing folder, a file that is not
+    a dataset, an unreachable scheduler, a bad option value)."""
 
 
 class RigError(TestbedError):
@@ -43,6 +74,12 @@ class RigError(TestbedError):
 
 class IdentificationError(TestbedError):
     """An identifier could not produce a model from the data given."""
+
+
+class HyperparameterError(IdentificationError, ValueError):
+    """An identifier was constructed with a hyperparameter its declaration refuses (checked
+    at fit time for estimators built in Python; scenario files are checked at load).  A
+    ValueError too, as scikit-learn estimators raise for bad parameters."""
 
 
 class DivergenceError(IdentificationError):

@@ -5,8 +5,8 @@ committed file equals :func:`render`.  Every key of every table is listed with i
 type and allowed values, unit, default and meaning, taken from
 :data:`testbed.scenario.HEADER_SCHEMA`, each registered rig's ``rig_schema`` /
 ``simulation_schema`` / ``excitation_schemas``, :data:`testbed.scenario.NOISE_SCHEMA`,
-:data:`testbed.preprocess.SIGNAL_SCHEMAS`, each registered identifier's constructor
-and :data:`testbed.scoring.METRICS`.
+:data:`testbed.preprocess.SIGNAL_SCHEMAS`, each registered identifier's declared
+``hyperparameters`` and :data:`testbed.scoring.METRICS`.
 """
 
 from __future__ import annotations
@@ -41,10 +41,23 @@ method = "sgd_sindy"        # plus the identifier's hyperparameters
 trac_min = 0.9              # <metric>_min / <metric>_max
 ```
 
-With `extends`, tables are merged key by key (the `[identify]` table is replaced
-whole), so a variant states only what differs.  Unknown keys, wrong types and values
-out of bounds are errors naming the file, the key, the value and what is allowed.
-Keys marked *required* must be given; every other key may be left out for its default.
+With `extends`, tables are merged key by key, so a variant states only what differs.
+Two tables are replaced whole instead: `[identify]` (a new identifier does not inherit
+another's hyperparameters) and `[score]`.  A child keeps its parent's `[score]` unless it
+declares its own, even when it replaces `[identify]`: it is held to its parent's bars until
+it states new ones.  `[score]` without `[identify]` is an error when the scenario is run
+on its own; a study may list such a scenario, holding the study's identifiers to its bars.
+
+Everything is checked when the file loads, before anything is simulated: unknown keys,
+wrong types and values out of bounds, and rules across keys (filter cut-offs below the
+Nyquist frequency, windows shorter than the record, the impact on a sensor, an identifier
+of the rig's kind, term names the data can provide, `f_min < f_max`).  A scenario whose run
+would need more than the budget of memory or integration steps (`testbed.budget`: 4 GiB,
+1e8 steps) is refused, naming the key that drives the cost.  Every error names the file,
+the key, the value and what is allowed, on one line.  Scenario names are letters, digits,
+`_`, `.` and `-` (not starting with `.` or `-`), and equal the file name.
+Keys marked *required* must be given; every other key may be left out for its default
+(*see meaning*: no default value, the identifier decides).
 """
 
 
@@ -104,18 +117,14 @@ def _identify_section() -> list[str]:
     from identify import IDENTIFIERS
 
     out = ["## `[identify]`\n",
-           "`method` names a registered identifier (required); every other key is one of its "
-           "hyperparameters, given with the type of its default.\n"]
+           "`method` names a registered identifier (required) of the rig's kind; every other key "
+           "is one of its declared hyperparameters.\n"]
     for name in IDENTIFIERS.names():
         cls = IDENTIFIERS.get(name)
         doc = (inspect.getdoc(cls) or "").split("\n\n")[0].replace("\n", " ")
         out.append(f"### `method = \"{name}\"` ({cls.kind})\n\n{doc}\n")
-        params = [p for k, p in inspect.signature(cls.__init__).parameters.items() if k != "self"
-                  and p.kind not in (p.VAR_POSITIONAL, p.VAR_KEYWORD)]
-        lines = ["| key | default |", "|---|---|"]
-        lines += [f"| `{p.name}` | " + ("*required*" if p.default is p.empty else f"`{_toml(p.default)}`")
-                  + " |" for p in params]
-        out.append("\n".join(lines) + "\n" if params else "*(no hyperparameters)*\n")
+        fields = cls.declared_hyperparameters()
+        out.append(table(fields) if fields else "*(no hyperparameters)*\n")
     if not IDENTIFIERS.names():
         out.append("*(no identifier registered)*\n")
     return out

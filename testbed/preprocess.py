@@ -8,7 +8,8 @@ identifier is handed is what a lab would have.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+import math
+from collections.abc import Callable, Mapping
 from typing import Any
 
 import numpy as np
@@ -77,6 +78,87 @@ SIGNAL_SCHEMAS: dict[str, dict[str, Field]] = {
                                 doc="'lowpass': order of the end-window polynomial fits"),
     },
 }
+
+
+def _filter_min_samples(order: int) -> int:
+    """Fewest samples a zero-phase filter of this order (one pass) accepts: its second-order
+    sections ``ceil(order / 2)`` set scipy's default padding, ``3 (2 n_sections + 1)``, and
+    ``sosfiltfilt`` needs more samples than that (see :func:`testbed.signal._filtfilt`)."""
+    return 3 * (2 * math.ceil(order / 2) + 1) + 1
+
+
+def check_signal(kind: str, cfg: Mapping[str, Any], fs: float, n_samples: int,
+                 error: Callable[[str, Any, str], None]) -> None:
+    """Cross-key checks of a validated ``[signal]`` table against the record it will process.
+
+    Parameters
+    ----------
+    kind : {"structural", "mechanical"}
+    cfg : mapping
+        A validated ``SIGNAL_SCHEMAS[kind]`` table.
+    fs : float
+        Sample rate of the record [Hz].
+    n_samples : int
+        Samples in the record.
+    error : callable
+        ``error(key, value, allowed)``, called on the first problem (it raises).
+
+    Notes
+    -----
+    Checked: cut-offs strictly below the Nyquist frequency ``fs / 2`` (a digital filter cannot
+    be designed at or above it), a high-pass below the low-pass, pass-band ripple below the
+    stop-band attenuation, records long enough for every zero-phase filter and polynomial
+    window, odd Savitzky-Golay windows with ``polyorder < window``, and margins shorter than
+    the record.
+    """
+    nyq = fs / 2.0
+    duration = n_samples / fs
+
+    def below_nyquist(key: str) -> None:
+        if not cfg[key] < nyq:
+            error(f"signal.{key}", cfg[key], f"expected below the Nyquist frequency {nyq:g} Hz "
+                                             f"(sample rate {fs:g} Hz)")
+
+    def long_enough(key: str, order: int) -> None:
+        need = _filter_min_samples(order)
+        if n_samples < need:
+            error(f"signal.{key}", cfg[key], f"the record has {n_samples} samples; a zero-phase "
+                                             f"filter of order {order} needs at least {need}")
+
+    if kind == "structural":
+        below_nyquist("highpass_hz")
+        long_enough("highpass_order", cfg["highpass_order"])
+        if cfg["lowpass_hz"] > 0:
+            below_nyquist("lowpass_hz")
+            long_enough("lowpass_order", cfg["lowpass_order"])
+            if not cfg["highpass_hz"] < cfg["lowpass_hz"]:
+                error("signal.highpass_hz", cfg["highpass_hz"],
+                      f"expected below lowpass_hz ({cfg['lowpass_hz']:g} Hz): the pass band "
+                      "would be empty")
+        if not cfg["ripple_db"] < cfg["stop_db"]:
+            error("signal.ripple_db", cfg["ripple_db"],
+                  f"expected below stop_db ({cfg['stop_db']:g} dB)")
+        if not cfg["free_margin_s"] < duration:
+            error("signal.free_margin_s", cfg["free_margin_s"],
+                  f"expected shorter than the record ({duration:g} s)")
+        return
+    if kind != "mechanical":
+        return
+    if cfg["window"] % 2 == 0:
+        error("signal.window", cfg["window"], "expected an odd number of samples")
+    if not cfg["polyorder"] < cfg["window"]:
+        error("signal.polyorder", cfg["polyorder"], f"expected below window ({cfg['window']})")
+    if cfg["derivatives"] == "estimated" and cfg["window"] > n_samples:
+        error("signal.window", cfg["window"], f"expected at most the record's {n_samples} samples")
+    if cfg["derivatives"] == "lowpass":
+        below_nyquist("cutoff_hz")
+        long_enough("filter_order", cfg["filter_order"])
+        n_fit = round(cfg["edge_fit_s"] * fs)
+        if not cfg["edge_fit_order"] < n_fit <= n_samples:
+            error("signal.edge_fit_s", cfg["edge_fit_s"],
+                  f"the end windows of {n_fit} samples must be longer than edge_fit_order "
+                  f"({cfg['edge_fit_order']}) and at most the record ({n_samples} samples, "
+                  f"{duration:g} s)")
 
 
 def measure(dataset: Dataset, signal_cfg: Mapping[str, Any], kind: str) -> Measurement:

@@ -10,6 +10,7 @@ documentation cannot drift from what is accepted.
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
@@ -19,7 +20,7 @@ from testbed.errors import ScenarioError
 REQUIRED = object()
 
 _TYPE_NAMES = {bool: "a boolean", int: "an integer", float: "a number", str: "a string",
-               list: "a list", dict: "a table"}
+               list: "a list", dict: "a table", object: "any value"}
 _ITEM_NAMES = {bool: "booleans", int: "integers", float: "numbers", str: "strings"}
 
 
@@ -46,6 +47,18 @@ class Field:
         Element type of a list.
     min_items, max_items : int, optional
         Length limits of a list.
+    pattern : str, optional
+        Regular expression a string (or every string item of a list) must match whole.
+    pattern_doc : str
+        The pattern in words, for messages and the guide.
+    also : Field, optional
+        An alternative form that is accepted too (e.g. a named library or a list of term
+        names); the value is accepted if it satisfies this field or ``also``.
+
+    Notes
+    -----
+    A ``default`` of None means "optional, no value": the key may be left out (TOML has no
+    null), and when given it is checked like any other.  Floats must always be finite.
     """
 
     type: type
@@ -60,6 +73,9 @@ class Field:
     item_type: type | None = None
     min_items: int | None = None
     max_items: int | None = None
+    pattern: str | None = None
+    pattern_doc: str = ""
+    also: Field | None = None
 
     @property
     def required(self) -> bool:
@@ -67,6 +83,10 @@ class Field:
 
     def describe(self) -> str:
         """What is allowed, in words (used in error messages and the guide)."""
+        own = self._describe_own()
+        return own if self.also is None else f"{own}, or {self.also.describe()}"
+
+    def _describe_own(self) -> str:
         what = _TYPE_NAMES.get(self.type, self.type.__name__)
         if self.type is list and self.item_type is not None:
             what = f"a list of {_ITEM_NAMES.get(self.item_type, self.item_type.__name__)}"
@@ -81,6 +101,8 @@ class Field:
             bounds.append(f"with at least {self.min_items} item(s)")
         if self.type is list and self.max_items is not None:
             bounds.append(f"with at most {self.max_items} item(s)")
+        if self.pattern is not None:
+            bounds.append(self.pattern_doc or f"matching {self.pattern}")
         unit = f" [{self.unit}]" if self.unit else ""
         return what + (" " + " and ".join(bounds) if bounds else "") + unit
 
@@ -102,7 +124,26 @@ def _check_number(value: float, f: Field) -> bool:
 
 
 def check_value(value: Any, f: Field, *, file: str, key: str) -> Any:
-    """Check one value against its field; return it (ints widened to float where asked)."""
+    """Check one value against its field; return it (ints widened to float where asked).
+
+    Raises
+    ------
+    ScenarioError
+        Naming ``file``, ``key``, the value and :meth:`Field.describe` (with ``also``: both
+        forms).
+    """
+    if f.also is None:
+        return _check_own(value, f, file=file, key=key)
+    try:
+        return _check_own(value, f, file=file, key=key)
+    except ScenarioError:
+        try:
+            return check_value(value, f.also, file=file, key=key)
+        except ScenarioError:
+            raise ScenarioError(file, key, value, f"expected {f.describe()}") from None
+
+
+def _check_own(value: Any, f: Field, *, file: str, key: str) -> Any:
     if not _is_type(value, f.type):
         raise ScenarioError(file, key, value, f"expected {f.describe()}")
     if f.choices is not None and value not in f.choices:
@@ -116,8 +157,11 @@ def check_value(value: Any, f: Field, *, file: str, key: str) -> Any:
             raise ScenarioError(file, key, value, f"expected {f.describe()}")
         if f.item_type is not None:
             item = Field(f.item_type, min=f.min, max=f.max, min_inclusive=f.min_inclusive,
-                         max_inclusive=f.max_inclusive, unit=f.unit)
+                         max_inclusive=f.max_inclusive, unit=f.unit, pattern=f.pattern,
+                         pattern_doc=f.pattern_doc)
             value = [check_value(v, item, file=file, key=f"{key}[{i}]") for i, v in enumerate(value)]
+    if f.type is str and f.pattern is not None and not re.fullmatch(f.pattern, value):
+        raise ScenarioError(file, key, value, f"expected {f.describe()}")
     if f.type is float:
         value = float(value)
     return value
@@ -160,7 +204,7 @@ def validate_variant(table: Mapping[str, Any], variants: Mapping[str, Mapping[st
     if kind is REQUIRED:
         raise ScenarioError(file, f"{section}.{selector}",
                             allowed="missing; expected one of " + ", ".join(map(repr, variants)))
-    if kind not in variants:
+    if not isinstance(kind, str) or kind not in variants:
         raise ScenarioError(file, f"{section}.{selector}", kind,
                             "expected one of " + ", ".join(map(repr, variants)))
     rest = {k: v for k, v in table.items() if k != selector}
@@ -177,8 +221,10 @@ def validate_header(raw: Mapping[str, Any], *, sections: tuple[str, ...], header
     """
     for section in raw:
         if section not in sections:
-            raise ScenarioError(file, section, raw[section],
-                                "unknown section; allowed: " + ", ".join(f"[{s}]" for s in sections))
+            # the section's content is not echoed: it may be a whole foreign file's
+            raise ScenarioError(file, section,
+                                allowed="unknown section; allowed: "
+                                + ", ".join(f"[{s}]" for s in sections))
     if header not in raw:
         raise ScenarioError(file, header, allowed=f"missing [{header}] table")
     head = validate_table(raw[header], schema, file=file, section=header)
@@ -189,3 +235,6 @@ def validate_header(raw: Mapping[str, Any], *, sections: tuple[str, ...], header
 
 
 Checker = Callable[[dict[str, Any]], None]
+
+ErrorFn = Callable[[str, Any, str], None]
+"""``error(key, value, allowed)``: report a problem (it raises)."""

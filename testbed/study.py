@@ -13,7 +13,8 @@ A study is a TOML file in ``studies/``::
                                         # register extra rigs / identifiers
 
     [identifiers.ls_sindy]              # optional hyperparameters, checked like a scenario's
-    threshold = 0.05                    # [identify] table against the identifier's __init__
+    rcond = 1e-8                        # [identify] table against the identifier's declared
+                                        # hyperparameters
 
 The grid is every (scenario, noise, seed, identifier).  A combination whose
 identifier kind ("structural" / "mechanical") differs from the scenario rig's
@@ -21,29 +22,43 @@ kind cannot be run (a structural identifier has no model of a linkage) and is
 skipped: :meth:`Study.skipped` lists those, and the study is rejected if an
 identifier, or a scenario, matches nothing.  Every problem raises
 :class:`~testbed.errors.ScenarioError` naming the file, the key, the value and
-what is allowed.  Scenario paths are relative to the study file.
+what is allowed.  Scenario paths are relative to the study file.  Each runnable
+(scenario, identifier) pair is also checked as a scenario's ``[identify]`` would be
+(term names for the rig's channels, windows against its record, simulation budget),
+with the study's hyperparameters over the scenario's own where the identifier is the
+scenario's method, so a study fails at load, not in its hundredth cell.
 """
 
 from __future__ import annotations
 
 import importlib
 import importlib.util
-import inspect
 import os
 import sys
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from testbed.errors import ScenarioError
-from testbed.scenario import SCENARIO_DIR, Scenario, _validate_identify, load_scenario, resolve_path
+from testbed.scenario import (
+    NAME_PATTERN,
+    NAME_PATTERN_DOC,
+    SCENARIO_DIR,
+    Scenario,
+    _check_stem,
+    _validate_identify,
+    check_identifier_for_rig,
+    load_scenario,
+    read_toml_file,
+    resolve_path,
+)
 from testbed.schema import Field, validate_header
 
 STUDY_DIR = Path(__file__).resolve().parent.parent / "studies"
 
 STUDY_SCHEMA = {
-    "name": Field(str, doc="study name; must equal the file name without .toml"),
+    "name": Field(str, doc="study name; must equal the file name without .toml",
+                  pattern=NAME_PATTERN, pattern_doc=NAME_PATTERN_DOC),
     "description": Field(str, "", doc="one line for listings and reports"),
     "scenarios": Field(list, item_type=str, min_items=1,
                        doc="scenario names (in scenarios/) or .toml paths relative to the study file"),
@@ -119,13 +134,6 @@ def _identifier_kind(name: str) -> str:
     return IDENTIFIERS.get(name).kind
 
 
-def _defaults(name: str) -> dict[str, Any]:
-    from identify import IDENTIFIERS
-
-    sig = inspect.signature(IDENTIFIERS.get(name).__init__)
-    return {k: p.default for k, p in sig.parameters.items() if k != "self"}
-
-
 def import_plugins(plugins: tuple[str, ...] | list[str]) -> None:
     """Import each plugin once (a dotted module name, or a ``.py`` file path).
 
@@ -182,12 +190,8 @@ def load_study(name_or_path: str | os.PathLike) -> Study:
     """
     path = resolve_study_path(name_or_path)
     file = str(path)
-    if not path.is_file():
-        raise ScenarioError(file, allowed="no such study file")
-    try:
-        raw = tomllib.loads(path.read_text())
-    except tomllib.TOMLDecodeError as e:
-        raise ScenarioError(file, allowed=f"not valid TOML: {e}") from None
+    _check_stem(path, "study", STUDY_DIR)
+    raw = read_toml_file(path, "study")
     return study_from_dict(raw, file=file, base=path.parent, stem=path.stem)
 
 
@@ -195,6 +199,11 @@ def study_from_dict(raw: dict[str, Any], *, file: str = "<dict>", base: Path | N
                     stem: str | None = None) -> Study:
     """Validate a study given as a dict of TOML tables (paths relative to ``base``)."""
     base = base if base is not None else Path.cwd()
+    if not isinstance(raw, dict):
+        raise ScenarioError(file, allowed="expected a table of sections")
+    if "study" not in raw and "scenario" in raw:
+        raise ScenarioError(file, allowed="a scenario file (it has [scenario]), not a study; run "
+                                          "it with `testbed run`")
     head = validate_header(raw, sections=SECTIONS, header="study", schema=STUDY_SCHEMA, file=file,
                            stem=stem)
     for key in ("scenarios", "noise", "seeds", "identifiers", "plugins"):
@@ -228,14 +237,33 @@ def study_from_dict(raw: dict[str, Any], *, file: str = "<dict>", base: Path | N
                                 f"no scenario file {spath}; expected a name among "
                                 f"{', '.join(known) or '(none in ' + str(SCENARIO_DIR) + ')'} "
                                 "or a .toml path relative to the study file")
-        scenarios.append(load_scenario(spath))
+        scenarios.append(load_scenario(spath, standalone=False))  # bars for the study's identifiers
 
     params = _validate_params(raw.get("identifiers", {}), head["identifiers"], file)
     study = Study(name=head["name"], description=head["description"], scenarios=tuple(scenarios),
                   noise=tuple(head["noise"]), seeds=tuple(head["seeds"]),
                   identifiers=tuple(head["identifiers"]), params=params, plugins=plugins, path=file)
     _check_grid(study, head, file)
+    _check_cells(study, file)
     return study
+
+
+def _check_cells(study: Study, file: str) -> None:
+    """Each runnable (scenario, identifier) pair's hyperparameters against the scenario's data.
+
+    The study's hyperparameters go over the scenario's own ``[identify]`` table where the
+    identifier is the scenario's method (as the sweep runs them).
+    """
+    from models import RIGS
+
+    for sc, m in study.combinations():
+        own = sc.identify if sc.identify and sc.identify["method"] == m else {"method": m}
+        params = {**own, **study.params.get(m, {})}
+        try:
+            check_identifier_for_rig(RIGS.get(sc.rig), sc.rig_params, sc.simulation, params,
+                                     file=file, section=f"identifiers.{m}")
+        except ScenarioError as e:
+            raise type(e)(file, e.key, e.value, f"{e.allowed} (for scenario {sc.name!r})") from None
 
 
 def _validate_params(table: Any, identifiers: list[str], file: str) -> dict[str, dict[str, Any]]:
@@ -259,10 +287,8 @@ def _validate_params(table: Any, identifiers: list[str], file: str) -> dict[str,
             raise ScenarioError(file, k, e.value, e.allowed) from None
         assert checked is not None
         checked.pop("method")
-        defaults = _defaults(name)
-        # widen ints given for float hyperparameters, so that 1 and 1.0 are one cell
-        params[name] = {k: float(v) if isinstance(defaults.get(k), float) else v
-                        for k, v in checked.items()}
+        # ints given for float hyperparameters come back widened, so 1 and 1.0 are one cell
+        params[name] = checked
     return params
 
 

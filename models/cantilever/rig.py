@@ -25,7 +25,7 @@ import numpy as np
 from models import RIGS
 from models._base import ErrorFn, Rig
 from models.cantilever.beam import BeamParams
-from models.cantilever.model import CantileverModel, build_model, sensor_positions
+from models.cantilever.model import CantileverModel, build_model, hit_position, sensor_positions
 from models.cantilever.simulate import (
     half_sine,
     mode_errors,
@@ -33,11 +33,30 @@ from models.cantilever.simulate import (
     static_equilibrium,
     unstable_modes,
 )
+from testbed.budget import MEMORY_BUDGET_BYTES, SAMPLE_BUDGET, STEP_BUDGET, Cost
 from testbed.dataset import Dataset, Signal
 from testbed.errors import RigError
 from testbed.schema import Field
 
 LOG = logging.getLogger(__name__)
+
+#: An impact must land within 1 mm [m] of an accelerometer: the structural signal chain
+#: (``testbed.preprocess.IMPACT_TOLERANCE_M``, the same 1 mm; a test keeps them equal) maps
+#: the force onto the sensor it hits, because a model in sensor coordinates cannot place a
+#: force between sensors.
+HIT_SENSOR_TOLERANCE_M = 1e-3
+
+#: Memory per integration step [bytes]: the hammer force is built for every step before the
+#: rollout (the step times, the phase, its clip and the force: about five float64 arrays).
+BYTES_PER_STEP = 48
+#: Memory per sample and sensor [bytes]: MuJoCo's 9 sensor readings per accelerometer (kept
+#: at every sample), the dataset's measured and reference copies (4), the noisy copy, the
+#: signal chain's filtered acceleration, velocity and displacement with their intermediates
+#: (about 10) and an identifier's library (up to 6 columns per sensor): about 30 float64
+#: values, doubled for temporaries.
+BYTES_PER_SAMPLE_PER_SENSOR = 512
+#: Memory per sample for the force channel and the time axis [bytes] (about 8 float64 arrays).
+BYTES_PER_SAMPLE = 64
 
 RIG_SCHEMA = {
     "E": Field(float, 210e9, unit="Pa", min=0.0, min_inclusive=False, doc="Young's modulus"),
@@ -148,10 +167,72 @@ class CantileverRig(Rig):
         loc = excitation["location"]
         if loc != 0.0 and not x0 < loc <= length:
             error("excitation.location", loc, f"allowed: 0 (= tip) or {where}")
+        positions = sensor_positions(rig)
+        hit = hit_position(rig, excitation)
+        gap = float(np.min(np.abs(positions - hit)))
+        if gap > HIT_SENSOR_TOLERANCE_M:
+            error("excitation.location", loc,
+                  f"allowed: 0 (= tip) or a sensor position, within {HIT_SENSOR_TOLERANCE_M * 1e3:g} "
+                  f"mm (sensors at {', '.join(f'{x:.6g}' for x in positions)} m; the impact at "
+                  f"{hit:.6g} m is {gap * 1e3:.3g} mm from the nearest): a model in sensor "
+                  "coordinates cannot place a force between sensors")
         end = excitation["start"] + excitation["pulse_duration"]
         if end >= simulation["duration"]:
             error("excitation.pulse_duration", excitation["pulse_duration"],
                   f"allowed: start + pulse_duration < duration ({simulation['duration']:g} s)")
+
+    @classmethod
+    def measurement_shape(cls, rig: dict[str, Any]) -> tuple[int, int]:
+        """One channel per accelerometer, one input (the hammer force)."""
+        return len(sensor_positions(rig)), 1
+
+    @classmethod
+    def cost(cls, rig: dict[str, Any], simulation: dict[str, Any],
+             excitation: dict[str, Any]) -> Cost:
+        """Memory and integration steps of a run, from the rig's own stepping rule.
+
+        The record's size alone is checked first (every sample takes at least one step); only
+        if it fits is the model compiled to learn its step
+        (:func:`models.cantilever.model.build_model`, about 20 ms for 10 segments, 1.3 s for
+        400), so an absurd ``duration`` or ``sample_rate`` is refused in microseconds.
+
+        Raises
+        ------
+        RigError
+            If the model cannot be compiled from these (valid but extreme) parameters.
+        """
+        fs = float(simulation["sample_rate"])
+        samples = simulation["duration"] * fs
+        n_sensors = len(sensor_positions(rig))
+        per_sample = BYTES_PER_SAMPLE_PER_SENSOR * n_sensors + BYTES_PER_SAMPLE
+        key = "simulation.sample_rate" if fs > 10 * SIMULATION_SCHEMA["sample_rate"].default \
+            else "simulation.duration"
+        value = simulation[key.split(".")[1]]
+
+        def cost(substeps: float, step_key: str, step_value: Any) -> Cost:
+            steps = samples * substeps
+            return Cost(memory_bytes=samples * per_sample + steps * BYTES_PER_STEP, steps=steps,
+                        samples=samples, memory_key=key, steps_key=step_key, samples_key=key,
+                        memory_value=value, steps_value=step_value, samples_value=value)
+
+        lower = cost(1.0, key, value)
+        if (lower.samples > SAMPLE_BUDGET or lower.steps > STEP_BUDGET
+                or lower.memory_bytes > MEMORY_BUDGET_BYTES):
+            return lower
+        try:
+            stepping = build_model(rig, simulation, excitation).stepping
+        except (ValueError, ArithmeticError, np.linalg.LinAlgError) as e:
+            raise RigError(f"the beam cannot be built from these parameters: {e}") from None
+        if simulation["timestep"] > 0:
+            step_key, step_value = "simulation.timestep", simulation["timestep"]
+        # accuracy alone asks ceil(pi / 0.49) = 7 substeps (RK4) or ceil(pi / 0.109) = 29
+        # (implicitfast) per sample; far more means stability, i.e. the stiffest mode of the
+        # chain, sets the step
+        elif stepping.substeps > 64:
+            step_key, step_value = "rig.n_segments", rig["n_segments"]
+        else:
+            step_key, step_value = key, value
+        return cost(float(stepping.substeps), step_key, step_value)
 
     def __init__(self, scenario: Any) -> None:
         super().__init__(scenario)

@@ -30,8 +30,16 @@ from models.fivebar.equations import true_equations
 from models.fivebar.excitation import EXCITATION_SCHEMAS, build_program, start_actuated
 from models.fivebar.integrate import simulate as simulate_pinocchio
 from models.fivebar.params import FiveBarParams
+from testbed.budget import Cost
 from testbed.dataset import Dataset, Signal
 from testbed.schema import Field
+
+#: Memory per sample of a run [bytes]: the record's 19 float64 channels (angles, rates,
+#: accelerations, torques, constraint force, end point, transmission angle, references:
+#: 152 B; a 3600 s record measured 5 GB), the dataset's noisy copy and the signal chain's
+#: estimates (about 30 values), and SINDy-PI's library matrix (32-60 columns) with its
+#: reconciled copies: about 120 float64 values in all, rounded up for temporaries.
+BYTES_PER_SAMPLE = 1024
 
 _POS = {"min": 0.0, "min_inclusive": False}
 RIG_SCHEMA: dict[str, Field] = {
@@ -141,6 +149,23 @@ class FiveBarRig(Rig):
                   f"{ratio:.6g}): samples and input holds fall on integration steps")
         if round(simulation["duration"] * simulation["sample_rate"]) < 2:
             error("simulation.duration", simulation["duration"], "expected at least two samples")
+        nyquist = simulation["sample_rate"] / 2.0
+        at_rest = rig["dth1_0"] == 0.0 and rig["dth4_0"] == 0.0 and not rig["gravity"]
+        if excitation.get("amplitude", 1.0) == 0.0 and (at_rest or excitation["type"] == "sine_replay"):
+            error("excitation.amplitude", 0.0,
+                  "expected > 0: with no input, no start rates and no gravity the linkage rests "
+                  "and every record is zero (nothing to identify)")
+        if excitation["type"] == "multisine":
+            if not excitation["f_min"] < excitation["f_max"]:
+                error("excitation.f_min", excitation["f_min"],
+                      f"expected f_min < f_max ({excitation['f_max']:g} Hz)")
+            if not excitation["f_max"] < nyquist:
+                error("excitation.f_max", excitation["f_max"],
+                      f"expected below the Nyquist frequency {nyquist:g} Hz")
+        for key in ("frequency", "f0", "f1"):
+            if key in excitation and not excitation[key] < nyquist:
+                error(f"excitation.{key}", excitation[key],
+                      f"expected below the Nyquist frequency {nyquist:g} Hz")
         p = FiveBarParams.from_rig(rig)
         if p.L0 >= p.l.sum():
             error("rig.L0", p.L0, f"the loop cannot close for any pose: expected L0 < l1 + l2 + l3 + l4 = "
@@ -171,6 +196,29 @@ class FiveBarRig(Rig):
             if why:
                 error("excitation.amplitude", excitation["amplitude"],
                       f"the prescribed motion leaves the usable workspace: {why}")
+
+    @classmethod
+    def measurement_shape(cls, rig: dict[str, Any]) -> tuple[int, int]:
+        """Four absolute angles th1..th4, two actuator torques u1, u2."""
+        return 4, 2
+
+    @classmethod
+    def cost(cls, rig: dict[str, Any], simulation: dict[str, Any],
+             excitation: dict[str, Any]) -> Cost:
+        """Memory and RK4 steps of a run: ``duration / dt`` steps, ``duration * sample_rate``
+        samples of :data:`BYTES_PER_SAMPLE` each (the step is the scenario's ``dt``)."""
+        fs = float(simulation["sample_rate"])
+        samples = simulation["duration"] * fs
+        steps = simulation["duration"] / simulation["dt"]
+        key = "simulation.sample_rate" if fs > 10 * SIMULATION_SCHEMA["sample_rate"].default \
+            else "simulation.duration"
+        step_key = "simulation.dt" if simulation["dt"] < SIMULATION_SCHEMA["dt"].default / 10 \
+            else "simulation.duration"
+        return Cost(memory_bytes=samples * BYTES_PER_SAMPLE, steps=steps, samples=samples,
+                    memory_key=key, steps_key=step_key, samples_key=key,
+                    memory_value=simulation[key.split(".")[1]],
+                    steps_value=simulation[step_key.split(".")[1]],
+                    samples_value=simulation[key.split(".")[1]])
 
     def __init__(self, scenario) -> None:
         super().__init__(scenario)

@@ -75,3 +75,24 @@ def test_identifier_follows_the_estimator_contract(name, structural_data, pendul
         assert arr.shape == (data.n_channels, n)
     eqs = est.equations()
     assert isinstance(eqs, list) and eqs and all(isinstance(e, str) and e for e in eqs)
+
+
+@pytest.mark.parametrize("name", IDENTIFIERS.names())
+def test_every_hyperparameter_is_declared_and_nothing_else(name):
+    """``hyperparameters`` (the declaration scenario files are checked against) equals
+    ``__init__``: same names, same order, same defaults, each with a line of doc."""
+    cls = IDENTIFIERS.get(name)
+    assert "hyperparameters" in vars(cls) or any(
+        "hyperparameters" in vars(b) for b in cls.__mro__[1:] if b is not Identifier), name
+    params = {k: p for k, p in inspect.signature(cls.__init__).parameters.items() if k != "self"}
+    declared = cls.hyperparameters
+    assert list(declared) == list(params), (name, set(declared) ^ set(params))
+    for k, p in params.items():
+        f = declared[k]
+        default = list(p.default) if isinstance(p.default, tuple) else p.default
+        assert f.default == default and type(f.default) is type(default), (name, k, f.default)
+        assert f.doc, (name, k)
+    # the defaults themselves validate (a declaration that rejects its own default is wrong)
+    assert cls.validate_hyperparameters({}) == {k: f.default for k, f in declared.items()}
+    given = {k: f.default for k, f in declared.items() if f.default is not None}
+    cls.validate_hyperparameters(given)

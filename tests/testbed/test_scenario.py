@@ -43,6 +43,7 @@ def test_good_file_loads_with_defaults(tmp_path):
     ('[rig]\nbase = "wobbly"\n', "rig.base", "'stiff', 'soft'"),
     ("[noise]\nrms_percent = -1.0\n", "noise.rms_percent", ">= 0"),
     ('[noise]\nsignals = ["force", "strain"]\n', "noise.signals", "strain"),
+    ('[noise]\nsignals = ["force", "force"]\n', "noise.signals[1]", "duplicate"),
     ("[wind]\nspeed = 3\n", "wind", "unknown section"),
     ('[identify]\nmethod = "magic"\n', "identify.method", "expected one of"),
     ('[identify]\nmethod = "ls_sindy"\nwarp = 9\n', "identify.warp", "unknown hyperparameter"),
@@ -116,7 +117,7 @@ def test_cli_prints_one_line_and_exits_2(tmp_path, capsys):
     assert "rig.n_segments" in err and "-4" in err
 
 
-def test_extends_replaces_identify_and_score_whole(tmp_path):
+def test_extends_replaces_identify_whole_and_keeps_the_parents_score(tmp_path):
     parent = GOOD + '[identify]\nmethod = "sgd_sindy"\nepochs = 7\n[score]\ntrac_min = 0.9\nmac_min = 0.9\n'
     _write(tmp_path, parent, name="base")
     own = _write(tmp_path, '[scenario]\nname = "own"\nextends = "base.toml"\n'
@@ -124,10 +125,94 @@ def test_extends_replaces_identify_and_score_whole(tmp_path):
     sc = load_scenario(own)
     assert sc.identify == {"method": "ls_sindy"}  # no epochs inherited from sgd_sindy
     assert sc.score == {"trac": {"min": 0.5}}  # no mac_min inherited
+    # a child that replaces [identify] but states no [score] keeps its parent's bars (it must
+    # never pass with no bars at all)
     bare = _write(tmp_path, '[scenario]\nname = "bare"\nextends = "base.toml"\n'
                   '[identify]\nmethod = "ls_sindy"\n', name="bare")
-    assert load_scenario(bare).score == {}
+    assert load_scenario(bare).score == {"trac": {"min": 0.9}, "mac": {"min": 0.9}}
     noisy = _write(tmp_path, '[scenario]\nname = "noisy"\nextends = "base.toml"\n[noise]\nrms_percent = 1\n',
                    name="noisy")
     sc = load_scenario(noisy)
     assert sc.identify == {"method": "sgd_sindy", "epochs": 7} and set(sc.score) == {"trac", "mac"}
+
+
+def test_impact_tolerance_is_the_signal_chains():
+    """The rig refuses an impact the structural signal chain could not map onto a sensor."""
+    from models.cantilever.rig import HIT_SENSOR_TOLERANCE_M
+    from testbed.preprocess import IMPACT_TOLERANCE_M
+
+    assert HIT_SENSOR_TOLERANCE_M == IMPACT_TOLERANCE_M
+
+
+def test_impact_on_a_sensor_is_accepted_and_between_sensors_refused(tmp_path):
+    ok = GOOD.replace("n_segments = 6", "n_segments = 6\nsensors = [0.1, 0.2, 0.3175]") \
+        + '[excitation]\ntype = "impact"\nlocation = 0.2005\n'  # 0.5 mm from the sensor at 0.2 m
+    assert load_scenario(_write(tmp_path, ok)).excitation["location"] == 0.2005
+    bad = ok.replace("0.2005", "0.15")
+    with pytest.raises(ScenarioError, match=r"'excitation.location'.*50 mm from the nearest"):
+        load_scenario(_write(tmp_path, bad))
+
+
+@pytest.mark.parametrize(("extra", "key"), [
+    ("[simulation]\nduration = 1e6\n", "simulation.duration"),
+    ("[simulation]\nsample_rate = 1e9\n", "simulation.sample_rate"),
+    ("[simulation]\ntimestep = 1e-12\n", "simulation.timestep"),
+    ("[rig]\nn_segments = 400\n", "rig.n_segments"),  # the stiffest mode sets a tiny step
+])
+def test_over_budget_is_refused_before_simulating_naming_the_key(tmp_path, extra, key):
+    from testbed.errors import BudgetError
+
+    text = GOOD.replace("[rig]\nn_segments = 6\n", "") if extra.startswith("[rig]") else GOOD
+    text = text.replace("[simulation]\nduration = 0.05\n", "") if "[simulation]" in extra else text
+    with pytest.raises(BudgetError) as e:
+        load_scenario(_write(tmp_path, text + extra))
+    assert f"'{key}'" in str(e.value) and "budget" in str(e.value)
+
+
+def test_every_shipped_scenario_is_within_budget_with_room():
+    """The estimates are not so pessimistic that a real scenario is refused: every shipped one
+    needs under a tenth of each budget."""
+    from models import RIGS
+    from testbed import budget
+    from testbed.scenario import list_scenarios
+
+    for sc in list_scenarios():
+        cost = RIGS.get(sc.rig).cost(sc.rig_params, sc.simulation, sc.excitation)
+        assert cost.memory_bytes < budget.MEMORY_BUDGET_BYTES / 10, sc.name
+        assert cost.steps < budget.STEP_BUDGET / 10, sc.name
+        assert cost.steps >= cost.samples >= 2, sc.name
+
+
+def test_score_without_identify_and_contradictory_bars_are_refused(tmp_path):
+    with pytest.raises(ScenarioError, match=r"'score'.*needs an \[identify\]"):
+        load_scenario(_write(tmp_path, GOOD + "[score]\ntrac_min = 0.9\n"))
+    # a study's scenario: the study's identifiers are held to its bars
+    bars = load_scenario(tmp_path / "s.toml", standalone=False)
+    assert bars.identify is None and bars.score == {"trac": {"min": 0.9}}
+    text = GOOD + '[identify]\nmethod = "ls_sindy"\n[score]\ntrac_min = 0.9\ntrac_max = 0.8\n'
+    with pytest.raises(ScenarioError, match=r"'score\.trac_min'.*no score could pass"):
+        load_scenario(_write(tmp_path, text))
+    with pytest.raises(ScenarioError, match=r"'score\.trac_min': value nan"):
+        load_scenario(_write(tmp_path, GOOD + '[identify]\nmethod = "ls_sindy"\n[score]\ntrac_min = nan\n'))
+
+
+def test_identifier_of_the_other_kind_is_refused_naming_both(tmp_path):
+    with pytest.raises(ScenarioError) as e:
+        load_scenario(_write(tmp_path, GOOD + '[identify]\nmethod = "sindy_pi"\n'))
+    msg = str(e.value)
+    assert "'identify.method'" in msg and "'mechanical'" in msg and "'structural'" in msg
+    assert "cantilever" in msg
+
+
+@pytest.mark.parametrize("stem", [".", "-x", "a b", "x" * 129])
+def test_unsafe_names_are_refused(tmp_path, stem):
+    p = tmp_path / f"{stem}.toml"
+    p.write_text(GOOD.replace("{name}", stem))
+    with pytest.raises(ScenarioError, match=r"scenario\.name"):
+        load_scenario(p)
+
+
+def test_identify_keeps_given_keys_only_with_floats_widened(tmp_path):
+    sc = load_scenario(_write(tmp_path, GOOD + '[identify]\nmethod = "ls_sindy"\nrcond = 0\n'))
+    assert sc.identify == {"method": "ls_sindy", "rcond": 0.0}
+    assert isinstance(sc.identify["rcond"], float)

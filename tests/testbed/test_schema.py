@@ -57,3 +57,41 @@ def test_variant_selects_schema_by_type():
         validate_variant({"type": "hammer"}, variants, file="f", section="excitation")
     with pytest.raises(ScenarioError, match="unknown key"):
         validate_variant({"type": "sine", "peak": 1.0}, variants, file="f", section="excitation")
+
+
+def test_pattern_also_and_any_value():
+    schema = {
+        "name": Field(str, "a", pattern="[a-z]+", pattern_doc="lower-case letters"),
+        "library": Field(str, "named", choices=("named",), also=Field(list, item_type=str, min_items=1)),
+        "anything": Field(object, None),
+    }
+    out = validate_table({"library": ["x", "y"], "anything": {"k": 1}}, schema, file="f", section="s")
+    assert out == {"name": "a", "library": ["x", "y"], "anything": {"k": 1}}
+    with pytest.raises(ScenarioError, match=r"key 's\.name': value 'A/b': expected a string lower-case"):
+        validate_table({"name": "A/b"}, schema, file="f", section="s")
+    with pytest.raises(ScenarioError, match=r"one of 'named', or a list of strings"):
+        validate_table({"library": 5}, schema, file="f", section="s")
+    with pytest.raises(ScenarioError, match=r"one of 'named', or a list of strings"):
+        validate_table({"library": []}, schema, file="f", section="s")
+
+
+def test_variant_selector_must_be_a_string():
+    with pytest.raises(ScenarioError, match=r"key 'excitation\.type'"):
+        validate_variant({"type": {"a": 1}}, {"impact": {}}, file="f", section="excitation")
+
+
+def test_messages_are_one_line_and_short_whatever_the_value():
+    huge = ["x" * 1000] * 1000
+    e = ScenarioError("f.toml", "rig.bad\nkey", huge, "expected\na table")
+    msg = str(e)
+    assert "\n" not in msg and len(msg) < 300, msg
+    assert "rig.bad\\nkey" in msg and msg.endswith("expected\\na table") and "[...]" in msg
+
+
+def test_unknown_section_does_not_echo_its_content():
+    from testbed.schema import validate_header
+
+    with pytest.raises(ScenarioError) as e:
+        validate_header({"study": {"secret": "content"}}, sections=("scenario",), header="scenario",
+                        schema={}, file="f", stem=None)
+    assert "secret" not in str(e.value) and "unknown section" in str(e.value)

@@ -6,6 +6,7 @@ nothing here is simulated), so these tests do not depend on the real rigs.
 
 from __future__ import annotations
 
+import sys
 import textwrap
 from pathlib import Path
 
@@ -73,13 +74,31 @@ solver = "qr"
 
 
 @pytest.fixture(scope="module")
-def folder(tmp_path_factory) -> Path:
+def folder(tmp_path_factory):
+    """The toy files; afterwards the registries and modules are as before, so the toy rigs and
+    identifiers do not leak into other tests (e.g. the generated scenario guide)."""
+    from identify import IDENTIFIERS
+    from models import RIGS
+
+    registries = (RIGS, IDENTIFIERS)
+    for r in registries:
+        r.names()  # load the packages' own entries first, so the snapshot holds them
+    saved = [(r, dict(r._entries), dict(r._tags)) for r in registries]
+    modules = set(sys.modules)
     d = tmp_path_factory.mktemp("study")
     (d / "plugin.py").write_text(PLUGIN)
     (d / "broken_plugin.py").write_text("raise RuntimeError('plugin broke')\n")
     for name, rig in (("mech", "st_mech_rig"), ("struct", "st_struct_rig")):
         (d / f"{name}.toml").write_text(f'[scenario]\nname = "{name}"\nrig = "{rig}"\n')
-    return d
+    yield d
+    for r, entries, tags in saved:
+        r._entries.clear()
+        r._entries.update(entries)
+        r._tags.clear()
+        r._tags.update(tags)
+    for m in set(sys.modules) - modules:
+        if m.startswith("_testbed_plugin_"):
+            del sys.modules[m]
 
 
 def write(folder: Path, name: str, text: str) -> Path:
@@ -142,9 +161,9 @@ CASES = {
     "unknown hyperparameter": (BASE + "beta = 2\n", "identifiers.st_mech_id.beta",
                                "unknown hyperparameter of st_mech_id; allowed: alpha, n_iter, solver"),
     "hyperparameter type": (_replace(BASE, 'solver = "qr"', "solver = 3"), "identifiers.st_mech_id.solver",
-                            "expected str"),
+                            "expected a string"),
     "int hyperparameter as float": (BASE + "n_iter = 2.5\n", "identifiers.st_mech_id.n_iter",
-                                    "expected int"),
+                                    "expected an integer"),
     "method in table": (BASE + 'method = "x"\n', "identifiers.st_mech_id.method", "not allowed here"),
     "params of unlisted identifier": (BASE + "[identifiers.st_other]\na = 1\n", "identifiers.st_other",
                                       "not in study.identifiers"),
