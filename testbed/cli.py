@@ -178,7 +178,8 @@ def cmd_generate(args: argparse.Namespace) -> int:
         sc = sc.replace(seed=args.seed)
     with _progress()(f"generating {sc.name}") as bar:
         # through the run cache unless --no-cache: a later `testbed run` of it simulates nothing
-        ds = generate(sc, progress=bar) if args.no_cache else DatasetCache(_cache_folder(args.cache)).get(sc, bar)
+        cache = None if args.no_cache else DatasetCache(_cache_folder(args.cache))
+        ds = generate(sc, progress=bar) if cache is None else cache.get(sc, bar)
     out = Path(args.output or f"{sc.name}-seed{sc.seed}.h5")
     ds.save(out)
     print_truth_summary(ds)
