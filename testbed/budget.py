@@ -24,6 +24,12 @@ MEMORY_BUDGET_BYTES = 4 * 2**30
 #: costs 93 us per step); the largest shipped scenario takes about 5e5.
 STEP_BUDGET = 1e8
 
+#: CPU time one simulation may take [s]: an hour of one core.  A step count alone misjudges a
+#: fine beam, whose steps cost ~N^3 (dense mass matrix): 400 segments take 3.8 ms per
+#: implicit step against ~10 us for 10 segments.  A study multiplies one run by its cells, so
+#: an hour per run is already a day's sweep.
+CPU_BUDGET_S = 3600.0
+
 #: Samples one record may hold, whatever its memory: 1e8 is 2.2 h at 12.8 kHz, far beyond
 #: any impact or identification record, and keeps index arithmetic and progress bars sane.
 SAMPLE_BUDGET = 1e8
@@ -45,6 +51,10 @@ class Cost:
         The scenario key that drives each figure (named in the refusal).
     memory_value, steps_value, samples_value : object
         That key's value.
+    seconds : float, optional
+        Estimated CPU time of the simulation [s] on one core (None: the rig does not say).
+    seconds_key, seconds_value : str, object
+        The key that drives it and its value.
     """
 
     memory_bytes: float
@@ -56,6 +66,9 @@ class Cost:
     memory_value: object = None
     steps_value: object = None
     samples_value: object = None
+    seconds: float | None = None
+    seconds_key: str = ""
+    seconds_value: object = None
 
 
 def check_cost(cost: Cost, file: str) -> None:
@@ -74,6 +87,10 @@ def check_cost(cost: Cost, file: str) -> None:
         raise BudgetError(file, cost.steps_key, cost.steps_value,
                           f"the simulation would take {cost.steps:.3g} integration steps; the "
                           f"budget is {STEP_BUDGET:.3g} (testbed.budget.STEP_BUDGET)")
+    if cost.seconds is not None and not cost.seconds <= CPU_BUDGET_S:
+        raise BudgetError(file, cost.seconds_key, cost.seconds_value,
+                          f"the simulation would take about {cost.seconds / 3600:.3g} h of CPU; the "
+                          f"budget is {CPU_BUDGET_S / 3600:g} h (testbed.budget.CPU_BUDGET_S)")
     if not cost.memory_bytes <= MEMORY_BUDGET_BYTES:
         raise BudgetError(file, cost.memory_key, cost.memory_value,
                           f"the run would need about {cost.memory_bytes / 2**30:.3g} GiB of memory; "

@@ -58,6 +58,20 @@ BYTES_PER_SAMPLE_PER_SENSOR = 512
 #: Memory per sample for the force channel and the time axis [bytes] (about 8 float64 arrays).
 BYTES_PER_SAMPLE = 64
 
+#: CPU time of one implicitfast step [s] ~ STEP_S_0 + STEP_S_3 * nv^3 (dense factorisation of
+#: the nv x nv mass matrix): fitted to 95 us at nv = 100 and 3.8 ms at nv = 400 (measured on
+#: the shared 2-core machine, 2026-11-23; 0.55 ms at 200 is predicted within 8 %).
+STEP_S_0, STEP_S_3 = 36e-6, 5.9e-11
+#: An RK4 step costs this many implicitfast steps (four model evaluations; measured 2.7-2.9).
+RK4_STEP_FACTOR = 2.8
+
+
+def step_seconds(nv: int, integrator: str) -> float:
+    """Estimated CPU time [s] of one integration step of a beam with ``nv`` joints."""
+    t = STEP_S_0 + STEP_S_3 * nv**3
+    return t * RK4_STEP_FACTOR if integrator.upper() == "RK4" else t
+
+
 RIG_SCHEMA = {
     "E": Field(float, 210e9, unit="Pa", min=0.0, min_inclusive=False, doc="Young's modulus"),
     "rho": Field(float, 7850.0, unit="kg/m^3", min=0.0, min_inclusive=False, doc="density"),
@@ -209,11 +223,15 @@ class CantileverRig(Rig):
             else "simulation.duration"
         value = simulation[key.split(".")[1]]
 
-        def cost(substeps: float, step_key: str, step_value: Any) -> Cost:
+        def cost(substeps: float, step_key: str, step_value: Any, step_s: float | None = None) -> Cost:
             steps = samples * substeps
+            nv = rig["n_segments"] + (rig["base"] == "soft")
             return Cost(memory_bytes=samples * per_sample + steps * BYTES_PER_STEP, steps=steps,
                         samples=samples, memory_key=key, steps_key=step_key, samples_key=key,
-                        memory_value=value, steps_value=step_value, samples_value=value)
+                        memory_value=value, steps_value=step_value, samples_value=value,
+                        seconds=None if step_s is None else steps * step_s,
+                        seconds_key="rig.n_segments" if nv > 60 else key,
+                        seconds_value=rig["n_segments"] if nv > 60 else value)
 
         lower = cost(1.0, key, value)
         if (lower.samples > SAMPLE_BUDGET or lower.steps > STEP_BUDGET
@@ -232,7 +250,8 @@ class CantileverRig(Rig):
             step_key, step_value = "rig.n_segments", rig["n_segments"]
         else:
             step_key, step_value = key, value
-        return cost(float(stepping.substeps), step_key, step_value)
+        return cost(float(stepping.substeps), step_key, step_value,
+                    step_seconds(rig["n_segments"] + (rig["base"] == "soft"), stepping.integrator))
 
     def __init__(self, scenario: Any) -> None:
         super().__init__(scenario)
