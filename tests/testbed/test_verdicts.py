@@ -225,9 +225,9 @@ def test_cli_run_without_thresholds_does_not_exit_as_a_pass(tmp_path, dataset_ca
     from testbed.cli import EXIT_FAIL, main
 
     base = load_scenario("cantilever_stiff_impact_lsq").path
-    # an [identify] table without [score] drops the parent's thresholds (scenario.extends)
+    # a child keeps its parent's [score] unless it declares its own: an empty one here
     (tmp_path / "nothr.toml").write_text(f'[scenario]\nname = "nothr"\nextends = "{base}"\n'
-                                         '[identify]\nmethod = "ls_sindy"\n')
+                                         '[identify]\nmethod = "ls_sindy"\n[score]\n')
     code = main(["run", str(tmp_path / "nothr.toml"), "--cache", str(dataset_cache.directory),
                  "-o", str(tmp_path / "out"), "--no-figures"])
     assert code == EXIT_FAIL
