@@ -25,8 +25,8 @@ import numpy as np
 from threadpoolctl import threadpool_limits
 
 from models.cantilever import CantileverRig
-from testbed.generate import generate
-from testbed.scenario import load_scenario
+from testbed.pipeline.generate import generate
+from testbed.pipeline.scenario import load_scenario
 
 TARGET_RATIO = 1.5
 REPEATS = 5

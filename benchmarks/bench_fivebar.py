@@ -17,8 +17,8 @@ import pinocchio as pin
 
 from models.fivebar import geometry as geo
 from models.fivebar.rig import FiveBarRig
-from testbed.generate import generate
-from testbed.scenario import load_scenario
+from testbed.pipeline.generate import generate
+from testbed.pipeline.scenario import load_scenario
 
 TARGET_RATIO = 2.0
 

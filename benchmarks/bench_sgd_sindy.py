@@ -24,8 +24,8 @@ from scipy.integrate import solve_ivp
 
 from identify.ls_sindy import LeastSquaresSINDy
 from identify.sgd_sindy import SGDSINDy
-from testbed.measurement import Measurement
-from testbed.metrics import frequency_error, mac_matrix, pair_modes, trac
+from testbed.core.measurement import Measurement
+from testbed.scoring.metrics import frequency_error, mac_matrix, pair_modes, trac
 
 FS = 12800.0
 
@@ -202,11 +202,11 @@ def _median_time(fn, repeats: int) -> float:
 
 def cantilever_case():
     """The stiff cantilever scenario's measurement and a scorer identical to its scored test."""
-    from testbed.cache import DatasetCache
-    from testbed.preprocess import measure
-    from testbed.run import noise_free
-    from testbed.scenario import load_scenario
-    from testbed.scoring import score_structural
+    from testbed.pipeline.cache import DatasetCache
+    from testbed.pipeline.scenario import load_scenario
+    from testbed.pipeline.signal_chain import measure
+    from testbed.scoring.run import noise_free
+    from testbed.scoring.scorers import score_structural
 
     sc = load_scenario("cantilever_stiff_impact")
     ds = DatasetCache().get(sc)

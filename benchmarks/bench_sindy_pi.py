@@ -31,7 +31,7 @@ import numpy as np  # noqa: E402
 from identify._implicit import DEFAULT_THRESHOLDS, grams, select_models, split_index, stlsq_sweep  # noqa: E402
 from identify.library import Library, generic_mechanical_library  # noqa: E402
 from identify.pysindy_pi import PySINDyPI  # noqa: E402
-from testbed.errors import IdentificationError  # noqa: E402
+from testbed.core.errors import IdentificationError  # noqa: E402
 
 _spec = importlib.util.spec_from_file_location("sindy_pi_problems", Path(__file__).with_name(
     "sindy_pi_problems.py"))

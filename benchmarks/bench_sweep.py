@@ -39,9 +39,9 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 os.environ.setdefault("OMP_NUM_THREADS", "1")  # before numpy loads: one thread per worker
 
-from testbed.results import read_results
-from testbed.study import load_study
-from testbed.sweep import SweepStats, run_sweep
+from testbed.studies.results import read_results
+from testbed.studies.study import load_study
+from testbed.studies.sweep import SweepStats, run_sweep
 
 # Left out of the identity check: timings, and the commit (provenance: a commit made while the
 # bench runs changes it without changing any score).

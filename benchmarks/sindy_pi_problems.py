@@ -22,8 +22,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from testbed.measurement import Measurement
-from testbed.terms import canonical
+from testbed.core.measurement import Measurement
+from testbed.core.terms import canonical
 
 
 @dataclass

@@ -4,7 +4,7 @@ Every module of this package is imported on first lookup of :data:`IDENTIFIERS`.
 ``identify`` never imports ``models``.
 """
 
-from testbed.registry import Registry
+from testbed.core.registry import Registry
 
 IDENTIFIERS = Registry("identifier", package="identify")
 

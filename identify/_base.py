@@ -1,13 +1,13 @@
 """The estimator contract (scikit-learn / pysindy style) every identifier follows.
 
 - ``__init__`` only stores hyperparameters, under the names of its arguments;
-- ``fit(data) -> self`` with ``data`` a :class:`~testbed.measurement.Measurement`;
+- ``fit(data) -> self`` with ``data`` a :class:`~testbed.core.measurement.Measurement`;
 - learned results end in ``_`` (``M_``, ``C_``, ``K_``, ``K3_``, ``coef_``) and exist
   only after ``fit``;
 - ``simulate(x0, xd0, t, u=None)`` integrates the identified model;
 - ``equations()`` returns the identified equations as text;
 - every ``__init__`` parameter is *declared* in the class attribute ``hyperparameters``
-  (a :class:`testbed.schema.Field` per name: type, default, bounds, unit, meaning), and
+  (a :class:`testbed.core.schema.Field` per name: type, default, bounds, unit, meaning), and
   nothing else is; scenario and study files are checked against it when they load, the
   scenario guide lists it, and a conformance test keeps it equal to ``__init__``.
   Cross-key checks go in :meth:`Identifier.check_hyperparameters`, checks against the
@@ -21,9 +21,9 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from testbed.errors import HyperparameterError, ScenarioError
-from testbed.measurement import Measurement, Trajectory
-from testbed.schema import ErrorFn, Field, validate_table
+from testbed.core.errors import HyperparameterError, ScenarioError
+from testbed.core.measurement import Measurement, Trajectory
+from testbed.core.schema import ErrorFn, Field, validate_table
 
 
 class Identifier:

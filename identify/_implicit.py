@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from testbed.errors import IdentificationError
+from testbed.core.errors import IdentificationError
 
 DEFAULT_THRESHOLDS = np.r_[0.0, np.logspace(-6, -0.5, 12)]
 

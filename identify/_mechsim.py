@@ -19,8 +19,8 @@ import numpy as np
 from scipy.interpolate import CubicHermiteSpline
 
 from identify.library import Library
-from testbed.errors import IdentificationError
-from testbed.measurement import Trajectory
+from testbed.core.errors import IdentificationError
+from testbed.core.measurement import Trajectory
 
 #: A closure fitted or declared must close the measured loop to this fraction of the longest
 #: link: 1e-3 covers angle noise of about 1e-3 rad, while a wrong sign convention or a wrong

@@ -89,7 +89,7 @@ import numpy as np
 from scipy import linalg
 
 from identify._sgd_penalties import Adam
-from testbed.measurement import Measurement
+from testbed.core.measurement import Measurement
 
 
 def _rms(a: np.ndarray, axis: int = 1) -> np.ndarray:

@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 from scipy import linalg, signal
 
-from testbed.measurement import Trajectory
+from testbed.core.measurement import Trajectory
 
 
 def _zoh_free_and_forced(A: np.ndarray, Bz: np.ndarray | None, z0: np.ndarray, dt: float, n_t: int,

@@ -37,7 +37,7 @@ import numpy as np
 from scipy.signal import fftconvolve
 
 from identify.library import Library
-from testbed.errors import IdentificationError
+from testbed.core.errors import IdentificationError
 
 
 def window_function(n: int, degree: int) -> tuple[np.ndarray, np.ndarray]:

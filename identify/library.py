@@ -1,6 +1,6 @@
 """Named candidate-term libraries for implicit (SINDy-PI) regression of mechanical systems.
 
-A :class:`Library` is a list of product terms named as in :mod:`testbed.terms`
+A :class:`Library` is a list of product terms named as in :mod:`testbed.core.terms`
 (``"sin(th2-th3)*ddth1"``, ``"sin(th1-th2)^2*dth2^2"``, ``"u1"``).  It evaluates them from
 the measured signals into the library matrix ``Theta`` (n_samples x n_terms).  Evaluation is
 vectorised: every distinct trigonometric factor is computed once, for all samples, as
@@ -38,7 +38,7 @@ from itertools import combinations
 
 import numpy as np
 
-from testbed.terms import canonical
+from testbed.core.terms import canonical
 
 _TRIG = re.compile(r"^(sin|cos)\(th(\d+)(?:-th(\d+))?\)$")
 _VAR = re.compile(r"^(ddth|dth|th|u|x|v|a)(\d+)$")
@@ -52,7 +52,7 @@ class Library:
     Parameters
     ----------
     terms : sequence of str
-        Term names; each is put in canonical form (:func:`testbed.terms.canonical`).  A sign
+        Term names; each is put in canonical form (:func:`testbed.core.terms.canonical`).  A sign
         picked up by canonicalisation is dropped: the column is the canonical term's value.
     n_coords : int, optional
         Number of coordinates (rows of x); default the largest index used.

@@ -14,8 +14,8 @@ from identify.structural import (
     mass_prior_value,
     matrices_from_coef,
 )
-from testbed.measurement import Measurement
-from testbed.schema import Field
+from testbed.core.measurement import Measurement
+from testbed.core.schema import Field
 
 #: The mass prior: which key of ``data.prior`` gives the mass scale [kg] (shared with
 #: sgd_sindy and sindy_pi_linear).

@@ -14,7 +14,7 @@ objective is identical (``||Q (R_j - R xi)||^2 = ||R_j - R xi||^2``) and each pr
 
 Failures are errors, not zeros: pysindy 2.1.0 turns an infeasible or failed cvxpy solve into
 zero (or NaN) coefficients with at most a warning; we raise
-:class:`~testbed.errors.IdentificationError` naming the candidates concerned.
+:class:`~testbed.core.errors.IdentificationError` naming the candidates concerned.
 """
 
 from __future__ import annotations
@@ -30,8 +30,8 @@ import numpy as np
 from identify import IDENTIFIERS
 from identify._implicit import Sweep, _errors
 from identify.sindy_pi import COMMON_HYPERPARAMETERS, _ImplicitMechanical, ordered_fields
-from testbed.errors import IdentificationError
-from testbed.schema import Field
+from testbed.core.errors import IdentificationError
+from testbed.core.schema import Field
 
 
 def pysindy_pi_coef(X: np.ndarray, cand: np.ndarray, reg_weight_lam: float, tol: float,

@@ -23,8 +23,8 @@ from identify.structural import (
     matrices_from_coef,
     measured_frequencies,
 )
-from testbed.measurement import Measurement
-from testbed.schema import ErrorFn, Field
+from testbed.core.measurement import Measurement
+from testbed.core.schema import ErrorFn, Field
 
 _TERMS = ("sym", "eig", "l1")
 

@@ -53,11 +53,11 @@ from identify._implicit import DEFAULT_THRESHOLDS, Sweep, grams, select_models, 
 from identify._mechsim import CLOSURE_RTOL, ImplicitModel, LoopClosure
 from identify._weak import weak_matrix
 from identify.library import Library, fivebar_library, generic_mechanical_library
-from testbed.errors import IdentificationError
-from testbed.gram import normalized_gram, ordered_independent
-from testbed.measurement import Measurement, Trajectory
-from testbed.schema import ErrorFn, Field
-from testbed.signal import lowpass
+from testbed.core.errors import IdentificationError
+from testbed.core.measurement import Measurement, Trajectory
+from testbed.core.schema import ErrorFn, Field
+from testbed.numerics.filters import lowpass
+from testbed.numerics.gram import normalized_gram, ordered_independent
 
 #: Rollout angle-RMSE differences below 1e-4 rad [rad] count as ties (then fewer terms win):
 #: far below the 0.05 rad the paper reports and below what chaos-sensitive rollouts resolve.

@@ -59,9 +59,9 @@ from identify.sindy_pi import (
     VAL_FRACTION_FIELD,
     check_thresholds,
 )
-from testbed.errors import IdentificationError
-from testbed.measurement import Measurement, Trajectory
-from testbed.schema import Field
+from testbed.core.errors import IdentificationError
+from testbed.core.measurement import Measurement, Trajectory
+from testbed.core.schema import Field
 
 
 def _sym_basis(n: int) -> np.ndarray:

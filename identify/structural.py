@@ -30,8 +30,8 @@ from scipy import linalg
 
 from identify._base import Identifier
 from identify._structural_sim import simulate_structural
-from testbed.errors import IdentificationError
-from testbed.measurement import Measurement, Trajectory
+from testbed.core.errors import IdentificationError
+from testbed.core.measurement import Measurement, Trajectory
 
 #: Keys of ``Measurement.prior`` a structural identifier may take the mass scale from.
 MASS_PRIORS = ("reduced_mass_trace", "total_mass")
@@ -189,7 +189,7 @@ def measured_frequencies(data: Measurement, n_modes: int, freq_range: tuple[floa
                          start: int | None = None) -> np.ndarray:
     """Natural frequencies [Hz] read from the spectral peaks of the measured accelerations.
 
-    Uses :func:`testbed.spectral.peak_frequencies` (rectangular window, 8x zero padding,
+    Uses :func:`testbed.numerics.spectral.peak_frequencies` (rectangular window, 8x zero padding,
     parabolic refinement; a Hann window would suppress the fast-decaying second mode of an impact
     response, whose energy sits at the start of the window) on ``data.xdd`` from the fit window.
     If fewer than ``n_modes`` peaks stand out the clear ones are returned (at least one).
@@ -209,7 +209,7 @@ def measured_frequencies(data: Measurement, n_modes: int, freq_range: tuple[floa
     ndarray, shape (k,), 1 <= k <= n_modes
         Ascending frequencies [Hz].
     """
-    from testbed.spectral import peak_frequencies
+    from testbed.numerics.spectral import peak_frequencies
 
     s = data.free_start if start is None else int(start)
     xdd = np.asarray(data.xdd, dtype=float)[:, s:]

@@ -5,7 +5,7 @@ is imported on first lookup.  ``models`` never imports ``identify`` or the
 metrics: a rig does not know who will judge it.
 """
 
-from testbed.registry import Registry
+from testbed.core.registry import Registry
 
 RIGS = Registry("rig", package="models")
 

@@ -3,25 +3,36 @@
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import TYPE_CHECKING, Any, ClassVar
+from typing import Any, ClassVar, Protocol
 
-from testbed.schema import Field
-
-if TYPE_CHECKING:
-    from testbed.budget import Cost
-    from testbed.dataset import Dataset
-    from testbed.scenario import Scenario
+from testbed.core.budget import Cost
+from testbed.core.dataset import Dataset
+from testbed.core.schema import Field
 
 ErrorFn = Callable[[str, Any, str], None]
+
+
+class ScenarioTables(Protocol):
+    """What a rig reads of a validated scenario: its name, seed and the rig's own tables.
+
+    :class:`testbed.pipeline.scenario.Scenario` is one; the contract names only what it needs,
+    so the rigs do not depend on the layer that loads scenario files.
+    """
+
+    name: str
+    seed: int
+    rig_params: dict[str, Any]
+    simulation: dict[str, Any]
+    excitation: dict[str, Any]
 
 
 class Rig:
     """A simulated test rig.
 
     Class attributes declare the scenario sections the rig accepts; an instance
-    is built from a validated :class:`~testbed.scenario.Scenario` and simulates
+    is built from a validated :class:`~testbed.pipeline.scenario.Scenario` and simulates
     noise-free data with its exact truth.  Noise and provenance are added by
-    :func:`testbed.generate.generate`, identically for every rig.
+    :func:`testbed.pipeline.generate.generate`, identically for every rig.
 
     Attributes
     ----------
@@ -76,13 +87,13 @@ class Rig:
     @classmethod
     def cost(cls, rig: dict[str, Any], simulation: dict[str, Any],
              excitation: dict[str, Any]) -> Cost | None:
-        """Estimated memory and integration steps of a run (:class:`testbed.budget.Cost`).
+        """Estimated memory and integration steps of a run (:class:`testbed.core.budget.Cost`).
 
         Called after :meth:`check`, before anything is simulated; None = no estimate.
         """
         return None
 
-    def __init__(self, scenario: Scenario) -> None:
+    def __init__(self, scenario: ScenarioTables) -> None:
         self.scenario = scenario
 
     def simulate(self, progress: Callable[[float], None] | None = None) -> Dataset:

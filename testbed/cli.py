@@ -15,7 +15,7 @@ import sys
 from pathlib import Path
 from urllib.parse import urlsplit
 
-from testbed.errors import InputError, TestbedError
+from testbed.core.errors import InputError, TestbedError
 
 EXIT_FAIL, EXIT_USAGE, EXIT_INTERNAL, EXIT_INTERRUPTED = 1, 2, 3, 130
 #: Seconds to wait for a Dask scheduler to accept a connection before calling it
@@ -72,7 +72,7 @@ def _dataset_file(path: Path) -> Path:
     """A dataset file written by ``testbed generate`` (HDF5 of this format), else InputError."""
     import h5py
 
-    from testbed.dataset import FORMAT
+    from testbed.core.dataset import FORMAT
 
     _existing_file(path, "a dataset .h5 file written by `testbed generate`")
     if not h5py.is_hdf5(path):
@@ -89,8 +89,8 @@ def _dataset_file(path: Path) -> Path:
 
 
 def _results_file(path: Path) -> Path:
-    """A sweep results file that :func:`testbed.results.read_results` can read, else InputError."""
-    from testbed.results import read_results
+    """A sweep results file that :func:`testbed.studies.results.read_results` can read, else InputError."""
+    from testbed.studies.results import read_results
 
     _existing_file(path, "a sweep results file (from `testbed sweep`)")
     try:
@@ -101,7 +101,7 @@ def _results_file(path: Path) -> Path:
 
 
 def _run_folder(path: Path) -> Path:
-    from testbed.runstore import load_run
+    from testbed.studies.runstore import load_run
 
     try:
         load_run(path)
@@ -136,7 +136,7 @@ def check_dask_address(address: str) -> None:
 
 
 def _progress():
-    from testbed.progress import progress_bar
+    from testbed.reporting.progress import progress_bar
 
     return progress_bar
 
@@ -145,9 +145,8 @@ def cmd_list(args: argparse.Namespace) -> int:
     from rich.console import Console
     from rich.table import Table
 
-    from identify import IDENTIFIERS
-    from models import RIGS
-    from testbed.scenario import list_scenarios
+    from testbed.pipeline.plugins import IDENTIFIERS, RIGS
+    from testbed.pipeline.scenario import list_scenarios
 
     con = Console()
     for title, registry in (("rigs", RIGS), ("identifiers", IDENTIFIERS)):
@@ -168,10 +167,10 @@ def cmd_list(args: argparse.Namespace) -> int:
 
 
 def cmd_generate(args: argparse.Namespace) -> int:
-    from testbed.cache import DatasetCache
-    from testbed.generate import generate
-    from testbed.scenario import load_scenario
-    from testbed.summaries import print_truth_summary
+    from testbed.pipeline.cache import DatasetCache
+    from testbed.pipeline.generate import generate
+    from testbed.pipeline.scenario import load_scenario
+    from testbed.reporting.console import print_truth_summary
 
     sc = load_scenario(args.scenario)
     if args.seed is not None:
@@ -188,11 +187,12 @@ def cmd_generate(args: argparse.Namespace) -> int:
 
 
 def cmd_run(args: argparse.Namespace) -> int:
-    from testbed.cache import DatasetCache
-    from testbed.run import run_scenario
-    from testbed.runstore import run_folder, save_run
-    from testbed.scenario import load_scenario
-    from testbed.summaries import print_score_table
+    from testbed.pipeline.cache import DatasetCache
+    from testbed.pipeline.scenario import load_scenario
+    from testbed.reporting.console import print_score_table
+    from testbed.reporting.figures import save_run_figures
+    from testbed.scoring.run import run_scenario
+    from testbed.studies.runstore import run_folder, save_run
 
     cache = None if args.no_cache else DatasetCache(_cache_folder(args.cache))
     ok = True
@@ -203,7 +203,7 @@ def cmd_run(args: argparse.Namespace) -> int:
         run_dir = run_folder(args.out, sc.name)  # refused before the work, not after
         with _progress()(f"{sc.name}: data") as bar:
             result = run_scenario(sc, cache=cache, progress=bar)
-        run_dir = save_run(result, run_dir, figures=not args.no_figures)
+        run_dir = save_run(result, run_dir, figures=None if args.no_figures else save_run_figures)
         print_score_table(result)
         print(f"run written to {run_dir}")
         ok &= result.passed
@@ -211,7 +211,7 @@ def cmd_run(args: argparse.Namespace) -> int:
 
 
 def cmd_report(args: argparse.Namespace) -> int:
-    from testbed.report import write_report
+    from testbed.reporting.report import write_report
 
     source = Path(args.source)
     if source.is_dir():
@@ -226,7 +226,7 @@ def cmd_report(args: argparse.Namespace) -> int:
 
 
 def cmd_export(args: argparse.Namespace) -> int:
-    from testbed.export import export_dataset
+    from testbed.reporting.export import export_dataset
 
     out = Path(args.output) if args.output else None
     for p in export_dataset(_dataset_file(Path(args.dataset)), args.format, out):
@@ -235,8 +235,8 @@ def cmd_export(args: argparse.Namespace) -> int:
 
 
 def cmd_sweep(args: argparse.Namespace) -> int:
-    from testbed.study import load_study
-    from testbed.sweep import SweepStats, run_sweep
+    from testbed.studies.study import load_study
+    from testbed.studies.sweep import SweepStats, run_sweep
 
     study = load_study(args.study)
     stats = SweepStats()
@@ -258,14 +258,14 @@ def cmd_sweep(args: argparse.Namespace) -> int:
 
 
 def cmd_summary(args: argparse.Namespace) -> int:
-    from testbed.summary import print_summary
+    from testbed.studies.statistics import print_summary
 
     print_summary(_results_file(Path(args.results)))
     return 0
 
 
 def cmd_cache(args: argparse.Namespace) -> int:
-    from testbed.cache import DatasetCache
+    from testbed.pipeline.cache import DatasetCache
 
     cache = DatasetCache(_cache_folder(args.cache))
     if args.action == "ls":
@@ -279,7 +279,7 @@ def cmd_cache(args: argparse.Namespace) -> int:
 
 
 def cmd_demo(args: argparse.Namespace) -> int:
-    from testbed.demo import run_demo
+    from testbed.reporting.demo import run_demo
 
     return run_demo(Path(args.out))
 

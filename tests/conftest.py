@@ -21,6 +21,6 @@ if str(ROOT) not in sys.path:
 
 @pytest.fixture(scope="session")
 def dataset_cache():
-    from testbed.cache import DatasetCache
+    from testbed.pipeline.cache import DatasetCache
 
     return DatasetCache(ROOT / ".cache" / "test-datasets")

@@ -35,17 +35,17 @@ def test_guide_example_runs(guide, tmp_path):
 
 
 def test_scenario_guide_is_up_to_date():
-    from testbed.guide import render
+    from testbed.reporting.guide import render
 
     committed = (DOCS / "scenarios.md").read_text()
     assert committed == render(), ("docs/scenarios.md is out of date with the schemas; regenerate it: "
-                                   "python -m testbed.guide > docs/scenarios.md")
+                                   "python -m testbed.reporting.guide > docs/scenarios.md")
 
 
 def test_scenario_guide_lists_every_key():
     from models import RIGS
-    from testbed.preprocess import SIGNAL_SCHEMAS
-    from testbed.scenario import HEADER_SCHEMA, NOISE_SCHEMA
+    from testbed.pipeline.scenario import HEADER_SCHEMA, NOISE_SCHEMA
+    from testbed.pipeline.signal_chain import SIGNAL_SCHEMAS
 
     text = (DOCS / "scenarios.md").read_text()
     schemas = [HEADER_SCHEMA, NOISE_SCHEMA, *SIGNAL_SCHEMAS.values()]

@@ -33,15 +33,15 @@ from models.cantilever.simulate import (
     static_equilibrium,
     unstable_modes,
 )
-from testbed.budget import MEMORY_BUDGET_BYTES, SAMPLE_BUDGET, STEP_BUDGET, Cost
-from testbed.dataset import Dataset, Signal
-from testbed.errors import RigError
-from testbed.schema import Field
+from testbed.core.budget import MEMORY_BUDGET_BYTES, SAMPLE_BUDGET, STEP_BUDGET, Cost
+from testbed.core.dataset import Dataset, Signal
+from testbed.core.errors import RigError
+from testbed.core.schema import Field
 
 LOG = logging.getLogger(__name__)
 
 #: An impact must land within 1 mm [m] of an accelerometer: the structural signal chain
-#: (``testbed.preprocess.IMPACT_TOLERANCE_M``, the same 1 mm; a test keeps them equal) maps
+#: (``testbed.pipeline.signal_chain.IMPACT_TOLERANCE_M``, the same 1 mm; a test keeps them equal) maps
 #: the force onto the sensor it hits, because a model in sensor coordinates cannot place a
 #: force between sensors.
 HIT_SENSOR_TOLERANCE_M = 1e-3

@@ -56,7 +56,7 @@ Failure
 MuJoCo does not stop an unstable simulation: it resets the state, counts a
 warning and carries on, so the data would be silently wrong.  :func:`rollout_sensors`
 checks the warning counters after every rollout call and raises
-:class:`~testbed.errors.RigError`; :func:`unstable_modes` refuses a requested step
+:class:`~testbed.core.errors.RigError`; :func:`unstable_modes` refuses a requested step
 the linear analysis already shows to be unstable, before any stepping.
 """
 
@@ -71,7 +71,7 @@ import mujoco.rollout
 import numpy as np
 import scipy.linalg as sla
 
-from testbed.errors import RigError
+from testbed.core.errors import RigError
 
 RK4_STABILITY = 2.0        # dt * max|eig(A)| for RK4 (stable to ~2.5; 20 % margin)
 RK4_ACCURACY = 0.49        # omega_Nyquist dt: (0.49)^4 / 120 = 4.8e-4 relative frequency error

@@ -19,7 +19,7 @@ substituting in the actuated rows and multiplying by the determinant::
     L2 L3 sin(th2-th3) (R4 - u2) - L3 L4 sin(th3-th4) R2 - L2 L4 sin(th2-th4) R3 = 0
 
 Expanded, each is a linear combination of product terms (a trig factor times a chain
-term) named by :func:`testbed.terms.canonical`.  The coefficients are checked against
+term) named by :func:`testbed.core.terms.canonical`.  The coefficients are checked against
 Pinocchio's constrained dynamics in the tests, not taken from the paper.
 """
 
@@ -31,7 +31,7 @@ from collections.abc import Mapping
 import numpy as np
 
 from models.fivebar.params import FiveBarParams
-from testbed.terms import canonical
+from testbed.core.terms import canonical
 
 _TRIG = re.compile(r"^(sin|cos)\(th(\d+)(?:-th(\d+))?\)$")
 _VAR = re.compile(r"^(ddth|dth|th|u)(\d+)$")
@@ -124,7 +124,7 @@ def evaluate_terms(terms: list[str], theta: np.ndarray, dtheta: np.ndarray, ddth
     Parameters
     ----------
     terms : list of str
-        Term names (``testbed.terms`` syntax).
+        Term names (``testbed.core.terms`` syntax).
     theta, dtheta, ddtheta : ndarray, shape (4, n)
         Absolute angles [rad], rates [rad/s], accelerations [rad/s^2].
     torque : ndarray, shape (2, n)

@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from testbed.schema import Field
+from testbed.core.schema import Field
 
 _FEEDBACK = {
     "kp": Field(float, 0.0, unit="N m/rad", min=0.0,

@@ -5,7 +5,7 @@ correction (semi-implicit Euler drifts ~1e-5 m), so none is used: the recorded m
 is the exact constrained motion up to the integrator's O(dt^4) error.
 
 A simulation that diverges (non-finite torque, state or record) or whose loop-closure
-solve stops unconverged raises :class:`~testbed.errors.RigError` with a one-line
+solve stops unconverged raises :class:`~testbed.core.errors.RigError` with a one-line
 message naming the time, instead of writing the garbage to a dataset.
 """
 
@@ -19,7 +19,7 @@ import pinocchio as pin
 from models.fivebar import geometry as geo
 from models.fivebar.dynamics import FiveBarDynamics
 from models.fivebar.excitation import TorqueProgram
-from testbed.errors import RigError
+from testbed.core.errors import RigError
 
 #: Samples between two transmission-angle / finiteness checks (and progress calls).
 CHECK_EVERY = 1000

@@ -90,7 +90,7 @@ class FiveBarParams:
         }
 
     def truth(self) -> tuple[dict[str, Any], dict[str, str]]:
-        """Truth arrays and their units for a :class:`~testbed.dataset.Dataset`."""
+        """Truth arrays and their units for a :class:`~testbed.core.dataset.Dataset`."""
         values = {"link_lengths": self.l.copy(), "base_length": np.float64(self.L0),
                   "link_masses": self.m.copy(), "link_inertias": self.inertia.copy(),
                   "link_com": self.com.copy(), "joint_damping": self.damping.copy(),

@@ -30,9 +30,9 @@ from models.fivebar.equations import true_equations
 from models.fivebar.excitation import EXCITATION_SCHEMAS, build_program, start_actuated
 from models.fivebar.integrate import simulate as simulate_pinocchio
 from models.fivebar.params import FiveBarParams
-from testbed.budget import Cost
-from testbed.dataset import Dataset, Signal
-from testbed.schema import Field
+from testbed.core.budget import Cost
+from testbed.core.dataset import Dataset, Signal
+from testbed.core.schema import Field
 
 #: Memory per sample of a run [bytes]: the record's 19 float64 channels (angles, rates,
 #: accelerations, torques, constraint force, end point, transmission angle, references:

@@ -24,7 +24,7 @@ from models.fivebar.dynamics import link_inertia_diag
 from models.fivebar.excitation import TorqueProgram
 from models.fivebar.integrate import CHECK_EVERY, check_finite, check_transmission
 from models.fivebar.params import FiveBarParams
-from testbed.errors import RigError
+from testbed.core.errors import RigError
 
 #: Constraint impedance: (dmin, dmax, width).  Close to 1 = nearly hard constraint.
 SOLIMP = (0.9999, 0.9999, 0.001)

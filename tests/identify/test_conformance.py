@@ -15,7 +15,7 @@ import pytest
 from benchmarks import bench_sgd_sindy, sindy_pi_problems
 from identify import IDENTIFIERS
 from identify._base import Identifier
-from testbed.measurement import Trajectory
+from testbed.core.measurement import Trajectory
 
 # Small budgets so each identifier fits in seconds: the contract does not depend on them.
 FAST = {"sgd_sindy": {"epochs": 2}, "pysindy_pi": {"stride": 4}}

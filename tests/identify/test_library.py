@@ -14,7 +14,7 @@ from identify.library import (
     linear_structural_library,
     near_dependencies,
 )
-from testbed.terms import canonical
+from testbed.core.terms import canonical
 
 ROOT = Path(__file__).resolve().parents[2]
 

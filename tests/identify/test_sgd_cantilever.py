@@ -13,10 +13,10 @@ import pytest
 
 from identify.sgd_sindy import SGDSINDy
 from identify.structural import measured_frequencies
-from testbed.preprocess import measure
-from testbed.run import noise_free
-from testbed.scenario import load_scenario
-from testbed.scoring import score_structural
+from testbed.pipeline.scenario import load_scenario
+from testbed.pipeline.signal_chain import measure
+from testbed.scoring.run import noise_free
+from testbed.scoring.scorers import score_structural
 
 
 @pytest.fixture(scope="module")

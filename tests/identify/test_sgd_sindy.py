@@ -14,7 +14,7 @@ from benchmarks import bench_sgd_sindy as bench
 from identify import IDENTIFIERS
 from identify.sgd_sindy import SGDSINDy
 from identify.structural import modal
-from testbed.metrics import mac_matrix, pair_modes, trac
+from testbed.scoring.metrics import mac_matrix, pair_modes, trac
 
 EPOCHS = 400
 K3_TRUE = 2.0e12  # N/m^3 at DOF 1: cubic force ~10 % of the linear one at the peak (x1 ~ 7e-5 m)

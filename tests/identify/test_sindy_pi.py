@@ -15,8 +15,8 @@ from identify._mechsim import LoopClosure
 from identify.pysindy_pi import PySINDyPI
 from identify.sindy_pi import SINDyPI
 from identify.sindy_pi_linear import SINDyPILinear
-from testbed.errors import IdentificationError
-from testbed.measurement import Measurement
+from testbed.core.errors import IdentificationError
+from testbed.core.measurement import Measurement
 
 ROOT = Path(__file__).resolve().parents[2]
 

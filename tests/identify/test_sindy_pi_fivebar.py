@@ -11,9 +11,9 @@ import pytest
 from identify._mechsim import LoopClosure
 from identify.library import fivebar_library
 from identify.sindy_pi import SINDyPI
-from testbed.equation_basis import compare_equations
-from testbed.preprocess import measure
-from testbed.scenario import load_scenario
+from testbed.pipeline.scenario import load_scenario
+from testbed.pipeline.signal_chain import measure
+from testbed.scoring.equation_basis import compare_equations
 
 
 @pytest.fixture(scope="module")

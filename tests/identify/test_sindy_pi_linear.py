@@ -12,10 +12,10 @@ import numpy as np
 import pytest
 
 from identify.sindy_pi_linear import SINDyPILinear
-from testbed.preprocess import measure
-from testbed.run import noise_free
-from testbed.scenario import load_scenario
-from testbed.scoring import score_structural
+from testbed.pipeline.scenario import load_scenario
+from testbed.pipeline.signal_chain import measure
+from testbed.scoring.run import noise_free
+from testbed.scoring.scorers import score_structural
 
 
 def _load(cache, name):

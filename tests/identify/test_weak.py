@@ -12,7 +12,7 @@ from benchmarks import sindy_pi_problems
 from identify._weak import weak_matrix, window_function
 from identify.library import Library
 from identify.sindy_pi import SINDyPI
-from testbed.derivatives import lowpass_differentiate
+from testbed.numerics.derivatives import lowpass_differentiate
 
 P = sindy_pi_problems
 

@@ -8,7 +8,7 @@ import pytest
 
 from models.cantilever import build_model, eb_frequencies
 from models.cantilever.simulate import choose_stepping, state_matrix
-from testbed.scenario import scenario_from_dict
+from testbed.pipeline.scenario import scenario_from_dict
 
 
 def scenario(rig=None, simulation=None, excitation=None):

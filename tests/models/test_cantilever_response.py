@@ -8,7 +8,7 @@ from scipy.signal import butter, sosfiltfilt
 
 from models.cantilever import CantileverRig, simulate_reduced
 from models.cantilever.simulate import half_sine
-from testbed.scenario import scenario_from_dict
+from testbed.pipeline.scenario import scenario_from_dict
 
 
 def scenario(rig=None, simulation=None, excitation=None):

@@ -5,9 +5,9 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from testbed.errors import ScenarioError
-from testbed.generate import generate
-from testbed.scenario import load_scenario, scenario_from_dict
+from testbed.core.errors import ScenarioError
+from testbed.pipeline.generate import generate
+from testbed.pipeline.scenario import load_scenario, scenario_from_dict
 
 
 def raw(rig=None, simulation=None, excitation=None, noise=None):

@@ -14,8 +14,8 @@ from models.cantilever.simulate import (
     mode_errors,
     rollout_sensors,
 )
-from testbed.errors import RigError
-from testbed.scenario import scenario_from_dict
+from testbed.core.errors import RigError
+from testbed.pipeline.scenario import scenario_from_dict
 
 
 def scenario(rig=None, simulation=None, excitation=None):

@@ -9,10 +9,10 @@ from models import RIGS
 from models.fivebar import geometry as geo
 from models.fivebar.params import FiveBarParams
 from models.fivebar.rig import RIG_SCHEMA, FiveBarRig
-from testbed.dataset import Dataset
-from testbed.errors import RigError, ScenarioError
-from testbed.scenario import load_scenario, scenario_from_dict
-from testbed.schema import validate_table
+from testbed.core.dataset import Dataset
+from testbed.core.errors import RigError, ScenarioError
+from testbed.core.schema import validate_table
+from testbed.pipeline.scenario import load_scenario, scenario_from_dict
 
 PAPER_POSE = {"th1_0": 1.78, "th4_0": 1.36}  # the shipped scenarios' start pose
 

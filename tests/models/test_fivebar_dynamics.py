@@ -9,8 +9,8 @@ from models.fivebar.equations import true_equations, true_library_residual
 from models.fivebar.excitation import TorqueProgram
 from models.fivebar.rig import FiveBarRig
 from models.fivebar.twin import MujocoTwin
-from testbed.generate import generate
-from testbed.scenario import load_scenario, scenario_from_dict
+from testbed.pipeline.generate import generate
+from testbed.pipeline.scenario import load_scenario, scenario_from_dict
 
 # Samples checked one by one with Pinocchio calls (spread over the whole record).
 IDX = np.linspace(0, 99_999, 157).astype(int)

@@ -6,8 +6,8 @@ import pytest
 
 from models.fivebar import geometry as geo
 from models.fivebar.rig import FiveBarRig
-from testbed.generate import generate
-from testbed.scenario import load_scenario, scenario_from_dict
+from testbed.pipeline.generate import generate
+from testbed.pipeline.scenario import load_scenario, scenario_from_dict
 
 
 def _free(duration, **rig):

@@ -10,9 +10,9 @@ from scipy.ndimage import distance_transform_edt
 from models.fivebar import geometry as geo
 from models.fivebar.params import FiveBarParams
 from models.fivebar.rig import RIG_SCHEMA, FiveBarRig
-from testbed.errors import RigError, ScenarioError
-from testbed.scenario import scenario_from_dict
-from testbed.schema import validate_table
+from testbed.core.errors import RigError, ScenarioError
+from testbed.core.schema import validate_table
+from testbed.pipeline.scenario import scenario_from_dict
 
 # Link lengths 0.6-1.4 m, base 0.4-1.6 m: long and short couplers, short and long bases.
 GEOMETRIES = [

@@ -5,8 +5,8 @@ this test ties the two together so that neither can drift."""
 
 import numpy as np
 
-from testbed.run import run_scenario
-from testbed.scenario import load_scenario
+from testbed.pipeline.scenario import load_scenario
+from testbed.scoring.run import run_scenario
 
 LINEAR, NONLINEAR = "cantilever_stiff_impact_cubic", "cantilever_soft_impact"
 

@@ -4,8 +4,8 @@ another seed changes only the noisy measured signals."""
 import numpy as np
 import pytest
 
-from testbed.generate import generate
-from testbed.scenario import list_scenarios
+from testbed.pipeline.generate import generate
+from testbed.pipeline.scenario import list_scenarios
 
 # Scenarios that differ only in identifier or score share their data: test each data set once.
 _seen, SCENARIOS = set(), []

@@ -3,9 +3,9 @@ thresholds.  Thresholds live in the scenario files, each with the reason for its
 
 import pytest
 
-from testbed.run import run_scenario
-from testbed.scenario import list_scenarios
-from testbed.summaries import print_score_table
+from testbed.pipeline.scenario import list_scenarios
+from testbed.reporting.console import print_score_table
+from testbed.scoring.run import run_scenario
 
 SCORED = [s for s in list_scenarios() if s.identify is not None and s.score]
 

@@ -12,11 +12,11 @@ from typing import Any
 import numpy as np
 from scipy.linalg import eigh
 
-from testbed.dataset import Dataset, Signal
-from testbed.measurement import Measurement
-from testbed.run import RunResult
-from testbed.scenario import Scenario
-from testbed.scoring import Scores, check_thresholds
+from testbed.core.dataset import Dataset, Signal
+from testbed.core.measurement import Measurement
+from testbed.pipeline.scenario import Scenario
+from testbed.scoring.run import RunResult
+from testbed.scoring.scorers import Scores, check_thresholds
 
 
 class FakeIdentifier:
@@ -128,7 +128,7 @@ def mechanical_result(n_samples: int = 2000, fs: float = 200.0) -> RunResult:
 
 
 def sweep_rows() -> list[dict[str, Any]]:
-    """Rows in the results schema of :mod:`testbed.results`: 2 identifiers x 3 noise levels x 2 seeds."""
+    """Results-schema rows (:mod:`testbed.studies.results`): 2 identifiers x 3 noise levels x 2 seeds."""
     rows = []
     for ident, base in (("sindy_ls", 0.9), ("sgd_sindy", 0.97)):
         for noise in (0.0, 1.0, 5.0):

@@ -1,10 +1,10 @@
-"""testbed.atomic: all or nothing, and ordinary permissions."""
+"""testbed.core.atomic: all or nothing, and ordinary permissions."""
 
 import os
 
 import pytest
 
-from testbed.atomic import atomic_write, atomic_write_text
+from testbed.core.atomic import atomic_write, atomic_write_text
 
 
 def test_writes_and_replaces(tmp_path):

@@ -2,9 +2,9 @@
 
 import numpy as np
 
-from testbed.cache import DatasetCache
-from testbed.generate import generate
-from testbed.scenario import load_scenario
+from testbed.pipeline.cache import DatasetCache
+from testbed.pipeline.generate import generate
+from testbed.pipeline.scenario import load_scenario
 
 
 def _short():

@@ -4,7 +4,7 @@ import h5py
 import numpy as np
 import pytest
 
-from testbed.dataset import Dataset, Signal
+from testbed.core.dataset import Dataset, Signal
 
 
 def _dataset(seed=0):
@@ -99,7 +99,7 @@ def test_failed_overwrite_keeps_the_old_file(tmp_path, monkeypatch):
 
 def test_format_1_file_still_loads_and_is_verified_with_its_own_hash(tmp_path):
     """A file written before the hash covered data only (format /1) is read, not called altered."""
-    from testbed.dataset import DatasetError
+    from testbed.core.dataset import DatasetError
 
     ds = _dataset()
     p = ds.save(tmp_path / "old.h5")

@@ -1,6 +1,6 @@
 """`make demo`'s job: scored runs, their reports and the Eq. 21 contrast line."""
 
-from testbed.demo import EQ21_PAIR, run_demo
+from testbed.reporting.demo import EQ21_PAIR, run_demo
 
 
 def test_demo_runs_scores_reports_and_states_the_contrast(tmp_path, dataset_cache, capsys):

@@ -8,7 +8,7 @@ import pytest
 
 from benchmarks import sindy_pi_problems
 from identify.library import fivebar_library
-from testbed.equation_basis import CanonicalBasis, compare_equations, evaluate_terms, has_input
+from testbed.scoring.equation_basis import CanonicalBasis, compare_equations, evaluate_terms, has_input
 
 ROOT = Path(__file__).resolve().parents[2]
 

@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 import pyuff
 
-from testbed.dataset import Dataset, Signal
-from testbed.export import export_dataset, modal_masses, node_numbers, read_sep005, to_sep005
+from testbed.core.dataset import Dataset, Signal
+from testbed.reporting.export import export_dataset, modal_masses, node_numbers, read_sep005, to_sep005
 
 FS = 1024.0
 N = 512
@@ -218,7 +218,7 @@ def test_unknown_format(saved):
 
 def test_uff_real_cantilever_modes_are_mass_normalised(dataset_cache, tmp_path):
     """The simulated beam's SEREP shapes: phi^T Mr phi = 1 for every mode, plain id2 text."""
-    from testbed.scenario import load_scenario
+    from testbed.pipeline.scenario import load_scenario
 
     ds = dataset_cache.get(load_scenario("cantilever_stiff_impact"))
     (out,) = export_dataset(ds.save(tmp_path / "beam.h5"), "uff")

@@ -26,15 +26,15 @@ import pytest
 sys.path.insert(0, str(Path(__file__).parent))
 import _synthetic_runs as synth
 
-from testbed.cache import DatasetCache
-from testbed.dataset import Dataset, DatasetError
-from testbed.generate import generate
-from testbed.results import ResultsError, parts_dir, read_results, write_part
-from testbed.runstore import RunStoreError, load_run, run_folder, save_run
-from testbed.scenario import load_scenario
-from testbed.study import load_study
-from testbed.summary import summarize
-from testbed.sweep import SweepStats, run_sweep
+from testbed.core.dataset import Dataset, DatasetError
+from testbed.pipeline.cache import DatasetCache
+from testbed.pipeline.generate import generate
+from testbed.pipeline.scenario import load_scenario
+from testbed.studies.results import ResultsError, parts_dir, read_results, write_part
+from testbed.studies.runstore import RunStoreError, load_run, run_folder, save_run
+from testbed.studies.statistics import summarize
+from testbed.studies.study import load_study
+from testbed.studies.sweep import SweepStats, run_sweep
 
 ROOT = Path(__file__).resolve().parents[2]
 # Columns that legitimately differ between two runs of the same cell.
@@ -74,9 +74,9 @@ def test_truncated_cache_entry_is_simulated_again_with_a_warning(tmp_path, caplo
     with pytest.raises(DatasetError, match="unreadable dataset file") as e:
         Dataset.load(path)
     assert str(path) in str(e.value)
-    with caplog.at_level(logging.WARNING, logger="testbed.cache"):
+    with caplog.at_level(logging.WARNING, logger="testbed.pipeline.cache"):
         again = cache.get(sc)
-    warnings = [r.getMessage() for r in caplog.records if r.name == "testbed.cache"]
+    warnings = [r.getMessage() for r in caplog.records if r.name == "testbed.pipeline.cache"]
     assert len(warnings) == 1 and str(path) in warnings[0] and "\n" not in warnings[0]
     _assert_same_data(again, first)
     Dataset.load(path)  # repaired in place
@@ -99,9 +99,9 @@ def test_flipped_bits_in_a_cached_array_are_caught_by_the_content_hash(tmp_path,
     with pytest.raises(DatasetError, match="does not match its stored content hash"):
         Dataset.load(path)
     assert Dataset.load(path, verify=False).measured  # still readable: only the hash can tell
-    with caplog.at_level(logging.WARNING, logger="testbed.cache"):
+    with caplog.at_level(logging.WARNING, logger="testbed.pipeline.cache"):
         again = cache.get(sc)
-    assert any(str(path) in r.getMessage() for r in caplog.records if r.name == "testbed.cache")
+    assert any(str(path) in r.getMessage() for r in caplog.records if r.name == "testbed.pipeline.cache")
     _assert_same_data(again, first)
 
 
@@ -163,7 +163,7 @@ def _fill_and_read(args) -> tuple[str, int]:
     warned: list[logging.LogRecord] = []
     handler = logging.Handler(logging.WARNING)
     handler.emit = warned.append
-    logging.getLogger("testbed.cache").addHandler(handler)
+    logging.getLogger("testbed.pipeline.cache").addHandler(handler)
     cache = DatasetCache(directory)
     ds = cache.get(sc)
     for _ in range(5):
@@ -207,9 +207,9 @@ from identify import IDENTIFIERS
 from identify._base import Identifier
 from models import RIGS
 from models._base import Rig
-from testbed.dataset import Dataset, Signal
-from testbed.measurement import Trajectory
-from testbed.schema import Field
+from testbed.core.dataset import Dataset, Signal
+from testbed.core.measurement import Trajectory
+from testbed.core.schema import Field
 
 NAMES = ["th1", "ddth1", "th2", "ddth2", "th3", "ddth3", "th4", "ddth4"]
 
@@ -329,7 +329,7 @@ def test_truncated_row_file_is_named_set_aside_and_its_cell_run_again(fault_dir,
     victim.write_bytes(victim.read_bytes()[:40])  # cut short mid-row
 
     # summary reads what it can, naming the file it skips, and changes nothing on disk
-    with caplog.at_level(logging.WARNING, logger="testbed.results"):
+    with caplog.at_level(logging.WARNING, logger="testbed.studies.results"):
         summary = summarize(res)
     assert sum(s["cells"] for s in summary) == 3
     assert any(str(victim) in r.getMessage() for r in caplog.records)
@@ -337,7 +337,7 @@ def test_truncated_row_file_is_named_set_aside_and_its_cell_run_again(fault_dir,
 
     caplog.clear()
     stats = SweepStats()
-    with caplog.at_level(logging.WARNING, logger="testbed.results"):
+    with caplog.at_level(logging.WARNING, logger="testbed.studies.results"):
         rows = read_results(run_sweep(study, results=res, cache_dir=cache, verbose=False, stats=stats))
     named = [r.getMessage() for r in caplog.records if str(victim) in r.getMessage()]
     assert len(named) == 1 and "set aside" in named[0]
@@ -382,7 +382,7 @@ def test_retry_failed_flag_reruns_failed_cells_and_exit_status(fault_dir, tmp_pa
 
 def test_sweep_interrupted_by_an_error_keeps_the_rows_that_finished(fault_dir, tmp_path, monkeypatch):
     """A lost worker (here: an error after two rows) ends the sweep; the two rows are consolidated."""
-    import testbed.sweep as sw
+    import testbed.studies.sweep as sw
 
     real = sw.parallel
 
@@ -486,7 +486,7 @@ def mechanical():
 
 def test_a_run_named_dot_or_dotdot_never_touches_the_output_folder(mechanical, tmp_path):
     out = tmp_path / "runs"
-    save_run(mechanical, out / "other", figures=False)
+    save_run(mechanical, out / "other")
     (tmp_path / "keep.txt").write_text("not a run")
     for name in (".", "..", "", ".hidden", "a/b", "../escape"):
         with pytest.raises(RunStoreError):
@@ -494,7 +494,7 @@ def test_a_run_named_dot_or_dotdot_never_touches_the_output_folder(mechanical, t
     # save_run called directly with such names: refused, nothing replaced or deleted
     for target in (out / ".", out / "..", f"{out}/.", f"{out}/..", tmp_path):
         with pytest.raises(RunStoreError):
-            save_run(mechanical, target, figures=False)
+            save_run(mechanical, target)
     assert sorted(p.name for p in out.iterdir()) == ["other"]
     assert load_run(out / "other").fit_time == mechanical.fit_time
     assert (tmp_path / "keep.txt").read_text() == "not a run"
@@ -511,7 +511,7 @@ def test_cli_run_of_a_scenario_named_dot_leaves_every_other_run(mechanical, tmp_
     from testbed.cli import main
 
     out = tmp_path / "runs"
-    save_run(mechanical, out / "other", figures=False)
+    save_run(mechanical, out / "other")
     dot = tmp_path / "..toml"
     dot.write_text(f'[scenario]\nextends = "{ROOT / "scenarios" / "cantilever_stiff_impact_lsq.toml"}"\n'
                    'name = "."\n')
@@ -525,9 +525,9 @@ def test_concurrent_writers_of_one_run_folder_leave_one_complete_run(mechanical,
     from concurrent.futures import ThreadPoolExecutor
 
     d = tmp_path / "runs" / "same"
-    save_run(mechanical, d, figures=False)
+    save_run(mechanical, d)
     with ThreadPoolExecutor(8) as ex:
-        done = list(ex.map(lambda i: save_run(replace(mechanical, fit_time=100.0 + i), d, figures=False),
+        done = list(ex.map(lambda i: save_run(replace(mechanical, fit_time=100.0 + i), d),
                            range(8)))
     assert done == [d] * 8
     run = load_run(d)

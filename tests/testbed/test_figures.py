@@ -13,8 +13,8 @@ from matplotlib.figure import Figure
 sys.path.insert(0, str(Path(__file__).parent))
 import _synthetic_runs as synth
 
-from testbed import figures
-from testbed.runstore import load_run, save_run
+from testbed.reporting import figures
+from testbed.studies.runstore import load_run, save_run
 
 
 def labelled(fig: Figure) -> list[tuple[str, str]]:
@@ -34,7 +34,7 @@ def assert_units(fig: Figure) -> None:
 @pytest.fixture(scope="module")
 def runs(tmp_path_factory):
     d = tmp_path_factory.mktemp("runs")
-    return {k: load_run(save_run(f(), d / k, figures=False))
+    return {k: load_run(save_run(f(), d / k))
             for k, f in (("structural", lambda: synth.structural_result(n_samples=1000)),
                          ("mechanical", lambda: synth.mechanical_result(n_samples=400)))}
 

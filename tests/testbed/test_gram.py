@@ -1,8 +1,8 @@
-"""testbed.gram on a case worked by hand: column 2 = column 0 + column 1."""
+"""testbed.numerics.gram on a case worked by hand: column 2 = column 0 + column 1."""
 
 import numpy as np
 
-from testbed.gram import normalized_gram, ordered_independent
+from testbed.numerics.gram import normalized_gram, ordered_independent
 
 
 def test_dependent_column_found_in_priority_order():

@@ -8,12 +8,12 @@ import numpy as np
 import pytest
 import pyuff
 
-from testbed.dataset import Dataset, Signal
-from testbed.errors import TestbedError
-from testbed.export import export_dataset, to_sep005
-from testbed.importers import MeasuredDataError, from_sep005, measurement_from_file, read_measured
-from testbed.preprocess import measure
-from testbed.scenario import load_scenario
+from testbed.core.dataset import Dataset, Signal
+from testbed.core.errors import TestbedError
+from testbed.pipeline.importers import MeasuredDataError, from_sep005, measurement_from_file, read_measured
+from testbed.pipeline.scenario import load_scenario
+from testbed.pipeline.signal_chain import measure
+from testbed.reporting.export import export_dataset, to_sep005
 
 FS = 1000.0
 N = 400

@@ -5,7 +5,7 @@ nesting, a study given as a scenario, each problem of the "Trustworthy verdicts"
 mutations generated from the shipped scenarios and studies: every key of every section
 (the rig's tables, the signal chain, the declared hyperparameters of the scenario's
 identifier) set to values of the wrong type, out of range or non-finite.  Every file must
-give a :class:`~testbed.errors.ScenarioError` (never another exception, never a Scenario)
+give a :class:`~testbed.core.errors.ScenarioError` (never another exception, never a Scenario)
 naming the file and the offending key on one line, within milliseconds: validation runs
 before any simulation.  A hypothesis property test draws random values for random keys.
 """
@@ -25,9 +25,9 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from testbed.errors import BudgetError, ScenarioError
-from testbed.scenario import SCENARIO_DIR, _read_toml, load_scenario, scenario_from_dict
-from testbed.study import STUDY_DIR, load_study
+from testbed.core.errors import BudgetError, ScenarioError
+from testbed.pipeline.scenario import SCENARIO_DIR, _read_toml, load_scenario, scenario_from_dict
+from testbed.studies.study import STUDY_DIR, load_study
 
 DATA = Path(__file__).resolve().parent.parent / "data" / "malformed"
 
@@ -124,8 +124,8 @@ def _sections(raw: dict):
     """(section, schema) of every table of a scenario whose keys are checked."""
     from identify import IDENTIFIERS
     from models import RIGS
-    from testbed.preprocess import SIGNAL_SCHEMAS
-    from testbed.scenario import HEADER_SCHEMA, NOISE_SCHEMA
+    from testbed.pipeline.scenario import HEADER_SCHEMA, NOISE_SCHEMA
+    from testbed.pipeline.signal_chain import SIGNAL_SCHEMAS
 
     rig = RIGS.get(raw["scenario"]["rig"])
     etype = raw.get("excitation", {}).get("type", rig.default_excitation)

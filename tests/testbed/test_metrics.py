@@ -8,7 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
-from testbed import metrics as mt
+from testbed.scoring import metrics as mt
 
 finite = st.floats(-1e3, 1e3, allow_nan=False, allow_infinity=False)
 
@@ -199,7 +199,7 @@ def test_modes_of_a_nonsymmetric_identified_stiffness_are_the_right_eigenvectors
     vibrates in the eigenvectors of A; symmetrising K would report other shapes."""
     import numpy as np
 
-    from testbed.metrics import mac_matrix, modal_from_matrices
+    from testbed.scoring.metrics import mac_matrix, modal_from_matrices
 
     m_true = np.array([[2.0, 0.5], [0.5, 1.0]])
     k_true = np.array([[300.0, -100.0], [-100.0, 200.0]])

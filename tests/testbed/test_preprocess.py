@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 from scipy import signal as ss
 
-from testbed import signal as sig
-from testbed.dataset import Dataset, Signal
-from testbed.errors import ScenarioError
-from testbed.preprocess import SIGNAL_SCHEMAS, measure, pulse_end
+from testbed.core.dataset import Dataset, Signal
+from testbed.core.errors import ScenarioError
+from testbed.numerics import filters as sig
+from testbed.pipeline.signal_chain import SIGNAL_SCHEMAS, measure, pulse_end
 
 FS = 2000.0  # [Hz]
 # a 3-DOF chain fixed at one end: masses [kg], springs [N/m]; modes about 9, 25 and 36 Hz
@@ -219,7 +219,7 @@ def test_mechanical_lowpass_derivatives():
 
 
 def test_mechanical_lowpass_settings_validated():
-    from testbed.errors import ScenarioError
+    from testbed.core.errors import ScenarioError
     with pytest.raises(ScenarioError):
         measure(mechanical_dataset(), {"derivatives": "lowpass", "cutoff_hz": -1.0}, "mechanical")
     with pytest.raises(ScenarioError):

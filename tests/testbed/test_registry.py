@@ -1,6 +1,6 @@
 import pytest
 
-from testbed.registry import Registry
+from testbed.core.registry import Registry
 
 
 def test_register_lookup_tags_and_clear_error():

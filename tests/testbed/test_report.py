@@ -23,8 +23,9 @@ import pytest
 sys.path.insert(0, str(Path(__file__).parent))
 import _synthetic_runs as synth
 
-from testbed.report import CSP, sweep_report, write_report
-from testbed.runstore import save_run
+from testbed.reporting.figures import save_run_figures
+from testbed.reporting.report import CSP, sweep_report, write_report
+from testbed.studies.runstore import save_run
 
 ROOT = Path(__file__).resolve().parents[2]
 ARTIFACTS = ROOT / "out" / "test-artifacts"
@@ -41,7 +42,7 @@ def reports(tmp_path_factory):
     out = {}
     for name, make in (("cantilever", lambda: synth.structural_result(n_samples=2000)),
                        ("fivebar", lambda: synth.mechanical_result(n_samples=600))):
-        run_dir = save_run(make(), d / "runs" / name)
+        run_dir = save_run(make(), d / "runs" / name, figures=save_run_figures)
         out[name] = write_report(run_dir, d / "reports" / name)
     out["sweep"] = sweep_report(synth.sweep_rows(), d / "reports" / "sweep", "noise_study")
     return out
@@ -151,8 +152,8 @@ def test_report_in_headless_chromium(chromium, reports, name, n_figures, tmp_pat
 
 def test_sweep_report_scores_are_not_wall_times():
     """Timing and bookkeeping columns of a results row are never plotted as scores."""
-    from testbed.report import score_names
-    from testbed.results import BASE_COLUMNS, TAIL_COLUMNS
+    from testbed.reporting.report import score_names
+    from testbed.studies.results import BASE_COLUMNS, TAIL_COLUMNS
 
     row = {k: 1.0 for k in (*BASE_COLUMNS, *TAIL_COLUMNS)} | {"trac": 0.9, "mac": 0.99}
     assert score_names([row]) == ["mac", "trac"]

@@ -2,9 +2,9 @@
 
 import numpy as np
 
-from testbed.preprocess import measure
-from testbed.scenario import load_scenario
-from testbed.signal import elliptic_highpass
+from testbed.numerics.filters import elliptic_highpass
+from testbed.pipeline.scenario import load_scenario
+from testbed.pipeline.signal_chain import measure
 
 
 def test_offset_correction_recovers_the_weakly_excited_modes(dataset_cache):

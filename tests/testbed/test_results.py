@@ -9,7 +9,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 import pytest
 
-from testbed.results import FORMAT, consolidate, parts_dir, read_results, write_part, write_rows
+from testbed.studies.results import FORMAT, consolidate, parts_dir, read_results, write_part, write_rows
 
 
 def row(cell: str, *, scenario="s", noise=0.0, seed=0, identifier="m", status="ok", **scores) -> dict:

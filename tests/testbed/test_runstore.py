@@ -13,7 +13,8 @@ import pytest
 sys.path.insert(0, str(Path(__file__).parent))
 import _synthetic_runs as synth
 
-from testbed.runstore import load_run, save_run
+from testbed.reporting.figures import save_run_figures
+from testbed.studies.runstore import load_run, save_run
 
 
 @pytest.fixture(scope="module")
@@ -28,7 +29,7 @@ def mechanical():
 
 def test_structural_round_trip(structural, tmp_path):
     r = structural
-    run = load_run(save_run(r, tmp_path / "run", figures=False))
+    run = load_run(save_run(r, tmp_path / "run"))
     assert run.name == "cantilever_synthetic" and run.kind == "structural"
     assert run.scenario == r.scenario.to_dict()
     assert run.scores == pytest.approx(r.scores.values)
@@ -56,7 +57,7 @@ def test_structural_round_trip(structural, tmp_path):
 
 
 def test_mechanical_round_trip_with_figures(mechanical, tmp_path):
-    run = load_run(save_run(mechanical, tmp_path / "fb"))
+    run = load_run(save_run(mechanical, tmp_path / "fb", figures=save_run_figures))
     assert run.kind == "mechanical" and run.passed
     assert run.model["feature_names_"] == mechanical.model.feature_names_
     assert run.details["terms"] == mechanical.scores.details["terms"]
@@ -70,15 +71,15 @@ def test_mechanical_round_trip_with_figures(mechanical, tmp_path):
 def test_nonfinite_scores_survive(mechanical, tmp_path):
     scores = replace(mechanical.scores, values={**mechanical.scores.values, "coef_error": float("inf"),
                                                 "angle_rmse": float("nan")})
-    run = load_run(save_run(replace(mechanical, scores=scores), tmp_path / "r", figures=False))
+    run = load_run(save_run(replace(mechanical, scores=scores), tmp_path / "r"))
     assert run.scores["coef_error"] == float("inf") and np.isnan(run.scores["angle_rmse"])
     json.loads((tmp_path / "r" / "run.json").read_text())  # still strict JSON
 
 
 def test_rewrite_replaces_whole_folder(mechanical, tmp_path):
     d = tmp_path / "run"
-    save_run(mechanical, d)
-    save_run(replace(mechanical, fit_time=9.0), d, figures=False)
+    save_run(mechanical, d, figures=save_run_figures)
+    save_run(replace(mechanical, fit_time=9.0), d)
     run = load_run(d)
     assert run.fit_time == 9.0
     assert not list(d.glob("*.png")), "old figures must not survive into the new run"
@@ -87,14 +88,13 @@ def test_rewrite_replaces_whole_folder(mechanical, tmp_path):
 
 def test_failed_write_keeps_old_run(mechanical, tmp_path, monkeypatch):
     d = tmp_path / "run"
-    save_run(mechanical, d, figures=False)
+    save_run(mechanical, d)
 
     def boom(*a, **k):
         raise RuntimeError("disk full")
 
-    monkeypatch.setattr("testbed.figures.save_run_figures", boom)
     with pytest.raises(RuntimeError, match="disk full"):
-        save_run(replace(mechanical, fit_time=5.0), d)
+        save_run(replace(mechanical, fit_time=5.0), d, figures=boom)
     assert load_run(d).fit_time == mechanical.fit_time
     assert [p.name for p in tmp_path.iterdir()] == ["run"]
 

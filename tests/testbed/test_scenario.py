@@ -5,8 +5,8 @@ import re
 import pytest
 
 from testbed.cli import main
-from testbed.errors import ScenarioError
-from testbed.scenario import load_scenario, scenario_from_dict
+from testbed.core.errors import ScenarioError
+from testbed.pipeline.scenario import load_scenario, scenario_from_dict
 
 GOOD = """
 [scenario]
@@ -139,7 +139,7 @@ def test_extends_replaces_identify_whole_and_keeps_the_parents_score(tmp_path):
 def test_impact_tolerance_is_the_signal_chains():
     """The rig refuses an impact the structural signal chain could not map onto a sensor."""
     from models.cantilever.rig import HIT_SENSOR_TOLERANCE_M
-    from testbed.preprocess import IMPACT_TOLERANCE_M
+    from testbed.pipeline.signal_chain import IMPACT_TOLERANCE_M
 
     assert HIT_SENSOR_TOLERANCE_M == IMPACT_TOLERANCE_M
 
@@ -162,7 +162,7 @@ def test_impact_on_a_sensor_is_accepted_and_between_sensors_refused(tmp_path):
     ("[rig]\nn_segments = 400\n[simulation]\nduration = 10.0\n", "rig.n_segments"),
 ])
 def test_over_budget_is_refused_before_simulating_naming_the_key(tmp_path, extra, key):
-    from testbed.errors import BudgetError
+    from testbed.core.errors import BudgetError
 
     text = GOOD.replace("[rig]\nn_segments = 6\n", "") if extra.startswith("[rig]") else GOOD
     text = text.replace("[simulation]\nduration = 0.05\n", "") if "[simulation]" in extra else text
@@ -175,8 +175,8 @@ def test_every_shipped_scenario_is_within_budget_with_room():
     """The estimates are not so pessimistic that a real scenario is refused: every shipped one
     needs under a tenth of each budget."""
     from models import RIGS
-    from testbed import budget
-    from testbed.scenario import list_scenarios
+    from testbed.core import budget
+    from testbed.pipeline.scenario import list_scenarios
 
     for sc in list_scenarios():
         cost = RIGS.get(sc.rig).cost(sc.rig_params, sc.simulation, sc.excitation)

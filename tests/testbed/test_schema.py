@@ -2,8 +2,8 @@
 
 import pytest
 
-from testbed.errors import ScenarioError
-from testbed.schema import Field, validate_table, validate_variant
+from testbed.core.errors import ScenarioError
+from testbed.core.schema import Field, validate_table, validate_variant
 
 SCHEMA = {
     "length": Field(float, 1.0, unit="m", min=0.0, min_inclusive=False),
@@ -89,7 +89,7 @@ def test_messages_are_one_line_and_short_whatever_the_value():
 
 
 def test_unknown_section_does_not_echo_its_content():
-    from testbed.schema import validate_header
+    from testbed.core.schema import validate_header
 
     with pytest.raises(ScenarioError) as e:
         validate_header({"study": {"secret": "content"}}, sections=("scenario",), header="scenario",

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 from scipy import signal as ss
 
-from testbed import derivatives as der
-from testbed import signal as sig
+from testbed.numerics import derivatives as der
+from testbed.numerics import filters as sig
 
 FS = 12800.0  # the paper's sample rate [Hz]
 MODES = ((89.6, 0.01, 1e-4), (576.3, 0.01, 1e-5))  # (f [Hz], zeta, amplitude [m]): the paper's beam

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from testbed.spectral import amplitude_spectrum, fft_resolution, peak_frequencies
+from testbed.numerics.spectral import amplitude_spectrum, fft_resolution, peak_frequencies
 
 FS = 12800.0
 T = np.arange(int(2 * FS)) / FS  # 2 s record: resolution 0.5 Hz

@@ -12,15 +12,15 @@ from pathlib import Path
 
 import pytest
 
-from testbed.errors import ScenarioError
-from testbed.study import STUDY_DIR, load_study
+from testbed.core.errors import ScenarioError
+from testbed.studies.study import STUDY_DIR, load_study
 
 PLUGIN = '''
 from identify import IDENTIFIERS
 from identify._base import Identifier
 from models import RIGS
 from models._base import Rig
-from testbed.schema import Field
+from testbed.core.schema import Field
 
 
 class _Toy(Rig):
@@ -208,6 +208,6 @@ def test_bare_name_resolves_in_studies_folder():
 def test_shipped_studies_are_valid(name):
     study = load_study(name)
     assert study.n_cells() > 0
-    from testbed.sweep import expand
+    from testbed.studies.sweep import expand
 
     assert len({c.key for c in expand(study)}) == study.n_cells()

@@ -8,8 +8,8 @@ import math
 import numpy as np
 from rich.console import Console
 
-from testbed.results import write_part, write_rows
-from testbed.summary import print_summary, summarize
+from testbed.studies.results import write_part, write_rows
+from testbed.studies.statistics import print_summary, summarize
 
 
 def row(cell, identifier, noise, seed, status="ok", passed=True, **scores):

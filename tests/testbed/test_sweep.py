@@ -19,9 +19,9 @@ from pathlib import Path
 
 import pytest
 
-from testbed.results import parts_dir, read_results
-from testbed.study import load_study
-from testbed.sweep import SweepStats, cell_key, expand, run_sweep
+from testbed.studies.results import parts_dir, read_results
+from testbed.studies.study import load_study
+from testbed.studies.sweep import SweepStats, cell_key, expand, run_sweep
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -35,9 +35,9 @@ from identify import IDENTIFIERS
 from identify._base import Identifier
 from models import RIGS
 from models._base import Rig
-from testbed.dataset import Dataset, Signal
-from testbed.measurement import Trajectory
-from testbed.schema import Field
+from testbed.core.dataset import Dataset, Signal
+from testbed.core.measurement import Trajectory
+from testbed.core.schema import Field
 
 NAMES = ["th1", "ddth1", "th2", "ddth2", "th3", "ddth3", "th4", "ddth4"]
 
@@ -309,7 +309,7 @@ def test_cli_summary_of_a_sweep(toy_dir, tmp_path, capsys):
 @pytest.mark.slow
 def test_smoke_study_on_the_real_rigs(tmp_path):
     """studies/smoke.toml end to end: one row per cell, each rig kind with its own scores."""
-    from testbed.scoring import metric_names
+    from testbed.scoring.scorers import metric_names
 
     study = load_study("smoke")
     rows = read_results(run_sweep(study, results=tmp_path / "smoke.parquet", cache_dir=tmp_path / "c",

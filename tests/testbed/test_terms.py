@@ -1,6 +1,6 @@
 import pytest
 
-from testbed.terms import canonical
+from testbed.core.terms import canonical
 
 
 @pytest.mark.parametrize(("raw", "name", "sign"), [

@@ -17,23 +17,24 @@ from rich.console import Console
 
 from identify.ls_sindy import LeastSquaresSINDy
 from identify.sindy_pi import SINDyPI
-from testbed import metrics
-from testbed.errors import DivergenceError, IdentificationError, ScenarioError
-from testbed.measurement import Trajectory
-from testbed.run import run_scenario
-from testbed.runstore import load_run, save_run
-from testbed.scenario import load_scenario
-from testbed.scoring import (
+from testbed.core.errors import DivergenceError, IdentificationError, ScenarioError
+from testbed.core.measurement import Trajectory
+from testbed.pipeline.scenario import load_scenario
+from testbed.reporting.console import print_score_table
+from testbed.reporting.figures import save_run_figures
+from testbed.scoring.run import run_scenario
+from testbed.scoring.scorers import (
     BLOWUP_FACTOR,
     FAIL,
     NO_VERDICT,
     PASS,
     Check,
+    metrics,
     physical_failures,
     simulate_scored,
     verdict,
 )
-from testbed.summaries import print_score_table
+from testbed.studies.runstore import load_run, save_run
 
 
 def table_text(result) -> str:
@@ -206,7 +207,7 @@ def test_negative_damping_is_a_scored_failure_with_its_reason(lsq, dataset_cache
     text = table_text(result)
     assert "failure: damping" in text and "negative damping" in text
     # the failed run is stored with its reasons and still renders (figures included)
-    run = load_run(save_run(result, tmp_path / "run", figures=True))
+    run = load_run(save_run(result, tmp_path / "run", figures=save_run_figures))
     assert run.failures == f and run.verdict == FAIL and not run.passed
     assert run.meta["passed"] is False and run.meta["verdict"] == FAIL
     assert run.figures
@@ -217,7 +218,7 @@ def test_no_thresholds_is_no_verdict(lsq, dataset_cache, tmp_path):
     assert result.checks == [] and not result.scores.failures
     assert result.verdict == NO_VERDICT and not result.passed
     assert "no thresholds declared" in table_text(result)
-    run = load_run(save_run(result, tmp_path / "run", figures=False))
+    run = load_run(save_run(result, tmp_path / "run"))
     assert run.verdict == NO_VERDICT and not run.passed
 
 
@@ -270,7 +271,7 @@ def test_fivebar_noisy_sine_replay_fit_failure_is_scored(tmp_path, dataset_cache
     assert result.failure.startswith("fit failed: no loop closure fits the measured angles")
     assert all(math.isnan(v) for v in result.scores.values.values())
     assert result.verdict == FAIL and "fit failed" in table_text(result)
-    run = load_run(save_run(result, tmp_path / "run", figures=True))  # renders without a fit
+    run = load_run(save_run(result, tmp_path / "run", figures=save_run_figures))  # renders without a fit
     assert run.failure == result.failure and not run.passed
     code = main(["run", str(path), "--cache", str(dataset_cache.directory), "-o", str(tmp_path / "out"),
                  "--no-figures"])

@@ -1,0 +1,106 @@
+"""The work a scenario may ask for: memory and integration steps, checked before any simulation.
+
+Each rig estimates its own cost from a scenario's validated tables
+(:meth:`models._base.Rig.cost`, using its own stepping rule); an identifier that simulates
+its model adds its steps (:meth:`identify._base.Identifier.simulation_steps`).  The loader
+(:func:`testbed.pipeline.scenario.scenario_from_dict`) refuses a scenario over budget with a
+:class:`~testbed.core.errors.BudgetError` naming the key that drives the cost, so a typo such as
+``duration = 1e6`` costs milliseconds, not a swapped-out machine.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from testbed.core.errors import BudgetError
+
+#: Peak memory one scenario run may need [bytes].  4 GiB: the machine has 24 GiB shared by
+#: five engineers and up to two sweep workers each; the largest shipped scenario needs well
+#: under 1 GiB (2 s of the soft cantilever at 12.8 kHz, 10 s of the five-bar at 10 kHz).
+MEMORY_BUDGET_BYTES = 4 * 2**30
+
+#: Integration steps one simulation may take.  1e8: about 45 min at the 27 us per RK4 step
+#: of the 10-segment cantilever measured on the shared 2-core machine (2026-11-23; the five-bar
+#: costs 93 us per step); the largest shipped scenario takes about 5e5.
+STEP_BUDGET = 1e8
+
+#: CPU time one simulation may take [s]: an hour of one core.  A step count alone misjudges a
+#: fine beam, whose steps cost ~N^3 (dense mass matrix): 400 segments take 3.8 ms per
+#: implicit step against ~10 us for 10 segments.  A study multiplies one run by its cells, so
+#: an hour per run is already a day's sweep.
+CPU_BUDGET_S = 3600.0
+
+#: Samples one record may hold, whatever its memory: 1e8 is 2.2 h at 12.8 kHz, far beyond
+#: any impact or identification record, and keeps index arithmetic and progress bars sane.
+SAMPLE_BUDGET = 1e8
+
+
+@dataclass(frozen=True)
+class Cost:
+    """Estimated cost of simulating (and identifying) one scenario.
+
+    Attributes
+    ----------
+    memory_bytes : float
+        Peak memory [bytes] of the run (simulation, signal chain, identification).
+    steps : float
+        Integration steps of the simulation.
+    samples : float
+        Samples of the record.
+    memory_key, steps_key, samples_key : str
+        The scenario key that drives each figure (named in the refusal).
+    memory_value, steps_value, samples_value : object
+        That key's value.
+    seconds : float, optional
+        Estimated CPU time of the simulation [s] on one core (None: the rig does not say).
+    seconds_key, seconds_value : str, object
+        The key that drives it and its value.
+    """
+
+    memory_bytes: float
+    steps: float
+    samples: float
+    memory_key: str
+    steps_key: str
+    samples_key: str
+    memory_value: object = None
+    steps_value: object = None
+    samples_value: object = None
+    seconds: float | None = None
+    seconds_key: str = ""
+    seconds_value: object = None
+
+
+def check_cost(cost: Cost, file: str) -> None:
+    """Refuse a scenario whose cost exceeds a budget.
+
+    Raises
+    ------
+    BudgetError
+        Naming the file, the key, its value, the estimate and the budget.
+    """
+    if not cost.samples <= SAMPLE_BUDGET:
+        raise BudgetError(file, cost.samples_key, cost.samples_value,
+                          f"the record would hold {cost.samples:.3g} samples; the budget is "
+                          f"{SAMPLE_BUDGET:.3g} (testbed.core.budget.SAMPLE_BUDGET)")
+    if not cost.steps <= STEP_BUDGET:
+        raise BudgetError(file, cost.steps_key, cost.steps_value,
+                          f"the simulation would take {cost.steps:.3g} integration steps; the "
+                          f"budget is {STEP_BUDGET:.3g} (testbed.core.budget.STEP_BUDGET)")
+    if cost.seconds is not None and not cost.seconds <= CPU_BUDGET_S:
+        raise BudgetError(file, cost.seconds_key, cost.seconds_value,
+                          f"the simulation would take about {cost.seconds / 3600:.3g} h of CPU; the "
+                          f"budget is {CPU_BUDGET_S / 3600:g} h (testbed.core.budget.CPU_BUDGET_S)")
+    if not cost.memory_bytes <= MEMORY_BUDGET_BYTES:
+        raise BudgetError(file, cost.memory_key, cost.memory_value,
+                          f"the run would need about {cost.memory_bytes / 2**30:.3g} GiB of memory; "
+                          f"the budget is {MEMORY_BUDGET_BYTES / 2**30:g} GiB "
+                          "(testbed.core.budget.MEMORY_BUDGET_BYTES)")
+
+
+def check_steps(steps: float, file: str, key: str, value: object) -> None:
+    """Refuse an identifier simulation of more than :data:`STEP_BUDGET` steps."""
+    if not steps <= STEP_BUDGET:
+        raise BudgetError(file, key, value,
+                          f"simulating the identified model would take {steps:.3g} steps; the "
+                          f"budget is {STEP_BUDGET:.3g} (testbed.core.budget.STEP_BUDGET)")

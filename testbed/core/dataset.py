@@ -1,0 +1,297 @@
+"""One simulated run: measured signals, noise-free reference signals, exact truth, provenance.
+
+Stored as one HDF5 file (h5py), data apart from code and config stored with data,
+as PDEBench does.  Layout::
+
+    /                       attrs: format, rig, seed, fs [Hz], scenario (canonical JSON),
+                                   versions (JSON), git_commit, gravity, content_hash, ...
+    /measured/<name>        (channels, samples) what a lab records (noisy if noise was asked)
+    /reference/<name>       (channels, samples) the same quantities, noise-free, and the
+                            true states (e.g. sensor displacements) no lab would have
+    /truth/<name>           exact truth arrays (M, K, frequencies, ...); attr ``unit``
+    /prior                  attrs: prior knowledge an identifier may be given (e.g. total mass)
+
+Every signal dataset carries attrs ``unit``, ``channels`` and, where defined,
+``positions`` [m].  Writes are atomic: the file appears whole or not at all.  Reads are
+verified: :meth:`Dataset.load` recomputes the content hash and compares it with the stored
+one, and an unreadable, foreign or altered file raises :class:`DatasetError` naming the file.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import h5py
+import numpy as np
+
+from testbed.core.atomic import atomic_write
+from testbed.core.errors import TestbedError
+
+#: Format written.  /2: the content hash covers the data-defining attributes only (see
+#: :meth:`Dataset.content_hash`); /1 files hashed every attribute but versions and commit.
+FORMAT = "sysid-testbed-dataset/2"
+#: Formats read (a /1 file is verified against the hash it was written with).
+READ_FORMATS = ("sysid-testbed-dataset/1", FORMAT)
+
+#: Keys of the ``scenario`` attribute that decide the data (as :meth:`Scenario.data_dict`); the
+#: name, description, tags, signal chain, ``[identify]`` and ``[score]`` do not.
+DATA_KEYS = ("rig", "rig_params", "simulation", "excitation", "noise", "seed")
+#: Attributes that describe how or where the data were made or by which scenario file, not what
+#: they are: left out of the content hash.
+_NOT_CONTENT = ("versions", "git_commit", "content_hash", "created", "scenario", "scenario_name")
+
+
+class DatasetError(TestbedError, ValueError):
+    """A dataset file cannot be read, is not a dataset, or its content does not match its hash.
+
+    Parameters
+    ----------
+    path : path-like
+        The offending file.
+    reason : str
+        What is wrong with it.
+    """
+
+    def __init__(self, path: str | os.PathLike, reason: str) -> None:
+        self.path, self.reason = Path(path), reason
+        super().__init__(f"{path}: {reason}")
+
+
+@dataclass
+class Signal:
+    """A group of sampled channels sharing a unit.
+
+    Parameters
+    ----------
+    data : ndarray, shape (n_channels, n_samples)
+    channels : tuple of str
+        One name per row.
+    unit : str
+        SI unit of every channel, e.g. ``"m/s^2"``.
+    positions : ndarray, shape (n_channels,), optional
+        Position of each channel along the structure [m], where defined.
+    """
+
+    data: np.ndarray
+    channels: tuple[str, ...]
+    unit: str
+    positions: np.ndarray | None = None
+
+    def __post_init__(self) -> None:
+        # C order always: a reduction over a row (e.g. the noise's RMS) then sums in one fixed
+        # order whether the array came from a rig (often a transposed view) or from a file
+        self.data = np.ascontiguousarray(self.data, dtype=float)
+        if self.data.ndim == 1:
+            self.data = self.data[None, :]
+        self.channels = tuple(self.channels)
+        if self.data.shape[0] != len(self.channels):
+            raise ValueError(f"{self.data.shape[0]} rows but {len(self.channels)} channel names")
+        if self.positions is not None:
+            self.positions = np.asarray(self.positions, dtype=float)
+
+
+@dataclass
+class Dataset:
+    """Signals, truth and provenance of one run.  See the module docstring for the layout.
+
+    Attributes
+    ----------
+    fs : float
+        Sample rate [Hz].
+    measured, reference : dict of str to Signal
+    truth : dict of str to ndarray (or list of str)
+    truth_units : dict of str to str
+    prior : dict of str to float
+        Prior knowledge an identifier may use (never the answer itself).
+    attrs : dict
+        Provenance: ``rig``, ``seed``, ``scenario`` (canonical JSON), ``versions``,
+        ``git_commit``, ``gravity`` and anything else the rig records.
+    """
+
+    fs: float
+    measured: dict[str, Signal]
+    reference: dict[str, Signal] = field(default_factory=dict)
+    truth: dict[str, Any] = field(default_factory=dict)
+    truth_units: dict[str, str] = field(default_factory=dict)
+    prior: dict[str, float] = field(default_factory=dict)
+    attrs: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def n_samples(self) -> int:
+        return next(iter(self.measured.values())).data.shape[1]
+
+    @property
+    def t(self) -> np.ndarray:
+        """Sample times [s], shape (n_samples,)."""
+        return np.arange(self.n_samples) / self.fs
+
+    def content_hash(self) -> str:
+        """SHA-256 of everything that is data: signals, truth, prior, sample rate, and the
+        data-defining attributes (rig, seed, the scenario's :data:`DATA_KEYS` sections, what
+        the rig records, e.g. ``gravity``).
+
+        Left out: versions, commit, the hash itself, and what only names or judges the data
+        (the scenario's name, description, tags, signal chain, ``[identify]``, ``[score]``).
+        The hash thus names the content: two scenarios that differ only in identifier or
+        thresholds give the same hash, and so does the same scenario and seed on any machine
+        whose physics engine gives the same numbers.
+        """
+        meta = {k: v for k, v in self.attrs.items() if k not in _NOT_CONTENT}
+        scenario = self.attrs.get("scenario")
+        if isinstance(scenario, dict):
+            meta["scenario"] = {k: scenario[k] for k in DATA_KEYS if k in scenario}
+        return self._hash(meta)
+
+    def _legacy_content_hash(self) -> str:
+        """The hash a format /1 file was written with (every attribute but versions and commit)."""
+        return self._hash({k: v for k, v in self.attrs.items()
+                           if k not in ("versions", "git_commit", "content_hash", "created")})
+
+    def _hash(self, meta: dict[str, Any]) -> str:
+        h = hashlib.sha256()
+        h.update(json.dumps({"fs": self.fs, "prior": self.prior, "attrs": meta},
+                            sort_keys=True, default=str).encode())
+        for group, signals in (("measured", self.measured), ("reference", self.reference)):
+            for name in sorted(signals):
+                s = signals[name]
+                h.update(f"{group}/{name}|{s.unit}|{','.join(s.channels)}".encode())
+                h.update(np.ascontiguousarray(s.data, dtype="<f8").tobytes())
+                if s.positions is not None:
+                    h.update(np.ascontiguousarray(s.positions, dtype="<f8").tobytes())
+        for name in sorted(self.truth):
+            h.update(f"truth/{name}|{self.truth_units.get(name, '')}".encode())
+            v = self.truth[name]
+            if isinstance(v, (list, tuple)) and v and isinstance(v[0], str):
+                h.update("\x1f".join(v).encode())
+            else:
+                h.update(np.ascontiguousarray(np.asarray(v, dtype=float), dtype="<f8").tobytes())
+        return h.hexdigest()
+
+    # ------------------------------------------------------------------ HDF5
+    def save(self, path: str | os.PathLike) -> Path:
+        """Write atomically to ``path`` (a temporary file in the same folder, then rename)."""
+        self.attrs["content_hash"] = self.content_hash()
+
+        def write(tmp: str) -> None:
+            with h5py.File(tmp, "w", track_order=True) as f:
+                self._write(f)
+
+        return atomic_write(path, write)
+
+    def _write(self, f: h5py.File) -> None:
+        f.attrs["format"] = FORMAT
+        f.attrs["fs"] = float(self.fs)
+        f.attrs["fs_unit"] = "Hz"
+        json_keys = []
+        for k, v in self.attrs.items():
+            if isinstance(v, (str, int, float, np.integer, np.floating)):
+                f.attrs[k] = v
+            else:
+                f.attrs[k] = json.dumps(v, sort_keys=True)
+                json_keys.append(k)
+        f.attrs["json_attrs"] = json.dumps(json_keys)
+        for group, signals in (("measured", self.measured), ("reference", self.reference)):
+            g = f.create_group(group)
+            for name, s in signals.items():
+                d = g.create_dataset(name, data=s.data, track_times=False)
+                d.attrs["unit"] = s.unit
+                d.attrs["channels"] = list(s.channels)
+                d.attrs["layout"] = "channels x samples"
+                if s.positions is not None:
+                    d.attrs["positions"] = s.positions
+                    d.attrs["positions_unit"] = "m"
+        g = f.create_group("truth")
+        for name, v in self.truth.items():
+            if isinstance(v, (list, tuple)) and v and isinstance(v[0], str):
+                d = g.create_dataset(name, data=np.array(v, dtype=h5py.string_dtype()),
+                                     track_times=False)
+            else:
+                d = g.create_dataset(name, data=np.asarray(v), track_times=False)
+            d.attrs["unit"] = self.truth_units.get(name, "")
+        p = f.create_group("prior")
+        for k, v in self.prior.items():
+            p.attrs[k] = v
+
+    @classmethod
+    def load(cls, path: str | os.PathLike, *, verify: bool = True) -> Dataset:
+        """Read a file written by :meth:`save`; the result equals the saved object.
+
+        Parameters
+        ----------
+        path : path-like
+        verify : bool
+            Recompute the content hash and compare it with the stored one.
+
+        Raises
+        ------
+        DatasetError
+            If the file is missing, not HDF5, truncated or otherwise unreadable, not a
+            dataset of this format, or (``verify``) its content does not match its hash.
+        """
+        try:
+            ds, fmt = cls._read(path)
+        except DatasetError:
+            raise
+        except FileNotFoundError:
+            raise DatasetError(path, "no such file") from None
+        except Exception as e:  # h5py raises OSError, KeyError, ValueError ... for damaged files
+            why = " ".join(str(e).split())  # one line, whatever the HDF5 library's message
+            raise DatasetError(path, f"unreadable dataset file ({type(e).__name__}: {why})") from None
+        if verify:
+            stored = ds.attrs.get("content_hash")
+            if not stored:
+                raise DatasetError(path, "no content hash stored; cannot verify")
+            actual = ds._legacy_content_hash() if fmt != FORMAT else ds.content_hash()
+            if actual != stored:
+                raise DatasetError(path, "content does not match its stored content hash "
+                                         "(the file was altered or damaged)")
+            if fmt != FORMAT:  # verified as written; in memory it carries this format's hash
+                ds.attrs["content_hash"] = ds.content_hash()
+        return ds
+
+    @classmethod
+    def _read(cls, path: str | os.PathLike) -> tuple[Dataset, str]:
+        """(the dataset, its file's format) without verification."""
+        if not Path(path).is_file():
+            raise FileNotFoundError(path)
+        with h5py.File(path, "r") as f:
+            fmt = f.attrs.get("format")
+            fmt = fmt.decode() if isinstance(fmt, bytes) else fmt
+            if fmt not in READ_FORMATS:
+                raise DatasetError(path, f"not a {FORMAT} file (format={fmt!r})")
+            attrs: dict[str, Any] = {}
+            json_keys = set(json.loads(f.attrs.get("json_attrs", "[]")))
+            for k, v in f.attrs.items():
+                if k in ("format", "fs", "fs_unit", "json_attrs"):
+                    continue
+                if isinstance(v, bytes):
+                    v = v.decode()
+                if k in json_keys:
+                    v = json.loads(v)
+                elif isinstance(v, np.generic):
+                    v = v.item()
+                attrs[k] = v
+            groups: dict[str, dict[str, Signal]] = {}
+            for group in ("measured", "reference"):
+                groups[group] = {}
+                for name, d in f[group].items():
+                    pos = d.attrs.get("positions")
+                    groups[group][name] = Signal(d[()], tuple(str(c) for c in d.attrs["channels"]),
+                                                 str(d.attrs["unit"]),
+                                                 None if pos is None else np.asarray(pos))
+            truth, units = {}, {}
+            for name, d in f["truth"].items():
+                v = d[()]
+                if d.dtype.kind in "OS":
+                    v = [x.decode() if isinstance(x, bytes) else str(x) for x in v]
+                truth[name] = v
+                units[name] = str(d.attrs["unit"])
+            prior = {k: (v.item() if isinstance(v, np.generic) else v) for k, v in f["prior"].attrs.items()}
+            ds = cls(float(f.attrs["fs"]), groups["measured"], groups["reference"], truth, units,
+                     prior, attrs)
+            return ds, fmt

@@ -1,0 +1,99 @@
+"""Errors a user can act on: each names the file, the key, the value and what is allowed."""
+
+from __future__ import annotations
+
+from typing import Any
+
+#: Longest rendering of an offending value in a message [characters]: a message stays one
+#: readable line even for a 10,000-item list or a megabyte string.
+MAX_VALUE_CHARS = 120
+
+
+def _one_line(text: str) -> str:
+    """``text`` with control characters escaped, so a message is always one line."""
+    return "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
+
+
+def show_value(value: Any) -> str:
+    """``repr(value)`` on one line, cut to :data:`MAX_VALUE_CHARS` characters."""
+    try:
+        text = repr(value)
+    except Exception:  # a broken __repr__ must not hide the real error
+        text = f"<{type(value).__name__}>"
+    text = _one_line(text)
+    if len(text) > MAX_VALUE_CHARS:
+        text = text[:MAX_VALUE_CHARS - 5] + "[...]"
+    return text
+
+
+class TestbedError(Exception):
+    """Base of the errors the CLI prints as one line, without a traceback."""
+
+    __test__ = False  # not a pytest test class despite the name
+
+
+class ScenarioError(TestbedError):
+    """A scenario or study file is missing or malformed.
+
+    Parameters
+    ----------
+    file : str
+        Path of the offending file.
+    key : str, optional
+        Dotted key, e.g. ``"rig.n_segments"``.
+    value : Any, optional
+        The offending value.
+    allowed : str
+        What would have been accepted.
+    """
+
+    def __init__(self, file: str, key: str | None = None, value: Any = ..., allowed: str = ""):
+        self.file, self.key, self.value, self.allowed = str(file), key, value, allowed
+        parts = [_one_line(self.file)]
+        if key is not None:
+            parts.append(f"key '{_one_line(str(key))}'")
+        if value is not ...:
+            parts.append(f"value {show_value(value)}")
+        msg = ": ".join(parts)
+        super().__init__(f"{msg}: {_one_line(allowed)}" if allowed else msg)
+
+
+class BudgetError(ScenarioError):
+    """A scenario would need more memory or integration steps than the declared budget
+    (:mod:`testbed.core.budget`); raised at load, before anything is simulated."""
+
+
+class InputError(TestbedError):
+    """A command-line input a user gave cannot be used (a missing folder, a file that is not
+    a dataset, an unreachable scheduler, a bad option value)."""
+
+
+class RigError(TestbedError):
+    """A rig cannot be built or simulated as asked (e.g. a linkage that cannot close)."""
+
+
+class IdentificationError(TestbedError):
+    """An identifier could not produce a model from the data given."""
+
+
+class HyperparameterError(IdentificationError, ValueError):
+    """An identifier was constructed with a hyperparameter its declaration refuses (checked
+    at fit time for estimators built in Python; scenario files are checked at load).  A
+    ValueError too, as scikit-learn estimators raise for bad parameters."""
+
+
+class DivergenceError(IdentificationError):
+    """A simulation of an identified model failed: non-finite state, blow-up, or a loop closure
+    that no longer solves.  Scoring turns it into a failed score with its reason and time.
+
+    Parameters
+    ----------
+    message : str
+        What went wrong.
+    time : float, optional
+        Simulation time [s] at which it happened (NaN if unknown).
+    """
+
+    def __init__(self, message: str, time: float = float("nan")):
+        self.time = float(time)
+        super().__init__(message if time != time else f"{message} (at t = {time:.4g} s)")

@@ -1,0 +1,42 @@
+"""The kinds of rig and the scores each kind reports (names and meanings, no code).
+
+A rig declares its ``kind``; every rig of a kind is measured, identified and scored alike.
+The catalogue lives in the core because scenario files are validated against it (a
+``[score]`` table may threshold ``<name>_min`` / ``<name>_max``) below the scoring layer that
+computes the scores (:mod:`testbed.scoring.scorers`).
+"""
+
+from __future__ import annotations
+
+METRICS: dict[str, dict[str, str]] = {
+    "structural": {
+        "trac": "smallest TRAC over sensors: simulated identified model vs noise-free "
+                "measured accelerations",
+        "mac": "smallest MAC over the scored modes (identified vs true sensor mode shapes, paired)",
+        "freq_error": "largest relative natural-frequency error over the scored modes",
+        "damping_error": "largest relative damping-ratio error over the scored modes",
+        "Mr_error": "relative Frobenius error of the identified mass matrix vs SEREP Mr",
+        "Kr_error": "relative Frobenius error of the identified stiffness matrix vs SEREP Kr",
+        "Cr_error": "relative Frobenius error of the identified damping matrix vs SEREP Cr",
+        "MinvK_error": "relative Frobenius error of M^-1 K (scale-free, identifiable from data)",
+        "K3_force_error": "relative RMS error of the identified cubic restoring force along the "
+                          "measured motion (soft base)",
+        "K3_norm": "Frobenius norm of the identified cubic matrix [N/m^3]",
+        "K3_force_ratio": "RMS of the identified cubic restoring force over that of the identified "
+                          "linear one, along the measured motion (scale-free size of K3)",
+        "cross_orth": "largest off-diagonal of Phi_id^T Mr Phi_true (mass-normalised modes)",
+    },
+    "mechanical": {
+        "angle_rmse": "largest joint-angle RMSE [rad] of the identified model simulated from the "
+                      "true initial state under the recorded torques",
+        "coef_error": "largest relative error of the true terms' coefficients",
+        "support_precision": "precision of the identified nonzero pattern",
+        "support_recall": "recall of the identified nonzero pattern",
+        "support_f1": "F1 of the identified nonzero pattern",
+    },
+}
+
+
+def metric_names(kind: str) -> set[str]:
+    """Score names a rig of ``kind`` reports."""
+    return set(METRICS[kind])

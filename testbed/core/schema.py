@@ -1,0 +1,240 @@
+"""Declarative schemas for scenario tables: each key's type, unit, default and limits.
+
+A schema is a ``dict[str, Field]``.  :func:`validate_table` checks one TOML table
+against it and returns the table with defaults filled in; every problem raises a
+:class:`~testbed.core.errors.ScenarioError` naming the file, the key, the value and
+what is allowed.  The same schemas generate the scenario-file guide, so the
+documentation cannot drift from what is accepted.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from typing import Any
+
+from testbed.core.errors import ScenarioError
+
+REQUIRED = object()
+
+_TYPE_NAMES = {bool: "a boolean", int: "an integer", float: "a number", str: "a string",
+               list: "a list", dict: "a table", object: "any value"}
+_ITEM_NAMES = {bool: "booleans", int: "integers", float: "numbers", str: "strings"}
+
+
+@dataclass(frozen=True)
+class Field:
+    """One key of a scenario table.
+
+    Parameters
+    ----------
+    type : type
+        ``float``, ``int``, ``bool``, ``str``, ``list`` or ``dict``.  An integer
+        is accepted where a float is expected; a boolean never counts as a number.
+    default : Any
+        Value used when the key is absent; ``REQUIRED`` if it must be given.
+    unit : str
+        Physical unit, for error messages and the guide ("" if dimensionless).
+    doc : str
+        One line for the guide.
+    choices : tuple, optional
+        The allowed values.
+    min, max : float, optional
+        Bounds; ``min_inclusive`` / ``max_inclusive`` say whether they are allowed.
+    item_type : type, optional
+        Element type of a list.
+    min_items, max_items : int, optional
+        Length limits of a list.
+    pattern : str, optional
+        Regular expression a string (or every string item of a list) must match whole.
+    pattern_doc : str
+        The pattern in words, for messages and the guide.
+    also : Field, optional
+        An alternative form that is accepted too (e.g. a named library or a list of term
+        names); the value is accepted if it satisfies this field or ``also``.
+
+    Notes
+    -----
+    A ``default`` of None means "optional, no value": the key may be left out (TOML has no
+    null), and when given it is checked like any other.  Floats must always be finite.
+    """
+
+    type: type
+    default: Any = REQUIRED
+    unit: str = ""
+    doc: str = ""
+    choices: tuple | None = None
+    min: float | None = None
+    max: float | None = None
+    min_inclusive: bool = True
+    max_inclusive: bool = True
+    item_type: type | None = None
+    min_items: int | None = None
+    max_items: int | None = None
+    pattern: str | None = None
+    pattern_doc: str = ""
+    also: Field | None = None
+
+    @property
+    def required(self) -> bool:
+        return self.default is REQUIRED
+
+    def describe(self) -> str:
+        """What is allowed, in words (used in error messages and the guide)."""
+        own = self._describe_own()
+        return own if self.also is None else f"{own}, or {self.also.describe()}"
+
+    def _describe_own(self) -> str:
+        what = _TYPE_NAMES.get(self.type, self.type.__name__)
+        if self.type is list and self.item_type is not None:
+            what = f"a list of {_ITEM_NAMES.get(self.item_type, self.item_type.__name__)}"
+        if self.choices is not None:
+            return "one of " + ", ".join(repr(c) for c in self.choices)
+        bounds = []
+        if self.min is not None:
+            bounds.append((">= " if self.min_inclusive else "> ") + f"{self.min:g}")
+        if self.max is not None:
+            bounds.append(("<= " if self.max_inclusive else "< ") + f"{self.max:g}")
+        if self.type is list and self.min_items:
+            bounds.append(f"with at least {self.min_items} item(s)")
+        if self.type is list and self.max_items is not None:
+            bounds.append(f"with at most {self.max_items} item(s)")
+        if self.pattern is not None:
+            bounds.append(self.pattern_doc or f"matching {self.pattern}")
+        unit = f" [{self.unit}]" if self.unit else ""
+        return what + (" " + " and ".join(bounds) if bounds else "") + unit
+
+
+def _is_type(value: Any, typ: type) -> bool:
+    if typ is float:
+        return isinstance(value, (int, float)) and not isinstance(value, bool)
+    if typ is int:
+        return isinstance(value, int) and not isinstance(value, bool)
+    return isinstance(value, typ)
+
+
+def _check_number(value: float, f: Field) -> bool:
+    if isinstance(value, float) and not math.isfinite(value):
+        return False
+    if f.min is not None and (value < f.min or (value == f.min and not f.min_inclusive)):
+        return False
+    return not (f.max is not None and (value > f.max or (value == f.max and not f.max_inclusive)))
+
+
+def check_value(value: Any, f: Field, *, file: str, key: str) -> Any:
+    """Check one value against its field; return it (ints widened to float where asked).
+
+    Raises
+    ------
+    ScenarioError
+        Naming ``file``, ``key``, the value and :meth:`Field.describe` (with ``also``: both
+        forms).
+    """
+    if f.also is None:
+        return _check_own(value, f, file=file, key=key)
+    try:
+        return _check_own(value, f, file=file, key=key)
+    except ScenarioError:
+        try:
+            return check_value(value, f.also, file=file, key=key)
+        except ScenarioError:
+            raise ScenarioError(file, key, value, f"expected {f.describe()}") from None
+
+
+def _check_own(value: Any, f: Field, *, file: str, key: str) -> Any:
+    if not _is_type(value, f.type):
+        raise ScenarioError(file, key, value, f"expected {f.describe()}")
+    if f.choices is not None and value not in f.choices:
+        raise ScenarioError(file, key, value, f"expected {f.describe()}")
+    if f.type in (int, float) and not _check_number(value, f):
+        raise ScenarioError(file, key, value, f"expected {f.describe()}")
+    if f.type is list:
+        if f.min_items is not None and len(value) < f.min_items:
+            raise ScenarioError(file, key, value, f"expected {f.describe()}")
+        if f.max_items is not None and len(value) > f.max_items:
+            raise ScenarioError(file, key, value, f"expected {f.describe()}")
+        if f.item_type is not None:
+            item = Field(f.item_type, min=f.min, max=f.max, min_inclusive=f.min_inclusive,
+                         max_inclusive=f.max_inclusive, unit=f.unit, pattern=f.pattern,
+                         pattern_doc=f.pattern_doc)
+            value = [check_value(v, item, file=file, key=f"{key}[{i}]") for i, v in enumerate(value)]
+    if f.type is str and f.pattern is not None and not re.fullmatch(f.pattern, value):
+        raise ScenarioError(file, key, value, f"expected {f.describe()}")
+    if f.type is float:
+        value = float(value)
+    return value
+
+
+def validate_table(table: Mapping[str, Any], schema: Mapping[str, Field], *, file: str,
+                   section: str) -> dict[str, Any]:
+    """Validate ``table`` against ``schema``; return a new dict with defaults filled in.
+
+    Raises
+    ------
+    ScenarioError
+        For an unknown key (listing the allowed ones), a missing required key,
+        or a value of the wrong type or out of bounds.
+    """
+    if not isinstance(table, Mapping):
+        raise ScenarioError(file, section, table, "expected a table")
+    out: dict[str, Any] = {}
+    for key in table:
+        if key not in schema:
+            allowed = ", ".join(sorted(schema)) or "(no keys)"
+            raise ScenarioError(file, f"{section}.{key}", table[key],
+                                f"unknown key; allowed keys in [{section}]: {allowed}")
+    for key, f in schema.items():
+        if key in table:
+            out[key] = check_value(table[key], f, file=file, key=f"{section}.{key}")
+        elif f.required:
+            raise ScenarioError(file, f"{section}.{key}", allowed=f"missing; expected {f.describe()}")
+        else:
+            out[key] = f.default
+    return out
+
+
+def validate_variant(table: Mapping[str, Any], variants: Mapping[str, Mapping[str, Field]], *,
+                     file: str, section: str, selector: str = "type") -> dict[str, Any]:
+    """Validate a table whose ``selector`` key chooses the schema among ``variants``."""
+    if not isinstance(table, Mapping):
+        raise ScenarioError(file, section, table, "expected a table")
+    kind = table.get(selector, REQUIRED)
+    if kind is REQUIRED:
+        raise ScenarioError(file, f"{section}.{selector}",
+                            allowed="missing; expected one of " + ", ".join(map(repr, variants)))
+    if not isinstance(kind, str) or kind not in variants:
+        raise ScenarioError(file, f"{section}.{selector}", kind,
+                            "expected one of " + ", ".join(map(repr, variants)))
+    rest = {k: v for k, v in table.items() if k != selector}
+    out = validate_table(rest, variants[kind], file=file, section=section)
+    return {selector: kind, **out}
+
+
+def validate_header(raw: Mapping[str, Any], *, sections: tuple[str, ...], header: str,
+                    schema: Mapping[str, Field], file: str, stem: str | None) -> dict[str, Any]:
+    """Check a TOML document's sections and validate its header table.
+
+    Every top-level table must be one of ``sections``; the ``[header]`` table must be present
+    and valid; its ``name`` must equal ``stem`` (the file name without ``.toml``) when given.
+    """
+    for section in raw:
+        if section not in sections:
+            # the section's content is not echoed: it may be a whole foreign file's
+            raise ScenarioError(file, section,
+                                allowed="unknown section; allowed: "
+                                + ", ".join(f"[{s}]" for s in sections))
+    if header not in raw:
+        raise ScenarioError(file, header, allowed=f"missing [{header}] table")
+    head = validate_table(raw[header], schema, file=file, section=header)
+    if stem is not None and head["name"] != stem:
+        raise ScenarioError(file, f"{header}.name", head["name"],
+                            f"must equal the file name without .toml ({stem!r})")
+    return head
+
+
+Checker = Callable[[dict[str, Any]], None]
+
+ErrorFn = Callable[[str, Any, str], None]
+"""``error(key, value, allowed)``: report a problem (it raises)."""

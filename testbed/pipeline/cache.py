@@ -1,0 +1,129 @@
+"""Content-keyed dataset cache shared by ``testbed run``, ``testbed generate`` and ``testbed sweep``.
+
+The cache holds each *clean* simulation once: one HDF5 file per rig configuration
+(:func:`~testbed.pipeline.generate.noise_free_scenario` of a scenario: its data sections with
+the noise level and seed set aside), named ``<rig>-<key>.h5``.  The key hashes that
+configuration (:meth:`Scenario.data_hash`), the versions of the engines that simulate it
+and this project's generating source (the rigs and the noise model).  A scenario's
+dataset, noisy or not, is :func:`~testbed.pipeline.generate.derive` of the clean entry with the
+scenario's noise spec and seed, made on load: bit-identical to a fresh
+:func:`~testbed.pipeline.generate.generate`, and no noisy copy is stored.
+
+Stored data defend themselves: every load recomputes the content hash and compares it
+with the stored one; an unreadable (e.g. truncated) or altered entry is reported in one
+warning line naming the file and simulated again.  Files are written atomically
+(temporary file, then rename), so a killed process never leaves a half-written entry,
+a reader never sees one, and two processes filling the same entry at once both finish
+(the last rename wins; both wrote the same content).
+"""
+
+from __future__ import annotations
+
+import functools
+import hashlib
+import json
+import logging
+import os
+from collections.abc import Callable
+from pathlib import Path
+
+from testbed.core.dataset import Dataset, DatasetError
+from testbed.core.provenance import versions
+from testbed.pipeline.generate import derive, noise_free_scenario, simulate_clean
+from testbed.pipeline.scenario import Scenario
+
+log = logging.getLogger(__name__)
+
+
+def default_cache_dir() -> Path:
+    """``$TESTBED_CACHE``, else ``.cache/datasets`` under the current directory."""
+    return Path(os.environ.get("TESTBED_CACHE", Path.cwd() / ".cache" / "datasets"))
+
+
+@functools.cache
+def generator_code_hash() -> str:
+    """SHA-256 of the source that turns a scenario into data: the rigs and the noise model.
+
+    Package versions alone miss a change to this project's own code (a developer's stale cache
+    would survive it); the source hash does not.
+    """
+    root = Path(__file__).resolve().parents[2]
+    h = hashlib.sha256()
+    files = sorted((root / "models").rglob("*.py")) + [root / "testbed" / n for n in
+                                                       ("pipeline/generate.py", "core/dataset.py")]
+    for f in files:
+        h.update(f.relative_to(root).as_posix().encode())
+        h.update(f.read_bytes())
+    return h.hexdigest()
+
+
+def cache_key(scenario: Scenario) -> str:
+    """Key of a scenario's dataset: its data sections and seed, package versions, generator code."""
+    blob = json.dumps({"data": scenario.data_hash(), "versions": versions(),
+                       "code": generator_code_hash()}, sort_keys=True)
+    return hashlib.sha256(blob.encode()).hexdigest()[:32]
+
+
+class DatasetCache:
+    """Datasets on disk, one HDF5 file per key.
+
+    Parameters
+    ----------
+    directory : path, optional
+        Where the files live (default :func:`default_cache_dir`).
+    """
+
+    def __init__(self, directory: str | os.PathLike | None = None) -> None:
+        self.directory = Path(directory) if directory is not None else default_cache_dir()
+
+    def path(self, scenario: Scenario) -> Path:
+        """The file of ``scenario``'s clean simulation (shared by all its noise levels and seeds)."""
+
+        clean_sc = noise_free_scenario(scenario)
+        return self.directory / f"{clean_sc.rig}-{cache_key(clean_sc)}.h5"
+
+    def clean(self, scenario: Scenario, progress: Callable[[float], None] | None = None) -> Dataset:
+        """The clean dataset of ``scenario``'s simulation, verified, simulated and stored if absent.
+
+        An entry that cannot be read or whose content does not match its stored hash is
+        reported (one warning line on the ``testbed.pipeline.cache`` logger, naming the file) and
+        simulated again; the new file replaces it atomically.
+        """
+
+        p = self.path(scenario)
+        if p.is_file():
+            try:
+                return Dataset.load(p)
+            except DatasetError as e:
+                if p.is_file():  # else another process cleared it meanwhile: a plain miss
+                    log.warning("dataset cache: %s; simulating it again", e)
+        ds = simulate_clean(scenario, progress)
+        ds.save(p)
+        return ds
+
+    def get(self, scenario: Scenario, progress: Callable[[float], None] | None = None) -> Dataset:
+        """The dataset of ``scenario``: its clean simulation (:meth:`clean`) with its noise added.
+
+        Bit-identical to :func:`testbed.pipeline.generate.generate` of ``scenario``; noise levels and
+        seeds of a study share one simulation per configuration.
+        """
+
+        return derive(self.clean(scenario, progress), scenario)
+
+    def entries(self) -> list[tuple[Path, int]]:
+        """(path, size in bytes) of every cached file, sorted by name."""
+        if not self.directory.is_dir():
+            return []
+        return [(p, p.stat().st_size) for p in sorted(self.directory.glob("*.h5"))]
+
+    def clear(self) -> int:
+        """Delete every cached file and any temporary file a killed writer left; return how many
+        cached files were removed."""
+        n = 0
+        for p, _ in self.entries():
+            p.unlink(missing_ok=True)
+            n += 1
+        if self.directory.is_dir():
+            for tmp in self.directory.glob(".*.h5.*.tmp"):  # testbed.core.atomic's temporary names
+                tmp.unlink(missing_ok=True)
+        return n

@@ -1,0 +1,130 @@
+"""Scenario -> Dataset: the named rig simulates without noise, then seeded sensor noise and provenance.
+
+Every dataset is made in two steps, whichever path asks for it:
+
+1. :func:`simulate_clean` runs the rig on :func:`noise_free_scenario` of the scenario (the
+   seed and the noise level do not reach the simulation), giving the *clean* dataset;
+2. :func:`derive` adds the scenario's noise to the clean arrays with the scenario's seed.
+
+:func:`generate` does both; the dataset cache (:mod:`testbed.pipeline.cache`) stores step 1 once per
+rig configuration and runs step 2 on load.  Since step 2 is one function of (clean arrays,
+noise spec, seed) and computes its statistics over C-ordered rows (see
+:class:`~testbed.core.dataset.Signal`), both paths give bit-identical data.
+"""
+
+from __future__ import annotations
+
+import copy
+from collections.abc import Callable
+
+import numpy as np
+
+from testbed.core.dataset import Dataset, Signal
+from testbed.core.provenance import git_commit, versions
+from testbed.pipeline.plugins import RIGS
+from testbed.pipeline.scenario import Scenario
+
+
+def add_noise(data: np.ndarray, rms_percent: float, rng: np.random.Generator) -> np.ndarray:
+    """White Gaussian noise with standard deviation ``rms_percent`` % of each row's RMS.
+
+    The RMS is taken about the channel's mean: an absolute joint angle's offset depends only on
+    where its zero is put (1.78 rad for the five-bar's th1 against a +-0.4 rad motion), so noise
+    scaled with the total RMS would depend on a coordinate choice.  For zero-mean signals such
+    as accelerations the two are the same.
+
+    The statistics are computed on a C-ordered float64 copy, so the result depends on the
+    values of ``data`` only, never on its memory layout (numpy sums a contiguous row pairwise
+    and a strided one in another order, which differ in the last bit).
+
+    Parameters
+    ----------
+    data : ndarray, shape (n_channels, n_samples)
+    rms_percent : float
+        Noise standard deviation as a percentage of the noise-free channel's RMS about its mean.
+    rng : numpy Generator
+    """
+    data = np.ascontiguousarray(data, dtype=np.float64)
+    if rms_percent == 0:
+        return data.copy()
+    rms = np.std(data, axis=1, keepdims=True)
+    return data + rng.standard_normal(data.shape) * (rms_percent / 100.0) * rms
+
+
+def noise_free_scenario(scenario: Scenario) -> Scenario:
+    """The same simulation without sensor noise (seed 0): what :func:`derive` starts from."""
+    return scenario.replace(noise={**scenario.noise, "rms_percent": 0.0}, seed=0)
+
+
+def _stamp(ds: Dataset, scenario: Scenario) -> Dataset:
+    ds.attrs.update(rig=scenario.rig, seed=scenario.seed, scenario=scenario.to_dict(),
+                    scenario_name=scenario.name, data_hash=scenario.data_hash())
+    ds.attrs["content_hash"] = ds.content_hash()
+    return ds
+
+
+def simulate_clean(scenario: Scenario, progress: Callable[[float], None] | None = None) -> Dataset:
+    """The rig's noise-free dataset of ``scenario``: the clean dataset :func:`derive` starts from.
+
+    The rig runs :func:`noise_free_scenario` of ``scenario``; the noisy signals' noise-free
+    arrays are kept in ``reference`` under the same names, as in every dataset.
+    """
+
+    clean_sc = noise_free_scenario(scenario)
+    ds = RIGS.get(clean_sc.rig)(clean_sc).simulate(progress=progress)
+    ds.attrs.update(versions=versions(), git_commit=git_commit())
+    return derive(ds, clean_sc)
+
+
+def derive(clean: Dataset, scenario: Scenario) -> Dataset:
+    """``scenario``'s dataset from the clean dataset of the same simulation: seeded noise added.
+
+    A pure function of (``clean``'s arrays, ``scenario.noise``, ``scenario.seed``): the
+    generator is ``default_rng(seed)``, drawn signal by signal in ``noise["signals"]`` order.
+    The noise-free array of each noisy signal is ``clean.reference[name]`` if there, else
+    ``clean.measured[name]`` (a raw rig output); it is kept in ``reference[name]``.
+
+    Parameters
+    ----------
+    clean : Dataset
+        Of :func:`simulate_clean` (or a raw rig simulation of :func:`noise_free_scenario`).
+    scenario : Scenario
+        Gives the noise spec and seed, and the provenance recorded in ``attrs``.
+
+    Raises
+    ------
+    ValueError
+        If ``clean`` records a simulation other than ``scenario``'s.
+    """
+    want = noise_free_scenario(scenario).data_hash()
+    have = clean.attrs.get("data_hash")
+    if have is not None and have not in (want, scenario.data_hash()):
+        raise ValueError("the clean dataset belongs to another simulation than this scenario")
+    ds = copy.deepcopy(clean)
+    rng = np.random.default_rng(scenario.seed)
+    for name in scenario.noise["signals"]:
+        raw = ds.reference.get(name, ds.measured[name])
+        ds.reference[name] = Signal(raw.data.copy(), raw.channels, raw.unit, raw.positions)
+        ds.measured[name] = Signal(add_noise(raw.data, scenario.noise["rms_percent"], rng),
+                                   raw.channels, raw.unit, raw.positions)
+    return _stamp(ds, scenario)
+
+
+def generate(scenario: Scenario, progress: Callable[[float], None] | None = None,
+             clean: Dataset | None = None) -> Dataset:
+    """Simulate ``scenario`` with its rig and add its sensor noise.
+
+    The seed drives only the noise: another seed changes the measured signals of
+    ``scenario.noise["signals"]`` and nothing else.  The noise-free measured
+    signals are kept in ``reference`` under the same names.
+
+    Parameters
+    ----------
+    clean : Dataset, optional
+        The clean dataset of ``scenario`` (:func:`simulate_clean`); given, the rig is not run
+        again.  Either way the result is :func:`derive` of the same clean arrays, so it is
+        bit-identical.
+    """
+    if clean is None:
+        clean = simulate_clean(scenario, progress)
+    return derive(clean, scenario)

@@ -1,0 +1,661 @@
+"""Measured data from files: UFF58, SEP-005 JSON, CSV and the project's HDF5, for identification.
+
+One entry point, :func:`read_measured`, gives an :class:`ImportedData`: the sample rate, one
+1-D array per channel in SI units, and where the file says so each channel's node,
+direction and position.  :meth:`ImportedData.to_dataset` turns it into a truth-free
+:class:`~testbed.core.dataset.Dataset` that :func:`testbed.pipeline.signal_chain.measure` (the rig kind's
+signal chain) turns into the :class:`~testbed.core.measurement.Measurement` an identifier fits.
+
+Formats (``format=`` or from the file's suffix)
+    ``"uff"`` (``.uff``, ``.unv``)
+        Every UFF58 record must be a time response (function type 1) with real ordinates;
+        one channel per record, named by ID line 1 (``"acceleration/acc1"`` in this
+        project's exports; ``"node<N>:<dir>"`` when ID line 1 is empty).  The sample rate is
+        the ``fs ... Hz`` of ID line 5 when present (this project's exports state it exactly),
+        else ``1 / abscissa increment`` (6 significant digits in the UFF header).  The unit is
+        the ordinate's axis label, else the one its specific data type and unit exponents
+        name.  Nodes and directions come from the response node and direction; positions
+        [m] from the x coordinate of that node in a UFF2411 or UFF15 record.  A UFF164 record
+        must be SI (all factors 1).  Other records (55, 82, ...) are ignored.  A file
+        whose last block is unfinished (no closing ``-1``) is refused as truncated.
+    ``"sep005"`` (``.json``)
+        A JSON list of SEP-005 channel dicts (``name``, ``data``, ``unit_str`` and ``fs`` or
+        ``time``), as :func:`testbed.reporting.export.write_sep005` writes, with the optional
+        ``node``, ``direction`` and ``position_m`` it adds.  :func:`from_sep005` takes the
+        same list in memory (``data`` as list or 1-D ndarray).
+    ``"csv"`` (``.csv``, ``.tsv``, ``.txt``)
+        A header row of channel names (``"acc1"``, or with a unit: ``"acc1 [m/s^2]"``), then
+        one row of numbers per sample; delimiter ``,``, ``;``, tab or blanks (from the
+        header); lines starting with ``#`` are skipped.  A column named ``t`` or ``time``
+        (unit s, if given) is the time: it must be uniform (each step within 1 % of the
+        median step), and ``fs = (n - 1) / (t[-1] - t[0])``; without it ``fs`` must be given.
+    ``"hdf5"`` (``.h5``, ``.hdf5``)
+        A dataset file of this project (:meth:`Dataset.load`, content hash verified): its
+        measured signals only (never the truth or the reference), channels named
+        ``"<signal>/<channel>"``, and its declared prior.
+
+Units: every channel ends up in SI.  Accepted: ``m/s^2``, ``m/s``, ``m``, ``N``, ``rad``,
+``rad/s``, ``rad/s^2``, ``N m`` (also ``m/s2``, ``N*m``, ``Nm``, ``N.m``, ``rad/s2``), and,
+converted to those, ``g`` (9.80665 m/s^2), ``mm``, ``mm/s``, ``mm/s^2``, ``deg``, ``deg/s``,
+``deg/s^2``, ``kN``, ``N mm``.  Anything else is an error.
+
+Every problem with the file or the arguments (missing file, unknown format, unreadable
+content, non-uniform time, channels of different lengths or rates, NaN or infinite values,
+unknown unit or channel) raises :class:`MeasuredDataError`: one line naming the file.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+import os
+import re
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from testbed.core.dataset import Dataset, DatasetError, Signal
+from testbed.core.errors import TestbedError
+from testbed.core.measurement import Measurement
+from testbed.pipeline.signal_chain import SIGNAL_SCHEMAS, measure
+
+FORMATS = ("uff", "sep005", "csv", "hdf5")
+SUFFIXES = {".uff": "uff", ".unv": "uff", ".json": "sep005", ".csv": "csv", ".tsv": "csv",
+            ".txt": "csv", ".h5": "hdf5", ".hdf5": "hdf5"}
+#: SI units a channel may have
+SI_UNITS = ("m/s^2", "m/s", "m", "N", "rad", "rad/s", "rad/s^2", "N m")
+#: other spellings and units -> (SI unit, factor to SI)
+UNIT_ALIASES: dict[str, tuple[str, float]] = {
+    "m/s2": ("m/s^2", 1.0), "m/s**2": ("m/s^2", 1.0), "m s^-2": ("m/s^2", 1.0),
+    "N*m": ("N m", 1.0), "Nm": ("N m", 1.0), "N.m": ("N m", 1.0), "rad/s2": ("rad/s^2", 1.0),
+    "g": ("m/s^2", 9.80665), "mm": ("m", 1e-3), "mm/s": ("m/s", 1e-3), "mm/s^2": ("m/s^2", 1e-3),
+    "deg": ("rad", math.pi / 180), "deg/s": ("rad/s", math.pi / 180),
+    "deg/s^2": ("rad/s^2", math.pi / 180), "kN": ("N", 1e3), "N mm": ("N m", 1e-3),
+}
+#: UFF58 ordinate (specific data type, length exponent, force exponent, rotational) -> SI unit
+_UFF_UNITS = {(12, 1, 0, False): "m/s^2", (11, 1, 0, False): "m/s", (8, 1, 0, False): "m",
+              (13, 0, 1, False): "N", (8, 0, 0, True): "rad", (11, 0, 0, True): "rad/s",
+              (12, 0, 0, True): "rad/s^2", (13, 1, 1, True): "N m"}
+#: a CSV column of these names (case-insensitive) is the time
+TIME_NAMES = ("t", "time")
+#: a time column's steps may differ from their median by this fraction
+TIME_TOLERANCE = 0.01
+
+
+class MeasuredDataError(TestbedError, ValueError):
+    """A measured-data file cannot be imported as asked.
+
+    Parameters
+    ----------
+    path : path-like
+        The offending file.
+    reason : str
+        What is wrong with it (one line).
+    """
+
+    def __init__(self, path: str | os.PathLike, reason: str) -> None:
+        self.path, self.reason = Path(path), " ".join(str(reason).split())
+        super().__init__(f"{path}: {self.reason}")
+
+
+@dataclass
+class ImportedData:
+    """Measured channels of one record, in SI units, without any truth.
+
+    Attributes
+    ----------
+    fs : float
+        Sample rate [Hz].
+    signals : dict of str to (str, ndarray)
+        Channel name -> (SI unit, samples of shape (n_samples,)), in file order (or the
+        order of ``channels=``); every channel has the same length and only finite values.
+    source : Path
+        The file read.
+    format : str
+        One of :data:`FORMATS`.
+    nodes : dict of str to int
+        Node number of the channels whose file gives one (UFF response node, SEP-005 ``node``).
+    directions : dict of str to int
+        UFF direction code where given (1..3 translation along x, y, z; 4..6 rotation about
+        them; negative: the opposite sense).
+    positions : dict of str to float
+        Position [m] along the structure of the channels whose file gives one.
+    prior : dict of str to float
+        Declared prior knowledge stored with the data (HDF5 datasets only), e.g. ``total_mass``.
+    """
+
+    fs: float
+    signals: dict[str, tuple[str, np.ndarray]]
+    source: Path
+    format: str
+    nodes: dict[str, int] = field(default_factory=dict)
+    directions: dict[str, int] = field(default_factory=dict)
+    positions: dict[str, float] = field(default_factory=dict)
+    prior: dict[str, float] = field(default_factory=dict)
+
+    @property
+    def n_samples(self) -> int:
+        """Number of samples of every channel."""
+        return next(iter(self.signals.values()))[1].size
+
+    @property
+    def t(self) -> np.ndarray:
+        """Sample times [s], shape (n_samples,), starting at 0."""
+        return np.arange(self.n_samples) / self.fs
+
+    def to_dataset(self, groups: Mapping[str, Sequence[str]] | None = None,
+                   prior: Mapping[str, float] | None = None) -> Dataset:
+        """The channels as a truth-free Dataset, ready for :func:`testbed.pipeline.signal_chain.measure`.
+
+        Parameters
+        ----------
+        groups : mapping of str to sequence of str, optional
+            Signal name -> channel names, e.g. ``{"acceleration": ["a1", "a2", "a3"], "force":
+            ["hammer"]}``.  Default: channels named ``"<signal>/<channel>"`` (as exported) are
+            grouped by ``<signal>``; any other channel is a signal of its own.  The structural
+            chain needs ``"acceleration"`` and ``"force"`` with positions, the mechanical one
+            ``"theta"``, ``"dtheta"``, ``"ddtheta"`` (4 channels each) and ``"torque"`` (2).
+        prior : mapping of str to float, optional
+            Declared prior knowledge (e.g. ``total_mass`` [kg]); updates :attr:`prior`.
+
+        Returns
+        -------
+        Dataset
+            ``measured`` only (each Signal's channels are the names after ``"/"``), ``fs``,
+            ``prior``, and ``attrs["source"]`` / ``attrs["source_format"]``.
+
+        Raises
+        ------
+        MeasuredDataError
+            If a group names an unknown channel, mixes units, or has positions for only
+            some of its channels.
+        """
+        if groups is None:
+            grouped: dict[str, list[str]] = {}
+            for name in self.signals:
+                grouped.setdefault(name.split("/", 1)[0] if "/" in name else name, []).append(name)
+        else:
+            grouped = {g: list(chs) for g, chs in groups.items()}
+        measured = {}
+        for g, names in grouped.items():
+            unknown = [n for n in names if n not in self.signals]
+            if unknown or not names:
+                raise MeasuredDataError(self.source, f"group {g!r}: unknown channel(s) "
+                                        f"{', '.join(unknown) or '(none given)'}; "
+                                        f"has {', '.join(self.signals)}")
+            units = {self.signals[n][0] for n in names}
+            if len(units) > 1:
+                raise MeasuredDataError(self.source, f"group {g!r} mixes units {', '.join(sorted(units))}")
+            have = [n in self.positions for n in names]
+            if any(have) and not all(have):
+                raise MeasuredDataError(self.source, f"group {g!r}: only some channels have positions")
+            measured[g] = Signal(np.array([self.signals[n][1] for n in names]),
+                                 tuple(n.split("/", 1)[1] if "/" in n else n for n in names),
+                                 units.pop(),
+                                 np.array([self.positions[n] for n in names]) if all(have) else None)
+        return Dataset(float(self.fs), measured, prior={**self.prior, **dict(prior or {})},
+                       attrs={"source": str(self.source), "source_format": self.format})
+
+
+def read_measured(path: str | os.PathLike, *, format: str | None = None, fs: float | None = None,
+                  units: str | Mapping[str, str] | None = None,
+                  channels: Sequence[str] | None = None) -> ImportedData:
+    """Read measured data for identification (no truth) from a UFF, SEP-005, CSV or HDF5 file.
+
+    Parameters
+    ----------
+    path : path-like
+        The file.
+    format : {"uff", "sep005", "csv", "hdf5"}, optional
+        Default from the suffix (see :data:`SUFFIXES`).
+    fs : float, optional
+        Sample rate [Hz].  Needed for a CSV file without a time column; otherwise, if given,
+        it must agree with the file's rate to 0.1 % and then replaces it (exact).
+    units : str or mapping of str to str, optional
+        Unit of every channel (str) or per channel name; overrides the file's units and is
+        required where the file has none (CSV without ``[unit]`` in its header).
+    channels : sequence of str, optional
+        Keep only these channels, in this order (default: all, in file order).
+
+    Returns
+    -------
+    ImportedData
+        Sample rate [Hz], channels in SI units (shape (n_samples,) each), nodes, directions
+        and positions [m] where the file gives them.
+
+    Raises
+    ------
+    MeasuredDataError
+        Missing file, unknown format, unreadable or malformed content, non-uniform time,
+        channels of different lengths or rates, non-finite values, unknown unit or channel,
+        a declared ``fs`` the file contradicts.
+    """
+    path = Path(path)
+    if format is None:
+        format = SUFFIXES.get(path.suffix.lower())
+        if format is None:
+            raise MeasuredDataError(path, f"cannot tell the format from the suffix {path.suffix!r}; "
+                                          f"pass format= one of {', '.join(FORMATS)}")
+    if format not in FORMATS:
+        raise MeasuredDataError(path, f"unknown format {format!r}; allowed: {', '.join(FORMATS)}")
+    if not path.is_file():
+        raise MeasuredDataError(path, "no such file")
+    if fs is not None and not (isinstance(fs, (int, float)) and math.isfinite(fs) and fs > 0):
+        raise MeasuredDataError(path, f"sample rate fs={fs!r} must be a finite number > 0 Hz")
+    reader = {"uff": _read_uff, "sep005": _read_sep005_file, "csv": _read_csv, "hdf5": _read_hdf5}[format]
+    raw = reader(path)
+    return _finish(raw, fs, units, channels)
+
+
+def measurement_from_file(path: str | os.PathLike, kind: str, signal: Mapping[str, Any] | None = None, *,
+                          format: str | None = None, fs: float | None = None,
+                          units: str | Mapping[str, str] | None = None,
+                          channels: Sequence[str] | None = None,
+                          groups: Mapping[str, Sequence[str]] | None = None,
+                          prior: Mapping[str, float] | None = None) -> Measurement:
+    """Read measured data and run the rig kind's signal chain: what an identifier fits.
+
+    ``measure(read_measured(path, ...).to_dataset(groups, prior), signal or {}, kind)``.
+
+    Parameters
+    ----------
+    path, format, fs, units, channels
+        As for :func:`read_measured`.
+    kind : {"structural", "mechanical"}
+        The rig kind whose chain to run (:data:`testbed.pipeline.signal_chain.SIGNAL_SCHEMAS`).
+    signal : mapping, optional
+        The ``[signal]`` table (a scenario's ``scenario.signal``); default: the kind's defaults.
+    groups, prior
+        As for :meth:`ImportedData.to_dataset`.
+
+    Returns
+    -------
+    Measurement
+        ``x``, ``xd``, ``xdd`` of shape (n_channels, n_samples), inputs ``u``, ``input_map``.
+
+    Raises
+    ------
+    MeasuredDataError
+        The file or the arguments (see :func:`read_measured`), or data the chain cannot take
+        (wrong signal names or channel counts, no positions for a structural record).
+    ScenarioError
+        A bad ``signal`` table.
+    """
+
+    if kind not in SIGNAL_SCHEMAS:
+        raise MeasuredDataError(path, f"unknown rig kind {kind!r}; allowed: {', '.join(SIGNAL_SCHEMAS)}")
+    data = read_measured(path, format=format, fs=fs, units=units, channels=channels)
+    ds = data.to_dataset(groups, prior)
+    try:
+        return measure(ds, dict(signal or {}), kind)
+    except TestbedError:
+        raise
+    except ValueError as e:  # the chain's own checks: signal names, channel counts, positions
+        raise MeasuredDataError(data.source, f"cannot run the {kind} signal chain: {e}; "
+                                             f"signals {', '.join(ds.measured)}") from None
+
+
+def from_sep005(channel_dicts: Sequence[Mapping[str, Any]], *, source: str | os.PathLike = "<sep005>",
+                fs: float | None = None, units: str | Mapping[str, str] | None = None,
+                channels: Sequence[str] | None = None) -> ImportedData:
+    """:class:`ImportedData` from an in-memory SEP-005 channel list (e.g. another SDyPy tool's).
+
+    Parameters
+    ----------
+    channel_dicts : sequence of mapping
+        SEP-005 channels: ``name``, ``data`` (list or ndarray of shape (n_samples,)),
+        ``unit_str`` and ``fs`` [Hz] or ``time`` [s]; optional ``node``, ``direction`` (int)
+        and ``position_m`` [m].
+    source : str or path-like
+        What to name in errors and :attr:`ImportedData.source`.
+    fs, units, channels
+        As for :func:`read_measured`.
+
+    Returns
+    -------
+    ImportedData
+    """
+    return _finish(_parse_sep005(Path(source), channel_dicts), fs, units, channels)
+
+
+# --------------------------------------------------------------------------- shared checks
+@dataclass
+class _Raw:
+    """What a reader found, before units, selection and checks."""
+
+    source: Path
+    format: str
+    fs: float | None
+    data: dict[str, np.ndarray]
+    units: dict[str, str | None]
+    nodes: dict[str, int] = field(default_factory=dict)
+    directions: dict[str, int] = field(default_factory=dict)
+    positions: dict[str, float] = field(default_factory=dict)
+    prior: dict[str, float] = field(default_factory=dict)
+
+
+def si_unit(unit: str) -> tuple[str, float]:
+    """(SI unit, factor to SI) of a unit string; ``("", nan)`` if unknown.
+
+    Parameters
+    ----------
+    unit : str
+        E.g. ``"m/s^2"``, ``"g"``, ``"N*m"``.
+    """
+    u = " ".join(unit.split())
+    if u in SI_UNITS:
+        return u, 1.0
+    return UNIT_ALIASES.get(u, ("", math.nan))
+
+
+def _finish(raw: _Raw, fs: float | None, units: str | Mapping[str, str] | None,
+            channels: Sequence[str] | None) -> ImportedData:
+    path = raw.source
+    if not raw.data:
+        raise MeasuredDataError(path, "no channels found")
+    names = list(raw.data)
+    if channels is not None:
+        missing = [c for c in channels if c not in raw.data]
+        if missing:
+            raise MeasuredDataError(path, f"no channel {', '.join(map(repr, missing))}; "
+                                          f"has {', '.join(names)}")
+        if len(set(channels)) != len(channels):
+            raise MeasuredDataError(path, "channels= names a channel twice")
+        names = list(channels)
+    if isinstance(units, Mapping):
+        unknown = [c for c in units if c not in raw.data]
+        if unknown:
+            raise MeasuredDataError(path, f"units= names unknown channel(s) {', '.join(unknown)}; "
+                                          f"has {', '.join(raw.data)}")
+    lengths = {n: raw.data[n].size for n in names}
+    if len(set(lengths.values())) > 1:
+        detail = ", ".join(f"{n} {k}" for n, k in lengths.items())
+        raise MeasuredDataError(path, f"channels have different lengths ({detail} samples)")
+    if min(lengths.values()) < 2:
+        raise MeasuredDataError(path, "fewer than 2 samples")
+    rate = raw.fs
+    if fs is not None:
+        if rate is not None and abs(rate / fs - 1) > 1e-3:
+            raise MeasuredDataError(path, f"declared fs={fs:g} Hz but the file's rate is {rate:.9g} Hz")
+        rate = float(fs)
+    if rate is None:
+        raise MeasuredDataError(path, "no time column (t or time) and no sample rate; pass fs= [Hz]")
+    signals = {}
+    for n in names:
+        unit = units if isinstance(units, str) else (units or {}).get(n, raw.units.get(n))
+        if not unit:
+            raise MeasuredDataError(path, f"channel {n!r} has no unit; declare it with units=")
+        si, factor = si_unit(unit)
+        if not si:
+            raise MeasuredDataError(path, f"channel {n!r}: unknown unit {unit!r}; allowed: "
+                                          f"{', '.join(SI_UNITS + tuple(UNIT_ALIASES))}")
+        x = np.asarray(raw.data[n], dtype=float)
+        bad = np.flatnonzero(~np.isfinite(x))
+        if bad.size:
+            raise MeasuredDataError(path, f"channel {n!r} has {bad.size} NaN or infinite value(s), "
+                                          f"the first at sample {bad[0]}")
+        signals[n] = (si, x * factor if factor != 1.0 else x.copy())
+    keep = set(names)
+    return ImportedData(float(rate), signals, path, raw.format,
+                        nodes={k: v for k, v in raw.nodes.items() if k in keep},
+                        directions={k: v for k, v in raw.directions.items() if k in keep},
+                        positions={k: v for k, v in raw.positions.items() if k in keep},
+                        prior=dict(raw.prior))
+
+
+def uniform_rate(path: Path, t: np.ndarray, what: str = "time column") -> float:
+    """Sample rate [Hz] of uniformly spaced times ``t`` [s], shape (n,); raises if not uniform."""
+    t = np.asarray(t, dtype=float)
+    if t.size < 2:
+        raise MeasuredDataError(path, f"{what}: fewer than 2 samples")
+    if not np.all(np.isfinite(t)):
+        raise MeasuredDataError(path, f"{what} has NaN or infinite values")
+    dt = np.diff(t)
+    step = float(np.median(dt))
+    if not step > 0:
+        raise MeasuredDataError(path, f"{what} does not increase")
+    worst = int(np.argmax(np.abs(dt - step)))
+    if abs(dt[worst] - step) > TIME_TOLERANCE * step:
+        raise MeasuredDataError(path, f"{what} is not uniform: step {dt[worst]:.6g} s after "
+                                      f"t = {t[worst]:.6g} s against a median step of {step:.6g} s")
+    return (t.size - 1) / float(t[-1] - t[0])
+
+
+# --------------------------------------------------------------------------- readers
+def _read_hdf5(path: Path) -> _Raw:
+    try:
+        ds = Dataset.load(path)
+    except DatasetError as e:
+        raise MeasuredDataError(path, e.reason) from None
+    raw = _Raw(path, "hdf5", float(ds.fs), {}, {}, prior=dict(ds.prior))
+    for g, s in ds.measured.items():
+        for i, ch in enumerate(s.channels):
+            name = f"{g}/{ch}"
+            raw.data[name], raw.units[name] = s.data[i], s.unit
+            if s.positions is not None:
+                raw.positions[name] = float(s.positions[i])
+    return raw
+
+
+def _read_sep005_file(path: Path) -> _Raw:
+    try:
+        content = json.loads(path.read_text())
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
+        raise MeasuredDataError(path, f"not a SEP-005 JSON file ({type(e).__name__}: {e})") from None
+    return _parse_sep005(path, content)
+
+
+def _parse_sep005(path: Path, content: Any) -> _Raw:
+    if isinstance(content, Mapping):
+        content = [content]
+    if not isinstance(content, Sequence) or isinstance(content, str) or not content:
+        raise MeasuredDataError(path, "SEP-005 data must be a non-empty list of channel dicts")
+    raw = _Raw(path, "sep005", None, {}, {})
+    rates: dict[str, float] = {}
+    for k, c in enumerate(content):
+        if not isinstance(c, Mapping):
+            raise MeasuredDataError(path, f"SEP-005 channel {k} is not a dict")
+        name = c.get("name")
+        if not isinstance(name, str) or not name:
+            raise MeasuredDataError(path, f"SEP-005 channel {k} has no name")
+        if name in raw.data:
+            raise MeasuredDataError(path, f"SEP-005 channel name {name!r} is not unique")
+        if "data" not in c:
+            raise MeasuredDataError(path, f"SEP-005 channel {name!r} has no data")
+        try:
+            data = np.asarray(c["data"], dtype=float)
+        except (TypeError, ValueError):
+            raise MeasuredDataError(path, f"SEP-005 channel {name!r}: data are not numbers") from None
+        if data.ndim != 1:
+            raise MeasuredDataError(path, f"SEP-005 channel {name!r}: data of shape {data.shape}; "
+                                          "only 1-D channels are supported")
+        if "fs" in c:
+            f = c["fs"]
+            if isinstance(f, bool) or not isinstance(f, (int, float)) or not (math.isfinite(f) and f > 0):
+                raise MeasuredDataError(path, f"SEP-005 channel {name!r}: fs={f!r} is not a rate > 0 Hz")
+            rates[name] = float(f)
+        elif "time" in c:
+            t = np.asarray(c["time"], dtype=float)
+            if t.shape != data.shape:
+                raise MeasuredDataError(path, f"SEP-005 channel {name!r}: {t.size} times for "
+                                              f"{data.size} samples")
+            rates[name] = uniform_rate(path, t, f"channel {name!r} time")
+        else:
+            raise MeasuredDataError(path, f"SEP-005 channel {name!r} has neither fs nor time")
+        unit = c.get("unit_str")
+        raw.data[name], raw.units[name] = data, (str(unit) if unit else None)
+        if isinstance(c.get("node"), int) and not isinstance(c.get("node"), bool):
+            raw.nodes[name] = int(c["node"])
+        direction = _direction(c.get("direction"))
+        if direction:
+            raw.directions[name] = direction
+        pos = c.get("position_m")
+        if isinstance(pos, (int, float)) and not isinstance(pos, bool) and math.isfinite(pos):
+            raw.positions[name] = float(pos)
+    raw.fs = _common_rate(path, rates, 1e-9)
+    return raw
+
+
+_DIRECTION = re.compile(r"^\s*([-+]?)\s*([XYZ])\s*(rotation)?\s*$", re.IGNORECASE)
+
+
+def _direction(value: Any) -> int:
+    """UFF direction code of an int or a text such as ``"+Z"`` / ``"-X rotation"``; 0 if none."""
+    if isinstance(value, int) and not isinstance(value, bool):
+        return value
+    m = _DIRECTION.match(value) if isinstance(value, str) else None
+    if m is None:
+        return 0
+    code = "XYZ".index(m.group(2).upper()) + 1 + (3 if m.group(3) else 0)
+    return -code if m.group(1) == "-" else code
+
+
+def _common_rate(path: Path, rates: dict[str, float], rtol: float) -> float:
+    first = next(iter(rates.values()))
+    for name, f in rates.items():
+        if abs(f / first - 1) > rtol:
+            raise MeasuredDataError(path, f"channels have different sample rates ({name!r}: {f:.9g} Hz, "
+                                          f"{next(iter(rates))!r}: {first:.9g} Hz)")
+    return first
+
+
+_HEADER = re.compile(r"^\s*(?P<name>.*?)\s*(?:[\[(](?P<unit>[^\])]*)[\])])?\s*$")
+
+
+def _read_csv(path: Path) -> _Raw:
+    try:
+        text = path.read_text()
+    except (OSError, UnicodeDecodeError) as e:
+        raise MeasuredDataError(path, f"not a text file ({type(e).__name__}: {e})") from None
+    lines = [(k + 1, ln) for k, ln in enumerate(text.splitlines())
+             if ln.strip() and not ln.lstrip().startswith("#")]
+    if len(lines) < 2:
+        raise MeasuredDataError(path, "need a header row and at least one row of numbers")
+    head = lines[0][1]
+    delim = next((d for d in (",", ";", "\t") if d in head), None)
+
+    def split(line: str) -> list[str]:
+        return next(csv.reader([line], delimiter=delim)) if delim else line.split()
+
+    header = [_HEADER.match(h).groupdict() for h in split(head)]  # type: ignore[union-attr]
+    names = [h["name"] for h in header]
+    if any(not n for n in names) or len(set(names)) != len(names):
+        raise MeasuredDataError(path, f"header names must be non-empty and unique, got {names}")
+    rows = []
+    for lineno, line in lines[1:]:
+        cells = split(line)
+        if len(cells) != len(names):
+            raise MeasuredDataError(path, f"line {lineno} has {len(cells)} fields, the header {len(names)}")
+        try:
+            rows.append([float(c) for c in cells])
+        except ValueError:
+            bad = next(c for c in cells if not _is_float(c))
+            raise MeasuredDataError(path, f"line {lineno}: {bad.strip()!r} is not a number") from None
+    table = np.array(rows, dtype=float).T
+    raw = _Raw(path, "csv", None, {}, {})
+    for h, col in zip(header, table, strict=True):
+        if h["name"].lower() in TIME_NAMES:
+            if raw.fs is not None:
+                raise MeasuredDataError(path, "more than one time column")
+            unit = (h["unit"] or "s").strip()
+            if unit != "s":
+                raise MeasuredDataError(path, f"time column unit {unit!r}; expected s")
+            raw.fs = uniform_rate(path, col)
+        else:
+            raw.data[h["name"]], raw.units[h["name"]] = col, (h["unit"] or "").strip() or None
+    return raw
+
+
+def _is_float(s: str) -> bool:
+    try:
+        float(s)
+    except ValueError:
+        return False
+    return True
+
+
+def _read_uff(path: Path) -> _Raw:
+    import pyuff
+
+    # every UFF block ends with a line "    -1"; pyuff silently drops an unfinished last block
+    with path.open("rb") as fh:
+        fh.seek(max(0, path.stat().st_size - 64))
+        tail = fh.read().rstrip()
+    if not re.search(rb"(^|\s)-1$", tail):
+        raise MeasuredDataError(path, "not a complete UFF file: it does not end with a block end "
+                                      "'-1' (truncated, or not UFF)")
+    try:
+        uff = pyuff.UFF(str(path))
+        types = list(uff.get_set_types())
+        sets = [uff.read_sets(i) for i in range(len(types))]
+    except Exception as e:  # pyuff raises bare Exception (and others) for damaged files
+        raise MeasuredDataError(path, f"unreadable UFF file ({type(e).__name__}: {e})") from None
+    if not any(int(t) == 58 for t in types):
+        raise MeasuredDataError(path, "no UFF58 (function at nodal DOF) record")
+    coords: dict[int, float] = {}
+    raw = _Raw(path, "uff", None, {}, {})
+    rates: dict[str, float] = {}
+    for k, s in enumerate(sets):
+        kind = int(s.get("type", 0))
+        if kind == 164:
+            factors = [float(s.get(key, 1.0)) for key in ("length", "force")]
+            if factors != [1.0, 1.0]:
+                raise MeasuredDataError(path, f"units record (164, code {s.get('units_code')}) is not SI: "
+                                              f"length factor {factors[0]:g}, force factor {factors[1]:g}")
+        elif kind in (15, 2411):
+            for node, x in zip(s["node_nums"], s["x"], strict=True):
+                coords[int(node)] = float(x)
+        elif kind == 58:
+            name, rate = _uff58_channel(path, k, s, raw)
+            rates[name] = rate
+    for name, node in raw.nodes.items():
+        if node in coords:
+            raw.positions[name] = coords[node]
+    raw.fs = _common_rate(path, rates, 1e-5)
+    return raw
+
+
+_FS_ID = re.compile(r"\bfs\s+([-+0-9.eE]+)\s*Hz")
+
+
+def _uff58_channel(path: Path, k: int, s: dict[str, Any], raw: _Raw) -> tuple[str, float]:
+    """Add one UFF58 record to ``raw``; its channel name and sample rate [Hz]."""
+    node, direction = int(s.get("rsp_node", 0)), int(s.get("rsp_dir", 0))
+    name = str(s.get("id1", "")).strip() or f"node{node}:{direction}"
+    where = f"record {k + 1} ({name})"
+    if int(s.get("func_type", 0)) != 1:
+        raise MeasuredDataError(path, f"{where} is function type {s.get('func_type')}, "
+                                      "not a time response (1)")
+    data = np.asarray(s.get("data", []))
+    if np.iscomplexobj(data):
+        raise MeasuredDataError(path, f"{where} has complex ordinates; a time response is real")
+    if name in raw.data:
+        name = f"{name}#{k + 1}"
+    m = _FS_ID.search(str(s.get("id5", "")))
+    if m is not None:
+        rate = float(m.group(1))
+    elif int(s.get("abscissa_spacing", 1)) == 1:
+        inc = float(s.get("abscissa_inc", 0.0))
+        if not inc > 0:
+            raise MeasuredDataError(path, f"{where}: abscissa increment {inc!r} s is not > 0")
+        rate = 1.0 / inc
+    else:
+        rate = uniform_rate(path, np.asarray(s["x"], dtype=float), f"{where} abscissa")
+    if int(s.get("abscissa_spec_data_type", 17)) not in (0, 17):
+        raise MeasuredDataError(path, f"{where}: abscissa is specific data type "
+                                      f"{s.get('abscissa_spec_data_type')}, not time (17)")
+    label = str(s.get("ordinate_axis_units_lab", "")).strip()
+    if not label or label.upper() == "NONE":
+        key = (int(s.get("ordinate_spec_data_type", 0)), int(s.get("ordinate_len_unit_exp", 0)),
+               int(s.get("ordinate_force_unit_exp", 0)), abs(direction) in (4, 5, 6))
+        label = _UFF_UNITS.get(key, "")
+    raw.data[name], raw.units[name] = data.astype(float), label or None
+    if node > 0:
+        raw.nodes[name] = node
+    if direction:
+        raw.directions[name] = direction
+    return name, rate

@@ -1,0 +1,464 @@
+"""Scenario files: rig + excitation + noise + signal chain + identifier + score thresholds.
+
+A scenario is a TOML file in ``scenarios/``::
+
+    [scenario]            name (= file stem), rig, seed, description, tags, extends
+    [rig]                 the rig's parameters (schema from the rig)
+    [simulation]          duration, sample rate ... (schema from the rig)
+    [excitation]          type = ... and that type's parameters (schema from the rig)
+    [noise]               rms_percent, signals
+    [signal]              the signal chain a lab would apply (schema by rig kind)
+    [identify]            method = registered identifier, plus its hyperparameters
+    [score]               <metric>_min / <metric>_max thresholds
+
+``extends = "other.toml"`` (path relative to the file) starts from another
+scenario and overrides it key by key, so variants (noise levels, identifiers)
+state only what differs.  Two tables are replaced whole rather than merged:
+``[identify]`` (a new identifier must not inherit another's hyperparameters) and
+``[score]``.  **A child keeps its parent's ``[score]`` unless it declares its own**
+(even when it replaces ``[identify]``): a variant is held to its parent's bars until
+it states new ones, and never passes with no bars at all.  ``[score]`` without
+``[identify]`` is an error in a scenario run on its own (there would be nothing to
+score); a study may use such a scenario, its identifiers being held to the scenario's
+bars.
+
+Everything is checked when the file loads, before anything is simulated: every key's
+type and range (the rig's, the signal chain's and the identifier's declared
+hyperparameters), cross-key rules (cut-offs below the Nyquist frequency, windows shorter
+than the record, the impact on a sensor, an identifier of the rig's kind, term names the
+data can provide) and the budget of memory and integration steps
+(:mod:`testbed.core.budget`).  Every problem raises :class:`ScenarioError` naming the file,
+the key, the value and what is allowed; files that are not UTF-8 TOML, nested too deeply,
+too large or not scenarios get one line without their content.
+"""
+
+from __future__ import annotations
+
+import copy
+import dataclasses
+import hashlib
+import json
+import math
+import os
+import re
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from testbed.core.budget import check_cost, check_steps
+from testbed.core.errors import RigError, ScenarioError
+from testbed.core.kinds import metric_names
+from testbed.core.schema import Field, validate_header, validate_table, validate_variant
+from testbed.pipeline.plugins import IDENTIFIERS, RIGS
+from testbed.pipeline.signal_chain import SIGNAL_SCHEMAS, check_signal
+
+#: Scenario and study names: a safe file stem (no path separators, not "." or "..").
+NAME_PATTERN = r"[A-Za-z0-9_][A-Za-z0-9_.-]{0,127}"
+NAME_PATTERN_DOC = ("a name of letters, digits, '_', '.', '-' (at most 128, not starting "
+                    "with '.' or '-')")
+#: Largest scenario or study file read [bytes]: the shipped ones are under 5 kB.
+MAX_FILE_BYTES = 1 << 20
+#: Deepest nesting of tables and lists accepted: scenario and study files need 3
+#: ([identifiers.<name>] holding a list); 16 leaves room without risking recursion limits.
+MAX_DEPTH = 16
+#: Longest chain of ``extends``: the shipped scenarios use 2.
+MAX_EXTENDS = 32
+
+SCENARIO_DIR = Path(os.environ.get("TESTBED_SCENARIOS",
+                                   Path(__file__).resolve().parents[2] / "scenarios"))
+
+HEADER_SCHEMA = {
+    "name": Field(str, doc="scenario name; must equal the file name without .toml",
+                  pattern=NAME_PATTERN, pattern_doc=NAME_PATTERN_DOC),
+    "rig": Field(str, doc="registered rig name (see `testbed list`)"),
+    "seed": Field(int, 0, min=0, doc="seed of the measurement noise"),
+    "description": Field(str, "", doc="one line for listings"),
+    "tags": Field(list, [], item_type=str, doc="free tags for selecting scenarios"),
+    "extends": Field(str, "", doc="scenario file this one starts from (relative path)"),
+}
+
+NOISE_SCHEMA = {
+    "rms_percent": Field(float, 0.0, unit="% of channel RMS", min=0.0, max=100.0,
+                         doc="white Gaussian sensor noise, standard deviation as % of each "
+                             "channel's noise-free RMS about its mean"),
+    "signals": Field(list, None, item_type=str,
+                     doc="measured signals that get noise (default: the rig's sensors)"),
+}
+
+SECTIONS = ("scenario", "rig", "simulation", "excitation", "noise", "signal", "identify", "score")
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """A validated scenario.  Sections are plain dicts with defaults filled in."""
+
+    name: str
+    rig: str
+    seed: int = 0
+    description: str = ""
+    tags: tuple[str, ...] = ()
+    rig_params: dict[str, Any] = field(default_factory=dict)
+    simulation: dict[str, Any] = field(default_factory=dict)
+    excitation: dict[str, Any] = field(default_factory=dict)
+    noise: dict[str, Any] = field(default_factory=dict)
+    signal: dict[str, Any] = field(default_factory=dict)
+    identify: dict[str, Any] | None = None
+    score: dict[str, dict[str, float]] = field(default_factory=dict)
+    path: str | None = field(default=None, compare=False)
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain, JSON-able form (the file path left out)."""
+        d = dataclasses.asdict(self)
+        d.pop("path")
+        d["tags"] = list(self.tags)
+        return d
+
+    def canonical_json(self) -> str:
+        return json.dumps(self.to_dict(), sort_keys=True, separators=(",", ":"))
+
+    def data_dict(self) -> dict[str, Any]:
+        """The parts that determine the generated data (not identifier, score, name)."""
+        return {"rig": self.rig, "rig_params": self.rig_params, "simulation": self.simulation,
+                "excitation": self.excitation, "noise": self.noise, "seed": self.seed}
+
+    def data_hash(self) -> str:
+        """SHA-256 of :meth:`data_dict`: scenarios that differ only in identifier share data."""
+        blob = json.dumps(self.data_dict(), sort_keys=True, separators=(",", ":"))
+        return hashlib.sha256(blob.encode()).hexdigest()
+
+    def replace(self, **changes: Any) -> Scenario:
+        return dataclasses.replace(self, **changes)
+
+    def with_noise(self, rms_percent: float) -> Scenario:
+        return self.replace(noise={**self.noise, "rms_percent": float(rms_percent)})
+
+
+def _deep_merge(base: dict, over: dict) -> dict:
+    out = copy.deepcopy(base)
+    for k, v in over.items():
+        # [identify] and [score] are replaced whole: a new identifier must not inherit another's
+        # hyperparameters, and a child's bars replace its parent's
+        if isinstance(v, dict) and isinstance(out.get(k), dict) and k not in ("identify", "score"):
+            out[k] = _deep_merge(out[k], v)
+        else:
+            out[k] = copy.deepcopy(v)
+    return out
+
+
+def _depth_exceeds(obj: Any, limit: int) -> bool:
+    """Whether tables and lists nest deeper than ``limit`` (iterative: no recursion)."""
+    stack = [(obj, 0)]
+    while stack:
+        o, d = stack.pop()
+        if d > limit:
+            return True
+        if isinstance(o, dict):
+            stack.extend((v, d + 1) for v in o.values())
+        elif isinstance(o, list):
+            stack.extend((v, d + 1) for v in o)
+    return False
+
+
+def read_toml_file(path: Path, what: str) -> dict:
+    """Read one TOML file defensively: one clear :class:`ScenarioError`, never its content.
+
+    Parameters
+    ----------
+    path : Path
+    what : str
+        "scenario" or "study", for messages.
+
+    Raises
+    ------
+    ScenarioError
+        Missing, a folder, unreadable, larger than :data:`MAX_FILE_BYTES`, not UTF-8, not
+        valid TOML, or nested deeper than :data:`MAX_DEPTH`.
+    """
+    file = str(path)
+    if path.is_dir():
+        raise ScenarioError(file, allowed=f"is a folder; expected a {what} .toml file")
+    if not path.is_file():
+        raise ScenarioError(file, allowed=f"no such {what} file")
+    try:
+        size = path.stat().st_size
+        if size > MAX_FILE_BYTES:
+            raise ScenarioError(file, allowed=f"{size} bytes; a {what} file is at most "
+                                              f"{MAX_FILE_BYTES} bytes of TOML")
+        data = path.read_bytes()
+    except OSError as e:
+        raise ScenarioError(file, allowed=f"cannot be read: {e.strerror or type(e).__name__}") from None
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as e:
+        raise ScenarioError(file, allowed=f"not UTF-8 text (byte {e.start}); a {what} file is "
+                                          "UTF-8 TOML") from None
+    if "\x00" in text:
+        raise ScenarioError(file, allowed=f"contains NUL bytes (a binary file?); a {what} file is "
+                                          "UTF-8 TOML")
+    for n, line in enumerate(text.splitlines(), 1):
+        # a dotted key of thousands of parts nests thousands of tables, and tomllib takes
+        # seconds (quadratic) to build them: refuse it before parsing
+        stripped = line.lstrip()
+        if stripped.startswith("#") or ("=" not in stripped and not stripped.startswith("[")):
+            continue
+        head = stripped.split("=", 1)[0].split("#", 1)[0]
+        if head.count(".") > MAX_DEPTH:
+            raise ScenarioError(file, allowed=f"not a {what} file: a key on line {n} is nested "
+                                              f"deeper than {MAX_DEPTH}")
+    try:
+        raw = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as e:
+        raise ScenarioError(file, allowed=f"not valid TOML: {e}") from None
+    except RecursionError:
+        raise ScenarioError(file, allowed=f"not a {what} file: TOML nested too deeply") from None
+    if _depth_exceeds(raw, MAX_DEPTH):
+        raise ScenarioError(file, allowed=f"not a {what} file: tables or lists nested deeper "
+                                          f"than {MAX_DEPTH}")
+    return raw
+
+
+def _read_toml(path: Path, chain: tuple[Path, ...] = ()) -> dict:
+    raw = read_toml_file(path, "scenario")
+    if "scenario" not in raw and "study" in raw:
+        raise ScenarioError(str(path), allowed="a study file (it has [study]), not a scenario; "
+                                               "run it with `testbed sweep`")
+    header = raw.get("scenario", {})
+    parent = header.get("extends") if isinstance(header, dict) else None
+    if parent:
+        if not isinstance(parent, str):
+            raise ScenarioError(str(path), "scenario.extends", parent, "expected a file path string")
+        if len(chain) >= MAX_EXTENDS:
+            raise ScenarioError(str(path), "scenario.extends", parent,
+                                f"a chain of at most {MAX_EXTENDS} files")
+        try:
+            ppath = (path.parent / parent).resolve()
+        except (OSError, RuntimeError, ValueError) as e:
+            raise ScenarioError(str(path), "scenario.extends", parent, f"not a usable path: {e}") \
+                from None
+        if ppath in chain or ppath == path.resolve():
+            raise ScenarioError(str(path), "scenario.extends", parent, "extends itself (a cycle)")
+        if not ppath.is_file():
+            raise ScenarioError(str(path), "scenario.extends", parent, f"no such file {ppath}")
+        try:
+            base = _read_toml(ppath, (*chain, path.resolve()))
+        except ScenarioError as e:
+            raise type(e)(e.file, e.key, e.value,
+                          f"{e.allowed + ' ' if e.allowed else ''}(extended by {path})") from None
+        if not isinstance(base.get("scenario", {}), dict):
+            raise ScenarioError(str(ppath), "scenario", base["scenario"], "expected a table")
+        base.setdefault("scenario", {}).pop("extends", None)
+        base["scenario"].pop("description", None)
+        base["scenario"].pop("tags", None)
+        # a child keeps its parent's [score] unless it declares its own (see the module docs)
+        raw = _deep_merge(base, raw)
+    return raw
+
+
+def resolve_path(name_or_path: str | os.PathLike) -> Path:
+    """A path as given, or ``scenarios/<name>.toml`` for a bare scenario name."""
+    p = Path(name_or_path)
+    if p.suffix == ".toml" or p.exists() or len(p.parts) > 1:
+        return p
+    return SCENARIO_DIR / f"{p}.toml"
+
+
+def _check_stem(path: Path, what: str, directory: Path) -> None:
+    """Refuse a folder, and a file whose stem is not a safe name (e.g. ``..toml``, stem ``.``)."""
+    if path.is_dir():
+        raise ScenarioError(str(path), allowed=f"is a folder; expected a {what} .toml file")
+    if not re.fullmatch(NAME_PATTERN, path.stem):
+        raise ScenarioError(str(path), f"{what}.name", path.stem,
+                            f"the file name without .toml must be {NAME_PATTERN_DOC}")
+    if not path.exists() and path.parent == directory:
+        known = sorted(p.stem for p in directory.glob("*.toml"))
+        raise ScenarioError(str(path), allowed=f"no {what} named {path.stem!r}; known: "
+                                               + (", ".join(known) or f"(none in {directory})"))
+
+
+def load_scenario(name_or_path: str | os.PathLike, *, standalone: bool = True) -> Scenario:
+    """Read and validate a scenario file (a path, or a name in ``scenarios/``).
+
+    ``standalone=False`` (a study's scenario, whose identifiers come from the study) allows
+    ``[score]`` without ``[identify]``.
+
+    Raises
+    ------
+    ScenarioError
+        For any problem of the file or a file it extends (see the module docs); its
+        subclass :class:`~testbed.core.errors.BudgetError` for a run over budget.
+    """
+    path = resolve_path(name_or_path)
+    _check_stem(path, "scenario", SCENARIO_DIR)
+    raw = _read_toml(path)
+    return scenario_from_dict(raw, file=str(path), stem=path.stem, standalone=standalone)
+
+
+def scenario_from_dict(raw: dict[str, Any], *, file: str = "<dict>", stem: str | None = None,
+                       standalone: bool = True) -> Scenario:
+    """Validate a scenario given as a dict of TOML tables (``standalone``: see
+    :func:`load_scenario`)."""
+
+    if not isinstance(raw, dict):
+        raise ScenarioError(file, allowed="expected a table of sections")
+    if "scenario" not in raw and "study" in raw:
+        raise ScenarioError(file, allowed="a study (it has [study]), not a scenario; run it with "
+                                          "`testbed sweep`")
+    head = validate_header(raw, sections=SECTIONS, header="scenario", schema=HEADER_SCHEMA, file=file,
+                           stem=stem)
+    try:
+        rig_cls = RIGS.get(head["rig"])
+    except KeyError as e:
+        raise ScenarioError(file, "scenario.rig", head["rig"], str(e.args[0])) from None
+
+    rig_params = validate_table(raw.get("rig", {}), rig_cls.rig_schema, file=file, section="rig")
+    simulation = validate_table(raw.get("simulation", {}), rig_cls.simulation_schema, file=file,
+                                section="simulation")
+    excitation = validate_variant(raw.get("excitation", {"type": rig_cls.default_excitation}),
+                                  rig_cls.excitation_schemas, file=file, section="excitation")
+    noise = validate_table(raw.get("noise", {}), NOISE_SCHEMA, file=file, section="noise")
+    if noise["signals"] is None:
+        noise["signals"] = list(rig_cls.noisy_signals)
+    for i, s in enumerate(noise["signals"]):
+        if s not in rig_cls.measured_signals:
+            raise ScenarioError(file, "noise.signals", s,
+                                "expected measured signals among " + ", ".join(rig_cls.measured_signals))
+        if s in noise["signals"][:i]:
+            raise ScenarioError(file, f"noise.signals[{i}]", s, "duplicate; each signal gets noise once")
+
+    def error(key: str, value: Any, allowed: str) -> None:
+        raise ScenarioError(file, key, value, allowed)
+
+    rig_cls.check(rig_params, simulation, excitation, error)
+    signal = validate_table(raw.get("signal", {}), SIGNAL_SCHEMAS[rig_cls.kind], file=file,
+                            section="signal")
+    record = rig_cls.record(simulation)
+    if record is not None:
+        check_signal(rig_cls.kind, signal, *record, error)
+    identify = _validate_identify(raw.get("identify"), file, kind=rig_cls.kind,
+                                  rig_kind_source=f"rig {head['rig']!r}")
+    score = _validate_score(raw.get("score", {}), rig_cls.kind, file)
+    if score and identify is None and standalone:
+        raise ScenarioError(file, "score", allowed="[score] needs an [identify] table: there is no "
+                                                   "identified model to score")
+    if identify is not None:
+        check_identifier_for_rig(rig_cls, rig_params, simulation, identify, file=file)
+    check_rig_cost(rig_cls, rig_params, simulation, excitation, file=file)
+    return Scenario(name=head["name"], rig=head["rig"], seed=head["seed"],
+                    description=head["description"], tags=tuple(head["tags"]),
+                    rig_params=rig_params, simulation=simulation, excitation=excitation,
+                    noise=noise, signal=signal, identify=identify, score=score, path=file)
+
+
+def check_rig_cost(rig_cls: Any, rig_params: dict[str, Any], simulation: dict[str, Any],
+                   excitation: dict[str, Any], *, file: str) -> None:
+    """Refuse a scenario whose simulation would exceed the budget (:mod:`testbed.core.budget`).
+
+    Raises
+    ------
+    BudgetError
+        Naming the key that drives the cost.
+    ScenarioError
+        If the rig cannot even be built from these (valid but extreme) parameters.
+    """
+
+    try:
+        cost = rig_cls.cost(rig_params, simulation, excitation)
+    except RigError as e:
+        raise ScenarioError(file, "rig", allowed=str(e)) from None
+    if cost is not None:
+        check_cost(cost, file)
+
+
+def check_identifier_for_rig(rig_cls: Any, rig_params: dict[str, Any], simulation: dict[str, Any],
+                             identify: dict[str, Any], *, file: str,
+                             section: str = "identify") -> None:
+    """Checks of an identifier's hyperparameters against a rig's data, before any simulation.
+
+    ``identify`` holds ``method`` and the given hyperparameters.  Checked: the identifier's
+    :meth:`~identify._base.Identifier.check_data_shape` (term names for the rig's channels
+    and inputs, frequencies against the Nyquist frequency, windows against the record) and
+    the steps of simulating the identified model over the record (:mod:`testbed.core.budget`).
+    """
+
+    cls = IDENTIFIERS.get(identify["method"])
+    params = {k: v for k, v in identify.items() if k != "method"}
+    full = cls.validate_hyperparameters(params, file=file, section=section)
+    record = rig_cls.record(simulation)
+    if record is None:
+        return
+    fs, n_samples = record
+
+    def error(name: str, value: Any, allowed: str) -> None:
+        raise ScenarioError(file, f"{section}.{name}", value, allowed)
+
+    shape = rig_cls.measurement_shape(rig_params)
+    if shape is not None:
+        cls.check_data_shape(full, shape[0], shape[1], fs, n_samples, error)
+    steps, key = cls.simulation_steps(full, n_samples / fs)
+    if key:
+        check_steps(steps, file, f"{section}.{key}", full[key])
+
+
+def _validate_identify(table: Any, file: str, *, kind: str | None = None,
+                       rig_kind_source: str = "the rig") -> dict[str, Any] | None:
+    """``method`` and the given hyperparameters, checked against the identifier's declaration.
+
+    Only the keys given are returned (floats widened), so a scenario's identity does not
+    change when a default does.  With ``kind``, an identifier of another kind is refused.
+    """
+    if table is None:
+        return None
+    if not isinstance(table, dict):
+        raise ScenarioError(file, "identify", table, "expected a table")
+    method = table.get("method")
+    if method is None:
+        raise ScenarioError(file, "identify.method",
+                            allowed="missing; expected one of " + ", ".join(IDENTIFIERS.names()))
+    if not isinstance(method, str) or method not in IDENTIFIERS:
+        raise ScenarioError(file, "identify.method", method,
+                            "expected one of " + ", ".join(IDENTIFIERS.names()))
+    cls = IDENTIFIERS.get(method)
+    if kind is not None and cls.kind != kind:
+        same = [n for n in IDENTIFIERS.names() if IDENTIFIERS.get(n).kind == kind]
+        raise ScenarioError(file, "identify.method", method,
+                            f"a {cls.kind!r} identifier cannot identify {rig_kind_source}, whose "
+                            f"kind is {kind!r}; expected one of " + (", ".join(same) or "(none)"))
+    params = {k: v for k, v in table.items() if k != "method"}
+    declared = cls.declared_hyperparameters()
+    for key, value in params.items():
+        if key not in declared:
+            raise ScenarioError(file, f"identify.{key}", value,
+                                f"unknown hyperparameter of {method}; allowed: "
+                                + ", ".join(sorted(declared)))
+    full = cls.validate_hyperparameters(params, file=file, section="identify")
+    return {"method": method, **{k: full[k] for k in params}}
+
+
+def _validate_score(table: Any, kind: str, file: str) -> dict[str, dict[str, float]]:
+    if not isinstance(table, dict):
+        raise ScenarioError(file, "score", table, "expected a table")
+    names = metric_names(kind)
+    out: dict[str, dict[str, float]] = {}
+    for key, value in table.items():
+        base, _, bound = key.rpartition("_")
+        if bound not in ("min", "max") or base not in names:
+            raise ScenarioError(file, f"score.{key}", value,
+                                "expected <metric>_min or <metric>_max with metric one of "
+                                + ", ".join(sorted(names)))
+        if not isinstance(value, (int, float)) or isinstance(value, bool) \
+                or not math.isfinite(value):
+            raise ScenarioError(file, f"score.{key}", value, "expected a finite number")
+        out.setdefault(base, {})[bound] = float(value)
+    for base, bounds in out.items():
+        if "min" in bounds and "max" in bounds and bounds["min"] > bounds["max"]:
+            raise ScenarioError(file, f"score.{base}_min", bounds["min"],
+                                f"expected at most {base}_max ({bounds['max']:g}): no score "
+                                "could pass")
+    return out
+
+
+def list_scenarios(directory: Path | None = None) -> list[Scenario]:
+    """Every scenario file in ``directory`` (default ``scenarios/``), validated, sorted by name."""
+    directory = directory or SCENARIO_DIR
+    return [load_scenario(p) for p in sorted(Path(directory).glob("*.toml"))]

@@ -1,0 +1,346 @@
+"""The lab's signal chain: from a Dataset's measured signals to a Measurement.
+
+``SIGNAL_SCHEMAS[kind]`` is the schema of a scenario's ``[signal]`` table for a
+rig of that kind; :func:`measure` applies it.  Only ``dataset.measured``, ``dataset.fs``
+and ``dataset.prior`` are read: never the truth or the noise-free reference, so what an
+identifier is handed is what a lab would have.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Mapping
+from typing import Any
+
+import numpy as np
+
+from testbed.core.dataset import Dataset
+from testbed.core.measurement import Measurement
+from testbed.core.schema import Field, validate_table
+from testbed.numerics import derivatives
+from testbed.numerics import filters as sig
+
+#: A sensor within this distance [m] of the impact point receives the force.
+IMPACT_TOLERANCE_M = 1e-3
+#: The force pulse has ended once ``|force|`` falls below this fraction of its peak
+#: (or below 5 robust noise standard deviations, whichever is larger).
+PULSE_END_FRACTION = 1e-6
+MECHANICAL_CHANNELS = ("th1", "th2", "th3", "th4")
+MECHANICAL_INPUTS = ("u1", "u2")
+
+SIGNAL_SCHEMAS: dict[str, dict[str, Field]] = {
+    "structural": {
+        "highpass_hz": Field(float, 10.0, unit="Hz", min=0.0, min_inclusive=False,
+                             doc="cut-off of the zero-phase elliptic high-pass applied after each "
+                                 "integration (removes drift); acceleration, velocity and "
+                                 "displacement all end up filtered alike"),
+        "highpass_order": Field(int, 5, min=1, max=12,
+                                doc="order of the elliptic high-pass; odd orders have a zero at DC "
+                                    "and unit gain at high frequency; even orders pass DC at the "
+                                    "stop-band level and have -ripple_db gain at high frequency"),
+        "ripple_db": Field(float, 0.1, unit="dB", min=0.0, min_inclusive=False,
+                           doc="pass-band ripple of the elliptic filter (the paper: 0.1 dB)"),
+        "stop_db": Field(float, 30.0, unit="dB", min=0.0, min_inclusive=False,
+                         doc="stop-band attenuation of the elliptic filter (the paper: 30 dB)"),
+        "lowpass_hz": Field(float, 0.0, unit="Hz", min=0.0,
+                            doc="optional zero-phase low-pass cut-off; 0 = off"),
+        "lowpass_order": Field(int, 8, min=1, max=16, doc="order of the optional Butterworth low-pass"),
+        "free_margin_s": Field(float, 1e-3, unit="s", min=0.0,
+                               doc="time after the end of the force pulse before the free "
+                                   "vibration is taken to start (covers the filters' smearing)"),
+        "rest_offset": Field(bool, True,
+                             doc="remove the post-pulse mean of each integral (free vibration of a "
+                                 "clamped structure is zero-mean; see integrate_acceleration)"),
+        "filter_force": Field(bool, True,
+                              doc="pass the force through the same filters as the acceleration, "
+                                  "so the equation of motion holds for the filtered signals"),
+    },
+    "mechanical": {
+        "derivatives": Field(str, "recorded", choices=("recorded", "estimated", "lowpass"),
+                             doc="use the recorded joint rates and accelerations, or estimate "
+                                 "them from the measured angles: 'estimated' by a Savitzky-Golay "
+                                 "filter (window, polyorder), 'lowpass' by a zero-phase "
+                                 "Butterworth low-pass and central differences (cutoff_hz, "
+                                 "filter_order, edge_fit_s, edge_fit_order)"),
+        "window": Field(int, 201, min=5, doc="Savitzky-Golay window [samples] for estimated "
+                                             "derivatives (odd)"),
+        "polyorder": Field(int, 4, min=2, max=8, doc="Savitzky-Golay polynomial order"),
+        "cutoff_hz": Field(float, 4.0, unit="Hz", min=0.0, min_inclusive=False,
+                           doc="'lowpass': -3 dB frequency of one pass of the zero-phase "
+                               "Butterworth; just above the band of the motion (noise in the "
+                               "acceleration grows as cutoff^2.5)"),
+        "filter_order": Field(int, 8, min=1, max=16,
+                              doc="'lowpass': Butterworth order of one pass"),
+        "edge_fit_s": Field(float, 0.1, unit="s", min=0.0, min_inclusive=False,
+                            doc="'lowpass': length of the end windows whose polynomial fits "
+                                "anchor the record's ends (value, rate, acceleration)"),
+        "edge_fit_order": Field(int, 5, min=2, max=8,
+                                doc="'lowpass': order of the end-window polynomial fits"),
+    },
+}
+
+
+def _filter_min_samples(order: int) -> int:
+    """Fewest samples a zero-phase filter of this order (one pass) accepts: its second-order
+    sections ``ceil(order / 2)`` set scipy's default padding, ``3 (2 n_sections + 1)``, and
+    ``sosfiltfilt`` needs more samples than that (see :func:`testbed.numerics.filters._filtfilt`)."""
+    return 3 * (2 * math.ceil(order / 2) + 1) + 1
+
+
+def check_signal(kind: str, cfg: Mapping[str, Any], fs: float, n_samples: int,
+                 error: Callable[[str, Any, str], None]) -> None:
+    """Cross-key checks of a validated ``[signal]`` table against the record it will process.
+
+    Parameters
+    ----------
+    kind : {"structural", "mechanical"}
+    cfg : mapping
+        A validated ``SIGNAL_SCHEMAS[kind]`` table.
+    fs : float
+        Sample rate of the record [Hz].
+    n_samples : int
+        Samples in the record.
+    error : callable
+        ``error(key, value, allowed)``, called on the first problem (it raises).
+
+    Notes
+    -----
+    Checked: cut-offs strictly below the Nyquist frequency ``fs / 2`` (a digital filter cannot
+    be designed at or above it), a high-pass below the low-pass, pass-band ripple below the
+    stop-band attenuation, records long enough for every zero-phase filter and polynomial
+    window, odd Savitzky-Golay windows with ``polyorder < window``, and margins shorter than
+    the record.
+    """
+    nyq = fs / 2.0
+    duration = n_samples / fs
+
+    def below_nyquist(key: str) -> None:
+        if not cfg[key] < nyq:
+            error(f"signal.{key}", cfg[key], f"expected below the Nyquist frequency {nyq:g} Hz "
+                                             f"(sample rate {fs:g} Hz)")
+
+    def long_enough(key: str, order: int) -> None:
+        need = _filter_min_samples(order)
+        if n_samples < need:
+            error(f"signal.{key}", cfg[key], f"the record has {n_samples} samples; a zero-phase "
+                                             f"filter of order {order} needs at least {need}")
+
+    if kind == "structural":
+        below_nyquist("highpass_hz")
+        long_enough("highpass_order", cfg["highpass_order"])
+        if cfg["lowpass_hz"] > 0:
+            below_nyquist("lowpass_hz")
+            long_enough("lowpass_order", cfg["lowpass_order"])
+            if not cfg["highpass_hz"] < cfg["lowpass_hz"]:
+                error("signal.highpass_hz", cfg["highpass_hz"],
+                      f"expected below lowpass_hz ({cfg['lowpass_hz']:g} Hz): the pass band "
+                      "would be empty")
+        if not cfg["ripple_db"] < cfg["stop_db"]:
+            error("signal.ripple_db", cfg["ripple_db"],
+                  f"expected below stop_db ({cfg['stop_db']:g} dB)")
+        if not cfg["free_margin_s"] < duration:
+            error("signal.free_margin_s", cfg["free_margin_s"],
+                  f"expected shorter than the record ({duration:g} s)")
+        return
+    if kind != "mechanical":
+        return
+    if cfg["window"] % 2 == 0:
+        error("signal.window", cfg["window"], "expected an odd number of samples")
+    if not cfg["polyorder"] < cfg["window"]:
+        error("signal.polyorder", cfg["polyorder"], f"expected below window ({cfg['window']})")
+    if cfg["derivatives"] == "estimated" and cfg["window"] > n_samples:
+        error("signal.window", cfg["window"], f"expected at most the record's {n_samples} samples")
+    if cfg["derivatives"] == "lowpass":
+        below_nyquist("cutoff_hz")
+        long_enough("filter_order", cfg["filter_order"])
+        n_fit = round(cfg["edge_fit_s"] * fs)
+        if not cfg["edge_fit_order"] < n_fit <= n_samples:
+            error("signal.edge_fit_s", cfg["edge_fit_s"],
+                  f"the end windows of {n_fit} samples must be longer than edge_fit_order "
+                  f"({cfg['edge_fit_order']}) and at most the record ({n_samples} samples, "
+                  f"{duration:g} s)")
+
+
+def measure(dataset: Dataset, signal_cfg: Mapping[str, Any], kind: str) -> Measurement:
+    """Run the lab's signal chain on a dataset's measured signals.
+
+    Parameters
+    ----------
+    dataset : Dataset
+        Only ``measured``, ``fs`` and ``prior`` are read.
+    signal_cfg : mapping
+        The scenario's ``[signal]`` table for this kind; missing keys take the defaults of
+        ``SIGNAL_SCHEMAS[kind]``, unknown keys or bad values raise ScenarioError.
+    kind : {"structural", "mechanical"}
+        The rig kind.
+
+    Returns
+    -------
+    Measurement
+        See :func:`measure_structural` and :func:`measure_mechanical`.
+    """
+    if kind not in SIGNAL_SCHEMAS:
+        raise ValueError(f"unknown rig kind {kind!r}; expected one of {', '.join(SIGNAL_SCHEMAS)}")
+    cfg = validate_table(dict(signal_cfg), SIGNAL_SCHEMAS[kind], file="<signal config>",
+                         section="signal")
+    if kind == "structural":
+        return measure_structural(dataset, cfg)
+    return measure_mechanical(dataset, cfg)
+
+
+def _get(dataset: Dataset, name: str, rows: int | None = None) -> np.ndarray:
+    if name not in dataset.measured:
+        raise ValueError(f"dataset has no measured signal {name!r} (has {', '.join(dataset.measured)})")
+    data = np.array(dataset.measured[name].data, dtype=float)
+    if rows is not None and data.shape[0] != rows:
+        raise ValueError(f"measured {name!r} has {data.shape[0]} channels, expected {rows}")
+    return data
+
+
+def pulse_end(force: np.ndarray) -> int:
+    """Index of the first sample after the force pulse.
+
+    Parameters
+    ----------
+    force : ndarray, shape (n_inputs, n_samples)
+        Measured force [N].
+
+    Returns
+    -------
+    int
+        First sample after the peak of ``max_j |force_j|`` at which the magnitude falls below
+        ``max(PULSE_END_FRACTION * peak, 5 sigma)``, sigma a robust (median absolute deviation)
+        estimate of the force noise (0 for a noise-free record, whose samples are mostly exact
+        zeros); 0 for an all-zero force, ``n_samples`` if the force never falls back.  Only
+        the contiguous run of above-threshold samples from the peak on counts as the pulse, so
+        a later noise spike does not postpone the end.
+    """
+    mag = np.max(np.abs(np.atleast_2d(force)), axis=0)
+    peak = mag.max(initial=0.0)
+    if peak == 0:
+        return 0
+    sigma = 1.4826 * np.median(np.abs(mag - np.median(mag)))
+    above = mag > max(PULSE_END_FRACTION * peak, 5.0 * sigma)
+    k = int(np.argmax(mag))
+    below = np.flatnonzero(~above[k:])
+    return len(mag) if below.size == 0 else k + int(below[0])
+
+
+def measure_structural(dataset: Dataset, cfg: Mapping[str, Any]) -> Measurement:
+    """Accelerations and impact force to sensor displacements, velocities and accelerations.
+
+    Parameters
+    ----------
+    dataset : Dataset
+        Measured ``"acceleration"`` (n_sensors x n [m/s^2], ``positions`` = sensor positions
+        [m]) and ``"force"`` (1 x n [N], ``positions`` = impact location [m]).
+    cfg : mapping
+        A validated ``SIGNAL_SCHEMAS["structural"]`` table.
+
+    Returns
+    -------
+    Measurement
+        ``x`` displacement [m], ``xd`` velocity [m/s], ``xdd`` acceleration [m/s^2] per sensor,
+        all through the same filters (optional Butterworth low-pass, then the elliptic
+        high-pass twice; see :func:`testbed.numerics.filters.integrate_acceleration`); ``u`` the force
+        [N] (through the same filters if ``filter_force``); ``input_map`` (n_sensors x 1) with
+        1 at the sensor within ``IMPACT_TOLERANCE_M`` of the impact; ``free_start`` the
+        first sample ``free_margin_s`` after the end of the raw force pulse; ``prior`` a copy
+        of ``dataset.prior``.
+
+    Notes
+    -----
+    With ``filter_force`` the equation of motion ``M xdd + C xd + K x = B u`` holds for the
+    filtered signals as it does for the raw ones (every filter is linear and time-invariant
+    and all signals get the same one).  After ``free_start`` the raw force is zero but the
+    filtered ``u`` is not: it carries the high-pass's response to the pulse, a tail lasting a
+    few ``1 / highpass_hz``.  An identifier fitting the "free" decay should keep ``u`` in
+    its regression (or start later); dropping it biases damping most.
+
+    Raises
+    ------
+    ValueError
+        If no sensor lies within 1 mm of the impact.  A model in sensor coordinates cannot
+        place a force between sensors, and spreading it (e.g. by shape functions) would be a
+        modelling choice the identifier should make, not the signal chain.
+    """
+    acc_sig = dataset.measured.get("acceleration")
+    acc = _get(dataset, "acceleration")
+    force = _get(dataset, "force")
+    fs = float(dataset.fs)
+    n_sensors = acc.shape[0]
+    if force.shape[1] != acc.shape[1]:
+        raise ValueError(f"force has {force.shape[1]} samples, acceleration {acc.shape[1]}")
+
+    input_map = np.zeros((n_sensors, force.shape[0]))
+    f_sig = dataset.measured["force"]
+    if acc_sig.positions is None or f_sig.positions is None:
+        raise ValueError("structural data need sensor positions and the impact position "
+                         "(Signal.positions of 'acceleration' and 'force')")
+    sensors = np.asarray(acc_sig.positions, dtype=float).ravel()
+    for j, p in enumerate(np.asarray(f_sig.positions, dtype=float).ravel()[:force.shape[0]]):
+        dist = np.abs(sensors - p)
+        i = int(np.argmin(dist))
+        if dist[i] > IMPACT_TOLERANCE_M:
+            raise ValueError(f"impact at {p:g} m is {dist[i] * 1e3:.3g} mm from the nearest sensor "
+                             f"(at {sensors[i]:g} m); it must lie within "
+                             f"{IMPACT_TOLERANCE_M * 1e3:g} mm of a sensor")
+        input_map[i, j] = 1.0
+
+    def chain_lowpass(z: np.ndarray) -> np.ndarray:
+        if cfg["lowpass_hz"] > 0:
+            return sig.lowpass(z, fs, cfg["lowpass_hz"], cfg["lowpass_order"])
+        return z
+
+    hp_args = (cfg["highpass_hz"], cfg["highpass_order"], cfg["ripple_db"], cfg["stop_db"])
+    end = pulse_end(force)
+    rest_from = end if (cfg["rest_offset"] and end > 0) else None
+    xdd, xd, x = sig.integrate_acceleration(chain_lowpass(acc), fs, *hp_args, rest_from=rest_from)
+    u = force
+    if cfg["filter_force"]:
+        u = chain_lowpass(force)
+        for _ in range(2):
+            u = sig.elliptic_highpass(u, fs, *hp_args)
+
+    free_start = 0 if end == 0 else min(acc.shape[1], end + int(np.ceil(cfg["free_margin_s"] * fs)))
+    return Measurement(fs=fs, x=x, xd=xd, xdd=xdd, channels=tuple(acc_sig.channels), u=u,
+                       inputs=tuple(f_sig.channels), input_map=input_map,
+                       prior=dict(dataset.prior), free_start=free_start)
+
+
+def measure_mechanical(dataset: Dataset, cfg: Mapping[str, Any]) -> Measurement:
+    """Joint angles, rates and accelerations, and the two actuator torques.
+
+    Parameters
+    ----------
+    dataset : Dataset
+        Measured ``"theta"`` (4 x n [rad]), ``"dtheta"`` [rad/s], ``"ddtheta"`` [rad/s^2] and
+        ``"torque"`` (2 x n [N m], channels u1, u2).
+    cfg : mapping
+        A validated ``SIGNAL_SCHEMAS["mechanical"]`` table.  ``derivatives = "recorded"``
+        uses the recorded rates; ``"estimated"`` smooths and differentiates the angles with a
+        Savitzky-Golay filter (``window``, ``polyorder``; :func:`testbed.numerics.derivatives.differentiate`),
+        ``"lowpass"`` with a zero-phase Butterworth low-pass and central differences
+        (``cutoff_hz``, ``filter_order``, ``edge_fit_s``, ``edge_fit_order``;
+        :func:`testbed.numerics.derivatives.lowpass_differentiate`); both ignore the recorded rates.
+
+    Returns
+    -------
+    Measurement
+        Channels th1..th4, inputs u1, u2, ``input_map`` (4 x 2) mapping u1 to th1 and u2 to
+        th4, ``free_start`` 0 (the input is continuous), ``prior`` a copy of the dataset's.
+    """
+    fs = float(dataset.fs)
+    theta = _get(dataset, "theta", 4)
+    torque = _get(dataset, "torque", 2)
+    if cfg["derivatives"] == "recorded":
+        x, xd, xdd = theta, _get(dataset, "dtheta", 4), _get(dataset, "ddtheta", 4)
+    elif cfg["derivatives"] == "lowpass":
+        x, xd, xdd = derivatives.lowpass_differentiate(theta, fs, cfg["cutoff_hz"], cfg["filter_order"],
+                                               cfg["edge_fit_s"], cfg["edge_fit_order"])
+    else:
+        x, xd, xdd = derivatives.differentiate(theta, fs, cfg["window"], cfg["polyorder"])
+    input_map = np.zeros((4, 2))
+    input_map[0, 0] = input_map[3, 1] = 1.0
+    return Measurement(fs=fs, x=x, xd=xd, xdd=xdd, channels=MECHANICAL_CHANNELS, u=torque,
+                       inputs=MECHANICAL_INPUTS, input_map=input_map, prior=dict(dataset.prior))

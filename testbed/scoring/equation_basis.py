@@ -1,0 +1,247 @@
+"""Implicit equations compared modulo the identities of the data (canonical basis).
+
+On a closed kinematic loop the library columns obey exact linear identities (the loop
+constraint and its time derivatives times trig factors), so an implicit equation
+``sum_c coef_c Theta_c = 0`` has many exactly equivalent forms: adding any identity changes the
+coefficients, not the equation.  Scoring raw coefficients against one form of the truth would
+penalise an exact identification.  This module puts every equation in one canonical form:
+
+1. Evaluate the columns (the identifier's library, in its order, then any true term the
+   library lacks) on the NOISE-FREE reference signals.  Only the scorer does this: it may
+   use truth and reference, an identifier may not.
+2. Walk the input-free columns in library order (ordered pivoted Cholesky of the unit-diagonal
+   Gram matrix, the rule of ``SINDyPI(prune_tol=...)``): a column whose residual variance after
+   projection on the earlier kept ones is at most :data:`DEPENDENCE_TOL` is *dependent* and
+   dropped (later columns go, earlier ones stay).  Columns with an input are never dropped: the
+   inputs are free signals, so no kinematic identity contains them.
+3. Express each dropped column in the kept ones (unique: the kept columns are independent) and
+   substitute it in an equation: ``c_K <- c_K + beta c_P``.  The result is the unique
+   representative of the equation's class modulo the identities.
+
+Two equations are equal on the loop manifold iff their canonical forms are equal, so a wrong
+equation still scores badly; only the arbitrary choice among equivalent forms is removed.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from itertools import permutations
+
+import numpy as np
+
+from testbed.numerics.gram import normalized_gram, ordered_independent
+from testbed.scoring import metrics
+
+#: Residual variance (of a unit-norm column, after projection on the earlier kept columns)
+#: at or below which a column counts as an exact combination of them.  Exact identities on the
+#: five-bar records leave 1e-19..1e-15 (Gram round-off, ~p eps, and the RK4 error of the
+#: record); the smallest genuine direction measured is 4.5e-6 (multisine, 32-term library).
+#: 1e-10 sits four to five decades from both (the identifier's default prune_tol, 1e-9, lies
+#: in the same gap, so both rules agree on noise-free data).
+DEPENDENCE_TOL = 1e-10
+#: A canonical coefficient below this fraction of its row's largest counts as zero: the
+#: substitution leaves ~1e-11 of round-off where identities cancel exactly, while the
+#: smallest physical coefficient of the five-bar (joint damping 1e-3 N m s/rad) is 5e-4.
+ZERO_RTOL = 1e-8
+
+_TRIG = re.compile(r"^(sin|cos)\(th(\d+)(?:-th(\d+))?\)$")
+_VAR = re.compile(r"^(ddth|dth|th|u)(\d+)$")
+_INPUT = re.compile(r"(^|\*)u\d+(\^\d+)?($|\*)")
+
+
+def evaluate_terms(names: Sequence[str], signals: Mapping[str, np.ndarray]) -> np.ndarray:
+    """Evaluate product terms (:mod:`testbed.core.terms` syntax) on samples.
+
+    An implementation independent of the identifiers' library code, so that the scorer checks
+    it rather than trusting it.
+
+    Parameters
+    ----------
+    names : sequence of str
+        Terms such as ``"cos(th1-th2)*sin(th2-th3)*ddth2"``, ``"sin(th1-th2)*dth2^2"``, ``"u1"``.
+    signals : mapping
+        ``"th"``, ``"dth"``, ``"ddth"`` (n_coords, n) [rad, rad/s, rad/s^2], ``"u"`` (m, n).
+
+    Returns
+    -------
+    ndarray, shape (n, len(names))
+    """
+    n = np.shape(signals["th"])[1]
+    cache: dict[str, np.ndarray] = {}
+
+    def factor(f: str) -> np.ndarray:
+        if f not in cache:
+            mt, mv = _TRIG.match(f), _VAR.match(f)
+            if mt:
+                fn, i, j = mt.groups()
+                arg = signals["th"][int(i) - 1] - (signals["th"][int(j) - 1] if j else 0.0)
+                cache[f] = np.sin(arg) if fn == "sin" else np.cos(arg)
+            elif mv:
+                cache[f] = np.asarray(signals[mv.group(1)][int(mv.group(2)) - 1], dtype=float)
+            else:
+                raise ValueError(f"cannot evaluate factor {f!r}")
+        return cache[f]
+
+    out = np.empty((len(names), n))
+    for c, name in enumerate(names):
+        col = np.ones(n)
+        if name != "1":
+            for raw in name.split("*"):
+                base, _, power = raw.partition("^")
+                col = col * factor(base) ** (int(power) if power else 1)
+        out[c] = col
+    return out.T
+
+
+def has_input(name: str) -> bool:
+    """Whether a term has an input factor ``u<k>``."""
+    return _INPUT.search(name) is not None
+
+
+@dataclass
+class CanonicalBasis:
+    """Kept and dependent columns of a library on given data, and the substitution.
+
+    Attributes
+    ----------
+    names : list of str
+        All columns, in priority order.
+    kept, dependent : ndarray of int
+        Indices of the kept (independent) and the dropped (dependent) columns.
+    beta : ndarray, shape (len(kept), len(dependent))
+        ``Theta[:, dependent] = Theta[:, kept] @ beta`` on the data (original units).
+    residual : ndarray, shape (len(dependent),)
+        Residual variance of each dropped unit-norm column (<= tol): how exact the identity is.
+    """
+
+    names: list[str]
+    kept: np.ndarray
+    dependent: np.ndarray
+    beta: np.ndarray
+    residual: np.ndarray
+
+    @classmethod
+    def from_data(cls, names: Sequence[str], Theta: np.ndarray,
+                  tol: float = DEPENDENCE_TOL) -> CanonicalBasis:
+        """Find the identities of ``Theta`` (n_samples, p) and the canonical basis (see module)."""
+        names = list(names)
+        G = np.ascontiguousarray(Theta.T) @ Theta
+        Gn, s = normalized_gram(G)
+        protected = np.array([has_input(nm) for nm in names], dtype=bool)
+        kept_free, dep, res = ordered_independent(Gn, np.flatnonzero(~protected), tol)
+        kept = np.sort(np.r_[np.flatnonzero(protected), kept_free].astype(np.intp))
+        dependent = np.array(dep, dtype=np.intp)
+        beta = np.zeros((kept.size, dependent.size))
+        if dependent.size:
+            kf = np.array(kept_free, dtype=np.intp)
+            Bn = np.linalg.solve(Gn[np.ix_(kf, kf)], Gn[np.ix_(kf, dependent)])
+            beta[np.searchsorted(kept, kf)] = Bn * s[dependent][None, :] / s[kf][:, None]
+        return cls(names, kept, dependent, beta, np.array(res))
+
+    def reduce(self, coef: np.ndarray) -> np.ndarray:
+        """Canonical form of equations ``coef`` (n_eq, p) over ``names``: (n_eq, len(kept))."""
+        coef = np.atleast_2d(np.asarray(coef, dtype=float))
+        return coef[:, self.kept] + coef[:, self.dependent] @ self.beta.T
+
+    @property
+    def kept_names(self) -> list[str]:
+        return [self.names[i] for i in self.kept]
+
+    @property
+    def dependent_names(self) -> list[str]:
+        return [self.names[i] for i in self.dependent]
+
+
+def _on(names: Sequence[str], coef: np.ndarray, basis_names: Sequence[str]) -> np.ndarray:
+    """Coefficient rows over ``names`` placed on the columns ``basis_names`` (by name)."""
+    pos = {n: i for i, n in enumerate(basis_names)}
+    coef = np.atleast_2d(np.asarray(coef, dtype=float))
+    out = np.zeros((coef.shape[0], len(basis_names)))
+    for j, n in enumerate(names):
+        out[:, pos[n]] += coef[:, j]
+    return out
+
+
+def _zeroed(C: np.ndarray) -> np.ndarray:
+    big = np.abs(C).max(axis=1, keepdims=True)
+    return np.where(np.abs(C) > ZERO_RTOL * big, C, 0.0)
+
+
+def compare_equations(id_names: Sequence[str], id_coef: np.ndarray, true_names: Sequence[str],
+                      true_coef: np.ndarray, signals: Mapping[str, np.ndarray],
+                      tol: float = DEPENDENCE_TOL) -> dict:
+    """Support and coefficient scores of identified vs true implicit equations, modulo identities.
+
+    Parameters
+    ----------
+    id_names, id_coef : sequence of str, ndarray (n_id, len(id_names))
+        The identifier's library (in its priority order) and its equations.
+    true_names, true_coef : sequence of str, ndarray (n_true, len(true_names))
+        The true equations.
+    signals : mapping
+        Noise-free reference signals for :func:`evaluate_terms`.
+    tol : float
+        Dependence tolerance (:data:`DEPENDENCE_TOL`).
+
+    Returns
+    -------
+    dict
+        ``coef_error``: largest relative error ``|c_id - c_true| / |c_true|`` over the
+        canonical true terms of every equation (``coef_errors`` per true row);
+        ``coef_error_norm``: largest
+        ``||c_id - c_true|| / ||c_true||`` over all canonical terms (extra terms included);
+        ``precision``, ``recall``, ``f1`` of the canonical nonzero patterns (an entry is
+        nonzero above ``ZERO_RTOL`` of its row's largest); ``names`` (canonical basis),
+        ``coef_id``, ``coef_true`` (canonical rows, identified rows paired to the true rows
+        and both divided by their coefficient on the true row's largest term), ``pairing``,
+        ``dependent`` (dropped column names), ``truth_residual`` (relative residual of the
+        canonical truth on the data: the substitution's accuracy).
+
+    Notes
+    -----
+    Rows are paired by the permutation with the smallest total ``coef_error_norm``.  A row
+    whose identified coefficient on the true lead term is zero has infinite error.
+    """
+    id_names = list(id_names)
+    extra = [n for n in true_names if n not in set(id_names)]  # true terms the library lacks
+    names = id_names + extra
+    Theta = evaluate_terms(names, signals)
+    basis = CanonicalBasis.from_data(names, Theta, tol)
+    T = _zeroed(basis.reduce(_on(true_names, true_coef, names)))
+    Id = _zeroed(basis.reduce(_on(id_names, id_coef, names)))
+    Tk = Theta[:, basis.kept]
+    tr_res = [float(np.abs(Tk @ row).max() / max(np.abs(Tk * row).sum(axis=1).max(), 1e-300))
+              for row in T]
+
+    def row_errors(i_row: np.ndarray, t_row: np.ndarray) -> tuple[float, float, np.ndarray]:
+        lead = int(np.argmax(np.abs(t_row)))
+        if i_row[lead] == 0:
+            return np.inf, np.inf, np.full_like(i_row, np.nan)
+        a, b = i_row / i_row[lead], t_row / t_row[lead]
+        return metrics.coefficient_error(a, b), metrics.relative_error(a, b), a
+
+    best = None
+    for perm in permutations(range(Id.shape[0]), T.shape[0]):
+        errs = [row_errors(Id[k], T[j]) for j, k in enumerate(perm)]
+        # A NaN row error (non-finite identified coefficients) makes the pairing worst of all,
+        # never unbeatable: ``total < nan`` is always False, so NaN is ranked as +inf here.
+        total = float(np.sum([e[1] for e in errs]))
+        total = np.inf if np.isnan(total) else total
+        if best is None or total < best[0]:
+            best = (total, perm, errs)
+    if best is None:
+        raise ValueError(f"{Id.shape[0]} identified equations for {T.shape[0]} true ones")
+    _, perm, errs = best
+    Ip = Id[list(perm)]
+    sup = metrics.support_scores(Ip, T)
+    lead = np.argmax(np.abs(T), axis=1)
+    return {"coef_error": metrics.worst([e[0] for e in errs], "max"),
+            "coef_error_norm": metrics.worst([e[1] for e in errs], "max"),
+            "coef_errors": np.array([e[0] for e in errs]),
+            "precision": float(sup["precision"]), "recall": float(sup["recall"]),
+            "f1": float(sup["f1"]), "names": basis.kept_names,
+            "coef_true": T / T[np.arange(T.shape[0]), lead][:, None],
+            "coef_id": np.array([e[2] for e in errs]), "pairing": list(perm),
+            "dependent": basis.dependent_names, "truth_residual": np.array(tr_res)}

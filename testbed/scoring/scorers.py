@@ -1,0 +1,448 @@
+"""Scores of an identified model against the truth, per rig kind.
+
+``METRICS[kind]`` names every score a run of that kind reports (and that a
+scenario's ``[score]`` table may threshold as ``<name>_min`` / ``<name>_max``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from testbed.core.dataset import Dataset
+from testbed.core.errors import DivergenceError, IdentificationError
+from testbed.core.kinds import METRICS
+from testbed.core.measurement import Measurement, Trajectory
+from testbed.scoring import metrics
+from testbed.scoring.equation_basis import compare_equations
+from testbed.scoring.metrics import worst
+
+#: Modes whose MAC, frequency and damping are scored (the paper scores modes 1-2;
+#: mode 3 of a 3-sensor cantilever sits near 1.45 kHz and is barely excited by the impact).
+SCORED_MODES = 2
+
+# --------------------------------------------------------------------------- physical checks
+#: Relative asymmetry ``|M - M^T|`` (entrywise, against ``max|M|``) above which an identified
+#: mass matrix is not symmetric: the identifiers that impose symmetry do so by construction,
+#: leaving round-off of ~1e-16 of the largest entry; 1e-10 is six decades above it (the same
+#: rule :func:`testbed.scoring.metrics.modal_from_matrices` applies).
+SYMMETRY_RTOL = 1e-10
+#: Smallest eigenvalue of the (symmetric) identified mass matrix, relative to its largest,
+#: below which M is not positive definite.  ``eigvalsh`` resolves eigenvalues to ~n eps ||M||
+#: (~1e-15 relative for these <= 10-DOF models); a mass matrix conditioned beyond 1e12 is
+#: numerically singular anyway (``M^-1 K`` keeps no digit), so 1e-12 separates both.
+MASS_PD_RTOL = 1e-12
+#: Negative damping: smallest eigenvalue of ``(C + C^T) / 2`` below ``-DAMPING_RTOL`` times its
+#: largest magnitude (a velocity direction along which the damper does positive work, i.e.
+#: feeds energy into a passive structure).  Eigenvalue round-off is ~n eps ||C|| (~1e-15
+#: relative); 1e-9 is six decades above it, so only an identified sign counts, not rounding.
+#: Applied when M and K are symmetric (:data:`SYMMETRY_RTOL`): only then is
+#: ``E = x'^T M x' / 2 + x^T K x / 2`` an energy with ``dE/dt = -x'^T C x'`` (free motion), so
+#: the symmetric part of C is a dissipation.  A model with a non-symmetric K (e.g. least-squares
+#: SINDy in sensor coordinates) has no such energy, and its C is judged by what it does: its
+#: damping ratios (:data:`ZETA_TOL`) and poles (:data:`STABILITY_RTOL`).
+DAMPING_RTOL = 1e-9
+#: Identified damping ratios below ``-ZETA_TOL`` [-] are negative damping.  A ratio comes from
+#: eigenvalues resolved to ~eps |lambda|_max, i.e. to ~1e-15 x (highest / lowest natural
+#: frequency) <= 1e-12 for the rigs' modes; 1e-9 is three decades above that.
+ZETA_TOL = 1e-9
+#: A pole of the first-order system ``[[0, I], [-M^-1 K, -M^-1 C]]`` with real part above
+#: ``STABILITY_RTOL * max|lambda|`` [1/s] is unstable (a mode grows).  The poles of an
+#: undamped but stable model sit on the imaginary axis up to round-off of ~eps |lambda|_max
+#: times the eigenvector condition (<= 1e3 here): ~1e-13; 1e-9 is four decades above it.
+STABILITY_RTOL = 1e-9
+#: A simulated signal whose magnitude exceeds this multiple of the largest magnitude of its
+#: reference has blown up (a divergence, scored with its time), even while still finite.
+#: It is a declaration, not a measurement: a response a thousand times larger than anything
+#: in the record reproduces nothing of it, and any model that still tracks the record (amplitude
+#: errors of a factor of a few) stays three decades below the cut.
+BLOWUP_FACTOR = 1e3
+
+#: Verdicts of a run (:func:`verdict`).
+PASS, FAIL, NO_VERDICT = "pass", "FAIL", "no verdict"
+
+
+@dataclass
+class Check:
+    """One threshold of a scenario's ``[score]`` table against a measured score."""
+
+    metric: str
+    value: float
+    bound: str  # "min" or "max"
+    threshold: float
+
+    @property
+    def passed(self) -> bool:
+        if not np.isfinite(self.value):
+            return False
+        return self.value >= self.threshold if self.bound == "min" else self.value <= self.threshold
+
+
+@dataclass
+class Scores:
+    """Scalar scores (names in :data:`METRICS`) plus the arrays behind them for figures.
+
+    Attributes
+    ----------
+    values : dict of str to float
+        The scores; NaN where a score could not be computed (never a pass).
+    details : dict
+        Arrays behind the scores.
+    failures : dict of str to str
+        Why the identified model fails whatever its scores, by aspect: ``"fit"`` (the fit
+        raised), ``"simulation"`` (diverged, blew up, or lost its loop closure; with the time
+        where known), ``"mass"`` (M not symmetric positive definite), ``"damping"`` (negative
+        damping), ``"stability"`` (a pole in the right half-plane), ``"model"`` (non-finite
+        learned values).  Empty for a physically admissible model whose simulation ran.
+    """
+
+    values: dict[str, float]
+    details: dict[str, Any] = field(default_factory=dict)
+    failures: dict[str, str] = field(default_factory=dict)
+
+    @property
+    def failure(self) -> str | None:
+        """The failure reasons as one line, or None."""
+        return "; ".join(self.failures.values()) if self.failures else None
+
+
+def verdict(checks: list[Check], failures: dict[str, str] | None = None) -> str:
+    """The verdict of a run: :data:`FAIL`, :data:`NO_VERDICT` or :data:`PASS`.
+
+    A scored failure (``failures``) or any failed check is :data:`FAIL`; otherwise a run with
+    no thresholds has :data:`NO_VERDICT` (nothing was asked of it, so it did not pass); only
+    thresholds all met give :data:`PASS`.
+    """
+    if failures or any(not c.passed for c in checks):
+        return FAIL
+    return PASS if checks else NO_VERDICT
+
+
+def check_thresholds(values: dict[str, float], thresholds: dict[str, dict[str, float]]) -> list[Check]:
+    """Compare scores with ``{metric: {"min"|"max": threshold}}``; a missing score fails."""
+    return [Check(m, float(values.get(m, np.nan)), b, t)
+            for m, bounds in sorted(thresholds.items()) for b, t in sorted(bounds.items())]
+
+
+def failed_scores(kind: str, reason: str, key: str = "fit") -> Scores:
+    """Scores of a run whose model could not be scored at all: every score NaN, one failure."""
+    return Scores({m: float("nan") for m in METRICS[kind]}, {}, {key: reason})
+
+
+def physical_failures(M: np.ndarray, C: np.ndarray, K: np.ndarray) -> dict[str, str]:
+    """What makes a structural model ``M x'' + C x' + K x = f`` physically impossible.
+
+    Parameters
+    ----------
+    M, C, K : ndarray, shape (n, n)
+        Identified mass [kg], damping [N s/m] and stiffness [N/m] matrices.
+
+    Returns
+    -------
+    dict of str to str
+        ``"model"``: non-finite entries; ``"mass"``: M not symmetric (:data:`SYMMETRY_RTOL`)
+        or not positive definite (:data:`MASS_PD_RTOL`); ``"damping"``: a negative
+        eigenvalue of the symmetric part of C when M and K are symmetric (:data:`DAMPING_RTOL`
+        says why only then) or a negative damping ratio (:data:`ZETA_TOL`); ``"stability"``:
+        a pole with positive real part (:data:`STABILITY_RTOL`), the fastest growth rate
+        [1/s] given.  Empty if none.
+    """
+    M, C, K = (np.asarray(a, dtype=float) for a in (M, C, K))
+    if not all(np.all(np.isfinite(a)) for a in (M, C, K)):
+        return {"model": "non-physical: M, C or K holds non-finite entries"}
+    out: dict[str, str] = {}
+    scale = np.abs(M).max()
+    if np.abs(M - M.T).max() > SYMMETRY_RTOL * scale:
+        out["mass"] = (f"non-physical: identified M is not symmetric (|M - M^T| = "
+                       f"{np.abs(M - M.T).max():.3g} of max|M| {scale:.3g})")
+    else:
+        lm = np.linalg.eigvalsh(0.5 * (M + M.T))
+        if not lm[0] > MASS_PD_RTOL * abs(lm[-1]):
+            out["mass"] = (f"non-physical: identified M is not positive definite (eigenvalues "
+                           f"{lm[0]:.3g} .. {lm[-1]:.3g} kg)")
+    damping = []
+    k_sym = np.abs(K - K.T).max() <= SYMMETRY_RTOL * np.abs(K).max()
+    lc = np.linalg.eigvalsh(0.5 * (C + C.T))
+    if "mass" not in out and k_sym and lc.size and lc[0] < -DAMPING_RTOL * np.abs(lc).max():
+        damping.append(f"symmetric part of C has eigenvalue {lc[0]:.3g} N s/m")
+    if "mass" not in out:
+        _, zeta, _ = metrics.modal_from_matrices(M, C, K, strict=False)
+        neg = zeta[np.isfinite(zeta) & (zeta < -ZETA_TOL)]
+        if neg.size:
+            damping.append(f"identified damping ratio {neg.min():.3g}")
+        n = M.shape[0]
+        A = np.block([[np.zeros((n, n)), np.eye(n)],
+                      [-np.linalg.solve(M, K), -np.linalg.solve(M, C)]])
+        lam = np.linalg.eigvals(A)
+        growth = float(lam.real.max())
+        if growth > STABILITY_RTOL * np.abs(lam).max():
+            out["stability"] = (f"unstable: pole with real part {growth:+.4g} 1/s "
+                                f"(a mode grows as exp({growth:.3g} t))")
+    if damping:
+        out["damping"] = f"non-physical: negative damping ({', '.join(damping)})"
+    return out
+
+
+def divergence(t: np.ndarray, y: np.ndarray, ref: np.ndarray | None = None) -> tuple[str, float] | None:
+    """Where a simulated signal stops being a response: non-finite or blown up.
+
+    Parameters
+    ----------
+    t : ndarray, shape (n_samples,)
+        Times [s].
+    y : ndarray, shape (n_channels, n_samples)
+        Simulated signal.
+    ref : ndarray, shape (n_channels, n_samples), optional
+        Its reference; ``|y| > BLOWUP_FACTOR * max|ref|`` counts as a blow-up.
+
+    Returns
+    -------
+    (reason, time [s]) or None
+        The first offending sample's time.
+    """
+    y = np.atleast_2d(np.asarray(y, dtype=float))
+    bad = ~np.isfinite(y).all(axis=0)
+    what = "non-finite"
+    if ref is not None:
+        lim = BLOWUP_FACTOR * float(np.max(np.abs(ref))) if np.size(ref) else np.inf
+        with np.errstate(invalid="ignore"):
+            big = (np.abs(y) > lim).any(axis=0) & ~bad
+        if big.any() and (not bad.any() or np.argmax(big) < np.argmax(bad)):
+            bad, what = big, f"blew up (beyond {BLOWUP_FACTOR:g} x the reference's largest value)"
+    if not bad.any():
+        return None
+    k = int(np.argmax(bad))
+    return f"{what} simulation", float(t[k])
+
+
+def simulate_scored(sim: Callable[[], Trajectory], t: np.ndarray, check: str,
+                    ref: np.ndarray) -> tuple[Trajectory | None, str | None, float]:
+    """Run an identified model's simulation; a failure is returned, not raised.
+
+    Parameters
+    ----------
+    sim : callable
+        ``model.simulate`` with its arguments bound.
+    t : ndarray
+        Its times [s].
+    check : {"x", "xd", "xdd"}
+        The trajectory field compared with ``ref`` for a blow-up (all are checked for
+        non-finite values).
+    ref : ndarray
+        Reference of that field.
+
+    Returns
+    -------
+    (trajectory or None, reason or None, time [s])
+        The trajectory is None if the simulation raised; its samples from the failure on are
+        NaN otherwise.  ``time`` is NaN where unknown (no failure, or an error without time).
+    """
+    try:
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+            traj = sim()
+    except DivergenceError as e:
+        return None, f"diverged: {e}", e.time
+    except IdentificationError as e:
+        return None, f"diverged: {e}", float("nan")
+    except np.linalg.LinAlgError as e:  # e.g. a singular identified M
+        return None, f"simulation failed: {e}", float("nan")
+    found = None
+    for name in ("x", "xd", "xdd"):
+        hit = divergence(t, getattr(traj, name), ref if name == check else None)
+        if hit is not None and (found is None or hit[1] < found[1]):
+            found = hit
+    if found is None:
+        return traj, None, float("nan")
+    why, when = found
+    k = int(np.searchsorted(t, when))
+    cut = [np.array(a, dtype=float) for a in (traj.x, traj.xd, traj.xdd)]
+    for a in cut:
+        a[:, k:] = np.nan
+    return Trajectory(*cut), f"diverged: {why} (at t = {when:.4g} s)", when
+
+
+def score(kind: str, dataset: Dataset, data: Measurement, clean: Measurement, model: Any) -> Scores:
+    """Score a fitted identifier against the dataset's truth.
+
+    Parameters
+    ----------
+    kind : {"structural", "mechanical"}
+    dataset : Dataset
+        Holds the truth.
+    data : Measurement
+        What the identifier was fitted on (its initial state starts simulations).
+    clean : Measurement
+        The same signal chain applied to the noise-free signals: the reference the
+        simulated model is compared with.
+    model : Identifier
+        Fitted.
+
+    Returns
+    -------
+    Scores
+        A model that diverges, blows up, loses its loop closure or is physically impossible
+        is scored, not raised: its affected scores are NaN and :attr:`Scores.failures` holds
+        the reasons (with the time of a divergence where known).
+    """
+    return (score_structural if kind == "structural" else score_mechanical)(dataset, data, clean, model)
+
+
+def score_structural(dataset: Dataset, data: Measurement, clean: Measurement, model: Any) -> Scores:
+    """TRAC, MAC, frequency, damping and matrix errors of a structural model.
+
+    The identified model is simulated from the measured state at the end of the
+    impact pulse (``data.free_start``) to the end of the record under the
+    measured force, and its accelerations are compared with the noise-free
+    accelerations passed through the same signal chain.
+
+    A physically impossible model (:func:`physical_failures`: M not symmetric positive
+    definite, negative damping, an unstable pole) and a simulation that raises, turns
+    non-finite or blows up (:func:`simulate_scored`) are recorded in ``Scores.failures``;
+    the TRAC of a failed simulation is NaN.  The other scores are still computed (NaN where
+    the model gives no modes), as diagnostics of what went wrong.
+    """
+    truth = dataset.truth
+    i0 = data.free_start
+    t = np.arange(data.n_samples - i0) / data.fs
+    u = None if data.u is None else data.u[:, i0:]
+    ref = clean.xdd[:, i0:]
+    failures = physical_failures(model.M_, model.C_, model.K_)
+    d: dict[str, Any] = {"t": t, "reference_xdd": ref, "channels": data.channels}
+    sim = None
+    if "model" not in failures:  # non-finite matrices: nothing to simulate (the failure says so)
+        sim, why, when = simulate_scored(
+            lambda: model.simulate(data.x[:, i0], data.xd[:, i0], t, u), t, "xdd", ref)
+        if why is not None:
+            failures["simulation"] = why
+            d["divergence_time"] = when
+    sim_xdd = sim.xdd if sim is not None else np.full_like(ref, np.nan)
+    # A failed simulation has no TRAC (NaN, never a pass), whatever its finite beginning matched.
+    trac = (metrics.trac(ref, sim_xdd) if sim is not None and "simulation" not in failures
+            else np.full(ref.shape[0], np.nan))
+    v: dict[str, float] = {"trac": worst(trac, "min")}
+    d.update(trac=trac, simulated_xdd=sim_xdd)
+
+    f_id, z_id, phi_id = metrics.modal_from_matrices(model.M_, model.C_, model.K_, strict=False)
+    m = min(SCORED_MODES, len(truth["frequencies_hz"]), len(f_id))
+    f_true = np.asarray(truth["frequencies_hz"])[: data.n_channels]
+    z_true = np.asarray(truth["damping_ratios"])[: data.n_channels]
+    phi_true = np.asarray(truth["sensor_modes"])[:, : data.n_channels]
+    mac = metrics.mac_matrix(phi_id, phi_true)
+    pair = metrics.pair_modes(mac.T)  # pair[j] = identified mode matched to true mode j
+    paired = [j for j in range(m) if pair[j] >= 0]
+    if len(paired) < m or not np.all(np.isfinite(mac)):  # a true mode without partner fails
+        v["mac"] = v["freq_error"] = v["damping_error"] = float("nan")
+    else:
+        v["mac"] = worst([mac[pair[j], j] for j in paired], "min")
+        v["freq_error"] = worst([metrics.frequency_error(f_id[pair[j]], f_true[j]) for j in paired], "max")
+        v["damping_error"] = worst([metrics.damping_error(z_id[pair[j]], z_true[j]) for j in paired], "max")
+    d.update(mac=mac, pair=pair, f_id=f_id, f_true=f_true, z_id=z_id, z_true=z_true)
+
+    Mr, Kr, Cr = (np.asarray(truth[k]) for k in ("Mr", "Kr", "Cr"))
+    v["Mr_error"] = metrics.relative_error(model.M_, Mr)
+    v["Kr_error"] = metrics.relative_error(model.K_, Kr)
+    v["Cr_error"] = metrics.relative_error(model.C_, Cr)
+    try:
+        v["MinvK_error"] = metrics.relative_error(np.linalg.solve(model.M_, model.K_),
+                                                  np.linalg.solve(Mr, Kr))
+    except np.linalg.LinAlgError:  # a singular identified M (a "mass" failure): no M^-1 K
+        v["MinvK_error"] = float("nan")
+    if np.all(np.isfinite(phi_id)) and np.all(pair >= 0):  # identified modes in paired order
+        xo = np.abs(metrics.cross_orthogonality(phi_id[:, pair], phi_true, Mr))
+        v["cross_orth"] = worst(xo - np.diag(np.diag(xo)), "max") if xo.shape[0] > 1 else 0.0
+    else:  # identified M not positive definite: no modes to compare
+        xo = np.full((data.n_channels, data.n_channels), np.nan)
+        v["cross_orth"] = float("nan")
+    d.update(M_id=model.M_, K_id=model.K_, C_id=model.C_, Mr=Mr, Kr=Kr, Cr=Cr, cross_orth=xo)
+
+    K3 = getattr(model, "K3_", None)
+    v["K3_norm"] = float(np.linalg.norm(K3)) if K3 is not None else 0.0
+    if K3 is not None:
+        x_ref = clean.x[:, i0:]
+        lin = np.linalg.norm(model.K_ @ x_ref)
+        v["K3_force_ratio"] = float(np.linalg.norm(K3 @ x_ref**3) / lin) if lin > 0 else float("nan")
+    else:
+        v["K3_force_ratio"] = 0.0
+    k3 = float(np.asarray(truth.get("k3", 0.0)))
+    if K3 is not None and k3 != 0.0:
+        x_ref = clean.x[:, i0:]
+        q0 = np.asarray(truth["cubic_map"]) @ x_ref
+        f_true = np.outer(np.asarray(truth["cubic_direction"]), k3 * q0**3)
+        f_id = K3 @ x_ref**3
+        v["K3_force_error"] = float(np.linalg.norm(f_id - f_true) / np.linalg.norm(f_true))
+        d.update(cubic_force_true=f_true, cubic_force_id=f_id)
+    return Scores({k: float(x) for k, x in v.items()}, d, failures)
+
+
+def score_mechanical(dataset: Dataset, data: Measurement, clean: Measurement, model: Any) -> Scores:
+    """Joint-angle RMSE of the free simulation, and coefficient and support scores modulo the
+    kinematic identities of the loop.
+
+    ``angle_rmse``: the identified model is simulated from the true initial state (the rig's
+    ``theta0`` / ``dtheta0``) under the recorded torques for the whole record; the largest
+    per-joint RMSE against the recorded noise-free angles (metrics.md).
+
+    Coefficients (:func:`testbed.scoring.equation_basis.compare_equations`): on loop-closed data the
+    true implicit equations are not unique (the loop constraint and its derivatives times trig
+    factors are exact linear identities among the library columns), so the truth
+    (``equation_terms`` / ``equation_coef``) and the identified equations are both put in the
+    canonical basis of the identifier's library: its columns (plus any true term it lacks) are
+    evaluated on the NOISE-FREE reference signals (the scorer's privilege; the identifier never
+    sees them), input-free columns dependent on earlier ones (unit-norm residual variance
+    <= ``DEPENDENCE_TOL``) are dropped in library order, and dropped columns are substituted by
+    their unique expression in the kept ones.  The identifier is not told this basis: the
+    scorer adapts the truth to the library.  Rows are paired, both divided by their coefficient
+    on the true row's largest term; ``coef_error`` is the largest relative error over the true
+    (canonical) terms, ``support_*`` compare the canonical nonzero patterns.  Equal canonical
+    forms mean equal equations on the loop manifold; a wrong equation keeps a wrong form.
+
+    A simulation that raises (e.g. a loop closure that no longer solves), turns non-finite or
+    blows up is a failure in ``Scores.failures`` with its time where known, and its
+    ``angle_rmse`` is NaN; non-finite coefficients are a failure with NaN coefficient scores.
+    """
+
+    def ref(name: str) -> np.ndarray:  # noise-free raw signal (reference if noise was added)
+        return np.asarray(dataset.reference.get(name, dataset.measured[name]).data, dtype=float)
+
+    # The true initial state and angles, as recorded by the rig: not the signal chain's estimates,
+    # whose end effects would otherwise count against the identifier.
+    theta = ref("theta")
+    x0 = np.asarray(dataset.truth.get("theta0", theta[:, 0]), dtype=float)
+    xd0 = np.asarray(dataset.truth.get("dtheta0", ref("dtheta")[:, 0]), dtype=float)
+    t = np.arange(data.n_samples) / data.fs
+    failures: dict[str, str] = {}
+    coef = np.asarray(model.coef_, dtype=float)
+    d: dict[str, Any] = {"t": t, "reference_x": theta, "channels": data.channels}
+    sim = None
+    if not np.all(np.isfinite(coef)):  # nothing to simulate (the failure says so)
+        failures["model"] = "non-physical: identified coefficients hold non-finite entries"
+    else:
+        sim, why, when = simulate_scored(lambda: model.simulate(x0, xd0, t, data.u), t, "x", theta)
+        if why is not None:
+            failures["simulation"] = why
+            d["divergence_time"] = when
+    sim_x = sim.x if sim is not None else np.full_like(theta, np.nan)
+    # A failed simulation has no RMSE (NaN, never a pass), however close its beginning was.
+    rmse = (metrics.rmse(theta, sim_x) if sim is not None and "simulation" not in failures
+            else np.full(theta.shape[0], np.nan))
+    v: dict[str, float] = {"angle_rmse": worst(rmse, "max")}
+    d.update(angle_rmse=rmse, simulated_x=sim_x)
+
+    if "model" in failures:
+        v.update(coef_error=float("nan"), support_precision=float("nan"),
+                 support_recall=float("nan"), support_f1=float("nan"))
+        return Scores(v, d, failures)
+    signals = {"th": ref("theta"), "dth": ref("dtheta"), "ddth": ref("ddtheta"), "u": ref("torque")}
+    cmp = compare_equations(list(model.feature_names_), coef,
+                            list(dataset.truth["equation_terms"]),
+                            np.asarray(dataset.truth["equation_coef"], dtype=float), signals)
+    v["coef_error"] = float(cmp["coef_error"])
+    v["support_precision"], v["support_recall"], v["support_f1"] = (
+        float(cmp["precision"]), float(cmp["recall"]), float(cmp["f1"]))
+    d.update(terms=cmp["names"], coef_true=cmp["coef_true"], coef_id=cmp["coef_id"],
+             coef_errors=cmp["coef_errors"], coef_error_norm=cmp["coef_error_norm"],
+             dependent_terms=cmp["dependent"], truth_residual=cmp["truth_residual"])
+    return Scores(v, d, failures)

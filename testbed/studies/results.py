@@ -1,0 +1,253 @@
+"""Sweep results: one row per cell, crash-safe while running, one Parquet file at the end.
+
+Layout of a results file ``R`` (e.g. ``out/studies/default.parquet``)::
+
+    R               Parquet (pyarrow), one row per cell, sorted by scenario, noise, seed,
+                    identifier; schema metadata ``format`` = FORMAT and ``study``.
+    R.parts/        while a sweep runs: ``<cell>.json``, one finished row per file, each
+                    written atomically (temporary file + ``os.replace``).  Consolidation
+                    merges them into ``R`` (again atomically) and then deletes them.
+
+A sweep killed at any moment therefore leaves only whole rows (in ``R`` or in
+``R.parts``) and loses just the cells in flight; :func:`read_results` reads both
+places and keeps one row per cell, so a rerun skips every finished cell.
+
+A row file damaged all the same (a full disk, a copy cut short, an edit by hand) is
+not trusted: :func:`read_results` names it in a warning and skips it, and with
+``set_aside=True`` (what a sweep does) renames it ``<cell>.json.bad``, so its cell runs
+again and the evidence stays; consolidation leaves ``*.bad`` files in place.  A damaged
+``R`` raises :class:`ResultsError` naming the file.
+
+Columns (:data:`BASE_COLUMNS`, then one float column per score name):
+
+======================  =========  ===================================================
+study, cell             str        study name; cell key (see ``testbed.studies.sweep.cell_key``)
+scenario, rig           str        scenario name and its rig
+noise                   float      sensor noise [% of channel RMS]
+seed                    int        noise seed
+identifier              str        identifier name
+params                  str        its hyperparameters (JSON)
+status                  str        "ok" or "failed"
+error                   str        ``Type: message (file:line)``; "" if ok
+fit_time                float      identifier fit wall time [s] (NaN if it never ran)
+data_time, cell_time    float      dataset load-or-generate / whole cell wall time [s]
+passed                  bool       every threshold of the scenario's [score] table met
+<score>                 float      each score name (NaN if absent for this rig kind)
+checks                  str        JSON list of {metric, value, bound, threshold, passed}
+versions                str        JSON of package versions that computed the row
+commit                  str        git commit of the code (``+dirty`` if modified)
+dataset_hash            str        content hash of the dataset the cell used
+======================  =========  ===================================================
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import logging
+import math
+import os
+from collections.abc import Iterable
+from pathlib import Path
+from typing import Any
+
+import pyarrow as pa
+import pyarrow.parquet as pq
+
+from testbed.core.atomic import atomic_write, atomic_write_text
+from testbed.core.errors import TestbedError
+
+FORMAT = "sysid-testbed-results/1"
+
+log = logging.getLogger(__name__)
+
+
+class ResultsError(TestbedError, ValueError):
+    """A results file cannot be read or is not a results file of :data:`FORMAT`; names the file."""
+
+BASE_COLUMNS: dict[str, pa.DataType] = {
+    "study": pa.string(), "cell": pa.string(), "scenario": pa.string(), "rig": pa.string(),
+    "noise": pa.float64(), "seed": pa.int64(), "identifier": pa.string(), "params": pa.string(),
+    "status": pa.string(), "error": pa.string(), "fit_time": pa.float64(),
+    "data_time": pa.float64(), "cell_time": pa.float64(), "passed": pa.bool_(),
+}
+TAIL_COLUMNS: dict[str, pa.DataType] = {
+    "checks": pa.string(), "versions": pa.string(), "commit": pa.string(),
+    "dataset_hash": pa.string(),
+}
+SORT_KEYS = ("scenario", "noise", "seed", "identifier", "cell")
+
+
+def parts_dir(path: str | os.PathLike) -> Path:
+    """The folder of per-cell row files belonging to results file ``path``."""
+    p = Path(path)
+    return p.with_name(p.name + ".parts")
+
+
+def score_columns(rows: Iterable[dict[str, Any]]) -> list[str]:
+    """Names of the score columns in ``rows`` (every key not a fixed column), sorted."""
+    fixed = set(BASE_COLUMNS) | set(TAIL_COLUMNS)
+    return sorted({k for r in rows for k in r if k not in fixed})
+
+
+def _sort_key(row: dict[str, Any]) -> tuple:
+    return tuple(row.get(k) if row.get(k) is not None else "" for k in SORT_KEYS)
+
+
+def write_part(path: str | os.PathLike, row: dict[str, Any]) -> Path:
+    """Write one finished row atomically as ``<path>.parts/<cell>.json``; return the file."""
+    out = parts_dir(path) / f"{row['cell']}.json"
+    atomic_write_text(out, json.dumps(row, sort_keys=True))  # NaN as the JSON extension NaN
+    return out
+
+
+def _read_part(p: Path) -> dict[str, Any]:
+    """One row file; ValueError if it is not a whole row written by :func:`write_part`."""
+    try:
+        row = json.loads(p.read_text(encoding="utf-8"))
+    except UnicodeDecodeError as e:
+        raise ValueError(f"not UTF-8 text: {e}") from None
+    except json.JSONDecodeError as e:
+        raise ValueError(f"not valid JSON ({e})") from None
+    if not isinstance(row, dict) or not all(isinstance(row.get(k), str) for k in ("cell", "status")):
+        raise ValueError("not a results row (no cell and status)")
+    if row["cell"] != p.stem:
+        raise ValueError(f"holds the row of cell {row['cell']!r}")
+    return row
+
+
+def _read_parts(path: str | os.PathLike, set_aside: bool = False) -> list[dict[str, Any]]:
+    d = parts_dir(path)
+    if not d.is_dir():
+        return []
+    rows = []
+    for p in sorted(d.glob("*.json")):  # temporary files (.*.tmp) of a killed write are skipped
+        try:
+            rows.append(_read_part(p))
+        except (OSError, ValueError) as e:
+            if not set_aside:
+                log.warning("results: %s is damaged (%s); skipped", p, e)
+                continue
+            bad = p.with_name(p.name + ".bad")
+            try:
+                os.replace(p, bad)
+            except FileNotFoundError:  # set aside by another reader meanwhile
+                continue
+            log.warning("results: %s is damaged (%s); set aside as %s, its cell will run again",
+                        p, e, bad.name)
+    return rows
+
+
+def _to_table(rows: list[dict[str, Any]], study: str | None) -> pa.Table:
+    scores = score_columns(rows)
+    schema = pa.schema([*(pa.field(k, t) for k, t in BASE_COLUMNS.items()),
+                        *(pa.field(k, pa.float64()) for k in scores),
+                        *(pa.field(k, t) for k, t in TAIL_COLUMNS.items())],
+                       metadata={"format": FORMAT, "study": study or ""})
+    cols = {}
+    for f in schema:
+        if f.type == pa.float64():
+            vals = [r.get(f.name) for r in rows]
+            cols[f.name] = [math.nan if v is None else float(v) for v in vals]
+        else:
+            cols[f.name] = [r.get(f.name) for r in rows]
+    return pa.table(cols, schema=schema)
+
+
+def write_rows(path: str | os.PathLike, rows: Iterable[dict[str, Any]], *,
+               study: str | None = None) -> Path:
+    """Write ``rows`` (one per cell) as the Parquet file ``path``, atomically.
+
+    Rows are sorted by scenario, noise, seed and identifier; score columns are
+    the union over rows, NaN where a row has none.
+    """
+    rows = sorted(rows, key=_sort_key)
+    keys = [r["cell"] for r in rows]
+    if len(set(keys)) != len(keys):
+        raise ValueError("write_rows: a cell appears more than once")
+    table = _to_table(rows, study)
+    path = Path(path)
+    atomic_write(path, lambda tmp: pq.write_table(table, tmp))
+    return path
+
+
+def _read_parquet(path: Path) -> list[dict[str, Any]]:
+    if not path.is_file():
+        return []
+    try:
+        table = pq.read_table(path)
+    except Exception as e:  # pyarrow raises ArrowInvalid, OSError ... for a damaged file
+        raise ResultsError(f"{path}: unreadable results file ({type(e).__name__}: {e})") from None
+    meta = table.schema.metadata or {}
+    if meta.get(b"format", b"").decode() != FORMAT:
+        raise ResultsError(f"{path}: not a {FORMAT} file")
+    return table.to_pylist()
+
+
+def read_results(path: str | os.PathLike, *, set_aside: bool = False) -> list[dict[str, Any]]:
+    """Every row of a results file, including rows not yet consolidated.
+
+    Parameters
+    ----------
+    path : path
+        The results file; ``<path>.parts/`` is read too.
+    set_aside : bool
+        Rename a damaged row file ``<cell>.json.bad`` (else it is only skipped); either
+        way a warning names it.
+
+    Returns
+    -------
+    list of dict
+        One row per cell (a row in both places counts once; the part wins, being
+        the newer), sorted by scenario, noise, seed and identifier.  Every row has
+        every score column found in any row (NaN where it has no such score).
+
+    Raises
+    ------
+    ResultsError
+        If ``path`` exists but is not a readable results file.
+    """
+    path = Path(path)
+    by_cell: dict[str, dict[str, Any]] = {r["cell"]: r for r in _read_parquet(path)}
+    for r in _read_parts(path, set_aside):
+        by_cell[r["cell"]] = r
+    rows = sorted(by_cell.values(), key=_sort_key)
+    scores = score_columns(rows)
+    for r in rows:
+        for k in scores:
+            if r.get(k) is None:
+                r[k] = math.nan
+    return rows
+
+
+def consolidate(path: str | os.PathLike, *, keep: set[str] | None = None,
+                study: str | None = None) -> tuple[int, int]:
+    """Merge ``<path>.parts/`` into the Parquet file ``path`` and delete the parts.
+
+    Parameters
+    ----------
+    keep : set of str, optional
+        Cell keys to keep; rows of other cells (e.g. of an edited study) are dropped.
+    study : str, optional
+        Study name stored in the file's metadata.
+
+    Returns
+    -------
+    (n_rows, n_dropped)
+    """
+    path = Path(path)
+    rows = read_results(path)
+    dropped = 0
+    if keep is not None:
+        kept = [r for r in rows if r["cell"] in keep]
+        dropped = len(rows) - len(kept)
+        rows = kept
+    write_rows(path, rows, study=study)
+    d = parts_dir(path)
+    if d.is_dir():  # only after the Parquet file holds every row; set-aside *.bad files stay
+        for p in d.iterdir():
+            if not p.name.endswith(".bad"):
+                p.unlink(missing_ok=True)
+        with contextlib.suppress(OSError):  # not empty: it keeps the *.bad files
+            d.rmdir()
+    return len(rows), dropped

@@ -1,0 +1,464 @@
+"""A scored run on disk: ``run.json`` + ``run.npz`` (+ figures), enough to report without re-running.
+
+Layout of a run folder::
+
+    run.json     format, scenario (dict), kind, identifier {name, class, params}, equations,
+                 scores, failures {aspect: reason}, checks, verdict ("pass", "FAIL" or
+                 "no verdict"), passed, fit_time [s], dataset {fs, n_samples, signals,
+                 prior, hash}, truth_units, rig_units, versions, commit, created, figures
+    run.npz      details/<name>  arrays behind the scores (TRAC, MAC, simulated signals ...)
+                 model/<name>    identified arrays (M_, C_, K_, K3_, coef_, ...)
+                 history/<name>  per-epoch training history (flattened with "/")
+                 truth/<name>    the dataset's truth arrays
+    *.png        the run figures (:mod:`testbed.reporting.figures`)
+
+The folder is written beside its final place (a private temporary folder) and renamed
+into it, so a reader sees the old run or the new one, never half of one; on Linux the old
+and new folders are swapped in one atomic ``renameat2(RENAME_EXCHANGE)``.  Two processes
+saving the same run at once both succeed, and the folder holds the last complete one.
+
+A run never touches a folder other than its own: :func:`run_folder` accepts only a plain
+name that stays strictly inside the output folder, and :func:`save_run` refuses a target
+named ``.`` or ``..`` and refuses to replace an existing folder that is not a run folder
+(no ``run.json``), e.g. the output folder itself with every other run in it.
+"""
+
+from __future__ import annotations
+
+import ctypes
+import datetime as _dt
+import errno
+import json
+import os
+import shutil
+import sys
+import tempfile
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from testbed.core.errors import TestbedError
+from testbed.core.provenance import git_commit, versions
+from testbed.pipeline.plugins import RIGS
+from testbed.scoring.scorers import PASS, Check, verdict
+
+FORMAT = "sysid-testbed-run/1"
+#: Truth arrays larger than this many elements are not copied into the run.
+MAX_TRUTH_SIZE = 1_000_000
+
+
+class RunStoreError(TestbedError, ValueError):
+    """A run folder that would leave the output folder, or replace something that is not a run."""
+
+
+def run_folder(out_dir: str | os.PathLike, name: str) -> Path:
+    """The folder of run ``name`` in ``out_dir``, checked to be strictly inside it.
+
+    Parameters
+    ----------
+    out_dir : path-like
+        The output folder (e.g. ``out/runs``).
+    name : str
+        The run's name (the scenario name): one path component, not empty, not starting
+        with ``.`` (``.`` and ``..`` would name the output folder or its parent; other dot
+        names are kept for the temporary folders of :func:`save_run`).
+
+    Returns
+    -------
+    Path
+        ``out_dir / name``.
+
+    Raises
+    ------
+    RunStoreError
+        If ``name`` is not such a component, or ``out_dir / name`` resolves (e.g. through a
+        symbolic link) to anything but a direct child of ``out_dir``.
+    """
+    if (not isinstance(name, str) or not name or name.startswith(".")
+            or any(c in name for c in ("/", "\\", "\0"))):
+        raise RunStoreError(f"run name {name!r}: expected a plain folder name (no path separator, "
+                            "not starting with '.'), so that the run stays inside "
+                            f"{os.fspath(out_dir)}")
+    out = Path(out_dir)
+    if (out / name).resolve().parent != out.resolve():
+        raise RunStoreError(f"run folder {out / name} resolves to {(out / name).resolve()}, "
+                            f"outside the output folder {out.resolve()}")
+    return out / name
+
+
+def _is_run_folder(p: Path) -> bool:
+    """A folder :func:`save_run` may replace: a real (not linked) folder holding a ``run.json``."""
+    return p.is_dir() and not p.is_symlink() and (p / "run.json").is_file()
+
+
+def _check_target(run_dir: str | os.PathLike) -> Path:
+    """``run_dir`` as a Path, refused if it names ``.``/``..`` or an existing non-run folder."""
+    last = os.path.basename(os.fspath(run_dir).rstrip("/" + os.sep))
+    if last in ("", ".", ".."):
+        raise RunStoreError(f"{os.fspath(run_dir)}: a run folder cannot be named {last!r}")
+    run_dir = Path(run_dir)
+    if (run_dir.exists() or run_dir.is_symlink()) and not _is_run_folder(run_dir) \
+            and not (run_dir.is_dir() and not run_dir.is_symlink() and not any(run_dir.iterdir())):
+        raise RunStoreError(f"{run_dir}: exists and is not a run folder (no run.json); "
+                            "refusing to replace it")
+    return run_dir
+
+
+@dataclass
+class SavedRun:
+    """A run read back from its folder (see the module docstring).
+
+    Attributes
+    ----------
+    path : Path
+    meta : dict
+        The content of ``run.json``.
+    details, model, history, truth : dict of str to ndarray or list of str
+        The groups of ``run.npz``.
+    """
+
+    path: Path
+    meta: dict[str, Any]
+    details: dict[str, Any] = field(default_factory=dict)
+    model: dict[str, Any] = field(default_factory=dict)
+    history: dict[str, Any] = field(default_factory=dict)
+    truth: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def name(self) -> str:
+        return str(self.scenario.get("name", self.path.name))
+
+    @property
+    def scenario(self) -> dict[str, Any]:
+        return self.meta["scenario"]
+
+    @property
+    def kind(self) -> str:
+        return str(self.meta.get("kind", ""))
+
+    @property
+    def identifier(self) -> str:
+        return str(self.meta["identifier"]["name"])
+
+    @property
+    def scores(self) -> dict[str, float]:
+        return {k: _num(v) for k, v in self.meta["scores"].items()}
+
+    @property
+    def checks(self) -> list[Check]:
+        return [Check(c["metric"], _num(c["value"]), c["bound"], _num(c["threshold"]))
+                for c in self.meta["checks"]]
+
+    @property
+    def failures(self) -> dict[str, str]:
+        """Why the model failed whatever its scores (``Scores.failures``); empty if nothing did."""
+        return {str(k): str(v) for k, v in self.meta.get("failures", {}).items()}
+
+    @property
+    def failure(self) -> str | None:
+        return "; ".join(self.failures.values()) if self.failures else None
+
+    @property
+    def verdict(self) -> str:
+        """``"pass"``, ``"FAIL"`` or ``"no verdict"`` (:func:`testbed.scoring.scorers.verdict`)."""
+        return verdict(self.checks, self.failures)
+
+    @property
+    def passed(self) -> bool:
+        return self.verdict == PASS
+
+    @property
+    def fit_time(self) -> float:
+        return float(self.meta["fit_time"])
+
+    @property
+    def equations(self) -> list[str]:
+        return list(self.meta.get("equations", []))
+
+    @property
+    def figures(self) -> list[Path]:
+        return [self.path / f for f in self.meta.get("figures", []) if (self.path / f).is_file()]
+
+
+def _num(v: Any) -> float:
+    """A number from ``run.json`` (NaN was stored as null, infinities as strings)."""
+    return float("nan") if v is None else float(v)
+
+
+def _jsonable(v: Any) -> Any:
+    """Plain JSON form of ``v`` (arrays to lists, numpy scalars to numbers, else ``repr``)."""
+    if isinstance(v, dict):
+        return {str(k): _jsonable(x) for k, x in v.items()}
+    if isinstance(v, (list, tuple)):
+        return [_jsonable(x) for x in v]
+    if isinstance(v, np.ndarray):
+        return _jsonable(v.tolist())
+    if isinstance(v, np.generic):
+        return v.item()
+    if isinstance(v, float) and not np.isfinite(v):
+        return None if np.isnan(v) else ("inf" if v > 0 else "-inf")
+    if v is None or isinstance(v, (bool, int, float, str)):
+        return v
+    return repr(v)
+
+
+def _as_array(v: Any) -> np.ndarray | None:
+    """``v`` as a numeric or string array storable without pickle, or None."""
+    if isinstance(v, (list, tuple)) and v and all(isinstance(x, str) for x in v):
+        return np.asarray(v, dtype=str)
+    try:
+        a = np.asarray(v)
+    except (ValueError, TypeError):
+        return None
+    return a if a.dtype.kind in "biufcU" else None
+
+
+def _flatten(d: dict[str, Any], prefix: str) -> dict[str, np.ndarray]:
+    out: dict[str, np.ndarray] = {}
+    for k, v in d.items():
+        key = f"{prefix}/{k}"
+        if isinstance(v, dict):
+            out.update(_flatten(v, key))
+        elif (a := _as_array(v)) is not None:
+            out[key] = a
+    return out
+
+
+def _model_arrays(model: Any) -> tuple[dict[str, Any], dict[str, Any]]:
+    """(learned arrays, learned string lists) of a fitted identifier: public attributes ending in _."""
+    arrays, lists = {}, {}
+    for k, v in vars(model).items():
+        if not k.endswith("_") or k.startswith("_") or k == "history_" or v is None:
+            continue
+        if isinstance(v, (list, tuple)) and v and all(isinstance(x, str) for x in v):
+            lists[k] = list(v)
+        elif (a := _as_array(v)) is not None and a.dtype.kind != "U":
+            arrays[k] = a
+    return arrays, lists
+
+
+def _identifier(result: Any) -> dict[str, Any]:
+    model = result.model
+    ident = result.scenario.identify or {}
+    params = model.get_params() if hasattr(model, "get_params") else {}
+    return {"name": ident.get("method", getattr(model, "name", "") or type(model).__name__),
+            "class": f"{type(model).__module__}.{type(model).__qualname__}",
+            "params": _jsonable(params)}
+
+
+def _equations(model: Any) -> list[str]:
+    try:
+        return [str(e) for e in model.equations()]
+    except Exception as e:  # an identifier without readable equations still gets a run folder
+        return [f"(equations unavailable: {type(e).__name__}: {e})"]
+
+
+def _rig_units(rig: str) -> dict[str, dict[str, str]]:
+    """Unit and doc of every ``[rig]`` key from the rig's schema (empty if the rig is unknown)."""
+    try:
+
+        schema = RIGS.get(rig).rig_schema
+    except Exception:
+        return {}
+    return {k: {"unit": f.unit, "doc": f.doc} for k, f in schema.items()}
+
+
+def _kind(result: Any) -> str:
+    kind = getattr(result.model, "kind", "")
+    if kind:
+        return str(kind)
+    return "structural" if "simulated_xdd" in result.scores.details else "mechanical"
+
+
+def build_meta(result: Any) -> dict[str, Any]:
+    """The ``run.json`` content of a :class:`~testbed.scoring.run.RunResult`."""
+
+    ds = result.dataset
+    signals = {f"{g}/{n}": {"unit": s.unit, "channels": list(s.channels),
+                            "positions": None if s.positions is None else s.positions.tolist()}
+               for g, group in (("measured", ds.measured), ("reference", ds.reference))
+               for n, s in group.items()}
+    _, model_lists = _model_arrays(result.model)
+    return _jsonable({
+        "format": FORMAT,
+        "scenario": result.scenario.to_dict(),
+        "kind": _kind(result),
+        "identifier": _identifier(result),
+        "equations": _equations(result.model),
+        "model_lists": model_lists,
+        "scores": result.scores.values,
+        "failures": result.scores.failures,
+        "checks": [{"metric": c.metric, "value": c.value, "bound": c.bound, "threshold": c.threshold,
+                    "passed": c.passed} for c in result.checks],
+        "verdict": verdict(result.checks, result.scores.failures),
+        "passed": verdict(result.checks, result.scores.failures) == PASS,
+        "fit_time": float(result.fit_time),
+        "dataset": {"fs": ds.fs, "n_samples": ds.n_samples, "signals": signals, "prior": ds.prior,
+                    "hash": ds.attrs.get("content_hash") or ds.content_hash(),
+                    "data_hash": ds.attrs.get("data_hash", ""),
+                    "versions": ds.attrs.get("versions", {}), "commit": ds.attrs.get("git_commit", "")},
+        "truth_units": ds.truth_units,
+        "rig_units": _rig_units(result.scenario.rig),
+        "versions": versions(),
+        "commit": git_commit(),
+        "created": _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds"),
+        "figures": [],
+    })
+
+
+def build_arrays(result: Any) -> dict[str, np.ndarray]:
+    """The ``run.npz`` content of a :class:`~testbed.scoring.run.RunResult`."""
+    arrays = _flatten(result.scores.details, "details")
+    model_arrays, _ = _model_arrays(result.model)
+    arrays.update(_flatten(model_arrays, "model"))
+    arrays.update(_flatten(getattr(result.model, "history_", None) or {}, "history"))
+    truth = {k: v for k, v in result.dataset.truth.items() if np.size(v) <= MAX_TRUTH_SIZE}
+    arrays.update(_flatten(truth, "truth"))
+    return arrays
+
+
+def _write_json(path: Path, obj: dict[str, Any]) -> None:
+    path.write_text(json.dumps(obj, indent=2, sort_keys=False, allow_nan=False) + "\n")
+
+
+def save_run(result: Any, run_dir: str | os.PathLike,
+             figures: Callable[[SavedRun, Path], list[Path]] | None = None) -> Path:
+    """Write a run folder atomically (see the module docstring).
+
+    Parameters
+    ----------
+    result : RunResult
+    run_dir : path
+        The folder to (re)place; see :func:`run_folder` for one inside an output folder.
+    figures : callable, optional
+        A figure writer ``figures(run, folder) -> paths`` (the reporting layer's
+        :func:`testbed.reporting.figures.save_run_figures`), called on the saved run in its
+        temporary folder before the atomic swap, so a run folder never holds half its figures.
+        None: no figures.  Passed in, not imported: the run store sits below reporting.
+
+    Returns
+    -------
+    Path
+        ``run_dir``.
+
+    Raises
+    ------
+    RunStoreError
+        If ``run_dir`` is named ``.`` or ``..``, or exists and is neither a run folder nor
+        empty (it is then left untouched).
+    """
+    run_dir = _check_target(run_dir)
+    run_dir.parent.mkdir(parents=True, exist_ok=True)
+    tmp = Path(tempfile.mkdtemp(prefix=f".{run_dir.name}.", suffix=".tmp", dir=run_dir.parent))
+    umask = os.umask(0)
+    os.umask(umask)
+    os.chmod(tmp, 0o777 & ~umask)  # mkdtemp makes it private; a run folder is as readable as any
+    try:
+        meta = build_meta(result)
+        _write_json(tmp / "run.json", meta)
+        np.savez_compressed(tmp / "run.npz", **build_arrays(result))
+        if figures is not None:
+            paths = figures(load_run(tmp), tmp)
+            meta["figures"] = [p.name for p in paths]
+            _write_json(tmp / "run.json", meta)
+        _replace_dir(tmp, run_dir)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    return run_dir
+
+
+#: renameat2 flag (linux/fs.h): swap the two paths atomically.
+_RENAME_EXCHANGE = 2
+_AT_FDCWD = -100
+
+
+def _exchange(a: Path, b: Path) -> bool:
+    """Swap folders ``a`` and ``b`` in one atomic step (Linux); False where unsupported."""
+    if not sys.platform.startswith("linux"):
+        return False
+    fn = getattr(ctypes.CDLL(None, use_errno=True), "renameat2", None)
+    if fn is None:  # a C library older than glibc 2.28
+        return False
+    if fn(_AT_FDCWD, os.fsencode(a), _AT_FDCWD, os.fsencode(b), _RENAME_EXCHANGE) == 0:
+        return True
+    err = ctypes.get_errno()
+    if err in (errno.EINVAL, errno.ENOSYS, errno.ENOENT, errno.EPERM):
+        return False  # file system without exchange, or b gone meanwhile: rename instead
+    raise OSError(err, os.strerror(err), str(b))
+
+
+def _replace_dir(new: Path, target: Path) -> None:
+    """Move folder ``new`` to ``target``, replacing an old run folder ``target``.
+
+    Safe against a concurrent writer of the same ``target``: each attempt either renames
+    ``new`` into an absent (or empty) ``target``, or swaps it atomically with the run there,
+    or moves that run aside and tries again; the last complete run wins.  Only ``new`` and
+    folders this call moved aside (all beside ``target``) are ever deleted.
+    """
+    # 100 attempts: each fails only if another writer renamed a run in between, which takes
+    # microseconds; a hundred such collisions in a row means something else is wrong
+    for _ in range(100):
+        try:
+            os.rename(new, target)  # POSIX: succeeds onto an absent or empty folder
+            return
+        except OSError as e:
+            if e.errno not in (errno.ENOTEMPTY, errno.EEXIST, errno.ENOTDIR, errno.EISDIR):
+                raise
+        if not _is_run_folder(target):
+            if not target.exists():
+                continue  # removed meanwhile: try the rename again
+            raise RunStoreError(f"{target}: exists and is not a run folder (no run.json); "
+                                "refusing to replace it")
+        if _exchange(new, target):  # new now holds the old run
+            shutil.rmtree(new, ignore_errors=True)
+            return
+        old = Path(tempfile.mkdtemp(prefix=f".{target.name}.", suffix=".old", dir=target.parent))
+        os.rmdir(old)
+        try:
+            os.rename(target, old)
+        except FileNotFoundError:
+            continue
+        shutil.rmtree(old, ignore_errors=True)
+    raise RunStoreError(f"{target}: could not be replaced (another process keeps writing it)")
+
+
+def _unflatten(arrays: dict[str, np.ndarray], group: str) -> dict[str, Any]:
+    out: dict[str, Any] = {}
+    for key, a in arrays.items():
+        head, _, rest = key.partition("/")
+        if head != group:
+            continue
+        node = out
+        *parents, leaf = rest.split("/")
+        for p in parents:
+            node = node.setdefault(p, {})
+        node[leaf] = a.tolist() if a.dtype.kind == "U" else a
+    return out
+
+
+def load_run(run_dir: str | os.PathLike) -> SavedRun:
+    """Read a run folder written by :func:`save_run`.
+
+    Raises
+    ------
+    FileNotFoundError
+        If the folder has no ``run.json``.
+    ValueError
+        If ``run.json`` is not a run of this format.
+    """
+    run_dir = Path(run_dir)
+    meta = json.loads((run_dir / "run.json").read_text())
+    if meta.get("format") != FORMAT:
+        raise ValueError(f"{run_dir}: not a {FORMAT} folder (format={meta.get('format')!r})")
+    arrays: dict[str, np.ndarray] = {}
+    if (run_dir / "run.npz").is_file():
+        with np.load(run_dir / "run.npz", allow_pickle=False) as z:
+            arrays = {k: z[k] for k in z.files}
+    model = _unflatten(arrays, "model")
+    model.update(meta.get("model_lists", {}))
+    return SavedRun(run_dir, meta, _unflatten(arrays, "details"), model, _unflatten(arrays, "history"),
+                    _unflatten(arrays, "truth"))

@@ -1,0 +1,305 @@
+"""Study files: a method comparison over scenarios x noise levels x seeds x identifiers.
+
+A study is a TOML file in ``studies/``::
+
+    [study]
+    name = "default"                    # = file stem
+    description = "..."
+    scenarios = ["cantilever_stiff_impact", "fivebar_multisine"]   # names in scenarios/ or paths
+    noise = [0.0, 1.0, 5.0]             # sensor noise, % of channel RMS (replaces the scenario's)
+    seeds = [0, 1, 2]                   # noise seeds (replace the scenario's seed)
+    identifiers = ["ls_sindy", "sindy_pi"]
+    plugins = []                        # optional: modules (dotted names or .py paths) that
+                                        # register extra rigs / identifiers
+
+    [identifiers.ls_sindy]              # optional hyperparameters, checked like a scenario's
+    rcond = 1e-8                        # [identify] table against the identifier's declared
+                                        # hyperparameters
+
+The grid is every (scenario, noise, seed, identifier).  A combination whose
+identifier kind ("structural" / "mechanical") differs from the scenario rig's
+kind cannot be run (a structural identifier has no model of a linkage) and is
+skipped: :meth:`Study.skipped` lists those, and the study is rejected if an
+identifier, or a scenario, matches nothing.  Every problem raises
+:class:`~testbed.core.errors.ScenarioError` naming the file, the key, the value and
+what is allowed.  Scenario paths are relative to the study file.  Each runnable
+(scenario, identifier) pair is also checked as a scenario's ``[identify]`` would be
+(term names for the rig's channels, windows against its record, simulation budget),
+with the study's hyperparameters over the scenario's own where the identifier is the
+scenario's method, so a study fails at load, not in its hundredth cell.
+"""
+
+from __future__ import annotations
+
+import importlib
+import importlib.util
+import os
+import sys
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from testbed.core.errors import ScenarioError
+from testbed.core.schema import Field, validate_header
+from testbed.pipeline.plugins import IDENTIFIERS, RIGS
+from testbed.pipeline.scenario import (
+    NAME_PATTERN,
+    NAME_PATTERN_DOC,
+    SCENARIO_DIR,
+    Scenario,
+    _check_stem,
+    _validate_identify,
+    check_identifier_for_rig,
+    load_scenario,
+    read_toml_file,
+    resolve_path,
+)
+
+STUDY_DIR = Path(__file__).resolve().parents[2] / "studies"
+
+STUDY_SCHEMA = {
+    "name": Field(str, doc="study name; must equal the file name without .toml",
+                  pattern=NAME_PATTERN, pattern_doc=NAME_PATTERN_DOC),
+    "description": Field(str, "", doc="one line for listings and reports"),
+    "scenarios": Field(list, item_type=str, min_items=1,
+                       doc="scenario names (in scenarios/) or .toml paths relative to the study file"),
+    "noise": Field(list, item_type=float, min_items=1, min=0.0, max=100.0, unit="% of channel RMS",
+                   doc="sensor-noise levels; each replaces the scenario's [noise] rms_percent"),
+    "seeds": Field(list, item_type=int, min_items=1, min=0,
+                   doc="noise seeds; each replaces the scenario's seed"),
+    "identifiers": Field(list, item_type=str, min_items=1, doc="registered identifier names"),
+    "plugins": Field(list, [], item_type=str,
+                     doc="modules (dotted names or .py paths relative to the study file) imported "
+                         "before validation and in every worker; they register extra rigs or "
+                         "identifiers"),
+}
+SECTIONS = ("study", "identifiers")
+
+
+@dataclass(frozen=True)
+class Study:
+    """A validated study.
+
+    Attributes
+    ----------
+    name, description : str
+    scenarios : tuple of Scenario
+        As loaded from their files (noise and seed are replaced per cell).
+    noise : tuple of float
+        Noise levels [% of channel RMS].
+    seeds : tuple of int
+    identifiers : tuple of str
+    params : dict of str to dict
+        Hyperparameters per identifier (``{}`` where the study gives none).
+    plugins : tuple of str
+        Absolute paths or dotted module names, imported before any lookup.
+    path : str, optional
+        The study file.
+    """
+
+    name: str
+    scenarios: tuple[Scenario, ...]
+    noise: tuple[float, ...]
+    seeds: tuple[int, ...]
+    identifiers: tuple[str, ...]
+    description: str = ""
+    params: dict[str, dict[str, Any]] = field(default_factory=dict)
+    plugins: tuple[str, ...] = ()
+    path: str | None = field(default=None, compare=False)
+
+    def combinations(self) -> list[tuple[Scenario, str]]:
+        """(scenario, identifier) pairs whose kinds agree, in study order."""
+        return [(sc, m) for sc in self.scenarios for m in self.identifiers
+                if _rig_kind(sc.rig) == _identifier_kind(m)]
+
+    def skipped(self) -> list[tuple[str, str, str]]:
+        """(scenario, identifier, reason) of the pairs left out because the kinds differ."""
+        return [(sc.name, m, f"identifier kind {_identifier_kind(m)!r} != rig kind {_rig_kind(sc.rig)!r}")
+                for sc in self.scenarios for m in self.identifiers
+                if _rig_kind(sc.rig) != _identifier_kind(m)]
+
+    def n_cells(self) -> int:
+        """Number of runnable cells: combinations x noise levels x seeds."""
+        return len(self.combinations()) * len(self.noise) * len(self.seeds)
+
+
+def _rig_kind(rig: str) -> str:
+
+    return RIGS.get(rig).kind
+
+
+def _identifier_kind(name: str) -> str:
+
+    return IDENTIFIERS.get(name).kind
+
+
+def import_plugins(plugins: tuple[str, ...] | list[str]) -> None:
+    """Import each plugin once (a dotted module name, or a ``.py`` file path).
+
+    A file is imported under a module name derived from its absolute path, so
+    importing it again (in the same process) is a no-op and its registrations
+    run once.
+    """
+    for p in plugins:
+        if not p.endswith(".py"):
+            importlib.import_module(p)
+            continue
+        path = Path(p).resolve()
+        modname = "_testbed_plugin_" + "".join(c if c.isalnum() else "_" for c in str(path))
+        if modname in sys.modules:
+            continue
+        spec = importlib.util.spec_from_file_location(modname, path)
+        if spec is None or spec.loader is None:
+            raise ImportError(f"cannot import plugin {p}")
+        module = importlib.util.module_from_spec(spec)
+        sys.modules[modname] = module
+        try:
+            spec.loader.exec_module(module)
+        except BaseException:
+            del sys.modules[modname]
+            raise
+
+
+def resolve_study_path(name_or_path: str | os.PathLike) -> Path:
+    """A path as given, or ``studies/<name>.toml`` for a bare study name."""
+    p = Path(name_or_path)
+    if p.suffix == ".toml" or p.exists() or len(p.parts) > 1:
+        return p
+    return STUDY_DIR / f"{p}.toml"
+
+
+def _no_duplicates(values: list, file: str, key: str) -> None:
+    seen = set()
+    for i, v in enumerate(values):
+        if v in seen:
+            raise ScenarioError(file, f"{key}[{i}]", v, f"duplicate; each entry of {key} must be unique")
+        seen.add(v)
+
+
+def load_study(name_or_path: str | os.PathLike) -> Study:
+    """Read and validate a study file (a path, or a name in ``studies/``).
+
+    Raises
+    ------
+    ScenarioError
+        For a missing or malformed file, an unknown section or key, a value of
+        the wrong type or out of bounds, an empty or duplicated list entry, an
+        unknown scenario or identifier, bad hyperparameters, or a grid with
+        nothing to run.
+    """
+    path = resolve_study_path(name_or_path)
+    file = str(path)
+    _check_stem(path, "study", STUDY_DIR)
+    raw = read_toml_file(path, "study")
+    return study_from_dict(raw, file=file, base=path.parent, stem=path.stem)
+
+
+def study_from_dict(raw: dict[str, Any], *, file: str = "<dict>", base: Path | None = None,
+                    stem: str | None = None) -> Study:
+    """Validate a study given as a dict of TOML tables (paths relative to ``base``)."""
+    base = base if base is not None else Path.cwd()
+    if not isinstance(raw, dict):
+        raise ScenarioError(file, allowed="expected a table of sections")
+    if "study" not in raw and "scenario" in raw:
+        raise ScenarioError(file, allowed="a scenario file (it has [scenario]), not a study; run "
+                                          "it with `testbed run`")
+    head = validate_header(raw, sections=SECTIONS, header="study", schema=STUDY_SCHEMA, file=file,
+                           stem=stem)
+    for key in ("scenarios", "noise", "seeds", "identifiers", "plugins"):
+        _no_duplicates(head[key], file, f"study.{key}")
+
+    plugins = tuple(str((base / p).resolve()) if p.endswith(".py") else p for p in head["plugins"])
+    for i, p in enumerate(plugins):
+        try:
+            import_plugins([p])
+        except Exception as e:
+            raise ScenarioError(file, f"study.plugins[{i}]", head["plugins"][i],
+                                f"an importable module or .py file; importing failed: "
+                                f"{type(e).__name__}: {e}") from None
+
+    for i, m in enumerate(head["identifiers"]):
+        if m not in IDENTIFIERS:
+            raise ScenarioError(file, f"study.identifiers[{i}]", m,
+                                "expected a registered identifier, one of "
+                                + ", ".join(IDENTIFIERS.names()))
+
+    scenarios = []
+    for i, s in enumerate(head["scenarios"]):
+        spath = resolve_path(s)
+        if not spath.is_absolute() and (s.endswith(".toml") or len(Path(s).parts) > 1):
+            spath = base / spath
+        if not spath.is_file():
+            known = sorted(p.stem for p in SCENARIO_DIR.glob("*.toml"))
+            raise ScenarioError(file, f"study.scenarios[{i}]", s,
+                                f"no scenario file {spath}; expected a name among "
+                                f"{', '.join(known) or '(none in ' + str(SCENARIO_DIR) + ')'} "
+                                "or a .toml path relative to the study file")
+        scenarios.append(load_scenario(spath, standalone=False))  # bars for the study's identifiers
+
+    params = _validate_params(raw.get("identifiers", {}), head["identifiers"], file)
+    study = Study(name=head["name"], description=head["description"], scenarios=tuple(scenarios),
+                  noise=tuple(head["noise"]), seeds=tuple(head["seeds"]),
+                  identifiers=tuple(head["identifiers"]), params=params, plugins=plugins, path=file)
+    _check_grid(study, head, file)
+    _check_cells(study, file)
+    return study
+
+
+def _check_cells(study: Study, file: str) -> None:
+    """Each runnable (scenario, identifier) pair's hyperparameters against the scenario's data.
+
+    The study's hyperparameters go over the scenario's own ``[identify]`` table where the
+    identifier is the scenario's method (as the sweep runs them).
+    """
+
+    for sc, m in study.combinations():
+        own = sc.identify if sc.identify and sc.identify["method"] == m else {"method": m}
+        params = {**own, **study.params.get(m, {})}
+        try:
+            check_identifier_for_rig(RIGS.get(sc.rig), sc.rig_params, sc.simulation, params,
+                                     file=file, section=f"identifiers.{m}")
+        except ScenarioError as e:
+            raise type(e)(file, e.key, e.value, f"{e.allowed} (for scenario {sc.name!r})") from None
+
+
+def _validate_params(table: Any, identifiers: list[str], file: str) -> dict[str, dict[str, Any]]:
+    if not isinstance(table, dict):
+        raise ScenarioError(file, "identifiers", table, "expected tables [identifiers.<name>]")
+    params: dict[str, dict[str, Any]] = {m: {} for m in identifiers}
+    for name, sub in table.items():
+        key = f"identifiers.{name}"
+        if name not in identifiers:
+            raise ScenarioError(file, key, sub, "hyperparameters for an identifier not in "
+                                "study.identifiers; allowed: " + ", ".join(identifiers))
+        if not isinstance(sub, dict):
+            raise ScenarioError(file, key, sub, f"expected a table [{key}] of hyperparameters")
+        if "method" in sub:
+            raise ScenarioError(file, f"{key}.method", sub["method"],
+                                "not allowed here: the table name is the identifier")
+        try:
+            checked = _validate_identify({"method": name, **sub}, file)
+        except ScenarioError as e:
+            k = (e.key or "").replace("identify.", f"{key}.", 1)
+            raise ScenarioError(file, k, e.value, e.allowed) from None
+        assert checked is not None
+        checked.pop("method")
+        # ints given for float hyperparameters come back widened, so 1 and 1.0 are one cell
+        params[name] = checked
+    return params
+
+
+def _check_grid(study: Study, head: dict[str, Any], file: str) -> None:
+    pairs = study.combinations()
+    for i, m in enumerate(study.identifiers):
+        if not any(pm == m for _, pm in pairs):
+            raise ScenarioError(file, f"study.identifiers[{i}]", m,
+                                f"a {_identifier_kind(m)} identifier but no scenario has a rig of that "
+                                "kind; every cell of it would be skipped")
+    for i, sc in enumerate(study.scenarios):
+        if not any(ps.name == sc.name for ps, _ in pairs):
+            raise ScenarioError(file, f"study.scenarios[{i}]", head["scenarios"][i],
+                                f"rig kind {_rig_kind(sc.rig)!r} but no identifier of that kind is "
+                                "listed; every cell of it would be skipped")
+    names = [sc.name for sc in study.scenarios]
+    _no_duplicates(names, file, "study.scenarios (names)")
+

@@ -1,0 +1,488 @@
+"""Run a study's grid of cells on one machine or a Dask cluster, resumably.
+
+A *cell* is one (scenario, noise level, seed, identifier) of a
+:class:`~testbed.studies.study.Study`.  :func:`run_sweep` sends every cell through one
+joblib seam (:func:`parallel`): sequential for ``jobs=1``, loky processes for
+``jobs>1``, and a ``distributed.Client`` with joblib's ``"dask"`` backend when a
+scheduler address is given.  It first simulates the clean datasets the cells
+need, one task per distinct rig configuration (cells that differ only in
+identifier, noise level or seed share one simulation through the
+:class:`~testbed.pipeline.cache.DatasetCache`, which derives each cell's noisy data on
+load), then runs the cells, writing each row as it arrives (:mod:`testbed.studies.results`).
+A rerun skips every cell already in the results; a killed sweep loses only the
+cells in flight.
+
+Faults: a damaged row file (e.g. truncated by a full disk) is named in a warning, set
+aside as ``*.bad`` and its cell run again; ``retry_failed`` runs the cells recorded as
+failed again.  Worker processes watch the sweep's main process and exit within
+:data:`WATCHDOG_PERIOD` seconds of its death (a ``kill -9`` of the sweep included), so no
+worker computes on as an orphan.
+
+With a Dask cluster on several machines, the dataset cache folder must be one
+all workers see (a shared file system); the results are written by the caller.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import hashlib
+import json
+import logging
+import math
+import os
+import sys
+import threading
+import time
+import traceback
+from collections.abc import Callable, Iterable, Iterator
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Any
+
+from joblib import Parallel, delayed, parallel_config
+
+from testbed.core.provenance import git_commit, versions
+from testbed.pipeline.cache import DatasetCache
+from testbed.pipeline.generate import noise_free_scenario
+from testbed.pipeline.plugins import IDENTIFIERS, RIGS
+from testbed.pipeline.scenario import Scenario
+from testbed.scoring.run import run_scenario
+from testbed.studies.results import ResultsError, consolidate, parts_dir, read_results, write_part
+from testbed.studies.study import Study, import_plugins, load_study
+
+DEFAULT_RESULTS_DIR = Path("out") / "studies"
+#: How often a worker checks that the sweep's main process is alive [s]: an orphaned worker
+#: stops within this time; a check is one getppid call, so polling costs nothing measurable.
+WATCHDOG_PERIOD = 0.5
+
+log = logging.getLogger(__name__)
+
+
+@dataclass(frozen=True)
+class Cell:
+    """One run of a study: a scenario with its noise, seed and identifier filled in.
+
+    Attributes
+    ----------
+    key : str
+        :func:`cell_key` of ``scenario``.
+    study : str
+    scenario : Scenario
+        ``with_noise(noise).replace(seed=seed, identify={"method": identifier, **params})``.
+    noise : float
+        [% of channel RMS]
+    seed : int
+    identifier : str
+    params : dict
+        The identifier's hyperparameters (without ``method``).
+    """
+
+    key: str
+    study: str
+    scenario: Scenario
+    noise: float
+    seed: int
+    identifier: str
+    params: dict[str, Any]
+
+
+def cell_key(scenario: Scenario) -> str:
+    """Stable key of a cell: a hash of everything that decides its row.
+
+    The scenario's name, its data (:meth:`Scenario.data_hash`: rig, simulation,
+    excitation, noise, seed), its signal chain, its ``[identify]`` table
+    (identifier and hyperparameters) and its ``[score]`` thresholds.  Code
+    versions are left out, so a rerun after a code change still resumes; each row
+    records the versions and commit that computed it.
+    """
+    blob = json.dumps({"scenario": scenario.name, "data": scenario.data_hash(),
+                       "signal": scenario.signal, "identify": scenario.identify,
+                       "score": scenario.score}, sort_keys=True, separators=(",", ":"))
+    return hashlib.sha256(blob.encode()).hexdigest()[:20]
+
+
+#: Rough relative cost of one fit, for scheduling only (measured on the default study: pysindy's
+#: convex solves take 10-20 s, SGD-SINDy 1-10 s, the least-squares fits well under a second).
+_IDENTIFIER_COST = {"pysindy_pi": 100.0, "sgd_sindy": 10.0, "sindy_pi": 3.0}
+
+
+def _expected_cost(cell: Cell) -> float:
+    """Scheduling weight of a cell: identifier cost times the simulated duration."""
+    return _IDENTIFIER_COST.get(cell.identifier, 1.0) * float(
+        cell.scenario.simulation.get("duration", 1.0))
+
+
+def expand(study: Study) -> list[Cell]:
+    """Every runnable cell of ``study`` in grid order (scenario, identifier, noise, seed).
+
+    Pairs whose identifier kind differs from the rig kind are left out (see
+    :meth:`Study.skipped`).  An identifier that is the scenario's own ``[identify]`` method
+    starts from that table's hyperparameters; the study's table for it overrides them.
+    """
+    cells = []
+    for sc, method in study.combinations():
+        # The scenario's own [identify] hyperparameters hold for its own method (they were chosen
+        # for its data); the study's [identifiers.<name>] table overrides them.
+        own = sc.identify if sc.identify and sc.identify.get("method") == method else {}
+        params = {**{k: v for k, v in own.items() if k != "method"}, **study.params.get(method, {})}
+        for noise in study.noise:
+            for seed in study.seeds:
+                csc = sc.with_noise(noise).replace(seed=seed, identify={"method": method, **params})
+                cells.append(Cell(cell_key(csc), study.name, csc, float(noise), int(seed), method,
+                                  dict(params)))
+    return cells
+
+
+# --------------------------------------------------------------------------- the joblib seam
+@contextlib.contextmanager
+def _backend(jobs: int, dask_address: str | None) -> Iterator[int]:
+    """Configure joblib for the run; yield the ``n_jobs`` to give ``Parallel``."""
+    if dask_address:
+        from distributed import Client
+
+        with Client(dask_address) as client, parallel_config(backend="dask"):
+            client.wait_for_workers(1, timeout=60)
+            yield -1
+    elif jobs > 1:
+        with parallel_config(backend="loky", inner_max_num_threads=1):
+            yield jobs
+    else:
+        with parallel_config(backend="sequential"):
+            yield 1
+
+
+def parallel(fn: Callable[..., Any], args: Iterable[tuple], n_jobs: int) -> Iterator[Any]:
+    """``fn(*a)`` for each ``a``, yielded as each finishes, under the active joblib backend.
+
+    ``batch_size=1`` so that each result is handed back (and written) as soon as
+    it exists rather than with a batch.
+    """
+    run = Parallel(n_jobs=n_jobs, return_as="generator_unordered", batch_size=1)
+    yield from run(delayed(fn)(*a) for a in args)
+
+
+# --------------------------------------------------------------------------- tasks (run in workers)
+def _error_text(e: BaseException) -> str:
+    tb = traceback.extract_tb(e.__traceback__)
+    where = f" ({Path(tb[-1].filename).name}:{tb[-1].lineno})" if tb else ""
+    return f"{type(e).__name__}: {e}{where}"
+
+
+_WORKER_LOCK = threading.Lock()
+_WATCHED: set[int] = set()
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # exists, owned by someone else (a recycled pid): not our sweep
+        return False
+    return True
+
+
+def watch_parent(parent: int | None, period: float = WATCHDOG_PERIOD) -> None:
+    """In a worker process: exit at once when the sweep's main process ``parent`` is gone.
+
+    Starts one daemon thread per process (later calls do nothing).  A loky worker is a
+    child of the main process, so its parent pid changes the moment the main process dies
+    (the orphan is adopted by init or a subreaper), even while the dead main process is a
+    zombie not yet reaped; a worker that is not a direct child polls ``parent`` itself.  The
+    thread ends the process with ``os._exit``, in the middle of a fit if need be: its cell
+    was not written and a rerun runs it.
+
+    Parameters
+    ----------
+    parent : int or None
+        Pid of the sweep's main process; None (a Dask worker, owned by its cluster) or this
+        process's own pid (a sequential sweep) starts nothing.
+    period : float
+        Seconds between checks.
+    """
+    if parent is None or parent == os.getpid():
+        return
+    with _WORKER_LOCK:
+        if _WATCHED:
+            return
+        _WATCHED.add(parent)
+    ppid = os.getppid()
+    direct = ppid == parent
+
+    def watch() -> None:
+        while (os.getppid() == ppid) if direct else _alive(parent):
+            time.sleep(period)
+        os._exit(3)  # 3: an exit status of its own, distinct from a failing cell's exception
+
+    threading.Thread(target=watch, name="testbed-parent-watchdog", daemon=True).start()
+
+
+def _prepare_worker(plugins: tuple[str, ...], parent: int | None = None) -> None:
+    """Import the plugins and load both registries, once per process; watch ``parent``.
+
+    The registries import their packages lazily on first lookup; a Dask worker
+    runs tasks in several threads, so the first load is serialised here.
+    See :func:`watch_parent` for ``parent``.
+    """
+
+    watch_parent(parent)
+    with _WORKER_LOCK:
+        import_plugins(plugins)
+        RIGS.names()
+        IDENTIFIERS.names()
+
+
+def ensure_dataset(scenario: Scenario, cache_dir: str, plugins: tuple[str, ...],
+                   parent: int | None = None) -> tuple[str, float, str]:
+    """Simulate ``scenario``'s clean dataset into the cache unless present (and intact).
+
+    ``parent``: the sweep's main process (see :func:`watch_parent`).
+
+    Returns
+    -------
+    (data_hash, seconds, error)
+        ``error`` is "" on success; a failure is left for the cells to record.
+    """
+
+    _prepare_worker(plugins, parent)
+    t0 = time.perf_counter()
+    try:
+        DatasetCache(cache_dir).clean(scenario)
+        err = ""
+    except Exception as e:
+        err = _error_text(e)
+    return scenario.data_hash(), time.perf_counter() - t0, err
+
+
+def run_cell(cell: Cell, cache_dir: str, plugins: tuple[str, ...],
+             parent: int | None = None) -> dict[str, Any]:
+    """Run one cell (dataset from the cache, identify, score) and return its results row.
+
+    Never raises for a failing cell: an exception, or a non-finite score, gives
+    ``status = "failed"`` with the error text, so the sweep goes on.  ``parent``: the
+    sweep's main process (see :func:`watch_parent`).
+    """
+
+    t0 = time.perf_counter()
+    sc = cell.scenario
+    row: dict[str, Any] = {
+        "study": cell.study, "cell": cell.key, "scenario": sc.name, "rig": sc.rig,
+        "noise": cell.noise, "seed": cell.seed, "identifier": cell.identifier,
+        "params": json.dumps(cell.params, sort_keys=True), "status": "ok", "error": "",
+        "fit_time": math.nan, "data_time": math.nan, "passed": False, "checks": "[]",
+        "dataset_hash": "",
+    }
+    try:
+        _prepare_worker(plugins, parent)
+
+        dataset = DatasetCache(cache_dir).get(sc)
+        row["data_time"] = time.perf_counter() - t0
+        row["dataset_hash"] = str(dataset.attrs.get("content_hash", ""))
+        result = run_scenario(sc, dataset=dataset)
+        row["fit_time"] = result.fit_time
+        row.update({k: float(v) for k, v in result.scores.values.items()})
+        row["checks"] = json.dumps([{**asdict(c), "passed": c.passed} for c in result.checks])
+        bad = sorted(k for k, v in result.scores.values.items() if not math.isfinite(v))
+        # a scored failure (fit failed, diverged, non-physical) keeps its reason; non-finite
+        # scores without one are named
+        reasons = [result.failure, bad and "non-finite scores: " + ", ".join(bad),
+                   not result.scores.values and "no scores"]
+        reason = "; ".join(r for r in reasons if r)
+        if reason:
+            row["status"], row["error"] = "failed", reason
+        row["passed"] = result.passed
+    except Exception as e:
+        row["status"], row["error"] = "failed", _error_text(e)
+    row["versions"] = json.dumps(versions(), sort_keys=True)
+    row["commit"] = git_commit()
+    row["cell_time"] = time.perf_counter() - t0
+    return row
+
+
+# --------------------------------------------------------------------------- the sweep
+def default_results_path(study: Study) -> Path:
+    """``out/studies/<study>.parquet`` under the current directory."""
+    return DEFAULT_RESULTS_DIR / f"{study.name}.parquet"
+
+
+class _Progress:
+    """Counters of a sweep, drawn as a rich progress bar only when stderr is a terminal."""
+
+    def __init__(self, label: str, total: int) -> None:
+        self.done = self.failed = 0
+        self._prog = None
+        if sys.stderr.isatty() and total:
+            from rich.console import Console
+            from rich.progress import (
+                BarColumn,
+                MofNCompleteColumn,
+                Progress,
+                TextColumn,
+                TimeElapsedColumn,
+                TimeRemainingColumn,
+            )
+
+            self._prog = Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
+                                  TextColumn("{task.fields[failed]} failed"), TimeElapsedColumn(),
+                                  TimeRemainingColumn(), console=Console(stderr=True), transient=True)
+            self._prog.start()
+            self._task = self._prog.add_task(label, total=total, failed=0)
+
+    def advance(self, failed: bool = False) -> None:
+        self.done += 1
+        self.failed += bool(failed)
+        if self._prog is not None:
+            self._prog.update(self._task, advance=1, failed=self.failed)
+
+    def close(self) -> None:
+        if self._prog is not None:
+            self._prog.stop()
+
+
+@dataclass
+class SweepStats:
+    """What one :func:`run_sweep` call did (pass one as ``stats=`` to have it filled in).
+
+    Attributes
+    ----------
+    cells, skipped_done, run, failed : int
+        Cells in the grid, already in the results, run now, failed now.
+    failed_total : int
+        Cells recorded as failed in the results at the end (now or by an earlier run).
+    datasets : int
+        Clean simulations run (absent from the cache); noisy datasets are derived, not counted.
+    data_seconds, cells_seconds : float
+        Wall time of the dataset phase and of the cell phase [s].
+    """
+
+    cells: int = 0
+    skipped_done: int = 0
+    run: int = 0
+    failed: int = 0
+    failed_total: int = 0
+    datasets: int = 0
+    data_seconds: float = 0.0
+    cells_seconds: float = 0.0
+
+
+def _say(msg: str, verbose: bool) -> None:
+    if verbose:
+        print(msg, file=sys.stderr, flush=True)
+
+
+def run_sweep(study: Study | str | os.PathLike, jobs: int = 1, dask_address: str | None = None,
+              results: str | os.PathLike | None = None, cache_dir: str | os.PathLike | None = None,
+              *, retry_failed: bool = False, verbose: bool = True,
+              stats: SweepStats | None = None) -> Path:
+    """Run every cell of ``study`` not yet in ``results``; return the results file.
+
+    Parameters
+    ----------
+    study : Study or path
+        A loaded study, or a study file / name to load.
+    jobs : int
+        Worker processes (joblib loky) when > 1; 1 runs in this process.
+    dask_address : str, optional
+        Scheduler address of a running ``dask.distributed`` cluster; the cells then
+        run on its workers through joblib's dask backend (``jobs`` is ignored).
+    results : path, optional
+        Parquet results file (default ``out/studies/<study>.parquet``).  Rows already
+        there (or in its ``.parts/`` folder from a killed run) are kept and their
+        cells skipped.
+    cache_dir : path, optional
+        Dataset cache folder (default :func:`testbed.pipeline.cache.default_cache_dir`).
+    retry_failed : bool
+        Run the cells recorded as failed again.  (Cells whose row file is damaged run
+        again anyway: the file is named in a warning and set aside as ``*.bad``.)
+    verbose : bool
+        One line on stderr about what is skipped and run.
+    stats : SweepStats, optional
+        Filled in with counts and phase wall times.
+
+    Returns
+    -------
+    Path
+        The consolidated results file: one row per cell of the study's grid (rows of
+        cells no longer in the grid, e.g. after editing the study, are dropped).  Failed
+        cells do not raise; see ``stats.failed_total``.  If the sweep itself is interrupted
+        by an exception (e.g. a worker killed from outside), the rows that finished are
+        consolidated before it propagates.
+    """
+
+    if not isinstance(study, Study):
+        study = load_study(study)
+    if jobs < 1:
+        raise ValueError(f"jobs must be >= 1, got {jobs}")
+    results = Path(results) if results is not None else default_results_path(study)
+    cache = DatasetCache(cache_dir)
+    cache_path = str(cache.directory.resolve())
+    cells = expand(study)
+    if parts_dir(results).is_dir():  # temporary files of a write that was killed
+        for tmp in parts_dir(results).glob(".*.tmp"):
+            tmp.unlink(missing_ok=True)
+    try:
+        previous = read_results(results, set_aside=True)
+    except ResultsError as e:  # a damaged consolidated file: keep it aside, rerun its cells
+        bad = results.with_name(results.name + ".bad")
+        os.replace(results, bad)
+        log.warning("%s; set aside as %s, its cells will run again", e, bad.name)
+        previous = read_results(results, set_aside=True)
+    done = {r["cell"] for r in previous if not (retry_failed and r["status"] == "failed")}
+    todo = [c for c in cells if c.key not in done]
+    skipped = study.skipped()
+    _say(f"sweep {study.name}: {len(cells)} cells ({len(skipped) * len(study.noise) * len(study.seeds)} "
+         f"skipped: identifier kind != rig kind), {len(cells) - len(todo)} already done, "
+         f"{len(todo)} to run", verbose)
+
+    stats = stats if stats is not None else SweepStats()
+    stats.cells, stats.skipped_done, stats.run = len(cells), len(cells) - len(todo), len(todo)
+    stats.failed = 0
+    # Every dataset derives from its configuration's clean simulation, the one file the cache
+    # holds for it (testbed.pipeline.cache): simulate each missing one once, in parallel, before the
+    # cells, so that two workers never simulate the same configuration.
+    missing: dict[Path, Scenario] = {}
+    for c in todo:
+        p = cache.path(c.scenario)
+        if p not in missing and not p.is_file():
+            missing[p] = noise_free_scenario(c.scenario)
+    stats.datasets = len(missing)
+    # Longest-processing-time-first: dispatch the cells expected to take longest first, so that
+    # no worker is left with a long cell at the end.  The order changes no row.
+    todo = sorted(todo, key=_expected_cost, reverse=True)
+    # workers of a local pool watch this process; Dask workers belong to their cluster
+    parent = os.getpid() if not dask_address and jobs > 1 else None
+    try:
+        with _backend(jobs, dask_address) as n_jobs:
+            t0 = time.perf_counter()
+            if missing:
+                bar = _Progress("datasets", len(missing))
+                try:
+                    for _, _, err in parallel(ensure_dataset, [(s, cache_path, study.plugins, parent)
+                                                               for s in missing.values()], n_jobs):
+                        bar.advance(bool(err))
+                finally:
+                    bar.close()
+            t1 = time.perf_counter()
+            bar = _Progress(f"{study.name}", len(todo))
+            try:
+                for row in parallel(run_cell, [(c, cache_path, study.plugins, parent) for c in todo],
+                                    n_jobs):
+                    write_part(results, row)
+                    stats.failed += row["status"] != "ok"
+                    bar.advance(row["status"] != "ok")
+            finally:
+                bar.close()
+            stats.data_seconds, stats.cells_seconds = t1 - t0, time.perf_counter() - t1
+    except Exception:
+        # keep what finished in the results file (atomically), then report the interruption
+        with contextlib.suppress(Exception):
+            consolidate(results, keep={c.key for c in cells}, study=study.name)
+        raise
+    _, dropped = consolidate(results, keep={c.key for c in cells}, study=study.name)
+    if dropped:
+        _say(f"dropped {dropped} row(s) of cells no longer in study {study.name}", verbose)
+    stats.failed_total = sum(r["status"] != "ok" for r in read_results(results))
+    if stats.failed_total:
+        _say(f"{stats.failed_total} cell(s) failed; `testbed sweep --retry-failed` runs them again",
+             verbose)
+    return results
