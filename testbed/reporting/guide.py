@@ -56,8 +56,8 @@ Everything is checked when the file loads, before anything is simulated: unknown
 wrong types and values out of bounds, and rules across keys (filter cut-offs below the
 Nyquist frequency, windows shorter than the record, the impact on a sensor, an identifier
 of the rig's kind, term names the data can provide, `f_min < f_max`).  A scenario whose run
-would need more than the budget of memory or integration steps (`testbed.core.budget`: 4 GiB,
-1e8 steps) is refused, naming the key that drives the cost.  Every error names the file,
+would need more than the budget of memory, integration steps or CPU time (`testbed.core.budget`:
+4 GiB, 1e8 steps, one hour) is refused, naming the key that drives the cost.  Every error names the file,
 the key, the value and what is allowed, on one line.  Scenario names are letters, digits,
 `_`, `.` and `-` (not starting with `.` or `-`), and equal the file name.
 Keys marked *required* must be given; every other key may be left out for its default

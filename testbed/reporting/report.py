@@ -22,8 +22,8 @@ from typing import Any
 import numpy as np
 
 from testbed.core.atomic import atomic_write_text
+from testbed.core.kinds import METRICS
 from testbed.reporting import figures as figs
-from testbed.scoring.scorers import METRICS
 from testbed.studies.results import read_results, score_columns
 from testbed.studies.runstore import SavedRun, load_run
 

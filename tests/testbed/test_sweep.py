@@ -309,7 +309,7 @@ def test_cli_summary_of_a_sweep(toy_dir, tmp_path, capsys):
 @pytest.mark.slow
 def test_smoke_study_on_the_real_rigs(tmp_path):
     """studies/smoke.toml end to end: one row per cell, each rig kind with its own scores."""
-    from testbed.scoring.scorers import metric_names
+    from testbed.core.kinds import metric_names
 
     study = load_study("smoke")
     rows = read_results(run_sweep(study, results=tmp_path / "smoke.parquet", cache_dir=tmp_path / "c",
