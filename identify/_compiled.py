@@ -1,0 +1,348 @@
+"""Compiled (numba) kernels for the inner loops that interpreted numpy cannot run fast.
+
+Imported lazily (numba's import costs ~0.4 s): by :meth:`identify._mechsim.ImplicitModel.simulate`,
+:meth:`identify._mechsim.LoopClosure` methods, :func:`identify._structural_sim.simulate_structural`
+(cubic models) and the SGD-SINDy optimiser (:mod:`identify._sgd_matrix`).  Compiled code is
+cached on disk (``cache=True``): the first call in a fresh checkout compiles (a few seconds),
+later processes load it.
+
+Status codes returned by the simulation kernels (the callers turn them into
+:class:`testbed.errors.DivergenceError` with the time at which they happened):
+``OK`` 0, ``SINGULAR_CLOSURE`` 1 (passive links collinear), ``NO_ASSEMBLY`` 2 (loop-closure
+Newton solve did not converge), ``SINGULAR_EQUATIONS`` 3 (identified equations singular in the
+accelerations), ``NON_FINITE`` 4 (state not finite).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+OK, SINGULAR_CLOSURE, NO_ASSEMBLY, SINGULAR_EQUATIONS, NON_FINITE = 0, 1, 2, 3, 4
+MESSAGES = {
+    SINGULAR_CLOSURE: "loop closure is singular (passive links collinear)",
+    NO_ASSEMBLY: "loop closure Newton solve did not converge (no assembly)",
+    SINGULAR_EQUATIONS: "identified equations are singular in the accelerations",
+    NON_FINITE: "simulation diverged (state not finite)",
+}
+
+_JIT = {"cache": True, "nogil": True, "fastmath": False, "error_model": "numpy"}
+
+
+# --------------------------------------------------------------------------------------------
+# Planar loop closure  sum_i a_i e(th_i) = b,  per sample (q, dq of shape (n,))
+# --------------------------------------------------------------------------------------------
+
+@njit(**_JIT)
+def _solve2(j11, j12, j21, j22, r1, r2, out):
+    """Solve [[j11, j12], [j21, j22]] z = r into out[0:2]; False if singular.
+
+    Singular: ``|det| < 1e-12 max(|j11|, |j22|)`` (passive links collinear).
+    """
+    det = j11 * j22 - j12 * j21
+    if not abs(det) >= 1e-12 * max(abs(j11), abs(j22), 1e-300):
+        return False
+    out[0] = (j22 * r1 - j12 * r2) / det
+    out[1] = (j11 * r2 - j21 * r1) / det
+    return True
+
+
+@njit(**_JIT)
+def closure_solve(a, b, p0, p1, q, tol, max_iter, z):
+    """Newton solve of the closure for the passive angles q[p0], q[p1] (in place).
+
+    The passive entries of ``q`` are the initial guess; ``z`` (2,) is scratch.  Returns a
+    status code (``OK``, ``SINGULAR_CLOSURE`` or ``NO_ASSEMBLY``).
+    """
+    n = a.size
+    for _ in range(max_iter):
+        gx, gy = 0.0, 0.0
+        for i in range(n):
+            gx += a[i] * math.cos(q[i])
+            gy += a[i] * math.sin(q[i])
+        gx -= b[0]
+        gy -= b[1]
+        # Jacobian columns a_i n(th_i) = a_i (-sin, cos)
+        if not _solve2(-a[p0] * math.sin(q[p0]), -a[p1] * math.sin(q[p1]),
+                       a[p0] * math.cos(q[p0]), a[p1] * math.cos(q[p1]), gx, gy, z):
+            return SINGULAR_CLOSURE
+        q[p0] -= z[0]
+        q[p1] -= z[1]
+        if max(abs(z[0]), abs(z[1])) < tol:
+            return OK
+    return NO_ASSEMBLY
+
+
+@njit(**_JIT)
+def closure_velocity(a, p0, p1, q, dq, z):
+    """Passive rates dq[p0], dq[p1] (in place) consistent with the closure; status code."""
+    sx, sy = 0.0, 0.0
+    for i in range(a.size):
+        if i != p0 and i != p1:
+            sx += -a[i] * math.sin(q[i]) * dq[i]
+            sy += a[i] * math.cos(q[i]) * dq[i]
+    if not _solve2(-a[p0] * math.sin(q[p0]), -a[p1] * math.sin(q[p1]),
+                   a[p0] * math.cos(q[p0]), a[p1] * math.cos(q[p1]), -sx, -sy, z):
+        return SINGULAR_CLOSURE
+    dq[p0], dq[p1] = z[0], z[1]
+    return OK
+
+
+@njit(**_JIT)
+def closure_acceleration_map(a, p0, p1, active, q, dq, P, r, z):
+    """``ddq_p = P ddq_a + r`` at one state: P (2, n_a), r (2,) filled in place; status code."""
+    j11, j12 = -a[p0] * math.sin(q[p0]), -a[p1] * math.sin(q[p1])
+    j21, j22 = a[p0] * math.cos(q[p0]), a[p1] * math.cos(q[p1])
+    wx, wy = 0.0, 0.0
+    for i in range(a.size):
+        w2 = a[i] * (dq[i] * dq[i])
+        wx += w2 * math.cos(q[i])
+        wy += w2 * math.sin(q[i])
+    if not _solve2(j11, j12, j21, j22, wx, wy, z):
+        return SINGULAR_CLOSURE
+    r[0], r[1] = z[0], z[1]
+    for m in range(active.size):
+        j = active[m]
+        _solve2(j11, j12, j21, j22, a[j] * math.sin(q[j]), -a[j] * math.cos(q[j]), z)
+        P[0, m], P[1, m] = z[0], z[1]
+    return OK
+
+
+@njit(**_JIT)
+def closure_solve_many(a, b, p0, p1, Q, tol, max_iter):
+    """:func:`closure_solve` for every column of Q (n, N) in place; first bad status or OK."""
+    z = np.empty(2)
+    qs = np.empty(Q.shape[0])
+    for s in range(Q.shape[1]):
+        qs[:] = Q[:, s]
+        st = closure_solve(a, b, p0, p1, qs, tol, max_iter, z)
+        if st != OK:
+            return st
+        Q[:, s] = qs
+    return OK
+
+
+@njit(**_JIT)
+def closure_velocity_many(a, p0, p1, Q, DQ):
+    """:func:`closure_velocity` for every column of (Q, DQ) (n, N), DQ in place."""
+    z = np.empty(2)
+    qs, ds = np.empty(Q.shape[0]), np.empty(Q.shape[0])
+    for s in range(Q.shape[1]):
+        qs[:], ds[:] = Q[:, s], DQ[:, s]
+        st = closure_velocity(a, p0, p1, qs, ds, z)
+        if st != OK:
+            return st
+        DQ[p0, s], DQ[p1, s] = ds[p0], ds[p1]
+    return OK
+
+
+@njit(**_JIT)
+def closure_acceleration_map_many(a, p0, p1, active, Q, DQ, P, R):
+    """:func:`closure_acceleration_map` per column: P (N, 2, n_a), R (N, 2) filled."""
+    z = np.empty(2)
+    qs, ds = np.empty(Q.shape[0]), np.empty(Q.shape[0])
+    for s in range(Q.shape[1]):
+        qs[:], ds[:] = Q[:, s], DQ[:, s]
+        st = closure_acceleration_map(a, p0, p1, active, qs, ds, P[s], R[s], z)
+        if st != OK:
+            return st
+    return OK
+
+
+# --------------------------------------------------------------------------------------------
+# Identified implicit equations  coef @ Theta(q, dq, ddq, u) = 0,  per sample
+# --------------------------------------------------------------------------------------------
+
+@njit(**_JIT)
+def term_values(q, dq, u, arg, is_sin, idx, F, out):
+    """Library terms at one state with zero accelerations (a :class:`identify.library.Library`
+    factor table): F (3n + m + n_trig + 1,) scratch, out (n_terms,) filled.
+
+    Factor rows ``[q (n); dq (n); ddq = 0 (n); u (m); trig (n_trig); 1]``; term c is the
+    product of the rows ``idx[c]`` in order (the acceleration factor replaced by 1 in
+    ``Library._idx_noacc``).
+    """
+    n, m, nt = q.size, u.size, arg.shape[0]
+    for i in range(n):
+        F[i] = q[i]
+        F[n + i] = dq[i]
+        F[2 * n + i] = 0.0
+    for i in range(m):
+        F[3 * n + i] = u[i]
+    for k in range(nt):
+        ang = 0.0
+        for i in range(n):
+            if arg[k, i] != 0.0:
+                ang += arg[k, i] * q[i]
+        F[3 * n + m + k] = math.sin(ang) if is_sin[k] else math.cos(ang)
+    F[3 * n + m + nt] = 1.0
+    for c in range(idx.shape[0]):
+        v = F[idx[c, 0]]
+        for j in range(1, idx.shape[1]):
+            v *= F[idx[c, j]]
+        out[c] = v
+
+
+@njit(**_JIT)
+def _lu_solve(A, x):
+    """Solve A x = b in place (A (k, k) overwritten, x holds b); partial pivoting; False if
+    a pivot is exactly zero or not finite."""
+    k = A.shape[0]
+    for c in range(k):
+        p = c
+        for i in range(c + 1, k):
+            if abs(A[i, c]) > abs(A[p, c]):
+                p = i
+        if not (A[p, c] != 0.0 and math.isfinite(A[p, c])):
+            return False
+        if p != c:
+            for j in range(k):
+                A[c, j], A[p, j] = A[p, j], A[c, j]
+            x[c], x[p] = x[p], x[c]
+        for i in range(c + 1, k):
+            f = A[i, c] / A[c, c]
+            for j in range(c, k):
+                A[i, j] -= f * A[c, j]
+            x[i] -= f * x[c]
+    for c in range(k - 1, -1, -1):
+        s = x[c]
+        for j in range(c + 1, k):
+            s -= A[c, j] * x[j]
+        x[c] = s / A[c, c]
+    return True
+
+
+@njit(**_JIT)
+def accelerations(q, dq, u, coef, acc_index, arg, is_sin, idx, actuated, has_closure, a, p0, p1,
+                  active, ddq, work):
+    """Accelerations ddq (n,) at a consistent state under input u (m,); status code.
+
+    ``coef`` (n_eq, n_terms) multiplies the terms; ``acc_index[c]`` is the coordinate whose
+    acceleration multiplies term c (-1: none).  With a closure the passive accelerations
+    ``ddq_p = P ddq_a + r`` are eliminated: ``(A_a + A_p P) ddq_a = -(f + A_p r)``.
+    ``work`` is a :class:`Work` tuple of scratch arrays.
+    """
+    F, vals, A, Ared, rhs, P, r, z = work
+    n_eq, p = coef.shape
+    n = q.size
+    term_values(q, dq, u, arg, is_sin, idx, F, vals)
+    for e in range(n_eq):
+        f = 0.0
+        for k in range(n):
+            A[e, k] = 0.0
+        for c in range(p):
+            ak = acc_index[c]
+            if ak < 0:
+                f += coef[e, c] * vals[c]
+            else:
+                A[e, ak] += coef[e, c] * vals[c]
+        rhs[e] = -f
+        for m in range(n_eq):
+            Ared[e, m] = A[e, actuated[m]]
+    if has_closure:
+        st = closure_acceleration_map(a, p0, p1, active, q, dq, P, r, z)
+        if st != OK:
+            return st
+        for e in range(n_eq):
+            for m in range(n_eq):
+                Ared[e, m] += A[e, p0] * P[0, m] + A[e, p1] * P[1, m]
+            rhs[e] -= A[e, p0] * r[0] + A[e, p1] * r[1]
+    if not _lu_solve(Ared, rhs):
+        return SINGULAR_EQUATIONS
+    for k in range(n):
+        ddq[k] = 0.0
+    for m in range(n_eq):
+        ddq[actuated[m]] = rhs[m]
+    if has_closure:
+        s0, s1 = 0.0, 0.0
+        for m in range(n_eq):
+            s0 += P[0, m] * rhs[m]
+            s1 += P[1, m] * rhs[m]
+        ddq[p0] = s0 + r[0]
+        ddq[p1] = s1 + r[1]
+    return OK
+
+
+@njit(**_JIT)
+def make_work(n, n_eq, n_terms, n_factors):
+    """Scratch arrays for :func:`accelerations`."""
+    return (np.empty(n_factors), np.empty(n_terms), np.empty((n_eq, n)), np.empty((n_eq, n_eq)),
+            np.empty(n_eq), np.empty((2, n_eq)), np.empty(2), np.empty(2))
+
+
+@njit(**_JIT)
+def accelerations_many(Q, DQ, U, coef, acc_index, arg, is_sin, idx, actuated, has_closure, a,
+                       p0, p1, active, DDQ):
+    """:func:`accelerations` per column of Q, DQ (n, N), U (m, N) into DDQ (n, N)."""
+    n, N = Q.shape
+    work = make_work(n, coef.shape[0], coef.shape[1], arg.shape[0] + 3 * n + U.shape[0] + 1)
+    qs, ds, us, dd = np.empty(n), np.empty(n), np.empty(U.shape[0]), np.empty(n)
+    for s in range(N):
+        qs[:], ds[:], us[:] = Q[:, s], DQ[:, s], U[:, s]
+        st = accelerations(qs, ds, us, coef, acc_index, arg, is_sin, idx, actuated, has_closure,
+                           a, p0, p1, active, dd, work)
+        if st != OK:
+            return st, s
+        DDQ[:, s] = dd
+    return OK, -1
+
+
+@njit(**_JIT)
+def rk4_implicit(q, dq, UU, h, n_steps, coef, acc_index, arg, is_sin, idx, actuated,
+                 has_closure, a, b, p0, p1, active, Q, DQ, DDQ):
+    """Fixed-step RK4 of the actuated state of an identified implicit model.
+
+    ``q, dq`` (n,): consistent initial state (passive rows solved).  ``UU`` (m, 2 n_steps + 1):
+    inputs at the half-step times.  Every stage sets the actuated state, completes the passive
+    angles (Newton from the previous stage's) and rates, and evaluates the accelerations.
+    Fills Q, DQ, DDQ (n_steps + 1, n) with the state at the start of each step (and the end).
+
+    Returns
+    -------
+    (status, step)
+        ``OK, -1`` or the status code and the step at which it occurred.
+    """
+    n = q.size
+    n_eq = actuated.size
+    work = make_work(n, n_eq, coef.shape[1], arg.shape[0] + 3 * n + UU.shape[0] + 1)
+    z = np.empty(2)
+    ya, va = np.empty(n_eq), np.empty(n_eq)
+    kx, kv = np.empty((4, n_eq)), np.empty((4, n_eq))
+    dd = np.empty(n)
+    for m in range(n_eq):
+        ya[m], va[m] = q[actuated[m]], dq[actuated[m]]
+    for s in range(n_steps + 1):
+        last = s == n_steps
+        for stage in range(1 if last else 4):
+            c = 0.0 if stage == 0 else (0.5 * h if stage < 3 else h)
+            for m in range(n_eq):
+                q[actuated[m]] = ya[m] + c * kx[stage - 1, m] if stage else ya[m]
+                dq[actuated[m]] = va[m] + c * kv[stage - 1, m] if stage else va[m]
+            if has_closure:
+                st = closure_solve(a, b, p0, p1, q, 1e-13, 30, z)
+                if st == OK:
+                    st = closure_velocity(a, p0, p1, q, dq, z)
+                if st != OK:
+                    return st, s
+            k = 2 * s + (0 if stage == 0 else (1 if stage < 3 else 2))
+            st = accelerations(q, dq, UU[:, k], coef, acc_index, arg, is_sin, idx, actuated,
+                               has_closure, a, p0, p1, active, dd, work)
+            if st != OK:
+                return st, s
+            if stage == 0:
+                Q[s] = q
+                DQ[s] = dq
+                DDQ[s] = dd
+            for m in range(n_eq):
+                kx[stage, m] = dq[actuated[m]]
+                kv[stage, m] = dd[actuated[m]]
+        if last:
+            break
+        for m in range(n_eq):
+            ya[m] = ya[m] + h / 6 * (kx[0, m] + 2 * kx[1, m] + 2 * kx[2, m] + kx[3, m])
+            va[m] = va[m] + h / 6 * (kv[0, m] + 2 * kv[1, m] + 2 * kv[2, m] + kv[3, m])
+            if not (math.isfinite(ya[m]) and math.isfinite(va[m])):
+                return NON_FINITE, s
+    return OK, -1
