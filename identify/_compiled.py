@@ -346,3 +346,57 @@ def rk4_implicit(q, dq, UU, h, n_steps, coef, acc_index, arg, is_sin, idx, actua
             if not (math.isfinite(ya[m]) and math.isfinite(va[m])):
                 return NON_FINITE, s
     return OK, -1
+
+
+# --------------------------------------------------------------------------------------------
+# Cubic structural models  x'' = -M^-1 (C x' + K x + K3 x^3) + M^-1 f
+# --------------------------------------------------------------------------------------------
+
+@njit(**_JIT)
+def _cubic_rhs(A, MK3, z, fk, out):
+    """``out = A z + [0; fk - MK3 z[:n]^3]`` for the state z (2n,)."""
+    nz = z.size
+    n = nz // 2
+    for i in range(nz):
+        s = 0.0
+        for j in range(nz):
+            s += A[i, j] * z[j]
+        out[i] = s
+    for i in range(n):
+        s = 0.0
+        for j in range(n):
+            s += MK3[i, j] * (z[j] * z[j] * z[j])
+        out[n + i] += fk[i] - s
+
+
+@njit(**_JIT)
+def rk4_cubic(A, MK3, MF, z0, h, sub, Z):
+    """Classical RK4 of ``z' = A z + [0; MF[:, k-1] - MK3 x^3]`` with ``sub`` steps of h [s] per
+    sample interval, the force held over each interval; Z (2n, n_t) filled from Z[:, 0] = z0.
+
+    Returns the first sample index at which the state is not finite, or -1.
+    """
+    nz = z0.size
+    z = z0.copy()
+    k1, k2, k3, k4, y = np.empty(nz), np.empty(nz), np.empty(nz), np.empty(nz), np.empty(nz)
+    Z[:, 0] = z0
+    for k in range(1, Z.shape[1]):
+        fk = MF[:, k - 1]
+        for _ in range(sub):
+            _cubic_rhs(A, MK3, z, fk, k1)
+            for i in range(nz):
+                y[i] = z[i] + 0.5 * h * k1[i]
+            _cubic_rhs(A, MK3, y, fk, k2)
+            for i in range(nz):
+                y[i] = z[i] + 0.5 * h * k2[i]
+            _cubic_rhs(A, MK3, y, fk, k3)
+            for i in range(nz):
+                y[i] = z[i] + h * k3[i]
+            _cubic_rhs(A, MK3, y, fk, k4)
+            for i in range(nz):
+                z[i] = z[i] + (h / 6.0) * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
+        for i in range(nz):
+            if not math.isfinite(z[i]):
+                return k
+        Z[:, k] = z
+    return -1
