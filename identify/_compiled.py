@@ -400,3 +400,268 @@ def rk4_cubic(A, MK3, MF, z0, h, sub, Z):
                 return k
         Z[:, k] = z
     return -1
+
+
+# --------------------------------------------------------------------------------------------
+# SGD-SINDy, matrix parametrisation (identify/_sgd_matrix.py): loss and gradients from a
+# second-moment matrix, Adam steps over mini-batches
+# --------------------------------------------------------------------------------------------
+
+@njit(**_JIT)
+def _theta(L, P, Q, R, m0, c0, k0, sc3, T):
+    """Rows ``T_i = [M_i, C_i, K_i, K3_i, e_i]`` (n, 5n): the residual of row i at a sample is
+    ``r_i = T_i z`` with z the sample's features ``[x'', x', x, x^3, -B u]`` (5n,)."""
+    n = L.shape[0]
+    for i in range(n):
+        for j in range(n):
+            s = 0.0
+            for k in range(n):
+                s += L[i, k] * L[j, k]
+            T[i, j] = m0 * s
+            T[i, n + j] = c0 * (0.5 * (Q[i, j] + Q[j, i]))
+            T[i, 2 * n + j] = k0 * (0.5 * (P[i, j] + P[j, i]))
+            T[i, 3 * n + j] = sc3[i, j] * R[i, j]
+            T[i, 4 * n + j] = 1.0 if i == j else 0.0
+
+
+@njit(**_JIT)
+def _grads(TS, e2, b, T, L, m0, c0, k0, sc3, s_a, gL, gP, gQ, gR):
+    """Data loss and gradients from ``TS[i, j] = sum_t r_i z_j`` and ``e2[i] = sum_t r_i^2``
+    over b samples.
+
+    The loss is ``sum_i w_i^2 e2_i / (b n)`` with ``w_i = 1 / (M_ii s_a_i)`` (the paper's
+    per-row reconstruction error, standardised).  Gradients (n, n) with respect to ``L``
+    (lower triangular, ``M = m0 L L^T``), ``P``, ``Q`` (``K = k0 sym(P)``, ``C = c0 sym(Q)``)
+    and ``R`` (``K3 = sc3 * R``) are written in place.
+    """
+    n = L.shape[0]
+    c = 2.0 / (b * n)
+    loss = 0.0
+    gM = np.empty((n, n))
+    for i in range(n):
+        w2 = 1.0 / (T[i, i] * s_a[i]) ** 2
+        ei = w2 * e2[i]  # sum_t E_i(t)^2
+        loss += ei
+        g = c * w2
+        for j in range(n):
+            gM[i, j] = g * TS[i, j]
+            gQ[i, j] = g * TS[i, n + j]
+            gP[i, j] = g * TS[i, 2 * n + j]
+            gR[i, j] = sc3[i, j] * (g * TS[i, 3 * n + j])
+        gM[i, i] -= c * ei / T[i, i]
+    for i in range(n):
+        for j in range(i, n):
+            q = c0 * (0.5 * (gQ[i, j] + gQ[j, i]))
+            p = k0 * (0.5 * (gP[i, j] + gP[j, i]))
+            gQ[i, j], gQ[j, i], gP[i, j], gP[j, i] = q, q, p, p
+    for i in range(n):
+        for j in range(n):
+            if j > i:
+                gL[i, j] = 0.0
+                continue
+            s = 0.0
+            for k in range(n):
+                s += (gM[i, k] + gM[k, i]) * L[k, j]
+            gL[i, j] = m0 * s
+    return loss / (b * n)
+
+
+@njit(**_JIT)
+def batch_loss_grad(Z, idx, active, L, P, Q, R, m0, c0, k0, sc3, s_a, T, TS, e2, r,
+                    gL, gP, gQ, gR):
+    """Data loss and gradients (:func:`_grads`) over the samples ``idx`` of Z (N, 5n).
+
+    ``active`` lists the feature columns that are not identically zero (x^3 without a cubic
+    term, B u without input are skipped); T, TS (n, 5n), e2, r (n,) are scratch.
+    """
+    n = L.shape[0]
+    _theta(L, P, Q, R, m0, c0, k0, sc3, T)
+    TS[:, :] = 0.0
+    e2[:] = 0.0
+    for s in range(idx.size):
+        z = Z[idx[s]]
+        for i in range(n):
+            a = 0.0
+            for k in active:
+                a += T[i, k] * z[k]
+            r[i] = a
+            e2[i] += a * a
+        for i in range(n):
+            for k in active:
+                TS[i, k] += r[i] * z[k]
+    return _grads(TS, e2, idx.size, T, L, m0, c0, k0, sc3, s_a, gL, gP, gQ, gR)
+
+
+@njit(**_JIT)
+def window_loss_grad(S, b, L, P, Q, R, m0, c0, k0, sc3, s_a, T, TS, e2, gL, gP, gQ, gR):
+    """Data loss and gradients (:func:`_grads`) over a whole window from its second moments
+    ``S = sum_t z z^T`` (5n, 5n) of b samples: ``sum_t r_i z = T_i S``, ``sum_t r_i^2 =
+    T_i S T_i^T`` -- O(n^3) whatever b.  (The loss value then carries a cancellation error
+    of ~1e-16 relative to the squared size of the terms, not of the residual.)"""
+    n = L.shape[0]
+    nf = S.shape[0]
+    _theta(L, P, Q, R, m0, c0, k0, sc3, T)
+    for i in range(n):
+        e = 0.0
+        for j in range(nf):
+            s = 0.0
+            for k in range(nf):
+                s += T[i, k] * S[k, j]
+            TS[i, j] = s
+            e += s * T[i, j]
+        e2[i] = e
+    return _grads(TS, e2, b, T, L, m0, c0, k0, sc3, s_a, gL, gP, gQ, gR)
+
+
+@njit(**_JIT)
+def eig_loss_grad(L, P, m0, k0, lam_hat, eL, eP):
+    """Eigenvalue penalty ``sum_k ((lam_hat_k - lam_k) / lam_hat_k)^2`` over the lowest
+    generalised eigenvalues of ``(K, M)`` and its exact first-order gradient (with the
+    mass-normalised modes u: ``d lam = u^T (dK - lam dM) u``), chained to L and P (in place).
+    """
+    n = L.shape[0]
+    nk = lam_hat.size
+    M = np.empty((n, n))
+    K = np.empty((n, n))
+    for i in range(n):
+        for j in range(n):
+            s = 0.0
+            for k in range(n):
+                s += L[i, k] * L[j, k]
+            M[i, j] = m0 * s
+            K[i, j] = k0 * (0.5 * (P[i, j] + P[j, i]))
+    Lc = np.linalg.cholesky(M)
+    Li = np.linalg.inv(Lc)
+    lam, V = np.linalg.eigh(Li @ K @ Li.T)
+    U = Li.T @ V  # U^T M U = I
+    loss = 0.0
+    gK = np.zeros((n, n))
+    gM = np.zeros((n, n))
+    for k in range(nk):
+        r = (lam_hat[k] - lam[k]) / lam_hat[k]
+        loss += r * r
+        a, bb = -2.0 * r / lam_hat[k], 2.0 * r * lam[k] / lam_hat[k]
+        for i in range(n):
+            for j in range(n):
+                gK[i, j] += a * U[i, k] * U[j, k]
+                gM[i, j] += bb * U[i, k] * U[j, k]
+    for i in range(n):
+        for j in range(n):
+            eP[i, j] = k0 * (0.5 * (gK[i, j] + gK[j, i]))
+            if j > i:
+                eL[i, j] = 0.0
+            else:
+                s = 0.0
+                for k in range(n):
+                    s += (gM[i, k] + gM[k, i]) * L[k, j]
+                eL[i, j] = m0 * s
+    return loss
+
+
+@njit(**_JIT)
+def _adam(X, g, m, v, t, lr, b1, b2, eps, scale):
+    """One Adam step on X in place (moments m, v in place); ``scale`` gets the per-entry step
+    size ``lr / (sqrt(v_hat) + eps)`` (the metric of the lasso's proximal step)."""
+    c1, c2 = 1.0 - b1**t, 1.0 - b2**t
+    for i in range(X.shape[0]):
+        for j in range(X.shape[1]):
+            m[i, j] = b1 * m[i, j] + (1.0 - b1) * g[i, j]
+            v[i, j] = b2 * v[i, j] + (1.0 - b2) * g[i, j] * g[i, j]
+            sc = lr / (math.sqrt(v[i, j] / c2) + eps)
+            scale[i, j] = sc
+            X[i, j] += -sc * (m[i, j] / c1)
+
+
+@njit(**_JIT)
+def project(L, P, Q, R, m0, m_hat):
+    """Eq. 5 at its fixed point, in place: all matrices scaled together so that
+    ``trace(M) = trace(m0 L L^T) = m_hat``."""
+    n = L.shape[0]
+    tr = 0.0
+    for i in range(n):
+        for j in range(n):
+            tr += L[i, j] * L[i, j]
+    sc = m_hat / (m0 * tr)
+    sq = math.sqrt(sc)
+    for i in range(n):
+        for j in range(n):
+            L[i, j] *= sq
+            P[i, j] *= sc
+            Q[i, j] *= sc
+            R[i, j] *= sc
+
+
+@njit(**_JIT)
+def sgd_steps(Z, active, S_full, n_full, perm, bs, n_steps, params, adam, t0, lr, m0, c0, k0, sc3, s_a,
+              lam_hat, eig_gain, has_R, support, use_support, lam_l1, prox, m_hat):
+    """``n_steps`` Adam steps of the matrix-parametrised SGD-SINDy, in place.
+
+    Parameters
+    ----------
+    Z : ndarray, shape (N, 5n)
+        Features ``[x'', x', x, x^3, -B u]`` of each sample of the fit window; ``active``
+        (int array) the columns not identically zero.
+    S_full : ndarray, shape (5n, 5n)
+        Their second moments over the window; used for every step when ``bs <= 0`` (the exact
+        full-window gradient), ``n_full`` the number of samples.
+    perm : ndarray of int, shape (N,)
+        This epoch's sample order; step s takes ``perm[(s bs) % N : (s bs) % N + bs]`` (the
+        first ``bs`` if that is empty).
+    params : tuple of ndarray (n, n)
+        ``L, P, Q, R`` (``M = m0 L L^T``, ``K = k0 sym(P)``, ``C = c0 sym(Q)``,
+        ``K3 = sc3 * R``); updated in place.
+    adam : tuple of ndarray
+        ``(m, v, scale)`` per parameter, each (4, n, n), and the step count starts at ``t0``.
+    eig_gain : float
+        ``alpha_eig * epsilon`` (0: no eigenvalue term; ``lam_hat`` empty likewise).
+    has_R, support, use_support, lam_l1, prox
+        The cubic block: R updated only if ``has_R``; its gradient and value masked by
+        ``support`` if ``use_support``; soft-thresholded by ``lam_l1 * scale`` if ``prox``.
+    m_hat : float
+        Total mass [kg]; after every step all matrices are scaled so that trace(M) = m_hat.
+    """
+    L, P, Q, R = params
+    am, av, asc = adam
+    n = L.shape[0]
+    N = Z.shape[0]
+    nf = 5 * n
+    T, TS = np.empty((n, nf)), np.empty((n, nf))
+    e2, r = np.empty(n), np.empty(n)
+    g = np.zeros((4, n, n))
+    eL, eP = np.zeros((n, n)), np.zeros((n, n))
+    use_eig = eig_gain != 0.0 and lam_hat.size > 0
+    b1, b2, eps = 0.9, 0.999, 1e-12
+    for s in range(n_steps):
+        if bs > 0:
+            lo = (s * bs) % N
+            hi = min(lo + bs, N)
+            idx = perm[lo:hi] if hi > lo else perm[:bs]
+            batch_loss_grad(Z, idx, active, L, P, Q, R, m0, c0, k0, sc3, s_a, T, TS, e2, r,
+                            g[0], g[1], g[2], g[3])
+        else:
+            window_loss_grad(S_full, n_full, L, P, Q, R, m0, c0, k0, sc3, s_a, T, TS, e2,
+                             g[0], g[1], g[2], g[3])
+        if use_eig:
+            eig_loss_grad(L, P, m0, k0, lam_hat, eL, eP)
+            for i in range(n):
+                for j in range(n):
+                    g[0, i, j] += eig_gain * eL[i, j]
+                    g[1, i, j] += eig_gain * eP[i, j]
+        t = t0 + s + 1
+        _adam(L, g[0], am[0], av[0], t, lr, b1, b2, eps, asc[0])
+        _adam(P, g[1], am[1], av[1], t, lr, b1, b2, eps, asc[1])
+        _adam(Q, g[2], am[2], av[2], t, lr, b1, b2, eps, asc[2])
+        if has_R:
+            if use_support:
+                for i in range(n):
+                    for j in range(n):
+                        g[3, i, j] *= support[i, j]
+            _adam(R, g[3], am[3], av[3], t, lr, b1, b2, eps, asc[3])
+            for i in range(n):
+                for j in range(n):
+                    if prox:
+                        a = abs(R[i, j]) - lam_l1[i, j] * asc[3, i, j]
+                        R[i, j] = math.copysign(a, R[i, j]) if a > 0.0 else 0.0
+                    if use_support:
+                        R[i, j] *= support[i, j]
+        project(L, P, Q, R, m0, m_hat)
