@@ -215,7 +215,7 @@ def fit_matrix_sgd(data: Measurement, est: Any, m_hat: float, lam_hat: np.ndarra
     # features z = [x'', x', x, x^3, -B u] per sample (N, 5n): the residual of row i is T_i z;
     # the whole window's loss and gradient follow from its second moments (cc.window_loss_grad)
     Z = np.ascontiguousarray(np.vstack([xdd, xd, x, x3 if x3 is not None else np.zeros_like(x), -bu]).T)
-    active = np.flatnonzero(np.any(Z != 0.0, axis=0))
+    nfa = int(np.flatnonzero(np.any(Z != 0.0, axis=0)).max(initial=-1)) + 1  # trailing zero columns
     S_full = Z.T @ Z
     L = np.ascontiguousarray(L)
     P, Q = np.ascontiguousarray(P), np.ascontiguousarray(Q)
@@ -266,7 +266,7 @@ def fit_matrix_sgd(data: Measurement, est: Any, m_hat: float, lam_hat: np.ndarra
     no_support = np.zeros((n, n))
     for epoch in range(1, int(est.epochs) + 1):
         perm = rng.permutation(N) if bs else np.arange(0)
-        cc.sgd_steps(Z, active, S_full, N, perm, bs, spe, (L, P, Q, R), adam, n_steps,
+        cc.sgd_steps(Z, nfa, S_full, N, perm, bs, spe, (L, P, Q, R), adam, n_steps,
                      float(est.learning_rate), m0, c0, k0, sc3, s_a, lam_hat,
                      alpha["eig"] * eps_eig if use_eig else 0.0, has_R,
                      support if support is not None else no_support, support is not None,
