@@ -100,16 +100,43 @@ def _errors(W: np.ndarray, G: np.ndarray, cand: np.ndarray) -> np.ndarray:
 
 
 def _solve_masked(Gn: np.ndarray, cand: np.ndarray, mask: np.ndarray, ridge: float) -> np.ndarray:
-    """Batched least squares of column cand[k] on the columns mask[k], all k at once."""
-    m = mask.astype(float)
-    A = Gn[None, :, :] * (m[:, :, None] * m[:, None, :])
-    d = np.arange(Gn.shape[0])
-    A[:, d, d] += np.where(mask, ridge, 1.0)
-    rhs = Gn[cand] * m
-    try:
-        return np.linalg.solve(A, rhs[..., None])[..., 0]
-    except np.linalg.LinAlgError:  # an exactly singular support: minimum-norm solution instead
-        return (np.linalg.pinv(A, hermitian=True) @ rhs[..., None])[..., 0] * m
+    """Least squares of column cand[k] on the columns mask[k], for every k.
+
+    Each model is solved on its support only, ``(Gn[S, S] + ridge I) xi_S = Gn[c, S]`` (the
+    other coefficients are zero), with one factorisation per distinct support, shared by every
+    model on it (on exact data many left-hand sides share one support); supports of equal size
+    are solved in one batched LAPACK call.  An exactly singular support gets the minimum-norm
+    solution instead.
+    """
+    out = np.zeros(mask.shape)
+    groups: dict[bytes, list[int]] = {}
+    for k in range(mask.shape[0]):
+        groups.setdefault(np.packbits(mask[k]).tobytes(), []).append(k)
+    by_size: dict[int, list[list[int]]] = {}
+    for ks in groups.values():
+        by_size.setdefault(int(np.count_nonzero(mask[ks[0]])), []).append(ks)
+    for size, sups in by_size.items():
+        if size == 0:
+            continue
+        Sidx = np.array([np.flatnonzero(mask[ks[0]]) for ks in sups])          # (u, size)
+        jj = np.concatenate([np.full(len(ks), j) for j, ks in enumerate(sups)])  # support of model
+        ll = np.concatenate([np.arange(len(ks)) for ks in sups])               # its rhs slot
+        kk = np.concatenate(sups)
+        A = Gn[Sidx[:, :, None], Sidx[:, None, :]]
+        A[:, np.arange(size), np.arange(size)] += ridge
+        R = np.zeros((len(sups), size, int(ll.max()) + 1))
+        R[jj, :, ll] = Gn[cand[kk][:, None], Sidx[jj]]
+        try:
+            sol = np.linalg.solve(A, R)
+        except np.linalg.LinAlgError:  # some support exactly singular: one at a time
+            sol = np.empty_like(R)
+            for j in range(len(sups)):
+                try:
+                    sol[j] = np.linalg.solve(A[j], R[j])
+                except np.linalg.LinAlgError:
+                    sol[j] = np.linalg.pinv(A[j], hermitian=True) @ R[j]
+        out[kk[:, None], Sidx[jj]] = sol[jj, :, ll]
+    return out
 
 
 def stlsq_sweep(G_train: np.ndarray, G_val: np.ndarray, candidates: Sequence[int],
@@ -214,14 +241,20 @@ def rank_models(sw: Sweep, elig: np.ndarray, rtol: float, atol: float) -> np.nda
     flat_err = err.ravel()
     n_t, n_c = err.shape
     support = (sw.W != 0).reshape(n_t * n_c, -1)
-    # rank of each support among all supports in lexicographic library order (rule 3): the
-    # support read as a bit string, first library column most significant
-    _, sup_rank = np.unique(~support, axis=0, return_inverse=True)
+    # rank of each good model's support among the good ones in lexicographic library order
+    # (rule 3): the support read as a bit string, first library column most significant
+    # (a dense rank: equal supports share one)
+    sup_rank = np.zeros(n_t * n_c, dtype=np.int64)
+    gi = np.flatnonzero(good)
+    rows = ~support[gi]
+    order_s = np.lexsort(rows[:, ::-1].T)
+    new_row = np.r_[True, np.any(rows[order_s[1:]] != rows[order_s[:-1]], axis=1)]
+    sup_rank[gi[order_s]] = np.cumsum(new_row) - 1
     cand = np.tile(sw.candidates, n_t)
     thr = np.repeat(np.arange(n_t), n_c)
     tied_err = np.where(flat_err <= atol, 0.0, flat_err)
     big = np.iinfo(np.int64).max
-    order = np.lexsort((thr, cand, np.where(good, sup_rank.ravel(), big),
+    order = np.lexsort((thr, cand, np.where(good, sup_rank, big),
                         np.where(good, tied_err, flat_err),
                         np.where(good, sw.nnz.ravel(), big), ~good))
     return order[np.isfinite(flat_err[order])]
