@@ -39,13 +39,13 @@ def _kernels():
     return _compiled
 
 
-def _check(status: int, error: type[IdentificationError] = IdentificationError,
-           time: float | None = None) -> None:
-    """Raise ``error`` with the kernel's message unless ``status`` is OK."""
+def _check(status: int, time: float | None = None) -> None:
+    """Raise unless the kernel's ``status`` is OK: IdentificationError with its message, or,
+    given the simulation ``time`` [s] at which it happened, DivergenceError."""
     if status:
         msg = _kernels().MESSAGES[status]
         if time is None:
-            raise error(msg)
+            raise IdentificationError(msg)
         raise DivergenceError(msg, time=time)
 
 
