@@ -12,9 +12,10 @@ Three sweeps of the same study, each into a fresh results file:
 It also checks that the three runs give identical rows (timings and commit aside).
 
 The default study (``studies/default.toml``, 90 cells) is too slow to run three
-times here: sgd_sindy's fits take ~260 s per cell at its default 10000 epochs
-(measured 2025-11-22 on this 2-core machine), 27 such cells.  So the bench runs a
-documented subset by default: the default study's first seed, without
+times within the ~10 minutes of ``make bench``: sgd_sindy's fits at its default 10000
+epochs (1,000,000 mini-batch steps on a 1 s record) take ~15-20 s per cell since its
+steps are compiled (~260 s before), 27 such cells.  So the bench runs a documented subset
+by default: the default study's first seed, without
 sgd_sindy (24 cells, 12 datasets) - every other scenario, identifier and noise
 level is kept, so generation and the other fits are represented.  ``--seeds``,
 ``--exclude`` and ``--study`` choose another grid (``--exclude ''`` keeps all).
@@ -37,8 +38,14 @@ import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
-os.environ.setdefault("OMP_NUM_THREADS", "1")  # before numpy loads: one thread per worker
+# inherited by the loky workers (new processes: set before they start, so it takes effect
+# there); this process is pinned by threadpool_limits around each timed sweep
+os.environ.setdefault("OMP_NUM_THREADS", "1")
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
+from threadpoolctl import threadpool_limits
+
+from benchmarks._timing import machine
 from testbed.studies.results import read_results
 from testbed.studies.study import load_study
 from testbed.studies.sweep import SweepStats, run_sweep
@@ -65,9 +72,11 @@ def _differences(a: list[dict], b: list[dict]) -> str:
 
 def _timed(study, jobs: int, results: Path, cache: Path) -> tuple[float, SweepStats, list[dict]]:
     stats = SweepStats()
-    t0 = time.perf_counter()
-    run_sweep(study, jobs=jobs, results=results, cache_dir=cache, stats=stats, verbose=False)
-    return time.perf_counter() - t0, stats, read_results(results)
+    with threadpool_limits(1):
+        t0 = time.perf_counter()
+        run_sweep(study, jobs=jobs, results=results, cache_dir=cache, stats=stats, verbose=False)
+        t = time.perf_counter() - t0
+    return t, stats, read_results(results)
 
 
 def run(study: str = "default", seeds: int | None = 1,
@@ -97,7 +106,7 @@ def run(study: str = "default", seeds: int | None = 1,
         t_par, st_par, rows_par = _timed(s, 2, d / "par.parquet", d / "cache_par")
         t_warm, st_warm, rows_warm = _timed(s, 2, d / "warm.parquet", d / "cache_par")
     ratio = t_par / t_seq
-    load = f"load average {load0:.1f} before, {os.getloadavg()[0]:.1f} after on {os.cpu_count()} cores"
+    load = f"load average {load0:.1f} before; after: {machine()}"
     failed = sum(r["status"] != "ok" for r in rows_par)
     diff = "; ".join(x for x in (_differences(rows_seq, rows_par), _differences(rows_par, rows_warm)) if x)
     same = not diff

@@ -8,6 +8,10 @@ accelerations from the actuated ones, ``ddq_p = P ddq_a + r``, and the equations
 ``(A_a + A_p P) ddq_a = -(f + A_p r)``.  The state ``(q_a, dq_a)`` is integrated by fixed-step
 RK4 (inputs linearly interpolated at the stage times); passive angles come from a vectorised
 Newton solve of the closure, passive rates from its first derivative.
+
+The per-state work (closure Newton solve, term evaluation, elimination, the RK4 loop) runs in
+compiled kernels (:mod:`identify._compiled`, imported on first use): one right-hand side of
+the identified five-bar costs a few microseconds instead of ~290 us of small numpy calls.
 """
 
 from __future__ import annotations
@@ -19,7 +23,7 @@ import numpy as np
 from scipy.interpolate import CubicHermiteSpline
 
 from identify.library import Library
-from testbed.core.errors import IdentificationError
+from testbed.core.errors import DivergenceError, IdentificationError
 from testbed.core.measurement import Trajectory
 
 #: A closure fitted or declared must close the measured loop to this fraction of the longest
@@ -28,12 +32,21 @@ from testbed.core.measurement import Trajectory
 CLOSURE_RTOL = 1e-3
 
 
-def _solve2(j11, j12, j21, j22, r1, r2):
-    """Solve [[j11, j12], [j21, j22]] z = r sample-wise (arrays of shape (N,))."""
-    det = j11 * j22 - j12 * j21
-    if np.any(np.abs(det) < 1e-12 * max(np.abs(j11).max(), np.abs(j22).max(), 1e-300)):
-        raise IdentificationError("loop closure is singular (passive links collinear)")
-    return (j22 * r1 - j12 * r2) / det, (j11 * r2 - j21 * r1) / det
+def _kernels():
+    """The compiled kernels (lazy: numba's import costs ~0.4 s)."""
+    from identify import _compiled
+
+    return _compiled
+
+
+def _check(status: int, time: float | None = None) -> None:
+    """Raise unless the kernel's ``status`` is OK: IdentificationError with its message, or,
+    given the simulation ``time`` [s] at which it happened, DivergenceError."""
+    if status:
+        msg = _kernels().MESSAGES[status]
+        if time is None:
+            raise IdentificationError(msg)
+        raise DivergenceError(msg, time=time)
 
 
 @dataclass
@@ -102,6 +115,9 @@ class LoopClosure:
         return cls(v[:n], v[n:], np.asarray(passive), "data (null vector of the closure rows)")
 
     def __post_init__(self) -> None:
+        self.a = np.ascontiguousarray(self.a, dtype=float)
+        self.b = np.ascontiguousarray(self.b, dtype=float)
+        self.passive = np.asarray(self.passive, dtype=np.intp)
         self.active = np.setdiff1d(np.arange(self.a.size), self.passive)
 
     def residual(self, x: np.ndarray, rms: bool = False) -> float:
@@ -113,32 +129,24 @@ class LoopClosure:
             return float(np.sqrt(np.mean(gx**2 + gy**2)) / np.abs(self.a).max())
         return float(max(np.abs(gx).max(), np.abs(gy).max()) / np.abs(self.a).max())
 
-    def _jac(self, q: np.ndarray) -> tuple[np.ndarray, ...]:
-        c, s = np.cos(q), np.sin(q)
-        return c, s, -self.a[:, None] * s, self.a[:, None] * c  # columns a_i n(th_i) = (jx, jy)
+    def _ints(self) -> tuple[int, int]:
+        return int(self.passive[0]), int(self.passive[1])
 
     def solve(self, q: np.ndarray, tol: float = 1e-13, max_iter: int = 30) -> np.ndarray:
-        """Passive angles for the actuated ones in ``q`` (n, N), passive rows as the guess."""
-        q = np.array(q, dtype=float)
-        p0, p1 = self.passive
-        for _ in range(max_iter):
-            c, s, jx, jy = self._jac(q)
-            z0, z1 = _solve2(jx[p0], jx[p1], jy[p0], jy[p1],
-                             self.a @ c - self.b[0], self.a @ s - self.b[1])
-            q[p0] -= z0
-            q[p1] -= z1
-            if max(np.abs(z0).max(), np.abs(z1).max()) < tol:
-                return q
-        raise IdentificationError("loop closure Newton solve did not converge (no assembly)")
+        """Passive angles for the actuated ones in ``q`` (n, N), passive rows as the guess.
+
+        Newton per sample until the step is below ``tol`` [rad] (at most ``max_iter`` steps).
+        """
+        q = np.array(q, dtype=float, order="C")
+        p0, p1 = self._ints()
+        _check(_kernels().closure_solve_many(self.a, self.b, p0, p1, q, tol, max_iter))
+        return q
 
     def velocity(self, q: np.ndarray, dq: np.ndarray) -> np.ndarray:
         """``dq`` with the passive rows replaced by the rates consistent with the closure."""
-        dq = np.array(dq, dtype=float)
-        _, _, jx, jy = self._jac(q)
-        p0, p1 = self.passive
-        act = self.active
-        dq[p0], dq[p1] = _solve2(jx[p0], jx[p1], jy[p0], jy[p1], -(jx[act] * dq[act]).sum(0),
-                                 -(jy[act] * dq[act]).sum(0))
+        dq = np.array(dq, dtype=float, order="C")
+        _check(_kernels().closure_velocity_many(self.a, *self._ints(),
+                                                np.ascontiguousarray(q, dtype=float), dq))
         return dq
 
     def reconcile(self, q: np.ndarray, dq: np.ndarray, ddq: np.ndarray
@@ -159,16 +167,13 @@ class LoopClosure:
         return q, dq, ddq
 
     def acceleration_map(self, q: np.ndarray, dq: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """``ddq_p = P ddq_a + r``: P (N, 2, n_a), r (N, 2)."""
-        c, s, jx, jy = self._jac(q)
-        p0, p1 = self.passive
-        J = (jx[p0], jx[p1], jy[p0], jy[p1])
-        w2 = self.a[:, None] * dq**2
-        r = _solve2(*J, (w2 * c).sum(0), (w2 * s).sum(0))
+        """``ddq_p = P ddq_a + r`` at consistent states q, dq (n, N): P (N, 2, n_a), r (N, 2)."""
+        q = np.ascontiguousarray(q, dtype=float)
         P = np.empty((q.shape[1], 2, self.active.size))
-        for m, j in enumerate(self.active):
-            P[:, 0, m], P[:, 1, m] = _solve2(*J, -jx[j], -jy[j])
-        return P, np.stack(r, axis=1)
+        r = np.empty((q.shape[1], 2))
+        _check(_kernels().closure_acceleration_map_many(
+            self.a, *self._ints(), self.active, q, np.ascontiguousarray(dq, dtype=float), P, r))
+        return P, r
 
 
 class ImplicitModel:
@@ -202,27 +207,33 @@ class ImplicitModel:
             raise IdentificationError(f"{self.coef.shape[0]} equations for "
                                       f"{self.actuated.size} actuated coordinates")
 
+    def _args(self) -> tuple:
+        """The model as the compiled kernels take it (after ``coef``: library tables, closure)."""
+        lib, cl = self.library, self.closure
+        if cl is None:
+            a, b, p0, p1, active = np.zeros(1), np.zeros(2), -1, -1, np.zeros(0, dtype=np.intp)
+        else:
+            a, b, (p0, p1), active = cl.a, cl.b, cl._ints(), cl.active.astype(np.intp)
+        return (np.ascontiguousarray(self.coef), lib.acc_index, lib._arg, lib._is_sin,
+                lib._idx_noacc, self.actuated, cl is not None, a, b, p0, p1, active)
+
+    def _inputs(self, u: np.ndarray | None, n_t: int) -> np.ndarray:
+        m = self.library.n_inputs
+        if not m:
+            return np.zeros((0, n_t))
+        if u is None or np.shape(u)[0] < m:
+            raise ValueError(f"library needs {m} input rows, got {0 if u is None else np.shape(u)[0]}")
+        return np.ascontiguousarray(np.atleast_2d(u)[:m], dtype=float)
+
     def accelerations(self, q: np.ndarray, dq: np.ndarray, u: np.ndarray | None) -> np.ndarray:
         """Accelerations (n, N) at consistent states q, dq (n, N) under inputs u (m, N)."""
-        free, acc = self.library.evaluate_parts(q, dq, u)
-        f = free @ self.coef.T                                   # (N, n_eq)
-        A = np.einsum("knp,ep->nek", acc, self.coef)             # (N, n_eq, n)
-        act = self.actuated
-        Ared, rhs = A[:, :, act], -f
-        if self.closure is not None:
-            pas = self.closure.passive
-            P, r = self.closure.acceleration_map(q, dq)
-            Ared = Ared + A[:, :, pas] @ P
-            rhs = rhs - np.einsum("nep,np->ne", A[:, :, pas], r)
-        try:
-            dda = np.linalg.solve(Ared, rhs[..., None])[..., 0]
-        except np.linalg.LinAlgError as exc:
-            raise IdentificationError("identified equations are singular in the "
-                                      "accelerations") from exc
-        ddq = np.zeros_like(np.asarray(q, dtype=float))
-        ddq[act] = dda.T
-        if self.closure is not None:
-            ddq[self.closure.passive] = (P @ dda[..., None])[..., 0].T + r.T
+        q = np.ascontiguousarray(q, dtype=float)
+        dq = np.ascontiguousarray(dq, dtype=float)
+        ddq = np.empty_like(q)
+        coef, acc_index, arg, is_sin, idx, act, has, a, _, p0, p1, active = self._args()
+        st, _ = _kernels().accelerations_many(q, dq, self._inputs(u, q.shape[1]), coef, acc_index,
+                                              arg, is_sin, idx, act, has, a, p0, p1, active, ddq)
+        _check(st)
         return ddq
 
     def _complete(self, q: np.ndarray, dq: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -244,6 +255,13 @@ class ImplicitModel:
         adds an impulse ``u(0) / (2 fs)`` at the start; on the five-bar multisine record
         (10 kHz) the exact equations then drift by 5e-4 rad over 10 s; with ``"zoh"`` they stay
         within 6e-7 rad at dt = 1 ms (8e-8 rad at 0.25 ms: what is left is RK4 sampling the input).
+
+        Raises
+        ------
+        DivergenceError
+            The state became non-finite, the loop closure lost assembly (Newton did not
+            converge) or became singular, or the equations became singular in the
+            accelerations; ``time`` [s] is the start of the failing step.
         """
         t = np.asarray(t, dtype=float)
         n_steps = max(1, int(np.ceil((t[-1] - t[0]) / dt - 1e-9)))
@@ -255,37 +273,28 @@ class ImplicitModel:
         uu = None if u is None else np.stack([np.interp(tt - delay, t, row) for row in np.atleast_2d(u)])
         act = self.actuated
         q, dq = self._complete(np.array(x0, float)[:, None], np.array(xd0, float)[:, None])
-        Q = np.empty((n_steps + 1, q.shape[0]))
+        n = q.shape[0]
+        Q = np.empty((n_steps + 1, n))
         DQ, DDQ = np.empty_like(Q), np.empty_like(Q)
-
-        def rhs(qa, dqa, k):
-            q[act, 0], dq[act, 0] = qa, dqa
-            qc, dqc = self._complete(q, dq)
-            q[:], dq[:] = qc, dqc
-            ddq = self.accelerations(qc, dqc, None if uu is None else uu[:, k:k + 1])
-            return dqc[act, 0].copy(), ddq[act, 0], ddq[:, 0]
-
-        ya, va = q[act, 0].copy(), dq[act, 0].copy()
-        for s in range(n_steps):
-            k1x, k1v, full = rhs(ya, va, 2 * s)
-            Q[s], DQ[s], DDQ[s] = q[:, 0], dq[:, 0], full
-            k2x, k2v, _ = rhs(ya + 0.5 * h * k1x, va + 0.5 * h * k1v, 2 * s + 1)
-            k3x, k3v, _ = rhs(ya + 0.5 * h * k2x, va + 0.5 * h * k2v, 2 * s + 1)
-            k4x, k4v, _ = rhs(ya + h * k3x, va + h * k3v, 2 * s + 2)
-            ya = ya + h / 6 * (k1x + 2 * k2x + 2 * k3x + k4x)
-            va = va + h / 6 * (k1v + 2 * k2v + 2 * k3v + k4v)
-            if not (np.all(np.isfinite(ya)) and np.all(np.isfinite(va))):
-                raise IdentificationError(f"simulation diverged at t = {t[0] + s * h:.4g} s")
-        _, _, full = rhs(ya, va, 2 * n_steps)
-        Q[-1], DQ[-1], DDQ[-1] = q[:, 0], dq[:, 0], full
+        coef, acc_index, arg, is_sin, idx, act, has, a, b, p0, p1, active = self._args()
+        st, step = _kernels().rk4_implicit(
+            np.ascontiguousarray(q[:, 0]), np.ascontiguousarray(dq[:, 0]),
+            self._inputs(uu, 2 * n_steps + 1), h, n_steps, coef, acc_index, arg, is_sin, idx,
+            act, has, a, b, p0, p1, active, Q, DQ, DDQ)
+        _check(st, time=float(t[0] + max(step, 0) * h))
         tg = t[0] + h * np.arange(n_steps + 1)
         qa = CubicHermiteSpline(tg, Q[:, act], DQ[:, act])(t).T
         va_ = CubicHermiteSpline(tg, DQ[:, act], DDQ[:, act])(t).T
-        x = np.empty((Q.shape[1], t.size))
+        x = np.empty((n, t.size))
         xd = np.empty_like(x)
-        for j in range(Q.shape[1]):  # passive rows: linear guesses, refined by the closure
+        for j in range(n):  # passive rows: linear guesses, refined by the closure
             x[j], xd[j] = np.interp(t, tg, Q[:, j]), np.interp(t, tg, DQ[:, j])
         x[act], xd[act] = qa, va_
-        x, xd = self._complete(x, xd)
-        u_t = None if u is None else np.atleast_2d(u)
-        return Trajectory(x, xd, self.accelerations(x, xd, u_t))
+        try:
+            x, xd = self._complete(x, xd)
+            u_t = None if u is None else np.atleast_2d(u)
+            return Trajectory(x, xd, self.accelerations(x, xd, u_t))
+        except DivergenceError:
+            raise
+        except IdentificationError as exc:  # between grid points: the time is not known
+            raise DivergenceError(str(exc)) from exc

@@ -48,6 +48,12 @@ class SGDSINDy(StructuralIdentifier):
         ``steps_per_epoch`` is set; ``n_steps_`` and ``history_["n_steps"]`` count the steps.
     batch_size : int
         Samples per mini-batch (Table 1: 128).
+    gradient : {"minibatch", "full"}
+        ``"minibatch"``: each step on a random mini-batch (a seeded permutation per epoch).
+        ``"full"``: each step on the exact gradient over the whole fit window (from the
+        features' second-moment matrix, O(n^3) per step whatever the window's length); an
+        epoch is then one step unless ``steps_per_epoch`` says otherwise.  Matrix
+        parametrisation only.
     learning_rate : float
         Step size of the coefficient optimiser in standardised units (Table 1: 1.5e-4).
     mass_learning_rate : float
@@ -251,6 +257,9 @@ class SGDSINDy(StructuralIdentifier):
                               doc="smallest partial correlation a cubic term needs to be kept"),
         "l1_debias": Field(float, 0.5, min=0.0, max=1.0, max_inclusive=False,
                            doc="fraction of the epochs, at the end, run without L1 on kept terms"),
+        "gradient": Field(str, "minibatch", choices=("minibatch", "full"),
+                          doc="mini-batch steps, or the exact full-window gradient each step "
+                              "(matrix parametrisation)"),
     }
 
     @classmethod
@@ -279,7 +288,7 @@ class SGDSINDy(StructuralIdentifier):
                  optimizer: str = "adam", init: str = "lstsq", mass_prior: str = "reduced_mass_trace",
                  mass_update: str = "lstsq", anneal: bool = True, alpha_max: float = 1.0,
                  random_state: int = 0, parametrization: str = "matrices", fit_duration: float = 0.0,
-                 l1_threshold: float = 0.2, l1_debias: float = 0.5):
+                 l1_threshold: float = 0.2, l1_debias: float = 0.5, gradient: str = "minibatch"):
         self.epochs = epochs
         self.batch_size = batch_size
         self.learning_rate = learning_rate
@@ -305,6 +314,7 @@ class SGDSINDy(StructuralIdentifier):
         self.fit_duration = fit_duration
         self.l1_threshold = l1_threshold
         self.l1_debias = l1_debias
+        self.gradient = gradient
 
     # ----------------------------------------------------------------------------------------
     def _check_params(self) -> None:

@@ -8,7 +8,6 @@ Arrays are (n_channels, n_samples); a 1-D array is one channel.  Two estimators:
 from __future__ import annotations
 
 import numpy as np
-from scipy import signal as ss
 
 from testbed.numerics.filters import _as_signal, _check_cutoff
 
@@ -91,6 +90,8 @@ def differentiate(x: np.ndarray, fs: float, window: int, polyorder: int
     xc = x - mean
     centre = _local_poly_rows(window, polyorder, np.array([half]))[:, 0]         # (p+1, window)
     edge = _local_poly_rows(window, polyorder, np.arange(half))                  # (p+1, half, window)
+    from scipy import signal as ss  # lazy: scipy.signal costs ~0.7 s of import
+
     out = []
     for d in (0, 1, 2):
         # correlation with the centre weights = convolution with the reversed weights
@@ -197,6 +198,8 @@ def lowpass_differentiate(x: np.ndarray, fs: float, cutoff_hz: float, order: int
                          f"2 <= order < samples <= {n}")
     start, end = _edge_jets(x2, fs, n_fit, int(edge_fit_order))
     bridge = _quintic_bridge(start, end, n, fs)
+    from scipy import signal as ss  # lazy: scipy.signal costs ~0.7 s of import
+
     sos = ss.butter(int(order), cutoff_hz, btype="lowpass", output="sos", fs=fs)
     pad = min(n - 1, round(8.0 / cutoff_hz * fs))
     ys = ss.sosfiltfilt(sos, x2 - bridge[0], axis=-1, padtype="odd", padlen=pad)

@@ -14,8 +14,6 @@ and 30 dB stop-band attenuation after each integration to remove drift.
 from __future__ import annotations
 
 import numpy as np
-from scipy import integrate
-from scipy import signal as ss
 
 
 def _as_signal(x: np.ndarray) -> np.ndarray:
@@ -49,6 +47,8 @@ def _filtfilt(sos: np.ndarray, x: np.ndarray) -> np.ndarray:
     if x.shape[-1] <= minimum:
         raise ValueError(f"signal of {x.shape[-1]} samples is too short for a zero-phase filter of "
                          f"order {2 * len(sos)} (needs more than {minimum} samples)")
+    from scipy import signal as ss  # lazy: scipy.signal costs ~0.7 s of import
+
     return ss.sosfiltfilt(sos, x, axis=-1)
 
 
@@ -74,6 +74,8 @@ def trapezoid(x: np.ndarray, fs: float) -> np.ndarray:
     a tenth of the sample rate.  Each integration multiplies the bias.
     """
     x = _as_signal(x)
+    from scipy import integrate  # lazy, as scipy.signal
+
     return integrate.cumulative_trapezoid(x, dx=1.0 / fs, axis=-1, initial=0.0)
 
 
@@ -115,6 +117,8 @@ def elliptic_highpass(x: np.ndarray, fs: float, cutoff_hz: float, order: int = 4
         raise ValueError(f"filter order must be >= 1, got {order}")
     if not (0 < ripple_db < stop_db):
         raise ValueError(f"need 0 < ripple_db < stop_db, got ripple_db={ripple_db}, stop_db={stop_db}")
+    from scipy import signal as ss
+
     sos = ss.ellip(int(order), ripple_db, stop_db, cutoff_hz, btype="highpass", output="sos", fs=fs)
     return _filtfilt(sos, x - x.mean(axis=-1, keepdims=True))
 
@@ -148,6 +152,8 @@ def lowpass(x: np.ndarray, fs: float, cutoff_hz: float, order: int = 8) -> np.nd
     _check_cutoff(cutoff_hz, fs, "low-pass")
     if int(order) < 1:
         raise ValueError(f"filter order must be >= 1, got {order}")
+    from scipy import signal as ss
+
     sos = ss.butter(int(order), cutoff_hz, btype="lowpass", output="sos", fs=fs)
     return _filtfilt(sos, x)
 

@@ -8,7 +8,6 @@ from __future__ import annotations
 
 import numpy as np
 from scipy import fft as sfft
-from scipy import signal as ss
 
 # Half-width of each window's main lobe in bins of the unpadded transform: peaks closer than
 # this are one lobe, not two modes.
@@ -131,6 +130,8 @@ def peak_frequencies(x: np.ndarray, fs: float, n_peaks: int, fmin: float = 0.0,
     fmax = nyq if fmax is None else float(fmax)
     if not 0.0 <= fmin < fmax <= nyq:
         raise ValueError(f"need 0 <= fmin < fmax <= Nyquist ({nyq:g} Hz), got fmin={fmin}, fmax={fmax}")
+    from scipy import signal as ss  # lazy: scipy.signal costs ~0.7 s of import
+
     w = ss.get_window(window, n, fftbins=True)
     nfft = sfft.next_fast_len(int(pad) * n, real=True)
     power = (np.abs(sfft.rfft((x - x.mean(axis=-1, keepdims=True)) * w, n=nfft, axis=-1)) ** 2).sum(0)
