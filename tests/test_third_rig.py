@@ -8,6 +8,7 @@ the kind's registries (signal chain, scorer, truth type), none by the rig's name
 """
 
 import json
+import sys
 
 import h5py
 import numpy as np
@@ -23,7 +24,17 @@ from testbed.reporting.report import write_report
 from testbed.scoring.run import run_scenario
 from testbed.studies.runstore import load_run, save_run
 
-load_plugins(["tests.springmass_rig"])
+PLUGIN = "tests.springmass_rig"
+
+
+@pytest.fixture(scope="module", autouse=True)
+def plugin():
+    """The rig joins the registry for this module's tests only (other tests list every rig)."""
+    load_plugins([PLUGIN])
+    yield
+    RIGS._entries.pop("springmass", None)  # the registry has no public removal: tests only
+    RIGS._tags.pop("springmass", None)
+    sys.modules.pop(PLUGIN, None)
 
 RIG = {"m1": 1.0, "m2": 0.5, "k1": 1e5, "k2": 5e4, "beta": 9e-5}  # 35.6 Hz, 71.2 Hz; zeta 1 %, 2 %
 FS = 8192.0
