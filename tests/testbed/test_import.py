@@ -93,6 +93,9 @@ def test_fivebar_uff_round_trip_and_input_nodes(tmp_path):
     ref = measure(ds, {"derivatives": "recorded"}, "mechanical")
     np.testing.assert_array_equal(m.x, ref.x)
     np.testing.assert_array_equal(m.u, ref.u)
+    # the torques' joints come back from their UFF nodes (u2 sits at th4's node 4)
+    np.testing.assert_array_equal(m.input_map, ref.input_map)
+    np.testing.assert_array_equal(m.input_map, [[1, 0], [0, 0], [0, 0], [0, 1]])
     assert m.prior == {"L0": 0.2}
 
 
