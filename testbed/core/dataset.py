@@ -43,7 +43,8 @@ READ_FORMATS = ("sysid-testbed-dataset/1", FORMAT)
 #: name, description, tags, signal chain, ``[identify]`` and ``[score]`` do not.
 DATA_KEYS = ("rig", "rig_params", "simulation", "excitation", "noise", "seed")
 #: Attributes that describe how or where the data were made or by which scenario file, not what
-#: they are: left out of the content hash.
+#: they are: left out of the content hash.  ``kind`` follows from ``rig`` (which is hashed);
+#: leaving it out keeps the hashes of files written before it was recorded.
 _NOT_CONTENT = ("versions", "git_commit", "content_hash", "created", "scenario", "scenario_name",
                 "kind")
 
