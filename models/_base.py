@@ -8,6 +8,7 @@ from typing import Any, ClassVar, Protocol
 from testbed.core.budget import Cost
 from testbed.core.dataset import Dataset
 from testbed.core.schema import Field
+from testbed.core.truth import Truth, truth_type
 
 ErrorFn = Callable[[str, Any, str], None]
 
@@ -38,8 +39,12 @@ class Rig:
     ----------
     kind : str
         ``"structural"`` (linear/cubic M, C, K models from accelerations) or
-        ``"mechanical"`` (multibody joint-space equations); selects the signal
-        chain and the scorer.
+        ``"mechanical"`` (multibody joint-space equations), or any kind registered with a
+        truth type (:data:`testbed.core.truth.TRUTH_TYPES`), a signal chain
+        (:data:`testbed.pipeline.signal_chain.SIGNAL_CHAINS`), a scorer
+        (:data:`testbed.scoring.scorers.SCORERS`) and a score catalogue
+        (:data:`testbed.core.kinds.METRICS`).  It is all the generic code knows of a rig:
+        ``Scenario.kind`` carries it, and the registries of that kind do the rest.
     rig_schema, simulation_schema : dict of str to Field
         Schemas of the ``[rig]`` and ``[simulation]`` tables.
     excitation_schemas : dict of str to dict of str to Field
@@ -96,9 +101,17 @@ class Rig:
     def __init__(self, scenario: ScenarioTables) -> None:
         self.scenario = scenario
 
+    @classmethod
+    def truth_type(cls) -> type[Truth]:
+        """The typed truth a rig of this kind writes (:func:`testbed.core.truth.truth_type`)."""
+        return truth_type(cls.kind)
+
     def simulate(self, progress: Callable[[float], None] | None = None) -> Dataset:
         """Noise-free measured and reference signals with every truth array.
 
-        ``progress`` (if given) is called with the fraction done, 0..1.
+        ``progress`` (if given) is called with the fraction done, 0..1.  ``Dataset.truth``
+        holds the fields of :meth:`truth_type` (build one and store ``.to_dict()``), checked
+        by :func:`testbed.pipeline.generate.simulate_clean`; an input signal that drives
+        coordinates (not placed by ``positions``) names them in ``Signal.acts_on``.
         """
         raise NotImplementedError

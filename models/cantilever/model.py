@@ -18,6 +18,7 @@ from models.cantilever import truth as tr
 from models.cantilever.beam import BeamParams, build_mjcf
 from models.cantilever.euler_bernoulli import eb_frequencies
 from models.cantilever.simulate import Stepping, choose_stepping
+from testbed.core.truth import StructuralTruth
 
 N_EB = 4  # Euler-Bernoulli frequencies reported
 
@@ -99,7 +100,8 @@ class CantileverModel:
         return float(self.params.base_k3) if self.params.base == "soft" else 0.0
 
     def truth(self) -> tuple[dict[str, Any], dict[str, str]]:
-        """Truth arrays and their units, as stored in ``Dataset.truth``."""
+        """Truth arrays and their units, as stored in ``Dataset.truth``: the fields of a
+        :class:`~testbed.core.truth.StructuralTruth` (units in the hinge angles' terms)."""
         p, red = self.params, self.red
         e0_row = red.T[0]  # e0^T T: root (base) joint angle per unit sensor displacement
         eb_clamped = eb_frequencies(p.E, p.width * p.thickness**3 / 12, p.mass_per_length,
@@ -107,7 +109,7 @@ class CantileverModel:
         eb = eb_clamped if p.base == "stiff" else eb_frequencies(
             p.E, p.width * p.thickness**3 / 12, p.mass_per_length, p.length, N_EB, k_r=p.base_k1)
         joint_x, _ = p.hinges()
-        t = {
+        t = StructuralTruth(**{
             "M": self.M, "C": self.C, "K": self.K,
             "frequencies_hz": self.freqs,
             "damped_frequencies_hz": tr.damped_frequencies(self.freqs, self.zetas),
@@ -124,7 +126,7 @@ class CantileverModel:
             "eb_frequencies_clamped_hz": eb_clamped,
             "sensor_positions": self.sensors,
             "joint_positions": joint_x,
-        }
+        }).to_dict()
         units = {
             "M": "kg m^2", "C": "N m s/rad", "K": "N m/rad", "frequencies_hz": "Hz",
             "damped_frequencies_hz": "Hz", "damping_ratios": "", "modes": "rad/sqrt(kg m^2)",

@@ -33,6 +33,7 @@ from models.fivebar.params import FiveBarParams
 from testbed.core.budget import Cost
 from testbed.core.dataset import Dataset, Signal
 from testbed.core.schema import Field
+from testbed.core.truth import MechanicalTruth
 
 #: Memory per sample of a run [bytes]: the record's 19 float64 channels (angles, rates,
 #: accelerations, torques, constraint force, end point, transmission angle, references:
@@ -260,7 +261,8 @@ class FiveBarRig(Rig):
             "theta": Signal(th.T, ("th1", "th2", "th3", "th4"), "rad"),
             "dtheta": Signal(rec["dtheta"].T, ("dth1", "dth2", "dth3", "dth4"), "rad/s"),
             "ddtheta": Signal(rec["ddtheta"].T, ("ddth1", "ddth2", "ddth3", "ddth4"), "rad/s^2"),
-            "torque": Signal(rec["torque"].T, ("u1", "u2"), "N m"),
+            # u1 drives joint A (link 1's angle th1), u2 joint B (link 4's angle th4)
+            "torque": Signal(rec["torque"].T, ("u1", "u2"), "N m", acts_on=("th1", "th4")),
         }
         reference = {
             "constraint_force": Signal(rec["constraint_force"].T, ("Fx", "Fy"), "N"),
@@ -273,9 +275,10 @@ class FiveBarRig(Rig):
         q0, v0 = geo.to_joint(theta0), geo.to_joint(dtheta0)
         Mr0, _ = dyn.reduced_dynamics(q0, v0)
         terms, coef, scale = true_equations(p)
-        truth.update(mass_matrix_q0=dyn.mass_matrix_absolute(theta0), reduced_mass_matrix_q0=Mr0,
-                     theta0=theta0, dtheta0=dtheta0, equation_terms=terms, equation_coef=coef,
-                     equation_scale=scale)
+        truth = MechanicalTruth(**truth, mass_matrix_q0=dyn.mass_matrix_absolute(theta0),
+                                reduced_mass_matrix_q0=Mr0, theta0=theta0, dtheta0=dtheta0,
+                                equation_terms=terms, equation_coef=coef,
+                                equation_scale=scale).to_dict()
         units.update(mass_matrix_q0="kg m^2", reduced_mass_matrix_q0="kg m^2", theta0="rad",
                      dtheta0="rad/s", equation_terms="", equation_coef="1 (row max |coef| = 1)",
                      equation_scale="N m^3")

@@ -31,6 +31,7 @@ import numpy as np
 
 from testbed.core.atomic import atomic_write
 from testbed.core.errors import TestbedError
+from testbed.core.truth import Truth, TruthError, truth_type
 
 #: Format written.  /2: the content hash covers the data-defining attributes only (see
 #: :meth:`Dataset.content_hash`); /1 files hashed every attribute but versions and commit.
@@ -42,8 +43,10 @@ READ_FORMATS = ("sysid-testbed-dataset/1", FORMAT)
 #: name, description, tags, signal chain, ``[identify]`` and ``[score]`` do not.
 DATA_KEYS = ("rig", "rig_params", "simulation", "excitation", "noise", "seed")
 #: Attributes that describe how or where the data were made or by which scenario file, not what
-#: they are: left out of the content hash.
-_NOT_CONTENT = ("versions", "git_commit", "content_hash", "created", "scenario", "scenario_name")
+#: they are: left out of the content hash.  ``kind`` follows from ``rig`` (which is hashed);
+#: leaving it out keeps the hashes of files written before it was recorded.
+_NOT_CONTENT = ("versions", "git_commit", "content_hash", "created", "scenario", "scenario_name",
+                "kind")
 
 
 class DatasetError(TestbedError, ValueError):
@@ -75,12 +78,17 @@ class Signal:
         SI unit of every channel, e.g. ``"m/s^2"``.
     positions : ndarray, shape (n_channels,), optional
         Position of each channel along the structure [m], where defined.
+    acts_on : tuple of str, optional
+        For an input signal (e.g. joint torques): per row, the name of the coordinate channel
+        (of another signal, e.g. ``"th1"`` of ``theta``) the input acts on.  A signal chain
+        builds its ``Measurement.input_map`` from it.
     """
 
     data: np.ndarray
     channels: tuple[str, ...]
     unit: str
     positions: np.ndarray | None = None
+    acts_on: tuple[str, ...] | None = None
 
     def __post_init__(self) -> None:
         # C order always: a reduction over a row (e.g. the noise's RMS) then sums in one fixed
@@ -93,6 +101,10 @@ class Signal:
             raise ValueError(f"{self.data.shape[0]} rows but {len(self.channels)} channel names")
         if self.positions is not None:
             self.positions = np.asarray(self.positions, dtype=float)
+        if self.acts_on is not None:
+            self.acts_on = tuple(str(c) for c in self.acts_on)
+            if len(self.acts_on) != self.data.shape[0]:
+                raise ValueError(f"{self.data.shape[0]} rows but {len(self.acts_on)} acts_on names")
 
 
 @dataclass
@@ -109,8 +121,17 @@ class Dataset:
     prior : dict of str to float
         Prior knowledge an identifier may use (never the answer itself).
     attrs : dict
-        Provenance: ``rig``, ``seed``, ``scenario`` (canonical JSON), ``versions``,
-        ``git_commit``, ``gravity`` and anything else the rig records.
+        Provenance: ``rig``, ``kind`` (the rig's kind), ``seed``, ``scenario`` (canonical
+        JSON), ``versions``, ``git_commit``, ``gravity`` and anything else the rig records.
+
+    Notes
+    -----
+    ``truth`` is a plain mapping (what is stored, and what readers index by name); its
+    declaration is the kind's typed truth (:mod:`testbed.core.truth`), and
+    :attr:`typed_truth` gives it as that dataclass.  A dataset that names its kind
+    (``attrs["kind"]``) has its truth validated when saved and loaded
+    (:meth:`check_truth`), so a missing, unknown or misshapen truth key is an error naming
+    the key; one that does not (a hand-made or imported dataset) is not checked.
     """
 
     fs: float
@@ -129,6 +150,37 @@ class Dataset:
     def t(self) -> np.ndarray:
         """Sample times [s], shape (n_samples,)."""
         return np.arange(self.n_samples) / self.fs
+
+    @property
+    def kind(self) -> str | None:
+        """The kind of the rig that made the data (``attrs["kind"]``), None if not recorded."""
+        kind = self.attrs.get("kind")
+        return str(kind) if kind else None
+
+    @property
+    def typed_truth(self) -> Truth:
+        """The truth as its kind's dataclass (:mod:`testbed.core.truth`), validated.
+
+        Raises
+        ------
+        TruthError
+            If the dataset records no kind, or the truth does not fit the kind's declaration.
+        """
+        if self.kind is None:
+            raise TruthError("the dataset records no rig kind (attrs['kind']); its truth has "
+                             "no declared type")
+        return truth_type(self.kind).from_dict(self.truth, self.truth_units)
+
+    def check_truth(self) -> None:
+        """Validate the truth against its kind's declaration, if the dataset records a kind.
+
+        Raises
+        ------
+        TruthError
+            Naming the missing, unknown or misshapen key, or a kind without a truth type.
+        """
+        if self.kind is not None:
+            truth_type(self.kind).validate(self.truth, self.truth_units)
 
     def content_hash(self) -> str:
         """SHA-256 of everything that is data: signals, truth, prior, sample rate, and the
@@ -163,6 +215,8 @@ class Dataset:
                 h.update(np.ascontiguousarray(s.data, dtype="<f8").tobytes())
                 if s.positions is not None:
                     h.update(np.ascontiguousarray(s.positions, dtype="<f8").tobytes())
+                if s.acts_on is not None:  # left out when absent: older hashes stay valid
+                    h.update(("acts_on|" + "\x1f".join(s.acts_on)).encode())
         for name in sorted(self.truth):
             h.update(f"truth/{name}|{self.truth_units.get(name, '')}".encode())
             v = self.truth[name]
@@ -174,7 +228,14 @@ class Dataset:
 
     # ------------------------------------------------------------------ HDF5
     def save(self, path: str | os.PathLike) -> Path:
-        """Write atomically to ``path`` (a temporary file in the same folder, then rename)."""
+        """Write atomically to ``path`` (a temporary file in the same folder, then rename).
+
+        Raises
+        ------
+        TruthError
+            If the dataset records a kind and its truth does not fit it (nothing is written).
+        """
+        self.check_truth()
         self.attrs["content_hash"] = self.content_hash()
 
         def write(tmp: str) -> None:
@@ -205,6 +266,8 @@ class Dataset:
                 if s.positions is not None:
                     d.attrs["positions"] = s.positions
                     d.attrs["positions_unit"] = "m"
+                if s.acts_on is not None:
+                    d.attrs["acts_on"] = list(s.acts_on)
         g = f.create_group("truth")
         for name, v in self.truth.items():
             if isinstance(v, (list, tuple)) and v and isinstance(v[0], str):
@@ -252,6 +315,10 @@ class Dataset:
                                          "(the file was altered or damaged)")
             if fmt != FORMAT:  # verified as written; in memory it carries this format's hash
                 ds.attrs["content_hash"] = ds.content_hash()
+        try:
+            ds.check_truth()
+        except TruthError as e:
+            raise DatasetError(path, str(e)) from None
         return ds
 
     @classmethod
@@ -281,9 +348,11 @@ class Dataset:
                 groups[group] = {}
                 for name, d in f[group].items():
                     pos = d.attrs.get("positions")
+                    acts = d.attrs.get("acts_on")
                     groups[group][name] = Signal(d[()], tuple(str(c) for c in d.attrs["channels"]),
                                                  str(d.attrs["unit"]),
-                                                 None if pos is None else np.asarray(pos))
+                                                 None if pos is None else np.asarray(pos),
+                                                 None if acts is None else tuple(str(c) for c in acts))
             truth, units = {}, {}
             for name, d in f["truth"].items():
                 v = d[()]

@@ -234,7 +234,5 @@ def validate_header(raw: Mapping[str, Any], *, sections: tuple[str, ...], header
     return head
 
 
-Checker = Callable[[dict[str, Any]], None]
-
 ErrorFn = Callable[[str, Any, str], None]
 """``error(key, value, allowed)``: report a problem (it raises)."""

@@ -20,7 +20,9 @@ from collections.abc import Callable
 import numpy as np
 
 from testbed.core.dataset import Dataset, Signal
+from testbed.core.errors import RigError
 from testbed.core.provenance import git_commit, versions
+from testbed.core.truth import TruthError
 from testbed.pipeline.plugins import RIGS
 from testbed.pipeline.scenario import Scenario
 
@@ -67,11 +69,23 @@ def simulate_clean(scenario: Scenario, progress: Callable[[float], None] | None 
     """The rig's noise-free dataset of ``scenario``: the clean dataset :func:`derive` starts from.
 
     The rig runs :func:`noise_free_scenario` of ``scenario``; the noisy signals' noise-free
-    arrays are kept in ``reference`` under the same names, as in every dataset.
+    arrays are kept in ``reference`` under the same names, as in every dataset.  The dataset
+    records the rig's kind (``attrs["kind"]``) and its truth is validated against the kind's
+    declaration (:mod:`testbed.core.truth`).
+
+    Raises
+    ------
+    RigError
+        If the rig's truth has a missing, unknown or misshapen key (named).
     """
 
     clean_sc = noise_free_scenario(scenario)
     ds = RIGS.get(clean_sc.rig)(clean_sc).simulate(progress=progress)
+    ds.attrs["kind"] = clean_sc.kind
+    try:  # the rig's truth must be its kind's declared truth (testbed.core.truth)
+        ds.check_truth()
+    except TruthError as e:
+        raise RigError(f"rig {clean_sc.rig!r} wrote a truth that does not fit its kind: {e}") from None
     ds.attrs.update(versions=versions(), git_commit=git_commit())
     return derive(ds, clean_sc)
 
@@ -104,9 +118,10 @@ def derive(clean: Dataset, scenario: Scenario) -> Dataset:
     rng = np.random.default_rng(scenario.seed)
     for name in scenario.noise["signals"]:
         raw = ds.reference.get(name, ds.measured[name])
-        ds.reference[name] = Signal(raw.data.copy(), raw.channels, raw.unit, raw.positions)
+        ds.reference[name] = Signal(raw.data.copy(), raw.channels, raw.unit, raw.positions,
+                                    raw.acts_on)
         ds.measured[name] = Signal(add_noise(raw.data, scenario.noise["rms_percent"], rng),
-                                   raw.channels, raw.unit, raw.positions)
+                                   raw.channels, raw.unit, raw.positions, raw.acts_on)
     return _stamp(ds, scenario)
 
 

@@ -148,7 +148,8 @@ class ImportedData:
         return np.arange(self.n_samples) / self.fs
 
     def to_dataset(self, groups: Mapping[str, Sequence[str]] | None = None,
-                   prior: Mapping[str, float] | None = None) -> Dataset:
+                   prior: Mapping[str, float] | None = None,
+                   acts_on: Mapping[str, Sequence[str]] | None = None) -> Dataset:
         """The channels as a truth-free Dataset, ready for :func:`testbed.pipeline.signal_chain.measure`.
 
         Parameters
@@ -161,6 +162,12 @@ class ImportedData:
             ``"theta"``, ``"dtheta"``, ``"ddtheta"`` (4 channels each) and ``"torque"`` (2).
         prior : mapping of str to float, optional
             Declared prior knowledge (e.g. ``total_mass`` [kg]); updates :attr:`prior`.
+        acts_on : mapping of str to sequence of str, optional
+            Input signal -> the coordinate channel each of its rows acts on
+            (:attr:`Signal.acts_on <testbed.core.dataset.Signal.acts_on>`), e.g. ``{"torque":
+            ["th1", "th4"]}``.  Default: a ``"torque"`` group whose every channel shares its
+            node with exactly one ``"theta"`` channel acts on those (an exported input sits at
+            the node of the coordinate it drives; :mod:`testbed.reporting.export`).
 
         Returns
         -------
@@ -197,6 +204,24 @@ class ImportedData:
                                  tuple(n.split("/", 1)[1] if "/" in n else n for n in names),
                                  units.pop(),
                                  np.array([self.positions[n] for n in names]) if all(have) else None)
+        declared = dict(acts_on or {})
+        if not declared and "torque" in grouped and "theta" in grouped:
+            coords = [(self.nodes.get(n), n.split("/", 1)[-1]) for n in grouped["theta"]]
+            targets = []
+            for n in grouped["torque"]:
+                hits = [c for node, c in coords if node is not None and node == self.nodes.get(n)]
+                targets.append(hits[0] if len(hits) == 1 else None)
+            if all(t is not None for t in targets):
+                declared["torque"] = targets
+        for g, names in declared.items():
+            if g not in measured:
+                raise MeasuredDataError(self.source, f"acts_on names signal {g!r}; has "
+                                                     f"{', '.join(measured)}")
+            sg = measured[g]
+            if len(names) != len(sg.channels):
+                raise MeasuredDataError(self.source, f"acts_on of {g!r}: {len(names)} names for "
+                                                     f"{len(sg.channels)} channels")
+            measured[g] = Signal(sg.data, sg.channels, sg.unit, sg.positions, tuple(names))
         return Dataset(float(self.fs), measured, prior={**self.prior, **dict(prior or {})},
                        attrs={"source": str(self.source), "source_format": self.format})
 

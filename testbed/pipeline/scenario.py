@@ -91,7 +91,13 @@ SECTIONS = ("scenario", "rig", "simulation", "excitation", "noise", "signal", "i
 
 @dataclass(frozen=True)
 class Scenario:
-    """A validated scenario.  Sections are plain dicts with defaults filled in."""
+    """A validated scenario.  Sections are plain dicts with defaults filled in.
+
+    ``kind`` is the rig's kind (``"structural"``, ``"mechanical"``, ...), taken from the
+    registered rig when the scenario is built: every later step (signal chain, scorer, run
+    store, study) reads it here instead of asking the registry again.  Left empty in a direct
+    construction, it is filled from the registry; a kind that contradicts the rig's is refused.
+    """
 
     name: str
     rig: str
@@ -106,6 +112,20 @@ class Scenario:
     identify: dict[str, Any] | None = None
     score: dict[str, dict[str, float]] = field(default_factory=dict)
     path: str | None = field(default=None, compare=False)
+    kind: str = ""
+
+    def __post_init__(self) -> None:
+        try:
+            rig_kind = RIGS.get(self.rig).kind
+        except KeyError as e:
+            if self.kind:  # a scenario of a rig not registered here (e.g. read back from a run)
+                return
+            raise ScenarioError(self.path or self.name, "scenario.rig", self.rig, str(e.args[0])) from None
+        if not self.kind:
+            object.__setattr__(self, "kind", rig_kind)
+        elif self.kind != rig_kind:
+            raise ScenarioError(self.path or self.name, "scenario.kind", self.kind,
+                                f"rig {self.rig!r} is of kind {rig_kind!r}")
 
     def to_dict(self) -> dict[str, Any]:
         """Plain, JSON-able form (the file path left out)."""
@@ -113,9 +133,6 @@ class Scenario:
         d.pop("path")
         d["tags"] = list(self.tags)
         return d
-
-    def canonical_json(self) -> str:
-        return json.dumps(self.to_dict(), sort_keys=True, separators=(",", ":"))
 
     def data_dict(self) -> dict[str, Any]:
         """The parts that determine the generated data (not identifier, score, name)."""
@@ -347,7 +364,8 @@ def scenario_from_dict(raw: dict[str, Any], *, file: str = "<dict>", stem: str |
     return Scenario(name=head["name"], rig=head["rig"], seed=head["seed"],
                     description=head["description"], tags=tuple(head["tags"]),
                     rig_params=rig_params, simulation=simulation, excitation=excitation,
-                    noise=noise, signal=signal, identify=identify, score=score, path=file)
+                    noise=noise, signal=signal, identify=identify, score=score, path=file,
+                    kind=rig_cls.kind)
 
 
 def check_rig_cost(rig_cls: Any, rig_params: dict[str, Any], simulation: dict[str, Any],

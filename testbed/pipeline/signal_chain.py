@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -25,58 +26,59 @@ IMPACT_TOLERANCE_M = 1e-3
 #: The force pulse has ended once ``|force|`` falls below this fraction of its peak
 #: (or below 5 robust noise standard deviations, whichever is larger).
 PULSE_END_FRACTION = 1e-6
-MECHANICAL_CHANNELS = ("th1", "th2", "th3", "th4")
-MECHANICAL_INPUTS = ("u1", "u2")
 
-SIGNAL_SCHEMAS: dict[str, dict[str, Field]] = {
-    "structural": {
-        "highpass_hz": Field(float, 10.0, unit="Hz", min=0.0, min_inclusive=False,
-                             doc="cut-off of the zero-phase elliptic high-pass applied after each "
-                                 "integration (removes drift); acceleration, velocity and "
-                                 "displacement all end up filtered alike"),
-        "highpass_order": Field(int, 5, min=1, max=12,
-                                doc="order of the elliptic high-pass; odd orders have a zero at DC "
-                                    "and unit gain at high frequency; even orders pass DC at the "
-                                    "stop-band level and have -ripple_db gain at high frequency"),
-        "ripple_db": Field(float, 0.1, unit="dB", min=0.0, min_inclusive=False,
-                           doc="pass-band ripple of the elliptic filter (the paper: 0.1 dB)"),
-        "stop_db": Field(float, 30.0, unit="dB", min=0.0, min_inclusive=False,
-                         doc="stop-band attenuation of the elliptic filter (the paper: 30 dB)"),
-        "lowpass_hz": Field(float, 0.0, unit="Hz", min=0.0,
-                            doc="optional zero-phase low-pass cut-off; 0 = off"),
-        "lowpass_order": Field(int, 8, min=1, max=16, doc="order of the optional Butterworth low-pass"),
-        "free_margin_s": Field(float, 1e-3, unit="s", min=0.0,
-                               doc="time after the end of the force pulse before the free "
-                                   "vibration is taken to start (covers the filters' smearing)"),
-        "rest_offset": Field(bool, True,
-                             doc="remove the post-pulse mean of each integral (free vibration of a "
-                                 "clamped structure is zero-mean; see integrate_acceleration)"),
-        "filter_force": Field(bool, True,
-                              doc="pass the force through the same filters as the acceleration, "
-                                  "so the equation of motion holds for the filtered signals"),
-    },
-    "mechanical": {
-        "derivatives": Field(str, "recorded", choices=("recorded", "estimated", "lowpass"),
-                             doc="use the recorded joint rates and accelerations, or estimate "
-                                 "them from the measured angles: 'estimated' by a Savitzky-Golay "
-                                 "filter (window, polyorder), 'lowpass' by a zero-phase "
-                                 "Butterworth low-pass and central differences (cutoff_hz, "
-                                 "filter_order, edge_fit_s, edge_fit_order)"),
-        "window": Field(int, 201, min=5, doc="Savitzky-Golay window [samples] for estimated "
-                                             "derivatives (odd)"),
-        "polyorder": Field(int, 4, min=2, max=8, doc="Savitzky-Golay polynomial order"),
-        "cutoff_hz": Field(float, 4.0, unit="Hz", min=0.0, min_inclusive=False,
-                           doc="'lowpass': -3 dB frequency of one pass of the zero-phase "
-                               "Butterworth; just above the band of the motion (noise in the "
-                               "acceleration grows as cutoff^2.5)"),
-        "filter_order": Field(int, 8, min=1, max=16,
-                              doc="'lowpass': Butterworth order of one pass"),
-        "edge_fit_s": Field(float, 0.1, unit="s", min=0.0, min_inclusive=False,
-                            doc="'lowpass': length of the end windows whose polynomial fits "
-                                "anchor the record's ends (value, rate, acceleration)"),
-        "edge_fit_order": Field(int, 5, min=2, max=8,
-                                doc="'lowpass': order of the end-window polynomial fits"),
-    },
+#: ``[signal]`` schema per rig kind (kept in step with :data:`SIGNAL_CHAINS` by
+#: :func:`register_signal_chain`).
+SIGNAL_SCHEMAS: dict[str, dict[str, Field]] = {}
+
+STRUCTURAL_SIGNAL_SCHEMA: dict[str, Field] = {
+    "highpass_hz": Field(float, 10.0, unit="Hz", min=0.0, min_inclusive=False,
+                         doc="cut-off of the zero-phase elliptic high-pass applied after each "
+                             "integration (removes drift); acceleration, velocity and "
+                             "displacement all end up filtered alike"),
+    "highpass_order": Field(int, 5, min=1, max=12,
+                            doc="order of the elliptic high-pass; odd orders have a zero at DC "
+                                "and unit gain at high frequency; even orders pass DC at the "
+                                "stop-band level and have -ripple_db gain at high frequency"),
+    "ripple_db": Field(float, 0.1, unit="dB", min=0.0, min_inclusive=False,
+                       doc="pass-band ripple of the elliptic filter (the paper: 0.1 dB)"),
+    "stop_db": Field(float, 30.0, unit="dB", min=0.0, min_inclusive=False,
+                     doc="stop-band attenuation of the elliptic filter (the paper: 30 dB)"),
+    "lowpass_hz": Field(float, 0.0, unit="Hz", min=0.0,
+                        doc="optional zero-phase low-pass cut-off; 0 = off"),
+    "lowpass_order": Field(int, 8, min=1, max=16, doc="order of the optional Butterworth low-pass"),
+    "free_margin_s": Field(float, 1e-3, unit="s", min=0.0,
+                           doc="time after the end of the force pulse before the free "
+                               "vibration is taken to start (covers the filters' smearing)"),
+    "rest_offset": Field(bool, True,
+                         doc="remove the post-pulse mean of each integral (free vibration of a "
+                             "clamped structure is zero-mean; see integrate_acceleration)"),
+    "filter_force": Field(bool, True,
+                          doc="pass the force through the same filters as the acceleration, "
+                              "so the equation of motion holds for the filtered signals"),
+}
+
+MECHANICAL_SIGNAL_SCHEMA: dict[str, Field] = {
+    "derivatives": Field(str, "recorded", choices=("recorded", "estimated", "lowpass"),
+                         doc="use the recorded joint rates and accelerations, or estimate "
+                             "them from the measured angles: 'estimated' by a Savitzky-Golay "
+                             "filter (window, polyorder), 'lowpass' by a zero-phase "
+                             "Butterworth low-pass and central differences (cutoff_hz, "
+                             "filter_order, edge_fit_s, edge_fit_order)"),
+    "window": Field(int, 201, min=5, doc="Savitzky-Golay window [samples] for estimated "
+                                         "derivatives (odd)"),
+    "polyorder": Field(int, 4, min=2, max=8, doc="Savitzky-Golay polynomial order"),
+    "cutoff_hz": Field(float, 4.0, unit="Hz", min=0.0, min_inclusive=False,
+                       doc="'lowpass': -3 dB frequency of one pass of the zero-phase "
+                           "Butterworth; just above the band of the motion (noise in the "
+                           "acceleration grows as cutoff^2.5)"),
+    "filter_order": Field(int, 8, min=1, max=16,
+                          doc="'lowpass': Butterworth order of one pass"),
+    "edge_fit_s": Field(float, 0.1, unit="s", min=0.0, min_inclusive=False,
+                        doc="'lowpass': length of the end windows whose polynomial fits "
+                            "anchor the record's ends (value, rate, acceleration)"),
+    "edge_fit_order": Field(int, 5, min=2, max=8,
+                            doc="'lowpass': order of the end-window polynomial fits"),
 }
 
 
@@ -87,13 +89,64 @@ def _filter_min_samples(order: int) -> int:
     return 3 * (2 * math.ceil(order / 2) + 1) + 1
 
 
+ErrorFn = Callable[[str, Any, str], None]
+
+
+@dataclass(frozen=True)
+class SignalChain:
+    """The signal chain of one rig kind: its ``[signal]`` schema, its checks, its function.
+
+    Attributes
+    ----------
+    kind : str
+        The rig kind it serves (``Rig.kind``, ``Scenario.kind``).
+    schema : dict of str to Field
+        Schema of a scenario's ``[signal]`` table for a rig of this kind.
+    measure : callable
+        ``measure(dataset, cfg) -> Measurement`` with ``cfg`` a validated table of ``schema``;
+        reads only ``dataset.measured``, ``dataset.fs`` and ``dataset.prior``.
+    check : callable, optional
+        ``check(cfg, fs, n_samples, error)``: cross-key checks of a validated table against
+        the record it will process (sample rate [Hz], samples); calls ``error(key, value,
+        allowed)`` on the first problem.
+    """
+
+    kind: str
+    schema: dict[str, Field]
+    measure: Callable[[Dataset, Mapping[str, Any]], Measurement]
+    check: Callable[[Mapping[str, Any], float, int, ErrorFn], None] | None = None
+
+
+#: Signal chain per rig kind, filled by :func:`register_signal_chain` (this module registers
+#: "structural" and "mechanical"; a module defining a new kind registers its own).
+SIGNAL_CHAINS: dict[str, SignalChain] = {}
+
+
+def register_signal_chain(chain: SignalChain) -> SignalChain:
+    """Make ``chain`` the signal chain of rigs of ``chain.kind`` (and its schema the ``[signal]``
+    schema of their scenarios).
+
+    Raises
+    ------
+    ValueError
+        If another chain is registered for that kind already.
+    """
+    have = SIGNAL_CHAINS.get(chain.kind)
+    if have is not None and have != chain:
+        raise ValueError(f"a signal chain for rig kind {chain.kind!r} is registered already")
+    SIGNAL_CHAINS[chain.kind] = chain
+    SIGNAL_SCHEMAS[chain.kind] = chain.schema
+    return chain
+
+
 def check_signal(kind: str, cfg: Mapping[str, Any], fs: float, n_samples: int,
-                 error: Callable[[str, Any, str], None]) -> None:
+                 error: ErrorFn) -> None:
     """Cross-key checks of a validated ``[signal]`` table against the record it will process.
 
     Parameters
     ----------
-    kind : {"structural", "mechanical"}
+    kind : str
+        A rig kind with a registered chain (:data:`SIGNAL_CHAINS`).
     cfg : mapping
         A validated ``SIGNAL_SCHEMAS[kind]`` table.
     fs : float
@@ -105,45 +158,54 @@ def check_signal(kind: str, cfg: Mapping[str, Any], fs: float, n_samples: int,
 
     Notes
     -----
-    Checked: cut-offs strictly below the Nyquist frequency ``fs / 2`` (a digital filter cannot
-    be designed at or above it), a high-pass below the low-pass, pass-band ripple below the
-    stop-band attenuation, records long enough for every zero-phase filter and polynomial
-    window, odd Savitzky-Golay windows with ``polyorder < window``, and margins shorter than
-    the record.
+    The chains of this module check: cut-offs strictly below the Nyquist frequency ``fs / 2``
+    (a digital filter cannot be designed at or above it), a high-pass below the low-pass,
+    pass-band ripple below the stop-band attenuation, records long enough for every zero-phase
+    filter and polynomial window, odd Savitzky-Golay windows with ``polyorder < window``, and
+    margins shorter than the record.
     """
-    nyq = fs / 2.0
+    check = _chain(kind).check
+    if check is not None:
+        check(cfg, fs, n_samples, error)
+
+
+def _below_nyquist(cfg: Mapping[str, Any], key: str, fs: float, error: ErrorFn) -> None:
+    if not cfg[key] < fs / 2.0:
+        error(f"signal.{key}", cfg[key], f"expected below the Nyquist frequency {fs / 2.0:g} Hz "
+                                         f"(sample rate {fs:g} Hz)")
+
+
+def _long_enough(cfg: Mapping[str, Any], key: str, order: int, n_samples: int,
+                 error: ErrorFn) -> None:
+    need = _filter_min_samples(order)
+    if n_samples < need:
+        error(f"signal.{key}", cfg[key], f"the record has {n_samples} samples; a zero-phase "
+                                         f"filter of order {order} needs at least {need}")
+
+
+def check_structural(cfg: Mapping[str, Any], fs: float, n_samples: int, error: ErrorFn) -> None:
+    """:func:`check_signal` of the structural chain."""
     duration = n_samples / fs
+    _below_nyquist(cfg, "highpass_hz", fs, error)
+    _long_enough(cfg, "highpass_order", cfg["highpass_order"], n_samples, error)
+    if cfg["lowpass_hz"] > 0:
+        _below_nyquist(cfg, "lowpass_hz", fs, error)
+        _long_enough(cfg, "lowpass_order", cfg["lowpass_order"], n_samples, error)
+        if not cfg["highpass_hz"] < cfg["lowpass_hz"]:
+            error("signal.highpass_hz", cfg["highpass_hz"],
+                  f"expected below lowpass_hz ({cfg['lowpass_hz']:g} Hz): the pass band "
+                  "would be empty")
+    if not cfg["ripple_db"] < cfg["stop_db"]:
+        error("signal.ripple_db", cfg["ripple_db"],
+              f"expected below stop_db ({cfg['stop_db']:g} dB)")
+    if not cfg["free_margin_s"] < duration:
+        error("signal.free_margin_s", cfg["free_margin_s"],
+              f"expected shorter than the record ({duration:g} s)")
 
-    def below_nyquist(key: str) -> None:
-        if not cfg[key] < nyq:
-            error(f"signal.{key}", cfg[key], f"expected below the Nyquist frequency {nyq:g} Hz "
-                                             f"(sample rate {fs:g} Hz)")
 
-    def long_enough(key: str, order: int) -> None:
-        need = _filter_min_samples(order)
-        if n_samples < need:
-            error(f"signal.{key}", cfg[key], f"the record has {n_samples} samples; a zero-phase "
-                                             f"filter of order {order} needs at least {need}")
-
-    if kind == "structural":
-        below_nyquist("highpass_hz")
-        long_enough("highpass_order", cfg["highpass_order"])
-        if cfg["lowpass_hz"] > 0:
-            below_nyquist("lowpass_hz")
-            long_enough("lowpass_order", cfg["lowpass_order"])
-            if not cfg["highpass_hz"] < cfg["lowpass_hz"]:
-                error("signal.highpass_hz", cfg["highpass_hz"],
-                      f"expected below lowpass_hz ({cfg['lowpass_hz']:g} Hz): the pass band "
-                      "would be empty")
-        if not cfg["ripple_db"] < cfg["stop_db"]:
-            error("signal.ripple_db", cfg["ripple_db"],
-                  f"expected below stop_db ({cfg['stop_db']:g} dB)")
-        if not cfg["free_margin_s"] < duration:
-            error("signal.free_margin_s", cfg["free_margin_s"],
-                  f"expected shorter than the record ({duration:g} s)")
-        return
-    if kind != "mechanical":
-        return
+def check_mechanical(cfg: Mapping[str, Any], fs: float, n_samples: int, error: ErrorFn) -> None:
+    """:func:`check_signal` of the mechanical chain."""
+    duration = n_samples / fs
     if cfg["window"] % 2 == 0:
         error("signal.window", cfg["window"], "expected an odd number of samples")
     if not cfg["polyorder"] < cfg["window"]:
@@ -151,14 +213,22 @@ def check_signal(kind: str, cfg: Mapping[str, Any], fs: float, n_samples: int,
     if cfg["derivatives"] == "estimated" and cfg["window"] > n_samples:
         error("signal.window", cfg["window"], f"expected at most the record's {n_samples} samples")
     if cfg["derivatives"] == "lowpass":
-        below_nyquist("cutoff_hz")
-        long_enough("filter_order", cfg["filter_order"])
+        _below_nyquist(cfg, "cutoff_hz", fs, error)
+        _long_enough(cfg, "filter_order", cfg["filter_order"], n_samples, error)
         n_fit = round(cfg["edge_fit_s"] * fs)
         if not cfg["edge_fit_order"] < n_fit <= n_samples:
             error("signal.edge_fit_s", cfg["edge_fit_s"],
                   f"the end windows of {n_fit} samples must be longer than edge_fit_order "
                   f"({cfg['edge_fit_order']}) and at most the record ({n_samples} samples, "
                   f"{duration:g} s)")
+
+
+def _chain(kind: str) -> SignalChain:
+    try:
+        return SIGNAL_CHAINS[kind]
+    except KeyError:
+        raise ValueError(f"unknown rig kind {kind!r}; expected one of "
+                         f"{', '.join(SIGNAL_CHAINS) or '(none registered)'}") from None
 
 
 def measure(dataset: Dataset, signal_cfg: Mapping[str, Any], kind: str) -> Measurement:
@@ -171,21 +241,22 @@ def measure(dataset: Dataset, signal_cfg: Mapping[str, Any], kind: str) -> Measu
     signal_cfg : mapping
         The scenario's ``[signal]`` table for this kind; missing keys take the defaults of
         ``SIGNAL_SCHEMAS[kind]``, unknown keys or bad values raise ScenarioError.
-    kind : {"structural", "mechanical"}
-        The rig kind.
+    kind : str
+        The rig kind (``Scenario.kind``), whose registered chain (:data:`SIGNAL_CHAINS`) runs.
 
     Returns
     -------
     Measurement
-        See :func:`measure_structural` and :func:`measure_mechanical`.
+        See the chain's function, e.g. :func:`measure_structural`, :func:`measure_mechanical`.
+
+    Raises
+    ------
+    ValueError
+        If no chain is registered for ``kind``.
     """
-    if kind not in SIGNAL_SCHEMAS:
-        raise ValueError(f"unknown rig kind {kind!r}; expected one of {', '.join(SIGNAL_SCHEMAS)}")
-    cfg = validate_table(dict(signal_cfg), SIGNAL_SCHEMAS[kind], file="<signal config>",
-                         section="signal")
-    if kind == "structural":
-        return measure_structural(dataset, cfg)
-    return measure_mechanical(dataset, cfg)
+    chain = _chain(kind)
+    cfg = validate_table(dict(signal_cfg), chain.schema, file="<signal config>", section="signal")
+    return chain.measure(dataset, cfg)
 
 
 def _get(dataset: Dataset, name: str, rows: int | None = None) -> np.ndarray:
@@ -309,13 +380,14 @@ def measure_structural(dataset: Dataset, cfg: Mapping[str, Any]) -> Measurement:
 
 
 def measure_mechanical(dataset: Dataset, cfg: Mapping[str, Any]) -> Measurement:
-    """Joint angles, rates and accelerations, and the two actuator torques.
+    """Joint angles, rates and accelerations, and the actuator torques.
 
     Parameters
     ----------
     dataset : Dataset
-        Measured ``"theta"`` (4 x n [rad]), ``"dtheta"`` [rad/s], ``"ddtheta"`` [rad/s^2] and
-        ``"torque"`` (2 x n [N m], channels u1, u2).
+        Measured ``"theta"`` (n_joints x n [rad]), ``"dtheta"`` [rad/s], ``"ddtheta"``
+        [rad/s^2] (n_joints rows each) and ``"torque"`` (n_inputs x n [N m]) whose
+        ``Signal.acts_on`` names, per input, the ``theta`` channel it drives.
     cfg : mapping
         A validated ``SIGNAL_SCHEMAS["mechanical"]`` table.  ``derivatives = "recorded"``
         uses the recorded rates; ``"estimated"`` smooths and differentiates the angles with a
@@ -327,20 +399,43 @@ def measure_mechanical(dataset: Dataset, cfg: Mapping[str, Any]) -> Measurement:
     Returns
     -------
     Measurement
-        Channels th1..th4, inputs u1, u2, ``input_map`` (4 x 2) mapping u1 to th1 and u2 to
-        th4, ``free_start`` 0 (the input is continuous), ``prior`` a copy of the dataset's.
+        Channels and inputs named as the data name them, ``input_map`` (n_joints x n_inputs)
+        with 1 where input j acts on joint i (from ``acts_on``; the five-bar: u1 on th1, u2
+        on th4), ``free_start`` 0 (the input is continuous), ``prior`` a copy of the dataset's.
+
+    Raises
+    ------
+    ValueError
+        A missing signal, row counts that disagree, or torques that do not declare (or
+        misname) the joints they act on.
     """
     fs = float(dataset.fs)
-    theta = _get(dataset, "theta", 4)
-    torque = _get(dataset, "torque", 2)
+    theta = _get(dataset, "theta")
+    n_joints = theta.shape[0]
+    channels = tuple(dataset.measured["theta"].channels)
+    torque = _get(dataset, "torque")
+    t_sig = dataset.measured["torque"]
+    if t_sig.acts_on is None:
+        raise ValueError("measured 'torque' does not declare the joints its inputs act on "
+                         "(Signal.acts_on: one 'theta' channel per input); the mechanical chain "
+                         "builds the input map from it")
+    input_map = np.zeros((n_joints, torque.shape[0]))
+    for j, name in enumerate(t_sig.acts_on):
+        if name not in channels:
+            raise ValueError(f"input {t_sig.channels[j]!r} acts on {name!r}, not a channel of "
+                             f"'theta' ({', '.join(channels)})")
+        input_map[channels.index(name), j] = 1.0
     if cfg["derivatives"] == "recorded":
-        x, xd, xdd = theta, _get(dataset, "dtheta", 4), _get(dataset, "ddtheta", 4)
+        x, xd, xdd = theta, _get(dataset, "dtheta", n_joints), _get(dataset, "ddtheta", n_joints)
     elif cfg["derivatives"] == "lowpass":
         x, xd, xdd = derivatives.lowpass_differentiate(theta, fs, cfg["cutoff_hz"], cfg["filter_order"],
                                                cfg["edge_fit_s"], cfg["edge_fit_order"])
     else:
         x, xd, xdd = derivatives.differentiate(theta, fs, cfg["window"], cfg["polyorder"])
-    input_map = np.zeros((4, 2))
-    input_map[0, 0] = input_map[3, 1] = 1.0
-    return Measurement(fs=fs, x=x, xd=xd, xdd=xdd, channels=MECHANICAL_CHANNELS, u=torque,
-                       inputs=MECHANICAL_INPUTS, input_map=input_map, prior=dict(dataset.prior))
+    return Measurement(fs=fs, x=x, xd=xd, xdd=xdd, channels=channels, u=torque,
+                       inputs=tuple(t_sig.channels), input_map=input_map, prior=dict(dataset.prior))
+
+register_signal_chain(SignalChain("structural", STRUCTURAL_SIGNAL_SCHEMA, measure_structural,
+                                  check_structural))
+register_signal_chain(SignalChain("mechanical", MECHANICAL_SIGNAL_SCHEMA, measure_mechanical,
+                                  check_mechanical))

@@ -104,7 +104,7 @@ def run_scenario(scenario: Scenario, *, cache: DatasetCache | None = None,
 
     if dataset is None:
         dataset = cache.get(scenario, progress) if cache is not None else generate(scenario, progress)
-    kind = plugins.rig_kind(scenario.rig)
+    kind = scenario.kind
     data = measure(dataset, scenario.signal, kind)
     clean = measure(noise_free(dataset), scenario.signal, kind)
     model = model if model is not None else make_identifier(scenario)

@@ -128,8 +128,39 @@ def check_thresholds(values: dict[str, float], thresholds: dict[str, dict[str, f
 
 
 def failed_scores(kind: str, reason: str, key: str = "fit") -> Scores:
-    """Scores of a run whose model could not be scored at all: every score NaN, one failure."""
+    """Scores of a run whose model could not be scored at all: every score NaN, one failure.
+
+    The names are the kind's catalogue (:data:`testbed.core.kinds.METRICS`); a kind without
+    one raises KeyError naming the known kinds.
+    """
+    if kind not in METRICS:
+        raise KeyError(f"no score catalogue for rig kind {kind!r}; known: {', '.join(METRICS)}")
     return Scores({m: float("nan") for m in METRICS[kind]}, {}, {key: reason})
+
+
+#: ``scorer(dataset, data, clean, model) -> Scores`` per rig kind; see :func:`score`.  This
+#: module registers "structural" and "mechanical" (at its end); a module defining a new kind
+#: registers its scorer with :func:`register_scorer`.
+Scorer = Callable[[Dataset, Measurement, Measurement, Any], "Scores"]
+SCORERS: dict[str, Scorer] = {}
+
+
+def register_scorer(kind: str, scorer: Scorer) -> Scorer:
+    """Make ``scorer`` the scorer of rigs of ``kind``; its scores must be the names of
+    ``METRICS[kind]`` (:mod:`testbed.core.kinds`).
+
+    Raises
+    ------
+    ValueError
+        If another scorer is registered for ``kind``, or the kind has no score catalogue.
+    """
+    if kind not in METRICS:
+        raise ValueError(f"rig kind {kind!r} has no score catalogue (testbed.core.kinds.METRICS)")
+    have = SCORERS.get(kind)
+    if have is not None and have is not scorer:
+        raise ValueError(f"a scorer for rig kind {kind!r} is registered already")
+    SCORERS[kind] = scorer
+    return scorer
 
 
 def physical_failures(M: np.ndarray, C: np.ndarray, K: np.ndarray) -> dict[str, str]:
@@ -269,7 +300,8 @@ def score(kind: str, dataset: Dataset, data: Measurement, clean: Measurement, mo
 
     Parameters
     ----------
-    kind : {"structural", "mechanical"}
+    kind : str
+        The rig kind (``Scenario.kind``); its registered scorer (:data:`SCORERS`) runs.
     dataset : Dataset
         Holds the truth.
     data : Measurement
@@ -287,7 +319,12 @@ def score(kind: str, dataset: Dataset, data: Measurement, clean: Measurement, mo
         is scored, not raised: its affected scores are NaN and :attr:`Scores.failures` holds
         the reasons (with the time of a divergence where known).
     """
-    return (score_structural if kind == "structural" else score_mechanical)(dataset, data, clean, model)
+    try:
+        scorer = SCORERS[kind]
+    except KeyError:
+        raise KeyError(f"no scorer for rig kind {kind!r}; registered: "
+                       f"{', '.join(SCORERS) or '(none)'}") from None
+    return scorer(dataset, data, clean, model)
 
 
 def score_structural(dataset: Dataset, data: Measurement, clean: Measurement, model: Any) -> Scores:
@@ -446,3 +483,7 @@ def score_mechanical(dataset: Dataset, data: Measurement, clean: Measurement, mo
              coef_errors=cmp["coef_errors"], coef_error_norm=cmp["coef_error_norm"],
              dependent_terms=cmp["dependent"], truth_residual=cmp["truth_residual"])
     return Scores(v, d, failures)
+
+
+register_scorer("structural", score_structural)
+register_scorer("mechanical", score_mechanical)

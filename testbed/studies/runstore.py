@@ -266,13 +266,6 @@ def _rig_units(rig: str) -> dict[str, dict[str, str]]:
     return {k: {"unit": f.unit, "doc": f.doc} for k, f in schema.items()}
 
 
-def _kind(result: Any) -> str:
-    kind = getattr(result.model, "kind", "")
-    if kind:
-        return str(kind)
-    return "structural" if "simulated_xdd" in result.scores.details else "mechanical"
-
-
 def build_meta(result: Any) -> dict[str, Any]:
     """The ``run.json`` content of a :class:`~testbed.scoring.run.RunResult`."""
 
@@ -285,7 +278,7 @@ def build_meta(result: Any) -> dict[str, Any]:
     return _jsonable({
         "format": FORMAT,
         "scenario": result.scenario.to_dict(),
-        "kind": _kind(result),
+        "kind": result.scenario.kind,
         "identifier": _identifier(result),
         "equations": _equations(result.model),
         "model_lists": model_lists,

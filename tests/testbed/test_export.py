@@ -44,7 +44,7 @@ def fivebar_dataset() -> Dataset:
     return Dataset(FS, {"theta": Signal(th, ("th1", "th2", "th3", "th4"), "rad"),
                         "dtheta": Signal(w * np.cos(w * t), ("dth1", "dth2", "dth3", "dth4"), "rad/s"),
                         "ddtheta": Signal(-w**2 * th, ("ddth1", "ddth2", "ddth3", "ddth4"), "rad/s^2"),
-                        "torque": Signal(tau, ("u1", "u2"), "N m")},
+                        "torque": Signal(tau, ("u1", "u2"), "N m", acts_on=("th1", "th4"))},
                    truth={"equation_terms": ["ddth1", "u1"], "equation_coef": np.array([[1.0, -1.0]])},
                    attrs={"rig": "fivebar", "seed": 0})
 

@@ -233,7 +233,8 @@ class FaultOscillators(Rig):
         ch = ("th1", "th2", "th3", "th4")
         measured = {"theta": Signal(th, ch, "rad"), "dtheta": Signal(w * np.cos(w * t + 0.3), ch, "rad/s"),
                     "ddtheta": Signal(-w**2 * th, ch, "rad/s^2"),
-                    "torque": Signal(np.zeros((2, n)), ("u1", "u2"), "N m")}
+                    "torque": Signal(np.zeros((2, n)), ("u1", "u2"), "N m",
+                                      acts_on=("th1", "th4"))}
         coef = np.zeros((4, 8))
         for i in range(4):
             coef[i, 2 * i], coef[i, 2 * i + 1] = w[i, 0] ** 2, 1.0

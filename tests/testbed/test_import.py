@@ -37,7 +37,7 @@ def fivebar_dataset() -> Dataset:
                         "ddtheta": Signal(-0.3 * w**2 * np.sin(w * t), ("ddth1", "ddth2", "ddth3", "ddth4"),
                                           "rad/s^2"),
                         "torque": Signal(np.array([np.cos(w[0] * t), 0.5 * np.sin(w[0] * t)]), ("u1", "u2"),
-                                         "N m")},
+                                         "N m", acts_on=("th1", "th4"))},
                    truth={"equation_terms": ["ddth1", "u1"], "equation_coef": np.array([[1.0, -1.0]])},
                    prior={"L0": 0.2}, attrs={"rig": "fivebar", "seed": 0})
 
@@ -93,6 +93,9 @@ def test_fivebar_uff_round_trip_and_input_nodes(tmp_path):
     ref = measure(ds, {"derivatives": "recorded"}, "mechanical")
     np.testing.assert_array_equal(m.x, ref.x)
     np.testing.assert_array_equal(m.u, ref.u)
+    # the torques' joints come back from their UFF nodes (u2 sits at th4's node 4)
+    np.testing.assert_array_equal(m.input_map, ref.input_map)
+    np.testing.assert_array_equal(m.input_map, [[1, 0], [0, 0], [0, 0], [0, 1]])
     assert m.prior == {"L0": 0.2}
 
 

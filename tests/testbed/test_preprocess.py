@@ -170,7 +170,8 @@ def mechanical_dataset(noise: float = 0.0, truth=None, reference=None) -> Datase
     measured = {"theta": Signal(th + noise * rng.normal(size=th.shape), ch, "rad"),
                 "dtheta": Signal(amp * np.cos(t + np.pi / 2 + phase), ch, "rad/s"),
                 "ddtheta": Signal(-th, ch, "rad/s^2"),
-                "torque": Signal(np.stack([np.sin(t), np.cos(t)]), ("u1", "u2"), "N m")}
+                "torque": Signal(np.stack([np.sin(t), np.cos(t)]), ("u1", "u2"), "N m",
+                                  acts_on=("th1", "th4"))}
     return Dataset(fs, measured, {} if reference is None else reference, {} if truth is None else truth,
                    {}, {}, {"rig": "five_bar"})
 
@@ -234,8 +235,30 @@ def test_mechanical_never_reads_truth_or_reference():
         np.testing.assert_array_equal(getattr(other, name), getattr(plain, name))
 
 
-def test_mechanical_needs_four_angles():
+def test_mechanical_joints_and_inputs_come_from_the_data():
+    """No five-bar facts in the chain: three joints, one torque on the second, named freely."""
+    n = 100
+    th = np.arange(3 * n, dtype=float).reshape(3, n)
+    ds = Dataset(100.0, {"theta": Signal(th, ("a", "b", "c"), "rad"),
+                         "dtheta": Signal(2 * th, ("da", "db", "dc"), "rad/s"),
+                         "ddtheta": Signal(3 * th, ("dda", "ddb", "ddc"), "rad/s^2"),
+                         "torque": Signal(np.ones((1, n)), ("motor",), "N m", acts_on=("b",))})
+    m = measure(ds, {}, "mechanical")
+    assert m.channels == ("a", "b", "c") and m.inputs == ("motor",)
+    np.testing.assert_array_equal(m.input_map, [[0], [1], [0]])
+    np.testing.assert_array_equal(m.xdd, 3 * th)
+    ds.measured["ddtheta"] = Signal(np.zeros((2, n)), ("x", "y"), "rad/s^2")
+    with pytest.raises(ValueError, match="expected 3"):
+        measure(ds, {}, "mechanical")
+
+
+def test_mechanical_inputs_must_declare_their_joints():
     ds = mechanical_dataset()
     ds.measured["theta"] = Signal(np.zeros((3, 100)), ("a", "b", "c"), "rad")
-    with pytest.raises(ValueError, match="expected 4"):
+    with pytest.raises(ValueError, match="acts on 'th1', not a channel of 'theta'"):
+        measure(ds, {}, "mechanical")
+    ds = mechanical_dataset()
+    tq = ds.measured["torque"]
+    ds.measured["torque"] = Signal(tq.data, tq.channels, tq.unit)
+    with pytest.raises(ValueError, match="does not declare the joints"):
         measure(ds, {}, "mechanical")
