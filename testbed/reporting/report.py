@@ -106,9 +106,10 @@ class Page:
         self.md += [text, ""]
 
     def table(self, head: Sequence[str], rows: Sequence[Sequence[Any]],
-              classes: Sequence[str | None] | None = None) -> None:
-        """A table; cells are formatted with :func:`fmt`; ``classes`` styles the last cell of a row."""
-        cells = [[fmt(c) for c in r] for r in rows]
+              classes: Sequence[str | None] | None = None, digits: int = 4) -> None:
+        """A table; cells are formatted with :func:`fmt` (``digits`` significant figures);
+        ``classes`` styles the last cell of a row."""
+        cells = [[fmt(c, digits) for c in r] for r in rows]
         ths = "".join(f"<th>{html.escape(c)}</th>" for c in head)
         h = [f"<table><thead><tr>{ths}</tr></thead><tbody>"]
         for i, (raw, r) in enumerate(zip(rows, cells, strict=True)):
@@ -244,10 +245,8 @@ def _schemas(run: SavedRun) -> dict[str, dict[str, Any]]:
 
 
 def _value(v: Any) -> Any:
-    if isinstance(v, float):
-        return f"{v:.6g}"
     if isinstance(v, (list, tuple)):
-        return ", ".join(fmt(x) for x in v) if v else "(empty)"
+        return ", ".join(fmt(x, 6) for x in v) if v else "(empty)"
     if isinstance(v, dict):
         return json.dumps(v, sort_keys=True)
     return v
@@ -271,7 +270,7 @@ def _settings_table(page: Page, title: str, values: dict[str, Any], schema: dict
             v, doc = override[k]
         rows.append([k, _value(v), unit, doc])
     page.heading(title, 3)
-    page.table(["key", "value", "unit", "meaning"], rows)
+    page.table(["key", "value", "unit", "meaning"], rows, digits=6)
     if hidden:
         page.para("Not shown, irrelevant to the options chosen here: " + ", ".join(sorted(hidden)) + ".",
                   '<span class="muted">Not shown, irrelevant to the options chosen here: '
@@ -294,7 +293,7 @@ def _settings_section(page: Page, run: SavedRun) -> None:
     head = [["scenario", sc.get("name", run.name)], ["description", sc.get("description", "")],
             ["rig", f"{sc['rig']} ({run.kind})"], ["seed", sc.get("seed")],
             ["tags", ", ".join(sc.get("tags", []))],
-            ["record", f"{n} samples at {fmt(fs)} Hz"
+            ["record", f"{n} samples at {fmt(fs, 6)} Hz"
                        + (f" ({fmt(n / fs)} s)" if n and fs else "")]]
     page.table(["item", "value"], [r for r in head if r[1] not in ("", None)])
     schemas = _schemas(run)
@@ -315,7 +314,7 @@ def _settings_section(page: Page, run: SavedRun) -> None:
     page.heading(f"Identifier {run.identifier}", 3)
     page.table(["hyperparameter", "value", "set by"],
                [[k, _value(v), "scenario" if k in declared else "default"] for k, v in params.items()]
-               or [["(none)", "", ""]])
+               or [["(none)", "", ""]], digits=6)
     page.para(f"Class {run.meta['identifier'].get('class', '')}; fitted in {run.fit_time:.3g} s.")
     if ds.get("prior"):
         page.para("Prior knowledge given to the identifier: "
