@@ -297,9 +297,6 @@ def matrices(panels: Sequence[tuple[str, np.ndarray, np.ndarray | None, str]]) -
         if im is not None:
             fig.colorbar(im, ax=ax[:, c], label=_label(name, shown_unit), shrink=0.8, location="bottom",
                          aspect=15)
-    # fixed-aspect images beside shared colour bars: constrained layout converges in its
-    # second pass only, so run the first here (savefig runs one more)
-    fig.draw_without_rendering()
     return fig
 
 
@@ -555,7 +552,9 @@ def score_panels(rows: Sequence[dict[str, Any]], metric: str, unit: str = "-",
         for ident, by_noise in sorted(pts[sc].items()):
             nz = sorted(by_noise)
             q = np.array([_quartiles(by_noise[z]) for z in nz])
-            a.plot(nz, q[:, 1], marker="o", ms=3.5, color=colours[ident], label=ident)
+            k = idents.index(ident)  # distinct markers and widths: equal medians stay visible
+            a.plot(nz, q[:, 1], marker="os^Dv<>"[k % 7], ms=4.5 - 0.5 * (k % 3), lw=2.0 - 0.4 * (k % 3),
+                   color=colours[ident], label=ident)
             a.fill_between(nz, q[:, 0], q[:, 2], color=colours[ident], alpha=0.18, lw=0)
         for bound, thr in thresholds.get(sc, []):
             a.axhline(thr, color="#c5221f", ls="--", lw=1.0, label="threshold")
