@@ -391,31 +391,12 @@ def spectra(t: np.ndarray, reference: np.ndarray, simulated: np.ndarray, channel
 
 
 def joint_angles(t: np.ndarray, reference: np.ndarray, simulated: np.ndarray, channels: Sequence[str],
-                 rmse: Sequence[float] | None = None, unit: str = "rad") -> Figure:
-    """One panel per joint: noise-free truth vs the identified model simulated (paper 001, Figs 3-6)."""
-    n = len(channels)
-    cols = 2 if n > 1 else 1
-    rows = math.ceil(n / cols)
-    fig = _fig(2.6 * rows + 0.5)
-    ax = _axes(fig, rows, cols, sharex=True).ravel()
-    for i, ch in enumerate(channels):
-        ax[i].plot(*_envelope(t, reference[i]), color=TRUTH, label="truth (noise-free)")
-        ax[i].plot(*_envelope(t, simulated[i]), color=IDENT, ls="--", label="identified model")
-        ax[i].set_ylabel(_label(f"joint angle {ch}", unit))
-        ax[i].set_title(ch + (f": RMSE {rmse[i]:.4g} {unit}" if rmse is not None else ""))
-    for a in ax[n:]:
-        a.axis("off")
-    for a in ax[max(0, n - cols):n]:
-        a.set_xlabel("time [s]")
-    ax[0].legend(loc="best")
-    return fig
-
-
-def angle_errors(t: np.ndarray, reference: np.ndarray, simulated: np.ndarray, channels: Sequence[str],
-                 unit: str = "rad", inputs: np.ndarray | None = None,
-                 input_channels: Sequence[str] = (), input_unit: str = "N m") -> Figure:
-    """Angle error of the identified model's simulation over time (one line per joint) and,
-    when given, the recorded inputs (torques) that drove it, on a shared time axis.
+                 rmse: Sequence[float] | None = None, unit: str = "rad", errors: bool = True,
+                 inputs: np.ndarray | None = None, input_channels: Sequence[str] = (),
+                 input_unit: str = "N m") -> Figure:
+    """One panel per joint: noise-free truth vs the identified model simulated (paper 001,
+    Figs 3-6); below them, on the same time axis, the angle error of every joint and the
+    recorded inputs (torques) that drove the simulation.
 
     Parameters
     ----------
@@ -423,34 +404,62 @@ def angle_errors(t: np.ndarray, reference: np.ndarray, simulated: np.ndarray, ch
     reference, simulated : ndarray, shape (n_channels, n_samples)
         Noise-free recorded angles and the identified model's simulation.
     channels : sequence of str
+    rmse : sequence of float, optional
+        RMSE per joint, shown in the titles.
     unit : str
         Angle unit.
+    errors : bool
+        Add the panel of angle errors (simulated - truth) over time.
     inputs : ndarray, shape (n_inputs, n_samples), optional
-        Recorded inputs; without them the figure has the error panel only.
+        Recorded inputs (:func:`recorded_inputs`); without them no input panel.
     input_channels : sequence of str
     input_unit : str
     """
+    n = len(channels)
+    cols = 2 if n > 1 else 1
+    rows = math.ceil(n / cols)
     has_u = inputs is not None and np.size(inputs) > 0
-    fig = _fig(5.2 if has_u else 2.9)
-    ax = _axes(fig, 2 if has_u else 1, 1, sharex=True)[:, 0]
-    err = np.asarray(simulated, dtype=float) - np.asarray(reference, dtype=float)
+    extra = int(errors) + int(has_u)
+    fig = _fig(2.4 * rows + 2.3 * extra + 0.5)
+    with mpl.rc_context(STYLE):
+        gs = fig.add_gridspec(rows + extra, cols)
+        first = fig.add_subplot(gs[0, 0])
+        ax = [first] + [fig.add_subplot(gs[i // cols, i % cols], sharex=first) for i in range(1, rows * cols)]
+        wide = [fig.add_subplot(gs[rows + k, :], sharex=first) for k in range(extra)]
     for i, ch in enumerate(channels):
-        ax[0].plot(*_envelope(t, err[i]), lw=0.9, label=ch)
-    ax[0].axhline(0, color="0.5", lw=0.6)
-    ax[0].set_ylabel(_label("angle error", unit))
-    ax[0].set_title("identified model - truth, per joint")
-    ax[0].legend(loc="upper left", ncols=min(4, len(channels)), fontsize=8)
+        ax[i].plot(*_envelope(t, reference[i]), color=TRUTH, label="truth (noise-free)")
+        ax[i].plot(*_envelope(t, simulated[i]), color=IDENT, ls="--", label="identified model")
+        ax[i].set_ylabel(_label(f"joint angle {ch}", unit))
+        ax[i].set_title(ch + (f": RMSE {rmse[i]:.4g} {unit}" if rmse is not None else ""))
+    for a in ax[n:]:
+        a.axis("off")
+    ax[0].legend(loc="best")
+    if errors:
+        e = wide[0]
+        err = np.asarray(simulated, dtype=float) - np.asarray(reference, dtype=float)
+        for i, ch in enumerate(channels):
+            e.plot(*_envelope(t, err[i]), lw=0.9, label=ch)
+        e.axhline(0, color="0.5", lw=0.6)
+        e.set_ylabel(_label("angle error", unit))
+        e.set_title("angle error: identified model - truth, per joint")
+        e.legend(loc="upper left", ncols=min(4, n), fontsize=8)
     if has_u:
+        b = wide[-1]
         u = np.atleast_2d(np.asarray(inputs, dtype=float))
         names = list(input_channels) or [f"u{j + 1}" for j in range(u.shape[0])]
         tu = t if u.shape[1] == t.size else np.arange(u.shape[1]) * (t[1] - t[0])
         for j, name in enumerate(names):
-            ax[1].plot(*_envelope(tu, u[j]), lw=0.9, label=name)
+            b.plot(*_envelope(tu, u[j]), lw=0.9, label=name)
         what = "torque" if input_unit.replace("*", " ") in ("N m", "Nm") else "force"
-        ax[1].set_ylabel(_label(what, input_unit))
-        ax[1].set_title(f"recorded inputs ({what}s)")
-        ax[1].legend(loc="upper left", ncols=len(names), fontsize=8)
-    ax[-1].set_xlabel("time [s]")
+        b.set_ylabel(_label(what, input_unit))
+        b.set_title(f"recorded inputs ({what}s)")
+        b.legend(loc="upper left", ncols=len(names), fontsize=8)
+    bottom = [wide[-1]] if wide else ax[max(0, n - cols):n]
+    for a in ax + wide:
+        if a not in bottom:
+            a.tick_params(labelbottom=False)
+    for a in bottom:
+        a.set_xlabel("time [s]")
     return fig
 
 
@@ -668,16 +677,13 @@ def _run_builders(run: Any, inputs: tuple[np.ndarray, list[str], str] | None
     if _series(run.history or {}):
         b["penalty_weights"] = lambda: penalty_weights(run.history)
     if "simulated_x" in d:
-        b["joint_angles"] = lambda: joint_angles(d["t"], d["reference_x"], d["simulated_x"], d["channels"],
-                                                 d.get("angle_rmse"))
-
-        def _errors() -> Figure:
+        def _angles() -> Figure:
             u = inputs if inputs is not None else recorded_inputs(run)
-            return angle_errors(d["t"], d["reference_x"], d["simulated_x"], d["channels"],
-                                inputs=None if u is None else u[0],
+            return joint_angles(d["t"], d["reference_x"], d["simulated_x"], d["channels"],
+                                d.get("angle_rmse"), inputs=None if u is None else u[0],
                                 input_channels=() if u is None else u[1],
                                 input_unit="N m" if u is None else u[2])
-        b["angle_errors"] = _errors
+        b["joint_angles"] = _angles
     if "coef_true" in d:
         b["coefficients"] = lambda: coefficients(d["terms"], d["coef_true"], d["coef_id"],
                                                  d.get("coef_errors"))

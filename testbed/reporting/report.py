@@ -63,19 +63,18 @@ CAPTIONS = {
     "matrices": "Identified vs true matrices (true: SEREP reduction to the sensor DOFs).",
     "penalty_weights": "Penalty weights and loss terms per training epoch.",
     "joint_angles": "Joint angles: noise-free truth vs the identified model simulated from the true "
-                    "initial state under the recorded torques.",
+                    "initial state under the recorded torques; below, the angle error of every joint "
+                    "over time and the recorded torques (read from the dataset cache when it holds "
+                    "the run's dataset).",
     "coefficients": "Coefficients of the library terms per equation: truth vs identified "
                     "(scaled so that the leading true term matches).",
     "spectra": "Where the model deviates: power spectral density of the noise-free measured "
                "acceleration, of the identified model's simulation and of their difference per "
                "sensor (true natural frequencies dotted), and the residual over time.",
-    "angle_errors": "Joint-angle error of the identified model's simulation over time, with the "
-                    "recorded torques that drove it (from the dataset cache, when it holds the run's "
-                    "dataset).",
 }
 #: Order of the run figures in a report.
 ORDER = ("reconstruction", "spectra", "mac", "frequencies", "matrices", "penalty_weights",
-         "joint_angles", "angle_errors", "coefficients")
+         "joint_angles", "coefficients")
 
 
 def fmt(v: Any, digits: int = 4) -> str:

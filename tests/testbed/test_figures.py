@@ -136,31 +136,33 @@ def test_psd_peak_and_parseval():
 
 def test_mechanical_run_figures(runs):
     figs = figures.run_figures(runs["mechanical"])
-    assert list(figs) == ["joint_angles", "angle_errors", "coefficients"]
+    assert list(figs) == ["joint_angles", "coefficients"]
     ja = figs["joint_angles"]
     panels = [a for a in ja.axes if a.lines]
-    assert len(panels) == 4 and all("[rad]" in a.get_ylabel() for a in panels)
+    # four joints, then the angle errors (no dataset in the cache for a synthetic run: no torques)
+    assert len(panels) == 5 and all("[rad]" in a.get_ylabel() for a in panels)
     assert "RMSE 0.0141 rad" in panels[0].get_title()
+    assert panels[-1].get_ylabel() == "angle error [rad]" and panels[-1].get_xlabel() == "time [s]"
     co = figs["coefficients"].axes
     assert len(co) == 2
     assert [t.get_text() for t in co[0].get_xticklabels()] == runs["mechanical"].details["terms"]
     heights = [p.get_height() for p in co[0].patches]
     np.testing.assert_allclose(heights[:5], runs["mechanical"].details["coef_true"][0])
-    # no dataset in the cache for a synthetic run: the error panel alone
-    assert [a.get_ylabel() for a in figs["angle_errors"].axes] == ["angle error [rad]"]
 
 
-def test_angle_errors_with_torques(runs):
+def test_joint_angles_with_errors_and_torques(runs):
     d = runs["mechanical"].details
     tau = np.vstack([np.sin(d["t"]), np.cos(d["t"])])
-    fig = figures.angle_errors(d["t"], d["reference_x"], d["simulated_x"], d["channels"], inputs=tau,
+    fig = figures.joint_angles(d["t"], d["reference_x"], d["simulated_x"], d["channels"], inputs=tau,
                                input_channels=["u1", "u2"], input_unit="N m")
-    err, torque = fig.axes
+    *joints, err, torque = [a for a in fig.axes if a.lines]
+    assert len(joints) == 4
     assert err.get_ylabel() == "angle error [rad]" and torque.get_ylabel() == "torque [N m]"
     assert [ln.get_label() for ln in err.lines[:4]] == list(d["channels"])
     np.testing.assert_allclose(err.lines[0].get_ydata(), d["simulated_x"][0] - d["reference_x"][0])
     np.testing.assert_allclose(torque.lines[1].get_ydata(), tau[1])
-    assert torque.get_xlabel() == "time [s]"
+    assert torque.get_xlabel() == "time [s]" and err.get_xlabel() == ""  # one time axis, at the bottom
+    assert torque.get_shared_x_axes().joined(torque, joints[0])
 
 
 def test_metric_units_and_log_rule():

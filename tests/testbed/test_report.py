@@ -57,7 +57,7 @@ def images(html: str) -> list[str]:
     return re.findall(r'<img src="([^"]*)"', html)
 
 
-FIGURES = [("cantilever", 6), ("fivebar", 3), ("sweep", 3), ("study", 4)]
+FIGURES = [("cantilever", 6), ("fivebar", 2), ("sweep", 3), ("study", 4)]
 
 
 @pytest.mark.parametrize(("name", "n_figures"), FIGURES)
