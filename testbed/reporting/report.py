@@ -290,7 +290,7 @@ def _settings_section(page: Page, run: SavedRun) -> None:
     sc, ds = run.scenario, run.meta.get("dataset", {})
     n, fs = ds.get("n_samples"), ds.get("fs")
     head = [["scenario", sc.get("name", run.name)], ["description", sc.get("description", "")],
-            ["rig", f"{sc['rig']} ({run.kind})"], ["seed", sc.get("seed")],
+            ["rig", f"{sc['rig']} ({run.kind})"], ["seed", str(sc.get("seed"))],
             ["tags", ", ".join(sc.get("tags", []))],
             ["record", f"{n} samples at {fmt(fs, 6)} Hz"
                        + (f" ({fmt(n / fs)} s)" if n and fs else "")]]
