@@ -590,9 +590,15 @@ def sweep_report(rows: Sequence[dict[str, Any]], out_dir: str | os.PathLike,
               "and interquartile range (band) per identifier; dashed red: the scenario's threshold.")
     ok = [r for r in rows if _ok(r)]
     names = score_names(rows)
+    kinds = list(METRICS)
+
+    def order(m: str) -> tuple[int, int, str]:  # thresholded first, then by rig kind, then name
+        kind = next((k for k, v in enumerate(METRICS.values()) if m in v), len(kinds))
+        return (0 if any(m in t for t in thr.values()) else 1, kind, m)
+
     thresholded = [m for m in names if any(m in t for t in thr.values())]
     figures_html, figures_md, zero = [], [], []
-    for m in thresholded + [m for m in names if m not in thresholded]:
+    for m in sorted(names, key=order):
         vals = [float(r[m]) for r in ok if _finite(r.get(m))]
         if vals and m not in thresholded and not any(vals):
             zero.append(m)  # e.g. a cubic norm of linear models: a flat line says nothing

@@ -158,9 +158,9 @@ def test_study_report_content(reports):
     assert "(identify/ls.py:42)" not in cant  # the reason without its source location
     assert '<div class="grid">' in text and text.count('<figure class="wide">') == 2  # trac, freq_error
     assert "Exactly 0 in every cell that ran (not drawn): K3_norm." in text
-    # thresholded scores first
-    order = [m for m in re.findall(r'<img src="[^"]*" alt="([a-zA-Z0-9_]+):', text)]
-    assert order[:2] == ["angle_rmse", "trac"]
+    # thresholded scores first, structural before mechanical, then the rest
+    order = re.findall(r'<img src="[^"]*" alt="([a-zA-Z0-9_]+):', text)
+    assert order == ["trac", "angle_rmse", "freq_error"]
 
 
 # ------------------------------------------------------------------ real headless Chromium
