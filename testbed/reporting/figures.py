@@ -609,6 +609,9 @@ def fit_times(rows: Sequence[dict[str, Any]]) -> Figure:
     return fig
 
 
+#: Largest cached dataset [bytes] read for its inputs: a figure does not wait for a long record
+#: (a 10 s five-bar record is about 20 MB; an hour, 5 GB).
+MAX_INPUT_FILE_BYTES = 200 * 2**20
 #: Units of measured signals that are inputs (forces and torques) rather than responses.
 INPUT_UNITS = ("N", "N m", "N*m", "Nm")
 
@@ -630,7 +633,8 @@ def recorded_inputs(run: Any, cache: Any = None) -> tuple[np.ndarray, list[str],
     -------
     (ndarray, list of str, str) or None
         Inputs (n_inputs, n_samples), channel names, unit; None if the dataset is not cached,
-        cannot be read, or has no measured signal in a force or torque unit.
+        is larger than :data:`MAX_INPUT_FILE_BYTES`, cannot be read, or has no measured signal
+        in a force or torque unit.
     """
     try:
         sc = dict(run.scenario)
@@ -638,7 +642,7 @@ def recorded_inputs(run: Any, cache: Any = None) -> tuple[np.ndarray, list[str],
         fields = {k: v for k, v in sc.items() if k in names}
         scenario = Scenario(**fields | {"tags": tuple(sc.get("tags", ()))})
         path = (cache or DatasetCache()).path(scenario)
-        if not path.is_file():
+        if not path.is_file() or path.stat().st_size > MAX_INPUT_FILE_BYTES:
             return None
         ds = Dataset.load(path)
     except Exception:  # a report never fails for want of an optional panel

@@ -210,3 +210,20 @@ def test_sweep_figures():
     ft = figures.fit_times(rows)
     assert ft.axes[0].get_xlabel() == "fit time [s]"
     assert [t.get_text() for t in ft.axes[0].get_yticklabels()] == ["sgd_sindy", "sindy_ls"]
+
+
+def test_recorded_inputs_come_from_the_dataset_cache(tmp_path):
+    from testbed.pipeline.cache import DatasetCache
+
+    result = synth.mechanical_result(n_samples=400)
+    run = load_run(save_run(result, tmp_path / "run"))
+    cache = DatasetCache(tmp_path / "cache")
+    assert figures.recorded_inputs(run, cache) is None  # not cached: no panel, no simulation
+    path = cache.path(result.scenario)
+    path.parent.mkdir(parents=True)
+    result.dataset.save(path)
+    data, names, unit = figures.recorded_inputs(run, cache)
+    assert names == ["tau1", "tau2"] and unit == "N m"
+    np.testing.assert_array_equal(data, result.dataset.measured["torques"].data)
+    fig = figures.run_figures(run, inputs=(data, names, unit))["joint_angles"]
+    assert [a.get_ylabel() for a in fig.axes if a.lines][-1] == "torque [N m]"
