@@ -1,11 +1,17 @@
 """Run and sweep figures in one matplotlib style, drawn without pyplot (Agg canvas, no global state).
 
 Run figures follow the papers the testbed reproduces: reconstruction of each sensor,
-truth vs identified with a zoom window (paper 000, Fig. 2a/3a); the MAC matrix with
-its values (Fig. 2b/3b); penalty weights per epoch (Fig. 4); true vs identified
-frequencies (Table 2); identified vs true matrices; joint angles truth vs identified
-(paper 001, Figs. 3-6); coefficients truth vs identified.  Sweep figures: a score
-against noise per identifier, and fit time per identifier.
+truth vs identified with a zoom window (paper 000, Fig. 2a/3a); where the model deviates
+(PSD of measured, simulated and residual acceleration per sensor, and the residual over
+time); the MAC matrix with its values (Fig. 2b/3b); penalty weights per epoch (Fig. 4);
+true vs identified frequencies (Table 2); identified vs true M, C, K (and K3) side by side
+with their relative errors; joint angles truth vs identified (paper 001, Figs. 3-6) with
+the angle errors and the recorded torques below; coefficients truth vs identified.
+
+Sweep figures: per score, a panel per scenario (shared axes) with a line per identifier
+(median over seeds, interquartile band) against noise, the unit from the metric catalogue
+(:func:`metric_unit`), a log axis where the values span decades (:func:`wants_log`) and the
+scenario's thresholds; fit time per identifier.
 """
 
 from __future__ import annotations

@@ -6,6 +6,14 @@ anywhere, offline, as one file.  The markdown twin links the PNGs written beside
 
 A report is written for a run folder (from :func:`testbed.studies.runstore.save_run`) or
 for the results file of a sweep (rows of :func:`testbed.studies.results.read_results`).
+
+A run report reads top-down as a person checks a run: the verdict and why it failed, the
+scores with units and thresholds, frequencies, the identified equations (wrapped, one per
+line), every setting of the scenario as tables (keys the chosen options make irrelevant left
+out and named, the actual sensor positions), the truth, the figures and provenance.  A sweep
+report is titled by its study and shows pass rates, a numeric summary per scenario
+(median and interquartile range over seeds, pass rate, reasons of failures counted) and
+one small-multiples figure per score (:func:`testbed.reporting.figures.score_panels`).
 """
 
 from __future__ import annotations
