@@ -367,7 +367,7 @@ def _scores_section(page: Page, run: SavedRun) -> None:
     unit = {k: figs.metric_unit(k, doc.get(k, "")) for k in run.scores}
     for c in run.checks:
         checked.add(c.metric)
-        op = ">= " if c.bound == "min" else "<= "
+        op = ">=\u00a0" if c.bound == "min" else "<=\u00a0"  # no break inside a threshold
         rows.append([c.metric, doc.get(c.metric, ""), c.value, unit.get(c.metric, "-"),
                      op + fmt(c.threshold), "pass" if c.passed else "FAIL"])
         classes.append("pass" if c.passed else "fail")
