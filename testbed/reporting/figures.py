@@ -1,18 +1,26 @@
 """Run and sweep figures in one matplotlib style, drawn without pyplot (Agg canvas, no global state).
 
 Run figures follow the papers the testbed reproduces: reconstruction of each sensor,
-truth vs identified with a zoom window (paper 000, Fig. 2a/3a); the MAC matrix with
-its values (Fig. 2b/3b); penalty weights per epoch (Fig. 4); true vs identified
-frequencies (Table 2); identified vs true matrices; joint angles truth vs identified
-(paper 001, Figs. 3-6); coefficients truth vs identified.  Sweep figures: a score
-against noise per identifier, and fit time per identifier.
+truth vs identified with a zoom window (paper 000, Fig. 2a/3a); where the model deviates
+(PSD of measured, simulated and residual acceleration per sensor, and the residual over
+time); the MAC matrix with its values (Fig. 2b/3b); penalty weights per epoch (Fig. 4);
+true vs identified frequencies (Table 2); identified vs true M, C, K (and K3) side by side
+with their relative errors; joint angles truth vs identified (paper 001, Figs. 3-6) with
+the angle errors and the recorded torques below; coefficients truth vs identified.
+
+Sweep figures: per score, a panel per scenario (shared axes) with a line per identifier
+(median over seeds, interquartile band) against noise, the unit from the metric catalogue
+(:func:`metric_unit`), a log axis where the values span decades (:func:`wants_log`) and the
+scenario's thresholds; fit time per identifier.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import os
-from collections.abc import Sequence
+import re
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -20,6 +28,11 @@ import matplotlib as mpl
 import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.patches import Rectangle
+from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
+
+from testbed.core.dataset import Dataset
+from testbed.pipeline.cache import DatasetCache
+from testbed.pipeline.scenario import Scenario
 
 STYLE: dict[str, Any] = {
     "font.size": 10, "axes.titlesize": 10, "axes.labelsize": 10, "legend.fontsize": 9,
@@ -71,6 +84,16 @@ def _envelope(t: np.ndarray, y: np.ndarray, n_bins: int = MAX_POINTS // 2
     i_hi = np.minimum(base + yp.argmax(axis=1), y.size - 1)
     idx = np.sort(np.stack([i_lo, i_hi], axis=1), axis=1).ravel()  # time order within a bin
     return t[idx], y[idx]
+
+
+def _log_y(ax: Any) -> None:
+    """Logarithmic y axis with plain ``1e-3`` tick labels: mathtext labels (``10^{-3}``) cost
+    most of a small figure's layout time (measured: 1.6 of 2.4 s of a 3-row spectrum figure)."""
+    ax.set_yscale("log")
+    ax.yaxis.set_major_locator(LogLocator(numticks=5))
+    ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:.0e}".replace("e-0", "e-")
+                                               .replace("e+0", "e").replace("e+", "e")))
+    ax.yaxis.set_minor_formatter(NullFormatter())
 
 
 def _label(quantity: str, unit: str) -> str:
@@ -173,7 +196,7 @@ def penalty_weights(history: dict[str, Any]) -> Figure | None:
         for k, v in g.items():
             a.plot(np.arange(1, v.size + 1), v, label=k)
         if all(np.all(v[np.isfinite(v)] > 0) for v in g.values()):
-            a.set_yscale("log")
+            _log_y(a)
         a.set(xlabel="epoch", ylabel=f"{title[:-1]} [-]", title=f"{title} vs epoch")
         a.legend(fontsize=8)
     return fig
@@ -225,19 +248,41 @@ def true_cubic(truth: dict[str, Any], n: int) -> np.ndarray | None:
     return float(np.asarray(truth["k3"])) * np.outer(np.asarray(truth["cubic_direction"], dtype=float), e)
 
 
+def relative_error(ident: np.ndarray, true: np.ndarray) -> float:
+    """Relative Frobenius error ``||ident - true|| / ||true||`` (NaN without a finite truth)."""
+    ident, true = np.asarray(ident, dtype=float), np.asarray(true, dtype=float)
+    den = float(np.linalg.norm(true))
+    if ident.shape != true.shape or not np.isfinite(den) or den == 0.0:
+        return float("nan")
+    return float(np.linalg.norm(ident - true)) / den
+
+
 def matrices(panels: Sequence[tuple[str, np.ndarray, np.ndarray | None, str]]) -> Figure:
-    """Identified (left) vs true (right) matrices as heat maps, one shared colour scale per row.
+    """Identified (top row) vs true (bottom row) matrices as heat maps, one column per matrix.
+
+    Each column shares one colour scale (its own colour bar, with the matrix's unit); the
+    identified panel's title gives its relative Frobenius error against the truth.
 
     Parameters
     ----------
     panels : sequence of (name, identified, true or None, unit)
+        E.g. ``[("M", M_id, Mr, "kg"), ("C", C_id, Cr, "N s/m"), ("K", K_id, Kr, "N/m")]``.
     """
-    fig = _fig(2.9 * len(panels) + 0.4, 8.0)
-    ax = _axes(fig, len(panels), 2)
-    for r, (name, ident, true, unit) in enumerate(panels):
+    n = len(panels)
+    size = max(np.asarray(p[1]).shape[0] for p in panels)
+    fig = _fig(5.6 if size <= 6 else 6.4, min(WIDTH, 3.4 * n + 0.4))
+    ax = _axes(fig, 2, n)
+    for c, (name, ident, true, unit) in enumerate(panels):
         mats = [np.asarray(ident, dtype=float), None if true is None else np.asarray(true, dtype=float)]
-        lim = max(float(np.max(np.abs(m))) for m in mats if m is not None) or 1.0
-        for c, (m, who) in enumerate(zip(mats, ("identified", "true"), strict=True)):
+        lim = max(float(np.nanmax(np.abs(m))) for m in mats if m is not None) or 1.0
+        # values such as 9.57e+06 do not fit a cell: show them in units of 10^k
+        k = int(np.floor(np.log10(lim))) if np.isfinite(lim) else 0
+        scale = 10.0**k if abs(k) >= 3 else 1.0
+        mats = [None if m is None else m / scale for m in mats]
+        lim /= scale
+        shown_unit = f"1e{k} {unit}" if scale != 1.0 else unit
+        im = None
+        for r, (m, who) in enumerate(zip(mats, ("identified", "true"), strict=True)):
             a = ax[r, c]
             a.grid(False)
             if m is None:
@@ -248,29 +293,145 @@ def matrices(panels: Sequence[tuple[str, np.ndarray, np.ndarray | None, str]]) -
             im = a.imshow(m, cmap="RdBu_r", vmin=-lim, vmax=lim)
             if m.shape[0] <= 6:
                 for (i, j), v in np.ndenumerate(m):
-                    a.text(j, i, f"{v:.3g}", ha="center", va="center", fontsize=8,
+                    a.text(j, i, f"{v:.3g}", ha="center", va="center", fontsize=7,
                            color="white" if abs(v) > 0.6 * lim else "black")
-            err = "" if c or mats[1] is None else \
-                f" (rel. error {np.linalg.norm(m - mats[1]) / max(np.linalg.norm(mats[1]), 1e-300):.2%})"
+            err = "" if r or mats[1] is None else f"\nrel. error {relative_error(m, mats[1]):.2%}"
             a.set_title(f"{name} {who}{err}")
             a.set_xticks(range(m.shape[1]), [str(j + 1) for j in range(m.shape[1])])
             a.set_yticks(range(m.shape[0]), [str(i + 1) for i in range(m.shape[0])])
-            a.set(xlabel="sensor DOF (column)", ylabel="sensor DOF (row)")
-        fig.colorbar(im, ax=ax[r, :], label=_label(name, unit), shrink=0.9)
-    # fixed-aspect images beside a shared colour bar: constrained layout converges in its
-    # second pass only, so run the first here (savefig runs one more)
-    fig.draw_without_rendering()
+            a.set(xlabel="sensor DOF", ylabel="sensor DOF" if c == 0 else "")
+        if im is not None:
+            fig.colorbar(im, ax=ax[:, c], label=_label(name, shown_unit), shrink=0.8, location="bottom",
+                         aspect=15)
+    return fig
+
+
+def psd(y: np.ndarray, fs: float, nperseg: int = 1024) -> tuple[np.ndarray, np.ndarray]:
+    """One-sided power spectral density of each row of ``y`` (Welch: Hann, 50 % overlap).
+
+    Written with numpy alone (no ``scipy.signal`` import for a figure).
+
+    Parameters
+    ----------
+    y : ndarray, shape (n_channels, n_samples) or (n_samples,)
+    fs : float
+        Sample rate [Hz].
+    nperseg : int
+        Segment length (shortened to the record if longer).
+
+    Returns
+    -------
+    f : ndarray, shape (nperseg // 2 + 1,)
+        Frequencies [Hz].
+    p : ndarray, shape (n_channels, nperseg // 2 + 1)
+        PSD [unit^2/Hz].
+    """
+    y = np.atleast_2d(np.asarray(y, dtype=float))
+    n = int(min(nperseg, y.shape[1]))
+    w = np.hanning(n)
+    step = max(1, n // 2)
+    segs = np.lib.stride_tricks.sliding_window_view(y, n, axis=1)[:, ::step]
+    segs = segs - segs.mean(axis=2, keepdims=True)
+    spec = np.abs(np.fft.rfft(segs * w, axis=2)) ** 2
+    p = spec.mean(axis=1) / (fs * np.sum(w**2))
+    p[:, 1:-1 if n % 2 == 0 else None] *= 2.0
+    return np.fft.rfftfreq(n, 1.0 / fs), p
+
+
+def spectra(t: np.ndarray, reference: np.ndarray, simulated: np.ndarray, channels: Sequence[str],
+            unit: str = "m/s^2", frequencies: Sequence[float] | None = None,
+            f_max: float | None = None) -> Figure:
+    """Where the model deviates: PSD of measured vs simulated signal and of their difference
+    (left), and the time residual measured - simulated (right), one row per channel.
+
+    Parameters
+    ----------
+    t : ndarray, shape (n_samples,)
+        Time [s] (uniform).
+    reference, simulated : ndarray, shape (n_channels, n_samples)
+        Noise-free measured signal and the identified model's simulation of it.
+    channels : sequence of str
+    unit : str
+        Unit of the signals.
+    frequencies : sequence of float, optional
+        True natural frequencies [Hz], marked as dotted vertical lines.
+    f_max : float, optional
+        Upper frequency limit [Hz]; default 1.5x the highest marked frequency (or Nyquist).
+    """
+    t = np.asarray(t, dtype=float)
+    ref, sim = np.atleast_2d(reference), np.atleast_2d(simulated)
+    fs = 1.0 / float(t[1] - t[0])
+    ok = np.all(np.isfinite(sim))
+    n = len(channels)
+    fig = _fig(2.0 * n + 0.7)
+    ax = _axes(fig, n, 2, width_ratios=(1, 1.2), sharex="col")
+    nper = int(2 ** np.clip(np.round(np.log2(ref.shape[1] / 8)), 6, 13))
+    f, p_ref = psd(ref, fs, nper)
+    _, p_sim = psd(np.nan_to_num(sim), fs, nper)
+    _, p_res = psd(np.nan_to_num(ref - sim), fs, nper)
+    freqs = [float(x) for x in (frequencies if frequencies is not None else []) if np.isfinite(x)]
+    top = f_max or (1.5 * max(freqs) if freqs else fs / 2)
+    band = (f > 0) & (f <= top)
+    for i, ch in enumerate(channels):
+        a = ax[i, 0]
+        a.plot(f[band], p_ref[i, band], color=TRUTH, label="measured (noise-free)")
+        if ok:
+            a.plot(f[band], p_sim[i, band], color=IDENT, ls="--", label="identified model")
+            a.plot(f[band], p_res[i, band], color="#1f77b4", lw=0.9, label="residual")
+        _log_y(a)
+        for fr in freqs:
+            if fr <= top:
+                a.axvline(fr, color="0.5", ls=":", lw=0.8)
+        a.set_ylabel(f"PSD [({unit})^2/Hz]")
+        a.set_title(f"{ch}: spectrum")
+        b = ax[i, 1]
+        b.plot(*_envelope(t, ref[i] - sim[i]), color="#1f77b4", lw=0.8)
+        b.set_ylabel(_label("residual", unit))
+        rel = float(np.sqrt(np.mean((ref[i] - sim[i]) ** 2)) / max(np.sqrt(np.mean(ref[i] ** 2)), 1e-300))
+        b.set_title(f"{ch}: measured - simulated (RMS {rel:.2%} of signal)" if ok
+                    else f"{ch}: no simulation (failed)")
+    ax[-1, 0].set_xlabel("frequency [Hz]")
+    ax[-1, 1].set_xlabel("time [s]")
+    ax[0, 0].legend(loc="upper right", fontsize=8)
     return fig
 
 
 def joint_angles(t: np.ndarray, reference: np.ndarray, simulated: np.ndarray, channels: Sequence[str],
-                 rmse: Sequence[float] | None = None, unit: str = "rad") -> Figure:
-    """One panel per joint: noise-free truth vs the identified model simulated (paper 001, Figs 3-6)."""
+                 rmse: Sequence[float] | None = None, unit: str = "rad", errors: bool = True,
+                 inputs: np.ndarray | None = None, input_channels: Sequence[str] = (),
+                 input_unit: str = "N m") -> Figure:
+    """One panel per joint: noise-free truth vs the identified model simulated (paper 001,
+    Figs 3-6); below them, on the same time axis, the angle error of every joint and the
+    recorded inputs (torques) that drove the simulation.
+
+    Parameters
+    ----------
+    t : ndarray, shape (n_samples,)
+    reference, simulated : ndarray, shape (n_channels, n_samples)
+        Noise-free recorded angles and the identified model's simulation.
+    channels : sequence of str
+    rmse : sequence of float, optional
+        RMSE per joint, shown in the titles.
+    unit : str
+        Angle unit.
+    errors : bool
+        Add the panel of angle errors (simulated - truth) over time.
+    inputs : ndarray, shape (n_inputs, n_samples), optional
+        Recorded inputs (:func:`recorded_inputs`); without them no input panel.
+    input_channels : sequence of str
+    input_unit : str
+    """
     n = len(channels)
     cols = 2 if n > 1 else 1
     rows = math.ceil(n / cols)
-    fig = _fig(2.6 * rows + 0.5)
-    ax = _axes(fig, rows, cols, sharex=True).ravel()
+    has_u = inputs is not None and np.size(inputs) > 0
+    extra = int(errors) + int(has_u)
+    fig = _fig(2.4 * rows + 2.3 * extra + 0.5)
+    with mpl.rc_context(STYLE):
+        gs = fig.add_gridspec(rows + extra, cols)
+        first = fig.add_subplot(gs[0, 0])
+        ax = [first] + [fig.add_subplot(gs[i // cols, i % cols], sharex=first) for i in range(1, rows * cols)]
+        wide = [fig.add_subplot(gs[rows + k, :], sharex=first) for k in range(extra)]
     for i, ch in enumerate(channels):
         ax[i].plot(*_envelope(t, reference[i]), color=TRUTH, label="truth (noise-free)")
         ax[i].plot(*_envelope(t, simulated[i]), color=IDENT, ls="--", label="identified model")
@@ -278,9 +439,33 @@ def joint_angles(t: np.ndarray, reference: np.ndarray, simulated: np.ndarray, ch
         ax[i].set_title(ch + (f": RMSE {rmse[i]:.4g} {unit}" if rmse is not None else ""))
     for a in ax[n:]:
         a.axis("off")
-    for a in ax[max(0, n - cols):n]:
-        a.set_xlabel("time [s]")
     ax[0].legend(loc="best")
+    if errors:
+        e = wide[0]
+        err = np.asarray(simulated, dtype=float) - np.asarray(reference, dtype=float)
+        for i, ch in enumerate(channels):
+            e.plot(*_envelope(t, err[i]), lw=0.9, label=ch)
+        e.axhline(0, color="0.5", lw=0.6)
+        e.set_ylabel(_label("angle error", unit))
+        e.set_title("angle error: identified model - truth, per joint")
+        e.legend(loc="upper left", ncols=min(4, n), fontsize=8)
+    if has_u:
+        b = wide[-1]
+        u = np.atleast_2d(np.asarray(inputs, dtype=float))
+        names = list(input_channels) or [f"u{j + 1}" for j in range(u.shape[0])]
+        tu = t if u.shape[1] == t.size else np.arange(u.shape[1]) * (t[1] - t[0])
+        for j, name in enumerate(names):
+            b.plot(*_envelope(tu, u[j]), lw=0.9, label=name)
+        what = "torque" if input_unit.replace("*", " ") in ("N m", "Nm") else "force"
+        b.set_ylabel(_label(what, input_unit))
+        b.set_title(f"recorded inputs ({what}s)")
+        b.legend(loc="upper left", ncols=len(names), fontsize=8)
+    bottom = [wide[-1]] if wide else ax[max(0, n - cols):n]
+    for a in ax + wide:
+        if a not in bottom:
+            a.tick_params(labelbottom=False)
+    for a in bottom:
+        a.set_xlabel("time [s]")
     return fig
 
 
@@ -304,25 +489,110 @@ def coefficients(terms: Sequence[str], coef_true: np.ndarray, coef_id: np.ndarra
     return fig
 
 
-def score_vs_noise(rows: Sequence[dict[str, Any]], metric: str) -> Figure:
-    """Median (line) and min-max over seeds (band) of ``metric`` against noise, per identifier."""
-    fig = _fig(3.8, 8.0)
-    ax = _axes(fig)[0, 0]
-    for ident in sorted({r["identifier"] for r in rows}):
-        pts: dict[float, list[float]] = {}
-        for r in rows:
-            v = r.get(metric)
-            if r["identifier"] == ident and v is not None and np.isfinite(float(v)):
-                pts.setdefault(float(r["noise"]), []).append(float(v))
-        if not pts:
+#: Units of scores whose unit the catalogue (:data:`testbed.core.kinds.METRICS`) does not write
+#: as ``[unit]`` in its text; relative errors, ratios, TRAC, MAC and F1 are dimensionless ("-").
+#: Kept here rather than in the catalogue: only figures and tables need them.
+UNITS: dict[str, str] = {"angle_rmse": "rad", "K3_norm": "N/m^3", "fit_time": "s"}
+#: Positive values spanning more than this many decades get a logarithmic axis.
+LOG_DECADES = 2.0
+
+
+def metric_unit(name: str, doc: str = "") -> str:
+    """Unit of score ``name``: :data:`UNITS`, else the first ``[unit]`` in its catalogue text
+    ``doc``, else ``"-"`` (dimensionless)."""
+    if name in UNITS:
+        return UNITS[name]
+    m = re.search(r"\[([^\]]+)\]", doc or "")
+    return m.group(1) if m else "-"
+
+
+def wants_log(values: Sequence[float], decades: float = LOG_DECADES) -> bool:
+    """Whether ``values`` belong on a log axis: all finite ones positive and spanning more
+    than ``decades`` decades."""
+    v = np.asarray([x for x in values if x is not None], dtype=float)
+    v = v[np.isfinite(v)]
+    return bool(v.size >= 2 and np.all(v > 0) and np.log10(v.max() / v.min()) > decades)
+
+
+def _quartiles(vals: Sequence[float]) -> tuple[float, float, float]:
+    q25, med, q75 = np.percentile(np.asarray(vals, dtype=float), [25, 50, 75])
+    return float(q25), float(med), float(q75)
+
+
+def score_panels(rows: Sequence[dict[str, Any]], metric: str, unit: str = "-",
+                 thresholds: dict[str, list[tuple[str, float]]] | None = None,
+                 max_cols: int = 3) -> Figure | None:
+    """One metric against noise: a panel per scenario (shared axes), a line per identifier
+    (median over seeds) with its interquartile band, and the scenario's thresholds.
+
+    Parameters
+    ----------
+    rows : sequence of dict
+        Result rows of cells that ran (``scenario``, ``identifier``, ``noise`` and the metric).
+    metric : str
+    unit : str
+        Unit for the y label (``"-"``: dimensionless).
+    thresholds : dict of str to list of (bound, threshold), optional
+        Per scenario, ``("min"|"max", value)`` of ``metric`` (dashed horizontal lines).
+    max_cols : int
+        Panels per figure row.
+
+    Returns
+    -------
+    Figure or None
+        None if no row has a finite value of ``metric``.
+    """
+    pts: dict[str, dict[str, dict[float, list[float]]]] = {}
+    for r in rows:
+        v = r.get(metric)
+        if v is None or isinstance(v, str) or not np.isfinite(float(v)):
             continue
-        nz = sorted(pts)
-        med = [float(np.median(pts[z])) for z in nz]
-        line, = ax.plot(nz, med, marker="o", label=ident)
-        ax.fill_between(nz, [min(pts[z]) for z in nz], [max(pts[z]) for z in nz],
-                        color=line.get_color(), alpha=0.15)
-    ax.set(xlabel="noise [% of channel RMS]", ylabel=f"{metric} [-]", title=f"{metric} vs noise")
-    ax.legend(title="identifier")
+        pts.setdefault(str(r["scenario"]), {}).setdefault(str(r["identifier"]), {}) \
+            .setdefault(float(r["noise"]), []).append(float(v))
+    if not pts:
+        return None
+    scenarios = sorted(pts)
+    idents = sorted({i for s in pts.values() for i in s})
+    thresholds = thresholds or {}
+    n = len(scenarios)
+    cols = min(n, max_cols)
+    nrows = math.ceil(n / cols)
+    fig = _fig(2.5 * nrows + 0.6, min(WIDTH, 3.3 * cols + 1.2))
+    ax = _axes(fig, nrows, cols, sharex=True, sharey=True).ravel()
+    colours = {i: f"C{k % 10}" for k, i in enumerate(idents)}
+    every = [v for s in pts.values() for d in s.values() for vs in d.values() for v in vs]
+    every += [thr for s in scenarios for _, thr in thresholds.get(s, [])]
+    noises = sorted({z for s in pts.values() for d in s.values() for z in d})
+    for a, sc in zip(ax, scenarios, strict=False):
+        for ident, by_noise in sorted(pts[sc].items()):
+            nz = sorted(by_noise)
+            q = np.array([_quartiles(by_noise[z]) for z in nz])
+            k = idents.index(ident)  # distinct markers and widths: equal medians stay visible
+            a.plot(nz, q[:, 1], marker="os^Dv<>"[k % 7], ms=4.5 - 0.5 * (k % 3), lw=2.0 - 0.4 * (k % 3),
+                   color=colours[ident], label=ident)
+            a.fill_between(nz, q[:, 0], q[:, 2], color=colours[ident], alpha=0.18, lw=0)
+        for bound, thr in thresholds.get(sc, []):
+            a.axhline(thr, color="#c5221f", ls="--", lw=1.0, label="threshold")
+            a.annotate(f"{'≥' if bound == 'min' else '≤'} {thr:.3g}", (1.0, thr),
+                       xycoords=("axes fraction", "data"), ha="right", va="bottom", fontsize=8,
+                       color="#c5221f")
+        a.set_title(sc, fontsize=9)
+    for a in ax[n:]:
+        a.axis("off")
+    if wants_log(every):
+        _log_y(ax[0])
+    ax[0].set_xticks(noises)
+    for k in range(n):
+        if k % cols == 0:
+            ax[k].set_ylabel(_label(metric, unit))
+        if k >= n - cols:
+            ax[k].set_xlabel("noise [% of RMS]")
+    handles: dict[str, Any] = {}
+    for a in ax[:n]:
+        for h, lab in zip(*a.get_legend_handles_labels(), strict=True):
+            handles.setdefault(lab, h)
+    fig.legend(handles.values(), handles.keys(), loc="outside upper center", ncols=min(5, len(handles)),
+               fontsize=8, frameon=False)
     return fig
 
 
@@ -345,30 +615,114 @@ def fit_times(rows: Sequence[dict[str, Any]]) -> Figure:
     return fig
 
 
-def run_figures(run: Any) -> dict[str, Figure]:
-    """Every figure a saved run (:class:`~testbed.studies.runstore.SavedRun`) supports, by stem."""
-    d, figs = run.details, {}
+#: Largest cached dataset [bytes] read for its inputs: a figure does not wait for a long record
+#: (a 10 s five-bar record is about 20 MB; an hour, 5 GB).
+MAX_INPUT_FILE_BYTES = 200 * 2**20
+#: Units of measured signals that are inputs (forces and torques) rather than responses.
+INPUT_UNITS = ("N", "N m", "N*m", "Nm")
+
+
+def recorded_inputs(run: Any, cache: Any = None) -> tuple[np.ndarray, list[str], str] | None:
+    """The recorded inputs (force or torque signals) of a saved run, from the dataset cache.
+
+    A run folder keeps what scoring needs, not the raw record; the run's clean simulation is
+    still in the dataset cache (:class:`testbed.pipeline.cache.DatasetCache`) when the run was
+    made here, and is read from there (never simulated).
+
+    Parameters
+    ----------
+    run : SavedRun
+    cache : DatasetCache, optional
+        Default: the default cache folder.
+
+    Returns
+    -------
+    (ndarray, list of str, str) or None
+        Inputs (n_inputs, n_samples), channel names, unit; None if the dataset is not cached,
+        is larger than :data:`MAX_INPUT_FILE_BYTES`, cannot be read, or has no measured signal
+        in a force or torque unit.
+    """
+    try:
+        sc = dict(run.scenario)
+        names = {f.name for f in dataclasses.fields(Scenario)}
+        fields = {k: v for k, v in sc.items() if k in names}
+        scenario = Scenario(**fields | {"tags": tuple(sc.get("tags", ()))})
+        path = (cache or DatasetCache()).path(scenario)
+        if not path.is_file() or path.stat().st_size > MAX_INPUT_FILE_BYTES:
+            return None
+        ds = Dataset.load(path)
+    except Exception:  # a report never fails for want of an optional panel
+        return None
+    for sig in ds.measured.values():
+        if sig.unit in INPUT_UNITS:
+            return sig.data, list(sig.channels), sig.unit
+    return None
+
+
+def _run_builders(run: Any, inputs: tuple[np.ndarray, list[str], str] | None
+                  ) -> dict[str, Callable[[], Figure | None]]:
+    """Stem -> builder of every figure ``run`` supports, in report order (nothing drawn yet)."""
+    d, b = run.details, {}
     if "simulated_xdd" in d:
-        figs["reconstruction"] = reconstruction(d["t"], d["reference_xdd"], d["simulated_xdd"],
-                                                d["channels"], trac=d.get("trac"))
+        b["reconstruction"] = lambda: reconstruction(d["t"], d["reference_xdd"], d["simulated_xdd"],
+                                                     d["channels"], trac=d.get("trac"))
+        b["spectra"] = lambda: spectra(d["t"], d["reference_xdd"], d["simulated_xdd"], d["channels"],
+                                       frequencies=np.asarray(d.get("f_true", []), dtype=float))
     if "mac" in d:
-        figs["mac"] = mac_matrix(d["mac"], d.get("pair"))
+        b["mac"] = lambda: mac_matrix(d["mac"], d.get("pair"))
     if "f_id" in d:
-        figs["frequencies"] = frequency_table(frequency_rows(d["f_true"], d["f_id"], d.get("pair"),
-                                                             d.get("z_true"), d.get("z_id")))
+        b["frequencies"] = lambda: frequency_table(frequency_rows(d["f_true"], d["f_id"], d.get("pair"),
+                                                                  d.get("z_true"), d.get("z_id")))
     if "M_id" in d:
-        panels = [("M", d["M_id"], d.get("Mr"), "kg"), ("K", d["K_id"], d.get("Kr"), "N/m")]
-        if run.model.get("K3_") is not None:
-            panels.append(("K3", run.model["K3_"], true_cubic(run.truth, len(d["channels"])), "N/m^3"))
-        figs["matrices"] = matrices(panels)
-    if (pw := penalty_weights(run.history)) is not None:
-        figs["penalty_weights"] = pw
+        def _matrices() -> Figure:
+            panels = [("M", d["M_id"], d.get("Mr"), "kg")]
+            if "C_id" in d:
+                panels.append(("C", d["C_id"], d.get("Cr"), "N s/m"))
+            panels.append(("K", d["K_id"], d.get("Kr"), "N/m"))
+            K3 = run.model.get("K3_")
+            if K3 is not None and np.any(np.asarray(K3) != 0):
+                panels.append(("K3", K3, true_cubic(run.truth, len(d["channels"])), "N/m^3"))
+            return matrices(panels)
+        b["matrices"] = _matrices
+    if _series(run.history or {}):
+        b["penalty_weights"] = lambda: penalty_weights(run.history)
     if "simulated_x" in d:
-        figs["joint_angles"] = joint_angles(d["t"], d["reference_x"], d["simulated_x"], d["channels"],
-                                            d.get("angle_rmse"))
+        def _angles() -> Figure:
+            u = inputs if inputs is not None else recorded_inputs(run)
+            return joint_angles(d["t"], d["reference_x"], d["simulated_x"], d["channels"],
+                                d.get("angle_rmse"), inputs=None if u is None else u[0],
+                                input_channels=() if u is None else u[1],
+                                input_unit="N m" if u is None else u[2])
+        b["joint_angles"] = _angles
     if "coef_true" in d:
-        figs["coefficients"] = coefficients(d["terms"], d["coef_true"], d["coef_id"], d.get("coef_errors"))
-    return figs
+        b["coefficients"] = lambda: coefficients(d["terms"], d["coef_true"], d["coef_id"],
+                                                 d.get("coef_errors"))
+    return b
+
+
+def run_figures_available(run: Any) -> list[str]:
+    """Stems of the figures :func:`run_figures` would draw for ``run`` (cheap: nothing drawn)."""
+    return list(_run_builders(run, None))
+
+
+def run_figures(run: Any, inputs: tuple[np.ndarray, list[str], str] | None = None,
+                only: Sequence[str] | None = None) -> dict[str, Figure]:
+    """Every figure a saved run (:class:`~testbed.studies.runstore.SavedRun`) supports, by stem.
+
+    Parameters
+    ----------
+    run : SavedRun
+    inputs : (ndarray, list of str, str), optional
+        Recorded inputs for the five-bar's error figure; default :func:`recorded_inputs`.
+    only : sequence of str, optional
+        Draw just these stems.
+    """
+    out = {}
+    for stem, build in _run_builders(run, inputs).items():
+        if only is None or stem in only:
+            if (f := build()) is not None:
+                out[stem] = f
+    return out
 
 
 def save_run_figures(run: Any, directory: str | os.PathLike) -> list[Path]:

@@ -6,14 +6,24 @@ anywhere, offline, as one file.  The markdown twin links the PNGs written beside
 
 A report is written for a run folder (from :func:`testbed.studies.runstore.save_run`) or
 for the results file of a sweep (rows of :func:`testbed.studies.results.read_results`).
+
+A run report reads top-down as a person checks a run: the verdict and why it failed, the
+scores with units and thresholds, frequencies, the identified equations (wrapped, one per
+line), every setting of the scenario as tables (keys the chosen options make irrelevant left
+out and named, the actual sensor positions), the truth, the figures and provenance.  A sweep
+report is titled by its study and shows pass rates, a numeric summary per scenario
+(median and interquartile range over seeds, pass rate, reasons of failures counted) and
+one small-multiples figure per score (:func:`testbed.reporting.figures.score_panels`).
 """
 
 from __future__ import annotations
 
 import base64
 import html
+import json
 import math
 import os
+import re
 import shutil
 from collections.abc import Sequence
 from pathlib import Path
@@ -23,6 +33,9 @@ import numpy as np
 
 from testbed.core.atomic import atomic_write_text
 from testbed.core.kinds import METRICS
+from testbed.pipeline.plugins import RIGS
+from testbed.pipeline.scenario import NOISE_SCHEMA
+from testbed.pipeline.signal_chain import SIGNAL_SCHEMAS
 from testbed.reporting import figures as figs
 from testbed.studies.results import read_results, score_columns
 from testbed.studies.runstore import SavedRun, load_run
@@ -33,13 +46,19 @@ padding:0 1em;color:#222;line-height:1.45}
 h1{border-bottom:2px solid #ddd;padding-bottom:.3em}h2{margin-top:1.6em;border-bottom:1px solid #eee}
 table{border-collapse:collapse;margin:.6em 0 1.2em}th,td{border:1px solid #ccc;padding:.25em .6em;
 text-align:left;font-variant-numeric:tabular-nums}th{background:#f3f3f3}
-td.num{text-align:right}.pass{color:#137333;font-weight:600}.fail{color:#c5221f;font-weight:600}
+td.num{text-align:right;white-space:nowrap}.pass{color:#137333;font-weight:600}.fail{color:#c5221f;font-weight:600}
 .badge{display:inline-block;padding:.1em .6em;border-radius:.3em;color:#fff;font-size:.8em;
 vertical-align:middle}.badge.pass{background:#137333;color:#fff}.badge.fail{background:#c5221f;color:#fff}
 .badge.none{background:#777;color:#fff}
 figure{margin:1em 0}figure img{max-width:100%;height:auto;border:1px solid #eee}
 figcaption{color:#555;font-size:.9em}pre{background:#f7f7f7;padding:.6em;overflow-x:auto}
 .muted{color:#666;font-size:.9em}
+ol.eq{background:#f7f7f7;padding:.6em .6em .6em 2.4em;font-family:ui-monospace,Menlo,Consolas,monospace;
+font-size:.85em}ol.eq li{white-space:pre-wrap;overflow-wrap:anywhere;margin:.2em 0;padding-left:2em;
+text-indent:-2em}
+.grid{display:grid;grid-template-columns:repeat(auto-fill,minmax(480px,1fr));gap:.6em 1em}
+.grid figure{margin:.3em 0}.grid figure.wide{grid-column:1/-1}
+td.fails{font-size:.85em;color:#8a1c1c;max-width:28em}
 """
 CSP = "default-src 'none'; img-src data:; style-src 'unsafe-inline'"
 #: Captions of the run figures, by file stem.
@@ -52,10 +71,18 @@ CAPTIONS = {
     "matrices": "Identified vs true matrices (true: SEREP reduction to the sensor DOFs).",
     "penalty_weights": "Penalty weights and loss terms per training epoch.",
     "joint_angles": "Joint angles: noise-free truth vs the identified model simulated from the true "
-                    "initial state under the recorded torques.",
+                    "initial state under the recorded torques; below, the angle error of every joint "
+                    "over time and the recorded torques (read from the dataset cache when it holds "
+                    "the run's dataset).",
     "coefficients": "Coefficients of the library terms per equation: truth vs identified "
                     "(scaled so that the leading true term matches).",
+    "spectra": "Where the model deviates: power spectral density of the noise-free measured "
+               "acceleration, of the identified model's simulation and of their difference per "
+               "sensor (true natural frequencies dotted), and the residual over time.",
 }
+#: Order of the run figures in a report.
+ORDER = ("reconstruction", "spectra", "mac", "frequencies", "matrices", "penalty_weights",
+         "joint_angles", "coefficients")
 
 
 def fmt(v: Any, digits: int = 4) -> str:
@@ -86,9 +113,10 @@ class Page:
         self.md += [text, ""]
 
     def table(self, head: Sequence[str], rows: Sequence[Sequence[Any]],
-              classes: Sequence[str | None] | None = None) -> None:
-        """A table; cells are formatted with :func:`fmt`; ``classes`` styles the last cell of a row."""
-        cells = [[fmt(c) for c in r] for r in rows]
+              classes: Sequence[str | None] | None = None, digits: int = 4) -> None:
+        """A table; cells are formatted with :func:`fmt` (``digits`` significant figures);
+        ``classes`` styles the last cell of a row."""
+        cells = [[fmt(c, digits) for c in r] for r in rows]
         ths = "".join(f"<th>{html.escape(c)}</th>" for c in head)
         h = [f"<table><thead><tr>{ths}</tr></thead><tbody>"]
         for i, (raw, r) in enumerate(zip(rows, cells, strict=True)):
@@ -105,16 +133,42 @@ class Page:
         self.md += ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
         self.md += ["| " + " | ".join(r) + " |" for r in esc] + [""]
 
-    def figure(self, png: Path, caption: str) -> None:
-        """Embed ``png`` (base64) in the HTML; copy it beside the markdown."""
+    def figure_html(self, png: Path, caption: str, cls: str = "") -> str:
+        """``<figure>`` of ``png`` embedded as base64 (copied beside the markdown as well)."""
         name = png.name
         if png.resolve() != (self.out_dir / name).resolve():
             shutil.copyfile(png, self.out_dir / name)
         data = base64.b64encode(png.read_bytes()).decode("ascii")
         alt = html.escape(caption, quote=True)
-        self.html.append(f'<figure><img src="data:image/png;base64,{data}" alt="{alt}">'
-                         f"<figcaption>{html.escape(caption)}</figcaption></figure>")
-        self.md += [f"![{png.stem}]({name})", "", f"*{caption}*", ""]
+        attr = f' class="{cls}"' if cls else ""
+        return (f'<figure{attr}><img src="data:image/png;base64,{data}" alt="{alt}">'
+                f"<figcaption>{html.escape(caption)}</figcaption></figure>")
+
+    @staticmethod
+    def figure_md(png: Path, caption: str) -> str:
+        return f"![{png.stem}]({png.name})\n\n*{caption}*"
+
+    def figure(self, png: Path, caption: str) -> None:
+        """Embed ``png`` (base64) in the HTML; copy it beside the markdown."""
+        self.html.append(self.figure_html(png, caption))
+        self.md += [self.figure_md(png, caption), ""]
+
+    def bullets(self, items: Sequence[str]) -> None:
+        """A bulleted list of plain-text items."""
+        self.html.append("<ul>" + "".join(f"<li>{html.escape(i)}</li>" for i in items) + "</ul>")
+        self.md += [f"- {i}" for i in items] + [""]
+
+    def equations(self, lines: Sequence[str]) -> None:
+        """Equations, one numbered item each, wrapping at any character with a hanging indent."""
+        self.html.append('<ol class="eq">' + "".join(f"<li>{html.escape(e)}</li>" for e in lines)
+                         + "</ol>")
+        self.md += ["```", *lines, "```", ""]
+
+    def raw(self, html_text: str, md_text: str = "") -> None:
+        """Raw HTML (built by the caller from escaped parts) and its markdown."""
+        self.html.append(html_text)
+        if md_text:
+            self.md += [md_text, ""]
 
     def pre(self, lines: Sequence[str]) -> None:
         self.html.append("<pre>" + html.escape("\n".join(lines)) + "</pre>")
@@ -133,68 +187,213 @@ class Page:
 
 
 # ----------------------------------------------------------------------------- run report
-def _truth_section(page: Page, run: SavedRun) -> None:
-    page.heading("Truth")
-    sc, units = run.scenario, run.meta.get("rig_units", {})
-    ds = run.meta.get("dataset", {})
-    noise = fmt(sc.get("noise", {}).get("rms_percent"))
-    page.para(f"Rig {sc['rig']}, seed {sc.get('seed')}, noise {noise} % of channel RMS, "
-              f"{ds.get('n_samples')} samples at {fmt(ds.get('fs'))} Hz.")
-    params = sc.get("rig_params", {})
-    if params:
-        page.table(["rig parameter", "value", "unit", "meaning"],
-                   [[k, v if isinstance(v, (int, float)) else str(v), units.get(k, {}).get("unit", ""),
-                     units.get(k, {}).get("doc", "")] for k, v in params.items()])
-    tr = run.truth
-    if "frequencies_hz" in tr:
-        f = np.asarray(tr["frequencies_hz"], dtype=float)
-        eb = np.asarray(tr.get("eb_frequencies_hz", []), dtype=float)
-        z = np.asarray(tr.get("damping_ratios", []), dtype=float)
-        rows = [[i + 1, f[i], eb[i] if i < eb.size else None,
-                 100 * (f[i] / eb[i] - 1) if i < eb.size else None, z[i] if i < z.size else None]
-                for i in range(min(len(f), 6))]
-        page.table(["mode", "true [Hz]", "Euler-Bernoulli [Hz]", "true vs E-B [%]", "damping ratio [-]"],
-                   rows)
+def _words(text: str) -> set[str]:
+    return set(re.findall(r"[A-Za-z0-9_]+", text.lower()))
+
+
+def irrelevant_keys(values: dict[str, Any], schema: dict[str, Any], chosen: Sequence[str] = ()) -> set[str]:
+    """Keys of a settings table that the chosen options make irrelevant, read from the schema.
+
+    Generic (no rig named), three conventions of the schemas' documentation: a key named
+    after a choice key (``base_k1`` after ``base``) whose documentation names another choice
+    and not the chosen one ("stiffness of the soft base spring" under ``base = "stiff"``); a
+    key whose documentation says ``not with X`` for a chosen value X of any table (``dth1_0``,
+    "not with sine_replay", under ``type = "sine_replay"``); and keys a choice key's
+    documentation lists in parentheses after another option only ("'lowpass' by a ...
+    filter (cutoff_hz, filter_order)" under ``derivatives = "recorded"``).
+
+    Parameters
+    ----------
+    values : dict
+        The table as validated (defaults filled in).
+    schema : dict of str to Field
+        Its schema (``unit``, ``doc``, ``choices``); keys without a field are kept.
+    chosen : sequence of str
+        Chosen option values of other tables (e.g. the excitation type).
+    """
+    picks = {k: str(values[k]) for k, f in schema.items()
+             if getattr(f, "choices", None) and k in values}
+    every_pick = {v.lower() for v in (*picks.values(), *chosen)}
+    out = set()
+    for k, f in schema.items():
+        doc = str(getattr(f, "doc", "") or "")
+        words = _words(doc)
+        for c, v in picks.items():
+            others = {str(o).lower() for o in schema[c].choices} - {v.lower()}
+            if k.startswith(c + "_") and words & others and v.lower() not in words:
+                out.add(k)
+        if any(f"not with {p}" in doc.lower() for p in every_pick):
+            out.add(k)
+    for c, v in picks.items():  # "'lowpass' by a ... filter (cutoff_hz, filter_order)" in c's doc
+        doc = str(getattr(schema[c], "doc", "") or "")
+        listed = {o: set(re.findall(r"[A-Za-z0-9_]+", m.group(1)))
+                  for o in schema[c].choices
+                  if (m := re.search(rf"'{re.escape(str(o))}'[^(']*\(([^)]*)\)", doc))}
+        keep = listed.get(v, set())
+        for o, keys in listed.items():
+            if o != v:
+                out |= keys - keep
+    return out & set(values)
+
+
+def _schemas(run: SavedRun) -> dict[str, dict[str, Any]]:
+    """Schemas of the scenario's tables by section (empty where the rig is unknown here)."""
+    sc = run.scenario
+    out: dict[str, dict[str, Any]] = {"noise": NOISE_SCHEMA,
+                                      "signal": SIGNAL_SCHEMAS.get(run.kind, {})}
+    try:
+        rig = RIGS.get(sc["rig"])
+    except Exception:  # a run made with a rig this installation lacks: tables without units
+        return out
+    out["rig"] = dict(rig.rig_schema)
+    out["simulation"] = dict(rig.simulation_schema)
+    out["excitation"] = dict(rig.excitation_schemas.get(sc.get("excitation", {}).get("type", ""), {}))
+    return out
+
+
+def _value(v: Any) -> Any:
+    if isinstance(v, (list, tuple)):
+        return ", ".join(fmt(x, 6) for x in v) if v else "(empty)"
+    if isinstance(v, dict):
+        return json.dumps(v, sort_keys=True)
+    return v
+
+
+def _settings_table(page: Page, title: str, values: dict[str, Any], schema: dict[str, Any],
+                    chosen: Sequence[str] = (), override: dict[str, tuple[Any, str]] | None = None) -> None:
+    """One settings table (key, value, unit, meaning), keys the options make irrelevant left out
+    and named below it; ``override`` replaces a value and its meaning (e.g. actual positions)."""
+    if not values:
+        return
+    hidden = irrelevant_keys(values, schema, chosen)
+    override = override or {}
+    rows = []
+    for k, v in values.items():
+        if k in hidden:
+            continue
+        f = schema.get(k)
+        unit, doc = getattr(f, "unit", "") or "", getattr(f, "doc", "") or ""
+        if k in override:
+            v, doc = override[k]
+        rows.append([k, _value(v), unit, doc])
+    page.heading(title, 3)
+    page.table(["key", "value", "unit", "meaning"], rows, digits=6)
+    if hidden:
+        page.para("Not shown, irrelevant to the options chosen here: " + ", ".join(sorted(hidden)) + ".",
+                  '<span class="muted">Not shown, irrelevant to the options chosen here: '
+                  + html.escape(", ".join(sorted(hidden))) + ".</span>")
+
+
+def _positions(run: SavedRun) -> list[float] | None:
+    """Actual sensor positions [m] of the run: the dataset's, else the truth's."""
+    for name, sig in run.meta.get("dataset", {}).get("signals", {}).items():
+        if name.startswith("measured/") and sig.get("positions") and sig.get("unit") not in figs.INPUT_UNITS:
+            return [float(x) for x in sig["positions"]]
+    pos = run.truth.get("sensor_positions")
+    return None if pos is None else [float(x) for x in np.atleast_1d(pos)]
+
+
+def _settings_section(page: Page, run: SavedRun) -> None:
+    page.heading("Settings")
+    sc, ds = run.scenario, run.meta.get("dataset", {})
+    n, fs = ds.get("n_samples"), ds.get("fs")
+    head = [["scenario", sc.get("name", run.name)], ["description", sc.get("description", "")],
+            ["rig", f"{sc['rig']} ({run.kind})"], ["seed", str(sc.get("seed"))],
+            ["tags", ", ".join(sc.get("tags", []))],
+            ["record", f"{n} samples at {fmt(fs, 6)} Hz"
+                       + (f" ({fmt(n / fs)} s)" if n and fs else "")]]
+    page.table(["item", "value"], [r for r in head if r[1] not in ("", None)])
+    schemas = _schemas(run)
+    exc_type = str(sc.get("excitation", {}).get("type", ""))
+    over = {}
+    pos = _positions(run)
+    rig = sc.get("rig_params", {})
+    for k, f in schemas.get("rig", {}).items():  # list-valued keys in metres: the actual positions
+        if k in rig and getattr(f, "type", None) is list and getattr(f, "unit", "") == "m" and pos:
+            note = " (the default)" if not rig[k] else ""
+            over[k] = (pos, f"actual positions from the dataset{note}; {getattr(f, 'doc', '')}")
+    _settings_table(page, "Rig", rig, schemas.get("rig", {}), (exc_type,), over)
+    for sec, title in (("simulation", "Simulation"), ("excitation", "Excitation"), ("noise", "Noise"),
+                       ("signal", "Signal chain")):
+        _settings_table(page, title, sc.get(sec, {}), schemas.get(sec, {}), (exc_type,))
+    params = run.meta["identifier"].get("params", {})
+    declared = {k for k in (sc.get("identify") or {}) if k != "method"}
+    page.heading(f"Identifier {run.identifier}", 3)
+    page.table(["hyperparameter", "value", "set by"],
+               [[k, _value(v), "scenario" if k in declared else "default"] for k, v in params.items()]
+               or [["(none)", "", ""]], digits=6)
+    page.para(f"Class {run.meta['identifier'].get('class', '')}; fitted in {run.fit_time:.3g} s.")
     if ds.get("prior"):
-        prior = ", ".join(f"{k} = {fmt(v)}" for k, v in ds["prior"].items())
-        page.para(f"Prior given to the identifier: {prior}")
+        page.para("Prior knowledge given to the identifier: "
+                  + ", ".join(f"{k} = {fmt(v)}" for k, v in ds["prior"].items()) + ".")
+
+
+def _truth_section(page: Page, run: SavedRun) -> None:
+    tr = run.truth
+    if "frequencies_hz" not in tr:
+        return
+    page.heading("Truth")
+    f = np.asarray(tr["frequencies_hz"], dtype=float)
+    eb = np.asarray(tr.get("eb_frequencies_hz", []), dtype=float)
+    z = np.asarray(tr.get("damping_ratios", []), dtype=float)
+    rows = [[i + 1, f[i], eb[i] if i < eb.size else None,
+             100 * (f[i] / eb[i] - 1) if i < eb.size else None, z[i] if i < z.size else None]
+            for i in range(min(len(f), 6))]
+    page.table(["mode", "true [Hz]", "Euler-Bernoulli [Hz]", "true vs E-B [%]", "damping ratio [-]"],
+               rows)
+
+
+def _verdict_section(page: Page, run: SavedRun) -> None:
+    label = run.verdict.upper()  # PASS, FAIL or NO VERDICT
+    status = {"PASS": "pass", "FAIL": "fail"}.get(label, "none")
+    n_checks = len(run.checks)
+    failed = [c for c in run.checks if not c.passed]
+    body = (f"{n_checks - len(failed)} of {n_checks} threshold(s) met" if n_checks
+            else "no thresholds declared in the scenario's [score] table (not a pass)")
+    body += f"; identifier {run.identifier}, fit {run.fit_time:.3g} s."
+    page.para(f"{label}: {body}", f'<span class="badge {status}">{label}</span> {html.escape(body)}')
+    reasons = [f"{c.metric} = {fmt(c.value)}, needs {'>=' if c.bound == 'min' else '<='} "
+               f"{fmt(c.threshold)}" for c in failed]
+    reasons += [f"{k}: {why}" for k, why in run.failures.items()]
+    if reasons:
+        page.heading("Why it failed", 3)
+        page.bullets(reasons)
 
 
 def _scores_section(page: Page, run: SavedRun) -> None:
     page.heading("Scores")
     doc = METRICS.get(run.kind, {})
     rows, classes, checked = [], [], set()
+    unit = {k: figs.metric_unit(k, doc.get(k, "")) for k in run.scores}
     for c in run.checks:
         checked.add(c.metric)
-        op = ">= " if c.bound == "min" else "<= "
-        rows.append([c.metric, doc.get(c.metric, ""), c.value, op + fmt(c.threshold),
-                     "pass" if c.passed else "FAIL"])
+        op = ">=\u00a0" if c.bound == "min" else "<=\u00a0"  # no break inside a threshold
+        rows.append([c.metric, doc.get(c.metric, ""), c.value, unit.get(c.metric, "-"),
+                     op + fmt(c.threshold), "pass" if c.passed else "FAIL"])
         classes.append("pass" if c.passed else "fail")
     for k, v in sorted(run.scores.items()):
         if k not in checked:
-            rows.append([k, doc.get(k, ""), v, "–", "reported"])
+            rows.append([k, doc.get(k, ""), v, unit.get(k, "-"), "–", "reported"])
             classes.append(None)
     for k, why in run.failures.items():  # a scored failure: diverged, fit failed, non-physical
-        rows.append([f"failure: {k}", why, None, "–", "FAIL"])
+        rows.append([f"failure: {k}", why, None, "", "–", "FAIL"])
         classes.append("fail")
-    page.table(["metric", "meaning", "value", "threshold", "result"], rows, classes)
-    if not run.checks:
-        page.para("No thresholds declared in the scenario's [score] table: no verdict (not a pass).")
+    page.table(["metric", "meaning", "value", "unit", "threshold", "result"], rows, classes)
 
 
 def run_report(run: SavedRun, out_dir: str | os.PathLike) -> Path:
-    """Write the report of a saved run into ``out_dir``; return the HTML path."""
+    """Write the report of a saved run into ``out_dir``; return the HTML path.
+
+    Sections: verdict and its reasons, every setting of the scenario as tables (rig keys
+    irrelevant to the chosen options left out, actual sensor positions), the truth, the
+    scores, natural frequencies, the identified equations (wrapped), the figures
+    (:func:`testbed.reporting.figures.run_figures`; the figures the run folder lacks are drawn
+    here) and provenance.
+    """
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     page = Page(f"Run {run.name}: {run.identifier}", out_dir)
-    label = run.verdict.upper()  # PASS, FAIL or NO VERDICT
-    status = {"PASS": "pass", "FAIL": "fail"}.get(label, "none")
-    params = ", ".join(f"{k}={v}" for k, v in run.meta["identifier"].get("params", {}).items())
-    body = f"identifier {run.identifier} ({params}) fitted in {run.fit_time:.3g} s."
-    if run.failure:
-        body += f" Failed: {run.failure}."
-    page.para(f"{label}: {body}", f'<span class="badge {status}">{label}</span> {html.escape(body)}')
-    _truth_section(page, run)
+    _verdict_section(page, run)
     _scores_section(page, run)
     d = run.details
     if "f_id" in d:
@@ -204,13 +403,18 @@ def run_report(run: SavedRun, out_dir: str | os.PathLike) -> Path:
                    [[r["mode"], r["f_true"], r["f_id"], r["error_pct"], r.get("z_true"), r.get("z_id")]
                     for r in rows])
     page.heading("Identified equations")
-    page.pre(run.equations or ["(none)"])
+    page.equations(run.equations or ["(none)"])
+    _settings_section(page, run)
+    _truth_section(page, run)
     page.heading("Figures")
     pngs = {p.stem: p for p in run.figures}
-    if not pngs:
-        pngs = {p.stem: p for p in figs.save_run_figures(run, out_dir)}
-    for stem, png in pngs.items():
-        page.figure(png, CAPTIONS.get(stem, stem))
+    wanted = list(figs.run_figures_available(run))
+    missing = [s for s in wanted if s not in pngs]
+    if missing:  # a run saved by an older version, or without figures: draw what it lacks
+        drawn = figs.run_figures(run, only=missing)
+        pngs.update({stem: figs.save_figure(f, out_dir / f"{stem}.png") for stem, f in drawn.items()})
+    for stem in [s for s in ORDER if s in pngs] + [s for s in pngs if s not in ORDER]:
+        page.figure(pngs[stem], CAPTIONS.get(stem, stem))
     page.heading("Provenance")
     ds = run.meta.get("dataset", {})
     prov = [["dataset content hash", ds.get("hash", "")], ["scenario data hash", ds.get("data_hash", "")],
@@ -232,48 +436,205 @@ def _ok(r: dict[str, Any]) -> bool:
     return str(r.get("status", "ok")) == "ok"
 
 
-def sweep_report(rows: Sequence[dict[str, Any]], out_dir: str | os.PathLike, title: str = "Sweep") -> Path:
-    """Write the report of sweep result rows into ``out_dir``; return the HTML path."""
+def _finite(v: Any) -> bool:
+    return isinstance(v, (int, float, np.number)) and not isinstance(v, bool) and math.isfinite(float(v))
+
+
+def _row_checks(r: dict[str, Any]) -> list[dict[str, Any]]:
+    """The ``checks`` JSON of a results row as a list (empty if absent or unreadable)."""
+    try:
+        checks = json.loads(r.get("checks") or "[]")
+    except (TypeError, ValueError):
+        return []
+    return [c for c in checks if isinstance(c, dict) and {"metric", "bound", "threshold"} <= set(c)]
+
+
+def thresholds(rows: Sequence[dict[str, Any]]) -> dict[str, dict[str, list[tuple[str, float]]]]:
+    """Declared thresholds by scenario and metric: ``{scenario: {metric: [(bound, value)]}}``."""
+    out: dict[str, dict[str, list[tuple[str, float]]]] = {}
+    for r in rows:
+        for c in _row_checks(r):
+            lst = out.setdefault(str(r["scenario"]), {}).setdefault(str(c["metric"]), [])
+            key = (str(c["bound"]), float(c["threshold"]))
+            if key not in lst:
+                lst.append(key)
+    return out
+
+
+def _short(error: str, n: int = 90) -> str:
+    """An error message without its ``(file:line)`` tail, cut to ``n`` characters."""
+    e = re.sub(r"\s*\([^()]*:\d+\)\s*$", "", str(error)).strip() or "unknown error"
+    return e if len(e) <= n else e[: n - 1] + "…"
+
+
+def failure_reasons(cells: Sequence[dict[str, Any]]) -> str:
+    """Why cells did not pass, counted: errors of cells that failed to run (``error`` column),
+    then thresholds missed by cells that ran (``checks`` column); "" if every cell passed."""
+    counts: dict[str, int] = {}
+    for r in cells:
+        if not _ok(r):
+            why = [f"failed: {_short(r.get('error', ''))}"]
+        elif r.get("passed"):
+            continue
+        else:
+            why = [f"{c['metric']} {'<' if c['bound'] == 'min' else '>'} {fmt(c['threshold'], 3)}"
+                   for c in _row_checks(r) if not c.get("passed", True)] or ["not passed"]
+        for w in why:
+            counts[w] = counts.get(w, 0) + 1
+    return "; ".join(f"{n}× {w}" for w, n in sorted(counts.items(), key=lambda x: (-x[1], x[0])))
+
+
+def _rate(cell: Sequence[dict[str, Any]]) -> str:
+    """``passed/cells (percent)`` of a group of cells; a cell that failed to run did not pass."""
+    n_pass = sum(bool(r.get("passed")) and _ok(r) for r in cell)
+    return f"{n_pass}/{len(cell)} ({100 * n_pass / len(cell):.0f} %)"
+
+
+def _iqr(vals: Sequence[float]) -> str:
+    if not vals:
+        return "–"
+    q25, med, q75 = np.percentile(np.asarray(vals, dtype=float), [25, 50, 75])
+    if q25 == q75:  # one seed, or all alike: the value alone
+        return fmt(med, 3)
+    return f"{fmt(med, 3)} [{fmt(q25, 3)}, {fmt(q75, 3)}]"
+
+
+def _doc(metric: str) -> str:
+    for kind in METRICS.values():
+        if metric in kind:
+            return kind[metric]
+    return ""
+
+
+def _summary_tables(page: Page, rows: Sequence[dict[str, Any]],
+                    thr: dict[str, dict[str, list[tuple[str, float]]]]) -> None:
+    """Per scenario: a row per identifier x noise with cells, pass rate, median [IQR] of the
+    scenario's thresholded scores (else its first scores) and the reasons cells did not pass."""
+    metrics = score_names(rows)
+    for sc in sorted({str(r["scenario"]) for r in rows}):
+        srows = [r for r in rows if str(r["scenario"]) == sc]
+        shown = [m for m in thr.get(sc, {}) if m in metrics]
+        if not shown:  # nothing thresholded: the first few scores this scenario has
+            shown = [m for m in metrics if any(_finite(r.get(m)) for r in srows)][:4]
+        head = ["identifier", "noise [%]", "cells", "pass rate"]
+        for m in shown:
+            bounds = ", ".join(f"{'≥' if b == 'min' else '≤'} {fmt(t, 3)}"
+                               for b, t in thr.get(sc, {}).get(m, []))
+            u = figs.metric_unit(m, _doc(m))
+            head.append(f"{m} [{u}]" + (f" ({bounds})" if bounds else ""))
+        head.append("why cells did not pass")
+        table, classes = [], []
+        for ident in sorted({str(r["identifier"]) for r in srows}):
+            for z in sorted({float(r["noise"]) for r in srows if str(r["identifier"]) == ident}):
+                cell = [r for r in srows if str(r["identifier"]) == ident and float(r["noise"]) == z]
+                n_pass = sum(bool(r.get("passed")) and _ok(r) for r in cell)
+                line: list[Any] = [ident, z, len(cell), _rate(cell)]
+                line += [_iqr([float(r[m]) for r in cell if _ok(r) and _finite(r.get(m))]) for m in shown]
+                line.append(failure_reasons(cell) or "–")
+                table.append(line)
+                classes.append("fails" if n_pass < len(cell) else None)
+        page.heading(f"Scenario {sc}", 3)
+        page.table(head, table, classes)
+
+
+def sweep_report(rows: Sequence[dict[str, Any]], out_dir: str | os.PathLike,
+                 title: str | None = None) -> Path:
+    """Write the report of sweep result rows into ``out_dir``; return the HTML path.
+
+    Parameters
+    ----------
+    rows : sequence of dict
+        Results rows (:func:`testbed.studies.results.read_results`).
+    out_dir : path
+        Report folder (created).
+    title : str, optional
+        Fallback title when the rows name no study (e.g. the results file's name).
+
+    Notes
+    -----
+    The page: a pass-rate overview (scenario x identifier x noise), a numeric summary per
+    scenario (median and interquartile range over seeds, pass rate, reasons of failures),
+    then one figure per score: a panel per scenario, a line per identifier (median, IQR
+    band) against noise, units from the metric catalogue, the scenario's thresholds as
+    dashed lines, a log axis where the values span decades; then fit times and failed cells.
+    """
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     rows = list(rows)
-    page = Page(f"Sweep {title}", out_dir)
+    studies = sorted({str(r.get("study") or "") for r in rows} - {""})
+    name = ", ".join(studies) or title or "sweep"
+    page = Page(f"Study {name}", out_dir)
     idents = sorted({str(r["identifier"]) for r in rows})
+    scenarios = sorted({str(r["scenario"]) for r in rows})
     noises = sorted({float(r["noise"]) for r in rows})
     errors = [r for r in rows if not _ok(r)]
-    page.para(f"{len(rows)} cells: {len(idents)} identifier(s) ({', '.join(idents)}), noise levels "
-              f"{', '.join(fmt(z) for z in noises)} % of channel RMS, "
-              f"{len({r['seed'] for r in rows})} seed(s), {len(errors)} failed to run.")
+    page.para(f"{len(rows)} cells: {len(scenarios)} scenario(s), {len(idents)} identifier(s) "
+              f"({', '.join(idents)}), noise levels {', '.join(fmt(z) for z in noises)} % of channel "
+              f"RMS, {len({r['seed'] for r in rows})} seed(s); {len(errors)} failed to run.")
+    thr = thresholds(rows)
+
     page.heading("Pass rate")
     page.para("Cells passing every threshold of their scenario, out of all cells (a cell that failed "
               "to run counts as not passed).")
     table = []
-    for i in idents:
-        line: list[Any] = [i]
-        for z in noises:
-            cell = [r for r in rows if r["identifier"] == i and float(r["noise"]) == z]
-            n_pass = sum(bool(r.get("passed")) and _ok(r) for r in cell)
-            line.append(f"{n_pass}/{len(cell)} ({100 * n_pass / len(cell):.0f} %)" if cell else "–")
-        table.append(line)
-    page.table(["identifier"] + [f"noise {fmt(z)} %" for z in noises], table)
+    for sc in scenarios:
+        for i in idents:
+            line: list[Any] = [sc, i]
+            cells = [[r for r in rows if r["scenario"] == sc and r["identifier"] == i
+                      and float(r["noise"]) == z] for z in noises]
+            if not any(cells):
+                continue
+            line += [_rate(cell) if cell else "–" for cell in cells]
+            table.append(line)
+    page.table(["scenario", "identifier"] + [f"noise {fmt(z)} %" for z in noises], table)
+
+    page.heading("Summary")
+    page.para("Median [25th, 75th percentile] over seeds of the cells that ran; thresholds in the "
+              "column heads; reasons counted over the cells of each row.")
+    _summary_tables(page, rows, thr)
+
     page.heading("Scores vs noise")
-    for m in score_names(rows):
-        ok = [r for r in rows if _ok(r)]
-        if not any(r.get(m) is not None and np.isfinite(float(r[m])) for r in ok):
+    page.para("One figure per score, a panel per scenario (shared axes): median over seeds (line) "
+              "and interquartile range (band) per identifier; dashed red: the scenario's threshold.")
+    ok = [r for r in rows if _ok(r)]
+    names = score_names(rows)
+    kinds = list(METRICS)
+
+    def order(m: str) -> tuple[int, int, str]:  # thresholded first, then by rig kind, then name
+        kind = next((k for k, v in enumerate(METRICS.values()) if m in v), len(kinds))
+        return (0 if any(m in t for t in thr.values()) else 1, kind, m)
+
+    thresholded = [m for m in names if any(m in t for t in thr.values())]
+    figures_html, figures_md, zero = [], [], []
+    for m in sorted(names, key=order):
+        vals = [float(r[m]) for r in ok if _finite(r.get(m))]
+        if vals and m not in thresholded and not any(vals):
+            zero.append(m)  # e.g. a cubic norm of linear models: a flat line says nothing
             continue
-        png = figs.save_figure(figs.score_vs_noise(ok, m), out_dir / f"score_{m}.png")
-        page.figure(png, f"{m} against noise per identifier: median over seeds (line), min-max (band).")
+        fig = figs.score_panels(ok, m, figs.metric_unit(m, _doc(m)),
+                                {sc: t[m] for sc, t in thr.items() if m in t})
+        if fig is None:
+            continue
+        wide = len({r["scenario"] for r in ok if _finite(r.get(m))}) > 1
+        png = figs.save_figure(fig, out_dir / f"score_{m}.png")
+        cap = f"{m}: {_doc(m) or 'score'}"
+        figures_html.append(page.figure_html(png, cap, "wide" if wide else ""))
+        figures_md.append(page.figure_md(png, cap))
+    page.raw('<div class="grid">' + "".join(figures_html) + "</div>", "\n\n".join(figures_md))
+    if zero:
+        page.para(f"Exactly 0 in every cell that ran (not drawn): {', '.join(zero)}.")
+
     page.heading("Fit time")
     page.table(["identifier", "cells", "median [s]", "max [s]"],
                [[i, len(t), float(np.median(t)) if t else None, float(np.max(t)) if t else None]
                 for i in idents for t in [[float(r["fit_time"]) for r in rows if r["identifier"] == i
-                                           and _ok(r) and r.get("fit_time") is not None]]])
-    page.figure(figs.save_figure(figs.fit_times([r for r in rows if _ok(r)]), out_dir / "fit_time.png"),
+                                           and _ok(r) and _finite(r.get("fit_time"))]]])
+    page.figure(figs.save_figure(figs.fit_times(ok), out_dir / "fit_time.png"),
                 "Fit time per identifier over all cells that ran.")
     if errors:
         page.heading("Cells that failed to run")
-        page.table(["cell", "identifier", "noise [%]", "seed", "error"],
-                   [[r.get("cell", ""), r["identifier"], r["noise"], r["seed"], r.get("error", "")]
+        page.table(["scenario", "identifier", "noise [%]", "seed", "error"],
+                   [[r["scenario"], r["identifier"], r["noise"], r["seed"], r.get("error", "")]
                     for r in errors])
     commits = sorted({str(r.get("commit", "")) for r in rows})
     page.para("Commit(s): " + ", ".join(commits) + ".")

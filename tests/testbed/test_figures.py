@@ -91,13 +91,18 @@ def test_true_cubic_only_when_it_exists_in_the_basis():
 
 def test_structural_run_figures(runs, tmp_path):
     figs = figures.run_figures(runs["structural"])
-    assert list(figs) == ["reconstruction", "mac", "frequencies", "matrices", "penalty_weights"]
-    assert [a.get_title() for a in figs["matrices"].axes if a.get_title()][-2:] == \
-        ["K3 identified (rel. error 10.00%)", "K3 true"]
-    for name in ("reconstruction", "penalty_weights"):
+    assert list(figs) == ["reconstruction", "spectra", "mac", "frequencies", "matrices", "penalty_weights"]
+    titles = [a.get_title() for a in figs["matrices"].axes if a.get_title()]
+    # M, C and K side by side, then the cubic matrix: identified (top row) over true
+    assert titles == ["M identified\nrel. error 2.00%", "C identified\nrel. error 0.00%",
+                      "K identified\nrel. error 1.00%", "K3 identified\nrel. error 10.00%",
+                      "M true", "C true", "K true", "K3 true"]
+    for name in ("reconstruction", "penalty_weights", "spectra"):
         assert_units(figs[name])
-    bars = [a.get_ylabel() for a in figs["matrices"].axes if a.get_label() == "<colorbar>"]
-    assert bars == ["M [kg]", "K [N/m]", "K3 [N/m^3]"]
+    bars = [a.get_xlabel() for a in figs["matrices"].axes if a.get_label() == "<colorbar>"]
+    assert bars == ["M [kg]", "C [N s/m]", "K [1e4 N/m]", "K3 [1e9 N/m^3]"]
+    cells = {t.get_text() for a in figs["matrices"].axes for t in a.texts}
+    assert "8" in cells and "0.9" in cells  # K[0, 0] = 8e4 N/m, K3[0, 0] = 9e8 N/m^3 in 1e4 / 1e9
     paths = figures.save_run_figures(runs["structural"], tmp_path)
     for p in paths:
         img = mpimg.imread(p)
@@ -105,13 +110,39 @@ def test_structural_run_figures(runs, tmp_path):
         assert img[..., :3].std() > 0.01, f"{p.name} is blank"
 
 
+def test_spectra_show_where_the_model_deviates(runs):
+    d = runs["structural"].details
+    fig = figures.spectra(d["t"], d["reference_xdd"], d["simulated_xdd"], d["channels"],
+                          frequencies=d["f_true"])
+    psd_axes = [a for a in fig.axes if a.get_xlabel() == "frequency [Hz]" or "PSD" in a.get_ylabel()]
+    assert len(psd_axes) == 3 and all(a.get_yscale() == "log" for a in psd_axes)
+    assert psd_axes[0].get_ylabel() == "PSD [(m/s^2)^2/Hz]"
+    assert [ln.get_label() for ln in psd_axes[0].lines[:3]] == ["measured (noise-free)", "identified model",
+                                                                "residual"]
+    marks = [ln.get_xdata()[0] for ln in psd_axes[0].lines[3:]]  # the true frequencies, dotted
+    np.testing.assert_allclose(marks, d["f_true"][d["f_true"] <= 1.5 * d["f_true"].max()])
+    res = [a for a in fig.axes if a.get_ylabel() == "residual [m/s^2]"]
+    assert len(res) == 3 and "RMS 2.00% of signal" in res[0].get_title()  # simulated = 0.98 x truth
+
+
+def test_psd_peak_and_parseval():
+    fs, f0 = 1000.0, 125.0
+    t = np.arange(20000) / fs
+    y = np.sqrt(2) * np.sin(2 * np.pi * f0 * t)  # variance 1
+    f, p = figures.psd(y, fs, 256)
+    assert f[np.argmax(p[0])] == pytest.approx(f0, abs=fs / 256)
+    assert np.sum(p[0]) * (f[1] - f[0]) == pytest.approx(1.0, rel=0.02)
+
+
 def test_mechanical_run_figures(runs):
     figs = figures.run_figures(runs["mechanical"])
     assert list(figs) == ["joint_angles", "coefficients"]
     ja = figs["joint_angles"]
     panels = [a for a in ja.axes if a.lines]
-    assert len(panels) == 4 and all("[rad]" in a.get_ylabel() for a in panels)
+    # four joints, then the angle errors (no dataset in the cache for a synthetic run: no torques)
+    assert len(panels) == 5 and all("[rad]" in a.get_ylabel() for a in panels)
     assert "RMSE 0.0141 rad" in panels[0].get_title()
+    assert panels[-1].get_ylabel() == "angle error [rad]" and panels[-1].get_xlabel() == "time [s]"
     co = figs["coefficients"].axes
     assert len(co) == 2
     assert [t.get_text() for t in co[0].get_xticklabels()] == runs["mechanical"].details["terms"]
@@ -119,9 +150,57 @@ def test_mechanical_run_figures(runs):
     np.testing.assert_allclose(heights[:5], runs["mechanical"].details["coef_true"][0])
 
 
+def test_joint_angles_with_errors_and_torques(runs):
+    d = runs["mechanical"].details
+    tau = np.vstack([np.sin(d["t"]), np.cos(d["t"])])
+    fig = figures.joint_angles(d["t"], d["reference_x"], d["simulated_x"], d["channels"], inputs=tau,
+                               input_channels=["u1", "u2"], input_unit="N m")
+    *joints, err, torque = [a for a in fig.axes if a.lines]
+    assert len(joints) == 4
+    assert err.get_ylabel() == "angle error [rad]" and torque.get_ylabel() == "torque [N m]"
+    assert [ln.get_label() for ln in err.lines[:4]] == list(d["channels"])
+    np.testing.assert_allclose(err.lines[0].get_ydata(), d["simulated_x"][0] - d["reference_x"][0])
+    np.testing.assert_allclose(torque.lines[1].get_ydata(), tau[1])
+    assert torque.get_xlabel() == "time [s]" and err.get_xlabel() == ""  # one time axis, at the bottom
+    assert torque.get_shared_x_axes().joined(torque, joints[0])
+
+
+def test_metric_units_and_log_rule():
+    assert figures.metric_unit("angle_rmse") == "rad"
+    assert figures.metric_unit("K3_norm") == "N/m^3"
+    assert figures.metric_unit("trac", "smallest TRAC over sensors") == "-"
+    assert figures.metric_unit("new_score", "peak torque error [N m] over the record") == "N m"
+    assert figures.wants_log([1e-6, 1e-4, 1e-2])
+    assert not figures.wants_log([0.9, 0.95, 0.99])
+    assert not figures.wants_log([0.0, 1e-6, 1e-2])  # a zero has no place on a log axis
+    assert not figures.wants_log([1e-3, 5e-2])  # under 2 decades
+
+
+def test_score_panels_small_multiples():
+    rows = [r for r in synth.study_rows() if r["status"] == "ok"]
+    thr = {"cantilever_a": [("min", 0.9)], "cantilever_b": [("min", 0.9)]}
+    fig = figures.score_panels(rows, "trac", "-", thr)
+    panels = [a for a in fig.axes if a.lines]
+    assert [a.get_title() for a in panels] == ["cantilever_a", "cantilever_b"]  # no five-bar panel
+    assert panels[0].get_yscale() == "linear" and panels[0].get_ylabel() == "trac [-]"
+    assert panels[0].get_shared_y_axes().joined(panels[0], panels[1])
+    lines = {ln.get_label(): ln for ln in panels[0].lines}
+    assert {"ls_sindy", "sgd_sindy", "threshold"} <= set(lines)
+    np.testing.assert_allclose(lines["sgd_sindy"].get_xdata(), [0, 1, 5])
+    np.testing.assert_allclose(lines["sgd_sindy"].get_ydata(), [0.988, 0.968, 0.888])  # median seed
+    np.testing.assert_allclose(lines["threshold"].get_ydata(), [0.9, 0.9])
+    band = panels[0].collections[1].get_paths()[0].vertices[:, 1]  # sgd_sindy's IQR band
+    assert band.min() == pytest.approx(0.887) and band.max() == pytest.approx(0.989)
+
+    rmse = figures.score_panels(rows, "angle_rmse", "rad", {"fivebar_x": [("max", 0.0501)]})
+    ax = next(a for a in rmse.axes if a.lines)
+    assert ax.get_yscale() == "log" and ax.get_ylabel() == "angle_rmse [rad]"
+    assert figures.score_panels(rows, "no_such_score") is None
+
+
 def test_sweep_figures():
     rows = synth.sweep_rows()
-    fig = figures.score_vs_noise([r for r in rows if r["status"] == "ok"], "trac")
+    fig = figures.score_panels([r for r in rows if r["status"] == "ok"], "trac")
     ax = fig.axes[0]
     lines = {ln.get_label(): ln for ln in ax.lines}
     assert set(lines) == {"sindy_ls", "sgd_sindy"}
@@ -131,3 +210,20 @@ def test_sweep_figures():
     ft = figures.fit_times(rows)
     assert ft.axes[0].get_xlabel() == "fit time [s]"
     assert [t.get_text() for t in ft.axes[0].get_yticklabels()] == ["sgd_sindy", "sindy_ls"]
+
+
+def test_recorded_inputs_come_from_the_dataset_cache(tmp_path):
+    from testbed.pipeline.cache import DatasetCache
+
+    result = synth.mechanical_result(n_samples=400)
+    run = load_run(save_run(result, tmp_path / "run"))
+    cache = DatasetCache(tmp_path / "cache")
+    assert figures.recorded_inputs(run, cache) is None  # not cached: no panel, no simulation
+    path = cache.path(result.scenario)
+    path.parent.mkdir(parents=True)
+    result.dataset.save(path)
+    data, names, unit = figures.recorded_inputs(run, cache)
+    assert names == ["tau1", "tau2"] and unit == "N m"
+    np.testing.assert_array_equal(data, result.dataset.measured["torques"].data)
+    fig = figures.run_figures(run, inputs=(data, names, unit))["joint_angles"]
+    assert [a.get_ylabel() for a in fig.axes if a.lines][-1] == "torque [N m]"

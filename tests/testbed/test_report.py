@@ -31,7 +31,11 @@ ROOT = Path(__file__).resolve().parents[2]
 ARTIFACTS = ROOT / "out" / "test-artifacts"
 PROBE = """<script>window.addEventListener("load", () => {
   const imgs = [...document.images].map(i => ({ok: i.complete && i.naturalWidth > 0, w: i.naturalWidth}));
-  document.body.setAttribute("data-probe", JSON.stringify(imgs));
+  const eqs = [...document.querySelectorAll("ol.eq")].map(e => ({scroll: e.scrollWidth, client: e.clientWidth,
+                                                                 height: e.clientHeight}));
+  const page = {height: document.documentElement.scrollHeight, width: document.documentElement.scrollWidth,
+                view: window.innerWidth};
+  document.body.setAttribute("data-probe", JSON.stringify({imgs, eqs, page}));
 });</script>"""
 
 
@@ -45,6 +49,7 @@ def reports(tmp_path_factory):
         run_dir = save_run(make(), d / "runs" / name, figures=save_run_figures)
         out[name] = write_report(run_dir, d / "reports" / name)
     out["sweep"] = sweep_report(synth.sweep_rows(), d / "reports" / "sweep", "noise_study")
+    out["study"] = sweep_report(synth.study_rows(), d / "reports" / "study", "results_file_name")
     return out
 
 
@@ -52,7 +57,10 @@ def images(html: str) -> list[str]:
     return re.findall(r'<img src="([^"]*)"', html)
 
 
-@pytest.mark.parametrize(("name", "n_figures"), [("cantilever", 5), ("fivebar", 2), ("sweep", 3)])
+FIGURES = [("cantilever", 6), ("fivebar", 2), ("sweep", 3), ("study", 4)]
+
+
+@pytest.mark.parametrize(("name", "n_figures"), FIGURES)
 def test_report_is_self_contained(reports, name, n_figures):
     html_path = reports[name]
     text = html_path.read_text()
@@ -71,19 +79,88 @@ def test_run_report_content(reports):
     assert '<span class="badge fail">FAIL</span>' in text
     assert re.search(r"<td>freq_error</td>.*?<td class=\"fail\">FAIL</td>", text)
     assert re.search(r"<td>trac</td>.*?<td class=\"pass\">pass</td>", text)
+    assert re.search(r"<h3>Why it failed</h3>\s*<ul><li>freq_error = [0-9.e-]+, needs &lt;= 0.01</li>", text)
     assert "Euler-Bernoulli [Hz]" in text and "total_mass = 0.6" in text
     assert "eq 0: xdd0 = ..." in text and "abababab" in text  # equations, dataset hash
     md = (reports["cantilever"].parent / "report.md").read_text()
     assert "| freq_error |" in md and "FAIL" in md
     fb = reports["fivebar"].read_text()
     assert '<span class="badge pass">PASS</span>' in fb and "angle_rmse" in fb
+    assert re.search(r"<td>angle_rmse</td><td>[^<]*</td><td class=\"num\">0.0141</td><td>rad</td>", fb)
+
+
+def _table(text: str, heading: str) -> str:
+    """The first table after ``<h3>heading</h3>``."""
+    m = re.search(rf"<h3>{re.escape(heading)}</h3>\s*<table>(.*?)</table>", text)
+    assert m, f"no table under {heading!r}"
+    return m.group(1)
+
+
+def test_run_report_settings_tables(reports):
+    text = reports["cantilever"].read_text()
+    rig = _table(text, "Rig")
+    assert "<td>base</td><td>stiff</td>" in rig
+    assert "base_k1" not in rig and "base_k3" not in rig  # soft-base keys under a clamped base
+    assert "Not shown, irrelevant to the options chosen here: base_k1, base_k3." in text
+    # the default empty list shown as the actual positions of the dataset
+    assert re.search(r"<td>sensors</td><td>0.1, 0.3, 0.5</td><td>m</td><td>actual positions", rig)
+    assert "<td>peak_force</td><td class=\"num\">50</td><td>N</td>" in _table(text, "Excitation")
+    assert "<td>rms_percent</td><td class=\"num\">1</td><td>% of channel RMS</td>" in _table(text, "Noise")
+    assert "<td>highpass_hz</td><td class=\"num\">10</td><td>Hz</td>" in _table(text, "Signal chain")
+    ident = _table(text, "Identifier sgd_sindy")
+    assert "<td>learning_rate</td><td class=\"num\">0.001</td><td>scenario</td>" in ident
+    assert "<td>epochs</td><td class=\"num\">40</td><td>scenario</td>" in ident
+    # equations: one list item each, wrapping anywhere with a hanging indent
+    assert '<ol class="eq"><li>eq 0: xdd0 = ...</li>' in text
+    assert "white-space:pre-wrap;overflow-wrap:anywhere" in text
+
+
+def test_irrelevant_keys_follow_the_options():
+    from testbed.pipeline.plugins import RIGS
+    from testbed.pipeline.signal_chain import SIGNAL_SCHEMAS
+    from testbed.reporting.report import irrelevant_keys
+
+    cant = RIGS.get("cantilever").rig_schema
+    values = {k: f.default for k, f in cant.items()}
+    assert irrelevant_keys(values | {"base": "stiff"}, cant) == {"base_k1", "base_k3"}
+    assert irrelevant_keys(values | {"base": "soft"}, cant) == set()
+    five = RIGS.get("fivebar").rig_schema
+    values = {k: f.default for k, f in five.items()}
+    assert irrelevant_keys(values, five, ("sine_replay",)) == {"dth1_0", "dth4_0"}
+    assert irrelevant_keys(values, five, ("multisine",)) == set()
+    sig = SIGNAL_SCHEMAS["mechanical"]
+    values = {k: f.default for k, f in sig.items()}
+    assert {"window", "polyorder", "cutoff_hz"} <= irrelevant_keys(values | {"derivatives": "recorded"}, sig)
+    low = irrelevant_keys(values | {"derivatives": "lowpass"}, sig)
+    assert "cutoff_hz" not in low and {"window", "polyorder"} <= low
 
 
 def test_sweep_report_content(reports):
     text = reports["sweep"].read_text()
     assert "2/2 (100 %)" in text and "0/2 (0 %)" in text  # sindy_ls fails to run at 5 % noise
     assert "LinAlgError: singular matrix" in text
-    assert "12 cells: 2 identifier(s)" in text
+    assert "12 cells: 1 scenario(s), 2 identifier(s)" in text
+    assert "<title>Study noise_study</title>" in text  # the study's name, not the file's
+
+
+def test_study_report_content(reports):
+    text = reports["study"].read_text()
+    assert "<title>Study method_comparison</title>" in text and "results_file_name" not in text
+    for sc in ("cantilever_a", "cantilever_b", "fivebar_x"):
+        assert re.search(rf"<h3>Scenario {sc}</h3>\s*<table>", text)
+    five = _table(text, "Scenario fivebar_x")
+    assert "<th>angle_rmse [rad] (≤ 0.0501)</th>" in five
+    assert "<td>1.5e-06 [1.25e-06, 1.75e-06]</td>" in five  # median [IQR] over 3 seeds at noise 0
+    cant = _table(text, "Scenario cantilever_b")
+    assert "<th>trac [-] (≥ 0.9)</th>" in cant
+    # ls_sindy at 5 %: one cell failed to run, two ran and missed the TRAC threshold
+    assert "1× failed: LinAlgError: singular matrix" in cant and "2× trac &lt; 0.9" in cant
+    assert "(identify/ls.py:42)" not in cant  # the reason without its source location
+    assert '<div class="grid">' in text and text.count('<figure class="wide">') == 2  # trac, freq_error
+    assert "Exactly 0 in every cell that ran (not drawn): K3_norm." in text
+    # thresholded scores first, structural before mechanical, then the rest
+    order = re.findall(r'<img src="[^"]*" alt="([a-zA-Z0-9_]+):', text)
+    assert order == ["trac", "angle_rmse", "freq_error"]
 
 
 # ------------------------------------------------------------------ real headless Chromium
@@ -121,7 +198,7 @@ def run_chromium(exe: str, url: str, tmp: Path, *extra: str) -> subprocess.Compl
 
 
 @pytest.mark.xdist_group("chromium")
-@pytest.mark.parametrize(("name", "n_figures"), [("cantilever", 5), ("fivebar", 2), ("sweep", 3)])
+@pytest.mark.parametrize(("name", "n_figures"), FIGURES)
 def test_report_in_headless_chromium(chromium, reports, name, n_figures, tmp_path):
     html_path = reports[name]
     ARTIFACTS.mkdir(parents=True, exist_ok=True)
@@ -143,9 +220,17 @@ def test_report_in_headless_chromium(chromium, reports, name, n_figures, tmp_pat
     assert r.returncode == 0, r.stderr[-2000:]
     m = re.search(r'data-probe="([^"]*)"', r.stdout)
     assert m, "the probe did not run: " + r.stdout[:500]
-    imgs = json.loads(m.group(1).replace("&quot;", '"'))
+    probe = json.loads(m.group(1).replace("&quot;", '"'))
+    imgs, page = probe["imgs"], probe["page"]
     assert len(imgs) == n_figures
     assert all(i["ok"] and i["w"] > 300 for i in imgs), imgs
+    assert page["width"] <= page["view"], f"the page scrolls sideways: {page}"
+    for eq in probe["eqs"]:  # equations wrap inside their block
+        assert eq["scroll"] <= eq["client"], eq
+    if name == "fivebar":
+        assert probe["eqs"] and probe["eqs"][0]["height"] > 60, "the long equations did not wrap"
+    if name == "study":  # 4 figures, 3 summary tables: a page, not a scroll of 10,000 px
+        assert page["height"] < 5000, page
     console = [ln for ln in r.stderr.splitlines() if ":CONSOLE" in ln]
     assert not console, "console messages:\n" + "\n".join(console)
 
