@@ -4,8 +4,8 @@ Every module of this package is imported on first lookup of :data:`IDENTIFIERS`.
 ``identify`` never imports ``models``.
 """
 
-from testbed.core.registry import Registry
+from testbed.core.registry import IDENTIFIER_ENTRY_POINTS, Registry
 
-IDENTIFIERS = Registry("identifier", package="identify")
+IDENTIFIERS = Registry("identifier", package="identify", entry_points=IDENTIFIER_ENTRY_POINTS)
 
 __all__ = ["IDENTIFIERS"]
