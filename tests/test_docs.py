@@ -77,3 +77,18 @@ def test_scenario_guide_lists_every_key():
             assert rows, key
             if f.unit:
                 assert any(f"| {f.unit} |" in r for r in rows), (key, f.unit)
+
+
+def test_citation_file_is_valid_and_current():
+    yaml = pytest.importorskip("yaml")
+
+    import testbed
+
+    cff = yaml.safe_load((ROOT / "CITATION.cff").read_text())
+    assert cff["cff-version"] == "1.2.0" and cff["type"] == "software"
+    assert str(cff["version"]) == testbed.__version__
+    titles = [r["title"] for r in cff["references"]]
+    assert any("Stochastic Gradient SINDy" in t for t in titles)
+    assert any("Parallel implicit sparse identification" in t for t in titles)
+    for ref in cff["references"]:
+        assert ref["authors"] and all(a.get("family-names") for a in ref["authors"])
