@@ -187,3 +187,29 @@ def test_runs_ls(tmp_path, capsys):
     out = capsys.readouterr().out.splitlines()
     assert out[-1] == f"1 run(s) in {tmp_path}"
     assert out[0].split()[1] == result.verdict and out[0].endswith(str(tmp_path / result.scenario.name))
+
+
+def test_sweep_with_a_plugin_identifier(tmp_path, dataset_cache):
+    """`sweep --plugin`: the study may name the plugin's identifier, and its cells run with it
+    (in loky workers too: the plugin travels with the study)."""
+    plugin = tmp_path / "my_method.py"
+    plugin.write_text(PLUGIN.format(name="my_sweep_method"))
+    study = tmp_path / "plug.toml"
+    study.write_text(textwrap.dedent(f'''
+        [study]
+        name = "plug"
+        scenarios = ["{ROOT / 'scenarios' / 'cantilever_stiff_impact_lsq.toml'}"]
+        noise = [0.0]
+        seeds = [0]
+        identifiers = ["my_sweep_method", "ls_sindy"]
+    '''))
+    results = tmp_path / "plug.parquet"
+    r = cli("sweep", str(study), "--results", str(results), cwd=tmp_path)
+    assert r.returncode == EXIT_USAGE and "my_sweep_method" in r.stderr, r.stderr
+    r = cli("sweep", str(study), "--plugin", str(plugin), "--jobs", "2", "--results", str(results),
+            "--cache", str(dataset_cache.directory), cwd=tmp_path)
+    assert r.returncode in (0, 1), r.stdout[-2000:] + r.stderr[-2000:]  # 1: a cell failed its bars
+    from testbed.studies.results import read_results
+
+    rows = read_results(results)
+    assert sorted(row["identifier"] for row in rows) == ["ls_sindy", "my_sweep_method"]
