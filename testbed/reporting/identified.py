@@ -23,7 +23,9 @@ def render_identified(summary: dict[str, Any]) -> str:
              f"{summary['fs_hz']:g} Hz)",
              f"- identifier: `{ident['class']}`({params})",
              f"- fit time: {summary['fit_time_s']:.3g} s",
-             f"- R^2 of the predicted accelerations (truth-free): {_num(summary.get('r2'))}", ""]
+             "- R^2 of the predicted accelerations (truth-free): "
+             + (_num(summary["r2"]) if summary.get("r2") is not None
+                else "not defined (implicit equations: no explicit acceleration)"), ""]
     modal = summary.get("modal")
     if modal:
         lines += ["## Modes", "", "| mode | frequency [Hz] | damping ratio |", "|---|---|---|"]

@@ -148,6 +148,17 @@ def test_identify_with_a_scenario_writes_model_and_report(tmp_path, dataset_cach
     assert sum(model["matrices"]["M"][i][i] for i in range(3)) == pytest.approx(2.5)
 
 
+def test_identify_mechanical(tmp_path, dataset_cache, capsys):
+    data = dataset_cache.get(load_scenario("fivebar_multisine")).save(tmp_path / "fb.h5")
+    out = tmp_path / "fb.json"
+    assert main(["identify", str(data), "--kind", "mechanical", "--method", "sindy_pi", "-o", str(out)]) == 0
+    model = json.loads(out.read_text())
+    assert model["kind"] == "mechanical" and model["r2"] is None and "matrices" not in model
+    coef = model["coefficients"]
+    assert len(coef["coef"][0]) == len(coef["feature_names"]) and len(model["equations"]) == 2
+    assert "not defined (implicit equations" in capsys.readouterr().out
+
+
 @pytest.mark.parametrize(("argv", "fragment"), [
     (["identify", "{data}"], "--kind structural|mechanical"),
     (["identify", "{data}", "--kind", "structural"], "--method NAME"),
