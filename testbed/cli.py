@@ -371,7 +371,9 @@ def build_parser() -> argparse.ArgumentParser:
 
     plugin_help = ("import this plugin first: a .py file or a dotted module that registers "
                    "identifiers or rigs (repeatable)")
-    p = _Parser(prog="testbed", description=__doc__.splitlines()[0])
+    p = _Parser(prog="testbed", description="Validate system-identification methods on physics "
+                                            "simulations with exact ground truth; "
+                                            "`testbed COMMAND --help` for each command.")
     p.add_argument("--version", action="version", version=f"testbed (sysid-testbed) {__version__}",
                    help="print the version and exit")
     p.add_argument("--debug", action="store_true",
