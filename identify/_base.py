@@ -12,21 +12,34 @@
   scenario guide lists it, and a conformance test keeps it equal to ``__init__``.
   Cross-key checks go in :meth:`Identifier.check_hyperparameters`, checks against the
   shape of the data (channels, inputs, sample rate) in :meth:`Identifier.check_data_shape`.
+
+Identifiers are scikit-learn estimators (:class:`sklearn.base.BaseEstimator`):
+``sklearn.base.clone``, ``get_params(deep=...)``/``set_params`` and
+``sklearn.utils.validation.check_is_fitted`` work on every one (``tests/test_public_api.py``).
+``fit`` takes a Measurement, not ``(X, y)`` arrays, so scikit-learn's own model-selection
+loops (``GridSearchCV``) do not apply directly; a grid over ``set_params`` does.
+
+Two conveniences follow pysindy: :meth:`Identifier.print` prints the equations, and
+:meth:`Identifier.score` gives a *truth-free* goodness of fit (R^2 of the predicted
+accelerations on a measurement, as a regressor's ``score`` does); the score against a
+simulation's exact truth is ``testbed.score(model, dataset, scenario)`` (the scoring layer).
 """
 
 from __future__ import annotations
 
 import inspect
-from typing import Any, ClassVar
+import sys
+from typing import Any, ClassVar, TextIO
 
 import numpy as np
+from sklearn.base import BaseEstimator
 
 from testbed.core.errors import HyperparameterError, ScenarioError
 from testbed.core.measurement import Measurement, Trajectory
 from testbed.core.schema import ErrorFn, Field, validate_table
 
 
-class Identifier:
+class Identifier(BaseEstimator):
     """Base class; subclasses implement :meth:`fit`, :meth:`simulate`, :meth:`equations`."""
 
     name: ClassVar[str] = ""
@@ -125,17 +138,33 @@ class Identifier:
         sig = inspect.signature(cls.__init__)
         return [p for p in sig.parameters if p != "self"]
 
-    def get_params(self) -> dict[str, Any]:
-        return {k: getattr(self, k) for k in self._param_names()}
+    def get_params(self, deep: bool = True) -> dict[str, Any]:
+        """Hyperparameters by name (scikit-learn's contract; ``deep`` also lists the parameters
+        of hyperparameters that are estimators themselves, as ``<name>__<parameter>``)."""
+        out = {k: getattr(self, k) for k in self._param_names()}
+        if deep:
+            for k, v in list(out.items()):
+                if hasattr(v, "get_params") and not isinstance(v, type):
+                    out.update({f"{k}__{kk}": vv for kk, vv in v.get_params().items()})
+        return out
 
     def set_params(self, **params: Any) -> Identifier:
+        """Set hyperparameters by name (``<name>__<parameter>`` for a nested estimator's); returns
+        ``self``.  ValueError naming the allowed names for an unknown one."""
         allowed = self._param_names()
         for k, v in params.items():
-            if k not in allowed:
-                raise ValueError(f"{type(self).__name__} has no hyperparameter {k!r}; "
+            head, _, rest = k.partition("__")
+            if head not in allowed:
+                raise ValueError(f"{type(self).__name__} has no hyperparameter {head!r}; "
                                  f"allowed: {', '.join(allowed)}")
-            setattr(self, k, v)
+            if rest:
+                getattr(self, head).set_params(**{rest: v})
+            else:
+                setattr(self, k, v)
         return self
+
+    def __sklearn_is_fitted__(self) -> bool:
+        return self.is_fitted()
 
     def clone(self) -> Identifier:
         """A new unfitted estimator with the same hyperparameters."""
@@ -150,6 +179,71 @@ class Identifier:
 
     def equations(self, precision: int = 4) -> list[str]:
         raise NotImplementedError
+
+    def print(self, precision: int = 4, file: TextIO | None = None) -> None:
+        """Print the identified equations, one per line (pysindy's ``model.print()``).
+
+        Parameters
+        ----------
+        precision : int
+            Significant digits of each coefficient.
+        file : text stream, optional
+            Where to print (default ``sys.stdout``).
+        """
+        for line in self.equations(precision):
+            print(line, file=file or sys.stdout)
+
+    def predict_acceleration(self, data: Measurement) -> np.ndarray:
+        """Accelerations the identified structural model gives for the measured state and input.
+
+        ``M_^-1 (B u - C_ x' - K_ x - K3_ x^3)`` on every sample of ``data`` (same channels as
+        the fit).
+
+        Returns
+        -------
+        ndarray, shape (n_channels, n_samples)
+            [m/s^2].
+
+        Raises
+        ------
+        NotImplementedError
+            For an identifier that is not structural (a mechanical model's equations are
+            implicit: there is no explicit acceleration to predict).
+        """
+        if getattr(self, "kind", "") != "structural" or not hasattr(self, "M_"):
+            raise NotImplementedError(f"{type(self).__name__}: predict_acceleration needs a fitted "
+                                      "structural model (M_, C_, K_)")
+        x, xd = np.asarray(data.x, dtype=float), np.asarray(data.xd, dtype=float)
+        force = -self.C_ @ xd - self.K_ @ x
+        if getattr(self, "K3_", None) is not None:
+            force -= self.K3_ @ x**3
+        bmap = getattr(self, "input_map_", None)
+        if bmap is not None and data.u is not None:
+            force += np.asarray(bmap, dtype=float) @ np.asarray(data.u, dtype=float)
+        return np.linalg.solve(self.M_, force)
+
+    def score(self, data: Measurement) -> float:
+        """Truth-free goodness of fit: R^2 of the predicted accelerations on ``data``.
+
+        The coefficient of determination ``1 - SS_res / SS_tot`` of :meth:`predict_acceleration`
+        against the measured ``xdd`` over the window ``data.free_start:``, averaged over channels
+        (scikit-learn's ``r2_score`` with uniform weights): 1 is a perfect fit, 0 is no better
+        than each channel's mean.  It needs only measurements, so it also scores a model of real
+        data; it is not the testbed's score against the exact truth (that is
+        ``testbed.score(model, dataset, scenario)``).
+
+        Raises
+        ------
+        NotImplementedError
+            For a mechanical (implicit) model; see :meth:`predict_acceleration`.
+        """
+        s = slice(data.free_start, None)
+        pred = self.predict_acceleration(data)[:, s]
+        meas = np.asarray(data.xdd, dtype=float)[:, s]
+        ss_res = np.sum((meas - pred) ** 2, axis=1)
+        ss_tot = np.sum((meas - meas.mean(axis=1, keepdims=True)) ** 2, axis=1)
+        ss_tot[ss_tot == 0.0] = np.finfo(float).tiny
+        return float(np.mean(1.0 - ss_res / ss_tot))
 
     def is_fitted(self) -> bool:
         return any(k.endswith("_") and not k.startswith("_") for k in vars(self))

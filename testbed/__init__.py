@@ -2,6 +2,75 @@
 
 Flow (see README): scenario file -> rig simulates (models/) -> dataset (HDF5) ->
 signal chain -> identifier (identify/) -> scores against the truth -> report.
+
+The public Python API is the names below (``testbed.__all__``), imported on first use so that
+``import testbed`` stays cheap; ``docs/python-api.md`` shows them at work::
+
+    import testbed
+    result = testbed.run_scenario("cantilever_stiff_impact_lsq")
+    result.model.print()
+    print(result.scores.values["trac"])
 """
 
+from __future__ import annotations
+
+import importlib
+from typing import Any
+
 __version__ = "0.1.0"
+
+#: public name -> (module, attribute)
+_API = {
+    # scenarios, data, runs
+    "load_scenario": ("testbed.pipeline.scenario", "load_scenario"),
+    "list_scenarios": ("testbed.pipeline.scenario", "list_scenarios"),
+    "scenario_from_dict": ("testbed.pipeline.scenario", "scenario_from_dict"),
+    "Scenario": ("testbed.pipeline.scenario", "Scenario"),
+    "generate": ("testbed.pipeline.generate", "generate"),
+    "DatasetCache": ("testbed.pipeline.cache", "DatasetCache"),
+    "measure": ("testbed.pipeline.signal_chain", "measure"),
+    "run_scenario": ("testbed.scoring.evaluate", "run_scenario"),
+    "score": ("testbed.scoring.evaluate", "score_model"),
+    "RunResult": ("testbed.scoring.run", "RunResult"),
+    # measured data from files (no truth)
+    "read_measured": ("testbed.pipeline.importers", "read_measured"),
+    "measurement_from_file": ("testbed.pipeline.importers", "measurement_from_file"),
+    "identify_file": ("testbed.pipeline.fit", "identify_file"),
+    "model_summary": ("testbed.pipeline.fit", "model_summary"),
+    # studies
+    "load_study": ("testbed.studies.study", "load_study"),
+    "run_sweep": ("testbed.studies.sweep", "run_sweep"),
+    "read_results": ("testbed.studies.results", "read_results"),
+    # writing identifiers and rigs
+    "IDENTIFIERS": ("testbed.pipeline.plugins", "IDENTIFIERS"),
+    "RIGS": ("testbed.pipeline.plugins", "RIGS"),
+    "load_plugins": ("testbed.pipeline.plugins", "load_plugins"),
+    "Identifier": ("identify", "Identifier"),
+    "StructuralIdentifier": ("identify", "StructuralIdentifier"),
+    "Rig": ("models", "Rig"),
+    "Field": ("testbed.core.schema", "Field"),
+    "Measurement": ("testbed.core.measurement", "Measurement"),
+    "Trajectory": ("testbed.core.measurement", "Trajectory"),
+    "Dataset": ("testbed.core.dataset", "Dataset"),
+    "Signal": ("testbed.core.dataset", "Signal"),
+    "StructuralTruth": ("testbed.core.truth", "StructuralTruth"),
+    "MechanicalTruth": ("testbed.core.truth", "MechanicalTruth"),
+    "TestbedError": ("testbed.core.errors", "TestbedError"),
+    "IdentificationError": ("testbed.core.errors", "IdentificationError"),
+}
+
+__all__ = ["__version__", *sorted(_API)]
+
+
+def __getattr__(name: str) -> Any:
+    try:
+        module, attr = _API[name]
+    except KeyError:
+        raise AttributeError(f"module 'testbed' has no attribute {name!r}") from None
+    value = getattr(importlib.import_module(module), attr)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_API))

@@ -10,6 +10,7 @@ a traceback.  A bug prints one line saying it is an internal error and exits wit
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import socket
 import sys
 from pathlib import Path
@@ -141,28 +142,47 @@ def _progress():
     return progress_bar
 
 
-def cmd_list(args: argparse.Namespace) -> int:
-    from rich.console import Console
-    from rich.table import Table
+def _load_plugins(args: argparse.Namespace) -> tuple[str, ...]:
+    """Import the ``--plugin`` files/modules; return them (file paths made absolute)."""
+    from testbed.pipeline.plugins import load_plugins
 
+    given = tuple(getattr(args, "plugin", None) or ())
+    load_plugins(given)
+    return tuple(str(Path(p).resolve()) if p.endswith(".py") else p for p in given)
+
+
+def cmd_list(args: argparse.Namespace) -> int:
     from testbed.pipeline.plugins import IDENTIFIERS, RIGS
     from testbed.pipeline.scenario import list_scenarios
 
-    con = Console()
+    _load_plugins(args)
+    sections = []
     for title, registry in (("rigs", RIGS), ("identifiers", IDENTIFIERS)):
+        rows = [(n, registry.get(n).kind, ", ".join(sorted(registry.tags(n))), registry.origin(n))
+                for n in registry.names()]
+        sections.append((title, ("name", "kind", "tags", "from"), rows))
+    rows = [(s.name, s.rig, (s.identify or {}).get("method", "-"), f"{s.noise['rms_percent']:g}",
+             s.description) for s in list_scenarios()]
+    sections.append(("scenarios", ("name", "rig", "identifier", "noise %", "description"), rows))
+    if args.plain or not sys.stdout.isatty():
+        # piped into another program: every field whole, tab-separated, one header per section
+        for title, cols, rows in sections:
+            print(f"# {title}")
+            print("\t".join(cols))
+            for r in rows:
+                print("\t".join(r))
+        return 0
+    from rich.console import Console
+    from rich.table import Table
+
+    con = Console()
+    for title, cols, rows in sections:
         t = Table(title=title)
-        for c in ("name", "kind", "tags"):
-            t.add_column(c)
-        for n in registry.names():
-            t.add_row(n, registry.get(n).kind, ", ".join(sorted(registry.tags(n))))
+        for c in cols:
+            t.add_column(c, overflow="fold")
+        for r in rows:
+            t.add_row(*r)
         con.print(t)
-    t = Table(title="scenarios")
-    for c in ("name", "rig", "identifier", "noise %", "description"):
-        t.add_column(c)
-    for s in list_scenarios():
-        t.add_row(s.name, s.rig, (s.identify or {}).get("method", "-"), f"{s.noise['rms_percent']:g}",
-                  s.description)
-    con.print(t)
     return 0
 
 
@@ -194,6 +214,7 @@ def cmd_run(args: argparse.Namespace) -> int:
     from testbed.scoring.run import run_scenario
     from testbed.studies.runstore import run_folder, save_run
 
+    _load_plugins(args)
     cache = None if args.no_cache else DatasetCache(_cache_folder(args.cache))
     ok = True
     for name in args.scenario:
@@ -238,7 +259,10 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     from testbed.studies.study import load_study
     from testbed.studies.sweep import SweepStats, run_sweep
 
+    extra = _load_plugins(args)
     study = load_study(args.study)
+    if extra:  # the workers import them too
+        study = dataclasses.replace(study, plugins=tuple(dict.fromkeys(study.plugins + extra)))
     stats = SweepStats()
     if args.dask:
         check_dask_address(args.dask)
@@ -278,6 +302,64 @@ def cmd_cache(args: argparse.Namespace) -> int:
     return 0
 
 
+def _key_values(items: list[str] | None, option: str, *, numbers: bool) -> dict:
+    """``KEY=VALUE`` options as a dict; a value is read as TOML (``3``, ``1e-3``, ``true``,
+    ``"text"``), a bare word as a string; with ``numbers`` every value must be a number."""
+    import tomllib
+
+    out: dict = {}
+    for item in items or []:
+        key, sep, text = item.partition("=")
+        if not sep or not key.strip():
+            raise InputError(f"{option} {item!r}: expected KEY=VALUE")
+        try:
+            value = tomllib.loads(f"v = {text}")["v"]
+        except tomllib.TOMLDecodeError:
+            value = text
+        if numbers and (isinstance(value, bool) or not isinstance(value, (int, float))):
+            raise InputError(f"{option} {item!r}: the value must be a number")
+        out[key.strip()] = float(value) if numbers else value
+    return out
+
+
+def cmd_identify(args: argparse.Namespace) -> int:
+    import json
+
+    from testbed.pipeline.fit import identify_file
+    from testbed.reporting.identified import render_identified
+
+    _load_plugins(args)
+    units = None
+    if args.units:
+        units = _key_values(args.units, "--units", numbers=False) if "=" in args.units[0] \
+            else args.units[0]
+    result = identify_file(_existing_file(Path(args.data), "a measured-data file (UFF58, SEP-005 "
+                                                          "JSON, CSV or HDF5)"),
+                           scenario=args.scenario, kind=args.kind, method=args.method,
+                           params=_key_values(args.param, "--param", numbers=False),
+                           format=args.format, fs=args.fs, units=units,
+                           prior=_key_values(args.prior, "--prior", numbers=True))
+    summary = result.summary()
+    out = Path(args.output or f"{Path(args.data).stem}.model.json")
+    out.parent.mkdir(parents=True, exist_ok=True)
+    out.write_text(json.dumps(summary, indent=1, allow_nan=True) + "\n")
+    report = render_identified(summary)
+    out.with_suffix(".md").write_text(report)
+    print(report, end="")
+    print(f"model written to {out} (report {out.with_suffix('.md')})")
+    return 0
+
+
+def cmd_runs(args: argparse.Namespace) -> int:
+    from testbed.studies.runstore import list_runs
+
+    runs = list_runs(args.out)
+    for r in runs:
+        print(f"{r['created']:<25} {r['verdict']:<10} {r['identifier']:<18} {r['path']}")
+    print(f"{len(runs)} run(s) in {args.out}")
+    return 0
+
+
 def cmd_demo(args: argparse.Namespace) -> int:
     from testbed.reporting.demo import run_demo
 
@@ -285,11 +367,24 @@ def cmd_demo(args: argparse.Namespace) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    p = _Parser(prog="testbed", description=__doc__.splitlines()[0])
+    from testbed import __version__
+
+    plugin_help = ("import this plugin first: a .py file or a dotted module that registers "
+                   "identifiers or rigs (repeatable)")
+    p = _Parser(prog="testbed", description="Validate system-identification methods on physics "
+                                            "simulations with exact ground truth; "
+                                            "`testbed COMMAND --help` for each command.")
+    p.add_argument("--version", action="version", version=f"testbed (sysid-testbed) {__version__}",
+                   help="print the version and exit")
     p.add_argument("--debug", action="store_true",
                    help="show the traceback of an internal error instead of one line")
-    sub = p.add_subparsers(dest="command", required=True)
-    sub.add_parser("list", help="registered rigs, identifiers and scenarios").set_defaults(fn=cmd_list)
+    sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    ls = sub.add_parser("list", help="registered rigs, identifiers (with where each came from) and "
+                                     "scenarios")
+    ls.add_argument("--plugin", action="append", metavar="FILE.py", help=plugin_help)
+    ls.add_argument("--plain", action="store_true",
+                    help="tab-separated lines, nothing cut (the default when not a terminal)")
+    ls.set_defaults(fn=cmd_list)
 
     g = sub.add_parser("generate", help="simulate a scenario and write its dataset (HDF5)")
     g.add_argument("scenario", help="scenario name or .toml path")
@@ -306,7 +401,31 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--cache", help="dataset cache folder (default .cache/datasets or $TESTBED_CACHE)")
     r.add_argument("--no-cache", action="store_true", help="generate afresh, store nothing")
     r.add_argument("--no-figures", action="store_true", help="skip the figures")
+    r.add_argument("--plugin", action="append", metavar="FILE.py", help=plugin_help)
     r.set_defaults(fn=cmd_run)
+
+    i = sub.add_parser("identify", help="fit an identifier to measured data from a file (no truth "
+                                        "needed): model, modal parameters, JSON")
+    i.add_argument("data", help="measured data: .uff/.unv (UFF58), .json (SEP-005), .csv/.tsv/.txt, "
+                                ".h5 (a testbed dataset: measured signals only)")
+    i.add_argument("--scenario", help="scenario (name or .toml) whose rig kind, [signal] chain and "
+                                      "[identify] table to use")
+    i.add_argument("--kind", choices=("structural", "mechanical"),
+                   help="rig kind of the data (which signal chain); needed without --scenario")
+    i.add_argument("--method", help="registered identifier (see `testbed list`); default the "
+                                    "scenario's")
+    i.add_argument("--param", action="append", metavar="NAME=VALUE",
+                   help="identifier hyperparameter, value as in TOML (repeatable)")
+    i.add_argument("--fs", type=float, help="sample rate [Hz] (needed for a CSV without a time column)")
+    i.add_argument("--units", action="append", metavar="UNIT|CHANNEL=UNIT",
+                   help="unit of every channel, or of one channel (repeatable), e.g. g, mm, N")
+    i.add_argument("--prior", action="append", metavar="KEY=VALUE",
+                   help="declared prior knowledge in SI units, e.g. total_mass=0.7 [kg] (repeatable)")
+    i.add_argument("--format", choices=("uff", "sep005", "csv", "hdf5"),
+                   help="file format (default from the suffix)")
+    i.add_argument("-o", "--output", help="JSON file of the fitted model (default <data>.model.json)")
+    i.add_argument("--plugin", action="append", metavar="FILE.py", help=plugin_help)
+    i.set_defaults(fn=cmd_identify)
 
     rep = sub.add_parser("report", help="HTML + markdown report of a run folder or sweep results")
     rep.add_argument("source", help="a run folder (from `testbed run`) or a sweep results file")
@@ -315,7 +434,8 @@ def build_parser() -> argparse.ArgumentParser:
 
     e = sub.add_parser("export", help="export a dataset to UFF (58/55) or SEP-005 JSON")
     e.add_argument("dataset", help="dataset .h5 file")
-    e.add_argument("--format", required=True, choices=("uff", "sep005"))
+    e.add_argument("--format", required=True, choices=("uff", "sep005"),
+                   help="uff: UFF58 time records + UFF55 true modes; sep005: SEP-005 channels as JSON")
     e.add_argument("-o", "--output", help="output file (default next to the dataset)")
     e.set_defaults(fn=cmd_export)
 
@@ -326,6 +446,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--results", help="results file (default out/studies/<study>.parquet)")
     s.add_argument("--cache", help="dataset cache folder")
     s.add_argument("--retry-failed", action="store_true", help="run the cells recorded as failed again")
+    s.add_argument("--plugin", action="append", metavar="FILE.py", help=plugin_help)
     s.set_defaults(fn=cmd_sweep)
 
     sm = sub.add_parser("summary", help="median, spread and pass rate per identifier and noise level")
@@ -333,12 +454,17 @@ def build_parser() -> argparse.ArgumentParser:
     sm.set_defaults(fn=cmd_summary)
 
     c = sub.add_parser("cache", help="list or clear the dataset cache")
-    c.add_argument("action", choices=("ls", "clear"))
-    c.add_argument("--cache", help="dataset cache folder")
+    c.add_argument("action", choices=("ls", "clear"), help="ls: list the datasets; clear: delete them")
+    c.add_argument("--cache", help="dataset cache folder (default .cache/datasets or $TESTBED_CACHE)")
+
+    rs = sub.add_parser("runs", help="list the runs saved by `testbed run`")
+    rs.add_argument("action", choices=("ls",), help="ls: one line per run folder")
+    rs.add_argument("-o", "--out", default="out/runs", help="folder of the runs (default out/runs)")
+    rs.set_defaults(fn=cmd_runs)
     c.set_defaults(fn=cmd_cache)
 
     d = sub.add_parser("demo", help="the main job: scored scenario runs and their report")
-    d.add_argument("--out", default="out/demo")
+    d.add_argument("--out", default="out/demo", help="output folder (default out/demo)")
     d.set_defaults(fn=cmd_demo)
     return p
 

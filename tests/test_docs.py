@@ -19,19 +19,38 @@ def python_blocks(path: Path) -> list[str]:
     return re.findall(r"^```python\n(.*?)^```", path.read_text(), flags=re.S | re.M)
 
 
-@pytest.mark.parametrize("guide", ["identifiers.md", "rigs.md"])
+@pytest.mark.parametrize("guide", ["identifiers.md", "rigs.md", "python-api.md"])
 def test_guide_example_runs(guide, tmp_path):
     blocks = python_blocks(DOCS / guide)
     assert blocks, f"{guide} has no python example"
     script = tmp_path / "example.py"
     script.write_text("\n\n".join(blocks))
     # a fresh interpreter: the example's registration must not leak into other tests' registries
+    # (the shared test cache: a dataset the examples need is simulated once per machine)
     env = {**os.environ, "OMP_NUM_THREADS": "1", "MPLBACKEND": "Agg",
+           "TESTBED_CACHE": str(ROOT / ".cache" / "test-datasets"),
            "PYTHONPATH": os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")])}
     r = subprocess.run([sys.executable, str(script)], cwd=tmp_path, capture_output=True, text=True,
                        timeout=120, env=env)
     assert r.returncode == 0, f"{guide} example failed:\n{r.stdout}\n{r.stderr[-3000:]}"
     assert r.stdout.strip()
+    if guide in ("identifiers.md", "rigs.md"):
+        # the example, saved as a file outside the repository, is a plugin of the command line
+        r = subprocess.run([sys.executable, "-m", "testbed.cli", "list", "--plugin", str(script)],
+                           cwd=tmp_path, capture_output=True, text=True, timeout=120, env=env)
+        assert r.returncode == 0, r.stderr[-3000:]
+        name = "example_least_squares" if guide == "identifiers.md" else "example_two_mass"
+        (row,) = [ln for ln in r.stdout.splitlines() if ln.startswith(name + "\t")]
+        assert row.endswith(f"\tfile {script}")
+
+
+@pytest.mark.parametrize("guide", ["identifiers.md", "rigs.md"])
+def test_guides_import_only_public_names(guide):
+    code = "\n".join(python_blocks(DOCS / guide))
+    imported = re.findall(r"^\s*(?:from|import) ([\w.]+)", code, flags=re.M)
+    private = [m for m in imported if m.split(".")[0] in ("testbed", "identify", "models")
+               and (m not in ("testbed", "identify", "models") or "._" in m)]
+    assert not private, f"{guide} imports {private}: use the public names of testbed.__all__"
 
 
 def test_scenario_guide_is_up_to_date():
@@ -58,3 +77,18 @@ def test_scenario_guide_lists_every_key():
             assert rows, key
             if f.unit:
                 assert any(f"| {f.unit} |" in r for r in rows), (key, f.unit)
+
+
+def test_citation_file_is_valid_and_current():
+    yaml = pytest.importorskip("yaml")
+
+    import testbed
+
+    cff = yaml.safe_load((ROOT / "CITATION.cff").read_text())
+    assert cff["cff-version"] == "1.2.0" and cff["type"] == "software"
+    assert str(cff["version"]) == testbed.__version__
+    titles = [r["title"] for r in cff["references"]]
+    assert any("Stochastic Gradient SINDy" in t for t in titles)
+    assert any("Parallel implicit sparse identification" in t for t in titles)
+    for ref in cff["references"]:
+        assert ref["authors"] and all(a.get("family-names") for a in ref["authors"])

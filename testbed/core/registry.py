@@ -3,15 +3,92 @@
 Rigs (``models``) and identifiers (``identify``) register themselves under a
 name; scenario files refer to those names.  Adding a rig or an identifier is
 adding a module with a registration, touching nothing else.
+
+Entries come from three places, and each remembers which (:meth:`Registry.origin`,
+shown by ``testbed list``):
+
+- ``builtin``: a module of the registry's own package (imported on first lookup);
+- an *entry point* of an installed distribution, in the group
+  :data:`IDENTIFIER_ENTRY_POINTS` or :data:`RIG_ENTRY_POINTS`, loaded on first lookup.
+  It names a module (whose import registers its classes) or a class (registered under its
+  ``name`` attribute)::
+
+      [project.entry-points."sysid_testbed.identifiers"]
+      my_method = "my_package.my_method:MyMethod"
+
+- a plugin *file* or module imported at run time (:func:`import_plugin`; ``--plugin FILE.py``
+  on the command line, ``plugins = [...]`` in a study).
 """
 
 from __future__ import annotations
 
 import importlib
+import importlib.metadata
+import importlib.util
 import pkgutil
+import sys
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
+
+from testbed.core.errors import TestbedError
+
+#: Entry-point group of identifiers from other distributions.
+IDENTIFIER_ENTRY_POINTS = "sysid_testbed.identifiers"
+#: Entry-point group of rigs from other distributions.
+RIG_ENTRY_POINTS = "sysid_testbed.rigs"
+#: Prefix of the module names under which plugin files are imported (see :func:`import_plugin`).
+PLUGIN_MODULE_PREFIX = "_testbed_plugin_"
+
+
+class PluginError(TestbedError):
+    """A plugin (file, module or entry point) that cannot be imported or registers nothing."""
+
+
+def plugin_module_name(path: str | Path) -> str:
+    """The module name a plugin file is imported under: derived from its absolute path, so the
+    same file is imported once per process however it is named."""
+    path = Path(path).resolve()
+    return PLUGIN_MODULE_PREFIX + "".join(c if c.isalnum() else "_" for c in str(path))
+
+
+def import_plugin(spec: str) -> Any:
+    """Import one plugin: a ``.py`` file path or a dotted module name; return the module.
+
+    Importing the same plugin again in the same process is a no-op (its registrations run
+    once).
+
+    Raises
+    ------
+    PluginError
+        If the file does not exist or the import fails (the message names the plugin and the
+        exception).
+    """
+    if not spec.endswith(".py"):
+        try:
+            return importlib.import_module(spec)
+        except Exception as e:
+            raise PluginError(f"plugin {spec}: cannot import it: {type(e).__name__}: {e}") from e
+    path = Path(spec).resolve()
+    if not path.is_file():
+        raise PluginError(f"plugin {spec}: no such file")
+    modname = plugin_module_name(path)
+    if modname in sys.modules:
+        return sys.modules[modname]
+    loader_spec = importlib.util.spec_from_file_location(modname, path)
+    if loader_spec is None or loader_spec.loader is None:
+        raise PluginError(f"plugin {spec}: cannot be imported as a Python module")
+    module = importlib.util.module_from_spec(loader_spec)
+    sys.modules[modname] = module
+    try:
+        loader_spec.loader.exec_module(module)
+    except BaseException as e:
+        del sys.modules[modname]
+        if isinstance(e, Exception):
+            raise PluginError(f"plugin {spec}: importing it failed: {type(e).__name__}: {e}") from e
+        raise
+    return module
 
 
 @dataclass
@@ -25,12 +102,18 @@ class Registry:
     package : str, optional
         Dotted name of a package whose submodules are imported on first
         lookup, so that their registrations run.
+    entry_points : str, optional
+        Entry-point group whose entries (modules or classes) are loaded on first lookup,
+        after the package.
     """
 
     kind: str
     package: str | None = None
+    entry_points: str | None = None
     _entries: dict[str, Any] = field(default_factory=dict)
     _tags: dict[str, frozenset[str]] = field(default_factory=dict)
+    _origins: dict[str, str] = field(default_factory=dict)
+    _loading_entry_point: str | None = None
     _loaded: bool = False
 
     def register(self, name: str, *, tags: Iterable[str] = ()) -> Callable[[Any], Any]:
@@ -41,18 +124,51 @@ class Registry:
                 raise ValueError(f"{self.kind} {name!r} is registered twice")
             self._entries[name] = obj
             self._tags[name] = frozenset(tags)
+            self._origins[name] = self._origin_of(obj)
             return obj
 
         return deco
 
+    def _origin_of(self, obj: Any) -> str:
+        if self._loading_entry_point is not None:
+            return self._loading_entry_point
+        mod = getattr(obj, "__module__", "") or ""
+        if self.package and (mod == self.package or mod.startswith(self.package + ".")):
+            return "builtin"
+        if mod.startswith(PLUGIN_MODULE_PREFIX):
+            return f"file {getattr(sys.modules.get(mod), '__file__', mod)}"
+        return f"module {mod}"
+
     def _load(self) -> None:
-        if self._loaded or self.package is None:
+        if self._loaded:
             return
         self._loaded = True
-        pkg = importlib.import_module(self.package)
-        for info in pkgutil.iter_modules(pkg.__path__):
-            if not info.name.startswith("_"):
-                importlib.import_module(f"{self.package}.{info.name}")
+        if self.package is not None:
+            pkg = importlib.import_module(self.package)
+            for info in pkgutil.iter_modules(pkg.__path__):
+                if not info.name.startswith("_"):
+                    importlib.import_module(f"{self.package}.{info.name}")
+        if self.entry_points is not None:
+            self._load_entry_points()
+
+    def _load_entry_points(self) -> None:
+        seen = set()
+        for ep in importlib.metadata.entry_points(group=self.entry_points):
+            if (ep.name, ep.value) in seen:  # the same distribution visible twice on sys.path
+                continue
+            seen.add((ep.name, ep.value))
+            dist = getattr(ep.dist, "name", None)
+            self._loading_entry_point = f"entry point {ep.name}" + (f" ({dist})" if dist else "")
+            try:
+                obj = ep.load()
+                if isinstance(obj, type) and obj not in self._entries.values():
+                    name = getattr(obj, "name", "") or ep.name
+                    self.register(name, tags=getattr(obj, "tags", ()))(obj)
+            except Exception as e:
+                raise PluginError(f"{self.kind} entry point {ep.name} = {ep.value} "
+                                  f"({self.entry_points}): {type(e).__name__}: {e}") from e
+            finally:
+                self._loading_entry_point = None
 
     def get(self, name: str) -> Any:
         """Return the entry called ``name``; KeyError naming what is allowed."""
@@ -69,8 +185,15 @@ class Registry:
         return sorted(n for n in self._entries if tag is None or tag in self._tags[n])
 
     def tags(self, name: str) -> frozenset[str]:
+        """Tags of the entry ``name``."""
         self.get(name)
         return self._tags[name]
+
+    def origin(self, name: str) -> str:
+        """Where ``name`` came from: ``"builtin"``, ``"entry point <name> (<distribution>)"``,
+        ``"file <path>"`` or ``"module <dotted name>"``."""
+        self.get(name)
+        return self._origins[name]
 
     def __contains__(self, name: str) -> bool:
         self._load()

@@ -9,15 +9,16 @@ project join them through :func:`load_plugins` (a study's ``plugins = [...]``).
 
 from __future__ import annotations
 
-import importlib
 from collections.abc import Iterable
 from typing import Any
 
 from identify import IDENTIFIERS
 from models import RIGS
 from testbed.core.errors import ScenarioError
+from testbed.core.registry import IDENTIFIER_ENTRY_POINTS, RIG_ENTRY_POINTS, PluginError, import_plugin
 
-__all__ = ["IDENTIFIERS", "RIGS", "identifier_class", "load_plugins", "make_identifier",
+__all__ = ["IDENTIFIERS", "IDENTIFIER_ENTRY_POINTS", "RIGS", "RIG_ENTRY_POINTS", "PluginError",
+           "identifier_class", "load_plugins", "make_identifier",
            "rig_class", "rig_kind"]
 
 
@@ -44,7 +45,26 @@ def make_identifier(identify: dict[str, Any] | None, scenario_name: str = "") ->
     return IDENTIFIERS.get(identify["method"])(**params)
 
 
-def load_plugins(modules: Iterable[str]) -> None:
-    """Import plugin modules (dotted names) so that their rigs and identifiers register."""
-    for m in modules:
-        importlib.import_module(m)
+def load_plugins(plugins: Iterable[str]) -> list[str]:
+    """Import plugins (``.py`` file paths or dotted module names) so that their rigs and
+    identifiers register; return the names each added (``"identifier foo"``, ``"rig bar"``).
+
+    Raises
+    ------
+    PluginError
+        If a plugin cannot be imported, or registers no rig and no identifier (most likely
+        the wrong file).
+    """
+    added = []
+    for p in plugins:
+        before = set(IDENTIFIERS.names()), set(RIGS.names())
+        module = import_plugin(p)
+        new = ([f"identifier {n}" for n in IDENTIFIERS.names() if n not in before[0]]
+               + [f"rig {n}" for n in RIGS.names() if n not in before[1]])
+        known = [n for reg in (IDENTIFIERS, RIGS) for n in reg.names()
+                 if getattr(reg.get(n), "__module__", None) == module.__name__]
+        if not new and not known:
+            raise PluginError(f"plugin {p}: registers no identifier and no rig (decorate a class "
+                              "with @IDENTIFIERS.register(name) or @RIGS.register(name))")
+        added += new
+    return added

@@ -65,8 +65,23 @@ MAX_DEPTH = 16
 #: Longest chain of ``extends``: the shipped scenarios use 2.
 MAX_EXTENDS = 32
 
-SCENARIO_DIR = Path(os.environ.get("TESTBED_SCENARIOS",
-                                   Path(__file__).resolve().parents[2] / "scenarios"))
+
+
+def shipped_dir(what: str) -> Path:
+    """Folder of the shipped ``"scenarios"`` or ``"studies"`` files.
+
+    In an installed wheel they are package data, ``testbed/data/<what>`` (``pyproject.toml``
+    maps the checkout's top-level folders there); in a checkout (editable install, or
+    ``PYTHONPATH``) they are the top-level folders ``<what>/`` themselves, the source of truth.
+    """
+    installed = Path(__file__).resolve().parents[1] / "data" / what
+    if installed.is_dir():
+        return installed
+    return Path(__file__).resolve().parents[2] / what
+
+
+#: Shipped scenario files, found by name (``$TESTBED_SCENARIOS`` overrides).
+SCENARIO_DIR = Path(os.environ.get("TESTBED_SCENARIOS", shipped_dir("scenarios")))
 
 HEADER_SCHEMA = {
     "name": Field(str, doc="scenario name; must equal the file name without .toml",

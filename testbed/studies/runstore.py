@@ -455,3 +455,35 @@ def load_run(run_dir: str | os.PathLike) -> SavedRun:
     model.update(meta.get("model_lists", {}))
     return SavedRun(run_dir, meta, _unflatten(arrays, "details"), model, _unflatten(arrays, "history"),
                     _unflatten(arrays, "truth"))
+
+
+def list_runs(out_dir: str | os.PathLike) -> list[dict[str, Any]]:
+    """The saved runs directly under ``out_dir`` (``testbed run``'s ``out/runs``), by folder name.
+
+    Only ``run.json`` is read (not the arrays); a folder without a readable ``run.json`` of
+    this format is left out.
+
+    Returns
+    -------
+    list of dict
+        ``path`` (Path), ``scenario``, ``identifier``, ``verdict``, ``fit_time`` [s], ``created``
+        (ISO 8601, UTC).
+    """
+    out = Path(out_dir)
+    if not out.is_dir():
+        return []
+    runs = []
+    for p in sorted(out.iterdir()):
+        if not _is_run_folder(p):
+            continue
+        try:
+            meta = json.loads((p / "run.json").read_text())
+        except (OSError, ValueError):
+            continue
+        if meta.get("format") != FORMAT:
+            continue
+        runs.append({"path": p, "scenario": meta.get("scenario", {}).get("name", p.name),
+                     "identifier": meta.get("identifier", {}).get("name", ""),
+                     "verdict": meta.get("verdict", ""), "fit_time": meta.get("fit_time", float("nan")),
+                     "created": meta.get("created", "")})
+    return runs

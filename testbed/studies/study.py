@@ -53,9 +53,11 @@ from testbed.pipeline.scenario import (
     load_scenario,
     read_toml_file,
     resolve_path,
+    shipped_dir,
 )
 
-STUDY_DIR = Path(__file__).resolve().parents[2] / "studies"
+#: Shipped study files, found by name (``$TESTBED_STUDIES`` overrides).
+STUDY_DIR = Path(os.environ.get("TESTBED_STUDIES", shipped_dir("studies")))
 
 STUDY_SCHEMA = {
     "name": Field(str, doc="study name; must equal the file name without .toml",

@@ -1,0 +1,189 @@
+"""Identify a model from measured data in a file: no simulation, no truth (``testbed identify``).
+
+The file (UFF58, SEP-005 JSON, CSV or a dataset HDF5, :mod:`testbed.pipeline.importers`) goes
+through the rig kind's signal chain and the chosen identifier, as a scenario's measurements do;
+the result is the fitted model, its equations and, for a structural model, its matrices and
+modal parameters, as a JSON-ready dict (:func:`model_summary`).  Nothing is scored against a
+truth: the only figure of merit is the identifier's truth-free ``score`` (R^2 of the predicted
+accelerations) where it has one.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import time
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from testbed.core.errors import InputError
+from testbed.core.measurement import Measurement
+from testbed.pipeline import plugins
+from testbed.pipeline.importers import measurement_from_file
+from testbed.pipeline.scenario import load_scenario
+from testbed.pipeline.signal_chain import SIGNAL_SCHEMAS
+
+
+@dataclass
+class FitResult:
+    """A model identified from a file.
+
+    Attributes
+    ----------
+    model : Identifier
+        The fitted identifier.
+    data : Measurement
+        What it was fitted on (after the signal chain).
+    kind : str
+        Rig kind whose signal chain ran (``"structural"`` or ``"mechanical"``).
+    method : str
+        Registered identifier name.
+    source : str
+        The data file.
+    fit_time : float
+        Wall time of ``fit`` [s].
+    """
+
+    model: Any
+    data: Measurement
+    kind: str
+    method: str
+    source: str
+    fit_time: float
+
+    def summary(self) -> dict[str, Any]:
+        """JSON-ready description: :func:`model_summary` plus the source and the data's shape."""
+        out = {"source": self.source, "kind": self.kind, "method": self.method,
+               "fit_time_s": self.fit_time, "fs_hz": self.data.fs, "n_samples": self.data.n_samples,
+               "channels": list(self.data.channels)}
+        out.update(model_summary(self.model, self.data))
+        return out
+
+
+def identify_file(path: str | os.PathLike, *, scenario: str | os.PathLike | None = None,
+                  kind: str | None = None, method: str | None = None,
+                  params: Mapping[str, Any] | None = None, format: str | None = None,
+                  fs: float | None = None, units: str | Mapping[str, str] | None = None,
+                  channels: Sequence[str] | None = None, prior: Mapping[str, float] | None = None
+                  ) -> FitResult:
+    """Read measured data, run the signal chain and fit an identifier.
+
+    Parameters
+    ----------
+    path : path-like
+        UFF58 (``.uff``/``.unv``), SEP-005 (``.json``), CSV (``.csv``/``.tsv``/``.txt``) or
+        dataset HDF5 (``.h5``) file (see :func:`testbed.pipeline.importers.read_measured`).
+    scenario : str or path-like, optional
+        A scenario (name or ``.toml`` path) whose rig kind, ``[signal]`` chain and
+        ``[identify]`` table are used; ``kind``/``method``/``params`` override its choices.
+    kind : {"structural", "mechanical"}, optional
+        Rig kind (which signal chain); required without ``scenario``, else must match it.
+    method : str, optional
+        Registered identifier; default the scenario's ``[identify] method``.
+    params : mapping, optional
+        Hyperparameters (over the scenario's when the method is the scenario's).
+    format, fs, units, channels
+        As for :func:`~testbed.pipeline.importers.read_measured` (``fs`` [Hz]).
+    prior : mapping of str to float, optional
+        Declared prior knowledge, e.g. ``{"total_mass": 0.7}`` [kg] (over the file's own).
+
+    Returns
+    -------
+    FitResult
+
+    Raises
+    ------
+    InputError
+        Nothing says which kind or method, a method of another kind, bad hyperparameters.
+    MeasuredDataError, ScenarioError, IdentificationError
+        The file, the scenario, or a fit that fails on these data.
+    """
+    signal: Mapping[str, Any] = {}
+    identify: dict[str, Any] = {}
+    if scenario is not None:
+        sc = load_scenario(scenario)
+        sc_kind = plugins.rig_kind(sc.rig)
+        if kind is not None and kind != sc_kind:
+            raise InputError(f"--kind {kind}: the scenario {sc.name} is of the {sc_kind} kind")
+        kind, signal, identify = sc_kind, sc.signal, dict(sc.identify or {})
+    if kind is None:
+        raise InputError("say which rig kind the data are from: --kind structural|mechanical, or "
+                         "--scenario NAME")
+    if kind not in SIGNAL_SCHEMAS:
+        raise InputError(f"--kind {kind!r}: unknown; allowed: {', '.join(SIGNAL_SCHEMAS)}")
+    if method is not None and method != identify.get("method"):
+        identify = {"method": method}
+    if "method" not in identify:
+        raise InputError("say which identifier to fit: --method NAME (see `testbed list`), or a "
+                         "--scenario with an [identify] table")
+    cls = plugins.identifier_class(identify["method"])
+    if cls.kind != kind:
+        raise InputError(f"identifier {identify['method']} is for {cls.kind} rigs; the data are "
+                         f"{kind}")
+    hyper = {k: v for k, v in identify.items() if k != "method"} | dict(params or {})
+    hyper = cls.validate_hyperparameters(hyper, file=str(scenario or "<command line>"))
+    data = measurement_from_file(path, kind, signal, format=format, fs=fs, units=units,
+                                 channels=channels, prior=prior)
+    model = cls(**hyper)
+    t0 = time.perf_counter()
+    model.fit(data)
+    return FitResult(model, data, kind, identify["method"], str(path), time.perf_counter() - t0)
+
+
+def _array(a: Any) -> Any:
+    return None if a is None else np.asarray(a, dtype=float).tolist()
+
+
+def modal_parameters(M: np.ndarray, C: np.ndarray, K: np.ndarray) -> dict[str, list[float]]:
+    """Damped modes of ``M x'' + C x' + K x = 0``, sorted by frequency (one per conjugate pair).
+
+    Returns
+    -------
+    dict
+        ``frequency_hz`` (undamped natural frequency ``|lambda| / 2 pi`` [Hz]) and
+        ``damping_ratio`` (``-Re(lambda) / |lambda|``) of each mode.
+    """
+    n = M.shape[0]
+    Minv = np.linalg.inv(M)
+    A = np.block([[np.zeros((n, n)), np.eye(n)], [-Minv @ K, -Minv @ C]])
+    lam = np.linalg.eigvals(A)
+    lam = lam[np.imag(lam) >= 0.0]
+    lam = lam[np.argsort(np.abs(lam))]
+    mag = np.abs(lam)
+    zeta = np.where(mag > 0, -np.real(lam) / np.where(mag > 0, mag, 1.0), math.nan)
+    return {"frequency_hz": (mag / (2 * np.pi)).tolist(), "damping_ratio": zeta.tolist()}
+
+
+def model_summary(model: Any, data: Measurement | None = None) -> dict[str, Any]:
+    """A fitted identifier as a JSON-ready dict.
+
+    Keys: ``identifier`` (name, class, hyperparameters), ``equations`` (text); for a structural
+    model ``matrices`` (``M`` [kg], ``C`` [N s/m], ``K`` [N/m], ``K3`` [N/m^3] or None) and
+    ``modal`` (:func:`modal_parameters`); for a mechanical one ``coefficients`` (``coef`` with
+    ``feature_names``); with ``data``, ``r2`` (the model's truth-free ``score(data)``, None where
+    the model has none).
+    """
+    params = {k: v for k, v in model.get_params(deep=False).items()
+              if isinstance(v, (bool, int, float, str, list, tuple, type(None)))}
+    out: dict[str, Any] = {"identifier": {"name": getattr(model, "name", ""),
+                                          "class": f"{type(model).__module__}.{type(model).__qualname__}",
+                                          "params": params},
+                           "equations": list(model.equations())}
+    if hasattr(model, "M_"):
+        M, C, K = (np.asarray(getattr(model, k), dtype=float) for k in ("M_", "C_", "K_"))
+        out["matrices"] = {"M": _array(M), "C": _array(C), "K": _array(K),
+                           "K3": _array(getattr(model, "K3_", None)),
+                           "units": {"M": "kg", "C": "N s/m", "K": "N/m", "K3": "N/m^3"}}
+        out["modal"] = modal_parameters(M, C, K)
+    elif hasattr(model, "coef_"):
+        out["coefficients"] = {"coef": _array(model.coef_),
+                               "feature_names": list(getattr(model, "feature_names_", []))}
+    if data is not None:
+        try:
+            out["r2"] = float(model.score(data))
+        except NotImplementedError:
+            out["r2"] = None
+    return out

@@ -1,0 +1,45 @@
+"""The short report of a model identified from measured data (``testbed identify``): plain text
+that reads the same on a terminal and as a markdown file."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+
+def _num(v: Any) -> str:
+    return "-" if v is None or (isinstance(v, float) and math.isnan(v)) else f"{v:.5g}"
+
+
+def render_identified(summary: dict[str, Any]) -> str:
+    """Markdown text of a :meth:`testbed.pipeline.fit.FitResult.summary` dict: source, method,
+    fit time, truth-free R^2, modal parameters (frequency [Hz], damping ratio), matrices and the
+    equations."""
+    ident = summary["identifier"]
+    params = ", ".join(f"{k}={v!r}" for k, v in ident["params"].items())
+    lines = [f"# Identified model: {summary['method']}", "",
+             f"- data: `{summary['source']}` ({summary['kind']}; {len(summary['channels'])} channels "
+             f"{', '.join(summary['channels'])}; {summary['n_samples']} samples at "
+             f"{summary['fs_hz']:g} Hz)",
+             f"- identifier: `{ident['class']}`({params})",
+             f"- fit time: {summary['fit_time_s']:.3g} s",
+             "- R^2 of the predicted accelerations (truth-free): "
+             + (_num(summary["r2"]) if summary.get("r2") is not None
+                else "not defined (implicit equations: no explicit acceleration)"), ""]
+    modal = summary.get("modal")
+    if modal:
+        lines += ["## Modes", "", "| mode | frequency [Hz] | damping ratio |", "|---|---|---|"]
+        lines += [f"| {k + 1} | {_num(f)} | {_num(z)} |"
+                  for k, (f, z) in enumerate(zip(modal["frequency_hz"], modal["damping_ratio"], strict=True))]
+        lines.append("")
+    mats = summary.get("matrices")
+    if mats:
+        lines += ["## Matrices (sensor coordinates)", ""]
+        for key in ("M", "C", "K", "K3"):
+            if mats.get(key) is None:
+                continue
+            lines += [f"{key} [{mats['units'][key]}]:", "```"]
+            lines += ["  ".join(f"{v:+.5e}" for v in row) for row in mats[key]]
+            lines += ["```", ""]
+    lines += ["## Equations", "", "```", *summary["equations"], "```"]
+    return "\n".join(lines) + "\n"
