@@ -24,3 +24,15 @@ def dataset_cache():
     from testbed.pipeline.cache import DatasetCache
 
     return DatasetCache(ROOT / ".cache" / "test-datasets")
+
+
+@pytest.fixture(autouse=True, scope="module")
+def _registries_restored_after_each_module():
+    """Plugins a test module registers (toy rigs, toy identifiers) are forgotten when it ends,
+    so no test sees another module's plugins whatever the order xdist runs them in."""
+    from testbed.pipeline.plugins import IDENTIFIERS, RIGS
+
+    saved = [(r, r.snapshot()) for r in (RIGS, IDENTIFIERS)]
+    yield
+    for r, snap in saved:
+        r.restore(snap)

@@ -30,10 +30,10 @@ PLUGIN = "tests.springmass_rig"
 @pytest.fixture(scope="module", autouse=True)
 def plugin():
     """The rig joins the registry for this module's tests only (other tests list every rig)."""
+    snap = RIGS.snapshot()
     load_plugins([PLUGIN])
     yield
-    RIGS._entries.pop("springmass", None)  # the registry has no public removal: tests only
-    RIGS._tags.pop("springmass", None)
+    RIGS.restore(snap)
     sys.modules.pop(PLUGIN, None)
 
 RIG = {"m1": 1.0, "m2": 0.5, "k1": 1e5, "k2": 5e4, "beta": 9e-5}  # 35.6 Hz, 71.2 Hz; zeta 1 %, 2 %

@@ -140,16 +140,46 @@ class Registry:
         return f"module {mod}"
 
     def _load(self) -> None:
+        """Import the package's modules and the entry points, once.
+
+        ``_loaded`` is set first so that a module looking the registry up while it is being
+        imported sees what has registered so far instead of recursing; if an import fails,
+        the flag is reset and the failure raised naming the module, so the next lookup tries
+        again rather than silently using a partial registry.
+        """
         if self._loaded:
             return
         self._loaded = True
-        if self.package is not None:
-            pkg = importlib.import_module(self.package)
-            for info in pkgutil.iter_modules(pkg.__path__):
-                if not info.name.startswith("_"):
-                    importlib.import_module(f"{self.package}.{info.name}")
-        if self.entry_points is not None:
-            self._load_entry_points()
+        try:
+            if self.package is not None:
+                pkg = importlib.import_module(self.package)
+                for info in pkgutil.iter_modules(pkg.__path__):
+                    if not info.name.startswith("_"):
+                        module = f"{self.package}.{info.name}"
+                        try:
+                            importlib.import_module(module)
+                        except PluginError:
+                            raise
+                        except Exception as e:
+                            raise PluginError(f"{self.kind} module {module} failed to import: "
+                                              f"{type(e).__name__}: {e}") from e
+            if self.entry_points is not None:
+                self._load_entry_points()
+        except BaseException:
+            self._loaded = False
+            raise
+
+    def snapshot(self) -> tuple[dict, dict, dict]:
+        """The registry's entries, tags and origins (loaded first), for :meth:`restore`."""
+        self._load()
+        return dict(self._entries), dict(self._tags), dict(self._origins)
+
+    def restore(self, snap: tuple[dict, dict, dict]) -> None:
+        """Return to a :meth:`snapshot`: registrations made since are forgotten (tests and
+        plugin experiments in one process)."""
+        for mine, saved in zip((self._entries, self._tags, self._origins), snap, strict=True):
+            mine.clear()
+            mine.update(saved)
 
     def _load_entry_points(self) -> None:
         seen = set()

@@ -31,3 +31,29 @@ def test_real_registries_load_their_packages():
     assert "cantilever" in RIGS.names()
     assert "fivebar" in RIGS.names()
     assert {"ls_sindy", "sgd_sindy", "sindy_pi"} <= set(IDENTIFIERS.names())
+
+
+def test_a_failing_plugin_module_is_named_and_not_a_silently_partial_registry(tmp_path, monkeypatch):
+    """One module of a registry's package that fails to import is an error naming it, on every
+    lookup: never a registry that silently lacks that module's entries."""
+    import sys
+
+    from testbed.core.registry import PluginError, Registry
+
+    pkg = tmp_path / "brokenpkg"
+    pkg.mkdir()
+    (pkg / "__init__.py").write_text("from testbed.core.registry import Registry\n"
+                                     "REG = Registry('thing', package='brokenpkg')\n")
+    (pkg / "good.py").write_text("from brokenpkg import REG\n@REG.register('good')\nclass Good: pass\n")
+    (pkg / "zbad.py").write_text("raise RuntimeError('plugin broke')\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    try:
+        import brokenpkg
+
+        reg: Registry = brokenpkg.REG
+        for _ in range(2):  # the second lookup fails the same way, not with a partial registry
+            with pytest.raises(PluginError, match=r"brokenpkg\.zbad.*plugin broke"):
+                reg.names()
+    finally:
+        for m in [m for m in sys.modules if m.startswith("brokenpkg")]:
+            sys.modules.pop(m)

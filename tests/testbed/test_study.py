@@ -80,10 +80,7 @@ def folder(tmp_path_factory):
     from identify import IDENTIFIERS
     from models import RIGS
 
-    registries = (RIGS, IDENTIFIERS)
-    for r in registries:
-        r.names()  # load the packages' own entries first, so the snapshot holds them
-    saved = [(r, dict(r._entries), dict(r._tags)) for r in registries]
+    saved = [(r, r.snapshot()) for r in (RIGS, IDENTIFIERS)]
     modules = set(sys.modules)
     d = tmp_path_factory.mktemp("study")
     (d / "plugin.py").write_text(PLUGIN)
@@ -91,11 +88,8 @@ def folder(tmp_path_factory):
     for name, rig in (("mech", "st_mech_rig"), ("struct", "st_struct_rig")):
         (d / f"{name}.toml").write_text(f'[scenario]\nname = "{name}"\nrig = "{rig}"\n')
     yield d
-    for r, entries, tags in saved:
-        r._entries.clear()
-        r._entries.update(entries)
-        r._tags.clear()
-        r._tags.update(tags)
+    for r, snap in saved:
+        r.restore(snap)
     for m in set(sys.modules) - modules:
         if m.startswith("_testbed_plugin_"):
             del sys.modules[m]
