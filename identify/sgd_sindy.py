@@ -398,7 +398,8 @@ class SGDSINDy(StructuralIdentifier):
         self
         """
         self._check_params()
-        self.learning_rate_, self.learning_rate_rule_ = learning_rate_for(bool(self.cubic), self.learning_rate)
+        self.learning_rate_, self.learning_rate_rule_ = learning_rate_for(bool(self.cubic),
+                                                                          self.learning_rate)
         if self.parametrization == "matrices":
             return self._fit_matrices(data)
         m_hat = mass_prior_value(data, self.mass_prior)

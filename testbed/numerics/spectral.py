@@ -237,11 +237,11 @@ def peak_candidates(x: np.ndarray, fs: float, fmin: float = 0.0, fmax: float | N
 
 def harmonic_amplitude_law(x: np.ndarray, fs: float, f_fund: float, k: int, n_segments: int = 8,
                            search: float = 0.15, rel_halfwidth: float = 0.03
-                           ) -> tuple[float, float]:
+                           ) -> tuple[float, float, float]:
     """How a candidate harmonic at ``k`` times a fundamental follows that fundamental.
 
-    The record is cut into ``n_segments`` equal segments (rectangular window, 4x zero
-    padding).  In each, the fundamental is the strongest line within ``f_fund (1 +- search)``
+    The record is cut into ``n_segments`` equal segments (Hann window, 4x zero padding).  In
+    each, the fundamental is the strongest line within ``f_fund (1 +- search)``
     (its frequency ``f_s`` and amplitude ``A_s``: a hardening mode's frequency falls as it
     decays), and the candidate's amplitude ``B_s`` is the strongest line within
     ``k f_s (1 +- rel_halfwidth)``, i.e. it is tracked at ``k`` times the fundamental's
@@ -271,29 +271,36 @@ def harmonic_amplitude_law(x: np.ndarray, fs: float, f_fund: float, k: int, n_se
     drift : float
         Relative change of the fundamental's frequency from the first to the last segment,
         ``(f_first - f_last) / f_last`` (0 for a linear mode, > 0 for a hardening one).
+    line : float
+        Spacing of the segments' (padded) spectral lines relative to ``f_last``: a drift of a
+        line or two is the resolution, not the structure.
     """
     x = np.atleast_2d(np.asarray(x, dtype=float))
     n = x.shape[-1]
     seg = n // int(n_segments)
     nfft = sfft.next_fast_len(4 * seg, real=True)
     f_axis = sfft.rfftfreq(nfft, 1.0 / fs)
+    # Hann window per segment: a rectangular one leaks the fundamental's side lobes (-36 dB
+    # twenty lines away) over a harmonic that has decayed three times faster, and flattened
+    # the measured law (slope 1.5 instead of 3 on an exact A^3 harmonic)
+    w = np.hanning(seg + 2)[1:-1]
     la, lb, fs_seg = [], [], []
     for s in range(int(n_segments)):
         z = x[:, s * seg:(s + 1) * seg]
-        p = (np.abs(sfft.rfft(z - z.mean(axis=-1, keepdims=True), n=nfft, axis=-1)) ** 2).sum(0)
+        p = (np.abs(sfft.rfft((z - z.mean(axis=-1, keepdims=True)) * w, n=nfft, axis=-1)) ** 2).sum(0)
         sel = np.flatnonzero((f_axis >= f_fund * (1 - search)) & (f_axis <= f_fund * (1 + search)))
         if sel.size == 0:
-            return float("nan"), float("nan")
+            return float("nan"), float("nan"), float("nan")
         j = sel[np.argmax(p[sel])]
         fj = f_axis[j]
         lo_h, hi_h = k * fj * (1 - rel_halfwidth), k * fj * (1 + rel_halfwidth)
         hs = np.flatnonzero((f_axis >= lo_h) & (f_axis <= hi_h))
         if hs.size == 0:
-            return float("nan"), float("nan")
+            return float("nan"), float("nan"), float("nan")
         la.append(0.5 * np.log(max(p[j], 1e-300)))
         lb.append(0.5 * np.log(max(p[hs].max(), 1e-300)))
         fs_seg.append(fj)
     la, lb = np.asarray(la), np.asarray(lb)
     da = la - la.mean()
     slope = float(da @ (lb - lb.mean()) / (da @ da)) if da @ da > 0 else float("nan")
-    return slope, float((fs_seg[0] - fs_seg[-1]) / fs_seg[-1])
+    return slope, float((fs_seg[0] - fs_seg[-1]) / fs_seg[-1]), float((f_axis[1] - f_axis[0]) / fs_seg[-1])
