@@ -262,7 +262,8 @@ class SGDSINDy(StructuralIdentifier):
         # None = by rule (learning_rate_for): Table 1's 1.5e-4 on the linear library, 1.5e-5
         # with the cubic library
         "learning_rate": Field(float, None, min=0.0, min_inclusive=False, max=1.0,
-                               doc="step size of the coefficient optimiser (standardised units)"),
+                               doc="step size of the coefficient optimiser (standardised units); default "
+                                   "1.5e-4, with the cubic library 1.5e-5"),
         "mass_learning_rate": Field(float, 1.5e-4, min=0.0, min_inclusive=False, max=1.0,
                                     doc="step size of the mass update"),
         "alpha_init": Field(float, 0.1, min=0.0, doc="initial weight of every penalty"),
