@@ -130,6 +130,11 @@ class SGDSINDy(StructuralIdentifier):
         Upper bound of every annealed weight (see Notes, item 7).
     random_state : int
         Seed of the mini-batch order.
+    iterate_average : float
+        Matrix parametrisation: fraction of the epochs, at the end (and within the debiasing
+        stage), whose end-of-epoch iterates are averaged into the result (Polyak-Ruppert
+        averaging; 0 = the last iterate).  Reasons and measurements in
+        :mod:`identify._sgd_matrix`.
 
     Attributes
     ----------
@@ -306,6 +311,11 @@ class SGDSINDy(StructuralIdentifier):
         "gradient": Field(str, "minibatch", choices=("minibatch", "full"),
                           doc="mini-batch steps, or the exact full-window gradient each step "
                               "(matrix parametrisation)"),
+        # 0.25: see identify/_sgd_matrix.py (iterate averaging); [0, 1): 1 would average from
+        # the warm start
+        "iterate_average": Field(float, 0.25, min=0.0, max=1.0, max_inclusive=False,
+                                 doc="fraction of the epochs, at the end, whose iterates are "
+                                     "averaged (matrix parametrisation); 0 = the last iterate"),
     }
 
     @classmethod
@@ -334,7 +344,8 @@ class SGDSINDy(StructuralIdentifier):
                  optimizer: str = "adam", init: str = "lstsq", mass_prior: str = "reduced_mass_trace",
                  mass_update: str = "lstsq", anneal: bool = True, alpha_max: float = 1.0,
                  random_state: int = 0, parametrization: str = "matrices", fit_duration: float = 0.0,
-                 l1_threshold: float = 0.2, l1_debias: float = 0.5, gradient: str = "minibatch"):
+                 l1_threshold: float = 0.2, l1_debias: float = 0.5, gradient: str = "minibatch",
+                 iterate_average: float = 0.25):
         self.epochs = epochs
         self.batch_size = batch_size
         self.learning_rate = learning_rate
@@ -361,6 +372,7 @@ class SGDSINDy(StructuralIdentifier):
         self.l1_threshold = l1_threshold
         self.l1_debias = l1_debias
         self.gradient = gradient
+        self.iterate_average = iterate_average
 
     # ----------------------------------------------------------------------------------------
     def _check_params(self) -> None:
