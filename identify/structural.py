@@ -32,6 +32,7 @@ from identify._base import Identifier
 from identify._structural_sim import simulate_structural
 from testbed.core.errors import IdentificationError
 from testbed.core.measurement import Measurement, Trajectory
+from testbed.numerics.spectral import harmonic_amplitude_law, peak_candidates
 
 #: Keys of ``Measurement.prior`` a structural identifier may take the mass scale from.
 MASS_PRIORS = ("reduced_mass_trace", "total_mass")
@@ -300,8 +301,6 @@ def modal_peaks(data: Measurement, n_modes: int | None = None,
     -------
     PeakSearch
     """
-    from testbed.numerics.spectral import harmonic_amplitude_law, peak_candidates
-
     s = data.free_start if start is None else int(start)
     xdd = np.asarray(data.xdd, dtype=float)[:, s:stop]
     n_modes = data.n_channels if n_modes is None else int(n_modes)
