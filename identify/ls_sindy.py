@@ -14,6 +14,7 @@ from identify.structural import (
     mass_prior_value,
     matrices_from_coef,
 )
+from testbed.core.errors import IdentificationError
 from testbed.core.measurement import Measurement
 from testbed.core.schema import Field
 
@@ -60,6 +61,12 @@ class LeastSquaresSINDy(StructuralIdentifier):
         ``data.input_map``.
     n_steps_ : int
         0 (closed form).
+
+    Raises
+    ------
+    IdentificationError
+        From ``fit``, if the identified linear model has a growing mode (negative damping or
+        stiffness): least squares does not constrain it, so it is refused, not returned.
 
     Notes
     -----
@@ -116,5 +123,25 @@ class LeastSquaresSINDy(StructuralIdentifier):
         self.M_, self.C_, self.K_, self.K3_ = matrices_from_coef(coef, lib.blocks, masses)
         self.input_map_ = None if data.input_map is None else np.asarray(data.input_map, dtype=float)
         self.n_steps_ = 0
+        self._check_physical()
         self._finish_fit()
         return self
+
+    def _check_physical(self) -> None:
+        """Raise :class:`IdentificationError` for a model with a growing mode.
+
+        Least squares does not constrain ``M^-1 C`` (M is ``m_hat / n I``, positive definite by
+        construction): on noisy data it can return negative damping.  A pole of the linear
+        model ``[[0, I], [-M^-1 K, -M^-1 C]]`` with real part above ``1e-9`` of its modulus
+        (rounding of an undamped pole) is a mode that grows: a passive structure has none.
+        """
+        n = self.M_.shape[0]
+        Minv = np.linalg.inv(self.M_)
+        A = np.block([[np.zeros((n, n)), np.eye(n)], [-Minv @ self.K_, -Minv @ self.C_]])
+        lam = np.linalg.eigvals(A)
+        bad = lam.real > 1e-9 * np.abs(lam)
+        if np.any(bad):
+            worst = lam[bad][np.argmax(lam[bad].real)]
+            raise IdentificationError(
+                f"non-physical model: a pole at {worst.real:+.4g} {worst.imag:+.4g}j 1/s grows "
+                f"(negative damping or negative stiffness); least squares does not constrain it")

@@ -247,6 +247,11 @@ class SINDyPILinear(Identifier):
         w, V = np.linalg.eigh(C)
         C = (V * np.maximum(w, 0.0)) @ V.T
         M, C = 0.5 * (M + M.T), 0.5 * (C + C.T)  # exactly symmetric (round-off of the products)
+        if not np.all(np.linalg.eigvalsh(0.5 * (K + K.T)) > 0):
+            # a structure held at its base has a positive definite K; with M positive definite
+            # and C positive semi-definite that is what makes the model stable
+            raise IdentificationError("identified K is not positive definite (a static divergence "
+                                      "mode): not returned")
         self.M_, self.C_, self.K_, self.K3_ = M, C, K, None
         self.normalisation_ = (
             f"M symmetric with M (M^-1 K) and M (M^-1 C) symmetric ({family}-dimensional family; "

@@ -32,6 +32,7 @@ from identify._base import Identifier
 from identify._structural_sim import simulate_structural
 from testbed.core.errors import IdentificationError
 from testbed.core.measurement import Measurement, Trajectory
+from testbed.numerics.spectral import harmonic_amplitude_law, peak_candidates
 
 #: Keys of ``Measurement.prior`` a structural identifier may take the mass scale from.
 MASS_PRIORS = ("reduced_mass_trace", "total_mass")
@@ -185,44 +186,163 @@ def mass_prior_value(data: Measurement, key: str) -> float:
 MODE_SEPARATION = 0.15
 
 
-def measured_frequencies(data: Measurement, n_modes: int, freq_range: tuple[float, float] | None = None,
-                         start: int | None = None) -> np.ndarray:
-    """Natural frequencies [Hz] read from the spectral peaks of the measured accelerations.
+#: Lower edge of the peak band, as a multiple of the chain's high-pass cut-off: the elliptic
+#: high-pass (applied at every integration stage, each forward-backward) attenuates, rings and
+#: leaves integrated drift up to its pass-band edge; 1.1 keeps 10 % clear of that edge (mode 1
+#: of cantilever_long_aluminium, 12.8 Hz, sits at 1.28x the 10 Hz cut-off and stays in).
+HIGHPASS_MARGIN = 1.1
+#: Upper edge of the peak band, as a multiple of the chain's low-pass cut-off (the Butterworth
+#: low-pass bends the spectrum from about 0.8 of its cut-off), or of the Nyquist frequency
+#: without one (0.45 fs: the last lines of a sampled spectrum carry aliasing).
+LOWPASS_MARGIN, NYQUIST_FRACTION = 0.8, 0.9
+#: A weaker peak within this relative distance of k times a stronger one (k = 2, 3) is a
+#: harmonic *candidate*; a hardening mode's peak sits above its small-amplitude frequency and
+#: its harmonic tracks it (measured: 139.7 / 45.4 Hz = 3.08 on the 150 N soft base).
+HARMONIC_TOL = 0.08
+#: Range of the log-log slope of the candidate's amplitude against the fundamental's over
+#: short-time segments, as multiples of k, for a harmonic: a polynomial restoring force makes
+#: the k-th harmonic scale as A^k (slope k).  Measured, 8 segments: the 150 N soft base's
+#: 139.7 Hz peak 2.2 against 45.4 Hz (k = 3); independent modes near 3x spacing 0.87-0.99
+#: (soft base 1210 / 391 Hz, aluminium beam 226 / 80 Hz).  A linear mode with
+#: stiffness-proportional damping would give (f_c / f_p)^2 ~ k^2, above the range.
+HARMONIC_SLOPE = (0.6, 1.6)
+#: Smallest fall of the fundamental's frequency from the first to the last short-time segment
+#: (and at least two spectral lines) for it to have harmonics: only an amplitude-dependent,
+#: i.e. nonlinear, mode makes them.  Needed beside the slope: a linear mode at 3x spacing that
+#: decays 9x faster (stiffness-proportional damping) falls into the spectral floor within the
+#: record and showed a slope of 3.5 (synthetic, measured).  Measured drift of the 150 N soft
+#: base's 45.4 Hz peak: 17.5 %; the 50 N soft base's mode 1 sweeps 40.2 -> 38.4 Hz (4.7 %).
+HARMONIC_DRIFT = 0.02
+#: Short-time segments of the harmonic test (each resolves 8 / T Hz: 4 Hz on a 2 s record).
+HARMONIC_SEGMENTS = 8
 
-    Uses :func:`testbed.numerics.spectral.peak_frequencies` (rectangular window, 8x zero padding,
-    parabolic refinement; a Hann window would suppress the fast-decaying second mode of an impact
-    response, whose energy sits at the start of the window) on ``data.xdd`` from the fit window.
-    If fewer than ``n_modes`` peaks stand out the clear ones are returned (at least one).
+
+@dataclass(frozen=True)
+class PeakSearch:
+    """The spectral peaks a structural identifier takes as measured natural frequencies.
+
+    Attributes
+    ----------
+    band : (float, float)
+        Search band [Hz] and the rule that set it (see :func:`modal_peaks`).
+    band_rule : str
+    peaks : ndarray, shape (k,)
+        Accepted peak frequencies [Hz], ascending, ``k <= n_modes``.
+    rejected : list of (float, str)
+        Every other candidate in the band [Hz] with the reason it was not taken.
+    nonlinear : bool
+        A harmonic was recognised: the structure's peak frequencies depend on amplitude.
+    """
+
+    band: tuple[float, float]
+    band_rule: str
+    peaks: np.ndarray
+    rejected: list[tuple[float, str]]
+    nonlinear: bool
+
+
+def peak_band(data: Measurement, n_window: int, freq_range: tuple[float, float] | None = None
+              ) -> tuple[tuple[float, float], str]:
+    """The band [Hz] searched for natural frequencies, and the rule that set it.
+
+    ``freq_range`` (a user's setting) wins.  Otherwise, from the chain's pass band
+    ``data.passband = (hp, lp)``: ``[HIGHPASS_MARGIN hp, LOWPASS_MARGIN lp]`` (with
+    ``NYQUIST_FRACTION fs / 2`` if ``lp`` is the Nyquist frequency), and never below 5 lines of
+    the window's transform (``5 fs / n_window``).  Without a declared pass band: 5 lines to
+    ``0.45 fs``.
+    """
+    nyq = data.fs / 2.0
+    lines = 5.0 * data.fs / n_window
+    if freq_range is not None:
+        return (float(freq_range[0]), float(freq_range[1])), "freq_range (user setting)"
+    if data.passband is None:
+        return (lines, NYQUIST_FRACTION * nyq), "no pass band declared: 5 lines to 0.45 fs"
+    hp, lp = (float(v) for v in data.passband)
+    lo = max(lines, HIGHPASS_MARGIN * hp)
+    hi = NYQUIST_FRACTION * nyq if lp >= nyq else LOWPASS_MARGIN * lp
+    return (lo, hi), (f"chain pass band [{hp:g}, {lp:g}] Hz: from {HIGHPASS_MARGIN:g} x the high-pass "
+                      f"cut-off to {'0.45 fs' if lp >= nyq else f'{LOWPASS_MARGIN:g} x the low-pass'}")
+
+
+def modal_peaks(data: Measurement, n_modes: int | None = None,
+                freq_range: tuple[float, float] | None = None, start: int | None = None,
+                stop: int | None = None) -> PeakSearch:
+    """Natural frequencies [Hz] from the spectral peaks of the measured accelerations, by rule.
+
+    Rules, in order (every candidate not taken is returned with its reason):
+
+    1. *Band*: :func:`peak_band` (the chain's pass band, or ``freq_range``).
+    2. *Candidates*: peaks of the channel-summed power spectrum of ``data.xdd`` on the window
+       (rectangular window: the impact response decays within the record and a Hann window
+       would hide a fast-decaying mode; 8x zero padding; 6 dB prominence; within 40 dB of the
+       strongest), peaks within :data:`MODE_SEPARATION` of a stronger one merged into it.
+    3. *Harmonics*: a weaker candidate within :data:`HARMONIC_TOL` of k = 2 or 3 times a
+       stronger one whose short-time amplitude follows the stronger one's k-th power
+       (:func:`testbed.numerics.spectral.harmonic_amplitude_law`, slope within
+       :data:`HARMONIC_SLOPE` x k), while the stronger one's frequency falls as it decays
+       (:data:`HARMONIC_DRIFT`: the fundamental is nonlinear), is a harmonic, not a mode.
+       If one is found the structure is amplitude-dependent and its record-long peaks are
+       not its linear natural frequencies (the 150 N soft base: 45.4 and 406.5 Hz against
+       39.6 and 386.6 Hz), so no peak is accepted (``nonlinear`` = True).
+    4. *Sensors*: at most ``n_modes`` (default the number of channels: n sensors resolve at
+       most n mode shapes), the strongest.
 
     Parameters
     ----------
     data : Measurement
-    n_modes : int
-        Frequencies wanted.
+    n_modes : int, optional
+        Most peaks taken; default ``data.n_channels``.
     freq_range : (float, float), optional
-        Search band [Hz]; default from 5 frequency bins (``5 fs / n_samples``) to ``0.45 fs``.
-    start : int, optional
-        First sample; default ``data.free_start``.
+        Band [Hz] overriding rule 1.
+    start, stop : int, optional
+        Window ``[start, stop)``; default ``data.free_start`` to the end.
 
     Returns
     -------
-    ndarray, shape (k,), 1 <= k <= n_modes
-        Ascending frequencies [Hz].
+    PeakSearch
     """
-    from testbed.numerics.spectral import peak_frequencies
-
     s = data.free_start if start is None else int(start)
-    xdd = np.asarray(data.xdd, dtype=float)[:, s:]
-    n = xdd.shape[1]
-    fmin, fmax = freq_range if freq_range is not None else (5.0 * data.fs / n, 0.45 * data.fs)
-    last: Exception | None = None
-    for k in range(int(n_modes), 0, -1):
-        try:
-            return peak_frequencies(xdd, data.fs, k, fmin=fmin, fmax=fmax, window="boxcar", pad=8,
-                                    min_rel_separation=MODE_SEPARATION)
-        except ValueError as exc:  # fewer clear peaks than asked for
-            last = exc
-    raise IdentificationError(f"no spectral peak found in the measured accelerations: {last}")
+    xdd = np.asarray(data.xdd, dtype=float)[:, s:stop]
+    n_modes = data.n_channels if n_modes is None else int(n_modes)
+    band, rule = peak_band(data, xdd.shape[1], freq_range)
+    freqs, _ = peak_candidates(xdd, data.fs, band[0], band[1], window="boxcar", pad=8,
+                                 min_rel_separation=MODE_SEPARATION)
+    rejected: list[tuple[float, str]] = []
+    kept: list[int] = []
+    nonlinear = False
+    for i in range(freqs.size):  # strongest first
+        why = None
+        for j in kept:
+            for k in (2, 3):
+                if abs(freqs[i] / (k * freqs[j]) - 1.0) <= HARMONIC_TOL:
+                    slope, drift, line = harmonic_amplitude_law(xdd, data.fs, freqs[j], k,
+                                                                HARMONIC_SEGMENTS)
+                    if (HARMONIC_SLOPE[0] * k <= slope <= HARMONIC_SLOPE[1] * k
+                            and drift > max(HARMONIC_DRIFT, 2.0 * line)):
+                        why = (f"harmonic {k} of {freqs[j]:.4g} Hz (amplitude ~ A^{slope:.2f} of it; "
+                               f"a harmonic of a polynomial force scales as A^{k}; the fundamental "
+                               f"drifts {drift:.1%} as it decays)")
+        if why is not None:
+            rejected.append((float(freqs[i]), why))
+            nonlinear = True
+        else:
+            kept.append(i)
+    if nonlinear:
+        for i in kept:
+            rejected.append((float(freqs[i]), "amplitude-dependent structure (a harmonic was found): "
+                                              "a record-long peak is not a linear natural frequency"))
+        kept = []
+    for i in kept[n_modes:]:
+        rejected.append((float(freqs[i]), f"beyond the {n_modes} strongest (n sensors resolve at most "
+                                          f"n modes)"))
+    kept = kept[:n_modes]
+    return PeakSearch(band, rule, np.sort(freqs[kept]), rejected, nonlinear)
+
+
+def measured_frequencies(data: Measurement, n_modes: int, freq_range: tuple[float, float] | None = None,
+                         start: int | None = None) -> np.ndarray:
+    """Accepted peak frequencies [Hz] of :func:`modal_peaks` (ascending; may be empty)."""
+    return modal_peaks(data, n_modes, freq_range, start).peaks
 
 
 # --------------------------------------------------------------------------------------------

@@ -31,6 +31,12 @@ class Measurement:
         Declared prior knowledge (e.g. ``total_mass`` [kg]); never the answer.
     free_start : int
         First sample after the excitation pulse (0 if the input is continuous).
+    passband : (float, float), optional
+        Pass band [Hz] of the signal chain the signals went through, ``(low, high)``: ``low``
+        the high-pass cut-off (its pass-band edge; 0 without a high-pass), ``high`` the
+        low-pass cut-off (the Nyquist frequency without one).  None = not declared (signals
+        not from a filtering chain).  Below ``low`` and near it a spectrum shows the filter,
+        not the structure.
     """
 
     fs: float
@@ -43,6 +49,7 @@ class Measurement:
     input_map: np.ndarray | None = None
     prior: dict[str, Any] = field(default_factory=dict)
     free_start: int = 0
+    passband: tuple[float, float] | None = None
 
     @property
     def n_channels(self) -> int:

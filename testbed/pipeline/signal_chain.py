@@ -317,7 +317,7 @@ def measure_structural(dataset: Dataset, cfg: Mapping[str, Any]) -> Measurement:
         [N] (through the same filters if ``filter_force``); ``input_map`` (n_sensors x 1) with
         1 at the sensor within ``IMPACT_TOLERANCE_M`` of the impact; ``free_start`` the
         first sample ``free_margin_s`` after the end of the raw force pulse; ``prior`` a copy
-        of ``dataset.prior``.
+        of ``dataset.prior``; ``passband`` ``(highpass_hz, lowpass_hz or fs / 2)`` [Hz].
 
     Notes
     -----
@@ -376,7 +376,9 @@ def measure_structural(dataset: Dataset, cfg: Mapping[str, Any]) -> Measurement:
     free_start = 0 if end == 0 else min(acc.shape[1], end + int(np.ceil(cfg["free_margin_s"] * fs)))
     return Measurement(fs=fs, x=x, xd=xd, xdd=xdd, channels=tuple(acc_sig.channels), u=u,
                        inputs=tuple(f_sig.channels), input_map=input_map,
-                       prior=dict(dataset.prior), free_start=free_start)
+                       prior=dict(dataset.prior), free_start=free_start,
+                       passband=(float(cfg["highpass_hz"]),
+                                 float(cfg["lowpass_hz"]) if cfg["lowpass_hz"] > 0 else fs / 2.0))
 
 
 def measure_mechanical(dataset: Dataset, cfg: Mapping[str, Any]) -> Measurement:
