@@ -8,7 +8,8 @@ fewer than 2 such cells it degenerates to the single value.
 The pass rate is over the *judged* cells of the group: those whose (scenario, identifier)
 pair was held to at least one threshold (a non-empty ``checks`` list in some cell of that
 pair; the study decides which bars each identifier meets, see
-:mod:`testbed.studies.study`).  A judged cell that failed counts as not passed, since a
+:mod:`testbed.studies.study`), and crashed cells of an identifier held to bars elsewhere.
+A judged cell that failed counts as not passed, since a
 method that crashes or returns NaN did not meet its thresholds.  A group with no judged cell
 has no pass rate (NaN): an identifier is never measured against bars declared for another.
 
@@ -61,17 +62,27 @@ def failure_kind(error: str) -> list[str]:
     return found or ["other"]
 
 
-def _judged_pairs(rows: list[dict[str, Any]]) -> set[tuple[str, str]]:
-    """(scenario, identifier) pairs held to at least one threshold in some cell."""
-    out = set()
+def _judged(rows: list[dict[str, Any]]) -> list[bool]:
+    """Whether each row was held to thresholds.
+
+    A row is judged if its (scenario, identifier) pair has a non-empty ``checks`` list in some
+    cell.  A cell that crashed has no checks (it never got to scoring); it is judged if its
+    identifier is held to bars on any scenario of the results, so that a crash is never left
+    out of a pass rate (it counts as not passed).
+    """
+    pairs, idents = set(), set()
     for r in rows:
         try:
             checks = json.loads(r.get("checks") or "[]")
         except (TypeError, ValueError):
             checks = []
         if checks:
-            out.add((r["scenario"], r["identifier"]))
-    return out
+            pairs.add((r["scenario"], r["identifier"]))
+            idents.add(r["identifier"])
+    return [(r["scenario"], r["identifier"]) in pairs
+            or (r["identifier"] in idents and any(k.startswith("crash")
+                                                  for k in failure_kind(r.get("error") or "")))
+            for r in rows]
 
 
 def summarize(path: str | os.PathLike, rows: list[dict[str, Any]] | None = None,
@@ -104,7 +115,7 @@ def summarize(path: str | os.PathLike, rows: list[dict[str, Any]] | None = None,
     rows = read_results(path) if rows is None else rows
     scores = score_columns(rows)
     keys = BY[by] + GROUP_KEYS
-    judged_pairs = _judged_pairs(rows)
+    judged_flags = {id(r): j for r, j in zip(rows, _judged(rows), strict=True)}
 
     def value(r: dict[str, Any], k: str) -> Any:
         return family_of(r["scenario"]) if k == "family" else r[k]
@@ -116,7 +127,7 @@ def summarize(path: str | os.PathLike, rows: list[dict[str, Any]] | None = None,
     for key in sorted(groups):
         g = groups[key]
         ok = [r for r in g if r["status"] == "ok"]
-        judged = [r for r in g if (r["scenario"], r["identifier"]) in judged_pairs]
+        judged = [r for r in g if judged_flags[id(r)]]
         failures: dict[str, int] = defaultdict(int)
         for r in g:
             for kind in failure_kind(r.get("error") or ""):
