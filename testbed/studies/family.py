@@ -101,6 +101,18 @@ MAX_MODE_FRACTION_OF_FS = 0.35
 #: continuous beam within ~1 % only while N >= ~3 k (the shipped 10-segment beam: modes 1-3
 #: within 0.4 %), so a member with s sensors has at least 3 s segments.
 MIN_SEGMENTS_PER_MODE = 3
+#: Periods of mode 1 the record must hold at least: the signal chain's high-pass (10 Hz by
+#: default), its end effects and a spectral peak need many cycles of the slowest mode; the
+#: shipped stiff beam has 80 (80 Hz over 1 s), and a first family run with 6-40 periods
+#: (mode 1 at 11-110 Hz over 0.5 s) failed on most members with mode 1 below 40 Hz
+#: (TRAC 0.0-0.3 for least squares at 0 % noise), i.e. on the set-up, not the method.
+MIN_MODE1_PERIODS = 20
+#: Largest damping ratio of the highest sensed mode: the rig's damping is stiffness-
+#: proportional (C = beta K, so zeta_k = zeta_1 f_k / f_1); a mode damped 30 % loses 85 % of
+#: its amplitude per cycle, so its free decay holds about one cycle and its frequency and
+#: damping cannot be measured: a model with that mode in its sensor coordinates is not
+#: determined by the record (first family run: members with zeta_N > 0.3 gave unstable poles).
+MAX_SENSED_DAMPING = 0.3
 #: Smallest gap between two drawn sensors and between a sensor and the root [fraction of the
 #: length]: two accelerometers closer than 5 % of the beam see nearly the same motion and make
 #: the sensor-coordinate model ill-conditioned by construction, not by the method.
@@ -109,8 +121,13 @@ MIN_SENSOR_GAP = 0.05
 #: Derived keys of cantilever families and their rules.
 CANTILEVER_DERIVED = {
     "rig.material": "a name in MATERIALS: sets E and rho",
-    "rig.n_sensors": "number of accelerometers; positions uniform on (0, L], sorted, at least "
-                     "MIN_SENSOR_GAP * L apart and from the root, rounded to 0.1 mm",
+    "checks": "every sensed mode (as many as sensors, Euler-Bernoulli estimate) below "
+              "MAX_MODE_FRACTION_OF_FS * sample_rate, at least MIN_SEGMENTS_PER_MODE segments "
+              "per sensed mode, at least MIN_MODE1_PERIODS periods of mode 1 in the record, "
+              "the highest sensed mode damped at most MAX_SENSED_DAMPING",
+    "rig.n_sensors": "number of accelerometers; positions uniform on (0, L], sorted, conditioned "
+                     "on being at least MIN_SENSOR_GAP * L apart and from the root (drawn "
+                     "directly, see _cantilever_rules), rounded down to 0.1 mm",
     "rig.base_k1_ratio": "soft base: base_k1 = ratio * E I / L (I = width thickness^3 / 12); "
                          "1.2 is the shipped soft base",
     "rig.cubic_fraction": "soft base: cubic base moment at the estimated peak base rotation as "
@@ -295,12 +312,18 @@ def _cantilever_rules(fam: Family, rig: dict[str, Any], exc: dict[str, Any],
         rig["E"], rig["rho"] = MATERIALS[derived["material"]]
     L = rig["length"]
     if "n_sensors" in derived:
+        # n sorted uniform positions conditioned on gaps >= g (root to first, between sensors):
+        # the n + 1 spacings of sorted uniforms are Dirichlet(1, ..., 1), so the positions are
+        # cumulative sums of g + (L - n g) d with d ~ Dirichlet(1^(n+1)) (the last spacing, to
+        # the tip, unconstrained): no draw is refused for crowded sensors.
         n = int(derived["n_sensors"])
-        pos = np.sort(rng.uniform(0.0, L, n))
-        pos = np.round(pos, 4)  # 0.1 mm: a lab's tape measure, and short decimal files
-        gaps = np.diff(np.concatenate([[0.0], pos]))
-        if gaps.min() < MIN_SENSOR_GAP * L:
-            return f"sensors closer than {MIN_SENSOR_GAP:g} L"
+        g = MIN_SENSOR_GAP * L
+        if n * g >= L:
+            return f"{n} sensors cannot be {MIN_SENSOR_GAP:g} L apart"
+        d = rng.dirichlet(np.ones(n + 1))
+        pos = np.cumsum(g + (L - n * g) * d[:n])
+        # 0.1 mm: a lab's tape measure, and short decimal files; never beyond the tip
+        pos = np.minimum(np.floor(pos * 1e4) / 1e4, L)
         rig["sensors"] = [float(x) for x in pos]
     n_sensors = len(rig["sensors"]) or 3
     if "base_k1_ratio" in derived:
@@ -320,11 +343,17 @@ def _cantilever_rules(fam: Family, rig: dict[str, Any], exc: dict[str, Any],
     f = eb_frequencies(rig, min(n_sensors, len(EB_BETA_L)))
     if f[-1] > MAX_MODE_FRACTION_OF_FS * sim["sample_rate"]:
         return f"mode {n_sensors} at {f[-1]:.0f} Hz"
+    if f[0] * sim["duration"] < MIN_MODE1_PERIODS:
+        return f"mode 1 at {f[0]:.0f} Hz: {f[0] * sim['duration']:.0f} periods in the record"
+    if rig["damping_ratio"] * f[-1] / f[0] > MAX_SENSED_DAMPING:
+        return f"mode {n_sensors} damped {rig['damping_ratio'] * f[-1] / f[0]:.2f}"
     return None
 
 
-def draw_member(fam: Family, k: int) -> tuple[Scenario, int]:
+def draw_member(fam: Family, k: int, refusals: list[str] | None = None) -> tuple[Scenario, int]:
     """Member ``k`` of a family and the attempt that gave it (see the module docs).
+
+    ``refusals``, if given, receives the reason of every refused draw (for reports).
 
     Raises
     ------
@@ -354,6 +383,8 @@ def draw_member(fam: Family, k: int) -> tuple[Scenario, int]:
             why = _cantilever_rules(fam, tables["rig"], tables["excitation"], tables["simulation"],
                                     derived, rng) or ""
             if why:
+                if refusals is not None:
+                    refusals.append(why)
                 continue
         raw = member_dict(fam, k, attempt, tables)
         try:
@@ -361,6 +392,8 @@ def draw_member(fam: Family, k: int) -> tuple[Scenario, int]:
                                       stem=fam.member_name(k), standalone=False), attempt
         except ScenarioError as e:
             why = f"{e.key}: {e.allowed}"
+            if refusals is not None:
+                refusals.append(why)
     raise ScenarioError(f"<family {fam.name}>", f"families.{fam.name}", k,
                         f"member {k}: {MAX_ATTEMPTS} draws all refused (last: {why}); widen or "
                         "move the ranges")
