@@ -21,6 +21,7 @@ from testbed.studies.family import (
     MIN_SEGMENTS_PER_MODE,
     MIN_SENSOR_GAP,
     draw_member,
+    eb_frequencies,
     family_of,
     peak_base_rotation,
 )
@@ -52,6 +53,9 @@ cubic_fraction = {{uniform = [0.0, 0.6]}}
 
 [families.beams.simulation]
 duration = 0.5
+
+[families.beams.signal]
+lowpass_hz = "auto"
 
 [families.beams.excitation]
 location = "sensor"
@@ -120,6 +124,8 @@ def test_members_inside_their_ranges(study):
         assert e["location"] in r["sensors"] and 10.0 <= e["peak_force"] <= 100.0
         assert sc.simulation["duration"] == 0.5 and "family:beams" in sc.tags
         assert sc.score == {}  # the base's bars are not the members'
+        f = eb_frequencies(r, len(r["sensors"]) + 1)
+        assert f[-2] < sc.signal["lowpass_hz"] < f[-1]  # between the last sensed mode and the next
         if r["base"] == "soft":
             EI = r["E"] * r["width"] * r["thickness"] ** 3 / 12
             assert 0.5 <= r["base_k1"] / (EI / r["length"]) <= 3.0
