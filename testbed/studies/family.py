@@ -135,6 +135,8 @@ CANTILEVER_DERIVED = {
                           "(see peak_base_rotation)",
     "excitation.location = 'sensor'": "the impact lands on one of the sensors, equally likely "
                                       "(the signal chain needs it on a sensor)",
+    "signal.highpass_hz = 'auto'": "half the Euler-Bernoulli estimate of mode 1 (the noisy-record "
+                                   "chain's 40 Hz for the shipped beam's 80 Hz), 0.1 Hz",
     "signal.lowpass_hz = 'auto'": "the low-pass between the last sensed mode n and mode n + 1: "
                                   "sqrt(f_n f_(n+1)) of the Euler-Bernoulli estimates, 0.1 Hz",
 }
@@ -253,11 +255,11 @@ def _check_cantilever_keys(fam: Family, file: str, key: str) -> None:
     if "n_sensors" in rig and "sensors" in rig:
         raise ScenarioError(file, f"{key}.rig.n_sensors", rig["n_sensors"],
                             "n_sensors (drawn positions) or sensors (fixed positions), not both")
-    lp = fam.ranges["signal"].get("lowpass_hz")
-    if isinstance(lp, str) and lp != "auto":
-        raise ScenarioError(file, f"{key}.signal.lowpass_hz", lp,
-                            "a frequency [Hz], a range, or 'auto' (between the last sensed mode "
-                            "and the next)")
+    for k in ("lowpass_hz", "highpass_hz"):
+        v = fam.ranges["signal"].get(k)
+        if isinstance(v, str) and v != "auto":
+            raise ScenarioError(file, f"{key}.signal.{k}", v,
+                                "a frequency [Hz], a range, or 'auto' (see CANTILEVER_DERIVED)")
     loc = fam.ranges["excitation"].get("location")
     if isinstance(loc, str) and loc != "sensor":
         raise ScenarioError(file, f"{key}.excitation.location", loc,
@@ -345,6 +347,11 @@ def _cantilever_rules(fam: Family, rig: dict[str, Any], exc: dict[str, Any],
             rig["base_k3"] = float(derived["cubic_fraction"] * rig["base_k1"] / q**2)
         else:
             rig["base_k3"] = 0.0  # no base spring: the fraction means nothing (drawn all the same)
+    if signal.get("highpass_hz") == "auto":
+        # the noisy-record chain's ratio on the shipped beam (40 Hz high-pass for mode 1 at
+        # 80 Hz): half the member's mode 1, so the cut-off tracks the beam instead of cutting
+        # into a 40 Hz mode 1
+        signal["highpass_hz"] = float(round(eb_frequencies(rig, 1)[0] / 2.0, 1))
     if signal.get("lowpass_hz") == "auto":
         # the lab's low-pass for a model of n modes: between mode n and mode n + 1 (geometric
         # mean of their Euler-Bernoulli estimates), so the first unmodelled mode, which the

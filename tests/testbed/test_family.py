@@ -56,6 +56,7 @@ duration = 0.5
 
 [families.beams.signal]
 lowpass_hz = "auto"
+highpass_hz = "auto"
 
 [families.beams.excitation]
 location = "sensor"
@@ -126,6 +127,7 @@ def test_members_inside_their_ranges(study):
         assert sc.score == {}  # the base's bars are not the members'
         f = eb_frequencies(r, len(r["sensors"]) + 1)
         assert f[-2] < sc.signal["lowpass_hz"] < f[-1]  # between the last sensed mode and the next
+        assert sc.signal["highpass_hz"] == pytest.approx(f[0] / 2, abs=0.05)
         if r["base"] == "soft":
             EI = r["E"] * r["width"] * r["thickness"] ** 3 / 12
             assert 0.5 <= r["base_k1"] / (EI / r["length"]) <= 3.0
