@@ -461,7 +461,7 @@ def _toml_value(v: Any) -> str:
 def scenario_toml(sc: Scenario) -> str:
     """A scenario as TOML text that :func:`~testbed.pipeline.scenario.load_scenario` reads back to
     an equal Scenario (``None`` values, i.e. defaults chosen by the rig, are left out)."""
-    lines = ["# Written by testbed.studies.family.write_family: a member of a scenario family.",
+    lines = ["# Written by testbed.studies.study.write_family: a member of a scenario family.",
              "", "[scenario]"]
     head = {"name": sc.name, "rig": sc.rig, "seed": sc.seed, "description": sc.description,
             "tags": list(sc.tags)}

@@ -345,8 +345,9 @@ def write_family(study: Study | str | os.PathLike, out_dir: str | os.PathLike,
     -------
     list of Path
         The written files, in family and member order.  Each reruns alone with
-        ``testbed run <file>`` (members carry their base's ``[identify]``) and reloads to a
-        Scenario equal to the member.
+        ``testbed run <file>`` (members carry their base's ``[identify]`` and, as ``[score]``,
+        the study's bars for that identifier, :meth:`Study.thresholds_for`) and reloads to a
+        Scenario equal to the member with those bars.
 
     Raises
     ------
@@ -360,7 +361,11 @@ def write_family(study: Study | str | os.PathLike, out_dir: str | os.PathLike,
                             "a family of the study: " + (", ".join(f.name for f in st.families)
                                                           or "(the study declares none)"))
     names = {f.member_name(k) for f in fams for k in range(f.members)}
-    return write_members([sc for sc in st.scenarios if sc.name in names], out_dir)
+    # each member carries the bars the study holds its own [identify] method to, so that it
+    # reruns alone with a verdict
+    return write_members([sc.replace(score=st.thresholds_for(sc, sc.identify["method"]))
+                          if sc.identify else sc
+                          for sc in st.scenarios if sc.name in names], out_dir)
 
 
 def _validate_params(table: Any, identifiers: list[str], file: str) -> dict[str, dict[str, Any]]:
