@@ -1,29 +1,93 @@
-"""Summary of sweep results: per identifier and noise level, median and IQR of each score.
+"""Summary of sweep results: per identifier and noise level (and optionally per scenario or
+family), median and IQR of each score, pass rate and failure reasons.
 
 The spread is the interquartile range (25th and 75th percentiles, numpy's
 default linear interpolation), taken over the cells that finished ("ok"); with
-fewer than 2 such cells it degenerates to the single value.  The pass rate is
-over all cells of the group: a failed cell counts as not passed, since a method
-that crashes or returns NaN did not meet the scenario's thresholds.
+fewer than 2 such cells it degenerates to the single value.
+
+The pass rate is over the *judged* cells of the group: those whose (scenario, identifier)
+pair was held to at least one threshold (a non-empty ``checks`` list in some cell of that
+pair; the study decides which bars each identifier meets, see
+:mod:`testbed.studies.study`), and crashed cells of an identifier held to bars elsewhere.
+A judged cell that failed counts as not passed, since a
+method that crashes or returns NaN did not meet its thresholds.  A group with no judged cell
+has no pass rate (NaN): an identifier is never measured against bars declared for another.
+
+Failure reasons are counted per group (:func:`failure_kind`): a scored failure's reason
+("fit failed", "diverged", "non-physical", "unstable", "non-finite scores") or, for a cell that
+raised, ``crash: <ExceptionType>``.
 """
 
 from __future__ import annotations
 
+import json
 import math
 import os
+import re
 from collections import defaultdict
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from testbed.studies.family import family_of
 from testbed.studies.results import read_results, score_columns
 
 GROUP_KEYS = ("identifier", "noise")
+#: Groupings of :func:`summarize`: the extra key before identifier and noise.
+BY = {"identifier": (), "scenario": ("scenario",), "family": ("family",)}
+#: An exception's text as the sweep records it (``Type: message (file.py:line)``): a crash, not a
+#: scored failure.
+CRASH_PATTERN = re.compile(
+    r"^([A-Za-z_][A-Za-z0-9_.]*(?:Error|Exception|Exit|Interrupt)): .*\([^()]+\.py:\d+\)$", re.DOTALL)
+#: Scored failure reasons (testbed.scoring.scorers, testbed.studies.sweep.run_cell), in the order
+#: they are looked for in a reason text.
+SCORED_REASONS = ("fit failed", "diverged", "simulation failed", "non-physical", "unstable",
+                  "non-finite scores", "no scores")
 
 
-def summarize(path: str | os.PathLike, rows: list[dict[str, Any]] | None = None) -> list[dict[str, Any]]:
-    """Per (identifier, noise) statistics of a results file.
+def failure_kind(error: str) -> list[str]:
+    """The kinds of failure in a cell's ``error`` text (empty for a cell that finished).
+
+    ``crash: <Type>`` for an exception the sweep caught (a bug or an unforeseen input), else
+    every scored reason of :data:`SCORED_REASONS` found in the text (a cell may fail for
+    several, e.g. non-physical and diverged), or ``other`` if none matches.
+    """
+    if not error:
+        return []
+    m = CRASH_PATTERN.match(error.strip())
+    if m:
+        return [f"crash: {m.group(1)}"]
+    found = [r for r in SCORED_REASONS if r in error]
+    return found or ["other"]
+
+
+def _judged(rows: list[dict[str, Any]]) -> list[bool]:
+    """Whether each row was held to thresholds.
+
+    A row is judged if its (scenario, identifier) pair has a non-empty ``checks`` list in some
+    cell.  A cell that crashed has no checks (it never got to scoring); it is judged if its
+    identifier is held to bars on any scenario of the results, so that a crash is never left
+    out of a pass rate (it counts as not passed).
+    """
+    pairs, idents = set(), set()
+    for r in rows:
+        try:
+            checks = json.loads(r.get("checks") or "[]")
+        except (TypeError, ValueError):
+            checks = []
+        if checks:
+            pairs.add((r["scenario"], r["identifier"]))
+            idents.add(r["identifier"])
+    return [(r["scenario"], r["identifier"]) in pairs
+            or (r["identifier"] in idents and any(k.startswith("crash")
+                                                  for k in failure_kind(r.get("error") or "")))
+            for r in rows]
+
+
+def summarize(path: str | os.PathLike, rows: list[dict[str, Any]] | None = None,
+              by: str = "identifier") -> list[dict[str, Any]]:
+    """Per (identifier, noise) statistics of a results file (or per scenario or family too).
 
     Parameters
     ----------
@@ -32,28 +96,48 @@ def summarize(path: str | os.PathLike, rows: list[dict[str, Any]] | None = None)
         are read too; a damaged row file is named in a warning and left out).
     rows : list of dict, optional
         Its rows as :func:`~testbed.studies.results.read_results` gave them (not read again).
+    by : {"identifier", "scenario", "family"}
+        Group per identifier and noise, or per scenario (or family: the family of a member,
+        the scenario itself otherwise) x identifier x noise.
 
     Returns
     -------
     list of dict
-        Sorted by identifier and noise.  Keys: ``identifier``, ``noise`` [%],
-        ``scenarios`` (comma-separated names), ``cells``, ``ok``, ``failed``,
-        ``pass_rate`` (passed / cells), and for every score ``<score>_median``,
-        ``<score>_q25``, ``<score>_q75`` and ``<score>_n`` (finite values used);
-        NaN where the group has no finite value of that score.
+        Sorted by the group keys.  Keys: ``identifier``, ``noise`` [%] (and ``scenario`` or
+        ``family``), ``scenarios`` (comma-separated names), ``cells``, ``ok``, ``failed``,
+        ``judged`` (cells held to thresholds), ``pass_rate`` (passed / judged; NaN if none is
+        judged), ``failures`` (dict: failure kind -> count, see :func:`failure_kind`), and for
+        every score ``<score>_median``, ``<score>_q25``, ``<score>_q75`` and ``<score>_n``
+        (finite values used); NaN where the group has no finite value of that score.
     """
+    if by not in BY:
+        raise ValueError(f"by must be one of {', '.join(BY)}, not {by!r}")
     rows = read_results(path) if rows is None else rows
     scores = score_columns(rows)
+    keys = BY[by] + GROUP_KEYS
+    judged_flags = {id(r): j for r, j in zip(rows, _judged(rows), strict=True)}
+
+    def value(r: dict[str, Any], k: str) -> Any:
+        return family_of(r["scenario"]) if k == "family" else r[k]
+
     groups: dict[tuple, list[dict[str, Any]]] = defaultdict(list)
     for r in rows:
-        groups[tuple(r[k] for k in GROUP_KEYS)].append(r)
+        groups[tuple(value(r, k) for k in keys)].append(r)
     out = []
     for key in sorted(groups):
         g = groups[key]
         ok = [r for r in g if r["status"] == "ok"]
-        s: dict[str, Any] = dict(zip(GROUP_KEYS, key, strict=True))
+        judged = [r for r in g if judged_flags[id(r)]]
+        failures: dict[str, int] = defaultdict(int)
+        for r in g:
+            for kind in failure_kind(r.get("error") or ""):
+                failures[kind] += 1
+        s: dict[str, Any] = dict(zip(keys, key, strict=True))
         s.update(scenarios=",".join(sorted({r["scenario"] for r in g})), cells=len(g), ok=len(ok),
-                 failed=len(g) - len(ok), pass_rate=sum(bool(r["passed"]) for r in g) / len(g))
+                 failed=len(g) - len(ok), judged=len(judged),
+                 pass_rate=(sum(bool(r["passed"]) for r in judged) / len(judged) if judged
+                            else math.nan),
+                 failures=dict(sorted(failures.items(), key=lambda kv: (-kv[1], kv[0]))))
         for m in scores:
             vals = np.array([r[m] for r in ok if r.get(m) is not None], dtype=float)
             vals = vals[np.isfinite(vals)]
@@ -73,12 +157,14 @@ def _fmt(x: float) -> str:
     return f"{x:.3g}"
 
 
-def print_summary(path: str | os.PathLike, console: Any = None) -> list[dict[str, Any]]:
+def print_summary(path: str | os.PathLike, console: Any = None,
+                  by: str = "identifier") -> list[dict[str, Any]]:
     """Print :func:`summarize` as rich tables and return its rows.
 
-    One table per identifier: a column per noise level, a row per score the
-    identifier reported (``median`` over ``[q25, q75]``), plus the cell count,
-    failures and pass rate; then the first errors of failed cells.
+    One table per identifier (per scenario or family and identifier with ``by``): a column
+    per noise level, a row per score the identifier reported (``median`` over
+    ``[q25, q75]``), plus the cell count, failures, pass rate (over judged cells) and the
+    failure reasons counted; then the first errors of failed cells.
     """
     from rich.console import Console
     from rich.table import Table
@@ -86,26 +172,33 @@ def print_summary(path: str | os.PathLike, console: Any = None) -> list[dict[str
     console = console or Console()
     path = Path(path)
     rows = read_results(path)
-    summary = summarize(path, rows)
+    summary = summarize(path, rows, by=by)
     if not rows:
         console.print(f"{path}: no results")
         return summary
     study = rows[0].get("study", "")
     console.print(f"study {study}: {len(rows)} cells from {path}; scores as median over "
-                  "[25th, 75th percentile] of the ok cells, pass rate over all cells",
+                  "[25th, 75th percentile] of the ok cells, pass rate over the cells held to "
+                  "thresholds (that identifier's own)",
                   highlight=False)
-    by_ident: dict[str, list[dict[str, Any]]] = defaultdict(list)
+    by_ident: dict[tuple, list[dict[str, Any]]] = defaultdict(list)
     for s in summary:
-        by_ident[s["identifier"]].append(s)
+        by_ident[(*(s[k] for k in BY[by]), s["identifier"])].append(s)
     metrics = score_columns(rows)
     for ident, group in by_ident.items():
         shown = [m for m in metrics if any(s[f"{m}_n"] for s in group)]
-        t = Table(title=f"{ident}  ({group[0]['scenarios']})", title_justify="left")
+        where = group[0]["scenarios"]
+        if len(where) > 60:
+            where = f"{len(where.split(','))} scenarios"
+        t = Table(title=f"{'  '.join(ident)}  ({where})", title_justify="left")
         t.add_column("")
         for s in group:
             t.add_column(f"noise {s['noise']:g} %", justify="right")
         t.add_row("cells (failed)", *(f"{s['cells']} ({s['failed']})" for s in group))
-        t.add_row("pass rate", *(f"{100 * s['pass_rate']:.0f} %" for s in group), end_section=True)
+        t.add_row("pass rate", *(f"{100 * s['pass_rate']:.0f} % of {s['judged']}"
+                                 if math.isfinite(s["pass_rate"]) else "no bars" for s in group))
+        t.add_row("failure reasons", *("\n".join(f"{k}: {n}" for k, n in s["failures"].items()) or "-"
+                                       for s in group), end_section=True)
         for m in shown:
             t.add_row(m, *(f"{_fmt(s[m + '_median'])}\n[{_fmt(s[m + '_q25'])}, {_fmt(s[m + '_q75'])}]"
                            for s in group))

@@ -16,6 +16,20 @@ A study is a TOML file in ``studies/``::
     rcond = 1e-8                        # [identify] table against the identifier's declared
                                         # hyperparameters
 
+    [thresholds.ls_sindy]               # optional bars for this identifier only, like a
+    trac_min = 0.9                      # scenario's [score] table
+
+    [families.beams]                    # optional: scenarios drawn from ranges
+    base = "cantilever_stiff_impact"    # (testbed.studies.family)
+    members = 50
+
+Thresholds per identifier: a cell of identifier ``m`` is held to ``[thresholds.m]`` when the
+study declares it; otherwise to its scenario's ``[score]`` only if that scenario's
+``[identify]`` names ``m`` (the bars were set for that method) or the scenario names no
+identifier (its bars are declared for whichever the study brings); otherwise to nothing (its
+verdict is "no verdict" and it counts in no pass rate).  An identifier is never held to bars
+set for another.  Family members carry no ``[score]`` of their own.
+
 The grid is every (scenario, noise, seed, identifier).  A combination whose
 identifier kind ("structural" / "mechanical") differs from the scenario rig's
 kind cannot be run (a structural identifier has no model of a linkage) and is
@@ -49,12 +63,14 @@ from testbed.pipeline.scenario import (
     Scenario,
     _check_stem,
     _validate_identify,
+    _validate_score,
     check_identifier_for_rig,
     load_scenario,
     read_toml_file,
     resolve_path,
     shipped_dir,
 )
+from testbed.studies.family import Family, family_members, parse_family, write_members
 
 #: Shipped study files, found by name (``$TESTBED_STUDIES`` overrides).
 STUDY_DIR = Path(os.environ.get("TESTBED_STUDIES", shipped_dir("studies")))
@@ -63,8 +79,9 @@ STUDY_SCHEMA = {
     "name": Field(str, doc="study name; must equal the file name without .toml",
                   pattern=NAME_PATTERN, pattern_doc=NAME_PATTERN_DOC),
     "description": Field(str, "", doc="one line for listings and reports"),
-    "scenarios": Field(list, item_type=str, min_items=1,
-                       doc="scenario names (in scenarios/) or .toml paths relative to the study file"),
+    "scenarios": Field(list, [], item_type=str,
+                       doc="scenario names (in scenarios/) or .toml paths relative to the study file "
+                           "(may be empty when the study declares [families.<name>])"),
     "noise": Field(list, item_type=float, min_items=1, min=0.0, max=100.0, unit="% of channel RMS",
                    doc="sensor-noise levels; each replaces the scenario's [noise] rms_percent"),
     "seeds": Field(list, item_type=int, min_items=1, min=0,
@@ -75,7 +92,7 @@ STUDY_SCHEMA = {
                          "before validation and in every worker; they register extra rigs or "
                          "identifiers"),
 }
-SECTIONS = ("study", "identifiers")
+SECTIONS = ("study", "identifiers", "families", "thresholds")
 
 
 @dataclass(frozen=True)
@@ -95,6 +112,10 @@ class Study:
         Hyperparameters per identifier (``{}`` where the study gives none).
     plugins : tuple of str
         Absolute paths or dotted module names, imported before any lookup.
+    thresholds : dict of str to dict
+        Bars per identifier (``{metric: {"min"|"max": value}}``); see the module docs.
+    families : tuple of Family
+        The declared families; their members are in ``scenarios`` (after the named ones).
     path : str, optional
         The study file.
     """
@@ -107,12 +128,26 @@ class Study:
     description: str = ""
     params: dict[str, dict[str, Any]] = field(default_factory=dict)
     plugins: tuple[str, ...] = ()
+    thresholds: dict[str, dict[str, dict[str, float]]] = field(default_factory=dict)
+    families: tuple[Family, ...] = ()
     path: str | None = field(default=None, compare=False)
 
     def combinations(self) -> list[tuple[Scenario, str]]:
-        """(scenario, identifier) pairs whose kinds agree, in study order."""
-        return [(sc, m) for sc in self.scenarios for m in self.identifiers
-                if _rig_kind(sc.rig) == _identifier_kind(m)]
+        """(scenario, identifier) pairs whose kinds agree, in study order.
+
+        Each scenario's ``score`` is the bars that identifier is held to
+        (:meth:`thresholds_for`), so a sweep judges every cell by its own identifier's bars.
+        """
+        return [(sc.replace(score=self.thresholds_for(sc, m)), m) for sc in self.scenarios
+                for m in self.identifiers if _rig_kind(sc.rig) == _identifier_kind(m)]
+
+    def thresholds_for(self, scenario: Scenario, identifier: str) -> dict[str, dict[str, float]]:
+        """The bars ``identifier`` is held to on ``scenario`` (see the module docs)."""
+        if identifier in self.thresholds:
+            return self.thresholds[identifier]
+        if scenario.identify is None or scenario.identify.get("method") == identifier:
+            return scenario.score
+        return {}
 
     def skipped(self) -> list[tuple[str, str, str]]:
         """(scenario, identifier, reason) of the pairs left out because the kinds differ."""
@@ -209,6 +244,12 @@ def study_from_dict(raw: dict[str, Any], *, file: str = "<dict>", base: Path | N
                            stem=stem)
     for key in ("scenarios", "noise", "seeds", "identifiers", "plugins"):
         _no_duplicates(head[key], file, f"study.{key}")
+    fam_table = raw.get("families", {})
+    if not isinstance(fam_table, dict):
+        raise ScenarioError(file, "families", fam_table, "expected tables [families.<name>]")
+    if not head["scenarios"] and not fam_table:
+        raise ScenarioError(file, "study.scenarios", [], "at least one scenario, or a "
+                                                          "[families.<name>] table")
 
     plugins = tuple(str((base / p).resolve()) if p.endswith(".py") else p for p in head["plugins"])
     for i, p in enumerate(plugins):
@@ -238,10 +279,15 @@ def study_from_dict(raw: dict[str, Any], *, file: str = "<dict>", base: Path | N
                                 "or a .toml path relative to the study file")
         scenarios.append(load_scenario(spath, standalone=False))  # bars for the study's identifiers
 
+    families = tuple(parse_family(n, t, file=file, base_dir=base) for n, t in fam_table.items())
+    for fam in families:
+        scenarios.extend(family_members(fam))
     params = _validate_params(raw.get("identifiers", {}), head["identifiers"], file)
+    thresholds = _validate_thresholds(raw.get("thresholds", {}), head["identifiers"], file)
     study = Study(name=head["name"], description=head["description"], scenarios=tuple(scenarios),
                   noise=tuple(head["noise"]), seeds=tuple(head["seeds"]),
-                  identifiers=tuple(head["identifiers"]), params=params, plugins=plugins, path=file)
+                  identifiers=tuple(head["identifiers"]), params=params, plugins=plugins,
+                  thresholds=thresholds, families=families, path=file)
     _check_grid(study, head, file)
     _check_cells(study, file)
     return study
@@ -262,6 +308,66 @@ def _check_cells(study: Study, file: str) -> None:
                                      file=file, section=f"identifiers.{m}")
         except ScenarioError as e:
             raise type(e)(file, e.key, e.value, f"{e.allowed} (for scenario {sc.name!r})") from None
+
+
+def _validate_thresholds(table: Any, identifiers: list[str],
+                         file: str) -> dict[str, dict[str, dict[str, float]]]:
+    """``[thresholds.<identifier>]`` tables, each checked like a scenario's ``[score]`` against the
+    scores of the identifier's kind."""
+    if not isinstance(table, dict):
+        raise ScenarioError(file, "thresholds", table, "expected tables [thresholds.<identifier>]")
+    out = {}
+    for name, sub in table.items():
+        key = f"thresholds.{name}"
+        if name not in identifiers:
+            raise ScenarioError(file, key, sub, "thresholds for an identifier not in "
+                                "study.identifiers; allowed: " + ", ".join(identifiers))
+        try:
+            out[name] = _validate_score(sub, _identifier_kind(name), file)
+        except ScenarioError as e:
+            k = (e.key or "").replace("score", key, 1)
+            raise ScenarioError(file, k, e.value, e.allowed) from None
+    return out
+
+
+def write_family(study: Study | str | os.PathLike, out_dir: str | os.PathLike,
+                 family: str | None = None) -> list[Path]:
+    """Write the members of a study's families as scenario files ``<out_dir>/<member>.toml``.
+
+    Parameters
+    ----------
+    study : Study or str or path
+        A loaded study, or its name / file (loaded with :func:`load_study`).
+    out_dir : path
+        Created if missing; files are written atomically.
+    family : str, optional
+        Only this family (default: every family of the study).
+
+    Returns
+    -------
+    list of Path
+        The written files, in family and member order.  Each reruns alone with
+        ``testbed run <file>`` (members carry their base's ``[identify]`` and, as ``[score]``,
+        the study's bars for that identifier, :meth:`Study.thresholds_for`) and reloads to a
+        Scenario equal to the member with those bars.
+
+    Raises
+    ------
+    ScenarioError
+        If the study declares no family (of that name).
+    """
+    st = study if isinstance(study, Study) else load_study(study)
+    fams = [f for f in st.families if family is None or f.name == family]
+    if not fams:
+        raise ScenarioError(str(st.path), "families", family,
+                            "a family of the study: " + (", ".join(f.name for f in st.families)
+                                                          or "(the study declares none)"))
+    names = {f.member_name(k) for f in fams for k in range(f.members)}
+    # each member carries the bars the study holds its own [identify] method to, so that it
+    # reruns alone with a verdict
+    return write_members([sc.replace(score=st.thresholds_for(sc, sc.identify["method"]))
+                          if sc.identify else sc
+                          for sc in st.scenarios if sc.name in names], out_dir)
 
 
 def _validate_params(table: Any, identifiers: list[str], file: str) -> dict[str, dict[str, Any]]:

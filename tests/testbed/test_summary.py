@@ -11,12 +11,17 @@ from rich.console import Console
 from testbed.studies.results import write_part, write_rows
 from testbed.studies.statistics import print_summary, summarize
 
+CHECKS = '[{"metric": "trac", "bound": "min", "threshold": 0.75}]'
 
-def row(cell, identifier, noise, seed, status="ok", passed=True, **scores):
-    return {"study": "t", "cell": cell, "scenario": "s", "rig": "r", "noise": noise, "seed": seed,
-            "identifier": identifier, "params": "{}", "status": status,
-            "error": "" if status == "ok" else "RuntimeError: diverged", "fit_time": 1.0,
-            "data_time": 0.0, "cell_time": 1.0, "passed": passed, "checks": "[]", "versions": "{}",
+
+def row(cell, identifier, noise, seed, status="ok", passed=True, scenario="s", checks=CHECKS,
+        error="RuntimeError: diverged (x.py:1)", **scores):
+    return {"study": "t", "cell": cell, "scenario": scenario, "rig": "r", "noise": noise,
+            "seed": seed, "identifier": identifier, "params": "{}", "status": status,
+            "error": "" if status == "ok" else error, "fit_time": 1.0,
+            "data_time": 0.0, "cell_time": 1.0, "passed": passed,
+            "checks": checks if "(x.py:1)" not in error or status == "ok" else "[]",  # a crash: none
+            "versions": "{}",
             "commit": "x", "dataset_hash": "h", **scores}
 
 
@@ -43,7 +48,7 @@ def test_median_iqr_and_pass_rate(tmp_path):
     out = buf.getvalue()
     assert "noise 1 %" in out and "60 %" in out and "5 (1)" in out
     assert f"{med:.3g}" in out and f"[{q25:.3g}, {q75:.3g}]" in out
-    assert "RuntimeError: diverged" in out
+    assert "RuntimeError: diverged" in out and "crash: RuntimeError: 1" in out
     pi_table = out[out.index("pi  (s)"):]
     assert "angle_rmse" in pi_table and "trac" not in pi_table.split("failed cell")[0]
 
@@ -52,3 +57,37 @@ def test_no_results(tmp_path):
     buf = io.StringIO()
     assert print_summary(tmp_path / "none.parquet", console=Console(file=buf, width=400)) == []
     assert "no results" in buf.getvalue()
+
+
+def test_pass_rate_only_against_own_bars_and_failure_reasons_by_family(tmp_path):
+    res = tmp_path / "r.parquet"
+    rows = [
+        # identifier "a" has bars on the members of family f: judged
+        row("a0", "a", 0.0, 0, scenario="f__000", passed=True, trac=0.95),
+        row("a1", "a", 0.0, 0, scenario="f__001", status="failed", passed=False,
+            error="unstable: pole with real part +3 1/s; diverged: blew up", trac=float("nan")),
+        row("a2", "a", 0.0, 0, scenario="f__002", passed=False, trac=0.5),
+        # identifier "b" was held to nothing: no pass rate, never a's bars
+        row("b0", "b", 0.0, 0, scenario="f__000", passed=False, checks="[]", trac=0.2),
+        row("b1", "b", 0.0, 0, scenario="f__001", status="failed", passed=False,
+            error="fit failed: singular", checks="[]", trac=float("nan")),
+        row("c0", "a", 0.0, 0, scenario="hand", passed=True, trac=0.99),
+        # a crash has no checks; it counts (as not passed) where its identifier is held to bars
+        row("a3", "a", 0.0, 0, scenario="f__003", status="failed", passed=False, trac=float("nan")),
+    ]
+    write_rows(res, rows)
+    s = {(x["identifier"], x["noise"]): x for x in summarize(res)}
+    assert s[("a", 0.0)]["judged"] == 5 and s[("a", 0.0)]["pass_rate"] == 2 / 5
+    assert s[("b", 0.0)]["judged"] == 0 and math.isnan(s[("b", 0.0)]["pass_rate"])
+    assert s[("a", 0.0)]["failures"] == {"crash: RuntimeError": 1, "diverged": 1, "unstable": 1}
+    assert s[("b", 0.0)]["failures"] == {"fit failed": 1}
+    fam = {(x["family"], x["identifier"]): x for x in summarize(res, by="family")}
+    assert set(fam) == {("f", "a"), ("f", "b"), ("hand", "a")}
+    assert fam[("f", "a")]["pass_rate"] == 1 / 4 and fam[("hand", "a")]["pass_rate"] == 1.0
+    per = {(x["scenario"], x["identifier"]) for x in summarize(res, by="scenario")}
+    assert ("f__001", "b") in per and len(per) == 7
+
+    buf = io.StringIO()
+    print_summary(res, console=Console(file=buf, width=120), by="family")
+    out = buf.getvalue()
+    assert "no bars" in out and "fit failed: 1" in out and "25 % of 4" in out
