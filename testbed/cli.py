@@ -284,7 +284,16 @@ def cmd_sweep(args: argparse.Namespace) -> int:
 def cmd_summary(args: argparse.Namespace) -> int:
     from testbed.studies.statistics import print_summary
 
-    print_summary(_results_file(Path(args.results)))
+    print_summary(_results_file(Path(args.results)), by=args.by)
+    return 0
+
+
+def cmd_family(args: argparse.Namespace) -> int:
+    from testbed.studies.study import load_study, write_family
+
+    paths = write_family(load_study(args.study), Path(args.out), family=args.family)
+    print(f"wrote {len(paths)} member scenario(s) to {args.out}; rerun one with "
+          f"`testbed run {paths[0] if paths else args.out}`")
     return 0
 
 
@@ -451,7 +460,17 @@ def build_parser() -> argparse.ArgumentParser:
 
     sm = sub.add_parser("summary", help="median, spread and pass rate per identifier and noise level")
     sm.add_argument("results", help="results file of a sweep")
+    sm.add_argument("--by", choices=("identifier", "scenario", "family"), default="identifier",
+                    help="group rows per identifier (default), per scenario or per family, "
+                         "each x identifier x noise")
     sm.set_defaults(fn=cmd_summary)
+
+    fam = sub.add_parser("family", help="write the members of a study's scenario families")
+    fam.add_argument("action", choices=("write",), help="write: one scenario file per member")
+    fam.add_argument("study", help="study name or .toml path declaring [families.<name>]")
+    fam.add_argument("-o", "--out", required=True, help="folder for the member scenario files")
+    fam.add_argument("--family", help="only this family (default: every family of the study)")
+    fam.set_defaults(fn=cmd_family)
 
     c = sub.add_parser("cache", help="list or clear the dataset cache")
     c.add_argument("action", choices=("ls", "clear"), help="ls: list the datasets; clear: delete them")
