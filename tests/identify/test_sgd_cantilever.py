@@ -59,6 +59,8 @@ def test_stiff_targets_at_reduced_budget(stiff):
     model = SGDSINDy(epochs=20).fit(data)
     assert model.n_steps_ == 2000
     v = score_structural(ds, data, clean, model).values
-    assert v["trac"] >= 0.95 and v["mac"] >= 0.95 and v["freq_error"] <= 0.01
+    # the targets are the paper's modes 1-2 (mode 3 is scored and reported too)
+    assert v["trac"] >= 0.95 and min(v["mac_mode1"], v["mac_mode2"]) >= 0.95
+    assert max(v["freq_error_mode1"], v["freq_error_mode2"]) <= 0.01
     assert np.all(np.linalg.eigvalsh(model.M_) > 0)  # symmetric positive definite by construction
     np.testing.assert_allclose(np.trace(model.M_), data.prior["reduced_mass_trace"], rtol=1e-12)
