@@ -463,6 +463,20 @@ def _read_hdf5(path: Path) -> _Raw:
             raw.data[name], raw.units[name] = s.data[i], s.unit
             if s.positions is not None:
                 raw.positions[name] = float(s.positions[i])
+    # inputs that declare the coordinates they act on (Signal.acts_on) keep that, as node
+    # numbers the way a UFF file states it: a coordinate channel and the inputs driving it share
+    # a node, which ImportedData.to_dataset turns back into acts_on
+    driven = {g: s for g, s in ds.measured.items() if s.acts_on}
+    if driven:
+        node: dict[str, int] = {}
+        for g, s in ds.measured.items():
+            if g not in driven:
+                for ch in s.channels:
+                    raw.nodes[f"{g}/{ch}"] = node.setdefault(ch, len(node) + 1)
+        for g, s in driven.items():
+            for ch, target in zip(s.channels, s.acts_on, strict=True):
+                if target in node:
+                    raw.nodes[f"{g}/{ch}"] = node[target]
     return raw
 
 
