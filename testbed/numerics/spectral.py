@@ -119,68 +119,28 @@ def peak_frequencies(x: np.ndarray, fs: float, n_peaks: int, fmin: float = 0.0,
     rules, so use it only for transients that decay within the record.  Asking for more peaks
     than the signal has modes returns noise peaks or side lobes, or raises.
     """
-    x = np.atleast_2d(np.asarray(x, dtype=float))
-    n = x.shape[-1]
     n_peaks = int(n_peaks)
     if n_peaks < 1:
         raise ValueError(f"n_peaks must be >= 1, got {n_peaks}")
     if int(pad) < 1:
         raise ValueError(f"pad must be >= 1, got {pad}")
-    nyq = fs / 2.0
-    fmax = nyq if fmax is None else float(fmax)
-    if not 0.0 <= fmin < fmax <= nyq:
-        raise ValueError(f"need 0 <= fmin < fmax <= Nyquist ({nyq:g} Hz), got fmin={fmin}, fmax={fmax}")
-    from scipy import signal as ss  # lazy: scipy.signal costs ~0.7 s of import
-
-    w = ss.get_window(window, n, fftbins=True)
-    nfft = sfft.next_fast_len(int(pad) * n, real=True)
-    power = (np.abs(sfft.rfft((x - x.mean(axis=-1, keepdims=True)) * w, n=nfft, axis=-1)) ** 2).sum(0)
-    freqs = sfft.rfftfreq(nfft, 1.0 / fs)
-    floor = power.max() * 1e-30 if power.max() > 0 else 1e-300
-    db = 10.0 * np.log10(power + floor)
-    band = np.flatnonzero((freqs >= fmin) & (freqs <= fmax))
-    if band.size < 3:
-        raise ValueError(f"band [{fmin}, {fmax}] Hz holds fewer than 3 spectral lines")
-    lo, hi = band[0], band[-1] + 1
-    lobe = (_MAIN_LOBE_BINS.get(window, 2.0) + 2.0) * nfft / n
-    idx, _ = ss.find_peaks(db[lo:hi], prominence=min_prominence_db, distance=max(1.0, lobe))
-    idx = idx + lo
-    if idx.size:
-        idx = idx[db[idx] >= db[idx].max() - dynamic_range_db]
-    if idx.size < n_peaks:
-        raise ValueError(f"found {idx.size} spectral peak(s) with prominence >= {min_prominence_db} dB "
-                         f"within {dynamic_range_db} dB of the highest in [{fmin:g}, {fmax:g}] Hz, "
+    freqs, _ = peak_candidates(x, fs, fmin, fmax, window, pad, min_prominence_db, dynamic_range_db,
+                               min_rel_separation)
+    if freqs.size < n_peaks:
+        sep = f", at least {min_rel_separation:.0%} apart," if min_rel_separation > 0 else ""
+        hi = fs / 2.0 if fmax is None else fmax
+        raise ValueError(f"found {freqs.size} spectral peak(s) with prominence >= {min_prominence_db} dB "
+                         f"within {dynamic_range_db} dB of the highest{sep} in [{fmin:g}, {hi:g}] Hz, "
                          f"asked for {n_peaks}")
-    if min_rel_separation > 0 and idx.size:
-        # One mode of a nonlinear structure sweeps in frequency as its amplitude decays and its
-        # peak smears into neighbours: keep only the highest peak within the relative band.
-        kept: list[int] = []
-        for k in idx[np.argsort(power[idx])[::-1]]:
-            if all(abs(freqs[k] - freqs[j]) > min_rel_separation * freqs[j] for j in kept):
-                kept.append(k)
-        idx = np.sort(np.asarray(kept))
-        if idx.size < n_peaks:
-            raise ValueError(f"found {idx.size} spectral peak(s) at least {min_rel_separation:.0%} apart in "
-                             f"[{fmin:g}, {fmax:g}] Hz, asked for {n_peaks}")
-    chosen = idx[np.argsort(power[idx])[::-1][:n_peaks]]
-    df = freqs[1] - freqs[0]
-    out = np.empty(n_peaks)
-    for i, k in enumerate(chosen):
-        if 0 < k < len(db) - 1:
-            a, b, c = db[k - 1], db[k], db[k + 1]
-            den = a - 2.0 * b + c
-            p = 0.5 * (a - c) / den if den != 0 else 0.0
-            out[i] = freqs[k] + float(np.clip(p, -0.5, 0.5)) * df
-        else:
-            out[i] = freqs[k]
-    return np.sort(out)
+    return np.sort(freqs[:n_peaks])  # candidates come strongest first
 
 
 def peak_candidates(x: np.ndarray, fs: float, fmin: float = 0.0, fmax: float | None = None,
                     window: str = "boxcar", pad: int = 4, min_prominence_db: float = 6.0,
                     dynamic_range_db: float = 40.0, min_rel_separation: float = 0.0
                     ) -> tuple[np.ndarray, np.ndarray]:
-    """Every spectral peak :func:`peak_frequencies` would choose from, with its power.
+    """Every spectral peak :func:`peak_frequencies` chooses from, with its power (the one
+    implementation of the peak rules: that function takes the strongest of these).
 
     Parameters
     ----------
