@@ -45,15 +45,13 @@ scenario's method, so a study fails at load, not in its hundredth cell.
 
 from __future__ import annotations
 
-import importlib
-import importlib.util
 import os
-import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from testbed.core.errors import ScenarioError
+from testbed.core.registry import import_plugin
 from testbed.core.schema import Field, validate_header
 from testbed.pipeline.plugins import IDENTIFIERS, RIGS
 from testbed.pipeline.scenario import (
@@ -171,30 +169,11 @@ def _identifier_kind(name: str) -> str:
 
 
 def import_plugins(plugins: tuple[str, ...] | list[str]) -> None:
-    """Import each plugin once (a dotted module name, or a ``.py`` file path).
-
-    A file is imported under a module name derived from its absolute path, so
-    importing it again (in the same process) is a no-op and its registrations
-    run once.
-    """
+    """Import each plugin once (a dotted module name, or a ``.py`` file path): the one
+    importer, :func:`testbed.core.registry.import_plugin` (a file is imported under a module
+    name derived from its absolute path, so its registrations run once per process)."""
     for p in plugins:
-        if not p.endswith(".py"):
-            importlib.import_module(p)
-            continue
-        path = Path(p).resolve()
-        modname = "_testbed_plugin_" + "".join(c if c.isalnum() else "_" for c in str(path))
-        if modname in sys.modules:
-            continue
-        spec = importlib.util.spec_from_file_location(modname, path)
-        if spec is None or spec.loader is None:
-            raise ImportError(f"cannot import plugin {p}")
-        module = importlib.util.module_from_spec(spec)
-        sys.modules[modname] = module
-        try:
-            spec.loader.exec_module(module)
-        except BaseException:
-            del sys.modules[modname]
-            raise
+        import_plugin(p)
 
 
 def resolve_study_path(name_or_path: str | os.PathLike) -> Path:
