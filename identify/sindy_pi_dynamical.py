@@ -18,9 +18,12 @@ Rational right-hand sides come through the implicit form: Michaelis-Menten
 
 Selection: one implicit equation per state k, among the models whose ``d<state k>`` terms
 carry a larger normalised coefficient than every other state's derivative terms
-(:func:`identify._implicit.select_models` with the derivative columns in the role of the
+(:func:`select_equations`: the rule of :func:`identify._implicit.select_models` with the
+derivative columns in the role of the
 inputs): smallest held-out error, then fewest terms within tolerance of the best, then the
-declared tie rule.  The held-out part is the last ``val_fraction`` of the record.
+declared tie rule.  A model whose terms share a factor (``x * (law) = 0``) is first divided by it
+(:func:`reduce_common_factors`); one whose quotient leaves the library is not eligible.  The
+held-out part is the last ``val_fraction`` of the record.
 
 Weak form (``formulation="weak"``): the rows are integrals of the library against the compact
 test functions of :mod:`identify._weak` (``(1 - s^2)^p`` over ``weak_window_s``), and a term
@@ -215,6 +218,58 @@ def common_factor(W: np.ndarray, lib: ImplicitTerms) -> np.ndarray:
     return (np.where(low == big, 0, low) > 0).any(axis=-1)
 
 
+def reduce_common_factors(sw: Sweep, lib: ImplicitTerms, G_train: np.ndarray,
+                          G_val: np.ndarray) -> Sweep:
+    """The sweep with every model whose terms share a monomial factor divided by it.
+
+    ``x * (Km dx + x dx - jx Km + (Vmax - jx) x) = 0`` is the Michaelis-Menten law times ``x``:
+    the same law away from ``x = 0``.  When the library holds both, on any trajectory the
+    equations of the library form a space of dimension two or more, and the sweep may find the
+    multiple and not the law.  Each such model is replaced by its quotient (every term's powers
+    lowered by the common ones) when the library holds every quotient term, with its held-out
+    and training errors recomputed from the Gram matrices; the left-hand side (its column
+    normalised to 1) is the quotient of the original one.  A model whose quotient leaves the
+    library is kept as it is (and stays ineligible, :func:`select_equations`).
+
+    Parameters
+    ----------
+    sw : Sweep
+    lib : ImplicitTerms
+    G_train, G_val : ndarray, shape (p, p)
+        The Gram matrices the sweep was run on (original units).
+
+    Returns
+    -------
+    Sweep
+        A new sweep (``sw`` is not modified).
+    """
+    index = {(tuple(lib.powers[j]), int(lib.deriv[j])): j for j in range(len(lib.names))}
+    s = sw.scale
+    Gn, Gv = G_train / np.outer(s, s), G_val / np.outer(s, s)
+    W = sw.W.copy()
+    val, train = sw.val_error.copy(), sw.train_error.copy()
+    reducible = common_factor(W, lib)
+    for t, c in zip(*np.nonzero(reducible), strict=True):
+        w = W[t, c]
+        nz = np.flatnonzero(w)
+        low = lib.powers[nz].min(axis=0)
+        target = [index.get((tuple(lib.powers[j] - low), int(lib.deriv[j]))) for j in nz]
+        lhs = index.get((tuple(lib.powers[sw.candidates[c]] - low), int(lib.deriv[sw.candidates[c]])))
+        if any(j is None for j in target) or lhs is None:
+            continue
+        w_orig = np.zeros_like(w)
+        w_orig[np.array(target)] = w[nz] / s[nz]
+        wn = w_orig * s
+        if wn[lhs] == 0.0:
+            continue
+        wn = wn / wn[lhs]
+        W[t, c] = wn
+        val[t, c] = max(float(wn @ Gv @ wn), 0.0) / Gv[lhs, lhs] if Gv[lhs, lhs] > 0 else np.inf
+        train[t, c] = max(float(wn @ Gn @ wn), 0.0) / Gn[lhs, lhs] if Gn[lhs, lhs] > 0 else np.inf
+    return Sweep(scale=s, candidates=sw.candidates, thresholds=sw.thresholds, W=W,
+                 val_error=val, train_error=train, nnz=np.count_nonzero(W, axis=2))
+
+
 def select_equations(sw: Sweep, lib: ImplicitTerms, deriv_cols: list[np.ndarray], rtol: float,
                      atol: float) -> list[tuple[int, int]]:
     """The (threshold, candidate) model of each state's equation.
@@ -222,7 +277,8 @@ def select_equations(sw: Sweep, lib: ImplicitTerms, deriv_cols: list[np.ndarray]
     Eligible for state k: models whose ``d<state k>`` terms carry a larger normalised
     coefficient than every other state's derivative terms (so the equations of different
     states are distinct and each can be solved for its own derivative) and whose terms share
-    no common factor (:func:`common_factor`: the reduced equation is the same law).  Ranked by
+    no common factor (:func:`common_factor`; :func:`reduce_common_factors` has divided it out
+    wherever the library holds the quotient).  Ranked by
     :func:`identify._implicit.rank_models` (held-out error, then fewest terms within
     tolerance, then the declared tie rule).
 
@@ -407,7 +463,8 @@ class SINDyPIDynamical(Identifier):
                 raise IdentificationError(f"lhs term {unknown[0]!r} is not in the library")
             cand = np.array([lib.names.index(t) for t in self.lhs])
         thr = DEFAULT_THRESHOLDS if self.thresholds is None else np.asarray(self.thresholds)
-        sw = stlsq_sweep(G_train, G_val, cand, thr, self.ridge, self.max_iter)
+        sw = reduce_common_factors(stlsq_sweep(G_train, G_val, cand, thr, self.ridge,
+                                               self.max_iter), lib, G_train, G_val)
         deriv_cols = [np.flatnonzero(lib.deriv == k) for k in range(n_states)]
         for k, cols in enumerate(deriv_cols):
             if cols.size == 0:

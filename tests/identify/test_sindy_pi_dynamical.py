@@ -46,6 +46,18 @@ def test_clean_michaelis_menten_recovers_the_implicit_equation(mm):
     assert cmp["coef_error"] < 1e-8  # exact data: round-off, not a tolerance of the method
 
 
+@pytest.mark.parametrize("degree", [2, 3])
+def test_the_default_library_finds_the_law_not_its_multiples(mm, degree):
+    # with x^k*dx in the library, x*(law) = 0 is exact as well; reduce_common_factors divides
+    # the factor out, so the law itself comes back
+    ds, data = mm
+    model = SINDyPIDynamical(degree=degree).fit(data)
+    assert "x^2*dx" in model.feature_names_
+    cmp = compare_implicit(model.feature_names_, model.coef_, ds.truth["equation_terms"],
+                           np.asarray(ds.truth["equation_coef"]))
+    assert cmp["f1"] == 1.0 and cmp["coef_error"] < 1e-8
+
+
 def test_a_library_without_the_states_derivative_is_refused(mm):
     _, data = mm
     with pytest.raises(IdentificationError, match="no term with dx"):
