@@ -16,14 +16,14 @@ Rational right-hand sides come through the implicit form: Michaelis-Menten
 ``dx = jx - Vmax x / (Km + x)`` is ``Km dx + x dx - jx Km + (Vmax - jx) x = 0`` in the terms
 ``{dx, x*dx, 1, x}``.
 
-Selection: one implicit equation per state k, among the models whose ``d<state k>`` terms
-carry a larger normalised coefficient than every other state's derivative terms
+Selection: one implicit equation per state k, among the models whose ``d<state k>`` terms carry
+a larger normalised coefficient than every other state's derivative terms
 (:func:`select_equations`: the rule of :func:`identify._implicit.select_models` with the
-derivative columns in the role of the
-inputs): smallest held-out error, then fewest terms within tolerance of the best, then the
-declared tie rule.  A model whose terms share a factor (``x * (law) = 0``) is first divided by it
-(:func:`reduce_common_factors`); one whose quotient leaves the library is not eligible.  The
-held-out part is the last ``val_fraction`` of the record.
+derivative columns in the role of the inputs): smallest held-out error, then fewest terms
+within tolerance of the best, then the declared tie rule. A model whose terms share a factor
+(``x * (law) = 0``) is first divided by it (:func:`reduce_common_factors`); one whose quotient
+leaves the library is not eligible. The held-out part is the last ``val_fraction`` of the
+record.
 
 Weak form (``formulation="weak"``): the rows are integrals of the library against the compact
 test functions of :mod:`identify._weak` (``(1 - s^2)^p`` over ``weak_window_s``), and a term
