@@ -43,6 +43,16 @@ METRICS: dict[str, dict[str, str]] = {
                              ("full_library", "the full 'fivebar_full' library"))
            for score in ("coef_error", "support_f1")},
     },
+    "dynamical": {
+        "state_rmse": "largest state RMSE [unit of the state] of the identified model simulated "
+                      "from the true initial state, against the noise-free states",
+        "coef_error": "largest relative error of the true terms' coefficients (equations "
+                      "compared up to scale: both divided by their coefficient on the true "
+                      "equation's largest term)",
+        "support_precision": "precision of the identified nonzero pattern (terms matched by name)",
+        "support_recall": "recall of the identified nonzero pattern",
+        "support_f1": "F1 of the identified nonzero pattern",
+    },
 }
 
 #: Per-mode structural scores ``<score>_mode<k>`` for k = 1 .. MAX_MODE_SCORES: a scenario may

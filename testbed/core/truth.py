@@ -7,7 +7,9 @@ their units and shapes is declared here, one dataclass per kind, so that the rea
 
 * :class:`StructuralTruth`: M, C, K, modes and their reduction to the sensors;
 * :class:`MechanicalTruth`: the implicit equations of motion, the initial state, the
-  physical parameters.
+  physical parameters;
+* :class:`DynamicalTruth`: the implicit first-order equations of a state-space system, its
+  state names, initial state and parameters.
 
 ``Dataset.truth`` stays the plain mapping (the stored format and every reader by key are
 unchanged); :meth:`Truth.from_dict` validates such a mapping (missing, unknown and
@@ -32,7 +34,7 @@ import numpy as np
 
 from testbed.core.errors import TestbedError
 
-__all__ = ["TRUTH_TYPES", "MechanicalTruth", "StructuralTruth", "Truth", "TruthError",
+__all__ = ["TRUTH_TYPES", "DynamicalTruth", "MechanicalTruth", "StructuralTruth", "Truth", "TruthError",
            "register_truth", "truth_type"]
 
 
@@ -320,3 +322,45 @@ class MechanicalTruth(Truth):
     link_com: np.ndarray | None = _f(("l",), "m", "centre-of-mass distances", required=False)
     joint_damping: np.ndarray | None = _f(("d",), "N m s/rad", "joint damping", required=False)
     gravity: np.ndarray | None = _f((), "m/s^2", "gravitational acceleration", required=False)
+
+
+@register_truth
+@dataclass(frozen=True)
+class DynamicalTruth(Truth):
+    """Truth of a dynamical rig: first-order ODEs ``dx/dt = f(x, u)`` as implicit equations.
+
+    Symbols: ``n`` states, ``q`` equations (one per state, row i the equation of state i),
+    ``t`` true terms, ``k`` parameters.  A term is a product of factors (:mod:`testbed.core.terms`
+    syntax) over the state names, their time derivatives spelt ``d<state>`` (``dx`` for
+    ``x``) and input names; ``1`` is the constant term.  Each equation is linear in the
+    derivatives, e.g. Michaelis-Menten ``(Km + x) dx - jx (Km + x) + Vmax x = 0``.
+
+    Attributes
+    ----------
+    equation_terms : list of str, length t
+        Names of the true terms.
+    equation_coef : ndarray, shape (q, t)
+        Coefficients, each row divided by its largest-magnitude entry [-] (an implicit
+        equation holds up to scale).
+    state_names : list of str, length n
+        Names of the states, as the measured ``"x"`` signal names its channels.
+    x0 : ndarray, shape (n,)
+        Initial state [unit of each state] (the scorer starts the identified model there).
+    parameter_names : list of str, length k
+        Names of the physical parameters the equations were derived from.
+    parameter_values : ndarray, shape (k,)
+        Their values [units as the rig's schema states them].
+    equation_scale : ndarray, shape (q,), optional
+        The divisor of each row [unit of the rig's equation].
+    """
+
+    kind: ClassVar[str] = "dynamical"
+
+    equation_terms: list[str] = _f(("t",), "", "names of the true terms", text=True)
+    equation_coef: np.ndarray = _f(("q", "t"), "1 (row max |coef| = 1)", "normalised coefficients")
+    state_names: list[str] = _f(("n",), "", "names of the states", text=True)
+    x0: np.ndarray = _f(("n",), "unit of each state", "initial state")
+    parameter_names: list[str] = _f(("k",), "", "names of the physical parameters", text=True)
+    parameter_values: np.ndarray = _f(("k",), "as the rig schema", "values of the parameters")
+    equation_scale: np.ndarray | None = _f(("q",), "unit of the equation", "row divisors",
+                                           required=False)

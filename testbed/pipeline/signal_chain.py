@@ -81,6 +81,16 @@ MECHANICAL_SIGNAL_SCHEMA: dict[str, Field] = {
                             doc="'lowpass': order of the end-window polynomial fits"),
 }
 
+DYNAMICAL_SIGNAL_SCHEMA: dict[str, Field] = {
+    "derivatives": Field(str, "recorded", choices=("recorded", "estimated"),
+                         doc="use the recorded state derivatives ('dx'), or estimate them from "
+                             "the measured states by a Savitzky-Golay filter (window, "
+                             "polyorder), which also smooths the states"),
+    "window": Field(int, 21, min=5, doc="Savitzky-Golay window [samples] for estimated "
+                                        "derivatives (odd)"),
+    "polyorder": Field(int, 3, min=2, max=8, doc="Savitzky-Golay polynomial order"),
+}
+
 
 def _filter_min_samples(order: int) -> int:
     """Fewest samples a zero-phase filter of this order (one pass) accepts: its second-order
@@ -437,7 +447,62 @@ def measure_mechanical(dataset: Dataset, cfg: Mapping[str, Any]) -> Measurement:
     return Measurement(fs=fs, x=x, xd=xd, xdd=xdd, channels=channels, u=torque,
                        inputs=tuple(t_sig.channels), input_map=input_map, prior=dict(dataset.prior))
 
+
+def check_dynamical(cfg: Mapping[str, Any], fs: float, n_samples: int, error: ErrorFn) -> None:
+    """:func:`check_signal` of the dynamical chain."""
+    if cfg["window"] % 2 == 0:
+        error("signal.window", cfg["window"], "expected an odd number of samples")
+    if not cfg["polyorder"] < cfg["window"]:
+        error("signal.polyorder", cfg["polyorder"], f"expected below window ({cfg['window']})")
+    if cfg["derivatives"] == "estimated" and cfg["window"] > n_samples:
+        error("signal.window", cfg["window"], f"expected at most the record's {n_samples} samples")
+
+
+def measure_dynamical(dataset: Dataset, cfg: Mapping[str, Any]) -> Measurement:
+    """States and their time derivatives, and the inputs if any.
+
+    Parameters
+    ----------
+    dataset : Dataset
+        Measured ``"x"`` (n_states x n [unit of each state]), optionally ``"dx"`` (the
+        recorded derivatives, same rows [unit / s]) and ``"input"`` (n_inputs x n).
+    cfg : mapping
+        A validated ``SIGNAL_SCHEMAS["dynamical"]`` table.  ``derivatives = "recorded"`` uses
+        ``"dx"``; ``"estimated"`` smooths and differentiates the states with a Savitzky-Golay
+        filter (:func:`testbed.numerics.derivatives.differentiate`) and ignores ``"dx"``.
+
+    Returns
+    -------
+    Measurement
+        ``x`` the states (smoothed when estimated), ``xd`` their derivatives, ``xdd`` the
+        second derivatives (recorded: central differences of ``dx``, ``numpy.gradient``; a
+        first-order identifier does not use them), channels named as the data name them,
+        ``u`` / ``inputs`` the inputs (None / () for an autonomous system), ``prior`` a copy.
+
+    Raises
+    ------
+    ValueError
+        A missing signal or row counts that disagree.
+    """
+    fs = float(dataset.fs)
+    x = _get(dataset, "x")
+    n = x.shape[0]
+    channels = tuple(dataset.measured["x"].channels)
+    if cfg["derivatives"] == "recorded":
+        xd = _get(dataset, "dx", n)
+        xdd = np.gradient(xd, 1.0 / fs, axis=1)
+    else:
+        x, xd, xdd = derivatives.differentiate(x, fs, cfg["window"], cfg["polyorder"])
+    u, inputs = None, ()
+    if "input" in dataset.measured:
+        u, inputs = _get(dataset, "input"), tuple(dataset.measured["input"].channels)
+    return Measurement(fs=fs, x=x, xd=xd, xdd=xdd, channels=channels, u=u, inputs=inputs,
+                       prior=dict(dataset.prior))
+
+
 register_signal_chain(SignalChain("structural", STRUCTURAL_SIGNAL_SCHEMA, measure_structural,
                                   check_structural))
 register_signal_chain(SignalChain("mechanical", MECHANICAL_SIGNAL_SCHEMA, measure_mechanical,
                                   check_mechanical))
+register_signal_chain(SignalChain("dynamical", DYNAMICAL_SIGNAL_SCHEMA, measure_dynamical,
+                                  check_dynamical))

@@ -16,6 +16,7 @@ from testbed.core.dataset import Dataset
 from testbed.core.errors import DivergenceError, IdentificationError
 from testbed.core.kinds import MAX_MODE_SCORES, METRICS
 from testbed.core.measurement import Measurement, Trajectory
+from testbed.core.terms import canonical
 from testbed.scoring import metrics
 from testbed.scoring.equation_basis import compare_equations
 from testbed.scoring.metrics import worst
@@ -550,3 +551,115 @@ def score_mechanical(dataset: Dataset, data: Measurement, clean: Measurement, mo
 
 register_scorer("structural", score_structural)
 register_scorer("mechanical", score_mechanical)
+
+
+def compare_implicit(names_id: list[str], coef_id: np.ndarray, names_true: list[str],
+                     coef_true: np.ndarray) -> dict[str, Any]:
+    """Identified vs true implicit equations, term by term (names matched canonically), up to
+    scale.
+
+    Row i of each is the equation of state i.  Both rows are divided by their coefficient on
+    the true row's largest-magnitude term (an implicit equation holds up to a factor); an
+    identified row without that term cannot be put on the truth's scale and its coefficient
+    error is infinite.  Term names are compared by :func:`testbed.core.terms.canonical`
+    (``dx*x`` is ``x*dx``).
+
+    Parameters
+    ----------
+    names_id, names_true : list of str
+        Term names of the identified and true coefficient columns.
+    coef_id : ndarray, shape (q, p)
+    coef_true : ndarray, shape (q, t)
+
+    Returns
+    -------
+    dict
+        ``names`` (union, true terms first), ``coef_true`` / ``coef_id`` (q, len(names)) on
+        the truth's scale, ``coef_errors`` (q, t) relative errors of the true terms,
+        ``coef_error`` their largest, ``precision``, ``recall``, ``f1`` of the nonzero
+        patterns over every (equation, term) pair.
+    """
+    def canon(names: list[str]) -> list[str]:
+        return [canonical(n)[0] for n in names]
+
+    c_true, c_id = canon(list(names_true)), canon(list(names_id))
+    sign_true = np.array([canonical(n)[1] for n in names_true], dtype=float)
+    sign_id = np.array([canonical(n)[1] for n in names_id], dtype=float)
+    names = list(dict.fromkeys(c_true + c_id))
+    q = coef_true.shape[0]
+    T = np.zeros((q, len(names)))
+    ID = np.zeros((q, len(names)))
+    for j, n in enumerate(c_true):
+        T[:, names.index(n)] += coef_true[:, j] * sign_true[j]
+    for j, n in enumerate(c_id):
+        ID[:q, names.index(n)] += coef_id[:q, j] * sign_id[j]
+    tj = [names.index(n) for n in c_true]
+    errors = np.full((q, len(c_true)), np.inf)
+    for i in range(q):
+        big = int(np.argmax(np.abs(T[i])))
+        T[i] = T[i] / T[i, big]
+        if ID[i, big] != 0.0:
+            ID[i] = ID[i] / ID[i, big]
+            with np.errstate(divide="ignore", invalid="ignore"):
+                errors[i] = np.abs(ID[i, tj] - T[i, tj]) / np.abs(T[i, tj])
+    true_nz, id_nz = T != 0.0, ID != 0.0
+    tp = float(np.sum(true_nz & id_nz))
+    precision = tp / max(float(np.sum(id_nz)), 1.0)
+    recall = tp / max(float(np.sum(true_nz)), 1.0)
+    f1 = 0.0 if tp == 0.0 else 2 * precision * recall / (precision + recall)
+    scored = errors[T[:, tj] != 0.0]  # the true terms of each row
+    return {"names": names, "coef_true": T, "coef_id": ID, "coef_errors": errors,
+            "coef_error": float(scored.max()) if scored.size else float("nan"),
+            "precision": precision, "recall": recall, "f1": f1}
+
+
+def score_dynamical(dataset: Dataset, data: Measurement, clean: Measurement, model: Any) -> Scores:
+    """State RMSE of the free simulation, and the implicit equations' coefficients and support.
+
+    ``state_rmse``: the identified model (``model.simulate``) is integrated from the true
+    initial state (truth ``x0``) under the measured inputs for the whole record; the largest
+    per-state RMSE against the noise-free recorded states.  A simulation that raises
+    :class:`~testbed.core.errors.DivergenceError` (e.g. a singular coefficient of the
+    derivatives), turns non-finite or blows up is a failure with its reason and NaN RMSE.
+
+    Coefficients (:func:`compare_implicit`): rows paired by state, compared up to scale on
+    the identifier's term names (``model.feature_names_``) against the truth's
+    (``equation_terms`` / ``equation_coef``).
+    """
+    x_ref = np.asarray(dataset.reference.get("x", dataset.measured["x"]).data, dtype=float)
+    x0 = np.asarray(dataset.truth["x0"], dtype=float)
+    t = np.arange(data.n_samples) / data.fs
+    failures: dict[str, str] = {}
+    coef = np.asarray(model.coef_, dtype=float)
+    d: dict[str, Any] = {"t": t, "reference_x": x_ref, "channels": data.channels}
+    sim = None
+    if not np.all(np.isfinite(coef)):
+        failures["model"] = "non-physical: identified coefficients hold non-finite entries"
+    else:
+        sim, why, when = simulate_scored(lambda: model.simulate(x0, None, t, data.u), t, "x", x_ref)
+        if why is not None:
+            failures["simulation"] = why
+            d["divergence_time"] = when
+    sim_x = sim.x if sim is not None else np.full_like(x_ref, np.nan)
+    rmse = (metrics.rmse(x_ref, sim_x) if sim is not None and "simulation" not in failures
+            else np.full(x_ref.shape[0], np.nan))
+    v: dict[str, float] = {"state_rmse": worst(rmse, "max")}
+    d.update(state_rmse=rmse, simulated_x=sim_x)
+    if "model" in failures:
+        v.update(coef_error=float("nan"), support_precision=float("nan"),
+                 support_recall=float("nan"), support_f1=float("nan"))
+        return Scores(v, d, failures)
+    cmp = compare_implicit(list(model.feature_names_), coef, list(dataset.truth["equation_terms"]),
+                           np.asarray(dataset.truth["equation_coef"], dtype=float))
+    v["coef_error"] = cmp["coef_error"]
+    v["support_precision"], v["support_recall"], v["support_f1"] = (
+        cmp["precision"], cmp["recall"], cmp["f1"])
+    errs = np.where(np.asarray(cmp["coef_true"])[:, [cmp["names"].index(canonical(n)[0])
+                                                     for n in dataset.truth["equation_terms"]]]
+                    != 0.0, cmp["coef_errors"], 0.0)
+    d.update(terms=cmp["names"], coef_true=cmp["coef_true"], coef_id=cmp["coef_id"],
+             coef_term_errors=cmp["coef_errors"], coef_errors=errs.max(axis=1))
+    return Scores(v, d, failures)
+
+
+register_scorer("dynamical", score_dynamical)

@@ -4,7 +4,7 @@ The contract (identify/_base.py): ``__init__`` only stores hyperparameters under
 ``fit(data)`` returns ``self``; learned attributes end in ``_`` and exist only after ``fit``;
 fitting is deterministic; ``clone`` gives an unfitted twin; ``simulate`` returns a Trajectory of
 the data's shape; ``equations`` returns text.  Structural identifiers expose ``M_``, ``C_``,
-``K_``; mechanical ones ``coef_`` and ``feature_names_``.
+``K_``; mechanical and dynamical ones ``coef_`` and ``feature_names_``.
 """
 
 import inspect
@@ -15,7 +15,7 @@ import pytest
 from benchmarks import bench_sgd_sindy, sindy_pi_problems
 from identify import IDENTIFIERS
 from identify._base import Identifier
-from testbed.core.measurement import Trajectory
+from testbed.core.measurement import Measurement, Trajectory
 
 # Small budgets so each identifier fits in seconds: the contract does not depend on them.
 FAST = {"sgd_sindy": {"epochs": 2}, "pysindy_pi": {"stride": 4}}
@@ -31,6 +31,17 @@ def pendulum():
     return sindy_pi_problems.double_pendulum(duration=3.0, fs=1e3, amp=10.0)
 
 
+@pytest.fixture(scope="module")
+def logistic():
+    """A first-order autonomous record in closed form: the logistic ``x = 1 / (1 + e^-t)``,
+    ``dx = x (1 - x)``, 0..4 s at 100 Hz."""
+    t = np.arange(400) / 100.0
+    x = 1.0 / (1.0 + np.exp(-t))
+    xd = x * (1.0 - x)
+    return Measurement(fs=100.0, x=x[None], xd=xd[None], xdd=(xd * (1 - 2 * x))[None],
+                       channels=("x",))
+
+
 def _make(name, pendulum):
     cls = IDENTIFIERS.get(name)
     params = dict(FAST.get(name, {}))
@@ -40,16 +51,16 @@ def _make(name, pendulum):
 
 
 @pytest.mark.parametrize("name", IDENTIFIERS.names())
-def test_identifier_follows_the_estimator_contract(name, structural_data, pendulum):
+def test_identifier_follows_the_estimator_contract(name, structural_data, pendulum, logistic):
     cls = IDENTIFIERS.get(name)
-    assert issubclass(cls, Identifier) and cls.name in ("", name) and cls.kind in ("structural",
-                                                                                   "mechanical")
+    assert issubclass(cls, Identifier) and cls.name in ("", name) and cls.kind in (
+        "structural", "mechanical", "dynamical")
     est = _make(name, pendulum)
     # __init__ stores every hyperparameter under its own name and learns nothing
     init_names = [p for p in inspect.signature(cls.__init__).parameters if p != "self"]
     assert sorted(est.get_params()) == sorted(init_names)
     assert not [k for k in vars(est) if k.endswith("_") and not k.startswith("_")]
-    data = structural_data if cls.kind == "structural" else pendulum.data
+    data = {"structural": structural_data, "dynamical": logistic}.get(cls.kind, pendulum.data)
     assert est.fit(data) is est
     learned = {k for k in vars(est) if k.endswith("_") and not k.startswith("_")}
     need = {"M_", "C_", "K_"} if cls.kind == "structural" else {"coef_", "feature_names_"}

@@ -1,0 +1,563 @@
+"""SINDy-PI for first-order dynamical systems (kind "dynamical"), autonomous or with inputs.
+
+The same machinery as :mod:`identify.sindy_pi` (one shared Gram matrix, sequentially
+thresholded least squares for every left-hand-side candidate, :func:`identify._implicit.stlsq_sweep`;
+held-out selection under the declared tie rule of :func:`identify._implicit.rank_models`), on
+a library the user writes over the data's own variable names:
+
+* the states, named as the measurement names its channels (``x``, ``s``, ...);
+* their time derivatives, ``d<state>`` (``dx``);
+* the inputs, named as the measurement names them (none for an autonomous system);
+* ``1``, products ``a*b`` and powers ``a^k`` of those; a term may hold at most one derivative
+  factor, to the first power (the equations are linear in the derivatives, so the identified
+  model can be solved for them).
+
+Rational right-hand sides come through the implicit form: Michaelis-Menten
+``dx = jx - Vmax x / (Km + x)`` is ``Km dx + x dx - jx Km + (Vmax - jx) x = 0`` in the terms
+``{dx, x*dx, 1, x}``.
+
+Selection: one implicit equation per state k, among the models whose ``d<state k>`` terms carry
+a larger normalised coefficient than every other state's derivative terms
+(:func:`select_equations`: the rule of :func:`identify._implicit.select_models` with the
+derivative columns in the role of the inputs): smallest held-out error, then fewest terms
+within tolerance of the best, then the declared tie rule. A model whose terms share a factor
+(``x * (law) = 0``) is first divided by it (:func:`reduce_common_factors`); one whose quotient
+leaves the library is not eligible. The held-out part is the last ``val_fraction`` of the
+record.
+
+Weak form (``formulation="weak"``): the rows are integrals of the library against the compact
+test functions of :mod:`identify._weak` (``(1 - s^2)^p`` over ``weak_window_s``), and a term
+``x_i^a * dx_i`` (a power of its own state times its derivative: every derivative term of a
+one-state library) is integrated by parts exactly, ``int phi x_i^a dx_i dt = -int phi'
+x_i^(a+1) / (a+1) dt``, so the derivatives of the noisy states never enter.  Any other
+derivative term is integrated as it stands with the signal chain's derivatives.  The held-out
+part is the last ``val_fraction`` of the windows.
+
+Simulation: at each RK4 stage the identified equations ``A(x, u) dx + b(x, u) = 0`` are solved
+for ``dx``; an (almost) singular ``A`` raises :class:`~testbed.core.errors.DivergenceError`.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from typing import Any, ClassVar
+
+import numpy as np
+
+from identify import IDENTIFIERS
+from identify._base import Identifier
+from identify._implicit import (
+    DEFAULT_THRESHOLDS,
+    Sweep,
+    grams,
+    input_shares,
+    rank_models,
+    split_index,
+    stlsq_sweep,
+)
+from identify._weak import _correlate, window_function
+from identify.sindy_pi import (
+    MAX_ITER_FIELD,
+    RIDGE_FIELD,
+    SELECTION_ATOL_FIELD,
+    SELECTION_RTOL_FIELD,
+    THRESHOLDS_FIELD,
+    VAL_FRACTION_FIELD,
+    check_thresholds,
+)
+from testbed.core.errors import DivergenceError, IdentificationError
+from testbed.core.measurement import Measurement, Trajectory
+from testbed.core.schema import ErrorFn, Field
+
+#: ``A`` (the identified coefficients of the derivatives at a state) counts as singular when
+#: its smallest singular value is below this.  Each equation is scaled to max |coef| = 1, so
+#: ``A``'s entries are of order one at states of order one; at 1e-8 solving for ``dx``
+#: amplifies the coefficients' own round-off (and noise) by 1e8: the model no longer decides
+#: the derivative.
+SINGULAR_TOL = 1e-8
+
+
+class ImplicitTerms:
+    """A library of product terms over named states, their derivatives and inputs.
+
+    Parameters
+    ----------
+    names : list of str
+        Term names (see the module docstring).
+    states, inputs : sequence of str
+        Variable names; the derivative of state ``s`` is ``d<s>``.
+
+    Attributes
+    ----------
+    powers : ndarray of int, shape (p, n_states + n_inputs)
+        Exponent of each state and input in each term.
+    deriv : ndarray of int, shape (p,)
+        Index of the state whose derivative the term holds, -1 for none.
+
+    Raises
+    ------
+    ValueError
+        For an unknown factor, a derivative to a power other than 1, or two derivative factors.
+    """
+
+    def __init__(self, names: list[str], states: tuple[str, ...], inputs: tuple[str, ...] = ()):
+        self.names, self.states, self.inputs = list(names), tuple(states), tuple(inputs)
+        dnames = tuple(f"d{s}" for s in self.states)
+        variables = self.states + self.inputs
+        clash = set(variables) & set(dnames) or (
+            set() if len(set(variables)) == len(variables) else {"(repeated name)"})
+        if clash:
+            raise ValueError(f"variable names {sorted(clash)} are ambiguous (a derivative is "
+                             "spelt 'd<state>')")
+        self.powers = np.zeros((len(self.names), len(variables)), dtype=int)
+        self.deriv = np.full(len(self.names), -1, dtype=int)
+        for j, term in enumerate(self.names):
+            if term.strip() == "1":
+                continue
+            for raw in term.split("*"):
+                base, _, power = raw.strip().partition("^")
+                try:
+                    k = int(power) if power else 1
+                except ValueError:
+                    raise ValueError(f"term {term!r}: bad power {power!r}") from None
+                if k < 1:
+                    raise ValueError(f"term {term!r}: powers must be positive integers")
+                if base in variables:
+                    self.powers[j, variables.index(base)] += k
+                elif base in dnames:
+                    if k != 1 or self.deriv[j] >= 0:
+                        raise ValueError(f"term {term!r}: at most one derivative factor, to the "
+                                         "first power (the equations must be linear in the "
+                                         "derivatives)")
+                    self.deriv[j] = dnames.index(base)
+                else:
+                    raise ValueError(f"term {term!r}: unknown factor {base!r}; known: "
+                                     f"{', '.join(('1', *variables, *dnames))}")
+        if len(set(self.names)) != len(self.names):
+            raise ValueError("repeated term names in the library")
+
+    def monomials(self, z: np.ndarray) -> np.ndarray:
+        """The terms without their derivative factor, shape (p, n_samples), at ``z``
+        (n_states + n_inputs, n_samples)."""
+        return np.prod(z[None, :, :] ** self.powers[:, :, None], axis=1)
+
+    def evaluate(self, x: np.ndarray, xd: np.ndarray, u: np.ndarray | None) -> np.ndarray:
+        """The library matrix, shape (n_samples, p), from states ``x`` and derivatives ``xd``
+        (n_states, n_samples) and inputs ``u`` (n_inputs, n_samples)."""
+        z = x if u is None or u.size == 0 else np.vstack([x, u])
+        m = self.monomials(z)
+        has = self.deriv >= 0
+        m[has] *= xd[self.deriv[has]]
+        return np.ascontiguousarray(m.T)
+
+
+def polynomial_terms(states: tuple[str, ...], inputs: tuple[str, ...], degree: int) -> list[str]:
+    """Monomials of the states and inputs up to total ``degree``, alone and times each state's
+    derivative: for one state ``x`` and degree 2, ``1, x, x^2, dx, x*dx, x^2*dx``."""
+    variables = states + inputs
+    monos = ["1"]
+    for d in range(1, degree + 1):
+        for combo in itertools.combinations_with_replacement(range(len(variables)), d):
+            monos.append("*".join(f"{variables[i]}^{combo.count(i)}" if combo.count(i) > 1
+                                  else variables[i] for i in sorted(set(combo))))
+    out = list(monos)
+    for s in states:
+        out += [f"d{s}" if m == "1" else f"{m}*d{s}" for m in monos]
+    return out
+
+
+def weak_rows(lib: ImplicitTerms, x: np.ndarray, xd: np.ndarray, u: np.ndarray | None,
+              fs: float, window_s: float, n_windows: int, degree: int) -> np.ndarray:
+    """Weak-form library matrix, shape (n_windows, p): ``V[k, c] = int phi_k Theta_c dt``.
+
+    A column ``x_i^a * dx_i`` is integrated by parts, ``-int phi_k' x_i^(a+1) / (a+1) dt``
+    (exact: ``phi_k`` vanishes at its window's ends); other columns by the rectangle rule on
+    the samples (module docstring of :mod:`identify._weak`).
+
+    Raises
+    ------
+    IdentificationError
+        If a test function is longer than the record.
+    """
+    N = x.shape[1]
+    L = round(window_s * fs) + 1
+    if L > N:
+        raise IdentificationError(f"test-function window {window_s} s is longer than the record")
+    starts = np.unique(np.round(np.linspace(0, N - L, int(n_windows))).astype(np.intp))
+    phi, dphi_ds = window_function(L, degree)
+    dt = 1.0 / fs
+    dphi = dphi_ds * (2.0 / ((L - 1) * dt))
+    A0 = lib.evaluate(x, xd, u)
+    A1 = np.zeros_like(A0)
+    n_states = x.shape[0]
+    for c in np.flatnonzero(lib.deriv >= 0):
+        i = lib.deriv[c]
+        own = np.zeros(lib.powers.shape[1], dtype=int)
+        own[i] = lib.powers[c, i]
+        if np.array_equal(lib.powers[c], own) and i < n_states:
+            a = own[i]
+            A0[:, c] = 0.0
+            A1[:, c] = -x[i] ** (a + 1) / (a + 1)
+    V = _correlate(A0, phi * dt, starts)
+    V += _correlate(A1, dphi * dt, starts)
+    return V
+
+
+def common_factor(W: np.ndarray, lib: ImplicitTerms) -> np.ndarray:
+    """Whether every term of a model shares a state or input factor, shape W.shape[:-1].
+
+    Such an equation is that factor times an equation of fewer degrees (``x * (Km dx + x dx
+    - jx Km + (Vmax - jx) x) = 0`` holds wherever the equation does), so on exact data it ties
+    with the reduced one in held-out error and often in number of terms.
+    """
+    nz = W != 0
+    big = np.iinfo(np.int64).max
+    # smallest power of each variable over the model's terms (a variable in every term -> > 0)
+    low = np.where(nz[..., None], lib.powers[None, None, :, :], big).min(axis=-2)
+    return (np.where(low == big, 0, low) > 0).any(axis=-1)
+
+
+def reduce_common_factors(sw: Sweep, lib: ImplicitTerms, G_train: np.ndarray,
+                          G_val: np.ndarray) -> Sweep:
+    """The sweep with every model whose terms share a monomial factor divided by it.
+
+    ``x * (Km dx + x dx - jx Km + (Vmax - jx) x) = 0`` is the Michaelis-Menten law times ``x``:
+    the same law away from ``x = 0``.  When the library holds both, on any trajectory the
+    equations of the library form a space of dimension two or more, and the sweep may find the
+    multiple and not the law.  Each such model is replaced by its quotient (every term's powers
+    lowered by the common ones) when the library holds every quotient term, with its held-out
+    and training errors recomputed from the Gram matrices; the left-hand side (its column
+    normalised to 1) is the quotient of the original one.  A model whose quotient leaves the
+    library is kept as it is (and stays ineligible, :func:`select_equations`).
+
+    Parameters
+    ----------
+    sw : Sweep
+    lib : ImplicitTerms
+    G_train, G_val : ndarray, shape (p, p)
+        The Gram matrices the sweep was run on (original units).
+
+    Returns
+    -------
+    Sweep
+        A new sweep (``sw`` is not modified).
+    """
+    index = {(tuple(lib.powers[j]), int(lib.deriv[j])): j for j in range(len(lib.names))}
+    s = sw.scale
+    Gn, Gv = G_train / np.outer(s, s), G_val / np.outer(s, s)
+    W = sw.W.copy()
+    val, train = sw.val_error.copy(), sw.train_error.copy()
+    reducible = common_factor(W, lib)
+    for t, c in zip(*np.nonzero(reducible), strict=True):
+        w = W[t, c]
+        nz = np.flatnonzero(w)
+        low = lib.powers[nz].min(axis=0)
+        target = [index.get((tuple(lib.powers[j] - low), int(lib.deriv[j]))) for j in nz]
+        lhs = index.get((tuple(lib.powers[sw.candidates[c]] - low), int(lib.deriv[sw.candidates[c]])))
+        if any(j is None for j in target) or lhs is None:
+            continue
+        w_orig = np.zeros_like(w)
+        w_orig[np.array(target)] = w[nz] / s[nz]
+        wn = w_orig * s
+        if wn[lhs] == 0.0:
+            continue
+        wn = wn / wn[lhs]
+        W[t, c] = wn
+        val[t, c] = max(float(wn @ Gv @ wn), 0.0) / Gv[lhs, lhs] if Gv[lhs, lhs] > 0 else np.inf
+        train[t, c] = max(float(wn @ Gn @ wn), 0.0) / Gn[lhs, lhs] if Gn[lhs, lhs] > 0 else np.inf
+    return Sweep(scale=s, candidates=sw.candidates, thresholds=sw.thresholds, W=W,
+                 val_error=val, train_error=train, nnz=np.count_nonzero(W, axis=2))
+
+
+def select_equations(sw: Sweep, lib: ImplicitTerms, deriv_cols: list[np.ndarray], rtol: float,
+                     atol: float) -> list[tuple[int, int]]:
+    """The (threshold, candidate) model of each state's equation.
+
+    Eligible for state k: models whose ``d<state k>`` terms carry a larger normalised
+    coefficient than every other state's derivative terms (so the equations of different
+    states are distinct and each can be solved for its own derivative) and whose terms share
+    no common factor (:func:`common_factor`; :func:`reduce_common_factors` has divided it out
+    wherever the library holds the quotient).  Ranked by
+    :func:`identify._implicit.rank_models` (held-out error, then fewest terms within
+    tolerance, then the declared tie rule).
+
+    Raises
+    ------
+    IdentificationError
+        If no model is eligible for some state.
+    """
+    shares = input_shares(sw.W, deriv_cols)
+    reducible = common_factor(sw.W, lib)
+    out = []
+    for k in range(len(deriv_cols)):
+        others = np.delete(shares, k, axis=0)
+        other = others.max(axis=0) if others.size else np.zeros_like(shares[k])
+        order = rank_models(sw, (shares[k] > 0) & (shares[k] > other) & ~reducible, rtol, atol)
+        if order.size == 0:
+            raise IdentificationError(f"no implicit model is dominated by the derivative of state "
+                                      f"{lib.states[k]!r} without a common factor")
+        t, c = np.unravel_index(order[0], sw.val_error.shape)
+        out.append((int(t), int(c)))
+    return out
+
+
+@IDENTIFIERS.register("sindy_pi_dynamical", tags=("dynamical", "implicit", "sparse"))
+class SINDyPIDynamical(Identifier):
+    """SINDy-PI for first-order systems ``f(x, dx/dt, u) = 0`` linear in ``dx/dt``.
+
+    Parameters
+    ----------
+    library : list of str, optional
+        Term names over the data's variables (module docstring); default
+        :func:`polynomial_terms` of ``degree``.
+    degree : int
+        Total degree of the default library's monomials.
+    lhs : list of str, optional
+        Candidate left-hand-side terms (library names); default every column.
+    thresholds : list of float, optional
+        Ascending thresholds on normalised coefficients; default 0 and 12 values log-spaced
+        over 1e-6..0.32.
+    ridge : float
+        Ridge added to the unit-diagonal normalised Gram matrix.
+    max_iter : int
+        Thresholding rounds per threshold.
+    val_fraction : float
+        Held-out fraction at the end of the record.
+    selection_rtol, selection_atol : float
+        Held-out error tolerances of the parsimony rule (:func:`identify._implicit.rank_models`).
+    formulation : {"strong", "weak"}
+        Regression rows: samples, or test-function integrals (module docstring).
+    weak_window_s : float
+        Test-function length [s] (weak form).
+    weak_windows : int
+        Number of test functions (weak form).
+    weak_degree : int
+        Test-function exponent (weak form).
+    sim_dt : float
+        Largest RK4 step [s] of the identified model's simulation.
+
+    Attributes
+    ----------
+    coef_ : ndarray, shape (n_states, p)
+        One implicit equation per state (row k: the equation of state k), scaled to
+        max |coef| = 1 (sign by :func:`identify._implicit.canonical_scale`).
+    feature_names_ : list of str
+        Library term names (columns of ``coef_``).
+    states_, inputs_ : tuple of str
+        Variable names of the data fitted.
+    val_error_ : ndarray, shape (n_states,)
+        Normalised held-out residual of each selected equation.
+    """
+
+    name: ClassVar[str] = "sindy_pi_dynamical"
+    kind: ClassVar[str] = "dynamical"
+    hyperparameters: ClassVar[dict[str, Field]] = {
+        "library": Field(list, None, item_type=str, min_items=1,
+                         doc="candidate terms over the data's states, their derivatives "
+                             "'d<state>' and inputs, e.g. ['1', 'x', 'dx', 'x*dx']; default "
+                             "the polynomial library of 'degree'"),
+        # 6: a monomial x^6 of a state of order 10 already spans 1e6 and the Gram matrix loses
+        # its digits; the default library's size grows as C(n + degree, degree)
+        "degree": Field(int, 2, min=0, max=6, doc="total degree of the default library's "
+                                                  "monomials (each also times each derivative)"),
+        "lhs": Field(list, None, item_type=str, min_items=1,
+                     doc="candidate left-hand-side terms (library term names); default every "
+                         "column"),
+        "thresholds": THRESHOLDS_FIELD,
+        "ridge": RIDGE_FIELD,
+        "max_iter": MAX_ITER_FIELD,
+        "val_fraction": VAL_FRACTION_FIELD,
+        "selection_rtol": SELECTION_RTOL_FIELD,
+        "selection_atol": SELECTION_ATOL_FIELD,
+        "formulation": Field(str, "strong", choices=("strong", "weak"),
+                             doc="regression rows: samples ('strong') or test-function "
+                                 "integrals with the derivative terms integrated by parts "
+                                 "('weak')"),
+        "weak_window_s": Field(float, 0.5, unit="s", min=0.0, min_inclusive=False,
+                               doc="'weak': length of each test function (shorter than the "
+                                   "record)"),
+        # >= 4: held-out and training parts each need at least 2 windows
+        "weak_windows": Field(int, 200, min=4, max=100000,
+                              doc="'weak': number of test functions, equally spaced"),
+        # >= 2: phi and phi' must vanish at the window ends for the integration by parts
+        "weak_degree": Field(int, 4, min=2, max=16, doc="'weak': exponent p of the test "
+                                                         "functions (1 - s^2)^p"),
+        # (0, 1] s: the shipped rigs' time constants are of order 0.1-1 s
+        "sim_dt": Field(float, 1e-3, unit="s", min=0.0, min_inclusive=False, max=1.0,
+                        doc="largest RK4 step of the identified model's simulation"),
+    }
+
+    def __init__(self, library: list[str] | None = None, degree: int = 2,
+                 lhs: list[str] | None = None, thresholds: list[float] | None = None,
+                 ridge: float = 1e-14, max_iter: int = 20, val_fraction: float = 0.2,
+                 selection_rtol: float = 0.1, selection_atol: float = 1e-12,
+                 formulation: str = "strong", weak_window_s: float = 0.5,
+                 weak_windows: int = 200, weak_degree: int = 4, sim_dt: float = 1e-3) -> None:
+        self.library = library
+        self.degree = degree
+        self.lhs = lhs
+        self.thresholds = thresholds
+        self.ridge = ridge
+        self.max_iter = max_iter
+        self.val_fraction = val_fraction
+        self.selection_rtol = selection_rtol
+        self.selection_atol = selection_atol
+        self.formulation = formulation
+        self.weak_window_s = weak_window_s
+        self.weak_windows = weak_windows
+        self.weak_degree = weak_degree
+        self.sim_dt = sim_dt
+
+    @classmethod
+    def check_hyperparameters(cls, params: dict[str, Any], error: ErrorFn) -> None:
+        check_thresholds(params, error)
+        lib, lhs = params.get("library"), params.get("lhs")
+        if lib is not None and lhs is not None:
+            missing = [t for t in lhs if t not in lib]
+            if missing:
+                error("lhs", lhs, f"terms of the library; {missing[0]!r} is not")
+
+    @classmethod
+    def check_data_shape(cls, params: dict[str, Any], n_channels: int, n_inputs: int, fs: float,
+                         n_samples: int, error: ErrorFn) -> None:
+        if params["formulation"] == "weak" and round(params["weak_window_s"] * fs) + 1 > n_samples:
+            error("weak_window_s", params["weak_window_s"],
+                  f"shorter than the record ({n_samples / fs:g} s)")
+
+    @classmethod
+    def simulation_steps(cls, params: dict[str, Any], record_s: float) -> tuple[float, str]:
+        return record_s / params["sim_dt"], "sim_dt"
+
+    def _terms(self, data: Measurement) -> ImplicitTerms:
+        inputs = tuple(data.inputs) if data.u is not None else ()
+        names = (list(self.library) if self.library is not None
+                 else polynomial_terms(tuple(data.channels), inputs, self.degree))
+        try:
+            return ImplicitTerms(names, tuple(data.channels), inputs)
+        except ValueError as e:
+            raise IdentificationError(f"sindy_pi_dynamical: library does not fit the data "
+                                      f"(states {', '.join(data.channels)}; inputs "
+                                      f"{', '.join(inputs) or 'none'}): {e}") from None
+
+    def fit(self, data: Measurement) -> SINDyPIDynamical:
+        """Fit one implicit equation per state to ``data`` (states ``x``, derivatives ``xd``,
+        inputs ``u`` if any)."""
+        self.check_params()
+        lib = self._terms(data)
+        n_states = data.n_channels
+        u = None if data.u is None else np.asarray(data.u, dtype=float)
+        x, xd = np.asarray(data.x, dtype=float), np.asarray(data.xd, dtype=float)
+        if self.formulation == "weak":
+            Theta = weak_rows(lib, x, xd, u, data.fs, self.weak_window_s, self.weak_windows,
+                              self.weak_degree)
+        else:
+            Theta = lib.evaluate(x, xd, u)
+        n_tr = split_index(Theta.shape[0], self.val_fraction)
+        G_train, G_val = grams(Theta, n_tr)
+        if self.lhs is None:
+            cand = np.arange(len(lib.names))
+        else:
+            unknown = [t for t in self.lhs if t not in lib.names]
+            if unknown:
+                raise IdentificationError(f"lhs term {unknown[0]!r} is not in the library")
+            cand = np.array([lib.names.index(t) for t in self.lhs])
+        thr = DEFAULT_THRESHOLDS if self.thresholds is None else np.asarray(self.thresholds)
+        sw = reduce_common_factors(stlsq_sweep(G_train, G_val, cand, thr, self.ridge,
+                                               self.max_iter), lib, G_train, G_val)
+        deriv_cols = [np.flatnonzero(lib.deriv == k) for k in range(n_states)]
+        for k, cols in enumerate(deriv_cols):
+            if cols.size == 0:
+                raise IdentificationError(f"the library holds no term with d{data.channels[k]}: "
+                                          f"no equation of state {data.channels[k]!r} can be "
+                                          "selected")
+        picked = select_equations(sw, lib, deriv_cols, self.selection_rtol, self.selection_atol)
+        self.coef_ = np.stack([sw.coef(t, c) for t, c in picked])
+        self.val_error_ = np.array([sw.val_error[t, c] for t, c in picked])
+        self.feature_names_ = list(lib.names)
+        self.states_, self.inputs_ = lib.states, lib.inputs
+        self._lib = lib
+        return self
+
+    def derivative(self, x: np.ndarray, u: np.ndarray | None = None, t: float = float("nan")
+                   ) -> np.ndarray:
+        """``dx/dt`` the identified equations give at state ``x`` (n_states,) and input ``u``.
+
+        Raises
+        ------
+        DivergenceError
+            If the coefficients of the derivatives are singular there (``SINGULAR_TOL``) or
+            the state is non-finite; ``t`` [s] is reported.
+        """
+        z = x if u is None or np.size(u) == 0 else np.concatenate([x, u])
+        if not np.all(np.isfinite(z)):
+            raise DivergenceError("non-finite state", t)
+        with np.errstate(over="ignore", invalid="ignore"):
+            m = self._lib.monomials(z[:, None])[:, 0]
+            cm = self.coef_ * m[None, :]
+        if not np.all(np.isfinite(cm)):
+            raise DivergenceError("non-finite terms of the identified equations", t)
+        n = self.coef_.shape[0]
+        D = np.zeros((len(m), n))
+        has = self._lib.deriv >= 0
+        D[np.flatnonzero(has), self._lib.deriv[has]] = 1.0
+        A, b = cm @ D, cm[:, ~has].sum(axis=1)
+        smin = np.linalg.svd(A, compute_uv=False).min()
+        if not smin > SINGULAR_TOL:
+            raise DivergenceError(f"the identified coefficient of the derivatives is singular "
+                                  f"(smallest singular value {smin:.3g} <= {SINGULAR_TOL:g})", t)
+        return np.linalg.solve(A, -b)
+
+    def simulate(self, x0: np.ndarray, xd0: np.ndarray | None, t: np.ndarray,
+                 u: np.ndarray | None = None) -> Trajectory:
+        """RK4 of the identified equations from ``x0`` (n_states,) over the uniform times ``t``
+        (n_samples,) [s], in steps of at most ``sim_dt``; ``xd0`` is unused (first order);
+        inputs ``u`` (n_inputs, n_samples) are interpolated linearly.
+
+        Returns
+        -------
+        Trajectory
+            ``x`` the states, ``xd`` the model's derivatives at them, ``xdd`` central
+            differences of ``xd`` (``numpy.gradient``), each (n_states, n_samples).
+
+        Raises
+        ------
+        DivergenceError
+            A singular derivative coefficient or a non-finite state, with its time.
+        """
+        t = np.asarray(t, dtype=float)
+        x = np.array(x0, dtype=float).ravel()
+        uu = None if u is None or np.size(u) == 0 else np.atleast_2d(np.asarray(u, dtype=float))
+
+        def u_at(s: float) -> np.ndarray | None:
+            return None if uu is None else np.array([np.interp(s, t, r) for r in uu])
+
+        def f(s: float, y: np.ndarray) -> np.ndarray:
+            return self.derivative(y, u_at(s), s)
+
+        X = np.empty((x.size, t.size))
+        Xd = np.empty_like(X)
+        X[:, 0] = x
+        for k in range(t.size - 1):
+            h_total = t[k + 1] - t[k]
+            steps = max(1, math.ceil(h_total / self.sim_dt - 1e-9))
+            h = h_total / steps
+            s = t[k]
+            for _ in range(steps):
+                k1 = f(s, x)
+                k2 = f(s + h / 2, x + h / 2 * k1)
+                k3 = f(s + h / 2, x + h / 2 * k2)
+                k4 = f(s + h, x + h * k3)
+                x = x + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+                s += h
+            X[:, k + 1] = x
+        for k in range(t.size):
+            Xd[:, k] = f(t[k], X[:, k])
+        Xdd = np.gradient(Xd, t, axis=1) if t.size > 1 else np.zeros_like(Xd)
+        return Trajectory(X, Xd, Xdd)
+
+    def equations(self, precision: int = 4) -> list[str]:
+        """One line per identified implicit equation, ``0 = c1*term1 + ...``."""
+        return ["0 = " + " ".join(f"{c:+.{precision}g}*{n}"
+                                  for c, n in zip(row, self.feature_names_, strict=True) if c != 0)
+                for row in self.coef_]

@@ -1,0 +1,166 @@
+"""Michaelis-Menten kinetics with influx: ``dx/dt = jx - Vmax x / (Km + x)`` (kind "dynamical").
+
+The example of Kaheman, Kutz & Brunton (2020), "SINDy-PI: a robust algorithm for parallel
+implicit sparse identification of nonlinear dynamics", Proc. R. Soc. A 476: 20200279: a
+substrate of concentration ``x`` [mM] fed at the constant rate ``jx`` [mM/s] and consumed by
+an enzyme at the saturating rate ``Vmax x / (Km + x)``.  The right-hand side is rational, so
+no polynomial library holds it explicitly; multiplied by ``Km + x`` it becomes the implicit
+polynomial equation
+
+    Km dx + x dx - jx Km + (Vmax - jx) x = 0,
+
+terms ``{dx, x*dx, 1, x}`` with coefficients ``(Km, 1, -jx Km, Vmax - jx)``, up to scale.
+That is the truth (:func:`implicit_equation`), derived from the ODE's own parameters.
+
+Measured: the concentration ``x`` and its rate ``dx`` (the right-hand side evaluated on the
+simulated state, so ``(x, dx)`` satisfy the implicit equation to round-off whatever the
+integrator's error); noise goes on ``x`` only.  With ``Vmax > jx`` the state tends to the
+stable steady state ``x* = jx Km / (Vmax - jx)`` [mM] (``check`` refuses ``Vmax <= jx``,
+whose state grows without bound).
+
+One trajectory per record, from ``x0``.  The paper concatenates several initial conditions;
+here a record is one trajectory because the testbed's Measurement carries no segment
+boundaries: concatenated segments would put jumps into the estimated derivatives and into
+the scored simulation.  One trajectory from ``x0`` above ``x*`` already covers every state
+between them, the range the implicit equation is fitted and scored on.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import Any, ClassVar
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+from models import RIGS
+from models._base import ErrorFn, Rig
+from testbed.core.budget import Cost
+from testbed.core.dataset import Dataset, Signal
+from testbed.core.schema import Field
+from testbed.core.truth import DynamicalTruth
+
+_POS = {"min": 0.0, "min_inclusive": False}
+
+#: Relative tolerance of ``solve_ivp`` (DOP853).  The scorer compares the identified model's
+#: simulation with these states, so the reference's own error must sit far below any RMSE a
+#: scenario bars (1e-6 mM on states of order 1 mM): 1e-12 leaves six decades of room, and is
+#: two decades above float64's ~1e-16, where the step control still works.
+RTOL = 1e-12
+#: Absolute tolerance [mM]: 1e-14, below RTOL times the smallest state (x* ~ 0.2 mM).
+ATOL = 1e-14
+
+#: Peak bytes per sample of a run: x and dx measured and as reference (4 float64), the signal
+#: chain's x, xd, xdd (3) and the identifier's library matrix (up to ~50 columns of float64,
+#: e.g. a degree-6 library with its derivative terms): 64 float64 with room.
+BYTES_PER_SAMPLE = 512
+
+TERMS = ["dx", "x*dx", "1", "x"]
+TRUTH_UNITS = {"equation_terms": "", "equation_coef": "1 (row max |coef| = 1)",
+               "state_names": "", "x0": "mM", "parameter_names": "",
+               "parameter_values": "mM/s, mM/s, mM", "equation_scale": "mM"}
+
+
+def rate(x: np.ndarray, jx: float, vmax: float, km: float) -> np.ndarray:
+    """Right-hand side ``dx/dt = jx - Vmax x / (Km + x)`` [mM/s] at states ``x`` [mM]."""
+    x = np.asarray(x, dtype=float)
+    return jx - vmax * x / (km + x)
+
+
+def implicit_equation(jx: float, vmax: float, km: float) -> tuple[list[str], np.ndarray, float]:
+    """The true implicit equation: term names, coefficients divided by the largest magnitude,
+    and that divisor.
+
+    Multiplying the ODE by ``Km + x``: ``Km dx + x dx - jx Km + (Vmax - jx) x = 0``.
+
+    Returns
+    -------
+    terms : list of str
+        ``["dx", "x*dx", "1", "x"]``.
+    coef : ndarray, shape (1, 4)
+        ``(Km, 1, -jx Km, Vmax - jx) / scale`` [-].
+    scale : float
+        Largest magnitude of the raw coefficients [mM] (mixed units: each term's coefficient
+        times its term is [mM^2/s]).
+    """
+    raw = np.array([km, 1.0, -jx * km, vmax - jx])
+    scale = float(np.abs(raw).max())
+    return list(TERMS), (raw / scale)[None, :], scale
+
+
+@RIGS.register("michaelis_menten", tags=("dynamical", "autonomous", "rational", "sindy-pi"))
+class MichaelisMentenRig(Rig):
+    """Michaelis-Menten kinetics with constant influx, one trajectory (see the module docs)."""
+
+    name: ClassVar[str] = "michaelis_menten"
+    kind: ClassVar[str] = "dynamical"
+    rig_schema: ClassVar[dict[str, Field]] = {
+        "jx": Field(float, 0.6, unit="mM/s", min=0.0, doc="constant influx of substrate "
+                                                          "(the paper: 0.6)"),
+        "Vmax": Field(float, 1.5, unit="mM/s", doc="maximum reaction rate (the paper: 1.5)",
+                      **_POS),
+        "Km": Field(float, 0.3, unit="mM", doc="Michaelis constant: the concentration at half "
+                                              "the maximum rate (the paper: 0.3)", **_POS),
+        "x0": Field(float, 2.0, unit="mM", min=0.0, doc="initial concentration"),
+    }
+    simulation_schema: ClassVar[dict[str, Field]] = {
+        "duration": Field(float, 4.0, unit="s", doc="record length", **_POS),
+        "sample_rate": Field(float, 100.0, unit="Hz", doc="output sample rate", **_POS),
+    }
+    excitation_schemas: ClassVar[dict[str, dict[str, Field]]] = {"autonomous": {}}
+    default_excitation: ClassVar[str] = "autonomous"
+    measured_signals: ClassVar[tuple[str, ...]] = ("x", "dx")
+    noisy_signals: ClassVar[tuple[str, ...]] = ("x",)
+
+    @classmethod
+    def check(cls, rig: dict[str, Any], simulation: dict[str, Any], excitation: dict[str, Any],
+              error: ErrorFn) -> None:
+        if not rig["Vmax"] > rig["jx"]:
+            error("rig.Vmax", rig["Vmax"], f"expected above jx ({rig['jx']:g} mM/s): otherwise "
+                                           "the influx outruns the enzyme and x grows without bound")
+
+    @classmethod
+    def measurement_shape(cls, rig: dict[str, Any]) -> tuple[int, int]:
+        return 1, 0
+
+    @classmethod
+    def cost(cls, rig: dict[str, Any], simulation: dict[str, Any],
+             excitation: dict[str, Any]) -> Cost:
+        """Memory and steps of a run.  ``solve_ivp`` steps adaptively: measured 22-47 DOP853
+        steps over 4 s at rtol 1e-12 (x0 = 0..2 mM, the paper's parameters), under 12 per
+        second; counted as 25 per second (2x room), and at least one per output sample (the
+        budget's convention)."""
+        samples = simulation["duration"] * float(simulation["sample_rate"])
+        steps = max(samples, 25.0 * simulation["duration"])
+        return Cost(memory_bytes=samples * BYTES_PER_SAMPLE, steps=steps, samples=samples,
+                    memory_key="simulation.duration", steps_key="simulation.duration",
+                    samples_key="simulation.duration", memory_value=simulation["duration"],
+                    steps_value=simulation["duration"], samples_value=simulation["duration"])
+
+    def simulate(self, progress: Callable[[float], None] | None = None) -> Dataset:
+        sc = self.scenario
+        p = sc.rig_params
+        jx, vmax, km, x0 = float(p["jx"]), float(p["Vmax"]), float(p["Km"]), float(p["x0"])
+        fs = float(sc.simulation["sample_rate"])
+        n = round(sc.simulation["duration"] * fs)
+        t = np.arange(n) / fs
+        sol = solve_ivp(lambda _t, y: rate(y, jx, vmax, km), (0.0, t[-1]), [x0], method="DOP853",
+                        t_eval=t, rtol=RTOL, atol=ATOL)
+        if not sol.success:
+            raise RuntimeError(f"michaelis_menten: solve_ivp failed: {sol.message}")
+        x = sol.y[:1]
+        dx = rate(x, jx, vmax, km)
+        if progress is not None:
+            progress(1.0)
+        terms, coef, scale = implicit_equation(jx, vmax, km)
+        truth = DynamicalTruth(equation_terms=terms, equation_coef=coef, state_names=["x"],
+                               x0=np.array([x0]), parameter_names=["jx", "Vmax", "Km"],
+                               parameter_values=np.array([jx, vmax, km]),
+                               equation_scale=np.array([scale]))
+        return Dataset(
+            fs=fs,
+            measured={"x": Signal(x, ("x",), "mM"), "dx": Signal(dx, ("dx",), "mM/s")},
+            reference={"x": Signal(x.copy(), ("x",), "mM"), "dx": Signal(dx.copy(), ("dx",), "mM/s")},
+            truth=truth.to_dict(), truth_units=dict(TRUTH_UNITS),
+            attrs={"integrator": "DOP853", "rtol": RTOL, "atol": ATOL,
+                   "steady_state": jx * km / (vmax - jx)})

@@ -1,0 +1,127 @@
+"""SINDy-PI for first-order systems: user terms, selection, simulation, scoring."""
+
+import numpy as np
+import pytest
+
+from identify.sindy_pi_dynamical import (
+    ImplicitTerms,
+    SINDyPIDynamical,
+    common_factor,
+    polynomial_terms,
+)
+from testbed.core.errors import DivergenceError, IdentificationError, ScenarioError
+from testbed.core.measurement import Measurement
+from testbed.pipeline.plugins import rig_class
+from testbed.pipeline.scenario import load_scenario, scenario_from_dict
+from testbed.pipeline.signal_chain import measure
+from testbed.scoring.scorers import compare_implicit, score
+
+
+@pytest.fixture(scope="module")
+def mm():
+    ds = rig_class("michaelis_menten")(load_scenario("michaelis_menten")).simulate()
+    return ds, measure(ds, {}, "dynamical")
+
+
+def test_terms_parse_products_powers_and_derivatives():
+    lib = ImplicitTerms(["1", "s", "s^2*u", "ds", "s*ds", "u*ds"], ("s",), ("u",))
+    np.testing.assert_array_equal(lib.powers, [[0, 0], [1, 0], [2, 1], [0, 0], [1, 0], [0, 1]])
+    np.testing.assert_array_equal(lib.deriv, [-1, -1, -1, 0, 0, 0])
+    x, xd, u = np.array([[2.0, 3.0]]), np.array([[5.0, 7.0]]), np.array([[0.5, 1.0]])
+    np.testing.assert_allclose(lib.evaluate(x, xd, u),
+                               [[1, 2, 2, 5, 10, 2.5], [1, 3, 9, 7, 21, 7]])
+    for bad, match in (("y", "unknown factor 'y'"), ("ds^2", "at most one derivative"),
+                       ("ds*s*ds", "at most one derivative")):
+        with pytest.raises(ValueError, match=match):
+            ImplicitTerms([bad], ("s",), ("u",))
+    assert polynomial_terms(("x",), (), 2) == ["1", "x", "x^2", "dx", "x*dx", "x^2*dx"]
+
+
+def test_clean_michaelis_menten_recovers_the_implicit_equation(mm):
+    ds, data = mm
+    model = SINDyPIDynamical(library=["1", "x", "x^2", "x^3", "dx", "x*dx"]).fit(data)
+    cmp = compare_implicit(model.feature_names_, model.coef_, ds.truth["equation_terms"],
+                           np.asarray(ds.truth["equation_coef"]))
+    assert cmp["f1"] == 1.0
+    assert cmp["coef_error"] < 1e-8  # exact data: round-off, not a tolerance of the method
+
+
+@pytest.mark.parametrize("degree", [2, 3])
+def test_the_default_library_finds_the_law_not_its_multiples(mm, degree):
+    # with x^k*dx in the library, x*(law) = 0 is exact as well; reduce_common_factors divides
+    # the factor out, so the law itself comes back
+    ds, data = mm
+    model = SINDyPIDynamical(degree=degree).fit(data)
+    assert "x^2*dx" in model.feature_names_
+    cmp = compare_implicit(model.feature_names_, model.coef_, ds.truth["equation_terms"],
+                           np.asarray(ds.truth["equation_coef"]))
+    assert cmp["f1"] == 1.0 and cmp["coef_error"] < 1e-8
+
+
+def test_a_library_without_the_states_derivative_is_refused(mm):
+    _, data = mm
+    with pytest.raises(IdentificationError, match="no term with dx"):
+        SINDyPIDynamical(library=["1", "x", "x^2"]).fit(data)
+    with pytest.raises(IdentificationError, match="unknown factor 'th1'"):
+        SINDyPIDynamical(library=["1", "th1", "dx"]).fit(data)
+
+
+def test_an_equation_with_a_common_factor_is_not_eligible():
+    lib = ImplicitTerms(["1", "x", "x^2", "dx", "x*dx", "x^2*dx"], ("x",))
+    W = np.array([[[0, 1.0, 1, 0, 1, 1],      # x (1 + x + dx + x dx): reducible
+                   [1.0, 1, 0, 1, 1, 0]]])    # the Michaelis-Menten form: not
+    np.testing.assert_array_equal(common_factor(W, lib), [[True, False]])
+
+
+def test_a_singular_derivative_coefficient_is_a_divergence(mm):
+    _, data = mm
+    model = SINDyPIDynamical(library=["1", "x", "x^2", "x^3", "dx", "x*dx"]).fit(data)
+    model.coef_ = np.array([[1.0, 0, 0, 0, 0, 1.0]])   # 1 + x dx = 0: dx = -1 / x
+    with pytest.raises(DivergenceError, match="singular"):
+        model.simulate(np.array([0.0]), None, np.arange(5) * 0.01)
+
+
+def test_the_scorer_reports_a_diverging_model_as_a_failure(mm):
+    ds, data = mm
+    model = SINDyPIDynamical(library=["1", "x", "x^2", "x^3", "dx", "x*dx"]).fit(data)
+    model.coef_ = np.array([[0.0, 0, 0, -1.0, 1e-12, 0]])  # dx's coefficient below SINGULAR_TOL
+    s = score("dynamical", ds, data, data, model)
+    assert "singular" in s.failures["simulation"] and np.isnan(s.values["state_rmse"])
+    assert s.values["support_recall"] < 1.0
+
+
+def test_compare_implicit_is_up_to_scale_and_by_canonical_name():
+    names, coef = ["dx", "x*dx", "1", "x"], np.array([[0.3, 1.0, -0.18, 0.9]])
+    same = compare_implicit(["dx*x", "x", "dx", "1"], -2.0 * np.array([[1.0, 0.9, 0.3, -0.18]]),
+                            names, coef)
+    assert same["coef_error"] < 1e-15 and same["f1"] == 1.0
+    off = compare_implicit(["dx", "x*dx", "1", "x", "x^2"], np.array([[0.3, 1.0, -0.18, 0.99, 0.1]]),
+                           names, coef)
+    assert off["coef_error"] == pytest.approx(0.1) and off["precision"] == 0.8
+    missing = compare_implicit(["dx", "1", "x"], np.array([[0.3, -0.18, 0.9]]), names, coef)
+    assert missing["recall"] == 0.75 and np.isinf(missing["coef_error"])
+
+
+def test_weak_form_on_noisy_states_and_a_dynamical_identifier_only_for_dynamical_rigs():
+    sc = load_scenario("michaelis_menten_noise1")
+    assert sc.kind == "dynamical" and sc.identify["formulation"] == "weak"
+    with pytest.raises(ScenarioError, match="'dynamical' identifier cannot identify"):
+        scenario_from_dict({"scenario": {"name": "x", "rig": "fivebar"},
+                            "identify": {"method": "sindy_pi_dynamical"}})
+
+
+def test_inputs_enter_the_library_and_the_simulation():
+    # dx = u - x with u = sin t: the implicit equation dx + x - u = 0 is recovered and simulated
+    fs, t = 100.0, np.arange(1000) / 100.0
+    x = 0.5 * (np.sin(t) - np.cos(t)) + 1.5 * np.exp(-t)   # x(0) = 1
+    u = np.sin(t)
+    data = Measurement(fs=fs, x=x[None], xd=(u - x)[None], xdd=np.zeros((1, t.size)),
+                       channels=("x",), u=u[None], inputs=("u",))
+    model = SINDyPIDynamical(library=["1", "x", "u", "x^2", "dx", "x*dx"]).fit(data)
+    cmp = compare_implicit(model.feature_names_, model.coef_, ["dx", "x", "u"],
+                           np.array([[1.0, 1.0, -1.0]]))
+    assert cmp["f1"] == 1.0 and cmp["coef_error"] < 1e-8
+    sim = model.simulate(np.array([1.0]), None, t, u[None])
+    # 1e-4: the input is interpolated linearly between 10 ms samples, an error of up to
+    # h^2 |u''| / 8 = 1.25e-5 in u; through the unit-rate decay it stays of that order in x
+    assert np.max(np.abs(sim.x[0] - x)) < 1e-4

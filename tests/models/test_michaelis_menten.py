@@ -1,0 +1,52 @@
+"""The Michaelis-Menten rig against its closed-form time-of-state and its implicit truth."""
+
+import numpy as np
+import pytest
+
+from models.michaelis_menten import implicit_equation, rate
+from testbed.core.errors import ScenarioError
+from testbed.core.truth import DynamicalTruth
+from testbed.pipeline.plugins import rig_class
+from testbed.pipeline.scenario import load_scenario, scenario_from_dict
+
+
+@pytest.fixture(scope="module")
+def dataset():
+    return rig_class("michaelis_menten")(load_scenario("michaelis_menten")).simulate()
+
+
+def test_trajectory_matches_the_closed_form_time_of_state(dataset):
+    # dt/dx = (Km + x) / (a x + b), a = jx - Vmax, b = jx Km, integrates to
+    # t(x) = (x - x0) / a + (Km - b / a) / a * ln((a x + b) / (a x0 + b)): independent of solve_ivp
+    jx, vmax, km = dataset.truth["parameter_values"]
+    x0 = float(dataset.truth["x0"][0])
+    a, b = jx - vmax, jx * km
+    x = dataset.measured["x"].data[0]
+    t_exact = (x - x0) / a + (km - b / a) / a * np.log((a * x + b) / (a * x0 + b))
+    # 1e-9 s: the integrator's rtol 1e-12 on x, amplified by 1 / |dx/dt| >= 1 / 1.4 s/mM and by
+    # the log's condition near the steady state (x(4 s) - x* = 0.045 mM)
+    np.testing.assert_allclose(t_exact, dataset.t, atol=1e-9)
+
+
+def test_truth_is_the_odes_implicit_form_and_holds_on_the_data(dataset):
+    truth = DynamicalTruth.from_dict(dataset.truth, dataset.truth_units)
+    assert truth.equation_terms == ["dx", "x*dx", "1", "x"] and truth.state_names == ["x"]
+    # (Km, 1, -jx Km, Vmax - jx) up to scale, for the paper's 0.6, 1.5, 0.3
+    np.testing.assert_allclose(truth.equation_coef, [[0.3, 1.0, -0.18, 0.9]], rtol=1e-15)
+    x, dx = dataset.measured["x"].data[0], dataset.measured["dx"].data[0]
+    cols = np.stack([dx, x * dx, np.ones_like(x), x])
+    resid = truth.equation_coef[0] @ cols
+    assert np.max(np.abs(resid)) < 1e-14 * 10  # round-off of four O(1) products
+    np.testing.assert_allclose(dx, rate(x, 0.6, 1.5, 0.3))
+
+
+def test_implicit_equation_scale_is_the_largest_raw_coefficient():
+    terms, coef, scale = implicit_equation(jx=0.1, vmax=2.0, km=3.0)
+    assert scale == 3.0 and terms[0] == "dx"
+    np.testing.assert_allclose(coef[0] * scale, [3.0, 1.0, -0.3, 1.9])
+
+
+def test_a_rate_the_enzyme_cannot_match_is_refused():
+    with pytest.raises(ScenarioError, match=r"rig\.Vmax"):
+        scenario_from_dict({"scenario": {"name": "x", "rig": "michaelis_menten"},
+                            "rig": {"jx": 2.0, "Vmax": 1.5}})
