@@ -24,12 +24,14 @@ import hashlib
 import json
 import logging
 import os
+import sys
 from collections.abc import Callable
 from pathlib import Path
 
 from testbed.core.dataset import Dataset, DatasetError
 from testbed.core.provenance import versions
 from testbed.pipeline.generate import derive, noise_free_scenario, simulate_clean
+from testbed.pipeline.plugins import rig_class
 from testbed.pipeline.scenario import Scenario
 
 log = logging.getLogger(__name__)
@@ -40,19 +42,38 @@ def default_cache_dir() -> Path:
     return Path(os.environ.get("TESTBED_CACHE", Path.cwd() / ".cache" / "datasets"))
 
 
+#: Source every rig's data depend on besides its own package: the rig contract, the noise model
+#: and the dataset format with its typed truth.
+SHARED_GENERATOR_SOURCES = ("models/__init__.py", "models/_base.py", "testbed/pipeline/generate.py",
+                            "testbed/core/dataset.py", "testbed/core/truth.py")
+
+
+def generator_sources(rig: str) -> list[Path]:
+    """The source files a scenario of ``rig`` turns into data through: the rig's own package (a
+    rig in ``models/<name>/``: every file there; a rig defined elsewhere, e.g. a plugin file:
+    that module) and :data:`SHARED_GENERATOR_SOURCES`."""
+    root = Path(__file__).resolve().parents[2]
+    models_dir = (root / "models").resolve()
+    module = Path(sys.modules[rig_class(rig).__module__].__file__).resolve()
+    if module.parent != models_dir and module.is_relative_to(models_dir):
+        own = sorted(module.parent.rglob("*.py"))
+    else:
+        own = [module]
+    return [*own, *(root / n for n in SHARED_GENERATOR_SOURCES)]
+
+
 @functools.cache
-def generator_code_hash() -> str:
-    """SHA-256 of the source that turns a scenario into data: the rigs and the noise model.
+def generator_code_hash(rig: str) -> str:
+    """SHA-256 of :func:`generator_sources` (paths and contents).
 
     Package versions alone miss a change to this project's own code (a developer's stale cache
-    would survive it); the source hash does not.
+    would survive it); the source hash does not.  Adding or editing one rig leaves the other
+    rigs' cached datasets valid.
     """
     root = Path(__file__).resolve().parents[2]
     h = hashlib.sha256()
-    files = sorted((root / "models").rglob("*.py")) + [root / "testbed" / n for n in
-                                                       ("pipeline/generate.py", "core/dataset.py")]
-    for f in files:
-        h.update(f.relative_to(root).as_posix().encode())
+    for f in generator_sources(rig):
+        h.update((f.relative_to(root) if f.is_relative_to(root) else f).as_posix().encode())
         h.update(f.read_bytes())
     return h.hexdigest()
 
@@ -60,7 +81,7 @@ def generator_code_hash() -> str:
 def cache_key(scenario: Scenario) -> str:
     """Key of a scenario's dataset: its data sections and seed, package versions, generator code."""
     blob = json.dumps({"data": scenario.data_hash(), "versions": versions(),
-                       "code": generator_code_hash()}, sort_keys=True)
+                       "code": generator_code_hash(scenario.rig)}, sort_keys=True)
     return hashlib.sha256(blob.encode()).hexdigest()[:32]
 
 

@@ -39,3 +39,16 @@ def test_cache_hit_loads_and_clear_removes(tmp_path):
     again = cache.get(sc)
     assert again.content_hash() == first.content_hash()
     assert cache.clear() == 1 and cache.entries() == []
+
+
+def test_a_rigs_cache_key_covers_its_own_source_and_the_shared_chain_only():
+    """Editing or adding one rig does not invalidate another rig's cached datasets, while a
+    change to the shared generation code (noise model, dataset format) does for every rig."""
+    from testbed.pipeline.cache import SHARED_GENERATOR_SOURCES, generator_sources
+
+    cant = {p.as_posix() for p in generator_sources("cantilever")}
+    five = {p.as_posix() for p in generator_sources("fivebar")}
+    assert any("/models/cantilever/" in p for p in cant) and not any("/models/fivebar/" in p for p in cant)
+    assert any("/models/fivebar/" in p for p in five) and not any("/models/cantilever/" in p for p in five)
+    for shared in SHARED_GENERATOR_SOURCES:
+        assert any(p.endswith(shared) for p in cant) and any(p.endswith(shared) for p in five)
