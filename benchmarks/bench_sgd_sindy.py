@@ -201,8 +201,12 @@ def cantilever_case():
     clean = measure(noise_free(ds), sc.signal, "structural")
 
     def scorer(model: SGDSINDy) -> dict[str, float]:
+        # the stiff scenario's targets are on the paper's modes 1-2 (scored by name since every
+        # sensed mode is scored; mode 3 at 1.45 kHz is ~4 % off for every method, a signal-chain
+        # limit, see the README's known gaps)
         v = score_structural(ds, data, clean, model).values
-        return {"trac": v["trac"], "mac": v["mac"], "freq_error": v["freq_error"]}
+        return {"trac": v["trac"], "mac": min(v["mac_mode1"], v["mac_mode2"]),
+                "freq_error": max(v["freq_error_mode1"], v["freq_error_mode2"])}
 
     return sc, data, scorer
 
