@@ -473,6 +473,55 @@ def _per_mode(mac: np.ndarray, pair: np.ndarray, f_id: np.ndarray, f_true: np.nd
     return out
 
 
+#: The equation scores of a model that has no usable coefficients (never a pass).
+NO_EQUATION_SCORES = {"coef_error": float("nan"), "support_precision": float("nan"),
+                      "support_recall": float("nan"), "support_f1": float("nan")}
+
+
+def implicit_rollout(coef: np.ndarray, simulate: Callable[[], Trajectory], t: np.ndarray,
+                     reference_x: np.ndarray, channels: Any
+                     ) -> tuple[np.ndarray, dict[str, str], dict[str, Any]]:
+    """Simulate an identified implicit model against the reference coordinates.
+
+    Parameters
+    ----------
+    coef : ndarray, shape (n_equations, n_terms)
+        The identified coefficients; non-finite ones are a "model" failure (nothing simulated).
+    simulate : callable
+        Runs the model's simulation from the true initial state, returning a ``Trajectory``.
+    t : ndarray, shape (n,)
+        Sample times [s].
+    reference_x : ndarray, shape (n_coords, n)
+        The noise-free coordinates the simulation is compared with.
+    channels : sequence of str
+        Coordinate names (for the figures).
+
+    Returns
+    -------
+    rmse : ndarray, shape (n_coords,)
+        RMSE per coordinate; NaN for a failed model or simulation (never a pass), however close
+        its beginning was.
+    failures : dict of str to str
+        ``"model"`` or ``"simulation"`` with the reason (and the time in the details).
+    details : dict
+        ``t``, ``reference_x``, ``simulated_x``, ``channels`` (and ``divergence_time``).
+    """
+    failures: dict[str, str] = {}
+    d: dict[str, Any] = {"t": t, "reference_x": reference_x, "channels": channels}
+    sim = None
+    if not np.all(np.isfinite(coef)):  # nothing to simulate (the failure says so)
+        failures["model"] = "non-physical: identified coefficients hold non-finite entries"
+    else:
+        sim, why, when = simulate_scored(simulate, t, "x", reference_x)
+        if why is not None:
+            failures["simulation"] = why
+            d["divergence_time"] = when
+    d["simulated_x"] = sim.x if sim is not None else np.full_like(reference_x, np.nan)
+    rmse = (metrics.rmse(reference_x, d["simulated_x"]) if sim is not None and "simulation" not in failures
+            else np.full(reference_x.shape[0], np.nan))
+    return rmse, failures, d
+
+
 def score_mechanical(dataset: Dataset, data: Measurement, clean: Measurement, model: Any) -> Scores:
     """Joint-angle RMSE of the free simulation, and coefficient and support scores modulo the
     kinematic identities of the loop.
@@ -509,28 +558,13 @@ def score_mechanical(dataset: Dataset, data: Measurement, clean: Measurement, mo
     x0 = np.asarray(dataset.truth.get("theta0", theta[:, 0]), dtype=float)
     xd0 = np.asarray(dataset.truth.get("dtheta0", ref("dtheta")[:, 0]), dtype=float)
     t = np.arange(data.n_samples) / data.fs
-    failures: dict[str, str] = {}
     coef = np.asarray(model.coef_, dtype=float)
-    d: dict[str, Any] = {"t": t, "reference_x": theta, "channels": data.channels}
-    sim = None
-    if not np.all(np.isfinite(coef)):  # nothing to simulate (the failure says so)
-        failures["model"] = "non-physical: identified coefficients hold non-finite entries"
-    else:
-        sim, why, when = simulate_scored(lambda: model.simulate(x0, xd0, t, data.u), t, "x", theta)
-        if why is not None:
-            failures["simulation"] = why
-            d["divergence_time"] = when
-    sim_x = sim.x if sim is not None else np.full_like(theta, np.nan)
-    # A failed simulation has no RMSE (NaN, never a pass), however close its beginning was.
-    rmse = (metrics.rmse(theta, sim_x) if sim is not None and "simulation" not in failures
-            else np.full(theta.shape[0], np.nan))
+    rmse, failures, d = implicit_rollout(coef, lambda: model.simulate(x0, xd0, t, data.u), t, theta,
+                                         data.channels)
     v: dict[str, float] = {"angle_rmse": worst(rmse, "max")}
-    d.update(angle_rmse=rmse, simulated_x=sim_x)
-
+    d["angle_rmse"] = rmse
     if "model" in failures:
-        v.update(coef_error=float("nan"), support_precision=float("nan"),
-                 support_recall=float("nan"), support_f1=float("nan"))
-        return Scores(v, d, failures)
+        return Scores({**v, **NO_EQUATION_SCORES}, d, failures)
     signals = {"th": ref("theta"), "dth": ref("dtheta"), "ddth": ref("ddtheta"), "u": ref("torque")}
     cmp = compare_equations(list(model.feature_names_), coef,
                             list(dataset.truth["equation_terms"]),
@@ -629,26 +663,13 @@ def score_dynamical(dataset: Dataset, data: Measurement, clean: Measurement, mod
     x_ref = np.asarray(dataset.reference.get("x", dataset.measured["x"]).data, dtype=float)
     x0 = np.asarray(dataset.truth["x0"], dtype=float)
     t = np.arange(data.n_samples) / data.fs
-    failures: dict[str, str] = {}
     coef = np.asarray(model.coef_, dtype=float)
-    d: dict[str, Any] = {"t": t, "reference_x": x_ref, "channels": data.channels}
-    sim = None
-    if not np.all(np.isfinite(coef)):
-        failures["model"] = "non-physical: identified coefficients hold non-finite entries"
-    else:
-        sim, why, when = simulate_scored(lambda: model.simulate(x0, None, t, data.u), t, "x", x_ref)
-        if why is not None:
-            failures["simulation"] = why
-            d["divergence_time"] = when
-    sim_x = sim.x if sim is not None else np.full_like(x_ref, np.nan)
-    rmse = (metrics.rmse(x_ref, sim_x) if sim is not None and "simulation" not in failures
-            else np.full(x_ref.shape[0], np.nan))
+    rmse, failures, d = implicit_rollout(coef, lambda: model.simulate(x0, None, t, data.u), t, x_ref,
+                                         data.channels)
     v: dict[str, float] = {"state_rmse": worst(rmse, "max")}
-    d.update(state_rmse=rmse, simulated_x=sim_x)
+    d["state_rmse"] = rmse
     if "model" in failures:
-        v.update(coef_error=float("nan"), support_precision=float("nan"),
-                 support_recall=float("nan"), support_f1=float("nan"))
-        return Scores(v, d, failures)
+        return Scores({**v, **NO_EQUATION_SCORES}, d, failures)
     cmp = compare_implicit(list(model.feature_names_), coef, list(dataset.truth["equation_terms"]),
                            np.asarray(dataset.truth["equation_coef"], dtype=float))
     v["coef_error"] = cmp["coef_error"]
