@@ -287,12 +287,13 @@ def _read_toml(path: Path, chain: tuple[Path, ...] = ()) -> dict:
     return raw
 
 
-def resolve_path(name_or_path: str | os.PathLike) -> Path:
-    """A path as given, or ``scenarios/<name>.toml`` for a bare scenario name."""
+def resolve_path(name_or_path: str | os.PathLike, directory: Path | None = None) -> Path:
+    """A path as given, or ``<directory>/<name>.toml`` for a bare name (default directory: the
+    shipped scenarios)."""
     p = Path(name_or_path)
     if p.suffix == ".toml" or p.exists() or len(p.parts) > 1:
         return p
-    return SCENARIO_DIR / f"{p}.toml"
+    return (SCENARIO_DIR if directory is None else directory) / f"{p}.toml"
 
 
 def _check_stem(path: Path, what: str, directory: Path) -> None:

@@ -178,10 +178,7 @@ def import_plugins(plugins: tuple[str, ...] | list[str]) -> None:
 
 def resolve_study_path(name_or_path: str | os.PathLike) -> Path:
     """A path as given, or ``studies/<name>.toml`` for a bare study name."""
-    p = Path(name_or_path)
-    if p.suffix == ".toml" or p.exists() or len(p.parts) > 1:
-        return p
-    return STUDY_DIR / f"{p}.toml"
+    return resolve_path(name_or_path, STUDY_DIR)
 
 
 def _no_duplicates(values: list, file: str, key: str) -> None:
