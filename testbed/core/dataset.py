@@ -24,7 +24,7 @@ import json
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
 
 import h5py
 import numpy as np
@@ -38,6 +38,8 @@ from testbed.core.truth import Truth, TruthError, truth_type
 FORMAT = "sysid-testbed-dataset/2"
 #: Formats read (a /1 file is verified against the hash it was written with).
 READ_FORMATS = ("sysid-testbed-dataset/1", FORMAT)
+
+T = TypeVar("T", bound=Truth)
 
 #: Keys of the ``scenario`` attribute that decide the data (as :meth:`Scenario.data_dict`); the
 #: name, description, tags, signal chain, ``[identify]`` and ``[score]`` do not.
@@ -126,9 +128,10 @@ class Dataset:
 
     Notes
     -----
-    ``truth`` is a plain mapping (what is stored, and what readers index by name); its
-    declaration is the kind's typed truth (:mod:`testbed.core.truth`), and
-    :attr:`typed_truth` gives it as that dataclass.  A dataset that names its kind
+    ``truth`` is a plain mapping (what is stored, and what a rig writes); its declaration is
+    the kind's typed truth (:mod:`testbed.core.truth`), and readers take it as that dataclass:
+    :attr:`typed_truth` (a reader of any kind) or :meth:`truth_as` (a reader of one kind, e.g. a
+    scorer), never by key.  A dataset that names its kind
     (``attrs["kind"]``) has its truth validated when saved and loaded
     (:meth:`check_truth`), so a missing, unknown or misshapen truth key is an error naming
     the key; one that does not (a hand-made or imported dataset) is not checked.
@@ -170,6 +173,27 @@ class Dataset:
             raise TruthError("the dataset records no rig kind (attrs['kind']); its truth has "
                              "no declared type")
         return truth_type(self.kind).from_dict(self.truth, self.truth_units)
+
+    def truth_as(self, cls: type[T]) -> T:
+        """The truth as ``cls`` (a kind's dataclass, e.g. ``StructuralTruth``), validated.
+
+        What a reader that needs one kind's truth calls (a scorer, an exporter of modes): its
+        fields are attributes, so a misspelt name is an ``AttributeError`` where it is written,
+        not a missing key at run time.  A dataset that records its kind gives that kind's
+        truth type, which must be ``cls`` or a subclass; one that records none (a hand-made
+        dataset) is read as ``cls``.
+
+        Raises
+        ------
+        TruthError
+            If the recorded kind's truth is not a ``cls``, or the truth does not fit ``cls``
+            (naming the missing, unknown or misshapen key).
+        """
+        typ = cls if self.kind is None else truth_type(self.kind)
+        if not issubclass(typ, cls):
+            raise TruthError(f"the dataset's truth is of rig kind {self.kind!r} ({typ.__name__}), "
+                             f"not {cls.__name__}")
+        return typ.from_dict(self.truth, self.truth_units)
 
     def check_truth(self) -> None:
         """Validate the truth against its kind's declaration, if the dataset records a kind.

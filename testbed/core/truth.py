@@ -11,11 +11,13 @@ their units and shapes is declared here, one dataclass per kind, so that the rea
 * :class:`DynamicalTruth`: the implicit first-order equations of a state-space system, its
   state names, initial state and parameters.
 
-``Dataset.truth`` stays the plain mapping (the stored format and every reader by key are
-unchanged); :meth:`Truth.from_dict` validates such a mapping (missing, unknown and
-misshapen keys raise :class:`TruthError` naming the key) and gives the dataclass,
-:meth:`Truth.to_dict` gives the mapping back.  :class:`~testbed.core.dataset.Dataset`
-validates its truth against ``TRUTH_TYPES[dataset.kind]`` when it is built and loaded.
+``Dataset.truth`` stays the plain mapping (the stored format is unchanged);
+:meth:`Truth.from_dict` validates such a mapping (missing, unknown and misshapen keys raise
+:class:`TruthError` naming the key) and gives the dataclass, :meth:`Truth.to_dict` gives the
+mapping back.  :class:`~testbed.core.dataset.Dataset` validates its truth against
+``TRUTH_TYPES[dataset.kind]`` when it is saved and loaded, and readers take it typed,
+never by key: ``dataset.truth_as(StructuralTruth).frequencies_hz`` (a reader of one kind, e.g.
+a scorer) or ``dataset.typed_truth`` (a reader of any kind, e.g. a summary).
 
 Shapes are declared with symbols: every field with symbol ``n`` must have the same length
 along it (e.g. ``M`` is ``(n, n)`` and ``frequencies_hz`` ``(n,)``).  A new kind adds a
@@ -28,7 +30,7 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import Any, ClassVar
+from typing import Any, ClassVar, Self
 
 import numpy as np
 
@@ -137,7 +139,7 @@ class Truth:
                              extra[0])
 
     @classmethod
-    def from_dict(cls, truth: Mapping[str, Any], units: Mapping[str, str] | None = None) -> Truth:
+    def from_dict(cls, truth: Mapping[str, Any], units: Mapping[str, str] | None = None) -> Self:
         """The validated typed truth of a mapping (:meth:`validate`); arrays as float ndarrays,
         text as lists of str, absent optional fields None."""
         cls.validate(truth, units)

@@ -8,6 +8,7 @@ import numpy as np
 from rich.console import Console
 from rich.table import Table
 
+from testbed.core.truth import DynamicalTruth, MechanicalTruth, StructuralTruth
 from testbed.scoring.scorers import FAIL, PASS
 
 if TYPE_CHECKING:
@@ -15,22 +16,21 @@ if TYPE_CHECKING:
     from testbed.scoring.run import RunResult
 
 def truth_rows(ds: Dataset) -> list[tuple[str, str]]:
-    """(label, value) pairs summarising a dataset's truth."""
+    """(label, value) pairs summarising a dataset's truth (its kind's typed truth; a dataset
+    that records no kind has no declared truth, and only its rig, samples and prior show)."""
     rows = [("rig", str(ds.attrs.get("rig", "?"))), ("samples", f"{ds.n_samples} at {ds.fs:g} Hz")]
-    tr = ds.truth
-    if "frequencies_hz" in tr:
-        f = np.asarray(tr["frequencies_hz"])
-        eb = np.asarray(tr.get("eb_frequencies_hz", []))
+    tr = ds.typed_truth if ds.kind is not None else None
+    if isinstance(tr, StructuralTruth):
+        f = tr.frequencies_hz
+        eb = tr.eb_frequencies_hz if tr.eb_frequencies_hz is not None else np.zeros(0)
         for i in range(min(4, len(f))):
             cell = f"{f[i]:9.2f} Hz"
             if i < len(eb):
                 cell += f"   Euler-Bernoulli {eb[i]:9.2f} Hz   ({100 * (f[i] / eb[i] - 1):+.3f} %)"
             rows.append((f"mode {i + 1}", cell))
-        if "damping_ratios" in tr:
-            z = np.asarray(tr["damping_ratios"])[:3]
-            rows.append(("damping ratios", ", ".join(f"{x:.4f}" for x in z)))
-    if "equation_terms" in tr:
-        rows.append(("true equation terms", str(len(tr["equation_terms"]))))
+        rows.append(("damping ratios", ", ".join(f"{x:.4f}" for x in tr.damping_ratios[:3])))
+    if isinstance(tr, (MechanicalTruth, DynamicalTruth)):
+        rows.append(("true equation terms", str(len(tr.equation_terms))))
     for k, v in ds.prior.items():
         rows.append((f"prior {k}", f"{v}"))
     for key in ("stepping", "start_pose"):  # what the rig chose automatically, and why

@@ -11,12 +11,14 @@ UFF
     the response node and direction, and the signal / scenario / content hash in
     the ID lines.  The UFF58 header keeps the sample interval to 6 significant
     digits only (format E13.5), so ID line 5 also states the exact ``fs``.  For a
-    structural truth (``frequencies_hz`` + ``sensor_modes``) one UFF55 *normal mode*
-    record per mode follows: frequency [Hz], viscous damping ratio, modal mass [kg]
-    (``phi^T Mr phi`` when the truth holds the reduced mass matrix ``Mr``, 1 for
-    shapes declared mass-normalised by their unit ``.../sqrt(kg ...)``, else 0 =
-    unknown) and the mode shape at the sensor nodes (nodes = sensors).  ID line 2
-    states frequency and damping as plain numbers (``82.7660 Hz, zeta 0.010000``).
+    dataset of a structural kind (its truth a
+    :class:`~testbed.core.truth.StructuralTruth`) one UFF55 *normal mode* record per
+    sensor mode follows: frequency [Hz], viscous damping ratio, modal mass [kg]
+    (``phi^T Mr phi`` with the reduced mass matrix ``Mr``: 1 for the cantilever's
+    mass-normalised SEREP shapes) and the mode shape at the sensor nodes (nodes =
+    sensors).  ID line 2 states frequency and damping as plain numbers
+    (``82.7660 Hz, zeta 0.010000``).  A dataset that records no kind (hand-made, or
+    imported) has no declared truth, and gets no modes.
 
     A mechanism without positions (the five-bar: absolute link angles th1..th4,
     whose moving joints have no fixed place, and no mode shapes to draw) gets
@@ -50,6 +52,7 @@ import numpy as np
 
 from testbed.core.atomic import atomic_write, atomic_write_text
 from testbed.core.dataset import Dataset, Signal
+from testbed.core.truth import StructuralTruth
 from testbed.pipeline.plugins import RIGS
 from testbed.pipeline.signal_chain import measure
 
@@ -77,11 +80,13 @@ def quantity(unit: str) -> tuple[str, int, int, int, bool, str]:
 
 
 def _rig_kind(ds: Dataset) -> str | None:
-    """The kind of the dataset's rig (``attrs["rig"]``), None if unknown or not registered."""
+    """The kind the dataset records, else that of its rig (``attrs["rig"]``) if registered,
+    else None (no signal chain to ask)."""
+    if ds.kind is not None:
+        return ds.kind
     try:
-
         return str(RIGS.get(str(ds.attrs.get("rig", ""))).kind)
-    except Exception:  # an unregistered or missing rig: no signal chain to ask
+    except KeyError:  # an unregistered or missing rig
         return None
 
 
@@ -178,34 +183,42 @@ def _uff58(ds: Dataset, name: str, i: int, s: Signal, node: int) -> dict[str, An
         orddenom_spec_data_type=0, z_axis_spec_data_type=0, z_axis_value=0.0)
 
 
-def modal_masses(ds: Dataset, phi: np.ndarray) -> np.ndarray:
-    """Modal mass [kg] of each sensor mode shape (columns of ``phi``, shape (n_sensors, n_modes)).
+def structural_truth(ds: Dataset) -> StructuralTruth | None:
+    """The dataset's truth if its recorded kind's truth is structural, else None (another
+    kind, or no kind recorded: a hand-made or imported dataset, whose truth is undeclared)."""
+    truth = ds.typed_truth if ds.kind is not None else None
+    return truth if isinstance(truth, StructuralTruth) else None
 
-    ``diag(phi^T Mr phi)`` when the truth holds the reduced mass matrix ``Mr`` [kg] in sensor
-    coordinates (1 for the cantilever's mass-normalised SEREP shapes), else 1 for shapes whose
-    unit declares them mass-normalised (``".../sqrt(kg ...)"``), else 0 (unknown).
+
+def modal_masses(truth: StructuralTruth, phi: np.ndarray) -> np.ndarray:
+    """Modal mass [kg] of each sensor mode shape: ``diag(phi^T Mr phi)``.
+
+    Parameters
+    ----------
+    truth : StructuralTruth
+        Its reduced mass matrix ``Mr`` [kg], shape (n_sensors, n_sensors).
+    phi : ndarray, shape (n_sensors, n_modes)
+        Mode shapes in columns [m / sqrt(kg)] (1 for the cantilever's mass-normalised shapes).
+
+    Returns
+    -------
+    ndarray, shape (n_modes,)
     """
-    mr = ds.truth.get("Mr")
-    if mr is not None and np.shape(mr) == (phi.shape[0], phi.shape[0]):
-        return np.einsum("ik,ij,jk->k", phi, np.asarray(mr, dtype=float), phi)
-    if "sqrt(kg" in ds.truth_units.get("sensor_modes", ""):
-        return np.ones(phi.shape[1])
-    return np.zeros(phi.shape[1])
+    return np.einsum("ik,ij,jk->k", phi, truth.Mr, phi)
 
 
-def _uff55(ds: Dataset, sensor_nodes: list[int]) -> list[dict[str, Any]]:
-    """One normal-mode record per true mode: the shape at the sensor nodes along the bending direction."""
+def _uff55(ds: Dataset, truth: StructuralTruth, sensor_nodes: list[int]) -> list[dict[str, Any]]:
+    """One normal-mode record per sensor mode: the shape at the sensor nodes along the bending
+    direction."""
     import pyuff
 
-    f = np.asarray(ds.truth["frequencies_hz"], dtype=float)
-    phi = np.atleast_2d(np.asarray(ds.truth["sensor_modes"], dtype=float))
-    zeta = np.asarray(ds.truth.get("damping_ratios", np.zeros_like(f)), dtype=float)
+    f, zeta, phi = truth.frequencies_hz, truth.damping_ratios, truth.sensor_modes
     n = min(f.size, phi.shape[1])
-    mass = modal_masses(ds, phi)
+    mass = modal_masses(truth, phi)
     zero = np.zeros(phi.shape[0])
     sets = []
     for k in range(n):
-        z = float(zeta[k]) if k < zeta.size else 0.0
+        z = float(zeta[k])
         shape = {"r1": zero, "r2": zero, "r3": zero, f"r{DIR_TRANSLATION}": phi[:, k]}
         sets.append(pyuff.prepare_55(
             model_type=1, analysis_type=2, data_ch=2, spec_data_type=8, data_type=2, n_data_per_node=3,
@@ -247,12 +260,10 @@ def _geometry(ds: Dataset) -> list[dict[str, Any]]:
     return sets
 
 
-def _sensor_nodes(ds: Dataset, nodes: dict[tuple[str, int], int]) -> list[int] | None:
-    """Nodes of the signal the true sensor mode shapes refer to (same row count, with positions)."""
-    phi = ds.truth.get("sensor_modes")
-    if phi is None or "frequencies_hz" not in ds.truth:
-        return None
-    rows = np.atleast_2d(np.asarray(phi)).shape[0]
+def _sensor_nodes(ds: Dataset, truth: StructuralTruth, nodes: dict[tuple[str, int], int]
+                  ) -> list[int] | None:
+    """Nodes of the signal the true sensor mode shapes refer to (same row count, a motion)."""
+    rows = truth.sensor_modes.shape[0]
     for name, s in ds.measured.items():
         if len(s.channels) == rows and quantity(s.unit)[0] in ("acceleration", "velocity", "displacement"):
             return [nodes[(name, i)] for i in range(rows)]
@@ -277,9 +288,10 @@ def write_uff(ds: Dataset, out: str | os.PathLike) -> Path:
     nodes = node_numbers(ds)
     sets = [_uff164(), *_geometry(ds)]
     sets += [_uff58(ds, name, i, s, nodes[(name, i)]) for name, i, s in _channels(ds)]
-    sensor_nodes = _sensor_nodes(ds, nodes)
-    if sensor_nodes is not None:
-        sets += _uff55(ds, sensor_nodes)
+    truth = structural_truth(ds)
+    sensor_nodes = None if truth is None else _sensor_nodes(ds, truth, nodes)
+    if truth is not None and sensor_nodes is not None:
+        sets += _uff55(ds, truth, sensor_nodes)
     # pyuff 2.5 truncates the header of a binary 58 written in "overwrite" mode (it reopens the
     # file "wb" for the data), so start from an empty file (the temporary one) and add every set.
     return atomic_write(out, lambda tmp: pyuff.UFF(tmp).write_sets(sets, mode="add"))

@@ -17,6 +17,7 @@ from testbed.core.errors import DivergenceError, IdentificationError
 from testbed.core.kinds import MAX_MODE_SCORES, METRICS
 from testbed.core.measurement import Measurement, Trajectory
 from testbed.core.terms import canonical
+from testbed.core.truth import DynamicalTruth, MechanicalTruth, StructuralTruth, TruthError
 from testbed.scoring import metrics
 from testbed.scoring.equation_basis import compare_equations
 from testbed.scoring.metrics import worst
@@ -352,7 +353,7 @@ def score_structural(dataset: Dataset, data: Measurement, clean: Measurement, mo
     the TRAC of a failed simulation is NaN.  The other scores are still computed (NaN where
     the model gives no modes), as diagnostics of what went wrong.
     """
-    truth = dataset.truth
+    truth = dataset.truth_as(StructuralTruth)
     i0 = data.free_start
     t = np.arange(data.n_samples - i0) / data.fs
     u = None if data.u is None else data.u[:, i0:]
@@ -374,9 +375,9 @@ def score_structural(dataset: Dataset, data: Measurement, clean: Measurement, mo
     d.update(trac=trac, simulated_xdd=sim_xdd)
 
     f_id, z_id, phi_id = metrics.modal_from_matrices(model.M_, model.C_, model.K_, strict=False)
-    f_true = np.asarray(truth["frequencies_hz"])[: data.n_channels]
-    z_true = np.asarray(truth["damping_ratios"])[: data.n_channels]
-    phi_true = np.asarray(truth["sensor_modes"])[:, : data.n_channels]
+    f_true = truth.frequencies_hz[: data.n_channels]
+    z_true = truth.damping_ratios[: data.n_channels]
+    phi_true = truth.sensor_modes[:, : data.n_channels]
     m = scored_modes(data.n_channels, len(f_true))
     mac = metrics.mac_matrix(phi_id, phi_true)
     pair = metrics.pair_modes(mac.T)  # pair[j] = identified mode matched to true mode j
@@ -393,7 +394,7 @@ def score_structural(dataset: Dataset, data: Measurement, clean: Measurement, mo
     d.update(scored_modes=m, **{f"{k}_per_mode": np.asarray(x) for k, x in per_mode.items()})
     d.update(mac=mac, pair=pair, f_id=f_id, f_true=f_true, z_id=z_id, z_true=z_true)
 
-    Mr, Kr, Cr = (np.asarray(truth[k]) for k in ("Mr", "Kr", "Cr"))
+    Mr, Kr, Cr = truth.Mr, truth.Kr, truth.Cr
     v["Mr_error"] = metrics.relative_error(model.M_, Mr)
     v["Kr_error"] = metrics.relative_error(model.K_, Kr)
     v["Cr_error"] = metrics.relative_error(model.C_, Cr)
@@ -423,11 +424,14 @@ def score_structural(dataset: Dataset, data: Measurement, clean: Measurement, mo
         v["K3_force_ratio"] = float(np.linalg.norm(K3 @ x_ref**3) / lin) if lin > 0 else float("nan")
     else:
         v["K3_force_ratio"] = 0.0
-    k3 = float(np.asarray(truth.get("k3", 0.0)))
+    k3 = 0.0 if truth.k3 is None else float(truth.k3)
     if K3 is not None and k3 != 0.0:
+        if truth.cubic_map is None or truth.cubic_direction is None:
+            raise TruthError("structural truth: a nonzero 'k3' needs 'cubic_map' and "
+                             "'cubic_direction'", "cubic_map")
         x_ref = clean.x[:, i0:]
-        q0 = np.asarray(truth["cubic_map"]) @ x_ref
-        f_true = np.outer(np.asarray(truth["cubic_direction"]), k3 * q0**3)
+        q0 = truth.cubic_map @ x_ref
+        f_true = np.outer(truth.cubic_direction, k3 * q0**3)
         f_id = K3 @ x_ref**3
         v["K3_force_error"] = float(np.linalg.norm(f_id - f_true) / np.linalg.norm(f_true))
         d.update(cubic_force_true=f_true, cubic_force_id=f_id)
@@ -478,48 +482,66 @@ NO_EQUATION_SCORES = {"coef_error": float("nan"), "support_precision": float("na
                       "support_recall": float("nan"), "support_f1": float("nan")}
 
 
-def implicit_rollout(coef: np.ndarray, simulate: Callable[[], Trajectory], t: np.ndarray,
-                     reference_x: np.ndarray, channels: Any
-                     ) -> tuple[np.ndarray, dict[str, str], dict[str, Any]]:
-    """Simulate an identified implicit model against the reference coordinates.
+def implicit_rollout(score: str, model: Any, data: Measurement, x0: np.ndarray,
+                     xd0: np.ndarray | None, reference_x: np.ndarray
+                     ) -> tuple[np.ndarray, dict[str, float], dict[str, str], dict[str, Any]]:
+    """Simulate an identified implicit model from the true initial state against the reference
+    coordinates, over the whole record under the measured inputs.
 
     Parameters
     ----------
-    coef : ndarray, shape (n_equations, n_terms)
-        The identified coefficients; non-finite ones are a "model" failure (nothing simulated).
-    simulate : callable
-        Runs the model's simulation from the true initial state, returning a ``Trajectory``.
-    t : ndarray, shape (n,)
-        Sample times [s].
-    reference_x : ndarray, shape (n_coords, n)
+    score : str
+        Name of the RMSE score (e.g. ``"angle_rmse"``).
+    model : Identifier
+        Fitted: ``coef_`` (n_equations, n_terms) and ``simulate(x0, xd0, t, u)``.
+    data : Measurement
+        What the model was fitted on: its sample rate [Hz], inputs ``u`` and channel names.
+    x0 : ndarray, shape (n_coords,)
+        True initial coordinates [their unit].
+    xd0 : ndarray, shape (n_coords,) or None
+        True initial rates [unit/s] (None for a first-order model).
+    reference_x : ndarray, shape (n_coords, n_samples)
         The noise-free coordinates the simulation is compared with.
-    channels : sequence of str
-        Coordinate names (for the figures).
 
     Returns
     -------
-    rmse : ndarray, shape (n_coords,)
-        RMSE per coordinate; NaN for a failed model or simulation (never a pass), however close
-        its beginning was.
+    coef : ndarray, shape (n_equations, n_terms)
+        The identified coefficients as floats; non-finite ones are a "model" failure
+        (nothing simulated).
+    values : dict of str to float
+        ``{score: largest per-coordinate RMSE}``; NaN for a failed model or simulation (never a
+        pass), however close its beginning was.
     failures : dict of str to str
         ``"model"`` or ``"simulation"`` with the reason (and the time in the details).
     details : dict
-        ``t``, ``reference_x``, ``simulated_x``, ``channels`` (and ``divergence_time``).
+        ``t``, ``reference_x``, ``simulated_x``, ``channels``, ``score`` (the RMSE per
+        coordinate) and, for a divergence, ``divergence_time``.
     """
+    t = np.arange(data.n_samples) / data.fs
+    coef = np.asarray(model.coef_, dtype=float)
     failures: dict[str, str] = {}
-    d: dict[str, Any] = {"t": t, "reference_x": reference_x, "channels": channels}
+    d: dict[str, Any] = {"t": t, "reference_x": reference_x, "channels": data.channels}
     sim = None
     if not np.all(np.isfinite(coef)):  # nothing to simulate (the failure says so)
         failures["model"] = "non-physical: identified coefficients hold non-finite entries"
     else:
-        sim, why, when = simulate_scored(simulate, t, "x", reference_x)
+        sim, why, when = simulate_scored(lambda: model.simulate(x0, xd0, t, data.u), t, "x",
+                                         reference_x)
         if why is not None:
             failures["simulation"] = why
             d["divergence_time"] = when
     d["simulated_x"] = sim.x if sim is not None else np.full_like(reference_x, np.nan)
     rmse = (metrics.rmse(reference_x, d["simulated_x"]) if sim is not None and "simulation" not in failures
             else np.full(reference_x.shape[0], np.nan))
-    return rmse, failures, d
+    d[score] = rmse
+    return coef, {score: worst(rmse, "max")}, failures, d
+
+
+def equation_scores(cmp: dict[str, Any]) -> dict[str, float]:
+    """``coef_error`` and ``support_precision`` / ``_recall`` / ``_f1`` of an equation
+    comparison (:func:`compare_implicit`, :func:`~testbed.scoring.equation_basis.compare_equations`)."""
+    return {"coef_error": float(cmp["coef_error"]), "support_precision": float(cmp["precision"]),
+            "support_recall": float(cmp["recall"]), "support_f1": float(cmp["f1"])}
 
 
 def score_mechanical(dataset: Dataset, data: Measurement, clean: Measurement, model: Any) -> Scores:
@@ -554,24 +576,17 @@ def score_mechanical(dataset: Dataset, data: Measurement, clean: Measurement, mo
 
     # The true initial state and angles, as recorded by the rig: not the signal chain's estimates,
     # whose end effects would otherwise count against the identifier.
+    truth = dataset.truth_as(MechanicalTruth)
     theta = ref("theta")
-    x0 = np.asarray(dataset.truth.get("theta0", theta[:, 0]), dtype=float)
-    xd0 = np.asarray(dataset.truth.get("dtheta0", ref("dtheta")[:, 0]), dtype=float)
-    t = np.arange(data.n_samples) / data.fs
-    coef = np.asarray(model.coef_, dtype=float)
-    rmse, failures, d = implicit_rollout(coef, lambda: model.simulate(x0, xd0, t, data.u), t, theta,
-                                         data.channels)
-    v: dict[str, float] = {"angle_rmse": worst(rmse, "max")}
-    d["angle_rmse"] = rmse
+    x0 = theta[:, 0] if truth.theta0 is None else truth.theta0
+    xd0 = ref("dtheta")[:, 0] if truth.dtheta0 is None else truth.dtheta0
+    coef, v, failures, d = implicit_rollout("angle_rmse", model, data, x0, xd0, theta)
     if "model" in failures:
         return Scores({**v, **NO_EQUATION_SCORES}, d, failures)
-    signals = {"th": ref("theta"), "dth": ref("dtheta"), "ddth": ref("ddtheta"), "u": ref("torque")}
-    cmp = compare_equations(list(model.feature_names_), coef,
-                            list(dataset.truth["equation_terms"]),
-                            np.asarray(dataset.truth["equation_coef"], dtype=float), signals)
-    v["coef_error"] = float(cmp["coef_error"])
-    v["support_precision"], v["support_recall"], v["support_f1"] = (
-        float(cmp["precision"]), float(cmp["recall"]), float(cmp["f1"]))
+    signals = {"th": theta, "dth": ref("dtheta"), "ddth": ref("ddtheta"), "u": ref("torque")}
+    cmp = compare_equations(list(model.feature_names_), coef, truth.equation_terms,
+                            truth.equation_coef, signals)
+    v.update(equation_scores(cmp))
     library = _library_name(model)
     if library in LIBRARY_SCORE_SUFFIX:  # the same scores under the fitted library's name
         suffix = LIBRARY_SCORE_SUFFIX[library]
@@ -660,23 +675,16 @@ def score_dynamical(dataset: Dataset, data: Measurement, clean: Measurement, mod
     the identifier's term names (``model.feature_names_``) against the truth's
     (``equation_terms`` / ``equation_coef``).
     """
+    truth = dataset.truth_as(DynamicalTruth)
     x_ref = np.asarray(dataset.reference.get("x", dataset.measured["x"]).data, dtype=float)
-    x0 = np.asarray(dataset.truth["x0"], dtype=float)
-    t = np.arange(data.n_samples) / data.fs
-    coef = np.asarray(model.coef_, dtype=float)
-    rmse, failures, d = implicit_rollout(coef, lambda: model.simulate(x0, None, t, data.u), t, x_ref,
-                                         data.channels)
-    v: dict[str, float] = {"state_rmse": worst(rmse, "max")}
-    d["state_rmse"] = rmse
+    coef, v, failures, d = implicit_rollout("state_rmse", model, data, truth.x0, None, x_ref)
     if "model" in failures:
         return Scores({**v, **NO_EQUATION_SCORES}, d, failures)
-    cmp = compare_implicit(list(model.feature_names_), coef, list(dataset.truth["equation_terms"]),
-                           np.asarray(dataset.truth["equation_coef"], dtype=float))
-    v["coef_error"] = cmp["coef_error"]
-    v["support_precision"], v["support_recall"], v["support_f1"] = (
-        cmp["precision"], cmp["recall"], cmp["f1"])
+    cmp = compare_implicit(list(model.feature_names_), coef, truth.equation_terms,
+                           truth.equation_coef)
+    v.update(equation_scores(cmp))
     errs = np.where(np.asarray(cmp["coef_true"])[:, [cmp["names"].index(canonical(n)[0])
-                                                     for n in dataset.truth["equation_terms"]]]
+                                                     for n in truth.equation_terms]]
                     != 0.0, cmp["coef_errors"], 0.0)
     d.update(terms=cmp["names"], coef_true=cmp["coef_true"], coef_id=cmp["coef_id"],
              coef_term_errors=cmp["coef_errors"], coef_errors=errs.max(axis=1))

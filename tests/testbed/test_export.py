@@ -10,7 +10,14 @@ import pytest
 import pyuff
 
 from testbed.core.dataset import Dataset, Signal
-from testbed.reporting.export import export_dataset, modal_masses, node_numbers, read_sep005, to_sep005
+from testbed.reporting.export import (
+    export_dataset,
+    modal_masses,
+    node_numbers,
+    read_sep005,
+    structural_truth,
+    to_sep005,
+)
 
 FS = 1024.0
 N = 512
@@ -23,16 +30,22 @@ def cantilever_dataset() -> Dataset:
     force = np.zeros((1, N))
     force[0, :4] = [5.0, 40.0, 40.0, 5.0]
     phi = np.array([[0.1, -0.5, 0.8], [0.5, -0.2, -0.6], [1.0, 0.9, 0.4]])
+    f = np.array([82.76612345678, 519.9, 1455.0])
+    zeta = np.array([0.01, 0.02, 0.03])
+    # a structural truth whose modes are phi: mass-normalised (phi^T M phi = I), with
+    # phi^T K phi = diag(w^2) and phi^T C phi = diag(2 zeta w); the sensors are the coordinates
     inv = np.linalg.inv(phi)
+    w = 2 * np.pi * f
+    M, K, C = (inv.T @ np.diag(d) @ inv for d in (np.ones(3), w**2, 2 * zeta * w))
+    truth = {"M": M, "C": C, "K": K, "frequencies_hz": f, "damping_ratios": zeta, "modes": phi,
+             "sensor_modes": phi, "Mr": M, "Cr": C, "Kr": K}
     return Dataset(FS, {"acceleration": Signal(acc, ("acc1", "acc2", "acc3"), "m/s^2", pos),
                         "force": Signal(force, ("impact",), "N", pos[2:])},
                    {"acceleration": Signal(acc * 0.9, ("acc1", "acc2", "acc3"), "m/s^2", pos)},
-                   {"frequencies_hz": np.array([82.76612345678, 519.9, 1455.0]),
-                    "damping_ratios": np.array([0.01, 0.02, 0.03]), "sensor_modes": phi,
-                    "Mr": inv.T @ inv},  # mass-normalised shapes: phi^T Mr phi = I
-                   {"frequencies_hz": "Hz", "sensor_modes": "m/sqrt(kg m^2)", "Mr": "kg"},
+                   truth, {"frequencies_hz": "Hz", "sensor_modes": "m/sqrt(kg m^2)", "Mr": "kg"},
                    {"total_mass": 0.4},
-                   {"rig": "cantilever", "seed": 7, "scenario_name": "cantilever_stiff_impact"})
+                   {"rig": "cantilever", "kind": "structural", "seed": 7,
+                    "scenario_name": "cantilever_stiff_impact"})
 
 
 def fivebar_dataset() -> Dataset:
@@ -46,7 +59,7 @@ def fivebar_dataset() -> Dataset:
                         "ddtheta": Signal(-w**2 * th, ("ddth1", "ddth2", "ddth3", "ddth4"), "rad/s^2"),
                         "torque": Signal(tau, ("u1", "u2"), "N m", acts_on=("th1", "th4"))},
                    truth={"equation_terms": ["ddth1", "u1"], "equation_coef": np.array([[1.0, -1.0]])},
-                   attrs={"rig": "fivebar", "seed": 0})
+                   attrs={"rig": "fivebar", "kind": "mechanical", "seed": 0})
 
 
 @pytest.fixture
@@ -144,14 +157,23 @@ def test_node_numbers_by_position_and_input_map():
     assert (nodes[("torque", 0)], nodes[("torque", 1)]) == (1, 4)
 
 
-def test_modal_mass_unknown_without_mass_matrix_or_normalisation():
+def test_modal_mass_is_phi_t_mr_phi():
+    truth = structural_truth(cantilever_dataset())
+    phi = truth.sensor_modes
+    # 1e-12: phi^T (inv^T inv) phi is I up to the round-off of inverting a 3x3 of condition ~10
+    assert modal_masses(truth, phi) == pytest.approx([1.0, 1.0, 1.0], rel=1e-12)
+    assert modal_masses(truth, phi * [1.0, 2.0, 3.0]) == pytest.approx([1.0, 4.0, 9.0], rel=1e-12)
+
+
+def test_no_modes_without_a_structural_kind(saved, tmp_path):
+    """The modes are exported from the declared structural truth only: a dataset that records no
+    kind (hand-made, imported) has an undeclared truth, a mechanism has no modes."""
     ds = cantilever_dataset()
-    phi = ds.truth["sensor_modes"]
-    assert modal_masses(ds, phi) == pytest.approx([1.0, 1.0, 1.0], rel=1e-12)
-    del ds.truth["Mr"]
-    assert list(modal_masses(ds, phi)) == [1.0, 1.0, 1.0]  # declared mass-normalised by its unit
-    ds.truth_units["sensor_modes"] = "m"
-    assert list(modal_masses(ds, phi)) == [0.0, 0.0, 0.0]
+    del ds.attrs["kind"]
+    assert structural_truth(ds) is None
+    (out,) = export_dataset(saved(ds), "uff", tmp_path / "beam.uff")
+    assert [s["type"] for s in read_uff(out)] == [164, 2411, 82] + [58] * 4
+    assert structural_truth(fivebar_dataset()) is None
 
 
 # SEP 5 (SDyPy unified timeseries): compulsory, optional and prohibited fields

@@ -3,6 +3,7 @@
 import numpy as np
 import pytest
 
+from testbed.core.dataset import Dataset, Signal
 from testbed.core.errors import ScenarioError
 from testbed.core.kinds import METRICS
 from testbed.core.truth import (
@@ -76,6 +77,25 @@ def test_mechanical_truth_text_terms():
         MechanicalTruth.validate({**d, "equation_terms": np.zeros(2)})
     with pytest.raises(TruthError, match=r"'equation_coef' has shape \(1, 3\).*t = 2"):
         MechanicalTruth.validate({**d, "equation_coef": np.ones((1, 3))})
+
+
+def test_readers_take_the_truth_typed():
+    measured = {"x": Signal(np.zeros((2, 4)), ("x1", "x2"), "m")}
+    ds = Dataset(100.0, measured, truth=structural(), attrs={"kind": "structural"})
+    t = ds.truth_as(StructuralTruth)
+    assert isinstance(t, StructuralTruth) and isinstance(ds.typed_truth, StructuralTruth)
+    np.testing.assert_array_equal(t.frequencies_hz, [1.0, 2.0, 3.0])
+    with pytest.raises(AttributeError):
+        t.frequency_hz  # noqa: B018  (a misspelt field fails where it is written)
+    with pytest.raises(TruthError, match=r"rig kind 'structural' \(StructuralTruth\), not MechanicalTruth"):
+        ds.truth_as(MechanicalTruth)
+    # a dataset that records no kind is read as the type asked for, and validated
+    bare = Dataset(100.0, measured, truth=structural())
+    assert bare.truth_as(StructuralTruth).Mr.shape == (2, 2)
+    with pytest.raises(TruthError, match="missing 'equation_terms'"):
+        bare.truth_as(MechanicalTruth)
+    with pytest.raises(TruthError, match="records no rig kind"):
+        bare.typed_truth  # noqa: B018  (the property raises)
 
 
 def test_a_second_truth_type_for_a_kind_is_refused():
