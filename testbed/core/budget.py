@@ -79,23 +79,27 @@ def check_cost(cost: Cost, file: str) -> None:
     BudgetError
         Naming the file, the key, its value, the estimate and the budget.
     """
-    if not cost.samples <= SAMPLE_BUDGET:
-        raise BudgetError(file, cost.samples_key, cost.samples_value,
-                          f"the record would hold {cost.samples:.3g} samples; the budget is "
-                          f"{SAMPLE_BUDGET:.3g} (testbed.core.budget.SAMPLE_BUDGET)")
-    if not cost.steps <= STEP_BUDGET:
-        raise BudgetError(file, cost.steps_key, cost.steps_value,
-                          f"the simulation would take {cost.steps:.3g} integration steps; the "
-                          f"budget is {STEP_BUDGET:.3g} (testbed.core.budget.STEP_BUDGET)")
-    if cost.seconds is not None and not cost.seconds <= CPU_BUDGET_S:
-        raise BudgetError(file, cost.seconds_key, cost.seconds_value,
-                          f"the simulation would take about {cost.seconds / 3600:.3g} h of CPU; the "
-                          f"budget is {CPU_BUDGET_S / 3600:g} h (testbed.core.budget.CPU_BUDGET_S)")
-    if not cost.memory_bytes <= MEMORY_BUDGET_BYTES:
-        raise BudgetError(file, cost.memory_key, cost.memory_value,
-                          f"the run would need about {cost.memory_bytes / 2**30:.3g} GiB of memory; "
-                          f"the budget is {MEMORY_BUDGET_BYTES / 2**30:g} GiB "
-                          "(testbed.core.budget.MEMORY_BUDGET_BYTES)")
+    # (estimate, budget, key, value, what the run would need; the budget): samples first
+    checks = (
+        (cost.samples, SAMPLE_BUDGET, cost.samples_key, cost.samples_value,
+         f"the record would hold {cost.samples:.3g} samples; the budget is "
+         f"{SAMPLE_BUDGET:.3g} (testbed.core.budget.SAMPLE_BUDGET)"),
+        (cost.steps, STEP_BUDGET, cost.steps_key, cost.steps_value,
+         f"the simulation would take {cost.steps:.3g} integration steps; the "
+         f"budget is {STEP_BUDGET:.3g} (testbed.core.budget.STEP_BUDGET)"),
+        (cost.seconds, CPU_BUDGET_S, cost.seconds_key, cost.seconds_value,
+         "" if cost.seconds is None else
+         f"the simulation would take about {cost.seconds / 3600:.3g} h of CPU; the "
+         f"budget is {CPU_BUDGET_S / 3600:g} h (testbed.core.budget.CPU_BUDGET_S)"),
+        (cost.memory_bytes, MEMORY_BUDGET_BYTES, cost.memory_key, cost.memory_value,
+         f"the run would need about {cost.memory_bytes / 2**30:.3g} GiB of memory; "
+         f"the budget is {MEMORY_BUDGET_BYTES / 2**30:g} GiB "
+         "(testbed.core.budget.MEMORY_BUDGET_BYTES)"),
+    )
+    for estimate, budget, key, value, why in checks:
+        # "not <=": a NaN estimate is over budget (never a pass); None: the rig does not say
+        if estimate is not None and not estimate <= budget:
+            raise BudgetError(file, key, value, why)
 
 
 def check_steps(steps: float, file: str, key: str, value: object) -> None:

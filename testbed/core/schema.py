@@ -212,13 +212,21 @@ def validate_variant(table: Mapping[str, Any], variants: Mapping[str, Mapping[st
     return {selector: kind, **out}
 
 
-def validate_header(raw: Mapping[str, Any], *, sections: tuple[str, ...], header: str,
-                    schema: Mapping[str, Field], file: str, stem: str | None) -> dict[str, Any]:
+def validate_header(raw: Any, *, sections: tuple[str, ...], header: str,
+                    schema: Mapping[str, Field], file: str, stem: str | None,
+                    other: tuple[str, str] | None = None) -> dict[str, Any]:
     """Check a TOML document's sections and validate its header table.
 
-    Every top-level table must be one of ``sections``; the ``[header]`` table must be present
-    and valid; its ``name`` must equal ``stem`` (the file name without ``.toml``) when given.
+    ``raw`` must be a table of sections, each one of ``sections``; the ``[header]`` table must
+    be present and valid; its ``name`` must equal ``stem`` (the file name without ``.toml``)
+    when given.  ``other`` is ``(header, what)`` of the other kind of file (a study where a
+    scenario is expected, and back): a document with that header and without ``[header]`` is
+    refused with ``what`` (saying which file it is and how to run it).
     """
+    if not isinstance(raw, Mapping):
+        raise ScenarioError(file, allowed="expected a table of sections")
+    if other is not None and header not in raw and other[0] in raw:
+        raise ScenarioError(file, allowed=other[1])
     for section in raw:
         if section not in sections:
             # the section's content is not echoed: it may be a whole foreign file's

@@ -34,6 +34,14 @@ def _check_cutoff(cutoff_hz: float, fs: float, what: str) -> None:
                          f"Nyquist frequency {nyq:g} Hz (fs = {fs:g} Hz)")
 
 
+def _check_design(cutoff_hz: float, fs: float, order: int, what: str) -> int:
+    """The filter order as an int, once the sample rate, cut-off and order are valid."""
+    _check_cutoff(cutoff_hz, fs, what)
+    if int(order) < 1:
+        raise ValueError(f"filter order must be >= 1, got {order}")
+    return int(order)
+
+
 def _filtfilt(sos: np.ndarray, x: np.ndarray) -> np.ndarray:
     """Forward-backward filter with scipy's default end handling.
 
@@ -112,14 +120,12 @@ def elliptic_highpass(x: np.ndarray, fs: float, cutoff_hz: float, order: int = 4
     of acceleration, velocity and displacement.
     """
     x = _as_signal(x)
-    _check_cutoff(cutoff_hz, fs, "high-pass")
-    if int(order) < 1:
-        raise ValueError(f"filter order must be >= 1, got {order}")
+    order = _check_design(cutoff_hz, fs, order, "high-pass")
     if not (0 < ripple_db < stop_db):
         raise ValueError(f"need 0 < ripple_db < stop_db, got ripple_db={ripple_db}, stop_db={stop_db}")
     from scipy import signal as ss
 
-    sos = ss.ellip(int(order), ripple_db, stop_db, cutoff_hz, btype="highpass", output="sos", fs=fs)
+    sos = ss.ellip(order, ripple_db, stop_db, cutoff_hz, btype="highpass", output="sos", fs=fs)
     return _filtfilt(sos, x - x.mean(axis=-1, keepdims=True))
 
 
@@ -128,10 +134,8 @@ def lowpass(x: np.ndarray, fs: float, cutoff_hz: float, order: int = 8) -> np.nd
 
     Parameters
     ----------
-    x : ndarray, shape (n_channels, n_samples)
-        Signal in any unit.
-    fs : float
-        Sample rate [Hz].
+    x, fs
+        Signal (n_channels, n_samples) and sample rate [Hz], as for :func:`elliptic_highpass`.
     cutoff_hz : float
         -3 dB frequency of one pass [Hz] (-6 dB after forward-backward), in (0, fs/2).
     order : int
@@ -140,6 +144,7 @@ def lowpass(x: np.ndarray, fs: float, cutoff_hz: float, order: int = 8) -> np.nd
     Returns
     -------
     ndarray, shape (n_channels, n_samples)
+        ``x`` low-passed, in its unit.
 
     Notes
     -----
@@ -149,12 +154,10 @@ def lowpass(x: np.ndarray, fs: float, cutoff_hz: float, order: int = 8) -> np.nd
     modes of interest, where a sharp transition is not needed.
     """
     x = _as_signal(x)
-    _check_cutoff(cutoff_hz, fs, "low-pass")
-    if int(order) < 1:
-        raise ValueError(f"filter order must be >= 1, got {order}")
+    order = _check_design(cutoff_hz, fs, order, "low-pass")
     from scipy import signal as ss
 
-    sos = ss.butter(int(order), cutoff_hz, btype="lowpass", output="sos", fs=fs)
+    sos = ss.butter(order, cutoff_hz, btype="lowpass", output="sos", fs=fs)
     return _filtfilt(sos, x)
 
 

@@ -332,13 +332,9 @@ def scenario_from_dict(raw: dict[str, Any], *, file: str = "<dict>", stem: str |
     """Validate a scenario given as a dict of TOML tables (``standalone``: see
     :func:`load_scenario`)."""
 
-    if not isinstance(raw, dict):
-        raise ScenarioError(file, allowed="expected a table of sections")
-    if "scenario" not in raw and "study" in raw:
-        raise ScenarioError(file, allowed="a study (it has [study]), not a scenario; run it with "
-                                          "`testbed sweep`")
     head = validate_header(raw, sections=SECTIONS, header="scenario", schema=HEADER_SCHEMA, file=file,
-                           stem=stem)
+                           stem=stem, other=("study", "a study (it has [study]), not a scenario; run "
+                                                      "it with `testbed sweep`"))
     try:
         rig_cls = RIGS.get(head["rig"])
     except KeyError as e:

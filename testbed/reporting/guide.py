@@ -12,7 +12,8 @@ type and allowed values, unit, default and meaning, taken from
 from __future__ import annotations
 
 import inspect
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
+from typing import Any
 
 from testbed.core.kinds import METRICS
 from testbed.core.schema import Field
@@ -95,41 +96,48 @@ def table(schema: Mapping[str, Field]) -> str:
     return "\n".join(lines) + "\n"
 
 
-def _rig_sections() -> list[str]:
-
-    out = ["## `[rig]`, `[simulation]`, `[excitation]`: per rig\n",
-           "These tables belong to the rig named in `[scenario] rig`.  `[excitation]` "
-           "chooses its schema by `type`.\n"]
-    for name in RIGS.names():
-        cls = RIGS.get(name)
+def _registered(registry: Any, title: str, intro: str, what: str,
+                heading: Callable[[str], str], body: Callable[[Any], list[str]]) -> list[str]:
+    """A section with one subsection per registered class: its heading and kind, the first
+    paragraph of its docstring, then ``body(cls)``; a line saying so if none is registered."""
+    out = [f"## {title}\n", intro]
+    for name in registry.names():
+        cls = registry.get(name)
         doc = (inspect.getdoc(cls) or "").split("\n\n")[0].replace("\n", " ")
-        out.append(f"### Rig `{name}` ({cls.kind})\n\n{doc}\n")
-        out.append(f"Measured signals: {', '.join(f'`{s}`' for s in cls.measured_signals) or '–'}; "
-                   f"noisy by default: {', '.join(f'`{s}`' for s in cls.noisy_signals) or '–'}.\n")
-        out.append(f"#### `[rig]`\n\n{table(cls.rig_schema)}")
-        out.append(f"#### `[simulation]`\n\n{table(cls.simulation_schema)}")
-        for etype, schema in cls.excitation_schemas.items():
-            default = " (the default)" if etype == cls.default_excitation else ""
-            out.append(f'#### `[excitation]` with `type = "{etype}"`{default}\n\n{table(schema)}')
-    if not RIGS.names():
-        out.append("*(no rig registered)*\n")
+        out.append(f"### {heading(name)} ({cls.kind})\n\n{doc}\n")
+        out += body(cls)
+    if not registry.names():
+        out.append(f"*(no {what} registered)*\n")
     return out
+
+
+def _rig_body(cls: Any) -> list[str]:
+    out = [f"Measured signals: {', '.join(f'`{s}`' for s in cls.measured_signals) or '–'}; "
+           f"noisy by default: {', '.join(f'`{s}`' for s in cls.noisy_signals) or '–'}.\n",
+           f"#### `[rig]`\n\n{table(cls.rig_schema)}",
+           f"#### `[simulation]`\n\n{table(cls.simulation_schema)}"]
+    for etype, schema in cls.excitation_schemas.items():
+        default = " (the default)" if etype == cls.default_excitation else ""
+        out.append(f'#### `[excitation]` with `type = "{etype}"`{default}\n\n{table(schema)}')
+    return out
+
+
+def _rig_sections() -> list[str]:
+    return _registered(RIGS, "`[rig]`, `[simulation]`, `[excitation]`: per rig",
+                       "These tables belong to the rig named in `[scenario] rig`.  `[excitation]` "
+                       "chooses its schema by `type`.\n", "rig", lambda name: f"Rig `{name}`",
+                       _rig_body)
 
 
 def _identify_section() -> list[str]:
-
-    out = ["## `[identify]`\n",
-           "`method` names a registered identifier (required) of the rig's kind; every other key "
-           "is one of its declared hyperparameters.\n"]
-    for name in IDENTIFIERS.names():
-        cls = IDENTIFIERS.get(name)
-        doc = (inspect.getdoc(cls) or "").split("\n\n")[0].replace("\n", " ")
-        out.append(f"### `method = \"{name}\"` ({cls.kind})\n\n{doc}\n")
+    def body(cls: Any) -> list[str]:
         fields = cls.declared_hyperparameters()
-        out.append(table(fields) if fields else "*(no hyperparameters)*\n")
-    if not IDENTIFIERS.names():
-        out.append("*(no identifier registered)*\n")
-    return out
+        return [table(fields) if fields else "*(no hyperparameters)*\n"]
+
+    return _registered(IDENTIFIERS, "`[identify]`",
+                       "`method` names a registered identifier (required) of the rig's kind; every "
+                       "other key is one of its declared hyperparameters.\n", "identifier",
+                       lambda name: f'`method = "{name}"`', body)
 
 
 def _score_section() -> list[str]:

@@ -137,7 +137,7 @@ class Study:
         (:meth:`thresholds_for`), so a sweep judges every cell by its own identifier's bars.
         """
         return [(sc.replace(score=self.thresholds_for(sc, m)), m) for sc in self.scenarios
-                for m in self.identifiers if _rig_kind(sc.rig) == _identifier_kind(m)]
+                for m in self.identifiers if sc.kind == _identifier_kind(m)]
 
     def thresholds_for(self, scenario: Scenario, identifier: str) -> dict[str, dict[str, float]]:
         """The bars ``identifier`` is held to on ``scenario`` (see the module docs)."""
@@ -149,22 +149,17 @@ class Study:
 
     def skipped(self) -> list[tuple[str, str, str]]:
         """(scenario, identifier, reason) of the pairs left out because the kinds differ."""
-        return [(sc.name, m, f"identifier kind {_identifier_kind(m)!r} != rig kind {_rig_kind(sc.rig)!r}")
+        return [(sc.name, m, f"identifier kind {_identifier_kind(m)!r} != rig kind {sc.kind!r}")
                 for sc in self.scenarios for m in self.identifiers
-                if _rig_kind(sc.rig) != _identifier_kind(m)]
+                if sc.kind != _identifier_kind(m)]
 
     def n_cells(self) -> int:
         """Number of runnable cells: combinations x noise levels x seeds."""
         return len(self.combinations()) * len(self.noise) * len(self.seeds)
 
 
-def _rig_kind(rig: str) -> str:
-
-    return RIGS.get(rig).kind
-
-
 def _identifier_kind(name: str) -> str:
-
+    """Kind of the registered identifier ``name`` (a scenario carries its rig's: ``Scenario.kind``)."""
     return IDENTIFIERS.get(name).kind
 
 
@@ -211,13 +206,9 @@ def study_from_dict(raw: dict[str, Any], *, file: str = "<dict>", base: Path | N
                     stem: str | None = None) -> Study:
     """Validate a study given as a dict of TOML tables (paths relative to ``base``)."""
     base = base if base is not None else Path.cwd()
-    if not isinstance(raw, dict):
-        raise ScenarioError(file, allowed="expected a table of sections")
-    if "study" not in raw and "scenario" in raw:
-        raise ScenarioError(file, allowed="a scenario file (it has [scenario]), not a study; run "
-                                          "it with `testbed run`")
     head = validate_header(raw, sections=SECTIONS, header="study", schema=STUDY_SCHEMA, file=file,
-                           stem=stem)
+                           stem=stem, other=("scenario", "a scenario file (it has [scenario]), not a "
+                                                         "study; run it with `testbed run`"))
     for key in ("scenarios", "noise", "seeds", "identifiers", "plugins"):
         _no_duplicates(head[key], file, f"study.{key}")
     fam_table = raw.get("families", {})
@@ -382,7 +373,7 @@ def _check_grid(study: Study, head: dict[str, Any], file: str) -> None:
     for i, sc in enumerate(study.scenarios):
         if not any(ps.name == sc.name for ps, _ in pairs):
             raise ScenarioError(file, f"study.scenarios[{i}]", head["scenarios"][i],
-                                f"rig kind {_rig_kind(sc.rig)!r} but no identifier of that kind is "
+                                f"rig kind {sc.kind!r} but no identifier of that kind is "
                                 "listed; every cell of it would be skipped")
     names = [sc.name for sc in study.scenarios]
     _no_duplicates(names, file, "study.scenarios (names)")
