@@ -52,7 +52,12 @@ class LeastSquaresSINDy(StructuralIdentifier):
     K3_ : ndarray, shape (n, n) or None
         ``-M_ Xi_c`` [N/m^3] if ``cubic``.
     coef_ : ndarray, shape (n, n_features)
-        Regression coefficients in SI units, row i predicts ``x''_i``.
+        Regression coefficients in SI units, row i predicts ``x''_i`` (the model's features
+        only).
+    drift_coef_ : ndarray, shape (n, n_drift)
+        Only when the measurement declares a ``drift_basis``: the coefficients of its rows,
+        fitted with the model so that the signal chain's integration constants are not read
+        as motion, then left out of the model.
     feature_names_ : list of str
     natural_frequencies_ : ndarray, shape (n,)
         [Hz] from ``eig(K_, M_)``.
@@ -106,7 +111,7 @@ class LeastSquaresSINDy(StructuralIdentifier):
         """
         self.check_params()
         m_hat = mass_prior_value(data, self.mass_prior)
-        lib = build_library(data, coupled_mass=False, cubic=bool(self.cubic))
+        lib = build_library(data, coupled_mass=False, cubic=bool(self.cubic), drift=True)
         n, p = lib.target.shape[0], lib.theta.shape[0]
         scale = np.sqrt(np.mean(lib.theta**2, axis=1))
         scale[scale == 0] = 1.0
@@ -117,8 +122,12 @@ class LeastSquaresSINDy(StructuralIdentifier):
             sol, *_ = np.linalg.lstsq(phi[:, cols], lib.target[i], rcond=self.rcond)
             coef[i, cols] = sol / scale[cols]
         masses = np.full(n, m_hat / n)
-        self.coef_ = coef
-        self.feature_names_ = lib.names
+        dyn = np.ones(p, dtype=bool)
+        if "z" in lib.blocks:  # the chain's integration constants: estimated, then dropped
+            dyn[lib.blocks["z"]] = False
+            self.drift_coef_ = coef[:, ~dyn]
+        self.coef_ = coef[:, dyn]
+        self.feature_names_ = [nm for nm, k in zip(lib.names, dyn, strict=True) if k]
         self.channels_ = tuple(data.channels)
         self.M_, self.C_, self.K_, self.K3_ = matrices_from_coef(coef, lib.blocks, masses)
         self.input_map_ = None if data.input_map is None else np.asarray(data.input_map, dtype=float)

@@ -49,14 +49,16 @@ class Library:
     ----------
     theta : ndarray, shape (n_features, n_samples)
         Feature rows, in this order: ``xdd`` (n, only if ``coupled_mass``), ``xd`` (n), ``x`` (n),
-        ``x^3`` (n, only if ``cubic``), ``(B u)`` (n, only if the window holds a nonzero input).
+        ``x^3`` (n, only if ``cubic``), ``(B u)`` (n, only if the window holds a nonzero input),
+        the drift rows (only with ``drift`` and a declared ``data.drift_basis``).
     target : ndarray, shape (n, n_samples)
         Accelerations ``xdd`` [m/s^2] to reconstruct, one row per channel.
     mask : ndarray of bool, shape (n, n_features)
         Which coefficient each row may use: the own acceleration is excluded (zero diagonal of
         ``xi_a``) and row i uses only its own forcing ``(B u)_i``.
     names : list of str
-        Feature names (``a1`` = x''_1, ``v1`` = x'_1, ``x1``, ``x1^3``, ``f1`` = (B u)_1).
+        Feature names (``a1`` = x''_1, ``v1`` = x'_1, ``x1``, ``x1^3``, ``f1`` = (B u)_1,
+        ``drift1``, ...).
     blocks : dict of str to slice
         Rows of ``theta`` of each block: keys among ``"a"``, ``"v"``, ``"d"``, ``"c"``, ``"f"``.
     """
@@ -68,7 +70,8 @@ class Library:
     blocks: dict[str, slice]
 
 
-def build_library(data: Measurement, *, coupled_mass: bool, cubic: bool, start: int | None = None) -> Library:
+def build_library(data: Measurement, *, coupled_mass: bool, cubic: bool, start: int | None = None,
+                  drift: bool = False) -> Library:
     """Build the structural SINDy library from a measurement's fit window.
 
     Parameters
@@ -81,6 +84,11 @@ def build_library(data: Measurement, *, coupled_mass: bool, cubic: bool, start: 
         Include the cubic displacement features ``x_j^3`` [m^3].
     start : int, optional
         First sample of the fit window; default ``data.free_start``.
+    drift : bool
+        Add the rows of ``data.drift_basis`` (if the chain declares one) as block ``"z"``,
+        free in every equation: the chain's unknown integration constants, to be estimated
+        with the model and then dropped (they are not dynamics; see
+        :attr:`testbed.core.measurement.Measurement.drift_basis`).
 
     Returns
     -------
@@ -115,6 +123,13 @@ def build_library(data: Measurement, *, coupled_mass: bool, cubic: bool, start: 
         f = np.asarray(data.input_map, dtype=float) @ np.asarray(data.u, dtype=float)[:, s:]
         if np.any(f != 0.0):
             add("f", f, "f", "", np.eye(n, dtype=bool))
+    if drift and data.drift_basis is not None:
+        z = np.asarray(data.drift_basis, dtype=float)[:, s:]
+        k0 = sum(r.shape[0] for r in rows)
+        rows.append(z)
+        names.extend(f"drift{k + 1}" for k in range(z.shape[0]))
+        blocks["z"] = slice(k0, k0 + z.shape[0])
+        mask_blocks.append(np.ones((n, z.shape[0]), dtype=bool))
     return Library(np.vstack(rows), xdd, np.hstack(mask_blocks), names, blocks)
 
 

@@ -37,6 +37,14 @@ class Measurement:
         low-pass cut-off (the Nyquist frequency without one).  None = not declared (signals
         not from a filtering chain).  Below ``low`` and near it a spectrum shows the filter,
         not the structure.
+    drift_basis : ndarray, shape (n_drift, n_samples), optional
+        Waveforms the signal chain's integration constants may have added to ``xd`` and ``x``
+        of every channel in unknown amounts (e.g. a velocity offset left by integrating a
+        sampled pulse, as it looks after the chain's filters).  They carry no dynamics: an
+        identifier regressing ``xdd`` on ``xd`` and ``x`` should give each equation a free
+        coefficient on every row, so that the offsets are estimated with the model rather
+        than read as motion (see :func:`testbed.pipeline.signal_chain.measure_structural`).
+        None = the chain declares none.
     """
 
     fs: float
@@ -50,6 +58,7 @@ class Measurement:
     prior: dict[str, Any] = field(default_factory=dict)
     free_start: int = 0
     passband: tuple[float, float] | None = None
+    drift_basis: np.ndarray | None = None
 
     @property
     def n_channels(self) -> int:

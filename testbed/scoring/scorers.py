@@ -20,6 +20,7 @@ from testbed.core.terms import canonical
 from testbed.core.truth import DynamicalTruth, MechanicalTruth, StructuralTruth, TruthError
 from testbed.scoring import metrics
 from testbed.scoring.equation_basis import compare_equations
+from testbed.scoring.initial_state import fit_initial_state
 from testbed.scoring.metrics import worst
 
 #: Modes whose MAC, frequency and damping are scored: every mode the sensors can resolve,
@@ -342,10 +343,12 @@ def score(kind: str, dataset: Dataset, data: Measurement, clean: Measurement, mo
 def score_structural(dataset: Dataset, data: Measurement, clean: Measurement, model: Any) -> Scores:
     """TRAC, MAC, frequency, damping and matrix errors of a structural model.
 
-    The identified model is simulated from the measured state at the end of the
-    impact pulse (``data.free_start``) to the end of the record under the
-    measured force, and its accelerations are compared with the noise-free
-    accelerations passed through the same signal chain.
+    The identified model is simulated from the end of the impact pulse
+    (``data.free_start``) to the end of the record under the measured force, and its
+    accelerations are compared with the noise-free accelerations passed through the same
+    signal chain.  The start is fitted to that reference by least squares from the
+    measured state (:func:`~testbed.scoring.initial_state.fit_initial_state`: the chain's
+    integration constants are not the model's error).
 
     A physically impossible model (:func:`physical_failures`: M not symmetric positive
     definite, negative damping, an unstable pole) and a simulation that raises, turns
@@ -362,8 +365,9 @@ def score_structural(dataset: Dataset, data: Measurement, clean: Measurement, mo
     d: dict[str, Any] = {"t": t, "reference_xdd": ref, "channels": data.channels}
     sim = None
     if "model" not in failures:  # non-finite matrices: nothing to simulate (the failure says so)
-        sim, why, when = simulate_scored(
-            lambda: model.simulate(data.x[:, i0], data.xd[:, i0], t, u), t, "xdd", ref)
+        x0, xd0 = fit_initial_state(lambda a, b: model.simulate(a, b, t, u),
+                                    data.x[:, i0], data.xd[:, i0], ref)
+        sim, why, when = simulate_scored(lambda: model.simulate(x0, xd0, t, u), t, "xdd", ref)
         if why is not None:
             failures["simulation"] = why
             d["divergence_time"] = when
