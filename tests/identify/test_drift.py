@@ -1,0 +1,49 @@
+"""The chain's integration constants are fitted with the model, not read as motion."""
+
+import dataclasses
+
+import numpy as np
+
+from identify._structural_sim import simulate_structural
+from identify.ls_sindy import LeastSquaresSINDy
+from testbed.core.measurement import Measurement
+from testbed.pipeline.signal_chain import drift_basis
+
+FS = 12800.0
+M = np.array([[2.0, 0.3], [0.3, 1.0]])
+K = np.array([[4e5, -1.5e5], [-1.5e5, 1.5e5]])
+C = 2e-4 * K
+
+
+def _measurement(offsets: np.ndarray) -> Measurement:
+    n, rest = 6400, 80
+    t = np.arange(n - rest) / FS
+    traj = simulate_structural(M, C, K, None, None, np.zeros(2), np.array([0.05, 0.02]), t)
+    x, xd, xdd = (np.hstack([np.zeros((2, rest)), a]) for a in (traj.x, traj.xd, traj.xdd))
+    basis = drift_basis(n, FS, rest, (10.0, 5, 0.1, 30.0))
+    # unit-RMS rows: velocity offsets as H^2 s in xd and H I H s in x
+    xd = xd + offsets[:, :1] * basis[0]
+    x = x + offsets[:, 1:] * basis[1]
+    return Measurement(fs=FS, x=x, xd=xd, xdd=xdd, channels=("s1", "s2"),
+                       prior={"reduced_mass_trace": float(np.trace(M))}, free_start=rest,
+                       drift_basis=basis)
+
+
+def test_drift_rows_make_least_squares_exact_again():
+    data = _measurement(np.array([[3e-3, 2e-6], [-2e-3, -1e-6]]))
+    true = np.linalg.solve(M, K)
+    with_drift = LeastSquaresSINDy().fit(data)
+    without = LeastSquaresSINDy().fit(dataclasses.replace(data, drift_basis=None))
+    err = lambda m: np.linalg.norm(np.linalg.solve(m.M_, m.K_) - true) / np.linalg.norm(true)  # noqa: E731
+    # exact signals of the model plus offsets in the span of the rows: the regression is
+    # exact up to rounding of the standardised least-squares solve (~1e-9 here)
+    assert err(with_drift) < 1e-6
+    assert err(without) > 1e-3  # the offsets read as motion bias the stiffness
+    assert with_drift.coef_.shape == without.coef_.shape  # the drift rows are not model terms
+    assert with_drift.drift_coef_.shape == (2, 2)
+    assert "drift1" not in with_drift.feature_names_
+
+
+def test_no_pulse_no_drift_rows():
+    assert drift_basis(1000, FS, None, (10.0, 5, 0.1, 30.0)) is None
+    assert drift_basis(1000, FS, 0, (10.0, 5, 0.1, 30.0)) is None
