@@ -26,12 +26,14 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.fft as sfft
 from scipy import linalg
 
 from identify._base import Identifier
 from identify._structural_sim import simulate_structural
 from testbed.core.errors import IdentificationError
 from testbed.core.measurement import Measurement, Trajectory
+from testbed.numerics.shapes import mac_matrix
 from testbed.numerics.spectral import harmonic_amplitude_law, peak_candidates
 
 #: Keys of ``Measurement.prior`` a structural identifier may take the mass scale from.
@@ -230,6 +232,13 @@ HARMONIC_SLOPE = (0.6, 1.6)
 HARMONIC_DRIFT = 0.02
 #: Short-time segments of the harmonic test (each resolves 8 / T Hz: 4 Hz on a 2 s record).
 HARMONIC_SEGMENTS = 8
+#: A weaker candidate whose deflection shape (the complex spectra of the channels at its
+#: frequency) has a MAC of at least this with a stronger accepted peak's is the same mode seen
+#: again: a side lobe of a lightly damped mode that rings through the whole record, or
+#: ringing of the chain's high-pass under it.  Measured on 2-sensor beams of the beams family
+#: (studies/families.toml): side lobes 0.985-1.000 against their mode; distinct bending modes
+#: 0.16-0.84 (the highest, 0.84, with both sensors on the outer half of the beam).
+ODS_MAC = 0.95
 
 
 @dataclass(frozen=True)
@@ -291,7 +300,11 @@ def modal_peaks(data: Measurement, n_modes: int | None = None,
        (rectangular window: the impact response decays within the record and a Hann window
        would hide a fast-decaying mode; 8x zero padding; 6 dB prominence; within 40 dB of the
        strongest), peaks within :data:`MODE_SEPARATION` of a stronger one merged into it.
-    3. *Harmonics*: a weaker candidate within :data:`HARMONIC_TOL` of k = 2 or 3 times a
+    3. *Same shape*: a weaker candidate whose deflection shape across the channels matches
+       a stronger accepted one's (MAC >= :data:`ODS_MAC`) is that mode again (a side lobe),
+       not a mode: n sensors tell distinct modes apart by their shapes.  Checked after the
+       harmonic test, which it does not replace.
+    4. *Harmonics*: a weaker candidate within :data:`HARMONIC_TOL` of k = 2 or 3 times a
        stronger one whose short-time amplitude follows the stronger one's k-th power
        (:func:`testbed.numerics.spectral.harmonic_amplitude_law`, slope within
        :data:`HARMONIC_SLOPE` x k), while the stronger one's frequency falls as it decays
@@ -299,7 +312,7 @@ def modal_peaks(data: Measurement, n_modes: int | None = None,
        If one is found the structure is amplitude-dependent and its record-long peaks are
        not its linear natural frequencies (the 150 N soft base: 45.4 and 406.5 Hz against
        39.6 and 386.6 Hz), so no peak is accepted (``nonlinear`` = True).
-    4. *Sensors*: at most ``n_modes`` (default the number of channels: n sensors resolve at
+    5. *Sensors*: at most ``n_modes`` (default the number of channels: n sensors resolve at
        most n mode shapes), the strongest.
 
     Parameters
@@ -325,6 +338,7 @@ def modal_peaks(data: Measurement, n_modes: int | None = None,
     rejected: list[tuple[float, str]] = []
     kept: list[int] = []
     nonlinear = False
+    shapes = deflection_shapes(xdd, data.fs, freqs, pad=8)
     for i in range(freqs.size):  # strongest first
         why = None
         for j in kept:
@@ -340,6 +354,13 @@ def modal_peaks(data: Measurement, n_modes: int | None = None,
         if why is not None:
             rejected.append((float(freqs[i]), why))
             nonlinear = True
+            continue
+        macs = [(float(mac_matrix(shapes[i], shapes[j])[0, 0]), j) for j in kept]
+        same = [(m, j) for m, j in macs if m >= ODS_MAC]
+        if same:
+            m, j = same[0]
+            rejected.append((float(freqs[i]), f"same deflection shape as the {freqs[j]:.4g} Hz peak "
+                                              f"(MAC {m:.3f}): a side lobe of that mode, not another one"))
         else:
             kept.append(i)
     if nonlinear:
@@ -352,6 +373,30 @@ def modal_peaks(data: Measurement, n_modes: int | None = None,
                                           f"n modes)"))
     kept = kept[:n_modes]
     return PeakSearch(band, rule, np.sort(freqs[kept]), rejected, nonlinear)
+
+
+def deflection_shapes(x: np.ndarray, fs: float, freqs: np.ndarray, pad: int = 8) -> np.ndarray:
+    """Operating deflection shapes: each channel's complex spectrum at each frequency.
+
+    Parameters
+    ----------
+    x : ndarray, shape (n_channels, n_samples)
+        Signals (mean removed here; rectangular window, as the peak search).
+    fs : float
+        Sample rate [Hz].
+    freqs : ndarray, shape (k,)
+        Frequencies [Hz]; each takes the nearest line of the ``pad``-times zero-padded transform.
+    pad : int
+
+    Returns
+    -------
+    ndarray, shape (k, n_channels), complex
+    """
+    x = np.atleast_2d(np.asarray(x, dtype=float))
+    nfft = sfft.next_fast_len(int(pad) * x.shape[1], real=True)
+    spec = sfft.rfft(x - x.mean(axis=1, keepdims=True), n=nfft, axis=1)
+    lines = np.clip(np.rint(np.asarray(freqs, dtype=float) * nfft / fs).astype(int), 0, spec.shape[1] - 1)
+    return spec[:, lines].T
 
 
 def measured_frequencies(data: Measurement, n_modes: int, freq_range: tuple[float, float] | None = None,

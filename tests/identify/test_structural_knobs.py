@@ -75,9 +75,10 @@ def test_third_harmonic_with_the_cubic_amplitude_law_is_rejected():
 
 def test_same_amplitude_law_without_a_drifting_fundamental_is_a_mode():
     """A linear fundamental (no frequency drift) has no harmonics: a 3x component decaying 3x
-    faster is then a mode, however well its amplitude follows A^3."""
+    faster is then a mode, however well its amplitude follows A^3.  (Its shape differs from the
+    fundamental's, as a distinct mode's must: see the same-shape test.)"""
     a, b = _decay(40.0, 1.5), 0.05 * _decay(121.0, 4.5)
-    ps = modal_peaks(_measurement(np.vstack([a + b, 0.7 * a + 0.9 * b])), n_modes=2)
+    ps = modal_peaks(_measurement(np.vstack([a + b, 0.7 * a - 0.9 * b])), n_modes=2)
     assert not ps.nonlinear and ps.peaks == pytest.approx([40.0, 121.0], abs=0.3)
 
 
@@ -91,10 +92,22 @@ def test_mode_at_three_times_the_fundamental_is_kept(sigma2):
 
 
 def test_at_most_as_many_peaks_as_sensors():
-    modes = _decay(40.0, 1.0) + 0.5 * _decay(170.0, 2.0) + 0.2 * _decay(450.0, 3.0)
-    ps = modal_peaks(_measurement(np.vstack([modes, 0.3 * modes + _decay(170.0, 2.0)])))
+    d40, d170, d450 = _decay(40.0, 1.0), _decay(170.0, 2.0), _decay(450.0, 3.0)
+    # three distinct shapes at two sensors: (1, 0.3), (0.5, 1.15), (0.2, -0.8)
+    ps = modal_peaks(_measurement(np.vstack([d40 + 0.5 * d170 + 0.2 * d450,
+                                             0.3 * d40 + 1.15 * d170 - 0.8 * d450])))
     assert ps.peaks.size == 2
     assert any("n sensors" in r for _, r in ps.rejected)
+
+
+def test_a_peak_with_a_stronger_peak_s_shape_is_not_another_mode():
+    """A lightly damped mode rings through the record; a weaker component with its shape (a
+    side lobe, or the high-pass ringing under it) is not a mode; one with its own shape is."""
+    ring = _decay(40.0, 0.2) + 0.3 * _decay(52.0, 1.0)           # same shape (1, 0.4)
+    other = 0.2 * _decay(170.0, 2.0)                              # shape (1, -1)
+    ps = modal_peaks(_measurement(np.vstack([ring + other, 0.4 * ring - other])))
+    assert ps.peaks == pytest.approx([40.0, 170.0], abs=0.3)
+    assert any("same deflection shape" in r for f, r in ps.rejected if abs(f - 52.0) < 1)
 
 
 @pytest.fixture(scope="module")

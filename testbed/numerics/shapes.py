@@ -1,0 +1,33 @@
+"""Comparing shapes across channels: the modal assurance criterion (one implementation)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["mac_matrix"]
+
+
+def mac_matrix(phi_a: np.ndarray, phi_b: np.ndarray) -> np.ndarray:
+    """Modal assurance criterion between every pair of mode shapes.
+
+    Parameters
+    ----------
+    phi_a : ndarray, shape (n_dof, n_a)
+        Mode shapes, one per column (real or complex); 1-D is one mode.
+    phi_b : ndarray, shape (n_dof, n_b)
+
+    Returns
+    -------
+    ndarray, shape (n_a, n_b)
+        ``MAC[i, j] = |a_i^H b_j|^2 / ((a_i^H a_i)(b_j^H b_j))`` in [0, 1]; NaN for a zero shape.
+    """
+    a, b = np.asarray(phi_a), np.asarray(phi_b)
+    a = a[:, None] if a.ndim == 1 else a
+    b = b[:, None] if b.ndim == 1 else b
+    if a.shape[0] != b.shape[0]:
+        raise ValueError(f"mode shapes have {a.shape[0]} and {b.shape[0]} DOFs")
+    num = np.abs(np.conj(a).T @ b) ** 2
+    den = np.outer(np.sum(np.abs(a) ** 2, axis=0), np.sum(np.abs(b) ** 2, axis=0))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        out = np.where(den > 0, num / np.where(den > 0, den, 1.0), np.nan)
+    return np.minimum(out, 1.0)
