@@ -23,7 +23,7 @@ identifiers their common ``simulate``/``equations``/modal attributes.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import scipy.fft as sfft
@@ -133,6 +133,56 @@ def build_library(data: Measurement, *, coupled_mass: bool, cubic: bool, start: 
         blocks["z"] = slice(k0, k0 + z.shape[0])
         mask_blocks.append(np.ones((n, z.shape[0]), dtype=bool))
     return Library(np.vstack(rows), xdd, np.hstack(mask_blocks), names, blocks)
+
+
+def remove_drift(data: Measurement) -> tuple[Measurement, np.ndarray | None]:
+    """The measurement with the chain's integration constants estimated and taken out.
+
+    For identifiers that do not carry :attr:`Measurement.drift_basis` in their own regression
+    (the SGD fits, SINDy-PI's linear form).  The rows are ``w0 = H^2 s`` and ``w1 = H I H s``
+    (:func:`testbed.pipeline.signal_chain.drift_basis`): a velocity offset ``e`` adds ``e w0``
+    to ``xd`` and ``e w1`` to ``x``, a displacement offset ``c`` adds ``c w0`` to ``x``.  A
+    least-squares fit of ``xdd = -A x - B xd (+ G f) + alpha w0 + beta w1`` per channel on the fit
+    window (the linear model; it only has to place the offsets) gives ``beta = A e`` and
+    ``alpha = B e + A c``, so ``e = A^-1 beta`` and ``c = A^-1 (alpha - B e)``.
+
+    Parameters
+    ----------
+    data : Measurement
+
+    Returns
+    -------
+    Measurement
+        ``xd - e w0`` and ``x - e w1 - c w0``, ``drift_basis`` None; ``data`` itself when it
+        declares no drift basis or the linear fit is singular.
+    offsets : ndarray, shape (2, n) or None
+        ``e`` [m/s] and ``c`` [m] per channel (None when nothing was removed).
+    """
+    if data.drift_basis is None or np.asarray(data.drift_basis).shape[0] != 2:
+        return data, None
+    lib = build_library(data, coupled_mass=False, cubic=False, drift=True)
+    scale = np.sqrt(np.mean(lib.theta**2, axis=1))
+    scale[scale == 0] = 1.0
+    phi = (lib.theta / scale[:, None]).T
+    n = lib.target.shape[0]
+    coef = np.zeros((n, lib.theta.shape[0]))
+    for i in range(n):
+        cols = np.flatnonzero(lib.mask[i])
+        sol, *_ = np.linalg.lstsq(phi[:, cols], lib.target[i], rcond=None)
+        coef[i, cols] = sol / scale[cols]
+    A, B = -coef[:, lib.blocks["d"]], -coef[:, lib.blocks["v"]]
+    z = coef[:, lib.blocks["z"]]
+    try:
+        e = np.linalg.solve(A, z[:, 1])
+        c = np.linalg.solve(A, z[:, 0] - B @ e)
+    except np.linalg.LinAlgError:
+        return data, None
+    if not (np.all(np.isfinite(e)) and np.all(np.isfinite(c))):
+        return data, None
+    w0, w1 = (np.asarray(r, dtype=float)[None, :] for r in data.drift_basis)
+    clean = replace(data, xd=data.xd - e[:, None] * w0, x=data.x - e[:, None] * w1 - c[:, None] * w0,
+                    drift_basis=None)
+    return clean, np.vstack([e, c])
 
 
 def matrices_from_coef(coef: np.ndarray, blocks: dict[str, slice], masses: np.ndarray

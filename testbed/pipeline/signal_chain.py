@@ -424,11 +424,11 @@ def drift_basis(n_samples: int, fs: float, rest_from: int | None,
     Returns
     -------
     ndarray, shape (2, n_samples), or None
-        Unit-RMS rows ``H^2 s`` and ``H I H s``, with ``s`` the unit step at ``rest_from``,
+        Rows ``H^2 s`` [-] and ``H I H s`` [s], with ``s`` the unit step at ``rest_from``,
         ``I`` trapezoid integration and ``H`` the zero-phase high-pass: a velocity offset ``e``
-        from ``rest_from`` on reaches ``xd`` as ``e H^2 s`` and ``x`` as ``e H I H s``; a
-        displacement offset ``c`` left by integrating the pulse reaches ``x`` as ``c H^2 s``
-        (``I`` and ``H`` commute).  None
+        [m/s] from ``rest_from`` on reaches ``xd`` as ``e H^2 s`` and ``x`` as ``e H I H s``; a
+        displacement offset ``c`` [m] left by integrating the pulse reaches ``x`` as
+        ``c H^2 s`` (``I`` and ``H`` commute).  None
         when there is no pulse to correct after.
 
     Notes
@@ -455,11 +455,7 @@ def drift_basis(n_samples: int, fs: float, rest_from: int | None,
     step[0, rest_from:] = 1.0
     h1 = hp(step)
     rows = np.vstack([hp(h1), hp(sig.trapezoid(h1, fs))])
-    rms = np.sqrt(np.mean(rows**2, axis=1))
-    keep = rms > 0
-    if not np.any(keep):
-        return None
-    return rows[keep] / rms[keep, None]
+    return rows if np.all(np.any(rows != 0.0, axis=1)) else None
 
 
 def measure_mechanical(dataset: Dataset, cfg: Mapping[str, Any]) -> Measurement:
