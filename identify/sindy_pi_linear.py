@@ -59,6 +59,7 @@ from identify.sindy_pi import (
     VAL_FRACTION_FIELD,
     check_thresholds,
 )
+from identify.structural import remove_drift
 from testbed.core.errors import IdentificationError
 from testbed.core.measurement import Measurement, Trajectory
 from testbed.core.schema import Field
@@ -148,6 +149,9 @@ class SINDyPILinear(Identifier):
 
     Attributes
     ----------
+    drift_offsets_ : ndarray, shape (2, n) or None
+        The chain's integration constants taken out before the fit
+        (:func:`identify.structural.remove_drift`: velocity [m/s] and displacement [m] offsets).
     M_, C_, K_ : ndarray, shape (n, n)
         Mass [kg], damping [N s/m], stiffness [N/m] in sensor coordinates.
     K3_ : None
@@ -197,6 +201,8 @@ class SINDyPILinear(Identifier):
         if self.mass_prior not in data.prior:
             raise IdentificationError(f"data.prior has no {self.mass_prior!r} (has "
                                       f"{sorted(data.prior)}): free vibration fixes M^-1 K only")
+        # the chain's integration constants out first: this library has no columns for them
+        data, self.drift_offsets_ = remove_drift(data)
         lib = linear_structural_library(n)
         s0 = data.free_start
         Theta = lib.evaluate(data.x[:, s0:], data.xd[:, s0:], data.xdd[:, s0:])
