@@ -73,7 +73,7 @@ class Library:
 
 
 def build_library(data: Measurement, *, coupled_mass: bool, cubic: bool, start: int | None = None,
-                  drift: bool = False) -> Library:
+                  drift: bool = False, input_coupling: bool = False) -> Library:
     """Build the structural SINDy library from a measurement's fit window.
 
     Parameters
@@ -91,6 +91,12 @@ def build_library(data: Measurement, *, coupled_mass: bool, cubic: bool, start: 
         free in every equation: the chain's unknown integration constants, to be estimated
         with the model and then dropped (they are not dynamics; see
         :attr:`testbed.core.measurement.Measurement.drift_basis`).
+    input_coupling : bool
+        Let every equation use every input column (``M^-1 B`` in full) instead of only the
+        channel the input acts on.  For a model whose accelerations are not coupled through
+        its own mass block (diagonal ``M``), ``M^-1 B`` of the real, mass-coupled structure
+        is full; and these coefficients also take up the quasi-static response of the
+        unmodelled modes (residual flexibility) to the chain-filtered force's slow tail.
 
     Returns
     -------
@@ -124,7 +130,7 @@ def build_library(data: Measurement, *, coupled_mass: bool, cubic: bool, start: 
     if data.u is not None and data.input_map is not None:
         f = np.asarray(data.input_map, dtype=float) @ np.asarray(data.u, dtype=float)[:, s:]
         if np.any(f != 0.0):
-            add("f", f, "f", "", np.eye(n, dtype=bool))
+            add("f", f, "f", "", np.ones((n, n), dtype=bool) if input_coupling else np.eye(n, dtype=bool))
     if drift and data.drift_basis is not None:
         z = np.asarray(data.drift_basis, dtype=float)[:, s:]
         k0 = sum(r.shape[0] for r in rows)
