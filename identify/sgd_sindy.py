@@ -108,8 +108,8 @@ SHARED_FIELDS: dict[str, Field] = {
     # None = by rule (learning_rate_for): Table 1's 1.5e-4 on the linear library, 1.5e-5
     # with the cubic library
     "learning_rate": Field(float, None, min=0.0, min_inclusive=False, max=1.0,
-                           doc="step size of the coefficient optimiser (standardised units); default "
-                               "1.5e-4, with the cubic library 1.5e-5"),
+                           doc="step size of the optimiser (standardised units); default 1.5e-4, "
+                               "with the cubic library 1.5e-5"),
     "alpha_init": Field(float, 0.1, min=0.0, doc="initial weight of every annealed penalty"),
     "epsilon": Field(float, 0.01, min=0.0, min_inclusive=False,
                      doc="gain of the eigenvalue gradient (Eqs 12-13)"),
