@@ -1,4 +1,4 @@
-"""SGD-SINDy in its symmetric-matrix parametrisation (the default of :class:`SGDSINDy`).
+"""SGD-SINDy in its symmetric-matrix parametrisation (``sgd_sindy``, :class:`identify.sgd_sindy.SGDSINDy`).
 
 Why not the paper's raw coefficients
 ------------------------------------
@@ -93,7 +93,8 @@ second-moment matrix in O(n^3), whatever the window's length.
 
 from __future__ import annotations
 
-from typing import Any
+from dataclasses import dataclass
+from typing import Any, Literal
 
 import numpy as np
 
@@ -193,10 +194,133 @@ def warm_start(xdd: np.ndarray, xd: np.ndarray, x: np.ndarray, x3: np.ndarray | 
     return M0, C0, K0, K30
 
 
-def fit_matrix_sgd(data: Measurement, est: Any, m_hat: float, lam_hat: np.ndarray) -> dict[str, Any]:
-    """Run the matrix-parametrised SGD; ``est`` supplies the hyperparameters.
+@dataclass(frozen=True)
+class MatrixSGDSettings:
+    """The hyperparameters :func:`fit_matrix_sgd` runs with (those of
+    :class:`identify.sgd_sindy.SGDSINDy`, where each is documented; built by its ``settings``).
 
-    Returns a dict with M, C, K, K3, history, n_steps and alphas.
+    Attributes
+    ----------
+    epochs : int
+        Number of epochs, >= 0.
+    batch_size : int
+        Samples per mini-batch, >= 1 (unused with ``gradient="full"``).
+    learning_rate : float
+        Adam step size [standardised units], > 0 (already resolved, never None).
+    alpha_init : float
+        Initial eigenvalue-penalty weight.
+    epsilon : float
+        Gain of the eigenvalue gradient (Eqs 12-13).
+    beta : float
+        Annealing stabilisation coefficient (Eq. 18).
+    cubic : bool
+        Cubic features ``x_j^3`` in the model.
+    l1 : bool
+        Lasso on the standardised cubic block (acts only with ``cubic``).
+    l1_threshold : float
+        Partial-correlation threshold of the lasso.
+    l1_debias : float
+        Fraction of the epochs, at the end, without L1 on the kept terms, in [0, 1).
+    steps_per_epoch : int or None
+        Gradient steps per epoch; None = a full pass (one step with ``gradient="full"``).
+    init : {"lstsq", "zeros"}
+        Warm start or zero start.
+    anneal : bool
+        Annealing of the eigenvalue weight (Eqs 17-18).
+    alpha_max : float
+        Upper bound of the annealed weight.
+    random_state : int
+        Seed of the mini-batch order.
+    fit_duration : float
+        Fit window after ``free_start`` [s]; 0 = to the end.
+    gradient : {"minibatch", "full"}
+        Mini-batch steps or the exact full-window gradient.
+    iterate_average : float
+        Fraction of the epochs, at the end, whose iterates are averaged, in [0, 1).
+    """
+
+    epochs: int
+    batch_size: int
+    learning_rate: float
+    alpha_init: float
+    epsilon: float
+    beta: float
+    cubic: bool
+    l1: bool
+    l1_threshold: float
+    l1_debias: float
+    steps_per_epoch: int | None
+    init: Literal["lstsq", "zeros"]
+    anneal: bool
+    alpha_max: float
+    random_state: int
+    fit_duration: float
+    gradient: Literal["minibatch", "full"]
+    iterate_average: float
+
+    def __post_init__(self) -> None:
+        for key, allowed in (("init", ("lstsq", "zeros")), ("gradient", ("minibatch", "full"))):
+            if getattr(self, key) not in allowed:
+                raise ValueError(f"{key} must be one of {allowed}, got {getattr(self, key)!r}")
+        if not (self.epochs >= 0 and self.batch_size >= 1 and self.learning_rate > 0):
+            raise ValueError("need epochs >= 0, batch_size >= 1 and learning_rate > 0, got "
+                             f"{self.epochs}, {self.batch_size}, {self.learning_rate}")
+        for key in ("l1_debias", "iterate_average"):
+            if not 0.0 <= getattr(self, key) < 1.0:
+                raise ValueError(f"{key} must be in [0, 1), got {getattr(self, key)}")
+
+
+@dataclass(frozen=True)
+class MatrixSGDResult:
+    """What :func:`fit_matrix_sgd` returns.
+
+    Attributes
+    ----------
+    M, C, K : ndarray, shape (n, n)
+        Symmetric [kg], [N s/m], [N/m]; ``M`` positive definite up to rounding, ``C`` and ``K``
+        positive semi-definite, ``trace(M)`` the mass prior.
+    K3 : ndarray, shape (n, n) or None
+        Cubic stiffness [N/m^3] (None without the cubic library).
+    n_steps : int
+        Gradient steps taken.
+    alphas : dict of str to float
+        Final weights ``sym``, ``eig``, ``l1``.
+    guard : dict of str to float
+        Most negative eigenvalue (relative) removed from ``"C"`` / ``"K"`` by the projections
+        onto the positive semi-definite cone; absent if none was needed.
+    history : dict of str to ndarray
+        Per-epoch records (:class:`identify.sgd_sindy.SGDSINDy`, ``history_``).
+    """
+
+    M: np.ndarray
+    C: np.ndarray
+    K: np.ndarray
+    K3: np.ndarray | None
+    n_steps: int
+    alphas: dict[str, float]
+    guard: dict[str, float]
+    history: dict[str, np.ndarray]
+
+
+def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
+                   lam_hat: np.ndarray) -> MatrixSGDResult:
+    """Run the matrix-parametrised SGD.
+
+    Parameters
+    ----------
+    data : Measurement
+        Signals (n channels), sample rate, ``free_start`` and inputs.
+    est : MatrixSGDSettings
+        The hyperparameters.
+    m_hat : float
+        Mass prior [kg] that ``trace(M)`` equals.
+    lam_hat : ndarray, shape (k,)
+        Measured eigenvalues ``(2 pi f)^2`` [rad^2/s^2] the eigenvalue penalty targets; empty
+        = no eigenvalue penalty.
+
+    Returns
+    -------
+    MatrixSGDResult
     """
     i0 = int(data.free_start)
     i1 = data.n_samples if not est.fit_duration else min(data.n_samples,
@@ -208,7 +332,7 @@ def fit_matrix_sgd(data: Measurement, est: Any, m_hat: float, lam_hat: np.ndarra
         bu = np.asarray(data.input_map, dtype=float) @ data.u[:, i0:i1]
     else:
         bu = np.zeros_like(x)
-    l1_on = est.cubic and est.l1 != "none"
+    l1_on = est.cubic and est.l1
     pr = cubic_profile(xdd, xd, x, x3) if est.cubic else None
     M0, C0, K0, K30 = warm_start(xdd, xd, x, x3, m_hat, float(est.l1_threshold) if l1_on else 0.0,
                                  pr) if est.init == "lstsq" else (
@@ -232,9 +356,7 @@ def fit_matrix_sgd(data: Measurement, est: Any, m_hat: float, lam_hat: np.ndarra
             lam_l1 = (2.0 / n) * float(est.l1_threshold) * np.outer(pr["rho"], pr["sigma"])
     from identify import _compiled as cc  # lazy: numba's import costs ~0.4 s
 
-    gradient = getattr(est, "gradient", "minibatch")
-    if gradient not in ("minibatch", "full"):
-        raise ValueError(f"gradient must be 'minibatch' or 'full', got {gradient!r}")
+    gradient = est.gradient
     # features z = [x'', x', x, x^3, -B u] per sample (N, 5n): the residual of row i is T_i z;
     # the whole window's loss and gradient follow from its second moments (cc.window_loss_grad)
     Z = np.ascontiguousarray(np.vstack([xdd, xd, x, x3 if x3 is not None else np.zeros_like(x), -bu]).T)
@@ -249,7 +371,7 @@ def fit_matrix_sgd(data: Measurement, est: Any, m_hat: float, lam_hat: np.ndarra
     lam_hat = np.ascontiguousarray(lam_hat, dtype=float)
     cc.project(L, P, Q, R, m0, m_hat)
     adam = (np.zeros((4, n, n)), np.zeros((4, n, n)), np.zeros((4, n, n)))  # m, v, step size
-    use_eig, use_l1 = bool(est.eigen) and lam_hat.size > 0, has_R and l1_on
+    use_eig, use_l1 = lam_hat.size > 0, has_R and l1_on
     lam_l1 = np.broadcast_to(lam_l1, (n, n)).astype(float)
     alpha = {"sym": float(est.alpha_init), "eig": float(est.alpha_init),
              "l1": float(np.max(lam_l1)) if use_l1 else 0.0}
@@ -306,14 +428,14 @@ def fit_matrix_sgd(data: Measurement, est: Any, m_hat: float, lam_hat: np.ndarra
     # trace m_hat) removed most of it (measured, seed 0: stiffer soft base TRAC 0.956, two
     # sensors at 3 % noise 0.80 -> 0.97, stiff beam 0.986 -> 0.995).  A quarter: averaging
     # half the epochs lagged the cubic block (soft base cubic force error 0.062 -> 0.099).
-    frac = float(getattr(est, "iterate_average", 0.0))
+    frac = est.iterate_average
     avg_from = max(int(np.ceil(int(est.epochs) * (1.0 - frac))), l1_epochs) + 1 if frac > 0 else None
     acc = [np.zeros((n, n)) for _ in range(4)]
     n_acc = 0
     for epoch in range(1, int(est.epochs) + 1):
         perm = rng.permutation(N) if bs else np.arange(0)
         cc.sgd_steps(Z, nfa, S_full, N, perm, bs, spe, (L, P, Q, R), adam, n_steps,
-                     float(est.learning_rate_), m0, c0, k0, sc3, s_a, lam_hat,
+                     float(est.learning_rate), m0, c0, k0, sc3, s_a, lam_hat,
                      alpha["eig"] * eps_eig if use_eig else 0.0, has_R,
                      support if support is not None else no_support, support is not None,
                      lam_l1, use_l1 and epoch <= l1_epochs, float(m_hat))
@@ -345,5 +467,5 @@ def fit_matrix_sgd(data: Measurement, est: Any, m_hat: float, lam_hat: np.ndarra
     M = m0 * (L @ L.T)
     C, K = c0 * _sym(Q), k0 * _sym(P)
     K3 = sc3 * R if has_R else None
-    return {"M": _sym(M), "C": C, "K": K, "K3": K3, "n_steps": n_steps, "alphas": alpha, "guard": guard,
-            "history": {k: np.asarray(v) for k, v in hist.items()}}
+    return MatrixSGDResult(M=_sym(M), C=C, K=K, K3=K3, n_steps=n_steps, alphas=alpha, guard=guard,
+                           history={k: np.asarray(v) for k, v in hist.items()})

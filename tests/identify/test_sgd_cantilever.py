@@ -53,7 +53,7 @@ def test_stiff_targets_at_reduced_budget(stiff):
     """The issue's stiff targets after 20 epochs (2,000 gradient steps, 0.2 % of the paper's budget).
 
     Measured: TRAC >= 0.994, MAC 1.000, frequency error 0.64 %; the paper-literal coefficient
-    parametrisation diverges here (its null space, see identify/_sgd_matrix.py).
+    form (``sgd_sindy_coefficients``) diverges here (its null space, see identify/_sgd_matrix.py).
     """
     ds, data, clean = stiff
     model = SGDSINDy(epochs=20).fit(data)

@@ -13,6 +13,7 @@ import pytest
 from benchmarks import bench_sgd_sindy as bench
 from identify import IDENTIFIERS
 from identify.sgd_sindy import SGDSINDy
+from identify.sgd_sindy_coefficients import SGDSINDyCoefficients
 from identify.structural import modal
 from testbed.scoring.metrics import mac_matrix, pair_modes, trac
 
@@ -42,7 +43,8 @@ def cubic_fits():
 
 def test_registered():
     assert IDENTIFIERS.get("sgd_sindy") is SGDSINDy
-    assert SGDSINDy.kind == "structural"
+    assert IDENTIFIERS.get("sgd_sindy_coefficients") is SGDSINDyCoefficients
+    assert SGDSINDy.kind == SGDSINDyCoefficients.kind == "structural"
 
 
 def test_linear_chain_dynamics(linear):
@@ -123,12 +125,28 @@ def test_history(linear):
 
 def test_options_run(linear):
     _, data, _ = linear
-    for kw in ({"mass_update": "eq6"}, {"mass_update": "symmetry"}, {"optimizer": "sgd"},
-               {"init": "zeros", "eigen": False, "anneal": False}, {"steps_per_epoch": 1, "l1": "all"},
-               {"mass_prior": "total_mass"}):
+    for kw in ({"init": "zeros", "eigen": False, "anneal": False}, {"steps_per_epoch": 1, "l1": "none"},
+               {"gradient": "full"}, {"mass_prior": "total_mass"}):
         m = SGDSINDy(epochs=3, **kw).fit(data)
         assert np.all(np.isfinite(m.coef_)), kw
-    assert np.isclose(np.trace(m.M_), 1.0)
+    assert np.isclose(np.trace(m.M_), 1.0)  # the declared total_mass prior [kg]
     assert SGDSINDy(epochs=3, steps_per_epoch=1).fit(data).n_steps_ == 3
-    with pytest.raises(ValueError):
-        SGDSINDy(l1="bad").fit(data)
+    for bad in ({"l1": "bad"}, {"l1": "all"}):  # the matrix form has L1 on the cubic block only
+        with pytest.raises(ValueError, match="l1"):
+            SGDSINDy(**bad).fit(data)
+
+
+def test_coefficient_form_options_run(linear):
+    """``sgd_sindy_coefficients``: the paper's literal form and its mass updates and optimisers."""
+    _, data, _ = linear
+    for kw in ({"mass_update": "eq6"}, {"mass_update": "symmetry"}, {"optimizer": "sgd"},
+               {"init": "zeros", "eigen": False, "anneal": False}, {"steps_per_epoch": 1, "l1": "all"},
+               {"symmetry": ""}, {"mass_prior": "total_mass"}):
+        m = SGDSINDyCoefficients(epochs=3, **kw).fit(data)
+        assert np.all(np.isfinite(m.coef_)), kw
+        assert m.history_["loss_data"].shape == (4,), kw
+    # Eq. 5 at its fixed point after every step: sum m = the declared total_mass prior, 1 kg
+    assert np.isclose(np.trace(m.M_), 1.0, rtol=1e-12)
+    assert SGDSINDyCoefficients(epochs=3, steps_per_epoch=1).fit(data).n_steps_ == 3
+    with pytest.raises(ValueError, match="l1"):
+        SGDSINDyCoefficients(l1="bad").fit(data)
