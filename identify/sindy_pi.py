@@ -58,6 +58,7 @@ from testbed.core.measurement import Measurement, Trajectory
 from testbed.core.schema import ErrorFn, Field
 from testbed.numerics.filters import lowpass
 from testbed.numerics.gram import normalized_gram, ordered_independent
+from testbed.numerics.noise import noise_std, signal_band
 
 #: Rollout angle-RMSE differences below 1e-4 rad [rad] count as ties (then fewer terms win):
 #: far below the 0.05 rad the paper reports and below what chaos-sensitive rollouts resolve.
@@ -209,7 +210,7 @@ def check_record(params: dict[str, Any], fs: float, n_samples: int, error: Error
     if cut is not None and not cut < fs / 2:
         error("column_lowpass_hz", cut, f"expected below the Nyquist frequency {fs / 2:g} Hz")
     record_s = n_samples / fs
-    if not 2 * params["edge_trim"] < record_s:
+    if params["edge_trim"] is not None and not 2 * params["edge_trim"] < record_s:
         error("edge_trim", params["edge_trim"], f"expected less than half the record "
                                                f"({record_s:g} s)")
 
@@ -272,6 +273,117 @@ def find_closure(data: Measurement, passive: np.ndarray) -> LoopClosure | None:
     return cl
 
 
+# --- The noise rule: SINDy-PI's filter, edge trim, ridge and form chosen from the data -------
+#: Relative noise (estimated std / channel RMS about its mean) at or below which the data count
+#: as exact: 1e-6 is 1e4x the estimator's floor on clean angles (round-off of a 1.8 rad angle
+#: differenced 4 times: ~1e-10 of a 0.15 rad swing) and 1e4x below the 1 % noise asked of
+#: SINDy-PI, so exact data keep the exact recipe (no filter, no trim, ridge 1e-14).
+NOISE_FREE_REL = 1e-6
+#: Share of the angles' (noise-floor-corrected) power whose band sets the column low-pass.
+BAND_SHARE = 0.999
+#: Column low-pass cut-off = CUTOFF_FACTOR x the angles' band: the columns are products of trig
+#: factors of the angles with rates, accelerations and inputs, so their band is wider than the
+#: angles'.  Measured on the 30 five-bar family members at 1 % noise (cut-offs 1.2-3.3 Hz):
+#: factor 1.0 / 1.2 / 1.5 / 2.0 passed 19 / 29 / 30 / 29 of 30 within 0.0501 rad; 1.5 is the
+#: middle of that plateau (no filter: 12 / 30; too low a cut-off starves the regression of
+#: excitation, too high keeps noise products that pick wrong dense equations).
+CUTOFF_FACTOR = 1.5
+#: Edge trim = EDGE_PERIODS periods of the cut-off (the zero-phase filter's end transients last
+#: about one period of its cut-off at order 4), at most a tenth of the record at each end.
+EDGE_PERIODS = 1.0
+EDGE_MAX_SHARE = 0.1
+#: Ridge, noisy data included: the 1e-14 round-off safeguard.  A ridge of the order of the
+#: noise the filtered columns keep (noise_rel^2 cutoff / (fs / 2), ~4e-8 at 1 %) was measured
+#: worse on the 30 five-bar members at 1 % noise (26/30 within 0.0501 rad against 30/30):
+#: the equations need the weak directions of the ill-conditioned library that a ridge shrinks.
+RIDGE_EXACT = 1e-14
+#: Weak form above this relative noise (its integrals by parts need no second derivative of
+#: the angles): fivebar_multisine_noise5 measured the strong form at 0.045/0.035/0.132 rad and
+#: the weak form at 0.015-0.034 rad over seeds 0-2 at 5 %; at 1 % the strong form with the
+#: column filter passes every family member.
+WEAK_ABOVE_REL = 0.03
+#: Weak-form test-function support in periods of the angles' band (fivebar_multisine_noise5:
+#: 1 s against a 1.5 Hz band), at most half the held-out span (at least two held-out windows).
+WEAK_PERIODS = 1.5
+#: The settings the noise rule chooses (each a SINDyPI hyperparameter; None = by rule).
+RULE_KNOBS = ("column_lowpass_hz", "edge_trim", "ridge", "formulation", "weak_window_s")
+
+
+def noise_knobs(x: np.ndarray, fs: float, val_fraction: float,
+                user: dict[str, Any]) -> tuple[dict[str, Any], str, dict[str, Any]]:
+    """SINDy-PI's noise-dependent settings from the angles, and the rule that chose them.
+
+    Rule (each setting the user gave is kept as given):
+
+    1. ``noise_rel`` = the largest over channels of the white-noise std
+       (:func:`testbed.numerics.noise.noise_std`) over the channel's RMS about its mean; the
+       band ``band_hz`` = the largest over channels of the frequency holding ``BAND_SHARE``
+       of the noise-corrected power (:func:`testbed.numerics.noise.signal_band`).
+    2. ``noise_rel <= NOISE_FREE_REL``: exact data: strong form, no column filter, no edge
+       trim, ridge ``RIDGE_EXACT``.
+    3. Otherwise strong form up to ``WEAK_ABOVE_REL``: column low-pass at
+       ``CUTOFF_FACTOR * band_hz`` (below Nyquist), edge trim ``EDGE_PERIODS / cutoff``
+       (at most ``EDGE_MAX_SHARE`` of the record), ridge ``RIDGE_EXACT``.
+    4. Above ``WEAK_ABOVE_REL``: weak form, test functions of ``WEAK_PERIODS / band_hz``
+       seconds (at most half the held-out span), the same edge trim (with
+       ``WEAK_PERIODS / window`` for ``cutoff``) and ridge.
+
+    Parameters
+    ----------
+    x : ndarray, shape (n_channels, n_samples)
+        Measured angles [rad] (as the signal chain delivers them).
+    fs : float
+        Sample rate [Hz].
+    val_fraction : float
+        Held-out share of the record (bounds the weak window).
+    user : dict
+        The user's settings (``None`` = by rule) of ``column_lowpass_hz``, ``edge_trim``,
+        ``ridge``, ``formulation``, ``weak_window_s``.
+
+    Returns
+    -------
+    knobs : dict
+        The five settings used.
+    rule : str
+        One line: the estimates, the branch taken and which settings the user overrode.
+    estimates : dict
+        ``noise_std`` (per channel [rad]), ``noise_rel``, ``band_hz``.
+    """
+    sig = noise_std(x)
+    rms = np.std(x, axis=1)
+    rel_ch = np.where(rms > 0, sig / np.where(rms > 0, rms, 1.0), 0.0)
+    noise_rel = float(rel_ch.max(initial=0.0))
+    band = float(signal_band(x, fs, BAND_SHARE, sig).max(initial=0.0))
+    record_s = x.shape[1] / fs
+    est = {"noise_std": sig, "noise_rel": noise_rel, "band_hz": band}
+    head = f"noise {100 * noise_rel:.3g} % of RMS (differences), band {band:.3g} Hz ({BAND_SHARE:g} of power)"
+    span = record_s * (1 - 2 * EDGE_MAX_SHARE)
+    window = min(WEAK_PERIODS / band, 0.5 * val_fraction * span) if band > 0 else 0.5
+    if noise_rel <= NOISE_FREE_REL or band <= 0.0:
+        form = user.get("formulation") or "strong"
+        rule = {"formulation": form, "column_lowpass_hz": 0.0, "edge_trim": 0.0,
+                "ridge": RIDGE_EXACT, "weak_window_s": window if form == "weak" else None}
+        branch = f"exact data (<= {NOISE_FREE_REL:g}): {form} form, no column filter, no trim"
+    else:
+        form = user.get("formulation") or ("weak" if noise_rel > WEAK_ABOVE_REL else "strong")
+        if form == "strong":
+            cut = min(CUTOFF_FACTOR * band, 0.45 * fs)
+            branch = f"noisy: strong form, column low-pass {CUTOFF_FACTOR:g} x band = {cut:.3g} Hz"
+        else:
+            cut = WEAK_PERIODS / window
+            branch = (f"noisy (> {WEAK_ABOVE_REL:g}): weak form, test functions "
+                      f"{WEAK_PERIODS:g} / band = {window:.3g} s")
+        trim = min(EDGE_PERIODS / cut, EDGE_MAX_SHARE * record_s)
+        ridge = RIDGE_EXACT
+        rule = {"formulation": form, "column_lowpass_hz": cut if form == "strong" else 0.0,
+                "edge_trim": trim, "ridge": ridge, "weak_window_s": window if form == "weak" else None}
+        branch += f", edge trim {trim:.3g} s, ridge {ridge:.3g}"
+    knobs = {k: (user[k] if user.get(k) is not None else v) for k, v in rule.items()}
+    given = [k for k in rule if user.get(k) is not None]
+    text = f"{head}; {branch}" + (f"; user setting: {', '.join(given)}" if given else "")
+    return knobs, text, est
+
+
 class _ImplicitMechanical(Identifier):
     """Fit pipeline shared by SINDy-PI and the pysindy wrapper; subclasses supply _sweep."""
 
@@ -280,6 +392,18 @@ class _ImplicitMechanical(Identifier):
     def _sweep(self, G_train: np.ndarray, G_val: np.ndarray, cand: np.ndarray,
                Theta_train: np.ndarray) -> Sweep:
         raise NotImplementedError
+
+    def _choose_knobs(self, data: Measurement) -> dict[str, Any]:
+        """Data-dependent settings of this fit (``column_lowpass_hz``, ``edge_trim``,
+        ``formulation``, ``weak_window_s``): the hyperparameters as set.  SINDy-PI overrides
+        this with its noise rule (:func:`noise_knobs`)."""
+        return {"column_lowpass_hz": self.column_lowpass_hz, "edge_trim": self.edge_trim,
+                "formulation": getattr(self, "formulation", "strong"),
+                "weak_window_s": getattr(self, "weak_window_s", None)}
+
+    def _knob(self, name: str) -> Any:
+        knobs = getattr(self, "_knobs", None)
+        return knobs[name] if knobs is not None else getattr(self, name)
 
     def _library_matrix(self, lib: Library, data: Measurement) -> tuple[np.ndarray, int]:
         """Library matrix of the (reconciled) data, column-filtered and trimmed; first sample.
@@ -293,13 +417,15 @@ class _ImplicitMechanical(Identifier):
         if self.reconcile and self.closure_ is not None:
             x, xd, xdd = self.closure_.reconcile(x, xd, xdd)
         Theta = lib.evaluate(x, xd, xdd, data.u)
-        if self.column_lowpass_hz:
-            Theta = lowpass(np.ascontiguousarray(Theta.T), data.fs, self.column_lowpass_hz,
+        cut = self._knob("column_lowpass_hz")
+        if cut:
+            Theta = lowpass(np.ascontiguousarray(Theta.T), data.fs, cut,
                             self.column_lowpass_order).T
-        i0 = round(self.edge_trim * data.fs)
+        trim = self._knob("edge_trim")
+        i0 = round(trim * data.fs)
         if i0:
             if 2 * i0 >= data.n_samples:
-                raise IdentificationError(f"edge_trim {self.edge_trim} s leaves no samples")
+                raise IdentificationError(f"edge_trim {trim} s leaves no samples")
             Theta = Theta[i0:data.n_samples - i0]
         return Theta, i0
 
@@ -312,27 +438,28 @@ class _ImplicitMechanical(Identifier):
         (:func:`identify._weak.weak_matrix`); windows wholly before the split time are
         training rows, wholly after it validation rows, those straddling it are dropped.
         """
-        form = getattr(self, "formulation", "strong")
+        form = self._knob("formulation")
         if form == "strong":
             Theta, i0 = self._library_matrix(lib, data)
             n_tr = split_index(Theta.shape[0], self.val_fraction)
             return Theta, n_tr, i0, i0 + n_tr
         if form != "weak":
             raise ValueError(f"formulation must be 'strong' or 'weak', got {form!r}")
-        if self.column_lowpass_hz:
+        if self._knob("column_lowpass_hz"):
             raise ValueError("column_lowpass_hz applies to the strong form only (the weak form's "
                              "test functions filter; integration by parts needs unfiltered columns)")
         x, xd, xdd = data.x, data.xd, data.xdd
         if self.reconcile and self.closure_ is not None:
             x, xd, xdd = self.closure_.reconcile(x, xd, xdd)
-        i0 = round(self.edge_trim * data.fs)
+        trim = self._knob("edge_trim")
+        i0 = round(trim * data.fs)
         n = data.n_samples - 2 * i0
         if n < 2:
-            raise IdentificationError(f"edge_trim {self.edge_trim} s leaves no samples")
+            raise IdentificationError(f"edge_trim {trim} s leaves no samples")
         sl = slice(i0, data.n_samples - i0)
         u = None if data.u is None else data.u[:, sl]
         xdd = None if xdd is None else xdd[:, sl]
-        wf = weak_matrix(lib, x[:, sl], xd[:, sl], xdd, u, data.fs, self.weak_window_s,
+        wf = weak_matrix(lib, x[:, sl], xd[:, sl], xdd, u, data.fs, self._knob("weak_window_s"),
                          self.weak_n_windows, self.weak_degree)
         split = split_index(n, self.val_fraction)
         tr = wf.starts + wf.length <= split
@@ -362,6 +489,8 @@ class _ImplicitMechanical(Identifier):
         actuated = np.array([int(np.argmax(imap[:, k])) for k in range(imap.shape[1])])
         passive = np.flatnonzero(~imap.any(axis=1))
         self.closure_ = find_closure(data, passive)
+        self._knobs = None
+        self._knobs = self._choose_knobs(data)
         lib = make_library(self.library, data)
         Theta, n_tr, i0, v0 = self._regression_matrix(lib, data)
         G_tr, G_v = grams(Theta, n_tr)
@@ -526,13 +655,24 @@ class SINDyPI(_ImplicitMechanical):
     hyperparameters: ClassVar[dict[str, Field]] = ordered_fields({
         **COMMON_HYPERPARAMETERS,
         "thresholds": THRESHOLDS_FIELD,
-        "ridge": RIDGE_FIELD,
+        "ridge": Field(float, None, min=0.0, max=1.0,
+                       doc="ridge added to the unit-diagonal normalised Gram matrix; default by "
+                           "the noise rule (1e-14 on exact data)"),
         "max_iter": MAX_ITER_FIELD,
-        "formulation": Field(str, "strong", choices=("strong", "weak"),
-                             doc="one regression row per sample, or per test-function integral"),
-        "weak_window_s": Field(float, 0.5, unit="s", min=0.0, min_inclusive=False,
+        # 0 = off, None = by the noise rule
+        "column_lowpass_hz": Field(float, None, unit="Hz", min=0.0,
+                                   doc="zero-phase low-pass cut-off applied to every library "
+                                       "column (below the Nyquist frequency; 0: off); default "
+                                       "by the noise rule"),
+        "edge_trim": Field(float, None, unit="s", min=0.0,
+                           doc="seconds dropped at each end of the record (less than half of "
+                               "it); default by the noise rule"),
+        "formulation": Field(str, None, choices=("strong", "weak"),
+                             doc="one regression row per sample, or per test-function integral; "
+                                 "default by the noise rule"),
+        "weak_window_s": Field(float, None, unit="s", min=0.0, min_inclusive=False,
                                doc="support of each test function (weak form; shorter than the "
-                                   "record)"),
+                                   "record); default by the noise rule"),
         # >= 4: the held-out split needs at least 2 training and 2 validation windows
         "weak_n_windows": Field(int, 400, min=4, max=100000,
                                 doc="number of overlapping test functions (weak form)"),
@@ -549,7 +689,7 @@ class SINDyPI(_ImplicitMechanical):
     def check_hyperparameters(cls, params, error):
         """Ascending thresholds; the weak form filters itself (no column low-pass)."""
         check_thresholds(params, error)
-        if params["formulation"] == "weak" and params["column_lowpass_hz"] is not None:
+        if params["formulation"] == "weak" and params["column_lowpass_hz"]:
             error("column_lowpass_hz", params["column_lowpass_hz"],
                   "not with formulation = 'weak' (its test functions filter; integration by "
                   "parts needs unfiltered columns)")
@@ -558,20 +698,22 @@ class SINDyPI(_ImplicitMechanical):
     def check_data_shape(cls, params, n_channels, n_inputs, fs, n_samples, error):
         """As the shared checks, plus a weak window shorter than the record."""
         super().check_data_shape(params, n_channels, n_inputs, fs, n_samples, error)
-        if params["formulation"] == "weak":
-            span = n_samples / fs - 2 * params["edge_trim"]
+        if params["formulation"] == "weak" and params["weak_window_s"] is not None:
+            span = n_samples / fs - 2 * (params["edge_trim"] or 0.0)
             if not params["weak_window_s"] < span:
                 error("weak_window_s", params["weak_window_s"],
                       f"expected shorter than the trimmed record ({span:g} s)")
 
     def __init__(self, library: Any = "fivebar", lhs: Sequence[str] | None = None,
-                 thresholds: Sequence[float] | None = None, ridge: float = 1e-14, max_iter: int = 20,
+                 thresholds: Sequence[float] | None = None, ridge: float | None = None,
+                 max_iter: int = 20,
                  val_fraction: float = 0.2, selection: str = "holdout", selection_rtol: float = 0.1,
                  selection_atol: float = 1e-12, n_rollout: int = 3, prune_tol: float | None = 1e-9,
                  sim_dt: float = 1e-3, reconcile: bool = True,
                  column_lowpass_hz: float | None = None, column_lowpass_order: int = 4,
-                 edge_trim: float = 0.0, input_hold: str = "linear", formulation: str = "strong",
-                 weak_window_s: float = 0.5, weak_n_windows: int = 400, weak_degree: int = 4):
+                 edge_trim: float | None = None, input_hold: str = "linear",
+                 formulation: str | None = None, weak_window_s: float | None = None,
+                 weak_n_windows: int = 400, weak_degree: int = 4):
         self.library = library
         self.lhs = lhs
         self.thresholds = thresholds
@@ -594,6 +736,19 @@ class SINDyPI(_ImplicitMechanical):
         self.weak_n_windows = weak_n_windows
         self.weak_degree = weak_degree
 
+    def _choose_knobs(self, data: Measurement) -> dict[str, Any]:
+        """The noise rule (:func:`noise_knobs`) on the measured angles; stored as fitted
+        attributes and ``noise_rule_``."""
+        user = {k: getattr(self, k) for k in RULE_KNOBS}
+        knobs, rule, est = noise_knobs(data.x, data.fs, self.val_fraction, user)
+        for k in RULE_KNOBS:
+            setattr(self, f"{k}_", knobs[k])
+        self.noise_rule_ = rule
+        self.noise_std_ = est["noise_std"]
+        self.noise_rel_ = est["noise_rel"]
+        self.band_hz_ = est["band_hz"]
+        return knobs
+
     def _sweep(self, G_train, G_val, cand, Theta_train):
         thr = DEFAULT_THRESHOLDS if self.thresholds is None else np.asarray(self.thresholds)
-        return stlsq_sweep(G_train, G_val, cand, thr, self.ridge, self.max_iter)
+        return stlsq_sweep(G_train, G_val, cand, thr, self._knob("ridge"), self.max_iter)
