@@ -59,13 +59,16 @@ def test_user_settings_override_the_rule(clean):
     assert forced.formulation_ == "weak" and forced.weak_window_s_ > 0
 
 
-def test_high_noise_chooses_the_weak_form(clean):
+def test_high_noise_keeps_the_strong_form_and_a_weak_request_gets_a_window(clean):
     m = SINDyPI().fit(_noisy(clean, 5.0))
-    assert m.noise_rel_ > sp.WEAK_ABOVE_REL
-    assert m.formulation_ == "weak" and m.column_lowpass_hz_ == 0.0
-    span = 8.0 * (1 - 2 * sp.EDGE_MAX_SHARE)
-    assert m.weak_window_s_ <= 0.5 * m.val_fraction * span + 1e-12
-    assert m.weak_strong_columns_ == []
+    assert m.noise_rel_ == pytest.approx(0.05, rel=0.05)
+    assert m.formulation_ == "strong" and m.column_lowpass_hz_ > 0
+    w = SINDyPI(formulation="weak").fit(_noisy(clean, 5.0))
+    assert w.formulation_ == "weak" and w.column_lowpass_hz_ == 0.0
+    span = clean.n_samples / clean.fs * (1 - 2 * sp.EDGE_MAX_SHARE)
+    assert w.weak_window_s_ == pytest.approx(min(sp.WEAK_PERIODS / w.band_hz_,
+                                                 0.5 * w.val_fraction * span))
+    assert w.weak_strong_columns_ == []
 
 
 def test_ensemble_on_exact_data_reproduces_the_fit(clean):

@@ -49,4 +49,8 @@ def test_signal_band_sees_through_the_noise_floor():
     # (9e-6 rad^2 over 500 Hz, 0.02 % of the power) would push the band far above 3 Hz
     band = signal_band(noisy, fs, 0.999)
     assert 2.9 <= band[0] <= 3.2
+    # 20x the noise (0.3 % of the power, beyond the 0.1 % left out): clipping the floor per bin
+    # kept 1/e of it and sent this band to hundreds of Hz
+    louder = x + 6e-2 * np.random.default_rng(1).standard_normal(x.shape)
+    assert 2.9 <= signal_band(louder, fs, 0.999)[0] <= 3.2
     assert signal_band(np.zeros((1, 100)) + 1.0, fs)[0] == 0.0
