@@ -41,6 +41,7 @@ dropped (ordered pivoted Cholesky; library order is priority) and listed in ``pr
 
 from __future__ import annotations
 
+import dataclasses
 import sys
 from collections.abc import Sequence
 from itertools import pairwise, product
@@ -515,9 +516,20 @@ class _ImplicitMechanical(Identifier):
         imap = np.abs(np.asarray(data.input_map)) > 0
         actuated = np.array([int(np.argmax(imap[:, k])) for k in range(imap.shape[1])])
         passive = np.flatnonzero(~imap.any(axis=1))
-        self.closure_ = find_closure(data, passive)
         self._knobs = None
         self._knobs = self._choose_knobs(data)
+        cut = self._knobs["column_lowpass_hz"]
+        if cut and passive.size:
+            # the closure is found on angles low-passed as the columns are: white angle noise
+            # on a small motion otherwise outweighs the loop's own residual
+            sl = slice(round(self._knobs["edge_trim"] * data.fs),
+                       data.n_samples - round(self._knobs["edge_trim"] * data.fs))
+            xs = lowpass(data.x, data.fs, cut, self.column_lowpass_order)
+            self.closure_ = find_closure(dataclasses.replace(data, x=xs[:, sl], xd=data.xd[:, sl],
+                                                             xdd=data.xdd[:, sl], u=None),
+                                         passive)
+        else:
+            self.closure_ = find_closure(data, passive)
         lib = make_library(self.library, data)
         Theta, n_tr, i0, v0 = self._regression_matrix(lib, data)
         G_tr, G_v = grams(Theta, n_tr)
