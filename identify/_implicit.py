@@ -383,8 +383,10 @@ def bagged_models(blocks: np.ndarray, G_val: np.ndarray, picks: Sequence[tuple[i
     inclusion_min : float
         Terms in fewer than this share of the bags are zeroed in the aggregate model (E-SINDy's
         inclusion cut; 0.5: in the majority of bags).
-    aggregate : {"median", "mean"}
-        Per-term median (E-SINDy's bragging) or mean (bagging) over the bags.
+    aggregate : {"median", "mean", "refit"}
+        Per-term median (E-SINDy's bragging) or mean (bagging) over the bags, or a least-
+        squares refit on all training rows of the terms kept by the inclusion cut (one
+        consistent equation instead of per-term aggregates).
 
     Returns
     -------
@@ -414,11 +416,27 @@ def bagged_models(blocks: np.ndarray, G_val: np.ndarray, picks: Sequence[tuple[i
         d = draws[r, ok[r]]
         inc[r] = np.mean(d != 0, axis=0)
         std[r] = d.std(axis=0)
+        keep = inc[r] >= inclusion_min
         if aggregate == "median":
-            agg = np.median(d, axis=0)
+            coef[r] = np.where(keep, np.median(d, axis=0), 0.0)
         elif aggregate == "mean":
-            agg = d.mean(axis=0)
+            coef[r] = np.where(keep, d.mean(axis=0), 0.0)
+        elif aggregate == "refit":
+            coef[r] = _refit(blocks.sum(axis=0), int(sw.candidates[picks[r][1]]), keep, ridge)
         else:
-            raise ValueError(f"aggregate must be 'median' or 'mean', got {aggregate!r}")
-        coef[r] = np.where(inc[r] >= inclusion_min, agg, 0.0)
+            raise ValueError(f"aggregate must be 'median', 'mean' or 'refit', got {aggregate!r}")
     return Ensemble(coef, std, inc)
+
+
+def _refit(G: np.ndarray, j: int, keep: np.ndarray, ridge: float) -> np.ndarray:
+    """Least squares of column ``j`` on the columns ``keep`` (``j`` excluded) on Gram matrix
+    ``G``; the implicit row in original units with coefficient 1 on ``j``."""
+    s = np.sqrt(np.clip(np.diag(G), 0.0, None))
+    s = np.where(s > 0, s, 1.0)
+    mask = keep.copy()
+    mask[j] = False
+    w = np.zeros(G.shape[0])
+    if mask.any():
+        w = -_solve_masked(G / np.outer(s, s), np.array([j]), mask[None, :], ridge)[0]
+    w[j] = 1.0
+    return w / s * s[j]

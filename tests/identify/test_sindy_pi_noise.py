@@ -82,6 +82,8 @@ def test_ensemble_on_exact_data_reproduces_the_fit(clean):
     assert np.all(ens.coef_std_ < 1e-8)
     np.testing.assert_array_equal(ens.inclusion_probability_, (one.coef_ != 0).astype(float))
     assert not hasattr(one, "coef_std_")
+    refit = SINDyPI(ensemble=6, ensemble_blocks=8, ensemble_aggregate="refit").fit(clean)
+    np.testing.assert_allclose(refit.coef_, one.coef_, atol=1e-8)
 
 
 def test_ensemble_reports_uncertainty_on_noisy_data(clean):
