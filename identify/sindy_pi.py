@@ -37,7 +37,7 @@ attributes (``column_lowpass_hz_``, ``edge_trim_``, ``ridge_``, ``formulation_``
 ``weak_window_s_``) and ``noise_rule_`` says why.  Measured on the 30 five-bar family
 members (studies/families.toml) at default settings: within the paper's 0.0501 rad 30/30 at
 1 % angle noise (12/30 before the rule; median 7.4e-4 rad, worst 0.030) and 30/30 clean
-(all <= 1e-6 rad, unchanged); the paper's sine input at 0.5-5 % noise 1e-6 rad.
+(all <= 3e-6 rad, unchanged); the paper's sine input at 0.5-5 % noise <= 9e-6 rad.
 
 Ensembling (``ensemble=N``): E-SINDy bagging of the selected models over moving-block
 bootstraps of the training rows, with ``coef_std_`` and ``inclusion_probability_``; off by
