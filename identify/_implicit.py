@@ -13,6 +13,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from itertools import pairwise
 
 import numpy as np
 
@@ -323,3 +324,119 @@ def select_models(sw: Sweep, input_cols: Sequence[np.ndarray], rtol: float = 0.1
                 break
         out.append(picked)
     return out
+
+
+@dataclass
+class Ensemble:
+    """Bagged refits of selected implicit models (E-SINDy's bagging and bragging).
+
+    Attributes
+    ----------
+    coef : ndarray, shape (n_models, p)
+        Median over the bags of each term's coefficient (original units, the left-hand-side
+        term's coefficient 1), zeroed where the inclusion probability is below the cut.
+    std : ndarray, shape (n_models, p)
+        Standard deviation over the bags, same units.
+    inclusion : ndarray, shape (n_models, p)
+        Share of bags in which each term is non-zero.
+    """
+
+    coef: np.ndarray
+    std: np.ndarray
+    inclusion: np.ndarray
+
+
+def block_grams(Theta_train: np.ndarray, n_blocks: int) -> np.ndarray:
+    """Gram matrices of ``n_blocks`` contiguous row blocks, shape (n_blocks, p, p)."""
+    n = Theta_train.shape[0]
+    if n < n_blocks:
+        raise IdentificationError(f"{n} training rows are too few for {n_blocks} ensemble blocks")
+    edges = np.linspace(0, n, n_blocks + 1).round().astype(np.intp)
+    return np.stack([Theta_train[a:b].T @ Theta_train[a:b] for a, b in pairwise(edges)])
+
+
+def bagged_models(blocks: np.ndarray, G_val: np.ndarray, picks: Sequence[tuple[int, int]],
+                  sw: Sweep, n_bags: int, ridge: float, max_iter: int,
+                  rng: np.random.Generator, inclusion_min: float = 0.5,
+                  aggregate: str = "median") -> Ensemble:
+    """Refit each picked model on ``n_bags`` block bootstraps of the training rows.
+
+    Every bag draws as many blocks as there are, with replacement (a moving-block bootstrap:
+    blocks keep the rows' time correlation), sums their Gram matrices and reruns the
+    thresholded least squares of the picked left-hand side over the thresholds up to the
+    picked one (:func:`stlsq_sweep`, so the path is the full fit's).  Coefficients are
+    compared in original units with the left-hand side's coefficient 1.
+
+    Parameters
+    ----------
+    blocks : ndarray, shape (n_blocks, p, p)
+        :func:`block_grams` of the training rows (kept columns).
+    G_val : ndarray, shape (p, p)
+    picks : sequence of (threshold index, candidate index)
+        The selected models of ``sw``.
+    sw : Sweep
+        The full fit's sweep (its candidates and thresholds).
+    n_bags : int
+    ridge : float
+    max_iter : int
+    rng : numpy Generator
+    inclusion_min : float
+        Terms in fewer than this share of the bags are zeroed in the aggregate model (E-SINDy's
+        inclusion cut; 0.5: in the majority of bags).
+    aggregate : {"median", "mean", "refit"}
+        Per-term median (E-SINDy's bragging) or mean (bagging) over the bags, or a least-
+        squares refit on all training rows of the terms kept by the inclusion cut (one
+        consistent equation instead of per-term aggregates).
+
+    Returns
+    -------
+    Ensemble
+    """
+    nb = blocks.shape[0]
+    p = blocks.shape[1]
+    draws = np.zeros((len(picks), n_bags, p))
+    for b in range(n_bags):
+        G = blocks[rng.integers(0, nb, nb)].sum(axis=0)
+        for r, (t, c) in enumerate(picks):
+            j = int(sw.candidates[c])
+            try:
+                bag = stlsq_sweep(G, G_val, [j], sw.thresholds[:t + 1], ridge, max_iter)
+            except IdentificationError:
+                draws[r, b] = np.nan
+                continue
+            w = bag.W[-1, 0] / bag.scale
+            draws[r, b] = w / w[j]
+    ok = np.all(np.isfinite(draws), axis=2)
+    if not ok.any(axis=1).all():
+        raise IdentificationError("no ensemble bag could be fitted")
+    coef = np.zeros((len(picks), p))
+    std = np.zeros((len(picks), p))
+    inc = np.zeros((len(picks), p))
+    for r in range(len(picks)):
+        d = draws[r, ok[r]]
+        inc[r] = np.mean(d != 0, axis=0)
+        std[r] = d.std(axis=0)
+        keep = inc[r] >= inclusion_min
+        if aggregate == "median":
+            coef[r] = np.where(keep, np.median(d, axis=0), 0.0)
+        elif aggregate == "mean":
+            coef[r] = np.where(keep, d.mean(axis=0), 0.0)
+        elif aggregate == "refit":
+            coef[r] = _refit(blocks.sum(axis=0), int(sw.candidates[picks[r][1]]), keep, ridge)
+        else:
+            raise ValueError(f"aggregate must be 'median', 'mean' or 'refit', got {aggregate!r}")
+    return Ensemble(coef, std, inc)
+
+
+def _refit(G: np.ndarray, j: int, keep: np.ndarray, ridge: float) -> np.ndarray:
+    """Least squares of column ``j`` on the columns ``keep`` (``j`` excluded) on Gram matrix
+    ``G``; the implicit row in original units with coefficient 1 on ``j``."""
+    s = np.sqrt(np.clip(np.diag(G), 0.0, None))
+    s = np.where(s > 0, s, 1.0)
+    mask = keep.copy()
+    mask[j] = False
+    w = np.zeros(G.shape[0])
+    if mask.any():
+        w = -_solve_masked(G / np.outer(s, s), np.array([j]), mask[None, :], ridge)[0]
+    w[j] = 1.0
+    return w / s * s[j]

@@ -1,0 +1,120 @@
+"""Sensor-noise level and signal band estimated from a record itself.
+
+Two estimators, for signals sampled far above their band (a mechanism's angles at kHz rates
+against motions of a few Hz):
+
+- :func:`noise_std`: white-noise standard deviation from the ``k``-th finite differences.  The
+  ``k``-th difference of a smooth signal of frequency ``f`` is ``(2 pi f / fs)^k`` times its
+  amplitude (negligible when ``f << fs``), while that of white noise of standard deviation
+  ``sigma`` has standard deviation ``sigma sqrt(C(2k, k))``; the median absolute deviation
+  (times 1.4826, the Gaussian consistency factor) makes it robust to the few samples where
+  the signal itself is rough (a zero-order-hold step, a start transient).
+- :func:`signal_band`: the frequency below which a given share of the signal's power lies,
+  after the white-noise floor (from :func:`noise_std`) is subtracted from the periodogram.
+
+Both are pure functions of the samples (no model, no truth).
+"""
+
+from __future__ import annotations
+
+from math import comb
+
+import numpy as np
+
+#: Gaussian consistency factor of the median absolute deviation: sigma = 1.4826 MAD.
+MAD_TO_STD = 1.482602218505602
+
+
+def _rows(x: np.ndarray) -> np.ndarray:
+    a = np.atleast_2d(np.asarray(x, dtype=float))
+    if a.ndim != 2:
+        raise ValueError(f"expected a signal of shape (n_channels, n_samples), got shape {a.shape}")
+    return a
+
+
+def noise_std(x: np.ndarray, order: int = 4) -> np.ndarray:
+    """Robust standard deviation of additive white noise in each row of ``x``.
+
+    Parameters
+    ----------
+    x : ndarray, shape (n_channels, n_samples) or (n_samples,)
+        Uniformly sampled signals (any unit; the result has the same unit).
+    order : int
+        Finite-difference order ``k`` (>= 1).  Higher orders annihilate more of the smooth
+        signal (it enters as ``(2 pi f / fs)^k``) but average fewer independent samples;
+        4 leaves 1e-11 of a 2 Hz motion at 10 kHz.
+
+    Returns
+    -------
+    ndarray, shape (n_channels,)
+        ``1.4826 * MAD(diff^k x) / sqrt(C(2k, k))`` per row.
+
+    Raises
+    ------
+    ValueError
+        Fewer than ``order + 2`` samples, a bad order, or non-finite samples.
+    """
+    a = _rows(x)
+    k = int(order)
+    if k < 1:
+        raise ValueError(f"difference order must be >= 1, got {order}")
+    if a.shape[1] < k + 2:
+        raise ValueError(f"{a.shape[1]} samples are too few for differences of order {k}")
+    if not np.all(np.isfinite(a)):
+        raise ValueError("the signal has non-finite samples")
+    d = np.diff(a, n=k, axis=1)
+    mad = np.median(np.abs(d - np.median(d, axis=1, keepdims=True)), axis=1)
+    return MAD_TO_STD * mad / np.sqrt(comb(2 * k, k))
+
+
+def signal_band(x: np.ndarray, fs: float, share: float = 0.99,
+                noise: np.ndarray | None = None) -> np.ndarray:
+    """Frequency below which ``share`` of each row's signal power lies [Hz].
+
+    The row is made zero-mean and detrended (a straight line through its ends removed, so the
+    record's jump between its ends does not leak as a 1/f tail), tapered by a Hann window, and
+    its periodogram's expected white-noise floor (``noise**2`` spread evenly over 0..fs/2)
+    subtracted; the band is where the cumulative remaining power first reaches ``share`` of
+    its total.
+
+    Parameters
+    ----------
+    x : ndarray, shape (n_channels, n_samples) or (n_samples,)
+    fs : float
+        Sample rate [Hz].
+    share : float
+        Share of the signal power, in (0, 1).
+    noise : ndarray, shape (n_channels,), optional
+        White-noise standard deviation of each row; default :func:`noise_std`.
+
+    Returns
+    -------
+    ndarray, shape (n_channels,)
+        [Hz]; 0 for a row without signal power above the noise floor.
+    """
+    a = _rows(x)
+    if not 0.0 < share < 1.0:
+        raise ValueError(f"share must lie in (0, 1), got {share}")
+    if not fs > 0:
+        raise ValueError(f"sample rate must be positive, got {fs}")
+    n = a.shape[1]
+    sig = noise_std(a) if noise is None else np.broadcast_to(np.asarray(noise, float), a.shape[:1])
+    ramp = np.linspace(0.0, 1.0, n)
+    z = a - a[:, :1] - (a[:, -1:] - a[:, :1]) * ramp
+    z = z - z.mean(axis=1, keepdims=True)
+    w = np.hanning(n)
+    P = np.abs(np.fft.rfft(z * w, axis=1)) ** 2
+    # expected periodogram of white noise through the window: sigma^2 sum(w^2) in every bin
+    floor = sig[:, None] ** 2 * np.sum(w**2)
+    # no clipping at zero per bin: a noise-only bin's periodogram is exponentially distributed
+    # about the floor, and clipping would keep 1/e of the noise power (at 5 % noise, 1e-3 of the
+    # signal's: the 99.9 % band then runs off to hundreds of Hz); unclipped, the noise bins sum
+    # to zero up to fluctuations of sqrt(n_bins) of one bin's floor
+    P = P - floor
+    f = np.fft.rfftfreq(n, 1.0 / fs)
+    cum = np.cumsum(P, axis=1)
+    out = np.zeros(a.shape[0])
+    for r in range(a.shape[0]):
+        if cum[r, -1] > 0:
+            out[r] = f[int(np.searchsorted(cum[r], share * cum[r, -1]))]
+    return out

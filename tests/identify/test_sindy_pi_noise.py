@@ -1,0 +1,124 @@
+"""SINDy-PI's noise rule (settings chosen from the data, recorded, overridden by the user) and
+E-SINDy ensembling, on the synthetic five-bar (benchmarks/sindy_pi_problems.py)."""
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from benchmarks import sindy_pi_problems as P
+from identify import sindy_pi as sp
+from identify.sindy_pi import SINDyPI
+from testbed.core.errors import HyperparameterError
+from testbed.numerics.derivatives import lowpass_differentiate
+
+
+@pytest.fixture(scope="module")
+def clean():
+    return P.fivebar(duration=8.0, fs=1e3, amp=1.0).data
+
+
+def _noisy(data, percent, seed=0):
+    """Angle noise of ``percent`` % of each channel's RMS about its mean (the testbed's
+    noise model); rates and accelerations stay exact (as with recorded derivatives)."""
+    rms = data.x.std(axis=1, keepdims=True)
+    rng = np.random.default_rng(seed)
+    return dataclasses.replace(data, x=data.x + percent / 100 * rms * rng.standard_normal(data.x.shape))
+
+
+def test_exact_data_keep_the_exact_recipe(clean):
+    m = SINDyPI().fit(clean)
+    assert m.formulation_ == "strong" and m.column_lowpass_hz_ == 0.0 and m.edge_trim_ == 0.0
+    assert m.ridge_ == sp.RIDGE_EXACT and m.weak_window_s_ is None
+    assert "exact data" in m.noise_rule_ and "user setting" not in m.noise_rule_
+    # exact angles: the 4th-difference estimate is signal leakage and round-off only
+    assert m.noise_rel_ <= sp.NOISE_FREE_REL
+    assert np.all(m.validation_errors_ < 1e-12)
+
+
+def test_noisy_data_get_the_rules_filter_and_it_is_recorded(clean):
+    m = SINDyPI().fit(_noisy(clean, 1.0))
+    # 1 % noise estimated within 5 % (3 standard errors of a MAD estimate on 8000 samples)
+    assert m.noise_rel_ == pytest.approx(0.01, rel=0.05)
+    assert np.all(m.noise_std_ > 0) and m.noise_std_.shape == (4,)
+    assert m.formulation_ == "strong"
+    assert m.column_lowpass_hz_ == pytest.approx(sp.CUTOFF_FACTOR * m.band_hz_)
+    # the synthetic five-bar's tones reach 1.6 Hz: its angles' band sits between 0.2 and 3 Hz
+    assert 0.2 < m.band_hz_ < 3.0
+    assert m.edge_trim_ == pytest.approx(min(sp.EDGE_PERIODS / m.column_lowpass_hz_, 0.8))
+    assert m.ridge_ == sp.RIDGE_EXACT
+    assert f"{m.column_lowpass_hz_:.3g} Hz" in m.noise_rule_ and "noise 1" in m.noise_rule_
+
+
+def test_user_settings_override_the_rule(clean):
+    m = SINDyPI(column_lowpass_hz=5.0, ridge=1e-6, edge_trim=0.3).fit(_noisy(clean, 1.0))
+    assert (m.column_lowpass_hz_, m.ridge_, m.edge_trim_) == (5.0, 1e-6, 0.3)
+    assert "user setting: column_lowpass_hz, edge_trim, ridge" in m.noise_rule_
+    off = SINDyPI(column_lowpass_hz=0.0).fit(_noisy(clean, 1.0))
+    assert off.column_lowpass_hz_ == 0.0  # 0 turns the rule's filter off
+    forced = SINDyPI(formulation="weak").fit(clean)  # and a form on exact data
+    assert forced.formulation_ == "weak" and forced.weak_window_s_ > 0
+
+
+def test_high_noise_keeps_the_strong_form_and_a_weak_request_gets_a_window(clean):
+    m = SINDyPI().fit(_noisy(clean, 5.0))
+    assert m.noise_rel_ == pytest.approx(0.05, rel=0.05)
+    assert m.formulation_ == "strong" and m.column_lowpass_hz_ > 0
+    w = SINDyPI(formulation="weak").fit(_noisy(clean, 5.0))
+    assert w.formulation_ == "weak" and w.column_lowpass_hz_ == 0.0
+    span = clean.n_samples / clean.fs * (1 - 2 * sp.EDGE_MAX_SHARE)
+    assert w.weak_window_s_ == pytest.approx(min(sp.WEAK_PERIODS / w.band_hz_,
+                                                 0.5 * w.val_fraction * span))
+    assert w.weak_strong_columns_ == []
+
+
+def test_ensemble_on_exact_data_reproduces_the_fit(clean):
+    one = SINDyPI().fit(clean)
+    ens = SINDyPI(ensemble=6, ensemble_blocks=8).fit(clean)
+    # every bag is exact data of the same equations: the median is the plain fit's equation
+    # (1e-8: the conditioned Gram solves of different row subsets agree to ~1e-10)
+    np.testing.assert_allclose(ens.coef_, one.coef_, atol=1e-8)
+    assert ens.coef_std_.shape == ens.coef_.shape == ens.inclusion_probability_.shape
+    assert np.all(ens.coef_std_ < 1e-8)
+    np.testing.assert_array_equal(ens.inclusion_probability_, (one.coef_ != 0).astype(float))
+    assert not hasattr(one, "coef_std_")
+    refit = SINDyPI(ensemble=6, ensemble_blocks=8, ensemble_aggregate="refit").fit(clean)
+    np.testing.assert_allclose(refit.coef_, one.coef_, atol=1e-8)
+
+
+def test_ensemble_reports_uncertainty_on_noisy_data(clean):
+    noisy = _noisy(clean, 1.0)
+    a = SINDyPI(ensemble=8, ensemble_blocks=8).fit(noisy)
+    b = SINDyPI(ensemble=8, ensemble_blocks=8).fit(noisy)
+    np.testing.assert_array_equal(a.coef_, b.coef_)  # seeded bags: reproducible
+    assert np.all(np.isfinite(a.coef_std_)) and a.coef_std_.max() > 0
+    p = a.inclusion_probability_
+    assert np.all((p >= 0) & (p <= 1))
+    # the median model keeps only terms in at least half the bags (a kept term's median may
+    # still be 0 when its non-zero draws straddle zero)
+    assert np.all(p[a.coef_ != 0] >= 0.5) and np.any((p > 0) & (p < 0.5))
+    c = SINDyPI(ensemble=8, ensemble_blocks=8, ensemble_seed=1).fit(noisy)
+    assert not np.array_equal(a.coef_std_, c.coef_std_)
+
+
+def test_ensemble_settings_are_checked():
+    with pytest.raises(HyperparameterError, match="ensemble_blocks"):
+        SINDyPI(ensemble_blocks=1).fit(P.fivebar(duration=1.0, fs=1e3).data)
+
+
+def test_print_shows_the_rule_and_the_uncertainty(clean, capsys):
+    m = SINDyPI(ensemble=4, ensemble_blocks=8).fit(_noisy(clean, 1.0))
+    m.print()
+    out = capsys.readouterr().out.splitlines()
+    assert out[:2] == m.equations() and out[2] == f"# noise rule: {m.noise_rule_}"
+    assert out[3].startswith("# ensemble, equation 1: ") and "+-" in out[3] and "(p " in out[3]
+
+
+def test_smoothed_noise_is_not_taken_for_exact_data(clean):
+    # angles low-passed by a derivative chain carry band-limited noise the differences cannot
+    # see; the exact-data fit's held-out error gives it away and the noisy recipe is used
+    x, xd, xdd = lowpass_differentiate(_noisy(clean, 1.0).x, clean.fs, 4.0)
+    m = SINDyPI().fit(dataclasses.replace(clean, x=x, xd=xd, xdd=xdd))
+    assert m.noise_rel_ <= sp.NOISE_FREE_REL
+    assert "smoothed noise" in m.noise_rule_ and m.column_lowpass_hz_ > 0 and m.edge_trim_ > 0
+    assert "smoothed" not in SINDyPI().fit(clean).noise_rule_
