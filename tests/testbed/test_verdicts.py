@@ -266,7 +266,9 @@ def test_fivebar_noisy_sine_replay_fit_failure_is_scored(tmp_path, dataset_cache
 
     base = load_scenario("fivebar_sine_replay").path
     path = tmp_path / "noisy_sine.toml"
-    path.write_text(f'[scenario]\nname = "noisy_sine"\nextends = "{base}"\n[noise]\nrms_percent = 2\n')
+    # 30 %: where no loop closure fits the noisy angles (measured; since the noise rule
+    # low-passes the library's columns, 2-10 % noise fit to 1e-5 rad and no longer fail)
+    path.write_text(f'[scenario]\nname = "noisy_sine"\nextends = "{base}"\n[noise]\nrms_percent = 30\n')
     result = run_scenario(load_scenario(str(path)), cache=dataset_cache)
     assert result.failure.startswith("fit failed: no loop closure fits the measured angles")
     assert all(math.isnan(v) for v in result.scores.values.values())
