@@ -47,6 +47,10 @@ _API = {
     "load_plugins": ("testbed.pipeline.plugins", "load_plugins"),
     "Identifier": ("identify", "Identifier"),
     "StructuralIdentifier": ("identify", "StructuralIdentifier"),
+    # model selection with scikit-learn (GridSearchCV) on a Measurement
+    "MeasurementSamples": ("identify._base", "MeasurementSamples"),
+    "TimeWindows": ("identify._base", "TimeWindows"),
+    "split_measurement": ("identify._base", "split_measurement"),
     "Rig": ("models", "Rig"),
     "Field": ("testbed.core.schema", "Field"),
     "Measurement": ("testbed.core.measurement", "Measurement"),
