@@ -32,6 +32,10 @@ _API = {
     "run_scenario": ("testbed.scoring.evaluate", "run_scenario"),
     "score": ("testbed.scoring.evaluate", "score_model"),
     "RunResult": ("testbed.scoring.run", "RunResult"),
+    # the run history (out/runs)
+    "save_new_run": ("testbed.studies.runstore", "save_new_run"),
+    "list_runs": ("testbed.studies.runstore", "list_runs"),
+    "resolve_run": ("testbed.studies.runstore", "resolve_run"),
     # measured data from files (no truth)
     "read_measured": ("testbed.pipeline.importers", "read_measured"),
     "measurement_from_file": ("testbed.pipeline.importers", "measurement_from_file"),
