@@ -687,13 +687,18 @@ INDEX_SCORES = 3
 def _key_scores(r: dict[str, Any]) -> tuple[str, str]:
     """(HTML, text) of a run's key scores: its checked metrics, else its first few scores."""
     if r["checks"]:
-        items = [(f"{c['metric']} {fmt(c['value'])} {c['bound']} {fmt(c['threshold'])}",
-                  "pass" if c["passed"] else "fail") for c in r["checks"]]
+        items = [(f"{c['metric']} {fmt(c['value'])} {_BOUND.get(c['bound'], c['bound'])} "
+                  f"{fmt(c['threshold'])}", "✓" if c["passed"] else "✗") for c in r["checks"]]
     else:
         items = [(f"{k} {fmt(v)}", "") for k, v in list(r["scores"].items())[:INDEX_SCORES]]
-    h = "<br>".join(f'<span class="{c}">{html.escape(t)}</span>' if c else html.escape(t)
-                    for t, c in items)
-    return h, "; ".join(t for t, _ in items)
+    h = "<br>".join('<span class="ks">'
+                    + (f'<span class="{"pass" if c == "✓" else "fail"}">{c}</span> ' if c else "")
+                    + html.escape(t) + "</span>" for t, c in items)
+    return h, "; ".join(f"{c} {t}".strip() for t, c in items)
+
+
+#: How a threshold's bound reads in the index.
+_BOUND = {"min": "≥", "max": "≤"}
 
 
 def runs_index_html(runs: Sequence[dict[str, Any]], out_dir: str | os.PathLike) -> str:
@@ -724,11 +729,14 @@ def runs_index_html(runs: Sequence[dict[str, Any]], out_dir: str | os.PathLike) 
         v = r["verdict"]
         badge = {"pass": "pass", "FAIL": "fail"}.get(v, "none")
         scores, _ = _key_scores(r)
-        cells = [html.escape(r["created"].replace("+00:00", "Z")), html.escape(r["scenario"]),
+        cells = [html.escape(r["created"].replace("+00:00", "Z").replace("T", " ")),
+                 html.escape(r["scenario"]),
                  html.escape(str(r["seed"])), html.escape(r["identifier"]),
                  f'<a href="{html.escape(href, quote=True)}">{html.escape(r["id"])}</a>',
                  f'<span class="badge {badge}">{html.escape(v or "?")}</span>', scores]
-        rows.append("<tr>" + "".join(f"<td>{c}</td>" for c in cells) + "</tr>")
+        nowrap = ' class="nowrap"'  # the time and the run's name read best on one line
+        rows.append("<tr>" + "".join(f"<td{nowrap if i in (0, 4) else ''}>{c}</td>"
+                                     for i, c in enumerate(cells)) + "</tr>")
     head = "".join(f"<th>{h}</th>" for h in ("time (UTC)", "scenario", "seed", "identifier", "run",
                                              "verdict", "key scores"))
     body = (f"<table><thead><tr>{head}</tr></thead><tbody>{''.join(rows)}</tbody></table>" if rows
@@ -736,6 +744,9 @@ def runs_index_html(runs: Sequence[dict[str, Any]], out_dir: str | os.PathLike) 
     return ("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
             f'<meta http-equiv="Content-Security-Policy" content="{CSP}">'
             '<meta name="viewport" content="width=device-width, initial-scale=1">'
-            f"<title>Runs</title><style>{CSS}</style></head>\n<body>\n<h1>Runs</h1>\n"
+            f"<title>Runs</title><style>{CSS}td.nowrap,.ks{{white-space:nowrap}}.ks{{font-size:.85em}}"
+            "body{max-width:1500px}"
+            "</style></head>\n"
+            "<body>\n<h1>Runs</h1>\n"
             f'<p class="muted">{len(runs)} run(s) in {html.escape(str(out_dir))}, newest first; '
             "each run links to its report.</p>\n" + body + "\n</body></html>\n")
