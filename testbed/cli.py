@@ -345,18 +345,19 @@ def cmd_identify(args: argparse.Namespace) -> int:
 
     from testbed.pipeline.fit import identify_file
     from testbed.reporting.identified import render_identified
+    from testbed.reporting.progress import run_progress
 
     _load_plugins(args)
     units = None
     if args.units:
         units = _key_values(args.units, "--units", numbers=False) if "=" in args.units[0] \
             else args.units[0]
-    result = identify_file(_existing_file(Path(args.data), "a measured-data file (UFF58, SEP-005 "
-                                                          "JSON, CSV or HDF5)"),
-                           scenario=args.scenario, kind=args.kind, method=args.method,
-                           params=_key_values(args.param, "--param", numbers=False),
-                           format=args.format, fs=args.fs, units=units,
-                           prior=_key_values(args.prior, "--prior", numbers=True))
+    data = _existing_file(Path(args.data), "a measured-data file (UFF58, SEP-005 JSON, CSV or HDF5)")
+    with run_progress(data.name) as phase:
+        result = identify_file(data, scenario=args.scenario, kind=args.kind, method=args.method,
+                               params=_key_values(args.param, "--param", numbers=False),
+                               format=args.format, fs=args.fs, units=units,
+                               prior=_key_values(args.prior, "--prior", numbers=True), phase=phase)
     summary = result.summary()
     out = Path(args.output or f"{Path(args.data).stem}.model.json")
     out.parent.mkdir(parents=True, exist_ok=True)

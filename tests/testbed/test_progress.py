@@ -106,3 +106,19 @@ def test_a_nan_fraction_leaves_the_bar_as_it_was(bad):
             update(bad)
             time.sleep(0.15)
     assert "25%" in buf.getvalue() and "nan" not in buf.getvalue().lower()
+
+
+def test_identify_file_reports_its_phases(tmp_path, dataset_cache):
+    from testbed.pipeline.fit import identify_file
+
+    names: list[str] = []
+
+    @contextmanager
+    def phase(name):
+        names.append(name)
+        yield lambda fraction=None, step=None: None
+
+    sc = testbed.load_scenario("cantilever_stiff_impact_lsq")
+    dataset_cache.get(sc).save(tmp_path / "d.h5")
+    fitted = identify_file(tmp_path / "d.h5", scenario=sc.name, phase=phase)
+    assert names == ["read and signal chain", "fit"] and fitted.model.is_fitted()
