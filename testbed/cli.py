@@ -385,11 +385,13 @@ def cmd_runs(args: argparse.Namespace) -> int:
     from rich.console import Console
     from rich.table import Table
 
-    t = Table(title=f"{len(runs)} run(s) in {args.out}, oldest first")
-    for c in cols:
+    # a terminal: the run's folder name, not its whole path (the title says where it is)
+    t = Table(title=f"{len(runs)} run(s), oldest first; folders {Path(args.out) / '<scenario>' / '<run>'}")
+    for c in (*cols[:-1], "run"):
         t.add_column(c, overflow="fold")
-    for row in rows:
-        t.add_row(*row)
+    for r, row in zip(runs, rows, strict=True):
+        t.add_row(*row[:-1], r["path"].name if r["path"].parent.name == r["scenario"]
+                  else str(r["path"]))
     Console().print(t)
     return 0
 
