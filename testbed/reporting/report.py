@@ -694,6 +694,8 @@ def _key_scores(r: dict[str, Any]) -> tuple[str, str]:
     h = "<br>".join('<span class="ks">'
                     + (f'<span class="{"pass" if c == "✓" else "fail"}">{c}</span> ' if c else "")
                     + html.escape(t) + "</span>" for t, c in items)
+    if r.get("failure"):
+        h = f'<span class="fail">{html.escape(_short(r["failure"]))}</span>' + ("<br>" + h if h else "")
     return h, "; ".join(f"{c} {t}".strip() for t, c in items)
 
 

@@ -656,6 +656,7 @@ def _run_row(p: Path, meta: dict[str, Any]) -> dict[str, Any]:
             "seed": sc.get("seed", ""), "identifier": str(meta.get("identifier", {}).get("name", "")),
             "verdict": str(meta.get("verdict", "")), "fit_time": _num(meta.get("fit_time")),
             "created": str(meta.get("created", "")),
+            "failure": "; ".join(str(v) for v in (meta.get("failures") or {}).values()),
             "checks": [{"metric": str(c.get("metric", "")), "value": _num(c.get("value")),
                         "bound": str(c.get("bound", "")), "threshold": _num(c.get("threshold")),
                         "passed": bool(c.get("passed"))} for c in meta.get("checks", [])],
@@ -703,8 +704,9 @@ def list_runs(out_dir: str | os.PathLike, scenario: str | None = None) -> list[d
     -------
     list of dict
         ``path`` (Path), ``id`` (folder name), ``scenario``, ``seed``, ``identifier``,
-        ``verdict``, ``fit_time`` [s], ``created`` (ISO 8601, UTC), ``checks`` (metric, value,
-        bound, threshold, passed) and ``scores`` (metric -> float); sorted by ``created``,
+        ``verdict``, ``fit_time`` [s], ``created`` (ISO 8601, UTC), ``failure`` (why the model
+        failed whatever its scores, "" if nothing did), ``checks`` (metric, value, bound,
+        threshold, passed) and ``scores`` (metric -> float); sorted by ``created``,
         then scenario and folder name.
     """
     out = Path(out_dir)

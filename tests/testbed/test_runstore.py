@@ -236,3 +236,15 @@ def test_index_page_links_every_run_and_is_self_contained(structural, mechanical
     # newest first
     first, second = (page.index(r["id"]) for r in list_runs(out))
     assert second < first
+
+
+def test_index_says_why_a_run_failed(structural, tmp_path):
+    from testbed.scoring.scorers import failed_scores
+
+    failed = replace(structural, scores=failed_scores(structural.scenario.kind,
+                                                      "fit failed: the Gram matrix is singular"))
+    save_new_run(failed, tmp_path, index=runs_index_html)
+    (row,) = list_runs(tmp_path)
+    assert row["verdict"] == "FAIL" and row["failure"] == "fit failed: the Gram matrix is singular"
+    page = (tmp_path / "index.html").read_text()
+    assert "fit failed: the Gram matrix is singular" in page and "badge fail" in page
