@@ -32,8 +32,14 @@ def _enabled(console: Any) -> bool:
 
 
 def _progress(console: Any, transient: bool = True) -> Any:
-    from rich.progress import (BarColumn, Progress, SpinnerColumn, TaskProgressColumn, TextColumn,
-                               TimeElapsedColumn)
+    from rich.progress import (
+        BarColumn,
+        Progress,
+        SpinnerColumn,
+        TaskProgressColumn,
+        TextColumn,
+        TimeElapsedColumn,
+    )
 
     return Progress(SpinnerColumn(finished_text="✓"), TextColumn("{task.description}"), BarColumn(),
                     TaskProgressColumn(), TimeElapsedColumn(), TextColumn("{task.fields[step]}"),
