@@ -16,8 +16,21 @@
 Identifiers are scikit-learn estimators (:class:`sklearn.base.BaseEstimator`):
 ``sklearn.base.clone``, ``get_params(deep=...)``/``set_params`` and
 ``sklearn.utils.validation.check_is_fitted`` work on every one (``tests/test_public_api.py``).
-``fit`` takes a Measurement, not ``(X, y)`` arrays, so scikit-learn's own model-selection
-loops (``GridSearchCV``) do not apply directly; a grid over ``set_params`` does.
+``fit(data, y=None)`` and ``score(data, y=None)`` take a Measurement (its targets are in it,
+so ``y`` stays None), and scikit-learn's model selection works on a
+:class:`MeasurementSamples` (a Measurement that scikit-learn can index by sample) with a
+splitter of contiguous time windows, :class:`TimeWindows` (or
+``sklearn.model_selection.TimeSeriesSplit``)::
+
+    search = GridSearchCV(LSSINDy(), {"threshold": [...]}, cv=TimeWindows(3))
+    search.fit(MeasurementSamples.of(data))
+
+Each split fits on a window from the start of the record and scores the truth-free
+:meth:`Identifier.score` on the window after it.
+
+A long fit may report its progress: inside ``fit``, ``self.report_progress(fraction, step)``
+reaches whoever attached a callback with :meth:`Identifier.progress_to` (``testbed run``'s
+progress display); without one it does nothing.
 
 Two conveniences follow pysindy: :meth:`Identifier.print` prints the equations, and
 :meth:`Identifier.score` gives a *truth-free* goodness of fit (R^2 of the predicted
@@ -27,8 +40,12 @@ simulation's exact truth is ``testbed.score(model, dataset, scenario)`` (the sco
 
 from __future__ import annotations
 
+import contextlib
 import inspect
+import itertools
 import sys
+from collections.abc import Callable, Iterator
+from dataclasses import fields
 from typing import Any, ClassVar, TextIO
 
 import numpy as np
@@ -170,8 +187,37 @@ class Identifier(BaseEstimator):
         """A new unfitted estimator with the same hyperparameters."""
         return type(self)(**self.get_params())
 
-    def fit(self, data: Measurement) -> Identifier:
+    def fit(self, data: Measurement, y: None = None) -> Identifier:
+        """Fit to a measurement; ``y`` is scikit-learn's target slot, unused (the targets are
+        in ``data``) and None whenever scikit-learn has no targets to pass."""
         raise NotImplementedError
+
+    @contextlib.contextmanager
+    def progress_to(self, callback: Callable[..., None]) -> Iterator[Identifier]:
+        """Send :meth:`report_progress` calls to ``callback(fraction, step)`` inside the block.
+
+        The callback is not a hyperparameter (``get_params``, ``clone`` and pickling ignore
+        it) and is removed on leaving the block.
+        """
+        self.__dict__["_progress_callback"] = callback
+        try:
+            yield self
+        finally:
+            self.__dict__.pop("_progress_callback", None)
+
+    def report_progress(self, fraction: float | None = None, step: str | None = None) -> None:
+        """Report the fit's progress: ``fraction`` done in [0, 1] (None: unknown) and the
+        current ``step`` (e.g. ``"epoch 40/100"``); nothing happens without a callback
+        (:meth:`progress_to`)."""
+        callback = self.__dict__.get("_progress_callback")
+        if callback is not None:
+            callback(fraction, step)
+
+    def __getstate__(self) -> dict[str, Any]:
+        state = super().__getstate__()
+        state = dict(state if isinstance(state, dict) else vars(self))
+        state.pop("_progress_callback", None)  # a display is not part of a model
+        return state
 
     def simulate(self, x0: np.ndarray, xd0: np.ndarray, t: np.ndarray,
                  u: np.ndarray | None = None) -> Trajectory:
@@ -222,7 +268,7 @@ class Identifier(BaseEstimator):
             force += np.asarray(bmap, dtype=float) @ np.asarray(data.u, dtype=float)
         return np.linalg.solve(self.M_, force)
 
-    def score(self, data: Measurement) -> float:
+    def score(self, data: Measurement, y: None = None) -> float:
         """Truth-free goodness of fit: R^2 of the predicted accelerations on ``data``.
 
         The coefficient of determination ``1 - SS_res / SS_tot`` of :meth:`predict_acceleration`
@@ -232,11 +278,28 @@ class Identifier(BaseEstimator):
         data; it is not the testbed's score against the exact truth (that is
         ``testbed.score(model, dataset, scenario)``).
 
+        Parameters
+        ----------
+        data : Measurement
+            Same channels as the fit.
+        y : None
+            scikit-learn's target slot (``GridSearchCV`` passes None); must be None.
+
+        Returns
+        -------
+        float
+            The mean R^2 [-], at most 1; NaN if a prediction is not finite.
+
         Raises
         ------
         NotImplementedError
             For a mechanical (implicit) model; see :meth:`predict_acceleration`.
+        ValueError
+            If ``y`` is given.
         """
+        if y is not None:
+            raise ValueError(f"{type(self).__name__}.score(data, y): y must be None, the measured "
+                             "accelerations in data are the targets")
         s = slice(data.free_start, None)
         pred = self.predict_acceleration(data)[:, s]
         meas = np.asarray(data.xdd, dtype=float)[:, s]
@@ -251,3 +314,118 @@ class Identifier(BaseEstimator):
     def __repr__(self) -> str:
         args = ", ".join(f"{k}={v!r}" for k, v in self.get_params().items())
         return f"{type(self).__name__}({args})"
+
+
+class MeasurementSamples(Measurement):
+    """A :class:`~testbed.core.measurement.Measurement` scikit-learn can split by sample.
+
+    It is a Measurement (every identifier fits it as one) with ``shape == (n_samples,)``
+    and ``m[indices]``: the measurement on the samples ``indices``, which must be one
+    contiguous, increasing run (a time window; an identifier cannot fit a record with holes).
+    That is what ``GridSearchCV``/``cross_val_score`` need to cut it with a splitter of time
+    windows, :class:`TimeWindows` or ``TimeSeriesSplit``.  Build one with :meth:`of`.
+    """
+
+    @classmethod
+    def of(cls, data: Measurement) -> MeasurementSamples:
+        """``data`` as a MeasurementSamples (same arrays, nothing copied)."""
+        return cls(**{f.name: getattr(data, f.name) for f in fields(Measurement)})
+
+    @property
+    def shape(self) -> tuple[int]:
+        return (self.n_samples,)
+
+    def __len__(self) -> int:
+        return self.n_samples
+
+    def window(self, start: int, stop: int) -> MeasurementSamples:
+        """Samples ``start:stop`` (``free_start`` shifted, 0 once the window starts after it).
+
+        Raises
+        ------
+        ValueError
+            If the window is empty or outside the record.
+        """
+        if not 0 <= start < stop <= self.n_samples:
+            raise ValueError(f"window {start}:{stop}: expected 0 <= start < stop <= "
+                             f"{self.n_samples} (the number of samples)")
+        s = slice(start, stop)
+
+        def cut(a: np.ndarray | None) -> np.ndarray | None:
+            return None if a is None else np.asarray(a)[..., s]
+
+        return type(self)(fs=self.fs, x=cut(self.x), xd=cut(self.xd), xdd=cut(self.xdd),
+                          channels=self.channels, u=cut(self.u), inputs=self.inputs,
+                          input_map=self.input_map, prior=self.prior,
+                          free_start=max(self.free_start - start, 0), passband=self.passband,
+                          drift_basis=cut(self.drift_basis))
+
+    def __getitem__(self, key: Any) -> MeasurementSamples:
+        if isinstance(key, tuple):  # scikit-learn indexes as X[indices, ...]
+            key = key[0]
+        if isinstance(key, slice):
+            start, stop, step = key.indices(self.n_samples)
+            if step != 1:
+                raise ValueError(f"{type(self).__name__}[{key}]: only contiguous windows (step 1)")
+            return self.window(start, stop)
+        idx = np.asarray(key)
+        if idx.dtype == bool:
+            idx = np.flatnonzero(idx)
+        if idx.ndim != 1 or idx.size == 0 or idx.dtype.kind not in "iu" \
+                or np.any(np.diff(idx) != 1):
+            raise ValueError(f"{type(self).__name__}: a fit or score window must be one contiguous "
+                             "run of samples; use TimeWindows or TimeSeriesSplit as the splitter, "
+                             "not a shuffling or k-fold one")
+        return self.window(int(idx[0]), int(idx[-1]) + 1)
+
+
+class TimeWindows:
+    """Forward-chaining time-window splitter for ``GridSearchCV(cv=...)`` on a Measurement.
+
+    The record is cut into ``n_splits + 1`` equal windows; split ``k`` (0-based) fits on the
+    windows ``0..k`` (always from the start of the record, where an impact excites the
+    structure) and tests on window ``k + 1``.  Like ``TimeSeriesSplit`` without a gap, but
+    with equal test windows by construction and a check of their length.
+
+    Parameters
+    ----------
+    n_splits : int
+        Number of (train, test) splits, >= 1.
+    min_window : int
+        Fewest samples a window may have (default 16).
+    """
+
+    def __init__(self, n_splits: int = 3, min_window: int = 16) -> None:
+        if isinstance(n_splits, bool) or not isinstance(n_splits, int) or n_splits < 1:
+            raise ValueError(f"TimeWindows(n_splits={n_splits!r}): expected an integer >= 1")
+        self.n_splits, self.min_window = n_splits, int(min_window)
+
+    def get_n_splits(self, X: Any = None, y: Any = None, groups: Any = None) -> int:
+        return self.n_splits
+
+    def split(self, X: Any, y: Any = None, groups: Any = None) -> Iterator[tuple[np.ndarray, np.ndarray]]:
+        """Yield ``(train, test)`` sample indices; ``X`` is anything with ``len`` (samples)."""
+        n = len(X)
+        edges = np.linspace(0, n, self.n_splits + 2).astype(int)
+        if np.min(np.diff(edges)) < self.min_window:
+            raise ValueError(f"TimeWindows({self.n_splits}): {n} samples give windows shorter than "
+                             f"min_window={self.min_window}")
+        for k in range(self.n_splits):
+            yield np.arange(0, edges[k + 1]), np.arange(edges[k + 1], edges[k + 2])
+
+
+def split_measurement(data: Measurement, n_windows: int) -> list[MeasurementSamples]:
+    """``data`` cut into ``n_windows`` consecutive windows of (nearly) equal length.
+
+    Returns
+    -------
+    list of MeasurementSamples
+        In time order; the first keeps ``free_start``, later ones start at 0 or after it.
+    """
+    if isinstance(n_windows, bool) or not isinstance(n_windows, int) or n_windows < 1:
+        raise ValueError(f"split_measurement(n_windows={n_windows!r}): expected an integer >= 1")
+    m = MeasurementSamples.of(data)
+    if n_windows > m.n_samples:
+        raise ValueError(f"split_measurement: {n_windows} windows of a {m.n_samples}-sample record")
+    edges = np.linspace(0, m.n_samples, n_windows + 1).astype(int)
+    return [m.window(int(a), int(b)) for a, b in itertools.pairwise(edges)]

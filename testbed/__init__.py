@@ -32,6 +32,10 @@ _API = {
     "run_scenario": ("testbed.scoring.evaluate", "run_scenario"),
     "score": ("testbed.scoring.evaluate", "score_model"),
     "RunResult": ("testbed.scoring.run", "RunResult"),
+    # the run history (out/runs)
+    "save_new_run": ("testbed.studies.runstore", "save_new_run"),
+    "list_runs": ("testbed.studies.runstore", "list_runs"),
+    "resolve_run": ("testbed.studies.runstore", "resolve_run"),
     # measured data from files (no truth)
     "read_measured": ("testbed.pipeline.importers", "read_measured"),
     "measurement_from_file": ("testbed.pipeline.importers", "measurement_from_file"),
@@ -47,6 +51,10 @@ _API = {
     "load_plugins": ("testbed.pipeline.plugins", "load_plugins"),
     "Identifier": ("identify", "Identifier"),
     "StructuralIdentifier": ("identify", "StructuralIdentifier"),
+    # model selection with scikit-learn (GridSearchCV) on a Measurement
+    "MeasurementSamples": ("identify._base", "MeasurementSamples"),
+    "TimeWindows": ("identify._base", "TimeWindows"),
+    "split_measurement": ("identify._base", "split_measurement"),
     "Rig": ("models", "Rig"),
     "Field": ("testbed.core.schema", "Field"),
     "Measurement": ("testbed.core.measurement", "Measurement"),

@@ -102,6 +102,7 @@ def _results_file(path: Path) -> Path:
 
 
 def _run_folder(path: Path) -> Path:
+    """A run folder :func:`testbed.studies.runstore.load_run` can read, else InputError."""
     from testbed.studies.runstore import load_run
 
     try:
@@ -210,9 +211,10 @@ def cmd_run(args: argparse.Namespace) -> int:
     from testbed.pipeline.cache import DatasetCache
     from testbed.pipeline.scenario import load_scenario
     from testbed.reporting.console import print_score_table
-    from testbed.reporting.figures import save_run_figures
+    from testbed.reporting.progress import run_progress
+    from testbed.reporting.report import runs_index_html, save_run_figures_and_report
     from testbed.scoring.run import run_scenario
-    from testbed.studies.runstore import run_folder, save_run
+    from testbed.studies.runstore import INDEX, save_new_run, scenario_folder
 
     _load_plugins(args)
     cache = None if args.no_cache else DatasetCache(_cache_folder(args.cache))
@@ -221,26 +223,33 @@ def cmd_run(args: argparse.Namespace) -> int:
         sc = load_scenario(name)
         if args.seed is not None:
             sc = sc.replace(seed=args.seed)
-        run_dir = run_folder(args.out, sc.name)  # refused before the work, not after
-        with _progress()(f"{sc.name}: data") as bar:
-            result = run_scenario(sc, cache=cache, progress=bar)
-        run_dir = save_run(result, run_dir, figures=None if args.no_figures else save_run_figures)
+        scenario_folder(args.out, sc.name)  # refused before the work, not after
+        with run_progress(sc.name) as phase:
+            result = run_scenario(sc, cache=cache, phase=phase)
+            figures = None if args.no_figures else save_run_figures_and_report
+            with phase("figures" if figures else "save"):
+                run_dir = save_new_run(result, args.out, figures=figures, index=runs_index_html)
         print_score_table(result)
-        print(f"run written to {run_dir}")
+        print(f"run written to {run_dir} (all runs: {Path(args.out) / INDEX})")
         ok &= result.passed
     return 0 if ok else EXIT_FAIL
 
 
 def cmd_report(args: argparse.Namespace) -> int:
     from testbed.reporting.report import write_report
+    from testbed.studies.runstore import RunStoreError, resolve_run
 
     source = Path(args.source)
-    if source.is_dir():
-        _run_folder(source)
-    elif source.is_file():
+    if source.is_file():
         _results_file(source)
     else:
-        raise InputError(f"{source}: no such run folder or results file")
+        try:  # a run folder, a scenario's folder of runs (its latest) or a scenario name
+            source = _run_folder(resolve_run(source, args.runs))
+        except RunStoreError:
+            if not source.exists():
+                raise InputError(f"{source}: no such run folder or results file (nor a scenario "
+                                 f"with runs in {args.runs})") from None
+            raise InputError(f"{source}: not a run folder written by `testbed run`") from None
     html = write_report(source, Path(args.output))
     print(f"report: {html.resolve()}")
     return 0
@@ -336,18 +345,19 @@ def cmd_identify(args: argparse.Namespace) -> int:
 
     from testbed.pipeline.fit import identify_file
     from testbed.reporting.identified import render_identified
+    from testbed.reporting.progress import run_progress
 
     _load_plugins(args)
     units = None
     if args.units:
         units = _key_values(args.units, "--units", numbers=False) if "=" in args.units[0] \
             else args.units[0]
-    result = identify_file(_existing_file(Path(args.data), "a measured-data file (UFF58, SEP-005 "
-                                                          "JSON, CSV or HDF5)"),
-                           scenario=args.scenario, kind=args.kind, method=args.method,
-                           params=_key_values(args.param, "--param", numbers=False),
-                           format=args.format, fs=args.fs, units=units,
-                           prior=_key_values(args.prior, "--prior", numbers=True))
+    data = _existing_file(Path(args.data), "a measured-data file (UFF58, SEP-005 JSON, CSV or HDF5)")
+    with run_progress(data.name) as phase:
+        result = identify_file(data, scenario=args.scenario, kind=args.kind, method=args.method,
+                               params=_key_values(args.param, "--param", numbers=False),
+                               format=args.format, fs=args.fs, units=units,
+                               prior=_key_values(args.prior, "--prior", numbers=True), phase=phase)
     summary = result.summary()
     out = Path(args.output or f"{Path(args.data).stem}.model.json")
     out.parent.mkdir(parents=True, exist_ok=True)
@@ -362,10 +372,27 @@ def cmd_identify(args: argparse.Namespace) -> int:
 def cmd_runs(args: argparse.Namespace) -> int:
     from testbed.studies.runstore import list_runs
 
-    runs = list_runs(args.out)
-    for r in runs:
-        print(f"{r['created']:<25} {r['verdict']:<10} {r['identifier']:<18} {r['path']}")
-    print(f"{len(runs)} run(s) in {args.out}")
+    runs = list_runs(args.out, scenario=args.scenario)
+    cols = ("scenario", "seed", "time (UTC)", "identifier", "verdict", "path")
+    rows = [(r["scenario"], str(r["seed"]), r["created"].replace("+00:00", "Z"), r["identifier"],
+             r["verdict"], str(r["path"])) for r in runs]
+    if args.plain or not sys.stdout.isatty():
+        # piped into another program: every field whole, tab-separated, oldest first
+        print("\t".join(cols))
+        for row in rows:
+            print("\t".join(row))
+        return 0
+    from rich.console import Console
+    from rich.table import Table
+
+    # a terminal: the run's folder name, not its whole path (the title says where it is)
+    t = Table(title=f"{len(runs)} run(s), oldest first; folders {Path(args.out) / '<scenario>' / '<run>'}")
+    for c in (*cols[:-1], "run"):
+        t.add_column(c, overflow="fold")
+    for r, row in zip(runs, rows, strict=True):
+        t.add_row(*row[:-1], r["path"].name if r["path"].parent.name == r["scenario"]
+                  else str(r["path"]))
+    Console().print(t)
     return 0
 
 
@@ -437,8 +464,11 @@ def build_parser() -> argparse.ArgumentParser:
     i.set_defaults(fn=cmd_identify)
 
     rep = sub.add_parser("report", help="HTML + markdown report of a run folder or sweep results")
-    rep.add_argument("source", help="a run folder (from `testbed run`) or a sweep results file")
+    rep.add_argument("source", help="a run folder (from `testbed run`), a scenario's folder of runs "
+                                    "or a scenario name (its latest run), or a sweep results file")
     rep.add_argument("-o", "--output", required=True, help="report folder")
+    rep.add_argument("--runs", default="out/runs",
+                     help="where a scenario name's runs are (default out/runs)")
     rep.set_defaults(fn=cmd_report)
 
     e = sub.add_parser("export", help="export a dataset to UFF (58/55) or SEP-005 JSON")
@@ -476,9 +506,12 @@ def build_parser() -> argparse.ArgumentParser:
     c.add_argument("action", choices=("ls", "clear"), help="ls: list the datasets; clear: delete them")
     c.add_argument("--cache", help="dataset cache folder (default .cache/datasets or $TESTBED_CACHE)")
 
-    rs = sub.add_parser("runs", help="list the runs saved by `testbed run`")
-    rs.add_argument("action", choices=("ls",), help="ls: one line per run folder")
+    rs = sub.add_parser("runs", help="list the runs saved by `testbed run` (the run history)")
+    rs.add_argument("action", choices=("ls",), help="ls: one row per run, oldest first")
+    rs.add_argument("scenario", nargs="?", help="only the runs of this scenario")
     rs.add_argument("-o", "--out", default="out/runs", help="folder of the runs (default out/runs)")
+    rs.add_argument("--plain", action="store_true",
+                    help="tab-separated lines, nothing cut (the default when not a terminal)")
     rs.set_defaults(fn=cmd_runs)
     c.set_defaults(fn=cmd_cache)
 

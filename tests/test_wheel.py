@@ -11,6 +11,7 @@ by name (package data), register its rigs and identifiers, and run a scenario en
 
 from __future__ import annotations
 
+import json
 import os
 import shutil
 import subprocess
@@ -118,5 +119,6 @@ def test_installed_wheel_runs_from_anywhere(wheel, tmp_path):
     ran = run(testbed, "run", "cantilever_stiff_impact_lsq", "--no-figures", "--cache", str(tmp_path / "c"),
               "-o", str(work / "runs"))
     assert ran.returncode == 0, ran.stdout[-2000:] + ran.stderr[-2000:]
-    assert (work / "runs" / "cantilever_stiff_impact_lsq" / "run.json").is_file()
+    latest = json.loads((work / "runs" / "cantilever_stiff_impact_lsq" / "latest.json").read_text())
+    assert (work / "runs" / "cantilever_stiff_impact_lsq" / latest["run"] / "run.json").is_file()
     assert not (work / "scenarios").exists()

@@ -10,10 +10,11 @@ accelerations) where it has one.
 
 from __future__ import annotations
 
+import contextlib
 import math
 import os
 import time
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -67,8 +68,8 @@ def identify_file(path: str | os.PathLike, *, scenario: str | os.PathLike | None
                   kind: str | None = None, method: str | None = None,
                   params: Mapping[str, Any] | None = None, format: str | None = None,
                   fs: float | None = None, units: str | Mapping[str, str] | None = None,
-                  channels: Sequence[str] | None = None, prior: Mapping[str, float] | None = None
-                  ) -> FitResult:
+                  channels: Sequence[str] | None = None, prior: Mapping[str, float] | None = None,
+                  phase: Callable[[str], Any] | None = None) -> FitResult:
     """Read measured data, run the signal chain and fit an identifier.
 
     Parameters
@@ -89,6 +90,11 @@ def identify_file(path: str | os.PathLike, *, scenario: str | os.PathLike | None
         As for :func:`~testbed.pipeline.importers.read_measured` (``fs`` [Hz]).
     prior : mapping of str to float, optional
         Declared prior knowledge, e.g. ``{"total_mass": 0.7}`` [kg] (over the file's own).
+    phase : callable, optional
+        ``phase(name)`` returns a context manager around each phase ("read and signal chain",
+        "fit") yielding ``update(fraction=None, step=None)``; the fit reports the steps its
+        identifier reports (:meth:`identify.Identifier.report_progress`).  The reporting
+        layer's :func:`testbed.reporting.progress.run_progress` draws them.
 
     Returns
     -------
@@ -125,12 +131,23 @@ def identify_file(path: str | os.PathLike, *, scenario: str | os.PathLike | None
                          f"{kind}")
     hyper = {k: v for k, v in identify.items() if k != "method"} | dict(params or {})
     hyper = cls.validate_hyperparameters(hyper, file=str(scenario or "<command line>"))
-    data = measurement_from_file(path, kind, signal, format=format, fs=fs, units=units,
-                                 channels=channels, prior=prior)
+    phase = phase or _no_phase
+    with phase("read and signal chain"):
+        data = measurement_from_file(path, kind, signal, format=format, fs=fs, units=units,
+                                     channels=channels, prior=prior)
     model = cls(**hyper)
-    t0 = time.perf_counter()
-    model.fit(data)
-    return FitResult(model, data, kind, identify["method"], str(path), time.perf_counter() - t0)
+    with phase("fit") as update:
+        t0 = time.perf_counter()
+        to = getattr(model, "progress_to", None)  # a plugin without it reports no steps
+        with to(update) if callable(to) else contextlib.nullcontext():
+            model.fit(data)
+        fit_time = time.perf_counter() - t0
+    return FitResult(model, data, kind, identify["method"], str(path), fit_time)
+
+
+@contextlib.contextmanager
+def _no_phase(name: str) -> Iterator[Callable[..., None]]:
+    yield lambda fraction=None, step=None: None
 
 
 def _array(a: Any) -> Any:

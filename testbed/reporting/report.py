@@ -38,7 +38,7 @@ from testbed.pipeline.scenario import NOISE_SCHEMA
 from testbed.pipeline.signal_chain import SIGNAL_SCHEMAS
 from testbed.reporting import figures as figs
 from testbed.studies.results import read_results, score_columns
-from testbed.studies.runstore import SavedRun, load_run
+from testbed.studies.runstore import SavedRun, load_run, resolve_run
 
 CSS = """
 body{font-family:system-ui,-apple-system,"Segoe UI",Roboto,sans-serif;max-width:1100px;margin:2em auto;
@@ -647,8 +647,9 @@ def write_report(source: str | os.PathLike, out_dir: str | os.PathLike) -> Path:
     Parameters
     ----------
     source : path
-        A run folder written by :func:`testbed.studies.runstore.save_run`, or a results
-        file of a sweep (read with :func:`testbed.studies.results.read_results`).
+        A run folder written by :func:`testbed.studies.runstore.save_run`, a scenario folder
+        of the run history (its latest run, :func:`~testbed.studies.runstore.resolve_run`),
+        or a results file of a sweep (read with :func:`testbed.studies.results.read_results`).
     out_dir : path
         Report folder (created); the PNGs of the markdown twin go beside it.
 
@@ -659,8 +660,95 @@ def write_report(source: str | os.PathLike, out_dir: str | os.PathLike) -> Path:
     """
     source = Path(source)
     if source.is_dir():
-        return run_report(load_run(source), out_dir)
+        return run_report(load_run(resolve_run(source)), out_dir)
     if not source.is_file():
         raise FileNotFoundError(f"{source}: neither a run folder nor a results file")
 
     return sweep_report(read_results(source), out_dir, title=source.stem)
+
+
+# ----------------------------------------------------------------------------- run history
+def save_run_figures_and_report(run: SavedRun, folder: Path) -> list[Path]:
+    """The figure writer of ``testbed run``: the run figures, then ``report.html`` beside them.
+
+    Passed as ``figures`` to :func:`testbed.studies.runstore.save_new_run`, so the report is
+    written in the temporary folder and appears with the run, atomically.  Returns the PNGs.
+    """
+    paths = figs.save_run_figures(run, folder)
+    run.meta["figures"] = [p.name for p in paths]
+    run_report(run, folder)
+    return paths
+
+
+#: Scores shown per run in the index when the run declares no thresholds.
+INDEX_SCORES = 3
+
+
+def _key_scores(r: dict[str, Any]) -> tuple[str, str]:
+    """(HTML, text) of a run's key scores: its checked metrics, else its first few scores."""
+    if r["checks"]:
+        items = [(f"{c['metric']} {fmt(c['value'])} {_BOUND.get(c['bound'], c['bound'])} "
+                  f"{fmt(c['threshold'])}", "✓" if c["passed"] else "✗") for c in r["checks"]]
+    else:
+        items = [(f"{k} {fmt(v)}", "") for k, v in list(r["scores"].items())[:INDEX_SCORES]]
+    h = "<br>".join('<span class="ks">'
+                    + (f'<span class="{"pass" if c == "✓" else "fail"}">{c}</span> ' if c else "")
+                    + html.escape(t) + "</span>" for t, c in items)
+    if r.get("failure"):
+        h = f'<span class="fail">{html.escape(_short(r["failure"]))}</span>' + ("<br>" + h if h else "")
+    return h, "; ".join(f"{c} {t}".strip() for t, c in items)
+
+
+#: How a threshold's bound reads in the index.
+_BOUND = {"min": "≥", "max": "≤"}
+
+
+def runs_index_html(runs: Sequence[dict[str, Any]], out_dir: str | os.PathLike) -> str:
+    """The self-contained index page of a run history (no network, no script), newest first.
+
+    Parameters
+    ----------
+    runs : sequence of dict
+        Rows of :func:`testbed.studies.runstore.list_runs`.
+    out_dir : path-like
+        The folder the page is written to; links are relative to it.
+
+    Returns
+    -------
+    str
+        One row per run: time (UTC), scenario, seed, identifier, run (a link to the run's
+        ``report.html``, or to its ``run.json`` when it has no report), verdict, key scores.
+    """
+    out = Path(out_dir).resolve()
+    rows = []
+    for r in sorted(runs, key=lambda r: (r["created"], r["scenario"], r["id"]), reverse=True):
+        folder = Path(r["path"]).resolve()
+        target = folder / "report.html" if (folder / "report.html").is_file() else folder / "run.json"
+        try:
+            href = target.relative_to(out).as_posix()
+        except ValueError:
+            href = target.as_uri()
+        v = r["verdict"]
+        badge = {"pass": "pass", "FAIL": "fail"}.get(v, "none")
+        scores, _ = _key_scores(r)
+        cells = [html.escape(r["created"].replace("+00:00", "Z").replace("T", " ")),
+                 html.escape(r["scenario"]),
+                 html.escape(str(r["seed"])), html.escape(r["identifier"]),
+                 f'<a href="{html.escape(href, quote=True)}">{html.escape(r["id"])}</a>',
+                 f'<span class="badge {badge}">{html.escape(v or "?")}</span>', scores]
+        nowrap = ' class="nowrap"'  # the time and the run's name read best on one line
+        rows.append("<tr>" + "".join(f"<td{nowrap if i in (0, 4) else ''}>{c}</td>"
+                                     for i, c in enumerate(cells)) + "</tr>")
+    head = "".join(f"<th>{h}</th>" for h in ("time (UTC)", "scenario", "seed", "identifier", "run",
+                                             "verdict", "key scores"))
+    body = (f"<table><thead><tr>{head}</tr></thead><tbody>{''.join(rows)}</tbody></table>" if rows
+            else "<p>No runs yet: <code>testbed run SCENARIO</code> adds one.</p>")
+    return ("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
+            f'<meta http-equiv="Content-Security-Policy" content="{CSP}">'
+            '<meta name="viewport" content="width=device-width, initial-scale=1">'
+            f"<title>Runs</title><style>{CSS}td.nowrap,.ks{{white-space:nowrap}}.ks{{font-size:.85em}}"
+            "body{max-width:1500px}"
+            "</style></head>\n"
+            "<body>\n<h1>Runs</h1>\n"
+            f'<p class="muted">{len(runs)} run(s) in {html.escape(str(out_dir))}, newest first; '
+            "each run links to its report.</p>\n" + body + "\n</body></html>\n")

@@ -6,8 +6,9 @@ measured signals; scoring alone opens the truth.
 
 from __future__ import annotations
 
+import contextlib
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, replace
 from typing import Any
 
@@ -72,9 +73,16 @@ def make_identifier(scenario: Scenario) -> Any:
     return plugins.make_identifier(scenario.identify, scenario.name)
 
 
+@contextlib.contextmanager
+def no_phase(name: str) -> Iterator[Callable[..., None]]:
+    """The silent ``phase`` of :func:`run_scenario`: yields an ``update`` that does nothing."""
+    yield lambda fraction=None, step=None: None
+
+
 def run_scenario(scenario: Scenario, *, cache: DatasetCache | None = None,
                  dataset: Dataset | None = None, model: Any = None,
-                 progress: Callable[[float], None] | None = None) -> RunResult:
+                 progress: Callable[[float], None] | None = None,
+                 phase: Callable[[str], Any] | None = None) -> RunResult:
     """Generate (or reuse) the data, identify, and score against the truth.
 
     Parameters
@@ -86,6 +94,14 @@ def run_scenario(scenario: Scenario, *, cache: DatasetCache | None = None,
         Use these data instead (must belong to ``scenario``).
     model : Identifier, optional
         Use this (unfitted) identifier instead of the scenario's ``[identify]``.
+    progress : callable, optional
+        ``progress(fraction)`` of the simulation done (with ``phase``, both are called).
+    phase : callable, optional
+        ``phase(name)`` returns a context manager around each phase ("simulate", "signal
+        chain", "fit", "score") that yields ``update(fraction=None, step=None)``: the
+        simulation reports its fraction done, the fit the steps its identifier reports
+        (:meth:`identify.Identifier.report_progress`); the reporting layer's
+        :func:`testbed.reporting.progress.run_progress` draws them.
 
     Returns
     -------
@@ -102,23 +118,42 @@ def run_scenario(scenario: Scenario, *, cache: DatasetCache | None = None,
         A configuration error of the user's (never scored).
     """
 
+    phase = phase or no_phase
     if dataset is None:
-        dataset = cache.get(scenario, progress) if cache is not None else generate(scenario, progress)
+        with phase("simulate") as update:
+            def simulated(fraction: float) -> None:
+                update(fraction)
+                if progress is not None:
+                    progress(fraction)
+
+            dataset = cache.get(scenario, simulated) if cache is not None \
+                else generate(scenario, simulated)
     kind = scenario.kind
-    data = measure(dataset, scenario.signal, kind)
-    clean = measure(noise_free(dataset), scenario.signal, kind)
+    with phase("signal chain"):
+        data = measure(dataset, scenario.signal, kind)
+        clean = measure(noise_free(dataset), scenario.signal, kind)
     model = model if model is not None else make_identifier(scenario)
-    t0 = time.perf_counter()
-    try:
-        model.fit(data)
-    except ScenarioError:  # the user's configuration: raised, not scored
-        raise
-    except IdentificationError as e:  # data the identifier cannot handle: a scored failure
-        scores = failed_scores(kind, f"fit failed: {e}")
-    else:
-        scores = None
-    fit_time = time.perf_counter() - t0
+    with phase("fit") as update:
+        t0 = time.perf_counter()
+        try:
+            with _reporting(model, update):
+                model.fit(data)
+        except ScenarioError:  # the user's configuration: raised, not scored
+            raise
+        except IdentificationError as e:  # data the identifier cannot handle: a scored failure
+            scores = failed_scores(kind, f"fit failed: {e}")
+        else:
+            scores = None
+        fit_time = time.perf_counter() - t0
     if scores is None:
-        scores = score(kind, dataset, data, clean, model)
+        with phase("score"):
+            scores = score(kind, dataset, data, clean, model)
     return RunResult(scenario, dataset, data, model, scores,
                      check_thresholds(scores.values, scenario.score), fit_time)
+
+
+def _reporting(model: Any, update: Callable[..., None]) -> Any:
+    """The identifier's progress reported to ``update`` during the fit (a plugin without
+    :meth:`~identify.Identifier.progress_to` reports nothing)."""
+    to = getattr(model, "progress_to", None)
+    return to(update) if callable(to) else contextlib.nullcontext()

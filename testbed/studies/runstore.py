@@ -21,10 +21,28 @@ A run never touches a folder other than its own: :func:`run_folder` accepts only
 name that stays strictly inside the output folder, and :func:`save_run` refuses a target
 named ``.`` or ``..`` and refuses to replace an existing folder that is not a run folder
 (no ``run.json``), e.g. the output folder itself with every other run in it.
+
+Run history (``testbed run``, :func:`save_new_run`) keeps every run instead of replacing
+one::
+
+    out/runs/index.html                    every run, newest first (regenerated after each run)
+    out/runs/<scenario>/latest.json        {"run": "<id>", "created": ..., "seed": ...}
+    out/runs/<scenario>/<id>/run.json ...  one run folder as above
+
+The identifier ``<id>`` is ``<YYYYmmddTHHMMSSZ>-s<seed>`` (UTC time of the run, noise seed),
+with ``-2``, ``-3`` ... appended when another run of the same scenario and seed took that
+name in the same second.  The folder is written under a temporary name in the scenario
+folder and renamed to an unused identifier (a rename never replaces a non-empty folder), so
+concurrent runs each get their own.  ``latest.json`` and the index are written atomically
+(temporary file, rename) under one lock per output folder.  :func:`resolve_run` turns a run
+folder, a scenario folder (its latest run) or a scenario name into a run folder;
+:func:`list_runs` reads both layouts (run folders directly under the output folder, as
+written before run history, and run folders inside scenario folders).
 """
 
 from __future__ import annotations
 
+import contextlib
 import ctypes
 import datetime as _dt
 import errno
@@ -33,13 +51,19 @@ import os
 import shutil
 import sys
 import tempfile
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+try:
+    import fcntl
+except ImportError:  # Windows
+    fcntl = None  # type: ignore[assignment]
+
+from testbed.core.atomic import atomic_write_text
 from testbed.core.errors import TestbedError
 from testbed.core.provenance import git_commit, versions
 from testbed.pipeline.plugins import RIGS
@@ -345,7 +369,20 @@ def save_run(result: Any, run_dir: str | os.PathLike,
     """
     run_dir = _check_target(run_dir)
     run_dir.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=f".{run_dir.name}.", suffix=".tmp", dir=run_dir.parent))
+    tmp, _ = _write_temporary(result, run_dir.parent, run_dir.name, figures)
+    try:
+        _replace_dir(tmp, run_dir)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    return run_dir
+
+
+def _write_temporary(result: Any, parent: Path, stem: str,
+                     figures: Callable[[SavedRun, Path], list[Path]] | None
+                     ) -> tuple[Path, dict[str, Any]]:
+    """A complete run folder under a private temporary name in ``parent``, and its meta."""
+    tmp = Path(tempfile.mkdtemp(prefix=f".{stem}.", suffix=".tmp", dir=parent))
     umask = os.umask(0)
     os.umask(umask)
     os.chmod(tmp, 0o777 & ~umask)  # mkdtemp makes it private; a run folder is as readable as any
@@ -357,11 +394,167 @@ def save_run(result: Any, run_dir: str | os.PathLike,
             paths = figures(load_run(tmp), tmp)
             meta["figures"] = [p.name for p in paths]
             _write_json(tmp / "run.json", meta)
-        _replace_dir(tmp, run_dir)
     except BaseException:
         shutil.rmtree(tmp, ignore_errors=True)
         raise
-    return run_dir
+    return tmp, meta
+
+
+#: The pointer file of a scenario folder naming its latest run.
+LATEST = "latest.json"
+#: The index page of an output folder.
+INDEX = "index.html"
+#: Lock file (``flock``) serialising the pointer and index updates of one output folder.
+LOCK = ".runs.lock"
+
+
+def run_id(created: str, seed: int) -> str:
+    """The identifier of a run made at ISO 8601 time ``created`` with noise seed ``seed``.
+
+    >>> run_id("2026-11-23T20:15:21+00:00", 7)
+    '20261123T201521Z-s7'
+    """
+    when = _dt.datetime.fromisoformat(created).astimezone(_dt.UTC)
+    return f"{when:%Y%m%dT%H%M%SZ}-s{int(seed)}"
+
+
+def scenario_folder(out_dir: str | os.PathLike, scenario: str) -> Path:
+    """The history folder of ``scenario`` in ``out_dir`` (checked as :func:`run_folder`)."""
+    folder = run_folder(out_dir, scenario)
+    if folder.is_symlink() or (folder.exists() and not folder.is_dir()):
+        raise RunStoreError(f"{folder}: exists and is not a folder of runs; refusing to write into it")
+    return folder
+
+
+@contextlib.contextmanager
+def _locked(out_dir: Path) -> Iterator[None]:
+    """Hold an exclusive ``flock`` on ``out_dir/.runs.lock`` (no lock where ``fcntl`` is missing)."""
+    if fcntl is None:  # not POSIX: pointer and index are still written atomically
+        yield
+        return
+    with open(out_dir / LOCK, "a") as fh:
+        fcntl.flock(fh.fileno(), fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(fh.fileno(), fcntl.LOCK_UN)
+
+
+def save_new_run(result: Any, out_dir: str | os.PathLike,
+                 figures: Callable[[SavedRun, Path], list[Path]] | None = None,
+                 index: Callable[[list[dict[str, Any]], Path], str] | None = None) -> Path:
+    """Add a run to the history in ``out_dir`` (see the module docstring); never replaces one.
+
+    Parameters
+    ----------
+    result : RunResult
+    out_dir : path-like
+        The output folder (``out/runs``); the run goes to ``out_dir/<scenario>/<id>``.
+    figures : callable, optional
+        As for :func:`save_run`.
+    index : callable, optional
+        ``index(runs, out_dir) -> html``: renders :func:`list_runs` of ``out_dir`` as the page
+        written atomically to ``out_dir/index.html`` (the reporting layer's
+        :func:`testbed.reporting.report.runs_index_html`).  None: no index page.
+
+    Returns
+    -------
+    Path
+        The new run folder.
+
+    Raises
+    ------
+    RunStoreError
+        If the scenario's name is not a plain folder name, or its folder is not a folder.
+    """
+    out = Path(out_dir)
+    folder = scenario_folder(out, result.scenario.name)
+    folder.mkdir(parents=True, exist_ok=True)
+    tmp, meta = _write_temporary(result, folder, "run", figures)
+    base = run_id(meta["created"], result.scenario.seed)
+    try:
+        # a rename onto a non-empty folder fails (ENOTEMPTY/EEXIST), so each writer lands in
+        # a folder of its own; 1000 runs of one scenario and seed in one second do not happen
+        for n in range(1, 1001):
+            target = folder / (base if n == 1 else f"{base}-{n}")
+            try:
+                os.rename(tmp, target)
+                break
+            except OSError as e:
+                if e.errno not in (errno.ENOTEMPTY, errno.EEXIST, errno.ENOTDIR):
+                    raise
+        else:
+            raise RunStoreError(f"{folder}: no free run name {base}-N (N <= 1000)")
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    with _locked(out):
+        pointer = _read_latest(folder)
+        if pointer is None or (str(pointer.get("created", "")), str(pointer["run"])) <= \
+                (meta["created"], target.name):
+            atomic_write_text(folder / LATEST, json.dumps(
+                {"run": target.name, "created": meta["created"], "seed": result.scenario.seed}) + "\n")
+        if index is not None:
+            atomic_write_text(out / INDEX, index(list_runs(out), out))
+    return target
+
+
+def write_index(out_dir: str | os.PathLike, index: Callable[[list[dict[str, Any]], Path], str]) -> Path:
+    """(Re)write ``out_dir/index.html`` from :func:`list_runs` (atomically, under the lock)."""
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    with _locked(out):
+        return atomic_write_text(out / INDEX, index(list_runs(out), out))
+
+
+def _read_latest(folder: Path) -> dict[str, Any] | None:
+    """The pointer of a scenario folder if it names an existing run folder in it, else None."""
+    try:
+        pointer = json.loads((folder / LATEST).read_text())
+        name = pointer["run"]
+    except (OSError, ValueError, KeyError, TypeError):
+        return None
+    if not isinstance(name, str) or "/" in name or "\\" in name or name.startswith(".") \
+            or not _is_run_folder(folder / name):
+        return None
+    return pointer
+
+
+def resolve_run(source: str | os.PathLike, out_dir: str | os.PathLike = "out/runs") -> Path:
+    """The run folder a user means by ``source``.
+
+    Parameters
+    ----------
+    source : path-like
+        A run folder; a scenario folder of the history (the run its ``latest.json`` names,
+        else its newest run); or a scenario name, read as ``out_dir/<name>``.
+    out_dir : path-like
+        Where a bare scenario name is looked up.
+
+    Returns
+    -------
+    Path
+        A folder holding a ``run.json``.
+
+    Raises
+    ------
+    RunStoreError
+        If ``source`` is none of these (the message names it and what was expected).
+    """
+    text = os.fspath(source)
+    p = Path(source)
+    if not p.exists() and not any(c in text for c in ("/", "\\")) and not text.startswith("."):
+        p = Path(out_dir) / text
+    if p.is_dir():
+        if (pointer := _read_latest(p)) is not None:
+            return p / pointer["run"]
+        children = [r for r in _runs_in(p) if r["path"] != p]
+        if children:
+            return max(children, key=lambda r: (r["created"], r["id"]))["path"]
+        if _is_run_folder(p):
+            return p
+    raise RunStoreError(f"{text}: not a run folder, a scenario folder of runs or a scenario "
+                        f"with runs in {os.fspath(out_dir)} (written by `testbed run`)")
 
 
 #: renameat2 flag (linux/fs.h): swap the two paths atomically.
@@ -457,33 +650,69 @@ def load_run(run_dir: str | os.PathLike) -> SavedRun:
                     _unflatten(arrays, "truth"))
 
 
-def list_runs(out_dir: str | os.PathLike) -> list[dict[str, Any]]:
-    """The saved runs directly under ``out_dir`` (``testbed run``'s ``out/runs``), by folder name.
+def _run_row(p: Path, meta: dict[str, Any]) -> dict[str, Any]:
+    sc = meta.get("scenario", {})
+    return {"path": p, "id": p.name, "scenario": str(sc.get("name", p.name)),
+            "seed": sc.get("seed", ""), "identifier": str(meta.get("identifier", {}).get("name", "")),
+            "verdict": str(meta.get("verdict", "")), "fit_time": _num(meta.get("fit_time")),
+            "created": str(meta.get("created", "")),
+            "failure": "; ".join(str(v) for v in (meta.get("failures") or {}).values()),
+            "checks": [{"metric": str(c.get("metric", "")), "value": _num(c.get("value")),
+                        "bound": str(c.get("bound", "")), "threshold": _num(c.get("threshold")),
+                        "passed": bool(c.get("passed"))} for c in meta.get("checks", [])],
+            "scores": {str(k): _num(v) for k, v in meta.get("scores", {}).items()
+                       if v is None or isinstance(v, (int, float, str))}}
 
-    Only ``run.json`` is read (not the arrays); a folder without a readable ``run.json`` of
-    this format is left out.
+
+def _read_row(p: Path) -> dict[str, Any] | None:
+    """The :func:`list_runs` row of run folder ``p``; None if it is not a readable run."""
+    if not _is_run_folder(p):
+        return None
+    try:
+        meta = json.loads((p / "run.json").read_text())
+        if meta.get("format") != FORMAT:
+            return None
+        return _run_row(p, meta)
+    except (OSError, ValueError, TypeError, AttributeError):
+        return None
+
+
+def _runs_in(folder: Path) -> list[dict[str, Any]]:
+    """Rows of ``folder`` itself if it is a run folder, and of the run folders in it."""
+    rows = [r for r in [_read_row(folder)] if r is not None]
+    if folder.is_dir() and not folder.is_symlink():
+        rows += [r for c in sorted(folder.iterdir()) if not c.name.startswith(".")
+                 and (r := _read_row(c)) is not None]
+    return rows
+
+
+def list_runs(out_dir: str | os.PathLike, scenario: str | None = None) -> list[dict[str, Any]]:
+    """The saved runs in ``out_dir`` (``testbed run``'s ``out/runs``), oldest first.
+
+    Reads run folders directly under ``out_dir`` (written by :func:`save_run` into a
+    :func:`run_folder`) and inside its scenario folders (:func:`save_new_run`).  Only
+    ``run.json`` is read (not the arrays); a folder without a readable ``run.json`` of this
+    format is left out.
+
+    Parameters
+    ----------
+    out_dir : path-like
+    scenario : str, optional
+        Only the runs of this scenario.
 
     Returns
     -------
     list of dict
-        ``path`` (Path), ``scenario``, ``identifier``, ``verdict``, ``fit_time`` [s], ``created``
-        (ISO 8601, UTC).
+        ``path`` (Path), ``id`` (folder name), ``scenario``, ``seed``, ``identifier``,
+        ``verdict``, ``fit_time`` [s], ``created`` (ISO 8601, UTC), ``failure`` (why the model
+        failed whatever its scores, "" if nothing did), ``checks`` (metric, value, bound,
+        threshold, passed) and ``scores`` (metric -> float); sorted by ``created``,
+        then scenario and folder name.
     """
     out = Path(out_dir)
     if not out.is_dir():
         return []
-    runs = []
-    for p in sorted(out.iterdir()):
-        if not _is_run_folder(p):
-            continue
-        try:
-            meta = json.loads((p / "run.json").read_text())
-        except (OSError, ValueError):
-            continue
-        if meta.get("format") != FORMAT:
-            continue
-        runs.append({"path": p, "scenario": meta.get("scenario", {}).get("name", p.name),
-                     "identifier": meta.get("identifier", {}).get("name", ""),
-                     "verdict": meta.get("verdict", ""), "fit_time": meta.get("fit_time", float("nan")),
-                     "created": meta.get("created", "")})
-    return runs
+    runs = [r for p in sorted(out.iterdir()) if not p.name.startswith(".") for r in _runs_in(p)]
+    if scenario is not None:
+        runs = [r for r in runs if r["scenario"] == scenario]
+    return sorted(runs, key=lambda r: (r["created"], r["scenario"], r["id"]))

@@ -183,21 +183,43 @@ def test_user_mistakes_are_one_line(argv, fragment, tmp_path, capsys):
     assert len(err.splitlines()) == 1 and err.startswith("error: ") and fragment in err, err
 
 
-def test_runs_ls(tmp_path, capsys):
+def test_runs_ls_and_report_by_scenario_name(tmp_path, capsys):
     sys.path.insert(0, str(ROOT / "tests" / "testbed"))
     try:
         from _synthetic_runs import structural_result
     finally:
         sys.path.pop(0)
-    from testbed.studies.runstore import run_folder, save_run
+    from testbed.reporting.report import runs_index_html
+    from testbed.studies.runstore import run_folder, save_new_run, save_run
 
-    result = structural_result()
-    save_run(result, run_folder(tmp_path, result.scenario.name))
+    result = structural_result(n_samples=800)
+    legacy = save_run(result, run_folder(tmp_path, "written_before_run_history"))
+    first = save_new_run(result, tmp_path, index=runs_index_html)
+    second = save_new_run(result, tmp_path, index=runs_index_html)
     (tmp_path / "not_a_run").mkdir()
     assert main(["runs", "ls", "-o", str(tmp_path)]) == 0
-    out = capsys.readouterr().out.splitlines()
-    assert out[-1] == f"1 run(s) in {tmp_path}"
-    assert out[0].split()[1] == result.verdict and out[0].endswith(str(tmp_path / result.scenario.name))
+    lines = capsys.readouterr().out.splitlines()
+    # piped: a header and one tab-separated line per run, every field whole, oldest first
+    assert lines[0].split("\t") == ["scenario", "seed", "time (UTC)", "identifier", "verdict", "path"]
+    rows = [line.split("\t") for line in lines[1:]]
+    assert sorted(r[5] for r in rows) == sorted([str(legacy), str(first), str(second)])
+    assert [r[2] for r in rows] == sorted(r[2] for r in rows)
+    assert [r[5] for r in rows if r[5] != str(legacy)] == [str(first), str(second)]
+    for r in rows:
+        assert r[0] == result.scenario.name and r[1] == str(result.scenario.seed)
+        assert r[3] == result.scenario.identify["method"] and r[4] == result.verdict and r[2].endswith("Z")
+    assert main(["runs", "ls", "no_such_scenario", "-o", str(tmp_path)]) == 0
+    assert capsys.readouterr().out.splitlines()[1:] == []
+    # a scenario's name or folder means its latest run
+    assert main(["report", result.scenario.name, "--runs", str(tmp_path), "-o", str(tmp_path / "r1")]) == 0
+    assert main(["report", str(tmp_path / result.scenario.name), "-o", str(tmp_path / "r2")]) == 0
+    assert main(["report", str(first), "-o", str(tmp_path / "r3")]) == 0
+    capsys.readouterr()
+    for r in ("r1", "r2", "r3"):
+        assert (tmp_path / r / "report.html").is_file()
+    assert main(["report", "no_such_scenario", "--runs", str(tmp_path), "-o", str(tmp_path / "r4")]) == 2
+    err = capsys.readouterr().err
+    assert len(err.splitlines()) == 1 and "no such run folder or results file" in err
 
 
 def test_sweep_with_a_plugin_identifier(tmp_path, dataset_cache):

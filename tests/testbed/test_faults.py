@@ -539,7 +539,8 @@ def test_concurrent_writers_of_one_run_folder_leave_one_complete_run(mechanical,
 
 @pytest.mark.slow
 def test_two_concurrent_testbed_runs_of_one_scenario(tmp_path):
-    """Two `testbed run` processes of one scenario and cache: both give a verdict, one run stays."""
+    """Two `testbed run` processes of one scenario and cache: both give a verdict, both runs stay
+    (each in its own folder of the run history), and the index lists both."""
     cache, out = tmp_path / "cache", tmp_path / "runs"
     cmd = [sys.executable, "-m", "testbed.cli", "run", "cantilever_stiff_impact_lsq", "--no-figures",
            "--cache", str(cache), "-o", str(out)]
@@ -549,9 +550,18 @@ def test_two_concurrent_testbed_runs_of_one_scenario(tmp_path):
     for p, (stdout, stderr) in zip(procs, results, strict=True):
         assert p.returncode in (0, 1) and "Traceback" not in stderr, stderr
         assert "run written to" in stdout
-    assert [p.name for p in out.iterdir()] == ["cantilever_stiff_impact_lsq"]
-    run = load_run(out / "cantilever_stiff_impact_lsq")
-    assert sorted(p.name for p in run.path.iterdir()) == ["run.json", "run.npz"]
-    assert run.scenario["name"] == "cantilever_stiff_impact_lsq"
+    assert sorted(p.name for p in out.iterdir()) == [".runs.lock", "cantilever_stiff_impact_lsq",
+                                                      "index.html"]
+    folder = out / "cantilever_stiff_impact_lsq"
+    runs = sorted(p for p in folder.iterdir() if p.is_dir())
+    assert len(runs) == 2 and sorted(p.name for p in folder.iterdir() if not p.is_dir()) == ["latest.json"]
+    for d in runs:
+        run = load_run(d)
+        assert sorted(p.name for p in run.path.iterdir()) == ["run.json", "run.npz"]
+        assert run.scenario["name"] == "cantilever_stiff_impact_lsq"
+    written = {line.removeprefix("run written to ").split(" ")[0] for stdout, _ in results
+               for line in stdout.splitlines() if line.startswith("run written to ")}
+    assert written == {str(d) for d in runs}
+    assert (out / "index.html").read_text().count("<tr>") == 1 + 2
     assert [p.name for p in cache.iterdir()] == [DatasetCache(cache).path(
         load_scenario("cantilever_stiff_impact_lsq")).name], "one whole cache entry, no temporary file"

@@ -1,8 +1,11 @@
-"""Run folders: everything a report needs survives save_run -> load_run, written atomically."""
+"""Run folders: everything a report needs survives save_run -> load_run, written atomically;
+the run history keeps every run (save_new_run), finds the latest, lists and indexes them."""
 
 from __future__ import annotations
 
 import json
+import re
+import shutil
 import sys
 from dataclasses import replace
 from pathlib import Path
@@ -14,7 +17,18 @@ sys.path.insert(0, str(Path(__file__).parent))
 import _synthetic_runs as synth
 
 from testbed.reporting.figures import save_run_figures
-from testbed.studies.runstore import load_run, save_run
+from testbed.reporting.report import runs_index_html
+from testbed.studies import runstore
+from testbed.studies.runstore import (
+    LATEST,
+    RunStoreError,
+    list_runs,
+    load_run,
+    resolve_run,
+    save_new_run,
+    save_run,
+    scenario_folder,
+)
 
 
 @pytest.fixture(scope="module")
@@ -105,3 +119,132 @@ def test_load_rejects_other_folders(tmp_path):
     (tmp_path / "run.json").write_text('{"format": "something-else"}')
     with pytest.raises(ValueError, match="not a sysid-testbed-run"):
         load_run(tmp_path)
+
+
+# ----------------------------------------------------------------------------- run history
+
+FIXED = "2026-01-02T03:04:05+00:00"
+
+
+@pytest.fixture()
+def same_second(monkeypatch):
+    """Every run made "now" is made in the same second, FIXED."""
+    build = runstore.build_meta
+
+    def fixed(result):
+        meta = build(result)
+        meta["created"] = FIXED
+        return meta
+
+    monkeypatch.setattr(runstore, "build_meta", fixed)
+
+
+def test_history_keeps_every_run_even_in_one_second(structural, tmp_path, same_second):
+    out = tmp_path / "runs"
+    paths = [save_new_run(replace(structural, fit_time=float(i)), out, index=runs_index_html)
+             for i in range(3)]
+    seed = structural.scenario.seed
+    folder = out / structural.scenario.name
+    assert [p.name for p in paths] == [f"20260102T030405Z-s{seed}", f"20260102T030405Z-s{seed}-2",
+                                       f"20260102T030405Z-s{seed}-3"]
+    assert [load_run(p).fit_time for p in paths] == [0.0, 1.0, 2.0], "no run replaced another"
+    assert sorted(p.name for p in folder.iterdir()) == sorted([LATEST] + [p.name for p in paths]), \
+        "no temporary folder left"
+    assert json.loads((folder / LATEST).read_text())["run"] == paths[-1].name
+    rows = list_runs(out)
+    assert [r["path"] for r in rows] == paths and {r["seed"] for r in rows} == {seed}
+    assert {r["id"] for r in rows} == {p.name for p in paths}
+
+
+def test_a_later_seed_is_its_own_run_and_the_latest(structural, tmp_path):
+    out = tmp_path / "runs"
+    first = save_new_run(structural, out)
+    other = replace(structural, scenario=structural.scenario.replace(seed=structural.scenario.seed + 5))
+    second = save_new_run(other, out)
+    assert second.name.split("-s")[1] == str(other.scenario.seed) and first != second
+    assert resolve_run(out / structural.scenario.name) == second
+    assert [r["seed"] for r in list_runs(out)] == [structural.scenario.seed, other.scenario.seed]
+
+
+def test_resolve_run_accepts_what_a_user_means(structural, tmp_path, same_second):
+    out = tmp_path / "runs"
+    name = structural.scenario.name
+    a = save_new_run(structural, out)
+    b = save_new_run(structural, out)
+    assert resolve_run(a) == a  # a run folder is itself
+    assert resolve_run(out / name) == b  # a scenario folder is its latest run
+    assert resolve_run(name, out) == b  # so is a bare scenario name
+    # a pointer to a run that is gone: the newest run left (by time, then name)
+    shutil.rmtree(b)
+    assert resolve_run(out / name) == a
+    (out / name / LATEST).write_text("{not json")
+    assert resolve_run(out / name) == a
+    # the layout before run history: a run folder directly in the output folder
+    legacy = save_run(structural, out / "legacy_name")
+    assert resolve_run(legacy) == legacy and resolve_run("legacy_name", out) == legacy
+    assert {r["path"] for r in list_runs(out)} == {a, legacy}
+    for bad in (tmp_path / "missing", "no_such_scenario", tmp_path):
+        with pytest.raises(RunStoreError, match="not a run folder"):
+            resolve_run(bad, out)
+
+
+def test_history_stays_inside_the_output_folder(structural, tmp_path):
+    out = tmp_path / "runs"
+    for bad in ("..", ".", "a/b", ".hidden"):
+        with pytest.raises(RunStoreError):
+            scenario_folder(out, bad)
+    out.mkdir()
+    (out / structural.scenario.name).write_text("a file, not a folder of runs")
+    with pytest.raises(RunStoreError, match="not a folder of runs"):
+        save_new_run(structural, out)
+    assert (out / structural.scenario.name).read_text() == "a file, not a folder of runs"
+
+
+def _save_one(args):
+    result, out, i = args
+    return save_new_run(replace(result, fit_time=float(i)), out, index=runs_index_html)
+
+
+def test_concurrent_processes_each_keep_their_run(structural, tmp_path, same_second):
+    """Four processes save a run of one scenario and seed in the same second: four folders."""
+    import multiprocessing
+
+    out = tmp_path / "runs"
+    with multiprocessing.get_context("fork").Pool(4) as pool:  # fork: keeps the patched clock
+        paths = pool.map(_save_one, [(structural, out, i) for i in range(4)])
+    assert len(set(paths)) == 4
+    assert sorted(load_run(p).fit_time for p in paths) == [0.0, 1.0, 2.0, 3.0]
+    assert len(list_runs(out)) == 4
+    index = (out / "index.html").read_text()
+    assert index.count("<tr>") == 1 + 4, "the index written last lists every run"
+    assert json.loads((out / structural.scenario.name / LATEST).read_text())["run"] in \
+        {p.name for p in paths}
+    assert not [p for p in (out / structural.scenario.name).iterdir() if p.name.startswith(".")]
+
+
+def test_index_page_links_every_run_and_is_self_contained(structural, mechanical, tmp_path):
+    out = tmp_path / "runs"
+    save_new_run(structural, out, figures=save_run_figures)
+    save_new_run(mechanical, out, index=runs_index_html)
+    page = (out / "index.html").read_text()
+    assert page.count("<tr>") == 1 + 2 and "default-src 'none'" in page
+    assert "http://" not in page and "https://" not in page and "<script" not in page
+    hrefs = [h for h in re.findall(r'href="([^"]+)"', page)]
+    assert len(hrefs) == 2 and all((out / h).is_file() for h in hrefs), hrefs
+    for r in list_runs(out):
+        assert r["scenario"] in page and r["id"] in page and r["verdict"] in page
+    # newest first
+    first, second = (page.index(r["id"]) for r in list_runs(out))
+    assert second < first
+
+
+def test_index_says_why_a_run_failed(structural, tmp_path):
+    from testbed.scoring.scorers import failed_scores
+
+    failed = replace(structural, scores=failed_scores(structural.scenario.kind,
+                                                      "fit failed: the Gram matrix is singular"))
+    save_new_run(failed, tmp_path, index=runs_index_html)
+    (row,) = list_runs(tmp_path)
+    assert row["verdict"] == "FAIL" and row["failure"] == "fit failed: the Gram matrix is singular"
+    page = (tmp_path / "index.html").read_text()
+    assert "fit failed: the Gram matrix is singular" in page and "badge fail" in page
