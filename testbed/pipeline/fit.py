@@ -177,7 +177,8 @@ def modal_parameters(M: np.ndarray, C: np.ndarray, K: np.ndarray) -> dict[str, l
 def model_summary(model: Any, data: Measurement | None = None) -> dict[str, Any]:
     """A fitted identifier as a JSON-ready dict.
 
-    Keys: ``identifier`` (name, class, hyperparameters), ``equations`` (text); for a structural
+    Keys: ``identifier`` (name, class, hyperparameters), ``equations`` (text), ``rules`` (the
+    fitted ``*rule_`` strings: which setting a rule chose from the data, and why); for a structural
     model ``matrices`` (``M`` [kg], ``C`` [N s/m], ``K`` [N/m], ``K3`` [N/m^3] or None) and
     ``modal`` (:func:`modal_parameters`); for a mechanical one ``coefficients`` (``coef`` with
     ``feature_names``); with ``data``, ``r2`` (the model's truth-free ``score(data)``, None where
@@ -189,6 +190,10 @@ def model_summary(model: Any, data: Measurement | None = None) -> dict[str, Any]
                                           "class": f"{type(model).__module__}.{type(model).__qualname__}",
                                           "params": params},
                            "equations": list(model.equations())}
+    rules = {k: v for k, v in vars(model).items()
+             if k.endswith("rule_") and not k.startswith("_") and isinstance(v, str)}
+    if rules:  # the settings chosen from the data, and why (e.g. noise_rule_, peak_band_rule_)
+        out["rules"] = rules
     if hasattr(model, "M_"):
         M, C, K = (np.asarray(getattr(model, k), dtype=float) for k in ("M_", "C_", "K_"))
         out["matrices"] = {"M": _array(M), "C": _array(C), "K": _array(K),

@@ -323,6 +323,11 @@ def _settings_section(page: Page, run: SavedRun) -> None:
                [[k, _value(v), "scenario" if k in declared else "default"] for k, v in params.items()]
                or [["(none)", "", ""]], digits=6)
     page.para(f"Class {run.meta['identifier'].get('class', '')}; fitted in {run.fit_time:.3g} s.")
+    rules = {k: v[0] for k, v in run.meta.get("model_lists", {}).items()
+             if k.endswith("rule_") and isinstance(v, list) and len(v) == 1}
+    if rules:  # settings the identifier chose from the data, and the rule that chose each
+        page.table(["chosen from the data", "rule"], [[k.removesuffix("rule_").rstrip("_") or k, v]
+                                                      for k, v in sorted(rules.items())])
     if ds.get("prior"):
         page.para("Prior knowledge given to the identifier: "
                   + ", ".join(f"{k} = {fmt(v)}" for k, v in ds["prior"].items()) + ".")

@@ -252,12 +252,18 @@ def _flatten(d: dict[str, Any], prefix: str) -> dict[str, np.ndarray]:
 
 
 def _model_arrays(model: Any) -> tuple[dict[str, Any], dict[str, Any]]:
-    """(learned arrays, learned string lists) of a fitted identifier: public attributes ending in _."""
+    """(learned arrays, learned string lists) of a fitted identifier: public attributes ending in _.
+
+    A plain string (the rule that chose a setting from the data, e.g. ``noise_rule_``) is kept
+    as a one-element list.
+    """
     arrays, lists = {}, {}
     for k, v in vars(model).items():
         if not k.endswith("_") or k.startswith("_") or k == "history_" or v is None:
             continue
-        if isinstance(v, (list, tuple)) and v and all(isinstance(x, str) for x in v):
+        if isinstance(v, str):  # e.g. a rule that chose a setting from the data (noise_rule_)
+            lists[k] = [v]
+        elif isinstance(v, (list, tuple)) and v and all(isinstance(x, str) for x in v):
             lists[k] = list(v)
         elif (a := _as_array(v)) is not None and a.dtype.kind != "U":
             arrays[k] = a
