@@ -13,6 +13,7 @@ from identify.structural import (
     build_library,
     mass_prior_value,
     matrices_from_coef,
+    solve_rows,
 )
 from testbed.core.errors import IdentificationError
 from testbed.core.measurement import Measurement
@@ -121,14 +122,7 @@ class LeastSquaresSINDy(StructuralIdentifier):
         lib = build_library(data, coupled_mass=False, cubic=bool(self.cubic), drift=True,
                             input_coupling=True)
         n, p = lib.target.shape[0], lib.theta.shape[0]
-        scale = np.sqrt(np.mean(lib.theta**2, axis=1))
-        scale[scale == 0] = 1.0
-        phi = (lib.theta / scale[:, None]).T
-        coef = np.zeros((n, p))
-        for i in range(n):
-            cols = np.flatnonzero(lib.mask[i])
-            sol, *_ = np.linalg.lstsq(phi[:, cols], lib.target[i], rcond=self.rcond)
-            coef[i, cols] = sol / scale[cols]
+        coef = solve_rows(lib, self.rcond)
         masses = np.full(n, m_hat / n)
         dyn = np.ones(p, dtype=bool)
         if "z" in lib.blocks:  # the chain's integration constants: estimated, then dropped

@@ -141,6 +141,33 @@ def build_library(data: Measurement, *, coupled_mass: bool, cubic: bool, start: 
     return Library(np.vstack(rows), xdd, np.hstack(mask_blocks), names, blocks)
 
 
+def solve_rows(lib: Library, rcond: float | None = None) -> np.ndarray:
+    """Least squares of each channel's target on the features its mask allows.
+
+    Parameters
+    ----------
+    lib : Library
+    rcond : float, optional
+        Relative singular-value cut-off of ``numpy.linalg.lstsq`` on the column-standardised
+        features (unit RMS each; an all-zero feature keeps scale 1); None = numpy's default.
+
+    Returns
+    -------
+    ndarray, shape (n, n_features)
+        Coefficients in the features' own units (zero where the mask excludes a feature).
+    """
+    scale = np.sqrt(np.mean(lib.theta**2, axis=1))
+    scale[scale == 0] = 1.0
+    phi = (lib.theta / scale[:, None]).T
+    n = lib.target.shape[0]
+    coef = np.zeros((n, lib.theta.shape[0]))
+    for i in range(n):
+        cols = np.flatnonzero(lib.mask[i])
+        sol, *_ = np.linalg.lstsq(phi[:, cols], lib.target[i], rcond=rcond)
+        coef[i, cols] = sol / scale[cols]
+    return coef
+
+
 def remove_drift(data: Measurement) -> tuple[Measurement, np.ndarray | None]:
     """The measurement with the chain's integration constants estimated and taken out.
 
@@ -167,15 +194,7 @@ def remove_drift(data: Measurement) -> tuple[Measurement, np.ndarray | None]:
     if data.drift_basis is None or np.asarray(data.drift_basis).shape[0] != 2:
         return data, None
     lib = build_library(data, coupled_mass=False, cubic=False, drift=True)
-    scale = np.sqrt(np.mean(lib.theta**2, axis=1))
-    scale[scale == 0] = 1.0
-    phi = (lib.theta / scale[:, None]).T
-    n = lib.target.shape[0]
-    coef = np.zeros((n, lib.theta.shape[0]))
-    for i in range(n):
-        cols = np.flatnonzero(lib.mask[i])
-        sol, *_ = np.linalg.lstsq(phi[:, cols], lib.target[i], rcond=None)
-        coef[i, cols] = sol / scale[cols]
+    coef = solve_rows(lib)
     A, B = -coef[:, lib.blocks["d"]], -coef[:, lib.blocks["v"]]
     z = coef[:, lib.blocks["z"]]
     try:
