@@ -11,6 +11,7 @@ from identify.structural import (
     MASS_PRIORS,
     StructuralIdentifier,
     build_library,
+    fit_band,
     mass_prior_value,
     matrices_from_coef,
     solve_rows,
@@ -50,9 +51,15 @@ class LeastSquaresSINDy(StructuralIdentifier):
     rcond : float
         Relative singular-value cut-off of the least-squares solve (``numpy.linalg.lstsq``)
         on column-standardised features.
+    fit_band_hz : float or None
+        Cut-off [Hz] of a zero-phase high-pass applied alike to every signal before the fit
+        (:func:`identify.structural.fit_band`); None = by rule,
+        :data:`~identify.structural.FIT_BAND_FRACTION` x the lowest measured peak; 0 = none.
 
     Attributes
     ----------
+    fit_band_hz_ : float
+        The fit-band high-pass used [Hz] (0 = none); ``fit_band_rule_`` (str) says what chose it.
     M_, C_, K_ : ndarray, shape (n, n)
         ``M_ = (m_hat / n) I`` [kg], ``C_ = -M_ Xi_v`` [N s/m], ``K_ = -M_ Xi_d`` [N/m].
     K3_ : ndarray, shape (n, n) or None
@@ -99,12 +106,17 @@ class LeastSquaresSINDy(StructuralIdentifier):
         # numpy's legacy -1 (machine precision) is not a documented choice here
         "rcond": Field(float, 1e-10, min=0.0, max=1.0, max_inclusive=False,
                        doc="relative singular-value cut-off of the least-squares solve"),
+        "fit_band_hz": Field(float, None, unit="Hz", min=0.0,
+                             doc="high-pass applied to every signal before the fit; default by "
+                                 "rule: 0.7 x the lowest measured peak; 0 = none"),
     }
 
-    def __init__(self, cubic: bool = False, mass_prior: str = "reduced_mass_trace", rcond: float = 1e-10):
+    def __init__(self, cubic: bool = False, mass_prior: str = "reduced_mass_trace", rcond: float = 1e-10,
+                 fit_band_hz: float | None = None):
         self.cubic = cubic
         self.mass_prior = mass_prior
         self.rcond = rcond
+        self.fit_band_hz = fit_band_hz
 
     def fit(self, data: Measurement) -> LeastSquaresSINDy:
         """Fit on ``data`` (signals only; the mass prior from ``data.prior``).
@@ -119,6 +131,7 @@ class LeastSquaresSINDy(StructuralIdentifier):
         """
         self.check_params()
         m_hat = mass_prior_value(data, self.mass_prior)
+        data, self.fit_band_hz_, self.fit_band_rule_ = fit_band(data, self.fit_band_hz)
         lib = build_library(data, coupled_mass=False, cubic=bool(self.cubic), drift=True,
                             input_coupling=True)
         n, p = lib.target.shape[0], lib.theta.shape[0]
