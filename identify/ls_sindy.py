@@ -8,6 +8,7 @@ import numpy as np
 
 from identify import IDENTIFIERS
 from identify.structural import (
+    FIT_BAND_FIELD,
     MASS_PRIORS,
     StructuralIdentifier,
     build_library,
@@ -106,9 +107,7 @@ class LeastSquaresSINDy(StructuralIdentifier):
         # numpy's legacy -1 (machine precision) is not a documented choice here
         "rcond": Field(float, 1e-10, min=0.0, max=1.0, max_inclusive=False,
                        doc="relative singular-value cut-off of the least-squares solve"),
-        "fit_band_hz": Field(float, None, unit="Hz", min=0.0,
-                             doc="high-pass applied to every signal before the fit; default by "
-                                 "rule: 0.7 x the lowest measured peak; 0 = none"),
+        "fit_band_hz": FIT_BAND_FIELD,
     }
 
     def __init__(self, cubic: bool = False, mass_prior: str = "reduced_mass_trace", rcond: float = 1e-10,

@@ -33,6 +33,7 @@ from identify._base import Identifier
 from identify._structural_sim import simulate_structural
 from testbed.core.errors import IdentificationError
 from testbed.core.measurement import Measurement, Trajectory
+from testbed.core.schema import Field
 from testbed.numerics.filters import elliptic_highpass
 from testbed.numerics.shapes import mac_matrix
 from testbed.numerics.spectral import harmonic_amplitude_law, peak_candidates
@@ -153,6 +154,10 @@ def build_library(data: Measurement, *, coupled_mass: bool, cubic: bool, start: 
 FIT_BAND_FRACTION = 0.7
 #: Order of the fit-band elliptic high-pass (the chain's design: 0.1 dB ripple, 30 dB stop band).
 FIT_BAND_ORDER = 5
+#: The structural identifiers' ``fit_band_hz`` hyperparameter (see :func:`fit_band`).
+FIT_BAND_FIELD = Field(float, None, unit="Hz", min=0.0,
+                       doc="high-pass applied to every signal before the fit; default by rule: "
+                           "0.7 x the lowest measured peak; 0 = none")
 
 
 def fit_band(data: Measurement, cutoff_hz: float | None = None
