@@ -122,7 +122,7 @@ def _ytick_width(ax: Any) -> float:
 
 
 def _fixed_layout(fig: Figure, grid: Any, *, right: float = 0.2, top_extra: float = 0.0,
-                  bottom_extra: float = 0.0, row_extra: float = 0.0, gridspec: Any = None) -> None:
+                  bottom_extra: float = 0.0, row_extra: float = 0.0) -> None:
     """Margins and gaps [in] of a grid of axes from its texts, set once (no layout engine).
 
     Each column's left room is its widest y tick label plus the y label; each row's top room
@@ -132,13 +132,12 @@ def _fixed_layout(fig: Figure, grid: Any, *, right: float = 0.2, top_extra: floa
     ----------
     fig : Figure
     grid : array of Axes, shape (rows, cols)
-        The axes of one GridSpec, as :func:`_axes` returns them (spanning axes: repeat them).
+        The axes of one GridSpec without parameters of its own (it takes the figure's subplot
+        parameters, set here), as :func:`_axes` returns them (spanning axes: repeat them).
     right : float
         Right margin [in] (a colour bar's room).
     top_extra, bottom_extra, row_extra : float
         More room [in] above the grid, below it, between rows.
-    gridspec : GridSpec, optional
-        The grid's GridSpec when it is not the figure's own subplot grid.
     """
     grid = np.asarray(grid, dtype=object)
     rows, cols = grid.shape
@@ -162,10 +161,7 @@ def _fixed_layout(fig: Figure, grid: Any, *, right: float = 0.2, top_extra: floa
     ah = (H - t_in - b_in - (rows - 1) * gap_h) / rows    # mean axes height [in]
     params = {"left": l_in / W, "right": 1.0 - right / W, "bottom": b_in / H, "top": 1.0 - t_in / H,
               "wspace": gap_w / max(aw, 0.1), "hspace": gap_h / max(ah, 0.1)}
-    if gridspec is not None:
-        gridspec.update(**params)
-    else:
-        fig.subplots_adjust(**params)
+    fig.subplots_adjust(**params)
 
 
 def _envelope(t: np.ndarray, y: np.ndarray, n_bins: int = MAX_POINTS // 2
@@ -587,7 +583,7 @@ def joint_angles(t: np.ndarray, reference: np.ndarray, simulated: np.ndarray, ch
     for a in bottom:
         a.set_xlabel("time [s]")
     grid = [ax[r * cols:(r + 1) * cols] for r in range(rows)] + [[w] * cols for w in wide]
-    _fixed_layout(fig, grid, gridspec=gs)
+    _fixed_layout(fig, grid)
     return fig
 
 
