@@ -14,7 +14,6 @@ from __future__ import annotations
 from collections.abc import Callable
 
 import numpy as np
-import pinocchio as pin
 
 from models.fivebar import geometry as geo
 from models.fivebar.dynamics import FiveBarDynamics
@@ -103,6 +102,8 @@ def simulate(dyn: FiveBarDynamics, theta0: np.ndarray, dtheta0: np.ndarray, prog
         The acceleration and constraint force of sample k are those of the state at
         t_k under the torque held from t_k.
     """
+    import pinocchio as pin  # lazy: ~0.1 s of import, only when simulating
+
     sps = round(1.0 / (fs * dt))
     model, data, cms, cds, prox = dyn.model, dyn.data, dyn.cmodels, dyn.cdatas, dyn.prox
     cd = pin.constraintDynamics
