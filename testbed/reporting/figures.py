@@ -28,6 +28,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from testbed.core.dataset import Dataset
+from testbed.core.truth import StructuralTruth, Truth, TruthError, truth_type
 from testbed.pipeline.cache import DatasetCache
 from testbed.pipeline.scenario import Scenario
 
@@ -344,17 +345,36 @@ def frequency_table(rows: list[dict[str, float]]) -> Figure:
     return fig
 
 
-def true_cubic(truth: dict[str, Any], n: int) -> np.ndarray | None:
-    """The true cubic matrix in the basis ``x**3`` when the cubic spring acts on one sensor DOF."""
-    if "k3" not in truth or "cubic_map" not in truth or "cubic_direction" not in truth:
+def typed_truth(run: Any) -> Truth | None:
+    """The truth of a saved run as its kind's dataclass (:mod:`testbed.core.truth`), or None if
+    the run's kind has none or its stored truth does not validate (a figure then leaves the true
+    panel out rather than failing)."""
+    try:
+        return truth_type(run.kind).from_dict(run.truth)
+    except TruthError:
         return None
-    cmap = np.atleast_2d(np.asarray(truth["cubic_map"], dtype=float))
+
+
+def true_cubic(truth: Truth | None, n: int) -> np.ndarray | None:
+    """The true cubic matrix in the basis ``x**3`` when the cubic spring acts on one sensor DOF.
+
+    Parameters
+    ----------
+    truth : StructuralTruth or None
+        Its ``k3`` [N/m^3], ``cubic_map`` and ``cubic_direction`` (m,) are read.
+    n : int
+        Sensor DOFs of the identified model.
+    """
+    if not isinstance(truth, StructuralTruth) or truth.k3 is None or truth.cubic_map is None \
+            or truth.cubic_direction is None:
+        return None
+    cmap = np.atleast_2d(truth.cubic_map)
     nz = np.flatnonzero(cmap[0])
     if cmap.shape != (1, n) or nz.size != 1:
         return None
     e = np.zeros(n)
     e[nz[0]] = cmap[0, nz[0]] ** 3
-    return float(np.asarray(truth["k3"])) * np.outer(np.asarray(truth["cubic_direction"], dtype=float), e)
+    return float(truth.k3) * np.outer(truth.cubic_direction, e)
 
 
 def relative_error(ident: np.ndarray, true: np.ndarray) -> float:
@@ -805,7 +825,7 @@ def _run_builders(run: Any, inputs: tuple[np.ndarray, list[str], str] | None
             panels.append(("K", d["K_id"], d.get("Kr"), "N/m"))
             K3 = run.model.get("K3_")
             if K3 is not None and np.any(np.asarray(K3) != 0):
-                panels.append(("K3", K3, true_cubic(run.truth, len(d["channels"])), "N/m^3"))
+                panels.append(("K3", K3, true_cubic(typed_truth(run), len(d["channels"])), "N/m^3"))
             return matrices(panels)
         b["matrices"] = _matrices
     if _series(run.history or {}):
