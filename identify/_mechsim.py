@@ -20,7 +20,6 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from scipy.interpolate import CubicHermiteSpline
 
 from identify.library import Library
 from testbed.core.errors import DivergenceError, IdentificationError
@@ -263,6 +262,8 @@ class ImplicitModel:
             converge) or became singular, or the equations became singular in the
             accelerations; ``time`` [s] is the start of the failing step.
         """
+        from scipy.interpolate import CubicHermiteSpline  # lazy: only when simulating
+
         t = np.asarray(t, dtype=float)
         n_steps = max(1, int(np.ceil((t[-1] - t[0]) / dt - 1e-9)))
         h = (t[-1] - t[0]) / n_steps

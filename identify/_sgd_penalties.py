@@ -10,7 +10,6 @@ and the diagonal masses ``m`` (n,) [kg]:
 from __future__ import annotations
 
 import numpy as np
-from scipy.optimize import linear_sum_assignment
 
 
 def symmetry_penalty(xa: np.ndarray, xv: np.ndarray, xd: np.ndarray, m: np.ndarray, which: str = "MCK"
@@ -88,6 +87,8 @@ def eigen_penalty(xa: np.ndarray, xd: np.ndarray, lam_hat: np.ndarray
     lam : ndarray, shape (n,)
         Real parts of the identified eigenvalues (unsorted).
     """
+    from scipy.optimize import linear_sum_assignment  # lazy: scipy.optimize costs ~0.3 s of import
+
     n = xa.shape[0]
     Mn = np.eye(n) - xa
     zeros = np.zeros((n, n))

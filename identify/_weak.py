@@ -34,7 +34,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.signal import fftconvolve
 
 from identify.library import Library
 from testbed.core.errors import IdentificationError
@@ -107,6 +106,8 @@ def _factor_rates(lib: Library, F: np.ndarray, xd: np.ndarray) -> tuple[np.ndarr
 
 def _correlate(A: np.ndarray, kernel: np.ndarray, starts: np.ndarray) -> np.ndarray:
     """``out[k, c] = sum_i kernel[i] A[starts[k] + i, c]`` for all windows (FFT)."""
+    from scipy.signal import fftconvolve  # lazy: scipy.signal costs ~0.3 s of import
+
     full = fftconvolve(A, kernel[::-1, None], mode="valid", axes=0)
     return full[starts]
 

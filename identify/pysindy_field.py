@@ -38,7 +38,6 @@ import warnings
 from typing import Any, ClassVar
 
 import numpy as np
-from sklearn.base import clone
 
 from identify import IDENTIFIERS
 from identify.ls_sindy import MASS_PRIOR_FIELD
@@ -192,6 +191,8 @@ class PySINDyField(StructuralIdentifier):
         return self
 
     def _fit_strong(self, data: Measurement) -> tuple[np.ndarray, list[str], dict[str, slice]]:
+        from sklearn.base import clone  # lazy: scikit-learn's import costs ~0.7 s
+
         lib = build_library(data, coupled_mass=False, cubic=bool(self.cubic))
         n, p = lib.target.shape[0], lib.theta.shape[0]
         scale = np.sqrt(np.mean(lib.theta**2, axis=1))

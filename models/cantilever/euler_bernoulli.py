@@ -17,7 +17,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.optimize import brentq
 
 
 def _characteristic(lam: float, kappa: float) -> float:
@@ -66,6 +65,8 @@ def eb_frequencies(E: float, I: float, mu: float, length: float, n: int = 4,
     ndarray, shape (n,)
         Natural frequencies, ascending [Hz].
     """
+    from scipy.optimize import brentq  # lazy: scipy.optimize costs ~0.3 s of import
+
     ei = E * I
     kappa = k_r * length / ei
     roots: list[float] = []

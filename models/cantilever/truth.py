@@ -22,7 +22,6 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 import scipy.linalg as sla
-from scipy.integrate import solve_ivp
 
 
 def mass_matrix(model: mujoco.MjModel) -> np.ndarray:
@@ -155,6 +154,8 @@ def simulate_reduced(Mr: np.ndarray, Cr: np.ndarray, Kr: np.ndarray, force_map: 
     u, ud, udd : ndarray, shape (m, n_samples)
         Displacements [m], velocities [m/s] and accelerations [m/s^2].
     """
+    from scipy.integrate import solve_ivp  # lazy: scipy.integrate costs ~0.1 s of import
+
     m = Mr.shape[0]
     minv = np.linalg.inv(Mr)
     b = np.asarray(force_map, float)

@@ -9,11 +9,15 @@ A, C, B, D (see :mod:`models.fivebar.params`); :mod:`models.fivebar.geometry` co
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
-import pinocchio as pin
 
 from models.fivebar import geometry as geo
 from models.fivebar.params import FiveBarParams
+
+if TYPE_CHECKING:
+    import pinocchio as pin
 
 #: Proximal solver settings (absolute accuracy, mu, max iterations).  With the default
 #: settings constraintDynamics returns NaN: the z row of the planar loop's 3D contact
@@ -24,6 +28,8 @@ ACT, PAS = [0, 2], [1, 3]
 
 
 def _inertia(mass: float, com: float, izz: float) -> pin.Inertia:
+    import pinocchio as pin  # lazy: ~0.1 s of import, only when the dynamics are built
+
     # A rod along x: only I_zz acts in the plane; I_xx small but positive and
     # I_yy = I_zz keep the 3-D tensor valid (MuJoCo's twin uses the same tensor).
     return pin.Inertia(mass, np.array([com, 0.0, 0.0]), np.diag([1e-2 * izz, izz, izz]))
@@ -43,6 +49,8 @@ class FiveBarDynamics:
     """
 
     def __init__(self, p: FiveBarParams) -> None:
+        import pinocchio as pin  # lazy: ~0.1 s of import, only when the dynamics are built
+
         self.p = p
         model = pin.Model()
         model.name = "fivebar"
@@ -80,6 +88,8 @@ class FiveBarDynamics:
     # ------------------------------------------------------------ matrices
     def mass_matrix(self, q: np.ndarray) -> np.ndarray:
         """Joint-space mass matrix (4, 4) [kg m^2] in relative coordinates, tree order."""
+        import pinocchio as pin  # lazy: ~0.1 s of import, only when the dynamics are built
+
         M = pin.crba(self.model, self.data, q)
         return np.triu(M) + np.triu(M, 1).T
 
@@ -94,6 +104,8 @@ class FiveBarDynamics:
         Computed by Pinocchio (frame Jacobians and classical frame accelerations at zero
         joint acceleration), independently of :func:`geometry.constraint_jacobian`.
         """
+        import pinocchio as pin  # lazy: ~0.1 s of import, only when the dynamics are built
+
         v = np.zeros(4) if v is None else v
         m, d = self.model, self.data
         pin.forwardKinematics(m, d, q, v, np.zeros(4))
@@ -120,6 +132,8 @@ class FiveBarDynamics:
         Mr : ndarray, shape (2, 2) [kg m^2]
         hr : ndarray, shape (2,) [N m]
         """
+        import pinocchio as pin  # lazy: ~0.1 s of import, only when the dynamics are built
+
         J, bias = self.loop_jacobian(q, v)
         M = self.mass_matrix(q)
         nle = pin.nonLinearEffects(self.model, self.data, q, v)
@@ -154,6 +168,8 @@ class FiveBarDynamics:
         lam : ndarray, shape (n, 2)
             Force on link 2 from link 3 at E [N] (world x, y).
         """
+        import pinocchio as pin  # lazy: ~0.1 s of import, only when the dynamics are built
+
         p = self.p
         theta = geo.assemble(th_act[:, 0], th_act[:, 1], p)
         dtheta, ddtheta = geo.complete_rates(theta, dth_act, ddth_act, p)
@@ -173,6 +189,8 @@ class FiveBarDynamics:
     # ------------------------------------------------------------ energy
     def energy(self, q: np.ndarray, v: np.ndarray) -> float:
         """Kinetic plus potential energy [J] (potential zero at y = 0)."""
+        import pinocchio as pin  # lazy: ~0.1 s of import, only when the dynamics are built
+
         T = pin.computeKineticEnergy(self.model, self.data, q, v)
         V = pin.computePotentialEnergy(self.model, self.data, q)
         return float(T + V)

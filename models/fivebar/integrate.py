@@ -14,7 +14,6 @@ from __future__ import annotations
 from collections.abc import Callable
 
 import numpy as np
-import pinocchio as pin
 
 from models.fivebar import geometry as geo
 from models.fivebar.dynamics import FiveBarDynamics
@@ -103,6 +102,8 @@ def simulate(dyn: FiveBarDynamics, theta0: np.ndarray, dtheta0: np.ndarray, prog
         The acceleration and constraint force of sample k are those of the state at
         t_k under the torque held from t_k.
     """
+    import pinocchio as pin  # lazy: ~0.1 s of import, only when simulating
+
     sps = round(1.0 / (fs * dt))
     model, data, cms, cds, prox = dyn.model, dyn.data, dyn.cmodels, dyn.cdatas, dyn.prox
     cd = pin.constraintDynamics
@@ -116,26 +117,35 @@ def simulate(dyn: FiveBarDynamics, theta0: np.ndarray, dtheta0: np.ndarray, prog
     t = np.arange(n_samples) / fs
     max_iter = prox.max_iter
 
-    def solve(q: np.ndarray, v: np.ndarray, tk: float) -> np.ndarray:
-        a = cd(model, data, q, v, tau_u - damp * v, cms, cds, prox)
+    # One right-hand side: ``cd(..., tau_u - damp * v, ...)`` written into two preallocated
+    # buffers (the same two floating-point operations, without their allocations); the solver's
+    # iteration count is read after every call and the residual only when it hit the limit.
+    tau, dv = np.empty(4), np.empty(4)
+    mul, sub = np.multiply, np.subtract
+
+    def refuse(q: np.ndarray, v: np.ndarray, a: np.ndarray, tk: float) -> None:
+        """Raise if the solve that just stopped at its iteration limit did not converge."""
         # ``not <=``: a NaN residual is a failed solve too.
-        if prox.iter >= max_iter and not prox.relative_residual <= RESIDUAL_REFUSE:
-            if not (np.isfinite(q).all() and np.isfinite(v).all() and np.isfinite(tau_u).all()
-                    and np.isfinite(a).all()):  # overflow, not a slow solve
-                raise RigError(f"fivebar (pinocchio): the simulation diverged, the accelerations are not "
-                               f"finite at t = {tk:.4f} s (RK4, dt = {dt:g} s, largest torque "
-                               f"{np.abs(tau_u).max():.3g} N m); reduce the excitation amplitude or "
-                               "simulation.dt")
-            raise RigError(f"fivebar (pinocchio): the loop-closure solve did not converge at t = {tk:.4f} s "
-                           f"(relative residual {prox.relative_residual:.3g} after {max_iter} iterations, "
-                           f"accepted <= {RESIDUAL_REFUSE:g}); the linkage is at or near a singularity: "
-                           "reduce the excitation amplitude or choose another start pose")
-        return a
+        if prox.relative_residual <= RESIDUAL_REFUSE:
+            return
+        if not (np.isfinite(q).all() and np.isfinite(v).all() and np.isfinite(tau_u).all()
+                and np.isfinite(a).all()):  # overflow, not a slow solve
+            raise RigError(f"fivebar (pinocchio): the simulation diverged, the accelerations are not "
+                           f"finite at t = {tk:.4f} s (RK4, dt = {dt:g} s, largest torque "
+                           f"{np.abs(tau_u).max():.3g} N m); reduce the excitation amplitude or "
+                           "simulation.dt")
+        raise RigError(f"fivebar (pinocchio): the loop-closure solve did not converge at t = {tk:.4f} s "
+                       f"(relative residual {prox.relative_residual:.3g} after {max_iter} iterations, "
+                       f"accepted <= {RESIDUAL_REFUSE:g}); the linkage is at or near a singularity: "
+                       "reduce the excitation amplitude or choose another start pose")
 
     for k in range(n_samples):
-        u = program.torque(k, q[[0, 2]], v[[0, 2]])
+        u = program.torque(k, q[0::2], v[0::2])  # the actuated joints 0 and 2 (views)
         tau_u[0], tau_u[2] = u
-        a1 = solve(q, v, t[k]).copy()
+        tk = t[k]
+        a1 = cd(model, data, q, v, sub(tau_u, mul(damp, v, out=dv), out=tau), cms, cds, prox).copy()
+        if prox.iter >= max_iter:
+            refuse(q, v, a1, tk)
         Q[k], V[k], A[k], U[k], LAM[k] = q, v, a1, u, data.lambda_c[:2]
         if (k + 1) % CHECK_EVERY == 0 or k == n_samples - 1:
             k0 = (k // CHECK_EVERY) * CHECK_EVERY
@@ -148,18 +158,26 @@ def simulate(dyn: FiveBarDynamics, theta0: np.ndarray, dtheta0: np.ndarray, prog
         if k == n_samples - 1:
             break
         for s in range(sps):
-            ts = t[k] + s * h
+            ts = tk + s * h
             if s:
-                a1 = solve(q, v, ts).copy()
+                a1 = cd(model, data, q, v, sub(tau_u, mul(damp, v, out=dv), out=tau), cms, cds, prox).copy()
+                if prox.iter >= max_iter:
+                    refuse(q, v, a1, ts)
             v2 = v + h2 * a1
             q2 = q + h2 * v
-            a2 = solve(q2, v2, ts).copy()
+            a2 = cd(model, data, q2, v2, sub(tau_u, mul(damp, v2, out=dv), out=tau), cms, cds, prox).copy()
+            if prox.iter >= max_iter:
+                refuse(q2, v2, a2, ts)
             v3 = v + h2 * a2
             q3 = q + h2 * v2
-            a3 = solve(q3, v3, ts).copy()
+            a3 = cd(model, data, q3, v3, sub(tau_u, mul(damp, v3, out=dv), out=tau), cms, cds, prox).copy()
+            if prox.iter >= max_iter:
+                refuse(q3, v3, a3, ts)
             v4 = v + h * a3
             q4 = q + h * v3
-            a4 = solve(q4, v4, ts)
+            a4 = cd(model, data, q4, v4, sub(tau_u, mul(damp, v4, out=dv), out=tau), cms, cds, prox)
+            if prox.iter >= max_iter:
+                refuse(q4, v4, a4, ts)
             q = q + h6 * (v + 2.0 * (v2 + v3) + v4)
             v = v + h6 * (a1 + 2.0 * (a2 + a3) + a4)
     return {"theta": geo.to_absolute(Q), "dtheta": geo.to_absolute(V), "ddtheta": geo.to_absolute(A),

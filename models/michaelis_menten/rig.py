@@ -31,7 +31,6 @@ from collections.abc import Callable
 from typing import Any, ClassVar
 
 import numpy as np
-from scipy.integrate import solve_ivp
 
 from models import RIGS
 from models._base import ErrorFn, Rig
@@ -138,6 +137,8 @@ class MichaelisMentenRig(Rig):
                     steps_value=simulation["duration"], samples_value=simulation["duration"])
 
     def simulate(self, progress: Callable[[float], None] | None = None) -> Dataset:
+        from scipy.integrate import solve_ivp  # lazy: scipy.integrate costs ~0.1 s of import
+
         sc = self.scenario
         p = sc.rig_params
         jx, vmax, km, x0 = float(p["jx"]), float(p["Vmax"]), float(p["Km"]), float(p["x0"])

@@ -17,33 +17,42 @@ scenario's thresholds; fit time per identifier.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 import os
 import re
 from collections.abc import Callable, Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-import matplotlib as mpl
 import numpy as np
-from matplotlib.figure import Figure
-from matplotlib.patches import Rectangle
-from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
 
 from testbed.core.dataset import Dataset
+from testbed.core.truth import StructuralTruth, Truth, TruthError, truth_type
 from testbed.pipeline.cache import DatasetCache
 from testbed.pipeline.scenario import Scenario
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
+# matplotlib is imported where a figure is drawn (about 0.35 s of import), not with this module:
+# a run without figures, a report's text, a sweep's summary do not pay for it.
 
 STYLE: dict[str, Any] = {
     "font.size": 10, "axes.titlesize": 10, "axes.labelsize": 10, "legend.fontsize": 9,
     "xtick.labelsize": 9, "ytick.labelsize": 9, "axes.grid": True, "grid.alpha": 0.3,
     "axes.spines.top": False, "axes.spines.right": False, "lines.linewidth": 1.2,
     "figure.dpi": 100, "savefig.dpi": 110, "image.cmap": "viridis",
+    # a title at a fixed height: matplotlib otherwise measures every axis's top tick labels to
+    # lift the title over them (none of our axes has any)
+    "axes.titley": 1.0,
 }
-# No "savefig.bbox": "tight": constrained layout already keeps every label inside the figure,
-# and a tight bounding box costs a second full draw of each figure (measured: 2 of the 5 s of a
-# `testbed run` went to five savefig calls).  The dpi stays at 110: rendering is not where
-# the time goes, and the smallest figure (a 3-mode frequency table) needs it to stay >= 200 px.
+# No "savefig.bbox": "tight" and no constrained layout for the run figures: both measure every
+# text of the figure in extra draw passes (measured: 2 of the 5 s of a `testbed run` went to
+# six savefig calls, more than half of it in constrained layout).  Run figures are laid out once
+# from margins in inches (:func:`_fixed_layout`), sized from the tick labels' text.  The dpi
+# stays at 110: rendering is not where the time goes, and the smallest figure (a 3-mode
+# frequency table) needs it to stay >= 200 px.
 #: Longest line drawn as is; longer ones are drawn as their min/max envelope over this many
 #: bins (at 1000 px a bin is under one pixel wide, so the picture is the same).
 MAX_POINTS = 4000
@@ -51,22 +60,109 @@ TRUTH, IDENT = "#222222", "#d62728"
 WIDTH = 10.0  # [in] every figure is this wide, so all read alike at report size
 
 
-def _fig(height: float, width: float = WIDTH) -> Figure:
+def _styled(fn: Callable[..., Any]) -> Callable[..., Any]:
+    """Run a figure builder inside the house style (every artist it makes takes STYLE)."""
+    @functools.wraps(fn)
+    def wrapper(*args: Any, **kw: Any) -> Any:
+        import matplotlib as mpl
+
+        with mpl.rc_context(STYLE):
+            return fn(*args, **kw)
+    return wrapper
+
+
+def _fig(height: float, width: float = WIDTH, layout: str | None = None) -> Figure:
+    """A figure of ``width`` x ``height`` [in]; ``layout="constrained"`` for the sweep figures
+    (their legend sits outside the axes), none for the run figures (:func:`_fixed_layout`)."""
+    import matplotlib as mpl
+    from matplotlib.figure import Figure
+
     with mpl.rc_context(STYLE):
-        return Figure(figsize=(width, height), layout="constrained")
+        return Figure(figsize=(width, height), layout=layout)
 
 
 def _axes(fig: Figure, *args: Any, **kw: Any) -> Any:
+    import matplotlib as mpl
+
     with mpl.rc_context(STYLE):
         return fig.subplots(*args, squeeze=False, **kw)
 
 
 def save_figure(fig: Figure, path: str | os.PathLike) -> Path:
     """Write ``fig`` as PNG to ``path`` in the house style; return the path."""
+    import matplotlib as mpl
+
     path = Path(path)
     with mpl.rc_context(STYLE):
-        fig.savefig(path, format="png")
+        # zlib level 3 instead of 6: a third less encoding time, files within 2 % of the size
+        fig.savefig(path, format="png", pil_kwargs={"compress_level": 3})
     return path
+
+
+#: Text heights [in] of the house style: a 9 pt tick label with its 3.5 pt tick and 3.5 pt pad,
+#: a 10 pt axis label with its 4 pt pad, one 10 pt title line with its 6 pt pad.
+_TICK_H, _LABEL_H, _TITLE_H = (9 * 1.2 + 7) / 72, (10 * 1.2 + 4) / 72, (10 * 1.2 + 6) / 72
+
+
+def _text_width(text: str, size_pt: float) -> float:
+    """Width [in] of ``text`` in DejaVu Sans at ``size_pt``, from per-character advances (an
+    upper estimate: digits 0.64 em, minus signs and wide letters 0.84 em, points 0.32 em)."""
+    em = sum(0.32 if c in ".,:;!|il'" else 0.84 if c in "\u2212-mwMW" else 0.64 for c in text)
+    return em * size_pt / 72.0
+
+
+def _ytick_width(ax: Any) -> float:
+    """Widest y tick label of ``ax`` [in], estimated from its text (nothing is drawn)."""
+    if not ax.axison or not ax.yaxis.get_tick_params().get("labelleft", True):
+        return 0.0
+    lo, hi = sorted(ax.get_ylim())
+    tol = 1e-9 * abs(hi - lo)
+    locs = [v for v in ax.yaxis.get_majorticklocs() if lo - tol <= v <= hi + tol]
+    labels = ax.yaxis.get_major_formatter().format_ticks(locs) if locs else []
+    return max((_text_width(str(t), 9) for t in labels), default=0.0)
+
+
+def _fixed_layout(fig: Figure, grid: Any, *, right: float = 0.2, top_extra: float = 0.0,
+                  bottom_extra: float = 0.0, row_extra: float = 0.0) -> None:
+    """Margins and gaps [in] of a grid of axes from its texts, set once (no layout engine).
+
+    Each column's left room is its widest y tick label plus the y label; each row's top room
+    its title lines, its bottom room the x tick labels and x label, as far as shown.
+
+    Parameters
+    ----------
+    fig : Figure
+    grid : array of Axes, shape (rows, cols)
+        The axes of one GridSpec without parameters of its own (it takes the figure's subplot
+        parameters, set here), as :func:`_axes` returns them (spanning axes: repeat them).
+    right : float
+        Right margin [in] (a colour bar's room).
+    top_extra, bottom_extra, row_extra : float
+        More room [in] above the grid, below it, between rows.
+    """
+    grid = np.asarray(grid, dtype=object)
+    rows, cols = grid.shape
+    W, H = fig.get_size_inches()
+    left = np.zeros(cols)
+    title, below = np.zeros(rows), np.zeros(rows)
+    for (r, c), ax in np.ndenumerate(grid):
+        if ax is None or not ax.axison:
+            continue
+        left[c] = max(left[c], _ytick_width(ax) + 0.1 + (_LABEL_H if ax.get_ylabel() else 0.0))
+        if ax.get_title():
+            title[r] = max(title[r], _TITLE_H * (ax.get_title().count("\n") + 1))
+        shown = ax.xaxis.get_tick_params().get("labelbottom", True)
+        below[r] = max(below[r], (_TICK_H if shown else 0.05) + (_LABEL_H if ax.get_xlabel() else 0.0))
+    l_in = left[0] + 0.1
+    t_in = title[0] + 0.1 + top_extra
+    b_in = below[-1] + 0.1 + bottom_extra
+    gap_w = (left[1:].max() + 0.25) if cols > 1 else 0.0
+    gap_h = (max(below[r] + title[r + 1] for r in range(rows - 1)) + 0.1 + row_extra) if rows > 1 else 0.0
+    aw = (W - l_in - right - (cols - 1) * gap_w) / cols   # mean axes width [in]
+    ah = (H - t_in - b_in - (rows - 1) * gap_h) / rows    # mean axes height [in]
+    params = {"left": l_in / W, "right": 1.0 - right / W, "bottom": b_in / H, "top": 1.0 - t_in / H,
+              "wspace": gap_w / max(aw, 0.1), "hspace": gap_h / max(ah, 0.1)}
+    fig.subplots_adjust(**params)
 
 
 def _envelope(t: np.ndarray, y: np.ndarray, n_bins: int = MAX_POINTS // 2
@@ -89,6 +185,8 @@ def _envelope(t: np.ndarray, y: np.ndarray, n_bins: int = MAX_POINTS // 2
 def _log_y(ax: Any) -> None:
     """Logarithmic y axis with plain ``1e-3`` tick labels: mathtext labels (``10^{-3}``) cost
     most of a small figure's layout time (measured: 1.6 of 2.4 s of a 3-row spectrum figure)."""
+    from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
+
     ax.set_yscale("log")
     ax.yaxis.set_major_locator(LogLocator(numticks=5))
     ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:.0e}".replace("e-0", "e-")
@@ -100,6 +198,7 @@ def _label(quantity: str, unit: str) -> str:
     return f"{quantity} [{unit}]" if unit else quantity
 
 
+@_styled
 def reconstruction(t: np.ndarray, reference: np.ndarray, simulated: np.ndarray, channels: Sequence[str],
                    unit: str = "m/s^2", quantity: str = "acceleration",
                    zoom: tuple[float, float] | None = None, trac: Sequence[float] | None = None) -> Figure:
@@ -133,14 +232,19 @@ def reconstruction(t: np.ndarray, reference: np.ndarray, simulated: np.ndarray, 
     for a in ax[-1]:
         a.set_xlabel("time [s]")
     ax[0, 0].legend(loc="upper right")
+    _fixed_layout(fig, ax)
     return fig
 
 
+@_styled
 def mac_matrix(mac: np.ndarray, pair: Sequence[int] | None = None) -> Figure:
     """Heat map of ``mac[identified, true]`` with each value written in its cell; pairs outlined."""
+    from matplotlib.patches import Rectangle
+
     mac = np.asarray(mac, dtype=float)
     fig = _fig(0.55 * mac.shape[0] + 1.6, min(WIDTH, 0.8 * mac.shape[1] + 3.0))
-    ax = _axes(fig)[0, 0]
+    grid = _axes(fig)
+    ax = grid[0, 0]
     im = ax.imshow(mac, vmin=0, vmax=1, cmap="Blues")
     ax.grid(False)
     for (i, j), v in np.ndenumerate(mac):
@@ -153,6 +257,7 @@ def mac_matrix(mac: np.ndarray, pair: Sequence[int] | None = None) -> Figure:
     ax.set_ylabel("identified mode")
     ax.set_title("MAC")
     fig.colorbar(im, ax=ax, label="MAC [-]")
+    _fixed_layout(fig, grid, right=0.15)  # the colour bar sits inside the axes' cell
     return fig
 
 
@@ -178,6 +283,7 @@ def is_weight(name: str) -> bool:
     return "alpha" in low or "weight" in low
 
 
+@_styled
 def penalty_weights(history: dict[str, Any]) -> Figure | None:
     """Penalty weights vs epoch (left) and loss terms vs epoch (right); None without a history."""
     series = _series(history or {})
@@ -199,6 +305,7 @@ def penalty_weights(history: dict[str, Any]) -> Figure | None:
             _log_y(a)
         a.set(xlabel="epoch", ylabel=f"{title[:-1]} [-]", title=f"{title} vs epoch")
         a.legend(fontsize=8)
+    _fixed_layout(fig, ax[None, :])
     return fig
 
 
@@ -217,6 +324,7 @@ def frequency_rows(f_true: np.ndarray, f_id: np.ndarray, pair: Sequence[int] | N
     return rows
 
 
+@_styled
 def frequency_table(rows: list[dict[str, float]]) -> Figure:
     """Table 2 of paper 000 as a figure: mode, true Hz, identified Hz, error %, damping ratios."""
     damp = all("z_true" in r for r in rows)
@@ -232,20 +340,41 @@ def frequency_table(rows: list[dict[str, float]]) -> Figure:
     tab.set_fontsize(10)
     tab.scale(1, 1.5)
     ax.set_title("natural frequencies: true vs identified")
+    h = fig.get_size_inches()[1]
+    fig.subplots_adjust(left=0.02, right=0.98, bottom=0.1 / h, top=1.0 - (_TITLE_H + 0.1) / h)
     return fig
 
 
-def true_cubic(truth: dict[str, Any], n: int) -> np.ndarray | None:
-    """The true cubic matrix in the basis ``x**3`` when the cubic spring acts on one sensor DOF."""
-    if "k3" not in truth or "cubic_map" not in truth or "cubic_direction" not in truth:
+def typed_truth(run: Any) -> Truth | None:
+    """The truth of a saved run as its kind's dataclass (:mod:`testbed.core.truth`), or None if
+    the run's kind has none or its stored truth does not validate (a figure then leaves the true
+    panel out rather than failing)."""
+    try:
+        return truth_type(run.kind).from_dict(run.truth)
+    except TruthError:
         return None
-    cmap = np.atleast_2d(np.asarray(truth["cubic_map"], dtype=float))
+
+
+def true_cubic(truth: Truth | None, n: int) -> np.ndarray | None:
+    """The true cubic matrix in the basis ``x**3`` when the cubic spring acts on one sensor DOF.
+
+    Parameters
+    ----------
+    truth : StructuralTruth or None
+        Its ``k3`` [N/m^3], ``cubic_map`` and ``cubic_direction`` (m,) are read.
+    n : int
+        Sensor DOFs of the identified model.
+    """
+    if not isinstance(truth, StructuralTruth) or truth.k3 is None or truth.cubic_map is None \
+            or truth.cubic_direction is None:
+        return None
+    cmap = np.atleast_2d(truth.cubic_map)
     nz = np.flatnonzero(cmap[0])
     if cmap.shape != (1, n) or nz.size != 1:
         return None
     e = np.zeros(n)
     e[nz[0]] = cmap[0, nz[0]] ** 3
-    return float(np.asarray(truth["k3"])) * np.outer(np.asarray(truth["cubic_direction"], dtype=float), e)
+    return float(truth.k3) * np.outer(truth.cubic_direction, e)
 
 
 def relative_error(ident: np.ndarray, true: np.ndarray) -> float:
@@ -257,6 +386,7 @@ def relative_error(ident: np.ndarray, true: np.ndarray) -> float:
     return float(np.linalg.norm(ident - true)) / den
 
 
+@_styled
 def matrices(panels: Sequence[tuple[str, np.ndarray, np.ndarray | None, str]]) -> Figure:
     """Identified (top row) vs true (bottom row) matrices as heat maps, one column per matrix.
 
@@ -271,7 +401,7 @@ def matrices(panels: Sequence[tuple[str, np.ndarray, np.ndarray | None, str]]) -
     n = len(panels)
     size = max(np.asarray(p[1]).shape[0] for p in panels)
     fig = _fig(5.6 if size <= 6 else 6.4, min(WIDTH, 3.4 * n + 0.4))
-    ax = _axes(fig, 2, n)
+    ax = _axes(fig, 3, n, height_ratios=(1.0, 1.0, 0.07))  # last row: the colour bars
     for c, (name, ident, true, unit) in enumerate(panels):
         mats = [np.asarray(ident, dtype=float), None if true is None else np.asarray(true, dtype=float)]
         lim = max(float(np.nanmax(np.abs(m))) for m in mats if m is not None) or 1.0
@@ -300,9 +430,13 @@ def matrices(panels: Sequence[tuple[str, np.ndarray, np.ndarray | None, str]]) -
             a.set_xticks(range(m.shape[1]), [str(j + 1) for j in range(m.shape[1])])
             a.set_yticks(range(m.shape[0]), [str(i + 1) for i in range(m.shape[0])])
             a.set(xlabel="sensor DOF", ylabel="sensor DOF" if c == 0 else "")
+        cax = ax[2, c]
         if im is not None:
-            fig.colorbar(im, ax=ax[:, c], label=_label(name, shown_unit), shrink=0.8, location="bottom",
-                         aspect=15)
+            cax.set_label("<colorbar>")
+            fig.colorbar(im, cax=cax, orientation="horizontal", label=_label(name, shown_unit))
+        else:
+            cax.axis("off")
+    _fixed_layout(fig, ax, right=0.3)
     return fig
 
 
@@ -338,6 +472,7 @@ def psd(y: np.ndarray, fs: float, nperseg: int = 1024) -> tuple[np.ndarray, np.n
     return np.fft.rfftfreq(n, 1.0 / fs), p
 
 
+@_styled
 def spectra(t: np.ndarray, reference: np.ndarray, simulated: np.ndarray, channels: Sequence[str],
             unit: str = "m/s^2", frequencies: Sequence[float] | None = None,
             f_max: float | None = None) -> Figure:
@@ -393,9 +528,11 @@ def spectra(t: np.ndarray, reference: np.ndarray, simulated: np.ndarray, channel
     ax[-1, 0].set_xlabel("frequency [Hz]")
     ax[-1, 1].set_xlabel("time [s]")
     ax[0, 0].legend(loc="upper right", fontsize=8)
+    _fixed_layout(fig, ax)
     return fig
 
 
+@_styled
 def joint_angles(t: np.ndarray, reference: np.ndarray, simulated: np.ndarray, channels: Sequence[str],
                  rmse: Sequence[float] | None = None, unit: str = "rad", errors: bool = True,
                  inputs: np.ndarray | None = None, input_channels: Sequence[str] = (),
@@ -427,11 +564,10 @@ def joint_angles(t: np.ndarray, reference: np.ndarray, simulated: np.ndarray, ch
     has_u = inputs is not None and np.size(inputs) > 0
     extra = int(errors) + int(has_u)
     fig = _fig(2.4 * rows + 2.3 * extra + 0.5)
-    with mpl.rc_context(STYLE):
-        gs = fig.add_gridspec(rows + extra, cols)
-        first = fig.add_subplot(gs[0, 0])
-        ax = [first] + [fig.add_subplot(gs[i // cols, i % cols], sharex=first) for i in range(1, rows * cols)]
-        wide = [fig.add_subplot(gs[rows + k, :], sharex=first) for k in range(extra)]
+    gs = fig.add_gridspec(rows + extra, cols)
+    first = fig.add_subplot(gs[0, 0])
+    ax = [first] + [fig.add_subplot(gs[i // cols, i % cols], sharex=first) for i in range(1, rows * cols)]
+    wide = [fig.add_subplot(gs[rows + k, :], sharex=first) for k in range(extra)]
     for i, ch in enumerate(channels):
         ax[i].plot(*_envelope(t, reference[i]), color=TRUTH, label="truth (noise-free)")
         ax[i].plot(*_envelope(t, simulated[i]), color=IDENT, ls="--", label="identified model")
@@ -466,9 +602,12 @@ def joint_angles(t: np.ndarray, reference: np.ndarray, simulated: np.ndarray, ch
             a.tick_params(labelbottom=False)
     for a in bottom:
         a.set_xlabel("time [s]")
+    grid = [ax[r * cols:(r + 1) * cols] for r in range(rows)] + [[w] * cols for w in wide]
+    _fixed_layout(fig, grid)
     return fig
 
 
+@_styled
 def coefficients(terms: Sequence[str], coef_true: np.ndarray, coef_id: np.ndarray,
                  errors: Sequence[float] | None = None) -> Figure:
     """Grouped bars per equation: true vs identified coefficient of every library term."""
@@ -486,6 +625,9 @@ def coefficients(terms: Sequence[str], coef_true: np.ndarray, coef_id: np.ndarra
         ax[k].set_title(f"equation {k + 1}" + (f": relative error {errors[k]:.3g}" if errors is not None
                                                else ""))
     ax[0].legend()
+    # the term names stand at 60 degrees below each panel: room for the longest one
+    slant = max((_text_width(str(x), 8) for x in terms), default=0.0) * math.sin(math.radians(60))
+    _fixed_layout(fig, ax[:, None], bottom_extra=slant, row_extra=slant)
     return fig
 
 
@@ -519,6 +661,7 @@ def _quartiles(vals: Sequence[float]) -> tuple[float, float, float]:
     return float(q25), float(med), float(q75)
 
 
+@_styled
 def score_panels(rows: Sequence[dict[str, Any]], metric: str, unit: str = "-",
                  thresholds: dict[str, list[tuple[str, float]]] | None = None,
                  max_cols: int = 3) -> Figure | None:
@@ -557,7 +700,7 @@ def score_panels(rows: Sequence[dict[str, Any]], metric: str, unit: str = "-",
     n = len(scenarios)
     cols = min(n, max_cols)
     nrows = math.ceil(n / cols)
-    fig = _fig(2.5 * nrows + 0.6, min(WIDTH, 3.3 * cols + 1.2))
+    fig = _fig(2.5 * nrows + 0.6, min(WIDTH, 3.3 * cols + 1.2), layout="constrained")
     ax = _axes(fig, nrows, cols, sharex=True, sharey=True).ravel()
     colours = {i: f"C{k % 10}" for k, i in enumerate(idents)}
     every = [v for s in pts.values() for d in s.values() for vs in d.values() for v in vs]
@@ -596,12 +739,13 @@ def score_panels(rows: Sequence[dict[str, Any]], metric: str, unit: str = "-",
     return fig
 
 
+@_styled
 def fit_times(rows: Sequence[dict[str, Any]]) -> Figure:
     """Fit time [s] per identifier: one box per identifier over all its cells."""
     idents = sorted({r["identifier"] for r in rows})
     data = [[float(r["fit_time"]) for r in rows if r["identifier"] == i and r.get("fit_time") is not None
              and np.isfinite(float(r["fit_time"]))] for i in idents]
-    fig = _fig(0.5 * len(idents) + 1.8, 8.0)
+    fig = _fig(0.5 * len(idents) + 1.8, 8.0, layout="constrained")
     ax = _axes(fig)[0, 0]
     boxes = [d or [np.nan] for d in data]
     try:
@@ -681,7 +825,7 @@ def _run_builders(run: Any, inputs: tuple[np.ndarray, list[str], str] | None
             panels.append(("K", d["K_id"], d.get("Kr"), "N/m"))
             K3 = run.model.get("K3_")
             if K3 is not None and np.any(np.asarray(K3) != 0):
-                panels.append(("K3", K3, true_cubic(run.truth, len(d["channels"])), "N/m^3"))
+                panels.append(("K3", K3, true_cubic(typed_truth(run), len(d["channels"])), "N/m^3"))
             return matrices(panels)
         b["matrices"] = _matrices
     if _series(run.history or {}):

@@ -70,9 +70,9 @@ def structural_result(n_samples: int = 4000, fs: float = 4000.0) -> RunResult:
                                              ("acc1", "acc2", "acc3"), "m/s^2", pos),
                       "force": Signal(np.where(t < 1e-3, 10.0, 0.0), ("force",), "N", pos[-1:])},
                  {"acceleration": Signal(acc, ("acc1", "acc2", "acc3"), "m/s^2", pos)},
-                 {"frequencies_hz": f, "eb_frequencies_hz": f * 1.01, "damping_ratios": zeta,
-                  "sensor_modes": phi, "Mr": M, "Kr": K, "Cr": C, "k3": 1e9,
-                  "cubic_map": np.array([[1.0, 0, 0]]), "cubic_direction": np.array([1.0, 0, 0])},
+                 {"M": M, "C": C, "K": K, "modes": phi, "frequencies_hz": f, "eb_frequencies_hz": f * 1.01,
+                  "damping_ratios": zeta, "sensor_modes": phi, "Mr": M, "Kr": K, "Cr": C, "k3": 1e9,
+                  "cubic_map": np.array([1.0, 0, 0]), "cubic_direction": np.array([1.0, 0, 0])},
                  {"frequencies_hz": "Hz", "Mr": "kg", "Kr": "N/m", "Cr": "N s/m", "k3": "N/m^3"},
                  {"total_mass": 0.6}, {"rig": "cantilever", "seed": 1, "content_hash": "ab" * 32})
     model = FakeIdentifier()

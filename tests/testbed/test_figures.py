@@ -13,6 +13,7 @@ from matplotlib.figure import Figure
 sys.path.insert(0, str(Path(__file__).parent))
 import _synthetic_runs as synth
 
+from testbed.core.truth import StructuralTruth
 from testbed.reporting import figures
 from testbed.studies.runstore import load_run, save_run
 
@@ -81,12 +82,18 @@ def test_frequency_rows_pair_and_error():
 
 
 def test_true_cubic_only_when_it_exists_in_the_basis():
-    tr = {"k3": 2.0, "cubic_map": np.array([[0, 3.0, 0]]), "cubic_direction": np.array([1.0, -1.0, 0])}
+    eye = np.eye(3)
+    base = {"M": eye, "C": eye, "K": eye, "frequencies_hz": np.ones(3), "damping_ratios": np.ones(3),
+            "modes": eye, "sensor_modes": eye, "Mr": eye, "Cr": eye, "Kr": eye}
+    cubic = {"k3": 2.0, "cubic_map": np.array([0, 3.0, 0]), "cubic_direction": np.array([1.0, -1.0, 0])}
+    tr = StructuralTruth.from_dict(base | cubic)
     K3 = figures.true_cubic(tr, 3)
     x = np.array([0.1, 0.2, 0.3])
-    np.testing.assert_allclose(K3 @ x**3, tr["cubic_direction"] * 2.0 * (3.0 * 0.2) ** 3)
-    assert figures.true_cubic({**tr, "cubic_map": np.array([[1.0, -1.0, 0]])}, 3) is None
-    assert figures.true_cubic({}, 3) is None
+    np.testing.assert_allclose(K3 @ x**3, cubic["cubic_direction"] * 2.0 * (3.0 * 0.2) ** 3)
+    two = StructuralTruth.from_dict(base | cubic | {"cubic_map": np.array([1.0, -1.0, 0])})
+    assert figures.true_cubic(two, 3) is None  # the cubic coordinate mixes two sensor DOFs
+    assert figures.true_cubic(StructuralTruth.from_dict(base), 3) is None  # linear: no cubic truth
+    assert figures.true_cubic(None, 3) is None
 
 
 def test_structural_run_figures(runs, tmp_path):

@@ -1,0 +1,98 @@
+"""What a user waits for at the command line: ``testbed`` start-up and one scored run with figures.
+
+Whole processes (``python -m testbed.cli ...``), as a user starts them, timed interleaved with
+their peers in the same run (:func:`benchmarks._timing.interleaved`), medians with spread:
+
+1. ``testbed --version`` and ``testbed list`` (every registry loaded: all rigs and identifiers
+   imported) against ``python -c "import numpy"``, the floor of any Python command of ours.
+   Target: each under 0.5 s (the issue's absolute goal).
+2. ``testbed run cantilever_stiff_impact`` with a warm dataset cache, with figures, against the
+   same run without figures (``--no-figures``) and against the numpy start-up.  Target: under
+   1.5 s (the issue's absolute goal).  The ratio to the run without figures is what the figures
+   cost; the ratio to the numpy start-up scales out the machine's speed.
+
+Each process's CPU time (user + sys, from ``getrusage`` of the reaped child) is reported beside
+the wall time: on a shared machine the wall time of a single-threaded command also holds the
+time it waited for a core.
+
+Run: ``.venv/bin/python -m benchmarks bench_cli``.
+"""
+
+from __future__ import annotations
+
+import os
+import resource
+import subprocess
+import sys
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from benchmarks._timing import interleaved, machine, ratio_spread, spread
+
+ROOT = Path(__file__).resolve().parents[1]
+TARGET_START_S = 0.5   # testbed --version / list, wall [s]
+TARGET_RUN_S = 1.5     # testbed run cantilever_stiff_impact, warm cache, with figures, wall [s]
+REPEATS = 5
+SCENARIO = "cantilever_stiff_impact"
+
+
+def _env() -> dict[str, str]:
+    env = dict(os.environ, PYTHONPATH=str(ROOT), OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1",
+               MKL_NUM_THREADS="1", MPLBACKEND="Agg")
+    return env
+
+
+def _command(args: list[str], cpu: list[float]):
+    """A callable running ``python args`` from the repository root; appends its CPU time [s]."""
+    def run() -> None:
+        before = resource.getrusage(resource.RUSAGE_CHILDREN)
+        subprocess.run([sys.executable, *args], cwd=ROOT, env=_env(), check=True,
+                       stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        after = resource.getrusage(resource.RUSAGE_CHILDREN)
+        cpu.append(after.ru_utime + after.ru_stime - before.ru_utime - before.ru_stime)
+    return run
+
+
+def run() -> list[dict]:
+    rows = []
+    with tempfile.TemporaryDirectory(prefix="bench_cli.") as out:
+        cpu: dict[str, list[float]] = {k: [] for k in ("numpy", "version", "list", "run", "run_nofig")}
+        cmds = {
+            "numpy": _command(["-c", "import numpy"], cpu["numpy"]),
+            "version": _command(["-m", "testbed.cli", "--version"], cpu["version"]),
+            "list": _command(["-m", "testbed.cli", "list"], cpu["list"]),
+            "run": _command(["-m", "testbed.cli", "run", SCENARIO, "--out", out], cpu["run"]),
+            "run_nofig": _command(["-m", "testbed.cli", "run", SCENARIO, "--out", out, "--no-figures"],
+                                  cpu["run_nofig"]),
+        }
+        # the warm-up round generates the dataset if the cache lacks it and loads numba's cache
+        t = interleaved(cmds, REPEATS)
+    c = {k: np.asarray(v[-REPEATS:]) for k, v in cpu.items()}  # without the warm-up round
+    for k in ("version", "list"):
+        ratio, rs = ratio_spread(t[k], t["numpy"])
+        med = float(np.median(t[k]))
+        rows.append({"name": f"testbed {'--version' if k == 'version' else k} start-up", "value": med,
+                     "unit": "s", "target": f"< {TARGET_START_S}", "ok": med < TARGET_START_S,
+                     "note": f"whole process, wall {spread(t[k])} s, CPU {spread(c[k])} s; "
+                             f"/ `python -c 'import numpy'` (wall {spread(t['numpy'])} s): "
+                             f"{ratio:.2f}x, {rs}"})
+    med = float(np.median(t["run"]))
+    r_nofig, rs_nofig = ratio_spread(t["run"], t["run_nofig"])
+    r_np, _ = ratio_spread(t["run"], t["numpy"])
+    rows.append({"name": f"testbed run {SCENARIO} (warm cache, figures)", "value": med, "unit": "s",
+                 "target": f"< {TARGET_RUN_S}", "ok": med < TARGET_RUN_S,
+                 "note": f"whole process, wall {spread(t['run'])} s, CPU {spread(c['run'])} s; "
+                         f"without figures wall {spread(t['run_nofig'])} s, CPU "
+                         f"{spread(c['run_nofig'])} s; {r_np:.1f}x the numpy start-up; {machine()}"})
+    rows.append({"name": f"testbed run {SCENARIO}: with / without figures", "value": r_nofig, "unit": "x",
+                 "target": "report", "ok": None,
+                 "note": f"what the six figures cost, same run, interleaved; {rs_nofig}"})
+    return rows
+
+
+if __name__ == "__main__":
+    for r in run():
+        mark = {True: "ok", False: "MISSED", None: "-"}[r["ok"]]
+        print(f"{r['name']}: {r['value']:.4g} {r['unit']}  target {r['target']}  [{mark}]  {r['note']}")
