@@ -53,8 +53,8 @@ class LeastSquaresSINDy(StructuralIdentifier):
         Relative singular-value cut-off of the least-squares solve (``numpy.linalg.lstsq``)
         on column-standardised features.
     fit_band_hz : float or None
-        Cut-off [Hz] of a zero-phase high-pass applied alike to every signal before the fit
-        (:func:`identify.structural.fit_band`); None = by rule,
+        Cut-off [Hz] of a zero-phase high-pass applied alike to every feature and target of
+        the regression (:func:`identify.structural.fit_band`); None = by rule,
         :data:`~identify.structural.FIT_BAND_FRACTION` x the lowest measured peak; 0 = none.
 
     Attributes
@@ -130,9 +130,10 @@ class LeastSquaresSINDy(StructuralIdentifier):
         """
         self.check_params()
         m_hat = mass_prior_value(data, self.mass_prior)
-        data, self.fit_band_hz_, self.fit_band_rule_ = fit_band(data, self.fit_band_hz)
-        lib = build_library(data, coupled_mass=False, cubic=bool(self.cubic), drift=True,
-                            input_coupling=True)
+
+        lib, self.fit_band_hz_, self.fit_band_rule_ = fit_band(
+            data, lambda s: build_library(data, coupled_mass=False, cubic=bool(self.cubic), start=s,
+                                          drift=True, input_coupling=True), self.fit_band_hz)
         n, p = lib.target.shape[0], lib.theta.shape[0]
         coef = solve_rows(lib, self.rcond)
         masses = np.full(n, m_hat / n)

@@ -23,6 +23,7 @@ identifiers their common ``simulate``/``equations``/modal attributes.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -143,34 +144,40 @@ def build_library(data: Measurement, *, coupled_mass: bool, cubic: bool, start: 
     return Library(np.vstack(rows), xdd, np.hstack(mask_blocks), names, blocks)
 
 
-#: The fit-band high-pass, as a fraction of the lowest measured natural frequency: below mode 1
-#: a structure's response has nothing to fit, while twice-integrated sensor noise (and what is
-#: left of the chain's integration constants) piles up there in the displacements and, as
-#: noise in a regressor, pulls every stiffness toward zero, the weakly excited modes most.
-#: Measured on the beams family at 1 % noise (ls_sindy, mode-2 frequency error on four
-#: members): 0.32-0.84 with the chain's 10 Hz high-pass only, 0.07-0.24 at 0.5 x f1, 0.04-0.12 at
-#: 0.7 x f1.  0.7 keeps mode 1 inside the pass band (its edge is the cut-off) with a 1.4x margin
-#: for a mode whose peak moves with amplitude (the soft base's hardening: 5 %).
+#: The fit-band high-pass (:func:`fit_band`), as a fraction of the lowest measured natural
+#: frequency.  Below mode 1 a structure's response has nothing to fit, while twice-integrated
+#: sensor noise (and what is left of the chain's integration constants) piles up there in the
+#: displacements and, as noise in a regressor, pulls every stiffness toward zero, the weakly
+#: excited modes most.  Measured on the beams family at 1 % noise (ls_sindy, mode-2 frequency
+#: error on four members): 0.32-0.84 with the chain's 10 Hz high-pass only, 0.07-0.24 at
+#: 0.5 x f1, 0.04-0.12 at 0.7 x f1.  0.7 keeps mode 1 inside the pass band (its edge is the
+#: cut-off) with a 1.4x margin for a mode whose peak moves with amplitude (the soft base's
+#: hardening: 5 %).
 FIT_BAND_FRACTION = 0.7
 #: Order of the fit-band elliptic high-pass (the chain's design: 0.1 dB ripple, 30 dB stop band).
 FIT_BAND_ORDER = 5
 #: The structural identifiers' ``fit_band_hz`` hyperparameter (see :func:`fit_band`).
 FIT_BAND_FIELD = Field(float, None, unit="Hz", min=0.0,
-                       doc="high-pass applied to every signal before the fit; default by rule: "
-                           "0.7 x the lowest measured peak; 0 = none")
+                       doc="high-pass applied to every feature and target of the fit; default "
+                           "by rule: 0.7 x the lowest measured peak; 0 = none")
 
 
-def fit_band(data: Measurement, cutoff_hz: float | None = None
-             ) -> tuple[Measurement, float, str]:
-    """The measurement restricted to the band of its modes: one zero-phase high-pass on all signals.
+def fit_band(data: Measurement, build: Callable[[int], Library], cutoff_hz: float | None = None
+             ) -> tuple[Library, float, str]:
+    """A library restricted to the band of the modes: one zero-phase high-pass on every row.
 
-    The same linear, time-invariant filter on ``x``, ``xd``, ``xdd``, ``u`` and the drift rows, so
-    every equation that held between them still holds (as in the chain,
-    :func:`testbed.numerics.filters.integrate_acceleration`).
+    The filter acts on the library's features and targets (built over the whole record, then
+    cut to the fit window), not on the signals: an equation ``x'' = sum_k xi_k theta_k`` that
+    holds sample by sample still holds for the filtered rows (the filter is linear and
+    time-invariant), whatever the features are (``x^3`` too, which a filter on ``x`` would
+    break).
 
     Parameters
     ----------
     data : Measurement
+    build : callable
+        ``build(start)``: the identifier's library from sample ``start`` on
+        (e.g. ``lambda s: build_library(data, ..., start=s)``).
     cutoff_hz : float, optional
         A user's cut-off [Hz] (0 = no filter).  Default: the rule,
         :data:`FIT_BAND_FRACTION` x the lowest peak of :func:`modal_peaks`; no filter when no
@@ -178,32 +185,33 @@ def fit_band(data: Measurement, cutoff_hz: float | None = None
 
     Returns
     -------
-    data : Measurement
-        Filtered (``data`` itself when no filter applies).
+    lib : Library
+        On the fit window ``data.free_start:``.
     cutoff_hz : float
         The cut-off used [Hz]; 0 for none.
     rule : str
         Which rule chose it, for the fitted model's ``fit_band_rule_``.
     """
+    s = int(data.free_start)
     if cutoff_hz is not None:
         fc, rule = float(cutoff_hz), f"fit_band_hz = {float(cutoff_hz):g} Hz (user setting)"
     else:
         peaks = modal_peaks(data).peaks
         if peaks.size == 0:
-            return data, 0.0, "no measured peak: the chain's band as it is"
+            return build(s), 0.0, "no measured peak: the chain's band as it is"
         fc = FIT_BAND_FRACTION * float(peaks.min())
         rule = f"{FIT_BAND_FRACTION:g} x the lowest measured peak ({peaks.min():.4g} Hz)"
         chain_hp = 0.0 if data.passband is None else float(data.passband[0])
         if not fc > chain_hp:
-            return data, 0.0, rule + f": not above the chain's high-pass ({chain_hp:g} Hz), none added"
+            return build(s), 0.0, rule + f": not above the chain's high-pass ({chain_hp:g} Hz), none added"
     if fc <= 0:
-        return data, 0.0, rule
-    def hp(z: np.ndarray | None) -> np.ndarray | None:
-        return None if z is None else elliptic_highpass(z, data.fs, fc, FIT_BAND_ORDER)
+        return build(s), 0.0, rule
+    full = build(0)
 
-    band = (fc, data.passband[1]) if data.passband is not None else (fc, data.fs / 2.0)
-    return (replace(data, x=hp(data.x), xd=hp(data.xd), xdd=hp(data.xdd), u=hp(data.u),
-                    drift_basis=hp(data.drift_basis), passband=band), fc, rule)
+    def hp(z: np.ndarray) -> np.ndarray:
+        return elliptic_highpass(z, data.fs, fc, FIT_BAND_ORDER)[:, s:]
+
+    return Library(hp(full.theta), hp(full.target), full.mask, full.names, full.blocks), fc, rule
 
 
 def solve_rows(lib: Library, rcond: float | None = None) -> np.ndarray:

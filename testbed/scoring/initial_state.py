@@ -95,12 +95,15 @@ def fit_initial_state(simulate: Callable[[np.ndarray, np.ndarray], Trajectory], 
                     jac[:, k] = ((getattr(simulate(*np.split(z + dz, 2)), field) - y0) / dz[k]).ravel()
                 if not np.all(np.isfinite(jac)):
                     break
-                step, *_ = np.linalg.lstsq(jac, (ref - y0).ravel(), rcond=None)
+                r0 = (ref - y0).ravel()
+                step, *_ = np.linalg.lstsq(jac, r0, rcond=None)
+                predicted = float(np.sum((r0 - jac @ step) ** 2))
                 trial = simulate(*np.split(z + step, 2))
                 new = _cost(trial, field, ref)
                 if not new < cost:
                     break
-                done = cost - new < RTOL * cost
+                # an affine response (a linear model) lands where the linearisation said: done
+                done = cost - new < RTOL * cost or abs(new - predicted) <= RTOL * cost
                 z, base, cost = z + step, trial, new
                 if done:
                     break
