@@ -24,7 +24,7 @@ inputs), picked by :func:`identify._implicit.select_passive_models` among the mo
 its acceleration.  Pruning is off there: the passive equations ARE exact input-free
 dependencies among the columns.  The model is simulated by solving the n x n system for every
 acceleration at each state.  Measured on ``scenarios/cartpole.toml``: exact (raw coefficients
-to 6e-15, rollout 3e-11 over 10 s); at 1 % noise the rollout RMSE is 0.009-0.012 over three
+to 6e-15, rollout 3e-11 over 10 s); at 1 % noise the rollout RMSE is 0.008-0.012 over five
 seeds with dense equations (``cartpole_noise1.toml``).
 
 Simulation: the equations are solved for the actuated accelerations; passive coordinates of a
