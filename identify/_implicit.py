@@ -227,6 +227,25 @@ def stlsq_sweep(G_train: np.ndarray, G_val: np.ndarray, candidates: Sequence[int
                  train_error=_errors(W, Gn, cand), nnz=np.count_nonzero(W, axis=2))
 
 
+def merge_sweeps(full: Sweep, part: Sweep, cols: np.ndarray) -> Sweep:
+    """One sweep holding the models of ``full`` and then those of ``part``.
+
+    ``part`` was run on the columns ``cols`` (indices into ``full``'s columns) of the same
+    Gram matrices with the same thresholds (e.g. the input-free columns, for the equations of
+    passive coordinates); its models are embedded with zeros on the other columns, its
+    candidates renumbered to ``full``'s columns.
+    """
+    if not np.array_equal(full.thresholds, part.thresholds):
+        raise ValueError("sweeps with different thresholds cannot be merged")
+    cols = np.asarray(cols, dtype=np.intp)
+    W = np.zeros(part.W.shape[:2] + full.W.shape[2:])
+    W[..., cols] = part.W
+    cat = lambda a, b: np.concatenate([a, b], axis=1)  # noqa: E731 - along the candidates
+    return Sweep(scale=full.scale, candidates=np.concatenate([full.candidates, cols[part.candidates]]),
+                 thresholds=full.thresholds, W=np.concatenate([full.W, W], axis=1),
+                 val_error=cat(full.val_error, part.val_error),
+                 train_error=cat(full.train_error, part.train_error), nnz=cat(full.nnz, part.nnz))
+
 def input_shares(W: np.ndarray, input_cols: Sequence[np.ndarray]) -> np.ndarray:
     """Largest |normalised coefficient| of each input's terms, shape (n_inputs,) + W.shape[:-1]."""
     return np.stack([np.abs(W[..., c]).max(axis=-1) if c.size else np.zeros(W.shape[:-1])
@@ -325,6 +344,71 @@ def select_models(sw: Sweep, input_cols: Sequence[np.ndarray], rtol: float = 0.1
         out.append(picked)
     return out
 
+
+
+def select_passive_models(sw: Sweep, input_cols: Sequence[np.ndarray],
+                          acc_cols: Sequence[np.ndarray], rtol: float = 0.1, atol: float = 1e-12,
+                          top: int = 1, labels: Sequence[str] | None = None
+                          ) -> list[list[tuple[int, int]]]:
+    """Pick the implicit equation of each passive coordinate of an open (underactuated) chain.
+
+    A passive coordinate is driven by no input, so its equation of motion holds without any
+    input term.  Models eligible for passive coordinate p carry no input term at all and a
+    nonzero coefficient on a term with p's acceleration (``acc_cols[p]``), so the equation can
+    be solved for it; they are ranked by :func:`rank_models` (held-out error, then
+    parsimony).  The first choice of an earlier passive coordinate is not offered again (two
+    copies of one equation would leave the accelerations undetermined).
+
+    Parameters
+    ----------
+    sw : Sweep
+    input_cols : sequence of ndarray of int
+        Library columns carrying each input.
+    acc_cols : sequence of ndarray of int
+        Per passive coordinate, the library columns holding its acceleration.
+    rtol, atol : float
+        As in :func:`select_models`.
+    top : int
+        Number of models returned per passive coordinate (distinct supports, best first).
+    labels : sequence of str, optional
+        Names of the passive coordinates for messages (default their positions, from 1).
+
+    Returns
+    -------
+    list (one per passive coordinate) of list of (threshold index, candidate index)
+
+    Raises
+    ------
+    IdentificationError
+        No eligible model for a passive coordinate.
+    """
+    free = np.ones(sw.W.shape[:-1], dtype=bool)
+    if len(input_cols):
+        free = ~(input_shares(sw.W, input_cols) > 0).any(axis=0)
+    taken: set[bytes] = set()
+    out = []
+    for p, cols in enumerate(acc_cols):
+        has_acc = (sw.W[..., cols] != 0).any(axis=-1) if cols.size else np.zeros_like(free)
+        order = rank_models(sw, free & has_acc, rtol, atol)
+        picked: list[tuple[int, int]] = []
+        seen: set[bytes] = set()
+        for flat in order:
+            t, c = np.unravel_index(flat, sw.val_error.shape)
+            key = np.flatnonzero(sw.W[t, c]).tobytes()
+            if key in seen or (not picked and key in taken):
+                continue
+            seen.add(key)
+            picked.append((int(t), int(c)))
+            if len(picked) == top:
+                break
+        if not picked:
+            name = labels[p] if labels is not None else str(p + 1)
+            raise IdentificationError(
+                f"no input-free implicit model contains the acceleration of passive coordinate "
+                f"{name} of the open chain: the library (or lhs) lacks its equation's terms")
+        taken.add(np.flatnonzero(sw.W[picked[0]]).tobytes())
+        out.append(picked)
+    return out
 
 @dataclass
 class Ensemble:

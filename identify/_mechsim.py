@@ -1,7 +1,9 @@
 """Simulating identified implicit mechanical equations, with a planar loop closure.
 
-The identified equations (one per actuated coordinate) are linear in the accelerations:
-``A(q, dq) ddq + f(q, dq, u) = 0`` (n_eq x n).  A closed chain adds the loop closure
+The identified equations (one per solved coordinate: each actuated one and, in an open
+underactuated chain such as a cart-pole, each passive one with its input-free equation) are
+linear in the accelerations: ``A(q, dq) ddq + f(q, dq, u) = 0`` (n_eq x n); without a closure
+the n x n system is solved for every acceleration at each state.  A closed chain adds the loop closure
 ``sum_i a_i e(th_i) = b`` with ``e(th) = (cos th, sin th)``: its second derivative
 ``sum_i a_i (n_i ddth_i - e_i dth_i^2) = 0`` (``n = (-sin, cos)``) gives the passive
 accelerations from the actuated ones, ``ddq_p = P ddq_a + r``, and the equations reduce to
@@ -183,11 +185,13 @@ class ImplicitModel:
     library : Library
         The terms used by ``coef`` (columns of coef).
     coef : ndarray, shape (n_eq, n_terms)
-        One implicit equation per actuated coordinate.
+        One implicit equation per solved coordinate.
     actuated : ndarray of int, shape (n_eq,)
-        Coordinates whose accelerations the equations are solved for.
+        Coordinates whose accelerations the equations are solved for: the actuated ones, plus
+        the passive ones of an open chain (their input-free equations; then every coordinate
+        is solved, ``n_eq = n``, and no closure is needed).
     closure : LoopClosure or None
-        Required when there are coordinates that are not actuated.
+        Required when some coordinates are not solved for (a closed chain's passive ones).
     """
 
     def __init__(self, library: Library, coef: np.ndarray, actuated: np.ndarray,
@@ -200,11 +204,11 @@ class ImplicitModel:
         n = library.n_coords
         rest = np.setdiff1d(np.arange(n), self.actuated)
         if closure is None and rest.size:
-            raise IdentificationError(f"coordinates {rest.tolist()} are neither actuated nor "
+            raise IdentificationError(f"coordinates {rest.tolist()} are neither solved for nor "
                                       "given by a loop closure: the model cannot be simulated")
         if self.coef.shape[0] != self.actuated.size:
             raise IdentificationError(f"{self.coef.shape[0]} equations for "
-                                      f"{self.actuated.size} actuated coordinates")
+                                      f"{self.actuated.size} solved coordinates")
 
     def _args(self) -> tuple:
         """The model as the compiled kernels take it (after ``coef``: library tables, closure)."""
