@@ -581,9 +581,11 @@ def _gen_eigh(K, M):
 
 @njit(**_JIT)
 def eig_loss_grad(L, P, m0, k0, lam_hat, eL, eP):
-    """Eigenvalue penalty ``sum_k ((lam_hat_k - lam_k) / lam_hat_k)^2`` over the lowest
-    generalised eigenvalues of ``(K, M)`` and its exact first-order gradient (with the
+    """Eigenvalue penalty ``sum_k ((lam_hat_k - lam_k) / lam_hat_k)^2`` over the generalised
+    eigenvalues of ``(K, M)`` in ascending order and its exact first-order gradient (with the
     mass-normalised modes u: ``d lam = u^T (dK - lam dM) u``), chained to L and P (in place).
+    ``lam_hat[k]`` is the target of the k-th lowest mode; a target <= 0 means "none" (the
+    mode is left to the data).
     """
     n = L.shape[0]
     nk = lam_hat.size
@@ -601,6 +603,8 @@ def eig_loss_grad(L, P, m0, k0, lam_hat, eL, eP):
     gK = np.zeros((n, n))
     gM = np.zeros((n, n))
     for k in range(nk):
+        if not lam_hat[k] > 0.0:
+            continue
         r = (lam_hat[k] - lam[k]) / lam_hat[k]
         loss += r * r
         a, bb = -2.0 * r / lam_hat[k], 2.0 * r * lam[k] / lam_hat[k]

@@ -97,8 +97,16 @@ from dataclasses import dataclass
 from typing import Any, Literal
 
 import numpy as np
+from scipy import linalg
+from scipy.optimize import linear_sum_assignment
 
+from identify.structural import MODE_SEPARATION
 from testbed.core.measurement import Measurement
+
+#: Relative singular-value cut-off of the nuisance columns' basis (:func:`nuisance_basis`):
+#: the drift rows and the force are independent waveforms, so only an exactly repeated column
+#: (two inputs driven alike) falls below it; 1e-10 is the least-squares cut-off ls_sindy uses.
+NUISANCE_RCOND = 1e-10
 
 
 def _rms(a: np.ndarray, axis: int = 1) -> np.ndarray:
@@ -144,6 +152,105 @@ def cubic_profile(xdd: np.ndarray, xd: np.ndarray, x: np.ndarray, x3: np.ndarray
     Er, Zr = Y - Q @ (Q.T @ Y), Z - Q @ (Q.T @ Z)
     return {"s_lin": s_lin, "s_a": s_a, "s3": s3, "F": F, "Q": Q, "Y": Y, "Z": Z,
             "Er": Er, "Zr": Zr, "rho": _rms(Er, 0), "sigma": _rms(Zr, 0)}
+
+
+def nuisance_basis(data: Measurement, i0: int, i1: int) -> tuple[np.ndarray, np.ndarray]:
+    """The columns every row of the model carries with a free coefficient, on samples ``[i0, i1)``.
+
+    They are the measured inputs ``u`` (when nonzero in the window) and the rows of
+    ``data.drift_basis`` (the chain's unknown integration constants), as in ``ls_sindy``
+    (``build_library(..., drift=True, input_coupling=True)``): the force's coefficients are
+    ``M B`` in full (they also absorb the residual flexibility of the unmodelled modes under
+    the chain-filtered force tail), the drift's are the offsets, then dropped.
+
+    Returns
+    -------
+    W : ndarray, shape (N, p)
+        The columns (inputs first), ``p = 0`` when there are none.
+    inputs : ndarray of int
+        Which inputs (rows of ``data.u``) are the first ``inputs.size`` columns.
+    """
+    cols, inputs = [], np.zeros(0, dtype=int)
+    if data.u is not None and data.input_map is not None:
+        u = np.asarray(data.u, dtype=float)[:, i0:i1]
+        inputs = np.flatnonzero(np.any(u != 0.0, axis=1))
+        cols.append(u[inputs])
+    if data.drift_basis is not None:
+        cols.append(np.asarray(data.drift_basis, dtype=float)[:, i0:i1])
+    if not cols:
+        return np.zeros((i1 - i0, 0)), inputs
+    return np.ascontiguousarray(np.vstack(cols).T), inputs
+
+
+def project_out(W: np.ndarray, *signals: np.ndarray) -> list[np.ndarray]:
+    """Each signal (n, N) minus its least-squares fit on the columns of ``W`` (N, p).
+
+    Minimising a row's residual ``(M x'' + C x' + K x + K3 x^3)_i - g_i W^T`` over the free
+    ``g_i`` is the same as fitting the model to the signals with the span of ``W`` removed
+    (Frisch-Waugh-Lovell), so the SGD runs on these and never sees ``g``.
+    """
+    if W.shape[1] == 0:
+        return list(signals)
+    U, sv, _ = np.linalg.svd(W / _rms(W, 0)[None, :], full_matrices=False)
+    Qw = U[:, sv > NUISANCE_RCOND * sv[0]]
+    return [s - (s @ Qw) @ Qw.T for s in signals]
+
+
+def eigen_targets(M: np.ndarray, K: np.ndarray, lam_hat: np.ndarray) -> np.ndarray:
+    """The measured eigenvalue each mode of ``(K, M)`` is held at, by rule.
+
+    Modes (ascending) and measured eigenvalues are paired by least total
+    ``|log(f / f_hat)|``; a pair counts only if the frequencies are within
+    :data:`identify.structural.MODE_SEPARATION` (15 %) of each other, the distance within
+    which the peak search itself calls two peaks one mode.  A measured peak farther than that
+    from every mode of the least-squares fit is not a mode that fit sees (a spurious or
+    mis-assigned peak), and a mode with no peak near it is left to the data.
+
+    Returns
+    -------
+    ndarray, shape (n,)
+        Target ``(2 pi f)^2`` [rad^2/s^2] of the k-th lowest mode; 0 = none.
+    """
+    n = M.shape[0]
+    target = np.zeros(n)
+    if lam_hat.size == 0:
+        return target
+    lam = linalg.eigh(_sym(K), _sym(M), eigvals_only=True)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        cost = 0.5 * np.abs(np.log(np.maximum(lam, 1e-300)[:, None] / lam_hat[None, :]))
+    rows, cols = linear_sum_assignment(cost)
+    for r, c in zip(rows, cols, strict=True):
+        if cost[r, c] <= np.log1p(MODE_SEPARATION):
+            target[r] = lam_hat[c]
+    return target
+
+
+def hold_eigenvalues(L: np.ndarray, P: np.ndarray, m0: float, k0: float, target: np.ndarray) -> float:
+    """Move the targeted eigenvalues of ``(K, M)`` onto their targets, in place on ``P``.
+
+    With ``U`` the mass-normalised modes (``U^T M U = I``, ascending eigenvalues ``lam``),
+    ``K + (M U) diag(target - lam) (M U)^T`` has the same modes and exactly the target
+    eigenvalues on the targeted modes (the others unchanged): the smallest change of K in
+    the modal metric that satisfies the eigenvalue constraints, i.e. the limit of the
+    eigenvalue penalty (Eqs 8-13) at infinite weight.  K stays symmetric, and positive
+    semi-definite when it was (targets are positive).
+
+    Returns
+    -------
+    float
+        The largest relative frequency change ``|sqrt(target / lam) - 1|`` made.
+    """
+    if not np.any(target > 0):
+        return 0.0
+    M, K = m0 * (L @ L.T), k0 * _sym(P)
+    lam, U = linalg.eigh(K, _sym(M))
+    on = target > 0
+    d = np.where(on, target - lam, 0.0)
+    MU = M @ U
+    P[...] = _sym(K + (MU * d) @ MU.T) / k0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        rel = np.abs(np.sqrt(target[on] / np.maximum(lam[on], 1e-300)) - 1.0)
+    return float(rel.max())
 
 
 def warm_start(xdd: np.ndarray, xd: np.ndarray, x: np.ndarray, x3: np.ndarray | None,
@@ -237,6 +344,9 @@ class MatrixSGDSettings:
         Mini-batch steps or the exact full-window gradient.
     iterate_average : float
         Fraction of the epochs, at the end, whose iterates are averaged, in [0, 1).
+    eigen_hold : bool
+        Hold the paired measured eigenvalues exactly (:func:`hold_eigenvalues`) after the warm
+        start and every epoch; only with measured targets.
     """
 
     epochs: int
@@ -257,6 +367,7 @@ class MatrixSGDSettings:
     fit_duration: float
     gradient: Literal["minibatch", "full"]
     iterate_average: float
+    eigen_hold: bool = True
 
     def __post_init__(self) -> None:
         for key, allowed in (("init", ("lstsq", "zeros")), ("gradient", ("minibatch", "full"))):
@@ -290,6 +401,17 @@ class MatrixSGDResult:
         onto the positive semi-definite cone; absent if none was needed.
     history : dict of str to ndarray
         Per-epoch records (:class:`identify.sgd_sindy.SGDSINDy`, ``history_``).
+    input_map : ndarray, shape (n, n_inputs) or None
+        Force per unit input on each coordinate [-]: identified (free in every row) for the
+        inputs nonzero in the window (:func:`nuisance_basis`), ``data.input_map``'s column
+        for the others; None without ``data.input_map``.
+    drift_coef : ndarray, shape (n, n_drift)
+        Coefficients [N / unit of the basis] of ``data.drift_basis``'s rows, dropped from the
+        model.
+    eigen_targets : ndarray, shape (n,) or (0,)
+        Frequency [Hz] each mode (ascending) was held at (:func:`eigen_targets`); 0 = none.
+    eigen_shift : float
+        Largest relative frequency change a hold made (0 without holding).
     """
 
     M: np.ndarray
@@ -300,6 +422,10 @@ class MatrixSGDResult:
     alphas: dict[str, float]
     guard: dict[str, float]
     history: dict[str, np.ndarray]
+    input_map: np.ndarray | None
+    drift_coef: np.ndarray
+    eigen_targets: np.ndarray
+    eigen_shift: float
 
 
 def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
@@ -325,13 +451,18 @@ def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
     i0 = int(data.free_start)
     i1 = data.n_samples if not est.fit_duration else min(data.n_samples,
                                                           i0 + round(est.fit_duration * data.fs))
-    xdd, xd, x = data.xdd[:, i0:i1], data.xd[:, i0:i1], data.x[:, i0:i1]
-    n, N = x.shape
-    x3 = x**3 if est.cubic else None
-    if data.u is not None and data.input_map is not None:
-        bu = np.asarray(data.input_map, dtype=float) @ data.u[:, i0:i1]
-    else:
-        bu = np.zeros_like(x)
+    raw = [np.asarray(a, dtype=float)[:, i0:i1] for a in (data.xdd, data.xd, data.x)]
+    if est.cubic:
+        raw.append(raw[2] ** 3)
+    n, N = raw[0].shape
+    # the force (every row, M B in full) and the chain's integration constants enter with free
+    # coefficients: profiled out of every feature (project_out), recovered after the fit
+    W, inputs = nuisance_basis(data, i0, i1)
+    n_u = inputs.size
+    sig = project_out(W, *raw)
+    xdd, xd, x = sig[:3]
+    x3 = sig[3] if est.cubic else None
+    bu = np.zeros_like(x)  # the force is in W
     l1_on = est.cubic and est.l1
     pr = cubic_profile(xdd, xd, x, x3) if est.cubic else None
     M0, C0, K0, K30 = warm_start(xdd, xd, x, x3, m_hat, float(est.l1_threshold) if l1_on else 0.0,
@@ -368,10 +499,13 @@ def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
     R = np.ascontiguousarray(R) if has_R else np.zeros((n, n))
     sc3 = np.broadcast_to(sc3, (n, n)).astype(float) if has_R else np.zeros((n, n))
     s_a = np.ascontiguousarray(s_a)
-    lam_hat = np.ascontiguousarray(lam_hat, dtype=float)
     cc.project(L, P, Q, R, m0, m_hat)
+    # the target of each mode (ascending; 0 = none), paired once at the start (eigen_targets)
+    target = eigen_targets(m0 * (L @ L.T), k0 * _sym(P), np.asarray(lam_hat, dtype=float))
+    lam_hat = np.ascontiguousarray(target)
+    hold = bool(est.eigen_hold) and bool(np.any(target > 0))
     adam = (np.zeros((4, n, n)), np.zeros((4, n, n)), np.zeros((4, n, n)))  # m, v, step size
-    use_eig, use_l1 = lam_hat.size > 0, has_R and l1_on
+    use_eig, use_l1 = bool(np.any(target > 0)), has_R and l1_on
     lam_l1 = np.broadcast_to(lam_l1, (n, n)).astype(float)
     alpha = {"sym": float(est.alpha_init), "eig": float(est.alpha_init),
              "l1": float(np.max(lam_l1)) if use_l1 else 0.0}
@@ -417,6 +551,12 @@ def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
     clipped = _project_psd(P)
     if clipped < 0:
         guard["K"] = clipped
+    # The measured frequencies are held, not only pulled toward: the annealed penalty with its
+    # weight capped at alpha_max let the data loss walk mode 2 of 2-sensor beams 10-60 % off
+    # a correctly measured peak (beams family, measured).  Targets paired once, at the warm
+    # start (eigen_targets); after the warm start and after every epoch the targeted
+    # eigenvalues are moved onto them (hold_eigenvalues), and again on the averaged result.
+    held = hold_eigenvalues(L, P, m0, k0, target) if hold else 0.0
     record(0, 0)
     n_steps = 0
     no_support = np.zeros((n, n))
@@ -446,10 +586,9 @@ def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
         if use_l1 and epoch == l1_epochs and epoch < int(est.epochs):  # L1 item 6: debias
             support = (R != 0).astype(float)
             alpha["l1"] = 0.0
-        if avg_from is not None and epoch >= avg_from:
-            for a_, v_ in zip(acc, (L @ L.T, P, Q, R), strict=True):
-                a_ += v_
-            n_acc += 1
+        # history and annealing see the epoch's end before the hold (after it the eigenvalue
+        # residual is 0 and Eq. 17 would have nothing to measure): loss_eig is how far the
+        # epoch's steps moved the held frequencies
         g_data = record(epoch, n_steps)
         if est.anneal:  # Eqs 17-18, capped
             gmax = float(np.max(np.abs(g_data)))
@@ -458,14 +597,31 @@ def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
                 if ge.mean() > 0:
                     hat = gmax / ge.mean()
                     alpha["eig"] = min((1 - est.beta) * alpha["eig"] + est.beta * hat, float(est.alpha_max))
+        if hold:
+            held = max(held, hold_eigenvalues(L, P, m0, k0, target))
+        if avg_from is not None and epoch >= avg_from:
+            for a_, v_ in zip(acc, (L @ L.T, P, Q, R), strict=True):
+                a_ += v_
+            n_acc += 1
     if n_acc:
         LLt, P, Q, R = (a_ / n_acc for a_ in acc)
         L = np.linalg.cholesky(_sym(LLt))
+        if hold:  # the average of held iterates is held only to first order
+            hold_eigenvalues(L, P, m0, k0, target)
     clipped = _project_psd(Q)  # C: projected once, at the end (see above)
     if clipped < 0:
         guard["C"] = min(guard.get("C", 0.0), clipped)
     M = m0 * (L @ L.T)
     C, K = c0 * _sym(Q), k0 * _sym(P)
     K3 = sc3 * R if has_R else None
+    # the free coefficients of the nuisance columns, from the unprojected residual
+    resid = M @ raw[0] + C @ raw[1] + K @ raw[2] + (K3 @ raw[3] if K3 is not None else 0.0)
+    G = (np.linalg.lstsq(W / _rms(W, 0)[None, :], resid.T, rcond=NUISANCE_RCOND)[0]
+         / _rms(W, 0)[:, None]).T if W.shape[1] else np.zeros((n, 0))
+    input_map = None if data.input_map is None else np.array(data.input_map, dtype=float)
+    if input_map is not None:
+        input_map[:, inputs] = G[:, :n_u]
     return MatrixSGDResult(M=_sym(M), C=C, K=K, K3=K3, n_steps=n_steps, alphas=alpha, guard=guard,
-                           history={k: np.asarray(v) for k, v in hist.items()})
+                           history={k: np.asarray(v) for k, v in hist.items()},
+                           input_map=input_map, drift_coef=G[:, n_u:],
+                           eigen_targets=np.sqrt(target) / (2.0 * np.pi), eigen_shift=held)

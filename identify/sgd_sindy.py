@@ -346,6 +346,8 @@ class SGDSINDy(SGDSINDyBase):
         "iterate_average": Field(float, 0.25, min=0.0, max=1.0, max_inclusive=False,
                                  doc="fraction of the epochs, at the end, whose iterates are "
                                      "averaged; 0 = the last iterate"),
+        "eigen_hold": Field(bool, True, doc="hold the identified frequencies exactly at the "
+                                            "measured peaks they pair with (needs eigen)"),
     }
 
     @classmethod
@@ -365,7 +367,7 @@ class SGDSINDy(SGDSINDyBase):
                  mass_prior: str = "reduced_mass_trace", anneal: bool = True,
                  alpha_max: float = 1.0, random_state: int = 0, fit_duration: float = 0.0,
                  l1_threshold: float = 0.2, l1_debias: float = 0.5, gradient: str = "minibatch",
-                 iterate_average: float = 0.25):
+                 iterate_average: float = 0.25, eigen_hold: bool = True):
         self.epochs = epochs
         self.batch_size = batch_size
         self.learning_rate = learning_rate
@@ -388,6 +390,7 @@ class SGDSINDy(SGDSINDyBase):
         self.l1_debias = l1_debias
         self.gradient = gradient
         self.iterate_average = iterate_average
+        self.eigen_hold = eigen_hold
 
     def settings(self) -> MatrixSGDSettings:
         """The hyperparameters :func:`identify._sgd_matrix.fit_matrix_sgd` runs with, the step
@@ -402,7 +405,8 @@ class SGDSINDy(SGDSINDyBase):
             steps_per_epoch=None if self.steps_per_epoch is None else int(self.steps_per_epoch),
             init=str(self.init), anneal=bool(self.anneal), alpha_max=float(self.alpha_max),
             random_state=int(self.random_state), fit_duration=float(self.fit_duration),
-            gradient=str(self.gradient), iterate_average=float(self.iterate_average))
+            gradient=str(self.gradient), iterate_average=float(self.iterate_average),
+            eigen_hold=bool(self.eigen_hold))
 
     def fit(self, data: Measurement) -> SGDSINDy:
         """Fit on ``data``: signals, sample rate and the mass prior only.
@@ -433,7 +437,10 @@ class SGDSINDy(SGDSINDyBase):
         self.channels_ = tuple(data.channels)
         self.masses_ = np.diag(M).copy()
         self.M_, self.C_, self.K_, self.K3_ = M, C, K, K3
-        self.input_map_ = None if data.input_map is None else np.asarray(data.input_map, dtype=float)
+        self.input_map_ = out.input_map
+        if out.drift_coef.size:
+            self.drift_coef_ = out.drift_coef
+        self.eigen_targets_, self.eigen_shift_ = out.eigen_targets, out.eigen_shift
         self.alphas_ = out.alphas
         self.history_ = out.history
         self.n_steps_ = out.n_steps

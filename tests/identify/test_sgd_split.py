@@ -53,6 +53,7 @@ MATRIX_CASES = {
     "l1_debias": ({"cubic": True, "data": "duffing"}, 0.0),
     "gradient": ({}, "full"),
     "iterate_average": ({}, 0.0),
+    "eigen_hold": ({}, False),
 }
 
 COEFFICIENT_CASES = {
@@ -132,7 +133,8 @@ def test_every_declared_hyperparameter_changes_the_fit(cls, cases, chains):
 
 
 def test_the_forms_declare_only_their_own_keys():
-    matrix_only = {"fit_duration", "l1_threshold", "l1_debias", "gradient", "iterate_average"}
+    matrix_only = {"fit_duration", "l1_threshold", "l1_debias", "gradient", "iterate_average",
+                   "eigen_hold"}
     coefficient_only = {"mass_learning_rate", "symmetry", "optimizer", "mass_update"}
     assert matrix_only <= set(SGDSINDy.hyperparameters)
     assert coefficient_only <= set(SGDSINDyCoefficients.hyperparameters)
