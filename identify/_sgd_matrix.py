@@ -199,12 +199,13 @@ def project_out(W: np.ndarray, *signals: np.ndarray) -> list[np.ndarray]:
 def eigen_targets(M: np.ndarray, K: np.ndarray, lam_hat: np.ndarray) -> np.ndarray:
     """The measured eigenvalue each mode of ``(K, M)`` is held at, by rule.
 
-    Modes (ascending) and measured eigenvalues are paired by least total
-    ``|log(f / f_hat)|``; a pair counts only if the frequencies are within
+    A mode and a measured eigenvalue pair only if their frequencies are within
     :data:`identify.structural.MODE_SEPARATION` (15 %) of each other, the distance within
-    which the peak search itself calls two peaks one mode.  A measured peak farther than that
-    from every mode of the least-squares fit is not a mode that fit sees (a spurious or
-    mis-assigned peak), and a mode with no peak near it is left to the data.
+    which the peak search itself calls two peaks one mode.  Pairs are taken closest first
+    (``|log(f / f_hat)|``, ties to the lower mode), each mode and peak at most once and only
+    in the same order as the modes (a pair that would cross an earlier one is skipped): a
+    measured peak farther than that from every mode of the model is not a mode it sees (a
+    spurious or mis-assigned peak), and a mode with no peak near it is left to the data.
 
     Returns
     -------
@@ -216,12 +217,19 @@ def eigen_targets(M: np.ndarray, K: np.ndarray, lam_hat: np.ndarray) -> np.ndarr
     if lam_hat.size == 0:
         return target
     lam = linalg.eigh(_sym(K), _sym(M), eigvals_only=True)
+    hat = np.sort(lam_hat)
     with np.errstate(divide="ignore", invalid="ignore"):
-        cost = 0.5 * np.abs(np.log(np.maximum(lam, 1e-300)[:, None] / lam_hat[None, :]))
-    rows, cols = linear_sum_assignment(cost)
-    for r, c in zip(rows, cols, strict=True):
-        if cost[r, c] <= np.log1p(MODE_SEPARATION):
-            target[r] = lam_hat[c]
+        cost = 0.5 * np.abs(np.log(np.maximum(lam, 1e-300)[:, None] / hat[None, :]))
+    order = np.lexsort((np.tile(np.arange(n)[:, None], (1, hat.size)).ravel(), cost.ravel()))
+    pairs: list[tuple[int, int]] = []
+    for flat in order:
+        r, c = divmod(int(flat), hat.size)
+        if not cost[r, c] <= np.log1p(MODE_SEPARATION):
+            break
+        if any(r == r2 or c == c2 or (r - r2) * (c - c2) < 0 for r2, c2 in pairs):
+            continue
+        pairs.append((r, c))
+        target[r] = hat[c]
     return target
 
 
@@ -293,10 +301,17 @@ def warm_start(xdd: np.ndarray, xd: np.ndarray, x: np.ndarray, x3: np.ndarray | 
     if np.all(np.abs(lam.imag) <= 1e-9 * np.abs(lam).max()) and np.all(lam.real > 0):
         phi_inv = np.linalg.inv(phi.real)
         M0 = phi_inv.T @ phi_inv
+        # classical damping: each identified mode keeps its own modal damping, the cross-modal
+        # terms of Phi^-1 B Phi are dropped (symmetrising them instead put the ill-determined
+        # coupling of barely excited modes into C: 4-sensor beams of the beams family went
+        # from the least-squares TRAC 0.98 to 0.21, measured); the SGD may add coupling
+        d = np.diag(phi_inv @ Bv @ phi.real)
+        scale = m_hat / np.trace(M0)
+        M0 *= scale
+        K0, C0 = _sym(M0 @ A), scale * (phi_inv.T * d) @ phi_inv
     else:
-        M0 = np.eye(n)
-    M0 *= m_hat / np.trace(M0)
-    K0, C0 = _sym(M0 @ A), _sym(M0 @ Bv)
+        M0 = np.eye(n) * m_hat / n
+        K0, C0 = _sym(M0 @ A), _sym(M0 @ Bv)
     K30 = M0 @ A3 if A3 is not None else None
     return M0, C0, K0, K30
 
@@ -500,8 +515,9 @@ def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
     sc3 = np.broadcast_to(sc3, (n, n)).astype(float) if has_R else np.zeros((n, n))
     s_a = np.ascontiguousarray(s_a)
     cc.project(L, P, Q, R, m0, m_hat)
-    # the target of each mode (ascending; 0 = none), paired once at the start (eigen_targets)
-    target = eigen_targets(m0 * (L @ L.T), k0 * _sym(P), np.asarray(lam_hat, dtype=float))
+    # the target of each mode (ascending; 0 = none), paired on the current modes (eigen_targets)
+    lam_meas = np.asarray(lam_hat, dtype=float)
+    target = eigen_targets(m0 * (L @ L.T), k0 * _sym(P), lam_meas)
     lam_hat = np.ascontiguousarray(target)
     hold = bool(est.eigen_hold) and bool(np.any(target > 0))
     adam = (np.zeros((4, n, n)), np.zeros((4, n, n)), np.zeros((4, n, n)))  # m, v, step size
@@ -553,9 +569,9 @@ def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
         guard["K"] = clipped
     # The measured frequencies are held, not only pulled toward: the annealed penalty with its
     # weight capped at alpha_max let the data loss walk mode 2 of 2-sensor beams 10-60 % off
-    # a correctly measured peak (beams family, measured).  Targets paired once, at the warm
-    # start (eigen_targets); after the warm start and after every epoch the targeted
-    # eigenvalues are moved onto them (hold_eigenvalues), and again on the averaged result.
+    # a correctly measured peak (beams family, measured).  Targets paired on the current
+    # modes (eigen_targets) after the warm start and after every epoch, the targeted
+    # eigenvalues moved onto them (hold_eigenvalues), and again on the averaged result.
     held = hold_eigenvalues(L, P, m0, k0, target) if hold else 0.0
     record(0, 0)
     n_steps = 0
@@ -597,6 +613,9 @@ def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
                 if ge.mean() > 0:
                     hat = gmax / ge.mean()
                     alpha["eig"] = min((1 - est.beta) * alpha["eig"] + est.beta * hat, float(est.alpha_max))
+        if use_eig:  # re-paired on this epoch's modes; the compiled penalty reads lam_hat
+            target = eigen_targets(m0 * (L @ L.T), k0 * _sym(P), lam_meas)
+            lam_hat[:] = target
         if hold:
             held = max(held, hold_eigenvalues(L, P, m0, k0, target))
         if avg_from is not None and epoch >= avg_from:
@@ -607,6 +626,7 @@ def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
         LLt, P, Q, R = (a_ / n_acc for a_ in acc)
         L = np.linalg.cholesky(_sym(LLt))
         if hold:  # the average of held iterates is held only to first order
+            target = eigen_targets(m0 * (L @ L.T), k0 * _sym(P), lam_meas)
             hold_eigenvalues(L, P, m0, k0, target)
     clipped = _project_psd(Q)  # C: projected once, at the end (see above)
     if clipped < 0:
