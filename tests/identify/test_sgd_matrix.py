@@ -100,3 +100,69 @@ def test_full_window_gradient_option():
     assert np.all(np.isfinite(a.K_)) and np.allclose(np.trace(a.M_), np.trace(b.M_))
     with pytest.raises(ValueError, match="gradient"):
         SGDSINDy(epochs=1, gradient="exact").fit(data)
+
+
+# --------------------------------------------------------------------------------------------
+# Measured frequencies held (eigen_targets, hold_eigenvalues); force and drift profiled out
+# --------------------------------------------------------------------------------------------
+def _pencil(seed=0, n=3):
+    rng = np.random.default_rng(seed)
+    A = rng.normal(size=(n, n))
+    M = A @ A.T + n * np.eye(n)
+    B = rng.normal(size=(n, n))
+    K = 1e4 * (B @ B.T + n * np.eye(n))
+    return M, K
+
+
+def test_hold_moves_the_targeted_eigenvalues_exactly_and_keeps_the_modes():
+    from scipy import linalg
+
+    from identify._sgd_matrix import hold_eigenvalues
+
+    M, K = _pencil()
+    lam, U = linalg.eigh(K, M)
+    target = np.array([0.0, 1.05 * lam[1], 0.97 * lam[2]])  # mode 1 left alone
+    L, P = np.linalg.cholesky(M / 2.0), K / 3.0  # M = m0 L L^T with m0 = 2, K = k0 P, k0 = 3
+    shift = hold_eigenvalues(L, P, 2.0, 3.0, target)
+    lam2, U2 = linalg.eigh(3.0 * P, M)
+    # eigh's relative accuracy on a 3 x 3 pencil (cond ~ 10): 1e-12 is 1e3 x the rounding
+    assert np.allclose(lam2, [lam[0], target[1], target[2]], rtol=1e-12)
+    assert np.allclose(np.abs(np.sum(U2 * (M @ U), axis=0)), 1.0, atol=1e-10)  # same modes
+    assert np.isclose(shift, np.sqrt(1.05) - 1.0, rtol=1e-9)
+    assert np.allclose(P, P.T)
+
+
+def test_targets_pair_only_near_peaks_and_in_mode_order():
+    from scipy import linalg
+
+    from identify._sgd_matrix import eigen_targets
+
+    M, K = _pencil(1)
+    lam = linalg.eigh(K, M, eigvals_only=True)
+    # a spurious low peak (far from every mode), modes 1 and 3 seen 3 % off, mode 2 missing
+    hat = np.array([0.01 * lam[0], 1.03**2 * lam[0], 0.97**2 * lam[2]])
+    t = eigen_targets(M, K, hat)
+    assert np.allclose(t, [hat[1], 0.0, hat[2]])
+    # a peak 20 % off every mode (beyond MODE_SEPARATION, 15 %) is not a target
+    assert np.all(eigen_targets(M, K, np.array([1.2**2 * lam[1]])) == 0.0)
+
+
+def test_drift_columns_do_not_change_the_fit_when_profiled_out():
+    """Adding the chain's drift waveforms to x, x' with unknown offsets, and declaring them as
+    drift_basis, leaves the identified model as without them (Frisch-Waugh-Lovell)."""
+    import dataclasses
+
+    data = bench.chain_measurement(bench.chain_system(coupled=True))
+    t = np.arange(data.n_samples) / data.fs
+    w0, w1 = np.exp(-3.0 * t), t * np.exp(-3.0 * t)  # smooth, independent of the motion
+    e = np.array([1e-4, -2e-4, 5e-5])  # velocity offsets [m/s]
+    drifted = dataclasses.replace(data, xd=data.xd + e[:, None] * w0, x=data.x + e[:, None] * w1,
+                                  drift_basis=np.vstack([w0, w1]))
+    clean_basis = dataclasses.replace(data, drift_basis=np.vstack([w0, w1]))
+    a = SGDSINDy(epochs=4).fit(drifted)
+    b = SGDSINDy(epochs=4).fit(clean_basis)
+    # the two fits see the same projected signals up to the offsets' round-off (1e-4 m/s
+    # beside ~1e-2 m/s motion, projected out to ~1e-12 relative)
+    assert np.allclose(a.natural_frequencies_, b.natural_frequencies_, rtol=1e-7)
+    assert np.allclose(a.drift_coef_[:, 0], b.drift_coef_[:, 0] + a.C_ @ e, rtol=1e-5, atol=1e-9)
+    assert np.allclose(a.drift_coef_[:, 1], b.drift_coef_[:, 1] + a.K_ @ e, rtol=1e-5)
