@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from benchmarks import bench_sgd_sindy as bench
-from identify._sgd_matrix import cubic_profile, warm_start
+from identify._sgd_matrix import _sym, cubic_profile, warm_start
 from identify.sgd_sindy import SGDSINDy
 
 
@@ -106,12 +106,15 @@ def test_full_window_gradient_option():
 # Measured frequencies held (eigen_targets, hold_eigenvalues); force and drift profiled out
 # --------------------------------------------------------------------------------------------
 def _pencil(seed=0, n=3):
+    """A coupled (M, K) whose generalised eigenvalues are 1e4 x (1, 9, 25): modes a factor
+    3-5 apart in frequency, like a beam's."""
     rng = np.random.default_rng(seed)
     A = rng.normal(size=(n, n))
     M = A @ A.T + n * np.eye(n)
-    B = rng.normal(size=(n, n))
-    K = 1e4 * (B @ B.T + n * np.eye(n))
-    return M, K
+    V = np.linalg.qr(rng.normal(size=(n, n)))[0]
+    C = np.linalg.cholesky(M)
+    K = C @ (V * (1e4 * np.array([1.0, 9.0, 25.0])[:n])) @ V.T @ C.T
+    return M, _sym(K)
 
 
 def test_hold_moves_the_targeted_eigenvalues_exactly_and_keeps_the_modes():
