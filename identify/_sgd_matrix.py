@@ -16,14 +16,19 @@ limit is built in: the parameters are a symmetric positive definite ``M = m0 L L
 Loss (the paper's terms, Eqs 2-18)
 ----------------------------------
 - data: the paper's reconstruction error of row ``i``, ``x''_i - Theta xi_i``, is
-  ``(M x'' + C x' + K x + K3 x^3 - B u)_i / M_ii``; it is standardised by the RMS of ``x''_i``;
+  ``(M x'' + C x' + K x + K3 x^3 - G u - D w)_i / M_ii``; it is standardised by the RMS of
+  ``x''_i``.  The input gain ``G`` (free in every row, as ``ls_sindy``'s coupled input) and
+  the coefficients ``D`` of the chain's drift waveforms ``w`` (``data.drift_basis``) are
+  profiled out (:func:`project_out`) and recovered after the fit;
 - symmetry (Eq. 7): zero by construction (recorded in the history as such);
 - total mass (Eqs 4-6): ``trace(M) = M_hat`` is enforced after every step by scaling all
-  matrices together (Eq. 5 at its fixed point; a common scale leaves the free-vibration fit
-  unchanged, the measured force, where present in the window, then sets nothing else);
-- eigenvalues (Eqs 8-13): relative squared error of the lowest generalised eigenvalues of
-  ``(K, M)`` against ``(2 pi f)^2`` of the measured spectral peaks, with the exact first-order
-  sensitivity ``d lambda = u^T (dK - lambda dM) u`` (``u`` mass-normalised);
+  matrices together (Eq. 5 at its fixed point; with the force's gain free, a common scale
+  leaves the whole fit unchanged);
+- eigenvalues (Eqs 8-13): relative squared error of the generalised eigenvalues of
+  ``(K, M)`` paired with the measured spectral peaks (:func:`eigen_targets`) against
+  ``(2 pi f)^2``, with the exact first-order sensitivity ``d lambda = u^T (dK - lambda dM) u``
+  (``u`` mass-normalised); the result's paired eigenvalues are then held within one line of
+  their peaks (:func:`hold_eigenvalues`);
 - L1 (Eqs 14-15) on the cubic block, as a lasso on *standardised* cubic coefficients (see
   below), with a proximal step in Adam's metric, then a debiasing stage;
 - learning-rate annealing of the eigenvalue weight (Eqs 17-18) once per epoch, capped at

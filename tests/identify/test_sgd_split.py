@@ -53,7 +53,10 @@ MATRIX_CASES = {
     "l1_debias": ({"cubic": True, "data": "duffing"}, 0.0),
     "gradient": ({}, "full"),
     "iterate_average": ({}, 0.0),
-    "eigen_hold": ({}, False),
+    # the hold acts only on a result more than one line (fs / N = 4 Hz here) off its peak:
+    # with a 0.1 step the synthetic chain's modes end up to 2.2 % off and the hold puts mode 3
+    # at its band's edge, 537.8 Hz for the 533.8 Hz peak (measured)
+    "eigen_hold": ({"learning_rate": 0.1}, False),
 }
 
 COEFFICIENT_CASES = {
