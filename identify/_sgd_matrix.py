@@ -365,8 +365,8 @@ class MatrixSGDSettings:
     iterate_average : float
         Fraction of the epochs, at the end, whose iterates are averaged, in [0, 1).
     eigen_hold : bool
-        Hold the paired measured eigenvalues exactly (:func:`hold_eigenvalues`) after the warm
-        start and every epoch; only with measured targets.
+        Move the result's paired eigenvalues into their peaks' bands, one line (fs / N) either
+        side (:func:`hold_eigenvalues`); only with measured targets.
     """
 
     epochs: int

@@ -401,8 +401,9 @@ class SGDSINDy(SGDSINDyBase):
         "iterate_average": Field(float, 0.25, min=0.0, max=1.0, max_inclusive=False,
                                  doc="fraction of the epochs, at the end, whose iterates are "
                                      "averaged; 0 = the last iterate"),
-        "eigen_hold": Field(bool, True, doc="hold the identified frequencies exactly at the "
-                                            "measured peaks they pair with (needs eigen)"),
+        "eigen_hold": Field(bool, True, doc="hold the identified frequencies within one "
+                                            "spectral line of the measured peaks they pair "
+                                            "with (needs eigen)"),
     }
 
     @classmethod
