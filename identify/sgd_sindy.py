@@ -53,7 +53,13 @@ import numpy as np
 from identify import IDENTIFIERS
 from identify._sgd_matrix import MatrixSGDSettings, fit_matrix_sgd
 from identify.ls_sindy import MASS_PRIOR_FIELD
-from identify.structural import StructuralIdentifier, build_library, mass_prior_value, modal_peaks
+from identify.structural import (
+    StructuralIdentifier,
+    build_library,
+    driving_point_scaling,
+    mass_prior_value,
+    modal_peaks,
+)
 from testbed.core.errors import IdentificationError
 from testbed.core.measurement import Measurement
 from testbed.core.schema import ErrorFn, Field
@@ -481,7 +487,8 @@ class SGDSINDy(SGDSINDyBase):
         lib = build_library(data, coupled_mass=True, cubic=bool(self.cubic))
         n = data.n_channels
         out = fit_matrix_sgd(data, self.settings(), m_hat, lam_hat)
-        M, C, K, K3 = out.M, out.C, out.K, out.K3
+        (M, C, K, K3, B), self.mass_scaling_rule_ = driving_point_scaling(
+            out.M, out.C, out.K, out.K3, out.input_map, data.input_map)
         m = np.diag(M)[:, None]
         bl = lib.blocks
         coef = np.zeros((n, lib.theta.shape[0]))
@@ -494,7 +501,7 @@ class SGDSINDy(SGDSINDyBase):
         self.channels_ = tuple(data.channels)
         self.masses_ = np.diag(M).copy()
         self.M_, self.C_, self.K_, self.K3_ = M, C, K, K3
-        self.input_map_ = out.input_map
+        self.input_map_ = B
         if out.drift_coef.size:
             self.drift_coef_ = out.drift_coef
         self.eigen_targets_, self.eigen_shift_ = out.eigen_targets, out.eigen_shift

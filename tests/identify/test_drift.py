@@ -65,3 +65,29 @@ def test_remove_drift_recovers_the_offsets_and_the_signals():
         assert np.linalg.norm(got - want) < 1e-6 * np.linalg.norm(want)
     assert clean.drift_basis is None
     assert remove_drift(clean) == (clean, None)
+
+
+def test_driving_point_scaling_recovers_the_mass_sharing():
+    """Same M^-1 K and trace, wrong modal masses; the gain at the driving point restores M, K, C."""
+    from scipy import linalg
+
+    from identify.structural import driving_point_scaling
+
+    M3 = np.array([[2.0, 0.3, 0.0], [0.3, 1.5, 0.2], [0.0, 0.2, 1.0]])
+    K3m = np.array([[6e5, -2e5, 0.0], [-2e5, 4e5, -1.5e5], [0.0, -1.5e5, 1.5e5]])
+    C3 = 2e-4 * K3m
+    _, phi = linalg.eigh(K3m, M3)
+    pinv = np.linalg.inv(phi)
+    wrong = pinv.T @ np.diag([0.5, 1.0, 2.0]) @ pinv          # other modal masses ...
+    wrong *= np.trace(M3) / np.trace(wrong)                     # ... same total (the prior)
+    Mf, Kf, Cf = wrong, wrong @ np.linalg.solve(M3, K3m), wrong @ np.linalg.solve(M3, C3)
+    declared = np.array([[0.0], [0.0], [1.0]])                  # the force at sensor 3
+    B = Mf @ np.linalg.solve(M3, declared)                      # what the fit's gain says
+    (M2, C2, K2, K32, B2), rule = driving_point_scaling(Mf, Cf, Kf, None, B, declared)
+    assert "driving point" in rule and K32 is None
+    # exact algebra on 3x3 matrices: rounding only
+    for got, want in ((M2, M3), (K2, K3m), (C2, C3), (B2, declared)):
+        np.testing.assert_allclose(got, want, rtol=1e-9, atol=1e-9 * np.abs(want).max())
+    # a cubic model keeps the prior's scale, as does a model without an input
+    assert driving_point_scaling(Mf, Cf, Kf, np.eye(3), B, declared)[0][0] is Mf
+    assert driving_point_scaling(Mf, Cf, Kf, None, None, declared)[0][0] is Mf
