@@ -11,6 +11,7 @@ from identify import sindy_pi as sp
 from identify.sindy_pi import SINDyPI
 from testbed.core.errors import HyperparameterError
 from testbed.numerics.derivatives import lowpass_differentiate
+from testbed.scoring.equation_basis import evaluate_terms
 
 
 @pytest.fixture(scope="module")
@@ -72,18 +73,35 @@ def test_high_noise_keeps_the_strong_form_and_a_weak_request_gets_a_window(clean
     assert w.weak_strong_columns_ == []
 
 
+def _rel_residual(model, data) -> np.ndarray:
+    """Per equation, |Theta c| / (|Theta| |c|) on ``data``: ~0 for an exact equation, whichever
+    of the loop's equivalent forms it is (terms evaluated by the scorer's own evaluator)."""
+    sig = {"th": data.x, "dth": data.xd, "ddth": data.xdd, "u": data.u}
+    theta = evaluate_terms(list(model.feature_names_), sig)
+    coef = np.atleast_2d(model.coef_)
+    return np.linalg.norm(theta @ coef.T, axis=0) / (np.abs(theta) @ np.abs(coef.T)).sum(axis=0)
+
+
 def test_ensemble_on_exact_data_reproduces_the_fit(clean):
+    """Every bag is exact data of the same equations, so the aggregate is an exact equation too.
+
+    Which of the loop's exactly equivalent forms a bag, the median or the refit lands on is
+    decided by rounding (measured: different forms, and a bag spread of 1e-8 or 6e-3, between
+    BLAS kernels and thread counts), so forms are compared by what they mean: each equation
+    vanishes on the data as the plain fit's does.
+    """
     one = SINDyPI().fit(clean)
     ens = SINDyPI(ensemble=6, ensemble_blocks=8).fit(clean)
-    # every bag is exact data of the same equations: the median is the plain fit's equation
-    # (1e-8: the conditioned Gram solves of different row subsets agree to ~1e-10)
-    np.testing.assert_allclose(ens.coef_, one.coef_, atol=1e-8)
-    assert ens.coef_std_.shape == ens.coef_.shape == ens.inclusion_probability_.shape
-    assert np.all(ens.coef_std_ < 1e-8)
-    np.testing.assert_array_equal(ens.inclusion_probability_, (one.coef_ != 0).astype(float))
-    assert not hasattr(one, "coef_std_")
     refit = SINDyPI(ensemble=6, ensemble_blocks=8, ensemble_aggregate="refit").fit(clean)
-    np.testing.assert_allclose(refit.coef_, one.coef_, atol=1e-8)
+    base = _rel_residual(one, clean)
+    # an exact equation: 5e-12 (measured); one fitted on 5 % noisy angles leaves 4e-6 to 2e-5
+    assert np.all(base < 1e-7)
+    assert np.all(_rel_residual(ens, clean) < 1e-6) and np.all(_rel_residual(refit, clean) < 1e-6)
+    assert ens.coef_std_.shape == ens.coef_.shape == ens.inclusion_probability_.shape
+    assert np.all(np.isfinite(ens.coef_std_)) and np.all(ens.coef_std_ >= 0)
+    # a median of six is nonzero only where at least half the bags kept the term
+    assert np.all(ens.inclusion_probability_[ens.coef_ != 0] >= 0.5)
+    assert not hasattr(one, "coef_std_")
 
 
 def test_ensemble_reports_uncertainty_on_noisy_data(clean):
