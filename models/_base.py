@@ -115,3 +115,25 @@ class Rig:
         coordinates (not placed by ``positions``) names them in ``Signal.acts_on``.
         """
         raise NotImplementedError
+
+
+def check_sample_steps(simulation: dict[str, Any], error: ErrorFn) -> None:
+    """Timing a fixed-step rig needs: whole integration steps per sample, at least two samples.
+
+    Parameters
+    ----------
+    simulation : dict
+        The scenario's ``[simulation]`` table with ``sample_rate`` [Hz], ``dt`` [s] and
+        ``duration`` [s].
+    error : callable
+        ``error(key, value, allowed)``.
+    """
+    ratio = 1.0 / (simulation["sample_rate"] * simulation["dt"])
+    # 1e-6 relative: a ratio typed in decimal (e.g. 1 / (1000 * 1e-4)) is off its integer by
+    # rounding only (~1e-15); anything larger is a real fraction of a step
+    if ratio < 1.0 - 1e-9 or abs(ratio - round(ratio)) > 1e-6 * ratio:
+        error("simulation.sample_rate", simulation["sample_rate"],
+              f"1/(sample_rate * dt) must be a whole number >= 1 (dt = {simulation['dt']:g} s gives "
+              f"{ratio:.6g}): samples and input holds fall on integration steps")
+    if round(simulation["duration"] * simulation["sample_rate"]) < 2:
+        error("simulation.duration", simulation["duration"], "expected at least two samples")

@@ -25,7 +25,7 @@ import mujoco
 import numpy as np
 
 from models import RIGS
-from models._base import ErrorFn, Rig
+from models._base import ErrorFn, Rig, check_sample_steps
 from models.cartpole.equations import CartPoleParams, true_equations
 from testbed.core.budget import Cost
 from testbed.core.dataset import Dataset, Signal
@@ -137,13 +137,7 @@ class CartPoleRig(Rig):
     def check(cls, rig: dict[str, Any], simulation: dict[str, Any], excitation: dict[str, Any],
               error: ErrorFn) -> None:
         """Whole steps per sample, tones below Nyquist, something to identify."""
-        ratio = 1.0 / (simulation["sample_rate"] * simulation["dt"])
-        if ratio < 1.0 - 1e-9 or abs(ratio - round(ratio)) > 1e-6 * ratio:
-            error("simulation.sample_rate", simulation["sample_rate"],
-                  f"1/(sample_rate * dt) must be a whole number >= 1 (dt = {simulation['dt']:g} s "
-                  f"gives {ratio:.6g}): samples and force holds fall on integration steps")
-        if round(simulation["duration"] * simulation["sample_rate"]) < 2:
-            error("simulation.duration", simulation["duration"], "expected at least two samples")
+        check_sample_steps(simulation, error)
         if not excitation["f_min"] < excitation["f_max"]:
             error("excitation.f_min", excitation["f_min"],
                   f"expected f_min < f_max ({excitation['f_max']:g} Hz)")

@@ -23,7 +23,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from models import RIGS
-from models._base import ErrorFn, Rig
+from models._base import ErrorFn, Rig, check_sample_steps
 from models.fivebar import geometry as geo
 from models.fivebar.dynamics import FiveBarDynamics
 from models.fivebar.equations import true_equations
@@ -143,13 +143,7 @@ class FiveBarRig(Rig):
     def check(cls, rig: dict[str, Any], simulation: dict[str, Any], excitation: dict[str, Any],
               error: ErrorFn) -> None:
         """Geometry that cannot close, start poses near a singularity, inconsistent timing."""
-        ratio = 1.0 / (simulation["sample_rate"] * simulation["dt"])
-        if ratio < 1.0 - 1e-9 or abs(ratio - round(ratio)) > 1e-6 * ratio:
-            error("simulation.sample_rate", simulation["sample_rate"],
-                  f"1/(sample_rate * dt) must be a whole number >= 1 (dt = {simulation['dt']:g} s gives "
-                  f"{ratio:.6g}): samples and input holds fall on integration steps")
-        if round(simulation["duration"] * simulation["sample_rate"]) < 2:
-            error("simulation.duration", simulation["duration"], "expected at least two samples")
+        check_sample_steps(simulation, error)
         nyquist = simulation["sample_rate"] / 2.0
         at_rest = rig["dth1_0"] == 0.0 and rig["dth4_0"] == 0.0 and not rig["gravity"]
         if excitation.get("amplitude", 1.0) == 0.0 and (at_rest or excitation["type"] == "sine_replay"):
