@@ -122,3 +122,33 @@ def test_fivebar_truth_and_identity_equivalents_score_perfectly(fivebar):
     wrong[0, names.index("cos(th1-th2)*sin(th2-th3)*ddth2")] *= 1.05
     c = compare_equations(names, wrong, fivebar.truth_terms, fivebar.truth_coef, sig)
     assert c["coef_error"] > 0.01 and c["coef_error_norm"] > 1e-3  # measured 0.025 and 0.0083
+
+
+def test_an_open_chain_passive_equation_is_dynamics_not_an_identity():
+    """A passive coordinate's equation of motion is an exact input-free dependency among the
+    columns, like a loop identity; it must not be factored out, or the equation itself would be
+    compared in a degenerate basis (the cart-pole's pole: coef_error 0.014 for exact
+    coefficients before this rule, 5e-14 after)."""
+    import numpy as np
+
+    from testbed.scoring.equation_basis import compare_equations
+
+    t = np.linspace(0.0, 10.0, 4001)
+    th = np.vstack([0.3 * np.sin(1.3 * t), 0.4 * np.sin(2.1 * t + 0.5)])
+    dth = np.vstack([0.39 * np.cos(1.3 * t), 0.84 * np.cos(2.1 * t + 0.5)])
+    u = np.vstack([np.sin(0.7 * t)])
+    a, b = 9.81 / 0.6, 0.05
+    # the passive row holds exactly by construction; the driven row involves the input
+    ddth = np.vstack([u[0] - 0.2 * dth[0], -a * np.sin(th[1]) - b * dth[1]])
+    sig = {"th": th, "dth": dth, "ddth": ddth, "u": u}
+    names = ["ddth1", "dth1", "u1", "ddth2", "sin(th2)", "dth2"]
+    true = np.array([[1.0, 0.2, -1.0, 0, 0, 0], [0, 0, 0, 1.0, a, b]])
+    exact = compare_equations(names, true, names, true, sig)
+    assert exact["coef_error"] < 1e-9 and exact["f1"] == 1.0
+    assert exact["dependent"] == []
+    off = true.copy()
+    off[1, 4] *= 1.1  # 10 % off on the pole's gravity term
+    wrong = compare_equations(names, off, names, true, sig)
+    # rows are divided by their coefficient on the true lead term (here sin(th2) itself), so the
+    # other terms come out 1 - 1/1.1 off: the error is seen, not factored away
+    assert abs(wrong["coef_error"] - (1 - 1 / 1.1)) < 1e-6
