@@ -98,6 +98,7 @@ second-moment matrix in O(n^3), whatever the window's length.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, Literal
 
@@ -449,7 +450,9 @@ class MatrixSGDResult:
 
 
 def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
-                   lam_hat: np.ndarray) -> MatrixSGDResult:
+                   lam_hat: np.ndarray,
+                   progress: Callable[[float | None, str | None], None] | None = None
+                   ) -> MatrixSGDResult:
     """Run the matrix-parametrised SGD.
 
     Parameters
@@ -463,6 +466,8 @@ def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
     lam_hat : ndarray, shape (k,)
         Measured eigenvalues ``(2 pi f)^2`` [rad^2/s^2] the eigenvalue penalty targets; empty
         = no eigenvalue penalty.
+    progress : callable, optional
+        ``progress(fraction, step)`` after every epoch (e.g. ``Identifier.report_progress``).
 
     Returns
     -------
@@ -612,6 +617,8 @@ def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
     acc = [np.zeros((n, n)) for _ in range(4)]
     n_acc = 0
     for epoch in range(1, int(est.epochs) + 1):
+        if progress is not None:
+            progress((epoch - 1) / int(est.epochs), f"epoch {epoch}/{int(est.epochs)}")
         perm = rng.permutation(N) if bs else np.arange(0)
         cc.sgd_steps(Z, nfa, S_full, N, perm, bs, spe, (L, P, Q, R), adam, n_steps,
                      float(est.learning_rate), m0, c0, k0, sc3, s_a, lam_hat,

@@ -486,7 +486,7 @@ class SGDSINDy(SGDSINDyBase):
         m_hat = mass_prior_value(data, self.mass_prior)
         lib = build_library(data, coupled_mass=True, cubic=bool(self.cubic))
         n = data.n_channels
-        out = fit_matrix_sgd(data, self.settings(), m_hat, lam_hat)
+        out = fit_matrix_sgd(data, self.settings(), m_hat, lam_hat, progress=self.report_progress)
         (M, C, K, K3, B), self.mass_scaling_rule_ = driving_point_scaling(
             out.M, out.C, out.K, out.K3, out.input_map, data.input_map)
         m = np.diag(M)[:, None]

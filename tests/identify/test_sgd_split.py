@@ -201,3 +201,16 @@ def test_matrix_settings_are_explicit_and_checked():
                 {"l1_debias": -0.1}, {"batch_size": 0}, {"learning_rate": 0.0}):
         with pytest.raises(ValueError, match=next(iter(bad))):
             dataclasses.replace(s, **bad)
+
+
+def test_sgd_sindy_reports_its_epochs():
+    """The progress seam (Identifier.progress_to) sees every epoch of the matrix SGD."""
+    from benchmarks import bench_sgd_sindy as bench
+
+    data = bench.chain_measurement(bench.chain_system(coupled=True, damping="proportional"))
+    seen = []
+    model = SGDSINDy(epochs=4)
+    with model.progress_to(lambda f, s: seen.append((f, s))):
+        model.fit(data)
+    assert seen == [(k / 4, f"epoch {k + 1}/4") for k in range(4)]
+    assert "_progress_callback" not in vars(model)  # not part of the fitted model
