@@ -222,15 +222,20 @@ def check_structural(cfg: Mapping[str, Any], fs: float, n_samples: int, error: E
               f"expected shorter than the record ({duration:g} s)")
 
 
-def check_mechanical(cfg: Mapping[str, Any], fs: float, n_samples: int, error: ErrorFn) -> None:
-    """:func:`check_signal` of the mechanical chain."""
-    duration = n_samples / fs
+def _check_polynomial_window(cfg: Mapping[str, Any], n_samples: int, error: ErrorFn) -> None:
+    """The local-polynomial derivative window: odd, above the polynomial order, within the record."""
     if cfg["window"] % 2 == 0:
         error("signal.window", cfg["window"], "expected an odd number of samples")
     if not cfg["polyorder"] < cfg["window"]:
         error("signal.polyorder", cfg["polyorder"], f"expected below window ({cfg['window']})")
     if cfg["derivatives"] == "estimated" and cfg["window"] > n_samples:
         error("signal.window", cfg["window"], f"expected at most the record's {n_samples} samples")
+
+
+def check_mechanical(cfg: Mapping[str, Any], fs: float, n_samples: int, error: ErrorFn) -> None:
+    """:func:`check_signal` of the mechanical chain."""
+    duration = n_samples / fs
+    _check_polynomial_window(cfg, n_samples, error)
     if cfg["derivatives"] == "lowpass":
         _below_nyquist(cfg, "cutoff_hz", fs, error)
         _long_enough(cfg, "filter_order", cfg["filter_order"], n_samples, error)
@@ -517,12 +522,7 @@ def measure_mechanical(dataset: Dataset, cfg: Mapping[str, Any]) -> Measurement:
 
 def check_dynamical(cfg: Mapping[str, Any], fs: float, n_samples: int, error: ErrorFn) -> None:
     """:func:`check_signal` of the dynamical chain."""
-    if cfg["window"] % 2 == 0:
-        error("signal.window", cfg["window"], "expected an odd number of samples")
-    if not cfg["polyorder"] < cfg["window"]:
-        error("signal.polyorder", cfg["polyorder"], f"expected below window ({cfg['window']})")
-    if cfg["derivatives"] == "estimated" and cfg["window"] > n_samples:
-        error("signal.window", cfg["window"], f"expected at most the record's {n_samples} samples")
+    _check_polynomial_window(cfg, n_samples, error)
 
 
 def measure_dynamical(dataset: Dataset, cfg: Mapping[str, Any]) -> Measurement:
