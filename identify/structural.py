@@ -467,6 +467,15 @@ HARMONIC_SEGMENTS = 8
 #: (studies/families.toml): side lobes 0.985-1.000 against their mode; distinct bending modes
 #: 0.16-0.84 (the highest, 0.84, with both sensors on the outer half of the beam).
 ODS_MAC = 0.95
+#: ... but only within this many spectral lines (``fs / n`` of the unpadded window) of that peak:
+#: the rectangular window's side lobes fall as ``1 / (pi k)`` at ``k`` lines, below the
+#: candidates' 40 dB range beyond ``100 / pi`` = 32 lines.  Two sensors can give distinct modes
+#: similar shapes (a soft-base member's modes 1 and 2, 30 and 316 Hz: MAC 0.978), and there
+#: shape alone rejected a genuine mode 143 lines away.
+SIDE_LOBE_LINES = 100.0 / np.pi
+#: ... or below this multiple of the chain's high-pass cut-off, where the high-pass rings
+#: under the displacement with its shape (the second reason for the rule).
+HIGHPASS_RING_FACTOR = 2.0
 
 
 @dataclass(frozen=True)
@@ -530,8 +539,10 @@ def modal_peaks(data: Measurement, n_modes: int | None = None,
        strongest), peaks within :data:`MODE_SEPARATION` of a stronger one merged into it.
     3. *Same shape*: a weaker candidate whose deflection shape across the channels matches
        a stronger accepted one's (MAC >= :data:`ODS_MAC`) is that mode again (a side lobe),
-       not a mode: n sensors tell distinct modes apart by their shapes.  Checked after the
-       harmonic test, which it does not replace.
+       not a mode: n sensors tell distinct modes apart by their shapes.  Only where a side
+       lobe can be: within :data:`SIDE_LOBE_LINES` lines of that peak, or below
+       :data:`HIGHPASS_RING_FACTOR` x the high-pass cut-off.  Checked after the harmonic
+       test, which it does not replace.
     4. *Harmonics*: a weaker candidate within :data:`HARMONIC_TOL` of k = 2 or 3 times a
        stronger one whose short-time amplitude follows the stronger one's k-th power
        (:func:`testbed.numerics.spectral.harmonic_amplitude_law`, slope within
@@ -583,7 +594,10 @@ def modal_peaks(data: Measurement, n_modes: int | None = None,
             rejected.append((float(freqs[i]), why))
             nonlinear = True
             continue
-        macs = [(float(mac_matrix(shapes[i], shapes[j])[0, 0]), j) for j in kept]
+        lobe_reach = SIDE_LOBE_LINES * data.fs / xdd.shape[1]
+        ring_top = HIGHPASS_RING_FACTOR * float(data.passband[0]) if data.passband else 0.0
+        macs = [(float(mac_matrix(shapes[i], shapes[j])[0, 0]), j) for j in kept
+                if abs(freqs[i] - freqs[j]) <= lobe_reach or freqs[i] <= ring_top]
         same = [(m, j) for m, j in macs if m >= ODS_MAC]
         if same:
             m, j = same[0]

@@ -110,6 +110,16 @@ def test_a_peak_with_a_stronger_peak_s_shape_is_not_another_mode():
     assert any("same deflection shape" in r for f, r in ps.rejected if abs(f - 52.0) < 1)
 
 
+def test_a_distant_mode_with_a_similar_shape_is_still_a_mode():
+    """Two sensors can see distinct modes with similar shapes; beyond a side lobe's reach
+    (SIDE_LOBE_LINES lines) a shape match does not make a peak a side lobe."""
+    one = _decay(40.0, 0.5)
+    two = 0.3 * _decay(300.0, 3.0)  # 520 lines away at 0.5 Hz per line
+    ps = modal_peaks(_measurement(np.vstack([one + two, 0.5 * one + 0.6 * two])))  # MAC 0.98
+    assert ps.peaks == pytest.approx([40.0, 300.0], abs=0.3)
+    assert not any(abs(f - 300.0) < 5 for f, _ in ps.rejected)
+
+
 @pytest.fixture(scope="module")
 def negative_damping():
     """The exact 3-DOF chain with C = -1e-5 K: every mode grows (zeta about -0.3 % in mode 1)."""
