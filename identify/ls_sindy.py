@@ -150,7 +150,7 @@ class LeastSquaresSINDy(StructuralIdentifier):
             self.input_map_ = self.M_ @ coef[:, lib.blocks["f"]] @ self.input_map_
         self.n_steps_ = 0
         self._check_physical()
-        self._finish_fit()
+        self._finish_fit(data)
         return self
 
     def _check_physical(self) -> None:

@@ -187,7 +187,7 @@ class PySINDyField(StructuralIdentifier):
         self.M_, self.C_, self.K_, self.K3_ = matrices_from_coef(coef, blocks, np.full(n, m_hat / n))
         self.input_map_ = None if data.input_map is None else np.asarray(data.input_map, dtype=float)
         self.n_steps_ = 0
-        self._finish_fit()
+        self._finish_fit(data)
         return self
 
     def _fit_strong(self, data: Measurement) -> tuple[np.ndarray, list[str], dict[str, slice]]:

@@ -60,6 +60,7 @@ from identify.structural import (
     fit_band_cutoff,
     mass_prior_value,
     modal_peaks,
+    warp_frequency,
 )
 from testbed.core.errors import IdentificationError
 from testbed.core.measurement import Measurement
@@ -187,7 +188,12 @@ class SGDSINDyBase(StructuralIdentifier):
             self._peaks(data)
         else:
             self.measured_frequencies_ = np.empty(0)
-        return (2.0 * np.pi * self.measured_frequencies_) ** 2
+        f = self.measured_frequencies_
+        if data.integration == "trapezoid":
+            # the fit runs on trapezoid integrals, where a mode at f sits at the warped
+            # frequency; the fitted poles are mapped back at the end (_finish_fit)
+            f = warp_frequency(f, float(data.fs))
+        return (2.0 * np.pi * f) ** 2
 
     def _peaks(self, data: Measurement) -> np.ndarray:
         """The eigenvalue penalty's targets by :func:`identify.structural.modal_peaks`; sets
@@ -568,5 +574,5 @@ class SGDSINDy(SGDSINDyBase):
             np.linalg.cholesky(M)
         except np.linalg.LinAlgError:
             raise IdentificationError("identified M is not positive definite (L L^T lost rank)") from None
-        self._finish_fit()
+        self._finish_fit(data)
         return self

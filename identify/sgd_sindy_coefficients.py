@@ -390,5 +390,5 @@ class SGDSINDyCoefficients(SGDSINDyBase):
         self.alphas_ = dict(alpha)
         self.history_ = {k: np.asarray(v) for k, v in hist.items()}
         self.n_steps_ = n_steps
-        self._finish_fit()
+        self._finish_fit(data)
         return self

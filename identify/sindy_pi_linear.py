@@ -59,7 +59,7 @@ from identify.sindy_pi import (
     VAL_FRACTION_FIELD,
     check_thresholds,
 )
-from identify.structural import remove_drift
+from identify.structural import remove_drift, unwarp_trapezoid
 from testbed.core.errors import IdentificationError
 from testbed.core.measurement import Measurement, Trajectory
 from testbed.core.schema import Field
@@ -258,6 +258,16 @@ class SINDyPILinear(Identifier):
             # and C positive semi-definite that is what makes the model stable
             raise IdentificationError("identified K is not positive definite (a static divergence "
                                       "mode): not returned")
+        self.integration_rule_ = "signals are exact derivatives: no mapping"
+        if data.integration == "trapezoid":
+            mapped = unwarp_trapezoid(M, C, K, float(data.fs))
+            if mapped is None:
+                self.integration_rule_ = ("trapezoid integrals, poles left warped: a pole "
+                                          "outside the bilinear map's range")
+            else:
+                C, K = mapped
+                self.integration_rule_ = ("trapezoid integrals: poles mapped back by "
+                                          "s = 2 fs artanh(p / (2 fs))")
         self.M_, self.C_, self.K_, self.K3_ = M, C, K, None
         self.normalisation_ = (
             f"M symmetric with M (M^-1 K) and M (M^-1 C) symmetric ({family}-dimensional family; "

@@ -45,6 +45,13 @@ class Measurement:
         coefficient on every row, so that the offsets are estimated with the model rather
         than read as motion (see :func:`testbed.pipeline.signal_chain.measure_structural`).
         None = the chain declares none.
+    integration : {"exact", "trapezoid"}
+        How ``xd`` and ``x`` relate to ``xdd``.  ``"trapezoid"``: they are trapezoid-rule
+        integrals of the sampled ``xdd`` (then filtered alike), so a model fitted to them is
+        exact in the bilinear (Tustin) variable ``s_T = 2 fs tanh(s / (2 fs))``, not in ``s``:
+        every mode comes out ``tan(w T / 2) / (w T / 2)`` too stiff.  A structural identifier maps its
+        poles back (:func:`identify.structural.unwarp_trapezoid`).  ``"exact"``: true
+        derivatives (simulated or differentiated signals).
     """
 
     fs: float
@@ -59,6 +66,7 @@ class Measurement:
     free_start: int = 0
     passband: tuple[float, float] | None = None
     drift_basis: np.ndarray | None = None
+    integration: str = "exact"
 
     @property
     def n_channels(self) -> int:

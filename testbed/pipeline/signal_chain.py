@@ -342,7 +342,9 @@ def measure_structural(dataset: Dataset, cfg: Mapping[str, Any]) -> Measurement:
         1 at the sensor within ``IMPACT_TOLERANCE_M`` of the impact; ``free_start`` the
         first sample ``free_margin_s`` after the end of the raw force pulse, or later, where
         the low-pass's response to the pulse has settled (:data:`LOWPASS_SETTLE_TOL`); ``prior`` a copy
-        of ``dataset.prior``; ``passband`` ``(highpass_hz, lowpass_hz or fs / 2)`` [Hz].
+        of ``dataset.prior``; ``passband`` ``(highpass_hz, lowpass_hz or fs / 2)`` [Hz];
+        ``integration`` ``"trapezoid"`` (identifiers map their poles back from the bilinear
+        variable: see :attr:`testbed.core.measurement.Measurement.integration`).
 
     Notes
     -----
@@ -408,7 +410,8 @@ def measure_structural(dataset: Dataset, cfg: Mapping[str, Any]) -> Measurement:
                        prior=dict(dataset.prior), free_start=free_start,
                        passband=(float(cfg["highpass_hz"]),
                                  float(cfg["lowpass_hz"]) if cfg["lowpass_hz"] > 0 else fs / 2.0),
-                       drift_basis=drift_basis(acc.shape[1], fs, rest_from, hp_args))
+                       drift_basis=drift_basis(acc.shape[1], fs, rest_from, hp_args),
+                       integration="trapezoid")
 
 
 def drift_basis(n_samples: int, fs: float, rest_from: int | None,
