@@ -105,8 +105,9 @@ from typing import Any, Literal
 import numpy as np
 from scipy import linalg
 
-from identify.structural import MODE_SEPARATION
+from identify.structural import FIT_BAND_ORDER, MODE_SEPARATION, fit_band_cutoff
 from testbed.core.measurement import Measurement
+from testbed.numerics.filters import elliptic_highpass
 
 #: Relative singular-value cut-off of the nuisance columns' basis (:func:`nuisance_basis`):
 #: the drift rows and the force are independent waveforms, so only an exactly repeated column
@@ -159,7 +160,8 @@ def cubic_profile(xdd: np.ndarray, xd: np.ndarray, x: np.ndarray, x3: np.ndarray
             "Er": Er, "Zr": Zr, "rho": _rms(Er, 0), "sigma": _rms(Zr, 0)}
 
 
-def nuisance_basis(data: Measurement, i0: int, i1: int) -> tuple[np.ndarray, np.ndarray]:
+def nuisance_basis(data: Measurement, i0: int, i1: int, inputs: np.ndarray | None = None
+                   ) -> tuple[np.ndarray, np.ndarray]:
     """The columns every row of the model carries with a free coefficient, on samples ``[i0, i1)``.
 
     They are the measured inputs ``u`` (when nonzero in the window) and the rows of
@@ -168,6 +170,8 @@ def nuisance_basis(data: Measurement, i0: int, i1: int) -> tuple[np.ndarray, np.
     ``M B`` in full (they also absorb the residual flexibility of the unmodelled modes under
     the chain-filtered force tail), the drift's are the offsets, then dropped.
 
+    ``inputs`` (optional) names the inputs to take instead of those nonzero on the samples.
+
     Returns
     -------
     W : ndarray, shape (N, p)
@@ -175,13 +179,15 @@ def nuisance_basis(data: Measurement, i0: int, i1: int) -> tuple[np.ndarray, np.
     inputs : ndarray of int
         Which inputs (rows of ``data.u``) are the first ``inputs.size`` columns.
     """
-    cols, inputs = [], np.zeros(0, dtype=int)
+    cols: list[np.ndarray] = []
     if data.u is not None and data.input_map is not None:
         u = np.asarray(data.u, dtype=float)[:, i0:i1]
-        inputs = np.flatnonzero(np.any(u != 0.0, axis=1))
+        if inputs is None:
+            inputs = np.flatnonzero(np.any(u != 0.0, axis=1))
         cols.append(u[inputs])
     if data.drift_basis is not None:
         cols.append(np.asarray(data.drift_basis, dtype=float)[:, i0:i1])
+    inputs = np.zeros(0, dtype=int) if inputs is None else np.asarray(inputs, dtype=int)
     if not cols:
         return np.zeros((i1 - i0, 0)), inputs
     return np.ascontiguousarray(np.vstack(cols).T), inputs
@@ -199,6 +205,44 @@ def project_out(W: np.ndarray, *signals: np.ndarray) -> list[np.ndarray]:
     U, sv, _ = np.linalg.svd(W / _rms(W, 0)[None, :], full_matrices=False)
     Qw = U[:, sv > NUISANCE_RCOND * sv[0]]
     return [s - (s @ Qw) @ Qw.T for s in signals]
+
+
+def cubic_direction(x: np.ndarray) -> np.ndarray:
+    """The direction the cubic feature is taken along: the data's dominant displacement shape.
+
+    The soft base's cubic moment acts on one coordinate, the base rotation, which at the
+    sensors is one linear combination ``c . x`` of the displacements, and pushes back along
+    one direction; ``n`` diagonal features ``x_j^3`` only approximate ``(c . x)^3`` and are
+    nearly collinear (while one mode dominates, ``x_j^3 ~ phi_j^3 q^3`` for every ``j``), so
+    the lasso and the SGD split one force among ``n^2`` coefficients by noise.  The rule:
+    ``w`` is the first left singular vector of the fit window's displacements (the shape
+    that carries most of their energy: the lowest mode's after an impact, which is also the
+    mode that moves the soft base most), unit length, its largest entry positive.  It depends
+    on the data only, and not on the displacements' scale (stiffness, amplitude).
+
+    Parameters
+    ----------
+    x : ndarray, shape (n, N)
+        Displacements [m] on the fit window.
+
+    Returns
+    -------
+    ndarray, shape (n,)
+        Unit vector ``w`` [-].
+    """
+    U = np.linalg.svd(np.asarray(x, dtype=float), full_matrices=False)[0]
+    w = U[:, 0]
+    return w if w[np.argmax(np.abs(w))] > 0 else -w
+
+
+def cubic_feature(x: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """The one cubic feature ``s = sum_j w_j^3 x_j^3`` [m^3], shape (N,), of ``x`` (n, N).
+
+    ``s = (w^3) . x^3`` rather than ``(w . x)^3``: both equal a constant times ``q^3`` while
+    the motion is along ``w`` (``x = w q``), and the first is exactly the structural model's
+    ``K3 x^3`` with the rank-one ``K3 = b (w^3)^T`` that the simulation and the scorers take.
+    """
+    return (np.asarray(w, dtype=float) ** 3) @ (np.asarray(x, dtype=float) ** 3)
 
 
 def eigen_targets(M: np.ndarray, K: np.ndarray, lam_hat: np.ndarray) -> np.ndarray:
@@ -368,6 +412,13 @@ class MatrixSGDSettings:
     eigen_hold : bool
         Move the result's paired eigenvalues into their peaks' bands, one line (fs / N) either
         side (:func:`hold_eigenvalues`); only with measured targets.
+    fit_band_hz : float or None
+        Cut-off [Hz] of the fit band's high-pass (:func:`identify.structural.fit_band_cutoff`):
+        None = by rule, 0 = none.
+    cubic_form : {"direction", "diagonal"}
+        ``"direction"``: one cubic feature along the data's dominant displacement direction,
+        ``K3 = b a^T`` (:func:`cubic_direction`); ``"diagonal"``: the n features ``x_j^3``, a
+        full ``K3``.
     """
 
     epochs: int
@@ -389,9 +440,12 @@ class MatrixSGDSettings:
     gradient: Literal["minibatch", "full"]
     iterate_average: float
     eigen_hold: bool = True
+    cubic_form: Literal["direction", "diagonal"] = "diagonal"
+    fit_band_hz: float | None = 0.0
 
     def __post_init__(self) -> None:
-        for key, allowed in (("init", ("lstsq", "zeros")), ("gradient", ("minibatch", "full"))):
+        for key, allowed in (("init", ("lstsq", "zeros")), ("gradient", ("minibatch", "full")),
+                             ("cubic_form", ("direction", "diagonal"))):
             if getattr(self, key) not in allowed:
                 raise ValueError(f"{key} must be one of {allowed}, got {getattr(self, key)!r}")
         if not (self.epochs >= 0 and self.batch_size >= 1 and self.learning_rate > 0):
@@ -476,13 +530,27 @@ def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
     i0 = int(data.free_start)
     i1 = data.n_samples if not est.fit_duration else min(data.n_samples,
                                                           i0 + round(est.fit_duration * data.fs))
-    raw = [np.asarray(a, dtype=float)[:, i0:i1] for a in (data.xdd, data.xd, data.x)]
-    if est.cubic:
-        raw.append(raw[2] ** 3)
-    n, N = raw[0].shape
+    full = [np.asarray(a, dtype=float) for a in (data.xdd, data.xd, data.x)]
+    n, N = full[0].shape[0], i1 - i0
+    cubic_dir = None
+    if est.cubic and est.cubic_form == "direction":  # one cubic feature, K3 = b a^T (below)
+        cubic_dir = cubic_direction(full[2][:, i0:i1])
+        full.append(np.vstack([cubic_feature(full[2], cubic_dir)[None, :],
+                               np.zeros((n - 1, full[2].shape[1]))]))
+    elif est.cubic:
+        full.append(full[2] ** 3)
     # the force (every row, M B in full) and the chain's integration constants enter with free
     # coefficients: profiled out of every feature (project_out), recovered after the fit
-    W, inputs = nuisance_basis(data, i0, i1)
+    inputs = nuisance_basis(data, i0, i1)[1]  # the inputs nonzero in the window
+    W = nuisance_basis(data, 0, data.n_samples, inputs)[0]
+    # the fit band (identify.structural.fit_band): one zero-phase high-pass on every feature,
+    # target and nuisance column over the whole record, then the window
+    fc = fit_band_cutoff(data, est.fit_band_hz)[0]
+    if fc > 0:
+        full = [elliptic_highpass(a, data.fs, fc, FIT_BAND_ORDER) for a in full]
+        W = elliptic_highpass(W.T, data.fs, fc, FIT_BAND_ORDER).T if W.shape[1] else W
+    raw = [a[:, i0:i1] for a in full]
+    W = np.ascontiguousarray(W[i0:i1])
     n_u = inputs.size
     sig = project_out(W, *raw)
     xdd, xd, x = sig[:3]
@@ -662,8 +730,11 @@ def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
     M = m0 * (L @ L.T)
     C, K = c0 * _sym(Q), k0 * _sym(P)
     K3 = sc3 * R if has_R else None
+    if K3 is not None and cubic_dir is not None:  # b (a . x^3): the one column's coefficients
+        K3 = np.outer(K3[:, 0], cubic_dir ** 3)
     # the free coefficients of the nuisance columns, from the unprojected residual
-    resid = M @ raw[0] + C @ raw[1] + K @ raw[2] + (K3 @ raw[3] if K3 is not None else 0.0)
+    K3f = None if K3 is None else (sc3 * R if cubic_dir is not None else K3)  # on the features
+    resid = M @ raw[0] + C @ raw[1] + K @ raw[2] + (K3f @ raw[3] if K3f is not None else 0.0)
     G = (np.linalg.lstsq(W / _rms(W, 0)[None, :], resid.T, rcond=NUISANCE_RCOND)[0]
          / _rms(W, 0)[:, None]).T if W.shape[1] else np.zeros((n, 0))
     input_map = None if data.input_map is None else np.array(data.input_map, dtype=float)

@@ -193,17 +193,7 @@ def fit_band(data: Measurement, build: Callable[[int], Library], cutoff_hz: floa
         Which rule chose it, for the fitted model's ``fit_band_rule_``.
     """
     s = int(data.free_start)
-    if cutoff_hz is not None:
-        fc, rule = float(cutoff_hz), f"fit_band_hz = {float(cutoff_hz):g} Hz (user setting)"
-    else:
-        peaks = modal_peaks(data).peaks
-        if peaks.size == 0:
-            return build(s), 0.0, "no measured peak: the chain's band as it is"
-        fc = FIT_BAND_FRACTION * float(peaks.min())
-        rule = f"{FIT_BAND_FRACTION:g} x the lowest measured peak ({peaks.min():.4g} Hz)"
-        chain_hp = 0.0 if data.passband is None else float(data.passband[0])
-        if not fc > chain_hp:
-            return build(s), 0.0, rule + f": not above the chain's high-pass ({chain_hp:g} Hz), none added"
+    fc, rule = fit_band_cutoff(data, cutoff_hz)
     if fc <= 0:
         return build(s), 0.0, rule
     full = build(0)
@@ -212,6 +202,26 @@ def fit_band(data: Measurement, build: Callable[[int], Library], cutoff_hz: floa
         return elliptic_highpass(z, data.fs, fc, FIT_BAND_ORDER)[:, s:]
 
     return Library(hp(full.theta), hp(full.target), full.mask, full.names, full.blocks), fc, rule
+
+
+def fit_band_cutoff(data: Measurement, cutoff_hz: float | None = None) -> tuple[float, str]:
+    """The cut-off [Hz] of :func:`fit_band`'s high-pass and the rule that chose it (0 = none).
+
+    ``cutoff_hz`` (a user's setting) wins; otherwise :data:`FIT_BAND_FRACTION` x the lowest
+    peak of :func:`modal_peaks`, none when no peak is accepted or when it would not be above
+    the chain's own high-pass.
+    """
+    if cutoff_hz is not None:
+        return float(cutoff_hz), f"fit_band_hz = {float(cutoff_hz):g} Hz (user setting)"
+    peaks = modal_peaks(data).peaks
+    if peaks.size == 0:
+        return 0.0, "no measured peak: the chain's band as it is"
+    fc = FIT_BAND_FRACTION * float(peaks.min())
+    rule = f"{FIT_BAND_FRACTION:g} x the lowest measured peak ({peaks.min():.4g} Hz)"
+    chain_hp = 0.0 if data.passband is None else float(data.passband[0])
+    if not fc > chain_hp:
+        return 0.0, rule + f": not above the chain's high-pass ({chain_hp:g} Hz), none added"
+    return fc, rule
 
 
 def driving_point_scaling(M: np.ndarray, C: np.ndarray, K: np.ndarray, K3: np.ndarray | None,

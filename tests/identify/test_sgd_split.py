@@ -57,6 +57,8 @@ MATRIX_CASES = {
     # with a 0.1 step the synthetic chain's modes end up to 2.2 % off and the hold puts mode 3
     # at its band's edge, 537.8 Hz for the 533.8 Hz peak (measured)
     "eigen_hold": ({"learning_rate": 0.1}, False),
+    "cubic_form": ({"cubic": True, "data": "duffing"}, "direction"),
+    "fit_band": ({}, True),
 }
 
 COEFFICIENT_CASES = {
