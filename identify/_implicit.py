@@ -155,6 +155,29 @@ def _solve_masked(Gn: np.ndarray, cand: np.ndarray, mask: np.ndarray, ridge: flo
     return out
 
 
+def _stlsq_rounds(Gn: np.ndarray, cand: np.ndarray, base: np.ndarray, xi: np.ndarray,
+                  thr: np.ndarray, ridge: float, max_iter: int) -> np.ndarray:
+    """The thresholding rounds of :func:`stlsq_sweep` batched across candidates, each round's
+    refits by :func:`_solve_masked` (LAPACK, minimum norm on exactly singular supports).
+
+    The path for candidates the compiled kernel flags as exactly singular; models of shape
+    (T, C, p).
+    """
+    xi = xi.copy()
+    mask = base.copy()
+    models = np.empty((thr.size, cand.size, Gn.shape[0]))
+    for t, lam in enumerate(thr):
+        for _ in range(max_iter):
+            new = base & (np.abs(xi) >= lam)
+            changed = np.flatnonzero((new != mask).any(axis=1))
+            if changed.size == 0:
+                break
+            mask[changed] = new[changed]
+            xi[changed] = _solve_masked(Gn, cand[changed], mask[changed], ridge)
+        models[t] = xi
+    return models
+
+
 def stlsq_sweep(G_train: np.ndarray, G_val: np.ndarray, candidates: Sequence[int],
                 thresholds: Sequence[float], ridge: float = 1e-14, max_iter: int = 20) -> Sweep:
     """SINDy-PI by sequentially thresholded least squares, all candidates on one Gram matrix.
@@ -207,17 +230,15 @@ def stlsq_sweep(G_train: np.ndarray, G_val: np.ndarray, candidates: Sequence[int
     base = ~dead[None, :].repeat(n_c, axis=0)
     base[idx, cand] = False
     xi[~base] = 0.0
-    mask = base.copy()
-    models = np.empty((thr.size, n_c, p))
-    for t, lam in enumerate(thr):
-        for _ in range(max_iter):
-            new = base & (np.abs(xi) >= lam)
-            changed = np.flatnonzero((new != mask).any(axis=1))
-            if changed.size == 0:
-                break
-            mask[changed] = new[changed]
-            xi[changed] = _solve_masked(Gn, cand[changed], mask[changed], ridge)
-        models[t] = xi
+    from identify._pi_kernels import stlsq_chains, stlsq_chains_downdate  # lazy: numba ~0.4 s
+
+    args = (thr, float(ridge), int(max_iter))
+    models, status, _ = stlsq_chains_downdate(Gn, cand, ~dead, base, xi, *args)
+    if np.all(status == 2):  # Gn + ridge I not numerically positive definite: fresh refits
+        models, status, _ = stlsq_chains(Gn, cand, base, xi, *args)
+    bad = np.flatnonzero(status == 2)  # a support exactly singular: minimum-norm refits
+    if bad.size:
+        models[:, bad] = _stlsq_rounds(Gn, cand[bad], base[bad], xi[bad], thr, ridge, max_iter)
     if not np.all(np.isfinite(models)):
         raise IdentificationError("the thresholded least-squares sweep produced non-finite "
                                   "coefficients (library columns exactly dependent?)")
