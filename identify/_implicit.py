@@ -187,8 +187,20 @@ def stlsq_sweep(G_train: np.ndarray, G_val: np.ndarray, candidates: Sequence[int
     from one inverse, ``B = (G + ridge I)^-1``: ``xi = -B[:, j] / B[j, j]`` (the Schur
     complement identity).  Then, threshold by threshold (ascending, warm-started from the
     previous threshold's models), coefficients with ``|xi| < threshold`` are zeroed and the
-    models whose support changed are refitted on their support in one batched solve, until no
-    support changes (at most ``max_iter`` rounds).
+    models whose support changed are refitted on their support, until no support changes (at
+    most ``max_iter`` rounds).  The refits run in one compiled loop
+    (:func:`identify._pi_kernels.stlsq_chains_downdate`): supports only shrink along a
+    candidate's path, so each refit deletes columns from one shared Cholesky factor of
+    ``G + ridge I`` by Givens rotations instead of factorising anew (at 100k x 97: ~1,280
+    refits, 87 ms as batched LAPACK solves, ~12 ms compiled).  If that factor does not exist
+    (not numerically positive definite) each refit gets a fresh Cholesky, else LU
+    (:func:`identify._pi_kernels.stlsq_chains`); an exactly singular support sends its
+    candidate to the round-batched LAPACK path with minimum-norm solutions
+    (:func:`_stlsq_rounds`).  All paths solve the same normal equations and agree to
+    round-off times the support's condition number (``tests/identify/test_sindy_pi_kernels.py``
+    states the comparison rule); on exact data, where supports along the path are
+    rank-deficient, round-off decides intermediate supports and so the threshold index at
+    which a selected equation is first reached (its support and coefficients are unchanged).
 
     Parameters
     ----------
