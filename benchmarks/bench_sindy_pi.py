@@ -10,8 +10,9 @@ precomputed factor.  Ours: the training and validation Gram matrices + the sweep
 the compiled downdating refits, held-out errors) + selection.  pysindy: the same Gram matrices
 (its models are scored by the same held-out selection) + column normalisation + for "QR" the R
 factor of the normalised training rows (``np.linalg.qr``, inside the timed region) + its
-optimiser + the same selection.  The floor of ours is what any Gram-based fit must do: build the library matrix and
-its Gram matrices once; ours end to end (build + Grams + sweep + selection) is timed against it.
+optimiser + the same selection.  The floor of ours is what any Gram-based fit must do: build
+the library matrix and its Gram matrices once; ours end to end (build + Grams + sweep +
+selection) is timed against it.
 
 Honest timing (:mod:`benchmarks._timing`): BLAS pinned by ``threadpool_limits(1)`` around
 every timed call, contenders interleaved, medians with spread; no tracer in a timed region
