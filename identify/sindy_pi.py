@@ -2,8 +2,9 @@
 
 For every candidate left-hand-side term j a sparse regression ``Theta_j ~ Theta_{-j} xi`` by
 sequentially thresholded least squares over a sweep of thresholds.  All candidates share one
-Gram matrix ``G = Theta^T Theta``: first solutions from one inverse, thresholded refits as one
-batched solve per round (:func:`identify._implicit.stlsq_sweep`), held-out errors from the
+Gram matrix ``G = Theta^T Theta``: first solutions from one inverse, thresholded refits by
+downdating one Cholesky factor in a compiled loop (:func:`identify._implicit.stlsq_sweep`),
+held-out errors from the
 validation Gram matrix.  No per-candidate convex solver and no pass over the samples after the
 Gram matrices are formed.
 
