@@ -103,11 +103,13 @@ from dataclasses import dataclass
 from typing import Any, Literal
 
 import numpy as np
-from scipy import linalg
 
 from identify.structural import FIT_BAND_ORDER, MODE_SEPARATION, fit_band_cutoff
+from testbed.core.lazy import lazy_module
 from testbed.core.measurement import Measurement
 from testbed.numerics.filters import elliptic_highpass
+
+linalg = lazy_module("scipy.linalg")  # imported on first use: `testbed list` does not pay for it
 
 #: Relative singular-value cut-off of the nuisance columns' basis (:func:`nuisance_basis`):
 #: the drift rows and the force are independent waveforms, so only an exactly repeated column

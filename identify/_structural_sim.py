@@ -8,10 +8,12 @@ by a compiled loop (:func:`identify._compiled.rk4_cubic`).
 from __future__ import annotations
 
 import numpy as np
-from scipy import linalg
 
 from testbed.core.errors import DivergenceError
+from testbed.core.lazy import lazy_module
 from testbed.core.measurement import Trajectory
+
+linalg = lazy_module("scipy.linalg")  # imported on first use: `testbed list` does not pay for it
 
 
 def _zoh_free_and_forced(A: np.ndarray, Bz: np.ndarray | None, z0: np.ndarray, dt: float, n_t: int,

@@ -44,7 +44,6 @@ from collections.abc import Sequence
 from typing import ClassVar
 
 import numpy as np
-from scipy.linalg import expm
 
 from identify import IDENTIFIERS
 from identify._base import Identifier
@@ -61,8 +60,11 @@ from identify.sindy_pi import (
 )
 from identify.structural import remove_drift, unwarp_trapezoid
 from testbed.core.errors import IdentificationError
+from testbed.core.lazy import lazy_module
 from testbed.core.measurement import Measurement, Trajectory
 from testbed.core.schema import Field
+
+linalg = lazy_module("scipy.linalg")  # imported on first use: `testbed list` does not pay for it
 
 
 def _sym_basis(n: int) -> np.ndarray:
@@ -294,7 +296,7 @@ class SINDyPILinear(Identifier):
         B = self.input_map_ if u is not None else np.zeros((n, 0))
         m = B.shape[1]
         Bz = np.vstack([np.zeros((n, m)), Minv @ B])
-        E = expm(np.block([[A, Bz], [np.zeros((m, 2 * n + m))]]) * dt)
+        E = linalg.expm(np.block([[A, Bz], [np.zeros((m, 2 * n + m))]]) * dt)
         Ad, Bd = E[:2 * n, :2 * n], E[:2 * n, 2 * n:]
         uu = np.zeros((m, t.size)) if u is None else np.atleast_2d(np.asarray(u, dtype=float))
         Z = np.empty((2 * n, t.size))

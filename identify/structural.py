@@ -27,17 +27,20 @@ from collections.abc import Callable
 from dataclasses import dataclass, replace
 
 import numpy as np
-import scipy.fft as sfft
-from scipy import linalg
 
 from identify._base import Identifier
 from identify._structural_sim import simulate_structural
 from testbed.core.errors import IdentificationError
+from testbed.core.lazy import lazy_module
 from testbed.core.measurement import Measurement, Trajectory
 from testbed.core.schema import Field
 from testbed.numerics.filters import elliptic_highpass
 from testbed.numerics.shapes import mac_matrix
 from testbed.numerics.spectral import harmonic_amplitude_law, peak_candidates
+
+# imported on first use: `testbed list` does not pay for them
+sfft = lazy_module("scipy.fft")
+linalg = lazy_module("scipy.linalg")
 
 #: Keys of ``Measurement.prior`` a structural identifier may take the mass scale from.
 MASS_PRIORS = ("reduced_mass_trace", "total_mass")

@@ -163,7 +163,7 @@ def cmd_list(args: argparse.Namespace) -> int:
                 for n in registry.names()]
         sections.append((title, ("name", "kind", "tags", "from"), rows))
     rows = [(s.name, s.rig, (s.identify or {}).get("method", "-"), f"{s.noise['rms_percent']:g}",
-             s.description) for s in list_scenarios()]
+             s.description) for s in list_scenarios(check_cost=False)]  # budgets: at run time
     sections.append(("scenarios", ("name", "rig", "identifier", "noise %", "description"), rows))
     if args.plain or not sys.stdout.isatty():
         # piped into another program: every field whole, tab-separated, one header per section

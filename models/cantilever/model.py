@@ -11,14 +11,16 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
-import mujoco
 import numpy as np
 
 from models.cantilever import truth as tr
 from models.cantilever.beam import BeamParams, build_mjcf
 from models.cantilever.euler_bernoulli import eb_frequencies
 from models.cantilever.simulate import Stepping, choose_stepping
+from testbed.core.lazy import lazy_module
 from testbed.core.truth import StructuralTruth
+
+mujoco = lazy_module("mujoco")  # imported on first use: `testbed list` does not pay for it
 
 N_EB = 4  # Euler-Bernoulli frequencies reported
 

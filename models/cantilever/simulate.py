@@ -66,12 +66,15 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
-import mujoco
-import mujoco.rollout
 import numpy as np
-import scipy.linalg as sla
 
 from testbed.core.errors import RigError
+from testbed.core.lazy import lazy_module
+
+# imported on first use: `testbed list` does not pay for them
+mujoco = lazy_module("mujoco")
+rollout = lazy_module("mujoco.rollout")
+sla = lazy_module("scipy.linalg")
 
 RK4_STABILITY = 2.0        # dt * max|eig(A)| for RK4 (stable to ~2.5; 20 % margin)
 RK4_ACCURACY = 0.49        # omega_Nyquist dt: (0.49)^4 / 120 = 4.8e-4 relative frequency error
@@ -258,11 +261,11 @@ def half_sine(peak: float, duration: float, start: float) -> Callable[[np.ndarra
     return force
 
 
-_WARNINGS = {  # MuJoCo's warnings that mean the state was reset or the input refused
-    mujoco.mjtWarning.mjWARN_BADQACC: "accelerations",
-    mujoco.mjtWarning.mjWARN_BADQVEL: "velocities",
-    mujoco.mjtWarning.mjWARN_BADQPOS: "positions",
-    mujoco.mjtWarning.mjWARN_BADCTRL: "hammer force (control)",
+_WARNINGS = {  # MuJoCo's warnings that mean the state was reset or the input refused (by name:
+    "mjWARN_BADQACC": "accelerations",  # MuJoCo is imported on first use)
+    "mjWARN_BADQVEL": "velocities",
+    "mjWARN_BADQPOS": "positions",
+    "mjWARN_BADCTRL": "hammer force (control)",
 }
 
 
@@ -277,7 +280,8 @@ def check_warnings(model: mujoco.MjModel, data: mujoco.MjData, when: str = "") -
     """
     integ = mujoco.mjtIntegrator(model.opt.integrator).name.removeprefix("mjINT_")
     integ = {"IMPLICITFAST": "implicitfast", "IMPLICIT": "implicit", "EULER": "Euler"}.get(integ, integ)
-    for w, what in _WARNINGS.items():
+    for name, what in _WARNINGS.items():
+        w = getattr(mujoco.mjtWarning, name)
         n = data.warning[w].number
         if not n:
             continue
@@ -332,7 +336,7 @@ def rollout_sensors(model: mujoco.MjModel, qpos0: np.ndarray, control: np.ndarra
     out = np.empty((nstep // substeps, model.nsensordata))
     for start in range(0, nstep, chunk):
         ctrl = control[start:start + chunk]
-        states, sens = mujoco.rollout.rollout(model, data, state[None, :], ctrl[None, :, None])
+        states, sens = rollout.rollout(model, data, state[None, :], ctrl[None, :, None])
         times = states[0, :, 0]  # the state starts with the time; a reset sets it back to 0
         back = np.flatnonzero(np.diff(times) < 0)
         check_warnings(model, data, f"near t = {times[back[0]]:.4g} s" if back.size else

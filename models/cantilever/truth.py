@@ -19,9 +19,13 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 
-import mujoco
 import numpy as np
-import scipy.linalg as sla
+
+from testbed.core.lazy import lazy_module
+
+# imported on first use: `testbed list` does not pay for them
+mujoco = lazy_module("mujoco")
+sla = lazy_module("scipy.linalg")
 
 
 def mass_matrix(model: mujoco.MjModel) -> np.ndarray:

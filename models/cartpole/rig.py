@@ -21,7 +21,6 @@ import math
 from collections.abc import Callable
 from typing import Any, ClassVar
 
-import mujoco
 import numpy as np
 
 from models import RIGS
@@ -29,8 +28,11 @@ from models._base import ErrorFn, Rig, check_sample_steps
 from models.cartpole.equations import CartPoleParams, true_equations
 from testbed.core.budget import Cost
 from testbed.core.dataset import Dataset, Signal
+from testbed.core.lazy import lazy_module
 from testbed.core.schema import Field
 from testbed.core.truth import MechanicalTruth
+
+mujoco = lazy_module("mujoco")  # imported on first use: `testbed list` does not pay for it
 
 _POS = {"min": 0.0, "min_inclusive": False}
 #: Bytes per sample of a run: 8 signal rows of float64 recorded, about as many again for the

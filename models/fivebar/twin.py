@@ -16,7 +16,6 @@ from __future__ import annotations
 
 from collections.abc import Callable
 
-import mujoco
 import numpy as np
 
 from models.fivebar import geometry as geo
@@ -25,6 +24,9 @@ from models.fivebar.excitation import TorqueProgram
 from models.fivebar.integrate import CHECK_EVERY, check_finite, check_transmission
 from models.fivebar.params import FiveBarParams
 from testbed.core.errors import RigError
+from testbed.core.lazy import lazy_module
+
+mujoco = lazy_module("mujoco")  # imported on first use: `testbed list` does not pay for it
 
 #: Constraint impedance: (dmin, dmax, width).  Close to 1 = nearly hard constraint.
 SOLIMP = (0.9999, 0.9999, 0.001)
@@ -79,8 +81,8 @@ def mjcf(p: FiveBarParams, dt: float) -> str:
 </mujoco>"""
 
 
-_RESETS = (mujoco.mjtWarning.mjWARN_BADQACC, mujoco.mjtWarning.mjWARN_BADQVEL,
-           mujoco.mjtWarning.mjWARN_BADQPOS, mujoco.mjtWarning.mjWARN_BADCTRL)
+#: The warnings of a state or control MuJoCo reset (names: MuJoCo is imported on first use).
+_RESETS = ("mjWARN_BADQACC", "mjWARN_BADQVEL", "mjWARN_BADQPOS", "mjWARN_BADCTRL")
 
 
 def check_resets(m: mujoco.MjModel, d: mujoco.MjData, t: float) -> None:
@@ -89,7 +91,8 @@ def check_resets(m: mujoco.MjModel, d: mujoco.MjData, t: float) -> None:
     MuJoCo answers a huge or non-finite acceleration, state or control by resetting
     (or zeroing) it and carrying on; the record would go on from the reset pose.
     """
-    for w in _RESETS:
+    for name in _RESETS:
+        w = getattr(mujoco.mjtWarning, name)
         n = d.warning[w].number
         if n:
             what = mujoco.mjtWarning(w).name.removeprefix("mjWARN_BAD").lower()

@@ -26,12 +26,14 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, TypeVar
 
-import h5py
 import numpy as np
 
 from testbed.core.atomic import atomic_write
 from testbed.core.errors import TestbedError
+from testbed.core.lazy import lazy_module
 from testbed.core.truth import Truth, TruthError, truth_type
+
+h5py = lazy_module("h5py")  # imported on first use: `testbed list` does not pay for it
 
 #: Format written.  /2: the content hash covers the data-defining attributes only (see
 #: :meth:`Dataset.content_hash`); /1 files hashed every attribute but versions and commit.

@@ -7,7 +7,10 @@ lab reads them off an FFT, never from the truth.
 from __future__ import annotations
 
 import numpy as np
-from scipy import fft as sfft
+
+from testbed.core.lazy import lazy_module
+
+sfft = lazy_module("scipy.fft")  # imported on first use: `testbed list` does not pay for it
 
 # Half-width of each window's main lobe in bins of the unpadded transform: peaks closer than
 # this are one lobe, not two modes.

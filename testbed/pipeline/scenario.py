@@ -309,11 +309,14 @@ def _check_stem(path: Path, what: str, directory: Path) -> None:
                                                + (", ".join(known) or f"(none in {directory})"))
 
 
-def load_scenario(name_or_path: str | os.PathLike, *, standalone: bool = True) -> Scenario:
+def load_scenario(name_or_path: str | os.PathLike, *, standalone: bool = True,
+                  check_cost: bool = True) -> Scenario:
     """Read and validate a scenario file (a path, or a name in ``scenarios/``).
 
     ``standalone=False`` (a study's scenario, whose identifiers come from the study) allows
-    ``[score]`` without ``[identify]``.
+    ``[score]`` without ``[identify]``.  ``check_cost=False`` skips the simulation budget
+    (:func:`check_rig_cost`), which builds the rig's model (MuJoCo for the cantilever): for
+    a listing, not for a run.
 
     Raises
     ------
@@ -324,12 +327,13 @@ def load_scenario(name_or_path: str | os.PathLike, *, standalone: bool = True) -
     path = resolve_path(name_or_path)
     _check_stem(path, "scenario", SCENARIO_DIR)
     raw = _read_toml(path)
-    return scenario_from_dict(raw, file=str(path), stem=path.stem, standalone=standalone)
+    return scenario_from_dict(raw, file=str(path), stem=path.stem, standalone=standalone,
+                              check_cost=check_cost)
 
 
 def scenario_from_dict(raw: dict[str, Any], *, file: str = "<dict>", stem: str | None = None,
-                       standalone: bool = True) -> Scenario:
-    """Validate a scenario given as a dict of TOML tables (``standalone``: see
+                       standalone: bool = True, check_cost: bool = True) -> Scenario:
+    """Validate a scenario given as a dict of TOML tables (``standalone``, ``check_cost``: see
     :func:`load_scenario`)."""
 
     head = validate_header(raw, sections=SECTIONS, header="scenario", schema=HEADER_SCHEMA, file=file,
@@ -372,7 +376,8 @@ def scenario_from_dict(raw: dict[str, Any], *, file: str = "<dict>", stem: str |
                                                    "identified model to score")
     if identify is not None:
         check_identifier_for_rig(rig_cls, rig_params, simulation, identify, file=file)
-    check_rig_cost(rig_cls, rig_params, simulation, excitation, file=file)
+    if check_cost:
+        check_rig_cost(rig_cls, rig_params, simulation, excitation, file=file)
     return Scenario(name=head["name"], rig=head["rig"], seed=head["seed"],
                     description=head["description"], tags=tuple(head["tags"]),
                     rig_params=rig_params, simulation=simulation, excitation=excitation,
@@ -488,7 +493,8 @@ def _validate_score(table: Any, kind: str, file: str) -> dict[str, dict[str, flo
     return out
 
 
-def list_scenarios(directory: Path | None = None) -> list[Scenario]:
-    """Every scenario file in ``directory`` (default ``scenarios/``), validated, sorted by name."""
+def list_scenarios(directory: Path | None = None, *, check_cost: bool = True) -> list[Scenario]:
+    """Every scenario file in ``directory`` (default ``scenarios/``), validated, sorted by name
+    (``check_cost``: see :func:`load_scenario`)."""
     directory = directory or SCENARIO_DIR
-    return [load_scenario(p) for p in sorted(Path(directory).glob("*.toml"))]
+    return [load_scenario(p, check_cost=check_cost) for p in sorted(Path(directory).glob("*.toml"))]

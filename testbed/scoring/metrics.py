@@ -7,9 +7,13 @@ mode-shape matrices hold one mode per column, ``(n_dof, n_modes)``.
 from __future__ import annotations
 
 import numpy as np
-from scipy import linalg, optimize
 
+from testbed.core.lazy import lazy_module
 from testbed.numerics.shapes import mac_matrix as mac_matrix  # re-exported: the scorers' name
+
+# imported on first use: `testbed list` does not pay for them
+linalg = lazy_module("scipy.linalg")
+optimize = lazy_module("scipy.optimize")
 
 
 def worst(values, how: str) -> float:

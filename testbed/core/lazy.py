@@ -1,0 +1,58 @@
+"""Heavy third-party modules imported on first use, not at start-up.
+
+``testbed list`` imports every rig and identifier module (the registries import their packages)
+and must not pay for the engines and libraries they use only when they compute: MuJoCo
+(~0.1 s of import), h5py (~0.07 s), SciPy's ``linalg``, ``fft``, ``optimize`` (~0.1-0.3 s).
+A module that uses one in many places binds a :class:`LazyModule` at its top instead of the
+module itself::
+
+    sla = lazy_module("scipy.linalg")   # nothing imported yet
+    ...
+    w = sla.eigh(K, M, eigvals_only=True)   # imported here, once
+
+``tests/test_cli_startup.py`` checks that listing the registries imports none of them.
+"""
+
+from __future__ import annotations
+
+import importlib
+from types import ModuleType
+from typing import Any
+
+__all__ = ["LazyModule", "lazy_module"]
+
+
+class LazyModule:
+    """Stands for the module ``name`` and imports it on the first attribute lookup.
+
+    After the import the module's attributes are copied onto the proxy, so later lookups are
+    plain instance-attribute lookups (as fast as a module's: the MuJoCo step loops call through
+    it); a name the module gains later (a submodule imported afterwards) is still found, through
+    :meth:`__getattr__`.
+
+    Parameters
+    ----------
+    name : str
+        Dotted name of the module (``"scipy.linalg"``, ``"mujoco"``).
+    """
+
+    def __init__(self, name: str) -> None:
+        object.__setattr__(self, "_lazy_name", name)
+
+    def _lazy_load(self) -> ModuleType:
+        module = importlib.import_module(self._lazy_name)
+        self.__dict__.update(vars(module))
+        return module
+
+    def __getattr__(self, attr: str) -> Any:  # only for names not yet on the proxy
+        if attr.startswith("__") and attr.endswith("__"):
+            raise AttributeError(attr)  # copy, pickle and friends probe these: not a reason to import
+        return getattr(self._lazy_load(), attr)
+
+    def __repr__(self) -> str:
+        return f"<lazy module {self._lazy_name!r}>"
+
+
+def lazy_module(name: str) -> Any:
+    """A :class:`LazyModule` for ``name`` (typed ``Any``: it is used as the module itself)."""
+    return LazyModule(name)

@@ -1,0 +1,118 @@
+"""Start-up cost of the command line, checked by what is imported (deterministic), not by a clock.
+
+``testbed list`` imports every rig and identifier module (the registries import their packages)
+and validates every scenario file; none of that may import an engine or a heavy library: they
+are imported where a command computes (``testbed.core.lazy``).  ``benchmarks/bench_cli.py``
+times the same commands.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import pytest
+
+from testbed.core.lazy import LazyModule, lazy_module
+
+ROOT = Path(__file__).resolve().parent.parent.parent
+TIMEOUT_S = 120
+
+#: Modules ``testbed list`` must not import (each costs 0.07-0.4 s of start-up, measured).
+HEAVY = ("mujoco", "pinocchio", "h5py", "matplotlib", "numba", "scipy.linalg", "scipy.signal",
+         "scipy.optimize", "scipy.fft", "sklearn", "pysindy", "joblib")
+
+
+def _in_fresh_process(code: str) -> dict:
+    env = dict(os.environ, PYTHONPATH=str(ROOT), MPLBACKEND="Agg")
+    r = subprocess.run([sys.executable, "-c", textwrap.dedent(code)], cwd=ROOT, env=env,
+                       capture_output=True, text=True, timeout=TIMEOUT_S)
+    assert r.returncode == 0, r.stderr
+    return json.loads(r.stdout.strip().splitlines()[-1])
+
+
+def test_list_imports_no_engine_and_no_heavy_library():
+    out = _in_fresh_process(f"""
+        import contextlib, io, json, sys
+        from testbed.cli import main
+        buf = io.StringIO()
+        with contextlib.redirect_stdout(buf):
+            code = main(["list", "--plain"])
+        print(json.dumps({{"code": code, "listing": buf.getvalue(),
+                          "heavy": [m for m in {HEAVY!r} if m in sys.modules]}}))
+    """)
+    assert out["code"] == 0
+    # the listing is whole: every built-in rig and a scored scenario of each engine
+    for name in ("cantilever", "fivebar", "cartpole", "sgd_sindy", "cantilever_stiff_impact"):
+        assert f"\n{name}\t" in out["listing"], name
+    assert out["heavy"] == [], f"`testbed list` imported {out['heavy']}"
+
+
+def test_version_imports_nothing_of_the_project_below_the_cli():
+    out = _in_fresh_process("""
+        import contextlib, io, json, sys
+        from testbed.cli import main
+        with contextlib.redirect_stdout(io.StringIO()):
+            try:
+                main(["--version"])
+            except SystemExit:
+                pass
+        print(json.dumps({"loaded": sorted(m for m in sys.modules
+                                           if m.split(".")[0] in ("models", "identify", "numpy"))}))
+    """)
+    assert out["loaded"] == []
+
+
+def test_the_budget_is_still_checked_when_a_scenario_is_loaded_for_a_run():
+    """The listing skips the simulation budget (it builds the rig's MuJoCo model); loading a
+    scenario to run it does not."""
+    from testbed.core.errors import BudgetError
+    from testbed.pipeline.scenario import scenario_from_dict
+
+    raw = {"scenario": {"name": "huge", "rig": "cantilever"},
+           "simulation": {"duration": 1e5, "sample_rate": 12800.0}}
+    with pytest.raises(BudgetError):
+        scenario_from_dict(raw)
+    assert scenario_from_dict(raw, check_cost=False).name == "huge"
+
+
+@pytest.fixture
+def probe_module(tmp_path, monkeypatch):
+    """A module on ``sys.path`` that nothing has imported, counting its own imports."""
+    (tmp_path / "lazy_probe_mod.py").write_text(
+        "import builtins\n"
+        "builtins.lazy_probe_imports = getattr(builtins, 'lazy_probe_imports', 0) + 1\n"
+        "VALUE = 42\n")
+    monkeypatch.syspath_prepend(str(tmp_path))
+    monkeypatch.delitem(sys.modules, "lazy_probe_mod", raising=False)
+    import builtins
+    monkeypatch.setattr(builtins, "lazy_probe_imports", 0, raising=False)
+    yield "lazy_probe_mod"
+    sys.modules.pop("lazy_probe_mod", None)
+
+
+def test_lazy_module_imports_on_first_attribute_only(probe_module):
+    import builtins
+
+    mod = lazy_module(probe_module)
+    assert isinstance(mod, LazyModule)
+    repr(mod)
+    assert not hasattr(mod, "__wrapped__")  # a dunder probe (copy, inspect) does not import
+    assert probe_module not in sys.modules and builtins.lazy_probe_imports == 0
+    assert mod.VALUE == 42
+    assert probe_module in sys.modules and builtins.lazy_probe_imports == 1
+    assert mod.VALUE == 42 and builtins.lazy_probe_imports == 1  # once
+    sys.modules[probe_module].LATER = "added after the import"
+    assert mod.LATER == "added after the import"  # found through the module, not the copy
+    with pytest.raises(AttributeError):
+        _ = mod.MISSING
+
+
+def test_lazy_module_of_a_missing_module_fails_at_first_use():
+    mod = lazy_module("no_such_module_for_testbed_xyz")
+    with pytest.raises(ModuleNotFoundError):
+        _ = mod.anything
