@@ -51,11 +51,13 @@ from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
 
-import pyarrow as pa
-import pyarrow.parquet as pq
-
 from testbed.core.atomic import atomic_write, atomic_write_text
 from testbed.core.errors import TestbedError
+from testbed.core.lazy import lazy_module
+
+# imported on first use: a run's report and `testbed list` do not pay for them (~0.05 s)
+pa = lazy_module("pyarrow")
+pq = lazy_module("pyarrow.parquet")
 
 FORMAT = "sysid-testbed-results/1"
 
@@ -65,15 +67,15 @@ log = logging.getLogger(__name__)
 class ResultsError(TestbedError, ValueError):
     """A results file cannot be read or is not a results file of :data:`FORMAT`; names the file."""
 
-BASE_COLUMNS: dict[str, pa.DataType] = {
-    "study": pa.string(), "cell": pa.string(), "scenario": pa.string(), "rig": pa.string(),
-    "noise": pa.float64(), "seed": pa.int64(), "identifier": pa.string(), "params": pa.string(),
-    "status": pa.string(), "error": pa.string(), "fit_time": pa.float64(),
-    "data_time": pa.float64(), "cell_time": pa.float64(), "passed": pa.bool_(),
+#: Column name -> its Arrow type, by the name of the ``pyarrow`` type factory.
+BASE_COLUMNS: dict[str, str] = {
+    "study": "string", "cell": "string", "scenario": "string", "rig": "string",
+    "noise": "float64", "seed": "int64", "identifier": "string", "params": "string",
+    "status": "string", "error": "string", "fit_time": "float64",
+    "data_time": "float64", "cell_time": "float64", "passed": "bool_",
 }
-TAIL_COLUMNS: dict[str, pa.DataType] = {
-    "checks": pa.string(), "versions": pa.string(), "commit": pa.string(),
-    "dataset_hash": pa.string(),
+TAIL_COLUMNS: dict[str, str] = {
+    "checks": "string", "versions": "string", "commit": "string", "dataset_hash": "string",
 }
 SORT_KEYS = ("scenario", "noise", "seed", "identifier", "cell")
 
@@ -140,9 +142,9 @@ def _read_parts(path: str | os.PathLike, set_aside: bool = False) -> list[dict[s
 
 def _to_table(rows: list[dict[str, Any]], study: str | None) -> pa.Table:
     scores = score_columns(rows)
-    schema = pa.schema([*(pa.field(k, t) for k, t in BASE_COLUMNS.items()),
+    schema = pa.schema([*(pa.field(k, getattr(pa, t)()) for k, t in BASE_COLUMNS.items()),
                         *(pa.field(k, pa.float64()) for k in scores),
-                        *(pa.field(k, t) for k, t in TAIL_COLUMNS.items())],
+                        *(pa.field(k, getattr(pa, t)()) for k, t in TAIL_COLUMNS.items())],
                        metadata={"format": FORMAT, "study": study or ""})
     cols = {}
     for f in schema:

@@ -24,7 +24,7 @@ TIMEOUT_S = 120
 
 #: Modules ``testbed list`` must not import (each costs 0.07-0.4 s of start-up, measured).
 HEAVY = ("mujoco", "pinocchio", "h5py", "matplotlib", "numba", "scipy.linalg", "scipy.signal",
-         "scipy.optimize", "scipy.fft", "sklearn", "pysindy", "joblib")
+         "scipy.optimize", "scipy.fft", "sklearn", "pysindy", "joblib", "pyarrow")
 
 
 def _in_fresh_process(code: str) -> dict:
@@ -63,6 +63,18 @@ def test_version_imports_nothing_of_the_project_below_the_cli():
                 pass
         print(json.dumps({"loaded": sorted(m for m in sys.modules
                                            if m.split(".")[0] in ("models", "identify", "numpy"))}))
+    """)
+    assert out["loaded"] == []
+
+
+def test_the_modules_of_a_run_import_no_figure_and_no_table_library():
+    """`testbed run --no-figures` imports what `cmd_run` imports; matplotlib (a figure) and
+    pyarrow (a sweep's results table) are imported where they are used."""
+    out = _in_fresh_process("""
+        import json, sys
+        import testbed.reporting.console, testbed.reporting.report, testbed.scoring.run
+        import testbed.studies.runstore
+        print(json.dumps({"loaded": [m for m in ("matplotlib", "pyarrow") if m in sys.modules]}))
     """)
     assert out["loaded"] == []
 
