@@ -8,10 +8,12 @@ import numpy as np
 
 from identify import IDENTIFIERS
 from identify.structural import (
+    CUBIC_SELECT_CORR,
     FIT_BAND_FIELD,
     MASS_PRIORS,
     StructuralIdentifier,
     build_library,
+    cubic_partial_correlation,
     fit_band,
     mass_prior_value,
     matrices_from_coef,
@@ -44,8 +46,11 @@ class LeastSquaresSINDy(StructuralIdentifier):
 
     Parameters
     ----------
-    cubic : bool
-        Add the cubic displacement features ``x_j^3``.
+    cubic : bool or None
+        Add the cubic displacement features ``x_j^3``.  None (default): by rule, when the largest
+        partial correlation of an ``x_j^3`` column with a row's linear-model residual exceeds
+        :data:`identify.structural.CUBIC_SELECT_CORR` (``cubic_`` and ``cubic_rule_`` say what
+        was chosen and why).
     mass_prior : {"reduced_mass_trace", "total_mass"}
         Key of ``data.prior`` giving the mass scale [kg] (see
         :func:`identify.structural.mass_prior_value`); same option as ``sgd_sindy``.
@@ -101,7 +106,9 @@ class LeastSquaresSINDy(StructuralIdentifier):
 
     name = "ls_sindy"
     hyperparameters: ClassVar[dict[str, Field]] = {
-        "cubic": Field(bool, False, doc="add the cubic displacement features x_j^3"),
+        "cubic": Field(bool, None, doc="add the cubic displacement features x_j^3; default by "
+                                       "rule: when one correlates with the linear model's "
+                                       "residual above CUBIC_SELECT_CORR"),
         "mass_prior": MASS_PRIOR_FIELD,
         # [0, 1): a relative cut-off of 1 or more would discard every singular value;
         # numpy's legacy -1 (machine precision) is not a documented choice here
@@ -110,8 +117,8 @@ class LeastSquaresSINDy(StructuralIdentifier):
         "fit_band_hz": FIT_BAND_FIELD,
     }
 
-    def __init__(self, cubic: bool = False, mass_prior: str = "reduced_mass_trace", rcond: float = 1e-10,
-                 fit_band_hz: float | None = None):
+    def __init__(self, cubic: bool | None = None, mass_prior: str = "reduced_mass_trace",
+                 rcond: float = 1e-10, fit_band_hz: float | None = None):
         self.cubic = cubic
         self.mass_prior = mass_prior
         self.rcond = rcond
@@ -131,9 +138,24 @@ class LeastSquaresSINDy(StructuralIdentifier):
         self.check_params()
         m_hat = mass_prior_value(data, self.mass_prior)
 
-        lib, self.fit_band_hz_, self.fit_band_rule_ = fit_band(
-            data, lambda s: build_library(data, coupled_mass=False, cubic=bool(self.cubic), start=s,
-                                          drift=True, input_coupling=True), self.fit_band_hz)
+        def library(cubic: bool) -> tuple:
+            return fit_band(data, lambda s: build_library(data, coupled_mass=False, cubic=cubic,
+                                                          start=s, drift=True, input_coupling=True),
+                            self.fit_band_hz)
+
+        if self.cubic is not None:
+            self.cubic_ = bool(self.cubic)
+            self.cubic_rule_ = "user setting"
+            lib, self.fit_band_hz_, self.fit_band_rule_ = library(self.cubic_)
+        else:
+            lib, self.fit_band_hz_, self.fit_band_rule_ = library(True)
+            corr = cubic_partial_correlation(lib)
+            self.cubic_ = corr > CUBIC_SELECT_CORR
+            self.cubic_rule_ = (f"largest partial correlation of an x^3 column with the linear "
+                                f"model's residual {corr:.3g} {'>' if self.cubic_ else '<='} "
+                                f"{CUBIC_SELECT_CORR:g}: cubic terms {'in' if self.cubic_ else 'out'}")
+            if not self.cubic_:
+                lib, self.fit_band_hz_, self.fit_band_rule_ = library(False)
         n, p = lib.target.shape[0], lib.theta.shape[0]
         coef = solve_rows(lib, self.rcond)
         masses = np.full(n, m_hat / n)

@@ -70,6 +70,21 @@ def test_cubic_recovered_by_lstsq():
     assert _rel(got, want) < 1e-5
 
 
+def test_cubic_terms_chosen_by_rule(lumped):
+    """Default cubic=None: a cubic force correlates with the linear model's residual and the
+    x^3 columns enter; on a linear chain they stay out (exact data: correlation ~ rounding)."""
+    _, linear = lumped
+    model = LeastSquaresSINDy().fit(linear)
+    assert model.cubic_ is False and model.K3_ is None
+    assert "cubic terms out" in model.cubic_rule_
+    sysd = bench.chain_system(coupled=False, damping="proportional", k3=2.0e12)
+    model = LeastSquaresSINDy().fit(bench.chain_measurement(sysd))
+    assert model.cubic_ is True and "cubic terms in" in model.cubic_rule_
+    got = np.linalg.solve(model.M_, model.K3_)
+    assert _rel(got, np.linalg.solve(sysd["M"], sysd["K3"])) < 1e-5  # as cubic=True below
+    assert LeastSquaresSINDy(cubic=False).fit(bench.chain_measurement(sysd)).cubic_rule_ == "user setting"
+
+
 def test_simulate_matches_independent_integration(coupled):
     """Exact ZOH discretisation vs DOP853 at rtol 1e-11: agreement to ~1e-9 of the amplitude."""
     sysd, data = coupled
