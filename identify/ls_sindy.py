@@ -8,12 +8,11 @@ import numpy as np
 
 from identify import IDENTIFIERS
 from identify.structural import (
-    CUBIC_SELECT_CORR,
     FIT_BAND_FIELD,
     MASS_PRIORS,
     StructuralIdentifier,
     build_library,
-    cubic_partial_correlation,
+    cubic_rule,
     fit_band,
     mass_prior_value,
     matrices_from_coef,
@@ -138,24 +137,10 @@ class LeastSquaresSINDy(StructuralIdentifier):
         self.check_params()
         m_hat = mass_prior_value(data, self.mass_prior)
 
-        def library(cubic: bool) -> tuple:
-            return fit_band(data, lambda s: build_library(data, coupled_mass=False, cubic=cubic,
-                                                          start=s, drift=True, input_coupling=True),
-                            self.fit_band_hz)
-
-        if self.cubic is not None:
-            self.cubic_ = bool(self.cubic)
-            self.cubic_rule_ = "user setting"
-            lib, self.fit_band_hz_, self.fit_band_rule_ = library(self.cubic_)
-        else:
-            lib, self.fit_band_hz_, self.fit_band_rule_ = library(True)
-            corr = cubic_partial_correlation(lib)
-            self.cubic_ = corr > CUBIC_SELECT_CORR
-            self.cubic_rule_ = (f"largest partial correlation of an x^3 column with the linear "
-                                f"model's residual {corr:.3g} {'>' if self.cubic_ else '<='} "
-                                f"{CUBIC_SELECT_CORR:g}: cubic terms {'in' if self.cubic_ else 'out'}")
-            if not self.cubic_:
-                lib, self.fit_band_hz_, self.fit_band_rule_ = library(False)
+        self.cubic_, self.cubic_rule_ = cubic_rule(data, self.cubic, self.fit_band_hz)
+        lib, self.fit_band_hz_, self.fit_band_rule_ = fit_band(
+            data, lambda s: build_library(data, coupled_mass=False, cubic=self.cubic_, start=s,
+                                          drift=True, input_coupling=True), self.fit_band_hz)
         n, p = lib.target.shape[0], lib.theta.shape[0]
         coef = solve_rows(lib, self.rcond)
         masses = np.full(n, m_hat / n)

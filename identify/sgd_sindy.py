@@ -56,6 +56,7 @@ from identify.ls_sindy import MASS_PRIOR_FIELD
 from identify.structural import (
     StructuralIdentifier,
     build_library,
+    cubic_rule,
     driving_point_scaling,
     fit_band_cutoff,
     mass_prior_value,
@@ -123,7 +124,9 @@ SHARED_FIELDS: dict[str, Field] = {
                      doc="gain of the eigenvalue gradient (Eqs 12-13)"),
     # [0, 1]: the annealing update (Eq. 18) is a convex blend of old and new weights
     "beta": Field(float, 0.1, min=0.0, max=1.0, doc="annealing stabilisation coefficient"),
-    "cubic": Field(bool, False, doc="add the cubic features x_j^3 (identifies K3_)"),
+    "cubic": Field(bool, None, doc="add the cubic features x_j^3 (identifies K3_); default by "
+                                   "rule: when one correlates with the least-squares linear "
+                                   "model's residual above CUBIC_SELECT_CORR"),
     "eigen": Field(bool, True, doc="eigenvalue penalty against the measured frequencies"),
     # 1000 modes: far beyond any sensor count; the peaks are searched in one spectrum
     "n_modes": Field(int, None, min=1, max=1000,
@@ -182,7 +185,8 @@ class SGDSINDyBase(StructuralIdentifier):
             with ``eigen=False`` or when no peak passed.
         """
         self.check_params()
-        self.learning_rate_, self.learning_rate_rule_ = learning_rate_for(bool(self.cubic),
+        self.cubic_, self.cubic_rule_ = cubic_rule(data, self.cubic)
+        self.learning_rate_, self.learning_rate_rule_ = learning_rate_for(self.cubic_,
                                                                           self.learning_rate)
         if self.eigen:
             self._peaks(data)
@@ -241,8 +245,10 @@ class SGDSINDy(SGDSINDyBase):
         Gain of the eigenvalue gradient, Eqs 12-13 (Table 1: 0.01).
     beta : float
         Annealing stabilisation coefficient, Eq. 18 (the paper: 0.1).
-    cubic : bool
-        Add the cubic features ``x_j^3`` (identifies ``K3_``).
+    cubic : bool or None
+        Add the cubic features ``x_j^3`` (identifies ``K3_``); None (default): by rule
+        (:func:`identify.structural.cubic_rule`; ``cubic_`` and ``cubic_rule_`` say what was
+        chosen and why).
     l1 : {"cubic", "none"}
         ``"cubic"``: the lasso on the standardised cubic coefficients, then debiasing (acts
         only with ``cubic=True``); ``"none"``: no L1, the cubic block is plain least squares.
@@ -474,7 +480,7 @@ class SGDSINDy(SGDSINDyBase):
 
     def __init__(self, epochs: int = 100, batch_size: int = 128, learning_rate: float | None = None,
                  alpha_init: float = 0.1, epsilon: float = 0.01, beta: float = 0.1,
-                 cubic: bool = False, l1: str = "cubic", eigen: bool = True,
+                 cubic: bool | None = None, l1: str = "cubic", eigen: bool = True,
                  n_modes: int | None = None, freq_range: tuple[float, float] | None = None,
                  steps_per_epoch: int | None = None, init: str = "lstsq",
                  mass_prior: str = "reduced_mass_trace", anneal: bool = True,
@@ -510,12 +516,14 @@ class SGDSINDy(SGDSINDyBase):
 
     def settings(self) -> MatrixSGDSettings:
         """The hyperparameters :func:`identify._sgd_matrix.fit_matrix_sgd` runs with, the step
-        size resolved by :func:`learning_rate_for`."""
+        size resolved by :func:`learning_rate_for` and ``cubic`` by :func:`cubic_rule` (once
+        fitted; before, an unset ``cubic`` counts as False)."""
+        cubic = bool(getattr(self, "cubic_", self.cubic))
         return MatrixSGDSettings(
             epochs=int(self.epochs), batch_size=int(self.batch_size),
-            learning_rate=learning_rate_for(bool(self.cubic), self.learning_rate)[0],
+            learning_rate=learning_rate_for(cubic, self.learning_rate)[0],
             alpha_init=float(self.alpha_init),
-            epsilon=float(self.epsilon), beta=float(self.beta), cubic=bool(self.cubic),
+            epsilon=float(self.epsilon), beta=float(self.beta), cubic=cubic,
             l1=self.l1 != "none", l1_threshold=float(self.l1_threshold),
             l1_debias=float(self.l1_debias),
             steps_per_epoch=None if self.steps_per_epoch is None else int(self.steps_per_epoch),
@@ -538,7 +546,7 @@ class SGDSINDy(SGDSINDyBase):
         """
         lam_hat = self._start_fit(data)
         m_hat = mass_prior_value(data, self.mass_prior)
-        lib = build_library(data, coupled_mass=True, cubic=bool(self.cubic))
+        lib = build_library(data, coupled_mass=True, cubic=self.cubic_)
         n = data.n_channels
         est = self.settings()
         out = fit_matrix_sgd(data, est, m_hat, lam_hat, progress=self.report_progress)

@@ -62,8 +62,10 @@ class SGDSINDyCoefficients(SGDSINDyBase):
         Gain of the eigenvalue gradient, Eqs 12-13 (Table 1: 0.01).
     beta : float
         Annealing stabilisation coefficient, Eq. 18 (the paper: 0.1).
-    cubic : bool
-        Add the cubic features ``x_j^3`` (identifies ``K3_``).
+    cubic : bool or None
+        Add the cubic features ``x_j^3`` (identifies ``K3_``); None (default): by rule
+        (:func:`identify.structural.cubic_rule`; ``cubic_`` and ``cubic_rule_`` say what was
+        chosen and why).
     l1 : {"cubic", "all", "none"}
         Which standardised coefficients the L1 penalty (Eqs 14-15) acts on.
     symmetry : str
@@ -205,7 +207,8 @@ class SGDSINDyCoefficients(SGDSINDyBase):
 
     def __init__(self, epochs: int = 100, batch_size: int = 128, learning_rate: float | None = None,
                  mass_learning_rate: float = 1.5e-4, alpha_init: float = 0.1, epsilon: float = 0.01,
-                 beta: float = 0.1, cubic: bool = False, l1: str = "cubic", symmetry: str = "MCK",
+                 beta: float = 0.1, cubic: bool | None = None, l1: str = "cubic",
+                 symmetry: str = "MCK",
                  eigen: bool = True, n_modes: int | None = None,
                  freq_range: tuple[float, float] | None = None, steps_per_epoch: int | None = None,
                  optimizer: str = "adam", init: str = "lstsq", mass_prior: str = "reduced_mass_trace",
@@ -246,7 +249,7 @@ class SGDSINDyCoefficients(SGDSINDyBase):
         """
         lam_hat = self._start_fit(data)
         m_hat = mass_prior_value(data, self.mass_prior)
-        lib = build_library(data, coupled_mass=True, cubic=bool(self.cubic))
+        lib = build_library(data, coupled_mass=True, cubic=self.cubic_)
         n, p = lib.target.shape[0], lib.theta.shape[0]
         n_samp = lib.theta.shape[1]
         bl = lib.blocks

@@ -273,6 +273,36 @@ def fit_band_cutoff(data: Measurement, cutoff_hz: float | None = None) -> tuple[
     return fc, rule
 
 
+def cubic_rule(data: Measurement, user: bool | None, fit_band_hz: float | None = None
+               ) -> tuple[bool, str]:
+    """Whether a structural model gets the cubic features ``x_j^3``, and why.
+
+    Parameters
+    ----------
+    data : Measurement
+    user : bool or None
+        The user's ``cubic`` setting; None = by rule.
+    fit_band_hz : float, optional
+        The fit band's cut-off (:func:`fit_band`'s ``cutoff_hz``).
+
+    Returns
+    -------
+    (bool, str)
+        The rule: in when :func:`cubic_partial_correlation` of the least-squares library (fit
+        band, drift and input columns as ``ls_sindy`` builds it) exceeds
+        :data:`CUBIC_SELECT_CORR`.
+    """
+    if user is not None:
+        return bool(user), "user setting"
+    lib, _, _ = fit_band(data, lambda s: build_library(data, coupled_mass=False, cubic=True, start=s,
+                                                       drift=True, input_coupling=True), fit_band_hz)
+    corr = cubic_partial_correlation(lib)
+    on = corr > CUBIC_SELECT_CORR
+    return on, (f"largest partial correlation of an x^3 column with the linear model's residual "
+                f"{corr:.3g} {'>' if on else '<='} {CUBIC_SELECT_CORR:g}: cubic terms "
+                f"{'in' if on else 'out'}")
+
+
 def driving_point_scaling(M: np.ndarray, C: np.ndarray, K: np.ndarray, K3: np.ndarray | None,
                           B: np.ndarray | None, declared: np.ndarray | None
                           ) -> tuple[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None,
