@@ -58,24 +58,18 @@ from identify.sindy_pi import (
     VAL_FRACTION_FIELD,
     check_thresholds,
 )
-from identify.structural import remove_drift, unwarp_trapezoid
+from identify.structural import (
+    remove_drift,
+    symmetric_basis,
+    symmetric_least_squares,
+    unwarp_trapezoid,
+)
 from testbed.core.errors import IdentificationError
 from testbed.core.lazy import lazy_module
 from testbed.core.measurement import Measurement, Trajectory
 from testbed.core.schema import Field
 
 linalg = lazy_module("scipy.linalg")  # imported on first use: `testbed list` does not pay for it
-
-
-def _sym_basis(n: int) -> np.ndarray:
-    """Basis of symmetric n x n matrices, shape (n(n+1)/2, n, n)."""
-    out = []
-    for i in range(n):
-        for j in range(i, n):
-            E = np.zeros((n, n))
-            E[i, j] = E[j, i] = 1.0
-            out.append(E)
-    return np.array(out)
 
 
 def symmetric_mass(AK: np.ndarray, AC: np.ndarray, guess: np.ndarray) -> tuple[np.ndarray, int]:
@@ -87,7 +81,7 @@ def symmetric_mass(AK: np.ndarray, AC: np.ndarray, guess: np.ndarray) -> tuple[n
     member nearest (Frobenius) to ``guess`` is returned.
     """
     n = AK.shape[0]
-    S = _sym_basis(n)
+    S = symmetric_basis(n)
     cols = [np.concatenate([(E @ A - A.T @ E)[np.triu_indices(n, 1)] / max(np.linalg.norm(A), 1e-300)
                             for A in (AK, AC)]) for E in S]
     L = np.array(cols).T
@@ -117,14 +111,8 @@ def symmetric_stiffness_damping(M: np.ndarray, x: np.ndarray, v: np.ndarray,
     K, C : ndarray, shape (n, n)
         Stiffness [N/m] and damping [N s/m], symmetric.
     """
-    S = _sym_basis(M.shape[0])
-    A = np.array([(E @ s).ravel() for s in (v, x) for E in S]).T
-    scale = np.linalg.norm(A, axis=0)
-    scale[scale == 0] = 1.0
-    # columns standardised: stiffness columns are ~1e3 x the damping ones on the cantilever
-    c = np.linalg.lstsq(A / scale, -(M @ a).ravel(), rcond=1e-12)[0] / scale
-    m = len(S)
-    return np.einsum("k,kij->ij", c[m:], S), np.einsum("k,kij->ij", c[:m], S)
+    C, K = symmetric_least_squares([v, x], -(M @ a))
+    return K, C
 
 
 #: Above this condition number the symmetric mass solve is taken as undetermined by the data.

@@ -379,6 +379,43 @@ def driving_point_scaling(M: np.ndarray, C: np.ndarray, K: np.ndarray, K3: np.nd
             f"modal masses from the input gain at the driving point (sensor {k + 1})")
 
 
+def symmetric_basis(n: int) -> np.ndarray:
+    """Basis of symmetric n x n matrices, shape (n(n+1)/2, n, n)."""
+    out = []
+    for i in range(n):
+        for j in range(i, n):
+            E = np.zeros((n, n))
+            E[i, j] = E[j, i] = 1.0
+            out.append(E)
+    return np.array(out)
+
+
+def symmetric_least_squares(signals: list[np.ndarray], rhs: np.ndarray) -> list[np.ndarray]:
+    """Symmetric matrices ``S_k`` minimising ``||sum_k S_k signals[k] - rhs||`` over the samples.
+
+    Parameters
+    ----------
+    signals : list of ndarray, each shape (n, N)
+        The signals each unknown matrix multiplies (e.g. velocities [m/s], displacements [m]).
+    rhs : ndarray, shape (n, N)
+        What their sum should reproduce (e.g. ``-M x''`` [N]).
+
+    Returns
+    -------
+    list of ndarray, each shape (n, n)
+        One symmetric matrix per signal, in its units ([rhs] / [signal]).
+    """
+    n = rhs.shape[0]
+    S = symmetric_basis(n)
+    A = np.array([(E @ s).ravel() for s in signals for E in S]).T
+    scale = np.linalg.norm(A, axis=0)
+    scale[scale == 0] = 1.0
+    # columns standardised: stiffness columns are ~1e3 x the damping ones on the cantilever
+    c = np.linalg.lstsq(A / scale, rhs.ravel(), rcond=1e-12)[0] / scale
+    m = len(S)
+    return [np.einsum("k,kij->ij", c[k * m:(k + 1) * m], S) for k in range(len(signals))]
+
+
 def _sym(a: np.ndarray) -> np.ndarray:
     return 0.5 * (a + a.T)
 
