@@ -341,21 +341,19 @@ class SGDSINDy(SGDSINDyBase):
     what was removed); the eigenvalue hold keeps K positive semi-definite (positive targets).
     The linear model is therefore never unstable: ``M`` > 0, ``C``, ``K`` >= 0.
 
-    *Measured on the beams family* (studies: 40 clamped and 20 soft-base cantilevers nobody
-    tuned for, thresholds TRAC/MAC > 0.90, modes 1-2 within 2.6 %; default settings):
-    clean data, 44/60 pass (34/40 clamped, 10/20 soft base), mode 2 within 2.6 % on 50 and
-    TRAC >= 0.9 on 49; ``ls_sindy`` on the same data 41/60 (36/60 before its fit band); this
-    identifier before the free force and drift, the hold and the lowest-mode K scale 10/60;
-    the symmetric warm start alone (``epochs=0``, held) 40/60.  What the penalties earn:
-    ``eigen=False`` (neither the penalty nor the hold) 37/60 (mode 2 within 2.6 % on 44),
-    ``eigen_hold=False`` (the annealed penalty alone) 41/60 (47): the penalty is worth 4
-    members, the hold 3 more, each by keeping mode 2 on its peak.  Symmetry is built into the
-    parametrisation and has no switch; ``ls_sindy`` is the fit without it (above).  At 1 %
-    noise 4/60 (mode 2 within 2.6 % on 8), 2/60 with the penalty or the hold off (2);
-    ``ls_sindy`` 2/60 before its fit band: the noise spoils the warm start (median mode-2
-    error 60 %) beyond what 15 %-paired peaks can hold.  Cubic restoring force on the soft
-    base (clean): K3 force error 0.15-0.41 on 7/20, 0.6 or more, or no cubic term kept, on
-    the rest; the 0.1 target is not met.
+    *Measured on the beams family* (studies/families.toml: 40 clamped and 20 soft-base
+    cantilevers nobody tuned for; default settings; 2026-11-24).  Pass counts on the study's
+    bars (TRAC/MAC > 0.90, modes 1-2 within 2.6 %) / on issue #15's (TRAC and MAC of modes 1-2
+    >= 0.95, their frequencies within 1 %): clean 46/60 / 39/60 (clamped 34/40 on the issue's),
+    at 1 % noise 24/60 / 16/60.  What the penalties earn: ``eigen_hold=False`` (the annealed
+    penalty alone) 45 / 37 clean, 18 / 11 at 1 %; ``eigen=False`` (no frequency information)
+    46 / 36 and 12 / 7; the warm start held (``epochs=0``) 48 / 40 and 20 / 12; ``ls_sindy``
+    (no symmetry, no penalties) 47 / 39 and 6 / 4.  So the eigenvalue penalty and the hold are
+    worth 3 members clean and 9 at 1 % noise (mode 2 kept on its peak), the gradient steps
+    cost one clean member against the held warm start and gain 4 at 1 %, and the symmetric
+    form with its penalties beats plain least squares at 1 % noise 16 to 4.  Cubic restoring
+    force on the soft base (clean): K3 force error 0.17-0.48 on 8/20, 0.58 or more, or no
+    cubic term kept, on the rest; the 0.1 target is not met.
 
     *The soft-base family's cubic force* (issue #15; 20 members, clean data, measured).  With
     ``cubic_form="direction"`` the cubic force error was 0.1 or less on 0/20 (0.5 or less on
