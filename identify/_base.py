@@ -44,6 +44,7 @@ simulation's exact truth is ``testbed.score(model, dataset, scenario)`` (the sco
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import inspect
 import itertools
 import sys
@@ -363,11 +364,10 @@ class MeasurementSamples(Measurement):
         def cut(a: np.ndarray | None) -> np.ndarray | None:
             return None if a is None else np.asarray(a)[..., s]
 
-        return type(self)(fs=self.fs, x=cut(self.x), xd=cut(self.xd), xdd=cut(self.xdd),
-                          channels=self.channels, u=cut(self.u), inputs=self.inputs,
-                          input_map=self.input_map, prior=self.prior,
-                          free_start=max(self.free_start - start, 0), passband=self.passband,
-                          drift_basis=cut(self.drift_basis))
+        # dataclasses.replace carries every other field (pass band, integration, ...) along
+        return dataclasses.replace(self, x=cut(self.x), xd=cut(self.xd), xdd=cut(self.xdd),
+                                   u=cut(self.u), free_start=max(self.free_start - start, 0),
+                                   drift_basis=cut(self.drift_basis))
 
     def __getitem__(self, key: Any) -> MeasurementSamples:
         if isinstance(key, tuple):  # scikit-learn indexes as X[indices, ...]

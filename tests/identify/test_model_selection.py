@@ -31,6 +31,8 @@ def test_windows_are_measurements_cut_in_time(data):
     assert w.drift_basis.shape == (data.drift_basis.shape[0], 200)
     assert w.free_start == max(data.free_start - 100, 0)
     assert data[np.arange(0, 50)].free_start == data.free_start  # 81: after the pulse
+    # every other field is the record's: the pass band, the chain's integration, ...
+    assert (w.passband, w.integration, w.channels) == (data.passband, "trapezoid", data.channels)
     parts = testbed.split_measurement(data, 4)
     assert sum(p.n_samples for p in parts) == data.n_samples
     np.testing.assert_array_equal(np.concatenate([p.x for p in parts], axis=1), data.x)
