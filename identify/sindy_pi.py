@@ -41,13 +41,16 @@ those the closure implies, so the kinematic identities hold exactly again; ``col
 filters every library column alike (the equations stay exact) to cut derivative noise.
 
 Noise rule (:func:`noise_knobs`, every setting overridable): the angles' white-noise level
-(robust 4th differences, :func:`testbed.numerics.noise_std`) and band (99.9 % of the
+(as the signal chain declares it, ``Measurement.noise_std``, else robust 4th differences,
+:func:`testbed.numerics.noise_std`) and band (99.9 % of the
 noise-corrected power, :func:`testbed.numerics.signal_band`) choose the column low-pass
-(off on exact data, 1.5x the band otherwise), the edge trim, the ridge and the form; data the
+(off on exact data, 1.5x the band otherwise), the edge trim, the ridge, the form and the LHS
+candidates; rates a low-pass chain derived from the noisy angles (a declared ``passband``) get
+the weak form, the input terms as LHS and a ridge in proportion to the noise variance; data the
 differences call exact but whose exact fit leaves a held-out error above ``EXACT_HOLDOUT_MAX``
 (angles a derivative chain smoothed) get the noisy recipe.  The values used are fitted
 attributes (``column_lowpass_hz_``, ``edge_trim_``, ``ridge_``, ``formulation_``,
-``weak_window_s_``) and ``noise_rule_`` says why.  Measured on the 30 five-bar family
+``weak_window_s_``, ``lhs_``) and ``noise_rule_`` says why.  Measured on the 30 five-bar family
 members (studies/families.toml) at default settings: within the paper's 0.0501 rad 30/30 at
 1 % angle noise (12/30 before the rule; median 7.4e-4 rad, worst 0.030) and 30/30 clean
 (all <= 3e-6 rad, unchanged); the paper's sine input at 0.5-5 % noise <= 9e-6 rad.
@@ -769,7 +772,9 @@ class SINDyPI(_ImplicitMechanical):
         ``"fivebar"`` (the reduced-equation library), ``"fivebar_full"``, ``"generic"``, a
         :class:`~identify.library.Library` or term names.
     lhs : list of str, optional
-        Candidate left-hand-side terms; default every (kept) column.
+        Candidate left-hand-side terms; default by the noise rule: the terms with an input
+        factor where a low-pass chain derived the rates from noisy angles, else every (kept)
+        column.
     thresholds : sequence of float, optional
         Ascending thresholds on normalised coefficients; default 0 and 12 values log-spaced
         over 1e-6..0.32.
@@ -815,7 +820,9 @@ class SINDyPI(_ImplicitMechanical):
         hold (see :meth:`identify._mechsim.ImplicitModel.simulate`).  Actuators driven by a
         DAC (the five-bar rig) hold; the wrong choice costs an impulse of half a sample.
     formulation : {"strong", "weak"}, optional
-        Default ``"strong"`` (the noise rule: measured better at 1 and 5 %).  ``"strong"``: one
+        Default by the noise rule: ``"weak"`` where a low-pass chain derived the rates from
+        noisy angles (declared ``passband``), else ``"strong"`` (measured better at 1 and 5 %
+        with recorded rates).  ``"strong"``: one
         regression row per sample of the library.  ``"weak"``: one row per
         test function, ``int phi_k Theta dt`` (:func:`identify._weak.weak_matrix`), with the
         acceleration terms integrated by parts so that only angles and rates enter (no second
@@ -861,12 +868,14 @@ class SINDyPI(_ImplicitMechanical):
     weak_strong_columns_ : list of str
         Weak form only: acceleration terms integrated with the measured accelerations (no
         exact integration by parts; :class:`identify._weak.WeakForm`).
-    column_lowpass_hz_, edge_trim_, ridge_, formulation_, weak_window_s_
-        The settings used (the user's where given, else the noise rule's).
+    column_lowpass_hz_, edge_trim_, ridge_, formulation_, weak_window_s_, lhs_
+        The settings used (the user's where given, else the noise rule's; ``lhs_`` None =
+        every kept column).
     noise_rule_ : str
         The rule's estimates, the branch it took and the settings the user overrode.
     noise_std_ : ndarray, shape (n_channels,)
-        White-noise std of each measured angle [rad] (:func:`testbed.numerics.noise_std`).
+        White-noise std of each measured angle [rad]: the chain's declaration
+        (``Measurement.noise_std``) or :func:`testbed.numerics.noise_std` of the angles.
     noise_rel_, band_hz_ : float
         Largest relative noise (std / RMS about the mean) and angles' band [Hz] over channels.
     coef_std_, inclusion_probability_ : ndarray, shape (n_inputs, n_terms)
@@ -877,6 +886,10 @@ class SINDyPI(_ImplicitMechanical):
     name = "sindy_pi"
     hyperparameters: ClassVar[dict[str, Field]] = ordered_fields({
         **COMMON_HYPERPARAMETERS,
+        "lhs": Field(list, None, item_type=str, min_items=1,
+                     doc="candidate left-hand-side terms (library term names); default by the "
+                         "noise rule (the input terms where a low-pass chain derived the rates "
+                         "from noisy angles, else every kept column)"),
         "thresholds": THRESHOLDS_FIELD,
         "ridge": Field(float, None, min=0.0, max=1.0,
                        doc="ridge added to the unit-diagonal normalised Gram matrix; default by "
