@@ -41,13 +41,16 @@ those the closure implies, so the kinematic identities hold exactly again; ``col
 filters every library column alike (the equations stay exact) to cut derivative noise.
 
 Noise rule (:func:`noise_knobs`, every setting overridable): the angles' white-noise level
-(robust 4th differences, :func:`testbed.numerics.noise_std`) and band (99.9 % of the
+(as the signal chain declares it, ``Measurement.noise_std``, else robust 4th differences,
+:func:`testbed.numerics.noise_std`) and band (99.9 % of the
 noise-corrected power, :func:`testbed.numerics.signal_band`) choose the column low-pass
-(off on exact data, 1.5x the band otherwise), the edge trim, the ridge and the form; data the
+(off on exact data, 1.5x the band otherwise), the edge trim, the ridge, the form and the LHS
+candidates; rates a low-pass chain derived from the noisy angles (a declared ``passband``) get
+the weak form, the input terms as LHS and a ridge in proportion to the noise variance; data the
 differences call exact but whose exact fit leaves a held-out error above ``EXACT_HOLDOUT_MAX``
 (angles a derivative chain smoothed) get the noisy recipe.  The values used are fitted
 attributes (``column_lowpass_hz_``, ``edge_trim_``, ``ridge_``, ``formulation_``,
-``weak_window_s_``) and ``noise_rule_`` says why.  Measured on the 30 five-bar family
+``weak_window_s_``, ``lhs_``) and ``noise_rule_`` says why.  Measured on the 30 five-bar family
 members (studies/families.toml) at default settings: within the paper's 0.0501 rad 30/30 at
 1 % angle noise (12/30 before the rule; median 7.4e-4 rad, worst 0.030) and 30/30 clean
 (all <= 3e-6 rad, unchanged); the paper's sine input at 0.5-5 % noise <= 9e-6 rad.
@@ -356,13 +359,16 @@ EDGE_MAX_SHARE = 0.1
 #: worse on the 30 five-bar members at 1 % noise (26/30 within 0.0501 rad against 30/30):
 #: the equations need the weak directions of the ill-conditioned library that a ridge shrinks.
 RIDGE_EXACT = 1e-14
-#: Form: strong on every noise level; the weak form only on the user's request.  Measured on
-#: the 30 five-bar family members at 5 % angle noise (recorded rates): strong form with the
-#: column filter 28/30 within 0.0501 rad, weak form (window by the rule below, 0.4 s on the
-#: 5 s records: half the held-out 0.8 s) 10/30.  Its advantage is the estimated
-#: accelerations it does without (fivebar_multisine_noise5, 10 s records, 1 s windows).
-#: Weak-form test-function support in periods of the angles' band (fivebar_multisine_noise5:
-#: 1 s against a 1.5 Hz band), at most half the held-out span (at least two held-out windows).
+#: Form: strong where the rates and accelerations are not derived from the noisy angles (a
+#: rate sensor, recorded derivatives: no pass band declared); weak where a signal chain derived
+#: them by low-passing the angles (``Measurement.passband`` declared below the Nyquist
+#: frequency, or angles found smoothed by the held-out test), whose accelerations carry the
+#: noise amplified as ``cutoff^5``.  Measured on the 30 five-bar family members at 5 % angle
+#: noise (recorded rates): strong form with the column filter 28/30 within 0.0501 rad, weak
+#: form (0.4 s windows on the 5 s records: half the held-out 0.8 s) 10/30.  On
+#: fivebar_multisine_noise1 (4 Hz chain), input-term LHS: strong form with the rule's 2.25 Hz
+#: column filter diverged or drifted (nan / 0.69 / 0.22 rad, seeds 0-2; only a 3 Hz filter with
+#: a 0.5 s trim passed, 2.5 and 3.5 Hz did not), weak form 0.0056 / 0.0127 / 0.0118 rad.
 WEAK_PERIODS = 1.5
 #: Held-out error (normalised squared residual, :mod:`identify._implicit`) above which data the
 #: differences call exact are not: the exact-data fit is then redone with the noisy recipe.
@@ -371,31 +377,51 @@ WEAK_PERIODS = 1.5
 #: whose angles the signal chain low-passed at 4 Hz (white-noise std by differences 1e-13).
 #: 1e-6 sits 400x above the first and 20x below the second.
 EXACT_HOLDOUT_MAX = 1e-6
+#: Weak-form ridge = RIDGE_PER_NOISE_VAR x noise_rel^2 (Tikhonov: a ridge in proportion to the
+#: noise variance relative to the signal's, which the unit-diagonal Gram matrix of the noisy
+#: columns carries, so that its directions below the noise are damped and those above are
+#: not).  The factor was measured on fivebar_multisine_noise5 (5 %, weak form, input-term LHS;
+#: worst of seeds 0-2): ridge 1e-14 0.36 rad, 3e-5 (factor 0.012) 0.024 rad, and the noise5
+#: file's hand-found plateau 1e-5..1e-4 (factor 0.004-0.04); at 1 % it gives 1.2e-6.
+RIDGE_PER_NOISE_VAR = 0.012
 #: The settings the noise rule chooses (each a SINDyPI hyperparameter; None = by rule).
-RULE_KNOBS = ("column_lowpass_hz", "edge_trim", "ridge", "formulation", "weak_window_s")
+#: ``lhs`` is given by the rule as "inputs" (the library's terms with an input factor) or None.
+RULE_KNOBS = ("column_lowpass_hz", "edge_trim", "ridge", "formulation", "weak_window_s", "lhs")
+#: The rule's ``lhs`` value for "the library's terms with an input factor".
+LHS_INPUT_TERMS = "inputs"
 
 
 def noise_knobs(x: np.ndarray, fs: float, val_fraction: float, user: dict[str, Any],
-                smoothed: float | None = None) -> tuple[dict[str, Any], str, dict[str, Any]]:
+                smoothed: float | None = None, declared: np.ndarray | None = None,
+                passband: tuple[float, float] | None = None
+                ) -> tuple[dict[str, Any], str, dict[str, Any]]:
     """SINDy-PI's noise-dependent settings from the angles, and the rule that chose them.
 
     Rule (each setting the user gave is kept as given):
 
-    1. ``noise_rel`` = the largest over channels of the white-noise std
-       (:func:`testbed.numerics.noise.noise_std`) over the channel's RMS about its mean; the
-       band ``band_hz`` = the largest over channels of the frequency holding ``BAND_SHARE``
-       of the noise-corrected power (:func:`testbed.numerics.noise.signal_band`).
+    1. ``noise_rel`` = the largest over channels of the white-noise std over the channel's RMS
+       about its mean: the std the signal chain declared (``declared``, estimated on the raw
+       angles before it smoothed them) or else that of the angles as given
+       (:func:`testbed.numerics.noise.noise_std`); the band ``band_hz`` = the largest over
+       channels of the frequency holding ``BAND_SHARE`` of the noise-corrected power of the
+       angles as given (:func:`testbed.numerics.noise.signal_band`).
     2. ``noise_rel <= NOISE_FREE_REL``: exact data: strong form, no column filter, no edge
-       trim, ridge ``RIDGE_EXACT``.  Unless ``smoothed`` is given: the fit with that recipe
-       left a held-out error above ``EXACT_HOLDOUT_MAX`` (angles smoothed by the signal
-       chain carry band-limited noise the differences cannot see), then as 3.
-    3. Otherwise the strong form: column low-pass at
-       ``CUTOFF_FACTOR * band_hz`` (below Nyquist), edge trim ``EDGE_PERIODS / cutoff`` (the
-       user's cut-off if set)
-       (at most ``EDGE_MAX_SHARE`` of the record), ridge ``RIDGE_EXACT``.
-    4. ``formulation="weak"`` (the user's choice only): test functions of
-       ``WEAK_PERIODS / band_hz`` seconds (at most half the held-out span), the same edge
-       trim (with ``WEAK_PERIODS / window`` for ``cutoff``) and ridge.
+       trim, ridge ``RIDGE_EXACT``, every LHS candidate.  Unless ``smoothed`` is given: the
+       fit with that recipe left a held-out error above ``EXACT_HOLDOUT_MAX`` (angles smoothed
+       by a signal chain that did not declare their noise), then as 4.
+    3. Noisy, rates not derived from the angles by a filter (no ``passband`` below Nyquist):
+       strong form, column low-pass at ``CUTOFF_FACTOR * band_hz`` (below Nyquist), edge trim
+       ``EDGE_PERIODS / cutoff`` (the user's cut-off if set; at most ``EDGE_MAX_SHARE`` of
+       the record), ridge ``RIDGE_EXACT``, every LHS candidate.
+    4. Noisy, rates and accelerations derived by a low-pass chain (``passband[1] < fs / 2``,
+       or ``smoothed``): weak form (no acceleration of the noisy angles enters), test
+       functions of ``WEAK_PERIODS / band_hz`` seconds (at most half the held-out span), edge
+       trim ``EDGE_PERIODS * window / WEAK_PERIODS``, ridge ``RIDGE_PER_NOISE_VAR *
+       noise_rel^2``, and LHS candidates the terms with an input factor (``"inputs"``): the
+       inputs are measured exactly, so an equation is written for its exact input term,
+       never for a term the noise dominates.
+    5. ``formulation`` given by the user: that form, with the window, trim and ridge of its
+       branch above (the weak form's window as in 4).
 
     Parameters
     ----------
@@ -414,33 +440,47 @@ def noise_knobs(x: np.ndarray, fs: float, val_fraction: float, user: dict[str, A
 
     Returns
     -------
+    declared : ndarray, shape (n_channels,), optional
+        White-noise std of each raw angle [rad] as the signal chain declared it
+        (``Measurement.noise_std``).
+    passband : (float, float), optional
+        The chain's declared pass band [Hz] (``Measurement.passband``).
     knobs : dict
-        The five settings used.
+        The settings of ``RULE_KNOBS`` used (``lhs``: None, ``"inputs"`` or the user's list).
     rule : str
         One line: the estimates, the branch taken and which settings the user overrode.
     estimates : dict
         ``noise_std`` (per channel [rad]), ``noise_rel``, ``band_hz``.
     """
-    sig = noise_std(x)
+    sig_x = noise_std(x)
+    sig = sig_x if declared is None else np.asarray(declared, dtype=float)
     rms = np.std(x, axis=1)
     rel_ch = np.where(rms > 0, sig / np.where(rms > 0, rms, 1.0), 0.0)
     noise_rel = float(rel_ch.max(initial=0.0))
-    band = float(signal_band(x, fs, BAND_SHARE, sig).max(initial=0.0))
+    # the band of the angles as given: their own floor (a chain's smoothing removed the rest)
+    band = float(signal_band(x, fs, BAND_SHARE, sig_x).max(initial=0.0))
     record_s = x.shape[1] / fs
     est = {"noise_std": sig, "noise_rel": noise_rel, "band_hz": band}
-    head = f"noise {100 * noise_rel:.3g} % of RMS (differences), band {band:.3g} Hz ({BAND_SHARE:g} of power)"
+    source = "differences" if declared is None else "declared by the signal chain"
+    head = (f"noise {100 * noise_rel:.3g} % of RMS ({source}), band {band:.3g} Hz "
+            f"({BAND_SHARE:g} of power)")
     span = record_s * (1 - 2 * EDGE_MAX_SHARE)
     window = min(WEAK_PERIODS / band, 0.5 * val_fraction * span) if band > 0 else 0.5
     if smoothed is not None:
         head += (f"; exact-data fit left held-out error {smoothed:.3g} > {EXACT_HOLDOUT_MAX:g}: "
                  "smoothed noise")
+    filtered = passband is not None and float(passband[1]) < fs / 2
+    if filtered:
+        head += f"; chain low-pass {float(passband[1]):.3g} Hz"
     if (noise_rel <= NOISE_FREE_REL and smoothed is None) or band <= 0.0:
         form = user.get("formulation") or "strong"
         rule = {"formulation": form, "column_lowpass_hz": 0.0, "edge_trim": 0.0,
-                "ridge": RIDGE_EXACT, "weak_window_s": window if form == "weak" else None}
+                "ridge": RIDGE_EXACT, "weak_window_s": window if form == "weak" else None,
+                "lhs": None}
         branch = f"exact data (<= {NOISE_FREE_REL:g}): {form} form, no column filter, no trim"
     else:
-        form = user.get("formulation") or "strong"
+        derived = filtered or smoothed is not None
+        form = user.get("formulation") or ("weak" if derived else "strong")
         if form == "strong":
             cut = user.get("column_lowpass_hz") or min(CUTOFF_FACTOR * band, 0.45 * fs)
             branch = (f"noisy: strong form, column low-pass {CUTOFF_FACTOR:g} x band = "
@@ -448,11 +488,17 @@ def noise_knobs(x: np.ndarray, fs: float, val_fraction: float, user: dict[str, A
         else:
             cut = WEAK_PERIODS / window
             branch = f"noisy: weak form, test functions {WEAK_PERIODS:g} / band = {window:.3g} s"
+        if derived:
+            branch = branch.replace("noisy:", "noisy, rates derived by a low-pass:")
         trim = min(EDGE_PERIODS / cut, EDGE_MAX_SHARE * record_s)
-        ridge = RIDGE_EXACT
+        ridge = max(RIDGE_PER_NOISE_VAR * noise_rel**2, RIDGE_EXACT) if derived else RIDGE_EXACT
+        lhs = LHS_INPUT_TERMS if derived else None
         rule = {"formulation": form, "column_lowpass_hz": cut if form == "strong" else 0.0,
-                "edge_trim": trim, "ridge": ridge, "weak_window_s": window if form == "weak" else None}
+                "edge_trim": trim, "ridge": ridge,
+                "weak_window_s": window if form == "weak" else None, "lhs": lhs}
         branch += f", edge trim {trim:.3g} s, ridge {ridge:.3g}"
+        if lhs is not None:
+            branch += ", LHS the input terms"
     knobs = {k: (user[k] if user.get(k) is not None else v) for k, v in rule.items()}
     given = [k for k in rule if user.get(k) is not None]
     text = f"{head}; {branch}" + (f"; user setting: {', '.join(given)}" if given else "")
@@ -474,7 +520,7 @@ class _ImplicitMechanical(Identifier):
         this with its noise rule (:func:`noise_knobs`)."""
         return {"column_lowpass_hz": self.column_lowpass_hz, "edge_trim": self.edge_trim,
                 "formulation": getattr(self, "formulation", "strong"),
-                "weak_window_s": getattr(self, "weak_window_s", None)}
+                "weak_window_s": getattr(self, "weak_window_s", None), "lhs": self.lhs}
 
     def _knob(self, name: str) -> Any:
         knobs = getattr(self, "_knobs", None)
@@ -594,11 +640,12 @@ class _ImplicitMechanical(Identifier):
         kidx = np.flatnonzero(keep)
         self.pruned_terms_ = [lib.names[c] for c in np.flatnonzero(~keep)]
         names = [lib.names[c] for c in kidx]
-        if self.lhs is None:
+        lhs = self._knob("lhs")
+        if lhs is None:
             cand = np.arange(kidx.size)
         else:
             pos = {n: i for i, n in enumerate(names)}
-            wanted = Library(list(self.lhs), lib.n_coords, lib.n_inputs).names
+            wanted = Library(list(lhs), lib.n_coords, lib.n_inputs).names
             missing = [w for w in wanted if w not in pos]
             if missing:
                 raise IdentificationError(f"lhs terms not in the (pruned) library: {missing}")
@@ -725,7 +772,9 @@ class SINDyPI(_ImplicitMechanical):
         ``"fivebar"`` (the reduced-equation library), ``"fivebar_full"``, ``"generic"``, a
         :class:`~identify.library.Library` or term names.
     lhs : list of str, optional
-        Candidate left-hand-side terms; default every (kept) column.
+        Candidate left-hand-side terms; default by the noise rule: the terms with an input
+        factor where a low-pass chain derived the rates from noisy angles, else every (kept)
+        column.
     thresholds : sequence of float, optional
         Ascending thresholds on normalised coefficients; default 0 and 12 values log-spaced
         over 1e-6..0.32.
@@ -771,7 +820,9 @@ class SINDyPI(_ImplicitMechanical):
         hold (see :meth:`identify._mechsim.ImplicitModel.simulate`).  Actuators driven by a
         DAC (the five-bar rig) hold; the wrong choice costs an impulse of half a sample.
     formulation : {"strong", "weak"}, optional
-        Default ``"strong"`` (the noise rule: measured better at 1 and 5 %).  ``"strong"``: one
+        Default by the noise rule: ``"weak"`` where a low-pass chain derived the rates from
+        noisy angles (declared ``passband``), else ``"strong"`` (measured better at 1 and 5 %
+        with recorded rates).  ``"strong"``: one
         regression row per sample of the library.  ``"weak"``: one row per
         test function, ``int phi_k Theta dt`` (:func:`identify._weak.weak_matrix`), with the
         acceleration terms integrated by parts so that only angles and rates enter (no second
@@ -817,12 +868,14 @@ class SINDyPI(_ImplicitMechanical):
     weak_strong_columns_ : list of str
         Weak form only: acceleration terms integrated with the measured accelerations (no
         exact integration by parts; :class:`identify._weak.WeakForm`).
-    column_lowpass_hz_, edge_trim_, ridge_, formulation_, weak_window_s_
-        The settings used (the user's where given, else the noise rule's).
+    column_lowpass_hz_, edge_trim_, ridge_, formulation_, weak_window_s_, lhs_
+        The settings used (the user's where given, else the noise rule's; ``lhs_`` None =
+        every kept column).
     noise_rule_ : str
         The rule's estimates, the branch it took and the settings the user overrode.
     noise_std_ : ndarray, shape (n_channels,)
-        White-noise std of each measured angle [rad] (:func:`testbed.numerics.noise_std`).
+        White-noise std of each measured angle [rad]: the chain's declaration
+        (``Measurement.noise_std``) or :func:`testbed.numerics.noise_std` of the angles.
     noise_rel_, band_hz_ : float
         Largest relative noise (std / RMS about the mean) and angles' band [Hz] over channels.
     coef_std_, inclusion_probability_ : ndarray, shape (n_inputs, n_terms)
@@ -833,6 +886,10 @@ class SINDyPI(_ImplicitMechanical):
     name = "sindy_pi"
     hyperparameters: ClassVar[dict[str, Field]] = ordered_fields({
         **COMMON_HYPERPARAMETERS,
+        "lhs": Field(list, None, item_type=str, min_items=1,
+                     doc="candidate left-hand-side terms (library term names); default by the "
+                         "noise rule (the input terms where a low-pass chain derived the rates "
+                         "from noisy angles, else every kept column)"),
         "thresholds": THRESHOLDS_FIELD,
         "ridge": Field(float, None, min=0.0, max=1.0,
                        doc="ridge added to the unit-diagonal normalised Gram matrix; default by "
@@ -957,7 +1014,20 @@ class SINDyPI(_ImplicitMechanical):
         attributes and ``noise_rule_``."""
         user = {k: getattr(self, k) for k in RULE_KNOBS}
         knobs, rule, est = noise_knobs(data.x, data.fs, self.val_fraction, user,
-                                       getattr(self, "_smoothed", None))
+                                       getattr(self, "_smoothed", None), data.noise_std,
+                                       data.passband)
+        if knobs["lhs"] == LHS_INPUT_TERMS:
+            imap = np.abs(np.asarray(data.input_map)) > 0
+            passive = np.flatnonzero(~imap.any(axis=1))
+            if passive.size and not closed_chain(data, passive):
+                # an open chain's passive equations have no input term: every candidate stays
+                knobs["lhs"] = None
+                rule += " (open chain: every LHS candidate)"
+            else:
+                lib = make_library(self.library, data)
+                cols = sorted(set(np.concatenate([lib.input_columns(k)
+                                                  for k in range(data.u.shape[0])]).tolist()))
+                knobs["lhs"] = [lib.names[c] for c in cols]
         for k in RULE_KNOBS:
             setattr(self, f"{k}_", knobs[k])
         self.noise_rule_ = rule

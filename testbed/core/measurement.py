@@ -52,6 +52,12 @@ class Measurement:
         every mode comes out ``tan(w T / 2) / (w T / 2)`` too stiff.  A structural identifier maps its
         poles back (:func:`identify.structural.unwarp_trapezoid`).  ``"exact"``: true
         derivatives (simulated or differentiated signals).
+    noise_std : ndarray, shape (n_channels,), optional
+        White-noise standard deviation of each raw coordinate [unit of ``x``] as the signal
+        chain estimated it from the record before any smoothing (e.g. robust finite
+        differences, :func:`testbed.numerics.noise.noise_std`).  A chain that low-passes the
+        coordinates hides that noise from anyone differencing ``x`` (what is left is
+        band-limited), so it declares it here.  None = not declared (estimate it from ``x``).
     """
 
     fs: float
@@ -67,6 +73,7 @@ class Measurement:
     passband: tuple[float, float] | None = None
     drift_basis: np.ndarray | None = None
     integration: str = "exact"
+    noise_std: np.ndarray | None = None
 
     @property
     def n_channels(self) -> int:

@@ -2,7 +2,8 @@
 
 Arrays are (n_channels, n_samples); a 1-D array is one channel.  Two estimators:
 :func:`differentiate` (Savitzky-Golay, weights computed in a well-conditioned basis) and
-:func:`lowpass_differentiate` (zero-phase low-pass, central differences, polynomial end bridges).
+:func:`lowpass_differentiate` (zero-phase low-pass, central differences, polynomial end bridges),
+whose cut-off :func:`harmonic_cutoff` can choose from the signal's band.
 """
 
 from __future__ import annotations
@@ -135,6 +136,50 @@ def _quintic_bridge(start: np.ndarray, end: np.ndarray, n: int, fs: float) -> np
         c = np.array([np.polynomial.polynomial.polyder(row, d) for row in coef])
         out[d] = np.array([np.polynomial.polynomial.polyval(tau, row) for row in c]) / T**d
     return out
+
+
+#: Harmonic of the band the low-pass must pass (:func:`harmonic_cutoff`): a mechanism's
+#: kinematics (trig factors of the angles) and any feedback double the frequencies of the
+#: motion, so its accelerations carry second harmonics of the angles' band.
+CUTOFF_HARMONIC = 2.0
+#: Smallest amplitude gain of the zero-phase filter over that harmonic: a 1 % loss there, where
+#: the motion's acceleration keeps ~1e-4 of its energy (five-bar multisine), biases the
+#: acceleration by well under 1 % of its RMS.
+CUTOFF_GAIN = 0.99
+
+
+def harmonic_cutoff(band_hz: float, order: int, harmonic: float = CUTOFF_HARMONIC,
+                    gain: float = CUTOFF_GAIN) -> float:
+    """Lowest -3 dB cut-off of a zero-phase Butterworth that passes ``harmonic x band_hz``.
+
+    The forward-backward filter's amplitude gain is ``1 / (1 + (f / fc)^(2 order))``; the
+    cut-off is where that gain equals ``gain`` at ``f = harmonic * band_hz``:
+    ``fc = harmonic band_hz / (1 / gain - 1)^(1 / (2 order))``.  Order 8, band 1.5 Hz (the
+    five-bar multisine's 99.9 % band): 4.0 Hz.  Any higher cut-off only passes more noise,
+    whose share of the second derivative grows as ``fc^5``.
+
+    Parameters
+    ----------
+    band_hz : float
+        Band of the signal [Hz] (e.g. :func:`testbed.numerics.noise.signal_band`), > 0.
+    order : int
+        Butterworth order of one pass (>= 1).
+    harmonic : float
+        Multiple of the band that must pass (>= 1).
+    gain : float
+        Least amplitude gain of the zero-phase filter there, in (0, 1).
+
+    Returns
+    -------
+    float
+        Cut-off [Hz].
+    """
+    if not band_hz > 0:
+        raise ValueError(f"band must be positive, got {band_hz}")
+    if int(order) < 1 or not harmonic >= 1 or not 0 < gain < 1:
+        raise ValueError(f"need order >= 1, harmonic >= 1, 0 < gain < 1; got {order}, "
+                         f"{harmonic}, {gain}")
+    return float(harmonic * band_hz / (1.0 / gain - 1.0) ** (1.0 / (2 * int(order))))
 
 
 def lowpass_differentiate(x: np.ndarray, fs: float, cutoff_hz: float, order: int = 8,

@@ -20,6 +20,7 @@ from testbed.core.measurement import Measurement
 from testbed.core.schema import Field, validate_table
 from testbed.numerics import derivatives
 from testbed.numerics import filters as sig
+from testbed.numerics import noise as noise_est
 
 #: A sensor within this distance [m] of the impact point receives the force.
 IMPACT_TOLERANCE_M = 1e-3
@@ -78,9 +79,12 @@ MECHANICAL_SIGNAL_SCHEMA: dict[str, Field] = {
                                          "derivatives (odd)"),
     "polyorder": Field(int, 4, min=2, max=8, doc="Savitzky-Golay polynomial order"),
     "cutoff_hz": Field(float, 4.0, unit="Hz", min=0.0, min_inclusive=False,
+                       also=Field(str, choices=("auto",)),
                        doc="'lowpass': -3 dB frequency of one pass of the zero-phase "
                            "Butterworth; just above the band of the motion (noise in the "
-                           "acceleration grows as cutoff^2.5)"),
+                           "acceleration grows as cutoff^2.5); 'auto': the lowest that passes "
+                           "twice the angles' 99.9 % band with 99 % amplitude (see "
+                           "auto_cutoff)"),
     "filter_order": Field(int, 8, min=1, max=16,
                           doc="'lowpass': Butterworth order of one pass"),
     "edge_fit_s": Field(float, 0.1, unit="s", min=0.0, min_inclusive=False,
@@ -237,7 +241,8 @@ def check_mechanical(cfg: Mapping[str, Any], fs: float, n_samples: int, error: E
     duration = n_samples / fs
     _check_polynomial_window(cfg, n_samples, error)
     if cfg["derivatives"] == "lowpass":
-        _below_nyquist(cfg, "cutoff_hz", fs, error)
+        if cfg["cutoff_hz"] != "auto":
+            _below_nyquist(cfg, "cutoff_hz", fs, error)
         _long_enough(cfg, "filter_order", cfg["filter_order"], n_samples, error)
         n_fit = round(cfg["edge_fit_s"] * fs)
         if not cfg["edge_fit_order"] < n_fit <= n_samples:
@@ -466,6 +471,53 @@ def drift_basis(n_samples: int, fs: float, rest_from: int | None,
     return rows if np.all(np.any(rows != 0.0, axis=1)) else None
 
 
+#: Share of the angles' noise-corrected power whose band sets ``cutoff_hz = "auto"``: 99.9 %
+#: (1.5 Hz on the five-bar multisine of 0.1-1.5 Hz tones, at 0-5 % noise alike); 99 % misses
+#: the top tones (0.8-1.1 Hz there).
+AUTO_BAND_SHARE = 0.999
+#: Highest automatic cut-off as a share of the sample rate: a digital filter needs its cut-off
+#: below the Nyquist frequency (0.5); 0.45 leaves the design a margin.
+AUTO_CUTOFF_MAX_SHARE = 0.45
+
+
+def auto_cutoff(theta: np.ndarray, fs: float, order: int, noise: np.ndarray | None = None
+                ) -> float:
+    """``cutoff_hz = "auto"``: the derivative low-pass's cut-off from the raw angles.
+
+    Rule: the band ``B`` = the largest over channels of the frequency holding
+    ``AUTO_BAND_SHARE`` of the angle's power above its white-noise floor
+    (:func:`testbed.numerics.noise.signal_band`); the cut-off is the lowest that passes
+    ``2 B`` (the linkage's second harmonics) with 99 % amplitude
+    (:func:`testbed.numerics.derivatives.harmonic_cutoff`), at most ``AUTO_CUTOFF_MAX_SHARE
+    fs``.  Five-bar multisine (band 1.5 Hz), order 8: 4.0 Hz, the hand-found value.
+
+    Parameters
+    ----------
+    theta : ndarray, shape (n_joints, n_samples)
+        Raw measured angles [rad].
+    fs : float
+        Sample rate [Hz].
+    order : int
+        Butterworth order of one pass of the derivative filter.
+    noise : ndarray, shape (n_joints,), optional
+        White-noise std of each angle [rad]; default :func:`testbed.numerics.noise.noise_std`.
+
+    Returns
+    -------
+    float
+        Cut-off [Hz].
+
+    Raises
+    ------
+    ValueError
+        If no channel has signal power above its noise floor (no band to pass).
+    """
+    band = float(noise_est.signal_band(theta, fs, AUTO_BAND_SHARE, noise).max(initial=0.0))
+    if not band > 0:
+        raise ValueError("cutoff_hz = 'auto': the angles hold no power above their noise floor")
+    return min(derivatives.harmonic_cutoff(band, order), AUTO_CUTOFF_MAX_SHARE * fs)
+
+
 def measure_mechanical(dataset: Dataset, cfg: Mapping[str, Any]) -> Measurement:
     """Joint angles, rates and accelerations, and the actuator torques.
 
@@ -481,14 +533,18 @@ def measure_mechanical(dataset: Dataset, cfg: Mapping[str, Any]) -> Measurement:
         Savitzky-Golay filter (``window``, ``polyorder``; :func:`testbed.numerics.derivatives.differentiate`),
         ``"lowpass"`` with a zero-phase Butterworth low-pass and central differences
         (``cutoff_hz``, ``filter_order``, ``edge_fit_s``, ``edge_fit_order``;
-        :func:`testbed.numerics.derivatives.lowpass_differentiate`); both ignore the recorded rates.
+        :func:`testbed.numerics.derivatives.lowpass_differentiate`; ``cutoff_hz = "auto"`` by
+        :func:`auto_cutoff`); both ignore the recorded rates.
 
     Returns
     -------
     Measurement
         Channels and inputs named as the data name them, ``input_map`` (n_joints x n_inputs)
         with 1 where input j acts on joint i (from ``acts_on``; the five-bar: u1 on th1, u2
-        on th4), ``free_start`` 0 (the input is continuous), ``prior`` a copy of the dataset's.
+        on th4), ``free_start`` 0 (the input is continuous), ``prior`` a copy of the dataset's,
+        ``noise_std`` the raw angles' white-noise std [rad] before any smoothing
+        (:func:`testbed.numerics.noise.noise_std`; the smoothed angles no longer show it),
+        ``passband`` ``(0, cutoff_hz)`` [Hz] for ``"lowpass"`` (None otherwise).
 
     Raises
     ------
@@ -512,15 +568,24 @@ def measure_mechanical(dataset: Dataset, cfg: Mapping[str, Any]) -> Measurement:
             raise ValueError(f"input {t_sig.channels[j]!r} acts on {name!r}, not a channel of "
                              f"'theta' ({', '.join(channels)})")
         input_map[channels.index(name), j] = 1.0
+    # declared only for finite records (the estimator refuses NaN; the identifier then
+    # sees an undeclared level, as for any chain that does not know it)
+    noise = noise_est.noise_std(theta) if np.all(np.isfinite(theta)) else None
+    passband = None
     if cfg["derivatives"] == "recorded":
         x, xd, xdd = theta, _get(dataset, "dtheta", n_joints), _get(dataset, "ddtheta", n_joints)
     elif cfg["derivatives"] == "lowpass":
-        x, xd, xdd = derivatives.lowpass_differentiate(theta, fs, cfg["cutoff_hz"], cfg["filter_order"],
-                                               cfg["edge_fit_s"], cfg["edge_fit_order"])
+        cut = cfg["cutoff_hz"]
+        if cut == "auto":
+            cut = auto_cutoff(theta, fs, cfg["filter_order"], noise)
+        x, xd, xdd = derivatives.lowpass_differentiate(theta, fs, cut, cfg["filter_order"],
+                                                       cfg["edge_fit_s"], cfg["edge_fit_order"])
+        passband = (0.0, float(cut))
     else:
         x, xd, xdd = derivatives.differentiate(theta, fs, cfg["window"], cfg["polyorder"])
     return Measurement(fs=fs, x=x, xd=xd, xdd=xdd, channels=channels, u=torque,
-                       inputs=tuple(t_sig.channels), input_map=input_map, prior=dict(dataset.prior))
+                       inputs=tuple(t_sig.channels), input_map=input_map, prior=dict(dataset.prior),
+                       passband=passband, noise_std=noise)
 
 
 def check_dynamical(cfg: Mapping[str, Any], fs: float, n_samples: int, error: ErrorFn) -> None:

@@ -11,6 +11,7 @@ from identify import sindy_pi as sp
 from identify.sindy_pi import SINDyPI
 from testbed.core.errors import HyperparameterError
 from testbed.numerics.derivatives import lowpass_differentiate
+from testbed.numerics.noise import noise_std
 from testbed.scoring.equation_basis import evaluate_terms
 
 
@@ -138,5 +139,60 @@ def test_smoothed_noise_is_not_taken_for_exact_data(clean):
     x, xd, xdd = lowpass_differentiate(_noisy(clean, 1.0).x, clean.fs, 4.0)
     m = SINDyPI().fit(dataclasses.replace(clean, x=x, xd=xd, xdd=xdd))
     assert m.noise_rel_ <= sp.NOISE_FREE_REL
-    assert "smoothed noise" in m.noise_rule_ and m.column_lowpass_hz_ > 0 and m.edge_trim_ > 0
+    # rates derived by a smoothing chain: the weak form, its trim, the input terms as LHS
+    assert "smoothed noise" in m.noise_rule_ and m.formulation_ == "weak" and m.edge_trim_ > 0
+    assert m.lhs_ and all("*u" in t for t in m.lhs_)
     assert "smoothed" not in SINDyPI().fit(clean).noise_rule_
+
+
+def _chain_smoothed(clean, percent, cut=4.0):
+    """Angles with ``percent`` % noise through the 4 Hz derivative chain, declaring the raw
+    angles' noise std and the pass band as the mechanical signal chain does."""
+    raw = _noisy(clean, percent).x
+    x, xd, xdd = lowpass_differentiate(raw, clean.fs, cut)
+    return dataclasses.replace(clean, x=x, xd=xd, xdd=xdd, noise_std=noise_std(raw),
+                               passband=(0.0, cut))
+
+
+@pytest.mark.parametrize("percent", [1.0, 5.0])
+def test_declared_noise_of_a_smoothing_chain_sets_the_rule(clean, percent):
+    data = _chain_smoothed(clean, percent)
+    knobs, rule, est = sp.noise_knobs(data.x, data.fs, 0.2, {}, None, data.noise_std,
+                                      data.passband)
+    # the declared level is the raw angles' (within 5 %: 3 standard errors of the MAD estimate
+    # on 8000 samples); the smoothed angles alone read as exact
+    assert est["noise_rel"] == pytest.approx(percent / 100, rel=0.05)
+    assert sp.noise_knobs(data.x, data.fs, 0.2, {})[2]["noise_rel"] <= sp.NOISE_FREE_REL
+    assert "declared by the signal chain" in rule and "chain low-pass 4 Hz" in rule
+    assert knobs["formulation"] == "weak" and knobs["column_lowpass_hz"] == 0.0
+    assert knobs["ridge"] == pytest.approx(sp.RIDGE_PER_NOISE_VAR * est["noise_rel"] ** 2)
+    assert knobs["lhs"] == sp.LHS_INPUT_TERMS and knobs["edge_trim"] > 0
+
+
+def test_declared_noise_fit_writes_equations_for_the_input_terms(clean):
+    m = SINDyPI().fit(_chain_smoothed(clean, 1.0))
+    assert m.formulation_ == "weak" and "declared by the signal chain" in m.noise_rule_
+    inputs = [n for n in m.feature_names_ if "*u1" in n or "*u2" in n]
+    assert m.lhs_ == inputs and set(m.lhs_terms_) <= set(inputs)
+    assert np.all(np.isfinite(m.validation_errors_)) and np.all(np.isfinite(m.coef_))
+
+
+def test_declared_noise_rule_is_overridden_by_the_user(clean):
+    data = _chain_smoothed(clean, 1.0)
+    lhs = ["sin(th2-th3)*u1"]
+    user = {"formulation": "strong", "ridge": 1e-6, "lhs": lhs}
+    knobs, rule, est = sp.noise_knobs(data.x, data.fs, 0.2, user, None, data.noise_std,
+                                      data.passband)
+    assert (knobs["formulation"], knobs["ridge"], knobs["lhs"]) == ("strong", 1e-6, lhs)
+    assert knobs["column_lowpass_hz"] == pytest.approx(sp.CUTOFF_FACTOR * est["band_hz"])
+    assert "user setting: formulation, ridge, lhs" in rule
+
+
+def test_recorded_rates_with_declared_noise_keep_the_strong_rule(clean):
+    # no pass band declared (rates from a sensor): the strong form and every LHS candidate,
+    # exactly as when the level is estimated from the angles themselves
+    noisy = _noisy(clean, 1.0)
+    m = SINDyPI().fit(dataclasses.replace(noisy, noise_std=noise_std(noisy.x)))
+    ref = SINDyPI().fit(noisy)
+    assert m.formulation_ == "strong" and m.lhs_ is None and m.ridge_ == sp.RIDGE_EXACT
+    np.testing.assert_array_equal(m.coef_, ref.coef_)
