@@ -87,7 +87,14 @@ def base_raw(name: str) -> dict:
 
 def bad_values(f) -> list:
     """Values a field must refuse: the wrong type, non-finite, out of its bounds."""
-    if f.also is not None:
+    if f.also is not None and f.type in (int, float):
+        # a number or a named choice ("auto"): refused are a bool, another word, a list and a
+        # number out of bounds
+        out = [True, "no-such-choice", [1]]
+        if f.min is not None:
+            out.append(f.min if not f.min_inclusive else f.min - 1 - abs(f.min))
+        return out
+    if f.also is not None:  # a word or a list of words
         return [5, True]
     if f.type is bool:
         return ["yes", 1]
