@@ -14,8 +14,10 @@ from identify.structural import (
     build_library,
     cubic_rule,
     fit_band,
+    harmonics_array,
     mass_prior_value,
     matrices_from_coef,
+    modal_peaks,
     solve_rows,
 )
 from testbed.core.errors import IdentificationError
@@ -65,6 +67,10 @@ class LeastSquaresSINDy(StructuralIdentifier):
     ----------
     fit_band_hz_ : float
         The fit-band high-pass used [Hz] (0 = none); ``fit_band_rule_`` (str) says what chose it.
+    harmonics_ : ndarray, shape (h, 3)
+        Spectral peaks :func:`identify.structural.modal_peaks` recognised as harmonics, not
+        modes (so not the lowest peak the fit band is set from), rows ``(f [Hz], k,
+        f_fundamental [Hz])``; ``harmonic_rule_`` (str) states the rule and what it found.
     M_, C_, K_ : ndarray, shape (n, n)
         ``M_ = (m_hat / n) I`` [kg], ``C_ = -M_ Xi_v`` [N s/m], ``K_ = -M_ Xi_d`` [N/m].
     K3_ : ndarray, shape (n, n) or None
@@ -137,6 +143,8 @@ class LeastSquaresSINDy(StructuralIdentifier):
         self.check_params()
         m_hat = mass_prior_value(data, self.mass_prior)
 
+        ps = modal_peaks(data)
+        self.harmonics_, self.harmonic_rule_ = harmonics_array(ps), ps.harmonic_rule
         self.cubic_, self.cubic_rule_ = cubic_rule(data, self.cubic, self.fit_band_hz)
         lib, self.fit_band_hz_, self.fit_band_rule_ = fit_band(
             data, lambda s: build_library(data, coupled_mass=False, cubic=self.cubic_, start=s,

@@ -59,6 +59,7 @@ from identify.structural import (
     cubic_rule,
     driving_point_scaling,
     fit_band_cutoff,
+    harmonics_array,
     mass_prior_value,
     modal_peaks,
     warp_frequency,
@@ -201,11 +202,12 @@ class SGDSINDyBase(StructuralIdentifier):
 
     def _peaks(self, data: Measurement) -> np.ndarray:
         """The eigenvalue penalty's targets by :func:`identify.structural.modal_peaks`; sets
-        ``peak_band_``, ``peak_band_rule_``, ``peaks_``, ``rejected_peaks_`` and
-        ``measured_frequencies_`` (= ``peaks_``)."""
+        ``peak_band_``, ``peak_band_rule_``, ``peaks_``, ``rejected_peaks_``, ``harmonics_``,
+        ``harmonic_rule_`` and ``measured_frequencies_`` (= ``peaks_``)."""
         ps = modal_peaks(data, self.n_modes, None if self.freq_range is None else tuple(self.freq_range))
         self.peak_band_, self.peak_band_rule_ = ps.band, ps.band_rule
         self.peaks_, self.rejected_peaks_ = ps.peaks, ps.rejected
+        self.harmonics_, self.harmonic_rule_ = harmonics_array(ps), ps.harmonic_rule
         self.measured_frequencies_ = ps.peaks
         return ps.peaks
 
@@ -395,6 +397,9 @@ class SGDSINDy(SGDSINDyBase):
         Accepted peaks [Hz] (= ``measured_frequencies_``).
     rejected_peaks_ : list of (float, str)
         Every other candidate peak [Hz] and why it was not taken.
+    harmonics_ : ndarray, shape (h, 3)
+        Peaks recognised as harmonics, rows ``(f [Hz], k, f_fundamental [Hz])``;
+        ``harmonic_rule_`` (str) states the rule and what it found.
     alphas_ : dict of str to float
         Final weights ``sym`` (``alpha_init``, unused), ``eig`` and ``l1`` (the largest lasso
         weight; 0 once debiasing).

@@ -123,6 +123,9 @@ class SGDSINDyCoefficients(SGDSINDyBase):
         Accepted peaks [Hz] (= ``measured_frequencies_``).
     rejected_peaks_ : list of (float, str)
         Every other candidate peak [Hz] and why it was not taken.
+    harmonics_ : ndarray, shape (h, 3)
+        Peaks recognised as harmonics, rows ``(f [Hz], k, f_fundamental [Hz])``;
+        ``harmonic_rule_`` (str) states the rule and what it found.
     alphas_ : dict of str to float
         Final penalty weights ``sym``, ``eig``, ``l1``.
     history_ : dict of str to ndarray

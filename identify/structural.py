@@ -24,7 +24,7 @@ identifiers their common ``simulate``/``equations``/modal attributes.
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -36,7 +36,7 @@ from testbed.core.measurement import Measurement, Trajectory
 from testbed.core.schema import Field
 from testbed.numerics.filters import elliptic_highpass
 from testbed.numerics.shapes import mac_matrix
-from testbed.numerics.spectral import harmonic_amplitude_law, peak_candidates
+from testbed.numerics.spectral import harmonic_amplitude_law, harmonic_lock, peak_candidates
 
 # imported on first use: `testbed list` does not pay for them
 sfft = lazy_module("scipy.fft")
@@ -586,6 +586,22 @@ HARMONIC_SLOPE = (0.6, 1.6)
 HARMONIC_DRIFT = 0.02
 #: Short-time segments of the harmonic test (each resolves 8 / T Hz: 4 Hz on a 2 s record).
 HARMONIC_SEGMENTS = 8
+#: Phase lock of a candidate at k x a stronger peak (within :data:`HARMONIC_TOL`) for it to be
+#: that peak's harmonic (:func:`testbed.numerics.spectral.harmonic_lock`, the mean resultant
+#: length of ``phi_c - k phi_p``): 2 / pi is a phase spread evenly over pi rad.  A harmonic is
+#: driven by the fundamental's motion and keeps its phase; a mode rings at its own frequency.
+#: Measured on the soft-base family's harmonics 0.83-0.99 (clean and 1 % noise).  A mode that
+#: decays within a few periods of its own stays locked too (soft base mode 3 at 2.99 x mode 2:
+#: 0.94), hence the shape test beside it.
+HARMONIC_LOCK = 2.0 / np.pi
+#: ... and whose deflection shape has at least this MAC with the stronger peak's: a harmonic is
+#: the structure's forced response at k f to the force the fundamental's motion makes, which
+#: below the next mode is mostly the fundamental's own mode.  Measured (studies/families.toml,
+#: clean and 1 % noise): the soft bases' harmonics 0.85-1.00; distinct modes at 2x or 3x
+#: within the tolerance 0.01-0.35 on both families; 0.6 sits between the two groups.  The
+#: rule does not need a record long enough to see the fundamental's frequency drift (a lightly
+#: damped 30 Hz mode decays 2 dB in 0.5 s), which the amplitude-law test below needs.
+HARMONIC_SHAPE_MAC = 0.6
 #: A weaker candidate whose deflection shape (the complex spectra of the channels at its
 #: frequency) has a MAC of at least this with a stronger accepted peak's is the same mode seen
 #: again: a side lobe of a lightly damped mode that rings through the whole record, or
@@ -618,7 +634,13 @@ class PeakSearch:
     rejected : list of (float, str)
         Every other candidate in the band [Hz] with the reason it was not taken.
     nonlinear : bool
-        A harmonic was recognised: the structure's peak frequencies depend on amplitude.
+        A harmonic following the amplitude law was recognised: the structure's peak
+        frequencies depend on amplitude (no peak is accepted).
+    harmonics : list of (float, int, float)
+        Candidates recognised as harmonics by their phase lock and shape: ``(f, k, f_fund)``
+        [Hz, -, Hz]; rejected, the other peaks kept.
+    harmonic_rule : str
+        The rule that recognised them, with its tolerances, and what it found.
     """
 
     band: tuple[float, float]
@@ -626,6 +648,8 @@ class PeakSearch:
     peaks: np.ndarray
     rejected: list[tuple[float, str]]
     nonlinear: bool
+    harmonics: list[tuple[float, int, float]] = field(default_factory=list)
+    harmonic_rule: str = ""
 
 
 def peak_band(data: Measurement, n_window: int, freq_range: tuple[float, float] | None = None
@@ -677,6 +701,13 @@ def modal_peaks(data: Measurement, n_modes: int | None = None,
        If one is found the structure is amplitude-dependent and its record-long peaks are
        not its linear natural frequencies (the 150 N soft base: 45.4 and 406.5 Hz against
        39.6 and 386.6 Hz), so no peak is accepted (``nonlinear`` = True).
+       Otherwise a weaker candidate within :data:`HARMONIC_TOL` of k = 2 or 3 times a
+       stronger accepted one that is phase-locked to it
+       (:func:`testbed.numerics.spectral.harmonic_lock` >= :data:`HARMONIC_LOCK`) and moves
+       in its deflection shape (MAC >= :data:`HARMONIC_SHAPE_MAC`) is its harmonic: rejected
+       and listed in ``harmonics``, the other peaks kept.  This needs no drift of the
+       fundamental, which a short record of a lightly damped mode does not show.  A
+       candidate with a harmonic's shape within side-lobe reach of it is its side lobe.
     5. *Sensors*: at most ``n_modes`` (default the number of channels: n sensors resolve at
        most n mode shapes), the strongest.
 
@@ -702,6 +733,8 @@ def modal_peaks(data: Measurement, n_modes: int | None = None,
                                  min_rel_separation=MODE_SEPARATION)
     rejected: list[tuple[float, str]] = []
     kept: list[int] = []
+    harmonics: list[tuple[float, int, float]] = []
+    lobed: list[int] = []  # stronger peaks whose side lobes are not modes: kept ones and harmonics
     nonlinear = False
     shapes = deflection_shapes(xdd, data.fs, freqs, pad=8)
     for i in range(freqs.size):  # strongest first
@@ -720,17 +753,27 @@ def modal_peaks(data: Measurement, n_modes: int | None = None,
             rejected.append((float(freqs[i]), why))
             nonlinear = True
             continue
+        locked = _locked_harmonic(xdd, data.fs, freqs, shapes, i, kept)
+        if locked is not None:
+            k, j, lock, m = locked
+            harmonics.append((float(freqs[i]), k, float(freqs[j])))
+            lobed.append(i)
+            rejected.append((float(freqs[i]), f"harmonic {k} of {freqs[j]:.4g} Hz (phase-locked to it: "
+                                              f"{lock:.3f}; its shape: MAC {m:.3f}), not a mode"))
+            continue
         lobe_reach = SIDE_LOBE_LINES * data.fs / xdd.shape[1]
         ring_top = HIGHPASS_RING_FACTOR * float(data.passband[0]) if data.passband else 0.0
-        macs = [(float(mac_matrix(shapes[i], shapes[j])[0, 0]), j) for j in kept
+        macs = [(float(mac_matrix(shapes[i], shapes[j])[0, 0]), j) for j in lobed
                 if abs(freqs[i] - freqs[j]) <= lobe_reach or freqs[i] <= ring_top]
         same = [(m, j) for m, j in macs if m >= ODS_MAC]
         if same:
             m, j = same[0]
+            what = "that mode" if j in kept else "that harmonic"
             rejected.append((float(freqs[i]), f"same deflection shape as the {freqs[j]:.4g} Hz peak "
-                                              f"(MAC {m:.3f}): a side lobe of that mode, not another one"))
+                                              f"(MAC {m:.3f}): a side lobe of {what}, not another mode"))
         else:
             kept.append(i)
+            lobed.append(i)
     if nonlinear:
         for i in kept:
             rejected.append((float(freqs[i]), "amplitude-dependent structure (a harmonic was found): "
@@ -740,7 +783,38 @@ def modal_peaks(data: Measurement, n_modes: int | None = None,
         rejected.append((float(freqs[i]), f"beyond the {n_modes} strongest (n sensors resolve at most "
                                           f"n modes)"))
     kept = kept[:n_modes]
-    return PeakSearch(band, rule, np.sort(freqs[kept]), rejected, nonlinear)
+    found = "; ".join(f"{f:.4g} Hz = {k} x {f0:.4g} Hz" for f, k, f0 in harmonics) or "none found"
+    return PeakSearch(band, rule, np.sort(freqs[kept]), rejected, nonlinear, harmonics,
+                      f"{HARMONIC_RULE}: {found}")
+
+
+#: The phase-lock harmonic rule as stored with a fitted model (``harmonic_rule_``).
+HARMONIC_RULE = (f"a weaker peak within {HARMONIC_TOL:g} of k = 2 or 3 x a stronger accepted one, "
+                 f"phase-locked to it (mean resultant length of phi_c - k phi_p >= 2/pi) and moving "
+                 f"in its shape (MAC >= {HARMONIC_SHAPE_MAC:g}), is its harmonic, not a mode")
+
+
+def _locked_harmonic(xdd: np.ndarray, fs: float, freqs: np.ndarray, shapes: np.ndarray, i: int,
+                     kept: list[int]) -> tuple[int, int, float, float] | None:
+    """The first accepted peak ``j`` (strongest first) whose ``k``-th harmonic candidate ``i`` is
+    by the phase-lock rule (:data:`HARMONIC_LOCK`, :data:`HARMONIC_SHAPE_MAC`), as
+    ``(k, j, lock, MAC)``; None if it is none's."""
+    for j in kept:
+        for k in (2, 3):
+            if abs(freqs[i] / (k * freqs[j]) - 1.0) > HARMONIC_TOL:
+                continue
+            m = float(mac_matrix(shapes[i], shapes[j])[0, 0])
+            if m < HARMONIC_SHAPE_MAC:
+                continue
+            lock = harmonic_lock(xdd, fs, float(freqs[j]), float(freqs[i]), k, shapes[j], shapes[i])
+            if lock >= HARMONIC_LOCK:
+                return k, j, lock, m
+    return None
+
+
+def harmonics_array(ps: PeakSearch) -> np.ndarray:
+    """``ps.harmonics`` as an array, shape (h, 3): rows ``(f [Hz], k, f_fundamental [Hz])``."""
+    return np.asarray(ps.harmonics, dtype=float).reshape(-1, 3)
 
 
 def deflection_shapes(x: np.ndarray, fs: float, freqs: np.ndarray, pad: int = 8) -> np.ndarray:

@@ -267,3 +267,84 @@ def harmonic_amplitude_law(x: np.ndarray, fs: float, f_fund: float, k: int, n_se
     da = la - la.mean()
     slope = float(da @ (lb - lb.mean()) / (da @ da)) if da @ da > 0 else float("nan")
     return slope, float((fs_seg[0] - fs_seg[-1]) / fs_seg[-1]), float((f_axis[1] - f_axis[0]) / fs_seg[-1])
+
+
+def band_analytic(x: np.ndarray, fs: float, lo: float, hi: float,
+                  weights: np.ndarray | None = None) -> np.ndarray:
+    """Analytic signal of the band ``[lo, hi]`` of ``x``, channels combined by ``weights``.
+
+    The band is cut out of the record's transform (a one-sided brick wall, so the result is
+    the analytic signal of the band-limited part: its modulus is the envelope, its unwrapped
+    angle the phase [rad]).
+
+    Parameters
+    ----------
+    x : ndarray, shape (n_channels, n_samples)
+        Signals (mean removed here).
+    fs : float
+        Sample rate [Hz].
+    lo, hi : float
+        Band edges [Hz], ``0 <= lo < hi``.
+    weights : ndarray, shape (n_channels,), optional
+        Complex channel weights (e.g. the conjugate of a deflection shape, which adds the
+        channels in phase); default every channel by 1.
+
+    Returns
+    -------
+    ndarray, shape (n_samples,), complex
+    """
+    x = np.atleast_2d(np.asarray(x, dtype=float))
+    n = x.shape[-1]
+    spec = sfft.fft(x - x.mean(axis=-1, keepdims=True), axis=-1)
+    f = sfft.fftfreq(n, 1.0 / fs)
+    spec[:, ~((f >= lo) & (f <= hi))] = 0.0
+    z = sfft.ifft(2.0 * spec, axis=-1)
+    w = np.ones(x.shape[0]) if weights is None else np.asarray(weights)
+    return w @ z
+
+
+def harmonic_lock(x: np.ndarray, fs: float, f_fund: float, f_cand: float, k: int,
+                  w_fund: np.ndarray, w_cand: np.ndarray, rel_band: float = 1.0 / 3.0) -> float:
+    """How firmly a candidate at ``k`` times a fundamental keeps ``k`` times its phase.
+
+    Both are demodulated (:func:`band_analytic`, bands ``f (1 +- rel_band)``, channels added in
+    phase by the conjugate deflection shapes), and ``1 / (rel_band f_fund)`` s (three periods,
+    twice the fundamental band's impulse response) are dropped at each end, where the band's
+    cut rings.  A harmonic is driven by the fundamental's motion, so its phase is ``k`` times the
+    fundamental's plus the structure's lag at ``k f``: ``psi = phi_c - k phi_p`` stays put.  A
+    mode rings at its own frequency: ``psi`` turns by ``2 pi delta T`` over ``T`` s when it is
+    ``delta`` Hz from ``k f``.
+
+    Parameters
+    ----------
+    x : ndarray, shape (n_channels, n_samples)
+        Free-decay signals.
+    fs : float
+        Sample rate [Hz].
+    f_fund, f_cand : float
+        Peak frequencies [Hz] of the fundamental and the candidate.
+    k : int
+        Harmonic order.
+    w_fund, w_cand : ndarray, shape (n_channels,), complex
+        Deflection shapes of the two peaks (their conjugates weight the channels).
+    rel_band : float
+        Relative half-width of the demodulation bands; 1/3 makes the fundamental's band and
+        its second harmonic's touch (``f (1 + 1/3) = 2 f (1 - 1/3)``).
+
+    Returns
+    -------
+    float
+        Mean resultant length of ``psi`` [-], weighted by ``|z_c| |z_p|^k`` (where the harmonic
+        is strong): 1 for a fixed ``psi``, ``|sinc(delta T)|`` for a steady mode ``delta`` Hz
+        off, ``2 / pi`` for a ``psi`` spread evenly over pi rad; NaN if nothing is left after
+        the ends are dropped.
+    """
+    x = np.atleast_2d(np.asarray(x, dtype=float))
+    zp = band_analytic(x, fs, f_fund * (1 - rel_band), f_fund * (1 + rel_band), np.conj(w_fund))
+    zc = band_analytic(x, fs, f_cand * (1 - rel_band), f_cand * (1 + rel_band), np.conj(w_cand))
+    trim = int(np.ceil(fs / (rel_band * f_fund)))
+    zp, zc = zp[trim:x.shape[-1] - trim], zc[trim:x.shape[-1] - trim]
+    # zc conj(zp)^k has angle psi and modulus |z_c| |z_p|^k
+    prod = zc * np.conj(zp) ** int(k)
+    tot = np.abs(prod).sum()
+    return float(np.abs(prod.sum()) / tot) if tot > 0 else float("nan")

@@ -95,3 +95,17 @@ def test_bad_arguments():
         peak_frequencies(x, FS, 1, fmin=500.0, fmax=100.0)
     with pytest.raises(ValueError, match="fmin"):
         peak_frequencies(x, FS, 1, fmax=FS)
+
+
+def test_harmonic_lock_tells_a_driven_harmonic_from_a_mode_off_by_a_few_hertz():
+    """A component whose phase is 3x the fundamental's keeps psi = phi_c - 3 phi_p fixed
+    (lock 1); a steady one 4 Hz off turns psi twice over 0.5 s (lock ~ |sinc(4 x 0.5)| ~ 0)."""
+    from testbed.numerics.spectral import harmonic_lock
+
+    fs, t = 2000.0, np.arange(2000) / 2000.0
+    fund = np.exp(-0.5 * t) * np.sin(2 * np.pi * 30.0 * t)
+    harm = 0.05 * np.exp(-1.5 * t) * np.sin(3 * 2 * np.pi * 30.0 * t + 0.4)
+    mode = 0.05 * np.exp(-1.5 * t) * np.sin(2 * np.pi * 94.0 * t)
+    one = np.ones(1)
+    assert harmonic_lock(fund + harm, fs, 30.0, 90.0, 3, one, one) > 0.99
+    assert harmonic_lock(fund + mode, fs, 30.0, 94.0, 3, one, one) < 0.3
