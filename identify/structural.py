@@ -590,9 +590,12 @@ HARMONIC_SEGMENTS = 8
 #: that peak's harmonic (:func:`testbed.numerics.spectral.harmonic_lock`, the mean resultant
 #: length of ``phi_c - k phi_p``): 2 / pi is a phase spread evenly over pi rad.  A harmonic is
 #: driven by the fundamental's motion and keeps its phase; a mode rings at its own frequency.
-#: Measured on the soft-base family's harmonics 0.83-0.99 (clean and 1 % noise).  A mode that
-#: decays within a few periods of its own stays locked too (soft base mode 3 at 2.99 x mode 2:
-#: 0.94), hence the shape test beside it.
+#: Measured on the soft-base family (studies/families.toml, clean / 1 % noise): the third
+#: harmonics of members 000, 001, 006, 008 0.82-0.99; member 017's 0.64 / 0.56 (then caught
+#: as a side lobe, MAC 0.97, and its fundamental, 17.8 Hz, is below the ringing zone anyway).
+#: A mode that decays within a few periods of its own stays locked too (member 005's mode 3
+#: at 2.99 x mode 2: 0.94), hence the shape test beside it; distinct modes at 2-3x within
+#: the tolerance on both families otherwise 0.13-0.63.
 HARMONIC_LOCK = 2.0 / np.pi
 #: ... and whose deflection shape has at least this MAC with the stronger peak's: a harmonic is
 #: the structure's forced response at k f to the force the fundamental's motion makes, which
@@ -708,6 +711,10 @@ def modal_peaks(data: Measurement, n_modes: int | None = None,
        and listed in ``harmonics``, the other peaks kept.  This needs no drift of the
        fundamental, which a short record of a lightly damped mode does not show.  A
        candidate with a harmonic's shape within side-lobe reach of it is its side lobe.
+       Fundamentals below :data:`HIGHPASS_RING_FACTOR` x the high-pass cut-off are not
+       tried: there the chain's filter rings, a linear response that makes no harmonics,
+       dies within a few periods (so anything looks locked to it over its short life) and
+       has the displacement's shape.
     5. *Sensors*: at most ``n_modes`` (default the number of channels: n sensors resolve at
        most n mode shapes), the strongest.
 
@@ -737,6 +744,8 @@ def modal_peaks(data: Measurement, n_modes: int | None = None,
     lobed: list[int] = []  # stronger peaks whose side lobes are not modes: kept ones and harmonics
     nonlinear = False
     shapes = deflection_shapes(xdd, data.fs, freqs, pad=8)
+    lobe_reach = SIDE_LOBE_LINES * data.fs / xdd.shape[1]
+    ring_top = HIGHPASS_RING_FACTOR * float(data.passband[0]) if data.passband else 0.0
     for i in range(freqs.size):  # strongest first
         why = None
         for j in kept:
@@ -753,7 +762,8 @@ def modal_peaks(data: Measurement, n_modes: int | None = None,
             rejected.append((float(freqs[i]), why))
             nonlinear = True
             continue
-        locked = _locked_harmonic(xdd, data.fs, freqs, shapes, i, kept)
+        locked = _locked_harmonic(xdd, data.fs, freqs, shapes, i,
+                                  [j for j in kept if freqs[j] > ring_top])
         if locked is not None:
             k, j, lock, m = locked
             harmonics.append((float(freqs[i]), k, float(freqs[j])))
@@ -761,8 +771,6 @@ def modal_peaks(data: Measurement, n_modes: int | None = None,
             rejected.append((float(freqs[i]), f"harmonic {k} of {freqs[j]:.4g} Hz (phase-locked to it: "
                                               f"{lock:.3f}; its shape: MAC {m:.3f}), not a mode"))
             continue
-        lobe_reach = SIDE_LOBE_LINES * data.fs / xdd.shape[1]
-        ring_top = HIGHPASS_RING_FACTOR * float(data.passband[0]) if data.passband else 0.0
         macs = [(float(mac_matrix(shapes[i], shapes[j])[0, 0]), j) for j in lobed
                 if abs(freqs[i] - freqs[j]) <= lobe_reach or freqs[i] <= ring_top]
         same = [(m, j) for m, j in macs if m >= ODS_MAC]
@@ -791,7 +799,8 @@ def modal_peaks(data: Measurement, n_modes: int | None = None,
 #: The phase-lock harmonic rule as stored with a fitted model (``harmonic_rule_``).
 HARMONIC_RULE = (f"a weaker peak within {HARMONIC_TOL:g} of k = 2 or 3 x a stronger accepted one, "
                  f"phase-locked to it (mean resultant length of phi_c - k phi_p >= 2/pi) and moving "
-                 f"in its shape (MAC >= {HARMONIC_SHAPE_MAC:g}), is its harmonic, not a mode")
+                 f"in its shape (MAC >= {HARMONIC_SHAPE_MAC:g}), is its harmonic, not a mode "
+                 f"(fundamentals above {HIGHPASS_RING_FACTOR:g} x the chain's high-pass cut-off)")
 
 
 def _locked_harmonic(xdd: np.ndarray, fs: float, freqs: np.ndarray, shapes: np.ndarray, i: int,
