@@ -46,6 +46,10 @@ STYLE: dict[str, Any] = {
     # a title at a fixed height: matplotlib otherwise measures every axis's top tick labels to
     # lift the title over them (none of our axes has any)
     "axes.titley": 1.0,
+    # glyphs drawn unhinted, as matplotlib draws them into PDF and SVG: hinting cost about a
+    # tenth of the six figures of `testbed run cantilever_stiff_impact` (2.26 -> 2.06 s CPU,
+    # minimum of 10 interleaved rounds, 2 cores under load 15) and is not visible at 110 dpi
+    "text.hinting": "no_hinting",
 }
 # No "savefig.bbox": "tight" and no constrained layout for the run figures: both measure every
 # text of the figure in extra draw passes (measured: 2 of the 5 s of a `testbed run` went to
@@ -185,13 +189,16 @@ def _envelope(t: np.ndarray, y: np.ndarray, n_bins: int = MAX_POINTS // 2
 def _log_y(ax: Any) -> None:
     """Logarithmic y axis with plain ``1e-3`` tick labels: mathtext labels (``10^{-3}``) cost
     most of a small figure's layout time (measured: 1.6 of 2.4 s of a 3-row spectrum figure)."""
-    from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
+    from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter, NullLocator
 
     ax.set_yscale("log")
     ax.yaxis.set_major_locator(LogLocator(numticks=5))
     ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:.0e}".replace("e-0", "e-")
                                                .replace("e+0", "e").replace("e+", "e")))
     ax.yaxis.set_minor_formatter(NullFormatter())
+    # no minor tick marks: unlabelled, they cost as much to make as labelled ones (58 of the 372
+    # ticks of a `testbed run` figure set were minor ticks of one penalty-weight panel)
+    ax.yaxis.set_minor_locator(NullLocator())
 
 
 def _label(quantity: str, unit: str) -> str:
@@ -218,7 +225,8 @@ def reconstruction(t: np.ndarray, reference: np.ndarray, simulated: np.ndarray, 
     n = len(channels)
     zoom = zoom or (float(t[0]), float(t[0] + 0.1 * (t[-1] - t[0])))
     fig = _fig(1.9 * n + 0.6)
-    ax = _axes(fig, n, 2, width_ratios=(2, 1))
+    # one time axis per column, labelled under the last row only (the rows above repeat it)
+    ax = _axes(fig, n, 2, width_ratios=(2, 1), sharex="col")
     inside = (t >= zoom[0]) & (t <= zoom[1])
     for i, ch in enumerate(channels):
         for a, sel in ((ax[i, 0], slice(None)), (ax[i, 1], inside)):

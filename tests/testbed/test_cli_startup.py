@@ -128,3 +128,35 @@ def test_lazy_module_of_a_missing_module_fails_at_first_use():
     mod = lazy_module("no_such_module_for_testbed_xyz")
     with pytest.raises(ModuleNotFoundError):
         _ = mod.anything
+
+
+def _mujoco_import_in_fresh_process(env_value: str | None) -> dict:
+    """Load the cantilever scenario (its budget check builds the MuJoCo model) in a fresh
+    process, with ``MUJOCO_GL`` unset or set to ``env_value``."""
+    env = dict(os.environ, PYTHONPATH=str(ROOT), MPLBACKEND="Agg")
+    env.pop("MUJOCO_GL", None)
+    if env_value is not None:
+        env["MUJOCO_GL"] = env_value
+    code = """
+        import json, os, sys
+        from testbed.pipeline.scenario import load_scenario
+        load_scenario("cantilever_stiff_impact")
+        print(json.dumps({"mujoco": "mujoco" in sys.modules, "glfw": "glfw" in sys.modules,
+                          "MUJOCO_GL": os.environ.get("MUJOCO_GL")}))
+    """
+    r = subprocess.run([sys.executable, "-c", textwrap.dedent(code)], cwd=ROOT, env=env,
+                       capture_output=True, text=True, timeout=TIMEOUT_S)
+    assert r.returncode == 0, r.stderr
+    return json.loads(r.stdout.strip().splitlines()[-1])
+
+
+def test_mujoco_is_imported_without_its_renderer():
+    """MuJoCo's OpenGL renderer (the glfw package, which starts a second Python process to read
+    the library's version) is not imported: the testbed never renders."""
+    out = _mujoco_import_in_fresh_process(None)
+    assert out == {"mujoco": True, "glfw": False, "MUJOCO_GL": "disable"}
+
+
+def test_a_users_mujoco_gl_setting_is_kept():
+    out = _mujoco_import_in_fresh_process("off")  # a synonym of "disable": no GL library needed
+    assert out["MUJOCO_GL"] == "off" and not out["glfw"]
