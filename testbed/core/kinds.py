@@ -25,6 +25,10 @@ METRICS: dict[str, dict[str, str]] = {
         "MinvC_error": "relative Frobenius error of M^-1 C (scale-free, identifiable from data)",
         "K3_force_error": "relative RMS error of the identified cubic restoring force along the "
                           "measured motion (soft base)",
+        "K3_accel_error": "relative RMS error of the acceleration the identified cubic force "
+                          "causes, M^-1 K3 x^3 against Mr^-1 times the truth's, along the "
+                          "measured motion (soft base; free of the modal-mass sharing, which "
+                          "free vibration does not determine)",
         "K3_norm": "Frobenius norm of the identified cubic matrix [N/m^3]",
         "K3_force_ratio": "RMS of the identified cubic restoring force over that of the identified "
                           "linear one, along the measured motion (scale-free size of K3)",

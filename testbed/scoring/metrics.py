@@ -372,3 +372,42 @@ def modal_from_matrices(m: np.ndarray, c: np.ndarray | None, k: np.ndarray, *, s
             zeta = -np.real(lam_pair.sum(axis=1)) / (2.0 * omega)
     order = np.argsort(omega)  # NaN (unstable) modes last
     return omega[order] / (2.0 * np.pi), zeta[order], modes[:, order]
+
+
+def cubic_acceleration_error(M_id: np.ndarray, f_id: np.ndarray, Mr: np.ndarray,
+                             f_true: np.ndarray) -> float:
+    """Relative RMS error of the cubic force's share of the acceleration, ``M^-1 f`` [-].
+
+    Free vibration (and an impact whose gain each row fits freely) determines ``M^-1 K``,
+    ``M^-1 C`` and ``M^-1 K3``, not how the mass is shared among the modes (the modal-mass
+    ratios: :mod:`identify.sgd_sindy`, item 4); a cubic model keeps its mass prior's sharing
+    (:func:`identify.structural.driving_point_scaling`).  The restoring force ``K3 x^3`` in
+    newtons carries that unidentified sharing (``K3_force_error`` compares it with the SEREP
+    truth's, whose sharing is the mass-normalised modes'); the acceleration it causes,
+    ``M^-1 K3 x^3``, does not: any equation of the same motion, left-multiplied by an
+    invertible matrix, gives the same one.  So this compares what the data determine, as
+    ``MinvK_error`` does beside ``Kr_error``.
+
+    Parameters
+    ----------
+    M_id : ndarray, shape (n, n)
+        Identified mass matrix [kg].
+    f_id : ndarray, shape (n, n_samples)
+        Identified cubic restoring force ``K3 x^3`` along the reference motion [N].
+    Mr : ndarray, shape (n, n)
+        SEREP mass matrix [kg].
+    f_true : ndarray, shape (n, n_samples)
+        The truth's cubic restoring force along the same motion [N].
+
+    Returns
+    -------
+    float
+        ``||M_id^-1 f_id - Mr^-1 f_true|| / ||Mr^-1 f_true||`` (Frobenius over channels and
+        samples); NaN for a singular identified M.
+    """
+    try:
+        a_id = np.linalg.solve(M_id, f_id)
+    except np.linalg.LinAlgError:
+        return float("nan")
+    a_true = np.linalg.solve(Mr, f_true)
+    return float(np.linalg.norm(a_id - a_true) / np.linalg.norm(a_true))

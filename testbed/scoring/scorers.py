@@ -438,6 +438,7 @@ def score_structural(dataset: Dataset, data: Measurement, clean: Measurement, mo
         f_true = np.outer(truth.cubic_direction, k3 * q0**3)
         f_id = K3 @ x_ref**3
         v["K3_force_error"] = float(np.linalg.norm(f_id - f_true) / np.linalg.norm(f_true))
+        v["K3_accel_error"] = metrics.cubic_acceleration_error(model.M_, f_id, Mr, f_true)
         d.update(cubic_force_true=f_true, cubic_force_id=f_id)
     return Scores({k: float(x) for k, x in v.items()}, d, failures)
 

@@ -211,3 +211,18 @@ def test_modes_of_a_nonsymmetric_identified_stiffness_are_the_right_eigenvectors
     f_id, _, phi_id = modal_from_matrices(m_id, None, k_id)
     np.testing.assert_allclose(f_id, f_true, rtol=1e-12)
     np.testing.assert_allclose(np.diag(mac_matrix(phi_id, phi_true)), 1.0, rtol=1e-12)
+
+
+def test_cubic_acceleration_error_ignores_the_mass_sharing():
+    """M^-1 K3 x^3 is what the data fix: an equation left-multiplied by any invertible S (another
+    modal-mass sharing) scores alike, while the force error sees the sharing."""
+    rng = np.random.default_rng(0)
+    A = rng.normal(size=(3, 3))
+    Mr = A @ A.T + 3 * np.eye(3)
+    f_true = rng.normal(size=(3, 200))
+    S = np.diag([1.0, 2.0, 0.5]) + 0.1 * rng.normal(size=(3, 3))
+    assert mt.cubic_acceleration_error(S @ Mr, S @ f_true, Mr, f_true) == pytest.approx(0.0, abs=1e-12)
+    assert mt.relative_error(S @ f_true, f_true) > 0.3  # K3_force_error's view of the same model
+    # a 10 % too large cubic acceleration scores 0.1, whatever the sharing
+    assert mt.cubic_acceleration_error(S @ Mr, 1.1 * S @ f_true, Mr, f_true) == pytest.approx(0.1)
+    assert np.isnan(mt.cubic_acceleration_error(np.zeros((3, 3)), f_true, Mr, f_true))

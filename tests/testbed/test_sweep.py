@@ -323,4 +323,6 @@ def test_smoke_study_on_the_real_rigs(tmp_path):
         other = metric_names("mechanical" if kind == "structural" else "structural")
         assert all(math.isnan(r[m]) for m in other if m in r)  # no score of the other kind
         if r["status"] == "ok":
-            assert all(math.isfinite(r[m]) for m in metric_names(kind) if m in r and m != "K3_force_error")
+            # the cubic scores are NaN without a cubic truth (a stiff base)
+            cubic = ("K3_force_error", "K3_accel_error")
+            assert all(math.isfinite(r[m]) for m in metric_names(kind) if m in r and m not in cubic)
