@@ -1,4 +1,4 @@
-"""Modal damping from each mode's measured free decay (``sgd_sindy``'s damping hold).
+"""Modal damping from each mode's measured free decay (``sgd_sindy``'s decay hold).
 
 Why
 ---
@@ -23,7 +23,9 @@ mode by its own signal.  The model's modal damping ``D = Phi^T C Phi`` is then r
 the congruence ``D' = G D G``, ``G = diag(sqrt(2 sigma_k / D_kk))``: each mode's damping
 ``D'_kk = 2 sigma_k`` is the measured one, the couplings keep their correlation
 ``D_ij / sqrt(D_ii D_jj)``, and ``C' = Phi^-T D' Phi^-1`` stays symmetric positive
-semi-definite when ``C`` was.  The frequencies and shapes are not touched.
+semi-definite when ``C`` was.  The shapes are not touched; the caller
+(``sgd_sindy``) moves a frequency to the fitted one only within one spectral line of the
+model's (``lam_model``, ``shift``).
 
 A mode keeps the model's damping when its decay fit fails: no convergence, a decay rate at
 its bounds, or a damped frequency nearer another mode's than its own (the fit followed
@@ -71,6 +73,12 @@ class ModalDecay:
     sigma_model : ndarray, shape (n,)
         The decay rate to give the model's mode [1/s]: ``sigma``, or with trapezoid integrals
         ``-Re`` of the measured pole warped (NaN where not taken).
+    lam_model : ndarray, shape (n,)
+        The eigenvalue of ``(K, M)`` that gives the model's mode the measured pole
+        [rad^2/s^2]: ``|p|^2`` of the (warped) pole ``p`` (NaN where not taken).
+    shift : ndarray, shape (n,)
+        ``|sqrt(lam_model) - w| / (2 pi)`` [Hz], how far the measured undamped frequency lies
+        from the model's ``w`` (both in the model's domain; NaN where not taken).
     r2 : ndarray, shape (n,)
         Share of the modal acceleration's energy the fitted decay explains [-].
     taken : ndarray of bool, shape (n,)
@@ -80,6 +88,8 @@ class ModalDecay:
     sigma: np.ndarray
     omega_d: np.ndarray
     sigma_model: np.ndarray
+    lam_model: np.ndarray
+    shift: np.ndarray
     r2: np.ndarray
     taken: np.ndarray
 
@@ -130,8 +140,7 @@ def modal_decay(data: Measurement, M: np.ndarray, K: np.ndarray, C: np.ndarray,
     """
     freqs, Phi = modal(M, K)
     n = M.shape[0]
-    out = ModalDecay(np.full(n, np.nan), np.full(n, np.nan), np.full(n, np.nan), np.zeros(n),
-                     np.zeros(n, bool))
+    out = ModalDecay(*(np.full(n, np.nan) for _ in range(5)), np.zeros(n), np.zeros(n, bool))
     if not np.all(np.isfinite(freqs)) or np.linalg.cond(Phi) > 1e12:
         return out
     # the measured accelerations as they are: they carry no integration drift, and a
@@ -143,7 +152,7 @@ def modal_decay(data: Measurement, M: np.ndarray, K: np.ndarray, C: np.ndarray,
     t = np.arange(i1 - i0) / float(data.fs)
     fs = float(data.fs)
     trap = data.integration == "trapezoid"
-    w = 2.0 * np.pi * freqs
+    w = w_model = 2.0 * np.pi * freqs
     if trap:  # the model's undamped poles i w mapped back: i 2 fs arctan(w / (2 fs))
         w = 2.0 * fs * np.arctan(w / (2.0 * fs))
     d = np.einsum("ik,ij,jk->k", Phi, C, Phi)  # modal damping 2 zeta_k w_k [1/s]
@@ -156,6 +165,8 @@ def modal_decay(data: Measurement, M: np.ndarray, K: np.ndarray, C: np.ndarray,
             if trap:
                 pole = 2.0 * fs * np.tanh(pole / (2.0 * fs))
             out.sigma_model[k] = -pole.real
+            out.lam_model[k] = abs(pole) ** 2
+            out.shift[k] = abs(abs(pole) - w_model[k]) / (2.0 * np.pi)
     return out
 
 

@@ -1,4 +1,4 @@
-"""The damping hold of ``sgd_sindy`` (identify/_modal_damping.py) on exact synthetic chains."""
+"""The decay hold of ``sgd_sindy`` (identify/_modal_damping.py) on exact synthetic chains."""
 
 from __future__ import annotations
 
@@ -53,6 +53,9 @@ def test_decay_fit_measures_each_mode_from_a_wrong_start(chain):
     # exact data: the decay rate to the optimiser's tolerance and the integrator's 1e-11
     assert dec.sigma == pytest.approx(0.5 * _modal_damping(M, C, K), rel=1e-4)
     assert np.array_equal(dec.sigma, dec.sigma_model)  # exact derivatives: no pole mapping
+    w = 2 * np.pi * modal(M, K)[0]
+    assert np.sqrt(dec.lam_model) == pytest.approx(w, rel=1e-6)  # |pole| = undamped frequency
+    assert dec.shift == pytest.approx(0.0, abs=1e-5 * w.max())
 
 
 def test_sgd_sindy_holds_the_measured_damping(chain):
@@ -60,11 +63,14 @@ def test_sgd_sindy_holds_the_measured_damping(chain):
     _, z_true, _ = modal_from_matrices(sysd["M"], sysd["C"], sysd["K"])
     m = SGDSINDy(epochs=20).fit(data)
     _, z, _ = modal_from_matrices(m.M_, m.C_, m.K_)
-    assert m.modal_decay_.taken.all() and "free decay" in m.damping_rule_
+    assert m.modal_decay_.taken.all() and "free decay" in m.decay_rule_
     assert z == pytest.approx(z_true, rel=1e-3)  # exact data: the fit's residue only
+    assert "frequencies of modes [1, 2, 3]" in m.decay_rule_
+    # exact data: the decay fit's frequency, to the optimiser's tolerance
+    assert m.natural_frequencies_ == pytest.approx(modal(sysd["M"], sysd["K"])[0], rel=1e-6)
     assert np.linalg.eigvalsh(m.C_).min() >= -1e-12 * np.abs(m.C_).max()
-    off = SGDSINDy(epochs=20, damping_hold=False).fit(data)
-    assert "damping_hold = False" in off.damping_rule_ and not hasattr(off, "modal_decay_")
+    off = SGDSINDy(epochs=20, decay_hold=False).fit(data)
+    assert "decay_hold = False" in off.decay_rule_ and not hasattr(off, "modal_decay_")
 
 
 def test_growing_modes_keep_the_projected_damping():
