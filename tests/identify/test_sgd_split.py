@@ -59,6 +59,7 @@ MATRIX_CASES = {
     "eigen_hold": ({"learning_rate": 0.1}, False),
     "cubic_form": ({"cubic": True, "data": "duffing"}, "direction"),
     "fit_band": ({}, False),
+    "decay_hold": ({}, False),
 }
 
 COEFFICIENT_CASES = {
@@ -139,7 +140,7 @@ def test_every_declared_hyperparameter_changes_the_fit(cls, cases, chains):
 
 def test_the_forms_declare_only_their_own_keys():
     matrix_only = {"fit_duration", "l1_threshold", "l1_debias", "gradient", "iterate_average",
-                   "eigen_hold"}
+                   "eigen_hold", "decay_hold"}
     coefficient_only = {"mass_learning_rate", "symmetry", "optimizer", "mass_update"}
     assert matrix_only <= set(SGDSINDy.hyperparameters)
     assert coefficient_only <= set(SGDSINDyCoefficients.hyperparameters)

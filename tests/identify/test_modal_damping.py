@@ -1,0 +1,83 @@
+"""The decay hold of ``sgd_sindy`` (identify/_modal_damping.py) on exact synthetic chains."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from benchmarks import bench_sgd_sindy as bench
+from identify._modal_damping import hold_modal_damping, modal_decay
+from identify.sgd_sindy import SGDSINDy
+from identify.structural import modal
+from testbed.scoring.metrics import modal_from_matrices
+
+
+def _modal_damping(M, C, K):
+    _, Phi = modal(M, K)
+    return np.diag(Phi.T @ C @ Phi)
+
+
+@pytest.fixture(scope="module")
+def chain():
+    sysd = bench.chain_system(coupled=True, damping="proportional")
+    return sysd, bench.chain_measurement(sysd)
+
+
+def test_hold_sets_each_mode_and_keeps_the_rest():
+    rng = np.random.default_rng(0)
+    A = rng.normal(size=(3, 3))
+    M = A @ A.T + 3 * np.eye(3)
+    B = rng.normal(size=(3, 3))
+    K = B @ B.T + np.eye(3)
+    G = rng.normal(size=(3, 3))
+    C = G @ G.T  # positive definite, non-proportional
+    sigma = np.array([0.05, np.nan, 0.7])
+    C2 = hold_modal_damping(M, C, K, sigma)
+    d, d2 = _modal_damping(M, C, K), _modal_damping(M, C2, K)
+    assert d2[[0, 2]] == pytest.approx(2 * sigma[[0, 2]], rel=1e-10)
+    assert d2[1] == pytest.approx(d[1], rel=1e-10)  # NaN: that mode keeps the model's damping
+    assert np.allclose(C2, C2.T, rtol=0, atol=1e-14 * np.abs(C2).max())
+    assert np.linalg.eigvalsh(C2).min() > 0  # a congruence keeps it positive definite
+    _, Phi = modal(M, K)  # the couplings keep their correlation D_ij / sqrt(D_ii D_jj)
+    D, D2 = Phi.T @ C @ Phi, Phi.T @ C2 @ Phi
+    corr = lambda X: X / np.sqrt(np.outer(np.diag(X), np.diag(X)))  # noqa: E731
+    assert np.allclose(corr(D), corr(D2), rtol=1e-9, atol=1e-12)
+
+
+def test_decay_fit_measures_each_mode_from_a_wrong_start(chain):
+    """From a model whose damping is 10x too high, each mode's decay rate is the true one."""
+    sysd, data = chain
+    M, C, K = sysd["M"], sysd["C"], sysd["K"]
+    dec = modal_decay(data, M, K, 10.0 * C, (0, data.n_samples))
+    assert dec.taken.all()
+    # exact data: the decay rate to the optimiser's tolerance and the integrator's 1e-11
+    assert dec.sigma == pytest.approx(0.5 * _modal_damping(M, C, K), rel=1e-4)
+    assert np.array_equal(dec.sigma, dec.sigma_model)  # exact derivatives: no pole mapping
+    w = 2 * np.pi * modal(M, K)[0]
+    assert np.sqrt(dec.lam_model) == pytest.approx(w, rel=1e-6)  # |pole| = undamped frequency
+    assert dec.shift == pytest.approx(0.0, abs=1e-5 * w.max())
+
+
+def test_sgd_sindy_holds_the_measured_damping(chain):
+    sysd, data = chain
+    _, z_true, _ = modal_from_matrices(sysd["M"], sysd["C"], sysd["K"])
+    m = SGDSINDy(epochs=20).fit(data)
+    _, z, _ = modal_from_matrices(m.M_, m.C_, m.K_)
+    assert m.modal_decay_.taken.all() and "free decay" in m.decay_rule_
+    assert z == pytest.approx(z_true, rel=1e-3)  # exact data: the fit's residue only
+    assert "frequencies of modes [1, 2, 3]" in m.decay_rule_
+    # exact data: the decay fit's frequency, to the optimiser's tolerance
+    assert m.natural_frequencies_ == pytest.approx(modal(sysd["M"], sysd["K"])[0], rel=1e-6)
+    assert np.linalg.eigvalsh(m.C_).min() >= -1e-12 * np.abs(m.C_).max()
+    off = SGDSINDy(epochs=20, decay_hold=False).fit(data)
+    assert "decay_hold = False" in off.decay_rule_ and not hasattr(off, "modal_decay_")
+
+
+def test_growing_modes_keep_the_projected_damping():
+    """Negative damping in the data: no decay is taken (a rate at its bound 0), so the fit's
+    positive semi-definite damping stands."""
+    sysd = bench.chain_system(coupled=False, damping="proportional")
+    sysd["C"] = -sysd["C"]
+    m = SGDSINDy(epochs=2, eigen=False).fit(bench.chain_measurement(sysd))
+    assert not m.modal_decay_.taken.any()
+    assert np.linalg.eigvalsh(m.C_).min() >= -1e-12 * np.abs(m.C_).max()
