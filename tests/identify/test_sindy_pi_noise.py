@@ -188,8 +188,21 @@ def test_weak_ridge_is_the_mean_squared_noise_share_of_the_columns(clean):
         assert m.ridge_ == pytest.approx(np.mean(m.weak_noise_share_ ** 2))
         assert "mean squared noise share" in m.noise_rule_
     assert 4 / 1.5 < m1.ridge_ / m05.ridge_ < 4 * 1.5
+    # the sweep keeps the thresholds up to the largest noise share only
+    assert np.all(m1.selected_thresholds_ <= m1.weak_noise_share_.max())
+    assert "thresholds up to" in m1.noise_rule_
     # reproducible: the draw is seeded
     assert SINDyPI().fit(_chain_smoothed(clean, 1.0)).ridge_ == m1.ridge_
+
+
+def test_noise_thresholds_keep_those_up_to_the_largest_share():
+    thr = np.array([0.0, 1e-4, 1e-3, 1e-2, 0.1])
+    np.testing.assert_array_equal(sp.noise_thresholds(thr, np.array([2e-3, 5e-3])), thr[:3])
+    # no noise: threshold 0 alone (a dense ridge fit)
+    np.testing.assert_array_equal(sp.noise_thresholds(thr, np.zeros(3)), [0.0])
+    # a user's first threshold is kept whatever the share
+    np.testing.assert_array_equal(sp.noise_thresholds(np.array([0.5, 1.0]), np.ones(2) * 1e-3),
+                                  [0.5])
 
 
 def test_declared_noise_rule_is_overridden_by_the_user(clean):
