@@ -186,25 +186,3 @@ def weak_matrix(lib: Library, x: np.ndarray, xd: np.ndarray, xdd: np.ndarray | N
     if ibp.any():
         V[:, ibp] += _correlate(A1[:, ibp], dphi * dt, starts)
     return WeakForm(V, starts, L, strong)
-
-
-def column_noise_share(V: np.ndarray, V_perturbed: np.ndarray) -> np.ndarray:
-    """Relative size of each weak column's change under one noise draw.
-
-    Parameters
-    ----------
-    V : ndarray, shape (n_windows, n_terms)
-        Weak-form matrix of the data (:attr:`WeakForm.V`).
-    V_perturbed : ndarray, shape (n_windows, n_terms)
-        The same matrix after adding one draw of the data's noise to its angles and rates.
-
-    Returns
-    -------
-    ndarray, shape (n_terms,)
-        ``||V_perturbed[:, c] - V[:, c]|| / ||V[:, c]||`` (dimensionless; 0 for a zero column):
-        the noise's share of the column, i.e. the square root of what the noise adds to the
-        diagonal of the unit-diagonal normalised Gram matrix.
-    """
-    nrm = np.linalg.norm(V, axis=0)
-    d = np.linalg.norm(V_perturbed - V, axis=0)
-    return np.where(nrm > 0, d / np.where(nrm > 0, nrm, 1.0), 0.0)

@@ -46,18 +46,14 @@ Noise rule (:func:`noise_knobs`, every setting overridable): the angles' white-n
 noise-corrected power, :func:`testbed.numerics.signal_band`) choose the column low-pass
 (off on exact data, 1.5x the band otherwise), the edge trim, the ridge, the form and the LHS
 candidates; rates a low-pass chain derived from the noisy angles (a declared ``passband``) get
-the weak form, the input terms as LHS and a ridge of the declared noise's share of the weak
-columns (:func:`noise_ridge`); data the
+the weak form, the input terms as LHS and a ridge in proportion to the noise variance; data the
 differences call exact but whose exact fit leaves a held-out error above ``EXACT_HOLDOUT_MAX``
 (angles a derivative chain smoothed) get the noisy recipe.  The values used are fitted
 attributes (``column_lowpass_hz_``, ``edge_trim_``, ``ridge_``, ``formulation_``,
 ``weak_window_s_``, ``lhs_``) and ``noise_rule_`` says why.  Measured on the 30 five-bar family
 members (studies/families.toml) at default settings: within the paper's 0.0501 rad 30/30 at
 1 % angle noise (12/30 before the rule; median 7.4e-4 rad, worst 0.030) and 30/30 clean
-(all <= 3e-6 rad, unchanged); the paper's sine input at 0.5-5 % noise <= 9e-6 rad.  With
-the rates estimated by the noise1 scenario's chain instead (weak branch): 21/30 at 1 % and
-12/30 at 5 % (the constant ridge this rule replaced: 12/30 and 6/30; issue #15 asks 27/30 at
-1 %: not met); see :func:`noise_ridge` and :func:`noise_thresholds`.
+(all <= 3e-6 rad, unchanged); the paper's sine input at 0.5-5 % noise <= 9e-6 rad.
 
 Ensembling (``ensemble=N``): E-SINDy bagging of the selected models over moving-block
 bootstraps of the training rows, with ``coef_std_`` and ``inclusion_probability_``; off by
@@ -101,12 +97,11 @@ from identify._implicit import (
     stlsq_sweep,
 )
 from identify._mechsim import CLOSURE_RTOL, ImplicitModel, LoopClosure
-from identify._weak import WeakForm, column_noise_share, weak_matrix
+from identify._weak import weak_matrix
 from identify.library import Library, fivebar_library, generic_mechanical_library
 from testbed.core.errors import IdentificationError
 from testbed.core.measurement import Measurement, Trajectory
 from testbed.core.schema import ErrorFn, Field
-from testbed.numerics.derivatives import lowpass_differentiate
 from testbed.numerics.filters import lowpass
 from testbed.numerics.gram import normalized_gram, ordered_independent
 from testbed.numerics.noise import noise_std, signal_band
@@ -382,88 +377,13 @@ WEAK_PERIODS = 1.5
 #: whose angles the signal chain low-passed at 4 Hz (white-noise std by differences 1e-13).
 #: 1e-6 sits 400x above the first and 20x below the second.
 EXACT_HOLDOUT_MAX = 1e-6
-#: The rule's ridge value for "from the declared noise's share of the weak columns", resolved
-#: when the weak matrix is built (:meth:`_ImplicitMechanical._set_noise_ridge`, :func:`noise_ridge`).
-RIDGE_BY_NOISE = "by noise"
-#: Seed of the noise draws that measure the noise's share of the weak columns (a fit is
-#: reproducible).
-NOISE_DRAW_SEED = 0
-#: Noise draws averaged (in eps^2) for that share: one draw of noise low-passed at the chain's
-#: few Hz holds only ~2 x cut-off x record independent values (about 30 on a 5 s five-bar
-#: record), and measured on family five-bars its ridge varied by up to 10x between seeds
-#: (member 006: 1 / 10.7 / 1.5 / 4.4 for seeds 0-3); the mean of 8 draws cuts that spread by
-#: sqrt(8) at 8 weak-matrix builds per fit (fit CPU on fivebar_multisine_noise1: 0.7 s with one
-#: draw, 4.1 s with 8).
-NOISE_DRAWS = 8
-
-
-def noise_ridge(eps: np.ndarray) -> tuple[float, str]:
-    """Ridge of the weak form: the mean squared noise share of its columns.
-
-    Rule: ``ridge = mean_c eps_c^2`` (at least ``RIDGE_EXACT``).  On the unit-diagonal
-    normalised Gram matrix a column's noise adds ``eps_c^2`` to its diagonal entry, so the
-    mean is the noise's share of the Gram matrix per direction: Tikhonov's choice of a ridge
-    of the noise variance relative to the signal's, which damps the directions of the
-    (ill-conditioned) library that lie below the noise and leaves those above it.  It
-    replaces a measured constant (0.012 x relative noise^2, fitted on one scenario), which
-    ignored how the chain's cut-off, the test functions and the motion's band shape the
-    noise the columns carry.  Measured on the 30 five-bar family members, rates from the
-    noise1 chain (weak form, 0.4 s windows, input-term LHS; one noise draw, every default
-    threshold): 15/30 within 0.0501 rad at 1 % and 10/30 at 5 % (the constant: 12/30 and
-    6/30); the resulting ridges span 3e-6..3e-4 at 1 %.  Scaling it by 0.3 / 3 / 10 (dense
-    fits): 19 / 21 / 19 of 30 against 21 at 1: a plateau.  On fivebar_multisine_noise1 / 5
-    it gives 5.2e-7 / 1.3e-5 (the constant: 1.2e-6 / 3.0e-5; the plateau measured by hand on
-    noise5: 1e-5..1e-4).
-
-    Parameters
-    ----------
-    eps : ndarray, shape (n_terms,)
-        ``||dV_c|| / ||V_c||`` per column (:func:`identify._weak.column_noise_share`),
-        dimensionless.
-
-    Returns
-    -------
-    ridge : float
-        On the unit-diagonal normalised Gram matrix (dimensionless).
-    text : str
-        For ``noise_rule_``.
-    """
-    e2 = np.asarray(eps, dtype=float) ** 2
-    ridge = max(float(np.mean(e2)), RIDGE_EXACT)
-    return ridge, (f"ridge {ridge:.3g} (mean squared noise share of the weak columns; "
-                   f"largest share {np.sqrt(e2.max(initial=0.0)):.3g})")
-
-
-def noise_thresholds(thresholds: np.ndarray, eps: np.ndarray) -> np.ndarray:
-    """The default thresholds the weak form's noise leaves: those up to its largest share.
-
-    Rule: keep the thresholds ``<= max_c eps_c`` (0 always stays).  On unit-norm columns one
-    draw of the noise moves no column by more than ``max eps``, so a normalised coefficient
-    above it is resolved by the data: a larger threshold discards terms the data hold, not
-    noise terms.  Measured on the 30 five-bar family members, rates from the noise1 chain
-    (ridge by :func:`noise_ridge`, one noise draw): within 0.0501 rad at 1 % / 5 % noise
-    21 / 15 of 30, against 15 / 10 with every default threshold (which picked 2-8-term
-    models at thresholds 0.03-0.32 from the few held-out windows) and 21 / 12 with threshold
-    0 alone; with the ``NOISE_DRAWS`` average (the default): 21 / 12.
-
-    Parameters
-    ----------
-    thresholds : ndarray, shape (n,)
-        Ascending thresholds on normalised coefficients.
-    eps : ndarray, shape (n_terms,)
-        Noise share of each weak column (:func:`identify._weak.column_noise_share`).
-
-    Returns
-    -------
-    ndarray
-        The kept thresholds (at least the first).
-    """
-    thr = np.asarray(thresholds, dtype=float)
-    keep = thr <= float(np.max(eps, initial=0.0))
-    keep[0] = True
-    return thr[keep]
-
-
+#: Weak-form ridge = RIDGE_PER_NOISE_VAR x noise_rel^2 (Tikhonov: a ridge in proportion to the
+#: noise variance relative to the signal's, which the unit-diagonal Gram matrix of the noisy
+#: columns carries, so that its directions below the noise are damped and those above are
+#: not).  The factor was measured on fivebar_multisine_noise5 (5 %, weak form, input-term LHS;
+#: worst of seeds 0-2): ridge 1e-14 0.36 rad, 3e-5 (factor 0.012) 0.024 rad, and the noise5
+#: file's hand-found plateau 1e-5..1e-4 (factor 0.004-0.04); at 1 % it gives 1.2e-6.
+RIDGE_PER_NOISE_VAR = 0.012
 #: The settings the noise rule chooses (each a SINDyPI hyperparameter; None = by rule).
 #: ``lhs`` is given by the rule as "inputs" (the library's terms with an input factor) or None.
 RULE_KNOBS = ("column_lowpass_hz", "edge_trim", "ridge", "formulation", "weak_window_s", "lhs")
@@ -496,15 +416,12 @@ def noise_knobs(x: np.ndarray, fs: float, val_fraction: float, user: dict[str, A
     4. Noisy, rates and accelerations derived by a low-pass chain (``passband[1] < fs / 2``,
        or ``smoothed``): weak form (no acceleration of the noisy angles enters), test
        functions of ``WEAK_PERIODS / band_hz`` seconds (at most half the held-out span), edge
-       trim ``EDGE_PERIODS * window / WEAK_PERIODS``, ridge ``RIDGE_BY_NOISE`` (the mean
-       squared share of the weak columns that one draw of the declared noise, passed through
-       the chain's low-pass, changes: :func:`noise_ridge`), and LHS candidates the terms
-       with an input factor (``"inputs"``): the inputs are measured exactly, so an
-       equation is written for its exact input term, never for a term the noise dominates.
-    5. ``formulation`` given by the user: that form, with the window and trim of its branch
-       above (the weak form's window as in 4); the ridge by noise only for the weak form on
-       rates a low-pass chain derived (it needs the declared pass band), else
-       ``RIDGE_EXACT``.
+       trim ``EDGE_PERIODS * window / WEAK_PERIODS``, ridge ``RIDGE_PER_NOISE_VAR *
+       noise_rel^2``, and LHS candidates the terms with an input factor (``"inputs"``): the
+       inputs are measured exactly, so an equation is written for its exact input term,
+       never for a term the noise dominates.
+    5. ``formulation`` given by the user: that form, with the window, trim and ridge of its
+       branch above (the weak form's window as in 4).
 
     Parameters
     ----------
@@ -574,12 +491,12 @@ def noise_knobs(x: np.ndarray, fs: float, val_fraction: float, user: dict[str, A
         if derived:
             branch = branch.replace("noisy:", "noisy, rates derived by a low-pass:")
         trim = min(EDGE_PERIODS / cut, EDGE_MAX_SHARE * record_s)
-        ridge = RIDGE_BY_NOISE if (filtered and form == "weak") else RIDGE_EXACT
+        ridge = max(RIDGE_PER_NOISE_VAR * noise_rel**2, RIDGE_EXACT) if derived else RIDGE_EXACT
         lhs = LHS_INPUT_TERMS if derived else None
         rule = {"formulation": form, "column_lowpass_hz": cut if form == "strong" else 0.0,
                 "edge_trim": trim, "ridge": ridge,
                 "weak_window_s": window if form == "weak" else None, "lhs": lhs}
-        branch += f", edge trim {trim:.3g} s, ridge " + (ridge if isinstance(ridge, str) else f"{ridge:.3g}")
+        branch += f", edge trim {trim:.3g} s, ridge {ridge:.3g}"
         if lhs is not None:
             branch += ", LHS the input terms"
     knobs = {k: (user[k] if user.get(k) is not None else v) for k, v in rule.items()}
@@ -665,8 +582,6 @@ class _ImplicitMechanical(Identifier):
         xdd = None if xdd is None else xdd[:, sl]
         wf = weak_matrix(lib, x[:, sl], xd[:, sl], xdd, u, data.fs, self._knob("weak_window_s"),
                          self.weak_n_windows, self.weak_degree)
-        if self._knob("ridge") == RIDGE_BY_NOISE:
-            self._set_noise_ridge(lib, data, wf, sl)
         split = split_index(n, self.val_fraction)
         tr = wf.starts + wf.length <= split
         va = wf.starts >= split
@@ -675,39 +590,6 @@ class _ImplicitMechanical(Identifier):
                                       "shorten weak_window_s or add weak_n_windows")
         self.weak_strong_columns_ = wf.strong_columns
         return np.concatenate([wf.V[tr], wf.V[va]]), int(tr.sum()), i0, i0 + split
-
-    def _set_noise_ridge(self, lib: Library, data: Measurement, wf: WeakForm, sl: slice) -> None:
-        """The weak form's ridge from the noise the data declare (:func:`noise_ridge`).
-
-        ``NOISE_DRAWS`` draws of white noise with the declared std per angle [rad] go through
-        the chain's recipe (:func:`testbed.numerics.derivatives.lowpass_differentiate` at the
-        declared pass band's upper edge, its default order 8) and are added to the angles and
-        rates;
-        the weak matrix is rebuilt from them (reconciled alike) and each column's relative
-        change (:func:`identify._weak.column_noise_share`) is the noise's share of it.  Sets
-        the ridge knob, ``ridge_``, ``weak_noise_share_`` and appends to ``noise_rule_``.
-        """
-        rng = np.random.default_rng(NOISE_DRAW_SEED)
-        sig = np.asarray(self.noise_std_, dtype=float)[:, None]
-        u = None if data.u is None else data.u[:, sl]
-        xdd = None if data.xdd is None else data.xdd[:, sl]
-        e2 = np.zeros(wf.V.shape[1])
-        for _ in range(NOISE_DRAWS):
-            dx, dxd, _ = lowpass_differentiate(sig * rng.standard_normal(data.x.shape), data.fs,
-                                               float(data.passband[1]))
-            x, xd = data.x + dx, data.xd + dxd
-            if self.reconcile and self.closure_ is not None:
-                x, xd, _ = self.closure_.reconcile(x, xd, data.xdd)
-            V2 = weak_matrix(lib, x[:, sl], xd[:, sl], xdd, u, data.fs,
-                             self._knob("weak_window_s"), self.weak_n_windows, self.weak_degree).V
-            e2 += column_noise_share(wf.V, V2) ** 2 / NOISE_DRAWS
-        eps = np.sqrt(e2)
-        ridge, text = noise_ridge(eps)
-        self._knobs["ridge"] = self.ridge_ = ridge
-        self.weak_noise_share_ = eps
-        if self.thresholds is None:
-            text += f", thresholds up to {float(eps.max(initial=0.0)):.3g} (noise_thresholds)"
-        self.noise_rule_ = self.noise_rule_.replace(f"ridge {RIDGE_BY_NOISE}", text)
 
     @classmethod
     def check_data_shape(cls, params, n_channels, n_inputs, fs, n_samples, error):
@@ -728,7 +610,6 @@ class _ImplicitMechanical(Identifier):
         actuated = np.array([int(np.argmax(imap[:, k])) for k in range(imap.shape[1])])
         passive = np.flatnonzero(~imap.any(axis=1))
         self._knobs = None
-        self.weak_noise_share_ = None  # set with the weak form's ridge by noise
         self._knobs = self._choose_knobs(data)
         cut = self._knobs["column_lowpass_hz"]
         self.closure_ = None  # fully actuated, or an open chain: one equation per coordinate
@@ -896,8 +777,7 @@ class SINDyPI(_ImplicitMechanical):
         column.
     thresholds : sequence of float, optional
         Ascending thresholds on normalised coefficients; default 0 and 12 values log-spaced
-        over 1e-6..0.32, with the weak form's ridge by noise only those up to the columns'
-        largest noise share (:func:`noise_thresholds`).
+        over 1e-6..0.32.
     ridge : float, optional
         Ridge added to the unit-diagonal normalised Gram matrix (see ``stlsq_sweep``);
         default by the noise rule (:func:`noise_knobs`: 1e-14).
@@ -998,9 +878,6 @@ class SINDyPI(_ImplicitMechanical):
         (``Measurement.noise_std``) or :func:`testbed.numerics.noise_std` of the angles.
     noise_rel_, band_hz_ : float
         Largest relative noise (std / RMS about the mean) and angles' band [Hz] over channels.
-    weak_noise_share_ : ndarray, shape (n_terms,) or None
-        With the weak form's ridge by noise: each weak column's relative change under one
-        draw of the declared noise (:func:`identify._weak.column_noise_share`); else None.
     coef_std_, inclusion_probability_ : ndarray, shape (n_inputs, n_terms)
         With ``ensemble``: standard deviation of each coefficient over the bags (scaled as
         ``coef_``) and the share of bags holding each term.
@@ -1174,6 +1051,4 @@ class SINDyPI(_ImplicitMechanical):
 
     def _sweep(self, G_train, G_val, cand, Theta_train):
         thr = DEFAULT_THRESHOLDS if self.thresholds is None else np.asarray(self.thresholds)
-        if self.thresholds is None and getattr(self, "weak_noise_share_", None) is not None:
-            thr = noise_thresholds(thr, self.weak_noise_share_)
         return stlsq_sweep(G_train, G_val, cand, thr, self._knob("ridge"), self.max_iter)

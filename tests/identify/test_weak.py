@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from benchmarks import sindy_pi_problems
-from identify._weak import column_noise_share, weak_matrix, window_function
+from identify._weak import weak_matrix, window_function
 from identify.library import Library
 from identify.sindy_pi import SINDyPI
 from testbed.numerics.derivatives import lowpass_differentiate
@@ -89,10 +89,3 @@ def test_deterministic(pendulum):
     a = SINDyPI(**kw).fit(pendulum.data).coef_
     b = SINDyPI(**kw).fit(pendulum.data).coef_
     assert np.array_equal(a, b)
-
-
-def test_column_noise_share():
-    V = np.array([[3.0, 0.0, 1.0], [4.0, 0.0, 0.0]])
-    dV = np.array([[0.03, 0.0, 0.0], [0.04, 1.0, 0.5]])
-    # relative change per column; a zero column has none
-    np.testing.assert_allclose(column_noise_share(V, V + dV), [0.01, 0.0, 0.5])
