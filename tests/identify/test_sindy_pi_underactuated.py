@@ -9,16 +9,15 @@ import pytest
 
 from identify.sindy_pi import SINDyPI
 from testbed.core.errors import IdentificationError
-from testbed.pipeline.generate import generate
 from testbed.pipeline.scenario import load_scenario
 from testbed.pipeline.signal_chain import measure
 from testbed.scoring.equation_basis import evaluate_terms
 
 
 @pytest.fixture(scope="module")
-def case():
+def case(dataset_cache):
     sc = load_scenario("scenarios/cartpole.toml")
-    ds = generate(sc)
+    ds = dataset_cache.get(sc)  # bit-identical to generate() (tests/testbed/test_cache.py)
     return sc, ds, measure(ds, sc.signal, "mechanical")
 
 

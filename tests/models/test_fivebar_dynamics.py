@@ -9,7 +9,6 @@ from models.fivebar.equations import true_equations, true_library_residual
 from models.fivebar.excitation import TorqueProgram
 from models.fivebar.rig import FiveBarRig
 from models.fivebar.twin import MujocoTwin
-from testbed.pipeline.generate import generate
 from testbed.pipeline.scenario import load_scenario, scenario_from_dict
 
 # Samples checked one by one with Pinocchio calls (spread over the whole record).
@@ -22,8 +21,10 @@ def rig():
 
 
 @pytest.fixture(scope="module")
-def ds():
-    return generate(load_scenario("fivebar_multisine"))
+def ds(dataset_cache):
+    # the shared test cache: bit-identical to generate() (tests/testbed/test_cache.py) and keyed on
+    # the rig's source, and the same record test_sindy_pi_fivebar and the scored five-bar scenarios use
+    return dataset_cache.get(load_scenario("fivebar_multisine"))
 
 
 @pytest.fixture(scope="module")

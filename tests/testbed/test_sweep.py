@@ -308,13 +308,17 @@ def test_cli_summary_of_a_sweep(toy_dir, tmp_path, capsys):
 
 
 @pytest.mark.slow
-def test_smoke_study_on_the_real_rigs(tmp_path):
+def test_smoke_study_on_the_real_rigs(tmp_path, dataset_cache):
     """studies/smoke.toml end to end: one row per cell, each rig kind with its own scores."""
     from testbed.core.kinds import metric_names
 
     study = load_study("smoke")
-    rows = read_results(run_sweep(study, results=tmp_path / "smoke.parquet", cache_dir=tmp_path / "c",
-                                  verbose=False))
+    # The shared test cache: the smoke cells' clean records are those of the shipped scenarios
+    # (cantilever_stiff_impact, fivebar_multisine) that test_scored and the rig tests use; a
+    # private cache simulated both again on every run (11 s of CPU).  A sweep's simulation on a
+    # cache miss is tested on the toy rigs above and in test_faults.
+    rows = read_results(run_sweep(study, results=tmp_path / "smoke.parquet",
+                                  cache_dir=dataset_cache.directory, verbose=False))
     assert sorted(r["cell"] for r in rows) == sorted(c.key for c in expand(study))
     for r in rows:
         assert r["status"] in ("ok", "failed") and (r["status"] == "ok") == (r["error"] == "")

@@ -7,7 +7,6 @@ import pytest
 
 from models.cartpole import CartPoleParams, CartPoleRig, build_mjcf, unnormalised_equations
 from testbed.core.truth import MechanicalTruth
-from testbed.pipeline.generate import generate
 from testbed.pipeline.plugins import RIGS
 from testbed.pipeline.scenario import ScenarioError, load_scenario, scenario_from_dict
 from testbed.scoring.equation_basis import evaluate_terms
@@ -19,8 +18,8 @@ def scenario():
 
 
 @pytest.fixture(scope="module")
-def dataset(scenario):
-    return generate(scenario)
+def dataset(scenario, dataset_cache):
+    return dataset_cache.get(scenario)  # bit-identical to generate() (tests/testbed/test_cache.py)
 
 
 def signals(ds):
