@@ -546,6 +546,15 @@ class MatrixSGDResult:
     eigen_shift: float
 
 
+def fit_window(data: Measurement, fit_duration: float) -> tuple[int, int]:
+    """Samples ``[i0, i1)`` of the fit window: from ``data.free_start``, ``fit_duration`` [s]
+    long (0 = to the record's end), clipped to the record."""
+    i0 = int(data.free_start)
+    i1 = data.n_samples if not fit_duration else min(data.n_samples,
+                                                     i0 + round(fit_duration * data.fs))
+    return i0, i1
+
+
 def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
                    lam_hat: np.ndarray,
                    progress: Callable[[float | None, str | None], None] | None = None
@@ -570,9 +579,7 @@ def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
     -------
     MatrixSGDResult
     """
-    i0 = int(data.free_start)
-    i1 = data.n_samples if not est.fit_duration else min(data.n_samples,
-                                                          i0 + round(est.fit_duration * data.fs))
+    i0, i1 = fit_window(data, est.fit_duration)
     full = [np.asarray(a, dtype=float) for a in (data.xdd, data.xd, data.x)]
     n, N = full[0].shape[0], i1 - i0
     cubic_dir = None

@@ -145,10 +145,11 @@ class LeastSquaresSINDy(StructuralIdentifier):
 
         ps = modal_peaks(data)
         self.harmonics_, self.harmonic_rule_ = harmonics_array(ps), ps.harmonic_rule
-        self.cubic_, self.cubic_rule_ = cubic_rule(data, self.cubic, self.fit_band_hz)
+        self.cubic_, self.cubic_rule_ = cubic_rule(data, self.cubic, self.fit_band_hz, ps.peaks)
         lib, self.fit_band_hz_, self.fit_band_rule_ = fit_band(
             data, lambda s: build_library(data, coupled_mass=False, cubic=self.cubic_, start=s,
-                                          drift=True, input_coupling=True), self.fit_band_hz)
+                                          drift=True, input_coupling=True), self.fit_band_hz,
+            ps.peaks)
         n, p = lib.target.shape[0], lib.theta.shape[0]
         coef = solve_rows(lib, self.rcond)
         masses = np.full(n, m_hat / n)

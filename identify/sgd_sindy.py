@@ -56,6 +56,7 @@ from identify._sgd_matrix import (
     MatrixSGDSettings,
     cubic_direction,
     fit_matrix_sgd,
+    fit_window,
     hold_eigenvalues,
 )
 from identify.ls_sindy import MASS_PRIOR_FIELD
@@ -613,9 +614,7 @@ class SGDSINDy(SGDSINDyBase):
         out = fit_matrix_sgd(data, est, m_hat, lam_hat, progress=self.report_progress)
         self.fit_band_hz_, self.fit_band_rule_ = fit_band_cutoff(data, est.fit_band_hz)
         if est.cubic and est.cubic_form == "direction":
-            i0 = int(data.free_start)
-            i1 = data.n_samples if not est.fit_duration else min(
-                data.n_samples, i0 + round(est.fit_duration * data.fs))
+            i0, i1 = fit_window(data, est.fit_duration)
             self.cubic_direction_ = cubic_direction(np.asarray(data.x, dtype=float)[:, i0:i1])
             self.cubic_direction_rule_ = ("first left singular vector of the fit window's "
                                           "displacements (K3 = b (w^3)^T)")
@@ -674,13 +673,11 @@ class SGDSINDy(SGDSINDyBase):
         if self.K3_ is not None:  # an amplitude-dependent frequency: no exponential decay
             self.decay_rule_ = "cubic library: the fit's (a free decay is not exponential)"
             return
-        i0 = int(data.free_start)
+        i0, i1 = fit_window(data, est.fit_duration)
         forced = data.u is not None and bool(np.any(np.asarray(data.u) != 0.0))
         if i0 == 0 and forced:  # free_start = 0 with an input: a continuous excitation
             self.decay_rule_ = "continuous input (free_start = 0): the fit's"
             return
-        i1 = data.n_samples if not est.fit_duration else min(
-            data.n_samples, i0 + round(est.fit_duration * data.fs))
         dec = modal_decay(data, self.M_, self.K_, self.C_, (i0, i1))
         self.modal_decay_ = dec
         if not np.any(dec.taken):

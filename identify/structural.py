@@ -211,8 +211,8 @@ FIT_BAND_FIELD = Field(float, None, unit="Hz", min=0.0,
                            "by rule: 0.7 x the lowest measured peak; 0 = none")
 
 
-def fit_band(data: Measurement, build: Callable[[int], Library], cutoff_hz: float | None = None
-             ) -> tuple[Library, float, str]:
+def fit_band(data: Measurement, build: Callable[[int], Library], cutoff_hz: float | None = None,
+             peaks: np.ndarray | None = None) -> tuple[Library, float, str]:
     """A library restricted to the band of the modes: one zero-phase high-pass on every row.
 
     The filter acts on the library's features and targets (built over the whole record, then
@@ -231,6 +231,8 @@ def fit_band(data: Measurement, build: Callable[[int], Library], cutoff_hz: floa
         A user's cut-off [Hz] (0 = no filter).  Default: the rule,
         :data:`FIT_BAND_FRACTION` x the lowest peak of :func:`modal_peaks`; no filter when no
         peak is accepted, or when the cut-off would not be above the chain's own high-pass.
+    peaks : ndarray, optional
+        ``modal_peaks(data).peaks`` [Hz] if the caller has them already (not searched again).
 
     Returns
     -------
@@ -242,7 +244,7 @@ def fit_band(data: Measurement, build: Callable[[int], Library], cutoff_hz: floa
         Which rule chose it, for the fitted model's ``fit_band_rule_``.
     """
     s = int(data.free_start)
-    fc, rule = fit_band_cutoff(data, cutoff_hz)
+    fc, rule = fit_band_cutoff(data, cutoff_hz, peaks)
     if fc <= 0:
         return build(s), 0.0, rule
     full = build(0)
@@ -253,16 +255,19 @@ def fit_band(data: Measurement, build: Callable[[int], Library], cutoff_hz: floa
     return Library(hp(full.theta), hp(full.target), full.mask, full.names, full.blocks), fc, rule
 
 
-def fit_band_cutoff(data: Measurement, cutoff_hz: float | None = None) -> tuple[float, str]:
+def fit_band_cutoff(data: Measurement, cutoff_hz: float | None = None,
+                    peaks: np.ndarray | None = None) -> tuple[float, str]:
     """The cut-off [Hz] of :func:`fit_band`'s high-pass and the rule that chose it (0 = none).
 
     ``cutoff_hz`` (a user's setting) wins; otherwise :data:`FIT_BAND_FRACTION` x the lowest
     peak of :func:`modal_peaks`, none when no peak is accepted or when it would not be above
-    the chain's own high-pass.
+    the chain's own high-pass.  ``peaks``: ``modal_peaks(data).peaks`` [Hz] if the caller has
+    them already (not searched again).
     """
     if cutoff_hz is not None:
         return float(cutoff_hz), f"fit_band_hz = {float(cutoff_hz):g} Hz (user setting)"
-    peaks = modal_peaks(data).peaks
+    if peaks is None:
+        peaks = modal_peaks(data).peaks
     if peaks.size == 0:
         return 0.0, "no measured peak: the chain's band as it is"
     fc = FIT_BAND_FRACTION * float(peaks.min())
@@ -273,8 +278,8 @@ def fit_band_cutoff(data: Measurement, cutoff_hz: float | None = None) -> tuple[
     return fc, rule
 
 
-def cubic_rule(data: Measurement, user: bool | None, fit_band_hz: float | None = None
-               ) -> tuple[bool, str]:
+def cubic_rule(data: Measurement, user: bool | None, fit_band_hz: float | None = None,
+               peaks: np.ndarray | None = None) -> tuple[bool, str]:
     """Whether a structural model gets the cubic features ``x_j^3``, and why.
 
     Parameters
@@ -284,6 +289,8 @@ def cubic_rule(data: Measurement, user: bool | None, fit_band_hz: float | None =
         The user's ``cubic`` setting; None = by rule.
     fit_band_hz : float, optional
         The fit band's cut-off (:func:`fit_band`'s ``cutoff_hz``).
+    peaks : ndarray, optional
+        ``modal_peaks(data).peaks`` [Hz] if the caller has them already (not searched again).
 
     Returns
     -------
@@ -295,7 +302,8 @@ def cubic_rule(data: Measurement, user: bool | None, fit_band_hz: float | None =
     if user is not None:
         return bool(user), "user setting"
     lib, _, _ = fit_band(data, lambda s: build_library(data, coupled_mass=False, cubic=True, start=s,
-                                                       drift=True, input_coupling=True), fit_band_hz)
+                                                       drift=True, input_coupling=True), fit_band_hz,
+                       peaks)
     corr = cubic_partial_correlation(lib)
     on = corr > CUBIC_SELECT_CORR
     return on, (f"largest partial correlation of an x^3 column with the linear model's residual "
