@@ -7,9 +7,14 @@ from typing import ClassVar
 import numpy as np
 
 from identify import IDENTIFIERS
+from identify._modal_damping import hold_modal_damping, modal_decay, set_eigenvalues
+from identify._sgd_matrix import eigen_targets, fit_window
 from identify.structural import (
     FIT_BAND_FIELD,
+    FIT_TILT_DIFFERENCES,
     MASS_PRIORS,
+    MODE_SEPARATION,
+    Library,
     StructuralIdentifier,
     build_library,
     cubic_rule,
@@ -17,8 +22,11 @@ from identify.structural import (
     harmonics_array,
     mass_prior_value,
     matrices_from_coef,
+    modal,
     modal_peaks,
     solve_rows,
+    tilt_library,
+    warp_frequency,
 )
 from testbed.core.errors import IdentificationError
 from testbed.core.measurement import Measurement
@@ -120,14 +128,27 @@ class LeastSquaresSINDy(StructuralIdentifier):
         "rcond": Field(float, 1e-10, min=0.0, max=1.0, max_inclusive=False,
                        doc="relative singular-value cut-off of the least-squares solve"),
         "fit_band_hz": FIT_BAND_FIELD,
+        "fit_tilt": Field(bool, None, doc="first differences of every row of the fit (weighs "
+                                          "the equation error by frequency squared); default "
+                                          "by rule: on, off when that fit is non-physical"),
+        "eigen_hold": Field(bool, True, doc="hold the identified frequencies within one "
+                                            "spectral line of the measured peaks they pair "
+                                            "with (sgd_sindy's rule)"),
+        "decay_hold": Field(bool, True, doc="give each mode the damping (and, within one "
+                                            "spectral line, the frequency) fitted to its "
+                                            "measured free decay (identify._modal_damping)"),
     }
 
     def __init__(self, cubic: bool | None = None, mass_prior: str = "reduced_mass_trace",
-                 rcond: float = 1e-10, fit_band_hz: float | None = None):
+                 rcond: float = 1e-10, fit_band_hz: float | None = None,
+                 fit_tilt: bool | None = None, eigen_hold: bool = True, decay_hold: bool = True):
         self.cubic = cubic
         self.mass_prior = mass_prior
         self.rcond = rcond
         self.fit_band_hz = fit_band_hz
+        self.fit_tilt = fit_tilt
+        self.eigen_hold = eigen_hold
+        self.decay_hold = decay_hold
 
     def fit(self, data: Measurement) -> LeastSquaresSINDy:
         """Fit on ``data`` (signals only; the mass prior from ``data.prior``).
@@ -150,9 +171,34 @@ class LeastSquaresSINDy(StructuralIdentifier):
             data, lambda s: build_library(data, coupled_mass=False, cubic=self.cubic_, start=s,
                                           drift=True, input_coupling=True), self.fit_band_hz,
             ps.peaks)
-        n, p = lib.target.shape[0], lib.theta.shape[0]
+        masses = np.full(lib.target.shape[0], m_hat / lib.target.shape[0])
+        if self.fit_tilt is False:
+            self.fit_tilt_, self.fit_tilt_rule_ = False, "fit_tilt = False (user setting)"
+            self._solve(data, lib, masses)
+            self._check_physical()
+        else:
+            self.fit_tilt_ = True
+            self._solve(data, tilt_library(lib), masses)
+            self.fit_tilt_rule_ = (f"{FIT_TILT_DIFFERENCES} first difference of every row "
+                                   + ("(user setting)" if self.fit_tilt else "(rule)"))
+            try:
+                self._check_physical()
+            except IdentificationError as e:
+                if self.fit_tilt:  # the user's choice: refused, not replaced
+                    raise
+                self.fit_tilt_ = False
+                self.fit_tilt_rule_ = f"rule: the tilted fit was refused ({e}); fitted flat"
+                self._solve(data, lib, masses)
+                self._check_physical()
+        self._hold(data, ps.peaks, masses[:, None], lib.blocks["v"], lib.blocks["d"])
+        self._finish_fit(data)
+        return self
+
+    def _solve(self, data: Measurement, lib: Library, masses: np.ndarray) -> None:
+        """Least squares on ``lib``; sets the matrices, ``coef_``, ``drift_coef_``,
+        ``feature_names_``, ``channels_``, ``input_map_`` and ``n_steps_``."""
+        p = lib.theta.shape[0]
         coef = solve_rows(lib, self.rcond)
-        masses = np.full(n, m_hat / n)
         dyn = np.ones(p, dtype=bool)
         if "z" in lib.blocks:  # the chain's integration constants: estimated, then dropped
             dyn[lib.blocks["z"]] = False
@@ -165,9 +211,79 @@ class LeastSquaresSINDy(StructuralIdentifier):
         if "f" in lib.blocks and self.input_map_ is not None:
             self.input_map_ = self.M_ @ coef[:, lib.blocks["f"]] @ self.input_map_
         self.n_steps_ = 0
-        self._check_physical()
-        self._finish_fit(data)
-        return self
+
+    def _hold(self, data: Measurement, peaks: np.ndarray, m: np.ndarray, v_block: slice,
+              d_block: slice) -> None:
+        """The eigenvalue hold, then the decay hold (class docstring), before
+        :meth:`_finish_fit` (in the trapezoid fit's warped domain, as ``sgd_sindy``'s).
+
+        Parameters
+        ----------
+        data : Measurement
+        peaks : ndarray, shape (k,)
+            Accepted peaks of :func:`identify.structural.modal_peaks` [Hz].
+        m : ndarray, shape (n, 1)
+            Diagonal masses [kg] that ``coef_`` divides by.
+        v_block, d_block : slice
+            The velocity and displacement columns of ``coef_``.
+        """
+        i0, i1 = fit_window(data, 0.0)
+        line = float(data.fs) / (i1 - i0)  # one line of the window's transform [Hz]
+        self.eigen_targets_ = np.zeros(self.M_.shape[0])
+        self.eigen_shift_ = 0.0
+        if not self.eigen_hold:
+            self.eigen_rule_ = "eigen_hold = False: the fit's frequencies"
+        elif peaks.size == 0:
+            self.eigen_rule_ = "no measured peak: the fit's frequencies"
+        else:
+            f = warp_frequency(peaks, float(data.fs)) if data.integration == "trapezoid" else peaks
+            target = eigen_targets(self.M_, self.K_, (2.0 * np.pi * f) ** 2)
+            on = target > 0
+            freqs = modal(self.M_, self.K_)[0]
+            f_hat = np.sqrt(np.where(on, target, 0.0)) / (2.0 * np.pi)
+            f_new = np.clip(freqs, np.maximum(f_hat - line, 0.5 * f_hat), f_hat + line)
+            move = on & (f_new != freqs)
+            if np.any(move):
+                self._set_stiffness(set_eigenvalues(
+                    self.M_, self.K_, np.where(move, (2.0 * np.pi * f_new) ** 2, np.nan)), m, d_block)
+                self.eigen_shift_ = float(np.max(np.abs(f_new[move] / freqs[move] - 1.0)))
+            self.eigen_targets_ = np.sqrt(target) / (2.0 * np.pi)
+            self.eigen_rule_ = (f"modes {(np.flatnonzero(on) + 1).tolist()} paired with measured "
+                                f"peaks (within {MODE_SEPARATION:.0%}), held within one line "
+                                f"({line:.3g} Hz) of them" if np.any(on)
+                                else "no mode within the pairing distance of a peak: the fit's")
+        if not self.decay_hold:
+            self.decay_rule_ = "decay_hold = False: the fit's damping and frequencies"
+            return
+        if self.K3_ is not None:  # an amplitude-dependent frequency: no exponential decay
+            self.decay_rule_ = "cubic library: the fit's (a free decay is not exponential)"
+            return
+        if i0 == 0 and data.u is not None and bool(np.any(np.asarray(data.u) != 0.0)):
+            self.decay_rule_ = "continuous input (free_start = 0): the fit's"
+            return
+        dec = modal_decay(data, self.M_, self.K_, self.C_, (i0, i1))
+        self.modal_decay_ = dec
+        if not np.any(dec.taken):
+            self.decay_rule_ = "modal decay fits: none taken, the fit's"
+            return
+        C = hold_modal_damping(self.M_, self.C_, self.K_, dec.sigma_model)
+        self.coef_[:, v_block] -= (C - self.C_) / m
+        self.C_ = C
+        on = dec.taken & (dec.shift <= line)
+        if np.any(on):
+            self._set_stiffness(set_eigenvalues(self.M_, self.K_, np.where(on, dec.lam_model, np.nan)),
+                                m, d_block)
+        kept, fixed = np.flatnonzero(~dec.taken) + 1, np.flatnonzero(on) + 1
+        self.decay_rule_ = ("each mode's damping from its measured free decay (modal "
+                            "accelerations Phi^-1 x'', fitted exp(-sigma t) sinusoid)"
+                            + (f"; modes {kept.tolist()} kept the fit's" if kept.size else "")
+                            + (f"; frequencies of modes {fixed.tolist()} from it (within one "
+                               f"line, {line:.3g} Hz)" if fixed.size else ""))
+
+    def _set_stiffness(self, K: np.ndarray, m: np.ndarray, d_block: slice) -> None:
+        """Replace ``K_`` by ``K`` [N/m] and ``coef_``'s displacement block with it."""
+        self.coef_[:, d_block] -= (K - self.K_) / m
+        self.K_ = K
 
     def _check_physical(self) -> None:
         """Raise :class:`IdentificationError` for a model with a growing mode.
