@@ -191,8 +191,12 @@ def hold_modal_damping(M: np.ndarray, C: np.ndarray, K: np.ndarray, sigma: np.nd
         when ``C`` is.
     """
     _, Phi = modal(M, K)
-    D = Phi.T @ C @ Phi
-    D = 0.5 * (D + D.T)
+    symmetric = _is_symmetric(M, C, K)
+    if symmetric:
+        D = Phi.T @ C @ Phi
+        D = 0.5 * (D + D.T)
+    else:  # Phi^-1 M^-1 C Phi: the same matrix when Phi^T M Phi = I (module docstring)
+        D = np.linalg.solve(Phi, np.linalg.solve(M, C @ Phi))
     dk = np.diag(D).copy()
     new = np.where(np.isfinite(sigma), 2.0 * np.nan_to_num(sigma), dk)
     g = np.ones_like(dk)
@@ -202,5 +206,43 @@ def hold_modal_damping(M: np.ndarray, C: np.ndarray, K: np.ndarray, sigma: np.nd
     zero = ~pos & np.isfinite(sigma)
     D2[zero, zero] = new[zero]
     MP = M @ Phi
+    if not symmetric:
+        return MP @ np.linalg.solve(Phi.T, D2.T).T  # M Phi D' Phi^-1
     C2 = MP @ D2 @ MP.T
     return 0.5 * (C2 + C2.T)
+
+
+def _is_symmetric(*mats: np.ndarray) -> bool:
+    """Whether every matrix equals its transpose to rounding (``rtol`` 1e-12)."""
+    return all(np.allclose(a, a.T, rtol=1e-12, atol=0.0) for a in mats)
+
+
+def set_eigenvalues(M: np.ndarray, K: np.ndarray, lam: np.ndarray) -> np.ndarray:
+    """``K`` with the eigenvalues of ``(K, M)`` set to ``lam`` and the mode shapes kept.
+
+    Parameters
+    ----------
+    M, K : ndarray, shape (n, n)
+        Mass [kg] and stiffness [N/m]; need not be symmetric (``ls_sindy``'s ``K`` is not).
+    lam : ndarray, shape (n,)
+        New eigenvalue [rad^2/s^2] of each mode (ascending, as
+        :func:`identify.structural.modal`); NaN = keep that mode's.
+
+    Returns
+    -------
+    ndarray, shape (n, n)
+        ``M Phi diag(lam') Phi^-1`` with ``Phi`` the modes of ``(K, M)``: ``M^-1 K'`` has the
+        same eigenvectors and exactly the eigenvalues ``lam'``; ``K`` unchanged when the modes
+        do not span the space (condition number of ``Phi`` above 1e12).  For a symmetric pair
+        (``Phi^T M Phi = I``, ``Phi^-1 = Phi^T M``) it is the change
+        ``K + (M Phi) diag(lam' - lam) (M Phi)^T`` of
+        :func:`identify._sgd_matrix.hold_eigenvalues`, symmetrised.
+    """
+    freqs, Phi = modal(M, K)
+    if np.linalg.cond(Phi) > 1e12:  # defective: the modes do not span the space, K kept
+        return K.copy()
+    old = (2.0 * np.pi * freqs) ** 2
+    d = np.where(np.isfinite(lam), lam - old, 0.0)
+    d = np.where(np.isfinite(d), d, 0.0)  # a mode without a (positive) eigenvalue stays
+    K2 = K + (M @ Phi) @ np.linalg.solve(Phi.T, np.diag(d)).T
+    return 0.5 * (K2 + K2.T) if _is_symmetric(M, K) else K2

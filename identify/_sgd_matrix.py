@@ -108,6 +108,7 @@ from identify.structural import (
     FIT_BAND_ORDER,
     MODE_SEPARATION,
     fit_band_cutoff,
+    modal,
     symmetric_least_squares,
 )
 from testbed.core.lazy import lazy_module
@@ -272,7 +273,10 @@ def eigen_targets(M: np.ndarray, K: np.ndarray, lam_hat: np.ndarray) -> np.ndarr
     target = np.zeros(n)
     if lam_hat.size == 0:
         return target
-    lam = linalg.eigh(_sym(K), _sym(M), eigvals_only=True)
+    if np.allclose(K, K.T, rtol=1e-12, atol=0.0) and np.allclose(M, M.T, rtol=1e-12, atol=0.0):
+        lam = linalg.eigh(_sym(K), _sym(M), eigvals_only=True)
+    else:  # a non-symmetric model (ls_sindy's K): the eigenvalues of M^-1 K, real parts
+        lam = (2.0 * np.pi * np.nan_to_num(modal(M, K)[0])) ** 2
     hat = np.sort(lam_hat)
     with np.errstate(divide="ignore", invalid="ignore"):
         cost = 0.5 * np.abs(np.log(np.maximum(lam, 1e-300)[:, None] / hat[None, :]))
