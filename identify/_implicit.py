@@ -198,7 +198,7 @@ def stlsq_sweep(G_train: np.ndarray, G_val: np.ndarray, candidates: Sequence[int
     (:func:`identify._pi_kernels.stlsq_chains_downdate`): supports only shrink along a
     candidate's path, so each refit deletes columns from one shared Cholesky factor of
     ``G + ridge I`` by Givens rotations instead of factorising anew (at 100k x 97: ~1,280
-    refits, 87 ms as batched LAPACK solves, ~12 ms compiled).  If that factor does not exist
+    refits, 87 ms as batched LAPACK solves, ~8 ms compiled).  If that factor does not exist
     (not numerically positive definite) each refit gets a fresh Cholesky, else LU
     (:func:`identify._pi_kernels.stlsq_chains`); an exactly singular support sends its
     candidate to the round-batched LAPACK path with minimum-norm solutions
@@ -260,7 +260,7 @@ def stlsq_sweep(G_train: np.ndarray, G_val: np.ndarray, candidates: Sequence[int
     if not np.all(np.isfinite(models)):
         raise IdentificationError("the thresholded least-squares sweep produced non-finite "
                                   "coefficients (library columns exactly dependent?)")
-    W = -models
+    W = np.negative(models, out=models)  # in place: one (T, C, p) array less
     W[:, idx, cand] = 1.0
     return Sweep(scale=s, candidates=cand, thresholds=thr, W=W, val_error=_errors(W, Gv, cand),
                  train_error=_errors(W, Gn, cand), nnz=np.count_nonzero(W, axis=2))

@@ -190,3 +190,69 @@ def test_exact_double_pendulum_selects_the_reference_equations():
     f1, _ = P.aligned_errors(lib.names, np.array([sw.coef(*q[0]) for q in select_models(sw, inputs)]),
                              pr.truth_terms, pr.truth_coef)
     assert f1 == 1.0
+
+
+def test_downdate_kernel_matches_reference_on_a_larger_random_problem():
+    """The row-stored downdating kernel on 60 columns (long paths: many refits leave gaps in
+    its storage, some close them up) against the masked least-squares reference, under the
+    module's rule.  FWD still covers p = 60: p * (growth 10) = 600 < 1e3."""
+    Gn = _normalised(planted_problem(7, n=4000, p=60))[2]
+    cond = np.linalg.cond(Gn)
+    assert cond <= 1e6, cond
+    p = Gn.shape[0]
+    cand = np.arange(p)
+    ref, margin = reference_sweep(Gn, cand, DEFAULT_THRESHOLDS)
+    B = np.linalg.inv(Gn + 1e-14 * np.eye(p))
+    base = ~np.eye(p, dtype=bool)
+    xi = np.where(base, -(B[:, cand] / B[cand, cand]).T, 0.0)
+    models, status, refits = stlsq_chains_downdate(Gn, cand, np.ones(p, dtype=bool), base, xi,
+                                                   DEFAULT_THRESHOLDS, 1e-14, 20)
+    assert (status == 0).all() and refits.sum() > 3 * p
+    ok = margin > MARGIN
+    assert ok.mean() > 0.9
+    np.testing.assert_array_equal((models != 0)[ok], (ref != 0)[ok])
+    err = _relative(models, ref)[ok]
+    assert err.max() <= FWD * cond, err.max()
+
+
+def test_retriangularise_keeps_the_normal_equations_with_and_without_gaps():
+    """Deleting columns from a row-stored factor in steps: after each step the kept columns'
+    factor reproduces their Gram block and right-hand side, ``R_S^T R_S = G[S, S]`` and
+    ``R_S^T z = G[S, j]``.  A small deletion leaves gaps in the storage, a large one closes
+    them up (both paths run).
+
+    Tolerance 1e-12 of max |G|: every entry meets at most n = 40 rotations (a few eps each)
+    and each product sums 40 terms, so the error is ~ (6 + 1) * 40 * eps ~ 3e-14 of the
+    largest entry; 1e-12 leaves 30x headroom and still catches any misplaced entry (O(1)).
+    """
+    from identify._pi_kernels import _retriangularise
+
+    rng = np.random.default_rng(11)
+    n = 40
+    X = rng.normal(size=(400, n + 1))
+    G = X.T @ X
+    R0 = np.linalg.cholesky(G).T  # upper; column n is the right-hand side
+    R = np.zeros((n, n))
+    R[:, :] = np.triu(R0[:n, :n])
+    z = R0[:n, n].copy()
+    cols = np.arange(n)
+    P = np.arange(n)
+    pos = np.empty(n, dtype=np.int64)
+    live = np.arange(n)
+    m = n
+    for step, n_del in enumerate((2, 15, 1, 6)):
+        keep = np.ones(m, dtype=bool)
+        keep[rng.choice(m, n_del, replace=False)] = False
+        live = live[keep]
+        m = _retriangularise(R, cols, P, m, keep, z, pos)
+        assert m == live.size
+        np.testing.assert_array_equal(cols[:m], live)
+        Rs = np.triu(R[:m, P[:m]])
+        S = live
+        tol = 1e-12 * np.abs(G).max()
+        assert np.abs(Rs.T @ Rs - G[np.ix_(S, S)]).max() <= tol
+        assert np.abs(Rs.T @ z[:m] - G[S, n]).max() <= tol
+        if step == 0:
+            assert not np.array_equal(P[:m], np.arange(m))  # 2 gaps kept
+        if step == 1:
+            np.testing.assert_array_equal(P[:m], np.arange(m))  # 17 gaps: closed up
