@@ -19,7 +19,11 @@ Loss (the paper's terms, Eqs 2-18)
   ``(M x'' + C x' + K x + K3 x^3 - G u - D w)_i / M_ii``; it is standardised by the RMS of
   ``x''_i``.  The input gain ``G`` (free in every row, as ``ls_sindy``'s coupled input) and
   the coefficients ``D`` of the chain's drift waveforms ``w`` (``data.drift_basis``) are
-  profiled out (:func:`project_out`) and recovered after the fit;
+  profiled out (:func:`project_out`) and recovered after the fit.  With the tilt
+  (``fit_tilt``, ``ls_sindy``'s rule, :func:`identify.structural.tilt_rows`) every feature,
+  target and nuisance column is differenced once before, for the warm start and the SGD
+  alike, so the error is weighed by frequency squared (the force and drift coefficients are
+  then fitted flat on the result's residual);
 - symmetry (Eq. 7): zero by construction (recorded in the history as such);
 - total mass (Eqs 4-6): ``trace(M) = M_hat`` is enforced after every step by scaling all
   matrices together (Eq. 5 at its fixed point; with the force's gain free, a common scale
@@ -106,11 +110,15 @@ import numpy as np
 
 from identify.structural import (
     FIT_BAND_ORDER,
+    FIT_TILT_DIFFERENCES,
     MODE_SEPARATION,
+    check_physical,
     fit_band_cutoff,
     modal,
     symmetric_least_squares,
+    tilt_rows,
 )
+from testbed.core.errors import IdentificationError
 from testbed.core.lazy import lazy_module
 from testbed.core.measurement import Measurement
 from testbed.numerics.filters import elliptic_highpass
@@ -466,6 +474,10 @@ class MatrixSGDSettings:
         ``"direction"``: one cubic feature along the data's dominant displacement direction,
         ``K3 = b a^T`` (:func:`cubic_direction`); ``"diagonal"``: the n features ``x_j^3``, a
         full ``K3``.
+    fit_tilt : bool or None
+        Difference every row once (warm start and SGD): None = by rule (tilted, flat with the
+        cubic library or when the tilted warm start has a growing mode), True = tilted (a
+        non-physical tilted warm start raises), False = flat.
     """
 
     epochs: int
@@ -489,6 +501,7 @@ class MatrixSGDSettings:
     eigen_hold: bool = True
     cubic_form: Literal["direction", "diagonal"] = "diagonal"
     fit_band_hz: float | None = 0.0
+    fit_tilt: bool | None = False
 
     def __post_init__(self) -> None:
         for key, allowed in (("init", ("lstsq", "zeros")), ("gradient", ("minibatch", "full")),
@@ -534,6 +547,8 @@ class MatrixSGDResult:
         Frequency [Hz] each mode (ascending) was held at (:func:`eigen_targets`); 0 = none.
     eigen_shift : float
         Largest relative frequency change a hold made (0 without holding).
+    fit_tilt : bool
+        Whether the fit was tilted; ``fit_tilt_rule`` (str) says why.
     """
 
     M: np.ndarray
@@ -548,6 +563,8 @@ class MatrixSGDResult:
     drift_coef: np.ndarray
     eigen_targets: np.ndarray
     eigen_shift: float
+    fit_tilt: bool = False
+    fit_tilt_rule: str = ""
 
 
 def fit_window(data: Measurement, fit_duration: float) -> tuple[int, int]:
@@ -606,15 +623,49 @@ def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
     raw = [a[:, i0:i1] for a in full]
     W = np.ascontiguousarray(W[i0:i1])
     n_u = inputs.size
-    sig = project_out(W, *raw)
+    l1_on = est.cubic and est.l1
+
+    def fit_signals(tilt: bool) -> list[np.ndarray]:
+        """The window's features with the nuisance columns profiled out, tilted or flat."""
+        rows = tilt_rows(*raw, W.T) if tilt else [*raw, W.T]
+        return project_out(np.ascontiguousarray(rows[-1].T), *rows[:-1])
+
+    def start(sig: list[np.ndarray]) -> tuple:
+        """The warm start (or zero start) on ``sig``, and the cubic profile."""
+        x3_ = sig[3] if est.cubic else None
+        pr_ = cubic_profile(*sig[:3], x3_) if est.cubic else None
+        if est.init != "lstsq":
+            return (np.eye(n) * m_hat / n, np.zeros((n, n)), np.zeros((n, n)),
+                    np.zeros((n, n)) if est.cubic else None), pr_
+        return warm_start(*sig[:3], x3_, m_hat, float(est.l1_threshold) if l1_on else 0.0,
+                          pr_), pr_
+
+    # the fit band's tilt (identify.structural.FIT_TILT_DIFFERENCES, ls_sindy's rule): every
+    # feature, target and nuisance column differenced once; flat with the cubic library or
+    # when the tilted warm start has a growing mode
+    if est.fit_tilt is False or (est.fit_tilt is None and est.cubic):
+        tilted = False
+        tilt_rule = ("fit_tilt = False (user setting)" if est.fit_tilt is False
+                     else "rule: cubic library, fitted flat")
+    else:
+        tilted = True
+        tilt_rule = (f"{FIT_TILT_DIFFERENCES} first difference of every row "
+                     + ("(user setting)" if est.fit_tilt else "(rule)"))
+    sig = fit_signals(tilted)
+    (M0, C0, K0, K30), pr = start(sig)
+    if tilted and est.init == "lstsq":
+        try:
+            check_physical(M0, C0, K0, "the warm start's least squares")
+        except IdentificationError as e:
+            if est.fit_tilt:  # the user's choice: refused, not replaced
+                raise
+            tilted = False
+            tilt_rule = f"rule: the tilted warm start was refused ({e}); fitted flat"
+            sig = fit_signals(False)
+            (M0, C0, K0, K30), pr = start(sig)
     xdd, xd, x = sig[:3]
     x3 = sig[3] if est.cubic else None
     bu = np.zeros_like(x)  # the force is in W
-    l1_on = est.cubic and est.l1
-    pr = cubic_profile(xdd, xd, x, x3) if est.cubic else None
-    M0, C0, K0, K30 = warm_start(xdd, xd, x, x3, m_hat, float(est.l1_threshold) if l1_on else 0.0,
-                                 pr) if est.init == "lstsq" else (
-        np.eye(n) * m_hat / n, np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n)) if est.cubic else None)
     # parameter scales (Adam steps are relative to these)
     m0 = m_hat / n
     if est.init == "lstsq":
@@ -652,6 +703,7 @@ def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
     Z = np.ascontiguousarray(np.vstack([xdd, xd, x, x3 if x3 is not None else np.zeros_like(x), -bu]).T)
     nfa = int(np.flatnonzero(np.any(Z != 0.0, axis=0)).max(initial=-1)) + 1  # trailing zero columns
     S_full = Z.T @ Z
+    Nz = Z.shape[0]  # the window's samples, one fewer per difference of the tilt
     L = np.ascontiguousarray(L)
     P, Q = np.ascontiguousarray(P), np.ascontiguousarray(Q)
     has_R = R is not None
@@ -686,7 +738,7 @@ def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
 
     def record(epoch, n_steps):
         """History row; returns the full-window data gradient (for annealing)."""
-        loss = cc.window_loss_grad(S_full, N, L, P, Q, R, m0, c0, k0, sc3, s_a, T, TS, e2, *g)
+        loss = cc.window_loss_grad(S_full, Nz, L, P, Q, R, m0, c0, k0, sc3, s_a, T, TS, e2, *g)
         le = cc.eig_loss_grad(L, P, m0, k0, lam_hat, eL, eP) if use_eig else np.nan
         hist["epoch"].append(epoch)
         hist["n_steps"].append(n_steps)
@@ -702,7 +754,7 @@ def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
     rng = np.random.default_rng(est.random_state)
     bs = int(est.batch_size) if gradient == "minibatch" else 0
     spe = (int(est.steps_per_epoch) if est.steps_per_epoch is not None
-           else (int(np.ceil(N / bs)) if bs else 1))
+           else (int(np.ceil(Nz / bs)) if bs else 1))
     eps_eig = float(est.epsilon)
     # A passive structure held at its base has C positive semi-definite (it dissipates) and K
     # positive semi-definite (no static divergence); with M = m0 L L^T positive definite the
@@ -741,8 +793,8 @@ def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
     for epoch in range(1, int(est.epochs) + 1):
         if progress is not None:
             progress((epoch - 1) / int(est.epochs), f"epoch {epoch}/{int(est.epochs)}")
-        perm = rng.permutation(N) if bs else np.arange(0)
-        cc.sgd_steps(Z, nfa, S_full, N, perm, bs, spe, (L, P, Q, R), adam, n_steps,
+        perm = rng.permutation(Nz) if bs else np.arange(0)
+        cc.sgd_steps(Z, nfa, S_full, Nz, perm, bs, spe, (L, P, Q, R), adam, n_steps,
                      float(est.learning_rate), m0, c0, k0, sc3, s_a, lam_hat,
                      alpha["eig"] * eps_eig if use_eig else 0.0, has_R,
                      support if support is not None else no_support, support is not None,
@@ -797,4 +849,5 @@ def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
     return MatrixSGDResult(M=_sym(M), C=C, K=K, K3=K3, n_steps=n_steps, alphas=alpha, guard=guard,
                            history={k: np.asarray(v) for k, v in hist.items()},
                            input_map=input_map, drift_coef=G[:, n_u:],
-                           eigen_targets=np.sqrt(target) / (2.0 * np.pi), eigen_shift=held)
+                           eigen_targets=np.sqrt(target) / (2.0 * np.pi), eigen_shift=held,
+                           fit_tilt=tilted, fit_tilt_rule=tilt_rule)

@@ -17,6 +17,7 @@ from identify.structural import (
     Library,
     StructuralIdentifier,
     build_library,
+    check_physical,
     cubic_rule,
     fit_band,
     harmonics_array,
@@ -350,20 +351,8 @@ class LeastSquaresSINDy(StructuralIdentifier):
         self.K_ = K
 
     def _check_physical(self) -> None:
-        """Raise :class:`IdentificationError` for a model with a growing mode.
-
-        Least squares does not constrain ``M^-1 C`` (M is ``m_hat / n I``, positive definite by
-        construction): on noisy data it can return negative damping.  A pole of the linear
-        model ``[[0, I], [-M^-1 K, -M^-1 C]]`` with real part above ``1e-9`` of its modulus
-        (rounding of an undamped pole) is a mode that grows: a passive structure has none.
-        """
-        n = self.M_.shape[0]
-        Minv = np.linalg.inv(self.M_)
-        A = np.block([[np.zeros((n, n)), np.eye(n)], [-Minv @ self.K_, -Minv @ self.C_]])
-        lam = np.linalg.eigvals(A)
-        bad = lam.real > 1e-9 * np.abs(lam)
-        if np.any(bad):
-            worst = lam[bad][np.argmax(lam[bad].real)]
-            raise IdentificationError(
-                f"non-physical model: a pole at {worst.real:+.4g} {worst.imag:+.4g}j 1/s grows "
-                f"(negative damping or negative stiffness); least squares does not constrain it")
+        """Raise :class:`IdentificationError` for a model with a growing mode
+        (:func:`identify.structural.check_physical`): least squares does not constrain
+        ``M^-1 C`` (M is ``m_hat / n I``, positive definite by construction), and on noisy data
+        it can return negative damping."""
+        check_physical(self.M_, self.C_, self.K_)

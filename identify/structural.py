@@ -290,8 +290,55 @@ def tilt_library(lib: Library, k: int = FIT_TILT_DIFFERENCES) -> Library:
     """
     if k <= 0:
         return lib
-    return Library(np.diff(lib.theta, k, axis=1), np.diff(lib.target, k, axis=1), lib.mask,
-                   lib.names, lib.blocks)
+    theta, target = tilt_rows(lib.theta, lib.target, k=k)
+    return Library(theta, target, lib.mask, lib.names, lib.blocks)
+
+
+def tilt_rows(*rows: np.ndarray, k: int = FIT_TILT_DIFFERENCES) -> list[np.ndarray]:
+    """Each array of ``rows`` with ``k`` first differences along its last axis (time).
+
+    The tilt of :func:`tilt_library` on bare signals (``sgd_sindy``'s fit, which keeps its
+    features and nuisance columns as arrays).
+
+    Parameters
+    ----------
+    *rows : ndarray, shape (..., N)
+        Signals sampled along the last axis.
+    k : int
+        Number of differences (0 = unchanged).
+
+    Returns
+    -------
+    list of ndarray
+        Each ``k`` samples shorter.
+    """
+    return [np.diff(r, k, axis=-1) if k > 0 else r for r in rows]
+
+
+def check_physical(M: np.ndarray, C: np.ndarray, K: np.ndarray, what: str = "least squares") -> None:
+    """Raise :class:`IdentificationError` for a linear model with a growing mode.
+
+    A pole of ``[[0, I], [-M^-1 K, -M^-1 C]]`` with real part above ``1e-9`` of its modulus
+    (rounding of an undamped pole) is a mode that grows (negative damping or negative
+    stiffness): a passive structure has none.
+
+    Parameters
+    ----------
+    M, C, K : ndarray, shape (n, n)
+        Mass [kg], damping [N s/m] and stiffness [N/m].
+    what : str
+        The fit named in the message as not constraining it.
+    """
+    n = M.shape[0]
+    Minv = np.linalg.inv(M)
+    A = np.block([[np.zeros((n, n)), np.eye(n)], [-Minv @ K, -Minv @ C]])
+    lam = np.linalg.eigvals(A)
+    bad = lam.real > 1e-9 * np.abs(lam)
+    if np.any(bad):
+        worst = lam[bad][np.argmax(lam[bad].real)]
+        raise IdentificationError(
+            f"non-physical model: a pole at {worst.real:+.4g} {worst.imag:+.4g}j 1/s grows "
+            f"(negative damping or negative stiffness); {what} does not constrain it")
 
 
 def fit_band_cutoff(data: Measurement, cutoff_hz: float | None = None,

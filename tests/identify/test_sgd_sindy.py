@@ -111,6 +111,33 @@ def test_deterministic_and_seeded(linear):
     assert not np.array_equal(a.coef_, c.coef_)
 
 
+def test_tilt_rule(linear, cubic_fits):
+    """fit_tilt=None: tilted on the linear library, flat with the cubic one."""
+    _, _, model = linear
+    _, lin, _, duff = cubic_fits
+    assert model.fit_tilt_ and "(rule)" in model.fit_tilt_rule_
+    assert not lin.fit_tilt_ and not duff.fit_tilt_ and "cubic" in duff.fit_tilt_rule_
+
+
+def test_tilt_falls_back_to_flat_when_non_physical(linear, monkeypatch):
+    """fit_tilt=None: a tilted warm start refused as non-physical is replaced by the flat one
+    (the same model as fit_tilt=False); fit_tilt=True keeps the refusal."""
+    import identify._sgd_matrix as sm
+    from testbed.core.errors import IdentificationError
+
+    def refuse(*args, **kwargs):
+        raise IdentificationError("non-physical model: test")
+
+    _, data, _ = linear
+    flat = SGDSINDy(epochs=4, fit_tilt=False).fit(data)
+    monkeypatch.setattr(sm, "check_physical", refuse)
+    model = SGDSINDy(epochs=4).fit(data)
+    assert model.fit_tilt_ is False and "fitted flat" in model.fit_tilt_rule_
+    assert np.array_equal(model.coef_, flat.coef_)
+    with pytest.raises(IdentificationError):
+        SGDSINDy(epochs=4, fit_tilt=True).fit(data)
+
+
 def test_history(linear):
     _, data, model = linear
     h = model.history_

@@ -60,6 +60,7 @@ MATRIX_CASES = {
     "cubic_form": ({"cubic": True, "data": "duffing"}, "direction"),
     "fit_band": ({}, False),
     "decay_hold": ({}, False),
+    "fit_tilt": ({}, False),
 }
 
 COEFFICIENT_CASES = {
