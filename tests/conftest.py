@@ -23,6 +23,10 @@ ROOT = Path(__file__).resolve().parent.parent
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
+#: The shared test dataset cache: ``$TESTBED_TEST_CACHE``, else ``.cache/test-datasets`` of the
+#: checkout (set it to time a cold suite without emptying the checkout's cache).
+TEST_CACHE = Path(os.environ.get("TESTBED_TEST_CACHE", ROOT / ".cache" / "test-datasets"))
+
 
 @pytest.hookimpl(tryfirst=True)  # before xdist reads the xdist_group marks
 def pytest_collection_modifyitems(config, items):
@@ -50,7 +54,7 @@ def pytest_collection_modifyitems(config, items):
 def dataset_cache():
     from testbed.pipeline.cache import DatasetCache
 
-    return DatasetCache(ROOT / ".cache" / "test-datasets")
+    return DatasetCache(TEST_CACHE)
 
 
 @pytest.fixture(autouse=True, scope="module")
