@@ -10,6 +10,7 @@ xdist otherwise deals a module's tests to both workers one by one, and each work
 module's fixtures (a simulation, a fit, a numba compile) again.
 """
 
+import contextlib
 import os
 import sys
 from pathlib import Path
@@ -26,6 +27,72 @@ if str(ROOT) not in sys.path:
 #: The shared test dataset cache: ``$TESTBED_TEST_CACHE``, else ``.cache/test-datasets`` of the
 #: checkout (set it to time a cold suite without emptying the checkout's cache).
 TEST_CACHE = Path(os.environ.get("TESTBED_TEST_CACHE", ROOT / ".cache" / "test-datasets"))
+#: Lock files of the test processes sharing :data:`TEST_CACHE` (outside the cached entries'
+#: folder listing: :meth:`DatasetCache.entries` reads ``*.h5`` only).
+LOCKS = TEST_CACHE / ".locks"
+
+
+@contextlib.contextmanager
+def _interprocess_lock(name: str):
+    """Hold the exclusive lock ``name`` among the processes of this checkout's test run (the
+    pytest-xdist workers): POSIX ``flock``, released by the kernel if the holder dies.  Where
+    ``fcntl`` is missing (Windows) nothing is locked: the work is then merely done twice."""
+    try:
+        import fcntl
+    except ImportError:
+        fcntl = None
+    if fcntl is None:
+        yield
+        return
+    LOCKS.mkdir(parents=True, exist_ok=True)
+    with open(LOCKS / f"{name}.lock", "a") as f:
+        fcntl.flock(f, fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(f, fcntl.LOCK_UN)
+
+
+def _compile_numba_once_per_run():
+    """Each ``cache=True`` numba function is compiled by one test process; the others load it.
+
+    numba's on-disk cache is shared by the workers, but a worker only finds an entry once the
+    compiling one has written it: on a cold cache both workers compiled the SGD-SINDy kernels
+    (``eig_loss_grad``, ``sgd_steps``: ~40 s of CPU on 2 loaded cores) and ``accelerations_many``
+    at the same time (measured).  The wrapper takes one lock per function around
+    ``Dispatcher.compile`` (whose first step after the in-memory check is loading from the disk
+    cache), inside numba's own process-wide compiler lock so that the lock order is always
+    compiler lock, then the callers' function locks before their callees' (no deadlock: the call
+    graph of the kernels has no cycle; a function already locked by this process is not locked
+    again).  Uncached functions (numba's own overloads) are compiled as before.
+    """
+    from numba.core import sigutils
+    from numba.core.caching import NullCache
+    from numba.core.compiler_lock import global_compiler_lock
+    from numba.core.dispatcher import Dispatcher
+
+    compile_ = Dispatcher.compile
+    held: set[str] = set()
+
+    def compile(self, sig):
+        name = f"numba-{self.py_func.__module__}.{self.py_func.__qualname__}"
+        if (isinstance(self._cache, NullCache) or name in held
+                or tuple(sigutils.normalize_signature(sig)[0]) in self.overloads):
+            return compile_(self, sig)
+        with global_compiler_lock:
+            held.add(name)
+            try:
+                with _interprocess_lock(name):
+                    return compile_(self, sig)
+            finally:
+                held.discard(name)
+
+    Dispatcher.compile = compile
+
+
+def pytest_configure(config):
+    if os.environ.get("PYTEST_XDIST_WORKER"):  # several processes share the numba cache
+        _compile_numba_once_per_run()
 
 
 @pytest.hookimpl(tryfirst=True)  # before xdist reads the xdist_group marks
@@ -52,9 +119,20 @@ def pytest_collection_modifyitems(config, items):
 
 @pytest.fixture(scope="session")
 def dataset_cache():
+    """The test dataset cache; an entry missing from it is simulated by one test process while
+    the others needing it wait for it (the cache alone lets two workers simulate one record at
+    once: on a cold cache both simulated ``fivebar_multisine``, 38 s each on 2 loaded cores)."""
     from testbed.pipeline.cache import DatasetCache
 
-    return DatasetCache(TEST_CACHE)
+    class SharedDatasetCache(DatasetCache):
+        def clean(self, scenario, progress=None):
+            p = self.path(scenario)
+            if p.is_file():
+                return super().clean(scenario, progress)
+            with _interprocess_lock(p.stem):
+                return super().clean(scenario, progress)  # loads it if another process made it
+
+    return SharedDatasetCache(TEST_CACHE)
 
 
 @pytest.fixture(autouse=True, scope="module")
