@@ -126,7 +126,7 @@ def pytest_collection_modifyitems(config, items):
 
 
 #: Seconds of the longest work units (an ``xdist_group``, or for a module without one each of
-#: its tests) on a cold cache, measured with ``-n 2 --dist loadgroup`` on 2 cores shared with
+#: its tests, or one test) on a cold cache, measured with ``-n 2 --dist loadgroup`` on 2 cores shared with
 #: other processes (load 5-9): the test-to-test order they are dealt in.  Only the order
 #: matters; a unit not listed follows them in collection order.  Longest-processing-time-first
 #: lets both workers finish together: dealt by number of tests (xdist's default), the wheel's
@@ -145,11 +145,19 @@ _COLD_SECONDS = {
     "tests/identify/test_library.py": 20, "tests/identify/test_pysindy_field.py": 18,
     "tests/models/test_cantilever_response.py": 18, "tests/testbed/test_runstore.py": 17,
     "tests/testbed/test_report.py": 17, "tests/identify/test_model_selection.py": 16,
+    # single tests simulating a long shipped record nothing else uses
+    **{f"tests/scenarios/test_scored.py::test_scenario_meets_its_thresholds[{name}]": s
+       for name, s in (("cantilever_long_aluminium", 90), ("cantilever_soft_impact_150N", 59),
+                       ("cantilever_long_aluminium_1m", 48), ("cantilever_soft_stiffer_base", 39),
+                       ("cantilever_two_sensors_noise3", 19))},
 }
 
 
 def _work_unit(item) -> str:
-    """The :data:`_COLD_SECONDS` key of ``item``: its xdist group, else its module."""
+    """The :data:`_COLD_SECONDS` key of ``item``: its node id if listed, else its xdist group,
+    else its module."""
+    if item.nodeid in _COLD_SECONDS:
+        return item.nodeid
     mark = item.get_closest_marker("xdist_group")
     return mark.args[0] if mark is not None and mark.args else item.nodeid.split("::")[0]
 
