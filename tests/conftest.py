@@ -145,11 +145,13 @@ _COLD_SECONDS = {
     "tests/identify/test_library.py": 20, "tests/identify/test_pysindy_field.py": 18,
     "tests/models/test_cantilever_response.py": 18, "tests/testbed/test_runstore.py": 17,
     "tests/testbed/test_report.py": 17, "tests/identify/test_model_selection.py": 16,
-    # single tests simulating a long shipped record nothing else uses
+    # single tests: pysindy's OSQP fits of the five-bar (130-139 s in two fresh-clone runs at
+    # load 6-12, where test_conformance took 303-310 s: scaled to this table's 158 s), then long
+    # shipped records nothing else simulates
     **{f"tests/scenarios/test_scored.py::test_scenario_meets_its_thresholds[{name}]": s
-       for name, s in (("cantilever_long_aluminium", 90), ("cantilever_soft_impact_150N", 59),
-                       ("cantilever_long_aluminium_1m", 48), ("cantilever_soft_stiffer_base", 39),
-                       ("cantilever_two_sensors_noise3", 19))},
+       for name, s in (("fivebar_multisine_pysindy", 70), ("cantilever_long_aluminium", 90),
+                       ("cantilever_soft_impact_150N", 59), ("cantilever_long_aluminium_1m", 48),
+                       ("cantilever_soft_stiffer_base", 39), ("cantilever_two_sensors_noise3", 19))},
 }
 
 
