@@ -10,6 +10,7 @@ xdist otherwise deals a module's tests to both workers one by one, and each work
 module's fixtures (a simulation, a fit, a numba compile) again.
 """
 
+import contextlib
 import os
 import sys
 from pathlib import Path
@@ -22,6 +23,81 @@ ROOT = Path(__file__).resolve().parent.parent
 # Tests share the benchmarks' synthetic problems (``from benchmarks import ...``).
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
+
+#: The shared test dataset cache: ``$TESTBED_TEST_CACHE``, else ``.cache/test-datasets`` of the
+#: checkout (set it to time a cold suite without emptying the checkout's cache).
+TEST_CACHE = Path(os.environ.get("TESTBED_TEST_CACHE", ROOT / ".cache" / "test-datasets"))
+#: Lock files of the test processes sharing :data:`TEST_CACHE` (outside the cached entries'
+#: folder listing: :meth:`DatasetCache.entries` reads ``*.h5`` only).
+LOCKS = TEST_CACHE / ".locks"
+
+
+@contextlib.contextmanager
+def _interprocess_lock(name: str):
+    """Hold the exclusive lock ``name`` among the processes of this checkout's test run (the
+    pytest-xdist workers): POSIX ``flock``, released by the kernel if the holder dies.  Where
+    ``fcntl`` is missing (Windows) nothing is locked: the work is then merely done twice."""
+    try:
+        import fcntl
+    except ImportError:
+        fcntl = None
+    if fcntl is None:
+        yield
+        return
+    LOCKS.mkdir(parents=True, exist_ok=True)
+    with open(LOCKS / f"{name}.lock", "a") as f:
+        fcntl.flock(f, fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(f, fcntl.LOCK_UN)
+
+
+def _compile_numba_once_per_run():
+    """Each ``cache=True`` numba function is compiled by one test process; the others load it.
+
+    numba's on-disk cache is shared by the workers, but a worker only finds an entry once the
+    compiling one has written it: on a cold cache both workers compiled the SGD-SINDy kernels
+    (``eig_loss_grad``, ``sgd_steps``: ~40 s of CPU on 2 loaded cores) and ``accelerations_many``
+    at the same time (measured).  The wrapper takes one lock per function around
+    ``Dispatcher.compile`` (whose first step after the in-memory check is loading from the disk
+    cache), inside numba's own process-wide compiler lock so that the lock order is always
+    compiler lock, then the callers' function locks before their callees' (no deadlock: the call
+    graph of the kernels has no cycle; a function already locked by this process is not locked
+    again).  Uncached functions (numba's own overloads) are compiled as before.
+    """
+    from numba.core import sigutils
+    from numba.core.caching import NullCache
+    from numba.core.compiler_lock import global_compiler_lock
+    from numba.core.dispatcher import Dispatcher
+
+    compile_ = Dispatcher.compile
+    held: set[str] = set()
+
+    def compile(self, sig):
+        name = f"numba-{self.py_func.__module__}.{self.py_func.__qualname__}"
+        if (isinstance(self._cache, NullCache) or name in held
+                or tuple(sigutils.normalize_signature(sig)[0]) in self.overloads):
+            return compile_(self, sig)
+        with global_compiler_lock:
+            held.add(name)
+            try:
+                with _interprocess_lock(name):
+                    return compile_(self, sig)
+            finally:
+                held.discard(name)
+
+    Dispatcher.compile = compile
+
+
+def pytest_configure(config):
+    # ``--dist loadgroup`` deals the work units in the order of the collection (which
+    # pytest_collection_modifyitems sorts longest first), not sorted by their number of tests
+    # (xdist's default ``--loadscope-reorder``).
+    if getattr(config.option, "dist", "no") == "loadgroup":
+        config.option.loadscopereorder = False
+    if os.environ.get("PYTEST_XDIST_WORKER"):  # several processes share the numba cache
+        _compile_numba_once_per_run()
 
 
 @pytest.hookimpl(tryfirst=True)  # before xdist reads the xdist_group marks
@@ -44,13 +120,66 @@ def pytest_collection_modifyitems(config, items):
         if any(fd.scope in ("module", "class") and fd.baseid.split("::")[0] == module
                for defs in item._fixtureinfo.name2fixturedefs.values() for fd in defs):
             item.add_marker(pytest.mark.xdist_group(module))
+    # longest work first (the order xdist deals the work units in: see pytest_configure)
+    rank = {id(item): _COLD_SECONDS.get(_work_unit(item), 0.0) for item in items}
+    items.sort(key=lambda item: -rank[id(item)])  # stable: a module's tests keep their order
+
+
+#: Seconds of the longest work units (an ``xdist_group``, or for a module without one each of
+#: its tests, or one test) on a cold cache, measured with ``-n 2 --dist loadgroup`` on 2 cores shared with
+#: other processes (load 5-9): the test-to-test order they are dealt in.  Only the order
+#: matters; a unit not listed follows them in collection order.  Longest-processing-time-first
+#: lets both workers finish together: dealt by number of tests (xdist's default), the wheel's
+#: 2-test group (106 s) started 513 s into the run and a 1-test fit of 49 s at 649 s.
+_COLD_SECONDS = {
+    "tests/identify/test_conformance.py": 158, "tests/test_wheel.py": 106,
+    "tests/identify/test_sgd_sindy.py": 80, "tests/models/test_fivebar_dynamics.py": 69,
+    "chromium": 65, "tests/models/test_fivebar_energy.py": 57,
+    "tests/identify/test_sindy_pi_noise.py": 55, "tests/identify/test_sindy_pi.py": 50,
+    "tests/identify/test_sindy_pi_linear.py": 49, "tests/identify/test_sindy_pi_fivebar.py": 44,
+    "tests/identify/test_sgd_split.py": 36, "tests/identify/test_weak.py": 35,
+    "tests/identify/test_ls_sindy.py": 33, "tests/identify/test_mechsim.py": 32,
+    "tests/test_third_rig.py": 30, "tests/identify/test_sindy_pi_dynamical.py": 29,
+    "tests/testbed/test_sweep.py": 29, "tests/testbed/test_faults.py": 26,
+    "tests/identify/test_sgd_matrix.py": 25, "tests/identify/test_sindy_pi_kernels.py": 23,
+    "tests/identify/test_library.py": 20, "tests/identify/test_pysindy_field.py": 18,
+    "tests/models/test_cantilever_response.py": 18, "tests/testbed/test_runstore.py": 17,
+    "tests/testbed/test_report.py": 17, "tests/identify/test_model_selection.py": 16,
+    # single tests: pysindy's OSQP fits of the five-bar (130-139 s in two fresh-clone runs at
+    # load 6-12, where test_conformance took 303-310 s: scaled to this table's 158 s), then long
+    # shipped records nothing else simulates
+    **{f"tests/scenarios/test_scored.py::test_scenario_meets_its_thresholds[{name}]": s
+       for name, s in (("fivebar_multisine_pysindy", 70), ("cantilever_long_aluminium", 90),
+                       ("cantilever_soft_impact_150N", 59), ("cantilever_long_aluminium_1m", 48),
+                       ("cantilever_soft_stiffer_base", 39), ("cantilever_two_sensors_noise3", 19))},
+}
+
+
+def _work_unit(item) -> str:
+    """The :data:`_COLD_SECONDS` key of ``item``: its node id if listed, else its xdist group,
+    else its module."""
+    if item.nodeid in _COLD_SECONDS:
+        return item.nodeid
+    mark = item.get_closest_marker("xdist_group")
+    return mark.args[0] if mark is not None and mark.args else item.nodeid.split("::")[0]
 
 
 @pytest.fixture(scope="session")
 def dataset_cache():
+    """The test dataset cache; an entry missing from it is simulated by one test process while
+    the others needing it wait for it (the cache alone lets two workers simulate one record at
+    once: on a cold cache both simulated ``fivebar_multisine``, 38 s each on 2 loaded cores)."""
     from testbed.pipeline.cache import DatasetCache
 
-    return DatasetCache(ROOT / ".cache" / "test-datasets")
+    class SharedDatasetCache(DatasetCache):
+        def clean(self, scenario, progress=None):
+            p = self.path(scenario)
+            if p.is_file():
+                return super().clean(scenario, progress)
+            with _interprocess_lock(p.stem):
+                return super().clean(scenario, progress)  # loads it if another process made it
+
+    return SharedDatasetCache(TEST_CACHE)
 
 
 @pytest.fixture(autouse=True, scope="module")

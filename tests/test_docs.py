@@ -28,7 +28,7 @@ def test_guide_example_runs(guide, tmp_path):
     # a fresh interpreter: the example's registration must not leak into other tests' registries
     # (the shared test cache: a dataset the examples need is simulated once per machine)
     env = {**os.environ, "OMP_NUM_THREADS": "1", "MPLBACKEND": "Agg",
-           "TESTBED_CACHE": str(ROOT / ".cache" / "test-datasets"),
+           "TESTBED_CACHE": os.environ.get("TESTBED_TEST_CACHE", str(ROOT / ".cache" / "test-datasets")),
            "PYTHONPATH": os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")])}
     r = subprocess.run([sys.executable, str(script)], cwd=tmp_path, capture_output=True, text=True,
                        timeout=120, env=env)

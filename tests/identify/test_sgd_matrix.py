@@ -1,6 +1,8 @@
 """The cubic-term selection of SGD-SINDy's matrix parametrisation (identify/_sgd_matrix.py):
 the warm start's lasso, on the partial-correlation scale, and the SGD's proximal step."""
 
+import functools
+
 import numpy as np
 import pytest
 
@@ -8,10 +10,20 @@ from benchmarks import bench_sgd_sindy as bench
 from identify._sgd_matrix import _sym, cubic_profile, warm_start
 from identify.sgd_sindy import SGDSINDy
 
+# One worker runs the module: each chain record below is integrated once (10 calls made 3
+# records; 4-6 s each on a loaded 2-core machine).
+pytestmark = pytest.mark.xdist_group("tests/identify/test_sgd_matrix.py")
 
+
+@functools.cache
 def _signals(k3):
+    """The coupled chain's record and its signals, integrated once per process and ``k3``;
+    read-only, so that no test can change what the next one reads."""
     d = bench.chain_measurement(bench.chain_system(coupled=True, k3=k3))
-    return d, (d.xdd, d.xd, d.x, d.x**3)
+    sig = (d.xdd, d.xd, d.x, d.x**3)
+    for a in sig:
+        a.flags.writeable = False
+    return d, sig
 
 
 def _partial_corr(xdd, xd, x, x3):
