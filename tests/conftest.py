@@ -53,51 +53,15 @@ def _interprocess_lock(name: str):
             fcntl.flock(f, fcntl.LOCK_UN)
 
 
-def _compile_numba_once_per_run():
-    """Each ``cache=True`` numba function is compiled by one test process; the others load it.
-
-    numba's on-disk cache is shared by the workers, but a worker only finds an entry once the
-    compiling one has written it: on a cold cache both workers compiled the SGD-SINDy kernels
-    (``eig_loss_grad``, ``sgd_steps``: ~40 s of CPU on 2 loaded cores) and ``accelerations_many``
-    at the same time (measured).  The wrapper takes one lock per function around
-    ``Dispatcher.compile`` (whose first step after the in-memory check is loading from the disk
-    cache), inside numba's own process-wide compiler lock so that the lock order is always
-    compiler lock, then the callers' function locks before their callees' (no deadlock: the call
-    graph of the kernels has no cycle; a function already locked by this process is not locked
-    again).  Uncached functions (numba's own overloads) are compiled as before.
-    """
-    from numba.core import sigutils
-    from numba.core.caching import NullCache
-    from numba.core.compiler_lock import global_compiler_lock
-    from numba.core.dispatcher import Dispatcher
-
-    compile_ = Dispatcher.compile
-    held: set[str] = set()
-
-    def compile(self, sig):
-        name = f"numba-{self.py_func.__module__}.{self.py_func.__qualname__}"
-        if (isinstance(self._cache, NullCache) or name in held
-                or tuple(sigutils.normalize_signature(sig)[0]) in self.overloads):
-            return compile_(self, sig)
-        with global_compiler_lock:
-            held.add(name)
-            try:
-                with _interprocess_lock(name):
-                    return compile_(self, sig)
-            finally:
-                held.discard(name)
-
-    Dispatcher.compile = compile
-
-
 def pytest_configure(config):
     # ``--dist loadgroup`` deals the work units in the order of the collection (which
     # pytest_collection_modifyitems sorts longest first), not sorted by their number of tests
     # (xdist's default ``--loadscope-reorder``).
     if getattr(config.option, "dist", "no") == "loadgroup":
         config.option.loadscopereorder = False
-    if os.environ.get("PYTEST_XDIST_WORKER"):  # several processes share the numba cache
-        _compile_numba_once_per_run()
+    # numba's cache=True kernels may be compiled by both workers on a cold cache (measured: ~40 s
+    # of CPU on 2 loaded cores); serialising that would mean wrapping numba's private Dispatcher
+    # internals, which a numba upgrade could break in CI, so the duplicate compile is accepted.
 
 
 @pytest.hookimpl(tryfirst=True)  # before xdist reads the xdist_group marks
