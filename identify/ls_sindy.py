@@ -7,7 +7,7 @@ from typing import ClassVar
 import numpy as np
 
 from identify import IDENTIFIERS
-from identify._modal_damping import hold_modal_damping, modal_decay, set_eigenvalues
+from identify._modal_damping import decay_hold, set_eigenvalues
 from identify._sgd_matrix import eigen_targets, fit_window
 from identify.structural import (
     FIT_BAND_FIELD,
@@ -323,27 +323,14 @@ class LeastSquaresSINDy(StructuralIdentifier):
         if self.K3_ is not None:  # an amplitude-dependent frequency: no exponential decay
             self.decay_rule_ = "cubic library: the fit's (a free decay is not exponential)"
             return
-        if i0 == 0 and data.u is not None and bool(np.any(np.asarray(data.u) != 0.0)):
-            self.decay_rule_ = "continuous input (free_start = 0): the fit's"
-            return
-        dec = modal_decay(data, self.M_, self.K_, self.C_, (i0, i1))
-        self.modal_decay_ = dec
-        if not np.any(dec.taken):
-            self.decay_rule_ = "modal decay fits: none taken, the fit's"
-            return
-        C = hold_modal_damping(self.M_, self.C_, self.K_, dec.sigma_model)
-        self.coef_[:, v_block] -= (C - self.C_) / m
-        self.C_ = C
-        on = dec.taken & (dec.shift <= line)
-        if np.any(on):
-            self._set_stiffness(set_eigenvalues(self.M_, self.K_, np.where(on, dec.lam_model, np.nan)),
-                                m, d_block)
-        kept, fixed = np.flatnonzero(~dec.taken) + 1, np.flatnonzero(on) + 1
-        self.decay_rule_ = ("each mode's damping from its measured free decay (modal "
-                            "accelerations Phi^-1 x'', fitted exp(-sigma t) sinusoid)"
-                            + (f"; modes {kept.tolist()} kept the fit's" if kept.size else "")
-                            + (f"; frequencies of modes {fixed.tolist()} from it (within one "
-                               f"line, {line:.3g} Hz)" if fixed.size else ""))
+        held = decay_hold(data, self.M_, self.C_, self.K_, (i0, i1),
+                          lambda on, lam: set_eigenvalues(self.M_, self.K_, np.where(on, lam, np.nan)))
+        if held.decay is not None:
+            self.modal_decay_ = held.decay
+        self.coef_[:, v_block] -= (held.C - self.C_) / m
+        self.C_ = held.C
+        self._set_stiffness(held.K, m, d_block)
+        self.decay_rule_ = held.rule
 
     def _set_stiffness(self, K: np.ndarray, m: np.ndarray, d_block: slice) -> None:
         """Replace ``K_`` by ``K`` [N/m] and ``coef_``'s displacement block with it."""

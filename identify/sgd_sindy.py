@@ -51,7 +51,7 @@ from typing import ClassVar
 import numpy as np
 
 from identify import IDENTIFIERS
-from identify._modal_damping import hold_modal_damping, modal_decay
+from identify._modal_damping import decay_hold
 from identify._sgd_matrix import (
     MatrixSGDSettings,
     cubic_direction,
@@ -714,34 +714,18 @@ class SGDSINDy(SGDSINDyBase):
         if self.K3_ is not None:  # an amplitude-dependent frequency: no exponential decay
             self.decay_rule_ = "cubic library: the fit's (a free decay is not exponential)"
             return
-        i0, i1 = fit_window(data, est.fit_duration)
-        forced = data.u is not None and bool(np.any(np.asarray(data.u) != 0.0))
-        if i0 == 0 and forced:  # free_start = 0 with an input: a continuous excitation
-            self.decay_rule_ = "continuous input (free_start = 0): the fit's"
-            return
-        dec = modal_decay(data, self.M_, self.K_, self.C_, (i0, i1))
-        self.modal_decay_ = dec
-        if not np.any(dec.taken):
-            self.decay_rule_ = "modal decay fits: none taken, the fit's"
-            return
-        C = hold_modal_damping(self.M_, self.C_, self.K_, dec.sigma_model)
-        self.coef_[:, v_block] -= (C - self.C_) / m
-        self.C_ = C
-        # The frequency only within one line of the window's transform, the resolution the
-        # peak search (and the eigenvalue hold) locates a mode to: the decay fit refines it
-        # (measured: member 009's mode 1, 71.1 -> 72.3 Hz against 72.3 true), and never moves
-        # a mode farther than the spectrum allows.
-        line = float(data.fs) / (i1 - i0)
-        on = dec.taken & (dec.shift <= line)
-        if np.any(on):
+        L = np.linalg.cholesky(self.M_)
+
+        def set_frequencies(on: np.ndarray, lam: np.ndarray) -> np.ndarray:
             K = self.K_.copy()
-            hold_eigenvalues(np.linalg.cholesky(self.M_), K, 1.0, 1.0,
-                             np.where(on, dec.lam_model, 0.0))
-            self.coef_[:, d_block] -= (K - self.K_) / m
-            self.K_ = K
-        kept, fixed = np.flatnonzero(~dec.taken) + 1, np.flatnonzero(on) + 1
-        self.decay_rule_ = ("each mode's damping from its measured free decay (modal "
-                            "accelerations Phi^-1 x'', fitted exp(-sigma t) sinusoid)"
-                            + (f"; modes {kept.tolist()} kept the fit's" if kept.size else "")
-                            + (f"; frequencies of modes {fixed.tolist()} from it (within one "
-                               f"line, {line:.3g} Hz)" if fixed.size else ""))
+            hold_eigenvalues(L, K, 1.0, 1.0, np.where(on, lam, 0.0))
+            return K
+
+        held = decay_hold(data, self.M_, self.C_, self.K_, fit_window(data, est.fit_duration),
+                          set_frequencies)
+        if held.decay is not None:
+            self.modal_decay_ = held.decay
+        self.coef_[:, v_block] -= (held.C - self.C_) / m
+        self.coef_[:, d_block] -= (held.K - self.K_) / m
+        self.C_, self.K_ = held.C, held.K
+        self.decay_rule_ = held.rule
