@@ -10,6 +10,7 @@ from identify import IDENTIFIERS
 from identify._modal_damping import decay_hold, set_eigenvalues
 from identify._sgd_matrix import eigen_targets, fit_window
 from identify.structural import (
+    DECAY_HOLD_FIELD,
     FIT_BAND_FIELD,
     FIT_TILT_DIFFERENCES,
     MASS_PRIORS,
@@ -195,9 +196,7 @@ class LeastSquaresSINDy(StructuralIdentifier):
         "eigen_hold": Field(bool, True, doc="hold the identified frequencies within one "
                                             "spectral line of the measured peaks they pair "
                                             "with (sgd_sindy's rule)"),
-        "decay_hold": Field(bool, True, doc="give each mode the damping (and, within one "
-                                            "spectral line, the frequency) fitted to its "
-                                            "measured free decay (identify._modal_damping)"),
+        "decay_hold": DECAY_HOLD_FIELD,
     }
 
     def __init__(self, cubic: bool | None = None, mass_prior: str = "reduced_mass_trace",

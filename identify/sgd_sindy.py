@@ -61,6 +61,7 @@ from identify._sgd_matrix import (
 )
 from identify.ls_sindy import MASS_PRIOR_FIELD
 from identify.structural import (
+    DECAY_HOLD_FIELD,
     StructuralIdentifier,
     build_library,
     cubic_rule,
@@ -558,9 +559,7 @@ class SGDSINDy(SGDSINDyBase):
         "fit_band": Field(bool, True, doc="high-pass every feature, target and nuisance "
                                            "column of the fit at 0.7 x the lowest measured "
                                            "peak (ls_sindy's fit band rule)"),
-        "decay_hold": Field(bool, True, doc="give each mode the damping (and, within one "
-                                            "spectral line, the frequency) fitted to its "
-                                            "measured free decay (identify._modal_damping)"),
+        "decay_hold": DECAY_HOLD_FIELD,
         "fit_tilt": Field(bool, None, doc="first differences of every row of the fit (weighs "
                                           "the equation error by frequency squared); default "
                                           "by rule: on, off when the tilted warm start is "

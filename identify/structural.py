@@ -210,6 +210,12 @@ FIT_BAND_FIELD = Field(float, None, unit="Hz", min=0.0,
                        doc="high-pass applied to every feature and target of the fit; default "
                            "by rule: 0.7 x the lowest measured peak; 0 = none")
 
+#: The decay hold's switch, declared alike by ``sgd_sindy`` and ``ls_sindy``
+#: (:func:`identify._modal_damping.decay_hold`).
+DECAY_HOLD_FIELD = Field(bool, True, doc="give each mode the damping (and, within one spectral "
+                                         "line, the frequency) fitted to its measured free "
+                                         "decay (identify._modal_damping)")
+
 
 def fit_band(data: Measurement, build: Callable[[int], Library], cutoff_hz: float | None = None,
              peaks: np.ndarray | None = None) -> tuple[Library, float, str]:
