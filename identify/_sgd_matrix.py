@@ -549,6 +549,12 @@ class MatrixSGDResult:
         Largest relative frequency change a hold made (0 without holding).
     fit_tilt : bool
         Whether the fit was tilted; ``fit_tilt_rule`` (str) says why.
+    input_map_record : ndarray, shape (n, n_inputs) or None
+        ``input_map`` fitted on the record from its start to the window's end (the impact
+        pulse included) instead of the window alone, the same model and nuisance columns;
+        None when no input is nonzero in the window or the window starts the record.
+        :class:`identify.sgd_sindy.SGDSINDy` takes it when the window's gain is refused at
+        the driving point (:func:`identify.structural.driving_point_scaling`).
     """
 
     M: np.ndarray
@@ -565,6 +571,7 @@ class MatrixSGDResult:
     eigen_shift: float
     fit_tilt: bool = False
     fit_tilt_rule: str = ""
+    input_map_record: np.ndarray | None = None
 
 
 def fit_window(data: Measurement, fit_duration: float) -> tuple[int, int]:
@@ -621,6 +628,7 @@ def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
         full = [elliptic_highpass(a, data.fs, fc, FIT_BAND_ORDER) for a in full]
         W = elliptic_highpass(W.T, data.fs, fc, FIT_BAND_ORDER).T if W.shape[1] else W
     raw = [a[:, i0:i1] for a in full]
+    W_record = W[:i1]  # from the record's start (the impact pulse) to the window's end
     W = np.ascontiguousarray(W[i0:i1])
     n_u = inputs.size
     l1_on = est.cubic and est.l1
@@ -840,14 +848,25 @@ def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
         K3 = np.outer(K3[:, 0], cubic_dir ** 3)
     # the free coefficients of the nuisance columns, from the unprojected residual
     K3f = None if K3 is None else (sc3 * R if cubic_dir is not None else K3)  # on the features
-    resid = M @ raw[0] + C @ raw[1] + K @ raw[2] + (K3f @ raw[3] if K3f is not None else 0.0)
-    G = (np.linalg.lstsq(W / _rms(W, 0)[None, :], resid.T, rcond=NUISANCE_RCOND)[0]
-         / _rms(W, 0)[:, None]).T if W.shape[1] else np.zeros((n, 0))
+    def nuisance_coef(sig: list[np.ndarray], Wn: np.ndarray) -> np.ndarray:
+        """The nuisance columns' coefficients (n, p) fitting the model's residual on ``sig``."""
+        if not Wn.shape[1]:
+            return np.zeros((n, 0))
+        res = M @ sig[0] + C @ sig[1] + K @ sig[2] + (K3f @ sig[3] if K3f is not None else 0.0)
+        sw = _rms(Wn, 0)
+        return (np.linalg.lstsq(Wn / sw[None, :], res.T, rcond=NUISANCE_RCOND)[0] / sw[:, None]).T
+
+    G = nuisance_coef(raw, W)
     input_map = None if data.input_map is None else np.array(data.input_map, dtype=float)
+    input_map_record = None
     if input_map is not None:
         input_map[:, inputs] = G[:, :n_u]
+        if n_u and i0 > 0:
+            input_map_record = input_map.copy()
+            input_map_record[:, inputs] = nuisance_coef([a[:, :i1] for a in full], W_record)[:, :n_u]
     return MatrixSGDResult(M=_sym(M), C=C, K=K, K3=K3, n_steps=n_steps, alphas=alpha, guard=guard,
                            history={k: np.asarray(v) for k, v in hist.items()},
                            input_map=input_map, drift_coef=G[:, n_u:],
                            eigen_targets=np.sqrt(target) / (2.0 * np.pi), eigen_shift=held,
-                           fit_tilt=tilted, fit_tilt_rule=tilt_rule)
+                           fit_tilt=tilted, fit_tilt_rule=tilt_rule,
+                           input_map_record=input_map_record)

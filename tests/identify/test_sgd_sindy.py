@@ -7,6 +7,8 @@ well under a minute on one core; the benchmark shows the targets are met far ear
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -177,3 +179,47 @@ def test_coefficient_form_options_run(linear):
     assert SGDSINDyCoefficients(epochs=3, steps_per_epoch=1).fit(data).n_steps_ == 3
     with pytest.raises(ValueError, match="l1"):
         SGDSINDyCoefficients(l1="bad").fit(data)
+
+
+@pytest.fixture(scope="module")
+def forced():
+    """The chain under a half-sine impact at the tip (samples 10-40) whose decaying tail
+    (2 ms) runs into the fit window (from sample 48): exact model signals, no chain."""
+    from identify._structural_sim import simulate_structural
+
+    sysd = bench.chain_system(coupled=True, damping="nonproportional")
+    fs, n_t, start = bench.FS, 3200, 48
+    t = np.arange(n_t) / fs
+    u = np.where((t >= 10 / fs) & (t < 40 / fs), np.sin(np.pi * (t * fs - 10) / 30), 0.0)
+    u += np.where(t >= 40 / fs, 0.05 * np.exp(-(t - 40 / fs) / 2e-3), 0.0)
+    u = 20.0 * u[None, :]
+    tr = simulate_structural(sysd["M"], sysd["C"], sysd["K"], None, sysd["B"], np.zeros(3),
+                             np.zeros(3), t, u)
+    data = dataclasses.replace(bench.chain_measurement(sysd, duration=n_t / fs),
+                               x=tr.x, xd=tr.xd, xdd=tr.xdd, u=u, free_start=start)
+    return sysd, data
+
+
+def test_input_map_from_the_record_when_the_window_gain_is_refused(forced, monkeypatch):
+    """The window's gain M^-1 B refused at the driving point (a non-positive modal mass) is
+    replaced by the record's (pulse included); an accepted window gain is kept."""
+    import identify.sgd_sindy as ss
+
+    sysd, data = forced
+    want = np.linalg.solve(sysd["M"], sysd["B"])
+    kept = SGDSINDy(epochs=4).fit(data)
+    assert "window" in kept.input_map_rule_ and "driving point" in kept.mass_scaling_rule_
+    real = ss.fit_matrix_sgd
+
+    def refused_window(*args, **kwargs):
+        out = real(*args, **kwargs)
+        # the record's gain recovers the true one on these exact signals
+        g = np.linalg.solve(out.M, out.input_map_record)
+        assert _rel(g, want) < 0.02
+        return dataclasses.replace(out, input_map=-out.input_map)  # negative modal masses
+
+    monkeypatch.setattr(ss, "fit_matrix_sgd", refused_window)
+    model = SGDSINDy(epochs=4).fit(data)
+    assert "record" in model.input_map_rule_ and "non-positive" in model.input_map_rule_
+    assert "driving point" in model.mass_scaling_rule_
+    assert _rel(np.linalg.solve(model.M_, model.input_map_), want) < 0.02
