@@ -236,7 +236,8 @@ class DecayHold:
 
 def decay_hold(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndarray,
                window: tuple[int, int],
-               set_frequencies: Callable[[np.ndarray, np.ndarray], np.ndarray]) -> DecayHold:
+               set_frequencies: Callable[[np.ndarray, np.ndarray], np.ndarray],
+               enabled: bool = True, cubic: bool = False) -> DecayHold:
     """The decay hold of ``sgd_sindy`` and ``ls_sindy`` on a fitted linear model.
 
     Each mode gets the damping of its measured free decay (:func:`modal_decay`,
@@ -259,11 +260,20 @@ def decay_hold(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndarray,
         the modes ``on`` (bool, shape (n,)) set to ``lam`` [rad^2/s^2] and the shapes kept
         (:func:`identify._sgd_matrix.hold_eigenvalues` for a symmetric model,
         :func:`set_eigenvalues` otherwise); called only when some mode moves.
+    enabled : bool
+        The identifier's ``decay_hold`` (False: nothing is held).
+    cubic : bool
+        Whether the model has cubic terms: an amplitude-dependent frequency has no exponential
+        decay, and nothing is held.
 
     Returns
     -------
     DecayHold
     """
+    if not enabled:
+        return DecayHold(C, K, None, "decay_hold = False: the fit's damping and frequencies")
+    if cubic:
+        return DecayHold(C, K, None, "cubic library: the fit's (a free decay is not exponential)")
     i0, i1 = window
     forced = data.u is not None and bool(np.any(np.asarray(data.u) != 0.0))
     if i0 == 0 and forced:  # free_start = 0 with an input: a continuous excitation

@@ -316,14 +316,9 @@ class LeastSquaresSINDy(StructuralIdentifier):
                                 f"peaks (within {MODE_SEPARATION:.0%}), held within one line "
                                 f"({line:.3g} Hz) of them" if np.any(on)
                                 else "no mode within the pairing distance of a peak: the fit's")
-        if not self.decay_hold:
-            self.decay_rule_ = "decay_hold = False: the fit's damping and frequencies"
-            return
-        if self.K3_ is not None:  # an amplitude-dependent frequency: no exponential decay
-            self.decay_rule_ = "cubic library: the fit's (a free decay is not exponential)"
-            return
         held = decay_hold(data, self.M_, self.C_, self.K_, (i0, i1),
-                          lambda on, lam: set_eigenvalues(self.M_, self.K_, np.where(on, lam, np.nan)))
+                          lambda on, lam: set_eigenvalues(self.M_, self.K_, np.where(on, lam, np.nan)),
+                          self.decay_hold, self.K3_ is not None)
         if held.decay is not None:
             self.modal_decay_ = held.decay
         self.coef_[:, v_block] -= (held.C - self.C_) / m

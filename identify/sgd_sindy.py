@@ -727,21 +727,13 @@ class SGDSINDy(SGDSINDyBase):
         v_block, d_block : slice
             The velocity and displacement columns of ``coef_``.
         """
-        if not self.decay_hold:
-            self.decay_rule_ = "decay_hold = False: the fit's damping and frequencies"
-            return
-        if self.K3_ is not None:  # an amplitude-dependent frequency: no exponential decay
-            self.decay_rule_ = "cubic library: the fit's (a free decay is not exponential)"
-            return
-        L = np.linalg.cholesky(self.M_)
-
         def set_frequencies(on: np.ndarray, lam: np.ndarray) -> np.ndarray:
             K = self.K_.copy()
-            hold_eigenvalues(L, K, 1.0, 1.0, np.where(on, lam, 0.0))
+            hold_eigenvalues(np.linalg.cholesky(self.M_), K, 1.0, 1.0, np.where(on, lam, 0.0))
             return K
 
         held = decay_hold(data, self.M_, self.C_, self.K_, fit_window(data, est.fit_duration),
-                          set_frequencies)
+                          set_frequencies, self.decay_hold, self.K3_ is not None)
         if held.decay is not None:
             self.modal_decay_ = held.decay
         self.coef_[:, v_block] -= (held.C - self.C_) / m

@@ -117,10 +117,10 @@ def test_compiled_sweep_matches_reference_on_well_conditioned_problems(seed):
         assert (c, a, b) in supports
 
 
-@pytest.mark.parametrize("seed", [0, 3])
-def test_fresh_cholesky_kernel_matches_reference(seed):
-    """The fallback kernel (a new Cholesky, else LU, per refit) under the same rule."""
-    Gn = _normalised(planted_problem(seed))[2]
+def _kernel_inputs(Gn):
+    """A well-conditioned normalised Gram matrix's condition number and kernel inputs: every
+    column a candidate,
+    the reference sweep and its margin, the base masks and the ridge-free starting models."""
     cond = np.linalg.cond(Gn)
     assert cond <= 1e6, cond
     p = Gn.shape[0]
@@ -129,6 +129,14 @@ def test_fresh_cholesky_kernel_matches_reference(seed):
     B = np.linalg.inv(Gn + 1e-14 * np.eye(p))
     base = ~np.eye(p, dtype=bool)
     xi = np.where(base, -(B[:, cand] / B[cand, cand]).T, 0.0)
+    return cond, p, cand, ref, margin, base, xi
+
+
+@pytest.mark.parametrize("seed", [0, 3])
+def test_fresh_cholesky_kernel_matches_reference(seed):
+    """The fallback kernel (a new Cholesky, else LU, per refit) under the same rule."""
+    Gn = _normalised(planted_problem(seed))[2]
+    cond, p, cand, ref, margin, base, xi = _kernel_inputs(Gn)
     for kernel in ("fresh", "downdate"):
         if kernel == "fresh":
             models, status, refits = stlsq_chains(Gn, cand, base, xi, DEFAULT_THRESHOLDS, 1e-14, 20)
@@ -197,14 +205,7 @@ def test_downdate_kernel_matches_reference_on_a_larger_random_problem():
     its storage, some close them up) against the masked least-squares reference, under the
     module's rule.  FWD still covers p = 60: p * (growth 10) = 600 < 1e3."""
     Gn = _normalised(planted_problem(7, n=4000, p=60))[2]
-    cond = np.linalg.cond(Gn)
-    assert cond <= 1e6, cond
-    p = Gn.shape[0]
-    cand = np.arange(p)
-    ref, margin = reference_sweep(Gn, cand, DEFAULT_THRESHOLDS)
-    B = np.linalg.inv(Gn + 1e-14 * np.eye(p))
-    base = ~np.eye(p, dtype=bool)
-    xi = np.where(base, -(B[:, cand] / B[cand, cand]).T, 0.0)
+    cond, p, cand, ref, margin, base, xi = _kernel_inputs(Gn)
     models, status, refits = stlsq_chains_downdate(Gn, cand, np.ones(p, dtype=bool), base, xi,
                                                    DEFAULT_THRESHOLDS, 1e-14, 20)
     assert (status == 0).all() and refits.sum() > 3 * p
