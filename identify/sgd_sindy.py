@@ -61,6 +61,7 @@ from identify._sgd_matrix import (
 )
 from identify.ls_sindy import MASS_PRIOR_FIELD
 from identify.structural import (
+    DECAY_BACKBONE_FIELD,
     DECAY_HOLD_FIELD,
     StructuralIdentifier,
     build_library,
@@ -334,10 +335,16 @@ class SGDSINDy(SGDSINDyBase):
         positive semi-definite, and its frequency when the fitted one lies within one line
         (``fs / N``) of the model's, by the smallest change of K that keeps the modes
         (:func:`identify._sgd_matrix.hold_eigenvalues`).  Shapes are kept.  Applied to the
-        result before the trapezoid map; not with the cubic library (no exponential decay)
-        nor for a continuous input (``free_start = 0`` with a nonzero input); a mode whose
-        fit fails (a bound, or a damped frequency more than 15 % from the mode's) keeps the
-        fit's pole.  See Notes for why and what it measured.
+        result before the trapezoid map; not for a continuous input (``free_start = 0`` with
+        a nonzero input); a mode whose fit fails (a bound, or a damped frequency more than
+        15 % from the mode's) keeps the fit's pole.  With the cubic library only with
+        ``decay_backbone``.  See Notes for why and what it measured.
+    decay_backbone : bool
+        With the cubic library, run the decay hold with the backbone decay fit (frequency
+        ``wd + c exp(-2 sigma t)``, ``wd`` the linear one) and move a frequency only where the
+        model's own cubic gives at least half the measured ``c``
+        (:mod:`identify._modal_damping`, "Cubic library"; soft-base family 5 -> 6 of 20 clean,
+        member 014 gained, none lost); False: no decay hold with the cubic library.
     fit_tilt : bool or None
         Difference every row of the fit once (warm start and SGD loss alike: features, target,
         force and drift columns; :func:`identify.structural.tilt_rows`, ``ls_sindy``'s tilted
@@ -568,6 +575,7 @@ class SGDSINDy(SGDSINDyBase):
                                           "the equation error by frequency squared); default "
                                           "by rule: on, off when the tilted warm start is "
                                           "non-physical or with the cubic library"),
+        "decay_backbone": DECAY_BACKBONE_FIELD,
     }
 
     @classmethod
@@ -589,7 +597,7 @@ class SGDSINDy(SGDSINDyBase):
                  l1_threshold: float = 0.2, l1_debias: float = 0.5, gradient: str = "minibatch",
                  iterate_average: float = 0.25, eigen_hold: bool = True,
                  cubic_form: str = "diagonal", fit_band: bool = True, decay_hold: bool = True,
-                 fit_tilt: bool | None = None):
+                 fit_tilt: bool | None = None, decay_backbone: bool = True):
         self.epochs = epochs
         self.batch_size = batch_size
         self.learning_rate = learning_rate
@@ -616,6 +624,7 @@ class SGDSINDy(SGDSINDyBase):
         self.cubic_form = cubic_form
         self.fit_band = fit_band
         self.decay_hold = decay_hold
+        self.decay_backbone = decay_backbone
         self.fit_tilt = fit_tilt
 
     def settings(self) -> MatrixSGDSettings:
@@ -733,7 +742,7 @@ class SGDSINDy(SGDSINDyBase):
             return K
 
         held = decay_hold(data, self.M_, self.C_, self.K_, fit_window(data, est.fit_duration),
-                          set_frequencies, self.decay_hold, self.K3_ is not None)
+                          set_frequencies, self.decay_hold, self.K3_, self.decay_backbone)
         if held.decay is not None:
             self.modal_decay_ = held.decay
         self.coef_[:, v_block] -= (held.C - self.C_) / m

@@ -215,6 +215,13 @@ FIT_BAND_FIELD = Field(float, None, unit="Hz", min=0.0,
 DECAY_HOLD_FIELD = Field(bool, True, doc="give each mode the damping (and, within one spectral "
                                          "line, the frequency) fitted to its measured free "
                                          "decay (identify._modal_damping)")
+#: The decay hold with the cubic library, declared alike by ``sgd_sindy`` and ``ls_sindy``
+#: (:func:`identify._modal_damping.decay_hold` with ``backbone``).
+DECAY_BACKBONE_FIELD = Field(bool, True, doc="with the cubic library, run the decay hold with an "
+                                             "amplitude-dependent frequency wd + c "
+                                             "exp(-2 sigma t), taking its small-amplitude "
+                                             "limit wd as the linear frequency where the "
+                                             "model's own cubic gives half the measured c")
 
 
 def fit_band(data: Measurement, build: Callable[[int], Library], cutoff_hz: float | None = None,

@@ -61,6 +61,7 @@ MATRIX_CASES = {
     "fit_band": ({}, False),
     "decay_hold": ({}, False),
     "fit_tilt": ({}, False),
+    "decay_backbone": ({"cubic": True, "data": "duffing"}, False),
 }
 
 COEFFICIENT_CASES = {
@@ -141,7 +142,7 @@ def test_every_declared_hyperparameter_changes_the_fit(cls, cases, chains):
 
 def test_the_forms_declare_only_their_own_keys():
     matrix_only = {"fit_duration", "l1_threshold", "l1_debias", "gradient", "iterate_average",
-                   "eigen_hold", "decay_hold"}
+                   "eigen_hold", "decay_hold", "decay_backbone"}
     coefficient_only = {"mass_learning_rate", "symmetry", "optimizer", "mass_update"}
     assert matrix_only <= set(SGDSINDy.hyperparameters)
     assert coefficient_only <= set(SGDSINDyCoefficients.hyperparameters)
