@@ -32,7 +32,8 @@ Loss (the paper's terms, Eqs 2-18)
   ``(K, M)`` paired with the measured spectral peaks (:func:`eigen_targets`) against
   ``(2 pi f)^2``, with the exact first-order sensitivity ``d lambda = u^T (dK - lambda dM) u``
   (``u`` mass-normalised); the result's paired eigenvalues are then held within one line of
-  their peaks (:func:`hold_eigenvalues`);
+  their peaks (:func:`hold_eigenvalues`); with the cubic library a hardening mode's peak is
+  replaced by its backbone's linear frequency (:func:`backbone_targets`, ``eigen_backbone``);
 - L1 (Eqs 14-15) on the cubic block, as a lasso on *standardised* cubic coefficients (see
   below), with a proximal step in Adam's metric, then a debiasing stage;
 - learning-rate annealing of the eigenvalue weight (Eqs 17-18) once per epoch, capped at
@@ -108,6 +109,7 @@ from typing import Any, Literal
 
 import numpy as np
 
+from identify._modal_damping import modal_decay
 from identify.structural import (
     FIT_BAND_ORDER,
     FIT_TILT_DIFFERENCES,
@@ -301,6 +303,56 @@ def eigen_targets(M: np.ndarray, K: np.ndarray, lam_hat: np.ndarray) -> np.ndarr
     return target
 
 
+def backbone_targets(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndarray,
+                     window: tuple[int, int], lam_hat: np.ndarray
+                     ) -> tuple[np.ndarray, np.ndarray, str]:
+    """The eigenvalue penalty's targets with each hardening mode's peak replaced by its
+    backbone's linear frequency (``sgd_sindy``'s ``eigen_backbone``, cubic library).
+
+    A hardening mode's spectral peak sits at the record's amplitude-shifted frequency, above
+    the linear one.  Each mode of the model ``(M, C, K)`` (the warm start) paired with a peak
+    (:func:`eigen_targets`) whose backbone decay fit
+    (:func:`identify._modal_damping.modal_decay` with ``backbone=True``) is taken and hardens
+    (``c > 0``) has that peak replaced by the fit's linear eigenvalue (``lam_model``), so that
+    the penalty pulls the linear part to the linear frequency and the cubic term has to carry
+    the shift.
+
+    Parameters
+    ----------
+    data : Measurement
+    M, C, K : ndarray, shape (n, n)
+        The warm start's mass [kg], damping [N s/m] and stiffness [N/m] (its modes).
+    window : (int, int)
+        Samples ``[i0, i1)`` of the fit window.
+    lam_hat : ndarray, shape (k,)
+        Measured eigenvalues ``(2 pi f)^2`` [rad^2/s^2] of the spectral peaks.
+
+    Returns
+    -------
+    lam : ndarray, shape (k,)
+        ``lam_hat`` sorted, the replaced entries the backbone fits' linear eigenvalues.
+    moved : ndarray of bool, shape (k,)
+        The replaced entries.
+    rule : str
+        What was replaced.
+    """
+    lam = np.sort(np.asarray(lam_hat, dtype=float))
+    moved = np.zeros(lam.size, bool)
+    target = eigen_targets(M, K, lam)
+    dec = modal_decay(data, M, K, C, window, backbone=True)
+    modes = []
+    for k in np.flatnonzero(dec.taken & (target > 0) & (np.nan_to_num(dec.chirp) > 0)):
+        j = int(np.flatnonzero((lam == target[k]) & ~moved)[0])
+        lam[j], moved[j] = dec.lam_model[k], True
+        modes.append(int(k) + 1)
+    if not modes:
+        return lam, moved, "no paired mode's backbone decay fit hardens: the peaks"
+    f0 = np.sqrt(np.sort(np.asarray(lam_hat, dtype=float))[moved]) / (2.0 * np.pi)
+    f1 = np.sqrt(lam[moved]) / (2.0 * np.pi)
+    return lam, moved, (f"modes {modes}: peak -> backbone linear frequency "
+                        + ", ".join(f"{a:.4g} -> {b:.4g} Hz" for a, b in zip(f0, f1, strict=True)))
+
+
 def hold_eigenvalues(L: np.ndarray, P: np.ndarray, m0: float, k0: float, target: np.ndarray,
                      band: float = 0.0) -> float:
     """Move each targeted eigenvalue of ``(K, M)`` into its target's band, in place on ``P``.
@@ -478,6 +530,11 @@ class MatrixSGDSettings:
         Difference every row once (warm start and SGD): None = by rule (tilted, flat with the
         cubic library or when the tilted warm start has a growing mode), True = tilted (a
         non-physical tilted warm start raises), False = flat.
+    eigen_backbone : bool
+        With the cubic library and a warm start that kept a cubic term, replace each hardening
+        mode's peak by its backbone's linear frequency in the penalty and the hold
+        (:func:`backbone_targets`); when the SGD then drops every cubic term, the hold puts
+        those modes onto their peaks.
     """
 
     epochs: int
@@ -502,6 +559,7 @@ class MatrixSGDSettings:
     cubic_form: Literal["direction", "diagonal"] = "diagonal"
     fit_band_hz: float | None = 0.0
     fit_tilt: bool | None = False
+    eigen_backbone: bool = False
 
     def __post_init__(self) -> None:
         for key, allowed in (("init", ("lstsq", "zeros")), ("gradient", ("minibatch", "full")),
@@ -555,6 +613,8 @@ class MatrixSGDResult:
         None when no input is nonzero in the window or the window starts the record.
         :class:`identify.sgd_sindy.SGDSINDy` takes it when the window's gain is refused at
         the driving point (:func:`identify.structural.driving_point_scaling`).
+    backbone_rule : str
+        What ``eigen_backbone`` did (:func:`backbone_targets`).
     """
 
     M: np.ndarray
@@ -572,6 +632,7 @@ class MatrixSGDResult:
     fit_tilt: bool = False
     fit_tilt_rule: str = ""
     input_map_record: np.ndarray | None = None
+    backbone_rule: str = ""
 
 
 def fit_window(data: Measurement, fit_duration: float) -> tuple[int, int]:
@@ -720,7 +781,17 @@ def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
     s_a = np.ascontiguousarray(s_a)
     cc.project(L, P, Q, R, m0, m_hat)
     # the target of each mode (ascending; 0 = none), paired on the current modes (eigen_targets)
-    lam_meas = np.asarray(lam_hat, dtype=float)
+    lam_meas = lam_peaks = np.asarray(lam_hat, dtype=float)
+    moved = np.zeros(lam_meas.size, bool)
+    backbone_rule = "eigen_backbone = False" if not est.eigen_backbone else (
+        "no cubic library" if not est.cubic else "no measured peak")
+    if est.cubic and est.eigen_backbone and lam_meas.size:
+        if K30 is None or not np.any(K30 != 0.0):
+            backbone_rule = "the warm start kept no cubic term: the peaks"
+        else:
+            lam_meas, moved, backbone_rule = backbone_targets(data, M0, C0, K0, (i0, i1),
+                                                              lam_meas)
+            lam_peaks = np.sort(lam_peaks)
     target = eigen_targets(m0 * (L @ L.T), k0 * _sym(P), lam_meas)
     lam_hat = np.ascontiguousarray(target)
     hold = bool(est.eigen_hold) and bool(np.any(target > 0))
@@ -838,6 +909,14 @@ def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
     if hold:
         target = eigen_targets(m0 * (L @ L.T), k0 * _sym(P), lam_meas)
         held = hold_eigenvalues(L, P, m0, k0, target, band)
+    if hold and np.any(moved) and not np.any(R != 0.0):
+        # the cubic was dropped: a linear model at the linear frequencies oscillates below the
+        # record at its large amplitudes, so the moved modes go onto their peaks
+        on = np.isin(eigen_targets(m0 * (L @ L.T), k0 * _sym(P), lam_meas), lam_meas[moved])
+        back = np.where(on, eigen_targets(m0 * (L @ L.T), k0 * _sym(P), lam_peaks), 0.0)
+        held = max(held, hold_eigenvalues(L, P, m0, k0, back, 0.0))
+        target = np.where(back > 0, back, target)
+        backbone_rule += "; the SGD dropped every cubic term: those modes put onto their peaks"
     clipped = _project_psd(Q)  # C: projected once, at the end (see above)
     if clipped < 0:
         guard["C"] = min(guard.get("C", 0.0), clipped)
@@ -869,4 +948,4 @@ def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
                            input_map=input_map, drift_coef=G[:, n_u:],
                            eigen_targets=np.sqrt(target) / (2.0 * np.pi), eigen_shift=held,
                            fit_tilt=tilted, fit_tilt_rule=tilt_rule,
-                           input_map_record=input_map_record)
+                           input_map_record=input_map_record, backbone_rule=backbone_rule)

@@ -142,3 +142,30 @@ def test_backbone_hold_moves_a_frequency_only_when_the_model_has_the_cubic(duffi
     bare = decay_hold(data, M, C, K, win, setf, K3=np.zeros((1, 1)))  # no cubic in the model
     assert bare.K[0, 0] == K[0, 0] and "kept the fit's frequency" in bare.rule
     assert bare.C[0, 0] == pytest.approx(2 * zeta * w, rel=0.15)  # the damping still held
+
+
+def test_backbone_targets_replace_a_hardening_peak_by_the_linear_frequency(duffing):
+    """``sgd_sindy``'s ``eigen_backbone``: the penalty's target of a hardening mode is its
+    backbone's linear eigenvalue, not the amplitude-shifted peak."""
+    from identify._sgd_matrix import backbone_targets
+
+    data, w, zeta, _ = duffing
+    peak = 1.023 * w  # where the exponential fit puts it (measured +2.3 %)
+    M, C, K = np.eye(1), np.eye(1) * 2 * zeta * w, np.eye(1) * peak**2
+    lam, moved, rule = backbone_targets(data, M, C, K, (0, data.n_samples),
+                                        np.array([peak**2]))
+    assert moved.tolist() == [True] and "modes [1]" in rule
+    # the linear frequency to the backbone fit's first order (measured +0.21 %), not the peak
+    assert np.sqrt(lam[0]) == pytest.approx(w, rel=3e-3)
+    # a peak no mode pairs with (beyond 15 %) is kept as it is
+    lam2, moved2, _ = backbone_targets(data, M, C, K, (0, data.n_samples),
+                                       np.array([peak**2, (1.5 * w) ** 2]))
+    assert moved2.tolist() == [True, False] and lam2[1] == (1.5 * w) ** 2
+
+
+def test_eigen_backbone_acts_only_with_the_cubic_library(chain):
+    _, data = chain
+    m = SGDSINDy(epochs=2).fit(data)
+    assert not m.cubic_ and m.eigen_backbone_rule_ == "no cubic library"
+    off = SGDSINDy(epochs=2, eigen_backbone=False).fit(data)
+    assert np.array_equal(m.K_, off.K_) and np.array_equal(m.C_, off.C_)

@@ -62,6 +62,7 @@ MATRIX_CASES = {
     "decay_hold": ({}, False),
     "fit_tilt": ({}, False),
     "decay_backbone": ({"cubic": True, "data": "duffing"}, False),
+    "eigen_backbone": ({"cubic": True, "data": "duffing"}, False),
 }
 
 COEFFICIENT_CASES = {
