@@ -58,6 +58,12 @@ class Measurement:
         differences, :func:`testbed.numerics.noise.noise_std`).  A chain that low-passes the
         coordinates hides that noise from anyone differencing ``x`` (what is left is
         band-limited), so it declares it here.  None = not declared (estimate it from ``x``).
+    chain_poles : ndarray of complex, shape (n_poles,), optional
+        Poles [1/s] of the transients the signal chain's filters add to ``xdd`` after an impact
+        (one of each conjugate pair; a pole repeated ``m`` times also gives ``t^i exp(p t)``,
+        ``i < m``): a free decay through the chain is the structure's modes plus these terms in
+        unknown amounts (:func:`testbed.numerics.filters.chain_poles`).  A declared instrument
+        property, like ``passband``.  None = not declared.
     """
 
     fs: float
@@ -74,6 +80,7 @@ class Measurement:
     drift_basis: np.ndarray | None = None
     integration: str = "exact"
     noise_std: np.ndarray | None = None
+    chain_poles: np.ndarray | None = None
 
     @property
     def n_channels(self) -> int:

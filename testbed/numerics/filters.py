@@ -123,10 +123,69 @@ def elliptic_highpass(x: np.ndarray, fs: float, cutoff_hz: float, order: int = 4
     order = _check_design(cutoff_hz, fs, order, "high-pass")
     if not (0 < ripple_db < stop_db):
         raise ValueError(f"need 0 < ripple_db < stop_db, got ripple_db={ripple_db}, stop_db={stop_db}")
+    return _filtfilt(_highpass_sos(fs, cutoff_hz, order, ripple_db, stop_db),
+                     x - x.mean(axis=-1, keepdims=True))
+
+
+def _highpass_sos(fs: float, cutoff_hz: float, order: int, ripple_db: float, stop_db: float
+                  ) -> np.ndarray:
+    """Second-order sections of :func:`elliptic_highpass`'s design (one pass)."""
     from scipy import signal as ss
 
-    sos = ss.ellip(order, ripple_db, stop_db, cutoff_hz, btype="highpass", output="sos", fs=fs)
-    return _filtfilt(sos, x - x.mean(axis=-1, keepdims=True))
+    return ss.ellip(order, ripple_db, stop_db, cutoff_hz, btype="highpass", output="sos", fs=fs)
+
+
+def _lowpass_sos(fs: float, cutoff_hz: float, order: int) -> np.ndarray:
+    """Second-order sections of :func:`lowpass`'s design (one pass)."""
+    from scipy import signal as ss
+
+    return ss.butter(int(order), cutoff_hz, btype="lowpass", output="sos", fs=fs)
+
+
+def chain_poles(fs: float, highpass: tuple[float, int, float, float] | None = None,
+                highpass_passes: int = 2, lowpass: tuple[float, int] | None = None
+                ) -> np.ndarray:
+    """Continuous-time poles of the transients a zero-phase filter chain adds after an impact.
+
+    A zero-phase (forward-backward) filter's forward pass answers the onset of an impact
+    response with its own free response, ``sum_j d_j exp(p_j t)`` over its poles ``p_j``; the
+    backward pass only scales those terms (in reversed time they are growing exponentials, in
+    its steady state), and adds nothing after the onset.  So after an impact a record through
+    the chain is the structure's modes plus these terms in unknown amounts; a filter applied
+    ``m`` times gives ``t^i exp(p t)``, ``i < m``, for each of its poles.
+
+    Parameters
+    ----------
+    fs : float
+        Sample rate [Hz].
+    highpass : (cutoff_hz, order, ripple_db, stop_db), optional
+        The elliptic high-pass (:func:`elliptic_highpass`), None without one.
+    highpass_passes : int
+        How many times the signal went through it (:func:`integrate_acceleration`: 2).
+    lowpass : (cutoff_hz, order), optional
+        The Butterworth low-pass (:func:`lowpass`, applied once), None without one.
+
+    Returns
+    -------
+    ndarray of complex, shape (n_poles,)
+        ``fs log z`` [1/s] of each z-plane pole of the designs, one of each conjugate pair
+        (imaginary part >= 0), repeated once per pass.
+    """
+    from scipy import signal as ss
+
+    out: list[complex] = []
+    designs = []
+    if highpass is not None:
+        designs.append((_highpass_sos(fs, *highpass), highpass_passes))
+    if lowpass is not None:
+        designs.append((_lowpass_sos(fs, *lowpass), 1))
+    for sos, passes in designs:
+        z = ss.sos2zpk(sos)[1].astype(complex)
+        z = z[np.abs(z) > 0]  # a pole at z = 0 (an odd order's padding) is a delay, no transient
+        s = fs * np.log(z)
+        s = s[s.imag >= -1e-9 * np.abs(s)]
+        out += [complex(v.real, max(v.imag, 0.0)) for v in s] * passes
+    return np.asarray(out, dtype=complex)
 
 
 def lowpass(x: np.ndarray, fs: float, cutoff_hz: float, order: int = 8) -> np.ndarray:
@@ -155,10 +214,7 @@ def lowpass(x: np.ndarray, fs: float, cutoff_hz: float, order: int = 8) -> np.nd
     """
     x = _as_signal(x)
     order = _check_design(cutoff_hz, fs, order, "low-pass")
-    from scipy import signal as ss
-
-    sos = ss.butter(order, cutoff_hz, btype="lowpass", output="sos", fs=fs)
-    return _filtfilt(sos, x)
+    return _filtfilt(_lowpass_sos(fs, cutoff_hz, order), x)
 
 
 def integrate_acceleration(acc: np.ndarray, fs: float, highpass_hz: float, order: int = 4,
@@ -263,7 +319,7 @@ def lowpass_settling(fs: float, cutoff_hz: float, order: int = 8, tol: float = 0
     _check_cutoff(cutoff_hz, fs, "low-pass")
     from scipy import signal as ss
 
-    sos = ss.butter(int(order), cutoff_hz, btype="lowpass", output="sos", fs=fs)
+    sos = _lowpass_sos(fs, cutoff_hz, order)
     # the response has decayed far below 1e-6 of its peak after 100 periods of the cut-off
     half = int(np.ceil(100 * fs / cutoff_hz))
     imp = np.zeros(2 * half + 1)

@@ -349,7 +349,9 @@ def measure_structural(dataset: Dataset, cfg: Mapping[str, Any]) -> Measurement:
         the low-pass's response to the pulse has settled (:data:`LOWPASS_SETTLE_TOL`); ``prior`` a copy
         of ``dataset.prior``; ``passband`` ``(highpass_hz, lowpass_hz or fs / 2)`` [Hz];
         ``integration`` ``"trapezoid"`` (identifiers map their poles back from the bilinear
-        variable: see :attr:`testbed.core.measurement.Measurement.integration`).
+        variable: see :attr:`testbed.core.measurement.Measurement.integration`);
+        ``chain_poles`` the poles of the low-pass (once) and of the high-pass (twice), whose
+        transients follow the impact in ``xdd`` (:func:`testbed.numerics.filters.chain_poles`).
 
     Notes
     -----
@@ -416,7 +418,11 @@ def measure_structural(dataset: Dataset, cfg: Mapping[str, Any]) -> Measurement:
                        passband=(float(cfg["highpass_hz"]),
                                  float(cfg["lowpass_hz"]) if cfg["lowpass_hz"] > 0 else fs / 2.0),
                        drift_basis=drift_basis(acc.shape[1], fs, rest_from, hp_args),
-                       integration="trapezoid")
+                       integration="trapezoid",
+                       chain_poles=sig.chain_poles(
+                           fs, hp_args, 2,
+                           (cfg["lowpass_hz"], cfg["lowpass_order"]) if cfg["lowpass_hz"] > 0
+                           else None))
 
 
 def drift_basis(n_samples: int, fs: float, rest_from: int | None,
