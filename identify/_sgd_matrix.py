@@ -349,7 +349,8 @@ def backbone_targets(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndar
     rule : str
         What was replaced.
     """
-    lam = np.sort(np.asarray(lam_hat, dtype=float))
+    peaks = np.sort(np.asarray(lam_hat, dtype=float))
+    lam = peaks.copy()
     moved = np.zeros(lam.size, bool)
     target = eigen_targets(M, K, lam)
     dec = modal_decay(data, M, K, C, window, backbone=True)
@@ -360,7 +361,7 @@ def backbone_targets(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndar
         modes.append(int(k) + 1)
     if not modes:
         return lam, moved, "no paired mode's backbone decay fit hardens: the peaks"
-    f0 = np.sqrt(np.sort(np.asarray(lam_hat, dtype=float))[moved]) / (2.0 * np.pi)
+    f0 = np.sqrt(peaks[moved]) / (2.0 * np.pi)
     f1 = np.sqrt(lam[moved]) / (2.0 * np.pi)
     return lam, moved, (f"modes {modes}: peak -> backbone linear frequency "
                         + ", ".join(f"{a:.4g} -> {b:.4g} Hz" for a, b in zip(f0, f1, strict=True)))
