@@ -87,6 +87,25 @@ stays 0.2-3 % off, which the share check keeps from moving.  Issue bars (TRAC, M
 modes 1-2 within 1 %): sgd_sindy 5 -> 6 of 20 clean (member 014: mode 1 +1.59 -> +0.12 %,
 TRAC 0.962 -> 0.985), 2 -> 2 at 1 % noise; ls_sindy 8 -> 8 and 5 -> 5; no member lost.
 
+Mode 2's shift by mode 1's amplitude is not in the decay fits, and cannot be from one impact
+(issue #15, measured 2026-11-26, clean soft-base members 002, 003, 010, 012 through the true
+modes).  The base rotation is ``x_b = b_1 q_1 + b_2 q_2 + ...`` (mass-normalised modes), so the
+averaged cubic moment ``k3 x_b^3`` stiffens mode 2 by ``3 k3 b_2^2 b_1^2 A_1^2 / (4 w_2)`` (twice
+the self-term's ``3/8`` per unit ``A^2``), decaying as ``exp(-2 sigma_1 t)``.  The truth's cubic
+gives +1.11, +1.56, +1.04, +0.86 % of ``w_2`` at the window's start (the same formula's self-term
+of mode 1, +4.16, +3.11, +3.24, +2.27 %, agrees with mode 1's measured ``c``, +4.05, +3.81,
++4.66, +2.46 %); mode 2's backbone fit is off +0.96, +1.61, +0.52, +0.20 %, and with that cross
+term held at the truth's value -0.11, +0.15, -0.47, -0.62 %.  But mode 2 is gone within
+``3 / sigma_2`` (7-40 ms) while ``exp(-2 sigma_1 t)`` keeps 0.91-0.94 of its value: a cross term
+``c_21 exp(-2 sigma_1 t)`` fitted freely beside ``wd`` is all but a constant offset to it (phase
+sensitivities' cosine 0.99990-0.99996 under mode 2's energy, condition number 380-570 against 4.9
+for ``wd, c``), and the fit put ``wd`` +10.1, -5.5, +6.5, +23.8 % off.  Nor does the model's
+cubic predict it: the diagonal library ``K3 x^3`` (``x_j^3``, no ``x_i^2 x_j``) gives mode 2 a
+shift by mode 1's amplitude of -0.12 / +0.27 % (ls_sindy / sgd_sindy, member 003), +1.54 / +0.67
+(012), -1.05 / +0.31 (002), -1.75 / -0.47 % (010).  The linear mode 2 of such a member needs a
+record where mode 2 rings at two mode-1 amplitudes, or a library whose cubic carries the cross
+terms.
+
 Trapezoid integrals
 -------------------
 A model fitted to trapezoid-rule integrals (``data.integration == "trapezoid"``) has its poles
