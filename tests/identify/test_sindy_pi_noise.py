@@ -202,3 +202,22 @@ def test_recorded_rates_with_declared_noise_keep_the_strong_rule(clean):
     ref = SINDyPI().fit(noisy)
     assert m.formulation_ == "strong" and m.lhs_ is None and m.ridge_ == sp.RIDGE_EXACT
     np.testing.assert_array_equal(m.coef_, ref.coef_)
+
+
+def test_declared_chain_trims_a_column_filter_period_up_to_a_quarter_of_the_record():
+    # slow motion (0.16 Hz, the paper's sine) on a 10 s record: the 1.5 x band column filter's
+    # period exceeds EDGE_MAX_SHARE of the record; a declared chain gets the full period up to
+    # EDGE_MAX_SHARE_DERIVED, recorded rates keep EDGE_MAX_SHARE
+    fs = 200.0
+    t = np.arange(int(10 * fs)) / fs
+    x = np.stack([0.07 * np.cos(t + k) for k in range(4)])
+    x = x + 1e-2 * x.std(axis=1, keepdims=True) * np.random.default_rng(0).standard_normal(x.shape)
+    declared = np.full(4, 1e-2 * 0.07 / np.sqrt(2))
+    knobs, rule, est = sp.noise_knobs(x, fs, 0.2, {}, None, declared, (0.0, 0.8))
+    want = sp.EDGE_PERIODS / knobs["column_lowpass_hz"]
+    assert want > sp.EDGE_MAX_SHARE * 10.0
+    assert knobs["formulation"] == "strong"
+    assert knobs["edge_trim"] == pytest.approx(min(want, sp.EDGE_MAX_SHARE_DERIVED * 10.0))
+    assert knobs["edge_trim"] > sp.EDGE_MAX_SHARE * 10.0
+    rec, _, _ = sp.noise_knobs(x, fs, 0.2, {}, None, declared, None)
+    assert rec["edge_trim"] == pytest.approx(sp.EDGE_MAX_SHARE * 10.0)
