@@ -11,6 +11,7 @@ from identify import sindy_pi as sp
 from identify.sindy_pi import SINDyPI
 from testbed.core.errors import HyperparameterError
 from testbed.numerics.derivatives import lowpass_differentiate
+from testbed.pipeline.signal_chain import auto_edge_fit
 from testbed.numerics.noise import noise_std
 from testbed.scoring.equation_basis import evaluate_terms
 
@@ -149,7 +150,8 @@ def _chain_smoothed(clean, percent, cut=4.0):
     """Angles with ``percent`` % noise through the 4 Hz derivative chain, declaring the raw
     angles' noise std and the pass band as the mechanical signal chain does."""
     raw = _noisy(clean, percent).x
-    x, xd, xdd = lowpass_differentiate(raw, clean.fs, cut)
+    x, xd, xdd = lowpass_differentiate(raw, clean.fs, cut, 8,
+                                       auto_edge_fit(cut, clean.fs, raw.shape[1]))
     return dataclasses.replace(clean, x=x, xd=xd, xdd=xdd, noise_std=noise_std(raw),
                                passband=(0.0, cut))
 
@@ -164,14 +166,18 @@ def test_declared_noise_of_a_smoothing_chain_sets_the_rule(clean, percent):
     assert est["noise_rel"] == pytest.approx(percent / 100, rel=0.05)
     assert sp.noise_knobs(data.x, data.fs, 0.2, {})[2]["noise_rel"] <= sp.NOISE_FREE_REL
     assert "declared by the signal chain" in rule and "chain low-pass 4 Hz" in rule
-    assert knobs["formulation"] == "weak" and knobs["column_lowpass_hz"] == 0.0
+    # a declared chain: the strong form with the column low-pass and its trim (the weak form
+    # is kept for angles an undeclared chain smoothed)
+    assert knobs["formulation"] == "strong" and knobs["weak_window_s"] is None
+    assert knobs["column_lowpass_hz"] == pytest.approx(sp.CUTOFF_FACTOR * est["band_hz"])
+    assert knobs["edge_trim"] == pytest.approx(sp.EDGE_PERIODS / knobs["column_lowpass_hz"])
     assert knobs["ridge"] == pytest.approx(sp.RIDGE_PER_NOISE_VAR * est["noise_rel"] ** 2)
-    assert knobs["lhs"] == sp.LHS_INPUT_TERMS and knobs["edge_trim"] > 0
+    assert knobs["lhs"] == sp.LHS_INPUT_TERMS and "strong form" in rule
 
 
 def test_declared_noise_fit_writes_equations_for_the_input_terms(clean):
     m = SINDyPI().fit(_chain_smoothed(clean, 1.0))
-    assert m.formulation_ == "weak" and "declared by the signal chain" in m.noise_rule_
+    assert m.formulation_ == "strong" and "declared by the signal chain" in m.noise_rule_
     inputs = [n for n in m.feature_names_ if "*u1" in n or "*u2" in n]
     assert m.lhs_ == inputs and set(m.lhs_terms_) <= set(inputs)
     assert np.all(np.isfinite(m.validation_errors_)) and np.all(np.isfinite(m.coef_))
@@ -180,11 +186,11 @@ def test_declared_noise_fit_writes_equations_for_the_input_terms(clean):
 def test_declared_noise_rule_is_overridden_by_the_user(clean):
     data = _chain_smoothed(clean, 1.0)
     lhs = ["sin(th2-th3)*u1"]
-    user = {"formulation": "strong", "ridge": 1e-6, "lhs": lhs}
+    user = {"formulation": "weak", "ridge": 1e-6, "lhs": lhs}
     knobs, rule, est = sp.noise_knobs(data.x, data.fs, 0.2, user, None, data.noise_std,
                                       data.passband)
-    assert (knobs["formulation"], knobs["ridge"], knobs["lhs"]) == ("strong", 1e-6, lhs)
-    assert knobs["column_lowpass_hz"] == pytest.approx(sp.CUTOFF_FACTOR * est["band_hz"])
+    assert (knobs["formulation"], knobs["ridge"], knobs["lhs"]) == ("weak", 1e-6, lhs)
+    assert knobs["column_lowpass_hz"] == 0.0 and knobs["weak_window_s"] > 0
     assert "user setting: formulation, ridge, lhs" in rule
 
 
@@ -196,3 +202,22 @@ def test_recorded_rates_with_declared_noise_keep_the_strong_rule(clean):
     ref = SINDyPI().fit(noisy)
     assert m.formulation_ == "strong" and m.lhs_ is None and m.ridge_ == sp.RIDGE_EXACT
     np.testing.assert_array_equal(m.coef_, ref.coef_)
+
+
+def test_declared_chain_trims_a_column_filter_period_up_to_a_quarter_of_the_record():
+    # slow motion (0.16 Hz, the paper's sine) on a 10 s record: the 1.5 x band column filter's
+    # period exceeds EDGE_MAX_SHARE of the record; a declared chain gets the full period up to
+    # EDGE_MAX_SHARE_DERIVED, recorded rates keep EDGE_MAX_SHARE
+    fs = 200.0
+    t = np.arange(int(10 * fs)) / fs
+    x = np.stack([0.07 * np.cos(t + k) for k in range(4)])
+    x = x + 1e-2 * x.std(axis=1, keepdims=True) * np.random.default_rng(0).standard_normal(x.shape)
+    declared = np.full(4, 1e-2 * 0.07 / np.sqrt(2))
+    knobs, rule, est = sp.noise_knobs(x, fs, 0.2, {}, None, declared, (0.0, 0.8))
+    want = sp.EDGE_PERIODS / knobs["column_lowpass_hz"]
+    assert want > sp.EDGE_MAX_SHARE * 10.0
+    assert knobs["formulation"] == "strong"
+    assert knobs["edge_trim"] == pytest.approx(min(want, sp.EDGE_MAX_SHARE_DERIVED * 10.0))
+    assert knobs["edge_trim"] > sp.EDGE_MAX_SHARE * 10.0
+    rec, _, _ = sp.noise_knobs(x, fs, 0.2, {}, None, declared, None)
+    assert rec["edge_trim"] == pytest.approx(sp.EDGE_MAX_SHARE * 10.0)

@@ -77,3 +77,20 @@ def test_auto_cutoff_from_the_angles_band():
 def test_auto_is_the_only_word_cutoff_takes():
     with pytest.raises(ScenarioError):
         measure(dataset(0.0), {"derivatives": "lowpass", "cutoff_hz": "high"}, "mechanical")
+
+
+def test_auto_edge_fit_spans_the_stated_periods_of_the_cutoff():
+    from testbed.pipeline.signal_chain import EDGE_FIT_MAX_SHARE, EDGE_FIT_PERIODS, auto_edge_fit
+
+    ds = dataset(0.01)
+    raw = ds.measured["theta"].data
+    # the default is the rule: EDGE_FIT_PERIODS periods of the cut-off (1.6 / 5 Hz = 0.32 s)
+    m = measure(ds, {"derivatives": "lowpass", "cutoff_hz": 5.0}, "mechanical")
+    assert auto_edge_fit(5.0, ds.fs, raw.shape[1]) == pytest.approx(EDGE_FIT_PERIODS / 5.0)
+    ref = der.lowpass_differentiate(raw, ds.fs, 5.0, 8, EDGE_FIT_PERIODS / 5.0, 5)
+    np.testing.assert_array_equal(m.xd, ref[1])
+    # a given length is kept
+    m01 = measure(ds, {"derivatives": "lowpass", "cutoff_hz": 5.0, "edge_fit_s": 0.1}, "mechanical")
+    np.testing.assert_array_equal(m01.xd, der.lowpass_differentiate(raw, ds.fs, 5.0, 8, 0.1, 5)[1])
+    # a low cut-off on a short record: at most a quarter of it (4 s here)
+    assert auto_edge_fit(0.2, ds.fs, raw.shape[1]) == pytest.approx(EDGE_FIT_MAX_SHARE * 4.0)
