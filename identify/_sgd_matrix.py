@@ -542,7 +542,8 @@ class MatrixSGDSettings:
         full ``K3``.
     fit_tilt : bool or None
         Difference every row once (warm start and SGD): None = by rule (tilted, flat with the
-        cubic library or when the tilted warm start has a growing mode), True = tilted (a
+        cubic library or when the tilted warm start has a growing mode; with the cubic library
+        tilted on the linear columns when the flat warm start kept no x^3 term), True = tilted (a
         non-physical tilted warm start raises), False = flat.
     eigen_backbone : bool
         With the cubic library and a warm start that kept a cubic term, replace each hardening
