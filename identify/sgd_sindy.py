@@ -358,7 +358,10 @@ class SGDSINDy(SGDSINDyBase):
         fit band).  None (default): by rule, tilted unless the tilted warm start has a growing
         mode (:func:`identify.structural.check_physical`; then flat), flat with the cubic
         library (``ls_sindy``'s exclusion: a hardening response's peaks are not its linear
-        frequencies); True: tilted (a non-physical tilted warm start raises); False: flat.
+        frequencies) unless the flat warm start's lasso kept no ``x^3`` term (a linear
+        model: its linear columns are then fitted tilted, if that is physical; soft-base
+        family, cubic = true: member 015 clean, 011, 018 at 1 % noise gained issue #15's bars,
+        none lost); True: tilted (a non-physical tilted warm start raises); False: flat.
         ``fit_tilt_`` and ``fit_tilt_rule_`` say what was done and why.  See Notes.
 
     Notes

@@ -114,11 +114,33 @@ def test_deterministic_and_seeded(linear):
 
 
 def test_tilt_rule(linear, cubic_fits):
-    """fit_tilt=None: tilted on the linear library, flat with the cubic one."""
+    """fit_tilt=None: tilted on the linear library; with the cubic one flat when the warm start
+    keeps an x^3 term (the Duffing chain), tilted when its lasso kept none (the linear chain:
+    a linear model, so the linear rule)."""
     _, _, model = linear
     _, lin, _, duff = cubic_fits
     assert model.fit_tilt_ and "(rule)" in model.fit_tilt_rule_
-    assert not lin.fit_tilt_ and not duff.fit_tilt_ and "cubic" in duff.fit_tilt_rule_
+    assert lin.fit_tilt_ and "kept no x^3 term" in lin.fit_tilt_rule_
+    assert not np.any(lin.K3_)
+    assert not duff.fit_tilt_ and duff.fit_tilt_rule_ == "rule: cubic library, fitted flat"
+
+
+def test_cubic_library_without_cubic_term_keeps_flat_when_tilt_refused(monkeypatch):
+    """The cubic library's warm start with no x^3 term is tried tilted, and a non-physical
+    tilted warm start leaves it flat (the same model as fit_tilt=False), with the reason."""
+    import identify._sgd_matrix as sm
+    from testbed.core.errors import IdentificationError
+
+    data = bench.chain_measurement(bench.chain_system(coupled=True))
+    flat = SGDSINDy(epochs=4, cubic=True, fit_tilt=False).fit(data)
+
+    def refuse(*args, **kwargs):
+        raise IdentificationError("non-physical model: test")
+
+    monkeypatch.setattr(sm, "check_physical", refuse)
+    model = SGDSINDy(epochs=4, cubic=True).fit(data)
+    assert model.fit_tilt_ is False and "tilted refused: non-physical model: test" in model.fit_tilt_rule_
+    assert np.array_equal(model.coef_, flat.coef_)
 
 
 def test_tilt_falls_back_to_flat_when_non_physical(linear, monkeypatch):
