@@ -48,7 +48,7 @@ from typing import Any
 
 from testbed.core.budget import check_cost, check_steps
 from testbed.core.errors import RigError, ScenarioError
-from testbed.core.kinds import metric_names
+from testbed.core.kinds import metric_names, metric_range
 from testbed.core.schema import Field, validate_header, validate_table, validate_variant
 from testbed.pipeline.plugins import IDENTIFIERS, RIGS
 from testbed.pipeline.signal_chain import SIGNAL_SCHEMAS, check_signal
@@ -484,6 +484,14 @@ def _validate_score(table: Any, kind: str, file: str) -> dict[str, dict[str, flo
         if not isinstance(value, (int, float)) or isinstance(value, bool) \
                 or not math.isfinite(value):
             raise ScenarioError(file, f"score.{key}", value, "expected a finite number")
+        low, high = metric_range(base)
+        if not low <= value <= high:
+            raise ScenarioError(file, f"score.{key}", value,
+                                f"expected a number >= {low:g}" + (f" and <= {high:g}" if
+                                                                   math.isfinite(high) else "")
+                                + f": {base} takes values in that range, so this bar could "
+                                + ("never pass" if (bound == "max") == (value < low) else
+                                   "never fail"))
         out.setdefault(base, {})[bound] = float(value)
     for base, bounds in out.items():
         if "min" in bounds and "max" in bounds and bounds["min"] > bounds["max"]:

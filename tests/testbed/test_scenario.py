@@ -218,3 +218,17 @@ def test_identify_keeps_given_keys_only_with_floats_widened(tmp_path):
     sc = load_scenario(_write(tmp_path, GOOD + '[identify]\nmethod = "ls_sindy"\nrcond = 0\n'))
     assert sc.identify == {"method": "ls_sindy", "rcond": 0.0}
     assert isinstance(sc.identify["rcond"], float)
+
+
+@pytest.mark.parametrize(("bar", "value", "fragment"), [
+    ("trac_min", -1.0, "never fail"),            # TRAC >= 0 always: a bar that cannot bind
+    ("trac_min", 2.0, "never pass"),             # TRAC <= 1 always
+    ("mac_mode1_max", 1.5, "never fail"),
+    ("freq_error_mode1_max", -0.1, "never pass"),  # an error is >= 0
+    ("Kr_error_min", -5.0, "never fail"),
+])
+def test_score_bar_outside_the_scores_range_is_refused(tmp_path, bar, value, fragment):
+    p = _write(tmp_path, GOOD + f'[identify]\nmethod = "ls_sindy"\n[score]\n{bar} = {value}\n')
+    with pytest.raises(ScenarioError, match=re.escape(fragment)) as e:
+        load_scenario(p, check_cost=False)
+    assert e.value.key == f"score.{bar}" and e.value.value == value
