@@ -33,8 +33,8 @@ class _Parser(argparse.ArgumentParser):
         sys.exit(EXIT_USAGE)
 
 
-def _int_at_least(low: int) -> Callable[[str], int]:
-    """An argparse type: an integer >= ``low``, refused in one line otherwise."""
+def _int_at_least(low: int, high: int | None = None) -> Callable[[str], int]:
+    """An argparse type: an integer >= ``low`` (and <= ``high``), refused in one line otherwise."""
 
     def parse(text: str) -> int:
         try:
@@ -43,13 +43,23 @@ def _int_at_least(low: int) -> Callable[[str], int]:
             raise argparse.ArgumentTypeError(f"expected an integer >= {low}, got {text!r}") from None
         if value < low:
             raise argparse.ArgumentTypeError(f"expected an integer >= {low}, got {value}")
+        if high is not None and value > high:
+            raise argparse.ArgumentTypeError(f"expected an integer <= {high}, got {value}")
         return value
 
     return parse
 
 
-#: A noise seed: an integer >= 0 (numpy's generators take no negative seeds).
-_seed = _int_at_least(0)
+def _noise_seed(text: str) -> int:
+    """A noise seed, as a scenario's ``seed`` (:data:`testbed.pipeline.scenario.MAX_SEED`)."""
+    from testbed.pipeline.scenario import MAX_SEED
+
+    return _int_at_least(0, MAX_SEED)(text)
+
+
+#: A noise seed: an integer >= 0 (numpy's generators take no negative seeds) that fits the
+#: 64-bit integers datasets and results store.
+_seed = _noise_seed
 #: A worker count: an integer >= 1.
 _jobs = _int_at_least(1)
 

@@ -83,11 +83,15 @@ def shipped_dir(what: str) -> Path:
 #: Shipped scenario files, found by name (``$TESTBED_SCENARIOS`` overrides).
 SCENARIO_DIR = Path(os.environ.get("TESTBED_SCENARIOS", shipped_dir("scenarios")))
 
+#: Largest noise seed: seeds are stored as 64-bit signed integers (HDF5 dataset attributes,
+#: the results file's ``seed`` column), which hold at most 2**63 - 1.
+MAX_SEED = 2**63 - 1
+
 HEADER_SCHEMA = {
     "name": Field(str, doc="scenario name; must equal the file name without .toml",
                   pattern=NAME_PATTERN, pattern_doc=NAME_PATTERN_DOC),
     "rig": Field(str, doc="registered rig name (see `testbed list`)"),
-    "seed": Field(int, 0, min=0, doc="seed of the measurement noise"),
+    "seed": Field(int, 0, min=0, max=MAX_SEED, doc="seed of the measurement noise"),
     "description": Field(str, "", doc="one line for listings"),
     "tags": Field(list, [], item_type=str, doc="free tags for selecting scenarios"),
     "extends": Field(str, "", doc="scenario file this one starts from (relative path)"),

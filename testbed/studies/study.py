@@ -57,6 +57,7 @@ from testbed.pipeline.plugins import IDENTIFIERS, RIGS
 from testbed.pipeline.scenario import (
     NAME_PATTERN,
     NAME_PATTERN_DOC,
+    MAX_SEED,
     SCENARIO_DIR,
     Scenario,
     _check_stem,
@@ -82,7 +83,7 @@ STUDY_SCHEMA = {
                            "(may be empty when the study declares [families.<name>])"),
     "noise": Field(list, item_type=float, min_items=1, min=0.0, max=100.0, unit="% of channel RMS",
                    doc="sensor-noise levels; each replaces the scenario's [noise] rms_percent"),
-    "seeds": Field(list, item_type=int, min_items=1, min=0,
+    "seeds": Field(list, item_type=int, min_items=1, min=0, max=MAX_SEED,
                    doc="noise seeds; each replaces the scenario's seed"),
     "identifiers": Field(list, item_type=str, min_items=1, doc="registered identifier names"),
     "plugins": Field(list, [], item_type=str,

@@ -40,6 +40,9 @@ def one_error_line(err: str) -> str:
     (["run", "no_such_scenario"], "no scenario named 'no_such_scenario'; known: "),
     (["run", "--seed", "-3", "cantilever_stiff_impact"], "--seed: expected an integer >= 0, got -3"),
     (["generate", "--seed", "x", "cantilever_stiff_impact"], "--seed: expected an integer >= 0"),
+    # 2**63: datasets and results store seeds as 64-bit signed integers (was an internal error)
+    (["generate", "--seed", "9223372036854775808", "michaelis_menten", "-o", "{tmp}/x.h5"],
+     "--seed: expected an integer <= 9223372036854775807"),
     (["sweep", "--jobs", "0", "smoke"], "--jobs: expected an integer >= 1"),
     (["report", "{tmp}/no_such_run", "-o", "{tmp}/report"], "no such run folder or results file"),
     (["report", "{tmp}", "-o", "{tmp}/report"], "not a run folder"),

@@ -232,3 +232,11 @@ def test_score_bar_outside_the_scores_range_is_refused(tmp_path, bar, value, fra
     with pytest.raises(ScenarioError, match=re.escape(fragment)) as e:
         load_scenario(p, check_cost=False)
     assert e.value.key == f"score.{bar}" and e.value.value == value
+
+
+def test_a_seed_beyond_64_bits_is_refused(tmp_path):
+    # datasets (HDF5 attributes) and results (the seed column) store 64-bit signed integers:
+    # 2**63 used to pass validation and fail on saving the dataset
+    with pytest.raises(ScenarioError, match=r"'scenario\.seed': value 9223372036854775808"):
+        load_scenario(_write(tmp_path, GOOD.replace("seed = 1", "seed = 9223372036854775808")))
+    assert load_scenario(_write(tmp_path, GOOD.replace("seed = 1", f"seed = {2**63 - 1}"))).seed == 2**63 - 1
