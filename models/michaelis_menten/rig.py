@@ -33,7 +33,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from models import RIGS
-from models._base import ErrorFn, Rig
+from models._base import ErrorFn, Rig, check_two_samples
 from testbed.core.budget import Cost
 from testbed.core.dataset import Dataset, Signal
 from testbed.core.schema import Field
@@ -123,6 +123,7 @@ class MichaelisMentenRig(Rig):
         if not rig["Vmax"] > rig["jx"]:
             error("rig.Vmax", rig["Vmax"], f"expected above jx ({rig['jx']:g} mM/s): otherwise "
                                            "the influx outruns the enzyme and x grows without bound")
+        check_two_samples(simulation, error)
 
     @classmethod
     def measurement_shape(cls, rig: dict[str, Any]) -> tuple[int, int]:

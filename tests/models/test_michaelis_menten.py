@@ -61,3 +61,11 @@ def test_a_stiff_rate_law_is_refused_by_the_step_budget_naming_vmax():
         scenario_from_dict({"scenario": {"name": "x", "rig": "michaelis_menten"},
                             "rig": {"Vmax": 1e9}})
     scenario_from_dict({"scenario": {"name": "x", "rig": "michaelis_menten"}, "rig": {"Vmax": 1e3}})
+
+
+@pytest.mark.parametrize("simulation", [{"sample_rate": 1e-6}, {"duration": 1e-6}])
+def test_a_record_of_fewer_than_two_samples_is_refused(simulation):
+    # no sample at all was an internal error (IndexError) in the simulation
+    with pytest.raises(ScenarioError, match=r"'simulation\.duration'.*at least two samples"):
+        scenario_from_dict({"scenario": {"name": "x", "rig": "michaelis_menten"},
+                            "simulation": simulation})
