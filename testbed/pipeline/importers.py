@@ -485,6 +485,8 @@ def _read_sep005_file(path: Path) -> _Raw:
         content = json.loads(path.read_text())
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
         raise MeasuredDataError(path, f"not a SEP-005 JSON file ({type(e).__name__}: {e})") from None
+    except RecursionError:  # arrays nested thousands deep: no channel list of SEP-005
+        raise MeasuredDataError(path, "not a SEP-005 JSON file: nested too deeply") from None
     return _parse_sep005(path, content)
 
 
@@ -518,10 +520,15 @@ def _parse_sep005(path: Path, content: Any) -> _Raw:
                 raise MeasuredDataError(path, f"SEP-005 channel {name!r}: fs={f!r} is not a rate > 0 Hz")
             rates[name] = float(f)
         elif "time" in c:
-            t = np.asarray(c["time"], dtype=float)
+            try:
+                t = np.asarray(c["time"], dtype=float)
+            except (TypeError, ValueError):
+                raise MeasuredDataError(path, f"SEP-005 channel {name!r}: time values are not "
+                                              "numbers") from None
             if t.shape != data.shape:
-                raise MeasuredDataError(path, f"SEP-005 channel {name!r}: {t.size} times for "
-                                              f"{data.size} samples")
+                raise MeasuredDataError(path, f"SEP-005 channel {name!r}: time of shape {t.shape} "
+                                              f"for data of shape {data.shape}; expected one time "
+                                              "per sample")
             rates[name] = uniform_rate(path, t, f"channel {name!r} time")
         else:
             raise MeasuredDataError(path, f"SEP-005 channel {name!r} has neither fs nor time")

@@ -203,6 +203,14 @@ MALFORMED = [
      "neither fs nor time"),
     ("SEP-005 null", lambda d: write(d, "x.json", json.dumps(
         [{"name": "a", "data": [1, None], "unit_str": "m", "fs": 10}])), {}, "NaN"),
+    # were internal errors: ValueError converting the time, RecursionError in json
+    ("SEP-005 time text", lambda d: write(d, "x.json", json.dumps(
+        [{"name": "a", "data": [1, 2], "unit_str": "m", "time": "ab"}])), {}, "time values are not numbers"),
+    ("JSON nested deep", lambda d: write(d, "x.json", "[" * 100000 + "]" * 100000), {},
+     "nested too deeply"),
+    ("SEP-005 time shape", lambda d: write(d, "x.json", json.dumps(
+        [{"name": "a", "data": [1, 2], "unit_str": "m", "time": [[0], [1]]}])), {},
+     "time of shape (2, 1) for data of shape (2,)"),
     ("garbage UFF", lambda d: write(d, "x.uff", "    -1\n    58\nnot a record\n    -1\n"), {}, "UFF"),
     ("not UFF", lambda d: write(d, "x.uff", "hello\n"), {}, "not a complete UFF file"),
     ("UFF without 58", lambda d: units_only_uff(d / "u.uff"), {}, "no UFF58"),
