@@ -179,8 +179,14 @@ class ImportedData:
         ------
         MeasuredDataError
             If a group names an unknown channel, mixes units, or has positions for only
-            some of its channels.
+            some of its channels, or a declared prior is not a finite number > 0.
         """
+        for key, value in dict(prior or {}).items():
+            # every prior an identifier reads is a size: a mass [kg] or a length [m]
+            if isinstance(value, bool) or not isinstance(value, (int, float)) \
+                    or not (math.isfinite(value) and value > 0):
+                raise MeasuredDataError(self.source, f"prior {key}={value!r}: expected a finite "
+                                                     "number > 0 (a mass [kg] or a length [m])")
         if groups is None:
             grouped: dict[str, list[str]] = {}
             for name in self.signals:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import math
 
 import numpy as np
 import pytest
@@ -279,3 +280,12 @@ def test_truncated_uff_export(beam, tmp_path):
     cut.write_bytes(out.read_bytes()[: out.stat().st_size // 2])
     with pytest.raises(MeasuredDataError, match=r"cut\.uff: not a complete UFF file"):
         read_measured(cut)
+
+
+@pytest.mark.parametrize("value", [math.nan, math.inf, -1.0, 0.0])
+def test_a_declared_prior_that_is_not_a_positive_size_is_refused(value):
+    # `testbed identify --prior total_mass=nan` used to fit and write a model
+    data = from_sep005([{"name": "a", "data": [1.0, 2.0], "unit_str": "m", "fs": 1.0}])
+    with pytest.raises(MeasuredDataError, match=r"prior total_mass=.*expected a finite number > 0"):
+        data.to_dataset(prior={"total_mass": value})
+    assert data.to_dataset(prior={"total_mass": 0.7}).prior["total_mass"] == 0.7
