@@ -249,7 +249,12 @@ def study_from_dict(raw: dict[str, Any], *, file: str = "<dict>", base: Path | N
 
     families = tuple(parse_family(n, t, file=file, base_dir=base) for n, t in fam_table.items())
     for fam in families:
-        scenarios.extend(family_members(fam))
+        try:
+            scenarios.extend(family_members(fam))
+        except ScenarioError as e:  # no member drawn: the study file's ranges, named as such
+            if not e.file.startswith("<family"):
+                raise
+            raise ScenarioError(file, e.key, e.value, e.allowed) from None
     params = _validate_params(raw.get("identifiers", {}), head["identifiers"], file)
     thresholds = _validate_thresholds(raw.get("thresholds", {}), head["identifiers"], file)
     study = Study(name=head["name"], description=head["description"], scenarios=tuple(scenarios),
