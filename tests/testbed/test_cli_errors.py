@@ -62,6 +62,19 @@ def one_error_line(err: str) -> str:
     (["sweep", "no_such_study"], "no study named 'no_such_study'; known: "),
     (["cache", "ls", "--cache", "{tmp}/text.txt"], "--cache"),
     (["run", "cantilever_stiff_impact", "--cache", "{tmp}/text.txt"], "not a folder"),
+    # output paths are checked before any work (were OSErrors after it, naming no option)
+    (["generate", "michaelis_menten", "-o", "{tmp}"], "--output {tmp}: is a folder"),
+    (["run", "michaelis_menten", "--out", "{tmp}/text.txt"], "--out {tmp}/text.txt: exists and is not a folder"),
+    (["report", "{tmp}", "-o", "{tmp}/text.txt"], "--output {tmp}/text.txt: exists and is not a folder"),
+    (["sweep", "smoke", "--results", "{tmp}"], "--results {tmp}: is a folder"),
+    (["family", "write", "smoke", "-o", "{tmp}/text.txt"], "--out {tmp}/text.txt: exists and is not a folder"),
+    (["demo", "--out", "{tmp}/text.txt"], "--out {tmp}/text.txt: exists and is not a folder"),
+    (["runs", "ls", "-o", "{tmp}/text.txt"], "--out {tmp}/text.txt: not a folder"),
+    (["identify", "{tmp}/text.txt", "--kind", "structural", "--method", "ls_sindy", "-o",
+      "{tmp}/text.txt/m.json"], "{tmp}/text.txt is a file, not a folder"),
+    # nothing the user gave is overwritten
+    (["identify", "{tmp}/text.txt", "--kind", "structural", "--method", "ls_sindy", "-o",
+      "{tmp}/text.txt"], "is the input file"),
 ])
 def test_user_mistakes_give_one_line_and_status_2(tmp_path, capsys, argv, fragment):
     (tmp_path / "text.txt").write_text("not a dataset\n")
@@ -72,7 +85,7 @@ def test_user_mistakes_give_one_line_and_status_2(tmp_path, capsys, argv, fragme
         sys.exit(main(argv))
     assert exc.value.code == EXIT_USAGE
     captured = capsys.readouterr()
-    assert fragment in one_error_line(captured.err), captured.err
+    assert fragment.replace("{tmp}", str(tmp_path)) in one_error_line(captured.err), captured.err
 
 
 def test_internal_error_is_one_line_and_debug_reraises(monkeypatch, capsys):
@@ -121,3 +134,30 @@ def test_real_command_on_a_sample_of_the_corpus(tmp_path):
         assert name in line, line
         assert out == "", out
     assert not (tmp_path / "runs").exists()  # refused before anything was run or written
+
+
+def test_export_onto_its_own_dataset_is_refused_and_the_dataset_kept(tmp_path, capsys):
+    # `testbed export x.h5 --format uff -o x.h5` used to replace the dataset with the UFF file
+    h5 = tmp_path / "mm.h5"
+    assert main(["generate", "michaelis_menten", "--no-cache", "-o", str(h5)]) == 0
+    before = h5.read_bytes()
+    capsys.readouterr()
+    assert main(["export", str(h5), "--format", "uff", "-o", str(h5)]) == EXIT_USAGE
+    assert "is the input file" in one_error_line(capsys.readouterr().err)
+    assert h5.read_bytes() == before
+
+
+def test_a_rig_that_cannot_simulate_the_scenario_names_its_file(tmp_path, monkeypatch, capsys):
+    # e.g. a five-bar whose RK4 diverges under a 1e6 N m torque: the error named no file
+    from testbed.core.errors import RigError
+    from testbed.pipeline.scenario import SCENARIO_DIR
+    from testbed.scoring import run
+
+    def diverges(*args, **kwargs):
+        raise RigError("fivebar (pinocchio): the simulation diverged")
+
+    monkeypatch.setattr(run, "run_scenario", diverges)
+    assert main(["run", "michaelis_menten", "--no-figures", "--out", str(tmp_path)]) == EXIT_USAGE
+    line = one_error_line(capsys.readouterr().err)
+    assert line == f"error: {SCENARIO_DIR / 'michaelis_menten.toml'}: fivebar (pinocchio): the " \
+                   "simulation diverged"
