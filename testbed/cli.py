@@ -12,6 +12,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import dataclasses
+import os
 import socket
 import sys
 from collections.abc import Callable, Iterator
@@ -119,9 +120,16 @@ def _output_folder(path: Path, option: str) -> Path:
 
 
 def _cache_folder(cache: str | None) -> str | None:
-    """A ``--cache`` folder (created on use) must not be an existing file."""
+    """A ``--cache`` folder, or without one ``$TESTBED_CACHE`` (created on use), must not be an
+    existing file."""
+    from testbed.pipeline.cache import default_cache_dir
+
     if cache is not None and Path(cache).exists() and not Path(cache).is_dir():
         raise InputError(f"--cache {cache}: not a folder")
+    if cache is None and default_cache_dir().exists() and not default_cache_dir().is_dir():
+        where = "$TESTBED_CACHE" if os.environ.get("TESTBED_CACHE") else "the default cache"
+        raise InputError(f"{where} {default_cache_dir()}: not a folder; expected the dataset "
+                         "cache folder")
     return cache
 
 

@@ -161,3 +161,11 @@ def test_a_rig_that_cannot_simulate_the_scenario_names_its_file(tmp_path, monkey
     line = one_error_line(capsys.readouterr().err)
     assert line == f"error: {SCENARIO_DIR / 'michaelis_menten.toml'}: fivebar (pinocchio): the " \
                    "simulation diverged"
+
+
+def test_a_testbed_cache_that_is_a_file_is_refused_naming_the_variable(tmp_path, monkeypatch, capsys):
+    # was "[Errno 17] File exists" after the simulation, naming no setting
+    (tmp_path / "text.txt").write_text("x\n")
+    monkeypatch.setenv("TESTBED_CACHE", str(tmp_path / "text.txt"))
+    assert main(["run", "michaelis_menten", "--no-figures", "--out", str(tmp_path / "o")]) == EXIT_USAGE
+    assert f"$TESTBED_CACHE {tmp_path / 'text.txt'}: not a folder" in one_error_line(capsys.readouterr().err)
