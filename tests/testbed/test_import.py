@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 
 import numpy as np
 import pytest
@@ -289,3 +290,28 @@ def test_a_declared_prior_that_is_not_a_positive_size_is_refused(value):
     with pytest.raises(MeasuredDataError, match=r"prior total_mass=.*expected a finite number > 0"):
         data.to_dataset(prior={"total_mass": value})
     assert data.to_dataset(prior={"total_mass": 0.7}).prior["total_mass"] == 0.7
+
+
+def _beam_channels(acc, positions=(0.1, 0.2, 0.3)):
+    """SEP-005 channels of a 3-sensor beam record (acc: (3, n) [m/s^2]) with a hammer at 0.3 m."""
+    n = acc.shape[1]
+    force = np.zeros(n)
+    force[5:8] = 1.0
+    return [{"name": f"acceleration/a{i}", "data": acc[i], "unit_str": "m/s^2", "fs": 1000.0,
+             "position_m": p} for i, p in enumerate(positions)] + \
+           [{"name": "force/hammer", "data": force, "unit_str": "N", "fs": 1000.0, "position_m": 0.3}]
+
+
+@pytest.mark.parametrize(("acc", "positions", "words"), [
+    # were fitted and written with exit 0 (zero stiffness, NaN damping ratios) or crashed
+    # inside an identifier (ZeroDivisionError, LinAlgError)
+    (np.zeros((3, 400)), (0.1, 0.2, 0.3), "do not move"),
+    (np.ones((3, 400)), (0.1, 0.2, 0.3), "do not move"),
+    (1e-300 * np.sin(np.arange(400.0))[None].repeat(3, 0), (0.1, 0.2, 0.3), "do not move"),
+    (1e300 * np.sin(np.arange(400.0))[None].repeat(3, 0), (0.1, 0.2, 0.3), "expected at most 1e+50"),
+    (np.sin(np.arange(400.0))[None].repeat(3, 0), (0.2, 0.2, 0.2), "share a position"),
+])
+def test_a_record_with_nothing_to_identify_is_refused(tmp_path, acc, positions, words):
+    path = write(tmp_path, "x.json", json.dumps(_beam_channels(acc, positions), default=list))
+    with pytest.raises(MeasuredDataError, match=re.escape(words)):
+        measurement_from_file(path, "structural")
