@@ -300,8 +300,8 @@ def cmd_run(args: argparse.Namespace) -> int:
     _output_folder(Path(args.out), "--out")
     cache = None if args.no_cache else DatasetCache(_cache_folder(args.cache))
     ok = True
-    for name in args.scenario:
-        sc = load_scenario(name)
+    scenarios = [load_scenario(name) for name in args.scenario]  # every file checked first
+    for sc in scenarios:
         if args.seed is not None:
             sc = sc.replace(seed=args.seed)
         scenario_folder(args.out, sc.name)  # refused before the work, not after
@@ -439,8 +439,11 @@ def cmd_identify(args: argparse.Namespace) -> int:
     _load_plugins(args)
     units = None
     if args.units:
-        units = _key_values(args.units, "--units", numbers=False) if "=" in args.units[0] \
-            else args.units[0]
+        per_channel = ["=" in u for u in args.units]
+        if any(per_channel) and not all(per_channel) or (not any(per_channel) and len(args.units) > 1):
+            raise InputError(f"--units {' '.join(args.units)}: expected one unit for every channel "
+                             "(--units g) or one CHANNEL=UNIT per option, not both or several units")
+        units = _key_values(args.units, "--units", numbers=False) if per_channel[0] else args.units[0]
     data = _existing_file(Path(args.data), "a measured-data file (UFF58, SEP-005 JSON, CSV or HDF5)")
     out = _output_file(Path(args.output or f"{data.stem}.model.json"), "--output", inputs=(data,))
     _output_file(out.with_suffix(".md"), "--output (its .md report)", inputs=(data,))

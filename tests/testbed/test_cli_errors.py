@@ -72,6 +72,11 @@ def one_error_line(err: str) -> str:
     (["runs", "ls", "-o", "{tmp}/text.txt"], "--out {tmp}/text.txt: not a folder"),
     (["identify", "{tmp}/text.txt", "--kind", "structural", "--method", "ls_sindy", "-o",
       "{tmp}/text.txt/m.json"], "{tmp}/text.txt is a file, not a folder"),
+    # a later unit was silently ignored
+    (["identify", "{tmp}/text.txt", "--kind", "structural", "--method", "ls_sindy", "--units", "g",
+      "--units", "a=mm"], "--units g a=mm: expected one unit for every channel"),
+    # every scenario is checked before the first runs (the first one ran, then the error)
+    (["run", "michaelis_menten", "{tmp}/no_such.toml", "--out", "{tmp}/o"], "no such scenario file"),
     # nothing the user gave is overwritten
     (["identify", "{tmp}/text.txt", "--kind", "structural", "--method", "ls_sindy", "-o",
       "{tmp}/text.txt"], "is the input file"),
