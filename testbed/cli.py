@@ -440,7 +440,7 @@ def cmd_identify(args: argparse.Namespace) -> int:
     units = None
     if args.units:
         per_channel = ["=" in u for u in args.units]
-        if any(per_channel) and not all(per_channel) or (not any(per_channel) and len(args.units) > 1):
+        if (any(per_channel) and not all(per_channel)) or (not any(per_channel) and len(args.units) > 1):
             raise InputError(f"--units {' '.join(args.units)}: expected one unit for every channel "
                              "(--units g) or one CHANNEL=UNIT per option, not both or several units")
         units = _key_values(args.units, "--units", numbers=False) if per_channel[0] else args.units[0]

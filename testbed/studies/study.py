@@ -55,9 +55,9 @@ from testbed.core.registry import import_plugin
 from testbed.core.schema import Field, validate_header
 from testbed.pipeline.plugins import IDENTIFIERS, RIGS
 from testbed.pipeline.scenario import (
+    MAX_SEED,
     NAME_PATTERN,
     NAME_PATTERN_DOC,
-    MAX_SEED,
     SCENARIO_DIR,
     Scenario,
     _check_stem,
