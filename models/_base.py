@@ -135,5 +135,20 @@ def check_sample_steps(simulation: dict[str, Any], error: ErrorFn) -> None:
         error("simulation.sample_rate", simulation["sample_rate"],
               f"1/(sample_rate * dt) must be a whole number >= 1 (dt = {simulation['dt']:g} s gives "
               f"{ratio:.6g}): samples and input holds fall on integration steps")
+    check_two_samples(simulation, error)
+
+
+def check_two_samples(simulation: dict[str, Any], error: ErrorFn) -> None:
+    """A record of at least two samples: ``round(duration * sample_rate) >= 2``.
+
+    Parameters
+    ----------
+    simulation : dict
+        The scenario's ``[simulation]`` table with ``sample_rate`` [Hz] and ``duration`` [s].
+    error : callable
+        ``error(key, value, allowed)``.
+    """
     if round(simulation["duration"] * simulation["sample_rate"]) < 2:
-        error("simulation.duration", simulation["duration"], "expected at least two samples")
+        error("simulation.duration", simulation["duration"],
+              f"expected at least two samples (duration x sample_rate = "
+              f"{simulation['duration'] * simulation['sample_rate']:.3g})")

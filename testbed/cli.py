@@ -10,10 +10,12 @@ a traceback.  A bug prints one line saying it is an internal error and exits wit
 from __future__ import annotations
 
 import argparse
+import contextlib
 import dataclasses
+import os
 import socket
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from urllib.parse import urlsplit
 
@@ -33,8 +35,8 @@ class _Parser(argparse.ArgumentParser):
         sys.exit(EXIT_USAGE)
 
 
-def _int_at_least(low: int) -> Callable[[str], int]:
-    """An argparse type: an integer >= ``low``, refused in one line otherwise."""
+def _int_at_least(low: int, high: int | None = None) -> Callable[[str], int]:
+    """An argparse type: an integer >= ``low`` (and <= ``high``), refused in one line otherwise."""
 
     def parse(text: str) -> int:
         try:
@@ -43,13 +45,23 @@ def _int_at_least(low: int) -> Callable[[str], int]:
             raise argparse.ArgumentTypeError(f"expected an integer >= {low}, got {text!r}") from None
         if value < low:
             raise argparse.ArgumentTypeError(f"expected an integer >= {low}, got {value}")
+        if high is not None and value > high:
+            raise argparse.ArgumentTypeError(f"expected an integer <= {high}, got {value}")
         return value
 
     return parse
 
 
-#: A noise seed: an integer >= 0 (numpy's generators take no negative seeds).
-_seed = _int_at_least(0)
+def _noise_seed(text: str) -> int:
+    """A noise seed, as a scenario's ``seed`` (:data:`testbed.pipeline.scenario.MAX_SEED`)."""
+    from testbed.pipeline.scenario import MAX_SEED
+
+    return _int_at_least(0, MAX_SEED)(text)
+
+
+#: A noise seed: an integer >= 0 (numpy's generators take no negative seeds) that fits the
+#: 64-bit integers datasets and results store.
+_seed = _noise_seed
 #: A worker count: an integer >= 1.
 _jobs = _int_at_least(1)
 
@@ -62,10 +74,62 @@ def _existing_file(path: Path, what: str) -> Path:
     return path
 
 
+def _writable_in(path: Path, option: str, start: Path) -> None:
+    """Refuse ``path`` unless a file can be created in ``start`` or, if it does not exist yet,
+    its nearest existing parent folder.
+
+    Probed by creating (and removing) a temporary file there: permission bits alone do not
+    tell root that ``/proc`` or a read-only mount refuses it.
+    """
+    import tempfile
+
+    folder = start
+    while not folder.exists() and folder != folder.parent:
+        folder = folder.parent
+    if not folder.is_dir():
+        raise InputError(f"{option} {path}: {folder} is a file, not a folder; expected a path in "
+                         "a folder you can write")
+    try:
+        with tempfile.TemporaryFile(dir=folder):
+            pass
+    except OSError as e:
+        raise InputError(f"{option} {path}: cannot write in {folder} "
+                         f"({e.strerror or type(e).__name__}); expected a path in a folder you "
+                         "can write") from None
+
+
+def _output_file(path: Path, option: str, *, inputs: tuple[Path, ...] = ()) -> Path:
+    """A file a command will write, checked before any work: not a folder, not one of its
+    ``inputs`` (nothing the user gave is overwritten), in a folder that can be written."""
+    if path.is_dir():
+        raise InputError(f"{option} {path}: is a folder; expected a file path")
+    for given in inputs:
+        if path.resolve() == given.resolve():
+            raise InputError(f"{option} {path}: is the input file; expected another path (the "
+                             "input would be overwritten)")
+    _writable_in(path, option, path.parent)
+    return path
+
+
+def _output_folder(path: Path, option: str) -> Path:
+    """A folder a command will write into (created on use), checked before any work."""
+    if path.exists() and not path.is_dir():
+        raise InputError(f"{option} {path}: exists and is not a folder; expected a folder")
+    _writable_in(path, option, path)
+    return path
+
+
 def _cache_folder(cache: str | None) -> str | None:
-    """A ``--cache`` folder (created on use) must not be an existing file."""
+    """A ``--cache`` folder, or without one ``$TESTBED_CACHE`` (created on use), must not be an
+    existing file."""
+    from testbed.pipeline.cache import default_cache_dir
+
     if cache is not None and Path(cache).exists() and not Path(cache).is_dir():
         raise InputError(f"--cache {cache}: not a folder")
+    if cache is None and default_cache_dir().exists() and not default_cache_dir().is_dir():
+        where = "$TESTBED_CACHE" if os.environ.get("TESTBED_CACHE") else "the default cache"
+        raise InputError(f"{where} {default_cache_dir()}: not a folder; expected the dataset "
+                         "cache folder")
     return cache
 
 
@@ -107,6 +171,9 @@ def _run_folder(path: Path) -> Path:
 
     try:
         load_run(path)
+    except ValueError as e:  # load_run's own checks (a JSONDecodeError is one too) say what
+        raise InputError(f"{path}: not a run folder written by `testbed run` "
+                         f"({type(e).__name__}: {_one_line(e)[:200]})") from None
     except Exception as e:  # any failure to read the user's folder is a property of the folder
         raise InputError(f"{path}: not a run folder written by `testbed run` "
                          f"({type(e).__name__})") from None
@@ -135,6 +202,18 @@ def check_dask_address(address: str) -> None:
     except OSError as e:
         raise InputError(f"--dask {address!r}: cannot reach a Dask scheduler there "
                          f"({e.strerror or type(e).__name__})") from None
+
+
+@contextlib.contextmanager
+def _rig_errors_name(sc) -> Iterator[None]:
+    """A rig that cannot simulate the scenario's parameters (it diverged, the beam did not move)
+    is the scenario file's problem: its error names the file."""
+    from testbed.core.errors import RigError
+
+    try:
+        yield
+    except RigError as e:
+        raise RigError(f"{sc.path or sc.name}: {e}") from None
 
 
 def _progress():
@@ -196,11 +275,12 @@ def cmd_generate(args: argparse.Namespace) -> int:
     sc = load_scenario(args.scenario)
     if args.seed is not None:
         sc = sc.replace(seed=args.seed)
+    out = _output_file(Path(args.output or f"{sc.name}-seed{sc.seed}.h5"), "--output")
     with _progress()(f"generating {sc.name}") as bar:
         # through the run cache unless --no-cache: a later `testbed run` of it simulates nothing
         cache = None if args.no_cache else DatasetCache(_cache_folder(args.cache))
-        ds = generate(sc, progress=bar) if cache is None else cache.get(sc, bar)
-    out = Path(args.output or f"{sc.name}-seed{sc.seed}.h5")
+        with _rig_errors_name(sc):
+            ds = generate(sc, progress=bar) if cache is None else cache.get(sc, bar)
     ds.save(out)
     print_truth_summary(ds)
     print(f"wrote {out} (content hash {ds.attrs['content_hash'][:16]})")
@@ -217,15 +297,17 @@ def cmd_run(args: argparse.Namespace) -> int:
     from testbed.studies.runstore import INDEX, save_new_run, scenario_folder
 
     _load_plugins(args)
+    _output_folder(Path(args.out), "--out")
     cache = None if args.no_cache else DatasetCache(_cache_folder(args.cache))
     ok = True
-    for name in args.scenario:
-        sc = load_scenario(name)
+    scenarios = [load_scenario(name) for name in args.scenario]  # every file checked first
+    for sc in scenarios:
         if args.seed is not None:
             sc = sc.replace(seed=args.seed)
         scenario_folder(args.out, sc.name)  # refused before the work, not after
         with run_progress(sc.name) as phase:
-            result = run_scenario(sc, cache=cache, phase=phase)
+            with _rig_errors_name(sc):
+                result = run_scenario(sc, cache=cache, phase=phase)
             figures = None if args.no_figures else save_run_figures_and_report
             with phase("figures" if figures else "save"):
                 run_dir = save_new_run(result, args.out, figures=figures, index=runs_index_html)
@@ -240,6 +322,7 @@ def cmd_report(args: argparse.Namespace) -> int:
     from testbed.studies.runstore import RunStoreError, resolve_run
 
     source = Path(args.source)
+    _output_folder(Path(args.output), "--output")
     if source.is_file():
         _results_file(source)
     else:
@@ -258,8 +341,10 @@ def cmd_report(args: argparse.Namespace) -> int:
 def cmd_export(args: argparse.Namespace) -> int:
     from testbed.reporting.export import export_dataset
 
-    out = Path(args.output) if args.output else None
-    for p in export_dataset(_dataset_file(Path(args.dataset)), args.format, out):
+    data = _dataset_file(Path(args.dataset))
+    default = data.with_suffix(".uff" if args.format == "uff" else ".sep005.json")
+    out = _output_file(Path(args.output) if args.output else default, "--output", inputs=(data,))
+    for p in export_dataset(data, args.format, out):
         print(f"wrote {p}")
     return 0
 
@@ -273,6 +358,8 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     if extra:  # the workers import them too
         study = dataclasses.replace(study, plugins=tuple(dict.fromkeys(study.plugins + extra)))
     stats = SweepStats()
+    if args.results:
+        _output_file(Path(args.results), "--results")
     if args.dask:
         check_dask_address(args.dask)
     try:
@@ -300,7 +387,8 @@ def cmd_summary(args: argparse.Namespace) -> int:
 def cmd_family(args: argparse.Namespace) -> int:
     from testbed.studies.study import load_study, write_family
 
-    paths = write_family(load_study(args.study), Path(args.out), family=args.family)
+    out = _output_folder(Path(args.out), "--out")
+    paths = write_family(load_study(args.study), out, family=args.family)
     print(f"wrote {len(paths)} member scenario(s) to {args.out}; rerun one with "
           f"`testbed run {paths[0] if paths else args.out}`")
     return 0
@@ -343,6 +431,7 @@ def _key_values(items: list[str] | None, option: str, *, numbers: bool) -> dict:
 def cmd_identify(args: argparse.Namespace) -> int:
     import json
 
+    from testbed.core.atomic import atomic_write_text
     from testbed.pipeline.fit import identify_file
     from testbed.reporting.identified import render_identified
     from testbed.reporting.progress import run_progress
@@ -350,20 +439,24 @@ def cmd_identify(args: argparse.Namespace) -> int:
     _load_plugins(args)
     units = None
     if args.units:
-        units = _key_values(args.units, "--units", numbers=False) if "=" in args.units[0] \
-            else args.units[0]
+        per_channel = ["=" in u for u in args.units]
+        if (any(per_channel) and not all(per_channel)) or (not any(per_channel) and len(args.units) > 1):
+            raise InputError(f"--units {' '.join(args.units)}: expected one unit for every channel "
+                             "(--units g) or one CHANNEL=UNIT per option, not both or several units")
+        units = _key_values(args.units, "--units", numbers=False) if per_channel[0] else args.units[0]
     data = _existing_file(Path(args.data), "a measured-data file (UFF58, SEP-005 JSON, CSV or HDF5)")
+    out = _output_file(Path(args.output or f"{data.stem}.model.json"), "--output", inputs=(data,))
+    _output_file(out.with_suffix(".md"), "--output (its .md report)", inputs=(data,))
     with run_progress(data.name) as phase:
         result = identify_file(data, scenario=args.scenario, kind=args.kind, method=args.method,
                                params=_key_values(args.param, "--param", numbers=False),
                                format=args.format, fs=args.fs, units=units,
                                prior=_key_values(args.prior, "--prior", numbers=True), phase=phase)
     summary = result.summary()
-    out = Path(args.output or f"{Path(args.data).stem}.model.json")
-    out.parent.mkdir(parents=True, exist_ok=True)
-    out.write_text(json.dumps(summary, indent=1, allow_nan=True) + "\n")
+    text = json.dumps(summary, indent=1, allow_nan=True) + "\n"
     report = render_identified(summary)
-    out.with_suffix(".md").write_text(report)
+    atomic_write_text(out, text)
+    atomic_write_text(out.with_suffix(".md"), report)
     print(report, end="")
     print(f"model written to {out} (report {out.with_suffix('.md')})")
     return 0
@@ -372,6 +465,9 @@ def cmd_identify(args: argparse.Namespace) -> int:
 def cmd_runs(args: argparse.Namespace) -> int:
     from testbed.studies.runstore import list_runs
 
+    if Path(args.out).exists() and not Path(args.out).is_dir():
+        raise InputError(f"--out {args.out}: not a folder; expected the folder of runs "
+                         "(from `testbed run --out`)")
     runs = list_runs(args.out, scenario=args.scenario)
     cols = ("scenario", "seed", "time (UTC)", "identifier", "verdict", "path")
     rows = [(r["scenario"], str(r["seed"]), r["created"].replace("+00:00", "Z"), r["identifier"],
@@ -399,7 +495,7 @@ def cmd_runs(args: argparse.Namespace) -> int:
 def cmd_demo(args: argparse.Namespace) -> int:
     from testbed.reporting.demo import run_demo
 
-    return run_demo(Path(args.out))
+    return run_demo(_output_folder(Path(args.out), "--out"))
 
 
 def build_parser() -> argparse.ArgumentParser:

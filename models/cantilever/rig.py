@@ -23,10 +23,11 @@ from typing import Any, ClassVar
 import numpy as np
 
 from models import RIGS
-from models._base import ErrorFn, Rig
+from models._base import ErrorFn, Rig, check_two_samples
 from models.cantilever.beam import BeamParams
 from models.cantilever.model import CantileverModel, build_model, hit_position, sensor_positions
 from models.cantilever.simulate import (
+    MUJOCO_MAX_CONTROL,
     half_sine,
     mode_errors,
     rollout_sensors,
@@ -176,8 +177,11 @@ class CantileverRig(Rig):
         if simulation["timestep"] > period:
             error("simulation.timestep", simulation["timestep"],
                   f"allowed: at most the sample period {period:.6g} s")
-        if simulation["duration"] * simulation["sample_rate"] < 2:
-            error("simulation.duration", simulation["duration"], "allowed: at least two samples")
+        check_two_samples(simulation, error)
+        if excitation["peak_force"] >= MUJOCO_MAX_CONTROL:
+            error("excitation.peak_force", excitation["peak_force"],
+                  f"expected below {MUJOCO_MAX_CONTROL:g} N: MuJoCo zeroes a larger control (the "
+                  "hammer's force) as huge")
         loc = excitation["location"]
         if loc != 0.0 and not x0 < loc <= length:
             error("excitation.location", loc, f"allowed: 0 (= tip) or {where}")

@@ -269,6 +269,11 @@ _WARNINGS = {  # MuJoCo's warnings that mean the state was reset or the input re
 }
 
 
+#: MuJoCo's largest accepted control (mjMAXVAL): a larger one counts as huge and is zeroed
+#: (mjWARN_BADCTRL).  The hammer's motor has gear 1, so this is the largest force [N].
+MUJOCO_MAX_CONTROL = 1e10
+
+
 def check_warnings(model: mujoco.MjModel, data: mujoco.MjData, when: str = "") -> None:
     """Raise :class:`RigError` if MuJoCo counted a reset (bad state or control) in ``data``.
 
@@ -287,7 +292,8 @@ def check_warnings(model: mujoco.MjModel, data: mujoco.MjData, when: str = "") -
             continue
         if w == mujoco.mjtWarning.mjWARN_BADCTRL:
             raise RigError(f"cantilever: MuJoCo refused the {what} {n} time(s) as non-finite or "
-                           "above its limit of 1e10 and zeroed it; reduce excitation.peak_force")
+                           f"above its limit of {MUJOCO_MAX_CONTROL:g} and zeroed it; reduce "
+                           "excitation.peak_force")
         raise RigError(f"cantilever: the simulation is unstable with {integ} at timestep "
                        f"{model.opt.timestep:.4g} s (MuJoCo reset it {n} time(s) after huge or "
                        f"non-finite {what}{', ' + when if when else ''}); set simulation.timestep = 0 "

@@ -28,6 +28,7 @@ from models._base import ErrorFn, Rig, check_sample_steps
 from models.cartpole.equations import CartPoleParams, true_equations
 from testbed.core.budget import Cost
 from testbed.core.dataset import Dataset, Signal
+from testbed.core.errors import RigError
 from testbed.core.lazy import lazy_module
 from testbed.core.schema import Field
 from testbed.core.truth import MechanicalTruth
@@ -114,6 +115,14 @@ def multisine(t: np.ndarray, excitation: dict[str, Any]) -> np.ndarray:
     return excitation["amplitude"] * np.sin(2.0 * math.pi * np.outer(t, f) + phases).sum(axis=1)
 
 
+def _resets(data: Any) -> bool:
+    """Whether MuJoCo reset the state or zeroed the force (bad acceleration, velocity, position
+    or control): it then carries on, and the record after it is garbage a finiteness check
+    never sees."""
+    return any(data.warning[getattr(mujoco.mjtWarning, w)].number
+               for w in ("mjWARN_BADQACC", "mjWARN_BADQVEL", "mjWARN_BADQPOS", "mjWARN_BADCTRL"))
+
+
 @RIGS.register("cartpole", tags=("mechanical", "mujoco", "underactuated"))
 class CartPoleRig(Rig):
     """Cart-pole driven at the cart only; the pole hangs and swings passively (module docs).
@@ -198,8 +207,10 @@ class CartPoleRig(Rig):
             q[:, k], v[:, k], a[:, k] = data.qpos, data.qvel, data.qacc
             for _ in range(sub):
                 mujoco.mj_step(model, data)
-            if not np.all(np.isfinite(data.qpos)):
-                raise FloatingPointError(f"cart-pole simulation non-finite at t = {t[k]:.4g} s")
+            if not np.all(np.isfinite(data.qpos)) or _resets(data):
+                raise RigError(f"cartpole: the simulation is unstable at t = {t[k]:.4g} s (MuJoCo "
+                               f"met huge or non-finite states or force and reset them); reduce "
+                               f"rig.gravity, the excitation (amplitude, kp, kd) or simulation.dt")
             if progress is not None and k % 1000 == 0:
                 progress(k / n)
         mujoco.mj_resetData(model, data)

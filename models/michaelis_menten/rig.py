@@ -33,7 +33,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from models import RIGS
-from models._base import ErrorFn, Rig
+from models._base import ErrorFn, Rig, check_two_samples
 from testbed.core.budget import Cost
 from testbed.core.dataset import Dataset, Signal
 from testbed.core.schema import Field
@@ -48,6 +48,12 @@ _POS = {"min": 0.0, "min_inclusive": False}
 RTOL = 1e-12
 #: Absolute tolerance [mM]: 1e-14, below RTOL times the smallest state (x* ~ 0.2 mM).
 ATOL = 1e-14
+
+#: Largest ``h |lambda|`` DOP853 (explicit) keeps on a stiff decay: measured 6.1-6.4 with
+#: ``solve_ivp`` at RTOL/ATOL (y' = -lambda y, lambda = 1e4-1e5 /s; this rate law at
+#: Vmax = 1e3-1e4 mM/s, Km = 0.3 mM), so ``Vmax / Km / 6`` steps per second is what a stiff
+#: run takes, within 6 %.
+STIFF_STEP_LIMIT = 6.0
 
 #: Peak bytes per sample of a run: x and dx measured and as reference (4 float64), the signal
 #: chain's x, xd, xdd (3) and the identifier's library matrix (up to ~50 columns of float64,
@@ -117,6 +123,7 @@ class MichaelisMentenRig(Rig):
         if not rig["Vmax"] > rig["jx"]:
             error("rig.Vmax", rig["Vmax"], f"expected above jx ({rig['jx']:g} mM/s): otherwise "
                                            "the influx outruns the enzyme and x grows without bound")
+        check_two_samples(simulation, error)
 
     @classmethod
     def measurement_shape(cls, rig: dict[str, Any]) -> tuple[int, int]:
@@ -128,13 +135,18 @@ class MichaelisMentenRig(Rig):
         """Memory and steps of a run.  ``solve_ivp`` steps adaptively: measured 22-47 DOP853
         steps over 4 s at rtol 1e-12 (x0 = 0..2 mM, the paper's parameters), under 12 per
         second; counted as 25 per second (2x room), and at least one per output sample (the
-        budget's convention)."""
+        budget's convention).  A stiff rate law needs more: DOP853 is explicit, stable only for
+        ``h |lambda| <= STIFF_STEP_LIMIT``, and the rate's Jacobian ``-Vmax Km / (Km + x)^2``
+        is largest, ``Vmax / Km``, at ``x = 0``; such a run is named by ``rig.Vmax``."""
         samples = simulation["duration"] * float(simulation["sample_rate"])
-        steps = max(samples, 25.0 * simulation["duration"])
+        accuracy = max(samples, 25.0 * simulation["duration"])
+        stiff = simulation["duration"] * rig["Vmax"] / rig["Km"] / STIFF_STEP_LIMIT
+        steps, key, value = ((stiff, "rig.Vmax", rig["Vmax"]) if stiff > accuracy
+                             else (accuracy, "simulation.duration", simulation["duration"]))
         return Cost(memory_bytes=samples * BYTES_PER_SAMPLE, steps=steps, samples=samples,
-                    memory_key="simulation.duration", steps_key="simulation.duration",
+                    memory_key="simulation.duration", steps_key=key,
                     samples_key="simulation.duration", memory_value=simulation["duration"],
-                    steps_value=simulation["duration"], samples_value=simulation["duration"])
+                    steps_value=value, samples_value=simulation["duration"])
 
     def simulate(self, progress: Callable[[float], None] | None = None) -> Dataset:
         from scipy.integrate import solve_ivp  # lazy: scipy.integrate costs ~0.1 s of import

@@ -8,6 +8,9 @@ computes the scores (:mod:`testbed.scoring.scorers`).
 
 from __future__ import annotations
 
+import math
+import re
+
 METRICS: dict[str, dict[str, str]] = {
     "structural": {
         "trac": "smallest TRAC over sensors: simulated identified model vs noise-free "
@@ -75,3 +78,18 @@ METRICS["structural"].update({
 def metric_names(kind: str) -> set[str]:
     """Score names a rig of ``kind`` reports."""
     return set(METRICS[kind])
+
+
+#: Scores that are fractions in [0, 1] by construction (TRAC and MAC are squared cosines,
+#: support precision / recall / F1 are ratios of counts); every other score is an error, a
+#: norm, an RMSE or a ratio of RMS values, in [0, inf).
+_UNIT_INTERVAL = re.compile(r"(trac|mac(_mode\d+)?|support_(precision|recall|f1)(_\w+)?)")
+
+
+def metric_range(name: str) -> tuple[float, float]:
+    """The values score ``name`` can take, ``(low, high)``: (0, 1) or (0, inf).
+
+    A threshold outside this range is either unpassable (``_max`` below 0, ``_min`` above 1)
+    or never binding (``_min`` below 0, ``_max`` above 1): scenario validation refuses both.
+    """
+    return (0.0, 1.0) if _UNIT_INTERVAL.fullmatch(name) else (0.0, math.inf)

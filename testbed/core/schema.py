@@ -94,9 +94,9 @@ class Field:
             return "one of " + ", ".join(repr(c) for c in self.choices)
         bounds = []
         if self.min is not None:
-            bounds.append((">= " if self.min_inclusive else "> ") + f"{self.min:g}")
+            bounds.append((">= " if self.min_inclusive else "> ") + _bound(self.min))
         if self.max is not None:
-            bounds.append(("<= " if self.max_inclusive else "< ") + f"{self.max:g}")
+            bounds.append(("<= " if self.max_inclusive else "< ") + _bound(self.max))
         if self.type is list and self.min_items:
             bounds.append(f"with at least {self.min_items} item(s)")
         if self.type is list and self.max_items is not None:
@@ -105,6 +105,12 @@ class Field:
             bounds.append(self.pattern_doc or f"matching {self.pattern}")
         unit = f" [{self.unit}]" if self.unit else ""
         return what + (" " + " and ".join(bounds) if bounds else "") + unit
+
+
+def _bound(v: float) -> str:
+    """A bound in short form (``1e+06``), exact where that would round an integer (2**63 - 1)."""
+    text = f"{v:g}"
+    return str(v) if isinstance(v, int) and float(text) != v else text
 
 
 def _is_type(value: Any, typ: type) -> bool:

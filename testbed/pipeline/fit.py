@@ -20,7 +20,7 @@ from typing import Any
 
 import numpy as np
 
-from testbed.core.errors import InputError
+from testbed.core.errors import IdentificationError, InputError
 from testbed.core.measurement import Measurement
 from testbed.pipeline import plugins
 from testbed.pipeline.importers import measurement_from_file
@@ -62,6 +62,22 @@ class FitResult:
                "channels": list(self.data.channels)}
         out.update(model_summary(self.model, self.data))
         return out
+
+
+#: Exceptions of a fit that are its model blowing up on the data, not a bug: a singular or
+#: non-convergent linear-algebra problem, a division by zero, an overflow.  A run scores them
+#: as a failed fit (:func:`testbed.scoring.run.run_scenario`); ``identify`` reports them as one.
+NUMERICAL_BREAKDOWN = (ArithmeticError, np.linalg.LinAlgError)
+
+
+def fit_or_fail(model: Any, data: Measurement) -> None:
+    """``model.fit(data)``; a :data:`NUMERICAL_BREAKDOWN` becomes an :class:`IdentificationError`
+    saying so (the identifier could not produce a model from these data)."""
+    try:
+        model.fit(data)
+    except NUMERICAL_BREAKDOWN as e:
+        raise IdentificationError(f"numerical breakdown ({type(e).__name__}: "
+                                  f"{' '.join(str(e).split()) or 'no message'})") from None
 
 
 def identify_file(path: str | os.PathLike, *, scenario: str | os.PathLike | None = None,
@@ -140,7 +156,7 @@ def identify_file(path: str | os.PathLike, *, scenario: str | os.PathLike | None
         t0 = time.perf_counter()
         to = getattr(model, "progress_to", None)  # a plugin without it reports no steps
         with to(update) if callable(to) else contextlib.nullcontext():
-            model.fit(data)
+            fit_or_fail(model, data)
         fit_time = time.perf_counter() - t0
     return FitResult(model, data, kind, identify["method"], str(path), fit_time)
 

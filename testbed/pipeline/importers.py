@@ -80,6 +80,14 @@ UNIT_ALIASES: dict[str, tuple[str, float]] = {
 _UFF_UNITS = {(12, 1, 0, False): "m/s^2", (11, 1, 0, False): "m/s", (8, 1, 0, False): "m",
               (13, 0, 1, False): "N", (8, 0, 0, True): "rad", (11, 0, 0, True): "rad/s",
               (12, 0, 0, True): "rad/s^2", (13, 1, 1, True): "N m"}
+#: Largest magnitude [SI unit] a channel may reach: identifier libraries go up to cubes of the
+#: signals and their Gram matrices sum squares of those, i.e. sixth powers, over the record;
+#: 1e50 keeps (1e50)^6 x 1e6 samples = 1e306 below float64's 1.8e308 (no physical record
+#: comes near: an accelerometer saturates below 1e6 m/s^2).
+MAX_MAGNITUDE = 1e50
+#: The measured response of each rig kind (what moves): a record in which it is constant, or
+#: whose peak is below 1 / MAX_MAGNITUDE (sixth powers underflow), holds no motion to identify.
+RESPONSE_SIGNAL = {"structural": "acceleration", "mechanical": "theta", "dynamical": "x"}
 #: a CSV column of these names (case-insensitive) is the time
 TIME_NAMES = ("t", "time")
 #: a time column's steps may differ from their median by this fraction
@@ -179,8 +187,14 @@ class ImportedData:
         ------
         MeasuredDataError
             If a group names an unknown channel, mixes units, or has positions for only
-            some of its channels.
+            some of its channels, or a declared prior is not a finite number > 0.
         """
+        for key, value in dict(prior or {}).items():
+            # every prior an identifier reads is a size: a mass [kg] or a length [m]
+            if isinstance(value, bool) or not isinstance(value, (int, float)) \
+                    or not (math.isfinite(value) and value > 0):
+                raise MeasuredDataError(self.source, f"prior {key}={value!r}: expected a finite "
+                                                     "number > 0 (a mass [kg] or a length [m])")
         if groups is None:
             grouped: dict[str, list[str]] = {}
             for name in self.signals:
@@ -315,6 +329,7 @@ def measurement_from_file(path: str | os.PathLike, kind: str, signal: Mapping[st
         raise MeasuredDataError(path, f"unknown rig kind {kind!r}; allowed: {', '.join(SIGNAL_SCHEMAS)}")
     data = read_measured(path, format=format, fs=fs, units=units, channels=channels)
     ds = data.to_dataset(groups, prior)
+    _check_response(data.source, ds, kind)
     try:
         return measure(ds, dict(signal or {}), kind)
     except TestbedError:
@@ -322,6 +337,23 @@ def measurement_from_file(path: str | os.PathLike, kind: str, signal: Mapping[st
     except ValueError as e:  # the chain's own checks: signal names, channel counts, positions
         raise MeasuredDataError(data.source, f"cannot run the {kind} signal chain: {e}; "
                                              f"signals {', '.join(ds.measured)}") from None
+
+
+def _check_response(path: Path, ds: Dataset, kind: str) -> None:
+    """Refuse a record whose response (:data:`RESPONSE_SIGNAL`) does not move, or whose
+    sensors share a position (their equations would be the same)."""
+    sig = ds.measured.get(RESPONSE_SIGNAL.get(kind, ""))
+    if sig is None:
+        return  # the chain says what is missing
+    peaks = np.ptp(sig.data, axis=1)
+    if not np.any(peaks > 1.0 / MAX_MAGNITUDE):
+        raise MeasuredDataError(path, f"the {RESPONSE_SIGNAL[kind]!r} channels do not move "
+                                      f"(largest peak-to-peak {float(peaks.max()):.3g} {sig.unit}): "
+                                      "no motion to identify")
+    if sig.positions is not None and len(set(sig.positions.tolist())) < len(sig.positions):
+        raise MeasuredDataError(path, f"the {RESPONSE_SIGNAL[kind]!r} channels share a position "
+                                      f"({', '.join(f'{p:g}' for p in sig.positions)} m); expected "
+                                      "one sensor per position")
 
 
 def from_sep005(channel_dicts: Sequence[Mapping[str, Any]], *, source: str | os.PathLike = "<sep005>",
@@ -423,7 +455,13 @@ def _finish(raw: _Raw, fs: float | None, units: str | Mapping[str, str] | None,
         if bad.size:
             raise MeasuredDataError(path, f"channel {n!r} has {bad.size} NaN or infinite value(s), "
                                           f"the first at sample {bad[0]}")
-        signals[n] = (si, x * factor if factor != 1.0 else x.copy())
+        x = x * factor if factor != 1.0 else x.copy()
+        peak = float(np.max(np.abs(x)))
+        if peak > MAX_MAGNITUDE:
+            raise MeasuredDataError(path, f"channel {n!r} reaches |value| {peak:.3g} {si}; "
+                                          f"expected at most {MAX_MAGNITUDE:g} (larger values "
+                                          "overflow the identifiers' sums of sixth powers)")
+        signals[n] = (si, x)
     keep = set(names)
     return ImportedData(float(rate), signals, path, raw.format,
                         nodes={k: v for k, v in raw.nodes.items() if k in keep},
@@ -485,6 +523,8 @@ def _read_sep005_file(path: Path) -> _Raw:
         content = json.loads(path.read_text())
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
         raise MeasuredDataError(path, f"not a SEP-005 JSON file ({type(e).__name__}: {e})") from None
+    except RecursionError:  # arrays nested thousands deep: no channel list of SEP-005
+        raise MeasuredDataError(path, "not a SEP-005 JSON file: nested too deeply") from None
     return _parse_sep005(path, content)
 
 
@@ -518,10 +558,15 @@ def _parse_sep005(path: Path, content: Any) -> _Raw:
                 raise MeasuredDataError(path, f"SEP-005 channel {name!r}: fs={f!r} is not a rate > 0 Hz")
             rates[name] = float(f)
         elif "time" in c:
-            t = np.asarray(c["time"], dtype=float)
+            try:
+                t = np.asarray(c["time"], dtype=float)
+            except (TypeError, ValueError):
+                raise MeasuredDataError(path, f"SEP-005 channel {name!r}: time values are not "
+                                              "numbers") from None
             if t.shape != data.shape:
-                raise MeasuredDataError(path, f"SEP-005 channel {name!r}: {t.size} times for "
-                                              f"{data.size} samples")
+                raise MeasuredDataError(path, f"SEP-005 channel {name!r}: time of shape {t.shape} "
+                                              f"for data of shape {data.shape}; expected one time "
+                                              "per sample")
             rates[name] = uniform_rate(path, t, f"channel {name!r} time")
         else:
             raise MeasuredDataError(path, f"SEP-005 channel {name!r} has neither fs nor time")

@@ -48,7 +48,7 @@ from typing import Any
 
 from testbed.core.budget import check_cost, check_steps
 from testbed.core.errors import RigError, ScenarioError
-from testbed.core.kinds import metric_names
+from testbed.core.kinds import metric_names, metric_range
 from testbed.core.schema import Field, validate_header, validate_table, validate_variant
 from testbed.pipeline.plugins import IDENTIFIERS, RIGS
 from testbed.pipeline.signal_chain import SIGNAL_SCHEMAS, check_signal
@@ -83,11 +83,15 @@ def shipped_dir(what: str) -> Path:
 #: Shipped scenario files, found by name (``$TESTBED_SCENARIOS`` overrides).
 SCENARIO_DIR = Path(os.environ.get("TESTBED_SCENARIOS", shipped_dir("scenarios")))
 
+#: Largest noise seed: seeds are stored as 64-bit signed integers (HDF5 dataset attributes,
+#: the results file's ``seed`` column), which hold at most 2**63 - 1.
+MAX_SEED = 2**63 - 1
+
 HEADER_SCHEMA = {
     "name": Field(str, doc="scenario name; must equal the file name without .toml",
                   pattern=NAME_PATTERN, pattern_doc=NAME_PATTERN_DOC),
     "rig": Field(str, doc="registered rig name (see `testbed list`)"),
-    "seed": Field(int, 0, min=0, doc="seed of the measurement noise"),
+    "seed": Field(int, 0, min=0, max=MAX_SEED, doc="seed of the measurement noise"),
     "description": Field(str, "", doc="one line for listings"),
     "tags": Field(list, [], item_type=str, doc="free tags for selecting scenarios"),
     "extends": Field(str, "", doc="scenario file this one starts from (relative path)"),
@@ -484,6 +488,14 @@ def _validate_score(table: Any, kind: str, file: str) -> dict[str, dict[str, flo
         if not isinstance(value, (int, float)) or isinstance(value, bool) \
                 or not math.isfinite(value):
             raise ScenarioError(file, f"score.{key}", value, "expected a finite number")
+        low, high = metric_range(base)
+        if not low <= value <= high:
+            raise ScenarioError(file, f"score.{key}", value,
+                                f"expected a number >= {low:g}" + (f" and <= {high:g}" if
+                                                                   math.isfinite(high) else "")
+                                + f": {base} takes values in that range, so this bar could "
+                                + ("never pass" if (bound == "max") == (value < low) else
+                                   "never fail"))
         out.setdefault(base, {})[bound] = float(value)
     for base, bounds in out.items():
         if "min" in bounds and "max" in bounds and bounds["min"] > bounds["max"]:

@@ -17,6 +17,7 @@ from testbed.core.errors import IdentificationError, ScenarioError
 from testbed.core.measurement import Measurement
 from testbed.pipeline import plugins
 from testbed.pipeline.cache import DatasetCache
+from testbed.pipeline.fit import fit_or_fail
 from testbed.pipeline.generate import generate
 from testbed.pipeline.scenario import Scenario
 from testbed.pipeline.signal_chain import measure
@@ -137,7 +138,7 @@ def run_scenario(scenario: Scenario, *, cache: DatasetCache | None = None,
         t0 = time.perf_counter()
         try:
             with _reporting(model, update):
-                model.fit(data)
+                fit_or_fail(model, data)
         except ScenarioError:  # the user's configuration: raised, not scored
             raise
         except IdentificationError as e:  # data the identifier cannot handle: a scored failure

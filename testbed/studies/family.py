@@ -54,7 +54,8 @@ import numpy as np
 
 from testbed.core.atomic import atomic_write_text
 from testbed.core.errors import ScenarioError
-from testbed.core.schema import Field, validate_table
+from testbed.core.schema import Field, check_value, validate_table
+from testbed.pipeline.plugins import RIGS
 from testbed.pipeline.scenario import (
     NAME_PATTERN,
     NAME_PATTERN_DOC,
@@ -63,6 +64,7 @@ from testbed.pipeline.scenario import (
     resolve_path,
     scenario_from_dict,
 )
+from testbed.pipeline.signal_chain import SIGNAL_SCHEMAS
 
 #: Draws per member before the family is refused: a range so narrow that 100 independent
 #: draws are all invalid is a mistake in the study file, not bad luck (the shipped families
@@ -210,9 +212,52 @@ def parse_family(name: str, table: Any, *, file: str, base_dir: Path) -> Family:
         ranges[t] = dict(sub)
     fam = Family(name=name, base=base, members=head["members"], seed=head["seed"], ranges=ranges,
                  description=head["description"])
+    _check_range_keys(fam, file, key)
     if base.rig == "cantilever":
         _check_cantilever_keys(fam, file, key)
     return fam
+
+
+#: The cantilever's derived keys of ``[families.<name>.rig]`` (:data:`CANTILEVER_DERIVED`) that
+#: take numbers, and what they allow (``material`` is checked against :data:`MATERIALS`).
+CANTILEVER_DERIVED_FIELDS = {
+    "n_sensors": Field(int, min=1, doc="number of accelerometers (0 would mean the rig's "
+                                       "default three)"),
+    "base_k1_ratio": Field(float, min=0.0, min_inclusive=False, doc="base_k1 / (E I / L)"),
+    "cubic_fraction": Field(float, min=0.0, doc="k3 q_peak^2 / k1"),
+}
+
+
+def _check_range_keys(fam: Family, file: str, key: str) -> None:
+    """Every key of a family's range tables is one the base rig declares, and every value a
+    distribution can draw (both ends of a range, every choice) is one its field allows.
+
+    A typo or a range wholly outside the allowed values used to surface only after every draw
+    of member 0 was refused, as ``<family ...>``.
+    """
+    rig_cls = RIGS.get(fam.base.rig)
+    schemas = {"rig": dict(rig_cls.rig_schema), "simulation": rig_cls.simulation_schema,
+               "excitation": rig_cls.excitation_schemas.get(fam.base.excitation.get("type"), {}),
+               "signal": SIGNAL_SCHEMAS[rig_cls.kind]}
+    derived = {"material"} if fam.base.rig == "cantilever" else set()
+    if fam.base.rig == "cantilever":
+        schemas["rig"].update(CANTILEVER_DERIVED_FIELDS)
+    for table, sub in fam.ranges.items():
+        schema = schemas.get(table, {})
+        for k, spec in sub.items():
+            where = f"{key}.{table}.{k}"
+            if (table, k) == ("excitation", "type") or (table == "rig" and k in derived):
+                continue  # checked in every member / by _check_cantilever_keys
+            if k not in schema:
+                raise ScenarioError(file, where, spec, f"unknown key; allowed keys in "
+                                                       f"[{key}.{table}]: "
+                                                       + ", ".join(sorted(schema) + sorted(derived)))
+            if isinstance(spec, dict):
+                (dist, values), = spec.items()
+                for v in values:
+                    check_value(v, schema[k], file=file, key=f"{where}.{dist}")
+            elif table == "rig" and k in CANTILEVER_DERIVED_FIELDS:
+                check_value(spec, schema[k], file=file, key=where)
 
 
 def _check_spec(spec: Any, file: str, key: str) -> None:

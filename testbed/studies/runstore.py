@@ -632,6 +632,27 @@ def _unflatten(arrays: dict[str, np.ndarray], group: str) -> dict[str, Any]:
     return out
 
 
+#: What every run.json holds, and of which type: what :class:`SavedRun` reads without a
+#: default (a damaged or hand-edited file is refused on read, not half-reported).
+_META_TYPES = {"scenario": dict, "identifier": dict, "scores": dict, "checks": list,
+               "fit_time": (int, float)}
+_CHECK_KEYS = ("metric", "value", "bound", "threshold")
+
+
+def _check_meta(run_dir: Path, meta: dict[str, Any]) -> None:
+    """Raise ValueError naming the first key of ``run.json`` missing or of the wrong type."""
+    for key, typ in _META_TYPES.items():
+        if not isinstance(meta.get(key), typ) or isinstance(meta.get(key), bool):
+            raise ValueError(f"{run_dir / 'run.json'}: key {key!r} missing or not a "
+                             f"{getattr(typ, '__name__', 'number')}")
+    if not isinstance(meta["identifier"].get("name"), str):
+        raise ValueError(f"{run_dir / 'run.json'}: key 'identifier.name' missing or not a str")
+    for i, c in enumerate(meta["checks"]):
+        if not isinstance(c, dict) or any(k not in c for k in _CHECK_KEYS):
+            raise ValueError(f"{run_dir / 'run.json'}: checks[{i}] is not a check with "
+                             + ", ".join(_CHECK_KEYS))
+
+
 def load_run(run_dir: str | os.PathLike) -> SavedRun:
     """Read a run folder written by :func:`save_run`.
 
@@ -640,12 +661,14 @@ def load_run(run_dir: str | os.PathLike) -> SavedRun:
     FileNotFoundError
         If the folder has no ``run.json``.
     ValueError
-        If ``run.json`` is not a run of this format.
+        If ``run.json`` is not a run of this format, or lacks a key a run has.
     """
     run_dir = Path(run_dir)
     meta = json.loads((run_dir / "run.json").read_text())
-    if meta.get("format") != FORMAT:
-        raise ValueError(f"{run_dir}: not a {FORMAT} folder (format={meta.get('format')!r})")
+    if not isinstance(meta, dict) or meta.get("format") != FORMAT:
+        fmt = meta.get("format") if isinstance(meta, dict) else None
+        raise ValueError(f"{run_dir}: not a {FORMAT} folder (format={fmt!r})")
+    _check_meta(run_dir, meta)
     arrays: dict[str, np.ndarray] = {}
     if (run_dir / "run.npz").is_file():
         with np.load(run_dir / "run.npz", allow_pickle=False) as z:

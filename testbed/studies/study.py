@@ -55,6 +55,7 @@ from testbed.core.registry import import_plugin
 from testbed.core.schema import Field, validate_header
 from testbed.pipeline.plugins import IDENTIFIERS, RIGS
 from testbed.pipeline.scenario import (
+    MAX_SEED,
     NAME_PATTERN,
     NAME_PATTERN_DOC,
     SCENARIO_DIR,
@@ -82,7 +83,7 @@ STUDY_SCHEMA = {
                            "(may be empty when the study declares [families.<name>])"),
     "noise": Field(list, item_type=float, min_items=1, min=0.0, max=100.0, unit="% of channel RMS",
                    doc="sensor-noise levels; each replaces the scenario's [noise] rms_percent"),
-    "seeds": Field(list, item_type=int, min_items=1, min=0,
+    "seeds": Field(list, item_type=int, min_items=1, min=0, max=MAX_SEED,
                    doc="noise seeds; each replaces the scenario's seed"),
     "identifiers": Field(list, item_type=str, min_items=1, doc="registered identifier names"),
     "plugins": Field(list, [], item_type=str,
@@ -248,7 +249,12 @@ def study_from_dict(raw: dict[str, Any], *, file: str = "<dict>", base: Path | N
 
     families = tuple(parse_family(n, t, file=file, base_dir=base) for n, t in fam_table.items())
     for fam in families:
-        scenarios.extend(family_members(fam))
+        try:
+            scenarios.extend(family_members(fam))
+        except ScenarioError as e:  # no member drawn: the study file's ranges, named as such
+            if not e.file.startswith("<family"):
+                raise
+            raise ScenarioError(file, e.key, e.value, e.allowed) from None
     params = _validate_params(raw.get("identifiers", {}), head["identifiers"], file)
     thresholds = _validate_thresholds(raw.get("thresholds", {}), head["identifiers"], file)
     study = Study(name=head["name"], description=head["description"], scenarios=tuple(scenarios),

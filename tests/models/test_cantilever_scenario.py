@@ -65,6 +65,8 @@ def test_other_seed_changes_only_noisy_signals(noisy):
     ("excitation", "location", 0.5, "excitation.location"),
     ("excitation", "pulse_duration", 0.2, "excitation.pulse_duration"),
     ("rig", "damping_beta", 1e-5, "rig.damping_beta"),
+    # above MuJoCo's control limit: refused at load (was a RigError after the simulation)
+    ("excitation", "peak_force", 1e12, "excitation.peak_force"),
 ])
 def test_bad_input_names_file_key_value(section, key, value, words):
     bad = raw()

@@ -50,3 +50,22 @@ def test_a_rate_the_enzyme_cannot_match_is_refused():
     with pytest.raises(ScenarioError, match=r"rig\.Vmax"):
         scenario_from_dict({"scenario": {"name": "x", "rig": "michaelis_menten"},
                             "rig": {"jx": 2.0, "Vmax": 1.5}})
+
+
+def test_a_stiff_rate_law_is_refused_by_the_step_budget_naming_vmax():
+    # Vmax / Km = 3.3e9 /s: the explicit DOP853 would need ~2e9 steps over 4 s (it hung for
+    # minutes before the budget counted stiffness); the shipped rates cost 25 steps per second
+    from testbed.core.errors import BudgetError
+
+    with pytest.raises(BudgetError, match=r"key 'rig\.Vmax'.*integration steps"):
+        scenario_from_dict({"scenario": {"name": "x", "rig": "michaelis_menten"},
+                            "rig": {"Vmax": 1e9}})
+    scenario_from_dict({"scenario": {"name": "x", "rig": "michaelis_menten"}, "rig": {"Vmax": 1e3}})
+
+
+@pytest.mark.parametrize("simulation", [{"sample_rate": 1e-6}, {"duration": 1e-6}])
+def test_a_record_of_fewer_than_two_samples_is_refused(simulation):
+    # no sample at all was an internal error (IndexError) in the simulation
+    with pytest.raises(ScenarioError, match=r"'simulation\.duration'.*at least two samples"):
+        scenario_from_dict({"scenario": {"name": "x", "rig": "michaelis_menten"},
+                            "simulation": simulation})

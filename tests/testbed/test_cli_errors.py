@@ -40,6 +40,9 @@ def one_error_line(err: str) -> str:
     (["run", "no_such_scenario"], "no scenario named 'no_such_scenario'; known: "),
     (["run", "--seed", "-3", "cantilever_stiff_impact"], "--seed: expected an integer >= 0, got -3"),
     (["generate", "--seed", "x", "cantilever_stiff_impact"], "--seed: expected an integer >= 0"),
+    # 2**63: datasets and results store seeds as 64-bit signed integers (was an internal error)
+    (["generate", "--seed", "9223372036854775808", "michaelis_menten", "-o", "{tmp}/x.h5"],
+     "--seed: expected an integer <= 9223372036854775807"),
     (["sweep", "--jobs", "0", "smoke"], "--jobs: expected an integer >= 1"),
     (["report", "{tmp}/no_such_run", "-o", "{tmp}/report"], "no such run folder or results file"),
     (["report", "{tmp}", "-o", "{tmp}/report"], "not a run folder"),
@@ -59,6 +62,26 @@ def one_error_line(err: str) -> str:
     (["sweep", "no_such_study"], "no study named 'no_such_study'; known: "),
     (["cache", "ls", "--cache", "{tmp}/text.txt"], "--cache"),
     (["run", "cantilever_stiff_impact", "--cache", "{tmp}/text.txt"], "not a folder"),
+    # output paths are checked before any work (were OSErrors after it, naming no option)
+    (["generate", "michaelis_menten", "-o", "{tmp}"], "--output {tmp}: is a folder"),
+    (["run", "michaelis_menten", "--out", "{tmp}/text.txt"],
+     "--out {tmp}/text.txt: exists and is not a folder"),
+    (["report", "{tmp}", "-o", "{tmp}/text.txt"], "--output {tmp}/text.txt: exists and is not a folder"),
+    (["sweep", "smoke", "--results", "{tmp}"], "--results {tmp}: is a folder"),
+    (["family", "write", "smoke", "-o", "{tmp}/text.txt"],
+     "--out {tmp}/text.txt: exists and is not a folder"),
+    (["demo", "--out", "{tmp}/text.txt"], "--out {tmp}/text.txt: exists and is not a folder"),
+    (["runs", "ls", "-o", "{tmp}/text.txt"], "--out {tmp}/text.txt: not a folder"),
+    (["identify", "{tmp}/text.txt", "--kind", "structural", "--method", "ls_sindy", "-o",
+      "{tmp}/text.txt/m.json"], "{tmp}/text.txt is a file, not a folder"),
+    # a later unit was silently ignored
+    (["identify", "{tmp}/text.txt", "--kind", "structural", "--method", "ls_sindy", "--units", "g",
+      "--units", "a=mm"], "--units g a=mm: expected one unit for every channel"),
+    # every scenario is checked before the first runs (the first one ran, then the error)
+    (["run", "michaelis_menten", "{tmp}/no_such.toml", "--out", "{tmp}/o"], "no such scenario file"),
+    # nothing the user gave is overwritten
+    (["identify", "{tmp}/text.txt", "--kind", "structural", "--method", "ls_sindy", "-o",
+      "{tmp}/text.txt"], "is the input file"),
 ])
 def test_user_mistakes_give_one_line_and_status_2(tmp_path, capsys, argv, fragment):
     (tmp_path / "text.txt").write_text("not a dataset\n")
@@ -69,7 +92,7 @@ def test_user_mistakes_give_one_line_and_status_2(tmp_path, capsys, argv, fragme
         sys.exit(main(argv))
     assert exc.value.code == EXIT_USAGE
     captured = capsys.readouterr()
-    assert fragment in one_error_line(captured.err), captured.err
+    assert fragment.replace("{tmp}", str(tmp_path)) in one_error_line(captured.err), captured.err
 
 
 def test_internal_error_is_one_line_and_debug_reraises(monkeypatch, capsys):
@@ -118,3 +141,38 @@ def test_real_command_on_a_sample_of_the_corpus(tmp_path):
         assert name in line, line
         assert out == "", out
     assert not (tmp_path / "runs").exists()  # refused before anything was run or written
+
+
+def test_export_onto_its_own_dataset_is_refused_and_the_dataset_kept(tmp_path, capsys):
+    # `testbed export x.h5 --format uff -o x.h5` used to replace the dataset with the UFF file
+    h5 = tmp_path / "mm.h5"
+    assert main(["generate", "michaelis_menten", "--no-cache", "-o", str(h5)]) == 0
+    before = h5.read_bytes()
+    capsys.readouterr()
+    assert main(["export", str(h5), "--format", "uff", "-o", str(h5)]) == EXIT_USAGE
+    assert "is the input file" in one_error_line(capsys.readouterr().err)
+    assert h5.read_bytes() == before
+
+
+def test_a_rig_that_cannot_simulate_the_scenario_names_its_file(tmp_path, monkeypatch, capsys):
+    # e.g. a five-bar whose RK4 diverges under a 1e6 N m torque: the error named no file
+    from testbed.core.errors import RigError
+    from testbed.pipeline.scenario import SCENARIO_DIR
+    from testbed.scoring import run
+
+    def diverges(*args, **kwargs):
+        raise RigError("fivebar (pinocchio): the simulation diverged")
+
+    monkeypatch.setattr(run, "run_scenario", diverges)
+    assert main(["run", "michaelis_menten", "--no-figures", "--out", str(tmp_path)]) == EXIT_USAGE
+    line = one_error_line(capsys.readouterr().err)
+    assert line == f"error: {SCENARIO_DIR / 'michaelis_menten.toml'}: fivebar (pinocchio): the " \
+                   "simulation diverged"
+
+
+def test_a_testbed_cache_that_is_a_file_is_refused_naming_the_variable(tmp_path, monkeypatch, capsys):
+    # was "[Errno 17] File exists" after the simulation, naming no setting
+    (tmp_path / "text.txt").write_text("x\n")
+    monkeypatch.setenv("TESTBED_CACHE", str(tmp_path / "text.txt"))
+    assert main(["run", "michaelis_menten", "--no-figures", "--out", str(tmp_path / "o")]) == EXIT_USAGE
+    assert f"$TESTBED_CACHE {tmp_path / 'text.txt'}: not a folder" in one_error_line(capsys.readouterr().err)

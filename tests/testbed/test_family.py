@@ -7,6 +7,7 @@ Nothing here is simulated: members are only drawn and validated (a few ms each).
 from __future__ import annotations
 
 import math
+import re
 import textwrap
 from pathlib import Path
 
@@ -186,6 +187,40 @@ def test_malformed_ranges_name_the_key(tmp_path, edit, key):
     p.write_text(textwrap.dedent(STUDY.format(name="bad", n_beams=2)).replace(edit, key))
     with pytest.raises(ScenarioError, match=r"families\.beams\.rig\.(length|material)"):
         load_study(p)
+
+
+@pytest.mark.parametrize("edit, key, fragment", [
+    # were refused only after 100 draws of member 0, as "<family beams>" (or, n_sensors = 0,
+    # accepted as the rig's default three sensors)
+    ('length = {uniform = [0.25, 0.5]}', 'lenght = {uniform = [0.25, 0.5]}',
+     "families.beams.rig.lenght': value {'uniform': [0.25, 0.5]}: unknown key"),
+    ('length = {uniform = [0.25, 0.5]}', 'length = {uniform = [-1.0, -0.5]}',
+     "families.beams.rig.length.uniform': value -1.0: expected a number > 0"),
+    ('n_sensors = {integers = [2, 6]}', 'n_sensors = {integers = [0, 2]}',
+     "families.beams.rig.n_sensors.integers': value 0: expected an integer >= 1"),
+    ('n_sensors = {integers = [2, 6]}', 'n_sensors = 0',
+     "families.beams.rig.n_sensors': value 0: expected an integer >= 1"),
+    ('duration = 0.5', 'durration = 0.5',
+     "families.beams.simulation.durration': value 0.5: unknown key"),
+])
+def test_ranges_outside_the_rigs_schema_are_refused_at_load(tmp_path, edit, key, fragment):
+    p = tmp_path / "bad.toml"
+    text = textwrap.dedent(STUDY.format(name="bad", n_beams=2))
+    assert edit in text
+    p.write_text(text.replace(edit, key))
+    with pytest.raises(ScenarioError, match=re.escape(fragment)) as e:
+        load_study(p)
+    assert e.value.file == str(p)
+
+
+def test_a_family_whose_every_draw_is_refused_names_the_study_file(tmp_path):
+    text = textwrap.dedent(STUDY.format(name="bad", n_beams=2)).replace(
+        "n_sensors = {integers = [2, 6]}", "n_sensors = 50")
+    p = tmp_path / "bad.toml"
+    p.write_text(text)
+    with pytest.raises(ScenarioError, match="draws all refused") as e:
+        load_study(p)
+    assert e.value.file == str(p)  # was "<family beams>"
 
 
 def test_thresholds_per_identifier(study):

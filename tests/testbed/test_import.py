@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import json
+import math
+import re
 
 import numpy as np
 import pytest
@@ -203,6 +205,14 @@ MALFORMED = [
      "neither fs nor time"),
     ("SEP-005 null", lambda d: write(d, "x.json", json.dumps(
         [{"name": "a", "data": [1, None], "unit_str": "m", "fs": 10}])), {}, "NaN"),
+    # were internal errors: ValueError converting the time, RecursionError in json
+    ("SEP-005 time text", lambda d: write(d, "x.json", json.dumps(
+        [{"name": "a", "data": [1, 2], "unit_str": "m", "time": "ab"}])), {}, "time values are not numbers"),
+    ("JSON nested deep", lambda d: write(d, "x.json", "[" * 100000 + "]" * 100000), {},
+     "nested too deeply"),
+    ("SEP-005 time shape", lambda d: write(d, "x.json", json.dumps(
+        [{"name": "a", "data": [1, 2], "unit_str": "m", "time": [[0], [1]]}])), {},
+     "time of shape (2, 1) for data of shape (2,)"),
     ("garbage UFF", lambda d: write(d, "x.uff", "    -1\n    58\nnot a record\n    -1\n"), {}, "UFF"),
     ("not UFF", lambda d: write(d, "x.uff", "hello\n"), {}, "not a complete UFF file"),
     ("UFF without 58", lambda d: units_only_uff(d / "u.uff"), {}, "no UFF58"),
@@ -271,3 +281,37 @@ def test_truncated_uff_export(beam, tmp_path):
     cut.write_bytes(out.read_bytes()[: out.stat().st_size // 2])
     with pytest.raises(MeasuredDataError, match=r"cut\.uff: not a complete UFF file"):
         read_measured(cut)
+
+
+@pytest.mark.parametrize("value", [math.nan, math.inf, -1.0, 0.0])
+def test_a_declared_prior_that_is_not_a_positive_size_is_refused(value):
+    # `testbed identify --prior total_mass=nan` used to fit and write a model
+    data = from_sep005([{"name": "a", "data": [1.0, 2.0], "unit_str": "m", "fs": 1.0}])
+    with pytest.raises(MeasuredDataError, match=r"prior total_mass=.*expected a finite number > 0"):
+        data.to_dataset(prior={"total_mass": value})
+    assert data.to_dataset(prior={"total_mass": 0.7}).prior["total_mass"] == 0.7
+
+
+def _beam_channels(acc, positions=(0.1, 0.2, 0.3)):
+    """SEP-005 channels of a 3-sensor beam record (acc: (3, n) [m/s^2]) with a hammer at 0.3 m."""
+    n = acc.shape[1]
+    force = np.zeros(n)
+    force[5:8] = 1.0
+    return [{"name": f"acceleration/a{i}", "data": acc[i], "unit_str": "m/s^2", "fs": 1000.0,
+             "position_m": p} for i, p in enumerate(positions)] + \
+           [{"name": "force/hammer", "data": force, "unit_str": "N", "fs": 1000.0, "position_m": 0.3}]
+
+
+@pytest.mark.parametrize(("acc", "positions", "words"), [
+    # were fitted and written with exit 0 (zero stiffness, NaN damping ratios) or crashed
+    # inside an identifier (ZeroDivisionError, LinAlgError)
+    (np.zeros((3, 400)), (0.1, 0.2, 0.3), "do not move"),
+    (np.ones((3, 400)), (0.1, 0.2, 0.3), "do not move"),
+    (1e-300 * np.sin(np.arange(400.0))[None].repeat(3, 0), (0.1, 0.2, 0.3), "do not move"),
+    (1e300 * np.sin(np.arange(400.0))[None].repeat(3, 0), (0.1, 0.2, 0.3), "expected at most 1e+50"),
+    (np.sin(np.arange(400.0))[None].repeat(3, 0), (0.2, 0.2, 0.2), "share a position"),
+])
+def test_a_record_with_nothing_to_identify_is_refused(tmp_path, acc, positions, words):
+    path = write(tmp_path, "x.json", json.dumps(_beam_channels(acc, positions), default=list))
+    with pytest.raises(MeasuredDataError, match=re.escape(words)):
+        measurement_from_file(path, "structural")

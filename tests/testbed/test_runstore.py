@@ -121,6 +121,23 @@ def test_load_rejects_other_folders(tmp_path):
         load_run(tmp_path)
 
 
+@pytest.mark.parametrize(("damage", "fragment"), [
+    (lambda m: m.pop("scenario"), "key 'scenario' missing"),
+    (lambda m: m.update(scores=[1, 2]), "key 'scores' missing or not a dict"),
+    (lambda m: m.update(fit_time="fast"), "key 'fit_time'"),
+    (lambda m: m["identifier"].pop("name"), "'identifier.name'"),
+    (lambda m: m.update(checks=[{"metric": "trac"}]), "checks[0]"),
+])
+def test_load_refuses_a_damaged_run_json_naming_the_key(mechanical, tmp_path, damage, fragment):
+    # `testbed report` on a run.json without "scenario" was an internal error (KeyError)
+    run = save_run(mechanical, tmp_path / "r")
+    meta = json.loads((run / "run.json").read_text())
+    damage(meta)
+    (run / "run.json").write_text(json.dumps(meta))
+    with pytest.raises(ValueError, match=re.escape(fragment)):
+        load_run(run)
+
+
 # ----------------------------------------------------------------------------- run history
 
 FIXED = "2026-01-02T03:04:05+00:00"

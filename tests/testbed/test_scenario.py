@@ -218,3 +218,25 @@ def test_identify_keeps_given_keys_only_with_floats_widened(tmp_path):
     sc = load_scenario(_write(tmp_path, GOOD + '[identify]\nmethod = "ls_sindy"\nrcond = 0\n'))
     assert sc.identify == {"method": "ls_sindy", "rcond": 0.0}
     assert isinstance(sc.identify["rcond"], float)
+
+
+@pytest.mark.parametrize(("bar", "value", "fragment"), [
+    ("trac_min", -1.0, "never fail"),            # TRAC >= 0 always: a bar that cannot bind
+    ("trac_min", 2.0, "never pass"),             # TRAC <= 1 always
+    ("mac_mode1_max", 1.5, "never fail"),
+    ("freq_error_mode1_max", -0.1, "never pass"),  # an error is >= 0
+    ("Kr_error_min", -5.0, "never fail"),
+])
+def test_score_bar_outside_the_scores_range_is_refused(tmp_path, bar, value, fragment):
+    p = _write(tmp_path, GOOD + f'[identify]\nmethod = "ls_sindy"\n[score]\n{bar} = {value}\n')
+    with pytest.raises(ScenarioError, match=re.escape(fragment)) as e:
+        load_scenario(p, check_cost=False)
+    assert e.value.key == f"score.{bar}" and e.value.value == value
+
+
+def test_a_seed_beyond_64_bits_is_refused(tmp_path):
+    # datasets (HDF5 attributes) and results (the seed column) store 64-bit signed integers:
+    # 2**63 used to pass validation and fail on saving the dataset
+    with pytest.raises(ScenarioError, match=r"'scenario\.seed': value 9223372036854775808"):
+        load_scenario(_write(tmp_path, GOOD.replace("seed = 1", "seed = 9223372036854775808")))
+    assert load_scenario(_write(tmp_path, GOOD.replace("seed = 1", f"seed = {2**63 - 1}"))).seed == 2**63 - 1

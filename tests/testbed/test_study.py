@@ -170,6 +170,12 @@ CASES = {
     "broken plugin": (_replace(BASE, '"plugin.py"]', '"plugin.py", "broken_plugin.py"]'),
                       "study.plugins[1]", "RuntimeError: plugin broke"),
     "missing [study]": ("[identifiers.x]\na = 1\n", "study", "missing [study] table"),
+    # seeds are stored as 64-bit signed integers (HDF5 attributes, the results' seed column)
+    "seed beyond 64 bits": (_replace(BASE, "seeds = [0, 1, 2]", "seeds = [9223372036854775808]"),
+                            "study.seeds[0]", "<= 9223372036854775807"),
+    # every score is >= 0: a negative bar could never pass (was accepted)
+    "negative threshold": (BASE + "[thresholds.st_mech_id]\nangle_rmse_max = -1.0\n",
+                           "thresholds.st_mech_id.angle_rmse_max", "could never pass"),
 }
 
 

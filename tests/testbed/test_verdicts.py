@@ -278,3 +278,18 @@ def test_fivebar_noisy_sine_replay_fit_failure_is_scored(tmp_path, dataset_cache
     code = main(["run", str(path), "--cache", str(dataset_cache.directory), "-o", str(tmp_path / "out"),
                  "--no-figures"])
     assert code == EXIT_FAIL  # a scored failure, not the usage/error exit
+
+
+@pytest.mark.parametrize("error", [ZeroDivisionError("float division by zero"),
+                                   np.linalg.LinAlgError("Eigenvalues did not converge"),
+                                   FloatingPointError("overflow encountered")])
+def test_a_fit_that_breaks_down_numerically_is_a_scored_failure(dataset_cache, error):
+    # identifiers raised these on degenerate data (constant records, values near 1e300) and
+    # the run ended as an internal error instead of a verdict
+    class BreaksDown:
+        def fit(self, data):
+            raise error
+
+    result = run_scenario(load_scenario("michaelis_menten"), cache=dataset_cache, model=BreaksDown())
+    assert result.failure.startswith(f"fit failed: numerical breakdown ({type(error).__name__}: ")
+    assert result.verdict == FAIL and all(math.isnan(v) for v in result.scores.values.values())

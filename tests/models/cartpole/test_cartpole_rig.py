@@ -100,3 +100,15 @@ def test_a_bad_scenario_is_refused_in_one_line():
     raw["excitation"] = {"type": "multisine", "f_max": 600.0}
     with pytest.raises(ScenarioError, match="Nyquist"):
         scenario_from_dict(raw, file="<test>")
+
+
+def test_an_unstable_simulation_is_a_rig_error_not_garbage_data():
+    # gravity 1e9 m/s^2: MuJoCo resets the exploding state and carries on; the run used to score
+    # an identifier on the garbage record (and a non-finite state was a bare FloatingPointError)
+    from testbed.core.errors import RigError
+    from testbed.pipeline.generate import generate
+
+    sc = scenario_from_dict({"scenario": {"name": "x", "rig": "cartpole"}, "rig": {"gravity": 1e9},
+                             "simulation": {"duration": 0.05}})
+    with pytest.raises(RigError, match=r"cartpole: the simulation is unstable at t = .*rig\.gravity"):
+        generate(sc)
