@@ -667,8 +667,8 @@ def fit_window(data: Measurement, fit_duration: float) -> tuple[int, int]:
 
 def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
                    lam_hat: np.ndarray,
-                   progress: Callable[[float | None, str | None], None] | None = None
-                   ) -> MatrixSGDResult:
+                   progress: Callable[[float | None, str | None], None] | None = None,
+                   peaks: np.ndarray | None = None) -> MatrixSGDResult:
     """Run the matrix-parametrised SGD.
 
     Parameters
@@ -684,6 +684,9 @@ def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
         = no eigenvalue penalty.
     progress : callable, optional
         ``progress(fraction, step)`` after every epoch (e.g. ``Identifier.report_progress``).
+    peaks : ndarray, optional
+        ``modal_peaks(data).peaks`` [Hz] for the fit band's cut-off if the caller has them
+        (:func:`identify.structural.fit_band_cutoff`; not searched again).
 
     Returns
     -------
@@ -705,7 +708,7 @@ def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
     W = nuisance_basis(data, 0, data.n_samples, inputs)[0]
     # the fit band (identify.structural.fit_band): one zero-phase high-pass on every feature,
     # target and nuisance column over the whole record, then the window
-    fc = fit_band_cutoff(data, est.fit_band_hz)[0]
+    fc = fit_band_cutoff(data, est.fit_band_hz, peaks)[0]
     if fc > 0:
         full = [elliptic_highpass(a, data.fs, fc, FIT_BAND_ORDER) for a in full]
         W = elliptic_highpass(W.T, data.fs, fc, FIT_BAND_ORDER).T if W.shape[1] else W

@@ -250,7 +250,7 @@ class SGDSINDyCoefficients(SGDSINDyBase):
         -------
         self
         """
-        lam_hat = self._start_fit(data)
+        lam_hat = self._start_fit(data)[0]
         m_hat = mass_prior_value(data, self.mass_prior)
         lib = build_library(data, coupled_mass=True, cubic=self.cubic_)
         n, p = lib.target.shape[0], lib.theta.shape[0]

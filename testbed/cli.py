@@ -22,6 +22,9 @@ from urllib.parse import urlsplit
 from testbed.core.errors import InputError, TestbedError
 
 EXIT_FAIL, EXIT_USAGE, EXIT_INTERNAL, EXIT_INTERRUPTED = 1, 2, 3, 130
+#: Thread-count variables of the BLAS libraries numpy and scipy load (OpenBLAS, MKL, an OpenMP
+#: build).  If the user sets none, a command runs its BLAS on one thread (:func:`_blas_threads`).
+BLAS_THREAD_VARIABLES = ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "OMP_NUM_THREADS")
 #: Seconds to wait for a Dask scheduler to accept a connection before calling it
 #: unreachable: a live scheduler on a LAN answers in milliseconds.
 DASK_CONNECT_TIMEOUT_S = 5.0
@@ -621,9 +624,27 @@ def _one_line(text: object) -> str:
     return " ".join(str(text).split())
 
 
+def _blas_threads() -> None:
+    """One BLAS thread for the command unless the user set a thread count (before numpy loads).
+
+    The testbed's matrices are small (a run's least squares are 12,800 x 12, its models 3-60
+    states): a second BLAS thread has nothing to share and spins while it waits.  Measured on
+    the 2-core machine under load (`testbed run cantilever_stiff_impact --no-figures`, 5 paired
+    runs): 6.24 s CPU with the default two OpenBLAS threads, 3.88 s with one; the fit alone
+    4.2 -> 1.6 s.  With one thread the results are also those of the tests, ``make`` and the
+    benchmarks, which all run on one: the scored simulation's last bits depend on the thread
+    count (TRAC 0.9999973639080992 with two threads, ...1009 with one).  Without effect when
+    numpy is already imported (the library called from Python: the caller's threads).
+    """
+    if not any(v in os.environ for v in BLAS_THREAD_VARIABLES):
+        for v in BLAS_THREAD_VARIABLES:
+            os.environ[v] = "1"
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run one command; return the exit status (0 ok, 1 a run failed its bars, 2 a user's
     mistake, 3 an internal error, 130 interrupted)."""
+    _blas_threads()
     args = build_parser().parse_args(argv)
     try:
         return args.fn(args)

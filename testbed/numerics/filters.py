@@ -13,6 +13,8 @@ and 30 dB stop-band attenuation after each integration to remove drift.
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 
@@ -129,17 +131,37 @@ def elliptic_highpass(x: np.ndarray, fs: float, cutoff_hz: float, order: int = 4
 
 def _highpass_sos(fs: float, cutoff_hz: float, order: int, ripple_db: float, stop_db: float
                   ) -> np.ndarray:
-    """Second-order sections of :func:`elliptic_highpass`'s design (one pass)."""
+    """Second-order sections of :func:`elliptic_highpass`'s design (one pass).
+
+    Designed once per parameter set and copied out (:func:`_ellip_sos`): a run asks for the
+    same few designs about 30 times (the chain's two passes on two records, the fit band on
+    every feature block), 3 ms of ``scipy.signal.ellip`` each.
+    """
+    return _ellip_sos(float(fs), float(cutoff_hz), int(order), float(ripple_db),
+                      float(stop_db)).copy()
+
+
+def _lowpass_sos(fs: float, cutoff_hz: float, order: int) -> np.ndarray:
+    """Second-order sections of :func:`lowpass`'s design (one pass), designed once per
+    parameter set (:func:`_butter_sos`) and copied out."""
+    return _butter_sos(float(fs), float(cutoff_hz), int(order)).copy()
+
+
+# The cached designs are never handed out (scipy's sosfilt needs a writable array, and a
+# caller could change it): the functions above return copies.
+@functools.lru_cache(maxsize=64)
+def _ellip_sos(fs: float, cutoff_hz: float, order: int, ripple_db: float, stop_db: float
+               ) -> np.ndarray:
     from scipy import signal as ss
 
     return ss.ellip(order, ripple_db, stop_db, cutoff_hz, btype="highpass", output="sos", fs=fs)
 
 
-def _lowpass_sos(fs: float, cutoff_hz: float, order: int) -> np.ndarray:
-    """Second-order sections of :func:`lowpass`'s design (one pass)."""
+@functools.lru_cache(maxsize=64)
+def _butter_sos(fs: float, cutoff_hz: float, order: int) -> np.ndarray:
     from scipy import signal as ss
 
-    return ss.butter(int(order), cutoff_hz, btype="lowpass", output="sos", fs=fs)
+    return ss.butter(order, cutoff_hz, btype="lowpass", output="sos", fs=fs)
 
 
 def chain_poles(fs: float, highpass: tuple[float, int, float, float] | None = None,

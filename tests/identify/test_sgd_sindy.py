@@ -245,3 +245,31 @@ def test_input_map_from_the_record_when_the_window_gain_is_refused(forced, monke
     assert "record" in model.input_map_rule_ and "non-positive" in model.input_map_rule_
     assert "driving point" in model.mass_scaling_rule_
     assert _rel(np.linalg.solve(model.M_, model.input_map_), want) < 0.02
+
+
+def test_the_default_peak_search_runs_once_per_fit(linear, monkeypatch):
+    """modal_peaks(data) serves the cubic rule, the eigenvalue targets and the fit band's
+    cut-off (it ran four times); a search of the user's n_modes is its own."""
+    import identify.sgd_sindy as ss
+    import identify.structural as st
+
+    _, data, _ = linear
+    before = SGDSINDy(epochs=2).fit(data)
+    calls = []
+    real = st.modal_peaks
+
+    def counted(*args, **kwargs):
+        calls.append((args[1:], kwargs))
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(ss, "modal_peaks", counted)
+    monkeypatch.setattr(st, "modal_peaks", counted)
+    after = SGDSINDy(epochs=2).fit(data)
+    assert len(calls) == 1
+    assert np.array_equal(after.coef_, before.coef_)
+    for attr in ("cubic_rule_", "fit_band_hz_", "fit_band_rule_", "peak_band_rule_"):
+        assert getattr(after, attr) == getattr(before, attr), attr
+    assert np.array_equal(after.measured_frequencies_, before.measured_frequencies_)
+    calls.clear()
+    SGDSINDy(epochs=2, n_modes=1).fit(data)
+    assert len(calls) == 2  # the default search (cubic rule, fit band) and the n_modes one

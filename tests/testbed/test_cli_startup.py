@@ -160,3 +160,42 @@ def test_mujoco_is_imported_without_its_renderer():
 def test_a_users_mujoco_gl_setting_is_kept():
     out = _mujoco_import_in_fresh_process("off")  # a synonym of "disable": no GL library needed
     assert out["MUJOCO_GL"] == "off" and not out["glfw"]
+
+
+def _blas_after_cli_in_fresh_process(user: dict[str, str]) -> dict:
+    """Run ``testbed --version`` in a fresh process whose environment sets only ``user`` of the
+    BLAS thread variables, then load numpy: the thread variables and OpenBLAS's thread count."""
+    from testbed.cli import BLAS_THREAD_VARIABLES
+
+    env = {k: v for k, v in os.environ.items() if k not in BLAS_THREAD_VARIABLES}
+    env.update(PYTHONPATH=str(ROOT), MPLBACKEND="Agg", **user)
+    code = f"""
+        import contextlib, io, json, os
+        from testbed.cli import main
+        with contextlib.redirect_stdout(io.StringIO()):
+            try:
+                main(["--version"])
+            except SystemExit:
+                pass
+        import numpy
+        from threadpoolctl import threadpool_info
+        print(json.dumps({{"env": {{v: os.environ.get(v) for v in {BLAS_THREAD_VARIABLES!r}}},
+                          "threads": [i["num_threads"] for i in threadpool_info()
+                                      if i["user_api"] == "blas"]}}))
+    """
+    r = subprocess.run([sys.executable, "-c", textwrap.dedent(code)], cwd=ROOT, env=env,
+                       capture_output=True, text=True, timeout=TIMEOUT_S)
+    assert r.returncode == 0, r.stderr
+    return json.loads(r.stdout.strip().splitlines()[-1])
+
+
+def test_a_command_runs_blas_on_one_thread():
+    """Unset, the command's BLAS runs one thread (small matrices: a second one only spins)."""
+    out = _blas_after_cli_in_fresh_process({})
+    assert set(out["env"].values()) == {"1"}
+    assert out["threads"] and set(out["threads"]) == {1}
+
+
+def test_a_users_blas_thread_setting_is_kept():
+    out = _blas_after_cli_in_fresh_process({"OPENBLAS_NUM_THREADS": "2"})
+    assert out["env"] == {"OPENBLAS_NUM_THREADS": "2", "MKL_NUM_THREADS": None, "OMP_NUM_THREADS": None}

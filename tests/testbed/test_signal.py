@@ -349,3 +349,22 @@ def test_lowpass_differentiate_rejects_bad_settings(kw, match):
     args = {"cutoff_hz": 4.0} | kw
     with pytest.raises(ValueError, match=match):
         der.lowpass_differentiate(np.zeros((2, 5000)), 1e4, **args)
+
+
+def test_a_filter_design_is_computed_once_and_handed_out_as_a_copy(monkeypatch):
+    """The designs are cached per parameter set (a run asks for the same few ~30 times); each
+    caller gets its own copy, equal to scipy's design, that it may change without harm."""
+    sig._ellip_sos.cache_clear()
+    sig._butter_sos.cache_clear()
+    calls = []
+    real = ss.ellip
+    monkeypatch.setattr(ss, "ellip", lambda *a, **k: calls.append(a) or real(*a, **k))
+    want = real(4, 0.1, 30.0, 20.0, btype="highpass", output="sos", fs=12800.0)
+    a = sig._highpass_sos(12800.0, 20.0, 4, 0.1, 30.0)
+    a[:] = 0.0  # a caller's change stays its own
+    b = sig._highpass_sos(np.float64(12800.0), 20, 4, 0.1, 30)
+    assert len(calls) == 1 and np.array_equal(b, want) and b.flags.writeable
+    lp = sig._lowpass_sos(12800.0, 450.0, 8)
+    lp[:] = 0.0
+    assert np.array_equal(sig._lowpass_sos(12800.0, 450.0, 8),
+                          ss.butter(8, 450.0, btype="lowpass", output="sos", fs=12800.0))
