@@ -434,15 +434,15 @@ def noise_knobs(x: np.ndarray, fs: float, val_fraction: float, user: dict[str, A
        strong form, column low-pass at ``CUTOFF_FACTOR * band_hz`` (below Nyquist), edge trim
        ``EDGE_PERIODS / cutoff`` (the user's cut-off if set; at most ``EDGE_MAX_SHARE`` of
        the record), ridge ``RIDGE_EXACT``, every LHS candidate.
-    4. Noisy, rates and accelerations derived by a low-pass chain (``passband[1] < fs / 2``,
-       or ``smoothed``): the strong form with the column low-pass and edge trim of 3 for a
-       declared chain (the trim at most ``EDGE_MAX_SHARE_DERIVED`` of the record); for ``smoothed`` data without a declared pass band the weak form (no
-       acceleration of the noisy angles enters), test functions of ``WEAK_PERIODS / band_hz``
-       seconds (at most half the held-out span), edge trim ``EDGE_PERIODS * window /
-       WEAK_PERIODS``; either way ridge ``RIDGE_PER_NOISE_VAR * noise_rel^2``, and LHS
-       candidates the terms with an input factor (``"inputs"``): the
-       inputs are measured exactly, so an equation is written for its exact input term,
-       never for a term the noise dominates.
+    4. Noisy, rates and accelerations derived by a low-pass chain (``passband[1] < fs / 2``, or
+       ``smoothed``): the strong form with the column low-pass and edge trim of 3 for a declared chain
+       (the trim at most ``EDGE_MAX_SHARE_DERIVED`` of the record); for ``smoothed`` data without a
+       declared pass band the weak form (no acceleration of the noisy angles enters), test functions
+       of ``WEAK_PERIODS / band_hz`` seconds (at most half the held-out span), edge trim
+       ``EDGE_PERIODS * window / WEAK_PERIODS``; either way ridge ``RIDGE_PER_NOISE_VAR *
+       noise_rel^2``, and LHS candidates the terms with an input factor (``"inputs"``): the inputs are
+       measured exactly, so an equation is written for its exact input term, never for a term the
+       noise dominates.
     5. ``formulation`` given by the user: that form, with the window, trim and ridge of its
        branch above (the weak form's window as in 4).
 

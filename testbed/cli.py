@@ -456,13 +456,39 @@ def cmd_identify(args: argparse.Namespace) -> int:
                                format=args.format, fs=args.fs, units=units,
                                prior=_key_values(args.prior, "--prior", numbers=True), phase=phase)
     summary = result.summary()
+    failures = _physical_failures(summary)
+    if failures is not None:
+        summary["physical_failures"] = failures
     text = json.dumps(summary, indent=1, allow_nan=True) + "\n"
     report = render_identified(summary)
     atomic_write_text(out, text)
     atomic_write_text(out.with_suffix(".md"), report)
     print(report, end="")
     print(f"model written to {out} (report {out.with_suffix('.md')})")
+    if failures:
+        print(f"FAIL: physically impossible model: {'; '.join(failures.values())}")
+        return EXIT_FAIL
     return 0
+
+
+def _physical_failures(summary: dict) -> dict[str, str] | None:
+    """What makes an identified structural model physically impossible
+    (:func:`testbed.scoring.scorers.physical_failures`: M not symmetric positive definite,
+    negative damping, a growing pole); None for a model without matrices.
+
+    Without a truth, ``identify`` has no score; a model no passive structure can have is still
+    a failed identification, never a result: the model is written (to be looked at) with the
+    reasons under ``physical_failures``, and the command exits 1 with a ``FAIL:`` line.
+    """
+    import numpy as np
+
+    from testbed.scoring.scorers import physical_failures
+
+    mats = summary.get("matrices")
+    if not mats:
+        return None
+    M, C, K = (np.asarray(mats[k], dtype=float) for k in ("M", "C", "K"))
+    return physical_failures(M, C, K)
 
 
 def cmd_runs(args: argparse.Namespace) -> int:

@@ -11,8 +11,8 @@ from identify import sindy_pi as sp
 from identify.sindy_pi import SINDyPI
 from testbed.core.errors import HyperparameterError
 from testbed.numerics.derivatives import lowpass_differentiate
-from testbed.pipeline.signal_chain import auto_edge_fit
 from testbed.numerics.noise import noise_std
+from testbed.pipeline.signal_chain import auto_edge_fit
 from testbed.scoring.equation_basis import evaluate_terms
 
 
@@ -187,7 +187,7 @@ def test_declared_noise_rule_is_overridden_by_the_user(clean):
     data = _chain_smoothed(clean, 1.0)
     lhs = ["sin(th2-th3)*u1"]
     user = {"formulation": "weak", "ridge": 1e-6, "lhs": lhs}
-    knobs, rule, est = sp.noise_knobs(data.x, data.fs, 0.2, user, None, data.noise_std,
+    knobs, rule, _est = sp.noise_knobs(data.x, data.fs, 0.2, user, None, data.noise_std,
                                       data.passband)
     assert (knobs["formulation"], knobs["ridge"], knobs["lhs"]) == ("weak", 1e-6, lhs)
     assert knobs["column_lowpass_hz"] == 0.0 and knobs["weak_window_s"] > 0
@@ -213,7 +213,7 @@ def test_declared_chain_trims_a_column_filter_period_up_to_a_quarter_of_the_reco
     x = np.stack([0.07 * np.cos(t + k) for k in range(4)])
     x = x + 1e-2 * x.std(axis=1, keepdims=True) * np.random.default_rng(0).standard_normal(x.shape)
     declared = np.full(4, 1e-2 * 0.07 / np.sqrt(2))
-    knobs, rule, est = sp.noise_knobs(x, fs, 0.2, {}, None, declared, (0.0, 0.8))
+    knobs, _rule, _est = sp.noise_knobs(x, fs, 0.2, {}, None, declared, (0.0, 0.8))
     want = sp.EDGE_PERIODS / knobs["column_lowpass_hz"]
     assert want > sp.EDGE_MAX_SHARE * 10.0
     assert knobs["formulation"] == "strong"

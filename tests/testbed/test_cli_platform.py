@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from testbed.cli import EXIT_USAGE, build_parser, main
+from testbed.cli import EXIT_FAIL, EXIT_USAGE, build_parser, main
 from testbed.pipeline.scenario import list_scenarios, load_scenario
 
 ROOT = Path(__file__).resolve().parent.parent.parent
@@ -107,6 +107,14 @@ def test_plugin_file_on_list_and_identify(tmp_path, dataset_cache):
     model = json.loads((tmp_path / "m.json").read_text())
     assert model["identifier"]["params"] == {"gain": 4.0}
     assert model["matrices"]["K"][0][0] == 4.0
+    assert model["physical_failures"] == {}
+    # a negative stiffness grows: written (to be looked at) with its reasons, but a failure
+    r = cli("identify", str(data), "--kind", "structural", "--method", "my_file_method",
+            "--plugin", str(plugin), "--param", "gain=-4", "-o", "m.json", cwd=tmp_path)
+    assert r.returncode == EXIT_FAIL, r.stderr
+    assert r.stdout.splitlines()[-1].startswith("FAIL: physically impossible model: unstable")
+    assert "Traceback" not in r.stderr
+    assert "stability" in json.loads((tmp_path / "m.json").read_text())["physical_failures"]
 
 
 def test_entry_point_plugin(tmp_path):
