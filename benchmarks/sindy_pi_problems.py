@@ -17,6 +17,7 @@ coefficient rows scaled to max |coef| = 1 with that entry positive.
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -35,9 +36,19 @@ class Problem:
     truth_coef: np.ndarray
 
 
+@functools.lru_cache(maxsize=None)
+def _phases(seed: int, n: int) -> np.ndarray:
+    """The ``n`` seeded phases [rad] of :func:`multisine`, drawn once per (seed, n): the
+    right-hand sides call it at every sample, where seeding a generator each time was most of
+    the cost of a record.  Read-only, shape (n,)."""
+    ph = np.random.default_rng(seed).uniform(0, 2 * np.pi, n)
+    ph.flags.writeable = False
+    return ph
+
+
 def multisine(t: np.ndarray, amp: float, freqs: np.ndarray, seed: int) -> np.ndarray:
     """Sum of sines with seeded phases: amp * sum_f sin(2 pi f t + phi_f) / sqrt(n_f)."""
-    ph = np.random.default_rng(seed).uniform(0, 2 * np.pi, freqs.size)
+    ph = _phases(seed, freqs.size)
     return amp * np.sin(2 * np.pi * freqs[:, None] * np.atleast_1d(t)[None] + ph[:, None]).sum(0) \
         / np.sqrt(freqs.size)
 
