@@ -36,7 +36,7 @@ class Problem:
     truth_coef: np.ndarray
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _phases(seed: int, n: int) -> np.ndarray:
     """The ``n`` seeded phases [rad] of :func:`multisine`, drawn once per (seed, n): the
     right-hand sides call it at every sample, where seeding a generator each time was most of

@@ -43,7 +43,7 @@ def _pip_installs_into_other_interpreters() -> bool:
     from importlib.metadata import PackageNotFoundError, version  # (importing pip would warn)
 
     try:
-        major, minor = (version("pip").split(".") + ["0"])[:2]
+        major, minor = [*version("pip").split("."), "0"][:2]
     except PackageNotFoundError:
         return False
     return major.isdigit() and minor.isdigit() and (int(major), int(minor)) >= (22, 3)
