@@ -17,6 +17,7 @@ coefficient rows scaled to max |coef| = 1 with that entry positive.
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -35,9 +36,19 @@ class Problem:
     truth_coef: np.ndarray
 
 
+@functools.cache
+def _phases(seed: int, n: int) -> np.ndarray:
+    """The ``n`` seeded phases [rad] of :func:`multisine`, drawn once per (seed, n): the
+    right-hand sides call it at every sample, where seeding a generator each time was most of
+    the cost of a record.  Read-only, shape (n,)."""
+    ph = np.random.default_rng(seed).uniform(0, 2 * np.pi, n)
+    ph.flags.writeable = False
+    return ph
+
+
 def multisine(t: np.ndarray, amp: float, freqs: np.ndarray, seed: int) -> np.ndarray:
     """Sum of sines with seeded phases: amp * sum_f sin(2 pi f t + phi_f) / sqrt(n_f)."""
-    ph = np.random.default_rng(seed).uniform(0, 2 * np.pi, freqs.size)
+    ph = _phases(seed, freqs.size)
     return amp * np.sin(2 * np.pi * freqs[:, None] * np.atleast_1d(t)[None] + ph[:, None]).sum(0) \
         / np.sqrt(freqs.size)
 
@@ -82,7 +93,7 @@ def double_pendulum(duration: float = 3.0, fs: float = 1e4, amp: float = 4.0, se
                       [m2 * l1 * l2 * np.cos(d), m2 * l2**2]])
         f = np.array([u1 - m2 * l1 * l2 * np.sin(d) * w2**2 - (m1 + m2) * g * l1 * np.sin(th1) - c[0] * w1,
                       u2 + m2 * l1 * l2 * np.sin(d) * w1**2 - m2 * g * l2 * np.sin(th2) - c[1] * w2])
-        return np.r_[w1, w2, np.linalg.solve(M, f)]
+        return np.concatenate(([w1, w2], np.linalg.solve(M, f)))  # (np.r_ is slower per call)
 
     t, x, xd, xdd = _record(rhs, np.zeros(4), fs, duration)
     k = m2 * l1 * l2
@@ -128,7 +139,7 @@ def fivebar(duration: float = 3.0, fs: float = 1e4, amp: float = 0.4, seed: int 
         gamma = (a * e) @ w**2 - 2 * 20.0 * (J @ w) - 20.0**2 * g  # Baumgarte, alpha = 20 1/s
         K = np.block([[M, -J.T], [J, np.zeros((2, 2))]])
         tau = np.array([u[0], 0.0, 0.0, u[1]])
-        return np.r_[w, np.linalg.solve(K, np.r_[tau - h, gamma])[:4]]
+        return np.concatenate((w, np.linalg.solve(K, np.concatenate((tau - h, gamma)))[:4]))
 
     q = np.array([q0[0], 1.0, 2.0, q0[1]])
     for _ in range(50):  # assemble the passive angles th2, th3 (Newton)

@@ -96,12 +96,12 @@ def pytest_collection_modifyitems(config, items):
 #: lets both workers finish together: dealt by number of tests (xdist's default), the wheel's
 #: 2-test group (106 s) started 513 s into the run and a 1-test fit of 49 s at 649 s.
 _COLD_SECONDS = {
-    "tests/identify/test_conformance.py": 158, "tests/test_wheel.py": 106,
+    "tests/identify/test_conformance.py": 158, "tests/test_wheel.py": 80,
     "tests/identify/test_sgd_sindy.py": 80, "tests/models/test_fivebar_dynamics.py": 69,
     "chromium": 65, "tests/models/test_fivebar_energy.py": 57,
     "tests/identify/test_sindy_pi_noise.py": 55, "tests/identify/test_sindy_pi.py": 50,
     "tests/identify/test_sindy_pi_linear.py": 49, "tests/identify/test_sindy_pi_fivebar.py": 44,
-    "tests/identify/test_sgd_split.py": 36, "tests/identify/test_weak.py": 35,
+    "tests/identify/test_sgd_split.py": 36, "tests/identify/test_weak.py": 24,
     "tests/identify/test_ls_sindy.py": 33, "tests/identify/test_mechsim.py": 32,
     "tests/test_third_rig.py": 30, "tests/identify/test_sindy_pi_dynamical.py": 29,
     "tests/testbed/test_sweep.py": 29, "tests/testbed/test_faults.py": 26,
