@@ -492,12 +492,16 @@ def _physical_failures(summary: dict) -> dict[str, str] | None:
 
 
 def cmd_runs(args: argparse.Namespace) -> int:
-    from testbed.studies.runstore import list_runs
+    from testbed.studies.runstore import list_runs, unreadable_runs
 
     if Path(args.out).exists() and not Path(args.out).is_dir():
         raise InputError(f"--out {args.out}: not a folder; expected the folder of runs "
                          "(from `testbed run --out`)")
     runs = list_runs(args.out, scenario=args.scenario)
+    damaged = unreadable_runs(args.out)
+    if damaged:  # left out of the table, but never silently
+        print(f"warning: {len(damaged)} run folder(s) left out, their run.json is damaged or of "
+              f"another format: {', '.join(map(str, damaged))}", file=sys.stderr)
     cols = ("scenario", "seed", "time (UTC)", "identifier", "verdict", "path")
     rows = [(r["scenario"], str(r["seed"]), r["created"].replace("+00:00", "Z"), r["identifier"],
              r["verdict"], str(r["path"])) for r in runs]

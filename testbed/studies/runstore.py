@@ -715,13 +715,40 @@ def _runs_in(folder: Path) -> list[dict[str, Any]]:
     return rows
 
 
+def unreadable_runs(out_dir: str | os.PathLike) -> list[Path]:
+    """Run folders in ``out_dir`` that :func:`list_runs` leaves out: a ``run.json`` that cannot
+    be read, is not JSON, or is not of this format (damaged, truncated or foreign).
+
+    Parameters
+    ----------
+    out_dir : path-like
+        As for :func:`list_runs`.
+
+    Returns
+    -------
+    list of Path
+        Sorted folder paths; empty if every run folder is readable.
+    """
+    out = Path(out_dir)
+    if not out.is_dir():
+        return []
+    found = []
+    for p in sorted(out.iterdir()):
+        if p.name.startswith("."):
+            continue
+        inner = sorted(c for c in p.iterdir() if not c.name.startswith(".")) \
+            if p.is_dir() and not p.is_symlink() else []
+        found += [c for c in (p, *inner) if _is_run_folder(c) and _read_row(c) is None]
+    return found
+
+
 def list_runs(out_dir: str | os.PathLike, scenario: str | None = None) -> list[dict[str, Any]]:
     """The saved runs in ``out_dir`` (``testbed run``'s ``out/runs``), oldest first.
 
     Reads run folders directly under ``out_dir`` (written by :func:`save_run` into a
     :func:`run_folder`) and inside its scenario folders (:func:`save_new_run`).  Only
     ``run.json`` is read (not the arrays); a folder without a readable ``run.json`` of this
-    format is left out.
+    format is left out (:func:`unreadable_runs` names those that hold a damaged one).
 
     Parameters
     ----------

@@ -206,7 +206,9 @@ def test_runs_ls_and_report_by_scenario_name(tmp_path, capsys):
     second = save_new_run(result, tmp_path, index=runs_index_html)
     (tmp_path / "not_a_run").mkdir()
     assert main(["runs", "ls", "-o", str(tmp_path)]) == 0
-    lines = capsys.readouterr().out.splitlines()
+    out, err = capsys.readouterr()
+    assert err == ""  # no damaged run folder to warn about
+    lines = out.splitlines()
     # piped: a header and one tab-separated line per run, every field whole, oldest first
     assert lines[0].split("\t") == ["scenario", "seed", "time (UTC)", "identifier", "verdict", "path"]
     rows = [line.split("\t") for line in lines[1:]]
@@ -218,6 +220,17 @@ def test_runs_ls_and_report_by_scenario_name(tmp_path, capsys):
         assert r[3] == result.scenario.identify["method"] and r[4] == result.verdict and r[2].endswith("Z")
     assert main(["runs", "ls", "no_such_scenario", "-o", str(tmp_path)]) == 0
     assert capsys.readouterr().out.splitlines()[1:] == []
+    # a damaged run.json is left out of the table, and said so on one line
+    damaged = tmp_path / result.scenario.name / "damaged_run"
+    damaged.mkdir()
+    (damaged / "run.json").write_text('{"format": ')
+    assert main(["runs", "ls", "-o", str(tmp_path)]) == 0
+    out, err = capsys.readouterr()
+    assert len(out.splitlines()) == 4 and str(damaged) not in out
+    assert len(err.splitlines()) == 1 and err.startswith("warning: 1 run folder(s) left out")
+    assert str(damaged) in err
+    damaged.joinpath("run.json").unlink()
+    damaged.rmdir()
     # a scenario's name or folder means its latest run
     assert main(["report", result.scenario.name, "--runs", str(tmp_path), "-o", str(tmp_path / "r1")]) == 0
     assert main(["report", str(tmp_path / result.scenario.name), "-o", str(tmp_path / "r2")]) == 0
