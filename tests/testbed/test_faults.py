@@ -172,19 +172,26 @@ def _fill_and_read(args) -> tuple[str, int]:
     return ds.content_hash(), len(warned)
 
 
+def _variant(path, base: str, name: str, tables: str):
+    """Write a scenario file at ``path`` extending the shipped ``base`` as ``name``, with the
+    TOML ``tables`` (indented text) added; return ``path``."""
+    path.write_text(textwrap.dedent(f"""
+        [scenario]
+        extends = "{ROOT / 'scenarios' / (base + '.toml')}"
+        name = "{name}"
+    """) + textwrap.dedent(tables))
+    return path
+
+
 def test_generate_to_a_file_fills_the_run_cache(tmp_path):
     from testbed.cli import main
 
-    variant = tmp_path / "short.toml"
-    variant.write_text(textwrap.dedent(f"""
-        [scenario]
-        extends = "{ROOT / 'scenarios' / 'cantilever_stiff_impact.toml'}"
-        name = "short"
+    variant = _variant(tmp_path / "short.toml", "cantilever_stiff_impact", "short", """
         [simulation]
         duration = 0.05
         [noise]
         rms_percent = 1.0
-    """))
+    """)
     out, cache_dir = tmp_path / "d.h5", tmp_path / "cache"
     assert main(["generate", str(variant), "-o", str(out), "--cache", str(cache_dir)]) == 0
     cache = DatasetCache(cache_dir)
@@ -544,14 +551,11 @@ def test_two_concurrent_testbed_runs_of_one_scenario(tmp_path):
     cache, out = tmp_path / "cache", tmp_path / "runs"
     # the shipped scenario over 0.1 s of its 1 s: what is checked is the run store and the cache
     # under two writers, not the identification (a failed verdict, exit 1, is accepted below)
-    scenario = tmp_path / "cantilever_stiff_impact_lsq.toml"
-    scenario.write_text(textwrap.dedent(f"""
-        [scenario]
-        extends = "{ROOT / 'scenarios' / 'cantilever_stiff_impact_lsq.toml'}"
-        name = "cantilever_stiff_impact_lsq"
+    scenario = _variant(tmp_path / "cantilever_stiff_impact_lsq.toml", "cantilever_stiff_impact_lsq",
+                        "cantilever_stiff_impact_lsq", """
         [simulation]
         duration = 0.1
-    """))
+    """)
     cmd = [sys.executable, "-m", "testbed.cli", "run", str(scenario), "--no-figures",
            "--cache", str(cache), "-o", str(out)]
     procs = [subprocess.Popen(cmd, cwd=ROOT, env=_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE,
