@@ -254,6 +254,7 @@ class LeastSquaresSINDy(StructuralIdentifier):
                                           drift=True, input_coupling=True), self.fit_band_hz,
             ps.peaks)
         masses = np.full(lib.target.shape[0], m_hat / lib.target.shape[0])
+        hold = (data, ps.peaks, masses[:, None], lib.blocks["v"], lib.blocks["d"])
         if self.fit_tilt is False or (self.fit_tilt is None and self.cubic_):
             self.fit_tilt_ = False
             self.fit_tilt_rule_ = ("fit_tilt = False (user setting)" if self.fit_tilt is False
@@ -270,7 +271,6 @@ class LeastSquaresSINDy(StructuralIdentifier):
             except IdentificationError as e:
                 if self.fit_tilt:  # the user's choice: refused, not replaced
                     raise
-                hold = (data, ps.peaks, masses[:, None], lib.blocks["v"], lib.blocks["d"])
                 if self._held_physical(hold):
                     self.fit_tilt_rule_ = (f"rule: the tilted fit had a growing pole ({e}); "
                                            "kept, physical after the holds")
@@ -281,7 +281,7 @@ class LeastSquaresSINDy(StructuralIdentifier):
                                        "after the holds; fitted flat")
                 self._solve(data, lib, masses)
                 self._check_physical()
-        self._hold(data, ps.peaks, masses[:, None], lib.blocks["v"], lib.blocks["d"])
+        self._hold(*hold)
         self._finish_fit(data)
         return self
 

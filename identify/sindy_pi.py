@@ -435,7 +435,7 @@ def noise_knobs(x: np.ndarray, fs: float, val_fraction: float, user: dict[str, A
        ``EDGE_PERIODS / cutoff`` (the user's cut-off if set; at most ``EDGE_MAX_SHARE`` of
        the record), ridge ``RIDGE_EXACT``, every LHS candidate.
     4. Noisy, rates and accelerations derived by a low-pass chain (``passband[1] < fs / 2``, or
-       ``smoothed``): the strong form with the column low-pass and edge trim of 3 for a declared chain
+       ``smoothed``): the strong form with the column low-pass and edge trim of item 3 for a declared chain
        (the trim at most ``EDGE_MAX_SHARE_DERIVED`` of the record); for ``smoothed`` data without a
        declared pass band the weak form (no acceleration of the noisy angles enters), test functions
        of ``WEAK_PERIODS / band_hz`` seconds (at most half the held-out span), edge trim

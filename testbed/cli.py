@@ -55,16 +55,15 @@ def _int_at_least(low: int, high: int | None = None) -> Callable[[str], int]:
     return parse
 
 
-def _noise_seed(text: str) -> int:
-    """A noise seed, as a scenario's ``seed`` (:data:`testbed.pipeline.scenario.MAX_SEED`)."""
+def _seed(text: str) -> int:
+    """A noise seed: an integer >= 0 (numpy's generators take no negative seeds) that fits the
+    64-bit integers datasets and results store, as a scenario's ``seed``
+    (:data:`testbed.pipeline.scenario.MAX_SEED`)."""
     from testbed.pipeline.scenario import MAX_SEED
 
     return _int_at_least(0, MAX_SEED)(text)
 
 
-#: A noise seed: an integer >= 0 (numpy's generators take no negative seeds) that fits the
-#: 64-bit integers datasets and results store.
-_seed = _noise_seed
 #: A worker count: an integer >= 1.
 _jobs = _int_at_least(1)
 
@@ -492,13 +491,13 @@ def _physical_failures(summary: dict) -> dict[str, str] | None:
 
 
 def cmd_runs(args: argparse.Namespace) -> int:
-    from testbed.studies.runstore import list_runs, unreadable_runs
+    from testbed.studies.runstore import list_runs
 
     if Path(args.out).exists() and not Path(args.out).is_dir():
         raise InputError(f"--out {args.out}: not a folder; expected the folder of runs "
                          "(from `testbed run --out`)")
-    runs = list_runs(args.out, scenario=args.scenario)
-    damaged = unreadable_runs(args.out)
+    damaged: list[Path] = []
+    runs = list_runs(args.out, scenario=args.scenario, damaged=damaged)
     if damaged:  # left out of the table, but never silently
         print(f"warning: {len(damaged)} run folder(s) left out, their run.json is damaged or of "
               f"another format: {', '.join(map(str, damaged))}", file=sys.stderr)

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from testbed.numerics.filters import _as_signal, _check_cutoff
+from testbed.numerics.filters import _as_signal, _check_cutoff, _lowpass_sos
 
 
 def _local_poly_rows(window: int, polyorder: int, positions: np.ndarray) -> np.ndarray:
@@ -273,7 +273,7 @@ def lowpass_differentiate(x: np.ndarray, fs: float, cutoff_hz: float, order: int
     bridge = _quintic_bridge(start, end, n, fs)
     from scipy import signal as ss  # lazy: scipy.signal costs ~0.7 s of import
 
-    sos = ss.butter(int(order), cutoff_hz, btype="lowpass", output="sos", fs=fs)
+    sos = _lowpass_sos(fs, cutoff_hz, order)
     pad = min(n - 1, round(8.0 / cutoff_hz * fs))
     ys = ss.sosfiltfilt(sos, _odd_about_zero(x2 - bridge[0], pad), axis=-1, padtype=None)
     ys = ys[..., pad:pad + n]

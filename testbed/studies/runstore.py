@@ -706,55 +706,40 @@ def _read_row(p: Path) -> dict[str, Any] | None:
         return None
 
 
-def _runs_in(folder: Path) -> list[dict[str, Any]]:
-    """Rows of ``folder`` itself if it is a run folder, and of the run folders in it."""
-    rows = [r for r in [_read_row(folder)] if r is not None]
+def _runs_in(folder: Path, damaged: list[Path] | None = None) -> list[dict[str, Any]]:
+    """Rows of ``folder`` itself if it is a run folder, and of the run folders in it; run
+    folders whose ``run.json`` cannot be read are appended to ``damaged`` if given."""
+    candidates = [folder]
     if folder.is_dir() and not folder.is_symlink():
-        rows += [r for c in sorted(folder.iterdir()) if not c.name.startswith(".")
-                 and (r := _read_row(c)) is not None]
+        candidates += [c for c in sorted(folder.iterdir()) if not c.name.startswith(".")]
+    rows = []
+    for c in candidates:
+        row = _read_row(c)
+        if row is not None:
+            rows.append(row)
+        elif damaged is not None and _is_run_folder(c):
+            damaged.append(c)
     return rows
 
 
-def unreadable_runs(out_dir: str | os.PathLike) -> list[Path]:
-    """Run folders in ``out_dir`` that :func:`list_runs` leaves out: a ``run.json`` that cannot
-    be read, is not JSON, or is not of this format (damaged, truncated or foreign).
-
-    Parameters
-    ----------
-    out_dir : path-like
-        As for :func:`list_runs`.
-
-    Returns
-    -------
-    list of Path
-        Sorted folder paths; empty if every run folder is readable.
-    """
-    out = Path(out_dir)
-    if not out.is_dir():
-        return []
-    found = []
-    for p in sorted(out.iterdir()):
-        if p.name.startswith("."):
-            continue
-        inner = sorted(c for c in p.iterdir() if not c.name.startswith(".")) \
-            if p.is_dir() and not p.is_symlink() else []
-        found += [c for c in (p, *inner) if _is_run_folder(c) and _read_row(c) is None]
-    return found
-
-
-def list_runs(out_dir: str | os.PathLike, scenario: str | None = None) -> list[dict[str, Any]]:
+def list_runs(out_dir: str | os.PathLike, scenario: str | None = None, *,
+              damaged: list[Path] | None = None) -> list[dict[str, Any]]:
     """The saved runs in ``out_dir`` (``testbed run``'s ``out/runs``), oldest first.
 
     Reads run folders directly under ``out_dir`` (written by :func:`save_run` into a
     :func:`run_folder`) and inside its scenario folders (:func:`save_new_run`).  Only
     ``run.json`` is read (not the arrays); a folder without a readable ``run.json`` of this
-    format is left out (:func:`unreadable_runs` names those that hold a damaged one).
+    format is left out (and named in ``damaged`` if it holds a damaged one).
 
     Parameters
     ----------
     out_dir : path-like
     scenario : str, optional
         Only the runs of this scenario.
+    damaged : list of Path, optional
+        If given, the run folders left out because their ``run.json`` cannot be read, is not
+        JSON or is of another format (damaged, truncated or foreign) are appended to it, in
+        folder order, whatever their scenario.
 
     Returns
     -------
@@ -768,7 +753,8 @@ def list_runs(out_dir: str | os.PathLike, scenario: str | None = None) -> list[d
     out = Path(out_dir)
     if not out.is_dir():
         return []
-    runs = [r for p in sorted(out.iterdir()) if not p.name.startswith(".") for r in _runs_in(p)]
+    runs = [r for p in sorted(out.iterdir()) if not p.name.startswith(".")
+            for r in _runs_in(p, damaged)]
     if scenario is not None:
         runs = [r for r in runs if r["scenario"] == scenario]
     return sorted(runs, key=lambda r: (r["created"], r["scenario"], r["id"]))
