@@ -75,7 +75,8 @@ class PySINDyPI(_ImplicitMechanical):
     Parameters
     ----------
     library, lhs, val_fraction, selection, selection_rtol, selection_atol, n_rollout,
-    prune_tol, sim_dt, reconcile, column_lowpass_hz, column_lowpass_order, edge_trim, input_hold
+    rollout_segments, prune_tol, sim_dt, reconcile, column_lowpass_hz, column_lowpass_order,
+    edge_trim, input_hold
         As :class:`~identify.sindy_pi.SINDyPI`.
     reg_weight_lam : float
         L1 weight of pysindy's objective.  1e-6 is the value of pysindy's SINDy-PI example; on
@@ -122,15 +123,15 @@ class PySINDyPI(_ImplicitMechanical):
     }, (
         "library", "lhs", "reg_weight_lam", "tol", "max_iter", "qr", "normalize", "support_tol",
         "stride", "val_fraction", "selection", "selection_rtol", "selection_atol", "n_rollout",
-        "prune_tol", "sim_dt", "reconcile", "column_lowpass_hz", "column_lowpass_order",
-        "edge_trim", "input_hold"))  # __init__ order, for the guide
+        "rollout_segments", "prune_tol", "sim_dt", "reconcile", "column_lowpass_hz",
+        "column_lowpass_order", "edge_trim", "input_hold"))  # __init__ order, for the guide
 
     def __init__(self, library: Any = "fivebar", lhs: Sequence[str] | None = None,
                  reg_weight_lam: float = 1e-6, tol: float = 1e-5, max_iter: int = 10000,
                  qr: bool = False, normalize: bool = True, support_tol: float = 0.0, stride: int = 1,
                  val_fraction: float = 0.2,
                  selection: str = "holdout", selection_rtol: float = 0.1,
-                 selection_atol: float = 1e-12, n_rollout: int = 3,
+                 selection_atol: float = 1e-12, n_rollout: int = 3, rollout_segments: int = 6,
                  prune_tol: float | None = 1e-9, sim_dt: float = 1e-3, reconcile: bool = True,
                  column_lowpass_hz: float | None = None, column_lowpass_order: int = 4,
                  edge_trim: float = 0.0, input_hold: str = "linear"):
@@ -148,6 +149,7 @@ class PySINDyPI(_ImplicitMechanical):
         self.selection_rtol = selection_rtol
         self.selection_atol = selection_atol
         self.n_rollout = n_rollout
+        self.rollout_segments = rollout_segments
         self.prune_tol = prune_tol
         self.sim_dt = sim_dt
         self.reconcile = reconcile
