@@ -17,6 +17,7 @@ the linear beam (the tests check the measured ratio).
 from __future__ import annotations
 
 import logging
+import math
 from collections.abc import Callable
 from typing import Any, ClassVar
 
@@ -27,14 +28,16 @@ from models._base import ErrorFn, Rig, check_two_samples
 from models.cantilever.beam import BeamParams
 from models.cantilever.model import CantileverModel, build_model, hit_position, sensor_positions
 from models.cantilever.simulate import (
+    IMPLICIT_ACCURACY,
     MUJOCO_MAX_CONTROL,
+    RK4_ACCURACY,
     half_sine,
     mode_errors,
     rollout_sensors,
     static_equilibrium,
     unstable_modes,
 )
-from testbed.core.budget import MEMORY_BUDGET_BYTES, SAMPLE_BUDGET, STEP_BUDGET, Cost
+from testbed.core.budget import CPU_BUDGET_S, MEMORY_BUDGET_BYTES, SAMPLE_BUDGET, STEP_BUDGET, Cost
 from testbed.core.dataset import Dataset, Signal
 from testbed.core.errors import RigError
 from testbed.core.schema import Field
@@ -71,6 +74,41 @@ def step_seconds(nv: int, integrator: str) -> float:
     """Estimated CPU time [s] of one integration step of a beam with ``nv`` joints."""
     t = STEP_S_0 + STEP_S_3 * nv**3
     return t * RK4_STEP_FACTOR if integrator.upper() == "RK4" else t
+
+
+def fewest_substeps(simulation: dict[str, Any], nv: int) -> tuple[int, float]:
+    """The least work :func:`models.cantilever.simulate.choose_stepping` could choose, from the
+    sample rate alone (no model): lower bounds of a run's steps and CPU time per sample.
+
+    A requested ``timestep`` fixes the substeps (RK4 under ``auto``).  Otherwise each
+    integrator needs at least its accuracy limit, ``ceil(pi / RK4_ACCURACY) = 7`` (RK4) or
+    ``ceil(pi / IMPLICIT_ACCURACY) = 29`` (implicitfast) steps per sample; stability can only
+    ask more.  ``auto`` may take either, so each bound is the smaller over both.
+
+    Parameters
+    ----------
+    simulation : dict
+        Validated ``[simulation]`` table.
+    nv : int
+        Joints of the chain (segments, plus the base hinge of a soft base).
+
+    Returns
+    -------
+    (substeps, seconds)
+        Fewest integration steps per sample, least CPU time per sample [s].
+    """
+    period = 1.0 / float(simulation["sample_rate"])
+    integrator = simulation["integrator"]
+    if simulation["timestep"] > 0:
+        integ = "RK4" if integrator == "auto" else integrator
+        n = max(1, round(period / simulation["timestep"]))
+        return n, n * step_seconds(nv, integ)
+    options = []
+    if integrator in ("auto", "RK4"):
+        options.append(("RK4", math.ceil(math.pi / RK4_ACCURACY)))
+    if integrator in ("auto", "implicitfast"):
+        options.append(("implicitfast", math.ceil(math.pi / IMPLICIT_ACCURACY)))
+    return min(n for _, n in options), min(n * step_seconds(nv, i) for i, n in options)
 
 
 RIG_SCHEMA = {
@@ -209,10 +247,12 @@ class CantileverRig(Rig):
              excitation: dict[str, Any]) -> Cost:
         """Memory and integration steps of a run, from the rig's own stepping rule.
 
-        The record's size alone is checked first (every sample takes at least one step); only
-        if it fits is the model compiled to learn its step
-        (:func:`models.cantilever.model.build_model`, about 20 ms for 10 segments, 1.3 s for
-        400), so an absurd ``duration`` or ``sample_rate`` is refused in microseconds.
+        The record's size alone is checked first (every sample takes at least one step), then
+        the least work any stepping could need (:func:`fewest_substeps`: steps and CPU time
+        from the sample rate and the segment count); only if both fit is the model compiled to
+        learn its step (:func:`models.cantilever.model.build_model`, about 20 ms for 10
+        segments, 2.4 s for 400 on the idle machine), so an absurd ``duration``,
+        ``sample_rate`` or ``n_segments`` is refused in microseconds.
 
         Raises
         ------
@@ -240,6 +280,16 @@ class CantileverRig(Rig):
         lower = cost(1.0, key, value)
         if (lower.samples > SAMPLE_BUDGET or lower.steps > STEP_BUDGET
                 or lower.memory_bytes > MEMORY_BUDGET_BYTES):
+            return lower
+        # the fewest steps any stepping rule could take, from the sample rate alone: a fine beam
+        # over the CPU budget is refused without compiling it (400 segments: 2.4 s idle, 39 s
+        # on the loaded shared machine)
+        substeps, per_sample_s = fewest_substeps(simulation, rig["n_segments"] + (rig["base"] == "soft"))
+        step_key, step_value = (("simulation.timestep", simulation["timestep"])
+                                if simulation["timestep"] > 0 else (key, value))
+        lower = cost(substeps, step_key, step_value, per_sample_s / substeps)
+        if (lower.steps > STEP_BUDGET or lower.memory_bytes > MEMORY_BUDGET_BYTES
+                or lower.seconds > CPU_BUDGET_S):
             return lower
         try:
             stepping = build_model(rig, simulation, excitation).stepping
