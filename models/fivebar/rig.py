@@ -111,14 +111,16 @@ MOTION_KEYS: dict[str, tuple[str, ...]] = {
 }
 
 
-def motion_keys_message(excitation: dict[str, Any], simulation: dict[str, Any], why: str) -> str:
+def motion_keys_message(rig: dict[str, Any], excitation: dict[str, Any], simulation: dict[str, Any],
+                        why: str) -> str:
     """A generation failure of the linkage in the scenario's terms: the keys and values that
     drive the motion, what happened, what to change.
 
     Parameters
     ----------
-    excitation, simulation : dict
-        Validated ``[excitation]`` and ``[simulation]`` tables.
+    rig, excitation, simulation : dict
+        Validated ``[rig]``, ``[excitation]`` and ``[simulation]`` tables (gravity, when on,
+        drives the motion too and is named).
     why : str
         The integrator's one-line account (time, transmission angle or non-finite signal).
 
@@ -131,6 +133,9 @@ def motion_keys_message(excitation: dict[str, Any], simulation: dict[str, Any], 
     names = [f"excitation.{k}" for k in MOTION_KEYS.get(excitation["type"], ("amplitude",))
              if k in excitation]
     values = [excitation[k.split(".", 1)[1]] for k in names]
+    if rig["gravity"]:
+        names.append("rig.gravity")
+        values.append(True)
     if "not finite" in why or "unstable" in why:  # a blow-up: the step is a suspect too
         names.append("simulation.dt")
         values.append(simulation["dt"])
@@ -286,7 +291,7 @@ class FiveBarRig(Rig):
             else:
                 rec = simulate_pinocchio(dyn, theta0, dtheta0, program, dt, fs, n, progress)
         except RigError as e:
-            raise RigError(motion_keys_message(sc.excitation, sim, str(e))) from None
+            raise RigError(motion_keys_message(rig, sc.excitation, sim, str(e))) from None
         return self._dataset(rec, extra, theta0, dtheta0, fs)
 
     def _dataset(self, rec: dict[str, np.ndarray], extra: dict[str, np.ndarray], theta0: np.ndarray,
