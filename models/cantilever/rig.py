@@ -119,6 +119,10 @@ RIG_SCHEMA = {
     "thickness": Field(float, 0.01, unit="m", min=0.0, min_inclusive=False,
                        doc="cross-section thickness (the bending depth)"),
     "length": Field(float, 0.3175, unit="m", min=0.0, min_inclusive=False, doc="beam length"),
+    # max 400: the finest chain whose 1 s record at the default 12.8 kHz (29 implicitfast
+    # substeps of ~3.8 ms, step_seconds) fits the CPU budget with room (1,400 s of 3,600 s);
+    # 600 segments would need 4,750 s for that second.  Longer records of a fine chain are
+    # refused by the budget (rig.n_segments named) before the model is compiled.
     "n_segments": Field(int, 10, min=2, max=400, doc="rigid segments of the hinge chain"),
     "joint_offset": Field(float, 1.0 / 3.0, min=0.0, max=0.5,
                           doc="first hinge at joint_offset * L / n_segments (1/3 minimises the "
