@@ -574,7 +574,7 @@ def build_parser() -> argparse.ArgumentParser:
                                 ".h5 (a testbed dataset: measured signals only)")
     i.add_argument("--scenario", help="scenario (name or .toml) whose rig kind, [signal] chain and "
                                       "[identify] table to use")
-    i.add_argument("--kind", choices=("structural", "mechanical"),
+    i.add_argument("--kind", choices=("structural", "mechanical", "dynamical"),
                    help="rig kind of the data (which signal chain); needed without --scenario")
     i.add_argument("--method", help="registered identifier (see `testbed list`); default the "
                                     "scenario's")

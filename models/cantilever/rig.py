@@ -17,6 +17,7 @@ the linear beam (the tests check the measured ratio).
 from __future__ import annotations
 
 import logging
+import math
 from collections.abc import Callable
 from typing import Any, ClassVar
 
@@ -27,14 +28,16 @@ from models._base import ErrorFn, Rig, check_two_samples
 from models.cantilever.beam import BeamParams
 from models.cantilever.model import CantileverModel, build_model, hit_position, sensor_positions
 from models.cantilever.simulate import (
+    IMPLICIT_ACCURACY,
     MUJOCO_MAX_CONTROL,
+    RK4_ACCURACY,
     half_sine,
     mode_errors,
     rollout_sensors,
     static_equilibrium,
     unstable_modes,
 )
-from testbed.core.budget import MEMORY_BUDGET_BYTES, SAMPLE_BUDGET, STEP_BUDGET, Cost
+from testbed.core.budget import CPU_BUDGET_S, MEMORY_BUDGET_BYTES, SAMPLE_BUDGET, STEP_BUDGET, Cost
 from testbed.core.dataset import Dataset, Signal
 from testbed.core.errors import RigError
 from testbed.core.schema import Field
@@ -73,6 +76,41 @@ def step_seconds(nv: int, integrator: str) -> float:
     return t * RK4_STEP_FACTOR if integrator.upper() == "RK4" else t
 
 
+def fewest_substeps(simulation: dict[str, Any], nv: int) -> tuple[int, float]:
+    """The least work :func:`models.cantilever.simulate.choose_stepping` could choose, from the
+    sample rate alone (no model): lower bounds of a run's steps and CPU time per sample.
+
+    A requested ``timestep`` fixes the substeps (RK4 under ``auto``).  Otherwise each
+    integrator needs at least its accuracy limit, ``ceil(pi / RK4_ACCURACY) = 7`` (RK4) or
+    ``ceil(pi / IMPLICIT_ACCURACY) = 29`` (implicitfast) steps per sample; stability can only
+    ask more.  ``auto`` may take either, so each bound is the smaller over both.
+
+    Parameters
+    ----------
+    simulation : dict
+        Validated ``[simulation]`` table.
+    nv : int
+        Joints of the chain (segments, plus the base hinge of a soft base).
+
+    Returns
+    -------
+    (substeps, seconds)
+        Fewest integration steps per sample, least CPU time per sample [s].
+    """
+    period = 1.0 / float(simulation["sample_rate"])
+    integrator = simulation["integrator"]
+    if simulation["timestep"] > 0:
+        integ = "RK4" if integrator == "auto" else integrator
+        n = max(1, round(period / simulation["timestep"]))
+        return n, n * step_seconds(nv, integ)
+    options = []
+    if integrator in ("auto", "RK4"):
+        options.append(("RK4", math.ceil(math.pi / RK4_ACCURACY)))
+    if integrator in ("auto", "implicitfast"):
+        options.append(("implicitfast", math.ceil(math.pi / IMPLICIT_ACCURACY)))
+    return min(n for _, n in options), min(n * step_seconds(nv, i) for i, n in options)
+
+
 RIG_SCHEMA = {
     "E": Field(float, 210e9, unit="Pa", min=0.0, min_inclusive=False, doc="Young's modulus"),
     "rho": Field(float, 7850.0, unit="kg/m^3", min=0.0, min_inclusive=False, doc="density"),
@@ -81,6 +119,10 @@ RIG_SCHEMA = {
     "thickness": Field(float, 0.01, unit="m", min=0.0, min_inclusive=False,
                        doc="cross-section thickness (the bending depth)"),
     "length": Field(float, 0.3175, unit="m", min=0.0, min_inclusive=False, doc="beam length"),
+    # max 400: the finest chain whose 1 s record at the default 12.8 kHz (29 implicitfast
+    # substeps of ~3.8 ms, step_seconds) fits the CPU budget with room (1,400 s of 3,600 s);
+    # 600 segments would need 4,750 s for that second.  Longer records of a fine chain are
+    # refused by the budget (rig.n_segments named) before the model is compiled.
     "n_segments": Field(int, 10, min=2, max=400, doc="rigid segments of the hinge chain"),
     "joint_offset": Field(float, 1.0 / 3.0, min=0.0, max=0.5,
                           doc="first hinge at joint_offset * L / n_segments (1/3 minimises the "
@@ -163,6 +205,14 @@ class CantileverRig(Rig):
         if len(sensor_positions(rig)) > n_dof:
             error("rig.sensors", sensors, f"allowed: at most {n_dof} sensors (the model's degrees "
                                           "of freedom, for the SEREP reduction)")
+        if rig["damping_ratio"] == 0 and rig["damping_beta"] == 0:
+            # the ideal sampler has no anti-aliasing filter: C = beta K damps every mode above
+            # the Nyquist frequency within a fraction of a millisecond, unless beta = 0
+            error("rig.damping_ratio", 0.0,
+                  "expected > 0 (or rig.damping_beta > 0): an undamped chain's modes above the "
+                  "Nyquist frequency ring for the whole record and fold into the band, where no "
+                  "mode of the truth is (measured: the default beam's mode 8, 12456 Hz, at "
+                  "344 Hz at 12.8 kHz, and ls_sindy's mode 1 off 3300 %)")
         if rig["damping_ratio"] > 0 and rig["damping_beta"] > 0:
             error("rig.damping_beta", rig["damping_beta"],
                   "allowed: only one damping form; set rig.damping_ratio = 0 to give damping_beta")
@@ -209,10 +259,12 @@ class CantileverRig(Rig):
              excitation: dict[str, Any]) -> Cost:
         """Memory and integration steps of a run, from the rig's own stepping rule.
 
-        The record's size alone is checked first (every sample takes at least one step); only
-        if it fits is the model compiled to learn its step
-        (:func:`models.cantilever.model.build_model`, about 20 ms for 10 segments, 1.3 s for
-        400), so an absurd ``duration`` or ``sample_rate`` is refused in microseconds.
+        The record's size alone is checked first (every sample takes at least one step), then
+        the least work any stepping could need (:func:`fewest_substeps`: steps and CPU time
+        from the sample rate and the segment count); only if both fit is the model compiled to
+        learn its step (:func:`models.cantilever.model.build_model`, about 20 ms for 10
+        segments, 2.4 s for 400 on the idle machine), so an absurd ``duration``,
+        ``sample_rate`` or ``n_segments`` is refused in microseconds.
 
         Raises
         ------
@@ -240,6 +292,16 @@ class CantileverRig(Rig):
         lower = cost(1.0, key, value)
         if (lower.samples > SAMPLE_BUDGET or lower.steps > STEP_BUDGET
                 or lower.memory_bytes > MEMORY_BUDGET_BYTES):
+            return lower
+        # the fewest steps any stepping rule could take, from the sample rate alone: a fine beam
+        # over the CPU budget is refused without compiling it (400 segments: 2.4 s idle, 39 s
+        # on the loaded shared machine)
+        substeps, per_sample_s = fewest_substeps(simulation, rig["n_segments"] + (rig["base"] == "soft"))
+        step_key, step_value = (("simulation.timestep", simulation["timestep"])
+                                if simulation["timestep"] > 0 else (key, value))
+        lower = cost(substeps, step_key, step_value, per_sample_s / substeps)
+        if (lower.steps > STEP_BUDGET or lower.memory_bytes > MEMORY_BUDGET_BYTES
+                or lower.seconds > CPU_BUDGET_S):
             return lower
         try:
             stepping = build_model(rig, simulation, excitation).stepping

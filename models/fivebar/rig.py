@@ -32,6 +32,7 @@ from models.fivebar.integrate import simulate as simulate_pinocchio
 from models.fivebar.params import FiveBarParams
 from testbed.core.budget import Cost
 from testbed.core.dataset import Dataset, Signal
+from testbed.core.errors import RigError, show_value
 from testbed.core.schema import Field
 from testbed.core.truth import MechanicalTruth
 
@@ -97,6 +98,49 @@ def _pose_problem(th1: np.ndarray, th4: np.ndarray, p: FiveBarParams) -> str | N
                 f"th4 = {np.atleast_1d(th4)[k]:.4g} rad: near a Type II singularity (links 2 and 3 "
                 f"collinear); allowed {lo_mu:g}-{hi_mu:g} deg")
     return None
+
+
+#: Keys of each excitation that set how far the linkage is driven, named when a simulation
+#: leaves the usable workspace or diverges (which only the simulation can tell: the motion
+#: under torques is not known before it is integrated).
+MOTION_KEYS: dict[str, tuple[str, ...]] = {
+    "multisine": ("amplitude", "f_max", "kp", "kd"),
+    "chirp": ("amplitude", "f1", "kp", "kd"),
+    "pd": ("amplitude", "frequency", "kp", "kd"),
+    "sine_replay": ("amplitude", "frequency"),
+}
+
+
+def motion_keys_message(rig: dict[str, Any], excitation: dict[str, Any], simulation: dict[str, Any],
+                        why: str) -> str:
+    """A generation failure of the linkage in the scenario's terms: the keys and values that
+    drive the motion, what happened, what to change.
+
+    Parameters
+    ----------
+    rig, excitation, simulation : dict
+        Validated ``[rig]``, ``[excitation]`` and ``[simulation]`` tables (gravity, when on,
+        drives the motion too and is named).
+    why : str
+        The integrator's one-line account (time, transmission angle or non-finite signal).
+
+    Returns
+    -------
+    str
+        ``key 'excitation.amplitude, ...': value [...]: <why>`` (one line; ``why`` ends with
+        what to change; the command line prefixes the scenario file).
+    """
+    names = [f"excitation.{k}" for k in MOTION_KEYS.get(excitation["type"], ("amplitude",))
+             if k in excitation]
+    values = [excitation[k.split(".", 1)[1]] for k in names]
+    if rig["gravity"]:
+        names.append("rig.gravity")
+        values.append(True)
+    if "not finite" in why or "unstable" in why:  # a blow-up: the step is a suspect too
+        names.append("simulation.dt")
+        values.append(simulation["dt"])
+    return (f"key '{', '.join(names)}': value {show_value(values)}: the motion under excitation "
+            f"{excitation['type']!r} is not usable (found only by simulating it): {why}")
 
 
 def start_pose(rig: dict[str, Any], p: FiveBarParams) -> np.ndarray:
@@ -239,12 +283,15 @@ class FiveBarRig(Rig):
         theta0, dtheta0 = self.start_state()
         program, extra = build_program(sc.excitation, start_pose(rig, p), t, fs,
                                        inverse_dynamics=dyn.inverse_dynamics)
-        if sim["engine"] == "mujoco":
-            from models.fivebar.twin import MujocoTwin
+        try:
+            if sim["engine"] == "mujoco":
+                from models.fivebar.twin import MujocoTwin
 
-            rec = MujocoTwin(p, dt).simulate(theta0, dtheta0, program, fs, n, progress)
-        else:
-            rec = simulate_pinocchio(dyn, theta0, dtheta0, program, dt, fs, n, progress)
+                rec = MujocoTwin(p, dt).simulate(theta0, dtheta0, program, fs, n, progress)
+            else:
+                rec = simulate_pinocchio(dyn, theta0, dtheta0, program, dt, fs, n, progress)
+        except RigError as e:
+            raise RigError(motion_keys_message(rig, sc.excitation, sim, str(e))) from None
         return self._dataset(rec, extra, theta0, dtheta0, fs)
 
     def _dataset(self, rec: dict[str, np.ndarray], extra: dict[str, np.ndarray], theta0: np.ndarray,

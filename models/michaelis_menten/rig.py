@@ -60,6 +60,10 @@ STIFF_STEP_LIMIT = 6.0
 #: e.g. a degree-6 library with its derivative terms): 64 float64 with room.
 BYTES_PER_SAMPLE = 512
 
+#: A start within this fraction of the steady state is at rest: the whole record moves less
+#: than 1e-9 of its value (float64 keeps 16 digits; nothing an identifier can fit on).
+REST_RTOL = 1e-9
+
 TERMS = ["dx", "x*dx", "1", "x"]
 TRUTH_UNITS = {"equation_terms": "", "equation_coef": "1 (row max |coef| = 1)",
                "state_names": "", "x0": "mM", "parameter_names": "",
@@ -123,6 +127,12 @@ class MichaelisMentenRig(Rig):
         if not rig["Vmax"] > rig["jx"]:
             error("rig.Vmax", rig["Vmax"], f"expected above jx ({rig['jx']:g} mM/s): otherwise "
                                            "the influx outruns the enzyme and x grows without bound")
+        else:
+            steady = rig["jx"] * rig["Km"] / (rig["Vmax"] - rig["jx"])
+            if abs(rig["x0"] - steady) <= REST_RTOL * steady:
+                error("rig.x0", rig["x0"], f"expected away from the steady state jx Km / (Vmax - jx) "
+                                           f"= {steady:.6g} mM: started there, x never moves and "
+                                           "the record holds nothing to identify")
         check_two_samples(simulation, error)
 
     @classmethod

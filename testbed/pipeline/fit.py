@@ -96,7 +96,7 @@ def identify_file(path: str | os.PathLike, *, scenario: str | os.PathLike | None
     scenario : str or path-like, optional
         A scenario (name or ``.toml`` path) whose rig kind, ``[signal]`` chain and
         ``[identify]`` table are used; ``kind``/``method``/``params`` override its choices.
-    kind : {"structural", "mechanical"}, optional
+    kind : {"structural", "mechanical", "dynamical"}, optional
         Rig kind (which signal chain); required without ``scenario``, else must match it.
     method : str, optional
         Registered identifier; default the scenario's ``[identify] method``.
@@ -132,7 +132,7 @@ def identify_file(path: str | os.PathLike, *, scenario: str | os.PathLike | None
             raise InputError(f"--kind {kind}: the scenario {sc.name} is of the {sc_kind} kind")
         kind, signal, identify = sc_kind, sc.signal, dict(sc.identify or {})
     if kind is None:
-        raise InputError("say which rig kind the data are from: --kind structural|mechanical, or "
+        raise InputError("say which rig kind the data are from: --kind structural|mechanical|dynamical, or "
                          "--scenario NAME")
     if kind not in SIGNAL_SCHEMAS:
         raise InputError(f"--kind {kind!r}: unknown; allowed: {', '.join(SIGNAL_SCHEMAS)}")

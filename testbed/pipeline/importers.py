@@ -76,6 +76,11 @@ UNIT_ALIASES: dict[str, tuple[str, float]] = {
     "deg": ("rad", math.pi / 180), "deg/s": ("rad/s", math.pi / 180),
     "deg/s^2": ("rad/s^2", math.pi / 180), "kN": ("N", 1e3), "N mm": ("N m", 1e-3),
 }
+#: Units of the same quantity on a translational and a rotational coordinate: a group may
+#: mix these, one unit per channel (a cart-pole's ``theta`` holds the cart's x [m] and the
+#: pole's angle [rad]), never two quantities (an acceleration with a force)
+SAME_ORDER = {"m": "coordinate", "rad": "coordinate", "m/s": "rate", "rad/s": "rate",
+              "m/s^2": "acceleration", "rad/s^2": "acceleration", "N": "load", "N m": "load"}
 #: UFF58 ordinate (specific data type, length exponent, force exponent, rotational) -> SI unit
 _UFF_UNITS = {(12, 1, 0, False): "m/s^2", (11, 1, 0, False): "m/s", (8, 1, 0, False): "m",
               (13, 0, 1, False): "N", (8, 0, 0, True): "rad", (11, 0, 0, True): "rad/s",
@@ -208,15 +213,16 @@ class ImportedData:
                 raise MeasuredDataError(self.source, f"group {g!r}: unknown channel(s) "
                                         f"{', '.join(unknown) or '(none given)'}; "
                                         f"has {', '.join(self.signals)}")
-            units = {self.signals[n][0] for n in names}
-            if len(units) > 1:
-                raise MeasuredDataError(self.source, f"group {g!r} mixes units {', '.join(sorted(units))}")
+            units = [self.signals[n][0] for n in names]
+            if len(set(units)) > 1 and len({SAME_ORDER.get(u, u) for u in units}) > 1:
+                raise MeasuredDataError(self.source, f"group {g!r} mixes units "
+                                                     f"{', '.join(sorted(set(units)))}")
             have = [n in self.positions for n in names]
             if any(have) and not all(have):
                 raise MeasuredDataError(self.source, f"group {g!r}: only some channels have positions")
             measured[g] = Signal(np.array([self.signals[n][1] for n in names]),
                                  tuple(n.split("/", 1)[1] if "/" in n else n for n in names),
-                                 units.pop(),
+                                 units[0] if len(set(units)) == 1 else ", ".join(units),
                                  np.array([self.positions[n] for n in names]) if all(have) else None)
         declared = dict(acts_on or {})
         if not declared and "torque" in grouped and "theta" in grouped:
@@ -304,7 +310,7 @@ def measurement_from_file(path: str | os.PathLike, kind: str, signal: Mapping[st
     ----------
     path, format, fs, units, channels
         As for :func:`read_measured`.
-    kind : {"structural", "mechanical"}
+    kind : {"structural", "mechanical", "dynamical"}
         The rig kind whose chain to run (:data:`testbed.pipeline.signal_chain.SIGNAL_SCHEMAS`).
     signal : mapping, optional
         The ``[signal]`` table (a scenario's ``scenario.signal``); default: the kind's defaults.
@@ -393,6 +399,9 @@ class _Raw:
     directions: dict[str, int] = field(default_factory=dict)
     positions: dict[str, float] = field(default_factory=dict)
     prior: dict[str, float] = field(default_factory=dict)
+    #: the file's units are its rig's own and stay as they are (a testbed dataset of a
+    #: ``dynamical`` rig: concentrations and the like have no SI form to convert to)
+    own_units: bool = False
 
 
 def si_unit(unit: str) -> tuple[str, float]:
@@ -447,6 +456,8 @@ def _finish(raw: _Raw, fs: float | None, units: str | Mapping[str, str] | None,
         if not unit:
             raise MeasuredDataError(path, f"channel {n!r} has no unit; declare it with units=")
         si, factor = si_unit(unit)
+        if not si and raw.own_units:
+            si, factor = unit, 1.0
         if not si:
             raise MeasuredDataError(path, f"channel {n!r}: unknown unit {unit!r}; allowed: "
                                           f"{', '.join(SI_UNITS + tuple(UNIT_ALIASES))}")
@@ -494,11 +505,17 @@ def _read_hdf5(path: Path) -> _Raw:
         ds = Dataset.load(path)
     except DatasetError as e:
         raise MeasuredDataError(path, e.reason) from None
-    raw = _Raw(path, "hdf5", float(ds.fs), {}, {}, prior=dict(ds.prior))
+    raw = _Raw(path, "hdf5", float(ds.fs), {}, {}, prior=dict(ds.prior),
+               own_units=ds.attrs.get("kind") == "dynamical")
     for g, s in ds.measured.items():
+        # a signal of mixed coordinates states one unit per channel ("m, rad": a cart's
+        # position and a pole's angle)
+        per_channel = [u.strip() for u in s.unit.split(",")]
+        if len(per_channel) != len(s.channels):
+            per_channel = [s.unit] * len(s.channels)
         for i, ch in enumerate(s.channels):
             name = f"{g}/{ch}"
-            raw.data[name], raw.units[name] = s.data[i], s.unit
+            raw.data[name], raw.units[name] = s.data[i], per_channel[i]
             if s.positions is not None:
                 raw.positions[name] = float(s.positions[i])
     # inputs that declare the coordinates they act on (Signal.acts_on) keep that, as node

@@ -284,7 +284,13 @@ def run_cell(cell: Cell, cache_dir: str, plugins: tuple[str, ...],
         row["checks"] = json.dumps([{**asdict(c), "passed": c.passed} for c in result.checks])
         bad = sorted(k for k, v in result.scores.values.items() if not math.isfinite(v))
         # a scored failure (fit failed, diverged, non-physical) keeps its reason; non-finite
-        # scores without one are named
+        # scores without one are named.  A cell judged on finite held scores is not failed by a
+        # reported score that is infinite by definition (the five-bar's coef_error when the
+        # identified row lacks the truth's largest term): it was marked failed and passed at
+        # once, and left out of the score medians
+        held = {c.metric for c in result.checks}
+        if held and not held & set(bad) and not result.failure:
+            bad = []
         reasons = [result.failure, bad and "non-finite scores: " + ", ".join(bad),
                    not result.scores.values and "no scores"]
         reason = "; ".join(r for r in reasons if r)

@@ -134,6 +134,19 @@ def test_transmission_leaving_range_during_simulation_raises_rig_error():
     with pytest.raises(RigError, match=r"transmission angle .* allowed 30-150 deg") as e:
         FiveBarRig(sc).simulate()
     assert "at t = " in str(e.value)
+    # only the simulation can tell, so the error names the keys that drive the motion and
+    # their values (it named none: the user could not tell what to change)
+    assert str(e.value).startswith("key 'excitation.amplitude, excitation.f_max, excitation.kp, "
+                                   "excitation.kd': value [5.0, 0.5, 0.0, 0.0]: ")
+
+
+def test_a_linkage_falling_under_gravity_names_gravity_among_the_keys():
+    sc = _scenario(rig={"gravity": True}, simulation={"duration": 2.0, "dt": 5e-4, "sample_rate": 2000.0},
+                   excitation={"type": "multisine", "amplitude": 1.0, "f_min": 0.2, "f_max": 0.5})
+    with pytest.raises(RigError, match=r"transmission angle") as e:
+        FiveBarRig(sc).simulate()
+    assert str(e.value).startswith("key 'excitation.amplitude, excitation.f_max, excitation.kp, "
+                                   "excitation.kd, rig.gravity': value [1.0, 0.5, 0.0, 0.0, True]: ")
 
 
 def test_short_dataset_layout_and_roundtrip(tmp_path):

@@ -107,6 +107,9 @@ def test_divergent_simulation_raises_one_line(engine):
     msg = str(e.value)
     assert "\n" not in msg and f"fivebar ({engine})" in msg
     assert "not finite" in msg or "unstable" in msg
+    # a blow-up names the step besides the excitation's keys
+    assert msg.startswith("key 'excitation.amplitude, excitation.f_max, excitation.kp, "
+                          "excitation.kd, simulation.dt': value [1e+300, "), msg
 
 
 def test_unconverged_loop_closure_raises_one_line():

@@ -52,6 +52,15 @@ def test_a_rate_the_enzyme_cannot_match_is_refused():
                             "rig": {"jx": 2.0, "Vmax": 1.5}})
 
 
+def test_a_start_at_the_steady_state_is_refused_naming_x0():
+    # x0 = jx Km / (Vmax - jx) = 0.2 mM: the record was constant and the fit a scored
+    # "singular" divergence at t = 0 instead of a load-time error
+    with pytest.raises(ScenarioError, match=r"key 'rig\.x0': value 0\.2: .*steady state"):
+        scenario_from_dict({"scenario": {"name": "mm", "rig": "michaelis_menten"},
+                            "rig": {"x0": 0.2}})
+    scenario_from_dict({"scenario": {"name": "mm", "rig": "michaelis_menten"}, "rig": {"x0": 0.21}})
+
+
 def test_a_stiff_rate_law_is_refused_by_the_step_budget_naming_vmax():
     # Vmax / Km = 3.3e9 /s: the explicit DOP853 would need ~2e9 steps over 4 s (it hung for
     # minutes before the budget counted stiffness); the shipped rates cost 25 steps per second

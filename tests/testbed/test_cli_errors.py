@@ -170,6 +170,20 @@ def test_a_rig_that_cannot_simulate_the_scenario_names_its_file(tmp_path, monkey
                    "simulation diverged"
 
 
+def test_a_five_bar_leaving_its_workspace_names_file_keys_and_values(tmp_path, capsys):
+    # valid at load (only the simulation can tell), refused during generation: the line named
+    # the file but no key, so a user could not tell what to change
+    text = (ROOT / "scenarios" / "fivebar_multisine.toml").read_text()
+    text = text.replace("amplitude = 1.0", "amplitude = 8.0").replace("duration = 10.0", "duration = 2.5")
+    path = tmp_path / "fivebar_multisine.toml"
+    path.write_text(text)
+    assert main(["generate", str(path), "-o", str(tmp_path / "x.h5")]) == EXIT_USAGE
+    line = one_error_line(capsys.readouterr().err)
+    assert line.startswith(f"error: {path}: key 'excitation.amplitude, excitation.f_max, "
+                           "excitation.kp, excitation.kd': value [8.0, 1.5, 10.0, 2.0]: "), line
+    assert "transmission angle" in line and "allowed 30-150 deg" in line
+
+
 def test_a_testbed_cache_that_is_a_file_is_refused_naming_the_variable(tmp_path, monkeypatch, capsys):
     # was "[Errno 17] File exists" after the simulation, naming no setting
     (tmp_path / "text.txt").write_text("x\n")

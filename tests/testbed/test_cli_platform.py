@@ -167,8 +167,21 @@ def test_identify_mechanical(tmp_path, dataset_cache, capsys):
     assert "not defined (implicit equations" in capsys.readouterr().out
 
 
+def test_identify_reads_a_dynamical_rigs_own_dataset_by_kind(tmp_path, capsys):
+    # --kind offered structural and mechanical only, and the file's "mM" was an unknown unit
+    from testbed.pipeline.generate import simulate_clean
+
+    sc = load_scenario("michaelis_menten")
+    data = simulate_clean(sc).save(tmp_path / "mm.h5")
+    out = tmp_path / "mm.json"
+    assert main(["identify", str(data), "--kind", "dynamical", "--method", "sindy_pi_dynamical",
+                 "-o", str(out)]) == 0
+    model = json.loads(out.read_text())
+    assert model["kind"] == "dynamical" and len(model["equations"]) == 1
+
+
 @pytest.mark.parametrize(("argv", "fragment"), [
-    (["identify", "{data}"], "--kind structural|mechanical"),
+    (["identify", "{data}"], "--kind structural|mechanical|dynamical"),
     (["identify", "{data}", "--kind", "structural"], "--method NAME"),
     (["identify", "{data}", "--kind", "structural", "--method", "sindy_pi"], "is for mechanical rigs"),
     (["identify", "{data}", "--kind", "mechanical", "--scenario", "cantilever_stiff_impact_lsq"],

@@ -235,6 +235,40 @@ def test_malformed_files_raise_one_line_naming_the_file(tmp_path, make, kwargs, 
     assert err.value.__cause__ is None and (err.value.__context__ is None or err.value.__suppress_context__)
 
 
+@pytest.mark.parametrize(("name", "simulation"), [
+    ("cartpole", {"duration": 0.5}), ("michaelis_menten", {"duration": 0.5})])
+def test_the_testbeds_own_datasets_of_every_rig_read_back(tmp_path, name, simulation):
+    # `testbed identify` refused them: the cart-pole's coordinates state one unit each
+    # ("m, rad": was "unknown unit"), the kinetics rig's concentrations have no SI form ("mM")
+    from testbed.pipeline.generate import simulate_clean
+    from testbed.pipeline.plugins import rig_kind
+
+    sc = load_scenario(name)
+    sc = sc.replace(simulation={**sc.simulation, **simulation})
+    ds = simulate_clean(sc)
+    kind = rig_kind(sc.rig)
+    path = ds.save(tmp_path / f"{name}.h5")
+    imported = read_measured(path).to_dataset()
+    for g, sig in ds.measured.items():
+        assert imported.measured[g].unit == sig.unit, g
+        np.testing.assert_array_equal(imported.measured[g].data, sig.data)
+    m = measurement_from_file(path, kind, dict(sc.signal))
+    ref = measure(ds, dict(sc.signal), kind)
+    np.testing.assert_array_equal(m.x, ref.x)
+
+
+def test_a_group_mixes_one_quantity_on_both_kinds_of_coordinate_never_two_quantities():
+    data = from_sep005([{"name": "x", "data": [1.0, 2.0], "unit_str": "mm", "fs": 1.0},
+                        {"name": "th", "data": [1.0, 2.0], "unit_str": "rad", "fs": 1.0},
+                        {"name": "a", "data": [1.0, 2.0], "unit_str": "m/s^2", "fs": 1.0}])
+    sig = data.to_dataset({"theta": ["x", "th"]}).measured["theta"]
+    assert sig.unit == "m, rad" and sig.data[0, 0] == 1e-3
+    with pytest.raises(MeasuredDataError, match="mixes units m, m/s\\^2"):
+        data.to_dataset({"theta": ["x", "a"]})
+    with pytest.raises(MeasuredDataError, match="unknown unit 'mM'"):  # only a dynamical rig's own file
+        from_sep005([{"name": "c", "data": [1.0, 2.0], "unit_str": "mM", "fs": 1.0}])
+
+
 def test_to_dataset_group_errors():
     data = from_sep005([{"name": "a", "data": [1.0, 2.0], "unit_str": "m", "fs": 1.0},
                         {"name": "f", "data": [1.0, 2.0], "unit_str": "N", "fs": 1.0}])

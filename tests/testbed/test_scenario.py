@@ -171,6 +171,46 @@ def test_over_budget_is_refused_before_simulating_naming_the_key(tmp_path, extra
     assert f"'{key}'" in str(e.value) and "budget" in str(e.value)
 
 
+def test_a_fine_beam_over_the_cpu_budget_is_refused_without_compiling_it(monkeypatch):
+    # the budget check compiled the 400-segment beam to learn its step (2.4 s idle, 39 s on
+    # the loaded machine) before refusing it; the sample rate alone bounds the steps
+    from models.cantilever import rig as cantilever
+    from testbed.core.errors import BudgetError
+
+    def no_build(*args, **kwargs):
+        raise AssertionError("the model was compiled")
+
+    monkeypatch.setattr(cantilever, "build_model", no_build)
+    raw = {"scenario": {"name": "t", "rig": "cantilever"}, "rig": {"n_segments": 400},
+           "simulation": {"duration": 10.0}}
+    with pytest.raises(BudgetError, match=r"key 'rig.n_segments': value 400: .* h of CPU"):
+        scenario_from_dict(raw)
+
+
+@pytest.mark.parametrize(("rig", "simulation"), [
+    ({"n_segments": 6}, {}),
+    ({"n_segments": 60}, {}),
+    ({"n_segments": 30, "base": "soft"}, {"integrator": "RK4"}),
+    ({"n_segments": 30}, {"integrator": "implicitfast"}),
+    ({"n_segments": 8, "damping_ratio": 1e-5}, {"integrator": "RK4", "sample_rate": 4000.0}),
+    ({"n_segments": 10}, {"timestep": 1e-5}),
+])
+def test_the_cheap_cost_bound_never_exceeds_the_built_cost(rig, simulation):
+    """The bound refuses only what the full estimate (which compiles the model) would refuse."""
+    from models.cantilever.model import build_model
+    from models.cantilever.rig import CantileverRig, fewest_substeps, step_seconds
+
+    sc = scenario_from_dict({"scenario": {"name": "t", "rig": "cantilever"}, "rig": rig,
+                             "simulation": {"duration": 0.05, **simulation}})
+    nv = sc.rig_params["n_segments"] + (sc.rig_params["base"] == "soft")
+    substeps, per_sample_s = fewest_substeps(sc.simulation, nv)
+    stepping = build_model(sc.rig_params, sc.simulation, sc.excitation).stepping
+    assert substeps <= stepping.substeps
+    assert per_sample_s <= stepping.substeps * step_seconds(nv, stepping.integrator) * (1 + 1e-12)
+    cost = CantileverRig.cost(sc.rig_params, sc.simulation, sc.excitation)
+    assert cost.seconds >= cost.samples * per_sample_s * (1 - 1e-12)
+
+
 def test_every_shipped_scenario_is_within_budget_with_room():
     """The estimates are not so pessimistic that a real scenario is refused: every shipped one
     needs under a tenth of each budget."""

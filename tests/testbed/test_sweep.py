@@ -89,6 +89,8 @@ class ToyFit(Identifier):
         coef = np.zeros((4, 8))
         for i in range(4):
             coef[i, 2 * i], coef[i, 2 * i + 1] = k[i], 1.0
+        if self.fail == "noterm":  # equations without the truth's largest term: coef_error inf
+            coef[:, ::2] = 0.0
         self.coef_ = coef
         return self
 
@@ -113,6 +115,11 @@ class ToyRaise(ToyFit):
 @IDENTIFIERS.register("toy_nan")
 class ToyNaN(ToyFit):
     fail = "nan"
+
+
+@IDENTIFIERS.register("toy_noterm")
+class ToyNoTerm(ToyFit):
+    fail = "noterm"
 '''
 
 SCENARIO = """
@@ -223,6 +230,22 @@ def test_failing_cells_are_recorded_and_the_rest_goes_on(toy_dir, tmp_path):
                                    retry_failed=True, verbose=False, stats=stats))
     assert (stats.run, stats.failed) == (2, 2)
     assert comparable(again) == comparable(rows)
+
+
+def test_an_infinite_reported_score_does_not_fail_a_cell_judged_on_finite_held_ones(toy_dir, tmp_path):
+    # the five-bar's coef_error is infinite by definition when the identified row lacks the
+    # truth's largest term; the cell was "failed" and passed at once, and its held scores were
+    # left out of the summary's medians
+    study = load_study(write_study(toy_dir, "noterm", ["toy_noterm", "toy_nan"], seeds=(0,),
+                                   noise=(0.0,)))
+    rows = read_results(run_sweep(study, results=tmp_path / "r.parquet", cache_dir=tmp_path / "c",
+                                  verbose=False))
+    by = {r["identifier"]: r for r in rows}
+    assert by["toy_noterm"]["coef_error"] == math.inf and by["toy_noterm"]["passed"]
+    assert by["toy_noterm"]["status"] == "ok" and by["toy_noterm"]["error"] == ""
+    # a non-finite held score still fails the cell, and names itself
+    assert by["toy_nan"]["status"] == "failed" and "angle_rmse" in by["toy_nan"]["error"]
+    assert not by["toy_nan"]["passed"]
 
 
 def test_rerun_after_editing_the_study_runs_only_new_cells(toy_dir, tmp_path):
