@@ -293,8 +293,9 @@ def cmd_run(args: argparse.Namespace) -> int:
     from testbed.pipeline.cache import DatasetCache
     from testbed.pipeline.scenario import load_scenario
     from testbed.reporting.console import print_score_table
+    from testbed.reporting.drawer import figure_drawer
     from testbed.reporting.progress import run_progress
-    from testbed.reporting.report import runs_index_html, save_run_figures_and_report
+    from testbed.reporting.report import runs_index_html
     from testbed.scoring.run import run_scenario
     from testbed.studies.runstore import INDEX, save_new_run, scenario_folder
 
@@ -302,20 +303,21 @@ def cmd_run(args: argparse.Namespace) -> int:
     _output_folder(Path(args.out), "--out")
     cache = None if args.no_cache else DatasetCache(_cache_folder(args.cache))
     ok = True
-    scenarios = [load_scenario(name) for name in args.scenario]  # every file checked first
-    for sc in scenarios:
-        if args.seed is not None:
-            sc = sc.replace(seed=args.seed)
-        scenario_folder(args.out, sc.name)  # refused before the work, not after
-        with run_progress(sc.name) as phase:
-            with _rig_errors_name(sc):
-                result = run_scenario(sc, cache=cache, phase=phase)
-            figures = None if args.no_figures else save_run_figures_and_report
-            with phase("figures" if figures else "save"):
-                run_dir = save_new_run(result, args.out, figures=figures, index=runs_index_html)
-        print_score_table(result)
-        print(f"run written to {run_dir} (all runs: {Path(args.out) / INDEX})")
-        ok &= result.passed
+    # the figures are drawn by a process forked now: it imports matplotlib during the fit
+    with figure_drawer(enabled=not args.no_figures) as figures:
+        scenarios = [load_scenario(name) for name in args.scenario]  # every file checked first
+        for sc in scenarios:
+            if args.seed is not None:
+                sc = sc.replace(seed=args.seed)
+            scenario_folder(args.out, sc.name)  # refused before the work, not after
+            with run_progress(sc.name) as phase:
+                with _rig_errors_name(sc):
+                    result = run_scenario(sc, cache=cache, phase=phase)
+                with phase("figures" if figures else "save"):
+                    run_dir = save_new_run(result, args.out, figures=figures, index=runs_index_html)
+            print_score_table(result)
+            print(f"run written to {run_dir} (all runs: {Path(args.out) / INDEX})")
+            ok &= result.passed
     return 0 if ok else EXIT_FAIL
 
 
