@@ -33,6 +33,10 @@ from collections.abc import Callable, Iterator, Sequence
 from pathlib import Path
 from typing import Any
 
+from testbed.reporting import figures as figs
+from testbed.reporting.report import save_run_figures_and_report
+from testbed.studies.runstore import load_run
+
 __all__ = ["FigureWorker", "FigureWorkerError", "figure_drawer", "split_figures"]
 
 #: Relative drawing cost of each run figure (measured CPU of the cantilever run's figures:
@@ -77,9 +81,6 @@ def _die_with_parent(parent: int) -> None:
 
 def _warm_up() -> None:
     """Import what drawing needs and draw one small figure (fonts, text layout, PNG encoder)."""
-    from testbed.reporting import figures as figs
-    from testbed.studies import runstore  # noqa: F401  (loads the run folders)
-
     fig = figs._fig(1.0, 2.0)
     ax = figs._axes(fig)[0, 0]
     ax.plot([0.0, 1.0], [0.0, 1.0])
@@ -89,9 +90,6 @@ def _warm_up() -> None:
 
 def _draw(folder: str, stems: Sequence[str]) -> list[str]:
     """Draw ``stems`` of the run in ``folder`` into it; the PNG paths written."""
-    from testbed.reporting import figures as figs
-    from testbed.studies.runstore import load_run
-
     run = load_run(Path(folder))
     drawn = figs.run_figures(run, only=stems)
     return [str(figs.save_figure(f, Path(folder) / f"{stem}.png")) for stem, f in drawn.items()]
@@ -117,9 +115,6 @@ def _raise(msg: tuple) -> None:
 
 def _draw_split(folder: str) -> list[str]:
     """Draw every figure of the run in ``folder``: a forked helper draws half of them."""
-    from testbed.reporting import figures as figs
-    from testbed.studies.runstore import load_run
-
     groups = split_figures(figs.run_figures_available(load_run(Path(folder))))
     if len(groups) < 2:
         return _draw(folder, groups[0] if groups else [])
@@ -208,8 +203,6 @@ class FigureWorker:
             What drawing raised (re-raised here); :class:`FigureWorkerError` if a drawing
             process died.
         """
-        from testbed.reporting import figures as figs
-
         try:
             self._conn.send(str(folder))
             msg = self._conn.recv()
@@ -248,8 +241,6 @@ def figure_drawer(enabled: bool = True) -> Iterator[Callable[[Any, Path], list[P
     (:func:`testbed.reporting.report.save_run_figures_and_report`) where ``fork`` is not
     available.  Start it before the work whose time it should overlap.
     """
-    from testbed.reporting.report import save_run_figures_and_report
-
     if not enabled:
         yield None
         return
