@@ -11,6 +11,10 @@ their peers in the same run (:func:`benchmarks._timing.interleaved`), medians wi
    1.5 s (the issue's absolute goal).  The ratio to the run without figures is what the figures
    cost; the ratio to the numpy start-up scales out the machine's speed.
 
+The run draws its figures in processes it forks (``testbed.reporting.drawer``): one imports
+matplotlib during the fit, then it and one more draw half of the figures each; their CPU time is
+in the run's (both are reaped before the command exits, so ``getrusage`` of the child counts them).
+
 Bytecode is written and reused as in a user's checkout (``PYTHONDONTWRITEBYTECODE`` is dropped
 from the environment; the warm-up round writes it).  Each process's CPU time (user + sys, from
 ``getrusage`` of the reaped child) is reported beside the wall time: on a shared machine the
@@ -93,7 +97,8 @@ def run() -> list[dict]:
                          f"{spread(c['run_nofig'])} s; {r_np:.1f}x the numpy start-up; {machine()}"})
     rows.append({"name": f"testbed run {SCENARIO}: with / without figures", "value": r_nofig, "unit": "x",
                  "target": "report", "ok": None,
-                 "note": f"what the six figures cost, same run, interleaved; {rs_nofig}"})
+                 "note": f"what the six figures add to the wall time (drawn in two forked processes "
+                         f"after the fit), same run, interleaved; {rs_nofig}"})
     return rows
 
 

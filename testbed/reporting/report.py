@@ -25,7 +25,7 @@ import math
 import os
 import re
 import shutil
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -673,13 +673,18 @@ def write_report(source: str | os.PathLike, out_dir: str | os.PathLike) -> Path:
 
 
 # ----------------------------------------------------------------------------- run history
-def save_run_figures_and_report(run: SavedRun, folder: Path) -> list[Path]:
+def save_run_figures_and_report(run: SavedRun, folder: Path,
+                                draw: Callable[[SavedRun, Path], list[Path]] | None = None
+                                ) -> list[Path]:
     """The figure writer of ``testbed run``: the run figures, then ``report.html`` beside them.
 
     Passed as ``figures`` to :func:`testbed.studies.runstore.save_new_run`, so the report is
-    written in the temporary folder and appears with the run, atomically.  Returns the PNGs.
+    written in the temporary folder and appears with the run, atomically.  ``draw(run,
+    folder)`` writes the PNGs and returns their paths in report order (default
+    :func:`testbed.reporting.figures.save_run_figures`; ``testbed run`` draws them in a
+    separate process, :mod:`testbed.reporting.drawer`).  Returns the PNGs.
     """
-    paths = figs.save_run_figures(run, folder)
+    paths = (draw or figs.save_run_figures)(run, folder)
     run.meta["figures"] = [p.name for p in paths]
     run_report(run, folder)
     return paths

@@ -199,3 +199,23 @@ def test_a_command_runs_blas_on_one_thread():
 def test_a_users_blas_thread_setting_is_kept():
     out = _blas_after_cli_in_fresh_process({"OPENBLAS_NUM_THREADS": "2"})
     assert out["env"] == {"OPENBLAS_NUM_THREADS": "2", "MKL_NUM_THREADS": None, "OMP_NUM_THREADS": None}
+
+
+def test_a_command_runs_with_the_raised_gc_threshold_and_main_restores_it(monkeypatch):
+    """`main` raises the young-generation threshold for the command (imports make hundreds of
+    thousands of objects) and gives the caller's back, also when the command raises."""
+    import gc
+
+    from testbed import cli
+
+    seen = []
+
+    def command(args):
+        seen.append(gc.get_threshold())
+        raise RuntimeError("a bug")
+
+    monkeypatch.setattr(cli, "cmd_list", command)
+    before = gc.get_threshold()
+    assert cli.main(["list"]) == cli.EXIT_INTERNAL
+    assert seen == [cli.GC_THRESHOLD]
+    assert gc.get_threshold() == before

@@ -1,0 +1,264 @@
+"""Run figures drawn in a separate process that imports matplotlib while the run computes.
+
+``testbed run`` spends about a second importing matplotlib and drawing six figures after the
+fit (``benchmarks/bench_cli.py``), all of it after the fit.  :func:`figure_drawer` forks a
+drawing process when the command starts: it imports matplotlib and draws one small figure (font
+files, PNG encoder) while the parent loads its data and fits, then waits for a run folder.  A
+run folder sent to it is drawn by it and by one more process forked from it at that moment
+(matplotlib already imported), each drawing about half of the figures; the parent writes the
+report from the PNGs.  The figures are the same as drawn in-process
+(:func:`testbed.reporting.figures.save_run_figures`): the same builders on the same files.
+
+Life cycle:
+
+- the drawing processes ignore Ctrl-C (the parent handles it and ends them) and are killed by
+  the kernel when their parent dies (``PR_SET_PDEATHSIG``), also when it is killed with
+  ``SIGKILL``; they also end when the pipe to the parent closes;
+- an exception while drawing is sent to the parent and raised there, as it would have been
+  in-process (same type where it pickles; the drawing process's traceback as a note);
+- a drawing process that dies is an error raised in the parent (its exit code named);
+- where ``fork`` is not available (not Linux) the figures are drawn in-process.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import gc
+import multiprocessing
+import os
+import pickle
+import signal
+import sys
+import traceback
+from collections.abc import Callable, Iterator, Sequence
+from pathlib import Path
+from typing import Any
+
+from testbed.reporting import figures as figs
+from testbed.reporting.report import save_run_figures_and_report
+from testbed.studies.runstore import load_run
+
+__all__ = ["FigureWorker", "FigureWorkerError", "figure_drawer", "split_figures"]
+
+#: Relative drawing cost of each run figure (measured CPU of the cantilever run's figures:
+#: reconstruction 0.30-0.36 s, spectra 0.33-0.39, matrices 0.43-0.47, mac 0.09, frequencies
+#: 0.07-0.11, penalty weights 0.13); a stem not listed counts 1.
+FIGURE_COST = {"reconstruction": 3.0, "spectra": 3.0, "matrices": 4.0, "joint_angles": 3.0,
+               "mac": 1.0, "frequencies": 1.0, "penalty_weights": 1.0, "coefficients": 1.0}
+#: Seconds the parent waits for a drawing process to end after asking it to stop.
+STOP_TIMEOUT_S = 5.0
+_PR_SET_PDEATHSIG = 1
+
+
+class FigureWorkerError(RuntimeError):
+    """A drawing process died or could not draw (its own exceptions are re-raised as they are)."""
+
+
+def split_figures(stems: Sequence[str], parts: int = 2) -> list[list[str]]:
+    """Stems split into ``parts`` groups of about equal drawing cost (:data:`FIGURE_COST`).
+
+    Longest first onto the least loaded group (ties: the earlier group, the earlier stem), so
+    the split is the same on every machine.  Empty groups are dropped.
+    """
+    load = [0.0] * parts
+    groups: list[list[str]] = [[] for _ in range(parts)]
+    for s in sorted(stems, key=lambda s: -FIGURE_COST.get(s, 1.0)):  # stable: report order in ties
+        g = min(range(parts), key=lambda k: (load[k], k))
+        groups[g].append(s)
+        load[g] += FIGURE_COST.get(s, 1.0)
+    return [g for g in groups if g]
+
+
+def _die_with_parent(parent: int) -> None:
+    """Be killed when ``parent`` dies (Linux ``prctl``); exit now if it already has."""
+    if sys.platform.startswith("linux"):
+        with contextlib.suppress(Exception):
+            import ctypes
+
+            ctypes.CDLL(None, use_errno=True).prctl(_PR_SET_PDEATHSIG, int(signal.SIGKILL))
+    if os.getppid() != parent:  # died between the fork and the prctl
+        os._exit(0)
+
+
+def _warm_up() -> None:
+    """Import what drawing needs and draw one small figure (fonts, text layout, PNG encoder)."""
+    fig = figs._fig(1.0, 2.0)
+    ax = figs._axes(fig)[0, 0]
+    ax.plot([0.0, 1.0], [0.0, 1.0])
+    ax.set(title="warm-up", xlabel="x [-]")
+    figs.save_figure(fig, os.devnull)
+
+
+def _draw(folder: str, stems: Sequence[str]) -> list[str]:
+    """Draw ``stems`` of the run in ``folder`` into it; the PNG paths written."""
+    run = load_run(Path(folder))
+    drawn = figs.run_figures(run, only=stems)
+    return [str(figs.save_figure(f, Path(folder) / f"{stem}.png")) for stem, f in drawn.items()]
+
+
+def _error(e: BaseException) -> tuple[str, bytes | None, str, str]:
+    """An exception as it crosses the pipe: (``"error"``, pickled or None, one line, traceback)."""
+    try:
+        blob: bytes | None = pickle.dumps(e)
+        pickle.loads(blob)
+    except Exception:
+        blob = None
+    return ("error", blob, f"{type(e).__name__}: {e}", traceback.format_exc())
+
+
+def _raise(msg: tuple) -> None:
+    """Raise the exception a drawing process sent (as it was, where it pickled)."""
+    _, blob, line, tb = msg
+    e = pickle.loads(blob) if blob is not None else FigureWorkerError(f"drawing failed: {line}")
+    e.add_note(f"raised in the figure-drawing process:\n{tb.rstrip()}")
+    raise e
+
+
+def _draw_split(folder: str) -> list[str]:
+    """Draw every figure of the run in ``folder``: a forked helper draws half of them."""
+    groups = split_figures(figs.run_figures_available(load_run(Path(folder))))
+    if len(groups) < 2:
+        return _draw(folder, groups[0] if groups else [])
+    recv, send = multiprocessing.Pipe(duplex=False)
+    me = os.getpid()
+    gc.freeze()  # see FigureWorker: no copy on write of the shared objects by the collector
+    pid = os.fork()
+    if pid == 0:  # the helper: draw the second group, report, exit (never return)
+        code = 1
+        try:
+            recv.close()
+            _die_with_parent(me)
+            try:
+                send.send(("ok", _draw(folder, groups[1])))
+            except BaseException as e:
+                send.send(_error(e))
+            code = 0
+        finally:
+            os._exit(code)
+    send.close()
+    try:
+        mine = _draw(folder, groups[0])
+    finally:
+        try:
+            theirs = recv.recv()
+        except EOFError:
+            theirs = None
+        recv.close()
+        _, status = os.waitpid(pid, 0)
+    if theirs is None:
+        raise FigureWorkerError(f"the second drawing process died (wait status {status})")
+    if theirs[0] == "error":
+        _raise(theirs)
+    return mine + theirs[1]
+
+
+def _serve(conn: Any, parent_end: Any, parent: int) -> None:
+    """The drawing process: warm up, then draw each run folder sent until ``None`` or EOF."""
+    parent_end.close()
+    _die_with_parent(parent)
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's to handle
+    try:
+        _warm_up()
+        broken = None
+    except BaseException as e:  # reported with the first run sent, where the parent waits
+        broken = _error(e)
+    while True:
+        try:
+            folder = conn.recv()
+        except (EOFError, OSError):
+            return
+        if folder is None:
+            return
+        if broken is not None:
+            conn.send(broken)
+            continue
+        try:
+            conn.send(("ok", _draw_split(folder)))
+        except BaseException as e:
+            conn.send(_error(e))
+
+
+class FigureWorker:
+    """A forked drawing process serving :meth:`draw` (see the module docstring).
+
+    Use as a context manager (:func:`figure_drawer`): leaving it stops the process, and ends
+    it at once when leaving on an exception (Ctrl-C included).
+    """
+
+    def __init__(self) -> None:
+        ctx = multiprocessing.get_context("fork")
+        self._conn, child = ctx.Pipe()
+        self._proc = ctx.Process(target=_serve, args=(child, self._conn, os.getpid()),
+                                 name="testbed-figures", daemon=True)
+        # the objects made so far go to the collector's permanent generation, in this process
+        # and so in the forked one: neither one's collections then write to (and so copy) the
+        # memory pages the two still share.  Measured: 0.3-0.5 s less CPU of the whole
+        # `testbed run cantilever_stiff_impact` in 2 of 3 interleaved pairs (2 cores, load 20);
+        # what is frozen lives to the end of the process, as the modules it is mostly made of.
+        gc.freeze()
+        self._proc.start()
+        child.close()
+
+    def draw(self, run: Any, folder: Path) -> list[Path]:
+        """Draw the figures of the run saved in ``folder`` there; their paths in report order.
+
+        ``run`` is the :class:`~testbed.studies.runstore.SavedRun` read from ``folder`` (the
+        drawing process reads the folder itself).
+
+        Raises
+        ------
+        Exception
+            What drawing raised (re-raised here); :class:`FigureWorkerError` if a drawing
+            process died.
+        """
+        try:
+            self._conn.send(str(folder))
+            msg = self._conn.recv()
+        except (EOFError, OSError, BrokenPipeError):
+            self._proc.join(STOP_TIMEOUT_S)
+            raise FigureWorkerError(f"the figure-drawing process died (exit code "
+                                    f"{self._proc.exitcode})") from None
+        if msg[0] == "error":
+            _raise(msg)
+        written = {Path(p).stem: Path(p) for p in msg[1]}
+        return [written[s] for s in figs.run_figures_available(run) if s in written]
+
+    def close(self, *, kill: bool = False) -> None:
+        """Stop the drawing process (``kill``: at once) and reap it."""
+        if self._proc.is_alive() and not kill:
+            with contextlib.suppress(OSError, ValueError):
+                self._conn.send(None)
+            self._proc.join(STOP_TIMEOUT_S)
+        if self._proc.is_alive():
+            self._proc.kill()
+            self._proc.join()
+        self._conn.close()
+
+
+def fork_available() -> bool:
+    """Whether figures can be drawn in a forked process here (Linux: ``fork`` is safe)."""
+    return sys.platform.startswith("linux") and "fork" in multiprocessing.get_all_start_methods()
+
+
+@contextlib.contextmanager
+def figure_drawer(enabled: bool = True) -> Iterator[Callable[[Any, Path], list[Path]] | None]:
+    """The figure writer of ``testbed run``: ``figures(run, folder)`` for
+    :func:`testbed.studies.runstore.save_new_run`, drawing in a :class:`FigureWorker`.
+
+    Yields None when not ``enabled`` (``--no-figures``), the in-process writer
+    (:func:`testbed.reporting.report.save_run_figures_and_report`) where ``fork`` is not
+    available.  Start it before the work whose time it should overlap.
+    """
+    if not enabled:
+        yield None
+        return
+    if not fork_available():
+        yield save_run_figures_and_report
+        return
+    worker = FigureWorker()
+    ok = False
+    try:
+        yield lambda run, folder: save_run_figures_and_report(run, folder, draw=worker.draw)
+        ok = True
+    finally:
+        worker.close(kill=not ok)
