@@ -51,7 +51,8 @@ noise-corrected power, :func:`testbed.numerics.signal_band`) choose the column l
 (off on exact data, 1.5x the band otherwise), the edge trim, the ridge, the form and the LHS
 candidates; rates a low-pass chain derived from the noisy angles (a declared ``passband``) get
 the strong form with the column low-pass, the input terms as LHS, a ridge in proportion to
-the noise variance and the rollout selection; data the differences call exact but whose exact
+the noise variance (at least the chain's own error, ``CHAIN_REL_FLOOR``, clean angles alike)
+and the rollout selection; data the differences call exact but whose exact
 fit leaves a held-out error above ``EXACT_HOLDOUT_MAX`` (angles an undeclared chain smoothed)
 get the weak form with that LHS and ridge.  The values used are fitted attributes
 (``column_lowpass_hz_``, ``edge_trim_``, ``ridge_``, ``formulation_``, ``weak_window_s_``,
@@ -61,7 +62,8 @@ members (studies/families.toml) at default settings: within the paper's 0.0501 r
 (all <= 3e-6 rad, unchanged); the paper's sine input at 0.5-5 % noise <= 9e-6 rad.  With the
 rates estimated by the low-pass chain (``derivatives = "lowpass"``, automatic cut-off and end
 fits) at 1 %: 29/30 family members with the rollout selection (25/30 with the held-out one,
-12/30 with the weak form and 0.1 s end fits), at 5 % 18/30 (14/30 held-out), the paper's sine
+12/30 with the weak form and 0.1 s end fits), at 5 % 18/30 (14/30 held-out), clean 29/30
+(13/30 when the noise estimate of ~0 sent them to the exact-data ridge), the paper's sine
 input 6 of seeds 0-5 (<= 0.0060 rad; ``scenarios/fivebar_sine_replay_noise1``).
 
 Ensembling (``ensemble=N``): E-SINDy bagging of the selected models over moving-block
@@ -554,7 +556,8 @@ def noise_knobs(x: np.ndarray, fs: float, val_fraction: float, user: dict[str, A
             cut = WEAK_PERIODS / window
             branch = f"noisy: weak form, test functions {WEAK_PERIODS:g} / band = {window:.3g} s"
         if derived:
-            branch = branch.replace("noisy:", "noisy, rates derived by a low-pass:")
+            state = "clean angles" if noise_rel <= NOISE_FREE_REL and smoothed is None else "noisy"
+            branch = branch.replace("noisy:", f"{state}, rates derived by a low-pass:")
         cap = EDGE_MAX_SHARE_DERIVED if filtered and form == "strong" else EDGE_MAX_SHARE
         trim = min(EDGE_PERIODS / cut, cap * record_s)
         level = max(noise_rel, CHAIN_REL_FLOOR) if filtered else noise_rel

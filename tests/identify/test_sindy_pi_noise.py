@@ -202,6 +202,7 @@ def test_clean_angles_through_a_declared_chain_get_the_chain_recipe(clean):
     assert knobs["formulation"] == "strong" and knobs["column_lowpass_hz"] > 0
     assert knobs["ridge"] == pytest.approx(sp.RIDGE_PER_NOISE_VAR * sp.CHAIN_REL_FLOOR ** 2)
     assert f"error floor {sp.CHAIN_REL_FLOOR:g}" in rule
+    assert "clean angles, rates derived by a low-pass: strong form" in rule
     assert knobs["lhs"] == sp.LHS_INPUT_TERMS and knobs["selection"] == "rollout"
     # the floor is a floor: 5 % noise keeps its own ridge (25 x the floor's)
     noisy = _chain_smoothed(clean, 5.0)
