@@ -190,6 +190,31 @@ def test_declared_noise_fit_writes_equations_for_the_input_terms(clean):
     assert m.selection_ == "rollout" and m.rollout_rmse_ < 0.0501 / 5
 
 
+def test_clean_angles_through_a_declared_chain_get_the_chain_recipe(clean):
+    # noise-free angles, rates and accelerations derived by the declared 4 Hz chain: the rates
+    # are still estimates (the chain's own error), so the noise estimate of ~0 must not send
+    # them to the exact-data recipe (ridge 1e-14: the family's clean members lost their input
+    # terms or diverged, 13/30 within 0.0501 rad)
+    data = _chain_smoothed(clean, 0.0)
+    knobs, rule, est = sp.noise_knobs(data.x, data.fs, 0.2, {}, None, data.noise_std,
+                                      data.passband)
+    assert est["noise_rel"] <= sp.NOISE_FREE_REL and "exact data" not in rule
+    assert knobs["formulation"] == "strong" and knobs["column_lowpass_hz"] > 0
+    assert knobs["ridge"] == pytest.approx(sp.RIDGE_PER_NOISE_VAR * sp.CHAIN_REL_FLOOR ** 2)
+    assert f"error floor {sp.CHAIN_REL_FLOOR:g}" in rule
+    assert "clean angles, rates derived by a low-pass: strong form" in rule
+    assert knobs["lhs"] == sp.LHS_INPUT_TERMS and knobs["selection"] == "rollout"
+    # the floor is a floor: 5 % noise keeps its own ridge (25 x the floor's)
+    noisy = _chain_smoothed(clean, 5.0)
+    assert sp.noise_knobs(noisy.x, noisy.fs, 0.2, {}, None, noisy.noise_std,
+                          noisy.passband)[0]["ridge"] > knobs["ridge"]
+    m = SINDyPI().fit(data)
+    # one fit with the chain's recipe (no exact-data first fit taken for smoothed noise); the
+    # clean pick simulates at least as well as the 1 % one's bar (a fifth of 0.0501 rad)
+    assert "smoothed noise" not in m.noise_rule_ and m.ridge_ == knobs["ridge"]
+    assert m.selection_ == "rollout" and m.rollout_rmse_ < 0.0501 / 5
+
+
 def test_declared_chain_rollout_selection_is_overridden_by_the_user(clean):
     data = _chain_smoothed(clean, 1.0)
     m = SINDyPI(selection="holdout").fit(data)
