@@ -468,7 +468,8 @@ def noise_knobs(x: np.ndarray, fs: float, val_fraction: float, user: dict[str, A
        of ``WEAK_PERIODS / band_hz`` seconds (at most half the held-out span), edge trim
        ``EDGE_PERIODS * window / WEAK_PERIODS``; either way ridge ``RIDGE_PER_NOISE_VAR *
        noise_rel^2`` (for a declared chain ``noise_rel`` at least ``CHAIN_REL_FLOOR``, the
-       chain's own error on exact angles, so clean angles take this branch too), and LHS candidates the terms with an input factor (``"inputs"``): the inputs are
+       chain's own error on exact angles, so clean angles take this branch too), and LHS
+       candidates the terms with an input factor (``"inputs"``): the inputs are
        measured exactly, so an equation is written for its exact input term, never for a term the
        noise dominates.  For a declared chain (``passband``) the models are chosen by rollout
        (``selection="rollout"``: ``n_rollout`` shortlisted per input by held-out error, the
