@@ -541,10 +541,10 @@ class MatrixSGDSettings:
         ``K3 = b a^T`` (:func:`cubic_direction`); ``"diagonal"``: the n features ``x_j^3``, a
         full ``K3``.
     fit_tilt : bool or None
-        Difference every row once (warm start and SGD): None = by rule (tilted, flat with the
-        cubic library or when the tilted warm start has a growing mode; with the cubic library
-        tilted on the linear columns when the flat warm start kept no x^3 term), True = tilted (a
-        non-physical tilted warm start raises), False = flat.
+        Difference every row once (warm start and SGD): None = by rule (tilted, with the cubic
+        library too; flat when the tilted warm start has a growing mode, and then, with the
+        cubic library, tilted on the linear columns when the flat warm start kept no x^3 term),
+        True = tilted (a non-physical tilted warm start raises), False = flat.
     eigen_backbone : bool
         With the cubic library and a warm start that kept a cubic term, replace each hardening
         mode's peak by its backbone's linear frequency in the penalty and the hold
@@ -733,13 +733,12 @@ def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
         return warm_start(*sig[:3], x3_, m_hat, float(est.l1_threshold) if l1_on else 0.0,
                           pr_), pr_
 
-    # the fit band's tilt (identify.structural.FIT_TILT_DIFFERENCES, ls_sindy's rule): every
-    # feature, target and nuisance column differenced once; flat with the cubic library or
+    # the fit band's tilt (identify.structural.FIT_TILT_DIFFERENCES, ls_sindy's rule, the
+    # cubic library's too): every feature, target and nuisance column differenced once; flat
     # when the tilted warm start has a growing mode
-    if est.fit_tilt is False or (est.fit_tilt is None and est.cubic):
+    if est.fit_tilt is False:
         tilted = False
-        tilt_rule = ("fit_tilt = False (user setting)" if est.fit_tilt is False
-                     else "rule: cubic library, fitted flat")
+        tilt_rule = "fit_tilt = False (user setting)"
     else:
         tilted = True
         tilt_rule = (f"{FIT_TILT_DIFFERENCES} first difference of every row "
@@ -756,14 +755,14 @@ def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
             tilt_rule = f"rule: the tilted warm start was refused ({e}); fitted flat"
             sig = fit_signals(False)
             (M0, C0, K0, K30), pr = start(sig)
-    elif est.cubic and est.fit_tilt is None and est.init == "lstsq" and not _kept_cubic(K30):
-        # The cubic exclusion of the tilt is for a cubic model.  A flat warm start whose lasso
-        # kept no x^3 term is a linear model: its linear columns are fitted again tilted (the
-        # linear rule; the x^3 columns the lasso removed stay out, K3 = 0 and off the SGD's
-        # support), unless that is non-physical.  Measured on soft-base member 015
-        # (studies/families.toml, clean, cubic = true): the flat fit gave a 0 Hz and a 448 Hz
-        # (zeta 0.26) mode for 55.6 and 562.6 Hz true (TRAC 0.0003); tilted on x^3 columns
-        # too, the lasso kept an x^3 term there.
+    if (not tilted and est.cubic and est.fit_tilt is None and est.init == "lstsq"
+            and not _kept_cubic(K30)):
+        # The tilted cubic warm start was refused.  A flat warm start whose lasso kept no x^3
+        # term is a linear model: its linear columns are fitted again tilted (the linear rule;
+        # the x^3 columns the lasso removed stay out, K3 = 0 and off the SGD's support), unless
+        # that is non-physical.  Measured on soft-base member 015 (studies/families.toml,
+        # clean, cubic = true), when the cubic library was fitted flat by rule: the flat fit
+        # gave a 0 Hz and a 448 Hz (zeta 0.26) mode for 55.6 and 562.6 Hz true (TRAC 0.0003).
         sig_t = fit_signals(True)
         M1, C1, K1, _ = warm_start(*sig_t[:3], None, m_hat)
         try:
@@ -774,9 +773,9 @@ def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
         if why is None:
             tilted, sig = True, sig_t
             (M0, C0, K0, K30), pr = (M1, C1, K1, np.zeros((n, n))), cubic_profile(*sig_t[:4])
-            tilt_rule = (f"rule: cubic library, but the flat warm start kept no x^3 term (a linear "
-                         f"model): its linear columns fitted with {FIT_TILT_DIFFERENCES} first "
-                         f"difference of every row, as without the cubic library")
+            tilt_rule += (f"; the flat warm start kept no x^3 term (a linear model): its linear "
+                          f"columns fitted with {FIT_TILT_DIFFERENCES} first difference of every "
+                          f"row")
         else:
             tilt_rule += f" (the flat warm start kept no x^3 term; tilted refused: {why})"
     xdd, xd, x = sig[:3]

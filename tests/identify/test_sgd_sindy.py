@@ -114,20 +114,21 @@ def test_deterministic_and_seeded(linear):
 
 
 def test_tilt_rule(linear, cubic_fits):
-    """fit_tilt=None: tilted on the linear library; with the cubic one flat when the warm start
-    keeps an x^3 term (the Duffing chain), tilted when its lasso kept none (the linear chain:
-    a linear model, so the linear rule)."""
+    """fit_tilt=None: tilted on the linear library and on the cubic one alike (ls_sindy's rule;
+    soft-base member 000 clean: mode 2 27.6 % off flat, 0.23 % tilted), the Duffing chain
+    keeping its cubic term; the linear chain's lasso keeps none."""
     _, _, model = linear
     _, lin, _, duff = cubic_fits
-    assert model.fit_tilt_ and "(rule)" in model.fit_tilt_rule_
-    assert lin.fit_tilt_ and "kept no x^3 term" in lin.fit_tilt_rule_
+    for m in (model, lin, duff):
+        assert m.fit_tilt_ and m.fit_tilt_rule_.endswith("first difference of every row (rule)")
     assert not np.any(lin.K3_)
-    assert not duff.fit_tilt_ and duff.fit_tilt_rule_ == "rule: cubic library, fitted flat"
+    assert np.any(duff.K3_)
 
 
 def test_cubic_library_without_cubic_term_keeps_flat_when_tilt_refused(monkeypatch):
-    """The cubic library's warm start with no x^3 term is tried tilted, and a non-physical
-    tilted warm start leaves it flat (the same model as fit_tilt=False), with the reason."""
+    """The cubic library's tilted warm start refused as non-physical: fitted flat, and when the
+    flat one kept no x^3 term its linear columns are tried tilted; a non-physical tilted warm
+    start leaves it flat (the same model as fit_tilt=False), with the reasons."""
     import identify._sgd_matrix as sm
     from testbed.core.errors import IdentificationError
 
@@ -140,6 +141,7 @@ def test_cubic_library_without_cubic_term_keeps_flat_when_tilt_refused(monkeypat
     monkeypatch.setattr(sm, "check_physical", refuse)
     model = SGDSINDy(epochs=4, cubic=True).fit(data)
     assert model.fit_tilt_ is False and "tilted refused: non-physical model: test" in model.fit_tilt_rule_
+    assert model.fit_tilt_rule_.startswith("rule: the tilted warm start was refused")
     assert np.array_equal(model.coef_, flat.coef_)
 
 
