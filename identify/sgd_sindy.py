@@ -444,7 +444,8 @@ class SGDSINDy(SGDSINDyBase):
     (013 gained: mode 2 2.8 -> 0.45 %), 16 -> 24 / 40 at 1 % noise (001, 002, 003, 005, 012,
     028, 034, 036 gained), no member lost; soft bases unchanged (5/20, 2/20: the cubic
     library was then fitted flat; tilted since, see ``fit_tilt``); with only the warm start
-    tilted 35 / 16, as flat.  The tilted warm start has a growing mode (mode 1's damping, which the tilt weighs least, or a stiffness)
+    tilted 35 / 16, as flat.  The tilted warm start has a growing mode (mode 1's damping, which
+    the tilt weighs least, or a stiffness)
     on 17 of the 80 clamped cells (clean 009, 012, 014, 016, 022, 023, 025; at 1 % 009, 010,
     014, 016, 018, 022, 023, 024, 025, 027), which then fit flat.  Tilted all the same (the
     SGD's projections and the decay hold make the result physical): 36 / 25, but clean 014
