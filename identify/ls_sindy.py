@@ -268,10 +268,14 @@ class LeastSquaresSINDy(StructuralIdentifier):
         ps = modal_peaks(data)
         self.harmonics_, self.harmonic_rule_ = harmonics_array(ps), ps.harmonic_rule
         self.cubic_, self.cubic_rule_ = cubic_rule(data, self.cubic, self.fit_band_hz, ps.peaks)
-        lib, self.fit_band_hz_, self.fit_band_rule_ = fit_band(
-            data, lambda s: build_library(data, coupled_mass=False, cubic=self.cubic_, start=s,
-                                          drift=True, input_coupling=True), self.fit_band_hz,
-            ps.peaks)
+        def band_library() -> Library:  # the regression of cubic_ in the fit band
+            lib, self.fit_band_hz_, self.fit_band_rule_ = fit_band(
+                data, lambda s: build_library(data, coupled_mass=False, cubic=self.cubic_,
+                                              start=s, drift=True, input_coupling=True),
+                self.fit_band_hz, ps.peaks)
+            return lib
+
+        lib = band_library()
         masses = np.full(lib.target.shape[0], m_hat / lib.target.shape[0])
         self._fit_library(data, lib, masses, ps.peaks)
         if self.cubic_ and self.cubic is None:
@@ -279,10 +283,7 @@ class LeastSquaresSINDy(StructuralIdentifier):
             if why:  # a cubic the data do not hold up: refused, the linear library fitted
                 self.cubic_ = False
                 self.cubic_rule_ += f"; the fitted cubic model refused ({why}): cubic terms out"
-                lib, self.fit_band_hz_, self.fit_band_rule_ = fit_band(
-                    data, lambda s: build_library(data, coupled_mass=False, cubic=False, start=s,
-                                                  drift=True, input_coupling=True),
-                    self.fit_band_hz, ps.peaks)
+                lib = band_library()
                 self.__dict__.pop("modal_decay_", None)
                 self._fit_library(data, lib, masses, ps.peaks)
         self._finish_fit(data)

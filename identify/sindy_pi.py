@@ -772,17 +772,17 @@ class _ImplicitMechanical(Identifier):
 
         best = [p[0] for p in picks]
         if selection == "rollout":
-            segments = getattr(self, "rollout_segments", ROLLOUT_SEGMENTS_FIELD.default)
+            combos = list(product(*picks))
             scores = [self._rollout_error(ImplicitModel(lib, build(combo), solved, self.closure_),
-                                          data, i0, segments)
-                      for combo in product(*picks)]
+                                          data, i0, self.rollout_segments)
+                      for combo in combos]
             if not np.isfinite(min(scores)):
                 raise IdentificationError("no shortlisted model combination could be simulated")
-            combos = list(product(*picks))
             size = [sum(int(sw.nnz[t, c]) for t, c in cb) for cb in combos]
             ok = np.array(scores) <= min(scores) * (1 + self.selection_rtol) + ROLLOUT_ATOL
-            best = list(combos[min(np.flatnonzero(ok), key=lambda i: (size[i], scores[i]))])
-            self.rollout_rmse_ = float(scores[combos.index(tuple(best))])
+            chosen = min(np.flatnonzero(ok), key=lambda i: (size[i], scores[i]))
+            best = list(combos[chosen])
+            self.rollout_rmse_ = float(scores[chosen])
         self.coef_ = build(best)
         if getattr(self, "ensemble", 0):
             if open_chain:

@@ -89,9 +89,8 @@ def _warm_up() -> None:
     figs.save_figure(fig, os.devnull)
 
 
-def _draw(folder: str, stems: Sequence[str]) -> list[str]:
-    """Draw ``stems`` of the run in ``folder`` into it; the PNG paths written."""
-    run = load_run(Path(folder))
+def _draw(run: Any, folder: str, stems: Sequence[str]) -> list[str]:
+    """Draw ``stems`` of ``run`` (read from ``folder``) into ``folder``; the PNG paths written."""
     drawn = figs.run_figures(run, only=stems)
     return [str(figs.save_figure(f, Path(folder) / f"{stem}.png")) for stem, f in drawn.items()]
 
@@ -116,9 +115,10 @@ def _raise(msg: tuple) -> None:
 
 def _draw_split(folder: str) -> list[str]:
     """Draw every figure of the run in ``folder``: a forked helper draws half of them."""
-    groups = split_figures(figs.run_figures_available(load_run(Path(folder))))
+    run = load_run(Path(folder))  # read once: the forked helper inherits it
+    groups = split_figures(figs.run_figures_available(run))
     if len(groups) < 2:
-        return _draw(folder, groups[0] if groups else [])
+        return _draw(run, folder, groups[0] if groups else [])
     recv, send = multiprocessing.Pipe(duplex=False)
     me = os.getpid()
     gc.freeze()  # see FigureWorker: no copy on write of the shared objects by the collector
@@ -129,7 +129,7 @@ def _draw_split(folder: str) -> list[str]:
             recv.close()
             _die_with_parent(me)
             try:
-                send.send(("ok", _draw(folder, groups[1])))
+                send.send(("ok", _draw(run, folder, groups[1])))
             except BaseException as e:
                 send.send(_error(e))
             code = 0
@@ -137,7 +137,7 @@ def _draw_split(folder: str) -> list[str]:
             os._exit(code)
     send.close()
     try:
-        mine = _draw(folder, groups[0])
+        mine = _draw(run, folder, groups[0])
     finally:
         try:
             theirs = recv.recv()
