@@ -29,8 +29,13 @@ CHECK_EVERY = 1000
 RESIDUAL_REFUSE = 1e-8
 
 
+class BlowUpError(RigError):
+    """The linkage's simulation blew up (a non-finite signal, or MuJoCo resetting its state):
+    the integration step is a suspect besides the excitation (:func:`models.fivebar.rig`)."""
+
+
 def check_finite(t: np.ndarray, engine: str, dt: float, **signals: np.ndarray) -> None:
-    """Raise :class:`RigError` (one line) at the first sample where a recorded signal is not finite.
+    """Raise :class:`BlowUpError` (one line) at the first sample where a recorded signal is not finite.
 
     Parameters
     ----------
@@ -47,7 +52,7 @@ def check_finite(t: np.ndarray, engine: str, dt: float, **signals: np.ndarray) -
         bad = ~np.isfinite(x).all(axis=1)
         if bad.any():
             k = int(np.argmax(bad))
-            raise RigError(f"fivebar ({engine}): the simulation diverged, {name} is not finite at "
+            raise BlowUpError(f"fivebar ({engine}): the simulation diverged, {name} is not finite at "
                            f"t = {t[k]:.4f} s (RK4, dt = {dt:g} s); reduce the excitation amplitude or "
                            "simulation.dt")
 
@@ -130,10 +135,10 @@ def simulate(dyn: FiveBarDynamics, theta0: np.ndarray, dtheta0: np.ndarray, prog
             return
         if not (np.isfinite(q).all() and np.isfinite(v).all() and np.isfinite(tau_u).all()
                 and np.isfinite(a).all()):  # overflow, not a slow solve
-            raise RigError(f"fivebar (pinocchio): the simulation diverged, the accelerations are not "
-                           f"finite at t = {tk:.4f} s (RK4, dt = {dt:g} s, largest torque "
-                           f"{np.abs(tau_u).max():.3g} N m); reduce the excitation amplitude or "
-                           "simulation.dt")
+            raise BlowUpError(f"fivebar (pinocchio): the simulation diverged, the accelerations are not "
+                              f"finite at t = {tk:.4f} s (RK4, dt = {dt:g} s, largest torque "
+                              f"{np.abs(tau_u).max():.3g} N m); reduce the excitation amplitude or "
+                              "simulation.dt")
         raise RigError(f"fivebar (pinocchio): the loop-closure solve did not converge at t = {tk:.4f} s "
                        f"(relative residual {prox.relative_residual:.3g} after {max_iter} iterations, "
                        f"accepted <= {RESIDUAL_REFUSE:g}); the linkage is at or near a singularity: "

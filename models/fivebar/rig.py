@@ -28,6 +28,7 @@ from models.fivebar import geometry as geo
 from models.fivebar.dynamics import FiveBarDynamics
 from models.fivebar.equations import true_equations
 from models.fivebar.excitation import EXCITATION_SCHEMAS, build_program, start_actuated
+from models.fivebar.integrate import BlowUpError
 from models.fivebar.integrate import simulate as simulate_pinocchio
 from models.fivebar.params import FiveBarParams
 from testbed.core.budget import Cost
@@ -112,7 +113,7 @@ MOTION_KEYS: dict[str, tuple[str, ...]] = {
 
 
 def motion_keys_message(rig: dict[str, Any], excitation: dict[str, Any], simulation: dict[str, Any],
-                        why: str) -> str:
+                        why: str, blow_up: bool) -> str:
     """A generation failure of the linkage in the scenario's terms: the keys and values that
     drive the motion, what happened, what to change.
 
@@ -123,6 +124,9 @@ def motion_keys_message(rig: dict[str, Any], excitation: dict[str, Any], simulat
         drives the motion too and is named).
     why : str
         The integrator's one-line account (time, transmission angle or non-finite signal).
+    blow_up : bool
+        The simulation blew up (:class:`~models.fivebar.integrate.BlowUpError`), so
+        ``simulation.dt`` is named too.
 
     Returns
     -------
@@ -136,7 +140,7 @@ def motion_keys_message(rig: dict[str, Any], excitation: dict[str, Any], simulat
     if rig["gravity"]:
         names.append("rig.gravity")
         values.append(True)
-    if "not finite" in why or "unstable" in why:  # a blow-up: the step is a suspect too
+    if blow_up:  # the step is a suspect too
         names.append("simulation.dt")
         values.append(simulation["dt"])
     return (f"key '{', '.join(names)}': value {show_value(values)}: the motion under excitation "
@@ -291,7 +295,8 @@ class FiveBarRig(Rig):
             else:
                 rec = simulate_pinocchio(dyn, theta0, dtheta0, program, dt, fs, n, progress)
         except RigError as e:
-            raise RigError(motion_keys_message(rig, sc.excitation, sim, str(e))) from None
+            raise RigError(motion_keys_message(rig, sc.excitation, sim, str(e),
+                                               isinstance(e, BlowUpError))) from None
         return self._dataset(rec, extra, theta0, dtheta0, fs)
 
     def _dataset(self, rec: dict[str, np.ndarray], extra: dict[str, np.ndarray], theta0: np.ndarray,

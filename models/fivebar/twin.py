@@ -21,9 +21,8 @@ import numpy as np
 from models.fivebar import geometry as geo
 from models.fivebar.dynamics import link_inertia_diag
 from models.fivebar.excitation import TorqueProgram
-from models.fivebar.integrate import CHECK_EVERY, check_finite, check_transmission
+from models.fivebar.integrate import CHECK_EVERY, BlowUpError, check_finite, check_transmission
 from models.fivebar.params import FiveBarParams
-from testbed.core.errors import RigError
 from testbed.core.lazy import lazy_module
 
 mujoco = lazy_module("mujoco")  # imported on first use: `testbed list` does not pay for it
@@ -86,7 +85,8 @@ _RESETS = ("mjWARN_BADQACC", "mjWARN_BADQVEL", "mjWARN_BADQPOS", "mjWARN_BADCTRL
 
 
 def check_resets(m: mujoco.MjModel, d: mujoco.MjData, t: float) -> None:
-    """Raise :class:`RigError` (one line) if MuJoCo reset the state or zeroed a control.
+    """Raise :class:`~models.fivebar.integrate.BlowUpError` (one line) if MuJoCo reset the
+    state or zeroed a control.
 
     MuJoCo answers a huge or non-finite acceleration, state or control by resetting
     (or zeroing) it and carrying on; the record would go on from the reset pose.
@@ -96,7 +96,7 @@ def check_resets(m: mujoco.MjModel, d: mujoco.MjData, t: float) -> None:
         n = d.warning[w].number
         if n:
             what = mujoco.mjtWarning(w).name.removeprefix("mjWARN_BAD").lower()
-            raise RigError(f"fivebar (mujoco): the simulation is unstable, MuJoCo reset it {n} time(s) "
+            raise BlowUpError(f"fivebar (mujoco): the simulation is unstable, MuJoCo reset it {n} time(s) "
                            f"after a huge or non-finite {what} by t = {t:.4f} s (RK4, timestep "
                            f"{m.opt.timestep:g} s); reduce the excitation amplitude or simulation.dt")
 
