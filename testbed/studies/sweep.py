@@ -302,7 +302,31 @@ def run_cell(cell: Cell, cache_dir: str, plugins: tuple[str, ...],
     row["versions"] = json.dumps(versions(), sort_keys=True)
     row["commit"] = git_commit()
     row["cell_time"] = time.perf_counter() - t0
+    release_freed_memory()
     return row
+
+
+def release_freed_memory() -> bool:
+    """Hand the C heap's free pages back to the system (glibc ``malloc_trim``); True if done.
+
+    A cell's arrays, MuJoCo models and compiled kernels are freed when it ends, but glibc keeps
+    the freed pages of its heap mapped, so a worker's resident size grew by 2-27 MB per beam
+    member while its Python heap stayed flat (measured on the families study: +114 MB over 11
+    members; after ``malloc_trim(0)`` flat).  loky counts that growth as a memory leak: past
+    300 MB it stops the worker after its task and warns "A worker stopped while some jobs were
+    given to the executor", and the next cell pays a fresh worker's imports.  No-op (False) on a
+    C library without ``malloc_trim`` (macOS, musl).
+    """
+    if not sys.platform.startswith("linux"):
+        return False
+    try:
+        import ctypes
+
+        trim = ctypes.CDLL(None).malloc_trim
+    except (OSError, AttributeError):
+        return False
+    trim(0)
+    return True
 
 
 # --------------------------------------------------------------------------- the sweep
