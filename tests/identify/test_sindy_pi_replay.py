@@ -7,13 +7,15 @@ member fb_sine__004, 0.89 Hz, clean, recorded rates).  The equations the held-ou
 the rates to round-off (held-out error 1e-15) and lose the loop closure at 1.3 s of the record;
 the data came from the study's own member, so the test runs what the sweep runs."""
 
+import dataclasses
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from identify.sindy_pi import SINDyPI
-from testbed.core.errors import DivergenceError
+from identify._implicit import NoModelError, Sweep, select_models
+from identify.sindy_pi import EXACT_REPLAY_MAX, REPLAY_NOISE_FACTOR, SINDyPI
+from testbed.core.errors import DivergenceError, IdentificationError
 from testbed.pipeline.scenario import load_scenario
 from testbed.pipeline.signal_chain import measure
 from testbed.studies.study import load_study
@@ -32,10 +34,12 @@ def sine004(dataset_cache):
     return member, _data(dataset_cache, member)
 
 
-def _replay(model, data):
-    """RMSE [rad] of the model's simulation of the whole record from its first state."""
-    tr = model.simulate(data.x[:, 0], data.xd[:, 0], data.t, data.u)
-    return float(np.sqrt(np.mean((tr.x - data.x) ** 2, axis=1)).max())
+def _replay(model, data, i0=0):
+    """RMSE [rad] of the model's simulation of the record trimmed by ``i0`` samples at each
+    end, from its first state."""
+    sl = slice(i0, data.n_samples - i0)
+    tr = model.simulate(data.x[:, i0], data.xd[:, i0], data.t[sl], data.u[:, sl])
+    return float(np.sqrt(np.mean((tr.x - data.x[:, sl]) ** 2, axis=1)).max())
 
 
 def test_rich_record_keeps_the_held_out_choice(dataset_cache):
@@ -45,6 +49,18 @@ def test_rich_record_keeps_the_held_out_choice(dataset_cache):
     # measured 6.1e-7 rad (the integration error); the check's bar is 1e-4
     assert m.replay_rmse_ < 1e-5
     assert len(m.pruned_terms_) == 2  # the two kinematic identities only
+
+
+def test_angles_only_simulation_is_the_same_simulation(dataset_cache):
+    """The replay rule's simulations skip the rates and accelerations at the output times;
+    the angles are those of the full simulation, bit for bit."""
+    data = _data(dataset_cache, load_scenario("fivebar_multisine"))
+    m = SINDyPI(input_hold="zoh").fit(data)
+    sl = slice(0, 5000)  # 0.5 s of the record
+    args = (data.x[:, 0], data.xd[:, 0], data.t[sl], data.u[:, sl], m.sim_dt, m.input_hold)
+    full, fast = m.model_.simulate(*args), m.model_.simulate(*args, angles_only=True)
+    np.testing.assert_array_equal(fast.x, full.x)
+    assert fast.xd is None and fast.xdd is None
 
 
 @pytest.mark.slow
@@ -63,3 +79,35 @@ def test_sine_replay_with_non_unique_equations_is_chosen_by_rollout(sine004):
     # measured 1.04e-4 rad over the 8 s record: bar 1e-3, 10x that (a replay over 8 s of a model
     # exact only on the record amplifies round-off), 50x below the paper's 0.0501 rad
     assert m.replay_rmse_ < 1e-3
+
+
+@pytest.mark.slow
+def test_noisy_angles_with_recorded_rates_are_checked_too(dataset_cache):
+    """fb_sine__004 at 1 % angle noise (rates recorded): the held-out choice (held-out error
+    2e-11) loses the loop at 3.2 s; the rule's bar is 1e-4 + 5 x the noise std."""
+    member = {m.name: m for m in load_study(UNSEEN).scenarios}["fb_sine__004"]
+    noisy = dataclasses.replace(member, noise={**member.noise, "rms_percent": 1.0})
+    data = _data(dataset_cache, noisy)
+    hold = SINDyPI(input_hold="zoh", selection="holdout").fit(data)
+    i0 = round(hold.edge_trim_ * data.fs)
+    with pytest.raises(DivergenceError, match="loop closure"):
+        _replay(hold, data, i0)
+    m = SINDyPI(input_hold="zoh").fit(data)
+    assert m.selection_ == "rollout" and "chosen again by rollout" in m.replay_rule_
+    bar = EXACT_REPLAY_MAX + REPLAY_NOISE_FACTOR * float(np.max(m.noise_std_))
+    # measured 1.9e-3 rad against angles whose noise std is 1.7e-3 rad
+    assert m.replay_rmse_ == pytest.approx(_replay(m, data, i0), rel=1e-9) and m.replay_rmse_ < bar
+
+
+def test_no_eligible_model_is_a_typed_error():
+    """select_models' "no model for input k" is a NoModelError (the replay rule catches it)."""
+    p, n_t = 4, 2
+    W = np.zeros((n_t, 2, p))
+    W[:, 0, 0] = W[:, 1, 1] = 1.0
+    W[:, :, 3] = 0.5  # every model carries input 2 (column 3), none input 1 (column 2)
+    sw = Sweep(scale=np.ones(p), candidates=np.array([0, 1]), thresholds=np.array([0.0, 0.1]),
+               W=W, val_error=np.full((n_t, 2), 1e-3), train_error=np.full((n_t, 2), 1e-3),
+               nnz=np.count_nonzero(W, axis=2))
+    with pytest.raises(NoModelError, match="input 1"):
+        select_models(sw, [np.array([2]), np.array([3])])
+    assert issubclass(NoModelError, IdentificationError)
