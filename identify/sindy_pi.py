@@ -27,17 +27,18 @@ chosen equations must replay the trimmed record from its first measured state wi
 else the record left the equations non-unique (a one-tone record such as the paper's sine
 replay: held-out error 1e-15, yet the simulation loses the loop) and they are chosen again by
 rollout over the whole trimmed record among the ``n_rollout`` best per input of the unpruned
-library.  Not with ``ensemble`` (the bags' aggregate is none of the models compared).
-Measured (within 0.0501 rad; 2026-11-26): the paper's sine replay on five unseen five-bars
-(benchmarks/unseen/unseen_linkages.toml, fb_sine) at 0 / 1 / 3 / 5 % angle noise 4 / 4 / 3 / 3
--> 5 / 5 / 5 / 4 of 5, none lost (the one left: no loop closure found at 5 %); 14 more
-sine-replay five-bars of those ranges (seed 23; its right 1 % fits set the noise factor) clean 14 -> 14
-(values unchanged), 1 % 11 -> 13 (two held-out fits had found no model for an input; one
-member passes worse, 0.0023 -> 0.011 rad: the replay from a noisy start state judged it); the
-30 family five-bars clean 30 -> 30 (values unchanged), 1 % with recorded rates 30 -> 30 (two
-re-chosen: 0.0082 -> 0.0020 and 0.0013 -> 0.0026 rad).  Cost: one simulation of the record
-(angles only) per fit: fivebar_multisine 0.21 -> 0.35 s of CPU, fivebar_sine_replay
-0.18 -> 0.28 s.
+library (the first fit wins ties).  Not with ``ensemble`` (the bags' aggregate is none of the
+models compared).  Measured (within 0.0501 rad; 2026-11-26): the paper's sine replay on five
+unseen five-bars (benchmarks/unseen/unseen_linkages.toml, fb_sine) at 0 / 1 / 3 / 5 % angle
+noise 4 / 4 / 3 / 3 -> 5 / 5 / 5 / 4 of 5, none lost (the one left: no loop closure found at
+5 %); 14 more sine-replay five-bars of those ranges (seed 23; its right 1 % fits set the noise
+factor) clean 14 -> 14 (values unchanged), 1 % 11 -> 13 (two held-out fits had found no model
+for an input; the others unchanged); unseen cart-poles (benchmarks/unseen/unseen_other.toml)
+at 0 / 1 / 5 % 5 / 5 / 3 -> 5 / 5 / 5 (cartpoles__000 clean: right equations now, coef_error
+1 -> 6e-7); the 30 family five-bars clean 30 -> 30 (values unchanged), 1 % with recorded
+rates 30 -> 30 (one re-chosen: 0.0082 -> 0.0020 rad), with chain-derived rates 29 -> 29
+(values unchanged).  Cost: one simulation of the record (angles only) per fit:
+fivebar_multisine 0.21 -> 0.35 s of CPU, fivebar_sine_replay 0.18 -> 0.28 s.
 
 Underactuated open chains (a cart-pole: inputs on some coordinates, no loop; the loop closure
 is used only where the data declare one, :func:`closed_chain`): one equation per coordinate.
