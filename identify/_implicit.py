@@ -22,6 +22,10 @@ from testbed.core.errors import IdentificationError
 DEFAULT_THRESHOLDS = np.r_[0.0, np.logspace(-6, -0.5, 12)]
 
 
+class NoModelError(IdentificationError):
+    """No model of the sweep is eligible as some input's equation (:func:`select_models`)."""
+
+
 def split_index(n_samples: int, val_fraction: float) -> int:
     """Index of the first validation sample: the last ``val_fraction`` of the record in time."""
     if not 0.0 < val_fraction < 1.0:
@@ -368,7 +372,7 @@ def select_models(sw: Sweep, input_cols: Sequence[np.ndarray], rtol: float = 0.1
         other = others.max(axis=0) if others.size else np.zeros_like(shares[k])
         order = rank_models(sw, (shares[k] > 0) & (shares[k] > other), rtol, atol)
         if order.size == 0:
-            raise IdentificationError(f"no implicit model contains input {k + 1} as its dominant "
+            raise NoModelError(f"no implicit model contains input {k + 1} as its dominant "
                                       "input: the library lacks its terms or the input is zero")
         picked: list[tuple[int, int]] = []
         seen: set[bytes] = set()
