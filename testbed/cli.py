@@ -474,23 +474,17 @@ def cmd_identify(args: argparse.Namespace) -> int:
 
 
 def _physical_failures(summary: dict) -> dict[str, str] | None:
-    """What makes an identified structural model physically impossible
-    (:func:`testbed.scoring.scorers.physical_failures`: M not symmetric positive definite,
-    negative damping, a growing pole); None for a model without matrices.
+    """What makes the identified model a failed identification
+    (:func:`testbed.pipeline.fit.identified_failures`: structural matrices no passive structure
+    can have, NaN or infinite coefficients); None for a model without either.
 
-    Without a truth, ``identify`` has no score; a model no passive structure can have is still
-    a failed identification, never a result: the model is written (to be looked at) with the
-    reasons under ``physical_failures``, and the command exits 1 with a ``FAIL:`` line.
+    Without a truth, ``identify`` has no score; such a model is still a failed identification,
+    never a result: the model is written (to be looked at) with the reasons under
+    ``physical_failures``, and the command exits 1 with a ``FAIL:`` line.
     """
-    import numpy as np
+    from testbed.pipeline.fit import identified_failures
 
-    from testbed.scoring.scorers import physical_failures
-
-    mats = summary.get("matrices")
-    if not mats:
-        return None
-    M, C, K = (np.asarray(mats[k], dtype=float) for k in ("M", "C", "K"))
-    return physical_failures(M, C, K)
+    return identified_failures(summary)
 
 
 def cmd_runs(args: argparse.Namespace) -> int:

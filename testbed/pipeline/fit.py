@@ -163,8 +163,49 @@ def identify_file(path: str | os.PathLike, *, scenario: str | os.PathLike | None
         except IdentificationError as e:
             # the data (or a hyperparameter for them) the identifier cannot take: say which file
             raise IdentificationError(f"{path}: {identify['method']} found no model: {e}") from None
+        except Exception as e:
+            origin = plugins.IDENTIFIERS.origin(identify["method"])
+            if origin == "builtin":
+                raise  # a bug of the testbed's own identifier: the CLI calls it one
+            # the user's own identifier failed: their code, not the testbed, says the message
+            raise IdentificationError(f"{path}: identifier {identify['method']} (from {origin}) "
+                                      f"raised {type(e).__name__}: {' '.join(str(e).split())}") \
+                from None
         fit_time = time.perf_counter() - t0
     return FitResult(model, data, kind, identify["method"], str(path), fit_time)
+
+
+def identified_failures(summary: Mapping[str, Any]) -> dict[str, str] | None:
+    """What makes a model identified from a file a failed identification, or None for a
+    model without matrices or coefficients.
+
+    Structural matrices: :func:`testbed.scoring.scorers.physical_failures` (M not symmetric
+    positive definite, negative damping, a growing pole; NaN fails each).  Coefficients of
+    an equation model: any NaN or infinite coefficient (``"coefficients"``), which no
+    equation holds.  Without a truth, ``testbed identify`` has no score; such a model is still
+    written (to be looked at) with the reasons, and the command fails.
+
+    Parameters
+    ----------
+    summary : mapping
+        :meth:`FitResult.summary`.
+
+    Returns
+    -------
+    dict of str to str or None
+        Failure name -> reason (empty: none found).
+    """
+    from testbed.scoring.scorers import physical_failures
+
+    mats = summary.get("matrices")
+    if mats:
+        M, C, K = (np.asarray(mats[k], dtype=float) for k in ("M", "C", "K"))
+        return physical_failures(M, C, K)
+    coef = (summary.get("coefficients") or {}).get("coef")
+    if coef is None:
+        return None
+    bad = int(np.count_nonzero(~np.isfinite(np.asarray(coef, dtype=float))))
+    return {"coefficients": f"{bad} identified coefficient(s) are NaN or infinite"} if bad else {}
 
 
 def check_against_data(cls: Any, hyper: dict[str, Any], data: Measurement, *, file: str) -> None:

@@ -569,3 +569,27 @@ def test_identify_refuses_units_the_chain_would_misread(tmp_path, kind, header, 
     with pytest.raises(MeasuredDataError, match=fragment) as e:
         measurement_from_file(path, kind)
     assert str(e.value).startswith(f"{path}: ")
+
+
+def test_identify_names_the_plugin_whose_fit_raised(tmp_path, monkeypatch):
+    # a user's identifier raising in fit was "internal error (a bug, not your input) ... please
+    # report it"; the testbed's own identifiers still are (a bug of ours)
+    from identify.sindy_pi_dynamical import SINDyPIDynamical
+    from testbed.core.errors import IdentificationError
+    from testbed.pipeline import fit
+
+    class Broken(SINDyPIDynamical):
+        def fit(self, data):
+            raise ValueError("my plugin is broken")
+
+    monkeypatch.setattr(fit.plugins, "identifier_class", lambda name: Broken)
+    origin = {"sindy_pi_dynamical": "file /home/me/broken.py"}
+    monkeypatch.setattr(fit.plugins.IDENTIFIERS, "origin", lambda name: origin[name])
+    path = _mm_csv(tmp_path / "mm.csv")
+    with pytest.raises(IdentificationError) as e:
+        _identify(path)
+    assert str(e.value) == (f"{path}: identifier sindy_pi_dynamical (from file /home/me/broken.py) "
+                            "raised ValueError: my plugin is broken")
+    origin["sindy_pi_dynamical"] = "builtin"
+    with pytest.raises(ValueError, match="my plugin is broken"):
+        _identify(path)

@@ -329,3 +329,16 @@ def test_cartpole_with_the_fivebar_library_is_a_scored_failure(dataset_cache):
     result = run_scenario(sc, cache=dataset_cache)
     assert result.failure.startswith("fit failed: library: its terms use 4 coordinates")
     assert result.verdict == FAIL and all(math.isnan(v) for v in result.scores.values.values())
+
+
+def test_an_identified_model_with_nan_coefficients_fails_testbed_identify():
+    # `testbed identify` wrote a model of NaN coefficients and exited 0 (a pass)
+    from testbed.pipeline.fit import identified_failures
+
+    coef = {"coefficients": {"coef": [[0.18, math.nan, 1.0]], "feature_names": ["1", "x", "dx"]}}
+    assert identified_failures(coef) == {"coefficients": "1 identified coefficient(s) are NaN or "
+                                                         "infinite"}
+    assert identified_failures({"coefficients": {"coef": [[0.18, -0.9, 1.0]]}}) == {}
+    assert identified_failures({"equations": []}) is None
+    nan_m = {"matrices": {"M": [[math.nan]], "C": [[1.0]], "K": [[1.0]]}}
+    assert identified_failures(nan_m)  # NaN matrices fail the physical checks
