@@ -347,8 +347,9 @@ def measurement_from_file(path: str | os.PathLike, kind: str, signal: Mapping[st
 
 
 def _check_response(path: Path, ds: Dataset, kind: str) -> None:
-    """Refuse a record whose response (:data:`RESPONSE_SIGNAL`) does not move, or whose
-    sensors share a position (their equations would be the same)."""
+    """Refuse a record whose response (:data:`RESPONSE_SIGNAL`) does not move, in which one
+    channel does not move (a dead sensor), or whose sensors share a position (their equations
+    would be the same)."""
     sig = ds.measured.get(RESPONSE_SIGNAL.get(kind, ""))
     if sig is None:
         return  # the chain says what is missing
@@ -357,6 +358,13 @@ def _check_response(path: Path, ds: Dataset, kind: str) -> None:
         raise MeasuredDataError(path, f"the {RESPONSE_SIGNAL[kind]!r} channels do not move "
                                       f"(largest peak-to-peak {float(peaks.max()):.3g} {sig.unit}): "
                                       "no motion to identify")
+    dead = np.flatnonzero(~(peaks > 1.0 / MAX_MAGNITUDE))
+    if dead.size:  # a dead sensor or a locked coordinate: its equation has nothing to fit
+        raise MeasuredDataError(path, f"{RESPONSE_SIGNAL[kind]!r} channel "
+                                      f"{sig.channels[dead[0]]!r} does not move (peak-to-peak "
+                                      f"{float(peaks[dead[0]]):.3g} {sig.unit}) while others do: "
+                                      "its equation cannot be identified; expected every channel "
+                                      "to move (leave a dead sensor out of the file)")
     if sig.positions is not None and len(set(sig.positions.tolist())) < len(sig.positions):
         raise MeasuredDataError(path, f"the {RESPONSE_SIGNAL[kind]!r} channels share a position "
                                       f"({', '.join(f'{p:g}' for p in sig.positions)} m); expected "

@@ -593,3 +593,18 @@ def test_identify_names_the_plugin_whose_fit_raised(tmp_path, monkeypatch):
     origin["sindy_pi_dynamical"] = "builtin"
     with pytest.raises(ValueError, match="my plugin is broken"):
         _identify(path)
+
+
+def test_a_dead_channel_among_moving_ones_is_refused(tmp_path):
+    # a dead accelerometer (all zeros) next to live ones: ls_sindy wrote a model with two 0 Hz
+    # modes and R^2 = -1.6 and `testbed identify` exited 0
+    from testbed.pipeline.importers import MeasuredDataError, measurement_from_file
+
+    rows = "\n".join(f"{k / 100!r},{math.sin(k / 5)!r},2.0,{math.cos(k / 5) / 5 * 100!r},0.0"
+                     for k in range(100))
+    path = tmp_path / "dead.csv"
+    path.write_text(f"t,x/x1 [m],x/x2 [m],dx/x1 [m/s],dx/x2 [m/s]\n{rows}\n")
+    with pytest.raises(MeasuredDataError, match=r"'x' channel 'x2' does not move \(peak-to-peak 0 m\) "
+                                                r"while others do") as e:
+        measurement_from_file(path, "dynamical")
+    assert str(e.value).startswith(f"{path}: ")
