@@ -472,6 +472,15 @@ class SINDyPIDynamical(Identifier):
     @classmethod
     def check_data_shape(cls, params: dict[str, Any], n_channels: int, n_inputs: int, fs: float,
                          n_samples: int, error: ErrorFn) -> None:
+        rows, what = n_samples, "samples"
+        if params["formulation"] == "weak":
+            span = n_samples - round(params["weak_window_s"] * fs)
+            rows, what = min(params["weak_windows"], max(span, 0)), "test-function windows"
+        n_fit = round(rows * (1.0 - params["val_fraction"]))
+        if rows >= 1 and (n_fit < 2 or rows - n_fit < 2):  # identify._implicit.split_index's rule
+            error("val_fraction", params["val_fraction"],
+                  f"a split leaving at least 2 of the {rows} {what} to fit and 2 held out "
+                  f"(here {n_fit} and {rows - n_fit}; the record holds {n_samples} samples)")
         if params["formulation"] != "weak":
             return
         samples = round(params["weak_window_s"] * fs) + 1

@@ -457,6 +457,8 @@ ROUND2 = [
      "identify.lhs", "'exp(x)' is not"),
     ("michaelis_menten", '[identify]\nmethod = "sindy_pi_dynamical"\nformulation = "weak"\n'
                          'weak_window_s = 1e-9\n', "identify.weak_window_s", "at least 2 sample steps"),
+    ("michaelis_menten", "[simulation]\nduration = 0.03\n", "identify.val_fraction",
+     "2 of the 3 samples to fit and 2 held out"),
     ("cartpole", "[rig]\npole_mass = 1e-16\n", "rig.pole_mass", "mjMINVAL"),
     ("cartpole", "[rig]\ncart_mass = 1e-16\n", "rig.cart_mass", "mjMINVAL"),
     ("cartpole", "[rig]\npole_length = 1e-9\n", "rig.pole_length", "mjMINVAL"),
@@ -524,12 +526,25 @@ def test_identify_checks_hyperparameters_against_the_data(tmp_path):
 
 
 def test_identify_names_the_file_when_the_fit_finds_no_model(tmp_path):
+    # the fit's own errors ("lhs term 'x^5' is not in the library") named no file
     from testbed.core.errors import IdentificationError
+    from testbed.pipeline.fit import identify_file
 
-    path = _mm_csv(tmp_path / "two.csv", n=2)
+    path = _mm_csv(tmp_path / "mm.csv")
     with pytest.raises(IdentificationError) as e:
-        _identify(path)
-    assert str(e.value).startswith(f"{path}: sindy_pi_dynamical found no model: 2 samples")
+        identify_file(path, kind="dynamical", method="sindy_pi_dynamical", params={"lhs": ["x^5"]})
+    assert str(e.value) == f"{path}: sindy_pi_dynamical found no model: lhs term 'x^5' is not in the library"
+
+
+@pytest.mark.parametrize(("n", "val_fraction", "split"), [(2, "0.2", "here 2 and 0"),
+                                                          (400, "1e-12", "here 400 and 0"),
+                                                          (400, "0.999999", "here 0 and 400")])
+def test_identify_refuses_a_split_that_leaves_nothing_to_fit_or_hold_out(tmp_path, n, val_fraction,
+                                                                         split):
+    # was "400 samples are too few to split for validation" from the fit, naming no key
+    path = _mm_csv(tmp_path / "mm.csv", n=n)
+    with pytest.raises(ScenarioError, match=rf"key 'identify.val_fraction'.*{split}"):
+        _identify(path, f"val_fraction={val_fraction}")
 
 
 @pytest.mark.parametrize(("content", "fragment"), [
