@@ -20,7 +20,8 @@ from typing import Any
 
 import numpy as np
 
-from testbed.core.errors import IdentificationError, InputError
+from testbed.core.budget import check_steps
+from testbed.core.errors import IdentificationError, InputError, ScenarioError
 from testbed.core.measurement import Measurement
 from testbed.pipeline import plugins
 from testbed.pipeline.importers import measurement_from_file
@@ -175,42 +176,10 @@ def identify_file(path: str | os.PathLike, *, scenario: str | os.PathLike | None
     return FitResult(model, data, kind, identify["method"], str(path), fit_time)
 
 
-def identified_failures(summary: Mapping[str, Any]) -> dict[str, str] | None:
-    """What makes a model identified from a file a failed identification, or None for a
-    model without matrices or coefficients.
-
-    Structural matrices: :func:`testbed.scoring.scorers.physical_failures` (M not symmetric
-    positive definite, negative damping, a growing pole; NaN fails each).  Coefficients of
-    an equation model: any NaN or infinite coefficient (``"coefficients"``), which no
-    equation holds.  Without a truth, ``testbed identify`` has no score; such a model is still
-    written (to be looked at) with the reasons, and the command fails.
-
-    Parameters
-    ----------
-    summary : mapping
-        :meth:`FitResult.summary`.
-
-    Returns
-    -------
-    dict of str to str or None
-        Failure name -> reason (empty: none found).
-    """
-    from testbed.scoring.scorers import physical_failures
-
-    mats = summary.get("matrices")
-    if mats:
-        M, C, K = (np.asarray(mats[k], dtype=float) for k in ("M", "C", "K"))
-        return physical_failures(M, C, K)
-    coef = (summary.get("coefficients") or {}).get("coef")
-    if coef is None:
-        return None
-    bad = int(np.count_nonzero(~np.isfinite(np.asarray(coef, dtype=float))))
-    return {"coefficients": f"{bad} identified coefficient(s) are NaN or infinite"} if bad else {}
-
-
 def check_against_data(cls: Any, hyper: dict[str, Any], data: Measurement, *, file: str) -> None:
     """The identifier's checks against the data's shape and the budget of its simulations, as a
-    scenario's are checked against its rig at load (:func:`testbed.pipeline.scenario.check_identifier_for_rig`).
+    scenario's are checked against its rig at load
+    (:func:`testbed.pipeline.scenario.check_identifier_for_rig`).
 
     Parameters
     ----------
@@ -231,9 +200,6 @@ def check_against_data(cls: Any, hyper: dict[str, Any], data: Measurement, *, fi
         ``identify.<name>``, the value and what the data allow; a
         :class:`~testbed.core.errors.BudgetError` for a simulation beyond the step budget.
     """
-    from testbed.core.budget import check_steps
-    from testbed.core.errors import ScenarioError
-
     def error(name: str, value: Any, allowed: str) -> None:
         raise ScenarioError(file, f"identify.{name}", value, f"{allowed} (data: {data.n_channels} "
                                                              f"channel(s), {data.n_samples} samples "

@@ -317,7 +317,7 @@ def test_a_library_of_other_coordinates_is_a_hyperparameter_error():
 
     lib = fivebar_library(n_inputs=1)
     x = np.zeros((2, 10))
-    with pytest.raises(HyperparameterError, match="its terms use 4 coordinates .* the data have 2"):
+    with pytest.raises(HyperparameterError, match=r"its terms use 4 coordinates .* the data have 2"):
         lib.evaluate(x, x, x, np.zeros((1, 10)))
     with pytest.raises(ValueError):  # still a ValueError for the callers that catch one
         lib.evaluate(x, x, x, np.zeros((1, 10)))
@@ -333,7 +333,7 @@ def test_cartpole_with_the_fivebar_library_is_a_scored_failure(dataset_cache):
 
 def test_an_identified_model_with_nan_coefficients_fails_testbed_identify():
     # `testbed identify` wrote a model of NaN coefficients and exited 0 (a pass)
-    from testbed.pipeline.fit import identified_failures
+    from testbed.cli import _physical_failures as identified_failures
 
     coef = {"coefficients": {"coef": [[0.18, math.nan, 1.0]], "feature_names": ["1", "x", "dx"]}}
     assert identified_failures(coef) == {"coefficients": "1 identified coefficient(s) are NaN or "
