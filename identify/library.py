@@ -38,6 +38,7 @@ from itertools import combinations
 
 import numpy as np
 
+from testbed.core.errors import HyperparameterError
 from testbed.core.terms import canonical
 
 _TRIG = re.compile(r"^(sin|cos)\(th(\d+)(?:-th(\d+))?\)$")
@@ -141,9 +142,15 @@ class Library:
         x = np.atleast_2d(np.asarray(x, dtype=float))
         ns = x.shape[1]
         if x.shape[0] < n:
-            raise ValueError(f"library needs {n} coordinates, got {x.shape[0]}")
+            # a library written for other data (the five-bar's on a two-coordinate rig): the
+            # user's choice of hyperparameter, never a bug; a ValueError still
+            raise HyperparameterError(f"library: its terms use {n} coordinates (th1..th{n}), the "
+                                      f"data have {x.shape[0]}; expected a library of the data's "
+                                      "coordinates (a list of terms, or 'generic')")
         if m and (u is None or np.shape(u)[0] < m):
-            raise ValueError(f"library needs {m} input rows, got {0 if u is None else np.shape(u)[0]}")
+            got = 0 if u is None else np.shape(u)[0]
+            raise HyperparameterError(f"library: its terms use {m} inputs (u1..u{m}), the data "
+                                      f"have {got}; expected a library of the data's inputs")
         F = np.empty((self._one + 1, ns))
         F[:n] = x[:n]
         F[n:2 * n] = np.atleast_2d(xd)[:n]

@@ -41,6 +41,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import re
 from typing import Any, ClassVar
 
 import numpy as np
@@ -76,6 +77,12 @@ from testbed.core.schema import ErrorFn, Field
 #: amplifies the coefficients' own round-off (and noise) by 1e8: the model no longer decides
 #: the derivative.
 SINGULAR_TOL = 1e-8
+#: A term's syntax (:class:`ImplicitTerms`): ``1``, or factors ``name`` / ``name^k`` joined by
+#: ``*`` (whether each name is a state, a derivative or an input is known only from the data).
+_TERM = re.compile(r"^\s*(1|[A-Za-z_]\w*(\^[1-9]\d*)?(\s*\*\s*[A-Za-z_]\w*(\^[1-9]\d*)?)*)\s*$")
+#: Fewest samples of a weak-form test function: ``(1 - s^2)^p`` is zero at both ends of its
+#: window, so it needs a sample in between to weigh anything (:func:`identify._weak.window_function`).
+MIN_WINDOW_SAMPLES = 3
 
 
 class ImplicitTerms:
@@ -184,6 +191,9 @@ def weak_rows(lib: ImplicitTerms, x: np.ndarray, xd: np.ndarray, u: np.ndarray |
     L = round(window_s * fs) + 1
     if L > N:
         raise IdentificationError(f"test-function window {window_s} s is longer than the record")
+    if L < MIN_WINDOW_SAMPLES:
+        raise IdentificationError(f"test-function window {window_s} s spans {L} sample(s) at "
+                                  f"{fs:g} Hz; expected at least {MIN_WINDOW_SAMPLES}")
     starts = np.unique(np.round(np.linspace(0, N - L, int(n_windows))).astype(np.intp))
     phi, dphi_ds = window_function(L, degree)
     dt = 1.0 / fs
@@ -202,6 +212,38 @@ def weak_rows(lib: ImplicitTerms, x: np.ndarray, xd: np.ndarray, u: np.ndarray |
     V = _correlate(A0, phi * dt, starts)
     V += _correlate(A1, dphi * dt, starts)
     return V
+
+
+def check_finite_library(Theta: np.ndarray, G_train: np.ndarray, G_val: np.ndarray,
+                         names: list[str]) -> None:
+    """Refuse a library whose columns or Gram matrices overflow float64 on the data.
+
+    Parameters
+    ----------
+    Theta : ndarray, shape (n_rows, p)
+        The library matrix.
+    G_train, G_val : ndarray, shape (p, p)
+        Its Gram matrices.
+    names : list of str
+        Term names (columns).
+
+    Raises
+    ------
+    IdentificationError
+        Naming the first term whose column or Gram entries are not finite (a high power of
+        a large state: ``x^999`` beyond 1.8e308), so the fit fails for its real reason rather
+        than on the NaN the overflow leaves.
+    """
+    # a column's own values first, then its sum of squares (the Gram diagonal): the cross
+    # entries of a small column with an overflowing one are not finite either
+    for col in (~np.isfinite(Theta).all(axis=0),
+                ~np.isfinite(np.diag(G_train)) | ~np.isfinite(np.diag(G_val)),
+                ~np.isfinite(G_train).all(axis=0) | ~np.isfinite(G_val).all(axis=0)):
+        if not col.any():
+            continue
+        raise IdentificationError(f"library term {names[int(np.argmax(col))]!r} overflows float64 "
+                                  "on the data (its values or their sums of squares exceed "
+                                  "1.8e308); expected terms of lower power or rescaled data")
 
 
 def common_factor(W: np.ndarray, lib: ImplicitTerms) -> np.ndarray:
@@ -413,6 +455,15 @@ class SINDyPIDynamical(Identifier):
     def check_hyperparameters(cls, params: dict[str, Any], error: ErrorFn) -> None:
         check_thresholds(params, error)
         lib, lhs = params.get("library"), params.get("lhs")
+        for key in ("library", "lhs"):
+            terms = params.get(key) or []
+            bad = next((t for t in terms if not _TERM.match(t)), None)
+            if bad is not None:
+                error(key, terms, f"terms '1' or products 'a*b^k' of variable names (letters, "
+                                  f"digits, '_'; powers integers >= 1); {bad!r} is not")
+            if len(set(terms)) != len(terms):
+                error(key, terms, f"distinct terms; "
+                                  f"{next(t for t in terms if terms.count(t) > 1)!r} is repeated")
         if lib is not None and lhs is not None:
             missing = [t for t in lhs if t not in lib]
             if missing:
@@ -421,9 +472,25 @@ class SINDyPIDynamical(Identifier):
     @classmethod
     def check_data_shape(cls, params: dict[str, Any], n_channels: int, n_inputs: int, fs: float,
                          n_samples: int, error: ErrorFn) -> None:
-        if params["formulation"] == "weak" and round(params["weak_window_s"] * fs) + 1 > n_samples:
+        rows, what = n_samples, "samples"
+        if params["formulation"] == "weak":
+            span = n_samples - round(params["weak_window_s"] * fs)
+            rows, what = min(params["weak_windows"], max(span, 0)), "test-function windows"
+        n_fit = round(rows * (1.0 - params["val_fraction"]))
+        if rows >= 1 and (n_fit < 2 or rows - n_fit < 2):  # identify._implicit.split_index's rule
+            error("val_fraction", params["val_fraction"],
+                  f"a split leaving at least 2 of the {rows} {what} to fit and 2 held out "
+                  f"(here {n_fit} and {rows - n_fit}; the record holds {n_samples} samples)")
+        if params["formulation"] != "weak":
+            return
+        samples = round(params["weak_window_s"] * fs) + 1
+        if samples > n_samples:
             error("weak_window_s", params["weak_window_s"],
                   f"shorter than the record ({n_samples / fs:g} s)")
+        if samples < MIN_WINDOW_SAMPLES:
+            error("weak_window_s", params["weak_window_s"],
+                  f"at least {MIN_WINDOW_SAMPLES - 1} sample steps ({(MIN_WINDOW_SAMPLES - 1) / fs:g} s "
+                  f"at {fs:g} Hz): a test function vanishing at both ends needs a sample between")
 
     @classmethod
     def simulation_steps(cls, params: dict[str, Any], record_s: float) -> tuple[float, str]:
@@ -448,13 +515,15 @@ class SINDyPIDynamical(Identifier):
         n_states = data.n_channels
         u = None if data.u is None else np.asarray(data.u, dtype=float)
         x, xd = np.asarray(data.x, dtype=float), np.asarray(data.xd, dtype=float)
-        if self.formulation == "weak":
-            Theta = weak_rows(lib, x, xd, u, data.fs, self.weak_window_s, self.weak_windows,
-                              self.weak_degree)
-        else:
-            Theta = lib.evaluate(x, xd, u)
-        n_tr = split_index(Theta.shape[0], self.val_fraction)
-        G_train, G_val = grams(Theta, n_tr)
+        with np.errstate(over="ignore", invalid="ignore"):  # overflow is refused just below
+            if self.formulation == "weak":
+                Theta = weak_rows(lib, x, xd, u, data.fs, self.weak_window_s, self.weak_windows,
+                                  self.weak_degree)
+            else:
+                Theta = lib.evaluate(x, xd, u)
+            n_tr = split_index(Theta.shape[0], self.val_fraction)
+            G_train, G_val = grams(Theta, n_tr)
+        check_finite_library(Theta, G_train, G_val, lib.names)
         if self.lhs is None:
             cand = np.arange(len(lib.names))
         else:

@@ -474,23 +474,28 @@ def cmd_identify(args: argparse.Namespace) -> int:
 
 
 def _physical_failures(summary: dict) -> dict[str, str] | None:
-    """What makes an identified structural model physically impossible
-    (:func:`testbed.scoring.scorers.physical_failures`: M not symmetric positive definite,
-    negative damping, a growing pole); None for a model without matrices.
+    """What makes the identified model a failed identification: structural matrices no passive
+    structure can have (:func:`testbed.scoring.scorers.physical_failures`: M not symmetric
+    positive definite, negative damping, a growing pole; NaN fails each), or NaN or infinite
+    coefficients of an equation model (``"coefficients"``); None for a model without either.
 
-    Without a truth, ``identify`` has no score; a model no passive structure can have is still
-    a failed identification, never a result: the model is written (to be looked at) with the
-    reasons under ``physical_failures``, and the command exits 1 with a ``FAIL:`` line.
+    Without a truth, ``identify`` has no score; such a model is still a failed identification,
+    never a result: the model is written (to be looked at) with the reasons under
+    ``physical_failures``, and the command exits 1 with a ``FAIL:`` line.
     """
     import numpy as np
 
     from testbed.scoring.scorers import physical_failures
 
     mats = summary.get("matrices")
-    if not mats:
+    if mats:
+        M, C, K = (np.asarray(mats[k], dtype=float) for k in ("M", "C", "K"))
+        return physical_failures(M, C, K)
+    coef = (summary.get("coefficients") or {}).get("coef")
+    if coef is None:
         return None
-    M, C, K = (np.asarray(mats[k], dtype=float) for k in ("M", "C", "K"))
-    return physical_failures(M, C, K)
+    bad = int(np.count_nonzero(~np.isfinite(np.asarray(coef, dtype=float))))
+    return {"coefficients": f"{bad} identified coefficient(s) are NaN or infinite"} if bad else {}
 
 
 def cmd_runs(args: argparse.Namespace) -> int:

@@ -80,6 +80,14 @@ EXCITATION_SCHEMAS: dict[str, dict[str, Field]] = {
 }
 
 
+#: MuJoCo's smallest mass [kg] and principal inertia [kg m^2] of a moving body (``mjMINVAL``):
+#: its compiler refuses a model below it.
+MJ_MINVAL = 1e-15
+#: The pole's inertia about its own axis as a fraction of the transverse one (a thin rod's is
+#: zero; MuJoCo needs it positive and the triangle inequality holds for any fraction <= 2).
+POLE_AXIAL_FRACTION = 1e-6
+
+
 def build_mjcf(p: CartPoleParams, timestep: float) -> str:
     """MJCF of the cart-pole (no geometry, no contacts).
 
@@ -98,7 +106,7 @@ def build_mjcf(p: CartPoleParams, timestep: float) -> str:
       <body name="pole">
         <joint name="hinge" type="hinge" axis="0 -1 0" damping="{p.pole_damping!r}"/>
         <inertial pos="0 0 {-p.com!r}" mass="{p.pole_mass!r}"
-                  diaginertia="{p.inertia!r} {p.inertia!r} {1e-6 * p.inertia!r}"/>
+                  diaginertia="{p.inertia!r} {p.inertia!r} {POLE_AXIAL_FRACTION * p.inertia!r}"/>
       </body>
     </body>
   </worldbody>
@@ -159,6 +167,17 @@ class CartPoleRig(Rig):
         if excitation["amplitude"] == 0.0:
             error("excitation.amplitude", 0.0,
                   "expected > 0: without a force the cart's equation has no input to identify")
+        for key in ("cart_mass", "pole_mass"):
+            if not rig[key] > MJ_MINVAL:
+                error(f"rig.{key}", rig[key], f"expected > {MJ_MINVAL:g} kg (MuJoCo's smallest "
+                                              "mass of a moving body, mjMINVAL)")
+        inertia = rig["pole_mass"] * rig["pole_length"] ** 2 / 12.0
+        if not POLE_AXIAL_FRACTION * inertia > MJ_MINVAL:
+            error("rig.pole_length", rig["pole_length"],
+                  f"expected a pole whose inertia m L^2 / 12 exceeds "
+                  f"{MJ_MINVAL / POLE_AXIAL_FRACTION:g} kg m^2 (its axial inertia, "
+                  f"{POLE_AXIAL_FRACTION:g} of it, must exceed MuJoCo's mjMINVAL {MJ_MINVAL:g}); "
+                  f"with pole_mass = {rig['pole_mass']:g} kg it is {inertia:.3g} kg m^2")
 
     @classmethod
     def measurement_shape(cls, rig: dict[str, Any]) -> tuple[int, int]:

@@ -20,7 +20,8 @@ from typing import Any
 
 import numpy as np
 
-from testbed.core.errors import IdentificationError, InputError
+from testbed.core.budget import check_steps
+from testbed.core.errors import IdentificationError, InputError, ScenarioError
 from testbed.core.measurement import Measurement
 from testbed.pipeline import plugins
 from testbed.pipeline.importers import measurement_from_file
@@ -146,19 +147,69 @@ def identify_file(path: str | os.PathLike, *, scenario: str | os.PathLike | None
         raise InputError(f"identifier {identify['method']} is for {cls.kind} rigs; the data are "
                          f"{kind}")
     hyper = {k: v for k, v in identify.items() if k != "method"} | dict(params or {})
-    hyper = cls.validate_hyperparameters(hyper, file=str(scenario or "<command line>"))
+    where = str(scenario or "<command line>")
+    hyper = cls.validate_hyperparameters(hyper, file=where)
     phase = phase or _no_phase
     with phase("read and signal chain"):
         data = measurement_from_file(path, kind, signal, format=format, fs=fs, units=units,
                                      channels=channels, prior=prior)
+    check_against_data(cls, hyper, data, file=where)
     model = cls(**hyper)
     with phase("fit") as update:
         t0 = time.perf_counter()
         to = getattr(model, "progress_to", None)  # a plugin without it reports no steps
-        with to(update) if callable(to) else contextlib.nullcontext():
-            fit_or_fail(model, data)
+        try:
+            with to(update) if callable(to) else contextlib.nullcontext():
+                fit_or_fail(model, data)
+        except IdentificationError as e:
+            # the data (or a hyperparameter for them) the identifier cannot take: say which file
+            raise IdentificationError(f"{path}: {identify['method']} found no model: {e}") from None
+        except Exception as e:
+            origin = plugins.IDENTIFIERS.origin(identify["method"])
+            if origin == "builtin":
+                raise  # a bug of the testbed's own identifier: the CLI calls it one
+            # the user's own identifier failed: their code, not the testbed, says the message
+            raise IdentificationError(f"{path}: identifier {identify['method']} (from {origin}) "
+                                      f"raised {type(e).__name__}: {' '.join(str(e).split())}") \
+                from None
         fit_time = time.perf_counter() - t0
     return FitResult(model, data, kind, identify["method"], str(path), fit_time)
+
+
+def check_against_data(cls: Any, hyper: dict[str, Any], data: Measurement, *, file: str) -> None:
+    """The identifier's checks against the data's shape and the budget of its simulations, as a
+    scenario's are checked against its rig at load
+    (:func:`testbed.pipeline.scenario.check_identifier_for_rig`).
+
+    Parameters
+    ----------
+    cls : type
+        The identifier class.
+    hyper : dict
+        Its complete, validated hyperparameters.
+    data : Measurement
+        The measurement it is about to fit.
+    file : str
+        Where the hyperparameters came from (a scenario path or ``"<command line>"``).
+
+    Raises
+    ------
+    ScenarioError
+        A hyperparameter the data's shape refuses (term names for other channels, a window
+        longer than the record, a cut-off above the Nyquist frequency), naming ``file``, the key
+        ``identify.<name>``, the value and what the data allow; a
+        :class:`~testbed.core.errors.BudgetError` for a simulation beyond the step budget.
+    """
+    def error(name: str, value: Any, allowed: str) -> None:
+        raise ScenarioError(file, f"identify.{name}", value, f"{allowed} (data: {data.n_channels} "
+                                                             f"channel(s), {data.n_samples} samples "
+                                                             f"at {data.fs:g} Hz)")
+
+    n_inputs = 0 if data.u is None else int(np.shape(data.u)[0])
+    cls.check_data_shape(hyper, data.n_channels, n_inputs, float(data.fs), data.n_samples, error)
+    steps, key = cls.simulation_steps(hyper, data.n_samples / data.fs)
+    if key:
+        check_steps(steps, file, f"identify.{key}", hyper[key])
 
 
 @contextlib.contextmanager

@@ -336,6 +336,7 @@ def measurement_from_file(path: str | os.PathLike, kind: str, signal: Mapping[st
     data = read_measured(path, format=format, fs=fs, units=units, channels=channels)
     ds = data.to_dataset(groups, prior)
     _check_response(data.source, ds, kind)
+    _check_units(data.source, ds, kind)
     try:
         return measure(ds, dict(signal or {}), kind)
     except TestbedError:
@@ -346,8 +347,9 @@ def measurement_from_file(path: str | os.PathLike, kind: str, signal: Mapping[st
 
 
 def _check_response(path: Path, ds: Dataset, kind: str) -> None:
-    """Refuse a record whose response (:data:`RESPONSE_SIGNAL`) does not move, or whose
-    sensors share a position (their equations would be the same)."""
+    """Refuse a record whose response (:data:`RESPONSE_SIGNAL`) does not move, in which one
+    channel does not move (a dead sensor), or whose sensors share a position (their equations
+    would be the same)."""
     sig = ds.measured.get(RESPONSE_SIGNAL.get(kind, ""))
     if sig is None:
         return  # the chain says what is missing
@@ -356,10 +358,63 @@ def _check_response(path: Path, ds: Dataset, kind: str) -> None:
         raise MeasuredDataError(path, f"the {RESPONSE_SIGNAL[kind]!r} channels do not move "
                                       f"(largest peak-to-peak {float(peaks.max()):.3g} {sig.unit}): "
                                       "no motion to identify")
+    dead = np.flatnonzero(~(peaks > 1.0 / MAX_MAGNITUDE))
+    if dead.size:  # a dead sensor or a locked coordinate: its equation has nothing to fit
+        raise MeasuredDataError(path, f"{RESPONSE_SIGNAL[kind]!r} channel "
+                                      f"{sig.channels[dead[0]]!r} does not move (peak-to-peak "
+                                      f"{float(peaks[dead[0]]):.3g} {sig.unit}) while others do: "
+                                      "its equation cannot be identified; expected every channel "
+                                      "to move (leave a dead sensor out of the file)")
     if sig.positions is not None and len(set(sig.positions.tolist())) < len(sig.positions):
         raise MeasuredDataError(path, f"the {RESPONSE_SIGNAL[kind]!r} channels share a position "
                                       f"({', '.join(f'{p:g}' for p in sig.positions)} m); expected "
                                       "one sensor per position")
+
+
+#: What each measured signal of a rig kind holds (:data:`SAME_ORDER` of its unit); a
+#: dynamical rig's ``dx`` is checked against its ``x`` instead (:func:`_check_units`).
+SIGNAL_ORDER = {
+    "structural": {"acceleration": "acceleration", "force": "load"},
+    "mechanical": {"theta": "coordinate", "dtheta": "rate", "ddtheta": "acceleration",
+                   "torque": "load"},
+}
+#: The SI unit of the time derivative of a quantity in an SI unit
+RATE_OF = {"m": "m/s", "m/s": "m/s^2", "rad": "rad/s", "rad/s": "rad/s^2"}
+
+
+def _channel_units(sig: Signal) -> list[str]:
+    """One unit per channel of ``sig`` (a group of mixed coordinates states ``"m, rad"``)."""
+    units = [u.strip() for u in sig.unit.split(",")]
+    return units if len(units) == len(sig.channels) else [sig.unit] * len(sig.channels)
+
+
+def _check_units(path: Path, ds: Dataset, kind: str) -> None:
+    """Refuse signals whose units are not what the kind's chain reads them as: an acceleration
+    given in m, a rate in N, a dynamical ``dx`` that is not the rate of its ``x``.
+
+    Raises
+    ------
+    MeasuredDataError
+        Naming the signal, the channel, its unit and the unit (or kind of quantity) expected.
+    """
+    for g, want in SIGNAL_ORDER.get(kind, {}).items():
+        if g not in ds.measured:
+            continue  # the chain says what is missing
+        sig = ds.measured[g]
+        for ch, unit in zip(sig.channels, _channel_units(sig), strict=True):
+            if SAME_ORDER.get(unit) != want:
+                allowed = ", ".join(u for u, o in SAME_ORDER.items() if o == want)
+                raise MeasuredDataError(path, f"signal {g!r} channel {ch!r} is in {unit}; the "
+                                              f"{kind} chain reads {g!r} as a {want} ({allowed})")
+    if kind == "dynamical" and "x" in ds.measured and "dx" in ds.measured:
+        x, dx = ds.measured["x"], ds.measured["dx"]
+        if len(x.channels) != len(dx.channels):
+            return  # the chain says the row counts differ
+        for ch, ux, ud in zip(dx.channels, _channel_units(x), _channel_units(dx), strict=True):
+            rate = RATE_OF.get(ux, f"{ux}/s")
+            if ud != rate:
+                raise MeasuredDataError(path, f"signal 'dx' channel {ch!r} is in {ud}; expected "
+                                              f"{rate}, the rate of its state's {ux}")
 
 
 def from_sep005(channel_dicts: Sequence[Mapping[str, Any]], *, source: str | os.PathLike = "<sep005>",
@@ -566,6 +621,9 @@ def _parse_sep005(path: Path, content: Any) -> _Raw:
             data = np.asarray(c["data"], dtype=float)
         except (TypeError, ValueError):
             raise MeasuredDataError(path, f"SEP-005 channel {name!r}: data are not numbers") from None
+        except OverflowError:  # a JSON integer such as 10**400: no float64 holds it
+            raise MeasuredDataError(path, f"SEP-005 channel {name!r}: data hold an integer beyond "
+                                          "float64's range (1.8e308)") from None
         if data.ndim != 1:
             raise MeasuredDataError(path, f"SEP-005 channel {name!r}: data of shape {data.shape}; "
                                           "only 1-D channels are supported")
@@ -577,9 +635,9 @@ def _parse_sep005(path: Path, content: Any) -> _Raw:
         elif "time" in c:
             try:
                 t = np.asarray(c["time"], dtype=float)
-            except (TypeError, ValueError):
+            except (TypeError, ValueError, OverflowError):
                 raise MeasuredDataError(path, f"SEP-005 channel {name!r}: time values are not "
-                                              "numbers") from None
+                                              "numbers of float64's range") from None
             if t.shape != data.shape:
                 raise MeasuredDataError(path, f"SEP-005 channel {name!r}: time of shape {t.shape} "
                                               f"for data of shape {data.shape}; expected one time "

@@ -41,6 +41,7 @@ from typing import Any
 
 from joblib import Parallel, delayed, parallel_config
 
+from testbed.core.errors import InputError
 from testbed.core.provenance import git_commit, versions
 from testbed.pipeline.cache import DatasetCache
 from testbed.pipeline.generate import noise_free_scenario
@@ -457,6 +458,11 @@ def run_sweep(study: Study | str | os.PathLike, jobs: int = 1, dask_address: str
         os.replace(results, bad)
         log.warning("%s; set aside as %s, its cells will run again", e, bad.name)
         previous = read_results(results, set_aside=True)
+    others = sorted({str(r.get("study")) for r in previous if r.get("study") not in (None, "", study.name)})
+    if others:  # consolidating would drop every row of the other study: refused, nothing touched
+        raise InputError(f"results {results}: holds rows of study {', '.join(map(repr, others))}, "
+                         f"not {study.name!r}; expected a results file of study {study.name!r} or "
+                         "a new path (its rows would be dropped)")
     done = {r["cell"] for r in previous if not (retry_failed and r["status"] == "failed")}
     todo = [c for c in cells if c.key not in done]
     skipped = study.skipped()

@@ -370,6 +370,23 @@ def test_damaged_results_file_is_named_by_summary_and_set_aside_by_sweep(fault_d
     assert res.with_name(res.name + ".bad").is_file()
 
 
+def test_results_file_of_another_study_is_refused_untouched(fault_dir, tmp_path):
+    # --results naming another study's file: consolidating dropped every row of that study
+    # ("dropped N row(s) of cells no longer in study ...") and wrote this one's in their place
+    from testbed.cli import main
+    from testbed.core.errors import InputError
+
+    res, cache = tmp_path / "r.parquet", tmp_path / "c"
+    run_sweep(load_study(_study(fault_dir, "first", ["fault_fit"], seeds=(0,))), results=res,
+              cache_dir=cache, verbose=False)
+    before = res.read_bytes()
+    other = _study(fault_dir, "second", ["fault_fit"], seeds=(0,))
+    with pytest.raises(InputError, match=r"holds rows of study 'first', not 'second'"):
+        run_sweep(load_study(other), results=res, cache_dir=cache, verbose=False)
+    assert main(["sweep", str(other), "--results", str(res), "--cache", str(cache)]) == 2
+    assert res.read_bytes() == before and not parts_dir(res).exists()
+
+
 def test_retry_failed_flag_reruns_failed_cells_and_exit_status(fault_dir, tmp_path, capsys):
     from testbed.cli import main
 

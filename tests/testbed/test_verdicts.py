@@ -293,3 +293,52 @@ def test_a_fit_that_breaks_down_numerically_is_a_scored_failure(dataset_cache, e
     result = run_scenario(load_scenario("michaelis_menten"), cache=dataset_cache, model=BreaksDown())
     assert result.failure.startswith(f"fit failed: numerical breakdown ({type(error).__name__}: ")
     assert result.verdict == FAIL and all(math.isnan(v) for v in result.scores.values.values())
+
+
+# ------------------------------------------------------------------ round 2: newer surfaces
+def test_a_library_that_overflows_on_the_data_fails_for_that_reason():
+    # x ~ 1e300 (a valid Michaelis-Menten start x0 = 1e300): x^2 overflows; the fit failed as
+    # "every candidate left-hand-side column is zero" after overflow warnings on the terminal
+    from identify.sindy_pi_dynamical import SINDyPIDynamical
+    from testbed.core.measurement import Measurement
+
+    t = np.arange(200) / 100.0
+    x = (1e300 * (1.0 + 0.1 * np.exp(-t)))[None, :]
+    xd = (-1e299 * np.exp(-t))[None, :]
+    data = Measurement(fs=100.0, x=x, xd=xd, xdd=-xd, channels=("x",))
+    with pytest.raises(IdentificationError, match=r"library term 'x\^2' overflows float64"):
+        SINDyPIDynamical(degree=2).fit(data)
+
+
+def test_a_library_of_other_coordinates_is_a_hyperparameter_error():
+    # the five-bar's library on the cart-pole's two coordinates: an internal ValueError before
+    from identify.library import fivebar_library
+    from testbed.core.errors import HyperparameterError
+
+    lib = fivebar_library(n_inputs=1)
+    x = np.zeros((2, 10))
+    with pytest.raises(HyperparameterError, match=r"its terms use 4 coordinates .* the data have 2"):
+        lib.evaluate(x, x, x, np.zeros((1, 10)))
+    with pytest.raises(ValueError):  # still a ValueError for the callers that catch one
+        lib.evaluate(x, x, x, np.zeros((1, 10)))
+
+
+def test_cartpole_with_the_fivebar_library_is_a_scored_failure(dataset_cache):
+    sc = load_scenario("cartpole")
+    sc = sc.replace(identify={**sc.identify, "library": "fivebar"})
+    result = run_scenario(sc, cache=dataset_cache)
+    assert result.failure.startswith("fit failed: library: its terms use 4 coordinates")
+    assert result.verdict == FAIL and all(math.isnan(v) for v in result.scores.values.values())
+
+
+def test_an_identified_model_with_nan_coefficients_fails_testbed_identify():
+    # `testbed identify` wrote a model of NaN coefficients and exited 0 (a pass)
+    from testbed.cli import _physical_failures as identified_failures
+
+    coef = {"coefficients": {"coef": [[0.18, math.nan, 1.0]], "feature_names": ["1", "x", "dx"]}}
+    assert identified_failures(coef) == {"coefficients": "1 identified coefficient(s) are NaN or "
+                                                         "infinite"}
+    assert identified_failures({"coefficients": {"coef": [[0.18, -0.9, 1.0]]}}) == {}
+    assert identified_failures({"equations": []}) is None
+    nan_m = {"matrices": {"M": [[math.nan]], "C": [[1.0]], "K": [[1.0]]}}
+    assert identified_failures(nan_m)  # NaN matrices fail the physical checks
