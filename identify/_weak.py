@@ -37,6 +37,28 @@ import numpy as np
 
 from identify.library import Library
 from testbed.core.errors import IdentificationError
+from testbed.core.schema import ErrorFn
+
+#: Fewest samples of a test function: ``(1 - s^2)^p`` is zero at both ends of its window, so it
+#: needs a sample in between to weigh anything (:func:`window_function`).
+MIN_WINDOW_SAMPLES = 3
+
+
+def window_samples(window_s: float, fs: float) -> int:
+    """Samples a test-function window of ``window_s`` [s] spans at ``fs`` [Hz], both ends in."""
+    return round(window_s * fs) + 1
+
+
+def check_window(window_s: float, fs: float, n_samples: int, error: ErrorFn) -> None:
+    """A ``weak_window_s`` within a record of ``n_samples`` at ``fs`` [Hz] and long enough for
+    a test function (:data:`MIN_WINDOW_SAMPLES`); ``error(key, value, allowed)`` otherwise."""
+    samples = window_samples(window_s, fs)
+    if samples > n_samples:
+        error("weak_window_s", window_s, f"shorter than the record ({n_samples / fs:g} s)")
+    if samples < MIN_WINDOW_SAMPLES:
+        error("weak_window_s", window_s,
+              f"at least {MIN_WINDOW_SAMPLES - 1} sample steps ({(MIN_WINDOW_SAMPLES - 1) / fs:g} s "
+              f"at {fs:g} Hz): a test function vanishing at both ends needs a sample between")
 
 
 def window_function(n: int, degree: int) -> tuple[np.ndarray, np.ndarray]:
@@ -55,8 +77,8 @@ def window_function(n: int, degree: int) -> tuple[np.ndarray, np.ndarray]:
         The test function and its derivative with respect to ``s`` (multiply by ``2 / L``
         for the time derivative).
     """
-    if n < 3:
-        raise ValueError(f"a test function needs at least 3 samples, got {n}")
+    if n < MIN_WINDOW_SAMPLES:
+        raise ValueError(f"a test function needs at least {MIN_WINDOW_SAMPLES} samples, got {n}")
     if int(degree) < 2:
         raise ValueError(f"test-function degree must be >= 2, got {degree}")
     p = int(degree)
@@ -143,7 +165,7 @@ def weak_matrix(lib: Library, x: np.ndarray, xd: np.ndarray, xdd: np.ndarray | N
     x = np.atleast_2d(np.asarray(x, dtype=float))
     xd = np.atleast_2d(np.asarray(xd, dtype=float))
     N = x.shape[1]
-    L = round(window_s * fs) + 1
+    L = window_samples(window_s, fs)
     if L > N:
         raise IdentificationError(f"test-function window {window_s} s is longer than the record")
     if int(n_windows) < 2:

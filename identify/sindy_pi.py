@@ -129,7 +129,7 @@ from identify._implicit import (
     stlsq_sweep,
 )
 from identify._mechsim import CLOSURE_RTOL, ImplicitModel, LoopClosure
-from identify._weak import weak_matrix
+from identify._weak import check_window, weak_matrix
 from identify.library import Library, fivebar_library, generic_mechanical_library
 from testbed.core.errors import IdentificationError
 from testbed.core.measurement import Measurement, Trajectory
@@ -277,6 +277,12 @@ def check_terms(params: dict[str, Any], n_channels: int, n_inputs: int, error: E
     except (ValueError, TypeError) as e:
         error("library", params["library"], f"a library for {n_channels} channels and {n_inputs} "
                                             f"inputs: {e}")
+        return
+    if lib.n_coords > n_channels or lib.n_inputs > n_inputs:  # a library written for other data
+        error("library", params["library"],
+              f"a library of the data's {n_channels} coordinates and {n_inputs} inputs (a list of "
+              f"terms, or 'generic'); its terms use {lib.n_coords} coordinates and "
+              f"{lib.n_inputs} inputs")
         return
     if params.get("lhs") is None:
         return
@@ -1118,6 +1124,7 @@ class SINDyPI(_ImplicitMechanical):
             if not params["weak_window_s"] < span:
                 error("weak_window_s", params["weak_window_s"],
                       f"expected shorter than the trimmed record ({span:g} s)")
+            check_window(params["weak_window_s"], fs, n_samples, error)
 
     def __init__(self, library: Any = "fivebar", lhs: Sequence[str] | None = None,
                  thresholds: Sequence[float] | None = None, ridge: float | None = None,

@@ -57,7 +57,7 @@ from identify._implicit import (
     split_index,
     stlsq_sweep,
 )
-from identify._weak import _correlate, window_function
+from identify._weak import MIN_WINDOW_SAMPLES, _correlate, check_window, window_function, window_samples
 from identify.sindy_pi import (
     MAX_ITER_FIELD,
     RIDGE_FIELD,
@@ -80,10 +80,6 @@ SINGULAR_TOL = 1e-8
 #: A term's syntax (:class:`ImplicitTerms`): ``1``, or factors ``name`` / ``name^k`` joined by
 #: ``*`` (whether each name is a state, a derivative or an input is known only from the data).
 _TERM = re.compile(r"^\s*(1|[A-Za-z_]\w*(\^[1-9]\d*)?(\s*\*\s*[A-Za-z_]\w*(\^[1-9]\d*)?)*)\s*$")
-#: Fewest samples of a weak-form test function: ``(1 - s^2)^p`` is zero at both ends of its
-#: window, so it needs a sample in between to weigh anything (:func:`identify._weak.window_function`).
-MIN_WINDOW_SAMPLES = 3
-
 
 class ImplicitTerms:
     """A library of product terms over named states, their derivatives and inputs.
@@ -188,7 +184,7 @@ def weak_rows(lib: ImplicitTerms, x: np.ndarray, xd: np.ndarray, u: np.ndarray |
         If a test function is longer than the record.
     """
     N = x.shape[1]
-    L = round(window_s * fs) + 1
+    L = window_samples(window_s, fs)
     if L > N:
         raise IdentificationError(f"test-function window {window_s} s is longer than the record")
     if L < MIN_WINDOW_SAMPLES:
@@ -483,14 +479,7 @@ class SINDyPIDynamical(Identifier):
                   f"(here {n_fit} and {rows - n_fit}; the record holds {n_samples} samples)")
         if params["formulation"] != "weak":
             return
-        samples = round(params["weak_window_s"] * fs) + 1
-        if samples > n_samples:
-            error("weak_window_s", params["weak_window_s"],
-                  f"shorter than the record ({n_samples / fs:g} s)")
-        if samples < MIN_WINDOW_SAMPLES:
-            error("weak_window_s", params["weak_window_s"],
-                  f"at least {MIN_WINDOW_SAMPLES - 1} sample steps ({(MIN_WINDOW_SAMPLES - 1) / fs:g} s "
-                  f"at {fs:g} Hz): a test function vanishing at both ends needs a sample between")
+        check_window(params["weak_window_s"], fs, n_samples, error)
 
     @classmethod
     def simulation_steps(cls, params: dict[str, Any], record_s: float) -> tuple[float, str]:

@@ -459,6 +459,10 @@ ROUND2 = [
                          'weak_window_s = 1e-9\n', "identify.weak_window_s", "at least 2 sample steps"),
     ("michaelis_menten", "[simulation]\nduration = 0.03\n", "identify.val_fraction",
      "2 of the 3 samples to fit and 2 held out"),
+    ("fivebar_multisine", '[identify]\nmethod = "sindy_pi"\nformulation = "weak"\n'
+                          'weak_window_s = 1e-9\n', "identify.weak_window_s", "at least 2 sample steps"),
+    ("cartpole", '[identify]\nmethod = "sindy_pi"\nlibrary = "fivebar"\n', "identify.library",
+     "its terms use 4 coordinates"),
     ("cartpole", "[rig]\npole_mass = 1e-16\n", "rig.pole_mass", "mjMINVAL"),
     ("cartpole", "[rig]\ncart_mass = 1e-16\n", "rig.cart_mass", "mjMINVAL"),
     ("cartpole", "[rig]\npole_length = 1e-9\n", "rig.pole_length", "mjMINVAL"),
