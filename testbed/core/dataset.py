@@ -79,7 +79,8 @@ class Signal:
     channels : tuple of str
         One name per row.
     unit : str
-        SI unit of every channel, e.g. ``"m/s^2"``.
+        SI unit of every channel, e.g. ``"m/s^2"``; or one per channel, comma-separated, for a
+        group of mixed coordinates (``"m, rad"``: a cart's position and a pole's angle).
     positions : ndarray, shape (n_channels,), optional
         Position of each channel along the structure [m], where defined.
     acts_on : tuple of str, optional
@@ -93,6 +94,12 @@ class Signal:
     unit: str
     positions: np.ndarray | None = None
     acts_on: tuple[str, ...] | None = None
+
+    def channel_units(self) -> list[str]:
+        """One unit per channel: ``unit`` split at commas when it names one per channel, else
+        ``unit`` for every channel."""
+        units = [u.strip() for u in self.unit.split(",")]
+        return units if len(units) == len(self.channels) else [self.unit] * len(self.channels)
 
     def __post_init__(self) -> None:
         # C order always: a reduction over a row (e.g. the noise's RMS) then sums in one fixed

@@ -382,12 +382,6 @@ SIGNAL_ORDER = {
 RATE_OF = {"m": "m/s", "m/s": "m/s^2", "rad": "rad/s", "rad/s": "rad/s^2"}
 
 
-def _channel_units(sig: Signal) -> list[str]:
-    """One unit per channel of ``sig`` (a group of mixed coordinates states ``"m, rad"``)."""
-    units = [u.strip() for u in sig.unit.split(",")]
-    return units if len(units) == len(sig.channels) else [sig.unit] * len(sig.channels)
-
-
 def _check_units(path: Path, ds: Dataset, kind: str) -> None:
     """Refuse signals whose units are not what the kind's chain reads them as: an acceleration
     given in m, a rate in N, a dynamical ``dx`` that is not the rate of its ``x``.
@@ -401,7 +395,7 @@ def _check_units(path: Path, ds: Dataset, kind: str) -> None:
         if g not in ds.measured:
             continue  # the chain says what is missing
         sig = ds.measured[g]
-        for ch, unit in zip(sig.channels, _channel_units(sig), strict=True):
+        for ch, unit in zip(sig.channels, sig.channel_units(), strict=True):
             if SAME_ORDER.get(unit) != want:
                 allowed = ", ".join(u for u, o in SAME_ORDER.items() if o == want)
                 raise MeasuredDataError(path, f"signal {g!r} channel {ch!r} is in {unit}; the "
@@ -410,7 +404,7 @@ def _check_units(path: Path, ds: Dataset, kind: str) -> None:
         x, dx = ds.measured["x"], ds.measured["dx"]
         if len(x.channels) != len(dx.channels):
             return  # the chain says the row counts differ
-        for ch, ux, ud in zip(dx.channels, _channel_units(x), _channel_units(dx), strict=True):
+        for ch, ux, ud in zip(dx.channels, x.channel_units(), dx.channel_units(), strict=True):
             rate = RATE_OF.get(ux, f"{ux}/s")
             if ud != rate:
                 raise MeasuredDataError(path, f"signal 'dx' channel {ch!r} is in {ud}; expected "
@@ -563,11 +557,7 @@ def _read_hdf5(path: Path) -> _Raw:
     raw = _Raw(path, "hdf5", float(ds.fs), {}, {}, prior=dict(ds.prior),
                own_units=ds.attrs.get("kind") == "dynamical")
     for g, s in ds.measured.items():
-        # a signal of mixed coordinates states one unit per channel ("m, rad": a cart's
-        # position and a pole's angle)
-        per_channel = [u.strip() for u in s.unit.split(",")]
-        if len(per_channel) != len(s.channels):
-            per_channel = [s.unit] * len(s.channels)
+        per_channel = s.channel_units()  # "m, rad": a cart's position and a pole's angle
         for i, ch in enumerate(s.channels):
             name = f"{g}/{ch}"
             raw.data[name], raw.units[name] = s.data[i], per_channel[i]

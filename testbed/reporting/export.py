@@ -165,11 +165,12 @@ def _channels(ds: Dataset) -> list[tuple[str, int, Signal]]:
 def _uff58(ds: Dataset, name: str, i: int, s: Signal, node: int) -> dict[str, Any]:
     import pyuff
 
-    q, spec, len_exp, force_exp, rot, _ = quantity(s.unit)
+    unit = s.channel_units()[i]
+    q, spec, len_exp, force_exp, rot, _ = quantity(unit)
     scen = str(ds.attrs.get("scenario_name") or ds.attrs.get("rig", ""))
     return pyuff.prepare_58(
         binary=1, func_type=1, ver_num=0, load_case_id=0,
-        id1=f"{name}/{s.channels[i]}"[:80], id2=f"{q} [{s.unit}]"[:80],
+        id1=f"{name}/{s.channels[i]}"[:80], id2=f"{q} [{unit}]"[:80],
         id3=f"scenario {scen} seed {ds.attrs.get('seed', '')}"[:80],
         id4=f"content hash {ds.attrs.get('content_hash', '')[:40]}"[:80],
         id5=f"fs {float(ds.fs)!r} Hz, sysid-testbed"[:80],
@@ -179,7 +180,7 @@ def _uff58(ds: Dataset, name: str, i: int, s: Signal, node: int) -> dict[str, An
         abscissa_spacing=1, abscissa_spec_data_type=TIME_SPEC_TYPE, abscissa_len_unit_exp=0,
         abscissa_force_unit_exp=0, abscissa_temp_unit_exp=0, abscissa_axis_units_lab="s",
         ordinate_spec_data_type=spec, ordinate_len_unit_exp=len_exp, ordinate_force_unit_exp=force_exp,
-        ordinate_temp_unit_exp=0, ordinate_axis_units_lab=s.unit[:20],
+        ordinate_temp_unit_exp=0, ordinate_axis_units_lab=unit[:20],
         orddenom_spec_data_type=0, z_axis_spec_data_type=0, z_axis_value=0.0)
 
 
@@ -302,9 +303,10 @@ def to_sep005(ds: Dataset) -> list[dict[str, Any]]:
     nodes = node_numbers(ds)
     out = []
     for name, i, s in _channels(ds):
-        q, _, _, _, rot, tex = quantity(s.unit)
+        unit = s.channel_units()[i]
+        q, _, _, _, rot, tex = quantity(unit)
         ch: dict[str, Any] = {"name": f"{name}/{s.channels[i]}", "data": np.array(s.data[i], dtype=float),
-                              "fs": float(ds.fs), "unit_str": s.unit, "unit_tex": tex, "quantity": q,
+                              "fs": float(ds.fs), "unit_str": unit, "unit_tex": tex, "quantity": q,
                               "node": nodes[(name, i)],
                               "direction": ("+Z rotation" if rot else "+Z"), "group": "measured",
                               "content_hash": str(ds.attrs.get("content_hash", ""))}

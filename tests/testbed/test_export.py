@@ -10,6 +10,7 @@ import pytest
 import pyuff
 
 from testbed.core.dataset import Dataset, Signal
+from testbed.pipeline.importers import read_measured
 from testbed.reporting.export import (
     export_dataset,
     modal_masses,
@@ -60,6 +61,20 @@ def fivebar_dataset() -> Dataset:
                         "torque": Signal(tau, ("u1", "u2"), "N m", acts_on=("th1", "th4"))},
                    truth={"equation_terms": ["ddth1", "u1"], "equation_coef": np.array([[1.0, -1.0]])},
                    attrs={"rig": "fivebar", "kind": "mechanical", "seed": 0})
+
+
+def cartpole_dataset() -> Dataset:
+    """The cart-pole rig's measured signals: groups of mixed coordinates state one unit per
+    channel ("m, rad": the cart's position, the pole's angle)."""
+    t = np.arange(N) / FS
+    w = 2 * np.pi * np.array([[1.0], [2.0]])
+    q = np.sin(w * t)
+    return Dataset(FS, {"theta": Signal(q, ("x", "th"), "m, rad"),
+                        "dtheta": Signal(w * np.cos(w * t), ("dx", "dth"), "m/s, rad/s"),
+                        "ddtheta": Signal(-w**2 * q, ("ddx", "ddth"), "m/s^2, rad/s^2"),
+                        "torque": Signal(np.cos(w[:1] * t), ("u1",), "N", acts_on=("x",))},
+                   truth={"equation_terms": ["ddth1", "u1"], "equation_coef": np.array([[1.0, -1.0]])},
+                   attrs={"rig": "cartpole", "kind": "mechanical", "seed": 0})
 
 
 @pytest.fixture
@@ -206,7 +221,7 @@ def assert_sep005(channels) -> None:
                 datetime.datetime.fromisoformat(c[key])
 
 
-@pytest.mark.parametrize("make", [cantilever_dataset, fivebar_dataset])
+@pytest.mark.parametrize("make", [cantilever_dataset, fivebar_dataset, cartpole_dataset])
 def test_sep005_file_is_compliant_and_exact(make, saved, tmp_path):
     path = saved(make())
     ds = Dataset.load(path)  # HDF5 lists the signals by name
@@ -219,7 +234,8 @@ def test_sep005_file_is_compliant_and_exact(make, saved, tmp_path):
     rows = [(n, i, s) for n, s in ds.measured.items() for i in range(len(s.channels))]
     assert len(channels) == len(rows)
     for c, (n, i, s) in zip(channels, rows, strict=True):
-        assert c["name"] == f"{n}/{s.channels[i]}" and c["unit_str"] == s.unit and c["fs"] == FS
+        assert c["name"] == f"{n}/{s.channels[i]}" and c["fs"] == FS
+        assert c["unit_str"] == s.channel_units()[i]
         np.testing.assert_array_equal(c["data"], s.data[i])  # JSON floats round-trip exactly
 
 
@@ -231,6 +247,19 @@ def test_sep005_quantities_and_positions():
     ch = {c["name"]: c for c in to_sep005(fivebar_dataset())}
     assert ch["torque/u2"]["quantity"] == "torque" and ch["theta/th1"]["unit_tex"] == "rad"
     assert ch["torque/u2"]["node"] == 4
+
+
+@pytest.mark.parametrize("fmt", ["uff", "sep005"])
+def test_mixed_unit_groups_export_one_unit_per_channel_and_read_back(fmt, saved, tmp_path):
+    """A cart-pole's export is read by the testbed's own importer: each channel carries its
+    own unit (the group's "m, rad" written whole was refused as an unknown unit)."""
+    ds = cartpole_dataset()
+    (out,) = export_dataset(saved(ds), fmt, tmp_path / ("x.uff" if fmt == "uff" else "x.json"))
+    back = read_measured(out).signals
+    assert back["theta/x"][0] == "m" and back["theta/th"][0] == "rad"
+    assert back["ddtheta/ddx"][0] == "m/s^2" and back["ddtheta/ddth"][0] == "rad/s^2"
+    # UFF58 binary stores float64 (exact); SEP-005 JSON floats round-trip exactly
+    np.testing.assert_array_equal(back["dtheta/dth"][1], ds.measured["dtheta"].data[1])
 
 
 def test_unknown_format(saved):
