@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 
 from testbed.core.budget import check_steps
-from testbed.core.errors import IdentificationError, InputError, ScenarioError
+from testbed.core.errors import IdentificationError, InputError, ScenarioError, TestbedError
 from testbed.core.measurement import Measurement
 from testbed.pipeline import plugins
 from testbed.pipeline.importers import measurement_from_file
@@ -71,14 +71,29 @@ class FitResult:
 NUMERICAL_BREAKDOWN = (ArithmeticError, np.linalg.LinAlgError)
 
 
-def fit_or_fail(model: Any, data: Measurement) -> None:
+def fit_or_fail(model: Any, data: Measurement, method: str | None = None) -> None:
     """``model.fit(data)``; a :data:`NUMERICAL_BREAKDOWN` becomes an :class:`IdentificationError`
-    saying so (the identifier could not produce a model from these data)."""
+    saying so (the identifier could not produce a model from these data).
+
+    ``method``: the registered name ``model`` was made from.  Any other exception raised by a
+    user's plugin identifier (not a built-in one, whose exception is a testbed bug and stays
+    one) becomes an :class:`IdentificationError` naming the identifier and its file: the
+    user's own code failed, and a run scores it as a failed fit instead of calling it an
+    internal error of the testbed.
+    """
     try:
         model.fit(data)
     except NUMERICAL_BREAKDOWN as e:
         raise IdentificationError(f"numerical breakdown ({type(e).__name__}: "
                                   f"{' '.join(str(e).split()) or 'no message'})") from None
+    except TestbedError:
+        raise
+    except Exception as e:
+        origin = plugins.IDENTIFIERS.origin(method) if method is not None else "builtin"
+        if origin == "builtin":
+            raise
+        raise IdentificationError(f"identifier {method} (from {origin}) raised "
+                                  f"{type(e).__name__}: {' '.join(str(e).split())}") from None
 
 
 def identify_file(path: str | os.PathLike, *, scenario: str | os.PathLike | None = None,
@@ -160,18 +175,11 @@ def identify_file(path: str | os.PathLike, *, scenario: str | os.PathLike | None
         to = getattr(model, "progress_to", None)  # a plugin without it reports no steps
         try:
             with to(update) if callable(to) else contextlib.nullcontext():
-                fit_or_fail(model, data)
+                fit_or_fail(model, data, identify["method"])
         except IdentificationError as e:
-            # the data (or a hyperparameter for them) the identifier cannot take: say which file
+            # the data (or a hyperparameter for them) the identifier cannot take, or the user's
+            # own identifier failing: say which file
             raise IdentificationError(f"{path}: {identify['method']} found no model: {e}") from None
-        except Exception as e:
-            origin = plugins.IDENTIFIERS.origin(identify["method"])
-            if origin == "builtin":
-                raise  # a bug of the testbed's own identifier: the CLI calls it one
-            # the user's own identifier failed: their code, not the testbed, says the message
-            raise IdentificationError(f"{path}: identifier {identify['method']} (from {origin}) "
-                                      f"raised {type(e).__name__}: {' '.join(str(e).split())}") \
-                from None
         fit_time = time.perf_counter() - t0
     return FitResult(model, data, kind, identify["method"], str(path), fit_time)
 

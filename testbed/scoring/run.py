@@ -138,7 +138,7 @@ def run_scenario(scenario: Scenario, *, cache: DatasetCache | None = None,
         t0 = time.perf_counter()
         try:
             with _reporting(model, update):
-                fit_or_fail(model, data)
+                fit_or_fail(model, data, scenario.identify.get("method"))
         except ScenarioError:  # the user's configuration: raised, not scored
             raise
         except IdentificationError as e:  # data the identifier cannot handle: a scored failure

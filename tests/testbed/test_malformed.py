@@ -607,11 +607,36 @@ def test_identify_names_the_plugin_whose_fit_raised(tmp_path, monkeypatch):
     path = _mm_csv(tmp_path / "mm.csv")
     with pytest.raises(IdentificationError) as e:
         _identify(path)
-    assert str(e.value) == (f"{path}: identifier sindy_pi_dynamical (from file /home/me/broken.py) "
-                            "raised ValueError: my plugin is broken")
+    assert str(e.value) == (f"{path}: sindy_pi_dynamical found no model: identifier "
+                            "sindy_pi_dynamical (from file /home/me/broken.py) raised ValueError: "
+                            "my plugin is broken")
     origin["sindy_pi_dynamical"] = "builtin"
     with pytest.raises(ValueError, match="my plugin is broken"):
         _identify(path)
+
+
+def test_a_run_scores_the_plugin_whose_fit_raised_as_a_failed_fit(monkeypatch):
+    # `testbed run` with a user's identifier raising in fit said "internal error ... please
+    # report it"; it is the user's code failing on these data: a scored failure naming it
+    from identify.sindy_pi_dynamical import SINDyPIDynamical
+    from testbed.pipeline import plugins
+    from testbed.pipeline.scenario import load_scenario
+    from testbed.scoring.run import run_scenario
+
+    class Broken(SINDyPIDynamical):
+        def fit(self, data):
+            raise KeyError("no such column")
+
+    origin = {"sindy_pi_dynamical": "file /home/me/broken.py"}
+    monkeypatch.setattr(plugins.IDENTIFIERS, "origin", lambda name: origin[name])
+    sc = load_scenario("michaelis_menten")
+    result = run_scenario(sc, model=Broken())
+    assert not result.passed
+    assert result.failure == ("fit failed: identifier sindy_pi_dynamical (from file "
+                              "/home/me/broken.py) raised KeyError: 'no such column'")
+    origin["sindy_pi_dynamical"] = "builtin"  # the testbed's own identifier: a bug, raised
+    with pytest.raises(KeyError):
+        run_scenario(sc, model=Broken())
 
 
 def test_a_dead_channel_among_moving_ones_is_refused(tmp_path):
