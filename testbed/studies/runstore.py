@@ -680,15 +680,20 @@ def load_run(run_dir: str | os.PathLike) -> SavedRun:
 
 
 def _run_row(p: Path, meta: dict[str, Any]) -> dict[str, Any]:
+    """A run's listing row.  Its verdict and each check's ``passed`` are judged again from the
+    stored values, thresholds and failures (as :class:`SavedRun` does), not read: a run.json
+    edited to say ``passed`` over a NaN score is listed as the FAIL it is."""
     sc = meta.get("scenario", {})
+    checks = [Check(str(c.get("metric", "")), _num(c.get("value")), str(c.get("bound", "")),
+                    _num(c.get("threshold"))) for c in meta.get("checks", [])]
+    failures = meta.get("failures") or {}
     return {"path": p, "id": p.name, "scenario": str(sc.get("name", p.name)),
             "seed": sc.get("seed", ""), "identifier": str(meta.get("identifier", {}).get("name", "")),
-            "verdict": str(meta.get("verdict", "")), "fit_time": _num(meta.get("fit_time")),
+            "verdict": verdict(checks, failures), "fit_time": _num(meta.get("fit_time")),
             "created": str(meta.get("created", "")),
-            "failure": "; ".join(str(v) for v in (meta.get("failures") or {}).values()),
-            "checks": [{"metric": str(c.get("metric", "")), "value": _num(c.get("value")),
-                        "bound": str(c.get("bound", "")), "threshold": _num(c.get("threshold")),
-                        "passed": bool(c.get("passed"))} for c in meta.get("checks", [])],
+            "failure": "; ".join(str(v) for v in failures.values()),
+            "checks": [{"metric": c.metric, "value": c.value, "bound": c.bound,
+                        "threshold": c.threshold, "passed": c.passed} for c in checks],
             "scores": {str(k): _num(v) for k, v in meta.get("scores", {}).items()
                        if v is None or isinstance(v, (int, float, str))}}
 

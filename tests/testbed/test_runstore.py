@@ -265,3 +265,17 @@ def test_index_says_why_a_run_failed(structural, tmp_path):
     assert row["verdict"] == "FAIL" and row["failure"] == "fit failed: the Gram matrix is singular"
     page = (tmp_path / "index.html").read_text()
     assert "fit failed: the Gram matrix is singular" in page and "badge fail" in page
+
+
+def test_a_run_json_edited_to_pass_over_a_nan_is_listed_as_failed(structural, tmp_path):
+    # the listing (testbed runs, the index page) read the stored verdict: a run.json edited to
+    # say "pass" over a NaN check value was listed PASS; it is judged again from the values
+    path = save_new_run(structural, tmp_path)
+    meta = json.loads((path / "run.json").read_text())
+    check = {"metric": "trac", "value": 0.97, "bound": "min", "threshold": 0.9, "passed": True}
+    for value, expected in ((0.97, "pass"), (None, "FAIL")):  # NaN is stored as null
+        meta.update(checks=[{**check, "value": value}], verdict="pass", passed=True, failures={})
+        (path / "run.json").write_text(json.dumps(meta))
+        (row,) = list_runs(tmp_path)
+        assert row["verdict"] == expected and row["checks"][0]["passed"] == (expected == "pass")
+        assert load_run(path).passed == (expected == "pass")
