@@ -155,8 +155,13 @@ class Identifier:
 
     @classmethod
     def _param_names(cls) -> list[str]:
+        """The named parameters of ``__init__`` (none for a class without its own, such as a
+        plugin with no hyperparameters; ``*args`` / ``**kwargs`` are not hyperparameters)."""
+        if cls.__init__ is object.__init__:
+            return []
         sig = inspect.signature(cls.__init__)
-        return [p for p in sig.parameters if p != "self"]
+        return [n for n, p in sig.parameters.items() if n != "self"
+                and p.kind not in (p.VAR_POSITIONAL, p.VAR_KEYWORD)]
 
     def get_params(self, deep: bool = True) -> dict[str, Any]:
         """Hyperparameters by name (scikit-learn's contract; ``deep`` also lists the parameters

@@ -107,3 +107,18 @@ def test_every_hyperparameter_is_declared_and_nothing_else(name):
     assert cls.validate_hyperparameters({}) == {k: f.default for k, f in declared.items()}
     given = {k: f.default for k, f in declared.items() if f.default is not None}
     cls.validate_hyperparameters(given)
+
+
+def test_an_identifier_without_its_own_init_has_no_hyperparameters():
+    # a plugin written without __init__ (nothing to set) inherited object's (*args, **kwargs)
+    # as "hyperparameters": get_params raised AttributeError 'args' when its run was saved
+    class Bare(Identifier):
+        name = "bare"
+        kind = "structural"
+
+    class Varargs(Identifier):
+        def __init__(self, alpha: float = 1.0, *args, **kwargs):
+            self.alpha = alpha
+
+    assert Bare().get_params() == {} and Bare().clone().get_params() == {}
+    assert Varargs().get_params() == {"alpha": 1.0}
