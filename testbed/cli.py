@@ -468,7 +468,8 @@ def cmd_identify(args: argparse.Namespace) -> int:
     print(report, end="")
     print(f"model written to {out} (report {out.with_suffix('.md')})")
     if failures:
-        print(f"FAIL: physically impossible model: {'; '.join(failures.values())}")
+        what = "unusable model" if "coefficients" in failures else "physically impossible model"
+        print(f"FAIL: {what}: {'; '.join(failures.values())}")
         return EXIT_FAIL
     return 0
 
