@@ -11,10 +11,8 @@ module's fixtures (a simulation, a fit, a numba compile) again.
 """
 
 import contextlib
-import functools
 import os
 import sys
-import threading
 from pathlib import Path
 
 import pytest
@@ -61,67 +59,10 @@ def pytest_configure(config):
     # (xdist's default ``--loadscope-reorder``).
     if getattr(config.option, "dist", "no") == "loadgroup":
         config.option.loadscopereorder = False
-    if os.environ.get("PYTEST_XDIST_WORKER"):  # a worker: others share its numba cache
-        _compile_each_kernel_once()
-
-
-#: Packages whose numba kernels are compiled with ``cache=True`` (every ``@njit`` of the project:
-#: ``identify/_compiled.py``, ``identify/_pi_kernels.py``).
-_CACHED_KERNEL_PACKAGES = ("identify", "models", "testbed")
-#: Held by the thread of this process that is compiling one of the project's kernels (numba
-#: compiles one function at a time per process anyway: its global compiler lock), and the names
-#: of the inter-process locks it holds (a kernel compiled while compiling itself keeps its lock).
-_COMPILING = threading.RLock()
-_HELD: set[str] = set()
-
-
-def _compile_each_kernel_once():
-    """Let one test process compile each of the project's numba kernels while the others wait
-    for its cache entry, instead of compiling it too.
-
-    The kernels are ``cache=True``: a process calling one for a new signature first looks in
-    the on-disk cache (``__pycache__`` beside the source), and compiles and stores it on a miss.
-    On a fresh clone the cache is empty and both workers start with fits that need the same
-    kernels, so both compiled them: measured on a cold cache, one process spends about 61 s of
-    CPU compiling the kernels that the conformance, mechsim and SINDy-PI kernel tests call
-    (``rk4_implicit`` 13.8 s, ``eig_loss_grad`` 11.6 s, ``sgd_steps`` 8.2 s,
-    ``stlsq_chains_downdate`` 7.7 s, ...).  Here :meth:`numba.core.dispatcher.Dispatcher.compile`
-    (public: "compile the function for the given signature"; it looks in the disk cache before
-    compiling) runs under the inter-process lock of the kernel's name, so a process that needs
-    a kernel another one is compiling waits, then loads the entry that one stored.
-
-    No deadlock: a process holds the locks of a chain of calls (a kernel, the callee being typed
-    in it, ...) and waits only for a callee of the last; the kernels do not call each other in a
-    cycle.  Another package's kernels are compiled unlocked.  If numba has no ``Dispatcher.compile``
-    the kernels are simply compiled by each process that needs them, as before.
-    """
-    try:
-        from numba.core.dispatcher import Dispatcher
-    except ImportError:
-        return
-    compile_ = getattr(Dispatcher, "compile", None)
-    if compile_ is None or getattr(compile_, "_one_process_at_a_time", False):
-        return
-
-    @functools.wraps(compile_)
-    def compile(self, *args, **kwargs):
-        py = getattr(self, "py_func", None)
-        module = getattr(py, "__module__", None) or ""
-        if module.partition(".")[0] not in _CACHED_KERNEL_PACKAGES:
-            return compile_(self, *args, **kwargs)
-        name = f"numba-{module}.{py.__qualname__}"
-        with _COMPILING:
-            if name in _HELD:
-                return compile_(self, *args, **kwargs)
-            with _interprocess_lock(name):
-                _HELD.add(name)
-                try:
-                    return compile_(self, *args, **kwargs)
-                finally:
-                    _HELD.discard(name)
-
-    compile._one_process_at_a_time = True
-    Dispatcher.compile = compile
+    # numba's cache=True kernels: measured on two cold runs (2026-11-26, with the order of
+    # _COLD_SECONDS), every kernel was compiled by one worker only (58 s of CPU in all), so
+    # nothing locks their compiles (a lock would wrap numba's Dispatcher, which an upgrade could
+    # break in CI); a change of order that made both workers compile one would show here.
 
 
 @pytest.hookimpl(tryfirst=True)  # before xdist reads the xdist_group marks

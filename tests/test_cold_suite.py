@@ -1,18 +1,5 @@
 """The cold-cache economies of the test run itself (tests/conftest.py) stay in effect."""
 
-import os
-
-import pytest
-
-
-@pytest.mark.skipif(not os.environ.get("PYTEST_XDIST_WORKER"), reason="only pytest-xdist workers lock")
-def test_numba_kernels_are_compiled_under_an_inter_process_lock():
-    """If a numba release renamed or replaced ``Dispatcher.compile``, conftest would silently stop
-    locking and both workers would compile every kernel again (75 s of CPU on a cold cache)."""
-    from numba.core.dispatcher import Dispatcher
-
-    assert getattr(Dispatcher.compile, "_one_process_at_a_time", False)
-
 
 def test_contrast_and_scored_runs_share_one_group():
     """The Eq. 21 contrast reads the runs of two scored tests (conftest ``scenario_run``): they
