@@ -62,7 +62,7 @@ def pytest_configure(config):
     # numba's cache=True kernels: measured on two cold runs (2026-11-26, with the order of
     # _COLD_SECONDS), every kernel was compiled by one worker only (58 s of CPU in all), so
     # nothing locks their compiles (a lock would wrap numba's Dispatcher, which an upgrade could
-    # break in CI); a change of order that made both workers compile one would show here.
+    # break in CI).  A new order can change that: count the compile events per worker again.
 
 
 @pytest.hookimpl(tryfirst=True)  # before xdist reads the xdist_group marks
