@@ -59,9 +59,10 @@ def pytest_configure(config):
     # (xdist's default ``--loadscope-reorder``).
     if getattr(config.option, "dist", "no") == "loadgroup":
         config.option.loadscopereorder = False
-    # numba's cache=True kernels may be compiled by both workers on a cold cache (measured: ~40 s
-    # of CPU on 2 loaded cores); serialising that would mean wrapping numba's private Dispatcher
-    # internals, which a numba upgrade could break in CI, so the duplicate compile is accepted.
+    # numba's cache=True kernels: measured on two cold runs (2026-11-26, with the order of
+    # _COLD_SECONDS), every kernel was compiled by one worker only (58 s of CPU in all), so
+    # nothing locks their compiles (a lock would wrap numba's Dispatcher, which an upgrade could
+    # break in CI).  A new order can change that: count the compile events per worker again.
 
 
 @pytest.hookimpl(tryfirst=True)  # before xdist reads the xdist_group marks
@@ -95,49 +96,47 @@ _SCORED = "tests/scenarios/test_scored.py::test_scenario_meets_its_thresholds["
 #: they are dealt in.  Only the order matters; a unit not listed follows them in collection
 #: order.  Longest-processing-time-first lets both workers finish together: dealt by number of
 #: tests (xdist's default), the wheel's 2-test group (106 s) started 513 s into the run and a
-#: 1-test fit of 49 s at 649 s.  Every unit of 25 s or more in one fresh-clone ``make test``
-#: (2026-11-26, ``--durations=0``, setup + call + teardown; 2 cores shared with other jobs,
-#: load 15-25, about 3x a quiet machine's seconds), all from that one run so that they compare.
-#: The earlier table (load 5-9) missed single tests such as the demo's (106 s here), the CLI
-#: plugin runs (48-67 s) and the cubic contrast (62 s): dealt last in collection order
-#: (``tests/testbed`` is collected last), they could leave one worker running alone at the end.
+#: 1-test fit of 49 s at 649 s.  Every unit of 4.5 s or more, in CPU seconds (process and its
+#: children, setup + call + teardown; wall seconds on a shared machine swing with its load) of
+#: one cold run of ``pytest -n 2 --dist loadgroup`` (2026-11-26: empty dataset and numba caches,
+#: 2 cores at load 8-12), all from that one run so that they compare.  A unit's cold share
+#: moves with the order (the first test that needs a dataset simulates it, the first that needs
+#: a kernel compiles it): ``test_soft_cantilever_fits`` holds the simulation of
+#: ``cantilever_soft_impact`` (8.9 s), the conformance group most numba compiles (sgd 26 s,
+#: mechsim 24 s).
 _COLD_SECONDS = {
     **{f"{_SCORED}{name}]": s for name, s in (
-        ("fivebar_multisine_pysindy", 234), ("cantilever_soft_impact_150N", 161),
-        ("cantilever_long_aluminium", 158), ("cantilever_soft_stiffer_base", 83),
-        ("cantilever_long_aluminium_1m", 76), ("cantilever_soft_impact", 57),
-        ("cantilever_two_sensors_noise3", 36), ("cantilever_soft_impact_lsq", 30))},
-    "tests/identify/test_conformance.py": 210,
-    "tests/testbed/test_demo.py::test_demo_runs_scores_reports_and_states_the_contrast": 106,
-    "tests/identify/test_sindy_pi_linear.py::test_soft_cantilever_fits": 93,
-    "tests/models/test_fivebar_energy.py": 84, "tests/test_wheel.py": 80, "chromium": 67,
-    "tests/testbed/test_cli_platform.py::test_runs_ls_and_report_by_scenario_name": 67,
-    "tests/models/test_fivebar_dynamics.py": 63,
-    "tests/scenarios/test_cubic_contrast.py::test_linear_beam_cubic_matrix_hundredfold_smaller": 62,
-    "tests/identify/test_mechsim.py": 62,
-    "tests/identify/test_sindy_pi_dynamical.py::test_inputs_enter_the_library_and_the_simulation": 55,
-    "tests/identify/test_weak.py::test_integration_by_parts_is_exact[fivebar]": 55,
-    "tests/testbed/test_cli_platform.py::test_sweep_with_a_plugin_identifier": 52,
-    "tests/testbed/test_cli_family.py::test_family_write_members_reload_equal": 52,
-    "tests/testbed/test_sweep.py": 52, "tests/identify/test_sgd_split.py": 51,
-    "tests/identify/test_sgd_matrix.py": 50,
-    "tests/testbed/test_cli_platform.py::test_plugin_file_on_list_and_identify": 48,
-    "tests/identify/test_sindy_pi_linear.py": 47, "tests/testbed/test_report.py": 46,
-    "tests/testbed/test_runstore.py": 44, "tests/identify/test_sindy_pi.py": 41,
-    "tests/testbed/test_faults.py": 40,
-    "tests/test_docs.py::test_guide_example_runs[python-api.md]": 39,
-    "tests/test_third_rig.py": 38,
-    "tests/testbed/test_faults.py::test_two_concurrent_testbed_runs_of_one_scenario": 37,
-    "tests/identify/test_sindy_pi_kernels.py::test_fresh_cholesky_kernel_matches_reference[0]": 37,
-    "tests/identify/test_sgd_sindy.py": 37, "tests/testbed/test_verdicts.py": 35,
-    "tests/identify/test_weak.py::test_integration_by_parts_is_exact[double_pendulum]": 34,
-    "tests/identify/test_model_selection.py": 34, "tests/identify/test_ls_sindy.py": 33,
-    "tests/models/test_cantilever_response.py": 33, "tests/identify/test_pysindy_field.py": 31,
-    "tests/testbed/test_malformed.py::test_random_values_give_a_scenario_or_a_scenario_error": 31,
-    "tests/testbed/test_malformed.py::test_every_mutation_of_every_key_is_refused_clearly_and_fast": 30,
-    "tests/identify/test_sindy_pi_noise.py": 28,
-    "tests/testbed/test_sweep.py::test_smoke_study_on_the_real_rigs": 26,
-    "tests/test_docs.py::test_guide_example_runs[identifiers.md]": 25,
+        ("fivebar_multisine_pysindy", 69.8), ("cantilever_soft_impact_150N", 21.3),
+        ("cantilever_long_aluminium", 16.6), ("cantilever_long_aluminium_1m", 11.8),
+        ("cantilever_soft_stiffer_base", 11.2), ("cantilever_two_sensors_noise3", 5.0))},
+    "tests/identify/test_conformance.py": 67.7, "tests/testbed/test_report.py": 21.1,
+    "tests/testbed/test_demo.py::test_demo_runs_scores_reports_and_states_the_contrast": 20.8,
+    "tests/test_wheel.py": 18.9, "tests/models/test_fivebar_energy.py": 15.2,
+    "tests/identify/test_sindy_pi_linear.py::test_soft_cantilever_fits": 10.7,
+    "eq21": 9.0,  # the scored cantilever_soft_impact and _stiff_impact_cubic, the Eq. 21 contrast
+    "tests/testbed/test_cli_platform.py::test_sweep_with_a_plugin_identifier": 9.0,
+    "tests/testbed/test_cli_platform.py::test_runs_ls_and_report_by_scenario_name": 8.7,
+    "tests/identify/test_sgd_sindy.py": 8.1,
+    "tests/testbed/test_faults.py::test_two_concurrent_testbed_runs_of_one_scenario": 7.7,
+    "tests/identify/test_mechsim.py": 7.6, "tests/identify/test_sgd_split.py": 7.5,
+    "tests/identify/test_sgd_matrix.py": 6.8,
+    "tests/identify/test_weak.py::test_integration_by_parts_is_exact[fivebar]": 6.6,
+    "tests/identify/test_sindy_pi_kernels.py::test_fresh_cholesky_kernel_matches_reference[0]": 6.6,
+    "tests/identify/test_sindy_pi_dynamical.py::test_inputs_enter_the_library_and_the_simulation": 6.6,
+    "tests/testbed/test_cli_platform.py::test_plugin_file_on_list_and_identify": 6.3,
+    "tests/identify/test_sindy_pi.py": 6.1,
+    "tests/testbed/test_cli_family.py::test_family_write_members_reload_equal": 5.9,
+    "tests/identify/test_ls_sindy.py": 5.9,
+    "tests/testbed/test_study.py::test_shipped_studies_are_valid[families]": 5.7,
+    "tests/testbed/test_runstore.py": 5.3, "tests/models/test_fivebar_dynamics.py": 5.3,
+    "tests/testbed/test_faults.py": 5.2, "tests/testbed/test_drawer.py": 4.9,
+    "tests/testbed/test_cli_errors.py::test_real_command_on_a_sample_of_the_corpus": 4.9,
+    "tests/models/test_cantilever_response.py": 4.9,
+    "tests/identify/test_weak.py::test_integration_by_parts_is_exact[double_pendulum]": 4.8,
+    "tests/identify/test_sindy_pi_noise.py": 4.5,
+    "tests/test_docs.py::test_guide_example_runs[python-api.md]": 4.5,
+    "tests/testbed/test_sweep.py": 4.5,
+    "tests/testbed/test_malformed.py::test_every_mutation_of_every_key_is_refused_clearly_and_fast": 4.5,
 }
 
 
@@ -166,6 +165,42 @@ def dataset_cache():
                 return super().clean(scenario, progress)  # loads it if another process made it
 
     return SharedDatasetCache(TEST_CACHE)
+
+
+@pytest.fixture(scope="session")
+def _group_runs() -> dict:
+    """Scenario runs of this process kept for the tests of their xdist group (key: group, name)."""
+    return {}
+
+
+@pytest.fixture
+def scenario_run(request, dataset_cache, _group_runs):
+    """``run(scenario)``: :func:`testbed.scoring.run.run_scenario` of ``scenario`` (a
+    :class:`~testbed.pipeline.scenario.Scenario`, or the name of a shipped one) on the shared
+    dataset cache.
+
+    A test in an ``xdist_group`` reads the run its group's other tests read: the first run of a
+    scenario name in that group is kept and returned again (``--dist loadgroup`` runs a group on
+    one worker).  The scored tests of ``cantilever_stiff_impact_cubic`` and
+    ``cantilever_soft_impact`` and the Eq. 21 contrast (group ``eq21``) made the same two fits
+    twice (the demo makes them a third time, inside ``run_demo``): measured on a cold cache, the
+    contrast's own two cost 9.0 s of CPU.  Outside a group every call runs afresh.
+    """
+    from testbed.pipeline.scenario import load_scenario
+    from testbed.scoring.run import run_scenario
+
+    mark = request.node.get_closest_marker("xdist_group")
+    group = mark.args[0] if mark is not None and mark.args else None
+
+    def run(scenario):
+        sc = load_scenario(scenario) if isinstance(scenario, str) else scenario
+        if group is None:
+            return run_scenario(sc, cache=dataset_cache)
+        if (group, sc.name) not in _group_runs:
+            _group_runs[group, sc.name] = run_scenario(sc, cache=dataset_cache)
+        return _group_runs[group, sc.name]
+
+    return run
 
 
 @pytest.fixture(autouse=True, scope="module")

@@ -197,7 +197,9 @@ def run_chromium(exe: str, url: str, tmp: Path, *extra: str) -> subprocess.Compl
     return subprocess.run(args, capture_output=True, text=True, timeout=120, cwd=tmp)
 
 
-@pytest.mark.xdist_group("chromium")
+# No xdist group of its own: the module's group (conftest) runs these where ``reports`` was built
+# (with a "chromium" group of their own, both workers drew the reports' figures: measured on a
+# cold cache, about 5 s of CPU twice).
 @pytest.mark.parametrize(("name", "n_figures"), FIGURES)
 def test_report_in_headless_chromium(chromium, reports, name, n_figures, tmp_path):
     html_path = reports[name]
