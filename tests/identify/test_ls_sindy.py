@@ -378,7 +378,8 @@ def test_unlocated_mode_not_moved_onto_another_mode(lumped, monkeypatch):
     held = hold()
     assert modal(M, held.K)[0][2] == pytest.approx(w[2] / (2 * np.pi), rel=1e-6)
     assert "which no measured peak located" not in held.rule
-    monkeypatch.setattr(md, "modal_decay", decay_at((0.9 * w[2]) ** 2))  # nearer its own (modes 90, 235, 343 Hz)
+    # nearer its own (modes 90, 235, 343 Hz)
+    monkeypatch.setattr(md, "modal_decay", decay_at((0.9 * w[2]) ** 2))
     held = hold()
     assert modal(M, held.K)[0][2] == pytest.approx(0.9 * w[2] / (2 * np.pi), rel=1e-9)
     assert "modes [3], which no measured peak located" in held.rule
