@@ -248,7 +248,7 @@ class ImportedData:
 
 def read_measured(path: str | os.PathLike, *, format: str | None = None, fs: float | None = None,
                   units: str | Mapping[str, str] | None = None,
-                  channels: Sequence[str] | None = None) -> ImportedData:
+                  channels: Sequence[str] | None = None, own_units: bool = False) -> ImportedData:
     """Read measured data for identification (no truth) from a UFF, SEP-005, CSV or HDF5 file.
 
     Parameters
@@ -265,6 +265,10 @@ def read_measured(path: str | os.PathLike, *, format: str | None = None, fs: flo
         required where the file has none (CSV without ``[unit]`` in its header).
     channels : sequence of str, optional
         Keep only these channels, in this order (default: all, in file order).
+    own_units : bool
+        Keep a unit with no SI form as it is (a ``dynamical`` system's concentrations, "mM",
+        "mM/s": its chain converts nothing) instead of refusing it; a testbed dataset of a
+        dynamical rig keeps its own units whatever this says.
 
     Returns
     -------
@@ -293,6 +297,7 @@ def read_measured(path: str | os.PathLike, *, format: str | None = None, fs: flo
         raise MeasuredDataError(path, f"sample rate fs={fs!r} must be a finite number > 0 Hz")
     reader = {"uff": _read_uff, "sep005": _read_sep005_file, "csv": _read_csv, "hdf5": _read_hdf5}[format]
     raw = reader(path)
+    raw.own_units = raw.own_units or own_units
     return _finish(raw, fs, units, channels)
 
 
@@ -333,7 +338,8 @@ def measurement_from_file(path: str | os.PathLike, kind: str, signal: Mapping[st
 
     if kind not in SIGNAL_SCHEMAS:
         raise MeasuredDataError(path, f"unknown rig kind {kind!r}; allowed: {', '.join(SIGNAL_SCHEMAS)}")
-    data = read_measured(path, format=format, fs=fs, units=units, channels=channels)
+    data = read_measured(path, format=format, fs=fs, units=units, channels=channels,
+                         own_units=kind == "dynamical")
     ds = data.to_dataset(groups, prior)
     _check_response(data.source, ds, kind)
     _check_units(data.source, ds, kind)
