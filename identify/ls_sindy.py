@@ -330,21 +330,15 @@ class LeastSquaresSINDy(StructuralIdentifier):
             except IdentificationError as e:
                 if self.fit_tilt:  # the user's choice: refused, not replaced
                     raise
-                if self.K3_ is not None:  # the eigenvalue hold does not act on a cubic model
-                    self.fit_tilt_ = False
-                    self.fit_tilt_rule_ = (f"rule: the tilted fit was refused ({e}); cubic "
-                                           "library: fitted flat")
-                    self._solve(data, lib, masses)
-                    self._check_physical()
-                    self._hold(*hold)
-                    return
-                if self._held_physical(hold):
+                if self.K3_ is None and self._held_physical(hold):
                     self.fit_tilt_rule_ = (f"rule: the tilted fit had a growing pole ({e}); "
                                            "kept, physical after the holds")
                     return
+                # the eigenvalue hold does not act on a cubic model: flat at once
+                then = ("; cubic library: fitted flat" if self.K3_ is not None
+                        else ", and again after the holds; fitted flat")
                 self.fit_tilt_ = False
-                self.fit_tilt_rule_ = (f"rule: the tilted fit was refused ({e}), and again "
-                                       "after the holds; fitted flat")
+                self.fit_tilt_rule_ = f"rule: the tilted fit was refused ({e}){then}"
                 self._solve(data, lib, masses)
                 self._check_physical()
         self._hold(*hold)

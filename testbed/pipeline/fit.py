@@ -20,12 +20,11 @@ from typing import Any
 
 import numpy as np
 
-from testbed.core.budget import check_steps
-from testbed.core.errors import IdentificationError, InputError, ScenarioError, TestbedError
+from testbed.core.errors import IdentificationError, InputError, TestbedError
 from testbed.core.measurement import Measurement
 from testbed.pipeline import plugins
 from testbed.pipeline.importers import measurement_from_file
-from testbed.pipeline.scenario import load_scenario
+from testbed.pipeline.scenario import check_identifier_for_record, load_scenario
 from testbed.pipeline.signal_chain import SIGNAL_SCHEMAS
 
 
@@ -208,16 +207,11 @@ def check_against_data(cls: Any, hyper: dict[str, Any], data: Measurement, *, fi
         ``identify.<name>``, the value and what the data allow; a
         :class:`~testbed.core.errors.BudgetError` for a simulation beyond the step budget.
     """
-    def error(name: str, value: Any, allowed: str) -> None:
-        raise ScenarioError(file, f"identify.{name}", value, f"{allowed} (data: {data.n_channels} "
-                                                             f"channel(s), {data.n_samples} samples "
-                                                             f"at {data.fs:g} Hz)")
-
     n_inputs = 0 if data.u is None else int(np.shape(data.u)[0])
-    cls.check_data_shape(hyper, data.n_channels, n_inputs, float(data.fs), data.n_samples, error)
-    steps, key = cls.simulation_steps(hyper, data.n_samples / data.fs)
-    if key:
-        check_steps(steps, file, f"identify.{key}", hyper[key])
+    check_identifier_for_record(cls, hyper, (data.n_channels, n_inputs), float(data.fs),
+                                data.n_samples, file=file,
+                                detail=f" (data: {data.n_channels} channel(s), {data.n_samples} "
+                                       f"samples at {data.fs:g} Hz)")
 
 
 @contextlib.contextmanager

@@ -428,10 +428,22 @@ def check_identifier_for_rig(rig_cls: Any, rig_params: dict[str, Any], simulatio
         return
     fs, n_samples = record
 
-    def error(name: str, value: Any, allowed: str) -> None:
-        raise ScenarioError(file, f"{section}.{name}", value, allowed)
+    check_identifier_for_record(cls, full, rig_cls.measurement_shape(rig_params), fs, n_samples,
+                                file=file, section=section)
 
-    shape = rig_cls.measurement_shape(rig_params)
+
+def check_identifier_for_record(cls: Any, full: dict[str, Any], shape: tuple[int, int] | None,
+                                fs: float, n_samples: int, *, file: str,
+                                section: str = "identify", detail: str = "") -> None:
+    """An identifier's :meth:`~identify._base.Identifier.check_data_shape` (skipped when
+    ``shape``, (channels, inputs), is unknown) and its simulation's step budget, on a record of
+    ``n_samples`` at ``fs`` [Hz]; ``full``: its complete, validated hyperparameters.  A refused
+    value raises :class:`ScenarioError` naming ``file`` and ``<section>.<name>``, ``detail``
+    appended to what is allowed."""
+
+    def error(name: str, value: Any, allowed: str) -> None:
+        raise ScenarioError(file, f"{section}.{name}", value, allowed + detail)
+
     if shape is not None:
         cls.check_data_shape(full, shape[0], shape[1], fs, n_samples, error)
     steps, key = cls.simulation_steps(full, n_samples / fs)
