@@ -533,6 +533,14 @@ def cmd_runs(args: argparse.Namespace) -> int:
     return 0
 
 
+def cmd_serve(args: argparse.Namespace) -> int:
+    from testbed.server import serve
+
+    if not args.idle > 0:
+        raise InputError(f"--idle {args.idle}: expected a positive number of seconds")
+    return serve(idle=args.idle, warm_up=None if args.warm_up == "none" else args.warm_up)
+
+
 def cmd_demo(args: argparse.Namespace) -> int:
     from testbed.reporting.demo import run_demo
 
@@ -655,6 +663,15 @@ def build_parser() -> argparse.ArgumentParser:
     d = sub.add_parser("demo", help="the main job: scored scenario runs and their report")
     d.add_argument("--out", default="out/demo", help="output folder (default out/demo)")
     d.set_defaults(fn=cmd_demo)
+
+    sv = sub.add_parser("serve", help="keep the libraries loaded: later commands fork from this process "
+                        "and skip their imports (see testbed.server)")
+    sv.add_argument("--idle", type=float, default=900.0,
+                    help="seconds without a command before the server exits (default 900)")
+    sv.add_argument("--warm-up", default="cantilever_stiff_impact", metavar="SCENARIO",
+                    help="scenario run once at start to warm the caches, or 'none' "
+                         "(default cantilever_stiff_impact)")
+    sv.set_defaults(fn=cmd_serve)
     return p
 
 
@@ -692,12 +709,25 @@ def main(argv: list[str] | None = None) -> int:
     """Run one command; return the exit status (0 ok, 1 a run failed its bars, 2 a user's
     mistake, 3 an internal error, 130 interrupted)."""
     _blas_threads()
+    if argv is None:  # the console program (not a call from Python): a resident server may run it
+        status = _served(sys.argv[1:])
+        if status is not None:
+            return status
     before = gc.get_threshold()
     gc.set_threshold(*GC_THRESHOLD)  # restored below: main() is also called from Python
     try:
         return _main(argv)
     finally:
         gc.set_threshold(*before)
+
+
+def _served(argv: list[str]) -> int | None:
+    """The command's status if a resident ``testbed serve`` ran it (:mod:`testbed.server`)."""
+    if not argv or argv[0] == "serve" or os.environ.get("TESTBED_NO_SERVER"):
+        return None
+    from testbed.server import socket_path, try_server
+
+    return try_server(argv) if socket_path().exists() else None
 
 
 def _main(argv: list[str] | None) -> int:

@@ -18,6 +18,9 @@ from pathlib import Path
 import pytest
 
 os.environ.setdefault("MPLBACKEND", "Agg")
+# a developer's resident `testbed serve` must not run the tests' commands (tests/testbed/
+# test_server.py starts its own and clears this for its clients)
+os.environ["TESTBED_NO_SERVER"] = "1"
 
 ROOT = Path(__file__).resolve().parent.parent
 # Tests share the benchmarks' synthetic problems (``from benchmarks import ...``).

@@ -1,0 +1,150 @@
+"""The resident server (``testbed serve``): a served command is the same command, a client that
+dies leaves no process behind, a server of other sources or environment is not used."""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from testbed import cli
+
+ROOT = Path(__file__).resolve().parents[2]
+pytestmark = [pytest.mark.xdist_group("server"),
+              pytest.mark.skipif(not sys.platform.startswith("linux"), reason="fork + SCM_RIGHTS")]
+#: Seconds to wait for a server to listen: imports (about 3 s of CPU) and a Michaelis-Menten
+#: warm-up on a 2-core machine that other tests keep busy.
+START_TIMEOUT_S = 180
+
+
+def _env(tmp: Path, **extra) -> dict:
+    env = {k: v for k, v in os.environ.items() if k != "TESTBED_NO_SERVER"}
+    cache = os.environ.get("TESTBED_TEST_CACHE", str(ROOT / ".cache" / "test-datasets"))
+    return {**env, "TESTBED_SERVER_SOCKET": str(tmp / "sock" / "s.sock"), "TESTBED_CACHE": cache,
+            "PYTHONPATH": str(ROOT), "MPLBACKEND": "Agg", **extra}
+
+
+def _testbed(args, env, cwd, **kw):
+    return subprocess.run([sys.executable, "-m", "testbed.cli", *args], env=env, cwd=cwd,
+                          capture_output=True, text=True, timeout=300, **kw)
+
+
+@pytest.fixture(scope="module")
+def server(tmp_path_factory):
+    """A server warmed on the scenario the tests run; its log; stopped (and checked gone) after."""
+    tmp = tmp_path_factory.mktemp("server")
+    (tmp / "sock").mkdir(mode=0o700)
+    env = _env(tmp)
+    log = open(tmp / "log", "w+")
+    proc = subprocess.Popen([sys.executable, "-m", "testbed.cli", "serve", "--idle", "600",
+                             "--warm-up", "michaelis_menten"], env=env, cwd=tmp,
+                            stdout=log, stderr=subprocess.STDOUT)
+    t0 = time.monotonic()
+    while "listening" not in (tmp / "log").read_text():
+        assert proc.poll() is None, (tmp / "log").read_text()
+        assert time.monotonic() - t0 < START_TIMEOUT_S, "the server did not start"
+        time.sleep(0.2)
+    yield tmp, env, proc
+    proc.send_signal(signal.SIGTERM)
+    assert proc.wait(timeout=30) == 0
+    assert not (tmp / "sock" / "s.sock").exists()  # the socket goes with it
+    log.close()
+
+
+def _served_lines(tmp: Path) -> list[str]:
+    return [ln for ln in (tmp / "log").read_text().splitlines() if ln.startswith("testbed server:")]
+
+
+def _run_json(out: Path) -> dict:
+    (run,) = [p for p in (out / "michaelis_menten").iterdir() if p.is_dir()]
+    d = json.loads((run / "run.json").read_text())
+    return {k: v for k, v in d.items() if k not in ("created", "fit_time")}, run
+
+
+def test_a_served_run_is_the_same_run(server):
+    tmp, env, _ = server
+    before = len(_served_lines(tmp))
+    served = _testbed(["run", "michaelis_menten", "--out", "served"], env, tmp)
+    alone = _testbed(["run", "michaelis_menten", "--out", "alone"], {**env, "TESTBED_NO_SERVER": "1"}, tmp)
+    assert served.returncode == alone.returncode == 0, served.stderr + alone.stderr
+    new = _served_lines(tmp)[before:]
+    assert any(ln.startswith("testbed server: run michaelis_menten --out served") for ln in new), new
+    assert not any("--out alone" in ln for ln in new)
+    (a, run_a), (b, run_b) = _run_json(tmp / "served"), _run_json(tmp / "alone")
+    assert a == b  # every score, setting and provenance field but the time stamps
+    for f in ("run.npz", "coefficients.png", "joint_angles.png"):  # bit for bit
+        assert (run_a / f).read_bytes() == (run_b / f).read_bytes(), f
+    # the output the user sees is the command's own (but the --out folder and the times)
+    def shown(r, out):
+        text = re.sub(r"\(fit [0-9.]+ s\)", "(fit)", r.stdout.replace(out, "X"))
+        return re.sub(r"/\d{8}T\d{6}Z-s0", "/TIME-s0", text)
+
+    assert shown(served, "served") == shown(alone, "alone")
+
+
+def test_a_users_mistake_is_one_line_through_the_server(server):
+    tmp, env, _ = server
+    before = len(_served_lines(tmp))
+    r = _testbed(["run", "no_such_scenario"], env, tmp)
+    assert r.returncode == cli.EXIT_USAGE
+    assert r.stderr.startswith("error: ") and len(r.stderr.strip().splitlines()) == 1, r.stderr
+    assert "Traceback" not in r.stderr
+    assert any("no_such_scenario" in ln for ln in _served_lines(tmp)[before:])
+
+
+def test_another_import_time_environment_runs_alone(server):
+    tmp, env, _ = server
+    before = len(_served_lines(tmp))
+    r = _testbed(["run", "michaelis_menten", "--out", "haswell", "--no-figures"],
+                 {**env, "OPENBLAS_CORETYPE": "Haswell"}, tmp)
+    assert r.returncode == 0, r.stderr
+    new = _served_lines(tmp)[before:]
+    assert any("refused a command from another key" in ln for ln in new), new
+    assert (tmp / "haswell" / "michaelis_menten").is_dir()
+
+
+def test_a_killed_client_leaves_no_process(server):
+    tmp, env, _ = server
+    before = len(_served_lines(tmp))
+    # a five-bar generation into an empty cache takes seconds: long enough to kill the client
+    client = subprocess.Popen([sys.executable, "-m", "testbed.cli", "run", "fivebar_multisine",
+                               "--out", "killed", "--cache", str(tmp / "empty-cache")],
+                              env=env, cwd=tmp, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    t0 = time.monotonic()
+    while not any("(pid " in ln for ln in _served_lines(tmp)[before:]):
+        assert time.monotonic() - t0 < 60 and client.poll() is None
+        time.sleep(0.05)
+    (line,) = [ln for ln in _served_lines(tmp)[before:] if "(pid " in ln]
+    child = int(line.rsplit("(pid ", 1)[1].rstrip(")"))
+    client.send_signal(signal.SIGKILL)
+    client.wait()
+    t0 = time.monotonic()
+    while _alive(child):
+        assert time.monotonic() - t0 < 10, f"served child {child} outlived its client"
+        time.sleep(0.05)
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    stat = Path(f"/proc/{pid}/stat")
+    return not (stat.exists() and stat.read_text().split()[2] == "Z")  # reaped soon by the server
+
+
+def test_serve_refuses_a_shared_socket_folder(tmp_path, monkeypatch, capsys):
+    shared = tmp_path / "shared"
+    shared.mkdir(mode=0o755)
+    shared.chmod(0o755)
+    monkeypatch.setenv("TESTBED_SERVER_SOCKET", str(shared / "s.sock"))
+    assert cli.main(["serve", "--warm-up", "none"]) == cli.EXIT_USAGE
+    err = capsys.readouterr().err
+    assert err.startswith("error: ") and "0700" in err and str(shared) in err
