@@ -312,13 +312,13 @@ def serve(idle: float = IDLE_S, path: Path | None = None, log=None,
                          "(mode 0700); set TESTBED_SERVER_SOCKET to a path in one")
     start_env = dict(os.environ)  # as the client's: before the libraries set their defaults
     key = server_key(start_env)
+    _refuse_if_served(path)
     _preload()
     _warm_up(warm_up, log)
     with contextlib.suppress(FileNotFoundError):
-        path.unlink()
-    listener = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
-    listener.bind(str(path))
-    listener.listen(16)
+        path.unlink()  # (a server that started meanwhile loses its socket to this one)
+    listener = _bind(path)
+    inode = path.stat().st_ino
     rfd, wfd = os.pipe()
     os.set_blocking(wfd, False)
     signal.set_wakeup_fd(wfd)
@@ -361,10 +361,36 @@ def serve(idle: float = IDLE_S, path: Path | None = None, log=None,
             with contextlib.suppress(ProcessLookupError):
                 os.killpg(pid, signal.SIGKILL)
         with contextlib.suppress(FileNotFoundError):
-            path.unlink()
+            if path.stat().st_ino == inode:  # ours still (never another server's)
+                path.unlink()
         listener.close()
         signal.set_wakeup_fd(-1)
     return 0
+
+
+def _refuse_if_served(path: Path) -> None:
+    """Refuse to start while another server answers at ``path``; remove a dead one's socket."""
+    from testbed.core.errors import InputError
+
+    if path.exists():
+        probe = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+        try:
+            probe.connect(str(path))
+        except OSError:
+            path.unlink()  # left by a server that was killed
+        else:
+            raise InputError(f"{path}: a testbed server is already listening there; stop it "
+                             "first, or set TESTBED_SERVER_SOCKET to another path")
+        finally:
+            probe.close()
+
+
+def _bind(path: Path) -> socket.socket:
+    """A listening socket at ``path`` (bound after the warm-up: until then clients run alone)."""
+    listener = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+    listener.bind(str(path))
+    listener.listen(16)
+    return listener
 
 
 def _accept(listener, key, sel, running, log) -> None:

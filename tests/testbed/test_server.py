@@ -148,3 +148,11 @@ def test_serve_refuses_a_shared_socket_folder(tmp_path, monkeypatch, capsys):
     assert cli.main(["serve", "--warm-up", "none"]) == cli.EXIT_USAGE
     err = capsys.readouterr().err
     assert err.startswith("error: ") and "0700" in err and str(shared) in err
+
+
+def test_a_second_server_on_the_socket_is_refused(server):
+    tmp, env, proc = server
+    r = _testbed(["serve", "--warm-up", "none"], env, tmp)
+    assert r.returncode == cli.EXIT_USAGE
+    assert r.stderr.startswith("error: ") and "already listening" in r.stderr, r.stderr
+    assert proc.poll() is None and (tmp / "sock" / "s.sock").exists()  # the first one serves on
