@@ -67,6 +67,9 @@ class Identifier:
     kind: ClassVar[str] = ""
     #: Declared hyperparameters: one Field per ``__init__`` argument, same default.
     hyperparameters: ClassVar[dict[str, Field]] = {}
+    #: Keys of ``Measurement.prior`` the identifier may read; ``testbed identify --prior`` refuses
+    #: any other (a mistyped key would be ignored).  None: undeclared (a plugin), any key.
+    prior_keys: ClassVar[tuple[str, ...] | None] = None
 
     @classmethod
     def declared_hyperparameters(cls) -> dict[str, Field]:

@@ -19,7 +19,7 @@ the identified five-bar costs a few microseconds instead of ~290 us of small num
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
@@ -70,6 +70,9 @@ class LoopClosure:
     b: np.ndarray
     passive: np.ndarray
     source: str
+    #: The keys of a declared prior that :meth:`from_prior` reads.
+    PRIOR_KEYS: ClassVar[tuple[str, ...]] = ("l1", "l2", "l3", "l4", "link_lengths", "L0",
+                                              "base_length", "l0")
 
     @classmethod
     def from_prior(cls, prior: dict[str, Any], passive: np.ndarray) -> LoopClosure | None:

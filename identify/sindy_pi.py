@@ -633,6 +633,7 @@ class _ImplicitMechanical(Identifier):
     """Fit pipeline shared by SINDy-PI and the pysindy wrapper; subclasses supply _sweep."""
 
     kind = "mechanical"
+    prior_keys = LoopClosure.PRIOR_KEYS
 
     def _sweep(self, G_train: np.ndarray, G_val: np.ndarray, cand: np.ndarray,
                Theta_train: np.ndarray) -> Sweep:

@@ -390,6 +390,7 @@ class SINDyPIDynamical(Identifier):
 
     name: ClassVar[str] = "sindy_pi_dynamical"
     kind: ClassVar[str] = "dynamical"
+    prior_keys: ClassVar[tuple[str, ...]] = ()
     hyperparameters: ClassVar[dict[str, Field]] = {
         "library": Field(list, None, item_type=str, min_items=1,
                          doc="candidate terms over the data's states, their derivatives "

@@ -59,6 +59,7 @@ from identify.sindy_pi import (
     check_thresholds,
 )
 from identify.structural import (
+    MASS_PRIORS,
     remove_drift,
     symmetric_basis,
     symmetric_least_squares,
@@ -158,6 +159,7 @@ class SINDyPILinear(Identifier):
 
     name = "sindy_pi_linear"
     kind = "structural"
+    prior_keys = MASS_PRIORS
     hyperparameters: ClassVar[dict[str, Field]] = {
         "thresholds": THRESHOLDS_FIELD,
         "ridge": Field(float, 1e-10, min=0.0, max=1.0,

@@ -1098,6 +1098,7 @@ class StructuralIdentifier(Identifier):
     """
 
     kind = "structural"
+    prior_keys = MASS_PRIORS
 
     def _finish_fit(self, data: Measurement | None = None) -> None:
         """Map the poles back from trapezoid integrals (:func:`unwarp_trapezoid`) when ``data``

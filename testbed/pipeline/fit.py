@@ -134,7 +134,8 @@ def identify_file(path: str | os.PathLike, *, scenario: str | os.PathLike | None
     Raises
     ------
     InputError
-        Nothing says which kind or method, a method of another kind, bad hyperparameters.
+        Nothing says which kind or method, a method of another kind, bad hyperparameters, a
+        ``prior`` key the identifier does not read (:attr:`identify.Identifier.prior_keys`).
     MeasuredDataError, ScenarioError, IdentificationError
         The file, the scenario, or a fit that fails on these data.
     """
@@ -160,6 +161,11 @@ def identify_file(path: str | os.PathLike, *, scenario: str | os.PathLike | None
     if cls.kind != kind:
         raise InputError(f"identifier {identify['method']} is for {cls.kind} rigs; the data are "
                          f"{kind}")
+    declared = getattr(cls, "prior_keys", None)
+    for key in sorted(set(prior or {}) - set(declared if declared is not None else prior or {})):
+        reads = ", ".join(declared) if declared else "none"
+        raise InputError(f"--prior {key}: identifier {identify['method']} reads no such prior; "
+                         f"it reads: {reads}")
     hyper = {k: v for k, v in identify.items() if k != "method"} | dict(params or {})
     where = str(scenario or "<command line>")
     hyper = cls.validate_hyperparameters(hyper, file=where)

@@ -109,6 +109,16 @@ def test_every_hyperparameter_is_declared_and_nothing_else(name):
     cls.validate_hyperparameters(given)
 
 
+@pytest.mark.parametrize("name", IDENTIFIERS.names())
+def test_every_identifier_declares_the_prior_keys_it_reads(name):
+    """A declared tuple (``testbed identify --prior`` refuses other keys); a mass-scaled
+    structural identifier reads the mass priors, SINDy-PI the loop's link lengths."""
+    keys = IDENTIFIERS.get(name).prior_keys
+    assert isinstance(keys, tuple) and all(isinstance(k, str) for k in keys), (name, keys)
+    if IDENTIFIERS.get(name).kind == "structural":
+        assert "total_mass" in keys and "reduced_mass_trace" in keys, name
+
+
 def test_an_identifier_without_its_own_init_has_no_hyperparameters():
     # a plugin written without __init__ (nothing to set) inherited object's (*args, **kwargs)
     # as "hyperparameters": get_params raised AttributeError 'args' when its run was saved
