@@ -213,3 +213,52 @@ def _registries_restored_after_each_module():
     yield
     for r, snap in saved:
         r.restore(snap)
+
+
+@pytest.fixture
+def cli_in_process(capsys, monkeypatch):
+    """``cli(*args, cwd=folder)``: the command ``testbed *args`` run by :func:`testbed.cli.main`
+    in this process, in ``folder``, returned as the :class:`subprocess.CompletedProcess`
+    (``returncode``, ``stdout``, ``stderr``) that starting ``python -m testbed.cli *args`` gives,
+    without the new interpreter and its imports (0.5-2 s of CPU a command).  For the tests of
+    what a command prints and returns; a test of the process itself (its start-up, its imports,
+    a kill, what reaches a real stderr) starts a real one.
+
+    The process is as a started command's would be: stdout and stderr are not terminals (both
+    captured), ``OMP_NUM_THREADS=1`` and ``MPLBACKEND=Agg`` are set (the environment the
+    subprocess tests gave theirs, so :func:`testbed.cli.main` sets no BLAS variable), and an
+    argparse error's ``SystemExit`` is its status.  What a command leaves behind in this process
+    is put back after each call: the working directory, and what its ``--plugin`` files
+    registered (both registries, and the plugin modules in ``sys.modules``: the next call
+    imports the file again, as a new process would).
+    """
+    import subprocess
+
+    from testbed.cli import main
+    from testbed.core.registry import PLUGIN_MODULE_PREFIX
+    from testbed.pipeline.plugins import IDENTIFIERS, RIGS
+
+    monkeypatch.setenv("OMP_NUM_THREADS", "1")
+    monkeypatch.setenv("MPLBACKEND", "Agg")
+
+    def cli(*args: str, cwd: Path) -> subprocess.CompletedProcess:
+        saved = [(r, r.snapshot()) for r in (RIGS, IDENTIFIERS)]
+        modules = set(sys.modules)
+        here = os.getcwd()
+        capsys.readouterr()  # what the test printed before is not the command's
+        os.chdir(cwd)
+        try:
+            code = main(list(args))
+        except SystemExit as e:  # argparse's own errors (and --help, --version)
+            code = e.code if isinstance(e.code, int) else int(e.code is not None)
+        finally:
+            os.chdir(here)
+            for r, snap in saved:
+                r.restore(snap)
+            for name in set(sys.modules) - modules:
+                if name.startswith(PLUGIN_MODULE_PREFIX):
+                    del sys.modules[name]
+        out, err = capsys.readouterr()
+        return subprocess.CompletedProcess(["testbed", *args], code, out, err)
+
+    return cli
