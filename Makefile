@@ -14,14 +14,27 @@ export MPLBACKEND := Agg
 
 .PHONY: demo test bench lint clean
 
-# pip does not byte-compile: compileall does it on every core instead (pip's one-core compile was
-# about 38 s of the install's 66 s of CPU), leaving out the dependencies' own test suites (a
-# quarter of their sources), which nothing here imports.  As with pip's own compile, a file that
-# does not compile does not stop the install (Python compiles it, or fails, on import).
+# The install: uv (a PyPI package) if the venv's own pip can install its wheel, else pip (one rule:
+# `pip install uv` failing is the only fallback; an error of uv's own install stops make).  uv
+# resolves the same versions as pip (pyproject's ranges, highest first: compared pip freeze) and
+# installs them in parallel: measured from a fresh clone with empty caches (2 cores at load 13,
+# CPU seconds user + sys), the download and install 13.7 s with uv (38.7 s wall) against 31.9 s
+# with pip (92.1 s wall); pip's own upgrade, needed by pip only (with the bundled pip 23.2 the
+# install took 99 s), is left out on the uv path.  Byte-compiling: compileall on every core
+# leaves out the dependencies' own test suites (a quarter of their sources), which nothing here
+# imports; uv's --compile-bytecode compiles them too (51.1 s against 13.7 + 34.2 s of CPU
+# measured: no gain).  As with pip's own compile, a file that does not compile does not stop the
+# install (Python compiles it, or fails, on import).  uv reads none of pip's settings (pip.conf,
+# PIP_*): an index or a certificate set only for pip is uv's to be told (UV_INDEX_URL, SSL_CERT_FILE).
 $(STAMP): pyproject.toml
 	$(PY) -m venv $(VENV)
-	$(BIN)/python -m pip install -q --upgrade pip
-	$(BIN)/python -m pip install -q --no-compile -e ".[dev]"
+	if $(BIN)/python -m pip install -q --only-binary=:all: uv; then \
+		$(BIN)/uv pip install -q --python $(BIN)/python -e ".[dev]"; \
+	else \
+		echo "uv could not be installed: installing with pip"; \
+		$(BIN)/python -m pip install -q --upgrade pip && \
+		$(BIN)/python -m pip install -q --no-compile -e ".[dev]"; \
+	fi
 	$(BIN)/python -m compileall -qq -j 0 -x '/tests?/' $(VENV)/lib || true
 	touch $(STAMP)
 

@@ -117,7 +117,10 @@ _COLD_SECONDS = {
     "tests/test_wheel.py": 18.9, "tests/models/test_fivebar_energy.py": 15.2,
     "tests/identify/test_sindy_pi_linear.py::test_soft_cantilever_fits": 10.7,
     "eq21": 9.0,  # the scored cantilever_soft_impact and _stiff_impact_cubic, the Eq. 21 contrast
-    "tests/testbed/test_cli_platform.py::test_sweep_with_a_plugin_identifier": 9.0,
+    # in-process since 2026-11-26 (cli_in_process): 0.3 s in a cold run's test process and about
+    # 5.2 s in its two loky workers (measured apart: a reusable executor's workers are reaped
+    # after the test), 9.0 s before as a `testbed sweep` subprocess
+    "tests/testbed/test_cli_platform.py::test_sweep_with_a_plugin_identifier": 5.5,
     "tests/testbed/test_cli_platform.py::test_runs_ls_and_report_by_scenario_name": 8.7,
     "tests/identify/test_sgd_sindy.py": 8.1,
     "tests/testbed/test_faults.py::test_two_concurrent_testbed_runs_of_one_scenario": 7.7,
@@ -126,7 +129,6 @@ _COLD_SECONDS = {
     "tests/identify/test_weak.py::test_integration_by_parts_is_exact[fivebar]": 6.6,
     "tests/identify/test_sindy_pi_kernels.py::test_fresh_cholesky_kernel_matches_reference[0]": 6.6,
     "tests/identify/test_sindy_pi_dynamical.py::test_inputs_enter_the_library_and_the_simulation": 6.6,
-    "tests/testbed/test_cli_platform.py::test_plugin_file_on_list_and_identify": 6.3,
     "tests/identify/test_sindy_pi.py": 6.1,
     "tests/testbed/test_cli_family.py::test_family_write_members_reload_equal": 5.9,
     "tests/identify/test_ls_sindy.py": 5.9,
@@ -216,3 +218,52 @@ def _registries_restored_after_each_module():
     yield
     for r, snap in saved:
         r.restore(snap)
+
+
+@pytest.fixture
+def cli_in_process(capsys, monkeypatch):
+    """``cli(*args, cwd=folder)``: the command ``testbed *args`` run by :func:`testbed.cli.main`
+    in this process, in ``folder``, returned as the :class:`subprocess.CompletedProcess`
+    (``returncode``, ``stdout``, ``stderr``) that starting ``python -m testbed.cli *args`` gives,
+    without the new interpreter and its imports (0.5-2 s of CPU a command).  For the tests of
+    what a command prints and returns; a test of the process itself (its start-up, its imports,
+    a kill, what reaches a real stderr) starts a real one.
+
+    The process is as a started command's would be: stdout and stderr are not terminals (both
+    captured), ``OMP_NUM_THREADS=1`` and ``MPLBACKEND=Agg`` are set (the environment the
+    subprocess tests gave theirs, so :func:`testbed.cli.main` sets no BLAS variable), and an
+    argparse error's ``SystemExit`` is its status.  What a command leaves behind in this process
+    is put back after each call: the working directory, and what its ``--plugin`` files
+    registered (both registries, and the plugin modules in ``sys.modules``: the next call
+    imports the file again, as a new process would).
+    """
+    import subprocess
+
+    from testbed.cli import main
+    from testbed.core.registry import PLUGIN_MODULE_PREFIX
+    from testbed.pipeline.plugins import IDENTIFIERS, RIGS
+
+    monkeypatch.setenv("OMP_NUM_THREADS", "1")
+    monkeypatch.setenv("MPLBACKEND", "Agg")
+
+    def cli(*args: str, cwd: Path) -> subprocess.CompletedProcess:
+        saved = [(r, r.snapshot()) for r in (RIGS, IDENTIFIERS)]
+        modules = set(sys.modules)
+        here = os.getcwd()
+        capsys.readouterr()  # what the test printed before is not the command's
+        os.chdir(cwd)
+        try:
+            code = main(list(args))
+        except SystemExit as e:  # argparse's own errors (and --help, --version)
+            code = e.code if isinstance(e.code, int) else int(e.code is not None)
+        finally:
+            os.chdir(here)
+            for r, snap in saved:
+                r.restore(snap)
+            for name in set(sys.modules) - modules:
+                if name.startswith(PLUGIN_MODULE_PREFIX):
+                    del sys.modules[name]
+        out, err = capsys.readouterr()
+        return subprocess.CompletedProcess(["testbed", *args], code, out, err)
+
+    return cli

@@ -20,7 +20,7 @@ def python_blocks(path: Path) -> list[str]:
 
 
 @pytest.mark.parametrize("guide", ["identifiers.md", "rigs.md", "python-api.md"])
-def test_guide_example_runs(guide, tmp_path):
+def test_guide_example_runs(guide, tmp_path, monkeypatch, cli_in_process):
     blocks = python_blocks(DOCS / guide)
     assert blocks, f"{guide} has no python example"
     script = tmp_path / "example.py"
@@ -36,8 +36,9 @@ def test_guide_example_runs(guide, tmp_path):
     assert r.stdout.strip()
     if guide in ("identifiers.md", "rigs.md"):
         # the example, saved as a file outside the repository, is a plugin of the command line
-        r = subprocess.run([sys.executable, "-m", "testbed.cli", "list", "--plugin", str(script)],
-                           cwd=tmp_path, capture_output=True, text=True, timeout=120, env=env)
+        # (`testbed list --plugin` in this process: what it registers is forgotten after it)
+        monkeypatch.setenv("TESTBED_CACHE", env["TESTBED_CACHE"])
+        r = cli_in_process("list", "--plugin", str(script), cwd=tmp_path)
         assert r.returncode == 0, r.stderr[-3000:]
         name = "example_least_squares" if guide == "identifiers.md" else "example_two_mass"
         (row,) = [ln for ln in r.stdout.splitlines() if ln.startswith(name + "\t")]

@@ -90,19 +90,22 @@ def test_list_piped_keeps_every_field_whole(tmp_path):
     assert "ls_sindy\tstructural\tbaseline, paper:000, structural\tbuiltin" in lines
 
 
-def test_plugin_file_on_list_and_identify(tmp_path, dataset_cache):
+def test_plugin_file_on_list_and_identify(tmp_path, dataset_cache, cli_in_process):
+    """In this process (``cli_in_process``) but for the last command, a real ``identify``
+    process with a plugin file: its failure reaches a real stderr without a traceback."""
     plugin = tmp_path / "my_method.py"
     plugin.write_text(PLUGIN.format(name="my_file_method"))
-    r = cli("list", "--plugin", str(plugin), cwd=tmp_path)
+    r = cli_in_process("list", "--plugin", str(plugin), cwd=tmp_path)
     assert r.returncode == 0, r.stderr
     (row,) = [ln for ln in r.stdout.splitlines() if ln.startswith("my_file_method\t")]
     assert row.endswith(f"\tfile {plugin}")
     # without the plugin the name is unknown: one line, status 2
     data = dataset_cache.get(load_scenario("cantilever_stiff_impact_lsq")).save(tmp_path / "d.h5")
-    r = cli("identify", str(data), "--kind", "structural", "--method", "my_file_method", cwd=tmp_path)
+    r = cli_in_process("identify", str(data), "--kind", "structural", "--method", "my_file_method",
+                       cwd=tmp_path)
     assert r.returncode == EXIT_USAGE and r.stderr.startswith("error: unknown identifier 'my_file_method'")
-    r = cli("identify", str(data), "--kind", "structural", "--method", "my_file_method",
-            "--plugin", str(plugin), "--param", "gain=4", "-o", "m.json", cwd=tmp_path)
+    r = cli_in_process("identify", str(data), "--kind", "structural", "--method", "my_file_method",
+                       "--plugin", str(plugin), "--param", "gain=4", "-o", "m.json", cwd=tmp_path)
     assert r.returncode == 0, r.stderr
     model = json.loads((tmp_path / "m.json").read_text())
     assert model["identifier"]["params"] == {"gain": 4.0}
@@ -256,9 +259,11 @@ def test_runs_ls_and_report_by_scenario_name(tmp_path, capsys):
     assert len(err.splitlines()) == 1 and "no such run folder or results file" in err
 
 
-def test_sweep_with_a_plugin_identifier(tmp_path, dataset_cache):
+def test_sweep_with_a_plugin_identifier(tmp_path, dataset_cache, cli_in_process):
     """`sweep --plugin`: the study may name the plugin's identifier, and its cells run with it
-    (in loky workers too: the plugin travels with the study)."""
+    (in loky workers too: the plugin travels with the study).  The command runs in this process
+    (``cli_in_process``; its loky workers are processes all the same); a real ``testbed sweep``
+    process is killed and resumed in test_sweep.py."""
     plugin = tmp_path / "my_method.py"
     plugin.write_text(PLUGIN.format(name="my_sweep_method"))
     study = tmp_path / "plug.toml"
@@ -271,10 +276,10 @@ def test_sweep_with_a_plugin_identifier(tmp_path, dataset_cache):
         identifiers = ["my_sweep_method", "ls_sindy"]
     '''))
     results = tmp_path / "plug.parquet"
-    r = cli("sweep", str(study), "--results", str(results), cwd=tmp_path)
+    r = cli_in_process("sweep", str(study), "--results", str(results), cwd=tmp_path)
     assert r.returncode == EXIT_USAGE and "my_sweep_method" in r.stderr, r.stderr
-    r = cli("sweep", str(study), "--plugin", str(plugin), "--jobs", "2", "--results", str(results),
-            "--cache", str(dataset_cache.directory), cwd=tmp_path)
+    r = cli_in_process("sweep", str(study), "--plugin", str(plugin), "--jobs", "2", "--results",
+                       str(results), "--cache", str(dataset_cache.directory), cwd=tmp_path)
     assert r.returncode in (0, 1), r.stdout[-2000:] + r.stderr[-2000:]  # 1: a cell failed its bars
     from testbed.studies.results import read_results
 
