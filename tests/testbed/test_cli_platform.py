@@ -191,6 +191,8 @@ def test_identify_reads_a_dynamical_rigs_own_dataset_by_kind(tmp_path, capsys):
      "is of the structural kind"),
     (["identify", "{data}", "--kind", "structural", "--method", "ls_sindy", "--prior", "m"],
      "expected KEY=VALUE"),
+    (["identify", "{data}", "--kind", "structural", "--method", "ls_sindy", "--prior", "totl_mass=1"],
+     "--prior totl_mass: identifier ls_sindy reads no such prior; it reads: reduced_mass_trace, total_mass"),
     (["identify", "{tmp}/none.csv", "--kind", "structural", "--method", "ls_sindy"], "no such file"),
     (["identify", "{data}", "--kind", "structural", "--method", "ls_sindy", "--param", "rcond=2"],
      "identify.rcond"),
