@@ -249,7 +249,8 @@ def check_mechanical(cfg: Mapping[str, Any], fs: float, n_samples: int, error: E
         _long_enough(cfg, "filter_order", cfg["filter_order"], n_samples, error)
         if cfg["edge_fit_s"] == "auto":
             return  # at most a quarter of the record; its length is checked when measured
-        n_fit = round(cfg["edge_fit_s"] * fs)
+        span = cfg["edge_fit_s"] * fs  # may overflow to inf (1e308 s), which round() cannot take
+        n_fit = round(span) if math.isfinite(span) else span
         if not cfg["edge_fit_order"] < n_fit <= n_samples:
             error("signal.edge_fit_s", cfg["edge_fit_s"],
                   f"the end windows of {n_fit} samples must be longer than edge_fit_order "
