@@ -12,15 +12,17 @@ from __future__ import annotations
 import argparse
 import contextlib
 import dataclasses
+import errno
 import gc
 import os
 import socket
+import stat
 import sys
 from collections.abc import Callable, Iterator
 from pathlib import Path
 from urllib.parse import urlsplit
 
-from testbed.core.errors import InputError, TestbedError
+from testbed.core.errors import InputError, ScenarioError, TestbedError
 
 EXIT_FAIL, EXIT_USAGE, EXIT_INTERNAL, EXIT_INTERRUPTED = 1, 2, 3, 130
 #: Thread-count variables of the BLAS libraries numpy and scipy load (OpenBLAS, MKL, an OpenMP
@@ -69,11 +71,39 @@ def _seed(text: str) -> int:
 _jobs = _int_at_least(1)
 
 
+def _stat(path: Path, option: str = "") -> os.stat_result | None:
+    """``path.stat()``, or None if nothing is there (a dangling link, a missing parent).
+
+    Raises
+    ------
+    InputError
+        For a path that can name nothing (a name too long for the file system, a NUL byte, a
+        symbolic-link loop): an OSError or a RuntimeError from deep in a command before.
+    """
+    from testbed.core.errors import _one_line as escaped  # a NUL or newline shown escaped
+
+    where = escaped(f"{option} {path}" if option else str(path))
+    try:
+        return path.stat()
+    except ValueError:
+        raise InputError(f"{where}: not a usable path (it contains a NUL byte)") from None
+    except OSError as e:
+        if e.errno in (errno.ENOENT, errno.ENOTDIR):
+            return None
+        what = {errno.ELOOP: "a symbolic link that loops",
+                errno.ENAMETOOLONG: "a file name too long for the file system"}.get(e.errno)
+        raise InputError(f"{where}: not a usable path ({what or e.strerror or type(e).__name__})") \
+            from None
+
+
 def _existing_file(path: Path, what: str) -> Path:
-    if path.is_dir():
+    st = _stat(path)
+    if st is not None and stat.S_ISDIR(st.st_mode):
         raise InputError(f"{path}: is a folder; expected {what}")
-    if not path.is_file():
+    if st is None:
         raise InputError(f"{path}: no such file; expected {what}")
+    if not stat.S_ISREG(st.st_mode):  # a FIFO or a device: a read would block or never end
+        raise InputError(f"{path}: not a regular file (a FIFO, socket or device); expected {what}")
     return path
 
 
@@ -102,10 +132,16 @@ def _writable_in(path: Path, option: str, start: Path) -> None:
 
 
 def _output_file(path: Path, option: str, *, inputs: tuple[Path, ...] = ()) -> Path:
-    """A file a command will write, checked before any work: not a folder, not one of its
-    ``inputs`` (nothing the user gave is overwritten), in a folder that can be written."""
-    if path.is_dir():
+    """A file a command will write, checked before any work: not a folder, not a device or
+    FIFO (written atomically, the file would replace it: as root, ``--results /dev/full``
+    replaced the device node), not one of its ``inputs`` (nothing the user gave is
+    overwritten), in a folder that can be written."""
+    st = _stat(path, option)
+    if st is not None and stat.S_ISDIR(st.st_mode):
         raise InputError(f"{option} {path}: is a folder; expected a file path")
+    if st is not None and not stat.S_ISREG(st.st_mode):
+        raise InputError(f"{option} {path}: exists and is not a regular file (a FIFO, socket or "
+                         "device, which the written file would replace); expected a file path")
     for given in inputs:
         if path.resolve() == given.resolve():
             raise InputError(f"{option} {path}: is the input file; expected another path (the "
@@ -116,10 +152,17 @@ def _output_file(path: Path, option: str, *, inputs: tuple[Path, ...] = ()) -> P
 
 def _output_folder(path: Path, option: str) -> Path:
     """A folder a command will write into (created on use), checked before any work."""
-    if path.exists() and not path.is_dir():
+    st = _stat(path, option)
+    if st is not None and not stat.S_ISDIR(st.st_mode):
         raise InputError(f"{option} {path}: exists and is not a folder; expected a folder")
     _writable_in(path, option, path)
     return path
+
+
+def _is_not_folder(path: Path, option: str) -> bool:
+    """Whether something other than a folder is at ``path`` (nothing there: False)."""
+    st = _stat(path, option)
+    return st is not None and not stat.S_ISDIR(st.st_mode)
 
 
 def _cache_folder(cache: str | None) -> str | None:
@@ -127,9 +170,9 @@ def _cache_folder(cache: str | None) -> str | None:
     existing file."""
     from testbed.pipeline.cache import default_cache_dir
 
-    if cache is not None and Path(cache).exists() and not Path(cache).is_dir():
+    if cache is not None and _is_not_folder(Path(cache), "--cache"):
         raise InputError(f"--cache {cache}: not a folder")
-    if cache is None and default_cache_dir().exists() and not default_cache_dir().is_dir():
+    if cache is None and _is_not_folder(default_cache_dir(), "$TESTBED_CACHE"):
         where = "$TESTBED_CACHE" if os.environ.get("TESTBED_CACHE") else "the default cache"
         raise InputError(f"{where} {default_cache_dir()}: not a folder; expected the dataset "
                          "cache folder")
@@ -308,6 +351,12 @@ def cmd_run(args: argparse.Namespace) -> int:
     with figure_drawer(enabled=not args.no_figures) as figures:
         scenarios = [load_scenario(name) for name in args.scenario]  # every file checked first
         for sc in scenarios:
+            if sc.identify is None:  # was found after simulating, naming the scenario, not its file
+                raise ScenarioError(sc.path or sc.name, "identify",
+                                    allowed="missing [identify] table: `testbed run` fits and "
+                                            "scores an identifier (method = ...); `testbed "
+                                            "generate` simulates a scenario without one")
+        for sc in scenarios:
             if args.seed is not None:
                 sc = sc.replace(seed=args.seed)
             scenario_folder(args.out, sc.name)  # refused before the work, not after
@@ -359,12 +408,12 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     from testbed.studies.sweep import SweepStats, run_sweep
 
     extra = _load_plugins(args)
+    if args.results:  # before the study's load, which simulates nothing but takes seconds
+        _output_file(Path(args.results), "--results")
     study = load_study(args.study)
     if extra:  # the workers import them too
         study = dataclasses.replace(study, plugins=tuple(dict.fromkeys(study.plugins + extra)))
     stats = SweepStats()
-    if args.results:
-        _output_file(Path(args.results), "--results")
     if args.dask:
         check_dask_address(args.dask)
     try:

@@ -596,3 +596,57 @@ def test_two_concurrent_testbed_runs_of_one_scenario(tmp_path):
     assert (out / "index.html").read_text().count("<tr>") == 1 + 2
     assert [p.name for p in cache.iterdir()] == [DatasetCache(cache).path(
         load_scenario(scenario)).name], "one whole cache entry, no temporary file"
+
+
+# --------------------------------------------------------------------------- paths that name no file
+def _cli(argv: list[str], capsys) -> tuple[int, str]:
+    from testbed.cli import main
+
+    code = main(argv)
+    err = capsys.readouterr().err
+    assert "Traceback" not in err and len(err.splitlines()) == 1, err
+    return code, err
+
+
+#: (argv, fragment): every path a command reads or writes is checked before any work.  A
+#: FIFO or device as an output was replaced by the atomic rename (as root, `--results
+#: /dev/full` replaced the device node with a parquet file); a symbolic-link loop and a name
+#: too long for the file system were internal errors (RuntimeError, OSError) after the work.
+BAD_PATHS = [
+    (["generate", "michaelis_menten", "-o", "{tmp}/fifo"], "not a regular file (a FIFO"),
+    (["sweep", "smoke", "--results", "{tmp}/fifo"], "not a regular file (a FIFO"),
+    (["identify", "{tmp}/fifo", "--kind", "dynamical", "--method", "sindy_pi_dynamical"],
+     "not a regular file (a FIFO"),
+    (["run", "michaelis_menten", "--no-figures", "--out", "{tmp}/loop"], "a symbolic link that loops"),
+    (["run", "michaelis_menten", "--no-figures", "--out", "{tmp}/loop/sub"],
+     "a symbolic link that loops"),
+    (["sweep", "smoke", "--results", "{tmp}/loop"], "a symbolic link that loops"),
+    (["cache", "ls", "--cache", "{tmp}/loop"], "a symbolic link that loops"),
+    (["run", "michaelis_menten", "--no-figures", "--out", "{tmp}/" + "y" * 300],
+     "a file name too long"),
+    (["sweep", "smoke", "--results", "{tmp}/" + "y" * 300 + ".parquet"], "a file name too long"),
+    (["run", "michaelis_menten", "--no-figures", "--out", "{tmp}/a\x00b"], "a NUL byte"),
+]
+
+
+@pytest.mark.parametrize(("argv", "fragment"), BAD_PATHS, ids=[" ".join(a)[:50] for a, _ in BAD_PATHS])
+def test_paths_that_name_no_usable_file_are_refused_and_kept(tmp_path, capsys, argv, fragment):
+    import stat
+
+    os.mkfifo(tmp_path / "fifo")
+    (tmp_path / "loop").symlink_to(tmp_path / "loop2")
+    (tmp_path / "loop2").symlink_to(tmp_path / "loop")
+    code, err = _cli([a.replace("{tmp}", str(tmp_path)) for a in argv], capsys)
+    assert code == 2 and fragment in err, err
+    assert stat.S_ISFIFO((tmp_path / "fifo").stat().st_mode)  # never replaced
+    assert (tmp_path / "loop").is_symlink()
+
+
+def test_run_of_a_scenario_without_identify_is_refused_before_simulating(tmp_path, capsys):
+    # was refused after simulating, naming the scenario instead of its file
+    path = tmp_path / "bare.toml"
+    parent = (ROOT / "scenarios" / "michaelis_menten.toml").read_text()
+    path.write_text(parent.split("[identify]")[0].replace('name = "michaelis_menten"', 'name = "bare"'))
+    code, err = _cli(["run", str(path), "--no-figures", "--out", str(tmp_path / "runs")], capsys)
+    assert code == 2 and err.startswith(f"error: {path}: key 'identify': missing [identify]"), err
+    assert not (tmp_path / "runs" / "bare").exists()
