@@ -778,3 +778,85 @@ def test_malformed_family_values_are_refused_clearly(tmp_path, rig, key, fragmen
     e, _ = refuse(load_study, path)
     assert_clear(e, path, key, fragment)
 
+
+# ------------------------------------------------------------------------ round 3: data files
+def _mm_sep005(path: Path, **x_changes: object) -> Path:
+    """The Michaelis-Menten-like record of :func:`_mm_csv` as SEP-005, channel x changed."""
+    import numpy as np
+
+    t = np.arange(400) / 100.0
+    x = {"name": "x/x", "data": (0.2 + 1.8 * np.exp(-t)).tolist(), "fs": 100.0, "unit_str": "m"}
+    dx = {"name": "dx/dx", "data": (-1.8 * np.exp(-t)).tolist(), "fs": 100.0, "unit_str": "m/s"}
+    path.write_text(json.dumps([{**x, **x_changes}, dx]))
+    return path
+
+
+@pytest.mark.parametrize(("change", "fragment"), [
+    # JSON strings and booleans were read as numbers ("1" as 1.0, true as 1.0)
+    ({"data": ["1.5"] * 400}, "data are not numbers"),
+    ({"data": [True] * 400}, "data are not numbers"),
+    ({"data": [1.0, "2"] * 200}, "data are not numbers"),
+    # a number was read as the unit "5" (refused later for a rate "5/s")
+    ({"unit_str": 5}, "unit_str=5 is not a string"),
+], ids=["strings", "booleans", "mixed", "unit-number"])
+def test_sep005_values_that_are_not_numbers_are_refused(tmp_path, change, fragment):
+    from testbed.pipeline.importers import MeasuredDataError, read_measured
+
+    path = _mm_sep005(tmp_path / "x.json", **change)
+    with pytest.raises(MeasuredDataError, match=fragment) as e:
+        read_measured(path)
+    assert str(e.value).startswith(f"{path}: ") and "\n" not in str(e.value)
+
+
+def _toy_dataset_file(path: Path, x, fs: float = 100.0) -> Path:
+    """A dataset file holding ``x`` as its measured signal ``x`` and its rate ``fs``, the content
+    hash recomputed the way the testbed computes it (what a user's own writer would do)."""
+    import h5py
+    import numpy as np
+
+    from testbed.core.dataset import Dataset, Signal
+
+    n = 50
+    t = np.arange(n) / 100.0
+    Dataset(fs=100.0, measured={"x": Signal(np.exp(-t), ("x",), "m"),
+                                "dx": Signal(-np.exp(-t), ("x",), "m/s")},
+            reference={}, truth={}, truth_units={}, prior={},
+            attrs={"rig": "toy"}).save(path)
+    with h5py.File(path, "r+") as f:
+        if x is not None:
+            attrs = dict(f["measured/x"].attrs)
+            del f["measured/x"]
+            d = f.create_dataset("measured/x", data=x)
+            d.attrs.update(attrs)
+        f.attrs["fs"] = fs
+    if x is None:  # (the dtype and shape checks come before the hash's)
+        ds = Dataset.load(path, verify=False)
+        with h5py.File(path, "r+") as f:
+            f.attrs["content_hash"] = ds.content_hash()
+    return path
+
+
+@pytest.mark.parametrize(("x", "fs", "fragment"), [
+    # complex: the imaginary part was dropped with a ComplexWarning on stderr; strings were
+    # parsed as numbers; a 3-D array was read as one flat channel
+    ("complex", 100.0, "complex128 data of shape (1, 50); expected real numbers"),
+    ("strings", 100.0, "object data of shape (1, 50)"),
+    ("3d", 100.0, "float64 data of shape (1, 1, 50)"),
+    # a sample rate of 0 was a ZeroDivisionError, -100 Hz was fitted and written
+    (None, 0.0, "sample rate 0 Hz; expected a finite rate > 0 Hz"),
+    (None, -100.0, "sample rate -100 Hz"),
+    (None, math.nan, "sample rate nan Hz"),
+], ids=["complex", "strings", "3d", "fs0", "fs-100", "fsnan"])
+def test_dataset_files_of_other_numbers_are_refused(tmp_path, x, fs, fragment):
+    import h5py
+    import numpy as np
+
+    from testbed.pipeline.importers import MeasuredDataError, read_measured
+
+    t = np.exp(-np.arange(50) / 100.0)[None, :]
+    arrays = {"complex": t + 1j, "strings": np.array([[str(v) for v in t[0]]], dtype=h5py.string_dtype()),
+              "3d": t[None, ...], None: None}
+    path = _toy_dataset_file(tmp_path / "d.h5", arrays[x], fs)
+    with pytest.raises(MeasuredDataError) as e:
+        read_measured(path)
+    assert str(e.value).startswith(f"{path}: ") and fragment in str(e.value), str(e.value)
