@@ -674,6 +674,15 @@ ROUND3 = [
      "whole number"),
     ("fivebar_multisine_noise1", "[signal]\nedge_fit_s = 1e308\n", "signal.edge_fit_s",
      "at most the record"),
+    # accepted at load, then internal errors from the filter design when the chain ran
+    # (OverflowError "math range error", scipy's "Cannot design a filter", "critical
+    # frequencies must be greater than 0")
+    ("cantilever_stiff_impact", "[signal]\nstop_db = 1e308\n", "signal.stop_db", "<= 300"),
+    ("cantilever_stiff_impact", "[signal]\nripple_db = 5e-324\n", "signal.ripple_db", ">= 1e-09"),
+    ("cantilever_stiff_impact", "[signal]\nhighpass_hz = 5e-324\n", "signal.highpass_hz",
+     "underflows to 0"),
+    ("fivebar_multisine_noise1", "[signal]\ncutoff_hz = 5e-324\n", "signal.cutoff_hz",
+     "underflows to 0"),
 ]
 
 
