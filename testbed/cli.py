@@ -15,9 +15,11 @@ import dataclasses
 import errno
 import gc
 import os
+import signal
 import socket
 import stat
 import sys
+import threading
 from collections.abc import Callable, Iterator
 from pathlib import Path
 from urllib.parse import urlsplit
@@ -737,14 +739,48 @@ def _blas_threads() -> None:
 GC_THRESHOLD = (50_000, 20, 100)
 
 
+class Terminated(KeyboardInterrupt):
+    """SIGTERM or SIGHUP (``kill``, ``timeout``, a batch scheduler, a closed terminal), raised in
+    the main thread like Ctrl-C's KeyboardInterrupt, so that a command so ended stops its
+    workers and keeps its finished work the same way and says so on one line.  Before, the
+    default action ended the process at once: exit status -15 and joblib's multi-line warning
+    about the workers' shared-memory folders instead of ``error: interrupted``."""
+
+    def __init__(self, signum: int) -> None:
+        super().__init__(signum)
+        self.signum = signum
+
+
+def _raise_terminated(signum: int, frame: object) -> None:
+    raise Terminated(signum)
+
+
+@contextlib.contextmanager
+def _terminate_as_interrupt() -> Iterator[None]:
+    """SIGTERM and SIGHUP raise :class:`Terminated` while a command runs (only where their
+    action is the default one and only in the main thread: a caller's own handlers stay)."""
+    installed = {}
+    if threading.current_thread() is threading.main_thread():
+        for s in (signal.SIGTERM, signal.SIGHUP):
+            if signal.getsignal(s) is signal.SIG_DFL:
+                installed[s] = signal.signal(s, _raise_terminated)
+    try:
+        yield
+    finally:
+        for s, handler in installed.items():
+            signal.signal(s, handler)
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run one command; return the exit status (0 ok, 1 a run failed its bars, 2 a user's
-    mistake, 3 an internal error, 130 interrupted)."""
+    mistake, 3 an internal error, 130 interrupted; 128 + the signal's number when ended by
+    SIGTERM or SIGHUP)."""
     _blas_threads()
     before = gc.get_threshold()
     gc.set_threshold(*GC_THRESHOLD)  # restored below: main() is also called from Python
     try:
-        return _main(argv)
+        with _terminate_as_interrupt():
+            return _main(argv)
     finally:
         gc.set_threshold(*before)
 
@@ -768,6 +804,9 @@ def _main(argv: list[str] | None) -> int:
             raise
         print(f"error: {_one_line(e)}", file=sys.stderr)
         return EXIT_USAGE
+    except Terminated as e:
+        print(f"error: interrupted by {signal.Signals(e.signum).name}", file=sys.stderr)
+        return 128 + e.signum
     except KeyboardInterrupt:
         print("error: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED

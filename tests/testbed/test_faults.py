@@ -650,3 +650,28 @@ def test_run_of_a_scenario_without_identify_is_refused_before_simulating(tmp_pat
     code, err = _cli(["run", str(path), "--no-figures", "--out", str(tmp_path / "runs")], capsys)
     assert code == 2 and err.startswith(f"error: {path}: key 'identify': missing [identify]"), err
     assert not (tmp_path / "runs" / "bare").exists()
+
+
+@pytest.mark.parametrize("signum", [signal.SIGTERM, signal.SIGHUP])
+def test_sigterm_ends_a_command_like_ctrl_c(monkeypatch, capsys, signum):
+    # `kill`, `timeout` or a batch scheduler's SIGTERM ended a sweep by the default action:
+    # exit status -15 and joblib's multi-line warning about its workers' shared memory, where
+    # Ctrl-C stops the workers, keeps the finished rows and says "error: interrupted"
+    # (measured with `testbed sweep --jobs 2` mid-cell, SIGTERM to the main process and to its
+    # group, SIGHUP: now status 143 / 129, one line, no process left, resumed with no
+    # duplicate row)
+    from testbed import cli
+
+    def killed(args):
+        os.kill(os.getpid(), signum)
+        time.sleep(5)  # the handler raises before this ends
+        return 0
+
+    monkeypatch.setattr(cli, "cmd_list", killed)
+    previous = signal.signal(signum, signal.SIG_DFL)  # as in a command (a test runner may differ)
+    try:
+        assert cli.main(["list"]) == 128 + signum
+        assert capsys.readouterr().err == f"error: interrupted by {signal.Signals(signum).name}\n"
+        assert signal.getsignal(signum) is signal.SIG_DFL  # restored: main() is called from Python
+    finally:
+        signal.signal(signum, previous)
