@@ -201,6 +201,21 @@ def test_generate_to_a_file_fills_the_run_cache(tmp_path):
     assert len(cache.entries()) == 1
 
 
+def test_a_folder_in_place_of_a_cache_entry_is_named_before_simulating(tmp_path):
+    # the atomic rename onto it failed after the simulation ("[Errno 21] Is a directory:
+    # '.../.x.h5.tmp' -> ..."), and `testbed cache clear` failed on it
+    from testbed.core.errors import InputError
+
+    sc = load_scenario("michaelis_menten")
+    cache = DatasetCache(tmp_path)
+    cache.path(sc).mkdir()
+    (tmp_path / "other.h5").symlink_to(tmp_path / "other.h5")  # a link that loops: listed, cleared
+    with pytest.raises(InputError, match=r"is a folder where a cached dataset belongs"):
+        cache.clean(sc)
+    assert [p.name for p, _ in cache.entries()] == ["other.h5"]
+    assert cache.clear() == 1 and cache.path(sc).is_dir()
+
+
 # --------------------------------------------------------------------------- sweeps
 # A "mechanical" toy, as in test_sweep.py but under names of its own (one registration per
 # process): four undamped oscillators, an identifier fitting k_i by least squares.
