@@ -480,6 +480,8 @@ def _key_values(items: list[str] | None, option: str, *, numbers: bool) -> dict:
             value = text
         if numbers and (isinstance(value, bool) or not isinstance(value, (int, float))):
             raise InputError(f"{option} {item!r}: the value must be a number")
+        if key.strip() in out:  # the last one silently won
+            raise InputError(f"{option} {item!r}: {key.strip()} is given twice; give each key once")
         out[key.strip()] = float(value) if numbers else value
     return out
 

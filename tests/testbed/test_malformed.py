@@ -869,3 +869,16 @@ def test_dataset_files_of_other_numbers_are_refused(tmp_path, x, fs, fragment):
     with pytest.raises(MeasuredDataError) as e:
         read_measured(path)
     assert str(e.value).startswith(f"{path}: ") and fragment in str(e.value), str(e.value)
+
+
+@pytest.mark.parametrize("option", ["--param", "--prior"])
+def test_identify_refuses_a_key_given_twice(tmp_path, capsys, option):
+    # `--param ridge=0.1 --param ridge=0.2`: the last one silently won
+    from testbed.cli import EXIT_USAGE, main
+
+    path = _mm_csv(tmp_path / "mm.csv")
+    argv = ["identify", str(path), "--kind", "dynamical", "--method", "sindy_pi_dynamical",
+            option, "ridge=0.1", option, "ridge=0.2"]
+    assert main(argv) == EXIT_USAGE
+    err = capsys.readouterr().err
+    assert err == f"error: {option} 'ridge=0.2': ridge is given twice; give each key once\n"
