@@ -524,6 +524,22 @@ def mechanical():
     return synth.mechanical_result(n_samples=400)
 
 
+def test_a_fifo_in_place_of_latest_json_does_not_block_the_report(mechanical, tmp_path):
+    # `testbed report <scenario>` read latest.json: a FIFO there blocked it forever
+    from testbed.studies.runstore import LATEST, resolve_run, save_new_run
+
+    run = save_new_run(mechanical, tmp_path / "runs")
+    (run.parent / LATEST).unlink()
+    os.mkfifo(run.parent / LATEST)
+    previous = signal.signal(signal.SIGALRM, lambda *a: pytest.fail("resolve_run blocked on a FIFO"))
+    signal.setitimer(signal.ITIMER_REAL, 10.0)
+    try:
+        assert resolve_run(run.parent) == run  # the newest run, as without a pointer
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, previous)
+
+
 def test_a_run_named_dot_or_dotdot_never_touches_the_output_folder(mechanical, tmp_path):
     out = tmp_path / "runs"
     save_run(mechanical, out / "other")
