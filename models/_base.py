@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from typing import Any, ClassVar, Protocol
 
@@ -81,7 +82,9 @@ class Rig:
         if "sample_rate" not in simulation or "duration" not in simulation:
             return None
         fs = float(simulation["sample_rate"])
-        return fs, int(min(round(simulation["duration"] * fs), 2**62))
+        # capped before rounding: duration x sample_rate may overflow to inf (1e308 s), which
+        # round() cannot take; the budget refuses such a record by its key
+        return fs, round(min(simulation["duration"] * fs, 2**62))
 
     @classmethod
     def measurement_shape(cls, rig: dict[str, Any]) -> tuple[int, int] | None:
@@ -128,10 +131,13 @@ def check_sample_steps(simulation: dict[str, Any], error: ErrorFn) -> None:
     error : callable
         ``error(key, value, allowed)``.
     """
-    ratio = 1.0 / (simulation["sample_rate"] * simulation["dt"])
+    product = simulation["sample_rate"] * simulation["dt"]
+    # sample_rate x dt may underflow to 0 (5e-324 Hz) and its inverse overflow to inf: no
+    # whole number of steps either way (round() cannot take inf)
+    ratio = 1.0 / product if product > 0.0 else math.inf
     # 1e-6 relative: a ratio typed in decimal (e.g. 1 / (1000 * 1e-4)) is off its integer by
     # rounding only (~1e-15); anything larger is a real fraction of a step
-    if ratio < 1.0 - 1e-9 or abs(ratio - round(ratio)) > 1e-6 * ratio:
+    if not math.isfinite(ratio) or ratio < 1.0 - 1e-9 or abs(ratio - round(ratio)) > 1e-6 * ratio:
         error("simulation.sample_rate", simulation["sample_rate"],
               f"1/(sample_rate * dt) must be a whole number >= 1 (dt = {simulation['dt']:g} s gives "
               f"{ratio:.6g}): samples and input holds fall on integration steps")
@@ -148,7 +154,9 @@ def check_two_samples(simulation: dict[str, Any], error: ErrorFn) -> None:
     error : callable
         ``error(key, value, allowed)``.
     """
-    if round(simulation["duration"] * simulation["sample_rate"]) < 2:
+    # compared before rounding: the product may overflow to inf (1e308 s), which round() cannot
+    # take; round(x) < 2 exactly when x < 1.5 (round half to even: round(1.5) = 2)
+    if simulation["duration"] * simulation["sample_rate"] < 1.5:
         error("simulation.duration", simulation["duration"],
               f"expected at least two samples (duration x sample_rate = "
               f"{simulation['duration'] * simulation['sample_rate']:.3g})")

@@ -12,15 +12,19 @@ from __future__ import annotations
 import argparse
 import contextlib
 import dataclasses
+import errno
 import gc
 import os
+import signal
 import socket
+import stat
 import sys
+import threading
 from collections.abc import Callable, Iterator
 from pathlib import Path
 from urllib.parse import urlsplit
 
-from testbed.core.errors import InputError, TestbedError
+from testbed.core.errors import InputError, ScenarioError, TestbedError
 
 EXIT_FAIL, EXIT_USAGE, EXIT_INTERNAL, EXIT_INTERRUPTED = 1, 2, 3, 130
 #: Thread-count variables of the BLAS libraries numpy and scipy load (OpenBLAS, MKL, an OpenMP
@@ -69,11 +73,39 @@ def _seed(text: str) -> int:
 _jobs = _int_at_least(1)
 
 
+def _stat(path: Path, option: str = "") -> os.stat_result | None:
+    """``path.stat()``, or None if nothing is there (a dangling link, a missing parent).
+
+    Raises
+    ------
+    InputError
+        For a path that can name nothing (a name too long for the file system, a NUL byte, a
+        symbolic-link loop): an OSError or a RuntimeError from deep in a command before.
+    """
+    from testbed.core.errors import _one_line as escaped  # a NUL or newline shown escaped
+
+    where = escaped(f"{option} {path}" if option else str(path))
+    try:
+        return path.stat()
+    except ValueError:
+        raise InputError(f"{where}: not a usable path (it contains a NUL byte)") from None
+    except OSError as e:
+        if e.errno in (errno.ENOENT, errno.ENOTDIR):
+            return None
+        what = {errno.ELOOP: "a symbolic link that loops",
+                errno.ENAMETOOLONG: "a file name too long for the file system"}.get(e.errno)
+        raise InputError(f"{where}: not a usable path ({what or e.strerror or type(e).__name__})") \
+            from None
+
+
 def _existing_file(path: Path, what: str) -> Path:
-    if path.is_dir():
+    st = _stat(path)
+    if st is not None and stat.S_ISDIR(st.st_mode):
         raise InputError(f"{path}: is a folder; expected {what}")
-    if not path.is_file():
+    if st is None:
         raise InputError(f"{path}: no such file; expected {what}")
+    if not stat.S_ISREG(st.st_mode):  # a FIFO or a device: a read would block or never end
+        raise InputError(f"{path}: not a regular file (a FIFO, socket or device); expected {what}")
     return path
 
 
@@ -102,10 +134,16 @@ def _writable_in(path: Path, option: str, start: Path) -> None:
 
 
 def _output_file(path: Path, option: str, *, inputs: tuple[Path, ...] = ()) -> Path:
-    """A file a command will write, checked before any work: not a folder, not one of its
-    ``inputs`` (nothing the user gave is overwritten), in a folder that can be written."""
-    if path.is_dir():
+    """A file a command will write, checked before any work: not a folder, not a device or
+    FIFO (written atomically, the file would replace it: as root, ``--results /dev/full``
+    replaced the device node), not one of its ``inputs`` (nothing the user gave is
+    overwritten), in a folder that can be written."""
+    st = _stat(path, option)
+    if st is not None and stat.S_ISDIR(st.st_mode):
         raise InputError(f"{option} {path}: is a folder; expected a file path")
+    if st is not None and not stat.S_ISREG(st.st_mode):
+        raise InputError(f"{option} {path}: exists and is not a regular file (a FIFO, socket or "
+                         "device, which the written file would replace); expected a file path")
     for given in inputs:
         if path.resolve() == given.resolve():
             raise InputError(f"{option} {path}: is the input file; expected another path (the "
@@ -116,10 +154,17 @@ def _output_file(path: Path, option: str, *, inputs: tuple[Path, ...] = ()) -> P
 
 def _output_folder(path: Path, option: str) -> Path:
     """A folder a command will write into (created on use), checked before any work."""
-    if path.exists() and not path.is_dir():
+    st = _stat(path, option)
+    if st is not None and not stat.S_ISDIR(st.st_mode):
         raise InputError(f"{option} {path}: exists and is not a folder; expected a folder")
     _writable_in(path, option, path)
     return path
+
+
+def _is_not_folder(path: Path, option: str) -> bool:
+    """Whether something other than a folder is at ``path`` (nothing there: False)."""
+    st = _stat(path, option)
+    return st is not None and not stat.S_ISDIR(st.st_mode)
 
 
 def _cache_folder(cache: str | None) -> str | None:
@@ -127,9 +172,9 @@ def _cache_folder(cache: str | None) -> str | None:
     existing file."""
     from testbed.pipeline.cache import default_cache_dir
 
-    if cache is not None and Path(cache).exists() and not Path(cache).is_dir():
+    if cache is not None and _is_not_folder(Path(cache), "--cache"):
         raise InputError(f"--cache {cache}: not a folder")
-    if cache is None and default_cache_dir().exists() and not default_cache_dir().is_dir():
+    if cache is None and _is_not_folder(default_cache_dir(), "$TESTBED_CACHE"):
         where = "$TESTBED_CACHE" if os.environ.get("TESTBED_CACHE") else "the default cache"
         raise InputError(f"{where} {default_cache_dir()}: not a folder; expected the dataset "
                          "cache folder")
@@ -308,6 +353,12 @@ def cmd_run(args: argparse.Namespace) -> int:
     with figure_drawer(enabled=not args.no_figures) as figures:
         scenarios = [load_scenario(name) for name in args.scenario]  # every file checked first
         for sc in scenarios:
+            if sc.identify is None:  # was found after simulating, naming the scenario, not its file
+                raise ScenarioError(sc.path or sc.name, "identify",
+                                    allowed="missing [identify] table: `testbed run` fits and "
+                                            "scores an identifier (method = ...); `testbed "
+                                            "generate` simulates a scenario without one")
+        for sc in scenarios:
             if args.seed is not None:
                 sc = sc.replace(seed=args.seed)
             scenario_folder(args.out, sc.name)  # refused before the work, not after
@@ -359,12 +410,12 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     from testbed.studies.sweep import SweepStats, run_sweep
 
     extra = _load_plugins(args)
+    if args.results:  # before the study's load, which simulates nothing but takes seconds
+        _output_file(Path(args.results), "--results")
     study = load_study(args.study)
     if extra:  # the workers import them too
         study = dataclasses.replace(study, plugins=tuple(dict.fromkeys(study.plugins + extra)))
     stats = SweepStats()
-    if args.results:
-        _output_file(Path(args.results), "--results")
     if args.dask:
         check_dask_address(args.dask)
     try:
@@ -429,6 +480,8 @@ def _key_values(items: list[str] | None, option: str, *, numbers: bool) -> dict:
             value = text
         if numbers and (isinstance(value, bool) or not isinstance(value, (int, float))):
             raise InputError(f"{option} {item!r}: the value must be a number")
+        if key.strip() in out:  # the last one silently won
+            raise InputError(f"{option} {item!r}: {key.strip()} is given twice; give each key once")
         out[key.strip()] = float(value) if numbers else value
     return out
 
@@ -705,9 +758,42 @@ def _blas_threads() -> None:
 GC_THRESHOLD = (50_000, 20, 100)
 
 
+class Terminated(KeyboardInterrupt):
+    """SIGTERM or SIGHUP (``kill``, ``timeout``, a batch scheduler, a closed terminal), raised in
+    the main thread like Ctrl-C's KeyboardInterrupt, so that a command so ended stops its
+    workers and keeps its finished work the same way and says so on one line.  Before, the
+    default action ended the process at once: exit status -15 and joblib's multi-line warning
+    about the workers' shared-memory folders instead of ``error: interrupted``."""
+
+    def __init__(self, signum: int) -> None:
+        super().__init__(signum)
+        self.signum = signum
+
+
+def _raise_terminated(signum: int, frame: object) -> None:
+    raise Terminated(signum)
+
+
+@contextlib.contextmanager
+def _terminate_as_interrupt() -> Iterator[None]:
+    """SIGTERM and SIGHUP raise :class:`Terminated` while a command runs (only where their
+    action is the default one and only in the main thread: a caller's own handlers stay)."""
+    installed = {}
+    if threading.current_thread() is threading.main_thread():
+        for s in (signal.SIGTERM, signal.SIGHUP):
+            if signal.getsignal(s) is signal.SIG_DFL:
+                installed[s] = signal.signal(s, _raise_terminated)
+    try:
+        yield
+    finally:
+        for s, handler in installed.items():
+            signal.signal(s, handler)
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run one command; return the exit status (0 ok, 1 a run failed its bars, 2 a user's
-    mistake, 3 an internal error, 130 interrupted)."""
+    mistake, 3 an internal error, 130 interrupted; 128 + the signal's number when ended by
+    SIGTERM or SIGHUP)."""
     _blas_threads()
     if argv is None:  # the console program (not a call from Python): a resident server may run it
         status = _served(sys.argv[1:])
@@ -716,7 +802,8 @@ def main(argv: list[str] | None = None) -> int:
     before = gc.get_threshold()
     gc.set_threshold(*GC_THRESHOLD)  # restored below: main() is also called from Python
     try:
-        return _main(argv)
+        with _terminate_as_interrupt():
+            return _main(argv)
     finally:
         gc.set_threshold(*before)
 
@@ -749,6 +836,9 @@ def _main(argv: list[str] | None) -> int:
             raise
         print(f"error: {_one_line(e)}", file=sys.stderr)
         return EXIT_USAGE
+    except Terminated as e:
+        print(f"error: interrupted by {signal.Signals(e.signum).name}", file=sys.stderr)
+        return 128 + e.signum
     except KeyboardInterrupt:
         print("error: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED

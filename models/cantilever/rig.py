@@ -101,7 +101,9 @@ def fewest_substeps(simulation: dict[str, Any], nv: int) -> tuple[int, float]:
     integrator = simulation["integrator"]
     if simulation["timestep"] > 0:
         integ = "RK4" if integrator == "auto" else integrator
-        n = max(1, round(period / simulation["timestep"]))
+        # capped before rounding: a subnormal timestep (5e-324 s) makes the ratio inf, which
+        # round() cannot take; the budget then refuses the steps by simulation.timestep
+        n = max(1, round(min(period / simulation["timestep"], 2**62)))
         return n, n * step_seconds(nv, integ)
     options = []
     if integrator in ("auto", "RK4"):

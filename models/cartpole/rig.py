@@ -171,7 +171,9 @@ class CartPoleRig(Rig):
             if not rig[key] > MJ_MINVAL:
                 error(f"rig.{key}", rig[key], f"expected > {MJ_MINVAL:g} kg (MuJoCo's smallest "
                                               "mass of a moving body, mjMINVAL)")
-        inertia = rig["pole_mass"] * rig["pole_length"] ** 2 / 12.0
+        # L * L, not L ** 2: a float power raises OverflowError (L = 1e308) where a product
+        # gives inf
+        inertia = rig["pole_mass"] * rig["pole_length"] * rig["pole_length"] / 12.0
         if not POLE_AXIAL_FRACTION * inertia > MJ_MINVAL:
             error("rig.pole_length", rig["pole_length"],
                   f"expected a pole whose inertia m L^2 / 12 exceeds "

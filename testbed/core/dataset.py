@@ -380,6 +380,12 @@ class Dataset:
             for group in ("measured", "reference"):
                 groups[group] = {}
                 for name, d in f[group].items():
+                    if d.dtype.kind not in "fiu" or d.ndim not in (1, 2):
+                        # complex lost its imaginary part (with a warning), strings were parsed
+                        # as numbers and a 3-D array read as one flat channel
+                        raise DatasetError(path, f"signal {group}/{name}: {d.dtype} data of shape "
+                                                 f"{d.shape}; expected real numbers, one row per "
+                                                 "channel")
                     pos = d.attrs.get("positions")
                     acts = d.attrs.get("acts_on")
                     groups[group][name] = Signal(d[()], tuple(str(c) for c in d.attrs["channels"]),

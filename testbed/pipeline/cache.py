@@ -29,6 +29,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 from testbed.core.dataset import Dataset, DatasetError
+from testbed.core.errors import InputError
 from testbed.core.provenance import versions
 from testbed.pipeline.generate import derive, noise_free_scenario, simulate_clean
 from testbed.pipeline.plugins import rig_class
@@ -112,6 +113,9 @@ class DatasetCache:
         """
 
         p = self.path(scenario)
+        if p.is_dir():  # the atomic rename onto it failed after simulating, naming a temporary file
+            raise InputError(f"dataset cache {self.directory}: {p.name} is a folder where a cached "
+                             "dataset belongs; remove it or use another cache folder (--cache)")
         if p.is_file():
             try:
                 return Dataset.load(p)
@@ -135,7 +139,9 @@ class DatasetCache:
         """(path, size in bytes) of every cached file, sorted by name."""
         if not self.directory.is_dir():
             return []
-        return [(p, p.stat().st_size) for p in sorted(self.directory.glob("*.h5"))]
+        # not a folder named *.h5 (`cache clear` failed on it, "Is a directory"); lstat: a link
+        # that loops is listed (and cleared), not an OSError
+        return [(p, p.lstat().st_size) for p in sorted(self.directory.glob("*.h5")) if not p.is_dir()]
 
     def clear(self) -> int:
         """Delete every cached file and any temporary file a killed writer left; return how many

@@ -505,6 +505,8 @@ def _finish(raw: _Raw, fs: float | None, units: str | Mapping[str, str] | None,
         rate = float(fs)
     if rate is None:
         raise MeasuredDataError(path, "no time column (t or time) and no sample rate; pass fs= [Hz]")
+    if not (math.isfinite(rate) and rate > 0):  # a dataset file's fs attribute of 0, -100 or NaN
+        raise MeasuredDataError(path, f"sample rate {rate:g} Hz; expected a finite rate > 0 Hz")
     signals = {}
     for n in names:
         unit = units if isinstance(units, str) else (units or {}).get(n, raw.units.get(n))
@@ -613,8 +615,15 @@ def _parse_sep005(path: Path, content: Any) -> _Raw:
             raise MeasuredDataError(path, f"SEP-005 channel name {name!r} is not unique")
         if "data" not in c:
             raise MeasuredDataError(path, f"SEP-005 channel {name!r} has no data")
+        values = c["data"]
+        # JSON strings and booleans are not samples (np.asarray would read "1.5" and true as
+        # numbers); an array given in memory must hold real numbers (complex lost its
+        # imaginary part)
+        if (isinstance(values, np.ndarray) and values.dtype.kind not in "fiu") or (
+                isinstance(values, (list, tuple)) and any(isinstance(v, (bool, str)) for v in values)):
+            raise MeasuredDataError(path, f"SEP-005 channel {name!r}: data are not numbers")
         try:
-            data = np.asarray(c["data"], dtype=float)
+            data = np.asarray(values, dtype=float)
         except (TypeError, ValueError):
             raise MeasuredDataError(path, f"SEP-005 channel {name!r}: data are not numbers") from None
         except OverflowError:  # a JSON integer such as 10**400: no float64 holds it
@@ -642,7 +651,10 @@ def _parse_sep005(path: Path, content: Any) -> _Raw:
         else:
             raise MeasuredDataError(path, f"SEP-005 channel {name!r} has neither fs nor time")
         unit = c.get("unit_str")
-        raw.data[name], raw.units[name] = data, (str(unit) if unit else None)
+        if unit is not None and not isinstance(unit, str):  # 5 was read as the unit "5"
+            raise MeasuredDataError(path, f"SEP-005 channel {name!r}: unit_str={unit!r} is not a "
+                                          "string")
+        raw.data[name], raw.units[name] = data, (unit or None)
         if isinstance(c.get("node"), int) and not isinstance(c.get("node"), bool):
             raw.nodes[name] = int(c["node"])
         direction = _direction(c.get("direction"))

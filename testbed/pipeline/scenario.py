@@ -36,11 +36,13 @@ from __future__ import annotations
 
 import copy
 import dataclasses
+import errno
 import hashlib
 import json
 import math
 import os
 import re
+import stat
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -182,6 +184,38 @@ def _deep_merge(base: dict, over: dict) -> dict:
     return out
 
 
+def file_problem(path: Path, what: str) -> str | None:
+    """Why ``path`` cannot be read as a ``what`` (scenario, study) file, in words; None if it is
+    a regular file (or a link to one).
+
+    Never raises: a name too long for the file system, a symbolic-link loop, a dangling link, a
+    NUL in the name, a folder and a FIFO or device (whose read would block or never end) each
+    get their own words instead of an OSError or a misleading "no such file".
+    """
+    try:
+        st = path.stat()
+    except ValueError:  # an embedded NUL byte
+        return "not a usable file name (it contains a NUL byte)"
+    except OSError as e:
+        if e.errno == errno.ELOOP:
+            return "a symbolic link that loops (it never reaches a file)"
+        if e.errno == errno.ENAMETOOLONG:
+            return "a file name too long for the file system"
+        if e.errno in (errno.ENOENT, errno.ENOTDIR):
+            try:
+                if path.is_symlink():
+                    return f"a symbolic link to {os.readlink(path)!r}, which does not exist"
+            except OSError:
+                pass
+            return f"no such {what} file"
+        return f"cannot be read: {e.strerror or type(e).__name__}"
+    if stat.S_ISDIR(st.st_mode):
+        return f"is a folder; expected a {what} .toml file"
+    if not stat.S_ISREG(st.st_mode):
+        return f"not a regular file (a FIFO, socket or device); expected a {what} .toml file"
+    return None
+
+
 def _depth_exceeds(obj: Any, limit: int) -> bool:
     """Whether tables and lists nest deeper than ``limit`` (iterative: no recursion)."""
     stack = [(obj, 0)]
@@ -212,10 +246,9 @@ def read_toml_file(path: Path, what: str) -> dict:
         valid TOML, or nested deeper than :data:`MAX_DEPTH`.
     """
     file = str(path)
-    if path.is_dir():
-        raise ScenarioError(file, allowed=f"is a folder; expected a {what} .toml file")
-    if not path.is_file():
-        raise ScenarioError(file, allowed=f"no such {what} file")
+    problem = file_problem(path, what)
+    if problem is not None:
+        raise ScenarioError(file, allowed=problem)
     try:
         size = path.stat().st_size
         if size > MAX_FILE_BYTES:
@@ -229,6 +262,9 @@ def read_toml_file(path: Path, what: str) -> dict:
     except UnicodeDecodeError as e:
         raise ScenarioError(file, allowed=f"not UTF-8 text (byte {e.start}); a {what} file is "
                                           "UTF-8 TOML") from None
+    if text.startswith("\ufeff"):  # Windows editors' "UTF-8 with BOM"; TOML forbids it
+        raise ScenarioError(file, allowed=f"starts with a byte-order mark (U+FEFF); a {what} file "
+                                          "is UTF-8 TOML without one (save it as plain UTF-8)")
     if "\x00" in text:
         raise ScenarioError(file, allowed=f"contains NUL bytes (a binary file?); a {what} file is "
                                           "UTF-8 TOML")
@@ -274,8 +310,11 @@ def _read_toml(path: Path, chain: tuple[Path, ...] = ()) -> dict:
                 from None
         if ppath in chain or ppath == path.resolve():
             raise ScenarioError(str(path), "scenario.extends", parent, "extends itself (a cycle)")
-        if not ppath.is_file():
-            raise ScenarioError(str(path), "scenario.extends", parent, f"no such file {ppath}")
+        problem = file_problem(ppath, "scenario")
+        if problem is not None:
+            raise ScenarioError(str(path), "scenario.extends", parent,
+                                f"no such file {ppath}" if problem.startswith("no such")
+                                else f"{ppath}: {problem}")
         try:
             base = _read_toml(ppath, (*chain, path.resolve()))
         except ScenarioError as e:
@@ -293,21 +332,27 @@ def _read_toml(path: Path, chain: tuple[Path, ...] = ()) -> dict:
 
 def resolve_path(name_or_path: str | os.PathLike, directory: Path | None = None) -> Path:
     """A path as given, or ``<directory>/<name>.toml`` for a bare name (default directory: the
-    shipped scenarios)."""
+    shipped scenarios).
+
+    A bare name is taken as a path only if it names a file: a folder of that name in the
+    working directory (``testbed run X --out .`` writes its runs to ``./X/``) must not hide
+    the scenario ``X``.
+    """
     p = Path(name_or_path)
-    if p.suffix == ".toml" or p.exists() or len(p.parts) > 1:
+    if p.suffix == ".toml" or len(p.parts) > 1 or file_problem(p, "") is None:
         return p
     return (SCENARIO_DIR if directory is None else directory) / f"{p}.toml"
 
 
 def _check_stem(path: Path, what: str, directory: Path) -> None:
     """Refuse a folder, and a file whose stem is not a safe name (e.g. ``..toml``, stem ``.``)."""
-    if path.is_dir():
-        raise ScenarioError(str(path), allowed=f"is a folder; expected a {what} .toml file")
+    problem = file_problem(path, what)
+    if problem is not None and not problem.startswith("no such"):
+        raise ScenarioError(str(path), allowed=problem)
     if not re.fullmatch(NAME_PATTERN, path.stem):
         raise ScenarioError(str(path), f"{what}.name", path.stem,
                             f"the file name without .toml must be {NAME_PATTERN_DOC}")
-    if not path.exists() and path.parent == directory:
+    if problem is not None and path.parent == directory:
         known = sorted(p.stem for p in directory.glob("*.toml"))
         raise ScenarioError(str(path), allowed=f"no {what} named {path.stem!r}; known: "
                                                + (", ".join(known) or f"(none in {directory})"))
@@ -367,6 +412,11 @@ def scenario_from_dict(raw: dict[str, Any], *, file: str = "<dict>", stem: str |
         raise ScenarioError(file, key, value, allowed)
 
     rig_cls.check(rig_params, simulation, excitation, error)
+    if check_cost:
+        # before the checks against the record: a record over budget (sample_rate = 1e308) is
+        # refused for its size, not for a window "longer than the record's 4.6e-290 s" (the
+        # sample count is capped at 2**62)
+        check_rig_cost(rig_cls, rig_params, simulation, excitation, file=file)
     signal = validate_table(raw.get("signal", {}), SIGNAL_SCHEMAS[rig_cls.kind], file=file,
                             section="signal")
     record = rig_cls.record(simulation)
@@ -380,8 +430,6 @@ def scenario_from_dict(raw: dict[str, Any], *, file: str = "<dict>", stem: str |
                                                    "identified model to score")
     if identify is not None:
         check_identifier_for_rig(rig_cls, rig_params, simulation, identify, file=file)
-    if check_cost:
-        check_rig_cost(rig_cls, rig_params, simulation, excitation, file=file)
     return Scenario(name=head["name"], rig=head["rig"], seed=head["seed"],
                     description=head["description"], tags=tuple(head["tags"]),
                     rig_params=rig_params, simulation=simulation, excitation=excitation,

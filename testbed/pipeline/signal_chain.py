@@ -49,9 +49,13 @@ STRUCTURAL_SIGNAL_SCHEMA: dict[str, Field] = {
                             doc="order of the elliptic high-pass; odd orders have a zero at DC "
                                 "and unit gain at high frequency; even orders pass DC at the "
                                 "stop-band level and have -ripple_db gain at high frequency"),
-    "ripple_db": Field(float, 0.1, unit="dB", min=0.0, min_inclusive=False,
+    # 1e-9 dB and 300 dB: scipy designs every order 1-12 between them (checked on a grid of
+    # cut-offs); a ripple of 1e-100 dB is an "improper transfer function", 5e-324 dB "cannot
+    # design", and 10**(stop_db / 10) overflows above ~3,080 dB.  300 dB is below float64's
+    # resolution anyway (20 log10(1 / eps) = 313 dB): a deeper stop band cannot show in data.
+    "ripple_db": Field(float, 0.1, unit="dB", min=1e-9, max=300.0,
                        doc="pass-band ripple of the elliptic filter (the paper: 0.1 dB)"),
-    "stop_db": Field(float, 30.0, unit="dB", min=0.0, min_inclusive=False,
+    "stop_db": Field(float, 30.0, unit="dB", min=0.0, min_inclusive=False, max=300.0,
                      doc="stop-band attenuation of the elliptic filter (the paper: 30 dB)"),
     "lowpass_hz": Field(float, 0.0, unit="Hz", min=0.0,
                         doc="optional zero-phase low-pass cut-off; 0 = off"),
@@ -199,6 +203,9 @@ def _below_nyquist(cfg: Mapping[str, Any], key: str, fs: float, error: ErrorFn) 
     if not cfg[key] < fs / 2.0:
         error(f"signal.{key}", cfg[key], f"expected below the Nyquist frequency {fs / 2.0:g} Hz "
                                          f"(sample rate {fs:g} Hz)")
+    if not cfg[key] / (fs / 2.0) > 0.0:  # 5e-324 Hz: the design's normalised cut-off is 0
+        error(f"signal.{key}", cfg[key], f"a cut-off whose fraction of the Nyquist frequency "
+                                         f"{fs / 2.0:g} Hz is a float64 > 0 (it underflows to 0)")
 
 
 def _long_enough(cfg: Mapping[str, Any], key: str, order: int, n_samples: int,
@@ -249,7 +256,8 @@ def check_mechanical(cfg: Mapping[str, Any], fs: float, n_samples: int, error: E
         _long_enough(cfg, "filter_order", cfg["filter_order"], n_samples, error)
         if cfg["edge_fit_s"] == "auto":
             return  # at most a quarter of the record; its length is checked when measured
-        n_fit = round(cfg["edge_fit_s"] * fs)
+        span = cfg["edge_fit_s"] * fs  # may overflow to inf (1e308 s), which round() cannot take
+        n_fit = round(span) if math.isfinite(span) else span
         if not cfg["edge_fit_order"] < n_fit <= n_samples:
             error("signal.edge_fit_s", cfg["edge_fit_s"],
                   f"the end windows of {n_fit} samples must be longer than edge_fit_order "

@@ -61,6 +61,7 @@ from testbed.pipeline.scenario import (
     NAME_PATTERN_DOC,
     Scenario,
     _read_toml,
+    file_problem,
     resolve_path,
     scenario_from_dict,
 )
@@ -198,8 +199,11 @@ def parse_family(name: str, table: Any, *, file: str, base_dir: Path) -> Family:
     bpath = resolve_path(head["base"])
     if not bpath.is_absolute() and (head["base"].endswith(".toml") or len(Path(head["base"]).parts) > 1):
         bpath = base_dir / bpath
-    if not bpath.is_file():
-        raise ScenarioError(file, f"{key}.base", head["base"], f"no scenario file {bpath}")
+    problem = file_problem(bpath, "scenario")
+    if problem is not None:
+        raise ScenarioError(file, f"{key}.base", head["base"],
+                            f"no scenario file {bpath}" if problem.startswith("no such")
+                            else f"{bpath}: {problem}")
     raw = _read_toml(bpath)
     base = scenario_from_dict(raw, file=str(bpath), stem=bpath.stem, standalone=False)
     ranges: dict[str, dict[str, Any]] = {}
@@ -256,8 +260,15 @@ def _check_range_keys(fam: Family, file: str, key: str) -> None:
                 (dist, values), = spec.items()
                 for v in values:
                     check_value(v, schema[k], file=file, key=f"{where}.{dist}")
-            elif table == "rig" and k in CANTILEVER_DERIVED_FIELDS:
+            elif not (fam.base.rig == "cantilever" and spec == _CANTILEVER_WORDS.get((table, k))):
+                # a fixed value too: the cantilever's rules compute with it before a member is
+                # validated ("abc" for a length was a TypeError there)
                 check_value(spec, schema[k], file=file, key=where)
+
+
+#: Words the cantilever's derived keys take in place of a value (:data:`CANTILEVER_DERIVED`).
+_CANTILEVER_WORDS = {("excitation", "location"): "sensor", ("signal", "highpass_hz"): "auto",
+                     ("signal", "lowpass_hz"): "auto"}
 
 
 def _check_spec(spec: Any, file: str, key: str) -> None:
@@ -290,9 +301,12 @@ def _check_cantilever_keys(fam: Family, file: str, key: str) -> None:
     rig = fam.ranges["rig"]
     if "material" in rig:
         spec = rig["material"]
+        if isinstance(spec, dict) and "choices" not in spec:
+            raise ScenarioError(file, f"{key}.rig.material", spec,
+                                "a material name or {choices = [names]}")
         names = spec["choices"] if isinstance(spec, dict) else [spec]
         for n in names:
-            if n not in MATERIALS:
+            if not isinstance(n, str) or n not in MATERIALS:
                 raise ScenarioError(file, f"{key}.rig.material", n,
                                     "one of " + ", ".join(MATERIALS) + " (or give E and rho)")
         if "E" in rig or "rho" in rig:
@@ -446,8 +460,11 @@ def draw_member(fam: Family, k: int, refusals: list[str] | None = None) -> tuple
                 else:
                     tables[t][key] = value
         if base.rig == "cantilever":
-            why = _cantilever_rules(fam, tables["rig"], tables["excitation"], tables["simulation"],
-                                    tables["signal"], derived, rng) or ""
+            try:
+                why = _cantilever_rules(fam, tables["rig"], tables["excitation"],
+                                        tables["simulation"], tables["signal"], derived, rng) or ""
+            except (OverflowError, ZeroDivisionError) as e:  # e.g. a length of 1e300 m squared
+                why = f"the Euler-Bernoulli estimates leave float64 ({e})"
             if why:
                 if refusals is not None:
                     refusals.append(why)

@@ -515,6 +515,8 @@ def write_index(out_dir: str | os.PathLike, index: Callable[[list[dict[str, Any]
 
 def _read_latest(folder: Path) -> dict[str, Any] | None:
     """The pointer of a scenario folder if it names an existing run folder in it, else None."""
+    if not (folder / LATEST).is_file():  # a FIFO there blocked `testbed report <scenario>` forever
+        return None
     try:
         pointer = json.loads((folder / LATEST).read_text())
         name = pointer["run"]

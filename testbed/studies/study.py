@@ -64,6 +64,7 @@ from testbed.pipeline.scenario import (
     _validate_identify,
     _validate_score,
     check_identifier_for_rig,
+    file_problem,
     load_scenario,
     read_toml_file,
     resolve_path,
@@ -239,7 +240,10 @@ def study_from_dict(raw: dict[str, Any], *, file: str = "<dict>", base: Path | N
         spath = resolve_path(s)
         if not spath.is_absolute() and (s.endswith(".toml") or len(Path(s).parts) > 1):
             spath = base / spath
-        if not spath.is_file():
+        problem = file_problem(spath, "scenario")
+        if problem is not None and not problem.startswith("no such"):
+            raise ScenarioError(file, f"study.scenarios[{i}]", s, f"{spath}: {problem}")
+        if problem is not None:
             known = sorted(p.stem for p in SCENARIO_DIR.glob("*.toml"))
             raise ScenarioError(file, f"study.scenarios[{i}]", s,
                                 f"no scenario file {spath}; expected a name among "

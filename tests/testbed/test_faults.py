@@ -201,6 +201,21 @@ def test_generate_to_a_file_fills_the_run_cache(tmp_path):
     assert len(cache.entries()) == 1
 
 
+def test_a_folder_in_place_of_a_cache_entry_is_named_before_simulating(tmp_path):
+    # the atomic rename onto it failed after the simulation ("[Errno 21] Is a directory:
+    # '.../.x.h5.tmp' -> ..."), and `testbed cache clear` failed on it
+    from testbed.core.errors import InputError
+
+    sc = load_scenario("michaelis_menten")
+    cache = DatasetCache(tmp_path)
+    cache.path(sc).mkdir()
+    (tmp_path / "other.h5").symlink_to(tmp_path / "other.h5")  # a link that loops: listed, cleared
+    with pytest.raises(InputError, match=r"is a folder where a cached dataset belongs"):
+        cache.clean(sc)
+    assert [p.name for p, _ in cache.entries()] == ["other.h5"]
+    assert cache.clear() == 1 and cache.path(sc).is_dir()
+
+
 # --------------------------------------------------------------------------- sweeps
 # A "mechanical" toy, as in test_sweep.py but under names of its own (one registration per
 # process): four undamped oscillators, an identifier fitting k_i by least squares.
@@ -509,6 +524,22 @@ def mechanical():
     return synth.mechanical_result(n_samples=400)
 
 
+def test_a_fifo_in_place_of_latest_json_does_not_block_the_report(mechanical, tmp_path):
+    # `testbed report <scenario>` read latest.json: a FIFO there blocked it forever
+    from testbed.studies.runstore import LATEST, resolve_run, save_new_run
+
+    run = save_new_run(mechanical, tmp_path / "runs")
+    (run.parent / LATEST).unlink()
+    os.mkfifo(run.parent / LATEST)
+    previous = signal.signal(signal.SIGALRM, lambda *a: pytest.fail("resolve_run blocked on a FIFO"))
+    signal.setitimer(signal.ITIMER_REAL, 10.0)
+    try:
+        assert resolve_run(run.parent) == run  # the newest run, as without a pointer
+    finally:
+        signal.setitimer(signal.ITIMER_REAL, 0)
+        signal.signal(signal.SIGALRM, previous)
+
+
 def test_a_run_named_dot_or_dotdot_never_touches_the_output_folder(mechanical, tmp_path):
     out = tmp_path / "runs"
     save_run(mechanical, out / "other")
@@ -596,3 +627,82 @@ def test_two_concurrent_testbed_runs_of_one_scenario(tmp_path):
     assert (out / "index.html").read_text().count("<tr>") == 1 + 2
     assert [p.name for p in cache.iterdir()] == [DatasetCache(cache).path(
         load_scenario(scenario)).name], "one whole cache entry, no temporary file"
+
+
+# --------------------------------------------------------------------------- paths that name no file
+def _cli(argv: list[str], capsys) -> tuple[int, str]:
+    from testbed.cli import main
+
+    code = main(argv)
+    err = capsys.readouterr().err
+    assert "Traceback" not in err and len(err.splitlines()) == 1, err
+    return code, err
+
+
+#: (argv, fragment): every path a command reads or writes is checked before any work.  A
+#: FIFO or device as an output was replaced by the atomic rename (as root, `--results
+#: /dev/full` replaced the device node with a parquet file); a symbolic-link loop and a name
+#: too long for the file system were internal errors (RuntimeError, OSError) after the work.
+BAD_PATHS = [
+    (["generate", "michaelis_menten", "-o", "{tmp}/fifo"], "not a regular file (a FIFO"),
+    (["sweep", "smoke", "--results", "{tmp}/fifo"], "not a regular file (a FIFO"),
+    (["identify", "{tmp}/fifo", "--kind", "dynamical", "--method", "sindy_pi_dynamical"],
+     "not a regular file (a FIFO"),
+    (["run", "michaelis_menten", "--no-figures", "--out", "{tmp}/loop"], "a symbolic link that loops"),
+    (["run", "michaelis_menten", "--no-figures", "--out", "{tmp}/loop/sub"],
+     "a symbolic link that loops"),
+    (["sweep", "smoke", "--results", "{tmp}/loop"], "a symbolic link that loops"),
+    (["cache", "ls", "--cache", "{tmp}/loop"], "a symbolic link that loops"),
+    (["run", "michaelis_menten", "--no-figures", "--out", "{tmp}/" + "y" * 300],
+     "a file name too long"),
+    (["sweep", "smoke", "--results", "{tmp}/" + "y" * 300 + ".parquet"], "a file name too long"),
+    (["run", "michaelis_menten", "--no-figures", "--out", "{tmp}/a\x00b"], "a NUL byte"),
+]
+
+
+@pytest.mark.parametrize(("argv", "fragment"), BAD_PATHS, ids=[" ".join(a)[:50] for a, _ in BAD_PATHS])
+def test_paths_that_name_no_usable_file_are_refused_and_kept(tmp_path, capsys, argv, fragment):
+    import stat
+
+    os.mkfifo(tmp_path / "fifo")
+    (tmp_path / "loop").symlink_to(tmp_path / "loop2")
+    (tmp_path / "loop2").symlink_to(tmp_path / "loop")
+    code, err = _cli([a.replace("{tmp}", str(tmp_path)) for a in argv], capsys)
+    assert code == 2 and fragment in err, err
+    assert stat.S_ISFIFO((tmp_path / "fifo").stat().st_mode)  # never replaced
+    assert (tmp_path / "loop").is_symlink()
+
+
+def test_run_of_a_scenario_without_identify_is_refused_before_simulating(tmp_path, capsys):
+    # was refused after simulating, naming the scenario instead of its file
+    path = tmp_path / "bare.toml"
+    parent = (ROOT / "scenarios" / "michaelis_menten.toml").read_text()
+    path.write_text(parent.split("[identify]")[0].replace('name = "michaelis_menten"', 'name = "bare"'))
+    code, err = _cli(["run", str(path), "--no-figures", "--out", str(tmp_path / "runs")], capsys)
+    assert code == 2 and err.startswith(f"error: {path}: key 'identify': missing [identify]"), err
+    assert not (tmp_path / "runs" / "bare").exists()
+
+
+@pytest.mark.parametrize("signum", [signal.SIGTERM, signal.SIGHUP])
+def test_sigterm_ends_a_command_like_ctrl_c(monkeypatch, capsys, signum):
+    # `kill`, `timeout` or a batch scheduler's SIGTERM ended a sweep by the default action:
+    # exit status -15 and joblib's multi-line warning about its workers' shared memory, where
+    # Ctrl-C stops the workers, keeps the finished rows and says "error: interrupted"
+    # (measured with `testbed sweep --jobs 2` mid-cell, SIGTERM to the main process and to its
+    # group, SIGHUP: now status 143 / 129, one line, no process left, resumed with no
+    # duplicate row)
+    from testbed import cli
+
+    def killed(args):
+        os.kill(os.getpid(), signum)
+        time.sleep(5)  # the handler raises before this ends
+        return 0
+
+    monkeypatch.setattr(cli, "cmd_list", killed)
+    previous = signal.signal(signum, signal.SIG_DFL)  # as in a command (a test runner may differ)
+    try:
+        assert cli.main(["list"]) == 128 + signum
+        assert capsys.readouterr().err == f"error: interrupted by {signal.Signals(signum).name}\n"
+        assert signal.getsignal(signum) is signal.SIG_DFL  # restored: main() is called from Python
+    finally:
+        signal.signal(signum, previous)

@@ -652,3 +652,233 @@ def test_a_dead_channel_among_moving_ones_is_refused(tmp_path):
                                                 r"while others do") as e:
         measurement_from_file(path, "dynamical")
     assert str(e.value).startswith(f"{path}: ")
+
+
+# ------------------------------------------------------------------------ round 3: extremes
+#: (base scenario, tables written over it, key the message names, fragment): finite values at
+#: the ends of float64 (1e308, 5e-324) overflowed round() or a float power in the rigs' and the
+#: signal chain's checks (OverflowError, ZeroDivisionError: internal errors), and a record over
+#: budget was refused for a window "longer than the record's 4.6e-290 s" (the sample count is
+#: capped at 2**62) instead of for its size.
+ROUND3 = [
+    ("michaelis_menten", "[simulation]\nduration = 1e308\n", "simulation.duration", "budget"),
+    ("michaelis_menten", "[simulation]\nsample_rate = 1e308\n", "simulation.duration", "budget"),
+    ("cantilever_stiff_impact", "[simulation]\nduration = 1e308\n", "simulation.duration", "budget"),
+    ("cantilever_stiff_impact", "[simulation]\nsample_rate = 1e308\n", "simulation.sample_rate",
+     "budget"),
+    ("cantilever_stiff_impact", "[simulation]\ntimestep = 5e-324\n", "simulation.timestep", "budget"),
+    ("fivebar_multisine", "[simulation]\ndt = 5e-324\n", "simulation.sample_rate", "gives inf"),
+    ("fivebar_multisine", "[simulation]\nsample_rate = 5e-324\n", "simulation.sample_rate",
+     "whole number"),
+    ("fivebar_multisine", "[simulation]\nsample_rate = 1e-308\n", "simulation.sample_rate",
+     "whole number"),
+    ("fivebar_multisine_noise1", "[signal]\nedge_fit_s = 1e308\n", "signal.edge_fit_s",
+     "at most the record"),
+    # accepted at load, then internal errors from the filter design when the chain ran
+    # (OverflowError "math range error", scipy's "Cannot design a filter", "critical
+    # frequencies must be greater than 0")
+    ("cantilever_stiff_impact", "[signal]\nstop_db = 1e308\n", "signal.stop_db", "<= 300"),
+    ("cantilever_stiff_impact", "[signal]\nripple_db = 5e-324\n", "signal.ripple_db", ">= 1e-09"),
+    ("cantilever_stiff_impact", "[signal]\nhighpass_hz = 5e-324\n", "signal.highpass_hz",
+     "underflows to 0"),
+    ("fivebar_multisine_noise1", "[signal]\ncutoff_hz = 5e-324\n", "signal.cutoff_hz",
+     "underflows to 0"),
+]
+
+
+@pytest.mark.parametrize(("base", "tables", "key", "fragment"), ROUND3,
+                         ids=[f"{b}:{t.split(chr(10))[1]}" for b, t, _, _ in ROUND3])
+def test_round3_extreme_values_are_refused_clearly(tmp_path, base, tables, key, fragment):
+    path = tmp_path / "r3.toml"
+    path.write_text(f'[scenario]\nname = "r3"\nextends = "{(SCENARIO_DIR / base).with_suffix(".toml")}"\n'
+                    f"{tables}")
+    e, seconds = refuse(load_scenario, path)
+    assert_clear(e, path, key, fragment)
+    assert seconds < HANG_S
+
+
+def test_a_pole_of_1e308_m_gives_a_scenario_or_a_scenario_error(tmp_path):
+    # was OverflowError from the float power L ** 2 in the cart-pole's inertia check
+    path = tmp_path / "r3.toml"
+    path.write_text(f'[scenario]\nname = "r3"\nextends = "{SCENARIO_DIR / "cartpole.toml"}"\n'
+                    "[rig]\npole_length = 1e308\n")
+    with contextlib.suppress(ScenarioError):
+        load_scenario(path)
+
+
+def _weird_file(tmp_path: Path, kind: str) -> Path:
+    """A file name that names no readable TOML file, of each ``kind``."""
+    import os
+
+    path = tmp_path / f"{kind}.toml"
+    if kind == "loop":
+        (tmp_path / "loop2.toml").symlink_to(path)
+        path.symlink_to(tmp_path / "loop2.toml")
+    elif kind == "dangling":
+        path.symlink_to(tmp_path / "nowhere.toml")
+    elif kind == "fifo":
+        os.mkfifo(path)  # a read would block forever
+    elif kind == "bom":
+        path.write_bytes(b'\xef\xbb\xbf[scenario]\nname = "bom"\nrig = "michaelis_menten"\n')
+    elif kind == "long":
+        path = tmp_path / ("x" * 300 + ".toml")
+    return path
+
+
+#: kind -> fragment: each was "no such file" (a loop, a FIFO: misleading), "not valid TOML
+#: ... line 1, column 1" (a byte-order mark), or an internal OSError (a name too long)
+WEIRD = {"loop": "a symbolic link that loops", "dangling": "a symbolic link to",
+         "fifo": "not a regular file (a FIFO", "bom": "byte-order mark",
+         "long": "a file name too long"}
+
+
+@pytest.mark.parametrize("kind", sorted(WEIRD))
+@pytest.mark.parametrize("load", [load_scenario, load_study], ids=["scenario", "study"])
+def test_files_that_cannot_be_read_say_why(tmp_path, kind, load):
+    path = _weird_file(tmp_path, kind)
+    e, _ = refuse(load, path)
+    assert_clear(e, path, None, WEIRD[kind])
+
+
+@pytest.mark.parametrize("kind", ["loop", "fifo", "long"])
+def test_extends_of_a_file_that_cannot_be_read_says_why(tmp_path, kind):
+    target = _weird_file(tmp_path, kind)
+    path = tmp_path / "child.toml"
+    path.write_text(f'[scenario]\nname = "child"\nextends = "{target.name}"\n')
+    e, _ = refuse(load_scenario, path)
+    assert_clear(e, path, "scenario.extends")
+
+
+def test_a_folder_named_like_a_scenario_does_not_hide_it(tmp_path, monkeypatch):
+    # `testbed run michaelis_menten --out .` writes ./michaelis_menten/; the next
+    # `testbed run michaelis_menten` said "michaelis_menten: is a folder"
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "michaelis_menten").mkdir()
+    sc = load_scenario("michaelis_menten", check_cost=False)
+    assert sc.path == str(SCENARIO_DIR / "michaelis_menten.toml")
+
+
+#: A study with one family of one member over the shipped clamped beam, its rig table given.
+FAMILY_STUDY = ('[study]\nname = "x"\nnoise = [0.0]\nseeds = [0]\nidentifiers = ["ls_sindy"]\n'
+                '[families.beams]\nbase = "cantilever_stiff_impact"\nmembers = 1\n'
+                '[families.beams.rig]\n{rig}\n')
+
+#: (rig table, key the message names, fragment): a fixed value of the wrong type reached the
+#: cantilever rules' arithmetic before any validation (TypeError, ZeroDivisionError), a material
+#: that is a list or a distribution other than choices was unhashable or a KeyError, and a range
+#: near 1e308 m overflowed the Euler-Bernoulli estimate (OverflowError).
+FAMILY_CASES = [
+    ('length = "abc"', "families.beams.rig.length", "expected a number"),
+    ("width = [1]", "families.beams.rig.width", "expected a number"),
+    ("thickness = 0", "families.beams.rig.thickness", "expected a number > 0"),
+    ('n_segments = "ten"', "families.beams.rig.n_segments", "expected an integer"),
+    ('damping_ratio = ""', "families.beams.rig.damping_ratio", "expected a number"),
+    ("material = []", "families.beams.rig.material", "one of steel"),
+    ("material = {uniform = [1, 2]}", "families.beams.rig.material", "{choices = [names]}"),
+    ("material = {choices = [[1]]}", "families.beams.rig.material", "one of steel"),
+    ("length = {uniform = [1e300, 1e308]}", "families.beams", "leave float64"),
+]
+
+
+@pytest.mark.parametrize(("rig", "key", "fragment"), FAMILY_CASES, ids=[c[0] for c in FAMILY_CASES])
+def test_malformed_family_values_are_refused_clearly(tmp_path, rig, key, fragment):
+    path = tmp_path / "x.toml"
+    path.write_text(FAMILY_STUDY.format(rig=rig))
+    e, _ = refuse(load_study, path)
+    assert_clear(e, path, key, fragment)
+
+
+# ------------------------------------------------------------------------ round 3: data files
+def _mm_sep005(path: Path, **x_changes: object) -> Path:
+    """The Michaelis-Menten-like record of :func:`_mm_csv` as SEP-005, channel x changed."""
+    import numpy as np
+
+    t = np.arange(400) / 100.0
+    x = {"name": "x/x", "data": (0.2 + 1.8 * np.exp(-t)).tolist(), "fs": 100.0, "unit_str": "m"}
+    dx = {"name": "dx/dx", "data": (-1.8 * np.exp(-t)).tolist(), "fs": 100.0, "unit_str": "m/s"}
+    path.write_text(json.dumps([{**x, **x_changes}, dx]))
+    return path
+
+
+@pytest.mark.parametrize(("change", "fragment"), [
+    # JSON strings and booleans were read as numbers ("1" as 1.0, true as 1.0)
+    ({"data": ["1.5"] * 400}, "data are not numbers"),
+    ({"data": [True] * 400}, "data are not numbers"),
+    ({"data": [1.0, "2"] * 200}, "data are not numbers"),
+    # a number was read as the unit "5" (refused later for a rate "5/s")
+    ({"unit_str": 5}, "unit_str=5 is not a string"),
+], ids=["strings", "booleans", "mixed", "unit-number"])
+def test_sep005_values_that_are_not_numbers_are_refused(tmp_path, change, fragment):
+    from testbed.pipeline.importers import MeasuredDataError, read_measured
+
+    path = _mm_sep005(tmp_path / "x.json", **change)
+    with pytest.raises(MeasuredDataError, match=fragment) as e:
+        read_measured(path)
+    assert str(e.value).startswith(f"{path}: ") and "\n" not in str(e.value)
+
+
+def _toy_dataset_file(path: Path, x, fs: float = 100.0) -> Path:
+    """A dataset file holding ``x`` as its measured signal ``x`` and its rate ``fs``, the content
+    hash recomputed the way the testbed computes it (what a user's own writer would do)."""
+    import h5py
+    import numpy as np
+
+    from testbed.core.dataset import Dataset, Signal
+
+    n = 50
+    t = np.arange(n) / 100.0
+    Dataset(fs=100.0, measured={"x": Signal(np.exp(-t), ("x",), "m"),
+                                "dx": Signal(-np.exp(-t), ("x",), "m/s")},
+            reference={}, truth={}, truth_units={}, prior={},
+            attrs={"rig": "toy"}).save(path)
+    with h5py.File(path, "r+") as f:
+        if x is not None:
+            attrs = dict(f["measured/x"].attrs)
+            del f["measured/x"]
+            d = f.create_dataset("measured/x", data=x)
+            d.attrs.update(attrs)
+        f.attrs["fs"] = fs
+    if x is None:  # (the dtype and shape checks come before the hash's)
+        ds = Dataset.load(path, verify=False)
+        with h5py.File(path, "r+") as f:
+            f.attrs["content_hash"] = ds.content_hash()
+    return path
+
+
+@pytest.mark.parametrize(("x", "fs", "fragment"), [
+    # complex: the imaginary part was dropped with a ComplexWarning on stderr; strings were
+    # parsed as numbers; a 3-D array was read as one flat channel
+    ("complex", 100.0, "complex128 data of shape (1, 50); expected real numbers"),
+    ("strings", 100.0, "object data of shape (1, 50)"),
+    ("3d", 100.0, "float64 data of shape (1, 1, 50)"),
+    # a sample rate of 0 was a ZeroDivisionError, -100 Hz was fitted and written
+    (None, 0.0, "sample rate 0 Hz; expected a finite rate > 0 Hz"),
+    (None, -100.0, "sample rate -100 Hz"),
+    (None, math.nan, "sample rate nan Hz"),
+], ids=["complex", "strings", "3d", "fs0", "fs-100", "fsnan"])
+def test_dataset_files_of_other_numbers_are_refused(tmp_path, x, fs, fragment):
+    import h5py
+    import numpy as np
+
+    from testbed.pipeline.importers import MeasuredDataError, read_measured
+
+    t = np.exp(-np.arange(50) / 100.0)[None, :]
+    arrays = {"complex": t + 1j, "strings": np.array([[str(v) for v in t[0]]], dtype=h5py.string_dtype()),
+              "3d": t[None, ...], None: None}
+    path = _toy_dataset_file(tmp_path / "d.h5", arrays[x], fs)
+    with pytest.raises(MeasuredDataError) as e:
+        read_measured(path)
+    assert str(e.value).startswith(f"{path}: ") and fragment in str(e.value), str(e.value)
+
+
+@pytest.mark.parametrize("option", ["--param", "--prior"])
+def test_identify_refuses_a_key_given_twice(tmp_path, capsys, option):
+    # `--param ridge=0.1 --param ridge=0.2`: the last one silently won
+    from testbed.cli import EXIT_USAGE, main
+
+    path = _mm_csv(tmp_path / "mm.csv")
+    argv = ["identify", str(path), "--kind", "dynamical", "--method", "sindy_pi_dynamical",
+            option, "ridge=0.1", option, "ridge=0.2"]
+    assert main(argv) == EXIT_USAGE
+    err = capsys.readouterr().err
+    assert err == f"error: {option} 'ridge=0.2': ridge is given twice; give each key once\n"
