@@ -10,6 +10,41 @@ import pytest
 from benchmarks import sindy_pi_problems
 from identify import pysindy_pi
 from identify.pysindy_pi import PYSINDY_MAX_SAMPLES, PySINDyPI, stride_rule
+from models.cantilever.model import build_model
+from testbed.core.errors import ScenarioError
+from testbed.pipeline.scenario import scenario_from_dict
+
+
+def beam(rig=None, simulation=None, excitation=None):
+    return {"scenario": {"name": "t", "rig": "cantilever", "seed": 0}, "rig": rig or {},
+            "simulation": {"duration": 0.1, **(simulation or {})},
+            "excitation": {"type": "impact", **(excitation or {})}, "noise": {}}
+
+
+# ------------------------------------------- three sensors on one rigid segment: refused
+def test_three_sensors_on_one_segment_are_refused_at_load():
+    # the default beam's last segment spans 0.296333-0.3175 m: three accelerometers on it read
+    # dependent signals and the SEREP reduction is singular (was: an internal error in the
+    # scorer, "a mode shape has zero or negative modal mass", after the simulation and fit)
+    with pytest.raises(ScenarioError) as e:
+        scenario_from_dict(beam({"sensors": [0.30, 0.31, 0.3175]}), file="bad.toml")
+    msg = str(e.value)
+    assert "bad.toml" in msg and "rig.sensors" in msg and "[0.3, 0.31, 0.3175]" in msg
+    assert "segment 10 (0.296333-0.3175 m)" in msg and "at most 2" in msg
+    # a soft base's stub (0 to the first hinge) is a segment too
+    with pytest.raises(ScenarioError, match="segment 1 "):
+        scenario_from_dict(beam({"base": "soft", "sensors": [0.002, 0.005, 0.008, 0.3175]},
+                                excitation={"location": 0.3175}))
+
+
+@pytest.mark.parametrize("sensors", [[0.30, 0.3175], [0.2, 0.2963, 0.2964]])
+def test_two_sensors_on_a_segment_keep_a_regular_reduction(sensors):
+    # two sensors per segment (or across a hinge, 0.1 mm apart) stay allowed: the reduced
+    # mass matrix is positive definite (its smallest eigenvalue far above round-off)
+    sc = scenario_from_dict(beam({"sensors": sensors}, excitation={"location": sensors[-1]}))
+    mr = build_model(sc.rig_params, sc.simulation, sc.excitation).red.Mr
+    ev = np.linalg.eigvalsh(mr)
+    assert ev.min() > 1e-9 * ev.max()
 
 
 # ------------------------------------------- pysindy_pi at default settings finishes
