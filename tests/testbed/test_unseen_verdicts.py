@@ -99,3 +99,32 @@ def test_no_model_reason_tells_outweighed_from_absent_inputs():
     W[0, :, 3] = 0.0  # no model carries input 2 at all
     with pytest.raises(NoModelError, match="no model carries its terms"):
         select_models(_sweep(W), cols)
+
+
+# ------------------------------------------- a rollout bar that a model at rest meets is no pass
+def test_uninformative_bar_is_a_named_failure():
+    from testbed.scoring.scorers import FAIL, Scores, uninformative_failures, verdict
+    s = Scores({"angle_rmse": 7.8e-10}, {"angle_rmse_rest": np.array([3e-7, 1e-7])})
+    why = uninformative_failures(s, {"angle_rmse": {"max": 0.0501}})
+    assert set(why) == {"uninformative"} and "angle_rmse 3e-07, within the bar 0.0501" in why[
+        "uninformative"]
+    assert verdict([], why) == FAIL
+    # a motion larger than the bar, a NaN baseline, a bar on another metric: nothing to say
+    big = Scores({"angle_rmse": 1e-3}, {"angle_rmse_rest": np.array([0.2, 0.01])})
+    assert uninformative_failures(big, {"angle_rmse": {"max": 0.0501}}) == {}
+    nan = Scores({}, {"angle_rmse_rest": np.array([np.nan])})
+    assert uninformative_failures(nan, {"angle_rmse": {"max": 0.0501}}) == {}
+    assert uninformative_failures(s, {"coef_error": {"max": 0.01}}) == {}
+
+
+@pytest.mark.parametrize("x0, uninformative", [(0.2, True), (2.0, False)])
+def test_kinetics_started_at_steady_state_cannot_pass(x0, uninformative):
+    # x* = jx Km / (Vmax - jx) = 0.2 mM: started there, the state never moves, and any model
+    # with that fixed point met state_rmse <= 0.01 (mm_x0_steady); started at 2 mM it moves
+    from testbed.pipeline.scenario import load_scenario
+    from testbed.scoring.run import run_scenario
+    sc = load_scenario("michaelis_menten")
+    sc = sc.replace(rig_params={**sc.rig_params, "x0": x0}, score={"state_rmse": {"max": 0.01}})
+    r = run_scenario(sc)
+    assert ("uninformative" in r.scores.failures) is uninformative
+    assert r.passed is not uninformative
