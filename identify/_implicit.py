@@ -338,6 +338,45 @@ def rank_models(sw: Sweep, elig: np.ndarray, rtol: float, atol: float) -> np.nda
     return order[np.isfinite(flat_err[order])]
 
 
+def no_model_reason(sw: Sweep, shares: np.ndarray, k: int) -> str:
+    """Why no model of the sweep is eligible for input ``k`` (0-based), for the error.
+
+    Three cases, told apart: no model carries the input's terms at all (the library lacks them,
+    or the input is zero); some do, but another input's terms outweigh them in every one (the
+    record does not separate the inputs: too short, or too little excited); or every model
+    carrying it has a non-finite held-out error.
+
+    Parameters
+    ----------
+    sw : Sweep
+    shares : ndarray, shape (n_inputs, T, C)
+        :func:`input_shares` of ``sw.W``.
+    k : int
+        The input.
+
+    Returns
+    -------
+    str
+    """
+    head = f"no implicit model contains input {k + 1} as its dominant input"
+    has = shares[k] > 0
+    n_has = int(np.count_nonzero(has))
+    if n_has == 0:
+        return f"{head}: no model carries its terms (the library lacks them, or the input is zero)"
+    others = np.delete(shares, k, axis=0)
+    dominant = has & (shares[k] > (others.max(axis=0) if others.size else 0.0))
+    if not dominant.any():
+        share_k, share_o = shares[k][has], others.max(axis=0)[has]
+        j = int(np.argmax(np.bincount(np.argmax(others[:, has], axis=0), minlength=len(others))))
+        j += j >= k  # index among all inputs
+        return (f"{head}: {n_has} of {has.size} models carry its terms, but another input's "
+                f"outweigh them in every one (largest share of input {k + 1} / of the others: "
+                f"{np.max(share_k / np.maximum(share_o, 1e-300)):.3g}; most often input {j + 1}): "
+                "the record does not separate the inputs (too short, or too little excited)")
+    return (f"{head}: the {int(np.count_nonzero(dominant))} models where it dominates have no "
+            "finite held-out error")
+
+
 def select_models(sw: Sweep, input_cols: Sequence[np.ndarray], rtol: float = 0.1,
                   atol: float = 1e-12, top: int = 1) -> list[list[tuple[int, int]]]:
     """Pick the implicit equation of each input by held-out error, then parsimony.
@@ -372,8 +411,7 @@ def select_models(sw: Sweep, input_cols: Sequence[np.ndarray], rtol: float = 0.1
         other = others.max(axis=0) if others.size else np.zeros_like(shares[k])
         order = rank_models(sw, (shares[k] > 0) & (shares[k] > other), rtol, atol)
         if order.size == 0:
-            raise NoModelError(f"no implicit model contains input {k + 1} as its dominant "
-                                      "input: the library lacks its terms or the input is zero")
+            raise NoModelError(no_model_reason(sw, shares, k))
         picked: list[tuple[int, int]] = []
         seen: set[bytes] = set()
         for flat in order:

@@ -25,8 +25,14 @@ import numpy as np
 
 from models import RIGS
 from models._base import ErrorFn, Rig, check_two_samples
-from models.cantilever.beam import BeamParams
-from models.cantilever.model import CantileverModel, build_model, hit_position, sensor_positions
+from models.cantilever.beam import BeamParams, body_of
+from models.cantilever.model import (
+    CantileverModel,
+    beam_params,
+    build_model,
+    hit_position,
+    sensor_positions,
+)
 from models.cantilever.simulate import (
     IMPLICIT_ACCURACY,
     MUJOCO_MAX_CONTROL,
@@ -49,6 +55,14 @@ LOG = logging.getLogger(__name__)
 #: the force onto the sensor it hits, because a model in sensor coordinates cannot place a
 #: force between sensors.
 HIT_SENSOR_TOLERANCE_M = 1e-3
+
+#: Most accelerometers one rigid segment of the chain may carry: a rigid body moving in the
+#: plane has two degrees of freedom (the translation and rotation of its hinge), so the
+#: readings of a third sensor on it are a fixed combination of the other two, the sensor rows
+#: of the mode shapes are dependent and the SEREP reduction at the sensors is singular
+#: (measured: sensors 0.30, 0.31, 0.3175 m on the default beam's last segment gave a reduced
+#: mass matrix with a zero eigenvalue and the scorer stopped with an internal error).
+MAX_SENSORS_PER_SEGMENT = 2
 
 #: Memory per integration step [bytes]: the hammer force is built for every step before the
 #: rollout (the step times, the phase, its clip and the force: about five float64 arrays).
@@ -177,6 +191,40 @@ def _root_hinge(rig: dict[str, Any]) -> float:
     return rig["joint_offset"] * rig["length"] / rig["n_segments"]
 
 
+def _check_sensors_per_segment(rig: dict[str, Any], sensors: list[float], x0: float,
+                               error: ErrorFn) -> None:
+    """Refuse more than :data:`MAX_SENSORS_PER_SEGMENT` sensors on one rigid segment.
+
+    Parameters
+    ----------
+    rig : dict
+        Validated ``[rig]`` table.
+    sensors : list of float
+        The given sensor positions [m] (the default L/3, 2L/3, L lie on three segments).
+    x0 : float
+        Position of the root hinge [m]; sensors inboard of it are refused elsewhere.
+    error : callable
+        The scenario's error reporter (key, value, what is allowed).
+    """
+    on_beam = [s for s in sensors if x0 < s <= rig["length"]]
+    if len(on_beam) <= MAX_SENSORS_PER_SEGMENT:
+        return
+    params = beam_params(rig)
+    xs, _ = params.hinges()
+    bodies = [body_of(params, s)[0] for s in on_beam]
+    for b in sorted(set(bodies)):
+        held = [s for s, i in zip(on_beam, bodies, strict=True) if i == b]
+        if len(held) > MAX_SENSORS_PER_SEGMENT:
+            end = xs[b + 1] if b + 1 < len(xs) else rig["length"]
+            error("rig.sensors", sensors,
+                  f"allowed: at most {MAX_SENSORS_PER_SEGMENT} sensors on one rigid segment; "
+                  f"{', '.join(f'{s:.6g}' for s in held)} m all lie on segment {b + 1} "
+                  f"({xs[b]:.6g}-{end:.6g} m), whose plane motion has 2 degrees of freedom: "
+                  "their readings are linearly dependent and the reduction at the sensors "
+                  "(SEREP) is singular")
+            return
+
+
 @RIGS.register("cantilever", tags=("structural", "mujoco", "beam"))
 class CantileverRig(Rig):
     """Steel cantilever (hinge chain in MuJoCo) under a hammer impact.  See the module docs."""
@@ -204,6 +252,7 @@ class CantileverRig(Rig):
         if len(set(sensors)) != len(sensors):
             error("rig.sensors", sensors, "allowed: distinct positions (one accelerometer each)")
         n_dof = rig["n_segments"] + (rig["base"] == "soft")
+        _check_sensors_per_segment(rig, sensors, x0, error)
         if len(sensor_positions(rig)) > n_dof:
             error("rig.sensors", sensors, f"allowed: at most {n_dof} sensors (the model's degrees "
                                           "of freedom, for the SEREP reduction)")

@@ -18,7 +18,7 @@ from testbed.pipeline.cache import DatasetCache
 from testbed.pipeline.scenario import Scenario, load_scenario
 from testbed.pipeline.signal_chain import measure
 from testbed.scoring import run as _run
-from testbed.scoring.scorers import Scores, score
+from testbed.scoring.scorers import Scores, score, uninformative_failures
 
 
 def _scenario(scenario: Scenario | str | os.PathLike) -> Scenario:
@@ -53,7 +53,9 @@ def score_model(model: Any, dataset: Dataset, scenario: Scenario | str | os.Path
     kind = plugins.rig_kind(sc.rig)
     data = measure(dataset, sc.signal, kind)
     clean = measure(_run.noise_free(dataset), sc.signal, kind)
-    return score(kind, dataset, data, clean, model)
+    scores = score(kind, dataset, data, clean, model)
+    scores.failures.update(uninformative_failures(scores, sc.score))  # as run_scenario
+    return scores
 
 
 def run_scenario(scenario: Scenario | str | os.PathLike, *, model: Any = None,

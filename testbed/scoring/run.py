@@ -21,7 +21,16 @@ from testbed.pipeline.fit import fit_or_fail
 from testbed.pipeline.generate import generate
 from testbed.pipeline.scenario import Scenario
 from testbed.pipeline.signal_chain import measure
-from testbed.scoring.scorers import PASS, Check, Scores, check_thresholds, failed_scores, score, verdict
+from testbed.scoring.scorers import (
+    PASS,
+    Check,
+    Scores,
+    check_thresholds,
+    failed_scores,
+    score,
+    uninformative_failures,
+    verdict,
+)
 
 
 @dataclass
@@ -149,6 +158,7 @@ def run_scenario(scenario: Scenario, *, cache: DatasetCache | None = None,
     if scores is None:
         with phase("score"):
             scores = score(kind, dataset, data, clean, model)
+            scores.failures.update(uninformative_failures(scores, scenario.score))
     return RunResult(scenario, dataset, data, model, scores,
                      check_thresholds(scores.values, scenario.score), fit_time)
 

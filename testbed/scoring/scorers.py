@@ -102,7 +102,9 @@ class Scores:
         raised), ``"simulation"`` (diverged, blew up, or lost its loop closure; with the time
         where known), ``"mass"`` (M not symmetric positive definite), ``"damping"`` (negative
         damping), ``"stability"`` (a pole in the right half-plane), ``"model"`` (non-finite
-        learned values).  Empty for a physically admissible model whose simulation ran.
+        learned values), ``"uninformative"`` (a rollout bar a model that never moves meets:
+        :func:`uninformative_failures`).  Empty for a physically admissible model whose
+        simulation ran.
     """
 
     values: dict[str, float]
@@ -131,6 +133,46 @@ def check_thresholds(values: dict[str, float], thresholds: dict[str, dict[str, f
     """Compare scores with ``{metric: {"min"|"max": threshold}}``; a missing score fails."""
     return [Check(m, float(values.get(m, np.nan)), b, t)
             for m, bounds in sorted(thresholds.items()) for b, t in sorted(bounds.items())]
+
+
+#: Rollout scores with a rest baseline (``details[score + "_rest"]``, per coordinate: the RMSE
+#: of a model that stays at the true initial state; :func:`implicit_rollout`).
+REST_BASELINES = ("angle_rmse", "state_rmse")
+
+
+def uninformative_failures(scores: Scores, thresholds: dict[str, dict[str, float]]
+                           ) -> dict[str, str]:
+    """A rollout bar that a model which never moves would meet: ``{"uninformative": reason}``.
+
+    The bar of :data:`REST_BASELINES` is absolute; on a record whose motion is smaller than
+    the bar (a 1e-6 N m torque, a state that starts at its steady state) any model that does
+    not diverge meets it, so meeting it is no pass.  Measured: a five-bar under 1e-6 N m tones
+    passed ``angle_rmse <= 0.0501`` at 7.8e-10 rad with wrong equations (coef_error 3.7).
+
+    Parameters
+    ----------
+    scores : Scores
+        With the rest baselines in ``details`` (other kinds: nothing to check).
+    thresholds : dict
+        The run's bars, ``{metric: {"min"|"max": value}}``.
+
+    Returns
+    -------
+    dict of str to str
+        Empty, or the reason naming the metric, the rest model's score and the bar.
+    """
+    for m in REST_BASELINES:
+        bar = thresholds.get(m, {}).get("max")
+        rest = scores.details.get(f"{m}_rest")
+        if bar is None or rest is None:
+            continue
+        r = worst(rest, "max")
+        if np.isfinite(r) and r <= bar:
+            return {"uninformative": (
+                f"uninformative: a model that never leaves the initial state scores {m} "
+                f"{r:.3g}, within the bar {bar:g}: this record's motion cannot tell a model "
+                "from rest")}
+    return {}
 
 
 def failed_scores(kind: str, reason: str, key: str = "fit") -> Scores:
@@ -539,6 +581,9 @@ def implicit_rollout(score: str, model: Any, data: Measurement, x0: np.ndarray,
     rmse = (metrics.rmse(reference_x, d["simulated_x"]) if sim is not None and "simulation" not in failures
             else np.full(reference_x.shape[0], np.nan))
     d[score] = rmse
+    # the model that never leaves the initial state: a bar it meets cannot tell a model from rest
+    d[f"{score}_rest"] = metrics.rmse(reference_x, np.broadcast_to(
+        np.asarray(x0, dtype=float)[:, None], reference_x.shape))
     return coef, {score: worst(rmse, "max")}, failures, d
 
 
