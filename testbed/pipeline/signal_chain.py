@@ -552,10 +552,17 @@ def auto_cutoff(theta: np.ndarray, fs: float, order: int, noise: np.ndarray | No
 EDGE_FIT_PERIODS = 1.6
 #: The two end fits take at most this share of the record each (they must not overlap).
 EDGE_FIT_MAX_SHARE = 0.25
+#: ... and at least this many samples per coefficient of their polynomial: a least-squares fit
+#: needs more samples than coefficients to average its noise at all.  It binds only where the
+#: automatic cut-off runs up to the Nyquist frequency, i.e. where the noise hides the motion
+#: (a five-bar at 50 % angle noise: cut-off 4.5 kHz, 1.6 periods = 4 samples for 6
+#: coefficients, which the fit cannot take); the run then goes on to a scored verdict.
+EDGE_FIT_MIN_SAMPLES_PER_COEF = 2
 
 
-def auto_edge_fit(cutoff_hz: float, fs: float, n_samples: int) -> float:
-    """``edge_fit_s = "auto"``: ``EDGE_FIT_PERIODS / cutoff_hz``, at most
+def auto_edge_fit(cutoff_hz: float, fs: float, n_samples: int, edge_fit_order: int = 5) -> float:
+    """``edge_fit_s = "auto"``: ``EDGE_FIT_PERIODS / cutoff_hz``, at least
+    ``EDGE_FIT_MIN_SAMPLES_PER_COEF`` samples per polynomial coefficient, at most
     ``EDGE_FIT_MAX_SHARE`` of the record.
 
     Parameters
@@ -566,13 +573,16 @@ def auto_edge_fit(cutoff_hz: float, fs: float, n_samples: int) -> float:
         Sample rate [Hz].
     n_samples : int
         Samples in the record.
+    edge_fit_order : int
+        Order of the end fits' polynomial.
 
     Returns
     -------
     float
         Length of each end fit [s].
     """
-    return min(EDGE_FIT_PERIODS / cutoff_hz, EDGE_FIT_MAX_SHARE * n_samples / fs)
+    floor = EDGE_FIT_MIN_SAMPLES_PER_COEF * (edge_fit_order + 1) / fs
+    return min(max(EDGE_FIT_PERIODS / cutoff_hz, floor), EDGE_FIT_MAX_SHARE * n_samples / fs)
 
 
 def measure_mechanical(dataset: Dataset, cfg: Mapping[str, Any]) -> Measurement:
@@ -638,7 +648,7 @@ def measure_mechanical(dataset: Dataset, cfg: Mapping[str, Any]) -> Measurement:
             cut = auto_cutoff(theta, fs, cfg["filter_order"], noise)
         edge = cfg["edge_fit_s"]
         if edge == "auto":
-            edge = auto_edge_fit(cut, fs, theta.shape[1])
+            edge = auto_edge_fit(cut, fs, theta.shape[1], cfg["edge_fit_order"])
         x, xd, xdd = derivatives.lowpass_differentiate(theta, fs, cut, cfg["filter_order"],
                                                        edge, cfg["edge_fit_order"])
         passband = (0.0, float(cut))

@@ -94,3 +94,24 @@ def test_auto_edge_fit_spans_the_stated_periods_of_the_cutoff():
     np.testing.assert_array_equal(m01.xd, der.lowpass_differentiate(raw, ds.fs, 5.0, 8, 0.1, 5)[1])
     # a low cut-off on a short record: at most a quarter of it (4 s here)
     assert auto_edge_fit(0.2, ds.fs, raw.shape[1]) == pytest.approx(EDGE_FIT_MAX_SHARE * 4.0)
+
+
+def test_auto_edge_fit_keeps_more_samples_than_coefficients_when_noise_hides_the_motion():
+    """At 50 % angle noise the automatic cut-off runs up to 0.45 fs and 1.6 of its periods were
+    4 samples for a quintic's 6 coefficients: an internal error in the run.  The floor keeps
+    2 samples per coefficient and the run ends in a scored verdict."""
+    from testbed.pipeline.signal_chain import (
+        AUTO_CUTOFF_MAX_SHARE,
+        EDGE_FIT_MIN_SAMPLES_PER_COEF,
+        auto_cutoff,
+        auto_edge_fit,
+    )
+
+    ds = dataset(0.5)
+    raw = ds.measured["theta"].data
+    cut = auto_cutoff(raw, ds.fs, 8)
+    assert cut == pytest.approx(AUTO_CUTOFF_MAX_SHARE * ds.fs)  # the noise hides the motion
+    edge = auto_edge_fit(cut, ds.fs, raw.shape[1], 5)
+    assert round(edge * ds.fs) == EDGE_FIT_MIN_SAMPLES_PER_COEF * 6
+    m = measure(ds, {"derivatives": "lowpass"}, "mechanical")  # cut-off and edge "auto"
+    assert np.all(np.isfinite(m.xd)) and np.all(np.isfinite(m.xdd))
