@@ -45,8 +45,10 @@ MIN_WINDOW_SAMPLES = 3
 
 
 def window_samples(window_s: float, fs: float) -> int:
-    """Samples a test-function window of ``window_s`` [s] spans at ``fs`` [Hz], both ends in."""
-    return round(window_s * fs) + 1
+    """Samples a test-function window of ``window_s`` [s] spans at ``fs`` [Hz], both ends in
+    (a window too long for any record, ``1e308`` s, counts ``2**62`` samples: no overflow)."""
+    steps = window_s * fs
+    return round(steps) + 1 if steps < 2.0**62 else 2**62
 
 
 def check_window(window_s: float, fs: float, n_samples: int, error: ErrorFn) -> None:

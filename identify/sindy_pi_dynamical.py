@@ -471,7 +471,7 @@ class SINDyPIDynamical(Identifier):
                          n_samples: int, error: ErrorFn) -> None:
         rows, what = n_samples, "samples"
         if params["formulation"] == "weak":
-            span = n_samples - round(params["weak_window_s"] * fs)
+            span = n_samples - (window_samples(params["weak_window_s"], fs) - 1)
             rows, what = min(params["weak_windows"], max(span, 0)), "test-function windows"
         n_fit = round(rows * (1.0 - params["val_fraction"]))
         if rows >= 1 and (n_fit < 2 or rows - n_fit < 2):  # identify._implicit.split_index's rule
