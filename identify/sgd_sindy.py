@@ -79,6 +79,8 @@ from identify.structural import (
 from testbed.core.errors import IdentificationError, TestbedError
 from testbed.core.measurement import Measurement
 from testbed.core.schema import ErrorFn, Field
+from testbed.numerics.initial_state import fit_initial_state
+from testbed.numerics.shapes import trac
 
 #: Adam step [standardised units] on the linear library: Table 1's.
 LR_LINEAR = 1.5e-4
@@ -108,9 +110,9 @@ def record_agreement(model: StructuralIdentifier, data: Measurement) -> float:
 
     The model is simulated from ``data.free_start`` to the record's end under the measured
     input, from the start whose accelerations best match the measured ones (least squares,
-    :func:`testbed.scoring.initial_state.fit_initial_state`, from the measured state: the
-    chain's integration constants are not the model's error), and compared with the measured
-    accelerations ``data.xdd`` by TRAC per channel (:func:`testbed.scoring.metrics.trac`).
+    :func:`testbed.numerics.initial_state.fit_initial_state`, the scorer's, from the measured
+    state: the chain's integration constants are not the model's error), and compared with
+    the measured accelerations ``data.xdd`` by TRAC per channel (:func:`testbed.numerics.shapes.trac`).
     Only the measured record enters, never the truth.
 
     Parameters
@@ -126,9 +128,6 @@ def record_agreement(model: StructuralIdentifier, data: Measurement) -> float:
         The smallest channel's TRAC in [0, 1]; NaN when the simulation fails or is not finite
         (a diverging model).
     """
-    from testbed.scoring.initial_state import fit_initial_state  # lazy: scoring imports scipy
-    from testbed.scoring.metrics import trac
-
     i0 = int(data.free_start)
     t = np.arange(data.n_samples - i0) / float(data.fs)
     u = None if data.u is None or model.input_map_ is None else data.u[:, i0:]
