@@ -14,7 +14,7 @@ import pytest
 
 from benchmarks import bench_sgd_sindy as bench
 from identify import IDENTIFIERS
-from identify.sgd_sindy import SGD_AGREEMENT_RATIO, SGDSINDy, keep_sgd_rule
+from identify.sgd_sindy import SGD_AGREEMENT_FLOOR, SGD_AGREEMENT_RATIO, SGDSINDy, keep_sgd_rule
 from identify.sgd_sindy_coefficients import SGDSINDyCoefficients
 from identify.structural import modal
 from testbed.scoring.metrics import mac_matrix, pair_modes, trac
@@ -166,12 +166,14 @@ def test_tilt_falls_back_to_flat_when_non_physical(linear, monkeypatch):
 
 def test_keep_sgd_rule():
     """The SGD's result is replaced only when it leaves more than SGD_AGREEMENT_RATIO x the warm
-    start's unexplained share of the record, or its simulation fails where the warm start's
-    does not; with both failing the SGD's failure is kept (and scored as one)."""
+    start's unexplained share of the record and more than SGD_AGREEMENT_FLOOR, or its
+    simulation fails where the warm start's does not; with both failing the SGD's failure is
+    kept (and scored as one)."""
     r = SGD_AGREEMENT_RATIO
-    assert keep_sgd_rule(0.99, 0.995)[0]  # 2x the share: kept (the boundary counts as kept)
-    assert keep_sgd_rule(1.0 - 0.005 * r, 0.995)[0]
-    assert not keep_sgd_rule(1.0 - 0.0051 * r, 0.995)[0]
+    assert keep_sgd_rule(1.0 - 0.0099 * r, 0.99)[0]  # within r x the warm start's share: kept
+    assert not keep_sgd_rule(1.0 - 0.0101 * r, 0.99)[0]
+    f = SGD_AGREEMENT_FLOOR  # at most 1 % unexplained: kept whatever the ratio
+    assert keep_sgd_rule(1.0 - 0.99 * f, 1.0 - 1e-9)[0] and not keep_sgd_rule(1.0 - 1.01 * f, 1.0 - 1e-9)[0]
     assert keep_sgd_rule(0.999, 0.9)[0]  # better than the warm start
     assert not keep_sgd_rule(float("nan"), 0.9)[0]
     assert keep_sgd_rule(0.5, float("nan"))[0] and keep_sgd_rule(float("nan"), float("nan"))[0]
