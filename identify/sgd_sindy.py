@@ -751,7 +751,8 @@ class SGDSINDy(SGDSINDyBase):
         "keep_sgd": Field(bool, None, doc="keep the SGD's result (True) or the held warm "
                                           "start's (False); default by rule: the SGD's unless "
                                           "its simulated response leaves more than twice the "
-                                          "warm start's unexplained share of the record"),
+                                          "warm start's unexplained share of the record, and "
+                                          "more than 1 %"),
     }
 
     @classmethod
