@@ -54,8 +54,8 @@ def _cost(traj: Trajectory, field: str, ref: np.ndarray) -> float:
 
 
 def fit_initial_state(simulate: Callable[[np.ndarray, np.ndarray], Trajectory], x0: np.ndarray,
-                      xd0: np.ndarray, ref: np.ndarray, field: str = "xdd"
-                      ) -> tuple[np.ndarray, np.ndarray]:
+                      xd0: np.ndarray, ref: np.ndarray, field: str = "xdd",
+                      max_iterations: int = MAX_ITERATIONS) -> tuple[np.ndarray, np.ndarray]:
     """The start ``(x0, xd0)`` whose simulated response best matches ``ref``.
 
     Parameters
@@ -69,6 +69,9 @@ def fit_initial_state(simulate: Callable[[np.ndarray, np.ndarray], Trajectory], 
         The reference of ``field`` over the window.
     field : {"x", "xd", "xdd"}
         The trajectory field compared.
+    max_iterations : int
+        Gauss-Newton iterations at most (each costs ``2 n + 1`` simulations); one is exact
+        for a linear model.
 
     Returns
     -------
@@ -90,7 +93,7 @@ def fit_initial_state(simulate: Callable[[np.ndarray, np.ndarray], Trajectory], 
             cost = _cost(base, field, ref)
             if not np.isfinite(cost):
                 return x0, xd0
-            for _ in range(MAX_ITERATIONS):
+            for _ in range(max_iterations):
                 y0 = getattr(base, field)
                 jac = np.empty((y0.size, 2 * n))
                 for k in range(2 * n):
