@@ -124,7 +124,8 @@ FLOOR_CHECK_ITERATIONS = 1
 
 
 def record_agreement(model: StructuralIdentifier, data: Measurement,
-                     iterations: int = MAX_ITERATIONS) -> tuple[float, str]:
+                     iterations: int = MAX_ITERATIONS,
+                     sims: dict[bytes, Trajectory] | None = None) -> tuple[float, str]:
     """How well a fitted model's simulated response reproduces the measured record [-].
 
     The model is simulated from ``data.free_start`` to the record's end under the measured
@@ -150,6 +151,10 @@ def record_agreement(model: StructuralIdentifier, data: Measurement,
         The record it was fitted on.
     iterations : int
         Gauss-Newton iterations of the start fit at most (default the scorer's).
+    sims : dict, optional
+        The model's simulations over this record by start (``(x0, xd0)``'s bytes), filled
+        here; pass the same dict to a second call on the same model and record (more
+        iterations): its first iteration is then read, not simulated again.
 
     Returns
     -------
@@ -171,16 +176,15 @@ def record_agreement(model: StructuralIdentifier, data: Measurement,
     t = np.arange(data.n_samples - i0) * dt
     u = None if data.u is None or model.input_map_ is None else data.u[:, i0:]
     ref = np.asarray(data.xdd, dtype=float)[:, i0:]
-    last: dict[bytes, Trajectory] = {}
+    sims = {} if sims is None else sims
 
     def simulate(x0: np.ndarray, xd0: np.ndarray) -> Trajectory:
-        """The model's response from ``(x0, xd0)``; the start fit's last accepted iterate is
-        the fitted start, so its simulation is kept rather than run again."""
+        """The model's response from ``(x0, xd0)``, each start simulated once (the fitted start
+        is the start fit's last accepted iterate)."""
         key = np.concatenate([x0, xd0]).tobytes()
-        if key not in last:
-            last.clear()
-            last[key] = model.simulate(x0, xd0, t, u)
-        return last[key]
+        if key not in sims:
+            sims[key] = model.simulate(x0, xd0, t, u)
+        return sims[key]
 
     try:
         with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
@@ -532,12 +536,13 @@ class SGDSINDy(SGDSINDyBase):
     keep_sgd : bool or None
         None (default): by rule (:func:`keep_sgd_rule`), the SGD's result unless its own
         simulation reproduces the measured record (:func:`record_agreement`) with more than
-        :data:`SGD_AGREEMENT_RATIO` x the unexplained share of the held warm start's (the same
-        fit with ``epochs=0``, holds included) and more than :data:`SGD_AGREEMENT_FLOOR`, or
-        fails where the warm start's does not; then
-        the held warm start's.  Acts only with ``init="lstsq"`` and ``epochs`` > 0.  True: the
-        SGD's result; False: the held warm start's (no SGD is run).  ``keep_sgd_`` and
-        ``keep_sgd_rule_`` say which and why; see Notes.
+        :data:`SGD_AGREEMENT_RATIO` x the unexplained share of the held warm start's (the state
+        the SGD started from, finished as with ``epochs=0``, holds included) and more than
+        :data:`SGD_AGREEMENT_FLOOR`, or has no agreement (not simulated, or its simulation
+        fails) where the warm start's has one; then the held warm start's.  Acts only with
+        ``init="lstsq"`` and ``epochs`` > 0.  True: the SGD's result; False: the held warm
+        start's (no SGD is run).  ``keep_sgd_`` and ``keep_sgd_rule_`` say which and why; see
+        Notes.
 
     Notes
     -----
@@ -725,9 +730,9 @@ class SGDSINDy(SGDSINDyBase):
         Whether the model is the SGD's result (False: the held warm start's);
         ``keep_sgd_rule_`` (str) says why, with both record agreements.
     record_agreement_ : dict of str to float
-        Only when the rule compared them: :func:`record_agreement` of the SGD's result
-        (``"sgd"``) and of the held warm start's (``"warm_start"``) [-]; NaN = its simulation
-        failed.
+        Only when the rule decided: :func:`record_agreement` of the SGD's result (``"sgd"``)
+        and, when it was needed, of the held warm start's (``"warm_start"``) [-]; NaN = not
+        simulated or its simulation failed (``keep_sgd_rule_`` says which).
     learning_rate_ : float
         The step size used; ``learning_rate_rule_`` (str) says where it came from.
     decay_rule_ : str
@@ -925,13 +930,15 @@ class SGDSINDy(SGDSINDyBase):
         # its result is kept only where its own simulation reproduces the measured record about
         # as well as the held warm start's (keep_sgd_rule); the warm start is the state the
         # SGD started from (fit_matrix_sgd's ``warm``), not fitted again
-        a_sgd, note_sgd = record_agreement(self, data, FLOOR_CHECK_ITERATIONS)
+        sims: dict[bytes, Trajectory] = {}
+        a_sgd, note_sgd = record_agreement(self, data, FLOOR_CHECK_ITERATIONS, sims)
         if a_sgd >= 1.0 - SGD_AGREEMENT_FLOOR:  # kept whatever the warm start's
             self.record_agreement_ = {"sgd": a_sgd}
             self.keep_sgd_, self.keep_sgd_rule_ = keep_sgd_rule(
                 a_sgd, None, (f"start fit of {FLOOR_CHECK_ITERATIONS} iteration", ""))
             return self
-        a_sgd, note_sgd = record_agreement(self, data)
+        a_sgd, note_sgd = record_agreement(self, data, sims=sims)
+        sims.clear()
         sgd = dict(self.__dict__)
         self.__dict__.clear()
         self.__dict__.update(started)

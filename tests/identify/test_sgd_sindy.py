@@ -207,6 +207,21 @@ def test_record_agreement_refuses_a_cubic_model_with_an_unresolved_pole(cubic_fi
     assert np.any(duff.K3_ != 0.0)
     a, note = record_agreement(duff, data)
     assert a > 0.99 and note == ""  # measured 0.99994
+    # a second call on the same model and record reads the first's simulations
+    counted = copy.copy(duff)
+    calls = []
+
+    def simulate(*args):
+        calls.append(1)
+        return duff.simulate(*args)
+
+    counted.simulate = simulate
+    sims = {}
+    record_agreement(counted, data, 1, sims)
+    first = len(calls)  # 1 + (2 n + 1) for the iteration; the fitted start is its trial
+    assert first == 1 + 2 * 3 + 1 and len(sims) == first
+    assert record_agreement(counted, data, sims=sims) == (a, note)  # the same number
+    assert len(calls) - first == len(sims) - first < first + 2 * (2 * 3 + 1)
     stiff = copy.copy(duff)
     stiff.C_ = duff.C_ + 1e3 * RK4_STABILITY_BOUND * data.fs * duff.M_  # poles near -2785 fs
     assert sample_rate_pole(stiff.M_, stiff.C_, stiff.K_, 1.0 / data.fs) > RK4_STABILITY_BOUND
