@@ -103,6 +103,7 @@ second-moment matrix in O(n^3), whatever the window's length.
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any, Literal
@@ -630,6 +631,9 @@ class MatrixSGDResult:
         the driving point (:func:`identify.structural.driving_point_scaling`).
     backbone_rule : str
         What ``eigen_backbone`` did (:func:`backbone_targets`).
+    warm : MatrixSGDResult or None
+        With ``with_warm``: the held warm start, the result ``epochs = 0`` gives (bit for bit;
+        ``n_steps`` 0, ``history`` the first row); else None.
     """
 
     M: np.ndarray
@@ -648,6 +652,7 @@ class MatrixSGDResult:
     fit_tilt_rule: str = ""
     input_map_record: np.ndarray | None = None
     backbone_rule: str = ""
+    warm: MatrixSGDResult | None = None
 
 
 def _kept_cubic(K3: np.ndarray | None) -> bool:
@@ -668,7 +673,7 @@ def fit_window(data: Measurement, fit_duration: float) -> tuple[int, int]:
 def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
                    lam_hat: np.ndarray,
                    progress: Callable[[float | None, str | None], None] | None = None,
-                   peaks: np.ndarray | None = None) -> MatrixSGDResult:
+                   peaks: np.ndarray | None = None, with_warm: bool = False) -> MatrixSGDResult:
     """Run the matrix-parametrised SGD.
 
     Parameters
@@ -687,6 +692,10 @@ def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
     peaks : ndarray, optional
         ``modal_peaks(data).peaks`` [Hz] for the fit band's cut-off if the caller has them
         (:func:`identify.structural.fit_band_cutoff`; not searched again).
+    with_warm : bool
+        Also return the held warm start (``MatrixSGDResult.warm``): the state the epochs start
+        from, finished (hold, projection, nuisance coefficients) exactly as with ``epochs = 0``,
+        without fitting it again.  Only with ``init = "lstsq"`` and ``epochs > 0``.
 
     Returns
     -------
@@ -899,9 +908,12 @@ def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
     # (eigen_targets) every epoch; the result's paired eigenvalues are then moved into their
     # peaks' bands (hold_eigenvalues).  Only the result: holding every epoch fought the data
     # loss along the flat modal-mass directions (stiff beam: Mr error 0.07 -> 0.32, measured).
-    held = 0.0
     record(0, 0)
     n_steps = 0
+    # the held warm start: the state the epochs start from, finished as epochs = 0 would
+    # (copies: the steps, the hold and the projections work in place)
+    warm = ((L.copy(), P.copy(), Q.copy(), R.copy(), target.copy()), dict(guard), dict(alpha)
+            ) if with_warm and est.init == "lstsq" and int(est.epochs) > 0 else None
     no_support = np.zeros((n, n))
     # Iterate averaging (Polyak-Ruppert) over the last ``iterate_average`` of the epochs, and
     # never before the debiasing stage starts: Adam's steps leave the last iterate jittering
@@ -952,46 +964,69 @@ def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
     if n_acc:
         LLt, P, Q, R = (a_ / n_acc for a_ in acc)
         L = np.linalg.cholesky(_sym(LLt))
-    if hold:
-        target = eigen_targets(m0 * (L @ L.T), k0 * _sym(P), lam_meas, True)
-        held = hold_eigenvalues(L, P, m0, k0, target, band)
-    if hold and np.any(moved) and not np.any(R != 0.0):
-        # the cubic was dropped: a linear model at the linear frequencies oscillates below the
-        # record at its large amplitudes, so the moved modes go onto their peaks
-        on = np.isin(eigen_targets(m0 * (L @ L.T), k0 * _sym(P), lam_meas, True), lam_meas[moved])
-        back = np.where(on, eigen_targets(m0 * (L @ L.T), k0 * _sym(P), lam_peaks, True), 0.0)
-        held = max(held, hold_eigenvalues(L, P, m0, k0, back, 0.0))
-        target = np.where(back > 0, back, target)
-        backbone_rule += "; the SGD dropped every cubic term: those modes put onto their peaks"
-    clipped = _project_psd(Q)  # C: projected once, at the end (see above)
-    if clipped < 0:
-        guard["C"] = min(guard.get("C", 0.0), clipped)
-    M = m0 * (L @ L.T)
-    C, K = c0 * _sym(Q), k0 * _sym(P)
-    K3 = sc3 * R if has_R else None
-    if K3 is not None and cubic_dir is not None:  # b (a . x^3): the one column's coefficients
-        K3 = np.outer(K3[:, 0], cubic_dir ** 3)
-    # the free coefficients of the nuisance columns, from the unprojected residual
-    K3f = None if K3 is None else (sc3 * R if cubic_dir is not None else K3)  # on the features
-    def nuisance_coef(sig: list[np.ndarray], Wn: np.ndarray) -> np.ndarray:
-        """The nuisance columns' coefficients (n, p) fitting the model's residual on ``sig``."""
-        if not Wn.shape[1]:
-            return np.zeros((n, 0))
-        res = M @ sig[0] + C @ sig[1] + K @ sig[2] + (K3f @ sig[3] if K3f is not None else 0.0)
-        sw = _rms(Wn, 0)
-        return (np.linalg.lstsq(Wn / sw[None, :], res.T, rcond=NUISANCE_RCOND)[0] / sw[:, None]).T
 
-    G = nuisance_coef(raw, W)
-    input_map = None if data.input_map is None else np.array(data.input_map, dtype=float)
-    input_map_record = None
-    if input_map is not None:
-        input_map[:, inputs] = G[:, :n_u]
-        if n_u and i0 > 0:
-            input_map_record = input_map.copy()
-            input_map_record[:, inputs] = nuisance_coef([a[:, :i1] for a in full], W_record)[:, :n_u]
-    return MatrixSGDResult(M=_sym(M), C=C, K=K, K3=K3, n_steps=n_steps, alphas=alpha, guard=guard,
-                           history={k: np.asarray(v) for k, v in hist.items()},
-                           input_map=input_map, drift_coef=G[:, n_u:],
-                           eigen_targets=np.sqrt(target) / (2.0 * np.pi), eigen_shift=held,
-                           fit_tilt=tilted, fit_tilt_rule=tilt_rule,
-                           input_map_record=input_map_record, backbone_rule=backbone_rule)
+    def finish(L: np.ndarray, P: np.ndarray, Q: np.ndarray, R: np.ndarray, target: np.ndarray,
+               guard: dict[str, float], n_steps: int, alpha: dict[str, float],
+               hist: dict[str, np.ndarray]) -> MatrixSGDResult:
+        """The result from the parameters ``L, P, Q, R`` (changed in place): the eigenvalue
+        hold, the damping's projection, the physical matrices and the nuisance coefficients;
+        ``target`` the modes' targets when nothing is held."""
+        held, rule = 0.0, backbone_rule
+        if hold:
+            target = eigen_targets(m0 * (L @ L.T), k0 * _sym(P), lam_meas, True)
+            held = hold_eigenvalues(L, P, m0, k0, target, band)
+        if hold and np.any(moved) and not np.any(R != 0.0):
+            # the cubic was dropped: a linear model at the linear frequencies oscillates below
+            # the record at its large amplitudes, so the moved modes go onto their peaks
+            on = np.isin(eigen_targets(m0 * (L @ L.T), k0 * _sym(P), lam_meas, True),
+                         lam_meas[moved])
+            back = np.where(on, eigen_targets(m0 * (L @ L.T), k0 * _sym(P), lam_peaks, True),
+                            0.0)
+            held = max(held, hold_eigenvalues(L, P, m0, k0, back, 0.0))
+            target = np.where(back > 0, back, target)
+            rule += "; the SGD dropped every cubic term: those modes put onto their peaks"
+        clipped = _project_psd(Q)  # C: projected once, at the end (see above)
+        if clipped < 0:
+            guard["C"] = min(guard.get("C", 0.0), clipped)
+        M = m0 * (L @ L.T)
+        C, K = c0 * _sym(Q), k0 * _sym(P)
+        K3 = sc3 * R if has_R else None
+        if K3 is not None and cubic_dir is not None:  # b (a . x^3): the column's coefficients
+            K3 = np.outer(K3[:, 0], cubic_dir ** 3)
+        # the free coefficients of the nuisance columns, from the unprojected residual
+        K3f = None if K3 is None else (sc3 * R if cubic_dir is not None else K3)  # on features
+
+        def nuisance_coef(sig: list[np.ndarray], Wn: np.ndarray) -> np.ndarray:
+            """The nuisance columns' coefficients (n, p) fitting the model's residual on
+            ``sig``."""
+            if not Wn.shape[1]:
+                return np.zeros((n, 0))
+            res = (M @ sig[0] + C @ sig[1] + K @ sig[2]
+                   + (K3f @ sig[3] if K3f is not None else 0.0))
+            sw = _rms(Wn, 0)
+            return (np.linalg.lstsq(Wn / sw[None, :], res.T, rcond=NUISANCE_RCOND)[0]
+                    / sw[:, None]).T
+
+        G = nuisance_coef(raw, W)
+        input_map = None if data.input_map is None else np.array(data.input_map, dtype=float)
+        input_map_record = None
+        if input_map is not None:
+            input_map[:, inputs] = G[:, :n_u]
+            if n_u and i0 > 0:
+                input_map_record = input_map.copy()
+                input_map_record[:, inputs] = nuisance_coef([a[:, :i1] for a in full],
+                                                            W_record)[:, :n_u]
+        return MatrixSGDResult(M=_sym(M), C=C, K=K, K3=K3, n_steps=n_steps, alphas=alpha,
+                               guard=guard, history=hist,
+                               input_map=input_map, drift_coef=G[:, n_u:],
+                               eigen_targets=np.sqrt(target) / (2.0 * np.pi), eigen_shift=held,
+                               fit_tilt=tilted, fit_tilt_rule=tilt_rule,
+                               input_map_record=input_map_record, backbone_rule=rule)
+
+    out = finish(L, P, Q, R, target, guard, n_steps, alpha,
+                 {k: np.asarray(v) for k, v in hist.items()})
+    if warm is None:
+        return out
+    (L0, P0, Q0, R0, target0), guard0, alpha0 = warm
+    return dataclasses.replace(out, warm=finish(L0, P0, Q0, R0, target0, guard0, 0, alpha0,
+                                                {k: v[:1] for k, v in out.history.items()}))

@@ -23,6 +23,16 @@ linalg = lazy_module("scipy.linalg")  # imported on first use: `testbed list` do
 #: needs 1.2 MB; a sweep's longest records stay far below this bound, beyond it nothing is kept).
 KEEP_BYTES = 1 << 26
 
+#: Where classical RK4's region of absolute stability meets the negative real axis:
+#: ``|1 + z + z^2/2 + z^3/6 + z^4/24| = 1`` at ``z = -2.785`` (on the imaginary axis the bound
+#: is ``2 sqrt 2``).  A pole with ``|lambda| dt`` beyond it (``dt`` the sample interval) is
+#: faster than one RK4 step per sample can follow: an overdamped pole there leaves less than
+#: ``exp(-2.785)`` = 6 % of its amplitude after one sample, a lightly damped mode lies above
+#: 0.44 ``fs``.  :func:`simulate_structural` still integrates such a cubic model (its sub-steps
+#: grow with ``|lambda| dt``, e.g. 2478 per sample for a pole at -3.2e6 rad/s at 12.8 kHz);
+#: :func:`sample_rate_pole` lets a caller refuse one before paying for that.
+RK4_STABILITY_BOUND = 2.785
+
 
 @dataclass
 class _Propagator:
@@ -110,6 +120,56 @@ def _zoh_free_and_forced(A: np.ndarray, Bz: np.ndarray | None, z0: np.ndarray, d
     return (p.V @ q).real
 
 
+def state_matrix(M: np.ndarray, C: np.ndarray, K: np.ndarray) -> np.ndarray:
+    """The first-order form ``A = [[0, I], [-M^-1 K, -M^-1 C]]`` of ``M x'' + C x' + K x``.
+
+    Parameters
+    ----------
+    M, C, K : ndarray, shape (n, n)
+        [kg], [N s/m], [N/m] (``M`` invertible).
+
+    Returns
+    -------
+    ndarray, shape (2 n, 2 n)
+        [1/s] and [1/s^2] blocks; its eigenvalues are the linear model's poles [rad/s].
+    """
+    M, C, K = (np.asarray(a, dtype=float) for a in (M, C, K))
+    n = M.shape[0]
+    Minv = np.linalg.inv(M)
+    return np.block([[np.zeros((n, n)), np.eye(n)], [-Minv @ K, -Minv @ C]])
+
+
+def pole_radius(A: np.ndarray) -> float:
+    """The fastest pole's magnitude ``max |eig(A)|`` [rad/s] of a state matrix
+    (:func:`state_matrix`)."""
+    return float(np.max(np.abs(np.linalg.eigvals(A))))
+
+
+def sample_rate_pole(M: np.ndarray, C: np.ndarray, K: np.ndarray, dt: float) -> float:
+    """The linear part's fastest pole per sample, ``max |lambda| dt`` [-].
+
+    Beyond :data:`RK4_STABILITY_BOUND` one RK4 step per sample interval cannot follow that
+    pole; the record cannot resolve it either.
+
+    Parameters
+    ----------
+    M, C, K : ndarray, shape (n, n)
+        [kg], [N s/m], [N/m].
+    dt : float
+        Sample interval [s].
+
+    Returns
+    -------
+    float
+        ``max |lambda| dt`` over the poles of :func:`state_matrix`; inf if they are not finite.
+    """
+    with np.errstate(over="ignore", invalid="ignore"):
+        A = state_matrix(M, C, K)
+    if not np.all(np.isfinite(A)):
+        return float("inf")
+    return pole_radius(A) * float(dt)
+
+
 def simulate_structural(M: np.ndarray, C: np.ndarray, K: np.ndarray, K3: np.ndarray | None,
                         B: np.ndarray | None, x0: np.ndarray, xd0: np.ndarray, t: np.ndarray,
                         u: np.ndarray | None = None, max_omega_h: float = 0.1) -> Trajectory:
@@ -170,7 +230,7 @@ def simulate_structural(M: np.ndarray, C: np.ndarray, K: np.ndarray, K3: np.ndar
         if u.shape != (B.shape[1], n_t):
             raise ValueError(f"u must have shape {(B.shape[1], n_t)}, got {u.shape}")
         f = np.asarray(B, dtype=float) @ u  # (n, n_t) force [N]
-    A = np.block([[np.zeros((n, n)), np.eye(n)], [-Minv @ K, -Minv @ C]])
+    A = state_matrix(M, C, K)
     z0 = np.concatenate([x0, xd0])
     nonlinear = K3 is not None and np.any(np.asarray(K3) != 0.0)
     if not nonlinear:
@@ -181,7 +241,7 @@ def simulate_structural(M: np.ndarray, C: np.ndarray, K: np.ndarray, K3: np.ndar
         return Trajectory(x, xd, xdd)
     MK3 = Minv @ np.asarray(K3, dtype=float)
     MF = Minv @ f if f is not None else np.zeros((n, n_t))
-    rho = float(np.max(np.abs(np.linalg.eigvals(A)))) if n_t > 1 else 0.0
+    rho = pole_radius(A) if n_t > 1 else 0.0
     sub = max(1, int(np.ceil(rho * dt / max_omega_h)))
     h = dt / sub
     from identify._compiled import rk4_cubic  # lazy: numba's import costs ~0.4 s

@@ -1,10 +1,11 @@
-"""Comparing shapes across channels: the modal assurance criterion (one implementation)."""
+"""Comparing shapes across channels: the modal and time-response assurance criteria (one
+implementation each; TRAC here since ``sgd_sindy`` compares its models with the record by it)."""
 
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["mac_matrix"]
+__all__ = ["mac_matrix", "trac"]
 
 
 def mac_matrix(phi_a: np.ndarray, phi_b: np.ndarray) -> np.ndarray:
@@ -31,3 +32,30 @@ def mac_matrix(phi_a: np.ndarray, phi_b: np.ndarray) -> np.ndarray:
     with np.errstate(invalid="ignore", divide="ignore"):
         out = np.where(den > 0, num / np.where(den > 0, den, 1.0), np.nan)
     return np.minimum(out, 1.0)
+
+
+def trac(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """Time response assurance criterion per channel.
+
+    Parameters
+    ----------
+    x : ndarray, shape (n_channels, n_samples)
+        Reference signal (truth or measurement), real or complex; 1-D is one channel.
+    y : ndarray, shape (n_channels, n_samples)
+        The identified model's counterpart.  Over frequency lines of FRFs this is FRAC.
+
+    Returns
+    -------
+    ndarray, shape (n_channels,)
+        ``|x_j^H y_j|^2 / ((x_j^H x_j)(y_j^H y_j))`` in [0, 1]; 1 for proportional signals
+        (any nonzero scale), 0 for orthogonal ones.  NaN where either channel is all zero
+        (undefined), so a threshold on it fails rather than passes.
+    """
+    x, y = np.atleast_2d(np.asarray(x)), np.atleast_2d(np.asarray(y))
+    if x.shape != y.shape:
+        raise ValueError(f"shapes differ: {x.shape} vs {y.shape}")
+    num = np.abs(np.sum(np.conj(x) * y, axis=-1)) ** 2
+    den = np.sum(np.abs(x) ** 2, axis=-1) * np.sum(np.abs(y) ** 2, axis=-1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        out = np.where(den > 0, num / np.where(den > 0, den, 1.0), np.nan)
+    return np.minimum(out, 1.0)  # rounding can push the ratio of equal numbers to 1 + 1e-16

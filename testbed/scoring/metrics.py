@@ -10,6 +10,7 @@ import numpy as np
 
 from testbed.core.lazy import lazy_module
 from testbed.numerics.shapes import mac_matrix as mac_matrix  # re-exported: the scorers' name
+from testbed.numerics.shapes import trac as trac  # re-exported: the scorers' name
 
 # imported on first use: `testbed list` does not pay for them
 linalg = lazy_module("scipy.linalg")
@@ -45,33 +46,6 @@ def worst(values, how: str) -> float:
     if a.size == 0 or np.any(np.isnan(a)):
         return float("nan")
     return float(np.max(a) if how == "max" else np.min(a))
-
-
-def trac(x: np.ndarray, y: np.ndarray) -> np.ndarray:
-    """Time response assurance criterion per channel.
-
-    Parameters
-    ----------
-    x : ndarray, shape (n_channels, n_samples)
-        Reference signal (truth or measurement), real or complex; 1-D is one channel.
-    y : ndarray, shape (n_channels, n_samples)
-        The identified model's counterpart.  Over frequency lines of FRFs this is FRAC.
-
-    Returns
-    -------
-    ndarray, shape (n_channels,)
-        ``|x_j^H y_j|^2 / ((x_j^H x_j)(y_j^H y_j))`` in [0, 1]; 1 for proportional signals
-        (any nonzero scale), 0 for orthogonal ones.  NaN where either channel is all zero
-        (undefined), so a threshold on it fails rather than passes.
-    """
-    x, y = np.atleast_2d(np.asarray(x)), np.atleast_2d(np.asarray(y))
-    if x.shape != y.shape:
-        raise ValueError(f"shapes differ: {x.shape} vs {y.shape}")
-    num = np.abs(np.sum(np.conj(x) * y, axis=-1)) ** 2
-    den = np.sum(np.abs(x) ** 2, axis=-1) * np.sum(np.abs(y) ** 2, axis=-1)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        out = np.where(den > 0, num / np.where(den > 0, den, 1.0), np.nan)
-    return np.minimum(out, 1.0)  # rounding can push the ratio of equal numbers to 1 + 1e-16
 
 
 def pair_modes(mac: np.ndarray) -> np.ndarray:

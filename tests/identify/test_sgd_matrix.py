@@ -1,14 +1,16 @@
 """The cubic-term selection of SGD-SINDy's matrix parametrisation (identify/_sgd_matrix.py):
 the warm start's lasso, on the partial-correlation scale, and the SGD's proximal step."""
 
+import dataclasses
 import functools
 
 import numpy as np
 import pytest
 
 from benchmarks import bench_sgd_sindy as bench
-from identify._sgd_matrix import _sym, cubic_profile, warm_start
+from identify._sgd_matrix import _sym, cubic_profile, fit_matrix_sgd, warm_start
 from identify.sgd_sindy import SGDSINDy
+from identify.structural import mass_prior_value
 
 # One worker runs the module: each chain record below is integrated once (10 calls made 3
 # records; 4-6 s each on a loaded 2-core machine).
@@ -183,3 +185,39 @@ def test_drift_columns_do_not_change_the_fit_when_profiled_out():
     assert np.allclose(a.natural_frequencies_, b.natural_frequencies_, rtol=1e-7)
     assert np.allclose(a.drift_coef_[:, 0], b.drift_coef_[:, 0] + a.C_ @ e, rtol=1e-5, atol=1e-9)
     assert np.allclose(a.drift_coef_[:, 1], b.drift_coef_[:, 1] + a.K_ @ e, rtol=1e-5)
+
+
+def _assert_same(a, b, path="result"):
+    """Every field of two results (dataclasses, dicts, arrays, numbers) equal bit for bit."""
+    if dataclasses.is_dataclass(a):
+        for f in dataclasses.fields(a):
+            if f.name != "warm":
+                _assert_same(getattr(a, f.name), getattr(b, f.name), f"{path}.{f.name}")
+    elif isinstance(a, dict):
+        assert a.keys() == b.keys(), path
+        for k in a:
+            _assert_same(a[k], b[k], f"{path}[{k!r}]")
+    elif isinstance(a, np.ndarray):
+        assert a.shape == b.shape and np.array_equal(a, b, equal_nan=True), path
+    else:
+        assert a == b or (a != a and b != b), (path, a, b)
+
+
+@pytest.mark.parametrize("k3, cubic", [(0.0, False), (2.0e12, True)])
+def test_the_held_warm_start_comes_with_the_fit(k3, cubic):
+    """``with_warm`` returns, besides the SGD's result, the held warm start the SGD started
+    from: bit for bit the result ``epochs = 0`` gives (not fitted a second time), hold and
+    projections included; the SGD's result is unchanged by asking for it."""
+    data, _ = _signals(k3)
+    model = SGDSINDy(epochs=5, cubic=cubic)
+    lam_hat, peaks = model._start_fit(data)
+    m_hat = mass_prior_value(data, model.mass_prior)
+    est = model.settings()
+    out = fit_matrix_sgd(data, est, m_hat, lam_hat, peaks=peaks, with_warm=True)
+    assert out.warm is not None and out.warm.n_steps == 0 and out.n_steps > 0
+    _assert_same(out.warm, fit_matrix_sgd(data, dataclasses.replace(est, epochs=0), m_hat,
+                                          lam_hat, peaks=peaks), "warm")
+    _assert_same(out, fit_matrix_sgd(data, est, m_hat, lam_hat, peaks=peaks), "sgd")
+    assert fit_matrix_sgd(data, est, m_hat, lam_hat, peaks=peaks).warm is None
+    assert fit_matrix_sgd(data, dataclasses.replace(est, epochs=0), m_hat, lam_hat,
+                          peaks=peaks, with_warm=True).warm is None  # nothing to compare

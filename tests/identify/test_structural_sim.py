@@ -144,3 +144,33 @@ def test_linear_matches_a_direct_zoh_recursion():
     # eigenbasis vs direct products: rounding over 3000 steps, measured 1e-11 of the peak; 100x margin
     for got, want in ((tr.x, Z[:n]), (tr.xd, Z[n:])):
         assert np.abs(got - want).max() <= 1e-9 * np.abs(want).max()
+
+
+def test_rk4_stability_bound_is_where_rk4_meets_the_negative_real_axis():
+    """RK4_STABILITY_BOUND: one classical RK4 step amplifies ``z' = lambda z`` by
+    ``R(z) = 1 + z + z^2/2 + z^3/6 + z^4/24`` (``z = lambda h``); |R| = 1 at z = -2.7853 (the
+    bound is quoted to 4 digits: |R| within 1e-3 of 1 there, below 1 just inside, above 1
+    just outside)."""
+    def amplification(z):
+        return abs(1 + z + z**2 / 2 + z**3 / 6 + z**4 / 24)
+
+    b = _structural_sim.RK4_STABILITY_BOUND
+    assert abs(amplification(-b) - 1.0) < 1e-3
+    assert amplification(-0.99 * b) < 1.0 < amplification(-1.01 * b)
+
+
+def test_sample_rate_pole_is_the_fastest_pole_per_sample():
+    """``max |lambda| dt`` over the poles of ``[[0, I], [-M^-1 K, -M^-1 C]]``: a single
+    oscillator ``m = 2, c = 4, k = 800`` has poles ``-1 +- i sqrt(399)``, |lambda| = 20 rad/s;
+    an overdamped one (c = 2000) a pole near -c/m = -1000 rad/s; inf for non-finite matrices."""
+    one = np.array([[2.0]])
+    assert _structural_sim.sample_rate_pole(one, 4 * one / 2, 800 * one / 2, 1e-3) == \
+        pytest.approx(20.0e-3, rel=1e-12)
+    assert _structural_sim.sample_rate_pole(one, 1000 * one, 400 * one, 1.0) == \
+        pytest.approx(1000.0 - 0.4, rel=1e-3)  # the fast root of 2 s^2 + 2000 s + 800
+    assert _structural_sim.sample_rate_pole(one, np.array([[np.inf]]), one, 1.0) == np.inf
+    M, C, K, _ = _system()
+    A = _structural_sim.state_matrix(M, C, K)
+    n = M.shape[0]
+    np.testing.assert_array_equal(A[:n, n:], np.eye(n))
+    np.testing.assert_allclose(M @ A[n:, :n], -K, rtol=1e-12, atol=1e-9 * np.abs(K).max())
