@@ -156,3 +156,160 @@ def test_a_second_server_on_the_socket_is_refused(server):
     assert r.returncode == cli.EXIT_USAGE
     assert r.stderr.startswith("error: ") and "already listening" in r.stderr, r.stderr
     assert proc.poll() is None and (tmp / "sock" / "s.sock").exists()  # the first one serves on
+
+
+# ---------------------------------------------------------------- hostile clients, dying servers
+# A server of the real loop that imports nothing and whose commands sleep (``sleep SECONDS``):
+# it starts in about a second, so these tests can kill it.
+_FAKE = """
+import sys, time
+import testbed.cli as c, testbed.server as s
+c._blas_threads()  # as `testbed serve` (cli.main) does before serving: part of the key
+s._preload = lambda: None
+def main(argv):
+    time.sleep(float(argv[1]))
+    print("slept", flush=True)
+    return int(argv[2]) if len(argv) > 2 else 0
+c.main = main
+s.serve(idle=60, warm_up=None)
+"""
+
+
+@pytest.fixture
+def sleeper(tmp_path):
+    """A sleeping-commands server (see ``_FAKE``): its process, environment, folder, log."""
+    (tmp_path / "sock").mkdir(mode=0o700)
+    env = _env(tmp_path)
+    log = open(tmp_path / "log", "w+")
+    proc = subprocess.Popen([sys.executable, "-c", _FAKE], env=env, cwd=tmp_path, stdout=log,
+                            stderr=subprocess.STDOUT)
+    t0 = time.monotonic()
+    while "listening" not in (tmp_path / "log").read_text():
+        assert proc.poll() is None, (tmp_path / "log").read_text()
+        assert time.monotonic() - t0 < 60, "the server did not start"
+        time.sleep(0.05)
+    yield proc, env, tmp_path
+    if proc.poll() is None:
+        proc.kill()
+    proc.wait()
+    log.close()
+
+
+def _client(env, cwd, *args):
+    return subprocess.Popen([sys.executable, "-m", "testbed.cli", *args], env=env, cwd=cwd,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+
+
+def _wait_for(pred, what, timeout=20.0):
+    t0 = time.monotonic()
+    while not pred():
+        assert time.monotonic() - t0 < timeout, what
+        time.sleep(0.02)
+
+
+def _pids(tmp: Path) -> list[int]:
+    return [int(ln.rsplit("(pid ", 1)[1].rstrip(")")) for ln in _served_lines(tmp) if "(pid " in ln]
+
+
+def test_a_killed_server_stops_its_commands_and_each_client_says_so(sleeper):
+    proc, env, tmp = sleeper
+    clients = [_client(env, tmp, "sleep", "60") for _ in range(2)]
+    _wait_for(lambda: len(_pids(tmp)) == 2, "two commands started")
+    proc.kill()  # SIGKILL: the clients must not wait for their commands (nor one for the other's)
+    for c in clients:
+        out, err = c.communicate(timeout=10)
+        assert c.returncode == 128 + signal.SIGKILL, err
+        assert err.startswith("error: the testbed server ended") and err.count("\n") == 1, err
+        assert "slept" not in out
+    for pid in _pids(tmp):
+        _wait_for(lambda: not _alive(pid), f"command {pid} outlived its server", 10)
+
+
+def test_a_stopped_server_stops_its_commands_and_each_client_says_so(sleeper):
+    proc, env, tmp = sleeper
+    c = _client(env, tmp, "sleep", "60")
+    _wait_for(lambda: len(_pids(tmp)) == 1, "the command started")
+    proc.terminate()
+    assert proc.wait(timeout=10) == 0
+    out, err = c.communicate(timeout=10)
+    assert c.returncode == 128 + signal.SIGKILL and err.startswith("error: the testbed server ended")
+    assert not (tmp / "sock" / "s.sock").exists()
+    _wait_for(lambda: not _alive(_pids(tmp)[0]), "the command outlived its server", 10)
+
+
+def _raw(env) -> "socket.socket":
+    import socket
+
+    s = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+    s.connect(env["TESTBED_SERVER_SOCKET"])
+    return s
+
+
+def test_a_silent_client_does_not_hold_the_others(sleeper):
+    proc, env, tmp = sleeper
+    silent = _raw(env)  # connects and sends nothing (a stopped client, another program)
+    try:
+        c = _client(env, tmp, "sleep", "0", "1")
+        out, err = c.communicate(timeout=30)
+        assert (c.returncode, out) == (1, "slept\n"), err  # served, with its own status
+    finally:
+        silent.close()
+    assert proc.poll() is None
+
+
+def test_damaged_requests_are_refused_and_leave_no_descriptor(sleeper):
+    import array
+    import socket
+    import struct
+
+    proc, env, tmp = sleeper
+    fds = lambda: len(os.listdir(f"/proc/{proc.pid}/fd"))  # noqa: E731
+    before = fds()
+    for body in (b"{not json", b"[1, 2]", b'{"key": "x"}', b'{"argv": 1}'):
+        s = _raw(env)
+        s.sendmsg([struct.pack("!I", len(body)) + body],
+                  [(socket.SOL_SOCKET, socket.SCM_RIGHTS, array.array("i", (0, 1, 2)))])
+        s.settimeout(10)
+        assert b"a damaged request" in s.recv(1000)
+        s.close()
+    _wait_for(lambda: fds() == before, f"descriptors {before} -> {fds()}", 5)
+    assert proc.poll() is None
+
+
+def test_a_client_gone_before_the_reply_neither_stops_the_server_nor_runs(sleeper):
+    import array
+    import socket
+
+    from testbed.server import _send, server_key
+
+    proc, env, tmp = sleeper
+    s = _raw(env)
+    request = {"argv": ["sleep", "60"], "cwd": str(tmp), "env": env, "umask": 0o022,
+               "key": server_key(env)}
+    _send(s, request, (0, 1, 2))
+    s.close()  # before the server's reply
+    _wait_for(lambda: len(_pids(tmp)) == 1, "the command started")
+    _wait_for(lambda: not _alive(_pids(tmp)[0]), "a command without a client ran on", 10)
+    c = _client(env, tmp, "sleep", "0")
+    assert c.communicate(timeout=30)[0] == "slept\n" and c.returncode == 0
+    assert proc.poll() is None
+
+
+def test_ctrl_c_before_the_server_answers_is_one_line(tmp_path):
+    import socket
+
+    (tmp_path / "sock").mkdir(mode=0o700)
+    env = _env(tmp_path)
+    mute = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)  # a server that never answers
+    mute.bind(env["TESTBED_SERVER_SOCKET"])
+    mute.listen(1)
+    mute.settimeout(30)
+    c = _client(env, tmp_path, "list")
+    conn, _ = mute.accept()
+    conn.settimeout(30)
+    assert conn.recv(4)  # the request came: the client now waits for the reply
+    c.send_signal(signal.SIGINT)
+    out, err = c.communicate(timeout=30)
+    conn.close()
+    mute.close()
+    assert (c.returncode, err) == (cli.EXIT_INTERRUPTED, "error: interrupted\n")
