@@ -7,6 +7,7 @@ import json
 import os
 import re
 import signal
+import socket
 import subprocess
 import sys
 import time
@@ -222,7 +223,7 @@ def test_a_killed_server_stops_its_commands_and_each_client_says_so(sleeper):
         assert err.startswith("error: the testbed server ended") and err.count("\n") == 1, err
         assert "slept" not in out
     for pid in _pids(tmp):
-        _wait_for(lambda: not _alive(pid), f"command {pid} outlived its server", 10)
+        _wait_for(lambda p=pid: not _alive(p), f"command {pid} outlived its server", 10)
 
 
 def test_a_stopped_server_stops_its_commands_and_each_client_says_so(sleeper):
@@ -231,15 +232,13 @@ def test_a_stopped_server_stops_its_commands_and_each_client_says_so(sleeper):
     _wait_for(lambda: len(_pids(tmp)) == 1, "the command started")
     proc.terminate()
     assert proc.wait(timeout=10) == 0
-    out, err = c.communicate(timeout=10)
+    _, err = c.communicate(timeout=10)
     assert c.returncode == 128 + signal.SIGKILL and err.startswith("error: the testbed server ended")
     assert not (tmp / "sock" / "s.sock").exists()
     _wait_for(lambda: not _alive(_pids(tmp)[0]), "the command outlived its server", 10)
 
 
-def _raw(env) -> "socket.socket":
-    import socket
-
+def _raw(env) -> socket.socket:
     s = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
     s.connect(env["TESTBED_SERVER_SOCKET"])
     return s
@@ -259,10 +258,9 @@ def test_a_silent_client_does_not_hold_the_others(sleeper):
 
 def test_damaged_requests_are_refused_and_leave_no_descriptor(sleeper):
     import array
-    import socket
     import struct
 
-    proc, env, tmp = sleeper
+    proc, env, _ = sleeper
     fds = lambda: len(os.listdir(f"/proc/{proc.pid}/fd"))  # noqa: E731
     before = fds()
     for body in (b"{not json", b"[1, 2]", b'{"key": "x"}', b'{"argv": 1}'):
@@ -277,9 +275,6 @@ def test_damaged_requests_are_refused_and_leave_no_descriptor(sleeper):
 
 
 def test_a_client_gone_before_the_reply_neither_stops_the_server_nor_runs(sleeper):
-    import array
-    import socket
-
     from testbed.server import _send, server_key
 
     proc, env, tmp = sleeper
@@ -296,8 +291,6 @@ def test_a_client_gone_before_the_reply_neither_stops_the_server_nor_runs(sleepe
 
 
 def test_ctrl_c_before_the_server_answers_is_one_line(tmp_path):
-    import socket
-
     (tmp_path / "sock").mkdir(mode=0o700)
     env = _env(tmp_path)
     mute = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)  # a server that never answers
@@ -309,7 +302,7 @@ def test_ctrl_c_before_the_server_answers_is_one_line(tmp_path):
     conn.settimeout(30)
     assert conn.recv(4)  # the request came: the client now waits for the reply
     c.send_signal(signal.SIGINT)
-    out, err = c.communicate(timeout=30)
+    _, err = c.communicate(timeout=30)
     conn.close()
     mute.close()
     assert (c.returncode, err) == (cli.EXIT_INTERRUPTED, "error: interrupted\n")
