@@ -167,9 +167,12 @@ import sys, time
 import testbed.cli as c, testbed.server as s
 c._blas_threads()  # as `testbed serve` (cli.main) does before serving: part of the key
 s._preload = lambda: None
-def main(argv):
+def main(argv):  # sleep SECONDS [STATUS [AT-EXIT-TEXT]]
     time.sleep(float(argv[1]))
     print("slept", flush=True)
+    if len(argv) > 3:  # printed at exit (a command alone prints it; loky's exit hooks are such)
+        import atexit
+        atexit.register(print, argv[3], flush=True)
     return int(argv[2]) if len(argv) > 2 else 0
 c.main = main
 s.serve(idle=60, warm_up=None)
@@ -306,3 +309,10 @@ def test_ctrl_c_before_the_server_answers_is_one_line(tmp_path):
     conn.close()
     mute.close()
     assert (c.returncode, err) == (cli.EXIT_INTERRUPTED, "error: interrupted\n")
+
+
+def test_a_served_command_does_its_exit_work_before_its_client_returns(sleeper):
+    _, env, tmp = sleeper  # (a served sweep's loky workers and resource tracker: stopped, silent)
+    c = _client(env, tmp, "sleep", "0", "0", "at exit")
+    out, err = c.communicate(timeout=30)
+    assert (c.returncode, out, err) == (0, "slept\nat exit\n", "")
