@@ -316,3 +316,23 @@ def test_a_served_command_does_its_exit_work_before_its_client_returns(sleeper):
     c = _client(env, tmp, "sleep", "0", "0", "at exit")
     out, err = c.communicate(timeout=30)
     assert (c.returncode, out, err) == (0, "slept\nat exit\n", "")
+
+
+def test_changed_sources_end_the_server_after_its_running_commands(sleeper):
+    proc, env, tmp = sleeper
+    running = _client(env, tmp, "sleep", "4", "0")
+    _wait_for(lambda: len(_pids(tmp)) == 1, "the command started")
+    source = ROOT / "testbed" / "server.py"
+    st = source.stat()
+    os.utime(source, ns=(st.st_atime_ns, st.st_mtime_ns + 1_000_000))  # "edited"
+    try:
+        # another command is refused (another key) and runs alone: here no 'sleep' command
+        late = _testbed(["sleep", "0"], env, tmp)
+        assert late.returncode == cli.EXIT_USAGE and "invalid choice: 'sleep'" in late.stderr
+        out, err = running.communicate(timeout=30)  # the running one ends as it would
+        assert (running.returncode, out, err) == (0, "slept\n", "")
+        assert proc.wait(timeout=10) == 0
+    finally:
+        os.utime(source, ns=(st.st_atime_ns, st.st_mtime_ns))  # (the module's server: its key)
+    assert any("sources changed" in ln for ln in _served_lines(tmp))
+    assert not (tmp / "sock" / "s.sock").exists()
