@@ -175,6 +175,8 @@ def try_server(argv: list[str]) -> int | None:
     path = socket_path()
     if not path.exists():
         return None
+    if not all(_is_open(fd) for fd in (0, 1, 2)):
+        return None  # a closed standard stream (``>&-``): alone the command sees it closed
     env = dict(os.environ)
     key = server_key(env)  # before connecting: a server waits for the request, not for this
     for s in (sys.stdout, sys.stderr):
@@ -224,6 +226,15 @@ def try_server(argv: list[str]) -> int | None:
         for s, h in old.items():
             signal.signal(s, h)
         sock.close()
+
+
+def _is_open(fd: int) -> bool:
+    """Whether descriptor ``fd`` is open."""
+    try:
+        os.fstat(fd)
+    except OSError:
+        return False
+    return True
 
 
 #: A client's status when its server ended while the command ran (the command was killed:
@@ -414,6 +425,9 @@ def serve(idle: float = IDLE_S, path: Path | None = None, log=None,
 
         raise InputError(f"{path.parent}: the server's socket folder must be private to you "
                          "(mode 0700); set TESTBED_SERVER_SOCKET to a path in one")
+    for fd in (0, 1, 2):  # closed, it would be the number of a socket or of a client's stream
+        if not _is_open(fd):
+            os.open(os.devnull, os.O_RDWR)  # (the lowest free number: this one)
     start_env = dict(os.environ)  # as the client's: before the libraries set their defaults
     key = server_key(start_env)
     _refuse_if_served(path)

@@ -336,3 +336,13 @@ def test_changed_sources_end_the_server_after_its_running_commands(sleeper):
         os.utime(source, ns=(st.st_atime_ns, st.st_mtime_ns))  # (the module's server: its key)
     assert any("sources changed" in ln for ln in _served_lines(tmp))
     assert not (tmp / "sock" / "s.sock").exists()
+
+
+def test_a_closed_standard_stream_runs_alone(sleeper):
+    _, env, tmp = sleeper  # (sent, the connection itself took its number: the command's output
+    # went into it and the client reported a dead server)
+    r = subprocess.run([sys.executable, "-m", "testbed.cli", "sleep", "0"], env=env, cwd=tmp,
+                       stdin=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, timeout=60,
+                       preexec_fn=lambda: os.close(1))
+    assert r.returncode == cli.EXIT_USAGE and "invalid choice: 'sleep'" in r.stderr, r.stderr
+    assert not _pids(tmp)
