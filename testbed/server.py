@@ -20,9 +20,10 @@ Rules, so that a served command is never a different command:
 - only the user who started it may use it (the socket's folder is private, mode 0700, and the
   server checks each client's uid with ``SO_PEERCRED``);
 - Ctrl-C in the client is sent on to the child (the command ends as it would alone, status
-  130); a client that dies (``kill -9`` included) has its child's process group killed by the
-  server, so no process is left behind; the server exits after ``idle`` seconds without a
-  command, removing its socket;
+  130); Ctrl-Z stops the command's process group with the client, ``fg`` resumes both; a
+  client that dies (``kill -9`` included) has its child's process group killed by the server,
+  so no process is left behind; the server exits after ``idle`` seconds without a command,
+  removing its socket;
 - a server that dies (``kill -9`` included) or is stopped takes its running commands with it
   (``PR_SET_PDEATHSIG``; the client also kills the command's group) and each client prints one
   line, status :data:`SERVER_GONE_STATUS`; a signal that reaches the client before the server
@@ -192,7 +193,18 @@ def try_server(argv: list[str]) -> int | None:
         with contextlib.suppress(OSError):
             os.kill(child[0], signum)
 
+    def on_stop(signum, frame):  # Ctrl-Z: the command (its whole group) stops with the client
+        with contextlib.suppress(OSError):
+            if child:
+                os.killpg(child[0], signal.SIGSTOP)
+            signal.signal(signal.SIGTSTP, signal.SIG_DFL)
+            os.kill(os.getpid(), signal.SIGTSTP)  # stopped here until `fg` / SIGCONT
+            signal.signal(signal.SIGTSTP, on_stop)
+            if child:
+                os.killpg(child[0], signal.SIGCONT)
+
     old = {s: signal.signal(s, on_signal) for s in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)}
+    old[signal.SIGTSTP] = signal.signal(signal.SIGTSTP, on_stop)
     sock = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
     try:
         try:
