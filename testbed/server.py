@@ -15,8 +15,9 @@ Rules, so that a served command is never a different command:
 - the client uses a server only if the server's *key* equals its own: the Python executable, the
   project's source files (their paths, sizes and modification times) and every environment
   variable read when the libraries load (:data:`IMPORT_TIME_VARIABLES`: BLAS thread counts,
-  numba, MuJoCo, matplotlib, ``PYTHON*``); otherwise, or if no server answers, it runs the
-  command itself.  A server whose sources changed refuses and exits;
+  numba, MuJoCo, matplotlib, ``PYTHON*``, ``TESTBED_*``); otherwise, or if no server
+  answers, it runs the command itself.  A server whose sources changed refuses new commands
+  and exits when its running ones have ended;
 - only the user who started it may use it (the socket's folder is private, mode 0700, and the
   server checks each client's uid with ``SO_PEERCRED``);
 - Ctrl-C in the client is sent on to the child (the command ends as it would alone, status
@@ -60,8 +61,12 @@ __all__ = ["IMPORT_TIME_VARIABLES", "serve", "server_key", "socket_path", "try_s
 #: run by itself.
 IMPORT_TIME_VARIABLES = ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "OMP_NUM_THREADS",
                          "OPENBLAS_CORETYPE", "MUJOCO_GL", "MPLBACKEND", "MPLCONFIGDIR")
-#: Prefixes of further import-time variables (numba's JIT and cache settings, the interpreter's).
-IMPORT_TIME_PREFIXES = ("NUMBA_", "PYTHON")
+#: Prefixes of further import-time variables (numba's JIT and cache settings, the interpreter's,
+#: the testbed's own: ``TESTBED_SCENARIOS`` and ``TESTBED_STUDIES`` are read when their modules
+#: load, so a served command with other ones listed and ran the server's scenarios).
+IMPORT_TIME_PREFIXES = ("NUMBA_", "PYTHON", "TESTBED_")
+#: The server's own variables: not keyed (a client that sees them set uses the server anyway).
+SERVER_VARIABLES = ("TESTBED_SERVER_SOCKET", "TESTBED_NO_SERVER")
 #: Default seconds a server waits for a command before it exits.
 IDLE_S = 900.0
 #: Modules a server imports at start (matplotlib picks the backend a command alone would:
@@ -107,7 +112,7 @@ def server_key(env: dict[str, str] | None = None) -> str:
                     st = os.stat(os.path.join(dirpath, f))
                     h.update(f"{dirpath}/{f}:{st.st_size}:{st.st_mtime_ns}".encode())
     for k in sorted(env):
-        if k in IMPORT_TIME_VARIABLES or k.startswith(IMPORT_TIME_PREFIXES):
+        if (k in IMPORT_TIME_VARIABLES or k.startswith(IMPORT_TIME_PREFIXES)) and k not in SERVER_VARIABLES:
             h.update(f"{k}={env[k]}".encode())
     return h.hexdigest()
 

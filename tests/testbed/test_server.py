@@ -361,3 +361,13 @@ def test_ctrl_z_stops_the_command_with_its_client(sleeper):
     c.send_signal(signal.SIGCONT)
     out, err = c.communicate(timeout=30)
     assert (c.returncode, out, err) == (0, "slept\n", "")
+
+
+def test_another_scenario_folder_runs_alone(sleeper):
+    _, env, tmp = sleeper  # (read when testbed.pipeline.scenario loads: served, a command
+    # listed and ran the server's scenarios, not the folder it was given)
+    for var in ("TESTBED_SCENARIOS", "TESTBED_STUDIES"):
+        r = _testbed(["sleep", "0"], {**env, var: str(tmp)}, tmp)
+        assert r.returncode == cli.EXIT_USAGE and "invalid choice: 'sleep'" in r.stderr, r.stderr
+    assert not _pids(tmp)
+    assert sum("refused a command from another key" in ln for ln in _served_lines(tmp)) == 2
