@@ -351,13 +351,16 @@ def test_a_closed_standard_stream_runs_alone(sleeper):
 def test_ctrl_z_stops_the_command_with_its_client(sleeper):
     _, env, tmp = sleeper  # (the command is in its own process group: the terminal stops only
     # the client, and before this the command ran on in the background)
-    c = _client(env, tmp, "sleep", "1")
+    c = _client(env, tmp, "sleep", "3")
     _wait_for(lambda: len(_pids(tmp)) == 1, "the command started")
+    # the server logs the pid just before it sends it: let the client receive it (a Ctrl-Z in
+    # those microseconds stops the client only: a known window)
+    time.sleep(0.5)
     state = lambda pid: Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]  # noqa: E731
     c.send_signal(signal.SIGTSTP)
     _wait_for(lambda: state(c.pid) == "T" and state(_pids(tmp)[0]) == "T", "both stopped", 10)
-    time.sleep(1.5)  # longer than the command's sleep: it is still stopped (no output)
-    assert c.poll() is None and state(_pids(tmp)[0]) == "T"
+    time.sleep(0.5)
+    assert c.poll() is None and state(_pids(tmp)[0]) == "T"  # (not resumed by anything else)
     c.send_signal(signal.SIGCONT)
     out, err = c.communicate(timeout=30)
     assert (c.returncode, out, err) == (0, "slept\n", "")
