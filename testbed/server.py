@@ -15,14 +15,23 @@ Rules, so that a served command is never a different command:
 - the client uses a server only if the server's *key* equals its own: the Python executable, the
   project's source files (their paths, sizes and modification times) and every environment
   variable read when the libraries load (:data:`IMPORT_TIME_VARIABLES`: BLAS thread counts,
-  numba, MuJoCo, matplotlib, ``PYTHON*``); otherwise, or if no server answers, it runs the
-  command itself.  A server whose sources changed refuses and exits;
+  numba, MuJoCo, matplotlib, ``PYTHON*``, ``TESTBED_*``); otherwise, or if no server
+  answers, it runs the command itself.  A server whose sources changed refuses new commands
+  and exits when its running ones have ended;
 - only the user who started it may use it (the socket's folder is private, mode 0700, and the
   server checks each client's uid with ``SO_PEERCRED``);
 - Ctrl-C in the client is sent on to the child (the command ends as it would alone, status
-  130); a client that dies (``kill -9`` included) has its child's process group killed by the
-  server, so no process is left behind; the server exits after ``idle`` seconds without a
-  command, removing its socket;
+  130); Ctrl-Z stops the command's process group with the client, ``fg`` resumes both; a
+  client that dies (``kill -9`` included) has its child's process group killed by the server,
+  so no process is left behind; the server exits after ``idle`` seconds without a command,
+  removing its socket;
+- a server that dies (``kill -9`` included) or is stopped takes its running commands with it
+  (``PR_SET_PDEATHSIG``; the client also kills the command's group) and each client prints one
+  line, status :data:`SERVER_GONE_STATUS`; a signal that reaches the client before the server
+  started its command ends the client as it would alone (Ctrl-C: one line, status 130);
+- the server never waits on one client: a request is read when it has arrived, a connection
+  that sends nothing is dropped after :data:`REQUEST_TIMEOUT_S`, a damaged request is refused
+  (its descriptors closed), a client gone before the reply has its command killed;
 - ``TESTBED_NO_SERVER=1`` makes a command run itself whatever is listening.
 
 The child gets the client's arguments, folder, environment, umask and standard streams; not
@@ -52,8 +61,12 @@ __all__ = ["IMPORT_TIME_VARIABLES", "serve", "server_key", "socket_path", "try_s
 #: run by itself.
 IMPORT_TIME_VARIABLES = ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "OMP_NUM_THREADS",
                          "OPENBLAS_CORETYPE", "MUJOCO_GL", "MPLBACKEND", "MPLCONFIGDIR")
-#: Prefixes of further import-time variables (numba's JIT and cache settings, the interpreter's).
-IMPORT_TIME_PREFIXES = ("NUMBA_", "PYTHON")
+#: Prefixes of further import-time variables (numba's JIT and cache settings, the interpreter's,
+#: the testbed's own: ``TESTBED_SCENARIOS`` and ``TESTBED_STUDIES`` are read when their modules
+#: load, so a served command with other ones listed and ran the server's scenarios).
+IMPORT_TIME_PREFIXES = ("NUMBA_", "PYTHON", "TESTBED_")
+#: The server's own variables: not keyed (a client that sees them set uses the server anyway).
+SERVER_VARIABLES = ("TESTBED_SERVER_SOCKET", "TESTBED_NO_SERVER")
 #: Default seconds a server waits for a command before it exits.
 IDLE_S = 900.0
 #: Modules a server imports at start (matplotlib picks the backend a command alone would:
@@ -99,7 +112,7 @@ def server_key(env: dict[str, str] | None = None) -> str:
                     st = os.stat(os.path.join(dirpath, f))
                     h.update(f"{dirpath}/{f}:{st.st_size}:{st.st_mtime_ns}".encode())
     for k in sorted(env):
-        if k in IMPORT_TIME_VARIABLES or k.startswith(IMPORT_TIME_PREFIXES):
+        if (k in IMPORT_TIME_VARIABLES or k.startswith(IMPORT_TIME_PREFIXES)) and k not in SERVER_VARIABLES:
             h.update(f"{k}={env[k]}".encode())
     return h.hexdigest()
 
@@ -138,7 +151,10 @@ def _recv(sock: socket.socket, with_fds: int = 0) -> tuple[dict | None, list[int
         if not more:
             return None, fds
         body += more
-    return json.loads(body), fds
+    try:
+        return json.loads(body), fds
+    except ValueError:  # (the descriptors are returned: the caller closes them)
+        return None, fds
 
 
 # ---------------------------------------------------------------- client
@@ -155,53 +171,112 @@ def try_server(argv: list[str]) -> int | None:
     Returns
     -------
     int or None
-        The command's exit status, or None when no (matching) server took it.
+        The command's exit status, or None when no (matching) server took it.  A signal
+        (Ctrl-C) before the server started the command ends it as alone (status 130 and one
+        line for Ctrl-C); a server that ends while the command runs (killed, stopped) stops the
+        command: one line, status :data:`SERVER_GONE_STATUS`.
     """
     if os.environ.get("TESTBED_NO_SERVER") or not sys.platform.startswith("linux"):
         return None
     path = socket_path()
     if not path.exists():
         return None
+    if not all(_is_open(fd) for fd in (0, 1, 2)):
+        return None  # a closed standard stream (``>&-``): alone the command sees it closed
+    env = dict(os.environ)
+    key = server_key(env)  # before connecting: a server waits for the request, not for this
+    for s in (sys.stdout, sys.stderr):
+        with contextlib.suppress(Exception):
+            s.flush()
+    mask = os.umask(0o022)
+    os.umask(mask)
+    child: list[int] = []
+
+    def on_signal(signum, frame):  # forwarded: the command ends as it would alone
+        if not child:
+            raise _Signalled(signum)
+        with contextlib.suppress(OSError):
+            os.kill(child[0], signum)
+
+    def on_stop(signum, frame):  # Ctrl-Z: the command (its whole group) stops with the client
+        with contextlib.suppress(OSError):
+            if child:
+                os.killpg(child[0], signal.SIGSTOP)
+            signal.signal(signal.SIGTSTP, signal.SIG_DFL)
+            os.kill(os.getpid(), signal.SIGTSTP)  # stopped here until `fg` / SIGCONT
+            signal.signal(signal.SIGTSTP, on_stop)
+            if child:
+                os.killpg(child[0], signal.SIGCONT)
+
+    old = {s: signal.signal(s, on_signal) for s in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)}
+    old[signal.SIGTSTP] = signal.signal(signal.SIGTSTP, on_stop)
     sock = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
     try:
-        sock.connect(str(path))
-        uid = struct.unpack("3i", sock.getsockopt(socket.SOL_SOCKET, socket.SO_PEERCRED,
-                                                  struct.calcsize("3i")))[1]
-        if uid != os.getuid():
+        try:
+            sock.connect(str(path))
+            uid = struct.unpack("3i", sock.getsockopt(socket.SOL_SOCKET, socket.SO_PEERCRED,
+                                                      struct.calcsize("3i")))[1]
+            if uid != os.getuid():
+                return None
+            _send(sock, {"argv": argv, "cwd": os.getcwd(), "env": env, "umask": mask,
+                         "key": key}, (0, 1, 2))
+            reply, _ = _recv(sock)
+            if reply is None or "pid" not in reply:
+                return None  # refused (another key) or gone: run here
+            child.append(int(reply["pid"]))
+        except OSError:
             return None
-        env = dict(os.environ)
-        for s in (sys.stdout, sys.stderr):
-            with contextlib.suppress(Exception):
-                s.flush()
-        mask = os.umask(0o022)
-        os.umask(mask)
-        _send(sock, {"argv": argv, "cwd": os.getcwd(), "env": env, "umask": mask,
-                     "key": server_key(env)}, (0, 1, 2))
-        reply, _ = _recv(sock)
-        if reply is None or "pid" not in reply:
-            return None  # refused (another key) or gone: run here
-        child = int(reply["pid"])
-    except OSError:
-        sock.close()
-        return None
-
-    def forward(signum, frame):  # the command ends as it would alone
+        except _Signalled as e:  # before the command started (the server kills it if it did)
+            sock.close()
+            return _as_alone(e.signum, old)
+        with contextlib.suppress(OSError, ValueError):
+            reply, _ = _recv(sock)
+            if reply and "status" in reply:
+                return int(reply["status"])
+        # the server ended (or was killed) while the command ran: stop the command with it
         with contextlib.suppress(OSError):
-            os.kill(child, signum)
-
-    old = {s: signal.signal(s, forward) for s in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)}
-    try:
-        while True:
-            try:
-                reply, _ = _recv(sock)
-                break
-            except InterruptedError:
-                continue
-        return int(reply["status"]) if reply and "status" in reply else 3
+            os.killpg(child[0], signal.SIGKILL)
+        print(f"error: the testbed server ended while the command ran ({path}); the command was "
+              "stopped: run it again", file=sys.stderr, flush=True)
+        return SERVER_GONE_STATUS
     finally:
         for s, h in old.items():
             signal.signal(s, h)
         sock.close()
+
+
+def _is_open(fd: int) -> bool:
+    """Whether descriptor ``fd`` is open."""
+    try:
+        os.fstat(fd)
+    except OSError:
+        return False
+    return True
+
+
+#: A client's status when its server ended while the command ran (the command was killed:
+#: 128 + SIGKILL, as a shell reports a killed command).
+SERVER_GONE_STATUS = 128 + 9
+
+
+class _Signalled(Exception):
+    """A signal reached the client before the server started its command."""
+
+    def __init__(self, signum: int) -> None:
+        super().__init__(signum)
+        self.signum = signum
+
+
+def _as_alone(signum: int, handlers: dict) -> int:
+    """End as the command alone would on ``signum`` before it did any work."""
+    if signum == signal.SIGINT:
+        from testbed.cli import EXIT_INTERRUPTED
+
+        print("error: interrupted", file=sys.stderr, flush=True)
+        return EXIT_INTERRUPTED
+    signal.signal(signum, handlers.get(signum, signal.SIG_DFL))
+    os.kill(os.getpid(), signum)  # SIGTERM / SIGHUP: killed by it, as alone
+    return 128 + signum
 
 
 # ---------------------------------------------------------------- server
@@ -244,18 +319,32 @@ def _warm_up(scenario: str | None, log) -> None:
         shutil.rmtree(tmp, ignore_errors=True)
 
 
-def _child(conn: socket.socket, listener: socket.socket, request: dict, fds: list[int]) -> None:
-    """In the forked child: become the client's command, run it, exit with its status."""
-    from testbed import cli
+def _child(request: dict, fds: list[int], inherited: list, server: int) -> None:
+    """In the forked child: become the client's command, run it, exit with its status.
 
+    ``inherited`` are the server's sockets, selector and descriptors, closed here: a child that
+    held another client's connection would keep that client waiting after the server died.
+    The child is killed with the server (``PR_SET_PDEATHSIG``); its client then says so.
+    """
+    status = 3  # EXIT_INTERNAL, until cli is imported
     try:
-        listener.close()
+        from testbed import cli
+        from testbed.reporting.drawer import _die_with_parent
+
+        status = cli.EXIT_INTERNAL
         os.setpgid(0, 0)  # its own group: the server can end it with everything it started
+        _die_with_parent(server)
+        for obj in inherited:
+            with contextlib.suppress(OSError):
+                if isinstance(obj, int):
+                    os.close(obj)
+                else:
+                    obj.close()
         for target, fd in zip((0, 1, 2), fds, strict=True):
             os.dup2(fd, target)
         for fd in fds:
-            os.close(fd)
-        conn.close()
+            if fd > 2:
+                os.close(fd)
         signal.signal(signal.SIGINT, signal.default_int_handler)
         signal.signal(signal.SIGTERM, signal.SIG_DFL)
         signal.signal(signal.SIGCHLD, signal.SIG_DFL)
@@ -272,19 +361,62 @@ def _child(conn: socket.socket, listener: socket.socket, request: dict, fds: lis
     except SystemExit as e:
         status = e.code if isinstance(e.code, int) else (0 if e.code is None else 1)
     except BaseException as e:  # one line, as the command itself would print
-        with contextlib.suppress(Exception):
+        with contextlib.suppress(BaseException):
             print(f"internal error (a bug, not your input): testbed server: {type(e).__name__}: {e}",
                   file=sys.stderr, flush=True)
-        status = cli.EXIT_INTERNAL
-    for s in (sys.stdout, sys.stderr):
-        with contextlib.suppress(Exception):
-            s.flush()
-    os._exit(status)
+    finally:
+        with contextlib.suppress(BaseException):
+            _exit_work()
+        for s in (sys.stdout, sys.stderr):
+            with contextlib.suppress(BaseException):
+                s.flush()
+        os._exit(status)
+
+
+def _exit_work() -> None:
+    """What the interpreter does at exit, which the command alone gets and ``os._exit`` skips.
+
+    Joins the threads and runs their exit hooks (loky's executor: its workers stop), then the
+    ``atexit`` functions (loky's and multiprocessing's resource trackers clean up).  Without it a
+    served ``testbed sweep --jobs 2`` left its workers to notice their parent's death and its
+    resource tracker to warn of "leaked" objects on the client's terminal after it returned.
+    """
+    import atexit
+    import threading
+
+    threading._shutdown()  # (private: the interpreter's own call at exit)
+    atexit._run_exitfuncs()
+
+
+class _Server:
+    """A server's state: its listener, selector, and the clients it serves."""
+
+    def __init__(self, listener: socket.socket, key: str, log, rfd: int, wfd: int) -> None:
+        self.listener: socket.socket | None = listener
+        self.key, self.log, self.rfd, self.wfd = key, log, rfd, wfd
+        self.sel = selectors.DefaultSelector()
+        self.sel.register(listener, selectors.EVENT_READ, ("accept",))
+        self.sel.register(rfd, selectors.EVENT_READ, ("signal",))
+        self.running: dict[int, socket.socket] = {}  # child pid -> its client's connection
+        self.pending: dict[socket.socket, float] = {}  # connected, no request yet -> deadline
+
+
+#: Seconds a connected client has to send its request.  A client sends it at once; one that
+#: connects and sends nothing (stopped, or not a testbed client) is dropped after this, and
+#: meanwhile the server serves the others.
+REQUEST_TIMEOUT_S = 10.0
+#: Seconds one read of a readable request may block (a request is sent in one piece; an
+#: environment larger than the socket's buffer arrives in a few, at once).
+READ_TIMEOUT_S = 2.0
 
 
 def serve(idle: float = IDLE_S, path: Path | None = None, log=None,
           warm_up: str | None = WARM_UP) -> int:
     """Listen for commands until ``idle`` seconds pass without one (or SIGTERM / Ctrl-C).
+
+    When the sources change the server stops taking commands (clients then run alone), lets
+    the running ones finish, and exits.  SIGTERM or Ctrl-C kill the running commands (their
+    clients say so, status :data:`SERVER_GONE_STATUS`).
 
     Parameters
     ----------
@@ -310,6 +442,9 @@ def serve(idle: float = IDLE_S, path: Path | None = None, log=None,
 
         raise InputError(f"{path.parent}: the server's socket folder must be private to you "
                          "(mode 0700); set TESTBED_SERVER_SOCKET to a path in one")
+    for fd in (0, 1, 2):  # closed, it would be the number of a socket or of a client's stream
+        if not _is_open(fd):
+            os.open(os.devnull, os.O_RDWR)  # (the lowest free number: this one)
     start_env = dict(os.environ)  # as the client's: before the libraries set their defaults
     key = server_key(start_env)
     _refuse_if_served(path)
@@ -325,47 +460,65 @@ def serve(idle: float = IDLE_S, path: Path | None = None, log=None,
     signal.signal(signal.SIGCHLD, lambda *a: None)
     stop = []
     signal.signal(signal.SIGTERM, lambda *a: stop.append(1))
-    sel = selectors.DefaultSelector()
-    sel.register(listener, selectors.EVENT_READ, "accept")
-    sel.register(rfd, selectors.EVENT_READ, "signal")
-    running: dict[int, socket.socket] = {}  # child pid -> its client's connection
+    st = _Server(listener, key, log, rfd, wfd)
     log(f"testbed server listening on {path} (exits after {idle:g} s idle)")
     last = time.monotonic()
     try:
         while not stop:
-            timeout = None if running else max(0.0, idle - (time.monotonic() - last))
-            if not running and timeout == 0.0:
-                break
+            now = time.monotonic()
+            for conn in [c for c, t in st.pending.items() if t <= now]:
+                _drop(st, conn)  # connected and sent nothing
+            if st.listener is None and not st.running and not st.pending:
+                break  # the sources changed and the last command ended
+            waits = [t - now for t in st.pending.values()]
+            if not st.running and not st.pending:
+                if now - last >= idle:
+                    break
+                waits.append(idle - (now - last))
             try:
-                events = sel.select(timeout)
+                events = st.sel.select(max(0.0, min(waits)) if waits else None)
             except KeyboardInterrupt:
                 break
             for sk, _ in events:
-                if sk.data == "accept":
-                    _accept(listener, key, sel, running, log)
-                elif sk.data == "signal":
+                if sk.data[0] == "accept":
+                    _accept(st)
+                elif sk.data[0] == "signal":
                     with contextlib.suppress(BlockingIOError):
                         os.read(rfd, 512)
-                else:  # a client's connection readable: it went away (kill -9)
-                    pid = sk.data
+                elif sk.data[0] == "request":
+                    _request(st, sk.fileobj)
+                else:  # a running command's client readable: it went away (kill -9)
+                    st.sel.unregister(sk.fileobj)  # (reaped below or at its SIGCHLD)
                     with contextlib.suppress(ProcessLookupError):
-                        os.killpg(pid, signal.SIGKILL)
-            _reap(sel, running, log)
+                        os.killpg(sk.data[1], signal.SIGKILL)
+            _reap(st)
             if events:
                 last = time.monotonic()  # idle counts from the last command's end
-            if key != server_key(start_env):
-                log("testbed server: the sources changed; exiting")
-                break
+            if st.listener is not None and key != server_key(start_env):
+                log("testbed server: the sources changed; no new commands, exiting after the "
+                    "running ones")
+                _stop_listening(st, path, inode)
     finally:
-        for pid in running:
+        for pid in st.running:
             with contextlib.suppress(ProcessLookupError):
                 os.killpg(pid, signal.SIGKILL)
-        with contextlib.suppress(FileNotFoundError):
-            if path.stat().st_ino == inode:  # ours still (never another server's)
-                path.unlink()
-        listener.close()
+        for conn in [*st.running.values(), *st.pending]:
+            conn.close()  # running: the client says the command was stopped; pending: runs alone
+        _stop_listening(st, path, inode)
         signal.set_wakeup_fd(-1)
     return 0
+
+
+def _stop_listening(st: _Server, path: Path, inode: int) -> None:
+    """Take no more commands: close the listener and remove the socket (if still this one's)."""
+    if st.listener is None:
+        return
+    st.sel.unregister(st.listener)
+    with contextlib.suppress(FileNotFoundError):
+        if path.stat().st_ino == inode:  # ours still (never another server's)
+            path.unlink()
+    st.listener.close()
+    st.listener = None
 
 
 def _refuse_if_served(path: Path) -> None:
@@ -393,52 +546,107 @@ def _bind(path: Path) -> socket.socket:
     return listener
 
 
-def _accept(listener, key, sel, running, log) -> None:
-    conn, _ = listener.accept()
+def _accept(st: _Server) -> None:
+    """Take a connection; its request is read when it arrives (never waited for here)."""
+    try:
+        conn, _ = st.listener.accept()
+    except OSError:
+        return
+    st.pending[conn] = time.monotonic() + REQUEST_TIMEOUT_S
+    st.sel.register(conn, selectors.EVENT_READ, ("request",))
+
+
+def _drop(st: _Server, conn: socket.socket) -> None:
+    """Forget a connection whose request never came (its client, if any, runs alone)."""
+    del st.pending[conn]
+    st.sel.unregister(conn)
+    conn.close()
+    st.log("testbed server: dropped a connection that sent no command")
+
+
+def _request(st: _Server, conn: socket.socket) -> None:
+    """Read a readable connection's request; start its command, or refuse it."""
+    del st.pending[conn]
+    st.sel.unregister(conn)
+    fds: list[int] = []
     try:
         uid = struct.unpack("3i", conn.getsockopt(socket.SOL_SOCKET, socket.SO_PEERCRED,
                                                   struct.calcsize("3i")))[1]
+        conn.settimeout(READ_TIMEOUT_S)
         request, fds = _recv(conn, with_fds=3)
-        why = ("another user" if uid != os.getuid() else "a damaged request"
-               if request is None or len(fds) != 3 else "another key (sources, interpreter or "
-               "import-time environment)" if request.get("key") != key else "")
+        why = _refusal(uid, request, fds, st.key)
         if why:
-            for fd in fds:
-                os.close(fd)
-            _send(conn, {"refused": why})
+            st.log(f"testbed server: refused a command from {why}")
+            with contextlib.suppress(OSError):
+                _send(conn, {"refused": why})
             conn.close()
-            log(f"testbed server: refused a command from {why}")
             return
-    except (OSError, ValueError):
+        _start(st, conn, request, fds)
+    except (OSError, ValueError):  # (a timeout is an OSError)
+        conn.close()
+    finally:
+        for fd in fds:
+            with contextlib.suppress(OSError):
+                os.close(fd)
+
+
+def _refusal(uid: int, request, fds: list[int], key: str) -> str:
+    """Why a request is not served ("" if it is)."""
+    if uid != os.getuid():
+        return "another user"
+    r = request
+    ok = (isinstance(r, dict) and len(fds) == 3 and isinstance(r.get("argv"), list)
+          and all(isinstance(a, str) for a in r["argv"]) and isinstance(r.get("cwd"), str)
+          and isinstance(r.get("env"), dict) and isinstance(r.get("umask"), int)
+          and all(isinstance(k, str) and isinstance(v, str) for k, v in r["env"].items()))
+    if not ok:
+        return "a damaged request"
+    if r.get("key") != key:
+        return "another key (sources, interpreter or import-time environment)"
+    return ""
+
+
+def _start(st: _Server, conn: socket.socket, request: dict, fds: list[int]) -> None:
+    """Fork the command's child; tell the client its pid (or kill it if the client is gone)."""
+    try:
+        pid = os.fork()
+    except OSError as e:
+        st.log(f"testbed server: cannot fork ({e}); the command runs alone")
+        with contextlib.suppress(OSError):
+            _send(conn, {"refused": "cannot fork"})
         conn.close()
         return
-    pid = os.fork()
     if pid == 0:
-        _child(conn, listener, request, fds)
-    for fd in fds:
-        os.close(fd)
+        _child(request, fds, [st.sel, *(s for s in (st.listener,) if s), conn, *st.running.values(),
+                              *st.pending, st.rfd, st.wfd], os.getppid())
     with contextlib.suppress(OSError):
         os.setpgid(pid, pid)  # (also done by the child: whichever runs first)
-    _send(conn, {"pid": pid})
-    running[pid] = conn
-    sel.register(conn, selectors.EVENT_READ, pid)
-    log(f"testbed server: {' '.join(request['argv'])} (pid {pid})")
+    st.running[pid] = conn
+    st.log(f"testbed server: {' '.join(request['argv'])} (pid {pid})")
+    try:
+        _send(conn, {"pid": pid})
+    except OSError:  # the client went away meanwhile (killed, Ctrl-C): so does its command
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(pid, signal.SIGKILL)
+        return
+    st.sel.register(conn, selectors.EVENT_READ, ("running", pid))
 
 
-def _reap(sel, running, log) -> None:
+def _reap(st: _Server) -> None:
     """Send each ended child's exit status to its client."""
-    while running:
+    while st.running:
         try:
             pid, status, usage = os.wait4(-1, os.WNOHANG)
         except ChildProcessError:
             return
         if pid == 0:
             return
-        conn = running.pop(pid, None)
+        conn = st.running.pop(pid, None)
         if conn is None:
             continue
-        log(f"testbed server: pid {pid} ended ({usage.ru_utime + usage.ru_stime:.2f} s of CPU)")
-        sel.unregister(conn)
+        st.log(f"testbed server: pid {pid} ended ({usage.ru_utime + usage.ru_stime:.2f} s of CPU)")
+        with contextlib.suppress(KeyError, ValueError):
+            st.sel.unregister(conn)
         with contextlib.suppress(OSError):
             code = os.waitstatus_to_exitcode(status)  # -N: killed by signal N (shell: 128 + N)
             _send(conn, {"status": code if code >= 0 else 128 - code})

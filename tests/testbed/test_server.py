@@ -7,6 +7,7 @@ import json
 import os
 import re
 import signal
+import socket
 import subprocess
 import sys
 import time
@@ -156,3 +157,220 @@ def test_a_second_server_on_the_socket_is_refused(server):
     assert r.returncode == cli.EXIT_USAGE
     assert r.stderr.startswith("error: ") and "already listening" in r.stderr, r.stderr
     assert proc.poll() is None and (tmp / "sock" / "s.sock").exists()  # the first one serves on
+
+
+# ---------------------------------------------------------------- hostile clients, dying servers
+# A server of the real loop that imports nothing and whose commands sleep (``sleep SECONDS``):
+# it starts in about a second, so these tests can kill it.
+_FAKE = """
+import sys, time
+import testbed.cli as c, testbed.server as s
+c._blas_threads()  # as `testbed serve` (cli.main) does before serving: part of the key
+s._preload = lambda: None
+def main(argv):  # sleep SECONDS [STATUS [AT-EXIT-TEXT]]
+    time.sleep(float(argv[1]))
+    print("slept", flush=True)
+    if len(argv) > 3:  # printed at exit (a command alone prints it; loky's exit hooks are such)
+        import atexit
+        atexit.register(print, argv[3], flush=True)
+    return int(argv[2]) if len(argv) > 2 else 0
+c.main = main
+s.serve(idle=60, warm_up=None)
+"""
+
+
+@pytest.fixture
+def sleeper(tmp_path):
+    """A sleeping-commands server (see ``_FAKE``): its process, environment, folder, log."""
+    (tmp_path / "sock").mkdir(mode=0o700)
+    env = _env(tmp_path)
+    log = open(tmp_path / "log", "w+")
+    proc = subprocess.Popen([sys.executable, "-c", _FAKE], env=env, cwd=tmp_path, stdout=log,
+                            stderr=subprocess.STDOUT)
+    t0 = time.monotonic()
+    while "listening" not in (tmp_path / "log").read_text():
+        assert proc.poll() is None, (tmp_path / "log").read_text()
+        assert time.monotonic() - t0 < 60, "the server did not start"
+        time.sleep(0.05)
+    yield proc, env, tmp_path
+    if proc.poll() is None:
+        proc.kill()
+    proc.wait()
+    log.close()
+
+
+def _client(env, cwd, *args):
+    return subprocess.Popen([sys.executable, "-m", "testbed.cli", *args], env=env, cwd=cwd,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+
+
+def _wait_for(pred, what, timeout=20.0):
+    t0 = time.monotonic()
+    while not pred():
+        assert time.monotonic() - t0 < timeout, what
+        time.sleep(0.02)
+
+
+def _pids(tmp: Path) -> list[int]:
+    return [int(ln.rsplit("(pid ", 1)[1].rstrip(")")) for ln in _served_lines(tmp) if "(pid " in ln]
+
+
+def test_a_killed_server_stops_its_commands_and_each_client_says_so(sleeper):
+    proc, env, tmp = sleeper
+    clients = [_client(env, tmp, "sleep", "60") for _ in range(2)]
+    _wait_for(lambda: len(_pids(tmp)) == 2, "two commands started")
+    proc.kill()  # SIGKILL: the clients must not wait for their commands (nor one for the other's)
+    for c in clients:
+        out, err = c.communicate(timeout=10)
+        assert c.returncode == 128 + signal.SIGKILL, err
+        assert err.startswith("error: the testbed server ended") and err.count("\n") == 1, err
+        assert "slept" not in out
+    for pid in _pids(tmp):
+        _wait_for(lambda p=pid: not _alive(p), f"command {pid} outlived its server", 10)
+
+
+def test_a_stopped_server_stops_its_commands_and_each_client_says_so(sleeper):
+    proc, env, tmp = sleeper
+    c = _client(env, tmp, "sleep", "60")
+    _wait_for(lambda: len(_pids(tmp)) == 1, "the command started")
+    proc.terminate()
+    assert proc.wait(timeout=10) == 0
+    _, err = c.communicate(timeout=10)
+    assert c.returncode == 128 + signal.SIGKILL and err.startswith("error: the testbed server ended")
+    assert not (tmp / "sock" / "s.sock").exists()
+    _wait_for(lambda: not _alive(_pids(tmp)[0]), "the command outlived its server", 10)
+
+
+def _raw(env) -> socket.socket:
+    s = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+    s.connect(env["TESTBED_SERVER_SOCKET"])
+    return s
+
+
+def test_a_silent_client_does_not_hold_the_others(sleeper):
+    proc, env, tmp = sleeper
+    silent = _raw(env)  # connects and sends nothing (a stopped client, another program)
+    try:
+        c = _client(env, tmp, "sleep", "0", "1")
+        out, err = c.communicate(timeout=30)
+        assert (c.returncode, out) == (1, "slept\n"), err  # served, with its own status
+    finally:
+        silent.close()
+    assert proc.poll() is None
+
+
+def test_damaged_requests_are_refused_and_leave_no_descriptor(sleeper):
+    import array
+    import struct
+
+    proc, env, _ = sleeper
+    fds = lambda: len(os.listdir(f"/proc/{proc.pid}/fd"))  # noqa: E731
+    before = fds()
+    for body in (b"{not json", b"[1, 2]", b'{"key": "x"}', b'{"argv": 1}'):
+        s = _raw(env)
+        s.sendmsg([struct.pack("!I", len(body)) + body],
+                  [(socket.SOL_SOCKET, socket.SCM_RIGHTS, array.array("i", (0, 1, 2)))])
+        s.settimeout(10)
+        assert b"a damaged request" in s.recv(1000)
+        s.close()
+    _wait_for(lambda: fds() == before, f"descriptors {before} -> {fds()}", 5)
+    assert proc.poll() is None
+
+
+def test_a_client_gone_before_the_reply_neither_stops_the_server_nor_runs(sleeper):
+    from testbed.server import _send, server_key
+
+    proc, env, tmp = sleeper
+    s = _raw(env)
+    request = {"argv": ["sleep", "60"], "cwd": str(tmp), "env": env, "umask": 0o022,
+               "key": server_key(env)}
+    _send(s, request, (0, 1, 2))
+    s.close()  # before the server's reply
+    _wait_for(lambda: len(_pids(tmp)) == 1, "the command started")
+    _wait_for(lambda: not _alive(_pids(tmp)[0]), "a command without a client ran on", 10)
+    c = _client(env, tmp, "sleep", "0")
+    assert c.communicate(timeout=30)[0] == "slept\n" and c.returncode == 0
+    assert proc.poll() is None
+
+
+def test_ctrl_c_before_the_server_answers_is_one_line(tmp_path):
+    (tmp_path / "sock").mkdir(mode=0o700)
+    env = _env(tmp_path)
+    mute = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)  # a server that never answers
+    mute.bind(env["TESTBED_SERVER_SOCKET"])
+    mute.listen(1)
+    mute.settimeout(30)
+    c = _client(env, tmp_path, "list")
+    conn, _ = mute.accept()
+    conn.settimeout(30)
+    assert conn.recv(4)  # the request came: the client now waits for the reply
+    c.send_signal(signal.SIGINT)
+    _, err = c.communicate(timeout=30)
+    conn.close()
+    mute.close()
+    assert (c.returncode, err) == (cli.EXIT_INTERRUPTED, "error: interrupted\n")
+
+
+def test_a_served_command_does_its_exit_work_before_its_client_returns(sleeper):
+    _, env, tmp = sleeper  # (a served sweep's loky workers and resource tracker: stopped, silent)
+    c = _client(env, tmp, "sleep", "0", "0", "at exit")
+    out, err = c.communicate(timeout=30)
+    assert (c.returncode, out, err) == (0, "slept\nat exit\n", "")
+
+
+def test_changed_sources_end_the_server_after_its_running_commands(sleeper):
+    proc, env, tmp = sleeper
+    running = _client(env, tmp, "sleep", "4", "0")
+    _wait_for(lambda: len(_pids(tmp)) == 1, "the command started")
+    source = ROOT / "testbed" / "server.py"
+    st = source.stat()
+    os.utime(source, ns=(st.st_atime_ns, st.st_mtime_ns + 1_000_000))  # "edited"
+    try:
+        # another command is refused (another key) and runs alone: here no 'sleep' command
+        late = _testbed(["sleep", "0"], env, tmp)
+        assert late.returncode == cli.EXIT_USAGE and "invalid choice: 'sleep'" in late.stderr
+        out, err = running.communicate(timeout=30)  # the running one ends as it would
+        assert (running.returncode, out, err) == (0, "slept\n", "")
+        assert proc.wait(timeout=10) == 0
+    finally:
+        os.utime(source, ns=(st.st_atime_ns, st.st_mtime_ns))  # (the module's server: its key)
+    assert any("sources changed" in ln for ln in _served_lines(tmp))
+    assert not (tmp / "sock" / "s.sock").exists()
+
+
+def test_a_closed_standard_stream_runs_alone(sleeper):
+    _, env, tmp = sleeper  # (sent, the connection itself took its number: the command's output
+    # went into it and the client reported a dead server)
+    r = subprocess.run([sys.executable, "-m", "testbed.cli", "sleep", "0"], env=env, cwd=tmp,
+                       stdin=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, timeout=60,
+                       preexec_fn=lambda: os.close(1))
+    assert r.returncode == cli.EXIT_USAGE and "invalid choice: 'sleep'" in r.stderr, r.stderr
+    assert not _pids(tmp)
+
+
+def test_ctrl_z_stops_the_command_with_its_client(sleeper):
+    _, env, tmp = sleeper  # (the command is in its own process group: the terminal stops only
+    # the client, and before this the command ran on in the background)
+    c = _client(env, tmp, "sleep", "3")
+    _wait_for(lambda: len(_pids(tmp)) == 1, "the command started")
+    # the server logs the pid just before it sends it: let the client receive it (a Ctrl-Z in
+    # those microseconds stops the client only: a known window)
+    time.sleep(0.5)
+    state = lambda pid: Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]  # noqa: E731
+    c.send_signal(signal.SIGTSTP)
+    _wait_for(lambda: state(c.pid) == "T" and state(_pids(tmp)[0]) == "T", "both stopped", 10)
+    time.sleep(0.5)
+    assert c.poll() is None and state(_pids(tmp)[0]) == "T"  # (not resumed by anything else)
+    c.send_signal(signal.SIGCONT)
+    out, err = c.communicate(timeout=30)
+    assert (c.returncode, out, err) == (0, "slept\n", "")
+
+
+def test_another_scenario_folder_runs_alone(sleeper):
+    _, env, tmp = sleeper  # (read when testbed.pipeline.scenario loads: served, a command
+    # listed and ran the server's scenarios, not the folder it was given)
+    for var in ("TESTBED_SCENARIOS", "TESTBED_STUDIES"):
+        r = _testbed(["sleep", "0"], {**env, var: str(tmp)}, tmp)
+        assert r.returncode == cli.EXIT_USAGE and "invalid choice: 'sleep'" in r.stderr, r.stderr
+    assert not _pids(tmp)
+    assert sum("refused a command from another key" in ln for ln in _served_lines(tmp)) == 2
