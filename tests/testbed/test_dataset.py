@@ -22,6 +22,18 @@ def _dataset(seed=0):
         attrs={"rig": "toy", "seed": 3, "scenario": {"name": "x", "rig": "toy"}, "gravity": "off"})
 
 
+def test_truth_and_prior_keys_come_in_one_order_whichever_path_made_them(tmp_path):
+    """A rig writes its truth in its own order, HDF5 gives it back sorted: a run's npz and its
+    report tables differed between a fresh simulation and the cache (same arrays)."""
+    ds = _dataset()
+    ds.prior = {"total_mass": 0.75, "reduced_mass_trace": 0.5}
+    ds = Dataset(ds.fs, ds.measured, ds.reference, ds.truth, ds.truth_units, ds.prior, ds.attrs)
+    back = Dataset.load(ds.save(tmp_path / "d.h5"))
+    for name in ("truth", "truth_units", "prior"):
+        assert list(getattr(back, name)) == list(getattr(ds, name)), name
+    assert list(ds.truth) == ["M", "frequencies_hz", "k3", "terms"]
+
+
 def test_round_trip_gives_back_the_same_object(tmp_path):
     ds = _dataset()
     p = ds.save(tmp_path / "d.h5")
