@@ -27,6 +27,8 @@ from urllib.parse import urlsplit
 from testbed.core.errors import InputError, ScenarioError, TestbedError
 
 EXIT_FAIL, EXIT_USAGE, EXIT_INTERNAL, EXIT_INTERRUPTED = 1, 2, 3, 130
+#: Status when the reader of standard output went away: a shell's for a command ended by SIGPIPE.
+EXIT_BROKEN_PIPE = 128 + 13
 #: Thread-count variables of the BLAS libraries numpy and scipy load (OpenBLAS, MKL, an OpenMP
 #: build).  If the user sets none, a command runs its BLAS on one thread (:func:`_blas_threads`).
 BLAS_THREAD_VARIABLES = ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "OMP_NUM_THREADS")
@@ -842,8 +844,20 @@ def _main(argv: list[str] | None) -> int:
     except KeyboardInterrupt:
         print("error: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
+    except BrokenPipeError:  # the reader went away (`testbed list | head -1`): stop quietly
+        _quiet_stdout()
+        return EXIT_BROKEN_PIPE
     except Exception as e:
         return _internal(e, args)
+
+
+def _quiet_stdout() -> None:
+    """Point standard output at /dev/null, so the interpreter's last flush into a closed pipe
+    prints nothing either (Python's documented remedy, "Note on SIGPIPE")."""
+    with contextlib.suppress(OSError, ValueError):
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        os.close(devnull)
 
 
 def _internal(e: BaseException, args: argparse.Namespace) -> int:

@@ -190,3 +190,18 @@ def test_a_testbed_cache_that_is_a_file_is_refused_naming_the_variable(tmp_path,
     monkeypatch.setenv("TESTBED_CACHE", str(tmp_path / "text.txt"))
     assert main(["run", "michaelis_menten", "--no-figures", "--out", str(tmp_path / "o")]) == EXIT_USAGE
     assert f"$TESTBED_CACHE {tmp_path / 'text.txt'}: not a folder" in one_error_line(capsys.readouterr().err)
+
+
+def test_a_reader_that_goes_away_ends_the_command_quietly(tmp_path):
+    """`testbed list | head -1`: the reader closes the pipe while the command still writes; that
+    was sometimes "internal error ... BrokenPipeError" (status 3).  Now no line on stderr and
+    the shell's status for a command ended by SIGPIPE (or 0 if it had finished writing)."""
+    env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[2])}
+    for _ in range(3):  # the race is the point: whichever side wins, the outcome is quiet
+        p = subprocess.Popen([sys.executable, "-m", "testbed.cli", "list"], stdout=subprocess.PIPE,
+                             stderr=subprocess.PIPE, env=env, cwd=tmp_path)
+        p.stdout.read(1)
+        p.stdout.close()  # the reader goes away
+        err = p.stderr.read().decode()
+        assert p.wait(timeout=60) in (0, cli.EXIT_BROKEN_PIPE)
+        assert err == "", err
