@@ -117,6 +117,8 @@ _COLD_SECONDS = {
     "tests/test_wheel.py": 18.9, "tests/models/test_fivebar_energy.py": 15.2,
     "tests/identify/test_sindy_pi_linear.py::test_soft_cantilever_fits": 10.7,
     "eq21": 9.0,  # the scored cantilever_soft_impact and _stiff_impact_cubic, the Eq. 21 contrast
+    "server": 21.1,  # tests/testbed/test_server.py: its servers and their clients (measured alone,
+    # 2026-11-26, warm dataset cache: 19.0 + 2.1 s of CPU with the processes it waits for)
     # in-process since 2026-11-26 (cli_in_process): 0.3 s in a cold run's test process and about
     # 5.2 s in its two loky workers (measured apart: a reusable executor's workers are reaped
     # after the test), 9.0 s before as a `testbed sweep` subprocess
