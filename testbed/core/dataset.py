@@ -154,14 +154,6 @@ class Dataset:
     prior: dict[str, float] = field(default_factory=dict)
     attrs: dict[str, Any] = field(default_factory=dict)
 
-    def __post_init__(self) -> None:
-        # One order whichever path made the dataset: HDF5 hands groups back sorted by name, a
-        # rig writes them in its own order (a run's npz and report tables listed truth and prior
-        # keys in one order when simulated, in another when read from the cache).
-        self.truth = dict(sorted(self.truth.items()))
-        self.truth_units = dict(sorted(self.truth_units.items()))
-        self.prior = dict(sorted(self.prior.items()))
-
     @property
     def n_samples(self) -> int:
         return next(iter(self.measured.values())).data.shape[1]
