@@ -191,6 +191,7 @@ def try_server(argv: list[str]) -> int | None:
     mask = os.umask(0o022)
     os.umask(mask)
     child: list[int] = []
+    stop_pending: list[bool] = []
 
     def on_signal(signum, frame):  # forwarded: the command ends as it would alone
         if not child:
@@ -199,14 +200,15 @@ def try_server(argv: list[str]) -> int | None:
             os.kill(child[0], signum)
 
     def on_stop(signum, frame):  # Ctrl-Z: the command (its whole group) stops with the client
+        if not child:  # not started yet, or its pid on the way: stop both once it is known
+            stop_pending.append(True)
+            return
         with contextlib.suppress(OSError):
-            if child:
-                os.killpg(child[0], signal.SIGSTOP)
+            os.killpg(child[0], signal.SIGSTOP)
             signal.signal(signal.SIGTSTP, signal.SIG_DFL)
             os.kill(os.getpid(), signal.SIGTSTP)  # stopped here until `fg` / SIGCONT
             signal.signal(signal.SIGTSTP, on_stop)
-            if child:
-                os.killpg(child[0], signal.SIGCONT)
+            os.killpg(child[0], signal.SIGCONT)
 
     old = {s: signal.signal(s, on_signal) for s in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)}
     old[signal.SIGTSTP] = signal.signal(signal.SIGTSTP, on_stop)
@@ -224,6 +226,8 @@ def try_server(argv: list[str]) -> int | None:
             if reply is None or "pid" not in reply:
                 return None  # refused (another key) or gone: run here
             child.append(int(reply["pid"]))
+            if stop_pending:  # a Ctrl-Z that came before the pid
+                on_stop(signal.SIGTSTP, None)
         except OSError:
             return None
         except _Signalled as e:  # before the command started (the server kills it if it did)
