@@ -207,7 +207,7 @@ def _client(env, cwd, *args):
 def _wait_for(pred, what, timeout=20.0):
     t0 = time.monotonic()
     while not pred():
-        assert time.monotonic() - t0 < timeout, what
+        assert time.monotonic() - t0 < timeout, what() if callable(what) else what
         time.sleep(0.02)
 
 
@@ -351,12 +351,17 @@ def test_a_closed_standard_stream_runs_alone(sleeper):
 def test_ctrl_z_stops_the_command_with_its_client(sleeper):
     _, env, tmp = sleeper  # (the command is in its own process group: the terminal stops only
     # the client, and before this the command ran on in the background)
-    c = _client(env, tmp, "sleep", "3")
+    # the client in a process group of its own, as a shell starts a job: the kernel discards a
+    # SIGTSTP whose default action would stop a process of an orphaned group (POSIX), which a
+    # test worker's group can be
+    c = subprocess.Popen([sys.executable, "-m", "testbed.cli", "sleep", "3"], env=env, cwd=tmp,
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, process_group=0)
     _wait_for(lambda: len(_pids(tmp)) == 1, "the command started")
     # (a Ctrl-Z before the client has the pid, as here under load, waits for it)
     state = lambda pid: Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]  # noqa: E731
     c.send_signal(signal.SIGTSTP)
-    _wait_for(lambda: state(c.pid) == "T" and state(_pids(tmp)[0]) == "T", "both stopped", 10)
+    _wait_for(lambda: state(c.pid) == "T" and state(_pids(tmp)[0]) == "T",
+              lambda: f"both stopped (client {state(c.pid)}, command {state(_pids(tmp)[0])})", 10)
     time.sleep(0.5)
     assert c.poll() is None and state(_pids(tmp)[0]) == "T"  # (not resumed by anything else)
     c.send_signal(signal.SIGCONT)
