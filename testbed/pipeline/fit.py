@@ -161,11 +161,11 @@ def identify_file(path: str | os.PathLike, *, scenario: str | os.PathLike | None
     if cls.kind != kind:
         raise InputError(f"identifier {identify['method']} is for {cls.kind} rigs; the data are "
                          f"{kind}")
-    declared = getattr(cls, "prior_keys", None)
-    for key in sorted(set(prior or {}) - set(declared if declared is not None else prior or {})):
-        reads = ", ".join(declared) if declared else "none"
-        raise InputError(f"--prior {key}: identifier {identify['method']} reads no such prior; "
-                         f"it reads: {reads}")
+    declared = getattr(cls, "prior_keys", None)  # None: a plugin that declares none, any key
+    unknown = sorted(set(prior or {}) - set(declared)) if declared is not None else []
+    if unknown:
+        raise InputError(f"--prior {unknown[0]}: identifier {identify['method']} reads no such "
+                         f"prior; it reads: {', '.join(declared) or 'none'}")
     hyper = {k: v for k, v in identify.items() if k != "method"} | dict(params or {})
     where = str(scenario or "<command line>")
     hyper = cls.validate_hyperparameters(hyper, file=where)
