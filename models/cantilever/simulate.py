@@ -300,8 +300,32 @@ def check_warnings(model: mujoco.MjModel, data: mujoco.MjData, when: str = "") -
                        "(automatic) or another simulation.integrator")
 
 
+def peak_segment_angle(qpos: np.ndarray) -> tuple[float, int, int]:
+    """The largest absolute angle of any segment from the beam's axis in a run of states.
+
+    The hinges all turn about one axis, so segment ``j`` lies at ``sum_{i <= j} q_i`` from the
+    undeformed beam's axis (a soft base's hinge is ``q_0``): the angle whose sine and cosine the
+    exact chain uses where the linear truth (all at ``q = 0``) takes ``phi`` and 1.
+
+    Parameters
+    ----------
+    qpos : ndarray, shape (n_steps, nq)
+        Joint angles [rad] per step.
+
+    Returns
+    -------
+    (angle, step, segment)
+        The largest ``|phi|`` [rad], the index of its step, and its segment (1-based).
+    """
+    phi = np.abs(np.cumsum(qpos, axis=1))
+    k = int(np.argmax(phi))
+    step, seg = divmod(k, phi.shape[1])
+    return float(phi.flat[k]), step, seg + 1
+
+
 def rollout_sensors(model: mujoco.MjModel, qpos0: np.ndarray, control: np.ndarray,
-                    substeps: int, progress: Callable[[float], None] | None = None) -> np.ndarray:
+                    substeps: int, progress: Callable[[float], None] | None = None,
+                    peak_angle: list[tuple[float, float, int]] | None = None) -> np.ndarray:
     """Step ``model`` from rest at ``qpos0`` and keep every ``substeps``-th sensor reading.
 
     Parameters
@@ -314,6 +338,11 @@ def rollout_sensors(model: mujoco.MjModel, qpos0: np.ndarray, control: np.ndarra
     substeps : int
     progress : callable, optional
         Called with the fraction done after each chunk.
+    peak_angle : list, optional
+        If given, receives one tuple ``(angle, time, segment)``: the largest absolute angle
+        [rad] of any segment of the chain from the beam's axis (the running sum of the hinge
+        angles, :func:`peak_segment_angle`) over every step, the time [s] and the segment
+        (1-based, counting a soft base's stub) where it occurred.
 
     Returns
     -------
@@ -348,6 +377,10 @@ def rollout_sensors(model: mujoco.MjModel, qpos0: np.ndarray, control: np.ndarra
         check_warnings(model, data, f"near t = {times[back[0]]:.4g} s" if back.size else
                        f"between t = {start * model.opt.timestep:.4g} and {times[-1]:.4g} s")
         out[start // substeps:(start + ctrl.size) // substeps] = sens[0, ::substeps]
+        if peak_angle is not None:
+            peak = peak_segment_angle(states[0, :, 1:1 + model.nq])
+            if not peak_angle or peak[0] > peak_angle[0][0]:
+                peak_angle[:] = [(peak[0], float(states[0, peak[1], 0]), peak[2])]
         state = states[0, -1]
         if progress is not None:
             progress(min(1.0, (start + ctrl.size) / nstep))

@@ -140,3 +140,38 @@ def test_round3_studies_load(name):
     path = Path(__file__).resolve().parents[2] / "benchmarks" / "unseen" / f"{name}.toml"
     study = load_study(path)
     assert study.name == name and len(study.scenarios) >= 5
+
+
+# ------------------------------------------- round 4: deflections beyond the linear truth's reach
+def test_peak_segment_angle_sums_the_hinges():
+    from models.cantilever.simulate import peak_segment_angle
+    # segment j lies at the sum of the hinge angles up to j: 0.05, 0.11, -0.09 and 0.01, -0.02,
+    # 0.03; the largest is 0.11 rad on segment 2 at step 0
+    q = np.array([[0.05, 0.06, -0.2], [0.01, -0.03, 0.05]])
+    assert peak_segment_angle(q) == (pytest.approx(0.11), 0, 2)
+    assert peak_segment_angle(-q) == (pytest.approx(0.11), 0, 2)
+
+
+@pytest.mark.parametrize("force, refused", [(20_000.0, True), (5_000.0, False)])
+def test_large_deflection_is_refused_naming_the_key(force, refused):
+    # round3/beam_force10k (10 kN on the default beam) turned its tip segment by 0.108 rad and
+    # passed both identifiers on a truth linearised at rest; at 20 kN 0.217 rad, where MuJoCo's
+    # record departs 3.6 % from that truth.  The rig refuses beyond SMALL_ANGLE_MAX_RAD (0.1) and
+    # says which force would stay within it (the motion is nearly proportional to the force);
+    # 5 kN turns it by 0.054 rad and runs.
+    from models.cantilever import CantileverRig
+    from models.cantilever.rig import SMALL_ANGLE_MAX_RAD
+    from testbed.core.errors import RigError
+    sc = scenario_from_dict(beam(simulation={"duration": 0.02}, excitation={"peak_force": force}))
+    rig = CantileverRig(sc)
+    if not refused:
+        ds = rig.simulate()
+        assert np.all(np.isfinite(ds.measured["acceleration"].data))
+        return
+    with pytest.raises(RigError) as e:
+        rig.simulate()
+    msg = str(e.value)
+    assert msg.startswith("key 'excitation.peak_force': value 20000: the beam turns by 0.217 rad")
+    assert f"small-angle reach of {SMALL_ANGLE_MAX_RAD:g} rad" in msg
+    assert "hinge at 0.2963 m" in msg and "below about 9.2" in msg
+
