@@ -27,6 +27,7 @@ from testbed.scoring.scorers import (
     Scores,
     check_thresholds,
     failed_scores,
+    out_of_band_failures,
     score,
     uninformative_failures,
     verdict,
@@ -159,6 +160,7 @@ def run_scenario(scenario: Scenario, *, cache: DatasetCache | None = None,
         with phase("score"):
             scores = score(kind, dataset, data, clean, model)
             scores.failures.update(uninformative_failures(scores, scenario.score))
+            scores.failures.update(out_of_band_failures(scores, scenario.score))
     return RunResult(scenario, dataset, data, model, scores,
                      check_thresholds(scores.values, scenario.score), fit_time)
 

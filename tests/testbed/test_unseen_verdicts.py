@@ -175,3 +175,31 @@ def test_large_deflection_is_refused_naming_the_key(force, refused):
     assert f"small-angle reach of {SMALL_ANGLE_MAX_RAD:g} rad" in msg
     assert "hinge at 0.2963 m" in msg and "below about 9.2" in msg
 
+
+# ------------------------------------------- round 4: a mode outside the chain's band is named
+def test_failed_bar_on_a_mode_outside_the_pass_band_is_named():
+    from testbed.scoring.scorers import FAIL, Scores, out_of_band_failures, verdict
+    # round4/b_len2m: a 2 m steel beam's mode 1 (2.1 Hz) lies under the default 10 Hz high-pass;
+    # sgd_sindy put it 295x off and the run failed with no word of why
+    details = {"passband": (10.0, 6400.0), "f_true": np.array([2.09, 13.1, 36.7]),
+               "scored_modes": 3}
+    bars = {"freq_error_mode1": {"max": 0.026}, "freq_error_mode2": {"max": 0.026}}
+    s = Scores({"freq_error_mode1": 295.1, "freq_error_mode2": 0.004}, details)
+    why = out_of_band_failures(s, bars)
+    assert set(why) == {"band"}
+    assert why["band"].startswith("out of band: mode 1 (2.09 Hz) lies below the signal chain's "
+                                  "high-pass cut-off (10 Hz; signal.highpass_hz)")
+    assert "mode 2" not in why["band"] and verdict([], why) == FAIL
+    # a bar met on that mode, or a failed bar on an in-band mode: nothing to explain (no
+    # verdict changes: only failures are explained)
+    assert out_of_band_failures(Scores({"freq_error_mode1": 0.01, "freq_error_mode2": 0.004},
+                                       details), bars) == {}
+    assert out_of_band_failures(Scores({"freq_error_mode1": 0.01, "freq_error_mode2": 0.5},
+                                       details), bars) == {}
+    # the worst-over-modes bar covers every scored mode; NaN fails; above the band is named too
+    high = {**details, "f_true": np.array([120.0, 900.0, 7000.0])}
+    why = out_of_band_failures(Scores({"mac": float("nan")}, high), {"mac": {"min": 0.9}})
+    assert "mode 3 (7000 Hz) lies above the signal chain's pass band, which ends at 6400 Hz" in \
+        why["band"] and "mode 1" not in why["band"]
+    # other kinds (no pass band in the details): nothing
+    assert out_of_band_failures(Scores({"freq_error_mode1": 9.0}), bars) == {}
