@@ -65,7 +65,9 @@ def verdict_line(verdict: str, failure: str | None, n_checks: int) -> str:
         return f"[green]PASS[/]: all {n_checks} threshold(s) met"
     if verdict == FAIL:
         return f"[red]FAIL[/]: {failure}" if failure else "[red]FAIL[/]: threshold(s) not met"
-    return "[yellow]no verdict[/]: no thresholds declared in the scenario's [score] table (not a pass)"
+    # "\\[" keeps the literal "[score]" (rich would take it for a style tag and drop it)
+    return ("[yellow]no verdict[/]: no thresholds declared in the scenario's \\[score] table "
+            "(not a pass)")
 
 
 def print_score_table(result: RunResult, console: Console | None = None) -> None:
