@@ -103,7 +103,7 @@ def _identified_rows() -> list[dict]:
 
     # the RK4 loop of ImplicitModel.simulate over the whole record, called directly so that
     # only right-hand sides are timed (no input interpolation or output spline)
-    n_steps = round((data.t[-1] - data.t[0]) / est.sim_dt)
+    n_steps = round((data.t[-1] - data.t[0]) / est.sim_dt_)
     h = (data.t[-1] - data.t[0]) / n_steps
     tt = data.t[0] + 0.5 * h * np.arange(2 * n_steps + 1)
     uu = np.ascontiguousarray(np.stack([np.interp(tt, data.t, r) for r in data.u]))
@@ -136,7 +136,7 @@ def _identified_rows() -> list[dict]:
              "target": f"<= {TARGET_RHS_RATIO:g}", "ok": ratio <= TARGET_RHS_RATIO,
              "note": f"per evaluation: ours {spread(per_ours, 1e6)} us inside the compiled RK4 "
                      f"loop ({n_rhs} evaluations over {data.t[-1] - data.t[0]:g} s at "
-                     f"{est.sim_dt:g} s), Pinocchio {spread(per_pin, 1e6)} us per call from "
+                     f"{est.sim_dt_:g} s), Pinocchio {spread(per_pin, 1e6)} us per call from "
                      f"Python (its call overhead included); {rs}; was 289 us per RHS in numpy"}]
 
     def cell():

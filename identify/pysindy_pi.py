@@ -177,9 +177,9 @@ class PySINDyPI(_ImplicitMechanical):
                  val_fraction: float = 0.2,
                  selection: str = "holdout", selection_rtol: float = 0.1,
                  selection_atol: float = 1e-12, n_rollout: int = 3, rollout_segments: int = 6,
-                 prune_tol: float | None = 1e-9, sim_dt: float = 1e-3, reconcile: bool = True,
+                 prune_tol: float | None = 1e-9, sim_dt: float | None = None, reconcile: bool = True,
                  column_lowpass_hz: float | None = None, column_lowpass_order: int = 4,
-                 edge_trim: float = 0.0, input_hold: str = "linear"):
+                 edge_trim: float = 0.0, input_hold: str | None = None):
         self.library = library
         self.lhs = lhs
         self.reg_weight_lam = reg_weight_lam

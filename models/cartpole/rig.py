@@ -30,6 +30,7 @@ from testbed.core.budget import Cost
 from testbed.core.dataset import Dataset, Signal
 from testbed.core.errors import RigError
 from testbed.core.lazy import lazy_module
+from testbed.core.measurement import ZOH_DECLARATION
 from testbed.core.schema import Field
 from testbed.core.truth import MechanicalTruth
 
@@ -259,6 +260,6 @@ class CartPoleRig(Rig):
         attrs = {"engine": "mujoco", "integrator": "RK4", "timestep": float(sim["dt"]),
                  "coordinates": "x: cart position along the rail [m]; th: pole angle from the "
                                 "downward vertical [rad], positive with the pole's end towards +x",
-                 "torque_hold": "zero-order hold over each sample interval"}
+                 "torque_hold": ZOH_DECLARATION}
         return Dataset(fs=fs, measured=measured, reference=reference, truth=truth.to_dict(),
                        truth_units=units, prior={}, attrs=attrs)

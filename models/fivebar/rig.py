@@ -34,6 +34,7 @@ from models.fivebar.params import FiveBarParams
 from testbed.core.budget import Cost
 from testbed.core.dataset import Dataset, Signal
 from testbed.core.errors import RigError, show_value
+from testbed.core.measurement import ZOH_DECLARATION
 from testbed.core.schema import Field
 from testbed.core.truth import MechanicalTruth
 
@@ -332,7 +333,7 @@ class FiveBarRig(Rig):
         attrs = {"gravity": f"on: {p.g} m/s^2 along -y" if p.g else "off: horizontal plane",
                  "engine": self.scenario.simulation["engine"], "branch": p.branch,
                  "angles": "absolute th1..th4 from the world x axis, counter-clockwise",
-                 "torque_hold": "zero-order hold over each sample interval"}
+                 "torque_hold": ZOH_DECLARATION}
         rig = self.scenario.rig_params
         th0 = start_pose(rig, p)
         attrs.update(th1_0=float(th0[0]), th4_0=float(th0[1]), start_pose="given" if rig["th1_0"] is not None

@@ -64,6 +64,11 @@ class Measurement:
         ``i < m``): a free decay through the chain is the structure's modes plus these terms in
         unknown amounts (:func:`testbed.numerics.filters.chain_poles`).  A declared instrument
         property, like ``passband``.  None = not declared.
+    input_hold : {"zoh", "linear"}, optional
+        What the sampled inputs ``u`` stand for between samples, as the instrument declares it:
+        ``"zoh"`` each sample held until the next (an actuator driven by a DAC), ``"linear"`` a
+        continuous signal.  A simulation of an identified model needs it (taking held inputs
+        for linear ones adds an impulse of half a sample at the start).  None = not declared.
     """
 
     fs: float
@@ -81,6 +86,7 @@ class Measurement:
     integration: str = "exact"
     noise_std: np.ndarray | None = None
     chain_poles: np.ndarray | None = None
+    input_hold: str | None = None
 
     @property
     def n_channels(self) -> int:
@@ -93,6 +99,18 @@ class Measurement:
     @property
     def t(self) -> np.ndarray:
         return np.arange(self.n_samples) / self.fs
+
+
+#: How a dataset's provenance declares zero-order-hold inputs: an ``attrs`` entry ``<input>_hold``
+#: (the rigs write ``torque_hold``) with this value.
+ZOH_DECLARATION = "zero-order hold over each sample interval"
+
+
+def declared_input_hold(attrs: dict[str, Any]) -> str | None:
+    """``"zoh"`` where a dataset's ``attrs`` declare its inputs held (an entry ending in
+    ``_hold`` whose value is :data:`ZOH_DECLARATION`), else None (not declared)."""
+    held = [k for k, v in attrs.items() if k.endswith("_hold") and v == ZOH_DECLARATION]
+    return "zoh" if held else None
 
 
 class Trajectory(NamedTuple):

@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 
 from testbed.core.dataset import Dataset
-from testbed.core.measurement import Measurement
+from testbed.core.measurement import Measurement, declared_input_hold
 from testbed.core.schema import Field, validate_table
 from testbed.numerics import derivatives
 from testbed.numerics import filters as sig
@@ -612,7 +612,8 @@ def measure_mechanical(dataset: Dataset, cfg: Mapping[str, Any]) -> Measurement:
         on th4), ``free_start`` 0 (the input is continuous), ``prior`` a copy of the dataset's,
         ``noise_std`` the raw angles' white-noise std [rad] before any smoothing
         (:func:`testbed.numerics.noise.noise_std`; the smoothed angles no longer show it),
-        ``passband`` ``(0, cutoff_hz)`` [Hz] for ``"lowpass"`` (None otherwise).
+        ``passband`` ``(0, cutoff_hz)`` [Hz] for ``"lowpass"`` (None otherwise), ``input_hold``
+        as the dataset's provenance declares it (:func:`testbed.core.measurement.declared_input_hold`).
 
     Raises
     ------
@@ -656,7 +657,8 @@ def measure_mechanical(dataset: Dataset, cfg: Mapping[str, Any]) -> Measurement:
         x, xd, xdd = derivatives.differentiate(theta, fs, cfg["window"], cfg["polyorder"])
     return Measurement(fs=fs, x=x, xd=xd, xdd=xdd, channels=channels, u=torque,
                        inputs=tuple(t_sig.channels), input_map=input_map, prior=dict(dataset.prior),
-                       passband=passband, noise_std=noise)
+                       passband=passband, noise_std=noise,
+                       input_hold=declared_input_hold(dataset.attrs))
 
 
 def check_dynamical(cfg: Mapping[str, Any], fs: float, n_samples: int, error: ErrorFn) -> None:
@@ -703,7 +705,7 @@ def measure_dynamical(dataset: Dataset, cfg: Mapping[str, Any]) -> Measurement:
     if "input" in dataset.measured:
         u, inputs = _get(dataset, "input"), tuple(dataset.measured["input"].channels)
     return Measurement(fs=fs, x=x, xd=xd, xdd=xdd, channels=channels, u=u, inputs=inputs,
-                       prior=dict(dataset.prior))
+                       prior=dict(dataset.prior), input_hold=declared_input_hold(dataset.attrs))
 
 
 register_signal_chain(SignalChain("structural", STRUCTURAL_SIGNAL_SCHEMA, measure_structural,

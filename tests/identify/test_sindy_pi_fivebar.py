@@ -104,7 +104,7 @@ def test_held_input_simulates_exactly(rig, fitted):
     n = 20001  # 2 s
     x0, v0, t, u = d.x[:, 0], d.xd[:, 0], d.t[:n], d.u[:, :n]
     err_zoh = np.sqrt(np.mean((fitted.simulate(x0, v0, t, u).x - d.x[:, :n]) ** 2, axis=1)).max()
-    lin = fitted.model_.simulate(x0, v0, t, u, fitted.sim_dt, "linear")
+    lin = fitted.model_.simulate(x0, v0, t, u, fitted.sim_dt_, "linear")
     err_lin = np.sqrt(np.mean((lin.x - d.x[:, :n]) ** 2, axis=1)).max()
     # taking the held torque for a linear one adds an impulse of half a sample; with the hold
     # what remains is RK4 at 1 ms (measured 6e-7 rad over 10 s)

@@ -234,7 +234,7 @@ def test_rollout_error_restarts_each_segment_from_the_measured_state(clean):
     sq = 0.0
     for a, b in pairwise(edges):
         tr = m.model_.simulate(noisy.x[:, a], noisy.xd[:, a], noisy.t[a:b], noisy.u[:, a:b],
-                               m.sim_dt, m.input_hold)
+                               m.sim_dt_, m.input_hold_)
         sq = sq + np.sum((tr.x - noisy.x[:, a:b]) ** 2, axis=1)
     want = np.sqrt(sq / (edges[-1] - i0)).max()
     assert m._rollout_error(m.model_, noisy, i0, k) == pytest.approx(want, rel=1e-12)

@@ -57,7 +57,7 @@ def test_angles_only_simulation_is_the_same_simulation(dataset_cache):
     data = _data(dataset_cache, load_scenario("fivebar_multisine"))
     m = SINDyPI(input_hold="zoh").fit(data)
     sl = slice(0, 5000)  # 0.5 s of the record
-    args = (data.x[:, 0], data.xd[:, 0], data.t[sl], data.u[:, sl], m.sim_dt, m.input_hold)
+    args = (data.x[:, 0], data.xd[:, 0], data.t[sl], data.u[:, sl], m.sim_dt_, m.input_hold_)
     full, fast = m.model_.simulate(*args), m.model_.simulate(*args, angles_only=True)
     np.testing.assert_array_equal(fast.x, full.x)
     assert fast.xd is None and fast.xdd is None
