@@ -214,8 +214,9 @@ FIT_BAND_FIELD = Field(float, None, unit="Hz", min=0.0,
 #: The peak search's lower-mode rule (rule 5 of :func:`modal_peaks`, :data:`LOWER_MODE_MAC`),
 #: declared alike by ``sgd_sindy`` and ``ls_sindy``.
 LOWER_MODES_FIELD = Field(bool, True, doc="a weaker peak below every kept one, with a shape "
-                                          "unlike each (MAC < 0.7), displaces the highest kept "
-                                          "peak (a lower mode); False: the n strongest peaks")
+                                          "unlike each (MAC < 0.7) and ringing at its own "
+                                          "frequency, displaces the highest kept peak (a lower "
+                                          "mode); False: the n strongest peaks")
 
 #: The decay hold's switch, declared alike by ``sgd_sindy`` and ``ls_sindy``
 #: (:func:`identify._modal_damping.decay_hold`).
@@ -755,9 +756,10 @@ LOWER_MODE_MAC = 0.7
 #: demodulated phase against ``2 pi f t`` (:func:`own_lock`) at least this (``2 / pi``: a phase
 #: spread evenly over pi rad, :data:`HARMONIC_LOCK`'s bar).  Noise has a chance shape, unlike
 #: any mode's: at 50 % noise (shipped soft bases) a 35.1 Hz noise peak passed the shape test
-#: and displaced mode 3; its lock is 0.02-0.28.  Measured 2026-11-26: beam_zeta1em5's mode 1
-#: 0.999 (clean and 1 %); the family's low candidates 0.04-0.69 (clamped 003's 24.9 Hz 0.12,
-#: soft 005's 55.8 Hz at 1 % 0.04).
+#: and displaced mode 3; its lock is 0.02-0.28 (white noise over a 0.5 s record at 60 Hz:
+#: 0.10-0.46).  Measured 2026-11-26: beam_zeta1em5's mode 1 0.999 (clean and 1 %); family low
+#: candidates (which the shape test already refuses) clamped 003's 24.9 Hz 0.12, 008's at 1 %
+#: 0.32-0.89 (0.89: 15.0 Hz, in the high-pass's ringing zone), soft 005's 55.8 Hz at 1 % 0.04.
 LOWER_MODE_LOCK = 2.0 / np.pi
 
 
