@@ -13,6 +13,7 @@ from identify.structural import (
     DECAY_BACKBONE_FIELD,
     DECAY_HOLD_FIELD,
     FIT_BAND_FIELD,
+    LOWER_MODES_FIELD,
     FIT_TILT_DIFFERENCES,
     MASS_PRIORS,
     MODE_SEPARATION,
@@ -166,6 +167,11 @@ class LeastSquaresSINDy(StructuralIdentifier):
         With the cubic library, run the decay hold with the backbone decay fit (step 3 and
         :mod:`identify._modal_damping`, "Cubic library"); False: no decay hold with the cubic
         library (``decay_rule_`` says which).
+    lower_modes : bool
+        True (default): the peak search's lower-mode rule
+        (:func:`identify.structural.modal_peaks`, rule 5): a weaker peak below every kept one
+        whose shape differs from each (MAC < :data:`identify.structural.LOWER_MODE_MAC`)
+        displaces the highest kept peak; False: the n strongest peaks (n sensors).
 
     Attributes
     ----------
@@ -186,6 +192,8 @@ class LeastSquaresSINDy(StructuralIdentifier):
         Spectral peaks :func:`identify.structural.modal_peaks` recognised as harmonics, not
         modes (so not the lowest peak the fit band is set from), rows ``(f [Hz], k,
         f_fundamental [Hz])``; ``harmonic_rule_`` (str) states the rule and what it found.
+    peak_count_rule_ : str
+        Which peaks were kept when more than n passed (``lower_modes``).
     M_, C_, K_ : ndarray, shape (n, n)
         ``M_ = (m_hat / n) I`` [kg], ``C_ = -M_ Xi_v`` [N s/m], ``K_ = -M_ Xi_d`` [N/m].
     K3_ : ndarray, shape (n, n) or None
@@ -247,12 +255,13 @@ class LeastSquaresSINDy(StructuralIdentifier):
                                             "with (sgd_sindy's rule)"),
         "decay_hold": DECAY_HOLD_FIELD,
         "decay_backbone": DECAY_BACKBONE_FIELD,
+        "lower_modes": LOWER_MODES_FIELD,
     }
 
     def __init__(self, cubic: bool | None = None, mass_prior: str = "reduced_mass_trace",
                  rcond: float = 1e-10, fit_band_hz: float | None = None,
                  fit_tilt: bool | None = None, eigen_hold: bool = True, decay_hold: bool = True,
-                 decay_backbone: bool = True):
+                 decay_backbone: bool = True, lower_modes: bool = True):
         self.cubic = cubic
         self.mass_prior = mass_prior
         self.rcond = rcond
@@ -261,6 +270,7 @@ class LeastSquaresSINDy(StructuralIdentifier):
         self.eigen_hold = eigen_hold
         self.decay_hold = decay_hold
         self.decay_backbone = decay_backbone
+        self.lower_modes = lower_modes
 
     def fit(self, data: Measurement) -> LeastSquaresSINDy:
         """Fit on ``data`` (signals only; the mass prior from ``data.prior``).
@@ -276,8 +286,9 @@ class LeastSquaresSINDy(StructuralIdentifier):
         self.check_params()
         m_hat = mass_prior_value(data, self.mass_prior)
 
-        ps = modal_peaks(data)
+        ps = modal_peaks(data, lower_modes=self.lower_modes)
         self.harmonics_, self.harmonic_rule_ = harmonics_array(ps), ps.harmonic_rule
+        self.peak_count_rule_ = ps.count_rule
         self.cubic_, self.cubic_rule_ = cubic_rule(data, self.cubic, self.fit_band_hz, ps.peaks)
         def band_library() -> Library:  # the regression of cubic_ in the fit band
             lib, self.fit_band_hz_, self.fit_band_rule_ = fit_band(

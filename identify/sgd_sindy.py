@@ -67,6 +67,7 @@ from identify.ls_sindy import MASS_PRIOR_FIELD
 from identify.structural import (
     DECAY_BACKBONE_FIELD,
     DECAY_HOLD_FIELD,
+    LOWER_MODES_FIELD,
     PeakSearch,
     StructuralIdentifier,
     build_library,
@@ -358,7 +359,7 @@ class SGDSINDyBase(StructuralIdentifier):
             :func:`identify.structural.fit_band_cutoff`); None without ``fit_band``.
         """
         self.check_params()
-        search = functools.cache(lambda: modal_peaks(data))
+        search = functools.cache(lambda: modal_peaks(data, lower_modes=self._lower_modes()))
         self.cubic_, self.cubic_rule_ = cubic_rule(data, self.cubic, None,
                                                    None if self.cubic is not None else search().peaks)
         self.learning_rate_, self.learning_rate_rule_ = learning_rate_for(self.cubic_,
@@ -374,6 +375,10 @@ class SGDSINDyBase(StructuralIdentifier):
             f = warp_frequency(f, float(data.fs))
         return (2.0 * np.pi * f) ** 2, search().peaks if getattr(self, "fit_band", False) else None
 
+    def _lower_modes(self) -> bool:
+        """The ``lower_modes`` hyperparameter (True where an identifier does not declare it)."""
+        return bool(getattr(self, "lower_modes", True))
+
     def _peaks(self, data: Measurement, ps: PeakSearch | None = None) -> np.ndarray:
         """The eigenvalue penalty's targets by :func:`identify.structural.modal_peaks`; sets
         ``peak_band_``, ``peak_band_rule_``, ``peaks_``, ``rejected_peaks_``, ``harmonics_``,
@@ -382,8 +387,10 @@ class SGDSINDyBase(StructuralIdentifier):
         with ``n_modes`` and ``freq_range``."""
         if ps is None:
             ps = modal_peaks(data, self.n_modes,
-                             None if self.freq_range is None else tuple(self.freq_range))
+                             None if self.freq_range is None else tuple(self.freq_range),
+                             lower_modes=self._lower_modes())
         self.peak_band_, self.peak_band_rule_ = ps.band, ps.band_rule
+        self.peak_count_rule_ = ps.count_rule
         self.peaks_, self.rejected_peaks_ = ps.peaks, ps.rejected
         self.harmonics_, self.harmonic_rule_ = harmonics_array(ps), ps.harmonic_rule
         self.measured_frequencies_ = ps.peaks
@@ -543,6 +550,12 @@ class SGDSINDy(SGDSINDyBase):
         ``init="lstsq"`` and ``epochs`` > 0.  True: the SGD's result; False: the held warm
         start's (no SGD is run).  ``keep_sgd_`` and ``keep_sgd_rule_`` say which and why; see
         Notes.
+    lower_modes : bool
+        True (default): the peak search's lower-mode rule
+        (:func:`identify.structural.modal_peaks`, rule 5): a weaker peak below every kept one
+        whose shape differs from each (MAC < :data:`identify.structural.LOWER_MODE_MAC`)
+        displaces the highest kept peak; False: the ``n_modes`` strongest peaks.
+        ``peak_count_rule_`` (str) says what it did.
 
     Notes
     -----
@@ -723,6 +736,8 @@ class SGDSINDy(SGDSINDyBase):
     harmonics_ : ndarray, shape (h, 3)
         Peaks recognised as harmonics, rows ``(f [Hz], k, f_fundamental [Hz])``;
         ``harmonic_rule_`` (str) states the rule and what it found.
+    peak_count_rule_ : str
+        Which peaks were kept when more than ``n_modes`` passed (``lower_modes``).
     alphas_ : dict of str to float
         Final weights ``sym`` (``alpha_init``, unused), ``eig`` and ``l1`` (the largest lasso
         weight; 0 once debiasing).
@@ -830,6 +845,7 @@ class SGDSINDy(SGDSINDyBase):
                                           "its simulated response leaves more than twice the "
                                           "warm start's unexplained share of the record, and "
                                           "more than 1 %"),
+        "lower_modes": LOWER_MODES_FIELD,
     }
 
     @classmethod
@@ -852,7 +868,8 @@ class SGDSINDy(SGDSINDyBase):
                  iterate_average: float = 0.25, eigen_hold: bool = True,
                  cubic_form: str = "diagonal", fit_band: bool = True, decay_hold: bool = True,
                  fit_tilt: bool | None = None, decay_backbone: bool = True,
-                 eigen_backbone: bool = True, keep_sgd: bool | None = None):
+                 eigen_backbone: bool = True, keep_sgd: bool | None = None,
+                 lower_modes: bool = True):
         self.epochs = epochs
         self.batch_size = batch_size
         self.learning_rate = learning_rate
@@ -883,6 +900,7 @@ class SGDSINDy(SGDSINDyBase):
         self.fit_tilt = fit_tilt
         self.eigen_backbone = eigen_backbone
         self.keep_sgd = keep_sgd
+        self.lower_modes = lower_modes
 
     def settings(self) -> MatrixSGDSettings:
         """The hyperparameters :func:`identify._sgd_matrix.fit_matrix_sgd` runs with, the step

@@ -36,7 +36,8 @@ from testbed.core.measurement import Measurement, Trajectory
 from testbed.core.schema import Field
 from testbed.numerics.filters import elliptic_highpass
 from testbed.numerics.shapes import mac_matrix
-from testbed.numerics.spectral import harmonic_amplitude_law, harmonic_lock, peak_candidates
+from testbed.numerics.spectral import (band_analytic, harmonic_amplitude_law, harmonic_lock,
+                                       peak_candidates)
 
 # imported on first use: `testbed list` does not pay for them
 sfft = lazy_module("scipy.fft")
@@ -209,6 +210,13 @@ FIT_BAND_ORDER = 5
 FIT_BAND_FIELD = Field(float, None, unit="Hz", min=0.0,
                        doc="high-pass applied to every feature and target of the fit; default "
                            "by rule: 0.7 x the lowest measured peak; 0 = none")
+
+#: The peak search's lower-mode rule (rule 5 of :func:`modal_peaks`, :data:`LOWER_MODE_MAC`),
+#: declared alike by ``sgd_sindy`` and ``ls_sindy``.
+LOWER_MODES_FIELD = Field(bool, True, doc="a weaker peak below every kept one, with a shape "
+                                          "unlike each (MAC < 0.7) and ringing at its own "
+                                          "frequency, displaces the highest kept peak (a lower "
+                                          "mode); False: the n strongest peaks")
 
 #: The decay hold's switch, declared alike by ``sgd_sindy`` and ``ls_sindy``
 #: (:func:`identify._modal_damping.decay_hold`).
@@ -730,6 +738,31 @@ SIDE_LOBE_LINES = 100.0 / np.pi
 HIGHPASS_RING_FACTOR = 2.0
 
 
+#: A candidate beyond the ``n`` strongest (rule 5 of :func:`modal_peaks`) that lies below every
+#: kept peak is a lower mode, not an artefact, when its deflection shape has a MAC below this
+#: with every kept peak's: then it displaces the highest kept peak (the model's ``n`` modes are
+#: the structure's lowest ``n``, as the truth's reduction onto the sensors; a stronger peak
+#: above them is a higher mode ringing beyond the model's reach, which an unfiltered record of
+#: a lightly damped beam holds: in acceleration each mode weighs ~ its frequency).  Measured
+#: 2026-11-26: on ``benchmarks/unseen/round3/beam_zeta1em5.toml`` (0.001 % damping, no
+#: low-pass, 3 sensors) mode 1 (82.8 Hz, 19 dB below the strongest peak) is the 4th strongest
+#: of five ringing modes, MAC 0.24 / 0.24 / 0.57 with modes 2-4; every such candidate of the
+#: beams families (studies/families.toml, clean and 1 % noise: high-pass ringing, its leakage
+#: and noise, 12.8-73.9 Hz) has a MAC of 0.82-1.00 with some kept peak (they take the lowest
+#: mode's shape, or noise's chance one on two sensors).  0.7 sits between; a genuine lower
+#: mode with a shape closer than that to a kept one is missed as before.
+LOWER_MODE_MAC = 0.7
+#: ... and only when it rings at its own frequency: the mean resultant length of its
+#: demodulated phase against ``2 pi f t`` (:func:`own_lock`) at least this (``2 / pi``: a phase
+#: spread evenly over pi rad, :data:`HARMONIC_LOCK`'s bar).  Noise has a chance shape, unlike
+#: any mode's: at 50 % noise (shipped soft bases) a 35.1 Hz noise peak passed the shape test
+#: and displaced mode 3; its lock is 0.02-0.28 (white noise over a 0.5 s record at 60 Hz:
+#: 0.10-0.46).  Measured 2026-11-26: beam_zeta1em5's mode 1 0.999 (clean and 1 %); family low
+#: candidates (which the shape test already refuses) clamped 003's 24.9 Hz 0.12, 008's at 1 %
+#: 0.32-0.89 (0.89: 15.0 Hz, in the high-pass's ringing zone), soft 005's 55.8 Hz at 1 % 0.04.
+LOWER_MODE_LOCK = 2.0 / np.pi
+
+
 @dataclass(frozen=True)
 class PeakSearch:
     """The spectral peaks a structural identifier takes as measured natural frequencies.
@@ -751,6 +784,8 @@ class PeakSearch:
         [Hz, -, Hz]; rejected, the other peaks kept.
     harmonic_rule : str
         The rule that recognised them, with its tolerances, and what it found.
+    count_rule : str
+        Which ``n_modes`` peaks were kept (rule 5 of :func:`modal_peaks`) and what it did.
     """
 
     band: tuple[float, float]
@@ -760,6 +795,7 @@ class PeakSearch:
     nonlinear: bool
     harmonics: list[tuple[float, int, float]] = field(default_factory=list)
     harmonic_rule: str = ""
+    count_rule: str = ""
 
 
 def peak_band(data: Measurement, n_window: int, freq_range: tuple[float, float] | None = None
@@ -787,7 +823,7 @@ def peak_band(data: Measurement, n_window: int, freq_range: tuple[float, float] 
 
 def modal_peaks(data: Measurement, n_modes: int | None = None,
                 freq_range: tuple[float, float] | None = None, start: int | None = None,
-                stop: int | None = None) -> PeakSearch:
+                stop: int | None = None, lower_modes: bool = True) -> PeakSearch:
     """Natural frequencies [Hz] from the spectral peaks of the measured accelerations, by rule.
 
     Rules, in order (every candidate not taken is returned with its reason):
@@ -823,7 +859,13 @@ def modal_peaks(data: Measurement, n_modes: int | None = None,
        dies within a few periods (so anything looks locked to it over its short life) and
        has the displacement's shape.
     5. *Sensors*: at most ``n_modes`` (default the number of channels: n sensors resolve at
-       most n mode shapes), the strongest.
+       most n mode shapes), the strongest; with ``lower_modes`` (default) a candidate beyond
+       them that lies below every kept peak and whose shape differs from each kept one's
+       (MAC < :data:`LOWER_MODE_MAC`), above the high-pass's ringing zone, ringing at its own
+       frequency (:func:`own_lock` >= :data:`LOWER_MODE_LOCK`: not noise), displaces the
+       highest kept peak (strongest such candidate first, until none is left): the model's
+       modes are the structure's lowest, and a higher mode may ring stronger in acceleration
+       (``count_rule``).
 
     Parameters
     ----------
@@ -834,6 +876,8 @@ def modal_peaks(data: Measurement, n_modes: int | None = None,
         Band [Hz] overriding rule 1.
     start, stop : int, optional
         Window ``[start, stop)``; default ``data.free_start`` to the end.
+    lower_modes : bool
+        Rule 5's lower-mode test (True, default); False keeps the ``n_modes`` strongest.
 
     Returns
     -------
@@ -894,13 +938,95 @@ def modal_peaks(data: Measurement, n_modes: int | None = None,
             rejected.append((float(freqs[i]), "amplitude-dependent structure (a harmonic was found): "
                                               "a record-long peak is not a linear natural frequency"))
         kept = []
+    kept, count_rule = _lower_modes_first(xdd, data.fs, freqs, shapes, kept, n_modes, ring_top,
+                                          lower_modes)
     for i in kept[n_modes:]:
-        rejected.append((float(freqs[i]), f"beyond the {n_modes} strongest (n sensors resolve at most "
+        rejected.append((float(freqs[i]), f"beyond the {n_modes} kept (n sensors resolve at most "
                                           f"n modes)"))
     kept = kept[:n_modes]
     found = "; ".join(f"{f:.4g} Hz = {k} x {f0:.4g} Hz" for f, k, f0 in harmonics) or "none found"
     return PeakSearch(band, rule, np.sort(freqs[kept]), rejected, nonlinear, harmonics,
-                      f"{HARMONIC_RULE}: {found}")
+                      f"{HARMONIC_RULE}: {found}", count_rule)
+
+
+def own_lock(x: np.ndarray, fs: float, f: float, shape: np.ndarray, rel_band: float = 1.0 / 3.0
+             ) -> float:
+    """How firmly a peak rings at its own frequency [-].
+
+    The channels, added in phase by the conjugate deflection shape, are demodulated in the band
+    ``f (1 +- rel_band)`` (:func:`testbed.numerics.spectral.band_analytic`; ``1 / (rel_band f)``
+    s dropped at each end, where the band's cut rings, as
+    :func:`testbed.numerics.spectral.harmonic_lock` does), and the phase of ``z(t) exp(-2 pi i
+    f t)`` is averaged, weighted by ``|z|``.
+
+    Parameters
+    ----------
+    x : ndarray, shape (n_channels, n_samples)
+        Free-decay signals.
+    fs : float
+        Sample rate [Hz].
+    f : float
+        Peak frequency [Hz].
+    shape : ndarray, shape (n_channels,), complex
+        Its deflection shape (:func:`deflection_shapes`).
+    rel_band : float
+        Relative half-width of the demodulation band.
+
+    Returns
+    -------
+    float
+        Mean resultant length: ``|sinc(delta T)|`` for a mode ringing ``delta`` Hz from ``f``
+        (about 1 at a refined peak), about ``1 / sqrt(2 rel_band f T)`` for noise over ``T``
+        s; NaN if nothing is left after the ends are dropped.
+    """
+    x = np.atleast_2d(np.asarray(x, dtype=float))
+    z = band_analytic(x, fs, f * (1 - rel_band), f * (1 + rel_band), np.conj(shape))
+    trim = int(np.ceil(fs / (rel_band * f)))
+    z = z[trim:x.shape[-1] - trim]
+    tot = np.abs(z).sum()
+    t = (trim + np.arange(z.size)) / fs
+    return float(np.abs((z * np.exp(-2j * np.pi * f * t)).sum()) / tot) if tot > 0 else float("nan")
+
+
+def _lower_modes_first(xdd: np.ndarray, fs: float, freqs: np.ndarray, shapes: np.ndarray,
+                       kept: list[int], n_modes: int, ring_top: float, on: bool
+                       ) -> tuple[list[int], str]:
+    """Rule 5 of :func:`modal_peaks`: the accepted candidates ``kept`` (indices into ``freqs``
+    [Hz], strongest first) reordered so that the first ``n_modes`` are the ones kept, and the
+    rule's statement.  A candidate beyond the first ``n_modes`` (strongest first) that lies
+    below each of them and above ``ring_top`` [Hz], with a deflection shape (``shapes``,
+    :func:`deflection_shapes`) of MAC < :data:`LOWER_MODE_MAC` with each, and ringing at its
+    own frequency in the window ``xdd`` sampled at ``fs`` [Hz] (:func:`own_lock` >=
+    :data:`LOWER_MODE_LOCK`), takes the place of the highest of them; repeated until no
+    candidate qualifies."""
+    strongest = f"the {n_modes} strongest accepted peaks"
+    if not on:
+        return kept, f"{strongest} (lower_modes = False: user setting)"
+    head, tail = list(kept[:n_modes]), list(kept[n_modes:])
+    moved: list[tuple[float, float]] = []
+    changed = True
+    while changed and head:
+        changed = False
+        for c in tail:
+            if not ring_top < freqs[c] < min(freqs[j] for j in head):
+                continue
+            if max(float(mac_matrix(shapes[c], shapes[j])[0, 0]) for j in head) >= LOWER_MODE_MAC:
+                continue
+            if not own_lock(xdd, fs, float(freqs[c]), shapes[c]) >= LOWER_MODE_LOCK:
+                continue
+            top = max(head, key=lambda j: freqs[j])
+            head[head.index(top)] = c
+            tail[tail.index(c)] = top
+            moved.append((float(freqs[c]), float(freqs[top])))
+            changed = True
+            break
+    did = ("; ".join(f"{a:.4g} Hz kept instead of {b:.4g} Hz" for a, b in moved)
+           or "none displaced")
+    return head + tail, (f"{strongest}, except that one beyond them below each kept peak, above "
+                         f"{HIGHPASS_RING_FACTOR:g} x the high-pass cut-off, with a shape of MAC < "
+                         f"{LOWER_MODE_MAC:g} against each and ringing at its own frequency (lock >= "
+                         f"2/pi), displaces the highest (a lower mode: a higher one rings stronger "
+                         f"in acceleration): {did}")
 
 
 #: The phase-lock harmonic rule as stored with a fitted model (``harmonic_rule_``).
