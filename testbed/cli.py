@@ -71,8 +71,17 @@ def _seed(text: str) -> int:
     return _int_at_least(0, MAX_SEED)(text)
 
 
-#: A worker count: an integer >= 1.
-_jobs = _int_at_least(1)
+#: Most sweep workers per CPU: each worker is a process that loads numpy, scipy and MuJoCo
+#: (about 300 MB) and runs one thread, so more than a few per core only share it;
+#: ``--jobs 100000`` started workers until the shared machine stalled (load 25).
+JOBS_PER_CPU = 4
+
+#: A worker count: an integer >= 1 and at most :data:`JOBS_PER_CPU` per CPU of this machine.
+_jobs = _int_at_least(1, JOBS_PER_CPU * (os.cpu_count() or 1))
+
+#: Longest ``serve --idle`` [s]: the selector's longest wait, 2^31 - 1 ms (about 24.8 days);
+#: ``--idle inf`` was an internal error (OverflowError) after the warm-up.
+MAX_IDLE_S = (2**31 - 1) / 1000
 
 
 def _stat(path: Path, option: str = "") -> os.stat_result | None:
@@ -591,8 +600,9 @@ def cmd_runs(args: argparse.Namespace) -> int:
 def cmd_serve(args: argparse.Namespace) -> int:
     from testbed.server import serve
 
-    if not args.idle > 0:
-        raise InputError(f"--idle {args.idle}: expected a positive number of seconds")
+    if not 0 < args.idle <= MAX_IDLE_S:
+        raise InputError(f"--idle {args.idle}: expected a positive number of seconds, at most "
+                         f"{MAX_IDLE_S:g} (2^31 - 1 ms)")
     return serve(idle=args.idle, warm_up=None if args.warm_up == "none" else args.warm_up)
 
 

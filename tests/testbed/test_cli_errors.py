@@ -44,6 +44,12 @@ def one_error_line(err: str) -> str:
     (["generate", "--seed", "9223372036854775808", "michaelis_menten", "-o", "{tmp}/x.h5"],
      "--seed: expected an integer <= 9223372036854775807"),
     (["sweep", "--jobs", "0", "smoke"], "--jobs: expected an integer >= 1"),
+    # at most 4 workers a CPU: 100000 started workers until the machine stalled
+    (["sweep", "--jobs", "100000", "smoke"], "--jobs: expected an integer <= "),
+    # the selector's longest wait: inf was an internal error (OverflowError) after the warm-up
+    (["serve", "--idle", "inf", "--warm-up", "none"], "--idle inf: expected a positive number of "
+                                                      "seconds, at most 2.14748e+06 (2^31 - 1 ms)"),
+    (["serve", "--idle", "1e300", "--warm-up", "none"], "--idle 1e+300: expected a positive number"),
     (["report", "{tmp}/no_such_run", "-o", "{tmp}/report"], "no such run folder or results file"),
     (["report", "{tmp}", "-o", "{tmp}/report"], "not a run folder"),
     (["report", "{tmp}/text.txt", "-o", "{tmp}/report"], "not a sweep results file"),

@@ -886,3 +886,117 @@ def test_identify_refuses_a_key_given_twice(tmp_path, capsys, option):
     assert main(argv) == EXIT_USAGE
     err = capsys.readouterr().err
     assert err == f"error: {option} 'ridge=0.2': ridge is given twice; give each key once\n"
+
+
+# ------------------------------------------------------------------------ round 4
+def test_a_csv_with_a_byte_order_mark_reads_its_time_column(tmp_path):
+    # spreadsheets write a UTF-8 byte-order mark: it became part of the first name and hid
+    # the time column "t" ("no time column (t or time) and no sample rate")
+    from testbed.pipeline.importers import read_measured
+
+    plain = _mm_csv(tmp_path / "mm.csv")
+    bom = tmp_path / "bom.csv"
+    bom.write_bytes(b"\xef\xbb\xbf" + plain.read_bytes())
+    a, b = read_measured(plain), read_measured(bom)
+    assert b.fs == a.fs == 100.0 and list(b.signals) == list(a.signals) == ["x/x", "dx/dx"]
+
+
+@pytest.mark.parametrize(("content", "fragment"), [
+    # Latin-1 text was "not a text file (UnicodeDecodeError: 'utf-8' codec can't ...)"
+    ("t,x [\u00b5m]\n0,1\n0.01,2\n".encode("latin-1"), "not UTF-8 text (byte 0xb5 at offset 5); "
+                                                       "save it as UTF-8"),
+    # a decimal comma under a semicolon delimiter: say so
+    (b"t;x [m]\n0,0;1,5\n0,01;2,5\n", "line 2: '0,0' is not a number (a decimal comma? write a point)"),
+], ids=["latin1", "decimal-comma"])
+def test_csv_text_the_reader_cannot_take_says_what_to_do(tmp_path, content, fragment):
+    from testbed.pipeline.importers import MeasuredDataError, read_measured
+
+    path = tmp_path / "x.csv"
+    path.write_bytes(content)
+    with pytest.raises(MeasuredDataError) as e:
+        read_measured(path)
+    assert str(e.value) == f"{path}: {fragment}"
+
+
+@pytest.mark.parametrize("form", ["csv", "sep005", "hdf5"])
+def test_identify_refuses_a_record_over_its_value_budget(tmp_path, monkeypatch, form):
+    # `identify` had no sample budget: a 2e6-row CSV took 73 s, a 1e7-row one minutes and
+    # gigabytes.  Checked with the budget lowered to 10 values (the records: 400 samples x 2
+    # channels, or 50 x 1); a CSV is refused before its numbers are converted (its last row
+    # is not a number), an HDF5 file from its shapes
+    from testbed.pipeline import importers
+    from testbed.pipeline.importers import MeasuredDataError, read_measured
+
+    path = _mm_csv(tmp_path / "mm.csv")
+    if form != "csv":
+        data = read_measured(path)  # written back from what the reader gives
+        if form == "sep005":
+            path = tmp_path / "mm.json"
+            path.write_text(json.dumps([{"name": n, "data": x.tolist(), "fs": data.fs, "unit_str": u}
+                                        for n, (u, x) in data.signals.items()]))
+        else:
+            path = _toy_dataset_file(tmp_path / "d.h5", None, 100.0)
+    else:
+        path.write_text(path.read_text() + "a,b,c\n")
+    monkeypatch.setattr(importers, "IDENTIFY_VALUE_BUDGET", 10)
+    with pytest.raises(MeasuredDataError, match=r"samples x .* values; expected at most 10 "
+                                                r"\(testbed.core.budget.IDENTIFY_VALUE_BUDGET"):
+        read_measured(path)
+
+
+def test_identify_refuses_a_text_file_over_its_size_budget(tmp_path, monkeypatch):
+    from testbed.pipeline import importers
+    from testbed.pipeline.importers import MeasuredDataError, read_measured
+
+    path = _mm_csv(tmp_path / "mm.csv")
+    monkeypatch.setattr(importers, "IDENTIFY_TEXT_BUDGET_BYTES", 1000)
+    with pytest.raises(MeasuredDataError, match=rf"file size {path.stat().st_size} bytes; expected "
+                                                r"at most 1000 bytes for a text file"):
+        read_measured(path)
+
+
+def test_a_study_grid_over_its_cell_budget_is_refused_at_load(tmp_path):
+    # 1000 seeds x 1000 noise levels expanded for minutes in silence before the sweep began
+    path = tmp_path / "huge.toml"
+    path.write_text('[study]\nname = "huge"\nscenarios = ["michaelis_menten"]\n'
+                    f"noise = {[k / 1000 for k in range(1000)]}\nseeds = {list(range(1000))}\n"
+                    'identifiers = ["sindy_pi_dynamical"]\n')
+    t0 = time.perf_counter()
+    with pytest.raises(BudgetError, match=r"key 'study.noise'.*the grid has 1000000 cells \(1 "
+                                          r"scenario-identifier pairs x 1000 noise levels x 1000 "
+                                          r"seeds\); the budget is 100000"):
+        load_study(path)
+    assert time.perf_counter() - t0 < HANG_S
+
+
+@pytest.mark.parametrize(("fitted", "fragment"), [
+    # a coef_ of another shape was "internal error (a bug, not your input)" in the scoring
+    ("coef", "fitted coef_ of shape (7, 3, 2); expected (n_equations, n_features), 6 features "
+             "as feature_names_ has"),
+    ("text", "fitted coef_ that is not an array of real numbers"),
+    # sys.exit(0) in a plugin's fit ended `testbed run` with status 0 and no verdict
+    ("exit", "raised SystemExit: 0"),
+])
+def test_a_run_scores_a_plugin_that_breaks_its_contract_as_a_failed_fit(monkeypatch, fitted, fragment):
+    import sys
+
+    import numpy as np
+
+    from identify.sindy_pi_dynamical import SINDyPIDynamical
+    from testbed.pipeline import plugins
+    from testbed.pipeline.scenario import load_scenario
+    from testbed.scoring.run import run_scenario
+
+    class Rogue(SINDyPIDynamical):
+        def fit(self, data):
+            if fitted == "exit":
+                sys.exit(0)
+            super().fit(data)
+            self.coef_ = np.ones((7, 3, 2)) if fitted == "coef" else np.array([["a"] * 6])
+            return self
+
+    monkeypatch.setattr(plugins.IDENTIFIERS, "origin", lambda name: "file /home/me/rogue.py")
+    result = run_scenario(load_scenario("michaelis_menten"), model=Rogue())
+    assert not result.passed
+    assert result.failure.startswith("fit failed: identifier sindy_pi_dynamical (from file "
+                                     "/home/me/rogue.py) ") and fragment in result.failure, result.failure
