@@ -829,9 +829,24 @@ def _served(argv: list[str]) -> int | None:
     return try_server(argv) if socket_path().exists() else None
 
 
+def _env_folders() -> None:
+    """``$TESTBED_SCENARIOS`` and ``$TESTBED_STUDIES``, where set, must be folders: a typo left
+    every command without scenarios ("no scenario named ...", `testbed list` empty, exit 0)
+    and a name too long for the file system was an internal error."""
+    for var, what in (("TESTBED_SCENARIOS", "scenario"), ("TESTBED_STUDIES", "study")):
+        value = os.environ.get(var)
+        if value is None:
+            continue
+        st = _stat(Path(value), f"${var}") if value else None
+        if st is None or not stat.S_ISDIR(st.st_mode):
+            raise InputError(f"${var} {value!r}: {'not a folder' if st else 'no such folder'}; "
+                             f"expected the folder of {what} files (unset it for the shipped ones)")
+
+
 def _main(argv: list[str] | None) -> int:
     args = build_parser().parse_args(argv)
     try:
+        _env_folders()
         return args.fn(args)
     except TestbedError as e:
         print(f"error: {_one_line(e)}", file=sys.stderr)

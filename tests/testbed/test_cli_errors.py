@@ -211,3 +211,20 @@ def test_a_reader_that_goes_away_ends_the_command_quietly(tmp_path):
         err = p.stderr.read().decode()
         assert p.wait(timeout=60) in (0, cli.EXIT_BROKEN_PIPE)
         assert err == "", err
+
+
+@pytest.mark.parametrize("var", ["TESTBED_SCENARIOS", "TESTBED_STUDIES"])
+@pytest.mark.parametrize(("value", "fragment"), [
+    # a typo left every command without scenarios (`testbed list` empty, exit 0)
+    ("{tmp}/no_such", "'{tmp}/no_such': no such folder; expected the folder of"),
+    ("{tmp}/text.txt", "'{tmp}/text.txt': not a folder; expected the folder of"),
+    # a name too long for the file system was an internal error (OSError)
+    ("/" + "x" * 5000, "not a usable path (a file name too long for the file system)"),
+], ids=["missing", "file", "too-long"])
+def test_a_scenario_or_study_folder_variable_that_is_no_folder_is_named(tmp_path, capsys, monkeypatch,
+                                                                       var, value, fragment):
+    (tmp_path / "text.txt").write_text("not a folder\n")
+    monkeypatch.setenv(var, value.replace("{tmp}", str(tmp_path)))
+    assert main(["list"]) == EXIT_USAGE
+    line = one_error_line(capsys.readouterr().err)
+    assert line.startswith(f"error: ${var} ") and fragment.replace("{tmp}", str(tmp_path)) in line, line
