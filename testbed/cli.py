@@ -20,6 +20,7 @@ import socket
 import stat
 import sys
 import threading
+import warnings
 from collections.abc import Callable, Iterator
 from pathlib import Path
 from urllib.parse import urlsplit
@@ -845,6 +846,20 @@ def _env_folders() -> None:
 
 def _main(argv: list[str] | None) -> int:
     args = build_parser().parse_args(argv)
+    if args.debug:
+        return _run(args)
+    # Python warnings of the libraries (numpy's overflow, a RuntimeWarning of scipy) wait until
+    # the command ends: a command that ends in its one error line shows that line alone (the
+    # warnings preceded it: several lines); one that ends in its verdict shows them after it
+    with warnings.catch_warnings(record=True) as caught:
+        status = _run(args)
+    if status in (0, EXIT_FAIL):
+        for w in caught:
+            warnings.showwarning(w.message, w.category, w.filename, w.lineno, w.file, w.line)
+    return status
+
+
+def _run(args: argparse.Namespace) -> int:
     try:
         _env_folders()
         return args.fn(args)

@@ -123,6 +123,36 @@ def test_a_key_error_from_a_bug_is_internal_not_a_user_error(monkeypatch, capsys
     assert capsys.readouterr().err.startswith("internal error")
 
 
+@pytest.mark.parametrize(("outcome", "status"), [("error", EXIT_USAGE), ("bug", EXIT_INTERNAL),
+                                                 ("fail", cli.EXIT_FAIL), ("pass", 0)])
+def test_library_warnings_never_precede_the_error_line(monkeypatch, capsys, outcome, status):
+    # numpy's and MuJoCo's warnings came before the one error line (several lines); they wait
+    # for the command's end: dropped under its error line, shown after its verdict
+    import warnings
+
+    from testbed.core.errors import IdentificationError
+
+    def command(args):
+        warnings.warn("overflow encountered in multiply", RuntimeWarning, stacklevel=1)
+        if outcome == "error":
+            raise IdentificationError("x.csv: no model")
+        if outcome == "bug":
+            raise ZeroDivisionError("a bug")
+        print("verdict")
+        return status
+
+    monkeypatch.setattr(cli, "cmd_list", command)
+    with warnings.catch_warnings(record=True) as shown:  # what reaches stderr in a process
+        warnings.simplefilter("always")
+        assert main(["list"]) == status
+    captured = capsys.readouterr()
+    if status in (EXIT_USAGE, EXIT_INTERNAL):
+        assert shown == [] and len(captured.err.splitlines()) == 1, (shown, captured.err)
+    else:
+        assert captured.out == "verdict\n"
+        assert [str(w.message) for w in shown] == ["overflow encountered in multiply"]
+
+
 #: Eight files of the corpus (the whole corpus runs in-process in test_malformed.py).
 SAMPLE = ["binary.toml", "utf16.toml", "a_study.toml", "..toml", "highpass_above_nyquist.toml",
           "kind_mismatch.toml", "duration_1e6.toml", "score_without_identify.toml"]
