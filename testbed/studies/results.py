@@ -219,7 +219,27 @@ def read_results(path: str | os.PathLike, *, set_aside: bool = False) -> list[di
         for k in scores:
             if r.get(k) is None:
                 r[k] = math.nan
+        r["passed"] = bool(r.get("passed")) and _checks_hold(r)
     return rows
+
+
+def _checks_hold(row: dict[str, Any]) -> bool:
+    """Whether every check stored in ``row["checks"]`` passes, judged again from its value and
+    threshold, a value that differs from the row's score column counting as NaN (never a
+    pass): a row edited to ``passed`` over a NaN score counted in the pass rate."""
+    from testbed.scoring.scorers import Check
+
+    try:
+        checks = json.loads(row.get("checks") or "[]")
+        judged = []
+        for c in checks:
+            value, score = float(c["value"]), float(row.get(c["metric"], math.nan))
+            same = value == score or (math.isnan(value) and math.isnan(score))
+            judged.append(Check(str(c["metric"]), value if same else math.nan, str(c["bound"]),
+                                float(c["threshold"])).passed)
+    except (TypeError, ValueError, KeyError):  # not a list of checks: nothing holds
+        return False
+    return bool(judged) and all(judged)
 
 
 def consolidate(path: str | os.PathLike, *, keep: set[str] | None = None,

@@ -706,3 +706,25 @@ def test_sigterm_ends_a_command_like_ctrl_c(monkeypatch, capsys, signum):
         assert signal.getsignal(signum) is signal.SIG_DFL  # restored: main() is called from Python
     finally:
         signal.signal(signum, previous)
+
+
+@pytest.mark.parametrize(("trac", "checks", "passed"), [
+    (0.97, None, True),              # as the sweep wrote it
+    (math.nan, None, False),         # the score edited to NaN under its passing check
+    (0.5, None, False),              # ... or to a failing value
+    (0.97, "[]", False),             # its checks removed
+    (0.97, "not json", False),
+    (0.97, '[{"metric": "trac"}]', False),
+], ids=["kept", "nan", "worse", "no-checks", "not-json", "no-threshold"])
+def test_a_results_row_edited_to_pass_is_judged_again_on_read(tmp_path, trac, checks, passed):
+    # `summary` and the report counted a row's stored "passed": a results row edited over a
+    # NaN score was a pass in the pass rate
+    res = tmp_path / "r.parquet"
+    check = [{"metric": "trac", "value": 0.97, "bound": "min", "threshold": 0.9, "passed": True}]
+    write_part(res, {"cell": "c0", "study": "s", "scenario": "a", "noise": 0.0, "seed": 0,
+                     "identifier": "m", "status": "ok", "error": "", "trac": trac, "passed": True,
+                     "checks": json.dumps(check) if checks is None else checks})
+    (row,) = read_results(res)
+    assert row["passed"] is passed
+    rate = summarize(res)[0]["pass_rate"]  # (a row without checks is held to no bar: NaN)
+    assert rate == float(passed) or (checks in ("[]", "not json") and math.isnan(rate))
