@@ -209,10 +209,11 @@ def test_a_folder_in_place_of_a_cache_entry_is_named_before_simulating(tmp_path)
     sc = load_scenario("michaelis_menten")
     cache = DatasetCache(tmp_path)
     cache.path(sc).mkdir()
-    (tmp_path / "other.h5").symlink_to(tmp_path / "other.h5")  # a link that loops: listed, cleared
+    other = f"other-{'f' * 32}.h5"  # (named as an entry: the cache lists only its own names)
+    (tmp_path / other).symlink_to(tmp_path / other)  # a link that loops: listed, cleared
     with pytest.raises(InputError, match=r"is a folder where a cached dataset belongs"):
         cache.clean(sc)
-    assert [p.name for p, _ in cache.entries()] == ["other.h5"]
+    assert [p.name for p, _ in cache.entries()] == [other]
     assert cache.clear() == 1 and cache.path(sc).is_dir()
 
 
@@ -728,3 +729,15 @@ def test_a_results_row_edited_to_pass_is_judged_again_on_read(tmp_path, trac, ch
     assert row["passed"] is passed
     rate = summarize(res)[0]["pass_rate"]  # (a row without checks is held to no bar: NaN)
     assert rate == float(passed) or (checks in ("[]", "not json") and math.isnan(rate))
+
+
+def test_cache_clear_deletes_only_the_caches_own_entries(tmp_path):
+    # `testbed cache clear --cache <folder>` deleted every *.h5 of the folder: a user's own
+    # datasets (`testbed generate -o <folder>/mine.h5`) with the cache's entries
+    entry = tmp_path / f"michaelis_menten-{'0123456789abcdef' * 2}.h5"
+    for p in (entry, tmp_path / "mine.h5", tmp_path / f"mine-{'0' * 31}.h5"):
+        p.write_bytes(b"x")
+    cache = DatasetCache(tmp_path)
+    assert [p for p, _ in cache.entries()] == [entry]
+    assert cache.clear() == 1
+    assert sorted(p.name for p in tmp_path.iterdir()) == [f"mine-{'0' * 31}.h5", "mine.h5"]
