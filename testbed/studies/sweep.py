@@ -454,6 +454,12 @@ def run_sweep(study: Study | str | os.PathLike, jobs: int = 1, dask_address: str
     try:
         previous = read_results(results, set_aside=True)
     except ResultsError as e:  # a damaged consolidated file: keep it aside, rerun its cells
+        with results.open("rb") as fh:
+            head = fh.read(4)
+        if head and head != b"PAR1":  # not Parquet at all (a dataset was renamed *.bad): not ours
+            raise InputError(f"results {results}: not a Parquet results file (it begins with "
+                             f"{head!r}); expected a results file of study {study.name!r} or a "
+                             "new path (the file is left as it is)") from None
         bad = results.with_name(results.name + ".bad")
         os.replace(results, bad)
         log.warning("%s; set aside as %s, its cells will run again", e, bad.name)

@@ -741,3 +741,18 @@ def test_cache_clear_deletes_only_the_caches_own_entries(tmp_path):
     assert [p for p, _ in cache.entries()] == [entry]
     assert cache.clear() == 1
     assert sorted(p.name for p in tmp_path.iterdir()) == [f"mine-{'0' * 31}.h5", "mine.h5"]
+
+
+def test_a_results_path_holding_another_format_is_refused_and_left_alone(fault_dir, tmp_path):
+    # `sweep --results mine.h5` renamed the user's dataset mine.h5.bad as a damaged results file
+    from testbed.core.errors import InputError
+
+    study = load_study(_study(fault_dir, "other_format", ["fault_fit"], seeds=(0,), noise=(0.0,)))
+    res = tmp_path / "mine.h5"
+    res.write_bytes(b"\x89HDF\r\n\x1a\n" + b"\0" * 100)
+    with pytest.raises(InputError, match=r"not a Parquet results file \(it begins with b'\\x89HDF'\)"):
+        run_sweep(study, results=res, cache_dir=tmp_path / "c", verbose=False)
+    assert [p.name for p in tmp_path.iterdir()] == ["mine.h5"] and res.read_bytes()[:4] == b"\x89HDF"
+    res.write_bytes(b"PAR1" + b"\0" * 100)  # a Parquet file cut short: set aside, its cells rerun
+    assert len(read_results(run_sweep(study, results=res, cache_dir=tmp_path / "c", verbose=False))) == 1
+    assert (tmp_path / "mine.h5.bad").read_bytes()[:4] == b"PAR1"
