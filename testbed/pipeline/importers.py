@@ -515,6 +515,11 @@ def _finish(raw: _Raw, fs: float | None, units: str | Mapping[str, str] | None,
         raise MeasuredDataError(path, "no time column (t or time) and no sample rate; pass fs= [Hz]")
     if not (math.isfinite(rate) and rate > 0):  # a dataset file's fs attribute of 0, -100 or NaN
         raise MeasuredDataError(path, f"sample rate {rate:g} Hz; expected a finite rate > 0 Hz")
+    n = max(lengths.values())
+    if not math.isfinite((n - 1) / rate):  # 5e-324 Hz: "inf steps" was blamed on identify.sim_dt
+        raise MeasuredDataError(path, f"sample rate {rate:g} Hz: {n} samples would last forever "
+                                      "(the duration overflows); expected a rate whose record lasts "
+                                      "a finite time")
     signals = {}
     for n in names:
         unit = units if isinstance(units, str) else (units or {}).get(n, raw.units.get(n))
@@ -629,12 +634,29 @@ def _check_hdf5_size(path: Path) -> None:
 
 def _read_sep005_file(path: Path) -> _Raw:
     try:
-        content = json.loads(path.read_text())
+        # utf-8-sig: a byte-order mark is read past, as in a CSV file
+        content = json.loads(path.read_text(encoding="utf-8-sig"), object_pairs_hook=_unique_keys)
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
         raise MeasuredDataError(path, f"not a SEP-005 JSON file ({type(e).__name__}: {e})") from None
     except RecursionError:  # arrays nested thousands deep: no channel list of SEP-005
         raise MeasuredDataError(path, "not a SEP-005 JSON file: nested too deeply") from None
+    except _DuplicateKey as e:
+        raise MeasuredDataError(path, f"key {e.args[0]!r} is given twice in one object; give each "
+                                      "key once") from None
     return _parse_sep005(path, content)
+
+
+class _DuplicateKey(Exception):
+    """A JSON object names a key twice (json.loads kept the last one silently)."""
+
+
+def _unique_keys(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
+    out: dict[str, Any] = {}
+    for k, v in pairs:
+        if k in out:
+            raise _DuplicateKey(k)
+        out[k] = v
+    return out
 
 
 def _parse_sep005(path: Path, content: Any) -> _Raw:

@@ -1000,3 +1000,31 @@ def test_a_run_scores_a_plugin_that_breaks_its_contract_as_a_failed_fit(monkeypa
     assert not result.passed
     assert result.failure.startswith("fit failed: identifier sindy_pi_dynamical (from file "
                                      "/home/me/rogue.py) ") and fragment in result.failure, result.failure
+
+
+@pytest.mark.parametrize(("edit", "fragment"), [
+    # json.loads kept the last of two "fs" keys silently
+    (lambda text: text.replace('"fs": 100.0', '"fs": 50.0, "fs": 100.0', 1),
+     "key 'fs' is given twice in one object; give each key once"),
+    # a rate of 5e-324 Hz was "key 'identify.sim_dt': value 0.001: ... inf steps"
+    (lambda text: text.replace('"fs": 100.0', '"fs": 5e-324'),
+     "sample rate 4.94066e-324 Hz: 400 samples would last forever"),
+], ids=["duplicate-key", "rate-5e-324"])
+def test_sep005_duplicate_keys_and_endless_records_are_refused(tmp_path, edit, fragment):
+    from testbed.pipeline.importers import MeasuredDataError, read_measured
+
+    path = _mm_sep005(tmp_path / "mm.json")
+    path.write_text(edit(path.read_text()))
+    with pytest.raises(MeasuredDataError) as e:
+        read_measured(path)
+    assert str(e.value).startswith(f"{path}: {fragment}"), str(e.value)
+
+
+def test_a_sep005_file_with_a_byte_order_mark_is_read(tmp_path):
+    # "not a SEP-005 JSON file (JSONDecodeError: Unexpected UTF-8 BOM ...)"
+    from testbed.pipeline.importers import read_measured
+
+    path = _mm_sep005(tmp_path / "mm.json")
+    bom = tmp_path / "bom.json"
+    bom.write_bytes(b"\xef\xbb\xbf" + path.read_bytes())
+    assert list(read_measured(bom).signals) == list(read_measured(path).signals) == ["x/x", "dx/dx"]
