@@ -258,3 +258,17 @@ def test_a_scenario_or_study_folder_variable_that_is_no_folder_is_named(tmp_path
     assert main(["list"]) == EXIT_USAGE
     line = one_error_line(capsys.readouterr().err)
     assert line.startswith(f"error: ${var} ") and fragment.replace("{tmp}", str(tmp_path)) in line, line
+
+
+@pytest.mark.parametrize(("source", "fragment"), [
+    # sys.exit(0) at import ended `testbed run` with status 0, no verdict and no line
+    ("import sys\nsys.exit(0)\n", "importing it failed: SystemExit: 0"),
+    ("import sys\nsys.exit('bye')\n", "importing it failed: SystemExit: bye"),
+])
+def test_a_plugin_that_exits_at_import_is_one_line(tmp_path, capsys, source, fragment):
+    plugin = tmp_path / "exits.py"
+    plugin.write_text(source)
+    assert main(["run", "michaelis_menten", "--plugin", str(plugin), "-o", str(tmp_path / "o")]) == EXIT_USAGE
+    line = one_error_line(capsys.readouterr().err)
+    assert line == f"error: plugin {plugin}: {fragment}", line
+    assert not (tmp_path / "o").exists()
