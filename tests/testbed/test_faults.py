@@ -756,3 +756,32 @@ def test_a_results_path_holding_another_format_is_refused_and_left_alone(fault_d
     res.write_bytes(b"PAR1" + b"\0" * 100)  # a Parquet file cut short: set aside, its cells rerun
     assert len(read_results(run_sweep(study, results=res, cache_dir=tmp_path / "c", verbose=False))) == 1
     assert (tmp_path / "mine.h5.bad").read_bytes()[:4] == b"PAR1"
+
+
+def test_a_worker_killed_by_a_plugin_is_one_line_naming_the_plugins(fault_dir, tmp_path, monkeypatch):
+    # a plugin's os._exit(0) in fit killed its loky worker: "internal error (a bug, not your
+    # input): TerminatedWorkerError ... please report it" (measured with --jobs 2; the worker's
+    # death is mimicked here, as joblib reports it)
+    from testbed.core.errors import IdentificationError
+    from testbed.studies import sweep
+
+    class TerminatedWorkerError(Exception):  # joblib.externals.loky's, by name
+        pass
+
+    real = sweep.parallel
+
+    def dying(fn, args, n_jobs):
+        if fn is not sweep.run_cell:
+            yield from real(fn, args, n_jobs)
+            return
+        raise TerminatedWorkerError("... The exit codes of the workers are {EXIT(0), EXIT(0)} ...")
+
+    monkeypatch.setattr(sweep, "parallel", dying)
+    study = load_study(_study(fault_dir, "dying", ["fault_fit"], seeds=(0,), noise=(0.0,)))
+    res = tmp_path / "r.parquet"
+    with pytest.raises(IdentificationError, match=r"sweep dying: a worker process died running cells "
+                                                  r"\(exit codes \{EXIT\(0\), EXIT\(0\)\}\): code of "
+                                                  r"plugin\(s\) .*faults.py may exit"):
+        run_sweep(study, results=res, cache_dir=tmp_path / "c", verbose=False)
+    with pytest.raises(TerminatedWorkerError):  # without plugins: the testbed's own bug, raised
+        run_sweep(replace(study, plugins=()), results=res, cache_dir=tmp_path / "c", verbose=False)
