@@ -871,13 +871,22 @@ def _uff58_channel(path: Path, k: int, s: dict[str, Any], raw: _Raw) -> tuple[st
         raise MeasuredDataError(path, f"{where} has complex ordinates; a time response is real")
     if name in raw.data:
         name = f"{name}#{k + 1}"
+    if "num_pts" in s and int(s["num_pts"]) != data.size:  # (a damaged header was read past)
+        raise MeasuredDataError(path, f"{where}: its header declares {int(s['num_pts'])} values, "
+                                      f"its data hold {data.size}")
     m = _FS_ID.search(str(s.get("id5", "")))
+    even = int(s.get("abscissa_spacing", 1)) == 1
+    if even:
+        inc = float(s.get("abscissa_inc", 0.0))
+        if not inc > 0:  # (a testbed file's exact rate in its ID line hid an increment of 0 or NaN)
+            raise MeasuredDataError(path, f"{where}: abscissa increment {inc!r} s is not > 0")
     if m is not None:
         rate = float(m.group(1))
-    elif int(s.get("abscissa_spacing", 1)) == 1:
-        inc = float(s.get("abscissa_inc", 0.0))
-        if not inc > 0:
-            raise MeasuredDataError(path, f"{where}: abscissa increment {inc!r} s is not > 0")
+        # the increment is written with 6 significant digits (rounding within 5e-6)
+        if even and not abs(inc * rate - 1.0) <= 1e-5:
+            raise MeasuredDataError(path, f"{where}: abscissa increment {inc!r} s disagrees with "
+                                          f"the rate {rate:g} Hz of its ID line")
+    elif even:
         rate = 1.0 / inc
     else:
         rate = uniform_rate(path, np.asarray(s["x"], dtype=float), f"{where} abscissa")

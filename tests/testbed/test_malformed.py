@@ -1028,3 +1028,26 @@ def test_a_sep005_file_with_a_byte_order_mark_is_read(tmp_path):
     bom = tmp_path / "bom.json"
     bom.write_bytes(b"\xef\xbb\xbf" + path.read_bytes())
     assert list(read_measured(bom).signals) == list(read_measured(path).signals) == ["x/x", "dx/dx"]
+
+
+@pytest.mark.parametrize(("old", "new", "fragment"), [
+    # the testbed's exact rate in the ID line ("fs 100.0 Hz") hid the increment of the record
+    (b"1.00000e-02", b"0.00000e+00", "record 2 (x/x): abscissa increment 0.0 s is not > 0"),
+    (b"1.00000e-02", b"        nan", "record 2 (x/x): abscissa increment nan s is not > 0"),
+    (b"1.00000e-02", b"2.00000e-02", "record 2 (x/x): abscissa increment 0.02 s disagrees with the "
+                                     "rate 100 Hz of its ID line"),
+    # a header's count of values was read past
+    (b"       400         1", b"    400000         1", "record 2 (x/x): its header declares 400000 "
+                                                       "values, its data hold 400"),
+], ids=["dt-0", "dt-nan", "dt-other", "count"])
+def test_a_uff58_header_that_contradicts_its_record_is_refused(tmp_path, old, new, fragment):
+    from testbed.pipeline.importers import MeasuredDataError, read_measured
+    from testbed.reporting.export import write_uff
+
+    path = write_uff(read_measured(_mm_csv(tmp_path / "mm.csv")).to_dataset(), tmp_path / "mm.uff")
+    raw = path.read_bytes()
+    assert raw.count(old) >= 1
+    path.write_bytes(raw.replace(old, new, 1))
+    with pytest.raises(MeasuredDataError) as e:
+        read_measured(path)
+    assert str(e.value) == f"{path}: {fragment}"
