@@ -378,10 +378,13 @@ def _check_grid(study: Study, head: dict[str, Any], file: str) -> None:
     pairs = study.combinations()
     cells = len(pairs) * len(study.noise) * len(study.seeds)
     if cells > STUDY_CELL_BUDGET:
-        factors = {"study.scenarios": len(study.scenarios), "study.identifiers": len(study.identifiers),
-                   "study.noise": len(study.noise), "study.seeds": len(study.seeds)}
-        key = max(factors, key=lambda k: factors[k])  # the longest list: first in this order on a tie
-        raise BudgetError(file, key, head[key.split(".")[1]] or f"{factors[key]} members",
+        factors = {"study.scenarios": (len(head["scenarios"]), head["scenarios"]),
+                   **{f"families.{f.name}.members": (f.members, f.members) for f in study.families},
+                   "study.identifiers": (len(study.identifiers), head["identifiers"]),
+                   "study.noise": (len(study.noise), head["noise"]),
+                   "study.seeds": (len(study.seeds), head["seeds"])}
+        key = max(factors, key=lambda k: factors[k][0])  # the longest: first in this order on a tie
+        raise BudgetError(file, key, factors[key][1],
                           f"the grid has {cells} cells ({len(pairs)} scenario-identifier pairs x "
                           f"{len(study.noise)} noise levels x {len(study.seeds)} seeds); the budget "
                           f"is {STUDY_CELL_BUDGET} (testbed.core.budget.STUDY_CELL_BUDGET)")

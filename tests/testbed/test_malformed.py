@@ -16,6 +16,7 @@ import contextlib
 import copy
 import json
 import math
+import re
 import signal
 import statistics
 import time
@@ -955,16 +956,28 @@ def test_identify_refuses_a_text_file_over_its_size_budget(tmp_path, monkeypatch
         read_measured(path)
 
 
-def test_a_study_grid_over_its_cell_budget_is_refused_at_load(tmp_path):
+@pytest.mark.parametrize(("grid", "key", "cells"), [
     # 1000 seeds x 1000 noise levels expanded for minutes in silence before the sweep began
+    (f'scenarios = ["michaelis_menten"]\nnoise = {[k / 1000 for k in range(1000)]}\n'
+     f"seeds = {list(range(1000))}\n", "study.noise", "1000000 cells (1 scenario-identifier pairs "
+                                                       "x 1000 noise levels x 1000 seeds)"),
+    # a family's members named as the key that drives the count
+    ("noise = [0.0]\nseeds = [0, 1]\n[families.mms]\nbase = \"michaelis_menten\"\n"
+     "members = 1000\n[families.mms.rig]\nVmax = {uniform = [0.5, 2.0]}\n", "families.mms.members",
+     "2000 cells (1000 scenario-identifier pairs x 1 noise levels x 2 seeds)"),
+], ids=["seeds-x-noise", "family"])
+def test_a_study_grid_over_its_cell_budget_is_refused_at_load(tmp_path, monkeypatch, grid, key, cells):
+    from testbed.studies import study
+
+    if key.startswith("families"):  # (1000 members load in about 1 s; 1e5 would take minutes)
+        monkeypatch.setattr(study, "STUDY_CELL_BUDGET", 1000)
     path = tmp_path / "huge.toml"
-    path.write_text('[study]\nname = "huge"\nscenarios = ["michaelis_menten"]\n'
-                    f"noise = {[k / 1000 for k in range(1000)]}\nseeds = {list(range(1000))}\n"
-                    'identifiers = ["sindy_pi_dynamical"]\n')
+    head, _, rest = grid.partition("[families")
+    path.write_text(f'[study]\nname = "huge"\nidentifiers = ["sindy_pi_dynamical"]\n{head}'
+                    + (f"[families{rest}" if rest else ""))
     t0 = time.perf_counter()
-    with pytest.raises(BudgetError, match=r"key 'study.noise'.*the grid has 1000000 cells \(1 "
-                                          r"scenario-identifier pairs x 1000 noise levels x 1000 "
-                                          r"seeds\); the budget is 100000"):
+    with pytest.raises(BudgetError, match=rf"key '{key}'.*the grid has {re.escape(cells)}; the "
+                                          rf"budget is {study.STUDY_CELL_BUDGET}"):
         load_study(path)
     assert time.perf_counter() - t0 < HANG_S
 
