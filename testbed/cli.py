@@ -169,6 +169,12 @@ def _output_folder(path: Path, option: str) -> Path:
     st = _stat(path, option)
     if st is not None and not stat.S_ISDIR(st.st_mode):
         raise InputError(f"{option} {path}: exists and is not a folder; expected a folder")
+    for folder in (p := Path(os.path.abspath(path)), *p.parents):
+        with contextlib.suppress(OSError):
+            if (folder / "run.json").is_file():  # (runs written there were lost to its rewrite)
+                raise InputError(f"{option} {path}: inside the run folder {folder}, which the "
+                                 "run store replaces whole when it saves that run again; expected "
+                                 "a folder outside any run")
     _writable_in(path, option, path)
     return path
 

@@ -85,12 +85,18 @@ def one_error_line(err: str) -> str:
       "--units", "a=mm"], "--units g a=mm: expected one unit for every channel"),
     # every scenario is checked before the first runs (the first one ran, then the error)
     (["run", "michaelis_menten", "{tmp}/no_such.toml", "--out", "{tmp}/o"], "no such scenario file"),
+    # an output inside a run folder was lost when the run store saved that run again
+    (["run", "michaelis_menten", "--out", "{tmp}/a_run/more"],
+     "--out {tmp}/a_run/more: inside the run folder {tmp}/a_run, which the run store replaces whole"),
+    (["report", "{tmp}", "-o", "{tmp}/a_run"], "--output {tmp}/a_run: inside the run folder"),
     # nothing the user gave is overwritten
     (["identify", "{tmp}/text.txt", "--kind", "structural", "--method", "ls_sindy", "-o",
       "{tmp}/text.txt"], "is the input file"),
 ])
 def test_user_mistakes_give_one_line_and_status_2(tmp_path, capsys, argv, fragment):
     (tmp_path / "text.txt").write_text("not a dataset\n")
+    (tmp_path / "a_run").mkdir()
+    (tmp_path / "a_run" / "run.json").write_text("{}")
     with h5py.File(tmp_path / "other.h5", "w") as f:
         f["x"] = np.zeros(3)
     argv = [a.replace("{tmp}", str(tmp_path)) for a in argv]
