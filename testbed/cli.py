@@ -604,8 +604,19 @@ def cmd_runs(args: argparse.Namespace) -> int:
     return 0
 
 
+#: Longest socket path [bytes]: Linux's ``sockaddr_un.sun_path`` holds 108 bytes with the
+#: terminating NUL; a longer $TESTBED_SERVER_SOCKET was an internal error (OSError).
+MAX_SOCKET_PATH = 107
+
+
 def cmd_serve(args: argparse.Namespace) -> int:
-    from testbed.server import serve
+    from testbed.server import serve, socket_path
+
+    where = socket_path()
+    if len(os.fsencode(where)) > MAX_SOCKET_PATH:
+        raise InputError(f"socket path {where} ($TESTBED_SERVER_SOCKET or the default): "
+                         f"{len(os.fsencode(where))} bytes; expected at most {MAX_SOCKET_PATH} "
+                         "(the longest Unix socket address)")
 
     if not 0 < args.idle <= MAX_IDLE_S:
         raise InputError(f"--idle {args.idle}: expected a positive number of seconds, at most "

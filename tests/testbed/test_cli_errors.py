@@ -278,3 +278,13 @@ def test_a_plugin_that_exits_at_import_is_one_line(tmp_path, capsys, source, fra
     line = one_error_line(capsys.readouterr().err)
     assert line == f"error: plugin {plugin}: {fragment}", line
     assert not (tmp_path / "o").exists()
+
+
+def test_a_server_socket_path_too_long_is_one_line(tmp_path, capsys, monkeypatch):
+    # was "internal error (a bug, not your input): OSError: AF_UNIX path too long"
+    path = tmp_path / ("x" * 120) / "s.sock"
+    monkeypatch.setenv("TESTBED_SERVER_SOCKET", str(path))
+    assert main(["serve", "--warm-up", "none", "--idle", "1"]) == EXIT_USAGE
+    line = one_error_line(capsys.readouterr().err)
+    assert line.startswith(f"error: socket path {path} ($TESTBED_SERVER_SOCKET or the default): ")
+    assert line.endswith("bytes; expected at most 107 (the longest Unix socket address)"), line
