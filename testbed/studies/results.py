@@ -54,6 +54,7 @@ from typing import Any
 from testbed.core.atomic import atomic_write, atomic_write_text
 from testbed.core.errors import TestbedError
 from testbed.core.lazy import lazy_module
+from testbed.scoring.scorers import Check
 
 # imported on first use: a run's report and `testbed list` do not pay for them (~0.05 s)
 pa = lazy_module("pyarrow")
@@ -227,13 +228,12 @@ def _checks_hold(row: dict[str, Any]) -> bool:
     """Whether every check stored in ``row["checks"]`` passes, judged again from its value and
     threshold, a value that differs from the row's score column counting as NaN (never a
     pass): a row edited to ``passed`` over a NaN score counted in the pass rate."""
-    from testbed.scoring.scorers import Check
-
     try:
         checks = json.loads(row.get("checks") or "[]")
         judged = []
-        for c in checks:
-            value, score = float(c["value"]), float(row.get(c["metric"], math.nan))
+        for c in checks:  # (a check without its value is judged from the score column alone)
+            score = float(row.get(c["metric"], math.nan))
+            value = float(c["value"]) if "value" in c else score
             same = value == score or (math.isnan(value) and math.isnan(score))
             judged.append(Check(str(c["metric"]), value if same else math.nan, str(c["bound"]),
                                 float(c["threshold"])).passed)
