@@ -20,6 +20,7 @@ import socket
 import stat
 import sys
 import threading
+import warnings
 from collections.abc import Callable, Iterator
 from pathlib import Path
 from urllib.parse import urlsplit
@@ -71,8 +72,17 @@ def _seed(text: str) -> int:
     return _int_at_least(0, MAX_SEED)(text)
 
 
-#: A worker count: an integer >= 1.
-_jobs = _int_at_least(1)
+#: Most sweep workers per CPU: each worker is a process that loads numpy, scipy and MuJoCo
+#: (about 300 MB) and runs one thread, so more than a few per core only share it;
+#: ``--jobs 100000`` started workers until the shared machine stalled (load 25).
+JOBS_PER_CPU = 4
+
+#: A worker count: an integer >= 1 and at most :data:`JOBS_PER_CPU` per CPU of this machine.
+_jobs = _int_at_least(1, JOBS_PER_CPU * (os.cpu_count() or 1))
+
+#: Longest ``serve --idle`` [s]: the selector's longest wait, 2^31 - 1 ms (about 24.8 days);
+#: ``--idle inf`` was an internal error (OverflowError) after the warm-up.
+MAX_IDLE_S = (2**31 - 1) / 1000
 
 
 def _stat(path: Path, option: str = "") -> os.stat_result | None:
@@ -159,6 +169,12 @@ def _output_folder(path: Path, option: str) -> Path:
     st = _stat(path, option)
     if st is not None and not stat.S_ISDIR(st.st_mode):
         raise InputError(f"{option} {path}: exists and is not a folder; expected a folder")
+    for folder in (p := Path(os.path.abspath(path)), *p.parents):
+        with contextlib.suppress(OSError):
+            if (folder / "run.json").is_file():  # (runs written there were lost to its rewrite)
+                raise InputError(f"{option} {path}: inside the run folder {folder}, which the "
+                                 "run store replaces whole when it saves that run again; expected "
+                                 "a folder outside any run")
     _writable_in(path, option, path)
     return path
 
@@ -588,11 +604,23 @@ def cmd_runs(args: argparse.Namespace) -> int:
     return 0
 
 
-def cmd_serve(args: argparse.Namespace) -> int:
-    from testbed.server import serve
+#: Longest socket path [bytes]: Linux's ``sockaddr_un.sun_path`` holds 108 bytes with the
+#: terminating NUL; a longer $TESTBED_SERVER_SOCKET was an internal error (OSError).
+MAX_SOCKET_PATH = 107
 
-    if not args.idle > 0:
-        raise InputError(f"--idle {args.idle}: expected a positive number of seconds")
+
+def cmd_serve(args: argparse.Namespace) -> int:
+    from testbed.server import serve, socket_path
+
+    where = socket_path()
+    if len(os.fsencode(where)) > MAX_SOCKET_PATH:
+        raise InputError(f"socket path {where} ($TESTBED_SERVER_SOCKET or the default): "
+                         f"{len(os.fsencode(where))} bytes; expected at most {MAX_SOCKET_PATH} "
+                         "(the longest Unix socket address)")
+
+    if not 0 < args.idle <= MAX_IDLE_S:
+        raise InputError(f"--idle {args.idle}: expected a positive number of seconds, at most "
+                         f"{MAX_IDLE_S:g} (2^31 - 1 ms)")
     return serve(idle=args.idle, warm_up=None if args.warm_up == "none" else args.warm_up)
 
 
@@ -819,9 +847,38 @@ def _served(argv: list[str]) -> int | None:
     return try_server(argv) if socket_path().exists() else None
 
 
+def _env_folders() -> None:
+    """``$TESTBED_SCENARIOS`` and ``$TESTBED_STUDIES``, where set, must be folders: a typo left
+    every command without scenarios ("no scenario named ...", `testbed list` empty, exit 0)
+    and a name too long for the file system was an internal error."""
+    for var, what in (("TESTBED_SCENARIOS", "scenario"), ("TESTBED_STUDIES", "study")):
+        value = os.environ.get(var)
+        if value is None:
+            continue
+        st = _stat(Path(value), f"${var}") if value else None
+        if st is None or not stat.S_ISDIR(st.st_mode):
+            raise InputError(f"${var} {value!r}: {'not a folder' if st else 'no such folder'}; "
+                             f"expected the folder of {what} files (unset it for the shipped ones)")
+
+
 def _main(argv: list[str] | None) -> int:
     args = build_parser().parse_args(argv)
+    if args.debug:
+        return _run(args)
+    # Python warnings of the libraries (numpy's overflow, a RuntimeWarning of scipy) wait until
+    # the command ends: a command that ends in its one error line shows that line alone (the
+    # warnings preceded it: several lines); one that ends in its verdict shows them after it
+    with warnings.catch_warnings(record=True) as caught:
+        status = _run(args)
+    if status in (0, EXIT_FAIL):
+        for w in caught:
+            warnings.showwarning(w.message, w.category, w.filename, w.lineno, w.file, w.line)
+    return status
+
+
+def _run(args: argparse.Namespace) -> int:
     try:
+        _env_folders()
         return args.fn(args)
     except TestbedError as e:
         print(f"error: {_one_line(e)}", file=sys.stderr)

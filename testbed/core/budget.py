@@ -34,6 +34,32 @@ CPU_BUDGET_S = 3600.0
 #: any impact or identification record, and keeps index arithmetic and progress bars sane.
 SAMPLE_BUDGET = 1e8
 
+#: Memory per recorded value (one sample of one channel) of a measured record that
+#: ``testbed identify`` reads [bytes]: the most any rig budgets per sample and channel (the
+#: five-bar's 1024 bytes a sample, the cantilever's 512 a sensor), for the signal chain's
+#: estimates and the identifier's library matrix.  A 2e5-row CSV of 2 channels measured
+#: about 200 bytes a value in all (2026-11-26).
+IDENTIFY_BYTES_PER_VALUE = 1024
+
+#: Values (samples x channels) a record read by ``testbed identify`` may hold: the memory
+#: budget at :data:`IDENTIFY_BYTES_PER_VALUE`, 4,194,304 (e.g. 2e6 samples of 2 channels,
+#: about 40 s to read from CSV and fit on the shared machine; 327 s of a 12.8 kHz accelerometer).
+IDENTIFY_VALUE_BUDGET = MEMORY_BUDGET_BYTES // IDENTIFY_BYTES_PER_VALUE
+
+#: Size of a text data file (CSV, SEP-005 JSON, UFF) ``testbed identify`` reads [bytes]:
+#: read into Python numbers a file may take 16 bytes of memory per byte (a 2-byte value "0,"
+#: becomes a 24-byte float and an 8-byte pointer), so 256 MiB keeps the read within
+#: :data:`MEMORY_BUDGET_BYTES`; a record within :data:`IDENTIFY_VALUE_BUDGET` written with
+#: 17 significant digits takes under 100 MiB.
+IDENTIFY_TEXT_BUDGET_BYTES = MEMORY_BUDGET_BYTES // 16
+
+#: Cells one study may expand to (scenarios, family members included, x identifiers x noise
+#: levels x seeds): 1e5.  Expanding a grid takes about 0.3 ms a cell (28 s for 1e5 on the
+#: shared machine), and at the families study's 0.9 s of CPU a cell 1e5 cells are a day's
+#: sweep on both cores; a typo such as 1000 seeds x 1000 noise levels planned for minutes
+#: in silence before.
+STUDY_CELL_BUDGET = 100_000
+
 
 @dataclass(frozen=True)
 class Cost:

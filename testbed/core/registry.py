@@ -68,8 +68,9 @@ def import_plugin(spec: str) -> Any:
     if not spec.endswith(".py"):
         try:
             return importlib.import_module(spec)
-        except Exception as e:
-            raise PluginError(f"plugin {spec}: cannot import it: {type(e).__name__}: {e}") from e
+        except (Exception, SystemExit) as e:  # (sys.exit(0) in a plugin ended a run with status 0)
+            raise PluginError(f"plugin {spec}: cannot import it: {type(e).__name__}: {e}; expected "
+                              "a .py file or an importable dotted module name") from e
     path = Path(spec).resolve()
     if not path.is_file():
         raise PluginError(f"plugin {spec}: no such file")
@@ -85,7 +86,8 @@ def import_plugin(spec: str) -> Any:
         loader_spec.loader.exec_module(module)
     except BaseException as e:
         del sys.modules[modname]
-        if isinstance(e, Exception):
+        # a plugin's sys.exit(0) ended `testbed run` with status 0 and no verdict
+        if isinstance(e, (Exception, SystemExit)):
             raise PluginError(f"plugin {spec}: importing it failed: {type(e).__name__}: {e}") from e
         raise
     return module

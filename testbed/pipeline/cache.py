@@ -24,6 +24,7 @@ import hashlib
 import json
 import logging
 import os
+import re
 import sys
 from collections.abc import Callable
 from pathlib import Path
@@ -36,6 +37,10 @@ from testbed.pipeline.plugins import rig_class
 from testbed.pipeline.scenario import Scenario
 
 log = logging.getLogger(__name__)
+
+
+#: The name of a cache entry: ``<rig>-<cache key, 32 hex digits>.h5`` (:meth:`DatasetCache.path`).
+ENTRY_NAME = re.compile(r"[^/]+-[0-9a-f]{32}\.h5")
 
 
 def default_cache_dir() -> Path:
@@ -141,7 +146,10 @@ class DatasetCache:
             return []
         # not a folder named *.h5 (`cache clear` failed on it, "Is a directory"); lstat: a link
         # that loops is listed (and cleared), not an OSError
-        return [(p, p.lstat().st_size) for p in sorted(self.directory.glob("*.h5")) if not p.is_dir()]
+        # only names this cache writes (<rig>-<32 hex digits>.h5, :meth:`path`): `cache clear`
+        # deleted every *.h5 of the folder, a user's own datasets in a --cache folder included
+        return [(p, p.lstat().st_size) for p in sorted(self.directory.glob("*.h5"))
+                if ENTRY_NAME.fullmatch(p.name) and not p.is_dir()]
 
     def clear(self) -> int:
         """Delete every cached file and any temporary file a killed writer left; return how many

@@ -80,6 +80,7 @@ def fit_or_fail(model: Any, data: Measurement, method: str | None = None) -> Non
     user's own code failed, and a run scores it as a failed fit instead of calling it an
     internal error of the testbed.
     """
+    origin = plugins.IDENTIFIERS.origin(method) if method is not None else "builtin"
     try:
         model.fit(data)
     except NUMERICAL_BREAKDOWN as e:
@@ -87,12 +88,56 @@ def fit_or_fail(model: Any, data: Measurement, method: str | None = None) -> Non
                                   f"{' '.join(str(e).split()) or 'no message'})") from None
     except TestbedError:
         raise
-    except Exception as e:
-        origin = plugins.IDENTIFIERS.origin(method) if method is not None else "builtin"
+    except (Exception, SystemExit) as e:  # a plugin's sys.exit(0) ended a run with exit 0, no verdict
         if origin == "builtin":
             raise
         raise IdentificationError(f"identifier {method} (from {origin}) raised "
                                   f"{type(e).__name__}: {' '.join(str(e).split())}") from None
+    if origin != "builtin":
+        problem = fitted_shape_problem(model)
+        if problem is not None:
+            raise IdentificationError(f"identifier {method} (from {origin}) fitted {problem}")
+
+
+def fitted_shape_problem(model: Any) -> str | None:
+    """What is wrong with the shapes of a fitted model's results, or None.
+
+    The contract of :class:`identify._base.Identifier`: a structural model's ``M_``, ``C_``,
+    ``K_`` (and ``K3_`` unless None) are real square matrices of one size (n_dof, n_dof); a
+    model with ``coef_`` holds a real 2-D array (n_equations, n_features), with one column
+    per name of ``feature_names_`` where it has them.  Checked for a user's plugin, whose
+    wrong shapes were an internal error of the scoring or the JSON ("a bug, not your input").
+    """
+    def real(name: str) -> np.ndarray | str:
+        try:
+            a = np.asarray(getattr(model, name), dtype=float)
+        except (TypeError, ValueError) as e:
+            return f"{name} that is not an array of real numbers ({type(e).__name__}: {e})"
+        return a
+
+    if getattr(model, "kind", "") == "structural" or hasattr(model, "M_"):
+        names = [k for k in ("M_", "C_", "K_", "K3_") if getattr(model, k, None) is not None]
+        if not {"M_", "C_", "K_"} <= set(names):
+            return "no M_, C_ and K_ (a structural model's matrices)"
+        arrays = [real(k) for k in names]
+        bad = next((a for a in arrays if isinstance(a, str)), None)
+        if bad is not None:
+            return bad
+        n = arrays[0].shape[0] if arrays[0].ndim == 2 else -1
+        for k, a in zip(names, arrays, strict=True):
+            if a.shape != (n, n) or n < 1:
+                return (f"{k} of shape {a.shape}; expected square matrices of one size "
+                        f"(n_dof, n_dof), M_ being {arrays[0].shape}")
+        return None
+    if getattr(model, "coef_", None) is not None:
+        coef = real("coef_")
+        if isinstance(coef, str):
+            return coef
+        names = getattr(model, "feature_names_", None)
+        if coef.ndim != 2 or (names is not None and coef.shape[1] != len(names)):
+            n = "" if names is None else f", {len(names)} features as feature_names_ has"
+            return f"coef_ of shape {coef.shape}; expected (n_equations, n_features){n}"
+    return None
 
 
 def identify_file(path: str | os.PathLike, *, scenario: str | os.PathLike | None = None,

@@ -58,6 +58,7 @@ from typing import Any
 
 import numpy as np
 
+from testbed.core.budget import IDENTIFY_BYTES_PER_VALUE, IDENTIFY_TEXT_BUDGET_BYTES, IDENTIFY_VALUE_BUDGET
 from testbed.core.dataset import Dataset, DatasetError, Signal
 from testbed.core.errors import TestbedError
 from testbed.core.measurement import Measurement
@@ -295,6 +296,12 @@ def read_measured(path: str | os.PathLike, *, format: str | None = None, fs: flo
         raise MeasuredDataError(path, "no such file")
     if fs is not None and not (isinstance(fs, (int, float)) and math.isfinite(fs) and fs > 0):
         raise MeasuredDataError(path, f"sample rate fs={fs!r} must be a finite number > 0 Hz")
+    if format != "hdf5" and path.stat().st_size > IDENTIFY_TEXT_BUDGET_BYTES:
+        raise MeasuredDataError(path, f"file size {path.stat().st_size} bytes; expected at most "
+                                      f"{IDENTIFY_TEXT_BUDGET_BYTES} bytes for a text file "
+                                      "(testbed.core.budget.IDENTIFY_TEXT_BUDGET_BYTES: read into "
+                                      "numbers it could exceed the 4 GiB memory budget); cut the "
+                                      "record or decimate it")
     reader = {"uff": _read_uff, "sep005": _read_sep005_file, "csv": _read_csv, "hdf5": _read_hdf5}[format]
     raw = reader(path)
     raw.own_units = raw.own_units or own_units
@@ -496,6 +503,7 @@ def _finish(raw: _Raw, fs: float | None, units: str | Mapping[str, str] | None,
     if len(set(lengths.values())) > 1:
         detail = ", ".join(f"{n} {k}" for n, k in lengths.items())
         raise MeasuredDataError(path, f"channels have different lengths ({detail} samples)")
+    check_record_size(path, max(lengths.values()), len(names))
     if min(lengths.values()) < 2:
         raise MeasuredDataError(path, "fewer than 2 samples")
     rate = raw.fs
@@ -507,6 +515,11 @@ def _finish(raw: _Raw, fs: float | None, units: str | Mapping[str, str] | None,
         raise MeasuredDataError(path, "no time column (t or time) and no sample rate; pass fs= [Hz]")
     if not (math.isfinite(rate) and rate > 0):  # a dataset file's fs attribute of 0, -100 or NaN
         raise MeasuredDataError(path, f"sample rate {rate:g} Hz; expected a finite rate > 0 Hz")
+    n = max(lengths.values())
+    if not math.isfinite((n - 1) / rate):  # 5e-324 Hz: "inf steps" was blamed on identify.sim_dt
+        raise MeasuredDataError(path, f"sample rate {rate:g} Hz: {n} samples would last forever "
+                                      "(the duration overflows); expected a rate whose record lasts "
+                                      "a finite time")
     signals = {}
     for n in names:
         unit = units if isinstance(units, str) else (units or {}).get(n, raw.units.get(n))
@@ -538,6 +551,19 @@ def _finish(raw: _Raw, fs: float | None, units: str | Mapping[str, str] | None,
                         prior=dict(raw.prior))
 
 
+def check_record_size(path: Path, n_samples: int, n_channels: int) -> None:
+    """Refuse a record of more than :data:`~testbed.core.budget.IDENTIFY_VALUE_BUDGET` values
+    (``n_samples`` x ``n_channels``): it would exceed the memory budget in the signal chain and
+    the identifier (a 1e7-row CSV took minutes and gigabytes before)."""
+    if n_samples * n_channels > IDENTIFY_VALUE_BUDGET:
+        raise MeasuredDataError(path, f"{n_samples} samples x {n_channels} channel(s) = "
+                                      f"{n_samples * n_channels} values; expected at most "
+                                      f"{IDENTIFY_VALUE_BUDGET} (testbed.core.budget."
+                                      "IDENTIFY_VALUE_BUDGET: the 4 GiB memory budget at "
+                                      f"{IDENTIFY_BYTES_PER_VALUE} bytes a value); cut the record, "
+                                      "decimate it or keep fewer channels")
+
+
 def uniform_rate(path: Path, t: np.ndarray, what: str = "time column") -> float:
     """Sample rate [Hz] of uniformly spaced times ``t`` [s], shape (n,); raises if not uniform."""
     t = np.asarray(t, dtype=float)
@@ -558,6 +584,7 @@ def uniform_rate(path: Path, t: np.ndarray, what: str = "time column") -> float:
 
 # --------------------------------------------------------------------------- readers
 def _read_hdf5(path: Path) -> _Raw:
+    _check_hdf5_size(path)
     try:
         ds = Dataset.load(path)
     except DatasetError as e:
@@ -588,14 +615,48 @@ def _read_hdf5(path: Path) -> _Raw:
     return raw
 
 
+def _check_hdf5_size(path: Path) -> None:
+    """The record's size from the file's metadata, before its arrays are read: each
+    ``measured/<signal>`` array of shape (channels, samples) (unreadable layouts are left to
+    :meth:`Dataset.load` to name)."""
+    import h5py
+
+    try:
+        with h5py.File(path, "r") as h:
+            group = h.get("measured")
+            shapes = [getattr(g, "shape", ()) for g in group.values()] if isinstance(group, h5py.Group) else []
+    except Exception:  # noqa: BLE001 - not a readable HDF5 file: Dataset.load says what is wrong
+        return
+    shapes = [s for s in shapes if len(s) == 2]
+    if shapes:
+        check_record_size(path, max(s[1] for s in shapes), sum(s[0] for s in shapes))
+
+
 def _read_sep005_file(path: Path) -> _Raw:
     try:
-        content = json.loads(path.read_text())
+        # utf-8-sig: a byte-order mark is read past, as in a CSV file
+        content = json.loads(path.read_text(encoding="utf-8-sig"), object_pairs_hook=_unique_keys)
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as e:
         raise MeasuredDataError(path, f"not a SEP-005 JSON file ({type(e).__name__}: {e})") from None
     except RecursionError:  # arrays nested thousands deep: no channel list of SEP-005
         raise MeasuredDataError(path, "not a SEP-005 JSON file: nested too deeply") from None
+    except _DuplicateKey as e:
+        raise MeasuredDataError(path, f"key {e.args[0]!r} is given twice in one object; give each "
+                                      "key once") from None
     return _parse_sep005(path, content)
+
+
+class _DuplicateKey(Exception):
+    """A JSON object names a key twice (json.loads kept the last one silently)."""
+
+
+def _unique_keys(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
+    out: dict[str, Any] = {}
+    for k, v in pairs:
+        if k in out:
+            raise _DuplicateKey(k)
+        out[k] = v
+    return out
 
 
 def _parse_sep005(path: Path, content: Any) -> _Raw:
@@ -695,8 +756,13 @@ _HEADER = re.compile(r"^\s*(?P<name>.*?)\s*(?:[\[(](?P<unit>[^\])]*)[\])])?\s*$"
 
 def _read_csv(path: Path) -> _Raw:
     try:
-        text = path.read_text()
-    except (OSError, UnicodeDecodeError) as e:
+        # utf-8-sig: a byte-order mark (spreadsheets write one) is not part of the first name
+        # (it hid the time column "t" of such a file: "no time column")
+        text = path.read_text(encoding="utf-8-sig")
+    except UnicodeDecodeError as e:
+        raise MeasuredDataError(path, f"not UTF-8 text (byte {e.object[e.start]:#04x} at offset "
+                                      f"{e.start}); save it as UTF-8") from None
+    except OSError as e:
         raise MeasuredDataError(path, f"not a text file ({type(e).__name__}: {e})") from None
     lines = [(k + 1, ln) for k, ln in enumerate(text.splitlines())
              if ln.strip() and not ln.lstrip().startswith("#")]
@@ -712,6 +778,8 @@ def _read_csv(path: Path) -> _Raw:
     names = [h["name"] for h in header]
     if any(not n for n in names) or len(set(names)) != len(names):
         raise MeasuredDataError(path, f"header names must be non-empty and unique, got {names}")
+    # every column but the time is a channel: refuse before converting a row
+    check_record_size(path, len(lines) - 1, max(1, len(names) - sum(n.lower() in TIME_NAMES for n in names)))
     rows = []
     for lineno, line in lines[1:]:
         cells = split(line)
@@ -721,7 +789,8 @@ def _read_csv(path: Path) -> _Raw:
             rows.append([float(c) for c in cells])
         except ValueError:
             bad = next(c for c in cells if not _is_float(c))
-            raise MeasuredDataError(path, f"line {lineno}: {bad.strip()!r} is not a number") from None
+            hint = " (a decimal comma? write a point)" if _is_float(bad.replace(",", ".")) else ""
+            raise MeasuredDataError(path, f"line {lineno}: {bad.strip()!r} is not a number{hint}") from None
     table = np.array(rows, dtype=float).T
     raw = _Raw(path, "csv", None, {}, {})
     for h, col in zip(header, table, strict=True):
@@ -802,13 +871,22 @@ def _uff58_channel(path: Path, k: int, s: dict[str, Any], raw: _Raw) -> tuple[st
         raise MeasuredDataError(path, f"{where} has complex ordinates; a time response is real")
     if name in raw.data:
         name = f"{name}#{k + 1}"
+    if "num_pts" in s and int(s["num_pts"]) != data.size:  # (a damaged header was read past)
+        raise MeasuredDataError(path, f"{where}: its header declares {int(s['num_pts'])} values, "
+                                      f"its data hold {data.size}")
     m = _FS_ID.search(str(s.get("id5", "")))
+    even = int(s.get("abscissa_spacing", 1)) == 1
+    if even:
+        inc = float(s.get("abscissa_inc", 0.0))
+        if not inc > 0:  # (a testbed file's exact rate in its ID line hid an increment of 0 or NaN)
+            raise MeasuredDataError(path, f"{where}: abscissa increment {inc!r} s is not > 0")
     if m is not None:
         rate = float(m.group(1))
-    elif int(s.get("abscissa_spacing", 1)) == 1:
-        inc = float(s.get("abscissa_inc", 0.0))
-        if not inc > 0:
-            raise MeasuredDataError(path, f"{where}: abscissa increment {inc!r} s is not > 0")
+        # the increment is written with 6 significant digits (rounding within 5e-6)
+        if even and not abs(inc * rate - 1.0) <= 1e-5:
+            raise MeasuredDataError(path, f"{where}: abscissa increment {inc!r} s disagrees with "
+                                          f"the rate {rate:g} Hz of its ID line")
+    elif even:
         rate = 1.0 / inc
     else:
         rate = uniform_rate(path, np.asarray(s["x"], dtype=float), f"{where} abscissa")

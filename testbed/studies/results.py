@@ -54,6 +54,7 @@ from typing import Any
 from testbed.core.atomic import atomic_write, atomic_write_text
 from testbed.core.errors import TestbedError
 from testbed.core.lazy import lazy_module
+from testbed.scoring.scorers import Check
 
 # imported on first use: a run's report and `testbed list` do not pay for them (~0.05 s)
 pa = lazy_module("pyarrow")
@@ -219,7 +220,26 @@ def read_results(path: str | os.PathLike, *, set_aside: bool = False) -> list[di
         for k in scores:
             if r.get(k) is None:
                 r[k] = math.nan
+        r["passed"] = bool(r.get("passed")) and _checks_hold(r)
     return rows
+
+
+def _checks_hold(row: dict[str, Any]) -> bool:
+    """Whether every check stored in ``row["checks"]`` passes, judged again from its value and
+    threshold, a value that differs from the row's score column counting as NaN (never a
+    pass): a row edited to ``passed`` over a NaN score counted in the pass rate."""
+    try:
+        checks = json.loads(row.get("checks") or "[]")
+        judged = []
+        for c in checks:  # (a check without its value is judged from the score column alone)
+            score = float(row.get(c["metric"], math.nan))
+            value = float(c["value"]) if "value" in c else score
+            same = value == score or (math.isnan(value) and math.isnan(score))
+            judged.append(Check(str(c["metric"]), value if same else math.nan, str(c["bound"]),
+                                float(c["threshold"])).passed)
+    except (TypeError, ValueError, KeyError):  # not a list of checks: nothing holds
+        return False
+    return bool(judged) and all(judged)
 
 
 def consolidate(path: str | os.PathLike, *, keep: set[str] | None = None,

@@ -47,6 +47,7 @@ import ctypes
 import datetime as _dt
 import errno
 import json
+import math
 import os
 import shutil
 import sys
@@ -173,8 +174,7 @@ class SavedRun:
 
     @property
     def checks(self) -> list[Check]:
-        return [Check(c["metric"], _num(c["value"]), c["bound"], _num(c["threshold"]))
-                for c in self.meta["checks"]]
+        return [_judged(c, self.meta["scores"]) for c in self.meta["checks"]]
 
     @property
     def failures(self) -> dict[str, str]:
@@ -639,6 +639,10 @@ def _unflatten(arrays: dict[str, np.ndarray], group: str) -> dict[str, Any]:
 _META_TYPES = {"scenario": dict, "identifier": dict, "scores": dict, "checks": list,
                "fit_time": (int, float)}
 _CHECK_KEYS = ("metric", "value", "bound", "threshold")
+#: Keys a run.json may lack (read with a default) but, where present, are of this type: a
+#: string for "dataset" was an internal error (AttributeError) of `testbed report`.
+_OPTIONAL_META_TYPES = {"failures": dict, "dataset": dict, "truth_units": dict, "rig_units": dict,
+                        "equations": list, "model_lists": dict, "figures": list, "versions": dict}
 
 
 def _check_meta(run_dir: Path, meta: dict[str, Any]) -> None:
@@ -649,10 +653,28 @@ def _check_meta(run_dir: Path, meta: dict[str, Any]) -> None:
                              f"{getattr(typ, '__name__', 'number')}")
     if not isinstance(meta["identifier"].get("name"), str):
         raise ValueError(f"{run_dir / 'run.json'}: key 'identifier.name' missing or not a str")
+    for key, typ in _OPTIONAL_META_TYPES.items():
+        if key in meta and not isinstance(meta[key], typ):
+            raise ValueError(f"{run_dir / 'run.json'}: key {key!r} not a {typ.__name__}")
     for i, c in enumerate(meta["checks"]):
         if not isinstance(c, dict) or any(k not in c for k in _CHECK_KEYS):
             raise ValueError(f"{run_dir / 'run.json'}: checks[{i}] is not a check with "
                              + ", ".join(_CHECK_KEYS))
+    for k, v in meta["scores"].items():  # as _jsonable stores them: NaN null, infinities strings
+        if not (v is None or v in ("inf", "-inf") or (isinstance(v, (int, float)) and not isinstance(v, bool))):
+            raise ValueError(f"{run_dir / 'run.json'}: scores[{k!r}] {v!r} is not a number "
+                             "(null for NaN, \"inf\" or \"-inf\")")
+
+
+def _judged(c: dict[str, Any], scores: dict[str, Any]) -> Check:
+    """A stored check judged again from its stored value and threshold, the value being NaN
+    (never a pass) unless it equals its metric's stored score (NaN without one, as
+    :func:`testbed.scoring.scorers.checks` makes it): a check holds a copy of its score, and a
+    score edited to NaN under an unchanged check was listed and reported "pass"."""
+    value, score = _num(c.get("value")), _num(scores.get(c.get("metric")))
+    same = value == score or (math.isnan(value) and math.isnan(score))
+    return Check(str(c.get("metric", "")), value if same else math.nan, str(c.get("bound", "")),
+                 _num(c.get("threshold")))
 
 
 def load_run(run_dir: str | os.PathLike) -> SavedRun:
@@ -686,8 +708,7 @@ def _run_row(p: Path, meta: dict[str, Any]) -> dict[str, Any]:
     stored values, thresholds and failures (as :class:`SavedRun` does), not read: a run.json
     edited to say ``passed`` over a NaN score is listed as the FAIL it is."""
     sc = meta.get("scenario", {})
-    checks = [Check(str(c.get("metric", "")), _num(c.get("value")), str(c.get("bound", "")),
-                    _num(c.get("threshold"))) for c in meta.get("checks", [])]
+    checks = [_judged(c, meta.get("scores", {})) for c in meta.get("checks", [])]
     failures = meta.get("failures") or {}
     return {"path": p, "id": p.name, "scenario": str(sc.get("name", p.name)),
             "seed": sc.get("seed", ""), "identifier": str(meta.get("identifier", {}).get("name", "")),
@@ -708,6 +729,7 @@ def _read_row(p: Path) -> dict[str, Any] | None:
         meta = json.loads((p / "run.json").read_text())
         if meta.get("format") != FORMAT:
             return None
+        _check_meta(p, meta)  # as load_run: a damaged or edited file is named, not listed
         return _run_row(p, meta)
     except (OSError, ValueError, TypeError, AttributeError):
         return None

@@ -50,7 +50,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from testbed.core.errors import ScenarioError
+from testbed.core.budget import STUDY_CELL_BUDGET
+from testbed.core.errors import BudgetError, ScenarioError
 from testbed.core.registry import import_plugin
 from testbed.core.schema import Field, validate_header
 from testbed.pipeline.plugins import IDENTIFIERS, RIGS
@@ -375,6 +376,18 @@ def _validate_params(table: Any, identifiers: list[str], file: str) -> dict[str,
 
 def _check_grid(study: Study, head: dict[str, Any], file: str) -> None:
     pairs = study.combinations()
+    cells = len(pairs) * len(study.noise) * len(study.seeds)
+    if cells > STUDY_CELL_BUDGET:
+        factors = {"study.scenarios": (len(head["scenarios"]), head["scenarios"]),
+                   **{f"families.{f.name}.members": (f.members, f.members) for f in study.families},
+                   "study.identifiers": (len(study.identifiers), head["identifiers"]),
+                   "study.noise": (len(study.noise), head["noise"]),
+                   "study.seeds": (len(study.seeds), head["seeds"])}
+        key = max(factors, key=lambda k: factors[k][0])  # the longest: first in this order on a tie
+        raise BudgetError(file, key, factors[key][1],
+                          f"the grid has {cells} cells ({len(pairs)} scenario-identifier pairs x "
+                          f"{len(study.noise)} noise levels x {len(study.seeds)} seeds); the budget "
+                          f"is {STUDY_CELL_BUDGET} (testbed.core.budget.STUDY_CELL_BUDGET)")
     for i, m in enumerate(study.identifiers):
         if not any(pm == m for _, pm in pairs):
             raise ScenarioError(file, f"study.identifiers[{i}]", m,

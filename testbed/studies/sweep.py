@@ -30,6 +30,7 @@ import json
 import logging
 import math
 import os
+import re
 import sys
 import threading
 import time
@@ -41,7 +42,7 @@ from typing import Any
 
 from joblib import Parallel, delayed, parallel_config
 
-from testbed.core.errors import InputError
+from testbed.core.errors import IdentificationError, InputError
 from testbed.core.provenance import git_commit, versions
 from testbed.pipeline.cache import DatasetCache
 from testbed.pipeline.generate import noise_free_scenario
@@ -454,6 +455,12 @@ def run_sweep(study: Study | str | os.PathLike, jobs: int = 1, dask_address: str
     try:
         previous = read_results(results, set_aside=True)
     except ResultsError as e:  # a damaged consolidated file: keep it aside, rerun its cells
+        with results.open("rb") as fh:
+            head = fh.read(4)
+        if head and head != b"PAR1":  # not Parquet at all (a dataset was renamed *.bad): not ours
+            raise InputError(f"results {results}: not a Parquet results file (it begins with "
+                             f"{head!r}); expected a results file of study {study.name!r} or a "
+                             "new path (the file is left as it is)") from None
         bad = results.with_name(results.name + ".bad")
         os.replace(results, bad)
         log.warning("%s; set aside as %s, its cells will run again", e, bad.name)
@@ -506,6 +513,18 @@ def run_sweep(study: Study | str | os.PathLike, jobs: int = 1, dask_address: str
                     write_part(results, row)
                     stats.failed += row["status"] != "ok"
                     bar.advance(row["status"] != "ok")
+            except Exception as e:  # (loky's TerminatedWorkerError, not imported for this)
+                if type(e).__name__ != "TerminatedWorkerError" or not study.plugins:
+                    raise  # the testbed's own code crashed a worker: a bug
+                # a plugin's os._exit or crash (a segmentation fault) killed a worker: an
+                # internal error "please report it" before, naming no plugin
+                codes = re.search(r"exit codes of the workers are (\{[^}]*\})", str(e))
+                raise IdentificationError(
+                    f"sweep {study.name}: a worker process died running cells (exit codes "
+                    f"{codes.group(1) if codes else 'unknown'}): code of plugin(s) "
+                    f"{', '.join(study.plugins)} may exit the interpreter (os._exit) or crash "
+                    f"it; the finished rows are kept in {results}; `--jobs 1` runs the cells "
+                    "in this process, one at a time") from None
             finally:
                 bar.close()
             stats.data_seconds, stats.cells_seconds = t1 - t0, time.perf_counter() - t1

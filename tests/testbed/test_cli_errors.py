@@ -44,6 +44,12 @@ def one_error_line(err: str) -> str:
     (["generate", "--seed", "9223372036854775808", "michaelis_menten", "-o", "{tmp}/x.h5"],
      "--seed: expected an integer <= 9223372036854775807"),
     (["sweep", "--jobs", "0", "smoke"], "--jobs: expected an integer >= 1"),
+    # at most 4 workers a CPU: 100000 started workers until the machine stalled
+    (["sweep", "--jobs", "100000", "smoke"], "--jobs: expected an integer <= "),
+    # the selector's longest wait: inf was an internal error (OverflowError) after the warm-up
+    (["serve", "--idle", "inf", "--warm-up", "none"], "--idle inf: expected a positive number of "
+                                                      "seconds, at most 2.14748e+06 (2^31 - 1 ms)"),
+    (["serve", "--idle", "1e300", "--warm-up", "none"], "--idle 1e+300: expected a positive number"),
     (["report", "{tmp}/no_such_run", "-o", "{tmp}/report"], "no such run folder or results file"),
     (["report", "{tmp}", "-o", "{tmp}/report"], "not a run folder"),
     (["report", "{tmp}/text.txt", "-o", "{tmp}/report"], "not a sweep results file"),
@@ -79,12 +85,18 @@ def one_error_line(err: str) -> str:
       "--units", "a=mm"], "--units g a=mm: expected one unit for every channel"),
     # every scenario is checked before the first runs (the first one ran, then the error)
     (["run", "michaelis_menten", "{tmp}/no_such.toml", "--out", "{tmp}/o"], "no such scenario file"),
+    # an output inside a run folder was lost when the run store saved that run again
+    (["run", "michaelis_menten", "--out", "{tmp}/a_run/more"],
+     "--out {tmp}/a_run/more: inside the run folder {tmp}/a_run, which the run store replaces whole"),
+    (["report", "{tmp}", "-o", "{tmp}/a_run"], "--output {tmp}/a_run: inside the run folder"),
     # nothing the user gave is overwritten
     (["identify", "{tmp}/text.txt", "--kind", "structural", "--method", "ls_sindy", "-o",
       "{tmp}/text.txt"], "is the input file"),
 ])
 def test_user_mistakes_give_one_line_and_status_2(tmp_path, capsys, argv, fragment):
     (tmp_path / "text.txt").write_text("not a dataset\n")
+    (tmp_path / "a_run").mkdir()
+    (tmp_path / "a_run" / "run.json").write_text("{}")
     with h5py.File(tmp_path / "other.h5", "w") as f:
         f["x"] = np.zeros(3)
     argv = [a.replace("{tmp}", str(tmp_path)) for a in argv]
@@ -115,6 +127,36 @@ def test_a_key_error_from_a_bug_is_internal_not_a_user_error(monkeypatch, capsys
     monkeypatch.setattr(cli, "cmd_list", broken)
     assert main(["list"]) == EXIT_INTERNAL
     assert capsys.readouterr().err.startswith("internal error")
+
+
+@pytest.mark.parametrize(("outcome", "status"), [("error", EXIT_USAGE), ("bug", EXIT_INTERNAL),
+                                                 ("fail", cli.EXIT_FAIL), ("pass", 0)])
+def test_library_warnings_never_precede_the_error_line(monkeypatch, capsys, outcome, status):
+    # numpy's and MuJoCo's warnings came before the one error line (several lines); they wait
+    # for the command's end: dropped under its error line, shown after its verdict
+    import warnings
+
+    from testbed.core.errors import IdentificationError
+
+    def command(args):
+        warnings.warn("overflow encountered in multiply", RuntimeWarning, stacklevel=1)
+        if outcome == "error":
+            raise IdentificationError("x.csv: no model")
+        if outcome == "bug":
+            raise ZeroDivisionError("a bug")
+        print("verdict")
+        return status
+
+    monkeypatch.setattr(cli, "cmd_list", command)
+    with warnings.catch_warnings(record=True) as shown:  # what reaches stderr in a process
+        warnings.simplefilter("always")
+        assert main(["list"]) == status
+    captured = capsys.readouterr()
+    if status in (EXIT_USAGE, EXIT_INTERNAL):
+        assert shown == [] and len(captured.err.splitlines()) == 1, (shown, captured.err)
+    else:
+        assert captured.out == "verdict\n"
+        assert [str(w.message) for w in shown] == ["overflow encountered in multiply"]
 
 
 #: Eight files of the corpus (the whole corpus runs in-process in test_malformed.py).
@@ -205,3 +247,44 @@ def test_a_reader_that_goes_away_ends_the_command_quietly(tmp_path):
         err = p.stderr.read().decode()
         assert p.wait(timeout=60) in (0, cli.EXIT_BROKEN_PIPE)
         assert err == "", err
+
+
+@pytest.mark.parametrize("var", ["TESTBED_SCENARIOS", "TESTBED_STUDIES"])
+@pytest.mark.parametrize(("value", "fragment"), [
+    # a typo left every command without scenarios (`testbed list` empty, exit 0)
+    ("{tmp}/no_such", "'{tmp}/no_such': no such folder; expected the folder of"),
+    ("{tmp}/text.txt", "'{tmp}/text.txt': not a folder; expected the folder of"),
+    # a name too long for the file system was an internal error (OSError)
+    ("/" + "x" * 5000, "not a usable path (a file name too long for the file system)"),
+], ids=["missing", "file", "too-long"])
+def test_a_scenario_or_study_folder_variable_that_is_no_folder_is_named(tmp_path, capsys, monkeypatch,
+                                                                       var, value, fragment):
+    (tmp_path / "text.txt").write_text("not a folder\n")
+    monkeypatch.setenv(var, value.replace("{tmp}", str(tmp_path)))
+    assert main(["list"]) == EXIT_USAGE
+    line = one_error_line(capsys.readouterr().err)
+    assert line.startswith(f"error: ${var} ") and fragment.replace("{tmp}", str(tmp_path)) in line, line
+
+
+@pytest.mark.parametrize(("source", "fragment"), [
+    # sys.exit(0) at import ended `testbed run` with status 0, no verdict and no line
+    ("import sys\nsys.exit(0)\n", "importing it failed: SystemExit: 0"),
+    ("import sys\nsys.exit('bye')\n", "importing it failed: SystemExit: bye"),
+])
+def test_a_plugin_that_exits_at_import_is_one_line(tmp_path, capsys, source, fragment):
+    plugin = tmp_path / "exits.py"
+    plugin.write_text(source)
+    assert main(["run", "michaelis_menten", "--plugin", str(plugin), "-o", str(tmp_path / "o")]) == EXIT_USAGE
+    line = one_error_line(capsys.readouterr().err)
+    assert line == f"error: plugin {plugin}: {fragment}", line
+    assert not (tmp_path / "o").exists()
+
+
+def test_a_server_socket_path_too_long_is_one_line(tmp_path, capsys, monkeypatch):
+    # was "internal error (a bug, not your input): OSError: AF_UNIX path too long"
+    path = tmp_path / ("x" * 120) / "s.sock"
+    monkeypatch.setenv("TESTBED_SERVER_SOCKET", str(path))
+    assert main(["serve", "--warm-up", "none", "--idle", "1"]) == EXIT_USAGE
+    line = one_error_line(capsys.readouterr().err)
+    assert line.startswith(f"error: socket path {path} ($TESTBED_SERVER_SOCKET or the default): ")
+    assert line.endswith("bytes; expected at most 107 (the longest Unix socket address)"), line

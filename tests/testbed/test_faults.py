@@ -209,10 +209,11 @@ def test_a_folder_in_place_of_a_cache_entry_is_named_before_simulating(tmp_path)
     sc = load_scenario("michaelis_menten")
     cache = DatasetCache(tmp_path)
     cache.path(sc).mkdir()
-    (tmp_path / "other.h5").symlink_to(tmp_path / "other.h5")  # a link that loops: listed, cleared
+    other = f"other-{'f' * 32}.h5"  # (named as an entry: the cache lists only its own names)
+    (tmp_path / other).symlink_to(tmp_path / other)  # a link that loops: listed, cleared
     with pytest.raises(InputError, match=r"is a folder where a cached dataset belongs"):
         cache.clean(sc)
-    assert [p.name for p, _ in cache.entries()] == ["other.h5"]
+    assert [p.name for p, _ in cache.entries()] == [other]
     assert cache.clear() == 1 and cache.path(sc).is_dir()
 
 
@@ -706,3 +707,81 @@ def test_sigterm_ends_a_command_like_ctrl_c(monkeypatch, capsys, signum):
         assert signal.getsignal(signum) is signal.SIG_DFL  # restored: main() is called from Python
     finally:
         signal.signal(signum, previous)
+
+
+@pytest.mark.parametrize(("trac", "checks", "passed"), [
+    (0.97, None, True),              # as the sweep wrote it
+    (math.nan, None, False),         # the score edited to NaN under its passing check
+    (0.5, None, False),              # ... or to a failing value
+    (0.97, "[]", False),             # its checks removed
+    (0.97, "not json", False),
+    (0.97, '[{"metric": "trac"}]', False),
+], ids=["kept", "nan", "worse", "no-checks", "not-json", "no-threshold"])
+def test_a_results_row_edited_to_pass_is_judged_again_on_read(tmp_path, trac, checks, passed):
+    # `summary` and the report counted a row's stored "passed": a results row edited over a
+    # NaN score was a pass in the pass rate
+    res = tmp_path / "r.parquet"
+    check = [{"metric": "trac", "value": 0.97, "bound": "min", "threshold": 0.9, "passed": True}]
+    write_part(res, {"cell": "c0", "study": "s", "scenario": "a", "noise": 0.0, "seed": 0,
+                     "identifier": "m", "status": "ok", "error": "", "trac": trac, "passed": True,
+                     "checks": json.dumps(check) if checks is None else checks})
+    (row,) = read_results(res)
+    assert row["passed"] is passed
+    rate = summarize(res)[0]["pass_rate"]  # (a row without checks is held to no bar: NaN)
+    assert rate == float(passed) or (checks in ("[]", "not json") and math.isnan(rate))
+
+
+def test_cache_clear_deletes_only_the_caches_own_entries(tmp_path):
+    # `testbed cache clear --cache <folder>` deleted every *.h5 of the folder: a user's own
+    # datasets (`testbed generate -o <folder>/mine.h5`) with the cache's entries
+    entry = tmp_path / f"michaelis_menten-{'0123456789abcdef' * 2}.h5"
+    for p in (entry, tmp_path / "mine.h5", tmp_path / f"mine-{'0' * 31}.h5"):
+        p.write_bytes(b"x")
+    cache = DatasetCache(tmp_path)
+    assert [p for p, _ in cache.entries()] == [entry]
+    assert cache.clear() == 1
+    assert sorted(p.name for p in tmp_path.iterdir()) == [f"mine-{'0' * 31}.h5", "mine.h5"]
+
+
+def test_a_results_path_holding_another_format_is_refused_and_left_alone(fault_dir, tmp_path):
+    # `sweep --results mine.h5` renamed the user's dataset mine.h5.bad as a damaged results file
+    from testbed.core.errors import InputError
+
+    study = load_study(_study(fault_dir, "other_format", ["fault_fit"], seeds=(0,), noise=(0.0,)))
+    res = tmp_path / "mine.h5"
+    res.write_bytes(b"\x89HDF\r\n\x1a\n" + b"\0" * 100)
+    with pytest.raises(InputError, match=r"not a Parquet results file \(it begins with b'\\x89HDF'\)"):
+        run_sweep(study, results=res, cache_dir=tmp_path / "c", verbose=False)
+    assert [p.name for p in tmp_path.iterdir()] == ["mine.h5"] and res.read_bytes()[:4] == b"\x89HDF"
+    res.write_bytes(b"PAR1" + b"\0" * 100)  # a Parquet file cut short: set aside, its cells rerun
+    assert len(read_results(run_sweep(study, results=res, cache_dir=tmp_path / "c", verbose=False))) == 1
+    assert (tmp_path / "mine.h5.bad").read_bytes()[:4] == b"PAR1"
+
+
+def test_a_worker_killed_by_a_plugin_is_one_line_naming_the_plugins(fault_dir, tmp_path, monkeypatch):
+    # a plugin's os._exit(0) in fit killed its loky worker: "internal error (a bug, not your
+    # input): TerminatedWorkerError ... please report it" (measured with --jobs 2; the worker's
+    # death is mimicked here, as joblib reports it)
+    from testbed.core.errors import IdentificationError
+    from testbed.studies import sweep
+
+    class TerminatedWorkerError(Exception):  # joblib.externals.loky's, by name
+        pass
+
+    real = sweep.parallel
+
+    def dying(fn, args, n_jobs):
+        if fn is not sweep.run_cell:
+            yield from real(fn, args, n_jobs)
+            return
+        raise TerminatedWorkerError("... The exit codes of the workers are {EXIT(0), EXIT(0)} ...")
+
+    monkeypatch.setattr(sweep, "parallel", dying)
+    study = load_study(_study(fault_dir, "dying", ["fault_fit"], seeds=(0,), noise=(0.0,)))
+    res = tmp_path / "r.parquet"
+    with pytest.raises(IdentificationError, match=r"sweep dying: a worker process died running cells "
+                                                  r"\(exit codes \{EXIT\(0\), EXIT\(0\)\}\): code of "
+                                                  r"plugin\(s\) .*faults.py may exit"):
+        run_sweep(study, results=res, cache_dir=tmp_path / "c", verbose=False)
+    with pytest.raises(TerminatedWorkerError):  # without plugins: the testbed's own bug, raised
+        run_sweep(replace(study, plugins=()), results=res, cache_dir=tmp_path / "c", verbose=False)

@@ -16,6 +16,7 @@ import contextlib
 import copy
 import json
 import math
+import re
 import signal
 import statistics
 import time
@@ -886,3 +887,180 @@ def test_identify_refuses_a_key_given_twice(tmp_path, capsys, option):
     assert main(argv) == EXIT_USAGE
     err = capsys.readouterr().err
     assert err == f"error: {option} 'ridge=0.2': ridge is given twice; give each key once\n"
+
+
+# ------------------------------------------------------------------------ round 4
+def test_a_csv_with_a_byte_order_mark_reads_its_time_column(tmp_path):
+    # spreadsheets write a UTF-8 byte-order mark: it became part of the first name and hid
+    # the time column "t" ("no time column (t or time) and no sample rate")
+    from testbed.pipeline.importers import read_measured
+
+    plain = _mm_csv(tmp_path / "mm.csv")
+    bom = tmp_path / "bom.csv"
+    bom.write_bytes(b"\xef\xbb\xbf" + plain.read_bytes())
+    a, b = read_measured(plain), read_measured(bom)
+    assert b.fs == a.fs == 100.0 and list(b.signals) == list(a.signals) == ["x/x", "dx/dx"]
+
+
+@pytest.mark.parametrize(("content", "fragment"), [
+    # Latin-1 text was "not a text file (UnicodeDecodeError: 'utf-8' codec can't ...)"
+    ("t,x [\u00b5m]\n0,1\n0.01,2\n".encode("latin-1"), "not UTF-8 text (byte 0xb5 at offset 5); "
+                                                       "save it as UTF-8"),
+    # a decimal comma under a semicolon delimiter: say so
+    (b"t;x [m]\n0,0;1,5\n0,01;2,5\n", "line 2: '0,0' is not a number (a decimal comma? write a point)"),
+], ids=["latin1", "decimal-comma"])
+def test_csv_text_the_reader_cannot_take_says_what_to_do(tmp_path, content, fragment):
+    from testbed.pipeline.importers import MeasuredDataError, read_measured
+
+    path = tmp_path / "x.csv"
+    path.write_bytes(content)
+    with pytest.raises(MeasuredDataError) as e:
+        read_measured(path)
+    assert str(e.value) == f"{path}: {fragment}"
+
+
+@pytest.mark.parametrize("form", ["csv", "sep005", "hdf5"])
+def test_identify_refuses_a_record_over_its_value_budget(tmp_path, monkeypatch, form):
+    # `identify` had no sample budget: a 2e6-row CSV took 73 s, a 1e7-row one minutes and
+    # gigabytes.  Checked with the budget lowered to 10 values (the records: 400 samples x 2
+    # channels, or 50 x 1); a CSV is refused before its numbers are converted (its last row
+    # is not a number), an HDF5 file from its shapes
+    from testbed.pipeline import importers
+    from testbed.pipeline.importers import MeasuredDataError, read_measured
+
+    path = _mm_csv(tmp_path / "mm.csv")
+    if form != "csv":
+        data = read_measured(path)  # written back from what the reader gives
+        if form == "sep005":
+            path = tmp_path / "mm.json"
+            path.write_text(json.dumps([{"name": n, "data": x.tolist(), "fs": data.fs, "unit_str": u}
+                                        for n, (u, x) in data.signals.items()]))
+        else:
+            path = _toy_dataset_file(tmp_path / "d.h5", None, 100.0)
+    else:
+        path.write_text(path.read_text() + "a,b,c\n")
+    monkeypatch.setattr(importers, "IDENTIFY_VALUE_BUDGET", 10)
+    with pytest.raises(MeasuredDataError, match=r"samples x .* values; expected at most 10 "
+                                                r"\(testbed.core.budget.IDENTIFY_VALUE_BUDGET"):
+        read_measured(path)
+
+
+def test_identify_refuses_a_text_file_over_its_size_budget(tmp_path, monkeypatch):
+    from testbed.pipeline import importers
+    from testbed.pipeline.importers import MeasuredDataError, read_measured
+
+    path = _mm_csv(tmp_path / "mm.csv")
+    monkeypatch.setattr(importers, "IDENTIFY_TEXT_BUDGET_BYTES", 1000)
+    with pytest.raises(MeasuredDataError, match=rf"file size {path.stat().st_size} bytes; expected "
+                                                r"at most 1000 bytes for a text file"):
+        read_measured(path)
+
+
+@pytest.mark.parametrize(("grid", "key", "cells"), [
+    # 1000 seeds x 1000 noise levels expanded for minutes in silence before the sweep began
+    (f'scenarios = ["michaelis_menten"]\nnoise = {[k / 1000 for k in range(1000)]}\n'
+     f"seeds = {list(range(1000))}\n", "study.noise", "1000000 cells (1 scenario-identifier pairs "
+                                                       "x 1000 noise levels x 1000 seeds)"),
+    # a family's members named as the key that drives the count
+    ("noise = [0.0]\nseeds = [0, 1]\n[families.mms]\nbase = \"michaelis_menten\"\n"
+     "members = 1000\n[families.mms.rig]\nVmax = {uniform = [0.5, 2.0]}\n", "families.mms.members",
+     "2000 cells (1000 scenario-identifier pairs x 1 noise levels x 2 seeds)"),
+], ids=["seeds-x-noise", "family"])
+def test_a_study_grid_over_its_cell_budget_is_refused_at_load(tmp_path, monkeypatch, grid, key, cells):
+    from testbed.studies import study
+
+    if key.startswith("families"):  # (1000 members load in about 1 s; 1e5 would take minutes)
+        monkeypatch.setattr(study, "STUDY_CELL_BUDGET", 1000)
+    path = tmp_path / "huge.toml"
+    head, _, rest = grid.partition("[families")
+    path.write_text(f'[study]\nname = "huge"\nidentifiers = ["sindy_pi_dynamical"]\n{head}'
+                    + (f"[families{rest}" if rest else ""))
+    t0 = time.perf_counter()
+    with pytest.raises(BudgetError, match=rf"key '{key}'.*the grid has {re.escape(cells)}; the "
+                                          rf"budget is {study.STUDY_CELL_BUDGET}"):
+        load_study(path)
+    assert time.perf_counter() - t0 < HANG_S
+
+
+@pytest.mark.parametrize(("fitted", "fragment"), [
+    # a coef_ of another shape was "internal error (a bug, not your input)" in the scoring
+    ("coef", "fitted coef_ of shape (7, 3, 2); expected (n_equations, n_features), 6 features "
+             "as feature_names_ has"),
+    ("text", "fitted coef_ that is not an array of real numbers"),
+    # sys.exit(0) in a plugin's fit ended `testbed run` with status 0 and no verdict
+    ("exit", "raised SystemExit: 0"),
+])
+def test_a_run_scores_a_plugin_that_breaks_its_contract_as_a_failed_fit(monkeypatch, fitted, fragment):
+    import sys
+
+    import numpy as np
+
+    from identify.sindy_pi_dynamical import SINDyPIDynamical
+    from testbed.pipeline import plugins
+    from testbed.pipeline.scenario import load_scenario
+    from testbed.scoring.run import run_scenario
+
+    class Rogue(SINDyPIDynamical):
+        def fit(self, data):
+            if fitted == "exit":
+                sys.exit(0)
+            super().fit(data)
+            self.coef_ = np.ones((7, 3, 2)) if fitted == "coef" else np.array([["a"] * 6])
+            return self
+
+    monkeypatch.setattr(plugins.IDENTIFIERS, "origin", lambda name: "file /home/me/rogue.py")
+    result = run_scenario(load_scenario("michaelis_menten"), model=Rogue())
+    assert not result.passed
+    assert result.failure.startswith("fit failed: identifier sindy_pi_dynamical (from file "
+                                     "/home/me/rogue.py) ") and fragment in result.failure, result.failure
+
+
+@pytest.mark.parametrize(("edit", "fragment"), [
+    # json.loads kept the last of two "fs" keys silently
+    (lambda text: text.replace('"fs": 100.0', '"fs": 50.0, "fs": 100.0', 1),
+     "key 'fs' is given twice in one object; give each key once"),
+    # a rate of 5e-324 Hz was "key 'identify.sim_dt': value 0.001: ... inf steps"
+    (lambda text: text.replace('"fs": 100.0', '"fs": 5e-324'),
+     "sample rate 4.94066e-324 Hz: 400 samples would last forever"),
+], ids=["duplicate-key", "rate-5e-324"])
+def test_sep005_duplicate_keys_and_endless_records_are_refused(tmp_path, edit, fragment):
+    from testbed.pipeline.importers import MeasuredDataError, read_measured
+
+    path = _mm_sep005(tmp_path / "mm.json")
+    path.write_text(edit(path.read_text()))
+    with pytest.raises(MeasuredDataError) as e:
+        read_measured(path)
+    assert str(e.value).startswith(f"{path}: {fragment}"), str(e.value)
+
+
+def test_a_sep005_file_with_a_byte_order_mark_is_read(tmp_path):
+    # "not a SEP-005 JSON file (JSONDecodeError: Unexpected UTF-8 BOM ...)"
+    from testbed.pipeline.importers import read_measured
+
+    path = _mm_sep005(tmp_path / "mm.json")
+    bom = tmp_path / "bom.json"
+    bom.write_bytes(b"\xef\xbb\xbf" + path.read_bytes())
+    assert list(read_measured(bom).signals) == list(read_measured(path).signals) == ["x/x", "dx/dx"]
+
+
+@pytest.mark.parametrize(("old", "new", "fragment"), [
+    # the testbed's exact rate in the ID line ("fs 100.0 Hz") hid the increment of the record
+    (b"1.00000e-02", b"0.00000e+00", "record 2 (x/x): abscissa increment 0.0 s is not > 0"),
+    (b"1.00000e-02", b"        nan", "record 2 (x/x): abscissa increment nan s is not > 0"),
+    (b"1.00000e-02", b"2.00000e-02", "record 2 (x/x): abscissa increment 0.02 s disagrees with the "
+                                     "rate 100 Hz of its ID line"),
+    # a header's count of values was read past
+    (b"       400         1", b"    400000         1", "record 2 (x/x): its header declares 400000 "
+                                                       "values, its data hold 400"),
+], ids=["dt-0", "dt-nan", "dt-other", "count"])
+def test_a_uff58_header_that_contradicts_its_record_is_refused(tmp_path, old, new, fragment):
+    from testbed.pipeline.importers import MeasuredDataError, read_measured
+    from testbed.reporting.export import write_uff
+
+    path = write_uff(read_measured(_mm_csv(tmp_path / "mm.csv")).to_dataset(), tmp_path / "mm.uff")
+    raw = path.read_bytes()
+    assert raw.count(old) >= 1
+    path.write_bytes(raw.replace(old, new, 1))
+    with pytest.raises(MeasuredDataError) as e:
+        read_measured(path)
+    assert str(e.value) == f"{path}: {fragment}"

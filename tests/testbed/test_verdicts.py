@@ -10,6 +10,7 @@ whole path (run_scenario -> score -> table -> run folder) is exercised.
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 import pytest
@@ -344,3 +345,60 @@ def test_an_identified_model_with_nan_coefficients_fails_testbed_identify():
     assert identified_failures({"equations": []}) is None
     nan_m = {"matrices": {"M": [[math.nan]], "C": [[1.0]], "K": [[1.0]]}}
     assert identified_failures(nan_m)  # NaN matrices fail the physical checks
+
+
+# ---------------------------------------------------------------- stored runs (input audit round 4)
+def _synthetic():
+    """tests/testbed/_synthetic_runs.py (imported as test_runstore and test_faults do)."""
+    import sys
+    from pathlib import Path
+
+    if str(Path(__file__).parent) not in sys.path:
+        sys.path.insert(0, str(Path(__file__).parent))
+    import _synthetic_runs
+
+    return _synthetic_runs
+
+
+@pytest.mark.parametrize(("edit", "verdict"), [
+    ("nan", "FAIL"), ("inf", "FAIL"), ("worse", "FAIL"), ("removed", "FAIL"), ("none", "pass"),
+])
+def test_a_stored_score_edited_under_its_check_is_not_a_pass(tmp_path, edit, verdict):
+    # a check holds a copy of its score: the score edited to NaN (or removed) under an
+    # unchanged check was listed by `testbed runs` and reported "pass"
+    import json
+
+    from testbed.studies.runstore import list_runs, save_new_run
+
+    path = save_new_run(_synthetic().structural_result(n_samples=200), tmp_path)
+    meta = json.loads((path / "run.json").read_text())
+    check = {"metric": "trac", "value": 0.97, "bound": "min", "threshold": 0.9, "passed": True}
+    scores = dict(meta["scores"], trac=0.97)
+    if edit == "removed":
+        del scores["trac"]
+    elif edit != "none":
+        scores["trac"] = {"nan": None, "inf": "-inf", "worse": 0.5}[edit]
+    meta.update(scores=scores, checks=[check], verdict="pass", passed=True, failures={})
+    (path / "run.json").write_text(json.dumps(meta))
+    (row,) = list_runs(tmp_path)
+    assert row["verdict"] == verdict and load_run(path).verdict == verdict
+
+
+@pytest.mark.parametrize(("key", "value", "fragment"), [
+    ("dataset", "/data/x.h5", "key 'dataset' not a dict"),  # was an AttributeError in `report`
+    ("scores", {"trac": "0.97"}, "scores['trac'] '0.97' is not a number"),
+    ("scores", {"trac": [1]}, "scores['trac'] [1] is not a number"),
+])
+def test_a_stored_run_of_the_wrong_types_is_refused_on_read(tmp_path, key, value, fragment):
+    import json
+
+    from testbed.studies.runstore import list_runs, save_new_run
+
+    path = save_new_run(_synthetic().structural_result(n_samples=200), tmp_path)
+    meta = json.loads((path / "run.json").read_text())
+    meta[key] = value
+    (path / "run.json").write_text(json.dumps(meta))
+    with pytest.raises(ValueError, match=re.escape(fragment)):
+        load_run(path)
+    damaged = []
+    assert list_runs(tmp_path, damaged=damaged) == [] and damaged == [path]
