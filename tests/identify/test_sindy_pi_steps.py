@@ -54,6 +54,7 @@ def test_the_first_step_the_next_does_not_move_is_kept():
 def test_a_step_at_which_the_model_fails_is_refined_and_never_kept():
     # fails at 1 ms only: 0.5 ms, which 0.1 ms moves by 2.4e-7, is kept
     dt, rule = choose_sim_dt(*_fake(1.0, fail_above=7e-4), fs=1e4)
+    assert "0.0005 s" in rule
     assert dt == pytest.approx(5e-4)
 
 
