@@ -364,7 +364,9 @@ def choose_sim_dt(simulate: Callable[[float], np.ndarray], x: np.ndarray,
                   fs: float) -> tuple[float, str]:
     """The step rule: the first of :func:`sim_dt_candidates` whose simulation the next
     candidate moves by at most :data:`SIM_DT_REL_TOL` of the motion (Richardson's test on the
-    identified model itself).
+    identified model itself).  A simulation that fails at two successive steps fails for the
+    model, not the step: then :data:`SIM_DT_START` is kept (the scored simulation names the
+    failure) without trying finer steps, whose failing simulations cost the most.
 
     Parameters
     ----------
@@ -384,12 +386,17 @@ def choose_sim_dt(simulate: Callable[[float], np.ndarray], x: np.ndarray,
     scale = np.ptp(x, axis=1)
     scale = np.where(scale > 0, scale, 1.0)[:, None]
     steps = sim_dt_candidates(fs)
-    prev = None
+    prev = cur = None
     for k, dt in enumerate(steps):
+        failed_before = k > 0 and cur is None
         try:
             cur = simulate(dt)
         except IdentificationError:
             cur = None
+        if cur is None and failed_before:  # a failure that a finer step does not cure
+            return SIM_DT_START, (f"{SIM_DT_START:g} s: the model's simulation fails at "
+                                  f"{steps[k - 1]:.3g} s and {dt:.3g} s alike (the step does "
+                                  "not decide it)")
         if cur is not None and prev is not None:
             moved = float(np.max(np.abs(cur - prev) / scale))
             if moved <= SIM_DT_REL_TOL:
@@ -398,8 +405,8 @@ def choose_sim_dt(simulate: Callable[[float], np.ndarray], x: np.ndarray,
                                       f"(<= {SIM_DT_REL_TOL:g})")
         prev = cur
     if cur is None:
-        return SIM_DT_START, (f"{SIM_DT_START:g} s: the model's simulation fails at every step "
-                              f"down to {steps[-1]:.3g} s (the step does not decide it)")
+        return SIM_DT_START, (f"{SIM_DT_START:g} s: the model's simulation fails at the finest "
+                              f"step, {steps[-1]:.3g} s (the step does not decide it)")
     return steps[-1], (f"{steps[-1]:.3g} s: not converged to {SIM_DT_REL_TOL:g} of the "
                        f"motion's range at any step from {SIM_DT_START:g} s (the finest kept)")
 
@@ -954,26 +961,52 @@ class _ImplicitMechanical(Identifier):
         return getattr(self, "sim_dt_", SIM_DT_START)
 
     def _choose_sim_dt(self, data: Measurement) -> None:
-        """``sim_dt_``: the user's, else :func:`choose_sim_dt` on the fitted model over the
-        record from its measured first state; ``sim_dt_rule_``."""
+        """``sim_dt_``: the user's, else :func:`choose_sim_dt` on the fitted model, simulated
+        as the rollout selection does (:meth:`_segment_rollouts`); ``sim_dt_rule_``."""
         if self.sim_dt is not None:
             self.sim_dt_, self.sim_dt_rule_ = self.sim_dt, "user-set"
             return
         self.__dict__.pop("sim_dt_", None)
         model = self.model_
+        i0 = round(self._knob("edge_trim") * data.fs)
+        segments = self._knob("rollout_segments")
 
         def simulate(dt: float) -> np.ndarray:
-            return model.simulate(data.x[:, 0], data.xd[:, 0], data.t, data.u, dt,
-                                  self.input_hold_, angles_only=True).x
+            return self._segment_rollouts(model, data, i0, segments, dt)
 
-        self.sim_dt_, self.sim_dt_rule_ = choose_sim_dt(simulate, data.x, data.fs)
+        self.sim_dt_, self.sim_dt_rule_ = choose_sim_dt(simulate, data.x[:, i0:data.n_samples - i0],
+                                                        data.fs)
+
+    def _segment_rollouts(self, model: ImplicitModel, data: Measurement, i0: int, segments: int,
+                          dt: float) -> np.ndarray:
+        """The simulated coordinates (n_channels, n - 2 i0) over the trimmed record
+        ``[i0, n - i0)`` cut into ``segments`` equal parts, each simulated from the measured
+        state at its start with RK4 step ``dt`` [s] (a part of fewer than 2 samples is the
+        measured one).
+
+        Raises
+        ------
+        IdentificationError
+            A simulation failed.
+        """
+        n = data.n_samples - 2 * i0
+        edges = i0 + np.arange(segments + 1) * n // segments
+        out = data.x[:, i0:i0 + n].copy()
+        for a, b in pairwise(edges):
+            if b - a < 2:
+                continue
+            out[:, a - i0:b - i0] = model.simulate(data.x[:, a], data.xd[:, a], data.t[a:b],
+                                                   data.u[:, a:b], dt, self.input_hold_,
+                                                   angles_only=True).x
+        return out
 
     def _rollout_error(self, model: ImplicitModel, data: Measurement, i0: int,
                        segments: int) -> float:
         """Simulation error of a candidate model on the measured angles [rad] (inf if a
         simulation fails): the trimmed record ``[i0, n - i0)`` cut into ``segments`` equal
-        parts, each simulated from the measured state at its start; the largest over
-        coordinates of the RMSE over all segments' samples.
+        parts, each simulated from the measured state at its start
+        (:meth:`_segment_rollouts`); the largest over coordinates of the RMSE over all
+        segments' samples.
 
         Segments, not one simulation: the five-bar's motion amplifies a state error, so one
         simulation of the whole record from the chain's estimated start state ranks
@@ -982,18 +1015,11 @@ class _ImplicitMechanical(Identifier):
         segments on none).
         """
         n = data.n_samples - 2 * i0
-        edges = i0 + np.arange(segments + 1) * n // segments
-        sq = np.zeros(data.n_channels)
         try:
-            for a, b in pairwise(edges):
-                if b - a < 2:
-                    continue
-                tr = model.simulate(data.x[:, a], data.xd[:, a], data.t[a:b], data.u[:, a:b],
-                                    self._step(), self.input_hold_, angles_only=True)
-                sq += np.sum((tr.x - data.x[:, a:b]) ** 2, axis=1)
+            sim = self._segment_rollouts(model, data, i0, segments, self._step())
         except IdentificationError:
             return np.inf
-        err = float(np.sqrt(sq / n).max())
+        err = float(np.sqrt(np.sum((sim - data.x[:, i0:i0 + n]) ** 2, axis=1) / n).max())
         return err if np.isfinite(err) else np.inf
 
     def _bag(self, Theta_train: np.ndarray, G_val: np.ndarray, best: list[tuple[int, int]],

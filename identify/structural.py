@@ -36,8 +36,7 @@ from testbed.core.measurement import Measurement, Trajectory
 from testbed.core.schema import Field
 from testbed.numerics.filters import elliptic_highpass
 from testbed.numerics.shapes import mac_matrix
-from testbed.numerics.spectral import (band_analytic, harmonic_amplitude_law, harmonic_lock,
-                                       peak_candidates)
+from testbed.numerics.spectral import band_analytic, harmonic_amplitude_law, harmonic_lock, peak_candidates
 
 # imported on first use: `testbed list` does not pay for them
 sfft = lazy_module("scipy.fft")

@@ -52,10 +52,23 @@ def test_the_first_step_the_next_does_not_move_is_kept():
 
 
 def test_a_step_at_which_the_model_fails_is_refined_and_never_kept():
-    dt, rule = choose_sim_dt(*_fake(1.0, fail_above=2e-4), fs=1e4)
-    assert dt == pytest.approx(1e-4)
-    dt, rule = choose_sim_dt(*_fake(1.0, fail_above=0.0), fs=1e4)
-    assert dt == SIM_DT_START and "fails at every step" in rule
+    # fails at 1 ms only: 0.5 ms, which 0.1 ms moves by 2.4e-7, is kept
+    dt, rule = choose_sim_dt(*_fake(1.0, fail_above=7e-4), fs=1e4)
+    assert "0.0005 s" in rule
+    assert dt == pytest.approx(5e-4)
+
+
+def test_a_model_failing_at_two_successive_steps_is_not_refined_further():
+    calls = []
+    simulate, x = _fake(1.0, fail_above=2e-4)
+
+    def counted(dt):
+        calls.append(dt)
+        return simulate(dt)
+
+    dt, rule = choose_sim_dt(counted, x, fs=1e4)
+    assert dt == SIM_DT_START and "alike" in rule
+    assert calls == pytest.approx([1e-3, 5e-4])  # no finer (costlier) failing simulation
 
 
 def test_not_converged_keeps_the_finest_and_says_so():
