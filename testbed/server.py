@@ -153,8 +153,8 @@ def _recv(sock: socket.socket, with_fds: int = 0) -> tuple[dict | None, list[int
         body += more
     try:
         return json.loads(body), fds
-    except ValueError:  # (the descriptors are returned: the caller closes them)
-        return None, fds
+    except (ValueError, RecursionError):  # garbage or nested past the parser's stack (a
+        return None, fds                  # damaged request); the caller closes the descriptors
 
 
 # ---------------------------------------------------------------- client

@@ -624,8 +624,9 @@ def _check_hdf5_size(path: Path) -> None:
     try:
         with h5py.File(path, "r") as h:
             group = h.get("measured")
-            shapes = [getattr(g, "shape", ()) for g in group.values()] if isinstance(group, h5py.Group) else []
-    except Exception:  # noqa: BLE001 - not a readable HDF5 file: Dataset.load says what is wrong
+            shapes = ([getattr(g, "shape", ()) for g in group.values()]
+                      if isinstance(group, h5py.Group) else [])
+    except Exception:
         return
     shapes = [s for s in shapes if len(s) == 2]
     if shapes:

@@ -268,7 +268,8 @@ def test_damaged_requests_are_refused_and_leave_no_descriptor(sleeper):
     proc, env, _ = sleeper
     fds = lambda: len(os.listdir(f"/proc/{proc.pid}/fd"))  # noqa: E731
     before = fds()
-    for body in (b"{not json", b"[1, 2]", b'{"key": "x"}', b'{"argv": 1}'):
+    deep = b"[" * 200_000 + b"]" * 200_000  # past the JSON parser's recursion limit
+    for body in (b"{not json", b"[1, 2]", b'{"key": "x"}', b'{"argv": 1}', deep):
         s = _raw(env)
         s.sendmsg([struct.pack("!I", len(body)) + body],
                   [(socket.SOL_SOCKET, socket.SCM_RIGHTS, array.array("i", (0, 1, 2)))])
