@@ -661,7 +661,8 @@ def _check_meta(run_dir: Path, meta: dict[str, Any]) -> None:
             raise ValueError(f"{run_dir / 'run.json'}: checks[{i}] is not a check with "
                              + ", ".join(_CHECK_KEYS))
     for k, v in meta["scores"].items():  # as _jsonable stores them: NaN null, infinities strings
-        if not (v is None or v in ("inf", "-inf") or (isinstance(v, (int, float)) and not isinstance(v, bool))):
+        number = isinstance(v, (int, float)) and not isinstance(v, bool)
+        if not (v is None or v in ("inf", "-inf") or number):
             raise ValueError(f"{run_dir / 'run.json'}: scores[{k!r}] {v!r} is not a number "
                              "(null for NaN, \"inf\" or \"-inf\")")
 
