@@ -573,6 +573,11 @@ def _physical_failures(summary: dict) -> dict[str, str] | None:
 def cmd_runs(args: argparse.Namespace) -> int:
     from testbed.studies.runstore import list_runs
 
+    if args.out is None:  # the default folder: no runs yet is an empty history
+        args.out = "out/runs"
+    elif not Path(args.out).exists():  # a folder the user named: a typo lists nothing
+        raise InputError(f"--out {args.out}: no such folder; expected the folder of runs "
+                         "(from `testbed run --out`)")
     if Path(args.out).exists() and not Path(args.out).is_dir():
         raise InputError(f"--out {args.out}: not a folder; expected the folder of runs "
                          "(from `testbed run --out`)")
@@ -737,7 +742,7 @@ def build_parser() -> argparse.ArgumentParser:
     rs = sub.add_parser("runs", help="list the runs saved by `testbed run` (the run history)")
     rs.add_argument("action", choices=("ls",), help="ls: one row per run, oldest first")
     rs.add_argument("scenario", nargs="?", help="only the runs of this scenario")
-    rs.add_argument("-o", "--out", default="out/runs", help="folder of the runs (default out/runs)")
+    rs.add_argument("-o", "--out", default=None, help="folder of the runs (default out/runs)")
     rs.add_argument("--plain", action="store_true",
                     help="tab-separated lines, nothing cut (the default when not a terminal)")
     rs.set_defaults(fn=cmd_runs)

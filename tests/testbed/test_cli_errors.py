@@ -78,6 +78,8 @@ def one_error_line(err: str) -> str:
      "--out {tmp}/text.txt: exists and is not a folder"),
     (["demo", "--out", "{tmp}/text.txt"], "--out {tmp}/text.txt: exists and is not a folder"),
     (["runs", "ls", "-o", "{tmp}/text.txt"], "--out {tmp}/text.txt: not a folder"),
+    # a folder the user named that does not exist listed an empty history with exit 0
+    (["runs", "ls", "-o", "{tmp}/no_such_folder"], "--out {tmp}/no_such_folder: no such folder"),
     (["identify", "{tmp}/text.txt", "--kind", "structural", "--method", "ls_sindy", "-o",
       "{tmp}/text.txt/m.json"], "{tmp}/text.txt is a file, not a folder"),
     # a later unit was silently ignored
