@@ -36,7 +36,12 @@ from testbed.core.measurement import Measurement, Trajectory
 from testbed.core.schema import Field
 from testbed.numerics.filters import elliptic_highpass
 from testbed.numerics.shapes import mac_matrix
-from testbed.numerics.spectral import band_analytic, harmonic_amplitude_law, harmonic_lock, peak_candidates
+from testbed.numerics.spectral import (
+    harmonic_amplitude_law,
+    harmonic_lock,
+    own_lock,
+    peak_candidates,
+)
 
 # imported on first use: `testbed list` does not pay for them
 sfft = lazy_module("scipy.fft")
@@ -946,45 +951,6 @@ def modal_peaks(data: Measurement, n_modes: int | None = None,
     found = "; ".join(f"{f:.4g} Hz = {k} x {f0:.4g} Hz" for f, k, f0 in harmonics) or "none found"
     return PeakSearch(band, rule, np.sort(freqs[kept]), rejected, nonlinear, harmonics,
                       f"{HARMONIC_RULE}: {found}", count_rule)
-
-
-def own_lock(x: np.ndarray, fs: float, f: float, shape: np.ndarray, rel_band: float = 1.0 / 3.0
-             ) -> float:
-    """How firmly a peak rings at its own frequency [-].
-
-    The channels, added in phase by the conjugate deflection shape, are demodulated in the band
-    ``f (1 +- rel_band)`` (:func:`testbed.numerics.spectral.band_analytic`; ``1 / (rel_band f)``
-    s dropped at each end, where the band's cut rings, as
-    :func:`testbed.numerics.spectral.harmonic_lock` does), and the phase of ``z(t) exp(-2 pi i
-    f t)`` is averaged, weighted by ``|z|``.
-
-    Parameters
-    ----------
-    x : ndarray, shape (n_channels, n_samples)
-        Free-decay signals.
-    fs : float
-        Sample rate [Hz].
-    f : float
-        Peak frequency [Hz].
-    shape : ndarray, shape (n_channels,), complex
-        Its deflection shape (:func:`deflection_shapes`).
-    rel_band : float
-        Relative half-width of the demodulation band.
-
-    Returns
-    -------
-    float
-        Mean resultant length: ``|sinc(delta T)|`` for a mode ringing ``delta`` Hz from ``f``
-        (about 1 at a refined peak), about ``1 / sqrt(2 rel_band f T)`` for noise over ``T``
-        s; NaN if nothing is left after the ends are dropped.
-    """
-    x = np.atleast_2d(np.asarray(x, dtype=float))
-    z = band_analytic(x, fs, f * (1 - rel_band), f * (1 + rel_band), np.conj(shape))
-    trim = int(np.ceil(fs / (rel_band * f)))
-    z = z[trim:x.shape[-1] - trim]
-    tot = np.abs(z).sum()
-    t = (trim + np.arange(z.size)) / fs
-    return float(np.abs((z * np.exp(-2j * np.pi * f * t)).sum()) / tot) if tot > 0 else float("nan")
 
 
 def _lower_modes_first(xdd: np.ndarray, fs: float, freqs: np.ndarray, shapes: np.ndarray,

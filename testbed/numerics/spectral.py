@@ -348,3 +348,42 @@ def harmonic_lock(x: np.ndarray, fs: float, f_fund: float, f_cand: float, k: int
     prod = zc * np.conj(zp) ** int(k)
     tot = np.abs(prod).sum()
     return float(np.abs(prod.sum()) / tot) if tot > 0 else float("nan")
+
+
+def own_lock(x: np.ndarray, fs: float, f: float, shape: np.ndarray, rel_band: float = 1.0 / 3.0
+             ) -> float:
+    """How firmly a peak rings at its own frequency [-].
+
+    The channels, added in phase by the conjugate deflection shape, are demodulated in the band
+    ``f (1 +- rel_band)`` (:func:`band_analytic`; ``1 / (rel_band f)``
+    s dropped at each end, where the band's cut rings, as
+    :func:`harmonic_lock` does), and the phase of ``z(t) exp(-2 pi i
+    f t)`` is averaged, weighted by ``|z|``.
+
+    Parameters
+    ----------
+    x : ndarray, shape (n_channels, n_samples)
+        Free-decay signals.
+    fs : float
+        Sample rate [Hz].
+    f : float
+        Peak frequency [Hz].
+    shape : ndarray, shape (n_channels,), complex
+        Its deflection shape (:func:`deflection_shapes`).
+    rel_band : float
+        Relative half-width of the demodulation band.
+
+    Returns
+    -------
+    float
+        Mean resultant length: ``|sinc(delta T)|`` for a mode ringing ``delta`` Hz from ``f``
+        (about 1 at a refined peak), about ``1 / sqrt(2 rel_band f T)`` for noise over ``T``
+        s; NaN if nothing is left after the ends are dropped.
+    """
+    x = np.atleast_2d(np.asarray(x, dtype=float))
+    z = band_analytic(x, fs, f * (1 - rel_band), f * (1 + rel_band), np.conj(shape))
+    trim = int(np.ceil(fs / (rel_band * f)))
+    z = z[trim:x.shape[-1] - trim]
+    tot = np.abs(z).sum()
+    t = (trim + np.arange(z.size)) / fs
+    return float(np.abs((z * np.exp(-2j * np.pi * f * t)).sum()) / tot) if tot > 0 else float("nan")

@@ -74,11 +74,12 @@ def test_both_identifiers_record_the_rule_and_take_the_override():
 
 
 def test_own_lock_tells_a_ringing_mode_from_noise():
-    """:func:`identify.structural.own_lock` of a decaying 60 Hz mode (0.05 % and 2 % damped) is
+    """:func:`testbed.numerics.spectral.own_lock` of a decaying 60 Hz mode (0.05 % and 2 % damped) is
     about 1; of white noise (the sensors' noise: a chance shape can pass the shape test, as a
     35.1 Hz noise peak of the shipped soft bases at 50 % noise did) about 1 / sqrt(2 f T / 3)
     = 0.22 over this record, below the rule's 2/pi on ten seeds."""
-    from identify.structural import LOWER_MODE_LOCK, own_lock
+    from identify.structural import LOWER_MODE_LOCK
+    from testbed.numerics.spectral import own_lock
 
     t = np.arange(round(T * FS)) / FS
     one = np.array([1.0 + 0.0j])
