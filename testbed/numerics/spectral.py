@@ -355,10 +355,9 @@ def own_lock(x: np.ndarray, fs: float, f: float, shape: np.ndarray, rel_band: fl
     """How firmly a peak rings at its own frequency [-].
 
     The channels, added in phase by the conjugate deflection shape, are demodulated in the band
-    ``f (1 +- rel_band)`` (:func:`band_analytic`; ``1 / (rel_band f)``
-    s dropped at each end, where the band's cut rings, as
-    :func:`harmonic_lock` does), and the phase of ``z(t) exp(-2 pi i
-    f t)`` is averaged, weighted by ``|z|``.
+    ``f (1 +- rel_band)`` (:func:`band_analytic`; ``1 / (rel_band f)`` s dropped at each end,
+    where the band's cut rings, as :func:`harmonic_lock` does), and the phase of
+    ``z(t) exp(-2 pi i f t)`` is averaged, weighted by ``|z|``.
 
     Parameters
     ----------
@@ -369,7 +368,7 @@ def own_lock(x: np.ndarray, fs: float, f: float, shape: np.ndarray, rel_band: fl
     f : float
         Peak frequency [Hz].
     shape : ndarray, shape (n_channels,), complex
-        Its deflection shape (:func:`deflection_shapes`).
+        Its deflection shape across the channels (complex amplitudes at ``f``).
     rel_band : float
         Relative half-width of the demodulation band.
 
