@@ -496,7 +496,10 @@ def check_identifier_for_record(cls: Any, full: dict[str, Any], shape: tuple[int
         cls.check_data_shape(full, shape[0], shape[1], fs, n_samples, error)
     steps, key = cls.simulation_steps(full, n_samples / fs)
     if key:
-        check_steps(steps, file, f"{section}.{key}", full[key])
+        # unset: the identifier chooses it from the data (e.g. sindy_pi's step rule); the
+        # line says so instead of showing None
+        value = full[key] if full[key] is not None else "unset (chosen from the data)"
+        check_steps(steps, file, f"{section}.{key}", value)
 
 
 def _validate_identify(table: Any, file: str, *, kind: str | None = None,

@@ -535,6 +535,20 @@ def test_identify_checks_hyperparameters_against_the_data(tmp_path):
         _identify(path, "sim_dt=1e-9")
 
 
+def test_a_step_budget_over_a_rule_chosen_step_says_it_is_unset(tmp_path):
+    """A five-bar record too long for sindy_pi's step rule names ``identify.sim_dt`` as unset
+    and chosen from the data (the line showed ``value None``)."""
+    from testbed.core.errors import BudgetError
+
+    base = SCENARIO_DIR.parent / "benchmarks" / "unseen" / "round4" / "fb_L0_0p3.toml"  # no identify
+    (tmp_path / "long.toml").write_text(
+        f'[scenario]\nname = "long"\nextends = "{base}"\n[simulation]\nduration = 3600.0\n'
+        'sample_rate = 1000.0\ndt = 0.001\n[identify]\nmethod = "sindy_pi"\n')
+    with pytest.raises(BudgetError, match=r"key 'identify.sim_dt': value 'unset \(chosen from "
+                                          r"the data\)'.*steps"):
+        load_scenario(tmp_path / "long.toml")
+
+
 def test_identify_names_the_file_when_the_fit_finds_no_model(tmp_path):
     # the fit's own errors ("lhs term 'x^5' is not in the library") named no file
     from testbed.core.errors import IdentificationError
