@@ -187,9 +187,10 @@ PRUNE_TOL_FIELD = Field(float, 1e-9, min=0.0, max=1.0, max_inclusive=False,
                             "combination of earlier ones")
 # (0, 1] s: the five-bar's motion is below 2 Hz; a step above 1 s resolves nothing
 SIM_DT_FIELD = Field(float, None, unit="s", min=0.0, min_inclusive=False, max=1.0,
-                     doc="RK4 step of the identified model's simulation; none = halved from "
-                         "1 ms until halving it moves the simulation by less than 1e-6 of "
-                         "the motion (the rule, sim_dt_rule_)")
+                     doc="RK4 step of the identified model's simulation; none = 1 ms, 0.5 ms, "
+                         "then the sample interval and its halves, the first that the next "
+                         "moves the simulation by at most 2.5e-6 of the motion (the rule, "
+                         "sim_dt_rule_)")
 RECONCILE_FIELD = Field(bool, True, doc="replace passive angles, rates and accelerations by those "
                                         "the loop closure implies")
 COLUMN_LOWPASS_FIELD = Field(float, None, unit="Hz", min=0.0, min_inclusive=False,
@@ -831,7 +832,8 @@ class _ImplicitMechanical(Identifier):
         actuated = np.array([int(np.argmax(imap[:, k])) for k in range(imap.shape[1])])
         passive = np.flatnonzero(~imap.any(axis=1))
         self._knobs = None
-        self._choose_input_hold(data)
+        self.__dict__.pop("sim_dt_", None)  # candidates are simulated at the rule's first step,
+        self._choose_input_hold(data)        # never at a step an earlier fit chose
         self._knobs = self._choose_knobs(data)
         cut = self._knobs["column_lowpass_hz"]
         self.closure_ = None  # fully actuated, or an open chain: one equation per coordinate
@@ -966,7 +968,6 @@ class _ImplicitMechanical(Identifier):
         if self.sim_dt is not None:
             self.sim_dt_, self.sim_dt_rule_ = self.sim_dt, "user-set"
             return
-        self.__dict__.pop("sim_dt_", None)
         model = self.model_
         i0 = round(self._knob("edge_trim") * data.fs)
         segments = self._knob("rollout_segments")

@@ -968,6 +968,7 @@ def _lower_modes_first(xdd: np.ndarray, fs: float, freqs: np.ndarray, shapes: np
     if not on:
         return kept, f"{strongest} (lower_modes = False: user setting)"
     head, tail = list(kept[:n_modes]), list(kept[n_modes:])
+    locks: dict[int, float] = {}  # a candidate's lock does not change as the kept set does
     moved: list[tuple[float, float]] = []
     changed = True
     while changed and head:
@@ -977,7 +978,9 @@ def _lower_modes_first(xdd: np.ndarray, fs: float, freqs: np.ndarray, shapes: np
                 continue
             if max(float(mac_matrix(shapes[c], shapes[j])[0, 0]) for j in head) >= LOWER_MODE_MAC:
                 continue
-            if not own_lock(xdd, fs, float(freqs[c]), shapes[c]) >= LOWER_MODE_LOCK:
+            if c not in locks:
+                locks[c] = own_lock(xdd, fs, float(freqs[c]), shapes[c])
+            if not locks[c] >= LOWER_MODE_LOCK:
                 continue
             top = max(head, key=lambda j: freqs[j])
             head[head.index(top)] = c
