@@ -33,7 +33,7 @@ from testbed.pipeline.signal_chain import measure
 from testbed.scoring.scorers import score_structural
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[3] / "tests" / "identify"))
-from soft_cubic_floor import base_angle_error  # noqa: E402
+from soft_cubic_floor import base_angle_error
 
 
 def eb_determinant(bl: float, kappa: float) -> float:
