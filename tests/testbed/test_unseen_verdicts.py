@@ -204,3 +204,26 @@ def test_failed_bar_on_a_mode_outside_the_pass_band_is_named():
         why["band"] and "mode 1" not in why["band"]
     # other kinds (no pass band in the details): nothing
     assert out_of_band_failures(Scores({"freq_error_mode1": 9.0}), bars) == {}
+
+
+# ------------------------------------------- round 5 beams
+def test_softening_base_is_refused_at_load_naming_the_key():
+    # round 5: a softening (negative cubic) base, what a researcher tries next to a hardening
+    # one, is refused at load in one line with the key, the value and what is allowed (the
+    # rig's base spring k1 q + k3 q^3 with k3 >= 0); no simulation, no warning first
+    with pytest.raises(ScenarioError) as e:
+        scenario_from_dict(beam({"base": "soft", "base_k3": -2.5e9}), file="soft.toml")
+    msg = str(e.value)
+    assert "soft.toml" in msg and "'rig.base_k3'" in msg and "-2500000000.0" in msg
+    assert ">= 0" in msg and "N m/rad^3" in msg
+
+
+def test_hammer_between_sensors_is_refused_naming_the_nearest():
+    # round 5 (h_between_sensors.toml): the hammer at 0.16 m on the default beam, between the
+    # sensors at 0.1058 and 0.2117 m; a model in sensor coordinates cannot place that force,
+    # and the one line says where the sensors are and how far the nearest is
+    with pytest.raises(ScenarioError) as e:
+        scenario_from_dict(beam(excitation={"location": 0.16}), file="hit.toml")
+    msg = str(e.value)
+    assert "hit.toml" in msg and "'excitation.location'" in msg and "0.16" in msg
+    assert "sensors at 0.105833, 0.211667, 0.3175 m" in msg and "51.7 mm from the nearest" in msg
