@@ -105,6 +105,26 @@ def test_flipped_bits_in_a_cached_array_are_caught_by_the_content_hash(tmp_path,
     _assert_same_data(again, first)
 
 
+def test_a_truth_array_rewritten_as_complex_is_caught(tmp_path, caplog):
+    # the content hash and the typed truth both cast a truth array to real: an imaginary part
+    # added to a cached entry's truth passed the verification (with three ComplexWarnings)
+    sc = _short()
+    cache = DatasetCache(tmp_path)
+    first = cache.get(sc)
+    path = cache.path(sc)
+    with h5py.File(path, "r+") as f:
+        old = f["truth/M"]
+        value, unit = old[()], old.attrs["unit"]
+        del f["truth/M"]
+        f.create_dataset("truth/M", data=value + 1j).attrs["unit"] = unit
+    with pytest.raises(DatasetError, match=r"truth/M: complex128 data; expected real numbers"):
+        Dataset.load(path)
+    with caplog.at_level(logging.WARNING, logger="testbed.pipeline.cache"):
+        again = cache.get(sc)
+    assert any(str(path) in r.getMessage() for r in caplog.records if r.name == "testbed.pipeline.cache")
+    _assert_same_data(again, first)
+
+
 def test_loading_a_file_that_is_not_a_dataset_names_it(tmp_path):
     junk = tmp_path / "notes.h5"
     junk.write_text("not HDF5 at all\n")
