@@ -13,6 +13,7 @@ import argparse
 import contextlib
 import dataclasses
 import errno
+import functools
 import gc
 import os
 import signal
@@ -22,6 +23,7 @@ import sys
 import threading
 import warnings
 from collections.abc import Callable, Iterator
+from typing import Any
 from pathlib import Path
 from urllib.parse import urlsplit
 
@@ -812,17 +814,42 @@ def _raise_terminated(signum: int, frame: object) -> None:
 @contextlib.contextmanager
 def _terminate_as_interrupt() -> Iterator[None]:
     """SIGTERM and SIGHUP raise :class:`Terminated` while a command runs (only where their
-    action is the default one and only in the main thread: a caller's own handlers stay)."""
+    action is the default one and only in the main thread: a caller's own handlers stay), and
+    an interrupt Python could not raise is delivered again (:func:`_redeliver_interrupt`)."""
     installed = {}
     if threading.current_thread() is threading.main_thread():
         for s in (signal.SIGTERM, signal.SIGHUP):
             if signal.getsignal(s) is signal.SIG_DFL:
                 installed[s] = signal.signal(s, _raise_terminated)
+    hook = sys.unraisablehook
+    sys.unraisablehook = functools.partial(_redeliver_interrupt, hook)
     try:
         yield
     finally:
+        sys.unraisablehook = hook
         for s, handler in installed.items():
             signal.signal(s, handler)
+
+
+#: Delay before an interrupt that could not be raised is sent again [s]: long enough for the
+#: callback that swallowed it (a few bytecodes) to have returned, short against a user's wait.
+REDELIVER_S = 0.01
+
+
+def _redeliver_interrupt(hook: Callable[[Any], None], unraisable: Any) -> None:
+    """``sys.unraisablehook`` while a command runs: a Ctrl-C (or SIGTERM, SIGHUP) whose
+    KeyboardInterrupt was raised inside a callback Python cannot raise from (a weak reference's,
+    e.g. the import system's module locks; a ``__del__``) is sent to the process again a moment
+    later, in silence; anything else goes to ``hook``.  Before, such an interrupt printed
+    "Exception ignored in ... Traceback ... KeyboardInterrupt" and was lost: a Ctrl-C in the
+    first second of `testbed run` let the run finish with status 0."""
+    if not isinstance(unraisable.exc_value, KeyboardInterrupt):
+        hook(unraisable)
+        return
+    signum = getattr(unraisable.exc_value, "signum", signal.SIGINT)
+    timer = threading.Timer(REDELIVER_S, os.kill, (os.getpid(), signum))
+    timer.daemon = True
+    timer.start()
 
 
 def main(argv: list[str] | None = None) -> int:

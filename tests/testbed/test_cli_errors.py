@@ -290,3 +290,20 @@ def test_a_server_socket_path_too_long_is_one_line(tmp_path, capsys, monkeypatch
     line = one_error_line(capsys.readouterr().err)
     assert line.startswith(f"error: socket path {path} ($TESTBED_SERVER_SOCKET or the default): ")
     assert line.endswith("bytes; expected at most 107 (the longest Unix socket address)"), line
+
+
+def test_an_interrupt_python_could_not_raise_still_ends_the_command(tmp_path, capsys):
+    # a Ctrl-C landing in a weak reference's callback (the import system's module locks, in the
+    # first second of `testbed run`) printed "Exception ignored in ... KeyboardInterrupt" and
+    # was lost: the run went on to its verdict, status 0; it is now delivered again
+    plugin = tmp_path / "swallows.py"
+    plugin.write_text("import gc, time\n"
+                      "class Swallowed:\n"
+                      "    def __del__(self):\n"
+                      "        raise KeyboardInterrupt\n"
+                      "Swallowed()\n"
+                      "gc.collect()\n"
+                      "time.sleep(1.5)  # the interrupt is sent again 10 ms later, during this\n"
+                      "raise SystemExit('the interrupt was lost')\n")
+    assert main(["list", "--plugin", str(plugin)]) == cli.EXIT_INTERRUPTED
+    assert one_error_line(capsys.readouterr().err) == "error: interrupted"
