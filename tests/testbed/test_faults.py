@@ -9,8 +9,10 @@ from __future__ import annotations
 
 import json
 import logging
+import contextlib
 import math
 import os
+import resource
 import signal
 import subprocess
 import sys
@@ -27,6 +29,7 @@ sys.path.insert(0, str(Path(__file__).parent))
 import _synthetic_runs as synth
 
 from testbed.core.dataset import Dataset, DatasetError
+from testbed.core.errors import InputError
 from testbed.pipeline.cache import DatasetCache
 from testbed.pipeline.generate import generate
 from testbed.pipeline.scenario import load_scenario
@@ -581,6 +584,44 @@ def test_a_run_named_dot_or_dotdot_never_touches_the_output_folder(mechanical, t
     with pytest.raises(RunStoreError, match="outside the output folder"):
         run_folder(out, "sneaky")
     assert run_folder(out, "fine_name") == out / "fine_name"
+
+
+@contextlib.contextmanager
+def _file_size_limit(nbytes: int):
+    """The process's file-size limit (``ulimit -f``, RLIMIT_FSIZE) at ``nbytes`` in the block: a
+    full disk as a write meets it (Python ignores SIGXFSZ, so the write fails with EFBIG)."""
+    soft, hard = resource.getrlimit(resource.RLIMIT_FSIZE)
+    resource.setrlimit(resource.RLIMIT_FSIZE, (nbytes, hard))
+    try:
+        yield
+    finally:
+        resource.setrlimit(resource.RLIMIT_FSIZE, (soft, hard))
+
+
+def test_a_full_disk_while_caching_a_dataset_is_one_error_naming_the_file(tmp_path):
+    # was an internal error, or HDF5's finalizers printing tracebacks and a crash (SIGBUS)
+    sc = _short()
+    cache = DatasetCache(tmp_path)
+    with _file_size_limit(20_000), pytest.raises(InputError) as e:  # the entry takes 93 kB
+        cache.get(sc)
+    msg = str(e.value)
+    assert msg.startswith(f"{cache.path(sc)}: cannot be written: File too large (") and "\n" not in msg
+    assert list(tmp_path.iterdir()) == []  # nothing half-written: no entry, no temporary file
+    _assert_same_data(cache.get(sc), generate(sc))  # room again: simulated and stored whole
+
+
+def test_a_full_disk_while_saving_a_run_is_one_error_naming_its_folder(mechanical, tmp_path):
+    from testbed.studies.runstore import save_new_run
+
+    out = tmp_path / "runs"
+    save_run(mechanical, out / "other")
+    with _file_size_limit(2_000), pytest.raises(InputError) as e:  # run.json takes 6 kB, run.npz 24 kB
+        save_new_run(mechanical, out)
+    assert str(e.value).startswith(f"a run folder in {out / mechanical.scenario.name}: cannot be "
+                                   "written: File too large")
+    assert not (out / mechanical.scenario.name).exists() or not any(
+        (out / mechanical.scenario.name).iterdir())  # no half-written run
+    assert load_run(out / "other").fit_time == mechanical.fit_time
 
 
 def test_cli_run_of_a_scenario_named_dot_leaves_every_other_run(mechanical, tmp_path, capsys):
