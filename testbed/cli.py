@@ -927,17 +927,38 @@ def _run(args: argparse.Namespace) -> int:
             raise
         print(f"error: {_one_line(e)}", file=sys.stderr)
         return EXIT_USAGE
-    except Terminated as e:
-        print(f"error: interrupted by {signal.Signals(e.signum).name}", file=sys.stderr)
-        return 128 + e.signum
-    except KeyboardInterrupt:
-        print("error: interrupted", file=sys.stderr)
-        return EXIT_INTERRUPTED
+    except KeyboardInterrupt as e:
+        return _interrupted(e)
     except BrokenPipeError:  # the reader went away (`testbed list | head -1`): stop quietly
         _quiet_stdout()
         return EXIT_BROKEN_PIPE
     except Exception as e:
-        return _internal(e, args)
+        interrupt = _interrupt_within(e)
+        return _internal(e, args) if interrupt is None else _interrupted(interrupt)
+
+
+def _interrupted(e: KeyboardInterrupt) -> int:
+    """One line for Ctrl-C (status 130), SIGTERM or SIGHUP (128 + its number)."""
+    if isinstance(e, Terminated):
+        print(f"error: interrupted by {signal.Signals(e.signum).name}", file=sys.stderr)
+        return 128 + e.signum
+    print("error: interrupted", file=sys.stderr)
+    return EXIT_INTERRUPTED
+
+
+def _interrupt_within(e: BaseException) -> KeyboardInterrupt | None:
+    """The interrupt ``e`` was raised from (its ``__cause__`` / ``__context__`` chain), or None.
+
+    A C extension whose import is interrupted (pybind11's: MuJoCo's, matplotlib's) raises
+    ``ImportError: initialization failed`` from the KeyboardInterrupt: a SIGTERM in a run's
+    first seconds was an internal error ("please report it")."""
+    seen: set[int] = set()
+    while e is not None and id(e) not in seen:
+        if isinstance(e, KeyboardInterrupt):
+            return e
+        seen.add(id(e))
+        e = e.__cause__ or e.__context__
+    return None
 
 
 def _quiet_stdout() -> None:

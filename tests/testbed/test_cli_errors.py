@@ -307,3 +307,20 @@ def test_an_interrupt_python_could_not_raise_still_ends_the_command(tmp_path, ca
                       "raise SystemExit('the interrupt was lost')\n")
     assert main(["list", "--plugin", str(plugin)]) == cli.EXIT_INTERRUPTED
     assert one_error_line(capsys.readouterr().err) == "error: interrupted"
+
+
+@pytest.mark.parametrize(("interrupt", "status", "line"), [
+    (KeyboardInterrupt(), cli.EXIT_INTERRUPTED, "error: interrupted"),
+    (cli.Terminated(15), 143, "error: interrupted by SIGTERM"),
+])
+def test_an_import_interrupted_is_an_interrupt_not_an_internal_error(monkeypatch, capsys, interrupt,
+                                                                     status, line):
+    # a C extension interrupted while it initialises (pybind11's: MuJoCo, matplotlib) raises
+    # "ImportError: initialization failed" from the interrupt: a SIGTERM at a run's start
+    # was "internal error (a bug, not your input): ImportError: initialization failed"
+    def cmd_list(args):
+        raise ImportError("initialization failed") from interrupt
+
+    monkeypatch.setattr(cli, "cmd_list", cmd_list)
+    assert main(["list"]) == status
+    assert one_error_line(capsys.readouterr().err) == line
