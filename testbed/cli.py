@@ -223,11 +223,14 @@ def _dataset_file(path: Path) -> Path:
 
 def _results_file(path: Path) -> Path:
     """A sweep results file that :func:`testbed.studies.results.read_results` can read, else InputError."""
-    from testbed.studies.results import read_results
+    from testbed.studies.results import ResultsError, read_results
 
     _existing_file(path, "a sweep results file (from `testbed sweep`)")
     try:
         read_results(path)
+    except ResultsError as e:  # with what is wrong with it (a column missing, a row damaged)
+        why = str(e).removeprefix(f"{path}: ")
+        raise InputError(f"{path}: not a sweep results file: {why}") from None
     except Exception as e:  # any failure to parse the user's file is a property of the file
         raise InputError(f"{path}: not a sweep results file ({type(e).__name__})") from None
     return path

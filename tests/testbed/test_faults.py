@@ -12,6 +12,7 @@ import logging
 import contextlib
 import math
 import os
+import re
 import resource
 import signal
 import subprocess
@@ -407,6 +408,55 @@ def test_damaged_results_file_is_named_by_summary_and_set_aside_by_sweep(fault_d
     rows = read_results(run_sweep(study, results=res, cache_dir=cache, verbose=False, stats=stats))
     assert stats.run == 2 and _comparable(rows) == _comparable(whole)
     assert res.with_name(res.name + ".bad").is_file()
+
+
+def _results_row(cell: str, **over) -> dict:
+    """A results row as a sweep writes it (one score, trac)."""
+    row = {"study": "s", "cell": cell, "scenario": "sc", "rig": "cantilever", "noise": 1.0,
+           "seed": 0, "identifier": "ls_sindy", "params": "{}", "status": "ok", "error": "",
+           "fit_time": 0.1, "data_time": 0.1, "cell_time": 0.2, "passed": True, "trac": 0.99,
+           "checks": json.dumps([{"metric": "trac", "value": 0.99, "bound": "min",
+                                  "threshold": 0.9, "passed": True}]),
+           "versions": "{}", "commit": "abc", "dataset_hash": "0" * 64}
+    return {**row, **over}
+
+
+def _retyped(table, name, values):
+    import pyarrow as pa
+
+    return table.set_column(table.schema.get_field_index(name), name, pa.array(values))
+
+
+@pytest.mark.parametrize(("edit", "fragment"), [
+    (lambda t: t.drop_columns(["noise"]), "no column 'noise'; expected the columns of a `testbed sweep`"),
+    (lambda t: t.drop_columns(["identifier"]), "no column 'identifier'"),
+    (lambda t: _retyped(t, "noise", ["1", "1"]), "column 'noise' holds string; expected double"),
+    (lambda t: _retyped(t, "trac", ["0.99", "0.99"]), "score column 'trac' holds string; expected double"),
+    (lambda t: _retyped(t, "passed", ["yes", "yes"]), "column 'passed' holds string; expected bool"),
+    (lambda t: _retyped(t, "status", ["ok", "maybe"]), "row 1 (cell 'b'): status 'maybe'; expected 'ok' or"),
+    (lambda t: _retyped(t, "noise", [math.nan, 1.0]), "row 0 (cell 'a'): noise nan; expected a finite level"),
+    (lambda t: _retyped(t, "passed", [None, True]), "row 0 (cell 'a'): no passed;"),
+    (lambda t: __import__("pyarrow").concat_tables([t, t]), "row 2 (cell 'a'): the cell appears twice"),
+])
+def test_a_results_file_with_a_column_missing_or_retyped_is_named(tmp_path, capsys, edit, fragment):
+    # a consolidated file without its noise, scenario or identifier column, or with noise as
+    # text or NaN, was an internal error of `testbed summary` and `testbed report` (KeyError,
+    # ValueError, ZeroDivisionError); a score as text, a passed of null or a cell twice passed
+    import pyarrow.parquet as pq
+
+    from testbed.cli import main
+    from testbed.studies.results import write_rows
+
+    res = tmp_path / "r.parquet"
+    write_rows(res, [_results_row("a"), _results_row("b")], study="s")
+    table = pq.read_table(res)
+    pq.write_table(edit(table).replace_schema_metadata(table.schema.metadata), res)
+    with pytest.raises(ResultsError, match=re.escape(fragment)):
+        read_results(res)
+    for argv in (["summary", str(res)], ["report", str(res), "-o", str(tmp_path / "rep")]):
+        assert main(argv) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and err.startswith(f"error: {res}: ") and fragment in err, err
 
 
 def test_results_file_of_another_study_is_refused_untouched(fault_dir, tmp_path):
