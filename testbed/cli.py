@@ -860,17 +860,22 @@ def main(argv: list[str] | None = None) -> int:
     mistake, 3 an internal error, 130 interrupted; 128 + the signal's number when ended by
     SIGTERM or SIGHUP)."""
     _blas_threads()
-    if argv is None:  # the console program (not a call from Python): a resident server may run it
-        status = _served(sys.argv[1:])
-        if status is not None:
-            return status
-    before = gc.get_threshold()
-    gc.set_threshold(*GC_THRESHOLD)  # restored below: main() is also called from Python
     try:
-        with _terminate_as_interrupt():
-            return _main(argv)
-    finally:
-        gc.set_threshold(*before)
+        if argv is None:  # the console program (not a call from Python): a resident server may run it
+            status = _served(sys.argv[1:])
+            if status is not None:
+                return status
+        before = gc.get_threshold()
+        gc.set_threshold(*GC_THRESHOLD)  # restored below: main() is also called from Python
+        try:
+            with _terminate_as_interrupt():
+                return _main(argv)
+        finally:
+            gc.set_threshold(*before)
+    except KeyboardInterrupt as e:
+        # a Ctrl-C outside the command's own handling (while its options were parsed, in a
+        # busy machine's first second) printed a 30-line traceback and ended by SIGINT (-2)
+        return _interrupted(e)
 
 
 def _served(argv: list[str]) -> int | None:

@@ -324,3 +324,14 @@ def test_an_import_interrupted_is_an_interrupt_not_an_internal_error(monkeypatch
     monkeypatch.setattr(cli, "cmd_list", cmd_list)
     assert main(["list"]) == status
     assert one_error_line(capsys.readouterr().err) == line
+
+
+def test_an_interrupt_while_the_options_are_parsed_is_one_line(monkeypatch, capsys):
+    # a Ctrl-C in a busy machine's first second landed in argparse (building the parser
+    # imports shutil): a 30-line traceback, and the process ended by SIGINT
+    def build_parser():
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(cli, "build_parser", build_parser)
+    assert main(["list"]) == cli.EXIT_INTERRUPTED
+    assert one_error_line(capsys.readouterr().err) == "error: interrupted"
