@@ -13,6 +13,7 @@ import argparse
 import contextlib
 import dataclasses
 import errno
+import functools
 import gc
 import os
 import signal
@@ -22,6 +23,7 @@ import sys
 import threading
 import warnings
 from collections.abc import Callable, Iterator
+from typing import Any
 from pathlib import Path
 from urllib.parse import urlsplit
 
@@ -221,11 +223,14 @@ def _dataset_file(path: Path) -> Path:
 
 def _results_file(path: Path) -> Path:
     """A sweep results file that :func:`testbed.studies.results.read_results` can read, else InputError."""
-    from testbed.studies.results import read_results
+    from testbed.studies.results import ResultsError, read_results
 
     _existing_file(path, "a sweep results file (from `testbed sweep`)")
     try:
         read_results(path)
+    except ResultsError as e:  # with what is wrong with it (a column missing, a row damaged)
+        why = str(e).removeprefix(f"{path}: ")
+        raise InputError(f"{path}: not a sweep results file: {why}") from None
     except Exception as e:  # any failure to parse the user's file is a property of the file
         raise InputError(f"{path}: not a sweep results file ({type(e).__name__})") from None
     return path
@@ -812,17 +817,42 @@ def _raise_terminated(signum: int, frame: object) -> None:
 @contextlib.contextmanager
 def _terminate_as_interrupt() -> Iterator[None]:
     """SIGTERM and SIGHUP raise :class:`Terminated` while a command runs (only where their
-    action is the default one and only in the main thread: a caller's own handlers stay)."""
+    action is the default one and only in the main thread: a caller's own handlers stay), and
+    an interrupt Python could not raise is delivered again (:func:`_redeliver_interrupt`)."""
     installed = {}
     if threading.current_thread() is threading.main_thread():
         for s in (signal.SIGTERM, signal.SIGHUP):
             if signal.getsignal(s) is signal.SIG_DFL:
                 installed[s] = signal.signal(s, _raise_terminated)
+    hook = sys.unraisablehook
+    sys.unraisablehook = functools.partial(_redeliver_interrupt, hook)
     try:
         yield
     finally:
+        sys.unraisablehook = hook
         for s, handler in installed.items():
             signal.signal(s, handler)
+
+
+#: Delay before an interrupt that could not be raised is sent again [s]: long enough for the
+#: callback that swallowed it (a few bytecodes) to have returned, short against a user's wait.
+REDELIVER_S = 0.01
+
+
+def _redeliver_interrupt(hook: Callable[[Any], None], unraisable: Any) -> None:
+    """``sys.unraisablehook`` while a command runs: a Ctrl-C (or SIGTERM, SIGHUP) whose
+    KeyboardInterrupt was raised inside a callback Python cannot raise from (a weak reference's,
+    e.g. the import system's module locks; a ``__del__``) is sent to the process again a moment
+    later, in silence; anything else goes to ``hook``.  Before, such an interrupt printed
+    "Exception ignored in ... Traceback ... KeyboardInterrupt" and was lost: a Ctrl-C in the
+    first second of `testbed run` let the run finish with status 0."""
+    if not isinstance(unraisable.exc_value, KeyboardInterrupt):
+        hook(unraisable)
+        return
+    signum = getattr(unraisable.exc_value, "signum", signal.SIGINT)
+    timer = threading.Timer(REDELIVER_S, os.kill, (os.getpid(), signum))
+    timer.daemon = True
+    timer.start()
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -830,17 +860,22 @@ def main(argv: list[str] | None = None) -> int:
     mistake, 3 an internal error, 130 interrupted; 128 + the signal's number when ended by
     SIGTERM or SIGHUP)."""
     _blas_threads()
-    if argv is None:  # the console program (not a call from Python): a resident server may run it
-        status = _served(sys.argv[1:])
-        if status is not None:
-            return status
-    before = gc.get_threshold()
-    gc.set_threshold(*GC_THRESHOLD)  # restored below: main() is also called from Python
     try:
-        with _terminate_as_interrupt():
-            return _main(argv)
-    finally:
-        gc.set_threshold(*before)
+        if argv is None:  # the console program (not a call from Python): a resident server may run it
+            status = _served(sys.argv[1:])
+            if status is not None:
+                return status
+        before = gc.get_threshold()
+        gc.set_threshold(*GC_THRESHOLD)  # restored below: main() is also called from Python
+        try:
+            with _terminate_as_interrupt():
+                return _main(argv)
+        finally:
+            gc.set_threshold(*before)
+    except KeyboardInterrupt as e:
+        # a Ctrl-C outside the command's own handling (while its options were parsed, in a
+        # busy machine's first second) printed a 30-line traceback and ended by SIGINT (-2)
+        return _interrupted(e)
 
 
 def _served(argv: list[str]) -> int | None:
@@ -900,17 +935,38 @@ def _run(args: argparse.Namespace) -> int:
             raise
         print(f"error: {_one_line(e)}", file=sys.stderr)
         return EXIT_USAGE
-    except Terminated as e:
-        print(f"error: interrupted by {signal.Signals(e.signum).name}", file=sys.stderr)
-        return 128 + e.signum
-    except KeyboardInterrupt:
-        print("error: interrupted", file=sys.stderr)
-        return EXIT_INTERRUPTED
+    except KeyboardInterrupt as e:
+        return _interrupted(e)
     except BrokenPipeError:  # the reader went away (`testbed list | head -1`): stop quietly
         _quiet_stdout()
         return EXIT_BROKEN_PIPE
     except Exception as e:
-        return _internal(e, args)
+        interrupt = _interrupt_within(e)
+        return _internal(e, args) if interrupt is None else _interrupted(interrupt)
+
+
+def _interrupted(e: KeyboardInterrupt) -> int:
+    """One line for Ctrl-C (status 130), SIGTERM or SIGHUP (128 + its number)."""
+    if isinstance(e, Terminated):
+        print(f"error: interrupted by {signal.Signals(e.signum).name}", file=sys.stderr)
+        return 128 + e.signum
+    print("error: interrupted", file=sys.stderr)
+    return EXIT_INTERRUPTED
+
+
+def _interrupt_within(e: BaseException) -> KeyboardInterrupt | None:
+    """The interrupt ``e`` was raised from (its ``__cause__`` / ``__context__`` chain), or None.
+
+    A C extension whose import is interrupted (pybind11's: MuJoCo's, matplotlib's) raises
+    ``ImportError: initialization failed`` from the KeyboardInterrupt: a SIGTERM in a run's
+    first seconds was an internal error ("please report it")."""
+    seen: set[int] = set()
+    while e is not None and id(e) not in seen:
+        if isinstance(e, KeyboardInterrupt):
+            return e
+        seen.add(id(e))
+        e = e.__cause__ or e.__context__
+    return None
 
 
 def _quiet_stdout() -> None:

@@ -6,15 +6,41 @@ write leaves no partial file behind.
 
 from __future__ import annotations
 
+import errno
 import os
 import tempfile
 from collections.abc import Callable
 from pathlib import Path
 
+from testbed.core.errors import InputError
+
 # mkstemp creates 0600 files; the result gets the permissions a plain open() would give
 # (read once at import: os.umask can only be read by setting it)
 _UMASK = os.umask(0o022)
 os.umask(_UMASK)
+
+#: errno values of a write refused for want of room: the disk full, a quota reached, or the
+#: file-size limit of the process (``ulimit -f``; Python ignores SIGXFSZ, so the write fails).
+NO_ROOM = (errno.ENOSPC, errno.EDQUOT, errno.EFBIG)
+
+
+def no_room(e: BaseException, path: str | os.PathLike) -> InputError | None:
+    """The one-line error for a write of ``path`` that failed for want of room, else None.
+
+    Recognised by the exception's errno (an ``OSError``) or, for libraries that wrap it in
+    their own message (h5py's ``RuntimeError: ... errno = 27, error message = 'File too
+    large'``), by that errno or its text in the message.  Such a failure was an internal error
+    ("please report it") naming no file.
+    """
+    code = getattr(e, "errno", None)
+    if code not in NO_ROOM:
+        text = str(e)
+        code = next((n for n in NO_ROOM if f"errno = {n}," in text or os.strerror(n) in text), None)
+    if code is None:
+        return None
+    return InputError(f"{path}: cannot be written: {os.strerror(code)} (the disk or a quota is "
+                      "full, or the file-size limit `ulimit -f` is reached); nothing was left "
+                      "half-written: make room and run the command again")
 
 
 def atomic_write(path: str | os.PathLike, write: Callable[[str], None]) -> Path:
@@ -41,8 +67,11 @@ def atomic_write(path: str | os.PathLike, write: Callable[[str], None]) -> Path:
             os.fsync(fh.fileno())
         os.chmod(tmp, 0o666 & ~_UMASK)
         os.replace(tmp, path)
-    except BaseException:
+    except BaseException as e:
         Path(tmp).unlink(missing_ok=True)
+        full = no_room(e, path)
+        if full is not None:
+            raise full from None
         raise
     return path
 

@@ -20,6 +20,7 @@ one, and an unreadable, foreign or altered file raises :class:`DatasetError` nam
 from __future__ import annotations
 
 import hashlib
+import io
 import json
 import os
 from dataclasses import dataclass, field
@@ -272,8 +273,15 @@ class Dataset:
         self.attrs["content_hash"] = self.content_hash()
 
         def write(tmp: str) -> None:
-            with h5py.File(tmp, "w", track_order=True) as f:
+            # built in memory, then written in one plain write: an HDF5 library that meets a
+            # full disk (or `ulimit -f`) while writing a file printed tracebacks from its
+            # finalizers and then crashed the process (SIGBUS, SIGSEGV); a plain write fails
+            # with an OSError, named by :func:`~testbed.core.atomic.atomic_write`
+            buffer = io.BytesIO()
+            with h5py.File(buffer, "w", track_order=True) as f:
                 self._write(f)
+            with open(tmp, "wb") as fh:
+                fh.write(buffer.getbuffer())
 
         return atomic_write(path, write)
 
@@ -394,6 +402,11 @@ class Dataset:
                                                  None if acts is None else tuple(str(c) for c in acts))
             truth, units = {}, {}
             for name, d in f["truth"].items():
+                if d.dtype.kind not in "fiuOS":
+                    # a complex truth passed the hash check: the hash (and the typed truth)
+                    # cast it to real, dropping an altered imaginary part with a warning
+                    raise DatasetError(path, f"truth/{name}: {d.dtype} data; expected real "
+                                             "numbers or text")
                 v = d[()]
                 if d.dtype.kind in "OS":
                     v = [x.decode() if isinstance(x, bytes) else str(x) for x in v]

@@ -26,6 +26,18 @@ def show_value(value: Any) -> str:
     return text
 
 
+#: Names listed in a message before the rest are counted [names]: a record of 3,000 channels
+#: named them all, twice, on one 40 kB line.
+MAX_NAMES = 12
+
+
+def show_names(names: Any) -> str:
+    """``names`` comma-separated, the first :data:`MAX_NAMES` of them and a count of the rest."""
+    names = [str(n) for n in names]
+    shown = ", ".join(_one_line(n) for n in names[:MAX_NAMES])
+    return shown if len(names) <= MAX_NAMES else f"{shown} and {len(names) - MAX_NAMES} more"
+
+
 class TestbedError(Exception):
     """Base of the errors the CLI prints as one line, without a traceback."""
 

@@ -9,6 +9,7 @@ documentation cannot drift from what is accepted.
 
 from __future__ import annotations
 
+import difflib
 import math
 import re
 from collections.abc import Callable, Mapping
@@ -173,6 +174,15 @@ def _check_own(value: Any, f: Field, *, file: str, key: str) -> Any:
     return value
 
 
+def near_miss(table: Mapping[str, Any], key: str) -> str:
+    """``"; given instead: 'metohd' (misspelt?)"`` when ``table`` holds a key spelt like the
+    missing ``key`` (case ignored; difflib's ratio >= 0.7), else ``""``.  A misspelt required
+    key was refused as the right key "missing", without naming the key the file has."""
+    given = {str(k).strip().lower(): str(k) for k in table if k != key}
+    close = difflib.get_close_matches(key.lower(), list(given), n=1, cutoff=0.7)
+    return f"; given instead: {given[close[0]]!r} (misspelt?)" if close else ""
+
+
 def validate_table(table: Mapping[str, Any], schema: Mapping[str, Field], *, file: str,
                    section: str) -> dict[str, Any]:
     """Validate ``table`` against ``schema``; return a new dict with defaults filled in.
@@ -209,7 +219,8 @@ def validate_variant(table: Mapping[str, Any], variants: Mapping[str, Mapping[st
     kind = table.get(selector, REQUIRED)
     if kind is REQUIRED:
         raise ScenarioError(file, f"{section}.{selector}",
-                            allowed="missing; expected one of " + ", ".join(map(repr, variants)))
+                            allowed="missing; expected one of " + ", ".join(map(repr, variants))
+                            + near_miss(table, selector))
     if not isinstance(kind, str) or kind not in variants:
         raise ScenarioError(file, f"{section}.{selector}", kind,
                             "expected one of " + ", ".join(map(repr, variants)))

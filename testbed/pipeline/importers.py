@@ -60,7 +60,7 @@ import numpy as np
 
 from testbed.core.budget import IDENTIFY_BYTES_PER_VALUE, IDENTIFY_TEXT_BUDGET_BYTES, IDENTIFY_VALUE_BUDGET
 from testbed.core.dataset import Dataset, DatasetError, Signal
-from testbed.core.errors import TestbedError
+from testbed.core.errors import TestbedError, show_names
 from testbed.core.measurement import Measurement
 from testbed.pipeline.signal_chain import SIGNAL_SCHEMAS, measure
 
@@ -356,7 +356,7 @@ def measurement_from_file(path: str | os.PathLike, kind: str, signal: Mapping[st
         raise
     except ValueError as e:  # the chain's own checks: signal names, channel counts, positions
         raise MeasuredDataError(data.source, f"cannot run the {kind} signal chain: {e}; "
-                                             f"signals {', '.join(ds.measured)}") from None
+                                             f"signals {show_names(ds.measured)}") from None
 
 
 def _check_response(path: Path, ds: Dataset, kind: str) -> None:
@@ -778,7 +778,12 @@ def _read_csv(path: Path) -> _Raw:
     header = [_HEADER.match(h).groupdict() for h in split(head)]  # type: ignore[union-attr]
     names = [h["name"] for h in header]
     if any(not n for n in names) or len(set(names)) != len(names):
-        raise MeasuredDataError(path, f"header names must be non-empty and unique, got {names}")
+        # the one at fault, not every name: a header of 3,000 columns made a 40 kB line
+        empty = [k + 1 for k, n in enumerate(names) if not n]
+        twice = next((n for k, n in enumerate(names) if n in names[:k]), "")
+        fault = f"column {empty[0]} has no name" if empty else f"{twice!r} names more than one column"
+        raise MeasuredDataError(path, f"header names must be non-empty and unique: {fault} "
+                                      f"(of {len(names)}: {show_names(names)})")
     # every column but the time is a channel: refuse before converting a row
     check_record_size(path, len(lines) - 1, max(1, len(names) - sum(n.lower() in TIME_NAMES for n in names)))
     rows = []

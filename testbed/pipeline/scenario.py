@@ -51,7 +51,7 @@ from typing import Any
 from testbed.core.budget import check_cost, check_steps
 from testbed.core.errors import RigError, ScenarioError
 from testbed.core.kinds import metric_names, metric_range
-from testbed.core.schema import Field, validate_header, validate_table, validate_variant
+from testbed.core.schema import Field, near_miss, validate_header, validate_table, validate_variant
 from testbed.pipeline.plugins import IDENTIFIERS, RIGS
 from testbed.pipeline.signal_chain import SIGNAL_SCHEMAS, check_signal
 
@@ -516,7 +516,8 @@ def _validate_identify(table: Any, file: str, *, kind: str | None = None,
     method = table.get("method")
     if method is None:
         raise ScenarioError(file, "identify.method",
-                            allowed="missing; expected one of " + ", ".join(IDENTIFIERS.names()))
+                            allowed="missing; expected one of " + ", ".join(IDENTIFIERS.names())
+                            + near_miss(table, "method"))
     if not isinstance(method, str) or method not in IDENTIFIERS:
         raise ScenarioError(file, "identify.method", method,
                             "expected one of " + ", ".join(IDENTIFIERS.names()))

@@ -17,6 +17,7 @@ import numpy as np
 
 from testbed.core.dataset import Dataset
 from testbed.core.measurement import Measurement, declared_input_hold
+from testbed.core.errors import show_names
 from testbed.core.schema import Field, validate_table
 from testbed.numerics import derivatives
 from testbed.numerics import filters as sig
@@ -303,7 +304,7 @@ def measure(dataset: Dataset, signal_cfg: Mapping[str, Any], kind: str) -> Measu
 
 def _get(dataset: Dataset, name: str, rows: int | None = None) -> np.ndarray:
     if name not in dataset.measured:
-        raise ValueError(f"dataset has no measured signal {name!r} (has {', '.join(dataset.measured)})")
+        raise ValueError(f"dataset has no measured signal {name!r} (has {show_names(dataset.measured)})")
     data = np.array(dataset.measured[name].data, dtype=float)
     if rows is not None and data.shape[0] != rows:
         raise ValueError(f"measured {name!r} has {data.shape[0]} channels, expected {rows}")

@@ -184,7 +184,50 @@ def _read_parquet(path: Path) -> list[dict[str, Any]]:
     meta = table.schema.metadata or {}
     if meta.get(b"format", b"").decode() != FORMAT:
         raise ResultsError(f"{path}: not a {FORMAT} file")
-    return table.to_pylist()
+    _check_columns(path, table.schema)
+    rows = table.to_pylist()
+    seen: set[str] = set()
+    for i, row in enumerate(rows):
+        why = _row_problem(row, seen)
+        if why:
+            raise ResultsError(f"{path}: row {i} (cell {row['cell']!r}): {why}; the file was "
+                               "altered or damaged")
+    return rows
+
+
+def _check_columns(path: Path, schema: pa.Schema) -> None:
+    """Every fixed column (:data:`BASE_COLUMNS`, :data:`TAIL_COLUMNS`) with its type and every
+    other column a float64 score, else ResultsError: a file without its ``noise`` or
+    ``identifier`` column, or with ``noise`` as text, was an internal error of `testbed
+    summary` and `testbed report` (KeyError, ValueError)."""
+    types = {f.name: f.type for f in schema}
+    for name, t in {**BASE_COLUMNS, **TAIL_COLUMNS}.items():
+        want = getattr(pa, t)()
+        if name not in types:
+            raise ResultsError(f"{path}: no column {name!r}; expected the columns of a "
+                               f"`testbed sweep` results file ({FORMAT})")
+        if types[name] != want:
+            raise ResultsError(f"{path}: column {name!r} holds {types[name]}; expected {want}")
+    for name, typ in types.items():
+        if name not in BASE_COLUMNS and name not in TAIL_COLUMNS and typ != pa.float64():
+            raise ResultsError(f"{path}: score column {name!r} holds {typ}; expected double")
+
+
+def _row_problem(row: dict[str, Any], seen: set[str]) -> str:
+    """What is wrong with one row of a results file ("" if nothing); ``seen``: the cells of the
+    rows before it (a cell twice is refused: :func:`write_rows` never writes one)."""
+    if not row["cell"]:
+        return "no cell key"
+    if row["cell"] in seen:
+        return "the cell appears twice"
+    seen.add(row["cell"])
+    if row["status"] not in ("ok", "failed"):
+        return f"status {row['status']!r}; expected 'ok' or 'failed'"
+    if row["passed"] is None or row["seed"] is None:
+        return "no " + ("passed" if row["passed"] is None else "seed")
+    if row["noise"] is None or not (math.isfinite(row["noise"]) and row["noise"] >= 0):
+        return f"noise {row['noise']!r}; expected a finite level >= 0 %"
+    return ""
 
 
 def read_results(path: str | os.PathLike, *, set_aside: bool = False) -> list[dict[str, Any]]:

@@ -64,7 +64,7 @@ try:
 except ImportError:  # Windows
     fcntl = None  # type: ignore[assignment]
 
-from testbed.core.atomic import atomic_write_text
+from testbed.core.atomic import atomic_write_text, no_room
 from testbed.core.errors import TestbedError
 from testbed.core.provenance import git_commit, versions
 from testbed.pipeline.plugins import RIGS
@@ -400,8 +400,11 @@ def _write_temporary(result: Any, parent: Path, stem: str,
             paths = figures(load_run(tmp), tmp)
             meta["figures"] = [p.name for p in paths]
             _write_json(tmp / "run.json", meta)
-    except BaseException:
+    except BaseException as e:
         shutil.rmtree(tmp, ignore_errors=True)
+        full = no_room(e, f"a run folder in {parent}")
+        if full is not None:
+            raise full from None
         raise
     return tmp, meta
 

@@ -290,3 +290,48 @@ def test_a_server_socket_path_too_long_is_one_line(tmp_path, capsys, monkeypatch
     line = one_error_line(capsys.readouterr().err)
     assert line.startswith(f"error: socket path {path} ($TESTBED_SERVER_SOCKET or the default): ")
     assert line.endswith("bytes; expected at most 107 (the longest Unix socket address)"), line
+
+
+def test_an_interrupt_python_could_not_raise_still_ends_the_command(tmp_path, capsys):
+    # a Ctrl-C landing in a weak reference's callback (the import system's module locks, in the
+    # first second of `testbed run`) printed "Exception ignored in ... KeyboardInterrupt" and
+    # was lost: the run went on to its verdict, status 0; it is now delivered again
+    plugin = tmp_path / "swallows.py"
+    plugin.write_text("import gc, time\n"
+                      "class Swallowed:\n"
+                      "    def __del__(self):\n"
+                      "        raise KeyboardInterrupt\n"
+                      "Swallowed()\n"
+                      "gc.collect()\n"
+                      "time.sleep(1.5)  # the interrupt is sent again 10 ms later, during this\n"
+                      "raise SystemExit('the interrupt was lost')\n")
+    assert main(["list", "--plugin", str(plugin)]) == cli.EXIT_INTERRUPTED
+    assert one_error_line(capsys.readouterr().err) == "error: interrupted"
+
+
+@pytest.mark.parametrize(("interrupt", "status", "line"), [
+    (KeyboardInterrupt(), cli.EXIT_INTERRUPTED, "error: interrupted"),
+    (cli.Terminated(15), 143, "error: interrupted by SIGTERM"),
+])
+def test_an_import_interrupted_is_an_interrupt_not_an_internal_error(monkeypatch, capsys, interrupt,
+                                                                     status, line):
+    # a C extension interrupted while it initialises (pybind11's: MuJoCo, matplotlib) raises
+    # "ImportError: initialization failed" from the interrupt: a SIGTERM at a run's start
+    # was "internal error (a bug, not your input): ImportError: initialization failed"
+    def cmd_list(args):
+        raise ImportError("initialization failed") from interrupt
+
+    monkeypatch.setattr(cli, "cmd_list", cmd_list)
+    assert main(["list"]) == status
+    assert one_error_line(capsys.readouterr().err) == line
+
+
+def test_an_interrupt_while_the_options_are_parsed_is_one_line(monkeypatch, capsys):
+    # a Ctrl-C in a busy machine's first second landed in argparse (building the parser
+    # imports shutil): a 30-line traceback, and the process ended by SIGINT
+    def build_parser():
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(cli, "build_parser", build_parser)
+    assert main(["list"]) == cli.EXIT_INTERRUPTED
+    assert one_error_line(capsys.readouterr().err) == "error: interrupted"

@@ -9,8 +9,11 @@ from __future__ import annotations
 
 import json
 import logging
+import contextlib
 import math
 import os
+import re
+import resource
 import signal
 import subprocess
 import sys
@@ -27,6 +30,7 @@ sys.path.insert(0, str(Path(__file__).parent))
 import _synthetic_runs as synth
 
 from testbed.core.dataset import Dataset, DatasetError
+from testbed.core.errors import InputError
 from testbed.pipeline.cache import DatasetCache
 from testbed.pipeline.generate import generate
 from testbed.pipeline.scenario import load_scenario
@@ -99,6 +103,26 @@ def test_flipped_bits_in_a_cached_array_are_caught_by_the_content_hash(tmp_path,
     with pytest.raises(DatasetError, match="does not match its stored content hash"):
         Dataset.load(path)
     assert Dataset.load(path, verify=False).measured  # still readable: only the hash can tell
+    with caplog.at_level(logging.WARNING, logger="testbed.pipeline.cache"):
+        again = cache.get(sc)
+    assert any(str(path) in r.getMessage() for r in caplog.records if r.name == "testbed.pipeline.cache")
+    _assert_same_data(again, first)
+
+
+def test_a_truth_array_rewritten_as_complex_is_caught(tmp_path, caplog):
+    # the content hash and the typed truth both cast a truth array to real: an imaginary part
+    # added to a cached entry's truth passed the verification (with three ComplexWarnings)
+    sc = _short()
+    cache = DatasetCache(tmp_path)
+    first = cache.get(sc)
+    path = cache.path(sc)
+    with h5py.File(path, "r+") as f:
+        old = f["truth/M"]
+        value, unit = old[()], old.attrs["unit"]
+        del f["truth/M"]
+        f.create_dataset("truth/M", data=value + 1j).attrs["unit"] = unit
+    with pytest.raises(DatasetError, match=r"truth/M: complex128 data; expected real numbers"):
+        Dataset.load(path)
     with caplog.at_level(logging.WARNING, logger="testbed.pipeline.cache"):
         again = cache.get(sc)
     assert any(str(path) in r.getMessage() for r in caplog.records if r.name == "testbed.pipeline.cache")
@@ -386,6 +410,55 @@ def test_damaged_results_file_is_named_by_summary_and_set_aside_by_sweep(fault_d
     assert res.with_name(res.name + ".bad").is_file()
 
 
+def _results_row(cell: str, **over) -> dict:
+    """A results row as a sweep writes it (one score, trac)."""
+    row = {"study": "s", "cell": cell, "scenario": "sc", "rig": "cantilever", "noise": 1.0,
+           "seed": 0, "identifier": "ls_sindy", "params": "{}", "status": "ok", "error": "",
+           "fit_time": 0.1, "data_time": 0.1, "cell_time": 0.2, "passed": True, "trac": 0.99,
+           "checks": json.dumps([{"metric": "trac", "value": 0.99, "bound": "min",
+                                  "threshold": 0.9, "passed": True}]),
+           "versions": "{}", "commit": "abc", "dataset_hash": "0" * 64}
+    return {**row, **over}
+
+
+def _retyped(table, name, values):
+    import pyarrow as pa
+
+    return table.set_column(table.schema.get_field_index(name), name, pa.array(values))
+
+
+@pytest.mark.parametrize(("edit", "fragment"), [
+    (lambda t: t.drop_columns(["noise"]), "no column 'noise'; expected the columns of a `testbed sweep`"),
+    (lambda t: t.drop_columns(["identifier"]), "no column 'identifier'"),
+    (lambda t: _retyped(t, "noise", ["1", "1"]), "column 'noise' holds string; expected double"),
+    (lambda t: _retyped(t, "trac", ["0.99", "0.99"]), "score column 'trac' holds string; expected double"),
+    (lambda t: _retyped(t, "passed", ["yes", "yes"]), "column 'passed' holds string; expected bool"),
+    (lambda t: _retyped(t, "status", ["ok", "maybe"]), "row 1 (cell 'b'): status 'maybe'; expected 'ok' or"),
+    (lambda t: _retyped(t, "noise", [math.nan, 1.0]), "row 0 (cell 'a'): noise nan; expected a finite level"),
+    (lambda t: _retyped(t, "passed", [None, True]), "row 0 (cell 'a'): no passed;"),
+    (lambda t: __import__("pyarrow").concat_tables([t, t]), "row 2 (cell 'a'): the cell appears twice"),
+])
+def test_a_results_file_with_a_column_missing_or_retyped_is_named(tmp_path, capsys, edit, fragment):
+    # a consolidated file without its noise, scenario or identifier column, or with noise as
+    # text or NaN, was an internal error of `testbed summary` and `testbed report` (KeyError,
+    # ValueError, ZeroDivisionError); a score as text, a passed of null or a cell twice passed
+    import pyarrow.parquet as pq
+
+    from testbed.cli import main
+    from testbed.studies.results import write_rows
+
+    res = tmp_path / "r.parquet"
+    write_rows(res, [_results_row("a"), _results_row("b")], study="s")
+    table = pq.read_table(res)
+    pq.write_table(edit(table).replace_schema_metadata(table.schema.metadata), res)
+    with pytest.raises(ResultsError, match=re.escape(fragment)):
+        read_results(res)
+    for argv in (["summary", str(res)], ["report", str(res), "-o", str(tmp_path / "rep")]):
+        assert main(argv) == 2
+        err = capsys.readouterr().err
+        assert err.count("\n") == 1 and err.startswith(f"error: {res}: ") and fragment in err, err
+
+
 def test_results_file_of_another_study_is_refused_untouched(fault_dir, tmp_path):
     # --results naming another study's file: consolidating dropped every row of that study
     # ("dropped N row(s) of cells no longer in study ...") and wrote this one's in their place
@@ -561,6 +634,44 @@ def test_a_run_named_dot_or_dotdot_never_touches_the_output_folder(mechanical, t
     with pytest.raises(RunStoreError, match="outside the output folder"):
         run_folder(out, "sneaky")
     assert run_folder(out, "fine_name") == out / "fine_name"
+
+
+@contextlib.contextmanager
+def _file_size_limit(nbytes: int):
+    """The process's file-size limit (``ulimit -f``, RLIMIT_FSIZE) at ``nbytes`` in the block: a
+    full disk as a write meets it (Python ignores SIGXFSZ, so the write fails with EFBIG)."""
+    soft, hard = resource.getrlimit(resource.RLIMIT_FSIZE)
+    resource.setrlimit(resource.RLIMIT_FSIZE, (nbytes, hard))
+    try:
+        yield
+    finally:
+        resource.setrlimit(resource.RLIMIT_FSIZE, (soft, hard))
+
+
+def test_a_full_disk_while_caching_a_dataset_is_one_error_naming_the_file(tmp_path):
+    # was an internal error, or HDF5's finalizers printing tracebacks and a crash (SIGBUS)
+    sc = _short()
+    cache = DatasetCache(tmp_path)
+    with _file_size_limit(20_000), pytest.raises(InputError) as e:  # the entry takes 93 kB
+        cache.get(sc)
+    msg = str(e.value)
+    assert msg.startswith(f"{cache.path(sc)}: cannot be written: File too large (") and "\n" not in msg
+    assert list(tmp_path.iterdir()) == []  # nothing half-written: no entry, no temporary file
+    _assert_same_data(cache.get(sc), generate(sc))  # room again: simulated and stored whole
+
+
+def test_a_full_disk_while_saving_a_run_is_one_error_naming_its_folder(mechanical, tmp_path):
+    from testbed.studies.runstore import save_new_run
+
+    out = tmp_path / "runs"
+    save_run(mechanical, out / "other")
+    with _file_size_limit(2_000), pytest.raises(InputError) as e:  # run.json takes 6 kB, run.npz 24 kB
+        save_new_run(mechanical, out)
+    assert str(e.value).startswith(f"a run folder in {out / mechanical.scenario.name}: cannot be "
+                                   "written: File too large")
+    assert not (out / mechanical.scenario.name).exists() or not any(
+        (out / mechanical.scenario.name).iterdir())  # no half-written run
+    assert load_run(out / "other").fit_time == mechanical.fit_time
 
 
 def test_cli_run_of_a_scenario_named_dot_leaves_every_other_run(mechanical, tmp_path, capsys):
