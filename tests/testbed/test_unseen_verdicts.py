@@ -227,3 +227,24 @@ def test_hammer_between_sensors_is_refused_naming_the_nearest():
     msg = str(e.value)
     assert "hit.toml" in msg and "'excitation.location'" in msg and "0.16" in msg
     assert "sensors at 0.105833, 0.211667, 0.3175 m" in msg and "51.7 mm from the nearest" in msg
+
+
+# ------------------------------------------- round 5 linkages
+@pytest.mark.parametrize("name, family", [("round5_linkages_sine", "fbsine"),
+                                          ("round5_linkages_chain", "fbchain")])
+def test_round5_linkage_studies_draw_the_family_geometries(name, family):
+    """The round-5 regression studies redraw studies/families.toml's 30 five-bars (same ranges,
+    order and seed), so their member k is linkages__k with another input or signal chain: a
+    change of either file's ranges would silently compare other linkages."""
+    from pathlib import Path
+
+    from testbed.studies.study import load_study
+    root = Path(__file__).resolve().parents[2]
+    fam = {s.name: s for s in load_study(root / "studies" / "families.toml").scenarios}
+    study = load_study(root / "benchmarks" / "unseen" / f"{name}.toml")
+    assert study.name == name and len(study.scenarios) == 30
+    keys = [f"l{i}" for i in range(1, 5)] + ["L0"] + [f"m{i}" for i in range(1, 5)]
+    for s in study.scenarios:
+        twin = fam["linkages__" + s.name.split("__")[1]]
+        assert [s.rig_params[k] for k in keys] == [twin.rig_params[k] for k in keys]
+    assert {s.signal["derivatives"] for s in study.scenarios} == {"lowpass"}
