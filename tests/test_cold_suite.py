@@ -17,3 +17,24 @@ def test_contrast_and_scored_runs_share_one_group():
     assert set(scored.SHARED) == {contrast.LINEAR, contrast.NONLINEAR}
     (mark,) = contrast.test_linear_beam_cubic_matrix_hundredfold_smaller.pytestmark
     assert mark.name == "xdist_group" and mark.args == ("eq21",)
+
+
+def test_make_test_byte_compiles_every_package_before_pytest():
+    """``make test`` compiles the project's sources before pytest starts (Makefile: with
+    PYTHONDONTWRITEBYTECODE set, each of the suite's processes compiled what it imported again):
+    every top-level package the wheel ships, and the benchmarks and tests the suite imports."""
+    import re
+    import tomllib
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parent.parent
+    recipe = re.search(r"^test:.*\n((?:\t.*\n)+)", (root / "Makefile").read_text(), re.M)
+    assert recipe, "Makefile has no test target"
+    lines = recipe.group(1).splitlines()
+    compile_at = [i for i, line in enumerate(lines) if "-m compileall" in line]
+    pytest_at = [i for i, line in enumerate(lines) if "-m pytest" in line]
+    assert compile_at and pytest_at and compile_at[0] < pytest_at[0], lines
+    folders = set(lines[compile_at[0]].split())
+    packages = tomllib.loads((root / "pyproject.toml").read_text())["tool"]["setuptools"]["packages"]
+    tops = {p.split(".")[0] for p in packages}
+    assert tops | {"benchmarks", "tests"} <= folders, sorted(tops - folders)
