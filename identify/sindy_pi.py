@@ -1335,7 +1335,8 @@ class SINDyPI(_ImplicitMechanical):
     }, (
         "library", "lhs", "thresholds", "ridge", "max_iter", "val_fraction", "selection",
         "selection_rtol", "selection_atol", "n_rollout", "rollout_segments", "record_replay",
-        "prune_tol", "sim_dt", "reconcile", "column_lowpass_hz", "column_lowpass_order", "edge_trim", "input_hold", "formulation",
+        "prune_tol", "sim_dt", "reconcile", "column_lowpass_hz", "column_lowpass_order",
+        "edge_trim", "input_hold", "formulation",
         "weak_window_s", "weak_n_windows", "weak_degree", "ensemble", "ensemble_blocks",
         "ensemble_seed", "ensemble_aggregate"))  # __init__ order, for the guide
 

@@ -23,8 +23,8 @@ import sys
 import threading
 import warnings
 from collections.abc import Callable, Iterator
-from typing import Any
 from pathlib import Path
+from typing import Any
 from urllib.parse import urlsplit
 
 from testbed.core.errors import InputError, ScenarioError, TestbedError

@@ -16,8 +16,8 @@ from typing import Any
 import numpy as np
 
 from testbed.core.dataset import Dataset
-from testbed.core.measurement import Measurement, declared_input_hold
 from testbed.core.errors import show_names
+from testbed.core.measurement import Measurement, declared_input_hold
 from testbed.core.schema import Field, validate_table
 from testbed.numerics import derivatives
 from testbed.numerics import filters as sig

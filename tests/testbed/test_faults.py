@@ -7,9 +7,9 @@ says which file, repairs what it can and never loses or mixes up finished work.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import logging
-import contextlib
 import math
 import os
 import re
