@@ -71,7 +71,7 @@ from testbed.pipeline.scenario import (
     resolve_path,
     shipped_dir,
 )
-from testbed.studies.family import Family, family_members, parse_family, write_members
+from testbed.studies.family import Family, family_members, family_of, parse_family, write_members
 
 #: Shipped study files, found by name (``$TESTBED_STUDIES`` overrides).
 STUDY_DIR = Path(os.environ.get("TESTBED_STUDIES", shipped_dir("studies")))
@@ -393,11 +393,18 @@ def _check_grid(study: Study, head: dict[str, Any], file: str) -> None:
             raise ScenarioError(file, f"study.identifiers[{i}]", m,
                                 f"a {_identifier_kind(m)} identifier but no scenario has a rig of that "
                                 "kind; every cell of it would be skipped")
+    named = len(head.get("scenarios") or ())
     for i, sc in enumerate(study.scenarios):
         if not any(ps.name == sc.name for ps, _ in pairs):
-            raise ScenarioError(file, f"study.scenarios[{i}]", head["scenarios"][i],
-                                f"rig kind {sc.kind!r} but no identifier of that kind is "
-                                "listed; every cell of it would be skipped")
+            if i < named:
+                key, value, what = f"study.scenarios[{i}]", head["scenarios"][i], "rig kind"
+            else:  # a family member (after the named scenarios): name its family
+                fam = next(f for f in study.families if f.name == family_of(sc.name))
+                key, value, what = f"families.{fam.name}", fam.base.name, "its members' rig kind"
+            raise ScenarioError(file, key, value,
+                                f"{what} {sc.kind!r} but no identifier of that kind is listed "
+                                f"(study.identifiers: {', '.join(study.identifiers)}); every cell "
+                                "of it would be skipped")
     names = [sc.name for sc in study.scenarios]
     _no_duplicates(names, file, "study.scenarios (names)")
 

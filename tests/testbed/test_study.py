@@ -211,3 +211,16 @@ def test_shipped_studies_are_valid(name):
     from testbed.studies.sweep import expand
 
     assert len({c.key for c in expand(study)}) == study.n_cells()
+
+
+def test_family_of_a_kind_no_identifier_fits_names_the_family():
+    # round 5 (benchmarks/unseen/round5/mm_study_kind_mismatch.toml): a kinetics family beside a
+    # cart-pole one, only a mechanical identifier listed; the members follow the named
+    # scenarios, so indexing study.scenarios by a member's position ended in an IndexError
+    path = Path(__file__).resolve().parents[2] / "benchmarks" / "unseen" / "round5" / \
+        "mm_study_kind_mismatch.toml"
+    with pytest.raises(ScenarioError) as err:
+        load_study(path)
+    e = err.value
+    assert e.key == "families.mm" and e.value == "michaelis_menten"
+    assert "rig kind 'dynamical'" in str(e) and "study.identifiers: sindy_pi" in str(e)
