@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from testbed.core.errors import DivergenceError
+from testbed.core.errors import DivergenceError, UnresolvedModelError
 from testbed.core.lazy import lazy_module
 from testbed.core.measurement import Trajectory
 
@@ -32,6 +32,16 @@ KEEP_BYTES = 1 << 26
 #: grow with ``|lambda| dt``, e.g. 2478 per sample for a pole at -3.2e6 rad/s at 12.8 kHz);
 #: :func:`sample_rate_pole` lets a caller refuse one before paying for that.
 RK4_STABILITY_BOUND = 2.785
+
+#: Most RK4 sub-steps (summed over the record) one simulation of a cubic model may take when its
+#: fastest pole lies beyond :data:`RK4_STABILITY_BOUND` per sample, i.e. is unresolved by the
+#: record.  Measured 0.3 us per step (3 sensors, 2 busy cores): 1.5 s per simulation, and the
+#: scorer's start fit simulates a model 2 n + 3 times and more.  A 0.5 s record at 12.8 kHz
+#: then takes poles up to |lambda| dt = 78 (an amplitude e^-78 after one sample); round 5's
+#: critically damped beam (``damping_ratio`` 0.999999999) gave a model with a pole at
+#: -1.4e9 rad/s, |lambda| dt = 1.1e5, which needed 7e9 steps per simulation (hours).  A pole
+#: the record resolves is simulated at any cost (its sub-steps are at most 28 per sample).
+MAX_UNRESOLVED_RK4_STEPS = 5_000_000
 
 
 @dataclass
@@ -242,6 +252,15 @@ def simulate_structural(M: np.ndarray, C: np.ndarray, K: np.ndarray, K3: np.ndar
     MK3 = Minv @ np.asarray(K3, dtype=float)
     MF = Minv @ f if f is not None else np.zeros((n, n_t))
     rho = pole_radius(A) if n_t > 1 else 0.0
+    if not np.isfinite(rho):
+        raise DivergenceError("cubic structural model: non-finite poles")
+    steps = float(np.ceil(rho * dt / max_omega_h)) * n_t
+    if rho * dt > RK4_STABILITY_BOUND and steps > MAX_UNRESOLVED_RK4_STEPS:
+        raise UnresolvedModelError(
+            f"a cubic model whose linear part has a pole of {rho:.3g} rad/s (|lambda| dt = "
+            f"{rho * dt:.3g} per sample, beyond RK4's stability bound {RK4_STABILITY_BOUND:g}: "
+            f"the record cannot resolve it) needs {steps:.3g} RK4 steps, more than "
+            f"{MAX_UNRESOLVED_RK4_STEPS:.3g} (identify._structural_sim.MAX_UNRESOLVED_RK4_STEPS)")
     sub = max(1, int(np.ceil(rho * dt / max_omega_h)))
     h = dt / sub
     from identify._compiled import rk4_cubic  # lazy: numba's import costs ~0.4 s

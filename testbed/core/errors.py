@@ -94,6 +94,12 @@ class HyperparameterError(IdentificationError, ValueError):
     ValueError too, as scikit-learn estimators raise for bad parameters."""
 
 
+class UnresolvedModelError(IdentificationError):
+    """An identified model was not simulated: a pole the record cannot resolve would make its
+    integration cost beyond a stated budget.  Scoring turns it into a failed score ("not
+    simulated") with its reason."""
+
+
 class DivergenceError(IdentificationError):
     """A simulation of an identified model failed: non-finite state, blow-up, or a loop closure
     that no longer solves.  Scoring turns it into a failed score with its reason and time.

@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 
 from testbed.core.dataset import Dataset
-from testbed.core.errors import DivergenceError, IdentificationError
+from testbed.core.errors import DivergenceError, IdentificationError, UnresolvedModelError
 from testbed.core.kinds import MAX_MODE_SCORES, METRICS
 from testbed.core.measurement import Measurement, Trajectory
 from testbed.core.terms import canonical
@@ -382,6 +382,8 @@ def simulate_scored(sim: Callable[[], Trajectory], t: np.ndarray, check: str,
             traj = sim()
     except DivergenceError as e:
         return None, f"diverged: {e}", e.time
+    except UnresolvedModelError as e:
+        return None, f"not simulated: {e}", float("nan")
     except IdentificationError as e:
         return None, f"diverged: {e}", float("nan")
     except np.linalg.LinAlgError as e:  # e.g. a singular identified M

@@ -174,3 +174,33 @@ def test_sample_rate_pole_is_the_fastest_pole_per_sample():
     n = M.shape[0]
     np.testing.assert_array_equal(A[:n, n:], np.eye(n))
     np.testing.assert_allclose(M @ A[n:, :n], -K, rtol=1e-12, atol=1e-9 * np.abs(K).max())
+
+
+def test_cubic_model_with_an_unresolved_pole_is_not_simulated_beyond_the_budget():
+    # round 5 (fuzz): a critically damped beam gave a cubic model with a pole at -1.4e9 rad/s;
+    # its RK4 sub-steps (|lambda| dt / 0.1 per sample) made one simulation take hours.  Beyond
+    # RK4's stability bound per sample and MAX_UNRESOLVED_RK4_STEPS it is refused with its
+    # reason (scored "not simulated"), in no time; the same pole resolved by the record is not.
+    from testbed.core.errors import UnresolvedModelError
+    from testbed.scoring.scorers import simulate_scored
+
+    from identify._structural_sim import MAX_UNRESOLVED_RK4_STEPS, RK4_STABILITY_BOUND
+
+    fs, n_t = 12800.0, 6400
+    t = np.arange(n_t) / fs
+    M, K3 = np.eye(2), np.eye(2) * 1e9
+    K = np.diag([1e5, 4e5])
+    fast = 1.0e8  # [1/s]: an overdamped pole at about -C/M = -1e8 rad/s, |lambda| dt = 7.8e3
+    C = np.diag([fast, 10.0])
+    steps = np.ceil(fast / fs / 0.1) * n_t
+    assert fast / fs > RK4_STABILITY_BOUND and steps > MAX_UNRESOLVED_RK4_STEPS
+    with pytest.raises(UnresolvedModelError, match=r"pole of 1e\+08 rad/s .* needs 5e\+08 RK4"):
+        simulate_structural(M, C, K, K3, None, np.full(2, 1e-4), np.zeros(2), t)
+    traj, why, _ = simulate_scored(
+        lambda: simulate_structural(M, C, K, K3, None, np.full(2, 1e-4), np.zeros(2), t),
+        t, "xdd", np.zeros((2, n_t)))
+    assert traj is None and why.startswith("not simulated: a cubic model whose linear part")
+    # a pole the record resolves (|lambda| dt = 2.3 < 2.785) is simulated, finite
+    C[0, 0] = 2.3 * fs
+    ok = simulate_structural(M, C, K, K3, None, np.full(2, 1e-4), np.zeros(2), t[:200])
+    assert np.all(np.isfinite(ok.xdd))
