@@ -13,6 +13,10 @@ from testbed.core.truth import Truth, truth_type
 
 ErrorFn = Callable[[str, Any, str], None]
 
+#: MuJoCo's smallest mass [kg] and principal inertia [kg m^2] of a moving body (``mjMINVAL``):
+#: its compiler refuses a model below it.
+MJ_MINVAL = 1e-15
+
 
 class ScenarioTables(Protocol):
     """What a rig reads of a validated scenario: its name, seed and the rig's own tables.

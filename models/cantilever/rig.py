@@ -30,7 +30,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from models import RIGS
-from models._base import ErrorFn, Rig, check_two_samples
+from models._base import MJ_MINVAL, ErrorFn, Rig, check_two_samples
 from models.cantilever.beam import BeamParams, body_of
 from models.cantilever.model import (
     CantileverModel,
@@ -211,6 +211,35 @@ def _root_hinge(rig: dict[str, Any]) -> float:
     return rig["joint_offset"] * rig["length"] / rig["n_segments"]
 
 
+#: The section and material keys a segment's mass and inertia come from (with ``length``).
+_MASS_KEYS = ("thickness", "width", "rho", "length")
+
+
+def _check_segment_inertia(rig: dict[str, Any], error: ErrorFn) -> None:
+    """Every segment's mass and principal inertias above MuJoCo's :data:`MJ_MINVAL`.
+
+    A segment of length ``s`` has mass ``m = rho b h s``, ``I_yy = m s^2 / 12`` and ``I_xx = m
+    b^2 / 12`` (:func:`models.cantilever.beam.build_mjcf`).  Below the bound MuJoCo refuses to
+    compile the chain; the key named is the one of :data:`_MASS_KEYS` furthest below its
+    default (by ratio), e.g. ``rig.thickness`` for a 1e-12 m deep beam.
+    """
+    params = beam_params(rig)
+    with np.errstate(over="ignore", invalid="ignore"):  # huge values: inf passes, refused elsewhere
+        xs, _ = params.hinges()
+        seg = np.append(xs[1:], params.length) - xs
+        seg = seg[seg > 0]
+        m = np.float64(params.mass_per_length) * seg
+        b = np.float64(params.width)
+        smallest = float(np.min(np.concatenate([m, m * seg**2 / 12.0, m * b**2 / 12.0])))
+    if not smallest > MJ_MINVAL:
+        key = min(_MASS_KEYS, key=lambda k: rig[k] / RIG_SCHEMA[k].default)
+        error(f"rig.{key}", rig[key],
+              f"a segment's mass and principal inertias must exceed MuJoCo's mjMINVAL "
+              f"{MJ_MINVAL:g} (kg, kg m^2); the smallest here is {smallest:.3g} (mass "
+              f"{float(np.min(m)):.3g} kg): a larger {key} (the others are rig."
+              f"{', rig.'.join(k for k in _MASS_KEYS if k != key)})")
+
+
 def _check_sensors_per_segment(rig: dict[str, Any], sensors: list[float], x0: float,
                                error: ErrorFn) -> None:
     """Refuse more than :data:`MAX_SENSORS_PER_SEGMENT` sensors on one rigid segment.
@@ -305,6 +334,7 @@ class CantileverRig(Rig):
         if len(set(sensors)) != len(sensors):
             error("rig.sensors", sensors, "allowed: distinct positions (one accelerometer each)")
         n_dof = rig["n_segments"] + (rig["base"] == "soft")
+        _check_segment_inertia(rig, error)
         _check_sensors_per_segment(rig, sensors, x0, error)
         if len(sensor_positions(rig)) > n_dof:
             error("rig.sensors", sensors, f"allowed: at most {n_dof} sensors (the model's degrees "

@@ -24,7 +24,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from models import RIGS
-from models._base import ErrorFn, Rig, check_sample_steps
+from models._base import MJ_MINVAL, ErrorFn, Rig, check_sample_steps
 from models.cartpole.equations import CartPoleParams, true_equations
 from testbed.core.budget import Cost
 from testbed.core.dataset import Dataset, Signal
@@ -81,9 +81,6 @@ EXCITATION_SCHEMAS: dict[str, dict[str, Field]] = {
 }
 
 
-#: MuJoCo's smallest mass [kg] and principal inertia [kg m^2] of a moving body (``mjMINVAL``):
-#: its compiler refuses a model below it.
-MJ_MINVAL = 1e-15
 #: The pole's inertia about its own axis as a fraction of the transverse one (a thin rod's is
 #: zero; MuJoCo needs it positive and the triangle inequality holds for any fraction <= 2).
 POLE_AXIAL_FRACTION = 1e-6

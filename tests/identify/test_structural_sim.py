@@ -181,10 +181,9 @@ def test_cubic_model_with_an_unresolved_pole_is_not_simulated_beyond_the_budget(
     # its RK4 sub-steps (|lambda| dt / 0.1 per sample) made one simulation take hours.  Beyond
     # RK4's stability bound per sample and MAX_UNRESOLVED_RK4_STEPS it is refused with its
     # reason (scored "not simulated"), in no time; the same pole resolved by the record is not.
+    from identify._structural_sim import MAX_UNRESOLVED_RK4_STEPS, RK4_STABILITY_BOUND
     from testbed.core.errors import UnresolvedModelError
     from testbed.scoring.scorers import simulate_scored
-
-    from identify._structural_sim import MAX_UNRESOLVED_RK4_STEPS, RK4_STABILITY_BOUND
 
     fs, n_t = 12800.0, 6400
     t = np.arange(n_t) / fs

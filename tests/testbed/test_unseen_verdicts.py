@@ -229,6 +229,19 @@ def test_hammer_between_sensors_is_refused_naming_the_nearest():
     assert "sensors at 0.105833, 0.211667, 0.3175 m" in msg and "51.7 mm from the nearest" in msg
 
 
+def test_beam_below_mujocos_smallest_inertia_names_the_key():
+    # round 5 (fuzz): a 1e-12 m deep beam was refused naming only 'rig' with MuJoCo's compiler
+    # message; its segments' inertia about the beam's axis (1.9e-16 kg m^2) is below mjMINVAL
+    with pytest.raises(ScenarioError) as e:
+        scenario_from_dict(beam({"thickness": 1e-12}), file="thin.toml")
+    msg = str(e.value)
+    assert "thin.toml" in msg and "'rig.thickness'" in msg and "1e-12" in msg
+    assert "mjMINVAL 1e-15" in msg and "1.86e-16" in msg
+    with pytest.raises(ScenarioError, match=r"'rig\.width'"):
+        scenario_from_dict(beam({"width": 1e-9}), file="narrow.toml")
+    scenario_from_dict(beam({"thickness": 1e-4}), file="ok.toml")  # 0.1 mm: 1.9e-8 kg m^2
+
+
 # ------------------------------------------- round 5 linkages
 @pytest.mark.parametrize("name, family", [("round5_linkages_sine", "fbsine"),
                                           ("round5_linkages_chain", "fbchain")])
