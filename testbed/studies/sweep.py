@@ -256,13 +256,28 @@ def ensure_dataset(scenario: Scenario, cache_dir: str, plugins: tuple[str, ...],
     return scenario.data_hash(), time.perf_counter() - t0, err
 
 
+def sweep_provenance() -> dict[str, str]:
+    """The ``versions`` and ``commit`` columns of a sweep's rows, as this process sees them.
+
+    :func:`run_sweep` takes them once, in its main process, and hands them to every cell: each
+    process caches its own answer from the first time it asks git (``git_commit``), so a loky
+    worker started after a commit (or after the tree turned dirty, or whose ``git status`` ran
+    past its timeout under load and gave "unknown") stamped its rows with another commit than
+    the sequential and Dask cells of the same sweep, which run in the main process: the same
+    cell gave another row depending on where it ran.
+    """
+    return {"versions": json.dumps(versions(), sort_keys=True), "commit": git_commit()}
+
+
 def run_cell(cell: Cell, cache_dir: str, plugins: tuple[str, ...],
-             parent: int | None = None) -> dict[str, Any]:
+             parent: int | None = None, provenance: dict[str, str] | None = None) -> dict[str, Any]:
     """Run one cell (dataset from the cache, identify, score) and return its results row.
 
     Never raises for a failing cell: an exception, or a non-finite score, gives
     ``status = "failed"`` with the error text, so the sweep goes on.  ``parent``: the
-    sweep's main process (see :func:`watch_parent`).
+    sweep's main process (see :func:`watch_parent`).  ``provenance``: the row's ``versions``
+    and ``commit`` (:func:`sweep_provenance` of the sweep's main process); None takes this
+    process's own.
     """
 
     t0 = time.perf_counter()
@@ -301,8 +316,7 @@ def run_cell(cell: Cell, cache_dir: str, plugins: tuple[str, ...],
         row["passed"] = result.passed
     except Exception as e:
         row["status"], row["error"] = "failed", _error_text(e)
-    row["versions"] = json.dumps(versions(), sort_keys=True)
-    row["commit"] = git_commit()
+    row.update(provenance if provenance is not None else sweep_provenance())
     row["cell_time"] = time.perf_counter() - t0
     release_freed_memory()
     return row
@@ -494,6 +508,8 @@ def run_sweep(study: Study | str | os.PathLike, jobs: int = 1, dask_address: str
     todo = sorted(todo, key=_expected_cost, reverse=True)
     # workers of a local pool watch this process; Dask workers belong to their cluster
     parent = os.getpid() if not dask_address and jobs > 1 else None
+    # one commit and one set of versions for every row of this sweep, whichever process runs it
+    provenance = sweep_provenance()
     try:
         with _backend(jobs, dask_address) as n_jobs:
             t0 = time.perf_counter()
@@ -508,7 +524,8 @@ def run_sweep(study: Study | str | os.PathLike, jobs: int = 1, dask_address: str
             t1 = time.perf_counter()
             bar = _Progress(f"{study.name}", len(todo))
             try:
-                for row in parallel(run_cell, [(c, cache_path, study.plugins, parent) for c in todo],
+                for row in parallel(run_cell, [(c, cache_path, study.plugins, parent, provenance)
+                                                     for c in todo],
                                     n_jobs):
                     write_part(results, row)
                     stats.failed += row["status"] != "ok"
