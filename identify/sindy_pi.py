@@ -930,15 +930,13 @@ class _ImplicitMechanical(Identifier):
                              if selection != "rollout" else "")
         if selection == "rollout":
             combos = list(product(*picks))
-            scores = [self._rollout_error(ImplicitModel(lib, build(combo), solved, self.closure_),
-                                          data, i0, self._knob("rollout_segments"))
-                      for combo in combos]
+            models = [ImplicitModel(lib, build(combo), solved, self.closure_) for combo in combos]
+            scores = [self._rollout_error(m, data, i0, self._knob("rollout_segments"))
+                      for m in models]
             if not np.isfinite(min(scores)):
                 self.record_rule_ = "not reached: no shortlisted combination simulated its segments"
                 raise IdentificationError("no shortlisted model combination could be simulated")
-            scores = self._record_rule(scores, [lambda cb=cb: ImplicitModel(lib, build(cb), solved,
-                                                                            self.closure_)
-                                                for cb in combos], data)
+            scores = self._record_rule(scores, models, data)
             size = [sum(int(sw.nnz[t, c]) for t, c in cb) for cb in combos]
             ok = np.array(scores) <= min(scores) * (1 + self.selection_rtol) + ROLLOUT_ATOL
             chosen = min(np.flatnonzero(ok), key=lambda i: (size[i], scores[i]))
@@ -1028,7 +1026,7 @@ class _ImplicitMechanical(Identifier):
             return False
         return bool(np.isfinite(sim).all())
 
-    def _record_rule(self, scores: list[float], models: list[Callable[[], ImplicitModel]],
+    def _record_rule(self, scores: list[float], models: list[ImplicitModel],
                      data: Measurement) -> list[float]:
         """The record rule of the rollout selection (``record_replay``; ``record_rule_``,
         ``record_replays_``): the rollout scores with every shortlisted combination that cannot
@@ -1054,7 +1052,7 @@ class _ImplicitMechanical(Identifier):
             self.record_replays_ = None
             self.record_rule_ = "user-set: off (rollout scores alone)"
             return scores
-        ok = np.array([bool(np.isfinite(s)) and self._replays_record(m(), data)
+        ok = np.array([bool(np.isfinite(s)) and self._replays_record(m, data)
                        for s, m in zip(scores, models, strict=True)])
         self.record_replays_ = ok
         head = (f"{int(ok.sum())} of {ok.size} shortlisted combinations simulate the whole record "

@@ -18,7 +18,7 @@ from testbed.pipeline.cache import DatasetCache
 from testbed.pipeline.scenario import Scenario, load_scenario
 from testbed.pipeline.signal_chain import measure
 from testbed.scoring import run as _run
-from testbed.scoring.scorers import Scores, out_of_band_failures, score, uninformative_failures
+from testbed.scoring.scorers import Scores, bar_failures, score
 
 
 def _scenario(scenario: Scenario | str | os.PathLike) -> Scenario:
@@ -54,8 +54,7 @@ def score_model(model: Any, dataset: Dataset, scenario: Scenario | str | os.Path
     data = measure(dataset, sc.signal, kind)
     clean = measure(_run.noise_free(dataset), sc.signal, kind)
     scores = score(kind, dataset, data, clean, model)
-    scores.failures.update(uninformative_failures(scores, sc.score))  # as run_scenario
-    scores.failures.update(out_of_band_failures(scores, sc.score))
+    scores.failures.update(bar_failures(scores, sc.score))  # as run_scenario
     return scores
 
 

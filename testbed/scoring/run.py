@@ -25,11 +25,10 @@ from testbed.scoring.scorers import (
     PASS,
     Check,
     Scores,
+    bar_failures,
     check_thresholds,
     failed_scores,
-    out_of_band_failures,
     score,
-    uninformative_failures,
     verdict,
 )
 
@@ -159,8 +158,7 @@ def run_scenario(scenario: Scenario, *, cache: DatasetCache | None = None,
     if scores is None:
         with phase("score"):
             scores = score(kind, dataset, data, clean, model)
-            scores.failures.update(uninformative_failures(scores, scenario.score))
-            scores.failures.update(out_of_band_failures(scores, scenario.score))
+            scores.failures.update(bar_failures(scores, scenario.score))
     return RunResult(scenario, dataset, data, model, scores,
                      check_thresholds(scores.values, scenario.score), fit_time)
 

@@ -182,6 +182,13 @@ def uninformative_failures(scores: Scores, thresholds: dict[str, dict[str, float
 _MODE_SCORE = re.compile(r"(mac|freq_error|damping_error)(?:_mode(\d+))?")
 
 
+def bar_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -> dict[str, str]:
+    """The failures a run's bars add to its scorer's: :func:`uninformative_failures` and
+    :func:`out_of_band_failures`, merged (one call for :func:`testbed.scoring.run.run_scenario`
+    and :func:`testbed.scoring.evaluate.score_model`)."""
+    return {**uninformative_failures(scores, thresholds), **out_of_band_failures(scores, thresholds)}
+
+
 def out_of_band_failures(scores: Scores, thresholds: dict[str, dict[str, float]]
                          ) -> dict[str, str]:
     """A failed bar on a true mode that the signal chain's pass band leaves out: ``{"band": reason}``.

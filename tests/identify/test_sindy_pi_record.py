@@ -51,7 +51,7 @@ def _rule(scores, diverge, **params):
     m = SINDyPI(**params)
     m.input_hold_ = "zoh"
     models = [_Model(d) for d in diverge]
-    out = m._record_rule(list(scores), [lambda mm=mm: mm for mm in models], _Data())
+    out = m._record_rule(list(scores), list(models), _Data())
     return m, out, models
 
 
