@@ -64,8 +64,9 @@ class FiveBarParams:
         """Build from a validated ``[rig]`` table (see :data:`models.fivebar.rig.RIG_SCHEMA`)."""
         l = np.array([rig[f"l{i}"] for i in range(1, 5)], dtype=float)
         m = np.array([rig[f"m{i}"] for i in range(1, 5)], dtype=float)
-        inertia = np.array([rig[f"I{i}"] if rig[f"I{i}"] > 0 else m[i - 1] * l[i - 1] ** 2 / 12.0
-                            for i in range(1, 5)])
+        with np.errstate(over="ignore"):  # a link beyond ~1e154 m: inf, which the rig refuses
+            inertia = np.array([rig[f"I{i}"] if rig[f"I{i}"] > 0 else m[i - 1] * l[i - 1] ** 2 / 12.0
+                                for i in range(1, 5)])
         return cls(l=l, L0=float(rig["L0"]), m=m, inertia=inertia, com=l / 2.0,
                    damping=np.full(4, float(rig["damping"])), g=G0 if rig["gravity"] else 0.0,
                    branch=rig["branch"])
