@@ -4,18 +4,26 @@ The contract (identify/_base.py): ``__init__`` only stores hyperparameters under
 ``fit(data)`` returns ``self``; learned attributes end in ``_`` and exist only after ``fit``;
 fitting is deterministic; ``clone`` gives an unfitted twin; ``simulate`` returns a Trajectory of
 the data's shape; ``equations`` returns text.  Structural identifiers expose ``M_``, ``C_``,
-``K_``; mechanical and dynamical ones ``coef_`` and ``feature_names_``.
+``K_``; mechanical and dynamical ones ``coef_`` and ``feature_names_``.  The contract is checked
+on every registered identifier and on a plugin loaded from a file (the guide's example,
+``docs/identifiers.md``), as a user adds one.
 """
 
 import inspect
+import re
+from pathlib import Path
 
 import numpy as np
 import pytest
+from sklearn.base import clone
 
 from benchmarks import bench_sgd_sindy, sindy_pi_problems
 from identify import IDENTIFIERS
 from identify._base import Identifier
 from testbed.core.measurement import Measurement, Trajectory
+from testbed.pipeline.plugins import load_plugins
+
+GUIDE = Path(__file__).resolve().parents[2] / "docs" / "identifiers.md"
 
 # Small budgets so each identifier fits in seconds: the contract does not depend on them.
 FAST = {"sgd_sindy": {"epochs": 2}, "pysindy_pi": {"stride": 4}}
@@ -50,25 +58,42 @@ def _make(name, pendulum):
     return cls(**params)
 
 
-@pytest.mark.parametrize("name", IDENTIFIERS.names())
-def test_identifier_follows_the_estimator_contract(name, structural_data, pendulum, logistic):
+@pytest.fixture
+def guide_plugin(tmp_path):
+    """The guide's example identifier (``docs/identifiers.md``), saved as a file and loaded as a
+    plugin (``--plugin``); its registration is forgotten after the test."""
+    code = "\n\n".join(re.findall(r"^```python\n(.*?)^```", GUIDE.read_text(), flags=re.S | re.M))
+    path = tmp_path / "my_method.py"
+    path.write_text(code)
+    snap = IDENTIFIERS.snapshot()
+    try:
+        (added,) = load_plugins([str(path)])
+        yield added.removeprefix("identifier ")
+    finally:
+        IDENTIFIERS.restore(snap)
+
+
+def check_contract(name, est, data):
+    """Assert the estimator contract on ``est``, an unfitted ``IDENTIFIERS.get(name)``, fitted to
+    ``data`` (a Measurement of its kind)."""
     cls = IDENTIFIERS.get(name)
     assert issubclass(cls, Identifier) and cls.name in ("", name) and cls.kind in (
         "structural", "mechanical", "dynamical")
-    est = _make(name, pendulum)
-    # __init__ stores every hyperparameter under its own name and learns nothing
+    # __init__ stores every hyperparameter under its own name and nothing else (no learned,
+    # cached or private attribute: clone and set_params would not reset it)
     init_names = [p for p in inspect.signature(cls.__init__).parameters if p != "self"]
     assert sorted(est.get_params()) == sorted(init_names)
-    assert not [k for k in vars(est) if k.endswith("_") and not k.startswith("_")]
-    data = {"structural": structural_data, "dynamical": logistic}.get(cls.kind, pendulum.data)
+    assert sorted(vars(est)) == sorted(init_names), (name, set(vars(est)) ^ set(init_names))
     assert est.fit(data) is est
     learned = {k for k in vars(est) if k.endswith("_") and not k.startswith("_")}
     need = {"M_", "C_", "K_"} if cls.kind == "structural" else {"coef_", "feature_names_"}
     assert need <= learned, f"{name} lacks {need - learned}"
-    # clone: same hyperparameters, nothing learned; refitting gives identical results
+    # clone (ours and scikit-learn's): same hyperparameters, nothing learned; refitting gives
+    # identical results
+    for twin in (est.clone(), clone(est)):
+        assert type(twin) is cls and twin.get_params() == est.get_params()
+        assert sorted(vars(twin)) == sorted(init_names)
     twin = est.clone()
-    assert twin.get_params() == est.get_params()
-    assert not [k for k in vars(twin) if k.endswith("_") and not k.startswith("_")]
     twin.fit(data)
     for k in need:
         a, b = getattr(est, k), getattr(twin, k)
@@ -86,6 +111,21 @@ def test_identifier_follows_the_estimator_contract(name, structural_data, pendul
         assert arr.shape == (data.n_channels, n)
     eqs = est.equations()
     assert isinstance(eqs, list) and eqs and all(isinstance(e, str) and e for e in eqs)
+
+
+@pytest.mark.parametrize("name", IDENTIFIERS.names())
+def test_identifier_follows_the_estimator_contract(name, structural_data, pendulum, logistic):
+    data = {"structural": structural_data, "dynamical": logistic}.get(IDENTIFIERS.get(name).kind,
+                                                                      pendulum.data)
+    check_contract(name, _make(name, pendulum), data)
+
+
+def test_a_plugin_identifier_follows_the_estimator_contract(guide_plugin, structural_data):
+    assert IDENTIFIERS.origin(guide_plugin).startswith("file ")
+    check_contract(guide_plugin, IDENTIFIERS.get(guide_plugin)(), structural_data)
+    test_every_hyperparameter_is_declared_and_nothing_else(guide_plugin)
+    # prior_keys may stay undeclared in a plugin (None: `testbed identify --prior` takes any key)
+    assert IDENTIFIERS.get(guide_plugin).prior_keys is None
 
 
 @pytest.mark.parametrize("name", IDENTIFIERS.names())
