@@ -63,6 +63,7 @@ _API = {
     "Signal": ("testbed.core.dataset", "Signal"),
     "StructuralTruth": ("testbed.core.truth", "StructuralTruth"),
     "MechanicalTruth": ("testbed.core.truth", "MechanicalTruth"),
+    "DynamicalTruth": ("testbed.core.truth", "DynamicalTruth"),
     "TestbedError": ("testbed.core.errors", "TestbedError"),
     "IdentificationError": ("testbed.core.errors", "IdentificationError"),
 }

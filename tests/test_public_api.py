@@ -31,6 +31,14 @@ def test_every_public_name_resolves_and_import_is_cheap():
     assert issubclass(testbed.StructuralIdentifier, testbed.Identifier)
 
 
+def test_a_plugin_rig_of_every_kind_finds_its_truth_type_public():
+    """A rig builds its kind's truth dataclass (docs/rigs.md): each registered one is public."""
+    from testbed.core.truth import TRUTH_TYPES
+
+    for kind, cls in TRUTH_TYPES.items():
+        assert getattr(testbed, cls.__name__, None) is cls and cls.__name__ in testbed.__all__, kind
+
+
 @pytest.mark.parametrize("name", testbed.IDENTIFIERS.names())
 def test_sklearn_clone_and_params(name):
     cls = testbed.IDENTIFIERS.get(name)
