@@ -20,9 +20,6 @@ import sys
 from collections.abc import Callable, Iterator
 from typing import Any
 
-#: The phases of ``testbed run``, in order.
-RUN_PHASES = ("simulate", "signal chain", "fit", "score", "figures")
-
 #: ``update(fraction=None, step=None)``: fraction done in [0, 1] (None: unknown), step name.
 Update = Callable[..., None]
 
