@@ -508,14 +508,6 @@ def save_new_run(result: Any, out_dir: str | os.PathLike,
     return target
 
 
-def write_index(out_dir: str | os.PathLike, index: Callable[[list[dict[str, Any]], Path], str]) -> Path:
-    """(Re)write ``out_dir/index.html`` from :func:`list_runs` (atomically, under the lock)."""
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    with _locked(out):
-        return atomic_write_text(out / INDEX, index(list_runs(out), out))
-
-
 def _read_latest(folder: Path) -> dict[str, Any] | None:
     """The pointer of a scenario folder if it names an existing run folder in it, else None."""
     if not (folder / LATEST).is_file():  # a FIFO there blocked `testbed report <scenario>` forever
