@@ -206,8 +206,27 @@ class Identifier:
         return type(self)(**self.get_params())
 
     def fit(self, data: Measurement, y: None = None) -> Identifier:
-        """Fit to a measurement; ``y`` is scikit-learn's target slot, unused (the targets are
-        in ``data``) and None whenever scikit-learn has no targets to pass."""
+        """Fit to a measurement.
+
+        Parameters
+        ----------
+        data : Measurement
+            The measured signals after the lab's signal chain and the declared ``prior``;
+            never the truth.
+        y : None
+            scikit-learn's target slot, unused (the targets are in ``data``) and None whenever
+            scikit-learn has no targets to pass.
+
+        Returns
+        -------
+        Identifier
+            ``self``, with the learned attributes (names ending in ``_``) set.
+
+        Raises
+        ------
+        IdentificationError
+            If the data cannot give a model (a named reason, scored as a failure).
+        """
         raise NotImplementedError
 
     @contextlib.contextmanager
@@ -239,9 +258,37 @@ class Identifier:
 
     def simulate(self, x0: np.ndarray, xd0: np.ndarray, t: np.ndarray,
                  u: np.ndarray | None = None) -> Trajectory:
+        """Integrate the identified model from an initial state.
+
+        Parameters
+        ----------
+        x0, xd0 : ndarray, shape (n_channels,)
+            Initial displacements [m] or angles [rad] and their rates, in the channels of the
+            fit; for a first-order (dynamical) model ``x0`` the states and ``xd0`` unused.
+        t : ndarray, shape (n_samples,)
+            Sample times [s], increasing.
+        u : ndarray, shape (n_inputs, n_samples), optional
+            The inputs at ``t`` (force [N], torque [N m]); None for free motion.
+
+        Returns
+        -------
+        Trajectory
+            ``x``, ``xd``, ``xdd``, each of shape (n_channels, n_samples).
+        """
         raise NotImplementedError
 
     def equations(self, precision: int = 4) -> list[str]:
+        """The identified equations as text, one per equation (shown in reports).
+
+        Parameters
+        ----------
+        precision : int
+            Significant digits of each coefficient.
+
+        Returns
+        -------
+        list of str
+        """
         raise NotImplementedError
 
     def print(self, precision: int = 4, file: TextIO | None = None) -> None:
@@ -327,6 +374,7 @@ class Identifier:
         return float(np.mean(1.0 - ss_res / ss_tot))
 
     def is_fitted(self) -> bool:
+        """Whether :meth:`fit` has set a learned attribute (a public name ending in ``_``)."""
         return any(k.endswith("_") and not k.startswith("_") for k in vars(self))
 
     def __repr__(self) -> str:
@@ -434,10 +482,22 @@ class TimeWindows:
 def split_measurement(data: Measurement, n_windows: int) -> list[MeasurementSamples]:
     """``data`` cut into ``n_windows`` consecutive windows of (nearly) equal length.
 
+    Parameters
+    ----------
+    data : Measurement
+        The record to cut.
+    n_windows : int
+        How many windows, at least 1 and at most the record's samples.
+
     Returns
     -------
     list of MeasurementSamples
         In time order; the first keeps ``free_start``, later ones start at 0 or after it.
+
+    Raises
+    ------
+    ValueError
+        If ``n_windows`` is not an integer >= 1 or exceeds the record's samples.
     """
     if isinstance(n_windows, bool) or not isinstance(n_windows, int) or n_windows < 1:
         raise ValueError(f"split_measurement(n_windows={n_windows!r}): expected an integer >= 1")
