@@ -303,6 +303,18 @@ def model_summary(model: Any, data: Measurement | None = None) -> dict[str, Any]
     ``modal`` (:func:`modal_parameters`); for a mechanical one ``coefficients`` (``coef`` with
     ``feature_names``); with ``data``, ``r2`` (the model's truth-free ``score(data)``, None where
     the model has none).
+
+    Parameters
+    ----------
+    model : Identifier
+        A fitted identifier.
+    data : Measurement, optional
+        The measurement it was fitted to, for ``r2``.
+
+    Returns
+    -------
+    dict
+        The keys above; arrays as nested lists.
     """
     params = {k: v for k, v in model.get_params(deep=False).items()
               if isinstance(v, (bool, int, float, str, list, tuple, type(None)))}

@@ -140,10 +140,20 @@ def generate(scenario: Scenario, progress: Callable[[float], None] | None = None
 
     Parameters
     ----------
+    scenario : Scenario
+        What to simulate: rig, simulation, excitation, noise and seed.
+    progress : callable, optional
+        ``progress(fraction)`` with the fraction of the simulation done, in [0, 1].
     clean : Dataset, optional
         The clean dataset of ``scenario`` (:func:`simulate_clean`); given, the rig is not run
         again.  Either way the result is :func:`derive` of the same clean arrays, so it is
         bit-identical.
+
+    Returns
+    -------
+    Dataset
+        The measured signals with the scenario's seeded noise, the noise-free ones in
+        ``reference``, the exact truth and the provenance.
     """
     if clean is None:
         clean = simulate_clean(scenario, progress)

@@ -46,8 +46,18 @@ def make_identifier(identify: dict[str, Any] | None, scenario_name: str = "") ->
 
 
 def load_plugins(plugins: Iterable[str]) -> list[str]:
-    """Import plugins (``.py`` file paths or dotted module names) so that their rigs and
-    identifiers register; return the names each added (``"identifier foo"``, ``"rig bar"``).
+    """Import plugins so that their rigs and identifiers register.
+
+    Parameters
+    ----------
+    plugins : iterable of str
+        ``.py`` file paths or dotted module names; one already imported in this process is
+        not imported again.
+
+    Returns
+    -------
+    list of str
+        What each added, in order: ``"identifier foo"``, ``"rig bar"``.
 
     Raises
     ------

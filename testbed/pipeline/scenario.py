@@ -362,10 +362,21 @@ def load_scenario(name_or_path: str | os.PathLike, *, standalone: bool = True,
                   check_cost: bool = True) -> Scenario:
     """Read and validate a scenario file (a path, or a name in ``scenarios/``).
 
-    ``standalone=False`` (a study's scenario, whose identifiers come from the study) allows
-    ``[score]`` without ``[identify]``.  ``check_cost=False`` skips the simulation budget
-    (:func:`check_rig_cost`), which builds the rig's model (MuJoCo for the cantilever): for
-    a listing, not for a run.
+    Parameters
+    ----------
+    name_or_path : str or os.PathLike
+        A ``.toml`` path, or the name of a shipped scenario (its file stem).
+    standalone : bool, default True
+        False for a study's scenario, whose identifiers come from the study: ``[score]`` is
+        then allowed without ``[identify]``.
+    check_cost : bool, default True
+        False skips the simulation budget (:func:`check_rig_cost`), which builds the rig's
+        model (MuJoCo for the cantilever): for a listing, not for a run.
+
+    Returns
+    -------
+    Scenario
+        Every section validated against its schema, defaults filled in.
 
     Raises
     ------
@@ -382,8 +393,31 @@ def load_scenario(name_or_path: str | os.PathLike, *, standalone: bool = True,
 
 def scenario_from_dict(raw: dict[str, Any], *, file: str = "<dict>", stem: str | None = None,
                        standalone: bool = True, check_cost: bool = True) -> Scenario:
-    """Validate a scenario given as a dict of TOML tables (``standalone``, ``check_cost``: see
-    :func:`load_scenario`)."""
+    """Validate a scenario given as a dict of TOML tables.
+
+    Parameters
+    ----------
+    raw : dict
+        The scenario's tables (``scenario``, ``rig``, ``simulation``, ``excitation``, ``noise``,
+        ``signal``, ``identify``, ``score``) as :func:`tomllib.loads` gives them.
+    file : str, default "<dict>"
+        The name error messages give the scenario.
+    stem : str, optional
+        The file name without ``.toml``, which ``scenario.name`` must equal; None: unchecked.
+    standalone, check_cost : bool, default True
+        As in :func:`load_scenario`.
+
+    Returns
+    -------
+    Scenario
+        Every section validated against its schema, defaults filled in.
+
+    Raises
+    ------
+    ScenarioError
+        For any problem of the tables; its subclass :class:`~testbed.core.errors.BudgetError`
+        for a run over budget.
+    """
 
     head = validate_header(raw, sections=SECTIONS, header="scenario", schema=HEADER_SCHEMA, file=file,
                            stem=stem, other=("study", "a study (it has [study]), not a scenario; run "
@@ -570,7 +604,24 @@ def _validate_score(table: Any, kind: str, file: str) -> dict[str, dict[str, flo
 
 
 def list_scenarios(directory: Path | None = None, *, check_cost: bool = True) -> list[Scenario]:
-    """Every scenario file in ``directory`` (default ``scenarios/``), validated, sorted by name
-    (``check_cost``: see :func:`load_scenario`)."""
+    """Every scenario file in a folder, validated.
+
+    Parameters
+    ----------
+    directory : Path, optional
+        The folder of ``*.toml`` scenario files; default the shipped ``scenarios/``.
+    check_cost : bool, default True
+        As in :func:`load_scenario`.
+
+    Returns
+    -------
+    list of Scenario
+        Sorted by file name.
+
+    Raises
+    ------
+    ScenarioError
+        For the first file that does not validate.
+    """
     directory = directory or SCENARIO_DIR
     return [load_scenario(p, check_cost=check_cost) for p in sorted(Path(directory).glob("*.toml"))]

@@ -190,6 +190,16 @@ def _no_duplicates(values: list, file: str, key: str) -> None:
 def load_study(name_or_path: str | os.PathLike) -> Study:
     """Read and validate a study file (a path, or a name in ``studies/``).
 
+    Parameters
+    ----------
+    name_or_path : str or os.PathLike
+        A ``.toml`` path, or the name of a shipped study (its file stem).
+
+    Returns
+    -------
+    Study
+        The grid (scenarios x noise levels x seeds x identifiers), validated.
+
     Raises
     ------
     ScenarioError
