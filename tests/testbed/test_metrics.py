@@ -63,6 +63,7 @@ def test_mac_hand_cases():
 def test_mac_symmetric_and_bounded(a, b):
     m = mt.mac_matrix(a, b)
     np.testing.assert_array_equal(np.isnan(m), np.isnan(mt.mac_matrix(b, a).T))
+    # MAC values lie in [0, 1]: the same products in the transposed order agree to rounding
     np.testing.assert_allclose(m, mt.mac_matrix(b, a).T, atol=1e-12)
     ok = ~np.isnan(m)
     assert np.all((m[ok] >= 0) & (m[ok] <= 1))
@@ -209,6 +210,7 @@ def test_modes_of_a_nonsymmetric_identified_stiffness_are_the_right_eigenvectors
     assert not np.allclose(k_id, k_id.T)
     f_true, _, phi_true = modal_from_matrices(m_true, None, k_true)
     f_id, _, phi_id = modal_from_matrices(m_id, None, k_id)
+    # one eigenproblem (M^-1 K = A for both models) solved twice: equal to rounding
     np.testing.assert_allclose(f_id, f_true, rtol=1e-12)
     np.testing.assert_allclose(np.diag(mac_matrix(phi_id, phi_true)), 1.0, rtol=1e-12)
 
@@ -221,6 +223,7 @@ def test_cubic_acceleration_error_ignores_the_mass_sharing():
     Mr = A @ A.T + 3 * np.eye(3)
     f_true = rng.normal(size=(3, 200))
     S = np.diag([1.0, 2.0, 0.5]) + 0.1 * rng.normal(size=(3, 3))
+    # S cancels exactly in (S Mr)^-1 (S f): zero to rounding
     assert mt.cubic_acceleration_error(S @ Mr, S @ f_true, Mr, f_true) == pytest.approx(0.0, abs=1e-12)
     assert mt.relative_error(S @ f_true, f_true) > 0.3  # K3_force_error's view of the same model
     # a 10 % too large cubic acceleration scores 0.1, whatever the sharing
