@@ -150,11 +150,13 @@ def test_uff_fivebar_angles_and_torques(saved, tmp_path):
         sig = ds.measured[group]
         for k, ch in enumerate(sig.channels):
             s = s58[f"{group}/{ch}"]
+            # a binary double-precision UFF58 record: the samples read back to rounding
             np.testing.assert_allclose(s["data"], sig.data[k], atol=1e-14)
             assert (s["rsp_node"], s["rsp_dir"], s["ordinate_axis_units_lab"]) == (k + 1, 6, unit)
     assert spec(s58["theta/th1"]) == (8, 0, 0)
     torques = [s58["torque/u1"], s58["torque/u2"]]
     for k, s in enumerate(torques):
+        # as the angles: binary double precision
         np.testing.assert_allclose(s["data"], ds.measured["torque"].data[k], atol=1e-14)
         assert (s["rsp_dir"], s["ordinate_axis_units_lab"]) == (6, "N m")
         assert spec(s) == (13, 1, 1)
@@ -279,6 +281,8 @@ def test_uff_real_cantilever_modes_are_mass_normalised(dataset_cache, tmp_path):
     modes = [s for s in sets if s["type"] == 55]
     assert len(modes) == ds.truth["sensor_modes"].shape[1], "the modes the sensors resolve"
     for k, m in enumerate(modes):
+        # UFF55 prints the modal mass as E13.5 (6 digits): a mass 1 to rounding reads back 1.00000;
+        # 1e-6 is below the format's step, so this checks the normalisation
         assert m["modal_m"] == pytest.approx(1.0, rel=1e-6)
         f, zeta = ds.truth["frequencies_hz"][k], ds.truth["damping_ratios"][k]
         assert m["id2"].strip() == f"{f:.4f} Hz, zeta {zeta:.6f}"
