@@ -115,6 +115,8 @@ def test_sep005_generic_list_with_time_and_direction_text():
     chans = [{"name": "a", "data": np.sin(t), "unit_str": "g", "time": t, "direction": "-Y"},
              {"name": "f", "data": list(np.cos(t)), "unit_str": "kN", "time": t.tolist(), "node": 7}]
     data = from_sep005(chans)
+    # the rate from the time column (t = k / 200 s): 200 Hz to rounding; g to m/s^2 is one
+    # product per sample, exact to its rounding (1e-15)
     assert data.fs == pytest.approx(200.0, rel=1e-12)
     np.testing.assert_allclose(data.signals["a"][1], 9.80665 * np.sin(t), rtol=1e-15)
     assert data.signals["a"][0] == "m/s^2" and data.signals["f"][0] == "N"
@@ -304,6 +306,7 @@ def test_generic_ascii_uff58_units_from_data_types(tmp_path):
     pyuff.UFF(str(path)).write_sets(sets, mode="add")
     data = read_measured(path)
     assert list(data.signals) == ["node12:-6"] and data.signals["node12:-6"][0] == "rad"
+    # ASCII: the abscissa increment is printed E13.5 (6 digits), so the rate is known to 1e-5
     assert data.fs == pytest.approx(256.0, rel=1e-5) and data.directions == {"node12:-6": -6}
     np.testing.assert_allclose(data.signals["node12:-6"][1], x, rtol=1e-5)  # ASCII: E13.5
 
