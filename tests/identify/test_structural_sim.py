@@ -155,6 +155,7 @@ def test_rk4_stability_bound_is_where_rk4_meets_the_negative_real_axis():
         return abs(1 + z + z**2 / 2 + z**3 / 6 + z**4 / 24)
 
     b = _structural_sim.RK4_STABILITY_BOUND
+    # b = 2.785, 4 digits: |dR/dz| = 1.5 there, so a half unit of the 4th digit moves |R| by 7.5e-4
     assert abs(amplification(-b) - 1.0) < 1e-3
     assert amplification(-0.99 * b) < 1.0 < amplification(-1.01 * b)
 
@@ -164,6 +165,7 @@ def test_sample_rate_pole_is_the_fastest_pole_per_sample():
     oscillator ``m = 2, c = 4, k = 800`` has poles ``-1 +- i sqrt(399)``, |lambda| = 20 rad/s;
     an overdamped one (c = 2000) a pole near -c/m = -1000 rad/s; inf for non-finite matrices."""
     one = np.array([[2.0]])
+    # |lambda| = sqrt(1 + 399) = 20 rad/s exactly: to rounding
     assert _structural_sim.sample_rate_pole(one, 4 * one / 2, 800 * one / 2, 1e-3) == \
         pytest.approx(20.0e-3, rel=1e-12)
     assert _structural_sim.sample_rate_pole(one, 1000 * one, 400 * one, 1.0) == \
