@@ -44,6 +44,7 @@ def test_basis_drops_the_later_dependent_column(toy):
     basis = CanonicalBasis.from_data(names, evaluate_terms(names, toy))
     assert basis.dependent_names == ["dth3"]
     assert basis.kept_names == ["dth1", "dth2", "ddth1", "u1"]
+    # dth3 = dth1 + dth2 exactly in the toy record: the least-squares beta is (1, 1, 0, 0) to rounding
     np.testing.assert_allclose(basis.beta[:, 0], [1, 1, 0, 0], atol=1e-12)
     # in another order the earlier columns stay: priority is library order
     other = ["dth3", "dth1", "dth2", "u1"]
@@ -56,6 +57,7 @@ def test_equivalent_forms_score_perfectly(toy, form):
     lib = ["dth1", "dth2", "dth3", "ddth1", "u1"]
     coef = np.array([[form.get(n, 0.0) for n in lib]])
     c = compare_equations(lib, coef, ["dth3", "u1"], np.array([[-1.0, 2.0]]), toy)
+    # the forms are the same equation under the identity: the error is rounding only
     assert c["f1"] == 1.0 and c["coef_error"] < 1e-12
     assert c["names"] == ["dth1", "dth2", "ddth1", "u1"]
 
