@@ -153,6 +153,7 @@ def test_integrate_acceleration_vectorised_over_channels():
     for ch in range(3):
         alone = sig.integrate_acceleration(a[ch:ch + 1], FS, 10.0, 5)
         for x, y in zip(together, alone, strict=True):
+            # the same filters on each row: equal to rounding (atol for the samples still at rest, 0)
             np.testing.assert_allclose(x[ch:ch + 1], y, rtol=1e-12, atol=1e-18)
 
 
@@ -263,6 +264,8 @@ def test_differentiate_matches_scipy_where_scipy_is_well_conditioned():
     ours = der.differentiate(x, fs, 31, 3)
     for d, got in enumerate(ours):
         ref = ss.savgol_filter(x, 31, 3, deriv=d, delta=1 / fs, axis=-1, mode="interp")
+        # two computations of the same local fit (ours: Legendre and QR on a scaled abscissa; scipy's
+        # monomials, well conditioned at window 31, order 3): rounding of the fit, times fs^d per derivative
         np.testing.assert_allclose(got, ref, rtol=0, atol=1e-9 * fs**d * np.abs(x).max())
 
 
