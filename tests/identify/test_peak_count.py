@@ -86,6 +86,7 @@ def test_own_lock_tells_a_ringing_mode_from_noise():
     for zeta in (ZETA, 0.02):
         w = 2.0 * np.pi * 60.0
         mode = np.exp(-zeta * w * t) * np.sin(w * np.sqrt(1.0 - zeta**2) * t)
+        # measured 0.999999 and 0.997: a mode's phase follows its own frequency
         assert own_lock(mode[None], FS, 60.0, one) > 0.99
     rng = np.random.default_rng(0)
     locks = [own_lock(rng.standard_normal(t.size)[None], FS, 60.0, one) for _ in range(10)]

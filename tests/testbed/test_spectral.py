@@ -107,5 +107,6 @@ def test_harmonic_lock_tells_a_driven_harmonic_from_a_mode_off_by_a_few_hertz():
     harm = 0.05 * np.exp(-1.5 * t) * np.sin(3 * 2 * np.pi * 30.0 * t + 0.4)
     mode = 0.05 * np.exp(-1.5 * t) * np.sin(2 * np.pi * 94.0 * t)
     one = np.ones(1)
+    # measured 0.9995 (locked) and 0.13 (|sinc| of the 4 Hz offset over the record, docstring)
     assert harmonic_lock(fund + harm, fs, 30.0, 90.0, 3, one, one) > 0.99
     assert harmonic_lock(fund + mode, fs, 30.0, 94.0, 3, one, one) < 0.3
