@@ -82,6 +82,7 @@ def test_acceleration_split_reconstructs_theta(signals):
     x, xd, xdd, u = signals
     lib = fivebar_library("full")
     free, acc = lib.evaluate_parts(x, xd, u)
+    # each column is a product of the same factors, taken apart and put back: equal to rounding
     np.testing.assert_allclose(free + np.einsum("ksc,ks->sc", acc, xdd), lib.evaluate(x, xd, xdd, u),
                                rtol=1e-13, atol=1e-14)
 
