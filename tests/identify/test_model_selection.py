@@ -80,6 +80,7 @@ def test_grid_search_over_rcond_picks_the_full_rank_solve(data):
 def test_other_splitters(data):
     cls = testbed.IDENTIFIERS.get("ls_sindy")
     scores = cross_val_score(cls(), data, cv=TimeSeriesSplit(2))
+    # R^2 is at most 1 by definition (no tolerance: a larger value is a bug)
     assert scores.shape == (2,) and np.all(np.isfinite(scores)) and np.all(scores <= 1.0)
     # a shuffling splitter would fit on a record with holes: refused in one line
     with pytest.raises(ValueError, match="contiguous"):

@@ -56,6 +56,8 @@ def test_partial_correlation_scale_is_free_of_units():
     _, (xdd, xd, x, x3) = _signals(2.0e12)
     c1 = _partial_corr(xdd, xd, x, x3)
     c2 = _partial_corr(7.0 * xdd, 7.0 * xd, 7.0 * x, 343.0 * x3)
+    # correlations lie in [-1, 1] and do not depend on scale: the rescaled signals give them to
+    # rounding
     assert np.allclose(c1, c2, atol=1e-9)
 
 
