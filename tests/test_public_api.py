@@ -72,6 +72,7 @@ def test_print_and_truth_free_score(chain_data):
     model.print(precision=3, file=out)
     lines = out.getvalue().splitlines()
     assert lines == model.equations(3) and len(lines) == chain_data.n_channels
+    # exact chain data: measured R^2 1 - 4e-11
     assert model.score(chain_data) > 0.999
     # a wrong model scores worse: with the stiffness 20 % off, R^2 falls to about 0.96
     model.K_ = 1.2 * model.K_

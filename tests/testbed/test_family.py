@@ -119,6 +119,7 @@ def test_members_inside_their_ranges(study):
     for sc in beams:
         r, e = sc.rig_params, sc.excitation
         assert (r["E"], r["rho"]) in [MATERIALS[m] for m in ("steel", "aluminium", "brass")]
+        # the family's declared ranges (the study above): not a tolerance
         assert 0.25 <= r["length"] <= 0.5 and 0.005 <= r["thickness"] <= 0.01
         assert 8 <= r["n_segments"] <= 30 and 2 <= len(r["sensors"]) <= 6
         assert r["n_segments"] >= MIN_SEGMENTS_PER_MODE * len(r["sensors"])

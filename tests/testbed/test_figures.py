@@ -48,6 +48,7 @@ def test_reconstruction_has_zoom_and_units():
     assert_units(fig)
     assert "m/s^2" in fig.axes[0].get_ylabel() and fig.axes[-1].get_xlabel() == "time [s]"
     zoom_line = fig.axes[1].lines[0].get_xdata()
+    # the zoom window asked for, (0.2, 0.3) s: not a tolerance
     assert zoom_line.min() >= 0.2 and zoom_line.max() <= 0.3
     assert "TRAC 0.990" in fig.axes[0].get_title()
 
