@@ -40,6 +40,15 @@ def truth_rows(ds: Dataset) -> list[tuple[str, str]]:
 
 
 def print_truth_summary(ds: Dataset, console: Console | None = None) -> None:
+    """Print :func:`truth_rows` of ``ds`` as a two-column table titled "truth".
+
+    Parameters
+    ----------
+    ds : Dataset
+        A generated or loaded dataset.
+    console : rich.console.Console, optional
+        Where to print; default a new console on standard output.
+    """
     t = Table(title="truth", show_header=False)
     t.add_column("")
     t.add_column("")

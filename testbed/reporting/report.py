@@ -105,10 +105,13 @@ class Page:
         self.md: list[str] = [f"# {title}", ""]
 
     def heading(self, text: str, level: int = 2) -> None:
+        """A heading of ``level`` (2: a section) in both texts."""
         self.html.append(f"<h{level}>{html.escape(text)}</h{level}>")
         self.md += ["#" * level + " " + text, ""]
 
     def para(self, text: str, raw_html: str | None = None) -> None:
+        """A paragraph: ``text`` escaped, or ``raw_html`` (built by the caller from escaped parts)
+        in the HTML; ``text`` in the markdown."""
         self.html.append(f"<p>{raw_html or html.escape(text)}</p>")
         self.md += [text, ""]
 
@@ -146,6 +149,7 @@ class Page:
 
     @staticmethod
     def figure_md(png: Path, caption: str) -> str:
+        """Markdown of ``png`` (by file name, beside the markdown) with its caption in italics."""
         return f"![{png.stem}]({png.name})\n\n*{caption}*"
 
     def figure(self, png: Path, caption: str) -> None:
@@ -171,10 +175,20 @@ class Page:
             self.md += [md_text, ""]
 
     def pre(self, lines: Sequence[str]) -> None:
+        """Preformatted lines (escaped in the HTML, a code block in the markdown)."""
         self.html.append("<pre>" + html.escape("\n".join(lines)) + "</pre>")
         self.md += ["```", *lines, "```", ""]
 
     def write(self) -> Path:
+        """Write ``report.html`` (self-contained: CSS inline, figures embedded, a
+        Content-Security-Policy forbidding network requests) and ``report.md`` into ``out_dir``,
+        each atomically.
+
+        Returns
+        -------
+        Path
+            The HTML file.
+        """
         doc = ("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
                f'<meta http-equiv="Content-Security-Policy" content="{CSP}">'
                '<meta name="viewport" content="width=device-width, initial-scale=1">'
