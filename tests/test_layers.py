@@ -96,3 +96,15 @@ def test_no_project_import_hides_in_a_function(path):
     project = ("testbed", "models", "identify")
     hidden = [t for t, in_fn in imports(path) if in_fn and t.split(".")[0] in project]
     assert not hidden, f"{module_name(path)} imports {hidden} inside a function"
+
+
+@pytest.mark.parametrize("path", sorted((ROOT / "identify").rglob("*.py")),
+                         ids=lambda p: str(p.relative_to(ROOT)))
+def test_identifiers_cannot_reach_the_truth(path):
+    """An identifier sees what a lab would measure (a Measurement), never the truth: no module of
+    ``identify`` imports the typed truth or the Dataset that carries it (docs/architecture.md,
+    Boundaries), not even from core, the floor below it."""
+    truth_modules = ("testbed.core.truth", "testbed.core.dataset")
+    reached = [t for t, _ in imports(path)
+               if any(t == m or t.startswith(m + ".") for m in truth_modules)]
+    assert not reached, f"{module_name(path)} imports {reached}"
