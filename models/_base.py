@@ -72,7 +72,17 @@ class Rig:
     @classmethod
     def check(cls, rig: dict[str, Any], simulation: dict[str, Any], excitation: dict[str, Any],
               error: ErrorFn) -> None:
-        """Cross-field checks; call ``error(key, value, allowed)`` on the first problem."""
+        """Cross-field checks; call ``error(key, value, allowed)`` on the first problem.
+
+        Parameters
+        ----------
+        rig, simulation, excitation : dict
+            The scenario's ``[rig]``, ``[simulation]`` and ``[excitation]`` tables, each
+            validated against its schema, defaults filled in.
+        error : callable
+            ``error(key, value, allowed)``: the dotted key (e.g. ``"rig.sensors"``), its value
+            and what is allowed; it raises.
+        """
 
     @classmethod
     def record(cls, simulation: dict[str, Any]) -> tuple[float, int] | None:
@@ -82,6 +92,16 @@ class Rig:
         a rig with other keys overrides it).  Used to check the signal chain against the
         record (cut-offs below Nyquist, windows shorter than the record) before anything is
         simulated.
+
+        Parameters
+        ----------
+        simulation : dict
+            The scenario's validated ``[simulation]`` table.
+
+        Returns
+        -------
+        tuple of (float, int) or None
+            Sample rate [Hz] and number of samples; None where the table does not say.
         """
         if "sample_rate" not in simulation or "duration" not in simulation:
             return None
@@ -93,7 +113,18 @@ class Rig:
     @classmethod
     def measurement_shape(cls, rig: dict[str, Any]) -> tuple[int, int] | None:
         """Channels and inputs of the measurement the signal chain makes of this rig's data
-        (checked against an identifier's terms at load); None = unknown."""
+        (checked against an identifier's terms at load).
+
+        Parameters
+        ----------
+        rig : dict
+            The scenario's validated ``[rig]`` table.
+
+        Returns
+        -------
+        tuple of (int, int) or None
+            Number of channels and of inputs; None = unknown.
+        """
         return None
 
     @classmethod
@@ -101,7 +132,18 @@ class Rig:
              excitation: dict[str, Any]) -> Cost | None:
         """Estimated memory and integration steps of a run (:class:`testbed.core.budget.Cost`).
 
-        Called after :meth:`check`, before anything is simulated; None = no estimate.
+        Called after :meth:`check`, before anything is simulated.
+
+        Parameters
+        ----------
+        rig, simulation, excitation : dict
+            The scenario's validated tables, as for :meth:`check`.
+
+        Returns
+        -------
+        Cost or None
+            Peak memory [bytes], integration steps and samples, each with the key that drives
+            it; None = no estimate.
         """
         return None
 
@@ -120,6 +162,17 @@ class Rig:
         holds the fields of :meth:`truth_type` (build one and store ``.to_dict()``), checked
         by :func:`testbed.pipeline.generate.simulate_clean`; an input signal that drives
         coordinates (not placed by ``positions``) names them in ``Signal.acts_on``.
+
+        Parameters
+        ----------
+        progress : callable, optional
+            ``progress(fraction)`` with the fraction done, in [0, 1].
+
+        Returns
+        -------
+        Dataset
+            ``measured`` (noise-free), ``reference`` and ``truth`` (``truth_type()(...).to_dict()``)
+            at the scenario's sample rate; the caller records the kind and checks the truth.
         """
         raise NotImplementedError
 
