@@ -85,6 +85,9 @@ def check_contract(name, est, data):
     assert sorted(est.get_params()) == sorted(init_names)
     assert sorted(vars(est)) == sorted(init_names), (name, set(vars(est)) ^ set(init_names))
     assert est.fit(data) is est
+    # what fit sets beside the hyperparameters is learned (public names end in _) or private
+    added = set(vars(est)) - set(init_names)
+    assert not [k for k in added if not k.endswith("_") and not k.startswith("_")], (name, added)
     learned = {k for k in vars(est) if k.endswith("_") and not k.startswith("_")}
     need = {"M_", "C_", "K_"} if cls.kind == "structural" else {"coef_", "feature_names_"}
     assert need <= learned, f"{name} lacks {need - learned}"
