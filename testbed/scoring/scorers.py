@@ -494,7 +494,9 @@ def score_structural(dataset: Dataset, data: Measurement, clean: Measurement, mo
     phi_true = truth.sensor_modes[:, : data.n_channels]
     m = scored_modes(data.n_channels, len(f_true))
     mac = metrics.mac_matrix(phi_id, phi_true)
-    pair = metrics.pair_modes(mac.T)  # pair[j] = identified mode matched to true mode j
+    # pair[j] = identified mode matched to true mode j, by shape and frequency (few sensors
+    # make shapes alike: see pair_modes)
+    pair = metrics.pair_modes(mac.T, f_true, f_id)
     per_mode = _per_mode(mac, pair, f_id, f_true, z_id, z_true, m)
     for name, vals in per_mode.items():
         for k, x in enumerate(vals[:MAX_MODE_SCORES], 1):

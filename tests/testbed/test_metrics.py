@@ -78,6 +78,25 @@ def test_pair_modes_beats_greedy():
     np.testing.assert_array_equal(mt.pair_modes(np.array([[np.nan, 0.5], [0.7, np.nan]])), [1, 0])
 
 
+
+def test_pair_modes_by_shape_and_frequency_on_alike_shapes():
+    # A soft-based family beam seen by three sensors (beams_soft__004, sgd_sindy, 2026-11-26):
+    # rows true modes 28.06 / 317.98 / 1002.3 Hz, columns identified 28.64 / 74.23 (an
+    # overdamped pole pair) / 305.7 Hz.  The summed MAC alone pairs true mode 1 with the 74 Hz
+    # pair (0.959 + 0.979 + 0.648 beats 1.000 + 1.000 + 0.312).
+    mac = np.array([[1.0, 0.9592, 0.9781], [0.9795, 0.8898, 1.0], [0.5016, 0.3124, 0.6477]])
+    f_true, f_id = np.array([28.0592, 317.9815, 1002.3005]), np.array([28.6354, 74.2255, 305.7356])
+    np.testing.assert_array_equal(mt.pair_modes(mac), [1, 0, 2])
+    np.testing.assert_array_equal(mt.pair_modes(mac, f_true, f_id), [0, 2, 1])
+    # an unstable identified mode (NaN frequency) is paired last, with what no other mode took
+    np.testing.assert_array_equal(
+        mt.pair_modes(np.ones((2, 2)), [10.0, 20.0], [np.nan, 10.5]), [1, 0])
+    # shapes still decide between modes of like frequency
+    np.testing.assert_array_equal(
+        mt.pair_modes(np.array([[0.2, 0.99], [0.99, 0.2]]), [10.0, 10.2], [10.1, 10.1]), [1, 0])
+    with pytest.raises(ValueError, match="do not match"):
+        mt.pair_modes(mac, f_true[:2], f_id)
+
 # ------------------------------------------------------------------ relative errors
 def test_frequency_and_damping_errors():
     np.testing.assert_allclose(mt.frequency_error([89.7, 591.2], [89.6, 576.3]),
