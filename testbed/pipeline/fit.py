@@ -22,6 +22,7 @@ import numpy as np
 
 from testbed.core.errors import IdentificationError, InputError, TestbedError
 from testbed.core.measurement import Measurement
+from testbed.numerics.shapes import modal_from_matrices
 from testbed.pipeline import plugins
 from testbed.pipeline.importers import measurement_from_file
 from testbed.pipeline.scenario import check_identifier_for_record, load_scenario
@@ -275,23 +276,25 @@ def _array(a: Any) -> Any:
 
 
 def modal_parameters(M: np.ndarray, C: np.ndarray, K: np.ndarray) -> dict[str, list[float]]:
-    """Damped modes of ``M x'' + C x' + K x = 0``, sorted by frequency (one per conjugate pair).
+    """The modes of ``M x'' + C x' + K x = 0`` as the scorer reports them, sorted by frequency.
+
+    Parameters
+    ----------
+    M, C, K : ndarray, shape (n, n)
+        Mass [kg], damping [N s/m] and stiffness [N/m] matrices.
 
     Returns
     -------
     dict
-        ``frequency_hz`` (undamped natural frequency ``|lambda| / 2 pi`` [Hz]) and
-        ``damping_ratio`` (``-Re(lambda) / |lambda|``) of each mode.
+        ``frequency_hz`` (undamped natural frequency ``w_n / 2 pi`` [Hz]) and ``damping_ratio``
+        [-] of each of the n modes (:func:`testbed.numerics.shapes.modal_from_matrices`: one
+        mode per pair of eigenvalues, an overdamped one with a ratio above 1; None for a mode
+        the model cannot give, e.g. an unstable one or every mode of a mass matrix that is not
+        positive definite).
     """
-    n = M.shape[0]
-    Minv = np.linalg.inv(M)
-    A = np.block([[np.zeros((n, n)), np.eye(n)], [-Minv @ K, -Minv @ C]])
-    lam = np.linalg.eigvals(A)
-    lam = lam[np.imag(lam) >= 0.0]
-    lam = lam[np.argsort(np.abs(lam))]
-    mag = np.abs(lam)
-    zeta = np.where(mag > 0, -np.real(lam) / np.where(mag > 0, mag, 1.0), math.nan)
-    return {"frequency_hz": (mag / (2 * np.pi)).tolist(), "damping_ratio": zeta.tolist()}
+    f, zeta, _ = modal_from_matrices(M, C, K, strict=False)
+    return {"frequency_hz": [None if not math.isfinite(x) else float(x) for x in f],
+            "damping_ratio": [None if not math.isfinite(x) else float(x) for x in zeta]}
 
 
 def model_summary(model: Any, data: Measurement | None = None) -> dict[str, Any]:

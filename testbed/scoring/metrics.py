@@ -10,6 +10,7 @@ import numpy as np
 
 from testbed.core.lazy import lazy_module
 from testbed.numerics.shapes import mac_matrix as mac_matrix  # re-exported: the scorers' name
+from testbed.numerics.shapes import modal_from_matrices as modal_from_matrices  # re-exported
 from testbed.numerics.shapes import trac as trac  # re-exported: the scorers' name
 
 # imported on first use: `testbed list` does not pay for them
@@ -282,111 +283,6 @@ def rmse(x: np.ndarray, y: np.ndarray, axis: int = -1) -> np.ndarray:
     """
     x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
     return np.sqrt(np.mean((x - y) ** 2, axis=axis))
-
-
-def modal_from_matrices(m: np.ndarray, c: np.ndarray | None, k: np.ndarray, *, strict: bool = True
-                        ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Natural frequencies, damping ratios and mass-normalised modes of ``M x'' + C x' + K x = 0``.
-
-    Parameters
-    ----------
-    m : ndarray, shape (n, n)
-        Mass matrix [kg]; must be symmetric positive definite.
-    c : ndarray, shape (n, n), or None
-        Damping matrix [N s/m]; None means undamped.
-    k : ndarray, shape (n, n)
-        Stiffness matrix [N/m]; symmetric.
-    strict : bool
-        If True (default) a mass matrix that is not symmetric positive definite, or a negative
-        stiffness eigenvalue, raises ValueError.  If False, the same cases return all-NaN
-        arrays (non-PD M) or NaN frequencies for the unstable modes, so a scorer can record a
-        failed identification without a try block.
-
-    Returns
-    -------
-    freqs_hz : ndarray, shape (n,)
-        Undamped natural frequencies ``w_n / 2 pi`` [Hz], ascending.
-    damping_ratios : ndarray, shape (n,)
-        Damping ratios [-] (zeros when ``c`` is None); above 1 for an overdamped mode.
-    modes : ndarray, shape (n, n)
-        Real mode shapes of ``(K, M)``, one per column, ``modes^T M modes = I``, largest
-        component of each positive.
-
-    Notes
-    -----
-    Modes come from the generalised symmetric eigenproblem ``K phi = w^2 M phi``.  With
-    damping, the 2n eigenvalues ``lambda`` of the first-order system
-    ``[[0, I], [-M^-1 K, -M^-1 C]]`` are assigned two per real mode by maximum MAC of their
-    displacement parts (mass-weighted MAC, two slots per mode), and each pair gives
-    ``w_n^2 = lambda_1 lambda_2`` and ``2 zeta w_n = -(lambda_1 + lambda_2)``: for an
-    underdamped mode ``lambda_2 = conj(lambda_1)``, so ``w_n = |lambda|`` and
-    ``zeta = -Re(lambda) / |lambda|``; an overdamped mode's two real eigenvalues give
-    ``zeta > 1``.  Exact for proportional damping; for non-proportional damping the
-    frequencies are the complex modes' and the shapes stay the undamped ones.
-    """
-    m, k = np.asarray(m, dtype=float), np.asarray(k, dtype=float)
-    n = m.shape[0]
-    if m.shape != (n, n) or k.shape != (n, n):
-        raise ValueError(f"M and K must be square and alike, got {m.shape} and {k.shape}")
-    nan = (np.full(n, np.nan), np.full(n, np.nan), np.full((n, n), np.nan))
-    if not (np.all(np.isfinite(m)) and np.all(np.isfinite(k))
-            and (c is None or np.all(np.isfinite(c)))):
-        if strict:
-            raise ValueError("M, C or K holds non-finite entries")
-        return nan
-    if not np.allclose(m, m.T, rtol=1e-10, atol=1e-14 * np.abs(m).max()):
-        if strict:
-            raise ValueError("mass matrix is not symmetric")
-        return nan
-    try:
-        linalg.cholesky(m, lower=True)
-    except linalg.LinAlgError:
-        if strict:
-            raise ValueError("mass matrix is not positive definite") from None
-        return nan
-    if np.allclose(k, k.T, rtol=1e-10, atol=1e-14 * max(np.abs(k).max(), 1e-300)):
-        lam, modes = linalg.eigh(0.5 * (k + k.T), m)
-    else:
-        # An identified K need not be symmetric (e.g. least-squares SINDy with a diagonal M):
-        # the shapes the model actually vibrates in are the right eigenvectors of M^-1 K.
-        # Symmetrising K first would score modes the model does not have.
-        lam_c, vec = linalg.eig(linalg.solve(m, k))
-        order = np.argsort(lam_c.real)
-        lam_c, vec = lam_c[order], vec[:, order]
-        # rotate each (possibly complex) vector so its largest component is real, keep the real part
-        big = np.argmax(np.abs(vec), axis=0)
-        vec = vec * np.exp(-1j * np.angle(vec[big, np.arange(n)]))
-        lam, modes = lam_c.real, vec.real
-        modes = modes / np.sqrt(np.einsum("ij,ik,kj->j", modes, 0.5 * (m + m.T), modes))
-    if np.any(lam < -1e-12 * max(1.0, np.abs(lam).max())):
-        if strict:
-            raise ValueError(f"stiffness has negative eigenvalues {lam[lam < 0]} (unstable model)")
-    big = np.argmax(np.abs(modes), axis=0)
-    modes = modes * np.sign(modes[big, np.arange(n)])
-    with np.errstate(invalid="ignore"):
-        omega = np.where(lam >= 0, np.sqrt(np.abs(lam)), np.nan)
-    zeta = np.zeros(n)
-    if c is not None:
-        c = np.asarray(c, dtype=float)
-        if c.shape != (n, n):
-            raise ValueError(f"C must be {(n, n)}, got {c.shape}")
-        minv = linalg.solve(m, np.eye(n), assume_a="pos")
-        a = np.block([[np.zeros((n, n)), np.eye(n)], [-minv @ k, -minv @ c]])
-        ev, vec = linalg.eig(a)
-        shapes = vec[:n]
-        # Two slots per real mode; assign the 2n eigenvalues to slots by maximum MAC.
-        proj = np.abs(np.conj(np.repeat(modes, 2, axis=1)).T @ m @ shapes) ** 2
-        with np.errstate(invalid="ignore", divide="ignore"):
-            mac = np.nan_to_num(proj / proj.sum(axis=0, keepdims=True) * 2.0)  # mass-weighted MAC
-        slot, which = optimize.linear_sum_assignment(mac, maximize=True)
-        lam_pair = np.empty((n, 2), dtype=complex)
-        lam_pair[slot // 2, slot % 2] = ev[which]
-        w2 = np.real(lam_pair[:, 0] * lam_pair[:, 1])
-        with np.errstate(invalid="ignore", divide="ignore"):
-            omega = np.where(w2 >= 0, np.sqrt(np.abs(w2)), np.nan)
-            zeta = -np.real(lam_pair.sum(axis=1)) / (2.0 * omega)
-    order = np.argsort(omega)  # NaN (unstable) modes last
-    return omega[order] / (2.0 * np.pi), zeta[order], modes[:, order]
 
 
 def cubic_acceleration_error(M_id: np.ndarray, f_id: np.ndarray, Mr: np.ndarray,

@@ -248,3 +248,20 @@ def test_cubic_acceleration_error_ignores_the_mass_sharing():
     # a 10 % too large cubic acceleration scores 0.1, whatever the sharing
     assert mt.cubic_acceleration_error(S @ Mr, 1.1 * S @ f_true, Mr, f_true) == pytest.approx(0.1)
     assert np.isnan(mt.cubic_acceleration_error(np.zeros((3, 3)), f_true, Mr, f_true))
+
+
+def test_identify_summary_reports_the_scorer_modes():
+    # `testbed identify`'s printed modes and the scorer's come from one routine: an overdamped
+    # mode is one mode with a ratio above 1 (not two real poles printed as two modes), an
+    # unstable mode is None (JSON null), and frequencies are the undamped w_n / 2 pi.
+    from testbed.pipeline.fit import modal_parameters
+
+    M, K = np.diag([1.0, 2.0]), np.diag([(2 * np.pi * 10.0) ** 2, 2.0 * (2 * np.pi * 30.0) ** 2])
+    C = np.diag([2 * 0.02 * 2 * np.pi * 10.0, 2.0 * 2 * 1.5 * 2 * np.pi * 30.0])  # zeta 0.02, 1.5
+    got = modal_parameters(M, C, K)
+    f, z, _ = mt.modal_from_matrices(M, C, K)
+    np.testing.assert_allclose(got["frequency_hz"], f, rtol=1e-12)  # the same numbers, rounding
+    np.testing.assert_allclose(got["frequency_hz"], [10.0, 30.0], rtol=1e-9)  # exact: decoupled
+    np.testing.assert_allclose(got["damping_ratio"], [0.02, 1.5], rtol=1e-9)
+    unstable = modal_parameters(M, C, np.diag([-1.0, 4.0]))
+    assert unstable["frequency_hz"][1] is None and unstable["damping_ratio"][1] is None
