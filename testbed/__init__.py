@@ -64,6 +64,15 @@ _API = {
     "StructuralTruth": ("testbed.core.truth", "StructuralTruth"),
     "MechanicalTruth": ("testbed.core.truth", "MechanicalTruth"),
     "DynamicalTruth": ("testbed.core.truth", "DynamicalTruth"),
+    # adding a rig kind (docs/rigs.md): its truth type, score catalogue, signal chain, scorer
+    "Truth": ("testbed.core.truth", "Truth"),
+    "register_truth": ("testbed.core.truth", "register_truth"),
+    "truth_field": ("testbed.core.truth", "truth_field"),
+    "KIND_METRICS": ("testbed.core.kinds", "METRICS"),
+    "SignalChain": ("testbed.pipeline.signal_chain", "SignalChain"),
+    "register_signal_chain": ("testbed.pipeline.signal_chain", "register_signal_chain"),
+    "Scores": ("testbed.scoring.scorers", "Scores"),
+    "register_scorer": ("testbed.scoring.scorers", "register_scorer"),
     "TestbedError": ("testbed.core.errors", "TestbedError"),
     "IdentificationError": ("testbed.core.errors", "IdentificationError"),
 }

@@ -37,7 +37,7 @@ import numpy as np
 from testbed.core.errors import TestbedError
 
 __all__ = ["TRUTH_TYPES", "DynamicalTruth", "MechanicalTruth", "StructuralTruth", "Truth", "TruthError",
-           "register_truth", "truth_type"]
+           "register_truth", "truth_field", "truth_type"]
 
 
 class TruthError(TestbedError, ValueError):
@@ -54,11 +54,35 @@ class TruthError(TestbedError, ValueError):
         super().__init__(message)
 
 
-def _f(shape: tuple[str | int, ...], unit: str, doc: str, *, required: bool = True,
-       text: bool = False) -> Any:
-    """A truth field: its symbolic shape, unit (as rigs write it) and meaning."""
+def truth_field(shape: tuple[str | int, ...], unit: str, doc: str, *, required: bool = True,
+                text: bool = False) -> Any:
+    """A field of a kind's truth dataclass: its symbolic shape, unit (as rigs write it) and
+    meaning.
+
+    Parameters
+    ----------
+    shape : tuple of str or int
+        Symbolic shape, e.g. ``("n", "n")``; ``()`` for a scalar.  Every field using a symbol
+        must have the same length along it.
+    unit : str
+        SI unit as the rig writes it (``""`` for a dimensionless value).
+    doc : str
+        Meaning.
+    required : bool
+        False for an optional field (default None).
+    text : bool
+        True for a list of names instead of an array.
+
+    Returns
+    -------
+    dataclasses.Field
+        To assign in a :class:`Truth` subclass body.
+    """
     meta = {"shape": shape, "unit": unit, "doc": doc, "text": text}
     return field(metadata=meta) if required else field(default=None, metadata=meta)
+
+
+_f = truth_field  # the short name the declarations below use
 
 
 @dataclass(frozen=True)

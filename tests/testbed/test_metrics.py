@@ -261,6 +261,7 @@ def test_identify_summary_reports_the_scorer_modes():
     got = modal_parameters(M, C, K)
     f, z, _ = mt.modal_from_matrices(M, C, K)
     np.testing.assert_allclose(got["frequency_hz"], f, rtol=1e-12)  # the same numbers, rounding
+    np.testing.assert_allclose(got["damping_ratio"], z, rtol=1e-12)
     np.testing.assert_allclose(got["frequency_hz"], [10.0, 30.0], rtol=1e-9)  # exact: decoupled
     np.testing.assert_allclose(got["damping_ratio"], [0.02, 1.5], rtol=1e-9)
     unstable = modal_parameters(M, C, np.diag([-1.0, 4.0]))
