@@ -127,8 +127,9 @@ def test_a_plugin_identifier_follows_the_estimator_contract(guide_plugin, struct
     assert IDENTIFIERS.origin(guide_plugin).startswith("file ")
     check_contract(guide_plugin, IDENTIFIERS.get(guide_plugin)(), structural_data)
     test_every_hyperparameter_is_declared_and_nothing_else(guide_plugin)
-    # prior_keys may stay undeclared in a plugin (None: `testbed identify --prior` takes any key)
-    assert IDENTIFIERS.get(guide_plugin).prior_keys is None
+    # the guide's example declares the prior it reads, as the guide's contract asks (an
+    # undeclared plugin, None, would let `testbed identify --prior` take any key)
+    assert IDENTIFIERS.get(guide_plugin).prior_keys == ("total_mass",)
 
 
 @pytest.mark.parametrize("name", IDENTIFIERS.names())
