@@ -516,6 +516,7 @@ def cmd_identify(args: argparse.Namespace) -> int:
     from testbed.pipeline.fit import identify_file
     from testbed.reporting.identified import render_identified
     from testbed.reporting.progress import run_progress
+    from testbed.scoring.scorers import fitted_model_failures
 
     _load_plugins(args)
     units = None
@@ -534,7 +535,7 @@ def cmd_identify(args: argparse.Namespace) -> int:
                                format=args.format, fs=args.fs, units=units,
                                prior=_key_values(args.prior, "--prior", numbers=True), phase=phase)
     summary = result.summary()
-    failures = _physical_failures(summary)
+    failures = fitted_model_failures(result.model)
     if failures is not None:
         summary["physical_failures"] = failures
     text = json.dumps(summary, indent=1, allow_nan=True) + "\n"
@@ -548,31 +549,6 @@ def cmd_identify(args: argparse.Namespace) -> int:
         print(f"FAIL: {what}: {'; '.join(failures.values())}")
         return EXIT_FAIL
     return 0
-
-
-def _physical_failures(summary: dict) -> dict[str, str] | None:
-    """What makes the identified model a failed identification: structural matrices no passive
-    structure can have (:func:`testbed.scoring.scorers.physical_failures`: M not symmetric
-    positive definite, negative damping, a growing pole; NaN fails each), or NaN or infinite
-    coefficients of an equation model (``"coefficients"``); None for a model without either.
-
-    Without a truth, ``identify`` has no score; such a model is still a failed identification,
-    never a result: the model is written (to be looked at) with the reasons under
-    ``physical_failures``, and the command exits 1 with a ``FAIL:`` line.
-    """
-    import numpy as np
-
-    from testbed.scoring.scorers import physical_failures
-
-    mats = summary.get("matrices")
-    if mats:
-        M, C, K = (np.asarray(mats[k], dtype=float) for k in ("M", "C", "K"))
-        return physical_failures(M, C, K)
-    coef = (summary.get("coefficients") or {}).get("coef")
-    if coef is None:
-        return None
-    bad = int(np.count_nonzero(~np.isfinite(np.asarray(coef, dtype=float))))
-    return {"coefficients": f"{bad} identified coefficient(s) are NaN or infinite"} if bad else {}
 
 
 def cmd_runs(args: argparse.Namespace) -> int:

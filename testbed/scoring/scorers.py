@@ -330,6 +330,38 @@ def physical_failures(M: np.ndarray, C: np.ndarray, K: np.ndarray) -> dict[str, 
     return out
 
 
+def fitted_model_failures(model: Any) -> dict[str, str] | None:
+    """What makes an identified model a failed identification without any truth to score it.
+
+    Parameters
+    ----------
+    model : Identifier
+        Fitted: a structural one with ``M_``, ``C_``, ``K_``, or an equation model with
+        ``coef_``.
+
+    Returns
+    -------
+    dict of str to str or None
+        A structural model's :func:`physical_failures` (M not symmetric positive definite,
+        negative damping, a growing pole; NaN fails each); for an equation model
+        ``"coefficients"`` when a coefficient is NaN or infinite; empty when neither applies;
+        None for a model with neither matrices nor coefficients.
+
+    Notes
+    -----
+    ``testbed identify`` (measured data, no truth) has no score; such a model is still a
+    failed identification, never a result: the command writes it (to be looked at) with these
+    reasons under ``physical_failures`` and exits 1 with a ``FAIL:`` line.
+    """
+    if hasattr(model, "M_"):
+        return physical_failures(model.M_, model.C_, model.K_)
+    coef = getattr(model, "coef_", None)
+    if coef is None:
+        return None
+    bad = int(np.count_nonzero(~np.isfinite(np.asarray(coef, dtype=float))))
+    return {"coefficients": f"{bad} identified coefficient(s) are NaN or infinite"} if bad else {}
+
+
 def divergence(t: np.ndarray, y: np.ndarray, ref: np.ndarray | None = None) -> tuple[str, float] | None:
     """Where a simulated signal stops being a response: non-finite or blown up.
 

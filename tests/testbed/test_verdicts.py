@@ -336,14 +336,15 @@ def test_cartpole_with_the_fivebar_library_is_a_scored_failure(dataset_cache):
 
 def test_an_identified_model_with_nan_coefficients_fails_testbed_identify():
     # `testbed identify` wrote a model of NaN coefficients and exited 0 (a pass)
-    from testbed.cli import _physical_failures as identified_failures
+    from types import SimpleNamespace as Model
 
-    coef = {"coefficients": {"coef": [[0.18, math.nan, 1.0]], "feature_names": ["1", "x", "dx"]}}
-    assert identified_failures(coef) == {"coefficients": "1 identified coefficient(s) are NaN or "
-                                                         "infinite"}
-    assert identified_failures({"coefficients": {"coef": [[0.18, -0.9, 1.0]]}}) == {}
-    assert identified_failures({"equations": []}) is None
-    nan_m = {"matrices": {"M": [[math.nan]], "C": [[1.0]], "K": [[1.0]]}}
+    from testbed.scoring.scorers import fitted_model_failures as identified_failures
+
+    assert identified_failures(Model(coef_=np.array([[0.18, math.nan, 1.0]]))) == {
+        "coefficients": "1 identified coefficient(s) are NaN or infinite"}
+    assert identified_failures(Model(coef_=np.array([[0.18, -0.9, 1.0]]))) == {}
+    assert identified_failures(Model()) is None
+    nan_m = Model(M_=np.array([[math.nan]]), C_=np.array([[1.0]]), K_=np.array([[1.0]]))
     assert identified_failures(nan_m)  # NaN matrices fail the physical checks
 
 
