@@ -64,6 +64,23 @@ BYTES_PER_SAMPLE = 512
 #: than 1e-9 of its value (float64 keeps 16 digits; nothing an identifier can fit on).
 REST_RTOL = 1e-9
 
+#: Bars on the identified equation that every run of this rig held to any bar must meet too
+#: (:func:`testbed.scoring.scorers.equation_failures`): the rig's question is the rate law, and
+#: on one trajectory ``x`` and ``dx`` lie on one curve, so a wrong equation can still simulate
+#: the state (measured, round 2's kinetics at ``state_rmse <= 0.01`` mM: clean member 000
+#: passed at 6.4e-12 mM with the law times a quadratic in x, support F1 0.73, coef_error 2.4;
+#: at 1 % noise all six passed at <= 9.5e-3 mM with F1 0.67 and coef_error 0.98-17).  A run's
+#: own stricter bars still apply; these are never loosened by them.
+EQUATION_BARS = {
+    # the true terms {dx, x*dx, 1, x} exactly, up to scale (issue #15: "the true implicit
+    # equation recovered exactly", support F1 1): one spurious or missing term is another law
+    "support_f1": {"min": 1.0},
+    # largest relative error of a true coefficient, both rows on the truth's scale: issue #15's
+    # 5 % at 1 % noise (the shipped weak-form scenario measures 1.0-4.7 % over seeds 0-3;
+    # clean data reach round-off, 2e-11)
+    "coef_error": {"max": 0.05},
+}
+
 TERMS = ["dx", "x*dx", "1", "x"]
 TRUTH_UNITS = {"equation_terms": "", "equation_coef": "1 (row max |coef| = 1)",
                "state_names": "", "x0": "mM", "parameter_names": "",
@@ -120,6 +137,8 @@ class MichaelisMentenRig(Rig):
     default_excitation: ClassVar[str] = "autonomous"
     measured_signals: ClassVar[tuple[str, ...]] = ("x", "dx")
     noisy_signals: ClassVar[tuple[str, ...]] = ("x",)
+    #: The identified equation's bars (:data:`EQUATION_BARS`), ``{metric: {"min"|"max": value}}``.
+    equation_bars: ClassVar[dict[str, dict[str, float]]] = EQUATION_BARS
 
     @classmethod
     def check(cls, rig: dict[str, Any], simulation: dict[str, Any], excitation: dict[str, Any],

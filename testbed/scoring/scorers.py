@@ -19,6 +19,7 @@ from testbed.core.kinds import MAX_MODE_SCORES, METRICS
 from testbed.core.measurement import Measurement, Trajectory
 from testbed.core.terms import canonical
 from testbed.core.truth import DynamicalTruth, MechanicalTruth, StructuralTruth, TruthError
+from testbed.pipeline.plugins import rig_class
 from testbed.scoring import metrics
 from testbed.scoring.equation_basis import compare_equations
 from testbed.scoring.initial_state import fit_initial_state
@@ -105,8 +106,9 @@ class Scores:
         damping), ``"stability"`` (a pole in the right half-plane), ``"model"`` (non-finite
         learned values), ``"uninformative"`` (a rollout bar a model that never moves meets:
         :func:`uninformative_failures`), ``"band"`` (a failed bar on a true mode outside the
-        signal chain's pass band: :func:`out_of_band_failures`).  Empty for a physically
-        admissible model whose simulation ran.
+        signal chain's pass band: :func:`out_of_band_failures`), ``"equation"`` (the
+        identified equation misses its rig's own bars: :func:`equation_failures`).  Empty for a
+        physically admissible model whose simulation ran.
     """
 
     values: dict[str, float]
@@ -183,10 +185,59 @@ _MODE_SCORE = re.compile(r"(mac|freq_error|damping_error)(?:_mode(\d+))?")
 
 
 def bar_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -> dict[str, str]:
-    """The failures a run's bars add to its scorer's: :func:`uninformative_failures` and
-    :func:`out_of_band_failures`, merged (one call for :func:`testbed.scoring.run.run_scenario`
-    and :func:`testbed.scoring.evaluate.score_model`)."""
-    return {**uninformative_failures(scores, thresholds), **out_of_band_failures(scores, thresholds)}
+    """The failures a run's bars add to its scorer's: :func:`uninformative_failures`,
+    :func:`out_of_band_failures` and :func:`equation_failures`, merged (one call for
+    :func:`testbed.scoring.run.run_scenario` and :func:`testbed.scoring.evaluate.score_model`)."""
+    return {**uninformative_failures(scores, thresholds), **out_of_band_failures(scores, thresholds),
+            **equation_failures(scores, thresholds)}
+
+
+def rig_equation_bars(dataset: Dataset) -> dict[str, dict[str, float]]:
+    """The bars a rig declares on the identified equation (its class's ``equation_bars``,
+    ``{metric: {"min"|"max": value}}``), or ``{}``: a rig whose question is its equation
+    (Michaelis-Menten) declares them; the dataset names its rig in ``attrs["rig"]``."""
+    name = dataset.attrs.get("rig")
+    if not isinstance(name, str):
+        return {}
+    try:
+        cls = rig_class(name)
+    except KeyError:  # data of a rig not registered here: no declaration to read
+        return {}
+    return dict(getattr(cls, "equation_bars", None) or {})
+
+
+def equation_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -> dict[str, str]:
+    """The rig's own bars on the identified equation, missed: ``{"equation": reason}``.
+
+    Held on every run held to any bar (a run without bars keeps "no verdict"), over and above
+    the run's own: a rig's declared bars are never loosened by a scenario's or a study's (a
+    stricter bar of the run's is checked as usual).  Nothing is added where the fit or the
+    model failed (no equation to judge; that failure says why).
+
+    Parameters
+    ----------
+    scores : Scores
+        With ``details["equation_bars"]`` (:func:`rig_equation_bars`; other rigs: nothing to
+        check).
+    thresholds : dict
+        The run's bars, ``{metric: {"min"|"max": value}}``.
+
+    Returns
+    -------
+    dict of str to str
+        Empty, or the reason naming each missed metric, its value and the rig's bar.
+    """
+    bars = scores.details.get("equation_bars") or {}
+    if not thresholds or not bars or {"fit", "model"} & set(scores.failures):
+        return {}
+    missed = [c for c in check_thresholds(scores.values, bars) if not c.passed]
+    if not missed:
+        return {}
+    said = "; ".join(f"{c.metric} {c.value:.3g} {'below' if c.bound == 'min' else 'above'} "
+                     f"{c.threshold:g}" for c in missed)
+    return {"equation": (f"wrong equation: {said} (the rig's own bars on the identified "
+                         "equation: its question is the law, which a state that simulates "
+                         "well does not prove)")}
 
 
 def out_of_band_failures(scores: Scores, thresholds: dict[str, dict[str, float]]
@@ -839,7 +890,8 @@ def score_dynamical(dataset: Dataset, data: Measurement, clean: Measurement, mod
                                                      for n in truth.equation_terms]]
                     != 0.0, cmp["coef_errors"], 0.0)
     d.update(terms=cmp["names"], coef_true=cmp["coef_true"], coef_id=cmp["coef_id"],
-             coef_term_errors=cmp["coef_errors"], coef_errors=errs.max(axis=1))
+             coef_term_errors=cmp["coef_errors"], coef_errors=errs.max(axis=1),
+             equation_bars=rig_equation_bars(dataset))
     return Scores(v, d, failures)
 
 

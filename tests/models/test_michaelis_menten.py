@@ -78,3 +78,83 @@ def test_a_record_of_fewer_than_two_samples_is_refused(simulation):
     with pytest.raises(ScenarioError, match=r"'simulation\.duration'.*at least two samples"):
         scenario_from_dict({"scenario": {"name": "x", "rig": "michaelis_menten"},
                             "simulation": simulation})
+
+
+# ------------------------------------------- a pass holds the law, not only the state
+_BARS = {"support_f1": {"min": 1.0}, "coef_error": {"max": 0.05}}
+
+
+def test_the_rig_declares_its_equation_bars():
+    # issue #15: the true implicit equation exactly (support F1 1), coefficients within 5 %
+    assert rig_class("michaelis_menten").equation_bars == _BARS
+
+
+def test_equation_failures_hold_the_rigs_bars_on_any_run_with_a_bar():
+    from testbed.scoring.scorers import FAIL, Scores, equation_failures, verdict
+    # round 2's kinetics__000, clean: the law times a quadratic in x met state_rmse <= 0.01 mM
+    wrong = Scores({"state_rmse": 6.4e-12, "support_f1": 0.727, "coef_error": 2.37},
+                   {"equation_bars": _BARS})
+    why = equation_failures(wrong, {"state_rmse": {"max": 0.01}})
+    assert set(why) == {"equation"}
+    assert "coef_error 2.37 above 0.05" in why["equation"]
+    assert "support_f1 0.727 below 1" in why["equation"]
+    assert verdict([], why) == FAIL
+    # a run's own looser bar does not loosen the rig's
+    assert set(equation_failures(wrong, {"coef_error": {"max": 10.0}})) == {"equation"}
+    # NaN never passes: an equation without scores is missed, not met
+    nan = Scores({"support_f1": np.nan, "coef_error": np.nan}, {"equation_bars": _BARS})
+    assert set(equation_failures(nan, {"state_rmse": {"max": 0.01}})) == {"equation"}
+    # nothing to add: no bar at all (no verdict stays no verdict), the bars met, no
+    # equation (a failed fit says why), a rig that declares no bars
+    assert equation_failures(wrong, {}) == {}
+    right = Scores({"support_f1": 1.0, "coef_error": 0.047}, {"equation_bars": _BARS})
+    assert equation_failures(right, {"state_rmse": {"max": 0.01}}) == {}
+    fit = Scores(dict(nan.values), {"equation_bars": _BARS}, {"fit": "fit failed: x"})
+    assert equation_failures(fit, {"state_rmse": {"max": 0.01}}) == {}
+    assert equation_failures(Scores(dict(wrong.values)), {"state_rmse": {"max": 0.01}}) == {}
+
+
+@pytest.fixture(scope="module")
+def fitted():
+    from testbed.pipeline.generate import generate
+    from testbed.scoring.run import run_scenario
+    sc = load_scenario("michaelis_menten").replace(score={"state_rmse": {"max": 0.01}})
+    ds = generate(sc)
+    return sc, ds, run_scenario(sc, dataset=ds)
+
+
+def _multiplied(model, factor):
+    """``model``'s single equation times the polynomial ``factor`` = {power of x: coef}, on the
+    degree-3 library (every product must stay in it)."""
+    names = list(model.feature_names_)
+    power = {"1": (0, ""), "x": (1, ""), "x^2": (2, ""), "x^3": (3, ""),
+             "dx": (0, "dx"), "x*dx": (1, "dx"), "x^2*dx": (2, "dx"), "x^3*dx": (3, "dx")}
+    name = {v: k for k, v in power.items()}
+    out = np.zeros(len(names))
+    for j, c in enumerate(model.coef_[0]):
+        for k, a in factor.items():
+            if c != 0.0:
+                p, d = power[names[j]]
+                out[names.index(name[(p + k, d)])] += a * c
+    return out[None, :] / np.abs(out).max()
+
+
+def test_the_law_up_to_scale_passes_and_the_law_times_a_factor_fails(fitted):
+    # On one trajectory the law times any q(x) without a root on the record simulates the same
+    # state; its support and coefficients are another equation's, so it is no pass.  Both are
+    # built from the fitted law (not from which exact equation round-off makes the sweep pick).
+    import copy
+
+    from testbed.scoring.evaluate import score_model
+    sc, ds, r = fitted
+    assert r.passed and r.scores.values["support_f1"] == 1.0 and not r.scores.failures
+    scaled = copy.deepcopy(r.model)
+    scaled.coef_ = -3.0 * r.model.coef_  # an implicit equation holds up to scale
+    s = score_model(scaled, ds, sc)
+    assert s.values["support_f1"] == 1.0 and not s.failures
+    times_q = copy.deepcopy(r.model)
+    times_q.coef_ = _multiplied(r.model, {0: 1.0, 1: 2.0})  # q = 1 + 2x > 0 on x in 0.2-2 mM
+    s = score_model(times_q, ds, sc)
+    # 1e-6 mM: RK4 at 1 ms solves the same dx as the law's (q cancels) up to round-off
+    assert s.values["state_rmse"] < 1e-6
+    assert s.values["support_f1"] < 1.0 and set(s.failures) == {"equation"}
