@@ -83,7 +83,7 @@ MECHANICAL_SIGNAL_SCHEMA: dict[str, Field] = {
     "window": Field(int, 201, min=5, doc="Savitzky-Golay window [samples] for estimated "
                                          "derivatives (odd)"),
     "polyorder": Field(int, 4, min=2, max=8, doc="Savitzky-Golay polynomial order"),
-    "cutoff_hz": Field(float, 4.0, unit="Hz", min=0.0, min_inclusive=False,
+    "cutoff_hz": Field(float, "auto", unit="Hz", min=0.0, min_inclusive=False,
                        also=Field(str, choices=("auto",)),
                        doc="'lowpass': -3 dB frequency of one pass of the zero-phase "
                            "Butterworth; just above the band of the motion (noise in the "
