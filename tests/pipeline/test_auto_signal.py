@@ -47,6 +47,7 @@ def test_lowpass_auto_between_the_last_sensed_mode_and_the_next(sensors):
     rule = sc.rules["signal.lowpass_hz"]
     assert rule.startswith(f"{sc.signal['lowpass_hz']:g} Hz by 'auto'") and f"mode {n + 1}" in rule
     assert sc.signal["highpass_hz"] == 10.0 and "signal.highpass_hz" not in sc.rules  # the default
+    assert sc.to_dict()["rules"] == sc.rules  # what run.json keeps beside the resolved value
 
 
 def test_auto_on_the_default_sensors_and_a_given_number_has_no_rule():

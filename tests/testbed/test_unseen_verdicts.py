@@ -284,3 +284,18 @@ def test_two_sensor_beam_passes_with_the_auto_lowpass(lowpass, passed):
     result = run_scenario(sc)
     assert result.passed is passed
     assert {c.metric for c in result.checks if not c.passed} == (set() if passed else {"trac"})
+
+
+@pytest.mark.parametrize("name, n", [("round6_beams", 39), ("round6_beams_noise", 3)])
+def test_round6_beam_studies_load_and_resolve_auto(name, n):
+    """The round-6 regression studies load, and every "auto" cut-off of theirs is resolved at
+    load with its rule (none reaches the signal chain as a word)."""
+    from pathlib import Path
+
+    from testbed.studies.study import load_study
+    root = Path(__file__).resolve().parents[2]
+    study = load_study(root / "benchmarks" / "unseen" / f"{name}.toml")
+    assert study.name == name and len(study.scenarios) == n
+    for sc in study.scenarios:
+        assert all(isinstance(sc.signal[k], float) for k in ("highpass_hz", "lowpass_hz"))
+        assert ("signal.lowpass_hz" in sc.rules) == (sc.signal["lowpass_hz"] > 0)
