@@ -32,6 +32,7 @@ import numpy as np
 from models import RIGS
 from models._base import MJ_MINVAL, ErrorFn, Rig, check_two_samples
 from models.cantilever.beam import BeamParams, body_of
+from models.cantilever.euler_bernoulli import auto_cutoff, clamped_estimates
 from models.cantilever.model import (
     CantileverModel,
     beam_params,
@@ -382,6 +383,23 @@ class CantileverRig(Rig):
         if end >= simulation["duration"]:
             error("excitation.pulse_duration", excitation["pulse_duration"],
                   f"allowed: start + pulse_duration < duration ({simulation['duration']:g} s)")
+
+    #: ``[signal]`` keys that may say ``"auto"``: resolved from the nominal geometry when the
+    #: scenario is loaded (:meth:`auto_signal`).
+    auto_signal_keys: ClassVar[tuple[str, ...]] = ("highpass_hz", "lowpass_hz")
+
+    @classmethod
+    def auto_signal(cls, rig: dict[str, Any], key: str) -> tuple[float, str]:
+        """Cut-off ``signal.<key> = "auto"`` [Hz] and its rule, from the rig's nominal geometry
+        (:func:`~models.cantilever.euler_bernoulli.auto_cutoff`; ValueError if it cannot be
+        resolved)."""
+        return auto_cutoff(rig, key)
+
+    @classmethod
+    def clamped_estimates(cls, rig: dict[str, Any], n: int) -> np.ndarray:
+        """Euler-Bernoulli clamped estimates of modes 1..n [Hz]
+        (:func:`~models.cantilever.euler_bernoulli.clamped_estimates`)."""
+        return clamped_estimates(rig, n)
 
     @classmethod
     def measurement_shape(cls, rig: dict[str, Any]) -> tuple[int, int]:

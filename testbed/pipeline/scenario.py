@@ -53,7 +53,7 @@ from testbed.core.errors import RigError, ScenarioError
 from testbed.core.kinds import metric_names, metric_range
 from testbed.core.schema import Field, near_miss, validate_header, validate_table, validate_variant
 from testbed.pipeline.plugins import IDENTIFIERS, RIGS
-from testbed.pipeline.signal_chain import SIGNAL_SCHEMAS, check_signal
+from testbed.pipeline.signal_chain import SIGNAL_SCHEMAS, check_signal, rig_auto_keys
 
 #: Scenario and study names: a safe file stem (no path separators, not "." or "..").
 NAME_PATTERN = r"[A-Za-z0-9_][A-Za-z0-9_.-]{0,127}"
@@ -118,6 +118,10 @@ class Scenario:
     registered rig when the scenario is built: every later step (signal chain, scorer, run
     store, study) reads it here instead of asking the registry again.  Left empty in a direct
     construction, it is filled from the registry; a kind that contradicts the rig's is refused.
+
+    ``rules`` holds the settings the loader resolved by a stated rule, ``"section.key"`` ->
+    the rule with the estimates it used (e.g. ``"signal.lowpass_hz"`` written as ``"auto"``:
+    the section holds the resolved value, see :func:`resolve_auto_signal`); run.json keeps both.
     """
 
     name: str
@@ -134,6 +138,7 @@ class Scenario:
     score: dict[str, dict[str, float]] = field(default_factory=dict)
     path: str | None = field(default=None, compare=False)
     kind: str = ""
+    rules: dict[str, str] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         try:
@@ -453,6 +458,7 @@ def scenario_from_dict(raw: dict[str, Any], *, file: str = "<dict>", stem: str |
         check_rig_cost(rig_cls, rig_params, simulation, excitation, file=file)
     signal = validate_table(raw.get("signal", {}), SIGNAL_SCHEMAS[rig_cls.kind], file=file,
                             section="signal")
+    rules = resolve_auto_signal(rig_cls, rig_params, signal, file)
     record = rig_cls.record(simulation)
     if record is not None:
         check_signal(rig_cls.kind, signal, *record, error)
@@ -468,7 +474,45 @@ def scenario_from_dict(raw: dict[str, Any], *, file: str = "<dict>", stem: str |
                     description=head["description"], tags=tuple(head["tags"]),
                     rig_params=rig_params, simulation=simulation, excitation=excitation,
                     noise=noise, signal=signal, identify=identify, score=score, path=file,
-                    kind=rig_cls.kind)
+                    kind=rig_cls.kind, rules=rules)
+
+
+def resolve_auto_signal(rig_cls: Any, rig_params: dict[str, Any], signal: dict[str, Any],
+                        file: str) -> dict[str, str]:
+    """Resolve the ``[signal]`` keys a scenario gives as ``"auto"`` from the rig, in place.
+
+    A rig that lists the key in ``auto_signal_keys`` resolves it by its ``auto_signal(rig,
+    key) -> (value, rule)`` (the cantilever: its filter cut-offs from the nominal geometry,
+    :func:`models.cantilever.euler_bernoulli.auto_cutoff`).  Keys whose chain resolves
+    ``"auto"`` itself from the record (the mechanical chain's ``cutoff_hz``) are left alone.
+
+    Returns
+    -------
+    dict of str to str
+        ``"signal.<key>"`` -> the rule and the value it gave, for :attr:`Scenario.rules`.
+
+    Raises
+    ------
+    ScenarioError
+        In one line, naming the key, if the rig has no rule for it or its rule cannot resolve it.
+    """
+    rules: dict[str, str] = {}
+    keys = getattr(rig_cls, "auto_signal_keys", ())
+    chain_auto = rig_auto_keys(rig_cls.kind)
+    for key, value in signal.items():
+        if value != "auto" or key not in chain_auto:
+            continue
+        if key not in keys:
+            raise ScenarioError(file, f"signal.{key}", value,
+                                f"a frequency [Hz]: rig {rig_cls.name or rig_cls.__name__!r} has "
+                                "no estimate of its modes to resolve 'auto' from")
+        try:
+            signal[key], rule = rig_cls.auto_signal(rig_params, key)
+        except ValueError as e:
+            raise ScenarioError(file, f"signal.{key}", value, f"a frequency [Hz] ('auto' cannot "
+                                                              f"be resolved here: {e})") from None
+        rules[f"signal.{key}"] = f"{signal[key]:g} Hz by {rule}"
+    return rules
 
 
 def check_rig_cost(rig_cls: Any, rig_params: dict[str, Any], simulation: dict[str, Any],

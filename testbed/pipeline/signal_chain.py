@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 
 from testbed.core.dataset import Dataset
-from testbed.core.errors import show_names
+from testbed.core.errors import ScenarioError, show_names
 from testbed.core.measurement import Measurement, declared_input_hold
 from testbed.core.schema import Field, validate_table
 from testbed.numerics import derivatives
@@ -43,9 +43,17 @@ SIGNAL_SCHEMAS: dict[str, dict[str, Field]] = {}
 
 STRUCTURAL_SIGNAL_SCHEMA: dict[str, Field] = {
     "highpass_hz": Field(float, 10.0, unit="Hz", min=0.0, min_inclusive=False,
+                         also=Field(str, choices=("auto",)),
                          doc="cut-off of the zero-phase elliptic high-pass applied after each "
                              "integration (removes drift); acceleration, velocity and "
-                             "displacement all end up filtered alike"),
+                             "displacement all end up filtered alike; 'auto': from the rig's "
+                             "nominal geometry when the scenario is loaded (the cantilever: half "
+                             "the Euler-Bernoulli estimate of mode 1 on its base, 0.1 Hz), the "
+                             "value and its rule recorded in the scenario's rules; a cut-off of "
+                             "a few Hz wants the hammer well after the record's start "
+                             "(excitation.start): the zero-phase filter spreads the pulse about "
+                             "1 / cut-off back in time (a 1.2 m beam at 2.9 Hz: TRAC 0.62 with "
+                             "the hammer at 5 ms, the truth's own reduction too; 0.999 at 0.5 s)"),
     "highpass_order": Field(int, 5, min=1, max=12,
                             doc="order of the elliptic high-pass; odd orders have a zero at DC "
                                 "and unit gain at high frequency; even orders pass DC at the "
@@ -58,8 +66,14 @@ STRUCTURAL_SIGNAL_SCHEMA: dict[str, Field] = {
                        doc="pass-band ripple of the elliptic filter (the paper: 0.1 dB)"),
     "stop_db": Field(float, 30.0, unit="dB", min=0.0, min_inclusive=False, max=300.0,
                      doc="stop-band attenuation of the elliptic filter (the paper: 30 dB)"),
-    "lowpass_hz": Field(float, 0.0, unit="Hz", min=0.0,
-                        doc="optional zero-phase low-pass cut-off; 0 = off"),
+    "lowpass_hz": Field(float, 0.0, unit="Hz", min=0.0, also=Field(str, choices=("auto",)),
+                        doc="optional zero-phase low-pass cut-off; 0 = off; 'auto': from the "
+                            "rig's nominal geometry when the scenario is loaded (the "
+                            "cantilever: between the last sensed mode n, one per sensor, and "
+                            "mode n + 1, sqrt(f_n f_(n+1)) of the clamped Euler-Bernoulli "
+                            "estimates, 0.1 Hz), the value and its rule recorded in the "
+                            "scenario's rules; a model of n modes fitted without it meets "
+                            "mode n + 1 ringing at the sensors"),
     "lowpass_order": Field(int, 8, min=1, max=16, doc="order of the optional Butterworth low-pass"),
     "free_margin_s": Field(float, 1e-3, unit="s", min=0.0,
                            doc="least time after the end of the force pulse before the free "
@@ -140,12 +154,17 @@ class SignalChain:
         ``check(cfg, fs, n_samples, error)``: cross-key checks of a validated table against
         the record it will process (sample rate [Hz], samples); calls ``error(key, value,
         allowed)`` on the first problem.
+    rig_auto : tuple of str
+        Keys whose ``"auto"`` the rig resolves from its nominal geometry when the scenario is
+        loaded (:func:`testbed.pipeline.scenario.resolve_auto_signal`), so ``measure`` and
+        ``check`` see numbers; other ``"auto"`` values the chain resolves from the record.
     """
 
     kind: str
     schema: dict[str, Field]
     measure: Callable[[Dataset, Mapping[str, Any]], Measurement]
     check: Callable[[Mapping[str, Any], float, int, ErrorFn], None] | None = None
+    rig_auto: tuple[str, ...] = ()
 
 
 #: Signal chain per rig kind, filled by :func:`register_signal_chain` (this module registers
@@ -168,6 +187,11 @@ def register_signal_chain(chain: SignalChain) -> SignalChain:
     SIGNAL_CHAINS[chain.kind] = chain
     SIGNAL_SCHEMAS[chain.kind] = chain.schema
     return chain
+
+
+def rig_auto_keys(kind: str) -> tuple[str, ...]:
+    """Keys of the kind's ``[signal]`` table whose ``"auto"`` the rig resolves (:class:`SignalChain`)."""
+    return _chain(kind).rig_auto
 
 
 def check_signal(kind: str, cfg: Mapping[str, Any], fs: float, n_samples: int,
@@ -383,6 +407,11 @@ def measure_structural(dataset: Dataset, cfg: Mapping[str, Any]) -> Measurement:
         place a force between sensors, and spreading it (e.g. by shape functions) would be a
         modelling choice the identifier should make, not the signal chain.
     """
+    for key in ("highpass_hz", "lowpass_hz"):
+        if cfg[key] == "auto":  # resolved by the rig when a scenario is loaded; here no rig
+            raise ScenarioError("<signal config>", f"signal.{key}", "auto",
+                                "a frequency [Hz]: 'auto' is resolved from a rig's nominal "
+                                "geometry when a scenario is loaded, and this chain has no rig")
     acc_sig = dataset.measured.get("acceleration")
     acc = _get(dataset, "acceleration")
     force = _get(dataset, "force")
@@ -710,7 +739,7 @@ def measure_dynamical(dataset: Dataset, cfg: Mapping[str, Any]) -> Measurement:
 
 
 register_signal_chain(SignalChain("structural", STRUCTURAL_SIGNAL_SCHEMA, measure_structural,
-                                  check_structural))
+                                  check_structural, rig_auto=("highpass_hz", "lowpass_hz")))
 register_signal_chain(SignalChain("mechanical", MECHANICAL_SIGNAL_SCHEMA, measure_mechanical,
                                   check_mechanical))
 register_signal_chain(SignalChain("dynamical", DYNAMICAL_SIGNAL_SCHEMA, measure_dynamical,

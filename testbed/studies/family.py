@@ -94,8 +94,6 @@ MATERIALS: dict[str, tuple[float, float]] = {
     "glass_epoxy": (24e9, 1900.0),
 }
 
-#: Dimensionless Euler-Bernoulli eigenvalues beta_k L of a clamped-free beam, modes 1-8.
-EB_BETA_L = (1.8751, 4.6941, 7.8548, 10.9955, 14.1372, 17.2788, 20.4204, 23.5619)
 #: A member's highest sensed mode (as many modes as sensors) must lie below this fraction of
 #: the sample rate: the signal chain and the identifiers' spectral peaks need it resolved
 #: below the Nyquist frequency (0.5) with room for its anti-alias roll-off.
@@ -138,10 +136,13 @@ CANTILEVER_DERIVED = {
                           "(see peak_base_rotation)",
     "excitation.location = 'sensor'": "the impact lands on one of the sensors, equally likely "
                                       "(the signal chain needs it on a sensor)",
-    "signal.highpass_hz = 'auto'": "half the Euler-Bernoulli estimate of mode 1 (the noisy-record "
-                                   "chain's 40 Hz for the shipped beam's 80 Hz), 0.1 Hz",
+    "signal.highpass_hz = 'auto'": "half the Euler-Bernoulli estimate of mode 1 on the member's "
+                                   "base (the noisy-record chain's 40 Hz for the shipped beam's "
+                                   "80 Hz), 0.1 Hz; the rig's rule, as in a scenario "
+                                   "(models/cantilever/euler_bernoulli.py auto_cutoff)",
     "signal.lowpass_hz = 'auto'": "the low-pass between the last sensed mode n and mode n + 1: "
-                                  "sqrt(f_n f_(n+1)) of the Euler-Bernoulli estimates, 0.1 Hz",
+                                  "sqrt(f_n f_(n+1)) of the clamped Euler-Bernoulli estimates, "
+                                  "0.1 Hz; the rig's rule, as in a scenario",
 }
 
 
@@ -364,12 +365,9 @@ def peak_base_rotation(rig: dict[str, Any], excitation: dict[str, Any]) -> float
 
 
 def eb_frequencies(rig: dict[str, Any], n: int) -> np.ndarray:
-    """Euler-Bernoulli clamped-free frequencies [Hz] of modes 1..n (n <= 8) of the rig's beam."""
-    EI = rig["E"] * rig["width"] * rig["thickness"] ** 3 / 12.0
-    rhoA = rig["rho"] * rig["width"] * rig["thickness"]
-    L = rig["length"]
-    bl = np.asarray(EB_BETA_L[:n])
-    return bl**2 / (2 * math.pi * L**2) * math.sqrt(EI / rhoA)
+    """Euler-Bernoulli clamped-free frequencies [Hz] of modes 1..n of the rig's beam (the
+    cantilever rig's :meth:`clamped_estimates`)."""
+    return RIGS.get("cantilever").clamped_estimates(rig, n)
 
 
 def _cantilever_rules(fam: Family, rig: dict[str, Any], exc: dict[str, Any],
@@ -406,21 +404,17 @@ def _cantilever_rules(fam: Family, rig: dict[str, Any], exc: dict[str, Any],
             rig["base_k3"] = float(derived["cubic_fraction"] * rig["base_k1"] / q**2)
         else:
             rig["base_k3"] = 0.0  # no base spring: the fraction means nothing (drawn all the same)
-    if signal.get("highpass_hz") == "auto":
-        # the noisy-record chain's ratio on the shipped beam (40 Hz high-pass for mode 1 at
-        # 80 Hz): half the member's mode 1, so the cut-off tracks the beam instead of cutting
-        # into a 40 Hz mode 1
-        signal["highpass_hz"] = float(round(eb_frequencies(rig, 1)[0] / 2.0, 1))
-    if signal.get("lowpass_hz") == "auto":
-        # the lab's low-pass for a model of n modes: between mode n and mode n + 1 (geometric
-        # mean of their Euler-Bernoulli estimates), so the first unmodelled mode, which the
-        # 0.3 ms hammer excites strongly, does not enter the fit (first family run: 2-sensor
-        # beams without it reached TRAC 0.64 at 0 % noise, 0.98 with it)
-        f_next = eb_frequencies(rig, min(n_sensors + 1, len(EB_BETA_L)))
-        signal["lowpass_hz"] = float(round(math.sqrt(f_next[-2] * f_next[-1]), 1))
+    for key in ("highpass_hz", "lowpass_hz"):
+        if signal.get(key) == "auto":
+            # the lab's cut-offs from the member's nominal geometry, by the rig's one rule
+            # (models/cantilever/euler_bernoulli.py auto_cutoff, also behind a scenario's "auto")
+            try:
+                signal[key] = RIGS.get(fam.base.rig).auto_signal(rig, key)[0]
+            except ValueError as e:
+                return f"signal.{key} = 'auto': {e}"
     if rig["n_segments"] < MIN_SEGMENTS_PER_MODE * n_sensors:
         return f"{rig['n_segments']} segments for {n_sensors} sensed modes"
-    f = eb_frequencies(rig, min(n_sensors, len(EB_BETA_L)))
+    f = eb_frequencies(rig, n_sensors)
     if f[-1] > MAX_MODE_FRACTION_OF_FS * sim["sample_rate"]:
         return f"mode {n_sensors} at {f[-1]:.0f} Hz"
     if f[0] * sim["duration"] < MIN_MODE1_PERIODS:
@@ -446,6 +440,9 @@ def draw_member(fam: Family, k: int, refusals: list[str] | None = None) -> tuple
         rng = np.random.default_rng([fam.seed, k, attempt])
         tables = {"rig": dict(base.rig_params), "simulation": dict(base.simulation),
                   "excitation": dict(base.excitation), "signal": dict(base.signal)}
+        for key in base.rules:  # a base's "auto" cut-off follows each member, not the base
+            if key.startswith("signal."):
+                tables["signal"][key.removeprefix("signal.")] = "auto"
         if base.rig == "fivebar":
             for key in ("th1_0", "th4_0"):  # the rig picks a usable pose for the drawn geometry
                 if key not in fam.ranges["rig"]:
