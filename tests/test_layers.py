@@ -108,3 +108,19 @@ def test_identifiers_cannot_reach_the_truth(path):
     reached = [t for t, _ in imports(path)
                if any(t == m or t.startswith(m + ".") for m in truth_modules)]
     assert not reached, f"{module_name(path)} imports {reached}"
+
+
+def test_tests_mirror_the_packages():
+    """``tests/testbed/<layer>/`` holds the tests of ``testbed/<layer>/`` (tests/testbed itself:
+    the CLI, the server and the cross-cutting audits); ``tests/identify`` and ``tests/models``
+    mirror theirs."""
+    tests = ROOT / "tests" / "testbed"
+    folders = {p.name for p in tests.iterdir() if p.is_dir() and p.name != "__pycache__"}
+    packages = {p.name for p in (ROOT / "testbed").iterdir() if (p / "__init__.py").is_file()}
+    assert folders <= packages, f"tests/testbed folders without a package: {folders - packages}"
+    assert {"core", "numerics", "pipeline", "scoring", "studies", "reporting"} <= folders
+    for layer in folders:
+        for f in sorted((tests / layer).glob("test_*.py")):
+            targets = [t for t, _ in imports(f)]
+            assert any(t == f"testbed.{layer}" or t.startswith(f"testbed.{layer}.")
+                       for t in targets), f"{f.relative_to(ROOT)} tests nothing of testbed.{layer}"

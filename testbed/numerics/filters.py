@@ -288,7 +288,7 @@ def integrate_acceleration(acc: np.ndarray, fs: float, highpass_hz: float, order
     3 % of such an offset, and because the sensors' higher modes carry little motion that
     residue dominates their direction: measured on the default stiff cantilever, the correction
     cuts the displacement error along the true sensor modes 1 / 2 / 3 from 2.4 / 103 / 1834 %
-    to 0.8 / 1.1 / 12 % (tests/testbed/test_rest_offset.py).
+    to 0.8 / 1.1 / 12 % (tests/testbed/pipeline/test_rest_offset.py).
 
     The commutation is exact only for a record that starts at rest and ends with the motion
     decayed (an impact test with enough post-trigger time); a record cut mid-motion carries

@@ -17,7 +17,7 @@ from testbed.scoring.equation_basis import evaluate_terms
 @pytest.fixture(scope="module")
 def case(dataset_cache):
     sc = load_scenario("scenarios/cartpole.toml")
-    ds = dataset_cache.get(sc)  # bit-identical to generate() (tests/testbed/test_cache.py)
+    ds = dataset_cache.get(sc)  # bit-identical to generate() (tests/testbed/pipeline/test_cache.py)
     return sc, ds, measure(ds, sc.signal, "mechanical")
 
 

@@ -22,7 +22,7 @@ def rig():
 
 @pytest.fixture(scope="module")
 def ds(dataset_cache):
-    # the shared test cache: bit-identical to generate() (tests/testbed/test_cache.py) and keyed on
+    # the shared test cache: bit-identical to generate() (tests/testbed/pipeline/test_cache.py) and keyed on
     # the rig's source, and the same record test_sindy_pi_fivebar and the scored five-bar scenarios use
     return dataset_cache.get(load_scenario("fivebar_multisine"))
 

@@ -19,7 +19,7 @@ def scenario():
 
 @pytest.fixture(scope="module")
 def dataset(scenario, dataset_cache):
-    return dataset_cache.get(scenario)  # bit-identical to generate() (tests/testbed/test_cache.py)
+    return dataset_cache.get(scenario)  # bit-identical to generate() (tests/testbed/pipeline/test_cache.py)
 
 
 def signals(ds):

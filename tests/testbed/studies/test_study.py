@@ -217,7 +217,7 @@ def test_family_of_a_kind_no_identifier_fits_names_the_family():
     # round 5 (benchmarks/unseen/round5/mm_study_kind_mismatch.toml): a kinetics family beside a
     # cart-pole one, only a mechanical identifier listed; the members follow the named
     # scenarios, so indexing study.scenarios by a member's position ended in an IndexError
-    path = Path(__file__).resolve().parents[2] / "benchmarks" / "unseen" / "round5" / \
+    path = Path(__file__).resolve().parents[3] / "benchmarks" / "unseen" / "round5" / \
         "mm_study_kind_mismatch.toml"
     with pytest.raises(ScenarioError) as err:
         load_study(path)

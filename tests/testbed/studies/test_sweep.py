@@ -23,7 +23,7 @@ from testbed.studies.results import parts_dir, read_results
 from testbed.studies.study import load_study
 from testbed.studies.sweep import SweepStats, cell_key, expand, release_freed_memory, run_sweep
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[3]
 
 # A "mechanical" toy: four undamped oscillators th_i'' = -w_i^2 th_i (what measure_mechanical
 # expects: theta, dtheta, ddtheta 4 x n, torque 2 x n).  The identifier fits k_i by least

@@ -13,14 +13,14 @@ from pathlib import Path
 
 import pytest
 
-sys.path.insert(0, str(Path(__file__).parent))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # tests/testbed: _synthetic_runs
 import _synthetic_runs as synth
 
 from testbed.reporting import drawer, figures
 from testbed.reporting.report import save_run_figures_and_report
 from testbed.studies.runstore import load_run, save_new_run, save_run
 
-ROOT = Path(__file__).resolve().parent.parent.parent
+ROOT = Path(__file__).resolve().parents[3]
 needs_fork = pytest.mark.skipif(not drawer.fork_available(), reason="figures drawn in-process here")
 
 

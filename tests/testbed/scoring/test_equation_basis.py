@@ -10,7 +10,7 @@ from benchmarks import sindy_pi_problems
 from identify.library import fivebar_library
 from testbed.scoring.equation_basis import CanonicalBasis, compare_equations, evaluate_terms, has_input
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[3]
 
 
 

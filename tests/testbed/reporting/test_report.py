@@ -20,14 +20,14 @@ from pathlib import Path
 import matplotlib.image as mpimg
 import pytest
 
-sys.path.insert(0, str(Path(__file__).parent))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # tests/testbed: _synthetic_runs
 import _synthetic_runs as synth
 
 from testbed.reporting.figures import save_run_figures
 from testbed.reporting.report import CSP, sweep_report, write_report
 from testbed.studies.runstore import save_run
 
-ROOT = Path(__file__).resolve().parents[2]
+ROOT = Path(__file__).resolve().parents[3]
 ARTIFACTS = ROOT / "out" / "test-artifacts"
 PROBE = """<script>window.addEventListener("load", () => {
   const imgs = [...document.images].map(i => ({ok: i.complete && i.naturalWidth > 0, w: i.naturalWidth}));
