@@ -28,10 +28,11 @@ REPEATS = 5
 WINDOW = 4000  # samples (0.31 s at 12.8 kHz)
 
 
-def _numpy_rk4(A: np.ndarray, MK3: np.ndarray, MF: np.ndarray, z0: np.ndarray, h: float,
+def numpy_rk4(A: np.ndarray, MK3: np.ndarray, MF: np.ndarray, z0: np.ndarray, h: float,
                sub: int, n_t: int) -> np.ndarray:
     """The peer: classical RK4 of ``z' = A z + [0; MF[:, k-1] - MK3 x^3]``, a numpy call per
-    stage; returns Z, shape (2n, n_t)."""
+    stage (the Python loop the compiled one replaced; ``tests/identify/test_structural_sim.py``
+    checks the compiled loop against it); returns Z, shape (2n, n_t)."""
     n = MK3.shape[0]
 
     def rhs(z: np.ndarray, f: np.ndarray) -> np.ndarray:
@@ -89,7 +90,7 @@ def run() -> list[dict]:
     peer: list[np.ndarray] = []
 
     def theirs() -> None:
-        peer[:] = [_numpy_rk4(A, MK3, MF, z0, h, sub, n_t)]
+        peer[:] = [numpy_rk4(A, MK3, MF, z0, h, sub, n_t)]
 
     t = interleaved({"ours": ours, "numpy": theirs}, REPEATS)
     gap = float(np.max(np.abs(Z - peer[0])) / np.max(np.abs(peer[0])))

@@ -4,36 +4,21 @@ as the reference): the same trajectory to round-off; divergence raised with its 
 import numpy as np
 import pytest
 
+from benchmarks.bench_structural import numpy_rk4
 from identify import _structural_sim
 from identify._structural_sim import simulate_structural
 from testbed.core.errors import DivergenceError
 
 
 def _python_rk4(M, C, K, K3, x0, xd0, t, f, max_omega_h=0.1):
-    """The replaced implementation, verbatim in substance: RK4 with sub-steps, force held."""
+    """The replaced implementation, verbatim in substance: RK4 with sub-steps, force held (the
+    loop itself is the benchmark's peer, ``benchmarks.bench_structural.numpy_rk4``)."""
     n = M.shape[0]
     Minv = np.linalg.inv(M)
     A = np.block([[np.zeros((n, n)), np.eye(n)], [-Minv @ K, -Minv @ C]])
-    MK3, MF = Minv @ K3, Minv @ f
     dt = t[1] - t[0]
     sub = max(1, int(np.ceil(float(np.max(np.abs(np.linalg.eigvals(A)))) * dt / max_omega_h)))
-    h = dt / sub
-    Z = np.empty((2 * n, t.size))
-    z = Z[:, 0] = np.concatenate([x0, xd0])
-
-    def rhs(z, fk):
-        return A @ z + np.concatenate([np.zeros(n), fk - MK3 @ z[:n] ** 3])
-
-    for k in range(1, t.size):
-        fk = MF[:, k - 1]
-        for _ in range(sub):
-            k1 = rhs(z, fk)
-            k2 = rhs(z + 0.5 * h * k1, fk)
-            k3 = rhs(z + 0.5 * h * k2, fk)
-            k4 = rhs(z + h * k3, fk)
-            z = z + (h / 6.0) * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
-        Z[:, k] = z
-    return Z
+    return numpy_rk4(A, Minv @ K3, Minv @ f, np.concatenate([x0, xd0]), dt / sub, sub, t.size)
 
 
 def _system():
