@@ -82,10 +82,10 @@ def test_refused_in_one_line_where_it_cannot_be_resolved():
     msg = str(e.value)
     assert "\n" not in msg and "signal.highpass_hz" in msg and "'auto'" in msg and "0 Hz" in msg
     # only the word "auto" is a word the key takes
-    with pytest.raises(ScenarioError, match="signal.lowpass_hz"):
+    with pytest.raises(ScenarioError, match=r"signal\.lowpass_hz"):
         scenario_from_dict(raw(signal={"lowpass_hz": "Auto"}))
     # a cut-off above the Nyquist frequency is refused as a number would be, naming the key
-    with pytest.raises(ScenarioError, match="signal.lowpass_hz.*Nyquist"):
+    with pytest.raises(ScenarioError, match=r"signal\.lowpass_hz.*Nyquist"):
         scenario_from_dict(raw(signal={"lowpass_hz": "auto"}, simulation={"sample_rate": 2000.0}))
 
 
@@ -109,7 +109,7 @@ def test_a_rig_without_an_estimate_refuses_auto():
 def test_measure_refuses_an_unresolved_auto():
     """A chain called without a scenario (a table handed to measure directly) has no rig."""
     sc = scenario_from_dict(raw())
-    with pytest.raises(ScenarioError, match="signal.lowpass_hz.*no rig"):
+    with pytest.raises(ScenarioError, match=r"signal\.lowpass_hz.*no rig"):
         measure(None, {**sc.signal, "lowpass_hz": "auto"}, "structural")
 
 
