@@ -27,6 +27,7 @@ from pathlib import Path
 from typing import Any
 from urllib.parse import urlsplit
 
+from testbed.core import interrupts  # armed on import by testbed/__init__.py, before this module
 from testbed.core.errors import InputError, ScenarioError, TestbedError
 
 EXIT_FAIL, EXIT_USAGE, EXIT_INTERNAL, EXIT_INTERRUPTED = 1, 2, 3, 130
@@ -810,25 +811,51 @@ class Terminated(KeyboardInterrupt):
         self.signum = signum
 
 
+#: Set by the handlers below when they run: the console program's signal watchdog
+#: (:func:`testbed.core.interrupts.watchdog`) ends the process if it is not set in time.
+_handled: threading.Event | None = None
+
+
 def _raise_terminated(signum: int, frame: object) -> None:
+    if _handled is not None:
+        _handled.set()
     raise Terminated(signum)
 
 
+def _raise_interrupt(signum: int, frame: object) -> None:
+    if _handled is not None:
+        _handled.set()
+    signal.default_int_handler(signum, frame)
+
+
 @contextlib.contextmanager
-def _terminate_as_interrupt() -> Iterator[None]:
+def _terminate_as_interrupt(console: bool = False) -> Iterator[None]:
     """SIGTERM and SIGHUP raise :class:`Terminated` while a command runs (only where their
     action is the default one and only in the main thread: a caller's own handlers stay), and
-    an interrupt Python could not raise is delivered again (:func:`_redeliver_interrupt`)."""
+    an interrupt Python could not raise is delivered again (:func:`_redeliver_interrupt`).
+
+    In the console program (``console``) a watchdog thread also ends the process in one line
+    if the main thread has not started handling Ctrl-C, SIGTERM or SIGHUP within
+    :data:`testbed.core.interrupts.GRACE_S`: Python runs a signal's handler only between two
+    bytecodes, and an identifier's numba kernel (compiled, ``nogil``) held the main thread for
+    the whole fit (28 s after a SIGTERM, measured) before the run said "interrupted"."""
+    global _handled
     installed = {}
     if threading.current_thread() is threading.main_thread():
         for s in (signal.SIGTERM, signal.SIGHUP):
             if signal.getsignal(s) is signal.SIG_DFL:
                 installed[s] = signal.signal(s, _raise_terminated)
+        if console and signal.getsignal(signal.SIGINT) is signal.default_int_handler:
+            installed[signal.SIGINT] = signal.signal(signal.SIGINT, _raise_interrupt)
     hook = sys.unraisablehook
     sys.unraisablehook = functools.partial(_redeliver_interrupt, hook)
     try:
-        yield
+        with (interrupts.watchdog(tuple(installed)) if console and installed
+              else contextlib.nullcontext()) as handled:
+            _handled = handled
+            yield
     finally:
+        _handled = None
         sys.unraisablehook = hook
         for s, handler in installed.items():
             signal.signal(s, handler)
@@ -861,6 +888,7 @@ def main(argv: list[str] | None = None) -> int:
     SIGTERM or SIGHUP)."""
     _blas_threads()
     try:
+        interrupts.disarm()  # the command handles its signals itself (below)
         if argv is None:  # the console program (not a call from Python): a resident server may run it
             status = _served(sys.argv[1:])
             if status is not None:
@@ -868,7 +896,7 @@ def main(argv: list[str] | None = None) -> int:
         before = gc.get_threshold()
         gc.set_threshold(*GC_THRESHOLD)  # restored below: main() is also called from Python
         try:
-            with _terminate_as_interrupt():
+            with _terminate_as_interrupt(console=argv is None):
                 return _main(argv)
         finally:
             gc.set_threshold(*before)
@@ -876,6 +904,9 @@ def main(argv: list[str] | None = None) -> int:
         # a Ctrl-C outside the command's own handling (while its options were parsed, in a
         # busy machine's first second) printed a 30-line traceback and ended by SIGINT (-2)
         return _interrupted(e)
+    finally:
+        if argv is None:  # the console program exits next: a signal now ends it at once
+            interrupts.arm()
 
 
 def _served(argv: list[str]) -> int | None:

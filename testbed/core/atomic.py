@@ -6,10 +6,12 @@ write leaves no partial file behind.
 
 from __future__ import annotations
 
+import contextlib
 import errno
 import os
+import shutil
 import tempfile
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 from testbed.core.errors import InputError
@@ -43,6 +45,42 @@ def no_room(e: BaseException, path: str | os.PathLike) -> InputError | None:
                       "half-written: make room and run the command again")
 
 
+#: Temporary files and folders being written (:func:`in_flight`): what a process ended at once
+#: (:func:`testbed.core.interrupts.exit_now`, no ``finally`` runs) removes first.
+_IN_FLIGHT: set[str] = set()
+
+
+def begin_in_flight(tmp: str | os.PathLike) -> None:
+    """Mark ``tmp`` (a temporary file or folder) as being written, until :func:`end_in_flight`."""
+    _IN_FLIGHT.add(os.fspath(tmp))
+
+
+def end_in_flight(tmp: str | os.PathLike) -> None:
+    """``tmp`` is renamed into place or removed: no longer being written."""
+    _IN_FLIGHT.discard(os.fspath(tmp))
+
+
+@contextlib.contextmanager
+def in_flight(tmp: str | os.PathLike) -> Iterator[None]:
+    """Mark ``tmp`` (a temporary file or folder) as being written while the block runs."""
+    begin_in_flight(tmp)
+    try:
+        yield
+    finally:
+        end_in_flight(tmp)
+
+
+def remove_in_flight() -> None:
+    """Remove every temporary file and folder being written (:func:`in_flight`), in silence:
+    for a process about to end without unwinding, so that it leaves nothing half-written."""
+    for tmp in list(_IN_FLIGHT):
+        if os.path.isdir(tmp) and not os.path.islink(tmp):
+            shutil.rmtree(tmp, ignore_errors=True)
+        else:
+            with contextlib.suppress(OSError):
+                os.unlink(tmp)
+
+
 def atomic_write(path: str | os.PathLike, write: Callable[[str], None]) -> Path:
     """Call ``write(tmp)`` on a temporary path next to ``path``, then rename it to ``path``.
 
@@ -62,11 +100,12 @@ def atomic_write(path: str | os.PathLike, write: Callable[[str], None]) -> Path:
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     os.close(fd)
     try:
-        write(tmp)
-        with open(tmp, "rb") as fh:
-            os.fsync(fh.fileno())
-        os.chmod(tmp, 0o666 & ~_UMASK)
-        os.replace(tmp, path)
+        with in_flight(tmp):
+            write(tmp)
+            with open(tmp, "rb") as fh:
+                os.fsync(fh.fileno())
+            os.chmod(tmp, 0o666 & ~_UMASK)
+            os.replace(tmp, path)
     except BaseException as e:
         Path(tmp).unlink(missing_ok=True)
         full = no_room(e, path)
