@@ -500,7 +500,7 @@ def _key_values(items: list[str] | None, option: str, *, numbers: bool) -> dict:
             raise InputError(f"{option} {item!r}: expected KEY=VALUE")
         try:
             value = tomllib.loads(f"v = {text}")["v"]
-        except tomllib.TOMLDecodeError:
+        except (tomllib.TOMLDecodeError, ValueError):  # ValueError: over 4300 digits
             value = text
         if numbers and (isinstance(value, bool) or not isinstance(value, (int, float))):
             raise InputError(f"{option} {item!r}: the value must be a number")
@@ -896,7 +896,7 @@ def main(argv: list[str] | None = None) -> int:
         before = gc.get_threshold()
         gc.set_threshold(*GC_THRESHOLD)  # restored below: main() is also called from Python
         try:
-            with _terminate_as_interrupt(console=argv is None):
+            with _terminate_as_interrupt(console=argv is None), _stdout_writes_file_names():
                 return _main(argv)
         finally:
             gc.set_threshold(*before)
@@ -907,6 +907,28 @@ def main(argv: list[str] | None = None) -> int:
     finally:
         if argv is None:  # the console program exits next: a signal now ends it at once
             interrupts.arm()
+
+
+@contextlib.contextmanager
+def _stdout_writes_file_names() -> Iterator[None]:
+    """Standard output writes a file name whose bytes are not text in its encoding as those
+    bytes (:func:`testbed.core.atomic._file_name_bytes`) while a command runs, instead of
+    raising UnicodeEncodeError: "run written to <a folder named in Latin-1>" was an internal
+    error after the run was saved.  The caller's error handler is put back after."""
+    from testbed.core.atomic import FILE_NAME_ERRORS
+
+    stream = sys.stdout
+    errors = getattr(stream, "errors", None)
+    try:
+        stream.reconfigure(errors=FILE_NAME_ERRORS)
+    except (AttributeError, ValueError, OSError):  # not a TextIOWrapper, or closed
+        yield
+        return
+    try:
+        yield
+    finally:
+        with contextlib.suppress(AttributeError, ValueError, OSError):
+            stream.reconfigure(errors=errors)
 
 
 def _served(argv: list[str]) -> int | None:
