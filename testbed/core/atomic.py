@@ -6,6 +6,7 @@ write leaves no partial file behind.
 
 from __future__ import annotations
 
+import codecs
 import contextlib
 import errno
 import os
@@ -115,6 +116,39 @@ def atomic_write(path: str | os.PathLike, write: Callable[[str], None]) -> Path:
     return path
 
 
+#: The codec error handler of :func:`_file_name_bytes`: text naming files, encoded.
+FILE_NAME_ERRORS = "testbed.file_names"
+
+
+def _file_name_bytes(e: UnicodeError) -> tuple[bytes, int]:
+    """A codec error handler: a lone surrogate that stands for a byte of a file name is that
+    byte, anything else the encoding cannot write a backslash escape.
+
+    A file name whose bytes are not text in the locale's encoding (a folder named in Latin-1 on
+    a UTF-8 system; any non-ASCII name under ``LC_ALL=C`` with Python's UTF-8 mode off) reaches
+    Python as lone surrogates U+DC80..U+DCFF (``surrogateescape``), which strict UTF-8 cannot
+    write: `testbed run` in such a folder saved its run and then ended in an internal error
+    printing "run written to ..." or writing the runs' index page.  Written back as the bytes
+    they stand for, the name is the file system's own (as ``ls`` prints it)."""
+    if not isinstance(e, UnicodeEncodeError):
+        raise e
+    out = bytearray()
+    for c in e.object[e.start:e.end]:
+        code = ord(c)
+        out += bytes([code - 0xDC00]) if 0xDC80 <= code <= 0xDCFF else \
+            c.encode("ascii", "backslashreplace")
+    return bytes(out), e.end
+
+
+codecs.register_error(FILE_NAME_ERRORS, _file_name_bytes)
+
+
+def utf8_bytes(text: str) -> bytes:
+    """``text`` as UTF-8, a file name in it as the file system's bytes (:func:`_file_name_bytes`)."""
+    return text.encode("utf-8", FILE_NAME_ERRORS)
+
+
 def atomic_write_text(path: str | os.PathLike, text: str) -> Path:
-    """:func:`atomic_write` of ``text`` as UTF-8."""
-    return atomic_write(path, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))
+    """:func:`atomic_write` of ``text`` as UTF-8 (:func:`utf8_bytes`)."""
+    data = utf8_bytes(text)
+    return atomic_write(path, lambda tmp: Path(tmp).write_bytes(data))

@@ -79,7 +79,10 @@ def generator_code_hash(rig: str) -> str:
     root = Path(__file__).resolve().parents[2]
     h = hashlib.sha256()
     for f in generator_sources(rig):
-        h.update((f.relative_to(root) if f.is_relative_to(root) else f).as_posix().encode())
+        # the path's bytes as the file system holds them: .encode() (UTF-8) failed on a plugin
+        # at a non-ASCII path under a non-UTF-8 locale (an internal error), and would have
+        # hashed the same file differently under another locale
+        h.update(os.fsencode((f.relative_to(root) if f.is_relative_to(root) else f).as_posix()))
         h.update(f.read_bytes())
     return h.hexdigest()
 

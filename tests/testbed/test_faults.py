@@ -963,3 +963,39 @@ def test_a_signal_handled_in_time_is_not_ended_by_the_watchdog(tmp_path):
     r = subprocess.run([sys.executable, "-c", code], env=_env(), cwd=tmp_path, capture_output=True,
                        text=True, timeout=60)
     assert (r.returncode, r.stdout, r.stderr) == (0, "cleaned up\n", "")
+
+
+def test_a_run_under_a_folder_whose_name_is_not_utf8(fault_dir, tmp_path, monkeypatch, capsys):
+    # a folder named in Latin-1 on a UTF-8 system, or any non-ASCII name under a locale that is
+    # not UTF-8 (LC_ALL=C with Python's UTF-8 mode off): Python reads the name as lone
+    # surrogates, which UTF-8 cannot write: the plugin rig's source hash (the cache key), the
+    # run index and "run written to ..." on a strict UTF-8 standard output (a UTF-8 locale
+    # other than C.UTF-8, PYTHONIOENCODING=utf-8) were internal errors ("surrogates not
+    # allowed"), the run already saved.  The name is written as the file system's bytes.
+    import io
+
+    from testbed.cli import main
+    from testbed.pipeline.plugins import IDENTIFIERS, RIGS
+
+    folder = tmp_path / os.fsdecode(b"caf\xe9")
+    folder.mkdir()
+    # under names of its own: the module's plugin may be registered in this process already
+    (folder / "faults.py").write_text(PLUGIN.replace('"fault_', '"latin1_'))
+    (folder / "fault_a.toml").write_text(SCENARIO.replace('"fault_osc"', '"latin1_osc"')
+                                         + '[identify]\nmethod = "latin1_fit"\n')
+    out = folder / "runs"
+    stdout = io.TextIOWrapper(io.BytesIO(), encoding="utf-8", errors="strict")
+    monkeypatch.setattr(sys, "stdout", stdout)
+    saved = IDENTIFIERS.snapshot(), RIGS.snapshot()  # the plugin registers its names here
+    try:
+        code = main(["run", str(folder / "fault_a.toml"), "--plugin", str(folder / "faults.py"),
+                     "--no-figures", "--out", str(out), "--cache", str(folder / "cache")])
+    finally:
+        IDENTIFIERS.restore(saved[0])
+        RIGS.restore(saved[1])
+    assert code == 0, capsys.readouterr().err
+    assert stdout.errors == "strict"  # the caller's handler is put back
+    stdout.flush()
+    assert b"run written to " + os.fsencode(str(out)) in stdout.buffer.getvalue()
+    assert os.fsencode(str(out)) in (out / "index.html").read_bytes()
+    assert len(list((folder / "cache").glob("latin1_osc-*.h5"))) == 1
