@@ -972,6 +972,11 @@ def _main(argv: list[str] | None) -> int:
 def _run(args: argparse.Namespace) -> int:
     try:
         _env_folders()
+        if sys.stdout is None and args.command != "serve":  # `testbed run x >&-`
+            # (was an internal error, AttributeError 'NoneType' ... 'isatty'; `list` printed
+            # nothing with status 0; `serve` writes nothing there and runs as before)
+            raise InputError("standard output is closed (file descriptor 1); give the command "
+                             "somewhere to write (> /dev/null to discard what it prints)")
         return args.fn(args)
     except TestbedError as e:
         print(f"error: {_one_line(e)}", file=sys.stderr)
@@ -986,7 +991,7 @@ def _run(args: argparse.Namespace) -> int:
             FileExistsError) as e:  # a path the user gave (an output folder, a file)
         if args.debug:
             raise
-        print(f"error: {_one_line(e)}", file=sys.stderr)
+        print(f"error: {_one_line(_no_cwd(e) or e)}", file=sys.stderr)
         return EXIT_USAGE
     except KeyboardInterrupt as e:
         return _interrupted(e)
@@ -994,8 +999,47 @@ def _run(args: argparse.Namespace) -> int:
         _quiet_stdout()
         return EXIT_BROKEN_PIPE
     except Exception as e:
+        if isinstance(e, OSError) and _stdout_failed(e):
+            print(f"error: cannot write to standard output: {e.strerror} (a full disk or "
+                  "/dev/full, or a file descriptor not open for writing)", file=sys.stderr)
+            _quiet_stdout()
+            return EXIT_USAGE
         interrupt = _interrupt_within(e)
         return _internal(e, args) if interrupt is None else _interrupted(interrupt)
+
+
+def _no_cwd(e: OSError) -> str | None:
+    """The message for ``e`` if it is the current folder that is gone (deleted while the shell
+    stayed in it: ``os.getcwd()`` fails), else None.  It read "[Errno 2] No such file or
+    directory", naming nothing, for a relative path or a default folder (the cache, ``out``)."""
+    if not isinstance(e, FileNotFoundError) or e.filename is not None:
+        return None
+    try:
+        os.getcwd()
+    except FileNotFoundError:
+        return ("the current folder no longer exists (deleted?); cd to a folder that exists, "
+                "or give absolute paths and --out/--cache")
+    return None
+
+
+#: errno values of a write to standard output that cannot succeed: no room (a full disk,
+#: /dev/full, a quota, `ulimit -f`), a descriptor not open for writing (``1</dev/null``), or
+#: a device error.
+STDOUT_WRITE_ERRNOS = (errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EBADF, errno.EIO)
+
+
+def _stdout_failed(e: OSError) -> bool:
+    """Whether ``e`` (naming no file) is standard output refusing its writes: a write of zero
+    bytes to it fails too (``/dev/full``, a descriptor not open for writing), or it is a file
+    on a disk without room.  Was an internal error ("please report it") for
+    `testbed list > /dev/full` or `testbed run ... 1</dev/null`."""
+    if e.filename is not None or e.errno not in STDOUT_WRITE_ERRNOS:
+        return False
+    try:
+        os.write(1, b"")
+        return e.errno in (errno.ENOSPC, errno.EDQUOT, errno.EFBIG) and stat.S_ISREG(os.fstat(1).st_mode)
+    except OSError:
+        return True
 
 
 def _interrupted(e: KeyboardInterrupt) -> int:

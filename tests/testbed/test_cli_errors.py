@@ -335,3 +335,46 @@ def test_an_interrupt_while_the_options_are_parsed_is_one_line(monkeypatch, caps
     monkeypatch.setattr(cli, "build_parser", build_parser)
     assert main(["list"]) == cli.EXIT_INTERRUPTED
     assert one_error_line(capsys.readouterr().err) == "error: interrupted"
+
+
+# ------------------------------------------------------------------ round 6: hostile stdio, cwd
+@pytest.mark.parametrize(("redirect", "reason"), [
+    ({"stdout": "/dev/full"}, "No space left on device"),
+    ({"stdout_mode": os.O_RDONLY}, "Bad file descriptor"),  # `testbed ... 1</dev/null`
+], ids=["dev-full", "read-only"])
+def test_a_standard_output_that_refuses_writes_is_one_line(tmp_path, redirect, reason):
+    # an internal error ("OSError: [Errno 28] ... please report it") before
+    fd = os.open(redirect.get("stdout", os.devnull), redirect.get("stdout_mode", os.O_WRONLY))
+    try:
+        r = subprocess.run([sys.executable, "-m", "testbed.cli", "cache", "ls", "--cache", str(tmp_path)],
+                           cwd=ROOT, stdout=fd, stderr=subprocess.PIPE, text=True,
+                           env={**os.environ, "PYTHONPATH": str(ROOT), "TESTBED_NO_SERVER": "1"},
+                           timeout=SUBPROCESS_TIMEOUT_S)
+    finally:
+        os.close(fd)
+    assert r.returncode == EXIT_USAGE, r.stderr
+    assert one_error_line(r.stderr) == (
+        f"error: cannot write to standard output: {reason} (a full disk or /dev/full, or a file "
+        "descriptor not open for writing)")
+
+
+def test_a_closed_standard_output_is_one_line(tmp_path, capsys, monkeypatch):
+    # `testbed run x >&-` was an internal error (AttributeError: 'NoneType' object has no
+    # attribute 'isatty'), `testbed list >&-` printed nothing with status 0
+    monkeypatch.setattr(sys, "stdout", None)
+    assert main(["cache", "ls", "--cache", str(tmp_path)]) == EXIT_USAGE
+    assert one_error_line(capsys.readouterr().err) == (
+        "error: standard output is closed (file descriptor 1); give the command somewhere to "
+        "write (> /dev/null to discard what it prints)")
+
+
+def test_a_deleted_current_folder_is_named(tmp_path, capsys, monkeypatch):
+    # "error: [Errno 2] No such file or directory", naming nothing, for the default cache
+    gone = tmp_path / "gone"
+    gone.mkdir()
+    monkeypatch.chdir(gone)
+    gone.rmdir()
+    assert main(["run", "michaelis_menten", "--no-figures"]) == EXIT_USAGE
+    assert one_error_line(capsys.readouterr().err) == (
+        "error: the current folder no longer exists (deleted?); cd to a folder that exists, or "
+        "give absolute paths and --out/--cache")
