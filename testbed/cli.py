@@ -28,7 +28,7 @@ from typing import Any
 from urllib.parse import urlsplit
 
 from testbed.core import interrupts  # armed on import by testbed/__init__.py, before this module
-from testbed.core.errors import InputError, ScenarioError, TestbedError
+from testbed.core.errors import InputError, ScenarioError, TestbedError, show_value
 
 EXIT_FAIL, EXIT_USAGE, EXIT_INTERNAL, EXIT_INTERRUPTED = 1, 2, 3, 130
 #: Status when the reader of standard output went away: a shell's for a command ended by SIGPIPE.
@@ -56,11 +56,12 @@ def _int_at_least(low: int, high: int | None = None) -> Callable[[str], int]:
         try:
             value = int(text)
         except ValueError:
-            raise argparse.ArgumentTypeError(f"expected an integer >= {low}, got {text!r}") from None
-        if value < low:
-            raise argparse.ArgumentTypeError(f"expected an integer >= {low}, got {value}")
+            raise argparse.ArgumentTypeError(f"expected an integer >= {low}, "
+                                             f"got {show_value(text)}") from None
+        if value < low:  # (each value cut: a 4,000-digit one made a 4 kB line)
+            raise argparse.ArgumentTypeError(f"expected an integer >= {low}, got {show_value(value)}")
         if high is not None and value > high:
-            raise argparse.ArgumentTypeError(f"expected an integer <= {high}, got {value}")
+            raise argparse.ArgumentTypeError(f"expected an integer <= {high}, got {show_value(value)}")
         return value
 
     return parse
@@ -267,12 +268,12 @@ def check_dask_address(address: str) -> None:
     except ValueError:
         host = port = None
     if parts.scheme not in ("tcp", "tls") or not host or port is None:
-        raise InputError(f"--dask {address!r}: expected a scheduler address tcp://host:port")
+        raise InputError(f"--dask {show_value(address)}: expected a scheduler address tcp://host:port")
     try:
         with socket.create_connection((host, port), timeout=DASK_CONNECT_TIMEOUT_S):
             pass
     except OSError as e:
-        raise InputError(f"--dask {address!r}: cannot reach a Dask scheduler there "
+        raise InputError(f"--dask {show_value(address)}: cannot reach a Dask scheduler there "
                          f"({e.strerror or type(e).__name__})") from None
 
 
@@ -451,7 +452,7 @@ def cmd_sweep(args: argparse.Namespace) -> int:
         if not args.dask:
             raise
         # the port answered but no scheduler served it (or it went away): the address is wrong
-        raise InputError(f"--dask {args.dask!r}: the Dask scheduler failed: "
+        raise InputError(f"--dask {show_value(args.dask)}: the Dask scheduler failed: "
                          f"{type(e).__name__}: {e}") from None
     print(f"results: {results}")
     return EXIT_FAIL if stats.failed_total else 0
@@ -497,15 +498,16 @@ def _key_values(items: list[str] | None, option: str, *, numbers: bool) -> dict:
     for item in items or []:
         key, sep, text = item.partition("=")
         if not sep or not key.strip():
-            raise InputError(f"{option} {item!r}: expected KEY=VALUE")
+            raise InputError(f"{option} {show_value(item)}: expected KEY=VALUE")
         try:
             value = tomllib.loads(f"v = {text}")["v"]
         except (tomllib.TOMLDecodeError, ValueError):  # ValueError: over 4300 digits
             value = text
         if numbers and (isinstance(value, bool) or not isinstance(value, (int, float))):
-            raise InputError(f"{option} {item!r}: the value must be a number")
+            raise InputError(f"{option} {show_value(item)}: the value must be a number")
         if key.strip() in out:  # the last one silently won
-            raise InputError(f"{option} {item!r}: {key.strip()} is given twice; give each key once")
+            raise InputError(f"{option} {show_value(item)}: {show_value(key.strip())[1:-1]} is given "
+                             "twice; give each key once")
         out[key.strip()] = float(value) if numbers else value
     return out
 
@@ -950,7 +952,7 @@ def _env_folders() -> None:
             continue
         st = _stat(Path(value), f"${var}") if value else None
         if st is None or not stat.S_ISDIR(st.st_mode):
-            raise InputError(f"${var} {value!r}: {'not a folder' if st else 'no such folder'}; "
+            raise InputError(f"${var} {show_value(value)}: {'not a folder' if st else 'no such folder'}; "
                              f"expected the folder of {what} files (unset it for the shipped ones)")
 
 

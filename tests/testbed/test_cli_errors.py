@@ -378,3 +378,26 @@ def test_a_deleted_current_folder_is_named(tmp_path, capsys, monkeypatch):
     assert one_error_line(capsys.readouterr().err) == (
         "error: the current folder no longer exists (deleted?); cd to a folder that exists, or "
         "give absolute paths and --out/--cache")
+
+
+@pytest.mark.parametrize("argv", [
+    ["sweep", "x.toml", "--jobs", "9" * 5000],   # not read: over Python's 4300 digits
+    ["sweep", "x.toml", "--jobs", "9" * 4000],   # read, and over the bound
+    ["run", "michaelis_menten", "--seed", "-" + "9" * 4000],
+], ids=["jobs-5000", "jobs-4000", "seed"])
+def test_an_option_value_of_thousands_of_characters_is_cut_in_its_line(cli_in_process, tmp_path, argv):
+    # the value was printed whole: a 5 kB error line
+    r = cli_in_process(*argv, cwd=tmp_path)
+    assert r.returncode == EXIT_USAGE
+    line = one_error_line(r.stderr)
+    assert len(line) < 400 and "[...]" in line, line[:500]
+
+
+def test_key_values_and_a_dask_address_of_thousands_of_characters_are_cut():
+    from testbed.core.errors import InputError
+
+    for call in (lambda: cli._key_values(["m=" + "9" * 5000], "--prior", numbers=True),
+                 lambda: cli.check_dask_address("x" * 5000)):
+        with pytest.raises(InputError) as e:
+            call()
+        assert len(str(e.value)) < 300 and "[...]" in str(e.value), str(e.value)[:500]
