@@ -999,3 +999,31 @@ def test_a_run_under_a_folder_whose_name_is_not_utf8(fault_dir, tmp_path, monkey
     assert b"run written to " + os.fsencode(str(out)) in stdout.buffer.getvalue()
     assert os.fsencode(str(out)) in (out / "index.html").read_bytes()
     assert len(list((folder / "cache").glob("latin1_osc-*.h5"))) == 1
+
+
+def test_a_cache_folder_that_cannot_be_written_still_serves_and_the_run_goes_on(tmp_path, monkeypatch,
+                                                                                caplog):
+    # a read-only --cache (a shared, pre-filled one; or the default .cache under a read-only
+    # current folder) ended a run after its simulation in "error: [Errno 13] Permission denied:
+    # '<cache>/.<entry>.h5.<random>.tmp'"; the datasets it holds are read as before
+    import errno as errno_
+
+    from testbed.pipeline import cache as cache_mod
+
+    sc = _short()
+    filled = DatasetCache(tmp_path / "filled")
+    held = filled.get(sc)
+
+    def refused(self, path):
+        raise PermissionError(errno_.EACCES, "Permission denied", str(path))
+
+    monkeypatch.setattr(Dataset, "save", refused)
+    monkeypatch.setattr(cache_mod, "_UNWRITABLE_WARNED", set())
+    _assert_same_data(filled.get(sc), held)  # held: read, nothing written
+    ro = DatasetCache(tmp_path / "ro")
+    with caplog.at_level(logging.WARNING, logger="testbed.pipeline.cache"):
+        _assert_same_data(ro.get(sc), held)
+        _assert_same_data(ro.get(sc.with_noise(1.0)), filled.get(sc.with_noise(1.0)))
+    assert [r.getMessage() for r in caplog.records] == [
+        f"dataset cache {tmp_path / 'ro'}: cannot be written (Permission denied); datasets it "
+        "lacks are simulated and not cached (--cache names another folder)"]  # once a folder
