@@ -67,6 +67,15 @@ def _int_at_least(low: int, high: int | None = None) -> Callable[[str], int]:
     return parse
 
 
+def _path_text(text: str) -> str:
+    """An argparse type for a path option: any text but the empty one, which names the current
+    folder: `run --out ""` wrote its run and index among the user's files, `--cache ""` its
+    datasets (a script's `--out "$DIR"` with the variable unset)."""
+    if not text:
+        raise argparse.ArgumentTypeError("an empty path; expected a file or folder name")
+    return text
+
+
 def _seed(text: str) -> int:
     """A noise seed: an integer >= 0 (numpy's generators take no negative seeds) that fits the
     64-bit integers datasets and results store, as a scenario's ``seed``
@@ -194,13 +203,39 @@ def _cache_folder(cache: str | None) -> str | None:
     existing file."""
     from testbed.pipeline.cache import default_cache_dir
 
+    if cache is None and os.environ.get("TESTBED_CACHE") == "":
+        # Path("") is the current folder: cache entries were written among the user's files
+        # (`--cache ""` is refused by its option's type, :func:`_path_text`)
+        raise InputError("$TESTBED_CACHE '': an empty path; expected the dataset cache folder "
+                         "(unset it for the default)")
     if cache is not None and _is_not_folder(Path(cache), "--cache"):
         raise InputError(f"--cache {cache}: not a folder")
     if cache is None and _is_not_folder(default_cache_dir(), "$TESTBED_CACHE"):
         where = "$TESTBED_CACHE" if os.environ.get("TESTBED_CACHE") else "the default cache"
         raise InputError(f"{where} {default_cache_dir()}: not a folder; expected the dataset "
                          "cache folder")
+    path = Path(cache) if cache is not None else default_cache_dir()
+    where = "--cache" if cache is not None else (
+        "$TESTBED_CACHE" if os.environ.get("TESTBED_CACHE") else "the default cache")
+    _creatable_folder(path, where)
     return cache
+
+
+def _creatable_folder(path: Path, where: str) -> None:
+    """Refuse a folder that is missing and cannot be created: a symbolic link to nothing, or
+    a file on its way.  Each was an OSError naming no option ("[Errno 17] File exists",
+    "[Errno 20] Not a directory") after the simulation."""
+    if path.is_dir():
+        return
+    if path.is_symlink():
+        raise InputError(f"{where} {path}: a symbolic link to {os.readlink(path)}, which does not "
+                         "exist; expected the dataset cache folder")
+    folder = path.parent
+    while not folder.exists() and folder != folder.parent:
+        folder = folder.parent
+    if not folder.is_dir():
+        raise InputError(f"{where} {path}: {folder} is a file, not a folder; expected the dataset "
+                         "cache folder")
 
 
 def _dataset_file(path: Path) -> Path:
@@ -658,27 +693,30 @@ def build_parser() -> argparse.ArgumentParser:
     sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
     ls = sub.add_parser("list", help="registered rigs, identifiers (with where each came from) and "
                                      "scenarios")
-    ls.add_argument("--plugin", action="append", metavar="FILE.py", help=plugin_help)
+    ls.add_argument("--plugin", action="append", metavar="FILE.py", type=_path_text, help=plugin_help)
     ls.add_argument("--plain", action="store_true",
                     help="tab-separated lines, nothing cut (the default when not a terminal)")
     ls.set_defaults(fn=cmd_list)
 
     g = sub.add_parser("generate", help="simulate a scenario and write its dataset (HDF5)")
     g.add_argument("scenario", help="scenario name or .toml path")
-    g.add_argument("-o", "--output", help="output file (default <scenario>-seed<N>.h5)")
+    g.add_argument("-o", "--output", type=_path_text, help="output file (default <scenario>-seed<N>.h5)")
     g.add_argument("--seed", type=_seed, help="override the scenario's seed")
-    g.add_argument("--cache", help="dataset cache folder it also fills (default .cache/datasets)")
+    g.add_argument("--cache", type=_path_text,
+                   help="dataset cache folder it also fills (default .cache/datasets)")
     g.add_argument("--no-cache", action="store_true", help="generate afresh, fill no cache")
     g.set_defaults(fn=cmd_generate)
 
     r = sub.add_parser("run", help="generate or reuse data, identify, score, write figures")
     r.add_argument("scenario", nargs="+", help="scenario names or .toml paths")
-    r.add_argument("-o", "--out", default="out/runs", help="folder for run results (default out/runs)")
+    r.add_argument("-o", "--out", default="out/runs", type=_path_text,
+                   help="folder for run results (default out/runs)")
     r.add_argument("--seed", type=_seed, help="override the scenario's seed")
-    r.add_argument("--cache", help="dataset cache folder (default .cache/datasets or $TESTBED_CACHE)")
+    r.add_argument("--cache", type=_path_text,
+                   help="dataset cache folder (default .cache/datasets or $TESTBED_CACHE)")
     r.add_argument("--no-cache", action="store_true", help="generate afresh, store nothing")
     r.add_argument("--no-figures", action="store_true", help="skip the figures")
-    r.add_argument("--plugin", action="append", metavar="FILE.py", help=plugin_help)
+    r.add_argument("--plugin", action="append", metavar="FILE.py", type=_path_text, help=plugin_help)
     r.set_defaults(fn=cmd_run)
 
     i = sub.add_parser("identify", help="fit an identifier to measured data from a file (no truth "
@@ -700,14 +738,15 @@ def build_parser() -> argparse.ArgumentParser:
                    help="declared prior knowledge in SI units, e.g. total_mass=0.7 [kg] (repeatable)")
     i.add_argument("--format", choices=("uff", "sep005", "csv", "hdf5"),
                    help="file format (default from the suffix)")
-    i.add_argument("-o", "--output", help="JSON file of the fitted model (default <data>.model.json)")
-    i.add_argument("--plugin", action="append", metavar="FILE.py", help=plugin_help)
+    i.add_argument("-o", "--output", type=_path_text,
+                   help="JSON file of the fitted model (default <data>.model.json)")
+    i.add_argument("--plugin", action="append", metavar="FILE.py", type=_path_text, help=plugin_help)
     i.set_defaults(fn=cmd_identify)
 
     rep = sub.add_parser("report", help="HTML + markdown report of a run folder or sweep results")
     rep.add_argument("source", help="a run folder (from `testbed run`), a scenario's folder of runs "
                                     "or a scenario name (its latest run), or a sweep results file")
-    rep.add_argument("-o", "--output", required=True, help="report folder")
+    rep.add_argument("-o", "--output", required=True, type=_path_text, help="report folder")
     rep.add_argument("--runs", default="out/runs",
                      help="where a scenario name's runs are (default out/runs)")
     rep.set_defaults(fn=cmd_report)
@@ -716,17 +755,17 @@ def build_parser() -> argparse.ArgumentParser:
     e.add_argument("dataset", help="dataset .h5 file")
     e.add_argument("--format", required=True, choices=("uff", "sep005"),
                    help="uff: UFF58 time records + UFF55 true modes; sep005: SEP-005 channels as JSON")
-    e.add_argument("-o", "--output", help="output file (default next to the dataset)")
+    e.add_argument("-o", "--output", type=_path_text, help="output file (default next to the dataset)")
     e.set_defaults(fn=cmd_export)
 
     s = sub.add_parser("sweep", help="run a method-comparison study (scenarios x noise x seeds x methods)")
     s.add_argument("study", help="study .toml file")
     s.add_argument("--jobs", type=_jobs, default=1, help="parallel worker processes (joblib loky)")
     s.add_argument("--dask", help="dask.distributed scheduler address (runs through joblib's dask backend)")
-    s.add_argument("--results", help="results file (default out/studies/<study>.parquet)")
-    s.add_argument("--cache", help="dataset cache folder")
+    s.add_argument("--results", type=_path_text, help="results file (default out/studies/<study>.parquet)")
+    s.add_argument("--cache", type=_path_text, help="dataset cache folder")
     s.add_argument("--retry-failed", action="store_true", help="run the cells recorded as failed again")
-    s.add_argument("--plugin", action="append", metavar="FILE.py", help=plugin_help)
+    s.add_argument("--plugin", action="append", metavar="FILE.py", type=_path_text, help=plugin_help)
     s.set_defaults(fn=cmd_sweep)
 
     sm = sub.add_parser("summary", help="median, spread and pass rate per identifier and noise level")
@@ -739,25 +778,28 @@ def build_parser() -> argparse.ArgumentParser:
     fam = sub.add_parser("family", help="write the members of a study's scenario families")
     fam.add_argument("action", choices=("write",), help="write: one scenario file per member")
     fam.add_argument("study", help="study name or .toml path declaring [families.<name>]")
-    fam.add_argument("-o", "--out", required=True, help="folder for the member scenario files")
+    fam.add_argument("-o", "--out", required=True, type=_path_text,
+                     help="folder for the member scenario files")
     fam.add_argument("--family", help="only this family (default: every family of the study)")
     fam.set_defaults(fn=cmd_family)
 
     c = sub.add_parser("cache", help="list or clear the dataset cache")
     c.add_argument("action", choices=("ls", "clear"), help="ls: list the datasets; clear: delete them")
-    c.add_argument("--cache", help="dataset cache folder (default .cache/datasets or $TESTBED_CACHE)")
+    c.add_argument("--cache", type=_path_text,
+                   help="dataset cache folder (default .cache/datasets or $TESTBED_CACHE)")
 
     rs = sub.add_parser("runs", help="list the runs saved by `testbed run` (the run history)")
     rs.add_argument("action", choices=("ls",), help="ls: one row per run, oldest first")
     rs.add_argument("scenario", nargs="?", help="only the runs of this scenario")
-    rs.add_argument("-o", "--out", default=None, help="folder of the runs (default out/runs)")
+    rs.add_argument("-o", "--out", default=None, type=_path_text,
+                    help="folder of the runs (default out/runs)")
     rs.add_argument("--plain", action="store_true",
                     help="tab-separated lines, nothing cut (the default when not a terminal)")
     rs.set_defaults(fn=cmd_runs)
     c.set_defaults(fn=cmd_cache)
 
     d = sub.add_parser("demo", help="the main job: scored scenario runs and their report")
-    d.add_argument("--out", default="out/demo", help="output folder (default out/demo)")
+    d.add_argument("--out", default="out/demo", type=_path_text, help="output folder (default out/demo)")
     d.set_defaults(fn=cmd_demo)
 
     sv = sub.add_parser("serve", help="keep the libraries loaded: later commands fork from this process "

@@ -401,3 +401,42 @@ def test_key_values_and_a_dask_address_of_thousands_of_characters_are_cut():
         with pytest.raises(InputError) as e:
             call()
         assert len(str(e.value)) < 300 and "[...]" in str(e.value), str(e.value)[:500]
+
+
+@pytest.mark.parametrize("argv", [
+    ["run", "michaelis_menten", "--out", ""],      # wrote the run and index.html in the cwd
+    ["run", "michaelis_menten", "--cache", ""],    # wrote the datasets in the cwd
+    ["runs", "ls", "--out", ""],
+    ["sweep", "x.toml", "--results", ""],
+    ["generate", "michaelis_menten", "-o", ""],
+    ["cache", "clear", "--cache", ""],
+    ["run", "michaelis_menten", "--plugin", ""],
+], ids=lambda a: f"{a[0]} {a[-2]}")
+def test_an_empty_path_option_is_refused(cli_in_process, tmp_path, argv):
+    r = cli_in_process(*argv, cwd=tmp_path)
+    assert r.returncode == EXIT_USAGE
+    assert "an empty path; expected a file or folder name" in one_error_line(r.stderr)
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize(("make", "fragment"), [
+    (lambda d: (d / "c").symlink_to(d / "nowhere"),
+     "c: a symbolic link to {d}/nowhere, which does not exist"),
+    (lambda d: (d / "f").write_text(""), "f/c: {d}/f is a file, not a folder"),
+    (lambda d: None, None),
+], ids=["dangling-link", "file-on-the-way", "empty-env"])
+def test_a_cache_folder_that_cannot_be_made_is_named(cli_in_process, tmp_path, monkeypatch, make, fragment):
+    # "[Errno 17] File exists" and "[Errno 20] Not a directory", naming no option, after the
+    # simulation; TESTBED_CACHE="" wrote the datasets in the current folder
+    make(tmp_path)
+    if fragment is None:
+        monkeypatch.setenv("TESTBED_CACHE", "")
+        argv, expected = [], ("error: $TESTBED_CACHE '': an empty path; expected the dataset cache "
+                              "folder (unset it for the default)")
+    else:
+        cache = tmp_path / ("c" if "link" in fragment else "f/c")
+        argv = ["--cache", str(cache)]
+        expected = (f"error: --cache {tmp_path}/{fragment.format(d=tmp_path)}; expected the dataset "
+                    "cache folder")
+    r = cli_in_process("cache", "ls", *argv, cwd=tmp_path)
+    assert (r.returncode, one_error_line(r.stderr)) == (EXIT_USAGE, expected)
