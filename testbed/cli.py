@@ -360,10 +360,11 @@ def cmd_list(args: argparse.Namespace) -> int:
             for r in rows:
                 print("\t".join(r))
         return 0
-    from rich.console import Console
     from rich.table import Table
 
-    con = Console()
+    from testbed.reporting.console import make_console
+
+    con = make_console()
     for title, cols, rows in sections:
         t = Table(title=title)
         for c in cols:
@@ -638,8 +639,9 @@ def cmd_runs(args: argparse.Namespace) -> int:
         for row in rows:
             print("\t".join(row))
         return 0
-    from rich.console import Console
     from rich.table import Table
+
+    from testbed.reporting.console import make_console
 
     # a terminal: the run's folder name, not its whole path (the title says where it is)
     t = Table(title=f"{len(runs)} run(s), oldest first; folders {Path(args.out) / '<scenario>' / '<run>'}")
@@ -648,7 +650,7 @@ def cmd_runs(args: argparse.Namespace) -> int:
     for r, row in zip(runs, rows, strict=True):
         t.add_row(*row[:-1], r["path"].name if r["path"].parent.name == r["scenario"]
                   else str(r["path"]))
-    Console().print(t)
+    make_console().print(t)
     return 0
 
 

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from rich.console import Console
@@ -14,6 +14,21 @@ from testbed.scoring.scorers import FAIL, PASS
 if TYPE_CHECKING:
     from testbed.core.dataset import Dataset
     from testbed.scoring.run import RunResult
+
+#: Narrowest terminal a table is drawn for [columns]; a narrower reported width is taken for
+#: rich's own default (80).  A terminal reporting 0 columns (``COLUMNS=0``, a pseudo-terminal
+#: never given a size) made rich draw nothing: `testbed run` printed its run folder without
+#: its score table or verdict.  No real terminal is narrower than the verdict line.
+MIN_CONSOLE_WIDTH = 20
+
+
+def make_console(**kwargs: Any) -> Console:
+    """A rich Console for tables (``kwargs`` as rich's), at least :data:`MIN_CONSOLE_WIDTH`
+    columns wide."""
+    console = Console(**kwargs)
+    if console.width < MIN_CONSOLE_WIDTH:
+        console = Console(**{**kwargs, "width": 80})
+    return console
 
 def truth_rows(ds: Dataset) -> list[tuple[str, str]]:
     """(label, value) pairs summarising a dataset's truth (its kind's typed truth; a dataset
@@ -45,7 +60,7 @@ def print_truth_summary(ds: Dataset, console: Console | None = None) -> None:
     t.add_column("")
     for a, b in truth_rows(ds):
         t.add_row(a, b)
-    (console or Console()).print(t)
+    (console or make_console()).print(t)
 
 
 def verdict_line(verdict: str, failure: str | None, n_checks: int) -> str:
@@ -94,4 +109,4 @@ def print_score_table(result: RunResult, console: Console | None = None) -> None
         t.add_row(f"[red]failure: {k}[/]", escape(why), "-", "[red]FAIL[/]")
     if not result.checks:
         t.add_row("[yellow]thresholds[/]", "none declared", "-", "[yellow]no verdict[/]")
-    (console or Console()).print(t)
+    (console or make_console()).print(t)

@@ -166,10 +166,11 @@ def print_summary(path: str | os.PathLike, console: Any = None,
     ``[q25, q75]``), plus the cell count, failures, pass rate (over judged cells) and the
     failure reasons counted; then the first errors of failed cells.
     """
-    from rich.console import Console
     from rich.table import Table
 
-    console = console or Console()
+    from testbed.reporting.console import make_console
+
+    console = console or make_console()
     path = Path(path)
     rows = read_results(path)
     summary = summarize(path, rows, by=by)
