@@ -16,19 +16,16 @@ session importing the library keeps Python's own handling, and so does a signal 
 set to be ignored (``nohup``, a shell's background job).  What comes before the first line of
 the testbed's code (the interpreter's start and its ``site`` import, 0.02-0.1 s) is Python's
 own and stays so.
+
+The module imports nothing beyond ``os``, ``signal`` and ``sys`` (loaded with the
+interpreter) before it arms: each further import is a window for a traceback.
 """
 
 from __future__ import annotations
 
 import os
 import signal
-import socket
 import sys
-import threading
-from collections.abc import Iterator
-from contextlib import contextmanager
-
-from testbed.core.atomic import remove_in_flight
 
 #: Signals so handled, each with its exit status: a shell's for Ctrl-C (130), 128 + the
 #: signal's number for the two that end a program (``kill``, a closed terminal).
@@ -54,7 +51,9 @@ def exit_now(signum: int) -> None:
     Written with ``os.write`` (no buffered stream: the signal may land inside a ``print``) and
     ended with ``os._exit`` (no Python code of a half-imported module, of the interpreter's
     shutdown or of a stuck main thread runs again)."""
-    remove_in_flight()
+    atomic = sys.modules.get("testbed.core.atomic")  # not imported yet: nothing is being written
+    if atomic is not None:
+        atomic.remove_in_flight()
     line = "interrupted" if signum == signal.SIGINT else \
         f"interrupted by {signal.Signals(signum).name}"
     try:
@@ -94,6 +93,9 @@ def arm() -> None:
     armed = True
 
 
+arm()  # on import: the package testbed imports this module before anything else
+
+
 def disarm() -> None:
     """Give the command its signals back as Python has them (Ctrl-C raises KeyboardInterrupt,
     SIGTERM and SIGHUP their default action): :func:`testbed.cli.main` handles them itself."""
@@ -119,6 +121,9 @@ class _Watchdog:
     (:func:`exit_now`) if the signal's Python handler has not run :data:`GRACE_S` later."""
 
     def __init__(self, signums: tuple[int, ...]) -> None:
+        import socket
+        import threading
+
         self.signums = frozenset(int(s) for s in signums)
         self.handled = threading.Event()
         self._read, self._write = socket.socketpair()
@@ -147,33 +152,40 @@ class _Watchdog:
             exit_now(ours[-1])
 
     def stop(self) -> None:
+        import socket
+
         signal.set_wakeup_fd(self.previous)
         self._write.close()
         self._read.shutdown(socket.SHUT_RDWR)  # wakes the thread's recv
         self._read.close()
 
 
-@contextmanager
-def watchdog(signums: tuple[int, ...]) -> Iterator[threading.Event | None]:
+def watchdog(signums: tuple[int, ...]) -> object:
     """While the block runs, a :class:`_Watchdog` of ``signums``; yields the event their Python
     handlers must set when they run (None where there is no watchdog: not the main thread, or
     a caller's own wakeup fd, which stays).
 
     For the console program only: the watchdog ends the process, which in a caller's Python
-    session would end that session."""
-    if threading.current_thread() is not threading.main_thread():
-        yield None
-        return
-    previous = signal.set_wakeup_fd(-1)
-    if previous != -1:
-        signal.set_wakeup_fd(previous)
-        yield None
-        return
-    dog = _Watchdog(signums)
-    try:
-        yield dog.handled
-    finally:
-        dog.stop()
+    session would end that session.  (A context manager; its imports wait for its first use.)"""
+    import contextlib
+    import threading
+    from collections.abc import Iterator
 
+    @contextlib.contextmanager
+    def run() -> Iterator[threading.Event | None]:
+        if threading.current_thread() is not threading.main_thread():
+            yield None
+            return
+        previous = signal.set_wakeup_fd(-1)
+        if previous != -1:
+            signal.set_wakeup_fd(previous)
+            yield None
+            return
+        dog = _Watchdog(signums)
+        try:
+            yield dog.handled
+        finally:
+            dog.stop()
 
-arm()  # on import: the package testbed imports this module before anything else
+    return run()
+
