@@ -17,19 +17,22 @@ set to be ignored (``nohup``, a shell's background job).  What comes before the 
 the testbed's code (the interpreter's start and its ``site`` import, 0.02-0.1 s) is Python's
 own and stays so.
 
-The module imports nothing beyond ``os``, ``signal`` and ``sys`` (loaded with the
-interpreter) before it arms: each further import is a window for a traceback.
+The module imports nothing but ``os``, ``sys`` and ``_signal`` (loaded with the interpreter)
+before it arms: each further import is a window for a traceback.  ``_signal`` is the C module
+under ``signal``, whose own import (an enum conversion of every signal) was such a window.
 """
 
 from __future__ import annotations
 
+import _signal as signal  # not `signal`: see above
 import os
-import signal
 import sys
 
 #: Signals so handled, each with its exit status: a shell's for Ctrl-C (130), 128 + the
 #: signal's number for the two that end a program (``kill``, a closed terminal).
 STATUS = {signal.SIGINT: 130, signal.SIGTERM: 128 + signal.SIGTERM, signal.SIGHUP: 128 + signal.SIGHUP}
+
+NAMES = {signal.SIGINT: "SIGINT", signal.SIGTERM: "SIGTERM", signal.SIGHUP: "SIGHUP"}
 
 #: True once :func:`arm` armed this process (the console program).
 armed = False
@@ -54,8 +57,7 @@ def exit_now(signum: int) -> None:
     atomic = sys.modules.get("testbed.core.atomic")  # not imported yet: nothing is being written
     if atomic is not None:
         atomic.remove_in_flight()
-    line = "interrupted" if signum == signal.SIGINT else \
-        f"interrupted by {signal.Signals(signum).name}"
+    line = "interrupted" if signum == signal.SIGINT else f"interrupted by {NAMES[signum]}"
     try:
         os.write(2, f"error: {line}\n".encode())
     except OSError:  # no standard error to write to: the status says it
@@ -86,7 +88,7 @@ def arm() -> None:
         return
     try:
         for s in STATUS:
-            if signal.getsignal(s) is _python_default(s):
+            if signal.getsignal(s) == _python_default(s):
                 signal.signal(s, _exit_now)
     except ValueError:  # not the main thread: signals are not this thread's to set
         return
@@ -102,7 +104,7 @@ def disarm() -> None:
     if not armed:
         return
     for s in STATUS:
-        if signal.getsignal(s) is _exit_now:
+        if signal.getsignal(s) == _exit_now:
             signal.signal(s, _python_default(s))
 
 
