@@ -887,11 +887,14 @@ def _terminate_as_interrupt(console: bool = False) -> Iterator[None]:
     the whole fit (28 s after a SIGTERM, measured) before the run said "interrupted"."""
     global _handled
     installed = {}
+    # the console program's own handler (testbed.core.interrupts, set while it imports) counts
+    # as the default here and is put back after: no moment is left with Python's handler alone
+    armed = interrupts.exit_at_once
     if threading.current_thread() is threading.main_thread():
         for s in (signal.SIGTERM, signal.SIGHUP):
-            if signal.getsignal(s) is signal.SIG_DFL:
+            if signal.getsignal(s) in (signal.SIG_DFL, armed):
                 installed[s] = signal.signal(s, _raise_terminated)
-        if console and signal.getsignal(signal.SIGINT) is signal.default_int_handler:
+        if console and signal.getsignal(signal.SIGINT) in (signal.default_int_handler, armed):
             installed[signal.SIGINT] = signal.signal(signal.SIGINT, _raise_interrupt)
     hook = sys.unraisablehook
     sys.unraisablehook = functools.partial(_redeliver_interrupt, hook)
@@ -934,7 +937,6 @@ def main(argv: list[str] | None = None) -> int:
     SIGTERM or SIGHUP)."""
     _blas_threads()
     try:
-        interrupts.disarm()  # the command handles its signals itself (below)
         if argv is None:  # the console program (not a call from Python): a resident server may run it
             status = _served(sys.argv[1:])
             if status is not None:
@@ -950,9 +952,6 @@ def main(argv: list[str] | None = None) -> int:
         # a Ctrl-C outside the command's own handling (while its options were parsed, in a
         # busy machine's first second) printed a 30-line traceback and ended by SIGINT (-2)
         return _interrupted(e)
-    finally:
-        if argv is None:  # the console program exits next: a signal now ends it at once
-            interrupts.arm()
 
 
 @contextlib.contextmanager

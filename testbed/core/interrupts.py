@@ -7,7 +7,9 @@ SIGTERM and SIGHUP 128 + their number).  Before it runs, the console program imp
 returns the interpreter shuts down; a Ctrl-C then printed Python's traceback (ending the
 process by SIGINT) or "Exception ignored in: <module 'threading'> ... KeyboardInterrupt" (the
 command ended with status 0).  This module makes those
-signals end the console program at once with the same line and status: nothing is written yet
+signals end the console program at once with the same line and status (:func:`exit_at_once`,
+the handler :func:`testbed.cli.main` replaces with its own while the command runs and puts back
+after): nothing is written yet
 (or everything is, at exit), so there is nothing to keep or clean up.  The package's
 ``__init__`` imports this module first, before its own imports and those of ``testbed.cli``.
 
@@ -65,7 +67,7 @@ def exit_now(signum: int) -> None:
     os._exit(STATUS[signum])
 
 
-def _exit_now(signum: int, frame: object) -> None:
+def exit_at_once(signum: int, frame: object) -> None:
     """The handler while armed: :func:`exit_now`, standard output flushed first (a finished
     command's table that sat in its buffer still reaches a pipe)."""
     for stream in (sys.stdout, sys.stderr):
@@ -89,7 +91,7 @@ def arm() -> None:
     try:
         for s in STATUS:
             if signal.getsignal(s) == _python_default(s):
-                signal.signal(s, _exit_now)
+                signal.signal(s, exit_at_once)
     except ValueError:  # not the main thread: signals are not this thread's to set
         return
     armed = True
@@ -98,22 +100,13 @@ def arm() -> None:
 arm()  # on import: the package testbed imports this module before anything else
 
 
-def disarm() -> None:
-    """Give the command its signals back as Python has them (Ctrl-C raises KeyboardInterrupt,
-    SIGTERM and SIGHUP their default action): :func:`testbed.cli.main` handles them itself."""
-    if not armed:
-        return
-    for s in STATUS:
-        if signal.getsignal(s) == _exit_now:
-            signal.signal(s, _python_default(s))
-
-
 
 #: Seconds the main thread has to start handling a signal (its Python handler runs) before
 #: the watchdog ends the process without it.  Python runs a handler between two bytecodes of
-#: the main thread: within milliseconds, except while the main thread is in one long call of
-#: compiled code that does not check for signals (a numba ``nogil`` kernel of an identifier ran
-#: 28 s after a SIGTERM; BLAS, zlib, MuJoCo's stepping), which is what this bounds.
+#: the main thread: in 26 SIGTERMs timed 0.5-11 s into runs of four shipped scenarios it ran
+#: within 0.36 s but once, when the main thread was in one long call of compiled code that
+#: does not check for signals (`sgd_sindy`'s numba ``nogil`` kernel: 30 s), which is what this
+#: bounds; 2 s is over five times the longest orderly delay measured.
 GRACE_S = 2.0
 
 

@@ -282,5 +282,5 @@ def test_importing_the_library_leaves_the_signals_as_python_has_them():
     from testbed.core import interrupts
 
     assert not interrupts._console_program()
-    assert signal.getsignal(signal.SIGINT) is not interrupts._exit_now
-    assert signal.getsignal(signal.SIGTERM) is not interrupts._exit_now
+    assert signal.getsignal(signal.SIGINT) is not interrupts.exit_at_once
+    assert signal.getsignal(signal.SIGTERM) is not interrupts.exit_at_once
