@@ -362,7 +362,7 @@ def cmd_list(args: argparse.Namespace) -> int:
         return 0
     from rich.table import Table
 
-    from testbed.reporting.console import make_console
+    from testbed.core.terminal import make_console
 
     con = make_console()
     for title, cols, rows in sections:
@@ -641,7 +641,7 @@ def cmd_runs(args: argparse.Namespace) -> int:
         return 0
     from rich.table import Table
 
-    from testbed.reporting.console import make_console
+    from testbed.core.terminal import make_console
 
     # a terminal: the run's folder name, not its whole path (the title says where it is)
     t = Table(title=f"{len(runs)} run(s), oldest first; folders {Path(args.out) / '<scenario>' / '<run>'}")

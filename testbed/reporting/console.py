@@ -2,12 +2,13 @@
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 import numpy as np
 from rich.console import Console
 from rich.table import Table
 
+from testbed.core.terminal import make_console
 from testbed.core.truth import DynamicalTruth, MechanicalTruth, StructuralTruth
 from testbed.scoring.scorers import FAIL, PASS
 
@@ -15,20 +16,6 @@ if TYPE_CHECKING:
     from testbed.core.dataset import Dataset
     from testbed.scoring.run import RunResult
 
-#: Narrowest terminal a table is drawn for [columns]; a narrower reported width is taken for
-#: rich's own default (80).  A terminal reporting 0 columns (``COLUMNS=0``, a pseudo-terminal
-#: never given a size) made rich draw nothing: `testbed run` printed its run folder without
-#: its score table or verdict.  No real terminal is narrower than the verdict line.
-MIN_CONSOLE_WIDTH = 20
-
-
-def make_console(**kwargs: Any) -> Console:
-    """A rich Console for tables (``kwargs`` as rich's), at least :data:`MIN_CONSOLE_WIDTH`
-    columns wide."""
-    console = Console(**kwargs)
-    if console.width < MIN_CONSOLE_WIDTH:
-        console = Console(**{**kwargs, "width": 80})
-    return console
 
 def truth_rows(ds: Dataset) -> list[tuple[str, str]]:
     """(label, value) pairs summarising a dataset's truth (its kind's typed truth; a dataset

@@ -30,6 +30,7 @@ from typing import Any
 
 import numpy as np
 
+from testbed.core.terminal import make_console
 from testbed.studies.family import family_of
 from testbed.studies.results import read_results, score_columns
 
@@ -168,7 +169,6 @@ def print_summary(path: str | os.PathLike, console: Any = None,
     """
     from rich.table import Table
 
-    from testbed.reporting.console import make_console
 
     console = console or make_console()
     path = Path(path)

@@ -410,7 +410,7 @@ def test_the_score_table_is_drawn_on_a_terminal_reporting_no_width(monkeypatch, 
     # drew nothing: `testbed run` printed "run written to ..." without its table or verdict
     import io
 
-    from testbed.reporting.console import make_console
+    from testbed.core.terminal import make_console
 
     monkeypatch.setenv("COLUMNS", columns)
     buf = io.StringIO()
