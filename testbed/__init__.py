@@ -14,6 +14,9 @@ The public Python API is the names below (``testbed.__all__``), imported on firs
 
 from __future__ import annotations
 
+# first of all: the `testbed` command's signals while it imports (testbed.core.interrupts)
+from testbed.core import interrupts as _interrupts  # noqa: F401  # isort: skip
+
 import importlib
 from typing import Any
 

@@ -27,7 +27,8 @@ from pathlib import Path
 from typing import Any
 from urllib.parse import urlsplit
 
-from testbed.core.errors import InputError, ScenarioError, TestbedError
+from testbed.core import interrupts  # armed on import by testbed/__init__.py, before this module
+from testbed.core.errors import InputError, ScenarioError, TestbedError, show_value
 
 EXIT_FAIL, EXIT_USAGE, EXIT_INTERNAL, EXIT_INTERRUPTED = 1, 2, 3, 130
 #: Status when the reader of standard output went away: a shell's for a command ended by SIGPIPE.
@@ -55,14 +56,24 @@ def _int_at_least(low: int, high: int | None = None) -> Callable[[str], int]:
         try:
             value = int(text)
         except ValueError:
-            raise argparse.ArgumentTypeError(f"expected an integer >= {low}, got {text!r}") from None
-        if value < low:
-            raise argparse.ArgumentTypeError(f"expected an integer >= {low}, got {value}")
+            raise argparse.ArgumentTypeError(f"expected an integer >= {low}, "
+                                             f"got {show_value(text)}") from None
+        if value < low:  # (each value cut: a 4,000-digit one made a 4 kB line)
+            raise argparse.ArgumentTypeError(f"expected an integer >= {low}, got {show_value(value)}")
         if high is not None and value > high:
-            raise argparse.ArgumentTypeError(f"expected an integer <= {high}, got {value}")
+            raise argparse.ArgumentTypeError(f"expected an integer <= {high}, got {show_value(value)}")
         return value
 
     return parse
+
+
+def _path_text(text: str) -> str:
+    """An argparse type for a path option: any text but the empty one, which names the current
+    folder: `run --out ""` wrote its run and index among the user's files, `--cache ""` its
+    datasets (a script's `--out "$DIR"` with the variable unset)."""
+    if not text:
+        raise argparse.ArgumentTypeError("an empty path; expected a file or folder name")
+    return text
 
 
 def _seed(text: str) -> int:
@@ -192,13 +203,39 @@ def _cache_folder(cache: str | None) -> str | None:
     existing file."""
     from testbed.pipeline.cache import default_cache_dir
 
+    if cache is None and os.environ.get("TESTBED_CACHE") == "":
+        # Path("") is the current folder: cache entries were written among the user's files
+        # (`--cache ""` is refused by its option's type, :func:`_path_text`)
+        raise InputError("$TESTBED_CACHE '': an empty path; expected the dataset cache folder "
+                         "(unset it for the default)")
     if cache is not None and _is_not_folder(Path(cache), "--cache"):
         raise InputError(f"--cache {cache}: not a folder")
     if cache is None and _is_not_folder(default_cache_dir(), "$TESTBED_CACHE"):
         where = "$TESTBED_CACHE" if os.environ.get("TESTBED_CACHE") else "the default cache"
         raise InputError(f"{where} {default_cache_dir()}: not a folder; expected the dataset "
                          "cache folder")
+    path = Path(cache) if cache is not None else default_cache_dir()
+    where = "--cache" if cache is not None else (
+        "$TESTBED_CACHE" if os.environ.get("TESTBED_CACHE") else "the default cache")
+    _creatable_folder(path, where)
     return cache
+
+
+def _creatable_folder(path: Path, where: str) -> None:
+    """Refuse a folder that is missing and cannot be created: a symbolic link to nothing, or
+    a file on its way.  Each was an OSError naming no option ("[Errno 17] File exists",
+    "[Errno 20] Not a directory") after the simulation."""
+    if path.is_dir():
+        return
+    if path.is_symlink():
+        raise InputError(f"{where} {path}: a symbolic link to {os.readlink(path)}, which does not "
+                         "exist; expected the dataset cache folder")
+    folder = path.parent
+    while not folder.exists() and folder != folder.parent:
+        folder = folder.parent
+    if not folder.is_dir():
+        raise InputError(f"{where} {path}: {folder} is a file, not a folder; expected the dataset "
+                         "cache folder")
 
 
 def _dataset_file(path: Path) -> Path:
@@ -266,12 +303,12 @@ def check_dask_address(address: str) -> None:
     except ValueError:
         host = port = None
     if parts.scheme not in ("tcp", "tls") or not host or port is None:
-        raise InputError(f"--dask {address!r}: expected a scheduler address tcp://host:port")
+        raise InputError(f"--dask {show_value(address)}: expected a scheduler address tcp://host:port")
     try:
         with socket.create_connection((host, port), timeout=DASK_CONNECT_TIMEOUT_S):
             pass
     except OSError as e:
-        raise InputError(f"--dask {address!r}: cannot reach a Dask scheduler there "
+        raise InputError(f"--dask {show_value(address)}: cannot reach a Dask scheduler there "
                          f"({e.strerror or type(e).__name__})") from None
 
 
@@ -323,10 +360,11 @@ def cmd_list(args: argparse.Namespace) -> int:
             for r in rows:
                 print("\t".join(r))
         return 0
-    from rich.console import Console
     from rich.table import Table
 
-    con = Console()
+    from testbed.core.terminal import make_console
+
+    con = make_console()
     for title, cols, rows in sections:
         t = Table(title=title)
         for c in cols:
@@ -450,7 +488,7 @@ def cmd_sweep(args: argparse.Namespace) -> int:
         if not args.dask:
             raise
         # the port answered but no scheduler served it (or it went away): the address is wrong
-        raise InputError(f"--dask {args.dask!r}: the Dask scheduler failed: "
+        raise InputError(f"--dask {show_value(args.dask)}: the Dask scheduler failed: "
                          f"{type(e).__name__}: {e}") from None
     print(f"results: {results}")
     return EXIT_FAIL if stats.failed_total else 0
@@ -496,15 +534,16 @@ def _key_values(items: list[str] | None, option: str, *, numbers: bool) -> dict:
     for item in items or []:
         key, sep, text = item.partition("=")
         if not sep or not key.strip():
-            raise InputError(f"{option} {item!r}: expected KEY=VALUE")
+            raise InputError(f"{option} {show_value(item)}: expected KEY=VALUE")
         try:
             value = tomllib.loads(f"v = {text}")["v"]
-        except tomllib.TOMLDecodeError:
+        except (tomllib.TOMLDecodeError, ValueError):  # ValueError: over 4300 digits
             value = text
         if numbers and (isinstance(value, bool) or not isinstance(value, (int, float))):
-            raise InputError(f"{option} {item!r}: the value must be a number")
+            raise InputError(f"{option} {show_value(item)}: the value must be a number")
         if key.strip() in out:  # the last one silently won
-            raise InputError(f"{option} {item!r}: {key.strip()} is given twice; give each key once")
+            raise InputError(f"{option} {show_value(item)}: {show_value(key.strip())[1:-1]} is given "
+                             "twice; give each key once")
         out[key.strip()] = float(value) if numbers else value
     return out
 
@@ -576,8 +615,9 @@ def cmd_runs(args: argparse.Namespace) -> int:
         for row in rows:
             print("\t".join(row))
         return 0
-    from rich.console import Console
     from rich.table import Table
+
+    from testbed.core.terminal import make_console
 
     # a terminal: the run's folder name, not its whole path (the title says where it is)
     t = Table(title=f"{len(runs)} run(s), oldest first; folders {Path(args.out) / '<scenario>' / '<run>'}")
@@ -586,7 +626,7 @@ def cmd_runs(args: argparse.Namespace) -> int:
     for r, row in zip(runs, rows, strict=True):
         t.add_row(*row[:-1], r["path"].name if r["path"].parent.name == r["scenario"]
                   else str(r["path"]))
-    Console().print(t)
+    make_console().print(t)
     return 0
 
 
@@ -631,27 +671,30 @@ def build_parser() -> argparse.ArgumentParser:
     sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
     ls = sub.add_parser("list", help="registered rigs, identifiers (with where each came from) and "
                                      "scenarios")
-    ls.add_argument("--plugin", action="append", metavar="FILE.py", help=plugin_help)
+    ls.add_argument("--plugin", action="append", metavar="FILE.py", type=_path_text, help=plugin_help)
     ls.add_argument("--plain", action="store_true",
                     help="tab-separated lines, nothing cut (the default when not a terminal)")
     ls.set_defaults(fn=cmd_list)
 
     g = sub.add_parser("generate", help="simulate a scenario and write its dataset (HDF5)")
     g.add_argument("scenario", help="scenario name or .toml path")
-    g.add_argument("-o", "--output", help="output file (default <scenario>-seed<N>.h5)")
+    g.add_argument("-o", "--output", type=_path_text, help="output file (default <scenario>-seed<N>.h5)")
     g.add_argument("--seed", type=_seed, help="override the scenario's seed")
-    g.add_argument("--cache", help="dataset cache folder it also fills (default .cache/datasets)")
+    g.add_argument("--cache", type=_path_text,
+                   help="dataset cache folder it also fills (default .cache/datasets)")
     g.add_argument("--no-cache", action="store_true", help="generate afresh, fill no cache")
     g.set_defaults(fn=cmd_generate)
 
     r = sub.add_parser("run", help="generate or reuse data, identify, score, write figures")
     r.add_argument("scenario", nargs="+", help="scenario names or .toml paths")
-    r.add_argument("-o", "--out", default="out/runs", help="folder for run results (default out/runs)")
+    r.add_argument("-o", "--out", default="out/runs", type=_path_text,
+                   help="folder for run results (default out/runs)")
     r.add_argument("--seed", type=_seed, help="override the scenario's seed")
-    r.add_argument("--cache", help="dataset cache folder (default .cache/datasets or $TESTBED_CACHE)")
+    r.add_argument("--cache", type=_path_text,
+                   help="dataset cache folder (default .cache/datasets or $TESTBED_CACHE)")
     r.add_argument("--no-cache", action="store_true", help="generate afresh, store nothing")
     r.add_argument("--no-figures", action="store_true", help="skip the figures")
-    r.add_argument("--plugin", action="append", metavar="FILE.py", help=plugin_help)
+    r.add_argument("--plugin", action="append", metavar="FILE.py", type=_path_text, help=plugin_help)
     r.set_defaults(fn=cmd_run)
 
     i = sub.add_parser("identify", help="fit an identifier to measured data from a file (no truth "
@@ -673,14 +716,15 @@ def build_parser() -> argparse.ArgumentParser:
                    help="declared prior knowledge in SI units, e.g. total_mass=0.7 [kg] (repeatable)")
     i.add_argument("--format", choices=("uff", "sep005", "csv", "hdf5"),
                    help="file format (default from the suffix)")
-    i.add_argument("-o", "--output", help="JSON file of the fitted model (default <data>.model.json)")
-    i.add_argument("--plugin", action="append", metavar="FILE.py", help=plugin_help)
+    i.add_argument("-o", "--output", type=_path_text,
+                   help="JSON file of the fitted model (default <data>.model.json)")
+    i.add_argument("--plugin", action="append", metavar="FILE.py", type=_path_text, help=plugin_help)
     i.set_defaults(fn=cmd_identify)
 
     rep = sub.add_parser("report", help="HTML + markdown report of a run folder or sweep results")
     rep.add_argument("source", help="a run folder (from `testbed run`), a scenario's folder of runs "
                                     "or a scenario name (its latest run), or a sweep results file")
-    rep.add_argument("-o", "--output", required=True, help="report folder")
+    rep.add_argument("-o", "--output", required=True, type=_path_text, help="report folder")
     rep.add_argument("--runs", default="out/runs",
                      help="where a scenario name's runs are (default out/runs)")
     rep.set_defaults(fn=cmd_report)
@@ -689,17 +733,17 @@ def build_parser() -> argparse.ArgumentParser:
     e.add_argument("dataset", help="dataset .h5 file")
     e.add_argument("--format", required=True, choices=("uff", "sep005"),
                    help="uff: UFF58 time records + UFF55 true modes; sep005: SEP-005 channels as JSON")
-    e.add_argument("-o", "--output", help="output file (default next to the dataset)")
+    e.add_argument("-o", "--output", type=_path_text, help="output file (default next to the dataset)")
     e.set_defaults(fn=cmd_export)
 
     s = sub.add_parser("sweep", help="run a method-comparison study (scenarios x noise x seeds x methods)")
     s.add_argument("study", help="study .toml file")
     s.add_argument("--jobs", type=_jobs, default=1, help="parallel worker processes (joblib loky)")
     s.add_argument("--dask", help="dask.distributed scheduler address (runs through joblib's dask backend)")
-    s.add_argument("--results", help="results file (default out/studies/<study>.parquet)")
-    s.add_argument("--cache", help="dataset cache folder")
+    s.add_argument("--results", type=_path_text, help="results file (default out/studies/<study>.parquet)")
+    s.add_argument("--cache", type=_path_text, help="dataset cache folder")
     s.add_argument("--retry-failed", action="store_true", help="run the cells recorded as failed again")
-    s.add_argument("--plugin", action="append", metavar="FILE.py", help=plugin_help)
+    s.add_argument("--plugin", action="append", metavar="FILE.py", type=_path_text, help=plugin_help)
     s.set_defaults(fn=cmd_sweep)
 
     sm = sub.add_parser("summary", help="median, spread and pass rate per identifier and noise level")
@@ -712,25 +756,28 @@ def build_parser() -> argparse.ArgumentParser:
     fam = sub.add_parser("family", help="write the members of a study's scenario families")
     fam.add_argument("action", choices=("write",), help="write: one scenario file per member")
     fam.add_argument("study", help="study name or .toml path declaring [families.<name>]")
-    fam.add_argument("-o", "--out", required=True, help="folder for the member scenario files")
+    fam.add_argument("-o", "--out", required=True, type=_path_text,
+                     help="folder for the member scenario files")
     fam.add_argument("--family", help="only this family (default: every family of the study)")
     fam.set_defaults(fn=cmd_family)
 
     c = sub.add_parser("cache", help="list or clear the dataset cache")
     c.add_argument("action", choices=("ls", "clear"), help="ls: list the datasets; clear: delete them")
-    c.add_argument("--cache", help="dataset cache folder (default .cache/datasets or $TESTBED_CACHE)")
+    c.add_argument("--cache", type=_path_text,
+                   help="dataset cache folder (default .cache/datasets or $TESTBED_CACHE)")
 
     rs = sub.add_parser("runs", help="list the runs saved by `testbed run` (the run history)")
     rs.add_argument("action", choices=("ls",), help="ls: one row per run, oldest first")
     rs.add_argument("scenario", nargs="?", help="only the runs of this scenario")
-    rs.add_argument("-o", "--out", default=None, help="folder of the runs (default out/runs)")
+    rs.add_argument("-o", "--out", default=None, type=_path_text,
+                    help="folder of the runs (default out/runs)")
     rs.add_argument("--plain", action="store_true",
                     help="tab-separated lines, nothing cut (the default when not a terminal)")
     rs.set_defaults(fn=cmd_runs)
     c.set_defaults(fn=cmd_cache)
 
     d = sub.add_parser("demo", help="the main job: scored scenario runs and their report")
-    d.add_argument("--out", default="out/demo", help="output folder (default out/demo)")
+    d.add_argument("--out", default="out/demo", type=_path_text, help="output folder (default out/demo)")
     d.set_defaults(fn=cmd_demo)
 
     sv = sub.add_parser("serve", help="keep the libraries loaded: later commands fork from this process "
@@ -786,25 +833,54 @@ class Terminated(KeyboardInterrupt):
         self.signum = signum
 
 
+#: Set by the handlers below when they run: the console program's signal watchdog
+#: (:func:`testbed.core.interrupts.watchdog`) ends the process if it is not set in time.
+_handled: threading.Event | None = None
+
+
 def _raise_terminated(signum: int, frame: object) -> None:
+    if _handled is not None:
+        _handled.set()
     raise Terminated(signum)
 
 
+def _raise_interrupt(signum: int, frame: object) -> None:
+    if _handled is not None:
+        _handled.set()
+    signal.default_int_handler(signum, frame)
+
+
 @contextlib.contextmanager
-def _terminate_as_interrupt() -> Iterator[None]:
+def _terminate_as_interrupt(console: bool = False) -> Iterator[None]:
     """SIGTERM and SIGHUP raise :class:`Terminated` while a command runs (only where their
     action is the default one and only in the main thread: a caller's own handlers stay), and
-    an interrupt Python could not raise is delivered again (:func:`_redeliver_interrupt`)."""
+    an interrupt Python could not raise is delivered again (:func:`_redeliver_interrupt`).
+
+    In the console program (``console``) a watchdog thread also ends the process in one line
+    if the main thread has not started handling Ctrl-C, SIGTERM or SIGHUP within
+    :data:`testbed.core.interrupts.GRACE_S`: Python runs a signal's handler only between two
+    bytecodes, and an identifier's numba kernel (compiled, ``nogil``) held the main thread for
+    the whole fit (28 s after a SIGTERM, measured) before the run said "interrupted"."""
+    global _handled
     installed = {}
+    # the console program's own handler (testbed.core.interrupts, set while it imports) counts
+    # as the default here and is put back after: no moment is left with Python's handler alone
+    armed = interrupts.exit_at_once
     if threading.current_thread() is threading.main_thread():
         for s in (signal.SIGTERM, signal.SIGHUP):
-            if signal.getsignal(s) is signal.SIG_DFL:
+            if signal.getsignal(s) in (signal.SIG_DFL, armed):
                 installed[s] = signal.signal(s, _raise_terminated)
+        if console and signal.getsignal(signal.SIGINT) in (signal.default_int_handler, armed):
+            installed[signal.SIGINT] = signal.signal(signal.SIGINT, _raise_interrupt)
     hook = sys.unraisablehook
     sys.unraisablehook = functools.partial(_redeliver_interrupt, hook)
     try:
-        yield
+        with (interrupts.watchdog(tuple(installed)) if console and installed
+              else contextlib.nullcontext()) as handled:
+            _handled = handled
+            yield
     finally:
+        _handled = None
         sys.unraisablehook = hook
         for s, handler in installed.items():
             signal.signal(s, handler)
@@ -844,7 +920,7 @@ def main(argv: list[str] | None = None) -> int:
         before = gc.get_threshold()
         gc.set_threshold(*GC_THRESHOLD)  # restored below: main() is also called from Python
         try:
-            with _terminate_as_interrupt():
+            with _terminate_as_interrupt(console=argv is None), _stdout_writes_file_names():
                 return _main(argv)
         finally:
             gc.set_threshold(*before)
@@ -852,6 +928,28 @@ def main(argv: list[str] | None = None) -> int:
         # a Ctrl-C outside the command's own handling (while its options were parsed, in a
         # busy machine's first second) printed a 30-line traceback and ended by SIGINT (-2)
         return _interrupted(e)
+
+
+@contextlib.contextmanager
+def _stdout_writes_file_names() -> Iterator[None]:
+    """Standard output writes a file name whose bytes are not text in its encoding as those
+    bytes (:func:`testbed.core.atomic._file_name_bytes`) while a command runs, instead of
+    raising UnicodeEncodeError: "run written to <a folder named in Latin-1>" was an internal
+    error after the run was saved.  The caller's error handler is put back after."""
+    from testbed.core.atomic import FILE_NAME_ERRORS
+
+    stream = sys.stdout
+    errors = getattr(stream, "errors", None)
+    try:
+        stream.reconfigure(errors=FILE_NAME_ERRORS)
+    except (AttributeError, ValueError, OSError):  # not a TextIOWrapper, or closed
+        yield
+        return
+    try:
+        yield
+    finally:
+        with contextlib.suppress(AttributeError, ValueError, OSError):
+            stream.reconfigure(errors=errors)
 
 
 def _served(argv: list[str]) -> int | None:
@@ -873,7 +971,7 @@ def _env_folders() -> None:
             continue
         st = _stat(Path(value), f"${var}") if value else None
         if st is None or not stat.S_ISDIR(st.st_mode):
-            raise InputError(f"${var} {value!r}: {'not a folder' if st else 'no such folder'}; "
+            raise InputError(f"${var} {show_value(value)}: {'not a folder' if st else 'no such folder'}; "
                              f"expected the folder of {what} files (unset it for the shipped ones)")
 
 
@@ -895,6 +993,11 @@ def _main(argv: list[str] | None) -> int:
 def _run(args: argparse.Namespace) -> int:
     try:
         _env_folders()
+        if sys.stdout is None and args.command != "serve":  # `testbed run x >&-`
+            # (was an internal error, AttributeError 'NoneType' ... 'isatty'; `list` printed
+            # nothing with status 0; `serve` writes nothing there and runs as before)
+            raise InputError("standard output is closed (file descriptor 1); give the command "
+                             "somewhere to write (> /dev/null to discard what it prints)")
         return args.fn(args)
     except TestbedError as e:
         print(f"error: {_one_line(e)}", file=sys.stderr)
@@ -909,7 +1012,7 @@ def _run(args: argparse.Namespace) -> int:
             FileExistsError) as e:  # a path the user gave (an output folder, a file)
         if args.debug:
             raise
-        print(f"error: {_one_line(e)}", file=sys.stderr)
+        print(f"error: {_one_line(_no_cwd(e) or e)}", file=sys.stderr)
         return EXIT_USAGE
     except KeyboardInterrupt as e:
         return _interrupted(e)
@@ -917,8 +1020,47 @@ def _run(args: argparse.Namespace) -> int:
         _quiet_stdout()
         return EXIT_BROKEN_PIPE
     except Exception as e:
+        if isinstance(e, OSError) and _stdout_failed(e):
+            print(f"error: cannot write to standard output: {e.strerror} (a full disk or "
+                  "/dev/full, or a file descriptor not open for writing)", file=sys.stderr)
+            _quiet_stdout()
+            return EXIT_USAGE
         interrupt = _interrupt_within(e)
         return _internal(e, args) if interrupt is None else _interrupted(interrupt)
+
+
+def _no_cwd(e: OSError) -> str | None:
+    """The message for ``e`` if it is the current folder that is gone (deleted while the shell
+    stayed in it: ``os.getcwd()`` fails), else None.  It read "[Errno 2] No such file or
+    directory", naming nothing, for a relative path or a default folder (the cache, ``out``)."""
+    if not isinstance(e, FileNotFoundError) or e.filename is not None:
+        return None
+    try:
+        os.getcwd()
+    except FileNotFoundError:
+        return ("the current folder no longer exists (deleted?); cd to a folder that exists, "
+                "or give absolute paths and --out/--cache")
+    return None
+
+
+#: errno values of a write to standard output that cannot succeed: no room (a full disk,
+#: /dev/full, a quota, `ulimit -f`), a descriptor not open for writing (``1</dev/null``), or
+#: a device error.
+STDOUT_WRITE_ERRNOS = (errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EBADF, errno.EIO)
+
+
+def _stdout_failed(e: OSError) -> bool:
+    """Whether ``e`` (naming no file) is standard output refusing its writes: a write of zero
+    bytes to it fails too (``/dev/full``, a descriptor not open for writing), or it is a file
+    on a disk without room.  Was an internal error ("please report it") for
+    `testbed list > /dev/full` or `testbed run ... 1</dev/null`."""
+    if e.filename is not None or e.errno not in STDOUT_WRITE_ERRNOS:
+        return False
+    try:
+        os.write(1, b"")
+        return e.errno in (errno.ENOSPC, errno.EDQUOT, errno.EFBIG) and stat.S_ISREG(os.fstat(1).st_mode)
+    except OSError:
+        return True
 
 
 def _interrupted(e: KeyboardInterrupt) -> int:

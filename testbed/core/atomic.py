@@ -6,10 +6,13 @@ write leaves no partial file behind.
 
 from __future__ import annotations
 
+import codecs
+import contextlib
 import errno
 import os
+import shutil
 import tempfile
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 from testbed.core.errors import InputError
@@ -43,6 +46,42 @@ def no_room(e: BaseException, path: str | os.PathLike) -> InputError | None:
                       "half-written: make room and run the command again")
 
 
+#: Temporary files and folders being written (:func:`in_flight`): what a process ended at once
+#: (:func:`testbed.core.interrupts.exit_now`, no ``finally`` runs) removes first.
+_IN_FLIGHT: set[str] = set()
+
+
+def begin_in_flight(tmp: str | os.PathLike) -> None:
+    """Mark ``tmp`` (a temporary file or folder) as being written, until :func:`end_in_flight`."""
+    _IN_FLIGHT.add(os.fspath(tmp))
+
+
+def end_in_flight(tmp: str | os.PathLike) -> None:
+    """``tmp`` is renamed into place or removed: no longer being written."""
+    _IN_FLIGHT.discard(os.fspath(tmp))
+
+
+@contextlib.contextmanager
+def in_flight(tmp: str | os.PathLike) -> Iterator[None]:
+    """Mark ``tmp`` (a temporary file or folder) as being written while the block runs."""
+    begin_in_flight(tmp)
+    try:
+        yield
+    finally:
+        end_in_flight(tmp)
+
+
+def remove_in_flight() -> None:
+    """Remove every temporary file and folder being written (:func:`in_flight`), in silence:
+    for a process about to end without unwinding, so that it leaves nothing half-written."""
+    for tmp in list(_IN_FLIGHT):
+        if os.path.isdir(tmp) and not os.path.islink(tmp):
+            shutil.rmtree(tmp, ignore_errors=True)
+        else:
+            with contextlib.suppress(OSError):
+                os.unlink(tmp)
+
+
 def atomic_write(path: str | os.PathLike, write: Callable[[str], None]) -> Path:
     """Call ``write(tmp)`` on a temporary path next to ``path``, then rename it to ``path``.
 
@@ -62,11 +101,12 @@ def atomic_write(path: str | os.PathLike, write: Callable[[str], None]) -> Path:
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     os.close(fd)
     try:
-        write(tmp)
-        with open(tmp, "rb") as fh:
-            os.fsync(fh.fileno())
-        os.chmod(tmp, 0o666 & ~_UMASK)
-        os.replace(tmp, path)
+        with in_flight(tmp):
+            write(tmp)
+            with open(tmp, "rb") as fh:
+                os.fsync(fh.fileno())
+            os.chmod(tmp, 0o666 & ~_UMASK)
+            os.replace(tmp, path)
     except BaseException as e:
         Path(tmp).unlink(missing_ok=True)
         full = no_room(e, path)
@@ -76,6 +116,39 @@ def atomic_write(path: str | os.PathLike, write: Callable[[str], None]) -> Path:
     return path
 
 
+#: The codec error handler of :func:`_file_name_bytes`: text naming files, encoded.
+FILE_NAME_ERRORS = "testbed.file_names"
+
+
+def _file_name_bytes(e: UnicodeError) -> tuple[bytes, int]:
+    """A codec error handler: a lone surrogate that stands for a byte of a file name is that
+    byte, anything else the encoding cannot write a backslash escape.
+
+    A file name whose bytes are not text in the locale's encoding (a folder named in Latin-1 on
+    a UTF-8 system; any non-ASCII name under ``LC_ALL=C`` with Python's UTF-8 mode off) reaches
+    Python as lone surrogates U+DC80..U+DCFF (``surrogateescape``), which strict UTF-8 cannot
+    write: `testbed run` in such a folder saved its run and then ended in an internal error
+    printing "run written to ..." or writing the runs' index page.  Written back as the bytes
+    they stand for, the name is the file system's own (as ``ls`` prints it)."""
+    if not isinstance(e, UnicodeEncodeError):
+        raise e
+    out = bytearray()
+    for c in e.object[e.start:e.end]:
+        code = ord(c)
+        out += bytes([code - 0xDC00]) if 0xDC80 <= code <= 0xDCFF else \
+            c.encode("ascii", "backslashreplace")
+    return bytes(out), e.end
+
+
+codecs.register_error(FILE_NAME_ERRORS, _file_name_bytes)
+
+
+def utf8_bytes(text: str) -> bytes:
+    """``text`` as UTF-8, a file name in it as the file system's bytes (:func:`_file_name_bytes`)."""
+    return text.encode("utf-8", FILE_NAME_ERRORS)
+
+
 def atomic_write_text(path: str | os.PathLike, text: str) -> Path:
-    """:func:`atomic_write` of ``text`` as UTF-8."""
-    return atomic_write(path, lambda tmp: Path(tmp).write_text(text, encoding="utf-8"))
+    """:func:`atomic_write` of ``text`` as UTF-8 (:func:`utf8_bytes`)."""
+    data = utf8_bytes(text)
+    return atomic_write(path, lambda tmp: Path(tmp).write_bytes(data))

@@ -14,16 +14,18 @@ def _one_line(text: str) -> str:
     return "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
 
 
+def _cut(text: str) -> str:
+    """``text`` cut to :data:`MAX_VALUE_CHARS` characters, the cut marked ``[...]``."""
+    return text if len(text) <= MAX_VALUE_CHARS else text[:MAX_VALUE_CHARS - 5] + "[...]"
+
+
 def show_value(value: Any) -> str:
     """``repr(value)`` on one line, cut to :data:`MAX_VALUE_CHARS` characters."""
     try:
         text = repr(value)
     except Exception:  # a broken __repr__ must not hide the real error
         text = f"<{type(value).__name__}>"
-    text = _one_line(text)
-    if len(text) > MAX_VALUE_CHARS:
-        text = text[:MAX_VALUE_CHARS - 5] + "[...]"
-    return text
+    return _cut(_one_line(text))
 
 
 #: Names listed in a message before the rest are counted [names]: a record of 3,000 channels
@@ -63,7 +65,8 @@ class ScenarioError(TestbedError):
         self.file, self.key, self.value, self.allowed = str(file), key, value, allowed
         parts = [_one_line(self.file)]
         if key is not None:
-            parts.append(f"key '{_one_line(str(key))}'")
+            # cut like a value: an unknown key of 5,000 digits made a 5 kB line
+            parts.append(f"key '{_cut(_one_line(str(key)))}'")
         if value is not ...:
             parts.append(f"value {show_value(value)}")
         msg = ": ".join(parts)

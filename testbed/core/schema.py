@@ -12,8 +12,9 @@ from __future__ import annotations
 import difflib
 import math
 import re
+import sys
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 from testbed.core.errors import ScenarioError
@@ -102,7 +103,9 @@ class Field:
             bounds.append(f"with at least {self.min_items} item(s)")
         if self.type is list and self.max_items is not None:
             bounds.append(f"with at most {self.max_items} item(s)")
-        if self.pattern is not None:
+        if self.pattern is not None and self.pattern_doc.startswith(("a ", "an ")):
+            what = self.pattern_doc  # "expected a string a name of letters ..." read badly
+        elif self.pattern is not None:
             bounds.append(self.pattern_doc or f"matching {self.pattern}")
         unit = f" [{self.unit}]" if self.unit else ""
         return what + (" " + " and ".join(bounds) if bounds else "") + unit
@@ -122,9 +125,19 @@ def _is_type(value: Any, typ: type) -> bool:
     return isinstance(value, typ)
 
 
+#: Integers a setting may hold: those of 64 bits, as numpy, HDF5 and the results tables store
+#: them (a count of 2**70 samples was an internal error of numpy, "Maximum allowed size
+#: exceeded", where a rig sets no maximum of its own).
+INT64_MIN, INT64_MAX = -(2**63), 2**63 - 1
+
+
 def _check_number(value: float, f: Field) -> bool:
     if isinstance(value, float) and not math.isfinite(value):
         return False
+    if f.type is int and not INT64_MIN <= value <= INT64_MAX:
+        return False
+    if f.type is float and isinstance(value, int) and abs(value) > sys.float_info.max:
+        return False  # float(10**400) raised OverflowError: an internal error
     if f.min is not None and (value < f.min or (value == f.min and not f.min_inclusive)):
         return False
     return not (f.max is not None and (value > f.max or (value == f.max and not f.max_inclusive)))
@@ -156,7 +169,10 @@ def _check_own(value: Any, f: Field, *, file: str, key: str) -> Any:
     if f.choices is not None and value not in f.choices:
         raise ScenarioError(file, key, value, f"expected {f.describe()}")
     if f.type in (int, float) and not _check_number(value, f):
-        raise ScenarioError(file, key, value, f"expected {f.describe()}")
+        # said only where the bounds stated would have taken the value
+        within = _check_number(value, replace(f, type=object))
+        limit = ("" if not within else " of 64 bits" if f.type is int else " (finite as a float)")
+        raise ScenarioError(file, key, value, f"expected {f.describe()}{limit}")
     if f.type is list:
         if f.min_items is not None and len(value) < f.min_items:
             raise ScenarioError(file, key, value, f"expected {f.describe()}")

@@ -19,6 +19,7 @@ a reader never sees one, and two processes filling the same entry at once both f
 
 from __future__ import annotations
 
+import errno
 import functools
 import hashlib
 import json
@@ -79,7 +80,10 @@ def generator_code_hash(rig: str) -> str:
     root = Path(__file__).resolve().parents[2]
     h = hashlib.sha256()
     for f in generator_sources(rig):
-        h.update((f.relative_to(root) if f.is_relative_to(root) else f).as_posix().encode())
+        # the path's bytes as the file system holds them: .encode() (UTF-8) failed on a plugin
+        # at a non-ASCII path under a non-UTF-8 locale (an internal error), and would have
+        # hashed the same file differently under another locale
+        h.update(os.fsencode((f.relative_to(root) if f.is_relative_to(root) else f).as_posix()))
         h.update(f.read_bytes())
     return h.hexdigest()
 
@@ -89,6 +93,12 @@ def cache_key(scenario: Scenario) -> str:
     blob = json.dumps({"data": scenario.data_hash(), "versions": versions(),
                        "code": generator_code_hash(scenario.rig)}, sort_keys=True)
     return hashlib.sha256(blob.encode()).hexdigest()[:32]
+
+
+#: errno values of a cache folder that cannot be written: no permission, a read-only file system.
+NOT_WRITABLE = (errno.EACCES, errno.EPERM, errno.EROFS)
+#: Cache folders already reported as not writable by this process.
+_UNWRITABLE_WARNED: set[str] = set()
 
 
 class DatasetCache:
@@ -128,7 +138,19 @@ class DatasetCache:
                 if p.is_file():  # else another process cleared it meanwhile: a plain miss
                     log.warning("dataset cache: %s; simulating it again", e)
         ds = simulate_clean(scenario, progress)
-        ds.save(p)
+        try:
+            ds.save(p)
+        except OSError as e:
+            if e.errno not in NOT_WRITABLE:
+                raise
+            # a read-only cache (shared, pre-filled) still serves what it holds; what it lacks
+            # is simulated and used uncached.  Was "error: [Errno 13] Permission denied:
+            # '<cache>/.<entry>.h5.<random>.tmp'" after the simulation, the run lost.
+            if str(self.directory) not in _UNWRITABLE_WARNED:  # once a folder: a sweep's cells
+                _UNWRITABLE_WARNED.add(str(self.directory))
+                log.warning("dataset cache %s: cannot be written (%s); datasets it lacks are "
+                            "simulated and not cached (--cache names another folder)",
+                            self.directory, e.strerror or type(e).__name__)
         return ds
 
     def get(self, scenario: Scenario, progress: Callable[[float], None] | None = None) -> Dataset:

@@ -20,7 +20,7 @@ from collections.abc import Callable
 import numpy as np
 
 from testbed.core.dataset import Dataset, Signal
-from testbed.core.errors import RigError
+from testbed.core.errors import RigError, TestbedError
 from testbed.core.provenance import git_commit, versions
 from testbed.core.truth import TruthError
 from testbed.pipeline.plugins import RIGS
@@ -65,6 +65,24 @@ def _stamp(ds: Dataset, scenario: Scenario) -> Dataset:
     return ds
 
 
+def _simulate_rig(scenario: Scenario, progress: Callable[[float], None] | None) -> Dataset:
+    """The rig of ``scenario`` built and run.  Any exception of a user's plugin rig (not a
+    built-in one, whose exception is a testbed bug and stays one) becomes a :class:`RigError`
+    naming the rig and its file, as a plugin identifier's does in its fit
+    (:func:`testbed.pipeline.fit.fit_or_fail`): a plugin rig given ``n_samples = 2**62`` raised
+    numpy's "array is too big", an internal error "please report it"."""
+    origin = RIGS.origin(scenario.rig)
+    try:
+        return RIGS.get(scenario.rig)(scenario).simulate(progress=progress)
+    except TestbedError:
+        raise
+    except (Exception, SystemExit) as e:
+        if origin == "builtin":
+            raise
+        raise RigError(f"rig {scenario.rig} (from {origin}) raised {type(e).__name__}: "
+                       f"{' '.join(str(e).split())}") from None
+
+
 def simulate_clean(scenario: Scenario, progress: Callable[[float], None] | None = None) -> Dataset:
     """The rig's noise-free dataset of ``scenario``: the clean dataset :func:`derive` starts from.
 
@@ -80,7 +98,7 @@ def simulate_clean(scenario: Scenario, progress: Callable[[float], None] | None 
     """
 
     clean_sc = noise_free_scenario(scenario)
-    ds = RIGS.get(clean_sc.rig)(clean_sc).simulate(progress=progress)
+    ds = _simulate_rig(clean_sc, progress)
     ds.attrs["kind"] = clean_sc.kind
     # one order whichever path made the dataset: HDF5 hands groups back sorted by name, a rig
     # writes them in its own (a run's npz and report tables listed truth and prior keys in one

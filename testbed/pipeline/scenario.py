@@ -43,6 +43,7 @@ import math
 import os
 import re
 import stat
+import sys
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -289,10 +290,26 @@ def read_toml_file(path: Path, what: str) -> dict:
         raise ScenarioError(file, allowed=f"not valid TOML: {e}") from None
     except RecursionError:
         raise ScenarioError(file, allowed=f"not a {what} file: TOML nested too deeply") from None
+    except ValueError as e:  # an integer beyond Python's str-to-int limit: an internal error before
+        raise ScenarioError(file, allowed=_long_integer(text) or f"not valid TOML: {e}") from None
     if _depth_exceeds(raw, MAX_DEPTH):
         raise ScenarioError(file, allowed=f"not a {what} file: tables or lists nested deeper "
                                           f"than {MAX_DEPTH}")
     return raw
+
+
+def _long_integer(text: str) -> str | None:
+    """Where ``text`` has an integer too long for Python to read (``sys.get_int_max_str_digits``:
+    4300 digits by default), as a message; None if it has none."""
+    limit = sys.get_int_max_str_digits()
+    if limit == 0:  # no limit set
+        return None
+    m = re.search(rf"\d(?:_?\d){{{limit},}}", text)
+    if m is None:
+        return None
+    line = text.count("\n", 0, m.start()) + 1
+    return (f"not valid TOML: an integer of more than {limit} digits (at line {line}); no "
+            "setting takes a number that long")
 
 
 def _read_toml(path: Path, chain: tuple[Path, ...] = ()) -> dict:

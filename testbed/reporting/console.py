@@ -8,12 +8,14 @@ import numpy as np
 from rich.console import Console
 from rich.table import Table
 
+from testbed.core.terminal import make_console
 from testbed.core.truth import DynamicalTruth, MechanicalTruth, StructuralTruth
 from testbed.scoring.scorers import FAIL, PASS
 
 if TYPE_CHECKING:
     from testbed.core.dataset import Dataset
     from testbed.scoring.run import RunResult
+
 
 def truth_rows(ds: Dataset) -> list[tuple[str, str]]:
     """(label, value) pairs summarising a dataset's truth (its kind's typed truth; a dataset
@@ -54,7 +56,7 @@ def print_truth_summary(ds: Dataset, console: Console | None = None) -> None:
     t.add_column("")
     for a, b in truth_rows(ds):
         t.add_row(a, b)
-    (console or Console()).print(t)
+    (console or make_console()).print(t)
 
 
 def verdict_line(verdict: str, failure: str | None, n_checks: int) -> str:
@@ -103,4 +105,4 @@ def print_score_table(result: RunResult, console: Console | None = None) -> None
         t.add_row(f"[red]failure: {k}[/]", escape(why), "-", "[red]FAIL[/]")
     if not result.checks:
         t.add_row("[yellow]thresholds[/]", "none declared", "-", "[yellow]no verdict[/]")
-    (console or Console()).print(t)
+    (console or make_console()).print(t)

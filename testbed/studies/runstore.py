@@ -64,7 +64,7 @@ try:
 except ImportError:  # Windows
     fcntl = None  # type: ignore[assignment]
 
-from testbed.core.atomic import atomic_write_text, no_room
+from testbed.core.atomic import atomic_write_text, begin_in_flight, end_in_flight, no_room
 from testbed.core.errors import TestbedError
 from testbed.core.provenance import git_commit, versions
 from testbed.pipeline.plugins import RIGS
@@ -381,14 +381,21 @@ def save_run(result: Any, run_dir: str | os.PathLike,
     except BaseException:
         shutil.rmtree(tmp, ignore_errors=True)
         raise
+    finally:
+        end_in_flight(tmp)
     return run_dir
 
 
 def _write_temporary(result: Any, parent: Path, stem: str,
                      figures: Callable[[SavedRun, Path], list[Path]] | None
                      ) -> tuple[Path, dict[str, Any]]:
-    """A complete run folder under a private temporary name in ``parent``, and its meta."""
+    """A complete run folder under a private temporary name in ``parent``, and its meta.
+
+    The folder is marked as being written (:func:`testbed.core.atomic.begin_in_flight`) until
+    the caller renames it into place or removes it (:func:`~testbed.core.atomic.end_in_flight`).
+    """
     tmp = Path(tempfile.mkdtemp(prefix=f".{stem}.", suffix=".tmp", dir=parent))
+    begin_in_flight(tmp)
     umask = os.umask(0)
     os.umask(umask)
     os.chmod(tmp, 0o777 & ~umask)  # mkdtemp makes it private; a run folder is as readable as any
@@ -402,6 +409,7 @@ def _write_temporary(result: Any, parent: Path, stem: str,
             _write_json(tmp / "run.json", meta)
     except BaseException as e:
         shutil.rmtree(tmp, ignore_errors=True)
+        end_in_flight(tmp)
         full = no_room(e, f"a run folder in {parent}")
         if full is not None:
             raise full from None
@@ -497,6 +505,8 @@ def save_new_run(result: Any, out_dir: str | os.PathLike,
     except BaseException:
         shutil.rmtree(tmp, ignore_errors=True)
         raise
+    finally:
+        end_in_flight(tmp)
     with _locked(out):
         pointer = _read_latest(folder)
         if pointer is None or (str(pointer.get("created", "")), str(pointer["run"])) <= \

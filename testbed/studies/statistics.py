@@ -30,6 +30,7 @@ from typing import Any
 
 import numpy as np
 
+from testbed.core.terminal import make_console
 from testbed.studies.family import family_of
 from testbed.studies.results import read_results, score_columns
 
@@ -166,10 +167,10 @@ def print_summary(path: str | os.PathLike, console: Any = None,
     ``[q25, q75]``), plus the cell count, failures, pass rate (over judged cells) and the
     failure reasons counted; then the first errors of failed cells.
     """
-    from rich.console import Console
     from rich.table import Table
 
-    console = console or Console()
+
+    console = console or make_console()
     path = Path(path)
     rows = read_results(path)
     summary = summarize(path, rows, by=by)

@@ -335,3 +335,108 @@ def test_an_interrupt_while_the_options_are_parsed_is_one_line(monkeypatch, caps
     monkeypatch.setattr(cli, "build_parser", build_parser)
     assert main(["list"]) == cli.EXIT_INTERRUPTED
     assert one_error_line(capsys.readouterr().err) == "error: interrupted"
+
+
+# ------------------------------------------------------------------ round 6: hostile stdio, cwd
+@pytest.mark.parametrize(("redirect", "reason"), [
+    ({"stdout": "/dev/full"}, "No space left on device"),
+    ({"stdout_mode": os.O_RDONLY}, "Bad file descriptor"),  # `testbed ... 1</dev/null`
+], ids=["dev-full", "read-only"])
+def test_a_standard_output_that_refuses_writes_is_one_line(tmp_path, redirect, reason):
+    # an internal error ("OSError: [Errno 28] ... please report it") before
+    fd = os.open(redirect.get("stdout", os.devnull), redirect.get("stdout_mode", os.O_WRONLY))
+    try:
+        r = subprocess.run([sys.executable, "-m", "testbed.cli", "cache", "ls", "--cache", str(tmp_path)],
+                           cwd=ROOT, stdout=fd, stderr=subprocess.PIPE, text=True,
+                           env={**os.environ, "PYTHONPATH": str(ROOT), "TESTBED_NO_SERVER": "1"},
+                           timeout=SUBPROCESS_TIMEOUT_S)
+    finally:
+        os.close(fd)
+    assert r.returncode == EXIT_USAGE, r.stderr
+    assert one_error_line(r.stderr) == (
+        f"error: cannot write to standard output: {reason} (a full disk or /dev/full, or a file "
+        "descriptor not open for writing)")
+
+
+def test_a_closed_standard_output_is_one_line(tmp_path, capsys, monkeypatch):
+    # `testbed run x >&-` was an internal error (AttributeError: 'NoneType' object has no
+    # attribute 'isatty'), `testbed list >&-` printed nothing with status 0
+    monkeypatch.setattr(sys, "stdout", None)
+    assert main(["cache", "ls", "--cache", str(tmp_path)]) == EXIT_USAGE
+    assert one_error_line(capsys.readouterr().err) == (
+        "error: standard output is closed (file descriptor 1); give the command somewhere to "
+        "write (> /dev/null to discard what it prints)")
+
+
+def test_a_deleted_current_folder_is_named(tmp_path, capsys, monkeypatch):
+    # "error: [Errno 2] No such file or directory", naming nothing, for the default cache
+    gone = tmp_path / "gone"
+    gone.mkdir()
+    monkeypatch.chdir(gone)
+    gone.rmdir()
+    assert main(["run", "michaelis_menten", "--no-figures"]) == EXIT_USAGE
+    assert one_error_line(capsys.readouterr().err) == (
+        "error: the current folder no longer exists (deleted?); cd to a folder that exists, or "
+        "give absolute paths and --out/--cache")
+
+
+@pytest.mark.parametrize("argv", [
+    ["sweep", "x.toml", "--jobs", "9" * 5000],   # not read: over Python's 4300 digits
+    ["sweep", "x.toml", "--jobs", "9" * 4000],   # read, and over the bound
+    ["run", "michaelis_menten", "--seed", "-" + "9" * 4000],
+], ids=["jobs-5000", "jobs-4000", "seed"])
+def test_an_option_value_of_thousands_of_characters_is_cut_in_its_line(cli_in_process, tmp_path, argv):
+    # the value was printed whole: a 5 kB error line
+    r = cli_in_process(*argv, cwd=tmp_path)
+    assert r.returncode == EXIT_USAGE
+    line = one_error_line(r.stderr)
+    assert len(line) < 400 and "[...]" in line, line[:500]
+
+
+def test_key_values_and_a_dask_address_of_thousands_of_characters_are_cut():
+    from testbed.core.errors import InputError
+
+    for call in (lambda: cli._key_values(["m=" + "9" * 5000], "--prior", numbers=True),
+                 lambda: cli.check_dask_address("x" * 5000)):
+        with pytest.raises(InputError) as e:
+            call()
+        assert len(str(e.value)) < 300 and "[...]" in str(e.value), str(e.value)[:500]
+
+
+@pytest.mark.parametrize("argv", [
+    ["run", "michaelis_menten", "--out", ""],      # wrote the run and index.html in the cwd
+    ["run", "michaelis_menten", "--cache", ""],    # wrote the datasets in the cwd
+    ["runs", "ls", "--out", ""],
+    ["sweep", "x.toml", "--results", ""],
+    ["generate", "michaelis_menten", "-o", ""],
+    ["cache", "clear", "--cache", ""],
+    ["run", "michaelis_menten", "--plugin", ""],
+], ids=lambda a: f"{a[0]} {a[-2]}")
+def test_an_empty_path_option_is_refused(cli_in_process, tmp_path, argv):
+    r = cli_in_process(*argv, cwd=tmp_path)
+    assert r.returncode == EXIT_USAGE
+    assert "an empty path; expected a file or folder name" in one_error_line(r.stderr)
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize(("make", "fragment"), [
+    (lambda d: (d / "c").symlink_to(d / "nowhere"),
+     "c: a symbolic link to {d}/nowhere, which does not exist"),
+    (lambda d: (d / "f").write_text(""), "f/c: {d}/f is a file, not a folder"),
+    (lambda d: None, None),
+], ids=["dangling-link", "file-on-the-way", "empty-env"])
+def test_a_cache_folder_that_cannot_be_made_is_named(cli_in_process, tmp_path, monkeypatch, make, fragment):
+    # "[Errno 17] File exists" and "[Errno 20] Not a directory", naming no option, after the
+    # simulation; TESTBED_CACHE="" wrote the datasets in the current folder
+    make(tmp_path)
+    if fragment is None:
+        monkeypatch.setenv("TESTBED_CACHE", "")
+        argv, expected = [], ("error: $TESTBED_CACHE '': an empty path; expected the dataset cache "
+                              "folder (unset it for the default)")
+    else:
+        cache = tmp_path / ("c" if "link" in fragment else "f/c")
+        argv = ["--cache", str(cache)]
+        expected = (f"error: --cache {tmp_path}/{fragment.format(d=tmp_path)}; expected the dataset "
+                    "cache folder")
+    r = cli_in_process("cache", "ls", *argv, cwd=tmp_path)
+    assert (r.returncode, one_error_line(r.stderr)) == (EXIT_USAGE, expected)

@@ -901,3 +901,129 @@ def test_a_worker_killed_by_a_plugin_is_one_line_naming_the_plugins(fault_dir, t
         run_sweep(study, results=res, cache_dir=tmp_path / "c", verbose=False)
     with pytest.raises(TerminatedWorkerError):  # without plugins: the testbed's own bug, raised
         run_sweep(replace(study, plugins=()), results=res, cache_dir=tmp_path / "c", verbose=False)
+
+
+def test_a_signal_while_the_main_thread_is_in_compiled_code_ends_the_command_promptly(tmp_path):
+    # a SIGTERM or Ctrl-C while an identifier's numba kernel (compiled, nogil) held the main
+    # thread was acted on when the kernel returned: `testbed run` of a plugin whose fit is one
+    # long kernel said "interrupted" 28 s after the SIGTERM (45 s with a hashlib loop, which
+    # also releases the GIL and checks no signal; that loop stands in for the kernel here, as
+    # numba's compilation would take seconds): now within the watchdog's grace, one line, the
+    # signal's status and no temporary file left
+    from testbed.core.interrupts import GRACE_S
+
+    mark, tmp = tmp_path / "in-kernel", tmp_path / ".run.json.abc.tmp"
+    code = textwrap.dedent(f"""
+        import hashlib, pathlib
+        from testbed import cli
+        from testbed.core.atomic import begin_in_flight
+        with cli._terminate_as_interrupt(console=True):
+            pathlib.Path({str(tmp)!r}).write_text("half")
+            begin_in_flight({str(tmp)!r})
+            pathlib.Path({str(mark)!r}).write_text("")
+            hashlib.pbkdf2_hmac("sha256", b"k", b"s", 10**9)  # minutes
+        print("the kernel returned")
+    """)
+    p = subprocess.Popen([sys.executable, "-c", code], env=_env(), cwd=tmp_path,
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        deadline = time.monotonic() + 60
+        while not mark.exists() and p.poll() is None and time.monotonic() < deadline:
+            time.sleep(0.01)
+        assert mark.exists(), p.communicate()[1]
+        sent = time.monotonic()
+        p.send_signal(signal.SIGTERM)
+        out, err = p.communicate(timeout=GRACE_S + 30)
+        took = time.monotonic() - sent
+    finally:
+        p.kill()
+    assert (p.returncode, out, err) == (128 + signal.SIGTERM, "", "error: interrupted by SIGTERM\n")
+    # the grace, and 1.5 s for the thread to wake and the process to end on a loaded machine
+    # (0.06 s measured idle)
+    assert GRACE_S <= took < GRACE_S + 1.5, took
+    assert not tmp.exists()
+
+
+def test_a_signal_handled_in_time_is_not_ended_by_the_watchdog(tmp_path):
+    # the watchdog acts only when the main thread has not begun to handle the signal: a
+    # command in Python code unwinds as before (its finally blocks run, its status is its own)
+    from testbed.core.interrupts import GRACE_S
+
+    code = textwrap.dedent(f"""
+        import os, signal, time
+        from testbed import cli
+        try:
+            with cli._terminate_as_interrupt(console=True):
+                os.kill(os.getpid(), signal.SIGTERM)
+                time.sleep(30)
+        except cli.Terminated:
+            time.sleep({GRACE_S} + 0.5)  # a slow but orderly clean-up, longer than the grace
+            print("cleaned up")
+    """)
+    r = subprocess.run([sys.executable, "-c", code], env=_env(), cwd=tmp_path, capture_output=True,
+                       text=True, timeout=60)
+    assert (r.returncode, r.stdout, r.stderr) == (0, "cleaned up\n", "")
+
+
+def test_a_run_under_a_folder_whose_name_is_not_utf8(fault_dir, tmp_path, monkeypatch, capsys):
+    # a folder named in Latin-1 on a UTF-8 system, or any non-ASCII name under a locale that is
+    # not UTF-8 (LC_ALL=C with Python's UTF-8 mode off): Python reads the name as lone
+    # surrogates, which UTF-8 cannot write: the plugin rig's source hash (the cache key), the
+    # run index and "run written to ..." on a strict UTF-8 standard output (a UTF-8 locale
+    # other than C.UTF-8, PYTHONIOENCODING=utf-8) were internal errors ("surrogates not
+    # allowed"), the run already saved.  The name is written as the file system's bytes.
+    import io
+
+    from testbed.cli import main
+    from testbed.pipeline.plugins import IDENTIFIERS, RIGS
+
+    folder = tmp_path / os.fsdecode(b"caf\xe9")
+    folder.mkdir()
+    # under names of its own: the module's plugin may be registered in this process already
+    (folder / "faults.py").write_text(PLUGIN.replace('"fault_', '"latin1_'))
+    (folder / "fault_a.toml").write_text(SCENARIO.replace('"fault_osc"', '"latin1_osc"')
+                                         + '[identify]\nmethod = "latin1_fit"\n')
+    out = folder / "runs"
+    stdout = io.TextIOWrapper(io.BytesIO(), encoding="utf-8", errors="strict")
+    monkeypatch.setattr(sys, "stdout", stdout)
+    saved = IDENTIFIERS.snapshot(), RIGS.snapshot()  # the plugin registers its names here
+    try:
+        code = main(["run", str(folder / "fault_a.toml"), "--plugin", str(folder / "faults.py"),
+                     "--no-figures", "--out", str(out), "--cache", str(folder / "cache")])
+    finally:
+        IDENTIFIERS.restore(saved[0])
+        RIGS.restore(saved[1])
+    assert code == 0, capsys.readouterr().err
+    assert stdout.errors == "strict"  # the caller's handler is put back
+    stdout.flush()
+    assert b"run written to " + os.fsencode(str(out)) in stdout.buffer.getvalue()
+    assert os.fsencode(str(out)) in (out / "index.html").read_bytes()
+    assert len(list((folder / "cache").glob("latin1_osc-*.h5"))) == 1
+
+
+def test_a_cache_folder_that_cannot_be_written_still_serves_and_the_run_goes_on(tmp_path, monkeypatch,
+                                                                                caplog):
+    # a read-only --cache (a shared, pre-filled one; or the default .cache under a read-only
+    # current folder) ended a run after its simulation in "error: [Errno 13] Permission denied:
+    # '<cache>/.<entry>.h5.<random>.tmp'"; the datasets it holds are read as before
+    import errno as errno_
+
+    from testbed.pipeline import cache as cache_mod
+
+    sc = _short()
+    filled = DatasetCache(tmp_path / "filled")
+    held = filled.get(sc)
+
+    def refused(self, path):
+        raise PermissionError(errno_.EACCES, "Permission denied", str(path))
+
+    monkeypatch.setattr(Dataset, "save", refused)
+    monkeypatch.setattr(cache_mod, "_UNWRITABLE_WARNED", set())
+    _assert_same_data(filled.get(sc), held)  # held: read, nothing written
+    ro = DatasetCache(tmp_path / "ro")
+    with caplog.at_level(logging.WARNING, logger="testbed.pipeline.cache"):
+        _assert_same_data(ro.get(sc), held)
+        _assert_same_data(ro.get(sc.with_noise(1.0)), filled.get(sc.with_noise(1.0)))
+    assert [r.getMessage() for r in caplog.records] == [
+        f"dataset cache {tmp_path / 'ro'}: cannot be written (Permission denied); datasets it "
+        "lacks are simulated and not cached (--cache names another folder)"]  # once a folder

@@ -1131,3 +1131,88 @@ def test_identify_of_a_wide_record_without_the_chains_signal_is_one_short_line(t
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and len(err) < 400, err[:500]
     assert "no measured signal 'x' (has y0, y1, y2," in err and "and 2988 more)" in err, err
+
+
+# ------------------------------------------------------------------------ round 6
+#: An integer of 5,000 digits: beyond Python's str-to-int limit (4300 digits by default).
+LONG_INT = "9" * 5000
+
+
+@pytest.mark.parametrize("load", [load_scenario, load_study], ids=["scenario", "study"])
+def test_an_integer_too_long_to_read_is_refused_naming_its_line(tmp_path, load):
+    # tomllib raised ValueError ("Exceeds the limit (4300 digits) for integer string
+    # conversion"), not a TOMLDecodeError: an internal error naming no file
+    path = tmp_path / "long.toml"
+    path.write_text(f'[scenario]\nname = "long"\nrig = "michaelis_menten"\nseed = {LONG_INT}\n')
+    e, _ = refuse(load, path)
+    assert str(e) == (f"{path}: not valid TOML: an integer of more than 4300 digits (at line 4); "
+                      "no setting takes a number that long")
+
+
+def test_a_param_option_too_long_to_read_is_refused_as_not_a_number():
+    from testbed.cli import _key_values
+    from testbed.core.errors import InputError
+
+    with pytest.raises(InputError, match="the value must be a number"):
+        _key_values([f"x={LONG_INT}"], "--prior", numbers=True)
+    assert _key_values([f"x={LONG_INT}"], "--param", numbers=False) == {"x": LONG_INT}
+
+
+def test_an_unknown_key_of_5000_characters_is_cut_in_the_message(tmp_path):
+    # the key was printed whole: a 5 kB error line
+    path = tmp_path / "wide_key.toml"
+    path.write_text(f'[scenario]\nname = "wide_key"\nextends = "{SCENARIO_DIR / "michaelis_menten.toml"}"\n'
+                    f"[rig]\n{LONG_INT} = 1\n")
+    e, _ = refuse(load_scenario, path)
+    assert_clear(e, path, None, "unknown key")
+    assert len(str(e)) < 400 and "99999[...]'" in str(e), str(e)[:500]
+
+
+@pytest.mark.parametrize(("field", "value", "fragment"), [
+    # numpy's "Maximum allowed size exceeded" (an internal error) for a count of 2**70
+    ("int", 2**70, "expected an integer >= 10 of 64 bits"),
+    ("int", -(2**63) - 1, "expected an integer >= 10"),
+    # float(10**400) raised OverflowError: an internal error
+    ("float", 10**400, "expected a number >= 0.1 (finite as a float)"),
+    ("float", -(10**400), "expected a number >= 0.1"),  # below the bound: the bound is the reason
+], ids=["2**70", "-2**63-1", "10**400", "-10**400"])
+def test_integers_beyond_64_bits_or_float64_are_refused(field, value, fragment):
+    from testbed.core.schema import Field, check_value
+
+    f = Field(int, 400, min=10) if field == "int" else Field(float, 1.0, min=0.1)
+    with pytest.raises(ScenarioError) as e:
+        check_value(value, f, file="x.toml", key="simulation.n")
+    assert str(e.value).startswith("x.toml: key 'simulation.n': value ")
+    assert str(e.value).endswith(fragment), str(e.value)
+    assert check_value(2**63 - 1, Field(int, 400, min=10), file="x.toml", key="k") == 2**63 - 1
+
+
+def test_a_pattern_described_as_a_name_reads_as_one():
+    # "expected a string a name of letters, ..."
+    with pytest.raises(ScenarioError, match=r"value 'a/b': expected a name of letters, digits"):
+        scenario_from_dict({"scenario": {"name": "a/b", "rig": "michaelis_menten"}}, file="x.toml")
+
+
+def test_a_plugin_rig_raising_in_simulate_is_one_line_naming_its_file(monkeypatch):
+    # a plugin rig whose simulate raised (numpy's "array is too big" for n_samples = 2**62) was
+    # "internal error (a bug, not your input) ... please report it"; a built-in rig's exception
+    # is still raised (a bug of ours)
+    from models.michaelis_menten.rig import MichaelisMentenRig as MichaelisMenten
+    from testbed.core.errors import RigError
+    from testbed.pipeline import generate as gen
+
+    class Broken(MichaelisMenten):
+        def simulate(self, progress=None):
+            raise ValueError("array is too big")
+
+    origin = {"michaelis_menten": "file /home/me/rig.py"}
+    monkeypatch.setattr(gen.RIGS, "origin", lambda name: origin[name])
+    monkeypatch.setattr(gen.RIGS, "get", lambda name: Broken)
+    sc = load_scenario("michaelis_menten", check_cost=False)
+    with pytest.raises(RigError) as e:
+        gen.simulate_clean(sc)
+    assert str(e.value) == ("rig michaelis_menten (from file /home/me/rig.py) raised ValueError: "
+                            "array is too big")
+    origin["michaelis_menten"] = "builtin"
+    with pytest.raises(ValueError, match="array is too big"):
+        gen.simulate_clean(sc)

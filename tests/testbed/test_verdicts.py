@@ -403,3 +403,19 @@ def test_a_stored_run_of_the_wrong_types_is_refused_on_read(tmp_path, key, value
         load_run(path)
     damaged = []
     assert list_runs(tmp_path, damaged=damaged) == [] and damaged == [path]
+
+
+@pytest.mark.parametrize(("columns", "width"), [("0", 80), ("1", 80), ("19", 80), ("20", 20), ("132", 132)])
+def test_the_score_table_is_drawn_on_a_terminal_reporting_no_width(monkeypatch, columns, width):
+    # on a terminal reporting 0 columns (COLUMNS=0, a pseudo-terminal never given a size) rich
+    # drew nothing: `testbed run` printed "run written to ..." without its table or verdict
+    import io
+
+    from testbed.core.terminal import make_console
+
+    monkeypatch.setenv("COLUMNS", columns)
+    buf = io.StringIO()
+    console = make_console(file=buf, force_terminal=True, highlight=False)
+    assert console.width == width
+    console.print("PASS: all 1 threshold(s) met")
+    assert buf.getvalue() == "PASS: all 1 threshold(s) met\n" if width >= 30 else "PASS" in buf.getvalue()
