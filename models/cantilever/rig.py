@@ -381,7 +381,9 @@ class CantileverRig(Rig):
                   "coordinates cannot place a force between sensors")
         end = excitation["start"] + excitation["pulse_duration"]
         if end >= simulation["duration"]:
-            error("excitation.pulse_duration", excitation["pulse_duration"],
+            # the key at fault: the start when the pulse begins after the record has ended
+            key = "start" if excitation["start"] >= simulation["duration"] else "pulse_duration"
+            error(f"excitation.{key}", excitation[key],
                   f"allowed: start + pulse_duration < duration ({simulation['duration']:g} s)")
 
     #: ``[signal]`` keys that may say ``"auto"``: resolved from the nominal geometry when the

@@ -64,6 +64,8 @@ def test_other_seed_changes_only_noisy_signals(noisy):
     ("rig", "sensors", [0.005, 0.3], "rig.sensors"),  # on the clamped stub: does not move
     ("excitation", "location", 0.5, "excitation.location"),
     ("excitation", "pulse_duration", 0.2, "excitation.pulse_duration"),
+    # a pulse that starts after the record ends names its start (it named pulse_duration)
+    ("excitation", "start", 1e308, "excitation.start"),
     ("rig", "damping_beta", 1e-5, "rig.damping_beta"),
     # undamped: modes above the Nyquist frequency alias into the band for the whole record
     # (was accepted; the record held a 344 Hz alias of mode 8 that no truth describes)
