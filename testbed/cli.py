@@ -381,6 +381,7 @@ def cmd_generate(args: argparse.Namespace) -> int:
     from testbed.pipeline.scenario import load_scenario
     from testbed.reporting.console import print_truth_summary
 
+    _load_plugins(args)  # a plugin rig's scenario, as `run` takes it
     sc = load_scenario(args.scenario)
     if args.seed is not None:
         sc = sc.replace(seed=args.seed)
@@ -683,6 +684,7 @@ def build_parser() -> argparse.ArgumentParser:
     g.add_argument("--cache", type=_path_text,
                    help="dataset cache folder it also fills (default .cache/datasets)")
     g.add_argument("--no-cache", action="store_true", help="generate afresh, fill no cache")
+    g.add_argument("--plugin", action="append", metavar="FILE.py", type=_path_text, help=plugin_help)
     g.set_defaults(fn=cmd_generate)
 
     r = sub.add_parser("run", help="generate or reuse data, identify, score, write figures")

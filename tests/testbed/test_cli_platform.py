@@ -288,3 +288,16 @@ def test_sweep_with_a_plugin_identifier(tmp_path, dataset_cache, cli_in_process)
 
     rows = read_results(results)
     assert sorted(row["identifier"] for row in rows) == ["ls_sindy", "my_sweep_method"]
+
+
+def test_generate_takes_a_plugin_rig(tmp_path, cli_in_process):
+    # `testbed generate` had no --plugin: a plugin rig's scenario could not be generated
+    (tmp_path / "spring.toml").write_text(
+        '[scenario]\nname = "spring"\nrig = "springmass"\n[simulation]\nduration = 0.05\n'
+        'sample_rate = 8192.0\n[excitation]\ntype = "impulse"\n')
+    plugin = str(ROOT / "tests" / "springmass_rig.py")
+    r = cli_in_process("generate", "spring.toml", "--plugin", plugin, "--no-cache", "-o", "s.h5",
+                       cwd=tmp_path)
+    assert r.returncode == 0 and (tmp_path / "s.h5").is_file(), r.stderr[-2000:]
+    r = cli_in_process("generate", "spring.toml", "--no-cache", "-o", "t.h5", cwd=tmp_path)
+    assert r.returncode == 2 and "springmass" in r.stderr and len(r.stderr.splitlines()) == 1
