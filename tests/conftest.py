@@ -23,6 +23,17 @@ os.environ.setdefault("MPLBACKEND", "Agg")
 os.environ["TESTBED_NO_SERVER"] = "1"
 
 ROOT = Path(__file__).resolve().parent.parent
+
+# The property tests (hypothesis) draw the same examples on every run, as every other test is
+# the same on every run: a random draw made CI's verdict depend on the day (round 7 drew
+# rig.length = 5e-324 once in one full run, an internal error then).  HYPOTHESIS_PROFILE=explore
+# draws afresh each run, for hunting; what it finds becomes a fixed regression test.
+with contextlib.suppress(ImportError):
+    from hypothesis import settings as _hypothesis_settings
+
+    _hypothesis_settings.register_profile("ci", derandomize=True, database=None)
+    _hypothesis_settings.register_profile("explore", derandomize=False, database=None)
+    _hypothesis_settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "ci"))
 # Tests share the benchmarks' synthetic problems (``from benchmarks import ...``).
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))

@@ -225,6 +225,11 @@ def _check_segment_inertia(rig: dict[str, Any], error: ErrorFn) -> None:
     default (by ratio), e.g. ``rig.thickness`` for a 1e-12 m deep beam.
     """
     params = beam_params(rig)
+    if not params.segment_length > 0.0:  # length / n_segments underflowed (5e-324 m): no segment
+        error("rig.length", rig["length"],
+              f"a segment length (rig.length / rig.n_segments) above 0 m; it underflows to "
+              f"{params.segment_length:g} m here")
+        return
     with np.errstate(over="ignore", invalid="ignore"):  # huge values: inf passes, refused elsewhere
         xs, _ = params.hinges()
         seg = np.append(xs[1:], params.length) - xs

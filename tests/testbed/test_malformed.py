@@ -1216,3 +1216,13 @@ def test_a_plugin_rig_raising_in_simulate_is_one_line_naming_its_file(monkeypatc
     origin["michaelis_menten"] = "builtin"
     with pytest.raises(ValueError, match="array is too big"):
         gen.simulate_clean(sc)
+
+
+def test_a_beam_length_whose_segments_underflow_is_refused():
+    """Found by the property test above (round 7): ``rig.length = 5e-324`` divided by the
+    segments underflows to 0 m, and the segment-inertia check divided by it (ZeroDivisionError,
+    an internal error)."""
+    raw = copy.deepcopy(base_raw("cantilever_stiff_impact"))
+    raw["rig"]["length"] = 5e-324
+    with pytest.raises(ScenarioError, match=r"key 'rig\.length'.*underflows to 0 m"):
+        scenario_from_dict(raw, file="<random>", stem=raw["scenario"]["name"])
