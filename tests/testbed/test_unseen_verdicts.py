@@ -396,3 +396,19 @@ def test_auto_lowpass_above_nyquist_names_auto_and_its_rule():
     raw["signal"] = {"lowpass_hz": 8000.0}
     with pytest.raises(ScenarioError, match=r"value 8000\.0: expected below the Nyquist"):
         scenario_from_dict(raw, file="six.toml")
+
+
+@pytest.mark.parametrize("name, cells", [("round7_beams", 92), ("round7_beams_noise", 32),
+                                         ("round7_linkages_sine_seeds", 40),
+                                         ("round7_linkages_geometry", 18),
+                                         ("round7_linkages_cartpoles", 12),
+                                         ("round7_linkages_kinetics", 14)])
+def test_round7_studies_load(name, cells):
+    """The round-7 studies load with every case valid (their refusals are reproducers outside
+    the studies: b_s6_short.toml), and every beam's "auto" low-pass is resolved at load."""
+    from testbed.studies.study import load_study
+    study = load_study(_root() / "benchmarks" / "unseen" / f"{name}.toml")
+    assert study.name == name and study.n_cells() == cells
+    for sc in study.scenarios:
+        if sc.rig == "cantilever":
+            assert isinstance(sc.signal["lowpass_hz"], float) and "signal.lowpass_hz" in sc.rules
