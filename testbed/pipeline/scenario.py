@@ -476,9 +476,18 @@ def scenario_from_dict(raw: dict[str, Any], *, file: str = "<dict>", stem: str |
     signal = validate_table(raw.get("signal", {}), SIGNAL_SCHEMAS[rig_cls.kind], file=file,
                             section="signal")
     rules = resolve_auto_signal(rig_cls, rig_params, signal, file)
+
+    def chain_error(key: str, value: Any, allowed: str) -> None:
+        # a cut-off the scenario wrote as "auto" is named as written, with the rule that
+        # resolved it (its estimates say which mode put it where: round 7, six sensors on a
+        # 0.32 m beam put mode 6 at 7 kHz and the low-pass above the Nyquist frequency)
+        if key in rules:
+            raise ScenarioError(file, key, "auto", f"{allowed}; 'auto' resolved it to {rules[key]}")
+        raise ScenarioError(file, key, value, allowed)
+
     record = rig_cls.record(simulation)
     if record is not None:
-        check_signal(rig_cls.kind, signal, *record, error)
+        check_signal(rig_cls.kind, signal, *record, chain_error)
     identify = _validate_identify(raw.get("identify"), file, kind=rig_cls.kind,
                                   rig_kind_source=f"rig {head['rig']!r}")
     score = _validate_score(raw.get("score", {}), rig_cls.kind, file)

@@ -376,3 +376,39 @@ def test_round6_beam_studies_load_and_resolve_auto(name, n):
     for sc in study.scenarios:
         assert all(isinstance(sc.signal[k], float) for k in ("highpass_hz", "lowpass_hz"))
         assert ("signal.lowpass_hz" in sc.rules) == (sc.signal["lowpass_hz"] > 0)
+
+
+# ------------------------------------------- round 7
+def test_auto_lowpass_above_nyquist_names_auto_and_its_rule():
+    """Round 7 (benchmarks/unseen/round7/b_s6_short.toml): six sensors on the shipped 0.3175 m
+    beam sense mode 6 at about 7 kHz, and ``lowpass_hz = "auto"`` resolves between modes 6 and 7
+    to 8317.5 Hz, above the 6.4 kHz Nyquist frequency.  The refusal named the value 8317.5, which
+    the scenario never wrote; it now names what was written and the rule with its estimates."""
+    sensors = [round(0.3175 * (k + 1) / 6, 6) for k in range(6)]
+    raw = beam({"sensors": sensors, "n_segments": 18})
+    raw["signal"] = {"lowpass_hz": "auto"}
+    with pytest.raises(ScenarioError) as e:
+        scenario_from_dict(raw, file="six.toml")
+    msg = str(e.value)
+    assert "six.toml" in msg and "signal.lowpass_hz" in msg and "value 'auto'" in msg
+    assert "Nyquist frequency 6400 Hz" in msg and "8317.5 Hz" in msg and "between mode 6" in msg
+    # a cut-off written as a number keeps its own value in the message
+    raw["signal"] = {"lowpass_hz": 8000.0}
+    with pytest.raises(ScenarioError, match=r"value 8000\.0: expected below the Nyquist"):
+        scenario_from_dict(raw, file="six.toml")
+
+
+@pytest.mark.parametrize("name, cells", [("round7_beams", 92), ("round7_beams_noise", 32),
+                                         ("round7_linkages_sine_seeds", 40),
+                                         ("round7_linkages_geometry", 18),
+                                         ("round7_linkages_cartpoles", 12),
+                                         ("round7_linkages_kinetics", 14)])
+def test_round7_studies_load(name, cells):
+    """The round-7 studies load with every case valid (their refusals are reproducers outside
+    the studies: b_s6_short.toml), and every beam's "auto" low-pass is resolved at load."""
+    from testbed.studies.study import load_study
+    study = load_study(_root() / "benchmarks" / "unseen" / f"{name}.toml")
+    assert study.name == name and study.n_cells() == cells
+    for sc in study.scenarios:
+        if sc.rig == "cantilever":
+            assert isinstance(sc.signal["lowpass_hz"], float) and "signal.lowpass_hz" in sc.rules
