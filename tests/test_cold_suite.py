@@ -38,3 +38,25 @@ def test_make_test_byte_compiles_every_package_before_pytest():
     packages = tomllib.loads((root / "pyproject.toml").read_text())["tool"]["setuptools"]["packages"]
     tops = {p.split(".")[0] for p in packages}
     assert tops | {"benchmarks", "tests"} <= folders, sorted(tops - folders)
+
+
+def test_demo_reads_the_runs_of_the_eq21_group():
+    """The demo test answers ``run_demo``'s two fits with the runs of the scored tests and the
+    Eq. 21 contrast (conftest ``scenario_run``): it must be in their xdist group, or it fits them
+    again on its own worker."""
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).parent / "testbed" / "reporting" / "test_demo.py"
+    spec = importlib.util.spec_from_file_location("_cold_test_demo", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    (mark,) = mod.test_demo_runs_scores_reports_and_states_the_contrast.pytestmark
+    assert mark.name == "xdist_group" and mark.args == ("eq21",)
+    from testbed.reporting.demo import EQ21_PAIR
+
+    scored = importlib.util.spec_from_file_location("_cold_scored", Path(__file__).parent / "scenarios"
+                                                    / "test_scored.py")
+    smod = importlib.util.module_from_spec(scored)
+    scored.loader.exec_module(smod)
+    assert set(EQ21_PAIR) == set(smod.SHARED)

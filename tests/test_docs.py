@@ -6,6 +6,7 @@ from __future__ import annotations
 import ast
 import os
 import re
+import runpy
 import subprocess
 import sys
 from pathlib import Path
@@ -17,6 +18,8 @@ DOCS = ROOT / "docs"
 #: Every markdown file with a ```python example (a test below checks that none is left out).
 GUIDES = {"identifiers.md": DOCS / "identifiers.md", "rigs.md": DOCS / "rigs.md",
           "python-api.md": DOCS / "python-api.md", "README.md": ROOT / "README.md"}
+#: The guides whose example registers an identifier or a rig (run in a fresh interpreter).
+REGISTERING = ("identifiers.md", "rigs.md")
 
 
 def python_blocks(path: Path) -> list[str]:
@@ -30,7 +33,7 @@ def test_every_python_example_is_run():
 
 
 @pytest.mark.parametrize("guide", list(GUIDES))
-def test_guide_example_runs(guide, tmp_path, monkeypatch, cli_in_process, dataset_cache):
+def test_guide_example_runs(guide, tmp_path, monkeypatch, capsys, cli_in_process, dataset_cache):
     blocks = python_blocks(GUIDES[guide])
     assert blocks, f"{guide} has no python example"
     if guide in ("python-api.md", "README.md"):
@@ -41,15 +44,31 @@ def test_guide_example_runs(guide, tmp_path, monkeypatch, cli_in_process, datase
         dataset_cache.clean(load_scenario("cantilever_stiff_impact_lsq"))
     script = tmp_path / "example.py"
     script.write_text("\n\n".join(blocks))
-    # a fresh interpreter: the example's registration must not leak into other tests' registries
-    # (the shared test cache: a dataset the examples need is simulated once per machine)
+    # the shared test cache: a dataset the examples need is simulated once per machine
     env = {**os.environ, "OMP_NUM_THREADS": "1", "MPLBACKEND": "Agg",
            "TESTBED_CACHE": os.environ.get("TESTBED_TEST_CACHE", str(ROOT / ".cache" / "test-datasets")),
            "PYTHONPATH": os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")])}
-    r = subprocess.run([sys.executable, str(script)], cwd=tmp_path, capture_output=True, text=True,
-                       timeout=120, env=env)
-    assert r.returncode == 0, f"{guide} example failed:\n{r.stdout}\n{r.stderr[-3000:]}"
-    assert r.stdout.strip()
+    if guide in REGISTERING:
+        # a fresh interpreter: the example's registration must not leak into other tests'
+        # registries
+        r = subprocess.run([sys.executable, str(script)], cwd=tmp_path, capture_output=True,
+                           text=True, timeout=120, env=env)
+        assert r.returncode == 0, f"{guide} example failed:\n{r.stdout}\n{r.stderr[-3000:]}"
+        out = r.stdout
+    else:
+        # registers nothing: run in this process, as a script in its own folder (the interpreter's
+        # start and imports were 2-3 s of CPU of each of these two examples on a cold run)
+        monkeypatch.chdir(tmp_path)
+        monkeypatch.setenv("TESTBED_CACHE", env["TESTBED_CACHE"])
+        from testbed.pipeline.plugins import IDENTIFIERS, RIGS
+
+        before = [r.snapshot() for r in (IDENTIFIERS, RIGS)]
+        capsys.readouterr()
+        runpy.run_path(str(script), run_name="__main__")
+        out = capsys.readouterr().out
+        assert [r.snapshot() for r in (IDENTIFIERS, RIGS)] == before, (
+            f"{guide}'s example registers: list it in REGISTERING")
+    assert out.strip()
     if guide in ("identifiers.md", "rigs.md"):
         # the example, saved as a file outside the repository, is a plugin of the command line
         # (`testbed list --plugin` in this process: what it registers is forgotten after it)
