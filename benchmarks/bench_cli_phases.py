@@ -163,11 +163,11 @@ def _summary(rounds: list[dict]) -> dict[str, np.ndarray]:
 
 def _measure() -> dict[str, list[float]]:
     """The measurement, in a process started with the served environment (:func:`run`)."""
-    from testbed import server
+    from testbed import cli, server
 
     with contextlib.redirect_stderr(io.StringIO()):
         server._preload()
-        server._warm_up(SCENARIO, lambda text: None)
+        server._warm_up(SCENARIO, lambda text: None, cli._main)
     # not a TemporaryDirectory: its finalizer is an atexit function, which each served command
     # runs at its end (testbed.server._exit_work), removing the folder under the next command
     tmp = Path(tempfile.mkdtemp(prefix="bench_cli_phases."))

@@ -28,9 +28,17 @@ from typing import Any
 from urllib.parse import urlsplit
 
 from testbed.core import interrupts  # armed on import by testbed/__init__.py, before this module
-from testbed.core.errors import InputError, ScenarioError, TestbedError, show_value
+from testbed.core.errors import (
+    EXIT_FAIL,
+    EXIT_INTERNAL,
+    EXIT_INTERRUPTED,
+    EXIT_USAGE,
+    InputError,
+    ScenarioError,
+    TestbedError,
+    show_value,
+)
 
-EXIT_FAIL, EXIT_USAGE, EXIT_INTERNAL, EXIT_INTERRUPTED = 1, 2, 3, 130
 #: Status when the reader of standard output went away: a shell's for a command ended by SIGPIPE.
 EXIT_BROKEN_PIPE = 128 + 13
 #: Thread-count variables of the BLAS libraries numpy and scipy load (OpenBLAS, MKL, an OpenMP
@@ -648,7 +656,8 @@ def cmd_serve(args: argparse.Namespace) -> int:
     if not 0 < args.idle <= MAX_IDLE_S:
         raise InputError(f"--idle {args.idle}: expected a positive number of seconds, at most "
                          f"{MAX_IDLE_S:g} (2^31 - 1 ms)")
-    return serve(idle=args.idle, warm_up=None if args.warm_up == "none" else args.warm_up)
+    return serve(main, idle=args.idle, warm_up=None if args.warm_up == "none" else args.warm_up,
+                 warm_up_command=_main)
 
 
 def cmd_demo(args: argparse.Namespace) -> int:

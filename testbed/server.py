@@ -52,6 +52,7 @@ import socket
 import struct
 import sys
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 __all__ = ["IMPORT_TIME_VARIABLES", "serve", "server_key", "socket_path", "try_server"]
@@ -274,7 +275,7 @@ class _Signalled(Exception):
 def _as_alone(signum: int, handlers: dict) -> int:
     """End as the command alone would on ``signum`` before it did any work."""
     if signum == signal.SIGINT:
-        from testbed.cli import EXIT_INTERRUPTED
+        from testbed.core.errors import EXIT_INTERRUPTED
 
         print("error: interrupted", file=sys.stderr, flush=True)
         return EXIT_INTERRUPTED
@@ -297,7 +298,7 @@ def _preload() -> None:
     RIGS.names(), IDENTIFIERS.names()  # the registries import their modules on first lookup
 
 
-def _warm_up(scenario: str | None, log) -> None:
+def _warm_up(scenario: str | None, log, command: Callable[[list[str]], int]) -> None:
     """Run one scored scenario with figures in a scratch folder, silently.
 
     What a first run in a process pays besides imports (numba loading its cached kernels, the
@@ -311,31 +312,32 @@ def _warm_up(scenario: str | None, log) -> None:
     import shutil
     import tempfile
 
-    from testbed import cli
+    from testbed.core.errors import EXIT_FAIL
 
     tmp = tempfile.mkdtemp(prefix="testbed-server-warm-up-")
     try:
         with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()) as err:
-            status = cli._main(["run", scenario, "--out", tmp])
-        if status not in (0, cli.EXIT_FAIL):
+            status = command(["run", scenario, "--out", tmp])
+        if status not in (0, EXIT_FAIL):
             log(f"testbed server: warm-up skipped ({err.getvalue().strip()[:200]})")
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
 
 
-def _child(request: dict, fds: list[int], inherited: list, server: int) -> None:
+def _child(request: dict, fds: list[int], inherited: list, server: int,
+           command: Callable[[list[str]], int]) -> None:
     """In the forked child: become the client's command, run it, exit with its status.
 
     ``inherited`` are the server's sockets, selector and descriptors, closed here: a child that
     held another client's connection would keep that client waiting after the server died.
     The child is killed with the server (``PR_SET_PDEATHSIG``); its client then says so.
     """
-    status = 3  # EXIT_INTERNAL, until cli is imported
+    from testbed.core.errors import EXIT_INTERNAL
+
+    status = EXIT_INTERNAL
     try:
-        from testbed import cli
         from testbed.reporting.drawer import _die_with_parent
 
-        status = cli.EXIT_INTERNAL
         os.setpgid(0, 0)  # its own group: the server can end it with everything it started
         _die_with_parent(server)
         for obj in inherited:
@@ -361,7 +363,7 @@ def _child(request: dict, fds: list[int], inherited: list, server: int) -> None:
         sys.stdout = open(1, "w", buffering=1 if os.isatty(1) else -1, closefd=False)
         sys.stderr = open(2, "w", buffering=1, errors="backslashreplace", closefd=False)
         sys.argv = ["testbed", *request["argv"]]
-        status = cli.main(list(request["argv"]))
+        status = command(list(request["argv"]))
     except SystemExit as e:
         status = e.code if isinstance(e.code, int) else (0 if e.code is None else 1)
     except BaseException as e:  # one line, as the command itself would print
@@ -395,9 +397,11 @@ def _exit_work() -> None:
 class _Server:
     """A server's state: its listener, selector, and the clients it serves."""
 
-    def __init__(self, listener: socket.socket, key: str, log, rfd: int, wfd: int) -> None:
+    def __init__(self, listener: socket.socket, key: str, log, rfd: int, wfd: int,
+                 command: Callable[[list[str]], int]) -> None:
         self.listener: socket.socket | None = listener
         self.key, self.log, self.rfd, self.wfd = key, log, rfd, wfd
+        self.command = command
         self.sel = selectors.DefaultSelector()
         self.sel.register(listener, selectors.EVENT_READ, ("accept",))
         self.sel.register(rfd, selectors.EVENT_READ, ("signal",))
@@ -414,8 +418,9 @@ REQUEST_TIMEOUT_S = 10.0
 READ_TIMEOUT_S = 2.0
 
 
-def serve(idle: float = IDLE_S, path: Path | None = None, log=None,
-          warm_up: str | None = WARM_UP) -> int:
+def serve(command: Callable[[list[str]], int], idle: float = IDLE_S, path: Path | None = None,
+          log=None, warm_up: str | None = WARM_UP,
+          warm_up_command: Callable[[list[str]], int] | None = None) -> int:
     """Listen for commands until ``idle`` seconds pass without one (or SIGTERM / Ctrl-C).
 
     When the sources change the server stops taking commands (clients then run alone), lets
@@ -424,6 +429,10 @@ def serve(idle: float = IDLE_S, path: Path | None = None, log=None,
 
     Parameters
     ----------
+    command : callable
+        ``command(argv) -> status``, what runs a client's command in its forked child (and the
+        warm-up): the command line's :func:`testbed.cli.main`, which ``testbed serve`` passes.
+        The server is the command line's transport and does not import it.
     idle : float
         Seconds without a running or new command before the server exits.
     path : Path, optional
@@ -432,6 +441,10 @@ def serve(idle: float = IDLE_S, path: Path | None = None, log=None,
         ``log(text)`` for one line per command served (default: standard error).
     warm_up : str or None
         Scenario run once at start to warm the caches (:func:`_warm_up`); None: none.
+    warm_up_command : callable, optional
+        What runs the warm-up in the server's own process (default ``command``): ``testbed
+        serve`` passes the command line's body without its signal handling, which the
+        serving command already holds.
 
     Returns
     -------
@@ -453,7 +466,7 @@ def serve(idle: float = IDLE_S, path: Path | None = None, log=None,
     key = server_key(start_env)
     _refuse_if_served(path)
     _preload()
-    _warm_up(warm_up, log)
+    _warm_up(warm_up, log, warm_up_command or command)
     with contextlib.suppress(FileNotFoundError):
         path.unlink()  # (a server that started meanwhile loses its socket to this one)
     listener = _bind(path)
@@ -464,7 +477,7 @@ def serve(idle: float = IDLE_S, path: Path | None = None, log=None,
     signal.signal(signal.SIGCHLD, lambda *a: None)
     stop = []
     signal.signal(signal.SIGTERM, lambda *a: stop.append(1))
-    st = _Server(listener, key, log, rfd, wfd)
+    st = _Server(listener, key, log, rfd, wfd, command)
     log(f"testbed server listening on {path} (exits after {idle:g} s idle)")
     last = time.monotonic()
     try:
@@ -622,7 +635,7 @@ def _start(st: _Server, conn: socket.socket, request: dict, fds: list[int]) -> N
         return
     if pid == 0:
         _child(request, fds, [st.sel, *(s for s in (st.listener,) if s), conn, *st.running.values(),
-                              *st.pending, st.rfd, st.wfd], os.getppid())
+                              *st.pending, st.rfd, st.wfd], os.getppid(), st.command)
     with contextlib.suppress(OSError):
         os.setpgid(pid, pid)  # (also done by the child: whichever runs first)
     st.running[pid] = conn

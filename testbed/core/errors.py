@@ -40,6 +40,11 @@ def show_names(names: Any) -> str:
     return shown if len(names) <= MAX_NAMES else f"{shown} and {len(names) - MAX_NAMES} more"
 
 
+
+#: Exit statuses of a command (:func:`testbed.cli.main`, and a command served by
+#: :mod:`testbed.server`): a run that failed its bars, a user's mistake, a bug, an interrupt.
+EXIT_FAIL, EXIT_USAGE, EXIT_INTERNAL, EXIT_INTERRUPTED = 1, 2, 3, 130
+
 class TestbedError(Exception):
     """Base of the errors the CLI prints as one line, without a traceback."""
 

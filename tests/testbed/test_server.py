@@ -176,8 +176,7 @@ def main(argv):  # sleep SECONDS [STATUS [AT-EXIT-TEXT]]
         import atexit
         atexit.register(print, argv[3], flush=True)
     return int(argv[2]) if len(argv) > 2 else 0
-c.main = main
-s.serve(idle=60, warm_up=None)
+s.serve(main, idle=60, warm_up=None)
 """
 
 
