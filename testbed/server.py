@@ -312,6 +312,7 @@ def _warm_up(scenario: str | None, log) -> None:
     import tempfile
 
     from testbed import cli
+    from testbed.reporting import drawer
 
     tmp = tempfile.mkdtemp(prefix="testbed-server-warm-up-")
     try:
@@ -319,6 +320,11 @@ def _warm_up(scenario: str | None, log) -> None:
             status = cli._main(["run", scenario, "--out", tmp])
         if status not in (0, cli.EXIT_FAIL):
             log(f"testbed server: warm-up skipped ({err.getvalue().strip()[:200]})")
+        # the run's figures were drawn in forked processes: fonts and the PNG encoder are
+        # loaded here too, and the frames of its figures (figure, axes, ticks) are made here,
+        # so that each command's drawing processes inherit them (testbed.reporting.frames)
+        drawer._warm_up()
+        drawer.prepare_frames(Path(tmp) / scenario)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
 
