@@ -11,7 +11,15 @@ three wrappers installed before the fork (so the command and its drawing process
 - each figure, its CPU time in the drawing process that drew it
   (:func:`testbed.reporting.drawer._draw`, one stem at a time);
 - the command's own CPU time at its end (:func:`testbed.server._exit_work`), and the whole
-  command's with its drawing processes (``wait4`` of the child).
+  command's with its drawing processes (``wait4`` of the child);
+- the figure frames made ahead in the drawing process while the command fits
+  (:func:`testbed.reporting.drawer.prepare_frames`): their CPU, and whether they were made
+  before the first figure was drawn (off the critical path).  A served command inherits the
+  frames the server made after its warm-up run, and so makes none.
+
+Each round also runs the command once without any frame made ahead (the server's pool emptied,
+the drawing process not asked to make any), interleaved: the per-round ratio of the critical
+paths is what the frames save, at whatever load the machine has.
 
 CPU time is what the work costs whatever else runs on the machine; wall time is reported with
 the load.  The *critical path* is the command's own CPU plus the larger of the two drawing
@@ -38,7 +46,7 @@ from pathlib import Path
 
 import numpy as np
 
-from benchmarks._timing import machine, spread
+from benchmarks._timing import machine, ratio_spread, spread
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENARIO = "cantilever_stiff_impact"
@@ -81,8 +89,18 @@ def _instrument(record) -> None:
         yield phase
 
     draw = drawer._draw
+    prepare = drawer.prepare_frames
+
+    def prepare_recorded(folder):
+        if _NO_FRAMES:
+            return 0
+        c = _cpu()
+        n = prepare(folder)
+        record(kind="prepare", name="frames", cpu=_cpu() - c, made=n, end=time.time())
+        return n
 
     def draw_each(run, folder, stems):
+        record(kind="draw start", name="", start=time.time())
         out = []
         for stem in stems:
             c = _cpu()
@@ -98,6 +116,7 @@ def _instrument(record) -> None:
 
     progress.run_progress = run_progress
     drawer._draw = draw_each
+    drawer.prepare_frames = prepare_recorded
     server._exit_work = exit_work_recorded
 
 
@@ -123,15 +142,35 @@ def _served_run(out: str) -> tuple[float, float]:
     return wall, _cpu(resource.RUSAGE_CHILDREN) - before
 
 
-def _rounds(log: Path, out: str) -> list[dict]:
-    """``REPEATS`` served runs after one untimed one; per run its records and totals."""
-    rounds = []
-    for i in range(REPEATS + 1):
-        log.write_text("")
-        wall, cpu = _served_run(out)
-        recs = [json.loads(line) for line in log.read_text().splitlines()]
-        if i:
-            rounds.append({"wall": wall, "cpu": cpu, "load": os.getloadavg()[0], "records": recs})
+#: Set while a command runs without frames made ahead (:func:`_rounds`).
+_NO_FRAMES = False
+
+
+def _rounds(log: Path, out: str) -> tuple[list[dict], list[dict]]:
+    """``REPEATS`` rounds after one untimed one, each a served run as shipped and one without
+    frames made ahead; per run its records and totals."""
+    global _NO_FRAMES
+    from testbed.reporting import frames
+
+    pool = {k: list(v) for k, v in frames._POOL.items()}  # the server's, made at its warm-up
+    rounds: tuple[list[dict], list[dict]] = ([], [])
+    try:
+        for i in range(REPEATS + 1):
+            for without in (False, True):
+                frames.clear()
+                if not without:
+                    frames._POOL.update({k: list(v) for k, v in pool.items()})
+                _NO_FRAMES = without
+                log.write_text("")
+                wall, cpu = _served_run(f"{out}-{int(without)}")
+                recs = [json.loads(line) for line in log.read_text().splitlines()]
+                if i:
+                    rounds[without].append({"wall": wall, "cpu": cpu, "load": os.getloadavg()[0],
+                                            "records": recs})
+    finally:
+        _NO_FRAMES = False
+        frames.clear()
+        frames._POOL.update(pool)
     return rounds
 
 
@@ -141,7 +180,15 @@ def _summary(rounds: list[dict]) -> dict[str, np.ndarray]:
     for r in rounds:
         groups: dict[int, float] = {}
         own = 0.0
+        prep, prep_end, starts = 0.0, None, []
         for rec in r["records"]:
+            if rec["kind"] == "prepare":
+                prep, prep_end = rec["cpu"], rec["end"]
+                s.setdefault("frames made ahead", []).append(rec["made"])
+                continue
+            if rec["kind"] == "draw start":
+                starts.append(rec["start"])
+                continue
             if rec["kind"] == "phase":
                 s.setdefault(f"phase {rec['name']} cpu", []).append(rec["cpu"])
                 s.setdefault(f"phase {rec['name']} wall", []).append(rec["wall"])
@@ -155,6 +202,9 @@ def _summary(rounds: list[dict]) -> dict[str, np.ndarray]:
         s.setdefault("larger drawing group", []).append(g[0])
         s.setdefault("smaller drawing group", []).append(g[1])
         s.setdefault("critical path", []).append(own + g[0])
+        s.setdefault("frames ahead cpu", []).append(prep)
+        s.setdefault("frames ahead in time", []).append(
+            float(prep_end is None or not starts or prep_end <= min(starts)))
         s.setdefault("wall", []).append(r["wall"])
         s.setdefault("cpu", []).append(r["cpu"])
         s.setdefault("load", []).append(r["load"])
@@ -174,7 +224,10 @@ def _measure() -> dict[str, list[float]]:
     try:
         log = tmp / "records.jsonl"
         _instrument(_recorder(log))
-        return {k: v.tolist() for k, v in _summary(_rounds(log, str(tmp / "runs"))).items()}
+        shipped, without = _rounds(log, str(tmp / "runs"))
+        out = {k: v.tolist() for k, v in _summary(shipped).items()}
+        out.update({f"none {k}": v.tolist() for k, v in _summary(without).items()})
+        return out
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
 
@@ -189,12 +242,27 @@ def run() -> list[dict]:
     s = {k: np.asarray(v) for k, v in json.loads(proc.stdout.splitlines()[-1]).items()}
     med = {k: float(np.median(v)) for k, v in s.items()}
     loads = f"load average during the runs {spread(s['load'], fmt='.2f')}; {machine()}"
+    r_path, n_path = ratio_spread(s["critical path"], s["none critical path"])
+    _, n_group = ratio_spread(s["larger drawing group"], s["none larger drawing group"])
     rows = [{"name": f"served {SCENARIO}: critical path (command's own CPU + larger drawing group)",
              "value": med["critical path"], "unit": "s", "target": "report", "ok": None,
              "note": f"{spread(s['critical path'])} s: command's own CPU {spread(s['command own cpu'])} s "
                      f"(phases below, its start and end), drawing groups {spread(s['larger drawing group'])} "
                      f"and {spread(s['smaller drawing group'])} s; bench_cli's target for the whole "
                      f"served run is < {TARGET_RUN_S} s wall; {loads}"},
+            {"name": f"served {SCENARIO}: critical path, frames made ahead / none", "value": r_path,
+             "unit": "x", "target": "report", "ok": None,
+             "note": f"{n_path}, interleaved; larger drawing group {n_group}; without frames: "
+                     f"critical path {spread(s['none critical path'])} s, drawing groups "
+                     f"{spread(s['none larger drawing group'])} and "
+                     f"{spread(s['none smaller drawing group'])} s, "
+                     f"whole command {spread(s['none cpu'])} s CPU (with them: {spread(s['cpu'])})"},
+            {"name": f"served {SCENARIO}: figure frames made ahead during the fit",
+             "value": med["frames ahead cpu"], "unit": "s CPU", "target": "report", "ok": None,
+             "note": f"{spread(s['frames ahead cpu'])} s CPU in the drawing process, "
+                     f"{spread(s.get('frames made ahead', np.zeros(1)), fmt='.0f')} frames made "
+                     f"(a served command inherits the server's), done before the first figure in "
+                     f"{int(sum(s['frames ahead in time']))} of {len(s['frames ahead in time'])} runs"},
             {"name": f"served {SCENARIO}: whole command", "value": med["cpu"], "unit": "s CPU",
              "target": "report", "ok": None,
              "note": f"drawing processes included, {spread(s['cpu'])} s; wall {spread(s['wall'])} s "

@@ -432,6 +432,8 @@ def cmd_run(args: argparse.Namespace) -> int:
             if args.seed is not None:
                 sc = sc.replace(seed=args.seed)
             scenario_folder(args.out, sc.name)  # refused before the work, not after
+            if figures is not None:  # its frames made while the run computes
+                figures.prepare(args.out, sc.name)
             with run_progress(sc.name) as phase:
                 with _rig_errors_name(sc):
                     result = run_scenario(sc, cache=cache, phase=phase)

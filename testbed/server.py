@@ -313,6 +313,7 @@ def _warm_up(scenario: str | None, log, command: Callable[[list[str]], int]) -> 
     import tempfile
 
     from testbed.core.errors import EXIT_FAIL
+    from testbed.reporting import drawer
 
     tmp = tempfile.mkdtemp(prefix="testbed-server-warm-up-")
     try:
@@ -320,6 +321,11 @@ def _warm_up(scenario: str | None, log, command: Callable[[list[str]], int]) -> 
             status = command(["run", scenario, "--out", tmp])
         if status not in (0, EXIT_FAIL):
             log(f"testbed server: warm-up skipped ({err.getvalue().strip()[:200]})")
+        # the run's figures were drawn in forked processes: fonts and the PNG encoder are
+        # loaded here too, and the frames of its figures (figure, axes, ticks) are made here,
+        # so that each command's drawing processes inherit them (testbed.reporting.frames)
+        drawer._warm_up()
+        drawer.prepare_frames(Path(tmp) / scenario)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
 

@@ -6,8 +6,11 @@ drawing process when the command starts: it imports matplotlib and draws one sma
 files, PNG encoder) while the parent loads its data and fits, then waits for a run folder.  A
 run folder sent to it is drawn by it and by one more process forked from it at that moment
 (matplotlib already imported), each drawing about half of the figures; the parent writes the
-report from the PNGs.  The figures are the same as drawn in-process
-(:func:`testbed.reporting.figures.save_run_figures`): the same builders on the same files.
+report from the PNGs.  While the parent fits, the drawing process also makes the figures'
+frames (figure, axes, ticks: :mod:`testbed.reporting.frames`), about a third of their CPU, with
+the shapes of the scenario's previous run when there is one (:meth:`RunFigures.prepare`).
+The figures are the same as drawn in-process (:func:`testbed.reporting.figures.save_run_figures`):
+the same builders on the same files.
 
 Life cycle:
 
@@ -24,27 +27,32 @@ from __future__ import annotations
 
 import contextlib
 import gc
+import math
 import multiprocessing
 import os
 import pickle
 import signal
 import sys
 import traceback
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import Any
 
 from testbed.reporting import figures as figs
 from testbed.reporting.report import save_run_figures_and_report
-from testbed.studies.runstore import load_run
+from testbed.studies.runstore import load_run, resolve_run, scenario_folder
 
-__all__ = ["FigureWorker", "FigureWorkerError", "figure_drawer", "split_figures"]
+__all__ = ["FigureWorker", "FigureWorkerError", "RunFigures", "figure_drawer", "prepare_frames",
+           "split_figures"]
 
-#: Relative drawing cost of each run figure (measured CPU of the cantilever run's figures:
-#: reconstruction 0.30-0.36 s, spectra 0.33-0.39, matrices 0.43-0.47, mac 0.09, frequencies
-#: 0.07-0.11, penalty weights 0.13); a stem not listed counts 1.
-FIGURE_COST = {"reconstruction": 3.0, "spectra": 3.0, "matrices": 4.0, "joint_angles": 3.0,
-               "mac": 1.0, "frequencies": 1.0, "penalty_weights": 1.0, "coefficients": 1.0}
+#: Relative drawing cost of each run figure, as drawn on a frame made ahead (CPU of the
+#: cantilever run's figures, served, 7 runs at load 10: matrices 0.48 s, spectra 0.41,
+#: reconstruction 0.36, penalty weights 0.17, mac 0.14, frequencies 0.11; in units of 0.12 s);
+#: a stem not listed counts 1.
+FIGURE_COST = {"matrices": 4.0, "spectra": 3.4, "reconstruction": 3.0, "joint_angles": 3.0,
+               "penalty_weights": 1.4, "mac": 1.2, "frequencies": 0.9, "coefficients": 1.0}
+#: Most figures split exactly (every split tried); more are split longest first.
+EXACT_SPLIT = 12
 #: Seconds the parent waits for a drawing process to end after asking it to stop.
 STOP_TIMEOUT_S = 5.0
 _PR_SET_PDEATHSIG = 1
@@ -57,11 +65,24 @@ class FigureWorkerError(RuntimeError):
 def split_figures(stems: Sequence[str], parts: int = 2) -> list[list[str]]:
     """Stems split into ``parts`` groups of about equal drawing cost (:data:`FIGURE_COST`).
 
-    Longest first onto the least loaded group (ties: the earlier group, the earlier stem), so
-    the split is the same on every machine.  Empty groups are dropped.
+    Two groups of at most :data:`EXACT_SPLIT` stems: the split whose costlier group costs
+    least (ties: the first found, stems in report order); else longest first onto the least
+    loaded group (ties: the earlier group, the earlier stem).  The split is the same on every
+    machine.  Empty groups are dropped; each group keeps the report order.
     """
+    cost = [FIGURE_COST.get(s, 1.0) for s in stems]
+    if parts == 2 and 0 < len(stems) <= EXACT_SPLIT:
+        best, pick = math.inf, 0
+        for mask in range(1 << (len(stems) - 1)):  # the last stem stays in the first group
+            second = sum(c for i, c in enumerate(cost) if mask >> i & 1)
+            worst = max(sum(cost) - second, second)
+            if worst < best - 1e-9:
+                best, pick = worst, mask
+        groups = [[s for i, s in enumerate(stems) if not pick >> i & 1],
+                  [s for i, s in enumerate(stems) if pick >> i & 1]]
+        return [g for g in groups if g]
     load = [0.0] * parts
-    groups: list[list[str]] = [[] for _ in range(parts)]
+    groups = [[] for _ in range(parts)]
     for s in sorted(stems, key=lambda s: -FIGURE_COST.get(s, 1.0)):  # stable: report order in ties
         g = min(range(parts), key=lambda k: (load[k], k))
         groups[g].append(s)
@@ -87,6 +108,19 @@ def _warm_up() -> None:
     ax.plot([0.0, 1.0], [0.0, 1.0])
     ax.set(title="warm-up", xlabel="x [-]")
     figs.save_figure(fig, os.devnull)
+
+
+def prepare_frames(folder: str | os.PathLike) -> int:
+    """Make the frames of the figures of the run saved in ``folder`` (a run folder, or a
+    scenario's folder of runs: its latest run), so that a run of the same shape takes them
+    (:func:`testbed.reporting.figures.prepare_run_frames`); the number made.
+
+    Never fails: a folder that is missing, damaged or of another layout makes none.
+    """
+    try:
+        return figs.prepare_run_frames(load_run(resolve_run(Path(folder))))
+    except Exception:
+        return 0
 
 
 def _draw(run: Any, folder: str, stems: Sequence[str]) -> list[str]:
@@ -169,6 +203,10 @@ def _serve(conn: Any, parent_end: Any, parent: int) -> None:
             return
         if folder is None:
             return
+        if isinstance(folder, tuple):  # ("prepare", previous run folder): no answer
+            if broken is None:
+                prepare_frames(folder[1])
+            continue
         if broken is not None:
             conn.send(broken)
             continue
@@ -223,6 +261,12 @@ class FigureWorker:
         written = {Path(p).stem: Path(p) for p in msg[1]}
         return [written[s] for s in figs.run_figures_available(run) if s in written]
 
+    def prepare(self, folder: Path) -> None:
+        """Have the drawing process make the frames of the figures of the run saved in
+        ``folder`` (:func:`prepare_frames`) while this process goes on (no answer awaited)."""
+        with contextlib.suppress(OSError, ValueError):  # a dead process is found by draw()
+            self._conn.send(("prepare", str(folder)))
+
     def close(self, *, kill: bool = False) -> None:
         """Stop the drawing process (``kill``: at once) and reap it."""
         if self._proc.is_alive() and not kill:
@@ -240,25 +284,55 @@ def fork_available() -> bool:
     return sys.platform.startswith("linux") and "fork" in multiprocessing.get_all_start_methods()
 
 
+class RunFigures:
+    """The figure writer of ``testbed run`` (:func:`figure_drawer`): ``figures(run, folder)``
+    writes the figures and report of a saved run; ``figures.prepare(out, scenario)`` has the
+    drawing process make the frames of the scenario's latest run in ``out`` ahead of its next.
+
+    Parameters
+    ----------
+    worker : FigureWorker or None
+        Where the figures are drawn; None: in this process, without frames made ahead.
+    """
+
+    def __init__(self, worker: FigureWorker | None = None) -> None:
+        self.worker = worker
+
+    def __call__(self, run: Any, folder: Path) -> list[Path]:
+        draw = self.worker.draw if self.worker is not None else None
+        return save_run_figures_and_report(run, folder, draw=draw)
+
+    def prepare(self, out_dir: str | os.PathLike, scenario: str) -> None:
+        """Before a run of ``scenario`` into ``out_dir``: the drawing process makes the frames
+        of the figures of the scenario's latest run there, if any (never fails)."""
+        if self.worker is None:
+            return
+        try:  # the drawing process finds the latest run (none: no frames are made ahead)
+            folder = scenario_folder(out_dir, scenario)
+        except Exception:
+            return
+        if folder.is_dir():
+            self.worker.prepare(folder)
+
+
 @contextlib.contextmanager
-def figure_drawer(enabled: bool = True) -> Iterator[Callable[[Any, Path], list[Path]] | None]:
-    """The figure writer of ``testbed run``: ``figures(run, folder)`` for
+def figure_drawer(enabled: bool = True) -> Iterator[RunFigures | None]:
+    """The figure writer of ``testbed run``: a :class:`RunFigures` to pass as ``figures`` to
     :func:`testbed.studies.runstore.save_new_run`, drawing in a :class:`FigureWorker`.
 
-    Yields None when not ``enabled`` (``--no-figures``), the in-process writer
-    (:func:`testbed.reporting.report.save_run_figures_and_report`) where ``fork`` is not
-    available.  Start it before the work whose time it should overlap.
+    Yields None when not ``enabled`` (``--no-figures``), one drawing in this process where
+    ``fork`` is not available.  Start it before the work whose time it should overlap.
     """
     if not enabled:
         yield None
         return
     if not fork_available():
-        yield save_run_figures_and_report
+        yield RunFigures()
         return
     worker = FigureWorker()
     ok = False
     try:
-        yield lambda run, folder: save_run_figures_and_report(run, folder, draw=worker.draw)
+        yield RunFigures(worker)
         ok = True
     finally:
         worker.close(kill=not ok)

@@ -31,6 +31,7 @@ from testbed.core.dataset import Dataset
 from testbed.core.truth import StructuralTruth, Truth, TruthError, truth_type
 from testbed.pipeline.cache import DatasetCache
 from testbed.pipeline.scenario import Scenario
+from testbed.reporting import frames
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -81,6 +82,8 @@ def _fig(height: float, width: float = WIDTH, layout: str | None = None) -> Figu
     import matplotlib as mpl
     from matplotlib.figure import Figure
 
+    if frames.recording():  # a builder that makes its own figure has no frame to record
+        raise frames.Recorded
     with mpl.rc_context(STYLE):
         return Figure(figsize=(width, height), layout=layout)
 
@@ -90,6 +93,33 @@ def _axes(fig: Figure, *args: Any, **kw: Any) -> Any:
 
     with mpl.rc_context(STYLE):
         return fig.subplots(*args, squeeze=False, **kw)
+
+
+def _frame(height: float, width: float = WIDTH, *grid: int, ticks: tuple[int, int] = frames.TICKS,
+           **kw: Any) -> tuple[Figure, Any]:
+    """A run figure of ``width`` x ``height`` [in] and its axes ``_axes(fig, *grid, **kw)``
+    (shape ``grid``), made ahead of time where :func:`prepare_run_frames` did (same frame);
+    ``ticks``: the major ticks (x, y) its axes likely show (:func:`frames.take`)."""
+    key = (float(height), float(width), tuple(int(g) for g in grid), tuple(sorted(kw.items())))
+    return frames.take(key, lambda: _make_frame(key), ticks)
+
+
+def _make_frame(key: tuple) -> tuple[Figure, Any]:
+    """The figure and axes of a :func:`_frame` key."""
+    height, width, grid, kw = key
+    fig = _fig(height, width)
+    return fig, _axes(fig, *grid, **dict(kw))
+
+
+def prepare_run_frames(run: Any) -> int:
+    """Make the frames of the figures of ``run`` (a :class:`~testbed.studies.runstore.SavedRun`)
+    into the pool of :mod:`testbed.reporting.frames`: a later run of the same shape (same
+    scenario, another seed or version of the model) takes them instead of making its own.
+    Returns the number made (0 for a run without run figures)."""
+    # recorded inputs are only read by the joint-angle figure, which makes its own figure
+    # (no frame): a placeholder spares reading the dataset
+    keys = frames.record(_run_builders(run, (np.zeros((0, 0)), [], "N m")).values())
+    return frames.prepare(keys, _make_frame, STYLE)
 
 
 def save_figure(fig: Figure, path: str | os.PathLike) -> Path:
@@ -298,9 +328,8 @@ def reconstruction(t: np.ndarray, reference: np.ndarray, simulated: np.ndarray, 
     """
     n = len(channels)
     zoom = zoom or (float(t[0]), float(t[0] + 0.1 * (t[-1] - t[0])))
-    fig = _fig(1.9 * n + 0.6)
     # one time axis per column, labelled under the last row only (the rows above repeat it)
-    ax = _axes(fig, n, 2, width_ratios=(2, 1), sharex="col")
+    fig, ax = _frame(1.9 * n + 0.6, WIDTH, n, 2, width_ratios=(2, 1), sharex="col")
     inside = (t >= zoom[0]) & (t <= zoom[1])
     for i, ch in enumerate(channels):
         for a, sel in ((ax[i, 0], slice(None)), (ax[i, 1], inside)):
@@ -324,8 +353,8 @@ def mac_matrix(mac: np.ndarray, pair: Sequence[int] | None = None) -> Figure:
     from matplotlib.patches import Rectangle
 
     mac = np.asarray(mac, dtype=float)
-    fig = _fig(0.55 * mac.shape[0] + 1.6, min(WIDTH, 0.8 * mac.shape[1] + 3.0))
-    grid = _axes(fig)
+    fig, grid = _frame(0.55 * mac.shape[0] + 1.6, min(WIDTH, 0.8 * mac.shape[1] + 3.0),
+                       ticks=(mac.shape[1], mac.shape[0]))
     ax = grid[0, 0]
     im = ax.imshow(mac, vmin=0, vmax=1, cmap="Blues")
     ax.grid(False)
@@ -378,8 +407,8 @@ def penalty_weights(history: dict[str, Any]) -> Figure | None:
     groups = [(t, g) for t, g in groups if g]
     if not groups:
         return None
-    fig = _fig(3.6)
-    ax = _axes(fig, 1, len(groups))[0]
+    fig, ax = _frame(3.6, WIDTH, 1, len(groups))
+    ax = ax[0]
     for a, (title, g) in zip(ax, groups, strict=True):
         for k, v in g.items():
             a.plot(np.arange(1, v.size + 1), v, label=k)
@@ -414,8 +443,8 @@ def frequency_table(rows: list[dict[str, float]]) -> Figure:
                                                                      if damp else [])
     cells = [[f"{r['mode']}", f"{r['f_true']:.2f}", f"{r['f_id']:.2f}", f"{r['error_pct']:+.2f}"]
              + ([f"{r['z_true']:.4f}", f"{r['z_id']:.4f}"] if damp else []) for r in rows]
-    fig = _fig(0.35 * len(rows) + 0.9, 7.0)
-    ax = _axes(fig)[0, 0]
+    fig, ax = _frame(0.35 * len(rows) + 0.9, 7.0, ticks=(0, 0))  # no axis shown
+    ax = ax[0, 0]
     ax.axis("off")
     tab = ax.table(cellText=cells, colLabels=head, loc="center", cellLoc="center")
     tab.auto_set_font_size(False)
@@ -482,8 +511,8 @@ def matrices(panels: Sequence[tuple[str, np.ndarray, np.ndarray | None, str]]) -
     """
     n = len(panels)
     size = max(np.asarray(p[1]).shape[0] for p in panels)
-    fig = _fig(5.6 if size <= 6 else 6.4, min(WIDTH, 3.4 * n + 0.4))
-    ax = _axes(fig, 3, n, height_ratios=(1.0, 1.0, 0.07))  # last row: the colour bars
+    fig, ax = _frame(5.6 if size <= 6 else 6.4, min(WIDTH, 3.4 * n + 0.4), 3, n,
+                     height_ratios=(1.0, 1.0, 0.07), ticks=(size, size))  # last row: colour bars
     for c, (name, ident, true, unit) in enumerate(panels):
         mats = [np.asarray(ident, dtype=float), None if true is None else np.asarray(true, dtype=float)]
         lim = max(float(np.nanmax(np.abs(m))) for m in mats if m is not None) or 1.0
@@ -580,8 +609,7 @@ def spectra(t: np.ndarray, reference: np.ndarray, simulated: np.ndarray, channel
     fs = 1.0 / float(t[1] - t[0])
     ok = np.all(np.isfinite(sim))
     n = len(channels)
-    fig = _fig(2.0 * n + 0.7)
-    ax = _axes(fig, n, 2, width_ratios=(1, 1.2), sharex="col")
+    fig, ax = _frame(2.0 * n + 0.7, WIDTH, n, 2, width_ratios=(1, 1.2), sharex="col")
     nper = int(2 ** np.clip(np.round(np.log2(ref.shape[1] / 8)), 6, 13))
     f, p_ref = psd(ref, fs, nper)
     _, p_sim = psd(np.nan_to_num(sim), fs, nper)
@@ -695,8 +723,8 @@ def coefficients(terms: Sequence[str], coef_true: np.ndarray, coef_id: np.ndarra
     """Grouped bars per equation: true vs identified coefficient of every library term."""
     T, I = np.atleast_2d(coef_true), np.atleast_2d(coef_id)
     n = T.shape[0]
-    fig = _fig(3.2 * n + 0.8)
-    ax = _axes(fig, n, 1)[:, 0]
+    fig, ax = _frame(3.2 * n + 0.8, WIDTH, n, 1)
+    ax = ax[:, 0]
     x = np.arange(len(terms))
     for k in range(n):
         ax[k].bar(x - 0.2, T[k], 0.4, color=TRUTH, label="true")

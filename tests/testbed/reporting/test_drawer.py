@@ -17,7 +17,6 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # tests/testbed: _
 import _synthetic_runs as synth
 
 from testbed.reporting import drawer, figures
-from testbed.reporting.report import save_run_figures_and_report
 from testbed.studies.runstore import load_run, save_new_run, save_run
 
 ROOT = Path(__file__).resolve().parents[3]
@@ -35,7 +34,12 @@ def test_split_is_balanced_and_the_same_every_time():
     assert groups == drawer.split_figures(stems)
     assert sorted(s for g in groups for s in g) == sorted(stems)
     cost = [sum(drawer.FIGURE_COST[s] for s in g) for g in groups]
-    assert cost == [7.0, 6.0]  # matrices + mac + frequencies + penalty weights | the two signal plots
+    # the best split of these costs (longest first would give 7.3 | 6.6: matrices, penalty
+    # weights and mac | spectra, reconstruction and frequencies); sums of one-decimal costs
+    assert groups == [["spectra", "mac", "frequencies", "penalty_weights"], ["reconstruction", "matrices"]]
+    assert cost == pytest.approx([6.9, 7.0], abs=1e-9)
+    many = [f"f{i}" for i in range(drawer.EXACT_SPLIT + 3)]  # longest first beyond the exact split
+    assert sorted(s for g in drawer.split_figures(many) for s in g) == sorted(many)
     assert drawer.split_figures(["mac"]) == [["mac"]]
     assert drawer.split_figures([]) == []
 
@@ -130,5 +134,9 @@ def test_without_figures_nothing_is_forked():
 
 def test_in_process_writer_where_fork_is_missing(monkeypatch):
     monkeypatch.setattr(drawer, "fork_available", lambda: False)
+    import multiprocessing
+
+    before = multiprocessing.active_children()
     with drawer.figure_drawer() as draw:
-        assert draw is save_run_figures_and_report
+        assert isinstance(draw, drawer.RunFigures) and draw.worker is None  # draws in this process
+        assert multiprocessing.active_children() == before
