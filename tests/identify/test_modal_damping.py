@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from benchmarks import bench_sgd_sindy as bench
-from identify._modal_damping import hold_modal_damping, modal_decay
+from identify._modal_damping import coupling_moves, hold_modal_damping, modal_decay
 from identify.sgd_sindy import SGDSINDy
 from identify.structural import modal
 from testbed.scoring.metrics import modal_from_matrices
@@ -42,6 +42,55 @@ def test_hold_sets_each_mode_and_keeps_the_rest():
     D, D2 = Phi.T @ C @ Phi, Phi.T @ C2 @ Phi
     corr = lambda X: X / np.sqrt(np.outer(np.diag(X), np.diag(X)))  # noqa: E731
     assert np.allclose(corr(D), corr(D2), rtol=1e-9, atol=1e-12)
+
+
+def _poles(M, C, K):
+    n = len(M)
+    A = np.block([[np.zeros((n, n)), np.eye(n)], [-np.linalg.solve(M, K), -np.linalg.solve(M, C)]])
+    p = np.linalg.eigvals(A)
+    return np.sort_complex(p[p.imag > 0])
+
+
+def _heavy_middle_mode():
+    """Three unit masses, modes at 40, 154, 392 Hz damped 2, 840 and 20 % (round 6's
+    ``b_soft_z2`` as ``ls_sindy`` fitted it: an overdamped middle mode no decay measures),
+    every pair of modes damping-coupled at correlation 0.9."""
+    M = np.eye(3)
+    Q, _ = np.linalg.qr(np.array([[1.0, 0.4, 0.2], [0.5, -1.0, 0.3], [0.2, 0.5, -1.0]]))
+    w = 2 * np.pi * np.array([40.0, 154.0, 392.0])
+    K = Q @ np.diag(w**2) @ Q.T
+    d = 2 * np.array([0.02, 8.4, 0.2]) * w
+    D = np.diag(d)
+    for i, j in ((0, 1), (1, 2), (0, 2)):
+        D[i, j] = D[j, i] = 0.9 * np.sqrt(d[i] * d[j])
+    return M, Q @ D @ Q.T, K, w, np.array([0.02, np.nan, 0.2]) * w
+
+
+def test_uncoupled_hold_gives_each_held_mode_its_measured_pole():
+    M, C, K, w, sigma = _heavy_middle_mode()
+    C2 = hold_modal_damping(M, C, K, sigma, uncouple=np.isfinite(sigma))
+    p = _poles(M, C2, K)
+    want = -sigma[[0, 2]] + 1j * np.sqrt(w[[0, 2]] ** 2 - sigma[[0, 2]] ** 2)
+    for q in want:  # exact: the held modes are uncoupled, so each pole is its own
+        assert np.min(np.abs(p - q)) < 1e-9 * abs(q)
+    assert np.linalg.eigvalsh(C2).min() > -1e-12 * np.abs(C2).max()  # still semi-definite
+
+
+def test_couplings_the_decays_contradict_are_named():
+    """Kept, the couplings put mode 3's pole at -15 + 384j Hz against its measured -78 + 384j
+    (63 Hz off: more than a 1 Hz line); couplings at 1 % of that correlation move no pole by a
+    line (0.007 Hz at most)."""
+    M, C, K, _, sigma = _heavy_middle_mode()
+    taken = np.isfinite(sigma)
+    alone = hold_modal_damping(M, C, K, sigma, uncouple=np.isfinite(sigma))
+    moved = coupling_moves(M, hold_modal_damping(M, C, K, sigma), K, alone, taken, line=1.0)
+    assert moved.tolist() == [False, False, True]  # mode 1 moves 0.64 Hz, under the line
+    _, Phi = modal(M, K)
+    D = Phi.T @ C @ Phi
+    D_weak = np.diag(np.diag(D)) + 0.01 * (D - np.diag(np.diag(D)))
+    C_weak = np.linalg.solve(Phi.T, np.linalg.solve(Phi.T, D_weak).T).T  # Phi^-T D Phi^-1
+    weak = hold_modal_damping(M, C_weak, K, sigma)
+    assert not coupling_moves(M, weak, K, alone, taken, line=1.0).any()
 
 
 def test_decay_fit_measures_each_mode_from_a_wrong_start(chain):
