@@ -1,0 +1,89 @@
+"""Seventh malformed-input round: MuJoCo's C-level log, matplotlib's folders, and the new
+families of hostile input of ``benchmarks/hostile7.py`` (docs/history.md, malformed-input audits).
+
+The tests of what reaches a real standard stream or the current folder start a real process:
+MuJoCo's log is written by C code, matplotlib's folders are read at its import.
+"""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+import textwrap
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parent.parent.parent
+TIMEOUT_S = 180  # a process start, a 0.05 s simulation or one Michaelis-Menten fit, under load
+
+
+def _env(**extra: str | None) -> dict[str, str]:
+    env = {**os.environ, "OMP_NUM_THREADS": "1", "MPLBACKEND": "Agg",
+           "PYTHONPATH": os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")])}
+    for key, value in extra.items():
+        if value is None:
+            env.pop(key, None)
+        else:
+            env[key] = value
+    return env
+
+
+def cli(*args: str, cwd: Path, **env: str | None) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "testbed.cli", *args], cwd=cwd, env=_env(**env),
+                          capture_output=True, text=True, timeout=TIMEOUT_S)
+
+
+# ------------------------------------------------------------------ MuJoCo's C-level log
+
+def test_a_mujoco_reset_leaves_one_line_and_no_log_file(tmp_path):
+    # A cart-pole pushed with 1e9 N: MuJoCo resets the state, printed "WARNING: Nan, Inf or
+    # huge value in QACC ..." to stdout before our line and wrote MUJOCO_LOG.TXT into the
+    # current folder.
+    text = (ROOT / "scenarios" / "cartpole.toml").read_text()
+    text = (text.replace('name = "cartpole"', 'name = "cp_huge"')
+            .replace("amplitude = 1.0", "amplitude = 1e9").replace("duration = 10.0", "duration = 0.05"))
+    (tmp_path / "cp_huge.toml").write_text(text)
+    r = cli("run", "cp_huge.toml", "--no-cache", "--no-figures", "--out", str(tmp_path / "runs"),
+            cwd=tmp_path)
+    assert r.returncode == 2, (r.stdout, r.stderr)
+    assert r.stdout == ""
+    lines = r.stderr.splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: cp_huge.toml: cartpole: the simulation "
+                                                   "is unstable"), r.stderr
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["cp_huge.toml"]
+
+
+PLUGIN_STEPPING_MUJOCO = textwrap.dedent('''
+    import mujoco  # imported by the plugin itself, not through the testbed's lazy proxy
+
+    XML = "<mujoco><worldbody><body><joint type='hinge'/><geom size='.1'/></body></worldbody></mujoco>"
+
+
+    def step_too_fast():
+        """One step from a velocity beyond MuJoCo's 1e10 limit: it resets and warns."""
+        m = mujoco.MjModel.from_xml_string(XML)
+        d = mujoco.MjData(m)
+        d.qvel[:] = 1e11
+        mujoco.mj_step(m, d)
+        return int(d.warning[mujoco.mjtWarning.mjWARN_BADQVEL].number)
+''')
+
+
+@pytest.mark.parametrize("through_testbed", [False, True])
+def test_a_plugin_stepping_mujoco_itself_is_quiet(tmp_path, through_testbed):
+    # Without the testbed (the control), MuJoCo prints (to stderr) and files its warning; a plugin imported
+    # by the testbed gets MuJoCo's log turned off as MuJoCo through the lazy proxy does.
+    (tmp_path / "plug.py").write_text(PLUGIN_STEPPING_MUJOCO)
+    load = ("from testbed.core.registry import import_plugin; m = import_plugin('plug.py')"
+            if through_testbed else "import plug as m")
+    r = subprocess.run([sys.executable, "-c", f"{load}; print('resets', m.step_too_fast())"],
+                       cwd=tmp_path, env=_env(), capture_output=True, text=True, timeout=TIMEOUT_S)
+    assert r.returncode == 0, r.stderr
+    assert r.stdout.splitlines()[-1] == "resets 1"  # MuJoCo did meet the bad state
+    log = tmp_path / "MUJOCO_LOG.TXT"
+    if through_testbed:
+        assert r.stdout == "resets 1\n" and r.stderr == "" and not log.exists(), (r.stdout, r.stderr)
+    else:
+        assert "WARNING" in r.stdout + r.stderr and log.exists()
