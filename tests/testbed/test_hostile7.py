@@ -87,3 +87,66 @@ def test_a_plugin_stepping_mujoco_itself_is_quiet(tmp_path, through_testbed):
         assert r.stdout == "resets 1\n" and r.stderr == "" and not log.exists(), (r.stdout, r.stderr)
     else:
         assert "WARNING" in r.stdout + r.stderr and log.exists()
+
+
+# ------------------------------------------------------------------ matplotlib's folders
+
+def test_usable_folder(tmp_path):
+    from testbed.reporting.mplconfig import usable_folder
+
+    (tmp_path / "file").write_text("x")
+    (tmp_path / "loop").symlink_to("loop")
+    assert usable_folder(tmp_path)
+    assert usable_folder(tmp_path / "not" / "yet")  # made by matplotlib's mkdir -p
+    assert not usable_folder(tmp_path / "file")
+    assert not usable_folder(tmp_path / "file" / "matplotlib")
+    assert not usable_folder(tmp_path / "loop" / "matplotlib")
+    assert not usable_folder("a\0b")
+
+
+@pytest.fixture(scope="module")
+def run_with_mplconfig_a_file(tmp_path_factory):
+    """`testbed run michaelis_menten` (figures drawn by forked processes) with MPLCONFIGDIR a
+    file and TMPDIR a folder of the test's own, to see what is left in it."""
+    d = tmp_path_factory.mktemp("mpl")
+    (d / "afile").write_text("not a folder")
+    (d / "tmp").mkdir()
+    r = cli("run", "michaelis_menten", "--no-cache", "--out", str(d / "runs"), cwd=d,
+            MPLCONFIGDIR=str(d / "afile"), TMPDIR=str(d / "tmp"))
+    return d, r
+
+
+def test_an_unusable_mplconfigdir_still_draws_in_silence(run_with_mplconfig_a_file):
+    # Before: matplotlib's "mkdir -p failed ..." and "Matplotlib created a temporary cache
+    # directory ..." lines on stderr, and one /tmp/matplotlib-* folder left per drawing process
+    # (ended by os._exit, matplotlib's atexit removal never ran).
+    d, r = run_with_mplconfig_a_file
+    assert r.returncode == 0, r.stderr
+    assert r.stderr == ""
+    assert r.stdout.splitlines()[-1].startswith("run written to")
+    assert sorted((d / "runs" / "michaelis_menten").glob("*/*.png"))
+    assert list((d / "tmp").iterdir()) == []
+
+
+@pytest.mark.parametrize("home", ["afile", "loop/x"])
+def test_a_home_matplotlib_cannot_use_still_reports(run_with_mplconfig_a_file, tmp_path, home):
+    # `testbed report` of sweep results draws its figures in-process.  HOME a file, or under a
+    # loop of links (as HOME under an unreadable folder, whose lookup raised "[Errno 13]
+    # Permission denied: '/proc/1/root'" naming nothing).
+    sys.path.insert(0, str(Path(__file__).parent))
+    import _synthetic_runs as synth
+
+    from testbed.studies.results import write_rows
+
+    rows = [{**row, "status": "failed" if row["status"] == "error" else row["status"]}
+            for row in synth.sweep_rows()]  # the statuses a results file holds
+    results = write_rows(tmp_path / "results.parquet", rows, study="noise_study")
+    (tmp_path / "afile").write_text("x")
+    (tmp_path / "loop").symlink_to("loop")
+    (tmp_path / "tmp").mkdir()
+    r = cli("report", str(results), "-o", str(tmp_path / "rep"), cwd=tmp_path, MPLCONFIGDIR=None,
+            XDG_CONFIG_HOME=None, XDG_CACHE_HOME=None, HOME=str(tmp_path / home),
+            TMPDIR=str(tmp_path / "tmp"))
+    assert r.returncode == 0 and r.stderr == "", r.stderr
+    assert sorted((tmp_path / "rep").glob("*.png"))
+    assert list((tmp_path / "tmp").iterdir()) == []
