@@ -8,6 +8,7 @@ MuJoCo's log is written by C code, matplotlib's folders are read at its import.
 from __future__ import annotations
 
 import os
+import re
 import subprocess
 import sys
 import textwrap
@@ -200,3 +201,41 @@ def test_an_integer_range_at_int64s_end_passes_to_the_rigs_own_bound(tmp_path):
         load_study(p)
     assert "integers within int64" not in str(e.value) and "<= 400" in str(e.value)
     assert e.value.key == "families.beams.rig.n_segments.integers"
+
+
+# ------------------------------------------------------------------ SEP-005 channels
+
+def _channel(**extra):
+    import numpy as np
+
+    t = np.arange(200) / 100.0  # 100 Hz
+    return {"name": "acceleration/acc1", "data": list(np.sin(2 * np.pi * 3 * t)), "unit_str": "m/s^2",
+            **extra}
+
+
+@pytest.mark.parametrize("extra, fragment", [
+    # fs won in silence over a time column saying otherwise (every frequency halved)
+    ({"fs": 50.0, "time": [i / 100.0 for i in range(200)]}, "fs=50 Hz but its time says 100 Hz"),
+    # optional keys of the wrong kind were dropped (NaN, text, 1.5) or kept (-1) in silence
+    ({"fs": 100.0, "position_m": float("nan")}, "position_m=nan; expected a finite number"),
+    ({"fs": 100.0, "position_m": "0.3"}, "position_m='0.3'; expected a finite number"),
+    ({"fs": 100.0, "position_m": True}, "position_m=True; expected a finite number"),
+    ({"fs": 100.0, "node": 1.5}, "node=1.5; expected an integer >= 1"),
+    ({"fs": 100.0, "node": -1}, "node=-1; expected an integer >= 1"),
+    ({"fs": 100.0, "node": True}, "node=True; expected an integer >= 1"),
+])
+def test_sep005_channel_keys_that_contradict_or_mistype_are_refused(extra, fragment):
+    from testbed.pipeline.importers import MeasuredDataError, from_sep005
+
+    with pytest.raises(MeasuredDataError, match=re.escape(fragment)):
+        from_sep005([_channel(**extra)], source="x.json")
+
+
+def test_sep005_fs_and_time_agreeing_are_read():
+    from testbed.pipeline.importers import from_sep005
+
+    # time printed to 4 significant digits: within the 1e-3 a declared rate may differ by
+    times = [float(f"{i / 100.0:.4g}") for i in range(200)]
+    d = from_sep005([_channel(fs=100.0, time=times, node=3, position_m=0.25)], source="x.json")
+    assert d.fs == 100.0
+    assert d.nodes == {"acceleration/acc1": 3} and d.positions == {"acceleration/acc1": 0.25}
