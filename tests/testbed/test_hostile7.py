@@ -239,3 +239,24 @@ def test_sep005_fs_and_time_agreeing_are_read():
     d = from_sep005([_channel(fs=100.0, time=times, node=3, position_m=0.25)], source="x.json")
     assert d.fs == 100.0
     assert d.nodes == {"acceleration/acc1": 3} and d.positions == {"acceleration/acc1": 0.25}
+
+
+def test_a_family_grid_over_the_cell_budget_is_refused_before_its_members_are_drawn(tmp_path,
+                                                                                    monkeypatch):
+    # 10,000 members x 11 noise levels = 110,000 cells: the members were drawn and validated
+    # first (36 ms each on a quiet machine, 0.27 s under load: 6 to 45 minutes), then refused
+    from testbed.core.budget import STUDY_CELL_BUDGET
+    from testbed.core.errors import BudgetError
+    from testbed.studies import study as study_module
+
+    def no_drawing(fam):
+        raise AssertionError("members drawn before the grid's budget was checked")
+
+    monkeypatch.setattr(study_module, "family_members", no_drawing)
+    p = tmp_path / "fam.toml"
+    p.write_text(FAMILY_STUDY.format(line="length = {uniform = [0.3, 0.5]}")
+                 .replace("members = 2", "members = 10000")
+                 .replace("noise = [0.0]", "noise = [0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0]"))
+    with pytest.raises(BudgetError, match=f"110000 cells .*the budget is {STUDY_CELL_BUDGET}") as e:
+        study_module.load_study(p)
+    assert e.value.key == "families.beams.members" and e.value.file == str(p)
