@@ -988,8 +988,18 @@ def _main(argv: list[str] | None) -> int:
         status = _run(args)
     if status in (0, EXIT_FAIL):
         for w in caught:
-            warnings.showwarning(w.message, w.category, w.filename, w.lineno, w.file, w.line)
+            warnings.showwarning(_first_line(w.message), w.category, w.filename, w.lineno, w.file,
+                                 w.line)
     return status
+
+
+def _first_line(message: Warning | str) -> Warning | str:
+    """A warning's message cut to its first line: numba's for a malformed ``$NUMBA_NUM_THREADS``
+    carries the whole traceback of its failed parse (9 lines after the verdict)."""
+    lines = str(message).splitlines()
+    if len(lines) <= 1:
+        return message
+    return f"{lines[0]} [{len(lines) - 1} more line(s): `testbed --debug ...` shows them]"
 
 
 def _run(args: argparse.Namespace) -> int:

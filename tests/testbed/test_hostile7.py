@@ -260,3 +260,31 @@ def test_a_family_grid_over_the_cell_budget_is_refused_before_its_members_are_dr
     with pytest.raises(BudgetError, match=f"110000 cells .*the budget is {STUDY_CELL_BUDGET}") as e:
         study_module.load_study(p)
     assert e.value.key == "families.beams.members" and e.value.file == str(p)
+
+
+# ------------------------------------------------------------------ the environment
+
+def test_a_warning_of_many_lines_is_shown_after_the_verdict_as_its_first_line(monkeypatch, capsys):
+    # NUMBA_NUM_THREADS=nan (or '', or any text): numba's warning carries the traceback of its
+    # failed parse, 9 lines with "Traceback (most recent call last)" after the verdict
+    import warnings
+
+    from testbed import cli
+
+    def command(args):
+        warnings.warn("Environment variable 'NUMBA_NUM_THREADS' is defined but its associated "
+                      "value 'nan' could not be parsed.\nThe parse failed with exception:\n"
+                      "Traceback (most recent call last):\n  File \"config.py\", line 185\n"
+                      "ValueError: invalid literal for int() with base 10: 'nan'",
+                      RuntimeWarning, stacklevel=1)
+        print("verdict")
+        return 0
+
+    monkeypatch.setattr(cli, "cmd_list", command)
+    with warnings.catch_warnings(record=True) as shown:  # what reaches stderr in a process
+        warnings.simplefilter("always")
+        assert cli.main(["list"]) == 0
+    assert capsys.readouterr().out == "verdict\n"
+    assert [str(w.message) for w in shown] == [
+        "Environment variable 'NUMBA_NUM_THREADS' is defined but its associated value 'nan' could "
+        "not be parsed. [4 more line(s): `testbed --debug ...` shows them]"]
