@@ -960,7 +960,11 @@ def _served(argv: list[str]) -> int | None:
         return None
     from testbed.server import socket_path, try_server
 
-    return try_server(argv) if socket_path().exists() else None
+    try:
+        present = socket_path().exists()
+    except OSError:  # $TESTBED_SERVER_SOCKET of 10,000 characters (ENAMETOOLONG): was a traceback
+        return None  # no server can listen there: the command runs alone
+    return try_server(argv) if present else None
 
 
 def _env_folders() -> None:

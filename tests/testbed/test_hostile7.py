@@ -288,3 +288,12 @@ def test_a_warning_of_many_lines_is_shown_after_the_verdict_as_its_first_line(mo
     assert [str(w.message) for w in shown] == [
         "Environment variable 'NUMBA_NUM_THREADS' is defined but its associated value 'nan' could "
         "not be parsed. [4 more line(s): `testbed --debug ...` shows them]"]
+
+
+@pytest.mark.parametrize("socket", ["x" * 10_000, "loop/s.sock"])
+def test_a_server_socket_path_that_cannot_be_looked_up_runs_the_command_alone(tmp_path, socket):
+    # 10,000 characters: ENAMETOOLONG from Path.exists, a traceback before any command ran
+    (tmp_path / "loop").symlink_to("loop")
+    r = cli("list", cwd=tmp_path, TESTBED_SERVER_SOCKET=socket, TESTBED_NO_SERVER=None)
+    assert r.returncode == 0 and r.stderr == "", r.stderr[-500:]
+    assert "michaelis_menten" in r.stdout
