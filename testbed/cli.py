@@ -1041,8 +1041,21 @@ def _run(args: argparse.Namespace) -> int:
                   "/dev/full, or a file descriptor not open for writing)", file=sys.stderr)
             _quiet_stdout()
             return EXIT_USAGE
+        refusal = _backend_refusal(e)
+        if refusal is not None and not args.debug:
+            print(f"error: {refusal}", file=sys.stderr)
+            return EXIT_USAGE
         interrupt = _interrupt_within(e)
         return _internal(e, args) if interrupt is None else _interrupted(interrupt)
+
+
+def _backend_refusal(e: BaseException) -> str | None:
+    """matplotlib's refusal of ``$MPLBACKEND`` as one line, if ``e`` is that."""
+    if "MPLBACKEND" not in os.environ:
+        return None
+    from testbed.reporting.mplconfig import backend_refusal
+
+    return backend_refusal(e)
 
 
 def _no_cwd(e: OSError) -> str | None:

@@ -92,9 +92,24 @@ class LazyModule:
         object.__setattr__(self, "_lazy_name", name)
 
     def _lazy_load(self) -> ModuleType:
-        for key, value in IMPORT_ENVIRONMENT.get(self._lazy_name.partition(".")[0], {}).items():
+        top = self._lazy_name.partition(".")[0]
+        users = {k: os.environ[k] for k in IMPORT_ENVIRONMENT.get(top, {}) if k in os.environ}
+        for key, value in IMPORT_ENVIRONMENT.get(top, {}).items():
             os.environ.setdefault(key, value)
-        module = importlib.import_module(self._lazy_name)
+        try:
+            module = importlib.import_module(self._lazy_name)
+        except Exception as e:
+            if not users:
+                raise
+            # MUJOCO_GL=bogus (RuntimeError) or osmesa without its library (AttributeError)
+            # were internal errors "please report it"
+            from testbed.core.errors import InputError, show_value
+
+            said = ", ".join(f"${k} {show_value(v)}" for k, v in users.items())
+            raise InputError(f"{said}: importing {top} failed with it ({type(e).__name__}: "
+                             f"{show_value(str(e))}); unset it (the testbed never renders: it sets "
+                             f"{', '.join(f'{k}={v}' for k, v in IMPORT_ENVIRONMENT[top].items())}) "
+                             f"or give a value {top} accepts") from None
         configure_loaded()
         self.__dict__.update(vars(module))
         return module

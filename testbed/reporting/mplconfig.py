@@ -99,3 +99,22 @@ def ensure_config_dir() -> str | None:
     atexit.register(_remove, made, os.getpid())
     os.environ["MPLCONFIGDIR"] = _made = made
     return made
+
+
+def backend_refusal(error: BaseException) -> str | None:
+    """The one line for matplotlib refusing ``$MPLBACKEND`` at its import, if ``error`` is that.
+
+    matplotlib validates the variable when first imported (``ValueError: Key backend: 'bogus'
+    is not a valid value for backend; supported values are [...]``: an internal error, "please
+    report it", in ``run`` and ``report``).  Which names it accepts is known only by importing
+    it (its registry, entry points included), so the refusal is recognised where it surfaces,
+    in the drawing process's error re-raised in the command or in the command itself.
+    """
+    backend = os.environ.get("MPLBACKEND")
+    if backend is None or not isinstance(error, ValueError) or "valid value for backend" not in str(error):
+        return None
+    from testbed.core.errors import show_value
+
+    return (f"$MPLBACKEND {show_value(backend)}: matplotlib refuses it as a backend; unset it (the "
+            "testbed draws on Agg canvases, never in a window) or name one matplotlib has "
+            "(agg, pdf, svg, ...)")

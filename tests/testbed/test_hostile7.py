@@ -297,3 +297,33 @@ def test_a_server_socket_path_that_cannot_be_looked_up_runs_the_command_alone(tm
     r = cli("list", cwd=tmp_path, TESTBED_SERVER_SOCKET=socket, TESTBED_NO_SERVER=None)
     assert r.returncode == 0 and r.stderr == "", r.stderr[-500:]
     assert "michaelis_menten" in r.stdout
+
+
+def test_a_mujoco_gl_mujoco_refuses_is_one_line_naming_it(tmp_path):
+    # MUJOCO_GL=bogus: "internal error ... RuntimeError: invalid value for environment variable
+    # MUJOCO_GL"; osmesa without its library an AttributeError, both "please report it"
+    text = (ROOT / "scenarios" / "cartpole.toml").read_text()
+    (tmp_path / "cp_short.toml").write_text(text.replace('name = "cartpole"', 'name = "cp_short"')
+                                            .replace("duration = 10.0", "duration = 0.05"))
+    r = cli("run", "cp_short.toml", "--no-cache", "--no-figures", "--out", str(tmp_path / "runs"),
+            cwd=tmp_path, MUJOCO_GL="bogus")
+    assert r.returncode == 2, r.stderr
+    assert r.stderr.startswith("error: $MUJOCO_GL 'bogus': importing mujoco failed with it "
+                               "(RuntimeError:") and len(r.stderr.splitlines()) == 1, r.stderr
+
+
+def test_an_mplbackend_matplotlib_refuses_is_one_line_naming_it(tmp_path):
+    # MPLBACKEND=bogus: "internal error ... ValueError: Key backend: 'bogus' is not a valid value
+    # for backend ..." from the drawing process (run) or the command (report)
+    sys.path.insert(0, str(Path(__file__).parent))
+    import _synthetic_runs as synth
+
+    from testbed.studies.results import write_rows
+
+    rows = [{**row, "status": "failed" if row["status"] == "error" else row["status"]}
+            for row in synth.sweep_rows()]
+    results = write_rows(tmp_path / "results.parquet", rows, study="noise_study")
+    r = cli("report", str(results), "-o", str(tmp_path / "rep"), cwd=tmp_path, MPLBACKEND="bogus")
+    assert r.returncode == 2, r.stderr
+    assert r.stderr.startswith("error: $MPLBACKEND 'bogus': matplotlib refuses it as a backend")
+    assert len(r.stderr.splitlines()) == 1
