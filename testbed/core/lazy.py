@@ -27,6 +27,8 @@ from collections.abc import Callable
 from types import ModuleType
 from typing import Any
 
+from testbed.core.errors import InputError, show_value
+
 __all__ = ["IMPORT_ENVIRONMENT", "IMPORT_SETUP", "LazyModule", "configure_loaded", "lazy_module"]
 
 #: Environment variables set before the first import of a package (by its top-level name),
@@ -103,8 +105,6 @@ class LazyModule:
                 raise
             # MUJOCO_GL=bogus (RuntimeError) or osmesa without its library (AttributeError)
             # were internal errors "please report it"
-            from testbed.core.errors import InputError, show_value
-
             said = ", ".join(f"${k} {show_value(v)}" for k, v in users.items())
             raise InputError(f"{said}: importing {top} failed with it ({type(e).__name__}: "
                              f"{show_value(str(e))}); unset it (the testbed never renders: it sets "

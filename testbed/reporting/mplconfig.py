@@ -24,6 +24,7 @@ import tempfile
 from pathlib import Path
 
 from testbed.core.atomic import begin_in_flight, end_in_flight
+from testbed.core.errors import show_value
 
 __all__ = ["ensure_config_dir", "usable_folder"]
 
@@ -113,8 +114,6 @@ def backend_refusal(error: BaseException) -> str | None:
     backend = os.environ.get("MPLBACKEND")
     if backend is None or not isinstance(error, ValueError) or "valid value for backend" not in str(error):
         return None
-    from testbed.core.errors import show_value
-
     return (f"$MPLBACKEND {show_value(backend)}: matplotlib refuses it as a backend; unset it (the "
             "testbed draws on Agg canvases, never in a window) or name one matplotlib has "
             "(agg, pdf, svg, ...)")
