@@ -971,7 +971,11 @@ def _served(argv: list[str]) -> int | None:
         return None
     from testbed.server import socket_path, try_server
 
-    return try_server(argv) if socket_path().exists() else None
+    try:
+        present = socket_path().exists()
+    except OSError:  # $TESTBED_SERVER_SOCKET of 10,000 characters (ENAMETOOLONG): was a traceback
+        return None  # no server can listen there: the command runs alone
+    return try_server(argv) if present else None
 
 
 def _env_folders() -> None:
@@ -999,8 +1003,18 @@ def _main(argv: list[str] | None) -> int:
         status = _run(args)
     if status in (0, EXIT_FAIL):
         for w in caught:
-            warnings.showwarning(w.message, w.category, w.filename, w.lineno, w.file, w.line)
+            warnings.showwarning(_first_line(w.message), w.category, w.filename, w.lineno, w.file,
+                                 w.line)
     return status
+
+
+def _first_line(message: Warning | str) -> Warning | str:
+    """A warning's message cut to its first line: numba's for a malformed ``$NUMBA_NUM_THREADS``
+    carries the whole traceback of its failed parse (9 lines after the verdict)."""
+    lines = str(message).splitlines()
+    if len(lines) <= 1:
+        return message
+    return f"{lines[0]} [{len(lines) - 1} more line(s): `testbed --debug ...` shows them]"
 
 
 def _run(args: argparse.Namespace) -> int:
@@ -1038,8 +1052,21 @@ def _run(args: argparse.Namespace) -> int:
                   "/dev/full, or a file descriptor not open for writing)", file=sys.stderr)
             _quiet_stdout()
             return EXIT_USAGE
+        refusal = _backend_refusal(e)
+        if refusal is not None and not args.debug:
+            print(f"error: {refusal}", file=sys.stderr)
+            return EXIT_USAGE
         interrupt = _interrupt_within(e)
         return _internal(e, args) if interrupt is None else _interrupted(interrupt)
+
+
+def _backend_refusal(e: BaseException) -> str | None:
+    """matplotlib's refusal of ``$MPLBACKEND`` as one line, if ``e`` is that."""
+    if "MPLBACKEND" not in os.environ:
+        return None
+    from testbed.reporting.mplconfig import backend_refusal
+
+    return backend_refusal(e)
 
 
 def _no_cwd(e: OSError) -> str | None:

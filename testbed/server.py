@@ -291,6 +291,9 @@ def _preload() -> None:
     """Import what commands use, so that forked children find it loaded."""
     import importlib
 
+    from testbed.reporting.mplconfig import ensure_config_dir
+
+    ensure_config_dir()  # a folder matplotlib can write, before PRELOAD imports it
     for name in PRELOAD:
         importlib.import_module(name)
     from testbed.pipeline.plugins import IDENTIFIERS, RIGS

@@ -33,6 +33,7 @@ from pathlib import Path
 from typing import Any
 
 from testbed.core.errors import TestbedError
+from testbed.core.lazy import configure_loaded
 
 #: Entry-point group of identifiers from other distributions.
 IDENTIFIER_ENTRY_POINTS = "sysid_testbed.identifiers"
@@ -67,10 +68,12 @@ def import_plugin(spec: str) -> Any:
     """
     if not spec.endswith(".py"):
         try:
-            return importlib.import_module(spec)
+            module = importlib.import_module(spec)
         except (Exception, SystemExit) as e:  # (sys.exit(0) in a plugin ended a run with status 0)
             raise PluginError(f"plugin {spec}: cannot import it: {type(e).__name__}: {e}; expected "
                               "a .py file or an importable dotted module name") from e
+        configure_loaded()  # a plugin importing MuJoCo itself: its C-level log silenced too
+        return module
     path = Path(spec).resolve()
     if not path.is_file():
         raise PluginError(f"plugin {spec}: no such file")
@@ -90,6 +93,7 @@ def import_plugin(spec: str) -> Any:
         if isinstance(e, (Exception, SystemExit)):
             raise PluginError(f"plugin {spec}: importing it failed: {type(e).__name__}: {e}") from e
         raise
+    configure_loaded()  # a plugin importing MuJoCo itself: its C-level log silenced too
     return module
 
 
@@ -170,6 +174,7 @@ class Registry:
         except BaseException:
             self._loaded = False
             raise
+        configure_loaded()  # an entry point importing MuJoCo itself
 
     def snapshot(self) -> tuple[dict, dict, dict]:
         """The registry's entries, tags and origins (loaded first), for :meth:`restore`."""

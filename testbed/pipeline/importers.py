@@ -98,6 +98,10 @@ RESPONSE_SIGNAL = {"structural": "acceleration", "mechanical": "theta", "dynamic
 TIME_NAMES = ("t", "time")
 #: a time column's steps may differ from their median by this fraction
 TIME_TOLERANCE = 0.01
+#: a rate declared twice (``--fs`` and the file's; a SEP-005 channel's ``fs`` and ``time``) may
+#: differ by this fraction: a time printed to 4 significant digits over a record of 1,000
+#: samples (t[-1] to +-5e-4 relative) stays within it; a wrong rate (2x, 1.5 %) does not
+DECLARED_RATE_RTOL = 1e-3
 
 
 class MeasuredDataError(TestbedError, ValueError):
@@ -508,7 +512,7 @@ def _finish(raw: _Raw, fs: float | None, units: str | Mapping[str, str] | None,
         raise MeasuredDataError(path, "fewer than 2 samples")
     rate = raw.fs
     if fs is not None:
-        if rate is not None and abs(rate / fs - 1) > 1e-3:
+        if rate is not None and abs(rate / fs - 1) > DECLARED_RATE_RTOL:
             raise MeasuredDataError(path, f"declared fs={fs:g} Hz but the file's rate is {rate:.9g} Hz")
         rate = float(fs)
     if rate is None:
@@ -699,7 +703,7 @@ def _parse_sep005(path: Path, content: Any) -> _Raw:
             if isinstance(f, bool) or not isinstance(f, (int, float)) or not (math.isfinite(f) and f > 0):
                 raise MeasuredDataError(path, f"SEP-005 channel {name!r}: fs={f!r} is not a rate > 0 Hz")
             rates[name] = float(f)
-        elif "time" in c:
+        if "time" in c:
             try:
                 t = np.asarray(c["time"], dtype=float)
             except (TypeError, ValueError, OverflowError):
@@ -709,21 +713,35 @@ def _parse_sep005(path: Path, content: Any) -> _Raw:
                 raise MeasuredDataError(path, f"SEP-005 channel {name!r}: time of shape {t.shape} "
                                               f"for data of shape {data.shape}; expected one time "
                                               "per sample")
-            rates[name] = uniform_rate(path, t, f"channel {name!r} time")
-        else:
+            rate = uniform_rate(path, t, f"channel {name!r} time")
+            # both given: fs won in silence (fs = 50 over a 100 Hz time: every frequency halved)
+            if name in rates and abs(rate / rates[name] - 1) > DECLARED_RATE_RTOL:
+                raise MeasuredDataError(path, f"SEP-005 channel {name!r}: fs={rates[name]:g} Hz but "
+                                              f"its time says {rate:.9g} Hz; give one, or both agreeing")
+            rates.setdefault(name, rate)
+        if name not in rates:
             raise MeasuredDataError(path, f"SEP-005 channel {name!r} has neither fs nor time")
         unit = c.get("unit_str")
         if unit is not None and not isinstance(unit, str):  # 5 was read as the unit "5"
             raise MeasuredDataError(path, f"SEP-005 channel {name!r}: unit_str={unit!r} is not a "
                                           "string")
         raw.data[name], raw.units[name] = data, (unit or None)
-        if isinstance(c.get("node"), int) and not isinstance(c.get("node"), bool):
-            raw.nodes[name] = int(c["node"])
+        # the optional keys: a value of the wrong kind was dropped in silence (position_m NaN
+        # or "0.3", node 1.5), or kept (node -1)
+        node = c.get("node")
+        if node is not None:
+            if not (isinstance(node, int) and not isinstance(node, bool) and node >= 1):
+                raise MeasuredDataError(path, f"SEP-005 channel {name!r}: node={node!r}; expected "
+                                              "an integer >= 1 (or no node key)")
+            raw.nodes[name] = node
         direction = _direction(c.get("direction"))
         if direction:
             raw.directions[name] = direction
         pos = c.get("position_m")
-        if isinstance(pos, (int, float)) and not isinstance(pos, bool) and math.isfinite(pos):
+        if pos is not None:
+            if isinstance(pos, bool) or not isinstance(pos, (int, float)) or not math.isfinite(pos):
+                raise MeasuredDataError(path, f"SEP-005 channel {name!r}: position_m={pos!r}; "
+                                              "expected a finite number [m] (or no position_m key)")
             raw.positions[name] = float(pos)
     raw.fs = _common_rate(path, rates, 1e-9)
     return raw

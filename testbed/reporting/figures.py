@@ -32,12 +32,14 @@ from testbed.core.truth import StructuralTruth, Truth, TruthError, truth_type
 from testbed.pipeline.cache import DatasetCache
 from testbed.pipeline.scenario import Scenario
 from testbed.reporting import frames
+from testbed.reporting.mplconfig import ensure_config_dir
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
 # matplotlib is imported where a figure is drawn (about 0.35 s of import), not with this module:
 # a run without figures, a report's text, a sweep's summary do not pay for it.
+ensure_config_dir()  # before that import, and before the drawing processes are forked
 
 STYLE: dict[str, Any] = {
     "font.size": 10, "axes.titlesize": 10, "axes.labelsize": 10, "legend.fontsize": 9,

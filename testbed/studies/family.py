@@ -83,6 +83,8 @@ FAMILY_SCHEMA = {
 }
 RANGE_TABLES = ("rig", "simulation", "excitation", "signal")
 DISTRIBUTIONS = ("uniform", "log_uniform", "integers", "log_integers", "choices")
+#: The integers numpy's Generator draws (int64).
+INT64_MIN, INT64_MAX = -(2**63), 2**63 - 1
 
 #: Materials a cantilever family may name: Young's modulus E [Pa] and density rho [kg/m^3]
 #: (handbook values at room temperature; any other material is given by E and rho ranges).
@@ -288,13 +290,15 @@ def _check_spec(spec: Any, file: str, key: str) -> None:
           and all(isinstance(a, (int, float)) and not isinstance(a, bool) and math.isfinite(a)
                   for a in arg) and arg[0] <= arg[1])
     if dist in ("integers", "log_integers"):
-        ok = ok and all(isinstance(a, int) for a in arg)
+        # numpy draws int64: [0, 2**64] was "ValueError: high is out of bounds for int64"
+        ok = ok and all(isinstance(a, int) and INT64_MIN <= a <= INT64_MAX for a in arg)
     if dist in ("log_uniform", "log_integers"):
         ok = ok and arg[0] > 0
     if not ok:
         raise ScenarioError(file, f"{key}.{dist}", arg,
                             "[lo, hi] with lo <= hi"
-                            + (", integers" if dist in ("integers", "log_integers") else "")
+                            + (", integers within int64 (-2**63 to 2**63 - 1)"
+                               if dist in ("integers", "log_integers") else "")
                             + (", lo > 0" if dist in ("log_uniform", "log_integers") else ""))
 
 
