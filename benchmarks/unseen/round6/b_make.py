@@ -109,7 +109,8 @@ def value(v) -> str:
     return repr(float(v)) if isinstance(v, float) else str(v)
 
 
-def scenario_text(name: str, desc: str, rig: dict, sim: dict, exc: dict, sig: dict) -> str:
+def scenario_text(name: str, desc: str, rig: dict, sim: dict, exc: dict, sig: dict,
+                  round_no: int = 6) -> str:
     base = rig.get("base", "stiff")
     tables = {
         "rig": {"E": 210e9, "rho": 7850.0, "width": 0.03, "thickness": 0.01, "length": L,
@@ -122,7 +123,7 @@ def scenario_text(name: str, desc: str, rig: dict, sim: dict, exc: dict, sig: di
     }
     tags = ["structural", "cantilever", "impact"] + (["nonlinear", "cubic"] if base == "soft" else ["linear"])
     out = [f'[scenario]\nname = "{name}"\nrig = "cantilever"\nseed = 0\n'
-           f'description = "Rigs nobody tuned, round 6: {desc}"\n'
+           f'description = "Rigs nobody tuned, round {round_no}: {desc}"\n'
            f"tags = {value(tags)}\n"]
     for t, kv in tables.items():
         out.append(f"[{t}]\n" + "".join(f"{k} = {value(v)}\n" for k, v in kv.items()))
