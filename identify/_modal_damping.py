@@ -151,6 +151,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from identify._structural_sim import state_matrix
 from identify.structural import MODE_SEPARATION, modal
 from testbed.core.lazy import lazy_module
 from testbed.core.measurement import Measurement
@@ -579,10 +580,7 @@ def coupling_moves(M: np.ndarray, C: np.ndarray, K: np.ndarray, C_uncoupled: np.
         the poles are not finite: nothing to compare).
     """
     def poles(Cm: np.ndarray) -> np.ndarray:
-        n = M.shape[0]
-        A = np.block([[np.zeros((n, n)), np.eye(n)],
-                      [-np.linalg.solve(M, K), -np.linalg.solve(M, Cm)]])
-        p = np.linalg.eigvals(A)
+        p = np.linalg.eigvals(state_matrix(M, Cm, K))
         return p[p.imag >= 0.0]
 
     taken = np.asarray(taken, bool)

@@ -29,7 +29,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from identify._base import Identifier
-from identify._structural_sim import simulate_structural
+from identify._structural_sim import simulate_structural, state_matrix
 from testbed.core.errors import IdentificationError
 from testbed.core.lazy import lazy_module
 from testbed.core.measurement import Measurement, Trajectory
@@ -354,10 +354,7 @@ def check_physical(M: np.ndarray, C: np.ndarray, K: np.ndarray, what: str = "lea
     what : str
         The fit named in the message as not constraining it.
     """
-    n = M.shape[0]
-    Minv = np.linalg.inv(M)
-    A = np.block([[np.zeros((n, n)), np.eye(n)], [-Minv @ K, -Minv @ C]])
-    lam = np.linalg.eigvals(A)
+    lam = np.linalg.eigvals(state_matrix(M, C, K))
     bad = lam.real > 1e-9 * np.abs(lam)
     if np.any(bad):
         worst = lam[bad][np.argmax(lam[bad].real)]
@@ -1152,10 +1149,9 @@ def unwarp_trapezoid(M: np.ndarray, C: np.ndarray, K: np.ndarray, fs: float
     """
     n = M.shape[0]
     try:
-        Minv = np.linalg.inv(M)
+        A = state_matrix(M, C, K)
     except np.linalg.LinAlgError:
         return None
-    A = np.block([[np.zeros((n, n)), np.eye(n)], [-Minv @ K, -Minv @ C]])
     if not np.all(np.isfinite(A)):
         return None
     p, V = linalg.eig(A)

@@ -17,6 +17,7 @@ from testbed.core.measurement import Measurement
 from testbed.pipeline.scenario import Scenario
 from testbed.scoring.run import RunResult
 from testbed.scoring.scorers import Scores, check_thresholds
+from testbed.studies.runstore import load_run, save_run
 
 
 class FakeIdentifier:
@@ -195,3 +196,11 @@ def study_rows() -> list[dict[str, Any]]:
                                    checks=five % (rmse, "true" if rmse <= 0.0501 else "false"))
                     rows.append(row)
     return rows
+
+
+def saved_runs(folder) -> dict[str, Any]:
+    """One small structural and one mechanical run, each saved under ``folder`` and read back
+    (``load_run``): what the figure tests draw, shape for shape as a real run's."""
+    return {k: load_run(save_run(f(), folder / k))
+            for k, f in (("structural", lambda: structural_result(n_samples=1000)),
+                         ("mechanical", lambda: mechanical_result(n_samples=400)))}

@@ -34,10 +34,7 @@ def assert_units(fig: Figure) -> None:
 
 @pytest.fixture(scope="module")
 def runs(tmp_path_factory):
-    d = tmp_path_factory.mktemp("runs")
-    return {k: load_run(save_run(f(), d / k))
-            for k, f in (("structural", lambda: synth.structural_result(n_samples=1000)),
-                         ("mechanical", lambda: synth.mechanical_result(n_samples=400)))}
+    return synth.saved_runs(tmp_path_factory.mktemp("runs"))
 
 
 def test_reconstruction_has_zoom_and_units():

@@ -12,15 +12,12 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # tests/testbed: _
 import _synthetic_runs as synth
 
 from testbed.reporting import drawer, figures, frames
-from testbed.studies.runstore import load_run, save_new_run, save_run
+from testbed.studies.runstore import load_run, save_new_run
 
 
 @pytest.fixture(scope="module")
 def runs(tmp_path_factory):
-    d = tmp_path_factory.mktemp("runs")
-    return {k: load_run(save_run(f(), d / k))
-            for k, f in (("structural", lambda: synth.structural_result(n_samples=1000)),
-                         ("mechanical", lambda: synth.mechanical_result(n_samples=400)))}
+    return synth.saved_runs(tmp_path_factory.mktemp("runs"))
 
 
 @pytest.fixture(autouse=True)
