@@ -48,6 +48,7 @@ import numpy as np
 
 from identify import IDENTIFIERS
 from identify._base import Identifier
+from identify._determinacy import DRAWS, determinacy_bound
 from identify._implicit import (
     DEFAULT_THRESHOLDS,
     Sweep,
@@ -70,6 +71,7 @@ from identify.sindy_pi import (
 from testbed.core.errors import DivergenceError, IdentificationError
 from testbed.core.measurement import Measurement, Trajectory
 from testbed.core.schema import ErrorFn, Field
+from testbed.numerics.noise import noise_std
 
 #: ``A`` (the identified coefficients of the derivatives at a state) counts as singular when
 #: its smallest singular value is below this.  Each equation is scaled to max |coef| = 1, so
@@ -386,6 +388,14 @@ class SINDyPIDynamical(Identifier):
         Variable names of the data fitted.
     val_error_ : ndarray, shape (n_states,)
         Normalised held-out residual of each selected equation.
+    noise_std_ : ndarray, shape (n_states,)
+        White-noise std of each state [unit of the state]: ``Measurement.noise_std`` as the
+        signal chain declares it from the raw states, else robust 4th differences of ``x``.
+    determinacy_ : ndarray, shape (n_states,)
+        Each selected equation's first-order bound on its rotation under noise of that level
+        (:func:`identify._determinacy.determinacy_bound`) [-]: 0 noise-free; at or above the
+        coefficient bar the record does not determine that equation (no selection or
+        estimator on these rows can).  ``determinacy_rule_`` states the rule and the figures.
     """
 
     name: ClassVar[str] = "sindy_pi_dynamical"
@@ -536,7 +546,42 @@ class SINDyPIDynamical(Identifier):
         self.feature_names_ = list(lib.names)
         self.states_, self.inputs_ = lib.states, lib.inputs
         self._lib = lib
+        self._fit_determinacy(data, lib, x, xd, u)
         return self
+
+    def _fit_determinacy(self, data: Measurement, lib: ImplicitTerms, x: np.ndarray,
+                         xd: np.ndarray, u: np.ndarray | None) -> None:
+        """``noise_std_``, ``determinacy_`` and ``determinacy_rule_`` of the selected equations
+        (:func:`identify._determinacy.determinacy_bound` on each equation's own terms and rows)."""
+        declared = data.noise_std is not None
+        try:
+            sigma = np.asarray(data.noise_std if declared else noise_std(x), dtype=float)
+        except ValueError:  # too few or non-finite samples: no noise level, no bound
+            sigma = np.full(x.shape[0], np.nan)
+        bounds = []
+        for row in self.coef_:
+            sub = ImplicitTerms([lib.names[j] for j in np.flatnonzero(row)], lib.states, lib.inputs)
+            if self.formulation == "weak":
+                def rows(z: np.ndarray, sub: ImplicitTerms = sub) -> np.ndarray:
+                    return weak_rows(sub, z, xd, u, data.fs, self.weak_window_s,
+                                     self.weak_windows, self.weak_degree)
+            else:
+                def rows(z: np.ndarray, sub: ImplicitTerms = sub) -> np.ndarray:
+                    return sub.evaluate(z, xd, u)
+            with np.errstate(over="ignore", invalid="ignore"):
+                bounds.append(determinacy_bound(rows, x, sigma) if np.all(np.isfinite(sigma))
+                              else float("nan"))
+        self.noise_std_ = sigma
+        self.determinacy_ = np.array(bounds)
+        where = ("as the signal chain declares it from the raw states" if declared
+                 else "robust 4th differences of the states")
+        self.determinacy_rule_ = (
+            f"noise std {', '.join(f'{v:.3g}' for v in sigma)} ({where}); bound "
+            f"{', '.join(f'{b:.3g}' for b in bounds)} = largest eigenvalue of the noise's Gram "
+            f"({DRAWS} draws at that level) over the second-smallest of each equation's "
+            "normalised Gram: >= the coefficient bar means the record does not determine the "
+            "equation" + ("" if self.formulation == "weak" else
+                          " (strong form: the chain's derivative noise left out, a lower bound)"))
 
     def derivative(self, x: np.ndarray, u: np.ndarray | None = None, t: float = float("nan")
                    ) -> np.ndarray:

@@ -218,14 +218,18 @@ def equation_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -
     ----------
     scores : Scores
         With ``details["equation_bars"]`` (:func:`rig_equation_bars`; other rigs: nothing to
-        check).
+        check) and, when the identifier reports it, ``details["determinacy"]`` (its
+        ``determinacy_``, per equation: :func:`identify._determinacy.determinacy_bound`).
     thresholds : dict
         The run's bars, ``{metric: {"min"|"max": value}}``.
 
     Returns
     -------
     dict of str to str
-        Empty, or the reason naming each missed metric, its value and the rig's bar.
+        Empty, or the reason naming each missed metric, its value and the rig's bar.  Where
+        the identifier's own bound (from the data alone) is at or above the rig's coefficient
+        bar, the reason says the record does not determine the equation (a failure all the
+        same: the verdict names why, it never changes).
     """
     bars = scores.details.get("equation_bars") or {}
     if not thresholds or not bars or {"fit", "model"} & set(scores.failures):
@@ -235,9 +239,16 @@ def equation_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -
         return {}
     said = "; ".join(f"{c.metric} {c.value:.3g} {'below' if c.bound == 'min' else 'above'} "
                      f"{c.threshold:g}" for c in missed)
-    return {"equation": (f"wrong equation: {said} (the rig's own bars on the identified "
-                         "equation: its question is the law, which a state that simulates "
-                         "well does not prove)")}
+    why = ("the rig's own bars on the identified equation: its question is the law, which a "
+           "state that simulates well does not prove")
+    bound = np.asarray(scores.details.get("determinacy", []), dtype=float)
+    bar = float(bars.get("coef_error", {}).get("max", 1.0))
+    if bound.size and np.any(bound >= bar):  # NaN (not estimated) never names it
+        return {"equation": (f"equation not determined by the record: {said}; at the record's "
+                             f"own noise level the fit's perturbation bound is "
+                             f"{np.nanmax(bound):.3g}, at or above the coefficient bar {bar:g} "
+                             f"(the identifier's determinacy_, from the data alone; {why})")}
+    return {"equation": f"wrong equation: {said} ({why})"}
 
 
 def out_of_band_failures(scores: Scores, thresholds: dict[str, dict[str, float]]
@@ -892,6 +903,8 @@ def score_dynamical(dataset: Dataset, data: Measurement, clean: Measurement, mod
     d.update(terms=cmp["names"], coef_true=cmp["coef_true"], coef_id=cmp["coef_id"],
              coef_term_errors=cmp["coef_errors"], coef_errors=errs.max(axis=1),
              equation_bars=rig_equation_bars(dataset))
+    if getattr(model, "determinacy_", None) is not None:  # the identifier's own, from the data
+        d["determinacy"] = np.asarray(model.determinacy_, dtype=float)
     return Scores(v, d, failures)
 
 
