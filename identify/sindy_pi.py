@@ -43,8 +43,10 @@ fivebar_multisine 0.21 -> 0.35 s of CPU, fivebar_sine_replay 0.18 -> 0.28 s.
 Record rule (:meth:`_ImplicitMechanical._record_rule`, ``record_rule_``, ``record_replay``):
 the rollout selection leaves out every shortlisted combination whose simulation of the whole
 record from its first measured state diverges (loses the loop closure), while another is left;
-where none is left, the fit is redone over the unpruned library
-(:meth:`SINDyPI._unpruned_refit`).  Measured (2026-11-26): the paper's sine input on the 30
+where none is left, or none even simulated its rollout segments (:class:`NoSimulationError`,
+which ended the fit until 2026-11-27; round 7's fbsine__002 at 3 %, seed 4: F -> P, 0.0078
+rad), the fit is redone over the unpruned library (:meth:`SINDyPI._unpruned_refit`).
+Measured (2026-11-26): the paper's sine input on the 30
 family geometries at 1 % noise with chain-derived rates 27 -> 29 / 30 within 0.0501 rad; the
 30 family five-bars with chain-derived rates (clean and 1 %) and with recorded rates (clean
 and 1 %) unchanged, value for value.
