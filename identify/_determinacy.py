@@ -74,7 +74,7 @@ def determinacy_bound(rows: Callable[[np.ndarray], np.ndarray], x: np.ndarray,
     for _ in range(DRAWS):
         d = np.asarray(rows(x + sigma * rng.standard_normal(x.shape)), dtype=float) / norms - base
         dG += d.T @ d
-    noise = float(np.linalg.eigvalsh(dG / DRAWS)[-1])
-    if not np.isfinite(noise):
+    if not np.all(np.isfinite(dG)):  # a perturbed record overflowed the terms: no bound
         return float("nan")
+    noise = float(np.linalg.eigvalsh(dG / DRAWS)[-1])
     return noise / gap if gap > 0.0 else float("inf")

@@ -179,3 +179,29 @@ def test_noise_free_data_have_a_zero_bound_and_a_wrong_equation_keeps_its_name()
     from testbed.scoring.scorers import equation_failures
     assert equation_failures(s, {"state_rmse": {"max": 1.0}})["equation"].startswith(
         "wrong equation: coef_error")
+
+
+def test_the_symmetric_refit_where_the_record_determines_the_equation():
+    # round 7's Km 0.05 mM at 2 % (benchmarks/unseen/round7/mm_km_0p05_w.toml, seed 3): the
+    # sweep's least squares on its left-hand side missed the rig's 5 % bar (0.0588); total least
+    # squares on the same terms meets it (0.0417), its bound being 2.8e-4 (determined)
+    ds, data, params = _noisy_mm({"Km": 0.05}, 2.0)
+    truth = ds.truth["equation_terms"], np.asarray(ds.truth["equation_coef"])
+    errs = {}
+    for refit in ("lhs", "symmetric"):
+        model = SINDyPIDynamical(**params, refit=refit).fit(data)
+        assert model.determinacy_[0] < 1e-2
+        errs[refit] = compare_implicit(model.feature_names_, model.coef_, *truth)
+    assert errs["symmetric"]["f1"] == errs["lhs"]["f1"] == 1.0   # the same terms
+    assert errs["symmetric"]["coef_error"] < 0.05 < errs["lhs"]["coef_error"]
+    assert model.refit_rule_.startswith("symmetric") and "for x" in model.refit_rule_
+
+
+def test_the_refit_keeps_the_sweeps_fit_where_the_record_does_not_determine_it():
+    # x0 = 10 mM at 0.5 %: bound >= 1, so total least squares could pick any direction the noise
+    # favours; the sweep's own fit stays, value for value
+    _, data, params = _noisy_mm({"x0": 10.0}, 0.5)
+    a = SINDyPIDynamical(**params, refit="lhs").fit(data)
+    b = SINDyPIDynamical(**params).fit(data)
+    np.testing.assert_array_equal(a.coef_, b.coef_)
+    assert "for no state" in b.refit_rule_
