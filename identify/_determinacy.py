@@ -2,10 +2,15 @@
 
 An implicit equation ``Theta w = 0`` is the null direction of the regression matrix's Gram
 ``G = Theta_n^T Theta_n`` (columns of the selected terms, normalised to unit norm).  Noise on the
-states perturbs ``G`` by ``dG``; by first-order perturbation theory of a symmetric matrix's
-eigenvectors (Davis-Kahan) the null direction rotates by at most about ``||dG|| / gap``, the
-gap being ``G``'s second-smallest eigenvalue (how far the nearest *other* combination of the
-same terms is from holding).  This module estimates that ratio from the data alone:
+states adds, in expectation, ``dG = E[D^T D]`` to ``G`` (``D`` the rows' change): the
+errors-in-variables term that biases the null direction.  ``G``'s second-smallest eigenvalue,
+the gap, measures how far the nearest *other* combination of the same terms is from holding.
+Where ``lambda_max(dG)`` reaches the gap, the noise alone adds as much to some combination's
+residual as separates the second-best equation from the best (Weyl: the eigenvalues of
+``G + dG`` move by up to ``lambda_max(dG)``), so which direction comes out smallest is the
+noise's choice.  The ratio is the bias's scale; the random part of the fit scales as its square
+root, so a ratio below 1 is necessary for a determined equation, not a guarantee of any
+accuracy.  This module estimates that ratio from the data alone:
 
 * the noise level is the record's own (``Measurement.noise_std``, as the signal chain estimated
   it from the raw states; else :func:`testbed.numerics.noise.noise_std` of ``x``);
@@ -14,12 +19,12 @@ same terms is from holding).  This module estimates that ratio from the data alo
   with :data:`SEED` so a run is repeatable on any platform);
 * the bound is ``lambda_max(dG) / lambda_2(G)`` (largest noise eigenvalue over the gap).
 
-A bound of 1 or more says the noise moves the regression as far as the gap to another equation
+A ratio of 1 or more says the noise moves the regression as far as the gap to another equation
 of the same terms: no estimator on these rows pins the equation, so a wrong one is the record's
 answer, not the identifier's choice (measured on round 7's Michaelis-Menten records: 2.0-47 on
 those whose true-support fit is itself 7-3900 % off, <= 4.2e-3 on every one within 5 %; see
 docs/known-gaps.md).  Derivative columns the rows take from the signal chain (the strong form)
-are not perturbed: the chain's derivative noise is left out, so the bound is then a lower one.
+are not perturbed: the chain's derivative noise is left out, so the ratio is then a lower one.
 """
 
 from __future__ import annotations
@@ -38,8 +43,8 @@ SEED = 0
 
 def determinacy_bound(rows: Callable[[np.ndarray], np.ndarray], x: np.ndarray,
                       sigma: np.ndarray) -> float:
-    """First-order bound on the rotation of an implicit equation's direction under the record's
-    noise (module docstring).
+    """The noise's Gram over the gap of an implicit equation's terms, at the record's noise
+    level (module docstring).
 
     Parameters
     ----------

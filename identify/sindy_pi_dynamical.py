@@ -34,14 +34,14 @@ derivative term is integrated as it stands with the signal chain's derivatives. 
 part is the last ``val_fraction`` of the windows.
 
 Determinacy and refit (``determinacy_``, ``determinacy_rule_``, ``refit_rule_``): for each
-selected equation the record's own noise level (``Measurement.noise_std``) gives a first-order
-bound on how far that noise turns the equation (:mod:`identify._determinacy`: the noise's Gram
-over the gap to the nearest other equation of the same terms).  Below 1 the direction is
-determined and, in the weak form, the coefficients are refitted by total least squares on the
-equation's own terms (``refit = "symmetric"``, :meth:`SINDyPIDynamical._refit`); at 1 or more the
-record does not determine the equation, the sweep's fit stays and the scorer names that reason.
-Measured on round 7's kinetics (seed 3): the bound is 2.0-47 on every record whose true terms,
-fitted on the same rows, are 7-3900 % off, and <= 4.2e-3 on every passing one.
+selected equation the record's own noise level (``Measurement.noise_std``) gives the ratio of
+the noise's Gram to the gap to the nearest other equation of the same terms
+(:mod:`identify._determinacy`).  Below 1 the direction is determined and, in the weak form,
+the coefficients are refitted by total least squares on the equation's own terms
+(``refit = "symmetric"``, :meth:`SINDyPIDynamical._refit`); at 1 or more the record does not
+determine the equation, the sweep's fit stays and the scorer names that reason.  Measured on
+round 7's kinetics (seed 3): the ratio is 2.0-47 on every record whose true terms, fitted on
+the same rows, are 7-3900 % off, and <= 4.2e-3 on every passing one.
 
 Simulation: at each RK4 stage the identified equations ``A(x, u) dx + b(x, u) = 0`` are solved
 for ``dx``; an (almost) singular ``A`` raises :class:`~testbed.core.errors.DivergenceError`.
@@ -405,10 +405,10 @@ class SINDyPIDynamical(Identifier):
         White-noise std of each state [unit of the state]: ``Measurement.noise_std`` as the
         signal chain declares it from the raw states, else robust 4th differences of ``x``.
     determinacy_ : ndarray, shape (n_states,)
-        Each selected equation's first-order bound on its rotation under noise of that level
-        (:func:`identify._determinacy.determinacy_bound`) [-]: 0 noise-free; at or above the
-        coefficient bar the record does not determine that equation (no selection or
-        estimator on these rows can).  ``determinacy_rule_`` states the rule and the figures.
+        Each selected equation's noise Gram over its gap at noise of that level
+        (:func:`identify._determinacy.determinacy_bound`) [-]: 0 noise-free; at 1 or more the
+        record does not determine that equation (no selection or estimator on these rows
+        can).  ``determinacy_rule_`` states the rule and the figures.
     """
 
     name: ClassVar[str] = "sindy_pi_dynamical"
@@ -641,12 +641,12 @@ class SINDyPIDynamical(Identifier):
         where = ("as the signal chain declares it from the raw states" if declared
                  else "robust 4th differences of the states")
         self.determinacy_rule_ = (
-            f"noise std {', '.join(f'{v:.3g}' for v in sigma)} ({where}); bound "
+            f"noise std {', '.join(f'{v:.3g}' for v in sigma)} ({where}); ratio "
             f"{', '.join(f'{b:.3g}' for b in bounds)} = largest eigenvalue of the noise's Gram "
             f"({DRAWS} draws at that level) over the second-smallest of each equation's "
-            "normalised Gram: >= the coefficient bar means the record does not determine the "
-            "equation" + ("" if self.formulation == "weak" else
-                          " (strong form: the chain's derivative noise left out, a lower bound)"))
+            "normalised Gram: >= 1 means the record does not determine the equation"
+            + ("" if self.formulation == "weak" else
+               " (strong form: the chain's derivative noise left out, a lower bound)"))
 
     def derivative(self, x: np.ndarray, u: np.ndarray | None = None, t: float = float("nan")
                    ) -> np.ndarray:
