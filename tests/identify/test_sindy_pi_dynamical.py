@@ -151,7 +151,7 @@ def test_the_determinacy_bound_tells_a_determined_record_from_a_zero_order_one()
     # >= 1: the noise moves the rows as far as the gap to another equation (the module's rule;
     # measured 2.0 here, 1.98 at 2 %)
     assert model.determinacy_[0] >= 1.0
-    assert "does not determine" in model.determinacy_rule_
+    assert "does not determine" in model.determinacy_rule_ and "ratio" in model.determinacy_rule_
     s = score("dynamical", ds, data, data, model)
     from testbed.scoring.scorers import equation_failures
     why = equation_failures(s, {"state_rmse": {"max": 0.01}})["equation"]
@@ -205,3 +205,17 @@ def test_the_refit_keeps_the_sweeps_fit_where_the_record_does_not_determine_it()
     b = SINDyPIDynamical(**params).fit(data)
     np.testing.assert_array_equal(a.coef_, b.coef_)
     assert "for no state" in b.refit_rule_
+
+
+@pytest.mark.parametrize("ratio, named", [(0.5, "wrong equation"), (np.nan, "wrong equation"),
+                                          (1.0, "equation not determined"),
+                                          (47.1, "equation not determined")])
+def test_a_missed_equation_bar_is_named_undetermined_from_a_ratio_of_one(ratio, named):
+    from testbed.scoring.scorers import Scores, equation_failures
+    s = Scores({"coef_error": 2.18, "support_f1": 0.889},
+               {"equation_bars": {"coef_error": {"max": 0.05}, "support_f1": {"min": 1.0}},
+                "determinacy": np.array([ratio])})
+    why = equation_failures(s, {"state_rmse": {"max": 0.01}})["equation"]
+    assert why.startswith(named) and "coef_error 2.18 above 0.05" in why
+    assert equation_failures(Scores({"coef_error": 0.01, "support_f1": 1.0}, s.details),
+                             {"state_rmse": {"max": 0.01}}) == {}   # a met bar is never named
