@@ -43,8 +43,10 @@ fivebar_multisine 0.21 -> 0.35 s of CPU, fivebar_sine_replay 0.18 -> 0.28 s.
 Record rule (:meth:`_ImplicitMechanical._record_rule`, ``record_rule_``, ``record_replay``):
 the rollout selection leaves out every shortlisted combination whose simulation of the whole
 record from its first measured state diverges (loses the loop closure), while another is left;
-where none is left, the fit is redone over the unpruned library
-(:meth:`SINDyPI._unpruned_refit`).  Measured (2026-11-26): the paper's sine input on the 30
+where none is left, or none even simulated its rollout segments (:class:`NoSimulationError`,
+which ended the fit until 2026-11-27; round 7's fbsine__002 at 3 %, seed 4: F -> P, 0.0078
+rad), the fit is redone over the unpruned library (:meth:`SINDyPI._unpruned_refit`).
+Measured (2026-11-26): the paper's sine input on the 30
 family geometries at 1 % noise with chain-derived rates 27 -> 29 / 30 within 0.0501 rad; the
 30 family five-bars with chain-derived rates (clean and 1 %) and with recorded rates (clean
 and 1 %) unchanged, value for value.
@@ -222,6 +224,10 @@ COMMON_HYPERPARAMETERS = {
     "column_lowpass_hz": COLUMN_LOWPASS_FIELD, "column_lowpass_order": COLUMN_LOWPASS_ORDER_FIELD,
     "edge_trim": EDGE_TRIM_FIELD, "input_hold": INPUT_HOLD_FIELD,
 }
+
+
+class NoSimulationError(IdentificationError):
+    """No shortlisted combination of the rollout selection simulated its segments."""
 
 
 def ordered_fields(fields: dict[str, Field], order: tuple[str, ...]) -> dict[str, Field]:
@@ -935,7 +941,8 @@ class _ImplicitMechanical(Identifier):
                       for m in models]
             if not np.isfinite(min(scores)):
                 self.record_rule_ = "not reached: no shortlisted combination simulated its segments"
-                raise IdentificationError("no shortlisted model combination could be simulated")
+                self.record_replays_ = np.zeros(len(models), dtype=bool)
+                raise NoSimulationError("no shortlisted model combination could be simulated")
             scores = self._record_rule(scores, models, data)
             size = [sum(int(sw.nnz[t, c]) for t, c in cb) for cb in combos]
             ok = np.array(scores) <= min(scores) * (1 + self.selection_rtol) + ROLLOUT_ATOL
@@ -1466,6 +1473,13 @@ class SINDyPI(_ImplicitMechanical):
                 raise
             self._pool_refit(data, np.inf, f"held-out selection: {exc}", None)
             return self
+        except NoSimulationError as exc:
+            # the record rule's second fit (_unpruned_refit) where not even the segments simulate
+            if not self._unpruned_refit(data):
+                raise IdentificationError(f"{exc} (nor over the unpruned library: "
+                                          f"{self.record_rule_})") from None
+            self._replay_check(data)
+            return self
         worst = float(np.max(self.validation_errors_))
         if (self.noise_rel_ <= NOISE_FREE_REL and self.column_lowpass_hz_ == 0.0
                 and self.column_lowpass_hz is None and self.formulation_ == "strong"
@@ -1476,22 +1490,25 @@ class SINDyPI(_ImplicitMechanical):
         self._replay_check(data)
         return self
 
-    def _unpruned_refit(self, data: Measurement) -> None:
+    def _unpruned_refit(self, data: Measurement) -> bool:
         """The record rule's second fit (:meth:`_record_rule`): where no shortlisted
-        combination of the rollout selection simulates the whole record, the fit is redone over
+        combination of the rollout selection simulates the whole record (or not even its
+        segments, :class:`NoSimulationError`), the fit is redone over
         the library without pruning (the replay rule's pool: on a record that leaves the
         equations non-unique the pruning takes its coincidental dependencies for kinematic
         identities, see :meth:`_replay_check`), and kept if one of its combinations simulates
         the whole record; else the first fit stays (a scored failure, if it fails).  Not when
-        the user set ``prune_tol`` to None already or ``record_replay = False``.
+        the user set ``prune_tol`` to None already or ``record_replay = False``.  Returns
+        whether the unpruned fit was kept.
         Measured (2026-11-26): fbsine__010 (the paper's sine input on family geometry 010 at
         1 % noise, chain-derived rates): none of the pruned library's 9 pairs simulated the
         record (the scored model lost its loop at 5.4 s); the unpruned library's choice
         scored 7.2e-4 rad.
         """
         ok = getattr(self, "record_replays_", None)
-        if ok is None or ok.any() or self._knob("prune_tol") is None:
-            return
+        if (ok is None or ok.any() or self._knob("prune_tol") is None
+                or getattr(self, "record_replay", None) is False):
+            return False
         first = dict(self.__dict__)
         head = self.record_rule_
         self._unpruned = True
@@ -1500,14 +1517,15 @@ class SINDyPI(_ImplicitMechanical):
         except IdentificationError as exc:
             self.__dict__.update(first)
             self.record_rule_ = f"{head}; the unpruned library's fit failed ({exc}): first fit kept"
-            return
+            return False
         finally:
             self._unpruned = False
         if not self.record_replays_.any():
             self.__dict__.update(first)
             self.record_rule_ = (f"{head}; none of the unpruned library's either: first fit kept")
-            return
+            return False
         self.record_rule_ = f"{head}; fitted again over the unpruned library: {self.record_rule_}"
+        return True
 
     def _replay_rule_applies(self) -> bool:
         """The noise rule (not the user) chose the held-out selection, for the strong form,

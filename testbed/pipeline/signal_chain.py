@@ -715,7 +715,10 @@ def measure_dynamical(dataset: Dataset, cfg: Mapping[str, Any]) -> Measurement:
         ``x`` the states (smoothed when estimated), ``xd`` their derivatives, ``xdd`` the
         second derivatives (recorded: central differences of ``dx``, ``numpy.gradient``; a
         first-order identifier does not use them), channels named as the data name them,
-        ``u`` / ``inputs`` the inputs (None / () for an autonomous system), ``prior`` a copy.
+        ``u`` / ``inputs`` the inputs (None / () for an autonomous system), ``prior`` a copy,
+        ``noise_std`` the raw states' white-noise std [unit of each state] before any smoothing
+        (:func:`testbed.numerics.noise.noise_std`, 4th differences: it needs 6 samples; None
+        for fewer or for non-finite samples).
 
     Raises
     ------
@@ -726,6 +729,8 @@ def measure_dynamical(dataset: Dataset, cfg: Mapping[str, Any]) -> Measurement:
     x = _get(dataset, "x")
     n = x.shape[0]
     channels = tuple(dataset.measured["x"].channels)
+    # the raw states' white noise, before the smoothing below hides it (as measure_mechanical)
+    noise = (noise_est.noise_std(x) if x.shape[1] >= 6 and np.all(np.isfinite(x)) else None)
     if cfg["derivatives"] == "recorded":
         xd = _get(dataset, "dx", n)
         xdd = np.gradient(xd, 1.0 / fs, axis=1)
@@ -735,7 +740,8 @@ def measure_dynamical(dataset: Dataset, cfg: Mapping[str, Any]) -> Measurement:
     if "input" in dataset.measured:
         u, inputs = _get(dataset, "input"), tuple(dataset.measured["input"].channels)
     return Measurement(fs=fs, x=x, xd=xd, xdd=xdd, channels=channels, u=u, inputs=inputs,
-                       prior=dict(dataset.prior), input_hold=declared_input_hold(dataset.attrs))
+                       prior=dict(dataset.prior), input_hold=declared_input_hold(dataset.attrs),
+                       noise_std=noise)
 
 
 register_signal_chain(SignalChain("structural", STRUCTURAL_SIGNAL_SCHEMA, measure_structural,

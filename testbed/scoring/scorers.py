@@ -206,6 +206,14 @@ def rig_equation_bars(dataset: Dataset) -> dict[str, dict[str, float]]:
     return dict(getattr(cls, "equation_bars", None) or {})
 
 
+#: ``determinacy_`` (the noise's Gram over the gap of an identified equation's terms,
+#: :func:`identify._determinacy.determinacy_bound`) from which a missed equation bar is named
+#: "not determined by the record": at 1 the noise alone moves the regression as far as the gap
+#: to another equation of the same terms (measured on round 7's kinetics: 2.0-47 where the
+#: truth's own terms fitted on the same rows are 7-3900 % off, <= 4.2e-3 on every pass).
+UNDETERMINED = 1.0
+
+
 def equation_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -> dict[str, str]:
     """The rig's own bars on the identified equation, missed: ``{"equation": reason}``.
 
@@ -218,14 +226,18 @@ def equation_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -
     ----------
     scores : Scores
         With ``details["equation_bars"]`` (:func:`rig_equation_bars`; other rigs: nothing to
-        check).
+        check) and, when the identifier reports it, ``details["determinacy"]`` (its
+        ``determinacy_``, per equation: :func:`identify._determinacy.determinacy_bound`).
     thresholds : dict
         The run's bars, ``{metric: {"min"|"max": value}}``.
 
     Returns
     -------
     dict of str to str
-        Empty, or the reason naming each missed metric, its value and the rig's bar.
+        Empty, or the reason naming each missed metric, its value and the rig's bar.  Where
+        the identifier's own ratio (from the data alone) is at least :data:`UNDETERMINED`, the
+        reason says the record does not determine the equation (a failure all the same: the
+        verdict names why, it never changes).
     """
     bars = scores.details.get("equation_bars") or {}
     if not thresholds or not bars or {"fit", "model"} & set(scores.failures):
@@ -235,9 +247,15 @@ def equation_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -
         return {}
     said = "; ".join(f"{c.metric} {c.value:.3g} {'below' if c.bound == 'min' else 'above'} "
                      f"{c.threshold:g}" for c in missed)
-    return {"equation": (f"wrong equation: {said} (the rig's own bars on the identified "
-                         "equation: its question is the law, which a state that simulates "
-                         "well does not prove)")}
+    why = ("the rig's own bars on the identified equation: its question is the law, which a "
+           "state that simulates well does not prove")
+    bound = np.asarray(scores.details.get("determinacy", []), dtype=float)
+    if bound.size and np.any(bound >= UNDETERMINED):  # NaN (not estimated) never names it
+        return {"equation": (f"equation not determined by the record: {said}; at the record's "
+                             f"own noise level the noise's Gram reaches {np.nanmax(bound):.3g} x "
+                             "the gap to another equation of the same terms (the identifier's "
+                             f"determinacy_, from the data alone; {why})")}
+    return {"equation": f"wrong equation: {said} ({why})"}
 
 
 def out_of_band_failures(scores: Scores, thresholds: dict[str, dict[str, float]]
@@ -892,6 +910,8 @@ def score_dynamical(dataset: Dataset, data: Measurement, clean: Measurement, mod
     d.update(terms=cmp["names"], coef_true=cmp["coef_true"], coef_id=cmp["coef_id"],
              coef_term_errors=cmp["coef_errors"], coef_errors=errs.max(axis=1),
              equation_bars=rig_equation_bars(dataset))
+    if getattr(model, "determinacy_", None) is not None:  # the identifier's own, from the data
+        d["determinacy"] = np.asarray(model.determinacy_, dtype=float)
     return Scores(v, d, failures)
 
 
