@@ -27,6 +27,23 @@ def _as_signal(x: np.ndarray) -> np.ndarray:
     return x
 
 
+def cutoff_problem(cutoff_hz: float, fs: float) -> str | None:
+    """What a zero-phase filter's cut-off ``cutoff_hz`` [Hz] > 0 lacks at ``fs`` [Hz], as the
+    "expected ..." of an error line; None if a design can take it.
+
+    Below the Nyquist frequency, and a fraction of it that is a float64 > 0: 5e-324 Hz passes
+    "> 0" but its normalised cut-off underflows to 0, which scipy's design refuses ("filter
+    critical frequencies must be greater than 0", an internal error where a setting said it).
+    """
+    nyq = fs / 2.0
+    if not cutoff_hz < nyq:
+        return f"expected below the Nyquist frequency {nyq:g} Hz (sample rate {fs:g} Hz)"
+    if not cutoff_hz / nyq > 0.0:
+        return (f"expected a cut-off whose fraction of the Nyquist frequency {nyq:g} Hz is a "
+                "float64 > 0 (it underflows to 0)")
+    return None
+
+
 def _check_cutoff(cutoff_hz: float, fs: float, what: str) -> None:
     if not fs > 0:
         raise ValueError(f"sample rate must be > 0 Hz, got {fs}")
