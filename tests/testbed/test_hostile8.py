@@ -1,0 +1,145 @@
+"""Eighth malformed-input round: the findings of ``benchmarks/hostile8.py`` (docs/history.md,
+malformed-input audits), each refused in one line by the layer that owns the check.
+
+Dataset files edited and rehashed (``Dataset.save`` recomputes the content hash, so the hash
+check passes): positions of the wrong length or NaN, priors NaN, negative or text, and -- for
+the exporters, which wrote them out in silence -- a NaN rate, NaN samples or channels cut to
+other lengths.  Scenario settings at finite extremes: a cut-off of 5e-324 Hz, a weak window of
+1e-300 s under the formulation rule, a cart-pole pole of 1e300 m.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+
+import numpy as np
+import pytest
+
+from testbed.core.dataset import Dataset, Signal
+from testbed.core.errors import ScenarioError, TestbedError
+from testbed.pipeline.importers import MeasuredDataError, read_measured
+from testbed.pipeline.scenario import SCENARIO_DIR, _read_toml, scenario_from_dict
+from testbed.reporting.export import export_dataset
+
+FS = 1000.0  # Hz; 400 samples of a 7 Hz sine: any rate and length the readers accept
+
+
+def _dataset(**edits) -> Dataset:
+    """A hand-made structural-looking record (no kind: no truth to validate): three sensors at
+    0.1, 0.2, 0.3 m and a force at 0.3 m."""
+    t = np.arange(400) / FS
+    acc = np.vstack([np.sin(2 * np.pi * 7 * t) * (k + 1) for k in range(3)])
+    force = np.exp(-t / 0.01)[None, :]
+    ds = Dataset(FS, {"acceleration": Signal(acc, ("acc1", "acc2", "acc3"), "m/s^2",
+                                             np.array([0.1, 0.2, 0.3])),
+                      "force": Signal(force, ("force",), "N", np.array([0.3]))},
+                 prior={"total_mass": 0.7})
+    for key, value in edits.items():
+        if key == "fs":
+            ds.fs = value
+        elif key == "prior":
+            ds.prior.update(value)
+        else:  # "<signal>.<attribute>"
+            sig, attr = key.split(".")
+            setattr(ds.measured[sig], attr, value(getattr(ds.measured[sig], attr)))
+    return ds
+
+
+def _saved(tmp_path, **edits):
+    return _dataset(**edits).save(tmp_path / "edited.h5")
+
+
+def test_a_clean_hand_made_dataset_is_read_and_exported(tmp_path):
+    p = _saved(tmp_path)
+    assert read_measured(p).positions["acceleration/acc2"] == 0.2
+    for fmt in ("uff", "sep005"):
+        (out,) = export_dataset(p, fmt, tmp_path / f"out.{fmt}")
+        assert out.stat().st_size > 0
+
+
+@pytest.mark.parametrize("edits, fragment", [
+    # one position for three channels (and two force rows against one position): IndexError,
+    # an internal error of `identify` and of `export`
+    ({"acceleration.positions": lambda p: p[:1]},
+     "signal measured/acceleration: positions of shape (1,) for 3 channel(s)"),
+    ({"force.data": lambda d: np.vstack([d, d]), "force.channels": lambda c: ("f1", "f2")},
+     "signal measured/force: positions of shape (1,) for 2 channel(s)"),
+    # a NaN position: kept in silence by `identify`, "nan is not in list" in `export`
+    ({"acceleration.positions": lambda p: np.array([np.nan, 0.2, 0.3])},
+     "channel 'acceleration/acc1': positions=nan; expected a finite number [m]"),
+    # the file's own priors were read unchecked (only --prior values were checked)
+    ({"prior": {"total_mass": math.nan}}, "prior total_mass=nan: expected a finite number > 0"),
+    ({"prior": {"total_mass": -1.0}}, "prior total_mass=-1.0: expected a finite number > 0"),
+    ({"prior": {"total_mass": "heavy"}}, "prior total_mass='heavy': expected a finite number > 0"),
+])
+def test_an_edited_dataset_file_is_refused_by_identify_and_export_alike(tmp_path, edits, fragment):
+    p = _saved(tmp_path, **edits)
+    with pytest.raises(MeasuredDataError) as e:
+        read_measured(p)
+    assert fragment in str(e.value) and "\n" not in str(e.value)
+    for fmt in ("uff", "sep005"):
+        with pytest.raises(MeasuredDataError) as e:
+            export_dataset(p, fmt, tmp_path / f"out.{fmt}")
+        assert fragment in str(e.value)
+        assert not (tmp_path / f"out.{fmt}").exists()
+
+
+@pytest.mark.parametrize("edits, fragment", [
+    ({"fs": math.nan}, "sample rate nan Hz; expected a finite rate > 0 Hz"),
+    ({"fs": -100.0}, "sample rate -100 Hz; expected a finite rate > 0 Hz"),
+    ({"acceleration.data": lambda d: np.where(np.arange(d.shape[1]) == 5, np.nan, d)},
+     "channel 'acceleration/acc1' has 1 NaN or infinite value(s), the first at sample 5"),
+    ({"force.data": lambda d: d[:, :100]}, "channels have different lengths"),
+])
+def test_export_refuses_what_it_wrote_in_silence(tmp_path, edits, fragment):
+    # These were exported with status 0: a UFF58 of NaN abscissa increment, NaN samples,
+    # channels of different lengths.  `identify` refused them already.
+    p = _saved(tmp_path, **edits)
+    for fmt in ("uff", "sep005"):
+        with pytest.raises(MeasuredDataError, match=fragment.replace("(", r"\(").replace(")", r"\)")):
+            export_dataset(p, fmt, tmp_path / f"out.{fmt}")
+
+
+def test_export_keeps_values_beyond_the_identifiers_bound_and_units_it_does_not_know(tmp_path):
+    # the exporter converts nothing: the identifiers' magnitude bound (1e50) and the list of
+    # units the importers convert are not its business
+    p = _saved(tmp_path, **{"acceleration.data": lambda d: d * 1e60,
+                            "acceleration.unit": lambda u: "furlong/fortnight^2"})
+    (out,) = export_dataset(p, "sep005", tmp_path / "out.json")
+    assert out.stat().st_size > 0
+
+
+# ------------------------------------------------------------------ settings at finite extremes
+
+def _scenario(base: str, section: str, key: str, value) -> None:
+    raw = copy.deepcopy(_read_toml(SCENARIO_DIR / f"{base}.toml"))
+    raw["scenario"].pop("extends", None)
+    raw.setdefault(section, {})[key] = value
+    scenario_from_dict(raw, file="x.toml", stem=base)
+
+
+@pytest.mark.parametrize("base, section, key, value, fragment", [
+    # 5e-324 Hz passed "> 0", then scipy: "filter critical frequencies must be greater than 0"
+    ("fivebar_multisine", "identify", "column_lowpass_hz", 5e-324, "underflows to 0"),
+    ("cartpole", "identify", "column_lowpass_hz", 5e-324, "underflows to 0"),
+    # a weak window with the formulation left to the rule was not checked: the fit raised
+    # "a test function needs at least 3 samples, got 1"
+    ("fivebar_multisine", "identify", "weak_window_s", 1e-300, "at least 2 sample steps"),
+    ("fivebar_multisine", "identify", "weak_window_s", 1e6, "shorter than the trimmed record"),
+    # L * L overflowed to inf and passed the inertia check; L ** 2 then raised OverflowError
+    ("cartpole", "rig", "pole_length", 1e300, "inertia m L^2 / 12 is a finite float64"),
+    ("cartpole", "rig", "pole_length", 1e200, "inertia m L^2 / 12 is a finite float64"),
+])
+def test_a_setting_at_a_finite_extreme_is_refused_naming_its_key(base, section, key, value,
+                                                                 fragment):
+    with pytest.raises(ScenarioError) as e:
+        _scenario(base, section, key, value)
+    assert e.value.key == f"{section}.{key}" and fragment in str(e.value), str(e.value)
+    assert "\n" not in str(e.value)
+
+
+def test_the_signal_chain_still_refuses_an_underflowing_cut_off():
+    # the chain's check and the identifiers' are one routine (testbed.numerics.filters)
+    with pytest.raises(TestbedError, match="underflows to 0"):
+        _scenario("cantilever_stiff_impact", "signal", "highpass_hz", 5e-324)
