@@ -127,6 +127,15 @@ def _scenario(base: str, section: str, key: str, value) -> None:
     # "a test function needs at least 3 samples, got 1"
     ("fivebar_multisine", "identify", "weak_window_s", 1e-300, "at least 2 sample steps"),
     ("fivebar_multisine", "identify", "weak_window_s", 1e6, "shorter than the trimmed record"),
+    # 1e-300 Hz and 1e-15 Hz at 12.8 kHz: numpy's "Singular matrix" in the signal chain (the
+    # zero-phase filter's start-up solve, poles within round-off of 1)
+    ("cantilever_stiff_impact_lsq", "signal", "highpass_hz", 1e-15, "at least 9.54e-05 Hz"),
+    ("cantilever_stiff_impact_lsq", "signal", "highpass_hz", 1e-300, "at least 9.54e-05 Hz"),
+    # ls_sindy's fit band was not checked against the data: ValueErrors of the fit (7000 Hz
+    # above Nyquist, 5e-324 Hz) and a "Singular matrix" scored as a fit failure (1e-15 Hz)
+    ("cantilever_stiff_impact_lsq", "identify", "fit_band_hz", 7000.0, "below the Nyquist"),
+    ("cantilever_stiff_impact_lsq", "identify", "fit_band_hz", 5e-324, "underflows to 0"),
+    ("cantilever_stiff_impact_lsq", "identify", "fit_band_hz", 1e-15, "at least 9.54e-05 Hz"),
     # L * L overflowed to inf and passed the inertia check; L ** 2 then raised OverflowError
     ("cartpole", "rig", "pole_length", 1e300, "inertia m L^2 / 12 is a finite float64"),
     ("cartpole", "rig", "pole_length", 1e200, "inertia m L^2 / 12 is a finite float64"),
@@ -143,3 +152,17 @@ def test_the_signal_chain_still_refuses_an_underflowing_cut_off():
     # the chain's check and the identifiers' are one routine (testbed.numerics.filters)
     with pytest.raises(TestbedError, match="underflows to 0"):
         _scenario("cantilever_stiff_impact", "signal", "highpass_hz", 5e-324)
+
+
+def test_the_smallest_cut_off_fraction_refuses_little_a_filter_could_take():
+    # MIN_CUTOFF_FRACTION = sqrt(eps) = 1.49e-8 of Nyquist: measured "Singular matrix" from
+    # 5.6e-9 down (orders 2-16, where LAPACK meets an exact zero pivot: not asserted, that is
+    # the kernel's); at 1e-8, just below the bar, the filters still work, so the bar refuses
+    # nothing a filter could take by more than its factor 1.5
+    from testbed.numerics import filters
+
+    x = np.random.default_rng(0).standard_normal((1, 4000))
+    for order in (2, 8, 16):
+        assert np.all(np.isfinite(filters.lowpass(x, 2.0, 1e-8, order)))  # Nyquist 1 Hz
+    assert filters.cutoff_problem(1e-8, 2.0) is not None
+    assert filters.cutoff_problem(filters.MIN_CUTOFF_FRACTION, 2.0) is None
