@@ -260,7 +260,12 @@ def library_for(spec: Any, n_channels: int, n_inputs: int) -> Library:
     if spec == "generic":
         return generic_mechanical_library(n_channels, n_inputs)
     if isinstance(spec, Sequence) and not isinstance(spec, str):
-        return Library(list(spec), n_channels, n_inputs)
+        lib = Library(list(spec), n_channels, n_inputs)
+        aliased = lib.structural_terms()
+        if aliased:  # 'x1' fitted as th1, then "cannot evaluate factor 'x1'" in scoring
+            raise ValueError(f"term {aliased[0]!r} uses the structural names x, v, a; a "
+                             "mechanical library names th, dth, ddth, u")
+        return lib
     raise ValueError(f"library must be 'fivebar', 'fivebar_full', 'generic', a Library or a list "
                      f"of term names, got {spec!r}")
 

@@ -166,3 +166,35 @@ def test_the_smallest_cut_off_fraction_refuses_little_a_filter_could_take():
         assert np.all(np.isfinite(filters.lowpass(x, 2.0, 1e-8, order)))  # Nyquist 1 Hz
     assert filters.cutoff_problem(1e-8, 2.0) is not None
     assert filters.cutoff_problem(filters.MIN_CUTOFF_FRACTION, 2.0) is None
+
+
+# ------------------------------------------------------------------ library terms
+
+@pytest.mark.parametrize("term, fragment", [
+    # index 0 was read as index -1: 'th0' the constant row, 'u0' the last acceleration; the run
+    # passed or failed with a silently different library
+    ("th0", "unknown factor 'th0'"),
+    ("u0", "unknown factor 'u0'"),
+    ("sin(th0)", "unknown factor 'sin(th0)'"),
+    # the evaluation gathers terms x factors x 8192 samples: 'th1^99999' was a MemoryError
+    # (24 GiB asked), 'th1^999999999' a list of 1e9 names before that
+    ("th1^99999", "more than 64 factors"),
+    ("th1^999999999", "more than 64 factors"),
+    # the structural names: fitted as th1, then "cannot evaluate factor 'x1'" in scoring
+    ("x1", "uses the structural names x, v, a"),
+])
+def test_a_mechanical_library_term_the_data_cannot_mean_is_refused(term, fragment):
+    lib = list(_read_toml(SCENARIO_DIR / "cartpole.toml")["identify"]["library"])
+    with pytest.raises(ScenarioError) as e:
+        _scenario("cartpole", "identify", "library", [*lib, term])
+    assert e.value.key == "identify.library" and fragment in str(e.value), str(e.value)
+
+
+def test_a_high_power_is_named_without_being_expanded():
+    # canonical() counted powers by expanding them; a dynamical library's 'x^200*dx' is left
+    # to the fit (its overflow check names the term), so the name must stay cheap and exact
+    from testbed.core.terms import canonical
+
+    assert canonical("x^999999999*dx") == ("x^999999999*dx", 1)
+    assert canonical("dth1^2*sin(th3-th2)*dth1") == ("sin(th2-th3)*dth1^3", -1)
+    assert canonical("th1^0") == ("", 1)
