@@ -12,7 +12,9 @@ Families: ``datasets`` (a hand-made dataset file edited and saved again, so its 
 is right: rate NaN, 0, -1, 5e-324, 1e300; samples NaN, inf, 1e300, 5e-324, zero; channels cut
 to 0, 1 or half their samples, repeated or without units; positions of the wrong length, NaN
 or 1e300; priors NaN, negative, text; each read for ``identify`` and exported to UFF and
-SEP-005), ``extremes`` (every number, choice and switch of ``[rig]``, ``[simulation]``,
+SEP-005), ``terms`` (library and ``lhs`` terms of a mechanical and a dynamical scenario:
+malformed, index 0, powers of 1e9, the other kinds' names; loaded and run), ``extremes``
+(every number, choice and switch of ``[rig]``, ``[simulation]``,
 ``[excitation]``, ``[noise]``, ``[signal]`` and ``[identify]`` of five shipped scenarios set
 to finite extremes -- 1e300, -1e300, 1e-300, 5e-324, -0.0, 0, 1e15, -1, 1e-15 for numbers,
 0, -1, 2**53 + 1, 2**62, 1e9 for integers, every allowed word, both switches -- loaded, and
@@ -233,6 +235,35 @@ def extreme_cases() -> list[tuple[str, object]]:
     return cases
 
 
+#: Library terms added to a shipped library (or given as its ``lhs``): malformed, out of the
+#: data's range, of huge powers, of the other kinds' names.
+TERMS = ["sin(th2", "th0", "th3", "u0", "u2", "th1^0", "th1^-1", "th1^1e300", "th1^99999",
+         "th1^999999999", "th1^2.5", "th1^3", "*".join(["dth1"] * 200), "ddth1*ddth2", "ddth1^2",
+         "1", "0", "", " ", "ddth1 ", "DDTH1", "sin(sin(th2))", "sin(th0)", "cos(th1-th0)",
+         "cos(th2)^2*ddth1", "exp(th1)", "th1/th2", "th1**2", "thé", "dth2^2", "u1^2", "x1",
+         "v1", "a1", "x", "dx", "y", "x^99999", "x^200*dx", "dx^2", "ddx"]
+
+
+def term_cases() -> list[tuple[str, object]]:
+    """Each of :data:`TERMS` added to the library of a mechanical (cart-pole, sindy_pi) and a
+    dynamical (Michaelis-Menten, sindy_pi_dynamical) scenario, and given as their ``lhs``."""
+    from testbed.pipeline.scenario import SCENARIO_DIR, _read_toml
+
+    cases = []
+    for base, cut in (("cartpole", 2.0), ("michaelis_menten", 4.0)):
+        raw0 = _read_toml(SCENARIO_DIR / f"{base}.toml")
+        raw0["simulation"]["duration"] = cut
+        library = raw0["identify"].get("library") or ["1", "x", "dx", "x*dx", "x^2*dx", "x^2"]
+        for term in TERMS:
+            for key, value in (("library", [*library, term]), ("lhs", [term])):
+                raw = copy.deepcopy(raw0)
+                raw["identify"]["library"] = list(library)
+                raw["identify"][key] = value
+                cases.append((f"{base}: identify.{key} with {term[:40]!r}",
+                              lambda raw=raw, base=base: _run(raw, base)))
+    return cases
+
+
 def run_inprocess(cases) -> Counter:
     counts = Counter()
     for name, fn in cases:
@@ -248,7 +279,7 @@ def run_inprocess(cases) -> Counter:
 
 
 def main(argv: list[str]) -> int:
-    families = argv or ["datasets", "extremes"]
+    families = argv or ["datasets", "terms", "extremes"]
     total = Counter()
     with tempfile.TemporaryDirectory(prefix="hostile8-") as tmp:
         work = Path(tmp)
@@ -256,6 +287,8 @@ def main(argv: list[str]) -> int:
             t0 = time.perf_counter()
             if fam == "datasets":
                 c = run_inprocess(dataset_cases(work))
+            elif fam == "terms":
+                c = run_inprocess(term_cases())
             elif fam == "extremes":
                 c = run_inprocess(extreme_cases())
             else:
