@@ -136,6 +136,9 @@ def _scenario(base: str, section: str, key: str, value) -> None:
     ("cantilever_stiff_impact_lsq", "identify", "fit_band_hz", 7000.0, "below the Nyquist"),
     ("cantilever_stiff_impact_lsq", "identify", "fit_band_hz", 5e-324, "underflows to 0"),
     ("cantilever_stiff_impact_lsq", "identify", "fit_band_hz", 1e-15, "at least 9.54e-05 Hz"),
+    # sgd_sindy's fit window of 1e-300 s, or one sample, was empty: IndexError in the fit
+    ("cantilever_stiff_impact", "identify", "fit_duration", 1e-300, "at least 2 samples"),
+    ("cantilever_stiff_impact", "identify", "fit_duration", 1 / 12800, "at least 2 samples"),
     # L * L overflowed to inf and passed the inertia check; L ** 2 then raised OverflowError
     ("cartpole", "rig", "pole_length", 1e300, "inertia m L^2 / 12 is a finite float64"),
     ("cartpole", "rig", "pole_length", 1e200, "inertia m L^2 / 12 is a finite float64"),
