@@ -201,3 +201,17 @@ def test_a_high_power_is_named_without_being_expanded():
     assert canonical("x^999999999*dx") == ("x^999999999*dx", 1)
     assert canonical("dth1^2*sin(th3-th2)*dth1") == ("sin(th2-th3)*dth1^3", -1)
     assert canonical("th1^0") == ("", 1)
+
+
+# ------------------------------------------------------------------ scale-free criteria
+
+@pytest.mark.parametrize("scale", [1e-299, 1e-305, 1e200, 1e300])
+def test_trac_and_mac_are_scale_free_at_the_ends_of_float64(scale):
+    # a beam struck with 1e-300 N: its accelerations of 1e-299 m/s^2 were identified exactly,
+    # and TRAC was NaN (the sums of squares underflowed: 0 / 0) with no failure naming why
+    from testbed.numerics.shapes import mac_matrix, trac
+
+    x = np.array([[1.0, -2.0, 3.0, 0.5], [0.25, 1.0, -1.0, 2.0]])
+    assert np.allclose(trac(x * scale, 3 * x * scale), 1.0)
+    assert np.allclose(np.diag(mac_matrix(x.T * scale, -x.T * scale)), 1.0)
+    assert np.isnan(trac(np.zeros((1, 4)), x[:1] * scale)).all()  # undefined stays NaN
