@@ -41,9 +41,18 @@ import numpy as np
 from testbed.core.errors import HyperparameterError
 from testbed.core.terms import canonical
 
-_TRIG = re.compile(r"^(sin|cos)\(th(\d+)(?:-th(\d+))?\)$")
-_VAR = re.compile(r"^(ddth|dth|th|u|x|v|a)(\d+)$")
+# indices from 1: 'th0' was read as index -1 (the constant row; 'u0' the last acceleration)
+_TRIG = re.compile(r"^(sin|cos)\(th([1-9]\d*)(?:-th([1-9]\d*))?\)$")
+_VAR = re.compile(r"^(ddth|dth|th|u|x|v|a)([1-9]\d*)$")
+#: The structural library's names of displacement, velocity and acceleration (x1, v1, a1),
+#: which a mechanical rig's truth and scoring do not use (they name th1, dth1, ddth1).
+STRUCTURAL_FACTOR = re.compile(r"^[xva][1-9]\d*$")
 _ROW = {"th": 0, "x": 0, "dth": 1, "v": 1, "ddth": 2, "a": 2, "u": 3}
+#: Most factors a term may have (powers counted: ``dth1^3`` has 3).  Each is a row of the
+#: gather that evaluates the library, terms x factors x :data:`_CHUNK` floats at once
+#: (``th1^99999`` asked 24 GiB), and a product of more overflows float64 for any value beyond
+#: 1e308 ** (1 / 64) = 6.6e4 in its unit.
+MAX_TERM_FACTORS = 64
 _CHUNK = 8192  # samples per gather-and-multiply block: bounds the temporary to p*k*8192 floats
 
 
@@ -120,6 +129,9 @@ class Library:
         for raw in name.split("*"):
             base, _, power = raw.partition("^")
             reps = int(power) if power else 1
+            if len(vars_) + len(trigs) + reps > MAX_TERM_FACTORS:
+                raise ValueError(f"term {name[:80]!r} has more than {MAX_TERM_FACTORS} factors "
+                                 "(powers counted); expected at most that many")
             mt, mv = _TRIG.match(base), _VAR.match(base)
             if mt:
                 fn, i, j = mt.groups()
@@ -132,6 +144,12 @@ class Library:
 
     def __len__(self) -> int:
         return len(self.names)
+
+    def structural_terms(self) -> list[str]:
+        """The terms with a factor of the structural names ``x``, ``v``, ``a``
+        (:data:`STRUCTURAL_FACTOR`)."""
+        return [n for n in self.names
+                if any(STRUCTURAL_FACTOR.match(f.partition("^")[0]) for f in n.split("*"))]
 
     def __repr__(self) -> str:
         return f"Library({len(self)} terms, n_coords={self.n_coords}, n_inputs={self.n_inputs})"

@@ -20,6 +20,7 @@ from identify.structural import (
     Library,
     StructuralIdentifier,
     build_library,
+    check_fit_band,
     check_physical,
     cubic_rule,
     fit_band,
@@ -257,6 +258,11 @@ class LeastSquaresSINDy(StructuralIdentifier):
         "decay_backbone": DECAY_BACKBONE_FIELD,
         "lower_modes": LOWER_MODES_FIELD,
     }
+
+    @classmethod
+    def check_data_shape(cls, params, n_channels, n_inputs, fs, n_samples, error):
+        """A fit band's cut-off below the Nyquist frequency (:func:`check_fit_band`)."""
+        check_fit_band(params, fs, error)
 
     def __init__(self, cubic: bool | None = None, mass_prior: str = "reduced_mass_trace",
                  rcond: float = 1e-10, fit_band_hz: float | None = None,

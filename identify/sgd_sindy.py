@@ -851,11 +851,16 @@ class SGDSINDy(SGDSINDyBase):
     @classmethod
     def check_data_shape(cls, params: dict, n_channels: int, n_inputs: int, fs: float,
                          n_samples: int, error: ErrorFn) -> None:
-        """``freq_range`` below the Nyquist frequency, ``fit_duration`` within the record."""
+        """``freq_range`` below the Nyquist frequency, ``fit_duration`` within the record and
+        of at least 2 samples."""
         super().check_data_shape(params, n_channels, n_inputs, fs, n_samples, error)
         if not params["fit_duration"] < n_samples / fs:
             error("fit_duration", params["fit_duration"],
                   f"expected shorter than the record ({n_samples / fs:g} s)")
+        if params["fit_duration"] and round(params["fit_duration"] * fs) < 2:
+            # 1e-300 s (and one sample) was an IndexError of the fit, on an empty window
+            error("fit_duration", params["fit_duration"],
+                  f"expected 0 (the whole record) or at least 2 samples ({2 / fs:g} s at {fs:g} Hz)")
 
     def __init__(self, epochs: int = 100, batch_size: int = 128, learning_rate: float | None = None,
                  alpha_init: float = 0.1, epsilon: float = 0.01, beta: float = 0.1,

@@ -145,7 +145,7 @@ from identify.library import Library, fivebar_library, generic_mechanical_librar
 from testbed.core.errors import IdentificationError
 from testbed.core.measurement import Measurement, Trajectory
 from testbed.core.schema import ErrorFn, Field
-from testbed.numerics.filters import lowpass
+from testbed.numerics.filters import cutoff_problem, lowpass
 from testbed.numerics.gram import normalized_gram, ordered_independent
 from testbed.numerics.noise import noise_std, signal_band
 
@@ -266,7 +266,12 @@ def library_for(spec: Any, n_channels: int, n_inputs: int) -> Library:
     if spec == "generic":
         return generic_mechanical_library(n_channels, n_inputs)
     if isinstance(spec, Sequence) and not isinstance(spec, str):
-        return Library(list(spec), n_channels, n_inputs)
+        lib = Library(list(spec), n_channels, n_inputs)
+        aliased = lib.structural_terms()
+        if aliased:  # 'x1' fitted as th1, then "cannot evaluate factor 'x1'" in scoring
+            raise ValueError(f"term {aliased[0]!r} uses the structural names x, v, a; a "
+                             "mechanical library names th, dth, ddth, u")
+        return lib
     raise ValueError(f"library must be 'fivebar', 'fivebar_full', 'generic', a Library or a list "
                      f"of term names, got {spec!r}")
 
@@ -318,8 +323,9 @@ def check_terms(params: dict[str, Any], n_channels: int, n_inputs: int, error: E
 def check_record(params: dict[str, Any], fs: float, n_samples: int, error: ErrorFn) -> None:
     """Column low-pass below Nyquist and an edge trim that leaves samples."""
     cut = params.get("column_lowpass_hz")
-    if cut is not None and not cut < fs / 2:
-        error("column_lowpass_hz", cut, f"expected below the Nyquist frequency {fs / 2:g} Hz")
+    problem = cutoff_problem(cut, fs) if cut else None  # None or 0: no low-pass
+    if problem:
+        error("column_lowpass_hz", cut, problem)
     record_s = n_samples / fs
     if params["edge_trim"] is not None and not 2 * params["edge_trim"] < record_s:
         error("edge_trim", params["edge_trim"], f"expected less than half the record "
@@ -1358,7 +1364,10 @@ class SINDyPI(_ImplicitMechanical):
     def check_data_shape(cls, params, n_channels, n_inputs, fs, n_samples, error):
         """As the shared checks, plus a weak window shorter than the record."""
         super().check_data_shape(params, n_channels, n_inputs, fs, n_samples, error)
-        if params["formulation"] == "weak" and params["weak_window_s"] is not None:
+        # "weak", or None (by rule, which may choose the weak form and then takes the window
+        # as given: 1e-300 s was a ValueError of the fit, "a test function needs at least 3
+        # samples, got 1")
+        if params["formulation"] != "strong" and params["weak_window_s"] is not None:
             span = n_samples / fs - 2 * (params["edge_trim"] or 0.0)
             if not params["weak_window_s"] < span:
                 error("weak_window_s", params["weak_window_s"],

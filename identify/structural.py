@@ -25,6 +25,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
+from typing import Any
 
 import numpy as np
 
@@ -33,8 +34,8 @@ from identify._structural_sim import simulate_structural, state_matrix
 from testbed.core.errors import IdentificationError
 from testbed.core.lazy import lazy_module
 from testbed.core.measurement import Measurement, Trajectory
-from testbed.core.schema import Field
-from testbed.numerics.filters import elliptic_highpass
+from testbed.core.schema import ErrorFn, Field
+from testbed.numerics.filters import cutoff_problem, elliptic_highpass
 from testbed.numerics.shapes import mac_matrix
 from testbed.numerics.spectral import (
     harmonic_amplitude_law,
@@ -214,6 +215,18 @@ FIT_BAND_ORDER = 5
 FIT_BAND_FIELD = Field(float, None, unit="Hz", min=0.0,
                        doc="high-pass applied to every feature and target of the fit; default "
                            "by rule: 0.7 x the lowest measured peak; 0 = none")
+
+
+
+def check_fit_band(params: dict[str, Any], fs: float, error: ErrorFn) -> None:
+    """A user's ``fit_band_hz`` a zero-phase high-pass at ``fs`` [Hz] can take
+    (:func:`testbed.numerics.filters.cutoff_problem`; None = by rule, 0 = none): 7000 Hz at
+    12.8 kHz and 5e-324 Hz were ValueErrors of the fit, 1e-15 Hz a "Singular matrix"."""
+    cut = params.get("fit_band_hz")
+    problem = cutoff_problem(cut, fs) if cut else None
+    if problem:
+        error("fit_band_hz", cut, problem)
+
 
 #: The peak search's lower-mode rule (rule 5 of :func:`modal_peaks`, :data:`LOWER_MODE_MAC`),
 #: declared alike by ``sgd_sindy`` and ``ls_sindy``.

@@ -172,6 +172,10 @@ class CartPoleRig(Rig):
         # L * L, not L ** 2: a float power raises OverflowError (L = 1e308) where a product
         # gives inf
         inertia = rig["pole_mass"] * rig["pole_length"] * rig["pole_length"] / 12.0
+        if not math.isfinite(inertia):  # L = 1e300: OverflowError building the model
+            error("rig.pole_length", rig["pole_length"],
+                  f"expected a pole whose inertia m L^2 / 12 is a finite float64; with pole_mass "
+                  f"= {rig['pole_mass']:g} kg it overflows")
         if not POLE_AXIAL_FRACTION * inertia > MJ_MINVAL:
             error("rig.pole_length", rig["pole_length"],
                   f"expected a pole whose inertia m L^2 / 12 exceeds "

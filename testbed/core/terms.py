@@ -49,20 +49,13 @@ def canonical(term: str) -> tuple[str, int]:
     if term.strip() == "1":
         return "1", 1
     sign = 1
-    factors = []
+    counts: dict[str, int] = {}  # powers counted, not expanded: 'x^999999999' made 1e9 names
     for raw in term.split("*"):
         base, _, power = raw.partition("^")
         f, s = _normalise_factor(base)
         n = int(power) if power else 1
         sign *= s**n
-        factors.extend([f] * n)
-    factors.sort(key=_factor_key)
-    out: list[str] = []
-    i = 0
-    while i < len(factors):
-        j = i
-        while j < len(factors) and factors[j] == factors[i]:
-            j += 1
-        out.append(factors[i] if j - i == 1 else f"{factors[i]}^{j - i}")
-        i = j
+        counts[f] = counts.get(f, 0) + max(n, 0)  # a power <= 0 adds no factor
+    out = [f if counts[f] == 1 else f"{f}^{counts[f]}"
+           for f in sorted(counts, key=_factor_key) if counts[f] > 0]
     return "*".join(out), sign

@@ -27,6 +27,39 @@ def _as_signal(x: np.ndarray) -> np.ndarray:
     return x
 
 
+#: Smallest cut-off of a zero-phase filter as a fraction of the Nyquist frequency: sqrt(eps).
+#: A second-order section at normalised cut-off ``w`` has poles about ``w`` from 1, and its
+#: start-up state solves ``(I - A) zi = ...`` whose determinant is about ``w**2``, lost in
+#: float64 round-off (eps = 2.2e-16) once ``w < sqrt(eps) = 1.5e-8``.  Measured (orders 2-16,
+#: elliptic high-pass and Butterworth low-pass, 4,000 samples): "Singular matrix" from a
+#: fraction of 5.6e-9 down, filtered at 1e-8 and above.
+MIN_CUTOFF_FRACTION = float(np.sqrt(np.finfo(float).eps))
+
+
+def cutoff_problem(cutoff_hz: float, fs: float) -> str | None:
+    """What a zero-phase filter's cut-off ``cutoff_hz`` [Hz] > 0 lacks at ``fs`` [Hz], as the
+    "expected ..." of an error line; None if a design can take it.
+
+    Below the Nyquist frequency, and a fraction of it that is a float64 > 0: 5e-324 Hz passes
+    "> 0" but its normalised cut-off underflows to 0, which scipy's design refuses ("filter
+    critical frequencies must be greater than 0", an internal error where a setting said it);
+    and a fraction of at least :data:`MIN_CUTOFF_FRACTION` (1e-300 Hz and 1e-15 Hz at 12.8 kHz
+    were numpy's "Singular matrix" in the signal chain).
+    """
+    nyq = fs / 2.0
+    if not cutoff_hz < nyq:
+        return f"expected below the Nyquist frequency {nyq:g} Hz (sample rate {fs:g} Hz)"
+    if not cutoff_hz / nyq > 0.0:
+        return (f"expected a cut-off whose fraction of the Nyquist frequency {nyq:g} Hz is a "
+                "float64 > 0 (it underflows to 0)")
+    if not cutoff_hz / nyq >= MIN_CUTOFF_FRACTION:
+        return (f"expected at least {MIN_CUTOFF_FRACTION * nyq:.3g} Hz, {MIN_CUTOFF_FRACTION:.3g} "
+                f"of the Nyquist frequency {nyq:g} Hz (below it a second-order section's poles "
+                "lie within float64 round-off of 1 and the zero-phase filter's start-up solve is "
+                "singular)")
+    return None
+
+
 def _check_cutoff(cutoff_hz: float, fs: float, what: str) -> None:
     if not fs > 0:
         raise ValueError(f"sample rate must be > 0 Hz, got {fs}")

@@ -35,11 +35,24 @@ def mac_matrix(phi_a: np.ndarray, phi_b: np.ndarray) -> np.ndarray:
     b = b[:, None] if b.ndim == 1 else b
     if a.shape[0] != b.shape[0]:
         raise ValueError(f"mode shapes have {a.shape[0]} and {b.shape[0]} DOFs")
+    a, b = _power_of_two_scaled(a, 0), _power_of_two_scaled(b, 0)  # scale-free by definition
     num = np.abs(np.conj(a).T @ b) ** 2
     den = np.outer(np.sum(np.abs(a) ** 2, axis=0), np.sum(np.abs(b) ** 2, axis=0))
     with np.errstate(invalid="ignore", divide="ignore"):
         out = np.where(den > 0, num / np.where(den > 0, den, 1.0), np.nan)
     return np.minimum(out, 1.0)
+
+
+def _power_of_two_scaled(z: np.ndarray, axis: int) -> np.ndarray:
+    """``z`` with each slice along ``axis`` scaled by the power of two that brings its largest
+    magnitude into [0.5, 1): exact (no rounding, for normal numbers), so a ratio of products
+    keeps every bit it had, while signals of 1e-299 no longer underflow in their sums of squares
+    (TRAC was NaN for a beam struck with 1e-300 N: 0 / 0) nor those of 1e200 overflow."""
+    peak = np.max(np.abs(z), axis=axis, keepdims=True) if z.size else np.zeros(1)
+    _, e = np.frexp(peak)  # peak = m 2**e, m in [0.5, 1); 0 for a zero slice: left as it is
+    if np.iscomplexobj(z):
+        return np.ldexp(z.real, -e) + 1j * np.ldexp(z.imag, -e)
+    return np.ldexp(np.asarray(z, dtype=float), -e)
 
 
 def trac(x: np.ndarray, y: np.ndarray) -> np.ndarray:
@@ -62,6 +75,7 @@ def trac(x: np.ndarray, y: np.ndarray) -> np.ndarray:
     x, y = np.atleast_2d(np.asarray(x)), np.atleast_2d(np.asarray(y))
     if x.shape != y.shape:
         raise ValueError(f"shapes differ: {x.shape} vs {y.shape}")
+    x, y = _power_of_two_scaled(x, -1), _power_of_two_scaled(y, -1)  # scale-free by definition
     num = np.abs(np.sum(np.conj(x) * y, axis=-1)) ** 2
     den = np.sum(np.abs(x) ** 2, axis=-1) * np.sum(np.abs(y) ** 2, axis=-1)
     with np.errstate(invalid="ignore", divide="ignore"):

@@ -200,11 +200,7 @@ class ImportedData:
             some of its channels, or a declared prior is not a finite number > 0.
         """
         for key, value in dict(prior or {}).items():
-            # every prior an identifier reads is a size: a mass [kg] or a length [m]
-            if isinstance(value, bool) or not isinstance(value, (int, float)) \
-                    or not (math.isfinite(value) and value > 0):
-                raise MeasuredDataError(self.source, f"prior {key}={value!r}: expected a finite "
-                                                     "number > 0 (a mass [kg] or a length [m])")
+            check_prior(self.source, key, value)
         if groups is None:
             grouped: dict[str, list[str]] = {}
             for name in self.signals:
@@ -485,7 +481,7 @@ def si_unit(unit: str) -> tuple[str, float]:
 
 
 def _finish(raw: _Raw, fs: float | None, units: str | Mapping[str, str] | None,
-            channels: Sequence[str] | None) -> ImportedData:
+            channels: Sequence[str] | None, *, max_magnitude: float = MAX_MAGNITUDE) -> ImportedData:
     path = raw.source
     if not raw.data:
         raise MeasuredDataError(path, "no channels found")
@@ -542,17 +538,41 @@ def _finish(raw: _Raw, fs: float | None, units: str | Mapping[str, str] | None,
                                           f"the first at sample {bad[0]}")
         x = x * factor if factor != 1.0 else x.copy()
         peak = float(np.max(np.abs(x)))
-        if peak > MAX_MAGNITUDE:
+        if peak > max_magnitude:
             raise MeasuredDataError(path, f"channel {n!r} reaches |value| {peak:.3g} {si}; "
-                                          f"expected at most {MAX_MAGNITUDE:g} (larger values "
+                                          f"expected at most {max_magnitude:g} (larger values "
                                           "overflow the identifiers' sums of sixth powers)")
         signals[n] = (si, x)
+    for key, value in raw.prior.items():  # a dataset file's own (an edited attribute)
+        check_prior(path, key, value)
     keep = set(names)
     return ImportedData(float(rate), signals, path, raw.format,
                         nodes={k: v for k, v in raw.nodes.items() if k in keep},
                         directions={k: v for k, v in raw.directions.items() if k in keep},
                         positions={k: v for k, v in raw.positions.items() if k in keep},
                         prior=dict(raw.prior))
+
+
+def check_prior(source: str | os.PathLike, key: str, value: Any) -> None:
+    """Refuse a declared prior that is not a finite number > 0: every prior an identifier reads
+    is a size, a mass [kg] or a length [m] (given with ``--prior`` or stored in a dataset file,
+    whose ``prior`` attributes a user may have edited: NaN, -1 or text were read in silence)."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)) \
+            or not (math.isfinite(value) and value > 0):
+        raise MeasuredDataError(source, f"prior {key}={value!r}: expected a finite number > 0 "
+                                        "(a mass [kg] or a length [m])")
+
+
+def check_position(source: str | os.PathLike, channel: str, value: Any, key: str) -> float:
+    """A channel's position [m] as a float, or refused naming ``key`` (the file's own name for
+    it: SEP-005's ``position_m``, a dataset's ``positions``, a UFF node's coordinate) unless a
+    finite number: a NaN position was kept in silence and placed the sensor nowhere."""
+    value = value.item() if isinstance(value, np.generic) else value  # named as 'nan', not
+    if isinstance(value, bool) or not isinstance(value, (int, float)) \
+            or not math.isfinite(value):  # 'np.float64(nan)'
+        raise MeasuredDataError(source, f"channel {channel!r}: {key}={value!r}; expected a finite "
+                                        f"number [m] (or no {key})")
+    return float(value)
 
 
 def check_record_size(path: Path, n_samples: int, n_channels: int) -> None:
@@ -593,15 +613,46 @@ def _read_hdf5(path: Path) -> _Raw:
         ds = Dataset.load(path)
     except DatasetError as e:
         raise MeasuredDataError(path, e.reason) from None
+    return _raw_from_dataset(path, ds)
+
+
+def check_recorded(ds: Dataset, path: str | os.PathLike) -> None:
+    """Refuse a loaded dataset file whose measured signals a reader could not take as they are.
+
+    The checks of :func:`read_measured` on its ``.h5`` form (a finite rate > 0 and a finite
+    duration, channels of one length of at least 2 samples, known units, finite values, one
+    finite position per positioned channel, finite positive priors), less its bound on the
+    magnitude of values, which is the identifiers' (:data:`MAX_MAGNITUDE`), and less its list
+    of known units (an exporter writes a unit as it is, "general" where it knows none).  For the exporters:
+    a dataset rehashed after an edit (fs NaN, a NaN sample, channels cut to other lengths)
+    was written out as a UFF or SEP-005 file in silence.
+
+    Raises
+    ------
+    MeasuredDataError
+        Naming ``path`` and what is wrong.
+    """
+    raw = _raw_from_dataset(Path(path), ds)
+    raw.own_units = True  # written as they are: an exporter converts no unit
+    _finish(raw, None, None, None, max_magnitude=math.inf)
+
+
+def _raw_from_dataset(path: Path, ds: Dataset) -> _Raw:
+    """The measured signals of a loaded dataset file as a reader's raw record."""
     raw = _Raw(path, "hdf5", float(ds.fs), {}, {}, prior=dict(ds.prior),
                own_units=ds.attrs.get("kind") == "dynamical")
     for g, s in ds.measured.items():
         per_channel = s.channel_units()  # "m, rad": a cart's position and a pole's angle
+        if s.positions is not None and np.shape(s.positions) != (len(s.channels),):
+            # one position for three channels was an internal error (IndexError)
+            raise MeasuredDataError(path, f"signal measured/{g}: positions of shape "
+                                          f"{np.shape(s.positions)} for {len(s.channels)} "
+                                          "channel(s); expected one position [m] per channel")
         for i, ch in enumerate(s.channels):
             name = f"{g}/{ch}"
             raw.data[name], raw.units[name] = s.data[i], per_channel[i]
             if s.positions is not None:
-                raw.positions[name] = float(s.positions[i])
+                raw.positions[name] = check_position(path, name, s.positions[i], "positions")
     # inputs that declare the coordinates they act on (Signal.acts_on) keep that, as node
     # numbers the way a UFF file states it: a coordinate channel and the inputs driving it share
     # a node, which ImportedData.to_dataset turns back into acts_on
@@ -739,10 +790,7 @@ def _parse_sep005(path: Path, content: Any) -> _Raw:
             raw.directions[name] = direction
         pos = c.get("position_m")
         if pos is not None:
-            if isinstance(pos, bool) or not isinstance(pos, (int, float)) or not math.isfinite(pos):
-                raise MeasuredDataError(path, f"SEP-005 channel {name!r}: position_m={pos!r}; "
-                                              "expected a finite number [m] (or no position_m key)")
-            raw.positions[name] = float(pos)
+            raw.positions[name] = check_position(path, name, pos, "position_m")
     raw.fs = _common_rate(path, rates, 1e-9)
     return raw
 
@@ -874,7 +922,7 @@ def _read_uff(path: Path) -> _Raw:
             rates[name] = rate
     for name, node in raw.nodes.items():
         if node in coords:
-            raw.positions[name] = coords[node]
+            raw.positions[name] = check_position(path, name, coords[node], f"node {node} x")
     raw.fs = _common_rate(path, rates, 1e-5)
     return raw
 

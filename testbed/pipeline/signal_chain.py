@@ -225,12 +225,9 @@ def check_signal(kind: str, cfg: Mapping[str, Any], fs: float, n_samples: int,
 
 
 def _below_nyquist(cfg: Mapping[str, Any], key: str, fs: float, error: ErrorFn) -> None:
-    if not cfg[key] < fs / 2.0:
-        error(f"signal.{key}", cfg[key], f"expected below the Nyquist frequency {fs / 2.0:g} Hz "
-                                         f"(sample rate {fs:g} Hz)")
-    if not cfg[key] / (fs / 2.0) > 0.0:  # 5e-324 Hz: the design's normalised cut-off is 0
-        error(f"signal.{key}", cfg[key], f"a cut-off whose fraction of the Nyquist frequency "
-                                         f"{fs / 2.0:g} Hz is a float64 > 0 (it underflows to 0)")
+    problem = sig.cutoff_problem(cfg[key], fs)
+    if problem:
+        error(f"signal.{key}", cfg[key], problem)
 
 
 def _long_enough(cfg: Mapping[str, Any], key: str, order: int, n_samples: int,

@@ -53,6 +53,7 @@ import numpy as np
 from testbed.core.atomic import atomic_write, atomic_write_text
 from testbed.core.dataset import Dataset, Signal
 from testbed.core.truth import StructuralTruth
+from testbed.pipeline.importers import check_recorded
 from testbed.pipeline.plugins import RIGS
 from testbed.pipeline.signal_chain import measure
 
@@ -342,9 +343,16 @@ def export_dataset(path: str | os.PathLike, fmt: str, out: str | os.PathLike | N
     -------
     list of Path
         The files written.
+
+    Raises
+    ------
+    DatasetError, MeasuredDataError
+        The file is no dataset (or fails its hash), or its measured signals cannot be read as
+        they are (:func:`testbed.pipeline.importers.check_recorded`).
     """
     path = Path(path)
     ds = Dataset.load(path)
+    check_recorded(ds, path)  # an edited, rehashed file: NaN rate or samples, cut channels
     if fmt == "uff":
         return [write_uff(ds, out or path.with_suffix(".uff"))]
     if fmt == "sep005":
