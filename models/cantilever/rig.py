@@ -214,6 +214,8 @@ def _root_hinge(rig: dict[str, Any]) -> float:
 
 #: The section and material keys a segment's mass and inertia come from (with ``length``).
 _MASS_KEYS = ("thickness", "width", "rho", "length")
+#: The keys the section's bending stiffness ``E width thickness^3 / 12`` comes from.
+_SECTION_KEYS = ("E", "width", "thickness")
 
 
 def _check_segment_inertia(rig: dict[str, Any], error: ErrorFn) -> None:
@@ -224,6 +226,16 @@ def _check_segment_inertia(rig: dict[str, Any], error: ErrorFn) -> None:
     compile the chain; the key named is the one of :data:`_MASS_KEYS` furthest below its
     default (by ratio), e.g. ``rig.thickness`` for a 1e-12 m deep beam.
     """
+    with np.errstate(over="ignore", under="ignore"):  # Python's float ** raises on overflow
+        ei = np.float64(rig["E"]) * np.float64(rig["width"]) * np.float64(rig["thickness"]) ** 3 / 12.0
+    if not (np.isfinite(ei) and ei > 0.0):  # thickness = 1e300: the hinges' stiffness overflows
+        with np.errstate(divide="ignore"):  # the key furthest from its default, by ratio
+            key = max(_SECTION_KEYS, key=lambda k: abs(np.log(rig[k] / RIG_SCHEMA[k].default)))
+        error(f"rig.{key}", rig[key],
+              f"a section whose bending stiffness E width thickness^3 / 12 is finite and above "
+              f"0 N m^2; it is {float(ei):g} here (the others are rig."
+              f"{', rig.'.join(k for k in _SECTION_KEYS if k != key)})")
+        return
     params = beam_params(rig)
     if not params.segment_length > 0.0:  # length / n_segments underflowed (5e-324 m): no segment
         error("rig.length", rig["length"],

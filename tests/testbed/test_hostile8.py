@@ -142,6 +142,11 @@ def _scenario(base: str, section: str, key: str, value) -> None:
     # L * L overflowed to inf and passed the inertia check; L ** 2 then raised OverflowError
     ("cartpole", "rig", "pole_length", 1e300, "inertia m L^2 / 12 is a finite float64"),
     ("cartpole", "rig", "pole_length", 1e200, "inertia m L^2 / 12 is a finite float64"),
+    # a beam 1e300 m deep: Python's thickness ** 3 raised OverflowError in the section's EI
+    # (an internal error); 1e-120 m or E = 1e-320 Pa make EI underflow to 0 (no stiffness)
+    ("cantilever_stiff_impact", "rig", "thickness", 1e300, "finite and above 0 N m^2"),
+    ("cantilever_stiff_impact", "rig", "thickness", 1e-120, "finite and above 0 N m^2"),
+    ("cantilever_soft_impact", "rig", "E", 1e-320, "finite and above 0 N m^2"),
 ])
 def test_a_setting_at_a_finite_extreme_is_refused_naming_its_key(base, section, key, value,
                                                                  fragment):
