@@ -160,6 +160,30 @@ def start_pose(rig: dict[str, Any], p: FiveBarParams) -> np.ndarray:
     return np.array([rig["th1_0"], rig["th4_0"]], dtype=float)
 
 
+#: The smallest link length (mass) as a fraction of the largest: sqrt(float64 eps).  Below it a
+#: link is lost to rounding in the loop's sums of lengths, and the open tree's mass matrix is
+#: singular to working precision (condition above 1 / sqrt(eps): the accelerations keep fewer
+#: than 8 digits); measured: l1 or m2 = 1e-300 diverged at t = 0, refused as if the multisine
+#: excitation were at fault.
+MIN_SCALE_RATIO = float(np.sqrt(np.finfo(float).eps))
+
+
+def _check_scales(rig: dict[str, Any], error: ErrorFn) -> None:
+    """Refuse link lengths or masses spread by more than ``1 / MIN_SCALE_RATIO``, naming the
+    smallest or the largest, whichever lies further from its default (by ratio)."""
+    for keys, what in ((("l1", "l2", "l3", "l4", "L0"), "lengths"),
+                       (("m1", "m2", "m3", "m4"), "masses")):
+        small, big = min(keys, key=lambda k: rig[k]), max(keys, key=lambda k: rig[k])
+        if not rig[small] >= MIN_SCALE_RATIO * rig[big]:
+            with np.errstate(divide="ignore"):
+                key = max((small, big), key=lambda k: abs(np.log(rig[k] / RIG_SCHEMA[k].default)))
+            error(f"rig.{key}", rig[key],
+                  f"link {what} within a factor {1.0 / MIN_SCALE_RATIO:.3g} of each other (here "
+                  f"{rig[small]:g} to {rig[big]:g}): a link below that share is lost to rounding "
+                  f"in the loop's kinematics and its mass matrix (the {what} are rig."
+                  f"{', rig.'.join(keys)})")
+
+
 @RIGS.register("fivebar", tags=("mechanical", "pinocchio", "closed-loop"))
 class FiveBarRig(Rig):
     """Planar five-bar linkage actuated at A and B (Yan et al., SINDy-PI on a 2-DOF linkage).
@@ -210,6 +234,7 @@ class FiveBarRig(Rig):
             if key in excitation and not excitation[key] < nyquist:
                 error(f"excitation.{key}", excitation[key],
                       f"expected below the Nyquist frequency {nyquist:g} Hz")
+        _check_scales(rig, error)
         p = FiveBarParams.from_rig(rig)
         if p.L0 >= p.l.sum():
             error("rig.L0", p.L0, f"the loop cannot close for any pose: expected L0 < l1 + l2 + l3 + l4 = "

@@ -147,6 +147,11 @@ def _scenario(base: str, section: str, key: str, value) -> None:
     ("cantilever_stiff_impact", "rig", "thickness", 1e300, "finite and above 0 N m^2"),
     ("cantilever_stiff_impact", "rig", "thickness", 1e-120, "finite and above 0 N m^2"),
     ("cantilever_soft_impact", "rig", "E", 1e-320, "finite and above 0 N m^2"),
+    # a five-bar link of 1e-300 m or kg diverged at t = 0 and was refused naming the
+    # excitation's keys and simulation.dt; spread beyond 1 / sqrt(eps), the key is the rig's
+    ("fivebar_multisine", "rig", "l1", 1e-300, "link lengths within a factor 6.71e+07"),
+    ("fivebar_multisine", "rig", "m2", 1e-300, "link masses within a factor 6.71e+07"),
+    ("fivebar_sine_replay", "rig", "m4", 1e15, "link masses within a factor 6.71e+07"),
 ])
 def test_a_setting_at_a_finite_extreme_is_refused_naming_its_key(base, section, key, value,
                                                                  fragment):
