@@ -7,6 +7,7 @@ from typing import ClassVar
 import numpy as np
 
 from identify import IDENTIFIERS
+from identify._cubic_rule import cubic_rule
 from identify._modal_damping import BACKBONE_SHARE, backbone_shift, decay_hold, set_eigenvalues
 from identify._sgd_matrix import eigen_targets, fit_window
 from identify.structural import (
@@ -21,7 +22,6 @@ from identify.structural import (
     StructuralIdentifier,
     build_library,
     check_physical,
-    cubic_rule,
     fit_band,
     harmonics_array,
     mass_prior_value,
@@ -137,9 +137,10 @@ class LeastSquaresSINDy(StructuralIdentifier):
     Parameters
     ----------
     cubic : bool or None
-        Add the cubic displacement features ``x_j^3``.  None (default): by rule, when the largest
-        partial correlation of an ``x_j^3`` column with a row's linear-model residual exceeds
-        :data:`identify.structural.CUBIC_SELECT_CORR`, and the fitted cubic model is then
+        Add the cubic displacement features ``x_j^3``.  None (default): by rule, when the lowest
+        measured mode's free decay hardens with amplitude
+        (:func:`identify._cubic_rule.cubic_rule`: a backbone chirp above
+        :data:`identify._cubic_rule.CUBIC_CHIRP_MIN`), and the fitted cubic model is then
         refused (the linear library fitted instead) when it contradicts the measured decays or
         its own simulation diverges (step 4; ``cubic_`` and ``cubic_rule_`` say what was chosen
         and why).
@@ -238,8 +239,9 @@ class LeastSquaresSINDy(StructuralIdentifier):
     name = "ls_sindy"
     hyperparameters: ClassVar[dict[str, Field]] = {
         "cubic": Field(bool, None, doc="add the cubic displacement features x_j^3; default by "
-                                       "rule: when one correlates with the linear model's "
-                                       "residual above CUBIC_SELECT_CORR"),
+                                       "rule: when the lowest measured mode's free decay "
+                                       "hardens with amplitude (backbone chirp above "
+                                       "CUBIC_CHIRP_MIN)"),
         "mass_prior": MASS_PRIOR_FIELD,
         # [0, 1): a relative cut-off of 1 or more would discard every singular value;
         # numpy's legacy -1 (machine precision) is not a documented choice here
