@@ -25,8 +25,9 @@ The rule
 --------
 The linear library (fit band, drift and input columns, as ``ls_sindy`` builds it) is fitted by
 least squares with equal diagonal masses, tilted as the identifiers fit it (flat when the tilted
-fit has a non-positive stiffness eigenvalue); the decay of its mode nearest the lowest measured
-peak (the lowest mode without a peak) is fitted with the backbone.  Cubic terms go in when that
+fit has a non-positive stiffness eigenvalue or no decay fit of the mode is taken on it); the
+decay of its mode nearest the lowest measured peak (the lowest mode without a peak) is fitted
+with the backbone.  Cubic terms go in when that
 decay fit is taken and its relative chirp ``c / wd`` exceeds :data:`CUBIC_CHIRP_MIN`: the mode
 hardens with amplitude.  The lowest mode: it carries the largest displacement, so a cubic
 force's largest share, and a heavily damped upper mode's decay is too short to measure a chirp
@@ -85,18 +86,19 @@ def lowest_mode_chirp(data: Measurement, fit_band_hz: float | None = None,
                                                        start=s, drift=True, input_coupling=True),
                          fit_band_hz, peaks)
     n = lib.target.shape[0]
-    for rows in (tilt_library(lib), lib):  # the fit's tilt rule; flat when tilted is non-physical
+    window = fit_window(data, 0.0)
+    for rows in (tilt_library(lib), lib):  # the fits' tilt rule; flat when tilted fails
         M, C, K, _ = matrices_from_coef(solve_rows(rows), rows.blocks, np.ones(n))
         freqs = modal(M, K)[0]
-        if np.all(np.isfinite(freqs)):
+        if not np.all(np.isfinite(freqs)):  # a non-positive stiffness eigenvalue
+            continue
+        k = 0
+        if peaks is not None and np.size(peaks):
+            k = int(np.argmin(np.abs(np.log(freqs / float(np.min(peaks))))))
+        dec = modal_decay(data, M, K, C, window, backbone=True)
+        if dec.taken[k]:  # not taken: e.g. repeated modes (soft member 001 at 1 %, tilted)
             break
     else:
-        return float("nan"), float("nan")
-    k = 0
-    if peaks is not None and np.size(peaks):
-        k = int(np.argmin(np.abs(np.log(freqs / float(np.min(peaks))))))
-    dec = modal_decay(data, M, K, C, fit_window(data, 0.0), backbone=True)
-    if not dec.taken[k]:
         return float("nan"), float("nan")
     return float(dec.chirp[k] / dec.omega_d[k]), float(dec.omega_d[k] / (2.0 * np.pi))
 

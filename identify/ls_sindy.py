@@ -124,10 +124,12 @@ class LeastSquaresSINDy(StructuralIdentifier):
        backbone shift (:func:`identify._modal_damping.backbone_shift`) is opposite to the
        measured one and at least :data:`~identify._modal_damping.BACKBONE_SHARE` of it in
        size, or (b) its own simulation over the fit window from the measured start turns
-       non-finite or leaves :data:`CUBIC_BLOWUP` x the measured peak (``cubic_rule_`` says
-       which).  Measured: soft-base member 014 clean (the cubic softened mode 2, -0.99 Hz
-       against a measured +1.66 Hz, and diverged in the scorer's simulation, TRAC NaN) passes
-       linear (TRAC 0.997, modes 1-2 0.33 / 0.51 %); 019 clean (NaN) -> TRAC 0.923, linear;
+       non-finite or leaves :data:`CUBIC_BLOWUP` x the measured peak, or (c) its fit is
+       non-physical tilted and flat (``cubic_rule_`` says which; (c): soft-base member 004
+       clean, whose hardening mode 1 the cubic rule sees since 2026-11-27, passes linear).
+       Measured: soft-base member 014 clean (the cubic softened mode 2, -0.99 Hz against a
+       measured +1.66 Hz, and diverged in the scorer's simulation, TRAC NaN) passes linear
+       (TRAC 0.997, modes 1-2 0.33 / 0.51 %); 019 clean (NaN) -> TRAC 0.923, linear;
        clamped member 030 at 1 % noise passes (mode 2 65 % -> 0.39 %).
 
     Measured on the beams of studies/families.toml (issue bars: TRAC and MAC >= 0.95, modes
@@ -301,9 +303,18 @@ class LeastSquaresSINDy(StructuralIdentifier):
 
         lib = band_library()
         masses = np.full(lib.target.shape[0], m_hat / lib.target.shape[0])
-        self._fit_library(data, lib, masses, ps.peaks)
+        refused = ""
+        try:
+            self._fit_library(data, lib, masses, ps.peaks)
+        except IdentificationError as e:
+            if not (self.cubic_ and self.cubic is None):
+                raise
+            # a cubic chosen by rule whose fit is non-physical tilted and flat (no hold acts on
+            # a cubic model): the linear library, as for a cubic the decays contradict (soft
+            # member 004 clean: a pole at +16.9 +797j 1/s; linear, TRAC 0.998)
+            refused = f"its fit is non-physical: {e}"
         if self.cubic_ and self.cubic is None:
-            why = self._cubic_softens() or self._cubic_diverges(data)
+            why = refused or self._cubic_softens() or self._cubic_diverges(data)
             if why:  # a cubic the data do not hold up: refused, the linear library fitted
                 self.cubic_ = False
                 self.cubic_rule_ += f"; the fitted cubic model refused ({why}): cubic terms out"
