@@ -139,10 +139,11 @@ class LeastSquaresSINDy(StructuralIdentifier):
     Parameters
     ----------
     cubic : bool or None
-        Add the cubic displacement features ``x_j^3``.  None (default): by rule, when the lowest
-        measured mode's free decay hardens with amplitude
-        (:func:`identify._cubic_rule.cubic_rule`: a backbone chirp above
-        :data:`identify._cubic_rule.CUBIC_CHIRP_MIN`), and the fitted cubic model is then
+        Add the cubic displacement features ``x_j^3``.  None (default): by rule
+        (:func:`identify._cubic_rule.cubic_rule`), when the largest partial correlation of an
+        ``x_j^3`` column with a row's linear-model residual exceeds
+        :data:`identify._cubic_rule.CUBIC_SELECT_CORR`, or its tilted one does while the lowest
+        mode's decay hardens with amplitude, and the fitted cubic model is then
         refused (the linear library fitted instead) when it contradicts the measured decays or
         its own simulation diverges (step 4; ``cubic_`` and ``cubic_rule_`` say what was chosen
         and why).
@@ -241,9 +242,9 @@ class LeastSquaresSINDy(StructuralIdentifier):
     name = "ls_sindy"
     hyperparameters: ClassVar[dict[str, Field]] = {
         "cubic": Field(bool, None, doc="add the cubic displacement features x_j^3; default by "
-                                       "rule: when the lowest measured mode's free decay "
-                                       "hardens with amplitude (backbone chirp above "
-                                       "CUBIC_CHIRP_MIN)"),
+                                       "rule: when one correlates with the linear model's "
+                                       "residual above CUBIC_SELECT_CORR, or does so tilted "
+                                       "while mode 1's decay hardens (CUBIC_CHIRP_MIN)"),
         "mass_prior": MASS_PRIOR_FIELD,
         # [0, 1): a relative cut-off of 1 or more would discard every singular value;
         # numpy's legacy -1 (machine precision) is not a documented choice here

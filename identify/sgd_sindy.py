@@ -291,9 +291,9 @@ SHARED_FIELDS: dict[str, Field] = {
     # [0, 1]: the annealing update (Eq. 18) is a convex blend of old and new weights
     "beta": Field(float, 0.1, min=0.0, max=1.0, doc="annealing stabilisation coefficient"),
     "cubic": Field(bool, None, doc="add the cubic features x_j^3 (identifies K3_); default by "
-                                   "rule: when the lowest measured mode's free decay "
-                                   "hardens with amplitude (backbone chirp above "
-                                   "CUBIC_CHIRP_MIN)"),
+                                   "rule: when one correlates with the least-squares linear "
+                                   "model's residual above CUBIC_SELECT_CORR, or does so "
+                                   "tilted while mode 1's decay hardens (CUBIC_CHIRP_MIN)"),
     "eigen": Field(bool, True, doc="eigenvalue penalty against the measured frequencies"),
     # 1000 modes: far beyond any sensor count; the peaks are searched in one spectrum
     "n_modes": Field(int, None, min=1, max=1000,
