@@ -7,6 +7,7 @@ from typing import ClassVar
 import numpy as np
 
 from identify import IDENTIFIERS
+from identify._cubic_rule import cubic_rule
 from identify._modal_damping import BACKBONE_SHARE, backbone_shift, decay_hold, set_eigenvalues
 from identify._sgd_matrix import eigen_targets, fit_window
 from identify.structural import (
@@ -22,7 +23,6 @@ from identify.structural import (
     build_library,
     check_fit_band,
     check_physical,
-    cubic_rule,
     fit_band,
     harmonics_array,
     mass_prior_value,
@@ -125,10 +125,12 @@ class LeastSquaresSINDy(StructuralIdentifier):
        backbone shift (:func:`identify._modal_damping.backbone_shift`) is opposite to the
        measured one and at least :data:`~identify._modal_damping.BACKBONE_SHARE` of it in
        size, or (b) its own simulation over the fit window from the measured start turns
-       non-finite or leaves :data:`CUBIC_BLOWUP` x the measured peak (``cubic_rule_`` says
-       which).  Measured: soft-base member 014 clean (the cubic softened mode 2, -0.99 Hz
-       against a measured +1.66 Hz, and diverged in the scorer's simulation, TRAC NaN) passes
-       linear (TRAC 0.997, modes 1-2 0.33 / 0.51 %); 019 clean (NaN) -> TRAC 0.923, linear;
+       non-finite or leaves :data:`CUBIC_BLOWUP` x the measured peak, or (c) its fit is
+       non-physical tilted and flat (``cubic_rule_`` says which; (c): soft-base member 004
+       clean, whose hardening mode 1 the cubic rule sees since 2026-11-27, passes linear).
+       Measured: soft-base member 014 clean (the cubic softened mode 2, -0.99 Hz against a
+       measured +1.66 Hz, and diverged in the scorer's simulation, TRAC NaN) passes linear
+       (TRAC 0.997, modes 1-2 0.33 / 0.51 %); 019 clean (NaN) -> TRAC 0.923, linear;
        clamped member 030 at 1 % noise passes (mode 2 65 % -> 0.39 %).
 
     Measured on the beams of studies/families.toml (issue bars: TRAC and MAC >= 0.95, modes
@@ -138,9 +140,11 @@ class LeastSquaresSINDy(StructuralIdentifier):
     Parameters
     ----------
     cubic : bool or None
-        Add the cubic displacement features ``x_j^3``.  None (default): by rule, when the largest
-        partial correlation of an ``x_j^3`` column with a row's linear-model residual exceeds
-        :data:`identify.structural.CUBIC_SELECT_CORR`, and the fitted cubic model is then
+        Add the cubic displacement features ``x_j^3``.  None (default): by rule
+        (:func:`identify._cubic_rule.cubic_rule`), when the largest partial correlation of an
+        ``x_j^3`` column with a row's linear-model residual exceeds
+        :data:`identify._cubic_rule.CUBIC_SELECT_CORR`, or its tilted one does while the lowest
+        mode's decay hardens with amplitude, and the fitted cubic model is then
         refused (the linear library fitted instead) when it contradicts the measured decays or
         its own simulation diverges (step 4; ``cubic_`` and ``cubic_rule_`` say what was chosen
         and why).
@@ -240,7 +244,8 @@ class LeastSquaresSINDy(StructuralIdentifier):
     hyperparameters: ClassVar[dict[str, Field]] = {
         "cubic": Field(bool, None, doc="add the cubic displacement features x_j^3; default by "
                                        "rule: when one correlates with the linear model's "
-                                       "residual above CUBIC_SELECT_CORR"),
+                                       "residual above CUBIC_SELECT_CORR, or does so tilted "
+                                       "while mode 1's decay hardens (CUBIC_CHIRP_MIN)"),
         "mass_prior": MASS_PRIOR_FIELD,
         # [0, 1): a relative cut-off of 1 or more would discard every singular value;
         # numpy's legacy -1 (machine precision) is not a documented choice here
@@ -305,9 +310,18 @@ class LeastSquaresSINDy(StructuralIdentifier):
 
         lib = band_library()
         masses = np.full(lib.target.shape[0], m_hat / lib.target.shape[0])
-        self._fit_library(data, lib, masses, ps.peaks)
+        refused = ""
+        try:
+            self._fit_library(data, lib, masses, ps.peaks)
+        except IdentificationError as e:
+            if not (self.cubic_ and self.cubic is None):
+                raise
+            # a cubic chosen by rule whose fit is non-physical tilted and flat (no hold acts on
+            # a cubic model): the linear library, as for a cubic the decays contradict (soft
+            # member 004 clean: a pole at +16.9 +797j 1/s; linear, TRAC 0.998)
+            refused = f"its fit is non-physical: {e}"
         if self.cubic_ and self.cubic is None:
-            why = self._cubic_softens() or self._cubic_diverges(data)
+            why = refused or self._cubic_softens() or self._cubic_diverges(data)
             if why:  # a cubic the data do not hold up: refused, the linear library fitted
                 self.cubic_ = False
                 self.cubic_rule_ += f"; the fitted cubic model refused ({why}): cubic terms out"

@@ -53,6 +53,7 @@ from typing import ClassVar
 import numpy as np
 
 from identify import IDENTIFIERS
+from identify._cubic_rule import cubic_rule
 from identify._modal_damping import decay_hold
 from identify._sgd_matrix import (
     MatrixSGDResult,
@@ -71,7 +72,6 @@ from identify.structural import (
     PeakSearch,
     StructuralIdentifier,
     build_library,
-    cubic_rule,
     driving_point_scaling,
     fit_band_cutoff,
     harmonics_array,
@@ -292,7 +292,8 @@ SHARED_FIELDS: dict[str, Field] = {
     "beta": Field(float, 0.1, min=0.0, max=1.0, doc="annealing stabilisation coefficient"),
     "cubic": Field(bool, None, doc="add the cubic features x_j^3 (identifies K3_); default by "
                                    "rule: when one correlates with the least-squares linear "
-                                   "model's residual above CUBIC_SELECT_CORR"),
+                                   "model's residual above CUBIC_SELECT_CORR, or does so "
+                                   "tilted while mode 1's decay hardens (CUBIC_CHIRP_MIN)"),
     "eigen": Field(bool, True, doc="eigenvalue penalty against the measured frequencies"),
     # 1000 modes: far beyond any sensor count; the peaks are searched in one spectrum
     "n_modes": Field(int, None, min=1, max=1000,
@@ -434,7 +435,7 @@ class SGDSINDy(SGDSINDyBase):
         Annealing stabilisation coefficient, Eq. 18 (the paper: 0.1).
     cubic : bool or None
         Add the cubic features ``x_j^3`` (identifies ``K3_``); None (default): by rule
-        (:func:`identify.structural.cubic_rule`; ``cubic_`` and ``cubic_rule_`` say what was
+        (:func:`identify._cubic_rule.cubic_rule`; ``cubic_`` and ``cubic_rule_`` say what was
         chosen and why).
     l1 : {"cubic", "none"}
         ``"cubic"``: the lasso on the standardised cubic coefficients, then debiasing (acts

@@ -64,7 +64,7 @@ class SGDSINDyCoefficients(SGDSINDyBase):
         Annealing stabilisation coefficient, Eq. 18 (the paper: 0.1).
     cubic : bool or None
         Add the cubic features ``x_j^3`` (identifies ``K3_``); None (default): by rule
-        (:func:`identify.structural.cubic_rule`; ``cubic_`` and ``cubic_rule_`` say what was
+        (:func:`identify._cubic_rule.cubic_rule`; ``cubic_`` and ``cubic_rule_`` say what was
         chosen and why).
     l1 : {"cubic", "all", "none"}
         Which standardised coefficients the L1 penalty (Eqs 14-15) acts on.

@@ -162,52 +162,6 @@ def build_library(data: Measurement, *, coupled_mass: bool, cubic: bool, start: 
 #: 0.5 x f1, 0.04-0.12 at 0.7 x f1.  0.7 keeps mode 1 inside the pass band (its edge is the
 #: cut-off) with a 1.4x margin for a mode whose peak moves with amplitude (the soft base's
 #: hardening: 5 %).
-#: A cubic column ``x_j^3`` enters a least-squares model chosen by rule when its partial
-#: correlation with some row's residual, every other column of that row profiled out, exceeds
-#: this.  A correlation is scale-free, so the choice does not depend on the beam's stiffness or
-#: the response's amplitude.  Measured on the clean family beams (studies/families.toml): the
-#: clamped (linear) beams 0.006-0.52, where what the linear model misses is unmodelled
-#: dynamics (heavily damped upper modes, integration remnants), not a cubic force; the soft
-#: bases 0.77-0.97 except two nearly linear members (0.12, 0.18).  0.65 sits between the two
-#: groups; SGD-SINDy's per-term lasso threshold (0.2) answers a different question (which
-#: terms, once cubic terms are in).
-CUBIC_SELECT_CORR = 0.65
-
-
-def cubic_partial_correlation(lib: Library) -> float:
-    """Largest partial correlation of a cubic column with a row's residual [-].
-
-    Parameters
-    ----------
-    lib : Library
-        Built with ``cubic=True``.
-
-    Returns
-    -------
-    float
-        ``max_ij |corr(e_i, z_j)|`` with ``e_i`` the residual of target row ``i`` and ``z_j``
-        cubic column ``j``, both after least squares on row ``i``'s other columns (its mask);
-        0 without a cubic block.
-    """
-    if "c" not in lib.blocks:
-        return 0.0
-    cub = np.zeros(lib.theta.shape[0], dtype=bool)
-    cub[lib.blocks["c"]] = True
-    best = 0.0
-    for i in range(lib.target.shape[0]):
-        base = lib.theta[lib.mask[i] & ~cub].T
-        scale = np.linalg.norm(base, axis=0)
-        q = np.linalg.qr(base / np.where(scale > 0, scale, 1.0))[0]
-        e = lib.target[i] - q @ (q.T @ lib.target[i])
-        z = lib.theta[cub & lib.mask[i]].T
-        z = z - q @ (q.T @ z)
-        norms = np.linalg.norm(z, axis=0) * np.linalg.norm(e)
-        ok = norms > 0
-        if np.any(ok):
-            best = max(best, float(np.max(np.abs(e @ z[:, ok]) / norms[ok])))
-    return best
-
-
 FIT_BAND_FRACTION = 0.7
 #: Order of the fit-band elliptic high-pass (the chain's design: 0.1 dB ripple, 30 dB stop band).
 FIT_BAND_ORDER = 5
@@ -397,39 +351,6 @@ def fit_band_cutoff(data: Measurement, cutoff_hz: float | None = None,
     if not fc > chain_hp:
         return 0.0, rule + f": not above the chain's high-pass ({chain_hp:g} Hz), none added"
     return fc, rule
-
-
-def cubic_rule(data: Measurement, user: bool | None, fit_band_hz: float | None = None,
-               peaks: np.ndarray | None = None) -> tuple[bool, str]:
-    """Whether a structural model gets the cubic features ``x_j^3``, and why.
-
-    Parameters
-    ----------
-    data : Measurement
-    user : bool or None
-        The user's ``cubic`` setting; None = by rule.
-    fit_band_hz : float, optional
-        The fit band's cut-off (:func:`fit_band`'s ``cutoff_hz``).
-    peaks : ndarray, optional
-        ``modal_peaks(data).peaks`` [Hz] if the caller has them already (not searched again).
-
-    Returns
-    -------
-    (bool, str)
-        The rule: in when :func:`cubic_partial_correlation` of the least-squares library (fit
-        band, drift and input columns as ``ls_sindy`` builds it) exceeds
-        :data:`CUBIC_SELECT_CORR`.
-    """
-    if user is not None:
-        return bool(user), "user setting"
-    lib, _, _ = fit_band(data, lambda s: build_library(data, coupled_mass=False, cubic=True, start=s,
-                                                       drift=True, input_coupling=True), fit_band_hz,
-                       peaks)
-    corr = cubic_partial_correlation(lib)
-    on = corr > CUBIC_SELECT_CORR
-    return on, (f"largest partial correlation of an x^3 column with the linear model's residual "
-                f"{corr:.3g} {'>' if on else '<='} {CUBIC_SELECT_CORR:g}: cubic terms "
-                f"{'in' if on else 'out'}")
 
 
 def driving_point_scaling(M: np.ndarray, C: np.ndarray, K: np.ndarray, K3: np.ndarray | None,

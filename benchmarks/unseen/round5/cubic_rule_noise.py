@@ -1,7 +1,7 @@
 """Round 5 (beams): the cubic rule's statistic per scenario at 0 / 0.5 / 1 / 2 % noise.
 
 Not a test: prints, per scenario file, the largest partial correlation of an x^3 column with
-the linear model's residual (:func:`identify.structural.cubic_rule`, the value its rule string
+the linear model's residual (:func:`identify._cubic_rule.cubic_rule`, the value its rule string
 states) on the scenario's own signal chain at each noise level (the scenario's seed), against
 ``CUBIC_SELECT_CORR``.  No identifier is fitted.
 
@@ -13,7 +13,7 @@ from __future__ import annotations
 import re
 import sys
 
-from identify.structural import CUBIC_SELECT_CORR, cubic_rule
+from identify._cubic_rule import CUBIC_SELECT_CORR, cubic_rule
 from testbed.pipeline.cache import DatasetCache
 from testbed.pipeline.scenario import load_scenario
 from testbed.pipeline.signal_chain import measure
