@@ -60,3 +60,52 @@ def test_demo_reads_the_runs_of_the_eq21_group():
     smod = importlib.util.module_from_spec(scored)
     scored.loader.exec_module(smod)
     assert set(EQ21_PAIR) == set(smod.SHARED)
+
+
+def test_make_test_writes_the_rewritten_test_modules_before_pytest():
+    """``make test`` runs tests/_rewrite_ahead.py after compiling and before pytest (each worker
+    rewrote every test module again: about half of its collection)."""
+    import re
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parent.parent
+    recipe = re.search(r"^test:.*\n((?:\t.*\n)+)", (root / "Makefile").read_text(), re.M)
+    assert recipe, "Makefile has no test target"
+    lines = recipe.group(1).splitlines()
+    ahead = [i for i, line in enumerate(lines) if "tests/_rewrite_ahead.py" in line]
+    pytest_at = [i for i, line in enumerate(lines) if "-m pytest" in line]
+    assert ahead and pytest_at and ahead[0] < pytest_at[0], lines
+
+
+def test_rewrite_ahead_writes_what_pytest_would_and_pytest_reads_it(request, tmp_path):
+    """What tests/_rewrite_ahead.py writes is pytest's own rewrite of the module under this run's
+    configuration (the same code object), pytest's reader accepts it, a module edited afterwards is
+    stale again, and every module this run collected is among those it rewrites."""
+    import importlib.util
+    import shutil
+    from pathlib import Path
+
+    from _pytest.assertion import rewrite
+
+    here = Path(__file__).resolve().parent
+    spec = importlib.util.spec_from_file_location("_cold_rewrite_ahead", here / "_rewrite_ahead.py")
+    ahead = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(ahead)
+
+    modules = set(ahead.rewritten_modules([here]))
+    collected = {Path(str(item.path)).resolve() for item in request.session.items}
+    assert collected <= modules, sorted(collected - modules)[:5]
+    assert here / "conftest.py" in modules
+
+    src = tmp_path / "test_copy.py"
+    shutil.copy(Path(__file__), src)
+    assert not ahead.up_to_date(src)
+    assert ahead.rewrite_one(src)
+    assert ahead.up_to_date(src)
+    written = rewrite._read_pyc(src, ahead.cache_file(src))
+    _, own = rewrite._rewrite_test(src, request.config)  # as pytest's import hook calls it
+    # code objects compare by their instructions, constants (nested code included), names and
+    # line tables; marshal's bytes are not compared, as they depend on reference counts
+    assert written == own and written.co_filename == own.co_filename == str(src)
+    src.write_text(src.read_text() + "\n# edited\n")
+    assert not ahead.up_to_date(src)
