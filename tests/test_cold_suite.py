@@ -1,5 +1,19 @@
 """The cold-cache economies of the test run itself (tests/conftest.py) stay in effect."""
 
+from pathlib import Path
+
+
+def _test_recipe(*fragments: str) -> tuple[list[str], ...]:
+    """The command lines of the Makefile's ``test`` recipe, and for each of ``fragments`` the
+    indices of the lines holding it."""
+    import re
+
+    root = Path(__file__).resolve().parent.parent
+    recipe = re.search(r"^test:.*\n((?:\t.*\n)+)", (root / "Makefile").read_text(), re.M)
+    assert recipe, "Makefile has no test target"
+    lines = recipe.group(1).splitlines()
+    return (lines, *([i for i, line in enumerate(lines) if f in line] for f in fragments))
+
 
 def test_contrast_and_scored_runs_share_one_group():
     """The Eq. 21 contrast reads the runs of two scored tests (conftest ``scenario_run``): they
@@ -23,17 +37,11 @@ def test_make_test_byte_compiles_every_package_before_pytest():
     """``make test`` compiles the project's sources before pytest starts (Makefile: with
     PYTHONDONTWRITEBYTECODE set, each of the suite's processes compiled what it imported again):
     every top-level package the wheel ships, and the benchmarks and tests the suite imports."""
-    import re
     import tomllib
-    from pathlib import Path
 
-    root = Path(__file__).resolve().parent.parent
-    recipe = re.search(r"^test:.*\n((?:\t.*\n)+)", (root / "Makefile").read_text(), re.M)
-    assert recipe, "Makefile has no test target"
-    lines = recipe.group(1).splitlines()
-    compile_at = [i for i, line in enumerate(lines) if "-m compileall" in line]
-    pytest_at = [i for i, line in enumerate(lines) if "-m pytest" in line]
+    lines, compile_at, pytest_at = _test_recipe("-m compileall", "-m pytest")
     assert compile_at and pytest_at and compile_at[0] < pytest_at[0], lines
+    root = Path(__file__).resolve().parent.parent
     folders = set(lines[compile_at[0]].split())
     packages = tomllib.loads((root / "pyproject.toml").read_text())["tool"]["setuptools"]["packages"]
     tops = {p.split(".")[0] for p in packages}
@@ -65,15 +73,9 @@ def test_demo_reads_the_runs_of_the_eq21_group():
 def test_make_test_writes_the_rewritten_test_modules_before_pytest():
     """``make test`` runs tests/_rewrite_ahead.py after compiling and before pytest (each worker
     rewrote every test module again: about half of its collection)."""
-    import re
-    from pathlib import Path
-
-    root = Path(__file__).resolve().parent.parent
-    recipe = re.search(r"^test:.*\n((?:\t.*\n)+)", (root / "Makefile").read_text(), re.M)
-    assert recipe, "Makefile has no test target"
-    lines = recipe.group(1).splitlines()
-    ahead = [i for i, line in enumerate(lines) if "tests/_rewrite_ahead.py" in line]
-    pytest_at = [i for i, line in enumerate(lines) if "-m pytest" in line]
+    lines, compile_at, ahead, pytest_at = _test_recipe("-m compileall", "tests/_rewrite_ahead.py",
+                                                       "-m pytest")
+    assert compile_at and ahead and compile_at[0] < ahead[0], lines
     assert ahead and pytest_at and ahead[0] < pytest_at[0], lines
 
 
