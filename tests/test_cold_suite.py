@@ -1,5 +1,19 @@
 """The cold-cache economies of the test run itself (tests/conftest.py) stay in effect."""
 
+from pathlib import Path
+
+
+def _test_recipe(*fragments: str) -> tuple[list[str], ...]:
+    """The command lines of the Makefile's ``test`` recipe, and for each of ``fragments`` the
+    indices of the lines holding it."""
+    import re
+
+    root = Path(__file__).resolve().parent.parent
+    recipe = re.search(r"^test:.*\n((?:\t.*\n)+)", (root / "Makefile").read_text(), re.M)
+    assert recipe, "Makefile has no test target"
+    lines = recipe.group(1).splitlines()
+    return (lines, *([i for i, line in enumerate(lines) if f in line] for f in fragments))
+
 
 def test_contrast_and_scored_runs_share_one_group():
     """The Eq. 21 contrast reads the runs of two scored tests (conftest ``scenario_run``): they
@@ -23,17 +37,11 @@ def test_make_test_byte_compiles_every_package_before_pytest():
     """``make test`` compiles the project's sources before pytest starts (Makefile: with
     PYTHONDONTWRITEBYTECODE set, each of the suite's processes compiled what it imported again):
     every top-level package the wheel ships, and the benchmarks and tests the suite imports."""
-    import re
     import tomllib
-    from pathlib import Path
 
-    root = Path(__file__).resolve().parent.parent
-    recipe = re.search(r"^test:.*\n((?:\t.*\n)+)", (root / "Makefile").read_text(), re.M)
-    assert recipe, "Makefile has no test target"
-    lines = recipe.group(1).splitlines()
-    compile_at = [i for i, line in enumerate(lines) if "-m compileall" in line]
-    pytest_at = [i for i, line in enumerate(lines) if "-m pytest" in line]
+    lines, compile_at, pytest_at = _test_recipe("-m compileall", "-m pytest")
     assert compile_at and pytest_at and compile_at[0] < pytest_at[0], lines
+    root = Path(__file__).resolve().parent.parent
     folders = set(lines[compile_at[0]].split())
     packages = tomllib.loads((root / "pyproject.toml").read_text())["tool"]["setuptools"]["packages"]
     tops = {p.split(".")[0] for p in packages}
@@ -60,3 +68,46 @@ def test_demo_reads_the_runs_of_the_eq21_group():
     smod = importlib.util.module_from_spec(scored)
     scored.loader.exec_module(smod)
     assert set(EQ21_PAIR) == set(smod.SHARED)
+
+
+def test_make_test_writes_the_rewritten_test_modules_before_pytest():
+    """``make test`` runs tests/_rewrite_ahead.py after compiling and before pytest (each worker
+    rewrote every test module again: about half of its collection)."""
+    lines, compile_at, ahead, pytest_at = _test_recipe("-m compileall", "tests/_rewrite_ahead.py",
+                                                       "-m pytest")
+    assert compile_at and ahead and compile_at[0] < ahead[0], lines
+    assert ahead and pytest_at and ahead[0] < pytest_at[0], lines
+
+
+def test_rewrite_ahead_writes_what_pytest_would_and_pytest_reads_it(request, tmp_path):
+    """What tests/_rewrite_ahead.py writes is pytest's own rewrite of the module under this run's
+    configuration (the same code object), pytest's reader accepts it, a module edited afterwards is
+    stale again, and every module this run collected is among those it rewrites."""
+    import importlib.util
+    import shutil
+    from pathlib import Path
+
+    from _pytest.assertion import rewrite
+
+    here = Path(__file__).resolve().parent
+    spec = importlib.util.spec_from_file_location("_cold_rewrite_ahead", here / "_rewrite_ahead.py")
+    ahead = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(ahead)
+
+    modules = set(ahead.rewritten_modules([here]))
+    collected = {Path(str(item.path)).resolve() for item in request.session.items}
+    assert collected <= modules, sorted(collected - modules)[:5]
+    assert here / "conftest.py" in modules
+
+    src = tmp_path / "test_copy.py"
+    shutil.copy(Path(__file__), src)
+    assert not ahead.up_to_date(src)
+    assert ahead.rewrite_one(src)
+    assert ahead.up_to_date(src)
+    written = rewrite._read_pyc(src, ahead.cache_file(src))
+    _, own = rewrite._rewrite_test(src, request.config)  # as pytest's import hook calls it
+    # code objects compare by their instructions, constants (nested code included), names and
+    # line tables; marshal's bytes are not compared, as they depend on reference counts
+    assert written == own and written.co_filename == own.co_filename == str(src)
+    src.write_text(src.read_text() + "\n# edited\n")
+    assert not ahead.up_to_date(src)
