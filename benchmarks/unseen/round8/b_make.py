@@ -49,7 +49,8 @@ CASES: dict[str, tuple[str, dict, dict, dict, dict]] = {
     "b8_L1_gfrp_s3": ("glass-epoxy 1 m x 50 mm (mode 1 at 26 Hz), three sensors, 20 segments, 3 s",
                       {**GFRP, "length": 1.0, "thickness": 0.05, "n_segments": 20, "sensors": even(3, 1.0)},
                       {"duration": 3.0}, {}, {}),
-    "b8_L0p9_hit_mid": ("steel 0.9 m x 20 mm (mode 1 at 21 Hz), sensors at 0.3/0.6/0.9 m, hammer at 0.6 m, 2 s",
+    "b8_L0p9_hit_mid": ("steel 0.9 m x 20 mm (mode 1 at 21 Hz), sensors at 0.3/0.6/0.9 m, hammer at "
+                        "0.6 m, 2 s",
                         {"length": 0.9, "thickness": 0.02, "n_segments": 18, "sensors": [0.3, 0.6, 0.9]},
                         {"duration": 2.0}, {"location": 0.6}, {}),
     "b8_L0p6_z0p3_s4": ("steel 0.6 m x 15 mm, 0.3 % damping, four sensors, 16 segments, 2 s",
