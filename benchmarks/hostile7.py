@@ -21,7 +21,6 @@ from __future__ import annotations
 import copy
 import math
 import os
-import signal
 import subprocess
 import sys
 import tempfile
@@ -29,6 +28,8 @@ import time
 import tomllib
 from collections import Counter
 from pathlib import Path
+
+from benchmarks import _hostile
 
 ROOT = Path(__file__).resolve().parent.parent
 TIMEOUT_S = 60  # a case longer than this is a hang (the slowest load below takes about 5 s)
@@ -50,43 +51,6 @@ ODD_SPECS = [
     {"uniform": [0.0, 1.0], "choices": [1]}, {"normal": [0.0, 1.0]}, {}, {"choices": [None] * 0},
     math.nan, math.inf, -math.inf, "nan", "inf", "", [], {"uniform": [1e-12, 1e-12]},
 ]
-
-
-class Hang(Exception):
-    pass
-
-
-def _alarm(signum, frame):
-    raise Hang
-
-
-def classify(fn) -> str:
-    """``ok`` (loaded / refused in one line naming a file) or a finding's description."""
-    from testbed.core.errors import TestbedError
-
-    signal.signal(signal.SIGALRM, _alarm)
-    signal.alarm(TIMEOUT_S)
-    t0 = time.perf_counter()
-    try:
-        result = fn()
-        bad = _nonfinite(result)
-        return f"accepted a non-finite value: {bad}" if bad else "ok"
-    except Hang:
-        return f"hang > {TIMEOUT_S} s"
-    except TestbedError as e:
-        text = str(e)
-        if "\n" in text:
-            return f"two lines: {text[:200]!r}"
-        if len(text) > 6000:
-            return f"line of {len(text)} chars"
-        return "ok"
-    except Exception as e:  # every other exception is a finding
-        return f"{type(e).__name__}: {str(e)[:200]}"
-    finally:
-        signal.alarm(0)
-        dt = time.perf_counter() - t0
-        if dt > 20:
-            print(f"  (slow case: {dt:.1f} s)", file=sys.stderr)
 
 
 def _nonfinite(study) -> str | None:
@@ -275,15 +239,14 @@ def concurrent_cases(work: Path) -> Counter:
     return counts
 
 
+def _check_study(study) -> str | None:
+    """A loaded study holding a non-finite number is a finding (a NaN never passes)."""
+    bad = _nonfinite(study)
+    return f"accepted a non-finite value: {bad}" if bad else None
+
+
 def run_inprocess(cases) -> Counter:
-    counts = Counter()
-    for name, fn in cases:
-        verdict = classify(fn)
-        counts["cases"] += 1
-        if verdict != "ok":
-            counts["findings"] += 1
-            print(f"FINDING {name}: {verdict}", flush=True)
-    return counts
+    return _hostile.run_inprocess(cases, TIMEOUT_S, _check_study)
 
 
 def tb(args: list[str], cwd: Path, env: dict[str, str] | None = None, umask: int | None = None,

@@ -27,12 +27,13 @@ from __future__ import annotations
 
 import copy
 import math
-import signal
 import sys
 import tempfile
 import time
 from collections import Counter
 from pathlib import Path
+
+from benchmarks import _hostile
 
 ROOT = Path(__file__).resolve().parent.parent
 TIMEOUT_S = 120  # a case longer than this is a hang (the slowest run below takes about 20 s)
@@ -44,33 +45,6 @@ BASES = {"michaelis_menten": 4.0, "cartpole": 1.0, "fivebar_multisine": 1.0,
 FLOATS = [1e300, -1e300, 1e-300, -1e-300, 5e-324, -0.0, 0.0, 1e15, -1.0, 1e-15]
 INTS = [0, -1, 2**53 + 1, 2**62, 10**9]
 FLOAT_LISTS = [[], [1e300], [5e-324, 1e300], [-0.0, -0.0], [0.0, 1e-300]]
-
-
-class Hang(Exception):
-    pass
-
-
-def _alarm(signum, frame):
-    raise Hang
-
-
-def classify(fn) -> str:
-    """``ok`` (a verdict, or refused in one line) or a finding's description."""
-    from testbed.core.errors import TestbedError
-
-    signal.signal(signal.SIGALRM, _alarm)
-    signal.alarm(TIMEOUT_S)
-    try:
-        return fn() or "ok"
-    except Hang:
-        return f"hang > {TIMEOUT_S} s"
-    except TestbedError as e:
-        text = str(e)
-        return f"two lines: {text[:200]!r}" if "\n" in text else "ok"
-    except Exception as e:  # every other exception is a finding
-        return f"{type(e).__name__}: {str(e)[:200]}"
-    finally:
-        signal.alarm(0)
 
 
 # ------------------------------------------------------------------ datasets
@@ -265,17 +239,8 @@ def term_cases() -> list[tuple[str, object]]:
 
 
 def run_inprocess(cases) -> Counter:
-    counts = Counter()
-    for name, fn in cases:
-        t0 = time.perf_counter()
-        verdict = classify(fn)
-        counts["cases"] += 1
-        if verdict != "ok":
-            counts["findings"] += 1
-            print(f"FINDING {name}: {verdict}", flush=True)
-        if time.perf_counter() - t0 > 30:
-            print(f"  (slow case {name}: {time.perf_counter() - t0:.0f} s)", file=sys.stderr)
-    return counts
+    """Each case returns a finding's description or None (a verdict, or refused in one line)."""
+    return _hostile.run_inprocess(cases, TIMEOUT_S, lambda finding: finding)
 
 
 def main(argv: list[str]) -> int:

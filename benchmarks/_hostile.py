@@ -1,0 +1,71 @@
+"""The malformed-input drivers' one harness (``benchmarks/hostile7.py``, ``hostile8.py``): each case
+runs in-process under a time limit and ends ``ok`` or as a finding.
+
+``ok`` is a result the driver's ``check`` finds nothing wrong in, or a
+:class:`~testbed.core.errors.TestbedError` in one line (the user's mistake, refused); a hang, a
+two-line or overlong error and every other exception are findings.
+"""
+
+from __future__ import annotations
+
+import signal
+import sys
+import time
+from collections import Counter
+from collections.abc import Callable, Iterable
+from typing import Any
+
+#: A refusal longer than this many characters is a finding: a user reads one line.
+MAX_LINE_CHARS = 6000
+#: A case slower than this [s] is printed to stderr (not a finding: the time limit is).
+SLOW_S = 20.0
+
+
+class Hang(Exception):
+    """A case ran past its time limit."""
+
+
+def _alarm(signum: int, frame: Any) -> None:
+    raise Hang
+
+
+def classify(fn: Callable[[], Any], timeout_s: int,
+             check: Callable[[Any], str | None] = lambda result: None) -> str:
+    """``"ok"`` or a finding's description for the case ``fn`` (its result given to ``check``,
+    which returns a finding or None)."""
+    from testbed.core.errors import TestbedError
+
+    signal.signal(signal.SIGALRM, _alarm)
+    signal.alarm(timeout_s)
+    t0 = time.perf_counter()
+    try:
+        return check(fn()) or "ok"
+    except Hang:
+        return f"hang > {timeout_s} s"
+    except TestbedError as e:
+        text = str(e)
+        if "\n" in text:
+            return f"two lines: {text[:200]!r}"
+        if len(text) > MAX_LINE_CHARS:
+            return f"line of {len(text)} chars"
+        return "ok"
+    except Exception as e:  # every other exception is a finding
+        return f"{type(e).__name__}: {str(e)[:200]}"
+    finally:
+        signal.alarm(0)
+        dt = time.perf_counter() - t0
+        if dt > SLOW_S:
+            print(f"  (slow case: {dt:.1f} s)", file=sys.stderr)
+
+
+def run_inprocess(cases: Iterable[tuple[str, Callable[[], Any]]], timeout_s: int,
+                  check: Callable[[Any], str | None] = lambda result: None) -> Counter:
+    """Classify every ``(name, fn)`` case; print each finding; count cases and findings."""
+    counts: Counter = Counter()
+    for name, fn in cases:
+        verdict = classify(fn, timeout_s, check)
+        counts["cases"] += 1
+        if verdict != "ok":
+            counts["findings"] += 1
+            print(f"FINDING {name}: {verdict}", flush=True)
+    return counts
