@@ -10,9 +10,11 @@ from __future__ import annotations
 
 import signal
 import sys
+import tempfile
 import time
 from collections import Counter
 from collections.abc import Callable, Iterable
+from pathlib import Path
 from typing import Any
 
 #: A refusal longer than this many characters is a finding: a user reads one line.
@@ -69,3 +71,20 @@ def run_inprocess(cases: Iterable[tuple[str, Callable[[], Any]]], timeout_s: int
             counts["findings"] += 1
             print(f"FINDING {name}: {verdict}", flush=True)
     return counts
+
+
+def main(argv: list[str], families: dict[str, Callable[[Path], Counter]], prefix: str) -> int:
+    """Run the named families (all when ``argv`` is empty) in one temporary folder; print each
+    family's count and the total; status 1 when anything was found."""
+    total: Counter = Counter()
+    with tempfile.TemporaryDirectory(prefix=prefix) as tmp:
+        for fam in argv or list(families):
+            if fam not in families:
+                raise SystemExit(f"unknown family {fam!r}; known: {', '.join(families)}")
+            t0 = time.perf_counter()
+            c = families[fam](Path(tmp))
+            print(f"{fam}: {c['cases']} cases, {c['findings']} findings "
+                  f"({time.perf_counter() - t0:.0f} s)", flush=True)
+            total += c
+    print(f"total: {total['cases']} cases, {total['findings']} findings")
+    return 1 if total["findings"] else 0

@@ -23,8 +23,6 @@ import math
 import os
 import subprocess
 import sys
-import tempfile
-import time
 import tomllib
 from collections import Counter
 from pathlib import Path
@@ -366,31 +364,14 @@ def run_processes(cases, work: Path) -> Counter:
 
 
 def main(argv: list[str]) -> int:
-    families = argv or ["specs", "members", "importers", "env", "paths", "concurrent"]
-    total = Counter()
-    with tempfile.TemporaryDirectory(prefix="hostile7-") as tmp:
-        work = Path(tmp)
-        for fam in families:
-            t0 = time.perf_counter()
-            if fam == "specs":
-                c = run_inprocess(family_specs())
-            elif fam == "members":
-                c = run_inprocess(family_members())
-            elif fam == "importers":
-                c = run_inprocess(importer_cases(work))
-            elif fam == "concurrent":
-                c = concurrent_cases(work)
-            elif fam == "env":
-                c = run_processes(env_cases(work), work)
-            elif fam == "paths":
-                c = run_processes(path_cases(work), work)
-            else:
-                raise SystemExit(f"unknown family {fam!r}")
-            print(f"{fam}: {c['cases']} cases, {c['findings']} findings "
-                  f"({time.perf_counter() - t0:.0f} s)", flush=True)
-            total += c
-    print(f"total: {total['cases']} cases, {total['findings']} findings")
-    return 1 if total["findings"] else 0
+    return _hostile.main(argv, {
+        "specs": lambda work: run_inprocess(family_specs()),
+        "members": lambda work: run_inprocess(family_members()),
+        "importers": lambda work: run_inprocess(importer_cases(work)),
+        "env": lambda work: run_processes(env_cases(work), work),
+        "paths": lambda work: run_processes(path_cases(work), work),
+        "concurrent": concurrent_cases,
+    }, "hostile7-")
 
 
 if __name__ == "__main__":

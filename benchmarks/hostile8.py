@@ -28,8 +28,6 @@ from __future__ import annotations
 import copy
 import math
 import sys
-import tempfile
-import time
 from collections import Counter
 from pathlib import Path
 
@@ -244,25 +242,11 @@ def run_inprocess(cases) -> Counter:
 
 
 def main(argv: list[str]) -> int:
-    families = argv or ["datasets", "terms", "extremes"]
-    total = Counter()
-    with tempfile.TemporaryDirectory(prefix="hostile8-") as tmp:
-        work = Path(tmp)
-        for fam in families:
-            t0 = time.perf_counter()
-            if fam == "datasets":
-                c = run_inprocess(dataset_cases(work))
-            elif fam == "terms":
-                c = run_inprocess(term_cases())
-            elif fam == "extremes":
-                c = run_inprocess(extreme_cases())
-            else:
-                raise SystemExit(f"unknown family {fam!r}")
-            print(f"{fam}: {c['cases']} cases, {c['findings']} findings "
-                  f"({time.perf_counter() - t0:.0f} s)", flush=True)
-            total += c
-    print(f"total: {total['cases']} cases, {total['findings']} findings")
-    return 1 if total["findings"] else 0
+    return _hostile.main(argv, {
+        "datasets": lambda work: run_inprocess(dataset_cases(work)),
+        "terms": lambda work: run_inprocess(term_cases()),
+        "extremes": lambda work: run_inprocess(extreme_cases()),
+    }, "hostile8-")
 
 
 if __name__ == "__main__":
