@@ -157,3 +157,26 @@ def test_fitted_peak_attributes():
     m = SGDSINDy(epochs=1).fit(data)
     assert m.peak_band_[0] > 0 and m.peaks_.size >= 1
     assert np.array_equal(m.peaks_, m.measured_frequencies_)
+
+
+def test_a_mode_fitted_below_the_fit_band_is_fitted_again_without_it(dataset_cache):
+    """Round 8's soft beam (0.8 m on k1 = 5000 N m/rad): mode 1 at 10.6 Hz, 1.06 x the chain's
+    10 Hz high-pass, below the peak search's 1.1 x, so no peak locates it; the fit band's cut-off,
+    0.7 x the lowest located peak (145 Hz), removed it, and ls_sindy fitted it at 12.4 Hz on what
+    was left (16.9 % off, TRAC 0.40).  A fitted mode below the band is refused with the band, and
+    the fit made again without one."""
+    import dataclasses
+    from pathlib import Path
+
+    from testbed.pipeline.scenario import load_scenario
+    from testbed.scoring.run import run_scenario
+
+    path = Path(__file__).resolve().parents[2] / "benchmarks/unseen/round8/b8_soft_L0p8_k1_5000.toml"
+    sc = load_scenario(path)
+    sc = dataclasses.replace(sc, identify={"method": "ls_sindy"})
+    r = run_scenario(sc, dataset=dataset_cache.get(sc))
+    assert "refused: the fitted mode 1 (12.42 Hz)" in r.model.fit_band_rule_
+    # the issue's bar (1 %): the refit puts mode 1 within 0.02 %, mode 2 within 0.06 %
+    assert r.scores.values["freq_error_mode1"] < 0.01
+    assert r.scores.values["freq_error_mode2"] < 0.01
+    assert r.passed, r.scores.failures
