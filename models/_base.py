@@ -217,3 +217,25 @@ def check_two_samples(simulation: dict[str, Any], error: ErrorFn) -> None:
         error("simulation.duration", simulation["duration"],
               f"expected at least two samples (duration x sample_rate = "
               f"{simulation['duration'] * simulation['sample_rate']:.3g})")
+
+
+def furthest_from_default(rig: dict[str, Any], keys: tuple[str, ...],
+                          schema: dict[str, Field]) -> str:
+    """The key of ``keys`` whose value lies furthest from its schema default by ratio
+    (``|ln(value / default)|``, a ratio that over- or underflows counting as infinitely far;
+    the first such key on a tie): the one a refusal of their combination names.
+
+    Parameters
+    ----------
+    rig : dict
+        The validated ``[rig]`` table.
+    keys : tuple of str
+        Keys with positive values and positive defaults.
+    schema : dict of str to Field
+        The rig's schema (the defaults).
+    """
+    def distance(k: str) -> float:
+        r = rig[k] / schema[k].default
+        return abs(math.log(r)) if 0.0 < r < math.inf else math.inf
+
+    return max(keys, key=distance)

@@ -30,7 +30,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from models import RIGS
-from models._base import MJ_MINVAL, ErrorFn, Rig, check_two_samples
+from models._base import MJ_MINVAL, ErrorFn, Rig, check_two_samples, furthest_from_default
 from models.cantilever.beam import BeamParams, body_of
 from models.cantilever.euler_bernoulli import auto_cutoff, clamped_estimates
 from models.cantilever.model import (
@@ -229,8 +229,7 @@ def _check_segment_inertia(rig: dict[str, Any], error: ErrorFn) -> None:
     with np.errstate(over="ignore", under="ignore"):  # Python's float ** raises on overflow
         ei = np.float64(rig["E"]) * np.float64(rig["width"]) * np.float64(rig["thickness"]) ** 3 / 12.0
     if not (np.isfinite(ei) and ei > 0.0):  # thickness = 1e300: the hinges' stiffness overflows
-        with np.errstate(divide="ignore"):  # the key furthest from its default, by ratio
-            key = max(_SECTION_KEYS, key=lambda k: abs(np.log(rig[k] / RIG_SCHEMA[k].default)))
+        key = furthest_from_default(rig, _SECTION_KEYS, RIG_SCHEMA)
         error(f"rig.{key}", rig[key],
               f"a section whose bending stiffness E width thickness^3 / 12 is finite and above "
               f"0 N m^2; it is {float(ei):g} here (the others are rig."

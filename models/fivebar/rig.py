@@ -23,7 +23,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from models import RIGS
-from models._base import ErrorFn, Rig, check_sample_steps
+from models._base import ErrorFn, Rig, check_sample_steps, furthest_from_default
 from models.fivebar import geometry as geo
 from models.fivebar.dynamics import FiveBarDynamics
 from models.fivebar.equations import true_equations
@@ -175,8 +175,7 @@ def _check_scales(rig: dict[str, Any], error: ErrorFn) -> None:
                        (("m1", "m2", "m3", "m4"), "masses")):
         small, big = min(keys, key=lambda k: rig[k]), max(keys, key=lambda k: rig[k])
         if not rig[small] >= MIN_SCALE_RATIO * rig[big]:
-            with np.errstate(divide="ignore"):
-                key = max((small, big), key=lambda k: abs(np.log(rig[k] / RIG_SCHEMA[k].default)))
+            key = furthest_from_default(rig, (small, big), RIG_SCHEMA)
             error(f"rig.{key}", rig[key],
                   f"link {what} within a factor {1.0 / MIN_SCALE_RATIO:.3g} of each other (here "
                   f"{rig[small]:g} to {rig[big]:g}): a link below that share is lost to rounding "
