@@ -36,6 +36,14 @@ _JIT = {"cache": True, "nogil": True, "fastmath": False, "error_model": "numpy"}
 # --------------------------------------------------------------------------------------------
 
 @njit(**_JIT)
+def _put(dst, src):
+    """``dst[:] = src`` for 1-D arrays of one size, as a loop: numba's slice assignment
+    compiles its broadcasting checks (about 3.7 s on a cold cache) for values that cannot differ."""
+    for i in range(dst.size):
+        dst[i] = src[i]
+
+
+@njit(**_JIT)
 def _solve2(j11, j12, j21, j22, r1, r2, out):
     """Solve [[j11, j12], [j21, j22]] z = r into out[0:2]; False if singular.
 
@@ -116,11 +124,11 @@ def closure_solve_many(a, b, p0, p1, Q, tol, max_iter):
     z = np.empty(2)
     qs = np.empty(Q.shape[0])
     for s in range(Q.shape[1]):
-        qs[:] = Q[:, s]
+        _put(qs, Q[:, s])
         st = closure_solve(a, b, p0, p1, qs, tol, max_iter, z)
         if st != OK:
             return st
-        Q[:, s] = qs
+        _put(Q[:, s], qs)
     return OK
 
 
@@ -130,7 +138,8 @@ def closure_velocity_many(a, p0, p1, Q, DQ):
     z = np.empty(2)
     qs, ds = np.empty(Q.shape[0]), np.empty(Q.shape[0])
     for s in range(Q.shape[1]):
-        qs[:], ds[:] = Q[:, s], DQ[:, s]
+        _put(qs, Q[:, s])
+        _put(ds, DQ[:, s])
         st = closure_velocity(a, p0, p1, qs, ds, z)
         if st != OK:
             return st
@@ -144,7 +153,8 @@ def closure_acceleration_map_many(a, p0, p1, active, Q, DQ, P, R):
     z = np.empty(2)
     qs, ds = np.empty(Q.shape[0]), np.empty(Q.shape[0])
     for s in range(Q.shape[1]):
-        qs[:], ds[:] = Q[:, s], DQ[:, s]
+        _put(qs, Q[:, s])
+        _put(ds, DQ[:, s])
         st = closure_acceleration_map(a, p0, p1, active, qs, ds, P[s], R[s], z)
         if st != OK:
             return st
@@ -280,12 +290,14 @@ def accelerations_many(Q, DQ, U, coef, acc_index, arg, is_sin, idx, actuated, ha
     work = make_work(n, coef.shape[0], coef.shape[1], arg.shape[0] + 3 * n + U.shape[0] + 1)
     qs, ds, us, dd = np.empty(n), np.empty(n), np.empty(U.shape[0]), np.empty(n)
     for s in range(N):
-        qs[:], ds[:], us[:] = Q[:, s], DQ[:, s], U[:, s]
+        _put(qs, Q[:, s])
+        _put(ds, DQ[:, s])
+        _put(us, U[:, s])
         st = accelerations(qs, ds, us, coef, acc_index, arg, is_sin, idx, actuated, has_closure,
                            a, p0, p1, active, dd, work)
         if st != OK:
             return st, s
-        DDQ[:, s] = dd
+        _put(DDQ[:, s], dd)
     return OK, -1
 
 
@@ -311,6 +323,9 @@ def rk4_implicit(q, dq, UU, h, n_steps, coef, acc_index, arg, is_sin, idx, actua
     ya, va = np.empty(n_eq), np.empty(n_eq)
     kx, kv = np.empty((4, n_eq)), np.empty((4, n_eq))
     dd = np.empty(n)
+    # the inputs of one stage copied into a contiguous row, so that :func:`accelerations` and
+    # :func:`term_values` are compiled for one array layout only (a column view is another)
+    us = np.empty(UU.shape[0])
     for m in range(n_eq):
         ya[m], va[m] = q[actuated[m]], dq[actuated[m]]
     for s in range(n_steps + 1):
@@ -321,20 +336,22 @@ def rk4_implicit(q, dq, UU, h, n_steps, coef, acc_index, arg, is_sin, idx, actua
                 q[actuated[m]] = ya[m] + c * kx[stage - 1, m] if stage else ya[m]
                 dq[actuated[m]] = va[m] + c * kv[stage - 1, m] if stage else va[m]
             if has_closure:
-                st = closure_solve(a, b, p0, p1, q, 1e-13, 30, z)
+                # np.int64: a bare 30 compiles closure_solve a second time for Literal[int](30)
+                st = closure_solve(a, b, p0, p1, q, 1e-13, np.int64(30), z)
                 if st == OK:
                     st = closure_velocity(a, p0, p1, q, dq, z)
                 if st != OK:
                     return st, s
             k = 2 * s + (0 if stage == 0 else (1 if stage < 3 else 2))
-            st = accelerations(q, dq, UU[:, k], coef, acc_index, arg, is_sin, idx, actuated,
+            _put(us, UU[:, k])
+            st = accelerations(q, dq, us, coef, acc_index, arg, is_sin, idx, actuated,
                                has_closure, a, p0, p1, active, dd, work)
             if st != OK:
                 return st, s
             if stage == 0:
-                Q[s] = q
-                DQ[s] = dq
-                DDQ[s] = dd
+                _put(Q[s], q)
+                _put(DQ[s], dq)
+                _put(DDQ[s], dd)
             for m in range(n_eq):
                 kx[stage, m] = dq[actuated[m]]
                 kv[stage, m] = dd[actuated[m]]
@@ -379,7 +396,7 @@ def rk4_cubic(A, MK3, MF, z0, h, sub, Z):
     nz = z0.size
     z = z0.copy()
     k1, k2, k3, k4, y = np.empty(nz), np.empty(nz), np.empty(nz), np.empty(nz), np.empty(nz)
-    Z[:, 0] = z0
+    _put(Z[:, 0], z0)
     for k in range(1, Z.shape[1]):
         fk = MF[:, k - 1]
         for _ in range(sub):
@@ -398,7 +415,7 @@ def rk4_cubic(A, MK3, MF, z0, h, sub, Z):
         for i in range(nz):
             if not math.isfinite(z[i]):
                 return k
-        Z[:, k] = z
+        _put(Z[:, k], z)
     return -1
 
 
@@ -523,6 +540,9 @@ def _gen_eigh(K, M):
     off-diagonal entry is below 1e-15 of the diagonal's norm), ``U = C^-T V`` so that
     ``U^T M U = I``.  Returns U (columns sorted by ascending eigenvalue) and the eigenvalues.
     Jacobi on an n = 3 matrix costs ~1 us against ~8 us for LAPACK's calls and allocations.
+    The products and the sort are plain loops (sums in ascending index order; an insertion sort,
+    stable): numba's ``@`` calls BLAS, whose rounding moves with the CPU's kernel, and ``@`` and
+    ``np.argsort`` took 4.6 of this function's 7.5 s of first compile.
     """
     n = K.shape[0]
     C = np.zeros((n, n))
@@ -544,7 +564,20 @@ def _gen_eigh(K, M):
             for k in range(j, i):
                 v -= C[i, k] * Ci[k, j]
             Ci[i, j] = v / C[i, i]
-    A = Ci @ K @ Ci.T
+    T = np.zeros((n, n))  # Ci K, then A = Ci K Ci^T: loops, not BLAS (see the docstring)
+    for i in range(n):
+        for j in range(n):
+            v = 0.0
+            for k in range(n):
+                v += Ci[i, k] * K[k, j]
+            T[i, j] = v
+    A = np.zeros((n, n))
+    for i in range(n):
+        for j in range(n):
+            v = 0.0
+            for k in range(n):
+                v += T[i, k] * Ci[j, k]
+            A[i, j] = v
     V = np.eye(n)
     for _sweep in range(50):
         off, diag = 0.0, 0.0
@@ -571,12 +604,25 @@ def _gen_eigh(K, M):
                 for k in range(n):
                     vkp, vkq = V[k, p], V[k, q]
                     V[k, p], V[k, q] = c * vkp - sn * vkq, sn * vkp + c * vkq
+    order = np.arange(n)  # ascending eigenvalues; equal ones keep their index order
+    for i in range(1, n):
+        o = order[i]
+        j = i
+        while j > 0 and A[order[j - 1], order[j - 1]] > A[o, o]:
+            order[j] = order[j - 1]
+            j -= 1
+        order[j] = o
+    U = np.empty((n, n))  # U = Ci^T V, columns in eigenvalue order
     lam = np.empty(n)
-    for i in range(n):
-        lam[i] = A[i, i]
-    order = np.argsort(lam)
-    U = Ci.T @ V
-    return np.ascontiguousarray(U[:, order]), lam[order]
+    for c in range(n):
+        oc = order[c]
+        lam[c] = A[oc, oc]
+        for i in range(n):
+            v = 0.0
+            for k in range(n):
+                v += Ci[k, i] * V[k, oc]
+            U[i, c] = v
+    return U, lam
 
 
 @njit(**_JIT)

@@ -102,7 +102,7 @@ def _refit(Gn, j, mask, ridge, idx, A, A2, b, b2, x):
     not set).
     """
     p = mask.size
-    n = 0
+    n = np.int64(0)  # not a bare 0: that compiles the solvers once more for Literal[int](0)
     for q in range(p):
         if mask[q]:
             idx[n] = q
