@@ -533,6 +533,20 @@ def window_loss_grad(S, b, L, P, Q, R, m0, c0, k0, sc3, s_a, T, TS, e2, gL, gP, 
 
 
 @njit(**_JIT)
+def _matmul(X, Y):
+    """``X @ Y`` for small matrices as loops, each sum in ascending index order (numba's ``@``
+    calls BLAS, whose rounding moves with the CPU's kernel)."""
+    Z = np.zeros((X.shape[0], Y.shape[1]))
+    for i in range(X.shape[0]):
+        for j in range(Y.shape[1]):
+            v = 0.0
+            for k in range(X.shape[1]):
+                v += X[i, k] * Y[k, j]
+            Z[i, j] = v
+    return Z
+
+
+@njit(**_JIT)
 def _gen_eigh(K, M):
     """Generalised symmetric eigenproblem ``K u = lam M u`` (M positive definite), small n.
 
@@ -564,20 +578,7 @@ def _gen_eigh(K, M):
             for k in range(j, i):
                 v -= C[i, k] * Ci[k, j]
             Ci[i, j] = v / C[i, i]
-    T = np.zeros((n, n))  # Ci K, then A = Ci K Ci^T: loops, not BLAS (see the docstring)
-    for i in range(n):
-        for j in range(n):
-            v = 0.0
-            for k in range(n):
-                v += Ci[i, k] * K[k, j]
-            T[i, j] = v
-    A = np.zeros((n, n))
-    for i in range(n):
-        for j in range(n):
-            v = 0.0
-            for k in range(n):
-                v += T[i, k] * Ci[j, k]
-            A[i, j] = v
+    A = _matmul(_matmul(Ci, K), Ci.T)
     V = np.eye(n)
     for _sweep in range(50):
         off, diag = 0.0, 0.0
@@ -612,16 +613,14 @@ def _gen_eigh(K, M):
             order[j] = order[j - 1]
             j -= 1
         order[j] = o
-    U = np.empty((n, n))  # U = Ci^T V, columns in eigenvalue order
+    W = _matmul(Ci.T, V)
+    U = np.empty((n, n))  # columns in eigenvalue order
     lam = np.empty(n)
     for c in range(n):
         oc = order[c]
         lam[c] = A[oc, oc]
         for i in range(n):
-            v = 0.0
-            for k in range(n):
-                v += Ci[k, i] * V[k, oc]
-            U[i, c] = v
+            U[i, c] = W[i, oc]
     return U, lam
 
 
