@@ -371,6 +371,38 @@ def unexcited_failures(scores: Scores, thresholds: dict[str, dict[str, float]]
                           "(excitation.location)")}
 
 
+def force_participation(truth: StructuralTruth, n: int) -> np.ndarray:
+    """The hammer's modal force in true modes ``1 .. n`` against each mode's largest amplitude
+    at the sensors: ``|phi_k . force_map| / (max_j |phi_k(j)| max|force_map|)`` [-], shape (n,)
+    (NaN for a mode with no amplitude at the sensors); see :data:`UNEXCITED_RATIO`."""
+    phi = np.asarray(truth.sensor_modes, float)[:, :n]
+    fm = np.asarray(truth.force_map, float).ravel()
+    scale = np.abs(phi).max(axis=0) * np.abs(fm).max()
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(scale > 0, np.abs(phi.T @ fm) / scale, np.nan)
+
+
+def record_details(kind: str, dataset: Dataset, data: Measurement) -> dict[str, Any]:
+    """What the record and the truth say about the true modes, with no model: the details
+    :func:`out_of_band_failures` and :func:`unexcited_failures` read (structural kind:
+    ``passband``, ``f_true``, ``scored_modes``, ``force_participation``; other kinds: none).
+
+    A run whose fit failed (:func:`failed_scores`) gets them too, so a fit that failed on a
+    mode the chain removed or the hammer missed says so (round 9: a soft-base beam's 8.9 Hz
+    mode 1 under the 10 Hz high-pass made ``ls_sindy``'s fit non-physical, and the run named
+    only the pole).
+    """
+    if kind != "structural":
+        return {}
+    truth = dataset.truth_as(StructuralTruth)
+    f_true = np.asarray(truth.frequencies_hz[: data.n_channels], float)
+    out: dict[str, Any] = {"passband": data.passband, "f_true": f_true,
+                           "scored_modes": scored_modes(data.n_channels, len(f_true))}
+    if truth.force_map is not None:
+        out["force_participation"] = force_participation(truth, data.n_channels)
+    return out
+
+
 def failed_scores(kind: str, reason: str, key: str = "fit") -> Scores:
     """Scores of a run whose model could not be scored at all: every score NaN, one failure.
 
@@ -672,11 +704,8 @@ def score_structural(dataset: Dataset, data: Measurement, clean: Measurement, mo
         v["damping_error"] = worst(per_mode["damping_error"], "max")
     d.update(scored_modes=m, **{f"{k}_per_mode": np.asarray(x) for k, x in per_mode.items()})
     d.update(mac=mac, pair=pair, f_id=f_id, f_true=f_true, z_id=z_id, z_true=z_true)
-    if truth.force_map is not None:  # the hammer's modal force per true mode, vs its largest
-        fm = np.asarray(truth.force_map, float).ravel()
-        scale = np.abs(phi_true).max(axis=0) * np.abs(fm).max()
-        with np.errstate(divide="ignore", invalid="ignore"):
-            d["force_participation"] = np.where(scale > 0, np.abs(phi_true.T @ fm) / scale, np.nan)
+    if truth.force_map is not None:
+        d["force_participation"] = force_participation(truth, data.n_channels)
 
     Mr, Kr, Cr = truth.Mr, truth.Kr, truth.Cr
     v["Mr_error"] = metrics.relative_error(model.M_, Mr)

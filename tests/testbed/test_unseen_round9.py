@@ -74,3 +74,32 @@ def test_round9_studies_load(name, cells):
     from testbed.studies.study import load_study
     from testbed.studies.sweep import expand
     assert len(expand(load_study(UNSEEN / f"{name}.toml"))) == cells
+
+
+# ------------------------------------------- a failed fit on a mode out of reach says so
+class _RefusingFit:
+    """A structural identifier whose fit is refused as ls_sindy refuses a non-physical one."""
+
+    def fit(self, data):
+        from testbed.core.errors import IdentificationError
+        raise IdentificationError("non-physical model: a pole at +53.52 +191.4j 1/s grows")
+
+
+def test_failed_fit_on_a_mode_below_the_highpass_names_the_band():
+    from testbed.pipeline.scenario import scenario_from_dict
+    from testbed.scoring.run import run_scenario
+    # round9/b9_soft_L1p2_k1_2e4 with ls_sindy: mode 1 (8.9 Hz) under the 10 Hz high-pass made
+    # the fit non-physical and the run said only "fit failed: ... a pole grows"; sgd_sindy's
+    # run on the same record named the band.  Here the shipped beam's mode 1 (82.8 Hz) lies
+    # under a 100 Hz high-pass, 0.1 s
+    sc = scenario_from_dict({
+        "scenario": {"name": "t", "rig": "cantilever", "seed": 0}, "rig": {},
+        "simulation": {"duration": 0.1}, "excitation": {"type": "impact"}, "noise": {},
+        "signal": {"highpass_hz": 100.0}, "identify": {"method": "ls_sindy"},
+        "score": {"trac_min": 0.9, "freq_error_mode1_max": 0.026}})
+    res = run_scenario(sc, model=_RefusingFit())
+    assert res.scores.failures["fit"].startswith("fit failed: non-physical model")
+    assert res.scores.failures["band"].startswith("out of band: mode 1 (82.")
+    assert "mode 2" not in res.scores.failures["band"]  # in the band: the fit's failure alone
+    assert "unexcited" not in res.scores.failures  # the hammer at the tip excites every mode
+    assert all(np.isnan(v) for v in res.scores.values.values())  # no score from a failed fit
