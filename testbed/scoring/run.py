@@ -28,6 +28,7 @@ from testbed.scoring.scorers import (
     bar_failures,
     check_thresholds,
     failed_scores,
+    record_details,
     score,
     verdict,
 )
@@ -152,6 +153,8 @@ def run_scenario(scenario: Scenario, *, cache: DatasetCache | None = None,
             raise
         except IdentificationError as e:  # data the identifier cannot handle: a scored failure
             scores = failed_scores(kind, f"fit failed: {e}")
+            scores.details.update(record_details(kind, dataset, data))
+            scores.failures.update(bar_failures(scores, scenario.score))  # a mode out of reach
         else:
             scores = None
         fit_time = time.perf_counter() - t0
