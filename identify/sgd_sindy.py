@@ -640,7 +640,9 @@ class SGDSINDy(SGDSINDyBase):
     0.68 / 0.70 -> 0.98 / 0.999 / 0.99), soft 014 lost (a spare mode at 107 Hz between
     peaks 1 and 2, mode 2 0.30 -> 2.59 %); TRAC rose on soft 007, 010, 016 and clamped 016,
     023 at 1 % (0.73 / 0.36 / 0.37 / 0.04 / 0.04 -> 0.93 / 0.88 / 0.97 / 0.97 / 0.95),
-    still failing on frequency.  Round 7's b_s6 at 0.5 % noise (seed 3): TRAC 0.64 -> 0.9999.
+    still failing on frequency.  Round 5-8 beam cells (benchmarks/unseen): fires on 50 of
+    208; round 7's b_s8 clean (flat: diverged) and b_s6 at 0.5 % (TRAC 0.64 -> 0.9999) gained,
+    round 6's b_soft_root_cluster clean lost (mode 1 +2.71 % against the 2.6 % bar).
 
     *Keeping the SGD's result* (``keep_sgd``).  From a sound warm start the SGD can wander
     while its data loss stays flat: soft-base member 006 (clean) ends with mode 1 off 1773 %,
