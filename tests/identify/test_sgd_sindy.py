@@ -25,6 +25,7 @@ from identify.sgd_sindy import (
 )
 from identify.sgd_sindy_coefficients import SGDSINDyCoefficients
 from identify.structural import modal
+from testbed.core.errors import IdentificationError
 from testbed.scoring.metrics import mac_matrix, pair_modes, trac
 
 EPOCHS = 400
@@ -173,6 +174,42 @@ def test_tilt_falls_back_to_flat_when_non_physical(linear, monkeypatch):
     assert np.array_equal(model.coef_, flat.coef_)
     with pytest.raises(IdentificationError):
         SGDSINDy(epochs=4, fit_tilt=True).fit(data)
+
+
+def test_psd_damping_warm_start():
+    """An indefinite damping's growing pole is removed by its projection onto the positive
+    semi-definite cone; a negative stiffness's is not (None: the flat fallback)."""
+    from identify._sgd_matrix import psd_damping_warm_start
+    from identify.structural import check_physical
+
+    M, K = np.eye(2), np.diag([1.0e4, 4.0e4])  # kg, N/m: modes at 15.9 and 31.8 Hz
+    C = np.array([[2.0, 0.0], [0.0, -5.0]])  # N s/m: the second mode grows
+    with pytest.raises(IdentificationError):
+        check_physical(M, C, K)
+    Cp = psd_damping_warm_start(M, C, K)
+    assert np.allclose(Cp, np.diag([2.0, 0.0]))
+    check_physical(M, Cp, K)
+    assert psd_damping_warm_start(M, C, np.diag([1.0e4, -4.0e4])) is None
+
+
+def test_tilted_warm_start_with_indefinite_damping_stays_tilted(linear, monkeypatch):
+    """fit_tilt=None: a linear tilted warm start whose growing pole is an indefinite damping
+    (round 7's b_s6 at 0.5 % noise) keeps the tilt with that damping projected (before:
+    refused and fitted flat)."""
+    import identify._sgd_matrix as sm
+
+    real = sm.warm_start
+
+    def indefinite(*args, **kwargs):  # the warm start with a negative damping on its top mode
+        M, C, K, K3 = real(*args, **kwargs)
+        v = np.linalg.eigh(K)[1][:, -1]
+        return M, C - 10.0 * np.abs(C).max() * np.outer(v, v), K, K3
+
+    _, data, _ = linear
+    monkeypatch.setattr(sm, "warm_start", indefinite)
+    model = SGDSINDy(epochs=4).fit(data)
+    assert model.fit_tilt_ is True
+    assert "kept with its damping projected onto the positive semi-definite cone" in model.fit_tilt_rule_
 
 
 def test_keep_sgd_rule():
