@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import logging
 import math
+import sys
 from collections.abc import Callable
 from typing import Any, ClassVar
 
@@ -205,6 +206,29 @@ IMPACT_SCHEMA = {
 }
 
 
+#: Least stiffness-proportional damping coefficient ``beta`` [s] a beam may have: float64's
+#: smallest normal number (2.2e-308).  Below it ``C = beta K`` is subnormal or 0 -- the undamped
+#: chain ``damping_ratio = 0`` is refused for -- and the truth's damping ratios and ``Cr`` lose
+#: their digits (``damping_ratio = 5e-324`` gave beta = 0 and damping scores of inf).
+MIN_NORMAL_BETA_S = sys.float_info.min
+
+
+def _least_damping_ratio(rig: dict[str, Any]) -> float:
+    """The least ``damping_ratio`` whose ``beta = 2 zeta_1 / omega_1`` [s] reaches
+    :data:`MIN_NORMAL_BETA_S`: ``MIN_NORMAL_BETA_S pi f_1``.
+
+    ``f_1`` is the clamped Euler-Bernoulli estimate of mode 1 (:func:`clamped_estimates`); the
+    model's exact mode 1, which :func:`build_model` uses, lies within a few per cent of it for a
+    clamped base and below it for a soft one, so the bound is never above the true one by more
+    than that.  0 when the estimate leaves float64 (other checks name such a beam).
+    """
+    try:
+        f1 = float(clamped_estimates(rig, 1)[0])
+    except (OverflowError, ZeroDivisionError, ValueError):
+        return 0.0
+    return MIN_NORMAL_BETA_S * math.pi * f1 if math.isfinite(f1) and f1 > 0 else 0.0
+
+
 def _root_hinge(rig: dict[str, Any]) -> float:
     """Position [m] of the first moving hinge (0 for a soft base)."""
     if rig["base"] == "soft":
@@ -364,9 +388,32 @@ class CantileverRig(Rig):
                   "Nyquist frequency ring for the whole record and fold into the band, where no "
                   "mode of the truth is (measured: the default beam's mode 8, 12456 Hz, at "
                   "344 Hz at 12.8 kHz, and ls_sindy's mode 1 off 3300 %)")
+        # C = beta K with beta subnormal or 0 is the undamped chain refused above, in a number
+        # that has lost its digits (round 8: damping_ratio = 5e-324 gave beta = 0, the truth's
+        # damping ratios 0 and the damping scores inf, with no reason given)
+        undamped = ("an undamped chain in all but name (C = beta K under float64's smallest "
+                    f"normal number, {MIN_NORMAL_BETA_S:.4g} s)")
+        if 0 < rig["damping_beta"] < MIN_NORMAL_BETA_S:
+            error("rig.damping_beta", rig["damping_beta"],
+                  f"expected 0 (derived from damping_ratio) or at least {MIN_NORMAL_BETA_S:.4g} "
+                  f"s: below it {undamped}")
+        zeta_min = _least_damping_ratio(rig)
+        if rig["damping_beta"] == 0 and 0 < rig["damping_ratio"] < zeta_min:
+            error("rig.damping_ratio", rig["damping_ratio"],
+                  f"expected in [{zeta_min:.4g}, 1): below it beta = 2 zeta_1 / omega_1 (mode 1 "
+                  f"about {zeta_min / MIN_NORMAL_BETA_S / math.pi:.4g} Hz by Euler-Bernoulli) is "
+                  f"{undamped}")
         if rig["damping_ratio"] > 0 and rig["damping_beta"] > 0:
             error("rig.damping_beta", rig["damping_beta"],
                   "allowed: only one damping form; set rig.damping_ratio = 0 to give damping_beta")
+        if rig["base"] == "stiff":
+            # a clamped base has no spring: base_k1 = 5000 was accepted and ignored (round 9);
+            # a value at its default is what a table written out whole lists
+            for key in ("base_k1", "base_k3"):
+                if rig[key] != RIG_SCHEMA[key].default:
+                    error(f"rig.{key}", rig[key],
+                          "read only with base = 'soft' (the clamped base has no spring): "
+                          "remove it or set rig.base = 'soft'")
         if rig["base"] == "soft" and rig["joint_offset"] == 0:
             error("rig.joint_offset", rig["joint_offset"],
                   "allowed: > 0 with base = 'soft' (the base hinge needs a stub of beam to move)")
