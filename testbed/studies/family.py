@@ -46,6 +46,8 @@ from __future__ import annotations
 import math
 import os
 import re
+import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -499,9 +501,41 @@ def member_dict(fam: Family, k: int, attempt: int, tables: dict[str, dict[str, A
     return raw
 
 
-def family_members(fam: Family) -> list[Scenario]:
-    """Every member of a family, in index order (see the module docs for the drawing rule)."""
-    return [draw_member(fam, k)[0] for k in range(fam.members)]
+#: A family of more members than this is announced before it is drawn, and its progress given
+#: at every tenth of it (:func:`family_members`): each member is drawn and validated as a
+#: scenario, 36-270 ms a member on the shared machine (round 7), so 10,000 members took 6-45
+#: minutes in silence before a sweep's first line.  The shipped families have 8-40 members.
+ANNOUNCE_MEMBERS = 100
+#: Seconds a member may take to draw under load (round 7's slowest, 0.27 s), for the announcement.
+SLOW_MEMBER_S = 0.27
+
+
+def family_members(fam: Family, progress: Callable[[str], None] | None = None) -> list[Scenario]:
+    """Every member of a family, in index order (see the module docs for the drawing rule).
+
+    Parameters
+    ----------
+    fam : Family
+        The family.
+    progress : callable, optional
+        ``progress(line)`` receives one line before a family of more than
+        :data:`ANNOUNCE_MEMBERS` members is drawn, with the time it may take, and one at every
+        tenth of its members (the ``testbed`` command prints them to standard error).
+    """
+    loud = progress is not None and fam.members > ANNOUNCE_MEMBERS
+    if loud:
+        progress(f"drawing family {fam.name}: {fam.members} members, each validated as a "
+                 f"scenario (up to {SLOW_MEMBER_S:g} s a member: up to "
+                 f"{fam.members * SLOW_MEMBER_S / 60:.0f} min)")
+    step = math.ceil(fam.members / 10)
+    t0 = time.perf_counter()
+    members = []
+    for k in range(fam.members):
+        members.append(draw_member(fam, k)[0])
+        if loud and (k + 1) % step == 0:
+            progress(f"family {fam.name}: {k + 1} of {fam.members} members drawn "
+                     f"({time.perf_counter() - t0:.0f} s)")
+    return members
 
 
 # --------------------------------------------------------------------------- writing
