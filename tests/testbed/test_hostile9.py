@@ -120,3 +120,41 @@ def test_a_large_family_is_announced_and_its_drawing_shown(tmp_path, monkeypatch
     monkeypatch.setattr(family, "ANNOUNCE_MEMBERS", 4)
     load_study(p, progress=quiet.append)
     assert quiet == []
+
+
+def test_base_spring_keys_given_with_a_clamped_base_are_refused():
+    # accepted and ignored: a clamped base has no spring
+    for key, value in (("base_k1", 5000.0), ("base_k3", 1e6)):
+        with pytest.raises(ScenarioError) as e:
+            _load("cantilever_stiff_impact", rig={key: value})
+        assert e.value.key == f"rig.{key}" and "read only with base = 'soft'" in str(e.value)
+    assert _load("cantilever_soft_impact", rig={"base_k1": 5000.0}).rig_params["base_k1"] == 5000.0
+
+
+# ------------------------------------------------------------------ round 9's own findings
+
+@pytest.mark.parametrize("params, key", [
+    # numpy's legacy global seed takes 32 bits: "ValueError: Seed must be between 0 and
+    # 2**32 - 1" in the fit
+    ({"seed": 2**53 + 1}, "identify.seed"),
+    # one STLSQ fit per bagged model: 2**53 + 1 ran past any time limit
+    ({"optimizer": "ensemble", "n_models": 2**53 + 1}, "identify.n_models"),
+])
+def test_pysindy_settings_its_fit_cannot_take_are_refused_at_load(params, key):
+    with pytest.raises(ScenarioError) as e:
+        _load("cantilever_stiff_impact_pysindy", identify={"method": "pysindy", **params})
+    assert e.value.key == key
+
+
+def test_a_model_whose_every_coefficient_is_zero_is_a_failure_with_its_reasons():
+    # pysindy with threshold = 1e300 keeps no coefficient: M only, C = K = 0; TRAC and the
+    # damping ratios were NaN with no failure naming why
+    from testbed.scoring.run import run_scenario
+
+    sc = _load("cantilever_stiff_impact", simulation={"duration": 0.1},
+               identify={"method": "pysindy", "threshold": 1e300})
+    result = run_scenario(sc)
+    failures = result.scores.failures
+    assert not result.passed
+    assert "3 identified mode(s) without stiffness" in failures["stiffness"]
+    assert failures["trac"].startswith("TRAC undefined on acc1")
