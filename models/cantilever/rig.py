@@ -240,6 +240,9 @@ def _root_hinge(rig: dict[str, Any]) -> float:
 _MASS_KEYS = ("thickness", "width", "rho", "length")
 #: The keys the section's bending stiffness ``E width thickness^3 / 12`` comes from.
 _SECTION_KEYS = ("E", "width", "thickness")
+#: The physical keys a beam's model is built from; a build that fails names the one furthest
+#: from its default (:func:`models._base.furthest_from_default`).
+_BUILD_KEYS = ("E", "rho", "width", "thickness", "length", "base_k1", "base_k3")
 
 
 def _check_segment_inertia(rig: dict[str, Any], error: ErrorFn) -> None:
@@ -271,7 +274,17 @@ def _check_segment_inertia(rig: dict[str, Any], error: ErrorFn) -> None:
         seg = seg[seg > 0]
         m = np.float64(params.mass_per_length) * seg
         b = np.float64(params.width)
-        smallest = float(np.min(np.concatenate([m, m * seg**2 / 12.0, m * b**2 / 12.0])))
+        inertias = np.concatenate([m, m * seg**2 / 12.0, m * b**2 / 12.0])
+        smallest = float(np.min(inertias))
+    if not np.all(np.isfinite(inertias)):
+        # length = 1e300: I_yy = m s^2 / 12 overflowed, and the build was refused naming the
+        # table alone ("key 'rig': ... (34, 'Numerical result out of range')", round 9)
+        key = furthest_from_default(rig, _MASS_KEYS, RIG_SCHEMA)
+        error(f"rig.{key}", rig[key],
+              f"a segment's mass and principal inertias must be finite (kg, kg m^2); they "
+              f"overflow here (mass {float(np.max(m)):.3g} kg): a smaller {key} (the others "
+              f"are rig.{', rig.'.join(k for k in _MASS_KEYS if k != key)})")
+        return
     if not smallest > MJ_MINVAL:
         key = min(_MASS_KEYS, key=lambda k: rig[k] / RIG_SCHEMA[k].default)
         error(f"rig.{key}", rig[key],
@@ -523,7 +536,13 @@ class CantileverRig(Rig):
         try:
             stepping = build_model(rig, simulation, excitation).stepping
         except (ValueError, ArithmeticError, np.linalg.LinAlgError) as e:
-            raise RigError(f"the beam cannot be built from these parameters: {e}") from None
+            # named: the key furthest from its default (round 9: length = 1e100 and a soft
+            # base_k1 = 1e100 were refused naming the table 'rig' alone)
+            keys = tuple(k for k in _BUILD_KEYS if rig[k] > 0)
+            key = furthest_from_default(rig, keys, RIG_SCHEMA)
+            raise RigError(f"the beam cannot be built from these parameters ({e}); rig.{key} "
+                           f"lies furthest from its default {RIG_SCHEMA[key].default:g}",
+                           key=f"rig.{key}", value=rig[key]) from None
         if simulation["timestep"] > 0:
             step_key, step_value = "simulation.timestep", simulation["timestep"]
         # accuracy alone asks ceil(pi / 0.49) = 7 substeps (RK4) or ceil(pi / 0.109) = 29

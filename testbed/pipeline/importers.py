@@ -838,10 +838,15 @@ def _read_csv(path: Path) -> _Raw:
     head = lines[0][1]
     delim = next((d for d in (",", ";", "\t") if d in head), None)
 
-    def split(line: str) -> list[str]:
-        return next(csv.reader([line], delimiter=delim)) if delim else line.split()
+    def split(line: str, lineno: int) -> list[str]:
+        try:
+            return next(csv.reader([line], delimiter=delim)) if delim else line.split()
+        except csv.Error as e:  # a field over csv's limit (a line of 10 MB): csv.Error, an
+            # internal error of `identify` (round 9)
+            raise MeasuredDataError(path, f"line {lineno}: {e} characters; a number or a "
+                                          "column name is far shorter") from None
 
-    header = [_HEADER.match(h).groupdict() for h in split(head)]  # type: ignore[union-attr]
+    header = [_HEADER.match(h).groupdict() for h in split(head, lines[0][0])]  # type: ignore[union-attr]
     names = [h["name"] for h in header]
     if any(not n for n in names) or len(set(names)) != len(names):
         # the one at fault, not every name: a header of 3,000 columns made a 40 kB line
@@ -854,7 +859,7 @@ def _read_csv(path: Path) -> _Raw:
     check_record_size(path, len(lines) - 1, max(1, len(names) - sum(n.lower() in TIME_NAMES for n in names)))
     rows = []
     for lineno, line in lines[1:]:
-        cells = split(line)
+        cells = split(line, lineno)
         if len(cells) != len(names):
             raise MeasuredDataError(path, f"line {lineno} has {len(cells)} fields, the header {len(names)}")
         try:

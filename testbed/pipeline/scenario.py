@@ -557,6 +557,8 @@ def check_rig_cost(rig_cls: Any, rig_params: dict[str, Any], simulation: dict[st
     try:
         cost = rig_cls.cost(rig_params, simulation, excitation)
     except RigError as e:
+        if getattr(e, "key", None):
+            raise ScenarioError(file, e.key, e.value, str(e)) from None
         raise ScenarioError(file, "rig", allowed=str(e)) from None
     if cost is not None:
         check_cost(cost, file)

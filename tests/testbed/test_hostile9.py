@@ -158,3 +158,30 @@ def test_a_model_whose_every_coefficient_is_zero_is_a_failure_with_its_reasons()
     assert not result.passed
     assert "3 identified mode(s) without stiffness" in failures["stiffness"]
     assert failures["trac"].startswith("TRAC undefined on acc1")
+
+
+@pytest.mark.parametrize("name, rig, key", [
+    # I_yy = m s^2 / 12 overflowed: "key 'rig': ... (34, 'Numerical result out of range')"
+    ("cantilever_stiff_impact", {"length": 1e300}, "rig.length"),
+    # the model's mode 1 underflowed to 0 Hz (beta = inf): "key 'rig': ... infs or NaNs"
+    ("cantilever_stiff_impact", {"length": 1e100}, "rig.length"),
+    ("cantilever_soft_impact", {"base_k1": 1e100}, "rig.base_k1"),
+])
+def test_a_beam_that_cannot_be_built_is_refused_naming_a_key(name, rig, key):
+    with np.errstate(all="ignore"), pytest.raises(ScenarioError) as e:
+        _load(name, rig=rig)
+    assert e.value.key == key and "\n" not in str(e.value)
+
+
+@pytest.mark.parametrize("text, line", [
+    ("t,x\n" + "".join(f"{k / 100},{k}\n" for k in range(50)) + "1" * 200_000 + ",1\n", 52),
+    ("t," + "x" * 200_000 + "\n0,1\n0.01,2\n", 1),
+])
+def test_a_csv_field_over_the_csv_modules_limit_is_refused_naming_its_line(tmp_path, text, line):
+    # csv.Error "field larger than field limit (131072)": an internal error of `identify`
+    from testbed.pipeline.importers import MeasuredDataError, read_measured
+
+    p = tmp_path / "long.csv"
+    p.write_text(text)
+    with pytest.raises(MeasuredDataError, match=f"line {line}: field larger than field limit"):
+        read_measured(p, units="m")
