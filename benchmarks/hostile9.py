@@ -238,12 +238,19 @@ def _resume(study_path: Path, results: Path, edit) -> str | None:
     if not results.is_file():
         return None  # refused in one line
     rows = read_results(results)
-    cells = {c.key for c in expand(load_study(study_path))} if hasattr(
-        expand(load_study(study_path))[0], "key") else None
+    if any(r["study"] != load_study(study_path).name for r in rows):
+        return None  # refused in one line, another study's file left as it was
+    grid = {c.key: c for c in expand(load_study(study_path))}
+    cells = set(grid)
     keys = [r["cell"] for r in rows]
+    for r in rows:  # a row must describe the cell it is kept for
+        c = grid.get(r["cell"])
+        if c is not None and (r["scenario"], r["identifier"], r["noise"], r["seed"]) != (
+                c.scenario.name, c.identifier, c.noise, c.seed):
+            return f"row of cell {r['cell']} kept as {r['scenario']!r}, {r['identifier']!r}"
     if len(keys) != len(set(keys)):
         return f"a cell twice after the resume: {sorted(keys)}"
-    if cells is not None and set(keys) != cells:
+    if set(keys) != cells:
         return f"cells after the resume {sorted(keys)} are not the study's {sorted(cells)}"
     return None
 
