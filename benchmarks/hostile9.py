@@ -144,6 +144,12 @@ def study_param_cases(work: Path) -> list[tuple[str, object]]:
 # ------------------------------------------------------------------ the command line
 
 def _cli(argv: list[str]) -> str | None:
+    """A finding of the command ``testbed <argv>`` run in-process, or None."""
+    return _cli_status(argv)[0]
+
+
+def _cli_status(argv: list[str]) -> tuple[str | None, int]:
+    """A finding of the command ``testbed <argv>`` run in-process, or None; and its status."""
     from testbed.cli import main
 
     out, err = io.StringIO(), io.StringIO()
@@ -155,17 +161,17 @@ def _cli(argv: list[str]) -> str | None:
     text = err.getvalue()
     errors = [x for x in text.splitlines() if x.strip()]
     if status == 3 or "internal error" in text:
-        return f"internal error (status {status}): {text.strip()[:200]}"
+        return f"internal error (status {status}): {text.strip()[:200]}", status
     if "Traceback" in text:
-        return f"traceback: {text.strip()[-200:]}"
+        return f"traceback: {text.strip()[-200:]}", status
     if status == 0 and any(x.startswith("error") for x in errors):
-        return f"status 0 with an error: {text.strip()[:200]}"
+        return f"status 0 with an error: {text.strip()[:200]}", status
     if status == 2 and len(errors) != 1 and not argv[-1:] == ["-h"]:
         # argparse prints its usage line(s) before its error line: one error line is asked of
         # the testbed's own refusals, the usage is argparse's
         if not any(x.startswith("usage:") for x in errors):
-            return f"{len(errors)} lines: {text.strip()[:200]!r}"
-    return None
+            return f"{len(errors)} lines: {text.strip()[:200]!r}", status
+    return None, status
 
 
 def cli_cases(work: Path) -> list[tuple[str, object]]:
@@ -232,10 +238,11 @@ def _resume(study_path: Path, results: Path, edit) -> str | None:
         results.unlink()
     shutil.copyfile(clean, results)
     edit(results)
-    finding = _cli(["sweep", str(study_path), "--jobs", "1", "--results", str(results)])
+    finding, status = _cli_status(["sweep", str(study_path), "--jobs", "1", "--results",
+                                   str(results)])
     if finding is not None:
         return finding
-    if not results.is_file():
+    if status == 2 or not results.is_file():
         return None  # refused in one line
     rows = read_results(results)
     if any(r["study"] != load_study(study_path).name for r in rows):

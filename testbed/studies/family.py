@@ -398,9 +398,14 @@ def _cantilever_rules(fam: Family, rig: dict[str, Any], exc: dict[str, Any],
         pos = np.minimum(np.floor(pos * 1e4) / 1e4, L)
         rig["sensors"] = [float(x) for x in pos]
     n_sensors = len(rig["sensors"]) or 3
-    if "base_k1_ratio" in derived:
+    if "base_k1_ratio" in derived and rig["base"] == "soft":
         EI = rig["E"] * rig["width"] * rig["thickness"] ** 3 / 12.0
         rig["base_k1"] = float(derived["base_k1_ratio"] * EI / L)
+    if rig["base"] != "soft":
+        # a clamped base reads no spring: its keys are left at their defaults (None: left out
+        # of the member), which the rig refuses otherwise (round 9); the ratio and fraction
+        # are drawn all the same, so the other draws do not move
+        rig["base_k1"] = rig["base_k3"] = None
     if exc.get("location") == "sensor":
         sensors = rig["sensors"] or [L / 3, 2 * L / 3, L]
         exc["location"] = float(sensors[int(rng.integers(len(sensors)))])
@@ -408,8 +413,6 @@ def _cantilever_rules(fam: Family, rig: dict[str, Any], exc: dict[str, Any],
         if rig["base"] == "soft":
             q = peak_base_rotation(rig, exc)
             rig["base_k3"] = float(derived["cubic_fraction"] * rig["base_k1"] / q**2)
-        else:
-            rig["base_k3"] = 0.0  # no base spring: the fraction means nothing (drawn all the same)
     for key in ("highpass_hz", "lowpass_hz"):
         if signal.get(key) == "auto":
             # the lab's cut-offs from the member's nominal geometry, by the rig's one rule
