@@ -176,7 +176,7 @@ def test_a_beam_that_cannot_be_built_is_refused_naming_a_key(name, rig, key):
 @pytest.mark.parametrize("text, line", [
     ("t,x\n" + "".join(f"{k / 100},{k}\n" for k in range(50)) + "1" * 200_000 + ",1\n", 52),
     ("t," + "x" * 200_000 + "\n0,1\n0.01,2\n", 1),
-])
+], ids=["long field", "long name"])
 def test_a_csv_field_over_the_csv_modules_limit_is_refused_naming_its_line(tmp_path, text, line):
     # csv.Error "field larger than field limit (131072)": an internal error of `identify`
     from testbed.pipeline.importers import MeasuredDataError, read_measured
