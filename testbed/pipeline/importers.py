@@ -699,6 +699,10 @@ def _read_sep005_file(path: Path) -> _Raw:
     except _DuplicateKey as e:
         raise MeasuredDataError(path, f"key {e.args[0]!r} is given twice in one object; give each "
                                       "key once") from None
+    except ValueError as e:  # an integer of over 4,300 digits: Python's int conversion limit
+        # (round 9: an internal error of `identify`); no SEP-005 value needs one
+        raise MeasuredDataError(path, f"not a SEP-005 JSON file ({str(e).split(':')[0]}: a "
+                                      "number of thousands of digits)") from None
     return _parse_sep005(path, content)
 
 

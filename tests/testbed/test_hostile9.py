@@ -185,3 +185,14 @@ def test_a_csv_field_over_the_csv_modules_limit_is_refused_naming_its_line(tmp_p
     p.write_text(text)
     with pytest.raises(MeasuredDataError, match=f"line {line}: field larger than field limit"):
         read_measured(p, units="m")
+
+
+def test_a_sep005_file_with_an_integer_of_5001_digits_is_refused(tmp_path):
+    # Python's int conversion limit (4,300 digits) raised a bare ValueError: an internal error
+    from testbed.pipeline.importers import MeasuredDataError, read_measured
+
+    p = tmp_path / "big.sep005.json"
+    p.write_text('[{"name": "acc1", "unit_str": "m/s^2", "fs": 100.0, "data": [1' + "0" * 5000
+                 + ', 2.0, 3.0]}]')
+    with pytest.raises(MeasuredDataError, match="not a SEP-005 JSON file .*thousands of digits"):
+        read_measured(p)
