@@ -194,5 +194,5 @@ def test_a_sep005_file_with_an_integer_of_5001_digits_is_refused(tmp_path):
     p = tmp_path / "big.sep005.json"
     p.write_text('[{"name": "acc1", "unit_str": "m/s^2", "fs": 100.0, "data": [1' + "0" * 5000
                  + ', 2.0, 3.0]}]')
-    with pytest.raises(MeasuredDataError, match="not a SEP-005 JSON file .*thousands of digits"):
+    with pytest.raises(MeasuredDataError, match=r"not a SEP-005 JSON file .*thousands of digits"):
         read_measured(p)
