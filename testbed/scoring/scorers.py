@@ -564,7 +564,10 @@ def score_structural(dataset: Dataset, data: Measurement, clean: Measurement, mo
     definite, negative damping, an unstable pole) and a simulation that raises, turns
     non-finite or blows up (:func:`simulate_scored`) are recorded in ``Scores.failures``;
     the TRAC of a failed simulation is NaN.  The other scores are still computed (NaN where
-    the model gives no modes), as diagnostics of what went wrong.
+    the model gives no modes), as diagnostics of what went wrong.  A score left undefined
+    without any of those failures names why: ``"stiffness"``, identified modes at 0 Hz (no
+    damping ratio) while the truth's are all above it; ``"trac"``, a channel whose simulated or
+    reference acceleration is zero (0 / 0).
     """
     truth = dataset.truth_as(StructuralTruth)
     i0 = data.free_start
