@@ -527,15 +527,16 @@ def family_members(fam: Family, progress: Callable[[str], None] | None = None) -
     """
     loud = progress is not None and fam.members > ANNOUNCE_MEMBERS
     if loud:
+        most = fam.members * SLOW_MEMBER_S
         progress(f"drawing family {fam.name}: {fam.members} members, each validated as a "
                  f"scenario (up to {SLOW_MEMBER_S:g} s a member: up to "
-                 f"{fam.members * SLOW_MEMBER_S / 60:.0f} min)")
+                 + (f"{most / 60:.0f} min)" if most >= 60 else f"{most:.0f} s)"))
     step = math.ceil(fam.members / 10)
     t0 = time.perf_counter()
     members = []
     for k in range(fam.members):
         members.append(draw_member(fam, k)[0])
-        if loud and (k + 1) % step == 0:
+        if loud and ((k + 1) % step == 0 or k + 1 == fam.members):
             progress(f"family {fam.name}: {k + 1} of {fam.members} members drawn "
                      f"({time.perf_counter() - t0:.0f} s)")
     return members
