@@ -112,8 +112,12 @@ class PySINDyField(StructuralIdentifier):
         "reg_weight_lam": Field(float, 1e-6, min=0.0, doc="SR3 regularisation weight"),
         "regularizer": Field(str, "L1", choices=("L0", "L1"), doc="SR3 regulariser"),
         "max_iter": Field(int, 30, min=1, doc="iterations of STLSQ / SR3"),
-        "n_models": Field(int, 20, min=2, doc="bagged models of the ensemble optimizer"),
-        "seed": Field(int, 0, min=0, doc="seed of the ensemble's resampling"),
+        # each bagged model is one STLSQ fit: 2**53 + 1 of them ran past any time limit
+        # (round 9); 1000 is 50 times the default
+        "n_models": Field(int, 20, min=2, max=1000, doc="bagged models of the ensemble optimizer"),
+        # numpy's legacy global generator, which pysindy's ensemble draws from, takes seeds of
+        # 32 bits: 2**53 + 1 was "ValueError: Seed must be between 0 and 2**32 - 1" in the fit
+        "seed": Field(int, 0, min=0, max=2**32 - 1, doc="seed of the ensemble's resampling"),
         "weak": Field(bool, False, doc="weak (integral) form with pysindy's WeakPDELibrary"),
         "n_windows": Field(int, 200, min=4, doc="test-function windows of the weak form (pysindy's K)"),
         "cubic": Field(bool, False, doc="add the cubic displacement features x_j^3 (strong form only)"),

@@ -477,6 +477,11 @@ def cmd_export(args: argparse.Namespace) -> int:
     return 0
 
 
+def _stderr_line(line: str) -> None:
+    """A progress line on standard error (a large family's drawing)."""
+    print(line, file=sys.stderr, flush=True)
+
+
 def cmd_sweep(args: argparse.Namespace) -> int:
     from testbed.studies.study import load_study
     from testbed.studies.sweep import SweepStats, run_sweep
@@ -484,7 +489,7 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     extra = _load_plugins(args)
     if args.results:  # before the study's load, which simulates nothing but takes seconds
         _output_file(Path(args.results), "--results")
-    study = load_study(args.study)
+    study = load_study(args.study, progress=_stderr_line)
     if extra:  # the workers import them too
         study = dataclasses.replace(study, plugins=tuple(dict.fromkeys(study.plugins + extra)))
     stats = SweepStats()
@@ -516,7 +521,7 @@ def cmd_family(args: argparse.Namespace) -> int:
     from testbed.studies.study import load_study, write_family
 
     out = _output_folder(Path(args.out), "--out")
-    paths = write_family(load_study(args.study), out, family=args.family)
+    paths = write_family(load_study(args.study, progress=_stderr_line), out, family=args.family)
     print(f"wrote {len(paths)} member scenario(s) to {args.out}; rerun one with "
           f"`testbed run {paths[0] if paths else args.out}`")
     return 0

@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import logging
 import math
+import sys
 from collections.abc import Callable
 from typing import Any, ClassVar
 
@@ -205,6 +206,29 @@ IMPACT_SCHEMA = {
 }
 
 
+#: Least stiffness-proportional damping coefficient ``beta`` [s] a beam may have: float64's
+#: smallest normal number (2.2e-308).  Below it ``C = beta K`` is subnormal or 0 -- the undamped
+#: chain ``damping_ratio = 0`` is refused for -- and the truth's damping ratios and ``Cr`` lose
+#: their digits (``damping_ratio = 5e-324`` gave beta = 0 and damping scores of inf).
+MIN_NORMAL_BETA_S = sys.float_info.min
+
+
+def _least_damping_ratio(rig: dict[str, Any]) -> float:
+    """The least ``damping_ratio`` whose ``beta = 2 zeta_1 / omega_1`` [s] reaches
+    :data:`MIN_NORMAL_BETA_S`: ``MIN_NORMAL_BETA_S pi f_1``.
+
+    ``f_1`` is the clamped Euler-Bernoulli estimate of mode 1 (:func:`clamped_estimates`); the
+    model's exact mode 1, which :func:`build_model` uses, lies within a few per cent of it for a
+    clamped base and below it for a soft one, so the bound is never above the true one by more
+    than that.  0 when the estimate leaves float64 (other checks name such a beam).
+    """
+    try:
+        f1 = float(clamped_estimates(rig, 1)[0])
+    except (OverflowError, ZeroDivisionError, ValueError):
+        return 0.0
+    return MIN_NORMAL_BETA_S * math.pi * f1 if math.isfinite(f1) and f1 > 0 else 0.0
+
+
 def _root_hinge(rig: dict[str, Any]) -> float:
     """Position [m] of the first moving hinge (0 for a soft base)."""
     if rig["base"] == "soft":
@@ -216,6 +240,9 @@ def _root_hinge(rig: dict[str, Any]) -> float:
 _MASS_KEYS = ("thickness", "width", "rho", "length")
 #: The keys the section's bending stiffness ``E width thickness^3 / 12`` comes from.
 _SECTION_KEYS = ("E", "width", "thickness")
+#: The physical keys a beam's model is built from; a build that fails names the one furthest
+#: from its default (:func:`models._base.furthest_from_default`).
+_BUILD_KEYS = ("E", "rho", "width", "thickness", "length", "base_k1", "base_k3")
 
 
 def _check_segment_inertia(rig: dict[str, Any], error: ErrorFn) -> None:
@@ -247,7 +274,17 @@ def _check_segment_inertia(rig: dict[str, Any], error: ErrorFn) -> None:
         seg = seg[seg > 0]
         m = np.float64(params.mass_per_length) * seg
         b = np.float64(params.width)
-        smallest = float(np.min(np.concatenate([m, m * seg**2 / 12.0, m * b**2 / 12.0])))
+        inertias = np.concatenate([m, m * seg**2 / 12.0, m * b**2 / 12.0])
+        smallest = float(np.min(inertias))
+    if not np.all(np.isfinite(inertias)):
+        # length = 1e300: I_yy = m s^2 / 12 overflowed, and the build was refused naming the
+        # table alone ("key 'rig': ... (34, 'Numerical result out of range')", round 9)
+        key = furthest_from_default(rig, _MASS_KEYS, RIG_SCHEMA)
+        error(f"rig.{key}", rig[key],
+              f"a segment's mass and principal inertias must be finite (kg, kg m^2); they "
+              f"overflow here (mass {float(np.max(m)):.3g} kg): a smaller {key} (the others "
+              f"are rig.{', rig.'.join(k for k in _MASS_KEYS if k != key)})")
+        return
     if not smallest > MJ_MINVAL:
         key = min(_MASS_KEYS, key=lambda k: rig[k] / RIG_SCHEMA[k].default)
         error(f"rig.{key}", rig[key],
@@ -364,9 +401,32 @@ class CantileverRig(Rig):
                   "Nyquist frequency ring for the whole record and fold into the band, where no "
                   "mode of the truth is (measured: the default beam's mode 8, 12456 Hz, at "
                   "344 Hz at 12.8 kHz, and ls_sindy's mode 1 off 3300 %)")
+        # C = beta K with beta subnormal or 0 is the undamped chain refused above, in a number
+        # that has lost its digits (round 8: damping_ratio = 5e-324 gave beta = 0, the truth's
+        # damping ratios 0 and the damping scores inf, with no reason given)
+        undamped = ("an undamped chain in all but name (C = beta K under float64's smallest "
+                    f"normal number, {MIN_NORMAL_BETA_S:.4g} s)")
+        if 0 < rig["damping_beta"] < MIN_NORMAL_BETA_S:
+            error("rig.damping_beta", rig["damping_beta"],
+                  f"expected 0 (derived from damping_ratio) or at least {MIN_NORMAL_BETA_S:.4g} "
+                  f"s: below it {undamped}")
+        zeta_min = _least_damping_ratio(rig)
+        if rig["damping_beta"] == 0 and 0 < rig["damping_ratio"] < zeta_min:
+            error("rig.damping_ratio", rig["damping_ratio"],
+                  f"expected in [{zeta_min:.4g}, 1): below it beta = 2 zeta_1 / omega_1 (mode 1 "
+                  f"about {zeta_min / MIN_NORMAL_BETA_S / math.pi:.4g} Hz by Euler-Bernoulli) is "
+                  f"{undamped}")
         if rig["damping_ratio"] > 0 and rig["damping_beta"] > 0:
             error("rig.damping_beta", rig["damping_beta"],
                   "allowed: only one damping form; set rig.damping_ratio = 0 to give damping_beta")
+        if rig["base"] == "stiff":
+            # a clamped base has no spring: base_k1 = 5000 was accepted and ignored (round 9);
+            # a value at its default is what a table written out whole lists
+            for key in ("base_k1", "base_k3"):
+                if rig[key] != RIG_SCHEMA[key].default:
+                    error(f"rig.{key}", rig[key],
+                          "read only with base = 'soft' (the clamped base has no spring): "
+                          "remove it or set rig.base = 'soft'")
         if rig["base"] == "soft" and rig["joint_offset"] == 0:
             error("rig.joint_offset", rig["joint_offset"],
                   "allowed: > 0 with base = 'soft' (the base hinge needs a stub of beam to move)")
@@ -476,7 +536,13 @@ class CantileverRig(Rig):
         try:
             stepping = build_model(rig, simulation, excitation).stepping
         except (ValueError, ArithmeticError, np.linalg.LinAlgError) as e:
-            raise RigError(f"the beam cannot be built from these parameters: {e}") from None
+            # named: the key furthest from its default (round 9: length = 1e100 and a soft
+            # base_k1 = 1e100 were refused naming the table 'rig' alone)
+            keys = tuple(k for k in _BUILD_KEYS if rig[k] > 0)
+            key = furthest_from_default(rig, keys, RIG_SCHEMA)
+            raise RigError(f"the beam cannot be built from these parameters ({e}); rig.{key} "
+                           f"lies furthest from its default {RIG_SCHEMA[key].default:g}",
+                           key=f"rig.{key}", value=rig[key]) from None
         if simulation["timestep"] > 0:
             step_key, step_value = "simulation.timestep", simulation["timestep"]
         # accuracy alone asks ceil(pi / 0.49) = 7 substeps (RK4) or ceil(pi / 0.109) = 29

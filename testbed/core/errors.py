@@ -89,7 +89,16 @@ class InputError(TestbedError):
 
 
 class RigError(TestbedError):
-    """A rig cannot be built or simulated as asked (e.g. a linkage that cannot close)."""
+    """A rig cannot be built or simulated as asked (e.g. a linkage that cannot close).
+
+    ``key`` and ``value``, when given, name the setting a scenario's refusal blames
+    (``"rig.length"``); without them the refusal names the ``rig`` table.
+    """
+
+    def __init__(self, message: str, key: str | None = None, value: object = None) -> None:
+        super().__init__(message)
+        self.key = key
+        self.value = value
 
 
 class IdentificationError(TestbedError):

@@ -699,6 +699,10 @@ def _read_sep005_file(path: Path) -> _Raw:
     except _DuplicateKey as e:
         raise MeasuredDataError(path, f"key {e.args[0]!r} is given twice in one object; give each "
                                       "key once") from None
+    except ValueError as e:  # an integer of over 4,300 digits: Python's int conversion limit
+        # (round 9: an internal error of `identify`); no SEP-005 value needs one
+        raise MeasuredDataError(path, f"not a SEP-005 JSON file ({str(e).split(':')[0]}: a "
+                                      "number of thousands of digits)") from None
     return _parse_sep005(path, content)
 
 
@@ -838,10 +842,15 @@ def _read_csv(path: Path) -> _Raw:
     head = lines[0][1]
     delim = next((d for d in (",", ";", "\t") if d in head), None)
 
-    def split(line: str) -> list[str]:
-        return next(csv.reader([line], delimiter=delim)) if delim else line.split()
+    def split(line: str, lineno: int) -> list[str]:
+        try:
+            return next(csv.reader([line], delimiter=delim)) if delim else line.split()
+        except csv.Error as e:  # a field over csv's limit (a line of 10 MB): csv.Error, an
+            # internal error of `identify` (round 9)
+            raise MeasuredDataError(path, f"line {lineno}: {e} characters; a number or a "
+                                          "column name is far shorter") from None
 
-    header = [_HEADER.match(h).groupdict() for h in split(head)]  # type: ignore[union-attr]
+    header = [_HEADER.match(h).groupdict() for h in split(head, lines[0][0])]  # type: ignore[union-attr]
     names = [h["name"] for h in header]
     if any(not n for n in names) or len(set(names)) != len(names):
         # the one at fault, not every name: a header of 3,000 columns made a 40 kB line
@@ -854,7 +863,7 @@ def _read_csv(path: Path) -> _Raw:
     check_record_size(path, len(lines) - 1, max(1, len(names) - sum(n.lower() in TIME_NAMES for n in names)))
     rows = []
     for lineno, line in lines[1:]:
-        cells = split(line)
+        cells = split(line, lineno)
         if len(cells) != len(names):
             raise MeasuredDataError(path, f"line {lineno} has {len(cells)} fields, the header {len(names)}")
         try:

@@ -54,7 +54,7 @@ from testbed.core.errors import RigError, ScenarioError
 from testbed.core.kinds import metric_names, metric_range
 from testbed.core.schema import Field, near_miss, validate_header, validate_table, validate_variant
 from testbed.pipeline.plugins import IDENTIFIERS, RIGS
-from testbed.pipeline.signal_chain import SIGNAL_SCHEMAS, check_signal, rig_auto_keys
+from testbed.pipeline.signal_chain import SIGNAL_SCHEMAS, check_keys_used, check_signal, rig_auto_keys
 
 #: Scenario and study names: a safe file stem (no path separators, not "." or "..").
 NAME_PATTERN = r"[A-Za-z0-9_][A-Za-z0-9_.-]{0,127}"
@@ -485,6 +485,7 @@ def scenario_from_dict(raw: dict[str, Any], *, file: str = "<dict>", stem: str |
             raise ScenarioError(file, key, "auto", f"{allowed}; 'auto' resolved it to {rules[key]}")
         raise ScenarioError(file, key, value, allowed)
 
+    check_keys_used(rig_cls.kind, raw.get("signal", {}), signal, chain_error)
     record = rig_cls.record(simulation)
     if record is not None:
         check_signal(rig_cls.kind, signal, *record, chain_error)
@@ -556,6 +557,8 @@ def check_rig_cost(rig_cls: Any, rig_params: dict[str, Any], simulation: dict[st
     try:
         cost = rig_cls.cost(rig_params, simulation, excitation)
     except RigError as e:
+        if getattr(e, "key", None):
+            raise ScenarioError(file, e.key, e.value, str(e)) from None
         raise ScenarioError(file, "rig", allowed=str(e)) from None
     if cost is not None:
         check_cost(cost, file)

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -138,6 +138,16 @@ ErrorFn = Callable[[str, Any, str], None]
 
 
 @dataclass(frozen=True)
+class KeyUse:
+    """When a chain reads a key: only while ``switch`` (another key of the table) satisfies
+    ``reads``, described in words by ``when`` (e.g. ``"derivatives = 'estimated'"``)."""
+
+    switch: str
+    reads: Callable[[Any], bool]
+    when: str
+
+
+@dataclass(frozen=True)
 class SignalChain:
     """The signal chain of one rig kind: its ``[signal]`` schema, its checks, its function.
 
@@ -158,6 +168,10 @@ class SignalChain:
         Keys whose ``"auto"`` the rig resolves from its nominal geometry when the scenario is
         loaded (:func:`testbed.pipeline.scenario.resolve_auto_signal`), so ``measure`` and
         ``check`` see numbers; other ``"auto"`` values the chain resolves from the record.
+    used_when : dict of str to KeyUse
+        Keys that only one setting of another key makes the chain read (the Savitzky-Golay
+        ``window`` only with ``derivatives = "estimated"``): :func:`check_keys_used` refuses
+        them given otherwise.
     """
 
     kind: str
@@ -165,6 +179,7 @@ class SignalChain:
     measure: Callable[[Dataset, Mapping[str, Any]], Measurement]
     check: Callable[[Mapping[str, Any], float, int, ErrorFn], None] | None = None
     rig_auto: tuple[str, ...] = ()
+    used_when: Mapping[str, KeyUse] = field(default_factory=dict)
 
 
 #: Signal chain per rig kind, filled by :func:`register_signal_chain` (this module registers
@@ -192,6 +207,39 @@ def register_signal_chain(chain: SignalChain) -> SignalChain:
 def rig_auto_keys(kind: str) -> tuple[str, ...]:
     """Keys of the kind's ``[signal]`` table whose ``"auto"`` the rig resolves (:class:`SignalChain`)."""
     return _chain(kind).rig_auto
+
+
+def check_keys_used(kind: str, given: Mapping[str, Any], cfg: Mapping[str, Any],
+                    error: ErrorFn) -> None:
+    """Refuse a key the table gives which the chain will not read (:attr:`SignalChain.used_when`).
+
+    Parameters
+    ----------
+    kind : str
+        The rig kind whose chain runs.
+    given : mapping
+        The ``[signal]`` table as written (before defaults are filled in).
+    cfg : mapping
+        The same table validated, defaults filled in.
+    error : callable
+        ``error(key, value, allowed)``, called on the first problem (it raises).
+
+    Notes
+    -----
+    Rule: a key given with a value other than its default, while the key it depends on is set
+    so that the chain does not read it, is refused (``signal.window = 301`` with recorded
+    derivatives was accepted and ignored).  A key given at its default is accepted: a table
+    written out whole (a family member, a run read back) lists every key at its default.
+    """
+    chain = _chain(kind)
+    for key, use in chain.used_when.items():
+        if key not in given or given[key] == chain.schema[key].default:
+            continue
+        if not use.reads(cfg[use.switch]):
+            error(f"signal.{key}", given[key],
+                  f"read only with {use.when}; here signal.{use.switch} = "
+                  f"{cfg[use.switch]!r}, so it would be ignored: remove it or set "
+                  f"signal.{use.switch}")
 
 
 def check_signal(kind: str, cfg: Mapping[str, Any], fs: float, n_samples: int,
@@ -741,9 +789,18 @@ def measure_dynamical(dataset: Dataset, cfg: Mapping[str, Any]) -> Measurement:
                        noise_std=noise)
 
 
-register_signal_chain(SignalChain("structural", STRUCTURAL_SIGNAL_SCHEMA, measure_structural,
-                                  check_structural, rig_auto=("highpass_hz", "lowpass_hz")))
-register_signal_chain(SignalChain("mechanical", MECHANICAL_SIGNAL_SCHEMA, measure_mechanical,
-                                  check_mechanical))
-register_signal_chain(SignalChain("dynamical", DYNAMICAL_SIGNAL_SCHEMA, measure_dynamical,
-                                  check_dynamical))
+_ESTIMATED = KeyUse("derivatives", lambda v: v == "estimated", "derivatives = 'estimated'")
+_LOWPASS = KeyUse("derivatives", lambda v: v == "lowpass", "derivatives = 'lowpass'")
+
+register_signal_chain(SignalChain(
+    "structural", STRUCTURAL_SIGNAL_SCHEMA, measure_structural, check_structural,
+    rig_auto=("highpass_hz", "lowpass_hz"),
+    used_when={"lowpass_order": KeyUse("lowpass_hz", lambda v: v == "auto" or v > 0,
+                                       "lowpass_hz > 0 (0 = no low-pass)")}))
+register_signal_chain(SignalChain(
+    "mechanical", MECHANICAL_SIGNAL_SCHEMA, measure_mechanical, check_mechanical,
+    used_when={"window": _ESTIMATED, "polyorder": _ESTIMATED, "cutoff_hz": _LOWPASS,
+               "filter_order": _LOWPASS, "edge_fit_s": _LOWPASS, "edge_fit_order": _LOWPASS}))
+register_signal_chain(SignalChain(
+    "dynamical", DYNAMICAL_SIGNAL_SCHEMA, measure_dynamical, check_dynamical,
+    used_when={"window": _ESTIMATED, "polyorder": _ESTIMATED}))

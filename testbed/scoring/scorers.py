@@ -658,7 +658,10 @@ def score_structural(dataset: Dataset, data: Measurement, clean: Measurement, mo
     definite, negative damping, an unstable pole) and a simulation that raises, turns
     non-finite or blows up (:func:`simulate_scored`) are recorded in ``Scores.failures``;
     the TRAC of a failed simulation is NaN.  The other scores are still computed (NaN where
-    the model gives no modes), as diagnostics of what went wrong.
+    the model gives no modes), as diagnostics of what went wrong.  A score left undefined
+    without any of those failures names why: ``"stiffness"``, identified modes at 0 Hz (no
+    damping ratio) while the truth's are all above it; ``"trac"``, a channel whose simulated or
+    reference acceleration is zero (0 / 0).
     """
     truth = dataset.truth_as(StructuralTruth)
     i0 = data.free_start
@@ -702,6 +705,19 @@ def score_structural(dataset: Dataset, data: Measurement, clean: Measurement, mo
         v["mac"] = worst(per_mode["mac"], "min")
         v["freq_error"] = worst(per_mode["freq_error"], "max")
         v["damping_error"] = worst(per_mode["damping_error"], "max")
+    if not failures:
+        # undefined scores name why (round 9: pysindy with threshold = 1e300 zeroed every
+        # coefficient; TRAC and the damping ratios were NaN with no failure given)
+        still = ~(np.isfinite(f_id) & (f_id > 0))
+        if np.any(still) and np.all(f_true > 0):
+            failures["stiffness"] = (f"non-physical: {int(still.sum())} identified mode(s) without "
+                                     "stiffness (0 Hz: an eigenvalue of M^-1 K at or below 0), "
+                                     "which have no damping ratio; the truth's modes are all "
+                                     "above 0 Hz")
+        if not np.all(np.isfinite(trac)):
+            flat = [data.channels[i] for i in np.flatnonzero(~np.isfinite(trac))]
+            failures["trac"] = (f"TRAC undefined on {', '.join(flat)}: the simulated or the "
+                                "reference acceleration is zero there")
     d.update(scored_modes=m, **{f"{k}_per_mode": np.asarray(x) for k, x in per_mode.items()})
     d.update(mac=mac, pair=pair, f_id=f_id, f_true=f_true, z_id=z_id, z_true=z_true)
     if truth.force_map is not None:

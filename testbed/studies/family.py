@@ -46,6 +46,8 @@ from __future__ import annotations
 import math
 import os
 import re
+import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -396,9 +398,14 @@ def _cantilever_rules(fam: Family, rig: dict[str, Any], exc: dict[str, Any],
         pos = np.minimum(np.floor(pos * 1e4) / 1e4, L)
         rig["sensors"] = [float(x) for x in pos]
     n_sensors = len(rig["sensors"]) or 3
-    if "base_k1_ratio" in derived:
+    if "base_k1_ratio" in derived and rig["base"] == "soft":
         EI = rig["E"] * rig["width"] * rig["thickness"] ** 3 / 12.0
         rig["base_k1"] = float(derived["base_k1_ratio"] * EI / L)
+    if rig["base"] != "soft":
+        # a clamped base reads no spring: its keys are left at their defaults (None: left out
+        # of the member), which the rig refuses otherwise (round 9); the ratio and fraction
+        # are drawn all the same, so the other draws do not move
+        rig["base_k1"] = rig["base_k3"] = None
     if exc.get("location") == "sensor":
         sensors = rig["sensors"] or [L / 3, 2 * L / 3, L]
         exc["location"] = float(sensors[int(rng.integers(len(sensors)))])
@@ -406,8 +413,6 @@ def _cantilever_rules(fam: Family, rig: dict[str, Any], exc: dict[str, Any],
         if rig["base"] == "soft":
             q = peak_base_rotation(rig, exc)
             rig["base_k3"] = float(derived["cubic_fraction"] * rig["base_k1"] / q**2)
-        else:
-            rig["base_k3"] = 0.0  # no base spring: the fraction means nothing (drawn all the same)
     for key in ("highpass_hz", "lowpass_hz"):
         if signal.get(key) == "auto":
             # the lab's cut-offs from the member's nominal geometry, by the rig's one rule
@@ -499,9 +504,42 @@ def member_dict(fam: Family, k: int, attempt: int, tables: dict[str, dict[str, A
     return raw
 
 
-def family_members(fam: Family) -> list[Scenario]:
-    """Every member of a family, in index order (see the module docs for the drawing rule)."""
-    return [draw_member(fam, k)[0] for k in range(fam.members)]
+#: A family of more members than this is announced before it is drawn, and its progress given
+#: at every tenth of it (:func:`family_members`): each member is drawn and validated as a
+#: scenario, 36-270 ms a member on the shared machine (round 7), so 10,000 members took 6-45
+#: minutes in silence before a sweep's first line.  The shipped families have 8-40 members.
+ANNOUNCE_MEMBERS = 100
+#: Seconds a member may take to draw under load (round 7's slowest, 0.27 s), for the announcement.
+SLOW_MEMBER_S = 0.27
+
+
+def family_members(fam: Family, progress: Callable[[str], None] | None = None) -> list[Scenario]:
+    """Every member of a family, in index order (see the module docs for the drawing rule).
+
+    Parameters
+    ----------
+    fam : Family
+        The family.
+    progress : callable, optional
+        ``progress(line)`` receives one line before a family of more than
+        :data:`ANNOUNCE_MEMBERS` members is drawn, with the time it may take, and one at every
+        tenth of its members (the ``testbed`` command prints them to standard error).
+    """
+    loud = progress is not None and fam.members > ANNOUNCE_MEMBERS
+    if loud:
+        most = fam.members * SLOW_MEMBER_S
+        progress(f"drawing family {fam.name}: {fam.members} members, each validated as a "
+                 f"scenario (up to {SLOW_MEMBER_S:g} s a member: up to "
+                 + (f"{most / 60:.0f} min)" if most >= 60 else f"{most:.0f} s)"))
+    step = math.ceil(fam.members / 10)
+    t0 = time.perf_counter()
+    members = []
+    for k in range(fam.members):
+        members.append(draw_member(fam, k)[0])
+        if loud and ((k + 1) % step == 0 or k + 1 == fam.members):
+            progress(f"family {fam.name}: {k + 1} of {fam.members} members drawn "
+                     f"({time.perf_counter() - t0:.0f} s)")
+    return members
 
 
 # --------------------------------------------------------------------------- writing

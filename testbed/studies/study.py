@@ -46,6 +46,7 @@ scenario's method, so a study fails at load, not in its hundredth cell.
 from __future__ import annotations
 
 import os
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -187,13 +188,17 @@ def _no_duplicates(values: list, file: str, key: str) -> None:
         seen.add(v)
 
 
-def load_study(name_or_path: str | os.PathLike) -> Study:
+def load_study(name_or_path: str | os.PathLike,
+               progress: Callable[[str], None] | None = None) -> Study:
     """Read and validate a study file (a path, or a name in ``studies/``).
 
     Parameters
     ----------
     name_or_path : str or os.PathLike
         A ``.toml`` path, or the name of a shipped study (its file stem).
+    progress : callable, optional
+        Receives a line before a large family is drawn and as it is drawn
+        (:func:`testbed.studies.family.family_members`).
 
     Returns
     -------
@@ -212,12 +217,14 @@ def load_study(name_or_path: str | os.PathLike) -> Study:
     file = str(path)
     _check_stem(path, "study", STUDY_DIR)
     raw = read_toml_file(path, "study")
-    return study_from_dict(raw, file=file, base=path.parent, stem=path.stem)
+    return study_from_dict(raw, file=file, base=path.parent, stem=path.stem, progress=progress)
 
 
 def study_from_dict(raw: dict[str, Any], *, file: str = "<dict>", base: Path | None = None,
-                    stem: str | None = None) -> Study:
-    """Validate a study given as a dict of TOML tables (paths relative to ``base``)."""
+                    stem: str | None = None,
+                    progress: Callable[[str], None] | None = None) -> Study:
+    """Validate a study given as a dict of TOML tables (paths relative to ``base``); ``progress``
+    as in :func:`load_study`."""
     base = base if base is not None else Path.cwd()
     head = validate_header(raw, sections=SECTIONS, header="study", schema=STUDY_SCHEMA, file=file,
                            stem=stem, other=("scenario", "a scenario file (it has [scenario]), not a "
@@ -271,7 +278,7 @@ def study_from_dict(raw: dict[str, Any], *, file: str = "<dict>", base: Path | N
                        head, families, file)
     for fam in families:
         try:
-            scenarios.extend(family_members(fam))
+            scenarios.extend(family_members(fam, progress))
         except ScenarioError as e:  # no member drawn: the study file's ranges, named as such
             if not e.file.startswith("<family"):
                 raise

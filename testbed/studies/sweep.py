@@ -42,7 +42,7 @@ from typing import Any
 
 from joblib import Parallel, delayed, parallel_config
 
-from testbed.core.errors import IdentificationError, InputError
+from testbed.core.errors import IdentificationError, InputError, show_value
 from testbed.core.provenance import git_commit, versions
 from testbed.pipeline.cache import DatasetCache
 from testbed.pipeline.generate import noise_free_scenario
@@ -416,6 +416,27 @@ def _say(msg: str, verbose: bool) -> None:
         print(msg, file=sys.stderr, flush=True)
 
 
+def _check_rows_match_cells(rows: list[dict[str, Any]], cells: list[Cell], results: Path) -> None:
+    """Refuse a finished row whose scenario, identifier, noise, seed or hyperparameters differ
+    from those of the grid's cell its ``cell`` key names (round 9: a row's scenario edited by
+    hand to another name was kept as that cell's result, under the other name, and its cell
+    skipped).  Nothing is touched: the user fixes or removes the row, or gives a new path."""
+    by_key = {c.key: c for c in cells}
+    for r in rows:
+        cell = by_key.get(r.get("cell"))
+        if cell is None:
+            continue  # a cell no longer in the grid: dropped at consolidation, as documented
+        want = {"scenario": cell.scenario.name, "identifier": cell.identifier,
+                "noise": cell.noise, "seed": cell.seed,
+                "params": json.dumps(cell.params, sort_keys=True)}
+        for col, value in want.items():
+            if r.get(col) != value:
+                raise InputError(f"results {results}: the row of cell {r['cell']} has {col} = "
+                                 f"{show_value(r.get(col))}, where the study's cell has "
+                                 f"{show_value(value)} (edited by hand?); correct or remove the "
+                                 "row, or give a new path (the file is left as it is)")
+
+
 def run_sweep(study: Study | str | os.PathLike, jobs: int = 1, dask_address: str | None = None,
               results: str | os.PathLike | None = None, cache_dir: str | os.PathLike | None = None,
               *, retry_failed: bool = False, verbose: bool = True,
@@ -484,6 +505,7 @@ def run_sweep(study: Study | str | os.PathLike, jobs: int = 1, dask_address: str
         raise InputError(f"results {results}: holds rows of study {', '.join(map(repr, others))}, "
                          f"not {study.name!r}; expected a results file of study {study.name!r} or "
                          "a new path (its rows would be dropped)")
+    _check_rows_match_cells(previous, cells, results)
     done = {r["cell"] for r in previous if not (retry_failed and r["status"] == "failed")}
     todo = [c for c in cells if c.key not in done]
     skipped = study.skipped()

@@ -409,3 +409,26 @@ def test_smoke_study_on_the_real_rigs(tmp_path, dataset_cache):
             # the cubic scores are NaN without a cubic truth (a stiff base)
             cubic = ("K3_force_error", "K3_accel_error")
             assert all(math.isfinite(r[m]) for m in metric_names(kind) if m in r and m not in cubic)
+
+
+@pytest.mark.parametrize("column, value", [("scenario", "ghost"), ("identifier", "toy_other"),
+                                           ("noise", 7.0), ("seed", 5)])
+def test_a_resumed_sweep_refuses_a_row_edited_to_another_cell(toy_dir, tmp_path, column, value):
+    # round 9: a row's scenario edited by hand was kept as its cell's result, under the other
+    # name, and the cell skipped
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    from testbed.core.errors import InputError
+
+    res, cache = tmp_path / "r.parquet", tmp_path / "c"
+    study = load_study(write_study(toy_dir, "edited", ["toy_fit"], seeds=(0,), noise=(0.0,)))
+    run_sweep(study, results=res, cache_dir=cache, verbose=False)
+    table = pq.read_table(res)
+    rows = table.to_pylist()
+    rows[0][column] = value
+    pq.write_table(pa.Table.from_pylist(rows, schema=table.schema), res)
+    before = res.read_bytes()
+    with pytest.raises(InputError, match=f"the row of cell {rows[0]['cell']} has {column} = "):
+        run_sweep(study, results=res, cache_dir=cache, verbose=False)
+    assert res.read_bytes() == before
