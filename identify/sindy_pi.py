@@ -157,8 +157,8 @@ ROLLOUT_ATOL = 1e-4
 
 #: The record rule's rest baseline [-]: a combination whose simulation of the whole record
 #: leaves some coordinate farther (RMSE) from the measured angles than that coordinate's RMSE
-#: about its first measured value does not replay the record
-#: (:meth:`_ImplicitMechanical._replays_record`).  1: the model that never moves.
+#: about its first measured value does not replay the record (closed chains:
+#: :meth:`_ImplicitMechanical._replays_record`).  1: the model that never moves.
 REPLAY_REST_RATIO = 1.0
 
 
@@ -1046,7 +1046,14 @@ class _ImplicitMechanical(Identifier):
         coordinate's RMSE about its first measured value (``REPLAY_REST_RATIO`` = 1) follows
         the record less than a model that never moves does: it is no model of that record,
         however finite.  The error is compared only with that baseline of the record itself,
-        never used to rank (one long simulation ranks by its start state's luck).
+        never used to rank (one long simulation ranks by its start state's luck).  Closed
+        chains only (a loop closure, ``closure_``): the loop holds every coordinate near the
+        record, whereas an open chain's free coordinate (a cart on its rail under replayed
+        forces) integrates the error of the chain's start-rate estimate (cart-pole
+        ``cp9_light_pole_short`` at 1 %: 0.054 m/s, every one of 9 pairs 1.2-15 x farther
+        than rest on the cart, good and bad alike), so rest is no baseline there.  Measured on
+        round 9's five-bars: the pairs that lost their loop from the true start 1.1-6.9 x
+        rest on some coordinate, those that held it 0.015-0.06 x.
         """
         try:
             sim = model.simulate(data.x[:, 0], data.xd[:, 0], data.t, data.u, self._step(),
@@ -1055,6 +1062,8 @@ class _ImplicitMechanical(Identifier):
             return False
         if not np.isfinite(sim).all():
             return False
+        if getattr(self, "closure_", None) is None:
+            return True
         x = np.asarray(data.x, dtype=float)
         err = np.sqrt(np.mean((sim - x) ** 2, axis=1))
         rest = np.sqrt(np.mean((x - x[:, :1]) ** 2, axis=1))

@@ -92,6 +92,9 @@ def test_a_finite_replay_farther_than_rest_is_not_a_replay():
     one_off[2] = 2.0 * rest[2] - data.x[2]       # only one coordinate farther than rest
     m = SINDyPI()
     m.input_hold_ = "zoh"
+    m.closure_ = None          # an open chain (a cart-pole): the rest baseline does not apply
+    assert m._replays_record(_Replay(mirrored), data)
+    m.closure_ = object()      # a closed chain: the loop holds every coordinate near the record
     assert m._replays_record(_Replay(data.x), data)
     assert m._replays_record(_Replay(rest), data)       # rest itself: the bar, met
     assert not m._replays_record(_Replay(mirrored), data)
