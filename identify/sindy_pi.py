@@ -956,6 +956,7 @@ class _ImplicitMechanical(Identifier):
             if not np.isfinite(min(scores)):
                 self.record_rule_ = "not reached: no shortlisted combination simulated its segments"
                 self.record_replays_ = np.zeros(len(models), dtype=bool)
+                self._record_finite = self.record_replays_
                 raise NoSimulationError("no shortlisted model combination could be simulated")
             scores = self._record_rule(scores, models, data)
             size = [sum(int(sw.nnz[t, c]) for t, c in cb) for cb in combos]
@@ -1037,9 +1038,14 @@ class _ImplicitMechanical(Identifier):
         return out
 
     def _replays_record(self, model: ImplicitModel, data: Measurement) -> bool:
+        """Whether ``model`` replays the record: both parts of :meth:`_replay_status`."""
+        return all(self._replay_status(model, data))
+
+    def _replay_status(self, model: ImplicitModel, data: Measurement) -> tuple[bool, bool]:
         """Whether ``model`` simulates the whole record, from its first measured state under
-        the measured inputs, without losing its loop closure or diverging, and stays nearer
-        the record than rest does (angles only; see :meth:`_record_rule`).
+        the measured inputs, without losing its loop closure or diverging; and whether that
+        simulation stays nearer the record than rest does (angles only; see
+        :meth:`_record_rule`).
 
         Rest: the record's first measured state held for the whole record.  A simulation
         whose RMSE against the measured angles exceeds, on some coordinate, that
@@ -1059,15 +1065,15 @@ class _ImplicitMechanical(Identifier):
             sim = model.simulate(data.x[:, 0], data.xd[:, 0], data.t, data.u, self._step(),
                                  self.input_hold_, angles_only=True).x
         except IdentificationError:
-            return False
+            return False, False
         if not np.isfinite(sim).all():
-            return False
+            return False, False
         if getattr(self, "closure_", None) is None:
-            return True
+            return True, True
         x = np.asarray(data.x, dtype=float)
         err = np.sqrt(np.mean((sim - x) ** 2, axis=1))
         rest = np.sqrt(np.mean((x - x[:, :1]) ** 2, axis=1))
-        return bool(np.all(err <= REPLAY_REST_RATIO * rest))
+        return True, bool(np.all(err <= REPLAY_REST_RATIO * rest))
 
     def _record_rule(self, scores: list[float], models: list[ImplicitModel],
                      data: Measurement) -> list[float]:
@@ -1083,7 +1089,10 @@ class _ImplicitMechanical(Identifier):
         farther from the measured angles than rest (:meth:`_replays_record`), is not a model
         of that record and is not chosen while another can be; the error of that simulation is
         not used to rank (one long simulation ranks by the luck of its start state, see
-        :meth:`_rollout_error`), only its failure.  The rest baseline since 2026-11-27
+        :meth:`_rollout_error`), only its failure.  Where none stays nearer than rest but
+        some do not diverge, those are kept (the divergence test alone, the rule before the
+        rest baseline) and ``record_replays_`` is all False, so the unpruned refit is tried
+        (:meth:`SINDyPI._unpruned_refit`).  The rest baseline since 2026-11-27
         (round 9): on ``fb9_asym3`` and ``fb9_mixed`` at 1 % (seed 9) the one pair left by the
         divergence test followed the record 4.7 / 4.0 x worse than rest (0.157 rad on a 0.07
         rad swing) and lost its loop from the true start; with it none is left, the unpruned
@@ -1100,16 +1109,23 @@ class _ImplicitMechanical(Identifier):
             self.record_replays_ = None
             self.record_rule_ = "user-set: off (rollout scores alone)"
             return scores
-        ok = np.array([bool(np.isfinite(s)) and self._replays_record(m, data)
-                       for s, m in zip(scores, models, strict=True)])
+        status = np.array([self._replay_status(m, data) if np.isfinite(s) else (False, False)
+                           for s, m in zip(scores, models, strict=True)], dtype=bool)
+        finite, ok = status[:, 0], status[:, 0] & status[:, 1]
         self.record_replays_ = ok
+        self._record_finite = finite
         head = (f"{int(ok.sum())} of {ok.size} shortlisted combinations simulate the whole record "
                 "from its first measured state")
         if not ok.any():
+            if finite.any() and not finite.all():
+                # the divergence test alone, as before the rest baseline
+                self.record_rule_ = (f"{head} nearer than rest: of the {int(finite.sum())} that "
+                                     "do not diverge none excluded, the others excluded")
+                return [s if k else np.inf for s, k in zip(scores, finite, strict=True)]
             self.record_rule_ = f"{head}: none excluded (the rollout scores alone)"
             return scores
-        self.record_rule_ = (f"{head}: the others (closure lost or diverged) excluded"
-                             if not ok.all() else f"{head}: none excluded")
+        self.record_rule_ = (f"{head}: the others (closure lost, diverged or farther than "
+                             "rest) excluded" if not ok.all() else f"{head}: none excluded")
         return [s if k else np.inf for s, k in zip(scores, ok, strict=True)]
 
     def _rollout_error(self, model: ImplicitModel, data: Measurement, i0: int,
@@ -1510,6 +1526,7 @@ class SINDyPI(_ImplicitMechanical):
         self._smoothed = None
         self._replay = None
         self._unpruned = False
+        self._record_finite = None
         try:
             super().fit(data)
         except NoModelError as exc:
@@ -1540,8 +1557,11 @@ class SINDyPI(_ImplicitMechanical):
         segments, :class:`NoSimulationError`), the fit is redone over
         the library without pruning (the replay rule's pool: on a record that leaves the
         equations non-unique the pruning takes its coincidental dependencies for kinematic
-        identities, see :meth:`_replay_check`), and kept if one of its combinations simulates
-        the whole record; else the first fit stays (a scored failure, if it fails).  Not when
+        identities, see :meth:`_replay_check`), and kept if one of its combinations replays
+        the whole record nearer than rest, or, where none of the first fit's simulated the
+        whole record at all, if one simulates it; else the first fit stays (whose record
+        rule then excludes the combinations that diverge, as before the rest baseline; a
+        scored failure, if it fails).  Not when
         the user set ``prune_tol`` to None already or ``record_replay = False``.  Returns
         whether the unpruned fit was kept.
         Measured (2026-11-26): fbsine__010 (the paper's sine input on family geometry 010 at
@@ -1564,7 +1584,12 @@ class SINDyPI(_ImplicitMechanical):
             return False
         finally:
             self._unpruned = False
-        if not self.record_replays_.any():
+        # kept where one of its combinations replays the record nearer than rest; or, where
+        # none of the first fit's even simulated it, one simulates it (the divergence test)
+        first_finite = first.get("_record_finite")
+        never = first_finite is None or not np.any(first_finite)
+        if not (self.record_replays_.any()
+                or (never and np.any(getattr(self, "_record_finite", False)))):
             self.__dict__.update(first)
             self.record_rule_ = (f"{head}; none of the unpruned library's either: first fit kept")
             return False

@@ -101,6 +101,11 @@ def test_a_finite_replay_farther_than_rest_is_not_a_replay():
     assert not m._replays_record(_Replay(one_off), data)
     out = m._record_rule([1e-4, 2e-4], [_Replay(mirrored), _Replay(data.x)], data)
     assert out == [np.inf, 2e-4] and m.record_replays_.tolist() == [False, True]
+    # none nearer than rest: the divergence test alone (the rule before), and record_replays_
+    # all False, so the unpruned library is tried (SINDyPI._unpruned_refit)
+    out = m._record_rule([1e-4, 2e-4], [_Replay(mirrored), _Model(diverges=True)], data)
+    assert out == [1e-4, np.inf] and not m.record_replays_.any()
+    assert "none excluded, the others excluded" in m.record_rule_
 
 
 def test_user_turns_the_rule_off():
