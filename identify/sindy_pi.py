@@ -1119,8 +1119,9 @@ class _ImplicitMechanical(Identifier):
         if not ok.any():
             if finite.any() and not finite.all():
                 # the divergence test alone, as before the rest baseline
-                self.record_rule_ = (f"{head} nearer than rest: of the {int(finite.sum())} that "
-                                     "do not diverge none excluded, the others excluded")
+                self.record_rule_ = (f"{head} nearer than rest; {int(finite.sum())} simulate it "
+                                     "without diverging: the others excluded (the divergence "
+                                     "test alone)")
                 return [s if k else np.inf for s, k in zip(scores, finite, strict=True)]
             self.record_rule_ = f"{head}: none excluded (the rollout scores alone)"
             return scores

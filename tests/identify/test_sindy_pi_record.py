@@ -105,7 +105,7 @@ def test_a_finite_replay_farther_than_rest_is_not_a_replay():
     # all False, so the unpruned library is tried (SINDyPI._unpruned_refit)
     out = m._record_rule([1e-4, 2e-4], [_Replay(mirrored), _Model(diverges=True)], data)
     assert out == [1e-4, np.inf] and not m.record_replays_.any()
-    assert "none excluded, the others excluded" in m.record_rule_
+    assert "1 simulate it without diverging: the others excluded" in m.record_rule_
 
 
 def test_user_turns_the_rule_off():
