@@ -11,8 +11,8 @@ large inertias, a pose near the transmission limit.  Where the paper's pose (1.7
 not assemble or leaves the transmission range, the start pose is the rig's own rule
 (``models.fivebar.geometry.auto_start_pose``), written out.  Each geometry is written twice:
 ``fb9_<case>`` with the noise chain (rates by the low-pass) and ``fb9_<case>_rec`` clean with the
-recorded rates (``fivebar_sine_replay``), scored on the issue's clean bar (1e-4 rad).  Cart-poles: ``cartpole_noise1``'s
-chain with other cart and pole masses, lengths and rail damping.  Kinetics:
+recorded rates (``fivebar_sine_replay``), scored on the issue's clean bar (1e-4 rad).
+Cart-poles: ``cartpole_noise1``'s chain with other cart and pole masses, lengths and rail damping.  Kinetics:
 ``michaelis_menten_noise1``'s weak setup with other Vmax, Km, x0 and influx.
 """
 
