@@ -835,6 +835,10 @@ def _read_csv(path: Path) -> _Raw:
                                       f"{e.start}); save it as UTF-8") from None
     except OSError as e:
         raise MeasuredDataError(path, f"not a text file ({type(e).__name__}: {e})") from None
+    if "\x00" in text:  # UTF-16 without a byte-order mark decodes as UTF-8 with a NUL a character
+        # (round 9: "'\x000\x00.' is not a number"); no number or name holds a NUL
+        raise MeasuredDataError(path, f"holds a NUL byte (offset {text.index(chr(0))}): not UTF-8 "
+                                      "text (UTF-16, or binary?); save it as UTF-8")
     lines = [(k + 1, ln) for k, ln in enumerate(text.splitlines())
              if ln.strip() and not ln.lstrip().startswith("#")]
     if len(lines) < 2:

@@ -922,7 +922,13 @@ def test_a_csv_with_a_byte_order_mark_reads_its_time_column(tmp_path):
                                                        "save it as UTF-8"),
     # a decimal comma under a semicolon delimiter: say so
     (b"t;x [m]\n0,0;1,5\n0,01;2,5\n", "line 2: '0,0' is not a number (a decimal comma? write a point)"),
-], ids=["latin1", "decimal-comma"])
+    # UTF-16 without a byte-order mark decodes as UTF-8 with NULs: was "'\x000\x00.' is not a
+    # number" (round 9); a NUL in a channel name was read as written
+    ("t,x [m]\n0,1\n0.01,2\n".encode("utf-16-le"), "holds a NUL byte (offset 1): not UTF-8 text "
+                                                    "(UTF-16, or binary?); save it as UTF-8"),
+    (b"t,x\x00y [m]\n0,1\n0.01,2\n", "holds a NUL byte (offset 3): not UTF-8 text (UTF-16, or "
+                                     "binary?); save it as UTF-8"),
+], ids=["latin1", "decimal-comma", "utf16-no-bom", "nul-in-name"])
 def test_csv_text_the_reader_cannot_take_says_what_to_do(tmp_path, content, fragment):
     from testbed.pipeline.importers import MeasuredDataError, read_measured
 
