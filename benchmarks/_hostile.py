@@ -1,5 +1,5 @@
-"""The malformed-input drivers' one harness (``benchmarks/hostile7.py``, ``hostile8.py``): each case
-runs in-process under a time limit and ends ``ok`` or as a finding.
+"""The malformed-input drivers' one harness (``benchmarks/hostile7.py``, ``hostile8.py``,
+``hostile9.py``): each case runs in-process under a time limit and ends ``ok`` or as a finding.
 
 ``ok`` is a result the driver's ``check`` finds nothing wrong in, or a
 :class:`~testbed.core.errors.TestbedError` in one line (the user's mistake, refused); a hang, a
@@ -58,6 +58,21 @@ def classify(fn: Callable[[], Any], timeout_s: int,
         dt = time.perf_counter() - t0
         if dt > SLOW_S:
             print(f"  (slow case: {dt:.1f} s)", file=sys.stderr)
+
+
+def scored_finding(result: Any) -> str | None:
+    """What is wrong with a scenario run's verdict, or None: a pass with a NaN score or a
+    failure, or NaN scores without a failure naming why (NaN only: an infinite error, a true
+    coefficient of 1e-300 missed, fails every bar on it)."""
+    import math
+
+    nan = sorted(k for k, v in result.scores.values.items() if isinstance(v, float) and math.isnan(v))
+    failures = result.scores.failures
+    if result.passed and (nan or failures):
+        return f"passed with NaN scores {nan} or failures {sorted(failures)}"
+    if nan and not failures:
+        return f"NaN scores without a failure naming why: {nan[:4]}"
+    return None
 
 
 def run_inprocess(cases: Iterable[tuple[str, Callable[[], Any]]], timeout_s: int,

@@ -177,15 +177,7 @@ def _run(raw: dict, base: str) -> str | None:
     from testbed.pipeline.scenario import scenario_from_dict
     from testbed.scoring.run import run_scenario
 
-    result = run_scenario(scenario_from_dict(raw, file="x.toml", stem=base))
-    # NaN only: an infinite error (a true coefficient of 1e-300 missed) fails every bar on it
-    nan = sorted(k for k, v in result.scores.values.items() if isinstance(v, float) and math.isnan(v))
-    failures = result.scores.failures
-    if result.passed and (nan or failures):
-        return f"passed with NaN scores {nan} or failures {sorted(failures)}"
-    if nan and not failures:
-        return f"NaN scores without a failure naming why: {nan[:4]}"
-    return None
+    return _hostile.scored_finding(run_scenario(scenario_from_dict(raw, file="x.toml", stem=base)))
 
 
 def extreme_cases() -> list[tuple[str, object]]:

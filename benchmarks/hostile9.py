@@ -1,10 +1,7 @@
 """Ninth malformed-input round: generated hostile inputs, counted by family (docs/history.md).
 
-Each case runs in-process; it is a *finding* when it ends in anything but one error line naming
-the file (a :class:`~testbed.core.errors.TestbedError`, status 2 at the command line) or a
-verdict: another exception (an internal error), a hang past its timeout, a line of several
-lines, or -- for a scenario that runs -- a NaN score without a failure naming its reason, or a
-pass with a NaN score or a failure.  Run from the repository root::
+Each case runs in-process and is a *finding* as in ``benchmarks/hostile8.py`` (the harness,
+``benchmarks/_hostile.py``, runs both).  Run from the repository root::
 
     python -m benchmarks.hostile9 [family ...]      # all families when none is named
 
@@ -81,14 +78,7 @@ def _run(raw: dict, base: str, run: bool) -> str | None:
     sc = scenario_from_dict(raw, file="x.toml", stem=base)
     if not run:
         return None
-    result = run_scenario(sc)
-    nan = sorted(k for k, v in result.scores.values.items() if isinstance(v, float) and math.isnan(v))
-    failures = result.scores.failures
-    if result.passed and (nan or failures):
-        return f"passed with NaN scores {nan} or failures {sorted(failures)}"
-    if nan and not failures:
-        return f"NaN scores without a failure naming why: {nan[:4]}"
-    return None
+    return _hostile.scored_finding(run_scenario(sc))
 
 
 def _raw(kind: str):

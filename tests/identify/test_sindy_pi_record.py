@@ -165,18 +165,23 @@ def test_no_combination_simulating_its_segments_is_fitted_again_unpruned(monkeyp
                 m.fit(_Data())
 
 
+def _run_cell(dataset_cache, study_file: str, name: str, noise: float, seed: int):
+    """The scored run of one cell of an unseen round's study (benchmarks/unseen/)."""
+    from testbed.scoring.run import run_scenario
+    from testbed.studies.sweep import expand
+
+    study = load_study(ROUND5.parent / study_file)
+    cell = next(c for c in expand(study)
+                if c.scenario.name == name and c.noise == noise and c.seed == seed)
+    return run_scenario(cell.scenario, dataset=dataset_cache.get(cell.scenario))
+
+
 @pytest.mark.slow
 def test_sine_replay_at_3_percent_whose_segments_never_simulated(dataset_cache):
     # round 7's fbsine__002 at 3 %, seed 4 (benchmarks/unseen/round7_linkages_sine_seeds.toml):
     # no pair of the pruned library simulated its segments (a fit failure until 2026-11-27);
     # the unpruned library's pair scores 0.0078 rad (the bar: the paper's 0.0501)
-    from testbed.scoring.run import run_scenario
-    from testbed.studies.sweep import expand
-
-    study = load_study(ROUND5.parent / "round7_linkages_sine_seeds.toml")
-    cell = next(c for c in expand(study)
-                if c.scenario.name == "fbsine__002" and c.noise == 3.0 and c.seed == 4)
-    r = run_scenario(cell.scenario, dataset=dataset_cache.get(cell.scenario))
+    r = _run_cell(dataset_cache, "round7_linkages_sine_seeds.toml", "fbsine__002", 3.0, 4)
     assert "fitted again over the unpruned library" in r.model.record_rule_
     assert r.passed and r.scores.values["angle_rmse"] < 0.0501
 
@@ -187,12 +192,6 @@ def test_round9_pair_farther_than_rest_is_not_chosen(dataset_cache):
     # 1 %, seed 9: the divergence test left one pair of 9, 0.157 rad from the record on a 0.07
     # rad swing, which lost its loop from the true start at 9.06 s (scored "diverged"); with
     # the rest baseline none is left and the unpruned library's pair scores 0.0030 rad
-    from testbed.scoring.run import run_scenario
-    from testbed.studies.sweep import expand
-
-    study = load_study(ROUND5.parent / "round9_linkages_geometry.toml")
-    cell = next(c for c in expand(study)
-                if c.scenario.name == "fb9_asym3" and c.noise == 1.0 and c.seed == 9)
-    r = run_scenario(cell.scenario, dataset=dataset_cache.get(cell.scenario))
+    r = _run_cell(dataset_cache, "round9_linkages_geometry.toml", "fb9_asym3", 1.0, 9)
     assert "fitted again over the unpruned library" in r.model.record_rule_
     assert r.passed and r.scores.values["angle_rmse"] < 0.0501
