@@ -164,10 +164,8 @@ def cubic_rule(data: Measurement, user: bool | None, fit_band_hz: float | None =
     data : Measurement
     user : bool or None
         The user's ``cubic`` setting; None = by rule.
-    fit_band_hz : float, optional
-        The fit band's cut-off (:func:`identify.structural.fit_band`'s ``cutoff_hz``).
-    peaks : ndarray, optional
-        ``modal_peaks(data).peaks`` [Hz] if the caller has them already (not searched again).
+    fit_band_hz, peaks
+        As :func:`lowest_mode_chirp`, which this calls with them.
 
     Returns
     -------

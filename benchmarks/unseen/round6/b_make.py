@@ -16,6 +16,11 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 L = 0.3175
 SOFT = {"base": "soft", "base_k1": 2000.0, "base_k3": 2.5e9}
+#: materials the later rounds put on the same base beam (E [Pa], rho [kg/m^3])
+AL = {"E": 69e9, "rho": 2700.0}
+TI = {"E": 116e9, "rho": 4500.0}
+BRASS = {"E": 100e9, "rho": 8500.0}
+GFRP = {"E": 20e9, "rho": 1900.0}
 EI = 210e9 * 0.03 * 0.01**3 / 12  # N m^2 of the shipped section
 
 #: name -> (description, rig, simulation, excitation, signal)
@@ -132,7 +137,12 @@ def scenario_text(name: str, desc: str, rig: dict, sim: dict, exc: dict, sig: di
     return "\n".join(out)
 
 
+def write_cases(cases: dict, here: Path, round_no: int) -> None:
+    """Write each case as ``here/<name>.toml`` (a round's scenario files) and say how many."""
+    for name, (desc, rig, sim, exc, sig) in cases.items():
+        (here / f"{name}.toml").write_text(scenario_text(name, desc, rig, sim, exc, sig, round_no))
+    print(f"{len(cases)} scenarios in {here}")
+
+
 if __name__ == "__main__":
-    for name, (desc, rig, sim, exc, sig) in CASES.items():
-        (HERE / f"{name}.toml").write_text(scenario_text(name, desc, rig, sim, exc, sig))
-    print(f"{len(CASES)} scenarios in {HERE}")
+    write_cases(CASES, HERE, 6)

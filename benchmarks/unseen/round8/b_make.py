@@ -19,11 +19,8 @@ HERE = Path(__file__).resolve().parent
 _SPEC = importlib.util.spec_from_file_location("round6_b_make", HERE.parent / "round6" / "b_make.py")
 _ROUND6 = importlib.util.module_from_spec(_SPEC)
 _SPEC.loader.exec_module(_ROUND6)
-SOFT = {"base": "soft", "base_k1": 2000.0, "base_k3": 2.5e9}
-AL = {"E": 69e9, "rho": 2700.0}
-TI = {"E": 116e9, "rho": 4500.0}
-BRASS = {"E": 100e9, "rho": 8500.0}
-GFRP = {"E": 20e9, "rho": 1900.0}
+L, SOFT, AL, TI, BRASS, GFRP = (_ROUND6.L, _ROUND6.SOFT, _ROUND6.AL, _ROUND6.TI, _ROUND6.BRASS,
+                                _ROUND6.GFRP)
 
 
 def even(n: int, length: float) -> list[float]:
@@ -80,12 +77,5 @@ CASES: dict[str, tuple[str, dict, dict, dict, dict]] = {
 }
 
 
-def scenario_text(name: str, desc: str, rig: dict, sim: dict, exc: dict, sig: dict) -> str:
-    """Round 6's writer (the same base beam and tables), labelled round 8."""
-    return _ROUND6.scenario_text(name, desc, rig, sim, exc, sig, round_no=8)
-
-
 if __name__ == "__main__":
-    for name, (desc, rig, sim, exc, sig) in CASES.items():
-        (HERE / f"{name}.toml").write_text(scenario_text(name, desc, rig, sim, exc, sig))
-    print(f"{len(CASES)} scenarios in {HERE}")
+    _ROUND6.write_cases(CASES, HERE, 8)
