@@ -274,3 +274,46 @@ def test_peak_offset_is_zeta_squared():
     assert off[0] == pytest.approx(814.0 * 0.02**2, rel=1e-3)  # zeta^2 f_n for light damping
     assert off[1] == pytest.approx(814.0 * (1 / np.sqrt(1 - 2 * 0.137**2) - 1), rel=1e-12)
     assert np.isinf(off[2]) and np.isnan(off[3])  # 2 zeta^2 >= 1: no spectral peak
+
+
+def test_two_column_solve_is_lstsq():
+    """The decay fit's two-column solve gives numpy lstsq's coefficients: full rank (to
+    round-off of a well-conditioned 2-column QR, 1e-12), rank one and a zero column (lstsq's
+    least-norm answer)."""
+    from identify._modal_damping import _two_column_lstsq
+
+    rng = np.random.default_rng(7)
+    for _ in range(50):
+        A = rng.standard_normal((500, 2)) * rng.uniform(1e-3, 1e3, 2)
+        q = rng.standard_normal(500)
+        ref = np.linalg.lstsq(A, q, rcond=None)[0]
+        assert np.allclose(_two_column_lstsq(A, q), ref, rtol=1e-10, atol=0)
+    q = np.arange(10.0)
+    for A in (np.c_[np.ones(10), -2 * np.ones(10)], np.c_[np.zeros(10), np.ones(10)],
+              np.zeros((10, 2))):
+        ref = np.linalg.lstsq(A, q, rcond=None)[0]
+        assert np.allclose(_two_column_lstsq(A, q), ref, rtol=1e-12, atol=1e-15)
+
+
+@pytest.mark.parametrize("backbone", [False, True])
+def test_decay_jacobian_is_the_residuals_derivative(backbone):
+    """The decay fit's variable-projection Jacobian against central differences of its own
+    residual (step 1e-6 of each parameter's scale: truncation ~1e-12, round-off ~1e-10 of the
+    residual's scale), on a decaying chirp with the chain's transients as nuisance columns."""
+    from scipy.optimize._numdiff import approx_derivative
+
+    from identify._modal_damping import _decay_problem, chain_transients
+
+    fs, w = 12800.0, 2 * np.pi * 180.0
+    t = np.arange(4000) / fs
+    rng = np.random.default_rng(3)
+    q = np.exp(-9.0 * t) * np.cos(w * t + 0.4 * (1 - np.exp(-18.0 * t)) / 18.0 * 40.0)
+    q = q + 1e-3 * rng.standard_normal(t.size)
+    nuisance = chain_transients(np.array([-2 * np.pi * 10.0, -900.0 + 8000.0j]), t)
+    resid, jac, _ = _decay_problem(q, t, backbone, nuisance)
+    for p in ([7.0, 0.99 * w, 30.0], [25.0, 1.02 * w, -50.0], [1e-3, w, 5.0]):
+        p = np.array(p[:3 if backbone else 2])
+        scale = np.array([1e-2 * w, 1e-3 * w, 1e-3 * w])[:len(p)]
+        fd = approx_derivative(resid, p, method="3-point", rel_step=1e-6 * scale / np.abs(p))
+        J = jac(p)
+        assert np.max(np.abs(J - fd)) <= 1e-6 * np.max(np.abs(fd))
