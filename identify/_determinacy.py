@@ -74,12 +74,71 @@ def determinacy_bound(rows: Callable[[np.ndarray], np.ndarray], x: np.ndarray,
     sigma = np.asarray(sigma, dtype=float).reshape(-1, 1)
     if not np.any(sigma > 0.0):
         return 0.0
+    dG = _noise_gram(rows, x, sigma, base, norms)
+    if not np.all(np.isfinite(dG)):  # a perturbed record overflowed the terms: no bound
+        return float("nan")
+    noise = float(np.linalg.eigvalsh(dG)[-1])
+    return noise / gap if gap > 0.0 else float("inf")
+
+
+def _noise_gram(rows: Callable[[np.ndarray], np.ndarray], x: np.ndarray, sigma: np.ndarray,
+                base: np.ndarray, norms: np.ndarray) -> np.ndarray:
+    """Mean ``D^T D`` over :data:`DRAWS` draws of white noise of std ``sigma`` (n_states, 1)
+    added to ``x``; ``D`` the change of the rows normalised by ``norms`` from ``base``."""
     rng = np.random.default_rng(SEED)
-    dG = np.zeros((theta.shape[1], theta.shape[1]))
+    dG = np.zeros((base.shape[1], base.shape[1]))
     for _ in range(DRAWS):
         d = np.asarray(rows(x + sigma * rng.standard_normal(x.shape)), dtype=float) / norms - base
         dG += d.T @ d
-    if not np.all(np.isfinite(dG)):  # a perturbed record overflowed the terms: no bound
-        return float("nan")
-    noise = float(np.linalg.eigvalsh(dG / DRAWS)[-1])
-    return noise / gap if gap > 0.0 else float("inf")
+    return dG / DRAWS
+
+
+def noise_residual_ratio(rows: Callable[[np.ndarray], np.ndarray], x: np.ndarray,
+                         sigma: np.ndarray) -> tuple[float, np.ndarray]:
+    """How far the best equation of some terms is from holding, in units of what the record's
+    noise alone leaves of it.
+
+    The best equation of the terms is the eigenvector ``v`` of the smallest eigenvalue of their
+    normalised Gram ``G`` (total least squares).  If the terms hold an equation of the noise-free
+    states, noise of the record's level leaves it the residual ``v^T dG v`` in expectation
+    (``dG`` as in :func:`determinacy_bound`, the same draws); an equation missing a needed term
+    leaves in addition its own misfit.  The ratio ``lambda_min(G) / (v^T dG v)`` is therefore
+    about 1 (below: the fit also absorbs part of the noise) for terms that hold an equation to
+    within the noise, and grows with the misfit beyond it.
+
+    Parameters
+    ----------
+    rows : callable
+        ``rows(x)`` -> regression rows of the terms, shape (n_rows, q), from states ``x``.
+    x : ndarray, shape (n_states, n_samples)
+        The states [unit of each state].
+    sigma : ndarray, shape (n_states,)
+        White-noise standard deviation of each state [unit of each state].
+
+    Returns
+    -------
+    ratio : float
+        ``lambda_min(G) / (v^T dG v)`` [-]; ``inf`` for noise-free states or zero noise
+        residual, NaN for fewer than two terms, an all-zero or non-finite column.
+    w : ndarray, shape (q,)
+        The equation ``v`` in the terms' original units (``v / norms``), or NaN.
+    """
+    theta = np.asarray(rows(x), dtype=float)
+    q = theta.shape[1]
+    nan = (float("nan"), np.full(q, np.nan))
+    if q < 2 or not np.all(np.isfinite(theta)):
+        return nan
+    norms = np.linalg.norm(theta, axis=0)
+    if np.any(norms == 0.0):
+        return nan
+    base = theta / norms
+    vals, vecs = np.linalg.eigh(base.T @ base)
+    v = vecs[:, 0]
+    sigma = np.asarray(sigma, dtype=float).reshape(-1, 1)
+    if not np.any(sigma > 0.0):
+        return float("inf"), v / norms
+    dG = _noise_gram(rows, x, sigma, base, norms)
+    if not np.all(np.isfinite(dG)):
+        return nan
+    noise = float(v @ dG @ v)
+    return (max(float(vals[0]), 0.0) / noise if noise > 0.0 else float("inf")), v / norms
