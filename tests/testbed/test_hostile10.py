@@ -115,3 +115,125 @@ def test_blank_lines_between_uff_blocks_are_read(tmp_path):
     p = tmp_path / "blank.uff"
     p.write_bytes(data[:i] + b"\n   \n" + data[i:])
     assert read_measured(p).signals.keys() == read_measured(tmp_path / "d.uff").signals.keys()
+
+
+# ------------------------------------------------------------------ round 10: combinations
+
+@pytest.mark.parametrize("method, params, key, fragment", [
+    # each fitted the same model to the bit as without the key (benchmarks/hostile10.py combos)
+    ("pysindy", {"optimizer": "stlsq", "n_models": 5}, "n_models", "read only with optimizer = 'ensemble'"),
+    ("pysindy", {"optimizer": "stlsq", "seed": 3}, "seed",
+     "here identify.optimizer = 'stlsq', identify.weak = False"),
+    ("pysindy_sr3", {"threshold": 0.1}, "threshold", "read only with optimizer = 'stlsq' or 'ensemble'"),
+    ("pysindy", {"optimizer": "ensemble", "regularizer": "L0"}, "regularizer", "optimizer = 'sr3'"),
+    ("pysindy", {"n_windows": 50}, "n_windows", "read only with weak = true"),
+    ("sgd_sindy", {"gradient": "full", "batch_size": 64}, "batch_size", "gradient = 'minibatch'"),
+    ("sgd_sindy", {"gradient": "full", "random_state": 3}, "random_state", "gradient = 'minibatch'"),
+    ("sgd_sindy", {"cubic": False, "l1_threshold": 0.5}, "l1_threshold", "the cubic library"),
+    ("sgd_sindy", {"cubic": True, "l1": "none", "l1_debias": 0.1}, "l1_debias", "l1 = 'cubic'"),
+    ("sgd_sindy", {"cubic": False, "cubic_form": "direction"}, "cubic_form", "the cubic library"),
+    ("sgd_sindy", {"eigen": False, "freq_range": [5.0, 2000.0]}, "freq_range", "eigen = true"),
+    ("sgd_sindy", {"anneal": False, "alpha_max": 0.5}, "alpha_max", "anneal = true"),
+    ("sgd_sindy", {"decay_hold": False, "decay_backbone": False}, "decay_backbone", "decay_hold = true"),
+    ("ls_sindy", {"cubic": False, "decay_backbone": False}, "decay_backbone", "the cubic library"),
+    ("sgd_sindy_coefficients", {"mass_learning_rate": 0.1}, "mass_learning_rate",
+     "mass_update = 'symmetry' or 'eq6'"),
+    ("sindy_pi_dynamical", {"weak_windows": 50}, "weak_windows", "formulation = 'weak'"),
+    ("sindy_pi_dynamical", {"library": ["1", "x", "dx", "x*dx"], "degree": 3}, "degree",
+     "the default library"),
+])
+def test_a_hyperparameter_the_identifier_would_not_read_is_refused_naming_its_switch(method, params,
+                                                                                   key, fragment):
+    from testbed.core.errors import ScenarioError
+    from testbed.pipeline.plugins import IDENTIFIERS
+
+    with pytest.raises(ScenarioError) as e:
+        IDENTIFIERS.get(method).validate_hyperparameters(params, file="s.toml")
+    assert e.value.key == f"identify.{key}" and fragment in str(e.value), str(e.value)
+    assert "so it would be ignored" in str(e.value) and "\n" not in str(e.value)
+
+
+@pytest.mark.parametrize("method, params", [
+    ("pysindy_ensemble", {"n_models": 5, "seed": 3}),   # read by the ensemble
+    ("pysindy", {"weak": True, "seed": 3}),              # the weak form's random domain centres
+    ("pysindy", {"optimizer": "stlsq", "n_models": 20}),  # at its default: a table written whole
+    ("sgd_sindy", {"l1_threshold": 0.5}),                 # cubic by rule (None) may read it
+    ("sgd_sindy", {"gradient": "full", "steps_per_epoch": 3}),  # read: steps of the full gradient
+    ("sindy_pi_dynamical", {"formulation": "weak", "weak_windows": 50}),
+])
+def test_a_hyperparameter_the_identifier_reads_is_still_accepted(method, params):
+    from testbed.pipeline.plugins import IDENTIFIERS
+
+    full = IDENTIFIERS.get(method).validate_hyperparameters(params)
+    assert all(full[k] == v for k, v in params.items())
+
+
+def test_an_identifier_built_in_python_with_an_unread_setting_is_refused_at_fit_time():
+    from identify.pysindy_field import PySINDyField
+    from testbed.core.errors import HyperparameterError
+
+    with pytest.raises(HyperparameterError, match="pysindy.n_models"):
+        PySINDyField(optimizer="sr3", n_models=5).check_params()
+
+
+# ------------------------------------------------------------------ round 10: Dask
+
+def _server(reply: bytes):
+    import socket
+    import threading
+
+    srv = socket.socket()
+    srv.bind(("127.0.0.1", 0))
+    srv.listen(4)
+
+    def serve():  # every connection answered at once, until the socket is closed
+        while True:
+            try:
+                conn, _ = srv.accept()
+            except OSError:
+                return
+            with conn:
+                conn.sendall(reply)
+
+    threading.Thread(target=serve, daemon=True).start()
+    return srv, f"tcp://127.0.0.1:{srv.getsockname()[1]}"
+
+
+@pytest.mark.parametrize("reply", [b"HTTP/1.0 200 OK\r\n\r\n", b""])
+def test_a_dask_address_held_by_another_server_is_refused_before_the_sweep(reply):
+    # an HTTP reply was read as a message length (MemoryError: 3 EiB, an internal error of
+    # `sweep`); a server closing at once failed after the sweep's first line
+    from testbed.cli import check_dask_address
+    from testbed.core.errors import InputError
+
+    srv, address = _server(reply)
+    with srv, pytest.raises(InputError) as e:
+        check_dask_address(address)
+    assert "no Dask scheduler answers there" in str(e.value) and "\n" not in str(e.value)
+
+
+def test_a_running_dask_scheduler_passes_the_check():
+    import asyncio
+
+    from distributed import Scheduler
+
+    from testbed.cli import check_dask_address
+
+    async def main():
+        async with Scheduler(host="127.0.0.1", port=0, dashboard_address=None) as s:
+            await asyncio.get_running_loop().run_in_executor(None, check_dask_address, s.address)
+
+    asyncio.run(main())
+
+
+def test_jobs_given_with_dask_is_refused_naming_both(tmp_path, capsys):
+    # the Dask backend runs as many cells as the cluster has workers: --jobs was ignored
+    from testbed.cli import main
+
+    study = tmp_path / "s.toml"
+    study.write_text('[study]\nname = "s"\nscenarios = ["michaelis_menten"]\nnoise = [0.0]\n'
+                     'seeds = [0]\nidentifiers = ["sindy_pi_dynamical"]\n')
+    status = main(["sweep", str(study), "--jobs", "2", "--dask", "tcp://127.0.0.1:1",
+                   "--results", str(tmp_path / "r.parquet")])
+    err = [x for x in capsys.readouterr().err.splitlines() if x.startswith("error")]
+    assert status == 2 and len(err) == 1 and "--jobs 2: not with --dask" in err[0], err
