@@ -118,6 +118,9 @@ COMBOS = [
     ("pysindy_pi", {"selection": "holdout"}, "rollout_segments", 3),
 ]
 COMBOS = [c for c in COMBOS if c[2]]
+#: Settings every fit of an identifier starts from: the five-bar's library cannot describe the
+#: cart-pole (refused at load, which would hide every case).
+BASE_PARAMS = {"sindy_pi": {"library": "generic"}, "pysindy_pi": {"library": "generic"}}
 
 
 def _raw(kind: str):
@@ -157,17 +160,22 @@ def _combo(m: str, switch: dict, key: str, value) -> str | None:
 
     def fit(params):
         raw = copy.deepcopy(raw0)
-        raw["identify"] = {"method": m, **params}
+        raw["identify"] = {"method": m, **BASE_PARAMS.get(m, {}), **params}
         return run_scenario(scenario_from_dict(raw, file="x.toml", stem=base))
 
+    bkey = (m, tuple(sorted((k, repr(v)) for k, v in switch.items())))
+    if bkey not in _BASELINES:
+        try:
+            _BASELINES[bkey] = fit(switch)
+        except TestbedError as e:  # the case would test nothing
+            _BASELINES[bkey] = f"the switch alone is refused: {str(e)[:160]}"
+    ref = _BASELINES[bkey]
+    if isinstance(ref, str):
+        return ref
     try:
         alt = fit({**switch, key: value})
     except TestbedError:
         return None  # refused in one line (the harness checks the line)
-    bkey = (m, tuple(sorted((k, repr(v)) for k, v in switch.items())))
-    if bkey not in _BASELINES:
-        _BASELINES[bkey] = fit(switch)
-    ref = _BASELINES[bkey]
     if ref.model is None or alt.model is None:
         return None  # a scored failure before a model: nothing to compare
     if _fitted(ref.model) == _fitted(alt.model):
@@ -177,9 +185,10 @@ def _combo(m: str, switch: dict, key: str, value) -> str | None:
 
 
 def combo_cases() -> list[tuple[str, object]]:
+    only = os.environ.get("HOSTILE10_IDENTIFIERS", "")  # comma-separated, to rerun a few
     return [(f"{m}: {switch} + {key} = {value!r}",
              lambda m=m, s=switch, k=key, v=value: _combo(m, s, k, v))
-            for m, switch, key, value in COMBOS]
+            for m, switch, key, value in COMBOS if not only or m in only.split(",")]
 
 
 # ------------------------------------------------------------------ edges of the numbers
@@ -289,11 +298,12 @@ def roundtrip_cases(work: Path) -> list[tuple[str, object]]:
     def set_attr(where, key, fn):
         def edit(f):
             obj = f if where == "/" else (first_signal(f) if where == "signal" else f[where])
-            if key == "positions":
+            k, change = key, fn
+            if k == "positions":
                 obj = positioned(f)
                 if obj is None:  # no positions in this rig's file: the edit is a change of unit
-                    obj, key, fn = first_signal(f), "unit", lambda v: "mm"
-            obj.attrs[key] = fn(obj.attrs[key])
+                    obj, k, change = first_signal(f), "unit", lambda v: "mm"
+            obj.attrs[k] = change(obj.attrs[k])
         return edit
 
     def del_attr(where, key):
@@ -313,6 +323,10 @@ def roundtrip_cases(work: Path) -> list[tuple[str, object]]:
         if d.shape[0] > 1:
             d[...] = d[()][::-1]
             d.attrs["channels"] = list(d.attrs["channels"])[::-1]
+        else:  # one channel a signal (Michaelis-Menten): two signals' samples swapped
+            a, b = list(f["measured"].values())[:2]
+            xa, xb = a[()], b[()]
+            a[...], b[...] = xb, xa
 
     content = {  # edits of content, not rehashed: each must be refused
         "fs x2": set_attr("/", "fs", lambda v: v * 2),

@@ -138,6 +138,11 @@ def test_blank_lines_between_uff_blocks_are_read(tmp_path):
     ("ls_sindy", {"cubic": False, "decay_backbone": False}, "decay_backbone", "the cubic library"),
     ("sgd_sindy_coefficients", {"mass_learning_rate": 0.1}, "mass_learning_rate",
      "mass_update = 'symmetry' or 'eq6'"),
+    ("sindy_pi", {"selection": "holdout", "n_rollout": 5}, "n_rollout", "selection = 'rollout'"),
+    ("sindy_pi", {"column_lowpass_hz": 0.0, "column_lowpass_order": 2}, "column_lowpass_order",
+     "a column low-pass"),
+    ("sindy_pi", {"formulation": "strong", "weak_degree": 2}, "weak_degree", "formulation = 'weak'"),
+    ("sindy_pi", {"ensemble_seed": 4}, "ensemble_seed", "read only with ensemble > 0"),
     ("sindy_pi_dynamical", {"weak_windows": 50}, "weak_windows", "formulation = 'weak'"),
     ("sindy_pi_dynamical", {"library": ["1", "x", "dx", "x*dx"], "degree": 3}, "degree",
      "the default library"),
@@ -160,6 +165,8 @@ def test_a_hyperparameter_the_identifier_would_not_read_is_refused_naming_its_sw
     ("sgd_sindy", {"l1_threshold": 0.5}),                 # cubic by rule (None) may read it
     ("sgd_sindy", {"gradient": "full", "steps_per_epoch": 3}),  # read: steps of the full gradient
     ("sindy_pi_dynamical", {"formulation": "weak", "weak_windows": 50}),
+    ("sindy_pi", {"n_rollout": 5, "weak_degree": 2}),     # selection and formulation by rule
+    ("sindy_pi", {"ensemble": 3, "ensemble_seed": 4}),
 ])
 def test_a_hyperparameter_the_identifier_reads_is_still_accepted(method, params):
     from testbed.pipeline.plugins import IDENTIFIERS
@@ -237,3 +244,24 @@ def test_jobs_given_with_dask_is_refused_naming_both(tmp_path, capsys):
                    "--results", str(tmp_path / "r.parquet")])
     err = [x for x in capsys.readouterr().err.splitlines() if x.startswith("error")]
     assert status == 2 and len(err) == 1 and "--jobs 2: not with --dask" in err[0], err
+
+
+# ------------------------------------------------------------------ round 10: float edges
+
+@pytest.mark.parametrize("rig, key", [
+    # Vmax x0 overflowed: solve_ivp's "Required step size is less than spacing between
+    # numbers" was a RuntimeError, an internal error
+    ({"x0": 1.7976931348623157e308}, "rig.x0"),
+    ({"Vmax": 1e308}, "rig.Vmax"),
+])
+def test_a_kinetics_rate_that_overflows_is_refused_naming_its_key(rig, key):
+    import copy
+
+    from testbed.core.errors import ScenarioError
+    from testbed.pipeline.scenario import SCENARIO_DIR, _read_toml, scenario_from_dict
+
+    raw = copy.deepcopy(_read_toml(SCENARIO_DIR / "michaelis_menten.toml"))
+    raw["rig"].update(rig)
+    with pytest.raises(ScenarioError) as e:
+        scenario_from_dict(raw, file="m.toml", stem="michaelis_menten")
+    assert e.value.key == key and "is finite" in str(e.value) and "\n" not in str(e.value)
