@@ -265,3 +265,18 @@ def test_a_kinetics_rate_that_overflows_is_refused_naming_its_key(rig, key):
     with pytest.raises(ScenarioError) as e:
         scenario_from_dict(raw, file="m.toml", stem="michaelis_menten")
     assert e.value.key == key and "is finite" in str(e.value) and "\n" not in str(e.value)
+
+
+def test_a_study_table_with_an_unread_setting_names_its_own_keys(tmp_path):
+    # the switch was named "identify.library", a key the study file does not have
+    from testbed.core.errors import ScenarioError
+    from testbed.studies.study import study_from_dict
+
+    raw = {"study": {"name": "s", "scenarios": ["michaelis_menten"], "noise": [0.0], "seeds": [0],
+                     "identifiers": ["sindy_pi_dynamical"]},
+           "identifiers": {"sindy_pi_dynamical": {"library": ["1", "x", "dx", "x*dx"], "degree": 3}}}
+    with pytest.raises(ScenarioError) as e:
+        study_from_dict(raw, file="s.toml", base=tmp_path)
+    assert e.value.key == "identifiers.sindy_pi_dynamical.degree"
+    assert "here identifiers.sindy_pi_dynamical.library = " in str(e.value)
+    assert "identify." not in str(e.value)
