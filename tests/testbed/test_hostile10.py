@@ -143,6 +143,7 @@ def test_blank_lines_between_uff_blocks_are_read(tmp_path):
      "a column low-pass"),
     ("sindy_pi", {"formulation": "strong", "weak_degree": 2}, "weak_degree", "formulation = 'weak'"),
     ("sindy_pi", {"ensemble_seed": 4}, "ensemble_seed", "read only with ensemble > 0"),
+    ("pysindy_pi", {"rollout_segments": 3}, "rollout_segments", "selection = 'rollout'"),
     ("sindy_pi_dynamical", {"weak_windows": 50}, "weak_windows", "formulation = 'weak'"),
     ("sindy_pi_dynamical", {"library": ["1", "x", "dx", "x*dx"], "degree": 3}, "degree",
      "the default library"),
