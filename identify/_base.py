@@ -48,7 +48,7 @@ import dataclasses
 import inspect
 import itertools
 import sys
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import fields
 from typing import Any, ClassVar, TextIO
 
@@ -56,7 +56,7 @@ import numpy as np
 
 from testbed.core.errors import HyperparameterError, ScenarioError
 from testbed.core.measurement import Measurement, Trajectory
-from testbed.core.schema import ErrorFn, Field, validate_table
+from testbed.core.schema import ErrorFn, Field, KeyUse, check_keys_used, validate_table
 
 
 class Identifier:
@@ -70,6 +70,10 @@ class Identifier:
     #: Keys of ``Measurement.prior`` the identifier may read; ``testbed identify --prior`` refuses
     #: any other (a mistyped key would be ignored).  None: undeclared (a plugin), any key.
     prior_keys: ClassVar[tuple[str, ...] | None] = None
+    #: Hyperparameters read only under a setting of others (``n_models`` only with the ensemble
+    #: optimizer): one given at another value than its default while the identifier would not
+    #: read it is refused (:func:`testbed.core.schema.check_keys_used`), not ignored.
+    used_when: ClassVar[Mapping[str, KeyUse | tuple[KeyUse, ...]]] = {}
 
     @classmethod
     def declared_hyperparameters(cls) -> dict[str, Field]:
@@ -127,6 +131,7 @@ class Identifier:
         def error(name: str, value: Any, allowed: str) -> None:
             raise ScenarioError(file, f"{section}.{name}", value, allowed)
 
+        check_keys_used(params, full, cls.declared_hyperparameters(), cls.used_when, section, error)
         cls.check_hyperparameters(full, error)
         return full
 

@@ -35,7 +35,7 @@ from identify.structural import (
 )
 from testbed.core.errors import DivergenceError, IdentificationError
 from testbed.core.measurement import Measurement
-from testbed.core.schema import Field
+from testbed.core.schema import Field, KeyUse
 
 #: The mass prior: which key of ``data.prior`` gives the mass scale [kg] (shared with
 #: sgd_sindy and sindy_pi_linear).
@@ -269,6 +269,12 @@ class LeastSquaresSINDy(StructuralIdentifier):
         "decay_hold": DECAY_HOLD_FIELD,
         "decay_backbone": DECAY_BACKBONE_FIELD,
         "lower_modes": LOWER_MODES_FIELD,
+    }
+    #: Keys the fit reads only under another setting (benchmarks/hostile10.py ``combos``; the
+    #: cubic rule, ``cubic`` None, may choose the cubic library).
+    used_when: ClassVar[dict[str, KeyUse]] = {
+        "decay_backbone": KeyUse(("cubic", "decay_hold"), lambda c, d: c is not False and d,
+                                 "the cubic library (cubic = true or the rule) and decay_hold = true"),
     }
 
     @classmethod

@@ -44,7 +44,7 @@ from identify.ls_sindy import MASS_PRIOR_FIELD
 from identify.structural import StructuralIdentifier, build_library, mass_prior_value, matrices_from_coef
 from testbed.core.errors import IdentificationError
 from testbed.core.measurement import Measurement
-from testbed.core.schema import ErrorFn, Field
+from testbed.core.schema import ErrorFn, Field, KeyUse
 
 OPTIMIZERS = ("stlsq", "sr3", "ensemble")
 
@@ -122,6 +122,18 @@ class PySINDyField(StructuralIdentifier):
         "n_windows": Field(int, 200, min=4, doc="test-function windows of the weak form (pysindy's K)"),
         "cubic": Field(bool, False, doc="add the cubic displacement features x_j^3 (strong form only)"),
         "mass_prior": MASS_PRIOR_FIELD,
+    }
+    #: What each optimizer reads (:meth:`_make_optimizer`); the seed draws the ensemble's bags
+    #: and the weak form's random domain centres (pysindy's WeakPDELibrary), nothing else.
+    used_when: ClassVar[dict[str, KeyUse]] = {
+        "threshold": KeyUse("optimizer", lambda v: v != "sr3", "optimizer = 'stlsq' or 'ensemble'"),
+        "alpha": KeyUse("optimizer", lambda v: v != "sr3", "optimizer = 'stlsq' or 'ensemble'"),
+        "reg_weight_lam": KeyUse("optimizer", lambda v: v == "sr3", "optimizer = 'sr3'"),
+        "regularizer": KeyUse("optimizer", lambda v: v == "sr3", "optimizer = 'sr3'"),
+        "n_models": KeyUse("optimizer", lambda v: v == "ensemble", "optimizer = 'ensemble'"),
+        "seed": KeyUse(("optimizer", "weak"), lambda opt, weak: opt == "ensemble" or weak,
+                       "optimizer = 'ensemble' or weak = true"),
+        "n_windows": KeyUse("weak", lambda v: v, "weak = true"),
     }
 
     def __init__(self, optimizer: str = "stlsq", threshold: float = 0.001, alpha: float = 1e-8,

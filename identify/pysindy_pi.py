@@ -32,7 +32,7 @@ from identify import IDENTIFIERS
 from identify._implicit import Sweep, _errors
 from identify.sindy_pi import COMMON_HYPERPARAMETERS, _ImplicitMechanical, ordered_fields
 from testbed.core.errors import IdentificationError
-from testbed.core.schema import Field
+from testbed.core.schema import Field, KeyUse
 
 #: Training samples pysindy's SINDyPI is given when ``stride`` is left to the rule: one OSQP
 #: problem per candidate, each carrying every sample.  Measured on fivebar_multisine (32
@@ -169,6 +169,11 @@ class PySINDyPI(_ImplicitMechanical):
         "stride", "val_fraction", "selection", "selection_rtol", "selection_atol", "n_rollout",
         "rollout_segments", "prune_tol", "sim_dt", "reconcile", "column_lowpass_hz",
         "column_lowpass_order", "edge_trim", "input_hold"))  # __init__ order, for the guide
+    #: Keys the fit reads only under another setting (benchmarks/hostile10.py ``combos``:
+    #: ``rollout_segments = 3`` under the held-out selection fitted the same model to the bit).
+    used_when: ClassVar[dict[str, KeyUse]] = {
+        "rollout_segments": KeyUse("selection", lambda v: v == "rollout", "selection = 'rollout'"),
+    }
 
     def __init__(self, library: Any = "fivebar", lhs: Sequence[str] | None = None,
                  reg_weight_lam: float = 1e-6, tol: float = 1e-5, max_iter: int = 10000,

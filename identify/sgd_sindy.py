@@ -81,7 +81,7 @@ from identify.structural import (
 )
 from testbed.core.errors import IdentificationError, TestbedError
 from testbed.core.measurement import Measurement, Trajectory
-from testbed.core.schema import ErrorFn, Field
+from testbed.core.schema import ErrorFn, Field, KeyUse
 from testbed.numerics.initial_state import MAX_ITERATIONS, fit_initial_state
 from testbed.numerics.shapes import trac
 
@@ -862,6 +862,31 @@ class SGDSINDy(SGDSINDyBase):
                                           "warm start's unexplained share of the record, and "
                                           "more than 1 %"),
         "lower_modes": LOWER_MODES_FIELD,
+    }
+    #: Keys the fit reads only under another setting (measured 2026-11-27, benchmarks/hostile10.py
+    #: ``combos``: each given otherwise fitted the same model to the bit).  ``cubic = None`` is
+    #: the rule, which may choose the cubic library, so it reads them all.
+    used_when: ClassVar[dict[str, KeyUse | tuple[KeyUse, ...]]] = {
+        "batch_size": KeyUse("gradient", lambda v: v == "minibatch", "gradient = 'minibatch'"),
+        "random_state": KeyUse("gradient", lambda v: v == "minibatch", "gradient = 'minibatch'"),
+        "l1": KeyUse("cubic", lambda v: v is not False, "the cubic library (cubic = true or the rule)"),
+        "l1_threshold": (KeyUse("cubic", lambda v: v is not False,
+                                "the cubic library (cubic = true or the rule)"),
+                         KeyUse("l1", lambda v: v == "cubic", "l1 = 'cubic'")),
+        "l1_debias": (KeyUse("cubic", lambda v: v is not False,
+                             "the cubic library (cubic = true or the rule)"),
+                      KeyUse("l1", lambda v: v == "cubic", "l1 = 'cubic'")),
+        "cubic_form": KeyUse("cubic", lambda v: v is not False,
+                             "the cubic library (cubic = true or the rule)"),
+        "decay_backbone": KeyUse(("cubic", "decay_hold"), lambda c, d: c is not False and d,
+                                 "the cubic library (cubic = true or the rule) and decay_hold = true"),
+        "epsilon": KeyUse("eigen", lambda v: v, "eigen = true"),
+        "alpha_init": KeyUse("eigen", lambda v: v, "eigen = true"),
+        "eigen_hold": KeyUse("eigen", lambda v: v, "eigen = true"),
+        "n_modes": KeyUse("eigen", lambda v: v, "eigen = true"),
+        "freq_range": KeyUse("eigen", lambda v: v, "eigen = true"),
+        "alpha_max": KeyUse("anneal", lambda v: v, "anneal = true"),
+        "beta": KeyUse("anneal", lambda v: v, "anneal = true"),
     }
 
     @classmethod

@@ -23,7 +23,7 @@ from identify._sgd_penalties import (
 from identify.sgd_sindy import SGDSINDyBase, shared_fields
 from identify.structural import build_library, mass_prior_value, matrices_from_coef
 from testbed.core.measurement import Measurement
-from testbed.core.schema import Field
+from testbed.core.schema import Field, KeyUse
 
 #: The penalty terms, in the order of ``alphas_`` and the history's columns.
 TERMS = ("sym", "eig", "l1")
@@ -206,6 +206,12 @@ class SGDSINDyCoefficients(SGDSINDyBase):
         "mass_update": Field(str, "lstsq", choices=("lstsq", "symmetry", "eq6"),
                              doc="how the diagonal masses are learned"),
         **shared_fields("anneal", "alpha_max", "random_state"),
+    }
+    #: Keys the fit reads only under another setting (benchmarks/hostile10.py ``combos``).
+    used_when: ClassVar[dict[str, KeyUse]] = {
+        "mass_learning_rate": KeyUse("mass_update", lambda v: v != "lstsq",
+                                     "mass_update = 'symmetry' or 'eq6'"),
+        "epsilon": KeyUse("eigen", lambda v: v, "eigen = true"),
     }
 
     def __init__(self, epochs: int = 100, batch_size: int = 128, learning_rate: float | None = None,

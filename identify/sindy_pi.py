@@ -146,7 +146,7 @@ from identify._weak import check_window, weak_matrix
 from identify.library import Library, fivebar_library, generic_mechanical_library
 from testbed.core.errors import IdentificationError
 from testbed.core.measurement import Measurement, Trajectory
-from testbed.core.schema import ErrorFn, Field
+from testbed.core.schema import ErrorFn, Field, KeyUse
 from testbed.numerics.filters import cutoff_problem, lowpass
 from testbed.numerics.gram import normalized_gram, ordered_independent
 from testbed.numerics.noise import noise_std, signal_band
@@ -1402,6 +1402,23 @@ class SINDyPI(_ImplicitMechanical):
         "edge_trim", "input_hold", "formulation",
         "weak_window_s", "weak_n_windows", "weak_degree", "ensemble", "ensemble_blocks",
         "ensemble_seed", "ensemble_aggregate"))  # __init__ order, for the guide
+    #: Keys the fit reads only under another setting (measured 2026-11-27, benchmarks/hostile10.py
+    #: ``combos``: each given otherwise fitted the same model to the bit).  ``selection`` and
+    #: ``column_lowpass_hz`` None are rules, which may choose the rollout or a low-pass.
+    used_when: ClassVar[dict[str, KeyUse]] = {
+        "n_rollout": KeyUse("selection", lambda v: v != "holdout", "selection = 'rollout' (or the rule)"),
+        "rollout_segments": KeyUse("selection", lambda v: v != "holdout",
+                                   "selection = 'rollout' (or the rule)"),
+        "record_replay": KeyUse("selection", lambda v: v != "holdout",
+                                "selection = 'rollout' (or the rule)"),
+        "column_lowpass_order": KeyUse("column_lowpass_hz", lambda v: v != 0,
+                                       "a column low-pass (column_lowpass_hz > 0 or the rule)"),
+        "weak_n_windows": KeyUse("formulation", lambda v: v != "strong", "formulation = 'weak' (or the rule)"),
+        "weak_degree": KeyUse("formulation", lambda v: v != "strong", "formulation = 'weak' (or the rule)"),
+        "ensemble_blocks": KeyUse("ensemble", lambda v: v > 0, "ensemble > 0"),
+        "ensemble_seed": KeyUse("ensemble", lambda v: v > 0, "ensemble > 0"),
+        "ensemble_aggregate": KeyUse("ensemble", lambda v: v > 0, "ensemble > 0"),
+    }
 
     @classmethod
     def check_hyperparameters(cls, params, error):

@@ -99,7 +99,7 @@ from identify.sindy_pi import (
 )
 from testbed.core.errors import DivergenceError, IdentificationError
 from testbed.core.measurement import Measurement, Trajectory
-from testbed.core.schema import ErrorFn, Field
+from testbed.core.schema import ErrorFn, Field, KeyUse
 from testbed.numerics.noise import noise_std
 
 #: ``A`` (the identified coefficients of the derivatives at a state) counts as singular when
@@ -481,6 +481,13 @@ class SINDyPIDynamical(Identifier):
         # (0, 1] s: the shipped rigs' time constants are of order 0.1-1 s
         "sim_dt": Field(float, 1e-3, unit="s", min=0.0, min_inclusive=False, max=1.0,
                         doc="largest RK4 step of the identified model's simulation"),
+    }
+    #: Keys the fit reads only under another setting (benchmarks/hostile10.py ``combos``).
+    used_when: ClassVar[dict[str, KeyUse]] = {
+        "degree": KeyUse("library", lambda v: v is None, "the default library (library not given)"),
+        "weak_window_s": KeyUse("formulation", lambda v: v == "weak", "formulation = 'weak'"),
+        "weak_windows": KeyUse("formulation", lambda v: v == "weak", "formulation = 'weak'"),
+        "weak_degree": KeyUse("formulation", lambda v: v == "weak", "formulation = 'weak'"),
     }
 
     def __init__(self, library: list[str] | None = None, degree: int = 2,

@@ -318,6 +318,39 @@ def check_dask_address(address: str) -> None:
     except OSError as e:
         raise InputError(f"--dask {show_value(address)}: cannot reach a Dask scheduler there "
                          f"({e.strerror or type(e).__name__})") from None
+    if parts.scheme == "tcp":
+        why = _dask_identity_problem(f"tcp://{parts.netloc}")
+        if why is not None:
+            raise InputError(f"--dask {show_value(address)}: no Dask scheduler answers there "
+                             f"({why})")
+
+
+def _dask_identity_problem(address: str) -> str | None:
+    """Ask the server at ``address`` who it is (the Dask ``identity`` call); why it is no Dask
+    scheduler, or None.  A port held by another server (an HTTP one) made the Dask client read
+    its reply as a message length and ask for 3 EiB: a MemoryError, an internal error of
+    ``sweep``; one that closed at once failed after the sweep had begun."""
+    import asyncio
+
+    from distributed.comm import connect
+
+    async def identity() -> object:
+        comm = await connect(address, timeout=DASK_CONNECT_TIMEOUT_S)
+        try:
+            await comm.write({"op": "identity"})
+            return await asyncio.wait_for(comm.read(), DASK_CONNECT_TIMEOUT_S)
+        finally:
+            comm.abort()
+
+    try:  # one time limit for it all: distributed's own handshake read waits for ever
+        reply = asyncio.run(asyncio.wait_for(identity(), 2 * DASK_CONNECT_TIMEOUT_S))
+    except TimeoutError:
+        return f"no reply within {2 * DASK_CONNECT_TIMEOUT_S:g} s"
+    except Exception as e:  # noqa: BLE001 -- whatever the server sent, it is not a scheduler
+        return f"{type(e).__name__}: {' '.join(str(e).split())[:120]}"
+    if not (isinstance(reply, dict) and reply.get("type") == "Scheduler"):
+        return f"it answered as {reply.get('type') if isinstance(reply, dict) else type(reply).__name__}"
+    return None
 
 
 @contextlib.contextmanager
@@ -494,9 +527,12 @@ def cmd_sweep(args: argparse.Namespace) -> int:
         study = dataclasses.replace(study, plugins=tuple(dict.fromkeys(study.plugins + extra)))
     stats = SweepStats()
     if args.dask:
+        if args.jobs is not None:  # the Dask backend runs as many cells as the cluster has workers
+            raise InputError(f"--jobs {args.jobs}: not with --dask (the scheduler's workers run "
+                             "the cells; start as many workers as should run at once)")
         check_dask_address(args.dask)
     try:
-        results = run_sweep(study, jobs=args.jobs, dask_address=args.dask,
+        results = run_sweep(study, jobs=args.jobs or 1, dask_address=args.dask,
                             results=Path(args.results) if args.results else None,
                             cache_dir=_cache_folder(args.cache), retry_failed=args.retry_failed,
                             stats=stats)
@@ -756,7 +792,8 @@ def build_parser() -> argparse.ArgumentParser:
 
     s = sub.add_parser("sweep", help="run a method-comparison study (scenarios x noise x seeds x methods)")
     s.add_argument("study", help="study .toml file")
-    s.add_argument("--jobs", type=_jobs, default=1, help="parallel worker processes (joblib loky)")
+    s.add_argument("--jobs", type=_jobs, default=None,
+                   help="parallel worker processes (joblib loky; default 1; not with --dask)")
     s.add_argument("--dask", help="dask.distributed scheduler address (runs through joblib's dask backend)")
     s.add_argument("--results", type=_path_text, help="results file (default out/studies/<study>.parquet)")
     s.add_argument("--cache", type=_path_text, help="dataset cache folder")

@@ -152,6 +152,19 @@ class MichaelisMentenRig(Rig):
                 error("rig.x0", rig["x0"], f"expected away from the steady state jx Km / (Vmax - jx) "
                                            f"= {steady:.6g} mM: started there, x never moves and "
                                            "the record holds nothing to identify")
+            # x moves monotonically from x0 to the steady state: the rate must be finite at
+            # both ends (x0 = 1.8e308 mM: Vmax x overflowed, solve_ivp's "Required step size is
+            # less than spacing between numbers" was an internal error)
+            with np.errstate(over="ignore", invalid="ignore"):
+                ends = rate(np.array([rig["x0"], steady]), rig["jx"], rig["Vmax"], rig["Km"])
+            if not np.isfinite(ends[0]):  # the larger of the two factors is named
+                key = "rig.x0" if rig["x0"] >= rig["Vmax"] else "rig.Vmax"
+                error(key, rig[key[4:]], "expected a start whose rate jx - Vmax x0 / (Km + x0) "
+                                         f"is finite (Vmax x0 below {np.finfo(float).max:.4g} "
+                                         "mM^2/s)")
+            if not np.isfinite(ends[1]):
+                error("rig.Vmax", rig["Vmax"], f"expected a rate finite at the steady state "
+                                               f"{steady:.6g} mM (Vmax times it overflows)")
         check_two_samples(simulation, error)
 
     @classmethod

@@ -384,6 +384,7 @@ class Dataset:
                 elif isinstance(v, np.generic):
                     v = v.item()
                 attrs[k] = v
+            _check_layout(path, f)
             groups: dict[str, dict[str, Signal]] = {}
             for group in ("measured", "reference"):
                 groups[group] = {}
@@ -416,3 +417,65 @@ class Dataset:
             ds = cls(float(f.attrs["fs"]), groups["measured"], groups["reference"], truth, units,
                      prior, attrs)
             return ds, fmt
+
+
+#: The groups at a dataset file's root (the module docstring's layout); nothing else is read.
+ROOT_GROUPS = ("measured", "reference", "truth", "prior")
+#: Attributes a signal dataset carries (``unit`` and ``channels`` required) and a truth one.
+SIGNAL_ATTRS = ("unit", "channels", "layout", "positions", "positions_unit", "acts_on")
+TRUTH_ATTRS = ("unit",)
+
+
+def _check_layout(path: str | os.PathLike, f: h5py.File) -> None:
+    """Refuse a file whose layout is not the one :meth:`Dataset.save` writes, naming the member.
+
+    What lies outside :data:`ROOT_GROUPS`, or an attribute a reader does not know, is outside
+    the content hash and would be read without a word (an extra group at the root, a signal's
+    extra attribute) or fail deep in the reader (an extra dataset under ``measured/`` without
+    its ``channels``: "KeyError"); so each is refused naming the key and what is allowed.
+
+    Raises
+    ------
+    DatasetError
+    """
+    allowed = ", ".join(ROOT_GROUPS)
+    for name in f:
+        if name not in ROOT_GROUPS:
+            raise DatasetError(path, f"/{name}: not part of a dataset file (its root holds the "
+                                     f"groups {allowed}; nothing else is read)")
+    for group in ROOT_GROUPS:
+        _check_hard_link(path, f, group)
+        if not isinstance(f.get(group), h5py.Group):
+            what = "missing" if group not in f else "not a group"
+            raise DatasetError(path, f"/{group}: {what} (a dataset file's root holds the groups "
+                                     f"{allowed})")
+    if len(f["prior"]):
+        raise DatasetError(path, f"/prior/{next(iter(f['prior']))}: the prior is held in the "
+                                 "group's attributes; it has no members")
+    for group, keys, required in (("measured", SIGNAL_ATTRS, ("unit", "channels")),
+                                  ("reference", SIGNAL_ATTRS, ("unit", "channels")),
+                                  ("truth", TRUTH_ATTRS, ("unit",))):
+        for name in f[group]:
+            where = f"/{group}/{name}"
+            _check_hard_link(path, f[group], name, where)
+            d = f[group][name]
+            if not isinstance(d, h5py.Dataset):
+                raise DatasetError(path, f"{where}: a group; /{group} holds datasets only")
+            for key in required:
+                if key not in d.attrs:
+                    raise DatasetError(path, f"{where}: no attribute {key!r} (a member of "
+                                             f"/{group} carries {', '.join(required)})")
+            for key in d.attrs:
+                if key not in keys:
+                    raise DatasetError(path, f"{where}: unknown attribute {key!r} (allowed: "
+                                             f"{', '.join(keys)})")
+
+
+def _check_hard_link(path: str | os.PathLike, group: h5py.Group, name: str, where: str = "") -> None:
+    """Refuse a soft or external link: its target (elsewhere in the file, or in another file)
+    would be read as this member's content."""
+    link = group.get(name, getlink=True)
+    if link is not None and not isinstance(link, h5py.HardLink):
+        raise DatasetError(path, f"{where or '/' + name}: a {type(link).__name__} (to "
+                                 f"{getattr(link, 'path', '?')!r}); a dataset file holds its "
+                                 "members itself")

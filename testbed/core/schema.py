@@ -277,3 +277,72 @@ def validate_header(raw: Any, *, sections: tuple[str, ...], header: str,
 
 ErrorFn = Callable[[str, Any, str], None]
 """``error(key, value, allowed)``: report a problem (it raises)."""
+
+
+@dataclass(frozen=True)
+class KeyUse:
+    """When a table's key is read: only while ``switch`` (another key of the table, or several)
+    satisfies ``reads``, described in words by ``when`` (e.g. ``"derivatives = 'estimated'"``).
+
+    Attributes
+    ----------
+    switch : str or tuple of str
+        The key (or keys) deciding whether the key is read.
+    reads : callable
+        ``reads(value)`` with the switch's validated value (one argument per key of a tuple
+        ``switch``): True when the key is read.
+    when : str
+        The setting under which it is read, in words.
+    """
+
+    switch: str | tuple[str, ...]
+    reads: Callable[..., bool]
+    when: str
+
+    @property
+    def switches(self) -> tuple[str, ...]:
+        return (self.switch,) if isinstance(self.switch, str) else self.switch
+
+    def read_in(self, cfg: Mapping[str, Any]) -> bool:
+        """Whether the key is read under the validated table ``cfg``."""
+        return bool(self.reads(*(cfg[k] for k in self.switches)))
+
+
+def check_keys_used(given: Mapping[str, Any], cfg: Mapping[str, Any],
+                    schema: Mapping[str, Field], used_when: Mapping[str, KeyUse | tuple[KeyUse, ...]],
+                    section: str, error: ErrorFn) -> None:
+    """Refuse a key the table gives which its reader will not read under the table's other keys.
+
+    Parameters
+    ----------
+    given : mapping
+        The table as written (before defaults are filled in).
+    cfg : mapping
+        The same table validated, defaults filled in.
+    schema : mapping of str to Field
+        The table's schema (for each key's default).
+    used_when : mapping of str to KeyUse or tuple of KeyUse
+        The keys read only under a setting of others (all of a tuple's uses must hold).
+    section : str
+        The table's name in messages (``"signal"``, ``"identify"``).
+    error : callable
+        ``error(key, value, allowed)`` with the bare key, called on the first problem (it
+        raises).
+
+    Notes
+    -----
+    Rule: a key given with a value other than its default, while a key it depends on is set
+    so that the reader does not read it, is refused (``signal.window = 301`` with recorded
+    derivatives, ``identify.n_models = 5`` with ``optimizer = "stlsq"``, were accepted and
+    ignored).  A key given at its default is accepted: a table written out whole (a family
+    member, a run read back) lists every key at its default.
+    """
+    for key, uses in used_when.items():
+        if key not in given or given[key] == schema[key].default:
+            continue
+        for use in (uses,) if isinstance(uses, KeyUse) else uses:
+            if not use.read_in(cfg):
+                here = ", ".join(f"{section}.{k} = {cfg[k]!r}" for k in use.switches)
+                keys = " or ".join(f"{section}.{k}" for k in use.switches)
+                error(key, given[key], f"read only with {use.when}; here {here}, so it would "
+                                       f"be ignored: remove it or set {keys}")

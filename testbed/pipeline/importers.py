@@ -909,6 +909,7 @@ def _read_uff(path: Path) -> _Raw:
     if not re.search(rb"(^|\s)-1$", tail):
         raise MeasuredDataError(path, "not a complete UFF file: it does not end with a block end "
                                       "'-1' (truncated, or not UFF)")
+    _check_uff_blocks(path, path.read_bytes())
     try:
         uff = pyuff.UFF(str(path))
         types = list(uff.get_set_types())
@@ -938,6 +939,40 @@ def _read_uff(path: Path) -> _Raw:
             raw.positions[name] = check_position(path, name, coords[node], f"node {node} x")
     raw.fs = _common_rate(path, rates, 1e-5)
     return raw
+
+
+#: The block delimiter as pyuff finds it: ``    -1`` then a line end, the file's end, or blanks
+#: to column 80 (``pyuff.UFF.refresh``).
+_UFF_TAG = re.compile(rb"    -1(?=\r|\n|$| {74})")
+
+
+def _check_uff_blocks(path: Path, data: bytes) -> None:
+    """Refuse text outside the UFF blocks: pyuff reads only what lies between a start and an
+    end delimiter ``    -1`` and skips anything else in silence (a line of junk between two
+    blocks, a header before the first one), so such a file is not read as if it were whole.
+
+    Raises
+    ------
+    MeasuredDataError
+        Naming the first line outside every block, or an unpaired delimiter.
+    """
+    tags = [m.start() for m in _UFF_TAG.finditer(data)]
+    if len(tags) % 2:
+        line = data.count(b"\n", 0, tags[-1]) + 1
+        raise MeasuredDataError(path, f"an unpaired UFF block delimiter '-1' (the last at line "
+                                      f"{line}): every block starts and ends with a line '    -1'")
+    # the gaps: the file's start to the first start tag, each end tag's line to the next start
+    ends = [0] + [data.find(b"\n", t) + 1 or len(data) for t in tags[1::2]]
+    starts = tags[0::2] + [len(data)]
+    for lo, hi in zip(ends, starts):
+        stray = data[lo:hi]
+        if stray.strip():
+            at = lo + len(stray) - len(stray.lstrip())
+            line = data.count(b"\n", 0, at) + 1
+            text = data[at:data.find(b"\n", at) if b"\n" in data[at:hi] else hi].rstrip()
+            raise MeasuredDataError(path, f"line {line} ({text[:40].decode('latin-1')!r}) lies outside "
+                                          "every UFF block (between one block's end '-1' and the "
+                                          "next one's start '-1'); a UFF file holds only blocks")
 
 
 _FS_ID = re.compile(r"\bfs\s+([-+0-9.eE]+)\s*Hz")

@@ -18,7 +18,8 @@ import numpy as np
 from testbed.core.dataset import Dataset
 from testbed.core.errors import ScenarioError, show_names
 from testbed.core.measurement import Measurement, declared_input_hold
-from testbed.core.schema import Field, validate_table
+from testbed.core.schema import Field, KeyUse, validate_table
+from testbed.core.schema import check_keys_used as schema_check_keys_used
 from testbed.numerics import derivatives
 from testbed.numerics import filters as sig
 from testbed.numerics import noise as noise_est
@@ -138,16 +139,6 @@ ErrorFn = Callable[[str, Any, str], None]
 
 
 @dataclass(frozen=True)
-class KeyUse:
-    """When a chain reads a key: only while ``switch`` (another key of the table) satisfies
-    ``reads``, described in words by ``when`` (e.g. ``"derivatives = 'estimated'"``)."""
-
-    switch: str
-    reads: Callable[[Any], bool]
-    when: str
-
-
-@dataclass(frozen=True)
 class SignalChain:
     """The signal chain of one rig kind: its ``[signal]`` schema, its checks, its function.
 
@@ -232,14 +223,8 @@ def check_keys_used(kind: str, given: Mapping[str, Any], cfg: Mapping[str, Any],
     written out whole (a family member, a run read back) lists every key at its default.
     """
     chain = _chain(kind)
-    for key, use in chain.used_when.items():
-        if key not in given or given[key] == chain.schema[key].default:
-            continue
-        if not use.reads(cfg[use.switch]):
-            error(f"signal.{key}", given[key],
-                  f"read only with {use.when}; here signal.{use.switch} = "
-                  f"{cfg[use.switch]!r}, so it would be ignored: remove it or set "
-                  f"signal.{use.switch}")
+    schema_check_keys_used(given, cfg, chain.schema, chain.used_when, "signal",
+                           lambda key, value, allowed: error(f"signal.{key}", value, allowed))
 
 
 def check_signal(kind: str, cfg: Mapping[str, Any], fs: float, n_samples: int,

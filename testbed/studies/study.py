@@ -389,7 +389,9 @@ def _validate_params(table: Any, identifiers: list[str], file: str) -> dict[str,
             checked = _validate_identify({"method": name, **sub}, file)
         except ScenarioError as e:
             k = (e.key or "").replace("identify.", f"{key}.", 1)
-            raise ScenarioError(file, k, e.value, e.allowed) from None
+            # the keys the message names are this table's too ("here identify.optimizer = ...")
+            allowed = e.allowed.replace("identify.", f"{key}.") if e.allowed else e.allowed
+            raise ScenarioError(file, k, e.value, allowed) from None
         assert checked is not None
         checked.pop("method")
         # ints given for float hyperparameters come back widened, so 1 and 1.0 are one cell
