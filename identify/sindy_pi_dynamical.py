@@ -600,7 +600,7 @@ class SINDyPIDynamical(Identifier):
         self.val_error_ = np.array([sw.val_error[t, c] for t, c in picked])
         self.feature_names_ = list(lib.names)
         self.states_, self.inputs_ = lib.states, lib.inputs
-        self._lib = lib
+        self._lib, self._dmap = lib, None
         self._fit_determinacy(data, lib, x, xd, u)
         if self._prune_at_noise(data, lib, x, xd, u, G_val, sw.scale, deriv_cols):
             self._fit_determinacy(data, lib, x, xd, u)   # of the pruned equations
@@ -762,6 +762,18 @@ class SINDyPIDynamical(Identifier):
             + ("" if self.formulation == "weak" else
                " (strong form: the chain's derivative noise left out, a lower bound)"))
 
+    def _derivative_map(self) -> tuple[np.ndarray, np.ndarray]:
+        """``D`` (p, n_states), 1 where a term carries a state's derivative, and the mask of
+        terms without one (p,): built once per fitted library, not at every RK4 stage."""
+        key = self.coef_.shape  # fit() resets the map with the library
+        cached = getattr(self, "_dmap", None)
+        if cached is None or cached[0] != key:
+            has = self._lib.deriv >= 0
+            D = np.zeros((len(self._lib.names), self.coef_.shape[0]))
+            D[np.flatnonzero(has), self._lib.deriv[has]] = 1.0
+            self._dmap = (key, D, ~has)
+        return self._dmap[1], self._dmap[2]
+
     def derivative(self, x: np.ndarray, u: np.ndarray | None = None, t: float = float("nan")
                    ) -> np.ndarray:
         """``dx/dt`` the identified equations give at state ``x`` (n_states,) and input ``u``.
@@ -780,12 +792,11 @@ class SINDyPIDynamical(Identifier):
             cm = self.coef_ * m[None, :]
         if not np.all(np.isfinite(cm)):
             raise DivergenceError("non-finite terms of the identified equations", t)
-        n = self.coef_.shape[0]
-        D = np.zeros((len(m), n))
-        has = self._lib.deriv >= 0
-        D[np.flatnonzero(has), self._lib.deriv[has]] = 1.0
-        A, b = cm @ D, cm[:, ~has].sum(axis=1)
-        smin = np.linalg.svd(A, compute_uv=False).min()
+        D, free = self._derivative_map()
+        A, b = cm @ D, cm[:, free].sum(axis=1)
+        # one state: the 1 x 1 coefficient's singular value is its magnitude (no LAPACK call
+        # per RK4 stage: the kinetics' rollouts spent a fifth of their time there)
+        smin = abs(A[0, 0]) if A.shape == (1, 1) else np.linalg.svd(A, compute_uv=False).min()
         if not smin > SINGULAR_TOL:
             raise DivergenceError(f"the identified coefficient of the derivatives is singular "
                                   f"(smallest singular value {smin:.3g} <= {SINGULAR_TOL:g})", t)
