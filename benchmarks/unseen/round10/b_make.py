@@ -140,6 +140,21 @@ CASES: dict[str, tuple[str, dict, dict, dict, dict]] = {
                            {**SOFT, "length": 1.0, "thickness": 0.03, "n_segments": 40,
                             "damping_ratio": 0.005, "base_k1": 5e4, "base_k3": 1e11,
                             "sensors": [0.35, 0.7, 1.0]}, {"duration": 2.0}, {}, {}),
+    # the three 3.2 kHz rigs above are refused at load (their 0.3 ms pulse falls between two
+    # sample instants: no force recorded); the same rigs with a 1 ms contact (3.2 periods)
+    "b10_L2_h20_hpauto_s2_p1ms": ("as b10_L2_h20_hpauto_s2 with a 1 ms contact",
+                                  {"length": 2.0, "thickness": 0.02, "n_segments": 30,
+                                   "damping_ratio": 0.005, "sensors": [1.0, 2.0]},
+                                  {"duration": 6.0, "sample_rate": 3200.0},
+                                  {"start": 0.5, "pulse_duration": 1e-3}, {"highpass_hz": "auto"}),
+    "b10_L3_h50_hpauto_s3_p1ms": ("as b10_L3_h50_hpauto_s3 with a 1 ms contact",
+                                  {"length": 3.0, "thickness": 0.05, "n_segments": 30,
+                                   "damping_ratio": 0.005, "sensors": [1.0, 2.0, 3.0]},
+                                  {"duration": 6.0, "sample_rate": 3200.0},
+                                  {"start": 0.5, "pulse_duration": 1e-3}, {"highpass_hz": "auto"}),
+    "b10_soft_fs3200_s2_p1ms": ("as b10_soft_fs3200_s2 with a 1 ms contact",
+                                {**SOFT, "sensors": [L / 2, L]}, {"sample_rate": 3200.0},
+                                {"pulse_duration": 1e-3}, {}),
 }
 
 
