@@ -249,7 +249,10 @@ def _pulse_recorded(excitation: dict[str, Any], fs: float) -> bool:
     start, width = excitation["start"], excitation["pulse_duration"]
     if not width * fs <= 2.0:  # (NaN-safe) longer than a period: a sample instant lies inside
         return True
-    k = np.arange(math.floor(start * fs), math.ceil((start + width) * fs) + 1)
+    hi = (start + width) * fs
+    if not hi < 2.0**53:  # a record of over 2^53 samples (or inf): the budget refuses it
+        return True
+    k = np.arange(math.floor(start * fs), math.ceil(hi) + 1)
     force = half_sine(1.0, width, start)(k / fs)
     return bool(np.any(force > 0.0))
 

@@ -47,3 +47,15 @@ def test_a_pulse_with_a_sample_inside_runs_and_is_recorded(simulation, excitatio
     sc = scenario_from_dict(beam(simulation, excitation))
     force = CantileverRig(sc).simulate().measured["force"].data
     assert np.max(force) > 0.0
+
+
+@pytest.mark.parametrize("start, width, fs, recorded", [
+    (0.005, 3e-4, 3200.0, False),   # round 10: starts on a sample, ends before the next
+    (0.0051, 3e-4, 3200.0, True),   # the sample at 5.3125 ms lies inside 5.1-5.4 ms
+    (0.005, 3.2e-4, 3200.0, True),  # longer than the period: always one inside
+    (1e308, 3e-4, 2.0, True),       # start x fs overflows: left to the budget, no exception
+    (1e300, 3e-4, 2.0, True),       # beyond 2^53 samples: left to the budget
+])
+def test_pulse_recorded_rule(start, width, fs, recorded):
+    from models.cantilever.rig import _pulse_recorded
+    assert _pulse_recorded({"start": start, "pulse_duration": width}, fs) is recorded
