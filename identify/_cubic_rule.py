@@ -38,6 +38,16 @@ lowest measured mode hardens with amplitude, its backbone chirp above :data:`CUB
 +0.6 % at most on the 40 clamped family beams, clean and 1 %; +1e-4 or less on round 7's), so a
 tilted correlation raised by unmodelled dynamics (clamped member 009: 0.654) does not let a
 cubic in.
+
+(3) Where the lowest mode's backbone decay fit is not taken (strong hardening: round 10's soft
+base k1 = 3000, k3 = 5e10 under 50 N, or the shipped soft base under a 2 ms contact), the tilted
+correlation above :data:`CUBIC_SELECT_CORR` takes as its second witness the peak search's own
+amplitude law (:func:`identify.structural.modal_peaks`, rule 4: a harmonic whose short-time
+amplitude follows the k-th power of a stronger peak whose frequency falls as it decays, so no
+peak is accepted, ``PeakSearch.nonlinear``).  That is the hardening the chirp measures, seen
+through a harmonic instead of a decay fit; it asks nothing of the record's first millisecond.
+It is tried only when (2) has no chirp and no peak was accepted (``peaks`` empty), so it never
+changes a decision (2) could make.
 """
 
 from __future__ import annotations
@@ -52,6 +62,7 @@ from identify.structural import (
     fit_band,
     matrices_from_coef,
     modal,
+    modal_peaks,
     solve_rows,
     tilt_library,
 )
@@ -174,7 +185,9 @@ def cubic_rule(data: Measurement, user: bool | None, fit_band_hz: float | None =
         least-squares library (fit band, drift and input columns as ``ls_sindy`` builds it)
         exceeds :data:`CUBIC_SELECT_CORR`, or when that of its tilted rows does and the lowest
         measured mode's backbone chirp (:func:`lowest_mode_chirp`) exceeds
-        :data:`CUBIC_CHIRP_MIN`.
+        :data:`CUBIC_CHIRP_MIN`, or (no chirp fit taken and ``peaks`` empty) the peak search
+        (:func:`identify.structural.modal_peaks` on ``data``, its default band) finds the
+        record amplitude-dependent (``nonlinear``; module docstring, rule (3)).
     """
     if user is not None:
         return bool(user), "user setting"
@@ -192,8 +205,11 @@ def cubic_rule(data: Measurement, user: bool | None, fit_band_hz: float | None =
         return False, f"{head} <= {CUBIC_SELECT_CORR:g}: cubic terms out"
     chirp, f = lowest_mode_chirp(data, fit_band_hz, peaks)
     if not np.isfinite(chirp):
-        return False, (f"{head}, but no backbone decay fit of the lowest mode taken: cubic "
-                       "terms out")
+        head += ", no backbone decay fit of the lowest mode taken"
+        if peaks is not None and np.size(peaks) == 0 and modal_peaks(data).nonlinear:
+            return True, (f"{head}, and the peak search found a harmonic following a hardening "
+                          "fundamental's amplitude law (no peak accepted): cubic terms in")
+        return False, f"{head}: cubic terms out"
     on = chirp > CUBIC_CHIRP_MIN
     return on, (f"{head} and the lowest mode's ({f:.4g} Hz) backbone chirp c / wd {chirp:+.3g} "
                 f"{'>' if on else '<='} {CUBIC_CHIRP_MIN:g} (it "

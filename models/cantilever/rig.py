@@ -229,6 +229,34 @@ def _least_damping_ratio(rig: dict[str, Any]) -> float:
     return MIN_NORMAL_BETA_S * math.pi * f1 if math.isfinite(f1) and f1 > 0 else 0.0
 
 
+def _pulse_recorded(excitation: dict[str, Any], fs: float) -> bool:
+    """Whether some sample instant ``k / fs`` falls strictly inside the hammer's pulse.
+
+    The force channel holds the half-sine sampled at ``k / fs`` (:meth:`CantileverRig.simulate`),
+    zero at the pulse's ends: a pulse between two sample instants is recorded as no force at
+    all (round 10: 0.3 ms at 3.2 kHz starting on a sample, 0.96 sample periods), and then the
+    scorer simulates every model, the truth too, unforced (the truth's TRAC 0.11-0.24).  Any
+    open interval longer than the sample period holds a sample instant, so only pulses of at
+    most two periods are looked at, on the same instants the simulation records.
+
+    Parameters
+    ----------
+    excitation : dict
+        Validated impact ``[excitation]`` table (``start``, ``pulse_duration`` [s]).
+    fs : float
+        Sample rate [Hz].
+    """
+    start, width = excitation["start"], excitation["pulse_duration"]
+    if not width * fs <= 2.0:  # (NaN-safe) longer than a period: a sample instant lies inside
+        return True
+    hi = (start + width) * fs
+    if not hi < 2.0**53:  # a record of over 2^53 samples (or inf): the budget refuses it
+        return True
+    k = np.arange(math.floor(start * fs), math.ceil(hi) + 1)
+    force = half_sine(1.0, width, start)(k / fs)
+    return bool(np.any(force > 0.0))
+
+
 def _root_hinge(rig: dict[str, Any]) -> float:
     """Position [m] of the first moving hinge (0 for a soft base)."""
     if rig["base"] == "soft":
@@ -461,6 +489,14 @@ class CantileverRig(Rig):
             key = "start" if excitation["start"] >= simulation["duration"] else "pulse_duration"
             error(f"excitation.{key}", excitation[key],
                   f"allowed: start + pulse_duration < duration ({simulation['duration']:g} s)")
+        elif not _pulse_recorded(excitation, float(simulation["sample_rate"])):
+            fs = float(simulation["sample_rate"])
+            error("excitation.pulse_duration", excitation["pulse_duration"],
+                  f"a pulse the force channel records: at {fs:g} Hz no sample instant falls "
+                  f"inside the pulse ({excitation['start']:.6g}-{end:.6g} s), so the recorded "
+                  "force is zero and no model can be simulated against the record; allowed: a "
+                  f"pulse longer than the sample period {1.0 / fs:.4g} s (or a start that "
+                  "puts a sample inside it)")
 
     #: ``[signal]`` keys that may say ``"auto"``: resolved from the nominal geometry when the
     #: scenario is loaded (:meth:`auto_signal`).

@@ -62,3 +62,21 @@ def test_soft_base_decision_same_at_6k4_and_20k(dataset_cache):
         assert on is True, why
         chirps.append(lowest_mode_chirp(data)[0])
     assert np.isclose(chirps[0], chirps[1], rtol=0.01)
+
+
+ROUND10 = Path(__file__).resolve().parents[2] / "benchmarks" / "unseen" / "round10"
+
+
+def test_strong_hardening_without_chirp_fit_is_cubic(dataset_cache):
+    """Round 10's soft base k1 = 3000, k3 = 5e10 under 50 N: the flat correlation 0.369, the
+    tilted 0.889, the lowest mode's backbone decay fit not taken (no chirp), and the peak
+    search finds the record amplitude-dependent (no peak accepted).  Rule (3) puts the cubic
+    in (it was left out: mode 1 10 % high with both identifiers; in, both pass)."""
+    from identify.structural import modal_peaks
+
+    sc = load_scenario(ROUND10 / "b10_soft_strong_F50.toml")
+    data = measure(dataset_cache.get(sc), sc.signal, sc.kind)
+    ps = modal_peaks(data)
+    assert ps.nonlinear and ps.peaks.size == 0
+    on, why = cubic_rule(data, None, None, ps.peaks)
+    assert on is True and "no backbone decay fit" in why and "amplitude law" in why, why
