@@ -152,7 +152,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from identify._structural_sim import state_matrix
-from identify.structural import MODE_SEPARATION, modal
+from identify.structural import MODE_SEPARATION, modal, peak_band
 from testbed.core.lazy import lazy_module
 from testbed.core.measurement import Measurement
 
@@ -219,9 +219,10 @@ class ModalDecay:
 
 
 def _decay_fit(q: np.ndarray, t: np.ndarray, sigma0: float, w: float, backbone: bool = False,
-               nuisance: np.ndarray | None = None
+               nuisance: np.ndarray | None = None, band: tuple[float, float] | None = None
                ) -> tuple[float, float, float, bool, float, float]:
-    """Least-squares ``exp(-sigma t) (a cos phi + b sin phi)`` to ``q`` (shape (N,)).
+    """Least-squares ``exp(-sigma t) (a cos phi + b sin phi)`` to ``q`` (shape (N,), or (N, m):
+    m signals sharing the pole, each with its own ``a, b`` and nuisance amounts).
 
     ``phi = wd t`` (an exponential decay); with ``backbone`` a hardening (or softening)
     oscillator's backbone, ``phi = wd t + c (1 - exp(-2 sigma t)) / (2 sigma)``: the
@@ -234,11 +235,13 @@ def _decay_fit(q: np.ndarray, t: np.ndarray, sigma0: float, w: float, backbone: 
     with ``a, b`` (:func:`chain_transients`: the signal chain's own transients).
 
     Starts from ``sigma0`` [1/s] (clipped into ``[1e-3 w, 0.35 w]``) and the damped frequency
-    of the undamped ``w`` [rad/s] at that decay; ``wd`` is bounded to ``[0.5, 1.5] w``.
+    of the undamped ``w`` [rad/s] at that decay; ``wd`` is bounded to ``[0.5, 1.5] w``, or to
+    ``band`` [rad/s] when given (without ``backbone``).
 
     Returns ``sigma`` [1/s], ``wd`` [rad/s], ``r2``, whether the optimiser converged with
     no parameter held at a bound (``0 <= sigma <= MAX_DECAY_RATIO w``), ``c`` [rad/s] (0
-    without ``backbone``) and the amplitude ``hypot(a, b)`` at ``t = 0`` [units of ``q``].
+    without ``backbone``) and the amplitude ``hypot(a, b)`` at ``t = 0`` [units of ``q``; for
+    several signals the norm over all of them].
     """
     def basis(p: np.ndarray) -> np.ndarray:
         ph = p[1] * t
@@ -249,7 +252,7 @@ def _decay_fit(q: np.ndarray, t: np.ndarray, sigma0: float, w: float, backbone: 
 
     def resid(p: np.ndarray) -> np.ndarray:
         A = basis(p)
-        return A @ np.linalg.lstsq(A, q, rcond=None)[0] - q
+        return (A @ np.linalg.lstsq(A, q, rcond=None)[0] - q).ravel()
 
     hi = MAX_DECAY_RATIO * w
     s0 = min(max(sigma0, 1e-3 * w), 0.5 * hi)
@@ -261,18 +264,22 @@ def _decay_fit(q: np.ndarray, t: np.ndarray, sigma0: float, w: float, backbone: 
                                         x_scale=[1e-2 * w, 1e-3 * w, 1e-3 * w])
                  for c0 in (0.0, 0.05 * w)), key=lambda r: r.cost)
     else:
-        r = optimize.least_squares(resid, [s0, wd0], bounds=([0.0, 0.5 * w], [hi, 1.5 * w]),
+        lo_w, hi_w = (0.5 * w, 1.5 * w) if band is None else band
+        wd0 = min(max(wd0, lo_w), hi_w)
+        r = optimize.least_squares(resid, [s0, wd0], bounds=([0.0, lo_w], [hi, hi_w]),
                                    x_scale=[1e-2 * w, 1e-3 * w])
     e = float(np.sum(q * q))
     r2 = 1.0 - float(np.sum(r.fun**2)) / e if e > 0 else 0.0
     inside = not np.any(r.active_mask)  # no parameter held at a bound
-    amp = float(np.hypot(*np.linalg.lstsq(basis(r.x), q, rcond=None)[0][:2]))
+    ab = np.linalg.lstsq(basis(r.x), q, rcond=None)[0][:2]
+    amp = float(np.hypot(*ab) if q.ndim == 1 else np.linalg.norm(ab))
     return (float(r.x[0]), float(r.x[1]), r2, bool(r.success > 0 and inside),
             float(r.x[2]) if backbone else 0.0, amp)
 
 
 def modal_decay(data: Measurement, M: np.ndarray, K: np.ndarray, C: np.ndarray,
-                window: tuple[int, int], backbone: bool = False) -> ModalDecay:
+                window: tuple[int, int], backbone: bool = False,
+                unlocated: np.ndarray | None = None) -> ModalDecay:
     """Each mode's decay rate and damped frequency fitted to its measured free decay.
 
     Parameters
@@ -287,6 +294,15 @@ def modal_decay(data: Measurement, M: np.ndarray, K: np.ndarray, C: np.ndarray,
     backbone : bool
         Fit each mode's decay with an amplitude-dependent frequency (:func:`_decay_fit`):
         ``omega_d`` is then the linear (small-amplitude) damped frequency.
+    unlocated : ndarray of bool, shape (n,), optional
+        Modes no measured spectral peak located (:func:`decay_hold`'s ``unlocated``): their
+        fit is taken wherever in its bounds it converges, not only within
+        :data:`~identify.structural.MODE_SEPARATION` of the model's frequency, which is the
+        distance a peak pairs a mode within and says nothing about a mode no peak located.
+        Without ``backbone`` their decay is then refitted on every channel at once
+        (:func:`_unlocated_fit`, after the located modes, whose decays it profiles out) between
+        the midpoints to the neighbouring modes (:func:`unlocated_band`): module docstring,
+        "Unlocated modes".  Default none.
 
     Returns
     -------
@@ -313,11 +329,19 @@ def modal_decay(data: Measurement, M: np.ndarray, K: np.ndarray, C: np.ndarray,
         w = 2.0 * fs * np.arctan(w / (2.0 * fs))
     d = np.einsum("ik,ij,jk->k", Phi, C, Phi)  # modal damping 2 zeta_k w_k [1/s]
     nuisance = chain_transients(getattr(data, "chain_poles", None), t)
-    for k in range(n):
+    free = np.zeros(n, bool) if unlocated is None else np.asarray(unlocated, bool)
+    fits = {}
+    for k in np.concatenate([np.flatnonzero(~free), np.flatnonzero(free)]):
         s, wd, r2, ok, c, amp = _decay_fit(q[k], t, 0.5 * d[k], w[k], backbone, nuisance)
         out.r2[k] = r2
+        if free[k] and not backbone:  # no peak located it: every channel's record (docstring)
+            s, wd, ok = _unlocated_fit(xdd[:, i0:i1], t, (s, wd) if ok else (0.5 * d[k], w[k]),
+                                       unlocated_band(w, k, peak_band(data, i1 - i0)[0]),
+                                       nuisance, fits)
         first_order = not backbone or abs(c) <= BACKBONE_MAX_SHIFT * wd
-        if ok and first_order and abs(np.log(wd / w[k])) <= np.log1p(MODE_SEPARATION):
+        paired = free[k] or abs(np.log(wd / w[k])) <= np.log1p(MODE_SEPARATION)
+        if ok and first_order and paired:
+            fits[k] = (s, wd)
             out.sigma[k], out.omega_d[k], out.taken[k] = s, wd, True
             pole = complex(-s, wd)
             if trap:
@@ -328,6 +352,78 @@ def modal_decay(data: Measurement, M: np.ndarray, K: np.ndarray, C: np.ndarray,
             if backbone:
                 out.chirp[k], out.amplitude[k] = c, amp
     return out
+
+
+def _unlocated_fit(x: np.ndarray, t: np.ndarray, start: tuple[float, float],
+                   band: tuple[float, float], nuisance: np.ndarray | None,
+                   taken: dict[int, tuple[float, float]]) -> tuple[float, float, bool]:
+    """The decay of a mode no peak located, fitted on every channel at once (module docstring,
+    "Unlocated modes").
+
+    Parameters
+    ----------
+    x : ndarray, shape (n_channels, N)
+        The measured accelerations on the fit window [m/s^2].
+    t : ndarray, shape (N,)
+        Time from the window's start [s].
+    start : (float, float)
+        Starting decay rate [1/s] and damped frequency [rad/s] (the modal coordinate's fit
+        when it was taken, else the model's).
+    band : (float, float)
+        Bounds of the damped frequency [rad/s] (:func:`unlocated_band`).
+    nuisance : ndarray, shape (N, m), or None
+        The signal chain's transients (:func:`chain_transients`).
+    taken : dict of int to (float, float)
+        The decays already taken (mode: ``sigma`` [1/s], ``omega_d`` [rad/s]); their waveforms
+        join the nuisance, amounts free per channel.
+
+    Returns
+    -------
+    sigma : float
+        Decay rate [1/s].
+    omega_d : float
+        Damped frequency [rad/s].
+    ok : bool
+        Converged with no parameter at a bound (:func:`_decay_fit`).
+    """
+    rms = np.sqrt(np.mean(x * x, axis=1))
+    y = (x[rms > 0] / rms[rms > 0, None]).T  # each channel at unit RMS (noise: a share of it)
+    cols = [] if nuisance is None else [nuisance]
+    for s, wd in taken.values():
+        e = np.exp(-s * t)
+        cols.append(np.column_stack([e * np.cos(wd * t), e * np.sin(wd * t)]))
+    s, wd, _, ok, _, _ = _decay_fit(y, t, start[0], float(np.hypot(*start)), False,
+                                    np.hstack(cols) if cols else None, band)
+    return s, wd, ok
+
+
+def unlocated_band(w: np.ndarray, k: int, peak_band_hz: tuple[float, float]) -> tuple[float, float]:
+    """Where the decay of mode ``k``, which no peak located, is searched [rad/s].
+
+    Between the midpoints to the model's neighbouring modes (beyond them the decay would be
+    nearer another mode's frequency than its own, which :func:`decay_hold` refuses); below
+    mode 1 and above the top mode, to the peak band's edge (:func:`identify.structural.peak_band`,
+    the chain's pass band: no mode is measured beyond it), and never narrower than the
+    ``[0.5, 1.5] w_k`` of a located mode's fit there.
+
+    Parameters
+    ----------
+    w : ndarray, shape (n,)
+        The model's undamped frequencies [rad/s], ascending.
+    k : int
+        The mode.
+    peak_band_hz : (float, float)
+        The peak band [Hz].
+
+    Returns
+    -------
+    (float, float)
+        Lower and upper bound of the damped frequency [rad/s].
+    """
+    lo = 0.5 * (w[k - 1] + w[k]) if k > 0 else min(0.5 * w[k], 2.0 * np.pi * peak_band_hz[0])
+    hi = (0.5 * (w[k] + w[k + 1]) if k + 1 < len(w)
+          else max(1.5 * w[k], 2.0 * np.pi * peak_band_hz[1]))
+    return float(lo), float(hi)
 
 
 def chain_transients(poles: np.ndarray | None, t: np.ndarray) -> np.ndarray | None:
@@ -478,7 +574,9 @@ def decay_hold(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndarray,
         Modes no measured spectral peak located (the caller's peak pairing found none within
         :data:`~identify.structural.MODE_SEPARATION`): the one-line bound is the spectrum's
         resolution and does not apply to them, so a taken decay fit moves such a mode to its
-        measured frequency wherever that lies (within the fit's own pairing check).  None: no
+        measured frequency wherever that lies; with a linear model that decay is fitted on
+        every channel at once between the midpoints to the neighbouring modes
+        (:func:`modal_decay`, module docstring "Unlocated modes").  None: no
         mode is exempt (every frequency moves within one line only).  Not to a frequency
         nearer another mode's than its own: that fit followed the other mode's leakage
         (clamped family member 033 at 1 % noise: the model's unlocated mode 4, 452.7 Hz, took
@@ -498,7 +596,7 @@ def decay_hold(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndarray,
     if i0 == 0 and forced:  # free_start = 0 with an input: a continuous excitation
         return DecayHold(C, K, None, "continuous input (free_start = 0): the fit's")
     with_backbone = K3 is not None  # a cubic model's decay: the backbone fit
-    dec = modal_decay(data, M, K, C, window, with_backbone)
+    dec = modal_decay(data, M, K, C, window, with_backbone, unlocated)
     if not np.any(dec.taken):
         return DecayHold(C, K, dec, "modal decay fits: none taken, the fit's")
     C2 = hold_modal_damping(M, C, K, dec.sigma_model)
@@ -537,6 +635,10 @@ def decay_hold(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndarray,
                f"f_n (1 / sqrt(1 - 2 zeta^2) - 1)"
                + (f"; modes {(np.flatnonzero(on & free & ~near) + 1).tolist()}, which no "
                   f"measured peak located, wherever it lies" if np.any(on & free & ~near) else "")
+               + ("; the decays of modes no peak located fitted on every channel at once (each "
+                  "channel's amplitudes free, the other measured decays profiled out), between "
+                  "the midpoints to their neighbouring modes"
+                  if np.any(on & free) and not with_backbone else "")
                + ")" if fixed.size else "")
             + (f"; modes {(np.flatnonzero(unexplained) + 1).tolist()} kept the fit's frequency "
                f"(its cubic gives less than {BACKBONE_SHARE:.0%} of the measured shift)"
