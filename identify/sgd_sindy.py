@@ -584,7 +584,11 @@ class SGDSINDy(SGDSINDyBase):
     what was removed); the eigenvalue hold keeps K positive semi-definite (positive targets).
     The linear model is therefore never unstable: ``M`` > 0, ``C``, ``K`` >= 0.
 
-    *Decay hold* (``decay_hold``).  The equation-error fit weighs each row by its
+    *Decay hold* (``decay_hold``; a mode the eigenvalue penalty paired with no peak,
+    ``eigen_targets_`` 0, is passed as ``unlocated`` since 2026-11-27, ``ls_sindy``'s rule:
+    its decay is fitted on every channel at once and taken wherever it lies between its
+    neighbouring modes, :mod:`identify._modal_damping`, "Unlocated modes").  The
+    equation-error fit weighs each row by its
     acceleration, which the highest sensed mode dominates, so a lightly damped mode 1's
     damping force (``2 zeta_1`` of its inertia) hardly enters it: on the clamped beams of
     studies/families.toml (clean, default settings) the result's mode-1 damping was off by
