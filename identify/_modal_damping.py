@@ -93,7 +93,11 @@ previous rule; issue bars: TRAC, MAC >= 0.95, modes 1-2 within 1 %; study bars 0
 -> 0.16 / 0.29 / 0.01 %; clamped 022: TRAC 0.92 -> 0.99; 023: mode 1, unlocated, 58.8 ->
 0.13 %), study bars 41 -> 47 (also 013, 026: mode 2 36.8 / 24.0 -> 2.5 / 2.1 %); clean 50 -> 50
 and 53 -> 53.  No pass lost; the largest change on a passing member: clamped 016
-clean, modes 1-2 0.01 -> 0.35 / 0.30 %.  SGD_NUMBERS
+clean, modes 1-2 0.01 -> 0.35 / 0.30 %.  ``sgd_sindy`` (its modes the eigenvalue penalty paired
+with no peak passed as unlocated): at 1 % noise 34 -> 39 (clamped 000, 007, 016, 022, soft 019:
+mode 2 20.4 / 19.1 / - / - / 48.9 % -> 0.16 / 0.29 / - / - / 0.21 %, 016 mode 1 64.3 -> 0.00 %,
+022 TRAC 0.93 -> 0.99), study bars 43 -> 50 (also 013, 023, 026); clean 50 -> 50 and 54 -> 54;
+no pass lost (largest change on a passing member: 039 at 1 %, mode 2 0.14 -> 0.35 %).
 
 Couplings the decays contradict
 -------------------------------
