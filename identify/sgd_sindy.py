@@ -584,7 +584,11 @@ class SGDSINDy(SGDSINDyBase):
     what was removed); the eigenvalue hold keeps K positive semi-definite (positive targets).
     The linear model is therefore never unstable: ``M`` > 0, ``C``, ``K`` >= 0.
 
-    *Decay hold* (``decay_hold``).  The equation-error fit weighs each row by its
+    *Decay hold* (``decay_hold``; a mode the eigenvalue penalty paired with no peak,
+    ``eigen_targets_`` 0, is passed as ``unlocated`` since 2026-11-27, ``ls_sindy``'s rule:
+    its decay is fitted on every channel at once and taken wherever it lies between its
+    neighbouring modes, :mod:`identify._modal_damping`, "Unlocated modes").  The
+    equation-error fit weighs each row by its
     acceleration, which the highest sensed mode dominates, so a lightly damped mode 1's
     damping force (``2 zeta_1`` of its inertia) hardly enters it: on the clamped beams of
     studies/families.toml (clean, default settings) the result's mode-1 damping was off by
@@ -1100,6 +1104,15 @@ class SGDSINDy(SGDSINDyBase):
         self._hold_decay(data, est, m, bl["v"], bl["d"])  # before the trapezoid map (_modal_damping)
         self._finish_fit(data)
 
+    def _unlocated(self) -> np.ndarray | None:
+        """Modes the eigenvalue penalty paired with no measured peak (``eigen_targets_`` 0),
+        when it paired some (a linear model); else None (``ls_sindy``'s rule: such a mode's
+        decay fit is taken wherever it lies, :func:`identify._modal_damping.decay_hold`)."""
+        t = np.asarray(self.eigen_targets_, dtype=float)
+        if self.K3_ is not None or t.size != self.M_.shape[0] or not np.any(t > 0):
+            return None
+        return t == 0
+
     def _hold_decay(self, data: Measurement, est: MatrixSGDSettings, m: np.ndarray,
                     v_block: slice, d_block: slice) -> None:
         """With ``decay_hold``, give each mode the pole of its measured free decay
@@ -1123,7 +1136,8 @@ class SGDSINDy(SGDSINDyBase):
             return K
 
         held = decay_hold(data, self.M_, self.C_, self.K_, fit_window(data, est.fit_duration),
-                          set_frequencies, self.decay_hold, self.K3_, self.decay_backbone)
+                          set_frequencies, self.decay_hold, self.K3_, self.decay_backbone,
+                          self._unlocated())
         if held.decay is not None:
             self.modal_decay_ = held.decay
         self.coef_[:, v_block] -= (held.C - self.C_) / m
