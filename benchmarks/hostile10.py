@@ -42,7 +42,6 @@ from __future__ import annotations
 import contextlib
 import copy
 import io
-import math
 import os
 import socket
 import sys
@@ -331,7 +330,7 @@ def roundtrip_cases(work: Path) -> list[tuple[str, object]]:
     content = {  # edits of content, not rehashed: each must be refused
         "fs x2": set_attr("/", "fs", lambda v: v * 2),
         "fs 5e-324": set_attr("/", "fs", lambda v: 5e-324),
-        "a channel renamed": set_attr("signal", "channels", lambda v: ["zz"] + list(v)[1:]),
+        "a channel renamed": set_attr("signal", "channels", lambda v: ["zz", *list(v)[1:]]),
         "a unit changed": set_attr("signal", "unit", lambda v: "mm"),
         "a position moved": set_attr("signal", "positions", lambda v: np.asarray(v) + 0.01),
         "one sample": one_sample,
@@ -395,7 +394,7 @@ def roundtrip_cases(work: Path) -> list[tuple[str, object]]:
     def uff_blocks(data: bytes) -> list[bytes]:
         tags = [i for i in range(len(data)) if data.startswith(b"    -1\n", i)
                 and (i == 0 or data[i - 1:i] == b"\n")]
-        return [data[a:b + 7] for a, b in zip(tags[0::2], tags[1::2])]
+        return [data[a:b + 7] for a, b in zip(tags[0::2], tags[1::2], strict=False)]
 
     def uff_dup_last(data: bytes) -> bytes:
         return data + uff_blocks(data)[-1]
@@ -450,8 +449,10 @@ def extends_cases(work: Path) -> list[tuple[str, object]]:
         "a blank": 'extends = " "',
         "a NUL": 'extends = "x\\u0000.toml"',
         "the cantilever, rig switched to the cart-pole": f'extends = "{cant}"\nrig = "cartpole"',
-        "the cantilever, identify switched to sindy_pi": f'extends = "{cant}"\n[identify]\nmethod = "sindy_pi"',
-        "mm with [rig] replaced by a number": f'extends = "{mm}"\n[simulation]\nduration = 2.0\n[noise]\nrms_percent = "x"',
+        "the cantilever, identify switched to sindy_pi":
+            f'extends = "{cant}"\n[identify]\nmethod = "sindy_pi"',
+        "mm with [rig] replaced by a number":
+            f'extends = "{mm}"\n[simulation]\nduration = 2.0\n[noise]\nrms_percent = "x"',
     }
     cases = []
     for tag, body in children.items():

@@ -346,7 +346,7 @@ def _dask_identity_problem(address: str) -> str | None:
         reply = asyncio.run(asyncio.wait_for(identity(), 2 * DASK_CONNECT_TIMEOUT_S))
     except TimeoutError:
         return f"no reply within {2 * DASK_CONNECT_TIMEOUT_S:g} s"
-    except Exception as e:  # noqa: BLE001 -- whatever the server sent, it is not a scheduler
+    except Exception as e:  # whatever the server sent, it is not a scheduler
         return f"{type(e).__name__}: {' '.join(str(e).split())[:120]}"
     if not (isinstance(reply, dict) and reply.get("type") == "Scheduler"):
         return f"it answered as {reply.get('type') if isinstance(reply, dict) else type(reply).__name__}"

@@ -963,8 +963,8 @@ def _check_uff_blocks(path: Path, data: bytes) -> None:
                                       f"{line}): every block starts and ends with a line '    -1'")
     # the gaps: the file's start to the first start tag, each end tag's line to the next start
     ends = [0] + [data.find(b"\n", t) + 1 or len(data) for t in tags[1::2]]
-    starts = tags[0::2] + [len(data)]
-    for lo, hi in zip(ends, starts):
+    starts = [*tags[0::2], len(data)]
+    for lo, hi in zip(ends, starts, strict=True):
         stray = data[lo:hi]
         if stray.strip():
             at = lo + len(stray) - len(stray.lstrip())

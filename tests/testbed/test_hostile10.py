@@ -180,7 +180,7 @@ def test_an_identifier_built_in_python_with_an_unread_setting_is_refused_at_fit_
     from identify.pysindy_field import PySINDyField
     from testbed.core.errors import HyperparameterError
 
-    with pytest.raises(HyperparameterError, match="pysindy.n_models"):
+    with pytest.raises(HyperparameterError, match=r"pysindy\.n_models"):
         PySINDyField(optimizer="sr3", n_models=5).check_params()
 
 
