@@ -103,3 +103,17 @@ def main(argv: list[str], families: dict[str, Callable[[Path], Counter]], prefix
             total += c
     print(f"total: {total['cases']} cases, {total['findings']} findings")
     return 1 if total["findings"] else 0
+
+
+def base_scenario(bases: dict[str, tuple[str, float]], kind: str) -> tuple[str, dict]:
+    """The shipped scenario a round starts a rig ``kind``'s cases from (``bases[kind]``: its
+    name and the record's duration [s]), as a raw table: no ``extends``, no ``[score]`` (the
+    bars were set for the base's identifier)."""
+    from testbed.pipeline.scenario import SCENARIO_DIR, _read_toml
+
+    base, cut = bases[kind]
+    raw = _read_toml(SCENARIO_DIR / f"{base}.toml")
+    raw["scenario"].pop("extends", None)
+    raw["simulation"]["duration"] = cut
+    raw.pop("score", None)
+    return base, raw

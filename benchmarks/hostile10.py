@@ -122,15 +122,8 @@ COMBOS = [c for c in COMBOS if c[2]]
 BASE_PARAMS = {"sindy_pi": {"library": "generic"}, "pysindy_pi": {"library": "generic"}}
 
 
-def _raw(kind: str):
-    from testbed.pipeline.scenario import SCENARIO_DIR, _read_toml
-
-    base, cut = BASES[kind]
-    raw = _read_toml(SCENARIO_DIR / f"{base}.toml")
-    raw["scenario"].pop("extends", None)
-    raw["simulation"]["duration"] = cut
-    raw.pop("score", None)  # the bars were set for the base's identifier
-    return base, raw
+def _raw(kind: str) -> tuple[str, dict]:
+    return _hostile.base_scenario(BASES, kind)
 
 
 def _fitted(model) -> dict:

@@ -81,15 +81,8 @@ def _run(raw: dict, base: str, run: bool) -> str | None:
     return _hostile.scored_finding(run_scenario(sc))
 
 
-def _raw(kind: str):
-    from testbed.pipeline.scenario import SCENARIO_DIR, _read_toml
-
-    base, cut = BASES[kind]
-    raw = _read_toml(SCENARIO_DIR / f"{base}.toml")
-    raw["scenario"].pop("extends", None)
-    raw["simulation"]["duration"] = cut
-    raw.pop("score", None)  # the bars were set for the base's identifier
-    return base, raw
+def _raw(kind: str) -> tuple[str, dict]:
+    return _hostile.base_scenario(BASES, kind)
 
 
 def hyper_cases() -> list[tuple[str, object]]:
