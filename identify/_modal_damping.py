@@ -267,30 +267,47 @@ class ModalDecay:
     amplitude: np.ndarray | None = None
 
 
-def _two_column_lstsq(A: np.ndarray, q: np.ndarray) -> np.ndarray:
-    """Least-squares coefficients (shape (2,), or (2, m)) of ``A`` (shape (N, 2)) for ``q``
-    (shape (N,), or (N, m): each column its own).
+def _two_column_qr(A: np.ndarray) -> tuple[float, np.ndarray, float, float, np.ndarray | None]:
+    """A QR of ``A`` (shape (N, 2)) by modified Gram-Schmidt, stable for two columns.
 
-    A QR by modified Gram-Schmidt, stable for two columns; LAPACK's divide-and-conquer SVD
-    (``numpy.linalg.lstsq``) spends about 3 ms on 12,800 x 2 against 0.1 ms here.  As lstsq's
-    default cut-off, the second column counts only when its part orthogonal to the first
-    exceeds ``eps * N`` of the first's norm; else (rank one) the least-norm coefficients, as
-    lstsq's.
+    Returns ``r00, u0, r01, r11, u1``: ``A = [u0 u1] [[r00, r01], [0, r11]]`` with ``u0, u1``
+    orthonormal (N,).  As lstsq's default cut-off, the second column counts only when its part
+    orthogonal to the first exceeds ``eps * N`` of the first's norm: else (rank one, or a zero
+    first column, ``r00 = 0``) ``u1`` is None.
     """
     a0, a1 = A[:, 0], A[:, 1]
     r00 = float(np.sqrt(a0 @ a0))
     if not r00 > 0.0:
-        a11 = float(a1 @ a1)
-        x1 = (a1 @ q) / a11 if a11 > 0.0 else np.zeros(q.shape[1:])
-        return np.array([np.zeros_like(x1), x1])
+        return r00, a0, 0.0, 0.0, None
     u0 = a0 / r00
     r01 = float(u0 @ a1)
     v = a1 - r01 * u0
     r11 = float(np.sqrt(v @ v))
+    if not r11 > np.finfo(float).eps * len(a0) * r00:
+        return r00, u0, r01, r11, None
+    return r00, u0, r01, r11, v / r11
+
+
+def _two_column_lstsq(A: np.ndarray, q: np.ndarray,
+                      qr: tuple[float, np.ndarray, float, float, np.ndarray | None] | None = None
+                      ) -> np.ndarray:
+    """Least-squares coefficients (shape (2,), or (2, m)) of ``A`` (shape (N, 2)) for ``q``
+    (shape (N,), or (N, m): each column its own), from :func:`_two_column_qr` (``qr``, when
+    already made).
+
+    LAPACK's divide-and-conquer SVD (``numpy.linalg.lstsq``) spends about 3 ms on 12,800 x 2
+    against 0.1 ms here.  Where the QR finds rank one: the least-norm coefficients, as lstsq's.
+    """
+    r00, u0, r01, r11, u1 = _two_column_qr(A) if qr is None else qr
+    if not r00 > 0.0:
+        a1 = A[:, 1]
+        a11 = float(a1 @ a1)
+        x1 = (a1 @ q) / a11 if a11 > 0.0 else np.zeros(q.shape[1:])
+        return np.array([np.zeros_like(x1), x1])
     b0 = u0 @ q
-    if not r11 > np.finfo(float).eps * len(q) * r00:  # rank one: lstsq's least-norm answer
+    if u1 is None:  # rank one: lstsq's least-norm answer
         return np.array([r00 * b0, r01 * b0]) / (r00 * r00 + r01 * r01)
-    x1 = ((v / r11) @ q) / r11
+    x1 = (u1 @ q) / r11
     return np.array([(b0 - r01 * x1) / r00, x1])
 
 
@@ -354,9 +371,10 @@ def _decay_problem(q: np.ndarray, t: np.ndarray, backbone: bool,
         E = np.exp(-p[0] * t)
         cs, sn = E * np.cos(ph), E * np.sin(ph)
         A = project(np.column_stack([cs, sn]))
-        x = _two_column_lstsq(A, q)
+        qr = _two_column_qr(A)
+        x = _two_column_lstsq(A, q, qr)
         last.clear()
-        last.update(p=np.array(p, dtype=float), cs=cs, sn=sn, E=E, A=A, x=x, r=A @ x - q,
+        last.update(p=np.array(p, dtype=float), cs=cs, sn=sn, E=E, qr=qr, x=x, r=A @ x - q,
                     g=g, s=s)  # x (2,) or (2, m), r (N,) or (N, m) as q
         return last
 
@@ -366,7 +384,7 @@ def _decay_problem(q: np.ndarray, t: np.ndarray, backbone: bool,
     def jac(p: np.ndarray) -> np.ndarray:
         """d resid / d p: ``P_perp dA_k x - pinv(A)^T dA_k^T r`` for each parameter."""
         wv = waves(p)
-        A, x, r, cs, sn = wv["A"], wv["x"], wv["r"], wv["cs"], wv["sn"]
+        x, r, cs, sn = wv["x"], wv["r"], wv["cs"], wv["sn"]
         # per parameter, d log(E) and d ph: d(E cos ph) = (dlogE cos ph - dph sin ph) E
         dlogE, dph = [-t, None], [None, t]
         if backbone:
@@ -382,15 +400,11 @@ def _decay_problem(q: np.ndarray, t: np.ndarray, backbone: bool,
             dph[0] = d0
             dlogE.append(None)
             dph.append(g)
-        a0, a1 = A[:, 0], A[:, 1]
-        r00 = float(np.sqrt(a0 @ a0))
-        u0 = a0 / r00
-        v = a1 - (u0 @ a1) * u0
-        r11 = float(np.sqrt(v @ v))
-        if not (r00 > 0.0 and r11 > np.finfo(float).eps * len(t) * r00):
+        r00, u0, r01, r11, u1 = wv["qr"]
+        if u1 is None:
             return _forward_jacobian(resid, p, r.ravel())  # rank one: no projector to differentiate
-        Qm = np.column_stack([u0, v / r11])
-        R = np.array([[r00, float(u0 @ a1)], [0.0, r11]])
+        Qm = np.column_stack([u0, u1])
+        R = np.array([[r00, r01], [0.0, r11]])
         cols = []
         for le, dp in zip(dlogE, dph, strict=True):
             c_, s_ = np.zeros_like(t), np.zeros_like(t)
