@@ -41,6 +41,20 @@ DRAWS = 32
 SEED = 0
 
 
+def _unit_rows(rows: Callable[[np.ndarray], np.ndarray], x: np.ndarray
+               ) -> tuple[np.ndarray, np.ndarray, str]:
+    """The terms' rows ``rows(x)`` (n_rows, q) with each column scaled to unit norm, the norms
+    (q,), and what makes them unusable: ``"rows"`` (fewer than two terms, or a non-finite
+    row), ``"zero"`` (an all-zero column), else ``""`` (then the first two are meaningful)."""
+    theta = np.asarray(rows(x), dtype=float)
+    if theta.shape[1] < 2 or not np.all(np.isfinite(theta)):
+        return theta, np.ones(theta.shape[1]), "rows"
+    norms = np.linalg.norm(theta, axis=0)
+    if np.any(norms == 0.0):
+        return theta, norms, "zero"
+    return theta / norms, norms, ""
+
+
 def determinacy_bound(rows: Callable[[np.ndarray], np.ndarray], x: np.ndarray,
                       sigma: np.ndarray) -> float:
     """The noise's Gram over the gap of an implicit equation's terms, at the record's noise
@@ -63,13 +77,9 @@ def determinacy_bound(rows: Callable[[np.ndarray], np.ndarray], x: np.ndarray,
         hold two equations exactly (``lambda_2 = 0``), NaN for an equation of fewer than two
         terms or non-finite rows.
     """
-    theta = np.asarray(rows(x), dtype=float)
-    if theta.shape[1] < 2 or not np.all(np.isfinite(theta)):
-        return float("nan")
-    norms = np.linalg.norm(theta, axis=0)
-    if np.any(norms == 0.0):
-        return float("inf")
-    base = theta / norms
+    base, norms, fault = _unit_rows(rows, x)
+    if fault:
+        return float("inf") if fault == "zero" else float("nan")
     gap = float(np.linalg.eigvalsh(base.T @ base)[1])
     sigma = np.asarray(sigma, dtype=float).reshape(-1, 1)
     if not np.any(sigma > 0.0):
@@ -123,15 +133,10 @@ def noise_residual_ratio(rows: Callable[[np.ndarray], np.ndarray], x: np.ndarray
     w : ndarray, shape (q,)
         The equation ``v`` in the terms' original units (``v / norms``), or NaN.
     """
-    theta = np.asarray(rows(x), dtype=float)
-    q = theta.shape[1]
-    nan = (float("nan"), np.full(q, np.nan))
-    if q < 2 or not np.all(np.isfinite(theta)):
+    base, norms, fault = _unit_rows(rows, x)
+    nan = (float("nan"), np.full(base.shape[1], np.nan))
+    if fault:
         return nan
-    norms = np.linalg.norm(theta, axis=0)
-    if np.any(norms == 0.0):
-        return nan
-    base = theta / norms
     vals, vecs = np.linalg.eigh(base.T @ base)
     v = vecs[:, 0]
     sigma = np.asarray(sigma, dtype=float).reshape(-1, 1)
