@@ -74,6 +74,11 @@ class Identifier:
     #: optimizer): one given at another value than its default while the identifier would not
     #: read it is refused (:func:`testbed.core.schema.check_keys_used`), not ignored.
     used_when: ClassVar[Mapping[str, KeyUse | tuple[KeyUse, ...]]] = {}
+    #: The fit is a function of the measurement and the hyperparameters alone (every random draw
+    #: seeded by a hyperparameter), to the bit: a study then computes the cells that differ only
+    #: in their noise seed at 0 % noise once (:func:`testbed.studies.sweep.shared_computation`).
+    #: False (a plugin that does not say): each such cell is fitted, showing the method's spread.
+    deterministic: ClassVar[bool] = False
 
     @classmethod
     def declared_hyperparameters(cls) -> dict[str, Field]:

@@ -104,6 +104,7 @@ class PySINDyField(StructuralIdentifier):
     """
 
     name = "pysindy"
+    deterministic = True  # pysindy's draws seeded by ``seed``; refitted to the bit in test_conformance
     hyperparameters: ClassVar[dict[str, Field]] = {
         "optimizer": Field(str, "stlsq", choices=OPTIMIZERS, doc="pysindy optimizer: STLSQ, SR3 or "
                                                                    "EnsembleOptimizer(STLSQ)"),

@@ -147,6 +147,7 @@ class PySINDyPI(_ImplicitMechanical):
     """
 
     name = "pysindy_pi"
+    deterministic = True  # OSQP, single-threaded; refitted to the bit in test_conformance
     hyperparameters: ClassVar[dict[str, Field]] = ordered_fields({
         **COMMON_HYPERPARAMETERS,
         "reg_weight_lam": Field(float, 1e-6, min=0.0, doc="L1 weight of pysindy's objective"),

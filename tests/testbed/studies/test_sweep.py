@@ -21,7 +21,15 @@ import pytest
 
 from testbed.studies.results import parts_dir, read_results
 from testbed.studies.study import load_study
-from testbed.studies.sweep import SweepStats, cell_key, expand, release_freed_memory, run_sweep
+from testbed.studies.sweep import (
+    SweepStats,
+    cell_key,
+    expand,
+    release_freed_memory,
+    run_cell,
+    run_sweep,
+    sweep_provenance,
+)
 
 ROOT = Path(__file__).resolve().parents[3]
 
@@ -105,6 +113,17 @@ class ToyFit(Identifier):
 
 
 IDENTIFIERS.register("toy_fit")(ToyFit)
+
+
+@IDENTIFIERS.register("toy_det")
+class ToyDeterministic(ToyFit):
+    """Declares its fit deterministic; counts its fits (in this process)."""
+    deterministic = True
+    fits = []
+
+    def fit(self, data):
+        type(self).fits.append(data.n_samples)
+        return super().fit(data)
 
 
 @IDENTIFIERS.register("toy_raise")
@@ -314,6 +333,34 @@ def test_rerun_after_editing_the_study_runs_only_new_cells(toy_dir, tmp_path):
     shrunk = load_study(write_study(toy_dir, "edit", ["toy_fit"], seeds=(1,)))
     third = read_results(run_sweep(shrunk, results=res, cache_dir=cache, verbose=False))
     assert {r["seed"] for r in third} == {1} and len(third) == 2
+
+
+def test_cells_at_zero_noise_of_a_deterministic_identifier_are_fitted_once(toy_dir, tmp_path):
+    """The seed draws only the noise: at 0 % the seeds' cells are one computation, fitted once;
+    each copy is the row fitting it gives (its own dataset hash included), on a resume too."""
+    from identify import IDENTIFIERS
+
+    res, cache = tmp_path / "r.parquet", tmp_path / "c"
+    study = load_study(write_study(toy_dir, "det", ["toy_det", "toy_fit"], seeds=(0, 1, 2)))
+    fits = IDENTIFIERS.get("toy_det").fits
+    fits.clear()
+    stats = SweepStats()
+    rows = read_results(run_sweep(study, results=res, cache_dir=cache, verbose=False, stats=stats))
+    assert len(rows) == 12 and stats.run == 12
+    # toy_det: 1 fit at 0 % + 3 at 2 %; toy_fit (undeclared, a plugin's default) fits every cell
+    assert stats.copied == 2 and len(fits) == 4
+    # each row equals the row of the cell run alone
+    cells = {c.key: c for c in expand(study)}
+    alone = [run_cell(cells[r["cell"]], str(cache), study.plugins, provenance=sweep_provenance())
+             for r in rows]
+    assert comparable(rows) == comparable(alone)
+    zero = [r for r in rows if r["identifier"] == "toy_det" and r["noise"] == 0.0]
+    assert len({r["dataset_hash"] for r in zero}) == 3  # each seed's own dataset (its seed attr)
+    # a resume after seeds were added copies the finished row: no new fit at 0 %
+    fits.clear()
+    grown = load_study(write_study(toy_dir, "det", ["toy_det", "toy_fit"], seeds=(0, 1, 2, 3)))
+    again = read_results(run_sweep(grown, results=res, cache_dir=cache, verbose=False, stats=stats))
+    assert len(again) == 16 and stats.run == 4 and stats.copied == 1 and len(fits) == 1
 
 
 def _finished_cells(results: Path) -> int:
