@@ -171,9 +171,12 @@ class PySINDyPI(_ImplicitMechanical):
         "rollout_segments", "prune_tol", "sim_dt", "reconcile", "column_lowpass_hz",
         "column_lowpass_order", "edge_trim", "input_hold"))  # __init__ order, for the guide
     #: Keys the fit reads only under another setting (benchmarks/hostile10.py ``combos``:
-    #: ``rollout_segments = 3`` under the held-out selection fitted the same model to the bit).
+    #: ``rollout_segments = 3`` under the held-out selection fitted the same model to the bit;
+    #: so did ``n_rollout = 5`` there, and ``stride = 7`` with ``qr``, on the double pendulum).
     used_when: ClassVar[dict[str, KeyUse]] = {
         "rollout_segments": KeyUse("selection", lambda v: v == "rollout", "selection = 'rollout'"),
+        "n_rollout": KeyUse("selection", lambda v: v == "rollout", "selection = 'rollout'"),
+        "stride": KeyUse("qr", lambda v: not v, "qr = false (the R factor carries every sample)"),
     }
 
     def __init__(self, library: Any = "fivebar", lhs: Sequence[str] | None = None,

@@ -144,6 +144,8 @@ def test_blank_lines_between_uff_blocks_are_read(tmp_path):
     ("sindy_pi", {"formulation": "strong", "weak_degree": 2}, "weak_degree", "formulation = 'weak'"),
     ("sindy_pi", {"ensemble_seed": 4}, "ensemble_seed", "read only with ensemble > 0"),
     ("pysindy_pi", {"rollout_segments": 3}, "rollout_segments", "selection = 'rollout'"),
+    ("pysindy_pi", {"n_rollout": 5}, "n_rollout", "selection = 'rollout'"),
+    ("pysindy_pi", {"qr": True, "stride": 7}, "stride", "qr = false"),
     ("sindy_pi_dynamical", {"weak_windows": 50}, "weak_windows", "formulation = 'weak'"),
     ("sindy_pi_dynamical", {"library": ["1", "x", "dx", "x*dx"], "degree": 3}, "degree",
      "the default library"),
@@ -168,6 +170,8 @@ def test_a_hyperparameter_the_identifier_would_not_read_is_refused_naming_its_sw
     ("sindy_pi_dynamical", {"formulation": "weak", "weak_windows": 50}),
     ("sindy_pi", {"n_rollout": 5, "weak_degree": 2}),     # selection and formulation by rule
     ("sindy_pi", {"ensemble": 3, "ensemble_seed": 4}),
+    ("pysindy_pi", {"selection": "rollout", "n_rollout": 5}),
+    ("pysindy_pi", {"stride": 7}),
 ])
 def test_a_hyperparameter_the_identifier_reads_is_still_accepted(method, params):
     from testbed.pipeline.plugins import IDENTIFIERS
