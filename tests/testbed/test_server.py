@@ -16,6 +16,7 @@ from pathlib import Path
 import pytest
 
 from testbed import cli
+from tests._processes import alive, state
 
 ROOT = Path(__file__).resolve().parents[2]
 pytestmark = [pytest.mark.xdist_group("server"),
@@ -138,12 +139,7 @@ def test_a_killed_client_leaves_no_process(server):
 
 
 def _alive(pid: int) -> bool:
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    stat = Path(f"/proc/{pid}/stat")
-    return not (stat.exists() and stat.read_text().split()[2] == "Z")  # reaped soon by the server
+    return alive(pid)  # a zombie is reaped soon by the server
 
 
 def test_serve_refuses_a_shared_socket_folder(tmp_path, monkeypatch, capsys):
@@ -363,7 +359,6 @@ def test_ctrl_z_stops_the_command_with_its_client(sleeper):
                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, process_group=0)
     _wait_for(lambda: len(_pids(tmp)) == 1, "the command started")
     # (a Ctrl-Z before the client has the pid, as here under load, waits for it)
-    state = lambda pid: Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]  # noqa: E731
     c.send_signal(signal.SIGTSTP)
     _wait_for(lambda: state(c.pid) == "T" and state(_pids(tmp)[0]) == "T",
               lambda: f"both stopped (client {state(c.pid)}, command {state(_pids(tmp)[0])})", 10)

@@ -18,6 +18,7 @@ import _synthetic_runs as synth
 
 from testbed.reporting import drawer, figures
 from testbed.studies.runstore import load_run, save_new_run, save_run
+from tests._processes import alive
 
 ROOT = Path(__file__).resolve().parents[3]
 needs_fork = pytest.mark.skipif(not drawer.fork_available(), reason="figures drawn in-process here")
@@ -87,14 +88,6 @@ def test_a_worker_that_dies_is_an_error_not_a_hang(run_folder, tmp_path):
         worker.close(kill=True)
 
 
-def _alive(pid: int) -> bool:
-    try:
-        with open(f"/proc/{pid}/stat") as fh:
-            return fh.read().split(") ")[1][0] != "Z"
-    except FileNotFoundError:
-        return False
-
-
 @needs_fork
 def test_a_killed_run_leaves_no_drawing_process(tmp_path):
     """SIGKILL of the command (no clean-up runs in it): the kernel ends its drawing process."""
@@ -111,13 +104,13 @@ def test_a_killed_run_leaves_no_drawing_process(tmp_path):
     p = subprocess.Popen([sys.executable, "-c", code], cwd=ROOT, env=env, stdout=subprocess.PIPE, text=True)
     try:
         pids = [int(x) for x in p.stdout.readline().split()]
-        assert pids and all(_alive(q) for q in pids)
+        assert pids and all(alive(q) for q in pids)
         p.kill()
         p.wait(10)
         deadline = time.monotonic() + 10
-        while any(_alive(q) for q in pids) and time.monotonic() < deadline:
+        while any(alive(q) for q in pids) and time.monotonic() < deadline:
             time.sleep(0.05)
-        assert not any(_alive(q) for q in pids), "a drawing process outlived the killed command"
+        assert not any(alive(q) for q in pids), "a drawing process outlived the killed command"
     finally:
         p.kill()
         p.wait()
