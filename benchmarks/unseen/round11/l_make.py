@@ -141,7 +141,8 @@ def main() -> None:
                "angle_rmse_max = 0.0501       # the paper's figure (rounds 2-10's bar for unseen cart-poles)")
     for name, (desc, tables) in KINETICS.items():
         _write(name, "michaelis_menten_noise1", desc + "; michaelis_menten_noise1's weak setup", tables,
-               "state_rmse_max = 0.01         # mM (rounds 2-10's bar); the rig's own equation bars apply too")
+               "state_rmse_max = 0.01         # mM (rounds 2-10's bar); "
+               "the rig's own equation bars apply too")
 
 
 if __name__ == "__main__":
