@@ -1614,8 +1614,8 @@ class SINDyPI(_ImplicitMechanical):
             "formulation user-set" if self.formulation is not None else
             "ensemble" if self.ensemble else
             "not the strong form with rollout selection" if not (
-                self.formulation_ == "strong" and self.selection_ == "rollout"
-                and self.selection is None) else "")
+                getattr(self, "formulation_", None) == "strong" and self.selection is None
+                and getattr(self, "selection_", None) == "rollout") else "")
         if self.formulation_rule_ != "not applied: ":
             return
         imap = np.abs(np.asarray(data.input_map)) > 0
