@@ -1384,7 +1384,9 @@ class SINDyPI(_ImplicitMechanical):
                                "it); default by the noise rule"),
         "formulation": Field(str, None, choices=("strong", "weak"),
                              doc="one regression row per sample, or per test-function integral; "
-                                 "default by the noise rule"),
+                                 "default by the noise rule (an open chain with chain-derived "
+                                 "rates: the form whose segmented rollout is smaller, "
+                                 "formulation_rule_)"),
         "weak_window_s": Field(float, None, unit="s", min=0.0, min_inclusive=False,
                                doc="support of each test function (weak form; shorter than the "
                                    "record); default by the noise rule"),
