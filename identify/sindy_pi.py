@@ -1597,8 +1597,10 @@ class SINDyPI(_ImplicitMechanical):
         redone in the weak form (the rule's window, trim and ridge for it, as if the user had
         set ``formulation = "weak"``), and the weak fit is kept only if its chosen model's
         segmented rollout error (:meth:`_ImplicitMechanical._rollout_error`, ``rollout_segments``
-        segments) is strictly smaller over the span both fits keep (the larger of the two edge
-        trims); a tie, a failed weak fit or a non-finite error keeps the strong one.
+        segments) over the span both fits keep (the larger of the two edge trims) is smaller
+        than the strong one's beyond the rollout selection's tie: ``strong > weak (1 +
+        selection_rtol) + ROLLOUT_ATOL``; a tie, a failed weak fit or a non-finite error keeps
+        the strong one (the noise rule's form, and a margin no BLAS round-off crosses).
 
         Why: an open chain's free coordinate (the cart on its rail) integrates every error of
         its equation when simulated under the replayed force, so the strong form's errors in
@@ -1647,11 +1649,12 @@ class SINDyPI(_ImplicitMechanical):
         head = (f"open chain, rates by a declared low-pass: segmented rollout over "
                 f"[{max(trims):.3g} s, end - {max(trims):.3g} s] strong {strong_err:.4g}, "
                 f"weak {weak_err:.4g}")
-        if np.isfinite(weak_err) and weak_err < strong_err:
+        # the rollout selection's tie (selection_rtol, ROLLOUT_ATOL) goes to the strong form
+        if np.isfinite(weak_err) and strong_err > weak_err * (1 + self.selection_rtol) + ROLLOUT_ATOL:
             self.__dict__.update(weak)
-            self.formulation_rule_ = f"{head}: weak form kept (smaller)"
+            self.formulation_rule_ = f"{head}: weak form kept (smaller beyond the tie)"
         else:
-            self.formulation_rule_ = f"{head}: strong form kept (not larger)"
+            self.formulation_rule_ = f"{head}: strong form kept (the weak not smaller beyond the tie)"
 
     def _fit_weak(self, data: Measurement) -> None:
         """The weak-form fit of :meth:`_open_chain_form`: the fit of :meth:`fit` with the
