@@ -76,8 +76,8 @@ def check_transmission(theta: np.ndarray, t: np.ndarray, engine: str) -> None:
         k = int(np.argmax(bad))
         raise RigError(f"fivebar ({engine}): at t = {t[k]:.4f} s the transmission angle (links 2-3 at E) "
                        f"is {mu[k]:.2f} deg; allowed {lo:g}-{hi:g} deg (outside it the linkage is near a "
-                       "Type II singularity). Reduce the excitation amplitude, add centring feedback "
-                       "(kp, kd) or start from a better-conditioned pose.")
+                       "Type II singularity). Drive the linkage less far (the keys named) or start "
+                       "from a better-conditioned pose.")
 
 
 def simulate(dyn: FiveBarDynamics, theta0: np.ndarray, dtheta0: np.ndarray, program: TorqueProgram,

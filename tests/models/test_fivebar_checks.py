@@ -149,6 +149,19 @@ def test_a_linkage_falling_under_gravity_names_gravity_among_the_keys():
                                    "excitation.kd, rig.gravity': value [1.0, 0.5, 0.0, 0.0, True]: ")
 
 
+def test_a_sine_replay_falling_under_gravity_is_told_to_change_only_keys_it_has():
+    """Round 11's fb11_gravity_asym: the replayed torques let the linkage fall off the sine's
+    path; the message advised "add centring feedback (kp, kd)", which sine_replay refuses."""
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[2] / "benchmarks/unseen/round11/fb11_gravity_asym.toml"
+    with pytest.raises(RigError, match=r"transmission angle") as e:
+        FiveBarRig(load_scenario(path)).simulate()
+    msg = str(e.value)
+    assert msg.startswith("key 'excitation.amplitude, excitation.frequency, rig.gravity'")
+    assert "kp" not in msg and "the keys named" in msg
+
+
 def test_short_dataset_layout_and_roundtrip(tmp_path):
     sc = _scenario(simulation={"duration": 0.05}, excitation={"type": "chirp"})
     ds = FiveBarRig(sc).simulate()
