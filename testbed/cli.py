@@ -49,8 +49,44 @@ BLAS_THREAD_VARIABLES = ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "OMP_NUM_THR
 DASK_CONNECT_TIMEOUT_S = 5.0
 
 
+#: Namespace attribute where :class:`_StoreOnce` records the options given so far (removed
+#: before the arguments are returned).
+_GIVEN = "_testbed_options_given"
+
+
+class _StoreOnce(argparse._StoreAction):
+    """argparse's ``store`` that refuses an option given twice with another value.
+
+    argparse keeps the last value in silence: ``sweep --jobs 1 ... --jobs 2`` ran on two
+    processes, ``run --seed 1 --seed 2`` under seed 2, ``report -o a -o b`` wrote ``b``
+    (round 11).  The same value twice changes nothing and passes; options that add up
+    (``--plugin``, ``--param``) are ``append`` actions and unaffected.
+    """
+
+    def __call__(self, parser, namespace, values, option_string=None):  # noqa: ANN001
+        given = namespace.__dict__.setdefault(_GIVEN, {})
+        if self.dest in given and given[self.dest][1] != values:
+            first, value = given[self.dest]
+            raise argparse.ArgumentError(
+                self, f"given twice ({first} {show_value(value)}, then {option_string} "
+                      f"{show_value(values)}); give it once")
+        given[self.dest] = (option_string, values)
+        setattr(namespace, self.dest, values)
+
+
 class _Parser(argparse.ArgumentParser):
-    """argparse with one-line errors (``error: ...``, status 2) instead of usage + message."""
+    """argparse with one-line errors (``error: ...``, status 2) instead of usage + message, and
+    an option given twice with different values refused (:class:`_StoreOnce`)."""
+
+    def __init__(self, *args, **kwargs) -> None:  # noqa: ANN002, ANN003
+        super().__init__(*args, **kwargs)
+        self.register("action", None, _StoreOnce)
+        self.register("action", "store", _StoreOnce)
+
+    def parse_known_args(self, args=None, namespace=None):  # noqa: ANN001
+        ns, rest = super().parse_known_args(args, namespace)
+        ns.__dict__.pop(_GIVEN, None)
+        return ns, rest
 
     def error(self, message: str) -> None:  # type: ignore[override]
         print(f"error: {self.prog}: {message} (see {self.prog} --help)", file=sys.stderr)
