@@ -116,7 +116,40 @@ def _read_part(p: Path) -> dict[str, Any]:
         raise ValueError("not a results row (no cell and status)")
     if row["cell"] != p.stem:
         raise ValueError(f"holds the row of cell {row['cell']!r}")
+    why = _part_value_problem(row) or _row_problem({**dict.fromkeys(BASE_COLUMNS), **row}, set())
+    if why:
+        raise ValueError(why)
     return row
+
+
+#: The Python types a row file's JSON value may have for each Arrow column type (None, JSON's
+#: null, is a missing value; NaN is a float).
+_JSON_TYPES: dict[str, tuple[type, ...]] = {
+    "string": (str,), "float64": (int, float), "int64": (int,), "bool_": (bool,),
+}
+
+
+def _part_value_problem(row: dict[str, Any]) -> str:
+    """What in a row file's values the Parquet file could not hold or a reader could not use
+    ("" if nothing): each fixed column of its type (:data:`BASE_COLUMNS`, :data:`TAIL_COLUMNS`)
+    or null, each other column a number or null, the seed within int64.
+
+    The Parquet file's rows were checked on read, a row file's only for its cell and status
+    (round 11): ``noise = "abc"`` in one made the resumed sweep an internal error (TypeError
+    sorting the rows), ``noise = NaN`` `testbed report`'s ZeroDivisionError and `testbed
+    summary` a table row of noise NaN.
+    """
+    fixed = {**BASE_COLUMNS, **TAIL_COLUMNS}
+    for name, value in row.items():
+        if value is None:
+            continue
+        types = _JSON_TYPES[fixed[name]] if name in fixed else (int, float)
+        if isinstance(value, bool) and bool not in types or not isinstance(value, types):
+            want = fixed.get(name, "float64").rstrip("_")
+            return f"column {name!r} holds {type(value).__name__} {value!r:.40}; expected {want}"
+    if isinstance(row.get("seed"), int) and not -(2**63) <= row["seed"] < 2**63:
+        return f"seed {row['seed']} beyond the 64-bit integers the results file stores"
+    return ""
 
 
 def _read_parts(path: str | os.PathLike, set_aside: bool = False) -> list[dict[str, Any]]:
