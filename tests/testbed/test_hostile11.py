@@ -150,6 +150,9 @@ def test_a_trickled_request_is_dropped_at_its_deadline():
 
 # ------------------------------------------------------------------ results row files
 
+DROP = "<column removed>"
+
+
 def _row(**change) -> dict:
     row = {"study": "s", "cell": "c1", "scenario": "michaelis_menten", "rig": "michaelis_menten",
            "noise": 0.0, "seed": 0, "identifier": "sindy_pi_dynamical", "params": "{}",
@@ -157,14 +160,14 @@ def _row(**change) -> dict:
            "passed": True, "coef_error": 0.01, "checks": "[]", "versions": "{}", "commit": "x",
            "dataset_hash": "h"}
     row.update(change)
-    return row
+    return {k: v for k, v in row.items() if v is not DROP}
 
 
 @pytest.mark.parametrize("change", [
     {"noise": "abc"}, {"noise": float("nan")}, {"noise": -1.0}, {"noise": None},
     {"status": "bogus"}, {"passed": "yes"}, {"passed": None}, {"seed": "x"}, {"seed": 1.5},
     {"seed": 2**70}, {"coef_error": "high"}, {"coef_error": [1, 2]}, {"identifier": 3},
-    {"fit_time": "slow"}, {"error": 5}, {"passed": 1},
+    {"fit_time": "slow"}, {"error": 5}, {"passed": 1}, {"scenario": None}, {"identifier": DROP},
 ], ids=lambda c: f"{next(iter(c))}={next(iter(c.values()))!r}")
 def test_a_row_file_with_a_value_the_results_cannot_hold_is_set_aside(tmp_path, change, caplog):
     from testbed.studies.results import parts_dir, read_results, write_part
@@ -234,3 +237,12 @@ def test_cache_clear_blocks_while_the_folder_is_held_for_a_write(tmp_path):
         assert not done.wait(0.3) and tmp.exists()  # the write under way keeps its file
     th.join(5.0)
     assert done.is_set() and not tmp.exists()  # a killed writer's file still goes
+
+
+def test_a_results_file_with_a_null_scenario_is_refused(tmp_path):
+    from testbed.studies.results import ResultsError, read_results, write_rows
+
+    # `testbed summary` sorting such rows was an internal error (TypeError)
+    write_rows(tmp_path / "r.parquet", [_row(scenario=None)], study="s")
+    with pytest.raises(ResultsError, match="scenario None; expected text"):
+        read_results(tmp_path / "r.parquet")
