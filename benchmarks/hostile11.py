@@ -136,7 +136,7 @@ def twice_cases() -> list[tuple[str, object]]:
     sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
     cases = []
     for name, sp in sub.choices.items():
-        positional = [("x" if not a.choices else list(a.choices)[0])
+        positional = [("x" if not a.choices else next(iter(a.choices)))
                       for a in sp._actions if not a.option_strings]
         single = [a for a in sp._actions if a.option_strings and a.nargs is None
                   and isinstance(a, argparse._StoreAction)]

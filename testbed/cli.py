@@ -63,7 +63,7 @@ class _StoreOnce(argparse._StoreAction):
     (``--plugin``, ``--param``) are ``append`` actions and unaffected.
     """
 
-    def __call__(self, parser, namespace, values, option_string=None):  # noqa: ANN001
+    def __call__(self, parser, namespace, values, option_string=None):
         given = namespace.__dict__.setdefault(_GIVEN, {})
         if self.dest in given and given[self.dest][1] != values:
             first, value = given[self.dest]
@@ -78,12 +78,12 @@ class _Parser(argparse.ArgumentParser):
     """argparse with one-line errors (``error: ...``, status 2) instead of usage + message, and
     an option given twice with different values refused (:class:`_StoreOnce`)."""
 
-    def __init__(self, *args, **kwargs) -> None:  # noqa: ANN002, ANN003
+    def __init__(self, *args, **kwargs) -> None:
         super().__init__(*args, **kwargs)
         self.register("action", None, _StoreOnce)
         self.register("action", "store", _StoreOnce)
 
-    def parse_known_args(self, args=None, namespace=None):  # noqa: ANN001
+    def parse_known_args(self, args=None, namespace=None):
         ns, rest = super().parse_known_args(args, namespace)
         ns.__dict__.pop(_GIVEN, None)
         return ns, rest

@@ -258,7 +258,8 @@ def _check_mode1_sampled(rig: dict[str, Any], simulation: dict[str, Any], error:
     left open ``rig.E = 2**63``: mode 1 at 549 kHz against 6.4 kHz, accepted within the step
     budget on a 0.05 s record, minutes of MuJoCo steps for a failure that says nothing of the
     identifier).  The rule: ``r f_1 > sample_rate / 2`` with ``f_1`` the clamped
-    Euler-Bernoulli estimate and ``r`` the chain's least ratio to it (:func:`chain_mode1_ratio`); a soft base is not checked (its mode 1, the beam turning on
+    Euler-Bernoulli estimate and ``r`` the chain's least ratio to it
+    (:func:`chain_mode1_ratio`); a soft base is not checked (its mode 1, the beam turning on
     the spring, may lie far below the clamped estimate).  The key named is the one of
     :data:`_MODE1_KEYS` or ``simulation.sample_rate`` furthest from its default by ratio.
     """
@@ -289,9 +290,9 @@ def _check_mode1_sampled(rig: dict[str, Any], simulation: dict[str, Any], error:
     error(name, value,
           f"expected a clamped beam whose mode 1 lies below the Nyquist frequency {nyquist:.6g} Hz "
           f"(sample_rate / 2): its Euler-Bernoulli estimate is {f1:.4g} Hz here (the chain's "
-          f"at least {ratio:.4g} of it with {rig['n_segments']} segments), so the record, sampled without an "
-          f"anti-aliasing filter, holds none of the beam's modes, only their aliases; allowed: "
-          f"rig.E below about {e_max:.3g} Pa on this beam (mode 1 scales as sqrt(E / rho) "
+          f"at least {ratio:.4g} of it with {rig['n_segments']} segments), so the record, "
+          "sampled without an anti-aliasing filter, holds none of the beam's modes, only their "
+          f"aliases; allowed: rig.E below about {e_max:.3g} Pa on this beam (mode 1 scales as sqrt(E / rho) "
           f"thickness / length^2), or simulation.sample_rate above "
           f"{2 * ratio * f1:.4g} Hz")
 

@@ -150,7 +150,7 @@ def _part_value_problem(row: dict[str, Any]) -> str:
                 return f"column {name!r} holds null; expected string"
             continue
         types = _JSON_TYPES[fixed[name]] if name in fixed else (int, float)
-        if isinstance(value, bool) and bool not in types or not isinstance(value, types):
+        if (isinstance(value, bool) and bool not in types) or not isinstance(value, types):
             want = fixed.get(name, "float64").rstrip("_")
             return f"column {name!r} holds {type(value).__name__} {value!r:.40}; expected {want}"
     if isinstance(row.get("seed"), int) and not -(2**63) <= row["seed"] < 2**63:
