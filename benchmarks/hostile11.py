@@ -16,6 +16,10 @@ Families (where rounds 1-10 went least):
     Every option of every subcommand that takes one value, given twice with two different
     values (the choices of a choice, two numbers, two paths): parsed by the command line's own
     parser; accepted is a finding (the first value ignored in silence).
+``empty``
+    Every name or address argument given as ``""`` (a script's ``"$NAME"`` with the variable
+    unset): scenario and study names, ``--scenario``, ``--dask``, ``--warm-up``; a command that
+    runs, or a refusal naming another file (``scenarios/..toml``), is a finding.
 ``serve``
     A ``testbed serve`` on a private socket sent requests its forked child cannot apply (umask
     out of range, a relative or missing folder, NUL bytes, environment names with ``=``), a
@@ -160,6 +164,39 @@ def twice_cases() -> list[tuple[str, object]]:
                 return "accepted: the first value ignored in silence"
             cases.append((" ".join(argv), run))
     return cases
+
+
+# ------------------------------------------------------------------ empty
+
+def empty_cases(work: Path) -> list[tuple[str, object]]:
+    """Every name or address argument given as "" (a script's ``"$NAME"`` with the variable
+    unset): one line naming the empty value is ok; a command that ran, or a refusal naming
+    another file (``scenarios/..toml``), is a finding."""
+    folder = work / "srv"
+    folder.mkdir(mode=0o700, exist_ok=True)
+    env = {**ENV, "TESTBED_SERVER_SOCKET": str(folder / "s.sock")}
+    (work / "x.csv").write_text("time [s],x [mM],dx [mM/s]\n" + "".join(
+        f"{k / 100},{math.exp(-k / 100)},{-math.exp(-k / 100)}\n" for k in range(400)))
+    argvs = [["run", ""], ["generate", ""], ["sweep", ""], ["sweep", " "],
+             ["family", "write", "", "-o", "f"], ["identify", "x.csv", "--scenario", ""],
+             ["sweep", "h11.toml", "--dask", ""], ["serve", "--warm-up", "", "--idle", "5"]]
+
+    def case(argv: list[str]):
+        def run() -> str | None:
+            (work / "h11.toml").write_text(STUDY)
+            p = _testbed(argv, work, env, timeout=120)
+            bad = _cli_finding(p)
+            if bad:
+                return bad
+            last = (p.stderr.strip().splitlines() or [""])[-1]
+            if p.returncode in (0, 1) or "listening" in p.stderr:  # 1: a verdict, a sweep with failures
+                return f"ran (status {p.returncode}): {last[:120]!r}"
+            if "..toml" in last or "empty" not in last:
+                return f"refused naming another thing: {last[:160]!r}"
+            return None
+        return run
+
+    return [(" ".join(repr(a) if not a.strip() else a for a in argv), case(argv)) for argv in argvs]
 
 
 # ------------------------------------------------------------------ serve
@@ -455,6 +492,7 @@ def _in(work: Path, sub: str) -> Path:
 FAMILIES = {
     "nyquist": lambda work: run_inprocess(nyquist_cases()),
     "twice": lambda work: run_inprocess(twice_cases()),
+    "empty": lambda work: run_inprocess(empty_cases(_in(work, "empty"))),
     "serve": lambda work: run_inprocess(serve_cases(_in(work, "serve"))),
     "parts": lambda work: run_inprocess(parts_cases(_in(work, "sweeps"))),
     "cache": lambda work: run_inprocess(cache_cases(_in(work, "cache"))),

@@ -120,6 +120,19 @@ def _path_text(text: str) -> str:
     return text
 
 
+def _nonempty(what: str) -> Callable[[str], str]:
+    """An argparse type for a name or address: any text but the empty one (or blanks), which
+    was taken as "not given": `sweep --dask ""` (a script's "$ADDR" unset) ran the sweep here,
+    `serve --warm-up ""` skipped the warm-up (round 11)."""
+
+    def parse(text: str) -> str:
+        if not text.strip():
+            raise argparse.ArgumentTypeError(f"an empty value; expected {what}")
+        return text
+
+    return parse
+
+
 def _seed(text: str) -> int:
     """A noise seed: an integer >= 0 (numpy's generators take no negative seeds) that fits the
     64-bit integers datasets and results store, as a scenario's ``seed``
@@ -830,7 +843,8 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("study", help="study .toml file")
     s.add_argument("--jobs", type=_jobs, default=None,
                    help="parallel worker processes (joblib loky; default 1; not with --dask)")
-    s.add_argument("--dask", help="dask.distributed scheduler address (runs through joblib's dask backend)")
+    s.add_argument("--dask", type=_nonempty("a scheduler address, e.g. tcp://127.0.0.1:8786"),
+                   help="dask.distributed scheduler address (runs through joblib's dask backend)")
     s.add_argument("--results", type=_path_text, help="results file (default out/studies/<study>.parquet)")
     s.add_argument("--cache", type=_path_text, help="dataset cache folder")
     s.add_argument("--retry-failed", action="store_true", help="run the cells recorded as failed again")
@@ -876,6 +890,7 @@ def build_parser() -> argparse.ArgumentParser:
     sv.add_argument("--idle", type=float, default=900.0,
                     help="seconds without a command before the server exits (default 900)")
     sv.add_argument("--warm-up", default="cantilever_stiff_impact", metavar="SCENARIO",
+                    type=_nonempty("a scenario name, or 'none'"),
                     help="scenario run once at start to warm the caches, or 'none' "
                          "(default cantilever_stiff_impact)")
     sv.set_defaults(fn=cmd_serve)

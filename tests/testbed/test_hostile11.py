@@ -246,3 +246,26 @@ def test_a_results_file_with_a_null_scenario_is_refused(tmp_path):
     write_rows(tmp_path / "r.parquet", [_row(scenario=None)], study="s")
     with pytest.raises(ResultsError, match="scenario None; expected text"):
         read_results(tmp_path / "r.parquet")
+
+
+# ------------------------------------------------------------------ empty names and addresses
+
+@pytest.mark.parametrize("name", ["", " "])
+def test_an_empty_scenario_or_study_name_is_refused_as_empty(name):
+    from testbed.pipeline.scenario import load_scenario
+    from testbed.studies.study import load_study
+
+    # Path("") is ".": refused as the file "scenarios/..toml" of name "." (round 11)
+    for load in (load_scenario, load_study):
+        with pytest.raises(ScenarioError, match="an empty name") as e:
+            load(name)
+        assert "..toml" not in str(e.value)
+
+
+@pytest.mark.parametrize("argv", [["sweep", "s.toml", "--dask", ""], ["serve", "--warm-up", ""],
+                                  ["serve", "--warm-up", " "]], ids=["dask", "warm-up", "blank"])
+def test_an_empty_address_or_warm_up_is_refused(argv, capsys):
+    # `sweep --dask ""` ran the sweep here; `serve --warm-up ""` skipped the warm-up
+    with pytest.raises(SystemExit) as e:
+        build_parser().parse_args(argv)
+    assert e.value.code == 2 and "an empty value" in capsys.readouterr().err
