@@ -79,6 +79,8 @@ TAIL_COLUMNS: dict[str, str] = {
     "checks": "string", "versions": "string", "commit": "string", "dataset_hash": "string",
 }
 SORT_KEYS = ("scenario", "noise", "seed", "identifier", "cell")
+#: Text columns every row must hold as text (not null): the readers sort and group by them.
+TEXT_KEYS = ("scenario", "identifier")
 
 
 def parts_dir(path: str | os.PathLike) -> Path:
@@ -131,9 +133,9 @@ _JSON_TYPES: dict[str, tuple[type, ...]] = {
 
 def _part_value_problem(row: dict[str, Any]) -> str:
     """What in a row file's values the Parquet file could not hold or a reader could not use
-    ("" if nothing): every fixed column (:data:`BASE_COLUMNS`, :data:`TAIL_COLUMNS`) present and
-    of its type (a number column may hold null), each other column a number or null, the seed
-    within int64.
+    ("" if nothing): :data:`TEXT_KEYS` present as text, every other fixed column
+    (:data:`BASE_COLUMNS`, :data:`TAIL_COLUMNS`) of its type or null, each other column a number
+    or null, the seed within int64.
 
     The Parquet file's rows were checked on read, a row file's only for its cell and status
     (round 11): ``noise = "abc"`` in one made the resumed sweep an internal error (TypeError
@@ -141,13 +143,11 @@ def _part_value_problem(row: dict[str, Any]) -> str:
     summary` a table row of noise NaN.
     """
     fixed = {**BASE_COLUMNS, **TAIL_COLUMNS}
-    missing = [k for k in fixed if k not in row]
-    if missing:  # write_part writes every column (identifier missing: summary's KeyError)
-        return f"no column {missing[0]!r}"
+    for name in TEXT_KEYS:  # identifier missing: summary's KeyError; null: its TypeError sorting
+        if not isinstance(row.get(name), str):
+            return f"column {name!r} holds {row.get(name)!r:.40}; expected string"
     for name, value in row.items():
         if value is None:
-            if fixed.get(name) == "string":  # scenario = null: summary's TypeError sorting
-                return f"column {name!r} holds null; expected string"
             continue
         types = _JSON_TYPES[fixed[name]] if name in fixed else (int, float)
         if (isinstance(value, bool) and bool not in types) or not isinstance(value, types):
@@ -260,8 +260,7 @@ def _row_problem(row: dict[str, Any], seen: set[str]) -> str:
     if row["cell"] in seen:
         return "the cell appears twice"
     seen.add(row["cell"])
-    text = next((k for k in ("study", "scenario", "rig", "identifier", "params", "error")
-                 if not isinstance(row.get(k), str)), None)
+    text = next((k for k in TEXT_KEYS if not isinstance(row.get(k), str)), None)
     if text:  # null: `testbed summary` sorting the rows was a TypeError (round 11)
         return f"{text} {row.get(text)!r}; expected text"
     if row["status"] not in ("ok", "failed"):
