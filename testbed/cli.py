@@ -49,8 +49,44 @@ BLAS_THREAD_VARIABLES = ("OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "OMP_NUM_THR
 DASK_CONNECT_TIMEOUT_S = 5.0
 
 
+#: Namespace attribute where :class:`_StoreOnce` records the options given so far (removed
+#: before the arguments are returned).
+_GIVEN = "_testbed_options_given"
+
+
+class _StoreOnce(argparse._StoreAction):
+    """argparse's ``store`` that refuses an option given twice with another value.
+
+    argparse keeps the last value in silence: ``sweep --jobs 1 ... --jobs 2`` ran on two
+    processes, ``run --seed 1 --seed 2`` under seed 2, ``report -o a -o b`` wrote ``b``
+    (round 11).  The same value twice changes nothing and passes; options that add up
+    (``--plugin``, ``--param``) are ``append`` actions and unaffected.
+    """
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        given = namespace.__dict__.setdefault(_GIVEN, {})
+        if self.dest in given and given[self.dest][1] != values:
+            first, value = given[self.dest]
+            raise argparse.ArgumentError(
+                self, f"given twice ({first} {show_value(value)}, then {option_string} "
+                      f"{show_value(values)}); give it once")
+        given[self.dest] = (option_string, values)
+        setattr(namespace, self.dest, values)
+
+
 class _Parser(argparse.ArgumentParser):
-    """argparse with one-line errors (``error: ...``, status 2) instead of usage + message."""
+    """argparse with one-line errors (``error: ...``, status 2) instead of usage + message, and
+    an option given twice with different values refused (:class:`_StoreOnce`)."""
+
+    def __init__(self, *args, **kwargs) -> None:
+        super().__init__(*args, **kwargs)
+        self.register("action", None, _StoreOnce)
+        self.register("action", "store", _StoreOnce)
+
+    def parse_known_args(self, args=None, namespace=None):
+        ns, rest = super().parse_known_args(args, namespace)
+        ns.__dict__.pop(_GIVEN, None)
+        return ns, rest
 
     def error(self, message: str) -> None:  # type: ignore[override]
         print(f"error: {self.prog}: {message} (see {self.prog} --help)", file=sys.stderr)
@@ -82,6 +118,19 @@ def _path_text(text: str) -> str:
     if not text:
         raise argparse.ArgumentTypeError("an empty path; expected a file or folder name")
     return text
+
+
+def _nonempty(what: str) -> Callable[[str], str]:
+    """An argparse type for a name or address: any text but the empty one (or blanks), which
+    was taken as "not given": `sweep --dask ""` (a script's "$ADDR" unset) ran the sweep here,
+    `serve --warm-up ""` skipped the warm-up (round 11)."""
+
+    def parse(text: str) -> str:
+        if not text.strip():
+            raise argparse.ArgumentTypeError(f"an empty value; expected {what}")
+        return text
+
+    return parse
 
 
 def _seed(text: str) -> int:
@@ -794,7 +843,8 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("study", help="study .toml file")
     s.add_argument("--jobs", type=_jobs, default=None,
                    help="parallel worker processes (joblib loky; default 1; not with --dask)")
-    s.add_argument("--dask", help="dask.distributed scheduler address (runs through joblib's dask backend)")
+    s.add_argument("--dask", type=_nonempty("a scheduler address, e.g. tcp://127.0.0.1:8786"),
+                   help="dask.distributed scheduler address (runs through joblib's dask backend)")
     s.add_argument("--results", type=_path_text, help="results file (default out/studies/<study>.parquet)")
     s.add_argument("--cache", type=_path_text, help="dataset cache folder")
     s.add_argument("--retry-failed", action="store_true", help="run the cells recorded as failed again")
@@ -840,6 +890,7 @@ def build_parser() -> argparse.ArgumentParser:
     sv.add_argument("--idle", type=float, default=900.0,
                     help="seconds without a command before the server exits (default 900)")
     sv.add_argument("--warm-up", default="cantilever_stiff_impact", metavar="SCENARIO",
+                    type=_nonempty("a scenario name, or 'none'"),
                     help="scenario run once at start to warm the caches, or 'none' "
                          "(default cantilever_stiff_impact)")
     sv.set_defaults(fn=cmd_serve)

@@ -127,8 +127,23 @@ def _send(sock: socket.socket, obj: dict, fds: tuple[int, ...] = ()) -> None:
         sock.sendall(msg)
 
 
-def _recv(sock: socket.socket, with_fds: int = 0) -> tuple[dict | None, list[int]]:
-    """One framed JSON message (and up to ``with_fds`` descriptors); None at end of stream."""
+def _recv(sock: socket.socket, with_fds: int = 0,
+          deadline: float | None = None) -> tuple[dict | None, list[int]]:
+    """One framed JSON message (and up to ``with_fds`` descriptors); None at end of stream.
+
+    ``deadline`` (a :func:`time.monotonic` instant) bounds the whole read, not each piece: a
+    socket timeout alone let a peer sending a byte every 1.5 s hold the server, and every
+    client waiting on it, for as long as it liked (round 11: 15 s for a 100-byte request, one
+    command waiting throughout); past it ``TimeoutError`` (an OSError) is raised.
+    """
+    def recv(n: int) -> bytes:
+        if deadline is not None:
+            left = deadline - time.monotonic()
+            if left <= 0:
+                raise TimeoutError("the request did not arrive in time")
+            sock.settimeout(left)
+        return sock.recv(n)
+
     fds: list[int] = []
     head = b""
     if with_fds:
@@ -139,7 +154,7 @@ def _recv(sock: socket.socket, with_fds: int = 0) -> tuple[dict | None, list[int
                 a.frombytes(data[:len(data) - len(data) % a.itemsize])
                 fds.extend(a)
     while len(head) < 4:
-        more = sock.recv(4 - len(head))
+        more = recv(4 - len(head))
         if not more:
             return None, fds
         head += more
@@ -148,7 +163,7 @@ def _recv(sock: socket.socket, with_fds: int = 0) -> tuple[dict | None, list[int
         return None, fds
     body = b""
     while len(body) < n:
-        more = sock.recv(n - len(body))
+        more = recv(n - len(body))
         if not more:
             return None, fds
         body += more
@@ -364,13 +379,19 @@ def _child(request: dict, fds: list[int], inherited: list, server: int,
         signal.signal(signal.SIGTERM, signal.SIG_DFL)
         signal.signal(signal.SIGCHLD, signal.SIG_DFL)
         signal.set_wakeup_fd(-1)
-        os.chdir(request["cwd"])
-        os.umask(int(request["umask"]))  # files are created as the client would create them
-        os.environ.clear()
-        os.environ.update(request["env"])
         sys.stdin = open(0, closefd=False)
         sys.stdout = open(1, "w", buffering=1 if os.isatty(1) else -1, closefd=False)
         sys.stderr = open(2, "w", buffering=1, errors="backslashreplace", closefd=False)
+        why = _enter_folder(request["cwd"])
+        if why:
+            from testbed.core.errors import EXIT_USAGE
+
+            print(why, file=sys.stderr)
+            status = EXIT_USAGE
+            return
+        os.umask(int(request["umask"]))  # files are created as the client would create them
+        os.environ.clear()
+        os.environ.update(request["env"])
         sys.argv = ["testbed", *request["argv"]]
         status = command(list(request["argv"]))
     except SystemExit as e:
@@ -386,6 +407,21 @@ def _child(request: dict, fds: list[int], inherited: list, server: int,
             with contextlib.suppress(BaseException):
                 s.flush()
         os._exit(status)
+
+
+def _enter_folder(cwd: str) -> str:
+    """``os.chdir(cwd)``; the one error line if it cannot be entered ("" if it was).
+
+    The client's folder, removed (or made unreadable) after the client sent it, made the
+    served command "internal error (a bug, not your input): ... FileNotFoundError" (round 11);
+    alone the command says its current folder no longer exists, in one line, status 2.
+    """
+    try:
+        os.chdir(cwd)
+    except OSError as e:
+        return (f"error: {cwd}: the current folder cannot be entered ({e.strerror}; deleted?); "
+                "cd to a folder that exists")
+    return ""
 
 
 def _exit_work() -> None:
@@ -422,7 +458,7 @@ class _Server:
 #: connects and sends nothing (stopped, or not a testbed client) is dropped after this, and
 #: meanwhile the server serves the others.
 REQUEST_TIMEOUT_S = 10.0
-#: Seconds one read of a readable request may block (a request is sent in one piece; an
+#: Seconds the whole read of a readable request may take (a request is sent in one piece; an
 #: environment larger than the socket's buffer arrives in a few, at once).
 READ_TIMEOUT_S = 2.0
 
@@ -599,7 +635,7 @@ def _request(st: _Server, conn: socket.socket) -> None:
         uid = struct.unpack("3i", conn.getsockopt(socket.SOL_SOCKET, socket.SO_PEERCRED,
                                                   struct.calcsize("3i")))[1]
         conn.settimeout(READ_TIMEOUT_S)
-        request, fds = _recv(conn, with_fds=3)
+        request, fds = _recv(conn, with_fds=3, deadline=time.monotonic() + READ_TIMEOUT_S)
         why = _refusal(uid, request, fds, st.key)
         if why:
             st.log(f"testbed server: refused a command from {why}")
@@ -627,8 +663,31 @@ def _refusal(uid: int, request, fds: list[int], key: str) -> str:
           and all(isinstance(k, str) and isinstance(v, str) for k, v in r["env"].items()))
     if not ok:
         return "a damaged request"
+    bad = _bad_field(r)
+    if bad:
+        return f"a damaged request ({bad})"
     if r.get("key") != key:
         return "another key (sources, interpreter or import-time environment)"
+    return ""
+
+
+def _bad_field(r: dict) -> str:
+    """What in a well-formed request the child could not apply ("" if nothing).
+
+    Each of these made the forked child print "internal error (a bug, not your input)" (round
+    11): a umask outside 0-0o777 (``os.umask``'s OverflowError; -1 or ``true`` were applied as
+    0o777 and 1), a ``cwd`` that is not an absolute path or holds a NUL byte, an environment
+    name that is empty or holds ``=`` or NUL, a value or argument holding NUL (the operating
+    system's C strings cannot).  The testbed's own client sends none of them.
+    """
+    if isinstance(r["umask"], bool) or not 0 <= r["umask"] <= 0o777:
+        return "umask outside 0-0o777"
+    if not r["cwd"].startswith("/") or "\0" in r["cwd"]:
+        return "cwd not an absolute path"
+    if any(not k or "=" in k or "\0" in k or "\0" in v for k, v in r["env"].items()):
+        return "an environment variable the system cannot hold"
+    if any("\0" in a for a in r["argv"]):
+        return "an argument holding a NUL byte"
     return ""
 
 

@@ -19,6 +19,7 @@ a reader never sees one, and two processes filling the same entry at once both f
 
 from __future__ import annotations
 
+import contextlib
 import errno
 import functools
 import hashlib
@@ -27,8 +28,13 @@ import logging
 import os
 import re
 import sys
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from pathlib import Path
+
+try:
+    import fcntl
+except ImportError:  # Windows: no folder lock (a `cache clear` during a write may fail it)
+    fcntl = None  # type: ignore[assignment]
 
 from testbed.core.dataset import Dataset, DatasetError
 from testbed.core.errors import InputError
@@ -38,6 +44,32 @@ from testbed.pipeline.plugins import rig_class
 from testbed.pipeline.scenario import Scenario
 
 log = logging.getLogger(__name__)
+
+
+@contextlib.contextmanager
+def _folder_lock(directory: Path, exclusive: bool) -> Iterator[None]:
+    """Hold ``flock`` on the cache folder itself while the block runs: shared while an entry is
+    written (:meth:`DatasetCache.clean`), exclusive while :meth:`DatasetCache.clear` removes.
+
+    `cache clear` removed the temporary file of another process's entry being written, whose
+    rename then failed after its simulation ("[Errno 2] No such file or directory:
+    '.../.cantilever-<key>.h5.<random>.tmp'", round 11: 15 of 15 writes against a clear in a
+    loop); now it waits for the writes under way, and a writer killed meanwhile (SIGKILL)
+    releases its lock with its descriptor.  The folder's own descriptor is locked, not a file in
+    it: HDF5 ``flock``-s the files it writes, and a read-only cache needs no lock file.  A
+    folder that cannot be opened is not locked (nothing is written into or cleared from it).
+    """
+    try:
+        fd = os.open(directory, os.O_RDONLY | os.O_DIRECTORY)
+    except (OSError, AttributeError):  # missing, unreadable; O_DIRECTORY absent (Windows)
+        yield
+        return
+    try:
+        if fcntl is not None:
+            fcntl.flock(fd, fcntl.LOCK_EX if exclusive else fcntl.LOCK_SH)
+        yield
+    finally:
+        os.close(fd)  # (releases the lock)
 
 
 #: The name of a cache entry: ``<rig>-<cache key, 32 hex digits>.h5`` (:meth:`DatasetCache.path`).
@@ -139,7 +171,9 @@ class DatasetCache:
                     log.warning("dataset cache: %s; simulating it again", e)
         ds = simulate_clean(scenario, progress)
         try:
-            ds.save(p)
+            self.directory.mkdir(parents=True, exist_ok=True)
+            with _folder_lock(self.directory, exclusive=False):
+                ds.save(p)
         except OSError as e:
             if e.errno not in NOT_WRITABLE:
                 raise
@@ -177,10 +211,11 @@ class DatasetCache:
         """Delete every cached file and any temporary file a killed writer left; return how many
         cached files were removed."""
         n = 0
-        for p, _ in self.entries():
-            p.unlink(missing_ok=True)
-            n += 1
-        if self.directory.is_dir():
-            for tmp in self.directory.glob(".*.h5.*.tmp"):  # testbed.core.atomic's temporary names
-                tmp.unlink(missing_ok=True)
+        with _folder_lock(self.directory, exclusive=True):  # after the writes under way
+            for p, _ in self.entries():
+                p.unlink(missing_ok=True)
+                n += 1
+            if self.directory.is_dir():
+                for tmp in self.directory.glob(".*.h5.*.tmp"):  # testbed.core.atomic's temporary names
+                    tmp.unlink(missing_ok=True)
         return n

@@ -360,6 +360,12 @@ def resolve_path(name_or_path: str | os.PathLike, directory: Path | None = None)
     working directory (``testbed run X --out .`` writes its runs to ``./X/``) must not hide
     the scenario ``X``.
     """
+    if not os.fspath(name_or_path).strip():
+        # Path("") is ".": `testbed run ""` (a script's "$NAME" unset) was refused as the file
+        # "scenarios/..toml" of name "." (round 11)
+        raise ScenarioError(repr(os.fspath(name_or_path)),
+                            allowed="an empty name; expected a name (see `testbed list`) or a "
+                                    ".toml path")
     p = Path(name_or_path)
     if p.suffix == ".toml" or len(p.parts) > 1 or file_problem(p, "") is None:
         return p

@@ -79,6 +79,8 @@ TAIL_COLUMNS: dict[str, str] = {
     "checks": "string", "versions": "string", "commit": "string", "dataset_hash": "string",
 }
 SORT_KEYS = ("scenario", "noise", "seed", "identifier", "cell")
+#: Text columns every row must hold as text (not null): the readers sort and group by them.
+TEXT_KEYS = ("scenario", "identifier")
 
 
 def parts_dir(path: str | os.PathLike) -> Path:
@@ -116,7 +118,44 @@ def _read_part(p: Path) -> dict[str, Any]:
         raise ValueError("not a results row (no cell and status)")
     if row["cell"] != p.stem:
         raise ValueError(f"holds the row of cell {row['cell']!r}")
+    why = _part_value_problem(row) or _row_problem({**dict.fromkeys(BASE_COLUMNS), **row}, set())
+    if why:
+        raise ValueError(why)
     return row
+
+
+#: The Python types a row file's JSON value may have for each Arrow column type (None, JSON's
+#: null, is a missing value; NaN is a float).
+_JSON_TYPES: dict[str, tuple[type, ...]] = {
+    "string": (str,), "float64": (int, float), "int64": (int,), "bool_": (bool,),
+}
+
+
+def _part_value_problem(row: dict[str, Any]) -> str:
+    """What in a row file's values the Parquet file could not hold or a reader could not use
+    ("" if nothing): :data:`TEXT_KEYS` present as text, every other fixed column
+    (:data:`BASE_COLUMNS`, :data:`TAIL_COLUMNS`) of its type or null, each other column a number
+    or null, the seed within int64.
+
+    The Parquet file's rows were checked on read, a row file's only for its cell and status
+    (round 11): ``noise = "abc"`` in one made the resumed sweep an internal error (TypeError
+    sorting the rows), ``noise = NaN`` `testbed report`'s ZeroDivisionError and `testbed
+    summary` a table row of noise NaN.
+    """
+    fixed = {**BASE_COLUMNS, **TAIL_COLUMNS}
+    for name in TEXT_KEYS:  # identifier missing: summary's KeyError; null: its TypeError sorting
+        if not isinstance(row.get(name), str):
+            return f"column {name!r} holds {row.get(name)!r:.40}; expected string"
+    for name, value in row.items():
+        if value is None:
+            continue
+        types = _JSON_TYPES[fixed[name]] if name in fixed else (int, float)
+        if (isinstance(value, bool) and bool not in types) or not isinstance(value, types):
+            want = fixed.get(name, "float64").rstrip("_")
+            return f"column {name!r} holds {type(value).__name__} {value!r:.40}; expected {want}"
+    if isinstance(row.get("seed"), int) and not -(2**63) <= row["seed"] < 2**63:
+        return f"seed {row['seed']} beyond the 64-bit integers the results file stores"
+    return ""
 
 
 def _read_parts(path: str | os.PathLike, set_aside: bool = False) -> list[dict[str, Any]]:
@@ -221,6 +260,9 @@ def _row_problem(row: dict[str, Any], seen: set[str]) -> str:
     if row["cell"] in seen:
         return "the cell appears twice"
     seen.add(row["cell"])
+    text = next((k for k in TEXT_KEYS if not isinstance(row.get(k), str)), None)
+    if text:  # null: `testbed summary` sorting the rows was a TypeError (round 11)
+        return f"{text} {row.get(text)!r}; expected text"
     if row["status"] not in ("ok", "failed"):
         return f"status {row['status']!r}; expected 'ok' or 'failed'"
     if row["passed"] is None or row["seed"] is None:
