@@ -197,7 +197,9 @@ def cubic_rule(data: Measurement, user: bool | None, fit_band_hz: float | None =
         measured mode's backbone chirp (:func:`lowest_mode_chirp`) exceeds
         :data:`CUBIC_CHIRP_MIN`, or (no chirp fit taken and ``peaks`` empty) the peak search
         (:func:`identify.structural.modal_peaks` on ``data``, its default band) finds the
-        record amplitude-dependent (``nonlinear``; module docstring, rule (3)).
+        record amplitude-dependent (``nonlinear``; module docstring, rule (3)), or, where
+        those leave it out and no chirp says the lowest mode does not harden, when that peak
+        search recognised a third harmonic of the lowest of ``peaks`` (rule (4)).
     """
     if user is not None:
         return bool(user), "user setting"
