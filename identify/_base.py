@@ -78,6 +78,7 @@ class Identifier:
     #: seeded by a hyperparameter), to the bit: a study then computes the cells that differ only
     #: in their noise seed at 0 % noise once (:func:`testbed.studies.sweep.shared_computation`).
     #: False (a plugin that does not say): each such cell is fitted, showing the method's spread.
+    #: Read from the class's own body only: a subclass that changes the fit does not inherit it.
     deterministic: ClassVar[bool] = False
 
     @classmethod

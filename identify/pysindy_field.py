@@ -276,6 +276,7 @@ def _variant(name: str, tags: tuple[str, ...], doc: str, **defaults: Any) -> typ
              for k, f in PySINDyField.hyperparameters.items()}
     cls = type(f"PySINDy_{name}", (PySINDyField,), {
         "__init__": init, "name": name, "hyperparameters": hyper, "__module__": __name__,
+        "deterministic": True,
         "__doc__": f"{doc}\n\n    Same model, parameters and attributes as :class:`PySINDyField`; "
                    f"defaults: {', '.join(f'{k}={v!r}' for k, v in defaults.items())}."})
     return IDENTIFIERS.register(name, tags=tags)(cls)

@@ -20,6 +20,7 @@ from testbed.core.measurement import Measurement, Trajectory
 from testbed.core.terms import canonical
 from testbed.core.truth import DynamicalTruth, MechanicalTruth, StructuralTruth, TruthError
 from testbed.pipeline.plugins import rig_class
+from testbed.pipeline.signal_chain import pulse_end
 from testbed.scoring import metrics
 from testbed.scoring.equation_basis import compare_equations
 from testbed.scoring.initial_state import fit_initial_state
@@ -263,6 +264,17 @@ def equation_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -
     return {"equation": f"wrong equation: {said} ({why})"}
 
 
+
+def _failed_modes(scores: Scores, thresholds: dict[str, dict[str, float]], n_modes: int) -> set[int]:
+    """The true modes (1-based) whose bars failed: a per-mode bar names its mode, a bar over
+    every scored mode (TRAC) names modes ``1 .. n_modes``."""
+    held: set[int] = set()
+    for c in check_thresholds(scores.values, thresholds):
+        found = _MODE_SCORE.fullmatch(c.metric)
+        if found and not c.passed:
+            held |= {int(found[2])} if found[2] else set(range(1, n_modes + 1))
+    return held
+
 def out_of_band_failures(scores: Scores, thresholds: dict[str, dict[str, float]]
                          ) -> dict[str, str]:
     """A failed bar on a true mode that the signal chain's pass band leaves out: ``{"band": reason}``.
@@ -291,11 +303,7 @@ def out_of_band_failures(scores: Scores, thresholds: dict[str, dict[str, float]]
         return {}
     lo, hi = (float(x) for x in band)
     n_modes = int(scores.details.get("scored_modes", len(f_true)))
-    held: set[int] = set()
-    for c in check_thresholds(scores.values, thresholds):
-        found = _MODE_SCORE.fullmatch(c.metric)
-        if found and not c.passed:
-            held |= {int(found[2])} if found[2] else set(range(1, n_modes + 1))
+    held = _failed_modes(scores, thresholds, n_modes)
     out = []
     for k in sorted(held):
         if k > len(f_true):
@@ -356,11 +364,7 @@ def unexcited_failures(scores: Scores, thresholds: dict[str, dict[str, float]]
     if part is None or f_true is None:
         return {}
     n_modes = int(scores.details.get("scored_modes", len(part)))
-    held: set[int] = set()
-    for c in check_thresholds(scores.values, thresholds):
-        found = _MODE_SCORE.fullmatch(c.metric)
-        if found and not c.passed:
-            held |= {int(found[2])} if found[2] else set(range(1, n_modes + 1))
+    held = _failed_modes(scores, thresholds, n_modes)
     out = [f"mode {k} ({float(f_true[k - 1]):.4g} Hz) meets the hammer at "
            f"{float(part[k - 1]):.2g} of its largest amplitude at the sensors"
            for k in sorted(held) if k <= min(len(part), len(f_true))
@@ -408,8 +412,6 @@ def window_decay(truth: StructuralTruth, dataset: Dataset, data: Measurement, n:
     with no pulse or no free decay (``free_start`` 0); NaN where the truth gives no damping
     ratio.  See :data:`DECAYED_RATIO`.
     """
-    from testbed.pipeline.signal_chain import pulse_end  # the chain's own pulse end
-
     force = dataset.measured.get("force")
     end = pulse_end(np.asarray(force.data, float)) if force is not None else 0
     dt = max(0, int(data.free_start) - end) / float(data.fs) if end > 0 and data.free_start else 0.0
@@ -448,11 +450,7 @@ def decayed_failures(scores: Scores, thresholds: dict[str, dict[str, float]]
     if left is None or f_true is None:
         return {}
     n_modes = int(scores.details.get("scored_modes", len(left)))
-    held: set[int] = set()
-    for c in check_thresholds(scores.values, thresholds):
-        found = _MODE_SCORE.fullmatch(c.metric)
-        if found and not c.passed:
-            held |= {int(found[2])} if found[2] else set(range(1, n_modes + 1))
+    held = _failed_modes(scores, thresholds, n_modes)
     out = []
     for k in sorted(held):
         if k > min(len(left), len(f_true)) or not float(left[k - 1]) < DECAYED_RATIO:

@@ -112,6 +112,17 @@ def shared_computation(cell: Cell) -> str:
     """Key of the computation whose row ``cell`` reports: cells of one key give one row, but for
     their own cell key, seed, dataset hash and times.
 
+    Parameters
+    ----------
+    cell : Cell
+
+    Returns
+    -------
+    str
+        ``"shared:"`` and the :func:`cell_key` of the cell with seed 0, for a cell at 0 % noise
+        of an identifier that declares itself deterministic (:func:`declares_deterministic`);
+        else the cell's own key.
+
     The seed draws only the measurement noise (:func:`testbed.pipeline.generate.derive`: at
     0 % noise it draws nothing and copies the clean arrays), and an identifier sees only the
     measurement and its hyperparameters.  So the cells of one scenario, identifier and
@@ -119,16 +130,24 @@ def shared_computation(cell: Cell) -> str:
     its fit :attr:`~identify._base.Identifier.deterministic` (every draw seeded by one of its
     hyperparameters; the conformance test refits each built-in one and compares to the bit)
     gives them bit-identical scores.  :func:`run_sweep` computes one of them and copies its row
-    to the others: the default study's 0 % seeds repeated 32 of its 144 cells (88 s of its
-    380 s of CPU, two thirds of it pysindy's SINDyPI).  Every other cell is its own
+    to the others, if that row passed through the fit (``ok``) and, a row of an earlier run, was
+    computed by this sweep's commit and versions (else each is computed): the default study's
+    0 % seeds repeated 32 of its 144 cells (88 s of its 380 s of CPU, two thirds of it
+    pysindy's SINDyPI).  Every other cell is its own
     computation (its :func:`cell_key`): noisy cells, and the cells of an identifier that does
     not declare itself deterministic (a plugin's 0 % seeds then show its own spread).
     """
     sc = cell.scenario
-    if float(sc.noise.get("rms_percent", 0.0)) == 0.0 and getattr(
-            IDENTIFIERS.get(cell.identifier), "deterministic", False):
+    if float(sc.noise.get("rms_percent", 0.0)) == 0.0 and declares_deterministic(
+            IDENTIFIERS.get(cell.identifier)):
         return "shared:" + cell_key(sc.replace(seed=0))
     return cell.key
+
+
+def declares_deterministic(cls: type) -> bool:
+    """Whether the identifier class itself declares ``deterministic = True``: a subclass (a
+    plugin deriving from a built-in identifier and changing its fit) does not inherit it."""
+    return vars(cls).get("deterministic", False) is True
 
 
 def _expected_cost(cell: Cell) -> float:
@@ -567,9 +586,17 @@ def run_sweep(study: Study | str | os.PathLike, jobs: int = 1, dask_address: str
         if p not in missing and not p.is_file():
             missing[p] = noise_free_scenario(c.scenario)
     stats.datasets = len(missing)
+    # one commit and one set of versions for every row of this sweep, whichever process runs it
+    provenance = sweep_provenance()
     # One computation per shared_computation key: a cell whose key already has a finished row
     # (from an earlier run) or another cell to compute it is a copy of that row
     finished = {r["cell"]: r for r in previous if r["cell"] in done}
+    # a source row must be what this sweep would compute: one that failed (perhaps for a
+    # passing reason, a MemoryError) or that another commit or other versions computed is
+    # not copied to cells it has not been run for
+    same_code = {k: provenance[k] for k in ("commit", "versions")}
+    sources = {k: r for k, r in finished.items() if r["status"] == "ok"
+               and all(r.get(c) == v for c, v in same_code.items())}
     by_share: dict[str, list[Cell]] = {}
     for c in cells:
         by_share.setdefault(shared_computation(c), []).append(c)
@@ -580,7 +607,7 @@ def run_sweep(study: Study | str | os.PathLike, jobs: int = 1, dask_address: str
         pending = [c for c in members if c.key in todo_keys]
         if not pending:
             continue
-        source = next((c for c in members if c.key in finished), None)
+        source = next((c for c in members if c.key in sources), None)
         if source is None:
             source, pending = pending[0], pending[1:]
             compute.append(source)
@@ -595,8 +622,6 @@ def run_sweep(study: Study | str | os.PathLike, jobs: int = 1, dask_address: str
     compute = sorted(compute, key=_expected_cost, reverse=True)
     # workers of a local pool watch this process; Dask workers belong to their cluster
     parent = os.getpid() if not dask_address and jobs > 1 else None
-    # one commit and one set of versions for every row of this sweep, whichever process runs it
-    provenance = sweep_provenance()
     try:
         with _backend(jobs, dask_address) as n_jobs:
             t0 = time.perf_counter()
@@ -621,10 +646,13 @@ def run_sweep(study: Study | str | os.PathLike, jobs: int = 1, dask_address: str
             try:
                 record(parallel(run_cell, [(c, cache_path, study.plugins, parent, provenance)
                                            for c in compute], n_jobs))
-                # the copies load their own datasets (their dataset_hash), nothing else
-                record(parallel(run_cell, [(c, cache_path, study.plugins, parent, provenance,
-                                            finished[src]) for src, cs in copies.items()
-                                           for c in cs], n_jobs))
+                # the copies load their own datasets (their dataset_hash), nothing else; the
+                # cells of a source that failed are computed after all
+                second = [(c, cache_path, study.plugins, parent, provenance,
+                           finished[src] if finished[src]["status"] == "ok" else None)
+                          for src, cs in copies.items() for c in cs]
+                stats.copied = sum(a[-1] is not None for a in second)
+                record(parallel(run_cell, second, n_jobs))
             except Exception as e:  # (loky's TerminatedWorkerError, not imported for this)
                 if type(e).__name__ != "TerminatedWorkerError" or not study.plugins:
                     raise  # the testbed's own code crashed a worker: a bug

@@ -126,6 +126,25 @@ class ToyDeterministic(ToyFit):
         return super().fit(data)
 
 
+@IDENTIFIERS.register("toy_flaky")
+class ToyFlaky(ToyDeterministic):
+    """Deterministic, but its first fit in a process fails for a passing reason."""
+    deterministic = True
+    fits = []
+
+    def fit(self, data):
+        if not type(self).fits:
+            type(self).fits.append(-1)
+            raise MemoryError("a passing shortage")
+        return super().fit(data)
+
+
+@IDENTIFIERS.register("toy_inherits")
+class ToyInherits(ToyDeterministic):
+    """Derives from a deterministic identifier without declaring it itself."""
+    fits = []
+
+
 @IDENTIFIERS.register("toy_raise")
 class ToyRaise(ToyFit):
     fail = "raise"
@@ -361,6 +380,41 @@ def test_cells_at_zero_noise_of_a_deterministic_identifier_are_fitted_once(toy_d
     grown = load_study(write_study(toy_dir, "det", ["toy_det", "toy_fit"], seeds=(0, 1, 2, 3)))
     again = read_results(run_sweep(grown, results=res, cache_dir=cache, verbose=False, stats=stats))
     assert len(again) == 16 and stats.run == 4 and stats.copied == 1 and len(fits) == 1
+
+
+def test_a_failed_row_or_another_commit_s_row_is_not_copied(toy_dir, tmp_path, monkeypatch):
+    """Only a row that passed through the fit (``ok``), computed by this sweep's commit and
+    versions, is copied; a subclass does not inherit ``deterministic``."""
+    import testbed.studies.sweep as sw
+    from identify import IDENTIFIERS
+
+    flaky = IDENTIFIERS.get("toy_flaky").fits
+    flaky.clear()
+    stats = SweepStats()
+    study = load_study(write_study(toy_dir, "flaky", ["toy_flaky"], seeds=(0, 1, 2), noise=(0.0,)))
+    rows = read_results(run_sweep(study, results=tmp_path / "f.parquet", cache_dir=tmp_path / "c",
+                                  verbose=False, stats=stats))
+    # the first fit failed (MemoryError); the other two seeds were fitted, not handed its failure
+    assert sorted(r["status"] for r in rows) == ["failed", "ok", "ok"] and stats.copied == 0
+    inherits = IDENTIFIERS.get("toy_inherits").fits
+    inherits.clear()
+    study = load_study(write_study(toy_dir, "inh", ["toy_inherits"], seeds=(0, 1), noise=(0.0,)))
+    run_sweep(study, results=tmp_path / "i.parquet", cache_dir=tmp_path / "c", verbose=False,
+              stats=stats)
+    assert stats.copied == 0 and len(inherits) == 2
+    # a resume by other code computes the added seed instead of copying the old code's row
+    det = IDENTIFIERS.get("toy_det").fits
+    res = tmp_path / "d.parquet"
+    monkeypatch.setattr(sw, "git_commit", lambda: "old-commit")
+    run_sweep(load_study(write_study(toy_dir, "code", ["toy_det"], seeds=(0,), noise=(0.0,))),
+              results=res, cache_dir=tmp_path / "c", verbose=False)
+    monkeypatch.setattr(sw, "git_commit", lambda: "new-commit")
+    det.clear()
+    rows = read_results(run_sweep(load_study(write_study(toy_dir, "code", ["toy_det"], seeds=(0, 1),
+                                                         noise=(0.0,))),
+                                  results=res, cache_dir=tmp_path / "c", verbose=False, stats=stats))
+    assert stats.copied == 0 and len(det) == 1
+    assert {r["seed"]: r["commit"] for r in rows} == {0: "old-commit", 1: "new-commit"}
 
 
 def _finished_cells(results: Path) -> int:
