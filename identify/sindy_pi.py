@@ -1617,6 +1617,8 @@ class SINDyPI(_ImplicitMechanical):
         """
         self.formulation_rule_ = "not applied: " + (
             "formulation user-set" if self.formulation is not None else
+            # a user's column low-pass is refused with the weak form (check_params)
+            "column_lowpass_hz user-set" if self.column_lowpass_hz else
             "ensemble" if self.ensemble else
             "not the strong form with rollout selection" if not (
                 getattr(self, "formulation_", None) == "strong" and self.selection is None
@@ -1637,6 +1639,7 @@ class SINDyPI(_ImplicitMechanical):
             self._fit_weak(data)
             trims.append(self.edge_trim_)
         except IdentificationError as exc:
+            self.__dict__.clear()
             self.__dict__.update(strong)
             self.formulation_rule_ = f"open chain: the weak form's fit failed ({exc}): strong form kept"
             return
@@ -1645,6 +1648,7 @@ class SINDyPI(_ImplicitMechanical):
         weak = dict(self.__dict__)
         i0 = round(max(trims) * data.fs)
         weak_err = self._rollout_error(self.model_, data, i0, segments)
+        self.__dict__.clear()  # nothing of the weak fit stays with the strong one
         self.__dict__.update(strong)
         strong_err = self._rollout_error(self.model_, data, i0, segments)
         head = (f"open chain, rates by a declared low-pass: segmented rollout over "
@@ -1652,6 +1656,7 @@ class SINDyPI(_ImplicitMechanical):
                 f"weak {weak_err:.4g}")
         # the rollout selection's tie (selection_rtol, ROLLOUT_ATOL) goes to the strong form
         if np.isfinite(weak_err) and strong_err > weak_err * (1 + self.selection_rtol) + ROLLOUT_ATOL:
+            self.__dict__.clear()
             self.__dict__.update(weak)
             self.formulation_rule_ = f"{head}: weak form kept (smaller beyond the tie)"
         else:
