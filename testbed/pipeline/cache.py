@@ -58,6 +58,10 @@ def _folder_lock(directory: Path, exclusive: bool) -> Iterator[None]:
     releases its lock with its descriptor.  The folder's own descriptor is locked, not a file in
     it: HDF5 ``flock``-s the files it writes, and a read-only cache needs no lock file.  A
     folder that cannot be opened is not locked (nothing is written into or cleared from it).
+    A file system without ``flock`` (ENOLCK, EOPNOTSUPP: NFS without its lock daemon, some
+    FUSE and SMB mounts) is used unlocked, with one warning: the lock only orders a `cache
+    clear` against writes, and it holds between processes of one host (``flock`` on NFS does
+    not reach other hosts; clear a cache a Dask cluster shares while no sweep runs).
     """
     try:
         fd = os.open(directory, os.O_RDONLY | os.O_DIRECTORY)
@@ -66,10 +70,20 @@ def _folder_lock(directory: Path, exclusive: bool) -> Iterator[None]:
         return
     try:
         if fcntl is not None:
-            fcntl.flock(fd, fcntl.LOCK_EX if exclusive else fcntl.LOCK_SH)
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX if exclusive else fcntl.LOCK_SH)
+            except OSError as e:
+                _warn_unlocked(directory, e.strerror or str(e))
         yield
     finally:
         os.close(fd)  # (releases the lock)
+
+
+@functools.cache
+def _warn_unlocked(directory: Path, reason: str) -> None:
+    """One warning per folder and reason that the cache goes on without its lock."""
+    log.warning("dataset cache %s: the file system refuses a lock (%s); going on without it "
+                "(do not run `testbed cache clear` while a sweep writes here)", directory, reason)
 
 
 #: The name of a cache entry: ``<rig>-<cache key, 32 hex digits>.h5`` (:meth:`DatasetCache.path`).

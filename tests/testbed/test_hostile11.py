@@ -239,6 +239,30 @@ def test_cache_clear_blocks_while_the_folder_is_held_for_a_write(tmp_path):
     assert done.is_set() and not tmp.exists()  # a killed writer's file still goes
 
 
+def test_a_file_system_without_locks_writes_and_clears_unlocked_with_one_warning(tmp_path, monkeypatch,
+                                                                                caplog):
+    import errno
+
+    import testbed.pipeline.cache as cache_mod
+
+    # review: flock's ENOLCK (NFS without its lock daemon) turned every write into an OSError
+    def no_lock(fd, op):
+        raise OSError(errno.ENOLCK, "No locks available")
+
+    monkeypatch.setattr(cache_mod.fcntl, "flock", no_lock)
+    cache_mod._warn_unlocked.cache_clear()
+    d = tmp_path / "nfs"
+    d.mkdir()
+    (d / "michaelis_menten-0123456789abcdef0123456789abcdef.h5").write_bytes(b"x")
+    with caplog.at_level("WARNING", logger="testbed.pipeline.cache"):
+        for _ in range(2):
+            with cache_mod._folder_lock(d, exclusive=False):
+                pass
+        cache_mod.DatasetCache(d).clear()
+    assert not list(d.glob("*.h5"))
+    assert [r.getMessage().count("refuses a lock") for r in caplog.records] == [1]
+
+
 def test_a_results_file_with_a_null_scenario_is_refused(tmp_path):
     from testbed.studies.results import ResultsError, read_results, write_rows
 
