@@ -237,6 +237,8 @@ def _third_harmonic_rule(data: Measurement, peaks: np.ndarray | None, head: str)
     if peaks is None or np.size(peaks) == 0:
         return False, f"{head}: cubic terms out"
     low = float(np.min(peaks))
+    # the fundamental is one of the search's own accepted peaks, the same number when the caller's
+    # peaks come from the same search: 1e-9 only absorbs a round trip through float formatting
     third = [(fh, ff) for fh, k, ff in modal_peaks(data).harmonics
              if k == 3 and abs(ff - low) <= 1e-9 * max(low, 1.0)]
     if not third:
