@@ -636,6 +636,7 @@ def _request(st: _Server, conn: socket.socket) -> None:
                                                   struct.calcsize("3i")))[1]
         conn.settimeout(READ_TIMEOUT_S)
         request, fds = _recv(conn, with_fds=3, deadline=time.monotonic() + READ_TIMEOUT_S)
+        conn.settimeout(READ_TIMEOUT_S)  # the read left the deadline's last sliver (review)
         why = _refusal(uid, request, fds, st.key)
         if why:
             st.log(f"testbed server: refused a command from {why}")
