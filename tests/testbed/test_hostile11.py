@@ -32,7 +32,8 @@ def _stiff_beam(**rig) -> dict:
 def test_a_clamped_beam_whose_mode_1_is_above_nyquist_is_refused_naming_E(E):
     # E = 2**63 Pa: mode 1 at 549 kHz against the record's 6.4 kHz Nyquist frequency, was
     # accepted within the step budget on a short record and ran for minutes; 1.3e15 Pa: the
-    # 10-segment chain's mode 1 at 6512 Hz, just above (the bound is the chain's, not 0.89 of it)
+    # 10-segment chain's mode 1 at 6512 Hz, just above (the bound: the Euler-Bernoulli mode 1
+    # times 1 - 0.5 / n_segments^2, 0.995 for these 10 segments)
     raw = _stiff_beam(E=E)
     raw["simulation"]["duration"] = 0.05
     with pytest.raises(ScenarioError, match=r"key 'rig\.E'.*Nyquist frequency 6400 Hz.*aliases"):
@@ -48,7 +49,7 @@ def test_too_low_a_sample_rate_is_named_when_it_is_the_furthest_key():
 
 
 def test_a_beam_with_mode_1_below_nyquist_still_loads():
-    # 1e15 Pa: estimate 5.7 kHz, 0.89 of it below 6.4 kHz (the rule fires narrowly)
+    # 1e15 Pa: estimate 5.7 kHz, 0.995 of it below 6.4 kHz (the rule fires narrowly)
     assert scenario_from_dict(_stiff_beam(E=1e15)).rig_params["E"] == 1e15
     # a soft base is not checked: its mode 1 (the beam on the spring) may lie far below
     soft = _read_toml(SCENARIO_DIR / "cantilever_soft_impact.toml")
