@@ -24,14 +24,17 @@ rise from 0.05 mM to x* = 0.6 mM over 6 s.
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 
 import numpy as np
 
 from models.fivebar import geometry
-from models.fivebar.params import FiveBarParams
 
 HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE.parent))  # benchmarks/unseen: round 10's linkage writer
+from round10.l_make import _params, path_transmission_deg  # noqa: E402
+
 PAPER_POSE = (1.78, 1.36)
 PAPER_AMP = 0.0698   # rad, the paper's 4 deg
 
@@ -95,23 +98,6 @@ def _write(name: str, base: str, description: str, tables: dict[str, dict], scor
             lines += ["", f"[{table}]"] + [f"{k} = {_value(v)}" for k, v in tables[table].items()]
     lines += ["", "[score]", score, ""]
     (HERE / f"{name}.toml").write_text("\n".join(lines))
-
-
-def _params(rig: dict) -> FiveBarParams:
-    full = {"l1": 1.0, "l2": 1.0, "l3": 1.0, "l4": 1.0, "L0": 1.0}
-    full.update({k: v for k, v in rig.items() if k in full})
-    return FiveBarParams(l=np.array([full[f"l{i}"] for i in range(1, 5)]), L0=full["L0"], m=np.ones(4),
-                         inertia=np.ones(4), com=np.ones(4), damping=np.zeros(4))
-
-
-def path_transmission_deg(rig: dict, amplitude: float) -> tuple[float, float]:
-    """Lowest and highest transmission angle [deg] along the sine path th_0 + A sin(t)."""
-    p = _params(rig)
-    s = np.sin(np.linspace(0.0, 2.0 * np.pi, 721))
-    with np.errstate(invalid="ignore"):
-        mu = np.degrees(geometry.transmission_angle(
-            geometry.assemble(rig["th1_0"] + amplitude * s, rig["th4_0"] + amplitude * s, p)))
-    return float(np.min(mu)), float(np.max(mu))
 
 
 def fivebar_tables(tables: dict[str, dict]) -> dict[str, dict]:
