@@ -39,7 +39,12 @@ state the SGD starts from; ``l1 = "none"`` the cubic block without the lasso, th
   warm start's 0.54 / 0.85 and is kept (1.42 / 1.98 x, below 2).  ``l1 = "none"``: warm start 0.895 /
   0.913, SGD 0.48 / 0.47 (replaced), seed 22 passes.
 
-From the repository's root (``--part soft``, ``z7``, ``hybrid`` or ``z0p1``; default all)::
+* Dropping the lasso (``l1 = "none"``) on the soft-base family (``--part family``; 20 members
+  written by ``write_family``, seed 0, the study's bars): clean 16 -> 13 / 20 (000, 002, 003
+  lost: mode 2 5.3 %, TRAC NaN, TRAC 0.14; none gained), 1 % 13 -> 13.  Not adopted.
+
+From the repository's root (``--part soft``, ``z7``, ``hybrid``, ``z0p1`` or ``family``;
+default all but ``family``)::
 
     PYTHONPATH=$PWD .venv/bin/python benchmarks/unseen/round11/sgd_damped_mode2_probe.py
 """
@@ -100,6 +105,24 @@ def hybrid(seed: int = 22, noise: float = 5.0) -> None:
                   f"f_n {np.round(m.natural_frequencies_, 1).tolist()}", flush=True)
 
 
+def family(folder: str = "out/sgd11_beams_soft") -> None:
+    """``sgd_sindy`` with and without the lasso on the beams_soft family, clean and at 1 %."""
+    from testbed.studies.study import write_family
+
+    files = write_family(str(ROUND.parents[2] / "studies" / "families.toml"), folder, family="beams_soft")
+    for noise in (0.0, 1.0):
+        for f in sorted(files):
+            name = Path(f).stem
+            for params in ({}, {"l1": "none"}):
+                sc = load_scenario(str(f)).with_noise(noise).replace(
+                    seed=0, identify={"method": "sgd_sindy", **params})
+                res = testbed.run_scenario(sc)
+                v = res.scores.values
+                print(f"{name} {noise:g} % {params}: {res.verdict}  TRAC {v['trac']:.4f}  "
+                      f"f1 {v['freq_error_mode1']:.4f}  f2 {v['freq_error_mode2']:.4f}  "
+                      f"MAC2 {v['mac_mode2']:.4f}  cubic {res.model.cubic_}", flush=True)
+
+
 def main(part: str | None) -> None:
     if part in (None, "soft"):
         for method, params in (("ls_sindy", {}), ("sgd_sindy", {}), ("sgd_sindy", {"keep_sgd": False}),
@@ -119,6 +142,8 @@ def main(part: str | None) -> None:
         run("b11_z7", 5.0, 22, "sgd_sindy", keep_sgd=True, eigen=False)
     if part in (None, "hybrid"):
         hybrid()
+    if part == "family":
+        family()
     if part in (None, "z0p1"):
         for seed in (21, 22):
             for method, params in (("ls_sindy", {}), ("sgd_sindy", {}), ("sgd_sindy", {"keep_sgd": False}),
