@@ -512,6 +512,29 @@ def test_smoke_study_on_the_real_rigs(tmp_path, dataset_cache):
             assert all(math.isfinite(r[m]) for m in metric_names(kind) if m in r and m not in cubic)
 
 
+def test_a_copied_row_of_a_real_identifier_is_the_row_computing_it_gives(tmp_path, dataset_cache):
+    """The 0 % seeds' rows of built-in identifiers on both real rigs: fitted once in a loky
+    worker and copied, each equal, column for column, to its cell computed alone in this process
+    (the conformance test compares only the fitted matrices or coefficients, in one process)."""
+    path = tmp_path / "copied.toml"
+    path.write_text('[study]\nname = "copied"\nscenarios = ["cantilever_stiff_impact", '
+                    '"fivebar_multisine"]\nnoise = [0.0]\nseeds = [0, 1]\n'
+                    'identifiers = ["ls_sindy", "sindy_pi"]\n')
+    study = load_study(path)
+    stats = SweepStats()
+    rows = read_results(run_sweep(study, jobs=2, results=tmp_path / "r.parquet",
+                                  cache_dir=dataset_cache.directory, verbose=False, stats=stats))
+    assert stats.copied == 2 and all(r["status"] == "ok" for r in rows)
+    cells = {c.key: c for c in expand(study)}
+    copied = sorted((r for r in rows if r["seed"] == 1), key=lambda r: r["cell"])
+    alone = [run_cell(cells[r["cell"]], str(dataset_cache.directory), study.plugins,
+                      provenance=sweep_provenance()) for r in copied]
+    # (the results file gives every row every score column, NaN where its kind has none)
+    pairs = list(zip(copied, alone, strict=True))
+    assert all(math.isnan(r[k]) for r, a in pairs for k in set(r) - set(a))
+    assert comparable([{k: r[k] for k in a} for r, a in pairs]) == comparable(alone)
+
+
 @pytest.mark.parametrize("column, value", [("scenario", "ghost"), ("identifier", "toy_other"),
                                            ("noise", 7.0), ("seed", 5)])
 def test_a_resumed_sweep_refuses_a_row_edited_to_another_cell(toy_dir, tmp_path, column, value):
