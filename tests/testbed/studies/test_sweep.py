@@ -388,26 +388,26 @@ def test_a_failed_row_or_another_commit_s_row_is_not_copied(toy_dir, tmp_path, m
     import testbed.studies.sweep as sw
     from identify import IDENTIFIERS
 
-    flaky = IDENTIFIERS.get("toy_flaky").fits
-    flaky.clear()
     stats = SweepStats()
     study = load_study(write_study(toy_dir, "flaky", ["toy_flaky"], seeds=(0, 1, 2), noise=(0.0,)))
+    flaky = IDENTIFIERS.get("toy_flaky").fits  # (registered by the study's plugin)
+    flaky.clear()
     rows = read_results(run_sweep(study, results=tmp_path / "f.parquet", cache_dir=tmp_path / "c",
                                   verbose=False, stats=stats))
     # the first fit failed (MemoryError); the other two seeds were fitted, not handed its failure
     assert sorted(r["status"] for r in rows) == ["failed", "ok", "ok"] and stats.copied == 0
+    study = load_study(write_study(toy_dir, "inh", ["toy_inherits"], seeds=(0, 1), noise=(0.0,)))
     inherits = IDENTIFIERS.get("toy_inherits").fits
     inherits.clear()
-    study = load_study(write_study(toy_dir, "inh", ["toy_inherits"], seeds=(0, 1), noise=(0.0,)))
     run_sweep(study, results=tmp_path / "i.parquet", cache_dir=tmp_path / "c", verbose=False,
               stats=stats)
     assert stats.copied == 0 and len(inherits) == 2
     # a resume by other code computes the added seed instead of copying the old code's row
-    det = IDENTIFIERS.get("toy_det").fits
     res = tmp_path / "d.parquet"
     monkeypatch.setattr(sw, "git_commit", lambda: "old-commit")
     run_sweep(load_study(write_study(toy_dir, "code", ["toy_det"], seeds=(0,), noise=(0.0,))),
               results=res, cache_dir=tmp_path / "c", verbose=False)
+    det = IDENTIFIERS.get("toy_det").fits
     monkeypatch.setattr(sw, "git_commit", lambda: "new-commit")
     det.clear()
     rows = read_results(run_sweep(load_study(write_study(toy_dir, "code", ["toy_det"], seeds=(0, 1),
