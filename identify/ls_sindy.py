@@ -319,7 +319,9 @@ class LeastSquaresSINDy(StructuralIdentifier):
         ps = modal_peaks(data, lower_modes=self.lower_modes)
         self.harmonics_, self.harmonic_rule_ = harmonics_array(ps), ps.harmonic_rule
         self.peak_count_rule_ = ps.count_rule
-        self.cubic_, self.cubic_rule_ = cubic_rule(data, self.cubic, self.fit_band_hz, ps.peaks)
+        default = ps if self.lower_modes else None  # the cubic rule's own default search
+        self.cubic_, self.cubic_rule_ = cubic_rule(data, self.cubic, self.fit_band_hz, ps.peaks,
+                                                   default)
         self._fit_in_band(data, ps.peaks, m_hat, self.fit_band_hz)
         low = self._lowest_mode_hz()
         if self.fit_band_hz is None and 0.0 < low < self.fit_band_hz_:
@@ -329,7 +331,7 @@ class LeastSquaresSINDy(StructuralIdentifier):
             rule = (f"{self.fit_band_rule_}; refused: the fitted mode 1 ({low:.4g} Hz) lies "
                     f"below it, fitted on what it removed: no band")
             self.__dict__.pop("modal_decay_", None)
-            self.cubic_, self.cubic_rule_ = cubic_rule(data, self.cubic, 0.0, ps.peaks)
+            self.cubic_, self.cubic_rule_ = cubic_rule(data, self.cubic, 0.0, ps.peaks, default)
             self._fit_in_band(data, ps.peaks, m_hat, 0.0)
             self.fit_band_rule_ = rule
         self._finish_fit(data)

@@ -361,8 +361,9 @@ class SGDSINDyBase(StructuralIdentifier):
         """
         self.check_params()
         search = functools.cache(lambda: modal_peaks(data, lower_modes=self._lower_modes()))
-        self.cubic_, self.cubic_rule_ = cubic_rule(data, self.cubic, None,
-                                                   None if self.cubic is not None else search().peaks)
+        self.cubic_, self.cubic_rule_ = cubic_rule(
+            data, self.cubic, None, None if self.cubic is not None else search().peaks,
+            search() if self.cubic is None and self._lower_modes() else None)
         self.learning_rate_, self.learning_rate_rule_ = learning_rate_for(self.cubic_,
                                                                           self.learning_rate)
         if self.eigen:
