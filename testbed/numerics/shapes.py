@@ -13,7 +13,30 @@ from testbed.core.lazy import lazy_module
 linalg = lazy_module("scipy.linalg")
 optimize = lazy_module("scipy.optimize")
 
-__all__ = ["mac_matrix", "modal_from_matrices", "pole_pairs", "trac"]
+__all__ = ["mac_matrix", "modal_from_matrices", "pole_pairs", "slowest_decay_rate", "trac"]
+
+
+def slowest_decay_rate(w: np.ndarray, zeta: np.ndarray) -> np.ndarray:
+    """The slower decay rate of each mode of natural frequency ``w`` and damping ratio ``zeta``.
+
+    ``zeta w`` for an underdamped mode (``zeta < 1``: the envelope's rate); ``w (zeta -
+    sqrt(zeta^2 - 1))`` for an overdamped one (its slower real pole, the one that is left).
+
+    Parameters
+    ----------
+    w : ndarray, shape (n,)
+        Natural frequencies [rad/s].
+    zeta : ndarray, shape (n,)
+        Damping ratios [-]; NaN gives NaN.
+
+    Returns
+    -------
+    ndarray, shape (n,)
+        Decay rates [1/s].
+    """
+    w, z = np.asarray(w, dtype=float), np.asarray(zeta, dtype=float)
+    with np.errstate(invalid="ignore"):
+        return np.where(z < 1.0, z * w, w * (z - np.sqrt(np.maximum(z * z - 1.0, 0.0))))
 
 
 def mac_matrix(phi_a: np.ndarray, phi_b: np.ndarray) -> np.ndarray:

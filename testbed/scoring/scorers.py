@@ -19,6 +19,7 @@ from testbed.core.kinds import MAX_MODE_SCORES, METRICS
 from testbed.core.measurement import Measurement, Trajectory
 from testbed.core.terms import canonical
 from testbed.core.truth import DynamicalTruth, MechanicalTruth, StructuralTruth, TruthError
+from testbed.numerics.shapes import slowest_decay_rate
 from testbed.pipeline.plugins import rig_class
 from testbed.pipeline.signal_chain import pulse_end
 from testbed.scoring import metrics
@@ -407,18 +408,15 @@ def window_decay(truth: StructuralTruth, dataset: Dataset, data: Measurement, n:
 
     ``exp(-s_k dt)``, with ``dt`` [s] from the end of the raw hammer pulse
     (:func:`testbed.pipeline.signal_chain.pulse_end`) to ``data.free_start`` and ``s_k``
-    [1/s] the mode's slowest decay rate: ``zeta_k w_k`` for ``zeta_k < 1``, ``w_k (zeta_k -
-    sqrt(zeta_k^2 - 1))`` for an overdamped mode (its slower real pole).  All ones for a record
-    with no pulse or no free decay (``free_start`` 0); NaN where the truth gives no damping
-    ratio.  See :data:`DECAYED_RATIO`.
+    [1/s] the mode's slowest decay rate (:func:`testbed.numerics.shapes.slowest_decay_rate`).
+    All ones for a record with no pulse or no free decay (``free_start`` 0); NaN where the
+    truth gives no damping ratio.  See :data:`DECAYED_RATIO`.
     """
     force = dataset.measured.get("force")
     end = pulse_end(np.asarray(force.data, float)) if force is not None else 0
     dt = max(0, int(data.free_start) - end) / float(data.fs) if end > 0 and data.free_start else 0.0
-    w = 2.0 * np.pi * np.asarray(truth.frequencies_hz[:n], float)
-    z = np.asarray(truth.damping_ratios[:n], float)
-    with np.errstate(invalid="ignore"):
-        rate = np.where(z < 1.0, z * w, w * (z - np.sqrt(np.maximum(z * z - 1.0, 0.0))))
+    rate = slowest_decay_rate(2.0 * np.pi * np.asarray(truth.frequencies_hz[:n], float),
+                              np.asarray(truth.damping_ratios[:n], float))
     return np.exp(-rate * dt)
 
 

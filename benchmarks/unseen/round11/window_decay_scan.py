@@ -24,6 +24,7 @@ from pathlib import Path
 import numpy as np
 
 from testbed.numerics import filters as sig
+from testbed.numerics.shapes import slowest_decay_rate
 from testbed.pipeline import signal_chain as chain
 from testbed.pipeline.scenario import load_scenario
 
@@ -54,7 +55,7 @@ def main(files: list[str]) -> None:
         if s["lowpass_hz"] > 0:
             margin = max(margin, sig.lowpass_settling(fs, s["lowpass_hz"], s["lowpass_order"],
                                                       chain.LOWPASS_SETTLE_TOL))
-        rate = np.where(z < 1, z * w, w * (z - np.sqrt(np.maximum(z * z - 1, 0))))
+        rate = slowest_decay_rate(w, z)
         left = np.exp(-rate * margin / fs)[: min(2, len(r["sensors"]) or 3)]
         if np.any(left < 0.05):
             print(f"{f}: left {np.round(left, 5)}, zeta {np.round(z[:2], 3)}, "
