@@ -71,18 +71,22 @@ def canonical_sign(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray
     return a, b
 
 
+def _identity(z: np.ndarray) -> np.ndarray:
+    return z
+
+
 def _value_grad(a: np.ndarray, x: np.ndarray, y: np.ndarray, Q: np.ndarray | None,
-                symmetric: bool = False) -> tuple[float, np.ndarray]:
+                symmetric: bool = False, transform=_identity) -> tuple[float, np.ndarray]:
     """``-J(a)`` and its gradient, ``z = P (a . x)^3`` (``P``: off ``Q``): ``J = |y z^T|^2 / |z|^2``
     (free ``b``), or with ``b = g a`` (``symmetric``) ``J = (a . y z^T)^2 / |z|^2`` at unit ``a``."""
     if symmetric:
         r = float(np.linalg.norm(a))
         u = a / r
-        J, dJ = _value_grad_symmetric(u, x, y, Q)
+        J, dJ = _value_grad_symmetric(u, x, y, Q, transform)
         return J, (dJ - u * float(u @ dJ)) / r
     q = a @ x
-    z = q**3
-    G = 3.0 * q**2 * x  # dz/da, (n, N)
+    z = transform(q**3)
+    G = transform(3.0 * q**2 * x)  # dz/da, (n, N')
     if Q is not None:
         z = z - (z @ Q) @ Q.T
         G = G - (G @ Q) @ Q.T
@@ -96,12 +100,12 @@ def _value_grad(a: np.ndarray, x: np.ndarray, y: np.ndarray, Q: np.ndarray | Non
     return -J, -dJ
 
 
-def _value_grad_symmetric(u: np.ndarray, x: np.ndarray, y: np.ndarray, Q: np.ndarray | None
-                          ) -> tuple[float, np.ndarray]:
+def _value_grad_symmetric(u: np.ndarray, x: np.ndarray, y: np.ndarray, Q: np.ndarray | None,
+                          transform=_identity) -> tuple[float, np.ndarray]:
     """``-(u . v)^2 / s`` with ``v = y z^T``, ``s = |z|^2``, and its gradient in ``u`` (not projected)."""
     q = u @ x
-    z = q**3
-    G = 3.0 * q**2 * x
+    z = transform(q**3)
+    G = transform(3.0 * q**2 * x)
     if Q is not None:
         z = z - (z @ Q) @ Q.T
         G = G - (G @ Q) @ Q.T
@@ -125,8 +129,8 @@ def rank_one_starts(x: np.ndarray) -> list[np.ndarray]:
 
 
 def fit_rank_one(x: np.ndarray, y: np.ndarray, Q: np.ndarray | None = None,
-                 starts: list[np.ndarray] | None = None, symmetric: bool = False
-                 ) -> tuple[np.ndarray, np.ndarray]:
+                 starts: list[np.ndarray] | None = None, symmetric: bool = False,
+                 transform=None) -> tuple[np.ndarray, np.ndarray]:
     """Least-squares ``y ~ b (a . x)^3`` over a unit direction ``a`` and a vector ``b``.
 
     Variable projection: for a given ``a`` the best ``b`` is ``y z^T / (z z^T)`` with
@@ -151,6 +155,11 @@ def fit_rank_one(x: np.ndarray, y: np.ndarray, Q: np.ndarray | None = None,
     symmetric : bool
         ``b = g a`` (one scalar ``g``, ``y`` with ``m = n`` rows): the force of the potential
         ``g (a . x)^4 / 4``, a conservative spring on the coordinate ``a . x``.
+    transform : callable, optional
+        A linear, time-invariant operation on the samples (last axis) that the fit applies
+        to every feature and the target alike (a band filter, the tilt's differences):
+        the cubic feature is ``transform((a . x)^3)``; ``y`` and ``Q`` are already in its
+        output's samples.
 
     Returns
     -------
@@ -166,15 +175,17 @@ def fit_rank_one(x: np.ndarray, y: np.ndarray, Q: np.ndarray | None = None,
     # scale-free optimisation: x to unit RMS (the direction is mapped back below)
     sx = float(np.sqrt(np.mean(x**2))) or 1.0
     xs = x / sx
+    tf = _identity if transform is None else transform
     best_J, best_a = -np.inf, None
     for a0 in (rank_one_starts(xs) if starts is None else starts):
         r = minimize(_value_grad, np.asarray(a0, dtype=float) / np.linalg.norm(a0),
-                     args=(xs, y, Q, symmetric), jac=True, method="BFGS", options={"gtol": 1e-10, "maxiter": 500})
+                     args=(xs, y, Q, symmetric, tf), jac=True, method="BFGS",
+                     options={"gtol": 1e-10, "maxiter": 500})
         J = -float(r.fun)
         if J > best_J * (1.0 + 1e-12) or best_a is None:
             best_J, best_a = J, np.asarray(r.x, dtype=float)
     a = best_a / np.linalg.norm(best_a)
-    z = (a @ x) ** 3
+    z = tf((a @ x) ** 3)
     if Q is not None:
         z = z - (z @ Q) @ Q.T
     b = (y @ z) / float(z @ z)
