@@ -14,6 +14,7 @@ cubic ``k3 d (c . x)^3`` (``K3_accel_error``'s measure: relative RMS of ``Mr^-1 
   least squares, and ``a`` is optimised on the sphere from several deterministic starts;
 - ``F[x^3]``: the diagonal and ``@c`` cubic with features in the chain's order, the chain's
   filter applied to the cube of the exact displacement (the filtered equation's own term);
+  ``F[xm^3]`` the same with the measured displacement's cube (what an identifier could form);
 - ``raw``: the same on the oracle's exact signals (no chain), with the directions' angles;
 - ``sym``: the symmetric rank one ``g a (a . x)^3`` (one scalar ``g``: the force of the
   potential ``g (a . x)^4 / 4``, as the truth's, whose ``d`` and ``c`` are the same vector);
@@ -26,7 +27,8 @@ cubic ``k3 d (c . x)^3`` (``K3_accel_error``'s measure: relative RMS of ``Mr^-1 
     PYTHONPATH=$PWD .venv/bin/python tests/identify/soft_cubic_rank_one_floor.py DIR [0,7,12]
 
 Trailing ``signal.KEY=VALUE`` arguments override the scenario's chain (a diagnosis: which part
-of the chain sets the floor).  ``DIR`` holds the members written by ``testbed family write studies/families.toml -o DIR
+of the chain sets the floor).  ``DIR`` holds the members written by
+``testbed family write studies/families.toml -o DIR
 --family beams_soft``; datasets go through the ordinary cache.
 """
 
@@ -127,11 +129,13 @@ def member(path: Path, cache: DatasetCache, signal: dict | None = None) -> str:
            "velocity": dataclasses.replace(ds.reference["velocity"], data=ud)}
     oracle = dataclasses.replace(ds, reference=ref, measured={
         **ds.measured, "acceleration": dataclasses.replace(ds.measured["acceleration"], data=udd)})
-    raw_d, raw_r, raw_ang, _, _, raw_s, raw_ang_s = floors(tr, u[:, start:], ud[:, start:], udd[:, start:], None)
+    raw_d, raw_r, raw_ang, _, _, raw_s, raw_ang_s = floors(tr, u[:, start:], ud[:, start:],
+                                                           udd[:, start:], None)
     m = measure(oracle, {**sc.signal, **(signal or {})}, sc.kind)
     i0 = m.free_start
     W = nuisance_basis(m, i0, m.n_samples)[0]
-    ch_d, ch_r, ang, sh, ch_c, ch_s, ang_s = floors(tr, *(np.asarray(a, float)[:, i0:] for a in (m.x, m.xd, m.xdd)), W)
+    window = [np.asarray(a, float)[:, i0:] for a in (m.x, m.xd, m.xdd)]
+    ch_d, ch_r, ang, sh, ch_c, ch_s, ang_s = floors(tr, *window, W)
     from testbed.numerics import filters as sig
     cfg = {**sc.signal, **(signal or {})}
     fs = float(ds.fs)
@@ -144,9 +148,11 @@ def member(path: Path, cache: DatasetCache, signal: dict | None = None) -> str:
                                       cfg["ripple_db"], cfg["stop_db"])
         return z
 
-    co_d, co_c = chain_order(tr, *(np.asarray(a, float)[:, i0:] for a in (m.x, m.xd, m.xdd)), W,
-                             u, chain)
-    return (f"{sc.name}: n {u.shape[0]} | F[x^3] diag {co_d:.3f} @c {co_c:.3f} | raw diag {raw_d:.4f} rank1 {raw_r:.4f} sym {raw_s:.4f}"
+    co_d, co_c = chain_order(tr, *window, W, u, chain)
+    cm_d, cm_c = chain_order(tr, *window, W, np.asarray(m.x, float), chain)
+    return (f"{sc.name}: n {u.shape[0]} | F[x^3] diag {co_d:.3f} @c {co_c:.3f}"
+            f" F[xm^3] diag {cm_d:.3f} @c {cm_c:.3f}"
+            f" | raw diag {raw_d:.4f} rank1 {raw_r:.4f} sym {raw_s:.4f}"
             f" angle {raw_ang:.1f} sym {raw_ang_s:.1f} deg"
             f" | chain diag {ch_d:.3f} rank1 {ch_r:.3f} sym {ch_s:.3f} rank1@c {ch_c:.3f}"
             f" angle {ang:.1f} sym {ang_s:.1f} deg | mode-2 shift % truth {sh[0]:.2f}"
