@@ -12,6 +12,9 @@ cubic ``k3 d (c . x)^3`` (``K3_accel_error``'s measure: relative RMS of ``Mr^-1 
 - ``rank1``: ``b (a . x)^3`` with a unit direction ``a`` and a free ``b`` (n,), by variable
   projection (:func:`identify._cubic.fit_rank_one`): for a given ``a`` the best ``b`` is linear
   least squares, and ``a`` is optimised on the sphere from several deterministic starts;
+- ``|Fx-x|``, ``|xm-Fx|``: how far the chain's filter alone moves the exact displacement on
+  the window, and how far the measured one is from that (integration, rest offset), relative
+  to the exact displacement's norm;
 - ``F[x^3]``: the diagonal and ``@c`` cubic with features in the chain's order, the chain's
   filter applied to the cube of the exact displacement (the filtered equation's own term);
   ``F[xm^3]`` the same with the measured displacement's cube (what an identifier could form);
@@ -150,8 +153,12 @@ def member(path: Path, cache: DatasetCache, signal: dict | None = None) -> str:
 
     co_d, co_c = chain_order(tr, *window, W, u, chain)
     cm_d, cm_c = chain_order(tr, *window, W, np.asarray(m.x, float), chain)
-    return (f"{sc.name}: n {u.shape[0]} | F[x^3] diag {co_d:.3f} @c {co_c:.3f}"
-            f" F[xm^3] diag {cm_d:.3f} @c {cm_c:.3f}"
+    Fu = chain(u)
+    rel = float(np.linalg.norm(u[:, i0:]))
+    e_F = float(np.linalg.norm((Fu - u)[:, i0:])) / rel
+    e_m = float(np.linalg.norm((np.asarray(m.x, float) - Fu)[:, i0:])) / rel
+    return (f"{sc.name}: n {u.shape[0]} | |Fx-x| {e_F:.3f} |xm-Fx| {e_m:.3f}"
+            f" | F[x^3] diag {co_d:.3f} @c {co_c:.3f} F[xm^3] diag {cm_d:.3f} @c {cm_c:.3f}"
             f" | raw diag {raw_d:.4f} rank1 {raw_r:.4f} sym {raw_s:.4f}"
             f" angle {raw_ang:.1f} sym {raw_ang_s:.1f} deg"
             f" | chain diag {ch_d:.3f} rank1 {ch_r:.3f} sym {ch_s:.3f} rank1@c {ch_c:.3f}"
