@@ -11,9 +11,12 @@ of the features ``x_j^3`` every structural identifier fits by default.  The *ran
 localised nonlinearity (a joint, a support), e.g. the soft base's ``k3 d (c . x)^3`` of the
 SEREP truth, whose cross terms ``x_i^2 x_j`` the diagonal features cannot represent.
 
-Every consumer of a model's cubic (simulation, residuals, scores, figures) computes it with
-:func:`cubic_features` / :func:`cubic_force`, so the two forms cannot diverge.
-:func:`fit_rank_one` fits ``b (a . x)^3`` to a target by variable projection.
+:func:`fit_rank_one` fits ``b (a . x)^3`` to a target by variable projection.  Used, for now,
+by the diagnosis scripts ``tests/identify/soft_cubic_rank_one_floor.py`` and
+``soft_cubic_rank_one_ls.py`` only: no identifier fits the rank-one form, and the consumers of
+``K3_`` (simulation, residuals, scores, figures) still take the diagonal ``K3_ @ x**3`` (the
+form was measured not to be the soft base's floor: ``docs/known-gaps.md``).  Should a model
+carry ``A``, every such consumer is to compute its cubic with :func:`cubic_force`.
 """
 
 from __future__ import annotations
