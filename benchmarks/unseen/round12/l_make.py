@@ -14,7 +14,8 @@ to 1.75x on a linkage with equal cranks, 3.6x with cranks 4x apart).  The rig's 
 keep the transmission angle in range) admits each; where the paper's pose does not, the start
 pose is the rig's own rule written out (round 11's ``fivebar_tables``).  Each case twice:
 ``fb12_<case>`` with the noise chain, ``fb12_<case>_rec`` clean with the recorded rates.
-The multisine (``fivebar_multisine_noise1``) at 0.25, 0.5 and 1.5 N m (rounds used 1, 2, 3).
+The multisine (``fivebar_multisine_noise1``) at 0.25, 0.5, 0.75, 1.25 and 1.5 N m (rounds used
+1, 2, 3).
 Cart-poles: ``cartpole_noise1``'s chain with friction-like damping on both joints (a rail of
 2 and 15 N s/m with a damped hinge, a hinge of 0.5 N m s/rad on the base pole).
 Kinetics: ``michaelis_menten_noise1``'s weak setup with other dosing: a 5 mM dose, a 1 mM dose
@@ -48,7 +49,7 @@ FIVEBARS: dict[str, tuple[str, dict[str, dict]]] = {
 MULTISINES: dict[str, tuple[str, dict[str, dict]]] = {
     f"fb12_ms_amp{str(a).replace('.', 'p')}": (f"the multisine at {a} N m (the paper's linkage)",
                                                 {"excitation": {"amplitude": a}})
-    for a in (0.25, 0.5, 1.5)
+    for a in (0.25, 0.5, 0.75, 1.25, 1.5)
 }
 
 #: name -> (description, {table: keys changed from cartpole_noise1})
