@@ -637,6 +637,9 @@ class MatrixSGDResult:
     warm : MatrixSGDResult or None
         With ``with_warm``: the held warm start, the result ``epochs = 0`` gives (bit for bit;
         ``n_steps`` 0, ``history`` the first row); else None.
+    stop_rule : str
+        Why the epochs ended before ``epochs`` (:data:`BREAKDOWN_RULE`), or ``""`` when all
+        ran; the history then ends at the last epoch that left a finite iterate.
     """
 
     M: np.ndarray
@@ -656,6 +659,18 @@ class MatrixSGDResult:
     input_map_record: np.ndarray | None = None
     backbone_rule: str = ""
     warm: MatrixSGDResult | None = None
+    stop_rule: str = ""
+
+
+#: The rule when an epoch's steps leave a non-finite iterate (round 12's
+#: ``b12_tip_cluster_L1``: three sensors within 0.15 m of a 1 m beam's tip, the mass
+#: matrix's Cholesky factor lost rank over 40 epochs, condition 1e16, then the next epoch's
+#: steps turned every entry NaN and the K projection's eigensolver raised): an iterate that is
+#: not a number is no result, so the epochs stop and the result is the last epoch's finite
+#: iterate.  ``SGDSINDy``'s ``keep_sgd`` comparison with the held warm start then decides as
+#: for every SGD result.  It fires only where the steps were about to fail the fit.
+BREAKDOWN_RULE = ("the SGD's steps of epoch {epoch} left a non-finite iterate: the epochs "
+                  "stopped there, the result is epoch {last}'s iterate")
 
 
 def psd_damping_warm_start(M: np.ndarray, C: np.ndarray, K: np.ndarray) -> np.ndarray | None:
@@ -975,6 +990,8 @@ def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
     avg_from = max(int(np.ceil(int(est.epochs) * (1.0 - frac))), l1_epochs) + 1 if frac > 0 else None
     acc = [np.zeros((n, n)) for _ in range(4)]
     n_acc = 0
+    stop_rule = ""
+    last = [a.copy() for a in (L, P, Q, R)]  # the last epoch's finite iterate (BREAKDOWN_RULE)
     for epoch in range(1, int(est.epochs) + 1):
         if progress is not None:
             progress((epoch - 1) / int(est.epochs), f"epoch {epoch}/{int(est.epochs)}")
@@ -984,6 +1001,11 @@ def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
                      alpha["eig"] * eps_eig if use_eig else 0.0, has_R,
                      support if support is not None else no_support, support is not None,
                      lam_l1, use_l1 and epoch <= l1_epochs, float(m_hat))
+        if not all(np.isfinite(a).all() for a in (L, P, Q, R)):
+            for a, b in zip((L, P, Q, R), last, strict=True):
+                a[...] = b
+            stop_rule = BREAKDOWN_RULE.format(epoch=epoch, last=epoch - 1)
+            break
         n_steps += spe
         clipped = _project_psd(P)  # K: positive semi-definite by construction, per epoch
         if clipped < 0:
@@ -1009,6 +1031,8 @@ def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
             for a_, v_ in zip(acc, (L @ L.T, P, Q, R), strict=True):
                 a_ += v_
             n_acc += 1
+        for a, b in zip(last, (L, P, Q, R), strict=True):
+            a[...] = b
     if n_acc:
         LLt, P, Q, R = (a_ / n_acc for a_ in acc)
         L = np.linalg.cholesky(_sym(LLt))
@@ -1071,8 +1095,9 @@ def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
                                fit_tilt=tilted, fit_tilt_rule=tilt_rule,
                                input_map_record=input_map_record, backbone_rule=rule)
 
-    out = finish(L, P, Q, R, target, guard, n_steps, alpha,
-                 {k: np.asarray(v) for k, v in hist.items()})
+    out = dataclasses.replace(finish(L, P, Q, R, target, guard, n_steps, alpha,
+                                     {k: np.asarray(v) for k, v in hist.items()}),
+                              stop_rule=stop_rule)
     if warm is None:
         return out
     (L0, P0, Q0, R0, target0), guard0, alpha0 = warm

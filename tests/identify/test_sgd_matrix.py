@@ -223,3 +223,35 @@ def test_the_held_warm_start_comes_with_the_fit(k3, cubic):
     assert fit_matrix_sgd(data, est, m_hat, lam_hat, peaks=peaks).warm is None
     assert fit_matrix_sgd(data, dataclasses.replace(est, epochs=0), m_hat, lam_hat,
                           peaks=peaks, with_warm=True).warm is None  # nothing to compare
+
+
+def test_an_epoch_that_leaves_a_non_finite_iterate_stops_the_epochs(monkeypatch):
+    """Round 12's ``b12_tip_cluster_L1`` (sensors within 0.15 m of a 1 m beam's tip): the mass
+    matrix's factor lost rank, an epoch's steps turned the iterate NaN, and the K projection's
+    eigensolver raised ("numerical breakdown", no model) while the held warm start passes
+    (TRAC 0.999).  Now the epochs stop and the result is the last finite epoch's iterate
+    (``BREAKDOWN_RULE``); the breakdown is forced here at epoch 3 (the old code raised
+    LinAlgError)."""
+    from identify import _compiled
+    from identify._sgd_matrix import BREAKDOWN_RULE
+
+    data, _ = _signals(0.0)
+    model = SGDSINDy(epochs=5)
+    lam_hat, peaks = model._start_fit(data)
+    m_hat = mass_prior_value(data, model.mass_prior)
+    est = model.settings()
+    assert fit_matrix_sgd(data, est, m_hat, lam_hat, peaks=peaks).stop_rule == ""
+    steps, calls = _compiled.sgd_steps, []
+
+    def breaking_steps(Z, nfa, S, Nz, perm, bs, spe, params, *rest):
+        steps(Z, nfa, S, Nz, perm, bs, spe, params, *rest)
+        calls.append(spe)
+        if len(calls) == 3:
+            params[1][...] = np.nan  # P, the stiffness factor
+
+    monkeypatch.setattr(_compiled, "sgd_steps", breaking_steps)
+    out = fit_matrix_sgd(data, est, m_hat, lam_hat, peaks=peaks, with_warm=True)
+    assert out.stop_rule == BREAKDOWN_RULE.format(epoch=3, last=2)
+    assert out.n_steps == 2 * calls[0] and len(out.history["epoch"]) == 3  # epochs 0-2
+    assert all(np.isfinite(a).all() for a in (out.M, out.C, out.K))
+    assert out.warm is not None and out.warm.stop_rule == ""
