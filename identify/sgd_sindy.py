@@ -811,6 +811,9 @@ class SGDSINDy(SGDSINDyBase):
         The fit band's high-pass cut-off [Hz] (0 = none); ``fit_band_rule_`` (str) says why.
     fit_tilt_ : bool
         Whether the fit (warm start and loss) was tilted; ``fit_tilt_rule_`` (str) says why.
+    sgd_stop_rule_ : str
+        Why the SGD's epochs ended early (:data:`identify._sgd_matrix.BREAKDOWN_RULE`: an
+        epoch left a non-finite iterate), or ``"every epoch ran"``.
     cubic_direction_ : ndarray, shape (n,)
         Only with ``cubic`` and ``cubic_form="direction"``: the unit direction ``w`` [-];
         ``cubic_direction_rule_`` (str, set with ``cubic``) says how the cubic block was formed.
@@ -994,6 +997,8 @@ class SGDSINDy(SGDSINDyBase):
         by_rule = self.keep_sgd is None and est.epochs > 0 and est.init == "lstsq"
         out = fit_matrix_sgd(data, est, m_hat, lam_hat, progress=self.report_progress,
                              peaks=band_peaks, with_warm=by_rule)
+        # whichever model is kept below, what stopped the SGD stays on record
+        self.sgd_stop_rule_ = out.stop_rule or "every epoch ran"
         started = dict(self.__dict__)
         self._set_model(data, est, out, band_peaks)
         if not by_rule:

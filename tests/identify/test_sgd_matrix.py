@@ -255,3 +255,25 @@ def test_an_epoch_that_leaves_a_non_finite_iterate_stops_the_epochs(monkeypatch)
     assert out.n_steps == 2 * calls[0] and len(out.history["epoch"]) == 3  # epochs 0-2
     assert all(np.isfinite(a).all() for a in (out.M, out.C, out.K))
     assert out.warm is not None and out.warm.stop_rule == ""
+
+
+def test_the_identifier_states_why_its_epochs_stopped(monkeypatch):
+    """``sgd_sindy`` keeps what stopped the SGD on the fitted model, whichever of the SGD's
+    result and the held warm start it keeps (``sgd_stop_rule_``)."""
+    from identify import _compiled
+    from identify._sgd_matrix import BREAKDOWN_RULE
+
+    data, _ = _signals(0.0)
+    assert SGDSINDy(epochs=5).fit(data).sgd_stop_rule_ == "every epoch ran"
+    steps, calls = _compiled.sgd_steps, []
+
+    def breaking_steps(Z, nfa, S, Nz, perm, bs, spe, params, *rest):
+        steps(Z, nfa, S, Nz, perm, bs, spe, params, *rest)
+        calls.append(spe)
+        if len(calls) == 3:
+            params[1][...] = np.nan
+
+    monkeypatch.setattr(_compiled, "sgd_steps", breaking_steps)
+    model = SGDSINDy(epochs=5).fit(data)
+    assert model.sgd_stop_rule_ == BREAKDOWN_RULE.format(epoch=3, last=2)
+    assert np.isfinite(model.K_).all()
