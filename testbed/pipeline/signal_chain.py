@@ -383,15 +383,35 @@ def pulse_end(force: np.ndarray) -> int:
         the contiguous run of above-threshold samples from the peak on counts as the pulse, so
         a later noise spike does not postpone the end.
     """
+    return pulse_span(force)[1]
+
+
+def pulse_span(force: np.ndarray) -> tuple[int, int]:
+    """First and one-past-last sample of the force pulse: ``(start, pulse_end(force))``.
+
+    The contiguous run of samples around the peak of ``max_j |force_j|`` above
+    :func:`pulse_end`'s threshold; ``(0, 0)`` for an all-zero force.
+
+    Parameters
+    ----------
+    force : ndarray, shape (n_inputs, n_samples)
+        Measured force [N].
+
+    Returns
+    -------
+    (int, int)
+    """
     mag = np.max(np.abs(np.atleast_2d(force)), axis=0)
     peak = mag.max(initial=0.0)
     if peak == 0:
-        return 0
+        return 0, 0
     sigma = 1.4826 * np.median(np.abs(mag - np.median(mag)))
     above = mag > max(PULSE_END_FRACTION * peak, 5.0 * sigma)
     k = int(np.argmax(mag))
     below = np.flatnonzero(~above[k:])
-    return len(mag) if below.size == 0 else k + int(below[0])
+    before = np.flatnonzero(~above[:k])
+    return (0 if before.size == 0 else int(before[-1]) + 1,
+            len(mag) if below.size == 0 else k + int(below[0]))
 
 
 def measure_structural(dataset: Dataset, cfg: Mapping[str, Any]) -> Measurement:
