@@ -7,21 +7,14 @@ by a compiled loop (:func:`identify._compiled.rk4_cubic`).
 
 from __future__ import annotations
 
-import threading
-from dataclasses import dataclass
-
 import numpy as np
 
 from testbed.core.errors import DivergenceError, UnresolvedModelError
-from testbed.core.lazy import lazy_module
 from testbed.core.measurement import Trajectory
+from testbed.numerics.linear_response import simulate_linear, state_matrix
 
-linalg = lazy_module("scipy.linalg")  # imported on first use: `testbed list` does not pay for it
+__all__ = ["pole_radius", "sample_rate_pole", "simulate_structural", "state_matrix"]
 
-
-#: Largest modal power table kept between calls [bytes] (a 3-sensor beam at 12.8 kHz for 1 s
-#: needs 1.2 MB; a sweep's longest records stay far below this bound, beyond it nothing is kept).
-KEEP_BYTES = 1 << 26
 
 #: Where classical RK4's region of absolute stability meets the negative real axis:
 #: ``|1 + z + z^2/2 + z^3/6 + z^4/24| = 1`` at ``z = -2.785`` (on the imaginary axis the bound
@@ -42,111 +35,6 @@ RK4_STABILITY_BOUND = 2.785
 #: -1.4e9 rad/s, |lambda| dt = 1.1e5, which needed 7e9 steps per simulation (hours).  A pole
 #: the record resolves is simulated at any cost (its sub-steps are at most 28 per sample).
 MAX_UNRESOLVED_RK4_STEPS = 5_000_000
-
-
-@dataclass
-class _Propagator:
-    """What :func:`_zoh_free_and_forced` computes from the model, step and input alone (not the
-    start): the transition, its eigen-decomposition, the modal powers and the modal forced
-    response.  The scorer's initial-state fit simulates one model from 2n + 3 starts over the
-    same window and input; each start then costs a solve and a product."""
-
-    A: np.ndarray
-    Bz: np.ndarray | None
-    dt: float
-    n_t: int
-    w: np.ndarray | None
-    E: np.ndarray
-    d: np.ndarray | None = None        # eigenvalues of the transition, (nz,); None: defective
-    V: np.ndarray | None = None        # its eigenvectors, (nz, nz)
-    powers: np.ndarray | None = None   # d_i^k, (nz, n_t)
-    forced: np.ndarray | None = None   # modal response to the input from rest, (nz, n_t)
-
-    def same(self, A: np.ndarray, Bz: np.ndarray | None, dt: float, n_t: int,
-             w: np.ndarray | None) -> bool:
-        """True if built from exactly these inputs (bit for bit)."""
-        def eq(a: np.ndarray | None, b: np.ndarray | None) -> bool:
-            return (a is None) == (b is None) and (a is None or (
-                a.shape == b.shape and a.dtype == b.dtype and a.tobytes() == b.tobytes()))
-        return dt == self.dt and n_t == self.n_t and eq(A, self.A) and eq(Bz, self.Bz) and eq(w, self.w)
-
-
-_LAST = threading.local()  # the last propagator of this thread (sweeps may run cells in threads)
-
-
-def _propagator(A: np.ndarray, Bz: np.ndarray | None, dt: float, n_t: int,
-                w: np.ndarray | None) -> _Propagator:
-    """The :class:`_Propagator` of these inputs: the last one if built from the same, else new."""
-    last = getattr(_LAST, "value", None)
-    if last is not None and last.same(A, Bz, dt, n_t, w):
-        return last
-    nz = A.shape[0]
-    if Bz is None or w is None:
-        aug = A
-    else:
-        aug = np.zeros((nz + Bz.shape[1], nz + Bz.shape[1]))
-        aug[:nz, :nz], aug[:nz, nz:] = A, Bz
-    E = linalg.expm(aug * dt)
-    p = _Propagator(A.copy(), None if Bz is None else Bz.copy(), dt, n_t,
-                    None if w is None else w.copy(), E)
-    d, V = linalg.eig(E[:nz, :nz])
-    if not np.linalg.cond(V) > 1e10:  # else defective (repeated) modes: stepped directly
-        p.d, p.V = d, V
-        p.powers = d[:, None] ** np.arange(n_t)[None, :]
-        if w is not None:
-            r = linalg.solve(V, E[:nz, nz:] @ w.astype(complex))  # modal input, (nz, n_t)
-            from scipy import signal  # lazy: scipy.signal costs ~0.7 s of import
-
-            # q_k = d q_{k-1} + r_{k-1}: a first-order IIR filter per mode
-            p.forced = np.array([signal.lfilter([0.0, 1.0], [1.0, -d[i]], r[i]) for i in range(nz)])
-    _LAST.value = p if p.powers is None or p.powers.nbytes <= KEEP_BYTES else None
-    return p
-
-
-def _zoh_free_and_forced(A: np.ndarray, Bz: np.ndarray | None, z0: np.ndarray, dt: float, n_t: int,
-                         w: np.ndarray | None) -> np.ndarray:
-    """Exact ZOH discretisation of ``z' = A z + Bz w``, propagated in modal coordinates.
-
-    ``A`` (nz, nz), ``Bz`` (nz, m) or None, ``z0`` (nz,), ``w`` (m, n_t) or None; ``dt`` [s].
-    Returns the states, shape (nz, n_t), at the sample times ``k dt``.  Everything but the
-    start is kept from the previous call of the thread when its inputs are the same bit for bit
-    (:class:`_Propagator`): the result is the same number for number as computed afresh.
-    """
-    if Bz is None or w is None:
-        Bz = w = None
-    p = _propagator(A, Bz, dt, n_t, w)
-    nz = A.shape[0]
-    if p.powers is None:  # defective (repeated) modes: step the recursion directly
-        Phi = p.E[:nz, :nz]
-        Z = np.empty((nz, n_t))
-        Z[:, 0] = z0
-        G = p.E[:nz, nz:] if w is not None else None
-        for k in range(1, n_t):
-            Z[:, k] = Phi @ Z[:, k - 1] + (G @ w[:, k - 1] if G is not None else 0.0)
-        return Z
-    q = linalg.solve(p.V, z0.astype(complex))[:, None] * p.powers
-    if p.forced is not None:
-        q += p.forced
-    return (p.V @ q).real
-
-
-def state_matrix(M: np.ndarray, C: np.ndarray, K: np.ndarray) -> np.ndarray:
-    """The first-order form ``A = [[0, I], [-M^-1 K, -M^-1 C]]`` of ``M x'' + C x' + K x``.
-
-    Parameters
-    ----------
-    M, C, K : ndarray, shape (n, n)
-        [kg], [N s/m], [N/m] (``M`` invertible).
-
-    Returns
-    -------
-    ndarray, shape (2 n, 2 n)
-        [1/s] and [1/s^2] blocks; its eigenvalues are the linear model's poles [rad/s].
-    """
-    M, C, K = (np.asarray(a, dtype=float) for a in (M, C, K))
-    n = M.shape[0]
-    Minv = np.linalg.inv(M)
-    return np.block([[np.zeros((n, n)), np.eye(n)], [-Minv @ K, -Minv @ C]])
 
 
 def pole_radius(A: np.ndarray) -> float:
@@ -213,7 +101,8 @@ def simulate_structural(M: np.ndarray, C: np.ndarray, K: np.ndarray, K3: np.ndar
     -----
     The linear model is discretised exactly (matrix exponential with a zero-order-hold input)
     and propagated in the eigenbasis of the transition matrix, vectorised over time (no
-    per-sample Python loop).  With a cubic term the full model is integrated with classical
+    per-sample Python loop: :func:`testbed.numerics.linear_response.simulate_linear`).
+    With a cubic term the full model is integrated with classical
     RK4 at sub-steps of the sample interval; the input is held over each interval.
 
     Raises
@@ -222,6 +111,8 @@ def simulate_structural(M: np.ndarray, C: np.ndarray, K: np.ndarray, K3: np.ndar
         Cubic model only: the state became non-finite; ``time`` [s] is the start of the
         sample interval in which it happened.
     """
+    if K3 is None or not np.any(np.asarray(K3) != 0.0):
+        return simulate_linear(M, C, K, B, x0, xd0, t, u)
     M, C, K = (np.asarray(a, dtype=float) for a in (M, C, K))
     n = M.shape[0]
     t = np.asarray(t, dtype=float)
@@ -242,13 +133,6 @@ def simulate_structural(M: np.ndarray, C: np.ndarray, K: np.ndarray, K3: np.ndar
         f = np.asarray(B, dtype=float) @ u  # (n, n_t) force [N]
     A = state_matrix(M, C, K)
     z0 = np.concatenate([x0, xd0])
-    nonlinear = K3 is not None and np.any(np.asarray(K3) != 0.0)
-    if not nonlinear:
-        Bz = np.vstack([np.zeros((n, n)), Minv]) if f is not None else None
-        Z = _zoh_free_and_forced(A, Bz, z0, dt, n_t, f)
-        x, xd = Z[:n], Z[n:]
-        xdd = -Minv @ (C @ xd + K @ x) + (Minv @ f if f is not None else 0.0)
-        return Trajectory(x, xd, xdd)
     MK3 = Minv @ np.asarray(K3, dtype=float)
     MF = Minv @ f if f is not None else np.zeros((n, n_t))
     rho = pole_radius(A) if n_t > 1 else 0.0

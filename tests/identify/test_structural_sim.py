@@ -8,6 +8,7 @@ from benchmarks.bench_structural import numpy_rk4
 from identify import _structural_sim
 from identify._structural_sim import simulate_structural
 from testbed.core.errors import DivergenceError
+from testbed.numerics import linear_response
 
 
 def _python_rk4(M, C, K, K3, x0, xd0, t, f, max_omega_h=0.1):
@@ -63,7 +64,7 @@ def _linear_case():
 
 def _fresh(*args):
     """simulate_structural with nothing kept from an earlier call."""
-    _structural_sim._LAST.value = None
+    linear_response._LAST.value = None
     return simulate_structural(*args)
 
 
@@ -77,9 +78,9 @@ def test_linear_kept_propagator_gives_the_same_numbers_as_a_fresh_one(forced):
     starts = [(np.array([1e-3, 0, -1e-3]), np.zeros(3)), (np.zeros(3), np.array([0.1, -0.2, 0.05])),
               (np.array([2e-4, 5e-4, 0.0]), np.array([0.0, 0.3, 0.0]))]
     fresh = [_fresh(M, C, K, None, B, x0, xd0, t, u) for x0, xd0 in starts]
-    _structural_sim._LAST.value = None
+    linear_response._LAST.value = None
     kept = [simulate_structural(M, C, K, None, B, x0, xd0, t, u) for x0, xd0 in starts]
-    assert _structural_sim._LAST.value is not None  # the second and third calls reused it
+    assert linear_response._LAST.value is not None  # the second and third calls reused it
     for a, b in zip(fresh, kept, strict=True):
         for f in ("x", "xd", "xdd"):
             assert np.array_equal(getattr(a, f), getattr(b, f))
