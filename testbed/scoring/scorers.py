@@ -194,8 +194,8 @@ _MODE_SCORE = re.compile(r"(mac|freq_error|damping_error)(?:_mode(\d+))?")
 def bar_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -> dict[str, str]:
     """The failures a run's bars add to its scorer's: :func:`uninformative_failures`,
     :func:`out_of_band_failures`, :func:`unexcited_failures`, :func:`decayed_failures`,
-    :func:`floor_failures` and :func:`equation_failures`, merged (one call for :func:`testbed.scoring.run.run_scenario` and
-    :func:`testbed.scoring.evaluate.score_model`)."""
+    :func:`floor_failures` and :func:`equation_failures`, merged (one call for
+    :func:`testbed.scoring.run.run_scenario` and :func:`testbed.scoring.evaluate.score_model`)."""
     return {**uninformative_failures(scores, thresholds), **out_of_band_failures(scores, thresholds),
             **unexcited_failures(scores, thresholds), **decayed_failures(scores, thresholds),
             **floor_failures(scores, thresholds), **equation_failures(scores, thresholds)}
