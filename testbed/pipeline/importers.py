@@ -62,7 +62,7 @@ from testbed.core.budget import IDENTIFY_BYTES_PER_VALUE, IDENTIFY_TEXT_BUDGET_B
 from testbed.core.dataset import Dataset, DatasetError, Signal
 from testbed.core.errors import TestbedError, show_names
 from testbed.core.measurement import Measurement
-from testbed.pipeline.signal_chain import SIGNAL_SCHEMAS, measure
+from testbed.pipeline.signal_chain import SIGNAL_CHAINS, SIGNAL_SCHEMAS, measure
 
 FORMATS = ("uff", "sep005", "csv", "hdf5")
 SUFFIXES = {".uff": "uff", ".unv": "uff", ".json": "sep005", ".csv": "csv", ".tsv": "csv",
@@ -348,6 +348,7 @@ def measurement_from_file(path: str | os.PathLike, kind: str, signal: Mapping[st
     data = read_measured(path, format=format, fs=fs, units=units, channels=channels,
                          own_units=kind == "dynamical")
     ds = data.to_dataset(groups, prior)
+    _check_read(data.source, ds, kind)
     _check_response(data.source, ds, kind)
     _check_units(data.source, ds, kind)
     try:
@@ -357,6 +358,23 @@ def measurement_from_file(path: str | os.PathLike, kind: str, signal: Mapping[st
     except ValueError as e:  # the chain's own checks: signal names, channel counts, positions
         raise MeasuredDataError(data.source, f"cannot run the {kind} signal chain: {e}; "
                                              f"signals {show_names(ds.measured)}") from None
+
+
+def _check_read(path: Path, ds: Dataset, kind: str) -> None:
+    """Refuse a signal the kind's chain never reads (:attr:`SignalChain.signals
+    <testbed.pipeline.signal_chain.SignalChain.signals>`): a CSV's column ``y [mM]`` beside
+    ``x`` and ``dx`` was dropped in silence and the model fitted to ``x`` alone (round 12)."""
+    known = SIGNAL_CHAINS[kind].signals
+    if RESPONSE_SIGNAL.get(kind) not in ds.measured:
+        return  # data of another kind, or without their response: the chain says what is missing
+    extra = [g for g in ds.measured if known is not None and g not in known]
+    if extra:
+        sig = ds.measured[extra[0]]
+        raise MeasuredDataError(path, f"signal {extra[0]!r} (channel(s) {', '.join(sig.channels)}) "
+                                      f"is not read by the {kind} signal chain, which reads "
+                                      f"{', '.join(known)}; expected only those (leave the others "
+                                      "out of the file, or name each channel "
+                                      f"'<signal>/<channel>', e.g. '{known[0]}/{sig.channels[0]}')")
 
 
 def _check_response(path: Path, ds: Dataset, kind: str) -> None:
