@@ -317,9 +317,12 @@ def _dataset_file(path: Path) -> Path:
 
 def _results_file(path: Path) -> Path:
     """A sweep results file that :func:`testbed.studies.results.read_results` can read, else InputError."""
-    from testbed.studies.results import ResultsError, read_results
+    from testbed.studies.results import ResultsError, parts_dir, read_results
 
-    _existing_file(path, "a sweep results file (from `testbed sweep`)")
+    # a sweep killed (SIGKILL, a lost machine) before its first consolidation leaves only its
+    # rows, `<path>.parts/`: "no such file" refused them (round 12); the sweep resumes from them
+    if _stat(path) is not None or not parts_dir(path).is_dir():
+        _existing_file(path, "a sweep results file (from `testbed sweep`)")
     try:
         read_results(path)
     except ResultsError as e:  # with what is wrong with it (a column missing, a row damaged)
@@ -531,10 +534,12 @@ def cmd_report(args: argparse.Namespace) -> int:
     from testbed.reporting.report import write_report
     from testbed.studies.runstore import RunStoreError, resolve_run
 
+    from testbed.studies.results import parts_dir
+
     source = Path(args.source)
     _output_folder(Path(args.output), "--output")
-    if source.is_file():
-        _results_file(source)
+    if source.is_file() or (not source.exists() and parts_dir(source).is_dir()):
+        _results_file(source)  # (only its rows, `<source>.parts/`: a sweep killed at once)
     else:
         try:  # a run folder, a scenario's folder of runs (its latest) or a scenario name
             source = _run_folder(resolve_run(source, args.runs))
