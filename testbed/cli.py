@@ -293,6 +293,23 @@ def _creatable_folder(path: Path, where: str) -> None:
     if not folder.is_dir():
         raise InputError(f"{where} {path}: {folder} is a file, not a folder; expected the dataset "
                          "cache folder")
+    # a folder where nothing can be created (/proc, /sys): `run` ended in "error: [Errno 2] No
+    # such file or directory: '/proc/x'" after its simulation, a sweep failed every cell with it
+    # (round 12).  Probed by a file created and removed; a folder we may not write (EACCES,
+    # EROFS) passes: a read-only cache serves what it holds (testbed.pipeline.cache)
+    import tempfile
+
+    from testbed.pipeline.cache import NOT_WRITABLE
+
+    try:
+        fd, probe = tempfile.mkstemp(prefix=".testbed-probe-", dir=folder)
+    except OSError as e:
+        if e.errno in NOT_WRITABLE:
+            return
+        raise InputError(f"{where} {path}: cannot be created in {folder} ({e.strerror or e}); "
+                         "expected the dataset cache folder in a folder that holds files") from None
+    os.close(fd)
+    os.unlink(probe)
 
 
 def _dataset_file(path: Path) -> Path:
