@@ -107,7 +107,7 @@ def results_cases(work: Path) -> list[tuple[str, object]]:
     from testbed.studies.results import parts_dir, write_part, write_rows
 
     def copied(rows):
-        return rows + [{**rows[0], "cell": "c9"}]
+        return [*rows, {**rows[0], "cell": "c9"}]
 
     # name -> (edit of the rows, a row file to add, the grid's cells: None for two studies'
     # rows, which only a refusal ends well; a copied row may also be refused)
@@ -201,7 +201,7 @@ def study_cases() -> list[tuple[str, object]]:
             st = study_from_dict(raw, stem="h12")
             if any(math.copysign(1.0, n) < 0 for n in st.noise):
                 return f"accepted a noise level of -0.0 ({st.noise}): other cells than 0.0's"
-            for sc, m in st.combinations():
+            for sc, _m in st.combinations():
                 for metric, bar in sc.score.items():
                     for bound, v in bar.items():
                         if v < 0 and bound == "max":  # every score here is >= 0
@@ -306,11 +306,11 @@ def channels_cases(work: Path) -> list[tuple[str, object]]:
     x = [math.exp(-k / 100) for k in range(n)]
     base = ["time [s]", "x [mM]", "dx [mM/s]"]
     files = {
-        "a copy of x beside x and dx": (base + ["y [mM]"], [(t[k], x[k], -x[k], x[k]) for k in range(n)]),
-        "a zero channel beside x and dx": (base + ["y [mM]"], [(t[k], x[k], -x[k], 0.0) for k in range(n)]),
-        "an integer channel beside x and dx": (base + ["y [mM]"], [(t[k], x[k], -x[k], int(1000 * x[k]))
+        "a copy of x beside x and dx": ([*base, "y [mM]"], [(t[k], x[k], -x[k], x[k]) for k in range(n)]),
+        "a zero channel beside x and dx": ([*base, "y [mM]"], [(t[k], x[k], -x[k], 0.0) for k in range(n)]),
+        "an integer channel beside x and dx": ([*base, "y [mM]"], [(t[k], x[k], -x[k], int(1000 * x[k]))
                                                                    for k in range(n)]),
-        "a second signal 'z' beside x and dx": (base + ["z [mM]"], [(t[k], x[k], -x[k], x[k] ** 2)
+        "a second signal 'z' beside x and dx": ([*base, "z [mM]"], [(t[k], x[k], -x[k], x[k] ** 2)
                                                                     for k in range(n)]),
         "x and dx only": (base, [(t[k], x[k], -x[k]) for k in range(n)]),
         "x, dx all zero": (base, [(t[k], 0.0, 0.0) for k in range(n)]),

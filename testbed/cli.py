@@ -549,9 +549,8 @@ def cmd_run(args: argparse.Namespace) -> int:
 
 def cmd_report(args: argparse.Namespace) -> int:
     from testbed.reporting.report import write_report
-    from testbed.studies.runstore import RunStoreError, resolve_run
-
     from testbed.studies.results import parts_dir
+    from testbed.studies.runstore import RunStoreError, resolve_run
 
     source = Path(args.source)
     _output_folder(Path(args.output), "--output")
