@@ -556,6 +556,10 @@ def cmd_report(args: argparse.Namespace) -> int:
     _output_folder(Path(args.output), "--output")
     if source.is_file() or (not source.exists() and parts_dir(source).is_dir()):
         _results_file(source)  # (only its rows, `<source>.parts/`: a sweep killed at once)
+        if Path(args.output).resolve() == parts_dir(source).resolve():
+            # the sweep's next consolidation deletes every file there but the *.bad ones
+            raise InputError(f"--output {args.output}: the folder of {source}'s row files, whose "
+                             "other files the sweep deletes; expected another folder")
     else:
         try:  # a run folder, a scenario's folder of runs (its latest) or a scenario name
             source = _run_folder(resolve_run(source, args.runs))

@@ -220,3 +220,14 @@ def test_a_full_disk_behind_a_librarys_own_exception_is_one_line(tmp_path):
 
     with pytest.raises(Exception, match="#58"):
         atomic_write(tmp_path / "y.uff", other)
+
+
+def test_a_report_into_the_results_row_folder_is_refused(tmp_path, capsys):
+    from testbed.cli import main
+    from testbed.studies.results import parts_dir, write_rows
+
+    # written there, the report was deleted by the sweep's next consolidation
+    res = write_rows(tmp_path / "r.parquet", _grid(), study="s")
+    parts_dir(res).mkdir()
+    assert main(["report", str(res), "-o", str(parts_dir(res))]) == 2
+    assert "the folder of" in capsys.readouterr().err and not list(parts_dir(res).iterdir())
