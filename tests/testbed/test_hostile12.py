@@ -231,3 +231,29 @@ def test_a_report_into_the_results_row_folder_is_refused(tmp_path, capsys):
     parts_dir(res).mkdir()
     assert main(["report", str(res), "-o", str(parts_dir(res))]) == 2
     assert "the folder of" in capsys.readouterr().err and not list(parts_dir(res).iterdir())
+
+
+# ------------------------------------------------------------------ plugin names
+
+@pytest.mark.parametrize("name", [5, "", " ", "a b", "a/b", "../up", "x\ny", ".hidden", "-x", "a" * 129])
+def test_a_registered_name_no_file_can_spell_is_refused(name):
+    from testbed.core.registry import Registry
+
+    # a plugin registering 5 made `testbed list` an internal error (TypeError sorting the
+    # names); "../up" a rig whose cache files went outside the cache folder
+    reg = Registry("rig")
+    with pytest.raises(ValueError, match=r"rig name .*: expected a name of letters, digits"):
+        reg.register(name)(type("R", (), {}))
+    reg.register("toy.v2-x_1")(type("R", (), {}))  # letters, digits, '_', '.', '-': registered
+    assert reg.names() == ["toy.v2-x_1"]
+
+
+def test_a_plugin_registering_a_bad_name_is_one_line(tmp_path, capsys):
+    from testbed.cli import main
+
+    plugin = tmp_path / "p_int.py"
+    plugin.write_text("from identify import IDENTIFIERS\n\n@IDENTIFIERS.register(5)\nclass Mine:\n"
+                      "    kind = 'structural'\n")
+    assert main(["list", "--plugin", str(plugin)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "identifier name 5: expected a name" in err
