@@ -35,6 +35,11 @@ Families (where rounds 1-11 went least):
     constant, one or two samples, repeated or jittered time stamps, ``--fs`` disagreeing with
     the time column: a model fitted while a channel of the file was left out in silence is a
     finding.
+``plugins``
+    A plugin registering an identifier or a rig under a name no scenario or file can spell
+    (an int, empty, blank, with a space, a slash, ``../`` or a newline, 129 characters) or a
+    built-in's name, then `testbed list --plugin`: registered, or an internal error, is a
+    finding.
 ``env``
     `run` and `sweep` under ``TESTBED_CACHE``, ``TESTBED_SCENARIOS``, ``TESTBED_STUDIES``,
     ``TESTBED_NO_SERVER``, ``TESTBED_SERVER_SOCKET`` and ``HOME`` malformed (``/proc/x``,
@@ -350,6 +355,37 @@ def channels_cases(work: Path) -> list[tuple[str, object]]:
     return cases
 
 
+# ------------------------------------------------------------------ plugins
+
+def plugins_cases(work: Path) -> list[tuple[str, object]]:
+    """A plugin file registering an identifier or a rig under a name no scenario or file can
+    spell (an int, empty, blank, a space, a slash, ``../``, a newline, a leading dot or dash,
+    129 characters) or under a built-in's name, then `testbed list --plugin`: an internal
+    error, or the name listed, is a finding."""
+    names = [5, "", " ", "a b", "a/b", "../up", "x\ny", ".hidden", "-x", "a" * 129, "ok_name.v2-x"]
+    cases = []
+    for reg, base, builtin in (
+            ("IDENTIFIERS", "from identify.ls_sindy import LeastSquaresSINDy as B", "ls_sindy"),
+            ("RIGS", "from models.michaelis_menten.rig import MichaelisMentenRig as B", "cantilever")):
+        for name in [*names, builtin]:
+            def run(reg=reg, base=base, name=name) -> str | None:
+                f = work / f"p{abs(hash((reg, repr(name)))) % 10**8}.py"
+                pkg = "identify" if reg == "IDENTIFIERS" else "models"
+                f.write_text(f"from {pkg} import {reg}\n{base}\n\n@{reg}.register({name!r})\n"
+                             "class Mine(B):\n    pass\n")
+                p = _testbed(["list", "--plugin", f.name], work, timeout=120)
+                bad = _cli_finding(p)
+                if bad:
+                    return bad
+                if p.returncode == 0 and name != "ok_name.v2-x":
+                    return f"registered and listed: {name!r:.40}"
+                if p.returncode != 0 and name == "ok_name.v2-x":
+                    return f"a good name refused: {p.stderr.strip()[-120:]!r}"
+                return None
+            cases.append((f"{reg}.register({name!r:.40})", run))
+    return cases
+
+
 # ------------------------------------------------------------------ env
 
 def env_cases(work: Path) -> list[tuple[str, object]]:
@@ -461,6 +497,7 @@ FAMILIES = {
     "negzero": lambda work: run_inprocess(negzero_cases()),
     "family": lambda work: run_inprocess(family_cases(_in(work, "family"))),
     "channels": lambda work: run_inprocess(channels_cases(_in(work, "channels"))),
+    "plugins": lambda work: run_inprocess(plugins_cases(_in(work, "plugins"))),
     "env": lambda work: run_inprocess(env_cases(_in(work, "env"))),
     "full": lambda work: _full_family(_in(work, "fullwork")),
 }
