@@ -257,3 +257,17 @@ def test_a_plugin_registering_a_bad_name_is_one_line(tmp_path, capsys):
     assert main(["list", "--plugin", str(plugin)]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "identifier name 5: expected a name" in err
+
+
+def test_summary_says_when_its_cells_come_from_two_versions_of_the_code(tmp_path, capsys):
+    from testbed.studies.results import write_rows
+    from testbed.studies.statistics import print_summary
+
+    # a sweep resumed after a code change pooled both commits' rows in its medians in silence
+    rows = [_row(cell="c1", commit="aaa"), _row(cell="c2", seed=1, commit="bbb"),
+            _row(cell="c3", noise=1.0, commit="bbb")]
+    print_summary(write_rows(tmp_path / "r.parquet", rows, study="s"))
+    out = capsys.readouterr().out.replace("\n", " ")
+    assert "computed by 2 versions of the code" in out and "aaa x 1, bbb x 2" in out
+    print_summary(write_rows(tmp_path / "one.parquet", _grid(), study="s"))
+    assert "versions of the code" not in capsys.readouterr().out
