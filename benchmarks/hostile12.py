@@ -34,7 +34,8 @@ Families (where rounds 1-11 went least):
     ``x`` and ``dx`` (an exact copy, all zeros, integers, another state), channels all zero or
     constant, one or two samples, repeated or jittered time stamps, ``--fs`` disagreeing with
     the time column: a model fitted while a channel of the file was left out in silence is a
-    finding.
+    finding; and a beam record (SEP-005) with a fourth sensor whose column is a copy, a double
+    or a sum of the others: identified is a finding.
 ``plugins``
     A plugin registering an identifier or a rig under a name no scenario or file can spell
     (an int, empty, blank, with a space, a slash, ``../`` or a newline, 129 characters) or a
@@ -356,7 +357,48 @@ def channels_cases(work: Path) -> list[tuple[str, object]]:
                         return f"fitted on {sorted(channels)}; left out {sorted(given - channels)}"
                 return None
             cases.append((f"{name} {' '.join(extra)}".strip(), run))
+    # a beam (structural) record with a fourth sensor whose column is another's pasted, doubled
+    # or the sum of two: accepted (a model of four modes, one of them an artefact) is a finding
+    for how in ("none", "copy", "double", "sum"):
+        def beam(how=how) -> str | None:
+            d = work / "ch"
+            d.mkdir(exist_ok=True)
+            f = d / f"beam_{how}.json"
+            _beam_sep005(f, how)
+            p = _testbed(["identify", f.name, "--kind", "structural", "--method", "ls_sindy",
+                          "--prior", "reduced_mass_trace=0.5", "-o", f"{f.stem}.model.json"], d,
+                         timeout=200)
+            bad = _cli_finding(p)
+            if bad:
+                return bad
+            if how != "none" and p.returncode in (0, 1):
+                return f"identified a record whose acc4 is {how} of others (status {p.returncode})"
+            return None
+        cases.append((f"beam: acc4 a {how} of other channels", beam))
     return cases
+
+
+def _beam_sep005(path: Path, how: str) -> None:
+    """A three-sensor beam record (decaying sines, 2 kHz, 1 s) as SEP-005, with a fourth sensor
+    at 0.4 m whose column is ``how`` of the others ("none": no fourth)."""
+    import numpy as np
+
+    fs, n = 2000.0, 2000
+    t = np.arange(n) / fs
+    acc = [np.exp(-2 * t) * (np.sin(2 * np.pi * (30 + 40 * k) * t) + 0.3 * np.sin(2 * np.pi * 170 * t))
+           for k in range(3)]
+    extra = {"copy": acc[0], "double": 2 * acc[0], "sum": acc[0] + acc[1]}.get(how)
+    pos = [0.1, 0.2, 0.3]
+    if extra is not None:
+        acc.append(extra)
+        pos.append(0.4)
+    force = np.zeros(n)
+    force[:10] = 50.0
+    chans = [{"name": f"acceleration/acc{i + 1}", "data": a.tolist(), "unit_str": "m/s^2", "fs": fs,
+              "position_m": p} for i, (a, p) in enumerate(zip(acc, pos, strict=True))]
+    chans.append({"name": "force/force", "data": force.tolist(), "unit_str": "N", "fs": fs,
+                  "position_m": 0.3})
+    path.write_text(json.dumps(chans))
 
 
 # ------------------------------------------------------------------ plugins

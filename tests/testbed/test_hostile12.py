@@ -271,3 +271,40 @@ def test_summary_says_when_its_cells_come_from_two_versions_of_the_code(tmp_path
     assert "computed by 2 versions of the code" in out and "aaa x 1, bbb x 2" in out
     print_summary(write_rows(tmp_path / "one.parquet", _grid(), study="s"))
     assert "versions of the code" not in capsys.readouterr().out
+
+
+# ------------------------------------------------------------------ identify: a channel pasted twice
+
+def _beam_sep005(path, copy_of: int | None = None) -> None:
+    import json
+
+    import numpy as np
+
+    fs, n = 2000.0, 2000
+    t = np.arange(n) / fs
+    acc = [np.exp(-2 * t) * (np.sin(2 * np.pi * (30 + 40 * k) * t) + 0.3 * np.sin(2 * np.pi * 170 * t))
+           for k in range(3)]
+    pos = [0.1, 0.2, 0.3]
+    if copy_of is not None:  # a fourth sensor whose column is another's, pasted
+        acc.append(acc[copy_of].copy())
+        pos.append(0.4)
+    force = np.zeros(n)
+    force[:10] = 50.0
+    chans = [{"name": f"acceleration/acc{i + 1}", "data": a.tolist(), "unit_str": "m/s^2", "fs": fs,
+              "position_m": p} for i, (a, p) in enumerate(zip(acc, pos, strict=True))]
+    chans.append({"name": "force/force", "data": force.tolist(), "unit_str": "N", "fs": fs,
+                  "position_m": 0.3})
+    path.write_text(json.dumps(chans))
+
+
+def test_a_structural_channel_pasted_twice_is_refused_naming_it(tmp_path):
+    from testbed.pipeline.importers import MeasuredDataError, measurement_from_file
+
+    # identified with a mode at 1.6e-5 Hz and exit status 0: the two columns of the library
+    # are one, and no fit tells their equations apart
+    _beam_sep005(tmp_path / "copy.json", copy_of=0)
+    with pytest.raises(MeasuredDataError, match=r"'acceleration' channel 'acc4' is a linear "
+                                                r"combination of 'acc1', 'acc2', 'acc3' to round-off"):
+        measurement_from_file(tmp_path / "copy.json", "structural")
+    _beam_sep005(tmp_path / "ok.json")
+    assert measurement_from_file(tmp_path / "ok.json", "structural").x.shape[0] == 3
