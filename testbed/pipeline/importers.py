@@ -414,9 +414,9 @@ def _check_independent(path: Path, sig: Signal, name: str) -> None:
     the two are the same, and no fit can tell their equations apart.  Checked on the structural
     kind only, whose sensors sit at distinct points of a continuum: over the 935 cantilever
     records of the dataset caches the least singular value is 9.2e7 times the rule's bound.  A
-    linkage's joint angles may be dependent by its geometry: a symmetric five-bar's records
-    hold ``th3 = -th2`` to 6.7e-16 (their rank 3 of 4 by this rule), and its identifiers model
-    the loop.
+    linkage's joint angles may be dependent by its motion: a five-bar test record driven alike
+    at both inputs holds ``th4 = th1`` to 4e-11 rad (rank 3 of 4 by this rule), and its
+    identifiers model the loop.
     """
     data = np.asarray(sig.data, dtype=float)
     if data.shape[0] < 2 or not np.all(np.isfinite(data)):
