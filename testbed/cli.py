@@ -293,6 +293,23 @@ def _creatable_folder(path: Path, where: str) -> None:
     if not folder.is_dir():
         raise InputError(f"{where} {path}: {folder} is a file, not a folder; expected the dataset "
                          "cache folder")
+    # a folder where nothing can be created (/proc, /sys): `run` ended in "error: [Errno 2] No
+    # such file or directory: '/proc/x'" after its simulation, a sweep failed every cell with it
+    # (round 12).  Probed by a file created and removed; a folder we may not write (EACCES,
+    # EROFS) passes: a read-only cache serves what it holds (testbed.pipeline.cache)
+    import tempfile
+
+    from testbed.pipeline.cache import NOT_WRITABLE
+
+    try:
+        fd, probe = tempfile.mkstemp(prefix=".testbed-probe-", dir=folder)
+    except OSError as e:
+        if e.errno in NOT_WRITABLE:
+            return
+        raise InputError(f"{where} {path}: cannot be created in {folder} ({e.strerror or e}); "
+                         "expected the dataset cache folder in a folder that holds files") from None
+    os.close(fd)
+    os.unlink(probe)
 
 
 def _dataset_file(path: Path) -> Path:
@@ -317,9 +334,12 @@ def _dataset_file(path: Path) -> Path:
 
 def _results_file(path: Path) -> Path:
     """A sweep results file that :func:`testbed.studies.results.read_results` can read, else InputError."""
-    from testbed.studies.results import ResultsError, read_results
+    from testbed.studies.results import ResultsError, parts_dir, read_results
 
-    _existing_file(path, "a sweep results file (from `testbed sweep`)")
+    # a sweep killed (SIGKILL, a lost machine) before its first consolidation leaves only its
+    # rows, `<path>.parts/`: "no such file" refused them (round 12); the sweep resumes from them
+    if _stat(path) is not None or not parts_dir(path).is_dir():
+        _existing_file(path, "a sweep results file (from `testbed sweep`)")
     try:
         read_results(path)
     except ResultsError as e:  # with what is wrong with it (a column missing, a row damaged)
@@ -529,12 +549,17 @@ def cmd_run(args: argparse.Namespace) -> int:
 
 def cmd_report(args: argparse.Namespace) -> int:
     from testbed.reporting.report import write_report
+    from testbed.studies.results import parts_dir
     from testbed.studies.runstore import RunStoreError, resolve_run
 
     source = Path(args.source)
     _output_folder(Path(args.output), "--output")
-    if source.is_file():
-        _results_file(source)
+    if source.is_file() or (not source.exists() and parts_dir(source).is_dir()):
+        _results_file(source)  # (only its rows, `<source>.parts/`: a sweep killed at once)
+        if Path(args.output).resolve() == parts_dir(source).resolve():
+            # the sweep's next consolidation deletes every file there but the *.bad ones
+            raise InputError(f"--output {args.output}: the folder of {source}'s row files, whose "
+                             "other files the sweep deletes; expected another folder")
     else:
         try:  # a run folder, a scenario's folder of runs (its latest) or a scenario name
             source = _run_folder(resolve_run(source, args.runs))

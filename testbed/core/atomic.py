@@ -35,10 +35,20 @@ def no_room(e: BaseException, path: str | os.PathLike) -> InputError | None:
     large'``), by that errno or its text in the message.  Such a failure was an internal error
     ("please report it") naming no file.
     """
-    code = getattr(e, "errno", None)
-    if code not in NO_ROOM:
-        text = str(e)
-        code = next((n for n in NO_ROOM if f"errno = {n}," in text or os.strerror(n) in text), None)
+    code = None
+    seen: set[int] = set()
+    cause: BaseException | None = e
+    # along the chain of exceptions: pyuff replaces the OSError of its write by a bare
+    # "Exception: Error writing data-set #58" raised while handling it (its __context__): `testbed
+    # export` on a full disk was an internal error (round 12)
+    while cause is not None and code is None and id(cause) not in seen:
+        seen.add(id(cause))
+        code = getattr(cause, "errno", None)
+        if code not in NO_ROOM:
+            text = str(cause)
+            code = next((n for n in NO_ROOM if f"errno = {n}," in text or os.strerror(n) in text),
+                        None)
+        cause = cause.__cause__ or cause.__context__
     if code is None:
         return None
     return InputError(f"{path}: cannot be written: {os.strerror(code)} (the disk or a quota is "

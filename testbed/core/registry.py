@@ -26,6 +26,7 @@ import importlib
 import importlib.metadata
 import importlib.util
 import pkgutil
+import re
 import sys
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
@@ -41,6 +42,13 @@ IDENTIFIER_ENTRY_POINTS = "sysid_testbed.identifiers"
 RIG_ENTRY_POINTS = "sysid_testbed.rigs"
 #: Prefix of the module names under which plugin files are imported (see :func:`import_plugin`).
 PLUGIN_MODULE_PREFIX = "_testbed_plugin_"
+#: A registered name: what a scenario's ``rig`` or ``[identify] method`` can name and a cache
+#: file's name can start with (the scenario names' pattern).  A plugin registering ``5`` made
+#: `testbed list` an internal error (TypeError sorting the names), ``"../up"`` a rig whose cache
+#: files went outside the cache folder, ``""`` or ``"x\ny"`` names no file can spell (round 12).
+REGISTERED_NAME = r"[A-Za-z0-9_][A-Za-z0-9_.-]{0,127}"
+REGISTERED_NAME_DOC = ("a name of letters, digits, '_', '.', '-' (at most 128, not starting with "
+                       "'.' or '-')")
 
 
 class PluginError(TestbedError):
@@ -126,6 +134,8 @@ class Registry:
         """Class decorator registering ``obj`` under ``name`` with ``tags``."""
 
         def deco(obj: Any) -> Any:
+            if not isinstance(name, str) or not re.fullmatch(REGISTERED_NAME, name):
+                raise ValueError(f"{self.kind} name {name!r}: expected {REGISTERED_NAME_DOC}")
             if name in self._entries and self._entries[name] is not obj:
                 raise ValueError(f"{self.kind} {name!r} is registered twice")
             self._entries[name] = obj

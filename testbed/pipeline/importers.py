@@ -62,7 +62,7 @@ from testbed.core.budget import IDENTIFY_BYTES_PER_VALUE, IDENTIFY_TEXT_BUDGET_B
 from testbed.core.dataset import Dataset, DatasetError, Signal
 from testbed.core.errors import TestbedError, show_names
 from testbed.core.measurement import Measurement
-from testbed.pipeline.signal_chain import SIGNAL_SCHEMAS, measure
+from testbed.pipeline.signal_chain import SIGNAL_CHAINS, SIGNAL_SCHEMAS, measure
 
 FORMATS = ("uff", "sep005", "csv", "hdf5")
 SUFFIXES = {".uff": "uff", ".unv": "uff", ".json": "sep005", ".csv": "csv", ".tsv": "csv",
@@ -348,6 +348,7 @@ def measurement_from_file(path: str | os.PathLike, kind: str, signal: Mapping[st
     data = read_measured(path, format=format, fs=fs, units=units, channels=channels,
                          own_units=kind == "dynamical")
     ds = data.to_dataset(groups, prior)
+    _check_read(data.source, ds, kind)
     _check_response(data.source, ds, kind)
     _check_units(data.source, ds, kind)
     try:
@@ -357,6 +358,23 @@ def measurement_from_file(path: str | os.PathLike, kind: str, signal: Mapping[st
     except ValueError as e:  # the chain's own checks: signal names, channel counts, positions
         raise MeasuredDataError(data.source, f"cannot run the {kind} signal chain: {e}; "
                                              f"signals {show_names(ds.measured)}") from None
+
+
+def _check_read(path: Path, ds: Dataset, kind: str) -> None:
+    """Refuse a signal the kind's chain never reads (:attr:`SignalChain.signals
+    <testbed.pipeline.signal_chain.SignalChain.signals>`): a CSV's column ``y [mM]`` beside
+    ``x`` and ``dx`` was dropped in silence and the model fitted to ``x`` alone (round 12)."""
+    known = SIGNAL_CHAINS[kind].signals
+    if RESPONSE_SIGNAL.get(kind) not in ds.measured:
+        return  # data of another kind, or without their response: the chain says what is missing
+    extra = [g for g in ds.measured if known is not None and g not in known]
+    if extra:
+        sig = ds.measured[extra[0]]
+        raise MeasuredDataError(path, f"signal {extra[0]!r} (channel(s) {', '.join(sig.channels)}) "
+                                      f"is not read by the {kind} signal chain, which reads "
+                                      f"{', '.join(known)}; expected only those (leave the others "
+                                      "out of the file, or name each channel "
+                                      f"'<signal>/<channel>', e.g. '{known[0]}/{sig.channels[0]}')")
 
 
 def _check_response(path: Path, ds: Dataset, kind: str) -> None:
@@ -382,6 +400,34 @@ def _check_response(path: Path, ds: Dataset, kind: str) -> None:
         raise MeasuredDataError(path, f"the {RESPONSE_SIGNAL[kind]!r} channels share a position "
                                       f"({', '.join(f'{p:g}' for p in sig.positions)} m); expected "
                                       "one sensor per position")
+    if kind == "structural":
+        _check_independent(path, sig, RESPONSE_SIGNAL[kind])
+
+
+def _check_independent(path: Path, sig: Signal, name: str) -> None:
+    """Refuse response channels that are linearly dependent to round-off: numpy's rank rule
+    (singular values below ``s_max * max(shape) * eps``), naming the first channel that the
+    ones before it give.
+
+    An exact copy of a channel under another name and position (a column pasted twice) was
+    identified with a mode at 1.6e-5 Hz and exit status 0 (round 12): the library's columns of
+    the two are the same, and no fit can tell their equations apart.  Checked on the structural
+    kind only, whose sensors sit at distinct points of a continuum: over the 935 cantilever
+    records of the dataset caches the least singular value is 9.2e7 times the rule's bound.  A
+    linkage's joint angles may be dependent by its motion: a five-bar test record driven alike
+    at both inputs holds ``th4 = th1`` to 4e-11 rad (rank 3 of 4 by this rule), and its
+    identifiers model the loop.
+    """
+    data = np.asarray(sig.data, dtype=float)
+    if data.shape[0] < 2 or not np.all(np.isfinite(data)):
+        return  # (non-finite samples are refused by the reader)
+    for j in range(2, data.shape[0] + 1):
+        if np.linalg.matrix_rank(data[:j]) < j:
+            raise MeasuredDataError(path, f"{name!r} channel {sig.channels[j - 1]!r} is a linear "
+                                          f"combination of {', '.join(map(repr, sig.channels[:j - 1]))} "
+                                          "to round-off (a copy or a multiple of another?): their "
+                                          "equations cannot be told apart; expected independent "
+                                          "channels (leave the copy out of the file)")
 
 
 #: What each measured signal of a rig kind holds (:data:`SAME_ORDER` of its unit); a

@@ -163,6 +163,10 @@ class SignalChain:
         Keys that only one setting of another key makes the chain read (the Savitzky-Golay
         ``window`` only with ``derivatives = "estimated"``): :func:`check_keys_used` refuses
         them given otherwise.
+    signals : tuple of str, optional
+        Names of every measured signal ``measure`` may read, under any setting (None: not
+        declared); a measured file holding another is refused
+        (:func:`testbed.pipeline.importers.measurement_from_file`), not ignored in silence.
     """
 
     kind: str
@@ -171,6 +175,7 @@ class SignalChain:
     check: Callable[[Mapping[str, Any], float, int, ErrorFn], None] | None = None
     rig_auto: tuple[str, ...] = ()
     used_when: Mapping[str, KeyUse] = field(default_factory=dict)
+    signals: tuple[str, ...] | None = None
 
 
 #: Signal chain per rig kind, filled by :func:`register_signal_chain` (this module registers
@@ -799,13 +804,15 @@ _LOWPASS = KeyUse("derivatives", lambda v: v == "lowpass", "derivatives = 'lowpa
 
 register_signal_chain(SignalChain(
     "structural", STRUCTURAL_SIGNAL_SCHEMA, measure_structural, check_structural,
-    rig_auto=("highpass_hz", "lowpass_hz"),
+    rig_auto=("highpass_hz", "lowpass_hz"), signals=("acceleration", "force"),
     used_when={"lowpass_order": KeyUse("lowpass_hz", lambda v: v == "auto" or v > 0,
                                        "lowpass_hz > 0 (0 = no low-pass)")}))
 register_signal_chain(SignalChain(
     "mechanical", MECHANICAL_SIGNAL_SCHEMA, measure_mechanical, check_mechanical,
+    signals=("theta", "dtheta", "ddtheta", "torque"),
     used_when={"window": _ESTIMATED, "polyorder": _ESTIMATED, "cutoff_hz": _LOWPASS,
                "filter_order": _LOWPASS, "edge_fit_s": _LOWPASS, "edge_fit_order": _LOWPASS}))
 register_signal_chain(SignalChain(
     "dynamical", DYNAMICAL_SIGNAL_SCHEMA, measure_dynamical, check_dynamical,
+    signals=("x", "dx", "input"),
     used_when={"window": _ESTIMATED, "polyorder": _ESTIMATED}))

@@ -27,6 +27,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from testbed.core.atomic import atomic_write
 from testbed.core.dataset import Dataset
 from testbed.core.truth import StructuralTruth, Truth, TruthError, truth_type
 from testbed.pipeline.cache import DatasetCache
@@ -125,14 +126,20 @@ def prepare_run_frames(run: Any) -> int:
 
 
 def save_figure(fig: Figure, path: str | os.PathLike) -> Path:
-    """Write ``fig`` as PNG to ``path`` in the house style; return the path."""
+    """Write ``fig`` as PNG to ``path`` in the house style, atomically; return the path.
+
+    A report written on a full disk left a PNG of 0 bytes and ended in an internal error
+    (OSError 28, naming no file; round 12): the write is now :func:`atomic_write`'s, which
+    leaves the old file or the new one and names ``path`` in one line for want of room.
+    """
     import matplotlib as mpl
 
-    path = Path(path)
-    with mpl.rc_context(STYLE):
-        # zlib level 3 instead of 6: a third less encoding time, files within 2 % of the size
-        fig.savefig(path, format="png", pil_kwargs={"compress_level": 3})
-    return path
+    def write(tmp: str) -> None:
+        with mpl.rc_context(STYLE):
+            # zlib level 3 instead of 6: a third less encoding time, files within 2 % of the size
+            fig.savefig(tmp, format="png", pil_kwargs={"compress_level": 3})
+
+    return atomic_write(path, write)
 
 
 #: Text heights [in] of the house style: a 9 pt tick label with its 3.5 pt tick and 3.5 pt pad,

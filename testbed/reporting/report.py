@@ -37,7 +37,7 @@ from testbed.pipeline.plugins import RIGS
 from testbed.pipeline.scenario import NOISE_SCHEMA
 from testbed.pipeline.signal_chain import SIGNAL_SCHEMAS
 from testbed.reporting import figures as figs
-from testbed.studies.results import read_results, score_columns
+from testbed.studies.results import parts_dir, read_results, score_columns
 from testbed.studies.runstore import SavedRun, load_run, resolve_run
 
 CSS = """
@@ -680,7 +680,7 @@ def write_report(source: str | os.PathLike, out_dir: str | os.PathLike) -> Path:
     source = Path(source)
     if source.is_dir():
         return run_report(load_run(resolve_run(source)), out_dir)
-    if not source.is_file():
+    if not source.is_file() and not parts_dir(source).is_dir():  # (parts: a sweep killed at once)
         raise FileNotFoundError(f"{source}: neither a run folder nor a results file")
 
     return sweep_report(read_results(source), out_dir, title=source.stem)

@@ -226,8 +226,11 @@ def _read_parquet(path: Path) -> list[dict[str, Any]]:
     _check_columns(path, table.schema)
     rows = table.to_pylist()
     seen: set[str] = set()
+    study = meta.get(b"study", b"").decode()
     for i, row in enumerate(rows):
         why = _row_problem(row, seen)
+        if not why and study and row["study"] != study:  # the sweep writes its name in both
+            why = f"study {row['study']!r}, the file's is {study!r}"
         if why:
             raise ResultsError(f"{path}: row {i} (cell {row['cell']!r}): {why}; the file was "
                                "altered or damaged")
@@ -272,7 +275,35 @@ def _row_problem(row: dict[str, Any], seen: set[str]) -> str:
     return ""
 
 
-def read_results(path: str | os.PathLike, *, set_aside: bool = False) -> list[dict[str, Any]]:
+def _grid_problem(rows: list[dict[str, Any]]) -> str:
+    """What makes ``rows`` (every row of a results file, parts included) more than one study's
+    grid ("" if nothing): rows of two studies, or two cells of one scenario, noise level, seed
+    and identifier.
+
+    Each cell's key hashes its whole scenario (:func:`testbed.studies.sweep.cell_key`), so a
+    row copied by hand under another key, or the rows of a study edited while its sweep ran
+    (new bars: new keys; until the sweep consolidates, both versions' rows are in the file),
+    were each counted: `testbed summary` reported 3 cells and a pass rate over 3 where the
+    grid has 2, and merged rows of another study under the first row's name (round 12).
+    """
+    studies = sorted({str(r.get("study")) for r in rows})
+    if len(studies) > 1:
+        return (f"holds rows of studies {', '.join(map(repr, studies))}; expected one study's "
+                "rows (a sweep writes one file per study)")
+    seen: dict[tuple, str] = {}
+    for r in rows:
+        key = (r["scenario"], r["noise"], r["seed"], r["identifier"])
+        if key in seen:
+            return (f"cells {seen[key]!r} and {r['cell']!r} are both scenario {key[0]!r}, noise "
+                    f"{key[1]:g} %, seed {key[2]}, identifier {key[3]!r}; expected one row per "
+                    "cell (a row copied by hand, or a study edited while its sweep ran: "
+                    "`testbed sweep` finishes it and keeps the current study's rows)")
+        seen[key] = r["cell"]
+    return ""
+
+
+def read_results(path: str | os.PathLike, *, set_aside: bool = False,
+                 resuming: bool = False) -> list[dict[str, Any]]:
     """Every row of a results file, including rows not yet consolidated.
 
     Parameters
@@ -282,6 +313,10 @@ def read_results(path: str | os.PathLike, *, set_aside: bool = False) -> list[di
     set_aside : bool
         Rename a damaged row file ``<cell>.json.bad`` (else it is only skipped); either
         way a warning names it.
+    resuming : bool
+        For the sweep that owns the file: rows of another study or of cells no longer in its
+        grid are the sweep's to refuse or drop (:func:`consolidate`); every other reader
+        gets a ResultsError for them (:func:`_grid_problem`).
 
     Returns
     -------
@@ -293,13 +328,17 @@ def read_results(path: str | os.PathLike, *, set_aside: bool = False) -> list[di
     Raises
     ------
     ResultsError
-        If ``path`` exists but is not a readable results file.
+        If ``path`` exists but is not a readable results file, or (unless ``resuming``)
+        holds rows of two studies or two rows of one cell.
     """
     path = Path(path)
     by_cell: dict[str, dict[str, Any]] = {r["cell"]: r for r in _read_parquet(path)}
     for r in _read_parts(path, set_aside):
         by_cell[r["cell"]] = r
     rows = sorted(by_cell.values(), key=_sort_key)
+    why = "" if resuming else _grid_problem(rows)
+    if why:
+        raise ResultsError(f"{path}: {why}")
     scores = score_columns(rows)
     for r in rows:
         for k in scores:
@@ -343,7 +382,7 @@ def consolidate(path: str | os.PathLike, *, keep: set[str] | None = None,
     (n_rows, n_dropped)
     """
     path = Path(path)
-    rows = read_results(path)
+    rows = read_results(path, resuming=True)  # the cells not kept are dropped below
     dropped = 0
     if keep is not None:
         kept = [r for r in rows if r["cell"] in keep]

@@ -24,7 +24,7 @@ import json
 import math
 import os
 import re
-from collections import defaultdict
+from collections import Counter, defaultdict
 from pathlib import Path
 from typing import Any
 
@@ -182,6 +182,12 @@ def print_summary(path: str | os.PathLike, console: Any = None,
                   "[25th, 75th percentile] of the ok cells, pass rate over the cells held to "
                   "thresholds (that identifier's own)",
                   highlight=False)
+    codes = Counter((str(r.get("commit") or "?"), str(r.get("versions") or "?")) for r in rows)
+    if len(codes) > 1:  # a sweep resumed after a change of code or libraries: said, not pooled in silence
+        commits = Counter(c for c, _ in codes.elements())
+        console.print(f"note: the cells were computed by {len(codes)} versions of the code or its "
+                      "libraries (commits " + ", ".join(f"{c} x {n}" for c, n in sorted(commits.items()))
+                      + "); the medians pool them", highlight=False)
     by_ident: dict[tuple, list[dict[str, Any]]] = defaultdict(list)
     for s in summary:
         by_ident[(*(s[k] for k in BY[by]), s["identifier"])].append(s)

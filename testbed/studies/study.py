@@ -52,7 +52,7 @@ from pathlib import Path
 from typing import Any
 
 from testbed.core.budget import STUDY_CELL_BUDGET
-from testbed.core.errors import BudgetError, ScenarioError
+from testbed.core.errors import BudgetError, InputError, ScenarioError
 from testbed.core.registry import import_plugin
 from testbed.core.schema import Field, validate_header
 from testbed.pipeline.plugins import IDENTIFIERS, RIGS
@@ -72,7 +72,14 @@ from testbed.pipeline.scenario import (
     resolve_path,
     shipped_dir,
 )
-from testbed.studies.family import Family, family_members, family_of, parse_family, write_members
+from testbed.studies.family import (
+    MEMBER_SEP,
+    Family,
+    family_members,
+    family_of,
+    parse_family,
+    write_members,
+)
 
 #: Shipped study files, found by name (``$TESTBED_STUDIES`` overrides).
 STUDY_DIR = Path(os.environ.get("TESTBED_STUDIES", shipped_dir("studies")))
@@ -364,11 +371,34 @@ def write_family(study: Study | str | os.PathLike, out_dir: str | os.PathLike,
                             "a family of the study: " + (", ".join(f.name for f in st.families)
                                                           or "(the study declares none)"))
     names = {f.member_name(k) for f in fams for k in range(f.members)}
+    _check_no_stale_members(Path(out_dir), fams, names)
     # each member carries the bars the study holds its own [identify] method to, so that it
     # reruns alone with a verdict
     return write_members([sc.replace(score=st.thresholds_for(sc, sc.identify["method"]))
                           if sc.identify else sc
                           for sc in st.scenarios if sc.name in names], out_dir)
+
+
+def _check_no_stale_members(out: Path, fams: list[Family], names: set[str]) -> None:
+    """Refuse to write into ``out`` beside member files of the written families that this write
+    does not produce (``<family>__<k>.toml`` with ``k`` at or beyond the family's ``members``).
+
+    Written into a folder that held a larger draw of the family, the new members replaced
+    theirs and the rest stayed in silence (round 12: 10 members, then 2, left 8 files of the
+    old draw beside the 2 new ones, which a run or sweep over the folder then took as members).
+    """
+    if not out.is_dir():
+        return
+    wanted = {f.name for f in fams}
+    stale = sorted(p.name for p in out.glob(f"*{MEMBER_SEP}*.toml")
+                   if family_of(p.stem) in wanted and p.stem != family_of(p.stem)
+                   and p.stem not in names)
+    if stale:
+        members = ", ".join(f"{f.name}: {f.members}" for f in fams)
+        raise InputError(f"{out}: holds {len(stale)} member file(s) this write does not "
+                         f"produce ({', '.join(stale[:3])}{', ...' if len(stale) > 3 else ''}; "
+                         f"the families now have {members} members); expected a folder without "
+                         "them: remove them or write to another folder")
 
 
 def _validate_params(table: Any, identifiers: list[str], file: str) -> dict[str, dict[str, Any]]:

@@ -549,7 +549,7 @@ def run_sweep(study: Study | str | os.PathLike, jobs: int = 1, dask_address: str
         for tmp in parts_dir(results).glob(".*.tmp"):
             tmp.unlink(missing_ok=True)
     try:
-        previous = read_results(results, set_aside=True)
+        previous = read_results(results, set_aside=True, resuming=True)
     except ResultsError as e:  # a damaged consolidated file: keep it aside, rerun its cells
         with results.open("rb") as fh:
             head = fh.read(4)
@@ -560,7 +560,7 @@ def run_sweep(study: Study | str | os.PathLike, jobs: int = 1, dask_address: str
         bad = results.with_name(results.name + ".bad")
         os.replace(results, bad)
         log.warning("%s; set aside as %s, its cells will run again", e, bad.name)
-        previous = read_results(results, set_aside=True)
+        previous = read_results(results, set_aside=True, resuming=True)
     others = sorted({str(r.get("study")) for r in previous if r.get("study") not in (None, "", study.name)})
     if others:  # consolidating would drop every row of the other study: refused, nothing touched
         raise InputError(f"results {results}: holds rows of study {', '.join(map(repr, others))}, "
