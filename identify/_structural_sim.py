@@ -11,7 +11,7 @@ import numpy as np
 
 from testbed.core.errors import DivergenceError, UnresolvedModelError
 from testbed.core.measurement import Trajectory
-from testbed.numerics.linear_response import simulate_linear, state_matrix
+from testbed.numerics.linear_response import prepare_inputs, simulate_linear, state_matrix
 
 __all__ = ["pole_radius", "sample_rate_pole", "simulate_structural", "state_matrix"]
 
@@ -113,24 +113,8 @@ def simulate_structural(M: np.ndarray, C: np.ndarray, K: np.ndarray, K3: np.ndar
     """
     if K3 is None or not np.any(np.asarray(K3) != 0.0):
         return simulate_linear(M, C, K, B, x0, xd0, t, u)
-    M, C, K = (np.asarray(a, dtype=float) for a in (M, C, K))
-    n = M.shape[0]
-    t = np.asarray(t, dtype=float)
-    n_t = t.size
-    x0 = np.asarray(x0, dtype=float).reshape(n)
-    xd0 = np.asarray(xd0, dtype=float).reshape(n)
-    dt = float(t[1] - t[0]) if n_t > 1 else 1.0
-    if n_t > 2 and not np.allclose(np.diff(t), dt, rtol=1e-6, atol=0.0):
-        raise ValueError("t must be equally spaced")
-    Minv = np.linalg.inv(M)
-    f = None
-    if u is not None:
-        if B is None:
-            raise ValueError("the model has no input map (no input in the fitted data); cannot apply u")
-        u = np.atleast_2d(np.asarray(u, dtype=float))
-        if u.shape != (B.shape[1], n_t):
-            raise ValueError(f"u must have shape {(B.shape[1], n_t)}, got {u.shape}")
-        f = np.asarray(B, dtype=float) @ u  # (n, n_t) force [N]
+    M, C, K, x0, xd0, t, dt, Minv, f = prepare_inputs(M, C, K, B, x0, xd0, t, u)
+    n, n_t = M.shape[0], t.size
     A = state_matrix(M, C, K)
     z0 = np.concatenate([x0, xd0])
     MK3 = Minv @ np.asarray(K3, dtype=float)

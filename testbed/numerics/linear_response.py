@@ -20,7 +20,7 @@ from testbed.core.measurement import Trajectory
 
 linalg = lazy_module("scipy.linalg")  # imported on first use: `testbed list` does not pay for it
 
-__all__ = ["simulate_linear", "state_matrix"]
+__all__ = ["prepare_inputs", "simulate_linear", "state_matrix"]
 
 #: Largest modal power table kept between calls [bytes] (a 3-sensor beam at 12.8 kHz for 1 s
 #: needs 1.2 MB; a sweep's longest records stay far below this bound, beyond it nothing is kept).
@@ -131,6 +131,46 @@ def state_matrix(M: np.ndarray, C: np.ndarray, K: np.ndarray) -> np.ndarray:
     return np.block([[np.zeros((n, n)), np.eye(n)], [-Minv @ K, -Minv @ C]])
 
 
+def prepare_inputs(M: np.ndarray, C: np.ndarray, K: np.ndarray, B: np.ndarray | None,
+                   x0: np.ndarray, xd0: np.ndarray, t: np.ndarray, u: np.ndarray | None
+                   ) -> tuple[np.ndarray, ...]:
+    """A structural simulation's inputs checked and converted (one rule for every integrator).
+
+    Parameters are those of :func:`simulate_linear`.
+
+    Returns
+    -------
+    tuple
+        ``(M, C, K, x0, xd0, t, dt, Minv, f)``: float arrays, the sample interval ``dt`` [s]
+        (1 for a single sample), ``M^-1`` and the force ``f = B u`` [N], shape (n, n_t), or
+        None without an input.
+
+    Raises
+    ------
+    ValueError
+        Unequally spaced ``t``, an input without an input map, or ``u`` of the wrong shape.
+    """
+    M, C, K = (np.asarray(a, dtype=float) for a in (M, C, K))
+    n = M.shape[0]
+    t = np.asarray(t, dtype=float)
+    n_t = t.size
+    x0 = np.asarray(x0, dtype=float).reshape(n)
+    xd0 = np.asarray(xd0, dtype=float).reshape(n)
+    dt = float(t[1] - t[0]) if n_t > 1 else 1.0
+    if n_t > 2 and not np.allclose(np.diff(t), dt, rtol=1e-6, atol=0.0):
+        raise ValueError("t must be equally spaced")
+    Minv = np.linalg.inv(M)
+    f = None
+    if u is not None:
+        if B is None:
+            raise ValueError("the model has no input map (no input in the fitted data); cannot apply u")
+        u = np.atleast_2d(np.asarray(u, dtype=float))
+        if u.shape != (B.shape[1], n_t):
+            raise ValueError(f"u must have shape {(B.shape[1], n_t)}, got {u.shape}")
+        f = np.asarray(B, dtype=float) @ u  # (n, n_t) force [N]
+    return M, C, K, x0, xd0, t, dt, Minv, f
+
+
 def simulate_linear(M: np.ndarray, C: np.ndarray, K: np.ndarray, B: np.ndarray | None,
                     x0: np.ndarray, xd0: np.ndarray, t: np.ndarray,
                     u: np.ndarray | None = None) -> Trajectory:
@@ -155,24 +195,8 @@ def simulate_linear(M: np.ndarray, C: np.ndarray, K: np.ndarray, B: np.ndarray |
         ``x`` [m], ``xd`` [m/s], ``xdd`` [m/s^2], each (n, n_t); ``xdd`` from the equation of
         motion at each sample.
     """
-    M, C, K = (np.asarray(a, dtype=float) for a in (M, C, K))
-    n = M.shape[0]
-    t = np.asarray(t, dtype=float)
-    n_t = t.size
-    x0 = np.asarray(x0, dtype=float).reshape(n)
-    xd0 = np.asarray(xd0, dtype=float).reshape(n)
-    dt = float(t[1] - t[0]) if n_t > 1 else 1.0
-    if n_t > 2 and not np.allclose(np.diff(t), dt, rtol=1e-6, atol=0.0):
-        raise ValueError("t must be equally spaced")
-    Minv = np.linalg.inv(M)
-    f = None
-    if u is not None:
-        if B is None:
-            raise ValueError("the model has no input map (no input in the fitted data); cannot apply u")
-        u = np.atleast_2d(np.asarray(u, dtype=float))
-        if u.shape != (B.shape[1], n_t):
-            raise ValueError(f"u must have shape {(B.shape[1], n_t)}, got {u.shape}")
-        f = np.asarray(B, dtype=float) @ u  # (n, n_t) force [N]
+    M, C, K, x0, xd0, t, dt, Minv, f = prepare_inputs(M, C, K, B, x0, xd0, t, u)
+    n, n_t = M.shape[0], t.size
     A = state_matrix(M, C, K)
     Bz = np.vstack([np.zeros((n, n)), Minv]) if f is not None else None
     Z = zoh_free_and_forced(A, Bz, np.concatenate([x0, xd0]), dt, n_t, f)
