@@ -588,11 +588,12 @@ def floor_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -> d
     worst_floor = float(np.min(floor))
     if not worst_floor < bar:
         return {}
-    return {"floor": (f"floor: the truth's own reduced model (one degree of freedom per sensor) "
-                      f"scores TRAC {worst_floor:.3g} on this record against the bar {bar:g}: the "
-                      "record and its signal chain put the bar out of reach of any model of that "
-                      "size (signal.lowpass_hz, signal.highpass_hz, rig.sensors, "
-                      "excitation.location)")}
+    got = float(scores.values.get("trac", float("nan")))
+    return {"floor": (f"floor: TRAC {got:.3g} against the bar {bar:g}, where the truth's own "
+                      f"reduced model (one degree of freedom per sensor) scores {worst_floor:.3g} "
+                      "on this record: the record and its signal chain put that bar out of reach "
+                      "of any model of that size (signal.lowpass_hz, signal.highpass_hz, "
+                      "rig.sensors, excitation.location)")}
 
 
 def record_details(kind: str, dataset: Dataset, data: Measurement) -> dict[str, Any]:

@@ -13,7 +13,8 @@ def test_a_failed_trac_bar_under_the_truths_own_is_named_floor():
     details = {"truth_trac": np.array([0.579, 1.0, 1.0])}
     why = floor_failures(Scores({"trac": 0.666, "freq_error_mode1": 0.001}, details), BARS)
     assert set(why) == {"floor"} and verdict([], why) == FAIL
-    assert "TRAC 0.579" in why["floor"] and "bar 0.9" in why["floor"]
+    assert why["floor"].startswith("floor: TRAC 0.666 against the bar 0.9, where the truth's own")
+    assert "scores 0.579 on this record" in why["floor"]
     # the truth meets the bar: the identifier's own failure, nothing to name
     assert floor_failures(Scores({"trac": 0.28}, {"truth_trac": np.array([0.92, 0.98])}),
                           BARS) == {}
