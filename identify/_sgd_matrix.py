@@ -671,6 +671,11 @@ class MatrixSGDResult:
 #: for every SGD result.  It fires only where the steps were about to fail the fit.
 BREAKDOWN_RULE = ("the SGD's steps of epoch {epoch} left a non-finite iterate: the epochs "
                   "stopped there, the result is epoch {last}'s iterate")
+#: The same when the breakdown comes inside the iterate averaging's epochs: the result is then
+#: the average of the finite epochs it had taken, as it would have been of all of them.
+BREAKDOWN_AVERAGED_RULE = ("the SGD's steps of epoch {epoch} left a non-finite iterate: the "
+                           "epochs stopped there, the result is the average of epochs "
+                           "{first}-{last}'s iterates")
 
 
 def psd_damping_warm_start(M: np.ndarray, C: np.ndarray, K: np.ndarray) -> np.ndarray | None:
@@ -990,7 +995,7 @@ def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
     avg_from = max(int(np.ceil(int(est.epochs) * (1.0 - frac))), l1_epochs) + 1 if frac > 0 else None
     acc = [np.zeros((n, n)) for _ in range(4)]
     n_acc = 0
-    stop_rule = ""
+    broke_at = 0  # the epoch whose steps left a non-finite iterate (BREAKDOWN_RULE), 0: none
     last = [a.copy() for a in (L, P, Q, R)]  # the last epoch's finite iterate (BREAKDOWN_RULE)
     for epoch in range(1, int(est.epochs) + 1):
         if progress is not None:
@@ -1004,7 +1009,7 @@ def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
         if not all(np.isfinite(a).all() for a in (L, P, Q, R)):
             for a, b in zip((L, P, Q, R), last, strict=True):
                 a[...] = b
-            stop_rule = BREAKDOWN_RULE.format(epoch=epoch, last=epoch - 1)
+            broke_at = epoch
             break
         n_steps += spe
         clipped = _project_psd(P)  # K: positive semi-definite by construction, per epoch
@@ -1036,6 +1041,9 @@ def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
     if n_acc:
         LLt, P, Q, R = (a_ / n_acc for a_ in acc)
         L = np.linalg.cholesky(_sym(LLt))
+    stop_rule = ("" if not broke_at else
+                 BREAKDOWN_AVERAGED_RULE.format(epoch=broke_at, first=avg_from, last=broke_at - 1)
+                 if n_acc else BREAKDOWN_RULE.format(epoch=broke_at, last=broke_at - 1))
 
     def finish(L: np.ndarray, P: np.ndarray, Q: np.ndarray, R: np.ndarray, target: np.ndarray,
                guard: dict[str, float], n_steps: int, alpha: dict[str, float],

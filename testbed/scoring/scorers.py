@@ -564,8 +564,19 @@ def truth_trac(truth: StructuralTruth, data: Measurement, t: np.ndarray, u: np.n
     return metrics.trac(ref, sim.xdd)
 
 
+#: How far below the truth's own TRAC on a channel an identified model's may lie for
+#: :func:`floor_failures` to call that channel's failure the record's floor: the gap between the
+#: paper's 0.90 and the issue's 0.95 bars, the spread the studies' bars themselves allow.  A model
+#: further below (round 11's ``b11_hit_clamp`` with ``sgd_sindy``: 0.375 against the truth's
+#: 0.579) failed on its own account.
+FLOOR_MARGIN = 0.05
+
+
 def floor_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -> dict[str, str]:
     """A failed TRAC bar the truth's own reduced model fails too: ``{"floor": reason}``.
+
+    Claimed only when every failing channel's TRAC is finite, the truth's own is below the bar
+    there and the model's lies within :data:`FLOOR_MARGIN` of the truth's (or above it).
 
     Measured (rounds 11-12, the families): a hammer next to the clamp read by two sensors
     (the truth's own TRAC 0.58-0.68: after 20 ms the reference is the chain's 10 Hz high-pass
@@ -576,18 +587,25 @@ def floor_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -> d
     Parameters
     ----------
     scores : Scores
-        With ``details["truth_trac"]`` (:func:`truth_trac`); without it, nothing to check.
+        With ``details["truth_trac"]`` (:func:`truth_trac`) and ``details["trac"]`` (per
+        channel); without them, nothing to check.
     thresholds : dict
         The run's bars, ``{metric: {"min"|"max": value}}``.
     """
     floor, bar = scores.details.get("truth_trac"), thresholds.get("trac", {}).get("min")
-    if floor is None or bar is None or not np.size(floor):
+    trac = scores.details.get("trac")
+    if floor is None or bar is None or trac is None or np.size(floor) != np.size(trac):
         return {}
     if not [c for c in check_thresholds(scores.values, {"trac": thresholds["trac"]}) if not c.passed]:
         return {}
-    worst_floor = float(np.min(floor))
-    if not worst_floor < bar:
+    floor, trac = np.asarray(floor, dtype=float), np.asarray(trac, dtype=float)
+    failing = ~(trac >= bar)
+    # every failing channel: finite (a diverged or non-physical model has no TRAC to compare),
+    # the truth below the bar there, and the model at the truth's floor (within FLOOR_MARGIN)
+    if not (failing.any() and np.all(np.isfinite(trac)) and np.all(floor[failing] < bar)
+            and np.all(trac[failing] >= floor[failing] - FLOOR_MARGIN)):
         return {}
+    worst_floor = float(np.min(floor[failing]))
     got = float(scores.values.get("trac", float("nan")))
     return {"floor": (f"floor: TRAC {got:.3g} against the bar {bar:g}, where the truth's own "
                       f"reduced model (one degree of freedom per sensor) scores {worst_floor:.3g} "

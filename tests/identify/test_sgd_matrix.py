@@ -277,3 +277,30 @@ def test_the_identifier_states_why_its_epochs_stopped(monkeypatch):
     model = SGDSINDy(epochs=5).fit(data)
     assert model.sgd_stop_rule_ == BREAKDOWN_RULE.format(epoch=3, last=2)
     assert np.isfinite(model.K_).all()
+
+
+def test_a_breakdown_inside_the_iterate_averaging_names_the_averaged_epochs(monkeypatch):
+    """With the iterate averaging on (the last quarter of 8 epochs: from epoch 7), a breakdown
+    at epoch 8 leaves the average of epoch 7's iterate alone, and the rule says so."""
+    import dataclasses
+
+    from identify import _compiled
+    from identify._sgd_matrix import BREAKDOWN_AVERAGED_RULE
+
+    data, _ = _signals(0.0)
+    model = SGDSINDy(epochs=8)
+    lam_hat, peaks = model._start_fit(data)
+    m_hat = mass_prior_value(data, model.mass_prior)
+    est = dataclasses.replace(model.settings(), iterate_average=0.25)
+    steps, calls = _compiled.sgd_steps, []
+
+    def breaking_steps(Z, nfa, S, Nz, perm, bs, spe, params, *rest):
+        steps(Z, nfa, S, Nz, perm, bs, spe, params, *rest)
+        calls.append(spe)
+        if len(calls) == 8:
+            params[1][...] = np.nan
+
+    monkeypatch.setattr(_compiled, "sgd_steps", breaking_steps)
+    out = fit_matrix_sgd(data, est, m_hat, lam_hat, peaks=peaks)
+    assert out.stop_rule == BREAKDOWN_AVERAGED_RULE.format(epoch=8, first=7, last=7)
+    assert all(np.isfinite(a).all() for a in (out.M, out.C, out.K))
