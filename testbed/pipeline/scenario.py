@@ -52,14 +52,13 @@ from typing import Any
 from testbed.core.budget import check_cost, check_steps
 from testbed.core.errors import RigError, ScenarioError
 from testbed.core.kinds import metric_names, metric_range
+from testbed.core.registry import REGISTERED_NAME, REGISTERED_NAME_DOC
 from testbed.core.schema import Field, near_miss, validate_header, validate_table, validate_variant
 from testbed.pipeline.plugins import IDENTIFIERS, RIGS
 from testbed.pipeline.signal_chain import SIGNAL_SCHEMAS, check_keys_used, check_signal, rig_auto_keys
 
 #: Scenario and study names: a safe file stem (no path separators, not "." or "..").
-NAME_PATTERN = r"[A-Za-z0-9_][A-Za-z0-9_.-]{0,127}"
-NAME_PATTERN_DOC = ("a name of letters, digits, '_', '.', '-' (at most 128, not starting "
-                    "with '.' or '-')")
+NAME_PATTERN, NAME_PATTERN_DOC = REGISTERED_NAME, REGISTERED_NAME_DOC  # one rule (core)
 #: Largest scenario or study file read [bytes]: the shipped ones are under 5 kB.
 MAX_FILE_BYTES = 1 << 20
 #: Deepest nesting of tables and lists accepted: scenario and study files need 3

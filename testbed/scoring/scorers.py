@@ -416,10 +416,12 @@ def force_participation(truth: StructuralTruth, n: int) -> np.ndarray:
 
 
 #: The share of a force record's energy (sum of squares) that must lie within its pulse's span
-#: for :func:`pulse_spectrum` to read it as one pulse: sensor noise at the studies' 10 % adds
-#: well under 1 % outside an impact's span, a continuous input (a shaker's sine or noise) most
-#: of its energy.
-PULSE_ENERGY_SHARE = 0.99
+#: for :func:`pulse_spectrum` to read it as one pulse.  Sensor noise set as a percentage of a
+#: channel's RMS puts that percentage squared of the force's energy outside an impact's span
+#: (measured at 10 %: the shipped beam's share 0.98996, round 12's 2 ms contact 0.9903), so
+#: 0.9 leaves room to 30 % noise; a continuous input (a shaker's sine or noise) holds most of
+#: its energy outside any one pulse.
+PULSE_ENERGY_SHARE = 0.9
 
 
 def pulse_spectrum(dataset: Dataset, f: np.ndarray) -> np.ndarray:
