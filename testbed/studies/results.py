@@ -229,7 +229,8 @@ def _read_parquet(path: Path) -> list[dict[str, Any]]:
     study = meta.get(b"study", b"").decode()
     for i, row in enumerate(rows):
         why = _row_problem(row, seen)
-        if not why and study and row["study"] != study:  # the sweep writes its name in both
+        # the sweep writes its name in both; a row without one is the sweep's own (as it reads it)
+        if not why and study and row["study"] not in (None, "", study):
             why = f"study {row['study']!r}, the file's is {study!r}"
         if why:
             raise ResultsError(f"{path}: row {i} (cell {row['cell']!r}): {why}; the file was "
@@ -286,7 +287,7 @@ def _grid_problem(rows: list[dict[str, Any]]) -> str:
     were each counted: `testbed summary` reported 3 cells and a pass rate over 3 where the
     grid has 2, and merged rows of another study under the first row's name (round 12).
     """
-    studies = sorted({str(r.get("study")) for r in rows})
+    studies = sorted({str(r.get("study")) for r in rows if r.get("study") not in (None, "")})
     if len(studies) > 1:
         return (f"holds rows of studies {', '.join(map(repr, studies))}; expected one study's "
                 "rows (a sweep writes one file per study)")

@@ -58,6 +58,10 @@ def test_rows_of_two_studies_are_refused_by_readers(tmp_path):
     res2 = write_rows(tmp_path / "r2.parquet", _grid(), study="other")  # the file's name: not its rows'
     with pytest.raises(ResultsError, match="study 's', the file's is 'other'"):
         read_results(res2)
+    # a row without a study name is the file's own, as the sweep reads it (review, round 12)
+    res3 = write_rows(tmp_path / "r3.parquet", [*_grid(), _row(cell="c4", seed=4, study="")],
+                      study="s")
+    assert len(read_results(res3)) == 4
 
 
 def test_summary_and_report_read_the_rows_of_a_sweep_killed_before_consolidating(tmp_path, capsys):
