@@ -63,7 +63,21 @@ def canonical_sign(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray
 
     ``b (a . x)^3`` is unchanged by ``a -> s a``, ``b -> b / s^3``; the rule fixes ``s`` from
     ``a`` alone (ties in magnitude go to the first such entry), so the stored direction does
-    not depend on the optimiser's path or the BLAS kernel's last bits beyond rounding.
+    not depend on the optimiser's path.  Where two entries are equal in magnitude to rounding
+    (a symmetric direction), the kernel's last bits may pick either and flip both signs: the
+    force ``b (a . x)^3`` is the same, so compare models by it, not by ``a``.
+
+    Parameters
+    ----------
+    a : ndarray, shape (n,)
+        Direction [-], nonzero.
+    b : ndarray, shape (n,)
+        Force coefficients [N per unit of ``(a . x)^3``].
+
+    Returns
+    -------
+    (ndarray, ndarray)
+        The same model with ``|a| = 1`` and its largest-magnitude entry positive.
     """
     a = np.asarray(a, dtype=float)
     b = np.asarray(b, dtype=float)

@@ -5,7 +5,7 @@ over time.
 One implementation, below the layers that use it: the structural identifiers' simulation
 (:func:`identify._structural_sim.simulate_structural`, whose linear branch this is) and the
 scorer's floor, the truth's own reduced model simulated as an identified one would be
-(:func:`testbed.scoring.scorers.truth_floor`).
+(:func:`testbed.scoring.scorers.truth_trac`).
 """
 
 from __future__ import annotations
@@ -20,7 +20,7 @@ from testbed.core.measurement import Trajectory
 
 linalg = lazy_module("scipy.linalg")  # imported on first use: `testbed list` does not pay for it
 
-__all__ = ["prepare_inputs", "simulate_linear", "state_matrix"]
+__all__ = ["prepare_inputs", "simulate_linear", "state_matrix", "zoh_free_and_forced"]
 
 #: Largest modal power table kept between calls [bytes] (a 3-sensor beam at 12.8 kHz for 1 s
 #: needs 1.2 MB; a sweep's longest records stay far below this bound, beyond it nothing is kept).
@@ -28,7 +28,7 @@ KEEP_BYTES = 1 << 26
 
 @dataclass
 class _Propagator:
-    """What :func:`_zoh_free_and_forced` computes from the model, step and input alone (not the
+    """What :func:`zoh_free_and_forced` computes from the model, step and input alone (not the
     start): the transition, its eigen-decomposition, the modal powers and the modal forced
     response.  The scorer's initial-state fit simulates one model from 2n + 3 starts over the
     same window and input; each start then costs a solve and a product."""

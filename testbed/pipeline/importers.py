@@ -419,8 +419,9 @@ def _check_independent(path: Path, sig: Signal, name: str) -> None:
     identifiers model the loop.
     """
     data = np.asarray(sig.data, dtype=float)
-    if data.shape[0] < 2 or not np.all(np.isfinite(data)):
-        return  # (non-finite samples are refused by the reader)
+    if data.shape[0] < 2 or data.shape[1] < data.shape[0] or not np.all(np.isfinite(data)):
+        return  # (non-finite samples are refused by the reader; fewer samples than channels
+        # bound the rank whatever the channels: that record's length is the identifiers' to judge)
     for j in range(2, data.shape[0] + 1):
         if np.linalg.matrix_rank(data[:j]) < j:
             raise MeasuredDataError(path, f"{name!r} channel {sig.channels[j - 1]!r} is a linear "

@@ -279,7 +279,7 @@ def test_summary_says_when_its_cells_come_from_two_versions_of_the_code(tmp_path
 
 # ------------------------------------------------------------------ identify: a channel pasted twice
 
-def _beam_sep005(path, copy_of: int | None = None) -> None:
+def _beam_sep005(path, copy_of: int | None = None, perturb: float = 0.0) -> None:
     import json
 
     import numpy as np
@@ -290,7 +290,8 @@ def _beam_sep005(path, copy_of: int | None = None) -> None:
            for k in range(3)]
     pos = [0.1, 0.2, 0.3]
     if copy_of is not None:  # a fourth sensor whose column is another's, pasted
-        acc.append(acc[copy_of].copy())
+        noise = np.random.default_rng(0).standard_normal(n) * perturb * np.std(acc[copy_of])
+        acc.append(acc[copy_of] + noise)
         pos.append(0.4)
     force = np.zeros(n)
     force[:10] = 50.0
@@ -312,3 +313,7 @@ def test_a_structural_channel_pasted_twice_is_refused_naming_it(tmp_path):
         measurement_from_file(tmp_path / "copy.json", "structural")
     _beam_sep005(tmp_path / "ok.json")
     assert measurement_from_file(tmp_path / "ok.json", "structural").x.shape[0] == 3
+    # two sensors reading nearly alike (1e-9 of the channel's spread apart: a real record's
+    # noise is 1e3-1e6 times that) are two channels, not a copy (numpy's rank rule: round-off)
+    _beam_sep005(tmp_path / "near.json", copy_of=0, perturb=1e-9)
+    assert measurement_from_file(tmp_path / "near.json", "structural").x.shape[0] == 4
