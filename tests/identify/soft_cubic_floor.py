@@ -75,26 +75,35 @@ def floor(truth: StructuralTruth, x: np.ndarray, xd: np.ndarray, xdd: np.ndarray
     return float(np.linalg.norm(np.linalg.solve(truth.Mr, K3 @ x**3) - a_true) / np.linalg.norm(a_true))
 
 
-def member(path: Path, cache: DatasetCache) -> str:
+def oracle_dataset(sc, ds, tr: StructuralTruth):
+    """The dataset with its signals replaced by the reduced truth's own (cubic included;
+    :func:`models.cantilever.truth.simulate_reduced`): a model of the identifier's form then
+    exists exactly.  Used by this script and its rank-one companions."""
     from models.cantilever.simulate import half_sine
     from models.cantilever.truth import simulate_reduced
 
+    exc = sc.excitation
+    fo = half_sine(exc["peak_force"], exc["pulse_duration"], exc["start"])
+    u, ud, udd = simulate_reduced(tr.Mr, tr.Cr, tr.Kr, tr.force_map, lambda t: float(fo(t)), ds.t,
+                                  (exc["start"], exc["start"] + exc["pulse_duration"]),
+                                  k3=float(tr.k3), cubic_direction=tr.cubic_direction,
+                                  cubic_map=tr.cubic_map, rtol=1e-9)
+    ref = {**ds.reference,
+           "acceleration": dataclasses.replace(ds.reference["acceleration"], data=udd),
+           "displacement": dataclasses.replace(ds.reference["displacement"], data=u),
+           "velocity": dataclasses.replace(ds.reference["velocity"], data=ud)}
+    return dataclasses.replace(ds, reference=ref, measured={
+        **ds.measured, "acceleration": dataclasses.replace(ds.measured["acceleration"], data=udd)})
+
+
+def member(path: Path, cache: DatasetCache) -> str:
     sc = load_scenario(path)
     ds = cache.get(sc)
     tr = ds.truth_as(StructuralTruth)
     start = int(ds.attrs["free_start"]) + 200
     e_q, e_q3 = base_angle_error(sc, tr, ds.reference["displacement"].data, start)
-    exc = sc.excitation
-    fo = half_sine(exc["peak_force"], exc["pulse_duration"], exc["start"])
-    u, ud, udd = simulate_reduced(tr.Mr, tr.Cr, tr.Kr, tr.force_map, lambda s: float(fo(s)), ds.t,
-                                  (exc["start"], exc["start"] + exc["pulse_duration"]),
-                                  k3=float(tr.k3), cubic_direction=tr.cubic_direction,
-                                  cubic_map=tr.cubic_map, rtol=1e-9)
-    ref = {**ds.reference, "acceleration": dataclasses.replace(ds.reference["acceleration"], data=udd),
-           "displacement": dataclasses.replace(ds.reference["displacement"], data=u),
-           "velocity": dataclasses.replace(ds.reference["velocity"], data=ud)}
-    oracle = dataclasses.replace(ds, reference=ref, measured={
-        **ds.measured, "acceleration": dataclasses.replace(ds.measured["acceleration"], data=udd)})
+    oracle = oracle_dataset(sc, ds, tr)
+    u, ud, udd = (oracle.reference[k].data for k in ("displacement", "velocity", "acceleration"))
     raw = floor(tr, u[:, start:], ud[:, start:], udd[:, start:], None)
     m = measure(oracle, sc.signal, sc.kind)
     i0 = m.free_start

@@ -37,11 +37,11 @@ of the chain sets the floor).  ``DIR`` holds the members written by
 
 from __future__ import annotations
 
-import dataclasses
 import sys
 from pathlib import Path
 
 import numpy as np
+from soft_cubic_floor import oracle_dataset  # this folder: the script's own (run as a script)
 
 from identify._cubic_form import cubic_jacobian, fit_rank_one
 from identify._sgd_matrix import NUISANCE_RCOND, nuisance_basis, project_out
@@ -114,24 +114,12 @@ def chain_order(truth: StructuralTruth, x: np.ndarray, xd: np.ndarray, xdd: np.n
 
 
 def member(path: Path, cache: DatasetCache, signal: dict | None = None) -> str:
-    from models.cantilever.simulate import half_sine
-    from models.cantilever.truth import simulate_reduced
-
     sc = load_scenario(path)
     ds = cache.get(sc)
     tr = ds.truth_as(StructuralTruth)
     start = int(ds.attrs["free_start"]) + 200
-    exc = sc.excitation
-    fo = half_sine(exc["peak_force"], exc["pulse_duration"], exc["start"])
-    u, ud, udd = simulate_reduced(tr.Mr, tr.Cr, tr.Kr, tr.force_map, lambda s: float(fo(s)), ds.t,
-                                  (exc["start"], exc["start"] + exc["pulse_duration"]),
-                                  k3=float(tr.k3), cubic_direction=tr.cubic_direction,
-                                  cubic_map=tr.cubic_map, rtol=1e-9)
-    ref = {**ds.reference, "acceleration": dataclasses.replace(ds.reference["acceleration"], data=udd),
-           "displacement": dataclasses.replace(ds.reference["displacement"], data=u),
-           "velocity": dataclasses.replace(ds.reference["velocity"], data=ud)}
-    oracle = dataclasses.replace(ds, reference=ref, measured={
-        **ds.measured, "acceleration": dataclasses.replace(ds.measured["acceleration"], data=udd)})
+    oracle = oracle_dataset(sc, ds, tr)
+    u, ud, udd = (oracle.reference[k].data for k in ("displacement", "velocity", "acceleration"))
     raw_d, raw_r, raw_ang, _, _, raw_s, raw_ang_s = floors(tr, u[:, start:], ud[:, start:],
                                                            udd[:, start:], None)
     m = measure(oracle, {**sc.signal, **(signal or {})}, sc.kind)

@@ -32,6 +32,7 @@ import sys
 from pathlib import Path
 
 import numpy as np
+from soft_cubic_floor import oracle_dataset  # this folder: the script's own (run as a script)
 
 from identify._cubic_form import cubic_jacobian, fit_rank_one
 from identify.structural import (
@@ -60,27 +61,6 @@ def mode2_shift(M: np.ndarray, K: np.ndarray, J: np.ndarray) -> float:
     return float(L[:, 1] @ np.linalg.solve(M, J) @ R[:, 1] / lam[1] * 100.0)
 
 
-def oracle(sc, ds, tr: StructuralTruth):
-    """The dataset with its signals replaced by the reduced truth's own (cubic included;
-    :func:`models.cantilever.truth.simulate_reduced`), as ``soft_cubic_floor.py``'s: a model of
-    the identifier's form then exists exactly."""
-    from models.cantilever.simulate import half_sine
-    from models.cantilever.truth import simulate_reduced
-
-    exc = sc.excitation
-    fo = half_sine(exc["peak_force"], exc["pulse_duration"], exc["start"])
-    u, ud, udd = simulate_reduced(tr.Mr, tr.Cr, tr.Kr, tr.force_map, lambda t: float(fo(t)), ds.t,
-                                  (exc["start"], exc["start"] + exc["pulse_duration"]),
-                                  k3=float(tr.k3), cubic_direction=tr.cubic_direction,
-                                  cubic_map=tr.cubic_map, rtol=1e-9)
-    ref = {**ds.reference,
-           "acceleration": dataclasses.replace(ds.reference["acceleration"], data=udd),
-           "displacement": dataclasses.replace(ds.reference["displacement"], data=u),
-           "velocity": dataclasses.replace(ds.reference["velocity"], data=ud)}
-    return dataclasses.replace(ds, reference=ref, measured={
-        **ds.measured, "acceleration": dataclasses.replace(ds.measured["acceleration"], data=udd)})
-
-
 def member(path: Path, cache: DatasetCache, noise: float | None, use_oracle: bool = False) -> str:
     from scipy.linalg import eigh
 
@@ -90,7 +70,7 @@ def member(path: Path, cache: DatasetCache, noise: float | None, use_oracle: boo
     ds = cache.get(sc)
     tr = ds.truth_as(StructuralTruth)
     if use_oracle:
-        ds = oracle(sc, ds, tr)
+        ds = oracle_dataset(sc, ds, tr)
     data = measure(ds, sc.signal, sc.kind)
     clean = measure(noise_free(ds), sc.signal, sc.kind)
     n, s = data.n_channels, int(data.free_start)
