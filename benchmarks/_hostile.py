@@ -88,6 +88,13 @@ def run_inprocess(cases: Iterable[tuple[str, Callable[[], Any]]], timeout_s: int
     return counts
 
 
+def subfolder(work: Path, sub: str) -> Path:
+    """``work / sub``, made if missing: a family's own scratch folder."""
+    d = work / sub
+    d.mkdir(exist_ok=True)
+    return d
+
+
 def main(argv: list[str], families: dict[str, Callable[[Path], Counter]], prefix: str) -> int:
     """Run the named families (all when ``argv`` is empty) in one temporary folder; print each
     family's count and the total; status 1 when anything was found."""

@@ -483,20 +483,14 @@ def run_inprocess(cases) -> Counter:
     return _hostile.run_inprocess(cases, TIMEOUT_S, lambda finding: finding)
 
 
-def _in(work: Path, sub: str) -> Path:
-    d = work / sub
-    d.mkdir(exist_ok=True)
-    return d
-
-
 FAMILIES = {
     "nyquist": lambda work: run_inprocess(nyquist_cases()),
     "twice": lambda work: run_inprocess(twice_cases()),
-    "empty": lambda work: run_inprocess(empty_cases(_in(work, "empty"))),
-    "serve": lambda work: run_inprocess(serve_cases(_in(work, "serve"))),
-    "parts": lambda work: run_inprocess(parts_cases(_in(work, "sweeps"))),
-    "cache": lambda work: run_inprocess(cache_cases(_in(work, "cache"))),
-    "kill": lambda work: run_inprocess(kill_cases(_in(work, "sweeps"))),
+    "empty": lambda work: run_inprocess(empty_cases(_hostile.subfolder(work, "empty"))),
+    "serve": lambda work: run_inprocess(serve_cases(_hostile.subfolder(work, "serve"))),
+    "parts": lambda work: run_inprocess(parts_cases(_hostile.subfolder(work, "sweeps"))),
+    "cache": lambda work: run_inprocess(cache_cases(_hostile.subfolder(work, "cache"))),
+    "kill": lambda work: run_inprocess(kill_cases(_hostile.subfolder(work, "sweeps"))),
 }
 
 

@@ -531,21 +531,15 @@ def run_inprocess(cases) -> Counter:
     return _hostile.run_inprocess(cases, TIMEOUT_S, lambda finding: finding)
 
 
-def _in(work: Path, sub: str) -> Path:
-    d = work / sub
-    d.mkdir(exist_ok=True)
-    return d
-
-
 FAMILIES = {
-    "results": lambda work: run_inprocess(results_cases(_in(work, "results"))),
+    "results": lambda work: run_inprocess(results_cases(_hostile.subfolder(work, "results"))),
     "study": lambda work: run_inprocess(study_cases()),
     "negzero": lambda work: run_inprocess(negzero_cases()),
-    "family": lambda work: run_inprocess(family_cases(_in(work, "family"))),
-    "channels": lambda work: run_inprocess(channels_cases(_in(work, "channels"))),
-    "plugins": lambda work: run_inprocess(plugins_cases(_in(work, "plugins"))),
-    "env": lambda work: run_inprocess(env_cases(_in(work, "env"))),
-    "full": lambda work: _full_family(_in(work, "fullwork")),
+    "family": lambda work: run_inprocess(family_cases(_hostile.subfolder(work, "family"))),
+    "channels": lambda work: run_inprocess(channels_cases(_hostile.subfolder(work, "channels"))),
+    "plugins": lambda work: run_inprocess(plugins_cases(_hostile.subfolder(work, "plugins"))),
+    "env": lambda work: run_inprocess(env_cases(_hostile.subfolder(work, "env"))),
+    "full": lambda work: _full_family(_hostile.subfolder(work, "fullwork")),
 }
 
 
