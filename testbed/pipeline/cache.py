@@ -47,7 +47,7 @@ log = logging.getLogger(__name__)
 
 
 @contextlib.contextmanager
-def _folder_lock(directory: Path, exclusive: bool) -> Iterator[None]:
+def _folder_lock(directory: Path, exclusive: bool) -> Iterator[bool]:
     """Hold ``flock`` on the cache folder itself while the block runs: shared while an entry is
     written (:meth:`DatasetCache.clean`), exclusive while :meth:`DatasetCache.clear` removes.
 
@@ -58,6 +58,10 @@ def _folder_lock(directory: Path, exclusive: bool) -> Iterator[None]:
     releases its lock with its descriptor.  The folder's own descriptor is locked, not a file in
     it: HDF5 ``flock``-s the files it writes, and a read-only cache needs no lock file.  A
     folder that cannot be opened is not locked (nothing is written into or cleared from it).
+    The block receives False when the folder does not exist (else True): a `cache clear` that
+    found no folder must not go on unlocked, since a writer may create it and start an entry
+    meanwhile (the clear then removed that entry's temporary file: CI, 2026-11-27, the first of
+    20 writes against a clear in a loop).
     A file system without ``flock`` (ENOLCK, EOPNOTSUPP: NFS without its lock daemon, some
     FUSE and SMB mounts) is used unlocked, with one warning: the lock only orders a `cache
     clear` against writes, and it holds between processes of one host (``flock`` on NFS does
@@ -65,8 +69,11 @@ def _folder_lock(directory: Path, exclusive: bool) -> Iterator[None]:
     """
     try:
         fd = os.open(directory, os.O_RDONLY | os.O_DIRECTORY)
-    except (OSError, AttributeError):  # missing, unreadable; O_DIRECTORY absent (Windows)
-        yield
+    except FileNotFoundError:
+        yield False
+        return
+    except (OSError, AttributeError):  # unreadable; O_DIRECTORY absent (Windows)
+        yield True
         return
     try:
         if fcntl is not None:
@@ -74,7 +81,7 @@ def _folder_lock(directory: Path, exclusive: bool) -> Iterator[None]:
                 fcntl.flock(fd, fcntl.LOCK_EX if exclusive else fcntl.LOCK_SH)
             except OSError as e:
                 _warn_unlocked(directory, e.strerror or str(e))
-        yield
+        yield True
     finally:
         os.close(fd)  # (releases the lock)
 
@@ -225,7 +232,9 @@ class DatasetCache:
         """Delete every cached file and any temporary file a killed writer left; return how many
         cached files were removed."""
         n = 0
-        with _folder_lock(self.directory, exclusive=True):  # after the writes under way
+        with _folder_lock(self.directory, exclusive=True) as present:  # after the writes under way
+            if not present:  # no folder, nothing to clear
+                return 0
             for p, _ in self.entries():
                 p.unlink(missing_ok=True)
                 n += 1

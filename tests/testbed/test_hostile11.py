@@ -224,6 +224,29 @@ def test_cache_clear_waits_for_an_entry_being_written(tmp_path, monkeypatch):
         th.join()
 
 
+def test_cache_clear_of_a_missing_folder_leaves_a_write_begun_meanwhile(tmp_path, monkeypatch):
+    import contextlib
+
+    import testbed.pipeline.cache as cache_mod
+
+    # a clear that found no folder went on unlocked; a writer that created the folder and began
+    # its entry in that gap lost its temporary file (CI, 2026-11-27: the race above, first write)
+    d = tmp_path / "cache"
+    tmp = d / ".michaelis_menten-0123456789abcdef0123456789abcdef.h5.abc.tmp"
+    folder_lock = cache_mod._folder_lock
+
+    @contextlib.contextmanager
+    def writer_begins_meanwhile(directory, exclusive):
+        with folder_lock(directory, exclusive) as present:
+            d.mkdir()  # the writer, between the clear's attempt to lock and its removals
+            tmp.write_bytes(b"x")
+            yield present
+
+    monkeypatch.setattr(cache_mod, "_folder_lock", writer_begins_meanwhile)
+    assert cache_mod.DatasetCache(d).clear() == 0
+    assert tmp.exists()
+
+
 def test_cache_clear_blocks_while_the_folder_is_held_for_a_write(tmp_path):
     from testbed.pipeline.cache import DatasetCache, _folder_lock
 
