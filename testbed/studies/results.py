@@ -37,12 +37,20 @@ checks                  str        JSON list of {metric, value, bound, threshold
 versions                str        JSON of package versions that computed the row
 commit                  str        git commit of the code (``+dirty`` if modified)
 dataset_hash            str        content hash of the dataset the cell used
+row_sha256              str        the row's checksum (:func:`row_digest`)
 ======================  =========  ===================================================
+
+Every row carries the SHA-256 of its own values (:func:`row_digest`), written with it by
+:func:`write_part` and :func:`write_rows` and verified by every reader: a row edited by hand
+within its column types (a score, ``passed``, a check's value) was summarised as if computed
+(round 12's open finding).  Rows of a file written before the checksum (format
+``sysid-testbed-results/1``) are read unverified, as they were written.
 """
 
 from __future__ import annotations
 
 import contextlib
+import hashlib
 import json
 import logging
 import math
@@ -60,7 +68,11 @@ from testbed.scoring.scorers import Check
 pa = lazy_module("pyarrow")
 pq = lazy_module("pyarrow.parquet")
 
-FORMAT = "sysid-testbed-results/1"
+FORMAT = "sysid-testbed-results/2"
+#: Formats :func:`read_results` reads: ``/1`` is ``/2`` without the ``row_sha256`` column.
+READ_FORMATS = ("sysid-testbed-results/1", FORMAT)
+#: The column of each row's checksum (:func:`row_digest`).
+DIGEST = "row_sha256"
 
 log = logging.getLogger(__name__)
 
@@ -77,6 +89,7 @@ BASE_COLUMNS: dict[str, str] = {
 }
 TAIL_COLUMNS: dict[str, str] = {
     "checks": "string", "versions": "string", "commit": "string", "dataset_hash": "string",
+    DIGEST: "string",
 }
 SORT_KEYS = ("scenario", "noise", "seed", "identifier", "cell")
 #: Text columns every row must hold as text (not null): the readers sort and group by them.
@@ -99,9 +112,49 @@ def _sort_key(row: dict[str, Any]) -> tuple:
     return tuple(row.get(k) if row.get(k) is not None else "" for k in SORT_KEYS)
 
 
+def row_digest(row: dict[str, Any]) -> str:
+    """The SHA-256 (64 hex digits) of a row's values, the same for the row as the sweep made it,
+    its row file and its Parquet row.
+
+    The values hashed are every column but :data:`DIGEST`, as canonical JSON (keys sorted); a
+    column whose value is null or a float NaN is left out, since the Parquet file stores a
+    score a row lacks as NaN (a row's NaN score and its absence are one value there), and a
+    float column's value is hashed as a float (a row file's ``1`` is the Parquet file's
+    ``1.0``).  A score edited to NaN or from NaN still changes the set of columns hashed.
+    """
+    fixed = {**BASE_COLUMNS, **TAIL_COLUMNS}
+    canon: dict[str, Any] = {}
+    for name, value in row.items():
+        if name == DIGEST or value is None:
+            continue
+        if (fixed.get(name, "float64") == "float64" and isinstance(value, (int, float))
+                and not isinstance(value, bool)):
+            value = float(value)
+            if math.isnan(value):
+                continue
+        canon[name] = value
+    # (default=repr: a value no column can hold still hashes, for the reader to refuse it)
+    text = json.dumps(canon, sort_keys=True, ensure_ascii=True, allow_nan=True, default=repr)
+    return hashlib.sha256(text.encode("ascii")).hexdigest()
+
+
+def _digest_problem(row: dict[str, Any]) -> str:
+    """"" if ``row`` holds its own checksum (:func:`row_digest`), else what is wrong."""
+    stored = row.get(DIGEST)
+    if not isinstance(stored, str):
+        return (f"no checksum ({DIGEST}); every row this version writes has one (a row of an "
+                "older version's interrupted sweep, or edited by hand)")
+    if stored != row_digest(row):
+        return (f"its values do not match the checksum stored with it ({DIGEST}): edited or "
+                "damaged after the sweep wrote it")
+    return ""
+
+
 def write_part(path: str | os.PathLike, row: dict[str, Any]) -> Path:
-    """Write one finished row atomically as ``<path>.parts/<cell>.json``; return the file."""
+    """Write one finished row atomically as ``<path>.parts/<cell>.json``, with its checksum
+    (:func:`row_digest`); return the file."""
     out = parts_dir(path) / f"{row['cell']}.json"
+    row = {**row, DIGEST: row_digest(row)}
     atomic_write_text(out, json.dumps(row, sort_keys=True))  # NaN as the JSON extension NaN
     return out
 
@@ -118,7 +171,8 @@ def _read_part(p: Path) -> dict[str, Any]:
         raise ValueError("not a results row (no cell and status)")
     if row["cell"] != p.stem:
         raise ValueError(f"holds the row of cell {row['cell']!r}")
-    why = _part_value_problem(row) or _row_problem({**dict.fromkeys(BASE_COLUMNS), **row}, set())
+    why = (_part_value_problem(row) or _row_problem({**dict.fromkeys(BASE_COLUMNS), **row}, set())
+           or _digest_problem(row))
     if why:
         raise ValueError(why)
     return row
@@ -201,9 +255,10 @@ def write_rows(path: str | os.PathLike, rows: Iterable[dict[str, Any]], *,
     """Write ``rows`` (one per cell) as the Parquet file ``path``, atomically.
 
     Rows are sorted by scenario, noise, seed and identifier; score columns are
-    the union over rows, NaN where a row has none.
+    the union over rows, NaN where a row has none.  Each row is written with its checksum
+    (:func:`row_digest`, computed here from its values).
     """
-    rows = sorted(rows, key=_sort_key)
+    rows = sorted(({**r, DIGEST: row_digest(r)} for r in rows), key=_sort_key)
     keys = [r["cell"] for r in rows]
     if len(set(keys)) != len(keys):
         raise ValueError("write_rows: a cell appears more than once")
@@ -221,9 +276,11 @@ def _read_parquet(path: Path) -> list[dict[str, Any]]:
     except Exception as e:  # pyarrow raises ArrowInvalid, OSError ... for a damaged file
         raise ResultsError(f"{path}: unreadable results file ({type(e).__name__}: {e})") from None
     meta = table.schema.metadata or {}
-    if meta.get(b"format", b"").decode() != FORMAT:
+    fmt = meta.get(b"format", b"").decode()
+    if fmt not in READ_FORMATS:
         raise ResultsError(f"{path}: not a {FORMAT} file")
-    _check_columns(path, table.schema)
+    verified = fmt == FORMAT  # a /1 file has no checksums: read as it was written
+    _check_columns(path, table.schema, verified)
     rows = table.to_pylist()
     seen: set[str] = set()
     study = meta.get(b"study", b"").decode()
@@ -232,19 +289,24 @@ def _read_parquet(path: Path) -> list[dict[str, Any]]:
         # the sweep writes its name in both; a row without one is the sweep's own (as it reads it)
         if not why and study and row["study"] not in (None, "", study):
             why = f"study {row['study']!r}, the file's is {study!r}"
+        if not why and verified:
+            why = _digest_problem(row)
         if why:
             raise ResultsError(f"{path}: row {i} (cell {row['cell']!r}): {why}; the file was "
                                "altered or damaged")
     return rows
 
 
-def _check_columns(path: Path, schema: pa.Schema) -> None:
+def _check_columns(path: Path, schema: pa.Schema, verified: bool = True) -> None:
     """Every fixed column (:data:`BASE_COLUMNS`, :data:`TAIL_COLUMNS`) with its type and every
     other column a float64 score, else ResultsError: a file without its ``noise`` or
     ``identifier`` column, or with ``noise`` as text, was an internal error of `testbed
-    summary` and `testbed report` (KeyError, ValueError)."""
+    summary` and `testbed report` (KeyError, ValueError).  ``verified`` False: a file of
+    format ``/1``, which has no :data:`DIGEST` column."""
     types = {f.name: f.type for f in schema}
     for name, t in {**BASE_COLUMNS, **TAIL_COLUMNS}.items():
+        if name == DIGEST and not verified and name not in types:
+            continue
         want = getattr(pa, t)()
         if name not in types:
             raise ResultsError(f"{path}: no column {name!r}; expected the columns of a "
@@ -324,7 +386,8 @@ def read_results(path: str | os.PathLike, *, set_aside: bool = False,
     list of dict
         One row per cell (a row in both places counts once; the part wins, being
         the newer), sorted by scenario, noise, seed and identifier.  Every row has
-        every score column found in any row (NaN where it has no such score).
+        every score column found in any row (NaN where it has no such score); its
+        checksum (:data:`DIGEST`), verified, is not among its columns.
 
     Raises
     ------
@@ -342,6 +405,7 @@ def read_results(path: str | os.PathLike, *, set_aside: bool = False,
         raise ResultsError(f"{path}: {why}")
     scores = score_columns(rows)
     for r in rows:
+        r.pop(DIGEST, None)  # verified on read; a writer computes it anew from the values
         for k in scores:
             if r.get(k) is None:
                 r[k] = math.nan

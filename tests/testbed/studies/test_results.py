@@ -73,3 +73,76 @@ def test_empty_and_foreign_files(tmp_path):
     pq.write_table(pa.table({"a": [1]}), other)
     with pytest.raises(ValueError, match="not a sysid-testbed-results"):
         read_results(other)
+
+
+# ------------------------------------------------------------------ the row checksum
+
+def test_a_row_edited_within_its_types_is_refused_in_a_part_and_in_the_parquet_file(tmp_path):
+    # round 12's open finding: a score or passed edited by hand to another value of its type
+    # was summarised as computed; now every row carries the checksum of its values
+    from testbed.studies.results import DIGEST, ResultsError
+
+    res = tmp_path / "r.parquet"
+    part = write_part(res, row("c1", trac=0.5))
+    doc = json.loads(part.read_text())
+    assert len(doc[DIGEST]) == 64
+    doc["trac"] = 0.95  # the same type, another value
+    part.write_text(json.dumps(doc))
+    assert read_results(res, set_aside=True) == []
+    assert part.with_name(part.name + ".bad").is_file()  # kept as evidence, its cell reruns
+
+    write_rows(res, [row("c1", trac=0.5), row("c2", seed=1, trac=0.2)], study="t")
+    table = pq.read_table(res)
+    rows = table.to_pylist()
+    rows[1]["trac"] = 0.25
+    pq.write_table(pa.Table.from_pylist(rows, schema=table.schema), res)
+    with pytest.raises(ResultsError, match=r"row 1 \(cell 'c2'\): its values do not match the "
+                                           r"checksum stored with it \(row_sha256\)"):
+        read_results(res)
+
+
+@pytest.mark.parametrize("edit", ["dropped", "null"])
+def test_a_part_without_its_checksum_is_refused(tmp_path, edit):
+    from testbed.studies.results import DIGEST
+
+    res = tmp_path / "r.parquet"
+    part = write_part(res, row("c1", trac=0.5))
+    doc = json.loads(part.read_text())
+    if edit == "dropped":
+        del doc[DIGEST]
+    else:
+        doc[DIGEST] = None
+    part.write_text(json.dumps(doc))
+    assert read_results(res) == []
+
+
+def test_the_checksum_is_the_same_for_a_row_its_part_and_its_parquet_row(tmp_path):
+    # NaN and absent scores, an int in a float column: one value in the Parquet file, one checksum
+    from testbed.studies.results import DIGEST, row_digest
+
+    res = tmp_path / "r.parquet"
+    r = row("c1", trac=0.5, mac=float("nan"), noise=1)  # noise 1 (int) is stored as 1.0
+    r["passed"] = False  # (what the reader judges it from its empty checks: kept as written)
+    digest = row_digest(r)
+    write_part(res, r)
+    consolidate(res, study="t")
+    stored = pq.read_table(res).to_pylist()[0]
+    assert stored[DIGEST] == digest and stored["noise"] == 1.0 and isinstance(stored["noise"], float)
+    assert row_digest({**r, "mac": 0.9}) != digest and row_digest({**r, "trac": None}) != digest
+    assert row_digest({**r, "passed": True}) != digest
+
+
+def test_a_results_file_of_format_1_is_read_without_checksums(tmp_path):
+    # files written before the checksum (format /1, no row_sha256 column) stay readable
+    from testbed.studies.results import DIGEST, READ_FORMATS
+
+    res = tmp_path / "r.parquet"
+    write_rows(res, [row("c1", trac=0.5)], study="t")
+    table = pq.read_table(res).drop_columns([DIGEST])
+    meta = {**table.schema.metadata, b"format": READ_FORMATS[0].encode()}
+    pq.write_table(table.replace_schema_metadata(meta), res)
+    assert [r["trac"] for r in read_results(res)] == [0.5]
+    meta[b"format"] = FORMAT.encode()  # claimed /2 without the column: refused
+    pq.write_table(table.replace_schema_metadata(meta), res)
+    with pytest.raises(ValueError, match="no column 'row_sha256'"):
+        read_results(res)

@@ -542,13 +542,18 @@ def test_a_copied_row_of_a_real_identifier_is_the_row_computing_it_gives(tmp_pat
 
 @pytest.mark.parametrize("column, value", [("scenario", "ghost"), ("identifier", "toy_other"),
                                            ("noise", 7.0), ("seed", 5)])
-def test_a_resumed_sweep_refuses_a_row_edited_to_another_cell(toy_dir, tmp_path, column, value):
+@pytest.mark.parametrize("checksum", ["kept", "recomputed"])
+def test_a_resumed_sweep_refuses_a_row_edited_to_another_cell(toy_dir, tmp_path, column, value,
+                                                              checksum):
     # round 9: a row's scenario edited by hand was kept as its cell's result, under the other
-    # name, and the cell skipped
+    # name, and the cell skipped.  An edit under the row's checksum makes the file damaged: set
+    # aside, its cells run again; an edit with the checksum made anew for it (a consistent row
+    # of another cell) is refused by the cell check, the file untouched.
     import pyarrow as pa
     import pyarrow.parquet as pq
 
     from testbed.core.errors import InputError
+    from testbed.studies.results import DIGEST, row_digest
 
     res, cache = tmp_path / "r.parquet", tmp_path / "c"
     study = load_study(write_study(toy_dir, "edited", ["toy_fit"], seeds=(0,), noise=(0.0,)))
@@ -556,8 +561,16 @@ def test_a_resumed_sweep_refuses_a_row_edited_to_another_cell(toy_dir, tmp_path,
     table = pq.read_table(res)
     rows = table.to_pylist()
     rows[0][column] = value
+    if checksum == "recomputed":
+        rows[0][DIGEST] = row_digest(rows[0])
     pq.write_table(pa.Table.from_pylist(rows, schema=table.schema), res)
     before = res.read_bytes()
-    with pytest.raises(InputError, match=f"the row of cell {rows[0]['cell']} has {column} = "):
-        run_sweep(study, results=res, cache_dir=cache, verbose=False)
-    assert res.read_bytes() == before
+    if checksum == "recomputed":
+        with pytest.raises(InputError, match=f"the row of cell {rows[0]['cell']} has {column} = "):
+            run_sweep(study, results=res, cache_dir=cache, verbose=False)
+        assert res.read_bytes() == before
+        return
+    stats = SweepStats()
+    run_sweep(study, results=res, cache_dir=cache, verbose=False, stats=stats)
+    assert stats.run == 1 and res.with_name(res.name + ".bad").read_bytes() == before
+    assert [r[column] for r in read_results(res)] != [value]
