@@ -1105,6 +1105,11 @@ def _served(argv: list[str]) -> int | None:
     """The command's status if a resident ``testbed serve`` ran it (:mod:`testbed.server`)."""
     if not argv or argv[0] == "serve" or os.environ.get("TESTBED_NO_SERVER"):
         return None
+    if argv[0] == "list" and not any(a.startswith("--plugin") for a in argv):
+        # alone it prints from its index (testbed.core.stamped: 0.17 s of CPU), or lists and
+        # rewrites the index; a server's child lists afresh (its registries are loaded) and
+        # cannot write the index (its modules were read when the server started)
+        return None
     from testbed.server import socket_path, try_server
 
     try:

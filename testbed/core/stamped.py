@@ -180,9 +180,9 @@ def stamped_value(name: str, build: Callable[[], Built]) -> Any:
     folder = index_folder()
     path = None if folder is None else folder / _key(name)
     if path is not None:
-        kept = _read(path)
-        if kept is not None:
-            return kept["value"]
+        index = _read(path)
+        if index is not None:
+            return index["value"]
     value, files, folders = build()
     value = json.loads(json.dumps(value))  # the value as the index will give it back
     if path is None:

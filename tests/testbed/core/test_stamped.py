@@ -160,3 +160,4 @@ def test_an_unwritable_index_folder_only_costs_time(index, tmp_path, monkeypatch
     assert stamped.stamped_value("t", build) == {"a.txt": "alpha"}
     assert stamped.stamped_value("t", build) == {"a.txt": "alpha"}
     assert len(calls) == 2
+
