@@ -20,7 +20,8 @@ The rule (stated here, applied by :func:`_current`):
   plugin package's, numpy's ...); the folders are those the caller names (the registries'
   packages, the scenario folder) **plus every folder on** ``sys.path``; and every installed
   distribution's ``entry_points.txt`` is recorded as a file (present or absent), so an entry
-  point added, removed or edited shows at once;
+  point added, removed or edited shows at once; a module loaded from no file of its own (a zip
+  archive) cannot be stamped, and no index is written;
 - an index is **keyed** by the interpreter (``sys.executable``, its version), ``sys.path``
   (``""`` as the working folder it stands for) and the ``TESTBED_*`` variables: another
   interpreter, path or scenario folder has its own index;
@@ -130,11 +131,16 @@ def _entry_point_files() -> set[str]:
     return out
 
 
-def _implicit() -> tuple[set[str], set[str]]:
+def _implicit() -> tuple[set[str], set[str]] | None:
     """The files and folders recorded for every value: the loaded modules' files and the
-    distributions' ``entry_points.txt``; the folders on ``sys.path``."""
+    distributions' ``entry_points.txt``; the folders on ``sys.path``.  None if a loaded module
+    has no file of its own to stamp (imported from a zip archive): its changes could not be
+    seen, so no index is written."""
+    modules = _module_files()
+    if any(_file_stamp(f) is None for f in modules):
+        return None
     folders = {os.path.abspath(p or os.getcwd()) for p in sys.path if os.path.isdir(p or ".")}
-    return _module_files() | _entry_point_files(), folders
+    return modules | _entry_point_files(), folders
 
 
 def _current(index: dict) -> bool:
@@ -187,7 +193,10 @@ def stamped_value(name: str, build: Callable[[], Built]) -> Any:
     value = json.loads(json.dumps(value))  # the value as the index will give it back
     if path is None:
         return value
-    implicit_files, implicit_folders = _implicit()
+    implicit = _implicit()
+    if implicit is None:
+        return value
+    implicit_files, implicit_folders = implicit
     file_names = {os.path.abspath(os.fspath(f)) for f in files} | implicit_files
     folder_names = {os.path.abspath(os.fspath(f)) for f in folders} | implicit_folders
     stamps_f = sorted([f, _file_stamp(f)] for f in file_names)

@@ -8,11 +8,15 @@ line's test (tests/testbed/test_cli_startup.py) runs with them.
 from __future__ import annotations
 
 import os
+import sys
 import time
 
 import pytest
 
 from testbed.core import stamped
+
+#: The implicit stamps as shipped (the fixture below replaces them).
+_REAL_IMPLICIT = stamped._implicit
 
 #: A time safely older than the racy window [s before now].
 OLD_S = 3600.0
@@ -161,3 +165,22 @@ def test_an_unwritable_index_folder_only_costs_time(index, tmp_path, monkeypatch
     assert stamped.stamped_value("t", build) == {"a.txt": "alpha"}
     assert len(calls) == 2
 
+
+
+
+def test_a_module_without_a_file_of_its_own_writes_no_index(index, tmp_path, monkeypatch):
+    """A module imported from a zip archive has no file to stamp: its edits could not be seen,
+    so nothing is kept; a module file of its own is recorded and kept."""
+    data = _setup(tmp_path)
+    monkeypatch.setattr(stamped, "_implicit", _REAL_IMPLICIT)
+    monkeypatch.setattr(sys, "path", [str(data)])
+    monkeypatch.setattr(stamped, "_entry_point_files", set)
+    module = tmp_path / "mod.py"
+    module.write_text("")
+    _backdate(module, data)
+    for modules, kept in (({str(tmp_path / "lib.zip" / "mod.py")}, False), ({str(module)}, True)):
+        monkeypatch.setattr(stamped, "_module_files", lambda m=modules: set(m))
+        build, calls = _counting(data)
+        stamped.stamped_value("t", build)
+        stamped.stamped_value("t", build)
+        assert len(calls) == (1 if kept else 2) and index.exists() == kept
