@@ -75,11 +75,19 @@ Built = tuple[Any, Iterable[str | os.PathLike], Iterable[str | os.PathLike]]
 
 
 def index_folder() -> Path | None:
-    """Where indexes are kept: ``$TESTBED_INDEX``, else the user's cache; None if turned off."""
+    """Where indexes are kept: ``$TESTBED_INDEX``, else the user's cache; None if turned off or
+    there is no absolute cache folder to use."""
     given = os.environ.get(INDEX_VARIABLE)
     if given is not None:
         return Path(given) if given else None
-    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    base = os.environ.get("XDG_CACHE_HOME")
+    if not base:
+        home = os.path.expanduser("~")
+        if not os.path.isabs(home):  # no home to find: not a folder named "~" in the working one
+            return None
+        base = os.path.join(home, ".cache")
+    if not os.path.isabs(base):  # a relative $XDG_CACHE_HOME is invalid (the XDG spec): ignored
+        return None
     return Path(base) / "sysid-testbed" / "index"
 
 

@@ -184,3 +184,16 @@ def test_a_module_without_a_file_of_its_own_writes_no_index(index, tmp_path, mon
         stamped.stamped_value("t", build)
         stamped.stamped_value("t", build)
         assert len(calls) == (1 if kept else 2) and index.exists() == kept
+
+
+def test_the_index_folder(monkeypatch, tmp_path):
+    monkeypatch.delenv(stamped.INDEX_VARIABLE, raising=False)
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
+    assert stamped.index_folder() == tmp_path / "sysid-testbed" / "index"
+    monkeypatch.setenv("XDG_CACHE_HOME", "relative")  # invalid (XDG): not under the working folder
+    assert stamped.index_folder() is None
+    monkeypatch.delenv("XDG_CACHE_HOME")
+    monkeypatch.setattr(os.path, "expanduser", lambda p: p)  # no home found: "~" stays "~"
+    assert stamped.index_folder() is None
+    monkeypatch.setenv(stamped.INDEX_VARIABLE, "")
+    assert stamped.index_folder() is None
