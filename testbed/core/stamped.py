@@ -56,7 +56,7 @@ from testbed.core.errors import TestbedError
 
 #: Format of an index file; another version is ignored (recomputed and rewritten).
 FORMAT = 1
-#: A stamp less than this old [s] when its value was computed is not trusted (see the module
+#: A stamp less than this old [s] at the import of this module is not trusted (see the module
 #: docs): 2 s is FAT's time resolution, the coarsest in common use (ext4's is 1-10 ms).
 RACY_S = 2.0
 #: A process writes an index only this soon [s] after it imported this module (see the
