@@ -123,7 +123,7 @@ def _instrument(record) -> None:
 def _served_run(out: str) -> tuple[float, float]:
     """Fork one served ``testbed run`` (as :func:`testbed.server._start` does); its wall time
     [s] and CPU time [s] with its drawing processes."""
-    from testbed import server
+    from testbed import cli, server
 
     devnull = [os.open(os.devnull, os.O_RDWR) for _ in range(3)]
     request = {"argv": ["run", SCENARIO, "--out", out], "cwd": str(ROOT), "env": dict(os.environ),
@@ -132,7 +132,8 @@ def _served_run(out: str) -> tuple[float, float]:
     t0 = time.perf_counter()
     pid = os.fork()
     if pid == 0:
-        server._child(request, devnull, [], os.getppid())  # never returns
+        server._child(request, devnull, [], os.getppid(), cli.main)  # never returns (as
+        # `testbed serve` runs a client's command: the command line's main)
     _, status = os.waitpid(pid, 0)
     wall = time.perf_counter() - t0
     for fd in devnull:

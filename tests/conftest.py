@@ -23,6 +23,8 @@ os.environ.setdefault("MPLBACKEND", "Agg")
 os.environ["TESTBED_NO_SERVER"] = "1"
 
 ROOT = Path(__file__).resolve().parent.parent
+# `testbed list`'s index (testbed.core.stamped) in the checkout's cache, not the user's
+os.environ.setdefault("TESTBED_INDEX", str(ROOT / ".cache" / "index"))
 
 # The property tests (hypothesis) draw the same examples on every run, as every other test is
 # the same on every run: a random draw made CI's verdict depend on the day (round 7 drew

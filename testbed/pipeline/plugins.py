@@ -9,6 +9,7 @@ project join them through :func:`load_plugins` (a study's ``plugins = [...]``).
 
 from __future__ import annotations
 
+import importlib
 from collections.abc import Iterable
 from typing import Any
 
@@ -18,7 +19,7 @@ from testbed.core.errors import ScenarioError
 from testbed.core.registry import IDENTIFIER_ENTRY_POINTS, RIG_ENTRY_POINTS, PluginError, import_plugin
 
 __all__ = ["IDENTIFIERS", "IDENTIFIER_ENTRY_POINTS", "RIGS", "RIG_ENTRY_POINTS", "PluginError",
-           "identifier_class", "load_plugins", "make_identifier",
+           "identifier_class", "load_plugins", "make_identifier", "registry_folders",
            "rig_class", "rig_kind"]
 
 
@@ -35,6 +36,13 @@ def rig_kind(name: str) -> str:
 def identifier_class(name: str) -> type:
     """The registered identifier class ``name`` (KeyError naming the known ones if unknown)."""
     return IDENTIFIERS.get(name)
+
+
+def registry_folders() -> list[str]:
+    """The folders whose modules the registries import (``identify/``, ``models/``): a module
+    added or removed there is an entry added or removed."""
+    return [str(p) for reg in (IDENTIFIERS, RIGS) if reg.package is not None
+            for p in importlib.import_module(reg.package).__path__]
 
 
 def make_identifier(identify: dict[str, Any] | None, scenario_name: str = "") -> Any:

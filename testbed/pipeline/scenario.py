@@ -34,6 +34,7 @@ too large or not scenarios get one line without their content.
 
 from __future__ import annotations
 
+import contextlib
 import copy
 import dataclasses
 import errno
@@ -45,6 +46,7 @@ import re
 import stat
 import sys
 import tomllib
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -235,6 +237,24 @@ def _depth_exceeds(obj: Any, limit: int) -> bool:
     return False
 
 
+#: Files read by :func:`read_toml_file` while a :func:`recording_reads` is open, else None.
+_reads: list[str] | None = None
+
+
+@contextlib.contextmanager
+def recording_reads() -> Iterator[list[str]]:
+    """A list that collects the absolute path of every file :func:`read_toml_file` reads in the
+    block (a scenario and the files it extends): what a listing depends on."""
+    global _reads
+    before, _reads = _reads, []
+    try:
+        yield _reads
+    finally:
+        if before is not None:
+            before.extend(_reads)
+        _reads = before
+
+
 def read_toml_file(path: Path, what: str) -> dict:
     """Read one TOML file defensively: one clear :class:`ScenarioError`, never its content.
 
@@ -251,6 +271,8 @@ def read_toml_file(path: Path, what: str) -> dict:
         valid TOML, or nested deeper than :data:`MAX_DEPTH`.
     """
     file = str(path)
+    if _reads is not None:
+        _reads.append(os.path.abspath(path))
     problem = file_problem(path, what)
     if problem is not None:
         raise ScenarioError(file, allowed=problem)

@@ -14,6 +14,7 @@ import signal
 import subprocess
 import sys
 import textwrap
+import time
 from pathlib import Path
 
 import pytest
@@ -28,8 +29,8 @@ HEAVY = ("mujoco", "pinocchio", "h5py", "matplotlib", "numba", "scipy.linalg", "
          "scipy.optimize", "scipy.fft", "sklearn", "pysindy", "joblib", "pyarrow")
 
 
-def _in_fresh_process(code: str) -> dict:
-    env = dict(os.environ, PYTHONPATH=str(ROOT), MPLBACKEND="Agg")
+def _in_fresh_process(code: str, **env_vars: str) -> dict:
+    env = {**os.environ, "PYTHONPATH": str(ROOT), "MPLBACKEND": "Agg", **env_vars}
     r = subprocess.run([sys.executable, "-c", textwrap.dedent(code)], cwd=ROOT, env=env,
                        capture_output=True, text=True, timeout=TIMEOUT_S)
     assert r.returncode == 0, r.stderr
@@ -37,6 +38,7 @@ def _in_fresh_process(code: str) -> dict:
 
 
 def test_list_imports_no_engine_and_no_heavy_library():
+    """Listed by importing every module (no index: testbed.core.stamped)."""
     out = _in_fresh_process(f"""
         import contextlib, io, json, sys
         from testbed.cli import main
@@ -45,12 +47,88 @@ def test_list_imports_no_engine_and_no_heavy_library():
             code = main(["list", "--plain"])
         print(json.dumps({{"code": code, "listing": buf.getvalue(),
                           "heavy": [m for m in {HEAVY!r} if m in sys.modules]}}))
-    """)
+    """, TESTBED_INDEX="")
     assert out["code"] == 0
     # the listing is whole: every built-in rig and a scored scenario of each engine
     for name in ("cantilever", "fivebar", "cartpole", "sgd_sindy", "cantilever_stiff_impact"):
         assert f"\n{name}\t" in out["listing"], name
     assert out["heavy"] == [], f"`testbed list` imported {out['heavy']}"
+
+
+#: A plugin distribution's module: an identifier registered with the tag ``{tag}``.
+EP_PLUGIN = """
+from testbed import IDENTIFIERS, StructuralIdentifier
+
+
+@IDENTIFIERS.register("my_ep_method", tags=("structural", "{tag}"))
+class Plugin(StructuralIdentifier):
+    \"\"\"Registration only.\"\"\"
+
+    name = "my_ep_method"
+"""
+LIST_CODE = """
+    import contextlib, io, json, sys
+    from testbed.cli import main
+    buf = io.StringIO()
+    with contextlib.redirect_stdout(buf):
+        code = main(["list", "--plain"])
+    print(json.dumps({"code": code, "listing": buf.getvalue(),
+                      "imported": [m for m in ("identify", "models", "numpy") if m in sys.modules]}))
+"""
+
+
+def _backdate(*paths: Path) -> None:
+    """Older than the index's racy window (testbed.core.stamped.RACY_S)."""
+    t = time.time() - 3600
+    for p in paths:
+        os.utime(p, (t, t))
+
+
+def test_list_from_its_index_shows_a_plugin_or_scenario_added_edited_or_removed_at_once(tmp_path):
+    """`testbed list` prints from its index (no rig, identifier or numpy imported) while every
+    file it was computed from holds its stamp, and lists afresh as soon as a plugin module is
+    edited, an entry point removed or a scenario file added (testbed.core.stamped)."""
+    site, scenarios = tmp_path / "site", tmp_path / "scenarios"
+    dist = site / "ep_plugin-0.1.dist-info"
+    dist.mkdir(parents=True)
+    scenarios.mkdir()
+    (site / "ep_plugin.py").write_text(EP_PLUGIN.format(tag="example"))
+    (dist / "METADATA").write_text("Metadata-Version: 2.1\nName: ep-plugin\nVersion: 0.1\n")
+    (dist / "entry_points.txt").write_text("[sysid_testbed.identifiers]\nmy_ep_method = ep_plugin\n")
+    for name in ("cartpole", "michaelis_menten"):  # neither extends another file
+        (scenarios / f"{name}.toml").write_bytes((ROOT / "scenarios" / f"{name}.toml").read_bytes())
+    _backdate(*site.rglob("*"), site, *scenarios.rglob("*"), scenarios)
+    env = {"PYTHONPATH": f"{ROOT}{os.pathsep}{site}", "TESTBED_SCENARIOS": str(scenarios),
+           "TESTBED_INDEX": str(tmp_path / "index")}
+
+    def listing(fresh: bool) -> str:
+        out = _in_fresh_process(LIST_CODE, **env)
+        assert out["code"] == 0, out
+        assert (out["imported"] == []) != fresh, out["imported"]
+        return out["listing"]
+
+    first = listing(fresh=True)
+    assert "\nmy_ep_method\tstructural\texample, structural\tentry point my_ep_method (ep-plugin)\n" in first
+    assert "\ncartpole\t" in first and "\ncantilever_stiff_impact\t" not in first
+    if not (tmp_path / "index").is_dir():  # a project file changed in the last 2 s: not kept yet
+        time.sleep(2.5)
+        listing(fresh=True)
+    assert listing(fresh=False) == first
+    # the plugin's module edited: listed afresh, at once
+    (site / "ep_plugin.py").write_text(EP_PLUGIN.format(tag="edited"))
+    assert "\tedited, structural\t" in listing(fresh=True)
+    # a scenario file added
+    (scenarios / "cartpole_copy.toml").write_text('[scenario]\nname = "cartpole_copy"\n'
+                                                  'extends = "cartpole.toml"\n')
+    assert "\ncartpole_copy\tcartpole\t" in listing(fresh=True)
+    # the distribution removed (after the index holds it again)
+    _backdate(*site.rglob("*"), site, *scenarios.rglob("*"), scenarios)
+    listing(fresh=True)
+    assert "my_ep_method" in listing(fresh=False)
+    for f in dist.iterdir():
+        f.unlink()
+    dist.rmdir()
+    assert "my_ep_method" not in listing(fresh=True)
 
 
 def test_version_imports_nothing_of_the_project_below_the_cli():
@@ -284,3 +362,24 @@ def test_importing_the_library_leaves_the_signals_as_python_has_them():
     assert not interrupts._console_program()
     assert signal.getsignal(signal.SIGINT) is not interrupts.exit_at_once
     assert signal.getsignal(signal.SIGTERM) is not interrupts.exit_at_once
+
+
+
+def test_list_without_a_plugin_is_never_served(tmp_path, monkeypatch):
+    """Alone, `list` prints from its index (or lists and rewrites it); a served `list` forks the
+    server and lists afresh, slower, and never refreshes the index (measured at load 11: served
+    0.46-0.80 s wall, alone from the index 0.22-0.45 s).  With a plugin file it is served."""
+    from testbed import cli, server
+
+    sock = tmp_path / "s.sock"
+    sock.write_text("")  # a server's socket as far as the client looks
+    monkeypatch.delenv("TESTBED_NO_SERVER", raising=False)
+    monkeypatch.setenv("TESTBED_SERVER_SOCKET", str(sock))
+    asked = []
+    monkeypatch.setattr(server, "try_server", lambda argv: asked.append(argv) or 0)
+    for argv, served in ((["list"], False), (["list", "--plain"], False),
+                         (["list", "--plugin", "p.py"], True), (["list", "--plugin=p.py"], True),
+                         (["run", "x"], True)):
+        asked.clear()
+        assert cli._served(argv) == (0 if served else None)
+        assert asked == ([argv] if served else [])

@@ -301,7 +301,7 @@ def test_ctrl_c_before_the_server_answers_is_one_line(tmp_path):
     mute.bind(env["TESTBED_SERVER_SOCKET"])
     mute.listen(1)
     mute.settimeout(30)
-    c = _client(env, tmp_path, "list")
+    c = _client(env, tmp_path, "runs", "ls")  # (`list` is not served: it runs alone)
     conn, _ = mute.accept()
     conn.settimeout(30)
     assert conn.recv(4)  # the request came: the client now waits for the reply

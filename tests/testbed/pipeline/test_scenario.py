@@ -6,7 +6,10 @@ import pytest
 
 from testbed.cli import main
 from testbed.core.errors import ScenarioError
-from testbed.pipeline.scenario import load_scenario, scenario_from_dict
+from testbed.pipeline.scenario import SCENARIO_DIR, load_scenario, scenario_from_dict
+
+#: The shipped scenarios (copied into the tests' own folders).
+ROOT_SCENARIOS = SCENARIO_DIR
 
 GOOD = """
 [scenario]
@@ -280,3 +283,22 @@ def test_a_seed_beyond_64_bits_is_refused(tmp_path):
     with pytest.raises(ScenarioError, match=r"'scenario\.seed': value 9223372036854775808"):
         load_scenario(_write(tmp_path, GOOD.replace("seed = 1", "seed = 9223372036854775808")))
     assert load_scenario(_write(tmp_path, GOOD.replace("seed = 1", f"seed = {2**63 - 1}"))).seed == 2**63 - 1
+
+
+def test_recording_reads_names_a_scenario_and_the_files_it_extends(tmp_path):
+    """What `testbed list`'s index records as read (testbed.core.stamped): a parent outside the
+    scenario folder included, and nothing outside the block."""
+    from testbed.pipeline.scenario import recording_reads
+
+    (tmp_path / "elsewhere").mkdir()
+    base = tmp_path / "elsewhere" / "base.toml"
+    base.write_bytes((ROOT_SCENARIOS / "cartpole.toml").read_bytes())
+    folder = tmp_path / "mine"
+    folder.mkdir()
+    child = folder / "child.toml"
+    child.write_text('[scenario]\nname = "child"\nextends = "../elsewhere/base.toml"\n')
+    with recording_reads() as read:
+        load_scenario(child, check_cost=False)
+    assert read == [str(child), str(base)]
+    load_scenario(child, check_cost=False)
+    assert read == [str(child), str(base)]  # closed: not recorded after the block
