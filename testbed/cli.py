@@ -468,6 +468,18 @@ def _list_sections() -> tuple[list, list[str], list[str]]:
     return sections, read, [*registry_folders(), str(SCENARIO_DIR)]
 
 
+def _list_shape(sections: object) -> bool:
+    """Whether a kept listing has the shape :func:`_list_sections` gives (as JSON returns it):
+    sections ``[title, columns, rows]`` of text, each row as long as its columns."""
+    def texts(x: object) -> bool:
+        return isinstance(x, list) and all(isinstance(v, str) for v in x)
+
+    return isinstance(sections, list) and all(
+        isinstance(sec, list) and len(sec) == 3 and isinstance(sec[0], str) and texts(sec[1])
+        and isinstance(sec[2], list) and all(texts(r) and len(r) == len(sec[1]) for r in sec[2])
+        for sec in sections)
+
+
 def cmd_list(args: argparse.Namespace) -> int:
     if getattr(args, "plugin", None) or "models" in sys.modules or "identify" in sys.modules:
         # a plugin file's registrations, or a process that has the registries already (and may
@@ -479,7 +491,7 @@ def cmd_list(args: argparse.Namespace) -> int:
         # (testbed.core.stamped: 0.1 s instead of importing every rig and identifier)
         from testbed.core.stamped import stamped_value
 
-        sections = stamped_value("list", _list_sections)
+        sections = stamped_value("list", _list_sections, valid=_list_shape)
     if args.plain or not sys.stdout.isatty():
         # piped into another program: every field whole, tab-separated, one header per section
         for title, cols, rows in sections:

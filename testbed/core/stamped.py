@@ -10,21 +10,29 @@ rewrites the index.
 
 The rule (stated here, applied by :func:`_current`):
 
-- a **file** holds if it has the recorded size [bytes] and modification time [ns] (Python's own
-  rule for its bytecode cache, at a finer time), or is still absent if it was absent;
-- a **folder** holds if it has the recorded modification time [ns]: a file created, removed or
-  renamed in it changes it (a new identifier module in ``identify/``, a new scenario file, a new
-  distribution's ``*.dist-info`` on ``sys.path``);
+- a **file** holds if it has the recorded size [bytes], modification time [ns] (Python's own
+  rule for its bytecode cache, at a finer time), status-change time [ns] and inode, or is still
+  absent if it was absent: a file replaced by one of the same size and modification time
+  (``cp -p``, ``rsync -t``, ``touch -r``) has another status-change time, which no user sets;
+- a **folder** holds if it has the recorded modification time [ns], status-change time and
+  inode: a file created, removed or renamed in it changes it (a new identifier module in
+  ``identify/``, a new scenario file);
+- a folder **on** ``sys.path`` holds if it holds the same distributions and path files (the
+  names of its ``*.dist-info``, ``*.egg-info``, ``*.egg-link`` and ``*.pth``): what can add an
+  entry point or a path.  Not its modification time: the project's own folder is on the path,
+  and a file a run writes there (``out/``, a log) would make every listing afresh (and the
+  command line's test flaky, as other tests write there while it runs);
 - the recorded files are those the caller names (the scenario files read) **plus the file of
   every module loaded in the process** when the value was computed (the project's modules, a
   plugin package's, numpy's ...); the folders are those the caller names (the registries'
-  packages, the scenario folder) **plus every folder on** ``sys.path``; and every installed
+  packages, the scenario folder) **plus every folder on** ``sys.path`` (by the rule above); and every installed
   distribution's ``entry_points.txt`` is recorded as a file (present or absent), so an entry
   point added, removed or edited shows at once; a module loaded from no file of its own (a zip
   archive) cannot be stamped, and no index is written;
 - an index is **keyed** by the interpreter (``sys.executable``, its version), ``sys.path``
-  (``""`` as the working folder it stands for) and the ``TESTBED_*`` variables: another
-  interpreter, path or scenario folder has its own index;
+  (``""`` as the working folder it stands for), the working folder (a relative
+  ``TESTBED_SCENARIOS`` names another folder in another one) and the ``TESTBED_*`` variables:
+  another interpreter, path, working or scenario folder has its own index;
 - **racy stamps** are not trusted: a value is written to the index only if every stamp is
   more than :data:`RACY_S` older than the import of this module (before the modules of the
   value were read; those read before it, the command line's own, were read at the command's
@@ -33,8 +41,9 @@ The rule (stated here, applied by :func:`_current`):
   :data:`WRITE_WITHIN_S` of that import (the command line imports this module as a listing
   starts, in a fresh process; a long-lived one may hold modules read long before).  The next
   call computes the value again;
-- an index that cannot be read, parsed or written is as good as none: the value is computed
-  (the index only ever saves time; it never fails a command).
+- an index that cannot be read, parsed or written, holds no stamps, or whose value the caller's
+  ``valid`` refuses, is as good as none: the value is computed (the index only ever saves time;
+  it never fails a command).
 
 Indexes live in ``$TESTBED_INDEX`` (a folder; the empty string turns them off), else
 ``$XDG_CACHE_HOME/sysid-testbed/index`` (``~/.cache/...``).
@@ -55,7 +64,9 @@ from testbed.core.atomic import atomic_write_text
 from testbed.core.errors import TestbedError
 
 #: Format of an index file; another version is ignored (recomputed and rewritten).
-FORMAT = 1
+FORMAT = 2
+#: Names in a folder on ``sys.path`` that are its stamp (see the module docs).
+PATH_ENTRY_SUFFIXES = (".dist-info", ".egg-info", ".egg-link", ".pth")
 #: A stamp less than this old [s] at the import of this module is not trusted (see the module
 #: docs): 2 s is FAT's time resolution, the coarsest in common use (ext4's is 1-10 ms).
 RACY_S = 2.0
@@ -93,8 +104,12 @@ def index_folder() -> Path | None:
 
 def _key(name: str) -> str:
     """The index file's name for ``name`` in this interpreter, path and environment."""
-    parts = [name, sys.executable, sys.version,
-             *(p or os.getcwd() for p in sys.path),
+    try:
+        cwd = os.getcwd()
+    except OSError:  # the working folder was removed
+        cwd = ""
+    parts = [name, sys.executable, sys.version, cwd,
+             *(p or cwd for p in sys.path),
              *(f"{k}={v}" for k, v in sorted(os.environ.items())
                if k.startswith("TESTBED_") and k not in _UNKEYED)]
     digest = hashlib.sha256("\0".join(parts).encode("utf-8", "surrogateescape")).hexdigest()
@@ -102,17 +117,29 @@ def _key(name: str) -> str:
 
 
 def _file_stamp(path: str) -> list[int] | None:
-    """[size, mtime_ns] of a file, None if it is absent (or cannot be looked up)."""
+    """[size, mtime_ns, ctime_ns, inode] of a file, None if it is absent (or cannot be looked
+    up)."""
     try:
         st = os.stat(path)
     except (OSError, ValueError):
         return None
-    return [st.st_size, st.st_mtime_ns]
+    return [st.st_size, st.st_mtime_ns, st.st_ctime_ns, st.st_ino]
 
 
-def _folder_stamp(path: str) -> int | None:
+def _folder_stamp(path: str) -> list[int] | None:
+    """[mtime_ns, ctime_ns, inode] of a folder, None if it is absent."""
     try:
-        return os.stat(path).st_mtime_ns
+        st = os.stat(path)
+    except (OSError, ValueError):
+        return None
+    return [st.st_mtime_ns, st.st_ctime_ns, st.st_ino]
+
+
+def _path_stamp(path: str) -> list[str] | None:
+    """The sorted names of the distributions and path files in a folder on ``sys.path``
+    (:data:`PATH_ENTRY_SUFFIXES`), None if it cannot be listed."""
+    try:
+        return sorted(n for n in os.listdir(path) if n.endswith(PATH_ENTRY_SUFFIXES))
     except (OSError, ValueError):
         return None
 
@@ -140,10 +167,10 @@ def _entry_point_files() -> set[str]:
 
 
 def _implicit() -> tuple[set[str], set[str]] | None:
-    """The files and folders recorded for every value: the loaded modules' files and the
-    distributions' ``entry_points.txt``; the folders on ``sys.path``.  None if a loaded module
-    has no file of its own to stamp (imported from a zip archive): its changes could not be
-    seen, so no index is written."""
+    """The files and path folders recorded for every value: the loaded modules' files and the
+    distributions' ``entry_points.txt``; the folders on ``sys.path`` (stamped by
+    :func:`_path_stamp`).  None if a loaded module has no file of its own to stamp (imported
+    from a zip archive): its changes could not be seen, so no index is written."""
     modules = _module_files()
     if any(_file_stamp(f) is None for f in modules):
         return None
@@ -152,28 +179,36 @@ def _implicit() -> tuple[set[str], set[str]] | None:
 
 
 def _current(index: dict) -> bool:
-    """Whether every stamp of ``index`` holds (the module docs' rule)."""
+    """Whether every stamp of ``index`` holds (the module docs' rule); an index holding no
+    file stamp is not (every value is computed by modules, whose files are stamped)."""
+    if not index["files"]:
+        return False
     for path, stamp in index["files"]:
         if _file_stamp(path) != stamp:
             return False
     for path, stamp in index["folders"]:
         if _folder_stamp(path) != stamp:
             return False
+    for path, stamp in index["paths"]:
+        if _path_stamp(path) != stamp:
+            return False
     return True
 
 
-def _read(path: Path) -> dict | None:
-    """The index in the file ``path`` if it is current (its value under ``"value"``), else None."""
+def _read(path: Path, valid: Callable[[Any], bool]) -> dict | None:
+    """The index in the file ``path`` if it is current and ``valid`` accepts its value (under
+    ``"value"``), else None."""
     try:
         index = json.loads(path.read_bytes())
         if index.get("format") != FORMAT or "value" not in index or not _current(index):
             return None
-        return index
-    except (OSError, ValueError, TypeError, KeyError, AttributeError):
+        return index if valid(index["value"]) else None
+    except (OSError, ValueError, TypeError, KeyError, AttributeError, IndexError):
         return None  # absent, unreadable or not an index of ours: compute
 
 
-def stamped_value(name: str, build: Callable[[], Built]) -> Any:
+def stamped_value(name: str, build: Callable[[], Built],
+                  valid: Callable[[Any], bool] = lambda value: True) -> Any:
     """``build()``'s value, from the index if it is current, else computed (and kept).
 
     Parameters
@@ -185,6 +220,10 @@ def stamped_value(name: str, build: Callable[[], Built]) -> Any:
         lists, str, numbers; tuples come back as lists), the files it read and the folders it
         listed, beyond the modules it imported (which are recorded anyway).  An exception it
         raises propagates, and nothing is written.
+    valid : callable, optional
+        ``valid(value) -> bool`` of a kept value, before it is returned: a value of another
+        shape (an index edited by hand, or written by another version under the same format)
+        is computed again instead of failing the caller.
 
     Returns
     -------
@@ -194,7 +233,7 @@ def stamped_value(name: str, build: Callable[[], Built]) -> Any:
     folder = index_folder()
     path = None if folder is None else folder / _key(name)
     if path is not None:
-        index = _read(path)
+        index = _read(path, valid)
         if index is not None:
             return index["value"]
     value, files, folders = build()
@@ -204,18 +243,21 @@ def stamped_value(name: str, build: Callable[[], Built]) -> Any:
     implicit = _implicit()
     if implicit is None:
         return value
-    implicit_files, implicit_folders = implicit
+    implicit_files, path_folders = implicit
     file_names = {os.path.abspath(os.fspath(f)) for f in files} | implicit_files
-    folder_names = {os.path.abspath(os.fspath(f)) for f in folders} | implicit_folders
+    folder_names = {os.path.abspath(os.fspath(f)) for f in folders}
     stamps_f = sorted([f, _file_stamp(f)] for f in file_names)
     stamps_d = sorted([d, _folder_stamp(d)] for d in folder_names)
+    stamps_p = sorted([d, _path_stamp(d)] for d in path_folders)
+    # (modification times: a status-change time is "now" after any chmod or utime)
     newest = max([s[1] for _, s in stamps_f if s is not None]
-                 + [s for _, s in stamps_d if s is not None], default=0)
+                 + [s[0] for _, s in stamps_d if s is not None], default=0)
     if newest / 1e9 > _IMPORTED_AT - RACY_S or time.time() - _IMPORTED_AT > WRITE_WITHIN_S:
         return value  # a stamp too young to trust, or modules read too long ago: not kept
     try:
         atomic_write_text(path, json.dumps({"format": FORMAT, "name": name, "files": stamps_f,
-                                            "folders": stamps_d, "value": value}))
+                                            "folders": stamps_d, "paths": stamps_p,
+                                            "value": value}))
     except (OSError, TestbedError):
         pass  # no room, a read-only cache: the index only ever saves time
     return value

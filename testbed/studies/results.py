@@ -154,8 +154,11 @@ def write_part(path: str | os.PathLike, row: dict[str, Any]) -> Path:
     """Write one finished row atomically as ``<path>.parts/<cell>.json``, with its checksum
     (:func:`row_digest`); return the file."""
     out = parts_dir(path) / f"{row['cell']}.json"
-    row = {**row, DIGEST: row_digest(row)}
-    atomic_write_text(out, json.dumps(row, sort_keys=True))  # NaN as the JSON extension NaN
+    row = {k: v for k, v in row.items() if k != DIGEST}
+    # the checksum of the values as the file holds them (JSON's, as its reader gets them back)
+    text = json.dumps(row, sort_keys=True)  # NaN as the JSON extension NaN
+    row[DIGEST] = row_digest(json.loads(text))
+    atomic_write_text(out, json.dumps(row, sort_keys=True))
     return out
 
 
@@ -256,13 +259,16 @@ def write_rows(path: str | os.PathLike, rows: Iterable[dict[str, Any]], *,
 
     Rows are sorted by scenario, noise, seed and identifier; score columns are
     the union over rows, NaN where a row has none.  Each row is written with its checksum
-    (:func:`row_digest`, computed here from its values).
+    (:func:`row_digest`), computed here from the values as the table holds them (a numpy
+    scalar or an integral float is hashed as the Arrow value it becomes, as its reader gets it).
     """
-    rows = sorted(({**r, DIGEST: row_digest(r)} for r in rows), key=_sort_key)
+    rows = sorted(({k: v for k, v in r.items() if k != DIGEST} for r in rows), key=_sort_key)
     keys = [r["cell"] for r in rows]
     if len(set(keys)) != len(keys):
         raise ValueError("write_rows: a cell appears more than once")
     table = _to_table(rows, study)
+    digests = pa.array([row_digest(r) for r in table.to_pylist()], pa.string())
+    table = table.set_column(table.schema.get_field_index(DIGEST), DIGEST, digests)
     path = Path(path)
     atomic_write(path, lambda tmp: pq.write_table(table, tmp))
     return path

@@ -197,3 +197,74 @@ def test_the_index_folder(monkeypatch, tmp_path):
     assert stamped.index_folder() is None
     monkeypatch.setenv(stamped.INDEX_VARIABLE, "")
     assert stamped.index_folder() is None
+
+
+def test_a_file_replaced_by_one_of_the_same_size_and_time_is_computed_again(index, tmp_path):
+    # `cp -p`, `rsync -t`, `touch -r`: same size and modification time, another content; the
+    # status-change time (which no user sets) tells
+    data = _setup(tmp_path)
+    build, calls = _counting(data)
+    stamped.stamped_value("t", build)
+    st = os.stat(data / "a.txt")
+    deadline = time.monotonic() + 5.0  # the file system's time resolution: up to 2 s (FAT)
+    while os.stat(data / "a.txt").st_ctime_ns == st.st_ctime_ns and time.monotonic() < deadline:
+        time.sleep(0.02)
+        (data / "a.txt").write_text("omega")  # as long as "alpha"
+        os.utime(data / "a.txt", ns=(st.st_atime_ns, st.st_mtime_ns))
+    os.utime(data, ns=(os.stat(data).st_atime_ns, os.stat(data).st_mtime_ns))
+    assert stamped.stamped_value("t", build) == {"a.txt": "omega"}
+    assert len(calls) == 2
+
+
+def test_a_kept_value_the_caller_refuses_is_computed_again(index, tmp_path):
+    # an index of the right format whose value has another shape (edited by hand) was the
+    # caller's TypeError on every `testbed list` until a stamp changed (review, 2026-11-27)
+    data = _setup(tmp_path)
+    build, calls = _counting(data)
+    valid = lambda v: isinstance(v, dict) and all(isinstance(x, str) for x in v.values())  # noqa: E731
+    stamped.stamped_value("t", build, valid)
+    (kept,) = index.iterdir()
+    doc = __import__("json").loads(kept.read_text())
+    doc["value"] = {"a.txt": 5}
+    kept.write_text(__import__("json").dumps(doc))
+    assert stamped.stamped_value("t", build, valid) == {"a.txt": "alpha"}
+    doc["value"], doc["files"] = {"a.txt": "forged"}, []  # no stamps: never current
+    kept.write_text(__import__("json").dumps(doc))
+    assert stamped.stamped_value("t", build, valid) == {"a.txt": "alpha"}
+    assert len(calls) == 3
+
+
+def test_the_working_folder_keys_the_index(index, tmp_path, monkeypatch):
+    # a relative TESTBED_SCENARIOS names another folder in another working folder: under the
+    # console script no sys.path entry stands for it, and folder B printed folder A's scenarios
+    data = _setup(tmp_path)
+    build, calls = _counting(data)
+    monkeypatch.chdir(tmp_path)
+    stamped.stamped_value("t", build)
+    stamped.stamped_value("t", build)
+    other = tmp_path / "other"
+    other.mkdir()
+    monkeypatch.chdir(other)
+    stamped.stamped_value("t", build)
+    assert len(calls) == 2 and len(list(index.iterdir())) == 2
+
+
+def test_a_folder_on_the_path_holds_while_its_distributions_do(index, tmp_path, monkeypatch):
+    # the project's own folder is on sys.path: a file a run writes there (out/, a log) made
+    # every listing afresh; a distribution or path file added or removed must not be missed
+    data = _setup(tmp_path)
+    site = tmp_path / "site"
+    site.mkdir()
+    monkeypatch.setattr(stamped, "_implicit", lambda: ({str(data / "a.txt")}, {str(site)}))
+    build, calls = _counting(data)
+    stamped.stamped_value("t", build)
+    (site / "MUJOCO_LOG.TXT").write_text("")
+    (site / "out").mkdir()
+    stamped.stamped_value("t", build)
+    assert len(calls) == 1
+    (site / "extra.pth").write_text(str(tmp_path))
+    stamped.stamped_value("t", build)
+    assert len(calls) == 2
+    (site / "pkg-1.0.dist-info").mkdir()
+    stamped.stamped_value("t", build)
+    assert len(calls) == 3

@@ -146,3 +146,17 @@ def test_a_results_file_of_format_1_is_read_without_checksums(tmp_path):
     pq.write_table(table.replace_schema_metadata(meta), res)
     with pytest.raises(ValueError, match="no column 'row_sha256'"):
         read_results(res)
+
+
+def test_rows_of_numpy_values_are_written_with_the_checksum_their_reader_computes(tmp_path):
+    # write_rows hashed the Python values given, not what Arrow stores: a numpy seed, score,
+    # passed or noise, or a seed of 3.0, made a file its own reader called damaged (review)
+    import numpy as np
+
+    res = tmp_path / "r.parquet"
+    r = row("c1", trac=np.float32(0.9), noise=np.float32(1.5))
+    r.update(seed=np.int64(3), passed=np.bool_(False))
+    write_rows(res, [r, row("c2", seed=3.0, trac=0.5)], study="t")
+    got = {x["cell"]: x for x in read_results(res)}
+    assert got["c1"]["seed"] == 3 and got["c1"]["trac"] == float(np.float32(0.9))
+    assert got["c2"]["seed"] == 3
