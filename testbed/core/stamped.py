@@ -25,10 +25,10 @@ The rule (stated here, applied by :func:`_current`):
 - the recorded files are those the caller names (the scenario files read) **plus the file of
   every module loaded in the process** when the value was computed (the project's modules, a
   plugin package's, numpy's ...); the folders are those the caller names (the registries'
-  packages, the scenario folder) **plus every folder on** ``sys.path`` (by the rule above); and every installed
-  distribution's ``entry_points.txt`` is recorded as a file (present or absent), so an entry
-  point added, removed or edited shows at once; a module loaded from no file of its own (a zip
-  archive) cannot be stamped, and no index is written;
+  packages, the scenario folder) **plus every folder on** ``sys.path`` (by the rule above);
+  and every installed distribution's ``entry_points.txt`` is recorded as a file (present or
+  absent), so an entry point added, removed or edited shows at once; a module loaded from no
+  file of its own (a zip archive) cannot be stamped, and no index is written;
 - an index is **keyed** by the interpreter (``sys.executable``, its version), ``sys.path``
   (``""`` as the working folder it stands for), the working folder (a relative
   ``TESTBED_SCENARIOS`` names another folder in another one) and the ``TESTBED_*`` variables:
