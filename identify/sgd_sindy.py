@@ -53,7 +53,7 @@ from typing import ClassVar
 import numpy as np
 
 from identify import IDENTIFIERS
-from identify._cubic_rule import cubic_rule
+from identify._cubic_rule import THIRD_HARMONIC_IN, cubic_rule
 from identify._modal_damping import decay_hold
 from identify._sgd_matrix import (
     MatrixSGDResult,
@@ -800,6 +800,9 @@ class SGDSINDy(SGDSINDyBase):
     drift_coef_ : ndarray, shape (n, n_drift)
         Only when the measurement declares a ``drift_basis``: the coefficients [N per unit of
         the basis] of its rows, fitted with the model (before ``decay_hold``) and dropped.
+    hardened_peak_rule_ : str
+        Whether the lowest peak was left out of the eigenvalue targets as the lowest mode's
+        amplitude-hardened frequency, and why (:meth:`_hardened_peak_targets`).
     eigen_backbone_rule_ : str
         What ``eigen_backbone`` did: which peaks were replaced by which backbone linear
         frequencies, or why none was.
@@ -990,6 +993,7 @@ class SGDSINDy(SGDSINDyBase):
         self
         """
         lam_hat, band_peaks = self._start_fit(data)
+        lam_hat = self._hardened_peak_targets(lam_hat)
         m_hat = mass_prior_value(data, self.mass_prior)
         est = self.settings()
         if self.keep_sgd is False:
@@ -1037,6 +1041,42 @@ class SGDSINDy(SGDSINDyBase):
         self.keep_sgd_, self.keep_sgd_rule_ = keep, rule
         self.record_agreement_ = {"sgd": a_sgd, "warm_start": a_warm}
         return self
+
+    def _hardened_peak_targets(self, lam_hat: np.ndarray) -> np.ndarray:
+        """The eigenvalue targets without the lowest peak where the cubic came in by its third
+        harmonic; sets ``hardened_peak_rule_``.
+
+        Rule: where the cubic rule (by rule, ``cubic`` unset) put the cubic in by rule (4),
+        a third harmonic of the lowest accepted peak (:data:`identify._cubic_rule.THIRD_HARMONIC_IN`
+        in ``cubic_rule_``), that harmonic is the rule's witness that the peak is the lowest
+        mode's amplitude-hardened frequency, above its linear one.  The peak is then no target
+        of the eigenvalue penalty or of ``eigen_hold`` (nor of ``eigen_backbone``'s
+        replacement): the mode keeps the fit's frequency, as ``ls_sindy`` keeps it with the
+        cubic library (``eigen_rule_``).  Every other peak stays a target.  Measured
+        2026-11-27 (round 13, ``b13_soft_r0p2_al_hmid_s2`` at 1 %: mode 1's peak 18.31 Hz
+        against 17.44 Hz linear; held there, mode 1 +4.4 %, TRAC 0.54; ``ls_sindy`` without a
+        hold 0.0 %, TRAC 0.99).
+
+        Parameters
+        ----------
+        lam_hat : ndarray, shape (k,)
+            The targets :meth:`_start_fit` returned, in ``measured_frequencies_``' order.
+
+        Returns
+        -------
+        ndarray, shape (k,) or (k - 1,)
+        """
+        f = np.asarray(getattr(self, "measured_frequencies_", np.empty(0)), dtype=float)
+        if not (self.cubic is None and self.cubic_ and THIRD_HARMONIC_IN in self.cubic_rule_
+                and f.size and f.size == np.size(lam_hat)):
+            self.hardened_peak_rule_ = ("every measured peak is a target (the cubic did not come "
+                                        "in by the lowest peak's third harmonic)")
+            return lam_hat
+        low = int(np.argmin(f))
+        self.hardened_peak_rule_ = (f"the lowest peak ({f[low]:.4g} Hz) is no eigenvalue target: "
+                                    "the cubic came in by its third harmonic, the witness that it "
+                                    "is the mode's amplitude-hardened frequency (the fit's kept)")
+        return np.delete(np.asarray(lam_hat, dtype=float), low)
 
     def _set_model(self, data: Measurement, est: MatrixSGDSettings, out: MatrixSGDResult,
                    band_peaks: np.ndarray | None) -> None:
