@@ -11,7 +11,7 @@ families (``studies/families.toml``) do not draw: soft bases with ``base_k1`` be
 k1``, the families' own ``peak_base_rotation`` estimate) beyond its 0-0.6 (0.65-1.0) or far
 below it (0.05); a polyamide (nylon: E 2.7 GPa, 1140 kg/m^3) and a polymer beam of 5.7 Hz,
 aluminium thin-and-wide (60 x 4 mm), a titanium square (15 x 15 mm), a tall steel section
-(10 mm wide, 30 mm tall, mode 2 at 1.75 kHz); 8-24 segments; 2-6 sensors at positions the
+(10 mm wide, 30 mm tall, mode 2 at 1.75 kHz); 9-24 segments; 2-6 sensors at positions the
 families' Dirichlet draw does not put them (no tip sensor, clusters at 0.3-0.6 L, five
 unevenly spaced); the hammer at mid-span and at 90 % of the length (it must land on a sensor);
 5-15 s records.  Noise 1 / 2 % and seeds 41-44 are the studies' (round13_beams_noise*.toml).
@@ -138,12 +138,13 @@ CASES: dict[str, tuple[str, dict, dict, dict, dict]] = {
                             {**PA, "length": 0.65, "width": 0.04, "n_segments": 16, "damping_ratio": 0.02,
                              "sensors": [0.2, 0.35, 0.5, 0.65]}, sim(duration=15.0),
                             {"start": 0.5}, {"highpass_hz": "auto"}),
-    "b13_al_n8_hmid": ("aluminium 0.3175 m x 30 x 10 mm, 9 segments, sensors at 0.5 / 0.75 / 1.0 L, "
+    "b13_al_n9_hmid": ("aluminium 0.3175 m x 30 x 10 mm, 9 segments, sensors at 0.5 / 0.75 / 1.0 L, "
                        "hammer at mid-span",
                        {**_AL_MID, "n_segments": 9, "sensors": [at(0.5), at(0.75), L]}, sim(),
                        {"location": at(0.5)}, {}),
     "b13_st_h0p9_notip": ("the shipped beam, sensors at 0.3 / 0.6 / 0.9 L (none at the tip), hammer at "
-                          "0.9 L", {"sensors": [at(0.3), at(0.6), at(0.9)]}, sim(), {"location": at(0.9)}, {}),
+                          "0.9 L", {"sensors": [at(0.3), at(0.6), at(0.9)]}, sim(),
+                          {"location": at(0.9)}, {}),
     "b13_ti_h0p9_s2_n16": ("titanium 0.4 m x 30 x 10 mm, 16 segments, sensors at 0.45 L and 0.9 L, hammer "
                            "at 0.9 L", {**TI, "length": 0.4, "n_segments": 16, "sensors": [0.18, 0.36]},
                            sim(), {"location": 0.36}, {}),
