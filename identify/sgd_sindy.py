@@ -504,7 +504,9 @@ class SGDSINDy(SGDSINDyBase):
         (:func:`identify._sgd_matrix.eigen_targets`: within 15 %, in mode order) into that
         peak's band, one line of the window's transform (``fs / N``) either side, by the
         smallest change of K that keeps the modes (:func:`identify._sgd_matrix.hold_eigenvalues`);
-        applied to the result.  Acts only with ``eigen`` and a paired peak.
+        applied to the result.  Acts only with ``eigen`` and a paired peak.  A lowest peak
+        whose third harmonic put the cubic in bounds its mode from above only
+        (``hardened_peak_rule_``).
     decay_hold : bool
         Give each mode the pole fitted to that mode's measured free decay (modal
         accelerations ``Phi^-1 x''`` of the result's own modes, least-squares
