@@ -13,7 +13,8 @@ UNSEEN = Path(__file__).resolve().parents[2] / "benchmarks" / "unseen"
 
 
 @pytest.mark.parametrize(("name", "cells"), [
-    ("round13_beams", 44), ("round13_beams_noise", 40), ("round13_beams_noise_clamped", 48),
+    ("round13_beams", 44), ("round13_beams_noise", 40), ("round13_beams_noise_s42", 20),
+    ("round13_beams_noise_clamped", 48),
     ("round13_linkages_sine", 12), ("round13_linkages_masses", 12), ("round13_linkages_clean", 4),
     ("round13_linkages_cartpoles", 9), ("round13_linkages_kinetics", 9)])
 def test_round13_studies_load(name, cells):
