@@ -100,6 +100,11 @@ CUBIC_SELECT_CORR = 0.65
 #: reach +0.60 %, member 019); a shift of 0.7 % of a mode's frequency is 4.4 rad of phase over
 #: 100 periods.
 CUBIC_CHIRP_MIN = 0.007
+#: The words rule (4)'s reason (:func:`_third_harmonic_rule`) puts the cubic in with: a caller
+#: that must know the cubic came in by the lowest peak's third harmonic, the witness that this
+#: peak is an amplitude-hardened frequency (``sgd_sindy``'s ``hardened_peak_rule_``), reads them
+#: in ``cubic_rule_``.
+THIRD_HARMONIC_IN = "the peak search recognised a third harmonic of the lowest peak"
 
 
 def cubic_partial_correlation(lib: Library) -> float:
@@ -253,6 +258,6 @@ def _third_harmonic_rule(data: Measurement, peaks: np.ndarray | None, head: str,
     if not third:
         return False, f"{head}, no third harmonic of the lowest peak recognised: cubic terms out"
     fh, ff = third[0]
-    return True, (f"{head}, but the peak search recognised a third harmonic of the lowest peak "
+    return True, (f"{head}, but {THIRD_HARMONIC_IN} "
                   f"({fh:.4g} Hz = 3 x {ff:.4g} Hz, phase-locked, in its shape): an odd "
                   "restoring force: cubic terms in")

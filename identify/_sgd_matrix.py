@@ -369,7 +369,7 @@ def backbone_targets(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndar
 
 
 def hold_eigenvalues(L: np.ndarray, P: np.ndarray, m0: float, k0: float, target: np.ndarray,
-                     band: float = 0.0) -> float:
+                     band: float = 0.0, upper_only: np.ndarray | None = None) -> float:
     """Move each targeted eigenvalue of ``(K, M)`` into its target's band, in place on ``P``.
 
     The band of a target ``lam_hat = (2 pi f_hat)^2`` is ``[(2 pi (f_hat - band))^2,
@@ -380,6 +380,8 @@ def hold_eigenvalues(L: np.ndarray, P: np.ndarray, m0: float, k0: float, target:
     ``lam_new``: the smallest change of K in the modal metric that meets the constraints, the
     limit of the eigenvalue penalty (Eqs 8-13) at infinite weight outside the band.  K stays
     symmetric, and positive semi-definite when it was (the bands are positive).
+    ``upper_only`` (bool, shape of ``target``): those targets bound their eigenvalues from
+    above only (the band's lower edge is 0: an eigenvalue below the band is left alone).
 
     Returns
     -------
@@ -394,6 +396,8 @@ def hold_eigenvalues(L: np.ndarray, P: np.ndarray, m0: float, k0: float, target:
     f_hat = np.sqrt(np.where(on, target, 0.0)) / (2.0 * np.pi)
     lo = (2.0 * np.pi * np.maximum(f_hat - band, 0.5 * f_hat)) ** 2
     hi = (2.0 * np.pi * (f_hat + band)) ** 2
+    if upper_only is not None:
+        lo = np.where(upper_only, 0.0, lo)
     new = np.where(on, np.clip(lam, lo, hi), lam)
     if np.all(new == lam):
         return 0.0
@@ -734,7 +738,8 @@ def fit_window(data: Measurement, fit_duration: float) -> tuple[int, int]:
 def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
                    lam_hat: np.ndarray,
                    progress: Callable[[float | None, str | None], None] | None = None,
-                   peaks: np.ndarray | None = None, with_warm: bool = False) -> MatrixSGDResult:
+                   peaks: np.ndarray | None = None, with_warm: bool = False,
+                   ceiling: np.ndarray | None = None) -> MatrixSGDResult:
     """Run the matrix-parametrised SGD.
 
     Parameters
@@ -757,6 +762,11 @@ def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
         Also return the held warm start (``MatrixSGDResult.warm``): the state the epochs start
         from, finished (hold, projection, nuisance coefficients) exactly as with ``epochs = 0``,
         without fitting it again.  Only with ``init = "lstsq"`` and ``epochs > 0``.
+    ceiling : ndarray, optional
+        Entries of ``lam_hat`` [rad^2/s^2] that bound their modes from above only: the hold
+        (``eigen_hold``) moves a mode paired with one down into its band when it lies above,
+        and leaves it where it lies below (``hold_eigenvalues``' ``upper_only``; ``sgd_sindy``'s
+        ``hardened_peak_rule_``).  The eigenvalue penalty targets them as every peak.
 
     Returns
     -------
@@ -1054,7 +1064,9 @@ def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
         held, rule = 0.0, backbone_rule
         if hold:
             target = eigen_targets(m0 * (L @ L.T), k0 * _sym(P), lam_meas, True)
-            held = hold_eigenvalues(L, P, m0, k0, target, band)
+            upper = (target > 0) & np.isin(target, np.asarray(
+                ceiling if ceiling is not None else [], dtype=float))
+            held = hold_eigenvalues(L, P, m0, k0, target, band, upper)
         if hold and np.any(moved) and not np.any(R != 0.0):
             # the cubic was dropped: a linear model at the linear frequencies oscillates below
             # the record at its large amplitudes, so the moved modes go onto their peaks

@@ -53,7 +53,7 @@ from typing import ClassVar
 import numpy as np
 
 from identify import IDENTIFIERS
-from identify._cubic_rule import cubic_rule
+from identify._cubic_rule import THIRD_HARMONIC_IN, cubic_rule
 from identify._modal_damping import decay_hold
 from identify._sgd_matrix import (
     MatrixSGDResult,
@@ -504,7 +504,9 @@ class SGDSINDy(SGDSINDyBase):
         (:func:`identify._sgd_matrix.eigen_targets`: within 15 %, in mode order) into that
         peak's band, one line of the window's transform (``fs / N``) either side, by the
         smallest change of K that keeps the modes (:func:`identify._sgd_matrix.hold_eigenvalues`);
-        applied to the result.  Acts only with ``eigen`` and a paired peak.
+        applied to the result.  Acts only with ``eigen`` and a paired peak.  A lowest peak
+        whose third harmonic put the cubic in bounds its mode from above only
+        (``hardened_peak_rule_``).
     decay_hold : bool
         Give each mode the pole fitted to that mode's measured free decay (modal
         accelerations ``Phi^-1 x''`` of the result's own modes, least-squares
@@ -800,6 +802,9 @@ class SGDSINDy(SGDSINDyBase):
     drift_coef_ : ndarray, shape (n, n_drift)
         Only when the measurement declares a ``drift_basis``: the coefficients [N per unit of
         the basis] of its rows, fitted with the model (before ``decay_hold``) and dropped.
+    hardened_peak_rule_ : str
+        Whether the lowest peak bounds its mode from above only (the lowest mode's
+        amplitude-hardened frequency) in the hold, and why (:meth:`_hardened_peak_ceiling`).
     eigen_backbone_rule_ : str
         What ``eigen_backbone`` did: which peaks were replaced by which backbone linear
         frequencies, or why none was.
@@ -990,13 +995,14 @@ class SGDSINDy(SGDSINDyBase):
         self
         """
         lam_hat, band_peaks = self._start_fit(data)
+        ceiling = self._hardened_peak_ceiling(lam_hat)
         m_hat = mass_prior_value(data, self.mass_prior)
         est = self.settings()
         if self.keep_sgd is False:
             est = dataclasses.replace(est, epochs=0)
         by_rule = self.keep_sgd is None and est.epochs > 0 and est.init == "lstsq"
         out = fit_matrix_sgd(data, est, m_hat, lam_hat, progress=self.report_progress,
-                             peaks=band_peaks, with_warm=by_rule)
+                             peaks=band_peaks, with_warm=by_rule, ceiling=ceiling)
         # whichever model is kept below, what stopped the SGD stays on record
         self.sgd_stop_rule_ = out.stop_rule or "every epoch ran"
         started = dict(self.__dict__)
@@ -1037,6 +1043,46 @@ class SGDSINDy(SGDSINDyBase):
         self.keep_sgd_, self.keep_sgd_rule_ = keep, rule
         self.record_agreement_ = {"sgd": a_sgd, "warm_start": a_warm}
         return self
+
+    def _hardened_peak_ceiling(self, lam_hat: np.ndarray) -> np.ndarray:
+        """The eigenvalue targets the hold treats as upper bounds only; sets
+        ``hardened_peak_rule_``.
+
+        Rule: where the cubic rule (by rule, ``cubic`` unset) put the cubic in by rule (4), a
+        third harmonic of the lowest accepted peak (:data:`identify._cubic_rule.THIRD_HARMONIC_IN`
+        in ``cubic_rule_``), that harmonic is the rule's witness that the peak is the lowest
+        mode's amplitude-hardened frequency, above its linear one: the peak bounds the linear
+        frequency from above, not from below.  ``eigen_hold`` then moves that mode down into
+        the peak's band when it lies above it (as before) and leaves it where it lies below
+        (:func:`identify._sgd_matrix.hold_eigenvalues`, ``upper_only``); every other peak,
+        and the eigenvalue penalty, as before.  Measured 2026-11-27: round 13's
+        ``b13_soft_r0p2_al_hmid_s2`` at 1 % (peak 18.31 Hz, linear 17.44 Hz): held onto the
+        peak, mode 1 +4.4 %, TRAC 0.54; ``ls_sindy`` (no hold with the cubic library) 0.0 %.
+        A two-sided release (the peak no target at all) lost round 12's
+        ``b12_soft_tip_cluster_s2`` at 2-3 % (the fit's mode 1 40.72 Hz above the peak 39.99,
+        true 39.57: +2.9 %), which the one-sided bound keeps.
+
+        Parameters
+        ----------
+        lam_hat : ndarray, shape (k,)
+            The targets :meth:`_start_fit` returned, in ``measured_frequencies_``' order.
+
+        Returns
+        -------
+        ndarray, shape (0,) or (1,)
+            The lowest peak's target [rad^2/s^2] where the rule fires, else empty.
+        """
+        f = np.asarray(getattr(self, "measured_frequencies_", np.empty(0)), dtype=float)
+        if not (self.cubic is None and self.cubic_ and THIRD_HARMONIC_IN in self.cubic_rule_
+                and f.size and f.size == np.size(lam_hat)):
+            self.hardened_peak_rule_ = ("every measured peak holds its mode from both sides (the "
+                                        "cubic did not come in by the lowest peak's third harmonic)")
+            return np.empty(0)
+        low = int(np.argmin(f))
+        self.hardened_peak_rule_ = (f"the lowest peak ({f[low]:.4g} Hz) bounds its mode from above "
+                                    "only: the cubic came in by its third harmonic, the witness "
+                                    "that it is the mode's amplitude-hardened frequency")
+        return np.asarray(lam_hat, dtype=float)[[low]]
 
     def _set_model(self, data: Measurement, est: MatrixSGDSettings, out: MatrixSGDResult,
                    band_peaks: np.ndarray | None) -> None:
