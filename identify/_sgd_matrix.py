@@ -644,6 +644,9 @@ class MatrixSGDResult:
     stop_rule : str
         Why the epochs ended before ``epochs`` (:data:`BREAKDOWN_RULE`), or ``""`` when all
         ran; the history then ends at the last epoch that left a finite iterate.
+    ceiling_held : bool
+        Whether the hold bounded a mode from above only (``ceiling``): False when none was
+        asked, the hold is off, or ``eigen_backbone`` replaced the peak.
     """
 
     M: np.ndarray
@@ -664,6 +667,7 @@ class MatrixSGDResult:
     backbone_rule: str = ""
     warm: MatrixSGDResult | None = None
     stop_rule: str = ""
+    ceiling_held: bool = False
 
 
 #: The rule when an epoch's steps leave a non-finite iterate (round 12's
@@ -762,11 +766,13 @@ def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
         Also return the held warm start (``MatrixSGDResult.warm``): the state the epochs start
         from, finished (hold, projection, nuisance coefficients) exactly as with ``epochs = 0``,
         without fitting it again.  Only with ``init = "lstsq"`` and ``epochs > 0``.
-    ceiling : ndarray, optional
-        Entries of ``lam_hat`` [rad^2/s^2] that bound their modes from above only: the hold
+    ceiling : ndarray of bool, shape (k,), optional
+        The entries of ``lam_hat`` that bound their modes from above only: the hold
         (``eigen_hold``) moves a mode paired with one down into its band when it lies above,
         and leaves it where it lies below (``hold_eigenvalues``' ``upper_only``; ``sgd_sindy``'s
-        ``hardened_peak_rule_``).  The eigenvalue penalty targets them as every peak.
+        ``hardened_peak_rule_``).  The eigenvalue penalty targets them as every peak.  An entry
+        ``eigen_backbone`` replaces by its backbone's linear frequency is no longer a peak and
+        is held from both sides (``MatrixSGDResult.ceiling_held`` says what was done).
 
     Returns
     -------
@@ -916,6 +922,8 @@ def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
     # the target of each mode (ascending; 0 = none), paired on the current modes (eigen_targets)
     lam_meas = lam_peaks = np.asarray(lam_hat, dtype=float)
     moved = np.zeros(lam_meas.size, bool)
+    ceiling = (np.zeros(lam_meas.size, bool) if ceiling is None
+               else np.asarray(ceiling, dtype=bool).reshape(lam_meas.shape))
     backbone_rule = "eigen_backbone = False" if not est.eigen_backbone else (
         "no cubic library" if not est.cubic else "no measured peak")
     if est.cubic and est.eigen_backbone and lam_meas.size:
@@ -928,6 +936,9 @@ def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
     target = eigen_targets(m0 * (L @ L.T), k0 * _sym(P), lam_meas, True)
     lam_hat = np.ascontiguousarray(target)
     hold = bool(est.eigen_hold) and bool(np.any(target > 0))
+    # the peaks bounding from above only: those the backbone left peaks (matched by value below:
+    # eigen_targets returns lam_meas's own entries, so the comparison is exact)
+    ceiling_values = lam_meas[ceiling & ~moved]
     # A spectral peak of the window locates its mode to about one line of the window's
     # transform (fs / N): the leakage of the neighbouring modes and the damping move the peak
     # of a decaying response by a fraction of a line.  Within that band the data decide.
@@ -1062,10 +1073,10 @@ def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
         hold, the damping's projection, the physical matrices and the nuisance coefficients;
         ``target`` the modes' targets when nothing is held."""
         held, rule = 0.0, backbone_rule
+        upper = np.zeros(0, bool)
         if hold:
             target = eigen_targets(m0 * (L @ L.T), k0 * _sym(P), lam_meas, True)
-            upper = (target > 0) & np.isin(target, np.asarray(
-                ceiling if ceiling is not None else [], dtype=float))
+            upper = (target > 0) & np.isin(target, ceiling_values)
             held = hold_eigenvalues(L, P, m0, k0, target, band, upper)
         if hold and np.any(moved) and not np.any(R != 0.0):
             # the cubic was dropped: a linear model at the linear frequencies oscillates below
@@ -1113,7 +1124,8 @@ def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
                                input_map=input_map, drift_coef=G[:, n_u:],
                                eigen_targets=np.sqrt(target) / (2.0 * np.pi), eigen_shift=held,
                                fit_tilt=tilted, fit_tilt_rule=tilt_rule,
-                               input_map_record=input_map_record, backbone_rule=rule)
+                               input_map_record=input_map_record, backbone_rule=rule,
+                               ceiling_held=bool(np.any(upper)))
 
     out = dataclasses.replace(finish(L, P, Q, R, target, guard, n_steps, alpha,
                                      {k: np.asarray(v) for k, v in hist.items()}),

@@ -1003,6 +1003,11 @@ class SGDSINDy(SGDSINDyBase):
         by_rule = self.keep_sgd is None and est.epochs > 0 and est.init == "lstsq"
         out = fit_matrix_sgd(data, est, m_hat, lam_hat, progress=self.report_progress,
                              peaks=band_peaks, with_warm=by_rule, ceiling=ceiling)
+        if np.any(ceiling) and not out.ceiling_held:  # the rule as it acted, not as asked
+            self.hardened_peak_rule_ += (
+                "; not applied: " + ("eigen_backbone replaced the peak by its backbone's linear "
+                                     "frequency, held from both sides" if est.eigen_backbone
+                                     and est.eigen_hold else "the hold is off"))
         # whichever model is kept below, what stopped the SGD stays on record
         self.sgd_stop_rule_ = out.stop_rule or "every epoch ran"
         started = dict(self.__dict__)
@@ -1069,20 +1074,20 @@ class SGDSINDy(SGDSINDyBase):
 
         Returns
         -------
-        ndarray, shape (0,) or (1,)
-            The lowest peak's target [rad^2/s^2] where the rule fires, else empty.
+        ndarray of bool, shape (k,)
+            True at the lowest peak where the rule fires (``fit_matrix_sgd``'s ``ceiling``).
         """
         f = np.asarray(getattr(self, "measured_frequencies_", np.empty(0)), dtype=float)
         if not (self.cubic is None and self.cubic_ and THIRD_HARMONIC_IN in self.cubic_rule_
                 and f.size and f.size == np.size(lam_hat)):
             self.hardened_peak_rule_ = ("every measured peak holds its mode from both sides (the "
                                         "cubic did not come in by the lowest peak's third harmonic)")
-            return np.empty(0)
+            return np.zeros(np.size(lam_hat), bool)
         low = int(np.argmin(f))
         self.hardened_peak_rule_ = (f"the lowest peak ({f[low]:.4g} Hz) bounds its mode from above "
                                     "only: the cubic came in by its third harmonic, the witness "
                                     "that it is the mode's amplitude-hardened frequency")
-        return np.asarray(lam_hat, dtype=float)[[low]]
+        return np.arange(f.size) == low
 
     def _set_model(self, data: Measurement, est: MatrixSGDSettings, out: MatrixSGDResult,
                    band_peaks: np.ndarray | None) -> None:
