@@ -125,3 +125,19 @@ def test_summary_and_report_count_an_infinite_score_and_say_how_many_cells_a_med
     print_summary(res2, console=Console(file=buf, width=100))
     assert " of 2 cells" not in buf.getvalue()
     json.dumps(summarize(res2))  # (plain values)
+
+
+# ------------------------------------------------------------------ paths that name nothing
+
+@pytest.mark.parametrize("argv", [["runs", "ls", "-o", "x" * 5000],
+                                  ["report", "michaelis_menten", "--runs", "x" * 5000, "-o", "rep"],
+                                  ["report", "x" * 5000, "-o", "rep"]])
+def test_a_run_history_path_too_long_for_the_file_system_is_one_line(argv, tmp_path, monkeypatch,
+                                                                     capsys):
+    from testbed.cli import main
+
+    # Path.exists / is_dir raised OSError 36 ("File name too long"): an internal error
+    monkeypatch.chdir(tmp_path)
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "a file name too long for the file system" in err
