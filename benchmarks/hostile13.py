@@ -28,6 +28,11 @@ Families (where rounds 1-12 went least):
     finite ones, only failed cells, one row: ``testbed summary`` and ``testbed report``.  A
     median other than the quartiles of the ok cells' values with the infinities counted, or a
     median over fewer cells than ran without saying how many, is a finding.
+``types``
+    Every key at every depth of six shipped scenarios (the four rigs, a replayed
+    five-bar, a lab beam) and three studies set to a table, a list, a string, a boolean, -1,
+    1e308, 5e-324, NaN, 2**63 and blanks, and an unknown key added to every table: an
+    exception other than one refusal line, a hang, or an unknown key accepted is a finding.
 ``concurrent``
     Two sweeps started 3 s apart on one results file, the second of the study edited (seeds
     0-11 against 0-5 and 12-19): both running, or a file holding fewer rows than the grid of
@@ -355,6 +360,81 @@ def concurrent_cases(work: Path) -> list[tuple[str, object]]:
     return [("two sweeps on one results file, the second of an edited study", run)]
 
 
+# ------------------------------------------------------------------ types
+
+TYPE_VALUES = [{}, {"a": 1}, [], [[]], "x", True, -1, 1e308, 5e-324, math.nan, 2**63, [{}], "", " "]
+TYPE_SCENARIOS = ["michaelis_menten", "cartpole", "fivebar_multisine", "cantilever_soft_impact",
+                  "fivebar_sine_replay", "cantilever_stiff_impact_lab"]
+TYPE_STUDIES = ["smoke", "families", "default"]
+
+
+def _key_paths(d, pre=()):
+    """Every key path of a TOML table, into tables and lists."""
+    for k, v in d.items():
+        yield (*pre, k), v
+        if isinstance(v, dict):
+            yield from _key_paths(v, (*pre, k))
+        elif isinstance(v, list):
+            for i, x in enumerate(v):
+                yield (*pre, k, i), x
+                if isinstance(x, dict):
+                    yield from _key_paths(x, (*pre, k, i))
+
+
+def types_cases() -> list[tuple[str, object]]:
+    import copy
+    import tomllib
+
+    from testbed.pipeline.scenario import SCENARIO_DIR, _read_toml, scenario_from_dict
+    from testbed.studies.study import study_from_dict
+
+    def at(raw, path):
+        for k in path:
+            raw = raw[k]
+        return raw
+
+    def edited(raw, path, value):
+        r = copy.deepcopy(raw)
+        at(r, path[:-1])[path[-1]] = value
+        return r
+
+    def unknown(raw, path):
+        r = copy.deepcopy(raw)
+        at(r, path)["bogus_key"] = 1
+        return r
+
+    def case(label, load, raw, must_refuse):
+        def run() -> str | None:
+            from testbed.core.errors import TestbedError
+
+            try:
+                load(raw)
+            except TestbedError:
+                raise
+            return f"an unknown key accepted: {label}" if must_refuse else None
+        return (label, run)
+
+    loads = []
+    for name in TYPE_SCENARIOS:
+        raw = _read_toml(SCENARIO_DIR / f"{name}.toml")
+        raw["scenario"].pop("extends", None)
+        loads.append((name, raw, lambda r, name=name: scenario_from_dict(r, file=f"{name}.toml", stem=name)))
+    for name in TYPE_STUDIES:
+        raw = tomllib.loads((ROOT / "studies" / f"{name}.toml").read_text())
+        loads.append((name, raw, lambda r, name=name: study_from_dict(
+            r, file=f"{name}.toml", base=ROOT / "studies", stem=name)))
+    cases = []
+    for name, raw, load in loads:
+        for path, old in list(_key_paths(raw)):
+            dotted = ".".join(map(str, path))
+            if path[-1] != "name":
+                cases += [case(f"{name} {dotted} = {v!r}", load, edited(raw, path, v), False)
+                          for v in TYPE_VALUES]
+            if isinstance(old, dict):
+                cases.append(case(f"{name} [{dotted}] bogus_key = 1", load, unknown(raw, path), True))
+    return cases
+
+
 def run_inprocess(cases) -> Counter:
     """Each case returns a finding's description or None (a verdict, or refused in one line)."""
     return _hostile.run_inprocess(cases, TIMEOUT_S, lambda finding: finding)
@@ -365,6 +445,7 @@ FAMILIES = {
     "longpaths": lambda work: run_inprocess(longpaths_cases(_hostile.subfolder(work, "longpaths"))),
     "runfolder": lambda work: run_inprocess(runfolder_cases(_hostile.subfolder(work, "runfolder"))),
     "medians": lambda work: run_inprocess(medians_cases(_hostile.subfolder(work, "medians"))),
+    "types": lambda work: run_inprocess(types_cases()),
     "concurrent": lambda work: run_inprocess(concurrent_cases(_hostile.subfolder(work, "concurrent"))),
 }
 
