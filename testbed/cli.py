@@ -584,6 +584,11 @@ def cmd_report(args: argparse.Namespace) -> int:
 
     source = Path(args.source)
     _output_folder(Path(args.output), "--output")
+    # a name too long for the file system, a NUL or a link loop: one line naming it (round 13:
+    # `--runs` of 5,000 characters was Path.is_dir's OSError 36, an internal error)
+    _stat(source)
+    if args.runs is not None:
+        _stat(Path(args.runs), "--runs")
     if source.is_file() or (not source.exists() and parts_dir(source).is_dir()):
         _results_file(source)  # (only its rows, `<source>.parts/`: a sweep killed at once)
         if Path(args.output).resolve() == parts_dir(source).resolve():
@@ -751,7 +756,7 @@ def cmd_runs(args: argparse.Namespace) -> int:
 
     if args.out is None:  # the default folder: no runs yet is an empty history
         args.out = "out/runs"
-    elif not Path(args.out).exists():  # a folder the user named: a typo lists nothing
+    elif _stat(Path(args.out), "--out") is None:  # a folder the user named: a typo lists nothing
         raise InputError(f"--out {args.out}: no such folder; expected the folder of runs "
                          "(from `testbed run --out`)")
     if Path(args.out).exists() and not Path(args.out).is_dir():

@@ -11,6 +11,7 @@ import contextlib
 import errno
 import os
 import shutil
+import stat
 import tempfile
 from collections.abc import Callable, Iterator
 from pathlib import Path
@@ -92,6 +93,18 @@ def remove_in_flight() -> None:
                 os.unlink(tmp)
 
 
+def not_regular(path: Path) -> None:
+    """Raise InputError if something other than a regular file or a folder is at ``path`` (a
+    device, FIFO or socket, which a rename onto it would replace); nothing there passes."""
+    try:
+        mode = os.stat(path).st_mode
+    except (OSError, ValueError):  # nothing there, or a path that names nothing: the write says
+        return
+    if not (stat.S_ISREG(mode) or stat.S_ISDIR(mode)):  # (a folder: the rename's own error)
+        raise InputError(f"{path}: exists and is not a regular file (a FIFO, socket or device, "
+                         "which the written file would replace); expected a file path")
+
+
 def atomic_write(path: str | os.PathLike, write: Callable[[str], None]) -> Path:
     """Call ``write(tmp)`` on a temporary path next to ``path``, then rename it to ``path``.
 
@@ -105,8 +118,17 @@ def atomic_write(path: str | os.PathLike, write: Callable[[str], None]) -> Path:
     Returns
     -------
     Path
+
+    Raises
+    ------
+    InputError
+        If ``path`` exists and is not a regular file (a device, FIFO or socket): the rename
+        would replace the node itself.  As root, the drawing process's warm-up figure, saved
+        to ``os.devnull`` through this function, replaced ``/dev/null`` with a regular file
+        for every process of the machine (round 13).
     """
     path = Path(path)
+    not_regular(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     os.close(fd)

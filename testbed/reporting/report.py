@@ -33,6 +33,7 @@ import numpy as np
 
 from testbed.core.atomic import atomic_write_text
 from testbed.core.kinds import METRICS
+from testbed.numerics.quantiles import quartiles
 from testbed.pipeline.plugins import RIGS
 from testbed.pipeline.scenario import NOISE_SCHEMA
 from testbed.pipeline.signal_chain import SIGNAL_SCHEMAS
@@ -455,6 +456,11 @@ def _ok(r: dict[str, Any]) -> bool:
     return str(r.get("status", "ok")) == "ok"
 
 
+def _number(v: Any) -> bool:
+    """A score value: a number, not a bool (NaN and infinities included)."""
+    return isinstance(v, (int, float, np.number)) and not isinstance(v, bool)
+
+
 def _finite(v: Any) -> bool:
     return isinstance(v, (int, float, np.number)) and not isinstance(v, bool) and math.isfinite(float(v))
 
@@ -509,13 +515,17 @@ def _rate(cell: Sequence[dict[str, Any]]) -> str:
     return f"{n_pass}/{len(cell)} ({100 * n_pass / len(cell):.0f} %)"
 
 
-def _iqr(vals: Sequence[float]) -> str:
-    if not vals:
+def _iqr(vals: Sequence[float], cells: int) -> str:
+    """Median [25th, 75th percentile] of a score over ``cells`` cells that ran, ``vals`` their
+    values (:func:`~testbed.numerics.quantiles.quartiles`: an infinite score counted, NaN left
+    out and the count said: a median over 5 of 6 cells was shown as if over all, round 13)."""
+    q25, med, q75, n = quartiles(vals)
+    if n == 0:
         return "–"
-    q25, med, q75 = np.percentile(np.asarray(vals, dtype=float), [25, 50, 75])
+    of = f" ({n} of {cells} cells)" if n < cells else ""
     if q25 == q75:  # one seed, or all alike: the value alone
-        return fmt(med, 3)
-    return f"{fmt(med, 3)} [{fmt(q25, 3)}, {fmt(q75, 3)}]"
+        return fmt(med, 3) + of
+    return f"{fmt(med, 3)} [{fmt(q25, 3)}, {fmt(q75, 3)}]" + of
 
 
 def _doc(metric: str) -> str:
@@ -534,7 +544,8 @@ def _summary_tables(page: Page, rows: Sequence[dict[str, Any]],
         srows = [r for r in rows if str(r["scenario"]) == sc]
         shown = [m for m in thr.get(sc, {}) if m in metrics]
         if not shown:  # nothing thresholded: the first few scores this scenario has
-            shown = [m for m in metrics if any(_finite(r.get(m)) for r in srows)][:4]
+            shown = [m for m in metrics if any(_number(r.get(m)) and not math.isnan(float(r[m]))
+                                               for r in srows)][:4]
         head = ["identifier", "noise [%]", "cells", "pass rate"]
         for m in shown:
             bounds = ", ".join(f"{'≥' if b == 'min' else '≤'} {fmt(t, 3)}"
@@ -548,7 +559,9 @@ def _summary_tables(page: Page, rows: Sequence[dict[str, Any]],
                 cell = [r for r in srows if str(r["identifier"]) == ident and float(r["noise"]) == z]
                 n_pass = sum(bool(r.get("passed")) and _ok(r) for r in cell)
                 line: list[Any] = [ident, z, len(cell), _rate(cell)]
-                line += [_iqr([float(r[m]) for r in cell if _ok(r) and _finite(r.get(m))]) for m in shown]
+                ran = [r for r in cell if _ok(r)]
+                line += [_iqr([float(r[m]) for r in ran if _number(r.get(m))], len(ran))
+                         for m in shown]
                 line.append(failure_reasons(cell) or "–")
                 table.append(line)
                 classes.append("fails" if n_pass < len(cell) else None)

@@ -28,9 +28,8 @@ from collections import Counter, defaultdict
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from testbed.core.terminal import make_console
+from testbed.numerics.quantiles import quartiles
 from testbed.studies.family import family_of
 from testbed.studies.results import read_results, score_columns
 
@@ -108,8 +107,10 @@ def summarize(path: str | os.PathLike, rows: list[dict[str, Any]] | None = None,
         ``family``), ``scenarios`` (comma-separated names), ``cells``, ``ok``, ``failed``,
         ``judged`` (cells held to thresholds), ``pass_rate`` (passed / judged; NaN if none is
         judged), ``failures`` (dict: failure kind -> count, see :func:`failure_kind`), and for
-        every score ``<score>_median``, ``<score>_q25``, ``<score>_q75`` and ``<score>_n``
-        (finite values used); NaN where the group has no finite value of that score.
+        every score ``<score>_median``, ``<score>_q25``, ``<score>_q75`` over the ok cells and
+        ``<score>_n``, the values they stand on (:func:`~testbed.numerics.quantiles.quartiles`:
+        NaN left out, an infinite score counted as the worst value it is); NaN where the group
+        has no value of that score.
     """
     if by not in BY:
         raise ValueError(f"by must be one of {', '.join(BY)}, not {by!r}")
@@ -140,22 +141,24 @@ def summarize(path: str | os.PathLike, rows: list[dict[str, Any]] | None = None,
                             else math.nan),
                  failures=dict(sorted(failures.items(), key=lambda kv: (-kv[1], kv[0]))))
         for m in scores:
-            vals = np.array([r[m] for r in ok if r.get(m) is not None], dtype=float)
-            vals = vals[np.isfinite(vals)]
-            if vals.size:
-                q25, med, q75 = np.percentile(vals, [25, 50, 75])
-            else:
-                q25 = med = q75 = math.nan
-            s.update({f"{m}_median": float(med), f"{m}_q25": float(q25), f"{m}_q75": float(q75),
-                      f"{m}_n": int(vals.size)})
+            q25, med, q75, n = quartiles(r.get(m) for r in ok)
+            s.update({f"{m}_median": med, f"{m}_q25": q25, f"{m}_q75": q75, f"{m}_n": n})
         out.append(s)
     return out
 
 
 def _fmt(x: float) -> str:
-    if not math.isfinite(x):
+    """A quartile for the table: "-" for NaN (no value), "inf" and "-inf" as they are."""
+    if math.isnan(x):
         return "-"
     return f"{x:.3g}"
+
+
+def _of(s: dict[str, Any], m: str) -> str:
+    """``"\\n<n> of <ok> cells"`` where score ``m``'s quartiles stand on fewer than the
+    group's ok cells (the others' ``m`` NaN: undefined for them), else "": a median of 5 of 6
+    cells was shown as the median of the 6 (round 13)."""
+    return f"\n{s[m + '_n']} of {s['ok']} cells" if s[m + "_n"] < s["ok"] else ""
 
 
 def print_summary(path: str | os.PathLike, console: Any = None,
@@ -208,7 +211,7 @@ def print_summary(path: str | os.PathLike, console: Any = None,
                                        for s in group), end_section=True)
         for m in shown:
             t.add_row(m, *(f"{_fmt(s[m + '_median'])}\n[{_fmt(s[m + '_q25'])}, {_fmt(s[m + '_q75'])}]"
-                           for s in group))
+                           + _of(s, m) for s in group))
         console.print(t)
     failed = [r for r in rows if r["status"] != "ok"]
     if failed:
