@@ -581,9 +581,11 @@ def results_lock(results: Path) -> Iterator[None]:
     process that holds it.  The lock goes with the sweep's process however it ends (SIGKILL
     included); the lock file is removed at the end while still locked, so a sweep that opened
     it meanwhile finds it gone once it holds it and opens the new one (only a killed sweep
-    leaves it, unlocked).  A folder where the lock file cannot be made is not locked (the
-    results cannot be written there either: that write names the problem), nor a file system
-    without ``flock`` (ENOLCK, EOPNOTSUPP).
+    leaves it, unlocked).  A lock file another user made (0644: not writable here) is locked
+    through a read-only descriptor (``flock`` needs none other): two users' sweeps on one shared
+    file are the case the lock is for.  A folder where the lock file cannot be made is not
+    locked (the results cannot be written there either: that write names the problem), nor a
+    file system without ``flock`` (ENOLCK, EOPNOTSUPP); either way one warning says so.
 
     Raises
     ------
@@ -600,8 +602,14 @@ def results_lock(results: Path) -> Iterator[None]:
     for _ in range(100):
         try:
             lock.parent.mkdir(parents=True, exist_ok=True)
-            fd = os.open(lock, os.O_RDWR | os.O_CREAT, 0o666)
-        except OSError:
+            try:
+                fd = os.open(lock, os.O_RDWR | os.O_CREAT, 0o666)
+            except PermissionError:  # another user's lock file: flock needs no write access
+                fd = os.open(lock, os.O_RDONLY)
+        except OSError as e:
+            log.warning("results %s: no lock file can be made (%s); this sweep runs unlocked "
+                        "(do not start another on the same file)", results,
+                        e.strerror or type(e).__name__)
             fd = -1
             break
         try:
@@ -612,8 +620,11 @@ def results_lock(results: Path) -> Iterator[None]:
             raise InputError(f"results {results}: another sweep (process {holder}) is writing it; "
                              "wait for it to end or give another --results path (two sweeps "
                              "consolidating one file delete each other's rows)") from None
-        except OSError:  # a file system without flock: unlocked, as before
+        except OSError as e:  # a file system without flock: unlocked, as before
             os.close(fd)
+            log.warning("results %s: the file system refuses a lock (%s); this sweep runs "
+                        "unlocked (do not start another on the same file)", results,
+                        e.strerror or type(e).__name__)
             fd = -1
             break
         try:

@@ -80,6 +80,29 @@ def test_a_second_sweep_on_a_results_file_being_written_is_refused(tmp_path):
             pass
 
 
+def test_another_users_lock_file_still_locks(tmp_path, monkeypatch):
+    # the lock file of another user's sweep (0644) cannot be opened for writing: the sweep ran
+    # unlocked in silence, beside the other user's (review); flock needs a read-only descriptor
+    # only.  (Simulated: the suite runs as root, whom no mode refuses.)
+    from testbed.studies import sweep as sweep_mod
+
+    res = tmp_path / "r.parquet"
+    sweep_mod.lock_path(res).write_text("4242")
+    real_open = os.open
+
+    def other_users(path, flags, *args):
+        if os.fspath(path) == os.fspath(sweep_mod.lock_path(res)) and flags & os.O_RDWR:
+            raise PermissionError(13, "Permission denied", os.fspath(path))
+        return real_open(path, flags, *args)
+
+    monkeypatch.setattr(sweep_mod.os, "open", other_users)
+    with sweep_mod.results_lock(res):
+        monkeypatch.setattr(sweep_mod.os, "open", real_open)
+        with pytest.raises(InputError, match=r"another sweep \(process 4242\) is writing it"):
+            with sweep_mod.results_lock(res):
+                pass
+
+
 # ------------------------------------------------------------------ medians of scores
 
 def test_quartiles_count_infinite_scores_and_equal_numpy_on_finite_ones():
