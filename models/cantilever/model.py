@@ -17,6 +17,7 @@ from models.cantilever import truth as tr
 from models.cantilever.beam import BeamParams, build_mjcf
 from models.cantilever.euler_bernoulli import eb_frequencies
 from models.cantilever.simulate import Stepping, choose_stepping
+from testbed.core.errors import RigError
 from testbed.core.lazy import lazy_module
 from testbed.core.truth import StructuralTruth
 
@@ -147,6 +148,40 @@ def _compile(params: BeamParams, sensors: np.ndarray, hit: float, stepping: Step
     return mujoco.MjModel.from_xml_string(xml), xml
 
 
+def check_mode_one_rings(f1: float, rig: dict[str, Any], simulation: dict[str, Any]) -> None:
+    """Refuse a soft base whose mode 1 (the base's own) completes less than one period in the
+    record.
+
+    The damping is sized on mode 1 (``beta = 2 zeta_1 / omega_1``), and on a soft base
+    ``base_k1`` alone sets it: ``base_k1 = 5e-324`` put mode 1 at 2e-162 Hz, ``beta`` at
+    4.3e158 s and every other mode 1e161-1e162 times critically damped, simulated in silence
+    with numpy's overflow warnings after its result (round 13).  An impact record shorter than
+    mode 1's period cannot show that mode either.  A clamped beam's mode 1 is set by its
+    geometry and material, whose own bounds hold it; its short records stay scored (round 3's
+    0.01 s record, 0.83 periods of mode 1: a scored failure, mode 1 off 5.6 %).
+
+    Parameters
+    ----------
+    f1 : float
+        Mode 1's undamped frequency [Hz].
+    rig, simulation : dict
+        The validated tables.
+
+    Raises
+    ------
+    RigError
+        Naming ``rig.base_k1``.
+    """
+    duration = float(simulation["duration"])
+    if rig["base"] != "soft" or (math.isfinite(f1) and f1 * duration >= 1.0):
+        return
+    raise RigError(f"cantilever: mode 1 at {f1:.3g} Hz (a soft base of base_k1 = "
+                   f"{rig['base_k1']:g} N m/rad) completes less than one period in the "
+                   f"{duration:g} s record; allowed: a base_k1 that puts mode 1 at or above "
+                   f"1 / duration = {1.0 / duration:.3g} Hz",
+                   key="rig.base_k1", value=rig["base_k1"])
+
+
 def build_model(rig: dict[str, Any], simulation: dict[str, Any],
                 excitation: dict[str, Any]) -> CantileverModel:
     """Compile the beam of validated scenario tables and compute its truth.
@@ -165,6 +200,7 @@ def build_model(rig: dict[str, Any], simulation: dict[str, Any],
     M = tr.mass_matrix(model0)
     K = np.diag(params0.hinges()[1])
     f0, _, _ = tr.modal(M, K, 0.0)
+    check_mode_one_rings(float(f0[0]), rig, simulation)  # before beta = 2 zeta_1 / omega_1
     beta = rig["damping_beta"] or 2.0 * rig["damping_ratio"] / (2.0 * math.pi * f0[0])
     params = dataclasses.replace(params0, beta=float(beta))
     C = beta * K

@@ -639,7 +639,7 @@ class CantileverRig(Rig):
                 or lower.seconds > CPU_BUDGET_S):
             return lower
         try:
-            stepping = build_model(rig, simulation, excitation).stepping
+            built = build_model(rig, simulation, excitation)
         except (ValueError, ArithmeticError, np.linalg.LinAlgError) as e:
             # named: the key furthest from its default (round 9: length = 1e100 and a soft
             # base_k1 = 1e100 were refused naming the table 'rig' alone)
@@ -648,6 +648,7 @@ class CantileverRig(Rig):
             raise RigError(f"the beam cannot be built from these parameters ({e}); rig.{key} "
                            f"lies furthest from its default {RIG_SCHEMA[key].default:g}",
                            key=f"rig.{key}", value=rig[key]) from None
+        stepping = built.stepping
         if simulation["timestep"] > 0:
             step_key, step_value = "simulation.timestep", simulation["timestep"]
         # accuracy alone asks ceil(pi / 0.49) = 7 substeps (RK4) or ceil(pi / 0.109) = 29

@@ -99,3 +99,21 @@ def test_bad_value_in_a_file(tmp_path):
     with pytest.raises(ScenarioError) as e:
         load_scenario(p)
     assert str(p) in str(e.value) and "rig.length" in str(e.value) and "-1.0" in str(e.value)
+
+
+def test_a_soft_base_whose_mode_one_does_not_ring_in_the_record_is_refused():
+    # round 13: base_k1 = 5e-324 was simulated with beta = 4.3e158 s (every other mode damped
+    # 1e161 times critically) and printed numpy's overflow warnings after its result
+    import warnings
+
+    def table(base_k1: float) -> dict:
+        return {"scenario": {"name": "soft", "rig": "cantilever"},
+                "rig": {"base": "soft", "base_k1": base_k1}, "simulation": {"duration": 1.0},
+                "excitation": {"type": "impact"}}
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # refused before beta is computed: no overflow
+        with pytest.raises(ScenarioError, match=r"key 'rig\.base_k1': value 5e-324: .*mode 1 at "
+                                                r"2.24e-162 Hz .*completes less than one period"):
+            scenario_from_dict(table(5e-324), file="soft.toml")
+    scenario_from_dict(table(2000.0), file="soft.toml")  # the shipped base: 40 Hz
