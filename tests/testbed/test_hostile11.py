@@ -7,10 +7,8 @@ from __future__ import annotations
 
 import copy
 import os
-import socket
 import struct
 import threading
-import time
 
 import pytest
 
@@ -120,33 +118,39 @@ def test_a_folder_that_cannot_be_entered_is_one_line(tmp_path):
     assert why.startswith("error: ") and "cannot be entered" in why and "\n" not in why
 
 
-def test_a_trickled_request_is_dropped_at_its_deadline():
-    from testbed.server import _recv
+def test_a_trickled_request_is_dropped_at_its_deadline(monkeypatch):
+    import types
 
-    a, b = socket.socketpair()
-    stop = threading.Event()
+    import testbed.server as server
 
-    def trickle():  # a 100-byte request, one byte every 0.2 s
-        a.sendall(struct.pack("!I", 100))
-        while not stop.wait(0.2):
-            try:
-                a.send(b" ")
-            except OSError:
-                return
+    # A peer sending one byte every 0.25 s, on a clock of the test's own: each piece arrives
+    # within any per-read timeout, so only the deadline on the whole read can end it.  (Timed
+    # on the wall clock with a thread trickling the bytes, the outcome hung on how soon a
+    # loaded machine ran the thread and woke the reader.)
+    now = [0.0]
+    monkeypatch.setattr(server, "time", types.SimpleNamespace(monotonic=lambda: now[0]))
 
-    th = threading.Thread(target=trickle, daemon=True)
-    th.start()
-    t0 = time.monotonic()
-    try:
-        b.settimeout(0.5)  # each piece arrives within it: the per-read timeout never fires
-        with pytest.raises(TimeoutError):
-            _recv(b, deadline=time.monotonic() + 1.0)
-        assert time.monotonic() - t0 < 2.0
-    finally:
-        stop.set()
-        a.close()
-        b.close()
-        th.join()
+    class Trickle:
+        def __init__(self):
+            self.pending = struct.pack("!I", 100) + b" " * 100
+            self.timeouts: list[float] = []
+
+        def settimeout(self, seconds):
+            self.timeouts.append(seconds)
+
+        def recv(self, n):
+            now[0] += 0.25  # the next piece, 0.25 s later (exact in binary: no rounding)
+            k = 4 if len(self.pending) == 104 else 1  # the length at once, then byte by byte
+            piece, self.pending = self.pending[:min(n, k)], self.pending[min(n, k):]
+            return piece
+
+    peer = Trickle()
+    with pytest.raises(TimeoutError):
+        server._recv(peer, deadline=1.0)
+    # the length and 3 body bytes arrived by t = 1.0 s; no read began after it, and none was
+    # allowed to wait past it (each read's timeout is what was left of the deadline)
+    assert len(peer.pending) == 97 and now[0] == 1.0
+    assert peer.timeouts == [1.0, 0.75, 0.5, 0.25]
 
 
 # ------------------------------------------------------------------ results row files
