@@ -435,6 +435,17 @@ def run_id(created: str, seed: int) -> str:
     return f"{when:%Y%m%dT%H%M%SZ}-s{int(seed)}"
 
 
+def run_order(created: str, name: str) -> tuple[str, str, int]:
+    """The order of runs: by ``created`` (ISO 8601 to the second), then by the folder ``name``
+    with its counter as a number (``<id>-2`` before ``<id>-10``; :func:`save_new_run` adds
+    ``-N`` to a run made in the same second as another of its seed).  As text, ``-10`` sorted
+    before ``-2``: the newest of ten such runs was taken for an older one."""
+    head, sep, tail = name.rpartition("-")
+    if sep and tail.isdigit() and not tail.startswith("0") and not head.endswith("-s"):
+        return created, head, int(tail)
+    return created, name, 1
+
+
 def scenario_folder(out_dir: str | os.PathLike, scenario: str) -> Path:
     """The history folder of ``scenario`` in ``out_dir`` (checked as :func:`run_folder`)."""
     folder = run_folder(out_dir, scenario)
@@ -509,8 +520,8 @@ def save_new_run(result: Any, out_dir: str | os.PathLike,
         end_in_flight(tmp)
     with _locked(out):
         pointer = _read_latest(folder)
-        if pointer is None or (str(pointer.get("created", "")), str(pointer["run"])) <= \
-                (meta["created"], target.name):
+        if pointer is None or run_order(str(pointer.get("created", "")), str(pointer["run"])) \
+                <= run_order(meta["created"], target.name):
             atomic_write_text(folder / LATEST, json.dumps(
                 {"run": target.name, "created": meta["created"], "seed": result.scenario.seed}) + "\n")
         if index is not None:
@@ -563,7 +574,7 @@ def resolve_run(source: str | os.PathLike, out_dir: str | os.PathLike = "out/run
             return p / pointer["run"]
         children = [r for r in _runs_in(p) if r["path"] != p]
         if children:
-            return max(children, key=lambda r: (r["created"], r["id"]))["path"]
+            return max(children, key=lambda r: run_order(r["created"], r["id"]))["path"]
         if _is_run_folder(p):
             return p
     raise RunStoreError(f"{text}: not a run folder, a scenario folder of runs or a scenario "
@@ -792,4 +803,4 @@ def list_runs(out_dir: str | os.PathLike, scenario: str | None = None, *,
             for r in _runs_in(p, damaged)]
     if scenario is not None:
         runs = [r for r in runs if r["scenario"] == scenario]
-    return sorted(runs, key=lambda r: (r["created"], r["scenario"], r["id"]))
+    return sorted(runs, key=lambda r: (r["created"], r["scenario"], run_order("", r["id"])[1:]))

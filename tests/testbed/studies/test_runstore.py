@@ -173,6 +173,19 @@ def test_history_keeps_every_run_even_in_one_second(structural, tmp_path, same_s
     assert {r["id"] for r in rows} == {p.name for p in paths}
 
 
+def test_the_tenth_run_of_one_second_is_the_latest(structural, tmp_path, same_second):
+    # "-10" sorted before "-2" as text: the pointer kept "-9" and, without it, resolve_run
+    # took "-9" for the newest of eleven runs of one seed in one second (review, round 13)
+    out = tmp_path / "runs"
+    paths = [save_new_run(replace(structural, fit_time=float(i)), out) for i in range(11)]
+    folder = out / structural.scenario.name
+    assert paths[-1].name.endswith("-11")
+    assert json.loads((folder / LATEST).read_text())["run"] == paths[-1].name
+    assert [r["path"] for r in list_runs(out)] == paths
+    (folder / LATEST).unlink()
+    assert resolve_run(folder) == paths[-1]
+
+
 def test_a_later_seed_is_its_own_run_and_the_latest(structural, tmp_path):
     out = tmp_path / "runs"
     first = save_new_run(structural, out)
