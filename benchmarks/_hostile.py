@@ -8,7 +8,9 @@ two-line or overlong error and every other exception are findings.
 
 from __future__ import annotations
 
+import os
 import signal
+import subprocess
 import sys
 import tempfile
 import time
@@ -16,6 +18,28 @@ from collections import Counter
 from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any
+
+ROOT = Path(__file__).resolve().parent.parent
+#: The environment of the commands the rounds start: one BLAS thread, no server, no screen.
+ENV = {**os.environ, "PYTHONPATH": os.environ.get("PYTHONPATH") or str(ROOT), "OMP_NUM_THREADS": "1",
+       "OPENBLAS_NUM_THREADS": "1", "TESTBED_NO_SERVER": "1", "MPLBACKEND": "Agg"}
+
+
+def testbed_cli(argv: list[str], cwd: Path, timeout: float) -> subprocess.CompletedProcess:
+    """``python -m testbed.cli argv`` in ``cwd`` with :data:`ENV`, its output captured."""
+    return subprocess.run([sys.executable, "-m", "testbed.cli", *argv], cwd=cwd, env=ENV,
+                          capture_output=True, text=True, timeout=timeout)
+
+
+def cli_finding(p: subprocess.CompletedProcess) -> str | None:
+    """An internal error, a traceback, or a refusal in more than one error line of a finished
+    command (rounds 12 on), else None."""
+    lines = [ln for ln in p.stderr.splitlines() if ln.strip()]
+    if "Traceback" in p.stderr or "internal error" in p.stderr or p.returncode not in (0, 1, 2):
+        return f"status {p.returncode}: {lines[-1][:200] if lines else ''}"
+    if p.returncode == 2 and len([ln for ln in lines if ln.startswith("error")]) != 1:
+        return f"refused in {len(lines)} lines: {p.stderr[:200]!r}"
+    return None
 
 #: A refusal longer than this many characters is a finding: a user reads one line.
 MAX_LINE_CHARS = 6000

@@ -72,24 +72,14 @@ from benchmarks import _hostile
 ROOT = Path(__file__).resolve().parent.parent
 TIMEOUT_S = 300
 PYTHON = sys.executable
-#: The environment of the commands started here (as round 11's): one BLAS thread, no server.
-ENV = {**os.environ, "PYTHONPATH": os.environ.get("PYTHONPATH") or str(ROOT), "OMP_NUM_THREADS": "1",
-       "OPENBLAS_NUM_THREADS": "1", "TESTBED_NO_SERVER": "1", "MPLBACKEND": "Agg"}
+ENV = _hostile.ENV
 
 
 def _testbed(argv: list[str], cwd: Path, timeout: float = TIMEOUT_S) -> subprocess.CompletedProcess:
-    return subprocess.run([PYTHON, "-m", "testbed.cli", *argv], cwd=cwd, env=ENV,
-                          capture_output=True, text=True, timeout=timeout)
+    return _hostile.testbed_cli(argv, cwd, timeout)
 
 
-def _cli_finding(p: subprocess.CompletedProcess) -> str | None:
-    """An internal error, a traceback or a multi-line error of a finished command, else None."""
-    lines = [ln for ln in p.stderr.splitlines() if ln.strip()]
-    if "Traceback" in p.stderr or "internal error" in p.stderr or p.returncode not in (0, 1, 2):
-        return f"status {p.returncode}: {lines[-1][:200] if lines else ''}"
-    if p.returncode == 2 and len([ln for ln in lines if ln.startswith("error")]) != 1:
-        return f"refused in {len(lines)} lines: {p.stderr[:200]!r}"
-    return None
+_cli_finding = _hostile.cli_finding
 
 
 # ------------------------------------------------------------------ results
