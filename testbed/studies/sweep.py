@@ -597,6 +597,10 @@ def results_lock(results: Path) -> Iterator[None]:
         return
     lock = lock_path(results)
     fd = -1
+
+    def unlocked(what: str, e: OSError) -> None:
+        log.warning("results %s: %s (%s); this sweep runs unlocked (do not start another on "
+                    "the same file)", results, what, e.strerror or type(e).__name__)
     # each turn fails only if the holder removed the file between our open and our lock:
     # microseconds; a hundred in a row means something else is wrong (then unlocked)
     for _ in range(100):
@@ -607,9 +611,7 @@ def results_lock(results: Path) -> Iterator[None]:
             except PermissionError:  # another user's lock file: flock needs no write access
                 fd = os.open(lock, os.O_RDONLY)
         except OSError as e:
-            log.warning("results %s: no lock file can be made (%s); this sweep runs unlocked "
-                        "(do not start another on the same file)", results,
-                        e.strerror or type(e).__name__)
+            unlocked("no lock file can be made", e)
             fd = -1
             break
         try:
@@ -622,9 +624,7 @@ def results_lock(results: Path) -> Iterator[None]:
                              "consolidating one file delete each other's rows)") from None
         except OSError as e:  # a file system without flock: unlocked, as before
             os.close(fd)
-            log.warning("results %s: the file system refuses a lock (%s); this sweep runs "
-                        "unlocked (do not start another on the same file)", results,
-                        e.strerror or type(e).__name__)
+            unlocked("the file system refuses a lock", e)
             fd = -1
             break
         try:
