@@ -25,6 +25,18 @@ ENV = {**os.environ, "PYTHONPATH": os.environ.get("PYTHONPATH") or str(ROOT), "O
        "OPENBLAS_NUM_THREADS": "1", "TESTBED_NO_SERVER": "1", "MPLBACKEND": "Agg"}
 
 
+def results_row(**change: Any) -> dict:
+    """One results row of a finished ``michaelis_menten`` cell (the hostile rounds' and their
+    tests' fixture), with ``change`` applied."""
+    row = {"study": "s", "cell": "c1", "scenario": "michaelis_menten", "rig": "michaelis_menten",
+           "noise": 0.0, "seed": 0, "identifier": "sindy_pi_dynamical", "params": "{}",
+           "status": "ok", "error": "", "fit_time": 0.1, "data_time": 0.1, "cell_time": 0.2,
+           "passed": True, "coef_error": 0.01, "checks": "[]", "versions": "{}", "commit": "x",
+           "dataset_hash": "h"}
+    row.update(change)
+    return row
+
+
 def testbed_cli(argv: list[str], cwd: Path, timeout: float) -> subprocess.CompletedProcess:
     """``python -m testbed.cli argv`` in ``cwd`` with :data:`ENV`, its output captured."""
     return subprocess.run([sys.executable, "-m", "testbed.cli", *argv], cwd=cwd, env=ENV,

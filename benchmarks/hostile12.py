@@ -84,14 +84,7 @@ _cli_finding = _hostile.cli_finding
 
 # ------------------------------------------------------------------ results
 
-def _row(**change) -> dict:
-    row = {"study": "s", "cell": "c1", "scenario": "michaelis_menten", "rig": "michaelis_menten",
-           "noise": 0.0, "seed": 0, "identifier": "sindy_pi_dynamical", "params": "{}",
-           "status": "ok", "error": "", "fit_time": 0.1, "data_time": 0.1, "cell_time": 0.2,
-           "passed": True, "coef_error": 0.01, "checks": "[]", "versions": "{}", "commit": "x",
-           "dataset_hash": "h"}
-    row.update(change)
-    return row
+_row = _hostile.results_row
 
 
 def _grid() -> list[dict]:

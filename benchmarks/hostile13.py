@@ -43,6 +43,7 @@ Prints one line a finding and the counts; exits 1 if any finding.
 
 from __future__ import annotations
 
+import functools
 import json
 import math
 import os
@@ -246,14 +247,7 @@ def runfolder_cases(work: Path) -> list[tuple[str, object]]:
 
 # ------------------------------------------------------------------ medians
 
-def _row(**change) -> dict:
-    row = {"study": "s", "cell": "c1", "scenario": "michaelis_menten", "rig": "michaelis_menten",
-           "noise": 0.0, "seed": 0, "identifier": "sindy_pi_dynamical", "params": "{}",
-           "status": "ok", "error": "", "fit_time": 0.1, "data_time": 0.1, "cell_time": 0.2,
-           "passed": False, "coef_error": 0.01, "checks": "[]", "versions": "{}", "commit": "x",
-           "dataset_hash": "h"}
-    row.update(change)
-    return row
+_row = functools.partial(_hostile.results_row, passed=False)
 
 
 FAILED = {"status": "failed", "error": "IdentificationError: diverged (x.py:1)", "passed": False,

@@ -159,13 +159,9 @@ DROP = "<column removed>"
 
 
 def _row(**change) -> dict:
-    row = {"study": "s", "cell": "c1", "scenario": "michaelis_menten", "rig": "michaelis_menten",
-           "noise": 0.0, "seed": 0, "identifier": "sindy_pi_dynamical", "params": "{}",
-           "status": "ok", "error": "", "fit_time": 0.1, "data_time": 0.1, "cell_time": 0.2,
-           "passed": True, "coef_error": 0.01, "checks": "[]", "versions": "{}", "commit": "x",
-           "dataset_hash": "h"}
-    row.update(change)
-    return {k: v for k, v in row.items() if v is not DROP}
+    from benchmarks._hostile import results_row
+
+    return {k: v for k, v in results_row(**change).items() if v is not DROP}
 
 
 @pytest.mark.parametrize("change", [

@@ -4,6 +4,7 @@ malformed-input audits), each fixed in the layer that owns it.
 
 from __future__ import annotations
 
+import functools
 import io
 import json
 import math
@@ -12,17 +13,10 @@ import os
 import numpy as np
 import pytest
 
+from benchmarks import _hostile
 from testbed.core.errors import InputError
 
-
-def _row(**change) -> dict:
-    row = {"study": "s", "cell": "c1", "scenario": "michaelis_menten", "rig": "michaelis_menten",
-           "noise": 0.0, "seed": 0, "identifier": "sindy_pi_dynamical", "params": "{}",
-           "status": "ok", "error": "", "fit_time": 0.1, "data_time": 0.1, "cell_time": 0.2,
-           "passed": False, "coef_error": 0.01, "checks": "[]", "versions": "{}", "commit": "x",
-           "dataset_hash": "h"}
-    row.update(change)
-    return row
+_row = functools.partial(_hostile.results_row, passed=False)
 
 
 # ------------------------------------------------------------------ writes onto devices

@@ -25,8 +25,6 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent))  # benchmarks/unseen: rounds 10-12's linkage writers
-from round10.l_make import path_transmission_deg  # noqa: E402
-from round11.l_make import PAPER_AMP, PAPER_POSE, fivebar_tables  # noqa: E402
 from round12 import l_make as _ROUND12  # noqa: E402
 
 #: name -> (description, {table: keys changed from the paper's sine scenario})
@@ -67,22 +65,7 @@ def _write(name: str, base: str, description: str, tables: dict[str, dict], scor
 
 
 def main() -> None:
-    for name, (desc, tables) in FIVEBARS.items():
-        t = fivebar_tables(tables)
-        rig = {"th1_0": PAPER_POSE[0], "th4_0": PAPER_POSE[1], **t.get("rig", {})}
-        lo, hi = path_transmission_deg(rig, PAPER_AMP)
-        print(f"{name}: pose ({rig['th1_0']}, {rig['th4_0']}), transmission {lo:.1f}-{hi:.1f} deg")
-        _write(name, "fivebar_sine_replay_noise1", desc, t,
-               "angle_rmse_max = 0.0501       # the paper's figure")
-        _write(name + "_rec", "fivebar_sine_replay", desc + ", recorded rates", t,
-               "angle_rmse_max = 1e-4         # the issue's clean bar")
-    for name, (desc, tables) in CARTPOLES.items():
-        _write(name, "cartpole_noise1", desc + "; cartpole_noise1's chain", tables,
-               "angle_rmse_max = 0.0501       # the paper's figure (rounds 2-12's bar for unseen cart-poles)")
-    for name, (desc, tables) in KINETICS.items():
-        _write(name, "michaelis_menten_noise1", desc + "; michaelis_menten_noise1's weak setup", tables,
-               "state_rmse_max = 0.01         # mM (rounds 2-12's bar); "
-               "the rig's own equation bars apply too")
+    _ROUND12.write_sets(_write, FIVEBARS, CARTPOLES, KINETICS, "2-12")
 
 
 if __name__ == "__main__":
