@@ -3,8 +3,9 @@
 A cart (slide joint ``slider`` along world x) carries a pole on a hinge (``hinge``, axis -y,
 so a positive angle swings the pole's lower end towards +x); the pole hangs down at angle 0
 and swings under the cart's motion.  Only the cart is driven: a MuJoCo ``motor`` on the
-slider applies the horizontal force ``u = f(t) - kp x - kd xd`` [N], a multisine ``f`` plus
-a centring feedback (included in the recorded force) that keeps the cart from drifting.  The
+slider applies the horizontal force ``u = f(t) - kp x - kd xd`` [N], a feed-forward ``f`` (a
+multisine, a linear chirp or a seeded sequence of held steps: :func:`feedforward`) plus a
+centring feedback (included in the recorded force) that keeps the cart from drifting.  The
 force is a zero-order hold over each sample interval (computed from the state at the sample).
 Integration: MuJoCo's RK4 at ``dt``, ``1 / (sample_rate dt)`` steps per sample.
 
@@ -68,6 +69,12 @@ SIMULATION_SCHEMA: dict[str, Field] = {
                              "1/(rate dt) must be a whole number", **_POS),
 }
 
+#: The centring feedback on the cart that every input carries (``u = f - kp x - kd xd``).
+_CENTRING: dict[str, Field] = {
+    "kp": Field(float, 5.0, unit="N/m", min=0.0, doc="centring stiffness on the cart position"),
+    "kd": Field(float, 2.0, unit="N s/m", min=0.0, doc="centring damping on the cart velocity"),
+}
+
 EXCITATION_SCHEMAS: dict[str, dict[str, Field]] = {
     "multisine": {
         "amplitude": Field(float, 2.0, unit="N", min=0.0, doc="amplitude of every tone"),
@@ -75,8 +82,21 @@ EXCITATION_SCHEMAS: dict[str, dict[str, Field]] = {
         "f_max": Field(float, 2.0, unit="Hz", doc="highest tone", **_POS),
         "n_tones": Field(int, 8, min=1, max=1000, doc="tones, evenly spaced in [f_min, f_max]"),
         "phase_seed": Field(int, 0, min=0, doc="seed of the random tone phases (uniform in [0, 2 pi))"),
-        "kp": Field(float, 5.0, unit="N/m", min=0.0, doc="centring stiffness on the cart position"),
-        "kd": Field(float, 2.0, unit="N s/m", min=0.0, doc="centring damping on the cart velocity"),
+        **_CENTRING,
+    },
+    "chirp": {
+        "amplitude": Field(float, 2.0, unit="N", min=0.0, doc="amplitude of the sweep"),
+        "f0": Field(float, 0.1, unit="Hz", min=0.0, doc="start frequency"),
+        "f1": Field(float, 2.0, unit="Hz", doc="end frequency (linear sweep over the record)",
+                    **_POS),
+        **_CENTRING,
+    },
+    "steps": {
+        "amplitude": Field(float, 2.0, unit="N", min=0.0,
+                           doc="the levels are drawn uniform in [-amplitude, amplitude]"),
+        "hold": Field(float, 1.0, unit="s", doc="time each level is held", **_POS),
+        "level_seed": Field(int, 0, min=0, doc="seed of the levels"),
+        **_CENTRING,
     },
 }
 
@@ -121,6 +141,31 @@ def multisine(t: np.ndarray, excitation: dict[str, Any]) -> np.ndarray:
     return excitation["amplitude"] * np.sin(2.0 * math.pi * np.outer(t, f) + phases).sum(axis=1)
 
 
+def chirp(t: np.ndarray, excitation: dict[str, Any], duration: float) -> np.ndarray:
+    """Feed-forward force [N] at the times t [s]: a sine swept linearly from ``f0`` at 0 to
+    ``f1`` at ``duration`` [s], shape (n,)."""
+    f0, f1 = excitation["f0"], excitation["f1"]
+    return excitation["amplitude"] * np.sin(2.0 * math.pi * (f0 * t + (f1 - f0) * t * t / (2.0 * duration)))
+
+
+def steps(t: np.ndarray, excitation: dict[str, Any]) -> np.ndarray:
+    """Feed-forward force [N] at the times t [s]: levels uniform in ``[-amplitude, amplitude]``
+    (numpy's default_rng(``level_seed``)), each held ``hold`` seconds, shape (n,)."""
+    index = np.floor(t / excitation["hold"] + 1e-9).astype(int)  # 1e-9: t = k hold exactly
+    levels = np.random.default_rng(excitation["level_seed"]).uniform(-1.0, 1.0, int(index[-1]) + 1)
+    return excitation["amplitude"] * levels[index]
+
+
+def feedforward(t: np.ndarray, excitation: dict[str, Any], duration: float) -> np.ndarray:
+    """The feed-forward force [N] of the scenario's input type at the times t [s], shape (n,)."""
+    kind = excitation.get("type", "multisine")
+    if kind == "chirp":
+        return chirp(t, excitation, duration)
+    if kind == "steps":
+        return steps(t, excitation)
+    return multisine(t, excitation)
+
+
 def _resets(data: Any) -> bool:
     """Whether MuJoCo reset the state or zeroed the force (bad acceleration, velocity, position
     or control): it then carries on, and the record after it is garbage a finiteness check
@@ -135,8 +180,8 @@ class CartPoleRig(Rig):
 
     Measured: ``theta`` (2 x n: cart position x [m], pole angle th [rad]), ``dtheta``,
     ``ddtheta`` ([m/s, rad/s], [m/s^2, rad/s^2]) and ``torque`` (1 x n: the force on the cart
-    [N], zero-order hold, acting on ``x``).  Reference: ``feedforward`` (the multisine part of
-    the force [N]).  Truth: the equations of :mod:`models.cartpole.equations`, ``theta0`` /
+    [N], zero-order hold, acting on ``x``).  Reference: ``feedforward`` (the input's part of the
+    force [N]: :func:`feedforward`).  Truth: the equations of :mod:`models.cartpole.equations`, ``theta0`` /
     ``dtheta0``, ``mass_matrix_q0`` (MuJoCo's, 2 x 2 [kg, kg m, kg m^2]), ``joint_damping``
     and ``gravity``.
     """
@@ -155,13 +200,20 @@ class CartPoleRig(Rig):
               error: ErrorFn) -> None:
         """Whole steps per sample, tones below Nyquist, something to identify."""
         check_sample_steps(simulation, error)
-        if not excitation["f_min"] < excitation["f_max"]:
-            error("excitation.f_min", excitation["f_min"],
-                  f"expected f_min < f_max ({excitation['f_max']:g} Hz)")
+        kind = excitation.get("type", "multisine")
         nyquist = simulation["sample_rate"] / 2.0
-        if not excitation["f_max"] < nyquist:
-            error("excitation.f_max", excitation["f_max"],
-                  f"expected below the Nyquist frequency {nyquist:g} Hz")
+        lo, hi = {"multisine": ("f_min", "f_max"), "chirp": ("f0", "f1")}.get(kind, (None, None))
+        if lo is not None:
+            if not excitation[lo] < excitation[hi]:
+                error(f"excitation.{lo}", excitation[lo],
+                      f"expected {lo} < {hi} ({excitation[hi]:g} Hz)")
+            if not excitation[hi] < nyquist:
+                error(f"excitation.{hi}", excitation[hi],
+                      f"expected below the Nyquist frequency {nyquist:g} Hz")
+        if kind == "steps" and not excitation["hold"] < simulation["duration"]:
+            error("excitation.hold", excitation["hold"],
+                  f"expected below simulation.duration ({simulation['duration']:g} s): one level "
+                  "held over the whole record is a constant force, no step")
         if excitation["amplitude"] == 0.0:
             error("excitation.amplitude", 0.0,
                   "expected > 0: without a force the cart's equation has no input to identify")
@@ -220,7 +272,7 @@ class CartPoleRig(Rig):
         data.qvel[:] = [rig["dx0"], rig["dth0"]]
         theta0, dtheta0 = data.qpos.copy(), data.qvel.copy()
         t = np.arange(n) / fs
-        ff = multisine(t, exc)
+        ff = feedforward(t, exc, float(sim["duration"]))
         q, v, a = (np.empty((2, n)) for _ in range(3))
         u = np.empty(n)
         for k in range(n):

@@ -112,3 +112,42 @@ def test_an_unstable_simulation_is_a_rig_error_not_garbage_data():
                              "simulation": {"duration": 0.05}})
     with pytest.raises(RigError, match=r"cartpole: the simulation is unstable at t = .*rig\.gravity"):
         generate(sc)
+
+
+def test_the_chirp_and_the_steps_drive_the_cart_and_the_equations_still_hold():
+    """Round 14's inputs (a linear chirp, seeded held steps): the recorded force is the input's
+    feed-forward minus the centring feedback, and the Lagrange equations hold on the record."""
+    from models.cartpole.rig import chirp, steps
+    from testbed.pipeline.generate import generate
+
+    t = np.arange(2000) / 1000.0
+    sweep = chirp(t, {"amplitude": 2.0, "f0": 0.5, "f1": 4.5}, 2.0)
+    # instantaneous frequency f0 + (f1 - f0) t / T: 0.5 Hz at the start, 4.5 Hz at the end
+    assert sweep[0] == 0.0 and np.abs(sweep).max() <= 2.0
+    held = steps(t, {"amplitude": 2.0, "hold": 0.25, "level_seed": 3})
+    assert len(np.unique(held)) == 8 and np.all(np.abs(held) <= 2.0)
+    assert np.all(held[:250] == held[0]) and held[250] != held[249]
+    for exc in ({"type": "chirp", "f0": 0.1, "f1": 3.0}, {"type": "steps", "hold": 0.5}):
+        sc = scenario_from_dict({"scenario": {"name": "x", "rig": "cartpole"}, "excitation": exc,
+                                 "simulation": {"duration": 2.0}})
+        ds = generate(sc)
+        ff = ds.reference["feedforward"].data[0]
+        th, dth = ds.measured["theta"].data, ds.measured["dtheta"].data
+        u = ds.measured["torque"].data[0]
+        # the recorded force is the feed-forward and the centring, to round-off
+        assert np.allclose(u, ff - 5.0 * th[0] - 2.0 * dth[0], rtol=0, atol=1e-12)
+        assert np.abs(ff).max() > 1.0
+        p = CartPoleParams.from_rig(sc.rig_params)
+        for eq in unnormalised_equations(p):
+            c, T = np.array(list(eq.values())), evaluate_terms(list(eq), signals(ds))
+            assert np.abs(T @ c).max() < 1e-9 * np.abs(T * c).max()  # as for the multisine above
+
+
+def test_a_bad_chirp_or_step_input_is_refused_in_one_line():
+    base = {"scenario": {"name": "bad", "rig": "cartpole", "description": "bad"}}
+    for exc, match in (({"type": "chirp", "f0": 2.0, "f1": 1.0}, "excitation.f0"),
+                       ({"type": "chirp", "f1": 600.0}, "Nyquist"),
+                       ({"type": "steps", "hold": 20.0}, "excitation.hold"),
+                       ({"type": "steps", "f_min": 0.1}, "unknown key")):
+        with pytest.raises(ScenarioError, match=match):
+            scenario_from_dict({**base, "excitation": exc}, file="<test>")
