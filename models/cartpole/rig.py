@@ -101,6 +101,21 @@ EXCITATION_SCHEMAS: dict[str, dict[str, Field]] = {
 }
 
 
+#: Bars on the identified law that every run of this rig held to any bar must meet too
+#: (:func:`testbed.scoring.scorers.equation_failures`; a run's own stricter bars still apply).
+#: ``law_error`` (:func:`testbed.scoring.law.law_errors`): the identified equations solved for
+#: the accelerations over the record's own state box, against the true ones, the worst
+#: coordinate's RMS error relative to its true accelerations.  Not the coefficients: any
+#: combination of the two rows is the same law, and the passive pole's equation mixed into the
+#: cart's reads as 5-5000 coef_error on laws 1-3 % off (round 13's cp13_two_tones: coef_error
+#: 2.98, support F1 0.43, law 2.3 % off).  0.25: a law whose accelerations where the record went
+#: are off by a quarter of their own RMS is not the rig's.  Measured on every cart-pole cell of
+#: rounds 3-14 and the shipped setups (docs/known-gaps.md, round 14): rollout passes at
+#: 0.001-0.08 but two, 0.17 (round 14's steps held 1 s, 1 %) and 0.62 (round 6's 10 kg cart at
+#: 1 %: its cart equation lost the force u1 and pushes the cart by a spring, th1, that the rig
+#: lacks); the bar sits between them.
+EQUATION_BARS: dict[str, dict[str, float]] = {"law_error": {"max": 0.25}}
+
 #: The pole's inertia about its own axis as a fraction of the transverse one (a thin rod's is
 #: zero; MuJoCo needs it positive and the triangle inequality holds for any fraction <= 2).
 POLE_AXIAL_FRACTION = 1e-6
@@ -194,6 +209,8 @@ class CartPoleRig(Rig):
     default_excitation = "multisine"
     measured_signals = ("theta", "dtheta", "ddtheta", "torque")
     noisy_signals = ("theta",)
+    #: The identified law's bars (:data:`EQUATION_BARS`), ``{metric: {"min"|"max": value}}``.
+    equation_bars: ClassVar[dict[str, dict[str, float]]] = EQUATION_BARS
 
     @classmethod
     def check(cls, rig: dict[str, Any], simulation: dict[str, Any], excitation: dict[str, Any],

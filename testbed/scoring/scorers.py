@@ -25,6 +25,7 @@ from testbed.pipeline.plugins import rig_class
 from testbed.pipeline.signal_chain import pulse_end, pulse_span
 from testbed.scoring import metrics
 from testbed.scoring.equation_basis import compare_equations
+from testbed.scoring.law import law_errors
 from testbed.scoring.initial_state import fit_initial_state
 from testbed.scoring.metrics import worst
 
@@ -223,6 +224,11 @@ def rig_equation_bars(dataset: Dataset) -> dict[str, dict[str, float]]:
 UNDETERMINED = 1.0
 
 
+#: Why a rig's equation metric is not finite, by metric (named in the failure).
+NOT_FINITE = {"law_error": "the identified law gives no finite acceleration somewhere in the "
+                           "record's state box: its equations are singular or non-finite there"}
+
+
 def equation_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -> dict[str, str]:
     """The rig's own bars on the identified equation, missed: ``{"equation": reason}``.
 
@@ -255,7 +261,9 @@ def equation_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -
     if not missed:
         return {}
     said = "; ".join(f"{c.metric} {c.value:.3g} {'below' if c.bound == 'min' else 'above'} "
-                     f"{c.threshold:g}" for c in missed)
+                     f"{c.threshold:g}" if np.isfinite(c.value) else
+                     f"{c.metric} not finite ({NOT_FINITE.get(c.metric, 'not computable')}; bar "
+                     f"{c.threshold:g})" for c in missed)
     why = ("the rig's own bars on the identified equation: its question is the law, which a "
            "state that simulates well does not prove")
     bound = np.asarray(scores.details.get("determinacy", []), dtype=float)
@@ -1141,6 +1149,13 @@ def score_mechanical(dataset: Dataset, data: Measurement, clean: Measurement, mo
     (canonical) terms, ``support_*`` compare the canonical nonzero patterns.  Equal canonical
     forms mean equal equations on the loop manifold; a wrong equation keeps a wrong form.
 
+    Law (``law_error``, open chains only: one equation per coordinate, the cart-pole): the
+    identified and the true equations solved for the accelerations over the record's state box
+    (:func:`testbed.scoring.law.law_errors`), the largest per-coordinate RMS error relative to
+    the true accelerations (``details["law_errors"]``); unlike the coefficients it is the same
+    for any combination of the rows.  The rig's own bars on it (``equation_bars``:
+    :func:`equation_failures`) apply to every run held to any bar.
+
     A simulation that raises (e.g. a loop closure that no longer solves), turns non-finite or
     blows up is a failure in ``Scores.failures`` with its time where known, and its
     ``angle_rmse`` is NaN; non-finite coefficients are a failure with NaN coefficient scores.
@@ -1170,6 +1185,12 @@ def score_mechanical(dataset: Dataset, data: Measurement, clean: Measurement, mo
     d.update(terms=cmp["names"], coef_true=cmp["coef_true"], coef_id=cmp["coef_id"],
              coef_errors=cmp["coef_errors"], coef_error_norm=cmp["coef_error_norm"],
              dependent_terms=cmp["dependent"], truth_residual=cmp["truth_residual"])
+    law = law_errors(list(model.feature_names_), coef, truth.equation_terms, truth.equation_coef,
+                     signals)
+    if law is not None:  # an open chain: its law over the record's state box, per coordinate
+        v["law_error"] = float(np.max(law)) if np.all(np.isfinite(law)) else float("nan")
+        d["law_errors"] = law
+    d["equation_bars"] = rig_equation_bars(dataset)
     return Scores(v, d, failures)
 
 

@@ -1,0 +1,83 @@
+"""An open chain's identified law over the record's state box (testbed/scoring/law.py)."""
+
+import numpy as np
+
+from models.cartpole.equations import CartPoleParams, true_equations
+from testbed.pipeline.scenario import load_scenario
+from testbed.scoring.equation_basis import compare_equations, evaluate_terms
+from testbed.scoring.law import accelerations, law_error, state_box
+
+P = CartPoleParams(cart_mass=1.0, pole_mass=0.5, pole_length=0.6, cart_damping=0.1,
+                   pole_damping=0.005, gravity=9.81)
+
+
+def record(n: int = 3000) -> dict:
+    """A stand-in record: only its ranges matter to the box (x 0.3 m, the pole 0.4 rad)."""
+    t = np.linspace(0.0, 10.0, n)
+    th = np.vstack([0.3 * np.sin(0.7 * t), 0.4 * np.sin(2.1 * t + 0.3)])
+    dth = np.vstack([0.21 * np.cos(0.7 * t), 0.84 * np.cos(2.1 * t + 0.3)])
+    return {"th": th, "dth": dth, "ddth": np.zeros_like(th), "u": np.atleast_2d(2.0 * np.sin(1.3 * t))}
+
+
+def test_a_combination_of_the_true_rows_is_the_same_law_that_coefficients_call_wrong(dataset_cache):
+    """The cart's equation plus 3x the passive pole's, the pole's doubled: the same
+    accelerations everywhere (law_error at round-off), while the row-by-row comparison
+    reads it as another equation (round 13's cp13_two_tones: coef_error 2.98, support F1
+    0.43 on a law 2.3 % off over its box)."""
+    names, coef, _ = true_equations(P)
+    mixed = np.vstack([coef[0] + 3.0 * coef[1], 2.0 * coef[1]])
+    m = dataset_cache.get(load_scenario("scenarios/cartpole.toml")).measured
+    sig = {"th": m["theta"].data, "dth": m["dtheta"].data, "ddth": m["ddtheta"].data,
+           "u": m["torque"].data}
+    assert law_error(names, mixed, names, coef, sig) < 1e-12
+    cmp = compare_equations(names, mixed, names, coef, sig)
+    assert cmp["f1"] < 1.0 and cmp["coef_error_norm"] > 1.0  # spurious terms, 3x the pole row
+
+
+def test_the_box_solves_the_true_law_for_its_accelerations():
+    """At every drawn state the true equations vanish at the solved accelerations."""
+    names, coef, _ = true_equations(P)
+    box = state_box(record(), samples=64)
+    ddq = accelerations(names, coef, box)
+    resid = evaluate_terms(names, {**box, "ddth": ddq}) @ coef.T
+    assert np.abs(resid).max() < 1e-12
+    assert box["th"].shape == (2, 64) and box["u"].shape == (1, 64)
+    assert np.all(np.abs(box["th"][1]) <= 0.4)  # within the record's own range
+
+
+def test_a_wrong_law_is_far_and_a_singular_or_non_finite_one_is_nan():
+    names, coef, _ = true_equations(P)
+    _, wrong, _ = true_equations(CartPoleParams(1.0, 0.5, 1.2, 0.1, 0.005, 9.81))  # twice the pole
+    sig = record()
+    assert law_error(names, wrong, names, coef, sig) > 0.3
+    assert np.isnan(law_error(names, np.vstack([coef[1], coef[1]]), names, coef, sig))
+    assert np.isnan(law_error(names, np.full_like(coef, np.nan), names, coef, sig))
+
+
+def test_no_box_off_an_open_chain():
+    """A closed chain (fewer equations than coordinates: the five-bar's 2 for 4 angles) has
+    states on its loop closure only: no law_error."""
+    names, coef, _ = true_equations(P)
+    sig = record()
+    sig4 = {k: np.vstack([v, v]) if k != "u" else v for k, v in sig.items()}
+    assert law_error(names, coef, names, coef, sig4) is None
+
+
+def test_the_cartpole_holds_every_run_to_its_law_bar_and_names_a_nan_law():
+    """The rig's own bar (models/cartpole/rig.py EQUATION_BARS) on a run held to any bar: round
+    6's 10 kg cart at 1 % passed the rollout bar (0.029 < 0.0501) with law_error 0.617; now a
+    scored failure naming the law.  A law singular somewhere in the box is named, not "nan"."""
+    from models.cartpole.rig import EQUATION_BARS, CartPoleRig
+    from testbed.scoring.scorers import FAIL, Scores, equation_failures, verdict
+
+    assert CartPoleRig.equation_bars == EQUATION_BARS == {"law_error": {"max": 0.25}}
+    run_bars = {"angle_rmse": {"max": 0.0501}}
+    for law, expect in ((0.617, "wrong equation: law_error 0.617 above 0.25"),
+                        (float("nan"), "law_error not finite (the identified law gives no finite")):
+        sc = Scores({"angle_rmse": 0.029, "law_error": law}, {"equation_bars": EQUATION_BARS})
+        failures = equation_failures(sc, run_bars)
+        assert expect in failures["equation"]
+        assert verdict([], failures) == FAIL
+    ok = Scores({"angle_rmse": 0.004, "law_error": 0.011}, {"equation_bars": EQUATION_BARS})
+    assert equation_failures(ok, run_bars) == {}
+    assert equation_failures(ok, {}) == {}  # no bars at all: "no verdict" stays
