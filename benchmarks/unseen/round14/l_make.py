@@ -90,7 +90,7 @@ def _write_cartpole(name: str, description: str, excitation: dict) -> None:
     """Write ``round14/<name>.toml``: ``cartpole_noise1`` with its input replaced whole, written
     out in full (an ``extends`` merges ``[excitation]`` key by key, so the multisine's keys would
     stay beside a chirp's), held to the rounds' cart-pole bar."""
-    sc = load_scenario(HERE.parents[2] / "scenarios" / "cartpole_noise1.toml")
+    sc = load_scenario("cartpole_noise1")  # a bare name: the shipped scenario
     exc = validate_variant(excitation, rig_class("cartpole").excitation_schemas, file=name, section="excitation")
     text = f"Rigs nobody tuned, round 14: {description}; cartpole_noise1's chain"
     sc = dataclasses.replace(sc, name=name, description=text, tags=("unseen", "round14"),
