@@ -109,9 +109,9 @@ EXCITATION_SCHEMAS: dict[str, dict[str, Field]] = {
 #: combination of the two rows is the same law, and the passive pole's equation mixed into the
 #: cart's reads as 5-5000 coef_error on laws 1-3 % off (round 13's cp13_two_tones: coef_error
 #: 2.98, support F1 0.43, law 2.3 % off).  0.25: a law whose accelerations where the record went
-#: are off by a quarter of their own RMS is not the rig's.  Measured on 131 cart-pole cells of
-#: rounds 3-14, their families and the shipped setups (docs/known-gaps.md, round 14): 99 of the
-#: 101 rollout passes at 1e-14-0.185 (clean: <= 0.04), the other two the cart equations of
+#: are off by a quarter of their own RMS is not the rig's.  Measured on 136 cart-pole cells of
+#: rounds 3-14, their families and the shipped setups (docs/known-gaps.md, round 14): 103 of the
+#: 105 rollout passes at 1e-14-0.185 (clean: <= 0.04), the other two the cart equations of
 #: heavy carts at 1-3 % (round 6's 10 kg cart under a 0.05 kg pole, 0.617: its cart equation
 #: lost the force u1 and pushes the cart by a spring, th1, that the rig lacks; round 5's
 #: cpchain__000, 3.8 kg under 0.064 kg, 0.287), which it fails.
