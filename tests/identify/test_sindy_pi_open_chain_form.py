@@ -50,7 +50,11 @@ def test_strong_form_kept_where_the_weak_rollout_is_larger(dataset_cache):
     m = r.model
     assert m.formulation_ == "strong"
     assert "strong form kept (the weak not smaller beyond the tie)" in m.formulation_rule_
-    assert r.passed  # measured 0.0131 (as before the comparison)
+    # the rollout as before the comparison (measured 0.0131); since round 14 the cart-pole's law
+    # bar fails the cell: the heavy cart's (3.8 kg under 0.064 kg) identified cart equation is
+    # 0.287 off over the record's state box (models/cartpole/rig.py EQUATION_BARS)
+    assert r.scores.values["angle_rmse"] < 0.0501
+    assert not r.passed and "wrong equation: law_error 0.287 above 0.25" in r.scores.failure
     # nothing of the weak trial stays on the strong model (review: its weak-only attributes did)
     assert not hasattr(m, "weak_strong_columns_") and not hasattr(m, "_weak_trial")
 
