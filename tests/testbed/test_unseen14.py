@@ -17,7 +17,9 @@ UNSEEN = ROOT / "benchmarks" / "unseen"
 @pytest.mark.parametrize(("name", "cells"), [
     ("round14_beams", 40), ("round14_beams_noise", 80), ("round14_linkages_sine", 18),
     ("round14_linkages_clean", 6), ("round14_linkages_multisine", 9),
-    ("round14_linkages_cartpoles", 12), ("round14_linkages_kinetics", 12)])
+    ("round14_linkages_cartpoles", 12), ("round14_linkages_kinetics", 12),
+    ("round14_beams_noise_s52", 40), ("round14_linkages_sine_seeds", 18),
+    ("round14_linkages_cartpoles_seeds", 12)])
 def test_round14_studies_load(name, cells):
     from testbed.studies.study import load_study
     from testbed.studies.sweep import expand
