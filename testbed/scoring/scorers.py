@@ -250,9 +250,11 @@ def equation_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -
     -------
     dict of str to str
         Empty, or the reason naming each missed metric, its value and the rig's bar.  Where
-        the identifier's own ratio (from the data alone) is at least :data:`UNDETERMINED`, the
-        reason says the record does not determine the equation (a failure all the same: the
-        verdict names why, it never changes).
+        the identifier's own ratio (from the data alone) is at least :data:`UNDETERMINED` on an
+        equation of true terms alone, the reason says the record does not determine the
+        equation (a failure all the same: the verdict names why, it never changes); on an
+        equation holding a term the law lacks (:func:`spurious_terms`) that ratio does not
+        show the record short, and the reason stays "wrong equation", naming those terms.
     """
     bars = scores.details.get("equation_bars") or {}
     if not thresholds or not bars or {"fit", "model"} & set(scores.failures):
@@ -267,12 +269,40 @@ def equation_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -
     why = ("the rig's own bars on the identified equation: its question is the law, which a "
            "state that simulates well does not prove")
     bound = np.asarray(scores.details.get("determinacy", []), dtype=float)
-    if bound.size and np.any(bound >= UNDETERMINED):  # NaN (not estimated) never names it
+    extra = spurious_terms(scores.details)
+    # The record is shown short only by an undetermined equation of true terms alone: adding
+    # terms never lowers the bound (interlacing: the Gram's second-smallest eigenvalue cannot
+    # rise, the noise's largest cannot fall), so the law's own terms are undetermined too.  An
+    # equation with a term the law lacks may be undetermined by that term alone.
+    short = [k for k in range(bound.size) if bound[k] >= UNDETERMINED  # NaN never names it
+             and not (k < len(extra) and extra[k])]
+    if short:
         return {"equation": (f"equation not determined by the record: {said}; at the record's "
-                             f"own noise level the noise's Gram reaches {np.nanmax(bound):.3g} x "
+                             f"own noise level the noise's Gram reaches "
+                             f"{max(bound[k] for k in short):.3g} x "
                              "the gap to another equation of the same terms (the identifier's "
                              f"determinacy_, from the data alone; {why})")}
+    undetermined = [k for k in range(bound.size) if bound[k] >= UNDETERMINED]
+    if undetermined:
+        terms = sorted({t for k in undetermined for t in extra[k]})
+        return {"equation": (f"wrong equation: {said}; its terms, with {', '.join(terms)} that "
+                             f"the law lacks, are not determined at the record's noise "
+                             f"(determinacy_ {max(bound[k] for k in undetermined):.3g}), which "
+                             f"does not show the record short of the law ({why})")}
     return {"equation": f"wrong equation: {said} ({why})"}
+
+
+def spurious_terms(details: dict[str, Any]) -> list[list[str]]:
+    """Per identified equation, the terms it holds that the true one lacks (from the scorer's
+    ``terms`` / ``coef_true`` / ``coef_id``, rows paired to the truth's); [] without them."""
+    names, ct, ci = details.get("terms"), details.get("coef_true"), details.get("coef_id")
+    if names is None or ct is None or ci is None:
+        return []
+    ct, ci = np.atleast_2d(np.asarray(ct, dtype=float)), np.atleast_2d(np.asarray(ci, dtype=float))
+    if ct.shape != ci.shape or ct.shape[1] != len(names):
+        return []
+    return [[names[j] for j in range(len(names)) if ci[k, j] != 0.0 and ct[k, j] == 0.0]
+            for k in range(ct.shape[0])]
 
 
 
