@@ -15,7 +15,8 @@ A scenario is a TOML file in ``scenarios/``::
 scenario and overrides it key by key, so variants (noise levels, identifiers)
 state only what differs.  Two tables are replaced whole rather than merged:
 ``[identify]`` (a new identifier must not inherit another's hyperparameters) and
-``[score]``.  **A child keeps its parent's ``[score]`` unless it declares its own**
+``[score]``; so is a table whose ``type`` the child sets to another value (an
+``[excitation]`` of another type does not inherit the parent's type's parameters).  **A child keeps its parent's ``[score]`` unless it declares its own**
 (even when it replaces ``[identify]``): a variant is held to its parent's bars until
 it states new ones, and never passes with no bars at all.  ``[score]`` without
 ``[identify]`` is an error in a scenario run on its own (there would be nothing to
@@ -183,8 +184,12 @@ def _deep_merge(base: dict, over: dict) -> dict:
     out = copy.deepcopy(base)
     for k, v in over.items():
         # [identify] and [score] are replaced whole: a new identifier must not inherit another's
-        # hyperparameters, and a child's bars replace its parent's
-        if isinstance(v, dict) and isinstance(out.get(k), dict) and k not in ("identify", "score"):
+        # hyperparameters, and a child's bars replace its parent's; so is a table whose `type`
+        # the child changes (an [excitation] of another type: the parent's keys are its type's,
+        # and a chirp child of a multisine parent was refused for the inherited f_min, a key the
+        # child could not remove)
+        if (isinstance(v, dict) and isinstance(out.get(k), dict) and k not in ("identify", "score")
+                and not ("type" in v and v["type"] != out[k].get("type", v["type"]))):
             out[k] = _deep_merge(out[k], v)
         else:
             out[k] = copy.deepcopy(v)

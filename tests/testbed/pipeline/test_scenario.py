@@ -302,3 +302,23 @@ def test_recording_reads_names_a_scenario_and_the_files_it_extends(tmp_path):
     assert read == [str(child), str(base)]
     load_scenario(child, check_cost=False)
     assert read == [str(child), str(base)]  # closed: not recorded after the block
+
+
+def test_extends_replaces_a_table_whose_type_the_child_changes(tmp_path):
+    """A child that sets ``excitation.type`` to another value starts that table afresh: the
+    parent's multisine keys (f_min ...) were inherited and the chirp child refused for a key it
+    could not remove (round 14).  A child that keeps the type still overrides key by key."""
+    import shutil
+
+    from testbed.pipeline.scenario import SCENARIO_DIR
+    shutil.copy(SCENARIO_DIR / "cartpole.toml", tmp_path / "cartpole.toml")
+    parent = load_scenario(tmp_path / "cartpole.toml")
+    assert parent.excitation["type"] == "multisine"
+    chirp = _write(tmp_path, '[scenario]\nname = "chirp"\nextends = "cartpole.toml"\n'
+                   '[excitation]\ntype = "chirp"\n', name="chirp")
+    sc = load_scenario(chirp)
+    assert sc.excitation["type"] == "chirp" and "n_tones" not in sc.excitation
+    same = _write(tmp_path, '[scenario]\nname = "same"\nextends = "cartpole.toml"\n'
+                  '[excitation]\ntype = "multisine"\nn_tones = 3\n', name="same")
+    sc = load_scenario(same)
+    assert sc.excitation["n_tones"] == 3 and sc.excitation["f_max"] == parent.excitation["f_max"]
