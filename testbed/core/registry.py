@@ -28,6 +28,7 @@ import importlib.util
 import pkgutil
 import re
 import sys
+import types
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -211,7 +212,17 @@ class Registry:
                 if isinstance(obj, type) and obj not in self._entries.values():
                     name = getattr(obj, "name", "") or ep.name
                     self.register(name, tags=getattr(obj, "tags", ()))(obj)
-            except Exception as e:
+                elif not isinstance(obj, (type, types.ModuleType)):
+                    # a function or an instance was loaded and ignored in silence (round 14)
+                    raise PluginError(f"{self.kind} entry point {ep.name} = {ep.value} "
+                                      f"({self.entry_points}) names an object of type {type(obj).__name__!r}; "
+                                      "expected a module (whose import registers its classes) "
+                                      "or a class")
+            except PluginError:
+                raise
+            except (Exception, SystemExit) as e:
+                # (SystemExit: an entry point's sys.exit(0) at import ended `testbed list` and
+                # `testbed run` with status 0 and no output, round 14; as a plugin file's)
                 raise PluginError(f"{self.kind} entry point {ep.name} = {ep.value} "
                                   f"({self.entry_points}): {type(e).__name__}: {e}") from e
             finally:

@@ -41,7 +41,8 @@ The rule (stated here, applied by :func:`_current`):
   :data:`WRITE_WITHIN_S` of that import (the command line imports this module as a listing
   starts, in a fresh process; a long-lived one may hold modules read long before).  The next
   call computes the value again;
-- an index that cannot be read, parsed or written, holds no stamps, or whose value the caller's
+- an index that cannot be read, parsed or written, is not a regular file (a FIFO, a device)
+  or is larger than :data:`MAX_INDEX_BYTES`, holds no stamps, or whose value the caller's
   ``valid`` refuses, is as good as none: the value is computed (the index only ever saves time;
   it never fails a command).
 
@@ -54,6 +55,7 @@ from __future__ import annotations
 import hashlib
 import json
 import os
+import stat
 import sys
 import time
 from collections.abc import Callable, Iterable
@@ -75,6 +77,9 @@ RACY_S = 2.0
 WRITE_WITHIN_S = 30.0
 #: When this module was imported [s since the epoch] (see the module docs).
 _IMPORTED_AT = time.time()
+#: Largest index file read [bytes]: the listing's index, with the stamps of some 2,000 loaded
+#: modules, is about 0.3 MB; a larger file is not one this module wrote, and is not read.
+MAX_INDEX_BYTES = 16 << 20
 #: Environment variable naming the index folder ("" turns indexes off).
 INDEX_VARIABLE = "TESTBED_INDEX"
 #: Variables that change how a command reaches a server, not what it computes: not keyed.
@@ -195,11 +200,27 @@ def _current(index: dict) -> bool:
     return True
 
 
+def _read_regular(path: Path) -> bytes:
+    """The bytes of the regular file ``path``; OSError if it is anything else or larger than
+    :data:`MAX_INDEX_BYTES`.  Opened without blocking and checked on its descriptor: a FIFO at
+    the index's path blocked `testbed list` for ever, a link to ``/dev/zero`` read until memory
+    ran out (round 14)."""
+    fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
+    try:
+        st = os.fstat(fd)
+        if not stat.S_ISREG(st.st_mode) or st.st_size > MAX_INDEX_BYTES:
+            raise OSError(f"{path}: not a regular file of at most {MAX_INDEX_BYTES} bytes")
+        with os.fdopen(os.dup(fd), "rb") as fh:
+            return fh.read(MAX_INDEX_BYTES + 1)
+    finally:
+        os.close(fd)
+
+
 def _read(path: Path, valid: Callable[[Any], bool]) -> dict | None:
     """The index in the file ``path`` if it is current and ``valid`` accepts its value (under
     ``"value"``), else None."""
     try:
-        index = json.loads(path.read_bytes())
+        index = json.loads(_read_regular(path))
         if index.get("format") != FORMAT or "value" not in index or not _current(index):
             return None
         return index if valid(index["value"]) else None

@@ -1,0 +1,127 @@
+"""Fourteenth malformed-input round: the findings of ``benchmarks/hostile14.py`` (docs/history.md,
+malformed-input audits), each fixed in the layer that owns it.
+"""
+
+from __future__ import annotations
+
+import os
+import socket
+
+import pytest
+
+from testbed.core.errors import InputError
+
+# ------------------------------------------------------------------ the `testbed list` index
+
+
+@pytest.mark.parametrize("node", ["fifo", "zero"])
+def test_an_index_that_is_a_fifo_or_device_is_computed_not_read(tmp_path, monkeypatch, node):
+    from testbed.core import stamped
+
+    # a FIFO at the index's path blocked `testbed list` for ever; a link to /dev/zero read
+    # until memory ran out
+    monkeypatch.setenv(stamped.INDEX_VARIABLE, str(tmp_path))
+    path = tmp_path / stamped._key("t")
+    if node == "fifo":
+        os.mkfifo(path)
+    else:
+        path.symlink_to("/dev/zero")
+    built = []
+
+    def build():
+        built.append(1)
+        return ["v"], [], []
+
+    assert stamped.stamped_value("t", build) == ["v"] and built == [1]
+    assert path.is_fifo() if node == "fifo" else path.is_symlink()  # left as it was
+
+
+def test_an_index_larger_than_any_index_is_not_read(tmp_path, monkeypatch):
+    from testbed.core import stamped
+
+    monkeypatch.setattr(stamped, "MAX_INDEX_BYTES", 10)
+    path = tmp_path / "i.json"
+    path.write_text('{"format": 2}')
+    with pytest.raises(OSError, match="not a regular file of at most 10 bytes"):
+        stamped._read_regular(path)
+    assert stamped._read(path, lambda v: True) is None
+
+
+# ------------------------------------------------------------------ `testbed serve`'s socket
+
+
+@pytest.mark.parametrize("what", ["file", "fifo", "folder", "link"])
+def test_serve_never_removes_what_is_not_a_socket(tmp_path, what):
+    from testbed import server
+
+    # a regular file named by $TESTBED_SERVER_SOCKET was deleted (its content lost) and a
+    # socket bound in its place; a folder ended `serve` in "[Errno 21] Is a directory"
+    path = tmp_path / "s"
+    if what == "file":
+        path.write_text("precious")
+    elif what == "fifo":
+        os.mkfifo(path)
+    elif what == "folder":
+        path.mkdir()
+    else:
+        path.symlink_to(tmp_path / "elsewhere")
+    kind = {"file": "a file", "fifo": "a FIFO", "folder": "a folder", "link": "a symbolic link"}
+    with pytest.raises(InputError, match=f"holds {kind[what]}, which the server would remove"):
+        server._refuse_if_served(path)
+    assert os.path.lexists(path)
+    if what == "file":
+        assert path.read_text() == "precious"
+
+
+def test_serve_still_removes_a_dead_servers_socket(tmp_path):
+    from testbed import server
+
+    path = tmp_path / "s"
+    dead = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+    dead.bind(str(path))
+    dead.close()  # bound, never listening: what a killed server leaves
+    server._refuse_if_served(path)
+    assert not os.path.lexists(path)
+
+
+# ------------------------------------------------------------------ entry-point plugins
+
+
+def _entry_point(site, value: str, source: str):
+    """A distribution in the folder ``site`` with one entry point ``x = value`` in a private
+    group, and its module ``fake14mod`` of ``source``; a registry reading that group."""
+    from testbed.core.registry import Registry
+
+    dist = site / "fake14-0.1.dist-info"
+    dist.mkdir(parents=True)
+    (dist / "METADATA").write_text("Metadata-Version: 2.1\nName: fake14\nVersion: 0.1\n")
+    (dist / "entry_points.txt").write_text(f"[testbed_hostile14]\nx = {value}\n")
+    (site / "fake14mod.py").write_text(source)
+    return Registry("identifier", entry_points="testbed_hostile14")
+
+
+@pytest.mark.parametrize("value, source, message", [
+    # sys.exit(0) at import ended `testbed list` and `testbed run` with status 0, no output
+    ("fake14mod", "import sys\nsys.exit(0)\n", "SystemExit: 0"),
+    # a function or an instance was loaded and ignored in silence
+    ("fake14mod:f", "def f():\n    pass\n", "names an object of type 'function'"),
+    ("fake14mod:obj", "obj = 5\n", "names an object of type 'int'"),
+])
+def test_an_entry_point_that_exits_or_names_no_class_is_refused(tmp_path, monkeypatch, value,
+                                                                 source, message):
+    from testbed.core.registry import PluginError
+
+    monkeypatch.syspath_prepend(str(tmp_path))
+    monkeypatch.delitem(__import__("sys").modules, "fake14mod", raising=False)
+    reg = _entry_point(tmp_path, value, source)
+    with pytest.raises(PluginError, match=f"entry point x = {value} .*{message}"):
+        reg.names()
+    monkeypatch.delitem(__import__("sys").modules, "fake14mod", raising=False)
+
+
+def test_an_entry_point_naming_a_class_still_registers_it(tmp_path, monkeypatch):
+    monkeypatch.syspath_prepend(str(tmp_path))
+    monkeypatch.delitem(__import__("sys").modules, "fake14mod", raising=False)
+    reg = _entry_point(tmp_path, "fake14mod:C", "class C:\n    name = 'c14'\n")
+    assert reg.names() == ["c14"] and reg.origin("c14") == "entry point x (fake14)"
+    monkeypatch.delitem(__import__("sys").modules, "fake14mod", raising=False)
