@@ -41,7 +41,9 @@ The rule (stated here, applied by :func:`_current`):
   :data:`WRITE_WITHIN_S` of that import (the command line imports this module as a listing
   starts, in a fresh process; a long-lived one may hold modules read long before).  The next
   call computes the value again;
-- an index that cannot be read, parsed or written, is not a regular file (a FIFO, a device)
+- an index that cannot be read, parsed or written, whose content is not the one its
+  ``sha256`` was computed from (a bit flipped, a value edited: an edited listing of no
+  sections printed nothing, status 0), is not a regular file (a FIFO, a device)
   or is larger than :data:`MAX_INDEX_BYTES`, holds no stamps, or whose value the caller's
   ``valid`` refuses, is as good as none: the value is computed (the index only ever saves time;
   it never fails a command).
@@ -65,8 +67,9 @@ from typing import Any
 from testbed.core.atomic import atomic_write_text
 from testbed.core.errors import TestbedError
 
-#: Format of an index file; another version is ignored (recomputed and rewritten).
-FORMAT = 2
+#: Format of an index file; another version is ignored (recomputed and rewritten).  3: the
+#: index carries the SHA-256 of its content (``sha256``), checked on read (round 14).
+FORMAT = 3
 #: Names in a folder on ``sys.path`` that are its stamp (see the module docs).
 PATH_ENTRY_SUFFIXES = (".dist-info", ".egg-info", ".egg-link", ".pth")
 #: A stamp less than this old [s] at the import of this module is not trusted (see the module
@@ -216,12 +219,19 @@ def _read_regular(path: Path) -> bytes:
         os.close(fd)
 
 
+def _digest(index: dict) -> str:
+    """SHA-256 of an index's content (every key but its own ``sha256``), in canonical JSON."""
+    text = json.dumps(index, sort_keys=True, separators=(",", ":"), ensure_ascii=True)
+    return hashlib.sha256(text.encode("ascii")).hexdigest()
+
+
 def _read(path: Path, valid: Callable[[Any], bool]) -> dict | None:
     """The index in the file ``path`` if it is current and ``valid`` accepts its value (under
     ``"value"``), else None."""
     try:
         index = json.loads(_read_regular(path))
-        if index.get("format") != FORMAT or "value" not in index or not _current(index):
+        if index.get("format") != FORMAT or "value" not in index \
+                or index.pop("sha256", None) != _digest(index) or not _current(index):
             return None
         return index if valid(index["value"]) else None
     except (OSError, ValueError, TypeError, KeyError, AttributeError, IndexError):
@@ -276,9 +286,9 @@ def stamped_value(name: str, build: Callable[[], Built],
     if newest / 1e9 > _IMPORTED_AT - RACY_S or time.time() - _IMPORTED_AT > WRITE_WITHIN_S:
         return value  # a stamp too young to trust, or modules read too long ago: not kept
     try:
-        atomic_write_text(path, json.dumps({"format": FORMAT, "name": name, "files": stamps_f,
-                                            "folders": stamps_d, "paths": stamps_p,
-                                            "value": value}))
+        index = {"format": FORMAT, "name": name, "files": stamps_f, "folders": stamps_d,
+                 "paths": stamps_p, "value": value}
+        atomic_write_text(path, json.dumps({**index, "sha256": _digest(index)}))
     except (OSError, TestbedError):
         pass  # no room, a read-only cache: the index only ever saves time
     return value

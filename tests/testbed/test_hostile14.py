@@ -47,6 +47,38 @@ def test_an_index_larger_than_any_index_is_not_read(tmp_path, monkeypatch):
     assert stamped._read(path, lambda v: True) is None
 
 
+@pytest.mark.parametrize("edit", ["flip", "no sections"])
+def test_an_index_whose_content_is_not_its_checksums_is_computed(tmp_path, monkeypatch, edit):
+    import json
+    import time
+
+    from testbed.core import stamped
+
+    # a bit flipped in a scenario's description was listed as flipped; a value edited to a
+    # listing of no sections printed nothing, status 0 (the shape check passes both)
+    monkeypatch.setenv(stamped.INDEX_VARIABLE, str(tmp_path / "index"))
+    monkeypatch.setattr(stamped, "_implicit", lambda: (set(), set()))
+    monkeypatch.setattr(stamped, "_IMPORTED_AT", time.time())
+    src = tmp_path / "a.txt"
+    src.write_text("alpha")
+    old = time.time() - 3600
+    os.utime(src, (old, old))
+    built = []
+
+    def build():
+        built.append(1)
+        return [["scenarios", ["name"], [[src.read_text()]]]], [src], []
+
+    assert stamped.stamped_value("list", build) == [["scenarios", ["name"], [["alpha"]]]]
+    assert stamped.stamped_value("list", build) and built == [1]  # kept, read back
+    path = tmp_path / "index" / stamped._key("list")
+    index = json.loads(path.read_text())
+    index["value"] = [] if edit == "no sections" else [["scenarios", ["name"], [["alphA"]]]]
+    path.write_text(json.dumps(index))
+    assert stamped.stamped_value("list", build) == [["scenarios", ["name"], [["alpha"]]]]
+    assert built == [1, 1]
+
+
 # ------------------------------------------------------------------ `testbed serve`'s socket
 
 

@@ -1,0 +1,426 @@
+"""Fourteenth malformed-input round: generated hostile inputs, counted by family (docs/history.md).
+
+Each case ends ``ok`` or as a *finding* (the harness, ``benchmarks/_hostile.py``): anything but a
+verdict, an output, or one error line naming what is wrong.  Run from the repository root::
+
+    python -m benchmarks.hostile14 [family ...]      # all families when none is named
+
+Families (where rounds 1-13 went least):
+
+``index``
+    The ``testbed list`` index (:mod:`testbed.core.stamped`) damaged: replaced by a FIFO, a
+    link to ``/dev/zero`` or ``/dev/full``, a folder, a link loop; cut at every 10 % of its
+    length and one bit flipped there; its value edited to another shape; 20 MB of JSON; two
+    listings at once.  A hang, a listing other than the undamaged one, or a status other than
+    0 is a finding.
+``socket``
+    ``testbed serve`` with ``$TESTBED_SERVER_SOCKET`` naming a regular file, a FIFO, a folder,
+    a symbolic link, a link loop, a path under a file: anything there removed or changed, or
+    an error other than one line, is a finding.
+``entrypoints``
+    An installed distribution's identifier entry point that raises at import (in two lines),
+    calls ``sys.exit(0)``, names a function, an int, a module registering nothing, a class
+    under a built-in's name, two entry points registering one name, a name no file can spell:
+    ``testbed list`` and ``testbed run``.  Status 0 without the listing or verdict, a
+    traceback, or the entry point ignored in silence is a finding.
+``envvars``
+    Every ``TESTBED_*`` variable the command line reads (``TESTBED_CACHE``,
+    ``TESTBED_SCENARIOS``, ``TESTBED_STUDIES``, ``TESTBED_INDEX``, ``TESTBED_SERVER_SOCKET``,
+    ``TESTBED_NO_SERVER``) empty, relative, a file, a FIFO, ``/dev/full``, ``/proc/self``, a link
+    loop, Unicode, 300 characters, holding a newline: ``list`` and ``generate``.  An internal
+    error or a refusal in more than one line is a finding.
+``channels``
+    A cantilever record exported to SEP-005 (``testbed export``), its channels renamed
+    (Unicode look-alikes, a newline, a slash more or less, 2,000 characters, a format string,
+    composed against decomposed accents) and its units respelled (``m/s²``, ``M/S^2``,
+    ``m/s/s``, ``µm/s^2``, blank, 1,000 characters), then ``testbed identify``: a traceback, a
+    refusal in more than one line, or a fit of a channel whose unit was not read is a finding.
+``tomlbytes``
+    A shipped scenario's bytes with a byte-order mark, CRLF and lone CR line ends, NUL,
+    UTF-16, a form feed, a trailing Ctrl-Z, a vertical tab, Unicode line separators, a line of
+    1 MB: loaded (:func:`testbed.pipeline.scenario.load_scenario`).  An exception other than
+    one refusal line, or a scenario other than the original's (its cell key) loaded from
+    bytes that change nothing TOML reads, is a finding.
+
+Prints one line a finding and the counts; exits 1 if any finding.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import subprocess
+import sys
+import time
+from collections import Counter
+from pathlib import Path
+
+from benchmarks import _hostile
+
+ROOT = Path(__file__).resolve().parent.parent
+TIMEOUT_S = 300
+PYTHON = sys.executable
+#: The shipped dataset cache: no case simulates anything new.
+CACHE = ROOT / ".cache" / "datasets"
+
+
+def _testbed(argv: list[str], cwd: Path, timeout: float = 120, **env: str) -> subprocess.CompletedProcess:
+    """``testbed argv`` in ``cwd`` with the round's environment and ``env`` over it (a value
+    of None removes a variable)."""
+    e = {**_hostile.ENV, **env}
+    e = {k: v for k, v in e.items() if v is not None}
+    return subprocess.run([PYTHON, "-m", "testbed.cli", *argv], cwd=cwd, env=e,
+                          capture_output=True, text=True, timeout=timeout)
+
+
+_cli_finding = _hostile.cli_finding
+
+
+def _hang(argv, cwd, timeout, **env) -> subprocess.CompletedProcess | str:
+    try:
+        return _testbed(argv, cwd, timeout, **env)
+    except subprocess.TimeoutExpired:
+        return f"hang > {timeout} s"
+
+
+# ------------------------------------------------------------------ index
+
+def index_cases(work: Path) -> list[tuple[str, object]]:
+    folder = work / "idx"
+    plain = ["list", "--plain"]
+
+    def baseline() -> tuple[str, Path]:
+        """The undamaged listing (indexes off) and the index file one listing writes."""
+        if not (work / "baseline.txt").exists():
+            p = _testbed(plain, work, TESTBED_INDEX="")
+            (work / "baseline.txt").write_text(p.stdout)
+            shutil.rmtree(folder, ignore_errors=True)
+            _testbed(plain, work, TESTBED_INDEX=str(folder))
+            time.sleep(2.5)  # (stamps younger than 2 s are not kept: testbed.core.stamped)
+            _testbed(plain, work, TESTBED_INDEX=str(folder))
+            files = list(folder.glob("list-*.json"))
+            if len(files) != 1:
+                raise RuntimeError(f"no index written in {folder}: {files}")
+            shutil.copy(files[0], work / "index.json")
+            (work / "index.name").write_text(files[0].name)
+        return (work / "baseline.txt").read_text(), folder / (work / "index.name").read_text()
+
+    def case(name: str, damage):
+        def run() -> str | None:
+            want, path = baseline()
+            shutil.rmtree(folder, ignore_errors=True)
+            folder.mkdir()
+            damage(path, (work / "index.json").read_bytes())
+            p = _hang(plain, work, 60, TESTBED_INDEX=str(folder))
+            if isinstance(p, str):
+                return p
+            bad = _cli_finding(p)
+            if bad or p.returncode != 0:
+                return bad or f"status {p.returncode}: {p.stderr.strip()[-200:]}"
+            return None if p.stdout == want else "a listing other than the undamaged one"
+        return (f"index {name}", run)
+
+    def cut(frac):
+        return lambda path, b: path.write_bytes(b[:int(len(b) * frac)])
+
+    def flip(frac):
+        def f(path, b):
+            k = min(int(len(b) * frac), len(b) - 1)
+            path.write_bytes(b[:k] + bytes([b[k] ^ 0x10]) + b[k + 1:])
+        return f
+
+    def value(v):
+        def f(path, b):
+            d = json.loads(b)
+            d["value"] = v
+            path.write_text(json.dumps(d))
+        return f
+
+    def renamed_row(path, b):  # a row of the right shape but another text: stale by design?
+        d = json.loads(b)
+        d["value"][0][2][0][0] = "renamed"
+        path.write_text(json.dumps(d))
+
+    cases = [
+        case("a FIFO", lambda path, b: os.mkfifo(path)),
+        case("a link to /dev/zero", lambda path, b: path.symlink_to("/dev/zero")),
+        case("a link to /dev/full", lambda path, b: path.symlink_to("/dev/full")),
+        case("a folder", lambda path, b: path.mkdir()),
+        case("a link loop", lambda path, b: (path.symlink_to(path.name + ".x"),
+                                             (path.parent / (path.name + ".x")).symlink_to(path.name))),
+        case("20 MB of JSON", lambda path, b: path.write_text(json.dumps({"format": 2, "pad": "x" * (20 << 20)}))),
+        case("empty", lambda path, b: path.write_bytes(b"")),
+    ]
+    cases += [case(f"cut at {f:.0%}", cut(f)) for f in (0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 0.99)]
+    cases += [case(f"bit flipped at {f:.0%}", flip(f)) for f in (0.0, 0.1, 0.3, 0.5, 0.7, 0.9, 0.99)]
+    cases += [case(f"value {v!r}", value(v)) for v in (None, [], [[1, 2, 3]], "x", [["a", ["b"], [["c", "d"]]]],
+                                                     {"a": 1}, [["t", ["c"], [[5]]]])]
+
+    def racing() -> str | None:
+        want, _ = baseline()
+        shutil.rmtree(folder, ignore_errors=True)
+        e = {**_hostile.ENV, "TESTBED_INDEX": str(folder)}
+        ps = [subprocess.Popen([PYTHON, "-m", "testbed.cli", *plain], cwd=work, env=e,
+                               stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True) for _ in range(4)]
+        outs = [p.communicate(timeout=120) for p in ps]
+        bad = [f"status {p.returncode}: {err[-200:]}" for p, (out, err) in zip(ps, outs) if p.returncode]
+        bad += ["a listing other than the undamaged one" for out, _ in outs if out != want]
+        return "; ".join(bad) or None
+
+    cases.append(("index: four listings at once", racing))
+    return cases
+
+
+# ------------------------------------------------------------------ socket
+
+def socket_cases(work: Path) -> list[tuple[str, object]]:
+    priv = work / "priv"
+    priv.mkdir(mode=0o700, exist_ok=True)
+
+    def make(kind: str, path: Path):
+        if kind == "file":
+            path.write_text("precious")
+        elif kind == "fifo":
+            os.mkfifo(path)
+        elif kind == "folder":
+            path.mkdir()
+            (path / "inside").write_text("precious")
+        elif kind == "link":
+            (priv / "target").write_text("precious")
+            path.symlink_to(priv / "target")
+        elif kind == "link loop":
+            path.symlink_to(path)
+        elif kind == "under a file":
+            path.write_text("precious")
+            return path / "s"
+        return path
+
+    def snapshot():
+        return sorted((p.name, p.is_symlink(), p.is_file() and p.read_text()) for p in priv.rglob("*")
+                      if not p.is_fifo() or True)
+
+    def case(kind: str):
+        def run() -> str | None:
+            for p in priv.iterdir():
+                if p.is_dir() and not p.is_symlink():
+                    shutil.rmtree(p)
+                else:
+                    p.unlink()
+            sock = make(kind, priv / "s")
+            before = snapshot()
+            p = _hang(["serve", "--idle", "1", "--warm-up", "none"], work, 60,
+                      TESTBED_SERVER_SOCKET=str(sock), TESTBED_NO_SERVER=None)
+            if isinstance(p, str):
+                return p
+            after = snapshot()
+            bad = _cli_finding(p)
+            if before != after:
+                return f"status {p.returncode}; the folder changed: {before} -> {after}"
+            return bad
+        return (f"serve at a {kind}", run)
+
+    return [case(k) for k in ("file", "fifo", "folder", "link", "link loop", "under a file")]
+
+
+# ------------------------------------------------------------------ entrypoints
+
+def _distribution(site: Path, entries: str, source: str) -> None:
+    shutil.rmtree(site, ignore_errors=True)
+    dist = site / "fake14-0.1.dist-info"
+    dist.mkdir(parents=True)
+    (dist / "METADATA").write_text("Metadata-Version: 2.1\nName: fake14\nVersion: 0.1\n")
+    (dist / "entry_points.txt").write_text(f"[sysid_testbed.identifiers]\n{entries}\n")
+    (site / "fake14mod.py").write_text(source)
+
+
+ENTRY_POINTS = {
+    "raises in two lines": ("x = fake14mod", "raise RuntimeError('boom\\nsecond line')"),
+    "calls sys.exit(0)": ("x = fake14mod", "import sys\nsys.exit(0)"),
+    "names a function": ("x = fake14mod:f", "def f():\n    pass"),
+    "names an int": ("x = fake14mod:obj", "obj = 5"),
+    "a class under a built-in's name": ("ls_sindy = fake14mod:C", "class C:\n    pass"),
+    "two registering one name": ("a = fake14mod:C\nb = fake14mod:D",
+                                 "class C:\n    name = 'same'\nclass D:\n    name = 'same'"),
+    "a name no file can spell": ("x = fake14mod:C", "class C:\n    name = '../up'"),
+    "a missing module": ("x = nosuchmodule14:C", ""),
+    "a missing attribute": ("x = fake14mod:Nope", "class C:\n    pass"),
+}
+
+
+def entrypoints_cases(work: Path) -> list[tuple[str, object]]:
+    def case(name: str, argv: list[str]):
+        def run() -> str | None:
+            entries, source = ENTRY_POINTS[name]
+            site = work / "site"
+            _distribution(site, entries, source)
+            p = _hang(argv, work, 120, PYTHONPATH=f"{ROOT}{os.pathsep}{site}", TESTBED_INDEX="",
+                      TESTBED_CACHE=str(CACHE))
+            if isinstance(p, str):
+                return p
+            bad = _cli_finding(p)
+            if bad:
+                return bad
+            if p.returncode == 0 and argv[0] == "list" and "fake14" not in p.stdout:
+                return "status 0, the entry point ignored in silence"
+            if p.returncode == 0 and argv[0] == "run" and "PASS" not in p.stdout + p.stderr:
+                return f"status 0 without a verdict: {p.stdout[-200:]!r}"
+            return None
+        return (f"entry point {name}: {argv[0]}", run)
+
+    return [case(n, argv) for n in ENTRY_POINTS
+            for argv in (["list", "--plain"],
+                         ["run", "michaelis_menten", "--no-figures", "-o", str(work / "out")])]
+
+
+# ------------------------------------------------------------------ envvars
+
+def envvars_cases(work: Path) -> list[tuple[str, object]]:
+    (work / "afile").write_text("x")
+    if not (work / "fifo").exists():
+        os.mkfifo(work / "fifo")
+    if not (work / "loop").is_symlink():
+        (work / "loop").symlink_to("loop")
+    values = {"empty": "", "relative": "rel", "a file": str(work / "afile"), "a FIFO": str(work / "fifo"),
+              "/dev/full": "/dev/full", "/proc/self": "/proc/self", "a link loop": str(work / "loop"),
+              "Unicode": str(work / "ünï"), "300 characters": str(work / ("y" * 300)),
+              "a newline": str(work / "a\nb"), "a path under a file": str(work / "afile" / "x")}
+    variables = ("TESTBED_CACHE", "TESTBED_SCENARIOS", "TESTBED_STUDIES", "TESTBED_INDEX",
+                 "TESTBED_SERVER_SOCKET", "TESTBED_NO_SERVER")
+    commands = {"list": ["list", "--plain"],
+                "generate": ["generate", "michaelis_menten", "-o", "g.h5"]}
+
+    def case(var, label, value, cmd):
+        def run() -> str | None:
+            env = {var: value}
+            if var == "TESTBED_SERVER_SOCKET":
+                env["TESTBED_NO_SERVER"] = None
+            if var != "TESTBED_CACHE":
+                env["TESTBED_CACHE"] = str(CACHE)
+            p = _hang(commands[cmd], work, 120, **env)
+            return p if isinstance(p, str) else _cli_finding(p)
+        return (f"{var} {label}: {cmd}", run)
+
+    return [case(v, lab, val, c) for v in variables for lab, val in values.items() for c in commands]
+
+
+# ------------------------------------------------------------------ channels
+
+NAMES = {
+    "fullwidth look-alike": "acceleration/ａｃｃ1", "a newline": "acceleration/acc\n1",
+    "no signal": "acc1", "a slash more": "acceleration/acc1/x", "an empty channel": "acceleration/",
+    "an empty signal": "/acc1", "two slashes": "acceleration//acc1", "2,000 characters": "acceleration/" + "a" * 2000,
+    "a format string": "acceleration/{0}%s", "upper-case signal": "ACCELERATION/acc1",
+    "decomposed accent": "acceleration/acce\u0301", "right-to-left mark": "acceleration/acc\u200f1",
+    "a space": "acceleration/acc 1", "a tab": "acceleration/acc\t1", "zero-width space": "acceleration/acc\u200b1",
+}
+UNITS = {"m/s²": "m/s²", "M/S^2": "M/S^2", "m/s/s": "m/s/s", "µm/s^2": "µm/s^2", "blank": " ",
+         "1,000 characters": "m" * 1000, "NBSP inside": "m/s\u00a0^2", "a newline": "m/s^2\n",
+         "N (a force)": "N", "g": "g", "kN": "kN", "rad/s^2": "rad/s^2"}
+
+
+def channels_cases(work: Path) -> list[tuple[str, object]]:
+    src = work / "cs.json"
+
+    def ensure() -> list[dict]:
+        if not src.exists():
+            h5 = work / "cs.h5"
+            _testbed(["generate", "cantilever_stiff_impact", "-o", str(h5), "--cache", str(CACHE)], work)
+            _testbed(["export", str(h5), "--format", "sep005", "-o", str(src)], work)
+        return json.loads(src.read_text())
+
+    def case(label: str, edit):
+        def run() -> str | None:
+            chans = ensure()
+            edit(chans)
+            f = work / f"c_{abs(hash(label))}.json"
+            f.write_text(json.dumps(chans))
+            p = _hang(["identify", str(f), "--kind", "structural", "--method", "ls_sindy",
+                       "--prior", "reduced_mass_trace=0.1", "-o", str(work / "m.json")], work, 120)
+            if isinstance(p, str):
+                return p
+            return _cli_finding(p)
+        return (f"channels: {label}", run)
+
+    def rename(name):
+        def f(chans):
+            chans[1]["name"] = name
+        return f
+
+    def unit(u):
+        def f(chans):
+            chans[0]["unit_str"] = u
+        return f
+
+    cases = [case(f"channel named with {k}", rename(v)) for k, v in NAMES.items()]
+    cases += [case(f"unit {k}", unit(v)) for k, v in UNITS.items()]
+    cases.append(case("the round trip", lambda chans: None))
+    return cases
+
+
+# ------------------------------------------------------------------ tomlbytes
+
+def tomlbytes_cases(work: Path) -> list[tuple[str, object]]:
+    from testbed.pipeline.scenario import SCENARIO_DIR
+
+    def key_of(path: Path) -> str:
+        from testbed.pipeline.scenario import load_scenario
+
+        sc = load_scenario(path)  # (the cell key without the name, which is the file's)
+        return json.dumps([sc.data_hash(), sc.signal, sc.identify, sc.score], sort_keys=True)
+
+    def case(base: str, label: str, edit, same: bool):
+        def run() -> str | None:
+            raw = (SCENARIO_DIR / f"{base}.toml").read_bytes()
+            f = work / f"{base}_{abs(hash(label))}.toml"
+            f.write_bytes(edit(raw))
+            got = key_of(f)  # a refusal (TestbedError) is ok
+            if same and got != key_of(SCENARIO_DIR / f"{base}.toml"):
+                return "another scenario from bytes TOML reads alike"
+            return None
+        return (f"{base}: {label}", run)
+
+    edits = {
+        "a byte-order mark": (lambda b: b"\xef\xbb\xbf" + b, False),
+        "CRLF line ends": (lambda b: b.replace(b"\n", b"\r\n"), True),
+        "lone CR line ends": (lambda b: b.replace(b"\n", b"\r"), False),
+        "a NUL at the end": (lambda b: b + b"\x00", False),
+        "a NUL in a comment": (lambda b: b"# a\x00b\n" + b, False),
+        "UTF-16": (lambda b: b.decode().encode("utf-16"), False),
+        "UTF-16 without its mark": (lambda b: b.decode().encode("utf-16-le"), False),
+        "a form feed": (lambda b: b + b"\x0c\n", False),
+        "a trailing Ctrl-Z": (lambda b: b + b"\x1a", False),
+        "a vertical tab": (lambda b: b"\x0b" + b, False),
+        "a Unicode line separator in a comment": (lambda b: b"# a\xe2\x80\xa8b\n" + b, True),
+        "a comment of 1 MB": (lambda b: b"# " + b"x" * (1 << 20) + b"\n" + b, True),
+        "no final newline": (lambda b: b.rstrip(b"\n"), True),
+        "CRLF and a mark": (lambda b: b"\xef\xbb\xbf" + b.replace(b"\n", b"\r\n"), False),
+        "a DEL in a comment": (lambda b: b"# a\x7fb\n" + b, False),
+    }
+    return [case(base, label, e, same) for base in ("michaelis_menten", "cantilever_stiff_impact",
+                                                   "fivebar_multisine", "cartpole")
+            for label, (e, same) in edits.items()]
+
+
+def run_inprocess(cases) -> Counter:
+    """Each case returns a finding's description or None (a verdict, or refused in one line)."""
+    return _hostile.run_inprocess(cases, TIMEOUT_S, lambda finding: finding)
+
+
+FAMILIES = {
+    "index": lambda work: run_inprocess(index_cases(_hostile.subfolder(work, "index"))),
+    "socket": lambda work: run_inprocess(socket_cases(_hostile.subfolder(work, "socket"))),
+    "entrypoints": lambda work: run_inprocess(entrypoints_cases(_hostile.subfolder(work, "entrypoints"))),
+    "envvars": lambda work: run_inprocess(envvars_cases(_hostile.subfolder(work, "envvars"))),
+    "channels": lambda work: run_inprocess(channels_cases(_hostile.subfolder(work, "channels"))),
+    "tomlbytes": lambda work: run_inprocess(tomlbytes_cases(_hostile.subfolder(work, "tomlbytes"))),
+}
+
+
+def main(argv: list[str]) -> int:
+    os.environ.setdefault("MPLBACKEND", "Agg")
+    return _hostile.main(argv, FAMILIES, "hostile14-")
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
