@@ -42,11 +42,22 @@ Families (where rounds 1-13 went least):
     one refusal line, or a scenario other than the original's (its cell key) loaded from
     bytes that change nothing TOML reads, is a finding.
 
+``bounds``
+    Every numeric setting with a declared bound (:class:`~testbed.core.schema.Field` ``min`` /
+    ``max``) of five shipped scenarios (the four rigs, a soft beam: the rig's, simulation's,
+    excitation's, noise, signal chain's and identifier's tables) at the bound itself and at the
+    next float (or integer) beyond it, or just inside an excluded bound; the accepted ones of
+    the two fast rigs (Michaelis-Menten, cart-pole) also run and scored, but for their
+    ``[simulation]`` (the budget's: 3600 s of cart-pole is allowed).  A value beyond its
+    bound accepted, an exception other than one refusal line, or a scored NaN passing or
+    without a reason is a finding.
+
 Prints one line a finding and the counts; exits 1 if any finding.
 """
 
 from __future__ import annotations
 
+import functools
 import json
 import os
 import shutil
@@ -402,6 +413,87 @@ def tomlbytes_cases(work: Path) -> list[tuple[str, object]]:
             for label, (e, same) in edits.items()]
 
 
+# ------------------------------------------------------------------ bounds
+
+#: The shipped scenarios whose numeric settings the ``bounds`` family sets at their bounds, and
+#: whether each accepted value is run and scored too (the two fast rigs).
+#: Time limit of one ``bounds`` case [s]: a Michaelis-Menten or cart-pole run takes 2-30 s.
+BOUND_TIMEOUT_S = 120
+BOUND_BASES = {"michaelis_menten": True, "cartpole": True, "fivebar_multisine": False,
+               "cantilever_stiff_impact": False, "cantilever_soft_impact": False}
+
+
+def _bound_values(f) -> list[tuple[str, object, bool]]:
+    """(label, value, allowed by the field's declared bounds) at and beyond each bound."""
+    import math
+
+    out = []
+    for side, b, incl, away in (("min", f.min, f.min_inclusive, -math.inf),
+                                ("max", f.max, f.max_inclusive, math.inf)):
+        if b is None or (isinstance(b, float) and not math.isfinite(b)):
+            continue
+        if f.type is int:
+            b = int(math.ceil(b) if side == "min" else math.floor(b))
+            if incl or b != (f.min if side == "min" else f.max):
+                out += [(f"{side} {b}", b, True), (f"beyond {side} {b}", b + (-1 if side == "min" else 1), False)]
+            else:
+                out += [(f"{side} {b} (excluded)", b, False),
+                        (f"inside {side} {b}", b + (1 if side == "min" else -1), True)]
+            continue
+        b = float(b)
+        if incl:
+            out += [(f"{side} {b!r}", b, True), (f"next float beyond {side}", math.nextafter(b, away), False)]
+        else:
+            out += [(f"{side} {b!r} (excluded)", b, False),
+                    (f"next float inside {side}", math.nextafter(b, -away), True)]
+    return out
+
+
+def bounds_cases(work: Path) -> list[tuple[str, object]]:
+    import copy
+
+    from testbed.pipeline.plugins import identifier_class, rig_class
+    from testbed.pipeline.scenario import NOISE_SCHEMA, SCENARIO_DIR, _read_toml, scenario_from_dict
+    from testbed.pipeline.signal_chain import SIGNAL_SCHEMAS
+
+    cases = []
+    for base, scored in BOUND_BASES.items():
+        raw = _read_toml(SCENARIO_DIR / f"{base}.toml")
+        raw["scenario"].pop("extends", None)
+        rc = rig_class(raw["scenario"]["rig"])
+        etype = raw.get("excitation", {}).get("type", rc.default_excitation)
+        schemas = {"rig": rc.rig_schema, "simulation": rc.simulation_schema,
+                   "excitation": rc.excitation_schemas.get(etype, {}), "noise": NOISE_SCHEMA,
+                   "signal": SIGNAL_SCHEMAS[rc.kind],
+                   "identify": identifier_class(raw["identify"]["method"]).declared_hyperparameters()}
+        for table, schema in schemas.items():
+            for key, f in schema.items():
+                if f.type not in (int, float) or (f.min is None and f.max is None):
+                    continue
+                for label, value, allowed in _bound_values(f):
+                    r = copy.deepcopy(raw)
+                    r.setdefault(table, {})[key] = value
+                    # (a simulation's own bounds are its budget's: 3600 s of the cart-pole is
+                    # allowed, and takes longer than a case may; loaded, not run)
+                    cases.append((f"{base} {table}.{key} {label} = {value!r}",
+                                  functools.partial(_bound_case, r, base, allowed,
+                                                    scored and table != "simulation", work)))
+    return cases
+
+
+def _bound_case(raw: dict, base: str, allowed: bool, scored: bool, work: Path) -> str | None:
+    from testbed.pipeline.cache import DatasetCache
+    from testbed.pipeline.scenario import scenario_from_dict
+    from testbed.scoring.run import run_scenario
+
+    sc = scenario_from_dict(raw, file=f"{base}.toml", stem=base)  # a refusal is ok
+    if not allowed:
+        return "a value beyond the field's declared bound accepted"
+    if not scored:
+        return None
+    return _hostile.scored_finding(run_scenario(sc, cache=DatasetCache(work / "cache")))
+
+
 def run_inprocess(cases) -> Counter:
     """Each case returns a finding's description or None (a verdict, or refused in one line)."""
     return _hostile.run_inprocess(cases, TIMEOUT_S, lambda finding: finding)
@@ -414,6 +506,8 @@ FAMILIES = {
     "envvars": lambda work: run_inprocess(envvars_cases(_hostile.subfolder(work, "envvars"))),
     "channels": lambda work: run_inprocess(channels_cases(_hostile.subfolder(work, "channels"))),
     "tomlbytes": lambda work: run_inprocess(tomlbytes_cases(_hostile.subfolder(work, "tomlbytes"))),
+    "bounds": lambda work: _hostile.run_inprocess(bounds_cases(_hostile.subfolder(work, "bounds")),
+                                                  BOUND_TIMEOUT_S, lambda finding: finding),
 }
 
 

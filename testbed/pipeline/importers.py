@@ -1061,10 +1061,23 @@ def _uff58_channel(path: Path, k: int, s: dict[str, Any], raw: _Raw) -> tuple[st
         raise MeasuredDataError(path, f"{where}: abscissa is specific data type "
                                       f"{s.get('abscissa_spec_data_type')}, not time (17)")
     label = str(s.get("ordinate_axis_units_lab", "")).strip()
+    key = (int(s.get("ordinate_spec_data_type", 0)), int(s.get("ordinate_len_unit_exp", 0)),
+           int(s.get("ordinate_force_unit_exp", 0)), abs(direction) in (4, 5, 6))
     if not label or label.upper() == "NONE":
-        key = (int(s.get("ordinate_spec_data_type", 0)), int(s.get("ordinate_len_unit_exp", 0)),
-               int(s.get("ordinate_force_unit_exp", 0)), abs(direction) in (4, 5, 6))
         label = _UFF_UNITS.get(key, "")
+    elif key in _UFF_UNITS:
+        # both declared: a displacement record (type 8) labelled m/s^2 was read as an
+        # acceleration by its label in silence (round 14); a label of the codes' quantity in
+        # another unit (g, mm) is read by the label, as before
+        coded, labelled = SAME_ORDER.get(_UFF_UNITS[key]), SAME_ORDER.get(si_unit(label)[0])
+        if labelled is not None and labelled != coded:
+            def a(w: str | None) -> str:
+                return f"{'an' if str(w)[0] in 'aeiou' else 'a'} {w}"
+
+            raise MeasuredDataError(path, f"{where}: ordinate unit label {label!r} ({a(labelled)}) "
+                                          f"disagrees with its specific data type {key[0]} and unit "
+                                          f"exponents ({a(coded)} in {_UFF_UNITS[key]}); expected "
+                                          "a label of the quantity the codes declare")
     raw.data[name], raw.units[name] = data.astype(float), label or None
     if node > 0:
         raw.nodes[name] = node

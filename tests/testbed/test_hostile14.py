@@ -5,6 +5,7 @@ malformed-input audits), each fixed in the layer that owns it.
 from __future__ import annotations
 
 import os
+import re
 import socket
 
 import pytest
@@ -157,3 +158,47 @@ def test_an_entry_point_naming_a_class_still_registers_it(tmp_path, monkeypatch)
     reg = _entry_point(tmp_path, "fake14mod:C", "class C:\n    name = 'c14'\n")
     assert reg.names() == ["c14"] and reg.origin("c14") == "entry point x (fake14)"
     monkeypatch.delitem(__import__("sys").modules, "fake14mod", raising=False)
+
+
+# ------------------------------------------------------------------ UFF58 units, declared twice
+
+
+def _uff58(path, label: str, spec: int, len_exp: int = 1):
+    """One UFF58 time record of 64 samples at 100 Hz: ``label`` and specific data type
+    ``spec`` (with ``len_exp``) as its ordinate's declared unit."""
+    import numpy as np
+    import pyuff
+
+    t = np.arange(64) / 100.0
+    rec = pyuff.prepare_58(
+        binary=0, func_type=1, ver_num=0, load_case_id=0, id1="acceleration/acc1", id2="",
+        id3="", id4="", id5="", rsp_ent_name="acc1", rsp_node=1, rsp_dir=3, ref_ent_name="NONE",
+        ref_node=0, ref_dir=0, data=np.sin(2 * np.pi * 5 * t), x=t, abscissa_spacing=1,
+        abscissa_spec_data_type=17, abscissa_len_unit_exp=0, abscissa_force_unit_exp=0,
+        abscissa_temp_unit_exp=0, abscissa_axis_units_lab="s", ordinate_spec_data_type=spec,
+        ordinate_len_unit_exp=len_exp, ordinate_force_unit_exp=0, ordinate_temp_unit_exp=0,
+        ordinate_axis_units_lab=label, orddenom_spec_data_type=0, z_axis_spec_data_type=0,
+        z_axis_value=0.0)
+    pyuff.UFF(str(path)).write_sets([rec], mode="overwrite")
+    return path
+
+
+@pytest.mark.parametrize("label, spec, refused", [
+    ("m/s^2", 8, True),   # a displacement record labelled as an acceleration: read as one
+    ("m", 12, True),      # an acceleration record labelled in metres
+    ("N", 12, True),
+    ("m/s^2", 12, False),  # agreeing
+    ("g", 12, False),      # the codes' quantity in another unit: read by the label, as before
+    ("m/s^2", 0, False),   # no quantity coded (type 0, unknown): the label alone
+])
+def test_a_uff_record_whose_label_and_codes_disagree_is_refused(tmp_path, label, spec, refused):
+    from testbed.pipeline.importers import MeasuredDataError, read_measured
+
+    path = _uff58(tmp_path / "r.uff", label, spec)
+    if refused:
+        with pytest.raises(MeasuredDataError, match=f"ordinate unit label '{re.escape(label)}' .* disagrees "
+                                                    f"with its specific data type {spec}"):
+            read_measured(path)
+    else:
+        unit = read_measured(path).signals["acceleration/acc1"][0]
+        assert unit == "m/s^2"
