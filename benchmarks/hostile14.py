@@ -35,6 +35,12 @@ Families (where rounds 1-13 went least):
     composed against decomposed accents) and its units respelled (``m/s²``, ``M/S^2``,
     ``m/s/s``, ``µm/s^2``, blank, 1,000 characters), then ``testbed identify``: a traceback, a
     refusal in more than one line, or a fit of a channel whose unit was not read is a finding.
+``uff``
+    The same record exported to UFF, one acceleration record's ordinate given every pairing of
+    a specific data type (displacement, velocity, acceleration, force) with a unit label (m,
+    mm, m/s, mm/s, m/s^2, g, mm/s^2, N, kN), and its ID line a NUL, an ESC, a DEL or a latin-1
+    byte: a record whose label and codes declare different quantities identified, a name with
+    a control character identified, or a traceback, is a finding.
 ``tomlbytes``
     A shipped scenario's bytes with a byte-order mark, CRLF and lone CR line ends, NUL,
     UTF-16, a form feed, a trailing Ctrl-Z, a vertical tab, Unicode line separators, a line of
@@ -350,6 +356,9 @@ def channels_cases(work: Path) -> list[tuple[str, object]]:
                        "--prior", "reduced_mass_trace=0.1", "-o", str(work / "m.json")], work, 120)
             if isinstance(p, str):
                 return p
+            hidden = [c["name"] for c in chans if not c["name"].isprintable()]
+            if p.returncode == 0 and hidden:  # (it reached the console, the JSON, the report)
+                return f"identified with a channel name holding a control character: {hidden[0]!r}"
             return _cli_finding(p)
         return (f"channels: {label}", run)
 
@@ -366,6 +375,60 @@ def channels_cases(work: Path) -> list[tuple[str, object]]:
     cases = [case(f"channel named with {k}", rename(v)) for k, v in NAMES.items()]
     cases += [case(f"unit {k}", unit(v)) for k, v in UNITS.items()]
     cases.append(case("the round trip", lambda chans: None))
+    return cases
+
+
+# ------------------------------------------------------------------ uff
+
+#: The ordinate line of a UFF58 record as ``testbed export`` writes an acceleration's
+#: (record 8: specific data type, length, force and temperature exponents, labels).
+_ORDINATE = b"        12    1    0    0 NONE                 m/s^2               "
+
+
+def uff_cases(work: Path) -> list[tuple[str, object]]:
+    src = work / "cs.uff"
+
+    def ensure() -> bytes:
+        if not src.exists():
+            h5 = work / "cs.h5"
+            _testbed(["generate", "cantilever_stiff_impact", "-o", str(h5), "--cache", str(CACHE)], work)
+            _testbed(["export", str(h5), "--format", "uff", "-o", str(src)], work)
+        return src.read_bytes()
+
+    def case(label: str, edit, must_refuse: bool):
+        def run() -> str | None:
+            b = ensure()
+            at = b.index(b"acceleration/acc2")
+            f = work / f"u_{abs(hash(label))}.uff"
+            f.write_bytes(edit(b, at))
+            p = _hang(["identify", str(f), "--kind", "structural", "--method", "ls_sindy",
+                       "--prior", "reduced_mass_trace=0.1", "-o", str(work / "m.json")], work, 120)
+            if isinstance(p, str):
+                return p
+            if must_refuse and p.returncode == 0:
+                return "identified"
+            return _cli_finding(p)
+        return (f"uff: {label}", run)
+
+    def ordinate(spec: int, unit: str):
+        new = f"{spec:10d}    1    0    0 NONE                 {unit:<20}".encode("latin-1")
+
+        def f(b, at):
+            j = b.index(_ORDINATE, at)
+            return b[:j] + new[:len(_ORDINATE)].ljust(len(_ORDINATE)) + b[j + len(_ORDINATE):]
+        return f
+
+    def name(new: bytes):
+        return lambda b, at: b[:at] + new.ljust(17)[:17] + b[at + 17:]
+
+    quantity = {8: "m", 11: "m/s", 12: "m/s^2", 13: "N"}
+    order = {"m": 0, "mm": 0, "m/s": 1, "mm/s": 1, "m/s^2": 2, "g": 2, "mm/s^2": 2, "N": 3, "kN": 3}
+    cases = [case(f"type {spec} labelled {unit}", ordinate(spec, unit),
+                  order[unit] != order[quantity[spec]])
+             for spec in quantity for unit in order]
+    cases += [case(f"a name of {k}", name(v), k != "a latin-1 byte")
+              for k, v in {"a NUL": b"acceleration/a\x002", "an ESC": b"acceleration/\x1b[31m",
+                           "a latin-1 byte": b"acceleration/acc\xe9", "a DEL": b"acceleration/ac\x7f2"}.items()]
     return cases
 
 
@@ -506,6 +569,7 @@ FAMILIES = {
     "envvars": lambda work: run_inprocess(envvars_cases(_hostile.subfolder(work, "envvars"))),
     "channels": lambda work: run_inprocess(channels_cases(_hostile.subfolder(work, "channels"))),
     "tomlbytes": lambda work: run_inprocess(tomlbytes_cases(_hostile.subfolder(work, "tomlbytes"))),
+    "uff": lambda work: run_inprocess(uff_cases(_hostile.subfolder(work, "uff"))),
     "bounds": lambda work: _hostile.run_inprocess(bounds_cases(_hostile.subfolder(work, "bounds")),
                                                   BOUND_TIMEOUT_S, lambda finding: finding),
 }

@@ -202,3 +202,25 @@ def test_a_uff_record_whose_label_and_codes_disagree_is_refused(tmp_path, label,
     else:
         unit = read_measured(path).signals["acceleration/acc1"][0]
         assert unit == "m/s^2"
+
+
+# ------------------------------------------------------------------ hostile channel names
+
+
+@pytest.mark.parametrize("name", ["acceleration/acc\n2", "acceleration/acc\x002",
+                                  "acceleration/acc\x1b[31mRED", "acceleration/acc\u200b2",
+                                  "acceleration/acc\u200f2"])
+def test_a_channel_name_with_a_control_or_invisible_character_is_refused(name):
+    import numpy as np
+
+    from testbed.pipeline.importers import MeasuredDataError, from_sep005
+
+    # a newline, NUL or terminal escape in a SEP-005 or UFF name went on to the console (an
+    # ESC sequence coloured it), the model's JSON and its report's markdown
+    x = np.sin(np.arange(100) / 10.0)
+    chans = [{"name": "acceleration/acc1", "data": x, "fs": 100.0, "unit_str": "m/s^2"},
+             {"name": name, "data": x + 1, "fs": 100.0, "unit_str": "m/s^2"}]
+    with pytest.raises(MeasuredDataError, match="holds the control or invisible character"):
+        from_sep005(chans)
+    chans[1]["name"] = "acceleration/accé 2"  # printable Unicode and a space: read as before
+    assert list(from_sep005(chans).signals) == ["acceleration/acc1", "acceleration/accé 2"]
