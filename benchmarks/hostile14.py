@@ -41,6 +41,11 @@ Families (where rounds 1-13 went least):
     mm, m/s, mm/s, m/s^2, g, mm/s^2, N, kN), and its ID line a NUL, an ESC, a DEL or a latin-1
     byte: a record whose label and codes declare different quantities identified, a name with
     a control character identified, or a traceback, is a finding.
+``texts``
+    A scenario's description and tags, a study's and a family's description (free texts that
+    ``testbed list --plain``, the reports and the console show on one line) holding a newline, a
+    tab, an ESC sequence, a carriage return, a Unicode line separator, DEL, a C1 control or a
+    NUL: accepted is a finding.
 ``tomlbytes``
     A shipped scenario's bytes with a byte-order mark, CRLF and lone CR line ends, NUL,
     UTF-16, a form feed, a trailing Ctrl-Z, a vertical tab, Unicode line separators, a line of
@@ -557,6 +562,48 @@ def _bound_case(raw: dict, base: str, allowed: bool, scored: bool, work: Path) -
     return _hostile.scored_finding(run_scenario(sc, cache=DatasetCache(work / "cache")))
 
 
+# ------------------------------------------------------------------ texts
+
+#: Free texts a listing or a report shows on one line, set to each of these.
+TEXTS = {"a newline": "two\nlines", "a tab": "a\ttab", "an ESC sequence": "an \x1b[31mESC",
+         "a carriage return": "over\rwritten", "a line separator": "a\u2028b", "a DEL": "a\x7fb",
+         "a C1 control": "a\x85b", "a NUL": "a\x00b"}
+
+
+def texts_cases() -> list[tuple[str, object]]:
+    import copy
+    import tomllib
+
+    from testbed.pipeline.scenario import SCENARIO_DIR, _read_toml, scenario_from_dict
+    from testbed.studies.study import study_from_dict
+
+    mm = _read_toml(SCENARIO_DIR / "michaelis_menten.toml")
+    smoke = tomllib.loads((ROOT / "studies" / "smoke.toml").read_text())
+    fams = tomllib.loads((ROOT / "studies" / "families.toml").read_text())
+
+    def case(label, load, raw, path, text):
+        def run() -> str | None:
+            r = copy.deepcopy(raw)
+            at = r
+            for k in path[:-1]:
+                at = at[k]
+            at[path[-1]] = [text] if path[-1] == "tags" else text
+            load(r)  # a refusal is ok
+            return f"{'.'.join(map(str, path))} {text!r} accepted: shown on more than one line"
+        return (f"texts: {label}", run)
+
+    loads = [("scenario", mm, ("scenario", "description"),
+              lambda r: scenario_from_dict(r, file="michaelis_menten.toml", stem="michaelis_menten")),
+             ("scenario", mm, ("scenario", "tags"),
+              lambda r: scenario_from_dict(r, file="michaelis_menten.toml", stem="michaelis_menten")),
+             ("study", smoke, ("study", "description"),
+              lambda r: study_from_dict(r, file="smoke.toml", base=ROOT / "studies", stem="smoke")),
+             ("family", fams, ("families", "beams_stiff", "description"),
+              lambda r: study_from_dict(r, file="families.toml", base=ROOT / "studies", stem="families"))]
+    return [case(f"{what} {'.'.join(map(str, path))} with {k}", load, raw, path, v)
+            for what, raw, path, load in loads for k, v in TEXTS.items()]
+
+
 def run_inprocess(cases) -> Counter:
     """Each case returns a finding's description or None (a verdict, or refused in one line)."""
     return _hostile.run_inprocess(cases, TIMEOUT_S, lambda finding: finding)
@@ -569,6 +616,7 @@ FAMILIES = {
     "envvars": lambda work: run_inprocess(envvars_cases(_hostile.subfolder(work, "envvars"))),
     "channels": lambda work: run_inprocess(channels_cases(_hostile.subfolder(work, "channels"))),
     "tomlbytes": lambda work: run_inprocess(tomlbytes_cases(_hostile.subfolder(work, "tomlbytes"))),
+    "texts": lambda work: run_inprocess(texts_cases()),
     "uff": lambda work: run_inprocess(uff_cases(_hostile.subfolder(work, "uff"))),
     "bounds": lambda work: _hostile.run_inprocess(bounds_cases(_hostile.subfolder(work, "bounds")),
                                                   BOUND_TIMEOUT_S, lambda finding: finding),

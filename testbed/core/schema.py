@@ -21,6 +21,14 @@ from testbed.core.errors import ScenarioError
 
 REQUIRED = object()
 
+#: A free text shown on one line (a description, a tag): no control character.  A scenario's
+#: description holding a newline split its row of `testbed list --plain` in two (a script
+#: reading the tab-separated rows read a broken one), a tab added a column, an ESC sequence
+#: went raw to the terminal (round 14).  C0 and C1 controls, DEL and the Unicode line and
+#: paragraph separators.
+ONE_LINE = "[^\\x00-\\x1f\\x7f-\\x9f\\u2028\\u2029]*"
+ONE_LINE_DOC = "a line of text without control characters (newline, tab, escape)"
+
 _TYPE_NAMES = {bool: "a boolean", int: "an integer", float: "a number", str: "a string",
                list: "a list", dict: "a table", object: "any value"}
 _ITEM_NAMES = {bool: "booleans", int: "integers", float: "numbers", str: "strings"}
@@ -103,7 +111,9 @@ class Field:
             bounds.append(f"with at least {self.min_items} item(s)")
         if self.type is list and self.max_items is not None:
             bounds.append(f"with at most {self.max_items} item(s)")
-        if self.pattern is not None and self.pattern_doc.startswith(("a ", "an ")):
+        if self.pattern is not None and self.type is list and self.pattern_doc.startswith(("a ", "an ")):
+            bounds.append(f"each {self.pattern_doc}")  # "a list of strings each a line of ..."
+        elif self.pattern is not None and self.pattern_doc.startswith(("a ", "an ")):
             what = self.pattern_doc  # "expected a string a name of letters ..." read badly
         elif self.pattern is not None:
             bounds.append(self.pattern_doc or f"matching {self.pattern}")

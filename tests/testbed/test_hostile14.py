@@ -224,3 +224,29 @@ def test_a_channel_name_with_a_control_or_invisible_character_is_refused(name):
         from_sep005(chans)
     chans[1]["name"] = "acceleration/accé 2"  # printable Unicode and a space: read as before
     assert list(from_sep005(chans).signals) == ["acceleration/acc1", "acceleration/accé 2"]
+
+
+# ------------------------------------------------------------------ one-line texts
+
+
+@pytest.mark.parametrize("text", ["two\nlines", "a\ttab", "an \x1b[31mESC", "a\u2028separator",
+                                  "a\x7fDEL", "a\x85NEL"])
+@pytest.mark.parametrize("where", ["scenario.description", "scenario.tags", "study.description",
+                                   "family.description"])
+def test_a_free_text_with_a_control_character_is_refused(text, where):
+    from testbed.core.errors import ScenarioError
+    from testbed.pipeline.scenario import HEADER_SCHEMA
+    from testbed.studies.family import FAMILY_SCHEMA
+    from testbed.studies.study import STUDY_SCHEMA
+    from testbed.core.schema import check_value
+
+    # a scenario's description with a newline split its row of `testbed list --plain` in two,
+    # a tab added a column, an ESC sequence went raw to the terminal
+    schema = {"scenario": HEADER_SCHEMA, "study": STUDY_SCHEMA, "family": FAMILY_SCHEMA}
+    table, key = where.split(".")
+    field = schema[table][key]
+    value = [text] if field.type is list else text
+    with pytest.raises(ScenarioError, match="without control characters"):
+        check_value(value, field, file="f.toml", key=where)
+    ok = ["Ünïcode — text, 'quoted' [1 %]"] if field.type is list else "Ünïcode — text, 'quoted' [1 %]"
+    assert check_value(ok, field, file="f.toml", key=where) == ok
