@@ -41,6 +41,11 @@ Families (where rounds 1-13 went least):
     mm, m/s, mm/s, m/s^2, g, mm/s^2, N, kN), and its ID line a NUL, an ESC, a DEL or a latin-1
     byte: a record whose label and codes declare different quantities identified, a name with
     a control character identified, or a traceback, is a finding.
+``escapes``
+    An ESC sequence in an argument of every command (a scenario, a seed, a study, a results
+    file, a report source, a dataset, a cache, an identifier, a ``--prior`` or ``--param`` key,
+    a ``--units`` channel, a family, a runs folder, an option, a command, a plugin): a raw ESC
+    in the error line (which the terminal obeys) is a finding.
 ``texts``
     A scenario's description and tags, a study's and a family's description (free texts that
     ``testbed list --plain``, the reports and the console show on one line) holding a newline, a
@@ -383,6 +388,41 @@ def channels_cases(work: Path) -> list[tuple[str, object]]:
     return cases
 
 
+# ------------------------------------------------------------------ escapes
+
+ESC = "\x1b[31mRED"
+
+
+def escapes_cases(work: Path) -> list[tuple[str, object]]:
+    (work / "mm.csv").write_text("t,x [mM],dx [mM/s]\n" + "".join(
+        f"{i * 0.1},{1 + 0.1 * i},{0.1 + 0.01 * i}\n" for i in range(40)))
+    argvs = [
+        ["run", f"x{ESC}"], ["run", "michaelis_menten", "--seed", ESC], ["generate", f"x{ESC}"],
+        ["sweep", f"x{ESC}"], ["summary", f"x{ESC}"], ["report", f"x{ESC}", "-o", "r"],
+        ["export", f"x{ESC}.h5", "--format", "uff"], ["cache", "ls", "--cache", f"/proc/x{ESC}"],
+        ["identify", "mm.csv", "--kind", "dynamical", "--method", f"x{ESC}"],
+        ["identify", "mm.csv", "--kind", "dynamical", "--method", "sindy_pi_dynamical",
+         "--prior", f"a{ESC}=1"],
+        ["identify", "mm.csv", "--kind", "dynamical", "--method", "sindy_pi_dynamical",
+         "--param", f"a{ESC}=1"],
+        ["identify", "mm.csv", "--kind", "dynamical", "--units", f"x{ESC}=m"],
+        ["family", "write", f"x{ESC}", "-o", "f"], ["runs", "ls", f"x{ESC}"], ["list", f"--x{ESC}"],
+        [f"x{ESC}"], ["run", "michaelis_menten", "--plugin", f"x{ESC}.py"],
+    ]
+
+    def case(argv):
+        def run() -> str | None:
+            p = _hang(argv, work, 120)
+            if isinstance(p, str):
+                return p
+            if "\x1b" in p.stderr:
+                return f"a raw ESC in the error output: {p.stderr.strip()[-160:]!r}"
+            return _cli_finding(p)
+        return ("escapes: " + " ".join(a.replace(ESC, "<ESC>") for a in argv), run)
+
+    return [case(a) for a in argvs]
+
+
 # ------------------------------------------------------------------ uff
 
 #: The ordinate line of a UFF58 record as ``testbed export`` writes an acceleration's
@@ -616,6 +656,7 @@ FAMILIES = {
     "envvars": lambda work: run_inprocess(envvars_cases(_hostile.subfolder(work, "envvars"))),
     "channels": lambda work: run_inprocess(channels_cases(_hostile.subfolder(work, "channels"))),
     "tomlbytes": lambda work: run_inprocess(tomlbytes_cases(_hostile.subfolder(work, "tomlbytes"))),
+    "escapes": lambda work: run_inprocess(escapes_cases(_hostile.subfolder(work, "escapes"))),
     "texts": lambda work: run_inprocess(texts_cases()),
     "uff": lambda work: run_inprocess(uff_cases(_hostile.subfolder(work, "uff"))),
     "bounds": lambda work: _hostile.run_inprocess(bounds_cases(_hostile.subfolder(work, "bounds")),

@@ -36,6 +36,7 @@ from testbed.core.errors import (
     InputError,
     ScenarioError,
     TestbedError,
+    printable,
     show_value,
 )
 
@@ -89,7 +90,7 @@ class _Parser(argparse.ArgumentParser):
         return ns, rest
 
     def error(self, message: str) -> None:  # type: ignore[override]
-        print(f"error: {self.prog}: {message} (see {self.prog} --help)", file=sys.stderr)
+        print(f"error: {self.prog}: {_one_line(message)} (see {self.prog} --help)", file=sys.stderr)
         sys.exit(EXIT_USAGE)
 
 
@@ -958,7 +959,10 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def _one_line(text: object) -> str:
-    return " ".join(str(text).split())
+    """``text`` as one printable line: runs of whitespace as one space, every other control
+    character escaped (an ESC in a `--prior` key, a `report` source or a `summary` file went
+    raw to the terminal, round 14)."""
+    return printable(" ".join(str(text).split()))
 
 
 def _blas_threads() -> None:

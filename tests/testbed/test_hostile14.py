@@ -250,3 +250,24 @@ def test_a_free_text_with_a_control_character_is_refused(text, where):
         check_value(value, field, file="f.toml", key=where)
     ok = ["Ünïcode — text, 'quoted' [1 %]"] if field.type is list else "Ünïcode — text, 'quoted' [1 %]"
     assert check_value(ok, field, file="f.toml", key=where) == ok
+
+
+# ------------------------------------------------------------------ error lines
+
+
+@pytest.mark.parametrize("argv", [["summary", "x\x1b[31mRED"], ["report", "x\x1b[31mRED", "-o", "r"],
+                                  ["list", "--bogus\x1b[31m"]])
+def test_an_error_line_never_carries_a_control_character(argv, capsys, tmp_path, monkeypatch):
+    from testbed.cli import main
+
+    # the ESC of a `summary` file, a `report` source or a `--prior` key went raw to the terminal
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("TESTBED_NO_SERVER", "1")
+    try:
+        status = main(argv)
+    except SystemExit as e:  # (argparse's own refusal exits)
+        status = e.code
+    assert status == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: ") and "\\x1b[31m" in err and "\x1b" not in err
+    assert err.count("\n") == 1
