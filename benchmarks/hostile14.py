@@ -41,6 +41,17 @@ Families (where rounds 1-13 went least):
     mm, m/s, mm/s, m/s^2, g, mm/s^2, N, kN), and its ID line a NUL, an ESC, a DEL or a latin-1
     byte: a record whose label and codes declare different quantities identified, a name with
     a control character identified, or a traceback, is a finding.
+``requests``
+    A resident server (``testbed serve``) sent requests a client of its own would not: a lone
+    surrogate in the environment, an environment name, the folder or an argument, a folder
+    that does not exist, an argument of 900 kB, a request over the limit, not JSON, JSON nested
+    100,000 deep, one or no descriptor, a client gone before the reply, ``argv`` a string, a
+    umask of 2**70, an empty ``argv``.  An internal error or traceback of the command, the
+    server ended, or the next command not served is a finding.
+``longargs``
+    Every path argument and option of the commands at 100,000 characters (Linux allows 128 kB
+    an argument; round 13 tried 5,000): an error line longer than the harness's limit
+    (:data:`benchmarks._hostile.MAX_LINE_CHARS`) is a finding.
 ``escapes``
     An ESC sequence in an argument of every command (a scenario, a seed, a study, a results
     file, a report source, a dataset, a cache, an identifier, a ``--prior`` or ``--param`` key,
@@ -79,6 +90,7 @@ import os
 import shutil
 import subprocess
 import sys
+import threading
 import time
 from collections import Counter
 from pathlib import Path
@@ -388,6 +400,144 @@ def channels_cases(work: Path) -> list[tuple[str, object]]:
     return cases
 
 
+# ------------------------------------------------------------------ requests
+
+def _served(path: Path, request: dict | bytes, fds: int = 3, vanish: bool = False) -> tuple[bytes, bytes]:
+    """Send ``request`` (a dict as JSON, or raw bytes after the length) to the server at
+    ``path`` with ``fds`` descriptors (standard input, a pipe for output and one for errors);
+    the server's replies and what the command wrote to its error pipe."""
+    import array
+    import socket
+    import struct
+
+    s = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+    s.connect(str(path))
+    out_r, out_w = os.pipe()
+    err_r, err_w = os.pipe()
+    data = request if isinstance(request, bytes) else json.dumps(request).encode()
+    msg = struct.pack("!I", len(data)) + data
+    s.sendmsg([msg], [(socket.SOL_SOCKET, socket.SCM_RIGHTS, array.array("i", [0, out_w, err_w][:fds]))])
+    os.close(out_w)
+    os.close(err_w)
+    got: dict[int, bytes] = {out_r: b"", err_r: b""}
+
+    def drain(fd: int) -> None:  # (a command blocked on a full pipe never replies)
+        while (b := os.read(fd, 1 << 16)):
+            got[fd] += b
+
+    readers = [threading.Thread(target=drain, args=(fd,), daemon=True) for fd in got]
+    for r in readers:
+        r.start()
+    replies = b""
+    if vanish:
+        s.close()
+    else:
+        s.settimeout(60)
+        while (b := s.recv(4096)):
+            replies += b
+        s.close()
+    for r in readers:
+        r.join(timeout=10)
+    for fd in got:
+        os.close(fd)
+    return replies, got[err_r]
+
+
+def requests_cases(work: Path) -> list[tuple[str, object]]:
+    from testbed import server
+
+    folder = work / "srv"
+    folder.mkdir(mode=0o700, exist_ok=True)
+    sock = folder / "s"
+    env = {**_hostile.ENV, "TESTBED_SERVER_SOCKET": str(sock)}
+    env.pop("TESTBED_NO_SERVER", None)
+    state: dict = {}
+
+    def ensure() -> dict:
+        if "proc" not in state or state["proc"].poll() is not None:
+            state["proc"] = subprocess.Popen([PYTHON, "-m", "testbed.cli", "serve", "--idle", "120",
+                                              "--warm-up", "none"], cwd=work, env=env,
+                                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+            for _ in range(300):
+                if sock.exists():
+                    break
+                time.sleep(0.1)
+        return {"argv": ["list", "--plain"], "cwd": str(work), "env": env, "umask": 0o22,
+                "key": server.server_key(env)}
+
+    def case(label, change=None, raw=None, fds=3, vanish=False):
+        def run() -> str | None:
+            base = ensure()
+            request = raw if raw is not None else {**base, **(change or {})}
+            replies, err = _served(sock, request, fds, vanish)
+            if b"internal error" in err or b"Traceback" in err:
+                return f"the command: {err.decode(errors='replace').strip()[-200:]}"
+            if state["proc"].poll() is not None:
+                return f"the server ended (status {state['proc'].returncode})"
+            replies, err = _served(sock, base)  # the server still serves
+            if b'"status": 0' not in replies:
+                return f"the next command was not served: {replies[:120]!r} {err[-120:]!r}"
+            return None
+        return (f"requests: {label}", run)
+
+    cases = [
+        case("a lone surrogate in the environment", {"env": {**env, "X": "\ud800"}}),
+        case("a lone surrogate in an environment name", {"env": {**env, "\ud800": "1"}}),
+        case("a lone surrogate in the folder", {"cwd": str(work) + "/\ud800"}),
+        case("a lone surrogate in an argument", {"argv": ["list", "\ud800"]}),
+        case("a folder that does not exist", {"cwd": "/nonexistent/x"}),
+        case("an argument of 900 kB", {"argv": ["run", "x" * 900_000]}),
+        case("a request over the limit", raw=b"x" * (server.MAX_REQUEST + 1)),
+        case("not JSON", raw=b"{not json"),
+        case("JSON nested 100,000 deep", raw=b"[" * 100_000),
+        case("one descriptor", fds=1),
+        case("no descriptor", fds=0),
+        case("a client gone before the reply", vanish=True),
+        case("argv a string", {"argv": "list"}),
+        case("umask 2**70", {"umask": 2 ** 70}),
+        case("an empty argv", {"argv": []}),
+    ]
+
+    def stop() -> str | None:
+        proc = state.get("proc")
+        if proc is not None and proc.poll() is None:
+            proc.terminate()
+            proc.wait(timeout=30)
+        return None
+
+    cases.append(("requests: (the server stopped)", stop))
+    return cases
+
+
+# ------------------------------------------------------------------ longargs
+
+#: A path argument this long [characters]: under Linux's 128 kB an argument (round 13 tried
+#: 5,000, under the harness's limit of a line).
+LONG = "x" * 100_000
+
+
+def longargs_cases(work: Path) -> list[tuple[str, object]]:
+    argvs = [["run", LONG], ["generate", LONG], ["sweep", LONG], ["summary", LONG],
+             ["report", LONG, "-o", "r"], ["export", LONG, "--format", "uff"],
+             ["identify", LONG, "--kind", "dynamical"], ["family", "write", LONG, "-o", "f"],
+             ["run", "michaelis_menten", "-o", LONG + "/y"], ["runs", "ls", LONG],
+             ["run", "michaelis_menten", "--plugin", LONG + ".py"], ["cache", "ls", "--cache", LONG],
+             ["identify", "x.csv", "--kind", "dynamical", "--units", LONG + "=m"]]
+
+    def case(argv):
+        def run() -> str | None:
+            p = _hang(argv, work, 120)
+            if isinstance(p, str):
+                return p
+            longest = max((len(ln) for ln in p.stderr.splitlines()), default=0)
+            if longest > _hostile.MAX_LINE_CHARS:
+                return f"an error line of {longest} characters"
+            return _cli_finding(p)
+        return ("longargs: " + " ".join(a if len(a) < 99_000 else "<100,000 chars>" for a in argv), run)
+
+    return [case(a) for a in argvs]
+
+
 # ------------------------------------------------------------------ escapes
 
 ESC = "\x1b[31mRED"
@@ -656,6 +806,8 @@ FAMILIES = {
     "envvars": lambda work: run_inprocess(envvars_cases(_hostile.subfolder(work, "envvars"))),
     "channels": lambda work: run_inprocess(channels_cases(_hostile.subfolder(work, "channels"))),
     "tomlbytes": lambda work: run_inprocess(tomlbytes_cases(_hostile.subfolder(work, "tomlbytes"))),
+    "requests": lambda work: run_inprocess(requests_cases(_hostile.subfolder(work, "requests"))),
+    "longargs": lambda work: run_inprocess(longargs_cases(_hostile.subfolder(work, "longargs"))),
     "escapes": lambda work: run_inprocess(escapes_cases(_hostile.subfolder(work, "escapes"))),
     "texts": lambda work: run_inprocess(texts_cases()),
     "uff": lambda work: run_inprocess(uff_cases(_hostile.subfolder(work, "uff"))),

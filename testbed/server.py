@@ -708,17 +708,33 @@ def _bad_field(r: dict) -> str:
     11): a umask outside 0-0o777 (``os.umask``'s OverflowError; -1 or ``true`` were applied as
     0o777 and 1), a ``cwd`` that is not an absolute path or holds a NUL byte, an environment
     name that is empty or holds ``=`` or NUL, a value or argument holding NUL (the operating
-    system's C strings cannot).  The testbed's own client sends none of them.
+    system's C strings cannot), a ``cwd`` or environment holding a lone surrogate the file
+    system's encoding cannot hold (round 14).  The testbed's own client sends none of them.
     """
     if isinstance(r["umask"], bool) or not 0 <= r["umask"] <= 0o777:
         return "umask outside 0-0o777"
     if not r["cwd"].startswith("/") or "\0" in r["cwd"]:
         return "cwd not an absolute path"
-    if any(not k or "=" in k or "\0" in k or "\0" in v for k, v in r["env"].items()):
+    if not _encodable(r["cwd"]):
+        return "a cwd the system cannot hold"
+    if any(not k or "=" in k or "\0" in k or "\0" in v or not (_encodable(k) and _encodable(v))
+           for k, v in r["env"].items()):
         return "an environment variable the system cannot hold"
     if any("\0" in a for a in r["argv"]):
         return "an argument holding a NUL byte"
     return ""
+
+
+def _encodable(text: str) -> bool:
+    """Whether ``text`` has a form in the file system's encoding: a lone surrogate such as
+    ``\ud800`` in a request's environment or folder (JSON can carry one; the testbed's own
+    client, decoding with ``surrogateescape``, sends none) made the child's ``os.environ`` or
+    ``os.chdir`` an internal error (round 14)."""
+    try:
+        os.fsencode(text)
+    except UnicodeEncodeError:
+        return False
+    return True
 
 
 def _start(st: _Server, conn: socket.socket, request: dict, fds: list[int]) -> None:

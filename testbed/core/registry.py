@@ -83,8 +83,14 @@ def import_plugin(spec: str) -> Any:
                               "a .py file or an importable dotted module name") from e
         configure_loaded()  # a plugin importing MuJoCo itself: its C-level log silenced too
         return module
-    path = Path(spec).resolve()
-    if not path.is_file():
+    try:
+        path = Path(spec).resolve()
+        is_file = path.is_file()
+    except OSError as e:  # a name of 100,000 characters: ENAMETOOLONG, an internal error of
+        # `run --plugin` (round 14)
+        raise PluginError(f"plugin {spec}: not a usable path ({e.strerror or type(e).__name__}); "
+                          "expected a .py file or an importable dotted module name") from None
+    if not is_file:
         raise PluginError(f"plugin {spec}: no such file")
     modname = plugin_module_name(path)
     if modname in sys.modules:

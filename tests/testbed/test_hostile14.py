@@ -271,3 +271,44 @@ def test_an_error_line_never_carries_a_control_character(argv, capsys, tmp_path,
     err = capsys.readouterr().err
     assert err.startswith("error: ") and "\\x1b[31m" in err and "\x1b" not in err
     assert err.count("\n") == 1
+
+
+# ------------------------------------------------------------------ served requests
+
+
+@pytest.mark.parametrize("change, why", [
+    ({"env": {"X": "\ud800"}}, "an environment variable the system cannot hold"),
+    ({"env": {"\ud800": "1"}}, "an environment variable the system cannot hold"),
+    ({"cwd": "/tmp/\ud800"}, "a cwd the system cannot hold"),
+])
+def test_a_request_holding_a_lone_surrogate_is_refused(change, why):
+    from testbed import server
+
+    # JSON carries a lone surrogate; the child's os.environ or os.chdir raised
+    # UnicodeEncodeError: "internal error (a bug, not your input)", status 3
+    request = {"argv": ["list"], "cwd": "/tmp", "env": {"HOME": "/root"}, "umask": 0o22, **change}
+    assert server._bad_field(request) == why
+    # what the testbed's own client sends: undecodable bytes as surrogateescape's \udc80-\udcff
+    request.update(cwd="/tmp", env={"X": os.fsdecode(b"\xff")})
+    assert server._bad_field(request) == ""
+
+
+@pytest.mark.parametrize("argv", [["summary", "x" * 100_000], ["export", "y" * 100_000, "--format", "uff"]])
+def test_an_error_line_cuts_a_path_of_100000_characters(argv, capsys, tmp_path, monkeypatch):
+    from testbed.cli import MAX_WORD_CHARS, main
+
+    # a path under Linux's 128 kB an argument made a 100 kB "one line" error
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setenv("TESTBED_NO_SERVER", "1")
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and len(err) < MAX_WORD_CHARS + 200
+    assert "characters ...]" in err and err.rstrip().endswith("too long for the file system)")
+
+
+def test_a_plugin_file_name_too_long_for_the_file_system_is_one_error_line():
+    from testbed.core.registry import PluginError, import_plugin
+
+    # `run --plugin <100,000 characters>.py`: OSError 36 from Path.resolve, an internal error
+    with pytest.raises(PluginError, match="not a usable path"):
+        import_plugin("x" * 100_000 + ".py")
