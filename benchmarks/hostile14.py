@@ -188,12 +188,14 @@ def index_cases(work: Path) -> list[tuple[str, object]]:
         case("a folder", lambda path, b: path.mkdir()),
         case("a link loop", lambda path, b: (path.symlink_to(path.name + ".x"),
                                              (path.parent / (path.name + ".x")).symlink_to(path.name))),
-        case("20 MB of JSON", lambda path, b: path.write_text(json.dumps({"format": 2, "pad": "x" * (20 << 20)}))),
+        case("20 MB of JSON", lambda path, b: path.write_text(
+            json.dumps({"format": 2, "pad": "x" * (20 << 20)}))),
         case("empty", lambda path, b: path.write_bytes(b"")),
     ]
     cases += [case(f"cut at {f:.0%}", cut(f)) for f in (0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 0.99)]
     cases += [case(f"bit flipped at {f:.0%}", flip(f)) for f in (0.0, 0.1, 0.3, 0.5, 0.7, 0.9, 0.99)]
-    cases += [case(f"value {v!r}", value(v)) for v in (None, [], [[1, 2, 3]], "x", [["a", ["b"], [["c", "d"]]]],
+    cases += [case(f"value {v!r}", value(v)) for v in (None, [], [[1, 2, 3]], "x",
+                                                     [["a", ["b"], [["c", "d"]]]],
                                                      {"a": 1}, [["t", ["c"], [[5]]]])]
 
     def racing() -> str | None:
@@ -203,7 +205,8 @@ def index_cases(work: Path) -> list[tuple[str, object]]:
         ps = [subprocess.Popen([PYTHON, "-m", "testbed.cli", *plain], cwd=work, env=e,
                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True) for _ in range(4)]
         outs = [p.communicate(timeout=120) for p in ps]
-        bad = [f"status {p.returncode}: {err[-200:]}" for p, (out, err) in zip(ps, outs) if p.returncode]
+        bad = [f"status {p.returncode}: {err[-200:]}" for p, (out, err) in zip(ps, outs, strict=True)
+               if p.returncode]
         bad += ["a listing other than the undamaged one" for out, _ in outs if out != want]
         return "; ".join(bad) or None
 
@@ -348,10 +351,12 @@ def envvars_cases(work: Path) -> list[tuple[str, object]]:
 NAMES = {
     "fullwidth look-alike": "acceleration/ａｃｃ1", "a newline": "acceleration/acc\n1",
     "no signal": "acc1", "a slash more": "acceleration/acc1/x", "an empty channel": "acceleration/",
-    "an empty signal": "/acc1", "two slashes": "acceleration//acc1", "2,000 characters": "acceleration/" + "a" * 2000,
+    "an empty signal": "/acc1", "two slashes": "acceleration//acc1",
+    "2,000 characters": "acceleration/" + "a" * 2000,
     "a format string": "acceleration/{0}%s", "upper-case signal": "ACCELERATION/acc1",
     "decomposed accent": "acceleration/acce\u0301", "right-to-left mark": "acceleration/acc\u200f1",
-    "a space": "acceleration/acc 1", "a tab": "acceleration/acc\t1", "zero-width space": "acceleration/acc\u200b1",
+    "a space": "acceleration/acc 1", "a tab": "acceleration/acc\t1",
+    "zero-width space": "acceleration/acc\u200b1",
 }
 UNITS = {"m/s²": "m/s²", "M/S^2": "M/S^2", "m/s/s": "m/s/s", "µm/s^2": "µm/s^2", "blank": " ",
          "1,000 characters": "m" * 1000, "NBSP inside": "m/s\u00a0^2", "a newline": "m/s^2\n",
@@ -623,7 +628,8 @@ def uff_cases(work: Path) -> list[tuple[str, object]]:
              for spec in quantity for unit in order]
     cases += [case(f"a name of {k}", name(v), k != "a latin-1 byte")
               for k, v in {"a NUL": b"acceleration/a\x002", "an ESC": b"acceleration/\x1b[31m",
-                           "a latin-1 byte": b"acceleration/acc\xe9", "a DEL": b"acceleration/ac\x7f2"}.items()]
+                           "a latin-1 byte": b"acceleration/acc\xe9",
+                           "a DEL": b"acceleration/ac\x7f2"}.items()]
     return cases
 
 
@@ -693,7 +699,8 @@ def _bound_values(f) -> list[tuple[str, object, bool]]:
         if f.type is int:
             b = int(math.ceil(b) if side == "min" else math.floor(b))
             if incl or b != (f.min if side == "min" else f.max):
-                out += [(f"{side} {b}", b, True), (f"beyond {side} {b}", b + (-1 if side == "min" else 1), False)]
+                out += [(f"{side} {b}", b, True),
+                        (f"beyond {side} {b}", b + (-1 if side == "min" else 1), False)]
             else:
                 out += [(f"{side} {b} (excluded)", b, False),
                         (f"inside {side} {b}", b + (1 if side == "min" else -1), True)]
@@ -711,7 +718,7 @@ def bounds_cases(work: Path) -> list[tuple[str, object]]:
     import copy
 
     from testbed.pipeline.plugins import identifier_class, rig_class
-    from testbed.pipeline.scenario import NOISE_SCHEMA, SCENARIO_DIR, _read_toml, scenario_from_dict
+    from testbed.pipeline.scenario import NOISE_SCHEMA, SCENARIO_DIR, _read_toml
     from testbed.pipeline.signal_chain import SIGNAL_SCHEMAS
 
     cases = []

@@ -963,7 +963,7 @@ def build_parser() -> argparse.ArgumentParser:
 #: this [characters] is shown as its head and tail: a scenario, results or dataset path of
 #: 100,000 characters (under Linux's 128 kB an argument) made a 100 kB error line (round 14).
 MAX_WORD_CHARS = 1000
-_LONG_WORD = re.compile(r"\S{%d,}" % (MAX_WORD_CHARS + 1))
+_LONG_WORD = re.compile(rf"\S{{{MAX_WORD_CHARS + 1},}}")
 
 
 def _cut_word(m: re.Match) -> str:

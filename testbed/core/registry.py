@@ -221,7 +221,8 @@ class Registry:
                 elif not isinstance(obj, (type, types.ModuleType)):
                     # a function or an instance was loaded and ignored in silence (round 14)
                     raise PluginError(f"{self.kind} entry point {ep.name} = {ep.value} "
-                                      f"({self.entry_points}) names an object of type {type(obj).__name__!r}; "
+                                      f"({self.entry_points}) names an object of type "
+                                      f"{type(obj).__name__!r}; "
                                       "expected a module (whose import registers its classes) "
                                       "or a class")
             except PluginError:

@@ -55,8 +55,15 @@ from testbed.core.budget import check_cost, check_steps
 from testbed.core.errors import RigError, ScenarioError
 from testbed.core.kinds import metric_names, metric_range
 from testbed.core.registry import REGISTERED_NAME, REGISTERED_NAME_DOC
-from testbed.core.schema import (ONE_LINE, ONE_LINE_DOC, Field, near_miss, validate_header, validate_table,
-                                 validate_variant)
+from testbed.core.schema import (
+    ONE_LINE,
+    ONE_LINE_DOC,
+    Field,
+    near_miss,
+    validate_header,
+    validate_table,
+    validate_variant,
+)
 from testbed.pipeline.plugins import IDENTIFIERS, RIGS
 from testbed.pipeline.signal_chain import SIGNAL_SCHEMAS, check_keys_used, check_signal, rig_auto_keys
 

@@ -235,10 +235,10 @@ def test_a_channel_name_with_a_control_or_invisible_character_is_refused(name):
                                    "family.description"])
 def test_a_free_text_with_a_control_character_is_refused(text, where):
     from testbed.core.errors import ScenarioError
+    from testbed.core.schema import check_value
     from testbed.pipeline.scenario import HEADER_SCHEMA
     from testbed.studies.family import FAMILY_SCHEMA
     from testbed.studies.study import STUDY_SCHEMA
-    from testbed.core.schema import check_value
 
     # a scenario's description with a newline split its row of `testbed list --plain` in two,
     # a tab added a column, an ESC sequence went raw to the terminal
