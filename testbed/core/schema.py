@@ -27,7 +27,7 @@ REQUIRED = object()
 #: went raw to the terminal (round 14).  C0 and C1 controls, DEL and the Unicode line and
 #: paragraph separators.
 ONE_LINE = "[^\\x00-\\x1f\\x7f-\\x9f\\u2028\\u2029]*"
-ONE_LINE_DOC = "a line of text without control characters (newline, tab, escape)"
+ONE_LINE_DOC = "of one line without control characters (newline, tab, escape)"
 
 _TYPE_NAMES = {bool: "a boolean", int: "an integer", float: "a number", str: "a string",
                list: "a list", dict: "a table", object: "any value"}
@@ -111,9 +111,7 @@ class Field:
             bounds.append(f"with at least {self.min_items} item(s)")
         if self.type is list and self.max_items is not None:
             bounds.append(f"with at most {self.max_items} item(s)")
-        if self.pattern is not None and self.type is list and self.pattern_doc.startswith(("a ", "an ")):
-            bounds.append(f"each {self.pattern_doc}")  # "a list of strings each a line of ..."
-        elif self.pattern is not None and self.pattern_doc.startswith(("a ", "an ")):
+        if self.pattern is not None and self.pattern_doc.startswith(("a ", "an ")):
             what = self.pattern_doc  # "expected a string a name of letters ..." read badly
         elif self.pattern is not None:
             bounds.append(self.pattern_doc or f"matching {self.pattern}")
