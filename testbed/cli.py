@@ -16,6 +16,7 @@ import errno
 import functools
 import gc
 import os
+import re
 import signal
 import socket
 import stat
@@ -36,6 +37,7 @@ from testbed.core.errors import (
     InputError,
     ScenarioError,
     TestbedError,
+    printable,
     show_value,
 )
 
@@ -89,7 +91,7 @@ class _Parser(argparse.ArgumentParser):
         return ns, rest
 
     def error(self, message: str) -> None:  # type: ignore[override]
-        print(f"error: {self.prog}: {message} (see {self.prog} --help)", file=sys.stderr)
+        print(f"error: {self.prog}: {_one_line(message)} (see {self.prog} --help)", file=sys.stderr)
         sys.exit(EXIT_USAGE)
 
 
@@ -957,8 +959,23 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
+#: A word (a run of characters without a space: a path, a value) of an error line longer than
+#: this [characters] is shown as its head and tail: a scenario, results or dataset path of
+#: 100,000 characters (under Linux's 128 kB an argument) made a 100 kB error line (round 14).
+MAX_WORD_CHARS = 1000
+_LONG_WORD = re.compile(rf"\S{{{MAX_WORD_CHARS + 1},}}")
+
+
+def _cut_word(m: re.Match) -> str:
+    w, keep = m.group(0), (MAX_WORD_CHARS - 40) // 2
+    return f"{w[:keep]}[... {len(w) - 2 * keep} characters ...]{w[-keep:]}"
+
+
 def _one_line(text: object) -> str:
-    return " ".join(str(text).split())
+    """``text`` as one printable line: runs of whitespace as one space, every other control
+    character escaped (an ESC in a `--prior` key, a `report` source or a `summary` file went
+    raw to the terminal, round 14), a word over :data:`MAX_WORD_CHARS` cut in its middle."""
+    return _LONG_WORD.sub(_cut_word, printable(" ".join(str(text).split())))
 
 
 def _blas_threads() -> None:

@@ -512,6 +512,7 @@ def serve(command: Callable[[list[str]], int], idle: float = IDLE_S, path: Path 
     _refuse_if_served(path)
     _preload()
     _warm_up(warm_up, log, warm_up_command or command)
+    _not_a_socket(path)  # (something other than a socket may have appeared meanwhile)
     with contextlib.suppress(FileNotFoundError):
         path.unlink()  # (a server that started meanwhile loses its socket to this one)
     listener = _bind(path)
@@ -583,10 +584,38 @@ def _stop_listening(st: _Server, path: Path, inode: int) -> None:
     st.listener = None
 
 
-def _refuse_if_served(path: Path) -> None:
-    """Refuse to start while another server answers at ``path``; remove a dead one's socket."""
+def _not_a_socket(path: Path) -> None:
+    """Refuse a ``path`` that holds something other than a socket: the server removes what is
+    there before it binds, and a regular file, a FIFO, a link or a folder named by
+    ``$TESTBED_SERVER_SOCKET`` was deleted (a file's content lost) or ended `testbed serve` in
+    "[Errno 21] Is a directory" (round 14)."""
+    import stat
+
     from testbed.core.errors import InputError
 
+    try:
+        mode = os.lstat(path).st_mode
+    except FileNotFoundError:
+        return
+    except OSError as e:
+        raise InputError(f"socket path {path} ($TESTBED_SERVER_SOCKET or the default): cannot be "
+                         f"looked up ({e.strerror}); expected a free path or a server's socket") \
+            from None
+    if not stat.S_ISSOCK(mode):
+        what = ("a folder" if stat.S_ISDIR(mode) else "a symbolic link" if stat.S_ISLNK(mode)
+                else "a FIFO" if stat.S_ISFIFO(mode) else "a file" if stat.S_ISREG(mode)
+                else "a device")
+        raise InputError(f"socket path {path} ($TESTBED_SERVER_SOCKET or the default): holds "
+                         f"{what}, which the server would remove; expected a free path or a "
+                         "server's socket")
+
+
+def _refuse_if_served(path: Path) -> None:
+    """Refuse to start while another server answers at ``path``; remove a dead one's socket;
+    refuse a path holding anything else (:func:`_not_a_socket`)."""
+    from testbed.core.errors import InputError
+
+    _not_a_socket(path)
     if path.exists():
         probe = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
         try:
@@ -679,17 +708,33 @@ def _bad_field(r: dict) -> str:
     11): a umask outside 0-0o777 (``os.umask``'s OverflowError; -1 or ``true`` were applied as
     0o777 and 1), a ``cwd`` that is not an absolute path or holds a NUL byte, an environment
     name that is empty or holds ``=`` or NUL, a value or argument holding NUL (the operating
-    system's C strings cannot).  The testbed's own client sends none of them.
+    system's C strings cannot), a ``cwd`` or environment holding a lone surrogate the file
+    system's encoding cannot hold (round 14).  The testbed's own client sends none of them.
     """
     if isinstance(r["umask"], bool) or not 0 <= r["umask"] <= 0o777:
         return "umask outside 0-0o777"
     if not r["cwd"].startswith("/") or "\0" in r["cwd"]:
         return "cwd not an absolute path"
-    if any(not k or "=" in k or "\0" in k or "\0" in v for k, v in r["env"].items()):
+    if not _encodable(r["cwd"]):
+        return "a cwd the system cannot hold"
+    if any(not k or "=" in k or "\0" in k or "\0" in v or not (_encodable(k) and _encodable(v))
+           for k, v in r["env"].items()):
         return "an environment variable the system cannot hold"
     if any("\0" in a for a in r["argv"]):
         return "an argument holding a NUL byte"
     return ""
+
+
+def _encodable(text: str) -> bool:
+    """Whether ``text`` has a form in the file system's encoding: a lone surrogate such as
+    ``\ud800`` in a request's environment or folder (JSON can carry one; the testbed's own
+    client, decoding with ``surrogateescape``, sends none) made the child's ``os.environ`` or
+    ``os.chdir`` an internal error (round 14)."""
+    try:
+        os.fsencode(text)
+    except UnicodeEncodeError:
+        return False
+    return True
 
 
 def _start(st: _Server, conn: socket.socket, request: dict, fds: list[int]) -> None:

@@ -14,6 +14,10 @@ def _one_line(text: str) -> str:
     return "".join(c if c.isprintable() else repr(c)[1:-1] for c in text)
 
 
+#: ``text`` with control characters escaped (the command line's error lines; public name).
+printable = _one_line
+
+
 def _cut(text: str) -> str:
     """``text`` cut to :data:`MAX_VALUE_CHARS` characters, the cut marked ``[...]``."""
     return text if len(text) <= MAX_VALUE_CHARS else text[:MAX_VALUE_CHARS - 5] + "[...]"

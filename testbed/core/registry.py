@@ -28,6 +28,7 @@ import importlib.util
 import pkgutil
 import re
 import sys
+import types
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -82,8 +83,14 @@ def import_plugin(spec: str) -> Any:
                               "a .py file or an importable dotted module name") from e
         configure_loaded()  # a plugin importing MuJoCo itself: its C-level log silenced too
         return module
-    path = Path(spec).resolve()
-    if not path.is_file():
+    try:
+        path = Path(spec).resolve()
+        is_file = path.is_file()
+    except OSError as e:  # a name of 100,000 characters: ENAMETOOLONG, an internal error of
+        # `run --plugin` (round 14)
+        raise PluginError(f"plugin {spec}: not a usable path ({e.strerror or type(e).__name__}); "
+                          "expected a .py file or an importable dotted module name") from None
+    if not is_file:
         raise PluginError(f"plugin {spec}: no such file")
     modname = plugin_module_name(path)
     if modname in sys.modules:
@@ -211,7 +218,18 @@ class Registry:
                 if isinstance(obj, type) and obj not in self._entries.values():
                     name = getattr(obj, "name", "") or ep.name
                     self.register(name, tags=getattr(obj, "tags", ()))(obj)
-            except Exception as e:
+                elif not isinstance(obj, (type, types.ModuleType)):
+                    # a function or an instance was loaded and ignored in silence (round 14)
+                    raise PluginError(f"{self.kind} entry point {ep.name} = {ep.value} "
+                                      f"({self.entry_points}) names an object of type "
+                                      f"{type(obj).__name__!r}; "
+                                      "expected a module (whose import registers its classes) "
+                                      "or a class")
+            except PluginError:
+                raise
+            except (Exception, SystemExit) as e:
+                # (SystemExit: an entry point's sys.exit(0) at import ended `testbed list` and
+                # `testbed run` with status 0 and no output, round 14; as a plugin file's)
                 raise PluginError(f"{self.kind} entry point {ep.name} = {ep.value} "
                                   f"({self.entry_points}): {type(e).__name__}: {e}") from e
             finally:

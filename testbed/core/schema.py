@@ -21,6 +21,14 @@ from testbed.core.errors import ScenarioError
 
 REQUIRED = object()
 
+#: A free text shown on one line (a description, a tag): no control character.  A scenario's
+#: description holding a newline split its row of `testbed list --plain` in two (a script
+#: reading the tab-separated rows read a broken one), a tab added a column, an ESC sequence
+#: went raw to the terminal (round 14).  C0 and C1 controls, DEL and the Unicode line and
+#: paragraph separators.
+ONE_LINE = "[^\\x00-\\x1f\\x7f-\\x9f\\u2028\\u2029]*"
+ONE_LINE_DOC = "of one line without control characters (newline, tab, escape)"
+
 _TYPE_NAMES = {bool: "a boolean", int: "an integer", float: "a number", str: "a string",
                list: "a list", dict: "a table", object: "any value"}
 _ITEM_NAMES = {bool: "booleans", int: "integers", float: "numbers", str: "strings"}

@@ -41,7 +41,10 @@ The rule (stated here, applied by :func:`_current`):
   :data:`WRITE_WITHIN_S` of that import (the command line imports this module as a listing
   starts, in a fresh process; a long-lived one may hold modules read long before).  The next
   call computes the value again;
-- an index that cannot be read, parsed or written, holds no stamps, or whose value the caller's
+- an index that cannot be read, parsed or written, whose content is not the one its
+  ``sha256`` was computed from (a bit flipped, a value edited: an edited listing of no
+  sections printed nothing, status 0), is not a regular file (a FIFO, a device)
+  or is larger than :data:`MAX_INDEX_BYTES`, holds no stamps, or whose value the caller's
   ``valid`` refuses, is as good as none: the value is computed (the index only ever saves time;
   it never fails a command).
 
@@ -54,6 +57,7 @@ from __future__ import annotations
 import hashlib
 import json
 import os
+import stat
 import sys
 import time
 from collections.abc import Callable, Iterable
@@ -63,8 +67,9 @@ from typing import Any
 from testbed.core.atomic import atomic_write_text
 from testbed.core.errors import TestbedError
 
-#: Format of an index file; another version is ignored (recomputed and rewritten).
-FORMAT = 2
+#: Format of an index file; another version is ignored (recomputed and rewritten).  3: the
+#: index carries the SHA-256 of its content (``sha256``), checked on read (round 14).
+FORMAT = 3
 #: Names in a folder on ``sys.path`` that are its stamp (see the module docs).
 PATH_ENTRY_SUFFIXES = (".dist-info", ".egg-info", ".egg-link", ".pth")
 #: A stamp less than this old [s] at the import of this module is not trusted (see the module
@@ -75,6 +80,9 @@ RACY_S = 2.0
 WRITE_WITHIN_S = 30.0
 #: When this module was imported [s since the epoch] (see the module docs).
 _IMPORTED_AT = time.time()
+#: Largest index file read [bytes]: the listing's index, with the stamps of some 2,000 loaded
+#: modules, is about 0.3 MB; a larger file is not one this module wrote, and is not read.
+MAX_INDEX_BYTES = 16 << 20
 #: Environment variable naming the index folder ("" turns indexes off).
 INDEX_VARIABLE = "TESTBED_INDEX"
 #: Variables that change how a command reaches a server, not what it computes: not keyed.
@@ -195,12 +203,35 @@ def _current(index: dict) -> bool:
     return True
 
 
+def _read_regular(path: Path) -> bytes:
+    """The bytes of the regular file ``path``; OSError if it is anything else or larger than
+    :data:`MAX_INDEX_BYTES`.  Opened without blocking and checked on its descriptor: a FIFO at
+    the index's path blocked `testbed list` for ever, a link to ``/dev/zero`` read until memory
+    ran out (round 14)."""
+    fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
+    try:
+        st = os.fstat(fd)
+        if not stat.S_ISREG(st.st_mode) or st.st_size > MAX_INDEX_BYTES:
+            raise OSError(f"{path}: not a regular file of at most {MAX_INDEX_BYTES} bytes")
+        with os.fdopen(os.dup(fd), "rb") as fh:
+            return fh.read(MAX_INDEX_BYTES + 1)
+    finally:
+        os.close(fd)
+
+
+def _digest(index: dict) -> str:
+    """SHA-256 of an index's content (every key but its own ``sha256``), in canonical JSON."""
+    text = json.dumps(index, sort_keys=True, separators=(",", ":"), ensure_ascii=True)
+    return hashlib.sha256(text.encode("ascii")).hexdigest()
+
+
 def _read(path: Path, valid: Callable[[Any], bool]) -> dict | None:
     """The index in the file ``path`` if it is current and ``valid`` accepts its value (under
     ``"value"``), else None."""
     try:
-        index = json.loads(path.read_bytes())
-        if index.get("format") != FORMAT or "value" not in index or not _current(index):
+        index = json.loads(_read_regular(path))
+        if index.get("format") != FORMAT or "value" not in index \
+                or index.pop("sha256", None) != _digest(index) or not _current(index):
             return None
         return index if valid(index["value"]) else None
     except (OSError, ValueError, TypeError, KeyError, AttributeError, IndexError):
@@ -255,9 +286,9 @@ def stamped_value(name: str, build: Callable[[], Built],
     if newest / 1e9 > _IMPORTED_AT - RACY_S or time.time() - _IMPORTED_AT > WRITE_WITHIN_S:
         return value  # a stamp too young to trust, or modules read too long ago: not kept
     try:
-        atomic_write_text(path, json.dumps({"format": FORMAT, "name": name, "files": stamps_f,
-                                            "folders": stamps_d, "paths": stamps_p,
-                                            "value": value}))
+        index = {"format": FORMAT, "name": name, "files": stamps_f, "folders": stamps_d,
+                 "paths": stamps_p, "value": value}
+        atomic_write_text(path, json.dumps({**index, "sha256": _digest(index)}))
     except (OSError, TestbedError):
         pass  # no room, a read-only cache: the index only ever saves time
     return value

@@ -86,6 +86,9 @@ SAME_ORDER = {"m": "coordinate", "rad": "coordinate", "m/s": "rate", "rad/s": "r
 _UFF_UNITS = {(12, 1, 0, False): "m/s^2", (11, 1, 0, False): "m/s", (8, 1, 0, False): "m",
               (13, 0, 1, False): "N", (8, 0, 0, True): "rad", (11, 0, 0, True): "rad/s",
               (12, 0, 0, True): "rad/s^2", (13, 1, 1, True): "N m"}
+#: UFF specific data type -> the quantity it declares (:data:`SAME_ORDER`'s words), on a
+#: translational or a rotational coordinate alike
+_UFF_QUANTITY = {8: "coordinate", 11: "rate", 12: "acceleration", 13: "load"}
 #: Largest magnitude [SI unit] a channel may reach: identifier libraries go up to cubes of the
 #: signals and their Gram matrices sum squares of those, i.e. sixth powers, over the record;
 #: 1e50 keeps (1e50)^6 x 1e6 samples = 1e306 below float64's 1.8e308 (no physical record
@@ -533,6 +536,14 @@ def _finish(raw: _Raw, fs: float | None, units: str | Mapping[str, str] | None,
     if not raw.data:
         raise MeasuredDataError(path, "no channels found")
     names = list(raw.data)
+    for n in names:
+        # a newline, a NUL or a terminal escape in a name went on to the console (an ESC
+        # sequence coloured it), the model's JSON and its report's markdown (round 14)
+        bad = next((c for c in n if not c.isprintable()), None)
+        if bad is not None:
+            raise MeasuredDataError(path, f"channel name {n!r} holds the control or invisible "
+                                          f"character {bad!r} (U+{ord(bad):04X}); expected a name "
+                                          "of printable characters")
     if channels is not None:
         missing = [c for c in channels if c not in raw.data]
         if missing:
@@ -1061,10 +1072,23 @@ def _uff58_channel(path: Path, k: int, s: dict[str, Any], raw: _Raw) -> tuple[st
         raise MeasuredDataError(path, f"{where}: abscissa is specific data type "
                                       f"{s.get('abscissa_spec_data_type')}, not time (17)")
     label = str(s.get("ordinate_axis_units_lab", "")).strip()
+    key = (int(s.get("ordinate_spec_data_type", 0)), int(s.get("ordinate_len_unit_exp", 0)),
+           int(s.get("ordinate_force_unit_exp", 0)), abs(direction) in (4, 5, 6))
     if not label or label.upper() == "NONE":
-        key = (int(s.get("ordinate_spec_data_type", 0)), int(s.get("ordinate_len_unit_exp", 0)),
-               int(s.get("ordinate_force_unit_exp", 0)), abs(direction) in (4, 5, 6))
         label = _UFF_UNITS.get(key, "")
+    elif key[0] in _UFF_QUANTITY:
+        # both declared: a displacement record (type 8) labelled m/s^2 was read as an
+        # acceleration by its label in silence (round 14); a label of the type's quantity in
+        # another unit (g, mm) is read by the label, as before
+        coded, labelled = _UFF_QUANTITY[key[0]], SAME_ORDER.get(si_unit(label)[0])
+        if labelled is not None and labelled != coded:
+            def a(w: str) -> str:
+                return f"{'an' if w[0] in 'aeiou' else 'a'} {w}"
+
+            raise MeasuredDataError(path, f"{where}: ordinate unit label {label!r} ({a(labelled)}) "
+                                          f"disagrees with its specific data type {key[0]} "
+                                          f"({a(coded)}); expected a label of the quantity the "
+                                          "type declares")
     raw.data[name], raw.units[name] = data.astype(float), label or None
     if node > 0:
         raw.nodes[name] = node

@@ -56,7 +56,15 @@ from testbed.core.budget import check_cost, check_steps
 from testbed.core.errors import RigError, ScenarioError
 from testbed.core.kinds import metric_names, metric_range
 from testbed.core.registry import REGISTERED_NAME, REGISTERED_NAME_DOC
-from testbed.core.schema import Field, near_miss, validate_header, validate_table, validate_variant
+from testbed.core.schema import (
+    ONE_LINE,
+    ONE_LINE_DOC,
+    Field,
+    near_miss,
+    validate_header,
+    validate_table,
+    validate_variant,
+)
 from testbed.pipeline.plugins import IDENTIFIERS, RIGS
 from testbed.pipeline.signal_chain import SIGNAL_SCHEMAS, check_keys_used, check_signal, rig_auto_keys
 
@@ -97,8 +105,9 @@ HEADER_SCHEMA = {
                   pattern=NAME_PATTERN, pattern_doc=NAME_PATTERN_DOC),
     "rig": Field(str, doc="registered rig name (see `testbed list`)"),
     "seed": Field(int, 0, min=0, max=MAX_SEED, doc="seed of the measurement noise"),
-    "description": Field(str, "", doc="one line for listings"),
-    "tags": Field(list, [], item_type=str, doc="free tags for selecting scenarios"),
+    "description": Field(str, "", pattern=ONE_LINE, pattern_doc=ONE_LINE_DOC, doc="one line for listings"),
+    "tags": Field(list, [], item_type=str, pattern=ONE_LINE,
+                  pattern_doc=ONE_LINE_DOC, doc="free tags for selecting scenarios"),
     "extends": Field(str, "", doc="scenario file this one starts from (relative path)"),
 }
 

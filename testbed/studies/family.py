@@ -56,7 +56,7 @@ import numpy as np
 
 from testbed.core.atomic import atomic_write_text
 from testbed.core.errors import ScenarioError
-from testbed.core.schema import Field, check_value, validate_table
+from testbed.core.schema import ONE_LINE, ONE_LINE_DOC, Field, check_value, validate_table
 from testbed.pipeline.plugins import RIGS
 from testbed.pipeline.scenario import (
     NAME_PATTERN,
@@ -81,7 +81,7 @@ FAMILY_SCHEMA = {
                            "relative to the study file)"),
     "members": Field(int, min=1, max=10000, doc="number of members"),
     "seed": Field(int, 0, min=0, doc="seed of the members' parameters (numpy Generator)"),
-    "description": Field(str, "", doc="one line for listings"),
+    "description": Field(str, "", pattern=ONE_LINE, pattern_doc=ONE_LINE_DOC, doc="one line for listings"),
 }
 RANGE_TABLES = ("rig", "simulation", "excitation", "signal")
 DISTRIBUTIONS = ("uniform", "log_uniform", "integers", "log_integers", "choices")

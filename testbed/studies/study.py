@@ -54,7 +54,7 @@ from typing import Any
 from testbed.core.budget import STUDY_CELL_BUDGET
 from testbed.core.errors import BudgetError, InputError, ScenarioError
 from testbed.core.registry import import_plugin
-from testbed.core.schema import Field, validate_header
+from testbed.core.schema import ONE_LINE, ONE_LINE_DOC, Field, validate_header
 from testbed.pipeline.plugins import IDENTIFIERS, RIGS
 from testbed.pipeline.scenario import (
     MAX_SEED,
@@ -87,7 +87,8 @@ STUDY_DIR = Path(os.environ.get("TESTBED_STUDIES", shipped_dir("studies")))
 STUDY_SCHEMA = {
     "name": Field(str, doc="study name; must equal the file name without .toml",
                   pattern=NAME_PATTERN, pattern_doc=NAME_PATTERN_DOC),
-    "description": Field(str, "", doc="one line for listings and reports"),
+    "description": Field(str, "", pattern=ONE_LINE, pattern_doc=ONE_LINE_DOC,
+                         doc="one line for listings and reports"),
     "scenarios": Field(list, [], item_type=str,
                        doc="scenario names (in scenarios/) or .toml paths relative to the study file "
                            "(may be empty when the study declares [families.<name>])"),

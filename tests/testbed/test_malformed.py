@@ -114,8 +114,9 @@ def bad_values(f) -> list:
         out = [5]
         if f.choices is not None:
             out.append("no-such-choice")
-        if f.pattern is not None:
-            out.append("../bad/name")
+        if f.pattern is not None:  # a value the pattern refuses: a name's, or a line's
+            from testbed.core.schema import ONE_LINE
+            out.append("two\nlines" if f.pattern == ONE_LINE else "../bad/name")
         return out
     if f.type is list:
         item = {str: [1], float: ["x"], int: [1.5]}.get(f.item_type, [])
