@@ -16,12 +16,12 @@ scenario and overrides it key by key, so variants (noise levels, identifiers)
 state only what differs.  Two tables are replaced whole rather than merged:
 ``[identify]`` (a new identifier must not inherit another's hyperparameters) and
 ``[score]``; so is a table whose ``type`` the child sets to another value (an
-``[excitation]`` of another type does not inherit the parent's type's parameters).  **A child keeps its parent's ``[score]`` unless it declares its own**
-(even when it replaces ``[identify]``): a variant is held to its parent's bars until
-it states new ones, and never passes with no bars at all.  ``[score]`` without
-``[identify]`` is an error in a scenario run on its own (there would be nothing to
-score); a study may use such a scenario, its identifiers being held to the scenario's
-bars.
+``[excitation]`` of another type does not inherit the parent's type's parameters).
+**A child keeps its parent's ``[score]`` unless it declares its own** (even when it
+replaces ``[identify]``): a variant is held to its parent's bars until it states
+new ones, and never passes with no bars at all.  ``[score]`` without ``[identify]``
+is an error in a scenario run on its own (there would be nothing to score); a study
+may use such a scenario, its identifiers being held to the scenario's bars.
 
 Everything is checked when the file loads, before anything is simulated: every key's
 type and range (the rig's, the signal chain's and the identifier's declared

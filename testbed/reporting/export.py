@@ -45,6 +45,7 @@ from __future__ import annotations
 import json
 import os
 import re
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -328,8 +329,14 @@ def read_sep005(path: str | os.PathLike) -> list[dict[str, Any]]:
     return [{**c, "data": np.asarray(c["data"], dtype=float)} for c in json.loads(Path(path).read_text())]
 
 
-def export_dataset(path: str | os.PathLike, fmt: str, out: str | os.PathLike | None = None) -> list[Path]:
+def export_dataset(path: str | os.PathLike, fmt: str, out: str | os.PathLike | None = None,
+                   note: Callable[[str], None] | None = None) -> list[Path]:
     """Export a dataset file (HDF5 from :meth:`Dataset.save`) to another tool's format.
+
+    Neither format carries the dataset's declared prior (``total_mass``, ``reduced_mass_trace``
+    [kg], link lengths [m]): an identifier that needs it refused the exported record ("prior has no
+    'reduced_mass_trace'", round 14).  ``note`` is told the prior left out, as the ``--prior``
+    options that give it back to ``testbed identify``.
 
     Parameters
     ----------
@@ -338,6 +345,8 @@ def export_dataset(path: str | os.PathLike, fmt: str, out: str | os.PathLike | N
     fmt : {"uff", "sep005"}
     out : path, optional
         Output file; default beside the dataset, ``<stem>.uff`` or ``<stem>.sep005.json``.
+    note : callable, optional
+        ``note(line)`` with one line naming the prior the format leaves out (none: not called).
 
     Returns
     -------
@@ -354,7 +363,12 @@ def export_dataset(path: str | os.PathLike, fmt: str, out: str | os.PathLike | N
     ds = Dataset.load(path)
     check_recorded(ds, path)  # an edited, rehashed file: NaN rate or samples, cut channels
     if fmt == "uff":
-        return [write_uff(ds, out or path.with_suffix(".uff"))]
-    if fmt == "sep005":
-        return [write_sep005(ds, out or path.with_suffix(".sep005.json"))]
-    raise ValueError(f"unknown export format {fmt!r}; allowed: 'uff', 'sep005'")
+        written = [write_uff(ds, out or path.with_suffix(".uff"))]
+    elif fmt == "sep005":
+        written = [write_sep005(ds, out or path.with_suffix(".sep005.json"))]
+    else:
+        raise ValueError(f"unknown export format {fmt!r}; allowed: 'uff', 'sep005'")
+    if note is not None and ds.prior:
+        given = " ".join(f"--prior {k}={float(v)!r}" for k, v in sorted(ds.prior.items()))
+        note(f"note: {fmt} files carry no prior; give it back when identifying: {given} (SI units)")
+    return written

@@ -25,8 +25,8 @@ from testbed.pipeline.plugins import rig_class
 from testbed.pipeline.signal_chain import pulse_end, pulse_span
 from testbed.scoring import metrics
 from testbed.scoring.equation_basis import compare_equations
-from testbed.scoring.law import law_errors
 from testbed.scoring.initial_state import fit_initial_state
+from testbed.scoring.law import law_errors
 from testbed.scoring.metrics import worst
 
 #: Modes whose MAC, frequency and damping are scored: every mode the sensors can resolve,

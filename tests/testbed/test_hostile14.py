@@ -312,3 +312,16 @@ def test_a_plugin_file_name_too_long_for_the_file_system_is_one_error_line():
     # `run --plugin <100,000 characters>.py`: OSError 36 from Path.resolve, an internal error
     with pytest.raises(PluginError, match="not a usable path"):
         import_plugin("x" * 100_000 + ".py")
+
+
+def test_a_written_path_is_printed_with_its_control_characters_escaped(cli_in_process, tmp_path):
+    """``generate -o $'e\\x1b[31m.h5'`` printed its "wrote" line with the ESC raw (round 14's
+    open item): every line naming a path the command wrote escapes it as the error lines do."""
+    from testbed.pipeline.scenario import SCENARIO_DIR
+
+    text = (SCENARIO_DIR / "michaelis_menten.toml").read_text()
+    (tmp_path / "michaelis_menten.toml").write_text(text)
+    done = cli_in_process("generate", "michaelis_menten.toml", "-o", "e\x1b[31m.h5", cwd=tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert (tmp_path / "e\x1b[31m.h5").is_file()
+    assert "\x1b" not in done.stdout and "wrote e\\x1b[31m.h5" in done.stdout
