@@ -63,7 +63,10 @@ def damped_frequency(y: np.ndarray, fs: float, f0: float, zeta0: float) -> float
         wd = w * np.sqrt(max(1 - z * z, 1e-9))
         return (np.exp(-z * w * t) * (a * np.cos(wd * t) + b * np.sin(wd * t)) + c0 + c1 * t - y) / scale
 
-    return float(least_squares(resid, [y[0], 0.0, f0, zeta0, 0.0, 0.0], x_scale="jac").x[2])
+    inf = np.inf  # the frequency within +-50 % of the truth's, the damping below critical
+    bounds = ([-inf, -inf, 0.5 * f0, 0.0, -inf, -inf], [inf, inf, 1.5 * f0, 0.99, inf, inf])
+    return float(least_squares(resid, [y[0], 0.0, f0, zeta0, 0.0, 0.0], bounds=bounds,
+                               x_scale="jac").x[2])
 
 
 def hardening(path: Path, cache: DatasetCache) -> dict:
