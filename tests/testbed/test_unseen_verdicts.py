@@ -243,18 +243,23 @@ def test_beam_below_mujocos_smallest_inertia_names_the_key():
 
 
 # ------------------------------------------- round 5 linkages
+@pytest.fixture(scope="module")
+def family_scenarios() -> dict:
+    """studies/families.toml's scenarios by name, loaded once for both round-5 studies (its
+    420 cells: about 1.2 s of CPU a load)."""
+    from testbed.studies.study import load_study
+    return {s.name: s for s in load_study(_root() / "studies" / "families.toml").scenarios}
+
+
 @pytest.mark.parametrize("name, family", [("round5_linkages_sine", "fbsine"),
                                           ("round5_linkages_chain", "fbchain")])
-def test_round5_linkage_studies_draw_the_family_geometries(name, family):
+def test_round5_linkage_studies_draw_the_family_geometries(name, family, family_scenarios):
     """The round-5 regression studies redraw studies/families.toml's 30 five-bars (same ranges,
     order and seed), so their member k is linkages__k with another input or signal chain: a
     change of either file's ranges would silently compare other linkages."""
-    from pathlib import Path
-
     from testbed.studies.study import load_study
-    root = Path(__file__).resolve().parents[2]
-    fam = {s.name: s for s in load_study(root / "studies" / "families.toml").scenarios}
-    study = load_study(root / "benchmarks" / "unseen" / f"{name}.toml")
+    fam = family_scenarios
+    study = load_study(_root() / "benchmarks" / "unseen" / f"{name}.toml")
     assert study.name == name and len(study.scenarios) == 30
     keys = [f"l{i}" for i in range(1, 5)] + ["L0"] + [f"m{i}" for i in range(1, 5)]
     for s in study.scenarios:
