@@ -103,6 +103,36 @@ def _noise_gram(rows: Callable[[np.ndarray], np.ndarray], x: np.ndarray, sigma: 
     return dG / DRAWS
 
 
+def noise_gram(rows: Callable[[np.ndarray], np.ndarray], x: np.ndarray,
+               sigma: np.ndarray) -> np.ndarray:
+    """Expected Gram the record's noise adds to an equation's normalised rows.
+
+    Parameters
+    ----------
+    rows : callable
+        ``rows(x)`` -> regression rows of the terms, shape (n_rows, q), from states ``x``.
+    x : ndarray, shape (n_states, n_samples)
+        The states [unit of each state].
+    sigma : ndarray, shape (n_states,)
+        White-noise standard deviation of each state [unit of each state].
+
+    Returns
+    -------
+    ndarray, shape (q, q)
+        Mean ``D^T D`` over :data:`DRAWS` seeded draws (``D`` the change of the rows, each
+        column scaled by its noise-free norm) [-]: the term to take out of the normalised Gram
+        for a bias-compensated fit; zeros for zero noise, NaN where the rows are unusable.
+    """
+    base, norms, fault = _unit_rows(rows, x)
+    q = base.shape[1]
+    if fault:
+        return np.full((q, q), np.nan)
+    sigma = np.asarray(sigma, dtype=float).reshape(-1, 1)
+    if not np.any(sigma > 0.0):
+        return np.zeros((q, q))
+    return _noise_gram(rows, x, sigma, base, norms)
+
+
 def noise_residual_ratio(rows: Callable[[np.ndarray], np.ndarray], x: np.ndarray,
                          sigma: np.ndarray) -> tuple[float, np.ndarray]:
     """How far the best equation of some terms is from holding, in units of what the record's
