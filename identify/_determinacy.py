@@ -103,6 +103,75 @@ def _noise_gram(rows: Callable[[np.ndarray], np.ndarray], x: np.ndarray, sigma: 
     return dG / DRAWS
 
 
+def noise_gram(rows: Callable[[np.ndarray], np.ndarray], x: np.ndarray,
+               sigma: np.ndarray) -> np.ndarray:
+    """Expected Gram the record's noise adds to an equation's normalised rows.
+
+    Parameters
+    ----------
+    rows : callable
+        ``rows(x)`` -> regression rows of the terms, shape (n_rows, q), from states ``x``.
+    x : ndarray, shape (n_states, n_samples)
+        The states [unit of each state].
+    sigma : ndarray, shape (n_states,)
+        White-noise standard deviation of each state [unit of each state].
+
+    Returns
+    -------
+    ndarray, shape (q, q)
+        Mean ``D^T D`` over :data:`DRAWS` seeded draws (``D`` the change of the rows, each
+        column scaled by its noise-free norm) [-]: the term to take out of the normalised Gram
+        for a bias-compensated fit; zeros for zero noise, NaN where the rows are unusable.
+    """
+    base, norms, fault = _unit_rows(rows, x)
+    q = base.shape[1]
+    if fault:
+        return np.full((q, q), np.nan)
+    sigma = np.asarray(sigma, dtype=float).reshape(-1, 1)
+    if not np.any(sigma > 0.0):
+        return np.zeros((q, q))
+    return _noise_gram(rows, x, sigma, base, norms)
+
+
+def direction_spread(rows: Callable[[np.ndarray], np.ndarray], x: np.ndarray,
+                     sigma: np.ndarray) -> float:
+    """Random spread of an equation's total-least-squares direction at the record's noise.
+
+    The smallest eigenvector of the normalised Gram of the rows of ``x`` plus each of the
+    :data:`DRAWS` seeded noise draws of :func:`noise_gram` (sign aligned with the record's own),
+    and the root mean square distance of those unit vectors from their mean: how far another
+    noise realisation of the record's level moves the fitted direction.
+
+    Parameters
+    ----------
+    rows, x, sigma
+        As in :func:`noise_gram`.
+
+    Returns
+    -------
+    float
+        The spread [-] (unit-norm directions; 0 for zero noise), NaN where the rows are unusable
+        or a draw's rows are not finite.
+    """
+    base, norms, fault = _unit_rows(rows, x)
+    if fault:
+        return float("nan")
+    sigma = np.asarray(sigma, dtype=float).reshape(-1, 1)
+    if not np.any(sigma > 0.0):
+        return 0.0
+    v0 = np.linalg.eigh(base.T @ base)[1][:, 0]
+    rng = np.random.default_rng(SEED)
+    vs = []
+    for _ in range(DRAWS):
+        d = np.asarray(rows(x + sigma * rng.standard_normal(x.shape)), dtype=float) / norms
+        if not np.all(np.isfinite(d)):
+            return float("nan")
+        v = np.linalg.eigh(d.T @ d)[1][:, 0]
+        vs.append(v if v @ v0 >= 0.0 else -v)
+    vs = np.array(vs)
+    return float(np.sqrt(np.mean(np.sum((vs - vs.mean(axis=0)) ** 2, axis=1))))
+
+
 def noise_residual_ratio(rows: Callable[[np.ndarray], np.ndarray], x: np.ndarray,
                          sigma: np.ndarray) -> tuple[float, np.ndarray]:
     """How far the best equation of some terms is from holding, in units of what the record's
