@@ -39,6 +39,7 @@ from testbed.core.errors import (
     TestbedError,
     printable,
     show_value,
+    terminal_safe,
 )
 
 #: Status when the reader of standard output went away: a shell's for a command ended by SIGPIPE.
@@ -535,7 +536,7 @@ def cmd_generate(args: argparse.Namespace) -> int:
             ds = generate(sc, progress=bar) if cache is None else cache.get(sc, bar)
     ds.save(out)
     print_truth_summary(ds)
-    print(f"wrote {printable(str(out))} (content hash {ds.attrs['content_hash'][:16]})")
+    print(f"wrote {terminal_safe(str(out))} (content hash {ds.attrs['content_hash'][:16]})")
     return 0
 
 
@@ -574,8 +575,8 @@ def cmd_run(args: argparse.Namespace) -> int:
                 with phase("figures" if figures else "save"):
                     run_dir = save_new_run(result, args.out, figures=figures, index=runs_index_html)
             print_score_table(result)
-            print(f"run written to {printable(str(run_dir))} "
-                  f"(all runs: {printable(str(Path(args.out) / INDEX))})")
+            print(f"run written to {terminal_safe(str(run_dir))} "
+                  f"(all runs: {terminal_safe(str(Path(args.out) / INDEX))})")
             ok &= result.passed
     return 0 if ok else EXIT_FAIL
 
@@ -607,7 +608,7 @@ def cmd_report(args: argparse.Namespace) -> int:
                                  f"with runs in {args.runs})") from None
             raise InputError(f"{source}: not a run folder written by `testbed run`") from None
     html = write_report(source, Path(args.output))
-    print(f"report: {printable(str(html.resolve()))}")
+    print(f"report: {terminal_safe(str(html.resolve()))}")
     return 0
 
 
@@ -618,7 +619,7 @@ def cmd_export(args: argparse.Namespace) -> int:
     default = data.with_suffix(".uff" if args.format == "uff" else ".sep005.json")
     out = _output_file(Path(args.output) if args.output else default, "--output", inputs=(data,))
     for p in export_dataset(data, args.format, out, note=print):
-        print(f"wrote {printable(str(p))}")
+        print(f"wrote {terminal_safe(str(p))}")
     return 0
 
 
@@ -654,7 +655,7 @@ def cmd_sweep(args: argparse.Namespace) -> int:
         # the port answered but no scheduler served it (or it went away): the address is wrong
         raise InputError(f"--dask {show_value(args.dask)}: the Dask scheduler failed: "
                          f"{type(e).__name__}: {e}") from None
-    print(f"results: {printable(str(results))}")
+    print(f"results: {terminal_safe(str(results))}")
     return EXIT_FAIL if stats.failed_total else 0
 
 
@@ -670,8 +671,8 @@ def cmd_family(args: argparse.Namespace) -> int:
 
     out = _output_folder(Path(args.out), "--out")
     paths = write_family(load_study(args.study, progress=_stderr_line), out, family=args.family)
-    print(f"wrote {len(paths)} member scenario(s) to {printable(str(args.out))}; rerun one "
-          f"with `testbed run {printable(str(paths[0] if paths else args.out))}`")
+    print(f"wrote {len(paths)} member scenario(s) to {terminal_safe(str(args.out))}; rerun one "
+          f"with `testbed run {terminal_safe(str(paths[0] if paths else args.out))}`")
     return 0
 
 
@@ -682,10 +683,10 @@ def cmd_cache(args: argparse.Namespace) -> int:
     if args.action == "ls":
         entries = cache.entries()
         for p, size in entries:
-            print(f"{size / 1e6:8.2f} MB  {printable(str(p))}")
-        print(f"{len(entries)} dataset(s) in {printable(str(cache.directory))}")
+            print(f"{size / 1e6:8.2f} MB  {terminal_safe(str(p))}")
+        print(f"{len(entries)} dataset(s) in {terminal_safe(str(cache.directory))}")
     else:
-        print(f"removed {cache.clear()} dataset(s) from {printable(str(cache.directory))}")
+        print(f"removed {cache.clear()} dataset(s) from {terminal_safe(str(cache.directory))}")
     return 0
 
 
@@ -746,7 +747,7 @@ def cmd_identify(args: argparse.Namespace) -> int:
     atomic_write_text(out, text)
     atomic_write_text(out.with_suffix(".md"), report)
     print(report, end="")
-    print(f"model written to {printable(str(out))} (report {printable(str(out.with_suffix('.md')))})")
+    print(f"model written to {terminal_safe(str(out))} (report {terminal_safe(str(out.with_suffix('.md')))})")
     if failures:
         what = "unusable model" if "coefficients" in failures else "physically impossible model"
         print(f"FAIL: {what}: {'; '.join(failures.values())}")

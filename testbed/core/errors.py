@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import unicodedata
 from typing import Any
 
 #: Longest rendering of an offending value in a message [characters]: a message stays one
@@ -16,6 +17,33 @@ def _one_line(text: str) -> str:
 
 #: ``text`` with control characters escaped (the command line's error lines; public name).
 printable = _one_line
+
+#: Characters that are neither C0/C1 controls nor line separators but change how a terminal or
+#: an editor shows the text around them: bidirectional controls and marks (a right-to-left
+#: override reorders what follows) and zero-width characters that hide inside a name.
+HIDDEN_FORMAT = frozenset("\u061c\u200b\u200e\u200f\u202a\u202b\u202c\u202d\u202e"
+                          "\u2060\u2066\u2067\u2068\u2069\ufeff")
+
+
+def is_control(c: str) -> bool:
+    """Whether the character ``c`` controls a terminal or a text's layout rather than showing.
+
+    Rule: the C0 and C1 controls and DEL (Unicode category Cc: newline, tab, ESC, NUL), the line
+    and paragraph separators (Zl, Zp) and :data:`HIDDEN_FORMAT`.  Every other character shows,
+    spaces of every width included (a no-break space U+00A0 from a spreadsheet, U+202F from a
+    French-locale export), and so do the surrogates Python decodes undecodable file-name bytes
+    to: a reader's own data, to be kept as given.
+    """
+    return unicodedata.category(c) in ("Cc", "Zl", "Zp") or c in HIDDEN_FORMAT
+
+
+def terminal_safe(text: str) -> str:
+    """``text`` with only the :func:`is_control` characters escaped (``\\x1b``, ``\\u202e``).
+
+    For a path the command wrote, printed so that it can be copied: a file name in any script
+    and with any spaces stays as it is, an escape sequence cannot reach the terminal.
+    """
+    return "".join(repr(c)[1:-1] if is_control(c) else c for c in text)
 
 
 def _cut(text: str) -> str:

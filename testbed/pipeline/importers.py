@@ -60,7 +60,7 @@ import numpy as np
 
 from testbed.core.budget import IDENTIFY_BYTES_PER_VALUE, IDENTIFY_TEXT_BUDGET_BYTES, IDENTIFY_VALUE_BUDGET
 from testbed.core.dataset import Dataset, DatasetError, Signal
-from testbed.core.errors import TestbedError, show_names
+from testbed.core.errors import TestbedError, is_control, show_names
 from testbed.core.measurement import Measurement
 from testbed.pipeline.signal_chain import SIGNAL_CHAINS, SIGNAL_SCHEMAS, measure
 
@@ -539,11 +539,11 @@ def _finish(raw: _Raw, fs: float | None, units: str | Mapping[str, str] | None,
     for n in names:
         # a newline, a NUL or a terminal escape in a name went on to the console (an ESC
         # sequence coloured it), the model's JSON and its report's markdown (round 14)
-        bad = next((c for c in n if not c.isprintable()), None)
+        bad = next((c for c in n if is_control(c)), None)
         if bad is not None:
             raise MeasuredDataError(path, f"channel name {n!r} holds the control or invisible "
                                           f"character {bad!r} (U+{ord(bad):04X}); expected a name "
-                                          "of printable characters")
+                                          "without control, bidirectional or zero-width characters")
     if channels is not None:
         missing = [c for c in channels if c not in raw.data]
         if missing:

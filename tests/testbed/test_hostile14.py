@@ -226,6 +226,29 @@ def test_a_channel_name_with_a_control_or_invisible_character_is_refused(name):
     assert list(from_sep005(chans).signals) == ["acceleration/acc1", "acceleration/accé 2"]
 
 
+@pytest.mark.parametrize("space", ["\u00a0", "\u202f", "\u00ad", "\u3000"])
+def test_a_channel_name_with_a_spreadsheets_space_is_read(space):
+    """The refusal above caught a spreadsheet's no-break space (U+00A0), a French-locale export's
+    narrow one (U+202F) and a soft hyphen (review of round 14): characters that show, or show
+    as a space, are a lab's own names and are read as given."""
+    import numpy as np
+
+    from testbed.pipeline.importers import from_sep005
+
+    x = np.sin(np.arange(100) / 10.0)
+    name = f"acceleration/acc{space}2"
+    chans = [{"name": "acceleration/acc1", "data": x, "fs": 100.0, "unit_str": "m/s^2"},
+             {"name": name, "data": x + 1, "fs": 100.0, "unit_str": "m/s^2"}]
+    assert list(from_sep005(chans).signals) == ["acceleration/acc1", name]
+
+
+def test_a_written_path_keeps_its_spaces_and_escapes_its_controls():
+    from testbed.core.errors import terminal_safe
+
+    assert terminal_safe("runs/caf\udce9 a\u202fb\u00a0c") == "runs/caf\udce9 a\u202fb\u00a0c"
+    assert terminal_safe("e\x1b[31m\u202e.h5\n") == "e\\x1b[31m\\u202e.h5\\n"
+
+
 # ------------------------------------------------------------------ one-line texts
 
 
