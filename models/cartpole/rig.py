@@ -228,6 +228,12 @@ class CartPoleRig(Rig):
             if not excitation[hi] < nyquist:
                 error(f"excitation.{hi}", excitation[hi],
                       f"expected below the Nyquist frequency {nyquist:g} Hz")
+        if kind == "steps" and not excitation["hold"] >= 1.0 / simulation["sample_rate"]:
+            # a level per sample is all a zero-order hold can show; hold = 1e-12 s drew 7e12
+            # levels (an internal error: MemoryError, review of round 14)
+            error("excitation.hold", excitation["hold"],
+                  f"expected at least one sample period (1 / simulation.sample_rate = "
+                  f"{1.0 / simulation['sample_rate']:g} s): the force is held over each sample")
         if kind == "steps" and not excitation["hold"] < simulation["duration"]:
             error("excitation.hold", excitation["hold"],
                   f"expected below simulation.duration ({simulation['duration']:g} s): one level "

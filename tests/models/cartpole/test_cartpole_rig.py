@@ -148,6 +148,7 @@ def test_a_bad_chirp_or_step_input_is_refused_in_one_line():
     for exc, match in (({"type": "chirp", "f0": 2.0, "f1": 1.0}, "excitation.f0"),
                        ({"type": "chirp", "f1": 600.0}, "Nyquist"),
                        ({"type": "steps", "hold": 20.0}, "excitation.hold"),
+                       ({"type": "steps", "hold": 1e-12}, "at least one sample period"),
                        ({"type": "steps", "f_min": 0.1}, "unknown key")):
         with pytest.raises(ScenarioError, match=match):
             scenario_from_dict({**base, "excitation": exc}, file="<test>")
