@@ -262,9 +262,12 @@ def equation_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -
     missed = [c for c in check_thresholds(scores.values, bars) if not c.passed]
     if not missed:
         return {}
+    def not_finite(metric: str) -> str:  # the scorer's own reason first (law_error_reason)
+        return scores.details.get(f"{metric}_reason") or NOT_FINITE.get(metric, "not computable")
+
     said = "; ".join(f"{c.metric} {c.value:.3g} {'below' if c.bound == 'min' else 'above'} "
                      f"{c.threshold:g}" if np.isfinite(c.value) else
-                     f"{c.metric} not finite ({NOT_FINITE.get(c.metric, 'not computable')}; bar "
+                     f"{c.metric} not finite ({not_finite(c.metric)}; bar "
                      f"{c.threshold:g})" for c in missed)
     why = ("the rig's own bars on the identified equation: its question is the law, which a "
            "state that simulates well does not prove")
@@ -1220,6 +1223,11 @@ def score_mechanical(dataset: Dataset, data: Measurement, clean: Measurement, mo
     if law is not None:  # an open chain: its law over the record's state box, per coordinate
         v["law_error"] = float(np.max(law)) if np.all(np.isfinite(law)) else float("nan")
         d["law_errors"] = law
+    elif np.shape(truth.equation_coef)[0] == np.shape(theta)[0]:
+        # an open chain whose identified set has another number of equations: no law to solve
+        v["law_error"] = float("nan")
+        d["law_error_reason"] = (f"{np.atleast_2d(coef).shape[0]} identified equations for "
+                                 f"{np.shape(theta)[0]} coordinates: no accelerations to compare")
     d["equation_bars"] = rig_equation_bars(dataset)
     return Scores(v, d, failures)
 

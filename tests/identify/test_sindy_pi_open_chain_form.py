@@ -52,9 +52,12 @@ def test_strong_form_kept_where_the_weak_rollout_is_larger(dataset_cache):
     assert "strong form kept (the weak not smaller beyond the tie)" in m.formulation_rule_
     # the rollout as before the comparison (measured 0.0131); since round 14 the cart-pole's law
     # bar fails the cell: the heavy cart's (3.8 kg under 0.064 kg) identified cart equation is
-    # 0.287 off over the record's state box (models/cartpole/rig.py EQUATION_BARS)
+    # 0.287 off over the record's state box (models/cartpole/rig.py EQUATION_BARS): its cart
+    # row holds no force term at all.  The figure is a 3 %-noise fit's: compared with a margin
+    # (0.2867 sits 2e-4 from where its printed digits would change), not as printed digits
     assert r.scores.values["angle_rmse"] < 0.0501
-    assert not r.passed and "wrong equation: law_error 0.287 above 0.25" in r.scores.failure
+    assert 0.25 < r.scores.values["law_error"] < 0.35
+    assert not r.passed and "wrong equation: law_error" in r.scores.failure
     # nothing of the weak trial stays on the strong model (review: its weak-only attributes did)
     assert not hasattr(m, "weak_strong_columns_") and not hasattr(m, "_weak_trial")
 

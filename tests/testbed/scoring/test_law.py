@@ -81,3 +81,16 @@ def test_the_cartpole_holds_every_run_to_its_law_bar_and_names_a_nan_law():
     ok = Scores({"angle_rmse": 0.004, "law_error": 0.011}, {"equation_bars": EQUATION_BARS})
     assert equation_failures(ok, run_bars) == {}
     assert equation_failures(ok, {}) == {}  # no bars at all: "no verdict" stays
+
+
+def test_a_law_missing_for_want_of_equations_is_named_as_such():
+    """An identified set with another number of equations than coordinates has no law to solve:
+    the failure said "no finite acceleration ... singular" (review of round 14); it names the
+    count."""
+    from testbed.scoring.scorers import Scores, equation_failures
+
+    reason = "1 identified equations for 2 coordinates: no accelerations to compare"
+    scores = Scores({"law_error": float("nan")},
+                    {"equation_bars": {"law_error": {"max": 0.25}}, "law_error_reason": reason}, {})
+    (said,) = equation_failures(scores, {"angle_rmse": {"max": 0.05}}).values()
+    assert reason in said and "singular" not in said
