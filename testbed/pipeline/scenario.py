@@ -15,8 +15,8 @@ A scenario is a TOML file in ``scenarios/``::
 scenario and overrides it key by key, so variants (noise levels, identifiers)
 state only what differs.  Two tables are replaced whole rather than merged:
 ``[identify]`` (a new identifier must not inherit another's hyperparameters) and
-``[score]``; so is a table whose ``type`` the child sets to another value (an
-``[excitation]`` of another type does not inherit the parent's type's parameters).
+``[score]``.  A child that sets ``excitation.type`` to another value inherits only the
+parent's excitation keys its new type also reads (amplitude, centring gains).
 **A child keeps its parent's ``[score]`` unless it declares its own** (even when it
 replaces ``[identify]``): a variant is held to its parent's bars until it states
 new ones, and never passes with no bars at all.  ``[score]`` without ``[identify]``
@@ -189,16 +189,31 @@ class Scenario:
         return self.replace(noise={**self.noise, "rms_percent": float(rms_percent)})
 
 
+def _keep_what_the_new_type_reads(base: dict, child: dict) -> None:
+    """Where ``child`` sets ``excitation.type`` to another than its parent's, drop from the
+    parent's ``[excitation]`` (in place) the keys the new type does not declare: a chirp child
+    of a multisine cart-pole was refused for the inherited ``f_min``, a key it could not remove
+    (round 14), while the keys both types read (amplitude, the centring gains) carry over as
+    every other inherited key does.  An unknown rig or type keeps nothing of the parent's table
+    (the child's is then refused or validated on its own)."""
+    old, new = base.get("excitation"), child.get("excitation")
+    if not (isinstance(old, dict) and isinstance(new, dict) and "type" in new
+            and new["type"] != old.get("type", new["type"])):
+        return
+    header = {**(base.get("scenario") or {}), **(child.get("scenario") or {})}
+    try:
+        schema = RIGS.get(header.get("rig")).excitation_schemas.get(new["type"], {})
+    except (KeyError, TypeError, AttributeError):
+        schema = {}
+    base["excitation"] = {k: v for k, v in old.items() if k in schema}
+
+
 def _deep_merge(base: dict, over: dict) -> dict:
     out = copy.deepcopy(base)
     for k, v in over.items():
         # [identify] and [score] are replaced whole: a new identifier must not inherit another's
-        # hyperparameters, and a child's bars replace its parent's; so is a table whose `type`
-        # the child changes (an [excitation] of another type: the parent's keys are its type's,
-        # and a chirp child of a multisine parent was refused for the inherited f_min, a key the
-        # child could not remove)
-        if (isinstance(v, dict) and isinstance(out.get(k), dict) and k not in ("identify", "score")
-                and not ("type" in v and v["type"] != out[k].get("type", v["type"]))):
+        # hyperparameters, and a child's bars replace its parent's
+        if isinstance(v, dict) and isinstance(out.get(k), dict) and k not in ("identify", "score"):
             out[k] = _deep_merge(out[k], v)
         else:
             out[k] = copy.deepcopy(v)
@@ -382,6 +397,7 @@ def _read_toml(path: Path, chain: tuple[Path, ...] = ()) -> dict:
         base.setdefault("scenario", {}).pop("extends", None)
         base["scenario"].pop("description", None)
         base["scenario"].pop("tags", None)
+        _keep_what_the_new_type_reads(base, raw)
         # a child keeps its parent's [score] unless it declares its own (see the module docs)
         raw = _deep_merge(base, raw)
     return raw

@@ -305,9 +305,11 @@ def test_recording_reads_names_a_scenario_and_the_files_it_extends(tmp_path):
 
 
 def test_extends_replaces_a_table_whose_type_the_child_changes(tmp_path):
-    """A child that sets ``excitation.type`` to another value starts that table afresh: the
-    parent's multisine keys (f_min ...) were inherited and the chirp child refused for a key it
-    could not remove (round 14).  A child that keeps the type still overrides key by key."""
+    """A child that sets ``excitation.type`` to another value inherits only the keys the new
+    type reads: the parent's multisine keys (f_min ...) were inherited and the chirp child
+    refused for a key it could not remove (round 14); dropping the whole table then changed the
+    force's amplitude and the centring gains in silence (review).  A child that keeps the type
+    still overrides key by key."""
     import shutil
 
     from testbed.pipeline.scenario import SCENARIO_DIR
@@ -318,6 +320,8 @@ def test_extends_replaces_a_table_whose_type_the_child_changes(tmp_path):
                    '[excitation]\ntype = "chirp"\n', name="chirp")
     sc = load_scenario(chirp)
     assert sc.excitation["type"] == "chirp" and "n_tones" not in sc.excitation
+    for key in ("amplitude", "kp", "kd"):  # read by both types: the parent's values
+        assert sc.excitation[key] == parent.excitation[key], key
     same = _write(tmp_path, '[scenario]\nname = "same"\nextends = "cartpole.toml"\n'
                   '[excitation]\ntype = "multisine"\nn_tones = 3\n', name="same")
     sc = load_scenario(same)
