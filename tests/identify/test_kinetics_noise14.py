@@ -5,7 +5,7 @@ selects the law's four terms, but plain total least squares leaves the ``Km dx``
 6.8 % low (coef_error 0.068 against the rig's 5 % bar): the weak form's noise inflates the
 derivative columns' norms and not the constant's, which pulls the smallest eigenvector.  Taking
 the noise's own Gram out (``refit = "compensated"``, the default, where that moves the direction
-by at least half its random spread: 1.14 here) gives coef_error 0.007."""
+by more than half its random spread: 1.14 here) gives coef_error 0.007."""
 
 from __future__ import annotations
 
