@@ -145,4 +145,8 @@ def law_errors(id_names: Sequence[str], id_coef: np.ndarray, true_names: Sequenc
     truth = accelerations(true_names, true_coef, box)
     ident = accelerations(id_names, id_coef, box)
     with np.errstate(all="ignore"):
-        return np.sqrt(np.mean((ident - truth) ** 2, axis=1)) / np.sqrt(np.mean(truth**2, axis=1))
+        num = np.sqrt(np.mean((ident - truth) ** 2, axis=1))
+        den = np.sqrt(np.mean(truth**2, axis=1))
+        # a coordinate the true law never accelerates in the box (0 / 0 was NaN, read as a
+        # singular law): 0 where the identified law agrees, inf where it accelerates it
+        return np.where(den > 0, num / den, np.where(num == 0, 0.0, np.where(np.isnan(num), num, np.inf)))

@@ -94,3 +94,18 @@ def test_a_law_missing_for_want_of_equations_is_named_as_such():
                     {"equation_bars": {"law_error": {"max": 0.25}}, "law_error_reason": reason}, {})
     (said,) = equation_failures(scores, {"angle_rmse": {"max": 0.05}}).values()
     assert reason in said and "singular" not in said
+
+
+def test_a_coordinate_the_true_law_never_accelerates_is_not_a_singular_law():
+    """0 / 0 gave NaN, read as "no finite acceleration" (review of round 14): where the true
+    accelerations of a coordinate are zero over the box, an identified law that agrees scores 0
+    and one that accelerates it scores inf."""
+    from testbed.scoring.law import law_errors
+
+    names = ["ddth1", "ddth2", "th1", "u1"]
+    true = np.array([[1.0, 0.0, 1.0, -1.0], [0.0, 1.0, 0.0, 0.0]])  # ddth2 = 0 everywhere
+    sig = record()
+    assert np.allclose(law_errors(names, true, names, true, sig), 0.0)
+    pushed = np.array([[1.0, 0.0, 1.0, -1.0], [0.0, 1.0, 0.5, 0.0]])
+    err = law_errors(names, pushed, names, true, sig)
+    assert err[0] == 0.0 and err[1] == np.inf
