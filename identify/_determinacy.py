@@ -29,7 +29,7 @@ are not perturbed: the chain's derivative noise is left out, so the ratio is the
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 
 import numpy as np
 
@@ -91,16 +91,40 @@ def determinacy_bound(rows: Callable[[np.ndarray], np.ndarray], x: np.ndarray,
     return noise / gap if gap > 0.0 else float("inf")
 
 
-def _noise_gram(rows: Callable[[np.ndarray], np.ndarray], x: np.ndarray, sigma: np.ndarray,
-                base: np.ndarray, norms: np.ndarray) -> np.ndarray:
-    """Mean ``D^T D`` over :data:`DRAWS` draws of white noise of std ``sigma`` (n_states, 1)
-    added to ``x``; ``D`` the change of the rows normalised by ``norms`` from ``base``."""
+def _noisy_rows(rows: Callable[[np.ndarray], np.ndarray], x: np.ndarray, sigma: np.ndarray,
+                norms: np.ndarray) -> Iterator[np.ndarray]:
+    """The rows, normalised by ``norms``, of ``x`` plus each of :data:`DRAWS` seeded draws of
+    white noise of std ``sigma`` (n_states, 1): the one parametric bootstrap every estimate of
+    this module draws (the same draws, in the same order, for each)."""
     rng = np.random.default_rng(SEED)
-    dG = np.zeros((base.shape[1], base.shape[1]))
     for _ in range(DRAWS):
-        d = np.asarray(rows(x + sigma * rng.standard_normal(x.shape)), dtype=float) / norms - base
+        yield np.asarray(rows(x + sigma * rng.standard_normal(x.shape)), dtype=float) / norms
+
+
+def _noise_gram(rows: Callable[[np.ndarray], np.ndarray], x: np.ndarray, sigma: np.ndarray,
+                base: np.ndarray, norms: np.ndarray, spread: bool = False
+                ) -> np.ndarray | tuple[np.ndarray, float]:
+    """Mean ``D^T D`` over the draws of :func:`_noisy_rows`, ``D`` the change of the rows from
+    ``base``; with ``spread``, also the RMS distance from their mean of the draws' unit
+    total-least-squares directions (signs aligned with ``base``'s; NaN if a draw's rows are
+    not finite), from the same evaluation of the rows."""
+    dG = np.zeros((base.shape[1], base.shape[1]))
+    v0 = np.linalg.eigh(base.T @ base)[1][:, 0] if spread else None
+    vs, finite = [], True
+    for d in _noisy_rows(rows, x, sigma, norms):
+        if spread:
+            finite = finite and bool(np.all(np.isfinite(d)))
+            if finite:
+                v = np.linalg.eigh(d.T @ d)[1][:, 0]
+                vs.append(v if v @ v0 >= 0.0 else -v)
+        d = d - base
         dG += d.T @ d
-    return dG / DRAWS
+    if not spread:
+        return dG / DRAWS
+    if not finite:
+        return dG / DRAWS, float("nan")
+    vs = np.array(vs)
+    return dG / DRAWS, float(np.sqrt(np.mean(np.sum((vs - vs.mean(axis=0)) ** 2, axis=1))))
 
 
 def noise_gram(rows: Callable[[np.ndarray], np.ndarray], x: np.ndarray,
@@ -153,23 +177,33 @@ def direction_spread(rows: Callable[[np.ndarray], np.ndarray], x: np.ndarray,
         The spread [-] (unit-norm directions; 0 for zero noise), NaN where the rows are unusable
         or a draw's rows are not finite.
     """
+    return noise_gram_and_spread(rows, x, sigma)[1]
+
+
+def noise_gram_and_spread(rows: Callable[[np.ndarray], np.ndarray], x: np.ndarray,
+                          sigma: np.ndarray) -> tuple[np.ndarray, float]:
+    """:func:`noise_gram` and :func:`direction_spread` from one evaluation of the draws' rows.
+
+    Parameters
+    ----------
+    rows, x, sigma
+        As in :func:`noise_gram`.
+
+    Returns
+    -------
+    dG : ndarray, shape (q, q)
+        As :func:`noise_gram` returns it [-].
+    spread : float
+        As :func:`direction_spread` returns it [-].
+    """
     base, norms, fault = _unit_rows(rows, x)
+    q = base.shape[1]
     if fault:
-        return float("nan")
+        return np.full((q, q), np.nan), float("nan")
     sigma = np.asarray(sigma, dtype=float).reshape(-1, 1)
     if not np.any(sigma > 0.0):
-        return 0.0
-    v0 = np.linalg.eigh(base.T @ base)[1][:, 0]
-    rng = np.random.default_rng(SEED)
-    vs = []
-    for _ in range(DRAWS):
-        d = np.asarray(rows(x + sigma * rng.standard_normal(x.shape)), dtype=float) / norms
-        if not np.all(np.isfinite(d)):
-            return float("nan")
-        v = np.linalg.eigh(d.T @ d)[1][:, 0]
-        vs.append(v if v @ v0 >= 0.0 else -v)
-    vs = np.array(vs)
-    return float(np.sqrt(np.mean(np.sum((vs - vs.mean(axis=0)) ** 2, axis=1))))
+        return np.zeros((q, q)), 0.0
+    return _noise_gram(rows, x, sigma, base, norms, spread=True)
 
 
 def noise_residual_ratio(rows: Callable[[np.ndarray], np.ndarray], x: np.ndarray,

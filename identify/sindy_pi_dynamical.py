@@ -82,8 +82,7 @@ from identify._base import Identifier
 from identify._determinacy import (
     DRAWS,
     determinacy_bound,
-    direction_spread,
-    noise_gram,
+    noise_gram_and_spread,
     noise_residual_ratio,
 )
 from identify._implicit import (
@@ -691,16 +690,16 @@ class SINDyPIDynamical(Identifier):
             if self.refit == "compensated":
                 rows = self._rows_of([lib.names[j] for j in support], lib, xd, u, data.fs)
                 with np.errstate(over="ignore", invalid="ignore"):
-                    dG = noise_gram(rows, x, sigma)
-                    spread = direction_spread(rows, x, sigma)
+                    dG, spread = noise_gram_and_spread(rows, x, sigma)  # one set of draws
                 if np.all(np.isfinite(dG)) and np.isfinite(spread):
-                    v_c = np.linalg.eigh(sub - dG)[1][:, 0]
+                    vecs_c = np.linalg.eigh(sub - dG)[1]
+                    v_c = vecs_c[:, 0]
                     v_t = vecs[:, 0]
                     shift = float(np.linalg.norm(v_c - np.sign(v_c @ v_t or 1.0) * v_t))
                     ratio = shift / spread if spread > 0.0 else float("inf")
                     self.compensation_[k] = ratio
                     if ratio > COMPENSATION_SIGNIFICANCE:
-                        vecs = np.linalg.eigh(sub - dG)[1]
+                        vecs = vecs_c
                         compensated.append(self.states_[k])
             w = np.zeros_like(row)
             w[support] = vecs[:, 0] / norms
