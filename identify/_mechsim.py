@@ -124,6 +124,26 @@ class LoopClosure:
         self.passive = np.asarray(self.passive, dtype=np.intp)
         self.active = np.setdiff1d(np.arange(self.a.size), self.passive)
 
+    def whiteness(self, x: np.ndarray) -> float:
+        """RMS closure error over its sample-to-sample part [-] (about 1 where the error is white).
+
+        The RMS of the residual ``(gx, gy)`` divided by ``sqrt(mean(diff^2) / 2)``, the RMS that
+        white noise of the same first differences has.  Independent angle noise leaves a white
+        residual (about 1); a wrong link length or base leaves one that follows the motion or
+        a constant offset, which the differences cancel (a large ratio; so do low-passed
+        angles, whose noise is no longer white).  ``inf`` where the residual does not change.
+
+        Parameters
+        ----------
+        x : ndarray, shape (n, N)
+            Absolute link angles [rad], N >= 2 samples.
+        """
+        gx = self.a @ np.cos(x) - self.b[0]
+        gy = self.a @ np.sin(x) - self.b[1]
+        white = np.sqrt(np.mean(np.diff(gx) ** 2 + np.diff(gy) ** 2) / 2.0)
+        rms = np.sqrt(np.mean(gx**2 + gy**2))
+        return float(rms / white) if white > 0 else float("inf")
+
     def residual(self, x: np.ndarray, rms: bool = False) -> float:
         """Largest (or with ``rms`` the RMS) closure error on the samples, relative to the
         longest link."""
