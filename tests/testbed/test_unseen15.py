@@ -18,6 +18,7 @@ UNSEEN = ROOT / "benchmarks" / "unseen"
     ("round15_beams", 38), ("round15_beams_noise", 76), ("round15_linkages_sine", 15),
     ("round15_linkages_sine_seeds", 15), ("round15_linkages_clean", 5),
     ("round15_linkages_cartpoles", 12), ("round15_linkages_cartpoles_seeds", 12),
+    ("round15_linkages_cartpoles_s2", 12),
     ("round15_linkages_kinetics", 12), ("round15_linkages_kinetics_seeds", 8)])
 def test_round15_studies_load(name, cells):
     from testbed.studies.study import load_study
