@@ -15,8 +15,10 @@ That is the truth (:func:`implicit_equation`), derived from the ODE's own parame
 Measured: the concentration ``x`` and its rate ``dx`` (the right-hand side evaluated on the
 simulated state, so ``(x, dx)`` satisfy the implicit equation to round-off whatever the
 integrator's error); noise goes on ``x`` only.  With ``Vmax > jx`` the state tends to the
-stable steady state ``x* = jx Km / (Vmax - jx)`` [mM] (``check`` refuses ``Vmax <= jx``,
-whose state grows without bound).
+stable steady state ``x* = jx Km / (Vmax - jx)`` [mM]; with ``Vmax < jx`` the influx outruns
+the enzyme and the substrate accumulates (at most ``jx`` per second: a finite record, the same
+law with a negative ``x`` coefficient; refused before round 15).  ``check`` refuses
+``Vmax = jx``, where the law's ``x`` term vanishes.
 
 One trajectory per record, from ``x0``.  The paper concatenates several initial conditions;
 here a record is one trajectory because the testbed's Measurement carries no segment
@@ -143,28 +145,33 @@ class MichaelisMentenRig(Rig):
     @classmethod
     def check(cls, rig: dict[str, Any], simulation: dict[str, Any], excitation: dict[str, Any],
               error: ErrorFn) -> None:
-        if not rig["Vmax"] > rig["jx"]:
-            error("rig.Vmax", rig["Vmax"], f"expected above jx ({rig['jx']:g} mM/s): otherwise "
-                                           "the influx outruns the enzyme and x grows without bound")
-        else:
-            steady = rig["jx"] * rig["Km"] / (rig["Vmax"] - rig["jx"])
-            if abs(rig["x0"] - steady) <= REST_RTOL * steady:
-                error("rig.x0", rig["x0"], f"expected away from the steady state jx Km / (Vmax - jx) "
-                                           f"= {steady:.6g} mM: started there, x never moves and "
-                                           "the record holds nothing to identify")
-            # x moves monotonically from x0 to the steady state: the rate must be finite at
-            # both ends (x0 = 1.8e308 mM: Vmax x overflowed, solve_ivp's "Required step size is
-            # less than spacing between numbers" was an internal error)
-            with np.errstate(over="ignore", invalid="ignore"):
-                ends = rate(np.array([rig["x0"], steady]), rig["jx"], rig["Vmax"], rig["Km"])
-            if not np.isfinite(ends[0]):  # the larger of the two factors is named
-                key = "rig.x0" if rig["x0"] >= rig["Vmax"] else "rig.Vmax"
-                error(key, rig[key[4:]], "expected a start whose rate jx - Vmax x0 / (Km + x0) "
-                                         f"is finite (Vmax x0 below {np.finfo(float).max:.4g} "
-                                         "mM^2/s)")
-            if not np.isfinite(ends[1]):
-                error("rig.Vmax", rig["Vmax"], f"expected a rate finite at the steady state "
-                                               f"{steady:.6g} mM (Vmax times it overflows)")
+        if rig["Vmax"] == rig["jx"]:
+            error("rig.Vmax", rig["Vmax"], f"expected other than jx ({rig['jx']:g} mM/s): at "
+                                           "Vmax = jx the law's term x has coefficient Vmax - jx = 0, "
+                                           "and this rig's truth is the four-term law")
+            check_two_samples(simulation, error)
+            return
+        # x moves monotonically from x0 to the steady state, or (Vmax < jx: the influx outruns
+        # the enzyme, a valid record: the substrate accumulates, by at most jx per second)
+        # upward without one; the rate must be finite at both ends (x0 = 1.8e308 mM: Vmax x
+        # overflowed, solve_ivp's "Required step size is less than spacing between numbers"
+        # was an internal error)
+        steady = rig["jx"] * rig["Km"] / (rig["Vmax"] - rig["jx"]) if rig["Vmax"] > rig["jx"] else None
+        if steady is not None and abs(rig["x0"] - steady) <= REST_RTOL * steady:
+            error("rig.x0", rig["x0"], f"expected away from the steady state jx Km / (Vmax - jx) "
+                                       f"= {steady:.6g} mM: started there, x never moves and "
+                                       "the record holds nothing to identify")
+        with np.errstate(over="ignore", invalid="ignore"):
+            ends = rate(np.array([rig["x0"], rig["x0"] if steady is None else steady]),
+                        rig["jx"], rig["Vmax"], rig["Km"])
+        if not np.isfinite(ends[0]):  # the larger of the two factors is named
+            key = "rig.x0" if rig["x0"] >= rig["Vmax"] else "rig.Vmax"
+            error(key, rig[key[4:]], "expected a start whose rate jx - Vmax x0 / (Km + x0) "
+                                     f"is finite (Vmax x0 below {np.finfo(float).max:.4g} "
+                                     "mM^2/s)")
+        if steady is not None and not np.isfinite(ends[1]):
+            error("rig.Vmax", rig["Vmax"], f"expected a rate finite at the steady state "
+                                           f"{steady:.6g} mM (Vmax times it overflows)")
         check_two_samples(simulation, error)
 
     @classmethod
@@ -218,4 +225,4 @@ class MichaelisMentenRig(Rig):
             reference={"x": Signal(x.copy(), ("x",), "mM"), "dx": Signal(dx.copy(), ("dx",), "mM/s")},
             truth=truth.to_dict(), truth_units=dict(TRUTH_UNITS),
             attrs={"integrator": "DOP853", "rtol": RTOL, "atol": ATOL,
-                   "steady_state": jx * km / (vmax - jx)})
+                   **({"steady_state": jx * km / (vmax - jx)} if vmax > jx else {})})

@@ -46,10 +46,29 @@ def test_implicit_equation_scale_is_the_largest_raw_coefficient():
     np.testing.assert_allclose(coef[0] * scale, [3.0, 1.0, -0.3, 1.9])
 
 
-def test_a_rate_the_enzyme_cannot_match_is_refused():
-    with pytest.raises(ScenarioError, match=r"rig\.Vmax"):
+def test_an_influx_the_enzyme_cannot_match_is_a_valid_record():
+    """jx 2 over Vmax 1.5 mM/s (refused before round 15 as growing "without bound"): over the
+    4 s record the substrate accumulates from 2 to about 4 mM, on the closed-form time of state
+    (a = jx - Vmax > 0 keeps a x + b > 0), and the law holds with a negative x coefficient."""
+    sc = scenario_from_dict({"scenario": {"name": "x", "rig": "michaelis_menten"},
+                             "rig": {"jx": 2.0, "Vmax": 1.5}})
+    ds = rig_class("michaelis_menten")(sc).simulate()
+    x, dx = ds.measured["x"].data[0], ds.measured["dx"].data[0]
+    assert np.all(dx > 0) and 3.0 < x[-1] < 2.0 + 2.0 * 4.0  # at most jx per second
+    a, b, km, x0 = 0.5, 2.0 * 0.3, 0.3, 2.0
+    t_exact = (x - x0) / a + (km - b / a) / a * np.log((a * x + b) / (a * x0 + b))
+    np.testing.assert_allclose(t_exact, ds.t, atol=1e-9)  # the same 1e-9 s as the shipped record
+    truth = DynamicalTruth.from_dict(ds.truth, ds.truth_units)
+    np.testing.assert_allclose(truth.equation_coef * truth.equation_scale[0], [[0.3, 1.0, -0.6, -0.5]],
+                               rtol=1e-15)
+    assert "steady_state" not in ds.attrs
+
+
+def test_an_enzyme_exactly_matching_the_influx_is_refused_naming_vmax():
+    # Vmax = jx: the law's x term vanishes, and the truth is the four-term law
+    with pytest.raises(ScenarioError, match=r"key 'rig\.Vmax': value 0\.6: .*coefficient Vmax - jx = 0"):
         scenario_from_dict({"scenario": {"name": "x", "rig": "michaelis_menten"},
-                            "rig": {"jx": 2.0, "Vmax": 1.5}})
+                            "rig": {"jx": 0.6, "Vmax": 0.6}})
 
 
 def test_a_start_at_the_steady_state_is_refused_naming_x0():
