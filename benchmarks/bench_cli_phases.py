@@ -99,12 +99,12 @@ def _instrument(record) -> None:
         record(kind="prepare", name="frames", cpu=_cpu() - c, made=n, end=time.time())
         return n
 
-    def draw_each(run, folder, stems):
+    def draw_each(run, folder, stems, cache=None):
         record(kind="draw start", name="", start=time.time())
         out = []
         for stem in stems:
             c = _cpu()
-            out += draw(run, folder, [stem])
+            out += draw(run, folder, [stem], cache)
             record(kind="figure", name=stem, cpu=_cpu() - c)
         return out
 

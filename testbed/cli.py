@@ -554,8 +554,10 @@ def cmd_run(args: argparse.Namespace) -> int:
     _output_folder(Path(args.out), "--out")
     cache = None if args.no_cache else DatasetCache(_cache_folder(args.cache))
     ok = True
-    # the figures are drawn by a process forked now: it imports matplotlib during the fit
-    with figure_drawer(enabled=not args.no_figures) as figures:
+    # the figures are drawn by a process forked now: it imports matplotlib during the fit;
+    # figures of the same inputs are copied from the cache's folder (testbed.reporting.figcache)
+    kept = None if cache is None else cache.directory / "figures"
+    with figure_drawer(enabled=not args.no_figures, cache=kept) as figures:
         scenarios = [load_scenario(name) for name in args.scenario]  # every file checked first
         for sc in scenarios:
             if sc.identify is None:  # was found after simulating, naming the scenario, not its file
