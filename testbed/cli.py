@@ -689,6 +689,11 @@ def cmd_cache(args: argparse.Namespace) -> int:
         print(f"{len(entries)} dataset(s) in {terminal_safe(str(cache.directory))}")
     else:
         print(f"removed {cache.clear()} dataset(s) from {terminal_safe(str(cache.directory))}")
+        from testbed.reporting.figcache import FigureCache
+
+        kept = FigureCache(cache.directory / "figures")
+        if n := kept.clear():  # the run figures kept there (testbed.reporting.figcache)
+            print(f"removed {n} run figure(s) from {terminal_safe(str(kept.directory))}")
     return 0
 
 

@@ -29,7 +29,7 @@ Rules (so that the cache never changes a picture, and never fails a run):
   is ignored: the figure is then drawn as without a cache.
 
 ``testbed run`` keeps it in the dataset cache's folder (``<cache>/figures``); ``--no-cache``
-keeps none.
+keeps none; ``testbed cache clear`` empties it with the datasets.
 """
 
 from __future__ import annotations
@@ -153,6 +153,20 @@ class FigureCache:
             self._trim()
         except Exception:  # a cache that cannot be written is no cache
             return
+
+    def clear(self) -> int:
+        """Remove every figure kept (and temporary files of killed writes); how many figures
+        were removed (0 without a folder; a file that cannot be removed is left)."""
+        n = 0
+        if not self.directory.is_dir():
+            return 0
+        for p in [*self._entries(), *self.directory.glob(".*.png.*.tmp")]:
+            try:
+                p.unlink()
+                n += p.suffix == ".png"
+            except OSError:
+                continue
+        return n
 
     def _trim(self) -> None:
         """Remove the least recently used PNGs beyond ``max_entries`` (ties: by name)."""

@@ -124,3 +124,19 @@ def test_a_run_repeated_draws_nothing_in_the_drawing_processes(run_folder, drawn
     assert [p.name for p in paths] == list(drawn)
     for p in paths:
         assert p.read_bytes() == drawn[p.name], p
+
+
+def test_cache_clear_removes_the_kept_figures(tmp_path, capsys):
+    from testbed.cli import main
+
+    png = tmp_path / "x.png"
+    png.write_bytes(figcache._PNG_HEAD + b"body" + figcache._PNG_TAIL)
+    cache = figcache.FigureCache(tmp_path / "cache" / "figures")
+    for i in range(3):
+        cache.store(cache.key("run", f"f{i}"), png)
+    (tmp_path / "cache" / "figures" / "notes.txt").write_text("not ours")
+    assert main(["cache", "clear", "--cache", str(tmp_path / "cache")]) == 0
+    out = capsys.readouterr().out
+    assert "removed 0 dataset(s)" in out and "removed 3 run figure(s)" in out
+    assert [p.name for p in (tmp_path / "cache" / "figures").iterdir()] == ["notes.txt"]
+    assert cache.clear() == 0
