@@ -12,8 +12,9 @@ seed, a noise level, an identifier's change) has another key and is drawn.
 The key (:func:`run_key`, :meth:`FigureCache.key`) is the SHA-256 of:
 
 - :data:`KEY_VERSION` and the figure's stem;
-- the drawing code: the bytes of :data:`DRAWING_SOURCES` (this package's modules that draw)
-  and the versions of matplotlib, numpy and Pillow;
+- the drawing code: the bytes of :data:`DRAWING_SOURCES` (this package's modules that draw),
+  the versions of matplotlib, numpy and Pillow, and matplotlib's settings in effect (a user's
+  ``matplotlibrc`` included; the backend's name left out: reading it can import pyplot);
 - the whole run as the builders see it: its kind, its scenario (JSON, sorted keys) and every
   entry of its ``details``, ``model``, ``history`` and ``truth`` (name, dtype, shape and bytes
   of each array; JSON of each list), more than any one figure reads.
@@ -71,6 +72,9 @@ def _code_digest() -> bytes:
             h.update(name.encode() + b"\0" + (here / name).read_bytes() + b"\0")
         for v in (matplotlib.__version__, np.__version__, PIL.__version__):
             h.update(str(v).encode() + b"\0")
+        rc = matplotlib.rcParams
+        h.update(repr(sorted((k, repr(rc[k])) for k in rc if k not in ("backend", "backend_fallback")))
+                 .encode())
         _CODE.append(h.digest())
     return _CODE[0]
 

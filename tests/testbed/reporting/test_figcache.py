@@ -140,3 +140,17 @@ def test_cache_clear_removes_the_kept_figures(tmp_path, capsys):
     assert "removed 0 dataset(s)" in out and "removed 3 run figure(s)" in out
     assert [p.name for p in (tmp_path / "cache" / "figures").iterdir()] == ["notes.txt"]
     assert cache.clear() == 0
+
+
+def test_the_key_follows_matplotlibs_settings(run_folder, monkeypatch):
+    """A user's matplotlibrc (another font size, say) draws other pictures: another key."""
+    import matplotlib as mpl
+
+    run = load_run(run_folder)
+    monkeypatch.setattr(figcache, "_CODE", [])
+    key = figcache.run_key(run)
+    monkeypatch.setattr(figcache, "_CODE", [])
+    with mpl.rc_context({"font.size": 13}):
+        assert figcache.run_key(run) != key
+    monkeypatch.setattr(figcache, "_CODE", [])
+    assert figcache.run_key(run) == key
