@@ -184,10 +184,22 @@ def _raise(msg: tuple) -> None:
     raise e
 
 
+def _all_kept(run: Any, stems: Sequence[str], cache: FigureCache) -> bool:
+    """Whether ``cache`` holds every figure ``stems`` of ``run`` (never fails: False)."""
+    try:
+        digest = run_key(run)
+        return all(cache.holds(cache.key(digest, s)) for s in stems)
+    except Exception:
+        return False
+
+
 def _draw_split(folder: str, cache: FigureCache | None = None) -> list[str]:
     """Draw every figure of the run in ``folder``: a forked helper draws half of them."""
     run = load_run(Path(folder))  # read once: the forked helper inherits it
-    groups = split_figures(figs.run_figures_available(run))
+    stems = figs.run_figures_available(run)
+    groups = split_figures(stems)
+    if cache is not None and _all_kept(run, stems, cache):  # copies only: no helper forked
+        return _draw(run, folder, stems, cache)
     if len(groups) < 2:
         return _draw(run, folder, groups[0] if groups else [], cache)
     recv, send = multiprocessing.Pipe(duplex=False)

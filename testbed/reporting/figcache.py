@@ -136,6 +136,13 @@ class FigureCache:
         """The key of figure ``stem`` of a run whose :func:`run_key` is ``run_digest``."""
         return hashlib.sha256(f"{run_digest}\0{stem}".encode()).hexdigest()
 
+    def holds(self, key: str) -> bool:
+        """Whether a whole PNG is kept under ``key`` (never fails: False)."""
+        try:
+            return _whole_png(self.directory / f"{key}.png")
+        except Exception:
+            return False
+
     def fetch(self, key: str, dest: Path) -> bool:
         """Copy the PNG of ``key`` to ``dest`` (atomically); whether there was a whole one."""
         src = self.directory / f"{key}.png"

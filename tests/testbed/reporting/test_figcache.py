@@ -154,3 +154,24 @@ def test_the_key_follows_matplotlibs_settings(run_folder, monkeypatch):
         assert figcache.run_key(run) != key
     monkeypatch.setattr(figcache, "_CODE", [])
     assert figcache.run_key(run) == key
+
+
+def test_a_drawing_process_forks_no_helper_when_every_figure_is_kept(run_folder, drawn, tmp_path,
+                                                                     monkeypatch):
+    cache = figcache.FigureCache(tmp_path / "cache")
+    there = tmp_path / "there"
+    there.mkdir()
+    for f in ("run.json", "run.npz"):
+        (there / f).write_bytes((run_folder / f).read_bytes())
+    drawer.draw_run_figures(load_run(run_folder), tmp_path / "a", cache)  # fills the cache
+
+    def no_fork():
+        raise AssertionError("a helper was forked to copy files")
+
+    monkeypatch.setattr(drawer.os, "fork", no_fork)
+    paths = drawer._draw_split(str(there), cache)
+    assert [Path(p).name for p in paths] == list(drawn)
+    assert all(Path(p).read_bytes() == drawn[Path(p).name] for p in paths)
+    (tmp_path / "cache" / f"{cache.key(figcache.run_key(load_run(there)), 'mac')}.png").unlink()
+    with pytest.raises(AssertionError, match="forked"):  # one to draw: the split as before
+        drawer._draw_split(str(there), cache)
