@@ -47,7 +47,7 @@ import numpy as np
 
 from testbed.core.atomic import atomic_write
 
-__all__ = ["DRAWING_SOURCES", "FigureCache", "KEY_VERSION", "MAX_ENTRIES", "run_key"]
+__all__ = ["DRAWING_SOURCES", "KEY_VERSION", "MAX_ENTRIES", "FigureCache", "run_key"]
 
 #: Changed when the key's make-up changes (old entries are then never found again).
 KEY_VERSION = "testbed-run-figure-1"
