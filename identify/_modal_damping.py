@@ -831,8 +831,6 @@ def decay_hold(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndarray,
     dec = modal_decay(data, M, K, C, window, with_backbone, unlocated)
     if not np.any(dec.taken):
         return DecayHold(C, K, dec, "modal decay fits: none taken, the fit's")
-    sigma, own = fit_pole_decay(M, C, K, dec.sigma_model, dec.taken)
-    C2 = hold_modal_damping(M, C, K, sigma)
     line = float(data.fs) / (i1 - i0)
     free = np.zeros(M.shape[0], bool) if unlocated is None else np.asarray(unlocated, bool)
     if np.any(free):  # only to a frequency nearer its own mode's than any other's
@@ -855,15 +853,12 @@ def decay_hold(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndarray,
         beyond = (dec.taken & ~near & ~free & explained
                   & (dec.shift <= line + peak_offset(dec.sigma_model, dec.lam_model)))
     K2 = set_frequencies(on, dec.lam_model) if np.any(on) else K
-    # couplings the measured decays contradict: uncouple the modes they move, until none moves
-    alone = hold_modal_damping(M, C, K, sigma, uncouple=dec.taken)
-    cut = np.zeros_like(dec.taken)
-    for _ in range(M.shape[0]):
-        moved = coupling_moves(M, C2, K2, alone, dec.taken, line)
-        if not np.any(moved):
-            break
-        cut |= moved
-        C2 = hold_modal_damping(M, C, K, sigma, uncouple=cut)
+    C2, cut = _hold_couplings(M, C, K, K2, dec.sigma_model, dec.taken, line)
+    own = np.zeros_like(dec.taken)
+    if _grows(M, C2, K2) and not _grows(M, C, K):  # the hold made a stable fit grow
+        sigma, own = fit_pole_decay(M, C, K, dec.sigma_model, dec.taken)
+        if np.any(own):
+            C2, cut = _hold_couplings(M, C, K, K2, sigma, dec.taken, line)
     kept, fixed = np.flatnonzero(~dec.taken & ~own) + 1, np.flatnonzero(on) + 1
     rule = ("each mode's damping from its measured free decay (modal accelerations "
             "Phi^-1 x'', fitted exp(-sigma t) sinusoid"
@@ -891,11 +886,42 @@ def decay_hold(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndarray,
                if np.any(unexplained) else "")
             + (f"; modes {(np.flatnonzero(own) + 1).tolist()}, whose decay no fit measured "
                f"and whose own modal damping the fit made negative, the decay rate of the fit's "
-               f"pole ({', '.join(f'{v:.4g}' for v in sigma[own])} 1/s)" if np.any(own) else "")
+               f"pole ({', '.join(f'{v:.4g}' for v in sigma[own])} 1/s: with the fit's the "
+               f"held model grew)" if np.any(own) else "")
             + (f"; modes {(np.flatnonzero(cut) + 1).tolist()} uncoupled (the fit's damping "
                f"couplings moved their poles more than one line from their measured decay)"
                if np.any(cut) else ""))
     return DecayHold(C2, K2, dec, rule)
+
+
+def _hold_couplings(M: np.ndarray, C: np.ndarray, K: np.ndarray, K2: np.ndarray,
+                    sigma: np.ndarray, taken: np.ndarray, line: float
+                    ) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`hold_modal_damping` of the fit ``(M, C, K)`` with ``sigma`` [1/s], then the
+    couplings the measured decays contradict cut (:func:`coupling_moves` on the held stiffness
+    ``K2`` [N/m]: uncouple the modes they move, until none moves; ``line`` [Hz] the window's
+    resolution).  Returns the held damping [N s/m] and which modes were uncoupled."""
+    C2 = hold_modal_damping(M, C, K, sigma)
+    alone = hold_modal_damping(M, C, K, sigma, uncouple=taken)
+    cut = np.zeros_like(taken)
+    for _ in range(M.shape[0]):
+        moved = coupling_moves(M, C2, K2, alone, taken, line)
+        if not np.any(moved):
+            break
+        cut |= moved
+        C2 = hold_modal_damping(M, C, K, sigma, uncouple=cut)
+    return C2, cut
+
+
+def _grows(M: np.ndarray, C: np.ndarray, K: np.ndarray) -> bool:
+    """Whether the linear model has a growing pole (real part above ``1e-9`` of its modulus,
+    :func:`identify.structural.check_physical`'s test); False when the poles are not finite."""
+    with np.errstate(all="ignore"):
+        try:
+            lam = np.linalg.eigvals(state_matrix(M, C, K))
+        except np.linalg.LinAlgError:
+            return False
+    return bool(np.all(np.isfinite(lam)) and np.any(lam.real > 1e-9 * np.abs(lam)))
 
 
 def fit_pole_decay(M: np.ndarray, C: np.ndarray, K: np.ndarray, sigma: np.ndarray,
@@ -911,11 +937,15 @@ def fit_pole_decay(M: np.ndarray, C: np.ndarray, K: np.ndarray, sigma: np.ndarra
     ``ls_sindy``: the fit's spurious mode 2 (420.9 Hz, no decay taken) had ``D_22`` =
     -624 1/s and a stable pole at -40.3 + 2605j 1/s; every hold of modes 1, 3, 4 (coupled or
     not) put it at +97 to +322 1/s and the run was refused as non-physical, while the
-    unheld fit passes (TRAC 0.9998).  Such a mode (not taken, ``D_kk < 0``) is given the
+    unheld fit passes (TRAC 0.9998).  So where the hold made a stable fit grow
+    (:func:`decay_hold` asks only then), such a mode (not taken, ``D_kk < 0``) is given the
     decay rate of the fit's own pole of that mode instead (the coupled pole nearest its
     undamped frequency in modulus, when that pole decays): what the fit says the mode does.
-    A mode with ``D_kk >= 0`` keeps the fit's ``D_kk`` as before; a symmetric positive
-    semi-definite ``C`` (``sgd_sindy``'s, projected) has none below 0.
+    A mode with ``D_kk >= 0`` keeps the fit's ``D_kk``; a symmetric positive semi-definite
+    ``C`` (``sgd_sindy``'s, projected) has none below 0.  Applied wherever a taken-free mode
+    had ``D_kk < 0`` (the first form) it also acted on soft-base family member 001 clean,
+    whose held model stayed stable with the fit's, and moved its TRAC 0.979 -> 0.909 (failing
+    both ways on mode 1, 3.69 / 3.07 %): hence only where the hold made the fit grow.
 
     Parameters
     ----------

@@ -425,7 +425,8 @@ def test_a_mode_damped_only_through_its_couplings_keeps_the_fit_pole(chain, monk
     modal damping ``D_kk`` and keep it stable through its couplings alone; the hold rescales or
     cuts the measured modes' couplings and that mode then grew.  Before (2026-11-27) round 14's
     ``b14_st_z5_s4_n28`` at 0.5 % noise (seed 51, ``ls_sindy``) was refused as non-physical that
-    way (a pole at +308.5 1/s; the unheld fit stable, TRAC 0.9998).  Now such a mode takes the
+    way (a pole at +308.5 1/s; the unheld fit stable, TRAC 0.9998).  Now, where the hold makes
+    a stable fit grow, such a mode takes the
     decay rate of the fit's own pole (its frequency is the uncoupled one, as for every mode the
     hold uncouples); a mode whose own damping is positive keeps it (as before)."""
     import identify._modal_damping as md
