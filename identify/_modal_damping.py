@@ -777,7 +777,10 @@ def decay_hold(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndarray,
     and the eigenvalue hold locate a mode to, so the decay fit refines a frequency (measured:
     family member 009's mode 1, 71.1 -> 72.3 Hz against 72.3 true) and never moves a mode
     farther than the spectrum allows.  With a continuous input (``i0 == 0`` and a non-zero
-    ``data.u``) there is no free decay and nothing is held.
+    ``data.u``) there is no free decay and nothing is held.  A mode whose decay fit was not
+    taken keeps the fit's damping; where the held model then grows while the fit did not, a
+    mode the fit damped only through its couplings takes the decay rate of the fit's own pole
+    (:func:`fit_pole_decay`, named in the rule).
 
     Parameters
     ----------
