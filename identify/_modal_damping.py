@@ -709,11 +709,7 @@ def hold_modal_damping(M: np.ndarray, C: np.ndarray, K: np.ndarray, sigma: np.nd
     """
     _, Phi = modal(M, K)
     symmetric = _is_symmetric(M, C, K)
-    if symmetric:
-        D = Phi.T @ C @ Phi
-        D = 0.5 * (D + D.T)
-    else:  # Phi^-1 M^-1 C Phi: the same matrix when Phi^T M Phi = I (module docstring)
-        D = np.linalg.solve(Phi, np.linalg.solve(M, C @ Phi))
+    D = _modal_damping_matrix(M, C, Phi, symmetric)
     dk = np.diag(D).copy()
     new = np.where(np.isfinite(sigma), 2.0 * np.nan_to_num(sigma), dk)
     g = np.ones_like(dk)
@@ -731,6 +727,16 @@ def hold_modal_damping(M: np.ndarray, C: np.ndarray, K: np.ndarray, sigma: np.nd
         return MP @ np.linalg.solve(Phi.T, D2.T).T  # M Phi D' Phi^-1
     C2 = MP @ D2 @ MP.T
     return 0.5 * (C2 + C2.T)
+
+
+def _modal_damping_matrix(M: np.ndarray, C: np.ndarray, Phi: np.ndarray,
+                          symmetric: bool) -> np.ndarray:
+    """The damping in the modes ``Phi`` (mass-normalised) [1/s]: ``Phi^T C Phi`` (symmetrised)
+    for a symmetric model, else ``Phi^-1 M^-1 C Phi`` (the same matrix when ``Phi^T M Phi = I``)."""
+    if symmetric:
+        D = Phi.T @ C @ Phi
+        return 0.5 * (D + D.T)
+    return np.linalg.solve(Phi, np.linalg.solve(M, C @ Phi))
 
 
 @dataclass(frozen=True)
@@ -771,7 +777,10 @@ def decay_hold(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndarray,
     and the eigenvalue hold locate a mode to, so the decay fit refines a frequency (measured:
     family member 009's mode 1, 71.1 -> 72.3 Hz against 72.3 true) and never moves a mode
     farther than the spectrum allows.  With a continuous input (``i0 == 0`` and a non-zero
-    ``data.u``) there is no free decay and nothing is held.
+    ``data.u``) there is no free decay and nothing is held.  A mode whose decay fit was not
+    taken keeps the fit's damping; where the held model then grows while the fit did not, a
+    mode the fit damped only through its couplings takes the decay rate of the fit's own pole
+    (:func:`fit_pole_decay`, named in the rule).
 
     Parameters
     ----------
@@ -825,7 +834,6 @@ def decay_hold(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndarray,
     dec = modal_decay(data, M, K, C, window, with_backbone, unlocated)
     if not np.any(dec.taken):
         return DecayHold(C, K, dec, "modal decay fits: none taken, the fit's")
-    C2 = hold_modal_damping(M, C, K, dec.sigma_model)
     line = float(data.fs) / (i1 - i0)
     free = np.zeros(M.shape[0], bool) if unlocated is None else np.asarray(unlocated, bool)
     if np.any(free):  # only to a frequency nearer its own mode's than any other's
@@ -848,16 +856,13 @@ def decay_hold(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndarray,
         beyond = (dec.taken & ~near & ~free & explained
                   & (dec.shift <= line + peak_offset(dec.sigma_model, dec.lam_model)))
     K2 = set_frequencies(on, dec.lam_model) if np.any(on) else K
-    # couplings the measured decays contradict: uncouple the modes they move, until none moves
-    alone = hold_modal_damping(M, C, K, dec.sigma_model, uncouple=dec.taken)
-    cut = np.zeros_like(dec.taken)
-    for _ in range(M.shape[0]):
-        moved = coupling_moves(M, C2, K2, alone, dec.taken, line)
-        if not np.any(moved):
-            break
-        cut |= moved
-        C2 = hold_modal_damping(M, C, K, dec.sigma_model, uncouple=cut)
-    kept, fixed = np.flatnonzero(~dec.taken) + 1, np.flatnonzero(on) + 1
+    C2, cut = _hold_couplings(M, C, K, K2, dec.sigma_model, dec.taken, line)
+    own = np.zeros_like(dec.taken)
+    if _grows(M, C2, K2) and not _grows(M, C, K):  # the hold made a stable fit grow
+        sigma, own = fit_pole_decay(M, C, K, dec.sigma_model, dec.taken)
+        if np.any(own):
+            C2, cut = _hold_couplings(M, C, K, K2, sigma, dec.taken, line)
+    kept, fixed = np.flatnonzero(~dec.taken & ~own) + 1, np.flatnonzero(on) + 1
     rule = ("each mode's damping from its measured free decay (modal accelerations "
             "Phi^-1 x'', fitted exp(-sigma t) sinusoid"
             + (" beside the signal chain's declared filter transients"
@@ -882,10 +887,106 @@ def decay_hold(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndarray,
             + (f"; modes {(np.flatnonzero(unexplained) + 1).tolist()} kept the fit's frequency "
                f"(its cubic gives less than {BACKBONE_SHARE:.0%} of the measured shift)"
                if np.any(unexplained) else "")
+            + (f"; modes {(np.flatnonzero(own) + 1).tolist()}, whose decay no fit measured "
+               f"and whose own modal damping the fit made negative, the decay rate of the fit's "
+               f"pole ({', '.join(f'{v:.4g}' for v in sigma[own])} 1/s: with the fit's the "
+               f"held model grew)" if np.any(own) else "")
             + (f"; modes {(np.flatnonzero(cut) + 1).tolist()} uncoupled (the fit's damping "
                f"couplings moved their poles more than one line from their measured decay)"
                if np.any(cut) else ""))
     return DecayHold(C2, K2, dec, rule)
+
+
+def _hold_couplings(M: np.ndarray, C: np.ndarray, K: np.ndarray, K2: np.ndarray,
+                    sigma: np.ndarray, taken: np.ndarray, line: float
+                    ) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`hold_modal_damping` of the fit ``(M, C, K)`` with ``sigma`` [1/s], then the
+    couplings the measured decays contradict cut (:func:`coupling_moves` on the held stiffness
+    ``K2`` [N/m]: uncouple the modes they move, until none moves; ``line`` [Hz] the window's
+    resolution).  Returns the held damping [N s/m] and which modes were uncoupled."""
+    C2 = hold_modal_damping(M, C, K, sigma)
+    alone = hold_modal_damping(M, C, K, sigma, uncouple=taken)
+    cut = np.zeros_like(taken)
+    for _ in range(M.shape[0]):
+        moved = coupling_moves(M, C2, K2, alone, taken, line)
+        if not np.any(moved):
+            break
+        cut |= moved
+        C2 = hold_modal_damping(M, C, K, sigma, uncouple=cut)
+    return C2, cut
+
+
+def _grows(M: np.ndarray, C: np.ndarray, K: np.ndarray) -> bool:
+    """Whether the linear model has a growing pole (real part above ``1e-9`` of its modulus,
+    :func:`identify.structural.check_physical`'s test); False when the poles are not finite."""
+    with np.errstate(all="ignore"):
+        try:
+            lam = np.linalg.eigvals(state_matrix(M, C, K))
+        except np.linalg.LinAlgError:
+            return False
+    return bool(np.all(np.isfinite(lam)) and np.any(lam.real > 1e-9 * np.abs(lam)))
+
+
+def fit_pole_decay(M: np.ndarray, C: np.ndarray, K: np.ndarray, sigma: np.ndarray,
+                   taken: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The decay rates the hold gives, with a mode the fit damps only through its couplings.
+
+    A mode whose decay no fit measured keeps the fit's damping, which
+    :func:`hold_modal_damping` reads as its own modal damping ``D_kk`` (``D`` the fit's ``C``
+    in its modal coordinates).  A least-squares fit (not symmetric) can leave ``D_kk``
+    negative and the mode stable only through its couplings to the other modes; the hold
+    rescales or cuts those couplings for the measured modes and the mode then grows.  Measured:
+    round 14's ``b14_st_z5_s4_n28`` (clamped, 5 % damping) at 0.5 % noise, seed 51,
+    ``ls_sindy``: the fit's spurious mode 2 (420.9 Hz, no decay taken) had ``D_22`` =
+    -624 1/s and a stable pole at -40.3 + 2605j 1/s; every hold of modes 1, 3, 4 (coupled or
+    not) put it at +97 to +322 1/s and the run was refused as non-physical, while the
+    unheld fit passes (TRAC 0.9998).  So where the hold made a stable fit grow
+    (:func:`decay_hold` asks only then), such a mode (not taken, ``D_kk < 0``) is given the
+    decay rate of the fit's own pole of that mode instead (the coupled pole nearest its
+    undamped frequency in modulus, when that pole decays): what the fit says the mode does.
+    A mode with ``D_kk >= 0`` keeps the fit's ``D_kk``; a symmetric positive semi-definite
+    ``C`` (``sgd_sindy``'s, projected) has none below 0.  Applied wherever a taken-free mode
+    had ``D_kk < 0`` (the first form) it also acted on soft-base family member 001 clean,
+    whose held model stayed stable with the fit's, and moved its TRAC 0.979 -> 0.909 (failing
+    both ways on mode 1, 3.69 / 3.07 %): hence only where the hold made the fit grow.
+
+    Parameters
+    ----------
+    M, C, K : ndarray, shape (n, n)
+        The fit's mass [kg], damping [N s/m] and stiffness [N/m].
+    sigma : ndarray, shape (n,)
+        The measured decay rates to hold [1/s] (NaN where not taken).
+    taken : ndarray of bool, shape (n,)
+        Modes whose decay was measured.
+
+    Returns
+    -------
+    sigma : ndarray, shape (n,)
+        ``sigma`` with the fit's pole decay rate [1/s] where the rule acts.
+    own : ndarray of bool, shape (n,)
+        Where it acts.
+    """
+    sigma = np.array(sigma, dtype=float)
+    own = np.zeros(M.shape[0], dtype=bool)
+    free = ~np.asarray(taken, bool)
+    if not np.any(free):
+        return sigma, own
+    with np.errstate(all="ignore"):
+        try:
+            w, Phi = modal(M, K)
+            D = _modal_damping_matrix(M, C, Phi, _is_symmetric(M, C, K))
+            p = np.linalg.eigvals(state_matrix(M, C, K))
+        except np.linalg.LinAlgError:
+            return sigma, own
+    if not (np.all(np.isfinite(D)) and np.all(np.isfinite(p))):
+        return sigma, own
+    p = p[p.imag >= 0.0]
+    w = 2.0 * np.pi * np.asarray(w)
+    for k in np.flatnonzero(free & (np.diag(D).real < 0.0)):
+        pk = p[np.argmin(np.abs(np.abs(p) - w[k]))]
+        if pk.real < 0.0:
+            sigma[k], own[k] = -pk.real, True
+    return sigma, own
 
 
 def coupling_moves(M: np.ndarray, C: np.ndarray, K: np.ndarray, C_uncoupled: np.ndarray,

@@ -418,3 +418,56 @@ def test_backbone_hold_moves_a_cubic_model_within_one_line_only():
     assert cubic.C[0, 0] == pytest.approx(2 * zeta * w, rel=0.15)  # its damping still held
     linear = decay_hold(data, M, C, K, win, setf)  # a linear model's frequency stands at a peak
     assert np.sqrt(linear.K[0, 0]) / w == pytest.approx(1.0, abs=0.03)
+
+
+def test_a_mode_damped_only_through_its_couplings_keeps_the_fit_pole(chain, monkeypatch):
+    """A least-squares fit (not symmetric) can give a mode no decay fit measured a negative own
+    modal damping ``D_kk`` and keep it stable through its couplings alone; the hold rescales or
+    cuts the measured modes' couplings and that mode then grew.  Before (2026-11-27) round 14's
+    ``b14_st_z5_s4_n28`` at 0.5 % noise (seed 51, ``ls_sindy``) was refused as non-physical that
+    way (a pole at +308.5 1/s; the unheld fit stable, TRAC 0.9998).  Now, where the hold makes
+    a stable fit grow, such a mode takes the
+    decay rate of the fit's own pole (its frequency is the uncoupled one, as for every mode the
+    hold uncouples); a mode whose own damping is positive keeps it (as before)."""
+    import identify._modal_damping as md
+    from identify.structural import check_physical, state_matrix
+
+    sysd, data = chain
+    M, K = sysd["M"], sysd["K"]
+    f, Phi = modal(M, K)
+    w = 2 * np.pi * f
+    D = np.diag([0.02 * w[0], -0.02 * w[1], 0.6 * w[2]])  # mode 2's own damping negative
+    D[1, 2], D[2, 1] = -0.3 * w[1], 3.0 * w[2]  # its couplings to mode 3 keep it stable
+    C = M @ Phi @ D @ np.linalg.inv(Phi)
+
+    def poles(Cm):
+        p = np.linalg.eigvals(state_matrix(M, Cm, K))
+        return p[p.imag >= 0]
+
+    fit = poles(C)
+    assert fit.real.max() < 0  # the fit is physical
+    mode2 = fit[np.argmin(np.abs(np.abs(fit) - w[1]))]
+    taken = np.array([True, False, True])
+    sigma = np.array([0.01 * w[0], np.nan, 0.05 * w[2]])  # modes 1 and 3 measured
+    nan = np.full(3, np.nan)
+    dec = md.ModalDecay(sigma=sigma, omega_d=nan, sigma_model=sigma, lam_model=np.where(taken, w**2, np.nan),
+                        shift=np.where(taken, 0.0, np.nan), r2=np.ones(3), taken=taken)
+    monkeypatch.setattr(md, "modal_decay", lambda *a, **k: dec)
+
+    def setf(on, lam):
+        return md.set_eigenvalues(M, K, np.where(on, lam, np.nan))
+
+    held = md.decay_hold(data, M, C, K, (0, data.n_samples), setf)
+    check_physical(M, held.C, K)  # before: mode 2 grew
+    p = poles(held.C)
+    held2 = p[np.argmin(np.abs(np.abs(p) - w[1]))]
+    assert held2.real == pytest.approx(mode2.real, rel=1e-9)  # the decay rate of the fit's pole
+    assert "whose own modal damping the fit made negative" in held.rule
+    # a mode with positive own damping keeps the fit's, as before
+    D[1, 1] = 0.02 * w[1]
+    C_pos = M @ Phi @ D @ np.linalg.inv(Phi)
+    kept = md.decay_hold(data, M, C_pos, K, (0, data.n_samples), setf)
+    assert "own modal damping" not in kept.rule
+    _, Phi_k = modal(M, K)
+    Dk = np.linalg.solve(Phi_k, np.linalg.solve(M, kept.C @ Phi_k))
+    assert Dk[1, 1] == pytest.approx(0.02 * w[1], rel=1e-9)
