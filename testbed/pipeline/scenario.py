@@ -539,7 +539,15 @@ def scenario_from_dict(raw: dict[str, Any], *, file: str = "<dict>", stem: str |
         # resolved it (its estimates say which mode put it where: round 7, six sensors on a
         # 0.32 m beam put mode 6 at 7 kHz and the low-pass above the Nyquist frequency)
         if key in rules:
-            raise ScenarioError(file, key, "auto", f"{allowed}; 'auto' resolved it to {rules[key]}")
+            fix = ""
+            if allowed.startswith("expected below the Nyquist"):
+                # what is allowed, not only what is wrong (round 15: three sensors at 3.2 kHz
+                # put the low-pass between modes 3 and 4 above the Nyquist frequency)
+                fs = float(simulation["sample_rate"])
+                fix = (f"; write a cut-off below {fs / 2:g} Hz, or a simulation.sample_rate above "
+                       f"{2 * float(value):g} Hz (twice the cut-off 'auto' gave)")
+            raise ScenarioError(file, key, "auto",
+                                f"{allowed}; 'auto' resolved it to {rules[key]}{fix}")
         raise ScenarioError(file, key, value, allowed)
 
     check_keys_used(rig_cls.kind, raw.get("signal", {}), signal, chain_error)

@@ -86,9 +86,14 @@ def test_refused_in_one_line_where_it_cannot_be_resolved():
         scenario_from_dict(raw(signal={"lowpass_hz": "Auto"}))
     # a cut-off above the Nyquist frequency is refused as a number would be, naming the key
     # (a 1 ms pulse: the default 0.3 ms one falls between two samples at 2 kHz, refused first)
-    with pytest.raises(ScenarioError, match=r"signal\.lowpass_hz.*Nyquist"):
+    with pytest.raises(ScenarioError, match=r"signal\.lowpass_hz.*Nyquist") as e:
         scenario_from_dict(raw(signal={"lowpass_hz": "auto"}, simulation={"sample_rate": 2000.0},
                                excitation={"pulse_duration": 1e-3}))
+    # ... and the line says what is allowed: a number below the Nyquist frequency, or a sample
+    # rate above twice the cut-off 'auto' gave (round 15: three sensors at 3.2 kHz)
+    msg = str(e.value)
+    cut = float(msg.split("'auto' resolved it to ")[1].split(" Hz")[0])
+    assert "below 1000 Hz" in msg and f"sample_rate above {2 * cut:g} Hz" in msg and "\n" not in msg
 
 
 def test_a_rig_without_an_estimate_refuses_auto():
