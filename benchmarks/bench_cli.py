@@ -11,14 +11,14 @@ their peers in the same run (:func:`benchmarks._timing.interleaved`), medians wi
    imported, every scenario validated, as after an edit) is reported beside it.
 2. ``testbed run cantilever_stiff_impact`` with a warm dataset cache, with figures, against the
    same run without figures (``--no-figures``) and against the numpy start-up; and the same run
-   served by a resident ``testbed serve`` (:mod:`testbed.server`: forked from a process that
-   has the libraries loaded).  Target: under 1.5 s (the issue's absolute goal), met only
-   served: a command alone spends most of its time importing the libraries.  The ratio to the
-   run without figures is what the figures cost; the ratio to the numpy start-up scales out the
-   machine's speed.  Every run here has the same inputs, so its six figures are copied from the
-   figure cache (:mod:`testbed.reporting.figcache`, filled by the warm-up round); the served run
-   is also measured with its figures drawn (the figure cache emptied before it), as a run of
-   new inputs pays them.
+   served by a resident ``testbed serve`` (:mod:`testbed.server`: forked from a process that has
+   the libraries loaded).  Target: under 1.5 s (the issue's absolute goal), for the served run
+   both with its figures copied and drawn: a command alone spends most of its time importing the
+   libraries.  The ratio to the run without figures is what the figures cost; the ratio to the
+   numpy start-up scales out the machine's speed.  Every run here has the same inputs, so its
+   six figures are copied from the figure cache (:mod:`testbed.reporting.figcache`, filled by
+   the warm-up round); the served run is also measured with its figures drawn (the figure cache
+   emptied before it), as a run of new inputs pays them.
 
 The run draws its figures in processes it forks (``testbed.reporting.drawer``): one imports
 matplotlib during the fit, then it and one more draw half of the figures each; their CPU time is
@@ -155,7 +155,8 @@ def run() -> list[dict]:
                          f"from the index / without: {ratio:.2f}x, {rs}"})
     med = float(np.median(t["served"]))
     r_served, rs_served = ratio_spread(t["served"], t["run"])
-    rows.append({"name": f"testbed run {SCENARIO} served by `testbed serve` (warm cache, figures)",
+    rows.append({"name": f"testbed run {SCENARIO} served by `testbed serve` (warm cache, figures "
+                         "copied: a repeated run)",
                  "value": med, "unit": "s", "target": f"< {TARGET_RUN_S}", "ok": med < TARGET_RUN_S,
                  "note": f"whole client process, wall {spread(t['served'])} s; / the same command "
                          f"alone: {r_served:.2f}x, {rs_served}; the six figures copied from the figure "
@@ -163,11 +164,11 @@ def run() -> list[dict]:
                          f"{machine()}"})
     med = float(np.median(t["served_drawn"]))
     r_drawn, rs_drawn = ratio_spread(t["served"], t["served_drawn"])
+    # the target holds for a run of new inputs too: its figures are drawn
     rows.append({"name": f"testbed run {SCENARIO} served, figures drawn (new inputs)",
-                 "value": med, "unit": "s", "target": "report", "ok": None,
+                 "value": med, "unit": "s", "target": f"< {TARGET_RUN_S}", "ok": med < TARGET_RUN_S,
                  "note": f"whole client process, figure cache emptied before each run, wall "
-                         f"{spread(t['served_drawn'])} s (the issue's {TARGET_RUN_S} s is for the "
-                         f"row above); copied / drawn: {r_drawn:.2f}x, {rs_drawn}"})
+                         f"{spread(t['served_drawn'])} s; copied / drawn: {r_drawn:.2f}x, {rs_drawn}"})
     med = float(np.median(t["run"]))
     r_nofig, rs_nofig = ratio_spread(t["run"], t["run_nofig"])
     r_np, _ = ratio_spread(t["run"], t["numpy"])

@@ -26,17 +26,26 @@ from round14 import l_make as _ROUND14  # noqa: E402
 
 #: name -> (description, {table: keys changed from the paper's sine scenario})
 FIVEBARS: dict[str, tuple[str, dict[str, dict]]] = {
-    "fb15_cranks_0p7_1p3": ("cranks of 0.7 m (left) and 1.3 m (right), 1 m couplers and base",
-                            {"rig": {"l1": 0.7, "l4": 1.3}}),
-    "fb15_cranks_1p3_0p7_20s": ("cranks of 1.3 m (left) and 0.7 m (right), 20 s",
-                                {"rig": {"l1": 1.3, "l4": 0.7}, "simulation": {"duration": 20.0}}),
-    "fb15_cranks_0p5_1_2s": ("cranks of 0.5 m (left) and 1 m (right), 2 s",
-                             {"rig": {"l1": 0.5, "l4": 1.0}, "simulation": {"duration": 2.0}}),
-    "fb15_cranks_1p6_1_5s": ("cranks of 1.6 m (left) and 1 m (right), 5 s",
-                             {"rig": {"l1": 1.6, "l4": 1.0}, "simulation": {"duration": 5.0}}),
-    "fb15_cranks_0p8_1p5_3s": ("cranks of 0.8 m (left) and 1.5 m (right), 1.2 m couplers, 3 s",
-                               {"rig": {"l1": 0.8, "l4": 1.5, "l2": 1.2, "l3": 1.2},
-                                "simulation": {"duration": 3.0}}),
+    "fb15_cranks_0p7_1p3": (
+        "cranks of 0.7 m (left) and 1.3 m (right), 1 m couplers and base",
+        {"rig": {"l1": 0.7, "l4": 1.3}},
+    ),
+    "fb15_cranks_1p3_0p7_20s": (
+        "cranks of 1.3 m (left) and 0.7 m (right), 20 s",
+        {"rig": {"l1": 1.3, "l4": 0.7}, "simulation": {"duration": 20.0}},
+    ),
+    "fb15_cranks_0p5_1_2s": (
+        "cranks of 0.5 m (left) and 1 m (right), 2 s",
+        {"rig": {"l1": 0.5, "l4": 1.0}, "simulation": {"duration": 2.0}},
+    ),
+    "fb15_cranks_1p6_1_5s": (
+        "cranks of 1.6 m (left) and 1 m (right), 5 s",
+        {"rig": {"l1": 1.6, "l4": 1.0}, "simulation": {"duration": 5.0}},
+    ),
+    "fb15_cranks_0p8_1p5_3s": (
+        "cranks of 0.8 m (left) and 1.5 m (right), 1.2 m couplers, 3 s",
+        {"rig": {"l1": 0.8, "l4": 1.5, "l2": 1.2, "l3": 1.2}, "simulation": {"duration": 3.0}},
+    ),
 }
 
 _CHIRP = {"type": "chirp", "amplitude": 2.0, "kp": 5.0, "kd": 2.0, "f0": 0.05, "f1": 4.0}
@@ -44,26 +53,42 @@ _STEPS = {"type": "steps", "amplitude": 2.0, "level_seed": 0, "kp": 5.0, "kd": 2
 _HEAVY, _LONG = {"pole_mass": 3.0}, {"pole_length": 2.0}
 #: name -> (description, {"rig": keys changed, "excitation": the input replacing the multisine})
 CARTPOLES: dict[str, tuple[str, dict[str, dict]]] = {
-    "cp15_heavy_chirp": ("a 3 kg pole on the 1 kg cart, a 2 N chirp 0.05-4 Hz over 10 s",
-                         {"rig": _HEAVY, "excitation": _CHIRP}),
-    "cp15_long_chirp": ("a 2 m pole (0.44 Hz), a 2 N chirp 0.05-4 Hz over 10 s",
-                        {"rig": _LONG, "excitation": _CHIRP}),
-    "cp15_heavy_steps": ("a 3 kg pole on the 1 kg cart, 2 N steps held 0.5 s",
-                         {"rig": _HEAVY, "excitation": _STEPS}),
-    "cp15_heavy_long_steps": ("a 3 kg, 2 m pole on the 1 kg cart, 2 N steps held 0.5 s",
-                              {"rig": {**_HEAVY, **_LONG}, "excitation": _STEPS}),
+    "cp15_heavy_chirp": (
+        "a 3 kg pole on the 1 kg cart, a 2 N chirp 0.05-4 Hz over 10 s",
+        {"rig": _HEAVY, "excitation": _CHIRP},
+    ),
+    "cp15_long_chirp": (
+        "a 2 m pole (0.44 Hz), a 2 N chirp 0.05-4 Hz over 10 s",
+        {"rig": _LONG, "excitation": _CHIRP},
+    ),
+    "cp15_heavy_steps": (
+        "a 3 kg pole on the 1 kg cart, 2 N steps held 0.5 s",
+        {"rig": _HEAVY, "excitation": _STEPS},
+    ),
+    "cp15_heavy_long_steps": (
+        "a 3 kg, 2 m pole on the 1 kg cart, 2 N steps held 0.5 s",
+        {"rig": {**_HEAVY, **_LONG}, "excitation": _STEPS},
+    ),
 }
 
 #: name -> (description, {table: keys changed from michaelis_menten_noise1}); influx 0.6 mM/s
 KINETICS: dict[str, tuple[str, dict[str, dict]]] = {
-    "mm15_km0p02_vmax3": ("Km 0.02 mM, Vmax 3 mM/s (x* 5e-3 mM: zero-order until the dose is gone)",
-                          {"rig": {"Km": 0.02, "Vmax": 3.0}}),
-    "mm15_km20_vmax40": ("Km 20 mM, Vmax 40 mM/s (x* 0.30 mM: first-order, x / Km under 0.1)",
-                         {"rig": {"Km": 20.0, "Vmax": 40.0}}),
-    "mm15_km0p5_vmax0p62_10s": ("Km 0.5 mM, Vmax 0.62 mM/s (x* 15 mM: saturated, a slow rise), 10 s",
-                                {"rig": {"Km": 0.5, "Vmax": 0.62}, "simulation": {"duration": 10.0}}),
-    "mm15_km3_vmax2": ("Km 3 mM, Vmax 2 mM/s (x* 1.29 mM, near Km over the record)",
-                       {"rig": {"Km": 3.0, "Vmax": 2.0}}),
+    "mm15_km0p02_vmax3": (
+        "Km 0.02 mM, Vmax 3 mM/s (x* 5e-3 mM: zero-order until the dose is gone)",
+        {"rig": {"Km": 0.02, "Vmax": 3.0}},
+    ),
+    "mm15_km20_vmax40": (
+        "Km 20 mM, Vmax 40 mM/s (x* 0.30 mM: first-order, x / Km under 0.1)",
+        {"rig": {"Km": 20.0, "Vmax": 40.0}},
+    ),
+    "mm15_km0p5_vmax0p62_10s": (
+        "Km 0.5 mM, Vmax 0.62 mM/s (x* 15 mM: saturated, a slow rise), 10 s",
+        {"rig": {"Km": 0.5, "Vmax": 0.62}, "simulation": {"duration": 10.0}},
+    ),
+    "mm15_km3_vmax2": (
+        "Km 3 mM, Vmax 2 mM/s (x* 1.29 mM, near Km over the record)",
+        {"rig": {"Km": 3.0, "Vmax": 2.0}},
+    ),
 }
 
 
