@@ -38,7 +38,7 @@ from testbed.pipeline.plugins import RIGS
 from testbed.pipeline.scenario import NOISE_SCHEMA
 from testbed.pipeline.signal_chain import SIGNAL_SCHEMAS
 from testbed.reporting import figures as figs
-from testbed.studies.results import parts_dir, read_results, score_columns
+from testbed.studies.results import parts_dir, read_results, score_columns, stored_checks
 from testbed.studies.runstore import SavedRun, load_run, resolve_run
 
 CSS = """
@@ -467,10 +467,7 @@ def _finite(v: Any) -> bool:
 
 def _row_checks(r: dict[str, Any]) -> list[dict[str, Any]]:
     """The ``checks`` JSON of a results row as a list (empty if absent or unreadable)."""
-    try:
-        checks = json.loads(r.get("checks") or "[]")
-    except (TypeError, ValueError):
-        return []
+    checks = stored_checks(r) or []  # (a JSON number there was a TypeError: round 15)
     return [c for c in checks if isinstance(c, dict) and {"metric", "bound", "threshold"} <= set(c)]
 
 

@@ -1,0 +1,54 @@
+"""Fifteenth malformed-input round: the findings of ``benchmarks/hostile15.py`` (docs/history.md,
+malformed-input audits), each fixed in the layer that owns it.
+"""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from benchmarks._hostile import results_row
+
+# ------------------------------------------------------------------ results files
+
+
+def _v1(path, rows):
+    """A results file of format ``/1`` (no checksums: read as it was written) holding ``rows``."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    from testbed.studies.results import BASE_COLUMNS, DIGEST, TAIL_COLUMNS
+
+    cols = {name: pa.array([r.get(name) for r in rows], getattr(pa, t)())
+            for name, t in {**BASE_COLUMNS, **TAIL_COLUMNS}.items() if name != DIGEST}
+    cols["coef_error"] = pa.array([r["coef_error"] for r in rows], pa.float64())
+    table = pa.table(cols).replace_schema_metadata({"format": "sysid-testbed-results/1", "study": "s"})
+    pq.write_table(table, path)
+    return path
+
+
+@pytest.mark.parametrize("checks", ["3", '{"metric": "coef_error"}', '"text"', "not json", "null"])
+def test_report_and_summary_of_results_whose_checks_are_not_a_list_end_in_their_tables(tmp_path, checks):
+    from testbed.reporting.report import write_report
+    from testbed.studies.results import read_results, stored_checks
+    from testbed.studies.statistics import summarize
+
+    # `testbed report` of a /1 file whose checks were "3" was an internal error (TypeError
+    # iterating an int): every reader parses the column through one function, and a value
+    # that is not a JSON list holds no check (the row does not pass), as text not JSON did
+    path = _v1(tmp_path / "r.parquet", [results_row(checks=checks)])
+    (row,) = read_results(path)
+    assert stored_checks(row) is None and row["passed"] is False
+    (s,) = summarize(path)
+    assert s["cells"] == 1 and s["judged"] == 0  # held to no bar: pass rate NaN, as "[]"
+    write_report(path, tmp_path / "rep")
+    assert (tmp_path / "rep" / "report.md").is_file()
+
+
+def test_stored_checks_reads_what_the_sweep_writes():
+    from testbed.studies.results import stored_checks
+
+    good = [{"metric": "coef_error", "value": 0.01, "bound": "max", "threshold": 0.1, "passed": True}]
+    assert stored_checks({"checks": json.dumps(good)}) == good
+    assert stored_checks({"checks": ""}) == stored_checks({"checks": None}) == stored_checks({}) == []
