@@ -5,6 +5,7 @@ malformed-input audits), each fixed in the layer that owns it.
 from __future__ import annotations
 
 import json
+import re
 
 import pytest
 
@@ -52,3 +53,45 @@ def test_stored_checks_reads_what_the_sweep_writes():
     good = [{"metric": "coef_error", "value": 0.01, "bound": "max", "threshold": 0.1, "passed": True}]
     assert stored_checks({"checks": json.dumps(good)}) == good
     assert stored_checks({"checks": ""}) == stored_checks({"checks": None}) == stored_checks({}) == []
+
+
+# ------------------------------------------------------------------ scenario extends
+
+_MM = "michaelis_menten.toml"
+
+
+@pytest.mark.parametrize(("edit", "key"), [
+    (("description = \"Michaelis", "description = \"a\\tb\" #"), "scenario.description"),
+    (("x0 = 2.0", "x0 = \"two\""), "rig.x0"),
+    (("degree = 3", "degree = \"three\""), "identify.degree"),
+])
+def test_a_parent_refused_on_its_own_is_refused_as_a_parent(tmp_path, edit, key):
+    from pathlib import Path
+
+    from testbed.core.errors import ScenarioError
+    from testbed.pipeline.scenario import SCENARIO_DIR, load_scenario
+
+    # the child overrides (or, [identify], replaces) the parent's malformed key: it loaded
+    # while the parent, run alone, was refused
+    text = (Path(SCENARIO_DIR) / _MM).read_text().replace('name = "michaelis_menten"', 'name = "p"')
+    assert edit[0] in text
+    (tmp_path / "p.toml").write_text(text.replace(edit[0], edit[1], 1))
+    (tmp_path / "k.toml").write_text('[scenario]\nname = "k"\nextends = "p.toml"\ndescription = "d"\n'
+                                     '[rig]\nx0 = 2.0\n[identify]\nmethod = "sindy_pi_dynamical"\n')
+    with pytest.raises(ScenarioError, match=rf"p\.toml: key '{re.escape(key)}'.*\(extended by .*k\.toml\)"):
+        load_scenario(tmp_path / "k.toml")
+
+
+def test_a_parent_over_budget_that_its_child_shortens_still_loads(tmp_path):
+    from pathlib import Path
+
+    from testbed.core.errors import BudgetError
+    from testbed.pipeline.scenario import SCENARIO_DIR, load_scenario
+
+    text = (Path(SCENARIO_DIR) / _MM).read_text().replace('name = "michaelis_menten"', 'name = "p"')
+    (tmp_path / "p.toml").write_text(text.replace("duration = 4.0", "duration = 1e6", 1))
+    (tmp_path / "k.toml").write_text('[scenario]\nname = "k"\nextends = "p.toml"\n'
+                                     '[simulation]\nduration = 4.0\n')
+    with pytest.raises(BudgetError):
+        load_scenario(tmp_path / "p.toml")
+    assert load_scenario(tmp_path / "k.toml").simulation["duration"] == 4.0
