@@ -10,6 +10,7 @@ import re
 import pytest
 
 from benchmarks._hostile import results_row
+from testbed.core.errors import InputError
 
 # ------------------------------------------------------------------ results files
 
@@ -95,3 +96,18 @@ def test_a_parent_over_budget_that_its_child_shortens_still_loads(tmp_path):
     with pytest.raises(BudgetError):
         load_scenario(tmp_path / "p.toml")
     assert load_scenario(tmp_path / "k.toml").simulation["duration"] == 4.0
+
+
+# ------------------------------------------------------------------ sweep --dask
+
+
+@pytest.mark.parametrize("address", ["tcp://[::1", "tcp://" + "a" * 64 + ":1", "tcp://a..b:1",
+                                     "tcp://.:1", "tcp://\udcff:1"])
+def test_a_dask_address_python_cannot_parse_or_encode_is_one_line(address):
+    from testbed.cli import check_dask_address
+
+    # urlsplit's ValueError (an unclosed IPv6 bracket) and the idna codec's UnicodeError (an
+    # empty label, one of 64 characters, a lone surrogate) were internal errors of `sweep`
+    with pytest.raises(InputError, match=r"^--dask .*expected a scheduler address tcp://host:port$") as e:
+        check_dask_address(address)
+    assert "\n" not in str(e.value)
