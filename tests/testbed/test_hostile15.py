@@ -111,3 +111,24 @@ def test_a_dask_address_python_cannot_parse_or_encode_is_one_line(address):
     with pytest.raises(InputError, match=r"^--dask .*expected a scheduler address tcp://host:port$") as e:
         check_dask_address(address)
     assert "\n" not in str(e.value)
+
+
+# ------------------------------------------------------------------ report of no results
+
+
+@pytest.mark.parametrize("source", ["rows", "parts"])
+def test_report_of_results_without_a_row_is_one_line_and_writes_nothing(tmp_path, capsys, source):
+    from testbed.cli import main
+    from testbed.studies.results import parts_dir, write_rows
+
+    # an empty results file, or the parts folder of a sweep killed before its first row, was
+    # reported as "0 cells: ... noise levels  % of channel RMS" with status 0
+    res = tmp_path / "r.parquet"
+    if source == "rows":
+        write_rows(res, [], study="s")
+    else:
+        parts_dir(res).mkdir(parents=True)
+    assert main(["report", str(res), "-o", str(tmp_path / "rep")]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "holds no results" in err, err
+    assert not (tmp_path / "rep").exists()
