@@ -37,6 +37,10 @@ Families (where rounds 1-14 went least):
     A results file and a row file cut at every 10 % of their length and one bit flipped
     there: read and summarized.  Rows other than the undamaged ones, or anything but one
     refusal line, is a finding.
+``dask``
+    ``sweep --dask`` addresses: an unclosed IPv6 bracket, host names the idna codec cannot
+    encode (an empty label, 64 characters, a lone surrogate), other schemes, ports out of
+    range, nothing listening: anything but one refusal line is a finding.
 ``results``
     ``summary`` and ``report`` of an empty file, a foreign Parquet file, a CSV under the
     ``.parquet`` suffix, a results file of format ``/1`` (no checksums: another version) holding
@@ -763,6 +767,9 @@ def results_cases(work: Path) -> list[tuple[str, object]]:
         "a foreign parquet": lambda p: pq.write_table(pa.table({"a": [1, 2]}), p) or p,
         "a CSV": lambda p: p.write_text("study,cell\ns,c1\n") or p,
         "a folder": lambda p: p.mkdir() or p,
+        "an empty parts folder (a sweep killed at once)": lambda p: (
+            p.with_name(p.name + ".parts").mkdir() or p
+        ),
         "a v1 file, checks not JSON": lambda p: v1(p, [row(checks="not json")]),
         "a v1 file, checks a JSON number": lambda p: v1(p, [row(checks="3")]),
         "a v1 file, checks a list of numbers": lambda p: v1(p, [row(checks="[1, 2]")]),
@@ -829,7 +836,9 @@ def results_cases(work: Path) -> list[tuple[str, object]]:
                 p = d / "x.parquet"
                 make(p)
                 argv = ["summary", str(p)] if cmd == "summary" else ["report", str(p), "-o", str(d / "rep")]
-                return _cli(argv, d)
+                # a report of no row is refused (round 15); summary says "no results"
+                nothing = what in ("a v2 file, zero rows", "an empty parts folder (a sweep killed at once)")
+                return _cli(argv, d, refuse=nothing and cmd == "report")
 
             cases.append((f"{cmd} of {what}", fn))
     return cases
@@ -880,6 +889,46 @@ def cut_cases(work: Path) -> list[tuple[str, object]]:
     return cases
 
 
+DASK_ADDRESSES = [
+    "tcp://[::1",
+    "tcp://" + "a" * 64 + ":1",
+    "tcp://a..b:1",
+    "tcp://.:1",
+    "tcp://\udcff:1",
+    "[::1",
+    "tcp://[zz]:1",
+    "tcp://h:99999",
+    "tcp://h:-1",
+    "nonsense://x",
+    "inproc://",
+    "",
+    "tcp://\u202e1:1",
+    "tcp://127.0.0.1:1",
+    "tcp://[::1]:1",
+    "tls://127.0.0.1:1",
+    ":1",
+    "tcp://:1",
+    "tcp://127.0.0.1:",
+    "tcp://127.0.0.1:0",
+    "tcp://127.0.0.1:1/path?q#f",
+    "tcp://user:pw@127.0.0.1:1",
+    "tcp://127.0.0.1:1 ",
+    " tcp://127.0.0.1:1",
+]
+
+
+def dask_cases() -> list[tuple[str, object]]:
+    """``sweep --dask`` addresses Python cannot parse or encode, or where nothing listens
+    (:func:`testbed.cli.check_dask_address`): anything but one refusal line is a finding."""
+    from testbed.cli import check_dask_address
+
+    def fn(a):
+        check_dask_address(a)
+        return "accepted"
+
+    return [(f"--dask {a!r:.50}", lambda a=a: fn(a)) for a in DASK_ADDRESSES]
+
+
 def run_inprocess(cases) -> Counter:
     """Each case returns a finding's description or None (a verdict, or refused in one line)."""
     return _hostile.run_inprocess(cases, TIMEOUT_S, lambda finding: finding)
@@ -892,6 +941,7 @@ FAMILIES = {
     "numopts": lambda work: run_inprocess(numopts_cases(_hostile.subfolder(work, "numopts"))),
     "results": lambda work: run_inprocess(results_cases(_hostile.subfolder(work, "results"))),
     "cuts": lambda work: run_inprocess(cut_cases(_hostile.subfolder(work, "cuts"))),
+    "dask": lambda work: run_inprocess(dask_cases()),
 }
 
 
