@@ -132,3 +132,20 @@ def test_report_of_results_without_a_row_is_one_line_and_writes_nothing(tmp_path
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "holds no results" in err, err
     assert not (tmp_path / "rep").exists()
+
+
+# ------------------------------------------------------------------ identify --scenario --param
+
+
+def test_a_param_over_a_scenarios_identify_table_is_named_as_the_command_lines(tmp_path):
+    from testbed.core.errors import ScenarioError
+    from testbed.pipeline.fit import identify_file
+
+    # `identify --scenario S --param max_iter=1` was refused as "S: key 'identify.max_iter'
+    # ...", naming a scenario file that holds no such key
+    data = tmp_path / "d.csv"
+    data.write_text("x [mM],dx [mM/s]\n" + "".join(f"{2 - 0.01 * k},{-0.7 + 0.001 * k}\n" for k in range(50)))
+    with pytest.raises(ScenarioError, match=r"^<command line>: key 'identify\.max_iter'"):
+        identify_file(data, scenario="cantilever_stiff_impact", params={"max_iter": 1}, fs=100.0)
+    with pytest.raises(ScenarioError, match=r"^<command line>: key 'identify\.degree'"):
+        identify_file(data, scenario="michaelis_menten", params={"degree": "x"}, fs=100.0)
