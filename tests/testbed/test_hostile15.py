@@ -149,3 +149,23 @@ def test_a_param_over_a_scenarios_identify_table_is_named_as_the_command_lines(t
         identify_file(data, scenario="cantilever_stiff_impact", params={"max_iter": 1}, fs=100.0)
     with pytest.raises(ScenarioError, match=r"^<command line>: key 'identify\.degree'"):
         identify_file(data, scenario="michaelis_menten", params={"degree": "x"}, fs=100.0)
+
+
+# ------------------------------------------------------------------ modes of a tiny mass
+
+
+@pytest.mark.parametrize("symmetric", [True, False])
+def test_modes_of_a_mass_matrix_tiny_against_k_are_nan_when_not_strict(symmetric):
+    import numpy as np
+
+    from testbed.numerics.shapes import modal_from_matrices
+
+    # `identify --prior total_mass=1e-320`: M^-1 K overflowed and scipy's eig raised
+    # ValueError (an internal error) where strict=False promises NaN modes
+    m = np.eye(2) * 1e-320
+    k = np.array([[2.0, -1.0], [-1.0 if symmetric else -0.5, 1.0]]) * 1e4
+    c = np.eye(2)
+    f, zeta, modes = modal_from_matrices(m, c, k, strict=False)
+    assert np.isnan(f).all() and np.isnan(zeta).all() and modes.shape == (2, 2)
+    with pytest.raises(ValueError, match="overflows"):
+        modal_from_matrices(m, c, k)
