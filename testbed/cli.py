@@ -377,16 +377,20 @@ def check_dask_address(address: str) -> None:
         If the address is not ``[tcp://]host:port`` or no scheduler accepts a TCP connection
         there within :data:`DASK_CONNECT_TIMEOUT_S` seconds.
     """
-    parts = urlsplit(address if "://" in address else f"tcp://{address}")
-    try:
+    try:  # "tcp://[::1" (an unclosed IPv6 bracket): urlsplit's ValueError, an internal error
+        parts = urlsplit(address if "://" in address else f"tcp://{address}")
         host, port = parts.hostname, parts.port
     except ValueError:
-        host = port = None
-    if parts.scheme not in ("tcp", "tls") or not host or port is None:
+        parts, host, port = None, None, None
+    if parts is None or parts.scheme not in ("tcp", "tls") or not host or port is None:
         raise InputError(f"--dask {show_value(address)}: expected a scheduler address tcp://host:port")
     try:
         with socket.create_connection((host, port), timeout=DASK_CONNECT_TIMEOUT_S):
             pass
+    except UnicodeError as e:  # a host name IDNA cannot encode (an empty label "a..b", one of
+        # 64 characters, a lone surrogate): the idna codec's UnicodeError, an internal error
+        raise InputError(f"--dask {show_value(address)}: host {show_value(host)} is not a host "
+                         f"name ({e}); expected a scheduler address tcp://host:port") from None
     except OSError as e:
         raise InputError(f"--dask {show_value(address)}: cannot reach a Dask scheduler there "
                          f"({e.strerror or type(e).__name__})") from None

@@ -121,8 +121,9 @@ def modal_from_matrices(m: np.ndarray, c: np.ndarray | None, k: np.ndarray, *, s
     strict : bool
         If True (default) a mass matrix that is not symmetric positive definite, or a negative
         stiffness eigenvalue, raises ValueError.  If False, the same cases return all-NaN
-        arrays (non-PD M) or NaN frequencies for the unstable modes, so a scorer can record a
-        failed identification without a try block.
+        arrays (non-PD M, or one so small against K or C that ``M^-1 K`` or ``M^-1 C``
+        overflows) or NaN frequencies for the unstable modes, so a scorer can record a failed
+        identification without a try block.
 
     Returns
     -------
@@ -171,7 +172,14 @@ def modal_from_matrices(m: np.ndarray, c: np.ndarray | None, k: np.ndarray, *, s
         # An identified K need not be symmetric (e.g. least-squares SINDy with a diagonal M):
         # the shapes the model actually vibrates in are the right eigenvectors of M^-1 K.
         # Symmetrising K first would score modes the model does not have.
-        lam_c, vec = linalg.eig(linalg.solve(m, k))
+        mk = linalg.solve(m, k)
+        if not np.all(np.isfinite(mk)):
+            # a mass matrix tiny against K (a declared total mass of 1e-320 kg): M^-1 K
+            # overflows and scipy's eig refused it, a ValueError even when not strict (round 15)
+            if strict:
+                raise ValueError("M^-1 K overflows (the mass matrix is too small against K)")
+            return nan
+        lam_c, vec = linalg.eig(mk)
         order = np.argsort(lam_c.real)
         lam_c, vec = lam_c[order], vec[:, order]
         # rotate each (possibly complex) vector so its largest component is real, keep the real part
@@ -192,7 +200,12 @@ def modal_from_matrices(m: np.ndarray, c: np.ndarray | None, k: np.ndarray, *, s
         if c.shape != (n, n):
             raise ValueError(f"C must be {(n, n)}, got {c.shape}")
         minv = linalg.solve(m, np.eye(n), assume_a="pos")
-        a = np.block([[np.zeros((n, n)), np.eye(n)], [-minv @ k, -minv @ c]])
+        with np.errstate(over="ignore", invalid="ignore"):
+            a = np.block([[np.zeros((n, n)), np.eye(n)], [-minv @ k, -minv @ c]])
+        if not np.all(np.isfinite(a)):  # as M^-1 K above, with M^-1 C
+            if strict:
+                raise ValueError("M^-1 K or M^-1 C overflows (the mass matrix is too small)")
+            return nan
         ev, vec = linalg.eig(a)
         lam_pair = pole_pairs(ev, vec[:n], modes, m)
         w2 = np.real(lam_pair[:, 0] * lam_pair[:, 1])

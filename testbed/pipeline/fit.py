@@ -13,6 +13,7 @@ from __future__ import annotations
 import contextlib
 import math
 import os
+import re
 import time
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
@@ -20,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from testbed.core.errors import IdentificationError, InputError, TestbedError
+from testbed.core.errors import IdentificationError, InputError, ScenarioError, TestbedError
 from testbed.core.measurement import Measurement
 from testbed.numerics.shapes import modal_from_matrices
 from testbed.pipeline import plugins
@@ -214,12 +215,14 @@ def identify_file(path: str | os.PathLike, *, scenario: str | os.PathLike | None
                          f"prior; it reads: {', '.join(declared) or 'none'}")
     hyper = {k: v for k, v in identify.items() if k != "method"} | dict(params or {})
     where = str(scenario or "<command line>")
-    hyper = cls.validate_hyperparameters(hyper, file=where)
+    with _named_source(params, scenario):
+        hyper = cls.validate_hyperparameters(hyper, file=where)
     phase = phase or _no_phase
     with phase("read and signal chain"):
         data = measurement_from_file(path, kind, signal, format=format, fs=fs, units=units,
                                      channels=channels, prior=prior)
-    check_against_data(cls, hyper, data, file=where)
+    with _named_source(params, scenario):
+        check_against_data(cls, hyper, data, file=where)
     model = cls(**hyper)
     with phase("fit") as update:
         t0 = time.perf_counter()
@@ -233,6 +236,21 @@ def identify_file(path: str | os.PathLike, *, scenario: str | os.PathLike | None
             raise IdentificationError(f"{path}: {identify['method']} found no model: {e}") from None
         fit_time = time.perf_counter() - t0
     return FitResult(model, data, kind, identify["method"], str(path), fit_time)
+
+
+@contextlib.contextmanager
+def _named_source(params: Mapping[str, Any] | None, scenario: Any) -> Iterator[None]:
+    """Name ``<command line>`` as the file of a ScenarioError about a hyperparameter given with
+    ``--param`` over a scenario's ``[identify]`` table: ``identify --scenario S --param
+    max_iter=1`` was refused as "S: key 'identify.max_iter' ... unknown key", naming a file
+    that holds no such key (round 15)."""
+    try:
+        yield
+    except ScenarioError as e:
+        name = re.split(r"[.\[]", (e.key or "").removeprefix("identify."), maxsplit=1)[0]
+        if scenario is None or not params or name not in params:
+            raise
+        raise type(e)("<command line>", e.key, e.value, e.allowed) from None
 
 
 def check_against_data(cls: Any, hyper: dict[str, Any], data: Measurement, *, file: str) -> None:

@@ -53,7 +53,7 @@ from pathlib import Path
 from typing import Any
 
 from testbed.core.budget import check_cost, check_steps
-from testbed.core.errors import RigError, ScenarioError
+from testbed.core.errors import BudgetError, RigError, ScenarioError
 from testbed.core.kinds import metric_names, metric_range
 from testbed.core.registry import REGISTERED_NAME, REGISTERED_NAME_DOC
 from testbed.core.schema import (
@@ -389,6 +389,7 @@ def _read_toml(path: Path, chain: tuple[Path, ...] = ()) -> dict:
                                 else f"{ppath}: {problem}")
         try:
             base = _read_toml(ppath, (*chain, path.resolve()))
+            _check_parent(base, ppath)
         except ScenarioError as e:
             raise type(e)(e.file, e.key, e.value,
                           f"{e.allowed + ' ' if e.allowed else ''}(extended by {path})") from None
@@ -401,6 +402,21 @@ def _read_toml(path: Path, chain: tuple[Path, ...] = ()) -> dict:
         # a child keeps its parent's [score] unless it declares its own (see the module docs)
         raw = _deep_merge(base, raw)
     return raw
+
+
+def _check_parent(base: dict, ppath: Path) -> None:
+    """Validate the parent ``ppath`` (its tables ``base``, its own parents merged in) as a
+    scenario of its own, as a study would use it, but for its budget (a child may shorten a
+    run its parent could not afford) and its name (a parent copied under another file name
+    keeps a name the child replaces); raises ScenarioError naming the parent's file.
+
+    A child overriding or dropping its parent's malformed keys (a description with a tab, an
+    ``x0 = "two"``, an ``[identify]`` it replaces) was loaded while the parent, run alone, was
+    refused (round 15).
+    """
+    with contextlib.suppress(BudgetError):
+        scenario_from_dict(copy.deepcopy(base), file=str(ppath), stem=None, standalone=False,
+                           check_cost=False)
 
 
 def resolve_path(name_or_path: str | os.PathLike, directory: Path | None = None) -> Path:

@@ -38,7 +38,7 @@ from testbed.pipeline.plugins import RIGS
 from testbed.pipeline.scenario import NOISE_SCHEMA
 from testbed.pipeline.signal_chain import SIGNAL_SCHEMAS
 from testbed.reporting import figures as figs
-from testbed.studies.results import parts_dir, read_results, score_columns
+from testbed.studies.results import ResultsError, parts_dir, read_results, score_columns, stored_checks
 from testbed.studies.runstore import SavedRun, load_run, resolve_run
 
 CSS = """
@@ -467,10 +467,7 @@ def _finite(v: Any) -> bool:
 
 def _row_checks(r: dict[str, Any]) -> list[dict[str, Any]]:
     """The ``checks`` JSON of a results row as a list (empty if absent or unreadable)."""
-    try:
-        checks = json.loads(r.get("checks") or "[]")
-    except (TypeError, ValueError):
-        return []
+    checks = stored_checks(r) or []  # (a JSON number there was a TypeError: round 15)
     return [c for c in checks if isinstance(c, dict) and {"metric", "bound", "threshold"} <= set(c)]
 
 
@@ -696,7 +693,12 @@ def write_report(source: str | os.PathLike, out_dir: str | os.PathLike) -> Path:
     if not source.is_file() and not parts_dir(source).is_dir():  # (parts: a sweep killed at once)
         raise FileNotFoundError(f"{source}: neither a run folder nor a results file")
 
-    return sweep_report(read_results(source), out_dir, title=source.stem)
+    rows = read_results(source)
+    if not rows:  # an empty results file, or the parts folder of a sweep killed before its
+        # first row: the report of nothing, "0 cells ... noise levels  % ...", status 0 (round 15)
+        raise ResultsError(f"{source}: holds no results (no cell has finished); nothing to "
+                           "report: run or resume its sweep (`testbed sweep`)")
+    return sweep_report(rows, out_dir, title=source.stem)
 
 
 # ----------------------------------------------------------------------------- run history

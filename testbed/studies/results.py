@@ -419,12 +419,34 @@ def read_results(path: str | os.PathLike, *, set_aside: bool = False,
     return rows
 
 
+def stored_checks(row: dict[str, Any]) -> list[Any] | None:
+    """The checks stored in a results row's ``checks`` column: the JSON list the sweep writes
+    (``[]`` for null or blank), or None when the text is not a JSON list (not JSON, a number,
+    an object): the one parse every reader of the column goes through.
+
+    A results file of format ``/1`` has no checksums, so its ``checks`` are read as they stand:
+    ``"3"`` made `testbed report` an internal error (TypeError iterating an int, round 15),
+    and `testbed summary` held the row to bars (a non-empty value) that no reader could list.
+    Each reader judges a None as it judges text that is not JSON: no check holds.
+    """
+    text = row.get("checks")
+    if text is None or text == "":
+        return []
+    try:
+        checks = json.loads(text)
+    except (TypeError, ValueError):
+        return None
+    return checks if isinstance(checks, list) else None
+
+
 def _checks_hold(row: dict[str, Any]) -> bool:
     """Whether every check stored in ``row["checks"]`` passes, judged again from its value and
     threshold, a value that differs from the row's score column counting as NaN (never a
     pass): a row edited to ``passed`` over a NaN score counted in the pass rate."""
+    checks = stored_checks(row)
+    if checks is None:  # not a list of checks: nothing holds
+        return False
     try:
-        checks = json.loads(row.get("checks") or "[]")
         judged = []
         for c in checks:  # (a check without its value is judged from the score column alone)
             score = float(row.get(c["metric"], math.nan))

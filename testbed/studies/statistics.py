@@ -20,7 +20,6 @@ raised, ``crash: <ExceptionType>``.
 
 from __future__ import annotations
 
-import json
 import math
 import os
 import re
@@ -31,7 +30,7 @@ from typing import Any
 from testbed.core.terminal import make_console
 from testbed.numerics.quantiles import quartiles
 from testbed.studies.family import family_of
-from testbed.studies.results import read_results, score_columns
+from testbed.studies.results import read_results, score_columns, stored_checks
 
 GROUP_KEYS = ("identifier", "noise")
 #: Groupings of :func:`summarize`: the extra key before identifier and noise.
@@ -72,11 +71,7 @@ def _judged(rows: list[dict[str, Any]]) -> list[bool]:
     """
     pairs, idents = set(), set()
     for r in rows:
-        try:
-            checks = json.loads(r.get("checks") or "[]")
-        except (TypeError, ValueError):
-            checks = []
-        if checks:
+        if stored_checks(r):  # (None, not a list of checks, holds no bar: round 15)
             pairs.add((r["scenario"], r["identifier"]))
             idents.add(r["identifier"])
     return [(r["scenario"], r["identifier"]) in pairs
