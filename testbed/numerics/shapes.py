@@ -167,7 +167,14 @@ def modal_from_matrices(m: np.ndarray, c: np.ndarray | None, k: np.ndarray, *, s
             raise ValueError("mass matrix is not positive definite") from None
         return nan
     if np.allclose(k, k.T, rtol=1e-10, atol=1e-14 * max(np.abs(k).max(), 1e-300)):
-        lam, modes = linalg.eigh(0.5 * (k + k.T), m)
+        try:
+            lam, modes = linalg.eigh(0.5 * (k + k.T), m)
+        except linalg.LinAlgError:
+            # M positive definite yet tiny against K (1e-320 kg: the reduction by its Cholesky
+            # factor overflows and LAPACK's solver fails); named as the overflow below is
+            if strict:
+                raise ValueError("M^-1 K overflows (the mass matrix is too small against K)") from None
+            return nan
     else:
         # An identified K need not be symmetric (e.g. least-squares SINDy with a diagonal M):
         # the shapes the model actually vibrates in are the right eigenvectors of M^-1 K.

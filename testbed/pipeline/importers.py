@@ -611,14 +611,26 @@ def _finish(raw: _Raw, fs: float | None, units: str | Mapping[str, str] | None,
                         prior=dict(raw.prior))
 
 
+#: Range of a declared prior (a mass [kg] or a length [m]).  A prior scales the identified
+#: matrices (M from a mass, then K = M w^2 with w^2 up to (pi fs)^2 ~ 1e9 rad^2/s^2, M^-1 K, and
+#: the eigen-solvers' products of them), which must stay inside float64's 1e-308 .. 1e308:
+#: ``total_mass`` 5e-324 kg made M singular, 1e-320 kg overflowed M^-1 K and 1e308 kg
+#: overflowed K (round 15: internal errors).  1e-100 .. 1e100 leaves a factor of 1e100 to each
+#: end, and holds every physical rig (an electron is 9e-31 kg, the Earth 6e24 kg).
+PRIOR_RANGE = (1e-100, 1e100)
+
+
 def check_prior(source: str | os.PathLike, key: str, value: Any) -> None:
-    """Refuse a declared prior that is not a finite number > 0: every prior an identifier reads
-    is a size, a mass [kg] or a length [m] (given with ``--prior`` or stored in a dataset file,
-    whose ``prior`` attributes a user may have edited: NaN, -1 or text were read in silence)."""
+    """Refuse a declared prior that is not a finite number in :data:`PRIOR_RANGE`: every prior
+    an identifier reads is a size, a mass [kg] or a length [m] (given with ``--prior`` or stored
+    in a dataset file, whose ``prior`` attributes a user may have edited: NaN, -1 or text were
+    read in silence)."""
+    lo, hi = PRIOR_RANGE
     if isinstance(value, bool) or not isinstance(value, (int, float)) \
-            or not (math.isfinite(value) and value > 0):
-        raise MeasuredDataError(source, f"prior {key}={value!r}: expected a finite number > 0 "
-                                        "(a mass [kg] or a length [m])")
+            or not (math.isfinite(value) and lo <= value <= hi):
+        raise MeasuredDataError(source, f"prior {key}={value!r}: expected a finite number from "
+                                        f"{lo:g} to {hi:g} (a mass [kg] or a length [m]; beyond, "
+                                        "the identified matrices leave float64's range)")
 
 
 def check_position(source: str | os.PathLike, channel: str, value: Any, key: str) -> float:

@@ -760,8 +760,18 @@ def physical_failures(M: np.ndarray, C: np.ndarray, K: np.ndarray) -> dict[str, 
         if neg.size:
             damping.append(f"identified damping ratio {neg.min():.3g}")
         n = M.shape[0]
-        A = np.block([[np.zeros((n, n)), np.eye(n)],
-                      [-np.linalg.solve(M, K), -np.linalg.solve(M, C)]])
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+            try:
+                A = np.block([[np.zeros((n, n)), np.eye(n)],
+                              [-np.linalg.solve(M, K), -np.linalg.solve(M, C)]])
+            except np.linalg.LinAlgError:  # M positive definite to its relative bar, yet
+                A = np.full((2 * n, 2 * n), np.nan)  # singular in float64 (subnormal entries)
+        if not np.all(np.isfinite(A)):  # M^-1 K overflowed (round 15: a 1e-320 kg mass prior)
+            out["model"] = ("non-physical: M^-1 K or M^-1 C is not finite in float64 (M "
+                            f"eigenvalues {lm[0]:.3g} .. {lm[-1]:.3g} kg)")
+            if damping:
+                out["damping"] = f"non-physical: negative damping ({', '.join(damping)})"
+            return out
         lam = np.linalg.eigvals(A)
         growth = float(lam.real.max())
         if growth > STABILITY_RTOL * np.abs(lam).max():

@@ -169,3 +169,33 @@ def test_modes_of_a_mass_matrix_tiny_against_k_are_nan_when_not_strict(symmetric
     assert np.isnan(f).all() and np.isnan(zeta).all() and modes.shape == (2, 2)
     with pytest.raises(ValueError, match="overflows"):
         modal_from_matrices(m, c, k)
+
+
+@pytest.mark.parametrize("mass", [1e-320, 5e-324])
+def test_scoring_a_model_whose_mass_is_tiny_against_k_names_it(mass):
+    import numpy as np
+
+    from testbed.numerics.shapes import modal_from_matrices
+    from testbed.scoring.scorers import physical_failures
+
+    # an M positive definite to its relative bar but subnormal: M^-1 K overflowed and numpy's
+    # eigvals raised LinAlgError inside the scorer (5e-324: scipy's eigh failed first), an
+    # internal error; now a failure named "model"
+    m, c, k = np.eye(3) * mass, np.eye(3) * 1e-3, np.eye(3) * 1e3
+    failures = physical_failures(m, c, k)
+    assert set(failures) == {"model"} and "not finite" in failures["model"]
+    assert np.isnan(modal_from_matrices(m, c, k, strict=False)[0]).all()
+    assert physical_failures(np.eye(3), c, k) == {}  # the same model at 1 kg is physical
+
+
+@pytest.mark.parametrize("value", [1e-320, 5e-324, 1e308, 1e-101, 1.1e100])
+def test_a_prior_beyond_float64s_working_range_is_one_line(value):
+    from testbed.pipeline.importers import PRIOR_RANGE, MeasuredDataError, check_prior
+
+    # `identify --prior total_mass=1e-320 / 5e-324 / 1e308`: three internal errors in the
+    # identifier and the scorer; the prior is refused where it is read, with its range
+    with pytest.raises(MeasuredDataError,
+                       match=r"prior total_mass=.*expected a finite number from 1e-100 to 1e\+100"):
+        check_prior("d.h5", "total_mass", value)
+    for ok in (*PRIOR_RANGE, 0.7):
+        check_prior("d.h5", "total_mass", ok)
