@@ -11,14 +11,11 @@ their peers in the same run (:func:`benchmarks._timing.interleaved`), medians wi
    imported, every scenario validated, as after an edit) is reported beside it.
 2. ``testbed run cantilever_stiff_impact`` with a warm dataset cache, with figures, against the
    same run without figures (``--no-figures``) and against the numpy start-up; and the same run
-   served by a resident ``testbed serve`` (:mod:`testbed.server`: forked from a process that has
-   the libraries loaded).  Target: under 1.5 s (the issue's absolute goal), for the served run
-   both with its figures copied and drawn: a command alone spends most of its time importing the
-   libraries.  The ratio to the run without figures is what the figures cost; the ratio to the
-   numpy start-up scales out the machine's speed.  Every run here has the same inputs, so its
-   six figures are copied from the figure cache (:mod:`testbed.reporting.figcache`, filled by
-   the warm-up round); the served run is also measured with its figures drawn (the figure cache
-   emptied before it), as a run of new inputs pays them.
+   served by a resident ``testbed serve`` (:mod:`testbed.server`: forked from a process that
+   has the libraries loaded).  Target: under 1.5 s (the issue's absolute goal), met only
+   served: a command alone spends most of its time importing the libraries.  The ratio to the
+   run without figures is what the figures cost; the ratio to the numpy start-up scales out the
+   machine's speed.
 
 The run draws its figures in processes it forks (``testbed.reporting.drawer``): one imports
 matplotlib during the fit, then it and one more draw half of the figures each; their CPU time is
@@ -90,22 +87,10 @@ def _server(folder: Path):
             proc.wait(timeout=60)
 
 
-def forget_figures() -> None:
-    """Empty the figure cache of the commands run here (``<dataset cache>/figures``,
-    :mod:`testbed.reporting.figcache`; they run in ROOT): the next run draws its figures."""
-    folder = Path(os.environ.get("TESTBED_CACHE", ROOT / ".cache" / "datasets")) / "figures"
-    for p in folder.glob("*.png"):
-        p.unlink(missing_ok=True)
-
-
-def _command(args: list[str], cpu: list[float], env: dict[str, str] | None = None,
-             before_run=None):
+def _command(args: list[str], cpu: list[float], env: dict[str, str] | None = None):
     """A callable running ``python args`` from the repository root; appends its CPU time [s]
-    (of the process itself: a served command's work is done by the server's child).
-    ``before_run()``: called first (inside the time measured: a few milliseconds)."""
+    (of the process itself: a served command's work is done by the server's child)."""
     def run() -> None:
-        if before_run is not None:
-            before_run()
         before = resource.getrusage(resource.RUSAGE_CHILDREN)
         subprocess.run([sys.executable, *args], cwd=ROOT, env=env or _env(), check=True,
                        stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
@@ -118,7 +103,7 @@ def run() -> list[dict]:
     rows = []
     with tempfile.TemporaryDirectory(prefix="bench_cli.") as out, _server(Path(out)) as sock:
         cpu: dict[str, list[float]] = {k: [] for k in ("numpy", "version", "list", "list_fresh",
-                                                       "run", "run_nofig", "served", "served_drawn")}
+                                                       "run", "run_nofig", "served")}
         cmds = {
             "numpy": _command(["-c", "import numpy"], cpu["numpy"]),
             "version": _command(["-m", "testbed.cli", "--version"], cpu["version"]),
@@ -130,10 +115,6 @@ def run() -> list[dict]:
                                   cpu["run_nofig"]),
             "served": _command(["-m", "testbed.cli", "run", SCENARIO, "--out", out], cpu["served"],
                                _served_env(sock)),
-            # the same, its figures drawn: what a run of new inputs (another seed, an edited
-            # scenario) pays; the runs above copy them from the figure cache
-            "served_drawn": _command(["-m", "testbed.cli", "run", SCENARIO, "--out", out],
-                                     cpu["served_drawn"], _served_env(sock), forget_figures),
         }
         # the warm-up round generates the dataset if the cache lacks it and loads numba's cache
         t = interleaved(cmds, REPEATS)
@@ -155,20 +136,10 @@ def run() -> list[dict]:
                          f"from the index / without: {ratio:.2f}x, {rs}"})
     med = float(np.median(t["served"]))
     r_served, rs_served = ratio_spread(t["served"], t["run"])
-    rows.append({"name": f"testbed run {SCENARIO} served by `testbed serve` (warm cache, figures "
-                         "copied: a repeated run)",
+    rows.append({"name": f"testbed run {SCENARIO} served by `testbed serve` (warm cache, figures)",
                  "value": med, "unit": "s", "target": f"< {TARGET_RUN_S}", "ok": med < TARGET_RUN_S,
                  "note": f"whole client process, wall {spread(t['served'])} s; / the same command "
-                         f"alone: {r_served:.2f}x, {rs_served}; the six figures copied from the figure "
-                         f"cache (testbed.reporting.figcache: the same inputs as the runs before); "
-                         f"{machine()}"})
-    med = float(np.median(t["served_drawn"]))
-    r_drawn, rs_drawn = ratio_spread(t["served"], t["served_drawn"])
-    # the issue's target holds for a run of new inputs too: its figures are drawn
-    rows.append({"name": f"testbed run {SCENARIO} served, figures drawn (new inputs)",
-                 "value": med, "unit": "s", "target": f"< {TARGET_RUN_S}", "ok": med < TARGET_RUN_S,
-                 "note": f"whole client process, figure cache emptied before each run, wall "
-                         f"{spread(t['served_drawn'])} s; copied / drawn: {r_drawn:.2f}x, {rs_drawn}"})
+                         f"alone: {r_served:.2f}x, {rs_served}; {machine()}"})
     med = float(np.median(t["run"]))
     r_nofig, rs_nofig = ratio_spread(t["run"], t["run_nofig"])
     r_np, _ = ratio_spread(t["run"], t["numpy"])
@@ -179,9 +150,8 @@ def run() -> list[dict]:
                          f"{spread(c['run_nofig'])} s; {r_np:.1f}x the numpy start-up; {machine()}"})
     rows.append({"name": f"testbed run {SCENARIO}: with / without figures", "value": r_nofig, "unit": "x",
                  "target": "report", "ok": None,
-                 "note": f"what the six figures add to the wall time (copied from the figure cache "
-                         f"by the two forked drawing processes after the fit: the same inputs as the "
-                         f"runs before), same run, interleaved; {rs_nofig}"})
+                 "note": f"what the six figures add to the wall time (drawn in two forked processes "
+                         f"after the fit), same run, interleaved; {rs_nofig}"})
     return rows
 
 

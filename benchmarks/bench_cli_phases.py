@@ -17,12 +17,9 @@ three wrappers installed before the fork (so the command and its drawing process
   before the first figure was drawn (off the critical path).  A served command inherits the
   frames the server made after its warm-up run, and so makes none.
 
-The command as shipped copies its six figures from the figure cache
-(:mod:`testbed.reporting.figcache`): the server's warm-up run and every run before it have the
-same inputs.  Each round also runs the command once with its figures drawn (the figure cache
-emptied just before it, frames made ahead as shipped), interleaved: the per-round ratio of the
-critical paths is what the cache saves on a repeated run, at whatever load the machine has, and
-the drawn runs give each figure's CPU and the drawing groups' (what a run of new inputs pays).
+Each round also runs the command once without any frame made ahead (the server's pool emptied,
+the drawing process not asked to make any), interleaved: the per-round ratio of the critical
+paths is what the frames save, at whatever load the machine has.
 
 CPU time is what the work costs whatever else runs on the machine; wall time is reported with
 the load.  The *critical path* is the command's own CPU plus the larger of the two drawing
@@ -95,17 +92,19 @@ def _instrument(record) -> None:
     prepare = drawer.prepare_frames
 
     def prepare_recorded(folder):
+        if _NO_FRAMES:
+            return 0
         c = _cpu()
         n = prepare(folder)
         record(kind="prepare", name="frames", cpu=_cpu() - c, made=n, end=time.time())
         return n
 
-    def draw_each(run, folder, stems, cache=None):
+    def draw_each(run, folder, stems):
         record(kind="draw start", name="", start=time.time())
         out = []
         for stem in stems:
             c = _cpu()
-            out += draw(run, folder, [stem], cache)
+            out += draw(run, folder, [stem])
             record(kind="figure", name=stem, cpu=_cpu() - c)
         return out
 
@@ -144,21 +143,25 @@ def _served_run(out: str) -> tuple[float, float]:
     return wall, _cpu(resource.RUSAGE_CHILDREN) - before
 
 
+#: Set while a command runs without frames made ahead (:func:`_rounds`).
+_NO_FRAMES = False
+
+
 def _rounds(log: Path, out: str) -> tuple[list[dict], list[dict]]:
-    """``REPEATS`` rounds after one untimed one, each a served run as shipped (figures copied
-    from the figure cache) and one with its figures drawn; per run its records and totals."""
-    from benchmarks.bench_cli import forget_figures
+    """``REPEATS`` rounds after one untimed one, each a served run as shipped and one without
+    frames made ahead; per run its records and totals."""
+    global _NO_FRAMES
     from testbed.reporting import frames
 
     pool = {k: list(v) for k, v in frames._POOL.items()}  # the server's, made at its warm-up
     rounds: tuple[list[dict], list[dict]] = ([], [])
     try:
         for i in range(REPEATS + 1):
-            for without in (False, True):  # without: the figures drawn
+            for without in (False, True):
                 frames.clear()
-                frames._POOL.update({k: list(v) for k, v in pool.items()})
-                if without:
-                    forget_figures()
+                if not without:
+                    frames._POOL.update({k: list(v) for k, v in pool.items()})
+                _NO_FRAMES = without
                 log.write_text("")
                 wall, cpu = _served_run(f"{out}-{int(without)}")
                 recs = [json.loads(line) for line in log.read_text().splitlines()]
@@ -166,6 +169,7 @@ def _rounds(log: Path, out: str) -> tuple[list[dict], list[dict]]:
                     rounds[without].append({"wall": wall, "cpu": cpu, "load": os.getloadavg()[0],
                                             "records": recs})
     finally:
+        _NO_FRAMES = False
         frames.clear()
         frames._POOL.update(pool)
     return rounds
@@ -245,21 +249,15 @@ def run() -> list[dict]:
              "value": med["critical path"], "unit": "s", "target": "report", "ok": None,
              "note": f"{spread(s['critical path'])} s: command's own CPU {spread(s['command own cpu'])} s "
                      f"(phases below, its start and end), drawing groups {spread(s['larger drawing group'])} "
-                     f"and {spread(s['smaller drawing group'])} s (the six figures copied from the "
-                     f"figure cache: a repeat of the same inputs); bench_cli's target for the whole "
+                     f"and {spread(s['smaller drawing group'])} s; bench_cli's target for the whole "
                      f"served run is < {TARGET_RUN_S} s wall; {loads}"},
-            {"name": f"served {SCENARIO}: critical path with the figures drawn (new inputs)",
-             "value": med["none critical path"], "unit": "s", "target": "report", "ok": None,
-             "note": f"{spread(s['none critical path'])} s: command's own CPU "
-                     f"{spread(s['none command own cpu'])} s, drawing groups "
-                     f"{spread(s['none larger drawing group'])} and "
-                     f"{spread(s['none smaller drawing group'])} s (figure cache emptied before "
-                     f"each run, frames made ahead as shipped), whole command "
-                     f"{spread(s['none cpu'])} s CPU, wall {spread(s['none wall'])} s"},
-            {"name": f"served {SCENARIO}: critical path, figures copied / drawn", "value": r_path,
+            {"name": f"served {SCENARIO}: critical path, frames made ahead / none", "value": r_path,
              "unit": "x", "target": "report", "ok": None,
-             "note": f"{n_path}, interleaved; larger drawing group {n_group}; whole command "
-                     f"{spread(s['cpu'])} against {spread(s['none cpu'])} s CPU"},
+             "note": f"{n_path}, interleaved; larger drawing group {n_group}; without frames: "
+                     f"critical path {spread(s['none critical path'])} s, drawing groups "
+                     f"{spread(s['none larger drawing group'])} and "
+                     f"{spread(s['none smaller drawing group'])} s, "
+                     f"whole command {spread(s['none cpu'])} s CPU (with them: {spread(s['cpu'])})"},
             {"name": f"served {SCENARIO}: figure frames made ahead during the fit",
              "value": med["frames ahead cpu"], "unit": "s CPU", "target": "report", "ok": None,
              "note": f"{spread(s['frames ahead cpu'])} s CPU in the drawing process, "
@@ -277,11 +275,9 @@ def run() -> list[dict]:
                      "note": f"{spread(s[k])} s CPU, wall {spread(s[f'phase {name} wall'])} s"
                              + (" (the command waits for its two drawing processes)"
                                 if name == "figures" else "")})
-    for k in sorted(k for k in s if k.startswith("none figure ")):
-        rows.append({"name": f"served {SCENARIO}: {k[len('none '):]} (drawn)", "value": med[k],
-                     "unit": "s CPU", "target": "report", "ok": None,
-                     "note": f"{spread(s[k])} s CPU (copied from the figure cache: "
-                             f"{spread(s.get(k[len('none '):], np.zeros(1)), fmt='.3f')} s)"})
+    for k in sorted(k for k in s if k.startswith("figure ")):
+        rows.append({"name": f"served {SCENARIO}: {k}", "value": med[k], "unit": "s CPU",
+                     "target": "report", "ok": None, "note": f"{spread(s[k])} s CPU"})
     return rows
 
 

@@ -558,10 +558,8 @@ def cmd_run(args: argparse.Namespace) -> int:
     _output_folder(Path(args.out), "--out")
     cache = None if args.no_cache else DatasetCache(_cache_folder(args.cache))
     ok = True
-    # the figures are drawn by a process forked now: it imports matplotlib during the fit;
-    # figures of the same inputs are copied from the cache's folder (testbed.reporting.figcache)
-    kept = None if cache is None else cache.directory / "figures"
-    with figure_drawer(enabled=not args.no_figures, cache=kept) as figures:
+    # the figures are drawn by a process forked now: it imports matplotlib during the fit
+    with figure_drawer(enabled=not args.no_figures) as figures:
         scenarios = [load_scenario(name) for name in args.scenario]  # every file checked first
         for sc in scenarios:
             if sc.identify is None:  # was found after simulating, naming the scenario, not its file
@@ -693,11 +691,6 @@ def cmd_cache(args: argparse.Namespace) -> int:
         print(f"{len(entries)} dataset(s) in {terminal_safe(str(cache.directory))}")
     else:
         print(f"removed {cache.clear()} dataset(s) from {terminal_safe(str(cache.directory))}")
-        from testbed.reporting.figcache import FigureCache
-
-        kept = FigureCache(cache.directory / "figures")
-        if n := kept.clear():  # the run figures kept there (testbed.reporting.figcache)
-            print(f"removed {n} run figure(s) from {terminal_safe(str(kept.directory))}")
     return 0
 
 

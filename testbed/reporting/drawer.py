@@ -10,9 +10,7 @@ report from the PNGs.  While the parent fits, the drawing process also makes the
 frames (figure, axes, ticks: :mod:`testbed.reporting.frames`), about a third of their CPU, with
 the shapes of the scenario's previous run when there is one (:meth:`RunFigures.prepare`).
 The figures are the same as drawn in-process (:func:`testbed.reporting.figures.save_run_figures`):
-the same builders on the same files.  With a figure cache (:mod:`testbed.reporting.figcache`),
-a figure whose inputs and drawing code are those of one drawn before is copied from it instead
-(the same bytes): a served ``testbed run`` of a scenario repeated draws none.
+the same builders on the same files.
 
 Life cycle:
 
@@ -41,12 +39,11 @@ from pathlib import Path
 from typing import Any
 
 from testbed.reporting import figures as figs
-from testbed.reporting.figcache import FigureCache, run_key
 from testbed.reporting.report import save_run_figures_and_report
 from testbed.studies.runstore import load_run, resolve_run, scenario_folder
 
-__all__ = ["FigureWorker", "FigureWorkerError", "RunFigures", "draw_run_figures", "figure_drawer",
-           "prepare_frames", "split_figures"]
+__all__ = ["FigureWorker", "FigureWorkerError", "RunFigures", "figure_drawer", "prepare_frames",
+           "split_figures"]
 
 #: Relative drawing cost of each run figure, as drawn on a frame made ahead (CPU of the
 #: cantilever run's figures, served, 7 runs at load 10: matrices 0.48 s, spectra 0.41,
@@ -133,37 +130,10 @@ def prepare_frames(folder: str | os.PathLike) -> int:
         return 0
 
 
-def _draw(run: Any, folder: str, stems: Sequence[str], cache: FigureCache | None = None) -> list[str]:
-    """Draw ``stems`` of ``run`` (read from ``folder``) into ``folder``; the PNG paths written,
-    in the order of ``stems``.  With a ``cache``, a figure kept there under the same key is
-    copied instead (:mod:`testbed.reporting.figcache`), and one drawn is kept there."""
-    written: dict[str, str] = {}
-    todo = list(stems)
-    if cache is not None:
-        try:
-            digest = run_key(run)
-        except Exception:  # (a run the key cannot be made of is drawn, as without a cache)
-            digest, cache = "", None
-    if cache is not None:
-        keys = {s: cache.key(digest, s) for s in stems}
-        for s in stems:
-            if cache.fetch(keys[s], Path(folder) / f"{s}.png"):
-                written[s] = str(Path(folder) / f"{s}.png")
-        todo = [s for s in stems if s not in written]
-    if todo:
-        for stem, f in figs.run_figures(run, only=todo).items():
-            written[stem] = str(figs.save_figure(f, Path(folder) / f"{stem}.png"))
-            if cache is not None:
-                cache.store(keys[stem], Path(written[stem]))
-    return [written[s] for s in stems if s in written]
-
-
-def draw_run_figures(run: Any, folder: str | os.PathLike, cache: FigureCache | None = None
-                     ) -> list[Path]:
-    """Every run figure of ``run`` into ``folder``, in this process, through ``cache`` if given
-    (as :func:`testbed.reporting.figures.save_run_figures` without one); the PNG paths."""
-    Path(folder).mkdir(parents=True, exist_ok=True)
-    return [Path(p) for p in _draw(run, str(folder), figs.run_figures_available(run), cache)]
+def _draw(run: Any, folder: str, stems: Sequence[str]) -> list[str]:
+    """Draw ``stems`` of ``run`` (read from ``folder``) into ``folder``; the PNG paths written."""
+    drawn = figs.run_figures(run, only=stems)
+    return [str(figs.save_figure(f, Path(folder) / f"{stem}.png")) for stem, f in drawn.items()]
 
 
 def _error(e: BaseException) -> tuple[str, bytes | None, str, str]:
@@ -184,24 +154,12 @@ def _raise(msg: tuple) -> None:
     raise e
 
 
-def _all_kept(run: Any, stems: Sequence[str], cache: FigureCache) -> bool:
-    """Whether ``cache`` holds every figure ``stems`` of ``run`` (never fails: False)."""
-    try:
-        digest = run_key(run)
-        return all(cache.holds(cache.key(digest, s)) for s in stems)
-    except Exception:
-        return False
-
-
-def _draw_split(folder: str, cache: FigureCache | None = None) -> list[str]:
+def _draw_split(folder: str) -> list[str]:
     """Draw every figure of the run in ``folder``: a forked helper draws half of them."""
     run = load_run(Path(folder))  # read once: the forked helper inherits it
-    stems = figs.run_figures_available(run)
-    groups = split_figures(stems)
-    if cache is not None and _all_kept(run, stems, cache):  # copies only: no helper forked
-        return _draw(run, folder, stems, cache)
+    groups = split_figures(figs.run_figures_available(run))
     if len(groups) < 2:
-        return _draw(run, folder, groups[0] if groups else [], cache)
+        return _draw(run, folder, groups[0] if groups else [])
     recv, send = multiprocessing.Pipe(duplex=False)
     me = os.getpid()
     gc.freeze()  # see FigureWorker: no copy on write of the shared objects by the collector
@@ -212,7 +170,7 @@ def _draw_split(folder: str, cache: FigureCache | None = None) -> list[str]:
             recv.close()
             _die_with_parent(me)
             try:
-                send.send(("ok", _draw(run, folder, groups[1], cache)))
+                send.send(("ok", _draw(run, folder, groups[1])))
             except BaseException as e:
                 send.send(_error(e))
             code = 0
@@ -220,7 +178,7 @@ def _draw_split(folder: str, cache: FigureCache | None = None) -> list[str]:
             os._exit(code)
     send.close()
     try:
-        mine = _draw(run, folder, groups[0], cache)
+        mine = _draw(run, folder, groups[0])
     finally:
         try:
             theirs = recv.recv()
@@ -235,9 +193,8 @@ def _draw_split(folder: str, cache: FigureCache | None = None) -> list[str]:
     return mine + theirs[1]
 
 
-def _serve(conn: Any, parent_end: Any, parent: int, cache: FigureCache | None = None) -> None:
-    """The drawing process: warm up, then draw each run folder sent until ``None`` or EOF
-    (through ``cache``, if given)."""
+def _serve(conn: Any, parent_end: Any, parent: int) -> None:
+    """The drawing process: warm up, then draw each run folder sent until ``None`` or EOF."""
     parent_end.close()
     _die_with_parent(parent)
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C is the parent's to handle
@@ -261,7 +218,7 @@ def _serve(conn: Any, parent_end: Any, parent: int, cache: FigureCache | None = 
             conn.send(broken)
             continue
         try:
-            conn.send(("ok", _draw_split(folder, cache)))
+            conn.send(("ok", _draw_split(folder)))
         except BaseException as e:
             conn.send(_error(e))
 
@@ -271,17 +228,12 @@ class FigureWorker:
 
     Use as a context manager (:func:`figure_drawer`): leaving it stops the process, and ends
     it at once when leaving on an exception (Ctrl-C included).
-
-    Parameters
-    ----------
-    cache : FigureCache, optional
-        Figures kept by content (:mod:`testbed.reporting.figcache`); None: every one drawn.
     """
 
-    def __init__(self, cache: FigureCache | None = None) -> None:
+    def __init__(self) -> None:
         ctx = multiprocessing.get_context("fork")
         self._conn, child = ctx.Pipe()
-        self._proc = ctx.Process(target=_serve, args=(child, self._conn, os.getpid(), cache),
+        self._proc = ctx.Process(target=_serve, args=(child, self._conn, os.getpid()),
                                  name="testbed-figures", daemon=True)
         # the objects made so far go to the collector's permanent generation, in this process
         # and so in the forked one: neither one's collections then write to (and so copy) the
@@ -348,22 +300,13 @@ class RunFigures:
     ----------
     worker : FigureWorker or None
         Where the figures are drawn; None: in this process, without frames made ahead.
-    cache : FigureCache, optional
-        Used where the figures are drawn in this process (a worker has its own).
     """
 
-    def __init__(self, worker: FigureWorker | None = None, cache: FigureCache | None = None) -> None:
+    def __init__(self, worker: FigureWorker | None = None) -> None:
         self.worker = worker
-        self.cache = cache
 
     def __call__(self, run: Any, folder: Path) -> list[Path]:
-        if self.worker is not None:
-            draw = self.worker.draw
-        elif self.cache is not None:
-            def draw(run: Any, folder: Path) -> list[Path]:
-                return draw_run_figures(run, folder, self.cache)
-        else:
-            draw = None
+        draw = self.worker.draw if self.worker is not None else None
         return save_run_figures_and_report(run, folder, draw=draw)
 
     def prepare(self, out_dir: str | os.PathLike, scenario: str) -> None:
@@ -380,24 +323,20 @@ class RunFigures:
 
 
 @contextlib.contextmanager
-def figure_drawer(enabled: bool = True, cache: str | os.PathLike | None = None
-                  ) -> Iterator[RunFigures | None]:
+def figure_drawer(enabled: bool = True) -> Iterator[RunFigures | None]:
     """The figure writer of ``testbed run``: a :class:`RunFigures` to pass as ``figures`` to
     :func:`testbed.studies.runstore.save_new_run`, drawing in a :class:`FigureWorker`.
 
     Yields None when not ``enabled`` (``--no-figures``), one drawing in this process where
     ``fork`` is not available.  Start it before the work whose time it should overlap.
-    ``cache``: the folder of a :class:`~testbed.reporting.figcache.FigureCache` (figures of
-    the same inputs copied, not drawn again); None: every figure drawn.
     """
     if not enabled:
         yield None
         return
-    kept = FigureCache(cache) if cache is not None else None
     if not fork_available():
-        yield RunFigures(cache=kept)
+        yield RunFigures()
         return
-    worker = FigureWorker(kept)
+    worker = FigureWorker()
     ok = False
     try:
         yield RunFigures(worker)
