@@ -64,11 +64,20 @@ def test_an_influx_the_enzyme_cannot_match_is_a_valid_record():
     assert "steady_state" not in ds.attrs
 
 
-def test_an_enzyme_exactly_matching_the_influx_is_refused_naming_vmax():
-    # Vmax = jx: the law's x term vanishes, and the truth is the four-term law
-    with pytest.raises(ScenarioError, match=r"key 'rig\.Vmax': value 0\.6: .*coefficient Vmax - jx = 0"):
-        scenario_from_dict({"scenario": {"name": "x", "rig": "michaelis_menten"},
-                            "rig": {"jx": 0.6, "Vmax": 0.6}})
+def test_an_enzyme_exactly_matching_the_influx_is_a_three_term_law():
+    """Vmax = jx (refused in round 15 while jx = 0, whose constant term vanishes, loaded): the
+    substrate accumulates at jx Km / (Km + x) > 0, and the truth's x coefficient is exactly 0,
+    so its support is the other three terms (the scorer's, testbed.scoring.equation_basis)."""
+    from testbed.scoring.equation_basis import ZERO_RTOL
+
+    sc = scenario_from_dict({"scenario": {"name": "x", "rig": "michaelis_menten"},
+                             "rig": {"jx": 0.6, "Vmax": 0.6}})
+    ds = rig_class("michaelis_menten")(sc).simulate()
+    x, dx = ds.measured["x"].data[0], ds.measured["dx"].data[0]
+    np.testing.assert_allclose(dx, 0.6 * 0.3 / (0.3 + x), rtol=1e-12)  # the rate's own form
+    truth = DynamicalTruth.from_dict(ds.truth, ds.truth_units)
+    coef = truth.equation_coef[0]
+    assert coef[3] == 0.0 and np.all(np.abs(coef[:3]) > ZERO_RTOL)
 
 
 def test_a_start_at_the_steady_state_is_refused_naming_x0():
