@@ -1,0 +1,32 @@
+"""The scenario writers of the rounds of rigs nobody tuned (benchmarks/unseen/roundN/b_make.py,
+l_make.py), run on a copy of their round's folder, write its files byte for byte: a round's
+files can be regenerated and reviewed from code (rounds 14 and on; the cart-poles of round 14 in
+full from cartpole_noise1: an ``extends`` would keep the multisine's keys beside a chirp's)."""
+
+from __future__ import annotations
+
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+UNSEEN = ROOT / "benchmarks" / "unseen"
+
+
+@pytest.mark.parametrize("round_name", ["round14", "round15"])
+def test_the_writers_reproduce_their_rounds_files(tmp_path, round_name):
+    src = UNSEEN / round_name
+    work = tmp_path / "unseen"
+    shutil.copytree(UNSEEN, work, ignore=shutil.ignore_patterns("*.parquet", "__pycache__"))
+    for f in (work / round_name).glob("*.toml"):
+        f.unlink()
+    for script in ("b_make.py", "l_make.py"):
+        subprocess.run([sys.executable, str(work / round_name / script)], cwd=ROOT, check=True,
+                       capture_output=True, env={"PYTHONPATH": str(ROOT), "PATH": "/usr/bin:/bin"})
+    written = sorted(p.name for p in (work / round_name).glob("*.toml"))
+    assert written == sorted(p.name for p in src.glob("*.toml"))
+    for name in written:
+        assert (work / round_name / name).read_bytes() == (src / name).read_bytes(), name
