@@ -176,7 +176,12 @@ class LeastSquaresSINDy(StructuralIdentifier):
         cannot be checked (the band's refusal raised if that fit is refused too; it acts only
         where the old rule raised): round 15's ``b15_soft_long_al_L0p8_cf0p3`` (mode 1 at
         2.26 Hz, no accepted peak: the chain's 1.1 Hz high-pass rings stronger in
-        acceleration), see docs/known-gaps.md, "Round 15's soft beams".
+        acceleration) clean / 1 / 2 % refused -> scored (modes 1-2 1.8 / 0.25 %, 1.5 / 3.1 %,
+        4.1 / 1.8 %; TRAC 0.002-0.10, the chain's floor), round 13's
+        ``b13_soft_r5_cf1_hmid`` at 2 % (seed 42) refused -> pass (TRAC 0.930), soft-base
+        member 006 at 1 % refused -> scored (TRAC 0.923, mode 1 5.8 %); it acts on no other
+        of the 60 family beams (0 / 1 %) or the soft cells of rounds 13-14 at their noise
+        levels (docs/known-gaps.md, "Round 15's soft beams").
         0 = none.
     fit_tilt : bool or None
         Difference every row of the fit once (step 1).  None (default): by rule, tilted unless
