@@ -394,3 +394,38 @@ def test_unlocated_mode_not_moved_onto_another_mode(lumped, monkeypatch):
     held = hold()
     assert modal(M, held.K)[0][2] == pytest.approx(0.9 * w[2] / (2 * np.pi), rel=1e-9)
     assert "modes [3], which no measured peak located" in held.rule
+
+
+def test_band_refused_non_physical_is_dropped(lumped, monkeypatch):
+    """fit_band_hz=None: a fit in the band by rule refused as non-physical (tilted and flat)
+    is made again without the band, where a mode below the cut-off the band removed cannot be
+    checked (round 15's ``b15_soft_long_al_L0p8_cf0p3``); a band the user set keeps the
+    refusal, and the band's refusal is raised when the fit without it is refused too."""
+    import identify.ls_sindy as ls
+    from testbed.core.errors import IdentificationError
+
+    _, data = lumped
+    band = LeastSquaresSINDy().fit(data).fit_band_hz_
+    assert band > 0.0  # the band by rule acts on this record
+    real = ls.LeastSquaresSINDy._check_physical
+
+    def refuse_banded(self):
+        if self.fit_band_hz_ > 0.0:
+            raise IdentificationError("non-physical model: banded test")
+        real(self)
+
+    monkeypatch.setattr(ls.LeastSquaresSINDy, "_check_physical", refuse_banded)
+    model = LeastSquaresSINDy().fit(data)
+    assert model.fit_band_hz_ == 0.0
+    assert "refused: its fit is non-physical" in model.fit_band_rule_
+    assert model.fit_band_rule_.endswith("no band")
+    with pytest.raises(IdentificationError, match="banded test"):
+        LeastSquaresSINDy(fit_band_hz=band).fit(data)
+
+    def refuse_all(self):
+        raise IdentificationError("non-physical model: " + (
+            "banded test" if self.fit_band_hz_ > 0.0 else "no-band test"))
+
+    monkeypatch.setattr(ls.LeastSquaresSINDy, "_check_physical", refuse_all)
+    with pytest.raises(IdentificationError, match="banded test"):
+        LeastSquaresSINDy().fit(data)
