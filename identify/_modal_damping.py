@@ -219,7 +219,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from identify._structural_sim import state_matrix
-from identify.structural import MODE_SEPARATION, modal, peak_band
+from identify.structural import MODE_SEPARATION, growing_poles, modal, peak_band
 from testbed.core.lazy import lazy_module
 from testbed.core.measurement import Measurement
 
@@ -917,14 +917,14 @@ def _hold_couplings(M: np.ndarray, C: np.ndarray, K: np.ndarray, K2: np.ndarray,
 
 
 def _grows(M: np.ndarray, C: np.ndarray, K: np.ndarray) -> bool:
-    """Whether the linear model has a growing pole (real part above ``1e-9`` of its modulus,
+    """Whether the linear model has a growing pole (:func:`identify.structural.growing_poles`,
     :func:`identify.structural.check_physical`'s test); False when the poles are not finite."""
     with np.errstate(all="ignore"):
         try:
             lam = np.linalg.eigvals(state_matrix(M, C, K))
         except np.linalg.LinAlgError:
             return False
-    return bool(np.all(np.isfinite(lam)) and np.any(lam.real > 1e-9 * np.abs(lam)))
+    return bool(np.all(np.isfinite(lam)) and np.any(growing_poles(lam)))
 
 
 def fit_pole_decay(M: np.ndarray, C: np.ndarray, K: np.ndarray, sigma: np.ndarray,
@@ -942,8 +942,16 @@ def fit_pole_decay(M: np.ndarray, C: np.ndarray, K: np.ndarray, sigma: np.ndarra
     not) put it at +97 to +322 1/s and the run was refused as non-physical, while the
     unheld fit passes (TRAC 0.9998).  So where the hold made a stable fit grow
     (:func:`decay_hold` asks only then), such a mode (not taken, ``D_kk < 0``) is given the
-    decay rate of the fit's own pole of that mode instead (the coupled pole nearest its
-    undamped frequency in modulus, when that pole decays): what the fit says the mode does.
+    decay rate of the fit's own pole of that mode instead (what the fit says the mode does):
+    the fit's pole nearest the mode's undamped frequency in modulus (a
+    pairing by frequency: a least-squares fit can mix the shapes so that the scorer's pairing by
+    shape, :func:`testbed.numerics.shapes.pole_pairs`, gives the mode only an overdamped pair,
+    as on that cell, where this pole at -40.3 + 2605j 1/s has mode 3's shape while mode 3's
+    own decay is measured), when it decays and no other mode the rule acts on is nearest to the
+    same pole (two modes never take one pole).  The hold sets the mode's own modal damping from
+    that rate and keeps its couplings (it measures no decay of the mode), so the held pole has
+    exactly the fit pole's decay where the mode ends up uncoupled, and near it otherwise
+    (:func:`decay_hold`'s rule reports the rate given).
     A mode with ``D_kk >= 0`` keeps the fit's ``D_kk``; a symmetric positive semi-definite
     ``C`` (``sgd_sindy``'s, projected) has none below 0.  Applied wherever a taken-free mode
     had ``D_kk < 0`` (the first form) it also acted on soft-base family member 001 clean,
@@ -982,10 +990,12 @@ def fit_pole_decay(M: np.ndarray, C: np.ndarray, K: np.ndarray, sigma: np.ndarra
         return sigma, own
     p = p[p.imag >= 0.0]
     w = 2.0 * np.pi * np.asarray(w)
-    for k in np.flatnonzero(free & (np.diag(D).real < 0.0)):
-        pk = p[np.argmin(np.abs(np.abs(p) - w[k]))]
-        if pk.real < 0.0:
-            sigma[k], own[k] = -pk.real, True
+    acts = np.flatnonzero(free & (np.diag(D).real < 0.0))
+    nearest = {int(k): int(np.argmin(np.abs(np.abs(p) - w[k]))) for k in acts}
+    for k, j in nearest.items():
+        shared = sum(1 for i in nearest.values() if i == j) > 1
+        if p[j].real < 0.0 and not shared:
+            sigma[k], own[k] = -p[j].real, True
     return sigma, own
 
 

@@ -307,12 +307,24 @@ def tilt_rows(*rows: np.ndarray, k: int = FIT_TILT_DIFFERENCES) -> list[np.ndarr
     return [np.diff(r, k, axis=-1) if k > 0 else r for r in rows]
 
 
+#: A pole whose real part exceeds this fraction of its modulus grows; below it, the real part
+#: is rounding of an undamped pole (float64 eigenvalues of a 2n x 2n state matrix).
+GROWTH_RTOL = 1e-9
+
+
+def growing_poles(lam: np.ndarray) -> np.ndarray:
+    """Which poles ``lam`` [1/s] (complex, any shape) grow: real part above :data:`GROWTH_RTOL`
+    of the modulus (a boolean array of the same shape); the one test of a growing mode."""
+    lam = np.asarray(lam)
+    return lam.real > GROWTH_RTOL * np.abs(lam)
+
+
 def check_physical(M: np.ndarray, C: np.ndarray, K: np.ndarray, what: str = "least squares") -> None:
     """Raise :class:`IdentificationError` for a linear model with a growing mode.
 
-    A pole of ``[[0, I], [-M^-1 K, -M^-1 C]]`` with real part above ``1e-9`` of its modulus
-    (rounding of an undamped pole) is a mode that grows (negative damping or negative
-    stiffness): a passive structure has none.
+    A pole of ``[[0, I], [-M^-1 K, -M^-1 C]]`` that grows (:func:`growing_poles`: real part
+    above ``1e-9`` of its modulus, below it rounding of an undamped pole) is a mode that grows
+    (negative damping or negative stiffness): a passive structure has none.
 
     Parameters
     ----------
@@ -322,7 +334,7 @@ def check_physical(M: np.ndarray, C: np.ndarray, K: np.ndarray, what: str = "lea
         The fit named in the message as not constraining it.
     """
     lam = np.linalg.eigvals(state_matrix(M, C, K))
-    bad = lam.real > 1e-9 * np.abs(lam)
+    bad = growing_poles(lam)
     if np.any(bad):
         worst = lam[bad][np.argmax(lam[bad].real)]
         raise IdentificationError(

@@ -471,3 +471,47 @@ def test_a_mode_damped_only_through_its_couplings_keeps_the_fit_pole(chain, monk
     _, Phi_k = modal(M, K)
     Dk = np.linalg.solve(Phi_k, np.linalg.solve(M, kept.C @ Phi_k))
     assert Dk[1, 1] == pytest.approx(0.02 * w[1], rel=1e-9)
+
+
+def test_the_fit_pole_rule_acts_only_on_a_negative_own_damping_where_the_hold_grows(chain, monkeypatch):
+    """The two gates of ``fit_pole_decay`` in ``decay_hold`` (review of session 15: the test
+    above passed with either deleted).  (1) ``fit_pole_decay`` itself: a free mode with positive
+    own damping is never given the fit pole's decay; one with negative own damping is, from a
+    pole of its own (modes paired with poles one to one).  (2) ``decay_hold``: a negative own
+    damping whose hold stays stable (here the measured modes' couplings to it are none, so the
+    hold moves nothing it depends on) is left as the fit had it."""
+    import identify._modal_damping as md
+
+    sysd, data = chain
+    M, K = sysd["M"], sysd["K"]
+    f, Phi = modal(M, K)
+    w = 2 * np.pi * f
+
+    def damping(D):
+        return M @ Phi @ D @ np.linalg.inv(Phi)
+
+    taken = np.array([True, False, False])
+    sigma = np.array([0.01 * w[0], np.nan, np.nan])
+    # (1) positive own damping: never acts; negative (stable through a coupling): acts
+    D = np.diag([0.02 * w[0], 0.02 * w[1], 0.03 * w[2]])
+    out, own = md.fit_pole_decay(M, damping(D), K, sigma, taken)
+    assert not own.any() and np.array_equal(out, sigma, equal_nan=True)
+    D = np.diag([0.02 * w[0], -0.02 * w[1], 0.6 * w[2]])
+    D[1, 2], D[2, 1] = -0.3 * w[1], 3.0 * w[2]
+    out, own = md.fit_pole_decay(M, damping(D), K, sigma, taken)
+    assert own.tolist() == [False, True, False] and out[1] > 0
+    # (2) a negative own damping the hold leaves stable: mode 2 coupled to mode 3 only, which
+    # the hold does not touch (not taken), so the held model is the fit's there and stable
+    nan = np.full(3, np.nan)
+    dec = md.ModalDecay(sigma=sigma, omega_d=nan, sigma_model=sigma,
+                        lam_model=np.where(taken, w**2, np.nan), shift=np.where(taken, 0.0, np.nan),
+                        r2=np.ones(3), taken=taken)
+    monkeypatch.setattr(md, "modal_decay", lambda *a, **k: dec)
+
+    def setf(on, lam):
+        return md.set_eigenvalues(M, K, np.where(on, lam, np.nan))
+
+    held = md.decay_hold(data, M, damping(D), K, (0, data.n_samples), setf)
+    assert not md._grows(M, held.C, K)
+    assert "whose own modal damping the fit made negative" not in held.rule
+
