@@ -76,10 +76,10 @@ def signal_band(x: np.ndarray, fs: float, share: float = 0.99,
     record's jump between its ends does not leak as a 1/f tail), tapered by a Hann window, and
     its periodogram's expected white-noise floor (``noise**2`` spread evenly over 0..fs/2)
     subtracted (unclipped).  The band is the lowest frequency ``f`` whose remaining power
-    ``R(f)`` (the noise-corrected bins above ``f``) is at most ``(1 - share)`` of the total or
-    no longer significant against the noise: ``R(f) <= (1 - share) T + SIGNIFICANCE_Z sd(f)``,
-    where ``sd(f)`` is the standard deviation of the same sum over noise alone,
-    ``floor * sqrt(WINDOW_VAR K + (FLOOR_REL_ERR K)^2 / n)`` for ``K`` bins above ``f`` and
+    ``R(f)`` (the noise-corrected bins above ``f``) is at most ``(1 - share)`` of the total
+    ``T`` (the cumulative share reached) or no longer significant against the noise:
+    ``R(f) <= max((1 - share) T, SIGNIFICANCE_Z sd(f))``, where ``sd(f)`` is the standard
+    deviation of the same sum over noise alone, ``floor * sqrt(WINDOW_VAR K + (FLOOR_REL_ERR K)^2 / n)`` for ``K`` bins above ``f`` and
     ``n`` samples: the periodogram's own fluctuation (one bin's is its floor; the Hann
     window's neighbouring bins correlate, ``WINDOW_VAR = n sum w^4 / (sum w^2)^2 = 35/18``)
     and the floor's estimation error, which every bin shares.  Without the second test the
@@ -130,7 +130,10 @@ def signal_band(x: np.ndarray, fs: float, share: float = 0.99,
         total = cum[r, -1]
         if total > 0:
             rest = total - cum[r]
-            ok = rest <= (1.0 - share) * total + SIGNIFICANCE_Z * floor[r, 0] * np.sqrt(var)
+            # the share reached, or nothing significant left (the test fires only where the
+            # noise's fluctuation exceeds the (1 - share) left out)
+            sd = floor[r, 0] * np.sqrt(var)
+            ok = rest <= np.maximum((1.0 - share) * total, SIGNIFICANCE_Z * sd)
             out[r] = f[int(np.argmax(ok))]
     return out
 
