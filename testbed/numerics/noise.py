@@ -77,14 +77,16 @@ def signal_band(x: np.ndarray, fs: float, share: float = 0.99,
     its periodogram's expected white-noise floor (``noise**2`` spread evenly over 0..fs/2)
     subtracted (unclipped).  The band is the lowest frequency ``f`` whose remaining power
     ``R(f)`` (the noise-corrected bins above ``f``) is at most ``(1 - share)`` of the total
-    ``T`` (the cumulative share reached) or no longer significant against the noise:
-    ``R(f) <= max((1 - share) T, SIGNIFICANCE_Z sd(f))``, where ``sd(f)`` is the standard
-    deviation of the same sum over noise alone, ``floor * sqrt(WINDOW_VAR K + (FLOOR_REL_ERR K)^2 / n)`` for ``K`` bins above ``f`` and
+    ``T`` (the cumulative share reached) or no longer significant against the noise (at
+    least one bin above 0 Hz): ``R(f) <= SIGNIFICANCE_Z sd(f)``, where ``sd(f)`` is the
+    standard deviation of the same sum over noise alone,
+    ``floor * sqrt(WINDOW_VAR K + (FLOOR_REL_ERR K)^2 / n)`` for ``K`` bins above ``f`` and
     ``n`` samples: the periodogram's own fluctuation (one bin's is its floor; the Hann
-    window's neighbouring bins correlate, ``WINDOW_VAR = n sum w^4 / (sum w^2)^2 = 35/18``)
-    and the floor's estimation error, which every bin shares.  Without the second test the
-    noise's fluctuations above a slow motion carried the cumulative share: a five-bar's 2 s
-    record (a third of a sine period) at 5 % noise gave 1.7 kHz instead of 1.5 Hz.
+    window's neighbouring bins correlate, ``WINDOW_VAR = n sum w^4 / (sum w^2)^2 = 35/18``,
+    :func:`window_var`) and the floor's estimation error, which every bin shares.  The second
+    test stops the band earlier only where the noise's fluctuation exceeds the ``1 - share``
+    left out.  Without it the noise above a slow motion carried the cumulative share: a
+    five-bar's 2 s record (a third of a sine period) at 5 % noise gave 1.7 kHz, not 1-1.5 Hz.
 
     Parameters
     ----------
@@ -129,12 +131,14 @@ def signal_band(x: np.ndarray, fs: float, share: float = 0.99,
     for r in range(a.shape[0]):
         total = cum[r, -1]
         if total > 0:
-            rest = total - cum[r]
-            # the share reached, or nothing significant left (the test fires only where the
-            # noise's fluctuation exceeds the (1 - share) left out)
-            sd = floor[r, 0] * np.sqrt(var)
-            ok = rest <= np.maximum((1.0 - share) * total, SIGNIFICANCE_Z * sd)
-            out[r] = f[int(np.argmax(ok))]
+            reached = int(np.searchsorted(cum[r], share * total))  # the share reached
+            # nothing significant left above: stops earlier only where the noise's fluctuation
+            # exceeds the (1 - share) left out
+            insignificant = total - cum[r] <= SIGNIFICANCE_Z * floor[r, 0] * np.sqrt(var)
+            # never at 0 Hz: a row with power above its floor has a band of at least one bin
+            # (1 / record; the window spreads even a slow bow over bins 0 and 1), and callers
+            # read 0 as "no power above the floor" (SINDy-PI: the exact-data recipe)
+            out[r] = f[max(min(reached, int(np.argmax(insignificant))), 1)]
     return out
 
 
