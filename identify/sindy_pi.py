@@ -80,7 +80,8 @@ filters every library column alike (the equations stay exact) to cut derivative 
 Noise rule (:func:`noise_knobs`, every setting overridable): the angles' white-noise level
 (as the signal chain declares it, ``Measurement.noise_std``, else robust 4th differences,
 :func:`testbed.numerics.noise_std`) and band (99.9 % of the
-noise-corrected power, :func:`testbed.numerics.signal_band`) choose the column low-pass
+noise-corrected power, or where the rest is no longer significant against the noise,
+:func:`testbed.numerics.signal_band`) choose the column low-pass
 (off on exact data, 1.5x the band otherwise), the edge trim, the ridge, the form and the LHS
 candidates; rates a low-pass chain derived from the noisy angles (a declared ``passband``) get
 the strong form with the column low-pass, the input terms as LHS, a ridge in proportion to
@@ -644,7 +645,8 @@ def noise_knobs(x: np.ndarray, fs: float, val_fraction: float, user: dict[str, A
        angles before it smoothed them) or else that of the angles as given
        (:func:`testbed.numerics.noise.noise_std`); the band ``band_hz`` = the largest over
        channels of the frequency holding ``BAND_SHARE`` of the noise-corrected power of the
-       angles as given (:func:`testbed.numerics.noise.signal_band`).
+       angles as given, or above which the power left is no longer significant against the
+       noise floor's fluctuation (:func:`testbed.numerics.noise.signal_band`).
     2. ``noise_rel <= NOISE_FREE_REL`` and no declared low-pass chain derived the rates
        (item 4 otherwise): exact data: strong form, no column filter, no edge
        trim, ridge ``RIDGE_EXACT``, every LHS candidate.  Unless ``smoothed`` is given: the

@@ -639,9 +639,10 @@ EDGE_FIT_PERIODS = 1.6
 EDGE_FIT_MAX_SHARE = 0.25
 #: ... and at least this many samples per coefficient of their polynomial: a least-squares fit
 #: needs more samples than coefficients to average its noise at all.  It binds only where the
-#: automatic cut-off runs up to the Nyquist frequency, i.e. where the noise hides the motion
-#: (a five-bar at 50 % angle noise: cut-off 4.5 kHz, 1.6 periods = 4 samples for 6
-#: coefficients, which the fit cannot take); the run then goes on to a scored verdict.
+#: automatic cut-off runs up to the Nyquist frequency (once a five-bar at 50 % angle noise:
+#: cut-off 4.5 kHz, 1.6 periods = 4 samples for 6 coefficients, which the fit cannot take,
+#: before :func:`testbed.numerics.noise.signal_band` tested its tail's significance; a user's
+#: cut-off near Nyquist still does); the run then goes on to a scored verdict.
 EDGE_FIT_MIN_SAMPLES_PER_COEF = 2
 
 

@@ -96,10 +96,13 @@ def test_auto_edge_fit_spans_the_stated_periods_of_the_cutoff():
     assert auto_edge_fit(0.2, ds.fs, raw.shape[1]) == pytest.approx(EDGE_FIT_MAX_SHARE * 4.0)
 
 
-def test_auto_edge_fit_keeps_more_samples_than_coefficients_when_noise_hides_the_motion():
-    """At 50 % angle noise the automatic cut-off runs up to 0.45 fs and 1.6 of its periods were
-    4 samples for a quintic's 6 coefficients: an internal error in the run.  The floor keeps
-    2 samples per coefficient and the run ends in a scored verdict."""
+def test_auto_edge_fit_keeps_more_samples_than_coefficients_at_the_highest_cutoff():
+    """A cut-off at 0.45 fs (the automatic rule's cap) made 1.6 of its periods 4 samples for a
+    quintic's 6 coefficients: an internal error in the run.  The floor keeps 2 samples per
+    coefficient and the run ends in a scored verdict.  (The cap was reached at 50 % angle noise
+    while the band estimate let the noise's fluctuations carry its cumulative share; with the
+    significance test of :func:`testbed.numerics.noise.signal_band` that record's band is
+    1.25 Hz, the top tone 1.2 Hz, and the cut-off sits below 5 Hz.)"""
     from testbed.pipeline.signal_chain import (
         AUTO_CUTOFF_MAX_SHARE,
         EDGE_FIT_MIN_SAMPLES_PER_COEF,
@@ -109,9 +112,10 @@ def test_auto_edge_fit_keeps_more_samples_than_coefficients_when_noise_hides_the
 
     ds = dataset(0.5)
     raw = ds.measured["theta"].data
-    cut = auto_cutoff(raw, ds.fs, 8)
-    assert cut == pytest.approx(AUTO_CUTOFF_MAX_SHARE * ds.fs)  # the noise hides the motion
+    # 50 % noise no longer hides the tones (0.3 and 1.2 Hz) from the automatic cut-off
+    assert auto_cutoff(raw, ds.fs, 8) < 5.0
+    cut = AUTO_CUTOFF_MAX_SHARE * ds.fs
     edge = auto_edge_fit(cut, ds.fs, raw.shape[1], 5)
     assert round(edge * ds.fs) == EDGE_FIT_MIN_SAMPLES_PER_COEF * 6
-    m = measure(ds, {"derivatives": "lowpass"}, "mechanical")  # cut-off and edge "auto"
+    m = measure(ds, {"derivatives": "lowpass", "cutoff_hz": cut}, "mechanical")  # edge "auto"
     assert np.all(np.isfinite(m.xd)) and np.all(np.isfinite(m.xdd))
