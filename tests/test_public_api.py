@@ -60,13 +60,13 @@ def test_sklearn_clone_and_params(name):
         est.set_params(no_such=1)
     # the API round (session 15): the template's checks hold for every identifier, and a clone
     # keeps them (tests/testbed/test_hostile_api16.py has the cases)
-    from testbed.core.errors import ArgumentError, HyperparameterError, NotFittedError
+    from testbed.core import errors
 
-    with pytest.raises(HyperparameterError, match="no hyperparameter 'no_such'"):
+    with pytest.raises(errors.HyperparameterError, match="no hyperparameter 'no_such'"):
         cls(no_such=1)
-    with pytest.raises(ArgumentError, match="expected a Measurement"):
+    with pytest.raises(errors.ArgumentError, match="expected a Measurement"):
         twin.fit(None)
-    with pytest.raises(NotFittedError):
+    with pytest.raises(errors.NotFittedError):
         twin.equations()
 
 
