@@ -118,8 +118,9 @@ def _fs(where: str, name: str, v: Any, r: Resolve) -> float:
 
 
 def _model(where: str, name: str, v: Any, r: Resolve) -> Any:
-    """An identifier instance (not its class, not its name)."""
-    if not isinstance(v, r("Identifier")):
+    """An identifier instance (not its class, not its name): a :class:`Identifier`, or any
+    object with a ``fit`` method (an estimator by contract, as a plugin may be)."""
+    if isinstance(v, (type, str)) or not callable(getattr(v, "fit", None)):
         hint = " (an instance: call the class)" if isinstance(v, type) else (
             " (an instance: testbed.IDENTIFIERS.get(name)())" if isinstance(v, str) else "")
         raise ArgumentError(where, name, args.describe(v), f"expected an identifier{hint}",
@@ -130,7 +131,8 @@ def _model(where: str, name: str, v: Any, r: Resolve) -> Any:
 def _fitted(where: str, name: str, v: Any, r: Resolve) -> Any:
     """A fitted identifier."""
     _model(where, name, v, r)
-    if not v.is_fitted():
+    fitted = getattr(v, "is_fitted", None)
+    if callable(fitted) and not fitted():
         raise NotFittedError(f"{where}: argument '{name}': {type(v).__name__} is not fitted; "
                              "call fit(data) first")
     return v
