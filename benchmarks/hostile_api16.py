@@ -309,7 +309,8 @@ def entry_cases() -> Iterator[Case]:
         testbed.IDENTIFIERS.get("ls_sindy")().fit(data), 3)
     yield "identify_file(None)", lambda: testbed.identify_file(None)
     yield "identify_file(3)", lambda: testbed.identify_file(3)
-    yield "measurement_from_file(None, 'structural')", lambda: testbed.measurement_from_file(None, "structural")
+    yield "measurement_from_file(None, 'structural')", lambda: testbed.measurement_from_file(
+        None, "structural")
     yield "measurement_from_file(kind=3)", lambda: testbed.measurement_from_file("x.csv", 3)
     yield "read_measured(None)", lambda: testbed.read_measured(None)
     yield "read_measured(fs=-1)", lambda: testbed.read_measured("x.csv", fs=-1)
@@ -341,7 +342,7 @@ def _measure_kind(kind: str) -> Any:
 def _measure_signal(sig: Any) -> Any:
     import testbed
 
-    sc, ds = _mm()
+    _sc, ds = _mm()
     return testbed.measure(ds, sig, "mechanical")
 
 
@@ -425,7 +426,8 @@ def studies_cases(work: Path) -> Iterator[Case]:
         yield f"run_sweep(jobs={jobs!r})", lambda jobs=jobs: testbed.run_sweep(
             study or "nope", jobs=jobs, results=work / "r.parquet", verbose=False)
     for v in (None, 3, ["a"], {"study": {}}):
-        yield f"run_sweep({v!r})", lambda v=v: testbed.run_sweep(v, results=work / "r2.parquet", verbose=False)
+        yield f"run_sweep({v!r})", lambda v=v: testbed.run_sweep(v, results=work / "r2.parquet",
+                                                                 verbose=False)
         yield f"load_study({v!r})", lambda v=v: testbed.load_study(v)
     yield "run_sweep(results=3)", lambda: testbed.run_sweep(study or "nope", results=3, verbose=False)
     yield "run_sweep(dask_address=3)", lambda: testbed.run_sweep(

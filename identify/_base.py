@@ -56,8 +56,14 @@ from typing import Any, ClassVar, TextIO
 import numpy as np
 
 from testbed.core import arguments as args
-from testbed.core.errors import (ArgumentError, HyperparameterError, IdentificationError,
-                                 NotFittedError, ScenarioError, UnsupportedError)
+from testbed.core.errors import (
+    ArgumentError,
+    HyperparameterError,
+    IdentificationError,
+    NotFittedError,
+    ScenarioError,
+    UnsupportedError,
+)
 from testbed.core.measurement import Measurement, Trajectory
 from testbed.core.schema import ErrorFn, Field, KeyUse, check_keys_used, validate_table
 
@@ -392,8 +398,8 @@ class Identifier:
         Raises
         ------
         UnsupportedError
-            (a NotImplementedError) for an identifier that is not structural (a mechanical model's equations are
-            implicit: there is no explicit acceleration to predict).
+            (a NotImplementedError) for an identifier that is not structural (a mechanical
+            model's equations are implicit: there is no explicit acceleration to predict).
         """
         if getattr(self, "kind", "") != "structural" or not hasattr(self, "M_"):
             raise UnsupportedError(f"{type(self).__name__}: predict_acceleration needs a fitted "

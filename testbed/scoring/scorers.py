@@ -14,8 +14,13 @@ from typing import Any
 import numpy as np
 
 from testbed.core.dataset import Dataset
-from testbed.core.errors import (DivergenceError, IdentificationError, RegistrationError,
-                                 UnresolvedModelError, show_value)
+from testbed.core.errors import (
+    DivergenceError,
+    IdentificationError,
+    RegistrationError,
+    UnresolvedModelError,
+    show_value,
+)
 from testbed.core.kinds import MAX_MODE_SCORES, METRICS
 from testbed.core.measurement import Measurement, Trajectory
 from testbed.core.terms import canonical

@@ -13,10 +13,16 @@ from sklearn.base import clone
 
 import testbed
 from benchmarks import bench_sgd_sindy
-from testbed.core.errors import (ArgumentError, HyperparameterError, IdentificationError,
-                                 NotFittedError, RegistrationError, TestbedError, UnknownNameError,
-                                 UnsupportedError)
-from testbed.core.measurement import Measurement
+from testbed.core.errors import (
+    ArgumentError,
+    HyperparameterError,
+    IdentificationError,
+    NotFittedError,
+    RegistrationError,
+    TestbedError,
+    UnknownNameError,
+    UnsupportedError,
+)
 
 
 @pytest.fixture(scope="module")
@@ -133,8 +139,8 @@ def test_results_before_fit_are_not_fitted_errors(data):
     for name in ("ls_sindy", "sindy_pi", "sindy_pi_linear", "sindy_pi_dynamical"):
         est = testbed.IDENTIFIERS.get(name)()
         # were RuntimeError, AttributeError ('coef_', '_lib') by identifier
-        for call in (lambda: est.equations(), lambda: est.simulate(np.zeros(3), np.zeros(3),
-                                                                     np.arange(10) / 1e3)):
+        for call in (est.equations, lambda e=est: e.simulate(np.zeros(3), np.zeros(3),
+                                                               np.arange(10) / 1e3)):
             with pytest.raises(NotFittedError) as e:
                 call()
             one_line(e, "not fitted")
@@ -231,7 +237,7 @@ def test_registering_twice_or_wrong_is_a_registration_error():
 
     with pytest.raises(RegistrationError, match="registered already"):
         testbed.register_scorer("structural", lambda *a: None)
-    kind, chain = next(iter(SIGNAL_CHAINS.items()))
+    chain = next(iter(SIGNAL_CHAINS.values()))
     with pytest.raises(RegistrationError, match="registered already"):
         testbed.register_signal_chain(dataclasses.replace(chain, measure=lambda *a: None))
     other = type("OtherTruth", (TRUTH_TYPES["structural"],), {"kind": "structural"})
