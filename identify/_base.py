@@ -45,6 +45,7 @@ from __future__ import annotations
 
 import contextlib
 import dataclasses
+import functools
 import inspect
 import itertools
 import sys
@@ -54,7 +55,15 @@ from typing import Any, ClassVar, TextIO
 
 import numpy as np
 
-from testbed.core.errors import HyperparameterError, ScenarioError
+from testbed.core import arguments as args
+from testbed.core.errors import (
+    ArgumentError,
+    HyperparameterError,
+    IdentificationError,
+    NotFittedError,
+    ScenarioError,
+    UnsupportedError,
+)
 from testbed.core.measurement import Measurement, Trajectory
 from testbed.core.schema import ErrorFn, Field, KeyUse, check_keys_used, validate_table
 
@@ -80,6 +89,27 @@ class Identifier:
     #: False (a plugin that does not say): each such cell is fitted, showing the method's spread.
     #: Read from the class's own body only: a subclass that changes the fit does not inherit it.
     deterministic: ClassVar[bool] = False
+
+    def __new__(cls, *args: Any, **kwargs: Any) -> Identifier:
+        """Refuse a keyword that is not one of ``__init__``'s hyperparameters with a
+        HyperparameterError naming the allowed ones (Python's TypeError named none).  Checked
+        here, not by wrapping ``__init__``: its signature and defaults stay the class's own."""
+        if kwargs and cls.__init__ is not object.__init__:
+            params = inspect.signature(cls.__init__).parameters
+            if not any(p.kind == p.VAR_KEYWORD for p in params.values()):
+                names = cls._param_names()
+                unknown = [k for k in kwargs if k not in names]
+                if unknown:
+                    raise HyperparameterError(
+                        f"{cls.__name__}: no hyperparameter {unknown[0]!r}; allowed: "
+                        f"{', '.join(names) or 'none'}")
+        return super().__new__(cls)
+
+    def __init_subclass__(cls, **kwargs: Any) -> None:
+        """Put the API's argument checks (:func:`_install_guards`) on the subclass's own
+        ``fit`` and the methods that need a fitted model."""
+        super().__init_subclass__(**kwargs)
+        _install_guards(cls)
 
     @classmethod
     def declared_hyperparameters(cls) -> dict[str, Field]:
@@ -154,18 +184,57 @@ class Identifier:
             (an IdentificationError and a ValueError) naming the hyperparameter, its value
             and what is allowed.
         """
-        given = {}
-        for k, v in self.get_params().items():
+        self._checked_params()
+
+    def _checked_params(self) -> tuple[dict[str, Any], bool]:
+        """:meth:`check_params`; return the complete validated hyperparameters and whether every
+        one of them was checked (False when one is a Python object such as a Library, left to
+        the algorithm: the dict then holds its declared default instead).
+
+        A numpy scalar counts as the Python number it holds (a grid of ``np.arange`` values);
+        None given for a hyperparameter whose default is not None is checked (and refused by
+        its declaration), not skipped.
+        """
+        given, complete = {}, True
+        for k, v in self.get_params(deep=False).items():
             v = list(v) if isinstance(v, tuple) else v
+            if isinstance(v, np.generic) and v.dtype.kind in "biuf":
+                v = v.item()
             f = self.declared_hyperparameters().get(k)
-            if v is None and f is not None and f.default is None:
+            if v is None and (f is None or f.default is None):
                 continue  # "not given"
-            if isinstance(v, (bool, int, float, str, list)):
+            if isinstance(v, (bool, int, float, str, list)) or v is None:
                 given[k] = v
+            else:
+                complete = False
         try:
-            self.validate_hyperparameters(given, file=type(self).__name__, section=self.name or "params")
+            full = self.validate_hyperparameters(given, file=type(self).__name__,
+                                                 section=self.name or "params")
         except ScenarioError as e:
             raise HyperparameterError(str(e)) from None
+        return full, complete
+
+    def check_params_for_data(self, data: Measurement) -> None:
+        """:meth:`check_params`, then :meth:`check_data_shape` against ``data`` (channels,
+        inputs, sample rate, samples) when every hyperparameter could be checked: what a
+        scenario's load checks against its record, for an estimator built in Python.
+
+        Raises
+        ------
+        HyperparameterError
+            Naming the hyperparameter, its value and what is allowed.
+        """
+        full, complete = self._checked_params()
+        if not complete:
+            return
+        section = self.name or "params"
+
+        def error(name: str, value: Any, allowed: str) -> None:
+            raise HyperparameterError(str(ScenarioError(type(self).__name__, f"{section}.{name}",
+                                                        value, allowed)))
+
+        n_inputs = 0 if data.u is None else data.u.shape[0]
+        self.check_data_shape(full, data.n_channels, n_inputs, data.fs, data.n_samples, error)
 
     @classmethod
     def _param_names(cls) -> list[str]:
@@ -194,8 +263,8 @@ class Identifier:
         for k, v in params.items():
             head, _, rest = k.partition("__")
             if head not in allowed:
-                raise ValueError(f"{type(self).__name__} has no hyperparameter {head!r}; "
-                                 f"allowed: {', '.join(allowed)}")
+                raise HyperparameterError(f"{type(self).__name__} has no hyperparameter {head!r}; "
+                                          f"allowed: {', '.join(allowed) or 'none'}")
             if rest:
                 getattr(self, head).set_params(**{rest: v})
             else:
@@ -328,13 +397,13 @@ class Identifier:
 
         Raises
         ------
-        NotImplementedError
-            For an identifier that is not structural (a mechanical model's equations are
-            implicit: there is no explicit acceleration to predict).
+        UnsupportedError
+            (a NotImplementedError) for an identifier that is not structural (a mechanical
+            model's equations are implicit: there is no explicit acceleration to predict).
         """
         if getattr(self, "kind", "") != "structural" or not hasattr(self, "M_"):
-            raise NotImplementedError(f"{type(self).__name__}: predict_acceleration needs a fitted "
-                                      "structural model (M_, C_, K_)")
+            raise UnsupportedError(f"{type(self).__name__}: predict_acceleration needs a fitted "
+                                   "structural model (M_, C_, K_)")
         x, xd = np.asarray(data.x, dtype=float), np.asarray(data.xd, dtype=float)
         force = -self.C_ @ xd - self.K_ @ x
         if getattr(self, "K3_", None) is not None:
@@ -368,14 +437,18 @@ class Identifier:
 
         Raises
         ------
-        NotImplementedError
-            For a mechanical (implicit) model; see :meth:`predict_acceleration`.
-        ValueError
-            If ``y`` is given.
+        UnsupportedError
+            (a NotImplementedError) for a mechanical (implicit) model; see
+            :meth:`predict_acceleration`.
+        ArgumentError
+            (a ValueError) if ``y`` is given.
+        NotFittedError
+            Before :meth:`fit`.
         """
         if y is not None:
-            raise ValueError(f"{type(self).__name__}.score(data, y): y must be None, the measured "
-                             "accelerations in data are the targets")
+            raise ArgumentError(f"{type(self).__name__}.score", "y", args.describe(y),
+                                "y must be None: the measured accelerations in data are the "
+                                "targets", described=True)
         s = slice(data.free_start, None)
         pred = self.predict_acceleration(data)[:, s]
         meas = np.asarray(data.xdd, dtype=float)[:, s]
@@ -393,6 +466,106 @@ class Identifier:
         return f"{type(self).__name__}({args})"
 
 
+#: Fewest samples a structural identifier fits after ``free_start``: the library's own floor
+#: (:func:`identify.structural.build_library`), checked before the fit's band and decay rules
+#: (which divided by the empty window's length: ZeroDivisionError, API round of session 15).
+MIN_FREE_SAMPLES = 4
+
+#: Methods that need a fitted model: called before ``fit`` they raise NotFittedError.
+FITTED_ONLY = ("score", "predict_acceleration", "equations", "simulate")
+
+
+def _guard_fit(fit: Callable[..., Identifier]) -> Callable[..., Identifier]:
+    """``fit`` checking its arguments first: ``data`` a Measurement (ArgumentError otherwise),
+    ``y`` None, the hyperparameters against their declaration and the data's shape
+    (:meth:`Identifier.check_params_for_data`)."""
+
+    takes_y = "y" in inspect.signature(fit).parameters
+
+    @functools.wraps(fit)
+    def guarded(self: Identifier, data: Any = None, y: Any = None, **kw: Any) -> Identifier:
+        where = f"{type(self).__name__}.fit"
+        if not isinstance(data, Measurement):
+            raise ArgumentError(where, "data", args.describe(data), "expected a Measurement (from "
+                                "testbed.measure, testbed.measurement_from_file or built as "
+                                "testbed.Measurement(fs, x, xd, xdd, channels))", described=True)
+        if y is not None:
+            raise ArgumentError(where, "y", args.describe(y), "expected None (the targets are in "
+                                "data)", described=True)
+        self.check_params_for_data(data)
+        free = data.n_samples - data.free_start
+        if self.kind == "structural" and free < MIN_FREE_SAMPLES:
+            raise IdentificationError(f"fit window from sample {data.free_start} (free_start) holds "
+                                      f"{max(free, 0)} samples of the {data.n_samples}; need at "
+                                      f"least {MIN_FREE_SAMPLES}")
+        return fit(self, data, y, **kw) if takes_y else fit(self, data, **kw)
+
+    guarded._api_guard = True  # type: ignore[attr-defined]
+    return guarded
+
+
+def _guard_fitted(name: str, method: Callable[..., Any]) -> Callable[..., Any]:
+    """``method`` (one of :data:`FITTED_ONLY`) raising NotFittedError before ``fit``, and
+    checking the arguments every implementation shares: ``equations``' precision an integer
+    >= 1; ``simulate``'s times a finite increasing 1-D array and initial state a finite 1-D
+    array (of the fitted channels' length for a structural model); ``score``'s and
+    ``predict_acceleration``'s data a Measurement of the fitted channels."""
+
+    @functools.wraps(method)
+    def guarded(self: Identifier, *a: Any, **kw: Any) -> Any:
+        where = f"{type(self).__name__}.{name}"
+        if name in ("score", "predict_acceleration") and self.kind != "structural":
+            return method(self, *a, **kw)  # NotImplementedError: no explicit acceleration
+        if not self.is_fitted():
+            raise NotFittedError(f"{where}: {type(self).__name__} is not fitted; call "
+                                 "fit(data) first")
+        if name == "equations":
+            precision = a[0] if a else kw.get("precision", 4)
+            args.integer(where, "precision", precision, low=1, high=17)
+        elif name == "simulate":
+            _check_simulate_args(self, where, *a, **kw)
+        else:
+            data = a[0] if a else kw.get("data")
+            if not isinstance(data, Measurement):
+                raise ArgumentError(where, "data", args.describe(data), "expected a Measurement",
+                                    described=True)
+            fitted = getattr(self, "channels_", None)
+            if fitted is not None and tuple(data.channels) != tuple(fitted):
+                raise ArgumentError(where, "data.channels", data.channels,
+                                    f"expected the fitted channels {tuple(fitted)}")
+        return method(self, *a, **kw)
+
+    guarded._api_guard = True  # type: ignore[attr-defined]
+    return guarded
+
+
+def _check_simulate_args(model: Identifier, where: str, x0: Any = None, xd0: Any = None,
+                         t: Any = None, *rest: Any, **kw: Any) -> None:
+    """The arguments every ``simulate(x0, xd0, t, u)`` shares (see :func:`_guard_fitted`)."""
+    x0 = kw.get("x0", x0)
+    t = kw.get("t", t)
+    n = len(model.channels_) if model.kind == "structural" and hasattr(model, "channels_") else None
+    args.array(where, "x0", x0, (n,))
+    tt = args.array(where, "t", t, (None,))
+    if tt.size < 1 or np.any(np.diff(tt) <= 0):
+        raise ArgumentError(where, "t", args.describe(tt), "expected sample times [s], at least "
+                            "one, increasing", described=True)
+
+
+def _install_guards(cls: type) -> None:
+    """Wrap ``cls``'s own ``fit`` and :data:`FITTED_ONLY` methods once."""
+    own = cls.__dict__
+    if "fit" in own and not getattr(own["fit"], "_api_guard", False):
+        cls.fit = _guard_fit(own["fit"])
+    for name in FITTED_ONLY:
+        method = own.get(name)
+        if callable(method) and not getattr(method, "_api_guard", False):
+            setattr(cls, name, _guard_fitted(name, method))
+
+
+_install_guards(Identifier)
+
+
 class MeasurementSamples(Measurement):
     """A :class:`~testbed.core.measurement.Measurement` scikit-learn can split by sample.
 
@@ -406,6 +579,9 @@ class MeasurementSamples(Measurement):
     @classmethod
     def of(cls, data: Measurement) -> MeasurementSamples:
         """``data`` as a MeasurementSamples (same arrays, nothing copied)."""
+        if not isinstance(data, Measurement):
+            raise ArgumentError(f"{cls.__name__}.of", "data", args.describe(data),
+                                "expected a Measurement", described=True)
         return cls(**{f.name: getattr(data, f.name) for f in fields(Measurement)})
 
     @property
@@ -424,8 +600,9 @@ class MeasurementSamples(Measurement):
             If the window is empty or outside the record.
         """
         if not 0 <= start < stop <= self.n_samples:
-            raise ValueError(f"window {start}:{stop}: expected 0 <= start < stop <= "
-                             f"{self.n_samples} (the number of samples)")
+            raise ArgumentError(f"{type(self).__name__}.window", "start:stop", f"{start}:{stop}",
+                                f"expected 0 <= start < stop <= {self.n_samples} (the number "
+                                "of samples)")
         s = slice(start, stop)
 
         def cut(a: np.ndarray | None) -> np.ndarray | None:
@@ -442,16 +619,18 @@ class MeasurementSamples(Measurement):
         if isinstance(key, slice):
             start, stop, step = key.indices(self.n_samples)
             if step != 1:
-                raise ValueError(f"{type(self).__name__}[{key}]: only contiguous windows (step 1)")
+                raise ArgumentError(type(self).__name__, "index", key,
+                                    "only contiguous windows (step 1)")
             return self.window(start, stop)
         idx = np.asarray(key)
         if idx.dtype == bool:
             idx = np.flatnonzero(idx)
         if idx.ndim != 1 or idx.size == 0 or idx.dtype.kind not in "iu" \
                 or np.any(np.diff(idx) != 1):
-            raise ValueError(f"{type(self).__name__}: a fit or score window must be one contiguous "
-                             "run of samples; use TimeWindows or TimeSeriesSplit as the splitter, "
-                             "not a shuffling or k-fold one")
+            raise ArgumentError(type(self).__name__, "index", args.describe(idx),
+                                "a fit or score window must be one contiguous run of samples; use "
+                                "TimeWindows or TimeSeriesSplit as the splitter, not a shuffling "
+                                "or k-fold one", described=True)
         return self.window(int(idx[0]), int(idx[-1]) + 1)
 
 
@@ -472,9 +651,8 @@ class TimeWindows:
     """
 
     def __init__(self, n_splits: int = 3, min_window: int = 16) -> None:
-        if isinstance(n_splits, bool) or not isinstance(n_splits, int) or n_splits < 1:
-            raise ValueError(f"TimeWindows(n_splits={n_splits!r}): expected an integer >= 1")
-        self.n_splits, self.min_window = n_splits, int(min_window)
+        self.n_splits = args.integer("TimeWindows", "n_splits", n_splits, low=1)
+        self.min_window = args.integer("TimeWindows", "min_window", min_window, low=1)
 
     def get_n_splits(self, X: Any = None, y: Any = None, groups: Any = None) -> int:
         return self.n_splits
@@ -484,8 +662,9 @@ class TimeWindows:
         n = len(X)
         edges = np.linspace(0, n, self.n_splits + 2).astype(int)
         if np.min(np.diff(edges)) < self.min_window:
-            raise ValueError(f"TimeWindows({self.n_splits}): {n} samples give windows shorter than "
-                             f"min_window={self.min_window}")
+            raise ArgumentError("TimeWindows.split", "X", f"{n} samples",
+                                f"{n} samples give {self.n_splits + 1} windows shorter than "
+                                f"min_window={self.min_window}", described=True)
         for k in range(self.n_splits):
             yield np.arange(0, edges[k + 1]), np.arange(edges[k + 1], edges[k + 2])
 
@@ -507,13 +686,13 @@ def split_measurement(data: Measurement, n_windows: int) -> list[MeasurementSamp
 
     Raises
     ------
-    ValueError
-        If ``n_windows`` is not an integer >= 1 or exceeds the record's samples.
+    ArgumentError
+        (a ValueError) if ``n_windows`` is not an integer >= 1 or exceeds the record's samples.
     """
-    if isinstance(n_windows, bool) or not isinstance(n_windows, int) or n_windows < 1:
-        raise ValueError(f"split_measurement(n_windows={n_windows!r}): expected an integer >= 1")
+    n_windows = args.integer("split_measurement", "n_windows", n_windows, low=1)
     m = MeasurementSamples.of(data)
     if n_windows > m.n_samples:
-        raise ValueError(f"split_measurement: {n_windows} windows of a {m.n_samples}-sample record")
+        raise ArgumentError("split_measurement", "n_windows", n_windows,
+                            f"expected an integer in [1, {m.n_samples}] (the record's samples)")
     edges = np.linspace(0, m.n_samples, n_windows + 1).astype(int)
     return [m.window(int(a), int(b)) for a, b in itertools.pairwise(edges)]

@@ -4,7 +4,10 @@ Flow (see README): scenario file -> rig simulates (models/) -> dataset (HDF5) ->
 signal chain -> identifier (identify/) -> scores against the truth -> report.
 
 The public Python API is the names below (``testbed.__all__``), imported on first use so that
-``import testbed`` stays cheap; ``docs/python-api.md`` shows them at work::
+``import testbed`` stays cheap; ``docs/python-api.md`` shows them at work.  The public functions'
+arguments are checked where a call enters (:mod:`testbed._api_checks`): a wrong one is an
+:class:`~testbed.core.errors.ArgumentError` naming the function, the argument, the value and
+what is allowed::
 
     import testbed
     result = testbed.run_scenario("cantilever_stiff_impact_lsq")
@@ -46,6 +49,7 @@ _API = {
     "model_summary": ("testbed.pipeline.fit", "model_summary"),
     # studies
     "load_study": ("testbed.studies.study", "load_study"),
+    "Study": ("testbed.studies.study", "Study"),
     "run_sweep": ("testbed.studies.sweep", "run_sweep"),
     "read_results": ("testbed.studies.results", "read_results"),
     # writing identifiers and rigs
@@ -78,6 +82,8 @@ _API = {
     "register_scorer": ("testbed.scoring.scorers", "register_scorer"),
     "TestbedError": ("testbed.core.errors", "TestbedError"),
     "IdentificationError": ("testbed.core.errors", "IdentificationError"),
+    "ArgumentError": ("testbed.core.errors", "ArgumentError"),
+    "NotFittedError": ("testbed.core.errors", "NotFittedError"),
 }
 
 __all__ = ["__version__", *sorted(_API)]
@@ -89,6 +95,9 @@ def __getattr__(name: str) -> Any:
     except KeyError:
         raise AttributeError(f"module 'testbed' has no attribute {name!r}") from None
     value = getattr(importlib.import_module(module), attr)
+    checks = importlib.import_module("testbed._api_checks")
+    if name in checks.RULES:  # a public function: its arguments checked where a call enters
+        value = checks.checked(name, value, __getattr__)
     globals()[name] = value
     return value
 

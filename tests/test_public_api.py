@@ -58,6 +58,16 @@ def test_sklearn_clone_and_params(name):
         assert {k: c.get_params()[k] for k in point} == point
     with pytest.raises(ValueError, match="no hyperparameter 'no_such'"):
         est.set_params(no_such=1)
+    # the API round (session 15): the template's checks hold for every identifier, and a clone
+    # keeps them (tests/testbed/test_hostile_api16.py has the cases)
+    from testbed.core import errors
+
+    with pytest.raises(errors.HyperparameterError, match="no hyperparameter 'no_such'"):
+        cls(no_such=1)
+    with pytest.raises(errors.ArgumentError, match="expected a Measurement"):
+        twin.fit(None)
+    with pytest.raises(errors.NotFittedError):
+        twin.equations()
 
 
 @pytest.fixture(scope="module")

@@ -164,3 +164,57 @@ class DivergenceError(IdentificationError):
     def __init__(self, message: str, time: float = float("nan")):
         self.time = float(time)
         super().__init__(message if time != time else f"{message} (at t = {time:.4g} s)")
+
+
+class ArgumentError(TestbedError, ValueError):
+    """A public function or class of the Python API was given an argument it cannot use
+    (:mod:`testbed.core.arguments`): the message names the function, the argument, its value and
+    what is allowed.  A ValueError too, as numpy and scikit-learn raise for bad arguments.
+
+    Parameters
+    ----------
+    where : str
+        The function or class, e.g. ``"Measurement"``, ``"run_sweep"``.
+    name : str
+        The argument, e.g. ``"xd"``, ``"jobs"``.
+    value : Any, optional
+        The offending value (shown cut to one line), or a description of it when
+        ``described`` (an array's shape and dtype).
+    allowed : str
+        What would have been accepted.
+    """
+
+    def __init__(self, where: str, name: str, value: Any = ..., allowed: str = "", *,
+                 described: bool = False):
+        self.where, self.name, self.value, self.allowed = where, name, value, allowed
+        parts = [_one_line(where), f"argument '{_cut(_one_line(name))}'"]
+        if value is not ...:
+            parts.append(_cut(_one_line(str(value))) if described else f"value {show_value(value)}")
+        msg = ": ".join(parts)
+        super().__init__(f"{msg}: {_one_line(allowed)}" if allowed else msg)
+
+
+class NotFittedError(TestbedError, ValueError, AttributeError):
+    """An identifier's result was asked for (``score``, ``equations``, ``simulate``,
+    ``predict_acceleration``) before :meth:`~identify._base.Identifier.fit`.  A ValueError and an
+    AttributeError too, as scikit-learn's ``NotFittedError``."""
+
+
+class UnsupportedError(TestbedError, NotImplementedError):
+    """An identifier was asked for what its kind of model has not (a mechanical model's
+    explicit accelerations: its equations are implicit).  A NotImplementedError too, as it was
+    documented before it was one of the project's errors."""
+
+
+class RegistrationError(TestbedError, ValueError):
+    """A rig kind's truth type, signal chain or scorer could not be registered (another one is
+    registered for that kind, the kind has no score catalogue, the object is not of the type
+    registered).  A ValueError too, as it was before it was one of the project's errors."""
+
+
+class UnknownNameError(TestbedError, KeyError):
+    """A name a registry does not hold (an identifier, a rig): the message lists the allowed
+    ones.  A KeyError too, as it was before it was one of the project's errors."""
+
+    def __str__(self) -> str:  # KeyError's own quotes the message: one readable line instead
+        return str(self.args[0]) if self.args else ""

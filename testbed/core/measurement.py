@@ -7,6 +7,9 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
+from testbed.core import arguments as args
+from testbed.core.errors import ArgumentError
+
 
 @dataclass(frozen=True)
 class Measurement:
@@ -87,6 +90,74 @@ class Measurement:
     noise_std: np.ndarray | None = None
     chain_poles: np.ndarray | None = None
     input_hold: str | None = None
+
+    def __post_init__(self) -> None:
+        """Check every field once, where a measurement is made (the shared rules of
+        :mod:`testbed.core.arguments`): arrays real, finite and of the shapes above (returned as
+        float64), ``fs`` a finite rate > 0, ``free_start`` an integer >= 0,
+        ``channels`` and ``inputs`` distinct names matching the rows of ``x`` and ``u`` (given),
+        ``input_map`` (n_channels, n_inputs), the pass
+        band ``0 <= low < high <= fs / 2``, ``integration`` and ``input_hold`` among their
+        values.
+
+        Raises
+        ------
+        ArgumentError
+            Naming the field, its value (an array by shape and dtype) and what is allowed.
+        """
+        where = type(self).__name__
+        put = object.__setattr__  # frozen: store the checked (float64) forms
+        put(self, "fs", args.real(where, "fs", self.fs, low=0.0, low_open=True))
+        x = args.array(where, "x", self.x, (None, None))
+        n_ch, n_s = x.shape
+        if n_ch < 1 or n_s < 1:
+            raise ArgumentError(where, "x", args.describe(x), "expected at least one channel and "
+                                "one sample (channels x samples)", described=True)
+        put(self, "x", x)
+        put(self, "xd", args.array(where, "xd", self.xd, (n_ch, n_s)))
+        put(self, "xdd", args.array(where, "xdd", self.xdd, (n_ch, n_s)))
+        put(self, "channels", args.names(where, "channels", self.channels, count=n_ch))
+        if self.u is None:
+            # names without their signals are allowed: a copy that drops u for a step that
+            # does not use it keeps them (identify.sindy_pi's loop closure)
+            put(self, "inputs", args.names(where, "inputs", self.inputs))
+            n_in = None
+        else:
+            u = args.array(where, "u", self.u, (None, n_s))
+            n_in = u.shape[0]
+            put(self, "u", u)
+            put(self, "inputs", args.names(where, "inputs", self.inputs, count=n_in))
+        if self.input_map is not None:
+            put(self, "input_map", args.array(where, "input_map", self.input_map, (n_ch, n_in)))
+        put(self, "prior", args.mapping(where, "prior", self.prior))
+        # no upper bound: a window cut before the excitation ends keeps the record's free_start
+        # (MeasurementSamples.window), a record that ends before its free decay starts
+        put(self, "free_start", args.integer(where, "free_start", self.free_start, low=0))
+        if self.passband is not None:
+            nyquist = self.fs / 2.0
+            band = self.passband
+            ok = isinstance(band, (tuple, list)) and len(band) == 2
+            if ok:
+                low = args.real(where, "passband[0]", band[0], low=0.0)
+                # 1e-9: a cut-off computed as fs / 2 in another order of operations
+                high = args.real(where, "passband[1]", band[1], low=low, low_open=True,
+                                 high=nyquist * (1 + 1e-9))
+                put(self, "passband", (low, high))
+            else:
+                raise ArgumentError(where, "passband", band, "expected None or (low, high) [Hz], "
+                                    f"0 <= low < high <= the Nyquist frequency {nyquist:g} Hz")
+        if self.drift_basis is not None:
+            put(self, "drift_basis", args.array(where, "drift_basis", self.drift_basis, (None, n_s)))
+        if self.noise_std is not None:
+            std = args.array(where, "noise_std", self.noise_std, (n_ch,))
+            if np.any(std < 0):
+                raise ArgumentError(where, "noise_std", std.tolist(), "expected values >= 0")
+            put(self, "noise_std", std)
+        if self.chain_poles is not None:
+            put(self, "chain_poles", args.array(where, "chain_poles", self.chain_poles, (None,),
+                                                complex_ok=True))
+        args.choice(where, "integration", self.integration, ("exact", "trapezoid"))
+        args.choice(where, "input_hold", self.input_hold, (None, "zoh", "linear"))
 
     @property
     def n_channels(self) -> int:

@@ -34,7 +34,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from testbed.core.errors import TestbedError
+from testbed.core.errors import TestbedError, UnknownNameError, show_value
 from testbed.core.lazy import configure_loaded
 
 #: Entry-point group of identifiers from other distributions.
@@ -236,13 +236,15 @@ class Registry:
                 self._loading_entry_point = None
 
     def get(self, name: str) -> Any:
-        """Return the entry called ``name``; KeyError naming what is allowed."""
+        """Return the entry called ``name``; UnknownNameError (a KeyError) naming what is
+        allowed for a name it does not hold (a value that is not text included)."""
         self._load()
         try:
             return self._entries[name]
-        except KeyError:
+        except (KeyError, TypeError):  # TypeError: an unhashable name (a list)
             allowed = ", ".join(sorted(self._entries)) or "(none registered)"
-            raise KeyError(f"unknown {self.kind} {name!r}; allowed: {allowed}") from None
+            raise UnknownNameError(f"unknown {self.kind} {show_value(name)}; allowed: {allowed}"
+                                   ) from None
 
     def names(self, tag: str | None = None) -> list[str]:
         """Sorted names, optionally only those carrying ``tag``."""

@@ -34,7 +34,7 @@ from typing import Any, ClassVar, Self
 
 import numpy as np
 
-from testbed.core.errors import TestbedError
+from testbed.core.errors import RegistrationError, TestbedError, show_value
 
 __all__ = ["TRUTH_TYPES", "DynamicalTruth", "MechanicalTruth", "StructuralTruth", "Truth", "TruthError",
            "register_truth", "truth_field", "truth_type"]
@@ -191,12 +191,22 @@ TRUTH_TYPES: dict[str, type[Truth]] = {}
 
 
 def register_truth(cls: type[Truth]) -> type[Truth]:
-    """Class decorator: make ``cls`` the truth type of rigs of ``cls.kind``."""
+    """Class decorator: make ``cls`` the truth type of rigs of ``cls.kind``.
+
+    Raises
+    ------
+    RegistrationError
+        (a ValueError) if ``cls`` is not a subclass of :class:`Truth`, declares no kind, or
+        another truth type is registered for its kind.
+    """
+    if not (isinstance(cls, type) and issubclass(cls, Truth)):
+        raise RegistrationError(f"register_truth: {show_value(cls)} is not a subclass of "
+                                "testbed.Truth")
     if not cls.kind:
-        raise ValueError(f"{cls.__name__} declares no kind")
+        raise RegistrationError(f"{cls.__name__} declares no kind")
     have = TRUTH_TYPES.get(cls.kind)
     if have is not None and have is not cls:
-        raise ValueError(f"a truth type for rig kind {cls.kind!r} is registered already "
+        raise RegistrationError(f"a truth type for rig kind {cls.kind!r} is registered already "
                          f"({have.__name__})")
     TRUTH_TYPES[cls.kind] = cls
     return cls

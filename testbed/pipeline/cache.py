@@ -36,6 +36,7 @@ try:
 except ImportError:  # Windows: no folder lock (a `cache clear` during a write may fail it)
     fcntl = None  # type: ignore[assignment]
 
+from testbed.core import arguments
 from testbed.core.dataset import Dataset, DatasetError
 from testbed.core.errors import InputError
 from testbed.core.provenance import versions
@@ -164,6 +165,8 @@ class DatasetCache:
     """
 
     def __init__(self, directory: str | os.PathLike | None = None) -> None:
+        if directory is not None:
+            arguments.path("DatasetCache", "directory", directory)
         self.directory = Path(directory) if directory is not None else default_cache_dir()
 
     def path(self, scenario: Scenario) -> Path:

@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 
 from testbed.core.dataset import Dataset
-from testbed.core.errors import ScenarioError, show_names
+from testbed.core.errors import RegistrationError, ScenarioError, show_names
 from testbed.core.measurement import Measurement, declared_input_hold
 from testbed.core.schema import Field, KeyUse, validate_table
 from testbed.core.schema import check_keys_used as schema_check_keys_used
@@ -189,12 +189,12 @@ def register_signal_chain(chain: SignalChain) -> SignalChain:
 
     Raises
     ------
-    ValueError
-        If another chain is registered for that kind already.
+    RegistrationError
+        (a ValueError) if another chain is registered for that kind already.
     """
     have = SIGNAL_CHAINS.get(chain.kind)
     if have is not None and have != chain:
-        raise ValueError(f"a signal chain for rig kind {chain.kind!r} is registered already")
+        raise RegistrationError(f"a signal chain for rig kind {chain.kind!r} is registered already")
     SIGNAL_CHAINS[chain.kind] = chain
     SIGNAL_SCHEMAS[chain.kind] = chain.schema
     return chain

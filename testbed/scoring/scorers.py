@@ -14,7 +14,13 @@ from typing import Any
 import numpy as np
 
 from testbed.core.dataset import Dataset
-from testbed.core.errors import DivergenceError, IdentificationError, UnresolvedModelError
+from testbed.core.errors import (
+    DivergenceError,
+    IdentificationError,
+    RegistrationError,
+    UnresolvedModelError,
+    show_value,
+)
 from testbed.core.kinds import MAX_MODE_SCORES, METRICS
 from testbed.core.measurement import Measurement, Trajectory
 from testbed.core.terms import canonical
@@ -706,14 +712,15 @@ def register_scorer(kind: str, scorer: Scorer) -> Scorer:
 
     Raises
     ------
-    ValueError
-        If another scorer is registered for ``kind``, or the kind has no score catalogue.
+    RegistrationError
+        (a ValueError) if another scorer is registered for ``kind``, or the kind has no score catalogue.
     """
     if kind not in METRICS:
-        raise ValueError(f"rig kind {kind!r} has no score catalogue (testbed.core.kinds.METRICS)")
+        raise RegistrationError(f"rig kind {show_value(kind)} has no score catalogue "
+                                "(testbed.core.kinds.METRICS)")
     have = SCORERS.get(kind)
     if have is not None and have is not scorer:
-        raise ValueError(f"a scorer for rig kind {kind!r} is registered already")
+        raise RegistrationError(f"a scorer for rig kind {kind!r} is registered already")
     SCORERS[kind] = scorer
     return scorer
 
