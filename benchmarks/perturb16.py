@@ -138,6 +138,11 @@ def _draw_beam(rng: random.Random, sc: dict, ch: dict, ident: str) -> list[str]:
                 z = round(10 ** rng.uniform(-3, -1.7), 4)
                 ch["rig"]["damping_ratio"] = z
                 what.append(f"z{z}")
+    # sensors drawn before a new length are laid out on the new length (same count)
+    if "length" in ch["rig"] and "sensors" in ch["rig"] and \
+            max(ch["rig"]["sensors"]) > ch["rig"]["length"]:
+        L, k = ch["rig"]["length"], len(ch["rig"]["sensors"])
+        ch["rig"]["sensors"] = [round(L * (i + 1) / k, 4) for i in range(k)]
     # the rig takes the hammer at the tip or on a sensor (its force must be measured where a
     # sensor sits): a drawn place is moved to the nearest sensor, as a researcher would
     loc = ch["excitation"].get("location")
