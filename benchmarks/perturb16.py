@@ -324,6 +324,8 @@ def main() -> None:
     ap.add_argument("--run", action="store_true")
     ap.add_argument("--from", dest="start", type=int, default=0)
     ap.add_argument("--out", default="/tmp/perturb16_runs")
+    ap.add_argument("--exclude", default="", help="skip cases whose name has this text")
+    ap.add_argument("--only", default="", help="run only cases whose name has this text")
     a = ap.parse_args()
     OUT_DIR.mkdir(parents=True, exist_ok=True)
     cases = draw_cases()
@@ -332,6 +334,8 @@ def main() -> None:
     if a.run:
         with open(OUT_DIR / "summary.tsv", "a") as f:
             for name, _, meta in cases[a.start:]:
+                if (a.exclude and a.exclude in name) or (a.only and a.only not in name):
+                    continue
                 line = _run(name, Path(a.out))
                 print(line, flush=True)
                 f.write(line + "\n")
