@@ -262,11 +262,11 @@ def draw_cases(n: int = N_CASES, seed: int = SEED) -> list[tuple[str, str, dict]
         ident = rng.choice(others)
         ch: dict[str, dict] = {t: {} for t in ("scenario", "rig", "simulation", "excitation",
                                                 "noise")}
-        draw = {"cantilever": lambda: _draw_beam(rng, sc, ch, ident),
-                "fivebar": lambda: _draw_fivebar(rng, sc, ch),
-                "cartpole": lambda: _draw_cartpole(rng, sc, ch),
-                "michaelis_menten": lambda: _draw_mm(rng, sc, ch)}[rig]
-        what = draw()
+        if rig == "cantilever":
+            what = _draw_beam(rng, sc, ch, ident)
+        else:
+            what = {"fivebar": _draw_fivebar, "cartpole": _draw_cartpole,
+                    "michaelis_menten": _draw_mm}[rig](rng, sc, ch)
         name = f"p16_{i:03d}_{path.stem}_{ident}"
         ident_table = {"method": ident}
         for k in CARRY:
@@ -329,11 +329,11 @@ def main() -> None:
     a = ap.parse_args()
     OUT_DIR.mkdir(parents=True, exist_ok=True)
     cases = draw_cases()
-    for name, text, meta in cases:
+    for name, text, _meta in cases:
         (OUT_DIR / f"{name}.toml").write_text(text)
     if a.run:
         with open(OUT_DIR / "summary.tsv", "a") as f:
-            for name, _, meta in cases[a.start:]:
+            for name, _, _meta in cases[a.start:]:
                 if (a.exclude and a.exclude in name) or (a.only and a.only not in name):
                     continue
                 line = _run(name, Path(a.out))

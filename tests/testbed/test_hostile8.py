@@ -22,6 +22,9 @@ from testbed.pipeline.importers import MeasuredDataError, read_measured
 from testbed.pipeline.scenario import SCENARIO_DIR, _read_toml, scenario_from_dict
 from testbed.reporting.export import export_dataset
 
+#: The prior refusal's allowed range, as testbed.pipeline.importers.check_prior words it
+_PRIOR = "expected a finite number from 1e-100 to 1e+100"
+
 FS = 1000.0  # Hz; 400 samples of a 7 Hz sine: any rate and length the readers accept
 
 
@@ -69,9 +72,9 @@ def test_a_clean_hand_made_dataset_is_read_and_exported(tmp_path):
     ({"acceleration.positions": lambda p: np.array([np.nan, 0.2, 0.3])},
      "channel 'acceleration/acc1': positions=nan; expected a finite number [m]"),
     # the file's own priors were read unchecked (only --prior values were checked)
-    ({"prior": {"total_mass": math.nan}}, "prior total_mass=nan: expected a finite number from 1e-100 to 1e+100"),
-    ({"prior": {"total_mass": -1.0}}, "prior total_mass=-1.0: expected a finite number from 1e-100 to 1e+100"),
-    ({"prior": {"total_mass": "heavy"}}, "prior total_mass='heavy': expected a finite number from 1e-100 to 1e+100"),
+    ({"prior": {"total_mass": math.nan}}, f"prior total_mass=nan: {_PRIOR}"),
+    ({"prior": {"total_mass": -1.0}}, f"prior total_mass=-1.0: {_PRIOR}"),
+    ({"prior": {"total_mass": "heavy"}}, f"prior total_mass='heavy': {_PRIOR}"),
 ])
 def test_an_edited_dataset_file_is_refused_by_identify_and_export_alike(tmp_path, edits, fragment):
     p = _saved(tmp_path, **edits)

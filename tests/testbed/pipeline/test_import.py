@@ -324,7 +324,8 @@ def test_truncated_uff_export(beam, tmp_path):
 def test_a_declared_prior_that_is_not_a_positive_size_is_refused(value):
     # `testbed identify --prior total_mass=nan` used to fit and write a model
     data = from_sep005([{"name": "a", "data": [1.0, 2.0], "unit_str": "m", "fs": 1.0}])
-    with pytest.raises(MeasuredDataError, match=r"prior total_mass=.*expected a finite number from 1e-100 to 1e\+100"):
+    with pytest.raises(MeasuredDataError,
+                       match=r"prior total_mass=.*expected a finite number from 1e-100 to 1e\+100"):
         data.to_dataset(prior={"total_mass": value})
     assert data.to_dataset(prior={"total_mass": 0.7}).prior["total_mass"] == 0.7
 
