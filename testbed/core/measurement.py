@@ -95,7 +95,8 @@ class Measurement:
         """Check every field once, where a measurement is made (the shared rules of
         :mod:`testbed.core.arguments`): arrays real, finite and of the shapes above (returned as
         float64), ``fs`` a finite rate > 0, ``free_start`` an integer >= 0,
-        ``channels`` and ``inputs`` distinct names matching the rows of ``x`` and ``u`` (given),
+        ``channels`` and ``inputs`` distinct names matching the rows of ``x`` and ``u`` (given;
+        ``inputs`` may be empty: unnamed inputs),
         ``input_map`` (n_channels, n_inputs), the pass
         band ``0 <= low < high <= fs / 2``, ``integration`` and ``input_hold`` among their
         values.
@@ -126,7 +127,12 @@ class Measurement:
             u = args.array(where, "u", self.u, (None, n_s))
             n_in = u.shape[0]
             put(self, "u", u)
-            put(self, "inputs", args.names(where, "inputs", self.inputs, count=n_in))
+            # names are optional (a record built in code may leave its inputs unnamed, as the
+            # identifiers' own tests do); given, one per row of u
+            if isinstance(self.inputs, (tuple, list)) and len(self.inputs) == 0:
+                put(self, "inputs", ())
+            else:
+                put(self, "inputs", args.names(where, "inputs", self.inputs, count=n_in))
         if self.input_map is not None:
             put(self, "input_map", args.array(where, "input_map", self.input_map, (n_ch, n_in)))
         put(self, "prior", args.mapping(where, "prior", self.prior))

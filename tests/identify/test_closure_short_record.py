@@ -20,9 +20,14 @@ CELL = Path(__file__).resolve().parents[2] / "benchmarks" / "unseen" / "round15"
 
 @pytest.fixture(scope="module")
 def short_record():
-    """fb15_cranks_0p5_1_2s at 5 %, seed 61: cranks 0.5 / 1 m, 2 s of the paper's 6.3 s sine."""
+    """fb15_cranks_0p5_1_2s at 5 %, seed 61: cranks 0.5 / 1 m, 2 s of the paper's 6.3 s sine,
+    with the angles as the chain left them when round 15 found it: its 'auto' cut-off then
+    came out at 4.43 kHz (the band rule carried by the noise, fixed in session 15:
+    docs/known-gaps.md "The noise rule's band"), so the angles keep their white noise; given
+    here as a number, so the closure rule is tested on raw angles whatever 'auto' resolves to."""
     sc = testbed.load_scenario(CELL)
-    sc = dataclasses.replace(sc, seed=61, noise={**sc.noise, "rms_percent": 5.0})
+    sc = dataclasses.replace(sc, seed=61, noise={**sc.noise, "rms_percent": 5.0},
+                             signal={**sc.signal, "cutoff_hz": 4430.0})
     m = testbed.measure(testbed.generate(sc), sc.signal, sc.kind)
     passive = np.flatnonzero(~(np.abs(np.asarray(m.input_map)) > 0).any(axis=1))
     return m, passive

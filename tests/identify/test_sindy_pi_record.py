@@ -153,16 +153,23 @@ def test_no_combination_simulating_its_segments_is_fitted_again_unpruned(monkeyp
             raise NoSimulationError("no shortlisted model combination could be simulated")
         return self
 
+    from testbed.core.measurement import Measurement
+
+    # a Measurement (the identifiers' fit takes no other object since session 15's API round)
+    # of _Data's shape: four angles and two inputs at rest
+    z = _Data()
+    data = Measurement(fs=100.0, x=z.x, xd=z.xd, xdd=np.zeros_like(z.x),
+                       channels=("th1", "th2", "th3", "th4"), u=z.u, inputs=("u1", "u2"))
     for kept, ok in (([True], True), ([False], False)):
         monkeypatch.setattr(_ImplicitMechanical, "fit",
                             lambda self, data, kept=kept: first_fails(self, data, kept))
         m = SINDyPI(input_hold="zoh", selection="rollout")
         if ok:
-            assert m.fit(_Data()) is m
+            assert m.fit(data) is m
             assert "fitted again over the unpruned library" in m.record_rule_
         else:   # nor the unpruned library: a fit failure naming both
             with pytest.raises(IdentificationError, match="nor over the unpruned library"):
-                m.fit(_Data())
+                m.fit(data)
 
 
 def _run_cell(dataset_cache, study_file: str, name: str, noise: float, seed: int):

@@ -67,7 +67,7 @@ def one_line(e: pytest.ExceptionInfo, *words: str) -> None:
     (lambda d: {"integration": "euler"}, ("'integration'", "'trapezoid'")),
     (lambda d: {"input_hold": "hold"}, ("'input_hold'",)),
     (lambda d: {"input_map": np.ones((2, 2))}, ("'input_map'",)),
-    (lambda d: {"u": np.ones((1, 640))}, ("'inputs'",)),
+    (lambda d: {"u": np.ones((1, 640)), "inputs": ("f", "g")}, ("'inputs'", "1 distinct")),
     (lambda d: {"noise_std": -np.ones(3)}, ("'noise_std'", ">= 0")),
     (lambda d: {"prior": {"total_mass": float("nan")}}, ("total_mass", "finite")),
     # were: TypeError / ValueError from the band rule
@@ -79,6 +79,13 @@ def test_a_malformed_measurement_is_refused_where_it_is_made(data, change, words
         dataclasses.replace(data, **change(data))
     one_line(e, "Measurement: argument", *words)
     assert isinstance(e.value, ValueError)  # as numpy's and scikit-learn's
+
+
+def test_inputs_may_be_left_unnamed(data):
+    # a record built in code may give u without names (the identifiers' own tests do); given,
+    # the names must match u's rows (above)
+    m = dataclasses.replace(data, u=np.ones((1, data.n_samples)))
+    assert m.inputs == () and m.u.shape == (1, data.n_samples)
 
 
 def test_float32_integer_lists_and_strided_arrays_fit_as_float64(data):
