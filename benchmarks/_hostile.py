@@ -131,6 +131,16 @@ def subfolder(work: Path, sub: str) -> Path:
     return d
 
 
+def families(makers: dict[str, Callable[[Path], Iterable[tuple[str, Callable[[], Any]]]]],
+             timeout_s: int) -> dict[str, Callable[[Path], Counter]]:
+    """A round's families for :func:`main`: each maker given its own :func:`subfolder` of the
+    work folder (named as the family) and its cases run by :func:`run_inprocess`, each case
+    returning a finding's description or None (a verdict, or refused in one line)."""
+    def family(name: str, make: Callable[[Path], Any]) -> Callable[[Path], Counter]:
+        return lambda work: run_inprocess(make(subfolder(work, name)), timeout_s, lambda f: f)
+    return {name: family(name, make) for name, make in makers.items()}
+
+
 def main(argv: list[str], families: dict[str, Callable[[Path], Counter]], prefix: str) -> int:
     """Run the named families (all when ``argv`` is empty) in one temporary folder; print each
     family's count and the total; status 1 when anything was found."""

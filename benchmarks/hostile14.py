@@ -92,7 +92,6 @@ import subprocess
 import sys
 import threading
 import time
-from collections import Counter
 from pathlib import Path
 
 from benchmarks import _hostile
@@ -801,25 +800,14 @@ def texts_cases() -> list[tuple[str, object]]:
             for what, raw, path, load in loads for k, v in TEXTS.items()]
 
 
-def run_inprocess(cases) -> Counter:
-    """Each case returns a finding's description or None (a verdict, or refused in one line)."""
-    return _hostile.run_inprocess(cases, TIMEOUT_S, lambda finding: finding)
-
-
 FAMILIES = {
-    "index": lambda work: run_inprocess(index_cases(_hostile.subfolder(work, "index"))),
-    "socket": lambda work: run_inprocess(socket_cases(_hostile.subfolder(work, "socket"))),
-    "entrypoints": lambda work: run_inprocess(entrypoints_cases(_hostile.subfolder(work, "entrypoints"))),
-    "envvars": lambda work: run_inprocess(envvars_cases(_hostile.subfolder(work, "envvars"))),
-    "channels": lambda work: run_inprocess(channels_cases(_hostile.subfolder(work, "channels"))),
-    "tomlbytes": lambda work: run_inprocess(tomlbytes_cases(_hostile.subfolder(work, "tomlbytes"))),
-    "requests": lambda work: run_inprocess(requests_cases(_hostile.subfolder(work, "requests"))),
-    "longargs": lambda work: run_inprocess(longargs_cases(_hostile.subfolder(work, "longargs"))),
-    "escapes": lambda work: run_inprocess(escapes_cases(_hostile.subfolder(work, "escapes"))),
-    "texts": lambda work: run_inprocess(texts_cases()),
-    "uff": lambda work: run_inprocess(uff_cases(_hostile.subfolder(work, "uff"))),
-    "bounds": lambda work: _hostile.run_inprocess(bounds_cases(_hostile.subfolder(work, "bounds")),
-                                                  BOUND_TIMEOUT_S, lambda finding: finding),
+    **_hostile.families({
+        "index": index_cases, "socket": socket_cases, "entrypoints": entrypoints_cases,
+        "envvars": envvars_cases, "channels": channels_cases, "tomlbytes": tomlbytes_cases,
+        "requests": requests_cases, "longargs": longargs_cases, "escapes": escapes_cases,
+        "texts": lambda work: texts_cases(), "uff": uff_cases,
+    }, TIMEOUT_S),
+    **_hostile.families({"bounds": bounds_cases}, BOUND_TIMEOUT_S),
 }
 
 

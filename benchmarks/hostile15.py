@@ -60,7 +60,6 @@ import math
 import os
 import subprocess
 import sys
-from collections import Counter
 from pathlib import Path
 
 try:
@@ -965,21 +964,11 @@ def dask_cases() -> list[tuple[str, object]]:
     return [(f"--dask {a!r:.50}", lambda a=a: fn(a)) for a in DASK_ADDRESSES]
 
 
-def run_inprocess(cases) -> Counter:
-    """Each case returns a finding's description or None (a verdict, or refused in one line)."""
-    return _hostile.run_inprocess(cases, TIMEOUT_S, lambda finding: finding)
-
-
-FAMILIES = {
-    "studies": lambda work: run_inprocess(study_cases(_hostile.subfolder(work, "studies"))),
-    "extends": lambda work: run_inprocess(extends_cases(_hostile.subfolder(work, "extends"))),
-    "csvdata": lambda work: run_inprocess(csv_cases(_hostile.subfolder(work, "csvdata"))),
-    "numopts": lambda work: run_inprocess(numopts_cases(_hostile.subfolder(work, "numopts"))),
-    "results": lambda work: run_inprocess(results_cases(_hostile.subfolder(work, "results"))),
-    "cuts": lambda work: run_inprocess(cut_cases(_hostile.subfolder(work, "cuts"))),
-    "dask": lambda work: run_inprocess(dask_cases()),
-    "priors": lambda work: run_inprocess(prior_cases(_hostile.subfolder(work, "priors"))),
-}
+FAMILIES = _hostile.families({
+    "studies": study_cases, "extends": extends_cases, "csvdata": csv_cases,
+    "numopts": numopts_cases, "results": results_cases, "cuts": cut_cases,
+    "dask": lambda work: dask_cases(), "priors": prior_cases,
+}, TIMEOUT_S)
 
 
 def main(argv: list[str]) -> int:

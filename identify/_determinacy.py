@@ -147,14 +147,7 @@ def noise_gram(rows: Callable[[np.ndarray], np.ndarray], x: np.ndarray,
         column scaled by its noise-free norm) [-]: the term to take out of the normalised Gram
         for a bias-compensated fit; zeros for zero noise, NaN where the rows are unusable.
     """
-    base, norms, fault = _unit_rows(rows, x)
-    q = base.shape[1]
-    if fault:
-        return np.full((q, q), np.nan)
-    sigma = np.asarray(sigma, dtype=float).reshape(-1, 1)
-    if not np.any(sigma > 0.0):
-        return np.zeros((q, q))
-    return _noise_gram(rows, x, sigma, base, norms)
+    return _gram_of_record(rows, x, sigma, spread=False)
 
 
 def direction_spread(rows: Callable[[np.ndarray], np.ndarray], x: np.ndarray,
@@ -196,14 +189,22 @@ def noise_gram_and_spread(rows: Callable[[np.ndarray], np.ndarray], x: np.ndarra
     spread : float
         As :func:`direction_spread` returns it [-].
     """
+    return _gram_of_record(rows, x, sigma, spread=True)
+
+
+def _gram_of_record(rows: Callable[[np.ndarray], np.ndarray], x: np.ndarray, sigma: np.ndarray,
+                    spread: bool) -> np.ndarray | tuple[np.ndarray, float]:
+    """:func:`_noise_gram` of the record's normalised rows, with the unusable rows' NaN and the
+    zero-noise zeros (and spread 0) handled once for :func:`noise_gram` and
+    :func:`noise_gram_and_spread`."""
     base, norms, fault = _unit_rows(rows, x)
     q = base.shape[1]
     if fault:
-        return np.full((q, q), np.nan), float("nan")
+        return (np.full((q, q), np.nan), float("nan")) if spread else np.full((q, q), np.nan)
     sigma = np.asarray(sigma, dtype=float).reshape(-1, 1)
     if not np.any(sigma > 0.0):
-        return np.zeros((q, q)), 0.0
-    return _noise_gram(rows, x, sigma, base, norms, spread=True)
+        return (np.zeros((q, q)), 0.0) if spread else np.zeros((q, q))
+    return _noise_gram(rows, x, sigma, base, norms, spread=spread)
 
 
 def noise_residual_ratio(rows: Callable[[np.ndarray], np.ndarray], x: np.ndarray,
