@@ -206,6 +206,26 @@ def test_failed_bar_on_a_mode_outside_the_pass_band_is_named():
     assert out_of_band_failures(Scores({"freq_error_mode1": 9.0}), bars) == {}
 
 
+def test_failed_trac_with_a_mode_below_the_high_pass_is_named():
+    from testbed.scoring.scorers import Scores, out_of_band_failures
+    # round 16's b16_soft_r0p06_hp10_3s (sgd_sindy, clean): the soft base's mode 1 (9.93 Hz)
+    # under the default 10 Hz high-pass; the frequency bars were met (2.1 %) and TRAC failed
+    # (0.605; its twin with the high-pass 'auto' 0.997) with no word of why
+    details = {"passband": (10.0, 6400.0), "f_true": np.array([9.931, 283.5]), "scored_modes": 2}
+    bars = {"trac": {"min": 0.90}, "freq_error_mode1": {"max": 0.026},
+            "freq_error_mode2": {"max": 0.026}}
+    why = out_of_band_failures(Scores({"trac": 0.605, "freq_error_mode1": 0.0213,
+                                       "freq_error_mode2": 0.0018}, details), bars)
+    assert why["band"].startswith("out of band: mode 1 (9.931 Hz) lies below the signal chain's "
+                                  "high-pass cut-off (10 Hz")
+    assert "mode 2" not in why["band"]
+    # TRAC met, or every mode in band: nothing to explain
+    assert out_of_band_failures(Scores({"trac": 0.95, "freq_error_mode1": 0.0213}, details),
+                                bars) == {}
+    inband = {**details, "f_true": np.array([11.0, 283.5])}
+    assert out_of_band_failures(Scores({"trac": 0.605}, inband), bars) == {}
+
+
 # ------------------------------------------- round 5 beams
 def test_softening_base_is_refused_at_load_naming_the_key():
     # round 5: a softening (negative cubic) base, what a researcher tries next to a hardening
