@@ -73,8 +73,8 @@ CASES: dict[str, tuple[str, dict, dict, dict, dict]] = {
         {}, {"location": round(0.2 * L, 4)}, {},
     ),
     # clamped: damping, pulses, forces
-    "b16_st_z0p2_n8": ("the shipped beam, 8 segments, 0.2 % damping", {"n_segments": 8, "damping_ratio": 0.002},
-                       {}, {}, {}),
+    "b16_st_z0p2_n8": ("the shipped beam, 8 segments, 0.2 % damping",
+                       {"n_segments": 8, "damping_ratio": 0.002}, {}, {}, {}),
     "b16_st_z8": ("the shipped beam, 8 % damping", {"damping_ratio": 0.08}, {}, {}, {}),
     "b16_st_p0p1ms": ("the shipped beam, a 0.1 ms pulse at 25.6 kHz", {}, {"sample_rate": 25600.0},
                       {"pulse_duration": 1e-4}, {}),

@@ -54,7 +54,8 @@ _LIGHT = {"pole_mass": 0.05}
 #: name -> (description, {table: keys changed from cartpole_noise1 (its multisine kept)})
 CARTPOLES: dict[str, tuple[str, dict[str, dict]]] = {
     "cp16_light": ("a 0.05 kg pole on the 1 kg cart, 10 s", {"rig": _LIGHT}),
-    "cp16_light_3s": ("a 0.05 kg pole on the 1 kg cart, 3 s", {"rig": _LIGHT, "simulation": {"duration": 3.0}}),
+    "cp16_light_3s": ("a 0.05 kg pole on the 1 kg cart, 3 s",
+                      {"rig": _LIGHT, "simulation": {"duration": 3.0}}),
     "cp16_3s": ("the shipped cart-pole, 3 s", {"simulation": {"duration": 3.0}}),
 }
 
@@ -68,7 +69,8 @@ CARTPOLES_FULL: dict[str, tuple[str, dict[str, dict]]] = {
     "cp16_light_steps_3s": (
         "a 0.05 kg pole, 2 N steps held 0.5 s, 3 s",
         {"rig": _LIGHT, "simulation": {"duration": 3.0},
-         "excitation": {"type": "steps", "amplitude": 2.0, "level_seed": 0, "kp": 5.0, "kd": 2.0, "hold": 0.5}},
+         "excitation": {"type": "steps", "amplitude": 2.0, "level_seed": 0, "kp": 5.0, "kd": 2.0,
+                        "hold": 0.5}},
     ),
 }
 
