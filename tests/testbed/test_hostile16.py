@@ -126,3 +126,83 @@ def test_a_v1_runs_figures_name_files_inside_its_folder_only(saved, tmp_path):
     _edit_json(run, lambda m: (m.update(format=READ_FORMATS[0], figures=["../../../x.png", "f.png", 3]),
                                m.pop(DIGEST), m.pop(NPZ_DIGEST)))
     assert load_run(run).figures == [run / "f.png"]
+
+
+# ------------------------------------------------------------------ measured records
+
+def _sep005(path: Path, channels: dict[str, tuple[str, list[float], int]], fs: float = 100.0) -> Path:
+    """A SEP-005 file of ``name: (unit, data, node)`` channels (an input acts on its node's joint)."""
+    path.write_text(json.dumps([{"name": name, "data": data, "fs": fs, "unit_str": unit, "node": node}
+                                for name, (unit, data, node) in channels.items()]))
+    return path
+
+
+def _cartpole_like(n: int = 400, fs: float = 100.0):
+    import numpy as np
+
+    t = np.arange(n) / fs
+    th = 3.0 + 0.5 * np.sin(2 * np.pi * 0.7 * t)  # crosses pi: wrapped, it jumps by 2 pi
+    x = 0.1 * np.sin(2 * np.pi * 0.3 * t)
+    u = np.sin(2 * np.pi * 1.1 * t)
+    return th, x, u
+
+
+@pytest.mark.parametrize("wrapped", [False, True])
+def test_a_wrapped_angle_is_refused_naming_its_channel_and_step(tmp_path, wrapped):
+    import math
+
+    import numpy as np
+
+    from testbed.pipeline.importers import MeasuredDataError, measurement_from_file
+
+    # a five-bar record whose angles were wrapped to (-pi, pi] was differentiated into spikes
+    # and refused as "loop closure Newton solve did not converge", naming neither
+    th, x, u = _cartpole_like()
+    if wrapped:
+        th = (th + math.pi) % (2 * math.pi) - math.pi
+    f = _sep005(tmp_path / "r.json", {"theta/x": ("m", x.tolist(), 1), "theta/th": ("rad", th.tolist(), 2),
+                                      "torque/u1": ("N", u.tolist(), 1)})
+    if not wrapped:
+        m = measurement_from_file(f, "mechanical", {"derivatives": "lowpass"})
+        assert np.all(np.isfinite(m.xd))
+        return
+    with pytest.raises(MeasuredDataError, match=r"'th' steps by [+-]6.2\d* rad between samples \d+ "
+                                                r"and \d+: a wrapped angle .*numpy.unwrap"):
+        measurement_from_file(f, "mechanical", {"derivatives": "lowpass"})
+
+
+@pytest.mark.parametrize("edit", ["none", "degrees", "copy", "negated"])
+def test_a_recorded_rate_that_is_not_its_signals_is_refused(tmp_path, edit):
+    import math
+
+    import numpy as np
+
+    from testbed.pipeline.importers import MeasuredDataError, measurement_from_file
+
+    # a cart-pole's pole angle logged in degrees under "rad", rates that were a copy of the
+    # angles, a kinetics record's negated rate: each was fitted into a model, status 0
+    fs, n = 100.0, 400
+    t = np.arange(n) / fs
+    w = 2 * np.pi * 0.7
+    th, dth = 0.5 * np.sin(w * t), 0.5 * w * np.cos(w * t)
+    x, dx = 0.1 * np.sin(0.3 * w * t), 0.03 * w * np.cos(0.3 * w * t)
+    if edit == "degrees":
+        th = th * 180 / math.pi
+    elif edit == "copy":
+        dth = th.copy()
+    if edit == "negated":  # the dynamical kind's (x, dx)
+        f = _sep005(tmp_path / "k.json", {"x/x": ("mM", (1.5 + th).tolist(), 1),
+                                          "dx/dx": ("mM/s", (-dth).tolist(), 1)})
+        with pytest.raises(MeasuredDataError, match=r"'dx' channel 'dx' is not the rate of 'x' channel 'x'"):
+            measurement_from_file(f, "dynamical")
+        return
+    f = _sep005(tmp_path / "r.json", {"theta/x": ("m", x.tolist(), 1), "theta/th": ("rad", th.tolist(), 2),
+                                      "dtheta/dx": ("m/s", dx.tolist(), 1),
+                                      "dtheta/dth": ("rad/s", dth.tolist(), 2),
+                                      "torque/u1": ("N", np.sin(1.1 * w * t).tolist(), 1)})
+    if edit == "none":
+        assert measurement_from_file(f, "mechanical", {"derivatives": "lowpass"}).x.shape == (2, n)
+        return
+    with pytest.raises(MeasuredDataError, match=r"'dtheta' channel 'dth' is not the rate of 'theta' "
+                                                r"channel 'th': its running integral misses"):
+        measurement_from_file(f, "mechanical", {"derivatives": "lowpass"})
