@@ -354,6 +354,8 @@ def measurement_from_file(path: str | os.PathLike, kind: str, signal: Mapping[st
     _check_read(data.source, ds, kind)
     _check_response(data.source, ds, kind)
     _check_units(data.source, ds, kind)
+    if kind == "mechanical" and RESPONSE_SIGNAL[kind] in ds.measured:  # after the units: in rad
+        _check_unwrapped(data.source, ds.measured[RESPONSE_SIGNAL[kind]], RESPONSE_SIGNAL[kind])
     _check_rates(data.source, ds, kind)
     try:
         return measure(ds, dict(signal or {}), kind)
@@ -406,8 +408,6 @@ def _check_response(path: Path, ds: Dataset, kind: str) -> None:
                                       "one sensor per position")
     if kind == "structural":
         _check_independent(path, sig, RESPONSE_SIGNAL[kind])
-    if kind == "mechanical":
-        _check_unwrapped(path, sig, RESPONSE_SIGNAL[kind])
 
 
 def _check_unwrapped(path: Path, sig: Signal, name: str) -> None:
