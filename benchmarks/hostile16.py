@@ -308,8 +308,8 @@ def record_cases(work: Path) -> list[tuple[str, object]]:
     chans, prior = bases["dynamical"]
     for label, (new, refuse) in _dynamical_mutations(chans).items():
         cases.append(case(f"michaelis_menten: {label}", "dynamical", "sindy_pi_dynamical", new, {}, refuse))
-    only = os.environ.get("HOSTILE16_ONLY")  # a substring of the case names to run (a rerun)
-    return [c for c in cases if not only or only in c[0]]
+    only = os.environ.get("HOSTILE16_ONLY")  # substrings (comma-separated) of the cases to run
+    return [c for c in cases if not only or any(o in c[0] for o in only.split(","))]
 
 
 # ------------------------------------------------------------------ run folders
