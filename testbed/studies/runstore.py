@@ -68,7 +68,7 @@ except ImportError:  # Windows
     fcntl = None  # type: ignore[assignment]
 
 from testbed.core.atomic import atomic_write_text, begin_in_flight, end_in_flight, no_room
-from testbed.core.errors import TestbedError
+from testbed.core.errors import TestbedError, is_control
 from testbed.core.provenance import git_commit, versions
 from testbed.pipeline.plugins import RIGS
 from testbed.scoring.scorers import PASS, Check, verdict
@@ -714,6 +714,18 @@ def _check_meta(run_dir: Path, meta: dict[str, Any]) -> None:
                              f"{getattr(typ, '__name__', 'number')}")
     if not isinstance(meta["identifier"].get("name"), str):
         raise ValueError(f"{run_dir / 'run.json'}: key 'identifier.name' missing or not a str")
+    # the fields a listing prints: a /1 run (no checksum) whose scenario name held a newline
+    # split its `testbed runs --plain` row in two, a tab added a column, an ESC went to the
+    # terminal and into the report (round 16)
+    for key, value in (("scenario.name", meta["scenario"].get("name", "")),
+                       ("identifier.name", meta["identifier"]["name"])):
+        if not isinstance(value, str) or any(is_control(c) for c in value):
+            raise ValueError(f"{run_dir / 'run.json'}: key {key!r} {value!r} is not one line of "
+                             "text without control characters")
+    seed = meta["scenario"].get("seed", 0)
+    if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
+        raise ValueError(f"{run_dir / 'run.json'}: key 'scenario.seed' {seed!r} is not an "
+                         "integer >= 0")
     for key, typ in _OPTIONAL_META_TYPES.items():
         if key in meta and not isinstance(meta[key], typ):
             raise ValueError(f"{run_dir / 'run.json'}: key {key!r} not a {typ.__name__}")

@@ -117,6 +117,29 @@ def test_a_v1_run_is_read_as_written(saved, tmp_path):
         load_run(run)
 
 
+@pytest.mark.parametrize(("key", "value"), [
+    ("name", "a\nb"), ("name", "x\x1b[31m"), ("seed", "s\tx"), ("seed", -1), ("seed", True),
+    ("identifier", "id\x1b[32m"),
+])
+def test_a_v1_run_whose_listed_fields_are_not_one_line_is_damaged(saved, tmp_path, key, value):
+    from testbed.studies.runstore import DIGEST, NPZ_DIGEST, READ_FORMATS, list_runs, load_run
+
+    # a /1 run (no checksum) whose scenario name held a newline split its `testbed runs
+    # --plain` row in two; a tab added a column, an ESC went raw to the terminal and the report
+    out, run = _copy(saved, tmp_path)
+
+    def edit(m):
+        m.update(format=READ_FORMATS[0])
+        m.pop(DIGEST), m.pop(NPZ_DIGEST)
+        (m["identifier"] if key == "identifier" else m["scenario"])[
+            "name" if key == "identifier" else key] = value
+    _edit_json(run, edit)
+    damaged: list = []
+    assert list_runs(out, damaged=damaged) == [] and damaged == [run]
+    with pytest.raises(ValueError, match="control characters|integer >= 0"):
+        load_run(run)
+
+
 def test_a_v1_runs_figures_name_files_inside_its_folder_only(saved, tmp_path):
     from testbed.studies.runstore import DIGEST, NPZ_DIGEST, READ_FORMATS, load_run
 
