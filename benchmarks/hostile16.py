@@ -171,16 +171,19 @@ def _structural_mutations(chans: list[dict]) -> dict[str, tuple[list[dict], bool
     muts["acc2 a pure sine"] = (edit(setdata("acc2", 50 * np.sin(2 * np.pi * 137.0 * t))), False)
     muts["all channels noise"] = (edit(lambda new: [c.__setitem__("data", rng.normal(size=n).tolist())
                                                     for c in new]), False)
-    muts["responses noise, force kept"] = (edit(lambda new: [c.__setitem__("data", rng.normal(size=n).tolist())
+    muts["responses noise, force kept"] = (
+        edit(lambda new: [c.__setitem__("data", rng.normal(size=n).tolist())
                                                              for c in new if "acc" in c["name"]]), False)
     muts["acc3 a copy of acc1 plus 1e-9 noise"] = (
-        edit(setdata("acc3", np.asarray(_ch(chans, "acc1")["data"]) * (1 + 1e-9 * rng.normal(size=n)))), False)
+        edit(setdata("acc3", np.asarray(_ch(chans, "acc1")["data"])
+                     * (1 + 1e-9 * rng.normal(size=n)))), False)
     muts["acc1 negated copy of acc2"] = (edit(setdata("acc1", -np.asarray(_ch(chans, "acc2")["data"]))), True)
     muts["fs relabelled 1 Hz"] = (edit(lambda new: [c.__setitem__("fs", 1.0) for c in new]), False)
     muts["fs relabelled 1 MHz"] = (edit(lambda new: [c.__setitem__("fs", 1e6) for c in new]), False)
     muts["fs relabelled 100 Hz"] = (edit(lambda new: [c.__setitem__("fs", 100.0) for c in new]), False)
     muts["force negative pulse"] = (edit(setdata("force", -force)), False)
-    muts["record 3 samples long"] = (edit(lambda new: [c.__setitem__("data", c["data"][:3]) for c in new]), False)
+    muts["record 3 samples long"] = (
+        edit(lambda new: [c.__setitem__("data", c["data"][:3]) for c in new]), False)
     return muts
 
 
@@ -225,9 +228,14 @@ def _mechanical_mutations(chans: list[dict], cartpole: bool) -> dict[str, tuple[
                                                  if c["name"].startswith("torque/")]), False)
     muts["inputs zero"] = (edit(lambda new: [c.__setitem__("data", [0.0] * n) for c in new
                                              if c["name"].startswith("torque/")]), False)
-    muts["all noise"] = (edit(lambda new: [c.__setitem__("data", rng.normal(size=n).tolist()) for c in new]), False)
-    muts["rates the angles' copy"] = (edit(lambda new: [c.__setitem__("data", _ch(new, "theta/" + c["name"].split("/d")[-1])["data"])
-                                                        for c in new if c["name"].startswith("dtheta/")]), True)
+    muts["all noise"] = (
+        edit(lambda new: [c.__setitem__("data", rng.normal(size=n).tolist()) for c in new]), False)
+
+    def rates_copied(new):
+        for c in new:
+            if c["name"].startswith("dtheta/"):
+                c["data"] = _ch(new, "theta/" + c["name"].split("/d")[-1])["data"]
+    muts["rates the angles' copy"] = (edit(rates_copied), True)
     muts["fs relabelled 1 Hz"] = (edit(lambda new: [c.__setitem__("fs", 1.0) for c in new]), False)
     muts["fs relabelled 1 MHz"] = (edit(lambda new: [c.__setitem__("fs", 1e6) for c in new]), False)
     muts["20 samples"] = (edit(lambda new: [c.__setitem__("data", c["data"][:20]) for c in new]), False)
@@ -283,7 +291,8 @@ def record_cases(work: Path) -> list[tuple[str, object]]:
         def fn():
             f = work / f"r{abs(hash((label, method))) % 10**9}{suffix}"
             f.write_text(text if text is not None else json.dumps(chans))
-            argv = ["identify", str(f), "--kind", kind, "--method", method, "-o", str(f.with_suffix(".model.json"))]
+            argv = ["identify", str(f), "--kind", kind, "--method", method,
+                    "-o", str(f.with_suffix(".model.json"))]
             for k, v in prior.items():
                 argv += ["--prior", f"{k}={v!r}"]
             for k, v in (params or {}).items():
@@ -345,30 +354,42 @@ def _replace_by_folder(name: str):
     return f
 
 
+def _latest(name: str):
+    def f(run: Path) -> None:
+        (run.parent / "latest.json").write_text(json.dumps({"run": name, "created": "x", "seed": 0}))
+    return f
+
+
 #: name -> (damage to a run folder, whether the damaged run must be refused or left out)
 RUN_DAMAGE = {
     "run.json missing": (lambda r: (r / "run.json").unlink(), True),
     "run.json empty": (lambda r: (r / "run.json").write_text(""), True),
     "run.json a folder": (_replace_by_folder("run.json"), True),
     "run.npz missing": (lambda r: (r / "run.npz").unlink(), True),
-    "run.npz cut in half": (lambda r: (r / "run.npz").write_bytes((r / "run.npz").read_bytes()[:(r / "run.npz").stat().st_size // 2]), True),
+    "run.npz cut in half": (lambda r: (r / "run.npz").write_bytes(
+        (r / "run.npz").read_bytes()[:(r / "run.npz").stat().st_size // 2]), True),
     "run.npz a bit flipped at 10 %": (_flip("run.npz", 0.1), True),
     "run.npz a bit flipped at 50 %": (_flip("run.npz", 0.5), True),
     "run.npz a bit flipped at 90 %": (_flip("run.npz", 0.9), True),
     "run.json a bit flipped at 50 %": (_flip("run.json", 0.5), True),
-    "a score edited with its check": (_edit_json(lambda m: (m["scores"].__setitem__("coef_error", 2.0), [c.__setitem__("value", 2.0) for c in m["checks"] if c["metric"] == "coef_error"])), True),
-    "every bar loosened to 1e9": (_edit_json(lambda m: [c.__setitem__("threshold", 1e9) for c in m["checks"]]), True),
+    "a score edited with its check": (_edit_json(lambda m: (
+        m["scores"].__setitem__("coef_error", 2.0),
+        [c.__setitem__("value", 2.0) for c in m["checks"] if c["metric"] == "coef_error"])), True),
+    "every bar loosened to 1e9": (
+        _edit_json(lambda m: [c.__setitem__("threshold", 1e9) for c in m["checks"]]), True),
     "scenario renamed": (_edit_json(lambda m: m["scenario"].__setitem__("name", "cartpole")), True),
     "seed edited": (_edit_json(lambda m: m["scenario"].__setitem__("seed", 7)), True),
     "seed text with an ESC": (_edit_json(lambda m: m["scenario"].__setitem__("seed", "x\x1b[31m")), True),
     "created a number": (_edit_json(lambda m: m.__setitem__("created", 5)), True),
-    "figures outside the folder": (_edit_json(lambda m: m.__setitem__("figures", ["../../../etc/passwd"])), True),
+    "figures outside the folder": (
+        _edit_json(lambda m: m.__setitem__("figures", ["../../../etc/passwd"])), True),
     "fit_time -1": (_edit_json(lambda m: m.__setitem__("fit_time", -1.0)), True),
-    "a check's bound 'between'": (_edit_json(lambda m: [c.__setitem__("bound", "between") for c in m["checks"]]), True),
+    "a check's bound 'between'": (
+        _edit_json(lambda m: [c.__setitem__("bound", "between") for c in m["checks"]]), True),
     "a figure missing": (lambda r: next(r.glob("*.png")).unlink() if list(r.glob("*.png")) else None, False),
-    "latest.json naming a missing run": (lambda r: (r.parent / "latest.json").write_text('{"run": "nope", "created": "x", "seed": 0}'), False),
-    "latest.json naming ..": (lambda r: (r.parent / "latest.json").write_text('{"run": "..", "created": "x", "seed": 0}'), False),
-    "latest.json naming /etc": (lambda r: (r.parent / "latest.json").write_text('{"run": "/etc", "created": "x", "seed": 0}'), False),
+    "latest.json naming a missing run": (_latest("nope"), False),
+    "latest.json naming ..": (_latest(".."), False),
+    "latest.json naming /etc": (_latest("/etc"), False),
 }
 
 
@@ -451,14 +472,15 @@ def study_cases(work: Path) -> list[tuple[str, object]]:
         ref = work / "fail16.parquet"
         found = []
         for argv in (["sweep", str(s16), "--results", str(ref)],):
-            status, out, err = cli_inprocess(argv)
+            status, _, err = cli_inprocess(argv)
             if status != 2 or "holds rows of study 'fail16'" not in err:
                 found.append(f"sweep of another study's results: status {status}")
         return "; ".join(found) or None
 
     def interrupted_then_two_jobs():
         res, ref = work / "int.parquet", work / "ref.parquet"
-        proc = subprocess.Popen([sys.executable, "-m", "testbed.cli", "sweep", str(s16), "--results", str(res)],
+        proc = subprocess.Popen([sys.executable, "-m", "testbed.cli", "sweep", str(s16),
+                                 "--results", str(res)],
                                 cwd=work, env=_hostile.ENV, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
                                 text=True)
         parts = Path(f"{res}.parts")

@@ -63,7 +63,7 @@ def test_an_edited_run_json_is_refused_as_damaged(saved, tmp_path, edit):
     _edit_json(run, edit)
     damaged: list = []
     assert list_runs(out, damaged=damaged) == [] and damaged == [run]
-    with pytest.raises(ValueError, match="does not match its checksum"):
+    with pytest.raises(ValueError, match=r"does not match its checksum"):
         load_run(run)
 
 
@@ -86,7 +86,7 @@ def test_a_damaged_or_missing_run_npz_is_refused(saved, tmp_path, damage):
         else:
             data = data[: len(data) - 7]
         npz.write_bytes(bytes(data))
-    with pytest.raises(ValueError, match="run.npz"):
+    with pytest.raises(ValueError, match=r"run\.npz"):
         load_run(run)
 
 
@@ -136,14 +136,14 @@ def test_a_v1_run_whose_listed_fields_are_not_one_line_is_damaged(saved, tmp_pat
     _edit_json(run, edit)
     damaged: list = []
     assert list_runs(out, damaged=damaged) == [] and damaged == [run]
-    with pytest.raises(ValueError, match="control characters|integer >= 0"):
+    with pytest.raises(ValueError, match=r"control characters|integer >= 0"):
         load_run(run)
 
 
 def test_a_v1_runs_figures_name_files_inside_its_folder_only(saved, tmp_path):
     from testbed.studies.runstore import DIGEST, NPZ_DIGEST, READ_FORMATS, load_run
 
-    out, run = _copy(saved, tmp_path)
+    _, run = _copy(saved, tmp_path)
     (tmp_path / "x.png").write_bytes(b"\x89PNG")
     (run / "f.png").write_bytes(b"\x89PNG")
     _edit_json(run, lambda m: (m.update(format=READ_FORMATS[0], figures=["../../../x.png", "f.png", 3]),
