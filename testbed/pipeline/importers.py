@@ -470,9 +470,9 @@ RATE_PAIRS = {"mechanical": (("theta", "dtheta"), ("dtheta", "ddtheta")), "dynam
 #: dataset caches the largest misfit is 0.021 (a cart-pole sampled at 100 Hz: the trapezoid
 #: rule's own error; 0.017 for a stiff kinetics member), 24 times below the bound; white noise
 #: of 5 % or 20 % of each channel's RMS on every signal and rate gives 0.05 or 0.20 (measured on
-#: the shipped five-bar, cart-pole and kinetics records).  A rate in other units (rad/s beside an angle in
-#: degrees, 57x) leaves 0.98 of the motion, a rate that is not the signal's (a copy of the
-#: angle, its negative) 1 or more.
+#: the shipped five-bar, cart-pole and kinetics records).  A rate in other units (rad/s beside
+#: an angle in degrees, 57x) leaves 0.98 of the motion, a rate that is not the signal's (a copy
+#: of the angle, its negative) 1 or more.
 RATE_MISFIT_MAX = 0.5
 
 
