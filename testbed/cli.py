@@ -773,7 +773,7 @@ def cmd_runs(args: argparse.Namespace) -> int:
     damaged: list[Path] = []
     runs = list_runs(args.out, scenario=args.scenario, damaged=damaged)
     if damaged:  # left out of the table, but never silently
-        print(f"warning: {len(damaged)} run folder(s) left out, their run.json is damaged or of "
+        print(f"warning: {len(damaged)} run folder(s) left out, their run.json is damaged, missing or of "
               f"another format: {', '.join(map(str, damaged))}", file=sys.stderr)
     cols = ("scenario", "seed", "time (UTC)", "identifier", "verdict", "path")
     rows = [(r["scenario"], str(r["seed"]), r["created"].replace("+00:00", "Z"), r["identifier"],

@@ -6,6 +6,8 @@ Layout of a run folder::
                  scores, failures {aspect: reason}, checks, verdict ("pass", "FAIL" or
                  "no verdict"), passed, fit_time [s], dataset {fs, n_samples, signals,
                  prior, hash}, truth_units, rig_units, versions, commit, created, figures
+                 (format ``/2`` on: sha256 of the rest of run.json, npz_sha256 of run.npz;
+                 checked on read, so a flipped bit or an edited value is refused as damaged)
     run.npz      details/<name>  arrays behind the scores (TRAC, MAC, simulated signals ...)
                  model/<name>    identified arrays (M_, C_, K_, K3_, coef_, ...)
                  history/<name>  per-epoch training history (flattened with "/")
@@ -46,6 +48,7 @@ import contextlib
 import ctypes
 import datetime as _dt
 import errno
+import hashlib
 import json
 import math
 import os
@@ -65,12 +68,19 @@ except ImportError:  # Windows
     fcntl = None  # type: ignore[assignment]
 
 from testbed.core.atomic import atomic_write_text, begin_in_flight, end_in_flight, no_room
-from testbed.core.errors import TestbedError
+from testbed.core.errors import TestbedError, is_control
 from testbed.core.provenance import git_commit, versions
 from testbed.pipeline.plugins import RIGS
 from testbed.scoring.scorers import PASS, Check, verdict
 
-FORMAT = "sysid-testbed-run/1"
+FORMAT = "sysid-testbed-run/2"
+#: Formats :func:`load_run` and :func:`list_runs` read: ``/1`` is ``/2`` without the checksums
+#: (runs written before them are read as they were written).
+READ_FORMATS = ("sysid-testbed-run/1", FORMAT)
+#: Key of ``run.json`` holding the SHA-256 of its other keys (:func:`meta_digest`).
+DIGEST = "sha256"
+#: Key of ``run.json`` holding the SHA-256 of ``run.npz``'s bytes.
+NPZ_DIGEST = "npz_sha256"
 #: Truth arrays larger than this many elements are not copied into the run.
 MAX_TRUTH_SIZE = 1_000_000
 
@@ -204,7 +214,11 @@ class SavedRun:
 
     @property
     def figures(self) -> list[Path]:
-        return [self.path / f for f in self.meta.get("figures", []) if (self.path / f).is_file()]
+        # plain file names only: a /1 run.json (no checksum) listing "../../x.png" named a
+        # file outside its folder (round 16)
+        return [self.path / f for f in self.meta.get("figures", [])
+                if isinstance(f, str) and f and f == Path(f).name and not f.startswith(".")
+                and (self.path / f).is_file()]
 
 
 def _num(v: Any) -> float:
@@ -343,8 +357,37 @@ def build_arrays(result: Any) -> dict[str, np.ndarray]:
     return arrays
 
 
+def meta_digest(meta: dict[str, Any]) -> str:
+    """The SHA-256 (64 hex digits) of ``run.json``'s content but its :data:`DIGEST`, as canonical
+    JSON (keys sorted, ASCII): what a run of format ``/2`` stores under :data:`DIGEST`."""
+    canon = {k: v for k, v in meta.items() if k != DIGEST}
+    text = json.dumps(canon, sort_keys=True, ensure_ascii=True, allow_nan=True, default=repr)
+    return hashlib.sha256(text.encode("ascii")).hexdigest()
+
+
 def _write_json(path: Path, obj: dict[str, Any]) -> None:
+    """Write ``run.json``, sealed with its :data:`DIGEST` (``obj`` gains it)."""
+    obj[DIGEST] = meta_digest(obj)
     path.write_text(json.dumps(obj, indent=2, sort_keys=False, allow_nan=False) + "\n")
+
+
+def _verify_meta(run_dir: Path, meta: dict[str, Any]) -> None:
+    """Raise ValueError if a run of :data:`FORMAT` lacks its checksum or its content does not
+    match it (round 16: a flipped digit of a score, a threshold loosened to 1e9, a seed or a
+    scenario name edited in ``run.json`` were listed and reported as the run's own)."""
+    if meta.get("format") != FORMAT:
+        return  # a /1 run has no checksums: read as it was written
+    if meta.get(DIGEST) != meta_digest(meta):
+        raise ValueError(f"{run_dir / 'run.json'}: its content does not match its checksum "
+                         f"({DIGEST!r}): damaged or edited after the run wrote it")
+
+
+def _file_digest(path: Path) -> str:
+    h = hashlib.sha256()
+    with open(path, "rb") as f:
+        for block in iter(lambda: f.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
 
 
 def save_run(result: Any, run_dir: str | os.PathLike,
@@ -403,6 +446,8 @@ def _write_temporary(result: Any, parent: Path, stem: str,
         meta = build_meta(result)
         _write_json(tmp / "run.json", meta)
         np.savez_compressed(tmp / "run.npz", **build_arrays(result))
+        meta[NPZ_DIGEST] = _file_digest(tmp / "run.npz")
+        _write_json(tmp / "run.json", meta)
         if figures is not None:
             paths = figures(load_run(tmp), tmp)
             meta["figures"] = [p.name for p in paths]
@@ -669,6 +714,18 @@ def _check_meta(run_dir: Path, meta: dict[str, Any]) -> None:
                              f"{getattr(typ, '__name__', 'number')}")
     if not isinstance(meta["identifier"].get("name"), str):
         raise ValueError(f"{run_dir / 'run.json'}: key 'identifier.name' missing or not a str")
+    # the fields a listing prints: a /1 run (no checksum) whose scenario name held a newline
+    # split its `testbed runs --plain` row in two, a tab added a column, an ESC went to the
+    # terminal and into the report (round 16)
+    for key, value in (("scenario.name", meta["scenario"].get("name", "")),
+                       ("identifier.name", meta["identifier"]["name"])):
+        if not isinstance(value, str) or any(is_control(c) for c in value):
+            raise ValueError(f"{run_dir / 'run.json'}: key {key!r} {value!r} is not one line of "
+                             "text without control characters")
+    seed = meta["scenario"].get("seed", 0)
+    if isinstance(seed, bool) or not isinstance(seed, int) or seed < 0:
+        raise ValueError(f"{run_dir / 'run.json'}: key 'scenario.seed' {seed!r} is not an "
+                         "integer >= 0")
     for key, typ in _OPTIONAL_META_TYPES.items():
         if key in meta and not isinstance(meta[key], typ):
             raise ValueError(f"{run_dir / 'run.json'}: key {key!r} not a {typ.__name__}")
@@ -702,17 +759,27 @@ def load_run(run_dir: str | os.PathLike) -> SavedRun:
     FileNotFoundError
         If the folder has no ``run.json``.
     ValueError
-        If ``run.json`` is not a run of this format, or lacks a key a run has.
+        If ``run.json`` is not a run of a format it reads (:data:`READ_FORMATS`), lacks a key a
+        run has, or (format ``/2``) does not match its checksum, or ``run.npz`` is missing or
+        does not match its own.
     """
     run_dir = Path(run_dir)
     meta = json.loads((run_dir / "run.json").read_text())
-    if not isinstance(meta, dict) or meta.get("format") != FORMAT:
+    if not isinstance(meta, dict) or meta.get("format") not in READ_FORMATS:
         fmt = meta.get("format") if isinstance(meta, dict) else None
         raise ValueError(f"{run_dir}: not a {FORMAT} folder (format={fmt!r})")
     _check_meta(run_dir, meta)
+    _verify_meta(run_dir, meta)
     arrays: dict[str, np.ndarray] = {}
-    if (run_dir / "run.npz").is_file():
-        with np.load(run_dir / "run.npz", allow_pickle=False) as z:
+    npz = run_dir / "run.npz"
+    if meta["format"] == FORMAT:  # its arrays are part of the run: missing or changed, refused
+        if not npz.is_file():
+            raise ValueError(f"{npz}: missing (or not a file); the run wrote it")
+        if _file_digest(npz) != meta.get(NPZ_DIGEST):
+            raise ValueError(f"{npz}: its bytes do not match the checksum in run.json "
+                             f"({NPZ_DIGEST!r}): damaged or replaced after the run wrote it")
+    if npz.is_file():
+        with np.load(npz, allow_pickle=False) as z:
             arrays = {k: z[k] for k in z.files}
     model = _unflatten(arrays, "model")
     model.update(meta.get("model_lists", {}))
@@ -744,12 +811,22 @@ def _read_row(p: Path) -> dict[str, Any] | None:
         return None
     try:
         meta = json.loads((p / "run.json").read_text())
-        if meta.get("format") != FORMAT:
+        if meta.get("format") not in READ_FORMATS:
             return None
         _check_meta(p, meta)  # as load_run: a damaged or edited file is named, not listed
+        _verify_meta(p, meta)
+        if meta["format"] == FORMAT and not (p / "run.npz").is_file():
+            return None  # its arrays lost: `testbed report` could not read it
         return _run_row(p, meta)
     except (OSError, ValueError, TypeError, AttributeError):
         return None
+
+
+def _lost_run_json(p: Path) -> bool:
+    """A real folder holding a run's ``run.npz`` but no ``run.json`` file (deleted, or a folder
+    in its place): a damaged run, which the listing left out in silence (round 16)."""
+    return (p.is_dir() and not p.is_symlink() and (p / "run.npz").is_file()
+            and not (p / "run.json").is_file())
 
 
 def _runs_in(folder: Path, damaged: list[Path] | None = None) -> list[dict[str, Any]]:
@@ -763,7 +840,7 @@ def _runs_in(folder: Path, damaged: list[Path] | None = None) -> list[dict[str, 
         row = _read_row(c)
         if row is not None:
             rows.append(row)
-        elif damaged is not None and _is_run_folder(c):
+        elif damaged is not None and (_is_run_folder(c) or _lost_run_json(c)):
             damaged.append(c)
     return rows
 
@@ -784,8 +861,9 @@ def list_runs(out_dir: str | os.PathLike, scenario: str | None = None, *,
         Only the runs of this scenario.
     damaged : list of Path, optional
         If given, the run folders left out because their ``run.json`` cannot be read, is not
-        JSON or is of another format (damaged, truncated or foreign) are appended to it, in
-        folder order, whatever their scenario.
+        JSON, is of another format, does not match its checksum or is missing beside a
+        ``run.npz`` (damaged, truncated, edited or foreign), or whose ``run.npz`` is missing,
+        are appended to it, in folder order, whatever their scenario.
 
     Returns
     -------

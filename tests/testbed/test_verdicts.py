@@ -371,7 +371,7 @@ def test_a_stored_score_edited_under_its_check_is_not_a_pass(tmp_path, edit, ver
     # unchanged check was listed by `testbed runs` and reported "pass"
     import json
 
-    from testbed.studies.runstore import list_runs, save_new_run
+    from testbed.studies.runstore import DIGEST, NPZ_DIGEST, READ_FORMATS, list_runs, save_new_run
 
     path = save_new_run(_synthetic().structural_result(n_samples=200), tmp_path)
     meta = json.loads((path / "run.json").read_text())
@@ -381,6 +381,9 @@ def test_a_stored_score_edited_under_its_check_is_not_a_pass(tmp_path, edit, ver
         del scores["trac"]
     elif edit != "none":
         scores["trac"] = {"nan": None, "inf": "-inf", "worse": 0.5}[edit]
+    # a run of format /1 (no checksums, read as written); a /2 run so edited is refused
+    meta.update(format=READ_FORMATS[0])
+    meta.pop(DIGEST), meta.pop(NPZ_DIGEST)
     meta.update(scores=scores, checks=[check], verdict="pass", passed=True, failures={})
     (path / "run.json").write_text(json.dumps(meta))
     (row,) = list_runs(tmp_path)
