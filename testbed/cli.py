@@ -743,7 +743,7 @@ def cmd_identify(args: argparse.Namespace) -> int:
                                format=args.format, fs=args.fs, units=units,
                                prior=_key_values(args.prior, "--prior", numbers=True), phase=phase)
     summary = result.summary()
-    failures = fitted_model_failures(result.model)
+    failures = fitted_model_failures(result.model, summary.get("r2"))
     if failures is not None:
         summary["physical_failures"] = failures
     text = json.dumps(summary, indent=1, allow_nan=True) + "\n"
@@ -753,7 +753,8 @@ def cmd_identify(args: argparse.Namespace) -> int:
     print(report, end="")
     print(f"model written to {terminal_safe(str(out))} (report {terminal_safe(str(out.with_suffix('.md')))})")
     if failures:
-        what = "unusable model" if "coefficients" in failures else "physically impossible model"
+        what = ("unusable model" if set(failures) <= {"coefficients", "prediction"}
+                else "physically impossible model")
         print(f"FAIL: {what}: {'; '.join(failures.values())}")
         return EXIT_FAIL
     return 0

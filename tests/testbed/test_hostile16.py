@@ -194,7 +194,7 @@ def test_a_wrapped_angle_is_refused_naming_its_channel_and_step(tmp_path, wrappe
         measurement_from_file(f, "mechanical", {"derivatives": "lowpass"})
 
 
-@pytest.mark.parametrize("edit", ["none", "degrees", "copy", "negated"])
+@pytest.mark.parametrize("edit", ["none", "degrees", "copy", "negated", "biased", "spinning degrees"])
 def test_a_recorded_rate_that_is_not_its_signals_is_refused(tmp_path, edit):
     import math
 
@@ -213,6 +213,11 @@ def test_a_recorded_rate_that_is_not_its_signals_is_refused(tmp_path, edit):
         th = th * 180 / math.pi
     elif edit == "copy":
         dth = th.copy()
+    elif edit == "biased":  # a gyroscope's offset, 15 % of the rate's RMS: a linear drift of its
+        dth = dth + 0.15 * np.sqrt(np.mean(dth ** 2))  # integral (0.75 of the motion: refused before)
+    elif edit == "spinning degrees":  # a link turning at 0.5 rev/s, logged in degrees under "rad":
+        th, dth = 2 * np.pi * 0.5 * t + th, 2 * np.pi * 0.5 + dth  # only an offset shows it
+        th = th * 180 / math.pi
     if edit == "negated":  # the dynamical kind's (x, dx)
         f = _sep005(tmp_path / "k.json", {"x/x": ("mM", (1.5 + th).tolist(), 1),
                                           "dx/dx": ("mM/s", (-dth).tolist(), 1)})
@@ -223,9 +228,12 @@ def test_a_recorded_rate_that_is_not_its_signals_is_refused(tmp_path, edit):
                                       "dtheta/dx": ("m/s", dx.tolist(), 1),
                                       "dtheta/dth": ("rad/s", dth.tolist(), 2),
                                       "torque/u1": ("N", np.sin(1.1 * w * t).tolist(), 1)})
-    if edit == "none":
+    if edit in ("none", "biased"):
         assert measurement_from_file(f, "mechanical", {"derivatives": "lowpass"}).x.shape == (2, n)
         return
+    what = "misses"
+    if edit == "spinning degrees":
+        what = r"drifts .* as if the rate were offset by 5\d\.\d of its RMS; expected at most 0.25"
     with pytest.raises(MeasuredDataError, match=r"'dtheta' channel 'dth' is not the rate of 'theta' "
-                                                r"channel 'th': its running integral misses"):
+                                                r"channel 'th': its running integral " + what):
         measurement_from_file(f, "mechanical", {"derivatives": "lowpass"})

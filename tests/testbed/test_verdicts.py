@@ -350,6 +350,23 @@ def test_an_identified_model_with_nan_coefficients_fails_testbed_identify():
     assert identified_failures(nan_m)  # NaN matrices fail the physical checks
 
 
+@pytest.mark.parametrize(("r2", "fails"), [(-0.01, True), (-4.7e5, True), (math.nan, True),
+                                           (0.0, False), (0.965, False), (None, False)])
+def test_testbed_identify_fails_a_model_that_predicts_worse_than_the_mean(r2, fails):
+    # round 16: `testbed identify` exited 0 on models of pure noise and of 40-80 samples after
+    # the pulse whose truth-free R^2 was -0.01 to -4.7e5 (worse than each channel's mean)
+    from types import SimpleNamespace as Model
+
+    from testbed.scoring.scorers import fitted_model_failures as identified_failures
+
+    one = np.array([[1.0]])
+    out = identified_failures(Model(M_=one, C_=0.1 * one, K_=one), r2)
+    assert ("prediction" in out) is fails
+    assert set(out) <= {"prediction"}  # the model itself is physical
+    eq = identified_failures(Model(coef_=np.array([[0.18, -0.9, 1.0]])), r2)
+    assert ("prediction" in eq) is fails
+
+
 # ---------------------------------------------------------------- stored runs (input audit round 4)
 def _synthetic():
     """tests/testbed/_synthetic_runs.py (imported as test_runstore and test_faults do)."""
