@@ -114,7 +114,7 @@ def _warm_up() -> None:
     # into memory: saved to os.devnull through the atomic write, the PNG replaced /dev/null
     # itself with a regular file when run as root (round 13)
     with mpl.rc_context(figs.STYLE):
-        fig.savefig(io.BytesIO(), format="png", pil_kwargs={"compress_level": 3})
+        fig.savefig(io.BytesIO(), format="png", pil_kwargs={"compress_level": figs.PNG_COMPRESS_LEVEL})
 
 
 def prepare_frames(folder: str | os.PathLike) -> int:

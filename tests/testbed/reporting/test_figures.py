@@ -275,3 +275,32 @@ def test_recorded_inputs_come_from_the_dataset_cache(tmp_path):
     np.testing.assert_array_equal(data, result.dataset.measured["torques"].data)
     fig = figures.run_figures(run, inputs=(data, names, unit))["joint_angles"]
     assert [a.get_ylabel() for a in fig.axes if a.lines][-1] == "torque [N m]"
+
+
+def _zlib_level(png: bytes) -> int:
+    """FLEVEL of the zlib stream of a PNG's first IDAT chunk (0: the fastest, levels 0-1;
+    1: levels 2-5; 2: level 6; 3: levels 7-9), from its header's FLG byte."""
+    i = png.index(b"IDAT")
+    return png[i + 5] >> 6
+
+
+def test_pngs_are_encoded_fast_and_hold_the_same_pixels(runs, tmp_path):
+    """The run figures' PNGs are written at zlib's fastest level, with every pixel equal to
+    matplotlib's default encoding of the same figure (PNG is lossless: only the bytes differ).
+    One run's figures: the encoder does not look at what is drawn."""
+    import matplotlib as mpl
+    from PIL import Image
+
+    drawn = []
+    for kind, run in list(runs.items())[:1]:
+        for stem, fig in figures.run_figures(run, only=("reconstruction", "matrices")).items():
+            ours = figures.save_figure(fig, tmp_path / f"{kind}-{stem}.png")
+            ref = tmp_path / f"{kind}-{stem}-default.png"
+            with mpl.rc_context(figures.STYLE):  # as save_figure draws (unhinted text)
+                fig.savefig(ref, format="png")
+            assert _zlib_level(ours.read_bytes()) == 0 and _zlib_level(ref.read_bytes()) == 2
+            drawn.append(stem)
+            with Image.open(ours) as a, Image.open(ref) as b:
+                assert a.mode == b.mode and a.size == b.size, stem
+                assert np.array_equal(np.asarray(a), np.asarray(b)), f"{kind} {stem}"
+    assert drawn == ["reconstruction", "matrices"]
