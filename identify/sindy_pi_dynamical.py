@@ -75,8 +75,7 @@ pass the record's own noise test: where its terms' noise residual ratio
 refutes it and its support leaves the selection (:func:`select_equations`).  Measured on that
 cell: 8.6e14 against the law's 0.  Where the best is itself far above the noise the tie stands
 (round 14's ``mm14_km0p05_vmax10`` clean: the law 3.9e15 against a 5-term model's 1.3e15, both
-limited by the record's simulation error, not its digits; refuting there lost the cell).  The
-strong form is left as it was (the ratio leaves out the chain's
+limited by the record's simulation error, not its digits; refuting there lost the cell).  The strong form is left as it was (the ratio leaves out the chain's
 derivative noise there, as in the prune rule).
 
 Simulation: at each RK4 stage the identified equations ``A(x, u) dx + b(x, u) = 0`` are solved
@@ -397,8 +396,7 @@ def select_equations(sw: Sweep, lib: ImplicitTerms, deriv_cols: list[np.ndarray]
 
     The exact tie (``refute``): a model ranked first only through the absolute tolerance
     ``atol`` (its held-out error above ``best * (1 + rtol)``, the best being the first model of
-    the ranking within that relative tolerance, and its support not the best's) is put to
-    ``refute(k, model, best)``; if that
+    the ranking within that relative tolerance, and its support not the best's) is put to ``refute(k, model, best)``; if that
     says the record refutes it, every model of its support leaves the eligible set and the
     ranking is redone.  The identifier's rule (:meth:`SINDyPIDynamical._refutes_tie`) is the
     record's own noise test; ``None`` keeps every tie.
@@ -429,8 +427,7 @@ def select_equations(sw: Sweep, lib: ImplicitTerms, deriv_cols: list[np.ndarray]
             if within[0]:
                 break
             tb, cb = np.unravel_index(order[int(np.argmax(within))], sw.val_error.shape)
-            if (np.array_equal(support[t, c], support[tb, cb])
-                    or not refute(k, (int(t), int(c)), (int(tb), int(cb)))):
+            if np.array_equal(support[t, c], support[tb, cb]) or not refute(k, (int(t), int(c)), (int(tb), int(cb))):
                 break
             elig = elig & ~np.all(support == support[t, c], axis=-1)
         out.append((int(t), int(c)))
@@ -788,8 +785,7 @@ class SINDyPIDynamical(Identifier):
         ``w_best`` give the supports) exceeds :data:`NOISE_PRUNE_RATIO` while the best model's
         is at most that (the test can refute only where it accepts the best: where the best
         too is far above the noise, the record's digits are not what limits the fit, e.g. the
-        simulation's own error, and the tie stands).  A NaN ratio refutes nothing.  Appends to
-        ``exact_tie_[k]`` and the notes of
+        simulation's own error, and the tie stands).  A NaN ratio refutes nothing.  Appends to ``exact_tie_[k]`` and the notes of
         ``exact_tie_rule_``."""
         names_m = [lib.names[j] for j in np.flatnonzero(w_model)]
         names_b = [lib.names[j] for j in np.flatnonzero(w_best)]
