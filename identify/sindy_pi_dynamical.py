@@ -70,12 +70,10 @@ above Km (round 16's ``mm16_x0_30``, x 30 -> 26.4 mM) the 3-term ``0.90 x + 0.51
 holds to a held-out 6.1e-14 against the law's 5.1e-16 (round-off) and won by fewer terms.  So a
 model ranked first only by that absolute tie (its error above the best's x (1 + rtol)) must
 pass the record's own noise test: where its terms' noise residual ratio
-(:func:`identify._determinacy.noise_residual_ratio`, the prune rule's statistic) exceeds
-:data:`NOISE_PRUNE_RATIO` while the best model's terms' ratio is at most that, the record
-refutes it and its support leaves the selection (:func:`select_equations`).  Measured on that
-cell: 8.6e14 against the law's 0.  Where the best is itself far above the noise the tie stands
-(round 14's ``mm14_km0p05_vmax10`` clean: the law 3.9e15 against a 5-term model's 1.3e15, both
-limited by the record's simulation error, not its digits; refuting there lost the cell).  The strong form is left as it was (the ratio leaves out the chain's
+(:func:`identify._determinacy.noise_residual_ratio`, the prune rule's statistic) exceeds both
+:data:`NOISE_PRUNE_RATIO` and the best model's terms' ratio, the record refutes it and its
+support leaves the selection (:func:`select_equations`).  Measured on that cell: 8.6e14
+against the law's 0.  The strong form is left as it was (the ratio leaves out the chain's
 derivative noise there, as in the prune rule).
 
 Simulation: at each RK4 stage the identified equations ``A(x, u) dx + b(x, u) = 0`` are solved
@@ -677,7 +675,7 @@ class SINDyPIDynamical(Identifier):
             (f"weak form, noise std {', '.join(f'{v:.3g}' for v in sigma)}: a model ranked first "
              f"only by selection_atol {self.selection_atol:g} (held-out error above the best's "
              f"x (1 + {self.selection_rtol:g})) is refuted where its terms' noise residual ratio "
-             f"exceeds {NOISE_PRUNE_RATIO:g} while the best model's terms' ratio is at most that "
+             f"exceeds {NOISE_PRUNE_RATIO:g} and the best model's terms' ratio "
              f"({'; '.join(self._tie_notes) or 'no model ranked first by the tie alone'})")
             if tie_rule else
             ("not applied: " + ("strong form (the chain's derivative noise is not in the noise "
@@ -782,17 +780,15 @@ class SINDyPIDynamical(Identifier):
         """Whether the record refutes a model the parsimony rule's absolute tie ranked first
         (the exact tie, module docstring): its terms' noise residual ratio
         (:func:`identify._determinacy.noise_residual_ratio`, shape (p,) rows ``w_model`` and
-        ``w_best`` give the supports) exceeds :data:`NOISE_PRUNE_RATIO` while the best model's
-        is at most that (the test can refute only where it accepts the best: where the best
-        too is far above the noise, the record's digits are not what limits the fit, e.g. the
-        simulation's own error, and the tie stands).  A NaN ratio refutes nothing.  Appends to ``exact_tie_[k]`` and the notes of
+        ``w_best`` give the supports) exceeds both :data:`NOISE_PRUNE_RATIO` and the best
+        model's.  A NaN ratio refutes nothing.  Appends to ``exact_tie_[k]`` and the notes of
         ``exact_tie_rule_``."""
         names_m = [lib.names[j] for j in np.flatnonzero(w_model)]
         names_b = [lib.names[j] for j in np.flatnonzero(w_best)]
         with np.errstate(over="ignore", invalid="ignore"):
             r_m = noise_residual_ratio(self._rows_of(names_m, lib, xd, u, fs), x, sigma)[0]
             r_b = noise_residual_ratio(self._rows_of(names_b, lib, xd, u, fs), x, sigma)[0]
-        out = bool(r_b <= NOISE_PRUNE_RATIO < r_m)  # False for a NaN on either side
+        out = bool(r_m > NOISE_PRUNE_RATIO and r_m > r_b)  # False for a NaN on either side
         terms = " + ".join(names_m)
         self._tie_notes.append(f"{lib.states[k]}: {terms} {r_m:.3g} against "
                                f"{' + '.join(names_b)} {r_b:.3g}: "
