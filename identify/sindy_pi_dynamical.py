@@ -63,19 +63,6 @@ Km at 2-3 % the ``Km dx`` term goes too (0.30-1.16: the noise hides Km there).  
 member on 92 kinetics cells of rounds 5-10 and the shipped noisy setup: 39 -> 54 passes, none
 lost (``benchmarks/unseen/round10/noise_prune_members.tsv``).
 
-The exact tie (``exact_tie_``, ``exact_tie_rule_``; weak form with a noise level only): the
-parsimony rule counts a held-out error within ``selection_atol`` (1e-12) of the best as equal,
-an absolute tolerance whose meaning depends on the record.  On a clean record saturated far
-above Km (round 16's ``mm16_x0_30``, x 30 -> 26.4 mM) the 3-term ``0.90 x + 0.51 dx + x dx = 0``
-holds to a held-out 6.1e-14 against the law's 5.1e-16 (round-off) and won by fewer terms.  So a
-model ranked first only by that absolute tie (its error above the best's x (1 + rtol)) must
-pass the record's own noise test: where its terms' noise residual ratio
-(:func:`identify._determinacy.noise_residual_ratio`, the prune rule's statistic) exceeds both
-:data:`NOISE_PRUNE_RATIO` and the best model's terms' ratio, the record refutes it and its
-support leaves the selection (:func:`select_equations`).  Measured on that cell: 8.6e14
-against the law's 0.  The strong form is left as it was (the ratio leaves out the chain's
-derivative noise there, as in the prune rule).
-
 Simulation: at each RK4 stage the identified equations ``A(x, u) dx + b(x, u) = 0`` are solved
 for ``dx``; an (almost) singular ``A`` raises :class:`~testbed.core.errors.DivergenceError`.
 """
@@ -380,8 +367,7 @@ def reduce_common_factors(sw: Sweep, lib: ImplicitTerms, G_train: np.ndarray,
 
 
 def select_equations(sw: Sweep, lib: ImplicitTerms, deriv_cols: list[np.ndarray], rtol: float,
-                     atol: float, refute: Callable[[int, tuple[int, int], tuple[int, int]], bool]
-                     | None = None) -> list[tuple[int, int]]:
+                     atol: float) -> list[tuple[int, int]]:
     """The (threshold, candidate) model of each state's equation.
 
     Eligible for state k: models whose ``d<state k>`` terms carry a larger normalised
@@ -392,13 +378,6 @@ def select_equations(sw: Sweep, lib: ImplicitTerms, deriv_cols: list[np.ndarray]
     :func:`identify._implicit.rank_models` (held-out error, then fewest terms within
     tolerance, then the declared tie rule).
 
-    The exact tie (``refute``): a model ranked first only through the absolute tolerance
-    ``atol`` (its held-out error above ``best * (1 + rtol)``, the best being the first model of
-    the ranking within that relative tolerance, and its support not the best's) is put to ``refute(k, model, best)``; if that
-    says the record refutes it, every model of its support leaves the eligible set and the
-    ranking is redone.  The identifier's rule (:meth:`SINDyPIDynamical._refutes_tie`) is the
-    record's own noise test; ``None`` keeps every tie.
-
     Raises
     ------
     IdentificationError
@@ -406,28 +385,15 @@ def select_equations(sw: Sweep, lib: ImplicitTerms, deriv_cols: list[np.ndarray]
     """
     shares = input_shares(sw.W, deriv_cols)
     reducible = common_factor(sw.W, lib)
-    support = sw.W != 0
     out = []
     for k in range(len(deriv_cols)):
         others = np.delete(shares, k, axis=0)
         other = others.max(axis=0) if others.size else np.zeros_like(shares[k])
-        elig = (shares[k] > 0) & (shares[k] > other) & ~reducible
-        while True:
-            order = rank_models(sw, elig, rtol, atol)
-            if order.size == 0:
-                raise IdentificationError(f"no implicit model is dominated by the derivative of "
-                                          f"state {lib.states[k]!r} without a common factor")
-            t, c = np.unravel_index(order[0], sw.val_error.shape)
-            if refute is None:
-                break
-            errs = sw.val_error.ravel()[order]
-            within = errs <= errs.min() * (1.0 + rtol)
-            if within[0]:
-                break
-            tb, cb = np.unravel_index(order[int(np.argmax(within))], sw.val_error.shape)
-            if np.array_equal(support[t, c], support[tb, cb]) or not refute(k, (int(t), int(c)), (int(tb), int(cb))):
-                break
-            elig = elig & ~np.all(support == support[t, c], axis=-1)
+        order = rank_models(sw, (shares[k] > 0) & (shares[k] > other) & ~reducible, rtol, atol)
+        if order.size == 0:
+            raise IdentificationError(f"no implicit model is dominated by the derivative of state "
+                                      f"{lib.states[k]!r} without a common factor")
+        t, c = np.unravel_index(order[0], sw.val_error.shape)
         out.append((int(t), int(c)))
     return out
 
@@ -486,10 +452,6 @@ class SINDyPIDynamical(Identifier):
     noise_prune_ : list of list of str
         Terms dropped from each state's selected equation as indistinguishable from the noise
         (module docstring); ``noise_prune_rule_`` states the rule and the ratios.
-    exact_tie_ : list of list of str
-        Per state, the models (their terms joined by ``+``) that the parsimony rule's absolute
-        tie ranked first and the record's noise test refuted (module docstring, "The exact
-        tie"); ``exact_tie_rule_`` states the rule and the ratios.
     determinacy_ : ndarray, shape (n_states,)
         Each selected equation's noise Gram over its gap at noise of that level
         (:func:`identify._determinacy.determinacy_bound`) [-]: 0 noise-free; at 1 or more the
@@ -660,27 +622,7 @@ class SINDyPIDynamical(Identifier):
                 raise IdentificationError(f"the library holds no term with d{data.channels[k]}: "
                                           f"no equation of state {data.channels[k]!r} can be "
                                           "selected")
-        sigma = self._noise_level(data, x)
-        self.exact_tie_ = [[] for _ in range(n_states)]
-        self._tie_notes: list[str] = []
-        tie_rule = (self.formulation == "weak" and bool(np.all(np.isfinite(sigma)))
-                    and bool(np.any(sigma > 0.0)))
-
-        def refute(k: int, model: tuple[int, int], best: tuple[int, int]) -> bool:
-            return self._refutes_tie(k, sw.W[model], sw.W[best], lib, x, xd, u, data.fs, sigma)
-
-        picked = select_equations(sw, lib, deriv_cols, self.selection_rtol, self.selection_atol,
-                                  refute if tie_rule else None)
-        self.exact_tie_rule_ = (
-            (f"weak form, noise std {', '.join(f'{v:.3g}' for v in sigma)}: a model ranked first "
-             f"only by selection_atol {self.selection_atol:g} (held-out error above the best's "
-             f"x (1 + {self.selection_rtol:g})) is refuted where its terms' noise residual ratio "
-             f"exceeds {NOISE_PRUNE_RATIO:g} and the best model's terms' ratio "
-             f"({'; '.join(self._tie_notes) or 'no model ranked first by the tie alone'})")
-            if tie_rule else
-            ("not applied: " + ("strong form (the chain's derivative noise is not in the noise "
-                                "residual ratio)" if self.formulation != "weak"
-                                else "no noise level")))
+        picked = select_equations(sw, lib, deriv_cols, self.selection_rtol, self.selection_atol)
         self.coef_ = np.stack([sw.coef(t, c) for t, c in picked])
         self.val_error_ = np.array([sw.val_error[t, c] for t, c in picked])
         self.feature_names_ = list(lib.names)
@@ -773,29 +715,6 @@ class SINDyPIDynamical(Identifier):
             f"{how} for "
             f"{', '.join(done) or 'no state'}: where determinacy_ < 1; the others keep the "
             "sweep's least squares (determinacy_ >= 1: not determined; 0: noise-free, exact)")
-
-    def _refutes_tie(self, k: int, w_model: np.ndarray, w_best: np.ndarray, lib: ImplicitTerms,
-                     x: np.ndarray, xd: np.ndarray, u: np.ndarray | None, fs: float,
-                     sigma: np.ndarray) -> bool:
-        """Whether the record refutes a model the parsimony rule's absolute tie ranked first
-        (the exact tie, module docstring): its terms' noise residual ratio
-        (:func:`identify._determinacy.noise_residual_ratio`, shape (p,) rows ``w_model`` and
-        ``w_best`` give the supports) exceeds both :data:`NOISE_PRUNE_RATIO` and the best
-        model's.  A NaN ratio refutes nothing.  Appends to ``exact_tie_[k]`` and the notes of
-        ``exact_tie_rule_``."""
-        names_m = [lib.names[j] for j in np.flatnonzero(w_model)]
-        names_b = [lib.names[j] for j in np.flatnonzero(w_best)]
-        with np.errstate(over="ignore", invalid="ignore"):
-            r_m = noise_residual_ratio(self._rows_of(names_m, lib, xd, u, fs), x, sigma)[0]
-            r_b = noise_residual_ratio(self._rows_of(names_b, lib, xd, u, fs), x, sigma)[0]
-        out = bool(r_m > NOISE_PRUNE_RATIO and r_m > r_b)  # False for a NaN on either side
-        terms = " + ".join(names_m)
-        self._tie_notes.append(f"{lib.states[k]}: {terms} {r_m:.3g} against "
-                               f"{' + '.join(names_b)} {r_b:.3g}: "
-                               + ("refuted" if out else "kept"))
-        if out:
-            self.exact_tie_[k].append(terms)
-        return out
 
     @staticmethod
     def _noise_level(data: Measurement, x: np.ndarray) -> np.ndarray:
