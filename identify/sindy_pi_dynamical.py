@@ -494,8 +494,9 @@ class SINDyPIDynamical(Identifier):
         (module docstring); ``noise_prune_rule_`` states the rule and the ratios.
     exact_tie_ : list of list of str
         Per state, the models (their terms joined by ``+``) that the parsimony rule's absolute
-        tie ranked first and the record's noise test refuted (module docstring, "The exact
-        tie"); ``exact_tie_rule_`` states the rule and the ratios.
+        tie ranked first and that were refuted, their held-out error above its round-off bound
+        (module docstring, "The exact tie"); ``exact_tie_rule_`` states the rule and the
+        figures (each error over its bound).
     determinacy_ : ndarray, shape (n_states,)
         Each selected equation's noise Gram over its gap at noise of that level
         (:func:`identify._determinacy.determinacy_bound`) [-]: 0 noise-free; at 1 or more the
