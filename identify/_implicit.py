@@ -12,7 +12,7 @@ validation Gram matrix ``G_v`` for every model at once.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from itertools import pairwise
 
 import numpy as np
@@ -377,14 +377,45 @@ def no_model_reason(sw: Sweep, shares: np.ndarray, k: int) -> str:
             "finite held-out error")
 
 
+def input_errors(sw: Sweep, G_val: np.ndarray, cols: np.ndarray) -> np.ndarray:
+    """Held-out residual of every model per unit of its input part, shape (T, C).
+
+    ``W^T G W / (W_u^T G W_u)`` with ``G`` the validation Gram in normalised units (``G_val``,
+    shape (p, p), over ``sw.scale``) and ``W_u`` the model restricted to the input's columns
+    ``cols``: the residual relative to the force the equation attributes to its input.
+    Adding an input-free equation that holds (a passive coordinate's) leaves it nearly
+    unchanged, where the left-hand-side normalisation of ``sw.val_error`` falls with the
+    input's share: on an open chain a passive equation plus a small admixture ``eps`` of the
+    input's (round 16's ``cp16_3s`` clean: the pole's equation taken as the cart's, input
+    share 0.029, law_error 0.855) has a residual per unit of left-hand side ``eps^2`` times the
+    input equation's.  ``inf`` where the input part is zero.
+
+    Returns
+    -------
+    ndarray, shape (T, C)
+        Dimensionless ratio of squared norms.
+    """
+    Gn = G_val / np.outer(sw.scale, sw.scale)
+    Wu = np.zeros_like(sw.W)
+    Wu[..., cols] = sw.W[..., cols]
+    num = np.einsum("tcp,tcp->tc", sw.W @ Gn, sw.W)
+    den = np.einsum("tcp,tcp->tc", Wu @ Gn, Wu)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(den > 0, np.maximum(num, 0.0) / np.where(den > 0, den, 1.0), np.inf)
+
+
 def select_models(sw: Sweep, input_cols: Sequence[np.ndarray], rtol: float = 0.1,
-                  atol: float = 1e-12, top: int = 1) -> list[list[tuple[int, int]]]:
+                  atol: float = 1e-12, top: int = 1, G_val: np.ndarray | None = None
+                  ) -> list[list[tuple[int, int]]]:
     """Pick the implicit equation of each input by held-out error, then parsimony.
 
     Models eligible for input k are those whose input-k terms carry a larger normalised
     coefficient than every other input's terms (so a sparse model contains u_k and no other
     input, and the equations picked for different inputs are distinct).  They are ranked by
-    :func:`rank_models`.
+    :func:`rank_models`, by their held-out error (``sw.val_error``, per unit of the left-hand
+    side) or, where ``G_val`` is given, per unit of the input's part (:func:`input_errors`; a
+    candidate for open chains, measured in docs/known-gaps.md "SINDy-PI selection, session
+    16" and not yet passed by the identifiers).
 
     Parameters
     ----------
@@ -399,6 +430,8 @@ def select_models(sw: Sweep, input_cols: Sequence[np.ndarray], rtol: float = 0.1
         of 1e-6) is where the Gram-based residual of an exact model loses its digits.
     top : int
         Number of models returned per input (distinct supports, best first).
+    G_val : ndarray, shape (p, p), optional
+        Validation Gram matrix in original units: rank by :func:`input_errors`.
 
     Returns
     -------
@@ -409,7 +442,9 @@ def select_models(sw: Sweep, input_cols: Sequence[np.ndarray], rtol: float = 0.1
     for k in range(len(input_cols)):
         others = np.delete(shares, k, axis=0)
         other = others.max(axis=0) if others.size else np.zeros_like(shares[k])
-        order = rank_models(sw, (shares[k] > 0) & (shares[k] > other), rtol, atol)
+        ranked = sw if G_val is None else replace(sw, val_error=input_errors(sw, G_val,
+                                                                            input_cols[k]))
+        order = rank_models(ranked, (shares[k] > 0) & (shares[k] > other), rtol, atol)
         if order.size == 0:
             raise NoModelError(no_model_reason(sw, shares, k))
         picked: list[tuple[int, int]] = []

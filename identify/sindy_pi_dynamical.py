@@ -63,6 +63,23 @@ Km at 2-3 % the ``Km dx`` term goes too (0.30-1.16: the noise hides Km there).  
 member on 92 kinetics cells of rounds 5-10 and the shipped noisy setup: 39 -> 54 passes, none
 lost (``benchmarks/unseen/round10/noise_prune_members.tsv``).
 
+The exact tie (``exact_tie_``, ``exact_tie_rule_``): the parsimony rule counts a held-out
+error within ``selection_atol`` (1e-12) of the best as equal, an absolute tolerance whose
+meaning depends on the record.  On a clean record saturated far above Km (round 16's
+``mm16_x0_30``, x 30 -> 26.4 mM) the 3-term ``0.90 x + 0.51 dx + x dx = 0`` holds to a held-out
+6.1e-14 against the law's 5.1e-16 (round-off) and won by fewer terms.  So a model ranked first
+only by that absolute tie (its error above the best's x (1 + rtol)) is refuted where its
+held-out error exceeds the round-off bound of its own Gram-based residual while the best's is
+within its own (:meth:`SINDyPIDynamical._refutes_tie`: ``n_val eps (sum_i |w_i|
+||theta_i||)^2 / ||theta_lhs||^2``, the first-order bound of the Gram's inner products over
+the ``n_val`` held-out rows); its support leaves the selection (:func:`select_equations`).
+Measured on that cell (40 held-out windows): the 3-term model at 1.7 x its bound, the law at
+0.014; round 14's ``mm14_km0p05_vmax10`` clean, where the tie must stand, the law at 0.19.
+The record's own noise test (:func:`identify._determinacy.noise_residual_ratio`) cannot
+decide this on a clean record: there its smallest eigenvalues are round-off of either sign
+(on ``mm16_x0_30`` the 3-term model 2.6e-15 against the law's -1.1e-15), so which side of 2
+a ratio falls is rounding's.
+
 Simulation: at each RK4 stage the identified equations ``A(x, u) dx + b(x, u) = 0`` are solved
 for ``dx``; an (almost) singular ``A`` raises :class:`~testbed.core.errors.DivergenceError`.
 """
@@ -367,7 +384,8 @@ def reduce_common_factors(sw: Sweep, lib: ImplicitTerms, G_train: np.ndarray,
 
 
 def select_equations(sw: Sweep, lib: ImplicitTerms, deriv_cols: list[np.ndarray], rtol: float,
-                     atol: float) -> list[tuple[int, int]]:
+                     atol: float, refute: Callable[[int, tuple[int, int], tuple[int, int]], bool]
+                     | None = None) -> list[tuple[int, int]]:
     """The (threshold, candidate) model of each state's equation.
 
     Eligible for state k: models whose ``d<state k>`` terms carry a larger normalised
@@ -378,6 +396,14 @@ def select_equations(sw: Sweep, lib: ImplicitTerms, deriv_cols: list[np.ndarray]
     :func:`identify._implicit.rank_models` (held-out error, then fewest terms within
     tolerance, then the declared tie rule).
 
+    The exact tie (``refute``): a model ranked first only through the absolute tolerance
+    ``atol`` (its held-out error above ``best * (1 + rtol)``, the best being the first model of
+    the ranking within that relative tolerance, and its support not the best's) is put to
+    ``refute(k, model, best)``; if that
+    says the record refutes it, every model of its support leaves the eligible set and the
+    ranking is redone.  The identifier's rule (:meth:`SINDyPIDynamical._refutes_tie`) is the
+    round-off bound of the held-out residual; ``None`` keeps every tie.
+
     Raises
     ------
     IdentificationError
@@ -385,15 +411,29 @@ def select_equations(sw: Sweep, lib: ImplicitTerms, deriv_cols: list[np.ndarray]
     """
     shares = input_shares(sw.W, deriv_cols)
     reducible = common_factor(sw.W, lib)
+    support = sw.W != 0
     out = []
     for k in range(len(deriv_cols)):
         others = np.delete(shares, k, axis=0)
         other = others.max(axis=0) if others.size else np.zeros_like(shares[k])
-        order = rank_models(sw, (shares[k] > 0) & (shares[k] > other) & ~reducible, rtol, atol)
-        if order.size == 0:
-            raise IdentificationError(f"no implicit model is dominated by the derivative of state "
-                                      f"{lib.states[k]!r} without a common factor")
-        t, c = np.unravel_index(order[0], sw.val_error.shape)
+        elig = (shares[k] > 0) & (shares[k] > other) & ~reducible
+        while True:
+            order = rank_models(sw, elig, rtol, atol)
+            if order.size == 0:
+                raise IdentificationError(f"no implicit model is dominated by the derivative of "
+                                          f"state {lib.states[k]!r} without a common factor")
+            t, c = np.unravel_index(order[0], sw.val_error.shape)
+            if refute is None:
+                break
+            errs = sw.val_error.ravel()[order]
+            within = errs <= errs.min() * (1.0 + rtol)
+            if within[0]:
+                break
+            tb, cb = np.unravel_index(order[int(np.argmax(within))], sw.val_error.shape)
+            if (np.array_equal(support[t, c], support[tb, cb])
+                    or not refute(k, (int(t), int(c)), (int(tb), int(cb)))):
+                break
+            elig = elig & ~np.all(support == support[t, c], axis=-1)
         out.append((int(t), int(c)))
     return out
 
@@ -452,6 +492,11 @@ class SINDyPIDynamical(Identifier):
     noise_prune_ : list of list of str
         Terms dropped from each state's selected equation as indistinguishable from the noise
         (module docstring); ``noise_prune_rule_`` states the rule and the ratios.
+    exact_tie_ : list of list of str
+        Per state, the models (their terms joined by ``+``) that the parsimony rule's absolute
+        tie ranked first and that were refuted, their held-out error above its round-off bound
+        (module docstring, "The exact tie"); ``exact_tie_rule_`` states the rule and the
+        figures (each error over its bound).
     determinacy_ : ndarray, shape (n_states,)
         Each selected equation's noise Gram over its gap at noise of that level
         (:func:`identify._determinacy.determinacy_bound`) [-]: 0 noise-free; at 1 or more the
@@ -622,7 +667,22 @@ class SINDyPIDynamical(Identifier):
                 raise IdentificationError(f"the library holds no term with d{data.channels[k]}: "
                                           f"no equation of state {data.channels[k]!r} can be "
                                           "selected")
-        picked = select_equations(sw, lib, deriv_cols, self.selection_rtol, self.selection_atol)
+        self.exact_tie_ = [[] for _ in range(n_states)]
+        self._tie_notes: list[str] = []
+        n_val = Theta.shape[0] - n_tr
+
+        def refute(k: int, model: tuple[int, int], best: tuple[int, int]) -> bool:
+            return self._refutes_tie(k, sw, model, best, G_val, n_val, lib)
+
+        picked = select_equations(sw, lib, deriv_cols, self.selection_rtol, self.selection_atol,
+                                  refute)
+        self.exact_tie_rule_ = (
+            f"a model ranked first only by selection_atol {self.selection_atol:g} (held-out error "
+            f"above the best's x (1 + {self.selection_rtol:g})) is refuted where its held-out "
+            "error exceeds the round-off bound of its Gram-based residual, n_val eps "
+            "(sum_i |w_i| ||theta_i||)^2 / ||theta_lhs||^2 over the held-out rows, while the "
+            f"best's is within its own ({n_val} held-out rows; "
+            f"{'; '.join(self._tie_notes) or 'no model ranked first by the tie alone'})")
         self.coef_ = np.stack([sw.coef(t, c) for t, c in picked])
         self.val_error_ = np.array([sw.val_error[t, c] for t, c in picked])
         self.feature_names_ = list(lib.names)
@@ -715,6 +775,40 @@ class SINDyPIDynamical(Identifier):
             f"{how} for "
             f"{', '.join(done) or 'no state'}: where determinacy_ < 1; the others keep the "
             "sweep's least squares (determinacy_ >= 1: not determined; 0: noise-free, exact)")
+
+    def _refutes_tie(self, k: int, sw: Sweep, model: tuple[int, int], best: tuple[int, int],
+                     G_val: np.ndarray, n_val: int, lib: ImplicitTerms) -> bool:
+        """Whether the record refutes a model the parsimony rule's absolute tie ranked first
+        (the exact tie, module docstring).
+
+        Each model's held-out error (``sw.val_error``, the Gram-based residual
+        ``w^T G w / G_jj``, ``G`` the validation Gram ``G_val`` (p, p) over ``sw.scale``) is
+        compared with what float64 round-off can make of it: the Gram's entries are sums of
+        ``n_val`` products, each off by at most ``n_val eps`` of ``||theta_i|| ||theta_j||``
+        (the first-order bound of an inner product), so the residual of an exact equation is
+        within ``n_val eps (sum_i |w_i| ||theta_i||)^2 / ||theta_j||^2``.  The model is refuted
+        where its error exceeds its bound while the best's is within its own (the best is at
+        round-off, so the record resolves the difference); elsewhere the tie stands.  Appends
+        to ``exact_tie_[k]`` and the notes of ``exact_tie_rule_``.
+        """
+        Gn = G_val / np.outer(sw.scale, sw.scale)
+        norm = np.sqrt(np.clip(np.diag(Gn), 0.0, None))
+        eps = np.finfo(float).eps
+
+        def over(tc: tuple[int, int]) -> float:
+            w, j = sw.W[tc], sw.candidates[tc[1]]
+            bound = n_val * eps * float(np.abs(w) @ norm) ** 2 / Gn[j, j]
+            return float(sw.val_error[tc]) / bound if bound > 0.0 else float("inf")
+
+        r_m, r_b = over(model), over(best)
+        out = bool(r_b <= 1.0 < r_m)  # False for a NaN on either side
+        terms = " + ".join(lib.names[j] for j in np.flatnonzero(sw.W[model]))
+        best_terms = " + ".join(lib.names[j] for j in np.flatnonzero(sw.W[best]))
+        self._tie_notes.append(f"{lib.states[k]}: {terms} at {r_m:.3g} x its bound against "
+                               f"{best_terms} at {r_b:.3g}: " + ("refuted" if out else "kept"))
+        if out:
+            self.exact_tie_[k].append(terms)
+        return out
 
     @staticmethod
     def _noise_level(data: Measurement, x: np.ndarray) -> np.ndarray:

@@ -202,3 +202,29 @@ def test_exact_ties_broken_by_declared_rule_not_rounding():
     # the sign convention ignores which of several exact +-1 entries rounding made largest
     row = np.array([0.0, -1.0, 1.0 - 1e-16, 1.0])
     assert canonical_scale(row)[1] == 1.0 and canonical_scale(-row)[1] == 1.0
+
+
+def test_input_errors_score_a_passive_equations_admixture_as_the_inputs_own():
+    # round 16's cp16_3s clean: a passive equation P (input-free, holds) plus a small
+    # admixture eps C of the input's equation C is an exact combination whose held-out residual
+    # per unit of its left-hand side falls as eps^2, so it outranked C itself (the pole's
+    # equation taken twice, law_error 0.855).  Per unit of its input part it scores as C, and
+    # the parsimony rule takes C (2 terms against 4)
+    from identify._implicit import Sweep, _errors, input_errors, select_models
+    rng = np.random.default_rng(0)
+    n = 400
+    a, c = rng.standard_normal(n), rng.standard_normal(n)
+    u = c + 1e-2 * rng.standard_normal(n)          # C: c - u = 0 up to 1 % misfit
+    Theta = np.column_stack([a, a, c, u])           # P: col0 - col1 = 0 exactly
+    G_val = Theta[n // 2:].T @ Theta[n // 2:]
+    eps = 0.03
+    W = np.array([[[1.0, -1.0, eps, -eps], [0.0, 0.0, 1.0, -1.0]]])
+    cand = np.array([0, 2])
+    err = _errors(W, G_val, cand)
+    sw = Sweep(scale=np.ones(4), candidates=cand, thresholds=np.array([0.0]), W=W,
+               val_error=err, train_error=err, nnz=np.array([[4, 2]]))
+    assert err[0, 0] < 1e-2 * err[0, 1]             # the admixture "wins" per unit of lhs
+    assert select_models(sw, [np.array([3])]) == [[(0, 0)]]
+    ein = input_errors(sw, G_val, np.array([3]))
+    assert ein[0, 0] == pytest.approx(ein[0, 1], rel=0.05)  # same misfit per unit of input
+    assert select_models(sw, [np.array([3])], G_val=G_val) == [[(0, 1)]]

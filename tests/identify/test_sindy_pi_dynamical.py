@@ -264,3 +264,24 @@ def test_the_noise_residual_ratio_is_one_for_a_law_and_large_for_a_missing_term(
     np.testing.assert_allclose(w / w[2], [-2.0, -1.0, 1.0], rtol=2e-2)
     assert noise_residual_ratio(lambda z: np.column_stack([z[0], y]), x, sigma)[0] > 100.0
     assert noise_residual_ratio(lambda z: np.column_stack([z[0], y]), x, np.zeros(1))[0] == np.inf
+
+
+def test_an_exact_tie_above_its_round_off_bound_is_not_selected():
+    # round 16's mm16_x0_30 clean (x 30 -> 26.4 mM, 100 Km; seed 74): 0.90 x + 0.51 dx + x dx = 0
+    # holds the record to a held-out 6.1e-14, under selection_atol 1e-12, against the law's 5e-16
+    # (round-off), and won by fewer terms (coef_error 1, F1 0.857); the round-off bound of its
+    # Gram-based residual over the 40 held-out windows is 3.6e-14 (1.7 x), the law's error
+    # 0.014 x its own, so the record resolves it and the law is selected
+    ds, data, params = _noisy_mm({"x0": 30.0}, 0.0, seed=74)
+    model = SINDyPIDynamical(**params).fit(data)
+    assert model.exact_tie_ == [["x + dx + x*dx"]]
+    assert "refuted" in model.exact_tie_rule_
+    cmp = compare_implicit(model.feature_names_, model.coef_, ds.truth["equation_terms"],
+                           np.asarray(ds.truth["equation_coef"]))
+    assert cmp["f1"] == 1.0 and cmp["coef_error"] < 0.05   # the rig's bars (was 0.857 / 1.0)
+
+
+def test_an_exact_law_is_never_refuted(mm):
+    _, data = mm   # noise-free, recorded derivatives, strong form: the law holds to round-off
+    model = SINDyPIDynamical(library=["1", "x", "x^2", "dx", "x*dx"]).fit(data)
+    assert model.exact_tie_ == [[]] and ": refuted" not in model.exact_tie_rule_
