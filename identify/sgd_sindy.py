@@ -535,9 +535,14 @@ class SGDSINDy(SGDSINDyBase):
         With the cubic library and a warm start that kept a cubic term: the eigenvalue
         penalty and ``eigen_hold`` target, for each mode whose backbone decay fit on the warm
         start's modes hardens, that fit's linear frequency instead of the mode's spectral peak
-        (:func:`identify._sgd_matrix.backbone_targets`); if the SGD then drops every cubic
-        term, the hold puts those modes back onto their peaks.  ``eigen_backbone_rule_``
-        says what was done.  No effect without the cubic library.  See Notes.
+        (:func:`identify._sgd_matrix.backbone_targets`), and every paired target lowered by
+        the stiffening the warm start's cubic gives that mode from the other modes' motion over
+        its life (:func:`identify._sgd_matrix.cross_stiffening`: the record's mode 2 rings
+        hardened by a mode 1 that outlives it, which the model's cubic adds back when
+        simulated; round 14's ``b14_soft_r2p5_cf0p5_n40_s4_z0p1`` TRAC 0.228 -> 0.975); if the
+        SGD then drops every cubic term, the hold puts those modes back onto their peaks.
+        ``eigen_backbone_rule_`` says what was done.  No effect without the cubic library.
+        See Notes.
     fit_tilt : bool or None
         Difference every row of the fit once (warm start and SGD loss alike: features, target,
         force and drift columns; :func:`identify.structural.tilt_rows`, ``ls_sindy``'s tilted
