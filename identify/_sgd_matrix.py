@@ -577,7 +577,10 @@ def warm_start(xdd: np.ndarray, xd: np.ndarray, x: np.ndarray, x3: np.ndarray | 
     A = -coef[:, n:2 * n]
     A3 = -coef[:, 2 * n:] if x3 is not None else None
     lam, phi = np.linalg.eig(A)
-    if np.all(np.abs(lam.imag) <= 1e-9 * np.abs(lam).max()) and np.all(lam.real > 0):
+    # (dependent eigenvectors, e.g. a 60-sample free decay through 5 sensors, define no mass:
+    # the identity, as for complex ones, instead of inverting a singular matrix)
+    if (np.all(np.abs(lam.imag) <= 1e-9 * np.abs(lam).max()) and np.all(lam.real > 0)
+            and np.linalg.cond(phi.real) < 1e12):
         phi_inv = np.linalg.inv(phi.real)
         M0 = phi_inv.T @ phi_inv
     else:
@@ -985,7 +988,10 @@ def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
         # lowest mode's damping the damping could not follow the data (3 % noise two-sensor
         # beam, damping error 0.68 against 0.35 with the largest entry; measured while the
         # frequencies were held every epoch).
-        lam_min = float(linalg.eigh(_sym(K0), _sym(M0), eigvals_only=True)[0])
+        try:
+            lam_min = float(linalg.eigh(_sym(K0), _sym(M0), eigvals_only=True)[0])
+        except np.linalg.LinAlgError:  # M0 not positive definite to rounding (a 140-sample
+            lam_min = 0.0  # free decay through 5 sensors): the stiffness diagonal's scale
         k0 = max(m0 * lam_min, 1e-12) if lam_min > 0 else max(np.abs(np.diag(K0)).max(), 1e-12)
         c0 = max(np.abs(np.diag(C0)).max(), 1e-12)
     else:  # the data's own scales, as standardised features have: K ~ M x''/x, C ~ M x''/x'

@@ -51,3 +51,36 @@ def test_a_band_the_chain_closes_is_named(chain):
     record's length (3300 >= 3200 Hz)."""
     with pytest.raises(IdentificationError, match=r"band .* is empty"):
         modal_peaks(dataclasses.replace(chain, passband=(3000.0, 4000.0)))
+
+
+def _beam_record(n_sensors: int):
+    """The shipped clamped beam (0.1 s) with ``n_sensors`` evenly spaced, hammer at the last."""
+    from testbed import load_scenario
+    from testbed.pipeline.generate import generate
+    from testbed.pipeline.signal_chain import measure
+
+    sc = load_scenario("cantilever_stiff_impact")
+    length = sc.rig_params["length"]
+    pos = [round(length * (k + 1) / n_sensors, 6) for k in range(n_sensors)]
+    sc = sc.replace(rig_params={**sc.rig_params, "sensors": pos, "n_segments": max(10, 3 * n_sensors + 2)},
+                    excitation={**sc.excitation, "location": pos[-1]},
+                    simulation={**sc.simulation, "duration": 0.1,
+                                "sample_rate": 51200.0 if n_sensors > 3 else 12800.0})
+    return measure(generate(sc), sc.signal, sc.kind)
+
+
+@pytest.mark.parametrize(("n_sensors", "name", "k"), [
+    (2, "ls_sindy", 33),  # was LinAlgError in backbone_shift (dependent mode shapes)
+    (5, "sgd_sindy", 60),  # was LinAlgError inverting the warm start's eigenvectors
+    (5, "sgd_sindy", 140),  # was LinAlgError from eigh: the warm start's M not positive definite
+])
+def test_a_short_free_decay_after_a_long_record_ends_in_a_model_or_a_named_refusal(
+        n_sensors, name, k):
+    """free_start k samples before the end of a 0.1 s record (the probe of session 16)."""
+    data = _beam_record(n_sensors)
+    short = dataclasses.replace(data, free_start=data.n_samples - k)
+    try:
+        model = IDENTIFIERS.get(name)().fit(short)
+    except IdentificationError:
+        return
+    assert model.is_fitted()
