@@ -1106,10 +1106,13 @@ def backbone_shift(M: np.ndarray, K: np.ndarray, K3: np.ndarray, dec: ModalDecay
     Returns
     -------
     ndarray, shape (n,)
-        ``3 g_k A_k^2 / (8 w_k)`` [rad/s], comparable with ``dec.chirp`` (NaN where no fit).
+        ``3 g_k A_k^2 / (8 w_k)`` [rad/s], comparable with ``dec.chirp`` (NaN where no fit,
+        and everywhere when the model's mode shapes are dependent, condition >= 1e12).
     """
     freqs, Phi = modal(M, K)
     w = 2.0 * np.pi * freqs
+    if not np.linalg.cond(Phi) < 1e12:  # dependent mode shapes (a 33-sample free decay): none
+        return np.full(np.size(freqs), np.nan)
     g = np.einsum("kj,jk->k", np.linalg.solve(Phi, np.linalg.solve(M, K3)), Phi**3)
     a = dec.amplitude / (dec.omega_d + dec.chirp) ** 2
     return 3.0 * g * a * a / (8.0 * w)

@@ -7,6 +7,7 @@ from typing import ClassVar
 import numpy as np
 
 from identify import IDENTIFIERS
+from identify._band_refusal import fit_with_band_refusal, lowest_mode_hz
 from identify._cubic_rule import cubic_rule
 from identify._modal_damping import BACKBONE_SHARE, backbone_shift, decay_hold, set_eigenvalues
 from identify._sgd_matrix import eigen_targets, fit_window
@@ -333,39 +334,24 @@ class LeastSquaresSINDy(StructuralIdentifier):
         self.harmonics_, self.harmonic_rule_ = harmonics_array(ps), ps.harmonic_rule
         self.peak_count_rule_ = ps.count_rule
         default = ps if self.lower_modes else None  # the cubic rule's own default search
-        self.cubic_, self.cubic_rule_ = cubic_rule(data, self.cubic, self.fit_band_hz, ps.peaks,
-                                                   default)
-        try:
-            self._fit_in_band(data, ps.peaks, m_hat, self.fit_band_hz)
-        except IdentificationError as e:
-            band = float(getattr(self, "fit_band_hz_", 0.0))
-            if self.fit_band_hz is not None or not band > 0.0:
-                raise
-            # the band by rule, refused non-physical: a mode below its cut-off cannot be
-            # checked there (round 15's aluminium 0.8 m on a soft base, mode 1 2.26 Hz with no
-            # accepted peak: the band at 0.7 x 23.9 Hz removed it, cubic and linear fits grew;
-            # without it modes 1-2 1.8 / 0.25 % off): fitted again without it, and the band's
-            # refusal is raised if that is refused too
-            rule = (f"{self.fit_band_rule_}; refused: its fit is non-physical ({e}), a mode "
-                    "below the cut-off unseen: no band")
+
+        def fit_in(cut: float | None) -> None:
+            # the fit band's refusal (identify._band_refusal): round 15's aluminium 0.8 m on a
+            # soft base (mode 1 2.26 Hz with no accepted peak: the band at 0.7 x 23.9 Hz removed
+            # it, cubic and linear fits grew; without it modes 1-2 1.8 / 0.25 % off) and round
+            # 8's soft beam (mode 1 at 1.06 x the high-pass, unlocated: fitted at 12.4 Hz
+            # against 10.6 true in the band at 0.7 x 101 Hz)
+            band_hz = self.fit_band_hz if cut is None else cut
             self.__dict__.pop("modal_decay_", None)
-            self.cubic_, self.cubic_rule_ = cubic_rule(data, self.cubic, 0.0, ps.peaks, default)
-            try:
-                self._fit_in_band(data, ps.peaks, m_hat, 0.0)
-            except IdentificationError:
-                raise e from None
-            self.fit_band_rule_ = rule
-        low = self._lowest_mode_hz()
-        if self.fit_band_hz is None and 0.0 < low < self.fit_band_hz_:
-            # a mode below the band's cut-off was fitted on what the band removed (round 8's
-            # soft beam, mode 1 at 1.06 x the high-pass, unlocated: 12.4 Hz against 10.6 true,
-            # with the band at 0.7 x the lowest located peak, 101 Hz): fitted again without it
-            rule = (f"{self.fit_band_rule_}; refused: the fitted mode 1 ({low:.4g} Hz) lies "
-                    f"below it, fitted on what it removed: no band")
-            self.__dict__.pop("modal_decay_", None)
-            self.cubic_, self.cubic_rule_ = cubic_rule(data, self.cubic, 0.0, ps.peaks, default)
-            self._fit_in_band(data, ps.peaks, m_hat, 0.0)
-            self.fit_band_rule_ = rule
+            self.cubic_, self.cubic_rule_ = cubic_rule(data, self.cubic, band_hz, ps.peaks, default)
+            self._fit_in_band(data, ps.peaks, m_hat, band_hz)
+
+        refused = fit_with_band_refusal(
+            fit_in, lambda: (float(getattr(self, "fit_band_hz_", 0.0)),
+                             str(getattr(self, "fit_band_rule_", ""))),
+            lambda: lowest_mode_hz(self.M_, self.K_), self.fit_band_hz is None)
+        if refused is not None:
+            self.fit_band_rule_ = refused
         self._finish_fit(data)
         return self
 
@@ -400,12 +386,6 @@ class LeastSquaresSINDy(StructuralIdentifier):
                 lib = band_library()
                 self.__dict__.pop("modal_decay_", None)
                 self._fit_library(data, lib, masses, peaks)
-
-    def _lowest_mode_hz(self) -> float:
-        """The fitted model's lowest undamped frequency [Hz] (0 when none is finite)."""
-        f = modal(self.M_, self.K_)[0]
-        f = f[np.isfinite(f)]
-        return float(f.min()) if f.size else 0.0
 
     def _fit_library(self, data: Measurement, lib: Library, masses: np.ndarray,
                      peaks: np.ndarray) -> None:

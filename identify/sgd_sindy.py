@@ -53,6 +53,7 @@ from typing import ClassVar
 import numpy as np
 
 from identify import IDENTIFIERS
+from identify._band_refusal import fit_with_band_refusal, lowest_mode_hz
 from identify._cubic_rule import THIRD_HARMONIC_IN, cubic_rule
 from identify._modal_damping import decay_hold
 from identify._sgd_matrix import (
@@ -498,7 +499,12 @@ class SGDSINDy(SGDSINDyBase):
         modes 1-2 >= 0.95 and their frequencies within 1 %) clamped beams pass 31/40 with it,
         26/40 without (soft bases 5/20 and 4/20): the low-frequency remnants of the chain's
         integration and high-pass, which it removes, dominate the displacements of the
-        weaker modes.
+        weaker modes.  The band is refused, and the whole fit made again without it, when
+        the fit in it is refused or its lowest mode lies below the cut-off (fitted on what
+        the band removed): ``ls_sindy``'s rule, one implementation
+        (:mod:`identify._band_refusal`; ``fit_band_rule_`` says so).  Measured on round 15's
+        ``b15_soft_long_al_L0p8_cf0p3`` clean: mode 1 54 % -> 1.8 % (docs/known-gaps.md,
+        "Beam identifiers, session 16").
     eigen_hold : bool
         Move each identified eigenvalue paired with a measured peak
         (:func:`identify._sgd_matrix.eigen_targets`: within 15 %, in mode order) into that
@@ -529,9 +535,14 @@ class SGDSINDy(SGDSINDyBase):
         With the cubic library and a warm start that kept a cubic term: the eigenvalue
         penalty and ``eigen_hold`` target, for each mode whose backbone decay fit on the warm
         start's modes hardens, that fit's linear frequency instead of the mode's spectral peak
-        (:func:`identify._sgd_matrix.backbone_targets`); if the SGD then drops every cubic
-        term, the hold puts those modes back onto their peaks.  ``eigen_backbone_rule_``
-        says what was done.  No effect without the cubic library.  See Notes.
+        (:func:`identify._sgd_matrix.backbone_targets`), and every paired target lowered by
+        the stiffening the warm start's cubic gives that mode from the other modes' motion over
+        its life (:func:`identify._sgd_matrix.cross_stiffening`: the record's mode 2 rings
+        hardened by a mode 1 that outlives it, which the model's cubic adds back when
+        simulated; round 14's ``b14_soft_r2p5_cf0p5_n40_s4_z0p1`` TRAC 0.228 -> 0.975); if the
+        SGD then drops every cubic term, the hold puts those modes back onto their peaks.
+        ``eigen_backbone_rule_`` says what was done.  No effect without the cubic library.
+        See Notes.
     fit_tilt : bool or None
         Difference every row of the fit once (warm start and SGD loss alike: features, target,
         force and drift columns; :func:`identify.structural.tilt_rows`, ``ls_sindy``'s tilted
@@ -995,9 +1006,52 @@ class SGDSINDy(SGDSINDyBase):
         self
         """
         lam_hat, band_peaks = self._start_fit(data)
-        ceiling = self._hardened_peak_ceiling(lam_hat)
         m_hat = mass_prior_value(data, self.mass_prior)
+        begun = dict(self.__dict__)
+
+        def fit_in(cut: float | None) -> None:
+            if cut is not None:  # the refit without the band, from the state _start_fit left
+                self.__dict__.clear()
+                self.__dict__.update(begun)
+                ps = modal_peaks(data, lower_modes=self._lower_modes())
+                self.cubic_, self.cubic_rule_ = cubic_rule(
+                    data, self.cubic, cut, None if self.cubic is not None else ps.peaks,
+                    ps if self.cubic is None and self._lower_modes() else None)
+                self.learning_rate_, self.learning_rate_rule_ = learning_rate_for(
+                    self.cubic_, self.learning_rate)
+            self._fit_in_band(data, lam_hat, band_peaks, m_hat, cut)
+
+        # the fit band's refusal (identify._band_refusal), as ls_sindy's: round 15's aluminium
+        # 0.8 m on a soft base, whose flat fit in the band put mode 1 at 1.04 Hz under the
+        # 16.7 Hz cut-off (54 % off; without the band 1.8 %)
+        refused = fit_with_band_refusal(
+            fit_in, lambda: (float(getattr(self, "fit_band_hz_", 0.0)),
+                             str(getattr(self, "fit_band_rule_", ""))),
+            lambda: lowest_mode_hz(self.M_, self.K_), bool(self.fit_band))
+        if refused is not None:
+            self.fit_band_rule_ = refused
+        return self
+
+    def _fit_in_band(self, data: Measurement, lam_hat: np.ndarray, band_peaks: np.ndarray | None,
+                     m_hat: float, cut: float | None) -> None:
+        """The fit (SGD, warm start, the keep rule, the model's attributes) with the fit band's
+        cut-off ``cut`` [Hz] (None: by ``fit_band``; 0.0: none).
+
+        Parameters
+        ----------
+        data : Measurement
+        lam_hat : ndarray, shape (k,)
+            The eigenvalue targets of :meth:`_start_fit`.
+        band_peaks : ndarray or None
+            Peaks [Hz] for the fit band's cut-off (:meth:`_start_fit`).
+        m_hat : float
+            The mass prior [kg].
+        cut : float or None
+        """
+        ceiling = self._hardened_peak_ceiling(lam_hat)
         est = self.settings()
+        if cut is not None:
+            est = dataclasses.replace(est, fit_band_hz=float(cut))
         if self.keep_sgd is False:
             est = dataclasses.replace(est, epochs=0)
         by_rule = self.keep_sgd is None and est.epochs > 0 and est.init == "lstsq"
@@ -1018,7 +1072,7 @@ class SGDSINDy(SGDSINDyBase):
                 f"keep_sgd = {self.keep_sgd} (user setting)" if self.keep_sgd is not None else
                 "epochs = 0: the held warm start" if est.epochs == 0 else
                 f"init = {est.init!r}: no warm start to compare with")
-            return self
+            return
         # The SGD may wander from a sound warm start while its data loss stays flat (soft-base
         # member 006: warm start MAC 1.000 / 0.9998, after the SGD mode 1 +1773 %, TRAC 0.007):
         # its result is kept only where its own simulation reproduces the measured record about
@@ -1030,7 +1084,7 @@ class SGDSINDy(SGDSINDyBase):
             self.record_agreement_ = {"sgd": a_sgd}
             self.keep_sgd_, self.keep_sgd_rule_ = keep_sgd_rule(
                 a_sgd, None, (f"start fit of {FLOOR_CHECK_ITERATIONS} iteration", ""))
-            return self
+            return
         a_sgd, note_sgd = record_agreement(self, data, sims=sims)
         sims.clear()
         sgd = dict(self.__dict__)
@@ -1047,7 +1101,6 @@ class SGDSINDy(SGDSINDyBase):
                                                           sgd["alphas_"])
         self.keep_sgd_, self.keep_sgd_rule_ = keep, rule
         self.record_agreement_ = {"sgd": a_sgd, "warm_start": a_warm}
-        return self
 
     def _hardened_peak_ceiling(self, lam_hat: np.ndarray) -> np.ndarray:
         """The eigenvalue targets the hold treats as upper bounds only; sets

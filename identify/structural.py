@@ -628,6 +628,13 @@ HIGHPASS_MARGIN = 1.1
 #: low-pass bends the spectrum from about 0.8 of its cut-off), or of the Nyquist frequency
 #: without one (0.45 fs: the last lines of a sampled spectrum carry aliasing).
 LOWPASS_MARGIN, NYQUIST_FRACTION = 0.8, 0.9
+#: Lower edge of the peak band in lines of the window's transform (``fs / n_window`` [Hz]
+#: each): a peak needs lines on both sides to be one, and the lowest lines of a short window
+#: carry its mean and the chain's drift.  So a window of ``n`` samples has a band only where
+#: ``PEAK_BAND_LINES fs / n`` lies below the band's top: the peak search, hence every structural
+#: identifier that reads its modes from it, needs more than ``PEAK_BAND_LINES fs / f_top``
+#: samples of free decay (12 without a declared pass band: ``f_top = 0.45 fs``).
+PEAK_BAND_LINES = 5
 #: A weaker peak within this relative distance of k times a stronger one (k = 2, 3) is a
 #: harmonic *candidate*; a hardening mode's peak sits above its small-amplitude frequency and
 #: its harmonic tracks it (measured: 139.7 / 45.4 Hz = 3.08 on the 150 N soft base).
@@ -751,12 +758,13 @@ def peak_band(data: Measurement, n_window: int, freq_range: tuple[float, float] 
 
     ``freq_range`` (a user's setting) wins.  Otherwise, from the chain's pass band
     ``data.passband = (hp, lp)``: ``[HIGHPASS_MARGIN hp, LOWPASS_MARGIN lp]`` (with
-    ``NYQUIST_FRACTION fs / 2`` if ``lp`` is the Nyquist frequency), and never below 5 lines of
-    the window's transform (``5 fs / n_window``).  Without a declared pass band: 5 lines to
-    ``0.45 fs``.
+    ``NYQUIST_FRACTION fs / 2`` if ``lp`` is the Nyquist frequency), and never below
+    :data:`PEAK_BAND_LINES` lines of the window's transform (``5 fs / n_window``).  Without a
+    declared pass band: 5 lines to ``0.45 fs``.  The band may be empty (lower edge at or above
+    the upper) on a short window: :func:`check_peak_band` names that.
     """
     nyq = data.fs / 2.0
-    lines = 5.0 * data.fs / n_window
+    lines = PEAK_BAND_LINES * data.fs / max(int(n_window), 1)
     if freq_range is not None:
         return (float(freq_range[0]), float(freq_range[1])), "freq_range (user setting)"
     if data.passband is None:
@@ -766,6 +774,43 @@ def peak_band(data: Measurement, n_window: int, freq_range: tuple[float, float] 
     hi = NYQUIST_FRACTION * nyq if lp >= nyq else LOWPASS_MARGIN * lp
     return (lo, hi), (f"chain pass band [{hp:g}, {lp:g}] Hz: from {HIGHPASS_MARGIN:g} x the high-pass "
                       f"cut-off to {'0.45 fs' if lp >= nyq else f'{LOWPASS_MARGIN:g} x the low-pass'}")
+
+
+def check_peak_band(data: Measurement, n_window: int, band: tuple[float, float], rule: str,
+                    start: int) -> None:
+    """Raise :class:`IdentificationError` where :func:`peak_band`'s band is empty.
+
+    The band's lower edge is at least :data:`PEAK_BAND_LINES` lines (``5 fs / n`` [Hz]) of an
+    ``n``-sample window, so the window must hold more than ``5 fs / f_top`` samples, ``f_top``
+    the band's upper edge [Hz] (0.45 fs without a declared pass band, 0.8 x the chain's
+    low-pass with one): the message names the window's length and that minimum.  A band the
+    chain's high-pass closes (``1.1 hp >= f_top``) or a user's ``freq_range`` out of order is
+    named as such (no window length opens it).
+
+    Parameters
+    ----------
+    data : Measurement
+    n_window : int
+        Samples in the searched window.
+    band : (float, float)
+        :func:`peak_band`'s band [Hz] and its ``rule``.
+    rule : str
+    start : int
+        The window's first sample (``free_start`` by default).
+    """
+    lo, hi = band
+    if lo < hi:
+        return
+    lines = PEAK_BAND_LINES * data.fs / max(int(n_window), 1)
+    if lo <= lines and lines >= hi:  # the window's length closed it
+        need = int(np.floor(PEAK_BAND_LINES * data.fs / hi)) + 1
+        raise IdentificationError(
+            f"the free decay from sample {start} holds {n_window} samples; the peak search that "
+            f"reads the natural frequencies needs at least {need} at fs = {data.fs:g} Hz (its "
+            f"band starts {PEAK_BAND_LINES} lines, {PEAK_BAND_LINES:g} fs / n Hz, above 0 Hz and "
+            f"must stay below its top {hi:g} Hz, {rule}): record a longer free decay")
+    raise IdentificationError(f"the peak search's band [{lo:g}, {hi:g}] Hz is empty ({rule}): "
+                              f"no natural frequency can be read from this record")
 
 
 def modal_peaks(data: Measurement, n_modes: int | None = None,
@@ -829,11 +874,18 @@ def modal_peaks(data: Measurement, n_modes: int | None = None,
     Returns
     -------
     PeakSearch
+
+    Raises
+    ------
+    IdentificationError
+        Where the window is too short for rule 1's band (:func:`check_peak_band`: more than
+        ``5 fs / f_top`` samples are needed), naming its length and the minimum.
     """
     s = data.free_start if start is None else int(start)
     xdd = np.asarray(data.xdd, dtype=float)[:, s:stop]
     n_modes = data.n_channels if n_modes is None else int(n_modes)
     band, rule = peak_band(data, xdd.shape[1], freq_range)
+    check_peak_band(data, xdd.shape[1], band, rule, s)
     freqs, _ = peak_candidates(xdd, data.fs, band[0], band[1], window="boxcar", pad=8,
                                  min_rel_separation=MODE_SEPARATION)
     rejected: list[tuple[float, str]] = []
