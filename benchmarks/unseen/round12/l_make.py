@@ -86,6 +86,18 @@ def _write(name: str, base: str, description: str, tables: dict[str, dict], scor
     (HERE / f"{name}.toml").write_text("\n".join(lines))
 
 
+def writer_for(here: Path, number: int):
+    """A later round's writer: :func:`_write` into ``here``, with round ``number``'s header and tag."""
+    def write(name: str, base: str, description: str, tables: dict[str, dict], score: str) -> None:
+        global HERE
+        HERE = here  # _write writes into this module's HERE
+        _write(name, base, description, tables, score)
+        path = here / f"{name}.toml"
+        path.write_text(path.read_text().replace("round 12", f"round {number}")
+                        .replace('"round12"', f'"round{number}"'))
+    return write
+
+
 def write_sets(write, fivebars: dict, cartpoles: dict, kinetics: dict, bar_rounds: str,
                multisines: dict | None = None) -> None:
     """Write each set's scenario files with ``write(name, base, description, tables, score)``:

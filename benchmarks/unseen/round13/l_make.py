@@ -56,12 +56,7 @@ KINETICS: dict[str, tuple[str, dict[str, dict]]] = {
 }
 
 
-def _write(name: str, base: str, description: str, tables: dict[str, dict], score: str) -> None:
-    """Write ``round13/<name>.toml`` by round 12's writer, with round 13's header and tag."""
-    _ROUND12.HERE = HERE  # round 12's writer writes into its module's HERE
-    _ROUND12._write(name, base, description, tables, score)
-    path = HERE / f"{name}.toml"
-    path.write_text(path.read_text().replace("round 12", "round 13").replace('"round12"', '"round13"'))
+_write = _ROUND12.writer_for(HERE, 13)
 
 
 def main() -> None:

@@ -92,13 +92,7 @@ KINETICS: dict[str, tuple[str, dict[str, dict]]] = {
 }
 
 
-def _write(name: str, base: str, description: str, tables: dict[str, dict], score: str) -> None:
-    """Write ``round14/<name>.toml`` by round 12's writer, with round 14's header and tag."""
-    _ROUND12.HERE = HERE  # round 12's writer writes into its module's HERE
-    _ROUND12._write(name, base, description, tables, score)
-    path = HERE / f"{name}.toml"
-    path.write_text(path.read_text().replace("round 12", "round 14").replace('"round12"', '"round14"'))
-
+_write = _ROUND12.writer_for(HERE, 14)
 
 def _write_cartpole(name: str, description: str, excitation: dict) -> None:
     """Write ``round14/<name>.toml``: ``cartpole_noise1`` with its input replaced whole, written
