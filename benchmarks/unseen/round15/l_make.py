@@ -97,13 +97,20 @@ _write = _ROUND12.writer_for(HERE, 15)
 
 def main() -> None:
     _ROUND12.write_sets(_write, FIVEBARS, {}, KINETICS, "2-14")
-    for name, (desc, tables) in CARTPOLES.items():
-        _ROUND14.HERE = HERE  # round 14's writer writes into its module's HERE
+    write_cartpoles(HERE, 15, CARTPOLES, ("rig",))
+
+
+def write_cartpoles(here: Path, number: int, cartpoles: dict, written: tuple[str, ...]) -> None:
+    """Write each cart-pole ``name: (description, tables)`` into ``here`` by round 14's writer,
+    with round ``number``'s header and tag, the keys of the ``written`` tables set in full."""
+    for name, (desc, tables) in cartpoles.items():
+        _ROUND14.HERE = here  # round 14's writer writes into its module's HERE
         _ROUND14._write_cartpole(name, desc, tables["excitation"])
-        path = HERE / f"{name}.toml"
-        text = path.read_text().replace("round 14", "round 15").replace('"round14"', '"round15"')
-        text = text.replace("round14/l_make.py", "round15/l_make.py")
-        for key, value in tables["rig"].items():  # the rig's keys, written in full by round 14's writer
+        path = here / f"{name}.toml"
+        text = path.read_text().replace("round 14", f"round {number}")
+        text = text.replace('"round14"', f'"round{number}"')
+        text = text.replace("round14/l_make.py", f"round{number}/l_make.py")
+        for key, value in {k: v for t in written for k, v in tables[t].items()}.items():
             text, n = _re_sub(key, value, text)
             assert n == 1, (name, key)
         path.write_text(text)

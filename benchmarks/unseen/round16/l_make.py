@@ -27,7 +27,6 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent))  # benchmarks/unseen: rounds 12, 14 and 15's linkage writers
 from round12 import l_make as _ROUND12  # noqa: E402
-from round14 import l_make as _ROUND14  # noqa: E402
 from round15 import l_make as _ROUND15  # noqa: E402
 
 #: name -> (description, {table: keys changed from the paper's sine scenario})
@@ -92,16 +91,7 @@ _write = _ROUND12.writer_for(HERE, 16)
 
 def main() -> None:
     _ROUND12.write_sets(_write, FIVEBARS, CARTPOLES, KINETICS, "2-15", MULTISINES)
-    for name, (desc, tables) in CARTPOLES_FULL.items():
-        _ROUND14.HERE = HERE  # round 14's writer writes into its module's HERE
-        _ROUND14._write_cartpole(name, desc, tables["excitation"])
-        path = HERE / f"{name}.toml"
-        text = path.read_text().replace("round 14", "round 16").replace('"round14"', '"round16"')
-        text = text.replace("round14/l_make.py", "round16/l_make.py")
-        for key, value in {**tables["rig"], **tables["simulation"]}.items():  # written in full
-            text, n = _ROUND15._re_sub(key, value, text)
-            assert n == 1, (name, key)
-        path.write_text(text)
+    _ROUND15.write_cartpoles(HERE, 16, CARTPOLES_FULL, ("rig", "simulation"))
 
 
 if __name__ == "__main__":
