@@ -144,7 +144,6 @@ def measurement_cases() -> Iterator[Case]:
     yield "prior a list", built(prior=[1, 2])
     yield "prior NaN mass", built(prior={"total_mass": float("nan")})
     yield "input_map of wrong shape", built(input_map=np.ones((2, 2)))
-    yield "u without inputs", built(u=np.ones((1, base.n_samples)))
     yield "u of wrong length", built(u=np.ones((1, 7)), inputs=("f",), input_map=np.ones((3, 1)))
     yield "noise_std of wrong shape", built(noise_std=np.ones(5))
     yield "noise_std negative", built(noise_std=-np.ones(3))
@@ -174,6 +173,13 @@ def measurement_cases() -> Iterator[Case]:
     yield "fs numpy float32", same(fs=np.float32(12800))
     yield "list x", same(x=x.tolist())
     yield "fs=1e-300 (a rate > 0: fitted)", lambda: _fit(Measurement(**{**f, "fs": 1e-300}))
+    def unnamed_inputs() -> Measurement:  # allowed when u is given (session 15): built, not refused
+        try:
+            return Measurement(**{**f, "u": np.ones((1, base.n_samples))})
+        except Exception as e:
+            raise AssertionError(f"refused a measurement with unnamed inputs: {e}") from e
+
+    yield "u without input names (accepted)", unnamed_inputs
 
 
 # --- estimators --------------------------------------------------------------------------------
