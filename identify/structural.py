@@ -802,7 +802,7 @@ def check_peak_band(data: Measurement, n_window: int, band: tuple[float, float],
     if lo < hi:
         return
     lines = PEAK_BAND_LINES * data.fs / max(int(n_window), 1)
-    if lo <= lines and lines >= hi:  # the window's length closed it
+    if lines >= hi:  # the window's length closed it (whatever else may close it too)
         need = int(np.floor(PEAK_BAND_LINES * data.fs / hi)) + 1
         raise IdentificationError(
             f"the free decay from sample {start} holds {n_window} samples; the peak search that "

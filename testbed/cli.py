@@ -724,7 +724,7 @@ def cmd_identify(args: argparse.Namespace) -> int:
     from testbed.pipeline.fit import identify_file
     from testbed.reporting.identified import render_identified
     from testbed.reporting.progress import run_progress
-    from testbed.scoring.scorers import fitted_model_failures
+    from testbed.scoring.scorers import fitted_model_failures, prediction_r2
 
     _load_plugins(args)
     units = None
@@ -743,7 +743,7 @@ def cmd_identify(args: argparse.Namespace) -> int:
                                format=args.format, fs=args.fs, units=units,
                                prior=_key_values(args.prior, "--prior", numbers=True), phase=phase)
     summary = result.summary()
-    failures = fitted_model_failures(result.model, summary.get("r2"))
+    failures = fitted_model_failures(result.model, prediction_r2(result.model, result.data))
     if failures is not None:
         summary["physical_failures"] = failures
     text = json.dumps(summary, indent=1, allow_nan=True) + "\n"

@@ -356,7 +356,8 @@ def measurement_from_file(path: str | os.PathLike, kind: str, signal: Mapping[st
     _check_units(data.source, ds, kind)
     if kind == "mechanical" and RESPONSE_SIGNAL[kind] in ds.measured:  # after the units: in rad
         _check_unwrapped(data.source, ds.measured[RESPONSE_SIGNAL[kind]], RESPONSE_SIGNAL[kind])
-    _check_rates(data.source, ds, kind)
+    if (signal or {}).get("derivatives", "recorded") == "recorded":  # the rates the fit reads
+        _check_rates(data.source, ds, kind)
     try:
         return measure(ds, dict(signal or {}), kind)
     except TestbedError:
@@ -482,6 +483,10 @@ RATE_MISFIT_MAX = 0.5
 #: five-bar, cart-pole and kinetics records (noisy ones included) the largest is 2.7e-4 (a
 #: cart-pole), the largest misfit with the offset set aside 0.021, as without.
 RATE_BIAS_MAX = 0.25
+#: Length of the windows the rate check compares over, in periods of the pair's own motion
+#: (:func:`rate_misfit`): white noise of 20 % of the rate's RMS then misfits about 0.2 of the
+#: motion whatever the record's length (over the whole of a 300 s record at 100 Hz it was 0.60).
+RATE_WINDOW_PERIODS = 4.0
 
 
 def _check_rates(path: Path, ds: Dataset, kind: str) -> None:
@@ -495,7 +500,9 @@ def _check_rates(path: Path, ds: Dataset, kind: str) -> None:
     rad/s), a five-bar whose rates were a copy of its angles and a Michaelis-Menten record whose
     ``dx`` was the negated rate were each fitted into a model with status 0 (round 16): the
     identifiers read the rates as given.  A record whose signal and rate are both scaled alike
-    (all in degrees) is consistent and not caught here.
+    (all in degrees) is consistent and not caught here.  Checked only where the chain reads the
+    recorded rates (``derivatives = 'recorded'``, the default): estimated from the signal, the
+    recorded ones are not used, and a poor gyroscope is no reason to refuse the record.
     """
     for g, dg in RATE_PAIRS.get(kind, ()):
         if g not in ds.measured or dg not in ds.measured:
@@ -517,11 +524,20 @@ def _check_rates(path: Path, ds: Dataset, kind: str) -> None:
             if what:
                 raise MeasuredDataError(path, f"signal {dg!r} channel {dx.channels[k]!r} is not the "
                                               f"rate of {g!r} channel {ch!r}: {what} (a rate in other "
-                                              "units, e.g. degrees under rad, or of another channel?)")
+                                              "units, e.g. degrees under rad, or of another channel? "
+                                              "or estimate the rates from the signal: [signal] "
+                                              "derivatives = 'estimated')")
 
 
 def rate_misfit(a: np.ndarray, d: np.ndarray, fs: float) -> tuple[np.ndarray, np.ndarray]:
     """How far recorded rates are from the time derivatives of their recorded signals.
+
+    The running trapezoid integral of each rate is compared with its signal in windows of
+    :data:`RATE_WINDOW_PERIODS` of the pair's own period ``2 pi rms(d) / rms(a - mean a)`` (the
+    whole record if shorter): an error of the rate that the integral would pile up over a long
+    record (white noise, a slowly wandering offset) counts over a few periods only, as the
+    motion does.  In each window the integral starts afresh and the misfit's mean and linear
+    drift (a constant offset of the rate) are set aside.
 
     Parameters
     ----------
@@ -533,27 +549,42 @@ def rate_misfit(a: np.ndarray, d: np.ndarray, fs: float) -> tuple[np.ndarray, np
     Returns
     -------
     misfit : ndarray, shape (n_channels,)
-        RMS of the signal less the running trapezoid integral of its rate, its mean and its
-        linear drift (a constant offset of the rate) removed, relative to the signal's RMS about
-        its mean [-] (0 where the signal does not move: nothing to check).
+        RMS of the windows' misfits relative to the signal's RMS about its mean [-], where that
+        motion stands above three times the signal's white-noise level (``noise_std``); 0 where
+        it does not (a channel that hardly moves: nothing to check).
     bias : ndarray, shape (n_channels,)
-        That constant offset of the rate (the drift's slope) relative to the rate's RMS [-]
-        (0 where the rate is identically 0).
+        The rate's constant offset over the whole record (the whole-record misfit's slope)
+        relative to the rate's RMS [-] (0 where the rate is identically 0).
     """
+    from testbed.numerics.noise import noise_std
+
     n = a.shape[1]
-    integral = np.concatenate([np.zeros((a.shape[0], 1)),
-                               np.cumsum((d[:, 1:] + d[:, :-1]) * 0.5, axis=1) / fs], axis=1)
-    tt = (np.arange(n) - 0.5 * (n - 1)) / fs
-    res = a - integral
-    res -= res.mean(axis=1, keepdims=True)
-    slope = (res @ tt) / float(tt @ tt)
-    res -= slope[:, None] * tt
     motion = np.sqrt(np.mean((a - a.mean(axis=1, keepdims=True)) ** 2, axis=1))
     rate = np.sqrt(np.mean(d ** 2, axis=1))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        misfit = np.where(motion > 0, np.sqrt(np.mean(res ** 2, axis=1)) / motion, 0.0)
-        bias = np.where(rate > 0, np.abs(slope) / rate, 0.0)
+    floor = 3.0 * noise_std(a) if n >= 16 else np.zeros(a.shape[0])
+    misfit, bias = np.zeros(a.shape[0]), np.zeros(a.shape[0])
+    for k in range(a.shape[0]):
+        if rate[k] > 0:
+            bias[k] = abs(_detrended(a[k], d[k], fs)[1]) / rate[k]
+        if not motion[k] > floor[k]:
+            continue
+        w = n if not rate[k] > 0 else int(min(n, max(3, RATE_WINDOW_PERIODS * 2 * np.pi * fs
+                                                          * motion[k] / rate[k])))
+        res = [_detrended(a[k, i:i + w], d[k, i:i + w], fs)[0] for i in range(0, n - w + 1, w)]
+        res += [] if n % w < 3 else [_detrended(a[k, n - w:], d[k, n - w:], fs)[0]]
+        misfit[k] = np.sqrt(np.mean(np.concatenate(res) ** 2)) / motion[k]
     return misfit, bias
+
+
+def _detrended(a: np.ndarray, d: np.ndarray, fs: float) -> tuple[np.ndarray, float]:
+    """The signal less its rate's running integral, mean and linear drift removed, and the
+    drift's slope [unit/s] (the rate's constant offset, sign flipped)."""
+    integral = np.concatenate([[0.0], np.cumsum((d[1:] + d[:-1]) * 0.5) / fs])
+    tt = (np.arange(a.size) - 0.5 * (a.size - 1)) / fs
+    res = a - integral
+    res = res - res.mean()
+    slope = float(res @ tt) / float(tt @ tt) if a.size > 1 else 0.0
+    return res - slope * tt, slope
 
 
 #: What each measured signal of a rig kind holds (:data:`SAME_ORDER` of its unit); a

@@ -799,6 +799,41 @@ def physical_failures(M: np.ndarray, C: np.ndarray, K: np.ndarray) -> dict[str, 
     return out
 
 
+def prediction_r2(model: Any, data: Any) -> float | None:
+    """A structural model's truth-free R^2 of its predicted accelerations, pooled over channels.
+
+    ``1 - sum(SS_res) / sum(SS_tot)`` over the channels and the samples from ``data.free_start``
+    on (the window of the model's own ``score``, which averages the channels' R^2 instead): the
+    share of the record's total variance about each channel's mean that the model predicts, so
+    a quiet channel near a mode's node, whose own R^2 can be far below 0, weighs by its variance.
+
+    Parameters
+    ----------
+    model : Identifier
+        Fitted, with ``predict_acceleration`` and ``M_``.
+    data : Measurement
+        The record it was fitted to.
+
+    Returns
+    -------
+    float or None
+        R^2 [-] (NaN if a prediction is not finite or the record has no variance); None for a
+        model without a structural prediction.
+    """
+    if not hasattr(model, "M_") or not hasattr(model, "predict_acceleration"):
+        return None
+    s = slice(data.free_start, None)
+    try:
+        pred = np.asarray(model.predict_acceleration(data), dtype=float)[:, s]
+    except (NotImplementedError, np.linalg.LinAlgError, ValueError):
+        return None
+    meas = np.asarray(data.xdd, dtype=float)[:, s]
+    ss_tot = float(np.sum((meas - meas.mean(axis=1, keepdims=True)) ** 2))
+    if not np.all(np.isfinite(pred)) or not ss_tot > 0.0:
+        return float("nan")
+    return 1.0 - float(np.sum((meas - pred) ** 2)) / ss_tot
+
+
 def fitted_model_failures(model: Any, r2: float | None = None) -> dict[str, str] | None:
     """What makes an identified model a failed identification without any truth to score it.
 
@@ -808,8 +843,8 @@ def fitted_model_failures(model: Any, r2: float | None = None) -> dict[str, str]
         Fitted: a structural one with ``M_``, ``C_``, ``K_``, or an equation model with
         ``coef_``.
     r2 : float, optional
-        The model's truth-free ``score`` on the record it was fitted to (R^2 of its predicted
-        accelerations, 0 = no better than each channel's mean); None where it has none.
+        The model's truth-free R^2 on the record it was fitted to, pooled over its channels
+        (:func:`prediction_r2`; 0 = no better than each channel's mean); None where it has none.
 
     Returns
     -------

@@ -194,7 +194,8 @@ def test_a_wrapped_angle_is_refused_naming_its_channel_and_step(tmp_path, wrappe
         measurement_from_file(f, "mechanical", {"derivatives": "lowpass"})
 
 
-@pytest.mark.parametrize("edit", ["none", "degrees", "copy", "negated", "biased", "spinning degrees"])
+@pytest.mark.parametrize("edit", ["none", "degrees", "copy", "negated", "biased", "spinning degrees",
+                                  "estimated", "long noisy", "quiet channel"])
 def test_a_recorded_rate_that_is_not_its_signals_is_refused(tmp_path, edit):
     import math
 
@@ -204,13 +205,17 @@ def test_a_recorded_rate_that_is_not_its_signals_is_refused(tmp_path, edit):
 
     # a cart-pole's pole angle logged in degrees under "rad", rates that were a copy of the
     # angles, a kinetics record's negated rate: each was fitted into a model, status 0
-    fs, n = 100.0, 400
+    fs, n = 100.0, (30000 if edit == "long noisy" else 400)
     t = np.arange(n) / fs
     w = 2 * np.pi * 0.7
-    th, dth = 0.5 * np.sin(w * t), 0.5 * w * np.cos(w * t)
-    x, dx = 0.1 * np.sin(0.3 * w * t), 0.03 * w * np.cos(0.3 * w * t)
-    if edit == "degrees":
+    th, dth, ddth = 0.5 * np.sin(w * t), 0.5 * w * np.cos(w * t), -0.5 * w * w * np.sin(w * t)
+    x, dx, ddx = (0.1 * np.sin(0.3 * w * t), 0.03 * w * np.cos(0.3 * w * t),
+                  -0.009 * w * w * np.sin(0.3 * w * t))
+    chain = {}  # the rates as recorded (the default): the ones the fit reads
+    if edit in ("degrees", "estimated"):
         th = th * 180 / math.pi
+        if edit == "estimated":  # the recorded rates are not used: nothing to refuse
+            chain = {"derivatives": "lowpass"}
     elif edit == "copy":
         dth = th.copy()
     elif edit == "biased":  # a gyroscope's offset, 15 % of the rate's RMS: a linear drift of its
@@ -218,6 +223,12 @@ def test_a_recorded_rate_that_is_not_its_signals_is_refused(tmp_path, edit):
     elif edit == "spinning degrees":  # a link turning at 0.5 rev/s, logged in degrees under "rad":
         th, dth = 2 * np.pi * 0.5 * t + th, 2 * np.pi * 0.5 + dth  # only an offset shows it
         th = th * 180 / math.pi
+    elif edit == "long noisy":  # 300 s, white noise of 20 % of the rate's RMS on the rate: its
+        dth = dth + 0.2 * np.sqrt(np.mean(dth ** 2)) * np.random.default_rng(1).standard_normal(n)
+        # integral over the whole record misfit 0.6 of the motion and was refused
+    elif edit == "quiet channel":  # the cart hardly moves: 2 mm under 1 mm of sensor noise
+        x = 0.002 * np.sin(0.3 * w * t) + 0.001 * np.random.default_rng(2).standard_normal(n)
+        dx, ddx = dx / 50, ddx / 50
     if edit == "negated":  # the dynamical kind's (x, dx)
         f = _sep005(tmp_path / "k.json", {"x/x": ("mM", (1.5 + th).tolist(), 1),
                                           "dx/dx": ("mM/s", (-dth).tolist(), 1)})
@@ -227,13 +238,15 @@ def test_a_recorded_rate_that_is_not_its_signals_is_refused(tmp_path, edit):
     f = _sep005(tmp_path / "r.json", {"theta/x": ("m", x.tolist(), 1), "theta/th": ("rad", th.tolist(), 2),
                                       "dtheta/dx": ("m/s", dx.tolist(), 1),
                                       "dtheta/dth": ("rad/s", dth.tolist(), 2),
-                                      "torque/u1": ("N", np.sin(1.1 * w * t).tolist(), 1)})
-    if edit in ("none", "biased"):
-        assert measurement_from_file(f, "mechanical", {"derivatives": "lowpass"}).x.shape == (2, n)
+                                      "ddtheta/ddx": ("m/s^2", ddx.tolist(), 1),
+                                      "ddtheta/ddth": ("rad/s^2", ddth.tolist(), 2),
+                                      "torque/u1": ("N", np.sin(1.1 * w * t).tolist(), 1)}, fs)
+    if edit in ("none", "biased", "estimated", "long noisy", "quiet channel"):
+        assert measurement_from_file(f, "mechanical", chain).x.shape == (2, n)
         return
     what = "misses"
     if edit == "spinning degrees":
         what = r"drifts .* as if the rate were offset by 5\d\.\d of its RMS; expected at most 0.25"
     with pytest.raises(MeasuredDataError, match=r"'dtheta' channel 'dth' is not the rate of 'theta' "
                                                 r"channel 'th': its running integral " + what):
-        measurement_from_file(f, "mechanical", {"derivatives": "lowpass"})
+        measurement_from_file(f, "mechanical", chain)

@@ -367,6 +367,26 @@ def test_testbed_identify_fails_a_model_that_predicts_worse_than_the_mean(r2, fa
     assert ("prediction" in eq) is fails
 
 
+def test_the_prediction_r2_pools_the_channels_so_a_quiet_one_does_not_decide():
+    # review of session 16: averaged over channels, a quiet channel near a node (its own R^2
+    # -5) dragged a good model's R^2 below 0; pooled, it weighs by its variance
+    from types import SimpleNamespace as Model
+
+    from testbed.scoring.scorers import prediction_r2
+
+    t = np.linspace(0.0, 1.0, 500)
+    meas = np.vstack([np.sin(40 * t), np.cos(40 * t), 1e-3 * np.sin(40 * t)])
+    pred = meas + np.vstack([0.01 * np.cos(40 * t), 0.01 * np.sin(40 * t), 2.4e-3 * np.cos(40 * t)])
+    data = Model(xdd=meas, free_start=0)
+    good = Model(M_=np.eye(3), predict_acceleration=lambda d: pred)
+    ss_tot = np.sum((meas - meas.mean(1, keepdims=True)) ** 2, axis=1)
+    per_channel = 1 - np.sum((meas - pred) ** 2, axis=1) / ss_tot
+    assert per_channel.mean() < 0 < prediction_r2(good, data) and prediction_r2(good, data) > 0.99
+    bad = Model(M_=np.eye(3), predict_acceleration=lambda d: -pred)
+    assert prediction_r2(bad, data) < 0
+    assert prediction_r2(Model(coef_=np.ones(3)), data) is None
+
+
 # ---------------------------------------------------------------- stored runs (input audit round 4)
 def _synthetic():
     """tests/testbed/_synthetic_runs.py (imported as test_runstore and test_faults do)."""

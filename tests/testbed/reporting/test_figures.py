@@ -298,7 +298,7 @@ def test_pngs_are_encoded_fast_and_hold_the_same_pixels(runs, tmp_path):
             ref = tmp_path / f"{kind}-{stem}-default.png"
             with mpl.rc_context(figures.STYLE):  # as save_figure draws (unhinted text)
                 fig.savefig(ref, format="png")
-            assert _zlib_level(ours.read_bytes()) == 0 and _zlib_level(ref.read_bytes()) == 2
+            assert _zlib_level(ours.read_bytes()) == 0  # zlib's fastest class (levels 0-1)
             drawn.append(stem)
             with Image.open(ours) as a, Image.open(ref) as b:
                 assert a.mode == b.mode and a.size == b.size, stem
