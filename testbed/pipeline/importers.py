@@ -62,6 +62,7 @@ from testbed.core.budget import IDENTIFY_BYTES_PER_VALUE, IDENTIFY_TEXT_BUDGET_B
 from testbed.core.dataset import Dataset, DatasetError, Signal
 from testbed.core.errors import TestbedError, is_control, show_names
 from testbed.core.measurement import Measurement
+from testbed.numerics.noise import noise_std
 from testbed.pipeline.signal_chain import SIGNAL_CHAINS, SIGNAL_SCHEMAS, measure
 
 FORMATS = ("uff", "sep005", "csv", "hdf5")
@@ -556,8 +557,6 @@ def rate_misfit(a: np.ndarray, d: np.ndarray, fs: float) -> tuple[np.ndarray, np
         The rate's constant offset over the whole record (the whole-record misfit's slope)
         relative to the rate's RMS [-] (0 where the rate is identically 0).
     """
-    from testbed.numerics.noise import noise_std
-
     n = a.shape[1]
     motion = np.sqrt(np.mean((a - a.mean(axis=1, keepdims=True)) ** 2, axis=1))
     rate = np.sqrt(np.mean(d ** 2, axis=1))
