@@ -29,6 +29,7 @@ import subprocess
 import sys
 import time
 import tomllib
+from collections.abc import Callable
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -73,6 +74,21 @@ def _merged(path: Path) -> dict:
                 base[k] = v
         return base
     return raw
+
+
+#: Draws every rig shares: option -> (table, key, draw(rng)); the case name gets ``{option}{value}``
+_COMMON = {
+    "noise": ("noise", "rms_percent", lambda rng: round(rng.uniform(0.5, 5.0), 2)),
+    "seed": ("scenario", "seed", lambda rng: rng.randint(1, 999)),
+}
+
+
+def _set(rng: random.Random, ch: dict, opt: str, spec: tuple) -> str:
+    """Draw ``spec``'s value into ``ch[table][key]``; the case name's part."""
+    table, key, draw = spec
+    v = draw(rng)
+    ch[table][key] = v
+    return f"{opt}{v}"
 
 
 def _draw_beam(rng: random.Random, sc: dict, ch: dict, ident: str) -> list[str]:
@@ -120,14 +136,8 @@ def _draw_beam(rng: random.Random, sc: dict, ch: dict, ident: str) -> list[str]:
             fs = rng.choice([6400.0, 25600.0])
             ch["simulation"]["sample_rate"] = fs
             what.append(f"fs{fs:g}")
-        elif opt == "noise":
-            p = round(rng.uniform(0.5, 5.0), 2)
-            ch["noise"]["rms_percent"] = p
-            what.append(f"noise{p}")
-        elif opt == "seed":
-            s = rng.randint(1, 999)
-            ch["scenario"]["seed"] = s
-            what.append(f"seed{s}")
+        elif opt in _COMMON:
+            what.append(_set(rng, ch, opt, _COMMON[opt]))
         elif opt == "base":
             if rig.get("base") == "soft":
                 k1 = round(10 ** rng.uniform(2.9, 3.9), 0)
@@ -177,14 +187,8 @@ def _draw_fivebar(rng: random.Random, sc: dict, ch: dict) -> list[str]:
             d = round(rng.uniform(3.0, 10.0), 1)
             ch["simulation"]["duration"] = d
             what.append(f"d{d}")
-        elif opt == "noise":
-            p = round(rng.uniform(0.5, 5.0), 2)
-            ch["noise"]["rms_percent"] = p
-            what.append(f"noise{p}")
-        elif opt == "seed":
-            s = rng.randint(1, 999)
-            ch["scenario"]["seed"] = s
-            what.append(f"seed{s}")
+        elif opt in _COMMON:
+            what.append(_set(rng, ch, opt, _COMMON[opt]))
         elif opt == "mass":
             key = rng.choice(["m1", "m2", "m3", "m4"])
             v = round(rng.uniform(0.5, 2.0), 2)
@@ -197,55 +201,32 @@ def _draw_fivebar(rng: random.Random, sc: dict, ch: dict) -> list[str]:
     return what
 
 
-def _draw_cartpole(rng: random.Random, sc: dict, ch: dict) -> list[str]:
-    what = []
-    for opt in rng.sample(["cart_mass", "pole_mass", "pole_length", "amplitude", "noise", "seed"],
-                          rng.randint(1, 3)):
-        if opt == "cart_mass":
-            v = round(rng.uniform(0.5, 3.0), 2)
-            ch["rig"]["cart_mass"] = v
-        elif opt == "pole_mass":
-            v = round(rng.uniform(0.1, 2.0), 2)
-            ch["rig"]["pole_mass"] = v
-        elif opt == "pole_length":
-            v = round(rng.uniform(0.3, 1.5), 2)
-            ch["rig"]["pole_length"] = v
-        elif opt == "amplitude":
-            v = round(rng.uniform(0.5, 3.0), 2)
-            ch["excitation"]["amplitude"] = v
-        elif opt == "noise":
-            v = round(rng.uniform(0.5, 5.0), 2)
-            ch["noise"]["rms_percent"] = v
-        else:
-            v = rng.randint(1, 999)
-            ch["scenario"]["seed"] = v
-        what.append(f"{opt}{v}")
-    return what
+#: The cart-pole's and the kinetics' draws, in the order the options are sampled from
+_CARTPOLE = {
+    "cart_mass": ("rig", "cart_mass", lambda rng: round(rng.uniform(0.5, 3.0), 2)),
+    "pole_mass": ("rig", "pole_mass", lambda rng: round(rng.uniform(0.1, 2.0), 2)),
+    "pole_length": ("rig", "pole_length", lambda rng: round(rng.uniform(0.3, 1.5), 2)),
+    "amplitude": ("excitation", "amplitude", lambda rng: round(rng.uniform(0.5, 3.0), 2)),
+    **_COMMON,
+}
+_MM = {
+    "Km": ("rig", "Km", lambda rng: round(10 ** rng.uniform(-1, 0.5), 3)),
+    "Vmax": ("rig", "Vmax", lambda rng: round(rng.uniform(1.0, 5.0), 2)),
+    "jx": ("rig", "jx", lambda rng: round(rng.uniform(0.2, 0.9), 2)),
+    "x0": ("rig", "x0", lambda rng: round(rng.uniform(0.5, 5.0), 2)),
+    **_COMMON,
+}
 
 
-def _draw_mm(rng: random.Random, sc: dict, ch: dict) -> list[str]:
-    what = []
-    for opt in rng.sample(["Km", "Vmax", "jx", "x0", "noise", "seed"], rng.randint(1, 3)):
-        if opt == "Km":
-            v = round(10 ** rng.uniform(-1, 0.5), 3)
-            ch["rig"]["Km"] = v
-        elif opt == "Vmax":
-            v = round(rng.uniform(1.0, 5.0), 2)
-            ch["rig"]["Vmax"] = v
-        elif opt == "jx":
-            v = round(rng.uniform(0.2, 0.9), 2)
-            ch["rig"]["jx"] = v
-        elif opt == "x0":
-            v = round(rng.uniform(0.5, 5.0), 2)
-            ch["rig"]["x0"] = v
-        elif opt == "noise":
-            v = round(rng.uniform(0.5, 5.0), 2)
-            ch["noise"]["rms_percent"] = v
-        else:
-            v = rng.randint(1, 999)
-            ch["scenario"]["seed"] = v
-        what.append(f"{opt}{v}")
-    return what
+def _draw_table(table: dict) -> Callable[[random.Random, dict, dict], list[str]]:
+    """A rig's drawer: one to three of ``table``'s options, each drawn into its key."""
+    def draw(rng: random.Random, sc: dict, ch: dict) -> list[str]:
+        return [_set(rng, ch, opt, table[opt]) for opt in rng.sample(list(table), rng.randint(1, 3))]
+    return draw
+
+
+_draw_cartpole = _draw_table(_CARTPOLE)
+_draw_mm = _draw_table(_MM)
 
 
 def draw_cases(n: int = N_CASES, seed: int = SEED) -> list[tuple[str, str, dict]]:

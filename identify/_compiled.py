@@ -570,21 +570,10 @@ def eig_work(n):
 
 
 @njit(**_JIT)
-def _gen_eigh(K, M):
-    """Generalised symmetric eigenproblem ``K u = lam M u`` (M positive definite), small n.
-
-    Returns U (n, n; columns sorted by ascending eigenvalue, ``U^T M U = I``) and the
-    eigenvalues (n,): :func:`_gen_eigh_into` with its own scratch.
-    """
-    w = eig_work(K.shape[0])
-    _gen_eigh_into(K, M, w)
-    return w[6].copy(), w[7].copy()
-
-
-@njit(**_JIT)
 def _gen_eigh_into(K, M, w):
-    """:func:`_gen_eigh` into the scratch ``w`` (:func:`eig_work`): U in ``w[6]``, the
-    eigenvalues in ``w[7]``.
+    """Generalised symmetric eigenproblem ``K u = lam M u`` (M positive definite), small n,
+    into the scratch ``w`` (:func:`eig_work`): U (n, n; columns sorted by ascending eigenvalue,
+    ``U^T M U = I``) in ``w[6]``, the eigenvalues (n,) in ``w[7]``.
 
     Cholesky ``M = C C^T``, cyclic Jacobi on ``C^-1 K C^-T`` (rotations until every
     off-diagonal entry is below 1e-15 of the diagonal's norm), ``U = C^-T V`` so that
