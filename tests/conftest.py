@@ -40,12 +40,16 @@ with contextlib.suppress(ImportError):
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
+from tests import _chromium  # noqa: E402  (the checkout on sys.path first)
+
 #: The shared test dataset cache: ``$TESTBED_TEST_CACHE``, else ``.cache/test-datasets`` of the
 #: checkout (set it to time a cold suite without emptying the checkout's cache).
 TEST_CACHE = Path(os.environ.get("TESTBED_TEST_CACHE", ROOT / ".cache" / "test-datasets"))
 #: Lock files of the test processes sharing :data:`TEST_CACHE` (outside the cached entries'
 #: folder listing: :meth:`DatasetCache.entries` reads ``*.h5`` only).
 LOCKS = TEST_CACHE / ".locks"
+#: Held while a background install of Chromium runs (:mod:`tests._chromium`).
+CHROMIUM_LOCK = LOCKS / "chromium.lock"
 
 
 @contextlib.contextmanager
@@ -104,6 +108,23 @@ def pytest_collection_modifyitems(config, items):
     # longest work first (the order xdist deals the work units in: see pytest_configure)
     rank = {id(item): _COLD_SECONDS.get(_work_unit(item), 0.0) for item in items}
     items.sort(key=lambda item: -rank[id(item)])  # stable: a module's tests keep their order
+    # a missing Chromium installed while the suite runs, not inside the report test's setup
+    if any("chromium" in item.fixturenames for item in items):
+        _chromium.start_install(CHROMIUM_LOCK, LOCKS / "chromium-install.log")
+
+
+@pytest.fixture(scope="session")
+def chromium() -> str:
+    """Chromium for the report tests; where missing, installed with apt-get (as root) while the
+    suite runs (:mod:`tests._chromium`, started at collection); skip only if it cannot be had."""
+    exe, why = _chromium.wait_and_find(CHROMIUM_LOCK)
+    if exe is None:
+        pytest.skip(why)
+    return exe
+
+
+def pytest_unconfigure(config):
+    _chromium.wait_started()  # no install outlives the run
 
 
 #: node id prefix of the shipped scenario tests

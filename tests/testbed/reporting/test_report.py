@@ -10,9 +10,7 @@ after load, whether every image decoded (``naturalWidth > 0``).
 from __future__ import annotations
 
 import json
-import os
 import re
-import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -164,31 +162,6 @@ def test_study_report_content(reports):
 
 
 # ------------------------------------------------------------------ real headless Chromium
-def _find_chromium() -> str | None:
-    for exe in ("chromium", "chromium-browser", "google-chrome"):
-        if path := shutil.which(exe):
-            return path
-    return None
-
-
-@pytest.fixture(scope="session")
-def chromium() -> str:
-    """Chromium, installed with apt-get when missing; skip only if it cannot be had."""
-    exe = _find_chromium()
-    if exe is None:
-        if shutil.which("apt-get") is None or os.geteuid() != 0:
-            pytest.skip("chromium missing and cannot be installed here (needs apt-get as root): "
-                        "apt-get install chromium chromium-driver")
-        cmd = ("apt-get update && apt-get install -y -o DPkg::Lock::Timeout=600 "
-               "chromium chromium-driver")
-        r = subprocess.run(cmd, shell=True, capture_output=True, text=True, timeout=1800,
-                           env={**os.environ, "DEBIAN_FRONTEND": "noninteractive"})
-        exe = _find_chromium()
-        if exe is None:
-            pytest.skip(f"apt-get could not install chromium (exit {r.returncode}): {r.stderr[-400:]}")
-    return exe
-
-
 def run_chromium(exe: str, url: str, tmp: Path, *extra: str) -> subprocess.CompletedProcess:
     args = [exe, "--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
             "--disable-component-update", "--disable-sync", "--no-first-run", "--disable-extensions",
