@@ -144,9 +144,10 @@ class LeastSquaresSINDy(StructuralIdentifier):
 
     5. *Unresolved modes placed* (linear library, ``fit_tilt`` by rule; only where the model
        would be refused: tilted, held and flat all grow): in the tilted fit, a mode whose
-       stiffness eigenvalue is not positive or whose frequency lies above the peak search's
-       band top (:func:`identify.structural.peak_band`: 0.8 x the chain's low-pass) is one the
-       record cannot resolve; where the other modes carry every accepted peak it is placed at
+       pole reaches beyond the peak search's band top (:func:`identify.structural.peak_band`:
+       0.8 x the chain's low-pass; :func:`identify._unresolved.modal_pole_reach`: the
+       frequency, or a negative stiffness's larger real pole) is one the record cannot
+       resolve; where the other modes carry every accepted peak it is placed at
        that top, critically damped and uncoupled in damping, shapes kept
        (:func:`identify._unresolved.place_unresolved`), then the holds; kept if physical
        (``unresolved_rule_`` says what was placed).  Round 16's five sensors at 12.8 kHz on
@@ -360,7 +361,8 @@ class LeastSquaresSINDy(StructuralIdentifier):
             # against 10.6 true in the band at 0.7 x 101 Hz)
             band_hz = self.fit_band_hz if cut is None else cut
             self.__dict__.pop("modal_decay_", None)
-            self.unresolved_rule_ = "not needed: no fit was refused for a growing mode"
+            self.unresolved_rule_ = ("none placed (step 5 acts only on a fit refused for a mode "
+                                     "beyond the peak band)")
             self.cubic_, self.cubic_rule_ = cubic_rule(data, self.cubic, band_hz, ps.peaks, default)
             self._fit_in_band(data, ps.peaks, m_hat, band_hz)
 

@@ -7,7 +7,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from identify._unresolved import UNRESOLVED_ZETA, place_unresolved, stiffness_eigenvalues
+from identify._unresolved import (
+    UNRESOLVED_ZETA,
+    modal_pole_reach,
+    place_unresolved,
+    stiffness_eigenvalues,
+)
 from identify.ls_sindy import LeastSquaresSINDy
 from identify.structural import check_physical, modal, state_matrix
 from testbed.pipeline.scenario import load_scenario
@@ -54,10 +59,22 @@ def test_a_mode_above_the_top_is_placed_but_not_a_missing_located_one():
     check_physical(M, C2, K2)
     np.testing.assert_allclose(modal(M, K2)[0], [100.0, 500.0, 2000.0], rtol=1e-9)
     assert place_unresolved(M, C, K, 3000.0, np.array([100.0])) is None  # all resolved
-    M, C, K = _model(np.array([-(2 * np.pi * 100.0) ** 2, *(2 * np.pi * np.array([500.0, 900.0])) ** 2]), rng)
+    # the 500 Hz peak's mode is the one above the top: not placed
+    M, C, K = _model((2 * np.pi * np.array([100.0, 2500.0, 2600.0])) ** 2, rng)
     assert place_unresolved(M, C, K, 2000.0, np.array([100.0, 500.0])) is None
+
+
+def test_a_negative_stiffness_inside_the_band_is_not_placed():
+    """A negative stiffness whose poles lie inside the band (a low mode the fit band removed,
+    round 15's b15_soft_long_al_L0p8_cf0p3: poles at +6.4 / -22.8 Hz, top 100 Hz) is no mode
+    beyond the band: not placed (the old rule put that mode 1 4353 % off)."""
+    rng = np.random.default_rng(5)
+    M, C, K = _model(np.array([-(2 * np.pi * 12.0) ** 2, *(2 * np.pi * np.array([24.0, 65.0])) ** 2]),
+                     rng)
     lam, _ = stiffness_eigenvalues(M, K)
     assert lam[0] < 0  # the negative one is reported, not NaN
+    assert modal_pole_reach(M, C, K)[0] < 2 * np.pi * 100.0
+    assert place_unresolved(M, C, K, 100.0, np.array([24.0])) is None
 
 
 def test_ls_sindy_fits_five_sensors_at_12k8(dataset_cache):
