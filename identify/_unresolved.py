@@ -1,0 +1,121 @@
+"""Modes the record cannot resolve: placed at the top of what the chain passes, not refused.
+
+A structural model has one mode per sensor. With many sensors at a modest sample rate the
+highest of them may lie where the record holds nothing to fit it by: at or past the peak
+search's band top (:func:`identify.structural.peak_band`, ``LOWPASS_MARGIN`` x the chain's low-
+pass, or ``0.45 fs``), and, with the beam's stiffness-proportional damping, so heavily damped
+that it dies within a sample or two (round 16's ``b16_ti_n32_s5``: five sensors at 12.8 kHz,
+mode 5 at 4619 Hz with 57 % damping, the band's top 4522 Hz). Least squares then fits that mode
+with a negative stiffness (a real pole pair, one growing at +1.8e5 1/s), and the whole model
+was refused although modes 1-3 came out within 2 % of the truth.
+
+The rule (:func:`place_unresolved`), from the data alone: a mode of the fitted model whose pole
+reaches beyond the band's top (:func:`modal_pole_reach`: its frequency for an underdamped mode,
+its larger real pole for a negative stiffness; 6275 Hz against the top's 4522 Hz on
+``b16_ti_n32_s5``) is *unresolved* by the record. A negative stiffness whose poles lie inside
+the band is not (round 15's ``b15_soft_long_al_L0p8_cf0p3``: mode 1 at 2.26 Hz, removed by the
+fit band, fitted with poles at +6.4 and -22.8 Hz: placing it at the 100 Hz top put mode 1
+4353 % off where the band's refusal gives 1.8 %). Where every accepted spectral peak is carried
+by a resolved mode (within :data:`~identify.structural.MODE_SEPARATION`: the located modes are
+all in the model, so the unresolved one is not a located mode gone wrong), each unresolved mode
+is placed at the band's top (the lowest frequency at which the record could hide it),
+critically damped (:data:`UNRESOLVED_ZETA`: no accepted peak shows it ringing) and uncoupled in
+damping from the other modes, its shape kept. Its contribution in the band is then the
+quasi-static one of a stiff, fast mode; the resolved modes keep what the fit gave them.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from identify._modal_damping import _is_symmetric, _modal_damping_matrix, hold_modal_damping
+from identify.structural import MODE_SEPARATION, modal
+
+#: Damping ratio given to an unresolved mode [-]: critical, the fastest decay without ringing
+#: (the record shows no peak of it).  Measured on ``b16_ti_n32_s5`` clean, ``ls_sindy``: TRAC
+#: 0.998 with 1.0 and 0.9997 with 0.5, modes 1-3 unchanged (not tuned: the declared choice).
+UNRESOLVED_ZETA = 1.0
+
+
+def stiffness_eigenvalues(M: np.ndarray, K: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The eigenvalues ``lambda`` [rad^2/s^2] of ``M^-1 K`` in the order and with the shapes of
+    :func:`identify.structural.modal` (non-positive ones kept, where ``modal`` gives NaN).
+
+    Parameters
+    ----------
+    M, K : ndarray, shape (n, n)
+        Mass [kg] and stiffness [N/m]; need not be symmetric.
+
+    Returns
+    -------
+    lam : ndarray, shape (n,)
+        Real parts [rad^2/s^2].
+    modes : ndarray, shape (n, n)
+        ``modal(M, K)[1]``.
+    """
+    _, Phi = modal(M, K)
+    lam = np.diag(np.linalg.solve(Phi, np.linalg.solve(M, K @ Phi))).real
+    return lam, Phi
+
+
+def modal_pole_reach(M: np.ndarray, C: np.ndarray, K: np.ndarray) -> np.ndarray:
+    """Each mode's largest pole modulus [1/s]: the larger root of ``s^2 + d_k s + lambda_k``,
+    ``lambda_k`` its stiffness eigenvalue (:func:`stiffness_eigenvalues`) and ``d_k`` its own
+    modal damping (the diagonal of ``Phi^-1 M^-1 C Phi``), couplings left out.  For an
+    underdamped mode it is ``sqrt(lambda_k)``; for a negative stiffness it is the growing or
+    the faster decaying real pole.  Shape (n,), ``modal``'s order."""
+    lam, Phi = stiffness_eigenvalues(M, K)
+    d = np.diag(_modal_damping_matrix(M, C, Phi, _is_symmetric(M, C, K))).real
+    disc = np.sqrt((0.25 * d * d - lam).astype(complex))
+    return np.maximum(np.abs(-0.5 * d + disc), np.abs(-0.5 * d - disc))
+
+
+def place_unresolved(M: np.ndarray, C: np.ndarray, K: np.ndarray, top_hz: float,
+                     peaks: np.ndarray) -> tuple[np.ndarray, np.ndarray, str] | None:
+    """The model with its unresolved modes placed at the band's top (module docstring).
+
+    Parameters
+    ----------
+    M, C, K : ndarray, shape (n, n)
+        The fitted mass [kg], damping [N s/m] and stiffness [N/m] (need not be symmetric).
+    top_hz : float
+        The peak search's band top [Hz] (:func:`identify.structural.peak_band`).
+    peaks : ndarray, shape (k,)
+        Accepted spectral peaks [Hz].
+
+    Returns
+    -------
+    (C, K, rule) or None
+        The new damping and stiffness and a statement of what was done; None where no mode is
+        unresolved (:func:`modal_pole_reach` beyond ``2 pi top_hz``), every mode is, a mode's
+        shapes do not span the space, or an accepted peak
+        has no resolved mode within :data:`~identify.structural.MODE_SEPARATION` of it.
+    """
+    if not (np.isfinite(top_hz) and top_hz > 0.0):
+        return None
+    lam, Phi = stiffness_eigenvalues(M, K)
+    bad = modal_pole_reach(M, C, K) > 2.0 * np.pi * top_hz
+    if not np.any(bad) or np.all(bad) or np.linalg.cond(Phi) > 1e12:
+        return None
+    f_ok = np.sqrt(lam[~bad]) / (2.0 * np.pi)
+    for p in np.asarray(peaks, dtype=float):
+        if not np.any(np.abs(f_ok / p - 1.0) <= MODE_SEPARATION):
+            return None
+    w2 = (2.0 * np.pi * top_hz) ** 2
+    d = np.where(bad, w2 - lam, 0.0)
+    K2 = K + (M @ Phi) @ np.linalg.solve(Phi.T, np.diag(d)).T
+    if np.allclose(M, M.T) and np.allclose(K, K.T):
+        K2 = 0.5 * (K2 + K2.T)
+    # the placed modes are now the highest (every resolved one lies at or below the top)
+    n_bad = int(np.count_nonzero(bad))
+    top = np.zeros(lam.size, dtype=bool)
+    top[lam.size - n_bad:] = True
+    sigma = np.where(top, UNRESOLVED_ZETA * np.sqrt(w2), np.nan)
+    C2 = hold_modal_damping(M, C, K2, sigma, uncouple=top)
+    what = ", ".join("a negative stiffness" if v <= 0 else f"{np.sqrt(v) / (2 * np.pi):.4g} Hz"
+                     for v in lam[bad])
+    rule = (f"{n_bad} mode(s) the record cannot resolve (fitted with {what}, a pole beyond the "
+            f"peak band's top {top_hz:.4g} Hz) placed at that top, damping ratio "
+            f"{UNRESOLVED_ZETA:g}, shapes kept; the {lam.size - n_bad} resolved modes carry "
+            f"every accepted peak")
+    return C2, K2, rule
