@@ -413,9 +413,9 @@ def select_models(sw: Sweep, input_cols: Sequence[np.ndarray], rtol: float = 0.1
     coefficient than every other input's terms (so a sparse model contains u_k and no other
     input, and the equations picked for different inputs are distinct).  They are ranked by
     :func:`rank_models`, by their held-out error (``sw.val_error``, per unit of the left-hand
-    side) or, where ``G_val`` is given, per unit of the input's part (:func:`input_errors`; a
-    candidate for open chains, measured in docs/known-gaps.md "SINDy-PI selection, session
-    16" and not yet passed by the identifiers).
+    side) or, where ``G_val`` is given, per unit of the input's part (:func:`input_errors`;
+    what ``sindy_pi`` passes for open chains, docs/known-gaps.md "SINDy-PI: the cart-pole's
+    input equation (session 18)").
 
     Parameters
     ----------
