@@ -579,11 +579,13 @@ def _detrended(a: np.ndarray, d: np.ndarray, fs: float) -> tuple[np.ndarray, flo
     """The signal less its rate's running integral, mean and linear drift removed, and the
     drift's slope [unit/s] (the rate's constant offset, sign flipped)."""
     integral = np.concatenate([[0.0], np.cumsum((d[1:] + d[:-1]) * 0.5) / fs])
-    tt = (np.arange(a.size) - 0.5 * (a.size - 1)) / fs
+    # the time in samples, not seconds: at fs = 1e200 Hz tt @ tt [s^2] underflowed to 0 (a
+    # ZeroDivisionError, round 17); the slope per sample is then scaled to per second
+    k = np.arange(a.size) - 0.5 * (a.size - 1)
     res = a - integral
     res = res - res.mean()
-    slope = float(res @ tt) / float(tt @ tt) if a.size > 1 else 0.0
-    return res - slope * tt, slope
+    per_sample = float(res @ k) / float(k @ k) if a.size > 1 else 0.0
+    return res - per_sample * k, per_sample * fs
 
 
 #: What each measured signal of a rig kind holds (:data:`SAME_ORDER` of its unit); a
