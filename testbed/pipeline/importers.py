@@ -833,6 +833,7 @@ def uniform_rate(path: Path, t: np.ndarray, what: str = "time column") -> float:
 # --------------------------------------------------------------------------- readers
 def _read_hdf5(path: Path) -> _Raw:
     _check_hdf5_size(path)
+    check_hdf5_rate(path)
     try:
         ds = Dataset.load(path)
     except DatasetError as e:
@@ -892,6 +893,41 @@ def _raw_from_dataset(path: Path, ds: Dataset) -> _Raw:
                 if target in node:
                     raw.nodes[f"{g}/{ch}"] = node[target]
     return raw
+
+
+def check_hdf5_rate(path: str | os.PathLike) -> None:
+    """Refuse a dataset file whose root attribute ``fs`` is not one real number, or whose
+    ``fs_unit`` is not ``"Hz"`` (a file that cannot be opened is left to :meth:`Dataset.load`).
+
+    :meth:`Dataset.load` read ``fs`` with ``float()``: the text ``"100"`` and ``True`` were
+    read as rates, a complex rate lost its imaginary part (with a warning over two lines), and
+    ``fs_unit`` (which the content hash leaves out) was never read, so ``"kHz"`` was taken as
+    Hz in silence (round 17).
+
+    Raises
+    ------
+    MeasuredDataError
+        Naming ``path``, the attribute, its value and what is allowed.
+    """
+    import h5py
+
+    try:
+        with h5py.File(path, "r") as h:
+            attrs = {k: h.attrs[k] for k in ("fs", "fs_unit") if k in h.attrs}
+    except Exception:
+        return
+    fs = attrs.get("fs")
+    if fs is not None and not (isinstance(fs, (np.floating, np.integer, float, int))
+                               and not isinstance(fs, (bool, np.bool_))):
+        shown = fs.item() if isinstance(fs, np.generic) else fs  # named as 'True', not
+        shown = shown.decode(errors="replace") if isinstance(shown, bytes) else shown  # np.True_
+        raise MeasuredDataError(path, f"attribute fs={shown!r} ({type(fs).__name__}); expected "
+                                      "one real number, the sample rate [Hz]")
+    unit = attrs.get("fs_unit")
+    unit = unit.decode(errors="replace") if isinstance(unit, bytes) else unit
+    if unit is not None and unit != "Hz":
+        raise MeasuredDataError(path, f"attribute fs_unit={unit!r}; expected 'Hz' (the unit the "
+                                      "sample rate fs is read in)")
 
 
 def _check_hdf5_size(path: Path) -> None:

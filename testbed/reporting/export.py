@@ -54,7 +54,7 @@ import numpy as np
 from testbed.core.atomic import atomic_write, atomic_write_text
 from testbed.core.dataset import Dataset, Signal
 from testbed.core.truth import StructuralTruth
-from testbed.pipeline.importers import check_recorded
+from testbed.pipeline.importers import check_hdf5_rate, check_recorded
 from testbed.pipeline.plugins import RIGS
 from testbed.pipeline.signal_chain import measure
 
@@ -360,6 +360,7 @@ def export_dataset(path: str | os.PathLike, fmt: str, out: str | os.PathLike | N
         they are (:func:`testbed.pipeline.importers.check_recorded`).
     """
     path = Path(path)
+    check_hdf5_rate(path)
     ds = Dataset.load(path)
     check_recorded(ds, path)  # an edited, rehashed file: NaN rate or samples, cut channels
     if fmt == "uff":

@@ -5,13 +5,17 @@ malformed-input audits), each fixed in the layer that owns it.
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
+import h5py
 import numpy as np
 import pytest
 
 from testbed import cli
-from testbed.pipeline.importers import rate_misfit
+from testbed.core.dataset import Dataset, Signal
+from testbed.pipeline.importers import MeasuredDataError, rate_misfit, read_measured
+from testbed.reporting.export import export_dataset
 
 
 def _mm_record(path: Path, fs: float, rate_scale: float = 1.0) -> Path:
@@ -45,3 +49,55 @@ def test_identify_of_a_record_relabelled_to_a_huge_rate_is_refused_in_one_line(t
                        "-o", str(tmp_path / "m.json")])
     err = capsys.readouterr().err.strip().splitlines()
     assert status == 2 and len(err) == 1 and "is not the rate of" in err[0], err
+
+
+# ------------------------------------------------------------------ a dataset file's rate attributes
+
+FS = 1000.0  # Hz; 400 samples of a 7 Hz sine: any rate and length the readers accept
+
+
+def _saved(tmp_path: Path) -> Path:
+    """A hand-made record (no kind: no truth to validate), saved with its content hash."""
+    t = np.arange(400) / FS
+    acc = np.vstack([np.sin(2 * np.pi * 7 * t) * (k + 1) for k in range(2)])
+    ds = Dataset(FS, {"acceleration": Signal(acc, ("acc1", "acc2"), "m/s^2"),
+                      "force": Signal(np.exp(-t / 0.01)[None, :], ("force",), "N")})
+    return ds.save(tmp_path / "d.h5")
+
+
+def _rehashed(path: Path, key: str, value) -> Path:
+    """``path`` with its root attribute ``key`` set to ``value`` and its content hash made anew
+    (as a user's edit would): only the readers' own checks stand between it and a fit."""
+    with h5py.File(path, "r+") as f:
+        f.attrs[key] = value
+    ds = Dataset.load(path, verify=False)
+    with h5py.File(path, "r+") as f:
+        f.attrs["content_hash"] = ds.content_hash()
+    return path
+
+
+@pytest.mark.parametrize(("key", "value", "said"), [
+    # each was read as a rate with status 0 (round 17): text by float(), True as 1 Hz, a complex
+    # rate with its imaginary part dropped (a ComplexWarning over two lines), and fs_unit never
+    # read (the content hash leaves it out: no rehash needed), so 1000 "kHz" fitted as 1000 Hz
+    ("fs", "1000", "fs='1000'"),
+    ("fs", np.bool_(True), "fs=True"),
+    ("fs", np.complex128(1000 + 1j), "fs=(1000+1j)"),
+    ("fs_unit", "kHz", "fs_unit='kHz'"),
+    ("fs_unit", np.bytes_(b"s"), "fs_unit='s'"),
+], ids=["text", "bool", "complex", "kHz", "bytes_s"])
+def test_a_dataset_files_rate_must_be_one_real_number_in_hz(tmp_path, capsys, key, value, said):
+    path = _rehashed(_saved(tmp_path), key, value)
+    with pytest.raises(MeasuredDataError, match=rf"attribute {re.escape(said)}.*expected"):
+        read_measured(path)
+    with pytest.raises(MeasuredDataError, match=re.escape(said)):
+        export_dataset(path, "sep005", tmp_path / "d.json")
+    status = cli.main(["identify", str(path), "--kind", "structural", "--method", "ls_sindy",
+                       "-o", str(tmp_path / "m.json")])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert status == 2 and len(err) == 1 and said in err[0], err
+
+
+def test_a_dataset_files_integer_rate_in_hz_is_read(tmp_path):
+    path = _rehashed(_saved(tmp_path), "fs", np.int64(1000))  # an integer is a real number
+    assert read_measured(path).fs == FS
