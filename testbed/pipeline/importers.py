@@ -665,6 +665,9 @@ class _Raw:
     directions: dict[str, int] = field(default_factory=dict)
     positions: dict[str, float] = field(default_factory=dict)
     prior: dict[str, float] = field(default_factory=dict)
+    #: time [s] of each channel's first sample, where the file states it per channel (a
+    #: SEP-005 channel's ``time``, a UFF58 record's abscissa)
+    starts: dict[str, float] = field(default_factory=dict)
     #: the file's units are its rig's own and stay as they are (a testbed dataset of a
     #: ``dynamical`` rig: concentrations and the like have no SI form to convert to)
     own_units: bool = False
@@ -732,6 +735,7 @@ def _finish(raw: _Raw, fs: float | None, units: str | Mapping[str, str] | None,
         raise MeasuredDataError(path, f"sample rate {rate:g} Hz: {n} samples would last forever "
                                       "(the duration overflows); expected a rate whose record lasts "
                                       "a finite time")
+    _check_starts(path, {n: raw.starts[n] for n in names if n in raw.starts}, rate)
     signals = {}
     for n in names:
         unit = units if isinstance(units, str) else (units or {}).get(n, raw.units.get(n))
@@ -763,6 +767,23 @@ def _finish(raw: _Raw, fs: float | None, units: str | Mapping[str, str] | None,
                         directions={k: v for k, v in raw.directions.items() if k in keep},
                         positions={k: v for k, v in raw.positions.items() if k in keep},
                         prior=dict(raw.prior))
+
+
+def _check_starts(path: Path, starts: Mapping[str, float], fs: float) -> None:
+    """Refuse channels whose first samples were taken at different times: the readers line
+    the channels up sample by sample, so a force recorded 0.3 s after its responses (a SEP-005
+    channel's ``time`` or a UFF58 record's abscissa starting later) was fitted as if
+    simultaneous, with status 0 (round 17).  Within half a sample step [s] they agree (a
+    time stamp's rounding)."""
+    if len(starts) < 2:
+        return
+    (first, t0), (worst, tw) = next(iter(starts.items())), max(
+        starts.items(), key=lambda kv: abs(kv[1] - next(iter(starts.values()))))
+    if abs(tw - t0) > 0.5 / fs:
+        raise MeasuredDataError(path, f"channel {worst!r} starts at t = {tw:.9g} s, channel "
+                                      f"{first!r} at t = {t0:.9g} s: {abs(tw - t0) * fs:.3g} "
+                                      "samples apart; expected every channel to start at one time "
+                                      "(within half a sample step)")
 
 
 #: Range of a declared prior (a mass [kg] or a length [m]).  A prior scales the identified
@@ -1029,6 +1050,7 @@ def _parse_sep005(path: Path, content: Any) -> _Raw:
                                               f"for data of shape {data.shape}; expected one time "
                                               "per sample")
             rate = uniform_rate(path, t, f"channel {name!r} time")
+            raw.starts[name] = float(t[0])
             # both given: fs won in silence (fs = 50 over a 100 Hz time: every frequency halved)
             if name in rates and abs(rate / rates[name] - 1) > DECLARED_RATE_RTOL:
                 raise MeasuredDataError(path, f"SEP-005 channel {name!r}: fs={rates[name]:g} Hz but "
@@ -1292,6 +1314,9 @@ def _uff58_channel(path: Path, k: int, s: dict[str, Any], raw: _Raw) -> tuple[st
                                           f"({a(coded)}); expected a label of the quantity the "
                                           "type declares")
     raw.data[name], raw.units[name] = data.astype(float), label or None
+    start = float(s.get("abscissa_min", 0.0)) if even else float(np.asarray(s["x"], dtype=float)[0])
+    if math.isfinite(start):
+        raw.starts[name] = start
     if node > 0:
         raw.nodes[name] = node
     if direction:

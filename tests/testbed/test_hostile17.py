@@ -101,3 +101,39 @@ def test_a_dataset_files_rate_must_be_one_real_number_in_hz(tmp_path, capsys, ke
 def test_a_dataset_files_integer_rate_in_hz_is_read(tmp_path):
     path = _rehashed(_saved(tmp_path), "fs", np.int64(1000))  # an integer is a real number
     assert read_measured(path).fs == FS
+
+
+# ------------------------------------------------------------------ channels of other start times
+
+def _sep005_started(path: Path, lag_steps: float) -> Path:
+    """Two channels of one 1000 Hz record, the second's time stamps ``lag_steps`` samples later."""
+    t = np.arange(400) / FS
+    path.write_text(json.dumps([
+        {"name": "acc1", "data": np.sin(2 * np.pi * 7 * t).tolist(), "unit_str": "m/s^2",
+         "time": t.tolist()},
+        {"name": "force", "data": np.exp(-t / 0.01).tolist(), "unit_str": "N",
+         "time": (t + lag_steps / FS).tolist()}]))
+    return path
+
+
+def test_sep005_channels_that_start_at_other_times_are_refused(tmp_path):
+    # a force stamped 0.3 s after its response was lined up sample by sample with it and fitted
+    # with status 0 (round 17)
+    with pytest.raises(MeasuredDataError, match=r"channel 'force' starts at t = 0\.3 s.*300 samples"):
+        read_measured(_sep005_started(tmp_path / "r.json", 300))
+    # within half a step: a time stamp's rounding, the same instant
+    assert read_measured(_sep005_started(tmp_path / "r.json", 0.4)).fs == pytest.approx(FS)
+
+
+def test_uff_records_that_start_at_other_times_are_refused(tmp_path):
+    import pyuff
+
+    src = export_dataset(_saved(tmp_path), "uff", tmp_path / "d.uff")[0]
+    sets = pyuff.UFF(str(src)).read_sets()
+    assert read_measured(src).fs == pytest.approx(FS)  # as exported: one start
+    last = max(k for k, s in enumerate(sets) if s["type"] == 58)
+    sets[last]["x"] = sets[last]["x"] + 0.3  # the force record's abscissa starts 0.3 s later
+    late = tmp_path / "late.uff"
+    pyuff.UFF(str(late)).write_sets(sets, mode="overwrite")
+    with pytest.raises(MeasuredDataError, match=r"starts at t = 0\.3 s.*expected every channel"):
+        read_measured(late)
