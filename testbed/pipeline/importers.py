@@ -896,6 +896,11 @@ def _raw_from_dataset(path: Path, ds: Dataset) -> _Raw:
                                           "channel(s); expected one position [m] per channel")
         for i, ch in enumerate(s.channels):
             name = f"{g}/{ch}"
+            if name in raw.data:  # the later channel replaced the earlier in silence (round 17:
+                # a record of three accelerations fitted on two, status 1 with a poor model)
+                raise MeasuredDataError(path, f"signal measured/{g} names channel {ch!r} twice "
+                                              f"(channels {', '.join(map(repr, s.channels))}); "
+                                              "expected one name per channel")
             raw.data[name], raw.units[name] = s.data[i], per_channel[i]
             if s.positions is not None:
                 raw.positions[name] = check_position(path, name, s.positions[i], "positions")

@@ -137,3 +137,19 @@ def test_uff_records_that_start_at_other_times_are_refused(tmp_path):
     pyuff.UFF(str(late)).write_sets(sets, mode="overwrite")
     with pytest.raises(MeasuredDataError, match=r"starts at t = 0\.3 s.*expected every channel"):
         read_measured(late)
+
+
+# ------------------------------------------------------------------ a channel named twice
+
+def test_a_dataset_signal_naming_a_channel_twice_is_refused(tmp_path):
+    # channels ("acc1", "acc1"): the second replaced the first in the reader's channel table,
+    # and a cantilever record of three accelerations was fitted on two (status 1, round 17)
+    path = _saved(tmp_path)
+    with h5py.File(path, "r+") as f:
+        f["measured/acceleration"].attrs["channels"] = np.array(["acc1", "acc1"],
+                                                                dtype=h5py.string_dtype())
+    _rehashed(path, "fs", FS)
+    with pytest.raises(MeasuredDataError, match=r"measured/acceleration names channel 'acc1' twice"):
+        read_measured(path)
+    with pytest.raises(MeasuredDataError, match=r"names channel 'acc1' twice"):
+        export_dataset(path, "sep005", tmp_path / "d.json")
