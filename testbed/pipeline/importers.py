@@ -747,6 +747,7 @@ def _finish(raw: _Raw, fs: float | None, units: str | Mapping[str, str] | None,
         if not si:
             raise MeasuredDataError(path, f"channel {n!r}: unknown unit {unit!r}; allowed: "
                                           f"{', '.join(SI_UNITS + tuple(UNIT_ALIASES))}")
+        _check_direction(path, n, raw.directions.get(n, 0), si)
         x = np.asarray(raw.data[n], dtype=float)
         bad = np.flatnonzero(~np.isfinite(x))
         if bad.size:
@@ -767,6 +768,27 @@ def _finish(raw: _Raw, fs: float | None, units: str | Mapping[str, str] | None,
                         directions={k: v for k, v in raw.directions.items() if k in keep},
                         positions={k: v for k, v in raw.positions.items() if k in keep},
                         prior=dict(raw.prior))
+
+
+#: The SI units of rotations (an angle, its rates, a moment); the other SI units translate.
+ROTATIONAL_UNITS = ("rad", "rad/s", "rad/s^2", "N m")
+
+
+def _check_direction(path: Path, name: str, direction: int, si: str) -> None:
+    """Refuse a channel whose direction and unit disagree: a rotation (UFF direction code
+    +-4..6, SEP-005 ``"... rotation"``) measured in a translation's unit or the reverse (an
+    acceleration in m/s^2 about X was read with status 0, round 17).  Units outside the SI
+    ones (a dynamical rig's own) and channels without a direction are not checked."""
+    if not direction or si not in SI_UNITS:
+        return
+    turns, unit_turns = abs(direction) in (4, 5, 6), si in ROTATIONAL_UNITS
+    if turns != unit_turns:
+        axis = "XYZ"[(abs(direction) - 1) % 3]
+        said = f"{'-' if direction < 0 else '+'}{axis}{' rotation' if turns else ''}"
+        raise MeasuredDataError(path, f"channel {name!r}: direction {said} (code {direction}) "
+                                      f"is a {'rotation' if turns else 'translation'} but its unit "
+                                      f"{si!r} is a {'rotation' if unit_turns else 'translation'}'s; "
+                                      "expected a direction and a unit of one kind")
 
 
 def _check_starts(path: Path, starts: Mapping[str, float], fs: float) -> None:

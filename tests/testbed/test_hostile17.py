@@ -153,3 +153,34 @@ def test_a_dataset_signal_naming_a_channel_twice_is_refused(tmp_path):
         read_measured(path)
     with pytest.raises(MeasuredDataError, match=r"names channel 'acc1' twice"):
         export_dataset(path, "sep005", tmp_path / "d.json")
+
+
+# ------------------------------------------------------------------ a direction against its unit
+
+@pytest.mark.parametrize(("direction", "unit", "said"), [
+    ("+X rotation", "m/s^2", r"direction \+X rotation \(code 4\) is a rotation but its unit 'm/s\^2'"),
+    ("-Z", "rad", r"direction -Z \(code -3\) is a translation but its unit 'rad'"),
+    (5, "N", r"direction \+Y rotation \(code 5\) is a rotation"),
+])
+def test_a_channel_whose_direction_and_unit_disagree_is_refused(tmp_path, direction, unit, said):
+    # an acceleration "about X" was read and fitted with status 0 (round 17)
+    t = np.arange(400) / FS
+    path = tmp_path / "r.json"
+    path.write_text(json.dumps([{"name": "c", "data": np.sin(2 * np.pi * 7 * t).tolist(),
+                                 "unit_str": unit, "fs": FS, "direction": direction}]))
+    with pytest.raises(MeasuredDataError, match=said):
+        read_measured(path)
+
+
+def test_exports_of_every_unit_keep_direction_and_unit_of_one_kind(tmp_path):
+    # the exporter writes +Z for a translation's unit and +Z rotation for a rotation's: both
+    # formats read back (a cart-pole's record holds both kinds of channel in one signal)
+    t = np.arange(400) / FS
+    ds = Dataset(FS, {"q": Signal(np.vstack([np.sin(2 * np.pi * 7 * t), np.cos(2 * np.pi * 7 * t)]),
+                                  ("x", "th"), "m, rad"),
+                      "u": Signal(np.sin(2 * np.pi * 3 * t)[None, :], ("f",), "N")})
+    path = ds.save(tmp_path / "d.h5")
+    for fmt in ("uff", "sep005"):
+        out = export_dataset(path, fmt, tmp_path / f"d.{'uff' if fmt == 'uff' else 'json'}")[0]
+        got = read_measured(out)
+        assert sorted(got.signals) == ["q/th", "q/x", "u/f"], fmt
