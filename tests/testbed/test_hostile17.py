@@ -6,6 +6,8 @@ from __future__ import annotations
 
 import json
 import re
+import shutil
+import sys
 from pathlib import Path
 
 import h5py
@@ -16,6 +18,7 @@ from testbed import cli
 from testbed.core.dataset import Dataset, Signal
 from testbed.pipeline.importers import MeasuredDataError, rate_misfit, read_measured
 from testbed.reporting.export import export_dataset
+from testbed.studies.runstore import list_runs, load_run, save_new_run
 
 
 def _mm_record(path: Path, fs: float, rate_scale: float = 1.0) -> Path:
@@ -184,3 +187,35 @@ def test_exports_of_every_unit_keep_direction_and_unit_of_one_kind(tmp_path):
         out = export_dataset(path, fmt, tmp_path / f"d.{'uff' if fmt == 'uff' else 'json'}")[0]
         got = read_measured(out)
         assert sorted(got.signals) == ["q/th", "q/x", "u/f"], fmt
+
+
+# ------------------------------------------------------------------ a run's format edited to /1
+
+@pytest.fixture(scope="module")
+def saved(tmp_path_factory):
+    """One run in a run history (its folder), written by save_new_run."""
+    if str(Path(__file__).parent) not in sys.path:
+        sys.path.insert(0, str(Path(__file__).parent))
+    import _synthetic_runs
+
+    return save_new_run(_synthetic_runs.structural_result(n_samples=200),
+                        tmp_path_factory.mktemp("runs"))
+
+
+@pytest.mark.parametrize("keep", [("sha256", "npz_sha256"), ("sha256",), ("npz_sha256",)])
+def test_a_run_whose_format_was_edited_to_1_is_refused(saved, tmp_path, keep):
+    # format /1 has no checksums and is read unchecked: a /2 run.json edited to say /1 (and a
+    # score edited with it) was listed and reported as the run's own (round 17)
+    out = tmp_path / "runs"
+    shutil.copytree(saved.parent.parent, out)
+    run = out / saved.parent.name / saved.name
+    meta = json.loads((run / "run.json").read_text())
+    meta["format"] = "sysid-testbed-run/1"
+    meta["scores"][next(iter(meta["scores"]))] = 123.0
+    for k in {"sha256", "npz_sha256"} - set(keep):
+        del meta[k]
+    (run / "run.json").write_text(json.dumps(meta, indent=2))
+    damaged: list = []
+    assert list_runs(out, damaged=damaged) == [] and damaged == [run]
+    with pytest.raises(ValueError, match=r"format 'sysid-testbed-run/1' with .*sha256.*edited"):
+        load_run(run)
