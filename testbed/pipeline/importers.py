@@ -288,6 +288,10 @@ def read_measured(path: str | os.PathLike, *, format: str | None = None, fs: flo
         channels of different lengths or rates, non-finite values, unknown unit or channel,
         a declared ``fs`` the file contradicts.
     """
+    if not isinstance(path, (str, os.PathLike)) or isinstance(os.fspath(path), bytes):
+        # an int or bytes: TypeError from pathlib (round 17)
+        raise MeasuredDataError(str(path), f"path={path!r} ({type(path).__name__}); expected a "
+                                           "file path (str or os.PathLike)")
     path = Path(path)
     if format is None:
         format = SUFFIXES.get(path.suffix.lower())
@@ -296,6 +300,7 @@ def read_measured(path: str | os.PathLike, *, format: str | None = None, fs: flo
                                           f"pass format= one of {', '.join(FORMATS)}")
     if format not in FORMATS:
         raise MeasuredDataError(path, f"unknown format {format!r}; allowed: {', '.join(FORMATS)}")
+    check_selection(path, units, channels)
     if not path.is_file():
         raise MeasuredDataError(path, "no such file")
     if fs is not None and not (isinstance(fs, (int, float)) and math.isfinite(fs) and fs > 0):
@@ -347,8 +352,11 @@ def measurement_from_file(path: str | os.PathLike, kind: str, signal: Mapping[st
         A bad ``signal`` table.
     """
 
-    if kind not in SIGNAL_SCHEMAS:
+    if not isinstance(kind, str) or kind not in SIGNAL_SCHEMAS:
         raise MeasuredDataError(path, f"unknown rig kind {kind!r}; allowed: {', '.join(SIGNAL_SCHEMAS)}")
+    if signal is not None and not isinstance(signal, Mapping):  # 5: AttributeError (round 17)
+        raise MeasuredDataError(path, f"signal={signal!r} ({type(signal).__name__}); expected "
+                                      "a [signal] table (a mapping) or None")
     data = read_measured(path, format=format, fs=fs, units=units, channels=channels,
                          own_units=kind == "dynamical")
     ds = data.to_dataset(groups, prior)
@@ -648,10 +656,27 @@ def from_sep005(channel_dicts: Sequence[Mapping[str, Any]], *, source: str | os.
     -------
     ImportedData
     """
+    check_selection(source, units, channels)
     return _finish(_parse_sep005(Path(source), channel_dicts), fs, units, channels)
 
 
 # --------------------------------------------------------------------------- shared checks
+def check_selection(source: str | os.PathLike, units: Any, channels: Any) -> None:
+    """Refuse ``units`` that are not a unit (str) or a mapping of channel name to unit, and
+    ``channels`` that are not a non-empty sequence of names: ``units=5`` was an AttributeError
+    and ``channels=[]`` a ValueError of ``max()`` (round 17)."""
+    if units is not None and not (isinstance(units, str) or (
+            isinstance(units, Mapping) and all(isinstance(k, str) and isinstance(v, str)
+                                               for k, v in units.items()))):
+        raise MeasuredDataError(source, f"units={units!r}: expected a unit (str) or a mapping of "
+                                        "channel name to unit (str to str)")
+    if channels is not None and (isinstance(channels, (str, bytes, Mapping))
+                                 or not isinstance(channels, Sequence) or not channels
+                                 or not all(isinstance(c, str) for c in channels)):
+        raise MeasuredDataError(source, f"channels={channels!r}: expected a non-empty list of "
+                                        "channel names (str)")
+
+
 @dataclass
 class _Raw:
     """What a reader found, before units, selection and checks."""
@@ -1045,6 +1070,12 @@ def _parse_sep005(path: Path, content: Any) -> _Raw:
         if "data" not in c:
             raise MeasuredDataError(path, f"SEP-005 channel {name!r} has no data")
         values = c["data"]
+        if np.ma.isMaskedArray(values) and np.ma.getmaskarray(values).any():
+            # np.asarray dropped the mask: a masked (missing) sample was read as a value
+            # (round 17)
+            raise MeasuredDataError(path, f"SEP-005 channel {name!r}: data are a masked array "
+                                          f"with {int(np.ma.getmaskarray(values).sum())} masked "
+                                          "sample(s); fill or cut them")
         # JSON strings and booleans are not samples (np.asarray would read "1.5" and true as
         # numbers); an array given in memory must hold real numbers (complex lost its
         # imaginary part)

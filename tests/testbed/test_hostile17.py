@@ -16,7 +16,13 @@ import pytest
 
 from testbed import cli
 from testbed.core.dataset import Dataset, Signal
-from testbed.pipeline.importers import MeasuredDataError, rate_misfit, read_measured
+from testbed.pipeline.importers import (
+    MeasuredDataError,
+    from_sep005,
+    measurement_from_file,
+    rate_misfit,
+    read_measured,
+)
 from testbed.reporting.export import export_dataset
 from testbed.studies.runstore import list_runs, load_run, save_new_run
 
@@ -219,3 +225,46 @@ def test_a_run_whose_format_was_edited_to_1_is_refused(saved, tmp_path, keep):
     assert list_runs(out, damaged=damaged) == [] and damaged == [run]
     with pytest.raises(ValueError, match=r"format 'sysid-testbed-run/1' with .*sha256.*edited"):
         load_run(run)
+
+
+# ------------------------------------------------------------------ the import API's arguments
+
+@pytest.mark.parametrize(("kwargs", "said"), [
+    # each was an AttributeError, a ValueError of max() or a TypeError of pathlib (round 17)
+    ({"units": 5}, "units=5: expected a unit"),
+    ({"units": ["m/s^2"]}, r"units=\['m/s\^2'\]: expected"),
+    ({"units": {"acc1": 5}}, r"units=\{'acc1': 5\}: expected"),
+    ({"channels": []}, r"channels=\[\]: expected a non-empty list"),
+    ({"channels": "acc1"}, "channels='acc1': expected"),
+    ({"channels": [5]}, r"channels=\[5\]: expected"),
+], ids=["units int", "units list", "units value int", "channels empty", "channels text", "channels int"])
+def test_read_measured_refuses_arguments_of_the_wrong_type(tmp_path, kwargs, said):
+    rec = _sep005_started(tmp_path / "r.json", 0)
+    with pytest.raises(MeasuredDataError, match=said):
+        read_measured(rec, **kwargs)
+    chans = json.loads(rec.read_text())
+    with pytest.raises(MeasuredDataError, match=said):
+        from_sep005(chans, **kwargs)
+
+
+@pytest.mark.parametrize("path", [5, None, b"r.json"])
+def test_read_measured_refuses_a_path_that_is_not_one(path):
+    with pytest.raises(MeasuredDataError, match=r"path=.*expected a file path"):
+        read_measured(path)
+
+
+@pytest.mark.parametrize("signal", [5, [], "recorded"])
+def test_measurement_from_file_refuses_a_signal_table_that_is_not_one(tmp_path, signal):
+    rec = _mm_record(tmp_path / "r.json", 100.0)
+    with pytest.raises(MeasuredDataError, match=r"signal=.*expected a \[signal\] table"):
+        measurement_from_file(rec, "dynamical", signal)
+
+
+def test_a_masked_sample_is_not_read_as_a_value():
+    # np.asarray dropped the mask: the masked first sample was read as the value under it
+    data = np.ma.masked_array(np.sin(np.arange(400) / 10.0), mask=[True] + [False] * 399)
+    chan = [{"name": "acc1", "data": data, "unit_str": "m/s^2", "fs": FS}]
+    with pytest.raises(MeasuredDataError, match=r"masked array with 1 masked sample"):
+        from_sep005(chan)
+    chan[0]["data"] = np.ma.masked_array(data.data, mask=False)  # nothing masked: read
+    assert from_sep005(chan).fs == FS
