@@ -43,6 +43,14 @@ Families (what rounds 1-16 did not try):
     ``/dev/null``, a deleted working folder, ``TESTBED_SCENARIOS`` / ``TESTBED_STUDIES`` a
     file.  A traceback, an internal error, a hang or a refusal in more than one line is a
     finding.
+``api``
+    The import API (:func:`~testbed.pipeline.importers.read_measured`,
+    :func:`~testbed.pipeline.importers.from_sep005`,
+    :func:`~testbed.pipeline.importers.measurement_from_file`) given ``units``, ``channels``,
+    ``path``, ``fs``, ``kind`` and ``signal`` of the wrong type or empty, and in-memory channel
+    data as float16, bool, complex, text, object, datetime64, structured, masked, a range, a
+    tuple, a dict, a string or an iterator: an exception other than one refusal line, or a
+    masked sample or a value of the wrong kind accepted, is a finding.
 ``runformat``
     A run folder (store format ``/2``) whose ``run.json`` says format ``/1`` (no checksums) with
     a score edited, keeping both, one or none of ``/2``'s checksum keys: listed or reported as
@@ -518,6 +526,70 @@ def environ_cases(work: Path) -> list[tuple[str, object]]:
     return cases
 
 
+# ------------------------------------------------------------------ api
+
+def api_cases(work: Path) -> list[tuple[str, object]]:
+    import numpy as np
+
+    from testbed.pipeline.importers import from_sep005, measurement_from_file, read_measured
+
+    def rec() -> Path:
+        path = work / "r.json"
+        if not path.exists():
+            t = np.arange(400) / 100.0
+            x = 2.0 * np.exp(-t)
+            path.write_text(json.dumps([{"name": "x/x", "data": x.tolist(), "unit_str": "mM", "fs": 100.0},
+                                        {"name": "dx/dx", "data": (-x).tolist(), "unit_str": "mM/s",
+                                         "fs": 100.0}]))
+        return path
+
+    def refused(fn):
+        def run() -> str | None:
+            fn()  # a refusal in one line ends the case ok (the harness)
+            return "accepted"
+        return run
+
+    def accepted(fn):
+        return lambda: fn() and None
+
+    def chan(data):
+        return [{"name": "a", "data": data, "unit_str": "m/s^2", "fs": 100.0}]
+
+    cases = []
+    for fs in (True, "100", math.nan, -1.0, [100], 100 + 0j, 0):
+        cases.append((f"read_measured fs={fs!r}", refused(lambda fs=fs: read_measured(rec(), fs=fs))))
+    for units in (5, {"x/x": 5}, ["mM"], b"mM"):
+        cases.append((f"read_measured units={units!r}",
+                      refused(lambda u=units: read_measured(rec(), units=u))))
+    for ch in ("x/x", [], [5], ("x/x", "x/x"), {"x/x": 1}, [b"x/x"]):
+        cases.append((f"read_measured channels={ch!r}",
+                      refused(lambda c=ch: read_measured(rec(), channels=c))))
+    for path in (5, None, b"r.json", ""):
+        cases.append((f"read_measured path={path!r}", refused(lambda p=path: read_measured(p))))
+    for fmt in ("HDF5", 5, ""):
+        cases.append((f"read_measured format={fmt!r}", refused(lambda f=fmt: read_measured(rec(), format=f))))
+    for kind in ("", "STRUCTURAL", 5, None):
+        cases.append((f"measurement_from_file kind={kind!r}",
+                      refused(lambda k=kind: measurement_from_file(rec(), k))))
+    for sig in (5, [], "recorded", {"derivatives": 5}, {"nope": 1}):
+        cases.append((f"measurement_from_file signal={sig!r}",
+                      refused(lambda g=sig: measurement_from_file(rec(), "dynamical", g))))
+    bad = {"bool": np.ones(10, dtype=bool), "complex": np.ones(10, dtype=complex),
+           "text": np.array(["1"] * 10), "object": np.ones(10, dtype=object),
+           "datetime64": np.arange(10).astype("datetime64[s]"),
+           "structured": np.ones(10, dtype=[("a", float)]),
+           "masked": np.ma.masked_array(np.arange(10.0), mask=[True] + [False] * 9),
+           "dict": {1: 2}, "str": "0123456789", "iterator": iter(range(10))}
+    for label, data in bad.items():
+        cases.append((f"from_sep005 data {label}", refused(lambda d=data: from_sep005(chan(d)))))
+    good = {"float16": np.ones(10, dtype=np.float16) * np.arange(10), "range": range(10),
+            "tuple": tuple(float(k) for k in range(10)), "int8": np.arange(10, dtype=np.int8),
+            "masked, none masked": np.ma.masked_array(np.arange(10.0), mask=False)}
+    for label, data in good.items():
+        cases.append((f"from_sep005 data {label}", accepted(lambda d=data: from_sep005(chan(d)))))
+    return cases
+
+
 # ------------------------------------------------------------------ runformat
 
 def runformat_cases(work: Path) -> list[tuple[str, object]]:
@@ -563,6 +635,7 @@ FAMILIES = _hostile.families({
     "truncated": truncated_cases,
     "toml": toml_cases,
     "environ": environ_cases,
+    "api": api_cases,
     "runformat": runformat_cases,
 }, TIMEOUT_S)
 
