@@ -736,6 +736,11 @@ def cmd_identify(args: argparse.Namespace) -> int:
         units = _key_values(args.units, "--units", numbers=False) if per_channel[0] else args.units[0]
     data = _existing_file(Path(args.data), "a measured-data file (UFF58, SEP-005 JSON, CSV or HDF5)")
     out = _output_file(Path(args.output or f"{data.stem}.model.json"), "--output", inputs=(data,))
+    if out.suffix.lower() == ".md":  # the report replaced the model it reports (round 17; .MD:
+        # the same file where names ignore case, as on macOS and Windows)
+        raise InputError(f"--output {terminal_safe(str(out))}: its report goes to the same path "
+                         "with the suffix .md, so the report would replace the model; expected a "
+                         "path not ending in .md (e.g. the default, <data>.model.json)")
     _output_file(out.with_suffix(".md"), "--output (its .md report)", inputs=(data,))
     with run_progress(data.name) as phase:
         result = identify_file(data, scenario=args.scenario, kind=args.kind, method=args.method,

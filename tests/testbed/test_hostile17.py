@@ -268,3 +268,17 @@ def test_a_masked_sample_is_not_read_as_a_value():
         from_sep005(chan)
     chan[0]["data"] = np.ma.masked_array(data.data, mask=False)  # nothing masked: read
     assert from_sep005(chan).fs == FS
+
+
+# ------------------------------------------------------------------ identify's output and its report
+
+@pytest.mark.parametrize("name", ["m.md", "m.MD"])
+def test_identify_refuses_an_output_that_its_report_would_replace(tmp_path, capsys, name):
+    # -o m.md: "model written to m.md (report m.md)", the model JSON overwritten by its report
+    # (round 17)
+    rec = _mm_record(tmp_path / "r.json", 100.0)
+    status = cli.main(["identify", str(rec), "--kind", "dynamical", "--method", "sindy_pi_dynamical",
+                       "-o", str(tmp_path / name)])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert status == 2 and len(err) == 1 and "the report would replace the model" in err[0], err
+    assert not (tmp_path / name).exists()
