@@ -237,6 +237,12 @@ def _output_file(path: Path, option: str, *, inputs: tuple[Path, ...] = ()) -> P
     return path
 
 
+def _given_files(*groups: Any) -> tuple[Path, ...]:
+    """The files among ``groups`` of paths (scenario files read, ``--plugin`` files or
+    modules): what a command's output must not replace."""
+    return tuple(Path(p) for g in groups for p in g if str(p).endswith((".toml", ".py")))
+
+
 def _output_folder(path: Path, option: str) -> Path:
     """A folder a command will write into (created on use), checked before any work."""
     st = _stat(path, option)
@@ -525,14 +531,18 @@ def cmd_list(args: argparse.Namespace) -> int:
 def cmd_generate(args: argparse.Namespace) -> int:
     from testbed.pipeline.cache import DatasetCache
     from testbed.pipeline.generate import generate
-    from testbed.pipeline.scenario import load_scenario
+    from testbed.pipeline.scenario import load_scenario, recording_reads
     from testbed.reporting.console import print_truth_summary
 
-    _load_plugins(args)  # a plugin rig's scenario, as `run` takes it
-    sc = load_scenario(args.scenario)
+    plugins = _load_plugins(args)  # a plugin rig's scenario, as `run` takes it
+    with recording_reads() as read:  # the scenario and the files it extends
+        sc = load_scenario(args.scenario)
     if args.seed is not None:
         sc = sc.replace(seed=args.seed)
-    out = _output_file(Path(args.output or f"{sc.name}-seed{sc.seed}.h5"), "--output")
+    # -o the scenario file itself (or a file it extends, or a plugin) replaced it with the
+    # dataset, status 0 (round 17)
+    out = _output_file(Path(args.output or f"{sc.name}-seed{sc.seed}.h5"), "--output",
+                       inputs=_given_files(read, plugins))
     with _progress()(f"generating {sc.name}") as bar:
         # through the run cache unless --no-cache: a later `testbed run` of it simulates nothing
         cache = None if args.no_cache else DatasetCache(_cache_folder(args.cache))
@@ -722,11 +732,12 @@ def cmd_identify(args: argparse.Namespace) -> int:
 
     from testbed.core.atomic import atomic_write_text
     from testbed.pipeline.fit import identify_file
+    from testbed.pipeline.scenario import resolve_path
     from testbed.reporting.identified import render_identified
     from testbed.reporting.progress import run_progress
     from testbed.scoring.scorers import fitted_model_failures, prediction_r2
 
-    _load_plugins(args)
+    plugins = _load_plugins(args)
     units = None
     if args.units:
         per_channel = ["=" in u for u in args.units]
@@ -735,13 +746,15 @@ def cmd_identify(args: argparse.Namespace) -> int:
                              "(--units g) or one CHANNEL=UNIT per option, not both or several units")
         units = _key_values(args.units, "--units", numbers=False) if per_channel[0] else args.units[0]
     data = _existing_file(Path(args.data), "a measured-data file (UFF58, SEP-005 JSON, CSV or HDF5)")
-    out = _output_file(Path(args.output or f"{data.stem}.model.json"), "--output", inputs=(data,))
+    # nor the --scenario file or a plugin (-o s.toml replaced the scenario: round 17)
+    given = (data, *_given_files([resolve_path(args.scenario)] if args.scenario else [], plugins))
+    out = _output_file(Path(args.output or f"{data.stem}.model.json"), "--output", inputs=given)
     if out.suffix.lower() == ".md":  # the report replaced the model it reports (round 17; .MD:
         # the same file where names ignore case, as on macOS and Windows)
         raise InputError(f"--output {terminal_safe(str(out))}: its report goes to the same path "
                          "with the suffix .md, so the report would replace the model; expected a "
                          "path not ending in .md (e.g. the default, <data>.model.json)")
-    _output_file(out.with_suffix(".md"), "--output (its .md report)", inputs=(data,))
+    _output_file(out.with_suffix(".md"), "--output (its .md report)", inputs=given)
     with run_progress(data.name) as phase:
         result = identify_file(data, scenario=args.scenario, kind=args.kind, method=args.method,
                                params=_key_values(args.param, "--param", numbers=False),

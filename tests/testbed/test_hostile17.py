@@ -282,3 +282,35 @@ def test_identify_refuses_an_output_that_its_report_would_replace(tmp_path, caps
     err = capsys.readouterr().err.strip().splitlines()
     assert status == 2 and len(err) == 1 and "the report would replace the model" in err[0], err
     assert not (tmp_path / name).exists()
+
+
+# ------------------------------------------------------------------ outputs over the given files
+
+SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
+CACHE = Path(__file__).resolve().parents[2] / ".cache" / "datasets"
+
+
+def test_generate_refuses_to_write_over_its_scenario_or_a_file_it_extends(tmp_path, capsys):
+    # `generate s.toml -o s.toml` replaced the scenario file by the dataset, status 0 (round 17)
+    parent = tmp_path / "michaelis_menten.toml"
+    parent.write_text((SCENARIOS / "michaelis_menten.toml").read_text())
+    child = tmp_path / "child.toml"
+    child.write_text('[scenario]\nname = "child"\nextends = "michaelis_menten.toml"\n')
+    before = {p: p.read_bytes() for p in (parent, child)}
+    for out in (child, parent):
+        status = cli.main(["generate", str(child), "-o", str(out), "--cache", str(CACHE)])
+        err = capsys.readouterr().err.strip().splitlines()
+        assert status == 2 and len(err) == 1 and "is the input file" in err[0], err
+    assert {p: p.read_bytes() for p in before} == before
+
+
+def test_identify_refuses_to_write_over_its_scenario(tmp_path, capsys):
+    rec = _mm_record(tmp_path / "r.json", 100.0)
+    scen = tmp_path / "michaelis_menten.toml"
+    scen.write_text((SCENARIOS / "michaelis_menten.toml").read_text())
+    text = scen.read_text()
+    status = cli.main(["identify", str(rec), "--scenario", str(scen), "--kind", "dynamical",
+                       "-o", str(scen)])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert status == 2 and len(err) == 1 and "is the input file" in err[0], err
+    assert scen.read_text() == text
