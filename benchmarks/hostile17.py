@@ -51,6 +51,13 @@ Families (what rounds 1-16 did not try):
     data as float16, bool, complex, text, object, datetime64, structured, masked, a range, a
     tuple, a dict, a string or an iterator: an exception other than one refusal line, or a
     masked sample or a value of the wrong kind accepted, is a finding.
+``outputs``
+    An output that is one of the command's inputs or that its own second output replaces:
+    ``identify -o m.md`` and ``m.MD`` (its report is the output with ``.md``), ``-o`` the data
+    file or a link to it, ``-o`` the ``--scenario`` file; ``generate -o`` the scenario file or a
+    file it extends; ``export -o`` the dataset; ``report -o`` a run folder or its ``run.json``;
+    ``sweep --results`` the study or a scenario file.  Status 0, or any given file changed, is
+    a finding.
 ``runformat``
     A run folder (store format ``/2``) whose ``run.json`` says format ``/1`` (no checksums) with
     a score edited, keeping both, one or none of ``/2``'s checksum keys: listed or reported as
@@ -590,6 +597,71 @@ def api_cases(work: Path) -> list[tuple[str, object]]:
     return cases
 
 
+# ------------------------------------------------------------------ outputs
+
+def outputs_cases(work: Path) -> list[tuple[str, object]]:
+    def case(argv_of, setup):
+        def run() -> str | None:
+            folder = Path(tempfile.mkdtemp(dir=work))
+            given = setup(folder)
+            before = {p: p.read_bytes() for p in given}
+            argv = argv_of(folder)
+            status, out, err = cli_inprocess(argv)
+            found = judged(status, out, err, refuse=True)
+            changed = [p.name for p, b in before.items() if not p.exists() or p.read_bytes() != b]
+            if changed:
+                found = f"{found + '; ' if found else ''}changed {changed}"
+            return found
+        return run
+
+    def mm_record(folder: Path) -> list[Path]:
+        src = _generated(work, "michaelis_menten")
+        rec = folder / "r.json"
+        cli_inprocess(["export", str(src), "--format", "sep005", "-o", str(rec)])
+        (folder / "link.json").symlink_to(rec)
+        scen = folder / "michaelis_menten.toml"
+        scen.write_text((ROOT / "scenarios" / "michaelis_menten.toml").read_text())
+        (folder / "child.toml").write_text('[scenario]\nname = "child"\nextends = "michaelis_menten.toml"\n')
+        (folder / "s.toml").write_text('[study]\nname = "s"\nscenarios = ["michaelis_menten"]\n'
+                                       'noise = [0.0]\nseeds = [0]\nidentifiers = ["sindy_pi_dynamical"]\n')
+        shutil.copyfile(src, folder / "d.h5")
+        return [rec, scen, folder / "child.toml", folder / "s.toml", folder / "d.h5"]
+
+    def run_folder(folder: Path) -> list[Path]:
+        given = mm_record(folder)
+        cli_inprocess(["run", "michaelis_menten", "--out", str(folder / "runs"), "--no-figures",
+                       "--cache", str(CACHE)])
+        run = next((folder / "runs" / "michaelis_menten").glob("2*"))
+        (folder / "run").symlink_to(run)
+        return [*given, run / "run.json", run / "run.npz"]
+
+    ident = ["identify", "{r}", "--kind", "dynamical", "--method", "sindy_pi_dynamical", "-o"]
+    cases = {
+        "identify -o m.md": [*ident, "{f}/m.md"],
+        "identify -o m.MD": [*ident, "{f}/m.MD"],
+        "identify -o the data": [*ident, "{r}"],
+        "identify -o a link to the data": [*ident, "{f}/link.json"],
+        "identify -o its --scenario": ["identify", "{r}", "--scenario", "{f}/michaelis_menten.toml",
+                                       "--kind", "dynamical", "-o", "{f}/michaelis_menten.toml"],
+        "generate -o the scenario": ["generate", "{f}/child.toml", "-o", "{f}/child.toml",
+                                     "--cache", str(CACHE)],
+        "generate -o the file it extends": ["generate", "{f}/child.toml", "-o",
+                                            "{f}/michaelis_menten.toml", "--cache", str(CACHE)],
+        "export -o the dataset": ["export", "{f}/d.h5", "--format", "sep005", "-o", "{f}/d.h5"],
+        "sweep --results the study": ["sweep", "{f}/s.toml", "--results", "{f}/s.toml",
+                                      "--cache", str(CACHE)],
+        "sweep --results a scenario": ["sweep", "{f}/s.toml", "--results", "{f}/michaelis_menten.toml",
+                                       "--cache", str(CACHE)],
+    }
+    out = [(name, case(lambda f, a=argv: [x.format(f=f, r=f / "r.json") for x in a], mm_record))
+           for name, argv in cases.items()]
+    out += [("report -o its run folder", case(lambda f: ["report", str(f / "run"), "-o", str(f / "run")],
+                                              run_folder)),
+            ("report -o its run.json", case(lambda f: ["report", str(f / "run"), "-o",
+                                                       str(f / "run" / "run.json")], run_folder))]
+    return out
+
+
 # ------------------------------------------------------------------ runformat
 
 def runformat_cases(work: Path) -> list[tuple[str, object]]:
@@ -636,6 +708,7 @@ FAMILIES = _hostile.families({
     "toml": toml_cases,
     "environ": environ_cases,
     "api": api_cases,
+    "outputs": outputs_cases,
     "runformat": runformat_cases,
 }, TIMEOUT_S)
 
