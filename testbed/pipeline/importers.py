@@ -625,6 +625,8 @@ def _check_units(path: Path, ds: Dataset, kind: str) -> None:
                 allowed = ", ".join(u for u, o in SAME_ORDER.items() if o == want)
                 raise MeasuredDataError(path, f"signal {g!r} channel {ch!r} is in {unit}; the "
                                               f"{kind} chain reads {g!r} as a {want} ({allowed})")
+    if kind == "mechanical":
+        _check_mechanical_units(path, ds)
     if kind == "dynamical" and "x" in ds.measured and "dx" in ds.measured:
         x, dx = ds.measured["x"], ds.measured["dx"]
         if len(x.channels) != len(dx.channels):
@@ -634,6 +636,37 @@ def _check_units(path: Path, ds: Dataset, kind: str) -> None:
             if ud != rate:
                 raise MeasuredDataError(path, f"signal 'dx' channel {ch!r} is in {ud}; expected "
                                               f"{rate}, the rate of its state's {ux}")
+
+
+#: The load that drives a coordinate of each SI unit: a force a translation, a moment a rotation.
+LOAD_ON = {"m": "N", "rad": "N m"}
+
+
+def _check_mechanical_units(path: Path, ds: Dataset) -> None:
+    """Refuse a mechanical record whose units disagree channel by channel: a rate that is not
+    in its coordinate's unit per second (``theta`` "rad, m" beside ``dtheta`` "m/s, rad/s"),
+    or an input whose load does not drive the coordinate it acts on (a moment "N m" on a cart's
+    position in m).  Each was fitted with status 0 (round 17): the checks above read every
+    unit alone."""
+    m = ds.measured
+    for g, dg in RATE_PAIRS["mechanical"]:
+        if g not in m or dg not in m or len(m[g].channels) != len(m[dg].channels):
+            continue  # the chain says what is missing
+        for ch, dch, u, du in zip(m[g].channels, m[dg].channels, m[g].channel_units(),
+                                  m[dg].channel_units(), strict=True):
+            if u in RATE_OF and du != RATE_OF[u]:
+                raise MeasuredDataError(path, f"signal {dg!r} channel {dch!r} is in {du}; expected "
+                                              f"{RATE_OF[u]}, the rate of {g!r} channel {ch!r} in {u}")
+    coords = dict(zip(m["theta"].channels, m["theta"].channel_units(), strict=True)) \
+        if "theta" in m else {}
+    for g, sig in m.items():
+        for ch, unit, target in zip(sig.channels, sig.channel_units(), sig.acts_on or (), strict=False):
+            want = LOAD_ON.get(coords.get(target, ""))
+            if want is not None and unit != want:
+                raise MeasuredDataError(path, f"signal {g!r} channel {ch!r} is in {unit} but acts on "
+                                              f"'theta' channel {target!r} in {coords[target]}; "
+                                              f"expected {want} (a force drives a translation, a "
+                                              "moment a rotation)")
 
 
 def from_sep005(channel_dicts: Sequence[Mapping[str, Any]], *, source: str | os.PathLike = "<sep005>",

@@ -314,3 +314,40 @@ def test_identify_refuses_to_write_over_its_scenario(tmp_path, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert status == 2 and len(err) == 1 and "is the input file" in err[0], err
     assert scen.read_text() == text
+
+
+# ------------------------------------------------------------------ mechanical units, channel by channel
+
+def _cart_pole_like(tmp_path: Path, theta_unit: str = "m, rad", torque_unit: str = "N",
+                    acts_on: str = "x") -> Path:
+    """A two-coordinate record (a cart's position [m] and a pole's angle [rad]) with exact
+    rates, and a force on the cart: 2,000 samples at 200 Hz."""
+    fs = 200.0
+    t = np.arange(2000) / fs
+    w = 2 * np.pi * np.array([[0.7], [1.3]])
+    q = 0.2 * np.sin(w * t)
+    ds = Dataset(fs, {"theta": Signal(q, ("x", "th"), theta_unit),
+                      "dtheta": Signal(0.2 * w * np.cos(w * t), ("dx", "dth"), "m/s, rad/s"),
+                      "ddtheta": Signal(-w**2 * q, ("ddx", "ddth"), "m/s^2, rad/s^2"),
+                      "torque": Signal(np.sin(2 * np.pi * 0.5 * t)[None, :], ("u1",), torque_unit,
+                                       acts_on=(acts_on,))})
+    return ds.save(tmp_path / "cp.h5")
+
+
+@pytest.mark.parametrize(("change", "said"), [
+    # each was fitted with status 0 (round 17): every unit was checked alone
+    ({"theta_unit": "rad, m"}, r"'dtheta' channel 'dx' is in m/s; expected rad/s, the rate of "
+                               r"'theta' channel 'x' in rad"),
+    ({"theta_unit": "m"}, r"'dtheta' channel 'dth' is in rad/s; expected m/s"),
+    ({"torque_unit": "N m"}, r"'torque' channel 'u1' is in N m but acts on 'theta' channel 'x' "
+                             r"in m; expected N"),
+    ({"acts_on": "th"}, r"'u1' is in N but acts on 'theta' channel 'th' in rad; expected N m"),
+], ids=["angle and position swapped", "one unit for both", "a moment on a cart", "a force on a pole"])
+def test_a_mechanical_record_whose_units_disagree_channel_by_channel_is_refused(tmp_path, change, said):
+    with pytest.raises(MeasuredDataError, match=said):
+        measurement_from_file(_cart_pole_like(tmp_path, **change), "mechanical")
+
+
+def test_a_mechanical_record_whose_units_agree_is_measured(tmp_path):
+    m = measurement_from_file(_cart_pole_like(tmp_path), "mechanical")
+    assert m.x.shape == (2, 2000)
