@@ -18,6 +18,13 @@ Families (what rounds 1-16 did not try):
     unknown key; ``kind``, ``rig``, ``format`` and ``json_attrs`` edited; ``measured`` empty, with
     a group or a soft link.  A traceback, an internal error, a refusal in more than one line,
     or status 0 for a file whose attributes contradict what is read, is a finding.
+``mechunits``
+    A cart-pole dataset file edited and rehashed: ``theta``'s units swapped or one unit for
+    both coordinates, a unit list too long or with an empty part, ``acts_on`` missing, naming
+    no coordinate, the pole or two coordinates for one input, the force in N m, ``theta``'s
+    channel names or rows swapped, a signal the chain does not read.  Status 0 for a record
+    whose units disagree channel by channel (a rate against its coordinate, a load against
+    the coordinate it drives) is a finding.
 ``rates``
     A Michaelis-Menten record as SEP-005 relabelled to 1e-300 .. 1e300 Hz, its rate channel left
     as it was (then no rate of the signal) or scaled with it (consistent): anything but a
@@ -286,6 +293,57 @@ def h5attrs_cases(work: Path) -> list[tuple[str, object]]:
                                            "ls_sindy", True))
               for name, (e, r) in _cantilever_edits().items()]
     return cases
+
+
+# ------------------------------------------------------------------ mechunits
+
+def mechunits_cases(work: Path) -> list[tuple[str, object]]:
+    import h5py
+    import numpy as np
+
+    text = h5py.string_dtype()
+
+    def attr(obj, key, value):
+        return lambda f: f[obj].attrs.__setitem__(key, value)
+
+    def swap_rows(f):
+        f["measured/theta"][...] = f["measured/theta"][()][::-1]
+
+    def extra(f):
+        d = f["measured"].create_dataset("extra", data=np.zeros((1, f["measured/theta"].shape[1])))
+        d.attrs.update({"channels": np.array(["e"], dtype=text), "unit": "m"})
+
+    edits = {  # name -> (edit, must be refused)
+        "theta 'rad, m'": (attr("measured/theta", "unit", "rad, m"), True),
+        "theta 'm' for both": (attr("measured/theta", "unit", "m"), True),
+        "theta 'm, rad, rad'": (attr("measured/theta", "unit", "m, rad, rad"), True),
+        "theta 'm, '": (attr("measured/theta", "unit", "m, "), True),
+        "acts_on missing": (lambda f: f["measured/torque"].attrs.__delitem__("acts_on"), True),
+        "acts_on a name of none": (attr("measured/torque", "acts_on", np.array(["nope"], dtype=text)), True),
+        "acts_on the pole": (attr("measured/torque", "acts_on", np.array(["th"], dtype=text)), True),
+        "acts_on two for one input": (attr("measured/torque", "acts_on", np.array(["x", "th"], dtype=text)),
+                                      True),
+        "force in N m": (attr("measured/torque", "unit", "N m"), True),
+        "theta's names swapped": (attr("measured/theta", "channels", np.array(["th", "x"], dtype=text)),
+                                  True),
+        "theta's rows swapped": (swap_rows, True),
+        "a signal the chain does not read": (extra, True),
+        "as generated": (lambda f: None, False),
+    }
+
+    def case(edit, refuse: bool):
+        def run() -> str | None:
+            src = _generated(work, "cartpole")
+            path = work / f"cp_{abs(hash(edit)) % 10**9}.h5"
+            shutil.copyfile(src, path)
+            with h5py.File(path, "r+") as f:
+                edit(f)
+            _rehash(path)
+            return judged(*cli_inprocess(["identify", str(path), "--kind", "mechanical", "--scenario",
+                                          "cartpole", "-o", f"{path}.model.json"]), refuse=refuse)
+        return run
+
+    return [(f"cartpole: {name}", case(e, r)) for name, (e, r) in edits.items()]
 
 
 # ------------------------------------------------------------------ rates
@@ -701,6 +759,7 @@ def runformat_cases(work: Path) -> list[tuple[str, object]]:
 
 FAMILIES = _hostile.families({
     "h5attrs": h5attrs_cases,
+    "mechunits": mechunits_cases,
     "rates": rates_cases,
     "starts": starts_cases,
     "directions": directions_cases,
