@@ -203,6 +203,11 @@ class ImportedData:
             If a group names an unknown channel, mixes units, or has positions for only
             some of its channels, or a declared prior is not a finite number > 0.
         """
+        if prior is not None and not (isinstance(prior, Mapping)
+                                      and all(isinstance(k, str) and k for k in prior)):
+            # prior=5 was a TypeError (round 17)
+            raise MeasuredDataError(self.source, f"prior={prior!r}: expected a mapping of prior "
+                                                 "names (non-empty str) to numbers")
         for key, value in dict(prior or {}).items():
             check_prior(self.source, key, value)
         if groups is None:
@@ -210,7 +215,7 @@ class ImportedData:
             for name in self.signals:
                 grouped.setdefault(name.split("/", 1)[0] if "/" in name else name, []).append(name)
         else:
-            grouped = {g: list(chs) for g, chs in groups.items()}
+            grouped = _checked_groups(self.source, groups)
         measured = {}
         for g, names in grouped.items():
             unknown = [n for n in names if n not in self.signals]
@@ -694,6 +699,41 @@ def from_sep005(channel_dicts: Sequence[Mapping[str, Any]], *, source: str | os.
 
 
 # --------------------------------------------------------------------------- shared checks
+def _checked_groups(source: Path, groups: Any) -> dict[str, list[str]]:
+    """``groups`` of :meth:`ImportedData.to_dataset` as ``{signal: [channel, ...]}``, refused
+    unless a mapping of signal names (non-empty text without ``/`` or control characters: a
+    dataset file's group path) to lists of channel names, no channel given twice and no two
+    channels of a signal sharing the name after their ``"/"``.  ``groups=5`` was an
+    AttributeError, and a channel twice, a signal named ``""``, ``"a/b"`` or ``5`` made a
+    Dataset (round 17)."""
+    if not isinstance(groups, Mapping):
+        raise MeasuredDataError(source, f"groups={groups!r}: expected a mapping of signal name to "
+                                        "channel names")
+    seen: dict[str, str] = {}
+    out: dict[str, list[str]] = {}
+    for g, chs in groups.items():
+        if not isinstance(g, str) or not g or "/" in g or any(is_control(c) for c in g):
+            raise MeasuredDataError(source, f"groups: signal name {g!r}; expected non-empty text "
+                                            "without '/' or control characters")
+        if isinstance(chs, (str, bytes)) or not isinstance(chs, Sequence) \
+                or not all(isinstance(c, str) for c in chs):
+            raise MeasuredDataError(source, f"group {g!r}: {chs!r}; expected a list of channel "
+                                            "names (str)")
+        short: set[str] = set()
+        for c in chs:
+            if c in seen:
+                raise MeasuredDataError(source, f"channel {c!r} is given twice (in group "
+                                                f"{seen[c]!r} and {g!r}); expected each at most once")
+            seen[c] = g
+            tail = c.split("/", 1)[1] if "/" in c else c
+            if tail in short:
+                raise MeasuredDataError(source, f"group {g!r}: two channels named {tail!r} after "
+                                                "their '/'; expected one name per channel")
+            short.add(tail)
+        out[g] = list(chs)
+    return out
+
+
 def check_selection(source: str | os.PathLike, units: Any, channels: Any) -> None:
     """Refuse ``units`` that are not a unit (str) or a mapping of channel name to unit, and
     ``channels`` that are not a non-empty sequence of names: ``units=5`` was an AttributeError
@@ -881,7 +921,9 @@ def check_prior(source: str | os.PathLike, key: str, value: Any) -> None:
     in a dataset file, whose ``prior`` attributes a user may have edited: NaN, -1 or text were
     read in silence)."""
     lo, hi = PRIOR_RANGE
-    if isinstance(value, bool) or not isinstance(value, (int, float)) \
+    # an int beyond float64 (10**400) is refused by its size: math.isfinite raised OverflowError
+    huge = isinstance(value, int) and not isinstance(value, bool) and abs(value) > hi
+    if huge or isinstance(value, bool) or not isinstance(value, (int, float)) \
             or not (math.isfinite(value) and lo <= value <= hi):
         raise MeasuredDataError(source, f"prior {key}={value!r}: expected a finite number from "
                                         f"{lo:g} to {hi:g} (a mass [kg] or a length [m]; beyond, "

@@ -351,3 +351,41 @@ def test_a_mechanical_record_whose_units_disagree_channel_by_channel_is_refused(
 def test_a_mechanical_record_whose_units_agree_is_measured(tmp_path):
     m = measurement_from_file(_cart_pole_like(tmp_path), "mechanical")
     assert m.x.shape == (2, 2000)
+
+
+# ------------------------------------------------------------------ to_dataset arguments
+
+@pytest.mark.parametrize(("groups", "said"), [
+    # an AttributeError, or a Dataset with a channel twice or a signal no file can name (round 17)
+    (5, r"groups=5: expected a mapping"),
+    ({"acceleration": ["acc1", "acc1"]}, r"channel 'acc1' is given twice"),
+    ({"acceleration": ["acc1"], "force": ["acc1"]}, r"channel 'acc1' is given twice \(in group "
+                                                    r"'acceleration' and 'force'\)"),
+    ({"": ["acc1"]}, r"signal name ''"),
+    ({"a/b": ["acc1"]}, r"signal name 'a/b'"),
+    ({5: ["acc1"]}, r"signal name 5"),
+    ({"acceleration": "acc1"}, r"group 'acceleration': 'acc1'; expected a list"),
+], ids=["int", "twice in one", "in two", "empty name", "slash", "int name", "text"])
+def test_to_dataset_refuses_groups_that_are_not_a_grouping(tmp_path, groups, said):
+    data = read_measured(_sep005_started(tmp_path / "r.json", 0))
+    with pytest.raises(MeasuredDataError, match=said):
+        data.to_dataset(groups)
+
+
+def test_to_dataset_refuses_two_channels_of_one_name_in_a_signal():
+    t = np.arange(400) / FS
+    data = from_sep005([{"name": f"{g}/x", "data": np.sin(2 * np.pi * 7 * t * k).tolist(),
+                         "unit_str": "m/s^2", "fs": FS} for k, g in ((1, "a"), (2, "b"))])
+    with pytest.raises(MeasuredDataError, match=r"two channels named 'x'"):
+        data.to_dataset({"acceleration": ["a/x", "b/x"]})
+
+
+@pytest.mark.parametrize(("prior", "said"), [
+    (5, r"prior=5: expected a mapping"), ([], r"prior=\[\]: expected a mapping"),
+    ({"total_mass": 10**400}, r"prior total_mass=1000.*expected a finite number"),
+], ids=["int", "list", "10**400"])
+def test_to_dataset_refuses_a_prior_that_is_not_one(tmp_path, prior, said):
+    # a TypeError, an empty list taken as no prior, and math.isfinite's OverflowError
+    data = read_measured(_sep005_started(tmp_path / "r.json", 0))
+    with pytest.raises(MeasuredDataError, match=said):
+        data.to_dataset(None, prior)
