@@ -53,6 +53,7 @@ import numpy as np
 
 from testbed.core.atomic import atomic_write, atomic_write_text
 from testbed.core.dataset import Dataset, Signal
+from testbed.core.errors import ArgumentError
 from testbed.core.truth import StructuralTruth
 from testbed.pipeline.importers import check_hdf5_rate, check_recorded
 from testbed.pipeline.plugins import RIGS
@@ -359,16 +360,24 @@ def export_dataset(path: str | os.PathLike, fmt: str, out: str | os.PathLike | N
         The file is no dataset (or fails its hash), or its measured signals cannot be read as
         they are (:func:`testbed.pipeline.importers.check_recorded`).
     """
+    # the export API's own arguments, before any reading: an unknown format was a ValueError
+    # after the file was read, and a path or output of another type a TypeError (round 17)
+    if fmt not in ("uff", "sep005"):
+        raise ArgumentError("export_dataset", "fmt", fmt, "unknown export format; allowed: "
+                                                          "'uff', 'sep005'")
+    for name, value in (("path", path), ("out", out)):
+        if not (isinstance(value, (str, os.PathLike)) and isinstance(os.fspath(value), str)) \
+                and not (name == "out" and value is None):
+            raise ArgumentError("export_dataset", name, value, f"of type {type(value).__name__}; "
+                                                               "expected a file path (str or os.PathLike)")
     path = Path(path)
     check_hdf5_rate(path)
     ds = Dataset.load(path)
     check_recorded(ds, path)  # an edited, rehashed file: NaN rate or samples, cut channels
     if fmt == "uff":
         written = [write_uff(ds, out or path.with_suffix(".uff"))]
-    elif fmt == "sep005":
-        written = [write_sep005(ds, out or path.with_suffix(".sep005.json"))]
     else:
-        raise ValueError(f"unknown export format {fmt!r}; allowed: 'uff', 'sep005'")
+        written = [write_sep005(ds, out or path.with_suffix(".sep005.json"))]
     if note is not None and ds.prior:
         given = " ".join(f"--prior {k}={float(v)!r}" for k, v in sorted(ds.prior.items()))
         note(f"note: {fmt} files carry no prior; give it back when identifying: {given} (SI units)")

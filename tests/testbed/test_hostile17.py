@@ -15,7 +15,9 @@ import numpy as np
 import pytest
 
 from testbed import cli
+from testbed.core.atomic import atomic_write_text
 from testbed.core.dataset import Dataset, Signal
+from testbed.core.errors import ArgumentError, InputError
 from testbed.pipeline.importers import (
     MeasuredDataError,
     from_sep005,
@@ -389,3 +391,29 @@ def test_to_dataset_refuses_a_prior_that_is_not_one(tmp_path, prior, said):
     data = read_measured(_sep005_started(tmp_path / "r.json", 0))
     with pytest.raises(MeasuredDataError, match=said):
         data.to_dataset(None, prior)
+
+
+# ------------------------------------------------------------------ export_dataset's arguments
+
+@pytest.mark.parametrize(("kwargs", "said"), [
+    # a ValueError (after reading the file), TypeErrors, and an IsADirectoryError naming the
+    # temporary file (round 17)
+    ({"fmt": "UFF"}, r"'fmt': value 'UFF': unknown export format"),
+    ({"fmt": None}, r"'fmt': value None: unknown export format"),
+    ({"out": 5}, r"'out': value 5: of type int; expected a file path"),
+    ({"out": b"x.uff"}, r"'out': value b'x.uff': of type bytes"),
+    ({"path": None}, r"'path': value None: of type NoneType"),
+], ids=["UFF", "None", "out int", "out bytes", "path None"])
+def test_export_dataset_refuses_arguments_that_are_not_its_own(tmp_path, kwargs, said):
+    args = {"path": _saved(tmp_path), "fmt": "uff", "out": tmp_path / "d.uff", **kwargs}
+    with pytest.raises(ArgumentError, match=said):
+        export_dataset(args["path"], args["fmt"], args["out"])
+
+
+def test_an_atomic_write_onto_a_folder_is_refused_naming_it(tmp_path):
+    (tmp_path / "f").mkdir()
+    with pytest.raises(InputError, match=r"/f: is a folder; expected a file path"):
+        export_dataset(_saved(tmp_path), "uff", tmp_path / "f")
+    with pytest.raises(InputError, match=r"is a folder"):
+        atomic_write_text(tmp_path / "f", "x")
+    assert [p.name for p in tmp_path.iterdir() if p.name.startswith(".")] == []  # no temporary left
