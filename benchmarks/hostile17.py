@@ -56,8 +56,11 @@ Families (what rounds 1-16 did not try):
     :func:`~testbed.pipeline.importers.measurement_from_file`) given ``units``, ``channels``,
     ``path``, ``fs``, ``kind`` and ``signal`` of the wrong type or empty, and in-memory channel
     data as float16, bool, complex, text, object, datetime64, structured, masked, a range, a
-    tuple, a dict, a string or an iterator: an exception other than one refusal line, or a
-    masked sample or a value of the wrong kind accepted, is a finding.
+    tuple, a dict, a string or an iterator; ``ImportedData.to_dataset`` given groups and priors
+    of the wrong type, a channel twice, a signal named ``""``, ``"a/b"`` or ``5``;
+    :func:`~testbed.reporting.export.export_dataset` given an unknown format, an output of the
+    wrong type or a folder: an exception other than one refusal line, or a masked sample or a
+    value of the wrong kind accepted, is a finding.
 ``outputs``
     An output that is one of the command's inputs or that its own second output replaces:
     ``identify -o m.md`` and ``m.MD`` (its report is the output with ``.md``), ``-o`` the data
@@ -652,7 +655,36 @@ def api_cases(work: Path) -> list[tuple[str, object]]:
             "masked, none masked": np.ma.masked_array(np.arange(10.0), mask=False)}
     for label, data in good.items():
         cases.append((f"from_sep005 data {label}", accepted(lambda d=data: from_sep005(chan(d)))))
-    return cases
+    both = ["x/x", "dx/dx"]
+    for groups in (5, [], {"x": ["x/x", "x/x"]}, {"x": ["x/x"], "dx": ["x/x"]}, {"": both}, {"a/b": both},
+                   {5: both}, {"x": "x/x"}):
+        cases.append((f"to_dataset groups={groups!r}",
+                      refused(lambda g=groups: read_measured(rec()).to_dataset(g))))
+    for prior in (5, [], {"total_mass": 10**400}, {"total_mass": "heavy"}, {"": 1.0}):
+        cases.append((f"to_dataset prior={str(prior)[:40]}",
+                      refused(lambda p=prior: read_measured(rec()).to_dataset(None, p))))
+    cases.append(("to_dataset groups by hand",
+                  accepted(lambda: read_measured(rec()).to_dataset({"x": ["x/x"]}))))
+    return cases + _export_api_cases(work)
+
+
+def _export_api_cases(work: Path) -> list[tuple[str, object]]:
+    from testbed.reporting.export import export_dataset
+
+    folder = work / "a_folder"
+    folder.mkdir(exist_ok=True)
+
+    def refused(**change):
+        def run() -> str | None:
+            args = {"path": _generated(work, "michaelis_menten"), "fmt": "uff", "out": work / "e.uff",
+                    **change}
+            export_dataset(args["path"], args["fmt"], args["out"])  # one refusal line: ok
+            return "accepted"
+        return run
+
+    return [(f"export_dataset {k}={v!r}", refused(**{k: v}))
+            for k, v in (("fmt", "UFF"), ("fmt", None), ("fmt", "csv"), ("out", 5), ("out", b"e.uff"),
+                         ("out", folder), ("path", None), ("path", 5))]
 
 
 # ------------------------------------------------------------------ outputs
