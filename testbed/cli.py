@@ -1252,7 +1252,7 @@ def _run(args: argparse.Namespace) -> int:
                   "/dev/full, or a file descriptor not open for writing)", file=sys.stderr)
             _quiet_stdout()
             return EXIT_USAGE
-        refusal = _backend_refusal(e)
+        refusal = _backend_refusal(e) or _descriptor_limit(e)
         if refusal is not None and not args.debug:
             print(f"error: {refusal}", file=sys.stderr)
             return EXIT_USAGE
@@ -1310,6 +1310,30 @@ def _interrupted(e: KeyboardInterrupt) -> int:
         return 128 + e.signum
     print("error: interrupted", file=sys.stderr)
     return EXIT_INTERRUPTED
+
+
+def _descriptor_limit(e: BaseException) -> str | None:
+    """One line for an exception raised from running out of file descriptors (EMFILE: the
+    process's ``ulimit -n``; ENFILE: the system's), else None.  Under ``ulimit -n 8`` `testbed
+    run` was an internal error ("OSError: [Errno 24] Too many open files", round 17): a limit of
+    the environment, as a full disk is (:func:`testbed.core.atomic.no_room`)."""
+    seen: set[int] = set()
+    while e is not None and id(e) not in seen:
+        if isinstance(e, OSError) and e.errno in (errno.EMFILE, errno.ENFILE):
+            if e.errno == errno.ENFILE:
+                return ("too many open files in the system (ENFILE); close some programs and run "
+                        "the command again")
+            try:
+                import resource  # (POSIX only)
+
+                limit = f"may open {resource.getrlimit(resource.RLIMIT_NOFILE)[0]}"
+            except ImportError:
+                limit = "has reached its limit"
+            return (f"too many open files: this process {limit} (`ulimit -n`); the command "
+                    "needs a few dozen: raise the limit (e.g. `ulimit -n 1024`) and run it again")
+        seen.add(id(e))
+        e = e.__cause__ or e.__context__
+    return None
 
 
 def _interrupt_within(e: BaseException) -> KeyboardInterrupt | None:

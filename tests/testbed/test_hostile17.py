@@ -5,6 +5,7 @@ malformed-input audits), each fixed in the layer that owns it.
 from __future__ import annotations
 
 import json
+import os
 import re
 import shutil
 import sys
@@ -417,3 +418,41 @@ def test_an_atomic_write_onto_a_folder_is_refused_naming_it(tmp_path):
     with pytest.raises(InputError, match=r"is a folder"):
         atomic_write_text(tmp_path / "f", "x")
     assert [p.name for p in tmp_path.iterdir() if p.name.startswith(".")] == []  # no temporary left
+
+
+# ------------------------------------------------------------------ out of file descriptors
+
+@pytest.mark.slow  # a whole run in a subprocess (about 10 s)
+def test_running_out_of_file_descriptors_is_one_line(tmp_path):
+    # `ulimit -n 8; testbed run michaelis_menten` was an internal error, "OSError: [Errno 24] Too
+    # many open files" (the drawing process's pipes), status 3 (round 17)
+    import resource
+    import subprocess
+    import sys as _sys
+
+    def limit():
+        resource.setrlimit(resource.RLIMIT_NOFILE, (8, 8))
+
+    env = {**os.environ, "TESTBED_NO_SERVER": "1", "MPLBACKEND": "Agg", "OMP_NUM_THREADS": "1",
+           "PYTHONPATH": str(Path(__file__).resolve().parents[2])}
+    p = subprocess.run([_sys.executable, "-m", "testbed.cli", "run", "michaelis_menten", "--cache",
+                        str(CACHE), "--out", str(tmp_path / "runs")], cwd=tmp_path, env=env,
+                       capture_output=True, text=True, timeout=300, preexec_fn=limit)
+    err = p.stderr.strip().splitlines()
+    assert p.returncode == 2 and len(err) == 1, p.stderr[-400:]
+    assert "too many open files: this process may open 8 (`ulimit -n`)" in err[0]
+
+
+def test_the_descriptor_limit_is_found_in_an_exception_chain():
+    import errno
+
+    try:
+        try:
+            raise OSError(errno.EMFILE, "Too many open files")
+        except OSError as inner:
+            raise RuntimeError("a drawing process failed") from inner
+    except RuntimeError as outer:
+        said = cli._descriptor_limit(outer)
+    assert said is not None and said.startswith("too many open files: this process may open")
+    assert cli._descriptor_limit(OSError(errno.ENFILE, "x")).startswith("too many open files in the system")
+    assert cli._descriptor_limit(OSError(errno.ENOENT, "x")) is None
