@@ -68,6 +68,12 @@ Families (what rounds 1-16 did not try):
     file it extends; ``export -o`` the dataset; ``report -o`` a run folder or its ``run.json``;
     ``sweep --results`` the study or a scenario file.  Status 0, or any given file changed, is
     a finding.
+``rlimits``
+    ``testbed run`` (and ``generate``, ``sweep``) under a resource limit: open files
+    (``ulimit -n``) 6, 8, 10, 12, 16 and 32; a file size of 20 kB (``ulimit -f``, a full disk's
+    stand-in); 600 MB of address space.  A traceback, an internal error or a refusal in more than
+    one line is a finding.  (At 5 descriptors or fewer the interpreter's own imports fail before
+    the command line: known-gaps.)
 ``runformat``
     A run folder (store format ``/2``) whose ``run.json`` says format ``/1`` (no checksums) with
     a score edited, keeping both, one or none of ``/2``'s checksum keys: listed or reported as
@@ -752,6 +758,36 @@ def outputs_cases(work: Path) -> list[tuple[str, object]]:
     return out
 
 
+# ------------------------------------------------------------------ rlimits
+
+def rlimits_cases(work: Path) -> list[tuple[str, object]]:
+    import resource
+
+    def case(argv: list[str], which: int, value: int):
+        def run() -> str | None:
+            out = Path(tempfile.mkdtemp(dir=work))
+            env = {**_hostile.ENV, "TESTBED_CACHE": str(CACHE)}
+            try:
+                p = subprocess.run([sys.executable, "-m", "testbed.cli", *argv], cwd=out, env=env,
+                                   capture_output=True, text=True, timeout=180,
+                                   preexec_fn=lambda: resource.setrlimit(which, (value, value)))
+            except subprocess.TimeoutExpired:
+                return "hang > 180 s"
+            return _hostile.cli_finding(p)
+        return run
+
+    study = work / "h17r.toml"
+    study.write_text('[study]\nname = "h17r"\nscenarios = ["michaelis_menten"]\nnoise = [0.0]\n'
+                     'seeds = [0]\nidentifiers = ["sindy_pi_dynamical"]\n')
+    run = ["run", "michaelis_menten"]
+    cases = [(f"ulimit -n {n}: run", case(run, resource.RLIMIT_NOFILE, n)) for n in (6, 8, 10, 12, 16, 32)]
+    cases += [(f"ulimit -f 20 kB: {' '.join(a[:1])}", case(a, resource.RLIMIT_FSIZE, 20 * 1024))
+              for a in (run, ["generate", "michaelis_menten", "-o", "g.h5"],
+                        ["sweep", str(study), "--results", "r.parquet"])]
+    cases.append(("600 MB of address space: run", case(run, resource.RLIMIT_AS, 600 * 2**20)))
+    return cases
+
+
 # ------------------------------------------------------------------ runformat
 
 def runformat_cases(work: Path) -> list[tuple[str, object]]:
@@ -800,6 +836,7 @@ FAMILIES = _hostile.families({
     "environ": environ_cases,
     "api": api_cases,
     "outputs": outputs_cases,
+    "rlimits": rlimits_cases,
     "runformat": runformat_cases,
 }, TIMEOUT_S)
 
