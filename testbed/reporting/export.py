@@ -274,6 +274,14 @@ def _sensor_nodes(ds: Dataset, truth: StructuralTruth, nodes: dict[tuple[str, in
     return None
 
 
+def _a_dataset(where: str, ds: Any) -> None:
+    """Refuse an exporter's ``ds`` that is not a :class:`Dataset`: 5, None or a dict was an
+    AttributeError from inside (round 17)."""
+    if not isinstance(ds, Dataset):
+        raise ArgumentError(where, "ds", ds, f"of type {type(ds).__name__}; expected a Dataset "
+                                             "(Dataset.load of a dataset file)")
+
+
 def write_uff(ds: Dataset, out: str | os.PathLike) -> Path:
     """Write units (164), geometry (2411, 82), every measured channel (58) and the true modes (55).
 
@@ -289,6 +297,7 @@ def write_uff(ds: Dataset, out: str | os.PathLike) -> Path:
     """
     import pyuff
 
+    _a_dataset("write_uff", ds)
     nodes = node_numbers(ds)
     sets = [_uff164(), *_geometry(ds)]
     sets += [_uff58(ds, name, i, s, nodes[(name, i)]) for name, i, s in _channels(ds)]
@@ -303,6 +312,7 @@ def write_uff(ds: Dataset, out: str | os.PathLike) -> Path:
 
 def to_sep005(ds: Dataset) -> list[dict[str, Any]]:
     """The measured channels as SEP-005 channel dicts (``data`` as 1-D ndarray)."""
+    _a_dataset("to_sep005", ds)
     nodes = node_numbers(ds)
     out = []
     for name, i, s in _channels(ds):

@@ -456,3 +456,14 @@ def test_the_descriptor_limit_is_found_in_an_exception_chain():
     assert said is not None and said.startswith("too many open files: this process may open")
     assert cli._descriptor_limit(OSError(errno.ENFILE, "x")).startswith("too many open files in the system")
     assert cli._descriptor_limit(OSError(errno.ENOENT, "x")) is None
+
+
+@pytest.mark.parametrize("ds", [5, None, {}], ids=["int", "None", "dict"])
+def test_the_exporters_refuse_what_is_not_a_dataset(tmp_path, ds):
+    from testbed.reporting.export import to_sep005, write_sep005, write_uff
+
+    # AttributeError: 'int' object has no attribute 'measured' (round 17)
+    for fn in (lambda: write_uff(ds, tmp_path / "d.uff"), lambda: write_sep005(ds, tmp_path / "d.json"),
+               lambda: to_sep005(ds)):
+        with pytest.raises(ArgumentError, match=r"argument 'ds'.*expected a Dataset"):
+            fn()
