@@ -877,6 +877,10 @@ def _check_direction(path: Path, name: str, direction: int, si: str) -> None:
     +-4..6, SEP-005 ``"... rotation"``) measured in a translation's unit or the reverse (an
     acceleration in m/s^2 about X was read with status 0, round 17).  Units outside the SI
     ones (a dynamical rig's own) and channels without a direction are not checked."""
+    if abs(direction) > 6:  # (a SEP-005 direction 9 or a UFF rsp_dir 9 read as a translation)
+        raise MeasuredDataError(path, f"channel {name!r}: direction code {direction}; expected -6 "
+                                      "to 6 (1-3 translations along X, Y, Z, 4-6 rotations about "
+                                      "them, 0 none)")
     if not direction or si not in SI_UNITS:
         return
     turns, unit_turns = abs(direction) in (4, 5, 6), si in ROTATIONAL_UNITS

@@ -173,6 +173,8 @@ def test_a_dataset_signal_naming_a_channel_twice_is_refused(tmp_path):
     ("+X rotation", "m/s^2", r"direction \+X rotation \(code 4\) is a rotation but its unit 'm/s\^2'"),
     ("-Z", "rad", r"direction -Z \(code -3\) is a translation but its unit 'rad'"),
     (5, "N", r"direction \+Y rotation \(code 5\) is a rotation"),
+    (9, "m/s^2", r"direction code 9; expected -6 to 6"),  # read as a translation along X
+    (-7, "m/s^2", r"direction code -7; expected -6 to 6"),
 ])
 def test_a_channel_whose_direction_and_unit_disagree_is_refused(tmp_path, direction, unit, said):
     # an acceleration "about X" was read and fitted with status 0 (round 17)
