@@ -25,6 +25,12 @@ Families (what rounds 1-16 did not try):
     channel names or rows swapped, a signal the chain does not read.  Status 0 for a record
     whose units disagree channel by channel (a rate against its coordinate, a load against
     the coordinate it drives) is a finding.
+``extremes``
+    Every number of the ``[rig]`` table of the two fast rigs (Michaelis-Menten, cart-pole) set
+    to 1e-300, 1e100, 1e200 and 1e308 (keys without a declared bound: round 14 set the bounded
+    ones at their bounds), run and scored: an exception other than one refusal line, or NaN
+    passing, is a finding.  (The Michaelis-Menten rig's ``jx`` at 1e200 and 1e308 is one,
+    the rig's own: known-gaps.)
 ``rates``
     A Michaelis-Menten record as SEP-005 relabelled to 1e-300 .. 1e300 Hz, its rate channel left
     as it was (then no rate of the signal) or scaled with it (consistent): anything but a
@@ -353,6 +359,35 @@ def mechunits_cases(work: Path) -> list[tuple[str, object]]:
         return run
 
     return [(f"cartpole: {name}", case(e, r)) for name, (e, r) in edits.items()]
+
+
+# ------------------------------------------------------------------ extremes
+
+def extremes_cases(work: Path) -> list[tuple[str, object]]:
+    from testbed.pipeline.scenario import SCENARIO_DIR, _read_toml
+
+    def case(base: str, key: str, value: float):
+        def run() -> str | None:
+            from testbed.pipeline.scenario import scenario_from_dict
+            from testbed.scoring.run import run_scenario
+
+            raw = _read_toml(SCENARIO_DIR / f"{base}.toml")
+            raw["scenario"].pop("extends", None)
+            raw["rig"][key] = value
+            sc = scenario_from_dict(raw, file=f"{base}.toml", stem=base)  # one refusal line: ok
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")  # the integrators' overflow warnings
+                return _hostile.scored_finding(run_scenario(sc))
+        return run
+
+    cases = []
+    for base in ("michaelis_menten", "cartpole"):
+        rig = _read_toml(SCENARIO_DIR / f"{base}.toml")["rig"]
+        for key, old in rig.items():
+            if isinstance(old, float):
+                cases += [(f"{base} rig.{key} = {v:g}", case(base, key, v))
+                          for v in (1e-300, 1e100, 1e200, 1e308)]
+    return cases
 
 
 # ------------------------------------------------------------------ rates
@@ -828,6 +863,7 @@ def runformat_cases(work: Path) -> list[tuple[str, object]]:
 FAMILIES = _hostile.families({
     "h5attrs": h5attrs_cases,
     "mechunits": mechunits_cases,
+    "extremes": extremes_cases,
     "rates": rates_cases,
     "starts": starts_cases,
     "directions": directions_cases,
