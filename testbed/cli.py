@@ -237,6 +237,12 @@ def _output_file(path: Path, option: str, *, inputs: tuple[Path, ...] = ()) -> P
     return path
 
 
+def _given_files(*groups: Any) -> tuple[Path, ...]:
+    """The files among ``groups`` of paths (scenario files read, ``--plugin`` files or
+    modules): what a command's output must not replace."""
+    return tuple(Path(p) for g in groups for p in g if str(p).endswith((".toml", ".py")))
+
+
 def _output_folder(path: Path, option: str) -> Path:
     """A folder a command will write into (created on use), checked before any work."""
     st = _stat(path, option)
@@ -525,14 +531,18 @@ def cmd_list(args: argparse.Namespace) -> int:
 def cmd_generate(args: argparse.Namespace) -> int:
     from testbed.pipeline.cache import DatasetCache
     from testbed.pipeline.generate import generate
-    from testbed.pipeline.scenario import load_scenario
+    from testbed.pipeline.scenario import load_scenario, recording_reads
     from testbed.reporting.console import print_truth_summary
 
-    _load_plugins(args)  # a plugin rig's scenario, as `run` takes it
-    sc = load_scenario(args.scenario)
+    plugins = _load_plugins(args)  # a plugin rig's scenario, as `run` takes it
+    with recording_reads() as read:  # the scenario and the files it extends
+        sc = load_scenario(args.scenario)
     if args.seed is not None:
         sc = sc.replace(seed=args.seed)
-    out = _output_file(Path(args.output or f"{sc.name}-seed{sc.seed}.h5"), "--output")
+    # -o the scenario file itself (or a file it extends, or a plugin) replaced it with the
+    # dataset, status 0 (round 17)
+    out = _output_file(Path(args.output or f"{sc.name}-seed{sc.seed}.h5"), "--output",
+                       inputs=_given_files(read, plugins))
     with _progress()(f"generating {sc.name}") as bar:
         # through the run cache unless --no-cache: a later `testbed run` of it simulates nothing
         cache = None if args.no_cache else DatasetCache(_cache_folder(args.cache))
@@ -722,11 +732,12 @@ def cmd_identify(args: argparse.Namespace) -> int:
 
     from testbed.core.atomic import atomic_write_text
     from testbed.pipeline.fit import identify_file
+    from testbed.pipeline.scenario import resolve_path
     from testbed.reporting.identified import render_identified
     from testbed.reporting.progress import run_progress
     from testbed.scoring.scorers import fitted_model_failures, prediction_r2
 
-    _load_plugins(args)
+    plugins = _load_plugins(args)
     units = None
     if args.units:
         per_channel = ["=" in u for u in args.units]
@@ -735,8 +746,15 @@ def cmd_identify(args: argparse.Namespace) -> int:
                              "(--units g) or one CHANNEL=UNIT per option, not both or several units")
         units = _key_values(args.units, "--units", numbers=False) if per_channel[0] else args.units[0]
     data = _existing_file(Path(args.data), "a measured-data file (UFF58, SEP-005 JSON, CSV or HDF5)")
-    out = _output_file(Path(args.output or f"{data.stem}.model.json"), "--output", inputs=(data,))
-    _output_file(out.with_suffix(".md"), "--output (its .md report)", inputs=(data,))
+    # nor the --scenario file or a plugin (-o s.toml replaced the scenario: round 17)
+    given = (data, *_given_files([resolve_path(args.scenario)] if args.scenario else [], plugins))
+    out = _output_file(Path(args.output or f"{data.stem}.model.json"), "--output", inputs=given)
+    if out.suffix.lower() == ".md":  # the report replaced the model it reports (round 17; .MD:
+        # the same file where names ignore case, as on macOS and Windows)
+        raise InputError(f"--output {terminal_safe(str(out))}: its report goes to the same path "
+                         "with the suffix .md, so the report would replace the model; expected a "
+                         "path not ending in .md (e.g. the default, <data>.model.json)")
+    _output_file(out.with_suffix(".md"), "--output (its .md report)", inputs=given)
     with run_progress(data.name) as phase:
         result = identify_file(data, scenario=args.scenario, kind=args.kind, method=args.method,
                                params=_key_values(args.param, "--param", numbers=False),
@@ -1234,7 +1252,7 @@ def _run(args: argparse.Namespace) -> int:
                   "/dev/full, or a file descriptor not open for writing)", file=sys.stderr)
             _quiet_stdout()
             return EXIT_USAGE
-        refusal = _backend_refusal(e)
+        refusal = _backend_refusal(e) or _descriptor_limit(e)
         if refusal is not None and not args.debug:
             print(f"error: {refusal}", file=sys.stderr)
             return EXIT_USAGE
@@ -1292,6 +1310,30 @@ def _interrupted(e: KeyboardInterrupt) -> int:
         return 128 + e.signum
     print("error: interrupted", file=sys.stderr)
     return EXIT_INTERRUPTED
+
+
+def _descriptor_limit(e: BaseException) -> str | None:
+    """One line for an exception raised from running out of file descriptors (EMFILE: the
+    process's ``ulimit -n``; ENFILE: the system's), else None.  Under ``ulimit -n 8`` `testbed
+    run` was an internal error ("OSError: [Errno 24] Too many open files", round 17): a limit of
+    the environment, as a full disk is (:func:`testbed.core.atomic.no_room`)."""
+    seen: set[int] = set()
+    while e is not None and id(e) not in seen:
+        if isinstance(e, OSError) and e.errno in (errno.EMFILE, errno.ENFILE):
+            if e.errno == errno.ENFILE:
+                return ("too many open files in the system (ENFILE); close some programs and run "
+                        "the command again")
+            try:
+                import resource  # (POSIX only)
+
+                limit = f"may open {resource.getrlimit(resource.RLIMIT_NOFILE)[0]}"
+            except ImportError:
+                limit = "has reached its limit"
+            return (f"too many open files: this process {limit} (`ulimit -n`); the command "
+                    "needs a few dozen: raise the limit (e.g. `ulimit -n 1024`) and run it again")
+        seen.add(id(e))
+        e = e.__cause__ or e.__context__
+    return None
 
 
 def _interrupt_within(e: BaseException) -> KeyboardInterrupt | None:

@@ -129,6 +129,8 @@ def atomic_write(path: str | os.PathLike, write: Callable[[str], None]) -> Path:
     """
     path = Path(path)
     not_regular(path)
+    if path.is_dir():  # the rename's IsADirectoryError named the temporary file (round 17)
+        raise InputError(f"{path}: is a folder; expected a file path")
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     os.close(fd)

@@ -203,6 +203,11 @@ class ImportedData:
             If a group names an unknown channel, mixes units, or has positions for only
             some of its channels, or a declared prior is not a finite number > 0.
         """
+        if prior is not None and not (isinstance(prior, Mapping)
+                                      and all(isinstance(k, str) and k for k in prior)):
+            # prior=5 was a TypeError (round 17)
+            raise MeasuredDataError(self.source, f"prior={prior!r}: expected a mapping of prior "
+                                                 "names (non-empty str) to numbers")
         for key, value in dict(prior or {}).items():
             check_prior(self.source, key, value)
         if groups is None:
@@ -210,7 +215,7 @@ class ImportedData:
             for name in self.signals:
                 grouped.setdefault(name.split("/", 1)[0] if "/" in name else name, []).append(name)
         else:
-            grouped = {g: list(chs) for g, chs in groups.items()}
+            grouped = _checked_groups(self.source, groups)
         measured = {}
         for g, names in grouped.items():
             unknown = [n for n in names if n not in self.signals]
@@ -288,6 +293,10 @@ def read_measured(path: str | os.PathLike, *, format: str | None = None, fs: flo
         channels of different lengths or rates, non-finite values, unknown unit or channel,
         a declared ``fs`` the file contradicts.
     """
+    if not isinstance(path, (str, os.PathLike)) or isinstance(os.fspath(path), bytes):
+        # an int or bytes: TypeError from pathlib (round 17)
+        raise MeasuredDataError(str(path), f"path={path!r} ({type(path).__name__}); expected a "
+                                           "file path (str or os.PathLike)")
     path = Path(path)
     if format is None:
         format = SUFFIXES.get(path.suffix.lower())
@@ -296,6 +305,7 @@ def read_measured(path: str | os.PathLike, *, format: str | None = None, fs: flo
                                           f"pass format= one of {', '.join(FORMATS)}")
     if format not in FORMATS:
         raise MeasuredDataError(path, f"unknown format {format!r}; allowed: {', '.join(FORMATS)}")
+    check_selection(path, units, channels)
     if not path.is_file():
         raise MeasuredDataError(path, "no such file")
     if fs is not None and not (isinstance(fs, (int, float)) and math.isfinite(fs) and fs > 0):
@@ -347,8 +357,11 @@ def measurement_from_file(path: str | os.PathLike, kind: str, signal: Mapping[st
         A bad ``signal`` table.
     """
 
-    if kind not in SIGNAL_SCHEMAS:
+    if not isinstance(kind, str) or kind not in SIGNAL_SCHEMAS:
         raise MeasuredDataError(path, f"unknown rig kind {kind!r}; allowed: {', '.join(SIGNAL_SCHEMAS)}")
+    if signal is not None and not isinstance(signal, Mapping):  # 5: AttributeError (round 17)
+        raise MeasuredDataError(path, f"signal={signal!r} ({type(signal).__name__}); expected "
+                                      "a [signal] table (a mapping) or None")
     data = read_measured(path, format=format, fs=fs, units=units, channels=channels,
                          own_units=kind == "dynamical")
     ds = data.to_dataset(groups, prior)
@@ -579,11 +592,13 @@ def _detrended(a: np.ndarray, d: np.ndarray, fs: float) -> tuple[np.ndarray, flo
     """The signal less its rate's running integral, mean and linear drift removed, and the
     drift's slope [unit/s] (the rate's constant offset, sign flipped)."""
     integral = np.concatenate([[0.0], np.cumsum((d[1:] + d[:-1]) * 0.5) / fs])
-    tt = (np.arange(a.size) - 0.5 * (a.size - 1)) / fs
+    # the time in samples, not seconds: at fs = 1e200 Hz tt @ tt [s^2] underflowed to 0 (a
+    # ZeroDivisionError, round 17); the slope per sample is then scaled to per second
+    k = np.arange(a.size) - 0.5 * (a.size - 1)
     res = a - integral
     res = res - res.mean()
-    slope = float(res @ tt) / float(tt @ tt) if a.size > 1 else 0.0
-    return res - slope * tt, slope
+    per_sample = float(res @ k) / float(k @ k) if a.size > 1 else 0.0
+    return res - per_sample * k, per_sample * fs
 
 
 #: What each measured signal of a rig kind holds (:data:`SAME_ORDER` of its unit); a
@@ -615,6 +630,8 @@ def _check_units(path: Path, ds: Dataset, kind: str) -> None:
                 allowed = ", ".join(u for u, o in SAME_ORDER.items() if o == want)
                 raise MeasuredDataError(path, f"signal {g!r} channel {ch!r} is in {unit}; the "
                                               f"{kind} chain reads {g!r} as a {want} ({allowed})")
+    if kind == "mechanical":
+        _check_mechanical_units(path, ds)
     if kind == "dynamical" and "x" in ds.measured and "dx" in ds.measured:
         x, dx = ds.measured["x"], ds.measured["dx"]
         if len(x.channels) != len(dx.channels):
@@ -624,6 +641,37 @@ def _check_units(path: Path, ds: Dataset, kind: str) -> None:
             if ud != rate:
                 raise MeasuredDataError(path, f"signal 'dx' channel {ch!r} is in {ud}; expected "
                                               f"{rate}, the rate of its state's {ux}")
+
+
+#: The load that drives a coordinate of each SI unit: a force a translation, a moment a rotation.
+LOAD_ON = {"m": "N", "rad": "N m"}
+
+
+def _check_mechanical_units(path: Path, ds: Dataset) -> None:
+    """Refuse a mechanical record whose units disagree channel by channel: a rate that is not
+    in its coordinate's unit per second (``theta`` "rad, m" beside ``dtheta`` "m/s, rad/s"),
+    or an input whose load does not drive the coordinate it acts on (a moment "N m" on a cart's
+    position in m).  Each was fitted with status 0 (round 17): the checks above read every
+    unit alone."""
+    m = ds.measured
+    for g, dg in RATE_PAIRS["mechanical"]:
+        if g not in m or dg not in m or len(m[g].channels) != len(m[dg].channels):
+            continue  # the chain says what is missing
+        for ch, dch, u, du in zip(m[g].channels, m[dg].channels, m[g].channel_units(),
+                                  m[dg].channel_units(), strict=True):
+            if u in RATE_OF and du != RATE_OF[u]:
+                raise MeasuredDataError(path, f"signal {dg!r} channel {dch!r} is in {du}; expected "
+                                              f"{RATE_OF[u]}, the rate of {g!r} channel {ch!r} in {u}")
+    coords = dict(zip(m["theta"].channels, m["theta"].channel_units(), strict=True)) \
+        if "theta" in m else {}
+    for g, sig in m.items():
+        for ch, unit, target in zip(sig.channels, sig.channel_units(), sig.acts_on or (), strict=False):
+            want = LOAD_ON.get(coords.get(target, ""))
+            if want is not None and unit != want:
+                raise MeasuredDataError(path, f"signal {g!r} channel {ch!r} is in {unit} but acts on "
+                                              f"'theta' channel {target!r} in {coords[target]}; "
+                                              f"expected {want} (a force drives a translation, a "
+                                              "moment a rotation)")
 
 
 def from_sep005(channel_dicts: Sequence[Mapping[str, Any]], *, source: str | os.PathLike = "<sep005>",
@@ -646,10 +694,62 @@ def from_sep005(channel_dicts: Sequence[Mapping[str, Any]], *, source: str | os.
     -------
     ImportedData
     """
+    check_selection(source, units, channels)
     return _finish(_parse_sep005(Path(source), channel_dicts), fs, units, channels)
 
 
 # --------------------------------------------------------------------------- shared checks
+def _checked_groups(source: Path, groups: Any) -> dict[str, list[str]]:
+    """``groups`` of :meth:`ImportedData.to_dataset` as ``{signal: [channel, ...]}``, refused
+    unless a mapping of signal names (non-empty text without ``/`` or control characters: a
+    dataset file's group path) to lists of channel names, no channel given twice and no two
+    channels of a signal sharing the name after their ``"/"``.  ``groups=5`` was an
+    AttributeError, and a channel twice, a signal named ``""``, ``"a/b"`` or ``5`` made a
+    Dataset (round 17)."""
+    if not isinstance(groups, Mapping):
+        raise MeasuredDataError(source, f"groups={groups!r}: expected a mapping of signal name to "
+                                        "channel names")
+    seen: dict[str, str] = {}
+    out: dict[str, list[str]] = {}
+    for g, chs in groups.items():
+        if not isinstance(g, str) or not g or "/" in g or any(is_control(c) for c in g):
+            raise MeasuredDataError(source, f"groups: signal name {g!r}; expected non-empty text "
+                                            "without '/' or control characters")
+        if isinstance(chs, (str, bytes)) or not isinstance(chs, Sequence) \
+                or not all(isinstance(c, str) for c in chs):
+            raise MeasuredDataError(source, f"group {g!r}: {chs!r}; expected a list of channel "
+                                            "names (str)")
+        short: set[str] = set()
+        for c in chs:
+            if c in seen:
+                raise MeasuredDataError(source, f"channel {c!r} is given twice (in group "
+                                                f"{seen[c]!r} and {g!r}); expected each at most once")
+            seen[c] = g
+            tail = c.split("/", 1)[1] if "/" in c else c
+            if tail in short:
+                raise MeasuredDataError(source, f"group {g!r}: two channels named {tail!r} after "
+                                                "their '/'; expected one name per channel")
+            short.add(tail)
+        out[g] = list(chs)
+    return out
+
+
+def check_selection(source: str | os.PathLike, units: Any, channels: Any) -> None:
+    """Refuse ``units`` that are not a unit (str) or a mapping of channel name to unit, and
+    ``channels`` that are not a non-empty sequence of names: ``units=5`` was an AttributeError
+    and ``channels=[]`` a ValueError of ``max()`` (round 17)."""
+    if units is not None and not (isinstance(units, str) or (
+            isinstance(units, Mapping) and all(isinstance(k, str) and isinstance(v, str)
+                                               for k, v in units.items()))):
+        raise MeasuredDataError(source, f"units={units!r}: expected a unit (str) or a mapping of "
+                                        "channel name to unit (str to str)")
+    if channels is not None and (isinstance(channels, (str, bytes, Mapping))
+                                 or not isinstance(channels, Sequence) or not channels
+                                 or not all(isinstance(c, str) for c in channels)):
+        raise MeasuredDataError(source, f"channels={channels!r}: expected a non-empty list of "
+                                        "channel names (str)")
+
+
 @dataclass
 class _Raw:
     """What a reader found, before units, selection and checks."""
@@ -663,6 +763,9 @@ class _Raw:
     directions: dict[str, int] = field(default_factory=dict)
     positions: dict[str, float] = field(default_factory=dict)
     prior: dict[str, float] = field(default_factory=dict)
+    #: time [s] of each channel's first sample, where the file states it per channel (a
+    #: SEP-005 channel's ``time``, a UFF58 record's abscissa)
+    starts: dict[str, float] = field(default_factory=dict)
     #: the file's units are its rig's own and stay as they are (a testbed dataset of a
     #: ``dynamical`` rig: concentrations and the like have no SI form to convert to)
     own_units: bool = False
@@ -730,6 +833,7 @@ def _finish(raw: _Raw, fs: float | None, units: str | Mapping[str, str] | None,
         raise MeasuredDataError(path, f"sample rate {rate:g} Hz: {n} samples would last forever "
                                       "(the duration overflows); expected a rate whose record lasts "
                                       "a finite time")
+    _check_starts(path, {n: raw.starts[n] for n in names if n in raw.starts}, rate)
     signals = {}
     for n in names:
         unit = units if isinstance(units, str) else (units or {}).get(n, raw.units.get(n))
@@ -741,6 +845,7 @@ def _finish(raw: _Raw, fs: float | None, units: str | Mapping[str, str] | None,
         if not si:
             raise MeasuredDataError(path, f"channel {n!r}: unknown unit {unit!r}; allowed: "
                                           f"{', '.join(SI_UNITS + tuple(UNIT_ALIASES))}")
+        _check_direction(path, n, raw.directions.get(n, 0), si)
         x = np.asarray(raw.data[n], dtype=float)
         bad = np.flatnonzero(~np.isfinite(x))
         if bad.size:
@@ -763,6 +868,48 @@ def _finish(raw: _Raw, fs: float | None, units: str | Mapping[str, str] | None,
                         prior=dict(raw.prior))
 
 
+#: The SI units of rotations (an angle, its rates, a moment); the other SI units translate.
+ROTATIONAL_UNITS = ("rad", "rad/s", "rad/s^2", "N m")
+
+
+def _check_direction(path: Path, name: str, direction: int, si: str) -> None:
+    """Refuse a channel whose direction and unit disagree: a rotation (UFF direction code
+    +-4..6, SEP-005 ``"... rotation"``) measured in a translation's unit or the reverse (an
+    acceleration in m/s^2 about X was read with status 0, round 17).  Units outside the SI
+    ones (a dynamical rig's own) and channels without a direction are not checked."""
+    if abs(direction) > 6:  # (a SEP-005 direction 9 or a UFF rsp_dir 9 read as a translation)
+        raise MeasuredDataError(path, f"channel {name!r}: direction code {direction}; expected -6 "
+                                      "to 6 (1-3 translations along X, Y, Z, 4-6 rotations about "
+                                      "them, 0 none)")
+    if not direction or si not in SI_UNITS:
+        return
+    turns, unit_turns = abs(direction) in (4, 5, 6), si in ROTATIONAL_UNITS
+    if turns != unit_turns:
+        axis = "XYZ"[(abs(direction) - 1) % 3]
+        said = f"{'-' if direction < 0 else '+'}{axis}{' rotation' if turns else ''}"
+        raise MeasuredDataError(path, f"channel {name!r}: direction {said} (code {direction}) "
+                                      f"is a {'rotation' if turns else 'translation'} but its unit "
+                                      f"{si!r} is a {'rotation' if unit_turns else 'translation'}'s; "
+                                      "expected a direction and a unit of one kind")
+
+
+def _check_starts(path: Path, starts: Mapping[str, float], fs: float) -> None:
+    """Refuse channels whose first samples were taken at different times: the readers line
+    the channels up sample by sample, so a force recorded 0.3 s after its responses (a SEP-005
+    channel's ``time`` or a UFF58 record's abscissa starting later) was fitted as if
+    simultaneous, with status 0 (round 17).  Within half a sample step [s] they agree (a
+    time stamp's rounding)."""
+    if len(starts) < 2:
+        return
+    (first, t0), (worst, tw) = next(iter(starts.items())), max(
+        starts.items(), key=lambda kv: abs(kv[1] - next(iter(starts.values()))))
+    if abs(tw - t0) > 0.5 / fs:
+        raise MeasuredDataError(path, f"channel {worst!r} starts at t = {tw:.9g} s, channel "
+                                      f"{first!r} at t = {t0:.9g} s: {abs(tw - t0) * fs:.3g} "
+                                      "samples apart; expected every channel to start at one time "
+                                      "(within half a sample step)")
+
+
 #: Range of a declared prior (a mass [kg] or a length [m]).  A prior scales the identified
 #: matrices (M from a mass, then K = M w^2 with w^2 up to (pi fs)^2 ~ 1e9 rad^2/s^2, M^-1 K, and
 #: the eigen-solvers' products of them), which must stay inside float64's 1e-308 .. 1e308:
@@ -778,7 +925,9 @@ def check_prior(source: str | os.PathLike, key: str, value: Any) -> None:
     in a dataset file, whose ``prior`` attributes a user may have edited: NaN, -1 or text were
     read in silence)."""
     lo, hi = PRIOR_RANGE
-    if isinstance(value, bool) or not isinstance(value, (int, float)) \
+    # an int beyond float64 (10**400) is refused by its size: math.isfinite raised OverflowError
+    huge = isinstance(value, int) and not isinstance(value, bool) and abs(value) > hi
+    if huge or isinstance(value, bool) or not isinstance(value, (int, float)) \
             or not (math.isfinite(value) and lo <= value <= hi):
         raise MeasuredDataError(source, f"prior {key}={value!r}: expected a finite number from "
                                         f"{lo:g} to {hi:g} (a mass [kg] or a length [m]; beyond, "
@@ -831,6 +980,7 @@ def uniform_rate(path: Path, t: np.ndarray, what: str = "time column") -> float:
 # --------------------------------------------------------------------------- readers
 def _read_hdf5(path: Path) -> _Raw:
     _check_hdf5_size(path)
+    check_hdf5_rate(path)
     try:
         ds = Dataset.load(path)
     except DatasetError as e:
@@ -872,6 +1022,11 @@ def _raw_from_dataset(path: Path, ds: Dataset) -> _Raw:
                                           "channel(s); expected one position [m] per channel")
         for i, ch in enumerate(s.channels):
             name = f"{g}/{ch}"
+            if name in raw.data:  # the later channel replaced the earlier in silence (round 17:
+                # a record of three accelerations fitted on two, status 1 with a poor model)
+                raise MeasuredDataError(path, f"signal measured/{g} names channel {ch!r} twice "
+                                              f"(channels {', '.join(map(repr, s.channels))}); "
+                                              "expected one name per channel")
             raw.data[name], raw.units[name] = s.data[i], per_channel[i]
             if s.positions is not None:
                 raw.positions[name] = check_position(path, name, s.positions[i], "positions")
@@ -890,6 +1045,41 @@ def _raw_from_dataset(path: Path, ds: Dataset) -> _Raw:
                 if target in node:
                     raw.nodes[f"{g}/{ch}"] = node[target]
     return raw
+
+
+def check_hdf5_rate(path: str | os.PathLike) -> None:
+    """Refuse a dataset file whose root attribute ``fs`` is not one real number, or whose
+    ``fs_unit`` is not ``"Hz"`` (a file that cannot be opened is left to :meth:`Dataset.load`).
+
+    :meth:`Dataset.load` read ``fs`` with ``float()``: the text ``"100"`` and ``True`` were
+    read as rates, a complex rate lost its imaginary part (with a warning over two lines), and
+    ``fs_unit`` (which the content hash leaves out) was never read, so ``"kHz"`` was taken as
+    Hz in silence (round 17).
+
+    Raises
+    ------
+    MeasuredDataError
+        Naming ``path``, the attribute, its value and what is allowed.
+    """
+    import h5py
+
+    try:
+        with h5py.File(path, "r") as h:
+            attrs = {k: h.attrs[k] for k in ("fs", "fs_unit") if k in h.attrs}
+    except Exception:
+        return
+    fs = attrs.get("fs")
+    if fs is not None and not (isinstance(fs, (np.floating, np.integer, float, int))
+                               and not isinstance(fs, (bool, np.bool_))):
+        shown = fs.item() if isinstance(fs, np.generic) else fs  # named as 'True', not
+        shown = shown.decode(errors="replace") if isinstance(shown, bytes) else shown  # np.True_
+        raise MeasuredDataError(path, f"attribute fs={shown!r} ({type(fs).__name__}); expected "
+                                      "one real number, the sample rate [Hz]")
+    unit = attrs.get("fs_unit")
+    unit = unit.decode(errors="replace") if isinstance(unit, bytes) else unit
+    if unit is not None and unit != "Hz":
+        raise MeasuredDataError(path, f"attribute fs_unit={unit!r}; expected 'Hz' (the unit the "
+                                      "sample rate fs is read in)")
 
 
 def _check_hdf5_size(path: Path) -> None:
@@ -959,6 +1149,12 @@ def _parse_sep005(path: Path, content: Any) -> _Raw:
         if "data" not in c:
             raise MeasuredDataError(path, f"SEP-005 channel {name!r} has no data")
         values = c["data"]
+        if np.ma.isMaskedArray(values) and np.ma.getmaskarray(values).any():
+            # np.asarray dropped the mask: a masked (missing) sample was read as a value
+            # (round 17)
+            raise MeasuredDataError(path, f"SEP-005 channel {name!r}: data are a masked array "
+                                          f"with {int(np.ma.getmaskarray(values).sum())} masked "
+                                          "sample(s); fill or cut them")
         # JSON strings and booleans are not samples (np.asarray would read "1.5" and true as
         # numbers); an array given in memory must hold real numbers (complex lost its
         # imaginary part)
@@ -991,6 +1187,7 @@ def _parse_sep005(path: Path, content: Any) -> _Raw:
                                               f"for data of shape {data.shape}; expected one time "
                                               "per sample")
             rate = uniform_rate(path, t, f"channel {name!r} time")
+            raw.starts[name] = float(t[0])
             # both given: fs won in silence (fs = 50 over a 100 Hz time: every frequency halved)
             if name in rates and abs(rate / rates[name] - 1) > DECLARED_RATE_RTOL:
                 raise MeasuredDataError(path, f"SEP-005 channel {name!r}: fs={rates[name]:g} Hz but "
@@ -1254,6 +1451,9 @@ def _uff58_channel(path: Path, k: int, s: dict[str, Any], raw: _Raw) -> tuple[st
                                           f"({a(coded)}); expected a label of the quantity the "
                                           "type declares")
     raw.data[name], raw.units[name] = data.astype(float), label or None
+    start = float(s.get("abscissa_min", 0.0)) if even else float(np.asarray(s["x"], dtype=float)[0])
+    if math.isfinite(start):
+        raw.starts[name] = start
     if node > 0:
         raw.nodes[name] = node
     if direction:

@@ -53,8 +53,9 @@ import numpy as np
 
 from testbed.core.atomic import atomic_write, atomic_write_text
 from testbed.core.dataset import Dataset, Signal
+from testbed.core.errors import ArgumentError
 from testbed.core.truth import StructuralTruth
-from testbed.pipeline.importers import check_recorded
+from testbed.pipeline.importers import check_hdf5_rate, check_recorded
 from testbed.pipeline.plugins import RIGS
 from testbed.pipeline.signal_chain import measure
 
@@ -273,6 +274,14 @@ def _sensor_nodes(ds: Dataset, truth: StructuralTruth, nodes: dict[tuple[str, in
     return None
 
 
+def _a_dataset(where: str, ds: Any) -> None:
+    """Refuse an exporter's ``ds`` that is not a :class:`Dataset`: 5, None or a dict was an
+    AttributeError from inside (round 17)."""
+    if not isinstance(ds, Dataset):
+        raise ArgumentError(where, "ds", ds, f"of type {type(ds).__name__}; expected a Dataset "
+                                             "(Dataset.load of a dataset file)")
+
+
 def write_uff(ds: Dataset, out: str | os.PathLike) -> Path:
     """Write units (164), geometry (2411, 82), every measured channel (58) and the true modes (55).
 
@@ -288,6 +297,7 @@ def write_uff(ds: Dataset, out: str | os.PathLike) -> Path:
     """
     import pyuff
 
+    _a_dataset("write_uff", ds)
     nodes = node_numbers(ds)
     sets = [_uff164(), *_geometry(ds)]
     sets += [_uff58(ds, name, i, s, nodes[(name, i)]) for name, i, s in _channels(ds)]
@@ -302,6 +312,7 @@ def write_uff(ds: Dataset, out: str | os.PathLike) -> Path:
 
 def to_sep005(ds: Dataset) -> list[dict[str, Any]]:
     """The measured channels as SEP-005 channel dicts (``data`` as 1-D ndarray)."""
+    _a_dataset("to_sep005", ds)
     nodes = node_numbers(ds)
     out = []
     for name, i, s in _channels(ds):
@@ -359,15 +370,24 @@ def export_dataset(path: str | os.PathLike, fmt: str, out: str | os.PathLike | N
         The file is no dataset (or fails its hash), or its measured signals cannot be read as
         they are (:func:`testbed.pipeline.importers.check_recorded`).
     """
+    # the export API's own arguments, before any reading: an unknown format was a ValueError
+    # after the file was read, and a path or output of another type a TypeError (round 17)
+    if fmt not in ("uff", "sep005"):
+        raise ArgumentError("export_dataset", "fmt", fmt, "unknown export format; allowed: "
+                                                          "'uff', 'sep005'")
+    for name, value in (("path", path), ("out", out)):
+        if not (isinstance(value, (str, os.PathLike)) and isinstance(os.fspath(value), str)) \
+                and not (name == "out" and value is None):
+            raise ArgumentError("export_dataset", name, value, f"of type {type(value).__name__}; "
+                                                               "expected a file path (str or os.PathLike)")
     path = Path(path)
+    check_hdf5_rate(path)
     ds = Dataset.load(path)
     check_recorded(ds, path)  # an edited, rehashed file: NaN rate or samples, cut channels
     if fmt == "uff":
         written = [write_uff(ds, out or path.with_suffix(".uff"))]
-    elif fmt == "sep005":
-        written = [write_sep005(ds, out or path.with_suffix(".sep005.json"))]
     else:
-        raise ValueError(f"unknown export format {fmt!r}; allowed: 'uff', 'sep005'")
+        written = [write_sep005(ds, out or path.with_suffix(".sep005.json"))]
     if note is not None and ds.prior:
         given = " ".join(f"--prior {k}={float(v)!r}" for k, v in sorted(ds.prior.items()))
         note(f"note: {fmt} files carry no prior; give it back when identifying: {given} (SI units)")

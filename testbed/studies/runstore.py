@@ -376,7 +376,14 @@ def _verify_meta(run_dir: Path, meta: dict[str, Any]) -> None:
     match it (round 16: a flipped digit of a score, a threshold loosened to 1e9, a seed or a
     scenario name edited in ``run.json`` were listed and reported as the run's own)."""
     if meta.get("format") != FORMAT:
-        return  # a /1 run has no checksums: read as it was written
+        # a /1 run has no checksums: read as it was written.  But /1 was never written with
+        # them: a /2 run.json whose format was edited to /1 (one word) was read unchecked, its
+        # other edits (a score, a verdict) listed and reported as the run's own (round 17)
+        sealed = [k for k in (DIGEST, NPZ_DIGEST) if k in meta]
+        if sealed:
+            raise ValueError(f"{run_dir / 'run.json'}: format {meta.get('format')!r} with "
+                             f"{', '.join(sealed)}, which only {FORMAT!r} writes: edited")
+        return
     if meta.get(DIGEST) != meta_digest(meta):
         raise ValueError(f"{run_dir / 'run.json'}: its content does not match its checksum "
                          f"({DIGEST!r}): damaged or edited after the run wrote it")
