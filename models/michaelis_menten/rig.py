@@ -38,6 +38,7 @@ from models import RIGS
 from models._base import ErrorFn, Rig, check_two_samples
 from testbed.core.budget import Cost
 from testbed.core.dataset import Dataset, Signal
+from testbed.core.errors import RigError
 from testbed.core.schema import Field
 from testbed.core.truth import DynamicalTruth
 
@@ -61,6 +62,10 @@ STIFF_STEP_LIMIT = 6.0
 #: chain's x, xd, xdd (3) and the identifier's library matrix (up to ~50 columns of float64,
 #: e.g. a degree-6 library with its derivative terms): 64 float64 with room.
 BYTES_PER_SAMPLE = 512
+
+#: Largest concentration a record may reach [mM]: the square root of the largest float64, so
+#: that the solver's error norm (a sum of squares of the state) stays finite.
+X_MAX = float(np.sqrt(np.finfo(float).max))
 
 #: A start within this fraction of the steady state is at rest: the whole record moves less
 #: than 1e-9 of its value (float64 keeps 16 digits; nothing an identifier can fit on).
@@ -168,6 +173,18 @@ class MichaelisMentenRig(Rig):
         if steady is not None and not np.isfinite(ends[1]):
             error("rig.Vmax", rig["Vmax"], f"expected a rate finite at the steady state "
                                            f"{steady:.6g} mM (Vmax times it overflows)")
+        # the largest concentration of the record: x moves monotonically from x0 towards the
+        # steady state, or grows by at most jx per second; its square must be finite, as the
+        # solver's error norm squares the state (hostile round 17: jx = 1e200 mM/s was an
+        # internal error, 'Required step size is less than spacing between numbers', and from
+        # about 1e154 every step warned of overflow)
+        growth = rig["jx"] * simulation["duration"]
+        x_max = max(rig["x0"], steady or 0.0, rig["x0"] + growth)
+        if x_max > X_MAX:
+            key = "rig.jx" if growth > rig["x0"] else "rig.x0"
+            error(key, rig[key[4:]], f"expected concentrations up to {X_MAX:.4g} mM over the record "
+                                     f"(the square of the state must be finite); x0 + jx x duration "
+                                     f"reaches {x_max:.4g} mM")
         check_two_samples(simulation, error)
 
     @classmethod
@@ -202,10 +219,18 @@ class MichaelisMentenRig(Rig):
         fs = float(sc.simulation["sample_rate"])
         n = round(sc.simulation["duration"] * fs)
         t = np.arange(n) / fs
-        sol = solve_ivp(lambda _t, y: rate(y, jx, vmax, km), (0.0, t[-1]), [x0], method="DOP853",
-                        t_eval=t, rtol=RTOL, atol=ATOL)
-        if not sol.success:
-            raise RuntimeError(f"michaelis_menten: solve_ivp failed: {sol.message}")
+        # the solver's error norm squares states and rates over its tolerances, which can
+        # overflow on huge values (jx = 1e153 mM/s, hostile round 17: warnings on every step):
+        # a failed or non-finite solution is this rig's refusal, not an internal error
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+            sol = solve_ivp(lambda _t, y: rate(y, jx, vmax, km), (0.0, t[-1]), [x0],
+                            method="DOP853", t_eval=t, rtol=RTOL, atol=ATOL)
+        if not sol.success or sol.y.shape[1] != n or not np.all(np.isfinite(sol.y)):
+            raise RigError(f"michaelis_menten: the rate law could not be integrated to "
+                           f"rtol {RTOL:g} / atol {ATOL:g} mM over the record ({sol.message}); "
+                           f"expected values whose rates and states over those tolerances stay "
+                           f"within float64 (jx = {jx:g} mM/s, x0 = {x0:g} mM)", key="rig.jx",
+                           value=jx)
         x = sol.y[:1]
         dx = rate(x, jx, vmax, km)
         if progress is not None:

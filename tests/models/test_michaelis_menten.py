@@ -1,10 +1,12 @@
 """The Michaelis-Menten rig against its closed-form time-of-state and its implicit truth."""
 
+import warnings
+
 import numpy as np
 import pytest
 
 from models.michaelis_menten import implicit_equation, rate
-from testbed.core.errors import ScenarioError
+from testbed.core.errors import RigError, ScenarioError
 from testbed.core.truth import DynamicalTruth
 from testbed.pipeline.plugins import rig_class
 from testbed.pipeline.scenario import load_scenario, scenario_from_dict
@@ -98,6 +100,30 @@ def test_a_stiff_rate_law_is_refused_by_the_step_budget_naming_vmax():
         scenario_from_dict({"scenario": {"name": "x", "rig": "michaelis_menten"},
                             "rig": {"Vmax": 1e9}})
     scenario_from_dict({"scenario": {"name": "x", "rig": "michaelis_menten"}, "rig": {"Vmax": 1e3}})
+
+
+@pytest.mark.parametrize(("rig", "key"), [({"jx": 1e200}, "jx"), ({"jx": 1e308}, "jx"),
+                                          ({"x0": 1e200, "jx": 0.0}, "x0")])
+def test_a_record_whose_concentration_squared_overflows_is_refused(rig, key):
+    # hostile round 17: jx = 1e200 mM/s ended `testbed run` in an internal error (solve_ivp's
+    # "Required step size is less than spacing between numbers"); x grows by jx per second
+    with pytest.raises(ScenarioError, match=rf"key 'rig\.{key}'.*concentrations up to 1\.341e\+154"):
+        scenario_from_dict({"scenario": {"name": "mm", "rig": "michaelis_menten"}, "rig": rig})
+
+
+def test_huge_but_representable_influx_simulates_without_warnings():
+    # jx = 1e153 mM/s (x reaches 4e153 mM, under the bound): the solver's norms overflowed
+    # inside its step control on every step (RuntimeWarnings flooding a study's stderr)
+    sc = scenario_from_dict({"scenario": {"name": "mm", "rig": "michaelis_menten"},
+                             "rig": {"jx": 1e153}})
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        try:
+            ds = rig_class("michaelis_menten")(sc).simulate()
+        except RigError as exc:  # a refusal naming the key is the other allowed outcome
+            assert exc.key == "rig.jx"
+        else:
+            assert np.all(np.isfinite(ds.measured["x"].data))
 
 
 @pytest.mark.parametrize("simulation", [{"sample_rate": 1e-6}, {"duration": 1e-6}])
