@@ -111,6 +111,7 @@ from typing import Any, Literal
 import numpy as np
 
 from identify._modal_damping import modal_decay
+from identify._unresolved import place_unresolved
 from identify.structural import (
     FIT_BAND_ORDER,
     FIT_TILT_DIFFERENCES,
@@ -537,6 +538,96 @@ def symmetric_damping(M: np.ndarray, K: np.ndarray, xdd: np.ndarray, xd: np.ndar
     return symmetric_least_squares([xd], r)[0]
 
 
+def _uncoupled_coef(xdd: np.ndarray, xd: np.ndarray, x: np.ndarray,
+                    x3: np.ndarray | None = None) -> np.ndarray:
+    """The uncoupled least squares of ``x''`` on ``[x', x (, x^3)]``, columns scaled to unit RMS
+    (cut-off 1e-10, ``ls_sindy``'s): coefficients, shape (n, 2 n) or (n, 3 n), so that
+    ``x'' = coef @ [x'; x (; x^3)]`` (``-M^-1 C``, ``-M^-1 K`` (, ``-M^-1 K3``))."""
+    theta = np.vstack([xd, x] + ([x3] if x3 is not None else []))
+    scale = _rms(theta)
+    return np.linalg.lstsq((theta / scale[:, None]).T, xdd.T, rcond=1e-10)[0].T / scale[None, :]
+
+
+def equal_modal_mass(A: np.ndarray, m_hat: float) -> tuple[np.ndarray, np.ndarray | None]:
+    """The warm start's mass for ``A = M^-1 K``: ``M0 = Phi^-T Phi^-1`` (equal modal masses of
+    the unit-norm eigenvectors ``Phi`` of ``A``), which makes ``M0 A`` symmetric, scaled to
+    ``trace = m_hat`` [kg].  ``m_hat / n * I`` (and ``Phi`` None) when ``A`` has a complex or
+    non-positive eigenvalue or dependent eigenvectors (e.g. a 60-sample free decay through 5
+    sensors defines no mass: the identity instead of inverting a singular matrix).
+
+    Returns
+    -------
+    M0 : ndarray, shape (n, n)
+        Mass [kg].
+    Phi : ndarray, shape (n, n) or None
+        The eigenvectors (columns, unit norm) ``M0`` was formed from.
+    """
+    n = A.shape[0]
+    lam, phi = np.linalg.eig(A)
+    if (np.all(np.abs(lam.imag) <= 1e-9 * np.abs(lam).max()) and np.all(lam.real > 0)
+            and np.linalg.cond(phi.real) < 1e12):
+        phi = phi.real
+        phi_inv = np.linalg.inv(phi)
+        M0 = phi_inv.T @ phi_inv
+    else:
+        phi, M0 = None, np.eye(n)
+    return M0 * (m_hat / np.trace(M0)), phi
+
+
+def unresolved_warm_start(xdd: np.ndarray, xd: np.ndarray, x: np.ndarray, m_hat: float,
+                          top_hz: float, peaks: np.ndarray
+                          ) -> tuple[np.ndarray, np.ndarray, np.ndarray, str] | None:
+    """A linear warm start with the modes the record cannot resolve placed (``ls_sindy``'s step
+    5, :func:`identify._unresolved.place_unresolved`, on the uncoupled regression).
+
+    The uncoupled least squares (``A = M^-1 K``, ``B = M^-1 C``, :func:`_uncoupled_coef`) has
+    its unresolved modes placed at the peak band's top, critically damped
+    (:func:`~identify._unresolved.place_unresolved` with ``M = I``); the mass is then
+    :func:`equal_modal_mass` of the placed ``A`` and ``K0 = M0 A`` (symmetric).  The damping
+    is each mode's own, ``C0 = M0 Phi diag(d) Phi^-1`` with ``d`` the diagonal of
+    ``Phi^-1 B Phi`` (symmetric, positive semi-definite where every ``d_k >= 0``): the fitted
+    couplings of ``B`` have no symmetric form with these masses (round 16's
+    ``b16_ti_n32_s5``: ``|D - D^T| / |D|`` 1.0), and :func:`symmetric_damping`'s least
+    squares gives the placed mode, which the record does not hold, a damping of its own
+    choosing (measured there: poles at +3058 +3330j 1/s x 2 pi; the held warm start TRAC
+    0.009, with the modal damping 0.985).
+
+    Parameters
+    ----------
+    xdd, xd, x : ndarray, shape (n, N)
+        The fit's (tilted, profiled) accelerations, velocities and displacements.
+    m_hat : float
+        Mass prior [kg], ``trace(M0)``.
+    top_hz : float
+        The peak search's band top [Hz].
+    peaks : ndarray, shape (k,)
+        Accepted spectral peaks [Hz].
+
+    Returns
+    -------
+    (M0, C0, K0, rule) or None
+        None where the rule does not act (:func:`~identify._unresolved.place_unresolved`) or
+        the placed ``A`` defines no equal-modal-mass ``M0``.
+    """
+    n = xdd.shape[0]
+    coef = _uncoupled_coef(xdd, xd, x)
+    placed = place_unresolved(np.eye(n), -coef[:, :n], -coef[:, n:], top_hz, peaks)
+    if placed is None:
+        return None
+    B, A, rule = placed
+    M0, phi = equal_modal_mass(A, m_hat)
+    if phi is None:
+        return None
+    # in modal form, M0 = s Phi^-T Phi^-1: C0 = s Phi^-T diag(d) Phi^-1, K0 likewise with the
+    # placed eigenvalues (not M0 @ A: with four root sensors M0's condition is 6e7)
+    phi_inv = np.linalg.inv(phi)
+    s = m_hat / float(np.sum(phi_inv * phi_inv))
+    d = np.diag(phi_inv @ B @ phi)
+    lam = np.diag(phi_inv @ A @ phi)
+    return (M0, _sym(s * (phi_inv.T * d) @ phi_inv), _sym(s * (phi_inv.T * lam) @ phi_inv),
+            rule)
+
+
 def warm_start(xdd: np.ndarray, xd: np.ndarray, x: np.ndarray, x3: np.ndarray | None,
                m_hat: float, l1_threshold: float = 0.0,
                profile: dict[str, Any] | None = None) -> tuple[np.ndarray, ...]:
@@ -560,9 +651,7 @@ def warm_start(xdd: np.ndarray, xd: np.ndarray, x: np.ndarray, x3: np.ndarray | 
     """
     n = xdd.shape[0]
     if x3 is None or not l1_threshold > 0:
-        theta = np.vstack([xd, x] + ([x3] if x3 is not None else []))
-        scale = _rms(theta)
-        coef = np.linalg.lstsq((theta / scale[:, None]).T, xdd.T, rcond=1e-10)[0].T / scale[None, :]
+        coef = _uncoupled_coef(xdd, xd, x, x3)
     else:
         from sklearn.linear_model import Lasso
 
@@ -576,16 +665,7 @@ def warm_start(xdd: np.ndarray, xd: np.ndarray, x: np.ndarray, x3: np.ndarray | 
             coef[i] = pr["s_a"][i] * np.concatenate([a / pr["s_lin"], w / pr["s3"]])
     A = -coef[:, n:2 * n]
     A3 = -coef[:, 2 * n:] if x3 is not None else None
-    lam, phi = np.linalg.eig(A)
-    # (dependent eigenvectors, e.g. a 60-sample free decay through 5 sensors, define no mass:
-    # the identity, as for complex ones, instead of inverting a singular matrix)
-    if (np.all(np.abs(lam.imag) <= 1e-9 * np.abs(lam).max()) and np.all(lam.real > 0)
-            and np.linalg.cond(phi.real) < 1e12):
-        phi_inv = np.linalg.inv(phi.real)
-        M0 = phi_inv.T @ phi_inv
-    else:
-        M0 = np.eye(n)
-    M0 *= m_hat / np.trace(M0)
+    M0 = equal_modal_mass(A, m_hat)[0]
     K0 = _sym(M0 @ A)
     C0 = symmetric_damping(M0, K0, xdd, xd, x, x3, M0 @ A3 if A3 is not None else None)
     K30 = M0 @ A3 if A3 is not None else None
@@ -747,6 +827,9 @@ class MatrixSGDResult:
     ceiling_held : bool
         Whether the hold bounded a mode from above only (``ceiling``): False when none was
         asked, the hold is off, or ``eigen_backbone`` replaced the peak.
+    unresolved_rule : str
+        What :func:`unresolved_warm_start` placed in the warm start (``fit_matrix_sgd``'s
+        ``unresolved``), or ``""`` where it did not act.
     """
 
     M: np.ndarray
@@ -768,6 +851,7 @@ class MatrixSGDResult:
     warm: MatrixSGDResult | None = None
     stop_rule: str = ""
     ceiling_held: bool = False
+    unresolved_rule: str = ""
 
 
 #: The rule when an epoch's steps leave a non-finite iterate (round 12's
@@ -824,6 +908,21 @@ def psd_damping_warm_start(M: np.ndarray, C: np.ndarray, K: np.ndarray) -> np.nd
     return C
 
 
+def _physical_placed(sig: list[np.ndarray], m_hat: float, top_hz: float, peaks: np.ndarray
+                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, str] | None:
+    """:func:`unresolved_warm_start` on the fit's signals ``sig`` (``[x'', x', x, ...]``),
+    if it acts and the model it gives is physical (:func:`identify.structural.check_physical`);
+    else None."""
+    placed = unresolved_warm_start(*sig[:3], m_hat, top_hz, peaks)
+    if placed is None:
+        return None
+    try:
+        check_physical(*placed[:3], "the warm start with its unresolved modes placed")
+    except IdentificationError:
+        return None
+    return placed
+
+
 def _kept_cubic(K3: np.ndarray | None) -> bool:
     """Whether a warm start's cubic stiffness [N/m^3] has a nonzero entry (its lasso kept an
     ``x^3`` term)."""
@@ -843,7 +942,8 @@ def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
                    lam_hat: np.ndarray,
                    progress: Callable[[float | None, str | None], None] | None = None,
                    peaks: np.ndarray | None = None, with_warm: bool = False,
-                   ceiling: np.ndarray | None = None) -> MatrixSGDResult:
+                   ceiling: np.ndarray | None = None,
+                   unresolved: tuple[float, np.ndarray] | None = None) -> MatrixSGDResult:
     """Run the matrix-parametrised SGD.
 
     Parameters
@@ -873,6 +973,12 @@ def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
         ``hardened_peak_rule_``).  The eigenvalue penalty targets them as every peak.  An entry
         ``eigen_backbone`` replaces by its backbone's linear frequency is no longer a peak and
         is held from both sides (``MatrixSGDResult.ceiling_held`` says what was done).
+    unresolved : (float, ndarray), optional
+        The peak search's band top [Hz] and accepted peaks [Hz]: with ``fit_tilt`` by rule
+        and the linear library, a tilted warm start that grows even with its damping projected
+        (:func:`psd_damping_warm_start`) is replaced by :func:`unresolved_warm_start`'s, kept
+        tilted when that is physical (``MatrixSGDResult.unresolved_rule`` says what was
+        placed); None: the rule does not act (flat, as before).
 
     Returns
     -------
@@ -931,6 +1037,7 @@ def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
                      + ("(user setting)" if est.fit_tilt else "(rule)"))
     sig = fit_signals(tilted)
     (M0, C0, K0, K30), pr = start(sig)
+    unresolved_rule = ""
     if tilted and est.init == "lstsq":
         try:
             check_physical(M0, C0, K0, "the warm start's least squares")
@@ -938,11 +1045,22 @@ def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
             if est.fit_tilt:  # the user's choice: refused, not replaced
                 raise
             C_psd = None if est.cubic else psd_damping_warm_start(M0, C0, K0)
+            placed = (None if est.cubic or C_psd is not None or unresolved is None
+                      else _physical_placed(sig, m_hat, *unresolved))
             if C_psd is not None:
                 C0 = C_psd
                 tilt_rule = (f"rule: the tilted warm start had a growing pole ({e}); kept with "
                              "its damping projected onto the positive semi-definite cone "
                              "(physical then)")
+            elif placed is not None:
+                # ls_sindy's step 5 (identify._unresolved): a mode whose pole reaches past the
+                # peak band's top is placed there (round 16's b16_ti_n32_s5, five sensors at
+                # 12.8 kHz: mode 5 fitted with a negative stiffness; flat, the SGD diverged,
+                # TRAC 4.6e-8; placed, 0.9946)
+                M0, C0, K0, unresolved_rule = placed
+                tilt_rule = (f"rule: the tilted warm start had a growing pole ({e}), not "
+                             "removed by projecting its damping; kept with its unresolved "
+                             "modes placed (physical then)")
             else:
                 tilted = False
                 tilt_rule = f"rule: the tilted warm start was refused ({e}); fitted flat"
@@ -1228,7 +1346,8 @@ def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
                                eigen_targets=np.sqrt(target) / (2.0 * np.pi), eigen_shift=held,
                                fit_tilt=tilted, fit_tilt_rule=tilt_rule,
                                input_map_record=input_map_record, backbone_rule=rule,
-                               ceiling_held=bool(np.any(upper)))
+                               ceiling_held=bool(np.any(upper)),
+                               unresolved_rule=unresolved_rule)
 
     out = dataclasses.replace(finish(L, P, Q, R, target, guard, n_steps, alpha,
                                      {k: np.asarray(v) for k, v in hist.items()}),

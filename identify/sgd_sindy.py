@@ -549,8 +549,10 @@ class SGDSINDy(SGDSINDyBase):
         fit band).  None (default): by rule, tilted unless the tilted warm start has a growing
         mode (:func:`identify.structural.check_physical`; then flat, unless the library is
         linear and the pole goes when the warm start's damping is projected onto the positive
-        semi-definite cone: tilted with that damping, see Notes), with the cubic library
-        as without it (``ls_sindy``'s rule since 2026-11-26); when a cubic library's tilted
+        semi-definite cone: tilted with that damping, see Notes; or, that failing, when a
+        mode whose pole reaches past the peak band's top is placed there in the warm start,
+        ``ls_sindy``'s step 5: tilted with it, see Notes, "Unresolved modes"), with the cubic
+        library as without it (``ls_sindy``'s rule since 2026-11-26); when a cubic library's tilted
         warm start was refused and the flat one's lasso kept no ``x^3`` term (a linear model)
         its linear columns are fitted tilted, if that is physical.  Measured on the soft-base
         family (issue #15's bars, 2026-11-26): clean 11 -> 12 / 20 (000: mode 2 27.6 ->
@@ -661,6 +663,23 @@ class SGDSINDy(SGDSINDyBase):
     still failing on frequency.  Round 5-8 beam cells (benchmarks/unseen): fires on 50 of
     208; round 7's b_s8 clean (flat: diverged) and b_s6 at 0.5 % (TRAC 0.64 -> 0.9999) gained,
     round 6's b_soft_root_cluster clean lost (mode 1 +2.71 % against the 2.6 % bar).
+
+    *Unresolved modes* (``unresolved_rule_``; linear library, ``fit_tilt`` by rule, with
+    ``eigen``).  Five sensors at 12.8 kHz on 32-36 segments (round 16's ``b16_ti_n32_s5``,
+    ``b16_al_f150_n36_s5``) ask for a fifth mode past the peak band's top (4619 Hz, 57 %
+    damped, against 4522 Hz); the tilted warm start fits it with a negative stiffness (a pole
+    at +2.99e10 1/s) that projecting the damping does not remove, and the flat fallback put
+    modes at 136 / 241 / 6878 / 10805 / 25794 Hz (truth 81.3 / 510 / 1427 / 2795 / 4619) and
+    the SGD diverged (TRAC 4.6e-8).  The rule is ``ls_sindy``'s step 5
+    (:func:`identify._unresolved.place_unresolved`) on the warm start's uncoupled regression,
+    before its mass is formed (:func:`identify._sgd_matrix.unresolved_warm_start`), with each
+    mode's own damping: the least-squares symmetric damping gave the placed mode, of which
+    the record holds nothing, a growing pole (held warm start TRAC 0.009).  Kept tilted when
+    the result is physical; else flat as before.  Measured clean (issue #15's bars):
+    ``b16_ti_n32_s5`` TRAC 4.6e-8 -> 0.9945, modes 1-3 within 0.29 %; ``b16_al_f150_n36_s5``
+    -> 0.9961, within 0.23 %; ``b16_st_root4`` (four root sensors, mode 4 fitted with a
+    negative stiffness, top 2931 Hz) mode 1 49x off -> 1.26 %, TRAC 0.930 (the held warm start:
+    the SGD diverges from it, 0.006), within the round's bars (2.6 %, TRAC 0.90).
 
     *Keeping the SGD's result* (``keep_sgd``).  From a sound warm start the SGD can wander
     while its data loss stays flat: soft-base member 006 (clean) ends with mode 1 off 1773 %,
@@ -827,6 +846,9 @@ class SGDSINDy(SGDSINDyBase):
         The fit band's high-pass cut-off [Hz] (0 = none); ``fit_band_rule_`` (str) says why.
     fit_tilt_ : bool
         Whether the fit (warm start and loss) was tilted; ``fit_tilt_rule_`` (str) says why.
+    unresolved_rule_ : str
+        What the warm start's unresolved-mode rule placed (``fit_tilt``; Notes, "Unresolved
+        modes"), or that it did not act.
     sgd_stop_rule_ : str
         Why the SGD's epochs ended early (:data:`identify._sgd_matrix.BREAKDOWN_RULE`: an
         epoch left a non-finite iterate), or ``"every epoch ran"``.
@@ -1055,8 +1077,13 @@ class SGDSINDy(SGDSINDyBase):
         if self.keep_sgd is False:
             est = dataclasses.replace(est, epochs=0)
         by_rule = self.keep_sgd is None and est.epochs > 0 and est.init == "lstsq"
+        # ls_sindy's step 5 (identify._unresolved) on the warm start: the peak search's band
+        # top and accepted peaks (only with the eigenvalue penalty's search, ``eigen``)
+        unresolved = ((float(self.peak_band_[1]), np.asarray(self.peaks_, dtype=float))
+                      if self.eigen else None)
         out = fit_matrix_sgd(data, est, m_hat, lam_hat, progress=self.report_progress,
-                             peaks=band_peaks, with_warm=by_rule, ceiling=ceiling)
+                             peaks=band_peaks, with_warm=by_rule, ceiling=ceiling,
+                             unresolved=unresolved)
         if np.any(ceiling) and not out.ceiling_held:  # the rule as it acted, not as asked
             self.hardened_peak_rule_ += (
                 "; not applied: " + ("eigen_backbone replaced the peak by its backbone's linear "
@@ -1162,6 +1189,9 @@ class SGDSINDy(SGDSINDyBase):
         n = data.n_channels
         self.fit_band_hz_, self.fit_band_rule_ = fit_band_cutoff(data, est.fit_band_hz, band_peaks)
         self.fit_tilt_, self.fit_tilt_rule_ = out.fit_tilt, out.fit_tilt_rule
+        self.unresolved_rule_ = out.unresolved_rule or (
+            "none placed (the warm start's rule acts only on a tilted warm start refused for a "
+            "growing pole that projecting its damping does not remove)")
         self.eigen_backbone_rule_ = out.backbone_rule
         if est.cubic and est.cubic_form == "direction":
             i0, i1 = fit_window(data, est.fit_duration)

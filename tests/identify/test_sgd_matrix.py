@@ -8,9 +8,15 @@ import numpy as np
 import pytest
 
 from benchmarks import bench_sgd_sindy as bench
-from identify._sgd_matrix import _sym, cubic_profile, fit_matrix_sgd, warm_start
+from identify._sgd_matrix import (
+    _sym,
+    cubic_profile,
+    fit_matrix_sgd,
+    unresolved_warm_start,
+    warm_start,
+)
 from identify.sgd_sindy import SGDSINDy
-from identify.structural import mass_prior_value
+from identify.structural import check_physical, mass_prior_value, modal, state_matrix
 
 # One worker runs the module: each chain record below is integrated once (10 calls made 3
 # records; 4-6 s each on a loaded 2-core machine).
@@ -304,3 +310,44 @@ def test_a_breakdown_inside_the_iterate_averaging_names_the_averaged_epochs(monk
     out = fit_matrix_sgd(data, est, m_hat, lam_hat, peaks=peaks)
     assert out.stop_rule == BREAKDOWN_AVERAGED_RULE.format(epoch=8, first=7, last=7)
     assert all(np.isfinite(a).all() for a in (out.M, out.C, out.K))
+
+
+def _uncoupled_signals(A: np.ndarray, B: np.ndarray, n_samples: int = 400, seed: int = 0):
+    """Signals on which the uncoupled regression is exactly ``x'' = -B x' - A x``: random
+    ``x``, ``x'`` (unit RMS) and ``x''`` from them."""
+    rng = np.random.default_rng(seed)
+    xd, x = rng.standard_normal((2, A.shape[0], n_samples))
+    return -B @ xd - A @ x, xd, x
+
+
+def test_the_unresolved_warm_start_places_the_mode_and_keeps_each_modes_damping():
+    """``A = M^-1 K`` with modes at 100 and 500 Hz and one fitted with a negative stiffness
+    (its real pole 3000 Hz x 2 pi beyond the 2000 Hz top), ``B = M^-1 C`` with modal damping
+    and a non-symmetric coupling: the warm start is symmetric, physical, with ``trace(M)``
+    the prior, modes 100 / 500 / 2000 Hz (to rounding), the resolved modes' own damping
+    kept and the placed one critically damped; with every mode resolved, None."""
+    rng = np.random.default_rng(7)
+    Phi = np.linalg.qr(rng.standard_normal((3, 3)))[0] + 0.3 * np.eye(3)
+    Pinv = np.linalg.inv(Phi)
+    w = 2 * np.pi * np.array([100.0, 500.0])
+    A = Phi @ np.diag([-(2 * np.pi * 3000.0) ** 2, *w**2]) @ Pinv
+    D = np.diag([50.0, 2 * 0.01 * w[0], 2 * 0.05 * w[1]])
+    D[1, 2] = 40.0  # a coupling no symmetric damping with equal modal masses holds
+    B = Phi @ D @ Pinv
+    sig = _uncoupled_signals(A, B)
+    M0, C0, K0, rule = unresolved_warm_start(*sig, 0.3, 2000.0, np.array([100.0, 500.0]))
+    assert "1 mode(s)" in rule and "negative stiffness" in rule
+    for X in (M0, C0, K0):
+        np.testing.assert_allclose(X, X.T, atol=0.0)
+    assert np.trace(M0) == pytest.approx(0.3, rel=1e-12)
+    check_physical(M0, C0, K0)
+    np.testing.assert_allclose(modal(M0, K0)[0], [100.0, 500.0, 2000.0], rtol=1e-8)
+    poles = np.linalg.eigvals(state_matrix(M0, C0, K0))
+    low = poles[(poles.imag > 0) & (np.abs(poles) < 2 * np.pi * 1000.0)]
+    low = low[np.argsort(low.imag)]
+    # the resolved modes' own damping (the coupling dropped): -zeta w, to rounding
+    np.testing.assert_allclose(-low.real, [0.01 * w[0], 0.05 * w[1]], rtol=1e-6)
+    top = poles[np.abs(poles) > 2 * np.pi * 1000.0]
+    # critically damped: a double real pole at -w_top (rounding of a double root: sqrt(eps))
+    np.testing.assert_allclose(top.real, -2 * np.pi * 2000.0, rtol=1e-5)
+    assert unresolved_warm_start(*sig, 0.3, 4000.0, np.array([100.0, 500.0])) is None
