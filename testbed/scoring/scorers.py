@@ -6,6 +6,7 @@ scenario's ``[score]`` table may threshold as ``<name>_min`` / ``<name>_max``).
 
 from __future__ import annotations
 
+import copy
 import re
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -201,11 +202,12 @@ _MODE_SCORE = re.compile(r"(mac|freq_error|damping_error)(?:_mode(\d+))?")
 def bar_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -> dict[str, str]:
     """The failures a run's bars add to its scorer's: :func:`uninformative_failures`,
     :func:`out_of_band_failures`, :func:`unexcited_failures`, :func:`decayed_failures`,
-    :func:`floor_failures` and :func:`equation_failures`, merged (one call for
+    :func:`floor_failures`, :func:`equation_failures` and :func:`step_failures`, merged (one call for
     :func:`testbed.scoring.run.run_scenario` and :func:`testbed.scoring.evaluate.score_model`)."""
     return {**uninformative_failures(scores, thresholds), **out_of_band_failures(scores, thresholds),
             **unexcited_failures(scores, thresholds), **decayed_failures(scores, thresholds),
-            **floor_failures(scores, thresholds), **equation_failures(scores, thresholds)}
+            **floor_failures(scores, thresholds), **equation_failures(scores, thresholds),
+            **step_failures(scores, thresholds)}
 
 
 def rig_equation_bars(dataset: Dataset) -> dict[str, dict[str, float]]:
@@ -1225,6 +1227,67 @@ def implicit_rollout(score: str, model: Any, data: Measurement, x0: np.ndarray,
     return coef, {score: worst(rmse, "max")}, failures, d
 
 
+def half_step_rollout(score: str, model: Any, data: Measurement, x0: np.ndarray,
+                      xd0: np.ndarray | None, reference_x: np.ndarray) -> dict[str, Any]:
+    """The scored rollout again at half the identifier's own integration step.
+
+    For an identifier whose ``simulate`` integrates in fixed steps of its parameter ``sim_dt``
+    [s] (``sindy_pi_dynamical``'s RK4): a copy of the fitted model with ``sim_dt / 2`` is
+    simulated as :func:`implicit_rollout` simulates it.  What it gives is a witness, not a
+    score: the scored rollout is the identifier's own; where it fails its bar and the half
+    step meets it, the integrator, not the identified equation, failed
+    (:func:`step_failures`).
+
+    Returns
+    -------
+    dict
+        ``{f"{score}_half_step": largest per-coordinate RMSE (NaN if that simulation failed),
+        "sim_dt": the identifier's step [s]}``; empty for a model without a float ``sim_dt``.
+    """
+    dt = getattr(model, "sim_dt", None)
+    if isinstance(dt, bool) or not isinstance(dt, (int, float)) or not np.isfinite(dt) or dt <= 0:
+        return {}
+    half = copy.copy(model)  # shallow: only the step differs; the fitted arrays are shared
+    half.sim_dt = float(dt) / 2.0
+    _, v, failures, _ = implicit_rollout(score, half, data, x0, xd0, reference_x)
+    return {f"{score}_half_step": v[score] if not failures else float("nan"),
+            "sim_dt": float(dt)}
+
+
+def step_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -> dict[str, str]:
+    """A failed rollout bar that half the identifier's step meets: ``{"step": reason}``.
+
+    The scored rollout stays the identifier's own (no verdict changes); the reason says the
+    failure is its integrator's at its step, not the identified equation's.  Round 17's
+    ``mm17_km1e-4`` clean (Km 1e-4 mM): the law exact to 2.6e-4, the 1 ms RK4 step (the
+    decay rate near x*, ``Vmax Km / (Km + x*)^2`` = 5.4e3 1/s, puts ``h |lambda|`` at 5.4, past
+    RK4's 2.79) stepped through x* to a negative concentration, -1.6 mM at 4 s: state_rmse
+    0.617 against the bar 0.01, named nothing; at 0.5 ms 1.0e-8.
+
+    Parameters
+    ----------
+    scores : Scores
+        With ``details[f"{score}_half_step"]`` and ``details["sim_dt"]``
+        (:func:`half_step_rollout`); without them, nothing to check.
+    thresholds : dict
+        The run's bars, ``{metric: {"min"|"max": value}}``.
+    """
+    dt = scores.details.get("sim_dt")
+    for score in ("state_rmse",):
+        half = scores.details.get(f"{score}_half_step")
+        bar = thresholds.get(score, {}).get("max")
+        got = scores.values.get(score)
+        if half is None or dt is None or bar is None or got is None:
+            continue
+        if np.isfinite(got) and got > bar and np.isfinite(half) and half <= bar:
+            return {"step": (f"rollout step: {score} {got:.3g} against the bar {bar:g}, but "
+                             f"{half:.3g} at half the identifier's integration step (sim_dt "
+                             f"{dt:g} s -> {dt / 2:g} s): the scored rollout is not converged at "
+                             "its step, so the failure is the integrator's, not the identified "
+                             "equation's (identify.sim_dt)")}
+    return {}
+
+
 def equation_scores(cmp: dict[str, Any]) -> dict[str, float]:
     """``coef_error`` and ``support_precision`` / ``_recall`` / ``_f1`` of an equation
     comparison (:func:`compare_implicit`, :func:`~testbed.scoring.equation_basis.compare_equations`)."""
@@ -1384,6 +1447,8 @@ def score_dynamical(dataset: Dataset, data: Measurement, clean: Measurement, mod
     truth = dataset.truth_as(DynamicalTruth)
     x_ref = np.asarray(dataset.reference.get("x", dataset.measured["x"]).data, dtype=float)
     coef, v, failures, d = implicit_rollout("state_rmse", model, data, truth.x0, None, x_ref)
+    if not failures:
+        d.update(half_step_rollout("state_rmse", model, data, truth.x0, None, x_ref))
     if "model" in failures:
         return Scores({**v, **NO_EQUATION_SCORES}, d, failures)
     cmp = compare_implicit(list(model.feature_names_), coef, truth.equation_terms,
