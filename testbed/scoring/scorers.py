@@ -83,10 +83,10 @@ BLOWUP_FACTOR = 1e3
 #: the record's second half exceeds this multiple of its largest over the first tenth, on a
 #: record whose own second half peaks below its first tenth's, is growing: no passive model's
 #: free decay does that (:func:`growth_failure`).  A declaration, like :data:`BLOWUP_FACTOR`:
-#: measured on rounds 15-17's beam studies (288 cells, both identifiers), the 211 passes reach
-#: 0.21 and the other 69 failures simulated to the end 0.56 (records: at most 0.26), round 17's
-#: ``b17_soft_r1p2_cf0p3_f300_uneven`` at 5 % (``ls_sindy``, a cubic ``K3`` that is no
-#: potential's) 767, under the blow-up bar.
+#: measured on rounds 15-17's beam studies (288 cells, both identifiers) and the 60 family beams
+#: at 0 / 1 % (240 cells), the passes reach 0.71 and the other failures simulated to the end
+#: 0.70 (records: at most 0.73), round 17's ``b17_soft_r1p2_cf0p3_f300_uneven`` at 5 %
+#: (``ls_sindy``, a cubic ``K3`` that is no potential's) 767, under the blow-up bar.
 GROWTH_FACTOR = 10.0
 
 #: Verdicts of a run (:func:`verdict`).
@@ -1287,7 +1287,8 @@ def half_step_rollout(score: str, model: Any, data: Measurement, x0: np.ndarray,
     simulated as :func:`implicit_rollout` simulates it.  What it gives is a witness, not a
     score: the scored rollout is the identifier's own; where it fails its bar and the half
     step meets it, the integrator, not the identified equation, failed
-    (:func:`step_failures`).
+    (:func:`step_failures`).  Run only where the scored rollout raised nothing: one more
+    simulation of the record per run.
 
     Returns
     -------
@@ -1310,10 +1311,10 @@ def step_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -> di
 
     The scored rollout stays the identifier's own (no verdict changes); the reason says the
     failure is its integrator's at its step, not the identified equation's.  Round 17's
-    ``mm17_km1e-4`` clean (Km 1e-4 mM): the law exact to 2.6e-4, the 1 ms RK4 step (the
+    ``mm17_km1em4`` clean (Km 1e-4 mM): the law exact to 2.6e-4, the 1 ms RK4 step (the
     decay rate near x*, ``Vmax Km / (Km + x*)^2`` = 5.4e3 1/s, puts ``h |lambda|`` at 5.4, past
     RK4's 2.79) stepped through x* to a negative concentration, -1.6 mM at 4 s: state_rmse
-    0.617 against the bar 0.01, named nothing; at 0.5 ms 1.0e-8.
+    0.617 against the bar 0.01, named nothing; at 0.5 ms 1.4e-6.
 
     Parameters
     ----------
