@@ -1310,7 +1310,8 @@ def step_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -> di
     """A failed rollout bar that half the identifier's step meets: ``{"step": reason}``.
 
     The scored rollout stays the identifier's own (no verdict changes); the reason says the
-    failure is its integrator's at its step, not the identified equation's.  Round 17's
+    rollout bar's failure is its integrator's at its step (the equation's own bars, if failed,
+    say what is wrong with the equation).  Round 17's
     ``mm17_km1em4`` clean (Km 1e-4 mM): the law exact to 2.6e-4, the 1 ms RK4 step (the
     decay rate near x*, ``Vmax Km / (Km + x*)^2`` = 5.4e3 1/s, puts ``h |lambda|`` at 5.4, past
     RK4's 2.79) stepped through x* to a negative concentration, -1.6 mM at 4 s: state_rmse
@@ -1335,8 +1336,8 @@ def step_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -> di
             return {"step": (f"rollout step: {score} {got:.3g} against the bar {bar:g}, but "
                              f"{half:.3g} at half the identifier's integration step (sim_dt "
                              f"{dt:g} s -> {dt / 2:g} s): the scored rollout is not converged at "
-                             "its step, so the failure is the integrator's, not the identified "
-                             "equation's (identify.sim_dt)")}
+                             "its step, so that bar's failure is the integrator's, whatever the "
+                             "identified equation's (identify.sim_dt)")}
     return {}
 
 
