@@ -4,6 +4,8 @@ machine's budget, at default settings."""
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -12,7 +14,9 @@ from identify import pysindy_pi
 from identify.pysindy_pi import PYSINDY_MAX_SAMPLES, PySINDyPI, stride_rule
 from models.cantilever.model import build_model
 from testbed.core.errors import ScenarioError
-from testbed.pipeline.scenario import scenario_from_dict
+from testbed.pipeline.scenario import load_scenario, scenario_from_dict
+from testbed.scoring.run import run_scenario
+from testbed.scoring.scorers import FAIL, GROWTH_FACTOR, Scores, growth_failure, late_growth, step_failures
 
 
 def beam(rig=None, simulation=None, excitation=None):
@@ -437,3 +441,61 @@ def test_round7_studies_load(name, cells):
     for sc in study.scenarios:
         if sc.rig == "cantilever":
             assert isinstance(sc.signal["lowpass_hz"], float) and "signal.lowpass_hz" in sc.rules
+
+
+# ------------------------------------------- round 17: a rollout the integrator's step failed
+def test_a_rollout_failed_by_the_identifiers_step_is_named():
+    """Round 17's mm17_km1em4 clean (Km 1e-4 mM): the identified law is exact (coef_error 2.6e-4,
+    support 1), but the identifier's 1 ms RK4 step (h |lambda| 5.4 near x*, RK4 is stable to
+    2.79) stepped through x* to a negative concentration: state_rmse 0.617 against the bar 0.01
+    with no reason given.  The verdict stays the scored rollout's; the reason names the step."""
+    sc = load_scenario(_root() / "benchmarks" / "unseen" / "round17" / "mm17_km1em4.toml")
+    sc.noise["rms_percent"] = 0.0
+    r = run_scenario(sc)
+    assert r.verdict == FAIL and r.scores.values["coef_error"] < 1e-3
+    assert r.scores.values["state_rmse"] > 0.1  # the identifier's own rollout, still scored
+    why = r.scores.failures["step"]
+    assert why.startswith("rollout step: state_rmse 0.6") and "sim_dt 0.001 s -> 0.0005 s" in why
+    assert r.scores.details["state_rmse_half_step"] < 1e-4  # [mM]: the same law, half the step
+
+
+def test_step_reason_only_explains_a_failed_bar_the_half_step_meets():
+    bars = {"state_rmse": {"max": 0.01}}
+    d = {"state_rmse_half_step": 1e-6, "sim_dt": 1e-3}
+    assert set(step_failures(Scores({"state_rmse": 0.6}, d), bars)) == {"step"}
+    # the bar met, the half step failing too (or diverged: NaN), or no step known: nothing
+    assert step_failures(Scores({"state_rmse": 0.005}, d), bars) == {}
+    assert step_failures(Scores({"state_rmse": 0.6}, {**d, "state_rmse_half_step": 0.5}), bars) == {}
+    assert step_failures(Scores({"state_rmse": 0.6}, {**d, "state_rmse_half_step": float("nan")}),
+                         bars) == {}
+    assert step_failures(Scores({"state_rmse": 0.6}, {"state_rmse_half_step": 1e-6}), bars) == {}
+    assert step_failures(Scores({"state_rmse": float("nan")}, d), bars) == {}
+
+
+# ------------------------------------------- round 17: a model whose free response grows
+def test_a_growing_free_response_is_a_named_non_physical_failure():
+    """Round 17's b17_soft_r1p2_cf0p3_f300_uneven at 5 % (ls_sindy, seed 81): the model's cubic
+    K3 (no potential's) pumps energy; its simulated response grows after 0.3 s to 770x the
+    record's largest value (under the 1e3 blow-up bar) and the run failed by its bars alone
+    (TRAC 1.3e-6, mode 2 88 % off), never named non-physical."""
+    sc = load_scenario(_root() / "benchmarks" / "unseen" / "round17"
+                       / "b17_soft_r1p2_cf0p3_f300_uneven.toml")
+    sc = dataclasses.replace(sc, seed=81)
+    sc.noise["rms_percent"] = 5.0
+    sc.identify["method"] = "ls_sindy"
+    r = run_scenario(sc)
+    assert r.verdict == FAIL
+    why = r.scores.failures["growth"]
+    assert why.startswith("non-physical: the simulated free response grows") and "first tenth" in why
+    assert "simulation" not in r.scores.failures  # not a blow-up by BLOWUP_FACTOR: its own reason
+
+
+def test_growth_is_claimed_only_where_the_record_decays():
+    t = np.linspace(0.0, 1.0, 1000)
+    decay = np.sin(2 * np.pi * 40 * t) * np.exp(-3 * t)[None, :]
+    grow = np.sin(2 * np.pi * 40 * t) * np.exp(5 * t)[None, :]  # late peak ~ e^5 / e^0.5 = 90x
+    assert late_growth(decay) < 1 < GROWTH_FACTOR < late_growth(grow)
+    assert set(growth_failure(grow, decay)) == {"growth"}
+    assert growth_failure(decay, decay) == {}
+    assert growth_failure(grow, grow) == {}  # the record grows too: no claim
+    assert growth_failure(np.full_like(grow, np.nan), decay) == {}  # NaN is the divergence's
