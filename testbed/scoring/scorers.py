@@ -681,7 +681,8 @@ def floor_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -> d
                       f"reduced model (one degree of freedom per sensor) scores {worst_floor:.3g} "
                       "on this record: the record and its signal chain put that bar out of reach "
                       "of any model of that size (signal.lowpass_hz, signal.highpass_hz, "
-                      "rig.sensors, excitation.location)")}
+                      "rig.sensors, excitation.location, excitation.start: a pulse within a few "
+                      "ms of the record's start is mirrored by the chain's filters' edges)")}
 
 
 def record_details(kind: str, dataset: Dataset, data: Measurement) -> dict[str, Any]:

@@ -20,6 +20,9 @@ def test_a_failed_trac_bar_under_the_truths_own_is_named_floor():
     assert set(named) == {"floor"} and verdict([], named) == FAIL
     assert named["floor"].startswith("floor: TRAC 0.666 against the bar 0.9, where the truth's own")
     assert "scores 0.579 on this record" in named["floor"]
+    # round 17's b17_st_start0 (the hammer at the record's first sample; the truth's own TRAC
+    # 0.45 through the filters' mirrored edges) named the chain's keys but not the start
+    assert "excitation.start" in named["floor"]
     # at the margin's edge still the floor; beyond it the model's own failure (sgd_sindy there:
     # 0.375 against the truth's 0.579)
     assert "floor" in why([0.579 - 0.049, 1.0, 1.0])
