@@ -180,8 +180,10 @@ class MichaelisMentenRig(Rig):
         # about 1e154 every step warned of overflow)
         growth = rig["jx"] * simulation["duration"]
         x_max = max(rig["x0"], steady or 0.0, rig["x0"] + growth)
-        if x_max > X_MAX:
-            key = "rig.jx" if growth > rig["x0"] else "rig.x0"
+        # (a growth whose larger factor is the duration, over 1e77 s, is the step budget's to
+        # refuse, naming simulation.duration)
+        if x_max > X_MAX and (growth <= rig["x0"] or rig["jx"] >= simulation["duration"]):
+            key = "rig.x0" if growth <= rig["x0"] else "rig.jx"
             error(key, rig[key[4:]], f"expected concentrations up to {X_MAX:.4g} mM over the record "
                                      f"(the square of the state must be finite); x0 + jx x duration "
                                      f"reaches {x_max:.4g} mM")
