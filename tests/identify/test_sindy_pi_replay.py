@@ -128,15 +128,26 @@ def test_no_eligible_model_is_a_typed_error():
 
 def test_cartpole_with_a_barely_excited_pole_gets_its_equations(dataset_cache):
     """benchmarks/unseen/unseen_other.toml, cartpoles__000 (3.8 kg cart, 64 g pole), clean: the
-    held-out choice replays the record to 1.8e-3 rad with wrong equations (coef_error 1); the
-    replay rule finds the exact pair (scored coef_error 6e-7)."""
+    fit ends with the exact pair on every CPU, by the replay rule where the held-out choice does
+    not replay the record.
+
+    Which input equation the held-out error picks is decided by round-off on this record: the
+    7-term pole equation plus a 1e-6 input admixture has an input part of 2.7e-17 (normalised
+    Gram units) and a residual whose Gram value is round-off of either sign (-3.2e-17 on this
+    machine's AVX-512 BLAS kernels, clipped to an input error 0: ranked first by fewest terms,
+    replaying to 1.8e-3 rad; positive under an AVX2 kernel, where the exact cart row is ranked
+    first and replays to 1.2e-11 rad).  docs/known-gaps.md "Portability (session 18)"."""
     other = Path(__file__).resolve().parents[2] / "benchmarks" / "unseen" / "unseen_other.toml"
     member = {m.name: m for m in load_study(other).scenarios}["cartpoles__000"]
     data = _data(dataset_cache, member)
     kw = {k: v for k, v in member.identify.items() if k != "method"}
-    hold = SINDyPI(**kw, selection="holdout").fit(data)
-    assert _replay(hold, data) > 1e-3  # measured 1.8e-3 rad
     m = SINDyPI(**kw).fit(data)
-    assert "chosen again by rollout" in m.replay_rule_
-    # measured 1.2e-11 rad: an exact pair replays to round-off (the shipped cartpole's bar 1e-9)
+    bar = EXACT_REPLAY_MAX + REPLAY_NOISE_FACTOR * float(np.max(m.noise_std_))
+    hold = SINDyPI(**kw, selection="holdout").fit(data)
+    if _replay(hold, data, round(m.edge_trim_ * data.fs)) > bar:  # wrong equations held out
+        assert "chosen again by rollout" in m.replay_rule_
+    else:  # the held-out choice replays the record: kept by the rule
+        assert m.selection_ == "holdout" and m.replay_rule_.endswith(": kept")
+    # measured 1.2e-11 rad either way: an exact pair replays to round-off (the shipped
+    # cartpole's bar 1e-9)
     assert m.replay_rmse_ < 1e-9
