@@ -581,7 +581,7 @@ def unresolved_warm_start(xdd: np.ndarray, xd: np.ndarray, x: np.ndarray, m_hat:
     5, :func:`identify._unresolved.place_unresolved`, on the uncoupled regression).
 
     The uncoupled least squares (``A = M^-1 K``, ``B = M^-1 C``, :func:`_uncoupled_coef`) has
-    its unresolved modes placed at the peak band's top, critically damped
+    its unresolved modes placed at the peak band's top, damped to 1/sqrt(2)
     (:func:`~identify._unresolved.place_unresolved` with ``M = I``); the mass is then
     :func:`equal_modal_mass` of the placed ``A`` and ``K0 = M0 A`` (symmetric).  The damping
     is each mode's own, ``C0 = M0 Phi diag(d) Phi^-1`` with ``d`` the diagonal of

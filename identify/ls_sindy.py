@@ -148,7 +148,7 @@ class LeastSquaresSINDy(StructuralIdentifier):
        0.8 x the chain's low-pass; :func:`identify._unresolved.modal_pole_reach`: the
        frequency, or a negative stiffness's larger real pole) is one the record cannot
        resolve; where the other modes carry every accepted peak it is placed at
-       that top, critically damped and uncoupled in damping, shapes kept
+       that top, damped to 1/sqrt(2) (no resonant peak) and uncoupled in damping, shapes kept
        (:func:`identify._unresolved.place_unresolved`), then the holds; kept if physical
        (``unresolved_rule_`` says what was placed).  Round 16's five sensors at 12.8 kHz on
        32-36 segments (mode 5 at 4619 Hz, 57 % damped, the band's top 4522 Hz; fitted with a
