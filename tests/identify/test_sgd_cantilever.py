@@ -85,3 +85,9 @@ def test_five_sensors_at_12k8_place_the_unresolved_mode_in_the_warm_start(datase
     f_true = np.asarray(ds.truth["frequencies_hz"])[:3]
     np.testing.assert_allclose(model.natural_frequencies_[:3], f_true, rtol=0.01)
     check_physical(model.M_, model.C_, model.K_)
+    # a user's narrower search range is no limit of the record: nothing is placed (review,
+    # session 18: freq_range [10, 2000] Hz placed mode 4, 2795 Hz true, at 2010 Hz, and
+    # [10, 1000] Hz two modes at one frequency, a raw LinAlgError)
+    for freq_range in ([10.0, 2000.0], [10.0, 1000.0]):
+        user = SGDSINDy(freq_range=freq_range).fit(measure(ds, sc.signal, "structural"))
+        assert "placed at that top" not in user.unresolved_rule_
