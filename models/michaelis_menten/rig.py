@@ -179,7 +179,9 @@ class MichaelisMentenRig(Rig):
         # internal error, 'Required step size is less than spacing between numbers', and from
         # about 1e154 every step warned of overflow)
         growth = rig["jx"] * simulation["duration"]
-        x_max = max(rig["x0"], steady or 0.0, rig["x0"] + growth)
+        # (towards a steady state above x0 no further than it, below x0 x0 itself)
+        x_max = (rig["x0"] + growth if steady is None else
+                 min(steady, rig["x0"] + growth) if rig["x0"] < steady else rig["x0"])
         # (a growth whose larger factor is the duration, over 1e77 s, is the step budget's to
         # refuse, naming simulation.duration)
         if x_max > X_MAX and (growth <= rig["x0"] or rig["jx"] >= simulation["duration"]):

@@ -116,6 +116,14 @@ def test_a_record_whose_concentration_squared_overflows_is_refused(rig, simulati
                             "simulation": simulation})
 
 
+def test_a_steady_state_beyond_the_bound_the_record_never_reaches_is_valid():
+    # review, session 18: Km = 1e160 mM puts the steady state at 1e160 mM, but x grows by at
+    # most jx per second: 1 -> 1.5 mM over 0.5 s, a valid record (it had been refused)
+    scenario_from_dict({"scenario": {"name": "mm", "rig": "michaelis_menten"},
+                        "rig": {"jx": 1.0, "Vmax": 2.0, "Km": 1e160, "x0": 1.0},
+                        "simulation": {"duration": 0.5}})
+
+
 def test_huge_but_representable_influx_simulates_without_warnings():
     # jx = 1e153 mM/s (x reaches 4e153 mM, under the bound): the solver's norms overflowed
     # inside its step control on every step (RuntimeWarnings flooding a study's stderr)
