@@ -239,8 +239,11 @@ def _output_file(path: Path, option: str, *, inputs: tuple[Path, ...] = ()) -> P
 
 def _given_files(*groups: Any) -> tuple[Path, ...]:
     """The files among ``groups`` of paths (scenario files read, ``--plugin`` files or
-    modules): what a command's output must not replace."""
-    return tuple(Path(p) for g in groups for p in g if str(p).endswith((".toml", ".py")))
+    modules): what a command's output must not replace.  A name ending in ``.toml`` or
+    ``.py`` in any case, or any existing file (a module name is neither: ``s.TOML`` had been
+    let through and replaced)."""
+    return tuple(Path(p) for g in groups for p in g
+                 if str(p).lower().endswith((".toml", ".py")) or os.path.isfile(p))
 
 
 def _output_folder(path: Path, option: str) -> Path:
@@ -732,7 +735,7 @@ def cmd_identify(args: argparse.Namespace) -> int:
 
     from testbed.core.atomic import atomic_write_text
     from testbed.pipeline.fit import identify_file
-    from testbed.pipeline.scenario import resolve_path
+    from testbed.pipeline.scenario import load_scenario, recording_reads
     from testbed.reporting.identified import render_identified
     from testbed.reporting.progress import run_progress
     from testbed.scoring.scorers import fitted_model_failures, prediction_r2
@@ -747,7 +750,11 @@ def cmd_identify(args: argparse.Namespace) -> int:
         units = _key_values(args.units, "--units", numbers=False) if per_channel[0] else args.units[0]
     data = _existing_file(Path(args.data), "a measured-data file (UFF58, SEP-005 JSON, CSV or HDF5)")
     # nor the --scenario file or a plugin (-o s.toml replaced the scenario: round 17)
-    given = (data, *_given_files([resolve_path(args.scenario)] if args.scenario else [], plugins))
+    read: list[str] = []
+    if args.scenario:  # the scenario and every file it extends (as `generate` protects them)
+        with recording_reads() as read:
+            load_scenario(args.scenario)
+    given = (data, *_given_files(read, plugins))
     out = _output_file(Path(args.output or f"{data.stem}.model.json"), "--output", inputs=given)
     if out.suffix.lower() == ".md":  # the report replaced the model it reports (round 17; .MD:
         # the same file where names ignore case, as on macOS and Windows)

@@ -316,9 +316,24 @@ def test_identify_refuses_to_write_over_its_scenario(tmp_path, capsys):
     rec = _mm_record(tmp_path / "r.json", 100.0)
     scen = tmp_path / "michaelis_menten.toml"
     scen.write_text((SCENARIOS / "michaelis_menten.toml").read_text())
+    # review: a file the scenario extends was not protected, nor a name in upper case
+    child = tmp_path / "child.TOML"
+    child.write_text('[scenario]\nname = "child"\nextends = "michaelis_menten.toml"\n')
+    before = {p: p.read_bytes() for p in (scen, child)}
+    for given, out in ((scen, scen), (child, scen), (child, child)):
+        status = cli.main(["identify", str(rec), "--scenario", str(given), "--kind", "dynamical",
+                           "-o", str(out)])
+        err = capsys.readouterr().err.strip().splitlines()
+        assert status == 2 and len(err) == 1 and "is the input file" in err[0], (given, out, err)
+    assert {p: p.read_bytes() for p in before} == before
+
+
+def test_generate_refuses_to_write_over_its_scenario_named_in_upper_case(tmp_path, capsys):
+    # review: `generate s.TOML -o s.TOML` wrote HDF5 over the scenario, status 0
+    scen = tmp_path / "michaelis_menten.TOML"
+    scen.write_text((SCENARIOS / "michaelis_menten.toml").read_text())
     text = scen.read_text()
-    status = cli.main(["identify", str(rec), "--scenario", str(scen), "--kind", "dynamical",
-                       "-o", str(scen)])
+    status = cli.main(["generate", str(scen), "-o", str(scen), "--cache", str(CACHE)])
     err = capsys.readouterr().err.strip().splitlines()
     assert status == 2 and len(err) == 1 and "is the input file" in err[0], err
     assert scen.read_text() == text
