@@ -3,8 +3,9 @@
 On a machine without Chromium the install took 71 s of one worker's wall time in a cold
 ``make test`` (2026-11-28, the report test's setup; the other worker kept working, so about
 half of it was added to the suite's wall time).  :func:`start_install` starts it in the
-background when the collection holds a test that needs it; :func:`wait_and_find` (the
-``chromium`` fixture) waits for it, and installs itself only where no background install ran.
+background when the selected tests hold one that needs it; :func:`wait_and_find` (the
+``chromium`` fixture) waits for it, and installs itself where Chromium is still missing then
+(no background install ran, or it failed: as each worker did before).
 
 One install per test run: the process that starts it holds an exclusive ``flock`` on
 ``lock_path`` and hands the locked file to the install, so the lock is held exactly as long as

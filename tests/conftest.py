@@ -108,8 +108,12 @@ def pytest_collection_modifyitems(config, items):
     # longest work first (the order xdist deals the work units in: see pytest_configure)
     rank = {id(item): _COLD_SECONDS.get(_work_unit(item), 0.0) for item in items}
     items.sort(key=lambda item: -rank[id(item)])  # stable: a module's tests keep their order
-    # a missing Chromium installed while the suite runs, not inside the report test's setup
-    if any("chromium" in item.fixturenames for item in items):
+
+
+def pytest_collection_finish(session):
+    # a missing Chromium installed while the suite runs, not inside the report test's setup;
+    # only where a selected test needs it (after -k / -m deselection)
+    if any("chromium" in item.fixturenames for item in session.items):
         _chromium.start_install(CHROMIUM_LOCK, LOCKS / "chromium-install.log")
 
 
