@@ -51,7 +51,7 @@ import json
 import math
 import os
 import re
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -699,6 +699,14 @@ def from_sep005(channel_dicts: Sequence[Mapping[str, Any]], *, source: str | os.
 
 
 # --------------------------------------------------------------------------- shared checks
+def _names(names: Any) -> bool:
+    """Whether ``names`` is a collection of channel names: any iterable of ``str`` (a list, a
+    tuple, a numpy array of ``str_``, a pandas Index) other than text itself or a mapping."""
+    if isinstance(names, (str, bytes, Mapping)) or not isinstance(names, Iterable):
+        return False
+    return all(isinstance(c, str) for c in names)
+
+
 def _checked_groups(source: Path, groups: Any) -> dict[str, list[str]]:
     """``groups`` of :meth:`ImportedData.to_dataset` as ``{signal: [channel, ...]}``, refused
     unless a mapping of signal names (non-empty text without ``/`` or control characters: a
@@ -715,8 +723,7 @@ def _checked_groups(source: Path, groups: Any) -> dict[str, list[str]]:
         if not isinstance(g, str) or not g or "/" in g or any(is_control(c) for c in g):
             raise MeasuredDataError(source, f"groups: signal name {g!r}; expected non-empty text "
                                             "without '/' or control characters")
-        if isinstance(chs, (str, bytes)) or not isinstance(chs, Sequence) \
-                or not all(isinstance(c, str) for c in chs):
+        if not _names(chs):
             raise MeasuredDataError(source, f"group {g!r}: {chs!r}; expected a list of channel "
                                             "names (str)")
         short: set[str] = set()
@@ -743,9 +750,7 @@ def check_selection(source: str | os.PathLike, units: Any, channels: Any) -> Non
                                                for k, v in units.items()))):
         raise MeasuredDataError(source, f"units={units!r}: expected a unit (str) or a mapping of "
                                         "channel name to unit (str to str)")
-    if channels is not None and (isinstance(channels, (str, bytes, Mapping))
-                                 or not isinstance(channels, Sequence) or not channels
-                                 or not all(isinstance(c, str) for c in channels)):
+    if channels is not None and (not _names(channels) or not list(channels)):
         raise MeasuredDataError(source, f"channels={channels!r}: expected a non-empty list of "
                                         "channel names (str)")
 

@@ -255,6 +255,14 @@ def test_read_measured_refuses_arguments_of_the_wrong_type(tmp_path, kwargs, sai
         from_sep005(chans, **kwargs)
 
 
+def test_channels_and_groups_as_numpy_arrays_are_still_names(tmp_path):
+    # review: the checks above refused np.array(["acc1"]) (worked before them)
+    rec = _sep005_started(tmp_path / "r.json", 0)
+    data = read_measured(rec, channels=np.array(["acc1", "force"]))
+    assert list(data.signals) == ["acc1", "force"]
+    data.to_dataset({"acceleration": np.array(["acc1"]), "force": np.array(["force"])})
+
+
 @pytest.mark.parametrize("path", [5, None, b"r.json"])
 def test_read_measured_refuses_a_path_that_is_not_one(path):
     with pytest.raises(MeasuredDataError, match=r"path=.*expected a file path"):
