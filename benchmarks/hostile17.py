@@ -441,11 +441,7 @@ def starts_cases(work: Path) -> list[tuple[str, object]]:
         def run() -> str | None:
             import pyuff
 
-            src = _generated(work, "cantilever_stiff_impact")
-            base = work / "cs.uff"
-            if not base.exists():
-                cli_inprocess(["export", str(src), "--format", "uff", "-o", str(base)])
-            sets = pyuff.UFF(str(base)).read_sets()
+            src, sets = _stiff_impact_uff_sets(work)
             for s in sets:
                 if s["type"] == 58 and s["id1"].startswith("force"):
                     s["x"] = s["x"] + lag_s
@@ -463,6 +459,18 @@ def starts_cases(work: Path) -> list[tuple[str, object]]:
             ("UFF force 1e-3 s late", uff(1e-3, True))]
 
 
+def _stiff_impact_uff_sets(work: Path) -> tuple[Path, list]:
+    """The shipped stiff cantilever's dataset (generated once in ``work``) and its UFF export's
+    sets, read afresh (each case edits its own copy)."""
+    import pyuff
+
+    src = _generated(work, "cantilever_stiff_impact")
+    base = work / "cs.uff"
+    if not base.exists():
+        cli_inprocess(["export", str(src), "--format", "uff", "-o", str(base)])
+    return src, pyuff.UFF(str(base)).read_sets()
+
+
 # ------------------------------------------------------------------ directions
 
 def directions_cases(work: Path) -> list[tuple[str, object]]:
@@ -470,11 +478,7 @@ def directions_cases(work: Path) -> list[tuple[str, object]]:
         def run() -> str | None:
             import pyuff
 
-            src = _generated(work, "cantilever_stiff_impact")
-            base = work / "cs.uff"
-            if not base.exists():
-                cli_inprocess(["export", str(src), "--format", "uff", "-o", str(base)])
-            sets = pyuff.UFF(str(base)).read_sets()
+            src, sets = _stiff_impact_uff_sets(work)
             for s in sets:
                 if s["type"] == 58 and s["id1"].endswith(channel):
                     s["rsp_dir"] = direction
