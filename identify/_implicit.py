@@ -377,7 +377,7 @@ def no_model_reason(sw: Sweep, shares: np.ndarray, k: int) -> str:
             "finite held-out error")
 
 
-def input_errors(sw: Sweep, G_val: np.ndarray, cols: np.ndarray) -> np.ndarray:
+def input_errors(sw: Sweep, G_val: np.ndarray, cols: np.ndarray, n_val: int = 0) -> np.ndarray:
     """Held-out residual of every model per unit of its input part, shape (T, C).
 
     ``W^T G W / (W_u^T G W_u)`` with ``G`` the validation Gram in normalised units (``G_val``,
@@ -390,6 +390,14 @@ def input_errors(sw: Sweep, G_val: np.ndarray, cols: np.ndarray) -> np.ndarray:
     share 0.029, law_error 0.855) has a residual per unit of left-hand side ``eps^2`` times the
     input equation's.  ``inf`` where the input part is zero.
 
+    With ``n_val`` (the validation rows behind ``G_val``) the residual is floored at its
+    round-off bound, ``n_val eps (sum_i |w_i| sqrt(G_ii))^2`` (each Gram entry a sum of
+    ``n_val`` products; as :mod:`identify.sindy_pi_dynamical`'s exact tie): below it the
+    residual's value and sign are round-off's, and clipping it at 0 let the CPU decide the
+    ranking (session 18's portability runs: a pole equation plus a 1e-6 input admixture,
+    input part 2.7e-17 under a bound 2.6x larger, ranked first on AVX-512 at residual
+    -3.2e-17 and not under Haswell at +1.0e-17).
+
     Returns
     -------
     ndarray, shape (T, C)
@@ -400,13 +408,16 @@ def input_errors(sw: Sweep, G_val: np.ndarray, cols: np.ndarray) -> np.ndarray:
     Wu[..., cols] = sw.W[..., cols]
     num = np.einsum("tcp,tcp->tc", sw.W @ Gn, sw.W)
     den = np.einsum("tcp,tcp->tc", Wu @ Gn, Wu)
+    if n_val > 0:
+        norm = np.sqrt(np.clip(np.diag(Gn), 0.0, None))
+        num = np.maximum(num, n_val * np.finfo(float).eps * (np.abs(sw.W) @ norm) ** 2)
     with np.errstate(divide="ignore", invalid="ignore"):
         return np.where(den > 0, np.maximum(num, 0.0) / np.where(den > 0, den, 1.0), np.inf)
 
 
 def select_models(sw: Sweep, input_cols: Sequence[np.ndarray], rtol: float = 0.1,
-                  atol: float = 1e-12, top: int = 1, G_val: np.ndarray | None = None
-                  ) -> list[list[tuple[int, int]]]:
+                  atol: float = 1e-12, top: int = 1, G_val: np.ndarray | None = None,
+                  n_val: int = 0) -> list[list[tuple[int, int]]]:
     """Pick the implicit equation of each input by held-out error, then parsimony.
 
     Models eligible for input k are those whose input-k terms carry a larger normalised
@@ -432,6 +443,8 @@ def select_models(sw: Sweep, input_cols: Sequence[np.ndarray], rtol: float = 0.1
         Number of models returned per input (distinct supports, best first).
     G_val : ndarray, shape (p, p), optional
         Validation Gram matrix in original units: rank by :func:`input_errors`.
+    n_val : int
+        The validation rows behind ``G_val`` (0: no round-off floor; :func:`input_errors`).
 
     Returns
     -------
@@ -442,8 +455,8 @@ def select_models(sw: Sweep, input_cols: Sequence[np.ndarray], rtol: float = 0.1
     for k in range(len(input_cols)):
         others = np.delete(shares, k, axis=0)
         other = others.max(axis=0) if others.size else np.zeros_like(shares[k])
-        ranked = sw if G_val is None else replace(sw, val_error=input_errors(sw, G_val,
-                                                                            input_cols[k]))
+        ranked = sw if G_val is None else replace(sw, val_error=input_errors(
+            sw, G_val, input_cols[k], n_val))
         order = rank_models(ranked, (shares[k] > 0) & (shares[k] > other), rtol, atol)
         if order.size == 0:
             raise NoModelError(no_model_reason(sw, shares, k))

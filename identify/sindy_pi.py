@@ -991,7 +991,8 @@ class _ImplicitMechanical(Identifier):
         # equation plus a small input admixture is an exact combination whose residual per unit
         # of its left-hand side falls as the admixture squared (identify._implicit.input_errors)
         picks = select_models(sw, loc_cols, self.selection_rtol, self.selection_atol, top,
-                              G_v[np.ix_(kidx, kidx)] if open_chain else None)
+                              G_v[np.ix_(kidx, kidx)] if open_chain else None,
+                              Theta.shape[0] - n_tr)
         solved = actuated
         if open_chain:
             acc = lib.acc_index[kidx]

@@ -61,3 +61,27 @@ def test_input_errors_are_unchanged_by_adding_an_input_free_equation():
                val_error=err, train_error=err, nnz=np.array([[2, 4]]))
     ein = input_errors(sw, G_val, np.array([3]))
     assert ein[0, 1] == pytest.approx(ein[0, 0], rel=1e-9)
+
+
+def test_a_round_off_residual_is_floored_not_clipped():
+    """Session 18's portability runs: a pole equation plus a 1e-6 input admixture had an input
+    part of 2.7e-17 and a Gram residual of round-off size whose sign the CPU decided (-3.2e-17
+    on AVX-512, clipped to 0: ranked first; +1.0e-17 under Haswell: not).  With the validation
+    rows given, the residual is floored at its round-off bound, the same on every CPU."""
+    p = 3
+    G = np.array([[1.0, 0.5, 0.0], [0.5, 1.0, 0.0], [0.0, 0.0, 1.0]])  # column 2: the input
+    W = np.zeros((1, 2, p))
+    W[0, 0] = [1.0, -2.0, 1.0]  # a model with a real input part
+    W[0, 1] = [1.0, -1.0, 1e-9]  # residual 1.0 (clipped) / input part 1e-18
+    sw = Sweep(scale=np.ones(p), candidates=np.array([0, 1]), thresholds=np.array([0.0]), W=W,
+               val_error=np.zeros((1, 2)), train_error=np.zeros((1, 2)),
+               nnz=np.count_nonzero(W, axis=2))
+    # a negative residual: the exact quadratic form of a model off by round-off
+    G_neg = G.copy()
+    G_neg[0, 1] = G_neg[1, 0] = 1.0 + 1e-12
+    clipped = input_errors(sw, G_neg, np.array([2]))
+    floored = input_errors(sw, G_neg, np.array([2]), n_val=1000)
+    assert clipped[0, 1] == 0.0  # without the floor: clipped, ranked first whatever its input
+    bound = 1000 * np.finfo(float).eps * (1.0 + 1.0 + 1e-9) ** 2
+    assert floored[0, 1] == pytest.approx(bound / 1e-18, rel=1e-9)  # far behind the real model
+    assert floored[0, 0] == pytest.approx(clipped[0, 0], rel=1e-12)  # above its bound: unchanged
