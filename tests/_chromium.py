@@ -64,7 +64,7 @@ def start_install(lock_path: Path, log_path: Path) -> bool:
         with open(log_path, "w") as log:
             # the child inherits the locked file: the lock lasts as long as the install
             _started.append(subprocess.Popen(
-                ["sh", "-c", f"timeout {INSTALL_TIMEOUT_S} sh -c '{INSTALL}'"], stdin=subprocess.DEVNULL,
+                ["timeout", str(INSTALL_TIMEOUT_S), "sh", "-c", INSTALL], stdin=subprocess.DEVNULL,
                 stdout=log, stderr=subprocess.STDOUT, env={**os.environ, **_ENV},
                 pass_fds=(lock.fileno(),)))
     return True  # closing our copy of the file leaves the lock with the child

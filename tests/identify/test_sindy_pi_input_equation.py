@@ -5,7 +5,15 @@ the cart-pole's input equation (session 18)").
 Round 16's ``cp16_3s`` (the shipped cart-pole on 3 s) clean, seed 73: ranked per unit of its
 left-hand side, the pole's equation P plus a small admixture ``0.0048 u1 - 0.0054 cos(th2) u1``
 (near-cancelling at small th2) outranked the cart's own equation, so both selected equations were
-the pole's and the law was 0.855 off (the rig's bar 0.25) while the rollout looked fine."""
+the pole's and the law was 0.855 off (the rig's bar 0.25) while the rollout looked fine.
+
+Round 17's ``cp17_kp1_kd1`` (the shipped cart-pole with ``u = f - 1 x - 1 xd`` [N]; seed 83,
+no noise) failed the same way as "wrong equation" (law_error 1140, rollout 1.44 rad) where 1 /
+2 % passed.  Not a record that leaves the law open: the feed-forward carries 87.5 % of the
+input's variance (the cart state explains 12.5 %, against 35-56 % at the other gains of rounds
+16-17), so the input's columns are not collinear with the state's; ranked per unit of the
+input's part the cart's equation is chosen: law_error 0.0028, rollout 0.0015 rad
+(docs/known-gaps.md "Issue #15")."""
 
 from __future__ import annotations
 
@@ -18,20 +26,26 @@ import pytest
 import testbed
 from identify._implicit import Sweep, _errors, input_errors
 
-CELL = Path(__file__).resolve().parents[2] / "benchmarks" / "unseen" / "round16" / "cp16_3s.toml"
+UNSEEN = Path(__file__).resolve().parents[2] / "benchmarks" / "unseen"
+#: The cells: (scenario file, seed, whether the pole's row is checked to carry no input term).
+CELLS = {"cp16_3s": (UNSEEN / "round16" / "cp16_3s.toml", 73, False),
+         "cp17_kp1_kd1": (UNSEEN / "round17" / "cp17_kp1_kd1.toml", 83, True)}
 #: The rig's law bar (models/cartpole/rig.py EQUATION_BARS): a quarter of the accelerations' RMS.
 LAW_BAR = 0.25
 
 
-@pytest.fixture(scope="module")
-def run():
-    sc = testbed.load_scenario(CELL)
-    sc = dataclasses.replace(sc, seed=73, noise={**sc.noise, "rms_percent": 0.0})
-    return testbed.run_scenario(sc)
+@pytest.fixture(scope="module", params=list(CELLS))
+def run(request):
+    path, seed, pole_checked = CELLS[request.param]
+    sc = testbed.load_scenario(path)
+    sc = dataclasses.replace(sc, seed=seed, noise={**sc.noise, "rms_percent": 0.0})
+    return testbed.run_scenario(sc), pole_checked
 
 
 def test_the_cart_equation_is_not_the_poles_with_an_input_admixture(run):
-    """Was law_error 0.855, the input's equation with lhs sin(th2) (the pole's); now 0.0073."""
+    """Was law_error 0.855 (cp16_3s) / 1140 (cp17_kp1_kd1), the input's equation with lhs
+    sin(th2) (the pole's); now 0.0073 / 0.0028."""
+    run, pole_checked = run
     law = run.scores.values["law_error"]
     assert np.isfinite(law) and law <= LAW_BAR
     m = run.model
@@ -42,7 +56,9 @@ def test_the_cart_equation_is_not_the_poles_with_an_input_admixture(run):
     # admixture's were 0.005 against sin(th2)'s 1)
     row = np.abs(m.coef_[0])
     assert row[u].max() / row.max() > 0.1
-    assert run.passed
+    if pole_checked:  # the two equations differ: the pole's has no input term
+        assert not np.any(np.abs(m.coef_[1])[u] > 0)
+    assert run.passed, run.scores.failures
 
 
 def test_input_errors_are_unchanged_by_adding_an_input_free_equation():
