@@ -131,7 +131,9 @@ class Scores:
         on a true mode the hammer meets at its node: :func:`unexcited_failures`), ``"decayed"`` (a
         failed bar on a true mode that dies out before the free decay begins:
         :func:`decayed_failures`), ``"floor"`` (a failed TRAC bar the truth's own reduced model
-        fails too: :func:`floor_failures`), ``"equation"`` (the
+        fails too: :func:`floor_failures`), ``"sensors"`` (a failed bar on a record whose
+        truth reduced to the sensors does not hold the true modes: :func:`sensor_failures`),
+        ``"equation"`` (the
         identified equation misses its rig's own bars: :func:`equation_failures`).  Empty for a
         physically admissible model whose simulation ran.
     """
@@ -212,12 +214,13 @@ _MODE_SCORE = re.compile(r"(mac|freq_error|damping_error)(?:_mode(\d+))?")
 def bar_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -> dict[str, str]:
     """The failures a run's bars add to its scorer's: :func:`uninformative_failures`,
     :func:`out_of_band_failures`, :func:`unexcited_failures`, :func:`decayed_failures`,
-    :func:`floor_failures`, :func:`equation_failures` and :func:`step_failures`, merged (one call for
+    :func:`floor_failures`, :func:`sensor_failures`, :func:`equation_failures` and
+    :func:`step_failures`, merged (one call for
     :func:`testbed.scoring.run.run_scenario` and :func:`testbed.scoring.evaluate.score_model`)."""
     return {**uninformative_failures(scores, thresholds), **out_of_band_failures(scores, thresholds),
             **unexcited_failures(scores, thresholds), **decayed_failures(scores, thresholds),
-            **floor_failures(scores, thresholds), **equation_failures(scores, thresholds),
-            **step_failures(scores, thresholds)}
+            **floor_failures(scores, thresholds), **sensor_failures(scores, thresholds),
+            **equation_failures(scores, thresholds), **step_failures(scores, thresholds)}
 
 
 def rig_equation_bars(dataset: Dataset) -> dict[str, dict[str, float]]:
@@ -597,6 +600,49 @@ def decayed_failures(scores: Scores, thresholds: dict[str, dict[str, float]]
                         "(rig.damping_ratio, signal.lowpass_hz)")}
 
 
+#: The largest relative gap between the reduced truth's undamped frequencies and the full
+#: truth's first ``n`` (:func:`reduced_truth_gap`) for :func:`truth_trac` to simulate the reduced
+#: truth as the record's floor.  SEREP is exact on the modes it keeps, so the gap is round-off
+#: times the reduced mass's condition.  Measured 2026-11-28 (the cached datasets of 115 beams of
+#: rounds 3-18 and the shipped scenarios, 45 on soft bases): 112 at most 4.6e-11; round 16's four
+#: sensors within 0.2 L (``b16_st_root4``, ``Mr``'s condition 1.7e12) 2.5e-6, on a soft base
+#: (``b16_soft_r1p2_f5_root4``, 3.8e11) 4.2e-7; round 18's three sensors at
+#: 0.06 / 0.12 / 0.18 L (``b18_st_root3_hit0p18``: two of them on the clamped beam's first rigid
+#: segment, which has one degree of freedom, so ``Mr``'s condition is 6.6e32) reduced modes at
+#: 91.9 / 109 / 733 Hz against 82.8 / 517 / 1447 (gap 0.79), whose TRAC (1e-14 - 5e-10) was claimed as the
+#: floor under models scoring 0.51-0.88.  At 1e-5 the phase the gap puts on the shipped beam's
+#: mode 3 (1.45 kHz) over its 1 s record grows to 0.09 rad, a TRAC loss of at most
+#: ``1 - cos(0.09)^2`` = 0.008 were that mode the whole record, against :data:`FLOOR_MARGIN`'s 0.05.
+REDUCED_TRUTH_GAP = 1e-5
+
+
+def reduced_truth_gap(Mr: np.ndarray, Kr: np.ndarray, f_true: np.ndarray
+                      ) -> tuple[float, np.ndarray]:
+    """Largest relative gap between the undamped frequencies of ``(Kr, Mr)`` and ``f_true`` [-].
+
+    Parameters
+    ----------
+    Mr, Kr : ndarray, shape (n, n)
+        Reduced mass [kg] and stiffness [N/m] (the truth at the sensors).
+    f_true : ndarray, shape (>= n,)
+        The full truth's undamped frequencies [Hz], ascending; the first ``n`` are compared.
+
+    Returns
+    -------
+    gap : float
+        ``max_k |f_k - f_true_k| / f_true_k``; inf where the reduced model has no finite
+        frequencies (a mass not positive definite, an overflow: :func:`metrics.modal_from_matrices`).
+    f : ndarray, shape (n,)
+        The reduced model's undamped frequencies [Hz], ascending (NaN where it has none).
+    """
+    f, _, _ = metrics.modal_from_matrices(np.asarray(Mr, float), None, np.asarray(Kr, float),
+                                          strict=False)
+    ft = np.asarray(f_true, dtype=float)[: f.size]
+    if f.size == 0 or ft.size != f.size or not np.all(np.isfinite(f)):
+        return float("inf"), f
+    return float(np.max(np.abs(f - ft) / ft)), f
+
+
 def truth_trac(truth: StructuralTruth, data: Measurement, t: np.ndarray, u: np.ndarray | None,
                ref: np.ndarray) -> np.ndarray | None:
     """TRAC per channel of the truth's own reduced model scored as an identified one is [-].
@@ -615,13 +661,17 @@ def truth_trac(truth: StructuralTruth, data: Measurement, t: np.ndarray, u: np.n
     ndarray, shape (n,), or None
         None (no claim) for a nonlinear truth (``k3`` not 0: the reduced truth's cubic is
         not the identifiers' form), a record without an input or a truth without a force map
-        or damping, or a simulation that does not give finite accelerations.
+        or damping, a reduced truth that does not hold the true modes it was reduced to
+        (:data:`REDUCED_TRUTH_GAP`: sensors whose readings are dependent), or a simulation
+        that does not give finite accelerations.
     """
     if truth.force_map is None or truth.Cr is None or u is None or u.shape[0] != 1:
         return None
     if truth.k3 is not None and float(truth.k3) != 0.0:
         return None
     Mr, Cr, Kr = (np.asarray(a, dtype=float) for a in (truth.Mr, truth.Cr, truth.Kr))
+    if not reduced_truth_gap(Mr, Kr, truth.frequencies_hz)[0] <= REDUCED_TRUTH_GAP:
+        return None
     B = np.asarray(truth.force_map, dtype=float).reshape(-1, 1)
     i0 = data.free_start
     try:
@@ -684,6 +734,42 @@ def floor_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -> d
                       "of any model of that size (signal.lowpass_hz, signal.highpass_hz, "
                       "rig.sensors, excitation.location, excitation.start: a pulse within a few "
                       "ms of the record's start is mirrored by the chain's filters' edges)")}
+
+
+def sensor_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -> dict[str, str]:
+    """A failed bar on a record whose truth at the sensors is singular: ``{"sensors": reason}``.
+
+    The truth reduced to the sensors (SEREP, one degree of freedom per sensor) is the exact
+    model of the size every structural identifier fits; where it does not hold the true modes it
+    was reduced to (:func:`reduced_truth_gap` above :data:`REDUCED_TRUTH_GAP`), the sensors'
+    readings are linearly dependent (round 18's ``b18_st_root3_hit0p18``: two sensors on the
+    clamped beam's first rigid segment, which has one degree of freedom, read proportional
+    accelerations) and no regular model of that size exists.  Measured: both identifiers failed
+    TRAC there (0.51-0.88) with the modes' bars met, named "floor" from the singular reduction's
+    own TRAC (1e-14).  Only a bar that already failed is explained, so no verdict changes.
+
+    Parameters
+    ----------
+    scores : Scores
+        With ``details["reduced_truth_gap"]`` [-], ``details["reduced_f"]`` and
+        ``details["f_true"]`` [Hz] (:func:`score_structural`); without them, nothing to check.
+    thresholds : dict
+        The run's bars, ``{metric: {"min"|"max": value}}``.
+    """
+    gap = scores.details.get("reduced_truth_gap")
+    if gap is None or not gap > REDUCED_TRUTH_GAP:
+        return {}
+    if not [c for c in check_thresholds(scores.values, thresholds) if not c.passed]:
+        return {}
+    f_red = np.asarray(scores.details.get("reduced_f", []), dtype=float)
+    f_true = np.asarray(scores.details.get("f_true", []), dtype=float)[: f_red.size]
+    return {"sensors": (
+        "sensors: the truth reduced to the sensors (one degree of freedom per sensor) does not "
+        f"hold the true modes ({' / '.join(f'{f:.4g}' for f in f_red)} Hz against "
+        f"{' / '.join(f'{f:.4g}' for f in f_true)} Hz, a gap of {gap:.3g} above "
+        f"{REDUCED_TRUTH_GAP:g}): the sensors' readings are linearly dependent (two on a rigid "
+        "segment of the model with one degree of freedom, e.g. the clamped beam's first), so no "
+        "regular model of that size exists for this record (rig.sensors, rig.n_segments)")}
 
 
 def record_details(kind: str, dataset: Dataset, data: Measurement) -> dict[str, Any]:
@@ -1085,6 +1171,9 @@ def score_structural(dataset: Dataset, data: Measurement, clean: Measurement, mo
             d["divergence_time"] = when
         else:
             failures.update(growth_failure(sim.xdd, ref))
+    if truth.Mr is not None and truth.Kr is not None:
+        d["reduced_truth_gap"], d["reduced_f"] = reduced_truth_gap(truth.Mr, truth.Kr,
+                                                                   truth.frequencies_hz)
     floor = truth_trac(truth, data, t, u, ref)
     if floor is not None:
         d["truth_trac"] = floor

@@ -16,7 +16,17 @@ from models.cantilever.model import build_model
 from testbed.core.errors import ScenarioError
 from testbed.pipeline.scenario import load_scenario, scenario_from_dict
 from testbed.scoring.run import run_scenario
-from testbed.scoring.scorers import FAIL, GROWTH_FACTOR, Scores, growth_failure, late_growth, step_failures
+from testbed.scoring.scorers import (
+    FAIL,
+    GROWTH_FACTOR,
+    REDUCED_TRUTH_GAP,
+    Scores,
+    growth_failure,
+    late_growth,
+    reduced_truth_gap,
+    sensor_failures,
+    step_failures,
+)
 
 
 def beam(rig=None, simulation=None, excitation=None):
@@ -499,3 +509,46 @@ def test_growth_is_claimed_only_where_the_record_decays():
     assert growth_failure(decay, decay) == {}
     assert growth_failure(grow, grow) == {}  # the record grows too: no claim
     assert growth_failure(np.full_like(grow, np.nan), decay) == {}  # NaN is the divergence's
+
+
+# ------------------------------------------- round 18: a singular reduction at the sensors
+def _round18(name):
+    return load_scenario(_root() / "benchmarks" / "unseen" / "round18" / f"{name}.toml")
+
+
+def test_a_singular_reduction_at_the_sensors_is_named_not_called_the_floor():
+    """Round 18's b18_st_root3_hit0p18 (sensors at 0.06 / 0.12 / 0.18 L, two of them on the clamped
+    beam's first rigid segment, one degree of freedom): the truth reduced to the sensors is
+    singular (Mr's condition 6.6e32, modes 92 / 109 / 733 Hz against 82.8 / 517 / 1447), and its
+    TRAC (1.6e-11) was claimed as the floor under ls_sindy's 0.753: "out of reach of any model of
+    that size", a floor the model stood far above.  Now no floor is claimed from it and the
+    failure names the sensors."""
+    sc = dataclasses.replace(_round18("b18_st_root3_hit0p18"), seed=91)
+    sc.identify["method"] = "ls_sindy"
+    r = run_scenario(sc)
+    assert r.verdict == FAIL and r.scores.values["trac"] < 0.9
+    assert "floor" not in r.scores.failures and "truth_trac" not in r.scores.details
+    why = r.scores.failures["sensors"]
+    assert why.startswith("sensors: the truth reduced to the sensors") and "rig.sensors" in why
+    assert r.scores.details["reduced_truth_gap"] > 0.1
+
+
+def test_the_reduced_truth_holds_the_true_modes_unless_sensors_are_dependent():
+    good = _round18("b18_st_p5ms")  # the shipped beam's sensors
+    m = build_model(good.rig_params, good.simulation, good.excitation)
+    gap, f = reduced_truth_gap(m.red.Mr, m.red.Kr, m.freqs)
+    assert gap < 1e-9 and f.shape == (3,)  # SEREP: exact on its modes up to round-off
+    bad = _round18("b18_st_root3_hit0p18")
+    m = build_model(bad.rig_params, bad.simulation, bad.excitation)
+    assert reduced_truth_gap(m.red.Mr, m.red.Kr, m.freqs)[0] > 1e4 * REDUCED_TRUTH_GAP
+
+
+def test_sensor_reason_only_explains_a_failed_bar():
+    bars = {"trac": {"min": 0.9}}
+    d = {"reduced_truth_gap": 0.79, "reduced_f": np.array([92.0, 109.0, 733.0]),
+         "f_true": np.array([82.8, 517.0, 1447.0])}
+    assert set(sensor_failures(Scores({"trac": 0.75}, d), bars)) == {"sensors"}
+    assert sensor_failures(Scores({"trac": 0.95}, d), bars) == {}  # the bar met: nothing
+    ok = {**d, "reduced_truth_gap": 2.5e-6}  # round 16's b16_st_root4: within the gap
+    assert sensor_failures(Scores({"trac": 0.75}, ok), bars) == {}
+    assert sensor_failures(Scores({"trac": 0.75}, {}), bars) == {}  # no reduction known
