@@ -27,6 +27,7 @@ from testbed.scoring.scorers import (
     sensor_failures,
     step_failures,
 )
+from testbed.studies.study import load_study
 
 
 def beam(rig=None, simulation=None, excitation=None):
@@ -552,3 +553,18 @@ def test_sensor_reason_only_explains_a_failed_bar():
     ok = {**d, "reduced_truth_gap": 2.5e-6}  # round 16's b16_st_root4: within the gap
     assert sensor_failures(Scores({"trac": 0.75}, ok), bars) == {}
     assert sensor_failures(Scores({"trac": 0.75}, {}), bars) == {}  # no reduction known
+
+
+@pytest.mark.parametrize("name, cells", [("round18_beams", 32), ("round18_beams_noise", 48),
+                                         ("round18_beams_noise_s92", 16),
+                                         ("round18_linkages_sine", 8),
+                                         ("round18_linkages_sine_seeds", 6),
+                                         ("round18_linkages_clean", 5),
+                                         ("round18_linkages_multisine", 8),
+                                         ("round18_linkages_cartpoles", 18),
+                                         ("round18_linkages_kinetics", 15)])
+def test_round18_studies_load(name, cells):
+    # every cell's scenario validates at load (the rig's own refusals, e.g. the dose at x*, are
+    # not in the studies; round18/l_make.py and b_make.py say why)
+    study = load_study(_root() / "benchmarks" / "unseen" / f"{name}.toml")
+    assert study.name == name and study.n_cells() == cells
