@@ -556,7 +556,8 @@ def test_sensor_reason_only_explains_a_failed_bar():
 
 
 @pytest.mark.parametrize("name, cells", [("round18_beams", 32), ("round18_beams_noise", 48),
-                                         ("round18_beams_noise_s92", 16),
+                                         ("round18_beams_noise_s92", 32),
+                                         ("round18_linkages_seeds", 15),
                                          ("round18_linkages_sine", 8),
                                          ("round18_linkages_sine_seeds", 6),
                                          ("round18_linkages_clean", 5),
