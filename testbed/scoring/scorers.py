@@ -606,7 +606,8 @@ def decayed_failures(scores: Scores, thresholds: dict[str, dict[str, float]]
 #: times the reduced mass's condition.  Measured 2026-11-28 (the cached datasets of 115 beams of
 #: rounds 3-18 and the shipped scenarios, 45 on soft bases): 112 at most 4.6e-11; round 16's four
 #: sensors within 0.2 L (``b16_st_root4``, ``Mr``'s condition 1.7e12) 2.5e-6, on a soft base
-#: (``b16_soft_r1p2_f5_root4``, 3.8e11) 4.2e-7; round 18's three sensors at
+#: (``b16_soft_r1p2_f5_root4``, 3.8e11) 4.2e-7 (built under ``OPENBLAS_CORETYPE=Haswell`` /
+#: ``SandyBridge``: 2.4e-6 / 3.5e-6 and 1.4e-6 / 3.2e-6); round 18's three sensors at
 #: 0.06 / 0.12 / 0.18 L (``b18_st_root3_hit0p18``: two of them on the clamped beam's first rigid
 #: segment, which has one degree of freedom, so ``Mr``'s condition is 6.6e32) reduced modes at
 #: 91.9 / 109 / 733 Hz against 82.8 / 517 / 1447 (gap 0.79), whose TRAC (1e-14 - 5e-10) was claimed as the
