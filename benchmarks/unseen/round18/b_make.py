@@ -3,25 +3,25 @@ tuned, default identifier settings, the families' bars.  Run from the repository
 
     python benchmarks/unseen/round18/b_make.py
 
-Each case is round 6's base beam (the shipped steel beam, 0.3175 m x 30 mm x 10 mm, 10 segments,
-1 % damping, 50 N / 0.3 ms hammer at the tip, ``lowpass_hz = "auto"``, 1 s at 12.8 kHz) with the
-keys below changed.  Round 18 goes to corners rounds 3-17 did not draw: long pulses (a soft hammer
-tip: 5 and 10 ms, rounds went to 2 ms; the half-sine's spectrum has its first zero at 1.5 / T, 300
-and 150 Hz, under mode 2), on the clamped and on a soft base; 19.2 kHz (with a 0.15 ms pulse) and
-6.4 kHz on a 0.5 s record (rounds drew 6.4 kHz on 5-15 s records only); aluminium beside steel at
-one length (0.45 m) and one coarse mesh (8 segments); aluminium at 40 segments; three sensors
-within 0.18 L of the root (rounds went to 0.3 L with three, 0.2 L with four) and two sensors both
-in the inner half with no tip sensor; a soft base with a nearly-vanishing cubic (fraction 0.001
-of the linear moment at the peak rotation, rounds went to 0.02) and a stiff one (k1 20 EI/L)
-with a tiny cubic (0.01); tungsten (E 411 GPa, rho 19300: no round's material) at 0.1 % damping
-(rounds went to 0.2 %); a plate-like section (100 x 3 mm).  A hammer between two sensors is not
-written: the rig refuses it (round 15).  Nor are sensors at 0.05 / 0.1 / 0.15 L: the first two lie
-on the clamped beam's first rigid segment (one degree of freedom), and the rig refuses the build
-("Singular matrix") naming ``rig.E``, not ``rig.sensors``.  The 0.06 / 0.12 / 0.18 L written
-instead put two on that segment too, but round-off leaves the reduction at the sensors
-non-singular (condition 6.6e32): the rig accepts it and its truth at the sensors does not hold
-the true modes (docs/known-gaps.md round 18).  Noise 0 / 0.5 / 1.5 / 3 % and seeds 91-92 are the
-studies' (round18_beams*.toml).
+Each case is round 6's base beam (the shipped steel beam, 0.3175 m x 30 mm x 10 mm, 10 segments, 1 %
+damping, 50 N / 0.3 ms hammer at the tip, ``lowpass_hz = "auto"``, 1 s at 12.8 kHz) with the keys
+below changed.  Round 18 draws these corners (where an earlier round drew the same family, it is
+named): long pulses, a soft hammer tip, of 5 ms (round 10 drew 5 ms) and 10 ms (the half-sine's
+spectrum has its first zero at 1.5 / T, 300 and 150 Hz, under mode 2), on the clamped beam and a
+soft base; 19.2 kHz (with a 0.15 ms pulse); 6.4 kHz on a 0.5 s record (rounds 7-13 drew 6.4 kHz on
+1-15 s); aluminium beside steel at one length (0.45 m) and one coarse mesh (8 segments); aluminium
+at 40 segments; three sensors within 0.18 L of the root (round 6 drew 0.1 / 0.2 / 0.3 L, round 16
+four within 0.2 L on 20 segments) and two sensors both in the inner half with no tip sensor; a soft
+base with a nearly-vanishing cubic (fraction 0.001 of the linear moment at the peak rotation; rounds
+13-15 went to 0.02) and a stiff one (k1 20 EI/L) with a tiny cubic (0.01); tungsten (E 411 GPa, rho
+19300: no round's material) at 0.1 % damping; a plate-like section (100 x 3 mm; rounds 13 and 16
+drew 60 x 4 and 50 x 2 mm).  A hammer between two sensors is not written: the rig refuses it (round
+15).  Nor are sensors at 0.05 / 0.1 / 0.15 L: the first two lie on the clamped beam's first rigid
+segment (one degree of freedom), and the rig refuses the build ("Singular matrix") naming ``rig.E``,
+not ``rig.sensors``.  The 0.06 / 0.12 / 0.18 L written instead put two on that segment too, but
+round-off leaves the reduction at the sensors non-singular (condition 6.6e32): the rig accepts it
+and its truth at the sensors does not hold the true modes (docs/known-gaps.md round 18).  Noise 0 /
+0.5 / 1.5 / 3 % and seeds 91-92 are the studies' (round18_beams*.toml).
 """
 
 from __future__ import annotations

@@ -5,20 +5,23 @@ root:
     python benchmarks/unseen/round18/l_make.py
 
 Five-bars under the paper's sine (``fivebar_sine_replay_noise1``, and clean with recorded rates):
-the paper's linkage held out at 2 and 4 % on new seeds (rounds drew 1 / 3 %), a nearly-parallelogram
-linkage (cranks 0.6 m, couplers 1 m, the left crank as long as the right coupler and the left
-coupler as long as the right crank, ground pivots 0.05 m apart: the four moving links nearly a
-parallelogram), records of 1 s (a sixth of the sine's period) and 30 s (rounds drew 2-20 s), and
-the sine at 0.5 Hz (3.1x the paper's 1 rad/s; no round changed its frequency).  The multisine
-(``fivebar_multisine_noise1``) on 1 s and 30 s records (rounds drew 3 and 15 s).  Chirps (no round
-since round 6), ``fivebar_multisine_noise1``'s chain and feedback with the input replaced whole and
-written in full: 1 N m 0.1-2 Hz over 10 s, and 1 N m 0.05-1 Hz over 30 s.  Cart-poles under
-``cartpole_noise1``'s multisine and chain: a light long pole (0.05 kg, 2 m), a 3 m pole, a 5 kg
-cart, a rail of 5 N s/m under the light 0.6 m pole, records of 2 s and 30 s.  Kinetics: an influx
-near Vmax with a small Km (1.4 of 1.5 mM/s, Km 0.01: x* 0.14 mM), Km 0.01 mM, a dose under x*
-(0.05 mM rising to 0.2), a 50 Hz record and a 30 s record.  Not written: the dose at the steady
-state (x0 = x* = 0.2 mM), which the rig refuses in one line ("started there, x never moves").
-Noise levels and seeds 91-94 are the studies' (round18_linkages_*.toml).
+the paper's linkage held out at 2 and 4 % on new seeds (round 17 drew 1 / 3 %), a nearly-
+parallelogram linkage (cranks 0.6 / 1 m, couplers 1 / 0.6 m: the left crank as long as the right
+coupler and the left coupler as long as the right crank, ground pivots 0.05 m apart; rounds 4, 5, 11
+and 14 drew ground links of 0.02-0.15 m on other link lengths), records of 1 s (a sixth of the
+sine's period) and 30 s (rounds 3 and 6 drew them under their own inputs), and the sine at 0.5 Hz
+(3.1x the paper's 1 rad/s; round 5 drew 0.02 and 2 Hz).  The multisine
+(``fivebar_multisine_noise1``) on 1 s and 30 s records (round 16 drew 3 and 15 s).  Chirps (rounds
+3-6 drew them at 1 %), ``fivebar_multisine_noise1``'s chain and feedback with the input replaced
+whole and written in full: 1 N m 0.1-2 Hz over 10 s, and 1 N m 0.05-1 Hz over 30 s.  Cart-poles
+under ``cartpole_noise1``'s multisine and chain: a light long pole (0.05 kg, 2 m; round 16 drew the
+0.05 kg pole at 0.6 m), a 3 m pole, a 5 kg cart (round 9 drew one under a long pole), a rail of 5 N
+s/m under the light 0.6 m pole (rounds 11-12 drew damped rails under the 0.5 kg pole), records of 2
+s (round 3 drew one) and 30 s.  Kinetics: an influx near Vmax with a small Km (1.4 of 1.5 mM/s, Km
+0.01: x* 0.14 mM), Km 0.01 mM (round 11 drew it), a dose under x* (0.05 mM rising to 0.2), a 50 Hz
+record and a 30 s record.  Not written: the dose at the steady state (x0 = x* = 0.2 mM), which the
+rig refuses in one line ("started there, x never moves"). Noise levels and seeds 91-95 are the
+studies' (round18_linkages_*.toml).
 """
 
 from __future__ import annotations
