@@ -32,7 +32,7 @@ import numpy as np
 
 from models import RIGS
 from models._base import MJ_MINVAL, ErrorFn, Rig, check_two_samples, furthest_from_default
-from models.cantilever.beam import BeamParams, body_of
+from models.cantilever.beam import BeamParams
 from models.cantilever.euler_bernoulli import auto_cutoff, clamped_estimates
 from models.cantilever.model import (
     CantileverModel,
@@ -392,7 +392,23 @@ def _check_segment_inertia(rig: dict[str, Any], error: ErrorFn) -> None:
 
 def _check_sensors_per_segment(rig: dict[str, Any], sensors: list[float], x0: float,
                                error: ErrorFn) -> None:
-    """Refuse more than :data:`MAX_SENSORS_PER_SEGMENT` sensors on one rigid segment.
+    """Refuse sensors whose readings are linearly dependent through the chain's kinematics.
+
+    Segment ``i`` (counted from the root, 1-based; a soft base's stub from 0 to the first
+    hinge is segment 1) turns on the ``i`` hinges inboard of it, and a transverse
+    accelerometer at ``s`` on it reads ``sum_j (s - x_j) ddot(theta_j)`` over those hinges.
+    Two rules follow, both exact counts (no rank decided by round-off):
+
+    * at most :data:`MAX_SENSORS_PER_SEGMENT` sensors on one segment (its rows lie in the
+      span of two vectors, ``1`` and ``x``);
+    * at most ``i`` sensors on segments ``1..i`` together, for every ``i`` (their rows have
+      ``i`` entries).  Round 18: 0.05 / 0.1 / 0.15 L on the shipped clamped beam put two
+      sensors on its first segment (one hinge); the build then failed with "Singular matrix"
+      naming ``rig.E``, and 0.06 / 0.12 / 0.18 L was accepted with a reduction at the sensors
+      whose modes were 92 / 109 / 733 Hz against the engine's 82.8 / 517 / 1447 Hz.
+
+    A sensor exactly at a hinge moves with the segment inboard of it (its offset on the
+    outboard one is zero), so it is counted there.
 
     Parameters
     ----------
@@ -405,22 +421,37 @@ def _check_sensors_per_segment(rig: dict[str, Any], sensors: list[float], x0: fl
     error : callable
         The scenario's error reporter (key, value, what is allowed).
     """
-    on_beam = [s for s in sensors if x0 < s <= rig["length"]]
-    if len(on_beam) <= MAX_SENSORS_PER_SEGMENT:
+    on_beam = sorted(s for s in sensors if x0 < s <= rig["length"])
+    if not on_beam:
         return
     params = beam_params(rig)
     xs, _ = params.hinges()
-    bodies = [body_of(params, s)[0] for s in on_beam]
-    for b in sorted(set(bodies)):
-        held = [s for s, i in zip(on_beam, bodies, strict=True) if i == b]
+    # 0-based segment index; a sensor at hinge x_b (searchsorted "left") belongs to segment b - 1
+    segments = [int(np.searchsorted(xs, s, side="left")) - 1 for s in on_beam]
+
+    def span(b: int) -> str:
+        return f"{xs[b]:.6g}-{xs[b + 1] if b + 1 < len(xs) else rig['length']:.6g} m"
+
+    for b in sorted(set(segments)):
+        held = [s for s, i in zip(on_beam, segments, strict=True) if i == b]
         if len(held) > MAX_SENSORS_PER_SEGMENT:
-            end = xs[b + 1] if b + 1 < len(xs) else rig["length"]
             error("rig.sensors", sensors,
                   f"allowed: at most {MAX_SENSORS_PER_SEGMENT} sensors on one rigid segment; "
                   f"{', '.join(f'{s:.6g}' for s in held)} m all lie on segment {b + 1} "
-                  f"({xs[b]:.6g}-{end:.6g} m), whose plane motion has 2 degrees of freedom: "
+                  f"({span(b)}), whose plane motion has 2 degrees of freedom: "
                   "their readings are linearly dependent and the reduction at the sensors "
                   "(SEREP) is singular")
+            return
+    for b in sorted(set(segments)):
+        inboard = [s for s, i in zip(on_beam, segments, strict=True) if i <= b]
+        if len(inboard) > b + 1:
+            hinges = f"{b + 1} hinge" + ("s" if b else "")
+            error("rig.sensors", sensors,
+                  f"allowed: at most {b + 1} sensor{'s' if b else ''} on segment"
+                  f"{'s 1-' if b else ' '}{b + 1} ({xs[0]:.6g}-{span(b).split('-')[1]}), which "
+                  f"turn{'' if b else 's'} on {hinges}; {', '.join(f'{s:.6g}' for s in inboard)} m "
+                  "lie there, so their readings are linearly dependent and the reduction at the "
+                  "sensors (SEREP) is singular")
             return
 
 
