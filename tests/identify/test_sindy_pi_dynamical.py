@@ -22,6 +22,7 @@ from testbed.pipeline.scenario import load_scenario, scenario_from_dict
 from testbed.pipeline.signal_chain import measure
 from testbed.scoring.run import run_scenario
 from testbed.scoring.scorers import compare_implicit, score
+from testbed.studies.runstore import build_arrays, build_meta
 from tests.identify.dynsim_reference import simulate_reference
 
 
@@ -460,3 +461,6 @@ def test_round17_km1em4_clean_passes_at_the_rules_step(dataset_cache):
     # 1e-6 mM: 1e-4 of the bar 0.01; measured 1.0e-8 (the fixed 1 ms step: 0.617)
     assert r.scores.values["state_rmse"] < 1e-6
     assert r.model.sim_dt_ < 5e-4 and "moves the simulation by" in r.model.sim_dt_rule_
+    # stored with the run as the other rules are (run.json's model_lists, run.npz)
+    assert build_meta(r)["model_lists"]["sim_dt_rule_"] == [r.model.sim_dt_rule_]
+    assert float(build_arrays(r)["model/sim_dt_"]) == r.model.sim_dt_
