@@ -82,6 +82,22 @@ a ratio falls is rounding's.
 
 Simulation: at each RK4 stage the identified equations ``A(x, u) dx + b(x, u) = 0`` are solved
 for ``dx``; an (almost) singular ``A`` raises :class:`~testbed.core.errors.DivergenceError`.
+
+The step (``sim_dt_``, ``sim_dt_rule_``): the user's ``sim_dt``, else the mechanical
+``sindy_pi``'s step rule (:func:`identify.sindy_pi.choose_sim_dt`, Richardson's test on the
+identified equations themselves: 1 ms, 0.5 ms, then the sample interval and its halves, the
+first that the next moves the simulated states by at most 2.5e-6 of their measured range),
+started from the law's stiffness: RK4 at step h is unstable for a decay rate above
+``RK4_STABILITY / h`` (2.785 / h) whatever the law, so where the law's largest ``|d(dx)/dx|``
+over the record's states (:func:`identify._dynsim.stiffness`) puts that bound below 1 ms, the
+rule's steps are scaled by the power of two that brings its first step within it
+(:data:`MAX_START_HALVINGS` at most).  Each candidate simulates the whole record from its first
+measured state, as scoring's rollout does.  A fixed 1 ms step is unstable for a stiff law:
+round 17's ``mm17_km1em4`` (Km 1e-4 mM; the decay rate near x*, ``Vmax Km / (Km + x*)^2`` =
+5.4e3 1/s, puts ``h |lambda|`` at 5.4) stepped through x* to -1.6 mM (state_rmse 0.617 with
+the law exact).  The RK4 itself is compiled (:mod:`identify._dynsim`): the interpreted one
+paid ~60 us of numpy per derivative call, and the rule's simulations took minutes where the
+step falls.
 """
 
 from __future__ import annotations
@@ -118,9 +134,12 @@ from identify.sindy_pi import (
     RIDGE_FIELD,
     SELECTION_ATOL_FIELD,
     SELECTION_RTOL_FIELD,
+    SIM_DT_REL_TOL,
+    SIM_DT_START,
     THRESHOLDS_FIELD,
     VAL_FRACTION_FIELD,
     check_thresholds,
+    choose_sim_dt,
 )
 from testbed.core.errors import DivergenceError, IdentificationError
 from testbed.core.measurement import Measurement, Trajectory
@@ -133,6 +152,25 @@ from testbed.numerics.noise import noise_std
 #: amplifies the coefficients' own round-off (and noise) by 1e8: the model no longer decides
 #: the derivative.
 SINGULAR_TOL = 1e-8
+
+#: The simulation's failures (:class:`~testbed.core.errors.DivergenceError`), one wording for
+#: :meth:`SINDyPIDynamical.derivative` and the compiled RK4.
+NON_FINITE_STATE = "non-finite state"
+NON_FINITE_TERMS = "non-finite terms of the identified equations"
+
+
+def singular_message(smin: float) -> str:
+    """The failure of an (almost) singular derivative coefficient, smallest singular value
+    ``smin``."""
+    return (f"the identified coefficient of the derivatives is singular (smallest singular "
+            f"value {smin:.3g} <= {SINGULAR_TOL:g})")
+
+
+def _dynsim() -> Any:
+    """:mod:`identify._dynsim`, imported on first use (numba's import costs ~0.4 s)."""
+    from identify import _dynsim as module
+    return module
+
 
 #: Largest ratio of an equation's residual to the noise's own share of it
 #: (:func:`identify._determinacy.noise_residual_ratio`) at which a term is dropped as
@@ -152,6 +190,13 @@ NOISE_PRUNE_RATIO = 2.0
 #: 10's Km 0.05 at 2 %: 0.051 -> 0.056) and 0.86-1.14 where it met the 5 % bar (round 10's 8 mM
 #: dose at 0.5 %: 0.051 -> 0.024; round 13's slow enzyme at 3 %: 0.068 -> 0.007).
 COMPENSATION_SIGNIFICANCE = 0.5
+#: Most halvings of :data:`identify.sindy_pi.SIM_DT_START` (1 ms) the law's stiffness may
+#: take the step rule's first step down by: 4, a first step of 62.5 us, stable for decay rates
+#: up to 4.5e4 1/s, 8x the stiffest law of the 121 kinetics cells of rounds 10-17 (round 17's
+#: Km 1e-4 mM, 5.4e3 1/s).  The rule's own halvings go on below it; the bound keeps a law whose
+#: derivative coefficient nearly vanishes on the record (stiffness without bound there) from
+#: starting the rule's whole-record simulations at steps of nanoseconds.
+MAX_START_HALVINGS = 4
 #: A term's syntax (:class:`ImplicitTerms`): ``1``, or factors ``name`` / ``name^k`` joined by
 #: ``*`` (whether each name is a state, a derivative or an input is known only from the data).
 _TERM = re.compile(r"^\s*(1|[A-Za-z_]\w*(\^[1-9]\d*)?(\s*\*\s*[A-Za-z_]\w*(\^[1-9]\d*)?)*)\s*$")
@@ -472,8 +517,9 @@ class SINDyPIDynamical(Identifier):
         Test-function exponent (weak form).
     refit : {"compensated", "symmetric", "lhs"}
         Final coefficients of each selected equation (:meth:`_refit`).
-    sim_dt : float
-        Largest RK4 step [s] of the identified model's simulation.
+    sim_dt : float, optional
+        Largest RK4 step [s] of the identified model's simulation; default by the step rule
+        (:meth:`_choose_sim_dt`: ``sim_dt_``, ``sim_dt_rule_``).
 
     Attributes
     ----------
@@ -502,6 +548,13 @@ class SINDyPIDynamical(Identifier):
         (:func:`identify._determinacy.determinacy_bound`) [-]: 0 noise-free; at 1 or more the
         record does not determine that equation (no selection or estimator on these rows
         can).  ``determinacy_rule_`` states the rule and the figures.
+    sim_dt_ : float
+        The RK4 step [s] of the identified model's simulations: the user's ``sim_dt``, else the
+        step rule's (:func:`identify.sindy_pi.choose_sim_dt`: 1 ms, 0.5 ms, then the sample
+        interval and its halves, the first that the next moves the simulated states by at most
+        :data:`identify.sindy_pi.SIM_DT_REL_TOL` of their measured range; scaled down by the
+        power of two that brings its first step within RK4's stability bound for the law's
+        stiffness, module docstring).  ``sim_dt_rule_`` says why, with the stiffness.
     compensation_ : ndarray, shape (n_states,)
         How far taking the noise's Gram out moves each refitted equation's unit direction, over
         the spread another noise draw gives it [-] (``refit = "compensated"``; compensated
@@ -551,8 +604,13 @@ class SINDyPIDynamical(Identifier):
                            "('symmetric'), or the sweep's least squares on its left-hand side "
                            "('lhs')"),
         # (0, 1] s: the shipped rigs' time constants are of order 0.1-1 s
-        "sim_dt": Field(float, 1e-3, unit="s", min=0.0, min_inclusive=False, max=1.0,
-                        doc="largest RK4 step of the identified model's simulation"),
+        "sim_dt": Field(float, None, unit="s", min=0.0, min_inclusive=False, max=1.0,
+                        doc="largest RK4 step of the identified model's simulation; none = "
+                            "1 ms, 0.5 ms, then the sample interval and its halves, the first "
+                            "that the next moves the simulated states by at most "
+                            f"{SIM_DT_REL_TOL:g} of their range, each scaled down by the power "
+                            "of two that puts the first within RK4's stability bound for the "
+                            "identified law's stiffness (the rule, sim_dt_rule_)"),
     }
     #: Keys the fit reads only under another setting (benchmarks/hostile10.py ``combos``).
     used_when: ClassVar[dict[str, KeyUse]] = {
@@ -568,7 +626,7 @@ class SINDyPIDynamical(Identifier):
                  selection_rtol: float = 0.1, selection_atol: float = 1e-12,
                  formulation: str = "strong", weak_window_s: float = 0.5,
                  weak_windows: int = 200, weak_degree: int = 4, refit: str = "compensated",
-                 sim_dt: float = 1e-3) -> None:
+                 sim_dt: float | None = None) -> None:
         self.library = library
         self.degree = degree
         self.lhs = lhs
@@ -621,7 +679,14 @@ class SINDyPIDynamical(Identifier):
 
     @classmethod
     def simulation_steps(cls, params: dict[str, Any], record_s: float) -> tuple[float, str]:
-        return record_s / params["sim_dt"], "sim_dt"
+        """RK4 steps of scoring's simulation over the record and, where ``sim_dt`` is None, the
+        step rule's (:meth:`_choose_sim_dt`) as it goes on a law that 1 ms does not resolve:
+        whole-record simulations at 1, 0.5, 0.25 and 0.125 ms, scoring's at 0.25 ms (a stiff
+        law's start, :data:`MAX_START_HALVINGS`, takes more steps, each of the compiled RK4 at
+        ~0.2 us a derivative call against the 27 us a step that the budget's figure assumes)."""
+        if params["sim_dt"] is not None:
+            return record_s / params["sim_dt"], "sim_dt"
+        return record_s / SIM_DT_START * (1 + 2 + 4 + 8 + 4), "sim_dt"
 
     def _terms(self, data: Measurement) -> ImplicitTerms:
         inputs = tuple(data.inputs) if data.u is not None else ()
@@ -692,7 +757,71 @@ class SINDyPIDynamical(Identifier):
         if self._prune_at_noise(data, lib, x, xd, u, G_val, sw.scale, deriv_cols):
             self._fit_determinacy(data, lib, x, xd, u)   # of the pruned equations
         self._refit(G_train + G_val, data, lib, x, xd, u)
+        self._choose_sim_dt(data)
         return self
+
+    def _step(self) -> float:
+        """The RK4 step of this model's simulations [s]: the user's ``sim_dt``, else the step
+        rule's ``sim_dt_`` once chosen, else :data:`identify.sindy_pi.SIM_DT_START`."""
+        if self.sim_dt is not None:
+            return float(self.sim_dt)
+        return getattr(self, "sim_dt_", SIM_DT_START)
+
+    def _choose_sim_dt(self, data: Measurement) -> None:
+        """``sim_dt_`` and ``sim_dt_rule_``: the user's ``sim_dt``, else the step rule
+        (:func:`identify.sindy_pi.choose_sim_dt`) on the fitted equations, its steps scaled by
+        :meth:`_start_scale` (the law's stiffness), each candidate simulating the whole record
+        from its first measured state (as scoring's rollout does), the tolerance over the
+        measured states' ranges."""
+        if self.sim_dt is not None:
+            self.sim_dt_, self.sim_dt_rule_ = float(self.sim_dt), "user-set"
+            return
+        self.__dict__.pop("sim_dt_", None)  # each candidate simulates at its own step
+        x = np.asarray(data.x, dtype=float)
+        t = np.arange(data.n_samples) / data.fs
+        u = None if data.u is None else np.asarray(data.u, dtype=float)
+        scale, why = self._start_scale(x, u)
+
+        done: dict[bytes, np.ndarray] = {}
+
+        def simulate(dt: float) -> np.ndarray:
+            # a step at or above the sample interval runs one step per sample (the RK4 steps
+            # per interval are those of _simulate_states): candidates with the same steps give
+            # the same array and are not simulated twice (a 5 kHz record: 1 and 0.5 ms both
+            # step at 0.2 ms)
+            h = dt * scale
+            key = np.maximum(1.0, np.ceil(np.diff(t) / h - 1e-9)).tobytes()
+            if key not in done:
+                done[key] = self._simulate_states(x[:, 0], t, u, h)[0]
+            return done[key]
+
+        dt, rule = choose_sim_dt(simulate, x, data.fs)
+        if scale != 1.0:   # the rule's sentence names its own (unscaled) steps: in seconds here
+            rule = re.sub(r"(?<![\w.])(\d+(?:\.\d+)?(?:e[+-]?\d+)?) s\b",
+                          lambda m: f"{float(m.group(1)) * scale:.3g} s", rule)
+        self.sim_dt_, self.sim_dt_rule_ = dt * scale, f"{rule}; {why}"
+
+    def _start_scale(self, x: np.ndarray, u: np.ndarray | None) -> tuple[float, str]:
+        """The factor (1 or a power of 1/2, at least 2^-:data:`MAX_START_HALVINGS`) by which the
+        step rule's steps are scaled, so that its first, :data:`identify.sindy_pi.SIM_DT_START`,
+        is within RK4's stability bound :data:`identify._dynsim.RK4_STABILITY` / ``L`` for the
+        law's stiffness ``L`` (:func:`identify._dynsim.stiffness` over the record's states
+        ``x``, inputs ``u``); and the sentence that says so."""
+        lam = _dynsim().stiffness(self.coef_, self._lib.powers, self._lib.deriv, x, u,
+                                  SINGULAR_TOL)
+        bound = _dynsim().RK4_STABILITY / lam if lam > 0 else math.inf
+        halvings = 0
+        while SIM_DT_START / 2 ** halvings > bound and halvings < MAX_START_HALVINGS:
+            halvings += 1
+        where = (f"the law's largest |d(dx)/dx| over the record's states {lam:.3g} 1/s puts "
+                 f"RK4's stability bound at {bound:.3g} s")
+        if halvings == 0:
+            return 1.0, f"{where}: the rule starts at {SIM_DT_START:g} s"
+        start = SIM_DT_START / 2 ** halvings
+        still = (f" (the most, {MAX_START_HALVINGS} halvings; still above the bound)"
+                 if start > bound else "")
+        return 0.5 ** halvings, (f"{where}: the rule's steps scaled by 1/{2 ** halvings}{still}, "
+                                 f"from {start:.3g} s")
 
     def _refit(self, G: np.ndarray, data: Measurement, lib: ImplicitTerms, x: np.ndarray,
                xd: np.ndarray, u: np.ndarray | None) -> None:
@@ -944,26 +1073,26 @@ class SINDyPIDynamical(Identifier):
         """
         z = x if u is None or np.size(u) == 0 else np.concatenate([x, u])
         if not np.all(np.isfinite(z)):
-            raise DivergenceError("non-finite state", t)
+            raise DivergenceError(NON_FINITE_STATE, t)
         with np.errstate(over="ignore", invalid="ignore"):
             m = self._lib.monomials(z[:, None])[:, 0]
             cm = self.coef_ * m[None, :]
         if not np.all(np.isfinite(cm)):
-            raise DivergenceError("non-finite terms of the identified equations", t)
+            raise DivergenceError(NON_FINITE_TERMS, t)
         D, free = self._derivative_map()
         A, b = cm @ D, cm[:, free].sum(axis=1)
         # one state: the 1 x 1 coefficient's singular value is its magnitude (no LAPACK call
         # per RK4 stage: the kinetics' rollouts spent a fifth of their time there)
         smin = abs(A[0, 0]) if A.shape == (1, 1) else np.linalg.svd(A, compute_uv=False).min()
         if not smin > SINGULAR_TOL:
-            raise DivergenceError(f"the identified coefficient of the derivatives is singular "
-                                  f"(smallest singular value {smin:.3g} <= {SINGULAR_TOL:g})", t)
+            raise DivergenceError(singular_message(smin), t)
         return np.linalg.solve(A, -b)
 
     def simulate(self, x0: np.ndarray, xd0: np.ndarray | None, t: np.ndarray,
                  u: np.ndarray | None = None) -> Trajectory:
         """RK4 of the identified equations from ``x0`` (n_states,) over the uniform times ``t``
-        (n_samples,) [s], in steps of at most ``sim_dt``; ``xd0`` is unused (first order);
+        (n_samples,) [s], in steps of at most ``sim_dt_`` (the user's ``sim_dt`` or the step
+        rule's, 1 ms before the fit); ``xd0`` is unused (first order);
         inputs ``u`` (n_inputs, n_samples) are interpolated linearly.
 
         Returns
@@ -978,35 +1107,40 @@ class SINDyPIDynamical(Identifier):
             A singular derivative coefficient or a non-finite state, with its time.
         """
         t = np.asarray(t, dtype=float)
-        x = np.array(x0, dtype=float).ravel()
-        uu = None if u is None or np.size(u) == 0 else np.atleast_2d(np.asarray(u, dtype=float))
-
-        def u_at(s: float) -> np.ndarray | None:
-            return None if uu is None else np.array([np.interp(s, t, r) for r in uu])
-
-        def f(s: float, y: np.ndarray) -> np.ndarray:
-            return self.derivative(y, u_at(s), s)
-
-        X = np.empty((x.size, t.size))
-        Xd = np.empty_like(X)
-        X[:, 0] = x
-        for k in range(t.size - 1):
-            h_total = t[k + 1] - t[k]
-            steps = max(1, math.ceil(h_total / self.sim_dt - 1e-9))
-            h = h_total / steps
-            s = t[k]
-            for _ in range(steps):
-                k1 = f(s, x)
-                k2 = f(s + h / 2, x + h / 2 * k1)
-                k3 = f(s + h / 2, x + h / 2 * k2)
-                k4 = f(s + h, x + h * k3)
-                x = x + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
-                s += h
-            X[:, k + 1] = x
-        for k in range(t.size):
-            Xd[:, k] = f(t[k], X[:, k])
+        X, Xd = self._simulate_states(x0, t, u, self._step())
         Xdd = np.gradient(Xd, t, axis=1) if t.size > 1 else np.zeros_like(Xd)
         return Trajectory(X, Xd, Xdd)
+
+    def _simulate_states(self, x0: np.ndarray, t: np.ndarray, u: np.ndarray | None,
+                         dt: float) -> tuple[np.ndarray, np.ndarray]:
+        """The states and the equations' derivatives at them (each n_states, n_samples) that
+        RK4 gives from ``x0`` (n_states,) over the uniform times ``t`` (n_samples,) [s] in
+        steps of at most ``dt`` [s], inputs ``u`` (n_inputs, n_samples) interpolated linearly
+        (the compiled :func:`identify._dynsim.rk4`; each stage as :meth:`derivative`).
+
+        Raises
+        ------
+        DivergenceError
+            A singular derivative coefficient or a non-finite state, with its time.
+        """
+        ds = _dynsim()
+        t = np.ascontiguousarray(t, dtype=float)
+        x = np.array(x0, dtype=float).ravel()
+        U = (np.empty((0, t.size)) if u is None or np.size(u) == 0
+             else np.ascontiguousarray(np.atleast_2d(np.asarray(u, dtype=float))))
+        X = np.empty((x.size, t.size))
+        Xd = np.empty_like(X)
+        status, when, smin = ds.rk4(x, t, U, float(dt), np.ascontiguousarray(self.coef_, dtype=float),
+                                    np.ascontiguousarray(self._lib.powers, dtype=np.int64),
+                                    np.ascontiguousarray(self._lib.deriv, dtype=np.int64),
+                                    SINGULAR_TOL, X, Xd)
+        if status == ds.NON_FINITE_STATE:
+            raise DivergenceError(NON_FINITE_STATE, when)
+        if status == ds.NON_FINITE_TERMS:
+            raise DivergenceError(NON_FINITE_TERMS, when)
+        if status == ds.SINGULAR:
+            raise DivergenceError(singular_message(smin), when)
+        return X, Xd
 
     def equations(self, precision: int = 4) -> list[str]:
         """One line per identified implicit equation, ``0 = c1*term1 + ...``."""

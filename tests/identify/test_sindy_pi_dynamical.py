@@ -1,9 +1,15 @@
 """SINDy-PI for first-order systems: user terms, selection, simulation, scoring."""
 
+import dataclasses
+from pathlib import Path
+
 import numpy as np
 import pytest
 
+from identify._dynsim import RK4_STABILITY, stiffness
+from identify.sindy_pi import SIM_DT_REL_TOL
 from identify.sindy_pi_dynamical import (
+    MAX_START_HALVINGS,
     ImplicitTerms,
     SINDyPIDynamical,
     common_factor,
@@ -14,7 +20,10 @@ from testbed.core.measurement import Measurement
 from testbed.pipeline.plugins import rig_class
 from testbed.pipeline.scenario import load_scenario, scenario_from_dict
 from testbed.pipeline.signal_chain import measure
+from testbed.scoring.run import run_scenario
 from testbed.scoring.scorers import compare_implicit, score
+from testbed.studies.runstore import build_arrays, build_meta
+from tests.identify.dynsim_reference import simulate_reference
 
 
 @pytest.fixture(scope="module")
@@ -285,3 +294,173 @@ def test_an_exact_law_is_never_refuted(mm):
     _, data = mm   # noise-free, recorded derivatives, strong form: the law holds to round-off
     model = SINDyPIDynamical(library=["1", "x", "x^2", "dx", "x*dx"]).fit(data)
     assert model.exact_tie_ == [[]] and ": refuted" not in model.exact_tie_rule_
+
+
+@pytest.fixture(scope="module")
+def mm_stiff():
+    # Km 1e-4 mM (round 17's mm17_km1em4, shortened): x falls from 0.3 mM at 0.9 mM/s to
+    # x* = jx Km / (Vmax - jx) = 6.7e-5 mM, where the law's decay rate Vmax Km / (Km + x*)^2 =
+    # 5.4e3 1/s puts a 1 ms RK4 step at h |lambda| 5.4, past RK4's stability limit 2.79
+    sc = scenario_from_dict({"scenario": {"name": "mm_stiff", "rig": "michaelis_menten"},
+                             "rig": {"jx": 0.6, "Vmax": 1.5, "Km": 1e-4, "x0": 0.3},
+                             "simulation": {"duration": 0.5, "sample_rate": 100.0},
+                             "signal": {"derivatives": "recorded"},
+                             "identify": {"method": "sindy_pi_dynamical"}})
+    ds = rig_class("michaelis_menten")(sc).simulate()
+    return ds, measure(ds, {}, "dynamical")
+
+
+def test_the_step_rule_simulates_a_stiff_law_the_1ms_step_does_not(mm_stiff):
+    # the law is identified exactly either way; the fixed 1 ms step (the old default) carried
+    # the state through x* to a negative concentration, the rule's step simulates the engine's
+    # record (noise-free: the rig's own states) to the rule's tolerance
+    ds, data = mm_stiff
+    lib = ["1", "x", "dx", "x*dx"]
+    model = SINDyPIDynamical(library=lib).fit(data)
+    cmp = compare_implicit(model.feature_names_, model.coef_, ds.truth["equation_terms"],
+                           np.asarray(ds.truth["equation_coef"]))
+    assert cmp["f1"] == 1.0 and cmp["coef_error"] < 1e-4
+    # the stiffness starts the rule below 1 ms (the law's own bound, 2.785 / 5.4e3 1/s =
+    # 0.52 ms at x*, or less where the record's states come nearer the law's pole at -Km)
+    assert model.sim_dt_ < 1e-3 and "moves the simulation by" in model.sim_dt_rule_
+    assert "the rule's steps scaled by 1/" in model.sim_dt_rule_
+    t = np.arange(data.n_samples) / data.fs
+    sim = model.simulate(data.x[:, 0], None, t).x
+    # 1e-6 mM: the shipped clean kinetics bar (state_rmse_max); the rule's tolerance is
+    # 2.5e-6 of the 0.3 mM range and RK4's error at the kept step is that of the next halving
+    # times 16/15 at most, so what is left is the identified law's own error
+    assert np.max(np.abs(sim - data.x)) < 1e-6
+    fixed = SINDyPIDynamical(library=lib, sim_dt=1e-3).fit(data)
+    assert fixed.sim_dt_ == 1e-3 and fixed.sim_dt_rule_ == "user-set"
+    assert np.min(fixed.simulate(data.x[:, 0], None, t).x) < 0.0   # the user's step is kept
+
+
+def test_the_step_rule_keeps_1ms_where_it_resolves_the_law(mm):
+    # the shipped clean record (Km 0.3 mM, time scale ~0.5 s): RK4 at 1 ms errs ~1e-11 mM, and
+    # the law's stiffness (at most Vmax / Km = 5 1/s) leaves 1 ms far inside RK4's bound
+    _, data = mm
+    model = SINDyPIDynamical(library=["1", "x", "x^2", "x^3", "dx", "x*dx"]).fit(data)
+    assert model.sim_dt_ == 1e-3 and f"<= {SIM_DT_REL_TOL:g}" in model.sim_dt_rule_
+    assert "the rule starts at 0.001 s" in model.sim_dt_rule_
+
+
+def test_the_stiffness_is_the_laws_decay_rate():
+    # Km dx + x dx - jx Km + (Vmax - jx) x = 0: dx = jx - Vmax x / (Km + x), whose derivative
+    # -Vmax Km / (Km + x)^2 is largest in magnitude at the smallest state
+    jx, vmax, km = 0.6, 1.5, 0.3
+    lib = ImplicitTerms(["1", "x", "dx", "x*dx"], ("x",))
+    coef = np.array([[-jx * km, vmax - jx, km, 1.0]])
+    x = np.linspace(0.2, 2.0, 50)[None, :]
+    lam = stiffness(coef, lib.powers, lib.deriv, x, None, 1e-8)
+    assert lam == pytest.approx(vmax * km / (km + 0.2) ** 2, rel=1e-12)
+    # a state where the derivative's coefficient vanishes (x = -Km) is left out, not infinite
+    x_pole = np.array([[-km, 0.2]])
+    assert stiffness(coef, lib.powers, lib.deriv, x_pole, None, 1e-8) == pytest.approx(lam)
+    assert RK4_STABILITY == pytest.approx(2.7853, abs=1e-4)
+    # two states with an input: the largest |eigenvalue| of the Jacobian, here of the linear
+    # law dx + 3 x - u = 0, dy - x + 40 y = 0 (eigenvalues -3 and -40)
+    lib2 = ImplicitTerms(["x", "y", "u", "dx", "dy"], ("x", "y"), ("u",))
+    coef2 = np.array([[3.0, 0, -1.0, 1.0, 0], [-1.0, 40.0, 0, 0, 1.0]])
+    z = np.array([[0.1, 0.5], [0.2, -0.3]])
+    assert stiffness(coef2, lib2.powers, lib2.deriv, z, np.array([[1.0, 2.0]]),
+                     1e-8) == pytest.approx(40.0, rel=1e-12)
+
+
+def test_the_budget_counts_the_step_rules_simulations():
+    params = {"sim_dt": None}
+    steps, key = SINDyPIDynamical.simulation_steps(params, 4.0)
+    # 1, 0.5, 0.25 and 0.125 ms, and scoring's at 0.25 ms: 19 simulations' worth at 1 ms
+    assert key == "sim_dt" and steps == pytest.approx(4.0 / 1e-3 * 19)
+    assert SINDyPIDynamical.simulation_steps({"sim_dt": 2e-3}, 4.0)[0] == pytest.approx(2000)
+
+
+def test_candidate_steps_above_the_sample_interval_are_simulated_once(mm, monkeypatch):
+    # the clean record is at 100 Hz: 1 and 0.5 ms take 10 and 20 steps per sample, two
+    # simulations; a record sampled at 2 kHz or faster steps once per sample at both: one
+    _, data = mm
+    calls = []
+    real = SINDyPIDynamical._simulate_states
+
+    def counted(self, x0, t, u, dt):
+        calls.append(dt)
+        return real(self, x0, t, u, dt)
+
+    monkeypatch.setattr(SINDyPIDynamical, "_simulate_states", counted)
+    fast = dataclasses.replace(data, fs=5000.0)   # the same samples, read as 5 kHz
+    model = SINDyPIDynamical(library=["1", "x", "x^2", "x^3", "dx", "x*dx"]).fit(fast)
+    assert calls == [1e-3] and model.sim_dt_ == 1e-3 and "moves the simulation by 0 " in model.sim_dt_rule_
+    calls.clear()
+    SINDyPIDynamical(library=["1", "x", "x^2", "x^3", "dx", "x*dx"]).fit(data)
+    assert calls == [1e-3, 5e-4]
+
+
+def _set_law(model: SINDyPIDynamical, names: list[str], states: tuple, inputs: tuple,
+             coef: np.ndarray) -> SINDyPIDynamical:
+    """``model`` (fitted) given the implicit law ``coef`` over the terms ``names``."""
+    model._lib, model._dmap = ImplicitTerms(names, states, inputs), None
+    model.feature_names_, model.coef_ = list(names), np.asarray(coef, dtype=float)
+    return model
+
+
+def test_the_compiled_simulation_is_the_interpreted_one(mm):
+    # the compiled RK4 against the interpreted one it replaced (tests/identify/
+    # dynsim_reference.py, one numpy derivative call per stage): a fitted one-state law, a
+    # two-state law with an input and cross-derivative terms (the solve and the input's
+    # interpolation), and the failures with their times
+    _, data = mm
+    model = SINDyPIDynamical(library=["1", "x", "x^2", "x^3", "dx", "x*dx"]).fit(data)
+    t = np.arange(100) / data.fs   # the first second: the fast part of the decay
+    fast, ref = model.simulate(data.x[:, 0], None, t), simulate_reference(model, data.x[:, 0], t,
+                                                                          None, 1e-3)
+    # 1e-13 of the 2 mM state: the same operations, in another order only where numpy's matmul
+    # and sum group the terms (round-off per stage, 1e3 steps)
+    for a, b in ((fast.x, ref.x), (fast.xd, ref.xd), (fast.xdd, ref.xdd)):
+        np.testing.assert_allclose(a, b, rtol=0, atol=1e-13 * np.max(np.abs(b)))
+    names = ["1", "x", "y", "u", "x*y", "dx", "dy", "x*dx", "y*dy"]
+    law = np.array([[0.0, 1.0, -0.5, -1.0, 0.2, 1.0, 0.1, 0.3, 0.0],
+                    [0.1, -1.0, 1.0, 0.0, 0.0, 0.05, 1.0, 0.0, 0.2]])
+    two = _set_law(SINDyPIDynamical(library=names, sim_dt=2.5e-3), names, ("x", "y"), ("u",), law)
+    t2 = np.arange(300) / 100.0
+    u = np.sin(3.0 * t2)[None, :]
+    fast, ref = two.simulate(np.array([0.5, -0.2]), None, t2, u), simulate_reference(
+        two, np.array([0.5, -0.2]), t2, u, 2.5e-3)
+    assert np.ptp(fast.x, axis=1).min() > 0.1   # it moves
+    for a, b in ((fast.x, ref.x), (fast.xd, ref.xd)):
+        np.testing.assert_allclose(a, b, rtol=0, atol=1e-13 * np.max(np.abs(b)))
+    # failures: dx = x^2 from 1 blows up at t = 1 s; 1 + x dx = 0 is singular at x = 0
+    for coef, x0, what in (([[0.0, 0, -1.0, 0, 1.0, 0]], 1.0, "non-finite"),
+                           ([[1.0, 0, 0, 0, 0, 1.0]], 0.0, "singular")):
+        _set_law(model, model.feature_names_, ("x",), (), np.array(coef))
+        tt = np.arange(300) / 100.0
+        with pytest.raises(DivergenceError, match=what) as got:
+            model.simulate(np.array([x0]), None, tt)
+        with pytest.raises(DivergenceError) as want:
+            simulate_reference(model, np.array([x0]), tt, None, 1e-3)
+        assert str(got.value) == str(want.value) and got.value.time == want.value.time
+
+
+def test_the_start_is_capped_for_a_law_without_bound_on_the_record(mm):
+    # a law whose derivative's coefficient nearly vanishes on the record (x - 0.25 + 1e-6 at
+    # x = 0.25 mM): its stiffness there is ~1e6 1/s, the start stops at MAX_START_HALVINGS
+    _, data = mm
+    model = SINDyPIDynamical(library=["1", "x", "x^2", "x^3", "dx", "x*dx"]).fit(data)
+    _set_law(model, model.feature_names_, ("x",), (), [[0.0, -1.0, 0, 0, -0.25 + 1e-6, 1.0]])
+    scale, why = model._start_scale(np.asarray(data.x), None)
+    assert scale == 0.5 ** MAX_START_HALVINGS and "still above the bound" in why
+
+
+def test_round17_km1em4_clean_passes_at_the_rules_step(dataset_cache):
+    # round 17's mm17_km1em4 clean (Km 1e-4 mM, the shipped noisy setup's weak form at 1 kHz):
+    # the law exact to 2.6e-4; at the old fixed 1 ms step its rollout was 0.617 mM off (RK4
+    # unstable near x*, h |lambda| 5.4), at the rule's step it is the law's own error
+    root = Path(__file__).resolve().parents[2]
+    sc = load_scenario(root / "benchmarks" / "unseen" / "round17" / "mm17_km1em4.toml")
+    sc = dataclasses.replace(sc.with_noise(0.0), seed=84)
+    r = run_scenario(sc, cache=dataset_cache)
+    assert r.passed and not r.scores.failures
+    # 1e-6 mM: 1e-4 of the bar 0.01; measured 1.0e-8 (the fixed 1 ms step: 0.617)
+    assert r.scores.values["state_rmse"] < 1e-6
+    assert r.model.sim_dt_ < 5e-4 and "moves the simulation by" in r.model.sim_dt_rule_
+    # stored with the run as the other rules are (run.json's model_lists, run.npz)
+    assert build_meta(r)["model_lists"]["sim_dt_rule_"] == [r.model.sim_dt_rule_]
+    assert float(build_arrays(r)["model/sim_dt_"]) == r.model.sim_dt_

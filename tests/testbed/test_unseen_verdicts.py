@@ -461,6 +461,7 @@ def test_a_rollout_failed_by_the_identifiers_step_is_named():
     with no reason given.  The verdict stays the scored rollout's; the reason names the step."""
     sc = load_scenario(_root() / "benchmarks" / "unseen" / "round17" / "mm17_km1em4.toml")
     sc.noise["rms_percent"] = 0.0
+    sc.identify["sim_dt"] = 1e-3   # the user's step (the default, the step rule, passes it)
     r = run_scenario(sc)
     assert r.verdict == FAIL and r.scores.values["coef_error"] < 1e-3
     assert r.scores.values["state_rmse"] > 0.1  # the identifier's own rollout, still scored
