@@ -1374,9 +1374,10 @@ def half_step_rollout(score: str, model: Any, data: Measurement, x0: np.ndarray,
                       xd0: np.ndarray | None, reference_x: np.ndarray) -> dict[str, Any]:
     """The scored rollout again at half the identifier's own integration step.
 
-    For an identifier whose ``simulate`` integrates in fixed steps of its parameter ``sim_dt``
-    [s] (``sindy_pi_dynamical``'s RK4): a copy of the fitted model with ``sim_dt / 2`` is
-    simulated as :func:`implicit_rollout` simulates it.  What it gives is a witness, not a
+    For an identifier whose ``simulate`` integrates in fixed steps (``sindy_pi_dynamical``'s
+    RK4): its step is the user's ``sim_dt`` where set, else the fitted ``sim_dt_`` (the step
+    rule's), and a copy of the fitted model with ``sim_dt`` set to half of it is simulated as
+    :func:`implicit_rollout` simulates it.  What it gives is a witness, not a
     score: the scored rollout is the identifier's own; where it fails its bar and the half
     step meets it, the integrator, not the identified equation, failed
     (:func:`step_failures`).  Run only where the scored rollout raised nothing: one more
@@ -1386,9 +1387,11 @@ def half_step_rollout(score: str, model: Any, data: Measurement, x0: np.ndarray,
     -------
     dict
         ``{f"{score}_half_step": largest per-coordinate RMSE (NaN if that simulation failed),
-        "sim_dt": the identifier's step [s]}``; empty for a model without a float ``sim_dt``.
+        "sim_dt": the identifier's step [s]}``; empty for a model without a float step.
     """
     dt = getattr(model, "sim_dt", None)
+    if dt is None:  # the step rule's (a user's sim_dt overrides it)
+        dt = getattr(model, "sim_dt_", None)
     if isinstance(dt, bool) or not isinstance(dt, (int, float)) or not np.isfinite(dt) or dt <= 0:
         return {}
     half = copy.copy(model)  # shallow: only the step differs; the fitted arrays are shared

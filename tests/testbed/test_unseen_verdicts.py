@@ -5,6 +5,7 @@ machine's budget, at default settings."""
 from __future__ import annotations
 
 import dataclasses
+import types
 
 import numpy as np
 import pytest
@@ -15,6 +16,7 @@ from identify.pysindy_pi import PYSINDY_MAX_SAMPLES, PySINDyPI, stride_rule
 from models.cantilever.model import build_model
 from testbed.core.errors import ScenarioError
 from testbed.pipeline.scenario import load_scenario, scenario_from_dict
+from testbed.scoring import scorers
 from testbed.scoring.run import run_scenario
 from testbed.scoring.scorers import (
     FAIL,
@@ -468,6 +470,26 @@ def test_a_rollout_failed_by_the_identifiers_step_is_named():
     why = r.scores.failures["step"]
     assert why.startswith("rollout step: state_rmse 0.6") and "sim_dt 0.001 s -> 0.0005 s" in why
     assert r.scores.details["state_rmse_half_step"] < 1e-4  # [mM]: the same law, half the step
+
+
+def test_the_half_step_witness_halves_the_step_rules_step(monkeypatch):
+    # with sim_dt None (the default since the step rule) the witness halves the fitted sim_dt_;
+    # it read sim_dt alone, so a default run had no witness at all; a user's sim_dt overrides
+    seen = []
+
+    def rollout(score, model, data, x0, xd0, ref):
+        seen.append(model.sim_dt)
+        return None, {score: 1e-6}, {}, {}
+
+    monkeypatch.setattr(scorers, "implicit_rollout", rollout)
+    model = types.SimpleNamespace(sim_dt=None, sim_dt_=2.5e-4)
+    got = scorers.half_step_rollout("state_rmse", model, None, None, None, None)
+    assert seen == [1.25e-4] and got == {"state_rmse_half_step": 1e-6, "sim_dt": 2.5e-4}
+    assert model.sim_dt is None  # the fitted model itself is untouched
+    user = types.SimpleNamespace(sim_dt=1e-3, sim_dt_=2.5e-4)
+    assert scorers.half_step_rollout("state_rmse", user, None, None, None, None)["sim_dt"] == 1e-3
+    assert scorers.half_step_rollout("state_rmse", types.SimpleNamespace(), None, None, None,
+                                     None) == {}
 
 
 def test_step_reason_only_explains_a_failed_bar_the_half_step_meets():
