@@ -8,6 +8,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
+from benchmarks import sindy_pi_problems
 from identify._mechsim import ImplicitModel
 from identify.library import Library
 from identify.sindy_pi import INERTIA_FAILURE, NoSimulationError, SINDyPI, gain_crossing
@@ -80,3 +81,22 @@ def test_none_left_searches_wider_then_names_the_failure():
     assert models == [physical] and keep.tolist() == [True] and combos == [(("w", 1),)]
     with pytest.raises(NoSimulationError, match=INERTIA_FAILURE):
         _rule([crossing], [crossing])
+
+
+def test_where_the_rule_excludes_nothing_the_fit_is_unchanged(monkeypatch):
+    # the synthetic five-bar (exact, 1 kHz, 4 s) chosen by rollout: every shortlisted pair
+    # keeps its reduced inertia, and the pair, its coefficients and its score are those of the
+    # selection without the rule, bit for bit
+    data = sindy_pi_problems.fivebar(duration=4.0, fs=1e3, amp=1.0).data
+    on = SINDyPI(selection="rollout").fit(data)
+    assert on.inertia_rule_.endswith("none excluded")
+    monkeypatch.setattr(SINDyPI, "_inertia_rule_on", False)
+    off = SINDyPI(selection="rollout").fit(data)
+    assert off.inertia_rule_ == "not applied: off for this identifier"
+    assert np.array_equal(on.coef_, off.coef_) and on.rollout_rmse_ == off.rollout_rmse_
+
+
+def test_held_out_selection_states_the_rule_unused():
+    data = sindy_pi_problems.fivebar(duration=4.0, fs=1e3, amp=1.0).data
+    m = SINDyPI().fit(data)
+    assert m.selection_ == "holdout" and m.inertia_rule_.startswith("not applied: models chosen")
