@@ -1554,6 +1554,11 @@ class SINDyPI(_ImplicitMechanical):
         error over the trimmed record from its first measured state [rad]; else None.
     replay_rule_ : str
         Whether the replay rule applied, the replay and its bar, and what it decided.
+    inertia_rule_ : str
+        The rollout selection's inertia rule (:meth:`_ImplicitMechanical._inertia_rule`) in
+        the final fit: whether it applied, how many shortlisted combinations keep the sign of
+        their input gain's determinant on the record's states, the times at which the others'
+        reduced inertia vanishes, and what the wider search found.
     formulation_rule_ : str
         The open chain's form comparison (:meth:`_open_chain_form`): whether it applied, both
         forms' segmented rollout errors [rad or m] and the form kept.
