@@ -277,7 +277,77 @@ class ImplicitModel:
         _check(st)
         return ddq
 
-    def _complete(self, q: np.ndarray, dq: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def gain_determinants(self, q: np.ndarray, dq: np.ndarray,
+                          u_scale: np.ndarray) -> tuple[np.ndarray | None, int, str]:
+        """The determinant of the input gain ``d ddq_s / du`` at every state (the model's
+        reduced inverse inertia, up to the inputs' scales), for as many inputs as solved
+        coordinates.
+
+        The equations are affine in the inputs, so the gain's column k is exactly the
+        accelerations under input ``u_scale[k] e_k`` less those under no input
+        (:func:`identify._compiled.accelerations_many`, one pass over the states per input
+        and one without); its determinant is that of ``d ddq_s / du`` times the product of
+        ``u_scale`` (> 0), so it has the gain's sign.
+
+        Parameters
+        ----------
+        q, dq : ndarray, shape (n, N)
+            States [rad, rad/s] (passive rows as measured; the closure gives their accelerations).
+        u_scale : ndarray, shape (m,)
+            Positive input steps (the inputs' units; their RMS keeps the differences well
+            above round-off).
+
+        Returns
+        -------
+        det : ndarray, shape (N,), or None
+            The determinants; None where they are not defined: the gain is not square (an
+            open chain's passive coordinates are solved too) or a state stopped the kernel.
+        index : int
+            The first state the kernel could not solve (-1: none).
+        status : str
+            ``""``, ``"singular"`` (the equations are singular in the accelerations at
+            ``index``: the gain is infinite there) or the closure's message (the loop closure
+            is singular at a state: the determinant is undefined for every model alike).
+        """
+        kern = _kernels()
+        m, act = self.library.n_inputs, self.actuated
+        if m != act.size or m == 0:
+            return None, -1, "not square"
+        q = np.ascontiguousarray(q, dtype=float)
+        dq = np.ascontiguousarray(dq, dtype=float)
+        coef, acc_index, arg, is_sin, idx, _, has, a, _, p0, p1, active = self._args()
+        U = np.zeros((m, q.shape[1]))
+        cols = []
+        for k in range(-1, m):
+            if k >= 0:
+                U[k] = u_scale[k]
+            ddq = np.empty_like(q)
+            st, s = kern.accelerations_many(q, dq, U, coef, acc_index, arg, is_sin, idx, act,
+                                            has, a, p0, p1, active, ddq)
+            if st == kern.SINGULAR_EQUATIONS:
+                return None, int(s), "singular"
+            if st != kern.OK:
+                return None, int(s), kern.MESSAGES[st]
+            cols.append(ddq[act])
+            if k >= 0:
+                U[k] = 0.0
+        G = np.stack([c - cols[0] for c in cols[1:]], axis=1)  # (m, m, N): row, input, state
+        if m == 1:
+            return G[0, 0], -1, ""
+        if m == 2:  # explicit: no LAPACK kernel decides a sign
+            return G[0, 0] * G[1, 1] - G[0, 1] * G[1, 0], -1, ""
+        return np.linalg.det(np.moveaxis(G, -1, 0)), -1, ""
+
+    def complete(self, q: np.ndarray, dq: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Consistent states (n, N): the passive angles and rates the loop closure gives for
+        the actuated ones of ``q``, ``dq`` (Newton from ``q``'s passive rows), as every
+        simulation completes them; unchanged without a closure.
+
+        Raises
+        ------
+        IdentificationError
+            The closure does not assemble (or is singular) at some state.
+        """
         if self.closure is None:
             return q, dq
         q = self.closure.solve(q)
@@ -320,7 +390,7 @@ class ImplicitModel:
         delay = 0.5 * (t[1] - t[0]) if input_hold == "zoh" and t.size > 1 else 0.0
         uu = None if u is None else np.stack([np.interp(tt - delay, t, row) for row in np.atleast_2d(u)])
         act = self.actuated
-        q, dq = self._complete(np.array(x0, float)[:, None], np.array(xd0, float)[:, None])
+        q, dq = self.complete(np.array(x0, float)[:, None], np.array(xd0, float)[:, None])
         n = q.shape[0]
         Q = np.empty((n_steps + 1, n))
         DQ, DDQ = np.empty_like(Q), np.empty_like(Q)
@@ -341,7 +411,7 @@ class ImplicitModel:
         try:
             if angles_only:
                 return Trajectory(x if self.closure is None else self.closure.solve(x), None, None)
-            x, xd = self._complete(x, xd)
+            x, xd = self.complete(x, xd)
             u_t = None if u is None else np.atleast_2d(u)
             return Trajectory(x, xd, self.accelerations(x, xd, u_t))
         except DivergenceError:

@@ -53,6 +53,16 @@ family geometries at 1 % noise with chain-derived rates 27 -> 29 / 30 within 0.0
 30 family five-bars with chain-derived rates (clean and 1 %) and with recorded rates (clean
 and 1 %) unchanged, value for value.
 
+Inertia rule (:meth:`_ImplicitMechanical._inertia_rule`, ``inertia_rule_``; SINDy-PI only, not
+the pysindy peer): before the rollout selection simulates its shortlist, a combination whose
+input gain ``d ddq_a / du`` changes the sign of its determinant on the record's states (the
+measured actuated states, the passive ones by the loop closure) is left out: a mechanism's
+reduced inertia cannot vanish where its chain assembles, and every simulation through such a
+state blows up.  Where none is left the ``WIDE_ROLLOUT`` best per input are searched; where
+none is left there either the fit fails with :data:`INERTIA_FAILURE` (after the unpruned
+library's refit).  Open chains (more solved coordinates than inputs) and the held-out
+selection are not reached (the replay rule simulates the held-out choice).
+
 Underactuated open chains (a cart-pole: inputs on some coordinates, no loop; the loop closure
 is used only where the data declare one, :func:`closed_chain`): one equation per coordinate. An
 actuated coordinate's as above; a passive coordinate's has no input term, so its candidates
@@ -172,6 +182,31 @@ ROLLOUT_ATOL = 1e-4
 #: about its first measured value does not replay the record (closed chains:
 #: :meth:`_ImplicitMechanical._replays_record`).  1: the model that never moves.
 REPLAY_REST_RATIO = 1.0
+
+#: The inertia rule's wider search [-]: where no shortlisted combination keeps its reduced
+#: inertia on the record, the ``WIDE_ROLLOUT`` best models per input are searched (the bound
+#: of ``n_rollout``, 10: 100 pairs for two inputs), and at most the shortlist's number of
+#: combinations that pass, nearest the top of the held-out ranking, are simulated.
+WIDE_ROLLOUT = 10
+
+#: The fit's error where no candidate keeps its reduced inertia on the record.
+INERTIA_FAILURE = "every candidate model's reduced inertia vanishes on the record"
+
+
+def gain_crossing(det: np.ndarray) -> int:
+    """The first state at which the input gain's determinant ``det`` (N,) is zero, not finite
+    or of the other sign than at the first state; -1 where it keeps one strict sign.
+
+    A mechanism's reduced inertia is positive definite wherever its chain assembles, so the
+    determinant of ``d ddq_a / du`` (its inverse, up to the inputs' scales) keeps one sign
+    along any recorded path; a model whose determinant crosses zero (or passes through a
+    pole: the equations singular in the accelerations) there is no model of it."""
+    det = np.asarray(det, dtype=float)
+    if det.size == 0:
+        return -1
+    s0 = np.sign(det[0])
+    bad = ~np.isfinite(det) | (np.sign(det) != s0) | (s0 == 0)
+    return int(np.argmax(bad)) if bad.any() else -1
 
 
 NAMED_LIBRARIES = ("fivebar", "fivebar_full", "generic")
@@ -817,6 +852,9 @@ class _ImplicitMechanical(Identifier):
 
     kind = "mechanical"
     prior_keys = LoopClosure.PRIOR_KEYS
+    #: The inertia rule of the rollout selection (:meth:`_inertia_rule`): SINDy-PI's own; the
+    #: pysindy peer keeps the selection it was measured with.
+    _inertia_rule_on: ClassVar[bool] = False
 
     def _sweep(self, G_train: np.ndarray, G_val: np.ndarray, cand: np.ndarray,
                Theta_train: np.ndarray) -> Sweep:
@@ -1015,11 +1053,22 @@ class _ImplicitMechanical(Identifier):
         self.record_replays_ = None
         self.record_rule_ = ("not applied: models chosen by held-out error"
                              if selection != "rollout" else "")
+        self.inertia_rule_ = "not applied: " + (
+            "models chosen by held-out error" if selection != "rollout" else
+            "off for this identifier" if not self._inertia_rule_on else
+            "an open chain (more solved coordinates than inputs)" if open_chain else "")
         if selection == "rollout":
             combos = list(product(*picks))
             models = [ImplicitModel(lib, build(combo), solved, self.closure_) for combo in combos]
-            scores = [self._rollout_error(m, data, i0, self._knob("rollout_segments"))
-                      for m in models]
+            keep = np.ones(len(models), dtype=bool)
+            if self.inertia_rule_ == "not applied: ":
+                combos, models, keep = self._inertia_rule(
+                    combos, models, data,
+                    lambda: select_models(sw, loc_cols, self.selection_rtol,
+                                          self.selection_atol, WIDE_ROLLOUT),
+                    lambda combo: ImplicitModel(lib, build(combo), solved, self.closure_))
+            scores = [self._rollout_error(m, data, i0, self._knob("rollout_segments")) if k
+                      else np.inf for m, k in zip(models, keep, strict=True)]
             if not np.isfinite(min(scores)):
                 self.record_rule_ = "not reached: no shortlisted combination simulated its segments"
                 self.record_replays_ = np.zeros(len(models), dtype=bool)
@@ -1045,6 +1094,114 @@ class _ImplicitMechanical(Identifier):
         self.model_ = ImplicitModel(lib, self.coef_, solved, self.closure_)
         self._choose_sim_dt(data)
         return self
+
+    def _inertia_rule(self, combos: list[tuple], models: list[ImplicitModel], data: Measurement,
+                      wider: Callable[[], list[list[tuple[int, int]]]],
+                      make: Callable[[tuple], ImplicitModel]
+                      ) -> tuple[list[tuple], list[ImplicitModel], np.ndarray]:
+        """The inertia rule of the rollout selection (``inertia_rule_``): the combinations
+        whose reduced inertia vanishes on the record's states are not simulated.
+
+        Rule: a mechanism's reduced inertia (the actuated coordinates' mass matrix after the
+        loop closure) is positive definite wherever its chain assembles, so the determinant
+        of a model's input gain ``d ddq_a / du`` keeps one sign along the recorded path
+        (:func:`gain_crossing` on :meth:`ImplicitModel.gain_determinants` at the measured
+        actuated states, every ``0.5 sim_dt fs``-th one (the half step at which the RK4
+        simulations evaluate the model: a narrower excursion they step over too; 5x fewer
+        states at 10 kHz and 1 ms: 0.25-0.29 s of CPU per call on a 10 s record, about 1.5 s at
+        every state),
+        with the passive ones the loop closure gives, as every simulation
+        completes them (:meth:`ImplicitModel.complete`): off the closure's manifold the
+        library's loop identities do not cancel, and on the measured noisy passive angles a
+        determinant of -4e-7 read +1e-3 on ``fb15_cranks_0p8_1p5_3s`` at 5 %; the sign itself
+        is not fixed: along one path the input is a function of the state, and exact pairs
+        of both signs fit one record).  A
+        combination whose determinant changes sign there (or that cannot be solved for the
+        accelerations at some recorded state) blows up in every simulation through that
+        state: no model of the record.  Where no shortlisted combination is left, the
+        ``WIDE_ROLLOUT`` best models per input (``wider``) are searched, and the combinations
+        left there, at most as many as the shortlist held, nearest the top of the held-out
+        ranking (the largest, then the summed, rank of their equations), are simulated; where
+        none is left there either, :class:`NoSimulationError` names the failure
+        (:data:`INERTIA_FAILURE`).  Where the closure cannot be evaluated at a recorded state
+        (collinear passive links) the rule cannot judge: every combination is kept.
+        Measured (2026-11-28, session 19; docs/known-gaps.md "SINDy-PI: the inertia rule"):
+        137 five-bar cells of rounds 14-17 and the five shipped five-bar scenarios, 118 -> 120
+        passes (``fb17_all_diff_ground_short`` 3 % and ``fb16_amp_0p2`` 4 % from the wider
+        search), none lost; the rule acted on 62 (49 unchanged to the bit, 3 passes moved,
+        8 failures now named otherwise); the 30 family five-bars clean and 1 % never reach it
+        (held-out selection).
+
+        Returns
+        -------
+        combos, models : list
+            The combinations to score (the shortlist, or the wider search's).
+        keep : ndarray of bool
+            Which of them the rule keeps (the others are scored inf).
+        """
+        u = np.asarray(data.u, dtype=float)[:self._library_.n_inputs]
+        scale = np.sqrt(np.mean(u ** 2, axis=1))
+        scale = np.where(np.isfinite(scale) & (scale > 0), scale, 1.0)
+        # every recorded state the simulations' RK4 stages resolve: a stride of half the step
+        stride = max(1, int(0.5 * self._step() * data.fs + 1e-9))
+        try:  # the states the models are simulated through: the closure's passive rows
+            q, dq = models[0].complete(np.asarray(data.x, dtype=float)[:, ::stride],
+                                       np.asarray(data.xd, dtype=float)[:, ::stride])
+        except IdentificationError as exc:
+            self.inertia_rule_ = f"not applied: the loop closure at the recorded states: {exc}"
+            return combos, models, np.ones(len(models), dtype=bool)
+
+        def judge(ms: list[ImplicitModel]) -> tuple[np.ndarray, list[float], str]:
+            keep, when = np.ones(len(ms), dtype=bool), []
+            for i, m in enumerate(ms):
+                det, s, why = m.gain_determinants(q, dq, scale)
+                j = s if why == "singular" else gain_crossing(det) if det is not None else -1
+                if det is None and why not in ("singular", "not square"):
+                    return np.ones(len(ms), dtype=bool), [], why  # the closure: no judgement
+                if j >= 0:
+                    keep[i] = False
+                    when.append(float(data.t[j * stride]))
+            return keep, when, ""
+
+        keep, when, why = judge(models)
+        if why:
+            self.inertia_rule_ = f"not applied: at a recorded state the {why}"
+            return combos, models, keep
+        head = (f"{int(keep.sum())} of {keep.size} shortlisted combinations keep the sign of "
+                "their input gain's determinant on the record's states")
+        if keep.all():
+            self.inertia_rule_ = f"{head}: none excluded"
+            return combos, models, keep
+        lost = (f"(reduced inertia vanishing at t = {min(when):.4g} - {max(when):.4g} s)")
+        if keep.any():
+            self.inertia_rule_ = f"{head}: the others excluded {lost}"
+            return combos, models, keep
+        wide = wider()
+        seen = set(combos)
+        extra = [c for c in product(*wide) if c not in seen]
+        rank = [{p: r for r, p in enumerate(w)} for w in wide]
+        extra.sort(key=lambda c: (max(rk[p] for rk, p in zip(rank, c, strict=True)),
+                                  sum(rk[p] for rk, p in zip(rank, c, strict=True)),
+                                  [rk[p] for rk, p in zip(rank, c, strict=True)]))
+        xmodels = [make(c) for c in extra]
+        xkeep, _, xwhy = judge(xmodels)
+        if xwhy:
+            xkeep[:] = False
+        take = np.flatnonzero(xkeep)[:len(combos)]
+        wide_head = (f"{head}: none {lost}; {int(xkeep.sum())} of {len(extra)} more among the "
+                     f"{WIDE_ROLLOUT} best per input keep it")
+        if take.size == 0:
+            self.inertia_rule_ = f"{wide_head}: {INERTIA_FAILURE}"
+            self.record_rule_ = "not reached: " + INERTIA_FAILURE
+            self.record_replays_ = np.zeros(len(models), dtype=bool)
+            self._record_finite = self.record_replays_
+            raise NoSimulationError(
+                f"{INERTIA_FAILURE} (the determinant of its input gain d ddq_a / du changes "
+                f"sign on the record's states, {len(models) + len(extra)} combinations of the "
+                f"{WIDE_ROLLOUT} best per input)")
+        self.inertia_rule_ = f"{wide_head}: the first {take.size} of those simulated"
+        return ([extra[i] for i in take], [xmodels[i] for i in take],
+                np.ones(take.size, dtype=bool))
 
     def _choose_input_hold(self, data: Measurement) -> None:
         """``input_hold_``: the user's, else the data's declared hold
@@ -1397,6 +1554,11 @@ class SINDyPI(_ImplicitMechanical):
         error over the trimmed record from its first measured state [rad]; else None.
     replay_rule_ : str
         Whether the replay rule applied, the replay and its bar, and what it decided.
+    inertia_rule_ : str
+        The rollout selection's inertia rule (:meth:`_ImplicitMechanical._inertia_rule`) in
+        the final fit: whether it applied, how many shortlisted combinations keep the sign of
+        their input gain's determinant on the record's states, the times at which the others'
+        reduced inertia vanishes, and what the wider search found.
     formulation_rule_ : str
         The open chain's form comparison (:meth:`_open_chain_form`): whether it applied, both
         forms' segmented rollout errors [rad or m] and the form kept.
@@ -1413,6 +1575,7 @@ class SINDyPI(_ImplicitMechanical):
     """
 
     name = "sindy_pi"
+    _inertia_rule_on = True
     deterministic = True  # ensembles drawn from ``ensemble_seed``; refitted to the bit in test_conformance
     hyperparameters: ClassVar[dict[str, Field]] = ordered_fields({
         **COMMON_HYPERPARAMETERS,

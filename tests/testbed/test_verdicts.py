@@ -285,15 +285,17 @@ def test_fivebar_sine_replay_at_30_percent_keeps_its_declared_closure(tmp_path, 
 def test_fivebar_noisy_sine_replay_fit_failure_is_scored(tmp_path, dataset_cache):
     from testbed.cli import EXIT_FAIL, main
 
-    # round 15's 2 s record (a third of the sine's period) at 1 %: no shortlisted combination
-    # of the implicit models simulates its segments (measured 2026-11-28; the 30 % sine replay
-    # that failed here before keeps its closure since session 18, above)
+    # round 15's 2 s record (a third of the sine's period) at 1 %: every candidate pair's
+    # reduced inertia vanishes on the record (SINDy-PI's inertia rule, session 19; before it
+    # "no shortlisted model combination could be simulated"; the 30 % sine replay that failed
+    # here before keeps its closure since session 18, above)
     base = ROUND15 / "fb15_cranks_0p5_1_2s.toml"
     path = tmp_path / "noisy_sine.toml"
     path.write_text(f'[scenario]\nname = "noisy_sine"\nextends = "{base}"\nseed = 61\n'
                     '[noise]\nrms_percent = 1\n')
     result = run_scenario(load_scenario(str(path)), cache=dataset_cache)
-    assert result.failure.startswith("fit failed: no shortlisted model combination could be simulated")
+    assert result.failure.startswith("fit failed: every candidate model's reduced inertia "
+                                      "vanishes on the record")
     assert all(math.isnan(v) for v in result.scores.values.values())
     assert result.verdict == FAIL and "fit failed" in table_text(result)
     run = load_run(save_run(result, tmp_path / "run", figures=save_run_figures))  # renders without a fit
