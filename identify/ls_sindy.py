@@ -597,7 +597,7 @@ class LeastSquaresSINDy(StructuralIdentifier):
         held = decay_hold(data, self.M_, self.C_, self.K_, (i0, i1),
                           lambda on, lam: set_eigenvalues(self.M_, self.K_, np.where(on, lam, np.nan)),
                           self.decay_hold, self.K3_, self.decay_backbone,
-                          self._unlocated(peaks))
+                          self._unlocated(peaks), self.eigen_targets_)
         if held.decay is not None:
             self.modal_decay_ = held.decay
         self.coef_[:, v_block] -= (held.C - self.C_) / m
