@@ -764,7 +764,8 @@ def decay_hold(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndarray,
                window: tuple[int, int],
                set_frequencies: Callable[[np.ndarray, np.ndarray], np.ndarray],
                enabled: bool = True, K3: np.ndarray | None = None,
-               backbone: bool = True, unlocated: np.ndarray | None = None) -> DecayHold:
+               backbone: bool = True, unlocated: np.ndarray | None = None,
+               peaks_hz: np.ndarray | None = None) -> DecayHold:
     """The decay hold of ``sgd_sindy`` and ``ls_sindy`` on a fitted linear model.
 
     Each mode gets the damping of its measured free decay (:func:`modal_decay`,
@@ -816,6 +817,15 @@ def decay_hold(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndarray,
         nearer another mode's than its own: that fit followed the other mode's leakage
         (clamped family member 033 at 1 % noise: the model's unlocated mode 4, 452.7 Hz, took
         412.8 Hz, its mode 3's, and mode 2's pairing went 0.06 -> 2.4 % off).
+    peaks_hz : ndarray, shape (n,), optional
+        The measured spectral peak each mode is paired with [Hz], in the model's domain (warped
+        like the model with trapezoid integrals), 0 where none (the identifiers'
+        ``eigen_targets_``).  A mode whose measured decay lies within one line (plus the
+        spectral-peak offset) of its peak takes the decay's frequency wherever the model's
+        lies: two measurements agree to the spectrum's resolution, and the fit's frequency of
+        the mode is the one that does not (clamped family member 009, ``sgd_sindy``: peak
+        72.32 Hz, decay 72.33 Hz, the fit's 70.29 Hz, 2.04 Hz away against one line of 2.03).
+        None: every frequency moves within one line of the model's only.
 
     Returns
     -------
@@ -845,6 +855,10 @@ def decay_hold(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndarray,
     # peak, which a hardening response moves), so its bound is the line alone ("Cubic library")
     offset = 0.0 if with_backbone else peak_offset(dec.sigma_model, dec.lam_model)
     near = dec.shift <= line + offset
+    if peaks_hz is not None and not with_backbone:  # the decay agrees with the mode's peak
+        pk = np.asarray(peaks_hz, dtype=float)
+        f_dec = np.sqrt(dec.lam_model) / (2.0 * np.pi)
+        near |= (pk > 0) & (np.abs(f_dec - pk) <= line + offset)
     on = dec.taken & (near | free)
     unexplained = np.zeros_like(on)
     beyond = np.zeros_like(on)

@@ -95,7 +95,11 @@ class LeastSquaresSINDy(StructuralIdentifier):
        (:func:`identify._modal_damping.set_eigenvalues`).
     3. *Decay hold* (``decay_hold``, sgd_sindy's rule, :mod:`identify._modal_damping`): each
        mode's damping from its measured free decay through the model's modes, its frequency
-       too when that lies within one line of the model's.  Clean clamped beams lost mode 1
+       too when that lies within one line of the model's, or of the peak step 2 paired the
+       mode with (``peaks_hz`` of :func:`identify._modal_damping.decay_hold`: the decay and
+       the peak agree, the fit's frequency does not; 2026-11-28, family issue bars clean
+       51 -> 52 of 60, soft 019 mode 1 5.05 -> 0.46 %; 1 % 39 -> 43; none lost).  Clean
+       clamped beams lost mode 1
        to 1.1-2.8 % and TRAC down to 0.79 without it (members 005, 008, 009, 012, 025).
        A mode step 2 paired with no measured peak (``eigen_targets_`` 0) takes its decay's
        frequency wherever it lies (``unlocated`` of :func:`identify._modal_damping.decay_hold`):
@@ -597,7 +601,7 @@ class LeastSquaresSINDy(StructuralIdentifier):
         held = decay_hold(data, self.M_, self.C_, self.K_, (i0, i1),
                           lambda on, lam: set_eigenvalues(self.M_, self.K_, np.where(on, lam, np.nan)),
                           self.decay_hold, self.K3_, self.decay_backbone,
-                          self._unlocated(peaks))
+                          self._unlocated(peaks), self.eigen_targets_)
         if held.decay is not None:
             self.modal_decay_ = held.decay
         self.coef_[:, v_block] -= (held.C - self.C_) / m

@@ -1257,6 +1257,12 @@ class SGDSINDy(SGDSINDyBase):
             return None
         return t == 0
 
+    def _paired_peaks(self) -> np.ndarray | None:
+        """The measured peak [Hz] the eigenvalue penalty paired each mode with (warped like
+        the model; 0 = none), for the decay hold; None where it paired none."""
+        t = np.asarray(getattr(self, "eigen_targets_", np.empty(0)), dtype=float)
+        return t if t.size == self.M_.shape[0] and np.any(t > 0) else None
+
     def _hold_decay(self, data: Measurement, est: MatrixSGDSettings, m: np.ndarray,
                     v_block: slice, d_block: slice) -> None:
         """With ``decay_hold``, give each mode the pole of its measured free decay
@@ -1281,7 +1287,7 @@ class SGDSINDy(SGDSINDyBase):
 
         held = decay_hold(data, self.M_, self.C_, self.K_, fit_window(data, est.fit_duration),
                           set_frequencies, self.decay_hold, self.K3_, self.decay_backbone,
-                          self._unlocated())
+                          self._unlocated(), self._paired_peaks())
         if held.decay is not None:
             self.modal_decay_ = held.decay
         self.coef_[:, v_block] -= (held.C - self.C_) / m

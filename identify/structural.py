@@ -1107,8 +1107,73 @@ def warp_frequency(f_hz: np.ndarray, fs: float) -> np.ndarray:
     return fs / np.pi * np.tan(np.pi * f / fs)
 
 
-def unwarp_trapezoid(M: np.ndarray, C: np.ndarray, K: np.ndarray, fs: float
-                     ) -> tuple[np.ndarray, np.ndarray] | None:
+#: Relative distance [-] from the real axis within which a pole ``q = p / (2 fs)`` with
+#: ``|Re q| >= 1`` lies on the trapezoid map's cut (:func:`on_trapezoid_cut`).  A critically
+#: damped mode is a double real pole, which round-off returns either as two real poles or as
+#: a complex pair split off the axis by about ``sqrt(eps ||A|| / |p|)`` relative: 1.2e-8 on
+#: the constructed 2-DOF model of ``tests/identify/test_trapezoid_unwarp.py``, 1.8e-7 on round
+#: 16's ``b16_ti_n32_s5`` (its mode placed critically damped at q = -1.11, session 18); 1e-4
+#: holds ``||A|| / |p|`` up to 4e7.  The image of a pole that near the cut would be a mode
+#: within about 1e-4 / (|Re q| - 1) of the Nyquist frequency, which no record resolves.
+TRAPEZOID_CUT_TOL = 1e-4
+
+
+def on_trapezoid_cut(q: np.ndarray) -> np.ndarray:
+    """Which poles lie on the cut of the trapezoid map (:func:`unwarp_trapezoid`).
+
+    Parameters
+    ----------
+    q : ndarray, shape (m,)
+        Poles divided by twice the sample rate, ``p / (2 fs)`` [-].
+
+    Returns
+    -------
+    ndarray of bool, shape (m,)
+        ``|Re q| >= 1`` and ``|Im q| <= TRAPEZOID_CUT_TOL |q|``: a real pole at ``|p| >= 2
+        fs``, which no continuous pole maps to (``|tanh| < 1`` on the real axis), or one that
+        round-off moved off the axis (:data:`TRAPEZOID_CUT_TOL`).
+    """
+    q = np.asarray(q, dtype=complex)
+    return (np.abs(q.real) >= 1.0) & (np.abs(q.imag) <= TRAPEZOID_CUT_TOL * np.abs(q))
+
+
+def _map_keeping_cut(A: np.ndarray, p: np.ndarray, V: np.ndarray, fs: float) -> np.ndarray | None:
+    """:func:`unwarp_trapezoid`'s map with ``keep_cut``: from the companion matrix ``A``
+    (shape (2n, 2n), [1/s]) with eigenvalues ``p`` and eigenvectors ``V`` (``linalg.eig``), the
+    one whose poles off the cut are ``2 fs artanh(p / (2 fs))`` with their shapes kept and
+    whose invariant subspace of the poles on the cut (:func:`on_trapezoid_cut`) is ``A``'s,
+    restriction and all; None where the two sets of shapes do not span the state space.
+
+    The poles on the cut are not diagonalised: a double real pole (a critically damped mode)
+    is a defective eigenproblem whose eigenvectors round-off returns parallel or not (10 of
+    753 constructed models gave a singular eigenvector matrix).  Their subspace comes from the
+    ordered Schur form instead, ``[X; X T]`` as every invariant subspace of a companion matrix
+    is, and the mapped modes' eigenvectors ``[psi; p psi]`` become ``[psi; s psi]``.
+    Velocities are counted in units of ``2 fs`` (the test of the spanning is then not one of
+    the state's units)."""
+    n = A.shape[0] // 2
+    cut = on_trapezoid_cut(p / (2.0 * fs))
+    unit = 2.0 * fs
+    T, Z, k = linalg.schur(A.astype(complex), output="complex",
+                           sort=lambda z: bool(on_trapezoid_cut(np.array([z / unit]))[0]))
+    if k != np.count_nonzero(cut):  # the two eigensolvers disagree on the cut: no map
+        return None
+    s = unit * np.arctanh(p[~cut] / unit)
+    psi, X = V[:n, ~cut], Z[:n, :k]
+    W = np.block([[psi, X], [psi * (s / unit), X @ T[:k, :k] / unit]])
+    if np.linalg.cond(W) > 1e12:  # the shapes do not span the state space
+        return None
+    B = np.zeros((2 * n, 2 * n), dtype=complex)
+    B[: s.size, : s.size] = np.diag(s / unit)
+    B[s.size:, s.size:] = T[:k, :k] / unit
+    A_s = unit * (W @ B @ np.linalg.inv(W))  # in [x; x' / unit] coordinates, then back
+    A_s[n:, :n] *= unit
+    A_s[:n, n:] /= unit
+    return A_s
+
+
+def unwarp_trapezoid(M: np.ndarray, C: np.ndarray, K: np.ndarray, fs: float,
+                     keep_cut: bool = False) -> tuple[np.ndarray, np.ndarray] | None:
     """Damping and stiffness whose poles are those of a model fitted to trapezoid integrals, mapped back.
 
     Parameters
@@ -1119,16 +1184,24 @@ def unwarp_trapezoid(M: np.ndarray, C: np.ndarray, K: np.ndarray, fs: float
         "trapezoid"``).
     fs : float
         Sample rate [Hz].
+    keep_cut : bool
+        False: None when a pole lies on or beyond the map's range (a real pole at ``|p| >= 2
+        fs``).  True: such poles, and those round-off moved off the real axis
+        (:func:`on_trapezoid_cut`), are kept as fitted and every other pole is mapped back,
+        so that whether the resolved modes are mapped does not depend on how round-off
+        returns a double real pole (the structural identifiers' rule).
 
     Returns
     -------
     (C, K) : tuple of ndarray, shape (n, n), or None
         ``M`` is kept.  The second-order model whose 2n poles are ``2 fs artanh(p / (2 fs))``
-        for the identified poles ``p`` and whose mode shapes are the identified ones.  Symmetric
+        for the identified poles ``p`` (``p`` itself for a pole on the cut kept by
+        ``keep_cut``) and whose mode shapes are the identified ones.  Symmetric
         when the given ``C`` and ``K`` are (the part of a non-proportional damping that
         would break the symmetry, second order in the correction, is dropped).  None when a
-        pole lies on or beyond the map's range (a real pole at ``|p| >= 2 fs``: such a model
-        has no continuous counterpart) or the modes do not span the state space.
+        pole lies on or beyond the map's range and ``keep_cut`` is False (a real pole at
+        ``|p| >= 2 fs``: such a model has no continuous counterpart) or the modes do not span
+        the state space.
 
     Notes
     -----
@@ -1154,16 +1227,21 @@ def unwarp_trapezoid(M: np.ndarray, C: np.ndarray, K: np.ndarray, fs: float
         return None
     p, V = linalg.eig(A)
     q = p / (2.0 * fs)
-    if np.any((np.abs(q.imag) < 1e-12 * (1.0 + np.abs(q))) & (np.abs(q.real) >= 1.0)):
-        return None
-    s = 2.0 * fs * np.arctanh(q.astype(complex))
-    psi = V[:n]
-    W = np.vstack([psi, psi * s])
-    if np.linalg.cond(W) > 1e12:  # defective: the shapes do not span the state space
-        return None
-    A_s = (W * s) @ np.linalg.inv(W)
-    if np.abs(A_s.imag).max() > 1e-8 * np.abs(A_s).max():  # poles not in conjugate pairs
-        return None
+    if keep_cut and np.any(on_trapezoid_cut(q)):
+        A_s = _map_keeping_cut(A, p, V, fs)
+        if A_s is None:
+            return None
+    else:  # no pole on the cut (keep_cut then maps as before, to the bit)
+        if np.any((np.abs(q.imag) < 1e-12 * (1.0 + np.abs(q))) & (np.abs(q.real) >= 1.0)):
+            return None
+        s = 2.0 * fs * np.arctanh(q.astype(complex))
+        psi = V[:n]
+        W = np.vstack([psi, psi * s])
+        if np.linalg.cond(W) > 1e12:  # defective: the shapes do not span the state space
+            return None
+        A_s = (W * s) @ np.linalg.inv(W)
+        if np.abs(A_s.imag).max() > 1e-8 * np.abs(A_s).max():  # poles not in conjugate pairs
+            return None
     A_s = A_s.real
     C_new, K_new = -M @ A_s[n:, n:], -M @ A_s[n:, :n]
     if np.allclose(C, C.T, rtol=1e-12, atol=0.0) and np.allclose(K, K.T, rtol=1e-12, atol=0.0):
@@ -1194,14 +1272,24 @@ class StructuralIdentifier(Identifier):
         ``integration_rule_``."""
         self.integration_rule_ = "signals are exact derivatives: no mapping"
         if data is not None and data.integration == "trapezoid":
-            out = unwarp_trapezoid(self.M_, self.C_, self.K_, float(data.fs))
+            fs = float(data.fs)
+            try:
+                n_cut = int(np.count_nonzero(on_trapezoid_cut(
+                    linalg.eigvals(state_matrix(self.M_, self.C_, self.K_)) / (2.0 * fs))))
+            except (np.linalg.LinAlgError, ValueError):
+                n_cut = 0
+            out = unwarp_trapezoid(self.M_, self.C_, self.K_, fs, keep_cut=True)
             if out is None:
-                self.integration_rule_ = ("trapezoid integrals, poles left warped: a pole "
-                                          "outside the bilinear map's range")
+                self.integration_rule_ = ("trapezoid integrals, poles left warped: no state "
+                                          "matrix, or modes that do not span the state space")
             else:
                 self.C_, self.K_ = out
                 self.integration_rule_ = ("trapezoid integrals: poles mapped back by "
                                           "s = 2 fs artanh(p / (2 fs))")
+                if n_cut:
+                    self.integration_rule_ += (
+                        f"; {n_cut} pole(s) on the map's cut (real, |p| >= 2 fs, or within "
+                        f"{TRAPEZOID_CUT_TOL:g} of it by round-off) kept as fitted")
         self.natural_frequencies_, self.modes_ = modal(self.M_, self.K_)
 
     def _check_fitted(self) -> None:

@@ -515,3 +515,32 @@ def test_the_fit_pole_rule_acts_only_on_a_negative_own_damping_where_the_hold_gr
     assert not md._grows(M, held.C, K)
     assert "whose own modal damping the fit made negative" not in held.rule
 
+
+
+def test_decay_agreeing_with_the_modes_peak_moves_it_beyond_one_line(chain):
+    """A mode whose measured decay lies within one line of its paired spectral peak takes the
+    decay's frequency although the model's lies 1.5 lines away (``peaks_hz``); without the
+    peak the one-line bound around the model's frequency leaves it (clamped family member 009,
+    ``sgd_sindy``: peak 72.32 Hz, decay 72.33, the fit's 70.29, one line 2.03 Hz)."""
+    from identify._modal_damping import decay_hold, set_eigenvalues
+    sysd, data = chain
+    M, C, K = sysd["M"], sysd["C"], sysd["K"]
+    f_true = modal(M, K)[0]
+    win = (0, data.n_samples)
+    line = data.fs / data.n_samples  # 4 Hz
+    f_off = f_true[0] + 1.5 * line
+    K_off = set_eigenvalues(M, K, np.array([(2 * np.pi * f_off) ** 2, np.nan, np.nan]))
+
+    def set_f(on, lam):
+        return set_eigenvalues(M, K_off, np.where(on, lam, np.nan))
+
+    alone = decay_hold(data, M, C, K_off, win, set_f)
+    assert modal(M, alone.K)[0][0] == pytest.approx(f_off, rel=1e-9)  # beyond one line: kept
+    peaks = f_true + 0.4 * line  # a peak located to a fraction of a line
+    held = decay_hold(data, M, C, K_off, win, set_f, peaks_hz=np.array([peaks[0], 0.0, 0.0]))
+    # exact data: the decay's frequency, the true one to the decay fit's tolerance
+    assert modal(M, held.K)[0][0] == pytest.approx(f_true[0], rel=1e-4)
+    # a peak the decay does not agree with (2 lines off it) moves nothing
+    far = decay_hold(data, M, C, K_off, win, set_f,
+                     peaks_hz=np.array([f_true[0] - 2 * line, 0.0, 0.0]))
+    assert modal(M, far.K)[0][0] == pytest.approx(f_off, rel=1e-9)
