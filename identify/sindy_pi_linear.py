@@ -63,7 +63,7 @@ from identify.structural import (
     remove_drift,
     symmetric_basis,
     symmetric_least_squares,
-    unwarp_trapezoid,
+    unwarp_rule,
 )
 from testbed.core.errors import IdentificationError
 from testbed.core.lazy import lazy_module
@@ -253,14 +253,11 @@ class SINDyPILinear(Identifier):
                                       "mode): not returned")
         self.integration_rule_ = "signals are exact derivatives: no mapping"
         if data.integration == "trapezoid":
-            mapped = unwarp_trapezoid(M, C, K, float(data.fs))
-            if mapped is None:
-                self.integration_rule_ = ("trapezoid integrals, poles left warped: a pole "
-                                          "outside the bilinear map's range")
-            else:
+            # the structural identifiers' rule: poles on the map's cut kept as fitted, every
+            # other pole mapped back (whatever round-off makes of a double real pole)
+            mapped, self.integration_rule_ = unwarp_rule(M, C, K, float(data.fs))
+            if mapped is not None:
                 C, K = mapped
-                self.integration_rule_ = ("trapezoid integrals: poles mapped back by "
-                                          "s = 2 fs artanh(p / (2 fs))")
         self.M_, self.C_, self.K_, self.K3_ = M, C, K, None
         self.normalisation_ = (
             f"M symmetric with M (M^-1 K) and M (M^-1 C) symmetric ({family}-dimensional family; "

@@ -1252,6 +1252,45 @@ def unwarp_trapezoid(M: np.ndarray, C: np.ndarray, K: np.ndarray, fs: float,
 # --------------------------------------------------------------------------------------------
 # Common identifier behaviour
 # --------------------------------------------------------------------------------------------
+def unwarp_rule(M: np.ndarray, C: np.ndarray, K: np.ndarray, fs: float
+                ) -> tuple[tuple[np.ndarray, np.ndarray] | None, str]:
+    """The structural identifiers' rule for a model fitted to trapezoid integrals, and its text.
+
+    :func:`unwarp_trapezoid` with ``keep_cut=True``: every pole off the map's cut is mapped
+    back, poles on it (:func:`on_trapezoid_cut`) are kept as fitted, so whether the resolved
+    modes are mapped does not depend on how round-off returns a double real pole.
+
+    Parameters
+    ----------
+    M, C, K : ndarray, shape (n, n)
+        Mass [kg], damping [N s/m] and stiffness [N/m] fitted to trapezoid integrals.
+    fs : float
+        Sample rate [Hz].
+
+    Returns
+    -------
+    mapped : (C, K) or None
+        The mapped damping and stiffness; None where the model has no state matrix or its modes
+        do not span the state space (poles left warped).
+    rule : str
+        What was done, for ``integration_rule_``.
+    """
+    try:
+        n_cut = int(np.count_nonzero(on_trapezoid_cut(
+            linalg.eigvals(state_matrix(M, C, K)) / (2.0 * fs))))
+    except (np.linalg.LinAlgError, ValueError):
+        n_cut = 0
+    out = unwarp_trapezoid(M, C, K, fs, keep_cut=True)
+    if out is None:
+        return None, ("trapezoid integrals, poles left warped: no state matrix, or modes that "
+                      "do not span the state space")
+    rule = "trapezoid integrals: poles mapped back by s = 2 fs artanh(p / (2 fs))"
+    if n_cut:
+        rule += (f"; {n_cut} pole(s) on the map's cut (real, |p| >= 2 fs, or within "
+                 f"{TRAPEZOID_CUT_TOL:g} of it by round-off) kept as fitted")
+    return out, rule
+
+
 def _fmt(v: float, precision: int) -> str:
     return f"{v:+.{precision}g}"
 
@@ -1272,24 +1311,9 @@ class StructuralIdentifier(Identifier):
         ``integration_rule_``."""
         self.integration_rule_ = "signals are exact derivatives: no mapping"
         if data is not None and data.integration == "trapezoid":
-            fs = float(data.fs)
-            try:
-                n_cut = int(np.count_nonzero(on_trapezoid_cut(
-                    linalg.eigvals(state_matrix(self.M_, self.C_, self.K_)) / (2.0 * fs))))
-            except (np.linalg.LinAlgError, ValueError):
-                n_cut = 0
-            out = unwarp_trapezoid(self.M_, self.C_, self.K_, fs, keep_cut=True)
-            if out is None:
-                self.integration_rule_ = ("trapezoid integrals, poles left warped: no state "
-                                          "matrix, or modes that do not span the state space")
-            else:
-                self.C_, self.K_ = out
-                self.integration_rule_ = ("trapezoid integrals: poles mapped back by "
-                                          "s = 2 fs artanh(p / (2 fs))")
-                if n_cut:
-                    self.integration_rule_ += (
-                        f"; {n_cut} pole(s) on the map's cut (real, |p| >= 2 fs, or within "
-                        f"{TRAPEZOID_CUT_TOL:g} of it by round-off) kept as fitted")
+            mapped, self.integration_rule_ = unwarp_rule(self.M_, self.C_, self.K_, float(data.fs))
+            if mapped is not None:
+                self.C_, self.K_ = mapped
         self.natural_frequencies_, self.modes_ = modal(self.M_, self.K_)
 
     def _check_fitted(self) -> None:
