@@ -986,6 +986,7 @@ def uniform_rate(path: Path, t: np.ndarray, what: str = "time column") -> float:
 def _read_hdf5(path: Path) -> _Raw:
     _check_hdf5_size(path)
     check_hdf5_rate(path)
+    check_hdf5_storage(path)
     try:
         ds = Dataset.load(path)
     except DatasetError as e:
@@ -1085,6 +1086,51 @@ def check_hdf5_rate(path: str | os.PathLike) -> None:
     if unit is not None and unit != "Hz":
         raise MeasuredDataError(path, f"attribute fs_unit={unit!r}; expected 'Hz' (the unit the "
                                       "sample rate fs is read in)")
+
+
+def check_hdf5_storage(path: str | os.PathLike) -> None:
+    """Refuse a dataset file one of whose arrays keeps its values in another file: a virtual
+    dataset (its values mapped from other files' arrays) or external storage (raw files named
+    in the array's creation properties).  A file that cannot be opened is left to
+    :meth:`Dataset.load`.
+
+    Round 18: ``measured/x`` made a virtual dataset over an array of another file, its content
+    hash made anew, was fitted by ``testbed identify`` (status 0) and exported: the record the
+    model came from was not the file named, and its values change with a file the command line
+    never names.  (External and soft links are refused by the reader's layout check.)
+
+    Raises
+    ------
+    MeasuredDataError
+        Naming ``path``, the array and where its values live.
+    """
+    import h5py
+
+    found: list[str] = []
+
+    def visit(name: str, obj: Any) -> None:
+        if found or not isinstance(obj, h5py.Dataset):
+            return
+        if obj.is_virtual:
+            sources = sorted({m.file_name for m in obj.virtual_sources()})
+            found.append(f"/{name}: a virtual dataset (its values read from "
+                         f"{', '.join(sources) or 'other files'})")
+        elif obj.id.get_create_plist().get_external_count() > 0:
+            plist = obj.id.get_create_plist()
+            files = [plist.get_external(i)[0].decode(errors="replace")
+                     for i in range(plist.get_external_count())]
+            found.append(f"/{name}: stored in external file(s) {', '.join(files)}")
+
+    try:
+        with h5py.File(path, "r") as h:
+            for group in ("measured", "reference", "truth"):
+                member = h.get(group, getlink=True)
+                if isinstance(member, h5py.HardLink) and isinstance(h[group], h5py.Group):
+                    h[group].visititems(lambda n, o, g=group: visit(f"{g}/{n}", o))
+    except Exception:
+        return
+    if found:
+        raise MeasuredDataError(path, f"{found[0]}; a dataset file holds its values itself")
 
 
 def _check_hdf5_size(path: Path) -> None:
