@@ -387,16 +387,19 @@ def studies_cases(work: Path) -> list[tuple[str, object]]:
     mm = SCENARIO_DIR / "michaelis_menten.toml"
 
     def study(folder: Path, scenarios: list[str], noise="[0.0]", extra: str = "") -> Path:
-        return _write(folder / "study.toml",
+        return _write(folder / "h18.toml",
                       "[study]\nname = \"h18\"\nscenarios = [" +
                       ", ".join(json.dumps(s) for s in scenarios) +
                       f"]\nnoise = {noise}\nseeds = [0]\nidentifiers = [\"sindy_pi_dynamical\"]\n"
                       + extra)
 
     def sweep(folder: Path, refuse: bool = False) -> str | None:
-        return judged(*cli_inprocess(["sweep", str(folder / "study.toml"), "--results",
-                                      str(folder / "results.parquet"), "--cache", str(CACHE)]),
-                      refuse=refuse)
+        status, out, err = cli_inprocess(["sweep", str(folder / "h18.toml"), "--results",
+                                          str(folder / "results.parquet"), "--cache", str(CACHE)])
+        found = judged(status, out, err, refuse=refuse)
+        if found is None and status == 2 and not refuse:
+            return f"a valid study refused: {err.strip()[:200]}"
+        return found
 
     def rows(folder: Path) -> list[dict]:
         from testbed.studies.results import read_results
@@ -409,7 +412,7 @@ def studies_cases(work: Path) -> list[tuple[str, object]]:
         other = _write(folder / "other" / "michaelis_menten.toml",
                        mm.read_text().replace("[rig]", "[rig]\n# a copy\n", 1))
         study(folder, ["michaelis_menten", str(other)])
-        found = sweep(folder)
+        found = sweep(folder, refuse=True)  # two cells would write under one name
         if found:
             return found
         cells = [r["cell"] for r in rows(folder)] if (folder / "results.parquet").exists() else []
@@ -423,10 +426,9 @@ def studies_cases(work: Path) -> list[tuple[str, object]]:
         a = _write(folder / "a" / "mm.toml", mm.read_text().replace(
             'name = "michaelis_menten"', 'name = "mm"'))
         b = _write(folder / "b" / "mm.toml", mm.read_text().replace(
-            'name = "michaelis_menten"', 'name = "mm"').replace("[rig]", "[rig]\nvmax = 2.0", 1)
-            if "vmax" not in mm.read_text() else mm.read_text())
+            'name = "michaelis_menten"', 'name = "mm"').replace("Vmax = 1.5", "Vmax = 2.0", 1))
         study(folder, [str(a), str(b)])
-        found = sweep(folder)
+        found = sweep(folder, refuse=True)  # two cells would write under one name
         if found:
             return found
         if (folder / "results.parquet").exists():
@@ -439,7 +441,7 @@ def studies_cases(work: Path) -> list[tuple[str, object]]:
         def run():
             folder = work / f"resume_{change}"
             shutil.rmtree(folder, ignore_errors=True)
-            scen = _write(folder / "mm.toml", mm.read_text())
+            scen = _write(folder / "michaelis_menten.toml", mm.read_text())
             study(folder, [str(scen)])
             found = sweep(folder)
             if found:
@@ -520,7 +522,12 @@ def api_cases(work: Path) -> list[tuple[str, object]]:
 
     def call(fn, check=lambda r: None):
         def run():
-            return check(fn())
+            try:
+                return check(fn())
+            except TypeError as e:  # the language's own one line at the call, naming the key
+                if "unexpected keyword argument" in str(e):
+                    return None
+                raise
         return run
 
     def scored(r):

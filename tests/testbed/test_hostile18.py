@@ -4,6 +4,7 @@ malformed-input audits), each fixed in the layer that owns it.
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import h5py
@@ -12,7 +13,10 @@ import pytest
 
 from testbed import cli
 from testbed.core.dataset import Dataset, Signal
+from testbed.core.errors import ArgumentError
 from testbed.pipeline.importers import MeasuredDataError, measurement_from_file
+from testbed.pipeline.scenario import load_scenario
+from testbed.pipeline.signal_chain import measure
 from testbed.reporting.export import export_dataset
 
 FS = 1000.0  # Hz; 400 samples of a 7 Hz sine: any rate and length the readers accept
@@ -89,3 +93,46 @@ def test_a_compressed_dataset_file_is_still_read(tmp_path):
     assert Dataset.load(path).measured["acceleration"].data.shape == (2, 400)
     export_dataset(path, "sep005", tmp_path / "out.json")
     assert (tmp_path / "out.json").is_file()
+
+
+# ------------------------------------------------------------------ the API's argument types
+
+def test_a_numpy_integer_seed_is_a_seed():
+    # round 18: run_scenario(mm.replace(seed=np.int64(3))) failed at the provenance's JSON,
+    # "Object of type int64 is not JSON serializable", a TypeError from inside
+    mm = load_scenario("michaelis_menten")
+    sc = mm.replace(seed=np.int64(3))
+    assert type(sc.seed) is int and sc.seed == 3
+    assert sc.data_hash() == mm.replace(seed=3).data_hash()
+    json.dumps(sc.to_dict())
+
+
+@pytest.mark.parametrize("seed", [3.0, True, np.bool_(True), "3", None, -1, 2**63])
+def test_a_seed_that_is_no_integer_in_range_is_refused_in_one_line(seed):
+    # 3.0 was numpy's "SeedSequence expects int or sequence of ints" from inside the run
+    with pytest.raises(ArgumentError, match="argument 'seed'") as e:
+        load_scenario("michaelis_menten").replace(seed=seed)
+    assert "\n" not in str(e.value)
+
+
+@pytest.mark.parametrize("name", [b"michaelis_menten", None, 5])
+def test_load_scenario_of_no_name_or_path_is_refused_in_one_line(name):
+    # bytes was pathlib's TypeError "argument should be a str object or an os.PathLike object"
+    with pytest.raises(ArgumentError, match="argument 'name_or_path'"):
+        load_scenario(name)
+
+
+def test_load_scenario_takes_a_path():
+    from testbed.pipeline.scenario import SCENARIO_DIR
+
+    assert load_scenario(SCENARIO_DIR / "michaelis_menten.toml") == load_scenario("michaelis_menten")
+
+
+def test_measure_of_a_dataset_through_another_kinds_chain_is_refused(dataset_cache):
+    # round 18: a beam's record through the mechanical chain was "dataset has no measured signal
+    # 'theta'", a plain ValueError; a kinetics record through the structural chain likewise
+    sc = load_scenario("michaelis_menten")
+    ds = dataset_cache.get(sc)
+    with pytest.raises(ArgumentError, match=r"argument 'kind'.*'structural'.*kind 'dynamical'"):
+        measure(ds, {}, "structural")
+    assert measure(ds, sc.signal, "dynamical").n_samples == ds.measured["x"].data.shape[1]
