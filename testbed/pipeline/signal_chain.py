@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 
 from testbed.core.dataset import Dataset
-from testbed.core.errors import RegistrationError, ScenarioError, show_names
+from testbed.core.errors import ArgumentError, RegistrationError, ScenarioError, show_names
 from testbed.core.measurement import Measurement, declared_input_hold
 from testbed.core.schema import Field, KeyUse, validate_table
 from testbed.core.schema import check_keys_used as schema_check_keys_used
@@ -356,6 +356,12 @@ def measure(dataset: Dataset, signal_cfg: Mapping[str, Any], kind: str) -> Measu
     ValueError
         If no chain is registered for ``kind``.
     """
+    made = getattr(dataset, "kind", None)
+    if made is not None and made != kind:
+        # a beam's record through the mechanical chain was "dataset has no measured signal
+        # 'theta'", a plain ValueError (round 18, the API)
+        raise ArgumentError("measure", "kind", kind, f"the dataset was made by a rig of kind "
+                            f"{made!r}; its signals go through that kind's chain")
     chain = _chain(kind)
     cfg = validate_table(dict(signal_cfg), chain.schema, file="<signal config>", section="signal")
     return chain.measure(dataset, cfg)
