@@ -559,6 +559,76 @@ def api_cases(work: Path) -> list[tuple[str, object]]:
     ]]
 
 
+# ------------------------------------------------------------------ importcombo
+
+def _lab_channels(work: Path) -> tuple[list[dict], list[str]]:
+    """The shipped lab beam (3 accelerations and the force, 12.8 kHz) as SEP-005 channels, and
+    the ``--prior`` arguments its export names."""
+    path = _generated(work, "cantilever_stiff_impact_lab")
+    out = work / "lab.sep005.json"
+    status, stdout, err = cli_inprocess(["export", str(path), "--format", "sep005", "-o", str(out)])
+    if status != 0:
+        raise RuntimeError(f"export: {err[-300:]}")
+    prior = [a for a in (stdout + err).split() if "=" in a and not a.startswith("-")]
+    return json.loads(out.read_text()), [x for p in prior for x in ("--prior", p)]
+
+
+def importcombo_cases(work: Path) -> list[tuple[str, object]]:
+    def record(label: str, edit) -> Path:
+        chans, _ = _lab_channels(work)
+        for c in chans:
+            c.pop("content_hash", None)
+        path = work / f"{''.join(c if c.isalnum() else '_' for c in label)}.json"
+        path.write_text(json.dumps(edit(chans)))
+        return path
+
+    def decimated(q: int):
+        def edit(chans):
+            for c in chans:
+                c["data"] = c["data"][::q]
+                c["fs"] = c["fs"] / q
+            return chans
+        return edit
+
+    def cut(first: int, last: int | None = None):
+        def edit(chans):
+            for c in chans:
+                c["data"] = c["data"][first:last]
+            return chans
+        return edit
+
+    def case(label: str, edit, extra: list[str], refuse: bool, with_prior: bool = True):
+        def run():
+            path = record(label, edit)
+            prior = _lab_channels(work)[1] if with_prior else []
+            argv = ["identify", str(path), "-o", f"{path}.model.json", *prior, *extra]
+            return judged(*cli_inprocess(argv), refuse=refuse)
+        return run
+
+    start = 64  # the lab beam's hammer, 5 ms at 12.8 kHz
+    same = lambda chans: chans  # noqa: E731
+    lab = ["--scenario", "cantilever_stiff_impact_lab"]
+    beam = ["--kind", "structural", "--method", "ls_sindy"]
+    return [(f"importcombo {label}", case(label, edit, extra, refuse, *rest))
+            for label, edit, extra, refuse, *rest in [
+        ("lab chain on the record at 3.2 kHz (low-pass 2 kHz above Nyquist)", decimated(4), lab, True),
+        ("lab chain on the record at 6.4 kHz", decimated(2), lab, False),
+        ("the record cut to 30 samples", cut(start, start + 30), beam, True),
+        ("the hammer at the record's first sample", cut(start), beam, False),
+        ("the hammer at the first sample, lab chain", cut(start), lab, False),
+        ("the record starting inside the pulse", cut(start + 2), beam, False),
+        ("the record ending inside the pulse", cut(0, start + 2), beam, True),
+        ("--fs contradicting the file's rate", same, [*beam, "--fs", "10000"], True),
+        ("--units g on a file that declares m/s^2", same, [*beam, "--units", "g"], True),
+        ("--kind mechanical on a beam", same, ["--kind", "mechanical", "--method", "sindy_pi"],
+         True, False),
+        ("--scenario of a five-bar on a beam", same, ["--scenario", "fivebar_multisine"], True,
+         False),
+        ("--scenario and --kind disagreeing", same, [*lab, "--kind", "dynamical"], True),
+        ("--method of another kind", same, ["--kind", "structural", "--method", "sindy_pi"], True),
+    ]]
+
+
 # ------------------------------------------------------------------ main
 
 FAMILIES = _hostile.families({
@@ -567,6 +637,7 @@ FAMILIES = _hostile.families({
     "store": store_cases,
     "studies": studies_cases,
     "api": api_cases,
+    "importcombo": importcombo_cases,
 }, TIMEOUT_S)
 
 

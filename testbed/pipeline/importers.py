@@ -790,6 +790,28 @@ def si_unit(unit: str) -> tuple[str, float]:
     return UNIT_ALIASES.get(u, ("", math.nan))
 
 
+def _check_declared_unit(path: Path, name: str, given: str | None, declared: str | None) -> None:
+    """Refuse a unit given for a channel (``units=``, ``--units``) that contradicts the unit its
+    file declares, as a declared ``fs`` the file contradicts is refused.
+
+    Both must be units of :func:`si_unit` and name another SI unit or another factor: a file's
+    unit that has no SI form ("general", a typo) is the case ``units=`` is there for.  Round
+    18: ``--units acceleration/acc1=g`` on a SEP-005 beam whose ``unit_str`` says ``m/s^2``
+    scaled that channel by 9.81 and fitted with status 0.
+
+    Raises
+    ------
+    MeasuredDataError
+    """
+    if not given or not declared or given == declared:
+        return
+    (g_si, g_factor), (d_si, d_factor) = si_unit(given), si_unit(declared)
+    if g_si and d_si and (g_si != d_si or not math.isclose(g_factor, d_factor, rel_tol=1e-12)):
+        raise MeasuredDataError(path, f"channel {name!r}: units= gives {given!r} but the file "
+                                      f"declares {declared!r}; a unit given must agree with the "
+                                      "file's (leave it out for a channel whose file names its unit)")
+
+
 def _finish(raw: _Raw, fs: float | None, units: str | Mapping[str, str] | None,
             channels: Sequence[str] | None, *, max_magnitude: float = MAX_MAGNITUDE) -> ImportedData:
     path = raw.source
@@ -842,6 +864,7 @@ def _finish(raw: _Raw, fs: float | None, units: str | Mapping[str, str] | None,
     signals = {}
     for n in names:
         unit = units if isinstance(units, str) else (units or {}).get(n, raw.units.get(n))
+        _check_declared_unit(path, n, unit, raw.units.get(n))
         if not unit:
             raise MeasuredDataError(path, f"channel {n!r} has no unit; declare it with units=")
         si, factor = si_unit(unit)

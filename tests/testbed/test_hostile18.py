@@ -14,7 +14,7 @@ import pytest
 from testbed import cli
 from testbed.core.dataset import Dataset, Signal
 from testbed.core.errors import ArgumentError
-from testbed.pipeline.importers import MeasuredDataError, measurement_from_file
+from testbed.pipeline.importers import MeasuredDataError, measurement_from_file, read_measured
 from testbed.pipeline.scenario import load_scenario
 from testbed.pipeline.signal_chain import measure
 from testbed.reporting.export import export_dataset
@@ -136,3 +136,34 @@ def test_measure_of_a_dataset_through_another_kinds_chain_is_refused(dataset_cac
     with pytest.raises(ArgumentError, match=r"argument 'kind'.*'structural'.*kind 'dynamical'"):
         measure(ds, {}, "structural")
     assert measure(ds, sc.signal, "dynamical").n_samples == ds.measured["x"].data.shape[1]
+
+
+# ------------------------------------------------------------------ a unit given against the file's
+
+def _sep005(path: Path, acc_unit: str) -> Path:
+    t = np.arange(400) / FS
+    path.write_text(json.dumps([
+        {"name": "acceleration/acc1", "data": np.sin(2 * np.pi * 7 * t).tolist(),
+         "unit_str": acc_unit, "fs": FS},
+        {"name": "force/force", "data": np.exp(-t / 0.01).tolist(), "unit_str": "N", "fs": FS}]))
+    return path
+
+
+@pytest.mark.parametrize("units", [{"acceleration/acc1": "g"}, {"acceleration/acc1": "mm/s^2"},
+                                   {"force/force": "kN"}, "g"])
+def test_a_unit_given_against_the_files_declared_unit_is_refused(tmp_path, units):
+    # round 18: `--units acceleration/acc1=g` on a SEP-005 beam whose unit_str says m/s^2 scaled
+    # that channel by 9.81 and fitted with status 0 (as a declared fs the file contradicts is
+    # refused, so is a unit)
+    path = _sep005(tmp_path / "r.json", "m/s^2")
+    with pytest.raises(MeasuredDataError, match=r"units= gives .* but the file declares"):
+        read_measured(path, units=units)
+
+
+def test_a_unit_given_that_agrees_or_names_what_the_file_does_not_is_taken(tmp_path):
+    path = _sep005(tmp_path / "r.json", "m/s^2")
+    same = read_measured(path, units={"acceleration/acc1": "m/s^2"})
+    assert same.signals["acceleration/acc1"][0] == "m/s^2"
+    odd = _sep005(tmp_path / "odd.json", "general")  # no SI form: what units= is there for
+    got = read_measured(odd, units={"acceleration/acc1": "g"}).signals["acceleration/acc1"]
+    assert got[0] == "m/s^2" and np.max(np.abs(got[1])) == pytest.approx(9.80665, rel=1e-3)
