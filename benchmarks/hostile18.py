@@ -22,11 +22,12 @@ Families (what rounds 1-17 did not try):
     finding.
 ``h5links``
     A dataset file (``testbed generate``) whose measured array is an HDF5 external link to
-    another file (there, missing, or a link loop), a virtual dataset over another file, stored
-    compressed by LZF, scale-offset or an optional unregistered filter, or declares its channel
-    rows transposed (samples x channels): ``testbed identify`` and ``export``.  A traceback, an
-    internal error, a refusal in more than one line, or a record whose data live in another
-    file accepted, is a finding.
+    another file (there, missing, or a link loop), a virtual dataset over another file, external
+    raw storage, stored compressed by LZF, scale-offset, gzip with shuffle and fletcher32, or by
+    a filter this installation has no plugin for (a shuffle filter's id patched to Blosc's), or
+    its channel rows transposed (samples x channels): ``testbed identify`` and ``export``.  A
+    traceback, an internal error, a refusal in more than one line or naming no filter, or a
+    record whose data live in another file accepted, is a finding.
 ``studies``
     Study files whose cells collide on what they write: one scenario by name and by a copy
     under another folder with the same stem, two scenarios of one stem, two identifier tables
@@ -289,7 +290,30 @@ def h5links_cases(work: Path) -> list[tuple[str, object]]:
             return f"export: {found}" if found else None
         return run
 
-    cases = []
+    def unknown_filter():
+        """``measured/x`` shuffled, the filter's id patched to 32001 (Blosc, no plugin here)."""
+        src = _generated(work, "michaelis_menten")
+        path = work / "michaelis_menten_unknown_filter.h5"
+        shutil.copy(src, path)
+        with h5py.File(path, "r+", libver="earliest") as f:
+            d = f["measured/x"]
+            attrs, data = dict(d.attrs), d[()]
+            del f["measured/x"]
+            new = f.create_dataset("measured/x", data=data, chunks=True, shuffle=True)
+            for k, v in attrs.items():
+                new.attrs[k] = v
+        raw = bytearray(path.read_bytes())
+        at = raw.find(b"shuffle")
+        raw[at - 8:at - 6] = (32001).to_bytes(2, "little")
+        path.write_bytes(bytes(raw))
+        status, out, err = cli_inprocess(["identify", str(path), "--kind", "dynamical", "--method",
+                                          "sindy_pi_dynamical", "-o", f"{path}.model.json"])
+        found = judged(status, out, err, refuse=True)
+        if found is None and "32001" not in err:
+            return f"refused without naming the filter: {err.strip()[:200]}"
+        return found
+
+    cases = [("h5links michaelis_menten compressed by a filter without a plugin", unknown_filter)]
     for label, (edit, refuse) in _h5_link_edits(work).items():
         cases.append((f"h5links michaelis_menten {label}",
                       case("michaelis_menten", "x", "dynamical", "sindy_pi_dynamical", label, edit,

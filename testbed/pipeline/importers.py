@@ -1112,20 +1112,22 @@ def check_hdf5_rate(path: str | os.PathLike) -> None:
 
 
 def check_hdf5_storage(path: str | os.PathLike) -> None:
-    """Refuse a dataset file one of whose arrays keeps its values in another file: a virtual
-    dataset (its values mapped from other files' arrays) or external storage (raw files named
-    in the array's creation properties).  A file that cannot be opened is left to
-    :meth:`Dataset.load`.
+    """Refuse a dataset file one of whose arrays keeps its values in another file, or is
+    compressed by an HDF5 filter this installation cannot decode.  A file that cannot be opened
+    is left to :meth:`Dataset.load`.
 
-    Round 18: ``measured/x`` made a virtual dataset over an array of another file, its content
-    hash made anew, was fitted by ``testbed identify`` (status 0) and exported: the record the
-    model came from was not the file named, and its values change with a file the command line
-    never names.  (External and soft links are refused by the reader's layout check.)
+    Round 18: ``measured/x`` made a virtual dataset over an array of another file (or kept in
+    external raw storage), its content hash made anew, was fitted by ``testbed identify``
+    (status 0) and exported: the record the model came from was not the file named, and its
+    values change with a file the command line never names.  (External and soft links are
+    refused by the reader's layout check.)  An array compressed by a filter without a plugin
+    here (Blosc, id 32001) was refused as "can't open directory (/usr/local/lib/plugin)":
+    one line, naming no array and no filter.
 
     Raises
     ------
     MeasuredDataError
-        Naming ``path``, the array and where its values live.
+        Naming ``path``, the array and where its values live or the filter.
     """
     import h5py
 
@@ -1134,15 +1136,25 @@ def check_hdf5_storage(path: str | os.PathLike) -> None:
     def visit(name: str, obj: Any) -> None:
         if found or not isinstance(obj, h5py.Dataset):
             return
+        plist = obj.id.get_create_plist()
         if obj.is_virtual:
             sources = sorted({m.file_name for m in obj.virtual_sources()})
             found.append(f"/{name}: a virtual dataset (its values read from "
-                         f"{', '.join(sources) or 'other files'})")
-        elif obj.id.get_create_plist().get_external_count() > 0:
-            plist = obj.id.get_create_plist()
+                         f"{', '.join(sources) or 'other files'}); a dataset file holds its "
+                         "values itself")
+        elif plist.get_external_count() > 0:
             files = [plist.get_external(i)[0].decode(errors="replace")
                      for i in range(plist.get_external_count())]
-            found.append(f"/{name}: stored in external file(s) {', '.join(files)}")
+            found.append(f"/{name}: stored in external file(s) {', '.join(files)}; a dataset "
+                         "file holds its values itself")
+        for k in range(plist.get_nfilters()):
+            code, _flags, _values, fname = plist.get_filter(k)
+            if not found and not h5py.h5z.filter_avail(code):
+                shown = fname.decode(errors="replace") if isinstance(fname, bytes) else str(fname)
+                found.append(f"/{name}: compressed by the HDF5 filter {shown!r} (id {code}), "
+                             "which this installation cannot decode (no plugin for it); "
+                             "allowed: uncompressed, gzip, LZF, shuffle, scale-offset, fletcher32 "
+                             "(or install that filter's plugin)")
 
     try:
         with h5py.File(path, "r") as h:
@@ -1153,7 +1165,7 @@ def check_hdf5_storage(path: str | os.PathLike) -> None:
     except Exception:
         return
     if found:
-        raise MeasuredDataError(path, f"{found[0]}; a dataset file holds its values itself")
+        raise MeasuredDataError(path, found[0])
 
 
 def _check_hdf5_size(path: Path) -> None:
