@@ -42,6 +42,7 @@ import errno
 import hashlib
 import json
 import math
+import operator
 import os
 import re
 import stat
@@ -53,7 +54,7 @@ from pathlib import Path
 from typing import Any
 
 from testbed.core.budget import check_cost, check_steps
-from testbed.core.errors import BudgetError, RigError, ScenarioError
+from testbed.core.errors import ArgumentError, BudgetError, RigError, ScenarioError
 from testbed.core.kinds import metric_names, metric_range
 from testbed.core.registry import REGISTERED_NAME, REGISTERED_NAME_DOC
 from testbed.core.schema import (
@@ -153,6 +154,19 @@ class Scenario:
     rules: dict[str, str] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
+        # a numpy integer seed (np.int64 from an array of seeds) is a seed; it was kept as one
+        # and failed at the provenance's JSON ("Object of type int64 is not JSON serializable"),
+        # and a float seed at numpy's SeedSequence (round 18, the API)
+        seed = self.seed
+        try:  # an integer of any integer type (numpy's too, not imported here), no truth value
+            if type(seed).__name__ in ("bool", "bool_"):
+                raise TypeError
+            object.__setattr__(self, "seed", operator.index(seed))
+        except TypeError:
+            raise ArgumentError("Scenario", "seed", seed, f"of type {type(seed).__name__}; expected "
+                                f"an integer in [0, {MAX_SEED}]") from None
+        if not 0 <= self.seed <= MAX_SEED:
+            raise ArgumentError("Scenario", "seed", seed, f"expected an integer in [0, {MAX_SEED}]")
         try:
             rig_kind = RIGS.get(self.rig).kind
         except KeyError as e:
@@ -479,6 +493,11 @@ def load_scenario(name_or_path: str | os.PathLike, *, standalone: bool = True,
         For any problem of the file or a file it extends (see the module docs); its
         subclass :class:`~testbed.core.errors.BudgetError` for a run over budget.
     """
+    if not (isinstance(name_or_path, (str, os.PathLike)) and isinstance(os.fspath(name_or_path), str)):
+        # bytes, None or a number: pathlib's TypeError (round 18, the API)
+        raise ArgumentError("load_scenario", "name_or_path", name_or_path,
+                            f"of type {type(name_or_path).__name__}; expected a scenario name or a "
+                            ".toml path (str or os.PathLike)")
     path = resolve_path(name_or_path)
     _check_stem(path, "scenario", SCENARIO_DIR)
     raw = _read_toml(path)
