@@ -688,6 +688,23 @@ EXACT_REPLAY_MAX = ROLLOUT_ATOL
 #: family five-bar linkages__010 at 1 %: 38 (truth 0.0082 rad; re-chosen 0.0020).  With factor
 #: 5 member 10 was re-chosen and passed worse (0.0023 -> 0.011 rad); 20 is above every right one.
 REPLAY_NOISE_FACTOR = 20.0
+#: The replay rule's damped refit (:meth:`SINDyPI._damped_refit`): where the unpruned library's
+#: fit at the noise rule's ridge replays no better than the held-out choice (or fails), it is
+#: fitted again with ridge UNPRUNED_RIDGE_PER_TOL x ``prune_tol`` (where that exceeds the rule's:
+#: exact data, ridge RIDGE_EXACT; not where the user set ``ridge``).  The columns the pruning
+#: drops have a residual variance (unit-norm column, on the record) below ``prune_tol``, so the
+#: unit-diagonal Gram matrix of the unpruned library has directions of eigenvalue <= prune_tol
+#: that the record does not determine; a ridge r shrinks a direction of eigenvalue l by
+#: l / (l + r), so 10 x prune_tol damps each of them at least 11x and biases directions above
+#: 1e-6 by under 1 %.  With the exact-data ridge 1e-14 they are free: round 18's clean sine
+#: replays at recorded rates had every pair of the unpruned shortlist unsimulable
+#: (fb18_f0p5_rec) or at 0.303 rad (fb18_30s_rec), and the held-out choice (0.0157 / 0.0024
+#: rad) was kept.  Ridge of that fit, replay of fb18_f0p5_rec: 1e-12 / 1e-10 / 1e-9 first fit
+#: kept (0.332 / 0.124 rad / none simulated), 1e-8 9.8e-6, 1e-7 1.5e-5, 1.2e-6 1.3e-5 rad;
+#: fb18_30s_rec 1e-8 2.1e-6, 1.2e-6 6.6e-6.  Only a fallback: the same ridge in every unpruned
+#: refit lost fb16_amp_0p2_rec (3.6e-5 rad -> no pair simulated, "no assembly" at 4.5 s), whose
+#: true equations need directions below 1e-8 that the rule's ridge keeps.
+UNPRUNED_RIDGE_PER_TOL = 10.0
 #: The settings the noise rule chooses (each a SINDyPI hyperparameter; None = by rule).
 #: ``lhs`` is given by the rule as "inputs" (the library's terms with an input factor) or None.
 RULE_KNOBS = ("column_lowpass_hz", "edge_trim", "ridge", "formulation", "weak_window_s", "lhs",
@@ -1770,6 +1787,10 @@ class SINDyPI(_ImplicitMechanical):
             knobs.update(selection="rollout", prune_tol=None, rollout_segments=1)
         if getattr(self, "_unpruned", False):  # the record rule's second fit (see fit)
             knobs.update(prune_tol=None)
+        if replay is not None and getattr(self, "_damped", False):  # see _pool_refit
+            knobs["ridge"] = UNPRUNED_RIDGE_PER_TOL * self.prune_tol
+            rule += (f"; unpruned library, damped: ridge {knobs['ridge']:.3g} "
+                     f"({UNPRUNED_RIDGE_PER_TOL:g} x prune_tol)")
         for k in RULE_KNOBS:
             setattr(self, f"{k}_", knobs[k])
         self.noise_rule_ = rule
@@ -1992,7 +2013,8 @@ class SINDyPI(_ImplicitMechanical):
                     first: dict[str, Any] | None) -> None:
         """The replay rule's second fit (see :meth:`_replay_check`); ``first`` is the first
         fit's state (None: it found no model), kept unless ``err`` [rad], its replay, exceeds
-        the second's by more than the tie rule."""
+        the second's by more than the tie rule; where it does not, or the second fit fails,
+        the damped refit (:meth:`_damped_refit`) is tried before the first fit is kept."""
         self._replay = err
         try:
             super().fit(data)
@@ -2004,11 +2026,16 @@ class SINDyPI(_ImplicitMechanical):
             again = self._rollout_error(self.model_, data, round(self.edge_trim_ * data.fs), 1)
             why = ""
         except IdentificationError as exc:
-            if first is None:
+            if first is None and not self._damped_refit(data, err, head, np.inf):
                 raise IdentificationError(f"{head}; the replay rule's rollout over the unpruned "
                                           f"library failed too: {exc}") from exc
+            if first is None:
+                return
             again, why = np.inf, f" ({exc})"
         # the rollout selection's tie rule: the first fit (the held-out choice) wins ties
+        if (not err > again * (1 + self.selection_rtol) + ROLLOUT_ATOL
+                and self._damped_refit(data, err, head, again)):
+            return
         if first is not None and not err > again * (1 + self.selection_rtol) + ROLLOUT_ATOL:
             self.__dict__.update(first)
             self.replay_rule_ = (f"{head}: equations non-unique on this record; rollout over "
@@ -2019,6 +2046,43 @@ class SINDyPI(_ImplicitMechanical):
         self.replay_rule_ = (f"{head}: equations non-unique on this record; chosen again by "
                              f"rollout over the trimmed record among the unpruned library's "
                              f"{self.n_rollout} best per input: {again:.3g} rad")
+
+    def _damped_ridge(self) -> float | None:
+        """The damped refit's ridge: ``UNPRUNED_RIDGE_PER_TOL * prune_tol`` where it exceeds the
+        noise rule's; None where the user set ``ridge`` or ``prune_tol = None``, or it does not."""
+        if self.ridge is not None or self.prune_tol is None:
+            return None
+        floor = UNPRUNED_RIDGE_PER_TOL * self.prune_tol
+        return floor if floor > self.ridge_ else None
+
+    def _damped_refit(self, data: Measurement, err: float, head: str, again: float) -> bool:
+        """The replay rule's damped refit: where the unpruned library's fit at the noise rule's
+        ridge replayed no better than the first fit (``again`` [rad] against ``err``, by the
+        tie rule; inf: it failed), it is fitted again with the ridge
+        :meth:`_damped_ridge` (see ``UNPRUNED_RIDGE_PER_TOL``) and kept (True) if its replay
+        beats ``err`` beyond the tie rule; else nothing of it stays (False)."""
+        damped = self._damped_ridge()
+        if damped is None:
+            return False
+        state = dict(self.__dict__)
+        self._damped = True
+        try:
+            super().fit(data)
+            new = self._rollout_error(self.model_, data, round(self.edge_trim_ * data.fs), 1)
+        except IdentificationError:
+            new = np.inf
+        finally:
+            self._damped = False
+        if not err > new * (1 + self.selection_rtol) + ROLLOUT_ATOL:
+            self.__dict__.clear()
+            self.__dict__.update(state)
+            return False
+        self.replay_rmse_ = new
+        self.replay_rule_ = (f"{head}: equations non-unique on this record; rollout over the "
+                             f"unpruned library at the rule's ridge replayed no better "
+                             f"({again:.3g} rad); chosen again by rollout with ridge {damped:.3g} "
+                             f"among its {self.n_rollout} best per input: {new:.3g} rad")
+        return True
 
     def _sweep(self, G_train, G_val, cand, Theta_train):
         thr = DEFAULT_THRESHOLDS if self.thresholds is None else np.asarray(self.thresholds)
