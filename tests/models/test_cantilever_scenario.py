@@ -8,6 +8,7 @@ import pytest
 from testbed.core.errors import ScenarioError
 from testbed.pipeline.generate import generate
 from testbed.pipeline.scenario import load_scenario, scenario_from_dict
+from testbed.pipeline.signal_chain import measure
 
 
 def raw(rig=None, simulation=None, excitation=None, noise=None):
@@ -117,3 +118,20 @@ def test_a_soft_base_whose_mode_one_does_not_ring_in_the_record_is_refused():
                                                 r"2.24e-162 Hz .*completes less than one period"):
             scenario_from_dict(table(5e-324), file="soft.toml")
     scenario_from_dict(table(2000.0), file="soft.toml")  # the shipped base: 40 Hz
+
+
+def test_a_hammer_exactly_one_millimetre_from_its_sensor_is_accepted():
+    # the rule is "within 1 mm"; 0.3175 - 0.3165 is 1.0000000000000009 mm in floats, which the
+    # rig refused ("1 mm from the nearest ... within 1 mm", hostile round 18): the positions'
+    # own round-off (a few eps of the position) is allowed, and the chain maps that hit to the
+    # tip sensor; 10 um further is refused
+    def beam(location):
+        return {"scenario": {"name": "t", "rig": "cantilever", "seed": 0},
+                "simulation": {"duration": 0.05},
+                "excitation": {"type": "impact", "location": location}}
+
+    sc = scenario_from_dict(beam(0.3165))
+    m = measure(generate(sc), sc.signal, "structural")
+    assert m.input_map.ravel().tolist() == [0.0, 0.0, 1.0]
+    with pytest.raises(ScenarioError, match=r"key 'excitation.location'.*within 1 mm"):
+        scenario_from_dict(beam(0.31649))
