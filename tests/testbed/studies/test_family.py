@@ -270,3 +270,23 @@ def test_failure_kinds():
     assert failure_kind("unstable: pole ...; diverged: blew up (at t = 0.1 s)") == ["diverged",
                                                                                    "unstable"]
     assert failure_kind("fit failed: no positive definite mass matrix") == ["fit failed"]
+
+
+def test_failure_kinds_name_the_scorers_explanations():
+    """The scorer's explanations of a failed bar are named, not "other" (held-out families:
+    three floor cells and one unexcited cell were summarised as "other"); the texts are those
+    the sweep recorded.  A word of a head inside another reason ("at the sensors") is not one."""
+    floor = ("floor: TRAC 0.0314 against the bar 0.9, where the truth's own reduced model (one "
+             "degree of freedom per sensor) scores 0.0133 on this record: the record and its "
+             "signal chain put that bar out of reach of any model of that size (rig.sensors)")
+    unexcited = ("unexcited: mode 1 (52.83 Hz) meets the hammer at 0.0085 of its largest "
+                 "amplitude at the sensors (below 0.01: the hammer lands where it barely moves, "
+                 "at a node or next to the clamp): the record holds almost none of it and barely "
+                 "determines its bars (excitation.location)")
+    assert failure_kind(floor) == ["floor"]
+    assert failure_kind(unexcited) == ["unexcited"]
+    assert failure_kind("out of band: mode 3 (2.1 kHz) lies above the low-pass") == ["out of band"]
+    assert failure_kind("diverged: blew up (at t = 0.1 s); " + floor) == ["diverged", "floor"]
+    assert failure_kind("sensors: the truth reduced to the sensors ...") == ["sensors"]
+    assert failure_kind("wrong equation: x^2 beside the law") == ["wrong equation"]
+    assert failure_kind("something new: at the sensors") == ["other"]
