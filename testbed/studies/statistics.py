@@ -74,6 +74,26 @@ def failure_kind(error: str) -> list[str]:
     return found or ["other"]
 
 
+def failed_cells_line(rows: list[dict[str, Any]]) -> str | None:
+    """One line on the failed rows of a sweep: how many crashed and how many are scored failures.
+
+    A scored failure (a diverged or non-physical model, a floor, ...) is the cell's verdict with
+    its reason and a rerun of the same code gives it again; a crash is an exception the sweep
+    caught.  ``None`` when no row failed.
+    """
+    kinds = [failure_kind(r.get("error") or "") for r in rows if r.get("status") != "ok"]
+    if not kinds:
+        return None
+    crashed = sum(any(k.startswith("crash") for k in ks) for ks in kinds)
+    other = sum(ks == ["other"] for ks in kinds)
+    scored = len(kinds) - crashed - other
+    parts = [f"{n} {what}" for n, what in ((crashed, "crashed"),
+                                            (scored, "scored failure(s) with their reason"),
+                                            (other, "with another error")) if n]
+    return (f"{len(kinds)} cell(s) failed ({', '.join(parts)}; `testbed summary` counts the "
+            "reasons); `testbed sweep --retry-failed` runs them again")
+
+
 def _judged(rows: list[dict[str, Any]]) -> list[bool]:
     """Whether each row was held to thresholds.
 

@@ -27,7 +27,7 @@ from testbed.studies.family import (
     family_of,
     peak_base_rotation,
 )
-from testbed.studies.statistics import failure_kind
+from testbed.studies.statistics import failed_cells_line, failure_kind
 from testbed.studies.study import load_study, write_family
 
 STUDY = """
@@ -290,3 +290,17 @@ def test_failure_kinds_name_the_scorers_explanations():
     assert failure_kind("sensors: the truth reduced to the sensors ...") == ["sensors"]
     assert failure_kind("wrong equation: x^2 beside the law") == ["wrong equation"]
     assert failure_kind("something new: at the sensors") == ["other"]
+
+
+def test_failed_cells_line_tells_crashes_from_scored_failures():
+    """The sweep's last line said only "N cell(s) failed" for a diverged model (a verdict with its
+    reason, which a rerun repeats) as for a crash (held-out families: 7 scored failures, no crash)."""
+    rows = [{"status": "ok", "error": ""},
+            {"status": "failed", "error": "diverged: cubic structural model diverged (at t = 0.009 s)"},
+            {"status": "failed", "error": "floor: TRAC 0.03 against the bar 0.9, where ..."},
+            {"status": "failed", "error": "ValueError: boom (x.py:3)"}]
+    line = failed_cells_line(rows)
+    assert line.startswith("3 cell(s) failed (1 crashed, 2 scored failure(s) with their reason;")
+    assert "--retry-failed" in line
+    assert failed_cells_line(rows[:1]) is None
+    assert "1 with another error" in failed_cells_line([{"status": "failed", "error": "odd"}])
