@@ -14,7 +14,8 @@ method that crashes or returns NaN did not meet its thresholds.  A group with no
 has no pass rate (NaN): an identifier is never measured against bars declared for another.
 
 Failure reasons are counted per group (:func:`failure_kind`): a scored failure's reason
-("fit failed", "diverged", "non-physical", "unstable", "non-finite scores") or, for a cell that
+("fit failed", "diverged", "non-physical", "unstable", "non-finite scores"), the scorer's
+explanation of a failed bar ("floor", "unexcited", "out of band", ...) or, for a cell that
 raised, ``crash: <ExceptionType>``.
 """
 
@@ -43,14 +44,24 @@ CRASH_PATTERN = re.compile(
 #: they are looked for in a reason text.
 SCORED_REASONS = ("fit failed", "diverged", "simulation failed", "non-physical", "unstable",
                   "non-finite scores", "no scores")
+#: The scorer's explanations of a failed bar (testbed.scoring.scorers: uninformative_failures,
+#: out_of_band_failures, unexcited_failures, decayed_failures, floor_failures, sensor_failures,
+#: equation_failures), each the head of its reason (``<head>: ...``).  Matched only at a
+#: reason's start (the text's or after ``"; "``, as ``Scores.failure`` joins them): their words
+#: occur inside other reasons ("at the sensors").  Without them a floor or an unexcited mode
+#: was counted as "other" (held-out families, 2026-11-28).
+EXPLAINED_REASONS = ("uninformative", "out of band", "unexcited", "decayed", "floor", "sensors",
+                     "wrong equation", "equation not determined")
+_EXPLAINED = re.compile(r"(?:^|; )(" + "|".join(map(re.escape, EXPLAINED_REASONS)) + r")\b")
 
 
 def failure_kind(error: str) -> list[str]:
     """The kinds of failure in a cell's ``error`` text (empty for a cell that finished).
 
     ``crash: <Type>`` for an exception the sweep caught (a bug or an unforeseen input), else
-    every scored reason of :data:`SCORED_REASONS` found in the text (a cell may fail for
-    several, e.g. non-physical and diverged), or ``other`` if none matches.
+    every scored reason of :data:`SCORED_REASONS` found in the text and every explanation of
+    :data:`EXPLAINED_REASONS` heading one of its reasons (a cell may fail for several, e.g.
+    non-physical and diverged), or ``other`` if none matches.
     """
     if not error:
         return []
@@ -58,7 +69,29 @@ def failure_kind(error: str) -> list[str]:
     if m:
         return [f"crash: {m.group(1)}"]
     found = [r for r in SCORED_REASONS if r in error]
+    heads = {h.group(1) for h in _EXPLAINED.finditer(error)}
+    found += [r for r in EXPLAINED_REASONS if r in heads]
     return found or ["other"]
+
+
+def failed_cells_line(rows: list[dict[str, Any]]) -> str | None:
+    """One line on the failed rows of a sweep: how many crashed and how many are scored failures.
+
+    A scored failure (a diverged or non-physical model, a floor, ...) is the cell's verdict with
+    its reason and a rerun of the same code gives it again; a crash is an exception the sweep
+    caught.  ``None`` when no row failed.
+    """
+    kinds = [failure_kind(r.get("error") or "") for r in rows if r.get("status") != "ok"]
+    if not kinds:
+        return None
+    crashed = sum(any(k.startswith("crash") for k in ks) for ks in kinds)
+    other = sum(ks == ["other"] for ks in kinds)
+    scored = len(kinds) - crashed - other
+    parts = [f"{n} {what}" for n, what in ((crashed, "crashed"),
+                                            (scored, "scored failure(s) with their reason"),
+                                            (other, "with another error")) if n]
+    return (f"{len(kinds)} cell(s) failed ({', '.join(parts)}; `testbed summary` counts the "
+            "reasons); `testbed sweep --retry-failed` runs them again")
 
 
 def _judged(rows: list[dict[str, Any]]) -> list[bool]:

@@ -27,7 +27,7 @@ from testbed.studies.family import (
     family_of,
     peak_base_rotation,
 )
-from testbed.studies.statistics import failure_kind
+from testbed.studies.statistics import failed_cells_line, failure_kind
 from testbed.studies.study import load_study, write_family
 
 STUDY = """
@@ -270,3 +270,37 @@ def test_failure_kinds():
     assert failure_kind("unstable: pole ...; diverged: blew up (at t = 0.1 s)") == ["diverged",
                                                                                    "unstable"]
     assert failure_kind("fit failed: no positive definite mass matrix") == ["fit failed"]
+
+
+def test_failure_kinds_name_the_scorers_explanations():
+    """The scorer's explanations of a failed bar are named, not "other" (held-out families:
+    three floor cells and one unexcited cell were summarised as "other"); the texts are those
+    the sweep recorded.  A word of a head inside another reason ("at the sensors") is not one."""
+    floor = ("floor: TRAC 0.0314 against the bar 0.9, where the truth's own reduced model (one "
+             "degree of freedom per sensor) scores 0.0133 on this record: the record and its "
+             "signal chain put that bar out of reach of any model of that size (rig.sensors)")
+    unexcited = ("unexcited: mode 1 (52.83 Hz) meets the hammer at 0.0085 of its largest "
+                 "amplitude at the sensors (below 0.01: the hammer lands where it barely moves, "
+                 "at a node or next to the clamp): the record holds almost none of it and barely "
+                 "determines its bars (excitation.location)")
+    assert failure_kind(floor) == ["floor"]
+    assert failure_kind(unexcited) == ["unexcited"]
+    assert failure_kind("out of band: mode 3 (2.1 kHz) lies above the low-pass") == ["out of band"]
+    assert failure_kind("diverged: blew up (at t = 0.1 s); " + floor) == ["diverged", "floor"]
+    assert failure_kind("sensors: the truth reduced to the sensors ...") == ["sensors"]
+    assert failure_kind("wrong equation: x^2 beside the law") == ["wrong equation"]
+    assert failure_kind("something new: at the sensors") == ["other"]
+
+
+def test_failed_cells_line_tells_crashes_from_scored_failures():
+    """The sweep's last line said only "N cell(s) failed" for a diverged model (a verdict with its
+    reason, which a rerun repeats) as for a crash (held-out families: 7 scored failures, no crash)."""
+    rows = [{"status": "ok", "error": ""},
+            {"status": "failed", "error": "diverged: cubic structural model diverged (at t = 0.009 s)"},
+            {"status": "failed", "error": "floor: TRAC 0.03 against the bar 0.9, where ..."},
+            {"status": "failed", "error": "ValueError: boom (x.py:3)"}]
+    line = failed_cells_line(rows)
+    assert line.startswith("3 cell(s) failed (1 crashed, 2 scored failure(s) with their reason;")
+    assert "--retry-failed" in line
+    assert failed_cells_line(rows[:1]) is None
+    assert "1 with another error" in failed_cells_line([{"status": "failed", "error": "odd"}])
