@@ -846,10 +846,16 @@ def decay_hold(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndarray,
         return DecayHold(C, K, dec, "modal decay fits: none taken, the fit's")
     line = float(data.fs) / (i1 - i0)
     free = np.zeros(M.shape[0], bool) if unlocated is None else np.asarray(unlocated, bool)
-    if np.any(free):  # only to a frequency nearer its own mode's than any other's
+
+    def own_nearest(move: np.ndarray) -> np.ndarray:
+        # only to a frequency nearer its own mode's than any other's (a decay that is another
+        # mode's leakage must not carry a mode across it)
         w = 2.0 * np.pi * modal(M, K)[0]
         gap = np.abs(np.sqrt(dec.lam_model)[:, None] - w[None, :])
-        free &= np.all(gap >= np.diag(gap)[:, None], axis=1)
+        return move & np.all(gap >= np.diag(gap)[:, None], axis=1)
+
+    if np.any(free):
+        free = own_nearest(free)
     # the peak offset widens the bound where the model's frequency stands at a spectral peak
     # (the eigenvalue hold's); a cubic model's frequencies are the fit's (no hold puts them at a
     # peak, which a hardening response moves), so its bound is the line alone ("Cubic library")
@@ -858,7 +864,9 @@ def decay_hold(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndarray,
     if peaks_hz is not None and not with_backbone:  # the decay agrees with the mode's peak
         pk = np.asarray(peaks_hz, dtype=float)
         f_dec = np.sqrt(dec.lam_model) / (2.0 * np.pi)
-        near |= (pk > 0) & (np.abs(f_dec - pk) <= line + offset)
+        agree = (pk > 0) & (np.abs(f_dec - pk) <= line + offset) & ~near
+        if np.any(agree):  # a move beyond one line: as far as the unlocated modes' (review)
+            near |= own_nearest(agree)
     on = dec.taken & (near | free)
     unexplained = np.zeros_like(on)
     beyond = np.zeros_like(on)

@@ -193,6 +193,14 @@ WIDE_ROLLOUT = 10
 INERTIA_FAILURE = "every candidate model's reduced inertia vanishes on the record"
 
 
+#: :func:`gain_crossing`'s zero band, in units of eps times the largest |determinant| on the
+#: record: the determinant is a 2 x 2 product of accelerations the compiled kernel evaluates
+#: with a few hundred flops of libm sin / cos (an ulp each), so its round-off is some tens of
+#: eps of the largest term; 64 is above that, and a determinant within it of zero at some
+#: state is singular there to working precision, whichever sign its last bits give it.
+GAIN_ZERO_EPS = 64.0
+
+
 def gain_crossing(det: np.ndarray) -> int:
     """The first state at which the input gain's determinant ``det`` (N,) is zero, not finite
     or of the other sign than at the first state; -1 where it keeps one strict sign.
@@ -200,12 +208,19 @@ def gain_crossing(det: np.ndarray) -> int:
     A mechanism's reduced inertia is positive definite wherever its chain assembles, so the
     determinant of ``d ddq_a / du`` (its inverse, up to the inputs' scales) keeps one sign
     along any recorded path; a model whose determinant crosses zero (or passes through a
-    pole: the equations singular in the accelerations) there is no model of it."""
+    pole: the equations singular in the accelerations) there is no model of it.
+
+    Zero is a band, not a bit: ``|det| <= GAIN_ZERO_EPS * eps * max |det|`` (over the finite
+    states) counts as zero, so a determinant that touches zero at round-off's level is excluded
+    whichever sign the last bit gives it (the compiled sin / cos differ by an ulp between CPUs)."""
     det = np.asarray(det, dtype=float)
     if det.size == 0:
         return -1
-    s0 = np.sign(det[0])
-    bad = ~np.isfinite(det) | (np.sign(det) != s0) | (s0 == 0)
+    finite = np.isfinite(det)
+    scale = float(np.max(np.abs(det[finite]))) if finite.any() else 0.0
+    zero = np.abs(np.where(finite, det, 0.0)) <= GAIN_ZERO_EPS * np.finfo(float).eps * scale
+    s0 = 0.0 if zero[0] or not finite[0] else np.sign(det[0])
+    bad = ~finite | zero | (np.sign(det) != s0)
     return int(np.argmax(bad)) if bad.any() else -1
 
 

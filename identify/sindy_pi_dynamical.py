@@ -141,7 +141,7 @@ from identify.sindy_pi import (
     check_thresholds,
     choose_sim_dt,
 )
-from testbed.core.errors import DivergenceError, IdentificationError
+from testbed.core.errors import ArgumentError, DivergenceError, IdentificationError
 from testbed.core.measurement import Measurement, Trajectory
 from testbed.core.schema import ErrorFn, Field, KeyUse
 from testbed.numerics.noise import noise_std
@@ -1128,6 +1128,17 @@ class SINDyPIDynamical(Identifier):
         x = np.array(x0, dtype=float).ravel()
         U = (np.empty((0, t.size)) if u is None or np.size(u) == 0
              else np.ascontiguousarray(np.atleast_2d(np.asarray(u, dtype=float))))
+        # the compiled kernel reads the inputs by the library's powers, unchecked: a missing or
+        # extra input row would be read past (review, session 19: u = None simulated u = 1)
+        n_in = len(self._lib.inputs)
+        if U.shape != (n_in, t.size) or x.size != len(self._lib.states):
+            raise ArgumentError("simulate", "u" if x.size == len(self._lib.states) else "x0",
+                                f"x0 of {x.size} state(s), u of shape {U.shape}",
+                                f"x0 of the {len(self._lib.states)} state(s) "
+                                f"{', '.join(self._lib.states)} and u of shape ({n_in}, "
+                                f"{t.size}): one row per input the law was fitted with "
+                                f"({', '.join(self._lib.inputs) or 'none'}), one column per time",
+                                described=True)
         X = np.empty((x.size, t.size))
         Xd = np.empty_like(X)
         status, when, smin = ds.rk4(x, t, U, float(dt), np.ascontiguousarray(self.coef_, dtype=float),

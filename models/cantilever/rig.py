@@ -54,6 +54,7 @@ from models.cantilever.simulate import (
 from testbed.core.budget import CPU_BUDGET_S, MEMORY_BUDGET_BYTES, SAMPLE_BUDGET, STEP_BUDGET, Cost
 from testbed.core.dataset import Dataset, Signal
 from testbed.core.errors import RigError
+from testbed.core.measurement import nearest_within
 from testbed.core.schema import Field
 
 LOG = logging.getLogger(__name__)
@@ -71,6 +72,15 @@ HIT_SENSOR_TOLERANCE_M = 1e-3
 #: (measured: sensors 0.30, 0.31, 0.3175 m on the default beam's last segment gave a reduced
 #: mass matrix with a zero eigenvalue and the scorer stopped with an internal error).
 MAX_SENSORS_PER_SEGMENT = 2
+
+#: A sensor within this fraction of a segment's length outboard of a hinge is counted on the
+#: segment inboard of it (:func:`_check_sensors_per_segment`): its lever arm about that hinge is
+#: too short for its reading to be told apart.  Measured (review, session 19; the stiff beam in
+#: 3 segments, 0.106 m, sensors 0.1 m / hinge 1 + d / L): d = 1e-7 m (1e-6 of a segment) gave a
+#: reduction at the sensors of condition 2e33 whose modes were 167 / 1082 / 1212 Hz against 82 /
+#: 516 / 1426; d = 1e-6 m (1e-5 of a segment) condition 1.2e11 and its modes within 4.2e-6,
+#: inside the scorer's REDUCED_TRUTH_GAP (1e-5).
+HINGE_SNAP = 1e-5
 
 #: Largest angle [rad] any segment may turn from the beam's axis (:func:`peak_segment_angle`).
 #: The truth (M, C, K, modes, SEREP) is the chain linearised at rest, where ``sin phi = phi``
@@ -407,8 +417,9 @@ def _check_sensors_per_segment(rig: dict[str, Any], sensors: list[float], x0: fl
       naming ``rig.E``, and 0.06 / 0.12 / 0.18 L was accepted with a reduction at the sensors
       whose modes were 92 / 109 / 733 Hz against the engine's 82.8 / 517 / 1447 Hz.
 
-    A sensor exactly at a hinge moves with the segment inboard of it (its offset on the
-    outboard one is zero), so it is counted there.
+    A sensor at a hinge moves with the segment inboard of it (its offset on the outboard one
+    is zero), so it is counted there, and so is one within :data:`HINGE_SNAP` of a segment
+    outboard of it (a lever arm too short to tell its reading from the inboard segment's).
 
     Parameters
     ----------
@@ -426,8 +437,16 @@ def _check_sensors_per_segment(rig: dict[str, Any], sensors: list[float], x0: fl
         return
     params = beam_params(rig)
     xs, _ = params.hinges()
-    # 0-based segment index; a sensor at hinge x_b (searchsorted "left") belongs to segment b - 1
-    segments = [int(np.searchsorted(xs, s, side="left")) - 1 for s in on_beam]
+    # 0-based segment index; a sensor at hinge x_b, or within HINGE_SNAP of it outboard,
+    # belongs to segment b - 1 (its lever arm about x_b is nil, or too short to tell)
+    snap = HINGE_SNAP * params.segment_length
+    segments = [int(np.searchsorted(xs + snap, s, side="left")) - 1 for s in on_beam]
+    if segments[0] < 0:
+        error("rig.sensors", sensors,
+              f"allowed: positions more than {snap:.3g} m ({HINGE_SNAP:g} of a segment) outboard "
+              f"of the root hinge at {xs[0]:.6g} m; {on_beam[0]:.9g} m reads no motion one can "
+              "tell from zero")
+        return
 
     def span(b: int) -> str:
         return f"{xs[b]:.6g}-{xs[b + 1] if b + 1 < len(xs) else rig['length']:.6g} m"
@@ -576,14 +595,12 @@ class CantileverRig(Rig):
             error("excitation.location", loc, f"allowed: 0 (= tip) or {where}")
         positions = sensor_positions(rig)
         hit = hit_position(rig, excitation)
-        gap = float(np.min(np.abs(positions - hit)))
-        # the positions' own round-off: 0.3175 - 0.3165 is 1.0000000000000009 mm (hostile 18)
-        slack = 4 * np.finfo(float).eps * max(abs(hit), float(np.max(np.abs(positions))))
-        if gap > HIT_SENSOR_TOLERANCE_M + slack:
+        _, gap, within = nearest_within(hit, positions, HIT_SENSOR_TOLERANCE_M)
+        if not within:
             error("excitation.location", loc,
                   f"allowed: 0 (= tip) or a sensor position, within {HIT_SENSOR_TOLERANCE_M * 1e3:g} "
                   f"mm (sensors at {', '.join(f'{x:.6g}' for x in positions)} m; the impact at "
-                  f"{hit:.6g} m is {gap * 1e3:.3g} mm from the nearest): a model in sensor "
+                  f"{hit:.6g} m is {gap * 1e3:.6g} mm from the nearest): a model in sensor "
                   "coordinates cannot place a force between sensors")
         end = excitation["start"] + excitation["pulse_duration"]
         if end >= simulation["duration"]:

@@ -196,3 +196,37 @@ class Trajectory(NamedTuple):
     x: np.ndarray
     xd: np.ndarray
     xdd: np.ndarray
+
+
+def nearest_within(point: float, positions: np.ndarray, tol: float) -> tuple[int, float, bool]:
+    """The position nearest ``point``, its distance, and whether it lies within ``tol``.
+
+    The one rule for an impact on a sensor (the cantilever rig's check at load and the
+    structural chain's force map): within ``tol`` [m] up to the pair's own round-off, ``4 eps``
+    of the larger of the two magnitudes (0.3175 - 0.3165 is 1.0000000000000009 mm in floats;
+    hostile round 18 had it refused "within 1 mm").
+
+    Parameters
+    ----------
+    point : float
+        Position [m], e.g. the hammer's.
+    positions : ndarray, shape (n,)
+        Candidate positions [m], e.g. the sensors'; n >= 1.
+    tol : float
+        Largest distance allowed [m].
+
+    Returns
+    -------
+    index : int
+        Index of the nearest position (the first of equals).
+    gap : float
+        Its distance from ``point`` [m].
+    within : bool
+        ``gap <= tol + 4 eps max(|point|, |positions[index]|)``.
+    """
+    positions = np.asarray(positions, dtype=float).ravel()
+    dist = np.abs(positions - float(point))
+    i = int(np.argmin(dist))
+    slack = 4 * np.finfo(float).eps * max(abs(float(point)), abs(float(positions[i])))
+    return i, float(dist[i]), bool(dist[i] <= tol + slack)
+

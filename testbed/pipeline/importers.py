@@ -1157,13 +1157,20 @@ def check_hdf5_storage(path: str | os.PathLike) -> None:
                              "(or install that filter's plugin)")
 
     try:
-        with h5py.File(path, "r") as h:
-            for group in ("measured", "reference", "truth"):
+        h = h5py.File(path, "r")
+    except Exception:  # not an HDF5 file we can open: Dataset.load names it
+        return
+    with h:
+        for group in ("measured", "reference", "truth"):
+            try:
                 member = h.get(group, getlink=True)
                 if isinstance(member, h5py.HardLink) and isinstance(h[group], h5py.Group):
                     h[group].visititems(lambda n, o, g=group: visit(f"{g}/{n}", o))
-    except Exception:
-        return
+            except Exception as e:  # fail closed: an array whose storage cannot be read
+                found.append(f"/{group}: the storage of its arrays cannot be inspected "
+                             f"({type(e).__name__}: {e}); a dataset file holds plain arrays")
+            if found:
+                break
     if found:
         raise MeasuredDataError(path, found[0])
 

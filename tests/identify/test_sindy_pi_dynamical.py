@@ -15,7 +15,7 @@ from identify.sindy_pi_dynamical import (
     common_factor,
     polynomial_terms,
 )
-from testbed.core.errors import DivergenceError, IdentificationError, ScenarioError
+from testbed.core.errors import ArgumentError, DivergenceError, IdentificationError, ScenarioError
 from testbed.core.measurement import Measurement
 from testbed.pipeline.plugins import rig_class
 from testbed.pipeline.scenario import load_scenario, scenario_from_dict
@@ -137,6 +137,13 @@ def test_inputs_enter_the_library_and_the_simulation():
     # 1e-4: the input is interpolated linearly between 10 ms samples, an error of up to
     # h^2 |u''| / 8 = 1.25e-5 in u; through the unit-rate decay it stays of that order in x
     assert np.max(np.abs(sim.x[0] - x)) < 1e-4
+    # the law has one input: simulating it without it, or with two, is refused in one line
+    # (the compiled kernel read past the rows it was given: u = None simulated u = 1)
+    for bad in (None, np.vstack([u, u])):
+        with pytest.raises(ArgumentError, match=r"simulate: argument 'u'.*u of shape \(1, 300\)"):
+            model.simulate(np.array([1.0]), None, t, bad)
+    with pytest.raises(ArgumentError, match="argument 'x0'"):
+        model.simulate(np.array([1.0, 0.0]), None, t, u[None])
 
 
 def _noisy_mm(rig_params: dict, rms_percent: float, seed: int = 3):

@@ -49,6 +49,16 @@ def test_a_determinant_crossing_zero_is_found_where_it_changes_sign():
     assert gain_crossing(np.array([-1.0, -3.0])) == -1
 
 
+def test_a_determinant_touching_zero_at_round_off_is_zero_whichever_its_sign():
+    # zero is a band (GAIN_ZERO_EPS eps of the largest |det|), so the last bit's sign decides
+    # nothing: +1e-17 and -1e-17 against a largest 1 both exclude the pair at that state
+    assert gain_crossing(np.array([1.0, 0.5, 1e-17, 0.7])) == 2
+    assert gain_crossing(np.array([1.0, 0.5, -1e-17, 0.7])) == 2
+    assert gain_crossing(np.array([-1.0, -0.5, 1e-17, -0.7])) == 2
+    assert gain_crossing(np.array([1.0, 0.5, 1e-12, 0.7])) == -1  # above the band: a sign
+    assert gain_crossing(np.array([1e-17, 0.5, 0.7])) == 0
+
+
 def test_equations_singular_at_a_state_are_named():
     q, dq = _states(1.0)
     det, index, why = _model(0.0, 0.0).gain_determinants(q, dq, np.ones(2))  # no ddth2 at all

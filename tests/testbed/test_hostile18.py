@@ -14,7 +14,12 @@ import pytest
 from testbed import cli
 from testbed.core.dataset import Dataset, Signal
 from testbed.core.errors import ArgumentError
-from testbed.pipeline.importers import MeasuredDataError, measurement_from_file, read_measured
+from testbed.pipeline.importers import (
+    MeasuredDataError,
+    check_hdf5_storage,
+    measurement_from_file,
+    read_measured,
+)
 from testbed.pipeline.scenario import load_scenario
 from testbed.pipeline.signal_chain import measure
 from testbed.reporting.export import export_dataset
@@ -78,6 +83,19 @@ def test_identify_of_a_virtual_dataset_file_is_one_line(tmp_path, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert status == 2 and len(err) == 1 and "measured/acceleration" in err[0], err
     assert not (tmp_path / "m.json").exists()
+
+
+def test_a_storage_check_that_cannot_inspect_an_array_refuses_the_file(tmp_path, monkeypatch):
+    # review, session 19: an error inside the inspection (a quirk of a crafted file) returned
+    # from the check and the file went on to be read, virtual arrays and all: it fails closed
+    path = _saved(tmp_path)
+
+    def broken(self, func):
+        raise RuntimeError("unreadable property list")
+
+    monkeypatch.setattr(h5py.Group, "visititems", broken)
+    with pytest.raises(MeasuredDataError, match=r"cannot be inspected.*unreadable property list"):
+        check_hdf5_storage(path)
 
 
 def test_a_compressed_dataset_file_is_still_read(tmp_path):

@@ -562,6 +562,18 @@ def test_sensors_that_read_dependent_signals_are_refused_at_load():
     hinge2 = 4 / 3 * L / 10
     with pytest.raises(ScenarioError, match="at most 1 sensor on segment 1 "):
         scenario_from_dict(beam({"sensors": [0.02, hinge2, L]}, excitation={"location": L}))
+    # ... and so does one within HINGE_SNAP (1e-5 of a segment) outboard of it (review, session
+    # 19: 1e-9..1e-7 m outboard of hinge 1 of a 3-segment beam was counted on segment 2 and
+    # built a reduction of condition 2e33); 2 um outboard (2e-5 of a segment) is a sensor there
+    x1 = 4 / 3 * L / 3
+    with pytest.raises(ScenarioError, match="at most 1 sensor on segment 1 "):
+        scenario_from_dict(beam({"n_segments": 3, "sensors": [0.1, x1 + 1e-7, L]},
+                                excitation={"location": L}))
+    scenario_from_dict(beam({"n_segments": 3, "sensors": [0.1, x1 + 2e-6, L]},
+                            excitation={"location": L}))
+    with pytest.raises(ScenarioError, match="outboard of the root hinge at 0 m"):
+        scenario_from_dict(beam({"base": "soft", "sensors": [1e-9, 0.2, L]},
+                                excitation={"location": L}))
     # a soft base's stub (0 to the first hinge) turns on the base's rotation alone
     with pytest.raises(ScenarioError, match=r"at most 1 sensor on segment 1 \(0-0.0105833 m\)"):
         scenario_from_dict(beam({"base": "soft", "sensors": [0.002, 0.005, L]},

@@ -7,7 +7,7 @@ import pytest
 from testbed.core.truth import StructuralTruth
 from testbed.pipeline.generate import generate
 from testbed.pipeline.scenario import load_scenario
-from testbed.pipeline.signal_chain import measure, rest_padding
+from testbed.pipeline.signal_chain import measure, rest_before, rest_padding
 from testbed.scoring.run import noise_free
 from testbed.scoring.scorers import truth_trac
 
@@ -59,3 +59,16 @@ def test_the_span_follows_the_low_pass():
     force = np.roll(force, 38)
     assert rest_padding(cfg, 12800.0, force) == 0
     assert rest_padding(cfg, 12800.0, np.zeros((1, 1000))) == 0
+
+
+def test_the_rest_put_before_is_each_channels_level_before_the_pulse():
+    # review, session 19: zeros before a record with a bias (an imported one) put a step at the
+    # join; the rest is each channel's median before the pulse (exactly 0 on a simulated
+    # record), robust to a sample of response onset, and 0 with fewer than 8 samples there
+    z = np.vstack([0.6 + np.zeros(12), np.zeros(12)])
+    z[:, 9:] = [[9.0, 3.0, 1.0], [4.0, 1.0, 2.0]]
+    z[0, 8] = 5.0  # the response's onset just before the force's first nonzero sample
+    out = rest_before(z, 9, 4)
+    assert out.shape == (2, 16) and np.array_equal(out[:, 4:], z)
+    assert np.array_equal(out[0, :4], np.full(4, 0.6)) and np.array_equal(out[1, :4], np.zeros(4))
+    assert np.array_equal(rest_before(z, 7, 2)[:, :2], np.zeros((2, 2)))
