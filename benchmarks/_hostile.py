@@ -8,6 +8,8 @@ two-line or overlong error and every other exception are findings.
 
 from __future__ import annotations
 
+import contextlib
+import io
 import os
 import signal
 import subprocess
@@ -170,3 +172,16 @@ def base_scenario(bases: dict[str, tuple[str, float]], kind: str) -> tuple[str, 
     raw["simulation"]["duration"] = cut
     raw.pop("score", None)
     return base, raw
+
+
+def cli_inprocess(argv: list[str]) -> tuple[int, str, str]:
+    """``testbed argv`` in this process: (status, stdout, stderr)."""
+    from testbed import cli
+
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        try:
+            status = cli.main(argv)
+        except SystemExit as e:  # argparse's own refusal
+            status = e.code if isinstance(e.code, int) else 2
+    return status, out.getvalue(), err.getvalue()

@@ -91,9 +91,7 @@ Prints one line a finding and the counts; exits 1 if any finding.
 
 from __future__ import annotations
 
-import contextlib
 import datetime
-import io
 import json
 import math
 import os
@@ -116,17 +114,8 @@ TIMEOUT_S = 180
 CACHE = ROOT / ".cache" / "datasets"
 
 
-def cli_inprocess(argv: list[str]) -> tuple[int, str, str]:
-    """``testbed argv`` in this process: (status, stdout, stderr)."""
-    from testbed import cli
-
-    out, err = io.StringIO(), io.StringIO()
-    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-        try:
-            status = cli.main(argv)
-        except SystemExit as e:  # argparse's own refusal
-            status = e.code if isinstance(e.code, int) else 2
-    return status, out.getvalue(), err.getvalue()
+#: ``testbed argv`` in this process: (status, stdout, stderr).
+cli_inprocess = _hostile.cli_inprocess
 
 
 def judged(status: int, out: str, err: str, refuse: bool = False) -> str | None:
