@@ -262,7 +262,7 @@ def test_hammer_between_sensors_is_refused_naming_the_nearest():
         scenario_from_dict(beam(excitation={"location": 0.16}), file="hit.toml")
     msg = str(e.value)
     assert "hit.toml" in msg and "'excitation.location'" in msg and "0.16" in msg
-    assert "sensors at 0.105833, 0.211667, 0.3175 m" in msg and "51.7 mm from the nearest" in msg
+    assert "sensors at 0.105833, 0.211667, 0.3175 m" in msg and "51.6667 mm from the nearest" in msg
 
 
 def test_beam_below_mujocos_smallest_inertia_names_the_key():
