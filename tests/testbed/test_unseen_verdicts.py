@@ -21,6 +21,7 @@ from testbed.scoring.run import run_scenario
 from testbed.scoring.scorers import (
     FAIL,
     GROWTH_FACTOR,
+    REDUCED_TRUTH_GAP,
     Scores,
     growth_failure,
     late_growth,
@@ -586,11 +587,12 @@ def test_sensors_that_read_dependent_signals_are_refused_at_load():
 def test_one_sensor_per_inboard_hinge_keeps_the_true_modes(base, sensors):
     # the count is exact, not conservative: one sensor on each of segments 1, 2, 3 (the fewest
     # hinges a set of three may turn on) is accepted, and its reduction holds the engine's modes
-    # to SEREP's round-off (gap below 1e-9; a dependent set's is 0.79)
+    # within the scorer's own bar for a reduction that holds them, REDUCED_TRUTH_GAP (1e-5: round-off
+    # times Mr's condition; measured 1e-13..1.6e-9 here, native and Haswell kernels, a dependent set's 0.79)
     sc = scenario_from_dict(beam({"base": base, "sensors": sensors},
                                  excitation={"location": sensors[-1]}))
     m = build_model(sc.rig_params, sc.simulation, sc.excitation)
-    assert reduced_truth_gap(m.red.Mr, m.red.Kr, m.freqs)[0] < 1e-9
+    assert reduced_truth_gap(m.red.Mr, m.red.Kr, m.freqs)[0] < REDUCED_TRUTH_GAP
 
 
 def test_the_reduced_truth_holds_the_true_modes_unless_sensors_are_dependent():
