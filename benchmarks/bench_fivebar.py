@@ -107,7 +107,7 @@ def _identified_rows() -> list[dict]:
     h = (data.t[-1] - data.t[0]) / n_steps
     tt = data.t[0] + 0.5 * h * np.arange(2 * n_steps + 1)
     uu = np.ascontiguousarray(np.stack([np.interp(tt, data.t, r) for r in data.u]))
-    q0, dq0 = model._complete(data.x[:, :1].copy(), data.xd[:, :1].copy())
+    q0, dq0 = model.complete(data.x[:, :1].copy(), data.xd[:, :1].copy())
     n = q0.shape[0]
     bufs = [np.empty((n_steps + 1, n)) for _ in range(3)]
 
