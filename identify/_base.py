@@ -492,6 +492,14 @@ def _guard_fit(fit: Callable[..., Identifier]) -> Callable[..., Identifier]:
         if y is not None:
             raise ArgumentError(where, "y", args.describe(y), "expected None (the targets are in "
                                 "data)", described=True)
+        made = getattr(data, "kind", None)
+        if made is not None and self.kind and made != self.kind:
+            # the command line refuses the pairing by kind; the API had fitted it silently
+            # (hostile round 18: sindy_pi_dynamical fitted a beam's accelerations)
+            raise ArgumentError(where, "data", f"a {made} record",
+                                f"expected a {self.kind} record ({type(self).__name__} is a "
+                                f"{self.kind} identifier; `testbed list` shows each "
+                                f"identifier's kind)", described=True)
         self.check_params_for_data(data)
         free = data.n_samples - data.free_start
         if self.kind == "structural" and free < MIN_FREE_SAMPLES:

@@ -72,6 +72,11 @@ class Measurement:
         ``"zoh"`` each sample held until the next (an actuator driven by a DAC), ``"linear"`` a
         continuous signal.  A simulation of an identified model needs it (taking held inputs
         for linear ones adds an impulse of half a sample at the start).  None = not declared.
+    kind : str, optional
+        The rig kind whose signal chain made it (``"structural"``, ``"mechanical"``,
+        ``"dynamical"``: :func:`testbed.pipeline.signal_chain.measure` sets it); an identifier
+        of another kind refuses it in one line, as the command line refuses the pairing.  None =
+        not declared (a measurement built by hand).
     """
 
     fs: float
@@ -90,6 +95,7 @@ class Measurement:
     noise_std: np.ndarray | None = None
     chain_poles: np.ndarray | None = None
     input_hold: str | None = None
+    kind: str | None = None
 
     def __post_init__(self) -> None:
         """Check every field once, where a measurement is made (the shared rules of
@@ -164,6 +170,8 @@ class Measurement:
                                                 complex_ok=True))
         args.choice(where, "integration", self.integration, ("exact", "trapezoid"))
         args.choice(where, "input_hold", self.input_hold, (None, "zoh", "linear"))
+        if self.kind is not None and not isinstance(self.kind, str):
+            raise ArgumentError(where, "kind", self.kind, "expected a rig kind's name or None")
 
     @property
     def n_channels(self) -> int:

@@ -8,6 +8,7 @@ identifier is handed is what a lab would have.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
@@ -364,7 +365,9 @@ def measure(dataset: Dataset, signal_cfg: Mapping[str, Any], kind: str) -> Measu
                             f"{made!r}; its signals go through that kind's chain")
     chain = _chain(kind)
     cfg = validate_table(dict(signal_cfg), chain.schema, file="<signal config>", section="signal")
-    return chain.measure(dataset, cfg)
+    m = chain.measure(dataset, cfg)
+    # the kind whose chain made it, for an identifier of another kind to refuse
+    return dataclasses.replace(m, kind=kind) if isinstance(m, Measurement) and m.kind is None else m
 
 
 def _get(dataset: Dataset, name: str, rows: int | None = None) -> np.ndarray:

@@ -11,9 +11,11 @@ import h5py
 import numpy as np
 import pytest
 
+from identify.sindy_pi_dynamical import SINDyPIDynamical
 from testbed import cli
 from testbed.core.dataset import Dataset, Signal
 from testbed.core.errors import ArgumentError
+from testbed.core.measurement import Measurement
 from testbed.pipeline.importers import (
     MeasuredDataError,
     check_hdf5_storage,
@@ -154,6 +156,23 @@ def test_measure_of_a_dataset_through_another_kinds_chain_is_refused(dataset_cac
     with pytest.raises(ArgumentError, match=r"argument 'kind'.*'structural'.*kind 'dynamical'"):
         measure(ds, {}, "structural")
     assert measure(ds, sc.signal, "dynamical").n_samples == ds.measured["x"].data.shape[1]
+
+
+def test_an_identifier_given_another_kinds_record_by_the_api_refuses_it(dataset_cache):
+    # round 18: sindy_pi_dynamical fitted a beam's accelerations and force given to it by the
+    # API without a word (the command line refuses the pairing by kind); a measurement now
+    # carries the kind whose chain made it, and a hand-built one (kind None) is fitted as before
+    sc = load_scenario("cantilever_stiff_impact")
+    m = measure(dataset_cache.get(sc), sc.signal, "structural")
+    assert m.kind == "structural"
+    with pytest.raises(ArgumentError, match=r"SINDyPIDynamical.fit: argument 'data': a structural "
+                                            r"record: expected a dynamical record"):
+        SINDyPIDynamical().fit(m)
+    mm = load_scenario("michaelis_menten")
+    rec = measure(dataset_cache.get(mm), mm.signal, "dynamical")
+    assert rec.kind == "dynamical"
+    hand = Measurement(fs=rec.fs, x=rec.x, xd=rec.xd, xdd=rec.xdd, channels=rec.channels)
+    assert hand.kind is None and SINDyPIDynamical().fit(hand).coef_.size
 
 
 # ------------------------------------------------------------------ a unit given against the file's
