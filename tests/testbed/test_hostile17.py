@@ -29,6 +29,7 @@ from testbed.pipeline.importers import (
 )
 from testbed.reporting.export import export_dataset
 from testbed.studies.runstore import list_runs, load_run, save_new_run
+from tests.testbed._saved_record import FS, saved_record
 
 
 def _mm_record(path: Path, fs: float, rate_scale: float = 1.0) -> Path:
@@ -66,16 +67,6 @@ def test_identify_of_a_record_relabelled_to_a_huge_rate_is_refused_in_one_line(t
 
 # ------------------------------------------------------------------ a dataset file's rate attributes
 
-FS = 1000.0  # Hz; 400 samples of a 7 Hz sine: any rate and length the readers accept
-
-
-def _saved(tmp_path: Path) -> Path:
-    """A hand-made record (no kind: no truth to validate), saved with its content hash."""
-    t = np.arange(400) / FS
-    acc = np.vstack([np.sin(2 * np.pi * 7 * t) * (k + 1) for k in range(2)])
-    ds = Dataset(FS, {"acceleration": Signal(acc, ("acc1", "acc2"), "m/s^2"),
-                      "force": Signal(np.exp(-t / 0.01)[None, :], ("force",), "N")})
-    return ds.save(tmp_path / "d.h5")
 
 
 def _rehashed(path: Path, key: str, value) -> Path:
@@ -102,7 +93,7 @@ def _rehashed(path: Path, key: str, value) -> Path:
     ("fs_unit", np.bytes_(b"s"), "fs_unit='s'"),
 ], ids=["text", "bool", "complex", "kHz", "bytes_s"])
 def test_a_dataset_files_rate_must_be_one_real_number_in_hz(tmp_path, capsys, key, value, said):
-    path = _rehashed(_saved(tmp_path), key, value)
+    path = _rehashed(saved_record(tmp_path), key, value)
     with pytest.raises(MeasuredDataError, match=rf"attribute {re.escape(said)}.*expected"):
         read_measured(path)
     with pytest.raises(MeasuredDataError, match=re.escape(said)):
@@ -114,7 +105,7 @@ def test_a_dataset_files_rate_must_be_one_real_number_in_hz(tmp_path, capsys, ke
 
 
 def test_a_dataset_files_integer_rate_in_hz_is_read(tmp_path):
-    path = _rehashed(_saved(tmp_path), "fs", np.int64(1000))  # an integer is a real number
+    path = _rehashed(saved_record(tmp_path), "fs", np.int64(1000))  # an integer is a real number
     assert read_measured(path).fs == FS
 
 
@@ -143,7 +134,7 @@ def test_sep005_channels_that_start_at_other_times_are_refused(tmp_path):
 def test_uff_records_that_start_at_other_times_are_refused(tmp_path):
     import pyuff
 
-    src = export_dataset(_saved(tmp_path), "uff", tmp_path / "d.uff")[0]
+    src = export_dataset(saved_record(tmp_path), "uff", tmp_path / "d.uff")[0]
     sets = pyuff.UFF(str(src)).read_sets()
     assert read_measured(src).fs == pytest.approx(FS)  # as exported: one start
     last = max(k for k, s in enumerate(sets) if s["type"] == 58)
@@ -159,7 +150,7 @@ def test_uff_records_that_start_at_other_times_are_refused(tmp_path):
 def test_a_dataset_signal_naming_a_channel_twice_is_refused(tmp_path):
     # channels ("acc1", "acc1"): the second replaced the first in the reader's channel table,
     # and a cantilever record of three accelerations was fitted on two (status 1, round 17)
-    path = _saved(tmp_path)
+    path = saved_record(tmp_path)
     with h5py.File(path, "r+") as f:
         f["measured/acceleration"].attrs["channels"] = np.array(["acc1", "acc1"],
                                                                 dtype=h5py.string_dtype())
@@ -434,7 +425,7 @@ def test_to_dataset_refuses_a_prior_that_is_not_one(tmp_path, prior, said):
     ({"path": None}, r"'path': value None: of type NoneType"),
 ], ids=["UFF", "None", "out int", "out bytes", "path None"])
 def test_export_dataset_refuses_arguments_that_are_not_its_own(tmp_path, kwargs, said):
-    args = {"path": _saved(tmp_path), "fmt": "uff", "out": tmp_path / "d.uff", **kwargs}
+    args = {"path": saved_record(tmp_path), "fmt": "uff", "out": tmp_path / "d.uff", **kwargs}
     with pytest.raises(ArgumentError, match=said):
         export_dataset(args["path"], args["fmt"], args["out"])
 
@@ -442,7 +433,7 @@ def test_export_dataset_refuses_arguments_that_are_not_its_own(tmp_path, kwargs,
 def test_an_atomic_write_onto_a_folder_is_refused_naming_it(tmp_path):
     (tmp_path / "f").mkdir()
     with pytest.raises(InputError, match=r"/f: is a folder; expected a file path"):
-        export_dataset(_saved(tmp_path), "uff", tmp_path / "f")
+        export_dataset(saved_record(tmp_path), "uff", tmp_path / "f")
     with pytest.raises(InputError, match=r"is a folder"):
         atomic_write_text(tmp_path / "f", "x")
     assert [p.name for p in tmp_path.iterdir() if p.name.startswith(".")] == []  # no temporary left

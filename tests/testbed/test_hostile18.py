@@ -13,7 +13,7 @@ import pytest
 
 from identify.sindy_pi_dynamical import SINDyPIDynamical
 from testbed import cli
-from testbed.core.dataset import Dataset, Signal
+from testbed.core.dataset import Dataset
 from testbed.core.errors import ArgumentError
 from testbed.core.measurement import Measurement
 from testbed.pipeline.importers import (
@@ -25,24 +25,14 @@ from testbed.pipeline.importers import (
 from testbed.pipeline.scenario import load_scenario
 from testbed.pipeline.signal_chain import measure
 from testbed.reporting.export import export_dataset
-
-FS = 1000.0  # Hz; 400 samples of a 7 Hz sine: any rate and length the readers accept
-
-
-def _saved(tmp_path: Path) -> Path:
-    """A hand-made record (no kind: no truth to validate), saved with its content hash."""
-    t = np.arange(400) / FS
-    acc = np.vstack([np.sin(2 * np.pi * 7 * t) * (k + 1) for k in range(2)])
-    ds = Dataset(FS, {"acceleration": Signal(acc, ("acc1", "acc2"), "m/s^2"),
-                      "force": Signal(np.exp(-t / 0.01)[None, :], ("force",), "N")})
-    return ds.save(tmp_path / "d.h5")
+from tests.testbed._saved_record import FS, saved_record
 
 
 def _values_elsewhere(tmp_path: Path, how: str) -> Path:
     """The saved record with ``measured/acceleration`` keeping its values in another file
     (``how``: "virtual" or "external"), its content hash made anew (as a user's edit would):
     the hash is of the values read, so it matches."""
-    path = _saved(tmp_path)
+    path = saved_record(tmp_path)
     name = "measured/acceleration"
     with h5py.File(path, "r+") as f:
         attrs, data = dict(f[name].attrs), f[name][()]
@@ -90,7 +80,7 @@ def test_identify_of_a_virtual_dataset_file_is_one_line(tmp_path, capsys):
 def test_a_storage_check_that_cannot_inspect_an_array_refuses_the_file(tmp_path, monkeypatch):
     # review, session 19: an error inside the inspection (a quirk of a crafted file) returned
     # from the check and the file went on to be read, virtual arrays and all: it fails closed
-    path = _saved(tmp_path)
+    path = saved_record(tmp_path)
 
     def broken(self, func):
         raise RuntimeError("unreadable property list")
@@ -102,7 +92,7 @@ def test_a_storage_check_that_cannot_inspect_an_array_refuses_the_file(tmp_path,
 
 def test_a_compressed_dataset_file_is_still_read(tmp_path):
     """Compression (gzip, shuffle, checksums) keeps the values in the file: read as before."""
-    path = _saved(tmp_path)
+    path = saved_record(tmp_path)
     name = "measured/acceleration"
     with h5py.File(path, "r+") as f:
         attrs, data = dict(f[name].attrs), f[name][()]
@@ -211,7 +201,7 @@ def _unknown_filter(tmp_path: Path) -> Path:
     id then patched to 32001 (Blosc) in the file's bytes: an array compressed by a filter this
     installation has no plugin for, made without the plugin.  The earliest file format keeps
     each filter's name after its id (no metadata checksum to redo)."""
-    path = _saved(tmp_path)
+    path = saved_record(tmp_path)
     name = "measured/acceleration"
     with h5py.File(path, "r+", libver="earliest") as f:
         attrs, data = dict(f[name].attrs), f[name][()]
