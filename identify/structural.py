@@ -1218,35 +1218,44 @@ def unwarp_trapezoid(M: np.ndarray, C: np.ndarray, K: np.ndarray, fs: float,
     ``psi``, and ``A = V diag(s) V^-1`` with ``V = [Psi; Psi diag(s)]`` has the companion form
     ``[[0, I], [-M^-1 K, -M^-1 C]]``.
     """
+    return _unwarp(M, C, K, fs, keep_cut)[0]
+
+
+def _unwarp(M: np.ndarray, C: np.ndarray, K: np.ndarray, fs: float, keep_cut: bool
+            ) -> tuple[tuple[np.ndarray, np.ndarray] | None, int]:
+    """:func:`unwarp_trapezoid`'s result and the number of poles on the map's cut
+    (:func:`on_trapezoid_cut`; 0 where the model has no finite state matrix), from one
+    eigensolve."""
     n = M.shape[0]
     try:
         A = state_matrix(M, C, K)
     except np.linalg.LinAlgError:
-        return None
+        return None, 0
     if not np.all(np.isfinite(A)):
-        return None
+        return None, 0
     p, V = linalg.eig(A)
     q = p / (2.0 * fs)
-    if keep_cut and np.any(on_trapezoid_cut(q)):
+    n_cut = int(np.count_nonzero(on_trapezoid_cut(q)))
+    if keep_cut and n_cut:
         A_s = _map_keeping_cut(A, p, V, fs)
         if A_s is None:
-            return None
+            return None, n_cut
     else:  # no pole on the cut (keep_cut then maps as before, to the bit)
         if np.any((np.abs(q.imag) < 1e-12 * (1.0 + np.abs(q))) & (np.abs(q.real) >= 1.0)):
-            return None
+            return None, n_cut
         s = 2.0 * fs * np.arctanh(q.astype(complex))
         psi = V[:n]
         W = np.vstack([psi, psi * s])
         if np.linalg.cond(W) > 1e12:  # defective: the shapes do not span the state space
-            return None
+            return None, n_cut
         A_s = (W * s) @ np.linalg.inv(W)
         if np.abs(A_s.imag).max() > 1e-8 * np.abs(A_s).max():  # poles not in conjugate pairs
-            return None
+            return None, n_cut
     A_s = A_s.real
     C_new, K_new = -M @ A_s[n:, n:], -M @ A_s[n:, :n]
     if np.allclose(C, C.T, rtol=1e-12, atol=0.0) and np.allclose(K, K.T, rtol=1e-12, atol=0.0):
         C_new, K_new = _sym(C_new), _sym(K_new)
-    return C_new, K_new
+    return (C_new, K_new), n_cut
 
 
 # --------------------------------------------------------------------------------------------
@@ -1275,12 +1284,7 @@ def unwarp_rule(M: np.ndarray, C: np.ndarray, K: np.ndarray, fs: float
     rule : str
         What was done, for ``integration_rule_``.
     """
-    try:
-        n_cut = int(np.count_nonzero(on_trapezoid_cut(
-            linalg.eigvals(state_matrix(M, C, K)) / (2.0 * fs))))
-    except (np.linalg.LinAlgError, ValueError):
-        n_cut = 0
-    out = unwarp_trapezoid(M, C, K, fs, keep_cut=True)
+    out, n_cut = _unwarp(M, C, K, fs, keep_cut=True)  # one eigensolve: the count is the map's
     if out is None:
         return None, ("trapezoid integrals, poles left warped: no state matrix, or modes that "
                       "do not span the state space")
