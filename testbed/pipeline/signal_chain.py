@@ -507,7 +507,8 @@ def measure_structural(dataset: Dataset, cfg: Mapping[str, Any]) -> Measurement:
     n = acc.shape[1]
     pad = rest_padding(cfg, fs, force)
     if pad:  # the rest the rig was at before the trigger, cut off again below
-        acc, force = (rest_before(z, pulse_span(force)[0], pad) for z in (acc, force))
+        start = pulse_span(force)[0]
+        acc, force = rest_before(acc, start, pad), rest_before(force, start, pad)
     end = pulse_end(force)
     rest_from = end if (cfg["rest_offset"] and end > 0) else None
     xdd, xd, x = sig.integrate_acceleration(chain_lowpass(acc), fs, *hp_args, rest_from=rest_from)
