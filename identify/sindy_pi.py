@@ -453,7 +453,7 @@ def sim_dt_candidates(fs: float) -> list[float]:
 
 
 def choose_sim_dt(simulate: Callable[[float], np.ndarray], x: np.ndarray,
-                  fs: float) -> tuple[float, str]:
+                  fs: float, step_scale: float = 1.0) -> tuple[float, str]:
     """The step rule: the first of :func:`sim_dt_candidates` whose simulation the next
     candidate moves by at most :data:`SIM_DT_REL_TOL` of the motion (Richardson's test on the
     identified model itself).  A simulation that fails at two successive steps fails for the
@@ -469,6 +469,9 @@ def choose_sim_dt(simulate: Callable[[float], np.ndarray], x: np.ndarray,
         The measured coordinates (their ranges scale the tolerance).
     fs : float
         Sample rate of the record [Hz].
+    step_scale : float
+        Factor [-] on every candidate step, the fallback :data:`SIM_DT_START` included (a stiff
+        law's start, :mod:`identify.sindy_pi_dynamical`; 1 for the mechanical rule).
 
     Returns
     -------
@@ -477,7 +480,8 @@ def choose_sim_dt(simulate: Callable[[float], np.ndarray], x: np.ndarray,
     """
     scale = np.ptp(x, axis=1)
     scale = np.where(scale > 0, scale, 1.0)[:, None]
-    steps = sim_dt_candidates(fs)
+    steps = [dt * step_scale for dt in sim_dt_candidates(fs)]
+    start = steps[0]
     prev = cur = None
     for k, dt in enumerate(steps):
         failed_before = k > 0 and cur is None
@@ -486,7 +490,7 @@ def choose_sim_dt(simulate: Callable[[float], np.ndarray], x: np.ndarray,
         except IdentificationError:
             cur = None
         if cur is None and failed_before:  # a failure that a finer step does not cure
-            return SIM_DT_START, (f"{SIM_DT_START:g} s: the model's simulation fails at "
+            return start, (f"{start:g} s: the model's simulation fails at "
                                   f"{steps[k - 1]:.3g} s and {dt:.3g} s alike (the step does "
                                   "not decide it)")
         if cur is not None and prev is not None:
@@ -497,10 +501,10 @@ def choose_sim_dt(simulate: Callable[[float], np.ndarray], x: np.ndarray,
                                       f"(<= {SIM_DT_REL_TOL:g})")
         prev = cur
     if cur is None:
-        return SIM_DT_START, (f"{SIM_DT_START:g} s: the model's simulation fails at the finest "
-                              f"step, {steps[-1]:.3g} s (the step does not decide it)")
+        return start, (f"{start:g} s: the model's simulation fails at the finest "
+                       f"step, {steps[-1]:.3g} s (the step does not decide it)")
     return steps[-1], (f"{steps[-1]:.3g} s: not converged to {SIM_DT_REL_TOL:g} of the "
-                       f"motion's range at any step from {SIM_DT_START:g} s (the finest kept)")
+                       f"motion's range at any step from {start:g} s (the finest kept)")
 
 
 def prune_dependent(G: np.ndarray, protected: np.ndarray, tol: float) -> np.ndarray:

@@ -784,22 +784,19 @@ class SINDyPIDynamical(Identifier):
 
         done: dict[bytes, np.ndarray] = {}
 
-        def simulate(dt: float) -> np.ndarray:
+        def simulate(h: float) -> np.ndarray:
             # a step at or above the sample interval runs one step per sample (the RK4 steps
             # per interval are those of _simulate_states): candidates with the same steps give
             # the same array and are not simulated twice (a 5 kHz record: 1 and 0.5 ms both
             # step at 0.2 ms)
-            h = dt * scale
             key = np.maximum(1.0, np.ceil(np.diff(t) / h - 1e-9)).tobytes()
             if key not in done:
                 done[key] = self._simulate_states(x[:, 0], t, u, h)[0]
             return done[key]
 
-        dt, rule = choose_sim_dt(simulate, x, data.fs)
-        if scale != 1.0:   # the rule's sentence names its own (unscaled) steps: in seconds here
-            rule = re.sub(r"(?<![\w.])(\d+(?:\.\d+)?(?:e[+-]?\d+)?) s\b",
-                          lambda m: f"{float(m.group(1)) * scale:.3g} s", rule)
-        self.sim_dt_, self.sim_dt_rule_ = dt * scale, f"{rule}; {why}"
+        # the rule's candidates scaled inside it, so that its sentence names the steps taken
+        dt, rule = choose_sim_dt(simulate, x, data.fs, step_scale=scale)
+        self.sim_dt_, self.sim_dt_rule_ = dt, f"{rule}; {why}"
 
     def _start_scale(self, x: np.ndarray, u: np.ndarray | None) -> tuple[float, str]:
         """The factor (1 or a power of 1/2, at least 2^-:data:`MAX_START_HALVINGS`) by which the
