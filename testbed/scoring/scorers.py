@@ -1498,9 +1498,11 @@ def law_witness(score: str, names: list[str], coef: np.ndarray, x0: np.ndarray,
 #: The share of the rig's law bar by which the witness's laws are off (at most the identified
 #: law's own error): a rollout bar that laws 100x closer to the truth than the law bar admits
 #: still fail is the record's, not the law's (round 19's cp19_amp6, the pole over the top:
-#: off by 0.0025, 8-15 rad).  Laws off by the identified law's whole error would claim records
-#: that only a large law error fails (round 16's cp16_3s at 1 %, seed 72: law_error 0.156,
-#: 0.108 rad against 0.0501, the law off by 0.156 0.18 rad; off by 0.0025 0.003).
+#: off by 0.0025, 11.7 rad; round 10's cp10_strong_wide, 0.68-3.7 rad).  Laws off by the
+#: identified law's whole error would claim records that only a large law error fails (round
+#: 16's cp16_3s at 1 %, seed 72: law_error 0.156, 0.108 rad against 0.0501, the law off by 0.156
+#: 0.18 rad; off by 0.0025 0.003).  Of rounds 6-19's 243 cart-pole cells it acts on those two
+#: rigs' six alone (docs/known-gaps.md, round 19).
 SENSITIVE_LAW_SHARE = 0.01
 
 
@@ -1519,7 +1521,7 @@ def sensitivity_failures(scores: Scores, thresholds: dict[str, dict[str, float]]
     fails the rollout bar ("sensitive": the record amplifies any law error).  Reasons only:
     the bar's failure stands (no verdict changes).  Round 19's ``cp19_amp6`` (a 6 N
     multisine: the pole turns over the top, th2 -9.05..19.8 rad) at 1 %: law_error 0.0030,
-    angle_rmse 11.5 rad, named nothing; the true law 1.8e-6 rad, off by 0.0025 8-15 rad.
+    angle_rmse 11.5 rad, named nothing; the true law 1.8e-6 rad, off by 0.0025 11.7 rad.
 
     Parameters
     ----------

@@ -641,7 +641,7 @@ def test_a_rollout_failed_on_a_sensitive_record_is_named():
     at 1 %, seed 103: the identified law is within 0.30 % of the truth (law_error 0.0030, the
     rig's bar 0.25), but its rollout ends 11.5 rad from the record, a failure with no reason.
     The true law rolled out by the scorer meets the bar (1.8e-6 rad); off by 0.0025 (1 % of the
-    law bar: its accelerations scaled by 1 +/- 0.0025) it fails it by as much (8-15 rad)."""
+    law bar: its accelerations scaled by 1 +/- 0.0025) it fails it by as much (11.7 rad)."""
     sc = load_scenario(_root() / "benchmarks" / "unseen" / "round19" / "cp19_amp6.toml")
     sc = dataclasses.replace(sc, seed=103)
     r = run_scenario(sc)  # the scenario's own 1 % noise
@@ -650,7 +650,7 @@ def test_a_rollout_failed_on_a_sensitive_record_is_named():
     assert why.startswith("sensitive record: angle_rmse 11") and "law_error 0.00304" in why
     assert "scaled by 1 +/- 0.0025 " in why and r.scores.details["law_off"] == 0.0025
     assert r.scores.details["angle_rmse_true_law"] < 1e-5  # [rad]: the witness's own floor
-    assert r.scores.details["angle_rmse_law_off"] > 1.0  # [rad]: 8-15 measured
+    assert r.scores.details["angle_rmse_law_off"] > 1.0  # [rad]: 11.7 measured
     assert set(r.scores.failures) == {"sensitive"}
 
 
