@@ -13,7 +13,8 @@ m, couplers 0.7 / 1.2 m, ground 0.8 m), and records of 5 s and 15 s (rounds 3 an
 under their own inputs, round 18 1 s and 30 s).  Cart-poles under ``cartpole_noise1``'s multisine
 and chain: a heavy short pole (1.2 kg, 0.45 m), a light cart (0.7 kg), hinge damping 0.02 N m s/rad
 (rounds 11-12 drew 0.05-0.5), Mars gravity (3.71 m/s^2; round 14 drew the Moon's), a 1.5 N m
-multisine on 5 s, and a 6 N multisine.  Kinetics: Vmax 4 with Km 0.7 and a 6 mM dose (x* 0.24 mM),
+multisine on 5 s, a 6 N multisine (the pole turns over the top), and towards that onset 3 N, 4 N on
+a 0.3 m pole and 2.5 N on 20 s.  Kinetics: Vmax 4 with Km 0.7 and a 6 mM dose (x* 0.24 mM),
 a weak influx with a small Km (0.1 mM/s, Km 0.15: x* 0.011 mM), an influx near a slow Vmax (0.75
 of 0.9 mM/s: x* 1.5 mM, 8 s), a 12 s record at 500 Hz, and Km 0.7 mM rising from a 0.1 mM dose.
 Noise levels and seeds 101-105 are the studies' (round19_linkages_*.toml).
@@ -54,6 +55,12 @@ CARTPOLES: dict[str, tuple[str, dict[str, dict]]] = {
     "cp19_amp1p5_5s": ("a 1.5 N multisine on a 5 s record",
                        {"simulation": {"duration": 5.0}, "excitation": {"amplitude": 1.5}}),
     "cp19_amp6": ("a 6 N multisine", {"excitation": {"amplitude": 6.0}}),
+    # towards the pole's turning over (round19_linkages_cartpoles_onset.toml)
+    "cp19_amp3": ("a 3 N multisine", {"excitation": {"amplitude": 3.0}}),
+    "cp19_amp4_L0p3": ("a 4 N multisine on a 0.3 m pole",
+                       {"rig": {"pole_length": 0.3}, "excitation": {"amplitude": 4.0}}),
+    "cp19_amp2p5_20s": ("a 2.5 N multisine on a 20 s record",
+                        {"simulation": {"duration": 20.0}, "excitation": {"amplitude": 2.5}}),
 }
 
 #: name -> (description, {table: keys changed from michaelis_menten_noise1}); Km 0.3, Vmax 1.5,
