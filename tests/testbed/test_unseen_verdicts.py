@@ -704,7 +704,8 @@ def test_the_law_witness_is_simulated_only_where_it_can_act_and_off_by_a_share_o
                                          ("round19_linkages_cartpoles", 18),
                                          ("round19_linkages_kinetics", 15),
                                          ("round19_linkages_seeds", 10),
-                                         ("round19_linkages_cartpoles_onset", 9)])
+                                         ("round19_linkages_cartpoles_onset", 9),
+                                         ("round19_beams_extra", 12)])
 def test_round19_studies_load(name, cells):
     study = load_study(_root() / "benchmarks" / "unseen" / f"{name}.toml")
     assert study.name == name and study.n_cells() == cells

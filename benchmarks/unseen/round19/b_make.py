@@ -15,7 +15,8 @@ fractions 0.05-2 (the families draw 0.5-3 EI/L and 0-0.6; rounds 13 and 17 went 
 and 0.65-3) under 1.5-3x the shipped 50 N; the hammer at mid-span (0.5 L) on the clamped beam with
 five sensors and with three at 4 % damping, and on a 15 EI/L soft base (round 13 drew mid-span
 hammers on 5 s records at 6.4 kHz); the shipped beam at 0.05 % damping on 8 s (rounds 11 / 14
-drew 0.05-0.1 % on 1-5 s).  Noise 0 / 1 / 2 % and seeds 101-102 are the studies'
+drew 0.05-0.1 % on 1-5 s), and the shipped soft base at 0.05 % damping on 8 s; a base of 50 EI/L
+(cubic fraction 0.1, 100 N, 2 s).  Noise 0 / 1 / 2 % and seeds 101-102 are the studies'
 (round19_beams*.toml).
 """
 
@@ -88,6 +89,13 @@ CASES: dict[str, tuple[str, dict, dict, dict, dict]] = {
                             {"location": _S3MID[1]}, {}),
     "b19_st_z0p05_8s": ("the shipped beam, 0.05 % damping, 8 s", {"damping_ratio": 0.0005},
                         {"duration": 8.0}, {}, {}),
+    # a light damping on a soft base over a long record, the stiffest base (round19_beams_extra.toml)
+    "b19_soft_r1p2_cf0p3_z0p05_8s": ("the shipped beam on k1 = 1.2 EI/L, cubic fraction 0.3, 0.05 % "
+                                     "damping, 8 s", {**soft(1.2, 0.3, {}), "damping_ratio": 0.0005},
+                                     {"duration": 8.0}, {}, {}),
+    "b19_soft_r50_cf0p1_f100_2s": ("the shipped beam on k1 = 50 EI/L, cubic fraction 0.1, 100 N, 2 s",
+                                   {**soft(50.0, 0.1, {}, _F["f100"])}, {"duration": 2.0},
+                                   {**_F["f100"]}, {}),
     "b19_al_s3_hitmid_f150": ("aluminium, the shipped section, sensors 0.3 / 0.5 / 1 L, a 150 N hit "
                               "at mid-span", {**AL, "sensors": _S3MID}, {},
                               {"location": _S3MID[1], **_F["f150"]}, {}),
