@@ -24,6 +24,7 @@ equation still scores badly; only the arbitrary choice among equivalent forms is
 
 from __future__ import annotations
 
+import functools
 import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
@@ -70,30 +71,51 @@ def evaluate_terms(names: Sequence[str], signals: Mapping[str, np.ndarray]) -> n
     ndarray, shape (n, len(names))
     """
     n = np.shape(signals["th"])[1]
-    cache: dict[str, np.ndarray] = {}
+    cache: dict[tuple, np.ndarray] = {}
 
-    def factor(f: str) -> np.ndarray:
-        if f not in cache:
-            mt, mv = _TRIG.match(f), _VAR.match(f)
-            if mt:
-                fn, i, j = mt.groups()
-                arg = signals["th"][int(i) - 1] - (signals["th"][int(j) - 1] if j else 0.0)
-                cache[f] = np.sin(arg) if fn == "sin" else np.cos(arg)
-            elif mv:
-                cache[f] = np.asarray(signals[mv.group(1)][int(mv.group(2)) - 1], dtype=float)
+    def factor(spec: tuple) -> np.ndarray:
+        if spec not in cache:
+            if spec[0] in ("sin", "cos"):
+                fn, i, j = spec
+                arg = signals["th"][i] - (signals["th"][j] if j is not None else 0.0)
+                cache[spec] = np.sin(arg) if fn == "sin" else np.cos(arg)
             else:
-                raise ValueError(f"cannot evaluate factor {f!r}")
-        return cache[f]
+                cache[spec] = np.asarray(signals[spec[1]][spec[2]], dtype=float)
+        return cache[spec]
 
     out = np.empty((len(names), n))
-    for c, name in enumerate(names):
+    for c, factors in enumerate(term_plan(tuple(names))):
         col = np.ones(n)
+        for spec, power in factors:
+            col = col * factor(spec) ** power
+        out[c] = col
+    return out.T
+
+
+@functools.lru_cache(maxsize=256)
+def term_plan(names: tuple[str, ...]) -> tuple[tuple[tuple[tuple, int], ...], ...]:
+    """Product terms parsed once: per term, its factors as ``(spec, power)`` in written order.
+
+    A spec is ``("sin" | "cos", i, j)`` (``j`` None without a difference) or ``("var", signal,
+    i)``, 0-based; ``"1"`` has no factors.  Raises ValueError on a factor it cannot read.
+    """
+    plan = []
+    for name in names:
+        factors = []
         if name != "1":
             for raw in name.split("*"):
                 base, _, power = raw.partition("^")
-                col = col * factor(base) ** (int(power) if power else 1)
-        out[c] = col
-    return out.T
+                mt, mv = _TRIG.match(base), _VAR.match(base)
+                if mt:
+                    fn, i, j = mt.groups()
+                    spec: tuple = (fn, int(i) - 1, int(j) - 1 if j else None)
+                elif mv:
+                    spec = ("var", mv.group(1), int(mv.group(2)) - 1)
+                else:
+                    raise ValueError(f"cannot evaluate factor {base!r}")
+                factors.append((spec, int(power) if power else 1))
+        plan.append(tuple(factors))
+    return tuple(plan)
 
 
 def has_input(name: str) -> bool:

@@ -18,6 +18,7 @@ closed chain's states must satisfy its loop closure, so no box is drawn there: N
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Mapping, Sequence
 
 import numpy as np
@@ -57,14 +58,45 @@ def state_box(signals: Mapping[str, np.ndarray], samples: int = BOX_SAMPLES,
     return out
 
 
+@functools.lru_cache(maxsize=64)
+def linear_split(names: tuple[str, ...]) -> tuple[tuple[str, ...], np.ndarray]:
+    """Each term as its factors other than an acceleration, and the acceleration it multiplies.
+
+    Every term is at most linear in the accelerations (:mod:`testbed.core.terms`): ``"cos(th2)*
+    ddth1"`` is ``("cos(th2)", 0)``, ``"ddth2"`` is ``("1", 1)``, ``"sin(th2)"`` is ``("sin(th2)",
+    -1)`` (no acceleration).
+
+    Parameters
+    ----------
+    names : tuple of str
+        Terms, length p.
+
+    Returns
+    -------
+    rest : tuple of str, length p
+        The terms without their acceleration factor (``"1"`` where nothing is left).
+    which : ndarray of int, shape (p,)
+        The 0-based coordinate of each term's acceleration, -1 for none.
+    """
+    rest, which = [], []
+    for name in names:
+        factors = name.split("*")
+        acc = [f for f in factors if f.partition("^")[0].startswith("ddth")]
+        if len(acc) > 1 or (acc and acc[0].partition("^")[2] not in ("", "1")):
+            raise ValueError(f"term {name!r} is not linear in the accelerations")
+        rest.append("*".join(f for f in factors if f not in acc) or "1")
+        which.append(int(acc[0].partition("^")[0][4:]) - 1 if acc else -1)
+    return tuple(rest), np.asarray(which, dtype=int)
+
+
 def accelerations(names: Sequence[str], coef: np.ndarray, states: Mapping[str, np.ndarray]
                   ) -> np.ndarray:
     """Accelerations (n, N) solving ``coef @ Theta(q, dq, ddq, u) = 0`` at each state.
 
-    Every term is at most linear in the accelerations (:mod:`testbed.core.terms`), so each
-    equation reads ``A(q, dq) ddq + b(q, dq, u) = 0``: ``b`` is the equations at ``ddq = 0`` and
-    column k of ``A`` their change at ``ddq = e_k``.  States where ``A`` is singular give
-    non-finite accelerations (the law says nothing there).
+    Every term is at most linear in the accelerations (:func:`linear_split`), so each
+    equation reads ``A(q, dq) ddq + b(q, dq, u) = 0``: ``b`` sums the terms without an
+    acceleration, column k of ``A`` those multiplying ``ddq_k`` (without it).  States where ``A``
+    is singular give non-finite accelerations (the law says nothing there).
 
     Parameters
     ----------
@@ -79,25 +111,89 @@ def accelerations(names: Sequence[str], coef: np.ndarray, states: Mapping[str, n
     -------
     ndarray, shape (n, N)
     """
+    n = np.shape(states["th"])[0]
+    return _solve_law(_law_parts(names, coef, n), states).T
+
+
+def _law_parts(names: Sequence[str], coef: np.ndarray, n: int) -> tuple:
+    """The law's terms without their accelerations, and the coefficients of ``b`` and of each
+    column of ``A`` (:func:`accelerations`) with the terms they take, for ``n`` coordinates."""
     coef = np.atleast_2d(np.asarray(coef, dtype=float))
-    n, N = np.shape(states["th"])
+    rest, which = linear_split(tuple(names))
+    cols = [np.flatnonzero(which == k) for k in range(-1, n)]  # b's, then A's columns
+    return list(rest), [(c, coef[:, c].T) for c in cols]
 
-    def equations(ddq: np.ndarray) -> np.ndarray:  # (N, n_eq)
-        sig = {**states, "ddth": ddq}
-        return evaluate_terms(list(names), sig) @ coef.T
 
-    b = equations(np.zeros((n, N)))
-    A = np.empty((N, coef.shape[0], n))
-    for k in range(n):
-        unit = np.zeros((n, N))
-        unit[k] = 1.0
-        A[:, :, k] = equations(unit) - b
+def _solve_law(parts: tuple, states: Mapping[str, np.ndarray]) -> np.ndarray:
+    """Accelerations (N, n) of the law ``parts`` (:func:`_law_parts`) at ``states``."""
+    rest, cols = parts
+    G = evaluate_terms(rest, states)  # (N, p)
     with np.errstate(all="ignore"):
-        det_ok = np.abs(np.linalg.det(A)) > 0
-        out = np.full((N, n), np.nan)
-        if np.any(det_ok):
-            out[det_ok] = np.linalg.solve(A[det_ok], -b[det_ok][..., None])[..., 0]
-    return out.T
+        b = G[:, cols[0][0]] @ cols[0][1]  # (N, n_eq)
+        A = np.stack([G[:, c] @ w for c, w in cols[1:]], axis=2)  # (N, n_eq, n)
+        try:  # one solve where every state's A is regular (the rollout's many small calls)
+            out = np.linalg.solve(A, -b[..., None])[..., 0]
+        except np.linalg.LinAlgError:  # some singular: those states say nothing (NaN)
+            det_ok = np.abs(np.linalg.det(A)) > 0
+            out = np.full((G.shape[0], A.shape[2]), np.nan)
+            if np.any(det_ok):
+                out[det_ok] = np.linalg.solve(A[det_ok], -b[det_ok][..., None])[..., 0]
+    return out
+
+
+def law_rollout(names: Sequence[str], coef: np.ndarray, x0: np.ndarray, xd0: np.ndarray,
+                u: np.ndarray, dt: float, scales: Sequence[float]) -> np.ndarray:
+    """The law's coordinates over a record, one rollout per scale of its accelerations.
+
+    Classical RK4 at the record's step ``dt``, the inputs held over each sample (as recorded);
+    rollout ``j`` integrates ``scales[j]`` times the law's accelerations (:func:`accelerations`),
+    so ``scales = (1, 1 + e)`` gives the law and a law off by exactly ``e`` in the relative
+    acceleration error of :func:`law_errors`.  All rollouts advance together (one evaluation of
+    the terms per stage); a non-finite state stays non-finite.
+
+    Parameters
+    ----------
+    names, coef : sequence of str, ndarray (n, p)
+        The law's terms and equations (one per coordinate).
+    x0, xd0 : ndarray, shape (n,)
+        Initial coordinates [rad or m] and rates [per s].
+    u : ndarray, shape (m, N)
+        Inputs at the record's samples [N or N m].
+    dt : float
+        The record's sample step [s].
+    scales : sequence of float, length K
+        Factors on the accelerations [-].
+
+    Returns
+    -------
+    ndarray, shape (K, n, N)
+        Coordinates at the record's samples.
+    """
+    s = np.asarray(scales, dtype=float)
+    K, N = s.size, np.shape(u)[1]
+    q = np.repeat(np.asarray(x0, dtype=float)[:, None], K, axis=1)
+    qd = np.repeat(np.asarray(xd0, dtype=float)[:, None], K, axis=1)
+    out = np.full((K, q.shape[0], N), np.nan)
+    out[:, :, 0] = q.T
+
+    parts = _law_parts(names, coef, q.shape[0])
+
+    def acc(a: np.ndarray, b: np.ndarray, uk: np.ndarray) -> np.ndarray:
+        return _solve_law(parts, {"th": a, "dth": b, "u": uk}).T * s
+
+    with np.errstate(all="ignore"):
+        for k in range(N - 1):
+            uk = np.repeat(np.asarray(u, dtype=float)[:, k:k + 1], K, axis=1)
+            a1 = acc(q, qd, uk)
+            a2 = acc(q + dt / 2 * qd, qd + dt / 2 * a1, uk)
+            a3 = acc(q + dt / 2 * (qd + dt / 2 * a1), qd + dt / 2 * a2, uk)
+            a4 = acc(q + dt * (qd + dt / 2 * a2), qd + dt * a3, uk)
+            q = q + dt / 6 * (qd + 2 * (qd + dt / 2 * a1) + 2 * (qd + dt / 2 * a2) + qd + dt * a3)
+            qd = qd + dt / 6 * (a1 + 2 * a2 + 2 * a3 + a4)
+            out[:, :, k + 1] = q.T
+            if not np.any(np.isfinite(q)):
+                break
+    return out
 
 
 def law_error(id_names: Sequence[str], id_coef: np.ndarray, true_names: Sequence[str],

@@ -26,6 +26,7 @@ from testbed.scoring.scorers import (
     growth_failure,
     late_growth,
     reduced_truth_gap,
+    sensitivity_failures,
     sensor_failures,
     step_failures,
 )
@@ -632,3 +633,92 @@ def test_round18_studies_load(name, cells):
     # not in the studies; round18/l_make.py and b_make.py say why)
     study = load_study(_root() / "benchmarks" / "unseen" / f"{name}.toml")
     assert study.name == name and study.n_cells() == cells
+
+
+# ------------------------------------------- round 19: a rollout bar a sensitive record fails
+def test_a_rollout_failed_on_a_sensitive_record_is_named():
+    """Round 19's cp19_amp6 (a 6 N multisine: the pole turns over the top, th2 -9.05..19.8 rad)
+    at 1 %, seed 103: the identified law is within 0.30 % of the truth (law_error 0.0030, the
+    rig's bar 0.25), but its rollout ends 11.5 rad from the record, a failure with no reason.
+    The true law rolled out by the scorer meets the bar (1.8e-6 rad); off by 0.0025 (1 % of the
+    law bar: its accelerations scaled by 1 +/- 0.0025) it fails it by as much (11.7 rad)."""
+    sc = load_scenario(_root() / "benchmarks" / "unseen" / "round19" / "cp19_amp6.toml")
+    sc = dataclasses.replace(sc, seed=103)
+    r = run_scenario(sc)  # the scenario's own 1 % noise
+    assert r.verdict == FAIL and r.scores.values["law_error"] < 0.01
+    why = r.scores.failures["sensitive"]
+    assert why.startswith("sensitive record: angle_rmse 11") and "law_error 0.00304" in why
+    assert "scaled by 1 +/- 0.0025 " in why and r.scores.details["law_off"] == 0.0025
+    assert r.scores.details["angle_rmse_true_law"] < 1e-5  # [rad]: the witness's own floor
+    assert r.scores.details["angle_rmse_law_off"] > 1.0  # [rad]: 11.7 measured
+    assert set(r.scores.failures) == {"sensitive"}
+
+
+def _witness(exact: float, off: float, seen: list | None = None):
+    def witness(e: float) -> dict:
+        if seen is not None:
+            seen.append(e)
+        return {"angle_rmse_true_law": exact, "angle_rmse_law_off": off, "law_off": e}
+    return witness
+
+
+@pytest.mark.parametrize("angle, law, exact, off, key", [
+    (11.5, 0.003, 1.8e-6, 13.8, "sensitive"),  # round 19's cp19_amp6 at 1 %
+    (11.5, 0.003, 0.2, 13.8, "floor"),  # the true law's own replay fails: no model can pass
+    (0.04, 0.003, 1.8e-6, 13.8, None),  # the bar met: nothing
+    (11.5, 0.3, 1.8e-6, 13.8, None),  # the law outside its bar: "wrong equation" says so
+    (11.5, float("nan"), 1.8e-6, 13.8, None),  # no law: nothing to claim
+    (float("nan"), 0.003, 1.8e-6, 13.8, None),  # a divergence names itself
+    (11.5, 0.003, 1.8e-6, 0.01, None),  # laws off by the error meet the bar: the model's own
+    (11.5, 0.003, 1.8e-6, float("nan"), None),  # a scaled law diverged: no claim
+])
+def test_sensitivity_reason_only_explains_a_failed_rollout_under_a_law_within_its_bar(
+        angle, law, exact, off, key):
+    bars = {"angle_rmse": {"max": 0.0501}}
+    d = {"equation_bars": {"law_error": {"max": 0.25}}, "angle_rmse_law_witness": _witness(exact, off)}
+    got = sensitivity_failures(Scores({"angle_rmse": angle, "law_error": law}, d), bars)
+    assert set(got) == ({key} if key else set())
+    assert "angle_rmse_law_witness" not in d  # popped: the details stay plain data
+
+
+def test_the_law_witness_is_simulated_only_where_it_can_act_and_off_by_a_share_of_the_bar():
+    bars, eq = {"angle_rmse": {"max": 0.0501}}, {"law_error": {"max": 0.25}}
+    seen: list = []
+    d = {"equation_bars": eq, "angle_rmse_law_witness": _witness(1e-6, 1.0, seen)}
+    sensitivity_failures(Scores({"angle_rmse": 0.01, "law_error": 0.003}, d), bars)
+    assert seen == []  # a met bar costs no rollout of the truth
+    # laws off by the smaller of the identified law's error and 1 % of the law bar: round 16's
+    # cp16_3s at 1 % (seed 72, law_error 0.156, 0.108 rad) was claimed "sensitive" by laws off
+    # by its whole error (0.18 rad), a large law error, not a sensitive record
+    for law, e in ((0.156, 0.0025), (0.001, 0.001)):
+        d = {"equation_bars": eq, "angle_rmse_law_witness": _witness(1e-6, 1.0, seen)}
+        sensitivity_failures(Scores({"angle_rmse": 0.108, "law_error": law}, d), bars)
+        assert seen.pop() == pytest.approx(e)
+
+
+@pytest.mark.parametrize("name, cells", [("round19_beams", 32), ("round19_beams_noise", 32),
+                                         ("round19_beams_noise_s102", 32),
+                                         ("round19_linkages_sine", 18),
+                                         ("round19_linkages_sine_seeds", 9),
+                                         ("round19_linkages_clean", 7),
+                                         ("round19_linkages_cartpoles", 18),
+                                         ("round19_linkages_kinetics", 15),
+                                         ("round19_linkages_seeds", 10),
+                                         ("round19_linkages_cartpoles_onset", 9),
+                                         ("round19_beams_extra", 12)])
+def test_round19_studies_load(name, cells):
+    study = load_study(_root() / "benchmarks" / "unseen" / f"{name}.toml")
+    assert study.name == name and study.n_cells() == cells
+
+
+def test_an_infinite_coef_error_names_the_missing_term():
+    """Round 19's mm19_km0p7_x0_0p1 at 1 %, seed 104 (Km 0.7 mM, a 0.1 mM dose rising to x*
+    0.47 mM): the identified equation drops x*dx, the true equation's largest term, so the
+    two have no common scale (coef_error inf); the reason said "not computable"."""
+    sc = load_scenario(_root() / "benchmarks" / "unseen" / "round19" / "mm19_km0p7_x0_0p1.toml")
+    r = run_scenario(dataclasses.replace(sc, seed=104))  # the scenario's own 1 % noise
+    assert r.verdict == FAIL and r.scores.values["coef_error"] == np.inf
+    why = r.scores.failures["equation"]
+    assert ("coef_error not finite (the identified equation of x lacks x*dx, the true "
+            "equation's largest term: no common scale to compare them on; bar 0.05)") in why
+    assert "not computable" not in why
