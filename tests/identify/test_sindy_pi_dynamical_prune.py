@@ -10,7 +10,9 @@ from identify.sindy_pi_dynamical import NOISE_PRUNE_RATIO, SINDyPIDynamical
 from testbed.pipeline.generate import generate
 from testbed.pipeline.scenario import load_scenario
 from testbed.pipeline.signal_chain import measure
+from testbed.scoring.run import run_scenario
 from testbed.scoring.scorers import compare_implicit
+from testbed.studies.runstore import build_meta
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -55,3 +57,13 @@ def test_several_removals_within_the_noise_keep_the_terms_and_the_reason():
     assert model.determinacy_[0] >= 1.0
     assert "not determined" in model.noise_prune_rule_
     assert f"3 removal(s) within {NOISE_PRUNE_RATIO:g}" in model.noise_prune_rule_
+
+
+def test_the_only_removal_is_stored_with_the_run_and_the_cell_passes():
+    # the same cell through the whole run: the rule's sentence in run.json's model_lists, and
+    # the rig's own bars met (it failed "wrong equation" with x^2 kept before)
+    sc = load_scenario(ROOT / "benchmarks/unseen/round11/mm11_rise_x0_0p05.toml")
+    r = run_scenario(dataclasses.replace(sc, seed=21).with_noise(1.0))
+    assert r.passed
+    rule = build_meta(r)["model_lists"]["noise_prune_rule_"]
+    assert rule == [r.model.noise_prune_rule_] and "-x^2 1.4" in rule[0]
