@@ -2064,12 +2064,20 @@ class SINDyPI(_ImplicitMechanical):
 
         Why: the held-out ranking of a one-tone record (the paper's sine) does not order the
         equations by how they simulate; where its top ``n_rollout`` per input all lose the
-        record, lower-ranked ones may hold it.  Measured (2026-11-28, session 20):
-        ``fbs41__009`` at 2 % (the paper's sine on a family geometry, seed 41; every one of
-        the top 3 x 3 lost the loop from the true start) the ranks 4-6 replay the record
-        (segmented rollouts 2e-5 - 7e-5 rad against 0.002-0.016): scored 0.0026 rad instead of
-        "diverged at 4.27 s"; ``fb15_cranks_0p8_1p5_3s`` 2 % s63: 0.017 rad instead of
-        "diverged at 0.32 s".
+        record, lower-ranked ones may hold it (``fbs41__009`` at 2 %, the paper's sine on a
+        family geometry: the top 3 x 3 replay nothing, the ranks 4-6 replay the record with
+        segmented rollouts of 2e-5 - 7e-5 rad against 0.002-0.016).  Measured (2026-11-28,
+        session 20; benchmarks/heldout/wide_record_probe.py, table wide_record_members.tsv):
+        249 five-bar cells (rounds 14-18's sine, sine-seed and multisine studies, round 18's
+        seeds, benchmarks/heldout's sine studies, the three shipped five-bars with estimated
+        rates), 218 -> 223 passes, none lost; reached on 23: F -> P ``fb15_cranks_1p3_0p7_20s``
+        1 % s61 / 2 % s64 (diverged at 12.07 / 3.32 s -> 0.0034 rad), ``fb15_cranks_0p8_1p5_3s``
+        2 % s63 (0.32 s -> 0.017), ``fb18_30s`` 4 % (6.34 s -> 0.0012), ``fbs41__009`` 2 %
+        (4.27 s -> 0.0015); passes moved 0.018 -> 0.0013 (``fb14_cranks_2p2`` 2 % s52),
+        0.040 -> 0.0052 (``fb15_cranks_1p6_1_5s`` 2 % s63), 0.024 -> 0.0039, 0.0045 -> 0.0016;
+        14 unchanged (none of the wider search's pairs replays: first fit kept).  Cost: one
+        simulation of the record per pair searched, in this branch only (``fb18_30s``: 8.9 ->
+        17.2 s of CPU).
         """
         ctx = getattr(self, "_wide_ctx", None)
         why = ("ensemble" if self.ensemble else "no rollout selection" if ctx is None
