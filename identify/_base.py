@@ -64,7 +64,7 @@ from testbed.core.errors import (
     ScenarioError,
     UnsupportedError,
 )
-from testbed.core.measurement import Measurement, Trajectory
+from testbed.core.measurement import MIN_FREE_SAMPLES, Measurement, Trajectory
 from testbed.core.schema import ErrorFn, Field, KeyUse, check_keys_used, validate_table
 
 
@@ -465,11 +465,6 @@ class Identifier:
         args = ", ".join(f"{k}={v!r}" for k, v in self.get_params().items())
         return f"{type(self).__name__}({args})"
 
-
-#: Fewest samples a structural identifier fits after ``free_start``: the library's own floor
-#: (:func:`identify.structural.build_library`), checked before the fit's band and decay rules
-#: (which divided by the empty window's length: ZeroDivisionError, API round of session 15).
-MIN_FREE_SAMPLES = 4
 
 #: Methods that need a fitted model: called before ``fit`` they raise NotFittedError.
 FITTED_ONLY = ("score", "predict_acceleration", "equations", "simulate")

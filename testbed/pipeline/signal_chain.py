@@ -18,7 +18,12 @@ import numpy as np
 
 from testbed.core.dataset import Dataset
 from testbed.core.errors import ArgumentError, RegistrationError, ScenarioError, show_names
-from testbed.core.measurement import Measurement, declared_input_hold, nearest_within
+from testbed.core.measurement import (
+    MIN_FREE_SAMPLES,
+    Measurement,
+    declared_input_hold,
+    nearest_within,
+)
 from testbed.core.schema import Field, KeyUse, validate_table
 from testbed.core.schema import check_keys_used as schema_check_keys_used
 from testbed.numerics import derivatives
@@ -379,6 +384,74 @@ def _get(dataset: Dataset, name: str, rows: int | None = None) -> np.ndarray:
     return data
 
 
+def free_start_after(cfg: Mapping[str, Any], fs: float, end: int, n_samples: int) -> int:
+    """The first sample of the structural chain's free decay: ``free_margin_s`` after the pulse's
+    end, or later where the low-pass's response to the pulse has settled
+    (:data:`LOWPASS_SETTLE_TOL`); 0 for a record without a pulse.
+
+    Parameters
+    ----------
+    cfg : mapping
+        A validated ``SIGNAL_SCHEMAS["structural"]`` table (cut-offs resolved).
+    fs : float
+        Sample rate [Hz].
+    end : int
+        First sample after the force pulse (:func:`pulse_end`); 0 for none.
+    n_samples : int
+        The record's length [samples]: the result is at most this.
+
+    Returns
+    -------
+    int
+    """
+    margin = int(np.ceil(cfg["free_margin_s"] * fs))
+    if cfg["lowpass_hz"] > 0:
+        margin = max(margin, sig.lowpass_settling(fs, cfg["lowpass_hz"], cfg["lowpass_order"],
+                                                  LOWPASS_SETTLE_TOL))
+    return 0 if end <= 0 else min(n_samples, end + margin)
+
+
+def check_free_decay(cfg: Mapping[str, Any], fs: float, n_samples: int, pulse_start_s: float,
+                     pulse_s: float, error: ErrorFn) -> None:
+    """Refuse an impact that leaves the record fewer than ``MIN_FREE_SAMPLES`` samples of free
+    decay after :func:`free_start_after`, naming the key at fault.
+
+    The pulse's end is taken as the first sample at or after ``pulse_start_s + pulse_s`` (the
+    nominal pulse; the measured one, :func:`pulse_end`, ends no later on a noise-free force).
+    The key named is ``excitation.start`` when the pulse itself ends fewer than
+    ``MIN_FREE_SAMPLES`` before the record's end (no margin could help), else
+    ``signal.free_margin_s`` (hostile round 18: a pulse ending
+    on the record's last samples, and a margin one sample short of the record, were scored
+    failures "fit window from sample 3200 (free_start) holds 0 samples", naming no key).
+
+    Parameters
+    ----------
+    cfg : mapping
+        A validated structural ``[signal]`` table.
+    fs : float
+        Sample rate [Hz].
+    n_samples : int
+        The record's length [samples].
+    pulse_start_s, pulse_s : float
+        The impact's start and duration [s].
+    error : callable
+        ``error(key, value, allowed)`` (it raises).
+    """
+    end = min(n_samples, math.ceil((pulse_start_s + pulse_s) * fs))
+    free = n_samples - free_start_after(cfg, fs, max(end, 1), n_samples)
+    if free >= MIN_FREE_SAMPLES:
+        return
+    after = (f"the free decay starts {cfg['free_margin_s']:g} s (signal.free_margin_s, or the "
+             "low-pass's settling) after the pulse's end "
+             f"({pulse_start_s:.6g} + {pulse_s:.6g} s) and holds {max(free, 0)} of the record's "
+             f"{n_samples} samples ({n_samples / fs:g} s); allowed: at least {MIN_FREE_SAMPLES} "
+             "samples after it (an earlier excitation.start, a shorter signal.free_margin_s or a "
+             "longer simulation.duration)")
+    if end + MIN_FREE_SAMPLES > n_samples:  # no margin could help: the pulse ends too late
+        error("excitation.start", pulse_start_s, after)
+    error("signal.free_margin_s", cfg["free_margin_s"], after)
+
+
 def pulse_end(force: np.ndarray) -> int:
     """Index of the first sample after the force pulse.
 
@@ -523,11 +596,7 @@ def measure_structural(dataset: Dataset, cfg: Mapping[str, Any]) -> Measurement:
         drift = None if drift is None else drift[:, pad:]
         end -= pad
 
-    margin = int(np.ceil(cfg["free_margin_s"] * fs))
-    if cfg["lowpass_hz"] > 0:
-        margin = max(margin, sig.lowpass_settling(fs, cfg["lowpass_hz"], cfg["lowpass_order"],
-                                                  LOWPASS_SETTLE_TOL))
-    free_start = 0 if end <= 0 else min(n, end + margin)
+    free_start = free_start_after(cfg, fs, end, n)
     return Measurement(fs=fs, x=x, xd=xd, xdd=xdd, channels=tuple(acc_sig.channels), u=u,
                        inputs=tuple(f_sig.channels), input_map=input_map,
                        prior=dict(dataset.prior), free_start=free_start,
