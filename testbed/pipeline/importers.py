@@ -771,6 +771,9 @@ class _Raw:
     #: time [s] of each channel's first sample, where the file states it per channel (a
     #: SEP-005 channel's ``time``, a UFF58 record's abscissa)
     starts: dict[str, float] = field(default_factory=dict)
+    #: channels of ``starts`` whose start the file does not state (a SEP-005 channel with
+    #: ``fs`` alone beside channels with a ``time``: taken as t = 0)
+    implied_starts: set[str] = field(default_factory=set)
     #: the file's units are its rig's own and stay as they are (a testbed dataset of a
     #: ``dynamical`` rig: concentrations and the like have no SI form to convert to)
     own_units: bool = False
@@ -860,7 +863,8 @@ def _finish(raw: _Raw, fs: float | None, units: str | Mapping[str, str] | None,
         raise MeasuredDataError(path, f"sample rate {rate:g} Hz: {n} samples would last forever "
                                       "(the duration overflows); expected a rate whose record lasts "
                                       "a finite time")
-    _check_starts(path, {n: raw.starts[n] for n in names if n in raw.starts}, rate)
+    _check_starts(path, {n: raw.starts[n] for n in names if n in raw.starts}, rate,
+                  raw.implied_starts)
     signals = {}
     for n in names:
         unit = units if isinstance(units, str) else (units or {}).get(n, raw.units.get(n))
@@ -921,21 +925,27 @@ def _check_direction(path: Path, name: str, direction: int, si: str) -> None:
                                       "expected a direction and a unit of one kind")
 
 
-def _check_starts(path: Path, starts: Mapping[str, float], fs: float) -> None:
+def _check_starts(path: Path, starts: Mapping[str, float], fs: float,
+                  implied: set[str] | frozenset[str] = frozenset()) -> None:
     """Refuse channels whose first samples were taken at different times: the readers line
     the channels up sample by sample, so a force recorded 0.3 s after its responses (a SEP-005
     channel's ``time`` or a UFF58 record's abscissa starting later) was fitted as if
     simultaneous, with status 0 (round 17).  Within half a sample step [s] they agree (a
-    time stamp's rounding)."""
+    time stamp's rounding).  A channel of ``implied`` states no start (``fs`` alone) and is
+    named as such."""
     if len(starts) < 2:
         return
     (first, t0), (worst, tw) = next(iter(starts.items())), max(
         starts.items(), key=lambda kv: abs(kv[1] - next(iter(starts.values()))))
     if abs(tw - t0) > 0.5 / fs:
-        raise MeasuredDataError(path, f"channel {worst!r} starts at t = {tw:.9g} s, channel "
-                                      f"{first!r} at t = {t0:.9g} s: {abs(tw - t0) * fs:.3g} "
-                                      "samples apart; expected every channel to start at one time "
-                                      "(within half a sample step)")
+        def said(name: str, t: float) -> str:
+            if name in implied:
+                return f"channel {name!r} gives fs alone (no time: read as starting at t = 0 s)"
+            return f"channel {name!r} starts at t = {t:.9g} s"
+        raise MeasuredDataError(path, f"{said(worst, tw)}, {said(first, t0)}: "
+                                      f"{abs(tw - t0) * fs:.3g} samples apart; expected every "
+                                      "channel to start at one time (within half a sample step; "
+                                      "give every channel a time, or none)")
 
 
 #: Range of a declared prior (a mass [kg] or a length [m]).  A prior scales the identified
@@ -1308,6 +1318,15 @@ def _parse_sep005(path: Path, content: Any) -> _Raw:
         if pos is not None:
             raw.positions[name] = check_position(path, name, pos, "position_m")
     raw.fs = _common_rate(path, rates, 1e-9)
+    if raw.starts:
+        # channels of one file, some with a `time` and some with `fs` alone (round 18, open
+        # item d): an fs-only channel states no start, and was lined up sample by sample with
+        # a timed channel starting 0.3 s later, in silence.  SEP-005 reads an fs-only channel
+        # as sampled from t = 0, so it is checked as starting there.
+        for name in raw.data:
+            if name not in raw.starts:
+                raw.starts[name] = 0.0
+                raw.implied_starts.add(name)
     return raw
 
 

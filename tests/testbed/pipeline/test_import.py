@@ -353,3 +353,24 @@ def test_a_record_with_nothing_to_identify_is_refused(tmp_path, acc, positions, 
     path = write(tmp_path, "x.json", json.dumps(_beam_channels(acc, positions), default=list))
     with pytest.raises(MeasuredDataError, match=re.escape(words)):
         measurement_from_file(path, "structural")
+
+
+def _mixed_channels(t0: float) -> list[dict]:
+    """Two channels at 100 Hz: ``a`` with a ``time`` from ``t0`` [s], ``b`` with ``fs`` alone."""
+    n = 50
+    return [{"name": "a", "data": list(np.sin(np.arange(n) / 5.0)), "unit_str": "m",
+             "time": list(t0 + np.arange(n) / 100.0)},
+            {"name": "b", "data": list(np.cos(np.arange(n) / 5.0)), "unit_str": "m", "fs": 100.0}]
+
+
+def test_a_sep005_channel_with_fs_alone_beside_a_later_timed_one_is_refused():
+    # round 18, open item (d): a channel with `fs` alone states no start; beside a channel
+    # whose `time` starts 0.3 s (30 samples) later, the two were lined up sample by sample
+    with pytest.raises(MeasuredDataError, match=r"channel 'b' gives fs alone .*t = 0 s\), channel "
+                                                r"'a' starts at t = 0\.3 s: 30 samples apart"):
+        from_sep005(_mixed_channels(0.3))
+
+
+def test_a_sep005_channel_with_fs_alone_beside_a_timed_one_from_zero_is_read():
+    data = from_sep005(_mixed_channels(0.0))
+    assert data.fs == 100.0 and list(data.signals) == ["a", "b"]
