@@ -61,9 +61,9 @@ import numpy as np
 from testbed.core.budget import IDENTIFY_BYTES_PER_VALUE, IDENTIFY_TEXT_BUDGET_BYTES, IDENTIFY_VALUE_BUDGET
 from testbed.core.dataset import Dataset, DatasetError, Signal
 from testbed.core.errors import TestbedError, is_control, show_names
-from testbed.core.measurement import Measurement
+from testbed.core.measurement import MIN_FREE_SAMPLES, Measurement
 from testbed.numerics.noise import noise_std
-from testbed.pipeline.signal_chain import SIGNAL_CHAINS, SIGNAL_SCHEMAS, measure
+from testbed.pipeline.signal_chain import SIGNAL_CHAINS, SIGNAL_SCHEMAS, measure, pulse_span
 
 FORMATS = ("uff", "sep005", "csv", "hdf5")
 SUFFIXES = {".uff": "uff", ".unv": "uff", ".json": "sep005", ".csv": "csv", ".tsv": "csv",
@@ -422,7 +422,31 @@ def _check_response(path: Path, ds: Dataset, kind: str) -> None:
                                       f"({', '.join(f'{p:g}' for p in sig.positions)} m); expected "
                                       "one sensor per position")
     if kind == "structural":
+        _check_pulse_ends(path, ds)
         _check_independent(path, sig, RESPONSE_SIGNAL[kind])
+
+
+def _check_pulse_ends(path: Path, ds: Dataset) -> None:
+    """Refuse a structural record whose force pulse has not ended ``MIN_FREE_SAMPLES`` samples
+    before the record does: cut inside the impact, it holds no free decay to fit.
+
+    Round 18: a beam record cut two samples into the pulse was refused as "'acceleration'
+    channel 'acc3' is a linear combination of 'acc1', 'acc2'" (every channel zero but for two
+    samples): one line, not the cause.  The pulse is the chain's own
+    (:func:`~testbed.pipeline.signal_chain.pulse_span`)."""
+    force = ds.measured.get("force")
+    if force is None or force.data.ndim != 2 or not np.all(np.isfinite(force.data)):
+        return  # the chain says what is missing; the reader refuses non-finite samples
+    n = force.data.shape[1]
+    start, end = pulse_span(force.data)
+    if end > 0 and n - end < MIN_FREE_SAMPLES:
+        mag = np.max(np.abs(force.data), axis=0)
+        raise MeasuredDataError(path, f"the force pulse (from sample {start}) has not ended "
+                                      f"{MIN_FREE_SAMPLES} samples before the record's last "
+                                      f"(sample {n - 1}, force {mag[-1] / mag.max():.3g} of its "
+                                      "peak): the record was cut inside the impact and holds no "
+                                      "free decay to identify; expected the whole pulse and the "
+                                      "decay after it")
 
 
 def _check_unwrapped(path: Path, sig: Signal, name: str) -> None:

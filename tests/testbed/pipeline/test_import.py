@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import math
 import re
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -374,3 +375,31 @@ def test_a_sep005_channel_with_fs_alone_beside_a_later_timed_one_is_refused():
 def test_a_sep005_channel_with_fs_alone_beside_a_timed_one_from_zero_is_read():
     data = from_sep005(_mixed_channels(0.0))
     assert data.fs == 100.0 and list(data.signals) == ["a", "b"]
+
+
+def _hammer_record(tmp_path: Path, last: int | None) -> Path:
+    """A beam-like SEP-005 record at 1 kHz: three decaying sines (their own frequencies) after
+    a 5-sample half-sine hammer at samples 20-24, the hammer at the tip sensor, cut at
+    ``last``."""
+    fs, n = 1000.0, 600
+    t = np.arange(n) / fs
+    force = np.where((t >= 0.020) & (t < 0.025), np.sin(np.pi * (t - 0.020) / 0.005), 0.0)
+    after = t >= 0.020
+    chans = [{"name": f"acceleration/acc{k + 1}", "unit_str": "m/s^2", "fs": fs, "position_m": 0.1 * (k + 1),
+              "data": list((after * np.exp(-3 * t) * np.sin(2 * np.pi * f * (t - 0.02)))[:last])}
+             for k, f in enumerate((11.0, 47.0, 103.0))]
+    chans.append({"name": "force/force", "unit_str": "N", "fs": fs, "position_m": 0.3,
+                  "data": list(force[:last])})
+    path = tmp_path / f"hammer_{last}.json"
+    path.write_text(json.dumps(chans))
+    return path
+
+
+def test_a_beam_record_cut_inside_the_pulse_is_refused_for_that(tmp_path):
+    # round 18, open item (b): cut two samples into the pulse it was refused as "'acc3' is a
+    # linear combination of 'acc1', 'acc2'": one line, not the cause
+    with pytest.raises(MeasuredDataError, match=r"force pulse \(from sample 2[01]\) has not ended "
+                                                r"4 samples before the record's last.*cut inside"):
+        measurement_from_file(_hammer_record(tmp_path, 23), "structural", {"highpass_hz": 2.0})
+    m = measurement_from_file(_hammer_record(tmp_path, None), "structural", {"highpass_hz": 2.0})
+    assert m.free_start < m.n_samples - 4
