@@ -285,6 +285,11 @@ def test_a_scenario_or_study_folder_variable_that_is_no_folder_is_named(tmp_path
     # sys.exit(0) at import ended `testbed run` with status 0, no verdict and no line
     ("import sys\nsys.exit(0)\n", "importing it failed: SystemExit: 0"),
     ("import sys\nsys.exit('bye')\n", "importing it failed: SystemExit: bye"),
+    # hostile round 19: another BaseException (GeneratorExit; pytest's Skipped from a plugin
+    # written as a test helper) was a traceback with status 1
+    ("raise GeneratorExit('done')\n", "importing it failed: GeneratorExit: done"),
+    ("class Skipped(BaseException):\n    pass\nraise Skipped('no mujoco')\n",
+     "importing it failed: Skipped: no mujoco"),
 ])
 def test_a_plugin_that_exits_at_import_is_one_line(tmp_path, capsys, source, fragment):
     plugin = tmp_path / "exits.py"
