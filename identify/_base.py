@@ -354,8 +354,19 @@ class Identifier:
         -------
         Trajectory
             ``x``, ``xd``, ``xdd``, each of shape (n_channels, n_samples).
+
+        Raises
+        ------
+        UnsupportedError
+            (a NotImplementedError) here, in the base class: an identifier that does not
+            implement it cannot be scored (the scorer integrates the identified model).  A
+            plugin without it was "internal error (a bug, not your input): NotImplementedError"
+            of `testbed run` (hostile round 19); now one line naming the class.
         """
-        raise NotImplementedError
+        raise UnsupportedError(f"{type(self).__name__}.simulate: not implemented; the scorer "
+                               "integrates the identified model, so an identifier to be scored "
+                               "implements simulate(x0, xd0, t, u) -> Trajectory "
+                               "(docs/identifiers.md)")
 
     def equations(self, precision: int = 4) -> list[str]:
         """The identified equations as text, one per equation (shown in reports).

@@ -90,8 +90,9 @@ def fit_or_fail(model: Any, data: Measurement, method: str | None = None) -> Non
                                   f"{' '.join(str(e).split()) or 'no message'})") from None
     except TestbedError:
         raise
-    except (Exception, SystemExit) as e:  # a plugin's sys.exit(0) ended a run with exit 0, no verdict
-        if origin == "builtin":
+    except BaseException as e:  # a plugin's sys.exit(0) ended a run with exit 0, no verdict;
+        # its GeneratorExit (any BaseException but Ctrl-C) was a traceback, status 1 (round 19)
+        if origin == "builtin" or isinstance(e, KeyboardInterrupt):
             raise
         raise IdentificationError(f"identifier {method} (from {origin}) raised "
                                   f"{type(e).__name__}: {' '.join(str(e).split())}") from None
