@@ -954,8 +954,31 @@ def plugins_cases(work: Path) -> list[tuple[str, object]]:
         ("M_ text", {"in_fit": "self.M_ = 'x'"}, False),
         ("learned attributes deleted", {"in_fit": "del self.M_, self.K_, self.C_"}, False),
     ]
+    def exits_the_interpreter():
+        """``os._exit(0)`` in the plugin's fit, through a real command (it would end this
+        process): status 0 without a verdict is a finding (open: no Python code runs after
+        ``os._exit``; ``sweep --jobs 2`` names the plugin, `--jobs 1` and `run` cannot)."""
+        name = "h19_exit"
+        plugin = work / f"{name}.py"
+        plugin.write_text(_PLUGIN.replace("NAME", name).replace("#AT_IMPORT", "")
+                          .replace("#IN_FIT", "import os\n        os._exit(0)")
+                          .replace("#SIMULATE", _SIMULATE))
+        scen = _write(work / f"{name}.toml",
+                      f'[scenario]\nname = "{name}"\nextends = '
+                      f'"{SCENARIO_DIR / "cantilever_stiff_impact_lsq.toml"}"\n'
+                      f'[identify]\nmethod = "{name}"\n')
+        p = _hostile.testbed_cli(["run", str(scen), "--plugin", str(plugin), "--no-figures", "-o",
+                                  str(work / "runs"), "--cache", str(CACHE)], work, TIMEOUT_S)
+        found = _hostile.cli_finding(p)
+        if found:
+            return found
+        if p.returncode == 0 and "run written to" not in p.stdout:
+            return "status 0 without a verdict (the plugin ended the interpreter in its fit)"
+        return None
+
     return [(f"plugins {label}", case(k, label, may_pass=may, **kw))
-            for k, (label, kw, may) in enumerate(cases)]
+            for k, (label, kw, may) in enumerate(cases)] + [
+        ("plugins os._exit(0) in fit (a real command)", exits_the_interpreter)]
 
 
 # ------------------------------------------------------------------ main
