@@ -47,6 +47,19 @@ Families (what rounds 1-18 did not try):
     a number is expected), ``run_scenario`` given a dict, a Dataset or a list.  A raw
     exception from inside, a wrong-typed hyperparameter fitted in silence, or a refit that
     differs from a fresh fit, is a finding.
+``csvform``
+    The Michaelis-Menten record as CSV text in spreadsheet and logger forms: decimal commas,
+    tabs, a byte-order mark, CRLF, time in ms (declared, and declared as s), swapped or repeated
+    time stamps, a header repeated mid-file, blank lines, NaN and empty cells, ragged rows, a
+    trailing empty column, quoted numbers, thousands separators, Latin-1 text, a column named
+    twice, a header alone, ``--fs`` contradicting the time column or at 1e-320 Hz.  A form read
+    whose model differs from the clean file's, or anything but one refusal line, is a finding.
+``plugins``
+    A user's ``--plugin`` identifier that raises GeneratorExit, a BaseException subclass or
+    ``sys.exit(0)`` at import or in ``fit``, leaves ``simulate`` out, returns None, or leaves
+    its matrices NaN, of another size, complex, float16, boolean, text, 1e308 times too large,
+    zero or negative; and ``os._exit(0)`` in ``fit`` through a real command.  A traceback, an
+    internal error, a pass of a broken model, or status 0 without a verdict, is a finding.
 
 Prints one line a finding and the counts; exits 1 if any finding.
 """
