@@ -749,6 +749,10 @@ def apiuse_cases(work: Path) -> list[tuple[str, object]]:
              mm, model=testbed.IDENTIFIERS.get("sindy_pi_dynamical")().fit(mm_data()), cache=cache))),
         ("score of an unfitted model", api(lambda: testbed.score(
             testbed.IDENTIFIERS.get("sindy_pi_dynamical")(), cache.get(mm), mm))),
+        ("score of a dataset of another scenario's record (1 kHz against 100 Hz)",
+         api(lambda: testbed.score(
+             testbed.IDENTIFIERS.get("sindy_pi_dynamical")(degree=3).fit(mm_data()),
+             cache.get(load_scenario("michaelis_menten_noise1")), mm))),
     ]]
 
 
