@@ -705,6 +705,27 @@ def apiuse_cases(work: Path) -> list[tuple[str, object]]:
 
     mm = load_scenario(MM)
 
+    def uff_names(channels: tuple[str, ...]):
+        """``write_uff`` of a record whose channel names a UFF58 ID line cannot hold as they are:
+        a file read back under other names is a finding."""
+        def run():
+            from testbed.core.dataset import Dataset, Signal
+            from testbed.pipeline.importers import read_measured
+            from testbed.reporting.export import write_uff
+
+            t = np.arange(200) / 1000.0
+            acc = np.vstack([np.sin(2 * np.pi * f * t) for f in (7.0, 11.0)])
+            ds = Dataset(1000.0, {"acceleration": Signal(acc, channels, "m/s^2",
+                                                         positions=np.array([0.1, 0.2])),
+                                  "force": Signal(np.exp(-t / 0.01)[None, :], ("force",), "N",
+                                                  positions=np.array([0.2]))})
+            out = work / f"names_{len(channels[0])}.uff"
+            write_uff(ds, out)
+            back = list(read_measured(out).signals)[:2]
+            want = [f"acceleration/{c}" for c in channels]
+            return None if back == want else f"written, read back as {back}"
+        return run
+
     def api(fn):
         def run():
             fn()
@@ -749,6 +770,9 @@ def apiuse_cases(work: Path) -> list[tuple[str, object]]:
              mm, model=testbed.IDENTIFIERS.get("sindy_pi_dynamical")().fit(mm_data()), cache=cache))),
         ("score of an unfitted model", api(lambda: testbed.score(
             testbed.IDENTIFIERS.get("sindy_pi_dynamical")(), cache.get(mm), mm))),
+        ("write_uff of two names sharing the 80 characters of the ID line",
+         uff_names(("a" * 90 + "1", "a" * 90 + "2"))),
+        ("write_uff of a name with a trailing blank", uff_names(("acc1 ", "acc2"))),
         ("score of a dataset of another scenario's record (1 kHz against 100 Hz)",
          api(lambda: testbed.score(
              testbed.IDENTIFIERS.get("sindy_pi_dynamical")(degree=3).fit(mm_data()),
