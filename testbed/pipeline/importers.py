@@ -213,7 +213,15 @@ class ImportedData:
         if groups is None:
             grouped: dict[str, list[str]] = {}
             for name in self.signals:
-                grouped.setdefault(name.split("/", 1)[0] if "/" in name else name, []).append(name)
+                head, slash, tail = name.partition("/")
+                if slash and not (head and tail):
+                    # "acceleration/" was a channel named "" and "/x" a signal named "" (round
+                    # 19): a report's rows and a `--units` key could not name them
+                    raise MeasuredDataError(self.source, f"channel name {name!r}: an empty "
+                                                         f"{'signal' if not head else 'channel'} "
+                                                         "name around '/'; expected "
+                                                         "'<signal>/<channel>' with both named")
+                grouped.setdefault(head if slash else name, []).append(name)
         else:
             grouped = _checked_groups(self.source, groups)
         measured = {}

@@ -403,3 +403,13 @@ def test_a_beam_record_cut_inside_the_pulse_is_refused_for_that(tmp_path):
         measurement_from_file(_hammer_record(tmp_path, 23), "structural", {"highpass_hz": 2.0})
     m = measurement_from_file(_hammer_record(tmp_path, None), "structural", {"highpass_hz": 2.0})
     assert m.free_start < m.n_samples - 4
+
+
+@pytest.mark.parametrize(("name", "empty"), [("acceleration/", "channel"), ("/acc1", "signal")])
+def test_a_channel_name_with_an_empty_part_around_the_slash_is_refused(name, empty):
+    # hostile round 19: "acceleration/" was read as a channel named "" and "/acc1" as a signal
+    # named "" (a report's rows and a --units key could not name them)
+    t = np.arange(100) / 1000.0
+    chans = [{"name": name, "data": list(np.sin(40 * t)), "fs": 1000.0, "unit_str": "m/s^2"}]
+    with pytest.raises(MeasuredDataError, match=f"channel name {name!r}: an empty {empty} name"):
+        from_sep005(chans).to_dataset()
