@@ -726,6 +726,18 @@ def apiuse_cases(work: Path) -> list[tuple[str, object]]:
             return None if back == want else f"written, read back as {back}"
         return run
 
+    def empty_part(name: str):
+        """``from_sep005`` of a channel named with an empty part around ``/``: a signal or a
+        channel named "" accepted is a finding."""
+        def run():
+            from testbed.pipeline.importers import from_sep005
+
+            t = np.arange(100) / 1000.0
+            ds = from_sep005([{"name": name, "data": list(np.sin(40 * t)), "fs": 1000.0,
+                               "unit_str": "m/s^2"}]).to_dataset()
+            return f"read as {{signal: channels}} {({k: v.channels for k, v in ds.measured.items()})}"
+        return run
+
     def api(fn):
         def run():
             fn()
@@ -773,6 +785,8 @@ def apiuse_cases(work: Path) -> list[tuple[str, object]]:
         ("write_uff of two names sharing the 80 characters of the ID line",
          uff_names(("a" * 90 + "1", "a" * 90 + "2"))),
         ("write_uff of a name with a trailing blank", uff_names(("acc1 ", "acc2"))),
+        ("a SEP-005 channel named 'acceleration/'", empty_part("acceleration/")),
+        ("a SEP-005 channel named '/acc1'", empty_part("/acc1")),
         ("score of a dataset of another scenario's record (1 kHz against 100 Hz)",
          api(lambda: testbed.score(
              testbed.IDENTIFIERS.get("sindy_pi_dynamical")(degree=3).fit(mm_data()),
