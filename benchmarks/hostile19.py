@@ -738,6 +738,18 @@ def apiuse_cases(work: Path) -> list[tuple[str, object]]:
             return f"read as {{signal: channels}} {({k: v.channels for k, v in ds.measured.items()})}"
         return run
 
+    def measured_at(fs):
+        """``measure`` of a hand-built kinetics Dataset whose rate is ``fs``: anything but one
+        refusal line is a finding (a measurement at a rate read from text or a boolean too)."""
+        def run():
+            from testbed.core.dataset import Dataset, Signal
+
+            x = (2.0 * np.exp(-np.arange(400) / 100.0))[None, :]
+            ds = Dataset(fs, {"x": Signal(x, ("x",), "mM"), "dx": Signal(-x, ("dx",), "mM/s")})
+            m = measure(ds, {}, "dynamical")
+            return f"measured at {m.fs!r} Hz"
+        return run
+
     def api(fn):
         def run():
             fn()
@@ -785,6 +797,11 @@ def apiuse_cases(work: Path) -> list[tuple[str, object]]:
         ("write_uff of two names sharing the 80 characters of the ID line",
          uff_names(("a" * 90 + "1", "a" * 90 + "2"))),
         ("write_uff of a name with a trailing blank", uff_names(("acc1 ", "acc2"))),
+        ("measure of a Dataset at 0 Hz", measured_at(0.0)),
+        ("measure of a Dataset at NaN Hz", measured_at(math.nan)),
+        ("measure of a Dataset at True Hz", measured_at(True)),
+        ("measure of a Dataset at '100' Hz", measured_at("100")),
+        ("measure of a Dataset at 100+0j Hz", measured_at(100 + 0j)),
         ("a SEP-005 channel named 'acceleration/'", empty_part("acceleration/")),
         ("a SEP-005 channel named '/acc1'", empty_part("/acc1")),
         ("score of a dataset of another scenario's record (1 kHz against 100 Hz)",
