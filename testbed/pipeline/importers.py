@@ -60,7 +60,7 @@ import numpy as np
 
 from testbed.core.budget import IDENTIFY_BYTES_PER_VALUE, IDENTIFY_TEXT_BUDGET_BYTES, IDENTIFY_VALUE_BUDGET
 from testbed.core.dataset import Dataset, DatasetError, Signal
-from testbed.core.errors import TestbedError, is_control, show_names
+from testbed.core.errors import TestbedError, is_control, printable, show_names
 from testbed.core.measurement import MIN_FREE_SAMPLES, Measurement
 from testbed.numerics.noise import noise_std
 from testbed.pipeline.signal_chain import SIGNAL_CHAINS, SIGNAL_SCHEMAS, measure, pulse_span
@@ -121,7 +121,9 @@ class MeasuredDataError(TestbedError, ValueError):
 
     def __init__(self, path: str | os.PathLike, reason: str) -> None:
         self.path, self.reason = Path(path), " ".join(str(reason).split())
-        super().__init__(f"{path}: {self.reason}")
+        # the path shown escaped: "r\nx.json" made the one error line two, and a NUL (the API
+        # only: argv cannot hold one) was printed raw (rounds 17 and 19)
+        super().__init__(f"{printable(str(path))}: {self.reason}")
 
 
 @dataclass

@@ -413,3 +413,13 @@ def test_a_channel_name_with_an_empty_part_around_the_slash_is_refused(name, emp
     chans = [{"name": name, "data": list(np.sin(40 * t)), "fs": 1000.0, "unit_str": "m/s^2"}]
     with pytest.raises(MeasuredDataError, match=f"channel name {name!r}: an empty {empty} name"):
         from_sep005(chans).to_dataset()
+
+
+@pytest.mark.parametrize(("path", "shown"), [("r\nx.json", r"r\nx.json"), ("r.json\0", r"r.json\x00")])
+def test_a_path_with_a_control_character_is_shown_escaped_in_one_line(path, shown):
+    # a newline in the path made the one error line two (round 19); a NUL was printed raw
+    # (round 17, open item 7)
+    with pytest.raises(MeasuredDataError) as e:
+        read_measured(path)
+    assert "\n" not in str(e.value) and "\0" not in str(e.value)
+    assert str(e.value).startswith(shown + ": "), str(e.value)
