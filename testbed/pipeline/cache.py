@@ -40,8 +40,8 @@ from testbed.core import arguments
 from testbed.core.dataset import Dataset, DatasetError
 from testbed.core.errors import InputError
 from testbed.core.provenance import versions
+from testbed.core.rate_attrs import fs_attribute_problem
 from testbed.pipeline.generate import derive, noise_free_scenario, simulate_clean
-from testbed.pipeline.importers import MeasuredDataError, check_hdf5_rate
 from testbed.pipeline.plugins import rig_class
 from testbed.pipeline.scenario import Scenario
 
@@ -158,7 +158,7 @@ _UNWRITABLE_WARNED: set[str] = set()
 
 def _load_entry(path: Path, scenario: Scenario) -> Dataset:
     """A cache entry, verified: its content hash (:meth:`Dataset.load`), its rate attributes
-    (:func:`~testbed.pipeline.importers.check_hdf5_rate`) and its rate against the record its
+    (:func:`~testbed.core.rate_attrs.fs_attribute_problem`) and its rate against the record its
     scenario asks for (:meth:`Rig.record`, where the rig declares one).
 
     :meth:`Dataset.load` reads ``fs`` with ``float()`` and no unit (round 17, open item 2 of
@@ -170,10 +170,12 @@ def _load_entry(path: Path, scenario: Scenario) -> Dataset:
 
     Raises
     ------
-    DatasetError, MeasuredDataError
+    DatasetError
         Naming the file and what is wrong (the caller simulates it again).
     """
-    check_hdf5_rate(path)
+    problem = fs_attribute_problem(path)
+    if problem:
+        raise DatasetError(path, problem)
     ds = Dataset.load(path)
     record = rig_class(scenario.rig).record(noise_free_scenario(scenario).simulation)
     if record is not None and not (ds.fs == float(record[0])):  # NaN fails
@@ -217,7 +219,7 @@ class DatasetCache:
         if p.is_file():
             try:
                 return _load_entry(p, scenario)
-            except (DatasetError, MeasuredDataError) as e:
+            except DatasetError as e:
                 if p.is_file():  # else another process cleared it meanwhile: a plain miss
                     log.warning("dataset cache: %s; simulating it again", e)
         ds = simulate_clean(scenario, progress)

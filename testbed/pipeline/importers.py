@@ -60,8 +60,9 @@ import numpy as np
 
 from testbed.core.budget import IDENTIFY_BYTES_PER_VALUE, IDENTIFY_TEXT_BUDGET_BYTES, IDENTIFY_VALUE_BUDGET
 from testbed.core.dataset import Dataset, DatasetError, Signal
-from testbed.core.errors import TestbedError, is_control, printable, show_names
+from testbed.core.errors import TestbedError, is_control, show_names
 from testbed.core.measurement import MIN_FREE_SAMPLES, Measurement
+from testbed.core.rate_attrs import fs_attribute_problem
 from testbed.numerics.noise import noise_std
 from testbed.pipeline.signal_chain import SIGNAL_CHAINS, SIGNAL_SCHEMAS, measure, pulse_span
 
@@ -121,9 +122,7 @@ class MeasuredDataError(TestbedError, ValueError):
 
     def __init__(self, path: str | os.PathLike, reason: str) -> None:
         self.path, self.reason = Path(path), " ".join(str(reason).split())
-        # the path shown escaped: "r\nx.json" made the one error line two, and a NUL (the API
-        # only: argv cannot hold one) was printed raw (rounds 17 and 19)
-        super().__init__(f"{printable(str(path))}: {self.reason}")
+        super().__init__(f"{path}: {self.reason}")  # shown escaped: TestbedError.__str__
 
 
 @dataclass
@@ -1134,25 +1133,9 @@ def check_hdf5_rate(path: str | os.PathLike) -> None:
     MeasuredDataError
         Naming ``path``, the attribute, its value and what is allowed.
     """
-    import h5py
-
-    try:
-        with h5py.File(path, "r") as h:
-            attrs = {k: h.attrs[k] for k in ("fs", "fs_unit") if k in h.attrs}
-    except Exception:
-        return
-    fs = attrs.get("fs")
-    if fs is not None and not (isinstance(fs, (np.floating, np.integer, float, int))
-                               and not isinstance(fs, (bool, np.bool_))):
-        shown = fs.item() if isinstance(fs, np.generic) else fs  # named as 'True', not
-        shown = shown.decode(errors="replace") if isinstance(shown, bytes) else shown  # np.True_
-        raise MeasuredDataError(path, f"attribute fs={shown!r} ({type(fs).__name__}); expected "
-                                      "one real number, the sample rate [Hz]")
-    unit = attrs.get("fs_unit")
-    unit = unit.decode(errors="replace") if isinstance(unit, bytes) else unit
-    if unit is not None and unit != "Hz":
-        raise MeasuredDataError(path, f"attribute fs_unit={unit!r}; expected 'Hz' (the unit the "
-                                      "sample rate fs is read in)")
+    problem = fs_attribute_problem(path)
+    if problem:
+        raise MeasuredDataError(path, problem)
 
 
 def check_hdf5_storage(path: str | os.PathLike) -> None:
