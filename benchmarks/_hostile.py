@@ -89,7 +89,10 @@ def classify(fn: Callable[[], Any], timeout_s: int,
         if len(text) > MAX_LINE_CHARS:
             return f"line of {len(text)} chars"
         return "ok"
-    except Exception as e:  # every other exception is a finding
+    except BaseException as e:  # every other exception is a finding (GeneratorExit from a
+        # plugin too: round 19's old code let it end the round), but the user's Ctrl-C
+        if isinstance(e, KeyboardInterrupt):
+            raise
         return f"{type(e).__name__}: {str(e)[:200]}"
     finally:
         signal.alarm(0)

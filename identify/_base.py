@@ -64,7 +64,7 @@ from testbed.core.errors import (
     ScenarioError,
     UnsupportedError,
 )
-from testbed.core.measurement import Measurement, Trajectory
+from testbed.core.measurement import MIN_FREE_SAMPLES, Measurement, Trajectory
 from testbed.core.schema import ErrorFn, Field, KeyUse, check_keys_used, validate_table
 
 
@@ -354,8 +354,19 @@ class Identifier:
         -------
         Trajectory
             ``x``, ``xd``, ``xdd``, each of shape (n_channels, n_samples).
+
+        Raises
+        ------
+        UnsupportedError
+            (a NotImplementedError) here, in the base class: an identifier that does not
+            implement it cannot be scored (the scorer integrates the identified model).  A
+            plugin without it was "internal error (a bug, not your input): NotImplementedError"
+            of `testbed run` (hostile round 19); now one line naming the class.
         """
-        raise NotImplementedError
+        raise UnsupportedError(f"{type(self).__name__}.simulate: not implemented; the scorer "
+                               "integrates the identified model, so an identifier to be scored "
+                               "implements simulate(x0, xd0, t, u) -> Trajectory "
+                               "(docs/identifiers.md)")
 
     def equations(self, precision: int = 4) -> list[str]:
         """The identified equations as text, one per equation (shown in reports).
@@ -465,11 +476,6 @@ class Identifier:
         args = ", ".join(f"{k}={v!r}" for k, v in self.get_params().items())
         return f"{type(self).__name__}({args})"
 
-
-#: Fewest samples a structural identifier fits after ``free_start``: the library's own floor
-#: (:func:`identify.structural.build_library`), checked before the fit's band and decay rules
-#: (which divided by the empty window's length: ZeroDivisionError, API round of session 15).
-MIN_FREE_SAMPLES = 4
 
 #: Methods that need a fitted model: called before ``fit`` they raise NotFittedError.
 FITTED_ONLY = ("score", "predict_acceleration", "equations", "simulate")

@@ -181,6 +181,49 @@ RULES: dict[str, dict[str, Rule]] = {
 }
 
 
+#: The sections of a scenario that decide its record (its rig and how it was simulated and
+#: excited); its noise and seed are left out: a noisy copy of the record is still its record.
+RECORD_SECTIONS = ("rig", "rig_params", "simulation", "excitation")
+
+
+def _dataset_of_scenario(where: str, bound: Mapping[str, Any], r: Resolve) -> None:
+    """``dataset`` made by ``scenario``'s rig and record (:data:`RECORD_SECTIONS`), where the
+    dataset says which scenario made it (a hand-built one says nothing and is not checked).
+
+    Hostile round 19: ``testbed.score(model, dataset, scenario)`` scored a 1 kHz dataset of
+    ``michaelis_menten_noise1`` with the 100 Hz ``michaelis_menten`` scenario in silence: its
+    chain and its ``[score]`` bars were set for another record, and its docstring says the
+    scenario is the one the dataset belongs to."""
+    import json
+
+    dataset, scenario = bound["dataset"], bound["scenario"]
+    made = dataset.attrs.get("scenario") if isinstance(dataset.attrs, Mapping) else None
+    if not isinstance(made, Mapping):
+        return
+    if not isinstance(scenario, r("Scenario")):
+        scenario = r("load_scenario")(scenario)
+    ours = scenario.to_dict()
+
+    def canonical(v: Any) -> str:  # tuples as lists, as the dataset's JSON holds them
+        return json.dumps(v, sort_keys=True, default=str)
+
+    for key in RECORD_SECTIONS:
+        if canonical(made.get(key)) != canonical(ours.get(key)):
+            raise ArgumentError(where, "dataset", f"a dataset of scenario {made.get('name')!r}",
+                                f"expected a dataset of scenario {scenario.name!r} (its {key} "
+                                f"differs: {canonical(made.get(key))[:120]} against "
+                                f"{canonical(ours.get(key))[:120]}); pass the scenario that "
+                                "made the dataset, or testbed.generate(scenario)'s dataset",
+                                described=True)
+
+
+#: Public name -> checks of its arguments together, after :data:`RULES` (each of
+#: ``check(where, bound_arguments, resolve)``).
+CROSS: dict[str, Callable[[str, Mapping[str, Any], Resolve], None]] = {
+    "score": _dataset_of_scenario,
+}
+
+
 def checked(name: str, fn: Callable[..., Any], resolve: Resolve) -> Callable[..., Any]:
     """``fn`` (the public function ``testbed.<name>``) with its arguments checked by
     ``RULES[name]``; ``resolve`` gives a public class by name."""
@@ -198,6 +241,8 @@ def checked(name: str, fn: Callable[..., Any], resolve: Resolve) -> Callable[...
         bound.apply_defaults()
         for arg, rule in rules.items():
             bound.arguments[arg] = rule(name, arg, bound.arguments[arg], resolve)
+        if name in CROSS:
+            CROSS[name](name, bound.arguments, resolve)
         return fn(*bound.args, **bound.kwargs)
 
     call.__wrapped_api__ = fn  # type: ignore[attr-defined]

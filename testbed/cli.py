@@ -96,12 +96,38 @@ class _Parser(argparse.ArgumentParser):
         sys.exit(EXIT_USAGE)
 
 
+#: A number as the command line takes it: ASCII digits, an optional sign, point and exponent
+#: (and the words inf / nan, which the options' own checks refuse where they must).
+_PLAIN_NUMBER = re.compile(r"\s*[+-]?((\d+(\.\d*)?|\.\d+)([eE][+-]?\d+)?|inf|infinity|nan)\s*",
+                           re.IGNORECASE | re.ASCII)
+
+
+def _plain_number(text: str) -> str:
+    """``text`` if it is a number written in ASCII, else ValueError.
+
+    Python's ``int()`` and ``float()`` also read other scripts' digits and underscores:
+    ``--seed ３`` (a fullwidth digit) ran seed 3 and ``--fs 1_000`` read 1000 Hz (hostile round
+    19), where a scenario file's TOML refuses both."""
+    if not _PLAIN_NUMBER.fullmatch(text):
+        raise ValueError(text)
+    return text
+
+
+def _float(text: str) -> float:
+    """An argparse type: a number written in ASCII (:func:`_plain_number`), as ``float()``."""
+    try:
+        return float(_plain_number(text))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number (ASCII digits), got "
+                                         f"{show_value(text)}") from None
+
+
 def _int_at_least(low: int, high: int | None = None) -> Callable[[str], int]:
     """An argparse type: an integer >= ``low`` (and <= ``high``), refused in one line otherwise."""
 
     def parse(text: str) -> int:
         try:
-            value = int(text)
+            value = int(_plain_number(text))
         except ValueError:
             raise argparse.ArgumentTypeError(f"expected an integer >= {low}, "
                                              f"got {show_value(text)}") from None
@@ -906,7 +932,7 @@ def build_parser() -> argparse.ArgumentParser:
                                     "scenario's")
     i.add_argument("--param", action="append", metavar="NAME=VALUE",
                    help="identifier hyperparameter, value as in TOML (repeatable)")
-    i.add_argument("--fs", type=float, help="sample rate [Hz] (needed for a CSV without a time column)")
+    i.add_argument("--fs", type=_float, help="sample rate [Hz] (needed for a CSV without a time column)")
     i.add_argument("--units", action="append", metavar="UNIT|CHANNEL=UNIT",
                    help="unit of every channel, or of one channel (repeatable), e.g. g, mm, N")
     i.add_argument("--prior", action="append", metavar="KEY=VALUE",

@@ -186,6 +186,13 @@ class Measurement:
         return np.arange(self.n_samples) / self.fs
 
 
+#: Fewest samples a structural identifier fits after ``free_start``: the library's own floor
+#: (:func:`identify.structural.build_library`), checked before the fit's band and decay rules
+#: (which divided by the empty window's length: ZeroDivisionError, API round of session 15).
+#: Here, not in ``identify._base``, so that a scenario's load check (an impact that leaves the
+#: record no free decay, ``testbed.pipeline.scenario``) and the fit use one number.
+MIN_FREE_SAMPLES = 4
+
 #: How a dataset's provenance declares zero-order-hold inputs: an ``attrs`` entry ``<input>_hold``
 #: (the rigs write ``torque_hold``) with this value.
 ZOH_DECLARATION = "zero-order hold over each sample interval"

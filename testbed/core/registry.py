@@ -78,7 +78,9 @@ def import_plugin(spec: str) -> Any:
     if not spec.endswith(".py"):
         try:
             module = importlib.import_module(spec)
-        except (Exception, SystemExit) as e:  # (sys.exit(0) in a plugin ended a run with status 0)
+        except BaseException as e:  # (sys.exit(0) in a plugin ended a run with status 0)
+            if isinstance(e, KeyboardInterrupt):  # the user's Ctrl-C stays an interrupt
+                raise
             raise PluginError(f"plugin {spec}: cannot import it: {type(e).__name__}: {e}; expected "
                               "a .py file or an importable dotted module name") from e
         configure_loaded()  # a plugin importing MuJoCo itself: its C-level log silenced too
@@ -104,8 +106,10 @@ def import_plugin(spec: str) -> Any:
         loader_spec.loader.exec_module(module)
     except BaseException as e:
         del sys.modules[modname]
-        # a plugin's sys.exit(0) ended `testbed run` with status 0 and no verdict
-        if isinstance(e, (Exception, SystemExit)):
+        # a plugin's sys.exit(0) ended `testbed run` with status 0 and no verdict; any other
+        # BaseException but the user's Ctrl-C (GeneratorExit, pytest's Skipped from a plugin
+        # written as a test helper) was a traceback with status 1 (hostile round 19)
+        if not isinstance(e, KeyboardInterrupt):
             raise PluginError(f"plugin {spec}: importing it failed: {type(e).__name__}: {e}") from e
         raise
     configure_loaded()  # a plugin importing MuJoCo itself: its C-level log silenced too

@@ -40,6 +40,7 @@ from testbed.core import arguments
 from testbed.core.dataset import Dataset, DatasetError
 from testbed.core.errors import InputError
 from testbed.core.provenance import versions
+from testbed.core.rate_attrs import fs_attribute_problem
 from testbed.pipeline.generate import derive, noise_free_scenario, simulate_clean
 from testbed.pipeline.plugins import rig_class
 from testbed.pipeline.scenario import Scenario
@@ -155,6 +156,34 @@ NOT_WRITABLE = (errno.EACCES, errno.EPERM, errno.EROFS)
 _UNWRITABLE_WARNED: set[str] = set()
 
 
+def _load_entry(path: Path, scenario: Scenario) -> Dataset:
+    """A cache entry, verified: its content hash (:meth:`Dataset.load`), its rate attributes
+    (:func:`~testbed.core.rate_attrs.fs_attribute_problem`) and its rate against the record its
+    scenario asks for (:meth:`Rig.record`, where the rig declares one).
+
+    :meth:`Dataset.load` reads ``fs`` with ``float()`` and no unit (round 17, open item 2 of
+    round 18: the text ``"12800"``, ``True`` or ``fs_unit = "kHz"`` were read as rates); checking
+    it there would change the file the cache key hashes (``testbed/core/dataset.py``), so the
+    cache checks what it reads here.  An entry whose rate is not its scenario's (an edit made
+    with its content hash anew) was served with that rate: the chain's filters and the scores'
+    time axis then belong to another record.
+
+    Raises
+    ------
+    DatasetError
+        Naming the file and what is wrong (the caller simulates it again).
+    """
+    problem = fs_attribute_problem(path)
+    if problem:
+        raise DatasetError(path, problem)
+    ds = Dataset.load(path)
+    record = rig_class(scenario.rig).record(noise_free_scenario(scenario).simulation)
+    if record is not None and not (ds.fs == float(record[0])):  # NaN fails
+        raise DatasetError(path, f"attribute fs={ds.fs!r} Hz; its scenario records at "
+                                 f"{float(record[0])!r} Hz")
+    return ds
+
+
 class DatasetCache:
     """Datasets on disk, one HDF5 file per key.
 
@@ -189,7 +218,7 @@ class DatasetCache:
                              "dataset belongs; remove it or use another cache folder (--cache)")
         if p.is_file():
             try:
-                return Dataset.load(p)
+                return _load_entry(p, scenario)
             except DatasetError as e:
                 if p.is_file():  # else another process cleared it meanwhile: a plain miss
                     log.warning("dataset cache: %s; simulating it again", e)

@@ -90,8 +90,9 @@ def fit_or_fail(model: Any, data: Measurement, method: str | None = None) -> Non
                                   f"{' '.join(str(e).split()) or 'no message'})") from None
     except TestbedError:
         raise
-    except (Exception, SystemExit) as e:  # a plugin's sys.exit(0) ended a run with exit 0, no verdict
-        if origin == "builtin":
+    except BaseException as e:  # a plugin's sys.exit(0) ended a run with exit 0, no verdict;
+        # its GeneratorExit (any BaseException but Ctrl-C) was a traceback, status 1 (round 19)
+        if origin == "builtin" or isinstance(e, KeyboardInterrupt):
             raise
         raise IdentificationError(f"identifier {method} (from {origin}) raised "
                                   f"{type(e).__name__}: {' '.join(str(e).split())}") from None
@@ -111,8 +112,18 @@ def fitted_shape_problem(model: Any) -> str | None:
     wrong shapes were an internal error of the scoring or the JSON ("a bug, not your input").
     """
     def real(name: str) -> np.ndarray | str:
+        value = getattr(model, name)
         try:
-            a = np.asarray(getattr(model, name), dtype=float)
+            kind = np.asarray(value).dtype
+            # complex was cast to real with a ComplexWarning on stderr (its imaginary part
+            # dropped), float16 was "internal error: array type float16 is unsupported in
+            # linalg" of the scoring, booleans read as 0 / 1 (hostile round 19)
+            if kind.kind == "c":
+                return f"{name} of complex dtype {kind}; expected real numbers (float64)"
+            if kind.kind == "b" or kind == np.float16:
+                return (f"{name} of dtype {kind}; expected real numbers of float32 or float64 "
+                        "(numpy's linear algebra takes no float16)")
+            a = np.asarray(value, dtype=float)
         except (TypeError, ValueError) as e:
             return f"{name} that is not an array of real numbers ({type(e).__name__}: {e})"
         return a

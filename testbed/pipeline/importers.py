@@ -61,9 +61,10 @@ import numpy as np
 from testbed.core.budget import IDENTIFY_BYTES_PER_VALUE, IDENTIFY_TEXT_BUDGET_BYTES, IDENTIFY_VALUE_BUDGET
 from testbed.core.dataset import Dataset, DatasetError, Signal
 from testbed.core.errors import TestbedError, is_control, show_names
-from testbed.core.measurement import Measurement
+from testbed.core.measurement import MIN_FREE_SAMPLES, Measurement
+from testbed.core.rate_attrs import fs_attribute_problem
 from testbed.numerics.noise import noise_std
-from testbed.pipeline.signal_chain import SIGNAL_CHAINS, SIGNAL_SCHEMAS, measure
+from testbed.pipeline.signal_chain import SIGNAL_CHAINS, SIGNAL_SCHEMAS, measure, pulse_span
 
 FORMATS = ("uff", "sep005", "csv", "hdf5")
 SUFFIXES = {".uff": "uff", ".unv": "uff", ".json": "sep005", ".csv": "csv", ".tsv": "csv",
@@ -121,7 +122,7 @@ class MeasuredDataError(TestbedError, ValueError):
 
     def __init__(self, path: str | os.PathLike, reason: str) -> None:
         self.path, self.reason = Path(path), " ".join(str(reason).split())
-        super().__init__(f"{path}: {self.reason}")
+        super().__init__(f"{path}: {self.reason}")  # shown escaped: TestbedError.__str__
 
 
 @dataclass
@@ -213,7 +214,15 @@ class ImportedData:
         if groups is None:
             grouped: dict[str, list[str]] = {}
             for name in self.signals:
-                grouped.setdefault(name.split("/", 1)[0] if "/" in name else name, []).append(name)
+                head, slash, tail = name.partition("/")
+                if slash and not (head and tail):
+                    # "acceleration/" was a channel named "" and "/x" a signal named "" (round
+                    # 19): a report's rows and a `--units` key could not name them
+                    raise MeasuredDataError(self.source, f"channel name {name!r}: an empty "
+                                                         f"{'signal' if not head else 'channel'} "
+                                                         "name around '/'; expected "
+                                                         "'<signal>/<channel>' with both named")
+                grouped.setdefault(head if slash else name, []).append(name)
         else:
             grouped = _checked_groups(self.source, groups)
         measured = {}
@@ -422,7 +431,31 @@ def _check_response(path: Path, ds: Dataset, kind: str) -> None:
                                       f"({', '.join(f'{p:g}' for p in sig.positions)} m); expected "
                                       "one sensor per position")
     if kind == "structural":
+        _check_pulse_ends(path, ds)
         _check_independent(path, sig, RESPONSE_SIGNAL[kind])
+
+
+def _check_pulse_ends(path: Path, ds: Dataset) -> None:
+    """Refuse a structural record whose force pulse has not ended ``MIN_FREE_SAMPLES`` samples
+    before the record does: cut inside the impact, it holds no free decay to fit.
+
+    Round 18: a beam record cut two samples into the pulse was refused as "'acceleration'
+    channel 'acc3' is a linear combination of 'acc1', 'acc2'" (every channel zero but for two
+    samples): one line, not the cause.  The pulse is the chain's own
+    (:func:`~testbed.pipeline.signal_chain.pulse_span`)."""
+    force = ds.measured.get("force")
+    if force is None or force.data.ndim != 2 or not np.all(np.isfinite(force.data)):
+        return  # the chain says what is missing; the reader refuses non-finite samples
+    n = force.data.shape[1]
+    start, end = pulse_span(force.data)
+    if end > 0 and n - end < MIN_FREE_SAMPLES:
+        mag = np.max(np.abs(force.data), axis=0)
+        raise MeasuredDataError(path, f"the force pulse (from sample {start}) has not ended "
+                                      f"{MIN_FREE_SAMPLES} samples before the record's last "
+                                      f"(sample {n - 1}, force {mag[-1] / mag.max():.3g} of its "
+                                      "peak): the record was cut inside the impact and holds no "
+                                      "free decay to identify; expected the whole pulse and the "
+                                      "decay after it")
 
 
 def _check_unwrapped(path: Path, sig: Signal, name: str) -> None:
@@ -771,6 +804,9 @@ class _Raw:
     #: time [s] of each channel's first sample, where the file states it per channel (a
     #: SEP-005 channel's ``time``, a UFF58 record's abscissa)
     starts: dict[str, float] = field(default_factory=dict)
+    #: channels of ``starts`` whose start the file does not state (a SEP-005 channel with
+    #: ``fs`` alone beside channels with a ``time``: taken as t = 0)
+    implied_starts: set[str] = field(default_factory=set)
     #: the file's units are its rig's own and stay as they are (a testbed dataset of a
     #: ``dynamical`` rig: concentrations and the like have no SI form to convert to)
     own_units: bool = False
@@ -860,7 +896,8 @@ def _finish(raw: _Raw, fs: float | None, units: str | Mapping[str, str] | None,
         raise MeasuredDataError(path, f"sample rate {rate:g} Hz: {n} samples would last forever "
                                       "(the duration overflows); expected a rate whose record lasts "
                                       "a finite time")
-    _check_starts(path, {n: raw.starts[n] for n in names if n in raw.starts}, rate)
+    _check_starts(path, {n: raw.starts[n] for n in names if n in raw.starts}, rate,
+                  raw.implied_starts)
     signals = {}
     for n in names:
         unit = units if isinstance(units, str) else (units or {}).get(n, raw.units.get(n))
@@ -921,21 +958,27 @@ def _check_direction(path: Path, name: str, direction: int, si: str) -> None:
                                       "expected a direction and a unit of one kind")
 
 
-def _check_starts(path: Path, starts: Mapping[str, float], fs: float) -> None:
+def _check_starts(path: Path, starts: Mapping[str, float], fs: float,
+                  implied: set[str] | frozenset[str] = frozenset()) -> None:
     """Refuse channels whose first samples were taken at different times: the readers line
     the channels up sample by sample, so a force recorded 0.3 s after its responses (a SEP-005
     channel's ``time`` or a UFF58 record's abscissa starting later) was fitted as if
     simultaneous, with status 0 (round 17).  Within half a sample step [s] they agree (a
-    time stamp's rounding)."""
+    time stamp's rounding).  A channel of ``implied`` states no start (``fs`` alone) and is
+    named as such."""
     if len(starts) < 2:
         return
     (first, t0), (worst, tw) = next(iter(starts.items())), max(
         starts.items(), key=lambda kv: abs(kv[1] - next(iter(starts.values()))))
     if abs(tw - t0) > 0.5 / fs:
-        raise MeasuredDataError(path, f"channel {worst!r} starts at t = {tw:.9g} s, channel "
-                                      f"{first!r} at t = {t0:.9g} s: {abs(tw - t0) * fs:.3g} "
-                                      "samples apart; expected every channel to start at one time "
-                                      "(within half a sample step)")
+        def said(name: str, t: float) -> str:
+            if name in implied:
+                return f"channel {name!r} gives fs alone (no time: read as starting at t = 0 s)"
+            return f"channel {name!r} starts at t = {t:.9g} s"
+        raise MeasuredDataError(path, f"{said(worst, tw)}, {said(first, t0)}: "
+                                      f"{abs(tw - t0) * fs:.3g} samples apart; expected every "
+                                      "channel to start at one time (within half a sample step; "
+                                      "give every channel a time, or none)")
 
 
 #: Range of a declared prior (a mass [kg] or a length [m]).  A prior scales the identified
@@ -1090,25 +1133,9 @@ def check_hdf5_rate(path: str | os.PathLike) -> None:
     MeasuredDataError
         Naming ``path``, the attribute, its value and what is allowed.
     """
-    import h5py
-
-    try:
-        with h5py.File(path, "r") as h:
-            attrs = {k: h.attrs[k] for k in ("fs", "fs_unit") if k in h.attrs}
-    except Exception:
-        return
-    fs = attrs.get("fs")
-    if fs is not None and not (isinstance(fs, (np.floating, np.integer, float, int))
-                               and not isinstance(fs, (bool, np.bool_))):
-        shown = fs.item() if isinstance(fs, np.generic) else fs  # named as 'True', not
-        shown = shown.decode(errors="replace") if isinstance(shown, bytes) else shown  # np.True_
-        raise MeasuredDataError(path, f"attribute fs={shown!r} ({type(fs).__name__}); expected "
-                                      "one real number, the sample rate [Hz]")
-    unit = attrs.get("fs_unit")
-    unit = unit.decode(errors="replace") if isinstance(unit, bytes) else unit
-    if unit is not None and unit != "Hz":
-        raise MeasuredDataError(path, f"attribute fs_unit={unit!r}; expected 'Hz' (the unit the "
-                                      "sample rate fs is read in)")
+    problem = fs_attribute_problem(path)
+    if problem:
+        raise MeasuredDataError(path, problem)
 
 
 def check_hdf5_storage(path: str | os.PathLike) -> None:
@@ -1308,6 +1335,15 @@ def _parse_sep005(path: Path, content: Any) -> _Raw:
         if pos is not None:
             raw.positions[name] = check_position(path, name, pos, "position_m")
     raw.fs = _common_rate(path, rates, 1e-9)
+    if raw.starts:
+        # channels of one file, some with a `time` and some with `fs` alone (round 18, open
+        # item d): an fs-only channel states no start, and was lined up sample by sample with
+        # a timed channel starting 0.3 s later, in silence.  SEP-005 reads an fs-only channel
+        # as sampled from t = 0, so it is checked as starting there.
+        for name in raw.data:
+            if name not in raw.starts:
+                raw.starts[name] = 0.0
+                raw.implied_starts.add(name)
     return raw
 
 

@@ -67,7 +67,13 @@ from testbed.core.schema import (
     validate_variant,
 )
 from testbed.pipeline.plugins import IDENTIFIERS, RIGS
-from testbed.pipeline.signal_chain import SIGNAL_SCHEMAS, check_keys_used, check_signal, rig_auto_keys
+from testbed.pipeline.signal_chain import (
+    SIGNAL_SCHEMAS,
+    check_free_decay,
+    check_keys_used,
+    check_signal,
+    rig_auto_keys,
+)
 
 #: Scenario and study names: a safe file stem (no path separators, not "." or "..").
 NAME_PATTERN, NAME_PATTERN_DOC = REGISTERED_NAME, REGISTERED_NAME_DOC  # one rule (core)
@@ -589,6 +595,10 @@ def scenario_from_dict(raw: dict[str, Any], *, file: str = "<dict>", stem: str |
     record = rig_cls.record(simulation)
     if record is not None:
         check_signal(rig_cls.kind, signal, *record, chain_error)
+        if rig_cls.kind == "structural" and {"start", "pulse_duration"} <= excitation.keys():
+            # an impact (the structural chain's excitation): its free decay must hold samples
+            check_free_decay(signal, *record, excitation["start"], excitation["pulse_duration"],
+                             chain_error)
     identify = _validate_identify(raw.get("identify"), file, kind=rig_cls.kind,
                                   rig_kind_source=f"rig {head['rig']!r}")
     score = _validate_score(raw.get("score", {}), rig_cls.kind, file)

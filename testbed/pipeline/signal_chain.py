@@ -16,9 +16,15 @@ from typing import Any
 
 import numpy as np
 
+from testbed.core import arguments as args
 from testbed.core.dataset import Dataset
 from testbed.core.errors import ArgumentError, RegistrationError, ScenarioError, show_names
-from testbed.core.measurement import Measurement, declared_input_hold, nearest_within
+from testbed.core.measurement import (
+    MIN_FREE_SAMPLES,
+    Measurement,
+    declared_input_hold,
+    nearest_within,
+)
 from testbed.core.schema import Field, KeyUse, validate_table
 from testbed.core.schema import check_keys_used as schema_check_keys_used
 from testbed.numerics import derivatives
@@ -363,6 +369,16 @@ def measure(dataset: Dataset, signal_cfg: Mapping[str, Any], kind: str) -> Measu
         # 'theta'", a plain ValueError (round 18, the API)
         raise ArgumentError("measure", "kind", kind, f"the dataset was made by a rig of kind "
                             f"{made!r}; its signals go through that kind's chain")
+    # a Dataset built or loaded with fs 0, NaN, inf, True, "100" or complex (Dataset.load reads
+    # the file's fs with float(); its content hash can be made anew): ZeroDivisionError,
+    # TypeError or a plain ValueError from inside the filters, or 1 Hz / 100 Hz in silence
+    # (hostile round 19)
+    if isinstance(dataset, Dataset):
+        fs = args.real("measure", "dataset.fs", dataset.fs, low=0.0, low_open=True)
+        n = max((np.shape(s.data)[-1] for s in dataset.measured.values()), default=0)
+        if not math.isfinite(max(n - 1, 0) / fs):
+            raise ArgumentError("measure", "dataset.fs", fs, f"a rate at which the record's {n} "
+                                "samples last a finite time (the duration overflows)")
     chain = _chain(kind)
     cfg = validate_table(dict(signal_cfg), chain.schema, file="<signal config>", section="signal")
     m = chain.measure(dataset, cfg)
@@ -377,6 +393,78 @@ def _get(dataset: Dataset, name: str, rows: int | None = None) -> np.ndarray:
     if rows is not None and data.shape[0] != rows:
         raise ValueError(f"measured {name!r} has {data.shape[0]} channels, expected {rows}")
     return data
+
+
+def free_start_after(cfg: Mapping[str, Any], fs: float, end: int, n_samples: int, *,
+                     settle: bool = True) -> int:
+    """The first sample of the structural chain's free decay: ``free_margin_s`` after the pulse's
+    end, or later where the low-pass's response to the pulse has settled
+    (:data:`LOWPASS_SETTLE_TOL`; left out with ``settle=False``: its rule imports SciPy's
+    filter design, which loading a scenario does not); 0 for a record without a pulse.
+
+    Parameters
+    ----------
+    cfg : mapping
+        A validated ``SIGNAL_SCHEMAS["structural"]`` table (cut-offs resolved).
+    fs : float
+        Sample rate [Hz].
+    end : int
+        First sample after the force pulse (:func:`pulse_end`); 0 for none.
+    n_samples : int
+        The record's length [samples]: the result is at most this.
+
+    Returns
+    -------
+    int
+    """
+    margin = int(np.ceil(cfg["free_margin_s"] * fs))
+    if settle and cfg["lowpass_hz"] > 0:
+        margin = max(margin, sig.lowpass_settling(fs, cfg["lowpass_hz"], cfg["lowpass_order"],
+                                                  LOWPASS_SETTLE_TOL))
+    return 0 if end <= 0 else min(n_samples, end + margin)
+
+
+def check_free_decay(cfg: Mapping[str, Any], fs: float, n_samples: int, pulse_start_s: float,
+                     pulse_s: float, error: ErrorFn) -> None:
+    """Refuse an impact that leaves the record fewer than ``MIN_FREE_SAMPLES`` samples of free
+    decay after :func:`free_start_after`, naming the key at fault.
+
+    The pulse's end is taken as the first sample at or after ``pulse_start_s + pulse_s`` (the
+    nominal pulse; the measured one, :func:`pulse_end`, ends no later on a noise-free force).
+    The key named is ``excitation.start`` when the pulse itself ends fewer than
+    ``MIN_FREE_SAMPLES`` before the record's end (no margin could help), else
+    ``signal.free_margin_s`` (hostile round 18: a pulse ending
+    on the record's last samples, and a margin one sample short of the record, were scored
+    failures "fit window from sample 3200 (free_start) holds 0 samples", naming no key).
+
+    Parameters
+    ----------
+    cfg : mapping
+        A validated structural ``[signal]`` table.
+    fs : float
+        Sample rate [Hz].
+    n_samples : int
+        The record's length [samples].
+    pulse_start_s, pulse_s : float
+        The impact's start and duration [s].
+    error : callable
+        ``error(key, value, allowed)`` (it raises).
+    """
+    end = min(n_samples, math.ceil((pulse_start_s + pulse_s) * fs))
+    # the margin alone: `testbed list` loads every scenario and imports no SciPy; a low-pass
+    # whose settling alone empties the window is the fit's to refuse (MIN_FREE_SAMPLES)
+    free = n_samples - free_start_after(cfg, fs, max(end, 1), n_samples, settle=False)
+    if free >= MIN_FREE_SAMPLES:
+        return
+    after = (f"the free decay starts {cfg['free_margin_s']:g} s (signal.free_margin_s) after "
+             "the pulse's end "
+             f"({pulse_start_s:.6g} + {pulse_s:.6g} s) and holds {max(free, 0)} of the record's "
+             f"{n_samples} samples ({n_samples / fs:g} s); allowed: at least {MIN_FREE_SAMPLES} "
+             "samples after it (an earlier excitation.start, a shorter signal.free_margin_s or a "
+             "longer simulation.duration)")
+    if end + MIN_FREE_SAMPLES > n_samples:  # no margin could help: the pulse ends too late
+        error("excitation.start", pulse_start_s, after)
+    error("signal.free_margin_s", cfg["free_margin_s"], after)
 
 
 def pulse_end(force: np.ndarray) -> int:
@@ -523,11 +611,7 @@ def measure_structural(dataset: Dataset, cfg: Mapping[str, Any]) -> Measurement:
         drift = None if drift is None else drift[:, pad:]
         end -= pad
 
-    margin = int(np.ceil(cfg["free_margin_s"] * fs))
-    if cfg["lowpass_hz"] > 0:
-        margin = max(margin, sig.lowpass_settling(fs, cfg["lowpass_hz"], cfg["lowpass_order"],
-                                                  LOWPASS_SETTLE_TOL))
-    free_start = 0 if end <= 0 else min(n, end + margin)
+    free_start = free_start_after(cfg, fs, end, n)
     return Measurement(fs=fs, x=x, xd=xd, xdd=xdd, channels=tuple(acc_sig.channels), u=u,
                        inputs=tuple(f_sig.channels), input_map=input_map,
                        prior=dict(dataset.prior), free_start=free_start,

@@ -282,6 +282,36 @@ def _a_dataset(where: str, ds: Any) -> None:
                                              "(Dataset.load of a dataset file)")
 
 
+#: Characters of a UFF record's ID line (ID line 1 holds a channel's ``<signal>/<channel>``).
+UFF_ID_LINE_CHARS = 80
+
+
+def _check_uff_names(ds: Dataset) -> None:
+    """Refuse a channel whose ``<signal>/<channel>`` a UFF58 record cannot hold as it is.
+
+    Hostile round 19: a name of more than :data:`UFF_ID_LINE_CHARS` characters was cut to the
+    ID line in silence (two channels sharing their first 80 characters read back as
+    ``acceleration/aaa...`` and ``acceleration/aaa...#5``), and blanks at either end of a name
+    were dropped (UFF lines lose trailing blanks): the file read back named other channels
+    than the dataset's.
+
+    Raises
+    ------
+    ArgumentError
+        Naming the channel, its length and what fits (SEP-005 JSON keeps any name).
+    """
+    for name, i, s in _channels(ds):
+        full = f"{name}/{s.channels[i]}"
+        if len(full) > UFF_ID_LINE_CHARS or full != full.strip():
+            why = (f"{len(full)} characters; a UFF ID line holds {UFF_ID_LINE_CHARS}"
+                   if len(full) > UFF_ID_LINE_CHARS else "blanks at its ends, which a UFF line "
+                   "drops")
+            raise ArgumentError("write_uff", "ds", f"channel {full[:100]!r}",
+                                f"has {why}: the file would name another channel; expected names "
+                                "that fit (or --format sep005, which keeps any name)",
+                                described=True)
+
+
 def write_uff(ds: Dataset, out: str | os.PathLike) -> Path:
     """Write units (164), geometry (2411, 82), every measured channel (58) and the true modes (55).
 
@@ -298,6 +328,7 @@ def write_uff(ds: Dataset, out: str | os.PathLike) -> Path:
     import pyuff
 
     _a_dataset("write_uff", ds)
+    _check_uff_names(ds)
     nodes = node_numbers(ds)
     sets = [_uff164(), *_geometry(ds)]
     sets += [_uff58(ds, name, i, s, nodes[(name, i)]) for name, i, s in _channels(ds)]

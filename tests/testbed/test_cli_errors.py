@@ -45,6 +45,18 @@ def one_error_line(err: str) -> str:
     (["generate", "--seed", "9223372036854775808", "michaelis_menten", "-o", "{tmp}/x.h5"],
      "--seed: expected an integer <= 9223372036854775807"),
     (["sweep", "--jobs", "0", "smoke"], "--jobs: expected an integer >= 1"),
+    # hostile round 19: int() and float() read other scripts' digits and underscores, so a
+    # fullwidth --seed ３ ran seed 3 and --fs 1_000 read 1000 Hz (a scenario's TOML refuses both)
+    (["generate", "--seed", "３", "michaelis_menten", "-o", "{tmp}/x.h5"],
+     "--seed: expected an integer >= 0, got '３'"),
+    (["generate", "--seed", "1_0", "michaelis_menten", "-o", "{tmp}/x.h5"],
+     "--seed: expected an integer >= 0, got '1_0'"),
+    (["sweep", "--jobs", "٢", "smoke", "--results", "{tmp}/r.parquet"],
+     "--jobs: expected an integer >= 1, got '٢'"),
+    (["identify", "{tmp}/text.txt", "--kind", "dynamical", "--fs", "１００"],
+     "--fs: expected a number (ASCII digits), got '１００'"),
+    (["identify", "{tmp}/text.txt", "--kind", "dynamical", "--fs", "1_000"],
+     "--fs: expected a number (ASCII digits), got '1_000'"),
     # at most 4 workers a CPU: 100000 started workers until the machine stalled
     (["sweep", "--jobs", "100000", "smoke"], "--jobs: expected an integer <= "),
     # the selector's longest wait: inf was an internal error (OverflowError) after the warm-up
@@ -273,6 +285,11 @@ def test_a_scenario_or_study_folder_variable_that_is_no_folder_is_named(tmp_path
     # sys.exit(0) at import ended `testbed run` with status 0, no verdict and no line
     ("import sys\nsys.exit(0)\n", "importing it failed: SystemExit: 0"),
     ("import sys\nsys.exit('bye')\n", "importing it failed: SystemExit: bye"),
+    # hostile round 19: another BaseException (GeneratorExit; pytest's Skipped from a plugin
+    # written as a test helper) was a traceback with status 1
+    ("raise GeneratorExit('done')\n", "importing it failed: GeneratorExit: done"),
+    ("class Skipped(BaseException):\n    pass\nraise Skipped('no mujoco')\n",
+     "importing it failed: Skipped: no mujoco"),
 ])
 def test_a_plugin_that_exits_at_import_is_one_line(tmp_path, capsys, source, fragment):
     plugin = tmp_path / "exits.py"

@@ -1,7 +1,12 @@
 """The dataset cache: content-keyed, atomic, and noisy data derived from one clean simulation."""
 
-import numpy as np
+import logging
 
+import h5py
+import numpy as np
+import pytest
+
+from testbed.core.dataset import Dataset
 from testbed.pipeline.cache import DatasetCache
 from testbed.pipeline.generate import generate
 from testbed.pipeline.scenario import load_scenario
@@ -52,3 +57,30 @@ def test_a_rigs_cache_key_covers_its_own_source_and_the_shared_chain_only():
     assert any("/models/fivebar/" in p for p in five) and not any("/models/cantilever/" in p for p in five)
     for shared in SHARED_GENERATOR_SOURCES:
         assert any(p.endswith(shared) for p in cant) and any(p.endswith(shared) for p in five)
+
+
+@pytest.mark.parametrize(("fs", "unit"), [("100", None), (True, None), (50.0, None),
+                                          (100.0, "kHz")])
+def test_a_cache_entry_whose_rate_was_edited_is_simulated_again(tmp_path, caplog, fs, unit):
+    # round 18's open item (c): Dataset.load read `fs` with float() and no unit, so a cache
+    # entry edited to fs "100" (text), True, another rate or fs_unit kHz, its content hash made
+    # anew, was served with that rate (50 Hz: the chain's filters and the time axis of another
+    # record); the cache now checks the rate it reads and simulates the entry again
+    sc = load_scenario("michaelis_menten")
+    cache = DatasetCache(tmp_path)
+    clean = cache.get(sc)
+    path = cache.path(sc)
+    with h5py.File(path, "r+") as f:
+        f.attrs["fs"] = fs
+        if unit:
+            f.attrs["fs_unit"] = unit
+    ds = Dataset.load(path, verify=False)
+    with h5py.File(path, "r+") as f:
+        f.attrs["content_hash"] = ds.content_hash()
+    Dataset.load(path)  # the edit passes the content hash: only the cache's checks remain
+    with caplog.at_level(logging.WARNING, logger="testbed.pipeline.cache"):
+        again = cache.get(sc)
+    assert again.fs == 100.0 and again.content_hash() == clean.content_hash()
+    assert any("fs" in r.getMessage() and "simulating it again" in r.getMessage()
+               for r in caplog.records), caplog.text
+    assert Dataset.load(path).fs == 100.0 and "kHz" not in str(h5py.File(path).attrs.get("fs_unit"))

@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import math
 import re
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -353,3 +354,72 @@ def test_a_record_with_nothing_to_identify_is_refused(tmp_path, acc, positions, 
     path = write(tmp_path, "x.json", json.dumps(_beam_channels(acc, positions), default=list))
     with pytest.raises(MeasuredDataError, match=re.escape(words)):
         measurement_from_file(path, "structural")
+
+
+def _mixed_channels(t0: float) -> list[dict]:
+    """Two channels at 100 Hz: ``a`` with a ``time`` from ``t0`` [s], ``b`` with ``fs`` alone."""
+    n = 50
+    return [{"name": "a", "data": list(np.sin(np.arange(n) / 5.0)), "unit_str": "m",
+             "time": list(t0 + np.arange(n) / 100.0)},
+            {"name": "b", "data": list(np.cos(np.arange(n) / 5.0)), "unit_str": "m", "fs": 100.0}]
+
+
+def test_a_sep005_channel_with_fs_alone_beside_a_later_timed_one_is_refused():
+    # round 18, open item (d): a channel with `fs` alone states no start; beside a channel
+    # whose `time` starts 0.3 s (30 samples) later, the two were lined up sample by sample
+    with pytest.raises(MeasuredDataError, match=r"channel 'b' gives fs alone .*t = 0 s\), channel "
+                                                r"'a' starts at t = 0\.3 s: 30 samples apart"):
+        from_sep005(_mixed_channels(0.3))
+
+
+def test_a_sep005_channel_with_fs_alone_beside_a_timed_one_from_zero_is_read():
+    data = from_sep005(_mixed_channels(0.0))
+    assert data.fs == 100.0 and list(data.signals) == ["a", "b"]
+
+
+def _hammer_record(tmp_path: Path, last: int | None) -> Path:
+    """A beam-like SEP-005 record at 1 kHz: three decaying sines (their own frequencies) after
+    a 5-sample half-sine hammer at samples 20-24, the hammer at the tip sensor, cut at
+    ``last``."""
+    fs, n = 1000.0, 600
+    t = np.arange(n) / fs
+    force = np.where((t >= 0.020) & (t < 0.025), np.sin(np.pi * (t - 0.020) / 0.005), 0.0)
+    after = t >= 0.020
+    chans = [{"name": f"acceleration/acc{k + 1}", "unit_str": "m/s^2", "fs": fs, "position_m": 0.1 * (k + 1),
+              "data": list((after * np.exp(-3 * t) * np.sin(2 * np.pi * f * (t - 0.02)))[:last])}
+             for k, f in enumerate((11.0, 47.0, 103.0))]
+    chans.append({"name": "force/force", "unit_str": "N", "fs": fs, "position_m": 0.3,
+                  "data": list(force[:last])})
+    path = tmp_path / f"hammer_{last}.json"
+    path.write_text(json.dumps(chans))
+    return path
+
+
+def test_a_beam_record_cut_inside_the_pulse_is_refused_for_that(tmp_path):
+    # round 18, open item (b): cut two samples into the pulse it was refused as "'acc3' is a
+    # linear combination of 'acc1', 'acc2'": one line, not the cause
+    with pytest.raises(MeasuredDataError, match=r"force pulse \(from sample 2[01]\) has not ended "
+                                                r"4 samples before the record's last.*cut inside"):
+        measurement_from_file(_hammer_record(tmp_path, 23), "structural", {"highpass_hz": 2.0})
+    m = measurement_from_file(_hammer_record(tmp_path, None), "structural", {"highpass_hz": 2.0})
+    assert m.free_start < m.n_samples - 4
+
+
+@pytest.mark.parametrize(("name", "empty"), [("acceleration/", "channel"), ("/acc1", "signal")])
+def test_a_channel_name_with_an_empty_part_around_the_slash_is_refused(name, empty):
+    # hostile round 19: "acceleration/" was read as a channel named "" and "/acc1" as a signal
+    # named "" (a report's rows and a --units key could not name them)
+    t = np.arange(100) / 1000.0
+    chans = [{"name": name, "data": list(np.sin(40 * t)), "fs": 1000.0, "unit_str": "m/s^2"}]
+    with pytest.raises(MeasuredDataError, match=f"channel name {name!r}: an empty {empty} name"):
+        from_sep005(chans).to_dataset()
+
+
+@pytest.mark.parametrize(("path", "shown"), [("r\nx.json", r"r\nx.json"), ("r.json\0", r"r.json\x00")])
+def test_a_path_with_a_control_character_is_shown_escaped_in_one_line(path, shown):
+    # a newline in the path made the one error line two (round 19); a NUL was printed raw
+    # (round 17, open item 7)
+    with pytest.raises(MeasuredDataError) as e:
+        read_measured(path)
+    assert "\n" not in str(e.value) and "\0" not in str(e.value)
+    assert str(e.value).startswith(shown + ": "), str(e.value)

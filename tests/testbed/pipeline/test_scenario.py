@@ -326,3 +326,41 @@ def test_extends_replaces_a_table_whose_type_the_child_changes(tmp_path):
                   '[excitation]\ntype = "multisine"\nn_tones = 3\n', name="same")
     sc = load_scenario(same)
     assert sc.excitation["n_tones"] == 3 and sc.excitation["f_max"] == parent.excitation["f_max"]
+
+
+def _short_beam(**changes) -> dict:
+    """The stiff beam's scenario as a raw table, 0.25 s (3200 samples at 12.8 kHz)."""
+    import tomllib
+
+    raw = tomllib.loads((SCENARIO_DIR / "cantilever_stiff_impact.toml").read_text())
+    raw["scenario"].pop("extends", None)
+    raw.pop("score", None)
+    raw["scenario"]["name"] = "b"
+    raw["simulation"]["duration"] = 0.25
+    for dotted, value in changes.items():
+        table, key = dotted.split(".")
+        raw.setdefault(table, {})[key] = value
+    return raw
+
+
+DT = 1.0 / 12800
+
+
+@pytest.mark.parametrize(("change", "key"), [
+    ({"excitation.start": 0.25 - 3e-4 - DT}, "excitation.start"),      # ends on the last sample
+    ({"excitation.start": 0.25 - 3e-4 - 2 * DT}, "excitation.start"),  # one before it
+    ({"signal.free_margin_s": 0.25 - DT}, "signal.free_margin_s"),     # one sample short
+    ({"signal.free_margin_s": 3129 * DT - 1e-9}, "signal.free_margin_s"),  # 3 samples left
+])
+def test_an_impact_that_leaves_no_free_decay_is_refused_naming_the_key(change, key):
+    # hostile round 18, open item (4): each was simulated and scored as a failure "fit window
+    # from sample 3200 (free_start) holds 0 samples", a verdict naming no key
+    with pytest.raises(ScenarioError, match=re.escape(f"key '{key}'") + ".*free decay.*at least 4"):
+        scenario_from_dict(_short_beam(**change), file="b.toml", stem="b")
+
+
+def test_an_impact_leaving_the_fewest_free_samples_loads():
+    # the pulse ends at 0.0053 s (first sample after it: 68), a margin of 3128 samples: 4 left
+    sc = scenario_from_dict(_short_beam(**{"signal.free_margin_s": 3128 * DT - 1e-9}),
+                            file="b.toml", stem="b")
+    assert sc.signal["free_margin_s"] > 0.24

@@ -10,6 +10,7 @@ import pytest
 import pyuff
 
 from testbed.core.dataset import Dataset, Signal
+from testbed.core.errors import ArgumentError
 from testbed.pipeline.importers import read_measured
 from testbed.reporting.export import (
     export_dataset,
@@ -18,6 +19,8 @@ from testbed.reporting.export import (
     read_sep005,
     structural_truth,
     to_sep005,
+    write_sep005,
+    write_uff,
 )
 
 FS = 1024.0
@@ -328,3 +331,33 @@ def test_the_prior_an_export_leaves_out_is_named_as_options(fmt, saved, tmp_path
     export_dataset(saved(fivebar_dataset()), fmt, tmp_path / ("y.uff" if fmt == "uff" else "y.json"),
                    note=quiet.append)
     assert quiet == []  # the five-bar's record declares no prior: nothing to say
+
+
+def _named(channels: tuple[str, ...]) -> Dataset:
+    """Two accelerations at 1 kHz under ``channels`` and a force, positioned."""
+    t = np.arange(200) / 1000.0
+    acc = np.vstack([np.sin(2 * np.pi * f * t) for f in (7.0, 11.0)])
+    return Dataset(1000.0, {"acceleration": Signal(acc, channels, "m/s^2",
+                                                   positions=np.array([0.1, 0.2])),
+                            "force": Signal(np.exp(-t / 0.01)[None, :], ("force",), "N",
+                                            positions=np.array([0.2]))})
+
+
+@pytest.mark.parametrize(("channels", "fragment"), [
+    # hostile round 19: cut to the 80-character ID line in silence, the two read back as
+    # "acceleration/aaa..." and "acceleration/aaa...#5"; a trailing blank was dropped
+    (("a" * 90 + "1", "a" * 90 + "2"), "has 104 characters; a UFF ID line holds 80"),
+    (("acc1 ", "acc2"), "has blanks at its ends"),
+])
+def test_a_channel_name_a_uff_record_cannot_hold_is_refused(tmp_path, channels, fragment):
+    with pytest.raises(ArgumentError, match=fragment):
+        write_uff(_named(channels), tmp_path / "d.uff")
+    assert not (tmp_path / "d.uff").exists()
+    write_sep005(_named(channels), tmp_path / "d.json")  # SEP-005 keeps any name
+    assert list(read_measured(tmp_path / "d.json").signals)[:2] == [f"acceleration/{c}" for c in channels]
+
+
+def test_a_name_of_80_characters_round_trips_through_uff(tmp_path):
+    name = "c" * (80 - len("acceleration/"))
+    write_uff(_named((name, "acc2")), tmp_path / "d.uff")
+    assert next(iter(read_measured(tmp_path / "d.uff").signals)) == f"acceleration/{name}"

@@ -1,0 +1,35 @@
+"""``identify._base``: what the base class of every identifier does for one that leaves a part out."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from identify._base import Identifier
+from testbed.core.errors import TestbedError, UnsupportedError
+from testbed.core.measurement import Measurement
+
+
+class _NoSimulate(Identifier):
+    """A structural identifier (as a user's plugin) that implements fit and nothing else."""
+
+    name = "no_simulate"
+    kind = "structural"
+
+    def fit(self, data: Measurement) -> _NoSimulate:
+        n = data.n_channels
+        self.M_, self.C_, self.K_ = np.eye(n), np.zeros((n, n)), np.eye(n)
+        self.channels_ = tuple(data.channels)
+        return self
+
+
+def test_simulate_left_out_is_one_line_naming_the_class():
+    # hostile round 19: `testbed run` of a plugin without simulate ended in "internal error (a
+    # bug, not your input): NotImplementedError: " (the base's bare NotImplementedError)
+    x = np.sin(np.arange(50) / 5.0)[None, :]
+    model = _NoSimulate().fit(Measurement(100.0, x, x, x, ("x1",)))
+    with pytest.raises(UnsupportedError, match=r"^_NoSimulate\.simulate: not implemented; the "
+                                               r"scorer integrates") as e:
+        model.simulate(np.zeros(1), np.zeros(1), np.arange(5) / 100.0)
+    assert isinstance(e.value, NotImplementedError) and isinstance(e.value, TestbedError)
+    assert "\n" not in str(e.value)

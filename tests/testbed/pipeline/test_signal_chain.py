@@ -1,0 +1,35 @@
+"""``testbed.pipeline.signal_chain.measure``: the dataset's sample rate checked before any chain runs."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from testbed.core.dataset import Dataset, Signal
+from testbed.core.errors import ArgumentError
+from testbed.pipeline.signal_chain import measure
+
+
+def _kinetics(fs) -> Dataset:
+    """A hand-made kinetics record of 400 samples at the rate ``fs``."""
+    x = (2.0 * np.exp(-np.arange(400) / 100.0))[None, :]
+    return Dataset(fs, {"x": Signal(x, ("x",), "mM"), "dx": Signal(-x, ("dx",), "mM/s")})
+
+
+@pytest.mark.parametrize(("fs", "allowed"), [
+    # hostile round 19: 0 was ZeroDivisionError, NaN / -100 a plain ValueError from the filters,
+    # complex a TypeError, and True and "100" were measured as 1 Hz and 100 Hz in silence
+    (0.0, "expected a finite number > 0"), (float("nan"), "expected a finite number > 0"),
+    (-100.0, "expected a finite number > 0"), (float("inf"), "expected a finite number > 0"),
+    (True, "expected a finite number > 0"), ("100", "expected a finite number > 0"),
+    (100 + 0j, "expected a finite number > 0"), (1e-320, "the duration overflows"),
+])
+def test_a_dataset_rate_that_is_no_rate_is_refused_in_one_line(fs, allowed):
+    with pytest.raises(ArgumentError, match=r"^measure: argument 'dataset\.fs': .*" + allowed) as e:
+        measure(_kinetics(fs), {}, "dynamical")
+    assert "\n" not in str(e.value)
+
+
+@pytest.mark.parametrize("fs", [100.0, 100, np.float32(100.0), np.int64(100)])
+def test_a_real_rate_of_any_numeric_type_is_measured(fs):
+    assert measure(_kinetics(fs), {}, "dynamical").fs == 100.0
