@@ -1007,7 +1007,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     sv = sub.add_parser("serve", help="keep the libraries loaded: later commands fork from this process "
                         "and skip their imports (see testbed.server)")
-    sv.add_argument("--idle", type=float, default=900.0,
+    sv.add_argument("--idle", type=_float, default=900.0,
                     help="seconds without a command before the server exits (default 900)")
     sv.add_argument("--warm-up", default="cantilever_stiff_impact", metavar="SCENARIO",
                     type=_nonempty("a scenario name, or 'none'"),

@@ -142,10 +142,11 @@ def _solve_law(parts: tuple, states: Mapping[str, np.ndarray]) -> np.ndarray:
 
 
 def law_rollout(names: Sequence[str], coef: np.ndarray, x0: np.ndarray, xd0: np.ndarray,
-                u: np.ndarray, dt: float, scales: Sequence[float]) -> np.ndarray:
+                u: np.ndarray, dt: float, scales: Sequence[float], substeps: int = 1) -> np.ndarray:
     """The law's coordinates over a record, one rollout per scale of its accelerations.
 
-    Classical RK4 at the record's step ``dt``, the inputs held over each sample (as recorded);
+    Classical RK4 in ``substeps`` equal steps per sample step ``dt``, the inputs held over each
+    sample (as recorded);
     rollout ``j`` integrates ``scales[j]`` times the law's accelerations (:func:`accelerations`),
     so ``scales = (1, 1 + e)`` gives the law and a law off by exactly ``e`` in the relative
     acceleration error of :func:`law_errors`.  All rollouts advance together (one evaluation of
@@ -163,6 +164,8 @@ def law_rollout(names: Sequence[str], coef: np.ndarray, x0: np.ndarray, xd0: np.
         The record's sample step [s].
     scales : sequence of float, length K
         Factors on the accelerations [-].
+    substeps : int
+        RK4 steps per sample step (each ``dt / substeps`` [s]).
 
     Returns
     -------
@@ -181,15 +184,17 @@ def law_rollout(names: Sequence[str], coef: np.ndarray, x0: np.ndarray, xd0: np.
     def acc(a: np.ndarray, b: np.ndarray, uk: np.ndarray) -> np.ndarray:
         return _solve_law(parts, {"th": a, "dth": b, "u": uk}).T * s
 
+    h = dt / substeps if substeps > 1 else dt
     with np.errstate(all="ignore"):
         for k in range(N - 1):
             uk = np.repeat(np.asarray(u, dtype=float)[:, k:k + 1], K, axis=1)
-            a1 = acc(q, qd, uk)
-            a2 = acc(q + dt / 2 * qd, qd + dt / 2 * a1, uk)
-            a3 = acc(q + dt / 2 * (qd + dt / 2 * a1), qd + dt / 2 * a2, uk)
-            a4 = acc(q + dt * (qd + dt / 2 * a2), qd + dt * a3, uk)
-            q = q + dt / 6 * (qd + 2 * (qd + dt / 2 * a1) + 2 * (qd + dt / 2 * a2) + qd + dt * a3)
-            qd = qd + dt / 6 * (a1 + 2 * a2 + 2 * a3 + a4)
+            for _ in range(substeps):
+                a1 = acc(q, qd, uk)
+                a2 = acc(q + h / 2 * qd, qd + h / 2 * a1, uk)
+                a3 = acc(q + h / 2 * (qd + h / 2 * a1), qd + h / 2 * a2, uk)
+                a4 = acc(q + h * (qd + h / 2 * a2), qd + h * a3, uk)
+                q = q + h / 6 * (qd + 2 * (qd + h / 2 * a1) + 2 * (qd + h / 2 * a2) + qd + h * a3)
+                qd = qd + h / 6 * (a1 + 2 * a2 + 2 * a3 + a4)
             out[:, :, k + 1] = q.T
             if not np.any(np.isfinite(q)):
                 break
@@ -213,7 +218,8 @@ def law_errors(id_names: Sequence[str], id_coef: np.ndarray, true_names: Sequenc
     Per coordinate, the RMS over the box (:func:`state_box`) of the identified minus the true
     accelerations, divided by the RMS of the true ones.  0 for
     the same law (in any combination of its rows); NaN where the identified law gives no finite
-    acceleration somewhere in the box (a singular or non-finite law: never a pass).
+    acceleration somewhere in the box (a singular or non-finite law: never a pass), or uses a
+    term not linear in the accelerations or an acceleration of a coordinate the record has not.
 
     Parameters
     ----------
@@ -237,9 +243,20 @@ def law_errors(id_names: Sequence[str], id_coef: np.ndarray, true_names: Sequenc
         return None
     if not np.all(np.isfinite(id_coef)):
         return np.full(n, np.nan)
+    # terms the identified law does not use are left out; one it uses that is not linear in the
+    # accelerations, or names a coordinate the record has not, gives no accelerations to compare
+    # (a plugin's ``ddth1*ddth2`` was a ValueError of the scoring, review of session 20): NaN
+    used = np.any(id_coef != 0.0, axis=0)
+    id_names = [name for name, u in zip(id_names, used, strict=False) if u]
+    try:
+        which = linear_split(tuple(id_names))[1]
+    except ValueError:
+        return np.full(n, np.nan)
+    if np.any(which >= n):
+        return np.full(n, np.nan)
     box = state_box(signals)
     truth = accelerations(true_names, true_coef, box)
-    ident = accelerations(id_names, id_coef, box)
+    ident = accelerations(id_names, id_coef[:, used], box)
     with np.errstate(all="ignore"):
         num = np.sqrt(np.mean((ident - truth) ** 2, axis=1))
         den = np.sqrt(np.mean(truth**2, axis=1))

@@ -6,7 +6,7 @@ import pytest
 from models.cartpole.equations import CartPoleParams, true_equations
 from testbed.pipeline.scenario import load_scenario
 from testbed.scoring.equation_basis import compare_equations, evaluate_terms
-from testbed.scoring.law import accelerations, law_error, law_rollout, linear_split, state_box
+from testbed.scoring.law import accelerations, law_error, law_errors, law_rollout, linear_split, state_box
 
 P = CartPoleParams(cart_mass=1.0, pole_mass=0.5, pole_length=0.6, cart_damping=0.1,
                    pole_damping=0.005, gravity=9.81)
@@ -117,6 +117,34 @@ def test_terms_split_at_their_acceleration():
     assert rest == ("cos(th2)", "1", "sin(th2)*dth2^2", "u1") and which.tolist() == [0, 1, -1, -1]
     with pytest.raises(ValueError, match="not linear in the accelerations"):
         linear_split(("ddth1*ddth2",))
+
+
+def test_a_law_with_a_term_not_linear_in_the_accelerations_scores_nan_not_a_crash():
+    """A plugin's identified terms are free: ``ddth1*ddth2`` or ``ddth3`` on two coordinates
+    raised ValueError / was dropped in silence (review of session 20); unused (zero) it is left
+    out, used it gives no accelerations to compare: NaN, never a pass."""
+    names, true = ["ddth1", "ddth2", "th1", "th2"], np.array([[1.0, 0, 1, 0], [0, 1.0, 0, 1]])
+    t = np.linspace(0, 1, 50)
+    sig = {"th": np.vstack([np.sin(t), np.cos(t)]), "dth": np.vstack([np.cos(t), -np.sin(t)]),
+           "u": np.zeros((0, 50))}
+    for extra in ("ddth1*ddth2", "ddth3"):
+        unused = np.hstack([true, np.zeros((2, 1))])
+        assert np.all(law_errors([*names, extra], unused, names, true, sig) == 0.0)
+        used = np.hstack([true, np.array([[0.1], [0.0]])])
+        assert np.all(np.isnan(law_errors([*names, extra], used, names, true, sig)))
+
+
+def test_substeps_are_the_finer_step():
+    """``substeps`` RK4 steps per sample are the rollout at that finer step, read every
+    ``substeps``-th sample (the witness steps no longer than the model: scorers.witness_substeps)."""
+    names, coef = ["ddth1", "sin(th1)", "dth1"], np.array([[1.0, 9.81, 0.1]])
+    u = np.zeros((0, 201))
+    fine = law_rollout(names, coef, np.array([1.0]), np.array([0.0]), np.zeros((0, 401)),
+                       5e-3, (1.0,))
+    sub = law_rollout(names, coef, np.array([1.0]), np.array([0.0]), u, 1e-2, (1.0,), 2)
+    assert np.array_equal(sub[0], fine[0][:, ::2])
+    coarse = law_rollout(names, coef, np.array([1.0]), np.array([0.0]), u, 1e-2, (1.0,))
+    assert not np.array_equal(coarse[0], sub[0])
 
 
 def test_the_true_law_rolled_out_follows_the_engine_and_a_scaled_one_does_not(dataset_cache):

@@ -290,6 +290,12 @@ def test_failure_kinds_name_the_scorers_explanations():
     assert failure_kind("sensors: the truth reduced to the sensors ...") == ["sensors"]
     assert failure_kind("wrong equation: x^2 beside the law") == ["wrong equation"]
     assert failure_kind("something new: at the sensors") == ["other"]
+    # session 20's review: these two were "other", left out of the medians and sent to
+    # --retry-failed
+    assert failure_kind("sensitive record: angle_rmse 11.5 against the bar 0.0501 with the law "
+                        "within law_error 0.003 ...") == ["sensitive record"]
+    assert failure_kind("rollout step: state_rmse 0.2 against the bar 0.01, but ...") == [
+        "rollout step"]
 
 
 def test_failed_cells_line_tells_crashes_from_scored_failures():
