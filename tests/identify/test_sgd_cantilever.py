@@ -8,6 +8,7 @@ The dataset is generated once per session through the shared ``dataset_cache`` f
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import numpy as np
@@ -108,8 +109,11 @@ def test_a_model_that_does_not_explain_its_record_is_named_and_refits_without_th
     sc = load_scenario(ROUND19 / "b19_st_s5_hitmid.toml")
     ds = dataset_cache.get(sc)
     model = SGDSINDy().fit(measure(ds, sc.signal, "structural"))
-    assert "refused: the model fitted in it does not explain its record (agreement 1.58" \
-        in model.fit_band_rule_
+    # the agreement's value is decided by round-off (1.6e-6 native, 5.1e-8 under Haswell's
+    # BLAS kernels): its side of the rule only
+    m = re.search(r"refused: the model fitted in it does not explain its record \(agreement "
+                  r"(\S+) < 0\.5\), the fit without it explains more \((\S+)\)", model.fit_band_rule_)
+    assert m and float(m.group(1)) < 0.5 and float(m.group(2)) > float(m.group(1))
     assert model.fit_band_hz_ == 0.0
     assert "does NOT explain its record" in model.record_rule_
     f_true = np.asarray(ds.truth["frequencies_hz"])[:2]
