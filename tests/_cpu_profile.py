@@ -10,7 +10,11 @@ in with ``-p tests._cpu_profile`` and a folder in ``TESTBED_CPU_PROFILE``::
 Each worker (``gw0``, ``gw1``; ``main`` without xdist) appends one JSON line per test to
 ``<folder>/<worker>.jsonl``: its node id, xdist group, CPU seconds (user + system of the worker
 and of the children it reaped: CLI subprocesses, a sweep's loky workers once shut down,
-Chromium; a server still running is not counted) and wall start and end.  Setup, call and
+Chromium; a server still running is not counted) and wall start and end; where Linux's
+``/proc/self/schedstat`` is readable, also the worker's own seconds on a CPU (``run``) and
+waiting for one (``queued``, the machine's load).  ``wall - run - queued`` is then the time the
+worker slept (on a child, a sleep, a lock, I/O): a core of the run left idle unless a child used
+it, which the load does not inflate as it does wall seconds.  Setup, call and
 teardown are counted together, so a module fixture falls in the first test that uses it.  The
 summary prints each worker's CPU and span (their difference is the imbalance of ``--dist
 loadgroup``), then the N largest modules and tests.  Without ``TESTBED_CPU_PROFILE`` the plugin
@@ -33,6 +37,16 @@ _FOLDER = os.environ.get("TESTBED_CPU_PROFILE")
 _out = []  # the open file of this process, once a test ran
 
 
+def _sched_seconds() -> tuple[float, float] | None:
+    """Seconds this process ran on a CPU and waited to run (``/proc/self/schedstat``), or None."""
+    try:
+        with open("/proc/self/schedstat") as f:
+            run_ns, queued_ns, _ = f.read().split()
+    except (OSError, ValueError):
+        return None
+    return int(run_ns) / 1e9, int(queued_ns) / 1e9
+
+
 def _cpu_seconds() -> float:
     """User + system CPU seconds of this process and of its reaped children."""
     own, children = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
@@ -48,12 +62,15 @@ def pytest_runtest_protocol(item, nextitem):
         Path(_FOLDER).mkdir(parents=True, exist_ok=True)
         worker = os.environ.get("PYTEST_XDIST_WORKER", "main")
         _out.append(open(Path(_FOLDER) / f"{worker}.jsonl", "a"))  # open for the whole run
-    cpu0, t0 = _cpu_seconds(), time.time()
+    cpu0, sched0, t0 = _cpu_seconds(), _sched_seconds(), time.time()
     yield
-    cpu1, t1 = _cpu_seconds(), time.time()
+    cpu1, sched1, t1 = _cpu_seconds(), _sched_seconds(), time.time()
     mark = item.get_closest_marker("xdist_group")
-    _out[0].write(json.dumps({"id": item.nodeid, "group": mark.args[0] if mark and mark.args else None,
-                              "cpu": cpu1 - cpu0, "t0": t0, "t1": t1}) + "\n")
+    row = {"id": item.nodeid, "group": mark.args[0] if mark and mark.args else None,
+           "cpu": cpu1 - cpu0, "t0": t0, "t1": t1, "pid": os.getpid()}
+    if sched0 is not None and sched1 is not None:
+        row.update(run=sched1[0] - sched0[0], queued=sched1[1] - sched0[1])
+    _out[0].write(json.dumps(row) + "\n")
     _out[0].flush()
 
 

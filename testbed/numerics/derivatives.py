@@ -13,28 +13,56 @@ import numpy as np
 from testbed.numerics.filters import _as_signal, _check_cutoff, _lowpass_sos
 
 
-def _local_poly_rows(window: int, polyorder: int, positions: np.ndarray) -> np.ndarray:
-    """Least-squares polynomial weights on a window of samples, in a well-conditioned basis.
+def _local_poly_fit(window: int, polyorder: int) -> tuple[np.ndarray, float]:
+    """The least-squares fit of a polynomial of order ``polyorder`` to a window of samples.
 
-    Returns ``W`` of shape ``(polyorder + 1, len(positions), window)``: ``W[d, i] @ x[:window]``
-    is the ``d``-th derivative (per sample**d) at sample ``positions[i]`` of the polynomial of
-    order ``polyorder`` fitted to the window.  The abscissa is scaled to [-1, 1] and the fit is
-    solved by QR: the monomials of raw sample offsets (what ``scipy.signal.savgol_coeffs`` uses)
-    reach ``1500**8`` for a 3001-sample window and the fit loses every digit.
+    Returns ``pinv`` of shape ``(polyorder + 1, window)`` (the Legendre coefficients of the fit
+    are ``pinv @ x[:window]``) and the half width ``(window - 1) / 2`` [samples].  The abscissa is
+    scaled to [-1, 1] and the fit is solved by QR: the monomials of raw sample offsets (what
+    ``scipy.signal.savgol_coeffs`` uses) reach ``1500**8`` for a 3001-sample window and the fit
+    loses every digit.
     """
     half = (window - 1) / 2.0
     z = (np.arange(window) - half) / half
     V = np.polynomial.legendre.legvander(z, polyorder)            # (window, p+1), cond ~ p
     Q, R = np.linalg.qr(V)
-    pinv = np.linalg.solve(R, Q.T)                                  # Legendre coefficients
+    return np.linalg.solve(R, Q.T), half                            # Legendre coefficients
+
+
+def _derivative_rows(fit: tuple[np.ndarray, float], positions: np.ndarray, d: int,
+                     out: np.ndarray | None = None) -> np.ndarray:
+    """Weights of the ``d``-th derivative of the fit ``fit`` (:func:`_local_poly_fit`).
+
+    Returns ``W`` of shape ``(len(positions), window)``: ``W[i] @ x[:window]`` is the ``d``-th
+    derivative (per sample**d) at sample ``positions[i]`` of the polynomial fitted to the window.
+    Written into ``out`` (C-contiguous, that shape) when given: a caller that needs several
+    derivatives of many positions reuses one array instead of holding them all.
+    """
+    pinv, half = fit
+    polyorder = pinv.shape[0] - 1
     zp = (np.asarray(positions, dtype=float) - half) / half
-    out = np.empty((polyorder + 1, zp.size, window))
-    for d in range(polyorder + 1):
-        E = np.polynomial.legendre.legvander(zp, polyorder)
-        if d:
-            E = np.stack([np.polynomial.legendre.legval(zp, np.polynomial.legendre.legder(
-                np.eye(polyorder + 1)[k], d)) for k in range(polyorder + 1)], axis=1)
-        out[d] = E @ pinv / half**d
+    E = np.polynomial.legendre.legvander(zp, polyorder)
+    if d:
+        E = np.stack([np.polynomial.legendre.legval(zp, np.polynomial.legendre.legder(
+            np.eye(polyorder + 1)[k], d)) for k in range(polyorder + 1)], axis=1)
+    out = np.matmul(E, pinv, out=out)
+    return np.divide(out, half**d, out=out)
+
+
+def _local_poly_rows(window: int, polyorder: int, positions: np.ndarray,
+                     n_derivatives: int | None = None) -> np.ndarray:
+    """Least-squares polynomial weights on a window of samples, in a well-conditioned basis.
+
+    Returns ``W`` of shape ``(n_derivatives, len(positions), window)`` (``n_derivatives``
+    defaults to ``polyorder + 1``, all of them): ``W[d, i] @ x[:window]`` is the ``d``-th
+    derivative (per sample**d) at sample ``positions[i]`` of the polynomial of order
+    ``polyorder`` fitted to the window (:func:`_local_poly_fit`, :func:`_derivative_rows`).
+    """
+    fit = _local_poly_fit(window, polyorder)
+    n_derivatives = polyorder + 1 if n_derivatives is None else int(n_derivatives)
+    out = np.empty((n_derivatives, np.size(positions), window))
+    for d in range(n_derivatives):
+        _derivative_rows(fit, positions, d, out=out[d])
     return out
 
 
@@ -89,17 +117,21 @@ def differentiate(x: np.ndarray, fs: float, window: int, polyorder: int
     half = window // 2
     mean = x.mean(axis=-1, keepdims=True)
     xc = x - mean
-    centre = _local_poly_rows(window, polyorder, np.array([half]))[:, 0]         # (p+1, window)
-    edge = _local_poly_rows(window, polyorder, np.arange(half))                  # (p+1, half, window)
+    fit = _local_poly_fit(window, polyorder)
+    # the edge rows of one derivative at a time, in one reused (half, window) array: all of them
+    # at once were (p+1, half, window), 957 MB resident for window 6001, order 4
+    edge = np.empty((half, window))
     from scipy import signal as ss  # lazy: scipy.signal costs ~0.7 s of import
 
     out = []
     for d in (0, 1, 2):
         # correlation with the centre weights = convolution with the reversed weights
-        y = ss.oaconvolve(xc, centre[d][::-1][None, :] if xc.ndim == 2 else centre[d][::-1],
+        centre = _derivative_rows(fit, np.array([half]), d)[0]                   # (window,)
+        y = ss.oaconvolve(xc, centre[::-1][None, :] if xc.ndim == 2 else centre[::-1],
                           mode="same", axes=-1) if n > window else np.zeros_like(xc)
-        y[..., :half] = xc[..., :window] @ edge[d].T
-        y[..., n - half:] = (xc[..., ::-1][..., :window] @ edge[d].T)[..., ::-1] * (-1) ** d
+        _derivative_rows(fit, np.arange(half), d, out=edge)
+        y[..., :half] = xc[..., :window] @ edge.T
+        y[..., n - half:] = (xc[..., ::-1][..., :window] @ edge.T)[..., ::-1] * (-1) ** d
         y = y * fs**d
         out.append(y + mean if d == 0 else y)
     return out[0], out[1], out[2]
@@ -112,7 +144,7 @@ def _edge_jets(x: np.ndarray, fs: float, n_fit: int, order: int) -> tuple[np.nda
     the end of the record: the least-squares polynomial of order ``order`` over the first
     (last) ``n_fit`` samples, evaluated at the end sample.
     """
-    W = _local_poly_rows(n_fit, order, np.array([0]))[:3, 0]                      # (3, n_fit)
+    W = _local_poly_rows(n_fit, order, np.array([0]), 3)[:, 0]                    # (3, n_fit)
     scale = np.array([1.0, fs, fs**2])[:, None]
     start = (W @ x[:, :n_fit].T) * scale
     end = (W @ x[:, ::-1][:, :n_fit].T) * scale * np.array([1.0, -1.0, 1.0])[:, None]

@@ -245,7 +245,8 @@ def test_a_folder_in_place_of_a_cache_entry_is_named_before_simulating(tmp_path)
 # A "mechanical" toy, as in test_sweep.py but under names of its own (one registration per
 # process): four undamped oscillators, an identifier fitting k_i by least squares.
 # fault_slow sleeps $FAULT_SLOW_SECONDS per fit: long while a sweep is to be killed, zero
-# when it resumes (the rows do not depend on it).
+# when it resumes (the rows do not depend on it); with $FAULT_SLOW_MARKS (a folder) it first
+# writes a file named by its process id there, so a test sees which processes are in the fit.
 PLUGIN = '''
 import os
 import time
@@ -323,6 +324,8 @@ class FaultFit(Identifier):
 @IDENTIFIERS.register("fault_slow")
 class FaultSlow(FaultFit):
     def pause(self):
+        if os.environ.get("FAULT_SLOW_MARKS"):  # a folder: each process marks its entering here
+            open(os.path.join(os.environ["FAULT_SLOW_MARKS"], str(os.getpid())), "w").close()
         time.sleep(float(os.environ.get("FAULT_SLOW_SECONDS", "0")))
 '''
 
@@ -558,14 +561,18 @@ def test_kill_9_of_a_two_worker_sweep_leaves_no_worker_and_resumes_exactly(fault
     res, cache = tmp_path / "killed.parquet", tmp_path / "cache"
     cmd = [sys.executable, "-m", "testbed.cli", "sweep", str(study), "--jobs", "2", "--results", str(res),
            "--cache", str(cache)]
-    proc = subprocess.Popen(cmd, cwd=ROOT, env=_env(FAULT_SLOW_SECONDS="600"), start_new_session=True,
-                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    marks = tmp_path / "in-slow-fit"
+    marks.mkdir()
+    proc = subprocess.Popen(cmd, cwd=ROOT, env=_env(FAULT_SLOW_SECONDS="600", FAULT_SLOW_MARKS=str(marks)),
+                            start_new_session=True, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
     try:
         deadline = time.monotonic() + 90
-        while (len(list(parts_dir(res).glob("*.json"))) if parts_dir(res).is_dir() else 0) < 4:
+        # both workers inside a 600 s fit (each marked its entering; a fixed 1 s sleep after the
+        # 4 quick cells assumed it)
+        while (len(list(parts_dir(res).glob("*.json"))) if parts_dir(res).is_dir() else 0) < 4 \
+                or len(list(marks.iterdir())) < 2:
             assert proc.poll() is None and time.monotonic() < deadline, proc.stderr.read().decode()
             time.sleep(0.05)
-        time.sleep(1.0)  # both workers are now inside a 600 s fit
         assert len(_group_alive(proc.pid)) >= 3, "expected the main process and two workers"
         os.kill(proc.pid, signal.SIGKILL)
         proc.wait(timeout=10)

@@ -163,15 +163,20 @@ def test_a_second_server_on_the_socket_is_refused(server):
 
 
 # ---------------------------------------------------------------- hostile clients, dying servers
-# A server of the real loop that imports nothing and whose commands sleep (``sleep SECONDS``):
-# it starts in about a second, so these tests can kill it.
+# A server of the real loop that imports nothing and whose commands sleep (``sleep SECONDS``, or
+# ``sleep FILE``: until the test makes FILE, for a command that must run until the test is done
+# with it): it starts in about a second, so these tests can kill it.
 _FAKE = """
-import sys, time
+import os, sys, time
 import testbed.cli as c, testbed.server as s
 c._blas_threads()  # as `testbed serve` (cli.main) does before serving: part of the key
 s._preload = lambda: None
-def main(argv):  # sleep SECONDS [STATUS [AT-EXIT-TEXT]]
-    time.sleep(float(argv[1]))
+def main(argv):  # sleep SECONDS|FILE [STATUS [AT-EXIT-TEXT]]: SECONDS, or until FILE exists
+    try:
+        time.sleep(float(argv[1]))
+    except ValueError:
+        while not os.path.exists(argv[1]):
+            time.sleep(0.01)
     print("slept", flush=True)
     if len(argv) > 3:  # printed at exit (a command alone prints it; loky's exit hooks are such)
         import atexit
@@ -323,7 +328,8 @@ def test_a_served_command_does_its_exit_work_before_its_client_returns(sleeper):
 
 def test_changed_sources_end_the_server_after_its_running_commands(sleeper):
     proc, env, tmp = sleeper
-    running = _client(env, tmp, "sleep", "4", "0")
+    go = tmp / "go"  # the running command ends once the late one is refused (it slept 4 s)
+    running = _client(env, tmp, "sleep", str(go), "0")
     _wait_for(lambda: len(_pids(tmp)) == 1, "the command started")
     source = ROOT / "testbed" / "server.py"
     st = source.stat()
@@ -332,11 +338,14 @@ def test_changed_sources_end_the_server_after_its_running_commands(sleeper):
         # another command is refused (another key) and runs alone: here no 'sleep' command
         late = _testbed(["sleep", "0"], env, tmp)
         assert late.returncode == cli.EXIT_USAGE and "invalid choice: 'sleep'" in late.stderr
+        assert running.poll() is None  # (it was running all along)
+        go.touch()
         out, err = running.communicate(timeout=30)  # the running one ends as it would
         assert (running.returncode, out, err) == (0, "slept\n", "")
         assert proc.wait(timeout=10) == 0
     finally:
         os.utime(source, ns=(st.st_atime_ns, st.st_mtime_ns))  # (the module's server: its key)
+        go.touch()  # (whatever failed: no command left waiting)
     assert any("sources changed" in ln for ln in _served_lines(tmp))
     assert not (tmp / "sock" / "s.sock").exists()
 
@@ -357,7 +366,8 @@ def test_ctrl_z_stops_the_command_with_its_client(sleeper):
     # the client in a process group of its own, as a shell starts a job: the kernel discards a
     # SIGTSTP whose default action would stop a process of an orphaned group (POSIX), which a
     # test worker's group can be
-    c = subprocess.Popen([sys.executable, "-m", "testbed.cli", "sleep", "3"], env=env, cwd=tmp,
+    go = tmp / "go"  # the command ends once resumed and told to (it slept 3 s)
+    c = subprocess.Popen([sys.executable, "-m", "testbed.cli", "sleep", str(go)], env=env, cwd=tmp,
                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, process_group=0)
     _wait_for(lambda: len(_pids(tmp)) == 1, "the command started")
     # (a Ctrl-Z before the client has the pid, as here under load, waits for it)
@@ -367,6 +377,7 @@ def test_ctrl_z_stops_the_command_with_its_client(sleeper):
     time.sleep(0.5)
     assert c.poll() is None and state(_pids(tmp)[0]) == "T"  # (not resumed by anything else)
     c.send_signal(signal.SIGCONT)
+    go.touch()
     out, err = c.communicate(timeout=30)
     assert (c.returncode, out, err) == (0, "slept\n", "")
 
