@@ -438,12 +438,19 @@ def check_record(params: dict[str, Any], fs: float, n_samples: int, error: Error
 def rollout_steps(params: dict[str, Any], record_s: float) -> tuple[float, str]:
     """RK4 steps of scoring's simulation over the record, plus the rollout selection's
     simulations of up to ``n_rollout^2`` model pairs (two inputs) over the record (its
-    segments cover the trimmed record once), and the step rule's simulations where ``sim_dt``
+    segments cover the trimmed record once) and, without an ensemble, the record rule's wider
+    search's of up to ``WIDE_ROLLOUT^2 - n_rollout^2`` more (a worst case: it runs only where
+    no shortlisted pair replays the record), and the step rule's simulations where ``sim_dt``
     is None; ``selection`` None (by the noise rule) counts as rollout."""
     dt = params["sim_dt"] or SIM_DT_START
     steps = record_s / dt
     if params["selection"] in ("rollout", None):
-        steps *= 1 + params["n_rollout"] ** 2
+        pairs = 1 + params["n_rollout"] ** 2
+        if not params.get("ensemble"):
+            # the record rule's wider search (``_wide_record``): at most one simulation of the
+            # record per pair of the first fit's WIDE_ROLLOUT best per input not yet simulated
+            pairs += max(0, WIDE_ROLLOUT**2 - params["n_rollout"] ** 2)
+        steps *= pairs
     if params["sim_dt"] is None:
         # the step rule (:func:`choose_sim_dt`), as it goes on a 10 kHz record that 1 ms does
         # not resolve: simulations at 1 and 0.5 ms, then at the 0.1 and 0.05 ms grid steps

@@ -243,3 +243,18 @@ def test_wider_search_not_for_open_chains_nor_ensembles():
     assert not m._wide_record(None, "head")
     assert m.record_rule_ == "head: first fit kept (no wider search: no rollout selection)"
     assert not hasattr(m, "coef_")
+
+
+def test_the_step_budget_counts_the_wider_search():
+    """The load-time step budget counts the wider search's worst case (one simulation of the
+    record per pair of the 10 best per input not yet simulated: 100 - 9 = 91) where it can run
+    (no ensemble); before (review of session 20) it counted the shortlist's 9 alone, admitting
+    records about 3x longer than its worst case fits in."""
+    from identify.sindy_pi import SIM_DT_START, WIDE_ROLLOUT, SINDyPI
+
+    p = SINDyPI.validate_hyperparameters({}, file="x", section="identify")
+    record_s = 10.0
+    one = record_s / SIM_DT_START  # one simulation of the record at the rule's first step
+    plain = SINDyPI.simulation_steps(dict(p, ensemble=5), record_s)[0]
+    wide = SINDyPI.simulation_steps(p, record_s)[0]
+    assert wide - plain == pytest.approx(one * (WIDE_ROLLOUT**2 - p["n_rollout"] ** 2), rel=1e-12)
