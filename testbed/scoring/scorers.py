@@ -1477,7 +1477,7 @@ def witness_substeps(fs: float, model_step: Any) -> int:
 
 def law_witness(score: str, names: list[str], coef: np.ndarray, x0: np.ndarray,
                 xd0: np.ndarray, data: Measurement, reference_x: np.ndarray, substeps: int,
-                law_off: float) -> dict[str, Any]:
+                law_off: float, bar: float) -> dict[str, Any]:
     """The true law rolled out as a model is, exactly and off by ``law_off``.
 
     The scorer's own RK4 (:func:`testbed.scoring.law.law_rollout`) in ``substeps`` steps per
@@ -1485,7 +1485,8 @@ def law_witness(score: str, names: list[str], coef: np.ndarray, x0: np.ndarray,
     inputs held over each sample, from the true initial state, of the true law and of the true
     law with its accelerations scaled by ``1 + law_off`` and ``1 - law_off`` (laws off by
     exactly ``law_off`` in ``law_error``'s measure).  Where the true law fails the rollout
-    bar's score at that step, it is rolled out again at half the step (``..._true_law_half``):
+    bar ``bar`` at that step (only there), it is rolled out again at half the step
+    (``..._true_law_half``):
     :func:`sensitivity_failures` claims a floor only where both fail.  A witness, not a score:
     what the record's rollout asks of a law (:func:`sensitivity_failures`).
 
@@ -1505,12 +1506,15 @@ def law_witness(score: str, names: list[str], coef: np.ndarray, x0: np.ndarray,
         RK4 steps per sample step.
     law_off : float
         The relative error of the scaled laws [-].
+    bar : float
+        The rollout bar of ``score``.
 
     Returns
     -------
     dict
         ``{score + "_true_law": the true law's score, score + "_true_law_half": the same at
-        half the step, score + "_law_off": the better of the two scaled laws' scores (NaN
+        half the step (present only where the first is above ``bar``), score + "_law_off":
+        the better of the two scaled laws' scores (NaN
         where a rollout failed), "law_off": law_off, "witness_dt": the step [s]}``.
     """
     u = np.zeros((0, reference_x.shape[1])) if data.u is None else data.u
@@ -1522,10 +1526,12 @@ def law_witness(score: str, names: list[str], coef: np.ndarray, x0: np.ndarray,
 
     x = law_rollout(names, coef, x0, xd0, u, dt, (1.0, 1.0 + law_off, 1.0 - law_off), substeps)
     rmse = [score_of(xj) for xj in x]
-    half = score_of(law_rollout(names, coef, x0, xd0, u, dt, (1.0,), 2 * substeps)[0])
-    return {f"{score}_true_law": rmse[0], f"{score}_true_law_half": half,
-            f"{score}_law_off": float(np.fmin(rmse[1], rmse[2])), "law_off": float(law_off),
-            "witness_dt": dt / substeps}
+    out = {f"{score}_true_law": rmse[0], f"{score}_law_off": float(np.fmin(rmse[1], rmse[2])),
+           "law_off": float(law_off), "witness_dt": dt / substeps}
+    if np.isfinite(rmse[0]) and rmse[0] > bar:  # a floor to confirm at half the step
+        out[f"{score}_true_law_half"] = score_of(
+            law_rollout(names, coef, x0, xd0, u, dt, (1.0,), 2 * substeps)[0])
+    return out
 
 
 #: The share of the rig's law bar by which the witness's laws are off (at most the identified
@@ -1577,9 +1583,9 @@ def sensitivity_failures(scores: Scores, thresholds: dict[str, dict[str, float]]
             or law > law_bar):
         return {}
     if not done:
-        scores.details.update(witness(min(law, SENSITIVE_LAW_SHARE * law_bar)))
+        scores.details.update(witness(min(law, SENSITIVE_LAW_SHARE * law_bar), bar))
     exact, off = scores.details[f"{score}_true_law"], scores.details[f"{score}_law_off"]
-    half = scores.details[f"{score}_true_law_half"]
+    half = scores.details.get(f"{score}_true_law_half", np.nan)
     e, wdt = scores.details["law_off"], scores.details["witness_dt"]
     how = (f"the true law rolled out as a model is (the scorer's RK4 at {wdt:.3g} s, no longer "
            "than the model's own step, the measured inputs held over each sample, from the true "

@@ -658,7 +658,7 @@ def test_a_rollout_failed_on_a_sensitive_record_is_named():
 
 
 def _witness(exact: float, off: float, seen: list | None = None, half: float | None = None):
-    def witness(e: float) -> dict:
+    def witness(e: float, bar: float) -> dict:
         if seen is not None:
             seen.append(e)
         return {"angle_rmse_true_law": exact, "angle_rmse_law_off": off, "law_off": e,
