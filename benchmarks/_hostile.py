@@ -188,3 +188,22 @@ def cli_inprocess(argv: list[str]) -> tuple[int, str, str]:
         except SystemExit as e:  # argparse's own refusal
             status = e.code if isinstance(e.code, int) else 2
     return status, out.getvalue(), err.getvalue()
+
+
+def judged(status: int, out: str, err: str, refuse: bool = False,
+           warnings: bool = False) -> str | None:
+    """A finding of a finished in-process command (:func:`cli_inprocess`), or None.
+
+    A status other than 0 / 1 / 2, a traceback or an internal error; a refusal (status 2) in
+    more than one line; with ``refuse``, anything but a refusal (the input is the user's
+    mistake); with ``warnings``, a warning printed beside a result (round 17's rule)."""
+    lines = [ln for ln in err.splitlines() if ln.strip()]
+    if status not in (0, 1, 2) or "Traceback" in err or "internal error" in err:
+        return f"status {status}: {(lines or [''])[-1][:200]}"
+    if status == 2 and len(lines) != 1:
+        return f"refused in {len(lines)} lines: {err[:200]!r}"
+    if warnings and status != 2 and lines and any("Warning" in ln for ln in lines):
+        return f"status {status} with a warning: {lines[0][:200]!r}"
+    if refuse and status != 2:
+        return f"accepted with status {status}: {(out.strip().splitlines() or [''])[-1][:160]!r}"
+    return None

@@ -81,17 +81,7 @@ CACHE = ROOT / ".cache" / "datasets"
 cli_inprocess = _hostile.cli_inprocess
 
 
-def judged(status: int, out: str, err: str, refuse: bool = False) -> str | None:
-    """A finding of a finished in-process command, or None; ``refuse``: it must end with
-    status 2 (the input contradicts itself)."""
-    lines = [ln for ln in err.splitlines() if ln.strip()]
-    if status not in (0, 1, 2) or "Traceback" in err or "internal error" in err:
-        return f"status {status}: {(lines or [''])[-1][:200]}"
-    if status == 2 and len(lines) != 1:
-        return f"refused in {len(lines)} lines: {err[:200]!r}"
-    if refuse and status != 2:
-        return f"accepted with status {status}: {(out.strip().splitlines() or [''])[-1][:160]!r}"
-    return None
+judged = _hostile.judged
 
 
 # ------------------------------------------------------------------ conflicts
