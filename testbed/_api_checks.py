@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import functools
 import inspect
+import json
 import os
 from collections.abc import Callable, Mapping
 from typing import Any
@@ -194,8 +195,6 @@ def _dataset_of_scenario(where: str, bound: Mapping[str, Any], r: Resolve) -> No
     ``michaelis_menten_noise1`` with the 100 Hz ``michaelis_menten`` scenario in silence: its
     chain and its ``[score]`` bars were set for another record, and its docstring says the
     scenario is the one the dataset belongs to."""
-    import json
-
     dataset, scenario = bound["dataset"], bound["scenario"]
     made = dataset.attrs.get("scenario") if isinstance(dataset.attrs, Mapping) else None
     if not isinstance(made, Mapping):
