@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import json
 import os
+import shutil
 import signal
 import subprocess
 import sys
@@ -122,12 +123,21 @@ def test_list_from_its_index_shows_a_plugin_or_scenario_added_edited_or_removed_
 
     def settle() -> str:
         """The test's files made older than the racy window, listed afresh (the index rewritten)
-        and then from the index: each change below is made to an index that holds."""
-        _backdate(*site.rglob("*"), site, *scenarios.rglob("*"), scenarios)
-        fresh = listing(fresh=True)
-        if not (tmp_path / "index").is_dir():  # a project file changed in the last 2 s: not kept
-            time.sleep(2.5)
+        and then from the index: each change below is made to an index that holds.
+
+        The index is removed before the fresh listing, so whether that listing kept one is
+        seen: a file the index stamps that changed in the last ``RACY_S`` (another test's
+        file, a ``__pycache__`` written by a worker) keeps none, and the listing is made again
+        once that window has passed.  (Before session 21 only the first call could see it:
+        later calls found the earlier index's folder, kept the stale index and failed.)"""
+        index = tmp_path / "index"
+        for _ in range(3):  # three racy windows in a row: the suite is writing that often
+            _backdate(*site.rglob("*"), site, *scenarios.rglob("*"), scenarios)
+            shutil.rmtree(index, ignore_errors=True)
             fresh = listing(fresh=True)
+            if any(index.glob("*.json")):
+                break
+            time.sleep(stamped.RACY_S + 0.5)
         assert listing(fresh=False) == fresh
         return fresh
 
