@@ -89,6 +89,36 @@ CASES: dict[str, tuple[str, dict, dict, dict, dict]] = {
         "0.2 L", {**soft(5.0, 0.3, {}, {"location": _SROOT2[0]}), "sensors": _SROOT2}, {},
         {"location": _SROOT2[0]}, {},
     ),
+    # a second batch (round20_beams_extra.toml): the corners above combined
+    "b20_soft_r1p2_cf0p3_z0p5_4s": ("the shipped beam on k1 = 1.2 EI/L, cubic fraction 0.3, 0.5 % damping, "
+                                    "4 s", {**soft(1.2, 0.3, {}), "damping_ratio": 0.005},
+                                    {"duration": 4.0}, {}, {}),
+    "b20_gf_soft_r1p2_cf0p3_s2tip": (
+        "glass-epoxy on k1 = 1.2 EI/L, cubic fraction 0.3, two sensors 0.9 / 1 L",
+        {**GFRP, **soft(1.2, 0.3, GFRP), "sensors": _S2TIP}, {}, {}, {},
+    ),
+    "b20_soft_r300_cf0p3_n12_s6_fs19k2": (
+        "the shipped beam in 12 segments on k1 = 300 EI/L, cubic fraction 0.3, six sensors evenly, "
+        "19.2 kHz", {"n_segments": 12, **soft(300.0, 0.3, {"n_segments": 12}), "sensors": _S6},
+        {"sample_rate": 19200.0}, {}, {},
+    ),
+    "b20_soft_r0p5_cf0p01_f15": ("the shipped beam on k1 = 0.5 EI/L, cubic fraction 0.01, under 15 N",
+                                 {**soft(0.5, 0.01, {}, _F15)}, {}, {**_F15}, {}),
+    "b20_st_L0p6_n6_s4tip_4s": (
+        "steel 0.6 m in 6 segments, four sensors 0.7 / 0.8 / 0.9 / 1 L, 4 s",
+        {"length": 0.6, "n_segments": 6, "sensors": sensors((0.7, 0.8, 0.9, 1.0), 0.6)},
+        {"duration": 4.0}, {}, {},
+    ),
+    "b20_al_L0p5_n8_hit0p1_f150": (
+        "aluminium 0.5 m in 8 segments, sensors 0.1 / 0.5 / 1 L, a 150 N hit at 0.1 L",
+        {**AL, "length": 0.5, "n_segments": 8, "sensors": sensors((0.1, 0.5, 1.0), 0.5)}, {},
+        {"location": round(0.05, 4), **_F150}, {},
+    ),
+    "b20_st_s2_hit0p1_z3": ("the shipped beam, sensors 0.1 / 1 L, the hammer at 0.1 L, 3 % damping",
+                            {"sensors": sensors((0.1, 1.0)), "damping_ratio": 0.03}, {},
+                            {"location": _SROOT[0]}, {}),
+    "b20_st_f15_fs6k4_4s": ("the shipped beam under 15 N at 6.4 kHz, 4 s", {},
+                            {"sample_rate": 6400.0, "duration": 4.0}, {**_F15}, {}),
 }
 
 
