@@ -119,6 +119,14 @@ CASES: dict[str, tuple[str, dict, dict, dict, dict]] = {
                             {"location": _SROOT[0]}, {}),
     "b20_st_f15_fs6k4_4s": ("the shipped beam under 15 N at 6.4 kHz, 4 s", {},
                             {"sample_rate": 6400.0, "duration": 4.0}, {**_F15}, {}),
+    # records whose chain leaves a scored mode out (round20_beams_band.toml): the scorer's reasons
+    "b20_st_fs1k_s2_nolp": ("the shipped beam at 1 kHz with no low-pass (mode 2 near 517 Hz above the "
+                            "500 Hz Nyquist frequency), sensors 0.5 / 1 L, a 2 ms pulse",
+                            {"sensors": sensors((0.5, 1.0))}, {"sample_rate": 1000.0},
+                            {"pulse_duration": 2e-3}, {"lowpass_hz": 0.0}),
+    "b20_st_fs2k4_nolp": ("the shipped beam at 2.4 kHz with no low-pass (mode 3 near 1.45 kHz above the "
+                          "1.2 kHz Nyquist frequency), a 0.6 ms pulse", {}, {"sample_rate": 2400.0},
+                          {"pulse_duration": 6e-4}, {"lowpass_hz": 0.0}),
 }
 
 

@@ -17,7 +17,9 @@ kg cart under a 1 kg pole, a nearly frictionless rail (0.01 N s/m, a tenth of th
 stiff gravity (20 m/s^2; rounds 14 and 19 drew the Moon's and Mars'), and a weak 0.3 N multisine.
 Kinetics: a fast enzyme (Vmax 10 mM/s, Km 2 mM: x* 0.13 mM), a nearly linear one (Km 5 mM, Vmax
 3: x* 1.25 mM), a tiny influx (0.02 mM/s: x* 4e-3 mM), a 20 mM dose, and a 2 s record at 200 Hz.
-Noise levels and seeds 111-115 are the studies' (round20_linkages_*.toml).
+Records that barely move, for the scorer's "uninformative" rule: the paper's sine at 0.001 rad, a
+0.01 N multisine on the cart-pole, a dose of 0.205 mM (2.5 % above x*).  Noise levels and seeds
+111-115 are the studies' (round20_linkages_*.toml).
 """
 
 from __future__ import annotations
@@ -46,6 +48,9 @@ FIVEBARS: dict[str, tuple[str, dict[str, dict]]] = {
     "fb20_light": ("all four links at 0.5 kg (the families' lightest)",
                    {"rig": {"m1": 0.5, "m2": 0.5, "m3": 0.5, "m4": 0.5}}),
     "fb20_3s": ("the paper's sine, a 3 s record", {"simulation": {"duration": 3.0}}),
+    # a record that barely moves (round20_linkages_small.toml)
+    "fb20_amp0p001": ("the paper's sine at 0.001 rad (1/70 of its 0.0698 rad)",
+                      {"excitation": {"amplitude": 0.001}}),
 }
 
 #: name -> (description, {table: keys changed from fivebar_multisine_noise1})
@@ -70,6 +75,8 @@ CARTPOLES: dict[str, tuple[str, dict[str, dict]]] = {
                       {"rig": {"cart_damping": 0.01}}),
     "cp20_g20": ("gravity 20 m/s^2", {"rig": {"gravity": 20.0}}),
     "cp20_amp0p3": ("a weak 0.3 N multisine", {"excitation": {"amplitude": 0.3}}),
+    # a record that barely moves (round20_linkages_small.toml)
+    "cp20_amp0p01": ("a 0.01 N multisine", {"excitation": {"amplitude": 0.01}}),
 }
 
 #: name -> (description, {table: keys changed from michaelis_menten_noise1}); Km 0.3, Vmax 1.5,
@@ -83,6 +90,8 @@ KINETICS: dict[str, tuple[str, dict[str, dict]]] = {
     "mm20_x0_20": ("a 20 mM dose", {"rig": {"x0": 20.0}}),
     "mm20_fs200_2s": ("the weak setup at 200 Hz on a 2 s record",
                       {"simulation": {"sample_rate": 200.0, "duration": 2.0}}),
+    # a record that barely moves (round20_linkages_small.toml)
+    "mm20_x0_0p205": ("a dose of 0.205 mM, 2.5 % above x* 0.2 mM", {"rig": {"x0": 0.205}}),
 }
 
 
