@@ -760,7 +760,9 @@ def test_an_infinite_coef_error_names_the_missing_term():
                                          ("round20_linkages_inputs", 6),
                                          ("round20_linkages_cartpoles", 15),
                                          ("round20_linkages_kinetics", 15),
-                                         ("round20_linkages_small", 6)])
+                                         ("round20_linkages_small", 6),
+                                         ("round20_beams_seeds", 40),
+                                         ("round20_linkages_seeds", 9)])
 def test_round20_studies_load(name, cells):
     study = load_study(_root() / "benchmarks" / "unseen" / f"{name}.toml")
     assert study.name == name and study.n_cells() == cells
