@@ -56,6 +56,9 @@ FIVEBARS: dict[str, tuple[str, dict[str, dict]]] = {
 #: name -> (description, {table: keys changed from fivebar_multisine_noise1})
 MULTISINES: dict[str, tuple[str, dict[str, dict]]] = {
     "fb20_ms_3s": ("the multisine, a 3 s record", {"simulation": {"duration": 3.0}}),
+    # round20_linkages_more.toml
+    "fb20_ms_short_cranks": ("the multisine on cranks 0.6 m under couplers 1.4 m (ground 1 m)",
+                             {"rig": {"l1": 0.6, "l2": 1.4, "l3": 1.4, "l4": 0.6}}),
 }
 
 #: name -> (description, the input replacing fivebar_multisine_noise1's whole, record [s])
@@ -77,6 +80,15 @@ CARTPOLES: dict[str, tuple[str, dict[str, dict]]] = {
     "cp20_amp0p3": ("a weak 0.3 N multisine", {"excitation": {"amplitude": 0.3}}),
     # a record that barely moves (round20_linkages_small.toml)
     "cp20_amp0p01": ("a 0.01 N multisine", {"excitation": {"amplitude": 0.01}}),
+    # large swings on the round's rigs (round20_linkages_more.toml)
+    "cp20_g20_amp3": ("gravity 20 m/s^2 under a 3 N multisine",
+                      {"rig": {"gravity": 20.0}, "excitation": {"amplitude": 3.0}}),
+    "cp20_pole0p2_L0p3_amp2": ("a light short pole (0.2 kg, 0.3 m) under a 2 N multisine",
+                               {"rig": {"pole_mass": 0.2, "pole_length": 0.3},
+                                "excitation": {"amplitude": 2.0}}),
+    "cp20_cart3_pole1_amp4": ("a 3 kg cart under a 1 kg pole, a 4 N multisine",
+                              {"rig": {"cart_mass": 3.0, "pole_mass": 1.0},
+                               "excitation": {"amplitude": 4.0}}),
 }
 
 #: name -> (description, {table: keys changed from michaelis_menten_noise1}); Km 0.3, Vmax 1.5,
