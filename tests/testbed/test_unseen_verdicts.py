@@ -787,3 +787,22 @@ def test_a_floor_is_claimed_for_the_exact_model_not_for_every_model_of_its_size(
     why = runs["sgd_sindy"].scores.failures["floor"]
     assert "out of reach of the exact model of that size" in why
     assert "any model" not in why  # a model of that size meets it: ls_sindy above
+
+
+def test_a_mode_above_the_nyquist_frequency_with_no_low_pass_is_named_folded_not_attenuated():
+    """Round 20's b20_st_fs1k_s2_nolp (the shipped beam at 1 kHz, no low-pass, sensors 0.5 / 1
+    L): mode 2 (517.4 Hz) is sampled above the 500 Hz Nyquist frequency and the record holds it
+    folded to 482.6 Hz at full amplitude; the reason said the chain "attenuates it in every
+    signal the identifier is given"."""
+    from testbed.scoring.scorers import aliased_frequency
+    sc = load_scenario(_root() / "benchmarks" / "unseen" / "round20" / "b20_st_fs1k_s2_nolp.toml")
+    r = run_scenario(dataclasses.replace(sc, seed=111, identify={**sc.identify, "method": "ls_sindy"}))
+    assert r.verdict == FAIL and r.scores.values["freq_error_mode2"] > 0.026
+    why = r.scores.failures["band"]
+    assert why.startswith("out of band: mode 2 (517.4 Hz) lies above the Nyquist frequency (500 Hz) "
+                          "and the record holds it folded to 482.6 Hz")
+    assert "attenuates" not in why
+    # the fold: at or below Nyquist a mode stays where it is; above, |f - fs round(f / fs)|
+    assert aliased_frequency(500.0, 1000.0) is None and aliased_frequency(82.7, 1000.0) is None
+    assert aliased_frequency(517.4, 1000.0) == pytest.approx(482.6)
+    assert aliased_frequency(1700.0, 1000.0) == pytest.approx(300.0)
