@@ -764,7 +764,9 @@ def test_an_infinite_coef_error_names_the_missing_term():
                                          ("round20_beams_seeds", 40),
                                          ("round20_linkages_seeds", 9),
                                          ("round20_linkages_more", 12),
-                                         ("round20_families", 64)])
+                                         ("round20_families", 64),
+                                         ("round20_beams_more", 24),
+                                         ("round20_linkages_last", 10)])
 def test_round20_studies_load(name, cells):
     study = load_study(_root() / "benchmarks" / "unseen" / f"{name}.toml")
     assert study.name == name and study.n_cells() == cells

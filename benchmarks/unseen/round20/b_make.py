@@ -16,7 +16,11 @@ at 0.2 % damping, 3.2 kHz (mode 3 at 0.9x the Nyquist frequency; two sensors, a 
 thick section (20 mm, outside the families' 6-15 mm); soft bases: the shipped base (k1 2000 N m/rad,
 k3 2.5e9) under 0.3x and 3x the shipped 50 N (15 / 150 N), a tiny cubic fraction (0.01) on k1 2
 EI/L, a base of 300 EI/L (near the clamped beam) with cubic fraction 0.3, and the hammer near the
-root on a 5 EI/L base.  Noise 0 / 0.5 / 3 / 5 % and seeds 111-112 are the studies'
+root on a 5 EI/L base.  Later batches combine them (round20_beams_extra.toml), sample at 1 and
+2.4 kHz with no low-pass so that a scored mode lies above the Nyquist frequency
+(round20_beams_band.toml), and add an aluminium plate (80 x 3 mm), a 0.5 EI/L base at 0.1 %
+damping on 3 s, a soft base read only at 0.1 / 0.2 L and three sensors near the root
+(round20_beams_more.toml).  Noise 0 / 0.5 / 1 / 3 / 5 % and seeds 111-118 are the studies'
 (round20_beams*.toml).
 
 Refused at load in one line each, so written with the keys that make them valid (the refusals are
@@ -127,6 +131,20 @@ CASES: dict[str, tuple[str, dict, dict, dict, dict]] = {
     "b20_st_fs2k4_nolp": ("the shipped beam at 2.4 kHz with no low-pass (mode 3 near 1.45 kHz above the "
                           "1.2 kHz Nyquist frequency), a 0.6 ms pulse", {}, {"sample_rate": 2400.0},
                           {"pulse_duration": 6e-4}, {"lowpass_hz": 0.0}),
+    # a third batch (round20_beams_more.toml)
+    "b20_soft_r1p2_cf0p3_root2": ("the shipped soft base (rule), sensors 0.1 / 0.2 L only, the hammer at "
+                                  "0.2 L",
+                                  {**soft(1.2, 0.3, {}, {"location": sensors((0.2,))[0]}),
+                                   "sensors": sensors((0.1, 0.2))}, {},
+                                  {"location": sensors((0.2,))[0]}, {}),
+    "b20_al_plate_80x3": ("aluminium plate 80 x 3 mm, 0.3175 m", {**AL, "width": 0.08, "thickness": 0.003},
+                          {}, {"peak_force": 15.0}, {}),
+    "b20_soft_r0p5_cf0p6_z0p1_3s": ("the shipped beam on k1 = 0.5 EI/L, cubic fraction 0.6, 0.1 % damping, "
+                                    "3 s",
+                                    {**soft(0.5, 0.6, {}), "damping_ratio": 0.001}, {"duration": 3.0},
+                                    {}, {}),
+    "b20_st_s4root_tip": ("the shipped beam, sensors 0.25 / 0.3 / 0.35 / 1 L (three near the root), "
+                          "hammer at the tip", {"sensors": sensors((0.25, 0.3, 0.35, 1.0))}, {}, {}, {}),
 }
 
 

@@ -104,6 +104,9 @@ KINETICS: dict[str, tuple[str, dict[str, dict]]] = {
                       {"simulation": {"sample_rate": 200.0, "duration": 2.0}}),
     # a record that barely moves (round20_linkages_small.toml)
     "mm20_x0_0p205": ("a dose of 0.205 mM, 2.5 % above x* 0.2 mM", {"rig": {"x0": 0.205}}),
+    # round20_linkages_last.toml
+    "mm20_km0p05_x0_0p5": ("Km 0.05 mM with a 0.5 mM dose (x* 0.033 mM)",
+                           {"rig": {"Km": 0.05, "x0": 0.5}}),
 }
 
 
