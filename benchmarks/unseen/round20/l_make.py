@@ -18,8 +18,10 @@ stiff gravity (20 m/s^2; rounds 14 and 19 drew the Moon's and Mars'), and a weak
 Kinetics: a fast enzyme (Vmax 10 mM/s, Km 2 mM: x* 0.13 mM), a nearly linear one (Km 5 mM, Vmax
 3: x* 1.25 mM), a tiny influx (0.02 mM/s: x* 4e-3 mM), a 20 mM dose, and a 2 s record at 200 Hz.
 Records that barely move, for the scorer's "uninformative" rule: the paper's sine at 0.001 rad, a
-0.01 N multisine on the cart-pole, a dose of 0.205 mM (2.5 % above x*).  Noise levels and seeds
-111-115 are the studies' (round20_linkages_*.toml).
+0.01 N multisine on the cart-pole, a dose of 0.205 mM (2.5 % above x*).  Large multisines on the
+round's cart-poles (3 N at g 20, 2 N on the light short pole, 4 N on the heavy pole), the multisine
+on the short cranks, and Km 0.05 mM from a 0.5 mM dose (x* 0.033 mM).  Noise levels and seeds
+111-119 are the studies' (round20_linkages_*.toml).
 """
 
 from __future__ import annotations
