@@ -2,8 +2,9 @@
 family), median and IQR of each score, pass rate and failure reasons.
 
 The spread is the interquartile range (25th and 75th percentiles, numpy's
-default linear interpolation), taken over the cells that finished ("ok"); with
-fewer than 2 such cells it degenerates to the single value.
+default linear interpolation), taken over the cells the scorer scored (:func:`scored`: those
+that finished "ok" and the scored failures, which keep their scores beside their reason; a
+crash has none); with fewer than 2 such cells it degenerates to the single value.
 
 The pass rate is over the *judged* cells of the group: those whose (scenario, identifier)
 pair was held to at least one threshold (a non-empty ``checks`` list in some cell of that
@@ -76,6 +77,24 @@ def failure_kind(error: str) -> list[str]:
     return found or ["other"]
 
 
+def scored(row: dict[str, Any]) -> bool:
+    """Whether a results row holds the scorer's scores: a cell that finished ("ok"), or a
+    scored failure (a diverged, non-physical or refused model, a failed bar the scorer
+    explains: "wrong equation", "floor", "out of band", ...), which keeps its scores beside its
+    reason; not a crash (:func:`failure_kind` ``crash: <Type>``: the cell never got to scoring).
+
+    The medians stand on these rows.  Over the "ok" rows alone they described the passing
+    cells: round 20's kinetics at 1.5 % showed coef_error 0.0232 [0.0232, 0.0232], the one cell
+    that passed, where the five cells scored 0.0232, 0.0519, 4.07, 5.89 and 88.1 (four "wrong
+    equation" failures with finite scores): median 4.07.  A score that is NaN for a failure
+    (a model that was never simulated) is left out and counted (``<score>_n``), an infinite
+    one counted as the worst value it is (:func:`~testbed.numerics.quantiles.quartiles`).
+    """
+    if row.get("status") == "ok":
+        return True
+    return not any(k.startswith("crash") for k in failure_kind(row.get("error") or ""))
+
+
 def failed_cells_line(rows: list[dict[str, Any]]) -> str | None:
     """One line on the failed rows of a sweep: how many crashed and how many are scored failures.
 
@@ -135,9 +154,10 @@ def summarize(path: str | os.PathLike, rows: list[dict[str, Any]] | None = None,
     list of dict
         Sorted by the group keys.  Keys: ``identifier``, ``noise`` [%] (and ``scenario`` or
         ``family``), ``scenarios`` (comma-separated names), ``cells``, ``ok``, ``failed``,
-        ``judged`` (cells held to thresholds), ``pass_rate`` (passed / judged; NaN if none is
-        judged), ``failures`` (dict: failure kind -> count, see :func:`failure_kind`), and for
-        every score ``<score>_median``, ``<score>_q25``, ``<score>_q75`` over the ok cells and
+        ``scored`` (the cells with the scorer's scores, :func:`scored`), ``judged`` (cells held
+        to thresholds), ``pass_rate`` (passed / judged; NaN if none is judged), ``failures``
+        (dict: failure kind -> count, see :func:`failure_kind`), and for every score
+        ``<score>_median``, ``<score>_q25``, ``<score>_q75`` over the scored cells and
         ``<score>_n``, the values they stand on (:func:`~testbed.numerics.quantiles.quartiles`:
         NaN left out, an infinite score counted as the worst value it is); NaN where the group
         has no value of that score.
@@ -159,6 +179,7 @@ def summarize(path: str | os.PathLike, rows: list[dict[str, Any]] | None = None,
     for key in sorted(groups):
         g = groups[key]
         ok = [r for r in g if r["status"] == "ok"]
+        with_scores = [r for r in g if scored(r)]
         judged = [r for r in g if judged_flags[id(r)]]
         failures: dict[str, int] = defaultdict(int)
         for r in g:
@@ -166,12 +187,12 @@ def summarize(path: str | os.PathLike, rows: list[dict[str, Any]] | None = None,
                 failures[kind] += 1
         s: dict[str, Any] = dict(zip(keys, key, strict=True))
         s.update(scenarios=",".join(sorted({r["scenario"] for r in g})), cells=len(g), ok=len(ok),
-                 failed=len(g) - len(ok), judged=len(judged),
+                 failed=len(g) - len(ok), scored=len(with_scores), judged=len(judged),
                  pass_rate=(sum(bool(r["passed"]) for r in judged) / len(judged) if judged
                             else math.nan),
                  failures=dict(sorted(failures.items(), key=lambda kv: (-kv[1], kv[0]))))
         for m in scores:
-            q25, med, q75, n = quartiles(r.get(m) for r in ok)
+            q25, med, q75, n = quartiles(r.get(m) for r in with_scores)
             s.update({f"{m}_median": med, f"{m}_q25": q25, f"{m}_q75": q75, f"{m}_n": n})
         out.append(s)
     return out
@@ -185,10 +206,10 @@ def _fmt(x: float) -> str:
 
 
 def _of(s: dict[str, Any], m: str) -> str:
-    """``"\\n<n> of <ok> cells"`` where score ``m``'s quartiles stand on fewer than the
-    group's ok cells (the others' ``m`` NaN: undefined for them), else "": a median of 5 of 6
-    cells was shown as the median of the 6 (round 13)."""
-    return f"\n{s[m + '_n']} of {s['ok']} cells" if s[m + "_n"] < s["ok"] else ""
+    """``"\\n<n> of <scored> cells"`` where score ``m``'s quartiles stand on fewer than the
+    group's scored cells (the others' ``m`` NaN: undefined for them, or a failure that was never
+    simulated), else "": a median of 5 of 6 cells was shown as the median of the 6 (round 13)."""
+    return f"\n{s[m + '_n']} of {s['scored']} cells" if s[m + "_n"] < s["scored"] else ""
 
 
 def print_summary(path: str | os.PathLike, console: Any = None,
@@ -212,8 +233,9 @@ def print_summary(path: str | os.PathLike, console: Any = None,
         return summary
     study = rows[0].get("study", "")
     console.print(f"study {study}: {len(rows)} cells from {path}; scores as median over "
-                  "[25th, 75th percentile] of the ok cells, pass rate over the cells held to "
-                  "thresholds (that identifier's own)",
+                  "[25th, 75th percentile] of the scored cells (passed, or failed with the scorer's "
+                  "reason; crashes left out), pass rate over the cells held to thresholds (that "
+                  "identifier's own)",
                   highlight=False)
     codes = Counter((str(r.get("commit") or "?"), str(r.get("versions") or "?")) for r in rows)
     if len(codes) > 1:  # a sweep resumed after a change of code or libraries: said, not pooled in silence

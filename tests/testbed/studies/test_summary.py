@@ -91,3 +91,31 @@ def test_pass_rate_only_against_own_bars_and_failure_reasons_by_family(tmp_path)
     print_summary(res, console=Console(file=buf, width=120), by="family")
     out = buf.getvalue()
     assert "no bars" in out and "fit failed: 1" in out and "25 % of 4" in out
+
+
+def test_medians_stand_on_every_scored_cell_not_the_passing_ones_alone(tmp_path):
+    # round 20's kinetics at 1.5 % (seed 114): one cell passed at coef_error 0.0232, four failed
+    # "wrong equation" with their scores (0.0519, 4.07, 5.89, 88.1); the summary showed 0.0232
+    # [0.0232, 0.0232], the passing cell alone
+    res = tmp_path / "r.parquet"
+    checks = '[{"metric": "coef_error", "bound": "max", "threshold": 0.05}]'
+    why = "wrong equation: coef_error {} above 0.05"
+    rows = [row("k0", "dyn", 1.5, 0, checks=checks, coef_error=0.0232)]
+    rows += [row(f"k{i}", "dyn", 1.5, i, status="failed", passed=False, checks=checks,
+                 error=why.format(v), coef_error=v)
+             for i, v in enumerate([0.0519, 4.07, 5.89, 88.1], start=1)]
+    # a model never simulated keeps its reason and no score; a crash is no scored cell (its
+    # value here stands for anything a crash might have left in the row)
+    rows.append(row("k5", "dyn", 1.5, 5, status="failed", passed=False, checks=checks,
+                    error="fit failed: non-physical model", coef_error=float("nan")))
+    rows.append(row("k6", "dyn", 1.5, 6, status="failed", passed=False, coef_error=1e9))
+    write_rows(res, rows)
+    (s,) = summarize(res)
+    assert (s["cells"], s["ok"], s["failed"], s["scored"]) == (7, 1, 6, 6)
+    assert (s["coef_error_q25"], s["coef_error_median"], s["coef_error_q75"], s["coef_error_n"]) \
+        == (*np.percentile([0.0232, 0.0519, 4.07, 5.89, 88.1], [25, 50, 75]), 5)
+    assert s["pass_rate"] == 1 / 7
+    buf = io.StringIO()
+    print_summary(res, console=Console(file=buf, width=120))
+    out = buf.getvalue()
+    assert "4.07" in out and "5 of 6 cells" in out and "of the scored cells" in out
