@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from identify._base import Identifier
-from testbed.core.errors import TestbedError, UnsupportedError
+from testbed.core.errors import IdentificationError, TestbedError, UnsupportedError
 from testbed.core.measurement import Measurement
 
 
@@ -32,4 +32,33 @@ def test_simulate_left_out_is_one_line_naming_the_class():
                                                r"scorer integrates") as e:
         model.simulate(np.zeros(1), np.zeros(1), np.arange(5) / 100.0)
     assert isinstance(e.value, NotImplementedError) and isinstance(e.value, TestbedError)
+    assert "\n" not in str(e.value)
+
+
+class _ReturnsNone(_NoSimulate):
+    """A plugin whose fit sets its model and forgets ``return self``."""
+
+    name = "returns_none"
+
+    def fit(self, data: Measurement) -> None:
+        super().fit(data)
+
+
+class _ReturnsOther(_NoSimulate):
+    """A plugin whose fit returns a fresh instance instead of itself."""
+
+    name = "returns_other"
+
+    def fit(self, data: Measurement) -> _NoSimulate:
+        return _NoSimulate().fit(data)
+
+
+@pytest.mark.parametrize("cls, shown", [(_ReturnsNone, "None"), (_ReturnsOther, "a _NoSimulate")])
+def test_a_fit_that_does_not_return_self_is_refused_in_one_line(cls, shown):
+    # hostile round 19's open item: `_ReturnsNone().fit(d)` handed the API user None (the
+    # chain `Id().fit(d).equations()` then failed on None) and `testbed run` scored it as fitted
+    x = np.sin(np.arange(50) / 5.0)[None, :]
+    with pytest.raises(IdentificationError, match=rf"^{cls.__name__}\.fit returned {shown}, not "
+                                                   r"the identifier itself; .*returns self") as e:
+        cls().fit(Measurement(100.0, x, x, x, ("x1",)))
     assert "\n" not in str(e.value)
