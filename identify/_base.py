@@ -48,6 +48,7 @@ import dataclasses
 import functools
 import inspect
 import itertools
+import numbers
 import sys
 from collections.abc import Callable, Iterator, Mapping
 from dataclasses import fields
@@ -66,6 +67,13 @@ from testbed.core.errors import (
 )
 from testbed.core.measurement import MIN_FREE_SAMPLES, Measurement, Trajectory
 from testbed.core.schema import ErrorFn, Field, KeyUse, check_keys_used, validate_table
+
+#: Types of a hyperparameter's value that are a number, a text or a sequence no scenario file
+#: holds: refused by :meth:`Identifier.check_params` (a Python object of another type, such
+#: as a :class:`identify.library.Library`, is left to the algorithm).  A tuple is read as a
+#: list and a numpy scalar of bool, integer or float as the Python number it holds first.
+_NOT_A_FILE_VALUE = (numbers.Number, bytes, bytearray, np.ndarray, np.generic, set, frozenset,
+                     range, memoryview)
 
 
 class Identifier:
@@ -203,8 +211,21 @@ class Identifier:
             f = self.declared_hyperparameters().get(k)
             if v is None and (f is None or f.default is None):
                 continue  # "not given"
-            if isinstance(v, (bool, int, float, str, list)) or v is None:
+            if isinstance(v, (bool, int, float, str, list, dict)) or v is None:
                 given[k] = v
+            elif isinstance(v, _NOT_A_FILE_VALUE) or isinstance(v, Iterator):
+                # a number, text or sequence in a form no scenario file holds was "left to the
+                # algorithm" as a Library is: Decimal, Fraction, complex, bytes, an array were
+                # raw TypeErrors inside the fit, a set of lhs terms fitted another model in
+                # silence (hostile round 20)
+                f_type = getattr(f, "type", None)
+                want = getattr(f_type, "__name__", "value of its declared type")
+                raise HyperparameterError(str(ScenarioError(
+                    type(self).__name__, f"{self.name or 'params'}.{k}", v,
+                    f"expected a Python {want}, as a scenario file gives it (a "
+                    f"{type(v).__name__} is not read as one"
+                    + ("; an array: pass .tolist(); a set or an iterator: a list in its order)"
+                       if f_type is list else ")"))))
             else:
                 complete = False
         try:
