@@ -36,6 +36,7 @@ from typing import Any
 
 from testbed.core.errors import TestbedError, UnknownNameError, show_value
 from testbed.core.exit_guard import no_process_exit
+from testbed.core.float_state import numpy_defaults
 from testbed.core.lazy import configure_loaded
 
 #: Entry-point group of identifiers from other distributions.
@@ -78,8 +79,8 @@ def import_plugin(spec: str) -> Any:
     """
     if not spec.endswith(".py"):
         try:
-            with no_process_exit():  # its os._exit(0) too (hostile round 20)
-                module = importlib.import_module(spec)
+            with no_process_exit(), numpy_defaults():  # its os._exit(0) and np.seterr too
+                module = importlib.import_module(spec)  # (hostile round 20)
         except BaseException as e:  # (sys.exit(0) in a plugin ended a run with status 0)
             if isinstance(e, KeyboardInterrupt):  # the user's Ctrl-C stays an interrupt
                 raise
@@ -105,8 +106,8 @@ def import_plugin(spec: str) -> Any:
     module = importlib.util.module_from_spec(loader_spec)
     sys.modules[modname] = module
     try:
-        with no_process_exit():  # its os._exit(0) too (hostile round 20)
-            loader_spec.loader.exec_module(module)
+        with no_process_exit(), numpy_defaults():  # its os._exit(0) and np.seterr too
+            loader_spec.loader.exec_module(module)  # (hostile round 20)
     except BaseException as e:
         del sys.modules[modname]
         # a plugin's sys.exit(0) ended `testbed run` with status 0 and no verdict; any other

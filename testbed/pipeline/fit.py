@@ -23,6 +23,7 @@ import numpy as np
 
 from testbed.core.errors import IdentificationError, InputError, ScenarioError, TestbedError
 from testbed.core.exit_guard import no_process_exit
+from testbed.core.float_state import numpy_defaults
 from testbed.core.measurement import Measurement
 from testbed.numerics.shapes import modal_from_matrices
 from testbed.pipeline import plugins
@@ -86,7 +87,10 @@ def fit_or_fail(model: Any, data: Measurement, method: str | None = None) -> Non
     origin = plugins.IDENTIFIERS.origin(method) if method is not None else "builtin"
     try:
         # a plugin's os._exit(0) in fit ended a run with status 0 and no verdict (round 19)
-        with no_process_exit() if origin != "builtin" else contextlib.nullcontext():
+        # under numpy's own float error state: a caller's or an earlier plugin's
+        # np.seterr(all="raise") failed a built-in fit; a plugin's own is undone after it
+        with no_process_exit() if origin != "builtin" else contextlib.nullcontext(), \
+                numpy_defaults():
             model.fit(data)
     except NUMERICAL_BREAKDOWN as e:
         raise IdentificationError(f"numerical breakdown ({type(e).__name__}: "

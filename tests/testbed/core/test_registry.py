@@ -78,3 +78,19 @@ def test_a_plugin_calling_os_exit_at_import_is_a_plugin_error(tmp_path):
     assert p.returncode == 0 and p.stdout.startswith(
         f"plugin {plugin}: importing it failed: ProcessExitCalled: os._exit(0) called"), (
         p.returncode, p.stdout, p.stderr[-300:])
+
+
+def test_a_plugins_float_error_state_set_at_import_is_undone(tmp_path):
+    # hostile round 20: a plugin's np.seterr(all="raise") at import held for every cell after
+    import numpy as np
+
+    from testbed.core.registry import import_plugin
+
+    plugin = tmp_path / "raises.py"
+    plugin.write_text("import numpy as np\nnp.seterr(all='raise')\n")
+    before = np.geterr()
+    try:
+        import_plugin(str(plugin))
+        assert np.geterr() == before
+    finally:
+        np.seterr(**before)

@@ -1,0 +1,32 @@
+"""``testbed.core.float_state``: the testbed computes under numpy's own float error state."""
+
+from __future__ import annotations
+
+import ast
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from testbed.core.float_state import DEFAULTS, numpy_defaults
+
+
+def test_defaults_are_those_of_a_fresh_interpreter():
+    out = subprocess.run([sys.executable, "-c", "import numpy; print(numpy.geterr())"],
+                         capture_output=True, text=True, timeout=60, check=True).stdout
+    assert ast.literal_eval(out.strip()) == DEFAULTS
+
+
+def test_within_the_defaults_hold_and_the_callers_state_comes_back():
+    old = np.seterr(all="raise")
+    try:
+        with numpy_defaults():
+            assert np.geterr() == DEFAULTS
+            assert np.exp(-1000.0) == 0.0  # an underflow: ignored, as numpy's default
+            np.seterr(all="raise")  # what a plugin sets within is undone
+        assert np.geterr() == {k: "raise" for k in DEFAULTS}
+        with pytest.raises(FloatingPointError):
+            np.exp(-1000.0)
+    finally:
+        np.seterr(**old)
