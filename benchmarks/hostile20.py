@@ -865,6 +865,91 @@ def hyperedge_cases(work: Path) -> list[tuple[str, object]]:
     return out
 
 
+# ------------------------------------------------------------------ leaks
+
+def leaks_cases(work: Path) -> list[tuple[str, object]]:
+    """A plugin identifier that changes the process's global state in its ``fit`` and is swept
+    (``--jobs 1``, one process) before ``ls_sindy`` on the stiff beam, with relative paths.  A
+    traceback, the results written elsewhere than asked, or an ``ls_sindy`` row that differs
+    from a sweep without the plugin (its verdict or a score), is a finding."""
+    from testbed.studies.results import read_results
+
+    def sweep(folder: Path, identifiers: list[str], plugin: Path | None) -> tuple[int, str, str]:
+        study = _write(folder / "lk.toml",
+                       f'[study]\nname = "lk"\nscenarios = ["{BEAM}"]\nnoise = [0.0]\n'
+                       f"seeds = [0]\nidentifiers = {json.dumps(identifiers)}\n"
+                       + (f'plugins = ["{plugin}"]\n' if plugin else ""))
+        old = os.getcwd()
+        os.chdir(folder)
+        try:
+            return cli_inprocess(["sweep", study.name, "--results", "r.parquet", "--jobs", "1",
+                                  "--cache", str(CACHE)])
+        finally:
+            os.chdir(old)
+
+    def reference() -> dict:
+        d = work / "reference"
+        if not (d / "r.parquet").exists():
+            d.mkdir(exist_ok=True)
+            found = judged(*sweep(d, ["ls_sindy"], None))
+            if found:
+                raise RuntimeError(found)
+        return read_results(d / "r.parquet")[0]
+
+    def case(k: int, label: str, in_fit: str):
+        def run():
+            ref = reference()
+            name = f"aa_leak{k}"  # sorted before ls_sindy: its cell runs first
+            d = work / name
+            d.mkdir(exist_ok=True)
+            plugin = d / f"{name}.py"
+            plugin.write_text(hostile19._PLUGIN.replace("NAME", name).replace("#AT_IMPORT", "")
+                              .replace("#IN_FIT", in_fit).replace("#SIMULATE", hostile19._SIMULATE))
+            snapshot = (os.getcwd(), np.geterr(), sys.getrecursionlimit(), os.umask(0o022),
+                        sys.stdout, os.environ.get("OMP_NUM_THREADS"))
+            os.umask(snapshot[3])
+            import warnings
+            with warnings.catch_warnings():
+                try:
+                    found = judged(*sweep(d, [name, "ls_sindy"], plugin))
+                finally:  # the round's own process is the plugin's too: put it back
+                    os.chdir(snapshot[0])
+                    np.seterr(**snapshot[1])
+                    sys.setrecursionlimit(snapshot[2])
+                    os.umask(snapshot[3])
+                    sys.stdout = snapshot[4]
+                    os.environ["OMP_NUM_THREADS"] = snapshot[5] or "1"
+            if found:
+                return found
+            if not (d / "r.parquet").exists():
+                return "no r.parquet where asked (the plugin moved the working folder?)"
+            rows = {r["identifier"]: r for r in read_results(d / "r.parquet")}
+            row = rows.get("ls_sindy")
+            if row is None:
+                return f"no ls_sindy row: {sorted(rows)}"
+            keys = [c for c in ref if c.endswith("_error") or c in ("passed", "trac", "mac")]
+            differ = [c for c in keys if str(row.get(c)) != str(ref.get(c))]
+            if differ:
+                return (f"ls_sindy after the plugin differs in {differ[:4]}: "
+                        f"{[(row.get(c), ref.get(c)) for c in differ[:2]]}")
+            return None
+        return run
+
+    rows = [
+        ("np.seterr(all='raise')", "np.seterr(all='raise')"),
+        ("np.seterr(under='raise')", "np.seterr(under='raise')"),
+        ("warnings as errors", "import warnings\n        warnings.simplefilter('error')"),
+        ("os.chdir('/')", "import os\n        os.chdir('/')"),
+        ("np.set_printoptions(precision=1)", "np.set_printoptions(precision=1)"),
+        ("sys.setrecursionlimit(120)", "import sys\n        sys.setrecursionlimit(120)"),
+        ("np.random.seed(1)", "np.random.seed(1)"),
+        ("os.umask(0o277)", "import os\n        os.umask(0o277)"),
+        ("OMP_NUM_THREADS=64 in os.environ", "import os\n        os.environ['OMP_NUM_THREADS'] = '64'"),
+        ("sys.stdout replaced by a StringIO", "import sys, io\n        sys.stdout = io.StringIO()"),
+    ]
+    return [(f"leaks {label}", case(k, label, code)) for k, (label, code) in enumerate(rows)]
+
+
 # ------------------------------------------------------------------ main
 
 FAMILIES = _hostile.families({
@@ -876,6 +961,7 @@ FAMILIES = _hostile.families({
     "storeedit": storeedit_cases,
     "plugins": plugins_cases,
     "hyperedge": hyperedge_cases,
+    "leaks": leaks_cases,
 }, TIMEOUT_S)
 
 

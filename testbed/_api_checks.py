@@ -26,8 +26,8 @@ from typing import Any
 
 from testbed.core import arguments as args
 from testbed.core.errors import ArgumentError, NotFittedError
-from testbed.core.float_state import numpy_defaults
 from testbed.core.kinds import METRICS
+from testbed.core.process_state import numpy_defaults
 
 #: Largest noise seed (numpy's SeedSequence takes any size; the run records and scenario files
 #: keep it as a signed 64-bit integer: ``testbed.pipeline.scenario.MAX_SEED``).

@@ -36,8 +36,8 @@ from typing import Any
 
 from testbed.core.errors import TestbedError, UnknownNameError, show_value
 from testbed.core.exit_guard import no_process_exit
-from testbed.core.float_state import numpy_defaults
 from testbed.core.lazy import configure_loaded
+from testbed.core.process_state import kept_process_state
 
 #: Entry-point group of identifiers from other distributions.
 IDENTIFIER_ENTRY_POINTS = "sysid_testbed.identifiers"
@@ -79,7 +79,7 @@ def import_plugin(spec: str) -> Any:
     """
     if not spec.endswith(".py"):
         try:
-            with no_process_exit(), numpy_defaults():  # its os._exit(0) and np.seterr too
+            with no_process_exit(), kept_process_state():  # its os._exit(0), np.seterr, os.chdir
                 module = importlib.import_module(spec)  # (hostile round 20)
         except BaseException as e:  # (sys.exit(0) in a plugin ended a run with status 0)
             if isinstance(e, KeyboardInterrupt):  # the user's Ctrl-C stays an interrupt
@@ -106,7 +106,7 @@ def import_plugin(spec: str) -> Any:
     module = importlib.util.module_from_spec(loader_spec)
     sys.modules[modname] = module
     try:
-        with no_process_exit(), numpy_defaults():  # its os._exit(0) and np.seterr too
+        with no_process_exit(), kept_process_state():  # its os._exit(0), np.seterr, os.chdir
             loader_spec.loader.exec_module(module)  # (hostile round 20)
     except BaseException as e:
         del sys.modules[modname]

@@ -154,3 +154,18 @@ def test_a_plugins_float_error_state_is_undone_after_its_fit(monkeypatch):
     model.leak = True
     fit_or_fail(model, _data(), "rogue")
     assert np.geterr() == before
+
+
+def test_a_plugins_chdir_in_its_fit_is_undone(monkeypatch, tmp_path):
+    # hostile round 20: a plugin's os.chdir("/") in its fit sent a sequential sweep's relative
+    # --results r.parquet to /r.parquet
+    monkeypatch.setattr(plugins.IDENTIFIERS, "origin", lambda name: "file /home/me/rogue.py")
+    monkeypatch.chdir(tmp_path)
+
+    class Moves(_Underflows):
+        def fit(self, data):
+            os.chdir("/")
+            return self
+
+    fit_or_fail(Moves(), _data(), "rogue")
+    assert os.getcwd() == str(tmp_path)

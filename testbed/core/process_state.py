@@ -1,5 +1,6 @@
-"""numpy's floating-point error state: the testbed computes under numpy's defaults, whatever
-its caller or a plugin set.
+"""Process-wide state a user's code may change under the testbed: numpy's floating-point error
+state (the testbed computes under numpy's defaults, whatever its caller or a plugin set) and the
+working folder (a plugin's ``os.chdir`` is undone).
 
 ``np.seterr(all="raise")`` in a user's Python session, or in a plugin's ``fit`` or at its import,
 changed the verdicts of built-in identifiers that ran after it (hostile round 20): the shipped
@@ -17,6 +18,7 @@ where numpy is loaded already (a caller who has not imported numpy has set nothi
 from __future__ import annotations
 
 import contextlib
+import os
 import sys
 from collections.abc import Iterator
 
@@ -38,3 +40,31 @@ def numpy_defaults() -> Iterator[None]:
         np = sys.modules.get("numpy")
         if np is not None:
             np.seterr(**(before or DEFAULTS))
+
+
+@contextlib.contextmanager
+def kept_working_folder() -> Iterator[None]:
+    """After: the working folder before, whatever the code within changed it to.
+
+    A plugin's ``os.chdir("/")`` in its fit sent a sequential sweep's relative ``--results
+    r.parquet`` to ``/r.parquet`` (hostile round 20).  A working folder that no longer exists
+    when entered is left as it is (there is nothing to return to)."""
+    try:
+        before = os.getcwd()
+    except OSError:
+        before = None
+    try:
+        yield
+    finally:
+        if before is not None:
+            with contextlib.suppress(OSError):
+                if os.getcwd() != before:
+                    os.chdir(before)
+
+
+@contextlib.contextmanager
+def kept_process_state() -> Iterator[None]:
+    """:func:`numpy_defaults` and :func:`kept_working_folder` together: around a user's code
+    (a plugin's import, any fit)."""
+    with numpy_defaults(), kept_working_folder():
+        yield

@@ -1,15 +1,16 @@
-"""``testbed.core.float_state``: the testbed computes under numpy's own float error state."""
+"""``testbed.core.process_state``: the testbed computes under numpy's own float error state."""
 
 from __future__ import annotations
 
 import ast
+import os
 import subprocess
 import sys
 
 import numpy as np
 import pytest
 
-from testbed.core.float_state import DEFAULTS, numpy_defaults
+from testbed.core.process_state import DEFAULTS, kept_process_state, numpy_defaults
 
 
 def test_defaults_are_those_of_a_fresh_interpreter():
@@ -30,3 +31,10 @@ def test_within_the_defaults_hold_and_the_callers_state_comes_back():
             np.exp(-1000.0)
     finally:
         np.seterr(**old)
+
+
+def test_the_working_folder_comes_back(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    with kept_process_state():
+        os.chdir("/")
+    assert os.getcwd() == str(tmp_path)
