@@ -748,7 +748,7 @@ def plugins_cases(work: Path) -> list[tuple[str, object]]:
             p = _hostile.testbed_cli(["run", str(scen), "--plugin", str(plugin), "--no-figures",
                                       "-o", str(work / "runs"), "--cache", str(CACHE)], work,
                                      TIMEOUT_S)
-            found = _hostile.cli_finding(p)
+            found = _hostile.cli_finding(p) if want >= 0 else None
             if found:
                 return found
             if p.returncode == 0 and "run written to" not in p.stdout:
@@ -788,6 +788,13 @@ def plugins_cases(work: Path) -> list[tuple[str, object]]:
         ("plugins os._exit(7) in fit (run)", run_case("h20_exit7", "import os\n        os._exit(7)")),
         ("plugins os._exit(0) at import (run)", run_case("h20_exiti", "", "import os\nos._exit(0)",
                                                          want=2)),
+        ("plugins posix._exit(0) in fit (run)", run_case("h20_posix",
+                                                         "import posix\n        posix._exit(0)")),
+        ("plugins os._exit(0) in a thread its fit starts (run)", run_case(
+            "h20_thread", "import os, threading\n        t = threading.Thread(target=os._exit, "
+            "args=(0,))\n        t.start()\n        t.join()")),
+        ("plugins os.abort() in fit (run: status 134, not 0)", run_case(
+            "h20_abort", "import os\n        os.abort()", want=-6)),
         ("plugins os._exit(0) in fit (sweep --jobs 1)", sweep_case("h20_sw1", exit0, 1)),
         ("plugins os._exit(0) in fit (sweep --jobs 2)", sweep_case("h20_sw2", exit0, 2)),
         ("plugins fit returns None (sweep --jobs 1)", sweep_case("h20_swn", "return None", 1)),

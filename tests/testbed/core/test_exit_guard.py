@@ -49,12 +49,14 @@ def _status(code: str) -> int:
                           timeout=60).returncode
 
 
-def test_another_threads_a_forked_childs_and_the_testbeds_own_exit_still_end_the_process():
+def test_a_thread_started_before_a_forked_childs_and_the_testbeds_own_exit_still_end_it():
     guard = "import os, threading\nfrom testbed.core.exit_guard import no_process_exit\n"
-    # a thread other than the guarded one (a sweep worker's parent watchdog)
+    # a thread that ran before the guard (a sweep worker's parent watchdog)
     assert _status(guard + """
+        go = threading.Event()
+        threading.Thread(target=lambda: (go.wait(30), os._exit(5))).start()
         with no_process_exit():
-            threading.Thread(target=os._exit, args=(5,)).start()
+            go.set()
             threading.Event().wait(30)
         """.replace("\n        ", "\n")) == 5
     # a child forked inside the guard (multiprocessing's fork ends its child with os._exit)
@@ -71,3 +73,34 @@ def test_another_threads_a_forked_childs_and_the_testbeds_own_exit_still_end_the
         with no_process_exit():
             exec("import os\\nos._exit(6)", {"__name__": "testbed.reporting.drawer"})
         """.replace("\n        ", "\n")) == 6
+
+
+def test_a_thread_the_guarded_code_starts_and_posix_exit_are_intercepted():
+    # hostile round 20: posix._exit(0), or os._exit(0) in a thread the plugin's fit started,
+    # ended `testbed run` with status 0 and no verdict.  In a child: on the old code the call
+    # ends the process it is made in.
+    code = textwrap.dedent("""
+        import os, posix, threading
+        from testbed.core.exit_guard import ProcessExitCalled, no_process_exit
+        real = os._exit
+        for how in ("thread", "posix"):
+            try:
+                with no_process_exit():
+                    if how == "thread":
+                        t = threading.Thread(target=os._exit, args=(3,))
+                        t.start()
+                        t.join(10)
+                    else:
+                        posix._exit(0)
+            except ProcessExitCalled as e:
+                print(how, e)
+        print(os._exit is real and posix._exit is real)
+        """)
+    p = subprocess.run([sys.executable, "-c", code], env={**os.environ, "PYTHONPATH": ROOT},
+                       capture_output=True, text=True, timeout=60)
+    assert p.returncode == 0 and p.stderr == "", (p.returncode, p.stderr[-300:])
+    assert p.stdout.splitlines() == [
+        "thread os._exit(3) called, which would have ended the testbed's process with no "
+        "verdict; raise an exception instead",
+        "posix os._exit(0) called, which would have ended the testbed's process with no "
+        "verdict; raise an exception instead", "True"], p.stdout
