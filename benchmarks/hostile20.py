@@ -732,19 +732,23 @@ def storeedit_cases(work: Path) -> list[tuple[str, object]]:
 def plugins_cases(work: Path) -> list[tuple[str, object]]:
     from testbed.pipeline.scenario import SCENARIO_DIR
 
-    def make(name: str, in_fit: str = "", at_import: str = "") -> tuple[Path, Path]:
+    def make(name: str, in_fit: str = "", at_import: str = "", in_simulate: str = ""
+             ) -> tuple[Path, Path]:
         plugin = work / f"{name}.py"
+        head = "    def simulate(self, x0, xd0, t, u=None):\n"
+        simulate = hostile19._SIMULATE.replace(head, head + in_simulate)
         plugin.write_text(hostile19._PLUGIN.replace("NAME", name).replace("#AT_IMPORT", at_import)
-                          .replace("#IN_FIT", in_fit).replace("#SIMULATE", hostile19._SIMULATE))
+                          .replace("#IN_FIT", in_fit).replace("#SIMULATE", simulate))
         scen = _write(work / f"{name}.toml",
                       f'[scenario]\nname = "{name}"\nextends = "{SCENARIO_DIR / (BEAM + ".toml")}"\n'
                       f'[identify]\nmethod = "{name}"\n')
         return plugin, scen
 
-    def run_case(name: str, in_fit: str = "", at_import: str = "", want: int = 1):
+    def run_case(name: str, in_fit: str = "", at_import: str = "", want: int = 1,
+                 in_simulate: str = ""):
         """A real ``testbed run`` (os._exit would end this process): status ``want``."""
         def run():
-            plugin, scen = make(name, in_fit, at_import)
+            plugin, scen = make(name, in_fit, at_import, in_simulate)
             p = _hostile.testbed_cli(["run", str(scen), "--plugin", str(plugin), "--no-figures",
                                       "-o", str(work / "runs"), "--cache", str(CACHE)], work,
                                      TIMEOUT_S)
@@ -793,6 +797,8 @@ def plugins_cases(work: Path) -> list[tuple[str, object]]:
         ("plugins os._exit(0) in a thread its fit starts (run)", run_case(
             "h20_thread", "import os, threading\n        t = threading.Thread(target=os._exit, "
             "args=(0,))\n        t.start()\n        t.join()")),
+        ("plugins os._exit(0) in simulate (run)", run_case(
+            "h20_simexit", in_simulate="        import os\n        os._exit(0)\n")),
         ("plugins os.abort() in fit (run: status 134, not 0)", run_case(
             "h20_abort", "import os\n        os.abort()", want=-6)),
         ("plugins os._exit(0) in fit (sweep --jobs 1)", sweep_case("h20_sw1", exit0, 1)),

@@ -63,8 +63,23 @@ def kept_working_folder() -> Iterator[None]:
 
 
 @contextlib.contextmanager
-def kept_process_state() -> Iterator[None]:
-    """:func:`numpy_defaults` and :func:`kept_working_folder` together: around a user's code
-    (a plugin's import, any fit)."""
-    with numpy_defaults(), kept_working_folder():
+def kept_numpy_state() -> Iterator[None]:
+    """After: numpy's error state before, whatever the code within set (within, the caller's
+    state holds: a scorer's ``np.errstate(over="ignore")`` around a model's simulation)."""
+    np = sys.modules.get("numpy")
+    before = np.geterr() if np is not None else None
+    try:
+        yield
+    finally:
+        np = sys.modules.get("numpy")
+        if np is not None:
+            np.seterr(**(before or DEFAULTS))
+
+
+@contextlib.contextmanager
+def kept_process_state(defaults: bool = True) -> Iterator[None]:
+    """:func:`numpy_defaults` (or, without ``defaults``, :func:`kept_numpy_state`) and
+    :func:`kept_working_folder` together: around a user's code (a plugin's import, any fit;
+    a plugin's simulation, without ``defaults``)."""
+    with numpy_defaults() if defaults else kept_numpy_state(), kept_working_folder():
         yield

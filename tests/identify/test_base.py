@@ -2,8 +2,13 @@
 
 from __future__ import annotations
 
+import os
+import subprocess
+import sys
+import textwrap
 from decimal import Decimal
 from fractions import Fraction
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -100,3 +105,62 @@ def test_a_hyperparameter_in_a_form_no_scenario_file_holds_is_refused(key, value
                                         ("lhs", ("x",)), ("ridge", np.float32(0.5))])
 def test_numpy_numbers_and_tuples_are_still_read_as_their_plain_values(key, value):
     _Tuned(**{key: value}).check_params()
+
+
+def test_a_plugins_simulate_calling_os_exit_is_an_identification_error():
+    # hostile round 20: a plugin's os._exit(0) in simulate (the scorer calls it) ended
+    # `testbed run` with status 0 and no verdict.  In a child: on the old code the call ends
+    # the process it is made in.
+    code = textwrap.dedent("""
+        import os
+        import numpy as np
+        from identify._base import Identifier
+        from testbed.core.errors import IdentificationError
+        from testbed.core.measurement import Measurement
+
+        class Exits(Identifier):
+            name, kind = "exits", "structural"
+
+            def fit(self, data):
+                n = data.n_channels
+                self.M_, self.C_, self.K_ = np.eye(n), np.zeros((n, n)), np.eye(n)
+                self.channels_ = tuple(data.channels)
+                return self
+
+            def simulate(self, x0, xd0, t, u=None):
+                os._exit(0)
+
+        x = np.sin(np.arange(50) / 5.0)[None, :]
+        model = Exits().fit(Measurement(100.0, x, x, x, ("x1",)))
+        try:
+            model.simulate(np.zeros(1), np.zeros(1), np.arange(5) / 100.0)
+        except IdentificationError as e:
+            print(e)
+        """)
+    env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[2])}
+    p = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True,
+                       timeout=120)
+    assert p.returncode == 0 and p.stdout.startswith(
+        "Exits.simulate: os._exit(0) called, which would have ended"), (p.returncode, p.stdout,
+                                                                       p.stderr[-300:])
+
+
+class _SetsErr(_NoSimulate):
+    """A plugin whose simulate sets numpy's float errors to raise."""
+
+    name = "sets_err"
+
+    def simulate(self, x0, xd0, t, u=None):
+        np.seterr(all="raise")
+        return None
+
+
+def test_a_plugins_simulate_leaves_numpys_error_state_as_it_was():
+    x = np.sin(np.arange(50) / 5.0)[None, :]
+    model = _SetsErr().fit(Measurement(100.0, x, x, x, ("x1",)))
+    before = np.geterr()
+    try:
+        model.simulate(np.zeros(1), np.zeros(1), np.arange(5) / 100.0)
+        assert np.geterr() == before
+    finally:
+        np.seterr(**before)

@@ -38,3 +38,11 @@ def test_the_working_folder_comes_back(tmp_path, monkeypatch):
     with kept_process_state():
         os.chdir("/")
     assert os.getcwd() == str(tmp_path)
+
+
+def test_kept_numpy_state_leaves_the_callers_state_within_and_restores_it_after():
+    with np.errstate(over="ignore"):
+        with kept_process_state(defaults=False):
+            assert np.geterr()["over"] == "ignore"
+            np.seterr(all="raise")
+        assert np.geterr()["over"] == "ignore" and np.geterr()["under"] == "ignore"
