@@ -314,8 +314,10 @@ def signals_cases(work: Path) -> list[tuple[str, object]]:
             f.attrs[key] = fn(f.attrs[key])
         return edit
 
-    def case(scenario: str, label: str, edit, refuse: bool | None):
-        """``refuse``: True must refuse, False must give a model, None either (one line)."""
+    def case(scenario: str, label: str, edit, refuse: bool | None, with_scenario: bool = False):
+        """``refuse``: True must refuse, False must give a model, None either (one line);
+        ``with_scenario``: ``identify --scenario`` (its chain and identifier) instead of
+        ``--kind`` / ``--method``."""
         def run():
             src = _generated(work, scenario)
             path = work / f"{_safe(scenario + label)}.h5"
@@ -325,8 +327,10 @@ def signals_cases(work: Path) -> list[tuple[str, object]]:
             _rehash(path)
             kind = "dynamical" if scenario == MM else "structural"
             method = "sindy_pi_dynamical" if scenario == MM else "ls_sindy"
-            status, out, err = cli_inprocess(["identify", str(path), "--kind", kind, "--method",
-                                              method, "-o", f"{path}.model.json"])
+            how = (["--scenario", scenario] if with_scenario
+                   else ["--kind", kind, "--method", method])
+            status, out, err = cli_inprocess(["identify", str(path), *how, "-o",
+                                              f"{path}.model.json"])
             found = judged(status, out, err, refuse=bool(refuse))
             if found:
                 return found
@@ -374,8 +378,18 @@ def signals_cases(work: Path) -> list[tuple[str, object]]:
         ("force negative", edit_array("measured/force", lambda a: -a), None),
         ("fs halved", attr("fs", lambda v: float(v) / 2), None),
     ]
+    rated = [  # the record's rate against the scenario's (its chain's cut-offs, its identifier)
+        (MM, "fs x 10 with the 100 Hz scenario", attr("fs", lambda v: float(v) * 10), None),
+        (MM, "fs / 4 with the 100 Hz scenario", attr("fs", lambda v: float(v) / 4), None),
+        (BEAM, "fs / 2 with the 12.8 kHz scenario", attr("fs", lambda v: float(v) / 2), None),
+        (BEAM, "fs / 20 with the 12.8 kHz scenario (below its low-pass)",
+         attr("fs", lambda v: float(v) / 20), None),
+        (BEAM, "fs x 4 with the 12.8 kHz scenario", attr("fs", lambda v: float(v) * 4), None),
+        (BEAM, "acc1 clipped at 10 % with the scenario", edit_array(acc, clip(0.1)), None),
+    ]
     return ([(f"signals mm {label}", case(MM, label, e, r)) for label, e, r in mm]
-            + [(f"signals beam {label}", case(BEAM, label, e, r)) for label, e, r in beam])
+            + [(f"signals beam {label}", case(BEAM, label, e, r)) for label, e, r in beam]
+            + [(f"signals {sc} {label}", case(sc, label, e, r, True)) for sc, label, e, r in rated])
 
 
 # ------------------------------------------------------------------ timecol
