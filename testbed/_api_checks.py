@@ -27,6 +27,7 @@ from typing import Any
 from testbed.core import arguments as args
 from testbed.core.errors import ArgumentError, NotFittedError
 from testbed.core.kinds import METRICS
+from testbed.core.process_state import numpy_defaults
 
 #: Largest noise seed (numpy's SeedSequence takes any size; the run records and scenario files
 #: keep it as a signed 64-bit integer: ``testbed.pipeline.scenario.MAX_SEED``).
@@ -242,7 +243,8 @@ def checked(name: str, fn: Callable[..., Any], resolve: Resolve) -> Callable[...
             bound.arguments[arg] = rule(name, arg, bound.arguments[arg], resolve)
         if name in CROSS:
             CROSS[name](name, bound.arguments, resolve)
-        return fn(*bound.args, **bound.kwargs)
+        with numpy_defaults():  # the caller's np.seterr(all="raise") changed built-in
+            return fn(*bound.args, **bound.kwargs)  # verdicts (hostile round 20)
 
     call.__wrapped_api__ = fn  # type: ignore[attr-defined]
     return call

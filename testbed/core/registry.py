@@ -35,7 +35,9 @@ from pathlib import Path
 from typing import Any
 
 from testbed.core.errors import TestbedError, UnknownNameError, show_value
+from testbed.core.exit_guard import no_process_exit
 from testbed.core.lazy import configure_loaded
+from testbed.core.process_state import kept_process_state
 
 #: Entry-point group of identifiers from other distributions.
 IDENTIFIER_ENTRY_POINTS = "sysid_testbed.identifiers"
@@ -77,7 +79,8 @@ def import_plugin(spec: str) -> Any:
     """
     if not spec.endswith(".py"):
         try:
-            module = importlib.import_module(spec)
+            with no_process_exit(), kept_process_state():  # its os._exit(0), np.seterr, os.chdir
+                module = importlib.import_module(spec)  # (hostile round 20)
         except BaseException as e:  # (sys.exit(0) in a plugin ended a run with status 0)
             if isinstance(e, KeyboardInterrupt):  # the user's Ctrl-C stays an interrupt
                 raise
@@ -103,7 +106,8 @@ def import_plugin(spec: str) -> Any:
     module = importlib.util.module_from_spec(loader_spec)
     sys.modules[modname] = module
     try:
-        loader_spec.loader.exec_module(module)
+        with no_process_exit(), kept_process_state():  # its os._exit(0), np.seterr, os.chdir
+            loader_spec.loader.exec_module(module)  # (hostile round 20)
     except BaseException as e:
         del sys.modules[modname]
         # a plugin's sys.exit(0) ended `testbed run` with status 0 and no verdict; any other

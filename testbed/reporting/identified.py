@@ -6,6 +6,8 @@ from __future__ import annotations
 import math
 from typing import Any
 
+from testbed.reporting.markdown import md_code_block, md_text
+
 
 def _num(v: Any) -> str:
     return "-" if v is None or (isinstance(v, float) and math.isnan(v)) else f"{v:.5g}"
@@ -17,11 +19,13 @@ def render_identified(summary: dict[str, Any]) -> str:
     equations."""
     ident = summary["identifier"]
     params = ", ".join(f"{k}={v!r}" for k, v in ident["params"].items())
-    lines = [f"# Identified model: {summary['method']}", "",
-             f"- data: `{summary['source']}` ({summary['kind']}; {len(summary['channels'])} channels "
-             f"{', '.join(summary['channels'])}; {summary['n_samples']} samples at "
-             f"{summary['fs_hz']:g} Hz)",
-             f"- identifier: `{ident['class']}`({params})",
+    # the source's path, the channels' names, the parameters and the equations are the user's
+    # text: shown as written, never as markup (hostile round 20)
+    lines = [f"# Identified model: {md_text(summary['method'])}", "",
+             f"- data: {md_text(summary['source'])} ({summary['kind']}; "
+             f"{len(summary['channels'])} channels {md_text(', '.join(summary['channels']))}; "
+             f"{summary['n_samples']} samples at {summary['fs_hz']:g} Hz)",
+             f"- identifier: {md_text(ident['class'])}({md_text(params)})",
              f"- fit time: {summary['fit_time_s']:.3g} s",
              "- R^2 of the predicted accelerations (truth-free): "
              + (_num(summary["r2"]) if summary.get("r2") is not None
@@ -41,5 +45,5 @@ def render_identified(summary: dict[str, Any]) -> str:
             lines += [f"{key} [{mats['units'][key]}]:", "```"]
             lines += ["  ".join(f"{v:+.5e}" for v in row) for row in mats[key]]
             lines += ["```", ""]
-    lines += ["## Equations", "", "```", *summary["equations"], "```"]
+    lines += ["## Equations", "", *md_code_block(summary["equations"])]
     return "\n".join(lines) + "\n"

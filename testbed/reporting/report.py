@@ -38,6 +38,7 @@ from testbed.pipeline.plugins import RIGS
 from testbed.pipeline.scenario import NOISE_SCHEMA
 from testbed.pipeline.signal_chain import SIGNAL_SCHEMAS
 from testbed.reporting import figures as figs
+from testbed.reporting.markdown import md_code_block, md_text
 from testbed.studies.results import ResultsError, parts_dir, read_results, score_columns, stored_checks
 from testbed.studies.runstore import SavedRun, load_run, resolve_run
 
@@ -103,18 +104,18 @@ class Page:
     def __init__(self, title: str, out_dir: Path) -> None:
         self.title, self.out_dir = title, out_dir
         self.html: list[str] = []
-        self.md: list[str] = [f"# {title}", ""]
+        self.md: list[str] = [f"# {md_text(title)}", ""]
 
     def heading(self, text: str, level: int = 2) -> None:
         """A heading of ``level`` (2: a section) in both texts."""
         self.html.append(f"<h{level}>{html.escape(text)}</h{level}>")
-        self.md += ["#" * level + " " + text, ""]
+        self.md += ["#" * level + " " + md_text(text), ""]
 
     def para(self, text: str, raw_html: str | None = None) -> None:
         """A paragraph: ``text`` escaped, or ``raw_html`` (built by the caller from escaped parts)
         in the HTML; ``text`` in the markdown."""
         self.html.append(f"<p>{raw_html or html.escape(text)}</p>")
-        self.md += [text, ""]
+        self.md += [md_text(text), ""]
 
     def table(self, head: Sequence[str], rows: Sequence[Sequence[Any]],
               classes: Sequence[str | None] | None = None, digits: int = 4) -> None:
@@ -133,8 +134,8 @@ class Page:
                 tds.append(f"<td{attr}>{html.escape(c)}</td>")
             h.append("<tr>" + "".join(tds) + "</tr>")
         self.html.append("".join(h) + "</tbody></table>")
-        esc = [[c.replace("|", "\\|") for c in r] for r in cells]
-        self.md += ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+        esc = [[md_text(c) for c in r] for r in cells]
+        self.md += ["| " + " | ".join(md_text(c) for c in head) + " |", "|" + "---|" * len(head)]
         self.md += ["| " + " | ".join(r) + " |" for r in esc] + [""]
 
     def figure_html(self, png: Path, caption: str, cls: str = "") -> str:
@@ -151,7 +152,7 @@ class Page:
     @staticmethod
     def figure_md(png: Path, caption: str) -> str:
         """Markdown of ``png`` (by file name, beside the markdown) with its caption in italics."""
-        return f"![{png.stem}]({png.name})\n\n*{caption}*"
+        return f"![{md_text(png.stem)}]({png.name})\n\n*{md_text(caption)}*"
 
     def figure(self, png: Path, caption: str) -> None:
         """Embed ``png`` (base64) in the HTML; copy it beside the markdown."""
@@ -161,13 +162,13 @@ class Page:
     def bullets(self, items: Sequence[str]) -> None:
         """A bulleted list of plain-text items."""
         self.html.append("<ul>" + "".join(f"<li>{html.escape(i)}</li>" for i in items) + "</ul>")
-        self.md += [f"- {i}" for i in items] + [""]
+        self.md += [f"- {md_text(i)}" for i in items] + [""]
 
     def equations(self, lines: Sequence[str]) -> None:
         """Equations, one numbered item each, wrapping at any character with a hanging indent."""
         self.html.append('<ol class="eq">' + "".join(f"<li>{html.escape(e)}</li>" for e in lines)
                          + "</ol>")
-        self.md += ["```", *lines, "```", ""]
+        self.md += [*md_code_block(lines), ""]
 
     def raw(self, html_text: str, md_text: str = "") -> None:
         """Raw HTML (built by the caller from escaped parts) and its markdown."""
@@ -178,7 +179,7 @@ class Page:
     def pre(self, lines: Sequence[str]) -> None:
         """Preformatted lines (escaped in the HTML, a code block in the markdown)."""
         self.html.append("<pre>" + html.escape("\n".join(lines)) + "</pre>")
-        self.md += ["```", *lines, "```", ""]
+        self.md += [*md_code_block(lines), ""]
 
     def write(self) -> Path:
         """Write ``report.html`` (self-contained: CSS inline, figures embedded, a

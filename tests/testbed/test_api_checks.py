@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 import testbed
@@ -35,3 +36,16 @@ def test_score_takes_the_scenarios_own_record_at_any_noise(dataset_cache):
     noisy = dataset_cache.get(sc.with_noise(1.0).replace(seed=3))  # a noisy copy is its record
     assert testbed.score(model, noisy, "michaelis_menten").values.keys() == \
         testbed.score(model, ds, sc).values.keys()
+
+
+def test_the_api_computes_under_numpys_defaults_whatever_the_caller_set(dataset_cache):
+    # hostile round 20: under the caller's np.seterr(all="raise"), run_scenario of the shipped
+    # cantilever_stiff_impact_sindy_pi raised a raw FloatingPointError (underflow) where it passes
+    sc = testbed.load_scenario("cantilever_stiff_impact_sindy_pi")
+    old = np.seterr(all="raise")
+    try:
+        result = testbed.run_scenario(sc, cache=dataset_cache)
+        assert np.geterr()["under"] == "raise"
+    finally:
+        np.seterr(**old)
+    assert result.passed, result.scores.failures
