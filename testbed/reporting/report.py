@@ -41,6 +41,7 @@ from testbed.reporting import figures as figs
 from testbed.reporting.markdown import md_code_block, md_text
 from testbed.studies.results import ResultsError, parts_dir, read_results, score_columns, stored_checks
 from testbed.studies.runstore import SavedRun, load_run, resolve_run
+from testbed.studies.statistics import scored
 
 CSS = """
 body{font-family:system-ui,-apple-system,"Segoe UI",Roboto,sans-serif;max-width:1100px;margin:2em auto;
@@ -557,7 +558,8 @@ def _summary_tables(page: Page, rows: Sequence[dict[str, Any]],
                 cell = [r for r in srows if str(r["identifier"]) == ident and float(r["noise"]) == z]
                 n_pass = sum(bool(r.get("passed")) and _ok(r) for r in cell)
                 line: list[Any] = [ident, z, len(cell), _rate(cell)]
-                ran = [r for r in cell if _ok(r)]
+                ran = [r for r in cell if scored(r)]  # a scored failure's scores too (its
+                # bar failed is the row's point: over the "ok" rows a failed cell showed "–")
                 line += [_iqr([float(r[m]) for r in ran if _number(r.get(m))], len(ran))
                          for m in shown]
                 line.append(failure_reasons(cell) or "–")
@@ -619,14 +621,15 @@ def sweep_report(rows: Sequence[dict[str, Any]], out_dir: str | os.PathLike,
     page.table(["scenario", "identifier"] + [f"noise {fmt(z)} %" for z in noises], table)
 
     page.heading("Summary")
-    page.para("Median [25th, 75th percentile] over seeds of the cells that ran; thresholds in the "
-              "column heads; reasons counted over the cells of each row.")
+    page.para("Median [25th, 75th percentile] over seeds of the cells that were scored (passed, "
+              "or failed with a reason; crashes left out); thresholds in the column heads; "
+              "reasons counted over the cells of each row.")
     _summary_tables(page, rows, thr)
 
     page.heading("Scores vs noise")
     page.para("One figure per score, a panel per scenario (shared axes): median over seeds (line) "
               "and interquartile range (band) per identifier; dashed red: the scenario's threshold.")
-    ok = [r for r in rows if _ok(r)]
+    ok = [r for r in rows if scored(r)]  # as the summary: every cell scored, crashes left out
     names = score_names(rows)
     kinds = list(METRICS)
 

@@ -217,3 +217,21 @@ def test_sweep_report_scores_are_not_wall_times():
 
     row = {k: 1.0 for k in (*BASE_COLUMNS, *TAIL_COLUMNS)} | {"trac": 0.9, "mac": 0.99}
     assert score_names([row]) == ["mac", "trac"]
+
+
+def test_the_sweep_reports_summary_shows_a_scored_failures_scores(tmp_path):
+    """A cell that failed its bar with a reason keeps its scores, and the summary's medians stand
+    on them (as `testbed summary`'s, `testbed.studies.statistics.scored`); a crash's are left
+    out.  Round 20: `mm20_x0_20` at 0.5 % showed state_rmse "–" with "wrong equation" while the
+    cell's state_rmse was 0.885 mM against the bar 0.01: the failed bar was shown nowhere."""
+    checks = '[{"metric": "state_rmse", "bound": "max", "threshold": 0.01}]'
+    base = {"study": "s", "scenario": "mm20_x0_20", "rig": "michaelis_menten", "noise": 0.5,
+            "identifier": "sindy_pi_dynamical", "fit_time": 0.1, "checks": checks,
+            "versions": '{"numpy": "2"}', "commit": "abc123", "dataset_hash": "ff" * 8}
+    rows = [{**base, "cell": "c0", "seed": 0, "status": "failed", "passed": False,
+             "error": "wrong equation: state_rmse 0.885 above 0.01", "state_rmse": 0.885},
+            {**base, "cell": "c1", "seed": 1, "status": "failed", "passed": False,
+             "error": "RuntimeError: boom (fit.py:12)", "state_rmse": 1e9}]  # a crash: not scored
+    html = sweep_report(rows, tmp_path / "r", "s").read_text()
+    summary = _table(html, "Scenario mm20_x0_20")
+    assert re.search(r">0\.885</td>", summary) and "1e+09" not in summary
