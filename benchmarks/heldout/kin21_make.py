@@ -11,7 +11,7 @@ The draws are log-uniform (uniform for the influx fraction) from
 influx jx a fraction 0-0.95 of Vmax, x0 0.05-30 mM (a draw within 20 % of the steady state
 jx Km / (Vmax - jx) is moved to 3 x it, the rig's refusal of a start at rest), records of
 4-40 s at 200-5000 Hz; kin20_make.py's ranges and rule, another stream.  Noise levels 0 / 1 / 2 %
-and seed 2101 are the study's (kinetics_validation21.toml).
+and seed 2101 are the study's (kin21_kinetics.toml).
 """
 
 from __future__ import annotations
