@@ -78,6 +78,26 @@ cell's scores changed (round 10's
 ``mm10_jx1p2_rise_8s`` at 2 %: x^2 the only removal at 1.2, the others 2.17-7.83, coef_error
 1.75 -> 0.031; round 11's ``mm11_rise_x0_0p05`` at 1 %: 1.4 against 5.6-22.7, 0.52 -> 0.0040).
 
+The quadrature floor (the same ``noise_prune_rule_``): the weak rows are integrals taken by
+the rectangle rule on the samples, so a law's own residual holds their quadrature error besides
+the noise's share, and on a clean record, or a slow one (50 Hz), that error is the larger: round
+18's ``mm18_fs50`` clean kept ``x^2`` at -1.4e-5 of the row because its removal's residual was
+7e5 x the clean record's noise share (noise std 6.9e-10).  So each removal's ratio counts that
+error in its floor: the rows on every second sample of each window (weights doubled, the same
+windows) against the rows on every sample estimate it by Richardson's rule,
+``(rows_2h - rows_h) / (2^e - 1)`` (:func:`quadrature_rows`; ``e`` :func:`quadrature_order`,
+4 for the default ``weak_degree`` 4: the order of the integrated-by-parts columns, whose
+``phi'`` vanishes to order 3 at the window's ends; the other columns converge as ``h^6``, for
+which this is an upper bound by 63 / 15), and the ratio is the residual over the noise's share
+plus that error's along the same direction (:meth:`SINDyPIDynamical._floor_ratio`).  On a
+noisy record the difference of the two grids also holds noise, about the noise's own share,
+which the ``(2^e - 1)^2`` = 225 divides away.  Measured (session 21, docs/known-gaps.md) on
+the 180 kinetics cells of rounds 10-19 and session 20's check set: two cells change, both clean,
+every other cell's equation and scores identical: ``mm18_fs50`` passes (``x^2``'s removal 7e5
+-> 0.07, coef_error 1.9e-4 with F1 0.889 -> 5e-5 with F1 1), and ``mmv_3`` (a 127-320 1/s
+decay sampled at 1 kHz, then 28 s at rest) fails as before, now with a 3-term equation that
+simulates within the state bar (0.0062 mM) where its 5-term one diverged.
+
 The exact tie (``exact_tie_``, ``exact_tie_rule_``): the parsimony rule counts a held-out
 error within ``selection_atol`` (1e-12) of the best as equal, an absolute tolerance whose
 meaning depends on the record.  On a clean record saturated far above Km (round 16's
@@ -306,12 +326,15 @@ def polynomial_terms(states: tuple[str, ...], inputs: tuple[str, ...], degree: i
 
 
 def weak_rows(lib: ImplicitTerms, x: np.ndarray, xd: np.ndarray, u: np.ndarray | None,
-              fs: float, window_s: float, n_windows: int, degree: int) -> np.ndarray:
+              fs: float, window_s: float, n_windows: int, degree: int,
+              stride: int = 1) -> np.ndarray:
     """Weak-form library matrix, shape (n_windows, p): ``V[k, c] = int phi_k Theta_c dt``.
 
     A column ``x_i^a * dx_i`` is integrated by parts, ``-int phi_k' x_i^(a+1) / (a+1) dt``
     (exact: ``phi_k`` vanishes at its window's ends); other columns by the rectangle rule on
-    the samples (module docstring of :mod:`identify._weak`).
+    the samples (module docstring of :mod:`identify._weak`).  ``stride`` 2: the rectangle rule
+    on every second sample of each window (from its first, weights doubled), the same windows:
+    the coarser grid of :func:`quadrature_rows`.
 
     Raises
     ------
@@ -340,9 +363,30 @@ def weak_rows(lib: ImplicitTerms, x: np.ndarray, xd: np.ndarray, u: np.ndarray |
             a = own[i]
             A0[:, c] = 0.0
             A1[:, c] = -x[i] ** (a + 1) / (a + 1)
-    V = _correlate(A0, phi * dt, starts)
-    V += _correlate(A1, dphi * dt, starts)
+    mask = np.zeros(L)
+    mask[::stride] = float(stride)
+    V = _correlate(A0, phi * mask * dt, starts)
+    V += _correlate(A1, dphi * mask * dt, starts)
     return V
+
+
+def quadrature_order(degree: int) -> int:
+    """The order ``e`` of the weak rows' quadrature error, ``O(h^e)`` in the sample interval
+    ``h``, for test functions ``(1 - s^2)^degree``: the rectangle rule on a window is the
+    trapezoid rule (the integrand vanishes at both ends), whose Euler-Maclaurin error is led by
+    the first odd derivative of the integrand that does not vanish at the ends; ``phi'``
+    (the integrated-by-parts columns) vanishes there to order ``degree - 1``, so that is the
+    derivative ``2 ceil(degree / 2) - 1`` and ``e = 2 ceil(degree / 2)`` (4 for the default
+    degree 4; the other columns, ``phi`` to order ``degree``, converge at least as fast)."""
+    return 2 * math.ceil(degree / 2)
+
+
+def quadrature_rows(rows_h: np.ndarray, rows_2h: np.ndarray, degree: int) -> np.ndarray:
+    """Richardson's estimate of the quadrature error of weak rows, shape (n_windows, q): the
+    rows on every sample ``rows_h`` minus those on every second sample ``rows_2h``
+    (:func:`weak_rows` with ``stride`` 2), over ``2^e - 1`` (``e`` :func:`quadrature_order`):
+    with the error ``C h^e``, ``rows_2h - rows_h = C h^e (2^e - 1)``."""
+    return (rows_2h - rows_h) / (2.0 ** quadrature_order(degree) - 1.0)
 
 
 def check_finite_library(Theta: np.ndarray, G_train: np.ndarray, G_val: np.ndarray,
@@ -962,13 +1006,38 @@ class SINDyPIDynamical(Identifier):
             return np.full(x.shape[0], np.nan)
 
     def _rows_of(self, names: list[str], lib: ImplicitTerms, xd: np.ndarray, u: np.ndarray | None,
-                 fs: float) -> Callable[[np.ndarray], np.ndarray]:
-        """``rows(x)``: the regression rows (this fit's formulation) of the terms ``names``."""
+                 fs: float, stride: int = 1) -> Callable[[np.ndarray], np.ndarray]:
+        """``rows(x)``: the regression rows (this fit's formulation) of the terms ``names``; in
+        the weak form ``stride`` 2 takes every second sample (:func:`weak_rows`)."""
         sub = ImplicitTerms(names, lib.states, lib.inputs)
         if self.formulation == "weak":
             return lambda z: weak_rows(sub, z, xd, u, fs, self.weak_window_s, self.weak_windows,
-                                       self.weak_degree)
+                                       self.weak_degree, stride)
         return lambda z: sub.evaluate(z, xd, u)
+
+    def _floor_ratio(self, names: list[str], lib: ImplicitTerms, x: np.ndarray, xd: np.ndarray,
+                     u: np.ndarray | None, fs: float, sigma: np.ndarray
+                     ) -> tuple[float, np.ndarray]:
+        """The best equation of the terms ``names`` and its residual over the floor a law of
+        those terms would leave on this record (module docstring, "The quadrature floor"):
+        :func:`identify._determinacy.noise_residual_ratio`'s ``r`` (the residual ``lam`` over
+        the noise's share) with the weak rows' own quadrature error ``quad`` (Richardson,
+        :func:`quadrature_rows`, along the same unit direction) added to the share:
+        ``1 / (1 / r + quad / lam)``.  Returns that ratio [-] and the equation (terms' units)."""
+        rows = self._rows_of(names, lib, xd, u, fs)
+        with np.errstate(over="ignore", invalid="ignore"):
+            r, w = noise_residual_ratio(rows, x, sigma)
+            if self.formulation != "weak" or not (np.isfinite(r) or r == math.inf) or r == 0.0:
+                return r, w
+            V1 = np.asarray(rows(x), dtype=float)
+            V2 = np.asarray(self._rows_of(names, lib, xd, u, fs, stride=2)(x), dtype=float)
+            norms = np.linalg.norm(V1, axis=0)
+            v = w * norms
+            lam = float(np.sum((V1 @ w) ** 2))
+            quad = float(np.sum((quadrature_rows(V1, V2, self.weak_degree) @ w) ** 2))
+        if not (np.all(np.isfinite(v)) and math.isfinite(quad) and lam > 0.0):
+            return r, w
+        return 1.0 / (1.0 / r + quad / lam), w
 
     def _prune_at_noise(self, data: Measurement, lib: ImplicitTerms, x: np.ndarray,
                         xd: np.ndarray, u: np.ndarray | None, G_val: np.ndarray,
@@ -1004,9 +1073,8 @@ class SINDyPIDynamical(Identifier):
                 rest = [i for i in support if i != j]
                 if not np.any(np.isin(rest, deriv_cols[k])):
                     continue
-                with np.errstate(over="ignore", invalid="ignore"):
-                    r, w = noise_residual_ratio(
-                        self._rows_of([lib.names[i] for i in rest], lib, xd, u, data.fs), x, sigma)
+                r, w = self._floor_ratio([lib.names[i] for i in rest], lib, x, xd, u, data.fs,
+                                         sigma)
                 if not np.isfinite(r):
                     continue
                 w_full = np.zeros(len(lib.names))
@@ -1069,7 +1137,9 @@ class SINDyPIDynamical(Identifier):
         self.noise_prune_rule_ = (
             f"weak form, noise std {', '.join(f'{v:.3g}' for v in sigma)}: a term goes while the "
             f"best equation of the others is within {NOISE_PRUNE_RATIO:g} x the residual the "
-            f"noise alone leaves it, in equations the record determines "
+            f"noise and the weak rows' own quadrature error leave it (Richardson: every second "
+            f"sample against every sample, O(h^{quadrature_order(self.weak_degree)})), in "
+            f"equations the record determines "
             f"({'; '.join(ratios) or 'no equation of more than two terms'})")
         return any(self.noise_prune_)
 
