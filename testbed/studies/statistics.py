@@ -68,6 +68,8 @@ def failure_kind(error: str) -> list[str]:
     """
     if not error:
         return []
+    if error.startswith("process ended: "):  # testbed.studies.sweep.ended_cell_row
+        return ["crash: process ended"]
     m = CRASH_PATTERN.match(error.strip())
     if m:
         return [f"crash: {m.group(1)}"]

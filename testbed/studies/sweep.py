@@ -47,7 +47,7 @@ except ImportError:  # (not on Windows)
 
 from joblib import Parallel, delayed, parallel_config
 
-from testbed.core.atomic import not_regular
+from testbed.core.atomic import atomic_write_text, not_regular
 from testbed.core.errors import IdentificationError, InputError, show_value
 from testbed.core.provenance import git_commit, versions
 from testbed.pipeline.cache import DatasetCache
@@ -325,9 +325,66 @@ OWN_COLUMNS = ("study", "cell", "scenario", "rig", "noise", "seed", "identifier"
                "data_time", "cell_time", "dataset_hash")
 
 
+#: A sweep run in this process (``jobs`` 1) whose process ended inside the same cell this many
+#: times in a row, leaving no row (``os.abort``, a signal, a crash in compiled code, ``kill -9``:
+#: nothing in the process can record it), records that cell as failed instead of running it
+#: again; one such end is not enough, since a user's ``kill -9`` of a long cell is one too, and
+#: a resumed sweep runs the cell again.  Hostile round 20: a plugin's ``os.abort()`` ended
+#: ``sweep --jobs 1`` with status 134 and no row, and every resume ran the cell and died again.
+ENDS_BEFORE_FAILED = 2
+#: The error text of such a cell (:func:`testbed.studies.statistics.failure_kind`: a crash).
+PROCESS_ENDED = "process ended"
+
+
+def inflight_path(results: str | os.PathLike, key: str) -> Path:
+    """The marker of a cell running in a sequential sweep: ``<results>.parts/<cell>.inflight``,
+    holding how many processes in a row have ended while running it."""
+    return parts_dir(results) / f"{key}.inflight"
+
+
+def _inflight_count(marker: Path) -> int:
+    """How many processes in a row ended inside the marker's cell (0 when there is no marker;
+    an unreadable marker counts as one end, whatever else it holds)."""
+    try:
+        return max(1, int(marker.read_text(encoding="ascii").strip()))
+    except FileNotFoundError:
+        return 0
+    except (OSError, ValueError, UnicodeDecodeError):
+        return 1
+
+
+def ended_cell_row(cell: Cell, ends: int, plugins: tuple[str, ...],
+                   provenance: dict[str, str]) -> dict[str, Any]:
+    """The failed row of a cell inside which :data:`ENDS_BEFORE_FAILED` processes in a row
+    ended (see :func:`run_cell`'s ``inflight``)."""
+    row = _base_row(cell)
+    who = (f"code of plugin(s) {', '.join(plugins)} may abort the interpreter or crash it"
+           if plugins else "the interpreter was aborted, crashed or killed")
+    row["status"], row["error"] = "failed", (
+        f"{PROCESS_ENDED}: the sweep's process ended {ends} times in a row while this cell ran, "
+        f"with no verdict ({who}: os.abort, a signal, a crash in compiled code, kill -9); "
+        "`--retry-failed` runs it again")
+    row.update(provenance)
+    row["cell_time"] = math.nan
+    return row
+
+
+def _base_row(cell: Cell) -> dict[str, Any]:
+    """A cell's results row before it runs: its grid columns, status ok and no scores."""
+    sc = cell.scenario
+    return {
+        "study": cell.study, "cell": cell.key, "scenario": sc.name, "rig": sc.rig,
+        "noise": cell.noise, "seed": cell.seed, "identifier": cell.identifier,
+        "params": json.dumps(cell.params, sort_keys=True), "status": "ok", "error": "",
+        "fit_time": math.nan, "data_time": math.nan, "passed": False, "checks": "[]",
+        "dataset_hash": "",
+    }
+
+
 def run_cell(cell: Cell, cache_dir: str, plugins: tuple[str, ...],
              parent: int | None = None, provenance: dict[str, str] | None = None,
-             same_as: dict[str, Any] | None = None) -> dict[str, Any]:
+             same_as: dict[str, Any] | None = None,
+             inflight: Path | None = None) -> dict[str, Any]:
     """Run one cell (dataset from the cache, identify, score) and return its results row.
 
     Never raises for a failing cell: an exception, or a non-finite score, gives
@@ -337,18 +394,27 @@ def run_cell(cell: Cell, cache_dir: str, plugins: tuple[str, ...],
     process's own.  ``same_as``: the finished row of a cell of the same
     :func:`shared_computation`; the cell's dataset is loaded (for its own ``dataset_hash``) and
     every other column but :data:`OWN_COLUMNS` is copied from it (its scores, verdict, fit time
-    and the commit that computed them).
+    and the commit that computed them).  ``inflight``: the cell's marker
+    (:func:`inflight_path`, a sweep run in this process), counted up before the cell runs and
+    removed after, whatever Python code ends it (an exception, Ctrl-C, SIGTERM's clean exit):
+    only a process that ended inside the cell leaves it.
     """
+    if inflight is None:
+        return _run_cell(cell, cache_dir, plugins, parent, provenance, same_as)
+    atomic_write_text(inflight, str(_inflight_count(inflight) + 1))
+    try:
+        return _run_cell(cell, cache_dir, plugins, parent, provenance, same_as)
+    finally:
+        inflight.unlink(missing_ok=True)
+
+
+def _run_cell(cell: Cell, cache_dir: str, plugins: tuple[str, ...], parent: int | None,
+              provenance: dict[str, str] | None, same_as: dict[str, Any] | None) -> dict[str, Any]:
+    """:func:`run_cell` without its marker."""
 
     t0 = time.perf_counter()
     sc = cell.scenario
-    row: dict[str, Any] = {
-        "study": cell.study, "cell": cell.key, "scenario": sc.name, "rig": sc.rig,
-        "noise": cell.noise, "seed": cell.seed, "identifier": cell.identifier,
-        "params": json.dumps(cell.params, sort_keys=True), "status": "ok", "error": "",
-        "fit_time": math.nan, "data_time": math.nan, "passed": False, "checks": "[]",
-        "dataset_hash": "",
-    }
+    row = _base_row(cell)
     try:
         _prepare_worker(plugins, parent)
 
@@ -678,6 +744,16 @@ def _run_locked(study: Study, jobs: int, dask_address: str | None, results: Path
                          f"not {study.name!r}; expected a results file of study {study.name!r} or "
                          "a new path (its rows would be dropped)")
     _check_rows_match_cells(previous, cells, results)
+    provenance = sweep_provenance()  # one commit and set of versions for every row of this sweep
+    # cells inside which processes kept ending (run_cell's inflight): recorded failed, not run again
+    for c in cells:
+        marker = inflight_path(results, c.key)
+        ends = _inflight_count(marker) if marker.exists() else 0
+        if ends >= ENDS_BEFORE_FAILED and not any(r["cell"] == c.key for r in previous):
+            row = ended_cell_row(c, ends, study.plugins, provenance)
+            write_part(results, row)
+            previous.append(row)
+            marker.unlink(missing_ok=True)
     done = {r["cell"] for r in previous if not (retry_failed and r["status"] == "failed")}
     todo = [c for c in cells if c.key not in done]
     skipped = study.skipped()
@@ -697,8 +773,6 @@ def _run_locked(study: Study, jobs: int, dask_address: str | None, results: Path
         if p not in missing and not p.is_file():
             missing[p] = noise_free_scenario(c.scenario)
     stats.datasets = len(missing)
-    # one commit and one set of versions for every row of this sweep, whichever process runs it
-    provenance = sweep_provenance()
     # One computation per shared_computation key: a cell whose key already has a finished row
     # (from an earlier run) or another cell to compute it is a copy of that row
     finished = {r["cell"]: r for r in previous if r["cell"] in done}
@@ -755,14 +829,20 @@ def _run_locked(study: Study, jobs: int, dask_address: str | None, results: Path
                     bar.advance(row["status"] != "ok")
 
             try:
-                record(parallel(run_cell, [(c, cache_path, study.plugins, parent, provenance)
-                                           for c in compute], n_jobs))
+                # in this process, each cell marked while it runs (run_cell's ``inflight``)
+                marked = n_jobs == 1 and not dask_address
+
+                def mark(c: Cell) -> Path | None:
+                    return inflight_path(results, c.key) if marked else None
+
+                record(parallel(run_cell, [(c, cache_path, study.plugins, parent, provenance,
+                                            None, mark(c)) for c in compute], n_jobs))
                 # the copies load their own datasets (their dataset_hash), nothing else; the
                 # cells of a source that failed are computed after all
                 second = [(c, cache_path, study.plugins, parent, provenance,
-                           finished[src] if finished[src]["status"] == "ok" else None)
+                           finished[src] if finished[src]["status"] == "ok" else None, mark(c))
                           for src, cs in copies.items() for c in cs]
-                stats.copied = sum(a[-1] is not None for a in second)
+                stats.copied = sum(a[5] is not None for a in second)  # (same_as)
                 record(parallel(run_cell, second, n_jobs))
             except Exception as e:  # (loky's TerminatedWorkerError, not imported for this)
                 if type(e).__name__ != "TerminatedWorkerError" or not study.plugins:

@@ -321,6 +321,15 @@ class FaultFit(Identifier):
         return [f"ddth{i + 1} = {-k:.{precision}g} th{i + 1}" for i, k in enumerate(self.k_)]
 
 
+@IDENTIFIERS.register("fault_abort")
+class FaultAbort(FaultFit):
+    def pause(self):
+        if os.environ.get("FAULT_ABORT"):  # the interpreter ends (SIGABRT): no Python runs after
+            os.abort()
+        if os.environ.get("FAULT_INTERRUPT"):
+            raise KeyboardInterrupt
+
+
 @IDENTIFIERS.register("fault_slow")
 class FaultSlow(FaultFit):
     def pause(self):
@@ -602,6 +611,43 @@ def test_kill_9_of_a_two_worker_sweep_leaves_no_worker_and_resumes_exactly(fault
     # changes it between them); within one sweep every row carries one commit
     assert _comparable(resumed, ("commit",)) == _comparable(whole, ("commit",))
     assert len({r["commit"] for r in whole}) == 1
+
+
+def test_a_cell_whose_process_keeps_ending_is_recorded_failed_not_run_forever(fault_dir, tmp_path,
+                                                                              monkeypatch):
+    """`sweep --jobs 1` of a plugin whose fit calls os.abort(): status 134, no row (hostile round
+    20); every resume ran the cell and died again.  A cell inside which two processes in a row
+    ended is recorded failed, naming it; a Ctrl-C in a cell leaves no marker (so an interrupted
+    sweep only ever resumes), and the cells that finished are kept."""
+    from testbed.studies.statistics import failure_kind
+    from testbed.studies.sweep import ENDS_BEFORE_FAILED, expand, inflight_path
+
+    study = _study(fault_dir, "aborting", ["fault_fit", "fault_abort"], seeds=(0,), noise=(0.0,))
+    (key,) = [c.key for c in expand(load_study(study)) if c.identifier == "fault_abort"]
+    res, cache = tmp_path / "r.parquet", tmp_path / "cache"
+    cmd = [sys.executable, "-c", "from testbed.studies.sweep import run_sweep; "
+           f"run_sweep({str(study)!r}, results={str(res)!r}, cache_dir={str(cache)!r})"]
+    for end in range(1, ENDS_BEFORE_FAILED + 1):
+        out = subprocess.run(cmd, cwd=ROOT, env=_env(FAULT_ABORT="1"), capture_output=True,
+                             text=True, timeout=120)
+        assert out.returncode == -signal.SIGABRT, out.stderr
+        rows = read_results(res, resuming=True)
+        assert [r["identifier"] for r in rows] == ["fault_fit"]  # the finished cell is kept
+        assert [p.name for p in parts_dir(res).glob("*.inflight")] == [f"{key}.inflight"]
+        assert inflight_path(res, key).read_text() == str(end)
+    cells = {r["identifier"]: r for r in read_results(run_sweep(
+        load_study(study), results=res, cache_dir=cache, verbose=False))}
+    assert cells["fault_fit"]["status"] == "ok"
+    failed = cells["fault_abort"]
+    assert failed["status"] == "failed" and failure_kind(failed["error"]) == ["crash: process ended"]
+    assert f"ended {ENDS_BEFORE_FAILED} times in a row" in failed["error"] and "faults.py" in failed["error"]
+    assert not parts_dir(res).exists()
+    # a Python-level end (Ctrl-C) in the cell leaves no marker: the next run runs it again
+    res2 = tmp_path / "r2.parquet"
+    monkeypatch.setenv("FAULT_INTERRUPT", "1")
+    with pytest.raises(KeyboardInterrupt):
+        run_sweep(load_study(study), results=res2, cache_dir=cache, verbose=False)
+    assert not list(parts_dir(res2).glob("*.inflight"))
 
 
 # --------------------------------------------------------------------------- run folders
