@@ -911,15 +911,23 @@ def psd_damping_warm_start(M: np.ndarray, C: np.ndarray, K: np.ndarray) -> np.nd
 def _physical_placed(sig: list[np.ndarray], m_hat: float, top_hz: float, peaks: np.ndarray
                      ) -> tuple[np.ndarray, np.ndarray, np.ndarray, str] | None:
     """:func:`unresolved_warm_start` on the fit's signals ``sig`` (``[x'', x', x, ...]``),
-    if it acts and the model it gives is physical (:func:`identify.structural.check_physical`);
-    else None."""
+    if it acts and the model it gives is physical (:func:`identify.structural.check_physical`),
+    or is physical with its damping projected (:func:`psd_damping_warm_start`); else None."""
     placed = unresolved_warm_start(*sig[:3], m_hat, top_hz, peaks)
     if placed is None:
         return None
     try:
         check_physical(*placed[:3], "the warm start with its unresolved modes placed")
     except IdentificationError:
-        return None
+        # a resolved mode's own damping fitted negative (b19_st_s5_hitmid: the 2241 Hz mode,
+        # a pole at +4096 +1.35e4j 1/s): the damping's projection, as for the tilted warm
+        # start (psd_damping_warm_start), kept when the model is then physical
+        C = psd_damping_warm_start(*placed[:3])
+        if C is None:
+            return None
+        return (placed[0], C, placed[2],
+                placed[3] + "; the damping then projected onto the positive semi-definite "
+                "cone (a resolved mode's damping was fitted negative)")
     return placed
 
 
