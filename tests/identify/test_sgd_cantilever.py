@@ -8,6 +8,7 @@ The dataset is generated once per session through the shared ``dataset_cache`` f
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import numpy as np
@@ -133,3 +134,22 @@ def test_a_mode_1_the_band_removed_is_refitted_without_the_band(dataset_cache):
     assert model.record_rule_.startswith("the kept model explains its record")
     f_true = np.asarray(ds.truth["frequencies_hz"])[:2]
     np.testing.assert_allclose(model.natural_frequencies_[:2], f_true, rtol=0.01)  # issue #15
+
+
+def test_a_mode_the_others_outlive_has_its_target_lowered_by_their_stiffening(dataset_cache):
+    """Round 19's b19_soft_r8_cf2_f75 (the shipped beam on k1 = 8 EI/L, cubic fraction 2, 75
+    N), clean: mode 2's peak (466.2 Hz) rings hardened by mode 1's motion, which outlives it
+    (measured decay rates 4.34 and 199.4 1/s), and its own chirp, read by the backbone decay
+    fit, holds only part of it (backbone 462.8 Hz; the engine's linear mode 2 446.9 Hz).  The
+    cross stiffening was subtracted only from modes whose decay does not chirp, so the model's
+    mode 2 was 2.90 % off.  Now a mode the other located modes outlive has it subtracted too
+    (14.6 Hz): measured 0.11 % off, TRAC 0.983 -> 0.992."""
+    sc = load_scenario(ROUND19 / "b19_soft_r8_cf2_f75.toml")
+    ds = dataset_cache.get(sc)
+    data = measure(ds, sc.signal, "structural")
+    model = SGDSINDy().fit(data)
+    assert re.search(r"other modes' motion over each mode's life: modes \[1, 2\]",
+                     model.eigen_backbone_rule_)
+    v = score_structural(ds, data, measure(noise_free(ds), sc.signal, "structural"), model).values
+    # issue #15's 1 % bar on mode 2 (the old code 2.90 %) and TRAC 0.95
+    assert abs(v["freq_error_mode2"]) <= 0.01 and v["trac"] >= 0.95
