@@ -4,6 +4,7 @@ function.  Read from the source with ``ast``, so the test holds for every import
 not."""
 
 import ast
+import functools
 from pathlib import Path
 
 import pytest
@@ -35,7 +36,8 @@ def module_name(path: Path) -> str:
     return ".".join(parts)
 
 
-def imports(path: Path) -> list[tuple[str, bool]]:
+@functools.cache  # each source is read by up to three of the tests below: parsed once a process
+def imports(path: Path) -> tuple[tuple[str, bool], ...]:
     """(imported module, inside a function?) for every import statement of the file."""
     tree = ast.parse(path.read_text())
     out = []
@@ -53,7 +55,7 @@ def imports(path: Path) -> list[tuple[str, bool]]:
             visit(child, fn)
 
     visit(tree, False)
-    return out
+    return tuple(out)
 
 
 SOURCES = sorted(p for pkg in ("testbed", "models", "identify") for p in (ROOT / pkg).rglob("*.py"))
