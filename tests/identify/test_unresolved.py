@@ -126,9 +126,10 @@ def test_a_resolved_negative_stiffness_is_no_placement():
 def test_a_growing_mode_no_peak_located_inside_the_band_is_placed_only_when_asked():
     """A mode inside the band with negative own damping and no accepted peak near it (round
     20's b20_gf_s4tip at 0.5 %: the fit's mode 2 at 265 Hz between peaks at 51.9 and 323.5 Hz)
-    is one the record does not resolve: with ``in_band`` (ls_sindy's step 5) it is placed at
+    is one the record does not resolve: with the band's lower edge (ls_sindy's step 5) it is placed at
     the top, the located modes kept (to rounding, 1e-9); without (sgd_sindy's warm start)
-    nothing is placed, as before; a growing mode a peak located is not placed."""
+    nothing is placed, as before; a growing mode a peak located, or one below the band's lower
+    edge, is not placed."""
     w2 = (2 * np.pi * np.array([100.0, 300.0, 500.0])) ** 2
     M, C, K = _model(w2, np.random.default_rng(20))
     lam, Phi = stiffness_eigenvalues(M, K)
@@ -139,15 +140,18 @@ def test_a_growing_mode_no_peak_located_inside_the_band_is_placed_only_when_aske
         check_physical(M, C, K)
     peaks = np.array([100.0, 500.0])
     assert place_unresolved(M, C, K, 2000.0, peaks) is None
-    C2, K2, rule = place_unresolved(M, C, K, 2000.0, peaks, in_band=True)
+    C2, K2, rule = place_unresolved(M, C, K, 2000.0, peaks, band_low_hz=20.0)
     check_physical(M, C2, K2)
     np.testing.assert_allclose(modal(M, K2)[0], [100.0, 500.0, 2000.0], rtol=1e-9)
     assert "inside the band" in rule and "300 Hz" in rule
     # located by a peak (a lightly damped mode the record shows): the record's own, not placed
-    assert place_unresolved(M, C, K, 2000.0, np.array([100.0, 300.0, 500.0]), in_band=True) is None
+    three = np.array([100.0, 300.0, 500.0])
+    assert place_unresolved(M, C, K, 2000.0, three, band_low_hz=20.0) is None
+    # below the peak band (under the chain's high-pass no mode shows a peak): not placed
+    assert place_unresolved(M, C, K, 2000.0, peaks, band_low_hz=400.0) is None
     # a decaying unlocated mode is no contradiction: not placed
     C = M @ Phi @ np.abs(d) @ np.linalg.inv(Phi)
-    assert place_unresolved(M, C, K, 2000.0, peaks, in_band=True) is None
+    assert place_unresolved(M, C, K, 2000.0, peaks, band_low_hz=20.0) is None
 
 
 def test_ls_sindy_places_a_growing_mode_between_two_peaks(dataset_cache):
