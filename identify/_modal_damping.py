@@ -515,7 +515,8 @@ def _decay_fit(q: np.ndarray, t: np.ndarray, sigma0: float, w: float, backbone: 
 
 def modal_decay(data: Measurement, M: np.ndarray, K: np.ndarray, C: np.ndarray,
                 window: tuple[int, int], backbone: bool = False,
-                unlocated: np.ndarray | None = None) -> ModalDecay:
+                unlocated: np.ndarray | None = None,
+                free_peaks_hz: np.ndarray | None = None) -> ModalDecay:
     """Each mode's decay rate and damped frequency fitted to its measured free decay.
 
     Parameters
@@ -539,6 +540,14 @@ def modal_decay(data: Measurement, M: np.ndarray, K: np.ndarray, C: np.ndarray,
         (:func:`_unlocated_fit`, after the located modes, whose decays it profiles out) between
         the midpoints to the neighbouring modes (:func:`unlocated_band`): module docstring,
         "Unlocated modes".  Default none.
+    free_peaks_hz : ndarray, shape (m,), optional
+        Accepted spectral peaks [Hz] (as measured, not warped) no mode was paired with.  An
+        unlocated mode (without ``backbone``) whose :func:`unlocated_band` holds exactly one of
+        them is fitted on every channel at once from that peak, its modal coordinate's own fit
+        not taken: the peak is measured, the model's frequency of the mode is what the pairing
+        found wrong (round 20's ``r20_stiff__002`` at 1 %: mode 1 10.79 Hz, peak 10.81 Hz, the
+        tilted fit's 29.83 Hz; the modal coordinate's decay fit converged at 29.14 Hz and was
+        taken).  None: no such start.
 
     Returns
     -------
@@ -571,7 +580,14 @@ def modal_decay(data: Measurement, M: np.ndarray, K: np.ndarray, C: np.ndarray,
         s, wd, r2, ok, c, amp = _decay_fit(q[k], t, 0.5 * d[k], w[k], backbone, nuisance)
         out.r2[k] = r2
         paired = abs(np.log(wd / w[k])) <= np.log1p(MODE_SEPARATION)
-        if free[k] and not backbone and not (ok and paired):
+        peak = _free_peak(free_peaks_hz, w, k, data, i1 - i0) if free[k] and not backbone \
+            else None
+        if peak is not None:  # from the measured peak no mode took (free_peaks_hz)
+            s, wd, ok = _unlocated_fit(xdd[:, i0:i1], t, (0.5 * abs(d[k]), peak),
+                                       unlocated_band(w, k, peak_band(data, i1 - i0)[0]),
+                                       nuisance, fits)
+            paired = True
+        elif free[k] and not backbone and not (ok and paired):
             # no peak located it and its modal coordinate's fit is not taken: every channel's
             # record, between its neighbours (module docstring, "Unlocated modes")
             s, wd, ok = _unlocated_fit(xdd[:, i0:i1], t, (s, wd) if ok else (0.5 * d[k], w[k]),
@@ -591,6 +607,18 @@ def modal_decay(data: Measurement, M: np.ndarray, K: np.ndarray, C: np.ndarray,
             if backbone:
                 out.chirp[k], out.amplitude[k] = c, amp
     return out
+
+
+def _free_peak(free_peaks_hz: np.ndarray | None, w: np.ndarray, k: int, data: Measurement,
+               n_window: int) -> float | None:
+    """The one accepted peak no mode took inside mode ``k``'s :func:`unlocated_band` [rad/s]
+    (``w`` the model's undamped frequencies [rad/s]), or None (none, or more than one)."""
+    if free_peaks_hz is None or len(free_peaks_hz) == 0:
+        return None
+    lo, hi = unlocated_band(w, k, peak_band(data, n_window)[0])
+    p = 2.0 * np.pi * np.asarray(free_peaks_hz, dtype=float)
+    inside = p[(p >= lo) & (p <= hi)]
+    return float(inside[0]) if inside.size == 1 else None
 
 
 def _unlocated_fit(x: np.ndarray, t: np.ndarray, start: tuple[float, float],
@@ -780,7 +808,8 @@ def decay_hold(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndarray,
                set_frequencies: Callable[[np.ndarray, np.ndarray], np.ndarray],
                enabled: bool = True, K3: np.ndarray | None = None,
                backbone: bool = True, unlocated: np.ndarray | None = None,
-               peaks_hz: np.ndarray | None = None) -> DecayHold:
+               peaks_hz: np.ndarray | None = None,
+               free_peaks_hz: np.ndarray | None = None) -> DecayHold:
     """The decay hold of ``sgd_sindy`` and ``ls_sindy`` on a fitted linear model.
 
     Each mode gets the damping of its measured free decay (:func:`modal_decay`,
@@ -841,6 +870,8 @@ def decay_hold(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndarray,
         the mode is the one that does not (clamped family member 009, ``sgd_sindy``: peak
         72.32 Hz, decay 72.33 Hz, the fit's 70.29 Hz, 2.04 Hz away against one line of 2.03).
         None: every frequency moves within one line of the model's only.
+    free_peaks_hz : ndarray, shape (m,), optional
+        Accepted peaks [Hz] no mode was paired with (:func:`modal_decay`; ``ls_sindy`` only).
 
     Returns
     -------
@@ -856,7 +887,7 @@ def decay_hold(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndarray,
     if i0 == 0 and forced:  # free_start = 0 with an input: a continuous excitation
         return DecayHold(C, K, None, "continuous input (free_start = 0): the fit's")
     with_backbone = K3 is not None  # a cubic model's decay: the backbone fit
-    dec = modal_decay(data, M, K, C, window, with_backbone, unlocated)
+    dec = modal_decay(data, M, K, C, window, with_backbone, unlocated, free_peaks_hz)
     if not np.any(dec.taken):
         return DecayHold(C, K, dec, "modal decay fits: none taken, the fit's")
     line = float(data.fs) / (i1 - i0)
@@ -905,6 +936,15 @@ def decay_hold(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndarray,
         if np.any(own):
             C2, cut = _hold_couplings(M, C, K, K2, sigma, dec.taken, line)
     kept, fixed = np.flatnonzero(~dec.taken & ~own) + 1, np.flatnonzero(on) + 1
+    from_peak: dict[int, float] = {}  # modes fitted from a peak no mode took (modal_decay)
+    if free_peaks_hz is not None and unlocated is not None and not with_backbone:
+        w_fit = 2.0 * np.pi * modal(M, K)[0]
+        if data.integration == "trapezoid":  # as modal_decay compares them
+            w_fit = 2.0 * float(data.fs) * np.arctan(w_fit / (2.0 * float(data.fs)))
+        for k in np.flatnonzero(np.asarray(unlocated, bool) & dec.taken):
+            p = _free_peak(free_peaks_hz, w_fit, int(k), data, i1 - i0)
+            if p is not None:
+                from_peak[int(k) + 1] = p / (2.0 * np.pi)
     rule = ("each mode's damping from its measured free decay (modal accelerations "
             "Phi^-1 x'', fitted exp(-sigma t) sinusoid"
             + (" beside the signal chain's declared filter transients"
@@ -923,6 +963,9 @@ def decay_hold(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndarray,
                   "the midpoints to their neighbouring modes"
                   if np.any(on & free) and not with_backbone else "")
                + ")" if fixed.size else "")
+            + (f"; modes {list(from_peak)} fitted from the accepted peak no mode was paired "
+               f"with ({', '.join(f'{v:.4g}' for v in from_peak.values())} Hz)"
+               if from_peak else "")
             + (f"; modes {(np.flatnonzero(beyond) + 1).tolist()} kept the fit's frequency (the "
                f"decay's lies beyond one line of it, within the spectral-peak offset: a cubic "
                f"model's frequency stands at no peak)" if np.any(beyond) else "")

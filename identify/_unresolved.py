@@ -23,6 +23,18 @@ at most: two at the one top would be a repeated eigenvalue whose shapes round-of
 damped with no resonant peak (:data:`UNRESOLVED_ZETA`: no accepted peak shows it ringing) and uncoupled in
 damping from the other modes, its shape kept. Its contribution in the band is then the
 quasi-static one of a stiff, fast mode; the resolved modes keep what the fit gave them.
+
+Inside the band (``band_low_hz`` given, ``ls_sindy``'s step 5 only; :func:`unlocated_growing`):
+where no mode reaches beyond the top, a mode inside the peak band that no accepted peak locates
+and whose own modal damping is negative is unresolved as well.  A mode with no damping of its
+own rings through the whole free decay and would show a spectral peak; none lies near it, so the
+record does not hold it where the fit put it (round 20, four sensors, three or two peaks: least
+squares put the mode the record cannot resolve between the peaks of modes 1 and 2 with a growing
+pole, while the truth's unlocated modes lie above the located ones, 17-34 % damped).  It is
+placed as above.  Not below the band's lower edge: the chain's high-pass attenuates a mode
+there, so no peak is no contradiction (round 19's ``b19_br_L0p8_n14_z2_f150_2s``: mode 1 at 8.65
+Hz under a 10 Hz high-pass, fitted growing at 8.46 Hz; placing it at the top put mode 1 1870 %
+off).
 """
 
 from __future__ import annotations
@@ -77,7 +89,8 @@ def modal_pole_reach(M: np.ndarray, C: np.ndarray, K: np.ndarray) -> np.ndarray:
 
 
 def place_unresolved(M: np.ndarray, C: np.ndarray, K: np.ndarray, top_hz: float,
-                     peaks: np.ndarray) -> tuple[np.ndarray, np.ndarray, str] | None:
+                     peaks: np.ndarray, band_low_hz: float | None = None
+                     ) -> tuple[np.ndarray, np.ndarray, str] | None:
     """The model with its unresolved modes placed at the band's top (module docstring).
 
     Parameters
@@ -88,6 +101,11 @@ def place_unresolved(M: np.ndarray, C: np.ndarray, K: np.ndarray, top_hz: float,
         The peak search's band top [Hz] (:func:`identify.structural.peak_band`).
     peaks : ndarray, shape (k,)
         Accepted spectral peaks [Hz].
+    band_low_hz : float, optional
+        The peak band's lower edge [Hz].  Given, where no mode reaches beyond the top, the
+        modes of :func:`unlocated_growing` inside ``[band_low_hz, top_hz]`` are the unresolved
+        ones (module docstring; ``ls_sindy``'s step 5).  None (``sgd_sindy``'s warm start):
+        beyond the top only.
 
     Returns
     -------
@@ -101,6 +119,11 @@ def place_unresolved(M: np.ndarray, C: np.ndarray, K: np.ndarray, top_hz: float,
         return None
     lam, Phi = stiffness_eigenvalues(M, K)
     bad = modal_pole_reach(M, C, K) > 2.0 * np.pi * top_hz
+    where = f"a pole beyond the peak band's top {top_hz:.4g} Hz) placed at that top"
+    if band_low_hz is not None and not np.any(bad):
+        bad = unlocated_growing(M, C, K, peaks, (float(band_low_hz), top_hz))
+        where = ("negative own damping inside the band, where no accepted peak located it) "
+                 f"placed at the peak band's top {top_hz:.4g} Hz")
     # one mode only: two or more placed at the one top would be a repeated eigenvalue whose
     # shapes round-off decides (on a non-symmetric warm start, 7 of 200 random 4-DOF models
     # with two modes above the top ended in a singular eigenvector matrix: session 18's review)
@@ -126,8 +149,49 @@ def place_unresolved(M: np.ndarray, C: np.ndarray, K: np.ndarray, top_hz: float,
         return None
     what = ", ".join("a negative stiffness" if v <= 0 else f"{np.sqrt(v) / (2 * np.pi):.4g} Hz"
                      for v in lam[bad])
-    rule = (f"{n_bad} mode(s) the record cannot resolve (fitted with {what}, a pole beyond the "
-            f"peak band's top {top_hz:.4g} Hz) placed at that top, damping ratio "
+    rule = (f"{n_bad} mode(s) the record cannot resolve (fitted with {what}, {where}, "
+            f"damping ratio "
             f"{UNRESOLVED_ZETA:g}, shapes kept; the {lam.size - n_bad} resolved modes carry "
             f"every accepted peak")
     return C2, K2, rule
+
+
+def unlocated_growing(M: np.ndarray, C: np.ndarray, K: np.ndarray, peaks: np.ndarray,
+                      band_hz: tuple[float, float]) -> np.ndarray:
+    """Modes of the fit inside the peak band that no accepted peak located and whose own modal
+    damping is negative.
+
+    A mode inside the peak band with no damping of its own (``d_k < 0``, the diagonal of
+    ``Phi^-1 M^-1 C Phi``) would ring through the whole free decay and show a spectral peak;
+    where no accepted peak lies within :data:`~identify.structural.MODE_SEPARATION` of its
+    frequency the record contradicts it: it is a mode the record does not resolve, fitted where
+    least squares put it (measured, round 20: ``b20_gf_s4tip`` 0.5 % seed 111, the tilted fit's
+    mode 2 at 265 Hz with a growing pole, between peaks at 51.9 and 323.5 Hz, while the
+    truth's unlocated mode 4 lies at 1778 Hz, 34 % damped; ``b20_st_s4root_tip`` 1 % seed 118,
+    mode 2 at 391 Hz between peaks 82.8 and 519.4 Hz, the truth's unlocated modes at 1447 and
+    2835 Hz).
+
+    Parameters
+    ----------
+    M, C, K : ndarray, shape (n, n)
+        The fitted mass [kg], damping [N s/m] and stiffness [N/m] (need not be symmetric).
+    peaks : ndarray, shape (k,)
+        Accepted spectral peaks [Hz].
+    band_hz : (float, float)
+        The peak search's band [Hz] (:func:`identify.structural.peak_band`): a mode outside it
+        shows no peak whatever its damping (below, the chain's high-pass attenuates it).
+
+    Returns
+    -------
+    ndarray of bool, shape (n,)
+        In :func:`identify.structural.modal`'s order; False for a non-positive stiffness
+        eigenvalue (the band-top rule's case).
+    """
+    lam, Phi = stiffness_eigenvalues(M, K)
+    d = np.diag(_modal_damping_matrix(M, C, Phi, _is_symmetric(M, C, K))).real
+    f = np.sqrt(np.maximum(lam, 0.0)) / (2.0 * np.pi)
+    p = np.asarray(peaks, dtype=float)
+    located = np.array([p.size > 0 and bool(np.any(np.abs(fk / p - 1.0) <= MODE_SEPARATION))
+                        for fk in f])
+    inside = (f >= band_hz[0]) & (f <= band_hz[1])
+    return (lam > 0.0) & inside & ~located & (d < 0.0)
