@@ -681,6 +681,20 @@ EDGE_MAX_SHARE = 0.1
 #: 0.019 rad; trimmed 2.2 s, 0.0065 and 0.0014 rad.  The recorded-rate branch keeps
 #: EDGE_MAX_SHARE (its family figures were measured with it).
 EDGE_MAX_SHARE_DERIVED = 0.25
+#: The excitation cap of that trim (:func:`excitation_trim`): the trimmed span keeps at least
+#: this share of the inputs' power about their mean.  The inertia is identified from the
+#: accelerations the inputs drive; a one-tone record shorter than half the tone's period (the
+#: paper's sine, 1 rad/s, on 3 s) holds its largest accelerations at its ends, where the
+#: motion turns, and a trim of a quarter of the record at each end kept 18 % of that power
+#: (0.75 s of 3 s; "no assembly" at 1.5 %, seeds 111-112).  Half: the trimmed span holds most
+#: of the excitation; not binding on the 10 s sine (2.85 s allowed, 2.2 s used) nor on a
+#: multisine (its power spread evenly: half is kept by any trim of at most a quarter).
+#: Measured (2026-11-28, session 21; docs/known-gaps.md "SINDy-PI: the edge trim of short
+#: one-tone records"): it binds on 9 of the 506 SINDy-PI cells of the shipped five-bars and
+#: cart-poles, the families, rounds 19-20 and the held-out sets (all 3 s / 5 s sines of rounds
+#: 19-20): 7 -> 8 pass; on 23 of rounds 13-18's: 12 -> 14 (one lost); on the new check set
+#: benchmarks/heldout/pi21_sine_short.toml 18 -> 17 (one lost; 3 s median 0.0041 -> 0.0018 rad).
+EDGE_KEEP_EXCITATION = 0.5
 #: Ridge, noisy data included: the 1e-14 round-off safeguard.  A ridge of the order of the
 #: noise the filtered columns keep (noise_rel^2 cutoff / (fs / 2), ~4e-8 at 1 %) was measured
 #: worse on the 30 five-bar members at 1 % noise (26/30 within 0.0501 rad against 30/30):
@@ -772,9 +786,36 @@ RULE_KNOBS = ("column_lowpass_hz", "edge_trim", "ridge", "formulation", "weak_wi
 LHS_INPUT_TERMS = "inputs"
 
 
+def excitation_trim(u: np.ndarray, fs: float, keep: float | None = None) -> float:
+    """The longest edge trim [s] (the same at each end) whose span keeps at least ``keep`` of
+    the inputs' power about their mean (summed over inputs); the half record where the inputs
+    do not vary.
+
+    Parameters
+    ----------
+    u : ndarray, shape (n_inputs, n_samples)
+        Measured inputs [their units].
+    fs : float
+        Sample rate [Hz].
+    keep : float, optional
+        Share of the power the trimmed span keeps, in [0, 1]; default ``EDGE_KEEP_EXCITATION``.
+    """
+    keep = EDGE_KEEP_EXCITATION if keep is None else keep
+    u = np.atleast_2d(np.asarray(u, dtype=float))
+    p = np.sum((u - u.mean(axis=1, keepdims=True)) ** 2, axis=0)
+    n = p.size
+    c = np.concatenate([[0.0], np.cumsum(p)])
+    if not c[-1] > 0:
+        return 0.5 * n / fs
+    i = np.arange((n + 1) // 2)
+    ok = np.flatnonzero(c[n - i] - c[i] >= keep * c[-1])
+    return float(ok.max()) / fs
+
+
 def noise_knobs(x: np.ndarray, fs: float, val_fraction: float, user: dict[str, Any],
                 smoothed: float | None = None, declared: np.ndarray | None = None,
-                passband: tuple[float, float] | None = None, ruled: tuple[str, ...] = ()
+                passband: tuple[float, float] | None = None, ruled: tuple[str, ...] = (),
+                *, inputs: np.ndarray | None = None
                 ) -> tuple[dict[str, Any], str, dict[str, Any]]:
     """SINDy-PI's noise-dependent settings from the angles, and the rule that chose them.
 
@@ -798,7 +839,9 @@ def noise_knobs(x: np.ndarray, fs: float, val_fraction: float, user: dict[str, A
        the record), ridge ``RIDGE_EXACT``, every LHS candidate.
     4. Noisy, rates and accelerations derived by a low-pass chain (``passband[1] < fs / 2``, or
        ``smoothed``): the strong form with the column low-pass and edge trim of item 3 for a declared chain
-       (the trim at most ``EDGE_MAX_SHARE_DERIVED`` of the record); for ``smoothed`` data without a
+       (the trim at most ``EDGE_MAX_SHARE_DERIVED`` of the record, and at most the longest trim
+       whose span keeps ``EDGE_KEEP_EXCITATION`` of the ``inputs``' power about their mean,
+       :func:`excitation_trim`); for ``smoothed`` data without a
        declared pass band the weak form (no acceleration of the noisy angles enters), test functions
        of ``WEAK_PERIODS / band_hz`` seconds (at most half the held-out span), edge trim
        ``EDGE_PERIODS * window / WEAK_PERIODS``; either way ridge ``RIDGE_PER_NOISE_VAR *
@@ -835,9 +878,6 @@ def noise_knobs(x: np.ndarray, fs: float, val_fraction: float, user: dict[str, A
     smoothed : float, optional
         The largest held-out error of a first fit with the exact-data recipe, when it
         exceeded ``EXACT_HOLDOUT_MAX``.
-
-    Returns
-    -------
     declared : ndarray, shape (n_channels,), optional
         White-noise std of each raw angle [rad] as the signal chain declared it
         (``Measurement.noise_std``).
@@ -847,6 +887,12 @@ def noise_knobs(x: np.ndarray, fs: float, val_fraction: float, user: dict[str, A
         Keys of ``user`` set by a rule of the caller, not by the user (the open chain's form
         comparison, :meth:`SINDyPI._open_chain_form`): used as given, not reported as the
         user's.
+    inputs : ndarray, shape (n_inputs, n_samples), optional
+        The measured inputs [their units]: cap the declared chain's edge trim so that the
+        trimmed span keeps ``EDGE_KEEP_EXCITATION`` of their power (:func:`excitation_trim`).
+
+    Returns
+    -------
     knobs : dict
         The settings of ``RULE_KNOBS`` used (``lhs``: None, ``"inputs"`` or the user's list).
     rule : str
@@ -884,6 +930,7 @@ def noise_knobs(x: np.ndarray, fs: float, val_fraction: float, user: dict[str, A
         branch = f"exact data (<= {NOISE_FREE_REL:g}): {form} form, no column filter, no trim"
     else:
         derived = filtered or smoothed is not None
+        capped = ""
         # a declared low-pass chain: the strong form (see the note above WEAK_PERIODS); an
         # undeclared smoother (ends of unknown quality): the weak form
         form = user.get("formulation") or ("weak" if smoothed is not None and not filtered
@@ -900,6 +947,12 @@ def noise_knobs(x: np.ndarray, fs: float, val_fraction: float, user: dict[str, A
             branch = branch.replace("noisy:", f"{state}, rates derived by a low-pass:")
         cap = EDGE_MAX_SHARE_DERIVED if filtered and form == "strong" else EDGE_MAX_SHARE
         trim = min(EDGE_PERIODS / cut, cap * record_s)
+        if filtered and form == "strong" and inputs is not None:
+            keep_trim = excitation_trim(inputs, fs)
+            if keep_trim < trim:
+                trim = keep_trim
+                capped = (f" (capped to keep {EDGE_KEEP_EXCITATION:g} of the inputs' power "
+                          "about their mean)")
         level = max(noise_rel, CHAIN_REL_FLOOR) if filtered else noise_rel
         ridge = max(RIDGE_PER_NOISE_VAR * level**2, RIDGE_EXACT) if derived else RIDGE_EXACT
         lhs = LHS_INPUT_TERMS if derived else None
@@ -910,7 +963,7 @@ def noise_knobs(x: np.ndarray, fs: float, val_fraction: float, user: dict[str, A
                 "edge_trim": trim, "ridge": ridge,
                 "weak_window_s": window if form == "weak" else None, "lhs": lhs,
                 "selection": selection}
-        branch += f", edge trim {trim:.3g} s, ridge {ridge:.3g}"
+        branch += f", edge trim {trim:.3g} s{capped}, ridge {ridge:.3g}"
         if filtered and noise_rel < CHAIN_REL_FLOOR:
             branch += f" (noise below the chain's own error floor {CHAIN_REL_FLOOR:g})"
         if lhs is not None:
@@ -1854,7 +1907,7 @@ class SINDyPI(_ImplicitMechanical):
             user["formulation"], ruled = "weak", ("formulation",)
         knobs, rule, est = noise_knobs(data.x, data.fs, self.val_fraction, user,
                                        getattr(self, "_smoothed", None), data.noise_std,
-                                       data.passband, ruled)
+                                       data.passband, ruled, inputs=data.u)
         if ruled:
             rule += "; weak form: the open chain's form comparison (formulation_rule_)"
         if knobs["lhs"] == LHS_INPUT_TERMS:
