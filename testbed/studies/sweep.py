@@ -47,7 +47,7 @@ except ImportError:  # (not on Windows)
 
 from joblib import Parallel, delayed, parallel_config
 
-from testbed.core.atomic import atomic_write_text, not_regular
+from testbed.core.atomic import atomic_write_text, begin_in_flight, end_in_flight, not_regular
 from testbed.core.errors import IdentificationError, InputError, show_value
 from testbed.core.provenance import git_commit, versions
 from testbed.pipeline.cache import DatasetCache
@@ -402,10 +402,15 @@ def run_cell(cell: Cell, cache_dir: str, plugins: tuple[str, ...],
     if inflight is None:
         return _run_cell(cell, cache_dir, plugins, parent, provenance, same_as)
     atomic_write_text(inflight, str(_inflight_count(inflight) + 1))
+    # a signal's exit that cannot unwind (testbed.core.interrupts.exit_now: SIGTERM while a
+    # compiled kernel runs) removes it too, as it removes the temporary files being written: a
+    # batch scheduler's wall-time kill twice in one slow cell is no crash of the cell
+    begin_in_flight(inflight)
     try:
         return _run_cell(cell, cache_dir, plugins, parent, provenance, same_as)
     finally:
         inflight.unlink(missing_ok=True)
+        end_in_flight(inflight)
 
 
 def _run_cell(cell: Cell, cache_dir: str, plugins: tuple[str, ...], parent: int | None,
@@ -745,16 +750,22 @@ def _run_locked(study: Study, jobs: int, dask_address: str | None, results: Path
                          "a new path (its rows would be dropped)")
     _check_rows_match_cells(previous, cells, results)
     provenance = sweep_provenance()  # one commit and set of versions for every row of this sweep
-    # cells inside which processes kept ending (run_cell's inflight): recorded failed, not run again
+    # cells inside which processes kept ending (run_cell's inflight): recorded failed and not run
+    # again by this invocation, whatever row they had (with --retry-failed a cell that aborts
+    # had its "process ended" row and was run, and died, on every retry, the cells after it
+    # never retried)
+    ended: set[str] = set()
     for c in cells:
         marker = inflight_path(results, c.key)
         ends = _inflight_count(marker) if marker.exists() else 0
-        if ends >= ENDS_BEFORE_FAILED and not any(r["cell"] == c.key for r in previous):
+        if ends >= ENDS_BEFORE_FAILED and not any(r["cell"] == c.key and r["status"] == "ok"
+                                                  for r in previous):
             row = ended_cell_row(c, ends, study.plugins, provenance)
             write_part(results, row)
-            previous.append(row)
+            previous = [r for r in previous if r["cell"] != c.key] + [row]
+            ended.add(c.key)
             marker.unlink(missing_ok=True)
-    done = {r["cell"] for r in previous if not (retry_failed and r["status"] == "failed")}
+    done = ended | {r["cell"] for r in previous if not (retry_failed and r["status"] == "failed")}
     todo = [c for c in cells if c.key not in done]
     skipped = study.skipped()
     _say(f"sweep {study.name}: {len(cells)} cells ({len(skipped) * len(study.noise) * len(study.seeds)} "

@@ -642,12 +642,44 @@ def test_a_cell_whose_process_keeps_ending_is_recorded_failed_not_run_forever(fa
     assert failed["status"] == "failed" and failure_kind(failed["error"]) == ["crash: process ended"]
     assert f"ended {ENDS_BEFORE_FAILED} times in a row" in failed["error"] and "faults.py" in failed["error"]
     assert not parts_dir(res).exists()
+    # --retry-failed runs it again; the second process ending in it records it again, and
+    # that invocation runs the cells after it (it had died in the cell on every retry)
+    retry = [*cmd[:-1], cmd[-1][:-1] + ", retry_failed=True)"]
+    for _ in range(ENDS_BEFORE_FAILED):
+        out = subprocess.run(retry, cwd=ROOT, env=_env(FAULT_ABORT="1"), capture_output=True,
+                             text=True, timeout=120)
+        assert out.returncode == -signal.SIGABRT, out.stderr
+    again = {r["identifier"]: r for r in read_results(run_sweep(
+        load_study(study), results=res, cache_dir=cache, verbose=False, retry_failed=True))}
+    assert again["fault_abort"]["error"] == failed["error"] and again["fault_fit"]["status"] == "ok"
     # a Python-level end (Ctrl-C) in the cell leaves no marker: the next run runs it again
     res2 = tmp_path / "r2.parquet"
     monkeypatch.setenv("FAULT_INTERRUPT", "1")
     with pytest.raises(KeyboardInterrupt):
         run_sweep(load_study(study), results=res2, cache_dir=cache, verbose=False)
     assert not list(parts_dir(res2).glob("*.inflight"))
+
+
+def test_a_cells_marker_is_removed_by_a_signals_exit_that_cannot_unwind(tmp_path, monkeypatch):
+    """SIGTERM while a compiled kernel runs ends the process by `os._exit` after removing what
+    is in flight (testbed.core.interrupts.exit_now -> atomic.remove_in_flight): the cell's
+    marker is in flight while the cell runs, so a scheduler's kill is not counted as the cell's
+    crash (review, session 21: two such kills recorded "process ended")."""
+    from testbed.core import atomic
+    from testbed.studies import sweep
+
+    marker = tmp_path / "r.parquet.parts" / "k.inflight"
+    seen = []
+
+    def cell(*a):
+        seen.append((marker.read_text(), os.fspath(marker) in atomic._IN_FLIGHT))
+        atomic.remove_in_flight()  # what exit_now does before os._exit
+        return {}
+
+    monkeypatch.setattr(sweep, "_run_cell", cell)
+    sweep.run_cell(None, "", (), inflight=marker)
+    assert seen == [("1", True)] and not marker.exists()
+    assert os.fspath(marker) not in atomic._IN_FLIGHT
 
 
 # --------------------------------------------------------------------------- run folders
