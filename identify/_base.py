@@ -50,6 +50,7 @@ import inspect
 import itertools
 import numbers
 import sys
+import typing
 from collections.abc import Callable, Iterator, Mapping
 from dataclasses import fields
 from typing import Any, ClassVar, TextIO
@@ -124,19 +125,29 @@ class Identifier:
     @classmethod
     def declared_hyperparameters(cls) -> dict[str, Field]:
         """``hyperparameters`` if the class declares them; else (an undeclared plugin) fields
-        derived from ``__init__``: the type of each default (any value for a None default).
+        derived from ``__init__``: the type of each default; for a None default the type its
+        annotation names besides None (``list | None``: a list), else any value.
 
         Every identifier of this package declares its own (a conformance test checks it).
         """
         if cls.hyperparameters:
             return cls.hyperparameters
+        plain = {bool: bool, int: int, float: float, str: str, list: list, tuple: list}
+        try:  # annotations (strings under ``from __future__ import annotations``) resolved
+            hints = typing.get_type_hints(cls.__init__)
+        except Exception:  # a name the annotation uses is not importable here: not read
+            hints = {}
         out = {}
         for k, p in inspect.signature(cls.__init__).parameters.items():
             if k == "self" or p.kind in (p.VAR_POSITIONAL, p.VAR_KEYWORD):
                 continue
             d = None if p.default is p.empty else p.default
-            typ = {bool: bool, int: int, float: float, str: str, list: list, tuple: list}.get(
-                type(d), object)
+            typ = plain.get(type(d), object)
+            if d is None:  # ``x: list | None = None`` is a list; unannotated, any value
+                kinds = [a for a in typing.get_args(hints.get(k)) or (hints.get(k),)
+                         if a is not type(None)]
+                typ = plain.get(typing.get_origin(kinds[0]) or kinds[0], object) \
+                    if len(kinds) == 1 else object
             out[k] = Field(typ, list(d) if isinstance(d, tuple) else d)
         return out
 
@@ -215,7 +226,10 @@ class Identifier:
                 continue  # "not given"
             if isinstance(v, (bool, int, float, str, list, dict)) or v is None:
                 given[k] = v
-            elif isinstance(v, _NOT_A_FILE_VALUE) or isinstance(v, Iterator):
+            elif (isinstance(v, _NOT_A_FILE_VALUE) or isinstance(v, Iterator)) and \
+                    getattr(f, "type", object) is not object:
+                # (an undeclared plugin's hyperparameter is typed ``object``, "any value": an
+                # array or a set there is the plugin's own to read, as before)
                 # a number, text or sequence in a form no scenario file holds was "left to the
                 # algorithm" as a Library is: Decimal, Fraction, complex, bytes, an array were
                 # raw TypeErrors inside the fit, a set of lhs terms fitted another model in
@@ -549,6 +563,22 @@ def _guard_fit(fit: Callable[..., Identifier]) -> Callable[..., Identifier]:
     return guarded
 
 
+def _called(model: Identifier, where: str, method: Callable[..., Any], *a: Any,
+            **kw: Any) -> Any:
+    """``method(model, ...)``; a plugin's (a class outside ``identify``) under
+    :func:`~testbed.core.exit_guard.no_process_exit` and its process state kept: the scorer and
+    the run's report call these methods as the pipeline calls its fit, and its ``os._exit(0)``
+    in ``simulate`` (hostile round 20) or ``equations`` (review, session 21) ended `testbed run`
+    with status 0 and no verdict."""
+    if type(model).__module__.partition(".")[0] == "identify":
+        return method(model, *a, **kw)
+    try:
+        with no_process_exit(), kept_process_state(defaults=False):
+            return method(model, *a, **kw)  # (under the caller's own errstate)
+    except ProcessExitCalled as e:
+        raise IdentificationError(f"{where}: {e}") from None
+
+
 def _guard_fitted(name: str, method: Callable[..., Any]) -> Callable[..., Any]:
     """``method`` (one of :data:`FITTED_ONLY`) raising NotFittedError before ``fit``, and
     checking the arguments every implementation shares: ``equations``' precision an integer
@@ -560,7 +590,8 @@ def _guard_fitted(name: str, method: Callable[..., Any]) -> Callable[..., Any]:
     def guarded(self: Identifier, *a: Any, **kw: Any) -> Any:
         where = f"{type(self).__name__}.{name}"
         if name in ("score", "predict_acceleration") and self.kind != "structural":
-            return method(self, *a, **kw)  # NotImplementedError: no explicit acceleration
+            return _called(self, where, method, *a, **kw)  # NotImplementedError: no explicit
+            # acceleration
         if not self.is_fitted():
             raise NotFittedError(f"{where}: {type(self).__name__} is not fitted; call "
                                  "fit(data) first")
@@ -569,14 +600,6 @@ def _guard_fitted(name: str, method: Callable[..., Any]) -> Callable[..., Any]:
             args.integer(where, "precision", precision, low=1, high=17)
         elif name == "simulate":
             _check_simulate_args(self, where, *a, **kw)
-            if type(self).__module__.partition(".")[0] != "identify":  # a plugin's: the scorer
-                # calls it, as the pipeline calls its fit; its os._exit(0) there ended
-                # `testbed run` with status 0 and no verdict (hostile round 20)
-                try:
-                    with no_process_exit(), kept_process_state(defaults=False):
-                        return method(self, *a, **kw)  # (under the scorer's own errstate)
-                except ProcessExitCalled as e:
-                    raise IdentificationError(f"{where}: {e}") from None
         else:
             data = a[0] if a else kw.get("data")
             if not isinstance(data, Measurement):
@@ -586,7 +609,7 @@ def _guard_fitted(name: str, method: Callable[..., Any]) -> Callable[..., Any]:
             if fitted is not None and tuple(data.channels) != tuple(fitted):
                 raise ArgumentError(where, "data.channels", data.channels,
                                     f"expected the fitted channels {tuple(fitted)}")
-        return method(self, *a, **kw)
+        return _called(self, where, method, *a, **kw)
 
     guarded._api_guard = True  # type: ignore[attr-defined]
     return guarded
