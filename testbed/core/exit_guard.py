@@ -5,18 +5,21 @@ sweep with status 0, no verdict and no line (hostile round 19's open item): no P
 after it, so nothing can record the cell.  While :func:`no_process_exit` is entered, a call of
 ``os._exit`` (or ``posix._exit``) made
 
-- by the thread that entered it, or by a thread started while a guard was entered (the user's
-  code's own threads; a thread that ran before, e.g. a sweep worker's parent watchdog, is left
-  alone),
-- in this process (a child it forked, e.g. by ``multiprocessing``, exits as it means to), and
+- by any thread of this process while a guard is entered (the user's code's own threads, a
+  thread pool it keeps across fits included: a thread that ran before the guard was entered was
+  left alone until the review of session 21, which a pool started in the first fit bypassed),
+- in this process (a child it forked, e.g. by ``multiprocessing``, exits as it means to; a
+  child forked inside a guard starts with no guard of its own), and
 - from code outside the ``testbed`` package (the testbed's own ``os._exit``: a signal's exit, a
-  forked drawer's end, is its own)
+  forked drawer's end, the sweep worker's parent watchdog, is its own)
 
 raises :class:`ProcessExitCalled` instead: the fit failed, naming the call, and the run or the
-cell is scored as a failure.  Made in another thread, the call ends that thread (silently, as
-``sys.exit`` there does) and the guarded block raises it when it ends.  Not covered, and cannot
-be from inside the process: ``os.abort``, a signal the code sends itself, a crash in compiled
-code (their status is not 0; a sweep with ``--jobs`` > 1 names the plugin: its worker died).
+cell is scored as a failure.  Made in a thread that entered no guard, the call ends that thread
+(silently, as ``sys.exit`` there does) and every guard entered at that moment raises it when
+it ends (which cell's thread started it is not known: each such cell fails, none passes).  Not
+covered, and cannot be from inside the process: ``os.abort``, a signal the code sends itself, a
+crash in compiled code (their status is not 0; a sweep names the cell), and a thread the code
+leaves running that calls ``os._exit`` after the last guard has ended.
 """
 
 from __future__ import annotations
@@ -30,13 +33,13 @@ from collections.abc import Iterator
 _LOCK = threading.Lock()
 #: Threads (by ident) inside :func:`no_process_exit`, with their depth.
 _GUARDED: dict[int, int] = {}
-#: The pid the first guard was entered in, and the threads (by ident) running then.
+#: The pid the first guard was entered in.
 _PID: list[int] = []
-_BEFORE: set[int] = set()
 #: ``os._exit`` as it was before the first guard was entered (restored when the last leaves).
 _REAL: list = []
-#: Codes of calls intercepted in threads other than a guarded one, not raised yet.
-_PENDING: list = []
+#: Per guarded thread (by ident), the code of a call intercepted in a thread that entered no
+#: guard while it was inside one, not raised yet.
+_PENDING: dict[int, object] = {}
 
 
 class ProcessExitCalled(SystemExit):
@@ -60,14 +63,29 @@ def _guarded_exit(code: object = 0) -> None:
     caller = sys._getframe(1).f_globals.get("__name__", "") or ""
     own = caller == "testbed" or caller.startswith("testbed.")
     me = threading.get_ident()
-    ours = me in _GUARDED or me not in _BEFORE
-    if own or not _PID or os.getpid() != _PID[0] or not ours:
+    if own or not _PID or os.getpid() != _PID[0]:
         real(code)  # type: ignore[arg-type]
-    if me not in _GUARDED:  # the guarded block raises it when it ends; this thread ends by
-        with _LOCK:  # a plain SystemExit, which threading's hook passes over in silence (a
-            _PENDING.append(code)  # subclass's traceback it prints)
+    if me not in _GUARDED:  # every guard entered now raises it when it ends; this thread ends
+        with _LOCK:  # by a plain SystemExit, which threading's hook passes over in silence (a
+            for ident in _GUARDED:  # subclass's traceback it prints)
+                _PENDING.setdefault(ident, code)
         raise SystemExit(code)
     raise ProcessExitCalled(code)
+
+
+def _forget_parents_guards() -> None:
+    """In a child forked inside a guard: the parent's guarded threads do not exist here; put
+    ``os._exit`` back and start with no guard (called under the lock)."""
+    if _PID and _PID[0] != os.getpid():
+        real = _REAL[0]
+        os._exit = real
+        posix = _posix()
+        if posix is not None:
+            posix._exit = real  # type: ignore[attr-defined]
+        _GUARDED.clear()
+        _PENDING.clear()
+        _REAL.clear()
+        _PID.clear()
 
 
 @contextlib.contextmanager
@@ -77,31 +95,34 @@ def no_process_exit() -> Iterator[None]:
     me = threading.get_ident()
     posix = _posix()
     with _LOCK:
+        _forget_parents_guards()
         if not _GUARDED:
             _REAL[:] = [os._exit]
             _PID[:] = [os.getpid()]
-            _BEFORE.clear()
-            _BEFORE.update(t.ident for t in threading.enumerate() if t.ident is not None)
             _PENDING.clear()
             os._exit = _guarded_exit
             if posix is not None:
                 posix._exit = _guarded_exit  # type: ignore[attr-defined]
         _GUARDED[me] = _GUARDED.get(me, 0) + 1
+    raised = False
     try:
         yield
+    except BaseException:
+        raised = True  # the block's own exception goes on; a pending exit is not raised over it
+        raise
     finally:
         with _LOCK:
             _GUARDED[me] -= 1
+            pending = None
             if not _GUARDED[me]:
                 del _GUARDED[me]
-            pending = _PENDING[:1] if _GUARDED.get(me) is None else []
-            del _PENDING[:len(pending)]
+                pending = _PENDING.pop(me, None)
             if not _GUARDED:
                 os._exit = _REAL[0]
                 if posix is not None:
                     posix._exit = _REAL[0]  # type: ignore[attr-defined]
                 _REAL.clear()
                 _PID.clear()
-                _BEFORE.clear()
-    if pending and sys.exc_info()[0] is None:
-        raise ProcessExitCalled(pending[0])
+                _PENDING.clear()
+    if pending is not None and not raised:
+        raise ProcessExitCalled(pending)

@@ -49,16 +49,37 @@ def _status(code: str) -> int:
                           timeout=60).returncode
 
 
-def test_a_thread_started_before_a_forked_childs_and_the_testbeds_own_exit_still_end_it():
-    guard = "import os, threading\nfrom testbed.core.exit_guard import no_process_exit\n"
-    # a thread that ran before the guard (a sweep worker's parent watchdog)
+def test_a_forked_childs_and_the_testbeds_own_exit_still_end_it():
+    guard = ("import os, threading\n"
+             "from testbed.core.exit_guard import ProcessExitCalled, no_process_exit\n")
+    # a thread that ran before the guard, as a plugin's pool kept across fits (review, session
+    # 21: it had been left alone, so a pool started in the first fit bypassed the guard in the
+    # second) is intercepted; the guard raises it as it ends, after os._exit is put back
     assert _status(guard + """
         go = threading.Event()
-        threading.Thread(target=lambda: (go.wait(30), os._exit(5))).start()
-        with no_process_exit():
-            go.set()
-            threading.Event().wait(30)
-        """.replace("\n        ", "\n")) == 5
+        t = threading.Thread(target=lambda: (go.wait(30), os._exit(5)))
+        t.start()
+        try:
+            with no_process_exit():
+                go.set()
+                t.join(30)
+        except ProcessExitCalled as e:
+            os._exit(2 + e.exit_code)
+        """.replace("\n        ", "\n")) == 7
+    # entered inside an except block (the caller's handled exception): raised all the same (it
+    # was dropped: the guard looked at sys.exc_info(), which sees the caller's exception too)
+    assert _status(guard + """
+        try:
+            raise ValueError
+        except ValueError:
+            try:
+                with no_process_exit():
+                    t = threading.Thread(target=os._exit, args=(3,))
+                    t.start()
+                    t.join(30)
+            except ProcessExitCalled:
+                os._exit(8)
+        """.replace("\n        ", "\n")) == 8
     # a child forked inside the guard (multiprocessing's fork ends its child with os._exit)
     assert _status(guard + """
         with no_process_exit():
