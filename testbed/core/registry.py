@@ -222,7 +222,8 @@ class Registry:
             dist = getattr(ep.dist, "name", None)
             self._loading_entry_point = f"entry point {ep.name}" + (f" ({dist})" if dist else "")
             try:
-                obj = ep.load()
+                with no_process_exit(), kept_process_state():  # as import_plugin's import
+                    obj = ep.load()
                 if isinstance(obj, type) and obj not in self._entries.values():
                     name = getattr(obj, "name", "") or ep.name
                     self.register(name, tags=getattr(obj, "tags", ()))(obj)

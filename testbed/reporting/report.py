@@ -662,7 +662,8 @@ def sweep_report(rows: Sequence[dict[str, Any]], out_dir: str | os.PathLike,
                [[i, len(t), float(np.median(t)) if t else None, float(np.max(t)) if t else None]
                 for i in idents for t in [[float(r["fit_time"]) for r in rows if r["identifier"] == i
                                            and _ok(r) and _finite(r.get("fit_time"))]]])
-    page.figure(figs.save_figure(figs.fit_times(ok), out_dir / "fit_time.png"),
+    page.figure(figs.save_figure(figs.fit_times([r for r in rows if _ok(r)]),  # as the table
+                                 out_dir / "fit_time.png"),
                 "Fit time per identifier over all cells that ran.")
     if errors:
         page.heading("Cells that failed to run")

@@ -393,7 +393,7 @@ def out_of_band_failures(scores: Scores, thresholds: dict[str, dict[str, float]]
             out.append(f"mode {k} ({f:.4g} Hz) lies below the signal chain's high-pass cut-off "
                        f"({lo:.4g} Hz; signal.highpass_hz)")
             cut += 1
-        elif alias is not None and alias <= hi:  # sampled above Nyquist, folded into the band
+        elif alias is not None and lo <= alias <= hi:  # above Nyquist, folded into the band
             out.append(f"mode {k} ({f:.4g} Hz) lies above the Nyquist frequency "
                        f"({float(fs) / 2:.4g} Hz) and the record holds it folded to "
                        f"{alias:.4g} Hz, inside the pass band (simulation.sample_rate)")
@@ -416,7 +416,7 @@ def out_of_band_failures(scores: Scores, thresholds: dict[str, dict[str, float]]
 
 
 def aliased_frequency(f: float, fs: float) -> float | None:
-    """Where a true mode at ``f`` [Hz] appears in a record sampled at ``fs`` [Hz] [Hz], or None
+    """Where a true mode at ``f`` [Hz] appears in a record sampled at ``fs`` [Hz], or None
     for a mode at or below the Nyquist frequency ``fs / 2`` (recorded where it is).
 
     Sampling folds a frequency above ``fs / 2`` to ``|f - fs round(f / fs)|``: the rigs record
