@@ -22,7 +22,9 @@ _ESCAPES = str.maketrans({"&": "&amp;", "<": "&lt;", ">": "&gt;", "[": "\\[", "`
 
 
 def md_text(text: Any) -> str:
-    """``str(text)`` as inline markdown that renders as the same characters on one line."""
+    """``str(text)`` as inline markdown on one line in which no HTML, link, image, code span or
+    table cell break takes effect (``&``, ``<``, ``>``, ``[``, backtick, ``|`` and backslash
+    escaped); emphasis marks (``*``, ``_``) and a leading ``#`` are left as they are."""
     return str(text).translate(_ESCAPES)
 
 
