@@ -50,8 +50,7 @@ def kept_working_folder() -> Iterator[None]:
     r.parquet`` to ``/r.parquet`` (hostile round 20).  A working folder that no longer exists
     when entered is left as it is (there is nothing to return to).  The working folder is the
     process's: with two threads inside at once (a Dask worker's), the one that leaves last
-    restores what it found, which the first may have changed; the sweep's own paths are
-    absolute before a cell runs."""
+    restores what it found, which the first may have changed (not covered)."""
     try:
         before = os.getcwd()
     except OSError:
