@@ -30,16 +30,11 @@ DEFAULTS = {"divide": "warn", "over": "warn", "under": "ignore", "invalid": "war
 def numpy_defaults() -> Iterator[None]:
     """Within: numpy's error state is :data:`DEFAULTS`; after: the state before (the defaults
     if numpy was loaded within), whatever the code within set."""
-    np = sys.modules.get("numpy")
-    before = np.geterr() if np is not None else None
-    if np is not None:
-        np.seterr(**DEFAULTS)
-    try:
-        yield
-    finally:
+    with kept_numpy_state():
         np = sys.modules.get("numpy")
         if np is not None:
-            np.seterr(**(before or DEFAULTS))
+            np.seterr(**DEFAULTS)
+        yield
 
 
 @contextlib.contextmanager
