@@ -88,6 +88,13 @@ EQUATION_BARS = {
     "coef_error": {"max": 0.05},
 }
 
+#: The states' physical lower bounds, ``{state: (bound [the state's unit], what the state
+#: is)}``: ``x`` is a concentration, never below 0 mM (the true law keeps it above its steady
+#: state ``x* >= 0``).  A scored rollout that goes below it is no kinetics whatever its RMSE:
+#: the scorer names it non-physical (:func:`testbed.scoring.scorers.bound_failures`; kin21:
+#: three wrong laws simulated -3.83 / -3.05 / -0.0016 mM and were named "wrong equation" only).
+STATE_LOWER_BOUNDS = {"x": (0.0, "a concentration")}
+
 TERMS = ["dx", "x*dx", "1", "x"]
 TRUTH_UNITS = {"equation_terms": "", "equation_coef": "1 (row max |coef| = 1)",
                "state_names": "", "x0": "mM", "parameter_names": "",
@@ -146,6 +153,8 @@ class MichaelisMentenRig(Rig):
     noisy_signals: ClassVar[tuple[str, ...]] = ("x",)
     #: The identified equation's bars (:data:`EQUATION_BARS`), ``{metric: {"min"|"max": value}}``.
     equation_bars: ClassVar[dict[str, dict[str, float]]] = EQUATION_BARS
+    #: The states' lower bounds (:data:`STATE_LOWER_BOUNDS`), ``{state: (bound, what it is)}``.
+    state_lower_bounds: ClassVar[dict[str, tuple[float, str]]] = STATE_LOWER_BOUNDS
 
     @classmethod
     def check(cls, rig: dict[str, Any], simulation: dict[str, Any], excitation: dict[str, Any],

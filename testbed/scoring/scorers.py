@@ -134,7 +134,8 @@ class Scores:
         fails too: :func:`floor_failures`), ``"sensors"`` (a failed bar on a record whose
         truth reduced to the sensors does not hold the true modes: :func:`sensor_failures`),
         ``"equation"`` (the
-        identified equation misses its rig's own bars: :func:`equation_failures`).  Empty for a
+        identified equation misses its rig's own bars: :func:`equation_failures`), ``"bounds"``
+        (a rollout below a state's declared lower bound: :func:`bound_failures`).  Empty for a
         physically admissible model whose simulation ran.
     """
 
@@ -224,10 +225,10 @@ def bar_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -> dic
             **sensitivity_failures(scores, thresholds)}
 
 
-def rig_equation_bars(dataset: Dataset) -> dict[str, dict[str, float]]:
-    """The bars a rig declares on the identified equation (its class's ``equation_bars``,
-    ``{metric: {"min"|"max": value}}``), or ``{}``: a rig whose question is its equation
-    (Michaelis-Menten) declares them; the dataset names its rig in ``attrs["rig"]``."""
+def rig_declaration(dataset: Dataset, attribute: str) -> dict[str, Any]:
+    """A dict the dataset's rig declares as a class attribute (e.g. ``equation_bars``), or
+    ``{}``: the dataset names its rig in ``attrs["rig"]``; a rig that declares nothing, an
+    unnamed rig and one not registered here (data of another installation) declare nothing."""
     name = dataset.attrs.get("rig")
     if not isinstance(name, str):
         return {}
@@ -235,7 +236,72 @@ def rig_equation_bars(dataset: Dataset) -> dict[str, dict[str, float]]:
         cls = rig_class(name)
     except KeyError:  # data of a rig not registered here: no declaration to read
         return {}
-    return dict(getattr(cls, "equation_bars", None) or {})
+    return dict(getattr(cls, attribute, None) or {})
+
+
+def rig_equation_bars(dataset: Dataset) -> dict[str, dict[str, float]]:
+    """The bars a rig declares on the identified equation (its class's ``equation_bars``,
+    ``{metric: {"min"|"max": value}}``), or ``{}``: a rig whose question is its equation
+    (Michaelis-Menten) declares them."""
+    return rig_declaration(dataset, "equation_bars")
+
+
+#: A scored rollout is below a state's declared lower bound when it goes under it by more than
+#: this fraction of the record's range (the noise-free reference's max - min of that state)
+#: [-].  The reference itself stays within the bound (a rig's states are integrated to rtol
+#: 1e-12); a rollout of a law that keeps the state within it can cross only by round-off, about
+#: eps x its range per step, ~2e-10 of the range over 1e6 RK4 steps (RK4's amplification
+#: ``1 + z + z^2/2 + z^3/6 + z^4/24`` is positive for every real ``z``, so a stable step of a
+#: decay towards the bound never steps over it).  1e-6 is four decades above that and, on a
+#: record of the kinetics' ~1-20 mM, 1e-6-2e-5 mM: below any state_rmse bar a scenario sets.
+BOUND_RTOL = 1e-6
+
+
+def bound_failures(simulated: np.ndarray, reference: np.ndarray, channels: list[str],
+                   units: list[str], bounds: dict[str, tuple[float, str]]) -> dict[str, str]:
+    """A scored rollout below a state's declared lower bound: ``{"bounds": reason}``.
+
+    A rig may declare its states' physical lower bounds (its class's ``state_lower_bounds``,
+    ``{state: (bound, what the state is)}``: Michaelis-Menten's concentration ``x`` >= 0 mM);
+    a simulation that goes below one by more than :data:`BOUND_RTOL` of the record's range is
+    non-physical, a failure whatever its RMSE (its scores are kept).  Only the simulated samples
+    before any divergence count (NaN after it).
+
+    Parameters
+    ----------
+    simulated, reference : ndarray, shape (n_states, n_samples)
+        The identified model's rollout and the noise-free record [each state's unit].
+    channels : list of str, length n_states
+        The states' names, as ``bounds`` names them.
+    units : list of str, length n_states
+        Each state's unit (named in the reason).
+    bounds : dict
+        ``{state: (lower bound [its unit], what the state is, e.g. "a concentration")}``; a
+        state not named is unbounded.
+
+    Returns
+    -------
+    dict of str to str
+        Empty, or ``{"bounds": reason}`` naming each state below its bound, its smallest
+        simulated value and the bound.
+    """
+    said = []
+    for i, name in enumerate(channels):
+        if name not in bounds or i >= np.shape(simulated)[0]:
+            continue
+        low, what = bounds[name]
+        sim = np.asarray(simulated[i], dtype=float)
+        ref = np.asarray(reference[i], dtype=float)
+        if not np.any(np.isfinite(sim)) or not np.all(np.isfinite(ref)):
+            continue
+        reached = float(np.nanmin(sim))
+        span = float(np.ptp(ref))
+        if reached < float(low) - BOUND_RTOL * span:
+            said.append(f"the simulated {name} reaches {reached:.3g} {units[i]}, below "
+                        f"{float(low):g} {units[i]} ({name} is {what})")
+    if not said:
+        return {}
+    return {"bounds": f"non-physical: {'; '.join(said)}"}
 
 
 #: ``determinacy_`` (the noise's Gram over the gap of an identified equation's terms,
@@ -1811,7 +1877,9 @@ def score_dynamical(dataset: Dataset, data: Measurement, clean: Measurement, mod
     initial state (truth ``x0``) under the measured inputs for the whole record; the largest
     per-state RMSE against the noise-free recorded states.  A simulation that raises
     :class:`~testbed.core.errors.DivergenceError` (e.g. a singular coefficient of the
-    derivatives), turns non-finite or blows up is a failure with its reason and NaN RMSE.
+    derivatives), turns non-finite or blows up is a failure with its reason and NaN RMSE; one
+    that goes below a lower bound its rig declares (``state_lower_bounds``: a concentration
+    below 0) is a failure with its reason, its scores kept (:func:`bound_failures`).
 
     Coefficients (:func:`compare_implicit`): rows paired by state, compared up to scale on
     the identifier's term names (``model.feature_names_``) against the truth's
@@ -1823,6 +1891,12 @@ def score_dynamical(dataset: Dataset, data: Measurement, clean: Measurement, mod
     if not failures:  # simulated by step_failures, and only where the bar failed
         d[f"state_rmse{HALF_STEP_WITNESS}"] = functools.partial(
             half_step_rollout, "state_rmse", model, data, truth.x0, None, x_ref)
+    # a rollout below the rig's declared bounds (a concentration below 0): non-physical,
+    # beside whatever else failed (after the witness: a step that crossed is named as such too)
+    x_sig = dataset.reference.get("x", dataset.measured["x"])
+    failures.update(bound_failures(d["simulated_x"], x_ref, list(x_sig.channels),
+                                   x_sig.channel_units(),
+                                   rig_declaration(dataset, "state_lower_bounds")))
     if "model" in failures:
         return Scores({**v, **NO_EQUATION_SCORES}, d, failures)
     cmp = compare_implicit(list(model.feature_names_), coef, truth.equation_terms,

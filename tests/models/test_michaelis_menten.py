@@ -156,6 +156,14 @@ def test_the_rig_declares_its_equation_bars():
     assert rig_class("michaelis_menten").equation_bars == _BARS
 
 
+def test_the_rig_declares_its_concentration_non_negative():
+    # the scorer names a rollout below it non-physical (testbed.scoring.scorers.bound_failures);
+    # the other rigs' states (angles, a cart's position) declare no bound
+    assert rig_class("michaelis_menten").state_lower_bounds == {"x": (0.0, "a concentration")}
+    for other in ("cartpole", "fivebar"):
+        assert not getattr(rig_class(other), "state_lower_bounds", None)
+
+
 def test_equation_failures_hold_the_rigs_bars_on_any_run_with_a_bar():
     from testbed.scoring.scorers import FAIL, Scores, equation_failures, verdict
     # round 2's kinetics__000, clean: the law times a quadratic in x met state_rmse <= 0.01 mM

@@ -1,0 +1,89 @@
+"""The dynamical scorer names a rollout below a state's declared lower bound (a concentration
+below 0) as non-physical, its scores kept; a rig that declares nothing is scored as before."""
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from testbed.core.measurement import Trajectory
+from testbed.pipeline.generate import generate
+from testbed.pipeline.scenario import load_scenario
+from testbed.pipeline.signal_chain import measure
+from testbed.scoring.run import noise_free
+from testbed.scoring.scorers import (
+    BOUND_RTOL,
+    FAIL,
+    bound_failures,
+    score_dynamical,
+    verdict,
+)
+
+_CONC = {"x": (0.0, "a concentration")}
+
+
+def test_a_rollout_below_the_bound_by_more_than_the_tolerance_is_non_physical():
+    ref = np.linspace(20.0, 0.0, 101)[None, :]  # a decay to 0: range 20 mM
+    sim = ref.copy()
+    sim[0, -1] = -3.83
+    why = bound_failures(sim, ref, ["x"], ["mM"], _CONC)
+    assert why == {"bounds": "non-physical: the simulated x reaches -3.83 mM, below 0 mM "
+                             "(x is a concentration)"}
+    # within the tolerance (a tenth of it: round-off of a rollout that keeps x >= 0) nothing;
+    # ten times it, named
+    sim[0, -1] = -0.1 * BOUND_RTOL * 20.0
+    assert bound_failures(sim, ref, ["x"], ["mM"], _CONC) == {}
+    sim[0, -1] = -10.0 * BOUND_RTOL * 20.0
+    assert set(bound_failures(sim, ref, ["x"], ["mM"], _CONC)) == {"bounds"}
+
+
+def test_only_declared_states_and_simulated_samples_count():
+    ref = np.linspace(2.0, 0.1, 50)[None, :]
+    sim = ref - 1.0  # reaches -0.9
+    assert bound_failures(sim, ref, ["x"], ["mM"], {}) == {}  # nothing declared
+    assert bound_failures(sim, ref, ["x"], ["mM"], {"y": (0.0, "a mass")}) == {}
+    nan = np.full_like(ref, np.nan)  # a model never simulated: its failure says why
+    assert bound_failures(nan, ref, ["x"], ["mM"], _CONC) == {}
+    cut = ref.copy()
+    cut[0, 10:] = np.nan  # diverged at sample 10: the samples before it count
+    cut[0, 5] = -0.5
+    assert "reaches -0.5 mM" in bound_failures(cut, ref, ["x"], ["mM"], _CONC)["bounds"]
+
+
+class _Fixed:
+    """A fitted model whose rollout is given (the true law's terms and coefficients, so only
+    the rollout can fail)."""
+
+    def __init__(self, coef, x):
+        self.feature_names_ = ["dx", "x*dx", "1", "x"]
+        self.coef_, self._x = np.atleast_2d(coef), np.atleast_2d(x)
+
+    def simulate(self, x0, xd0, t, u):
+        return Trajectory(self._x, np.gradient(self._x, t, axis=1), np.zeros_like(self._x))
+
+
+@pytest.fixture(scope="module")
+def record():
+    sc = load_scenario("michaelis_menten")
+    ds = generate(sc)
+    data = measure(ds, sc.signal, "dynamical")
+    return ds, data, measure(noise_free(ds), sc.signal, "dynamical")
+
+
+def test_score_dynamical_names_a_negative_concentration_and_keeps_the_scores(record):
+    ds, data, clean = record
+    ref = ds.reference["x"].data
+    coef = ds.truth["equation_coef"]
+    went_negative = ref.copy()
+    went_negative[0, -50:] = -3.83  # kin21: round 16's mm16_jx0_x0_20_20s rollout at 1 %
+    sc = score_dynamical(ds, data, clean, _Fixed(coef, went_negative))
+    assert sc.failures.get("bounds") == ("non-physical: the simulated x reaches -3.83 mM, below "
+                                         "0 mM (x is a concentration)")
+    assert np.isfinite(sc.values["state_rmse"]) and sc.values["state_rmse"] > 1.0  # kept
+    assert sc.values["coef_error"] < 1e-12  # the equation's scores too
+    assert verdict([], sc.failures) == FAIL
+    # the reference's own rollout stays within the bound: nothing named
+    assert score_dynamical(ds, data, clean, _Fixed(coef, ref.copy())).failures == {}
+    # a rig that declares nothing (data of a rig not registered here) is scored as before
+    other = replace(ds, attrs={**ds.attrs, "rig": "not_a_registered_rig"})
+    assert "bounds" not in score_dynamical(other, data, clean, _Fixed(coef, went_negative)).failures
