@@ -584,6 +584,7 @@ def cmd_generate(args: argparse.Namespace) -> int:
 
 
 def cmd_run(args: argparse.Namespace) -> int:
+    from testbed.numerics.clipping import from_table
     from testbed.pipeline.cache import DatasetCache
     from testbed.pipeline.scenario import load_scenario
     from testbed.reporting.console import print_score_table
@@ -618,6 +619,9 @@ def cmd_run(args: argparse.Namespace) -> int:
                 with phase("figures" if figures else "save"):
                     run_dir = save_new_run(result, args.out, figures=figures, index=runs_index_html)
             print_score_table(result)
+            for c in from_table(result.scores.details.get("clipped_sensors") or {}):
+                print(f"warning: {terminal_safe(sc.name)}: {c.describe()} (the record's verdict "
+                      "stands; a failed bar says so)", file=sys.stderr)
             print(f"run written to {terminal_safe(str(run_dir))} "
                   f"(all runs: {terminal_safe(str(Path(args.out) / INDEX))})")
             ok &= result.passed
@@ -761,6 +765,7 @@ def cmd_identify(args: argparse.Namespace) -> int:
 
     from testbed.core.atomic import atomic_write_text
     from testbed.pipeline.fit import identify_file
+    from testbed.pipeline.importers import clipping_lines
     from testbed.pipeline.scenario import load_scenario, recording_reads
     from testbed.reporting.identified import render_identified
     from testbed.reporting.progress import run_progress
@@ -793,6 +798,8 @@ def cmd_identify(args: argparse.Namespace) -> int:
                                params=_key_values(args.param, "--param", numbers=False),
                                format=args.format, fs=args.fs, units=units,
                                prior=_key_values(args.prior, "--prior", numbers=True), phase=phase)
+    for line in clipping_lines(data, result.clipped):  # said, not refused: the model is written
+        print(f"warning: {terminal_safe(line)}", file=sys.stderr)
     summary = result.summary()
     failures = fitted_model_failures(result.model, prediction_r2(result.model, result.data))
     if failures is not None:

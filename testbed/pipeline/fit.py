@@ -25,9 +25,10 @@ from testbed.core.errors import IdentificationError, InputError, ScenarioError, 
 from testbed.core.exit_guard import no_process_exit
 from testbed.core.measurement import Measurement
 from testbed.core.process_state import kept_process_state
+from testbed.numerics.clipping import Clipping
 from testbed.numerics.shapes import modal_from_matrices
 from testbed.pipeline import plugins
-from testbed.pipeline.importers import measurement_from_file
+from testbed.pipeline.importers import measurement_and_clipping
 from testbed.pipeline.scenario import check_identifier_for_record, load_scenario
 from testbed.pipeline.signal_chain import SIGNAL_SCHEMAS
 
@@ -50,6 +51,9 @@ class FitResult:
         The data file.
     fit_time : float
         Wall time of ``fit`` [s].
+    clipped : tuple of Clipping
+        The record's channels holding a clip level (a saturated sensor:
+        :mod:`testbed.numerics.clipping`); said, nothing refused.
     """
 
     model: Any
@@ -58,12 +62,15 @@ class FitResult:
     method: str
     source: str
     fit_time: float
+    clipped: tuple[Clipping, ...] = ()
 
     def summary(self) -> dict[str, Any]:
         """JSON-ready description: :func:`model_summary` plus the source and the data's shape."""
         out = {"source": self.source, "kind": self.kind, "method": self.method,
                "fit_time_s": self.fit_time, "fs_hz": self.data.fs, "n_samples": self.data.n_samples,
                "channels": list(self.data.channels)}
+        if self.clipped:  # stored with the model: a saturated sensor's record
+            out["clipped_sensors"] = [c.as_dict() for c in self.clipped]
         out.update(model_summary(self.model, self.data))
         return out
 
@@ -238,8 +245,8 @@ def identify_file(path: str | os.PathLike, *, scenario: str | os.PathLike | None
         hyper = cls.validate_hyperparameters(hyper, file=where)
     phase = phase or _no_phase
     with phase("read and signal chain"):
-        data = measurement_from_file(path, kind, signal, format=format, fs=fs, units=units,
-                                     channels=channels, prior=prior)
+        data, clipped = measurement_and_clipping(path, kind, signal, format=format, fs=fs,
+                                                 units=units, channels=channels, prior=prior)
     with _named_source(params, scenario):
         check_against_data(cls, hyper, data, file=where)
     model = cls(**hyper)
@@ -254,7 +261,7 @@ def identify_file(path: str | os.PathLike, *, scenario: str | os.PathLike | None
             # own identifier failing: say which file
             raise IdentificationError(f"{path}: {identify['method']} found no model: {e}") from None
         fit_time = time.perf_counter() - t0
-    return FitResult(model, data, kind, identify["method"], str(path), fit_time)
+    return FitResult(model, data, kind, identify["method"], str(path), fit_time, tuple(clipped))
 
 
 @contextlib.contextmanager

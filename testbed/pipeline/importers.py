@@ -51,6 +51,7 @@ import json
 import math
 import os
 import re
+import warnings
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -63,6 +64,7 @@ from testbed.core.dataset import Dataset, DatasetError, Signal
 from testbed.core.errors import TestbedError, is_control, show_names
 from testbed.core.measurement import MIN_FREE_SAMPLES, Measurement
 from testbed.core.rate_attrs import fs_attribute_problem
+from testbed.numerics.clipping import Clipping, measured_clipping
 from testbed.numerics.noise import noise_std
 from testbed.pipeline.signal_chain import SIGNAL_CHAINS, SIGNAL_SCHEMAS, measure, pulse_span
 
@@ -364,8 +366,48 @@ def measurement_from_file(path: str | os.PathLike, kind: str, signal: Mapping[st
         (wrong signal names or channel counts, no positions for a structural record).
     ScenarioError
         A bad ``signal`` table.
-    """
 
+    Warns
+    -----
+    ClippedSensorWarning
+        One per clip level of a channel (:func:`measurement_and_clipping`): the file, the
+        channel, the share of its samples at the level and the level.  Nothing is refused.
+    """
+    data, clipped = measurement_and_clipping(path, kind, signal, format=format, fs=fs, units=units,
+                                             channels=channels, groups=groups, prior=prior)
+    for line in clipping_lines(path, clipped):  # said, not refused (an API caller's warning)
+        warnings.warn(line, ClippedSensorWarning, stacklevel=2)
+    return data
+
+
+class ClippedSensorWarning(UserWarning):
+    """A channel of a measured record holds a clip level (:mod:`testbed.numerics.clipping`)."""
+
+
+def clipping_lines(path: str | os.PathLike, clipped: Sequence[Clipping]) -> list[str]:
+    """One warning line per clip level: the file, the channel, the share of samples, the level."""
+    return [f"{path}: {c.describe()}; a model of this record may be wrong (the sensor "
+            "saturated: the record is not the response there)" for c in clipped]
+
+
+def measurement_and_clipping(path: str | os.PathLike, kind: str,
+                             signal: Mapping[str, Any] | None = None, *,
+                             format: str | None = None, fs: float | None = None,
+                             units: str | Mapping[str, str] | None = None,
+                             channels: Sequence[str] | None = None,
+                             groups: Mapping[str, Sequence[str]] | None = None,
+                             prior: Mapping[str, float] | None = None
+                             ) -> tuple[Measurement, list[Clipping]]:
+    """:func:`measurement_from_file` and the record's clipped channels, with no warning.
+
+    Returns
+    -------
+    Measurement
+        As :func:`measurement_from_file`.
+    list of Clipping
+        The channels of the record as read (before the signal chain, in SI units) holding a
+        clip level (:func:`testbed.numerics.clipping.measured_clipping`); empty for most.
+    """
     if not isinstance(kind, str) or kind not in SIGNAL_SCHEMAS:
         raise MeasuredDataError(path, f"unknown rig kind {kind!r}; allowed: {', '.join(SIGNAL_SCHEMAS)}")
     if signal is not None and not isinstance(signal, Mapping):  # 5: AttributeError (round 17)
@@ -382,7 +424,7 @@ def measurement_from_file(path: str | os.PathLike, kind: str, signal: Mapping[st
     if (signal or {}).get("derivatives", "recorded") == "recorded":  # the rates the fit reads
         _check_rates(data.source, ds, kind)
     try:
-        return measure(ds, dict(signal or {}), kind)
+        return measure(ds, dict(signal or {}), kind), measured_clipping(ds.measured)
     except TestbedError:
         raise
     except ValueError as e:  # the chain's own checks: signal names, channel counts, positions

@@ -27,6 +27,7 @@ from testbed.core.kinds import MAX_MODE_SCORES, METRICS
 from testbed.core.measurement import Measurement, Trajectory
 from testbed.core.terms import canonical
 from testbed.core.truth import DynamicalTruth, MechanicalTruth, StructuralTruth, TruthError
+from testbed.numerics.clipping import clipping_table, from_table, measured_clipping
 from testbed.numerics.linear_response import simulate_linear
 from testbed.numerics.shapes import slowest_decay_rate
 from testbed.pipeline.plugins import rig_class
@@ -216,13 +217,13 @@ def bar_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -> dic
     """The failures a run's bars add to its scorer's: :func:`uninformative_failures`,
     :func:`out_of_band_failures`, :func:`unexcited_failures`, :func:`decayed_failures`,
     :func:`floor_failures`, :func:`sensor_failures`, :func:`equation_failures`,
-    :func:`step_failures` and :func:`sensitivity_failures`, merged (one call for
+    :func:`step_failures`, :func:`sensitivity_failures` and :func:`clipping_failures`, merged (one call for
     :func:`testbed.scoring.run.run_scenario` and :func:`testbed.scoring.evaluate.score_model`)."""
     return {**uninformative_failures(scores, thresholds), **out_of_band_failures(scores, thresholds),
             **unexcited_failures(scores, thresholds), **decayed_failures(scores, thresholds),
             **floor_failures(scores, thresholds), **sensor_failures(scores, thresholds),
             **equation_failures(scores, thresholds), **step_failures(scores, thresholds),
-            **sensitivity_failures(scores, thresholds)}
+            **sensitivity_failures(scores, thresholds), **clipping_failures(scores, thresholds)}
 
 
 def rig_declaration(dataset: Dataset, attribute: str) -> dict[str, Any]:
@@ -882,6 +883,31 @@ def sensor_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -> 
         "regular model of that size exists for this record (rig.sensors, rig.n_segments)")}
 
 
+def clipping_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -> dict[str, str]:
+    """A failed bar on a record with a clipped sensor: ``{"clipped": reason}``.
+
+    A sensor that saturated (:mod:`testbed.numerics.clipping`, from the record alone) holds a
+    rail where the structure moved on: no model of the structure predicts that record.
+    Measured (hostile round 20): the stiff beam's acc1 clipped at 10 % of its peak failed its
+    bars (mode error 67 %, MAC 0.136) with no reason naming the clipping.  Only a bar that
+    already failed is explained, so no verdict changes.
+
+    Parameters
+    ----------
+    scores : Scores
+        With ``details["clipped_sensors"]`` (a :func:`~testbed.numerics.clipping.clipping_table`,
+        :func:`record_details`); without it, nothing to say.
+    thresholds : dict
+        The run's bars, ``{metric: {"min"|"max": value}}``.
+    """
+    table = scores.details.get("clipped_sensors")
+    if not table or not [c for c in check_thresholds(scores.values, thresholds) if not c.passed]:
+        return {}
+    return {"clipped": "clipped: " + "; ".join(c.describe() for c in from_table(table))
+                       + ": the failed bar may be the saturation's (a record no model of the "
+                         "structure predicts), not only the identifier's"}
+
+
 def record_details(kind: str, dataset: Dataset, data: Measurement) -> dict[str, Any]:
     """What the record and the truth say about the true modes, with no model: the details
     :func:`out_of_band_failures`, :func:`unexcited_failures` and :func:`decayed_failures` read
@@ -904,6 +930,9 @@ def record_details(kind: str, dataset: Dataset, data: Measurement) -> dict[str, 
         out["pulse_spectrum"] = pulse_spectrum(dataset, f_true)
     out["z_true"] = np.asarray(truth.damping_ratios[: data.n_channels], float)
     out["window_decay"] = window_decay(truth, dataset, data, data.n_channels)
+    clipped = measured_clipping(dataset.measured)  # the record alone (clipping_failures)
+    if clipped:
+        out["clipped_sensors"] = clipping_table(clipped)
     return out
 
 
@@ -1329,8 +1358,8 @@ def score_structural(dataset: Dataset, data: Measurement, clean: Measurement, mo
     d.update(scored_modes=m, **{f"{k}_per_mode": np.asarray(x) for k, x in per_mode.items()})
     d.update(mac=mac, pair=pair, f_id=f_id, f_true=f_true, z_id=z_id, z_true=z_true)
     record = record_details("structural", dataset, data)  # what the record holds of each mode
-    d.update({k: record[k] for k in ("force_participation", "pulse_spectrum", "window_decay", "fs")
-              if k in record})
+    d.update({k: record[k] for k in ("force_participation", "pulse_spectrum", "window_decay", "fs",
+                                     "clipped_sensors") if k in record})
 
     Mr, Kr, Cr = truth.Mr, truth.Kr, truth.Cr
     v["Mr_error"] = metrics.relative_error(model.M_, Mr)

@@ -1,0 +1,109 @@
+"""The clipped-sensor rule (testbed/numerics/clipping.py): told on clipped copies, silent on
+smooth records, on records quantised to 16 bits and on the shipped scenarios' records."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from testbed.numerics.clipping import (
+    Clipping,
+    clipped_channels,
+    clipped_levels,
+    clipping_table,
+    from_table,
+    measured_clipping,
+    on_lattice,
+)
+from testbed.pipeline.scenario import load_scenario
+
+FS = 12800.0  # Hz, the beam's accelerometers
+
+
+def _ring(seconds: float = 1.0) -> np.ndarray:
+    """An impact's ring: three decaying modes (60, 410, 1150 Hz) with a little float noise."""
+    t = np.arange(int(seconds * FS)) / FS
+    y = sum(a * np.exp(-z * 2 * np.pi * f * t) * np.sin(2 * np.pi * f * t)
+            for a, f, z in ((1.0, 60.0, 0.01), (0.6, 410.0, 0.005), (0.3, 1150.0, 0.004)))
+    return y + 1e-4 * np.random.default_rng(0).standard_normal(t.size)
+
+
+def _quantised(y: np.ndarray, bits: int) -> np.ndarray:
+    q = np.max(np.abs(y)) / 2 ** (bits - 1)
+    return np.round(y / q) * q
+
+
+@pytest.mark.parametrize("frac", [0.1, 0.2, 0.3, 0.4, 0.5])
+def test_clipped_copy_is_told(frac):
+    y = _ring()
+    lim = frac * np.max(np.abs(y))
+    found = clipped_channels({"acc1": np.clip(y, -lim, lim)}, {"acc1": "m/s^2"})
+    assert found and all(c.channel == "acc1" and abs(c.level) == lim for c in found)
+    assert all(c.n_held >= 2 and 0 < c.share < 1 for c in found)
+    assert "sensor acc1 is clipped at" in found[0].describe()
+    assert "m/s^2" in found[0].describe()
+
+
+@pytest.mark.parametrize("frac", [0.1, 0.3])
+def test_quantised_clipped_copy_is_told(frac):
+    """A 16-bit ADC that saturates: the quantised branch (the top code held far longer than the
+    next one) tells it."""
+    y = _ring()
+    lim = frac * np.max(np.abs(y))
+    assert clipped_channels({"acc1": _quantised(np.clip(y, -lim, lim), 16)})
+
+
+@pytest.mark.parametrize("f", [0.5, 3.0, 60.0, 410.0, 1150.0])
+def test_no_alarm_on_a_sine_quantised_to_16_bits(f):
+    """A smooth peak quantised holds its top code several samples at a slow apex (0.5 Hz at
+    12.8 kHz: ~40 samples) but no longer than 2.41 times the next code: no clip."""
+    t = np.arange(int(4 * FS)) / FS
+    y = 3.7 * np.sin(2 * np.pi * f * t + 0.3)
+    assert clipped_levels(_quantised(y, 16)) == []
+    assert clipped_levels(_quantised(_ring(), 16)) == []
+    assert clipped_levels(y) == [] and clipped_levels(_ring()) == []
+
+
+def test_rest_at_the_record_ends_is_no_clip():
+    """A record that starts (or ends) at rest holds its value there: no clip."""
+    y = np.r_[np.ones(500), np.exp(-np.arange(3000) / 800.0)]
+    assert clipped_levels(y) == [] and clipped_levels(y[::-1]) == []
+    assert clipped_levels(np.zeros(100)) == []  # constant: not a clip (a dead sensor)
+
+
+def test_lattice():
+    q = 3.7 / 2 ** 15
+    assert on_lattice(np.array([5, 9, 10, 17]) * q + 1.0, q)
+    assert not on_lattice(np.array([5.0, 9.3, 10.0]) * q, q)
+
+
+def test_table_round_trip():
+    c = Clipping("acc1", -2.5, 31, 12800, 5, "m/s^2")
+    assert from_table(clipping_table([c])) == [c]
+    assert from_table({}) == []
+
+
+@pytest.mark.parametrize("name", ["cantilever_stiff_impact", "cantilever_soft_impact",
+                                  "fivebar_multisine", "michaelis_menten_noise1", "cartpole"])
+def test_no_alarm_on_shipped_records(dataset_cache, name):
+    """The records as simulated (float) and quantised to 16 bits (a top code met twice at a
+    fast apex, the next codes once each: the lattice test keeps it from the float branch)."""
+    measured = dataset_cache.get(load_scenario(name)).measured
+    assert measured_clipping(measured) == []
+    quantised = {g: dataclasses.replace(s, data=np.array([_quantised(r, 16) for r in s.data]))
+                 for g, s in measured.items()}
+    assert measured_clipping(quantised) == []
+
+
+def test_stiff_beam_clipped_at_ten_percent(dataset_cache):
+    """Hostile round 20's case: acc1 at 10 % of its peak, 57 samples at the two rails."""
+    ds = dataset_cache.get(load_scenario("cantilever_stiff_impact"))
+    s = ds.measured["acceleration"]
+    a = s.data.copy()
+    lim = 0.1 * np.max(np.abs(a[0]))
+    a[0] = np.clip(a[0], -lim, lim)
+    found = measured_clipping({**ds.measured, "acceleration": dataclasses.replace(s, data=a)})
+    assert {c.channel for c in found} == {"acc1"}
+    assert sum(c.n_held for c in found) == int(np.count_nonzero(np.abs(a[0]) == lim)) == 57

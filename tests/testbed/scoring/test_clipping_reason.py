@@ -1,0 +1,43 @@
+"""A failed bar on a record with a clipped sensor names the clipping (clipping_failures);
+a met bar, or a record with none, gets nothing: no verdict changes."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from testbed.numerics.clipping import Clipping, clipping_table
+from testbed.pipeline.scenario import load_scenario
+from testbed.scoring.run import run_scenario
+from testbed.scoring.scorers import Scores, bar_failures, clipping_failures
+
+BARS = {"mac": {"min": 0.95}}
+TABLE = clipping_table([Clipping("acc1", 23.1, 26, 12800, 4, "m/s^2")])
+
+
+def test_reason_only_on_a_failed_bar():
+    failed = Scores({"mac": 0.136}, {"clipped_sensors": TABLE}, {})
+    reason = clipping_failures(failed, BARS)["clipped"]
+    assert reason.startswith("clipped: sensor acc1 is clipped at +23.1 m/s^2: 26 of 12800 samples")
+    assert bar_failures(failed, BARS)["clipped"] == reason
+    assert clipping_failures(Scores({"mac": 0.99}, {"clipped_sensors": TABLE}, {}), BARS) == {}
+    assert clipping_failures(Scores({"mac": 0.136}, {}, {}), BARS) == {}
+
+
+def test_stiff_beam_clipped_run_says_so(dataset_cache):
+    """Hostile round 20: acc1 clipped at 10 % of its peak failed its bars with no reason naming
+    the clipping; the clean record passes with no such reason."""
+    sc = load_scenario("cantilever_stiff_impact")
+    ds = dataset_cache.get(sc)
+    s = ds.measured["acceleration"]
+    a = s.data.copy()
+    lim = 0.1 * np.max(np.abs(a[0]))
+    a[0] = np.clip(a[0], -lim, lim)
+    clipped = dataclasses.replace(ds, measured={**ds.measured,
+                                                "acceleration": dataclasses.replace(s, data=a)})
+    r = run_scenario(sc, dataset=clipped)
+    assert not r.passed and "sensor acc1 is clipped at" in r.scores.failures["clipped"]
+    clean = run_scenario(sc, dataset=ds)
+    assert clean.passed and "clipped" not in clean.scores.failures
+    assert "clipped_sensors" not in clean.scores.details
