@@ -119,3 +119,11 @@ def test_medians_stand_on_every_scored_cell_not_the_passing_ones_alone(tmp_path)
     print_summary(res, console=Console(file=buf, width=120))
     out = buf.getvalue()
     assert "4.07" in out and "5 of 6 cells" in out and "of the scored cells" in out
+
+
+def test_a_clipped_sensors_reason_is_a_named_kind():
+    # session 21: a failed bar on a record with a clipped sensor reads "clipped: ..." (the
+    # scorer's clipping_failures); counted as "other" it named nothing
+    from testbed.studies.statistics import failure_kind
+
+    assert failure_kind("clipped: sensor acc1 is clipped at +23.1 m/s^2: ...") == ["clipped"]
