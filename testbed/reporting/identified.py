@@ -30,6 +30,15 @@ def render_identified(summary: dict[str, Any]) -> str:
              "- R^2 of the predicted accelerations (truth-free): "
              + (_num(summary["r2"]) if summary.get("r2") is not None
                 else "not defined (implicit equations: no explicit acceleration)"), ""]
+    clipped = summary.get("clipped_sensors") or []
+    if clipped:  # (testbed.numerics.clipping; FitResult.summary) said, nothing refused
+        lines += ["## Clipped sensors", "",
+                  "The record holds a clip level (a saturated sensor): a model of it may be "
+                  "wrong there.", ""]
+        lines += [f"- {md_text(c['channel'])}: {c['level']:+.6g} {md_text(c['unit'])}, "
+                  f"{c['n_held']} of {c['n_samples']} samples ({100 * c['share']:.3g} %) in "
+                  f"{c['runs']} run(s)" for c in clipped]
+        lines.append("")
     modal = summary.get("modal")
     if modal:
         lines += ["## Modes", "", "| mode | frequency [Hz] | damping ratio |", "|---|---|---|"]

@@ -13,6 +13,7 @@ import pytest
 from testbed.pipeline.fit import identify_file
 from testbed.pipeline.importers import ClippedSensorWarning, measurement_from_file
 from testbed.pipeline.scenario import load_scenario
+from testbed.reporting.identified import render_identified
 
 
 @pytest.fixture(scope="module")
@@ -47,8 +48,12 @@ def test_stored_with_the_model(records):
     assert [c["channel"] for c in summary["clipped_sensors"]] == ["acc1", "acc1"]
     assert sorted(c["level"] for c in summary["clipped_sensors"]) == [-lim, lim]
     assert sum(c["n_held"] for c in summary["clipped_sensors"]) == 57
-    assert "clipped_sensors" not in identify_file(clean, kind="structural",
-                                                  method="ls_sindy").summary()
+    clean_summary = identify_file(clean, kind="structural", method="ls_sindy").summary()
+    assert "clipped_sensors" not in clean_summary
+    # and in the identify command's markdown report
+    text = render_identified(summary)
+    assert "## Clipped sensors" in text and text.count("\n- acc1: ") == 2
+    assert "Clipped" not in render_identified(clean_summary)
 
 
 def test_identify_command_says_it(records, cli_in_process, tmp_path):
