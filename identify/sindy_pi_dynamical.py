@@ -1037,7 +1037,8 @@ class SINDyPIDynamical(Identifier):
             quad = float(np.sum((quadrature_rows(V1, V2, self.weak_degree) @ w) ** 2))
         if not (np.all(np.isfinite(v)) and math.isfinite(quad) and lam > 0.0):
             return r, w
-        return 1.0 / (1.0 / r + quad / lam), w
+        share = 1.0 / r + quad / lam  # 0 only for r = inf with no quadrature error: inf
+        return (1.0 / share if share > 0.0 else math.inf), w
 
     def _prune_at_noise(self, data: Measurement, lib: ImplicitTerms, x: np.ndarray,
                         xd: np.ndarray, u: np.ndarray | None, G_val: np.ndarray,
