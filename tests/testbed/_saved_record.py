@@ -1,7 +1,9 @@
-"""A small hand-made record saved as a dataset file, for the malformed-input tests."""
+"""A small hand-made record saved as a dataset file, and a record with a clipped sensor, for the
+malformed-input tests."""
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 
 import numpy as np
@@ -18,3 +20,14 @@ def saved_record(tmp_path: Path) -> Path:
     ds = Dataset(FS, {"acceleration": Signal(acc, ("acc1", "acc2"), "m/s^2"),
                       "force": Signal(np.exp(-t / 0.01)[None, :], ("force",), "N")})
     return ds.save(tmp_path / "d.h5")
+
+
+def clipped_acc1(ds: Dataset, share: float = 0.1) -> tuple[Dataset, float]:
+    """``ds`` with its first acceleration channel clipped at ``share`` of its peak (a saturated
+    sensor, hostile round 20), and the clip level [m/s^2]."""
+    s = ds.measured["acceleration"]
+    a = s.data.copy()
+    lim = share * float(np.max(np.abs(a[0])))
+    a[0] = np.clip(a[0], -lim, lim)
+    return dataclasses.replace(ds, measured={**ds.measured,
+                                             "acceleration": dataclasses.replace(s, data=a)}), lim

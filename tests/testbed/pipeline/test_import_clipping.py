@@ -3,17 +3,16 @@ share of samples and the level), stored with the model, and refuses nothing."""
 
 from __future__ import annotations
 
-import dataclasses
 import json
 import warnings
 
-import numpy as np
 import pytest
 
 from testbed.pipeline.fit import identify_file
 from testbed.pipeline.importers import ClippedSensorWarning, measurement_from_file
 from testbed.pipeline.scenario import load_scenario
 from testbed.reporting.identified import render_identified
+from tests.testbed._saved_record import clipped_acc1
 
 
 @pytest.fixture(scope="module")
@@ -21,12 +20,7 @@ def records(dataset_cache, tmp_path_factory):
     """The stiff beam's record and a copy with acc1 clipped at 10 % of its peak (files)."""
     folder = tmp_path_factory.mktemp("clip")
     ds = dataset_cache.get(load_scenario("cantilever_stiff_impact"))
-    s = ds.measured["acceleration"]
-    a = s.data.copy()
-    lim = 0.1 * np.max(np.abs(a[0]))
-    a[0] = np.clip(a[0], -lim, lim)
-    bad = dataclasses.replace(ds, measured={**ds.measured,
-                                            "acceleration": dataclasses.replace(s, data=a)})
+    bad, lim = clipped_acc1(ds)
     return ds.save(folder / "beam.h5"), bad.save(folder / "clipped.h5"), lim
 
 

@@ -3,14 +3,11 @@ a met bar, or a record with none, gets nothing: no verdict changes."""
 
 from __future__ import annotations
 
-import dataclasses
-
-import numpy as np
-
 from testbed.numerics.clipping import Clipping, clipping_table
 from testbed.pipeline.scenario import load_scenario
 from testbed.scoring.run import run_scenario
 from testbed.scoring.scorers import Scores, bar_failures, clipping_failures
+from tests.testbed._saved_record import clipped_acc1
 
 BARS = {"mac": {"min": 0.95}}
 TABLE = clipping_table([Clipping("acc1", 23.1, 26, 12800, 4, "m/s^2")])
@@ -30,12 +27,7 @@ def test_stiff_beam_clipped_run_says_so(dataset_cache):
     the clipping; the clean record passes with no such reason."""
     sc = load_scenario("cantilever_stiff_impact")
     ds = dataset_cache.get(sc)
-    s = ds.measured["acceleration"]
-    a = s.data.copy()
-    lim = 0.1 * np.max(np.abs(a[0]))
-    a[0] = np.clip(a[0], -lim, lim)
-    clipped = dataclasses.replace(ds, measured={**ds.measured,
-                                                "acceleration": dataclasses.replace(s, data=a)})
+    clipped, _ = clipped_acc1(ds)
     r = run_scenario(sc, dataset=clipped)
     assert not r.passed and "sensor acc1 is clipped at" in r.scores.failures["clipped"]
     clean = run_scenario(sc, dataset=ds)
