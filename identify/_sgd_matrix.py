@@ -589,6 +589,44 @@ def equal_modal_mass(A: np.ndarray, m_hat: float) -> tuple[np.ndarray, np.ndarra
     return M0 * (m_hat / np.trace(M0)), phi
 
 
+def complex_stiffness_pair(A: np.ndarray) -> str:
+    """Why an uncoupled regression's ``A = M^-1 K`` has no real mode shapes, or ``""``.
+
+    Rule: the placement of an unresolved mode (:func:`~identify._unresolved.place_unresolved`)
+    moves one eigenvalue of ``A`` along its shape and keeps the others' shapes; it needs
+    ``n`` real shapes that span the space.  Where the fit gave ``A`` a complex eigenvalue
+    pair (two modes coalesced: a "stiffness" that couples them with no real mode between
+    them, which no passive structure has) the real parts of the pair's shapes are one vector
+    and no mode can be placed by them: the placement does not act, stated here, and the
+    fallback is the flat fit (round 20's ``b20_st_hit0p1`` at 3 %, seed 113: modes 2-3 fitted
+    as 532.5 +- 11.7j Hz, the shapes' matrix singular and the fit ended in "numerical
+    breakdown (LinAlgError: Singular matrix)"; flat, a scored model, TRAC 0.795, modes 1-2
+    within 0.02 %).  A pair is complex where LAPACK returns a nonzero imaginary part (a real
+    matrix's real eigenvalues come from its real Schur form's 1 x 1 blocks, exactly real);
+    a pair near coalescence that comes out real has near-parallel shapes, which
+    ``place_unresolved``'s own condition bound refuses, so either way the placement does
+    not act.
+
+    Parameters
+    ----------
+    A : ndarray, shape (n, n)
+        ``M^-1 K`` [1/s^2] of the uncoupled regression (:func:`_uncoupled_coef`).
+
+    Returns
+    -------
+    str
+        The statement (the pair in Hz), or ``""`` where every eigenvalue is real.
+    """
+    lam = np.linalg.eigvals(np.asarray(A, dtype=float))
+    pair = lam[lam.imag > 0.0]
+    if not pair.size:
+        return ""
+    f = np.sqrt(pair.astype(complex)) / (2.0 * np.pi)
+    shown = ", ".join(f"{z.real:.4g} +- {abs(z.imag):.3g}j Hz" for z in f)
+    return (f"none placed: the uncoupled regression's A = M^-1 K has a complex eigenvalue pair "
+            f"({shown}: two modes coalesced, no real mode shapes to place a mode by)")
+
+
 def unresolved_warm_start(xdd: np.ndarray, xd: np.ndarray, x: np.ndarray, m_hat: float,
                           top_hz: float, peaks: np.ndarray
                           ) -> tuple[np.ndarray, np.ndarray, np.ndarray, str] | None:
@@ -620,12 +658,16 @@ def unresolved_warm_start(xdd: np.ndarray, xd: np.ndarray, x: np.ndarray, m_hat:
 
     Returns
     -------
-    (M0, C0, K0, rule) or None
+    (M0, C0, K0, rule) or str or None
         None where the rule does not act (:func:`~identify._unresolved.place_unresolved`) or
-        the placed ``A`` defines no equal-modal-mass ``M0``.
+        the placed ``A`` defines no equal-modal-mass ``M0``; a statement of why, where ``A``
+        has no real mode shapes to place a mode by (:func:`complex_stiffness_pair`).
     """
     n = xdd.shape[0]
     coef = _uncoupled_coef(xdd, xd, x)
+    why = complex_stiffness_pair(-coef[:, n:])
+    if why:
+        return why
     placed = place_unresolved(np.eye(n), -coef[:, :n], -coef[:, n:], top_hz, peaks)
     if placed is None:
         return None
@@ -924,13 +966,14 @@ def psd_damping_warm_start(M: np.ndarray, C: np.ndarray, K: np.ndarray) -> np.nd
 
 
 def _physical_placed(sig: list[np.ndarray], m_hat: float, top_hz: float, peaks: np.ndarray
-                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, str] | None:
+                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, str] | str | None:
     """:func:`unresolved_warm_start` on the fit's signals ``sig`` (``[x'', x', x, ...]``),
     if it acts and the model it gives is physical (:func:`identify.structural.check_physical`),
-    or is physical with its damping projected (:func:`psd_damping_warm_start`); else None."""
+    or is physical with its damping projected (:func:`psd_damping_warm_start`); its statement
+    where it refuses to act (:func:`complex_stiffness_pair`); else None."""
     placed = unresolved_warm_start(*sig[:3], m_hat, top_hz, peaks)
-    if placed is None:
-        return None
+    if placed is None or isinstance(placed, str):
+        return placed
     try:
         check_physical(*placed[:3], "the warm start with its unresolved modes placed")
     except IdentificationError:
@@ -1070,6 +1113,8 @@ def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
             C_psd = None if est.cubic else psd_damping_warm_start(M0, C0, K0)
             placed = (None if est.cubic or C_psd is not None or unresolved is None
                       else _physical_placed(sig, m_hat, *unresolved))
+            if isinstance(placed, str):  # the placement's stated refusal
+                unresolved_rule, placed = placed, None
             if C_psd is not None:
                 C0 = C_psd
                 tilt_rule = (f"rule: the tilted warm start had a growing pole ({e}); kept with "

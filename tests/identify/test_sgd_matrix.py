@@ -10,6 +10,7 @@ import pytest
 from benchmarks import bench_sgd_sindy as bench
 from identify._sgd_matrix import (
     _sym,
+    complex_stiffness_pair,
     cubic_profile,
     fit_matrix_sgd,
     unresolved_warm_start,
@@ -353,3 +354,32 @@ def test_the_unresolved_warm_start_places_the_mode_and_keeps_each_modes_damping(
     np.testing.assert_allclose(top.real, -wt * 2**-0.5, rtol=1e-8)
     np.testing.assert_allclose(np.sort(top.imag), [-wt * 2**-0.5, wt * 2**-0.5], rtol=1e-8)
     assert unresolved_warm_start(*sig, 0.3, 4000.0, np.array([100.0, 500.0])) is None
+
+
+def test_an_uncoupled_stiffness_with_a_complex_pair_places_no_mode_and_says_why():
+    """``A = M^-1 K`` with a real mode at 100 Hz and two modes coalesced into a complex pair
+    (eigenvalues (2 pi 530)^2 +- (2 pi 120)^2 j: round 20's ``b20_st_hit0p1`` at 3 %, s113,
+    fitted modes 2-3 as 532.5 +- 11.7j Hz) and one negative stiffness beyond the 2000 Hz
+    top: the real parts of the pair's shapes are one vector, so no mode can be placed.  The
+    old code solved with that singular shape matrix (``identify._unresolved
+    .stiffness_eigenvalues``): on the cell's ``A`` LAPACK's LU met an exact zero pivot
+    ("LinAlgError: Singular matrix", the cell's "numerical breakdown", test_sgd_cantilever),
+    on this one rounding left a tiny pivot and eigenvalues of +-2.4e22 (None, no reason
+    stated): which of the two depends on rounding.  Now the placement states why it does
+    not act, before any solve, and a real ``A`` gives ""."""
+    rng = np.random.default_rng(3)
+    V = np.linalg.qr(rng.standard_normal((4, 4)))[0] + 0.3 * np.eye(4)
+    a, b = (2 * np.pi * 530.0) ** 2, (2 * np.pi * 120.0) ** 2
+    blocks = np.zeros((4, 4))
+    blocks[0, 0] = (2 * np.pi * 100.0) ** 2
+    blocks[1:3, 1:3] = [[a, b], [-b, a]]  # the real form of a +- b j
+    blocks[3, 3] = -(2 * np.pi * 3000.0) ** 2
+    A = V @ blocks @ np.linalg.inv(V)
+    B = V @ np.diag([5.0, 60.0, 60.0, 50.0]) @ np.linalg.inv(V)
+    why = complex_stiffness_pair(A)
+    assert why.startswith("none placed") and "complex eigenvalue pair" in why
+    sig = _uncoupled_signals(A, B)
+    placed = unresolved_warm_start(*sig, 0.3, 2000.0, np.array([100.0, 530.0]))
+    assert isinstance(placed, str) and "complex eigenvalue pair" in placed
+    real = V @ np.diag(np.diag(blocks) * [1, 1, 1.5, 1]) @ np.linalg.inv(V)
+    assert complex_stiffness_pair(real) == ""
