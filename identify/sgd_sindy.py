@@ -210,6 +210,35 @@ def record_agreement(model: StructuralIdentifier, data: Measurement,
     return float(np.min(tr)), ""
 
 
+def cubic_diverges(note: str) -> bool:
+    """Whether a :func:`record_agreement` note says the model's simulation from the record's own
+    start failed (diverged, turned non-finite, or its start fit broke down), as opposed to a
+    model not simulated at all (a pole past RK4's bound: soft-base members 014 and 015 of the
+    families, which pass scored, :func:`record_rule`) or one simulated to the end.
+
+    Rule (:meth:`SGDSINDy.fit`): a cubic model (``cubic_``, by rule or by the user's
+    ``cubic = true``) whose SGD result and held warm start both fail that way is refused and
+    the linear library fitted in its place, stated in ``cubic_rule_`` (``ls_sindy``'s step 4
+    (b), :meth:`identify.ls_sindy.LSSINDy._cubic_diverges`, where the cubic came in by rule).
+    Both, because the keep rule already keeps a warm start that runs where the SGD's result
+    does not (:func:`keep_sgd_rule`).  Why: such a model has no simulated response to score
+    (the scorer's simulation diverges too: "diverged", TRAC NaN), while the linear part of the
+    record is what the linear library fits.  Round 20's soft family (``round20_families.toml``,
+    3-30 EI/L bases, cubic fractions 0.6-1.2): members 004 clean, 006 and 007 at 1 % diverged
+    at 6-31 ms with their fitted ``K3`` of mixed signs, no potential's gradient.
+
+    Parameters
+    ----------
+    note : str
+        :func:`record_agreement`'s note.
+
+    Returns
+    -------
+    bool
+    """
+    return note.startswith(("simulation failed", "simulation not finite"))
+
+
 def keep_sgd_rule(agree_sgd: float, agree_warm: float | None,
                   notes: tuple[str, str] = ("", "")) -> tuple[bool, str]:
     """Whether the SGD's result is kept rather than the held warm start's, and why.
@@ -757,6 +786,19 @@ class SGDSINDy(SGDSINDyBase):
     start is finished with its decay hold and both are simulated (the slowest family fit,
     soft 006 at 1 %, 3.9 -> 5.6 s; before, one took 856 s).
 
+    *A cubic that diverges from the record's own start* (``cubic_rule_``).  Where the cubic
+    library is in (by rule or by the user's ``cubic = true``) and the keep rule's two
+    simulations from the record's own start, the SGD's result and its held warm start, both
+    fail (diverge or turn non-finite: :func:`cubic_diverges`; a model *not simulated*, its
+    pole past RK4's bound, is not such a failure), the cubic model is refused and the whole fit
+    made again with the linear library, stated in ``cubic_rule_`` ("the fitted cubic model
+    refused (...): cubic terms out"): ``ls_sindy``'s step 4 (b).  A model that cannot be run
+    from its own record's start has no response to score; the keep rule alone kept the SGD's
+    result whenever neither had an agreement.  Round 20's soft family
+    (``round20_families.toml``, seed 117; ``K3`` of mixed signs in one column): members 004
+    clean, 006 and 007 at 1 % "diverged" -> TRAC 0.967 / 0.976 / 0.939, modes 1-2 within
+    2.1 / 0.46 / 0.24 %.
+
     *Measured on the beams family* (studies/families.toml: 40 clamped and 20 soft-base
     cantilevers nobody tuned for; default settings; 2026-11-24).  Pass counts on the study's
     bars (TRAC/MAC > 0.90, modes 1-2 within 2.6 %) / on issue #15's (TRAC and MAC of modes 1-2
@@ -1086,6 +1128,31 @@ class SGDSINDy(SGDSINDyBase):
         lam_hat, band_peaks = self._start_fit(data)
         m_hat = mass_prior_value(data, self.mass_prior)
         begun = dict(self.__dict__)
+        self._fit_banded(data, lam_hat, band_peaks, m_hat, self.cubic)
+        why = self.__dict__.pop("_cubic_diverged", "")
+        if why:
+            # A cubic model that neither the SGD nor its warm start can run from the record's
+            # own start is refused and the linear library fitted (ls_sindy's step 4 (b)):
+            # round 20's soft family members 004 clean, 006 and 007 at 1 % (cubic = true, the
+            # shipped soft scenario's table) were scored "diverged" (TRAC NaN); linear, TRAC
+            # 0.967 / 0.976 / 0.939 with modes 1-2 within 2.2 %
+            rule = self.cubic_rule_
+            self.__dict__.clear()
+            self.__dict__.update(begun)
+            self.cubic_ = False
+            self.learning_rate_, self.learning_rate_rule_ = learning_rate_for(False,
+                                                                              self.learning_rate)
+            self._fit_banded(data, lam_hat, band_peaks, m_hat, False)
+            self.__dict__.pop("_cubic_diverged", None)
+            self.cubic_rule_ = f"{rule}; the fitted cubic model refused ({why}): cubic terms out"
+        return self
+
+    def _fit_banded(self, data: Measurement, lam_hat: np.ndarray, band_peaks: np.ndarray | None,
+                    m_hat: float, cubic: bool | None) -> None:
+        """The fit with the fit band's refusals (:meth:`fit`'s body before the cubic's refusal),
+        from the state :meth:`_start_fit` left; ``cubic``: the cubic setting a refit without
+        the band chooses the library by (``self.cubic``, or False for the linear refit)."""
+        begun = dict(self.__dict__)
 
         def fit_in(cut: float | None) -> None:
             if cut is not None:  # the refit without the band, from the state _start_fit left
@@ -1093,8 +1160,8 @@ class SGDSINDy(SGDSINDyBase):
                 self.__dict__.update(begun)
                 ps = modal_peaks(data, lower_modes=self._lower_modes())
                 self.cubic_, self.cubic_rule_ = cubic_rule(
-                    data, self.cubic, cut, None if self.cubic is not None else ps.peaks,
-                    ps if self.cubic is None and self._lower_modes() else None)
+                    data, cubic, cut, None if cubic is not None else ps.peaks,
+                    ps if cubic is None and self._lower_modes() else None)
                 self.learning_rate_, self.learning_rate_rule_ = learning_rate_for(
                     self.cubic_, self.learning_rate)
             self._fit_in_band(data, lam_hat, band_peaks, m_hat, cut)
@@ -1136,7 +1203,6 @@ class SGDSINDy(SGDSINDyBase):
                     f"{band_rule}; kept: the model fitted in it does not explain its record "
                     f"(agreement {show(a_band)} < {UNEXPLAINED_RECORD:g}), nor better without it "
                     f"({show(a_none)})")
-        return self
 
     def _kept_agreement(self) -> float:
         """The kept model's record agreement [-] where the keep rule measured it (NaN: not
@@ -1225,6 +1291,9 @@ class SGDSINDy(SGDSINDyBase):
                                                           sgd["alphas_"])
         self.keep_sgd_, self.keep_sgd_rule_ = keep, rule
         self.record_agreement_ = {"sgd": a_sgd, "warm_start": a_warm}
+        if self.cubic_ and cubic_diverges(note_sgd) and cubic_diverges(note_warm):
+            self._cubic_diverged = (f"its simulation from the record's own start fails, the "
+                                    f"SGD's ({note_sgd}) and its warm start's ({note_warm})")
         self.record_rule_ = record_rule(a_sgd if keep else a_warm, self.M_, self.C_, self.K_)
 
     def _hardened_peak_ceiling(self, lam_hat: np.ndarray) -> np.ndarray:
