@@ -313,6 +313,41 @@ def bound_failures(simulated: np.ndarray, reference: np.ndarray, channels: list[
 UNDETERMINED = 1.0
 
 
+def noise_free_ratio(bound: float) -> float:
+    """The largest ratio of the noise's Gram to the *noise-free* gap that a ``determinacy_``
+    measured on the noisy rows allows [-]: ``bound / (1 - bound)``, ``inf`` from 1 on, NaN for NaN.
+
+    ``determinacy_`` divides the noise's Gram ``dG`` by the gap of the record's own rows, which
+    hold that noise (in expectation their Gram is the noise-free one plus ``dG``): by Weyl's
+    inequality the noise-free gap is at least ``(1 - bound)`` of the measured one and may be no
+    more, so the noise may reach ``bound / (1 - bound)`` of it.  That ratio reaches
+    :data:`UNDETERMINED` from a measured ``bound`` of 0.5 on (round 20's ``mm20_x0_20``, s113:
+    0.790 at 0.5 % noise and 0.792 at 1.5 %, where a signal's gap would leave the ratio growing
+    as the noise's variance, 9x: the gap is the noise's own).
+
+    Parameters
+    ----------
+    bound : float
+        The identifier's ``determinacy_`` of one equation [-] (>= 0, or NaN).
+
+    Returns
+    -------
+    float
+        ``bound / (1 - bound)`` [-] below 1, ``inf`` at 1 or more, NaN for NaN.
+    """
+    if not bound < 1.0:
+        return float("nan") if np.isnan(bound) else float("inf")
+    return float(bound) / (1.0 - float(bound))
+
+
+def shown_undetermined(bound: float) -> bool:
+    """Whether an identifier's ``determinacy_`` leaves the equation not shown determined: the
+    noise's Gram may exceed the noise-free gap (:func:`noise_free_ratio` above
+    :data:`UNDETERMINED`, a measured ratio above 0.5) or reaches the measured one (at 1 or
+    more, the identifier's own rule); NaN never."""
+    return bool(bound >= UNDETERMINED or noise_free_ratio(bound) > UNDETERMINED)
+
+
 #: Why a rig's equation metric is not finite, by metric (named in the failure).
 NOT_FINITE = {"law_error": "the identified law gives no finite acceleration somewhere in the "
                            "record's state box: its equations are singular or non-finite there"}
@@ -339,7 +374,9 @@ def equation_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -
     -------
     dict of str to str
         Empty, or the reason naming each missed metric, its value and the rig's bar.  Where
-        the identifier's own ratio (from the data alone) is at least :data:`UNDETERMINED` on an
+        the identifier's own ratio (from the data alone) is at least :data:`UNDETERMINED`, or
+        above 0.5 (measured on the noisy rows, it allows a noise-free one above 1:
+        :func:`noise_free_ratio`), on an
         equation of true terms alone, the reason says the record does not determine the
         equation (a failure all the same: the verdict names why, it never changes); on an
         equation holding a term the law lacks (:func:`spurious_terms`) that ratio does not
@@ -366,15 +403,21 @@ def equation_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -
     # terms never lowers the bound (interlacing: the Gram's second-smallest eigenvalue cannot
     # rise, the noise's largest cannot fall), so the law's own terms are undetermined too.  An
     # equation with a term the law lacks may be undetermined by that term alone.
-    short = [k for k in range(bound.size) if bound[k] >= UNDETERMINED  # NaN never names it
+    short = [k for k in range(bound.size) if shown_undetermined(bound[k])  # NaN never names it
              and not (k < len(extra) and extra[k])]
     if short:
+        worst = max(bound[k] for k in short)
+        if worst >= UNDETERMINED:
+            reach = (f"reaches {worst:.3g} x the gap to another equation of the same terms")
+        else:  # measured on the noisy rows: the noise-free gap may be (1 - worst) of it
+            reach = (f"is {worst:.3g} x the gap to another equation of the same terms on the "
+                     f"record's rows, which hold that noise: the noise-free gap may be as small "
+                     f"as {1.0 - worst:.2g} of it (Weyl), {noise_free_ratio(worst):.2g} x below "
+                     "the noise's Gram")
         return {"equation": (f"equation not determined by the record: {said}; at the record's "
-                             f"own noise level the noise's Gram reaches "
-                             f"{max(bound[k] for k in short):.3g} x "
-                             "the gap to another equation of the same terms (the identifier's "
+                             f"own noise level the noise's Gram {reach} (the identifier's "
                              f"determinacy_, from the data alone; {why})")}
-    undetermined = [k for k in range(bound.size) if bound[k] >= UNDETERMINED]
+    undetermined = [k for k in range(bound.size) if shown_undetermined(bound[k])]
     if undetermined:
         terms = sorted({t for k in undetermined for t in extra[k]})
         return {"equation": (f"wrong equation: {said}; its terms, with {', '.join(terms)} that "
