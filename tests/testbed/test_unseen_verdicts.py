@@ -772,6 +772,20 @@ def test_round20_studies_load(name, cells):
     assert study.name == name and study.n_cells() == cells
 
 
+
+@pytest.mark.parametrize("name, cells", [("round21_beams", 32), ("round21_beams_noise", 32),
+                                         ("round21_beams_noise_s123", 64),
+                                         ("round21_beams_extra", 32),
+                                         ("round21_linkages_sine", 12),
+                                         ("round21_linkages_clean", 6),
+                                         ("round21_linkages_inputs", 6),
+                                         ("round21_linkages_cartpoles", 15),
+                                         ("round21_linkages_kinetics", 15)])
+def test_round21_studies_load(name, cells):
+    study = load_study(_root() / "benchmarks" / "unseen" / f"{name}.toml")
+    assert study.name == name and study.n_cells() == cells
+
+
 def test_a_floor_is_claimed_for_the_exact_model_not_for_every_model_of_its_size():
     """Round 20's b20_st_s2_hit0p1_z3 (sensors 0.1 / 1 L, the hammer at 0.1 L, 3 % damping),
     clean: the truth's reduced model scores TRAC 0.884 at the 0.1 L sensor; sgd_sindy 0.867 is
