@@ -47,14 +47,15 @@ SCORED_REASONS = ("fit failed", "diverged", "simulation failed", "non-physical",
                   "non-finite scores", "no scores")
 #: The scorer's explanations of a failed bar (testbed.scoring.scorers: uninformative_failures,
 #: out_of_band_failures, unexcited_failures, decayed_failures, floor_failures, sensor_failures,
-#: equation_failures, step_failures, sensitivity_failures, clipping_failures), each the head of its reason
+#: equation_failures, step_failures, sensitivity_failures, clipping_failures,
+#: linear_model_failures), each the head of its reason
 #: (``<head>: ...``).  Matched only at a
 #: reason's start (the text's or after ``"; "``, as ``Scores.failure`` joins them): their words
 #: occur inside other reasons ("at the sensors").  Without them a floor or an unexcited mode
 #: was counted as "other" (held-out families, 2026-11-28).
 EXPLAINED_REASONS = ("uninformative", "out of band", "unexcited", "decayed", "floor", "sensors",
                      "wrong equation", "equation not determined", "rollout step",
-                     "sensitive record", "clipped")
+                     "sensitive record", "clipped", "linear model")
 _EXPLAINED = re.compile(r"(?:^|; )(" + "|".join(map(re.escape, EXPLAINED_REASONS)) + r")\b")
 
 

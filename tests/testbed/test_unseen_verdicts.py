@@ -21,15 +21,18 @@ from testbed.scoring.run import run_scenario
 from testbed.scoring.scorers import (
     FAIL,
     GROWTH_FACTOR,
+    MISSED_CUBIC_SHARE,
     REDUCED_TRUTH_GAP,
     Scores,
     growth_failure,
     late_growth,
+    linear_model_failures,
     reduced_truth_gap,
     sensitivity_failures,
     sensor_failures,
     step_failures,
 )
+from testbed.studies.statistics import failure_kind
 from testbed.studies.study import load_study
 
 
@@ -839,3 +842,31 @@ def test_a_law_the_noisy_rows_do_not_show_determined_names_the_record():
     why = r.scores.failures["equation"]
     assert why.startswith("equation not determined by the record: coef_error")
     assert f"the noise's Gram is {bound:.3g} x the gap" in why
+
+
+def test_a_linear_model_of_a_strongly_cubic_base_names_the_missing_term():
+    """Round 21's b21_soft_f300 (the shipped soft base under 300 N, cubic fraction about 8 at
+    the peak base rotation), clean, seed 121: ls_sindy kept the cubic terms out and failed
+    modes 1-2 by 24 / 17 % (TRAC 0.557), named by its bars alone; the truth's cubic base force
+    is 1.5x its linear force over the free decay."""
+    sc = load_scenario(_root() / "benchmarks" / "unseen" / "round21" / "b21_soft_f300.toml")
+    r = run_scenario(dataclasses.replace(sc, seed=121, identify={**sc.identify, "method": "ls_sindy"}))
+    assert r.verdict == FAIL and r.scores.values["K3_norm"] == 0.0
+    assert r.scores.values["freq_error_mode1"] > 0.1
+    share = r.scores.details["truth_cubic_share"]
+    assert share > 1.0
+    why = r.scores.failures["cubic"]
+    assert why.startswith(f"linear model: the identified model has no cubic term, where the "
+                          f"truth's cubic base force is {share:.3g} x its linear force")
+    assert "linear model" in failure_kind(r.scores.failure)
+    # only a failed bar is explained; a model with a cubic term, a small share: nothing
+    bars = {"freq_error_mode1": {"max": 0.026}}
+    s = Scores({"K3_norm": 0.0, "freq_error_mode1": 0.2}, {"truth_cubic_share": 1.5})
+    assert set(linear_model_failures(s, bars)) == {"cubic"}
+    assert linear_model_failures(Scores({"K3_norm": 0.0, "freq_error_mode1": 0.01},
+                                        s.details), bars) == {}
+    assert linear_model_failures(Scores({"K3_norm": 1e12, "freq_error_mode1": 0.2},
+                                        s.details), bars) == {}
+    for small in (0.5 * MISSED_CUBIC_SHARE, float("nan")):
+        assert linear_model_failures(Scores(s.values, {"truth_cubic_share": small}), bars) == {}
+    assert linear_model_failures(Scores(s.values, {}), bars) == {}  # a linear truth
