@@ -16,11 +16,15 @@ record, 8 % damping, the hammer at 0.3 L (steel) and 0.7 L (aluminium), each on 
 shipped soft base under 300 N and a base by the families' rule (1.2 EI/L, cubic fraction 0.3) under
 5 N, a soft base on a 0.5 s record, a 6 s record at 6.4 kHz, 25.6 kHz, two sensors both near
 mid-span (0.45 / 0.55 L) on the clamped beam and on a soft base, and glass-epoxy on a 0.8 EI/L base
-with cubic fraction 1.  A second batch combines them (round21_beams_extra.toml): the shipped soft
+with cubic fraction 1. A second batch combines them (round21_beams_extra.toml): the shipped soft
 base under 5 N (cubic fraction near 0.002) and the rule base under 300 N, 40 segments at 0.05 %
 damping, glass-epoxy hit at 0.3 L, 8 % damping read by two mid-span sensors, a soft base on 6 s at
-6.4 kHz, aluminium at 25.6 kHz on 0.5 s, and the long titanium beam on a soft base.  Noise 0 / 0.5 /
-2 / 4 % and seeds 121-129 are the studies' (round21_beams*.toml).
+6.4 kHz, aluminium at 25.6 kHz on 0.5 s, and the long titanium beam on a soft base. A third batch
+(round21_beams_more.toml): brass 0.5 m hit at 0.3 L, the root-read soft base under 5 N, three
+sensors clustered at mid-span (0.4 / 0.5 / 0.6 L, the hammer on the middle one), glass-epoxy at 0.05
+% damping on 6 s, a 0.8 EI/L base with cubic fraction 1 under 5 N, and thin aluminium (0.45 m x 5
+mm, 30 segments) with two tip sensors. Noise 0 / 0.5 / 1 / 2 / 3 / 4 % and seeds 121-129 are the
+studies' (round21_beams*.toml).
 """
 
 from __future__ import annotations
@@ -34,9 +38,10 @@ from round6 import b_make as _ROUND6  # noqa: E402
 from round13.b_make import soft  # noqa: E402
 from round14.b_make import sensors  # noqa: E402
 
-AL, GFRP, TI, SOFT = _ROUND6.AL, _ROUND6.GFRP, _ROUND6.TI, _ROUND6.SOFT
+AL, BRASS, GFRP, TI, SOFT = _ROUND6.AL, _ROUND6.BRASS, _ROUND6.GFRP, _ROUND6.TI, _ROUND6.SOFT
 _SROOT3 = sensors((0.15, 0.25, 0.35))
 _SMID2 = sensors((0.45, 0.55))
+_SMID3 = sensors((0.4, 0.5, 0.6))
 _S03 = sensors((0.3, 0.6, 1.0))
 _S07 = sensors((0.4, 0.7, 1.0))
 _F5, _F300 = {"peak_force": 5.0}, {"peak_force": 300.0}
@@ -106,6 +111,28 @@ CASES: dict[str, tuple[str, dict, dict, dict, dict]] = {
         "titanium 0.6 m x 30 x 6 mm in 20 segments on k1 = 1.2 EI/L, cubic fraction 0.3, sensors 0.3 / 0.6 / "
         "1 L", {**_TI_LONG, **soft(1.2, 0.3, _TI_LONG), "sensors": sensors((0.3, 0.6, 1.0), 0.6)}, {}, {},
         {},
+    ),
+    # a third batch (round21_beams_more.toml)
+    "b21_br_L0p5_n16_hit0p3": (
+        "brass 0.5 m in 16 segments (mode 1 near 22 Hz), sensors 0.3 / 0.6 / 1 L, the hammer at 0.3 L",
+        {**BRASS, "length": 0.5, "n_segments": 16, "sensors": sensors((0.3, 0.6, 1.0), 0.5)}, {},
+        {"location": sensors((0.3,), 0.5)[0]}, {},
+    ),
+    "b21_soft_root3_f5": (
+        "the shipped beam on k1 = 1.2 EI/L, cubic fraction 0.3 at 50 N, sensors 0.15 / 0.25 / 0.35 L, a "
+        "5 N hit at 0.35 L", {**soft(1.2, 0.3, {}, {"location": _SROOT3[2]}), "sensors": _SROOT3}, {},
+        {"location": _SROOT3[2], **_F5}, {},
+    ),
+    "b21_st_s3mid_hit0p5": ("the shipped beam, sensors 0.4 / 0.5 / 0.6 L, the hammer at 0.5 L",
+                            {"sensors": _SMID3}, {}, {"location": _SMID3[1]}, {}),
+    "b21_gf_z0p05_6s": ("glass-epoxy, 0.05 % damping, 6 s at 6.4 kHz", {**GFRP, "damping_ratio": 0.0005},
+                        {"duration": 6.0, "sample_rate": 6400.0}, {}, {}),
+    "b21_soft_r0p8_cf1_f5": ("the shipped beam on k1 = 0.8 EI/L, cubic fraction 1 at 5 N, under 5 N",
+                             {**soft(0.8, 1.0, {}, _F5)}, {}, {**_F5}, {}),
+    "b21_al_L0p45_t5_n30_s2tip": (
+        "aluminium 0.45 m x 30 x 5 mm in 30 segments, two sensors 0.9 / 1 L",
+        {**AL, "length": 0.45, "thickness": 0.005, "n_segments": 30,
+         "sensors": sensors((0.9, 1.0), 0.45)}, {}, {}, {},
     ),
 }
 
