@@ -785,7 +785,8 @@ def test_round20_studies_load(name, cells):
                                          ("round21_linkages_cartpoles", 15),
                                          ("round21_linkages_kinetics", 15),
                                          ("round21_linkages_seeds", 18),
-                                         ("round21_beams_more", 36)])
+                                         ("round21_beams_more", 36),
+                                         ("round21_linkages_more", 12)])
 def test_round21_studies_load(name, cells):
     study = load_study(_root() / "benchmarks" / "unseen" / f"{name}.toml")
     assert study.name == name and study.n_cells() == cells

@@ -14,8 +14,10 @@ chirp), and a 0.5 N m chirp 0.2-1 Hz over 10 s with the multisine's feedback.  C
 ``cartpole_noise1``'s multisine and chain: a heavy long pole (2 kg, 1.2 m), a light cart (0.3 kg),
 a rail of 1 N s/m (10x the base rig's), gravity 5 m/s^2, and a 1.5 N multisine.  Kinetics: Km 1
 mM with Vmax 0.8 mM/s (x* 3 mM: a rise from the 2 mM dose), an influx near Vmax (1.4 of 1.5 mM/s,
-x* 4.2 mM), Km 0.01 mM (x* 0.0067 mM), a 5 mM dose, and 100 Hz on an 8 s record.  Noise levels
-and seeds 121-129 are the studies' (round21_linkages_*.toml).
+x* 4.2 mM), Km 0.01 mM (x* 0.0067 mM), a 5 mM dose, and 100 Hz on an 8 s record.  Later
+(round21_linkages_more.toml): the multisine on the 1.4 m ground and with 3 kg couplers, the heavy
+long pole under a 2 N multisine, Km 0.01 mM from a 5 mM dose.  Noise levels and seeds 121-129 are
+the studies' (round21_linkages_*.toml).
 """
 
 from __future__ import annotations
@@ -49,6 +51,10 @@ FIVEBARS: dict[str, tuple[str, dict[str, dict]]] = {
 MULTISINES: dict[str, tuple[str, dict[str, dict]]] = {
     "fb21_ms_amp0p5": ("the multisine at 0.5 N m", {"excitation": {"amplitude": 0.5}}),
     "fb21_ms_amp1p5": ("the multisine at 1.5 N m", {"excitation": {"amplitude": 1.5}}),
+    # round21_linkages_more.toml
+    "fb21_ms_ground_1p4": ("the multisine on a 1.4 m ground under four 1 m links", {"rig": {"L0": 1.4}}),
+    "fb21_ms_heavy_couplers": ("the multisine with couplers of 3 kg each",
+                               {"rig": {"m2": 3.0, "m3": 3.0}}),
 }
 
 #: name -> (description, the input replacing fivebar_multisine_noise1's whole, record [s])
@@ -66,6 +72,10 @@ CARTPOLES: dict[str, tuple[str, dict[str, dict]]] = {
     "cp21_rail1": ("a rail of 1 N s/m (10x the base rig's)", {"rig": {"cart_damping": 1.0}}),
     "cp21_g5": ("gravity 5 m/s^2", {"rig": {"gravity": 5.0}}),
     "cp21_amp1p5": ("a 1.5 N multisine", {"excitation": {"amplitude": 1.5}}),
+    # round21_linkages_more.toml
+    "cp21_pole2_L1p2_amp2": ("a heavy long pole (2 kg, 1.2 m) under a 2 N multisine",
+                             {"rig": {"pole_mass": 2.0, "pole_length": 1.2},
+                              "excitation": {"amplitude": 2.0}}),
 }
 
 #: name -> (description, {table: keys changed from michaelis_menten_noise1}); Km 0.3, Vmax 1.5,
@@ -78,6 +88,8 @@ KINETICS: dict[str, tuple[str, dict[str, dict]]] = {
     "mm21_x0_5": ("a 5 mM dose", {"rig": {"x0": 5.0}}),
     "mm21_fs100_8s": ("the weak setup at 100 Hz on an 8 s record",
                       {"simulation": {"sample_rate": 100.0, "duration": 8.0}}),
+    # round21_linkages_more.toml
+    "mm21_km0p01_x0_5": ("Km 0.01 mM with a 5 mM dose (x* 0.0067 mM)", {"rig": {"Km": 0.01, "x0": 5.0}}),
 }
 
 
