@@ -17,7 +17,8 @@ has no pass rate (NaN): an identifier is never measured against bars declared fo
 Failure reasons are counted per group (:func:`failure_kind`): a scored failure's reason
 ("fit failed", "diverged", "non-physical", "unstable", "non-finite scores"), the scorer's
 explanation of a failed bar ("floor", "unexcited", "out of band", ...) or, for a cell that
-raised, ``crash: <ExceptionType>``.
+raised, ``refused: <ExceptionType>`` (a scenario its rig or loader refused, one line naming the
+keys) or ``crash: <ExceptionType>`` (anything else).
 """
 
 from __future__ import annotations
@@ -29,6 +30,7 @@ from collections import Counter, defaultdict
 from pathlib import Path
 from typing import Any
 
+from testbed.core import errors
 from testbed.core.terminal import make_console
 from testbed.numerics.quantiles import quartiles
 from testbed.studies.family import family_of
@@ -47,21 +49,39 @@ SCORED_REASONS = ("fit failed", "diverged", "simulation failed", "non-physical",
                   "non-finite scores", "no scores")
 #: The scorer's explanations of a failed bar (testbed.scoring.scorers: uninformative_failures,
 #: out_of_band_failures, unexcited_failures, decayed_failures, floor_failures, sensor_failures,
-#: equation_failures, step_failures, sensitivity_failures, clipping_failures), each the head of its reason
+#: equation_failures, step_failures, sensitivity_failures, clipping_failures,
+#: linear_model_failures), each the head of its reason
 #: (``<head>: ...``).  Matched only at a
 #: reason's start (the text's or after ``"; "``, as ``Scores.failure`` joins them): their words
 #: occur inside other reasons ("at the sensors").  Without them a floor or an unexcited mode
 #: was counted as "other" (held-out families, 2026-11-28).
 EXPLAINED_REASONS = ("uninformative", "out of band", "unexcited", "decayed", "floor", "sensors",
                      "wrong equation", "equation not determined", "rollout step",
-                     "sensitive record", "clipped")
+                     "sensitive record", "clipped", "linear model")
 _EXPLAINED = re.compile(r"(?:^|; )(" + "|".join(map(re.escape, EXPLAINED_REASONS)) + r")\b")
+
+
+#: The failure kinds of a cell that never got to scoring (:func:`failure_kind`): no scores.
+UNSCORED = ("crash", "refused")
+
+
+def refusal(type_name: str) -> bool:
+    """Whether an exception type the sweep recorded (by name) is a refusal of what the cell asks:
+    a :class:`~testbed.core.errors.RigError` or :class:`~testbed.core.errors.ScenarioError`
+    (and their subclasses, e.g. ``BudgetError``) of :mod:`testbed.core.errors`, which a rig or
+    the scenario's loader raises for a scenario it cannot build or simulate as asked, in one
+    line naming the keys (round 21's ``fb21_ms_amp1p5``: "the motion under excitation
+    'multisine' is not usable (found only by simulating it) ... transmission angle 150.00 deg"),
+    not a bug."""
+    cls = getattr(errors, type_name, None)
+    return isinstance(cls, type) and issubclass(cls, (errors.RigError, errors.ScenarioError))
 
 
 def failure_kind(error: str) -> list[str]:
     """The kinds of failure in a cell's ``error`` text (empty for a cell that finished).
 
-    ``crash: <Type>`` for an exception the sweep caught (a bug or an unforeseen input), else
+    ``refused: <Type>`` for a scenario the rig or the loader refused (:func:`refusal`),
+    ``crash: <Type>`` for any other exception the sweep caught (a bug or an unforeseen input), else
     every scored reason of :data:`SCORED_REASONS` found in the text and every explanation of
     :data:`EXPLAINED_REASONS` heading one of its reasons (a cell may fail for several, e.g.
     non-physical and diverged), or ``other`` if none matches.
@@ -72,7 +92,7 @@ def failure_kind(error: str) -> list[str]:
         return ["crash: process ended"]
     m = CRASH_PATTERN.match(error.strip())
     if m:
-        return [f"crash: {m.group(1)}"]
+        return [f"{'refused' if refusal(m.group(1)) else 'crash'}: {m.group(1)}"]
     found = [r for r in SCORED_REASONS if r in error]
     heads = {h.group(1) for h in _EXPLAINED.finditer(error)}
     found += [r for r in EXPLAINED_REASONS if r in heads]
@@ -94,7 +114,7 @@ def scored(row: dict[str, Any]) -> bool:
     """
     if row.get("status") == "ok":
         return True
-    return not any(k.startswith("crash") for k in failure_kind(row.get("error") or ""))
+    return not any(k.startswith(UNSCORED) for k in failure_kind(row.get("error") or ""))
 
 
 def failed_cells_line(rows: list[dict[str, Any]]) -> str | None:
@@ -108,9 +128,11 @@ def failed_cells_line(rows: list[dict[str, Any]]) -> str | None:
     if not kinds:
         return None
     crashed = sum(any(k.startswith("crash") for k in ks) for ks in kinds)
+    refused = sum(any(k.startswith("refused") for k in ks) for ks in kinds)
     other = sum(ks == ["other"] for ks in kinds)
-    scored = len(kinds) - crashed - other
+    scored = len(kinds) - crashed - refused - other
     parts = [f"{n} {what}" for n, what in ((crashed, "crashed"),
+                                            (refused, "refused by the rig or the scenario"),
                                             (scored, "scored failure(s) with their reason"),
                                             (other, "with another error")) if n]
     return (f"{len(kinds)} cell(s) failed ({', '.join(parts)}; `testbed summary` counts the "
@@ -131,7 +153,7 @@ def _judged(rows: list[dict[str, Any]]) -> list[bool]:
             pairs.add((r["scenario"], r["identifier"]))
             idents.add(r["identifier"])
     return [(r["scenario"], r["identifier"]) in pairs
-            or (r["identifier"] in idents and any(k.startswith("crash")
+            or (r["identifier"] in idents and any(k.startswith(UNSCORED)
                                                   for k in failure_kind(r.get("error") or "")))
             for r in rows]
 

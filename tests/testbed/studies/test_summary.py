@@ -9,7 +9,13 @@ import numpy as np
 from rich.console import Console
 
 from testbed.studies.results import write_part, write_rows
-from testbed.studies.statistics import print_summary, summarize
+from testbed.studies.statistics import (
+    failed_cells_line,
+    failure_kind,
+    print_summary,
+    scored,
+    summarize,
+)
 
 CHECKS = '[{"metric": "trac", "bound": "min", "threshold": 0.75}]'
 
@@ -127,3 +133,33 @@ def test_a_clipped_sensors_reason_is_a_named_kind():
     from testbed.studies.statistics import failure_kind
 
     assert failure_kind("clipped: sensor acc1 is clipped at +23.1 m/s^2: ...") == ["clipped"]
+
+
+REFUSED = ("RigError: key 'excitation.amplitude, excitation.f_max, excitation.kp, excitation.kd': "
+           "value [1.5, 1.5, 10.0, 2.0]: the motion under excitation 'multisine' is not usable "
+           "(found only by simulating it): fivebar (pinocchio): at t = 6.6170 s the transmission "
+           "angle (links 2-3 at E) is 150.00 deg; allowed 30-150 deg (rig.py:323)")
+
+
+def test_a_scenario_the_rig_refuses_is_counted_refused_not_crashed(tmp_path):
+    """Round 21's fb21_ms_amp1p5 (the multisine at 1.5 N m) at 1 / 2 %: the rig refuses the
+    motion in one line naming the keys (a transmission angle of 150 deg at 6.6 s), and the
+    sweep's last line said "2 crashed", the summary "crash: RigError": a refusal of what the
+    cell asks, not a bug."""
+    assert failure_kind(REFUSED) == ["refused: RigError"]
+    assert failure_kind("BudgetError: scenario 'x': 3e9 steps (scenario.py:9)") == [
+        "refused: BudgetError"]
+    assert failure_kind("ValueError: boom (x.py:3)") == ["crash: ValueError"]
+    assert failure_kind("TestbedError: what (x.py:3)") == ["crash: TestbedError"]  # not a refusal
+    line = failed_cells_line([{"status": "failed", "error": REFUSED},
+                              {"status": "failed", "error": "ValueError: boom (x.py:3)"}])
+    assert line.startswith("2 cell(s) failed (1 crashed, 1 refused by the rig or the scenario;")
+    res = tmp_path / "r.parquet"
+    rows = [row("a0", "pi", 1.0, 0, trac=0.9),
+            row("a1", "pi", 1.0, 1, status="failed", passed=False, error=REFUSED, checks="[]",
+                trac=float("nan"))]
+    write_rows(res, rows)
+    (g,) = summarize(res)
+    assert g["failures"] == {"refused: RigError": 1} and g["scored"] == 1
+    assert g["judged"] == 2 and g["pass_rate"] == 0.5  # held to bars elsewhere: not passed
+    assert not scored(rows[1])
