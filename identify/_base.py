@@ -543,6 +543,12 @@ def _guard_fit(fit: Callable[..., Identifier]) -> Callable[..., Identifier]:
                                 f"expected a {self.kind} record ({type(self).__name__} is a "
                                 f"{self.kind} identifier; `testbed list` shows each "
                                 f"identifier's kind)", described=True)
+        # a fit learns afresh: an earlier fit's learned attributes (public names ending in "_",
+        # scikit-learn's convention) are removed first, so none survives into this fit's result
+        # or decides one of its rules (session 22's review: SGDSINDy's refit compared an earlier
+        # fit's record_agreement_ with its own)
+        for k in [k for k in vars(self) if k.endswith("_") and not k.startswith("_")]:
+            delattr(self, k)
         self.check_params_for_data(data)
         free = data.n_samples - data.free_start
         if self.kind == "structural" and free < MIN_FREE_SAMPLES:

@@ -111,7 +111,7 @@ from typing import Any, Literal
 import numpy as np
 
 from identify._modal_damping import modal_decay
-from identify._unresolved import place_unresolved
+from identify._unresolved import SHAPES_COND_MAX, place_unresolved
 from identify.structural import (
     FIT_BAND_ORDER,
     FIT_TILT_DIFFERENCES,
@@ -601,11 +601,18 @@ def complex_stiffness_pair(A: np.ndarray) -> str:
     fallback is the flat fit (round 20's ``b20_st_hit0p1`` at 3 %, seed 113: modes 2-3 fitted
     as 532.5 +- 11.7j Hz, the shapes' matrix singular and the fit ended in "numerical
     breakdown (LinAlgError: Singular matrix)"; flat, a scored model, TRAC 0.795, modes 1-2
-    within 0.02 %).  A pair is complex where LAPACK returns a nonzero imaginary part (a real
-    matrix's real eigenvalues come from its real Schur form's 1 x 1 blocks, exactly real);
-    a pair near coalescence that comes out real has near-parallel shapes, which
-    ``place_unresolved``'s own condition bound refuses, so either way the placement does
-    not act.
+    within 0.02 %).
+
+    Decided on the shapes the placement itself uses (:func:`identify.structural.modal`'s
+    real parts, the same solver): they span the space where their condition number is at
+    most :data:`identify._unresolved.SHAPES_COND_MAX`, the placement's own bound.  A pair
+    near coalescence splits into a real or a complex pair by rounding, differently in each
+    eigensolver, but its shapes are near-parallel either way, so the statement does not
+    depend on which (session 22's review: decided by a second solver, 9 of 300 near-defective
+    ``A`` passed this check and the placement's solve met a singular matrix); a repeated
+    eigenvalue with independent shapes is no coalescence and gives ``""``.  The statement
+    names the pair as complex where LAPACK's eigenvalues have an imaginary part above
+    ``1e-9`` of the largest modulus, else as near-parallel real shapes.
 
     Parameters
     ----------
@@ -615,16 +622,24 @@ def complex_stiffness_pair(A: np.ndarray) -> str:
     Returns
     -------
     str
-        The statement (the pair in Hz), or ``""`` where every eigenvalue is real.
+        The statement (the pair in Hz), or ``""`` where the shapes span the space.
     """
-    lam = np.linalg.eigvals(np.asarray(A, dtype=float))
-    pair = lam[lam.imag > 0.0]
-    if not pair.size:
+    A = np.asarray(A, dtype=float)
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        phi = modal(np.eye(A.shape[0]), A)[1]
+        cond = np.linalg.cond(phi) if np.all(np.isfinite(phi)) else np.inf
+    if cond <= SHAPES_COND_MAX:
         return ""
-    f = np.sqrt(pair.astype(complex)) / (2.0 * np.pi)
-    shown = ", ".join(f"{z.real:.4g} +- {abs(z.imag):.3g}j Hz" for z in f)
-    return (f"none placed: the uncoupled regression's A = M^-1 K has a complex eigenvalue pair "
-            f"({shown}: two modes coalesced, no real mode shapes to place a mode by)")
+    lam = np.linalg.eigvals(A)
+    pair = lam[lam.imag > 1e-9 * np.abs(lam).max()]
+    if pair.size:
+        f = np.sqrt(pair.astype(complex)) / (2.0 * np.pi)
+        shown = ", ".join(f"{z.real:.4g} +- {abs(z.imag):.3g}j Hz" for z in f)
+        return (f"none placed: the uncoupled regression's A = M^-1 K has a complex eigenvalue "
+                f"pair ({shown}: two modes coalesced, no real mode shapes to place a mode by)")
+    return (f"none placed: the uncoupled regression's A = M^-1 K has near-parallel real mode "
+            f"shapes (condition number {cond:.3g} > {SHAPES_COND_MAX:g}: two modes near "
+            "coalescence, no shapes to place a mode by)")
 
 
 def unresolved_warm_start(xdd: np.ndarray, xd: np.ndarray, x: np.ndarray, m_hat: float,

@@ -53,6 +53,11 @@ from identify.structural import MODE_SEPARATION, modal
 #: runs).  Measured on ``b16_ti_n32_s5`` clean, ``ls_sindy``: TRAC 0.998 with 1.0 and 0.9997
 #: with 0.5, modes 1-3 unchanged (not tuned: the declared choice).
 UNRESOLVED_ZETA = float(1.0 / np.sqrt(2.0))
+#: Largest condition number of the mode shapes' matrix (:func:`identify.structural.modal`'s real
+#: parts) by which a mode is placed: past it two shapes are parallel to within rounding (a
+#: coalesced or near-coalesced pair; float64's 1e-16 times 1e12 leaves 1e-4 of a shape's
+#: direction), and a solve with them returns the rounding's choice.
+SHAPES_COND_MAX = 1e12
 
 
 def stiffness_eigenvalues(M: np.ndarray, K: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -127,7 +132,8 @@ def place_unresolved(M: np.ndarray, C: np.ndarray, K: np.ndarray, top_hz: float,
     # one mode only: two or more placed at the one top would be a repeated eigenvalue whose
     # shapes round-off decides (on a non-symmetric warm start, 7 of 200 random 4-DOF models
     # with two modes above the top ended in a singular eigenvector matrix: session 18's review)
-    if np.count_nonzero(bad) != 1 or np.linalg.cond(Phi) > 1e12 or np.any(lam[~bad] <= 0.0):
+    if (np.count_nonzero(bad) != 1 or not np.linalg.cond(Phi) <= SHAPES_COND_MAX
+            or np.any(lam[~bad] <= 0.0)):
         return None
     f_ok = np.sqrt(lam[~bad]) / (2.0 * np.pi)
     for p in np.asarray(peaks, dtype=float):

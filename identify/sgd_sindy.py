@@ -48,7 +48,7 @@ from __future__ import annotations
 
 import dataclasses
 import functools
-from typing import ClassVar
+from typing import Any, ClassVar
 
 import numpy as np
 
@@ -133,6 +133,10 @@ FLOOR_CHECK_ITERATIONS = 1
 #: ``b19_st_s5_hitmid`` clean, SGD 1.6e-6 and warm start 2.8e-7 (scored TRAC 1.6e-6, mode 1 96 %
 #: off, damping ratios to 1.6e5), which failed by its bars alone.
 UNEXPLAINED_RECORD = 0.5
+#: The openings of :func:`record_agreement`'s notes for a simulation from the record's own start
+#: that failed: written there and read by :func:`cubic_diverges`, one spelling for both.
+SIMULATION_FAILED = "simulation failed"
+SIMULATION_NOT_FINITE = "simulation not finite"
 
 
 def record_agreement(model: StructuralIdentifier, data: Measurement,
@@ -204,9 +208,9 @@ def record_agreement(model: StructuralIdentifier, data: Measurement,
                                         max_iterations=iterations)
             tr = trac(ref, simulate(x0, xd0).xdd)
     except (TestbedError, np.linalg.LinAlgError, ValueError, FloatingPointError) as e:
-        return float("nan"), f"simulation failed: {e}"
+        return float("nan"), f"{SIMULATION_FAILED}: {e}"
     if not np.all(np.isfinite(tr)):
-        return float("nan"), "simulation not finite"
+        return float("nan"), SIMULATION_NOT_FINITE
     return float(np.min(tr)), ""
 
 
@@ -236,7 +240,7 @@ def cubic_diverges(note: str) -> bool:
     -------
     bool
     """
-    return note.startswith(("simulation failed", "simulation not finite"))
+    return note.startswith((SIMULATION_FAILED, SIMULATION_NOT_FINITE))
 
 
 def keep_sgd_rule(agree_sgd: float, agree_warm: float | None,
@@ -1134,6 +1138,8 @@ class SGDSINDy(SGDSINDyBase):
         -------
         self
         """
+        for k in ("_lowest_unpaired", "_cubic_diverged"):  # an earlier fit's markers
+            self.__dict__.pop(k, None)
         lam_hat, band_peaks = self._start_fit(data)
         m_hat = mass_prior_value(data, self.mass_prior)
         begun = dict(self.__dict__)
@@ -1158,36 +1164,62 @@ class SGDSINDy(SGDSINDyBase):
             self.cubic_rule_ = refused
         unpaired = self.__dict__.pop("_lowest_unpaired", "")
         if unpaired:
-            # The projected tilted warm start missed the lowest measured peak
-            # (_sgd_matrix.lowest_peak_unpaired): the fit is made again with it refused (flat,
-            # as for any growing tilted warm start), and the one whose kept model explains more
-            # of its record is kept (round 20's b20_soft_r1p2_cf0p3_root2 at 1 %: 0.275 -> 0.993)
-            first, a_first = dict(self.__dict__), self._kept_agreement()
-            self.__dict__.clear()
-            self.__dict__.update(begun)
+            self._lowest_peak_refit(data, lam_hat, band_peaks, m_hat, begun, refused, unpaired)
+        return self
+
+    def _lowest_peak_refit(self, data: Measurement, lam_hat: np.ndarray,
+                           band_peaks: np.ndarray | None, m_hat: float, begun: dict[str, Any],
+                           refused: str, unpaired: str) -> None:
+        """The projected tilted warm start missed the lowest measured peak
+        (:func:`identify._sgd_matrix.lowest_peak_unpaired`): the fit is made again with it
+        refused (flat, as for any growing tilted warm start), and the one whose kept model
+        explains more of its record (:func:`record_agreement`) is kept, stated in
+        ``fit_tilt_rule_`` (round 20's ``b20_soft_r1p2_cf0p3_root2`` at 1 %: 0.275 -> 0.993).
+
+        A candidate with an agreement beats one without (NaN: its simulation failed), as in
+        :func:`keep_sgd_rule`; where the first fit's agreement was not measured (the keep rule
+        did not run: ``keep_sgd`` or ``epochs = 0`` set) nothing is compared and the first fit
+        stands, said so; a refit that fails keeps the first fit, with the reason.
+        """
+        first, a_first = dict(self.__dict__), self._kept_agreement()
+        if a_first == float("inf"):
+            self.fit_tilt_rule_ += (f"; {unpaired}, but no flat fit was compared: the keep rule "
+                                    f"did not run ({self.keep_sgd_rule_}), so neither model's "
+                                    "record agreement is measured")
+            return
+        self.__dict__.clear()
+        self.__dict__.update(begun)
+        try:
             self._fit_banded(data, lam_hat, band_peaks, m_hat,
                              self.cubic if not refused else False, lowest_flat=True)
-            for k in ("_lowest_unpaired", "_cubic_diverged"):
-                self.__dict__.pop(k, None)
-            if refused:
-                self.cubic_rule_ = refused
-            a_flat = self._kept_agreement()
+        except (IdentificationError, np.linalg.LinAlgError, FloatingPointError) as e:
+            self.__dict__.clear()
+            self.__dict__.update(first)
+            self.fit_tilt_rule_ += f"; {unpaired}, but the flat refit failed ({e}): first fit kept"
+            return
+        for k in ("_lowest_unpaired", "_cubic_diverged"):
+            self.__dict__.pop(k, None)
+        if refused:
+            self.cubic_rule_ = refused
+        a_flat = self._kept_agreement()
 
-            def show(a: float) -> str:
-                return f"{a:.4g}" if np.isfinite(a) else "none"
+        def show(a: float) -> str:
+            return f"{a:.4g}" if np.isfinite(a) else "none (its simulation failed)"
 
-            if a_flat > a_first:  # False where either has none (NaN) or neither was measured
-                self.fit_tilt_rule_ += (
-                    f"; the flat fit's model explains more of its record than the projected "
-                    f"tilted one's (record agreement {show(a_flat)} against {show(a_first)}): "
-                    "flat kept")
-            else:
-                self.__dict__.clear()
-                self.__dict__.update(first)
-                self.fit_tilt_rule_ += (
-                    f"; {unpaired}, but the flat fit's model explains no more of its record "
-                    f"(record agreement {show(a_flat)} against {show(a_first)}): tilted kept")
-        return self
+        # the refit's kept model: flat, or the tilted fit with the unresolved mode placed
+        # (_physical_placed keeps the tilt where the placement makes it physical)
+        which = "tilted (its unresolved mode placed)" if self.fit_tilt_ else "flat"
+        if a_flat > a_first or (np.isnan(a_first) and np.isfinite(a_flat)):
+            self.fit_tilt_rule_ += (
+                f"; the refit's {which} model explains more of its record than the projected "
+                f"tilted one's (record agreement {show(a_flat)} against {show(a_first)}): "
+                "refit kept")
+        else:
+            self.__dict__.clear()
+            self.__dict__.update(first)
+            self.fit_tilt_rule_ += (
+                f"; {unpaired}, but the refit's {which} model explains no more of its record "
+                f"(record agreement {show(a_flat)} against {show(a_first)}): first fit kept")
 
     def _fit_banded(self, data: Measurement, lam_hat: np.ndarray, band_peaks: np.ndarray | None,
                     m_hat: float, cubic: bool | None, lowest_flat: bool = False) -> None:

@@ -223,4 +223,4 @@ def test_a_projected_warm_start_whose_modes_miss_the_peaks_falls_back_flat(datas
     assert v["trac"] >= 0.95 and min(v["mac_mode1"], v["mac_mode2"]) >= 0.95
     assert max(v["freq_error_mode1"], v["freq_error_mode2"]) <= 0.01
     assert "its stiffness, not its damping, is wrong" in model.fit_tilt_rule_
-    assert model.fit_tilt_rule_.endswith("flat kept") and not model.fit_tilt_
+    assert model.fit_tilt_rule_.endswith("refit kept") and not model.fit_tilt_

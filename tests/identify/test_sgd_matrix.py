@@ -401,3 +401,32 @@ def test_a_warm_start_that_misses_the_lowest_peak_is_named_and_one_that_carries_
     assert "lowest measured peak 39.8 Hz" in why and "its stiffness, not its damping" in why
     assert lowest_peak_unpaired(np.eye(2), k(40.0, 283.5), lam_hat) == ""
     assert lowest_peak_unpaired(np.eye(2), k(81.76, 283.5), np.empty(0)) == ""
+
+
+def test_near_coalesced_modes_are_decided_on_the_shapes_the_placement_uses():
+    """Two modes near coalescence (a Jordan-like block ``a, 1e-3 a; 0, a`` at 530 Hz) split
+    into a real or a complex pair by rounding, differently in LAPACK's standard and
+    generalised solvers; decided by the standard one, 9 of 300 such warm starts passed the
+    check and the placement's solve with the generalised solver's parallel shapes raised
+    "Singular matrix" (session 22's review).  Now the shapes the placement uses decide
+    (:data:`identify._unresolved.SHAPES_COND_MAX`): none raises, and a repeated eigenvalue
+    with independent shapes (no coalescence; named a complex pair on 48 of 300 before) is no
+    reason at all."""
+    a = (2 * np.pi * 530.0) ** 2
+    raised = 0
+    for seed in range(300):
+        rng = np.random.default_rng(seed)
+        V = np.linalg.qr(rng.standard_normal((4, 4)))[0] + 0.3 * np.eye(4)
+        J = np.diag([(2 * np.pi * 100.0) ** 2, a, a, -(2 * np.pi * 3000.0) ** 2])
+        J[1, 2] = 1e-3 * a
+        A = V @ J @ np.linalg.inv(V)
+        B = V @ np.diag([5.0, 60.0, 60.0, 50.0]) @ np.linalg.inv(V)
+        xd, x = rng.standard_normal((2, 4, 400))
+        try:
+            unresolved_warm_start(-B @ xd - A @ x, xd, x, 0.3, 2000.0, np.array([100.0, 530.0]))
+        except np.linalg.LinAlgError:
+            raised += 1
+        W = rng.standard_normal((4, 4))
+        repeated = W @ np.diag(np.diag(J)) @ np.linalg.inv(W)
+        assert complex_stiffness_pair(repeated) == "", seed
+    assert raised == 0
