@@ -546,16 +546,25 @@ def _guard_fit(fit: Callable[..., Identifier]) -> Callable[..., Identifier]:
         # a fit learns afresh: an earlier fit's learned attributes (public names ending in "_",
         # scikit-learn's convention) are removed first, so none survives into this fit's result
         # or decides one of its rules (session 22's review: SGDSINDy's refit compared an earlier
-        # fit's record_agreement_ with its own)
-        for k in [k for k in vars(self) if k.endswith("_") and not k.startswith("_")]:
-            delattr(self, k)
+        # fit's record_agreement_ with its own).  Only by the outermost fit: a subclass's fit
+        # that calls its parent's (SINDyPI's super().fit) keeps what it has set
+        outermost = not self.__dict__.get("_fit_running", False)
+        if outermost:
+            for k in [k for k in vars(self) if k.endswith("_") and not k.startswith("_")]:
+                delattr(self, k)
         self.check_params_for_data(data)
         free = data.n_samples - data.free_start
         if self.kind == "structural" and free < MIN_FREE_SAMPLES:
             raise IdentificationError(f"fit window from sample {data.free_start} (free_start) holds "
                                       f"{max(free, 0)} samples of the {data.n_samples}; need at "
                                       f"least {MIN_FREE_SAMPLES}")
-        out = fit(self, data, y, **kw) if takes_y else fit(self, data, **kw)
+        if outermost:
+            self.__dict__["_fit_running"] = True
+        try:
+            out = fit(self, data, y, **kw) if takes_y else fit(self, data, **kw)
+        finally:
+            if outermost:
+                self.__dict__.pop("_fit_running", None)
         if out is not self:
             # a plugin's fit returning None was scored as fitted, and the API's chain
             # ``Id().fit(d).equations()`` handed the user None (hostile round 19's open item)
