@@ -520,7 +520,14 @@ class SGDSINDy(SGDSINDyBase):
     cubic : bool or None
         Add the cubic features ``x_j^3`` (identifies ``K3_``); None (default): by rule
         (:func:`identify._cubic_rule.cubic_rule`; ``cubic_`` and ``cubic_rule_`` say what was
-        chosen and why).
+        chosen and why).  ``True`` asks for the cubic library; one exception, stated in
+        ``cubic_rule_``: a cubic model that neither the SGD nor its warm start can simulate
+        from the record's own start (:func:`cubic_diverges`) is replaced by the linear
+        library's fit.  Why the user's ``True`` is not honoured there, where ``fit_tilt``'s is
+        (refused, an error): such a model has no response to score, while the rig's record
+        still has a linear part to fit; the scorer names the missing cubic where the truth's
+        cubic force would move a frequency past its bar ("linear model").  The shipped soft
+        scenario's table, and so the families' soft members, set ``True``.
     l1 : {"cubic", "none"}
         ``"cubic"``: the lasso on the standardised cubic coefficients, then debiasing (acts
         only with ``cubic=True``); ``"none"``: no L1, the cubic block is plain least squares.
