@@ -344,6 +344,34 @@ def noise_free_ratio(bound: float) -> float:
     return float(bound) / (1.0 - float(bound))
 
 
+def determinacy_entry(value: Any, n_equations: int) -> dict[str, Any]:
+    """An identifier's ``determinacy_`` as the scorer keeps it: ``{"determinacy": array}``
+    (one ratio per equation, each >= 0, inf or NaN), or ``{"determinacy_note": why}`` where
+    the value is not that (a plugin's: another shape, a negative or non-numeric value), which
+    then words no reason (review 22b: a (1, 1) array raised a TypeError in the scorer, a
+    negative one was taken as determined).
+
+    Parameters
+    ----------
+    value : array_like
+        The identifier's ``determinacy_``.
+    n_equations : int
+        The identified equations' count.
+
+    Returns
+    -------
+    dict
+    """
+    try:
+        arr = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        arr = None
+    if arr is None or arr.ndim != 1 or arr.size != n_equations or np.any(arr < 0.0):
+        return {"determinacy_note": (f"the identifier's determinacy_ ({show_value(value)}) is not "
+                                     f"one ratio >= 0 per equation ({n_equations}): not used")}
+    return {"determinacy": arr}
+
+
 def shown_undetermined(bound: float) -> bool:
     """Whether an identifier's ``determinacy_`` leaves the equation not shown determined: the
     noise's Gram may exceed the noise-free gap (:func:`noise_free_ratio` above
@@ -412,15 +440,19 @@ def equation_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -
     if short:
         worst = max(bound[k] for k in short)
         if worst >= UNDETERMINED:
+            head = "equation not determined by the record"
             reach = (f"reaches {worst:.3g} x the gap to another equation of the same terms")
         else:  # measured on the noisy rows: the noise-free gap may be (1 - worst) of it
+            # not proven short: the noise-free ratio lies between d and d / (1 - d), so the
+            # record is only not shown to determine the equation (review 22b)
+            head = "equation not shown determined by the record"
             reach = (f"is {worst:.3g} x the gap to another equation of the same terms on the "
                      f"record's rows, which hold that noise: the noise-free gap may be as small "
-                     f"as {1.0 - worst:.2g} of it (Weyl), {noise_free_ratio(worst):.2g} x below "
-                     "the noise's Gram")
-        return {"equation": (f"equation not determined by the record: {said}; at the record's "
-                             f"own noise level the noise's Gram {reach} (the identifier's "
-                             f"determinacy_, from the data alone; {why})")}
+                     f"as {1.0 - worst:.3g} of it (Weyl), so the noise's Gram may be up to "
+                     f"{noise_free_ratio(worst):.3g} x it")
+        return {"equation": (f"{head}: {said}; at the record's own noise level the noise's "
+                             f"Gram {reach} (the identifier's determinacy_, from the data "
+                             f"alone; {why})")}
     undetermined = [k for k in range(bound.size) if shown_undetermined(bound[k])]
     if undetermined:
         terms = sorted({t for k in undetermined for t in extra[k]})
@@ -930,25 +962,40 @@ def sensor_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -> 
         "regular model of that size exists for this record (rig.sensors, rig.n_segments)")}
 
 
-#: The truth's cubic force share (its ``K3_force_ratio``: the cubic base force's norm over the
-#: linear force's, over the free decay) from which a linear model's failed bar names the missing
-#: term (:func:`linear_model_failures`): a force share ``r`` left to a linear stiffness moves
-#: a frequency by about ``sqrt(1 + r) - 1``, which reaches the families' 2.6 % frequency bar at
-#: ``1.026^2 - 1`` = 0.0527.  Where to say it, not a verdict: only failed bars are explained.
-MISSED_CUBIC_SHARE = 1.026**2 - 1.0
+def missed_cubic_share(freq_bar: float) -> float:
+    """The truth's cubic force share (its ``K3_force_ratio``: the cubic base force's norm over
+    the linear force's, over the free decay) from which a linear model's failed frequency bar
+    names the missing term (:func:`linear_model_failures`): a force share ``r`` left to a
+    linear stiffness moves a frequency by about ``sqrt(1 + r) - 1``, which reaches a relative
+    frequency bar ``b`` at ``(1 + b)^2 - 1`` (the families' 2.6 %: 0.0527).  Where to say it,
+    not a verdict: only failed bars are explained.
+
+    Parameters
+    ----------
+    freq_bar : float
+        The run's smallest frequency-error bar [-] (a fraction).
+
+    Returns
+    -------
+    float
+        The share [-].
+    """
+    return (1.0 + float(freq_bar)) ** 2 - 1.0
 
 
 def linear_model_failures(scores: Scores, thresholds: dict[str, dict[str, float]]
                           ) -> dict[str, str]:
-    """A failed bar of a linear model on a truth whose cubic force is not small:
+    """A failed frequency bar of a linear model on a truth whose cubic force is not small:
     ``{"cubic": reason}``.
 
     Round 21's ``b21_soft_f300`` (the shipped soft base under 300 N, cubic fraction about 8 at
     the peak base rotation), clean: both identifiers kept the cubic terms out (``ls_sindy``'s
     cubic rule: partial correlation 0.173 <= 0.65) and failed modes 1-2 by 17-24 % with TRAC
-    0.22-0.56, the truth's cubic force 2.6x its linear one over the free decay: the failure
-    was named by its bars alone.  Only a bar that already failed is explained, so no verdict
-    changes.
+    0.22-0.56, the truth's cubic force 1.5x its linear one over the free decay: the failure
+    was named by its bars alone.  Only a frequency bar (``freq_error_*``, what the share's
+    derivation is about) that already failed is explained, from the run's own smallest such
+    bar (:func:`missed_cubic_share`), so no verdict changes; nothing where the fit, the
+    model or its simulation failed (that failure says why).
 
     Parameters
     ----------
@@ -960,14 +1007,21 @@ def linear_model_failures(scores: Scores, thresholds: dict[str, dict[str, float]
         The run's bars, ``{metric: {"min"|"max": value}}``.
     """
     share = scores.details.get("truth_cubic_share")
-    if share is None or not share >= MISSED_CUBIC_SHARE or scores.values.get("K3_norm") != 0.0:
+    if (share is None or scores.values.get("K3_norm") != 0.0
+            or {"fit", "model", "simulation"} & set(scores.failures)):
         return {}
-    if not [c for c in check_thresholds(scores.values, thresholds) if not c.passed]:
+    missed = [c for c in check_thresholds(scores.values, thresholds)
+              if not c.passed and c.metric.startswith("freq_error") and c.bound == "max"]
+    if not missed:
+        return {}
+    bar = min(c.threshold for c in missed)
+    least = missed_cubic_share(bar)
+    if not share >= least:
         return {}
     return {"cubic": (f"linear model: the identified model has no cubic term, where the truth's "
                       f"cubic base force is {share:.3g} x its linear force over the free decay "
-                      f"(norms; from {MISSED_CUBIC_SHARE:.3g} on, such a force left to a linear "
-                      "stiffness can move a frequency by the families' 2.6 % bar): the failed "
+                      f"(norms; from {least:.3g} on, such a force left to a linear stiffness "
+                      f"can move a frequency by the run's {bar:.3g} bar): the failed frequency "
                       "bars may be the missing term's")}
 
 
@@ -1480,10 +1534,11 @@ def score_structural(dataset: Dataset, data: Measurement, clean: Measurement, mo
     else:
         v["K3_force_ratio"] = 0.0
     k3 = 0.0 if truth.k3 is None else float(truth.k3)
-    if k3 != 0.0:
-        if truth.cubic_map is None or truth.cubic_direction is None:
-            raise TruthError("structural truth: a nonzero 'k3' needs 'cubic_map' and "
-                             "'cubic_direction'", "cubic_map")
+    mapped = truth.cubic_map is not None and truth.cubic_direction is not None
+    if K3 is not None and k3 != 0.0 and not mapped:
+        raise TruthError("structural truth: a nonzero 'k3' needs 'cubic_map' and "
+                         "'cubic_direction'", "cubic_map")
+    if k3 != 0.0 and mapped:  # a linear model of such a truth is scored as before, no share
         x_ref = clean.x[:, i0:]
         q0 = truth.cubic_map @ x_ref
         f_true = np.outer(truth.cubic_direction, k3 * q0**3)
@@ -2030,7 +2085,7 @@ def score_dynamical(dataset: Dataset, data: Measurement, clean: Measurement, mod
              coef_term_errors=cmp["coef_errors"], coef_errors=errs.max(axis=1),
              equation_bars=rig_equation_bars(dataset))
     if getattr(model, "determinacy_", None) is not None:  # the identifier's own, from the data
-        d["determinacy"] = np.asarray(model.determinacy_, dtype=float)
+        d.update(determinacy_entry(model.determinacy_, int(np.shape(cmp["coef_id"])[0])))
     lacking = [f"of {data.channels[i] if i < len(data.channels) else i} lacks {t}"
                for i, t in enumerate(cmp["unscaled"]) if t is not None]
     if lacking:  # why coef_error is infinite, for the equation bars' reason (round 19's

@@ -56,7 +56,8 @@ SCORED_REASONS = ("fit failed", "diverged", "simulation failed", "non-physical",
 #: occur inside other reasons ("at the sensors").  Without them a floor or an unexcited mode
 #: was counted as "other" (held-out families, 2026-11-28).
 EXPLAINED_REASONS = ("uninformative", "out of band", "unexcited", "decayed", "floor", "sensors",
-                     "wrong equation", "equation not determined", "rollout step",
+                     "wrong equation", "equation not determined",
+                     "equation not shown determined", "rollout step",
                      "sensitive record", "clipped", "linear model")
 _EXPLAINED = re.compile(r"(?:^|; )(" + "|".join(map(re.escape, EXPLAINED_REASONS)) + r")\b")
 
@@ -68,7 +69,9 @@ UNSCORED = ("crash", "refused")
 def refusal(type_name: str) -> bool:
     """Whether an exception type the sweep recorded (by name) is a refusal of what the cell asks:
     a :class:`~testbed.core.errors.RigError` or :class:`~testbed.core.errors.ScenarioError`
-    (and their subclasses, e.g. ``BudgetError``) of :mod:`testbed.core.errors`, which a rig or
+    (and their subclasses, e.g. ``BudgetError``) of :mod:`testbed.core.errors` (the sweep
+    records a plugin's own subclass by the nearest of those and another module's class of the
+    same name by its qualified name: :func:`testbed.studies.sweep.error_name`), which a rig or
     the scenario's loader raises for a scenario it cannot build or simulate as asked, in one
     line naming the keys (round 21's ``fb21_ms_amp1p5``: "the motion under excitation
     'multisine' is not usable (found only by simulating it) ... transmission angle 150.00 deg"),
@@ -135,8 +138,11 @@ def failed_cells_line(rows: list[dict[str, Any]]) -> str | None:
                                             (refused, "refused by the rig or the scenario"),
                                             (scored, "scored failure(s) with their reason"),
                                             (other, "with another error")) if n]
+    again = ("; `testbed sweep --retry-failed` runs them again" if refused < len(kinds) else "")
+    if refused and again:
+        again += " (a refused cell is refused again until its scenario changes)"
     return (f"{len(kinds)} cell(s) failed ({', '.join(parts)}; `testbed summary` counts the "
-            "reasons); `testbed sweep --retry-failed` runs them again")
+            f"reasons){again}")
 
 
 def _judged(rows: list[dict[str, Any]]) -> list[bool]:

@@ -47,6 +47,7 @@ except ImportError:  # (not on Windows)
 
 from joblib import Parallel, delayed, parallel_config
 
+from testbed.core import errors
 from testbed.core.atomic import atomic_write_text, begin_in_flight, end_in_flight, not_regular
 from testbed.core.errors import IdentificationError, InputError, show_value
 from testbed.core.provenance import git_commit, versions
@@ -213,10 +214,28 @@ def parallel(fn: Callable[..., Any], args: Iterable[tuple], n_jobs: int) -> Iter
 
 
 # --------------------------------------------------------------------------- tasks (run in workers)
+def error_name(e: BaseException) -> str:
+    """The exception's name as a failed cell's row records it (read back by
+    :func:`testbed.studies.statistics.failure_kind`): its class name, but a refusal
+    (:class:`~testbed.core.errors.RigError`, :class:`~testbed.core.errors.ScenarioError`)
+    whose class :mod:`testbed.core.errors` does not hold (a plugin's subclass) is named by the
+    nearest class there, its own name after it, and another class that only shares a name
+    with one there by its qualified name: the name decides refused or crashed (review 22b)."""
+    cls = type(e)
+    if isinstance(e, (errors.RigError, errors.ScenarioError)):
+        if getattr(errors, cls.__name__, None) is cls:
+            return cls.__name__
+        base = next(c for c in cls.__mro__ if getattr(errors, c.__name__, None) is c)
+        return f"{base.__name__}: {cls.__name__}"
+    if hasattr(errors, cls.__name__) and getattr(errors, cls.__name__) is not cls:
+        return f"{cls.__module__}.{cls.__name__}"
+    return cls.__name__
+
+
 def _error_text(e: BaseException) -> str:
     tb = traceback.extract_tb(e.__traceback__)
     where = f" ({Path(tb[-1].filename).name}:{tb[-1].lineno})" if tb else ""
-    return f"{type(e).__name__}: {e}{where}"
+    return f"{error_name(e)}: {e}{where}"
 
 
 _WORKER_LOCK = threading.Lock()

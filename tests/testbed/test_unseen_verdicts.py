@@ -21,12 +21,12 @@ from testbed.scoring.run import run_scenario
 from testbed.scoring.scorers import (
     FAIL,
     GROWTH_FACTOR,
-    MISSED_CUBIC_SHARE,
     REDUCED_TRUTH_GAP,
     Scores,
     growth_failure,
     late_growth,
     linear_model_failures,
+    missed_cubic_share,
     reduced_truth_gap,
     sensitivity_failures,
     sensor_failures,
@@ -843,7 +843,7 @@ def test_a_law_the_noisy_rows_do_not_show_determined_names_the_record():
     bound = float(r.scores.details["determinacy"][0])
     assert 0.5 < bound < 1.0
     why = r.scores.failures["equation"]
-    assert why.startswith("equation not determined by the record: coef_error")
+    assert why.startswith("equation not shown determined by the record: coef_error")
     assert f"the noise's Gram is {bound:.3g} x the gap" in why
 
 
@@ -870,6 +870,17 @@ def test_a_linear_model_of_a_strongly_cubic_base_names_the_missing_term():
                                         s.details), bars) == {}
     assert linear_model_failures(Scores({"K3_norm": 1e12, "freq_error_mode1": 0.2},
                                         s.details), bars) == {}
-    for small in (0.5 * MISSED_CUBIC_SHARE, float("nan")):
+    for small in (0.5 * missed_cubic_share(0.026), float("nan")):
         assert linear_model_failures(Scores(s.values, {"truth_cubic_share": small}), bars) == {}
     assert linear_model_failures(Scores(s.values, {}), bars) == {}  # a linear truth
+    # review 22b: only a failed frequency bar, from the run's own bar, and never where the fit,
+    # the model or its simulation failed (that failure says why)
+    assert missed_cubic_share(0.026) == pytest.approx(0.052676)
+    trac = Scores({"K3_norm": 0.0, "trac": 0.5, "freq_error_mode1": 0.0}, s.details)
+    assert linear_model_failures(trac, {**bars, "trac": {"min": 0.95}}) == {}
+    wide = {"freq_error_mode1": {"max": 0.7}}  # from 1.7^2 - 1 = 1.89 on: 1.5 says nothing
+    assert linear_model_failures(Scores({"K3_norm": 0.0, "freq_error_mode1": 0.8},
+                                        {"truth_cubic_share": 1.5}), wide) == {}
+    assert "run's 0.026 bar" in linear_model_failures(s, bars)["cubic"]
+    for failed in ("fit", "model", "simulation"):
+        assert linear_model_failures(Scores(s.values, s.details, {failed: "x"}), bars) == {}

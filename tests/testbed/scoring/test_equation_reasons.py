@@ -6,6 +6,7 @@ import pytest
 
 from testbed.scoring.scorers import (
     Scores,
+    determinacy_entry,
     equation_failures,
     noise_free_ratio,
     shown_undetermined,
@@ -56,9 +57,11 @@ def test_a_ratio_measured_on_the_noisy_rows_above_one_half_names_the_record():
     s = scores([-18.4, 1.0, -16.1, 0.875, 0.0], 0.79)
     assert spurious_terms(s.details) == [[]]
     why = equation_failures(s, {"state_rmse": {"max": 0.01}})["equation"]
-    assert why.startswith("equation not determined by the record: coef_error 1.6 above 0.05")
+    # not proven short (the noise-free ratio lies between 0.79 and 3.76): "not shown", a head
+    # of its own (review 22b), kept apart from the proven "not determined" of 1 and more
+    assert why.startswith("equation not shown determined by the record: coef_error 1.6 above 0.05")
     assert "the noise's Gram is 0.79 x the gap" in why
-    assert "may be as small as 0.21 of it (Weyl), 3.8 x below the noise's Gram" in why
+    assert "may be as small as 0.21 of it (Weyl), so the noise's Gram may be up to 3.76 x it" in why
     # with a term the law lacks, the ratio does not show the record short (as from 1 on)
     s = scores([-18.4, 1.0, -16.1, 0.875, 0.02], 0.79)
     why = equation_failures(s, {"state_rmse": {"max": 0.01}})["equation"]
@@ -81,4 +84,18 @@ def test_the_noise_free_ratio_a_measured_determinacy_allows(bound, named):
         assert r == pytest.approx(bound / (1.0 - bound))
     why = equation_failures(scores([0.005, 0.1, -0.003, 1.0, 0.0], bound),
                             {"state_rmse": {"max": 0.01}})["equation"]
-    assert why.startswith("equation not determined by the record" if named else "wrong equation")
+    head = ("equation not determined by the record" if bound >= 1.0 else
+            "equation not shown determined by the record")
+    assert why.startswith(head if named else "wrong equation")
+
+
+@pytest.mark.parametrize("value", [np.array([[0.79]]), 0.79, np.array([-0.5]), "0.79",
+                                   np.array([0.1, 0.2]), object()])
+def test_a_determinacy_that_is_not_one_ratio_per_equation_is_noted_not_used(value):
+    """A plugin's ``determinacy_`` of another shape raised a TypeError (a (1, 1) array) or an
+    IndexError (a scalar) in the scorer, and a negative one was taken as determined (review
+    22b): now noted and not used, so the reason is the bars' own."""
+    got = determinacy_entry(value, 1)
+    assert set(got) == {"determinacy_note"} and "not used" in got["determinacy_note"]
+    assert determinacy_entry([0.79], 1)["determinacy"].tolist() == [0.79]
+    assert np.isnan(determinacy_entry([np.nan], 1)["determinacy"][0])

@@ -8,6 +8,7 @@ import math
 import numpy as np
 from rich.console import Console
 
+from testbed.core import errors
 from testbed.studies.results import write_part, write_rows
 from testbed.studies.statistics import (
     failed_cells_line,
@@ -16,6 +17,7 @@ from testbed.studies.statistics import (
     scored,
     summarize,
 )
+from testbed.studies.sweep import _error_text, error_name
 
 CHECKS = '[{"metric": "trac", "bound": "min", "threshold": 0.75}]'
 
@@ -163,3 +165,32 @@ def test_a_scenario_the_rig_refuses_is_counted_refused_not_crashed(tmp_path):
     assert g["failures"] == {"refused: RigError": 1} and g["scored"] == 1
     assert g["judged"] == 2 and g["pass_rate"] == 0.5  # held to bars elsewhere: not passed
     assert not scored(rows[1])
+
+
+def test_a_refusal_is_told_by_its_class_not_by_a_name_it_shares():
+    """The sweep records a failed cell's exception by name, and the name decides refused or
+    crashed (review 22b): a plugin's own subclass of RigError was counted a crash, and another
+    module's class called RigError a refusal.  Now a subclass is recorded by the nearest class
+    of testbed.core.errors, a namesake by its qualified name; a line of refusals alone does not
+    offer --retry-failed, which would refuse them again."""
+    class PluginRigError(errors.RigError):
+        pass
+
+    class RigError(Exception):  # a namesake, not ours
+        pass
+
+    for e, kind in ((PluginRigError("no"), "refused: RigError"), (errors.RigError("no"),
+                    "refused: RigError"), (RigError("no"), None), (ValueError("no"),
+                                                                    "crash: ValueError")):
+        try:
+            raise e
+        except Exception as caught:
+            text = _error_text(caught)
+        got = failure_kind(text)
+        assert got == [kind] if kind else got[0].startswith("crash: ") and "RigError" in got[0]
+    assert error_name(PluginRigError("no")) == "RigError: PluginRigError"
+    only = failed_cells_line([{"status": "failed", "error": REFUSED}])
+    assert "--retry-failed" not in only
+    both = failed_cells_line([{"status": "failed", "error": REFUSED},
+                              {"status": "failed", "error": "ValueError: boom (x.py:3)"}])
+    assert "--retry-failed` runs them again (a refused cell is refused again" in both
