@@ -126,7 +126,15 @@ class LeastSquaresSINDy(StructuralIdentifier):
        tilted fit's 29.83 Hz, its modal coordinate's decay fit 29.14 Hz): mode 1 169 -> 0.05 %
        (MAC 0.35 unchanged, still failing), TRAC 0.977 -> 0.994; ``b20_st_s4root_tip`` 5 % TRAC
        0.949 -> 0.984; clamped member 032 at 1 % mode 1 138 -> 146 % (failing both ways); no
-       verdict changed on 326 beam cells (families 0 / 1 %, rounds 19-20).
+       verdict changed on 326 beam cells (families 0 / 1 %, rounds 19-20).  Such a mode also
+       takes that fit's shape, each channel's amplitude of the one decay
+       (:func:`identify._modal_damping.peak_shape`, ``set_shapes``; the rule says "shaped by
+       that fit"): the fit's shape of a mode the pairing found misplaced has as little behind
+       it as its frequency.  ``r20_stiff__002`` at 1 %: mode 1 MAC 0.35 -> 0.9999 (pass;
+       TRAC 0.994 -> 0.977).  On the same 326 cells (2026-11-28): passes 279 -> 281
+       (also ``b20_st_s2_hit0p1_z3`` 3 % seed 113, TRAC 0.895 -> 0.922), none lost; it acts
+       on 20, MAC of the shaped mode up on 12 (soft member 006 at 1 % mode 2 0.89 -> 0.99),
+       largest TRAC drop on a pass the 0.017 above.
 
     With the cubic library step 1 acts as on the linear one, except that a non-physical tilted
     fit goes flat at once (step 2 does not act on a cubic model, so no hold repairs it:
