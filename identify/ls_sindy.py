@@ -614,7 +614,6 @@ class LeastSquaresSINDy(StructuralIdentifier):
             The velocity and displacement columns of ``coef_``.
         """
         i0, i1 = fit_window(data, 0.0)
-        self._fs, self._trap = float(data.fs), data.integration == "trapezoid"
         line = float(data.fs) / (i1 - i0)  # one line of the window's transform [Hz]
         self.eigen_targets_ = np.zeros(self.M_.shape[0])
         self.eigen_shift_ = 0.0
@@ -644,7 +643,7 @@ class LeastSquaresSINDy(StructuralIdentifier):
         held = decay_hold(data, self.M_, self.C_, self.K_, (i0, i1),
                           lambda on, lam: set_eigenvalues(self.M_, self.K_, np.where(on, lam, np.nan)),
                           self.decay_hold, self.K3_, self.decay_backbone,
-                          self._unlocated(peaks), self.eigen_targets_, self._free_peaks(data, peaks))
+                          self._unlocated(data, peaks), self.eigen_targets_, self._free_peaks(data, peaks))
         if held.decay is not None:
             self.modal_decay_ = held.decay
         self.coef_[:, v_block] -= (held.C - self.C_) / m
@@ -652,22 +651,22 @@ class LeastSquaresSINDy(StructuralIdentifier):
         self._set_stiffness(held.K, m, d_block)
         self.decay_rule_ = held.rule
 
-    def _unlocated(self, peaks: np.ndarray) -> np.ndarray | None:
+    def _unlocated(self, data: Measurement, peaks: np.ndarray) -> np.ndarray | None:
         """Modes the eigenvalue hold paired with no measured peak (``eigen_targets_`` 0), when
         it paired at all (``eigen_hold`` on, some peak accepted); else None.  A cubic model is
         not held, but paired the same way (:func:`identify._sgd_matrix.eigen_targets` on its
-        linear stiffness; the record's rate and integration as :meth:`_hold` saw them)."""
+        linear stiffness, the peaks warped as the hold warps them)."""
         if not self.eigen_hold or peaks.size == 0:
             return None
         if self.K3_ is not None:  # not held, but paired as the hold pairs (class docstring)
-            f = warp_frequency(peaks, float(self._fs)) if self._trap else peaks
+            f = warp_frequency(peaks, float(data.fs)) if data.integration == "trapezoid" else peaks
             return eigen_targets(self.M_, self.K_, (2.0 * np.pi * f) ** 2) == 0
         return self.eigen_targets_ == 0
 
     def _free_peaks(self, data: Measurement, peaks: np.ndarray) -> np.ndarray | None:
         """Accepted peaks [Hz] the eigenvalue hold paired with no mode (as measured), when it
         paired at all (:meth:`_unlocated`); else None."""
-        if self.K3_ is not None or self._unlocated(peaks) is None:
+        if self.K3_ is not None or self._unlocated(data, peaks) is None:
             return None
         f = warp_frequency(peaks, float(data.fs)) if data.integration == "trapezoid" else peaks
         taken = self.eigen_targets_[self.eigen_targets_ > 0]
