@@ -94,6 +94,30 @@ non-physical fit).  At 0 % noise the
 same fit gives mode 2 of member 013 within 0.14 %; at 1 % 2.5 % (784.5 / 797.2 against 777.7
 Hz, zeta 18 %: the noise, the fit's minimum is unique from starts 0.6-2 x the model's).
 
+In a cubic model (backbone fits) a mode no accepted peak located (``unlocated``, paired as
+the eigenvalue hold pairs, although the hold does not act on a cubic model) whose backbone
+fit converged with ``|c| > BACKBONE_MAX_SHIFT wd`` (no first-order backbone, so not taken) is
+refitted as an exponential decay (``exponential`` of :class:`ModalDecay`), and that decay's
+frequency is taken wherever it lies, as a linear model's unlocated mode's.  Round 20's
+``r20_soft__003`` clean (cubic chosen at partial correlation 0.665; one accepted peak, 40.6
+Hz; mode 2 267.2 Hz, 8.4 % damped, no peak): the cubic fit's mode 2 239.4 Hz (-10.4 %) was
+kept; its modal coordinate's backbone fit gave ``c`` = -113 Hz at 285.7 Hz, the exponential
+fit 269.0 Hz, zeta 7.7 %: mode 2 10.4 -> 0.99 %.  Only such modes: the fallback on every mode
+whose backbone fit fails the first order lost 11 passes of 326 (the shipped soft base under
+150 N: mode 1's large ``c`` is real, TRAC 0.99 -> 0.08-0.72), and the unlocated modes' free
+frequency for every backbone fit lost soft member 008 (its 20.6 % damped mode 2 moved
++3.3 %, clean and at 1 %).
+
+A mode fitted from the accepted peak no mode took (``free_peaks_hz``) also takes that fit's
+shape (:func:`peak_shape`, :func:`set_shapes`; ``decay_rule_`` says "shaped by that fit"):
+each channel's amplitudes of the one decay, their common phase, at the model's norm and sign,
+eigenvalues and modal damping kept.  The fit's shape of such a mode has as little behind it
+as its frequency, which the pairing found wrong: round 20's ``r20_stiff__002`` at 1 % (two
+sensors, mode 1 at 10.79 Hz, 0.19 % damped; the tilted fit put mode 1 at 29.83 Hz, weighed
+1/39 of mode 2) kept the tilted fit's shape, MAC 0.35 against the engine's, where the
+peak's fit on both channels gives 0.9999.  Not taken where the shapes would not span the
+space, or where the held model would then grow and did not before.
+
 Measured (2026-11-27, the 60 beams of studies/families.toml, member by member against the
 previous rule, this form and the first alike; issue bars: TRAC, MAC >= 0.95, modes 1-2
 within 1 %; study bars 0.90 / 2.6 %):
@@ -287,6 +311,10 @@ class ModalDecay:
     amplitude : ndarray, shape (n,) or None
         With the backbone fit, each modal acceleration's amplitude at the window's start
         [m/s^2 in modal units] (NaN where not taken); None without it.
+    shape : ndarray, shape (n_channels, n) or None
+        Column ``k``: the sensor shape of mode ``k`` measured by its fit from an accepted peak
+        no mode took (:func:`peak_shape`; ``free_peaks_hz`` of :func:`modal_decay`), NaN for
+        the other modes; None where no mode was so fitted.
     """
 
     sigma: np.ndarray
@@ -298,6 +326,8 @@ class ModalDecay:
     taken: np.ndarray
     chirp: np.ndarray | None = None
     amplitude: np.ndarray | None = None
+    shape: np.ndarray | None = None
+    exponential: np.ndarray | None = None
 
 
 def _two_column_qr(A: np.ndarray) -> tuple[float, np.ndarray, float, float, np.ndarray | None]:
@@ -578,6 +608,13 @@ def modal_decay(data: Measurement, M: np.ndarray, K: np.ndarray, C: np.ndarray,
     fits = {}
     for k in np.concatenate([np.flatnonzero(~free), np.flatnonzero(free)]):
         s, wd, r2, ok, c, amp = _decay_fit(q[k], t, 0.5 * d[k], w[k], backbone, nuisance)
+        if backbone and ok and abs(c) > BACKBONE_MAX_SHIFT * wd and free[k]:
+            # no peak located it and its decay holds no first-order backbone: the exponential
+            # decay ("Cubic library")
+            s, wd, r2, ok, c, amp = _decay_fit(q[k], t, 0.5 * d[k], w[k], False, nuisance)
+            if out.exponential is None:
+                object.__setattr__(out, "exponential", np.zeros(n, bool))
+            out.exponential[k] = ok
         out.r2[k] = r2
         paired = abs(np.log(wd / w[k])) <= np.log1p(MODE_SEPARATION)
         peak = _free_peak(free_peaks_hz, w, k, data, i1 - i0) if free[k] and not backbone \
@@ -587,6 +624,11 @@ def modal_decay(data: Measurement, M: np.ndarray, K: np.ndarray, C: np.ndarray,
                                        unlocated_band(w, k, peak_band(data, i1 - i0)[0]),
                                        nuisance, fits)
             paired = True
+            v = peak_shape(xdd[:, i0:i1], t, s, wd, nuisance, fits) if ok else None
+            if v is not None:
+                if out.shape is None:
+                    object.__setattr__(out, "shape", np.full((xdd.shape[0], n), np.nan))
+                out.shape[:, k] = v
         elif free[k] and not backbone and not (ok and paired):
             # no peak located it and its modal coordinate's fit is not taken: every channel's
             # record, between its neighbours (module docstring, "Unlocated modes")
@@ -653,15 +695,57 @@ def _unlocated_fit(x: np.ndarray, t: np.ndarray, start: tuple[float, float],
     ok : bool
         Converged with no parameter at a bound (:func:`_decay_fit`).
     """
+    y, _, cols = _channel_problem(x, t, nuisance, taken)
+    s, wd, _, ok, _, _ = _decay_fit(y, t, start[0], float(np.hypot(*start)), False, cols, band)
+    return s, wd, ok
+
+
+def _channel_problem(x: np.ndarray, t: np.ndarray, nuisance: np.ndarray | None,
+                     taken: dict[int, tuple[float, float]]
+                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+    """:func:`_unlocated_fit`'s signals and nuisance columns: each channel of ``x`` (shape
+    (n_channels, N)) at unit RMS, shape (N, m) (channels at zero RMS left out); the RMS
+    [m/s^2] of each channel, shape (n_channels,); the chain's transients and the taken
+    decays' waveforms as columns (shape (N, k)), or None."""
     rms = np.sqrt(np.mean(x * x, axis=1))
     y = (x[rms > 0] / rms[rms > 0, None]).T  # each channel at unit RMS (noise: a share of it)
     cols = [] if nuisance is None else [nuisance]
     for s, wd in taken.values():
         e = np.exp(-s * t)
         cols.append(np.column_stack([e * np.cos(wd * t), e * np.sin(wd * t)]))
-    s, wd, _, ok, _, _ = _decay_fit(y, t, start[0], float(np.hypot(*start)), False,
-                                    np.hstack(cols) if cols else None, band)
-    return s, wd, ok
+    return y, rms, np.hstack(cols) if cols else None
+
+
+def peak_shape(x: np.ndarray, t: np.ndarray, sigma: float, omega_d: float,
+               nuisance: np.ndarray | None, taken: dict[int, tuple[float, float]]
+               ) -> np.ndarray | None:
+    """The sensor shape of a decay fitted on every channel at once (:func:`_unlocated_fit`).
+
+    Each channel's amplitudes ``(a, b)`` of ``exp(-sigma t) (a cos + b sin)(omega_d t)``
+    (the nuisance columns profiled out, as in the fit) form a (2, n_channels) matrix; its
+    first right singular vector is the shape, the direction every channel rings in with one
+    phase (a real mode: the second singular value is that part of the amplitudes no common
+    phase explains).  Accelerations and displacements of one mode share it.
+
+    Parameters
+    ----------
+    x, t, nuisance, taken
+        As :func:`_unlocated_fit`.
+    sigma, omega_d : float
+        The fitted decay rate [1/s] and damped frequency [rad/s].
+
+    Returns
+    -------
+    ndarray, shape (n_channels,), or None
+        Unit norm, its largest entry positive; None where a channel is at zero RMS.
+    """
+    y, rms, cols = _channel_problem(x, t, nuisance, taken)
+    if np.any(rms <= 0):
+        return None
+    _, _, coef = _decay_problem(y, t, False, cols)
+    ab = np.asarray(coef(np.array([sigma, omega_d], dtype=float))) * rms[None, :]
+    v = np.linalg.svd(ab)[2][0]
+    return v if v[np.argmax(np.abs(v))] > 0 else -v
 
 
 def unlocated_band(w: np.ndarray, k: int, peak_band_hz: tuple[float, float]) -> tuple[float, float]:
@@ -900,6 +984,8 @@ def decay_hold(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndarray,
         gap = np.abs(np.sqrt(dec.lam_model)[:, None] - w[None, :])
         return move & np.all(gap >= np.diag(gap)[:, None], axis=1)
 
+    if with_backbone:  # a cubic model's mode no peak located, whose decay showed no backbone
+        free = free & (np.zeros_like(free) if dec.exponential is None else dec.exponential)
     if np.any(free):
         free = own_nearest(free)
     # the peak offset widens the bound where the model's frequency stands at a spectral peak
@@ -945,6 +1031,16 @@ def decay_hold(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndarray,
             p = _free_peak(free_peaks_hz, w_fit, int(k), data, i1 - i0)
             if p is not None:
                 from_peak[int(k) + 1] = p / (2.0 * np.pi)
+    shaped = np.zeros(M.shape[0], bool)
+    if from_peak and dec.shape is not None:
+        shaped = np.array([k + 1 in from_peak for k in range(M.shape[0])]) \
+            & np.all(np.isfinite(dec.shape), axis=0)
+        held = set_shapes(M, C2, K2, np.where(shaped, dec.shape, np.nan)) if np.any(shaped) \
+            else None
+        if held is None or (_grows(M, *held) and not _grows(M, C2, K2)):
+            shaped[:] = False
+        else:
+            C2, K2 = held
     rule = ("each mode's damping from its measured free decay (modal accelerations "
             "Phi^-1 x'', fitted exp(-sigma t) sinusoid"
             + (" beside the signal chain's declared filter transients"
@@ -966,6 +1062,13 @@ def decay_hold(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndarray,
             + (f"; modes {list(from_peak)} fitted from the accepted peak no mode was paired "
                f"with ({', '.join(f'{v:.4g}' for v in from_peak.values())} Hz)"
                if from_peak else "")
+            + (f"; modes {(np.flatnonzero(shaped) + 1).tolist()} shaped by that fit (each "
+               f"channel's amplitude of the one decay, their common phase)"
+               if np.any(shaped) else "")
+            + (f"; modes {(np.flatnonzero(dec.exponential) + 1).tolist()}, which no measured "
+               f"peak located and whose decay holds no first-order backbone (|c| > "
+               f"{BACKBONE_MAX_SHIFT:g} wd), from an exponential decay fit, wherever it lies"
+               if dec.exponential is not None and np.any(dec.exponential) else "")
             + (f"; modes {(np.flatnonzero(beyond) + 1).tolist()} kept the fit's frequency (the "
                f"decay's lies beyond one line of it, within the spectral-peak offset: a cubic "
                f"model's frequency stands at no peak)" if np.any(beyond) else "")
@@ -1210,6 +1313,44 @@ def backbone_shift(M: np.ndarray, K: np.ndarray, K3: np.ndarray, dec: ModalDecay
 def _is_symmetric(*mats: np.ndarray) -> bool:
     """Whether every matrix equals its transpose to rounding (``rtol`` 1e-12)."""
     return all(np.allclose(a, a.T, rtol=1e-12, atol=0.0) for a in mats)
+
+
+def set_shapes(M: np.ndarray, C: np.ndarray, K: np.ndarray, shapes: np.ndarray
+               ) -> tuple[np.ndarray, np.ndarray] | None:
+    """``C`` and ``K`` with some mode shapes replaced, eigenvalues and modal damping kept.
+
+    Parameters
+    ----------
+    M, C, K : ndarray, shape (n, n)
+        Mass [kg], damping [N s/m] and stiffness [N/m]; need not be symmetric.
+    shapes : ndarray, shape (n, n)
+        Column ``k``: the new shape of mode ``k`` (:func:`identify.structural.modal`'s
+        order; any scale and sign: it takes the model's shape's norm and sign, so that the
+        modal damping couplings ``D_jk`` mix the modes in the same proportions), or NaN to
+        keep that mode's.
+
+    Returns
+    -------
+    (C, K) or None
+        ``K' = M Phi' Lambda Phi'^-1`` and ``C' = M Phi' D Phi'^-1``, ``Lambda`` the
+        eigenvalues of ``M^-1 K`` and ``D = Phi^-1 M^-1 C Phi`` the modal damping (couplings
+        too) in the model's own shapes ``Phi``, ``Phi'`` those shapes with the given columns;
+        None where ``Phi`` or ``Phi'`` does not span the space (condition number above 1e12).
+    """
+    Phi = modal(M, K)[1]
+    if np.linalg.cond(Phi) > 1e12:
+        return None
+    new = Phi.copy()
+    on = np.all(np.isfinite(shapes), axis=0)
+    for k in np.flatnonzero(on):  # the model's scale and sign: a coupling D_jk keeps its share
+        v = shapes[:, k] * np.linalg.norm(Phi[:, k]) / np.linalg.norm(shapes[:, k])
+        new[:, k] = v if v @ Phi[:, k] >= 0 else -v
+    if np.linalg.cond(new) > 1e12:
+        return None
+    lam = np.diag(np.linalg.solve(Phi, np.linalg.solve(M, K @ Phi))).real
+    D = np.linalg.solve(Phi, np.linalg.solve(M, C @ Phi)).real
+    inv = np.linalg.inv(new)
+    return M @ new @ D @ inv, M @ new @ np.diag(lam) @ inv
 
 
 def set_eigenvalues(M: np.ndarray, K: np.ndarray, lam: np.ndarray) -> np.ndarray:

@@ -453,3 +453,38 @@ def test_an_unlocated_mode_with_an_unpaired_peak_in_its_band_is_fitted_from_that
     assert "fitted from the accepted peak no mode was paired with" in model.decay_rule_
     f_true = np.asarray(ds.truth["frequencies_hz"])[:2]
     np.testing.assert_allclose(model.natural_frequencies_, f_true, rtol=0.01)
+
+
+def test_a_mode_fitted_from_an_unpaired_peak_takes_that_fits_shape(dataset_cache):
+    """The same cell: mode 1's frequency came from the peak, its shape was the tilted fit's
+    (MAC 0.35 against the engine's sensor shape; the tilt weighs mode 1 1/39 of mode 2).  The
+    peak's fit on every channel measures each channel's amplitude of that one decay; mode 1
+    takes it (``set_shapes``; measured MAC 0.9999), above the issue's 0.95."""
+    member = {m.name: m for m in load_study(UNSEEN / "round20_families.toml").scenarios}[
+        "r20_stiff__002"]
+    sc = member.with_noise(1.0).replace(seed=117)
+    ds = dataset_cache.get(sc)
+    model = LeastSquaresSINDy().fit(measure(ds, sc.signal, sc.kind))
+    phi = np.real(modal(model.M_, model.K_)[1][:, 0])
+    true = np.asarray(ds.truth["sensor_modes"], dtype=float)[:, 0]
+    mac = (phi @ true) ** 2 / ((phi @ phi) * (true @ true))
+    assert mac >= 0.95  # the issue's bar (old code: 0.35)
+    assert "modes [1] shaped by that fit" in model.decay_rule_
+
+
+def test_a_cubic_models_unlocated_mode_with_no_backbone_takes_its_exponential_decay(
+        dataset_cache):
+    """Round 20's r20_soft__003 clean (round20_families.toml, seed 117): the cubic library (by
+    rule), one accepted peak (mode 1); mode 2 (267.2 Hz, 8.4 % damped) was the cubic fit's
+    239.4 Hz (-10.4 %), its backbone decay fit not first order (c = -113 Hz).  Its exponential
+    decay (269.0 Hz) is taken: mode 2 within the issue's 1 % (measured 0.99 %; the truth is
+    the engine's)."""
+    member = {m.name: m for m in load_study(UNSEEN / "round20_families.toml").scenarios}[
+        "r20_soft__003"]
+    sc = member.replace(seed=117)
+    ds = dataset_cache.get(sc)
+    model = LeastSquaresSINDy().fit(measure(ds, sc.signal, sc.kind))
+    assert model.cubic_
+    f_true = np.asarray(ds.truth["frequencies_hz"])[:2]
+    assert abs(model.natural_frequencies_[1] / f_true[1] - 1.0) <= 0.01  # old code: 0.104
+    assert "from an exponential decay fit" in model.decay_rule_

@@ -6,7 +6,14 @@ import numpy as np
 import pytest
 
 from benchmarks import bench_sgd_sindy as bench
-from identify._modal_damping import coupling_moves, hold_modal_damping, modal_decay
+from identify._modal_damping import (
+    chain_transients,
+    coupling_moves,
+    hold_modal_damping,
+    modal_decay,
+    peak_shape,
+    set_shapes,
+)
 from identify.sgd_sindy import SGDSINDy
 from identify.structural import modal
 from testbed.scoring.metrics import modal_from_matrices
@@ -393,6 +400,68 @@ def test_unlocated_fit_uses_every_channel_not_the_model_shapes(chain):
     assert ok
     assert np.hypot(s, wd) == pytest.approx(w[2], rel=1e-5)
     assert s == pytest.approx(0.5 * d[2], rel=1e-3)
+
+
+def test_peak_shape_is_each_channels_share_of_the_one_decay(chain):
+    """The shape of a decay fitted on every channel at once (modes 1-2's decays profiled out,
+    as the unlocated fit profiles them) is mode 3's own: exact data, proportional damping
+    (real shapes), so equal to the engine's shape to round-off; the fit's shape is not used."""
+    sysd, data = chain
+    M, C, K = sysd["M"], sysd["C"], sysd["K"]
+    f, Phi = modal(M, K)
+    d = _modal_damping(M, C, K)
+    t = np.arange(data.n_samples) / data.fs
+    w = 2 * np.pi * f
+    taken = {k: (0.5 * d[k], np.sqrt(w[k] ** 2 - (0.5 * d[k]) ** 2)) for k in (0, 1)}
+    s3 = 0.5 * d[2]
+    v = peak_shape(np.asarray(data.xdd), t, s3, np.sqrt(w[2] ** 2 - s3**2),
+                   chain_transients(None, t), taken)
+    true = Phi[:, 2] / np.linalg.norm(Phi[:, 2])
+    mac = (v @ true) ** 2 / (v @ v)
+    assert mac == pytest.approx(1.0, abs=1e-9)  # round-off of a least-squares fit on exact data
+    assert v[np.argmax(np.abs(v))] > 0
+    # the wrong pole gives another shape: the decay picks the mode, not the channels' RMS
+    other = peak_shape(np.asarray(data.xdd), t, 0.5 * d[0], np.sqrt(w[0] ** 2 - (0.5 * d[0]) ** 2),
+                       chain_transients(None, t), {})
+    assert (other @ true) ** 2 < 0.99
+
+
+def test_set_shapes_moves_the_given_shape_and_keeps_eigenvalues_and_modal_damping():
+    """``set_shapes``: mode 1 takes the given shape; every eigenvalue and the modal damping
+    matrix (couplings too) stay as they were, so the damped poles do (the new ``M^-1 K`` and
+    ``M^-1 C`` are the old ones under one similarity); a NaN column keeps that mode's shape."""
+    rng = np.random.default_rng(3)
+    M = np.diag([1.0, 2.0, 1.5])
+    B = rng.normal(size=(3, 3))
+    K = B @ B.T + np.eye(3)
+    C = 0.01 * K + 0.02 * np.eye(3) + 0.003 * rng.normal(size=(3, 3))
+    f, Phi = modal(M, K)
+    new = np.full((3, 3), np.nan)
+    new[:, 0] = Phi[:, 0] + 0.3 * Phi[:, 1]
+    C2, K2 = set_shapes(M, C, K, new)
+    f2, Phi2 = modal(M, K2)
+    np.testing.assert_allclose(f2, f, rtol=1e-10)
+    for k, want in ((0, new[:, 0]), (1, Phi[:, 1]), (2, Phi[:, 2])):
+        mac = (Phi2[:, k] @ want) ** 2 / ((Phi2[:, k] @ Phi2[:, k]) * (want @ want))
+        assert mac == pytest.approx(1.0, abs=1e-10)
+    D = np.linalg.solve(Phi, np.linalg.solve(M, C @ Phi))
+    D2 = np.linalg.solve(Phi2, np.linalg.solve(M, C2 @ Phi2))
+    np.testing.assert_allclose(np.diag(D2), np.diag(D), rtol=1e-9)
+
+    def poles(Cm, Km):
+        A = np.block([[np.zeros((3, 3)), np.eye(3)],
+                      [-np.linalg.solve(M, Km), -np.linalg.solve(M, Cm)]])
+        return np.sort_complex(np.linalg.eigvals(A))
+
+    np.testing.assert_allclose(poles(C2, K2), poles(C, K), rtol=1e-9)
+    # the scale of the given shape does not matter (the model's is taken)
+    C3, K3 = set_shapes(M, C, K, np.where(np.isfinite(new), -40.0 * new, np.nan))
+    np.testing.assert_allclose(C3, C2, rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(K3, K2, rtol=1e-9, atol=1e-12)
+    # shapes that do not span the space: not acted on
+    bad = np.full((3, 3), np.nan)
+    bad[:, 0] = Phi[:, 1]
+    assert set_shapes(M, C, K, bad) is None
 
 
 def test_unlocated_band_is_the_region_nearest_the_mode():

@@ -167,3 +167,17 @@ def test_ls_sindy_places_a_growing_mode_between_two_peaks(dataset_cache):
     check_physical(model.M_, model.C_, model.K_)
     f_true = np.asarray(ds.truth["frequencies_hz"])[:2]
     np.testing.assert_allclose(model.natural_frequencies_[:2], f_true, rtol=0.01)
+
+
+def test_a_complex_stiffness_pair_is_refused_before_any_solve():
+    """``M^-1 K`` with a complex eigenvalue pair (modes 2-3 coalesced, as round 20's tilted fit
+    of ``b20_st_hit0p1`` at 3 %): ``modal`` keeps the eigenvectors' real parts, one vector for
+    the pair, so the shapes are singular.  The placement does not act (None), with or without
+    the in-band rule; the old code solved with them first and raised LinAlgError."""
+    w1, w2 = (2 * np.pi * 80.0) ** 2, (2 * np.pi * 520.0) ** 2
+    K = np.array([[w1, 0.0, 0.0], [0.0, w2, 0.05 * w2], [0.0, -0.05 * w2, w2]])
+    M = np.eye(3)
+    C = 0.01 * np.sqrt(w2) * np.eye(3)
+    peaks = np.array([80.0, 520.0])
+    assert place_unresolved(M, C, K, 1600.0, peaks) is None
+    assert place_unresolved(M, C, K, 1600.0, peaks, band_low_hz=11.0) is None
