@@ -48,6 +48,18 @@ apiuse csvform apihyper cliparam signals timecol paths storeedit hyperedge leaks
     ``pysindy_ensemble``, ``pysindy_weak``) with each numeric hyperparameter at the edges its
     declaration allows, through ``testbed identify --param`` on the stiff beam's record: a
     traceback, an internal error or a hang is a finding (a model or a named failure is not).
+``latethreads``
+    Round 20's open item (a): a ``--plugin`` identifier whose ``fit`` starts a thread, or a
+    pool's worker, that calls ``os._exit(0)`` / ``os._exit(4)`` 0.3-1.5 s after the fit has
+    returned (while the testbed scores, draws or writes): ``testbed run`` with and without
+    figures, ``identify``, ``sweep --jobs 1``, each a real process.  Status 0 (or the thread's
+    code) without the verdict, model or results line is a finding.
+``interrupts``
+    ``testbed run`` of the stiff beam with a cache of its own (it simulates, fits, scores,
+    draws and writes) sent SIGINT or SIGTERM 0.5-12 s after its start, then run again: a
+    process left in its session (a zombie whose parent is init aside: init reaps it), a
+    traceback, more than one error line, a temporary file left, or a second run without a
+    verdict is a finding.
 
 Prints one line a finding and the counts; exits 1 if any finding.
 """
@@ -511,15 +523,25 @@ def interrupts_cases(work: Path) -> list[tuple[str, object]]:
     A process left in the command's session, a traceback, a status other than 0 / 1 / 2 /
     130 / 143, more than one error line, a temporary file left in the cache or the runs
     folder, or a second run without a verdict, is a finding."""
+    import contextlib
     import os
     import signal
     import subprocess
     import time
 
     def left_in_session(sid: int) -> list[str]:
-        out = subprocess.run(["ps", "-eo", "pid=,sid=,args="], capture_output=True, text=True).stdout
-        return [ln.strip() for ln in out.splitlines()
-                if len(ln.split()) >= 2 and ln.split()[1] == str(sid)]
+        """Processes of the session ``sid`` still there within 5 s, but zombies whose parent
+        is init (its to reap, at its own pace: the command that forked them has ended)."""
+        for _ in range(10):
+            out = subprocess.run(["ps", "-eo", "pid=,ppid=,sid=,stat=,args="], capture_output=True,
+                                 text=True).stdout
+            left = [ln.strip() for ln in out.splitlines() if len(ln.split()) >= 4
+                    and ln.split()[2] == str(sid)
+                    and not (ln.split()[3].startswith("Z") and ln.split()[1] == "1")]
+            if not left:
+                return []
+            time.sleep(0.5)
+        return left
 
     def temporaries(folder: Path) -> list[str]:
         return [str(p.relative_to(folder)) for p in folder.rglob("*")
@@ -546,7 +568,7 @@ def interrupts_cases(work: Path) -> list[tuple[str, object]]:
             left = left_in_session(p.pid)
             if left:
                 for ln in left:
-                    with __import__("contextlib").suppress(ProcessLookupError):
+                    with contextlib.suppress(ProcessLookupError):
                         os.kill(int(ln.split()[0]), signal.SIGKILL)
                 return f"processes left in its session: {left[:3]}"
             lines = [ln for ln in err.splitlines() if ln.strip()]
