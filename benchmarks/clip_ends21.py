@@ -9,10 +9,12 @@ trapezoid integral of the rate over it, relative to the signal's motion (RMS abo
 is ``mismatch``.  At rest both are ~0; a clipped signal is constant while its rate integrates
 to the motion it missed, a clipped rate integrates to less than the signal moved.
 
-Prints, over every record of the dataset cache(s) given (default ``.cache/datasets``) of a
-kind with rate pairs, the largest ``mismatch`` of the unclipped records' end runs (false-alarm
-margin) and, for each record's channels clipped at 10-90 % of their range from the extreme the
-record starts or ends at, the smallest ``mismatch`` (the rule's reach)::
+Measured with the rule as shipped (``testbed.numerics.clipping.rate_contradicted_levels``,
+which also keeps the quantisation of both channels and skips a constant channel): prints, over
+every record of the dataset cache(s) given (default ``.cache/datasets``) of a kind with rate
+pairs, its alarms on the records as stored and on their 16-bit copies, and by kind the share
+told of their channels clipped at 50 % (from the extreme the record starts or ends nearer, and
+at +-50 % of the peak about the mean)::
 
     python -m benchmarks.clip_ends21 [cache folder ...]
 """
@@ -28,7 +30,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))
 
-from testbed.numerics.clipping import MIN_RUN  # noqa: E402
+from testbed.numerics.clipping import MIN_RUN, rate_contradicted_levels  # noqa: E402
 from testbed.pipeline.importers import RATE_PAIRS  # noqa: E402
 
 #: The share of the record's range (or peak) cut away by the clip [-]
@@ -85,17 +87,20 @@ def clipped_from_end(y: np.ndarray, frac: float) -> np.ndarray:
 
 
 def main(folders: list[str]) -> int:
-    clean: list[tuple[float, str]] = []
-    told: dict[float, list[float]] = {f: [] for f in FRACTIONS}
-    told_both: dict[float, list[float]] = {f: [] for f in FRACTIONS}
-    n_records = 0
+    """The shipped rule (:func:`testbed.numerics.clipping.rate_contradicted_levels`) on every
+    rate pair of the records: alarms on them as stored and on their 16-bit copies, and the
+    share told of their channels clipped at 50 % (from the end the record starts or ends
+    nearer, and at +-50 % of the peak about the mean), by kind."""
+    alarms: dict[str, list[str]] = {"float": [], "16 bit": []}
+    told: dict[tuple[str, str], list[bool]] = {}
+    n_records = n_channels = 0
     for folder in folders or [str(ROOT / ".cache" / "datasets")]:
         for path in sorted(Path(folder).glob("*.h5")):
             try:
                 with h5py.File(path, "r") as f:
                     kind = f.attrs.get("kind")
-                    kind = kind.decode() if isinstance(kind, bytes) else kind
-                    pairs = RATE_PAIRS.get(str(kind), ())
+                    kind = kind.decode() if isinstance(kind, bytes) else str(kind)
+                    pairs = RATE_PAIRS.get(kind, ())
                     if not pairs:
                         continue
                     fs = float(f.attrs["fs"])
@@ -107,28 +112,22 @@ def main(folders: list[str]) -> int:
                 if g not in m or dg not in m or m[g].shape != m[dg].shape:
                     continue
                 for a, d in zip(m[g], m[dg], strict=True):
-                    for bits in (None, 16, 12):
-                        qa, qd = (a, d) if bits is None else (quantised(a, bits), quantised(d, bits))
-                        clean += [(v, f"{path.name} {g}/{dg} {bits or 'float'}")
-                                  for v in pair_mismatches(qa, qd, fs, ends_only=False)]
-                    for frac in FRACTIONS:
+                    n_channels += 1
+                    if rate_contradicted_levels(a, d, fs):
+                        alarms["float"].append(f"{path.name} {g}")
+                    if rate_contradicted_levels(quantised(a, 16), quantised(d, 16), fs):
+                        alarms["16 bit"].append(f"{path.name} {g}")
+                    for name, clip in (("from the end", clipped_from_end), ("+-50 %", clipped_both)):
                         for which in ("signal", "rate"):
-                            for clip, store in ((clipped_from_end, told), (clipped_both, told_both)):
-                                aa = clip(a, 1 - frac) if which == "signal" else a
-                                dd = clip(d, 1 - frac) if which == "rate" else d
-                                v = pair_mismatches(aa, dd, fs, ends_only=False)
-                                store[frac].append(max(v) if v else 0.0)
-    clean.sort(reverse=True)
-    print(f"{n_records} records with rate pairs; {len(clean)} held runs of unclipped channels "
-          "(float, 16- and 12-bit copies)")
-    print("largest unclipped mismatches:", [(round(v, 4), n) for v, n in clean[:6]])
-    for name, store in (("from the end it starts or ends nearer", told), ("at +-frac of the peak",
-                                                                          told_both)):
-        for frac, vals in store.items():
-            v = np.asarray(vals)
-            print(f"clipped {name}, {int(100 * frac)} % cut: {v.size} channels, quantiles 5/50 % "
-                  f"{np.quantile(v, 0.05):.4g} / {np.quantile(v, 0.5):.4g}, above 0.05: "
-                  f"{np.mean(v > 0.05):.3f}, no held run: {np.mean(v == 0):.3f}")
+                            aa = clip(a, 0.5) if which == "signal" else a
+                            dd = clip(d, 0.5) if which == "rate" else d
+                            told.setdefault((kind, f"{which} {name}"), []).append(
+                                bool(rate_contradicted_levels(aa, dd, fs)))
+    print(f"{n_records} records with rate pairs, {n_channels} channel pairs")
+    for k, v in alarms.items():
+        print(f"alarms on the records {k}: {len(v)} {v[:4]}")
+    for (kind, how), v in sorted(told.items()):
+        print(f"{kind}: {how} clipped at 50 %: {sum(v)} of {len(v)} told")
     return 0
 
 

@@ -475,12 +475,21 @@ def test_a_cache_folder_that_cannot_be_made_is_named(cli_in_process, tmp_path, m
 def test_a_late_exit_of_a_thread_a_plugin_left_running_is_one_warning_line(capsys):
     # hostile round 21: such a call ended `testbed run` / `identify` / a sequential sweep with
     # the thread's status and no verdict; now it ends the thread and the command says it
-    real, go = os._exit, threading.Event()
+    real, go, ended = os._exit, threading.Event(), []
+
+    def late() -> None:
+        go.wait(30)
+        try:
+            os._exit(4)
+        except SystemExit as e:  # a plain SystemExit ends the thread (pytest's hook reports it)
+            ended.append((type(e), e.code))
+
     with no_process_exit():
-        t = threading.Thread(target=lambda: (go.wait(30), os._exit(4)), name="plugin-timer")
+        t = threading.Thread(target=late, name="plugin-timer")
         t.start()
     go.set()
     t.join(30)
+    assert ended == [(SystemExit, 4)]
     with no_process_exit():  # puts the real os._exit back (the thread has ended)
         pass
     assert os._exit is real

@@ -143,3 +143,5 @@ def test_a_decay_at_rest_first_and_its_16_bit_copy_are_no_clip():
     assert rate_contradicted_levels(x, dx, 100.0) == []
     assert rate_contradicted_levels(_quantised(x, 16), _quantised(dx, 16), 100.0) == []
     assert rate_contradicted_levels(np.zeros(100), np.zeros(100), 100.0) == []  # dead sensor
+    # a signal whose motion lies within one code (constant once quantised) cannot judge its rate
+    assert rate_contradicted_levels(np.full(500, 1.78), dx[:500] * 1e-6, 100.0) == []
