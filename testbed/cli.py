@@ -41,6 +41,7 @@ from testbed.core.errors import (
     show_value,
     terminal_safe,
 )
+from testbed.core.exit_guard import late_exit_calls
 
 #: Status when the reader of standard output went away: a shell's for a command ended by SIGPIPE.
 EXIT_BROKEN_PIPE = 128 + 13
@@ -1169,13 +1170,29 @@ def main(argv: list[str] | None = None) -> int:
         gc.set_threshold(*GC_THRESHOLD)  # restored below: main() is also called from Python
         try:
             with _terminate_as_interrupt(console=argv is None), _stdout_writes_file_names():
-                return _main(argv)
+                status = _main(argv)
+                _say_late_exits()
+                return status
         finally:
             gc.set_threshold(*before)
     except KeyboardInterrupt as e:
         # a Ctrl-C outside the command's own handling (while its options were parsed, in a
         # busy machine's first second) printed a 30-line traceback and ended by SIGINT (-2)
         return _interrupted(e)
+
+
+def _say_late_exits() -> None:
+    """One warning line for the ``os._exit`` calls that threads a plugin's fit left running
+    made after the fit (:func:`testbed.core.exit_guard.late_exit_calls`): each ended its
+    thread, not the command, whose verdict stands (hostile round 21: the command had ended with
+    the thread's status and no verdict)."""
+    calls = late_exit_calls()
+    if calls:
+        shown = ", ".join(f"{terminal_safe(name)!s} os._exit({code!r})" for name, code in calls[:3])
+        more = f" and {len(calls) - 3} more" if len(calls) > 3 else ""
+        print(f"warning: {len(calls)} thread(s) a plugin's code left running called os._exit after "
+              f"its fit had returned ({shown}{more}): each ended its own thread, not this command",
+              file=sys.stderr, flush=True)
 
 
 @contextlib.contextmanager

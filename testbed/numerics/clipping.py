@@ -29,6 +29,15 @@ extreme are a clip; a quantised clipped record holds the code below the
 rail a few samples only, as the record crosses it fast on its way to the rail.  A clip held by
 one sample per peak (a rail just below the peaks) cannot be told from a peak, and is not.
 
+A record and its recorded rate (a pair such as a kinetics state ``x`` and ``dx``, a five-bar's
+angles and rates) tell more (:func:`rate_contradicted_levels`): where either holds its extreme
+on a run of :data:`MIN_RUN` samples or more (at the record's start or end too: a kinetics
+decay clipped from its first sample, which the rule above leaves out), the signal's change
+over the run less the trapezoid integral of the rate over it must stay within
+:data:`RATE_HOLD_TOL` of the signal's motion and within the two channels' quantisation there;
+beyond, the held channel was clipped (a signal cannot stand still while its rate integrates to
+a motion, nor a rate stand at a value the signal does not follow).  At rest both are ~0.
+
 Checked (docs/known-gaps.md, "clipped sensor"): no alarm on the records of the shipped
 scenarios and the rounds' records in the run cache, nor on a sine quantised to 16 bits;
 the stiff beam's accelerometer clipped at 10-50 % of its peak is told.
@@ -36,7 +45,7 @@ the stiff beam's accelerometer clipped at 10-50 % of its peak is told.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -62,6 +71,16 @@ MIN_HELD = 3
 #: ... and by more than this many times the samples of the next code toward the inside [-]:
 #: a quantised parabolic apex holds its top code at most 2.41 times as long as the next one.
 RATIO = 4.0
+#: A held run's signal change less its rate's trapezoid integral, relative to the signal's
+#: motion (RMS about its mean), beyond which the held channel was clipped [-]: the largest
+#: whole-record misfit of the caches' rate pairs is 0.021 (the trapezoid rule's own error,
+#: ``testbed.pipeline.importers.RATE_MISFIT_MAX``'s measurement); the 24 held runs of the 598
+#: rate-pair records of the dataset cache (2,709 channel pairs) and their 16-bit copies give no
+#: alarm (``benchmarks/clip_ends21.py``, docs/known-gaps.md)
+RATE_HOLD_TOL = 0.05
+#: The quantisation term: a held code's true change is within a step on either side and one
+#: inside it, and each rate sample within its step [steps]
+HOLD_STEPS = 3.0
 
 
 @dataclass(frozen=True)
@@ -178,6 +197,61 @@ def clipped_levels(y: np.ndarray) -> list[tuple[float, int, int]]:
     return out
 
 
+def _smallest_gap(y: np.ndarray) -> float:
+    u = np.unique(y[np.isfinite(y)])
+    return float(np.diff(u).min()) if u.size > 1 else 0.0
+
+
+def rate_contradicted_levels(a: np.ndarray, d: np.ndarray, fs: float
+                             ) -> list[tuple[str, float, int, int]]:
+    """Extremes held by a signal or its recorded rate that the other channel contradicts.
+
+    Parameters
+    ----------
+    a, d : ndarray, shape (n_samples,)
+        One channel of a signal and its recorded rate (``d`` in ``a``'s unit per second).
+    fs : float
+        Sample rate [Hz].
+
+    Returns
+    -------
+    list of (str, float, int, int)
+        ``(which, level, n_held, runs)``: ``which`` is ``"signal"`` or ``"rate"``, the held
+        channel; ``level`` its clip level; the samples held there on the contradicted runs and
+        their count.  A constant or non-finite channel gives none.
+    """
+    a, d = np.asarray(a, dtype=float).ravel(), np.asarray(d, dtype=float).ravel()
+    n = a.size
+    if n != d.size or n < 2 * MIN_HELD or not (np.all(np.isfinite(a)) and np.all(np.isfinite(d))
+                                               and fs > 0):
+        return []
+    if a.max() == a.min() or d.max() == d.min():
+        # a constant channel: a dead sensor (said elsewhere), or a signal whose motion lies
+        # within one quantisation step (a 16-bit copy of a five-bar at rest within 1.6e-7 rad
+        # of 1.78 rad: four alarms on its rate, which no signal step can confirm)
+        return []
+    motion = float(np.sqrt(np.mean((a - a.mean()) ** 2)))
+    qa, qd = _smallest_gap(a), _smallest_gap(d)
+    out = []
+    for which, y in (("signal", a), ("rate", d)):
+        hi, lo = float(y.max()), float(y.min())
+        for level in (hi, lo):
+            starts, lengths = _runs(y == level)
+            held = runs = 0
+            for s0, m in zip(starts.tolist(), lengths.tolist(), strict=True):
+                if m < MIN_RUN:
+                    continue
+                i, j = max(s0 - 1, 0), min(s0 + m + 1, n)  # one sample past each side
+                change = float(a[j - 1] - a[i])
+                integral = float(np.sum(d[i + 1:j] + d[i:j - 1]) * 0.5 / fs)
+                tol = max(RATE_HOLD_TOL * motion, HOLD_STEPS * qa + (j - i) * qd / fs)
+                if abs(change - integral) > tol:
+                    held, runs = held + m, runs + 1
+            if runs:
+                out.append((which, level, held, runs))
+    return out
+
+
 def clipped_channels(signals: Mapping[str, np.ndarray],
                      units: Mapping[str, str] | None = None) -> list[Clipping]:
     """Every channel held at a clip level (:func:`clipped_levels`), in the given order.
@@ -202,7 +276,8 @@ def clipped_channels(signals: Mapping[str, np.ndarray],
     return out
 
 
-def measured_clipping(measured: Mapping[str, Any]) -> list[Clipping]:
+def measured_clipping(measured: Mapping[str, Any], fs: float | None = None,
+                      rate_pairs: Sequence[tuple[str, str]] = ()) -> list[Clipping]:
     """The clipped channels of a record's measured signals (a dataset's ``measured``).
 
     Parameters
@@ -212,6 +287,12 @@ def measured_clipping(measured: Mapping[str, Any]) -> list[Clipping]:
         n_samples), ``channels``, ``channel_units()``, ``acts_on``).  A commanded input that
         declares the coordinates it drives (``acts_on``: the five-bar's torques) is left out:
         a step or a square wave holds its extremes by design.
+    fs : float, optional
+        Sample rate [Hz], for ``rate_pairs``.
+    rate_pairs : sequence of (str, str)
+        ``(signal, its recorded rate)`` names (``testbed.pipeline.importers.RATE_PAIRS`` of
+        the record's kind): their held extremes are also judged by
+        :func:`rate_contradicted_levels`, channel row by row.
 
     Returns
     -------
@@ -225,7 +306,21 @@ def measured_clipping(measured: Mapping[str, Any]) -> list[Clipping]:
         for row, name, unit in zip(np.atleast_2d(sig.data), sig.channels, sig.channel_units(),
                                    strict=True):
             signals[name], units[name] = row, unit
-    return clipped_channels(signals, units)
+    out = clipped_channels(signals, units)
+    seen = {(c.channel, c.level) for c in out}
+    for g, dg in rate_pairs if fs else ():
+        sig, rate = measured.get(g), measured.get(dg)
+        if sig is None or rate is None or np.shape(sig.data) != np.shape(rate.data):
+            continue
+        for a, d, names, rnames, units_a, units_d in zip(
+                np.atleast_2d(sig.data), np.atleast_2d(rate.data), sig.channels, rate.channels,
+                sig.channel_units(), rate.channel_units(), strict=True):
+            for which, level, held, runs in rate_contradicted_levels(a, d, float(fs)):
+                name, unit = (names, units_a) if which == "signal" else (rnames, units_d)
+                if (name, level) not in seen:
+                    seen.add((name, level))
+                    out.append(Clipping(str(name), level, held, a.size, runs, unit))
+    return out
 
 
 #: The fields of :func:`clipping_table`, in order.

@@ -424,7 +424,8 @@ def measurement_and_clipping(path: str | os.PathLike, kind: str,
     if (signal or {}).get("derivatives", "recorded") == "recorded":  # the rates the fit reads
         _check_rates(data.source, ds, kind)
     try:
-        return measure(ds, dict(signal or {}), kind), measured_clipping(ds.measured)
+        return (measure(ds, dict(signal or {}), kind),
+                measured_clipping(ds.measured, ds.fs, RATE_PAIRS.get(kind, ())))
     except TestbedError:
         raise
     except ValueError as e:  # the chain's own checks: signal names, channel counts, positions

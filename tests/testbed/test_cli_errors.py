@@ -12,6 +12,7 @@ import os
 import signal
 import subprocess
 import sys
+import threading
 from pathlib import Path
 
 import h5py
@@ -20,6 +21,7 @@ import pytest
 
 from testbed import cli
 from testbed.cli import EXIT_INTERNAL, EXIT_USAGE, main
+from testbed.core.exit_guard import no_process_exit
 
 ROOT = Path(__file__).resolve().parent.parent.parent
 DATA = ROOT / "tests" / "data" / "malformed"
@@ -468,3 +470,32 @@ def test_a_cache_folder_that_cannot_be_made_is_named(cli_in_process, tmp_path, m
                     "cache folder")
     r = cli_in_process("cache", "ls", *argv, cwd=tmp_path)
     assert (r.returncode, one_error_line(r.stderr)) == (EXIT_USAGE, expected)
+
+
+def test_a_late_exit_of_a_thread_a_plugin_left_running_is_one_warning_line(capsys):
+    # hostile round 21: such a call ended `testbed run` / `identify` / a sequential sweep with
+    # the thread's status and no verdict; now it ends the thread and the command says it
+    real, go, ended = os._exit, threading.Event(), []
+
+    def late() -> None:
+        go.wait(30)
+        try:
+            os._exit(4)
+        except SystemExit as e:  # a plain SystemExit ends the thread (pytest's hook reports it)
+            ended.append((type(e), e.code))
+
+    with no_process_exit():
+        t = threading.Thread(target=late, name="plugin-timer")
+        t.start()
+    go.set()
+    t.join(30)
+    assert ended == [(SystemExit, 4)]
+    with no_process_exit():  # puts the real os._exit back (the thread has ended)
+        pass
+    assert os._exit is real
+    cli._say_late_exits()
+    cli._say_late_exits()  # said once
+    err = capsys.readouterr().err
+    assert err.splitlines() == [
+        "warning: 1 thread(s) a plugin's code left running called os._exit after its fit had "
+        "returned (plugin-timer os._exit(4)): each ended its own thread, not this command"], err

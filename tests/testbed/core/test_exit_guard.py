@@ -125,3 +125,36 @@ def test_a_thread_the_guarded_code_starts_and_posix_exit_are_intercepted():
         "verdict; raise an exception instead",
         "posix os._exit(0) called, which would have ended the testbed's process with no "
         "verdict; raise an exception instead", "True"], p.stdout
+
+
+def test_a_thread_left_running_that_exits_after_the_guard_ends_only_itself():
+    # hostile round 21 (round 20's open item): a plugin's fit started a thread (or a pool's
+    # worker) that called os._exit 0.3-1.5 s after the fit returned: `testbed run` ended with
+    # status 0 (or the thread's code) and no verdict, a sequential sweep with no results file.
+    # Now the left-over thread ends alone and the call is kept for the command line's warning;
+    # a thread of the caller's own, started outside every guard, still ends the process.  On
+    # the old code the first script ends with status 5.
+    code = textwrap.dedent("""
+        import os, posix, threading
+        from testbed.core.exit_guard import late_exit_calls, no_process_exit
+        real = os._exit
+        go = threading.Event()
+        with no_process_exit():
+            t = threading.Thread(target=lambda: (go.wait(30), os._exit(5)), name="left")
+            t.start()
+        print(os._exit is real)  # still intercepted while the left-over thread lives
+        go.set()
+        t.join(30)
+        print(late_exit_calls(), late_exit_calls())
+        with no_process_exit():  # the next guard's end puts the real one back
+            pass
+        print(os._exit is real and posix._exit is real)
+        mine = threading.Thread(target=os._exit, args=(6,))  # the caller's own: ends it
+        mine.start()
+        mine.join(30)
+        print("not reached")
+        """)
+    p = subprocess.run([sys.executable, "-c", code], env={**os.environ, "PYTHONPATH": ROOT},
+                       capture_output=True, text=True, timeout=60)
+    assert p.returncode == 6 and p.stderr == "", (p.returncode, p.stderr[-300:])
+    assert p.stdout.splitlines() == ["False", "[('left', 5)] []", "True"], p.stdout

@@ -16,7 +16,9 @@ from testbed.numerics.clipping import (
     from_table,
     measured_clipping,
     on_lattice,
+    rate_contradicted_levels,
 )
+from testbed.pipeline.importers import RATE_PAIRS
 from testbed.pipeline.scenario import load_scenario
 from tests.testbed._saved_record import clipped_acc1
 
@@ -92,10 +94,11 @@ def test_no_alarm_on_shipped_records(dataset_cache, name):
     """The records as simulated (float) and quantised to 16 bits (a top code met twice at a
     fast apex, the next codes once each: the lattice test keeps it from the float branch)."""
     measured = dataset_cache.get(load_scenario(name)).measured
-    assert measured_clipping(measured) == []
+    fs, pairs = dataset_cache.get(load_scenario(name)).fs, RATE_PAIRS.get(load_scenario(name).kind, ())
+    assert measured_clipping(measured, fs, pairs) == []
     quantised = {g: dataclasses.replace(s, data=np.array([_quantised(r, 16) for r in s.data]))
                  for g, s in measured.items()}
-    assert measured_clipping(quantised) == []
+    assert measured_clipping(quantised, fs, pairs) == []
 
 
 def test_stiff_beam_clipped_at_ten_percent(dataset_cache):
@@ -105,3 +108,40 @@ def test_stiff_beam_clipped_at_ten_percent(dataset_cache):
     found = measured_clipping(clipped.measured)
     assert {c.channel for c in found} == {"acc1"}
     assert sum(c.n_held for c in found) == int(np.count_nonzero(np.abs(a[0]) == lim)) == 57
+
+
+def _decay(fs: float = 100.0, rest: int = 0) -> tuple[np.ndarray, np.ndarray]:
+    """A kinetics-like decay x = 2 exp(-t) and its rate over 5 s, after ``rest`` samples held
+    at 2 with rate 0 (at rest)."""
+    t = np.arange(int(5 * fs)) / fs
+    x, dx = 2.0 * np.exp(-t), -2.0 * np.exp(-t)
+    return np.r_[np.full(rest, 2.0), x], np.r_[np.zeros(rest), dx]
+
+
+@pytest.mark.parametrize("frac", [0.1, 0.3, 0.5, 0.7, 0.9])
+def test_a_decay_clipped_from_its_first_sample_is_told_by_its_rate(frac):
+    """Round 20's open item (b): the rail is the record's start, so the run touches the first
+    sample and the single-channel rule leaves it out (as rest); the recorded rate says the state
+    moved while it read the rail.  On the old code no function judged the pair."""
+    x, dx = _decay()
+    rail = 2.0 - frac * (2.0 - x.min())
+    clipped = np.minimum(x, rail)
+    assert clipped_levels(clipped) == []  # the single-channel rule: a record starting at rest
+    found = rate_contradicted_levels(clipped, dx, 100.0)
+    assert [(w, lv) for w, lv, *_ in found] == [("signal", rail)]
+    # its rate clipped at the same share of its range: the state does not follow the rail
+    # (at 10 % the state's missed change, 0.01 mM, is within 5 % of its motion: not told)
+    if frac < 0.3:
+        return
+    rate_rail = dx.min() + frac * (dx.max() - dx.min())
+    found = rate_contradicted_levels(x, np.maximum(dx, rate_rail), 100.0)
+    assert [(w, lv) for w, lv, *_ in found] == [("rate", rate_rail)]
+
+
+def test_a_decay_at_rest_first_and_its_16_bit_copy_are_no_clip():
+    x, dx = _decay(rest=50)
+    assert rate_contradicted_levels(x, dx, 100.0) == []
+    assert rate_contradicted_levels(_quantised(x, 16), _quantised(dx, 16), 100.0) == []
+    assert rate_contradicted_levels(np.zeros(100), np.zeros(100), 100.0) == []  # dead sensor
+    # a signal whose motion lies within one code (constant once quantised) cannot judge its rate
+    assert rate_contradicted_levels(np.full(500, 1.78), dx[:500] * 1e-6, 100.0) == []
