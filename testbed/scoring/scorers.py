@@ -30,6 +30,7 @@ from testbed.core.truth import DynamicalTruth, MechanicalTruth, StructuralTruth,
 from testbed.numerics.clipping import clipping_table, from_table, measured_clipping
 from testbed.numerics.linear_response import simulate_linear
 from testbed.numerics.shapes import slowest_decay_rate
+from testbed.pipeline.importers import RATE_PAIRS
 from testbed.pipeline.plugins import rig_class
 from testbed.pipeline.signal_chain import pulse_end, pulse_span
 from testbed.scoring import metrics
@@ -1029,7 +1030,7 @@ def clipping_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -
     """A failed bar on a record with a clipped sensor: ``{"clipped": reason}``.
 
     A sensor that saturated (:mod:`testbed.numerics.clipping`, from the record alone) holds a
-    rail where the structure moved on: no model of the structure predicts that record.
+    rail where the structure moved on: no model of the system predicts that record.
     Measured (hostile round 20): the stiff beam's acc1 clipped at 10 % of its peak failed its
     bars (mode error 67 %, MAC 0.136) with no reason naming the clipping.  Only a bar that
     already failed is explained, so no verdict changes.
@@ -1047,7 +1048,7 @@ def clipping_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -
         return {}
     return {"clipped": "clipped: " + "; ".join(c.describe() for c in from_table(table))
                        + ": the failed bar may be the saturation's (a record no model of the "
-                         "structure predicts), not only the identifier's"}
+                         "system predicts), not only the identifier's"}
 
 
 def record_details(kind: str, dataset: Dataset, data: Measurement) -> dict[str, Any]:
@@ -1062,7 +1063,7 @@ def record_details(kind: str, dataset: Dataset, data: Measurement) -> dict[str, 
     only the pole).
     """
     if kind != "structural":
-        return {}
+        return clipping_details(kind, dataset)
     truth = dataset.truth_as(StructuralTruth)
     f_true = np.asarray(truth.frequencies_hz[: data.n_channels], float)
     out: dict[str, Any] = {"passband": data.passband, "f_true": f_true, "fs": float(data.fs),
@@ -1072,10 +1073,17 @@ def record_details(kind: str, dataset: Dataset, data: Measurement) -> dict[str, 
         out["pulse_spectrum"] = pulse_spectrum(dataset, f_true)
     out["z_true"] = np.asarray(truth.damping_ratios[: data.n_channels], float)
     out["window_decay"] = window_decay(truth, dataset, data, data.n_channels)
-    clipped = measured_clipping(dataset.measured)  # the record alone (clipping_failures)
-    if clipped:
-        out["clipped_sensors"] = clipping_table(clipped)
+    out.update(clipping_details(kind, dataset))
     return out
+
+
+def clipping_details(kind: str, dataset: Dataset) -> dict[str, Any]:
+    """``{"clipped_sensors": table}`` for a record with a clipped channel, else ``{}``: the
+    record alone (:func:`~testbed.numerics.clipping.measured_clipping`, with the kind's
+    recorded rates, :data:`testbed.pipeline.importers.RATE_PAIRS`: a signal held at its
+    extreme while its rate says it moved, or the reverse), for :func:`clipping_failures`."""
+    clipped = measured_clipping(dataset.measured, dataset.fs, RATE_PAIRS.get(kind, ()))
+    return {"clipped_sensors": clipping_table(clipped)} if clipped else {}
 
 
 def failed_scores(kind: str, reason: str, key: str = "fit") -> Scores:
@@ -1411,7 +1419,10 @@ def score(kind: str, dataset: Dataset, data: Measurement, clean: Measurement, mo
     except KeyError:
         raise KeyError(f"no scorer for rig kind {kind!r}; registered: "
                        f"{', '.join(SCORERS) or '(none)'}") from None
-    return scorer(dataset, data, clean, model)
+    scores = scorer(dataset, data, clean, model)
+    if kind != "structural":  # the structural scorer keeps its record's details itself
+        scores.details.update(clipping_details(kind, dataset))
+    return scores
 
 
 def score_structural(dataset: Dataset, data: Measurement, clean: Measurement, model: Any) -> Scores:

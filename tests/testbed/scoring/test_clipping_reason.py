@@ -3,6 +3,10 @@ a met bar, or a record with none, gets nothing: no verdict changes."""
 
 from __future__ import annotations
 
+import dataclasses
+
+import numpy as np
+
 from testbed.numerics.clipping import Clipping, clipping_table
 from testbed.pipeline.scenario import load_scenario
 from testbed.scoring.run import run_scenario
@@ -33,3 +37,21 @@ def test_stiff_beam_clipped_run_says_so(dataset_cache):
     clean = run_scenario(sc, dataset=ds)
     assert clean.passed and "clipped" not in clean.scores.failures
     assert "clipped_sensors" not in clean.scores.details
+
+
+def test_a_kinetics_record_clipped_from_its_start_says_so(dataset_cache):
+    """Malformed-input round 21: a Michaelis-Menten record whose x is clipped from its first
+    sample (a saturated probe, 30 % below the dose) failed its equation bars with no reason
+    naming the clipping: the scorer judged clipping on structural records only and without
+    the recorded rate (``dx`` says x moved while x is held).  The clean record passes with no
+    such reason."""
+    sc = load_scenario("michaelis_menten")
+    ds = dataset_cache.get(sc)
+    s = ds.measured["x"]
+    x = s.data.copy()
+    x[0] = np.minimum(x[0], 0.7 * float(np.max(x[0])))
+    clipped = dataclasses.replace(ds, measured={**ds.measured, "x": dataclasses.replace(s, data=x)})
+    r = run_scenario(sc, dataset=clipped)
+    assert not r.passed and "sensor x is clipped at" in r.scores.failures["clipped"]
+    clean = run_scenario(sc, dataset=ds)
+    assert clean.passed and "clipped_sensors" not in clean.scores.details
