@@ -80,11 +80,8 @@ def test_short_sine_record_keeps_its_loop_with_the_excitation_cap(dataset_cache,
     assert r.model.edge_trim_ == pytest.approx(0.388, abs=1e-3)
     assert "capped to keep" in r.model.noise_rule_
     assert r.passed and r.scores.values["angle_rmse"] < 0.0501
-    # the rule without the cap (as before it): a scored "no assembly".  The record rule's
-    # start set (session 22) rescues the uncapped trim too (measured: 0.0098 rad), so it is
-    # pinned off here: this test is the cap's
+    # the rule without the cap (as before it): a scored "no assembly"
     monkeypatch.setattr(sp, "EDGE_KEEP_EXCITATION", 0.0)
-    monkeypatch.setattr(sp.SINDyPI, "_start_set_on", False)
     old = _run_cell(dataset_cache, "round20_linkages_seeds.toml", "fb20_3s", 1.5, 112)
     assert old.model.edge_trim_ == pytest.approx(0.75)
     assert not old.passed and "no assembly" in old.scores.failures["simulation"]
