@@ -175,7 +175,6 @@ from testbed.core.measurement import Measurement, Trajectory
 from testbed.core.schema import ErrorFn, Field, KeyUse
 from testbed.numerics.filters import cutoff_problem, lowpass
 from testbed.numerics.gram import normalized_gram, ordered_independent
-from testbed.numerics.initial_state import fit_initial_state
 from testbed.numerics.noise import noise_std, signal_band
 
 #: Rollout angle-RMSE differences below 1e-4 rad [rad] count as ties (then fewer terms win):
@@ -1081,9 +1080,6 @@ class _ImplicitMechanical(Identifier):
         """See :func:`rollout_steps`."""
         return rollout_steps(params, record_s)
 
-    #: The record rule's start set (:meth:`_record_starts`): off here, on for SINDy-PI.
-    _start_set_on: ClassVar[bool] = False
-
     def fit(self, data: Measurement) -> _ImplicitMechanical:
         self.check_params()
         if data.u is None or data.input_map is None:
@@ -1191,7 +1187,6 @@ class _ImplicitMechanical(Identifier):
             "off for this identifier" if not self._inertia_rule_on else
             "an open chain (more solved coordinates than inputs)" if open_chain else "")
         self._wide_ctx = None
-        self._starts = None  # the record rule's start set (_record_starts), per fit
         if selection == "rollout":
             combos = list(product(*picks))
             models = [ImplicitModel(lib, build(combo), solved, self.closure_) for combo in combos]
@@ -1421,86 +1416,14 @@ class _ImplicitMechanical(Identifier):
         return out
 
     def _replays_record(self, model: ImplicitModel, data: Measurement) -> bool:
-        """Whether ``model`` replays the record: both parts of :meth:`_replay_status`, from
-        the record rule's start set with ``model``'s own fitted start added
-        (:meth:`_record_starts`)."""
-        return all(self._replay_status(model, data, own=True))
+        """Whether ``model`` replays the record: both parts of :meth:`_replay_status`."""
+        return all(self._replay_status(model, data))
 
-    def _start_set_applies(self) -> bool:
-        """The record rule's start set is used: a closed chain (the rest baseline's, see
-        :meth:`_replay_status`) and not switched off (``_start_set_on``)."""
-        return getattr(self, "closure_", None) is not None and self._start_set_on
-
-    def _start_window(self, data: Measurement) -> int:
-        """Samples of the record's first span the starts are fitted over: the edge trim
-        (where the chain's estimates are least sure) plus the rollout selection's first
-        segment (the horizon over which it trusts a simulation from a measured state)."""
-        i0 = round((self._knob("edge_trim") or 0.0) * data.fs)
-        seg = (data.n_samples - 2 * i0) // max(1, int(self._knob("rollout_segments")))
-        return min(data.n_samples, i0 + seg)
-
-    def _fitted_start(self, model: ImplicitModel, data: Measurement
-                      ) -> tuple[np.ndarray, np.ndarray]:
-        """``model``'s own start: the angles and rates [rad, rad/s] whose simulation best
-        matches the measured angles over :meth:`_start_window` (least squares by
-        :func:`testbed.numerics.initial_state.fit_initial_state`, the scorers' start fit,
-        from the first measured state); the passive rows stay the measured ones (the loop
-        closure completes them in every simulation).  The measured start where the fit
-        fails or does no better."""
-        x0 = np.asarray(data.x[:, 0], dtype=float)
-        xd0 = np.asarray(data.xd[:, 0], dtype=float)
-        w = self._start_window(data)
-        if w < 2:
-            return x0, xd0
-        free = np.ones(x0.size, dtype=bool)
-        free[np.asarray(getattr(self, "passive_", ()), dtype=int)] = False
-
-        def full(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-            qa, va = x0.copy(), xd0.copy()
-            qa[free], va[free] = a, b
-            return qa, va
-
-        def simulate(a: np.ndarray, b: np.ndarray) -> Trajectory:
-            # only the free (actuated) rows are fitted: the closure completes the others
-            return model.simulate(*full(a, b), data.t[:w], data.u[:, :w], self._step(),
-                                  self.input_hold_, angles_only=True)
-
-        a, b = fit_initial_state(simulate, x0[free], xd0[free],
-                                 np.asarray(data.x[:, :w], dtype=float), field="x")
-        return full(a, b)
-
-    def _record_starts(self, models: list[ImplicitModel], data: Measurement
-                       ) -> list[tuple[np.ndarray, np.ndarray]]:
-        """The record rule's start set (``record_starts_``): the record's first measured
-        state, then each of ``models``' own fitted start (:meth:`_fitted_start`), each once.
-
-        Rule: the scored simulation starts from the true state, which no identifier sees; the
-        chain's estimate at the record's first sample is where its end effects are largest
-        (on ``fb20_3s`` at 1.5 %, s111: rates -1.5e-3 / 1.5e-4 rad/s on the actuated joints
-        against the truth's 0), and a model's own least-squares start over the record's
-        first span is another estimate the record supports (there: 2e-4 / 5e-4 and -6e-4 /
-        7e-4 rad/s for the two kinds of shortlisted pair).  Every one is a start the record
-        supports as well as the others; the truth's is not known to be nearer any of them."""
-        x0 = np.asarray(data.x[:, 0], dtype=float)
-        xd0 = np.asarray(data.xd[:, 0], dtype=float)
-        starts = [(x0, xd0)]
-        if not self._start_set_applies():
-            return starts
-        for m in models:
-            a, b = self._fitted_start(m, data)
-            if not any(np.array_equal(a, s[0]) and np.array_equal(b, s[1]) for s in starts):
-                starts.append((a, b))
-        return starts
-
-    def _replay_status(self, model: ImplicitModel, data: Measurement,
-                       own: bool = False) -> tuple[bool, bool]:
-        """Whether ``model`` simulates the whole record, from every start of the record
-        rule's start set (:meth:`_record_starts`, ``_starts``; the first measured state alone
-        before it is made, and for an open chain), under the measured inputs, without losing
-        its loop closure or diverging; and whether its simulation from one of them stays
-        nearer the record than rest does (angles only; see :meth:`_record_rule`).  ``own``:
-        ``model``'s own fitted start (:meth:`_fitted_start`) added to the set (the wider
-        search's combinations, which were not in the shortlist the set was made from).
+    def _replay_status(self, model: ImplicitModel, data: Measurement) -> tuple[bool, bool]:
+        """Whether ``model`` simulates the whole record, from its first measured state under
+        the measured inputs, without losing its loop closure or diverging; and whether that
+        simulation stays nearer the record than rest does (angles only; see
+        :meth:`_record_rule`).
 
         Rest: the record's first measured state held for the whole record.  A simulation
         whose RMSE against the measured angles exceeds, on some coordinate, that
@@ -1516,27 +1439,19 @@ class _ImplicitMechanical(Identifier):
         round 9's five-bars: the pairs that lost their loop from the true start 1.1-6.9 x
         rest on some coordinate, those that held it 0.015-0.06 x.
         """
-        starts = list(getattr(self, "_starts", None) or [(data.x[:, 0], data.xd[:, 0])])
-        if not self._start_set_applies():
-            starts = starts[:1]
-        elif own:
-            starts.append(self._fitted_start(model, data))
+        try:
+            sim = model.simulate(data.x[:, 0], data.xd[:, 0], data.t, data.u, self._step(),
+                                 self.input_hold_, angles_only=True).x
+        except IdentificationError:
+            return False, False
+        if not np.isfinite(sim).all():
+            return False, False
+        if getattr(self, "closure_", None) is None:
+            return True, True
         x = np.asarray(data.x, dtype=float)
+        err = np.sqrt(np.mean((sim - x) ** 2, axis=1))
         rest = np.sqrt(np.mean((x - x[:, :1]) ** 2, axis=1))
-        near = False
-        for x0, xd0 in starts:
-            try:
-                sim = model.simulate(x0, xd0, data.t, data.u, self._step(), self.input_hold_,
-                                     angles_only=True).x
-            except IdentificationError:
-                return False, False
-            if not np.isfinite(sim).all():
-                return False, False
-            if getattr(self, "closure_", None) is None:
-                return True, True
-            err = np.sqrt(np.mean((sim - x) ** 2, axis=1))
-            near = near or bool(np.all(err <= REPLAY_REST_RATIO * rest))
-        return True, near
+        return True, bool(np.all(err <= REPLAY_REST_RATIO * rest))
 
     def _record_rule(self, scores: list[float], models: list[ImplicitModel],
                      data: Measurement) -> list[float]:
@@ -1566,42 +1481,19 @@ class _ImplicitMechanical(Identifier):
         loop at 6.5 s of the record from the measured start and at 2.0 s from the true one).
         ``record_replay = False`` turns the rule off; combinations whose rollout failed are not
         simulated again.
-
-        The start set (SINDy-PI, closed chains; :meth:`_record_starts`, ``record_starts_``,
-        since 2026-11-28, session 22): the whole record is simulated from the first measured
-        state and from each shortlisted combination's own least-squares start over the record's
-        first span (:meth:`_fitted_start`); a combination that loses its loop closure or
-        diverges from any of them does not replay the record, and one replays it nearer than
-        rest if it does so from one of them.  Why: the scorer starts from the true state,
-        which none sees; the chain's estimate at the record's edge is its worst, and the
-        rollout selection of a record that pins the equations down on one curve only (the
-        paper's sine on both cranks, 3 s) shortlists pairs whose simulation amplifies a start
-        error of 1e-3 rad/s into a lost loop.  ``fb20_3s`` at 1.5 % (s111): 6 of 9 pairs
-        replayed from the measured start (rates -1.5e-3 / 1.5e-4 rad/s, the truth at rest)
-        and were chosen; all 6 lose the loop from the other 3 pairs' fitted starts (rates 2e-4
-        / 5e-4) and from the true one (at 2.05 s); the other 3 keep it from every start (worst
-        2.1 x rest from the measured one, 0.15-0.19 x from their own) and score 0.0013-0.0019
-        rad from the true start.
         """
         flag = getattr(self, "record_replay", None)
         if flag is False:
             self.record_replays_ = None
             self.record_rule_ = "user-set: off (rollout scores alone)"
             return scores
-        self._starts = self._record_starts(
-            [m for s, m in zip(scores, models, strict=True) if np.isfinite(s)], data)
-        self.record_starts_ = len(self._starts)
         status = np.array([self._replay_status(m, data) if np.isfinite(s) else (False, False)
                            for s, m in zip(scores, models, strict=True)], dtype=bool)
         finite, ok = status[:, 0], status[:, 0] & status[:, 1]
         self.record_replays_ = ok
         self._record_finite = finite
-        where = ("from its first measured state" if len(self._starts) == 1 else
-                 f"from each of {len(self._starts)} starts (the first measured state and the "
-                 f"combinations' own, fitted over the first "
-                 f"{self._start_window(data) / data.fs:.3g} s), nearer than rest from one")
         head = (f"{int(ok.sum())} of {ok.size} shortlisted combinations simulate the whole record "
-                f"{where}")
+                "from its first measured state")
         if not ok.any():
             if finite.any() and not finite.all():
                 # the divergence test alone, as before the rest baseline
@@ -1811,10 +1703,6 @@ class SINDyPI(_ImplicitMechanical):
     rollout_rmse_ : float
         With ``selection_ == "rollout"``: the chosen combination's segmented simulation error
         on the measured angles [rad] (:meth:`_ImplicitMechanical._rollout_error`).
-    record_starts_ : int
-        With ``selection_ == "rollout"``: how many starts the last record rule simulated each
-        shortlisted combination from (:meth:`_ImplicitMechanical._record_starts`; 1: the first
-        measured state alone, as for an open chain).
     replay_rmse_ : float or None
         Where the replay rule applied (:meth:`_replay_check`): the final model's simulation
         error over the trimmed record from its first measured state [rad]; else None.
@@ -1845,9 +1733,6 @@ class SINDyPI(_ImplicitMechanical):
     #: The record rule's wider search (:meth:`_wide_record`); a switch for probes that
     #: measure it against the rule without it.
     _wide_record_on: ClassVar[bool] = True
-    #: The record rule's start set (:meth:`_ImplicitMechanical._record_starts`); a switch
-    #: for probes that measure the rule without it.
-    _start_set_on: ClassVar[bool] = True
     deterministic = True  # ensembles drawn from ``ensemble_seed``; refitted to the bit in test_conformance
     hyperparameters: ClassVar[dict[str, Field]] = ordered_fields({
         **COMMON_HYPERPARAMETERS,

@@ -42,7 +42,6 @@ class _Model:
 
 class _Data:
     def __init__(self, n=50):
-        self.fs, self.n_samples = 100.0, n
         self.t = np.arange(n) / 100.0
         self.x = np.zeros((4, n))
         self.xd = np.zeros((4, n))
@@ -79,7 +78,7 @@ class _Replay:
         self.sim = sim
 
     def simulate(self, x0, xd0, t, u, dt, hold, angles_only=False):
-        return Trajectory(self.sim[:, :t.size].copy(), None, None)
+        return Trajectory(self.sim.copy(), None, None)
 
 
 def test_a_finite_replay_farther_than_rest_is_not_a_replay():
