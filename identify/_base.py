@@ -518,6 +518,14 @@ class Identifier:
 FITTED_ONLY = ("score", "predict_acceleration", "equations", "simulate")
 
 
+#: ``id`` of each identifier whose outermost guarded ``fit`` is running (a fit's own calls of
+#: its parents' guarded fits are inner ones).  Kept outside the instance, so a copy or a pickle
+#: made during a fit carries no mark (session 22's review: a flag in ``__dict__`` travelled
+#: into a deep copy, whose later fits then never removed an earlier fit's attributes); an id
+#: is unique while its object lives, which it does for the whole fit.
+_FITTING: set[int] = set()
+
+
 def _guard_fit(fit: Callable[..., Identifier]) -> Callable[..., Identifier]:
     """``fit`` checking its arguments first: ``data`` a Measurement (ArgumentError otherwise),
     ``y`` None, the hyperparameters against their declaration and the data's shape
@@ -548,7 +556,7 @@ def _guard_fit(fit: Callable[..., Identifier]) -> Callable[..., Identifier]:
         # or decides one of its rules (session 22's review: SGDSINDy's refit compared an earlier
         # fit's record_agreement_ with its own).  Only by the outermost fit: a subclass's fit
         # that calls its parent's (SINDyPI's super().fit) keeps what it has set
-        outermost = not self.__dict__.get("_fit_running", False)
+        outermost = id(self) not in _FITTING
         if outermost:
             for k in [k for k in vars(self) if k.endswith("_") and not k.startswith("_")]:
                 delattr(self, k)
@@ -559,12 +567,12 @@ def _guard_fit(fit: Callable[..., Identifier]) -> Callable[..., Identifier]:
                                       f"{max(free, 0)} samples of the {data.n_samples}; need at "
                                       f"least {MIN_FREE_SAMPLES}")
         if outermost:
-            self.__dict__["_fit_running"] = True
+            _FITTING.add(id(self))
         try:
             out = fit(self, data, y, **kw) if takes_y else fit(self, data, **kw)
         finally:
             if outermost:
-                self.__dict__.pop("_fit_running", None)
+                _FITTING.discard(id(self))
         if out is not self:
             # a plugin's fit returning None was scored as fitted, and the API's chain
             # ``Id().fit(d).equations()`` handed the user None (hostile round 19's open item)
@@ -644,10 +652,17 @@ def _check_simulate_args(model: Identifier, where: str, x0: Any = None, xd0: Any
 
 
 def _install_guards(cls: type) -> None:
-    """Wrap ``cls``'s own ``fit`` and :data:`FITTED_ONLY` methods once."""
+    """Wrap ``cls``'s own ``fit`` and :data:`FITTED_ONLY` methods once; a ``fit`` that ``cls``
+    inherits unguarded (a mixin's, listed before an identifier's in its bases) is wrapped on
+    ``cls`` too, so the outermost fit of every call is a guarded one (session 22's review: a
+    mixin's ``fit`` ran unchecked, and what it set before ``super().fit`` was removed as an
+    earlier fit's by the inner guard)."""
     own = cls.__dict__
     if "fit" in own and not getattr(own["fit"], "_api_guard", False):
         cls.fit = _guard_fit(own["fit"])
+    elif "fit" not in own and callable(getattr(cls, "fit", None)) and not getattr(
+            cls.fit, "_api_guard", False):
+        cls.fit = _guard_fit(cls.fit)
     for name in FITTED_ONLY:
         method = own.get(name)
         if callable(method) and not getattr(method, "_api_guard", False):

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import copy
 import os
 import subprocess
 import sys
@@ -184,3 +185,46 @@ def test_an_undeclared_plugins_hyperparameter_may_be_any_value():
             self.weights, self.terms = weights, terms
 
     Weighted(weights=np.ones(3), terms={"x", "y"}).check_params()
+
+
+def _noise_record() -> Measurement:
+    x = np.random.default_rng(0).normal(size=(2, 4000))
+    return Measurement(fs=1000.0, x=x, xd=x, xdd=x, channels=("a", "b"))
+
+
+class _Learns(Identifier):
+    kind = "structural"
+
+    def fit(self, data):
+        self.coef_ = 1.0
+        return self
+
+
+def test_a_fit_starts_afresh_yet_keeps_what_its_own_outer_fit_set():
+    """A fit removes an earlier fit's learned attributes (SGDSINDy's refit once compared an
+    earlier fit's record_agreement_ with its own), at the outermost fit only (session 22's
+    review): a mixin's fit listed before the identifier's keeps what it set before
+    super().fit, and a copy made during a fit carries no mark that would stop its own later
+    fits from starting afresh."""
+    class Mixin:
+        def fit(self, data):
+            self.started_ = "set before super().fit"
+            return super().fit(data)
+
+    class WithMixin(Mixin, _Learns):
+        pass
+
+    class Snapshots(_Learns):
+        def fit(self, data):
+            super().fit(data)
+            self.snapshot_ = copy.deepcopy(self)
+            return self
+
+    data = _noise_record()
+    assert WithMixin().fit(data).started_ == "set before super().fit"
+    m = _Learns().fit(data)
+    m.stale_ = "from an earlier fit"
+    assert not hasattr(m.fit(data), "stale_")
+    snap = Snapshots().fit(data).snapshot_
+    snap.stale_ = "from an earlier fit"
+    assert not hasattr(snap.fit(data), "stale_")
