@@ -51,6 +51,8 @@ from typing import Any
 
 import numpy as np
 
+from testbed.numerics.noise import noise_std
+
 #: A clip level is held on at least one run of this many consecutive samples [samples]: a
 #: smooth float record meets each value once.
 MIN_RUN = 2
@@ -78,6 +80,11 @@ RATIO = 4.0
 #: rate-pair records of the dataset cache (2,709 channel pairs) and their 16-bit copies give no
 #: alarm (``benchmarks/clip_ends21.py``, docs/known-gaps.md)
 RATE_HOLD_TOL = 0.05
+#: Standard deviations of the channels' white noise (:func:`testbed.numerics.noise.noise_std`,
+#: of differences of this order) the held run's change and the rate's integral may differ by
+#: on top: a Gaussian's chance beyond 5 sigma is 6e-7 a run
+NOISE_SIGMAS = 5.0
+NOISE_ORDER = 4
 #: The quantisation term: a held code's true change is within a step on either side and one
 #: inside it, and each rate sample within its step [steps]
 HOLD_STEPS = 3.0
@@ -232,6 +239,16 @@ def rate_contradicted_levels(a: np.ndarray, d: np.ndarray, fs: float
         return []
     motion = float(np.sqrt(np.mean((a - a.mean()) ** 2)))
     qa, qd = _smallest_gap(a), _smallest_gap(d)
+    # the rate's own offset (a sensor's bias, which the importer accepts up to RATE_BIAS_MAX
+    # of its RMS) from the whole record's drift: a run of tau seconds then drifts bias * tau
+    # (session 22's review: an angle at rest at its lowest, its gyro offset by 2 % of its RMS,
+    # was called clipped); a clip's own share of that drift only widens the tolerance
+    bias = (float(np.sum(d[1:] + d[:-1])) * 0.5 / fs - float(a[-1] - a[0])) / ((n - 1) / fs)
+    # white noise on either channel: the change of a over the run and the rate's integral
+    # wander by sqrt(2) sa and sqrt(m) sd / fs (session 22's review: a 12-bit encoder with
+    # gyro noise of 20 % of the rate's RMS alarmed on 19-24 of 50 draws)
+    sa, sd = (float(noise_std(y, order=NOISE_ORDER)[0]) if n > NOISE_ORDER + 2 else 0.0
+              for y in (a, d))
     out = []
     for which, y in (("signal", a), ("rate", d)):
         hi, lo = float(y.max()), float(y.min())
@@ -244,7 +261,9 @@ def rate_contradicted_levels(a: np.ndarray, d: np.ndarray, fs: float
                 i, j = max(s0 - 1, 0), min(s0 + m + 1, n)  # one sample past each side
                 change = float(a[j - 1] - a[i])
                 integral = float(np.sum(d[i + 1:j] + d[i:j - 1]) * 0.5 / fs)
-                tol = max(RATE_HOLD_TOL * motion, HOLD_STEPS * qa + (j - i) * qd / fs)
+                integral -= bias * (j - 1 - i) / fs
+                noise = NOISE_SIGMAS * np.sqrt(2.0 * sa * sa + (j - i) * (sd / fs) ** 2)
+                tol = max(RATE_HOLD_TOL * motion, HOLD_STEPS * qa + (j - i) * qd / fs) + noise
                 if abs(change - integral) > tol:
                     held, runs = held + m, runs + 1
             if runs:

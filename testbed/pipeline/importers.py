@@ -424,8 +424,10 @@ def measurement_and_clipping(path: str | os.PathLike, kind: str,
     if (signal or {}).get("derivatives", "recorded") == "recorded":  # the rates the fit reads
         _check_rates(data.source, ds, kind)
     try:
+        # the rates judge a held extreme only where the rate check above vouched for them
+        checked = (signal or {}).get("derivatives", "recorded") == "recorded"
         return (measure(ds, dict(signal or {}), kind),
-                measured_clipping(ds.measured, ds.fs, RATE_PAIRS.get(kind, ())))
+                measured_clipping(ds.measured, ds.fs, RATE_PAIRS.get(kind, ()) if checked else ()))
     except TestbedError:
         raise
     except ValueError as e:  # the chain's own checks: signal names, channel counts, positions
