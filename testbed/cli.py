@@ -1168,11 +1168,13 @@ def main(argv: list[str] | None = None) -> int:
                 return status
         before = gc.get_threshold()
         gc.set_threshold(*GC_THRESHOLD)  # restored below: main() is also called from Python
+        late_exit_calls()  # an earlier command's, in this process (main() called from Python)
         try:
             with _terminate_as_interrupt(console=argv is None), _stdout_writes_file_names():
-                status = _main(argv)
-                _say_late_exits()
-                return status
+                try:
+                    return _main(argv)
+                finally:  # after the verdict, and after an interrupt too (review 22c)
+                    _say_late_exits()
         finally:
             gc.set_threshold(*before)
     except KeyboardInterrupt as e:

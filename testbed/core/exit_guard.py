@@ -55,6 +55,12 @@ _LEFTOVER: weakref.WeakSet = weakref.WeakSet()
 #: ``(thread name, code)`` of each ``os._exit`` a left-over thread made outside every guard
 #: (that thread was ended instead), until :func:`late_exit_calls` takes them.
 _LATE: list[tuple[str, object]] = []
+#: Threads alive when the interception was put in place (the caller's own: their ``os._exit``
+#: outside every guard ends the process).  A thread started later that calls it while no guard
+#: is entered and the interception lingers for a left-over thread was started by a guarded
+#: block's code or by a left-over thread (a pool's worker started lazily: session 22's review),
+#: and ends itself as a left-over thread does.
+_BEFORE: weakref.WeakSet = weakref.WeakSet()
 
 
 class ProcessExitCalled(SystemExit):
@@ -87,7 +93,9 @@ def _guarded_exit(code: object = 0) -> None:
         for ident in _GUARDED:  # every guard entered now raises it when it ends; this
             _PENDING.setdefault(ident, code)  # thread ends by a plain SystemExit, which
             # threading's hook passes over in silence (a subclass's traceback it prints)
-        late = not guarded and threading.current_thread() in _LEFTOVER
+        this = threading.current_thread()
+        late = not guarded and (this in _LEFTOVER or (this not in _BEFORE
+                                                      and this is not threading.main_thread()))
         if late:  # after every guard ended: a thread a guarded block left running
             _LATE.append((threading.current_thread().name, code))
     if guarded or late:
@@ -119,6 +127,7 @@ def _restore() -> None:
     _REAL.clear()
     _PID.clear()
     _PENDING.clear()
+    _BEFORE.clear()
 
 
 def _forget_parents_guards() -> None:
@@ -136,6 +145,7 @@ def _forget_parents_guards() -> None:
         _PID.clear()
         _LEFTOVER.clear()
         _LATE.clear()
+        _BEFORE.clear()
 
 
 @contextlib.contextmanager
@@ -150,6 +160,8 @@ def no_process_exit() -> Iterator[None]:
             if not _REAL:  # else still intercepted for a left-over thread: _REAL is the real one
                 _REAL[:] = [os._exit]
                 _PID[:] = [os.getpid()]
+                _BEFORE.clear()
+                _BEFORE.update(threading.enumerate())
             _PENDING.clear()
             os._exit = _guarded_exit
             if posix is not None:

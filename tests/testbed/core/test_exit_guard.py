@@ -158,3 +158,29 @@ def test_a_thread_left_running_that_exits_after_the_guard_ends_only_itself():
                        capture_output=True, text=True, timeout=60)
     assert p.returncode == 6 and p.stderr == "", (p.returncode, p.stderr[-300:])
     assert p.stdout.splitlines() == ["False", "[('left', 5)] []", "True"], p.stdout
+
+
+def test_a_thread_a_left_over_thread_starts_later_ends_only_itself():
+    # session 22's review: a thread started after the guard ended by a thread the guarded
+    # block left running (a pool that grows its workers lazily) was not known as left over,
+    # and its os._exit ended the process with its own status and no verdict (7 here)
+    code = textwrap.dedent("""
+        import os, threading
+        from testbed.core.exit_guard import late_exit_calls, no_process_exit
+        go, done = threading.Event(), threading.Event()
+        def left():
+            go.wait(30)
+            t = threading.Thread(target=lambda: os._exit(7), name="later")
+            t.start()
+            t.join(30)
+            done.set()
+        with no_process_exit():
+            threading.Thread(target=left, name="left").start()
+        go.set()
+        done.wait(30)
+        print(late_exit_calls())
+        """)
+    p = subprocess.run([sys.executable, "-c", code], env={**os.environ, "PYTHONPATH": ROOT},
+                       capture_output=True, text=True, timeout=60)
+    assert p.returncode == 0 and p.stderr == "", (p.returncode, p.stderr[-300:])
+    assert p.stdout.splitlines() == ["[('later', 7)]"], p.stdout
