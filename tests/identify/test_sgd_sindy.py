@@ -15,6 +15,7 @@ import pytest
 
 from benchmarks import bench_sgd_sindy as bench
 from identify import IDENTIFIERS
+from identify._record import record_agreement
 from identify._structural_sim import RK4_STABILITY_BOUND, sample_rate_pole
 from identify.sgd_sindy import (
     SGD_AGREEMENT_FLOOR,
@@ -22,7 +23,6 @@ from identify.sgd_sindy import (
     UNEXPLAINED_RECORD,
     SGDSINDy,
     keep_sgd_rule,
-    record_agreement,
     record_rule,
 )
 from identify.sgd_sindy_coefficients import SGDSINDyCoefficients

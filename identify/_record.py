@@ -1,0 +1,99 @@
+"""How well a fitted structural model reproduces the record it was fitted on (no truth).
+
+One routine, :func:`record_agreement`, shared by the identifiers that judge a fitted model by
+its own record: ``sgd_sindy`` (the SGD's result against its held warm start,
+:func:`identify.sgd_sindy.keep_sgd_rule`) and ``ls_sindy`` (the free window's fitted input map
+against none, :func:`identify.ls_sindy.LeastSquaresSINDy.fit`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from identify._structural_sim import RK4_STABILITY_BOUND, sample_rate_pole
+from identify.structural import StructuralIdentifier
+from testbed.core.errors import TestbedError
+from testbed.core.measurement import Measurement, Trajectory
+from testbed.numerics.initial_state import MAX_ITERATIONS, fit_initial_state
+from testbed.numerics.shapes import trac
+
+#: The openings of :func:`record_agreement`'s notes for a simulation from the record's own start
+#: that failed: written there and read by :func:`identify.sgd_sindy.cubic_diverges`, one
+#: spelling for both.
+SIMULATION_FAILED = "simulation failed"
+SIMULATION_NOT_FINITE = "simulation not finite"
+
+
+def record_agreement(model: StructuralIdentifier, data: Measurement,
+                     iterations: int = MAX_ITERATIONS,
+                     sims: dict[bytes, Trajectory] | None = None) -> tuple[float, str]:
+    """How well a fitted model's simulated response reproduces the measured record [-].
+
+    The model is simulated from ``data.free_start`` to the record's end under the measured
+    input, from the start whose accelerations best match the measured ones (least squares,
+    :func:`testbed.numerics.initial_state.fit_initial_state`, the scorer's, from the measured
+    state: the chain's integration constants are not the model's error), and compared with
+    the measured accelerations ``data.xdd`` by TRAC per channel
+    (:func:`testbed.numerics.shapes.trac`).  Only the measured record enters, never the truth.
+
+    The cost is bounded by rule: a linear model is simulated exactly at any pole speed (its
+    transition matrix, :func:`identify._structural_sim.simulate_structural`); a cubic model is
+    integrated by RK4 whose sub-steps grow with its fastest pole, so one whose linear part has
+    a pole beyond :data:`identify._structural_sim.RK4_STABILITY_BOUND` per sample interval
+    (:func:`identify._structural_sim.sample_rate_pole`: a pole the record cannot resolve; a
+    warm start of soft-base member 001 had one at -3.2e6 rad/s, 16 s per simulation) is not
+    simulated: NaN, with the reason.
+
+    Parameters
+    ----------
+    model : StructuralIdentifier
+        Fitted (``M_``, ``C_``, ``K_``, ``K3_``, ``input_map_``).
+    data : Measurement
+        The record it was fitted on.
+    iterations : int
+        Gauss-Newton iterations of the start fit at most (default the scorer's).
+    sims : dict, optional
+        The model's simulations over this record by start (``(x0, xd0)``'s bytes), filled
+        here; pass the same dict to a second call on the same model and record (more
+        iterations): its first iteration is then read, not simulated again.
+
+    Returns
+    -------
+    agreement : float
+        The smallest channel's TRAC in [0, 1]; NaN when the model was not simulated, the
+        simulation fails or is not finite (a diverging model).
+    note : str
+        Why the agreement is NaN ("" when it is not).
+    """
+    dt = 1.0 / float(data.fs)
+    if model.K3_ is not None and np.any(model.K3_ != 0.0):
+        rate = sample_rate_pole(model.M_, model.C_, model.K_, dt)
+        if not rate <= RK4_STABILITY_BOUND:
+            return float("nan"), (
+                f"not simulated: a cubic model whose linear part has a pole of {rate / dt:.3g} "
+                f"rad/s, |lambda| dt = {rate:.3g} beyond RK4's stability bound "
+                f"{RK4_STABILITY_BOUND:g} (unresolved at the sample rate)")
+    i0 = int(data.free_start)
+    t = np.arange(data.n_samples - i0) * dt
+    u = None if data.u is None or model.input_map_ is None else data.u[:, i0:]
+    ref = np.asarray(data.xdd, dtype=float)[:, i0:]
+    sims = {} if sims is None else sims
+
+    def simulate(x0: np.ndarray, xd0: np.ndarray) -> Trajectory:
+        """The model's response from ``(x0, xd0)``, each start simulated once (the fitted start
+        is the start fit's last accepted iterate)."""
+        key = np.concatenate([x0, xd0]).tobytes()
+        if key not in sims:
+            sims[key] = model.simulate(x0, xd0, t, u)
+        return sims[key]
+
+    try:
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+            x0, xd0 = fit_initial_state(simulate, data.x[:, i0], data.xd[:, i0], ref,
+                                        max_iterations=iterations)
+            tr = trac(ref, simulate(x0, xd0).xdd)
+    except (TestbedError, np.linalg.LinAlgError, ValueError, FloatingPointError) as e:
+        return float("nan"), f"{SIMULATION_FAILED}: {e}"
+    if not np.all(np.isfinite(tr)):
+        return float("nan"), SIMULATION_NOT_FINITE
+    return float(np.min(tr)), ""
