@@ -246,7 +246,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from identify._structural_sim import state_matrix
-from identify.structural import MODE_SEPARATION, growing_poles, modal, peak_band
+from identify.structural import (
+    MODE_SEPARATION,
+    SHAPES_COND_MAX,
+    growing_poles,
+    modal,
+    peak_band,
+)
 from testbed.core.lazy import lazy_module
 from testbed.core.measurement import Measurement
 
@@ -1065,10 +1071,10 @@ def decay_hold(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndarray,
             + (f"; modes {(np.flatnonzero(shaped) + 1).tolist()} shaped by that fit (each "
                f"channel's amplitude of the one decay, their common phase)"
                if np.any(shaped) else "")
-            + (f"; modes {(np.flatnonzero(dec.exponential) + 1).tolist()}, which no measured "
+            + (f"; modes {(np.flatnonzero(dec.exponential & on) + 1).tolist()}, which no measured "
                f"peak located and whose decay holds no first-order backbone (|c| > "
                f"{BACKBONE_MAX_SHIFT:g} wd), from an exponential decay fit, wherever it lies"
-               if dec.exponential is not None and np.any(dec.exponential) else "")
+               if dec.exponential is not None and np.any(dec.exponential & on) else "")
             + (f"; modes {(np.flatnonzero(beyond) + 1).tolist()} kept the fit's frequency (the "
                f"decay's lies beyond one line of it, within the spectral-peak offset: a cubic "
                f"model's frequency stands at no peak)" if np.any(beyond) else "")
@@ -1335,17 +1341,18 @@ def set_shapes(M: np.ndarray, C: np.ndarray, K: np.ndarray, shapes: np.ndarray
         ``K' = M Phi' Lambda Phi'^-1`` and ``C' = M Phi' D Phi'^-1``, ``Lambda`` the
         eigenvalues of ``M^-1 K`` and ``D = Phi^-1 M^-1 C Phi`` the modal damping (couplings
         too) in the model's own shapes ``Phi``, ``Phi'`` those shapes with the given columns;
-        None where ``Phi`` or ``Phi'`` does not span the space (condition number above 1e12).
+        None where ``Phi`` or ``Phi'`` does not span the space (condition number above
+        :data:`~identify.structural.SHAPES_COND_MAX`, or not finite).
     """
     Phi = modal(M, K)[1]
-    if np.linalg.cond(Phi) > 1e12:
+    if not np.linalg.cond(Phi) <= SHAPES_COND_MAX:  # NaN too (review 22c)
         return None
     new = Phi.copy()
     on = np.all(np.isfinite(shapes), axis=0)
     for k in np.flatnonzero(on):  # the model's scale and sign: a coupling D_jk keeps its share
         v = shapes[:, k] * np.linalg.norm(Phi[:, k]) / np.linalg.norm(shapes[:, k])
         new[:, k] = v if v @ Phi[:, k] >= 0 else -v
-    if np.linalg.cond(new) > 1e12:
+    if not np.linalg.cond(new) <= SHAPES_COND_MAX:
         return None
     lam = np.diag(np.linalg.solve(Phi, np.linalg.solve(M, K @ Phi))).real
     D = np.linalg.solve(Phi, np.linalg.solve(M, C @ Phi)).real

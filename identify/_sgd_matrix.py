@@ -605,7 +605,7 @@ def complex_stiffness_pair(A: np.ndarray) -> str:
 
     Decided on the shapes the placement itself uses (:func:`identify.structural.modal`'s
     real parts, the same solver): they span the space where their condition number is at
-    most :data:`identify._unresolved.SHAPES_COND_MAX`, the placement's own bound.  A pair
+    most :data:`identify.structural.SHAPES_COND_MAX`, the placement's own bound.  A pair
     near coalescence splits into a real or a complex pair by rounding, differently in each
     eigensolver, but its shapes are near-parallel either way, so the statement does not
     depend on which (session 22's review: decided by a second solver, 9 of 300 near-defective

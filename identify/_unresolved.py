@@ -42,7 +42,7 @@ from __future__ import annotations
 import numpy as np
 
 from identify._modal_damping import _is_symmetric, _modal_damping_matrix, hold_modal_damping
-from identify.structural import MODE_SEPARATION, modal
+from identify.structural import MODE_SEPARATION, SHAPES_COND_MAX, modal
 
 #: Damping ratio given to an unresolved mode [-]: 1/sqrt(2), the least damping whose response
 #: has no resonant peak (the record shows no peak of it), and a complex pole pair.  Not
@@ -53,11 +53,6 @@ from identify.structural import MODE_SEPARATION, modal
 #: runs).  Measured on ``b16_ti_n32_s5`` clean, ``ls_sindy``: TRAC 0.998 with 1.0 and 0.9997
 #: with 0.5, modes 1-3 unchanged (not tuned: the declared choice).
 UNRESOLVED_ZETA = float(1.0 / np.sqrt(2.0))
-#: Largest condition number of the mode shapes' matrix (:func:`identify.structural.modal`'s real
-#: parts) by which a mode is placed: past it two shapes are parallel to within rounding (a
-#: coalesced or near-coalesced pair; float64's 1e-16 times 1e12 leaves 1e-4 of a shape's
-#: direction), and a solve with them returns the rounding's choice.
-SHAPES_COND_MAX = 1e12
 
 
 def stiffness_eigenvalues(M: np.ndarray, K: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -617,6 +617,11 @@ def mass_prior_value(data: Measurement, key: str) -> float:
 #: spring sweeps the soft cantilever's mode 1 from 40.2 to 38.4 Hz as it decays (measured), so
 #: its peak splits; distinct bending modes of a beam lie a factor of 2 or more apart.
 MODE_SEPARATION = 0.15
+#: Largest condition number of the mode shapes' matrix (:func:`modal`'s real parts) by which a
+#: mode is placed or reshaped: past it two shapes are parallel to within rounding (a coalesced
+#: or near-coalesced pair; float64's 1e-16 times 1e12 leaves 1e-4 of a shape's direction), and
+#: a solve with them returns the rounding's choice.
+SHAPES_COND_MAX = 1e12
 
 
 #: Lower edge of the peak band, as a multiple of the chain's high-pass cut-off: the elliptic

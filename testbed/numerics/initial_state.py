@@ -16,7 +16,7 @@ against ``n`` x thousands of samples cannot make a wrong model right: the respon
 frequencies and decay rates are the model's own.
 
 Here in :mod:`testbed.numerics` since ``sgd_sindy`` compares its candidate models with the
-measured record the same way (:func:`identify.sgd_sindy.record_agreement`);
+measured record the same way (:func:`identify._record.record_agreement`);
 :mod:`testbed.scoring.initial_state` re-exports it for the scorers.
 """
 

@@ -409,7 +409,7 @@ def test_near_coalesced_modes_are_decided_on_the_shapes_the_placement_uses():
     generalised solvers; decided by the standard one, 9 of 300 such warm starts passed the
     check and the placement's solve with the generalised solver's parallel shapes raised
     "Singular matrix" (session 22's review).  Now the shapes the placement uses decide
-    (:data:`identify._unresolved.SHAPES_COND_MAX`): none raises, and a repeated eigenvalue
+    (:data:`identify.structural.SHAPES_COND_MAX`): none raises, and a repeated eigenvalue
     with independent shapes (no coalescence; named a complex pair on 48 of 300 before) is no
     reason at all."""
     a = (2 * np.pi * 530.0) ** 2
