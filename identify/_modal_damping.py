@@ -321,6 +321,13 @@ class ModalDecay:
         Column ``k``: the sensor shape of mode ``k`` measured by its fit from an accepted peak
         no mode took (:func:`peak_shape`; ``free_peaks_hz`` of :func:`modal_decay`), NaN for
         the other modes; None where no mode was so fitted.
+    peak_hz : ndarray, shape (n,) or None
+        The accepted peak [Hz] mode ``k`` was fitted from (``free_peaks_hz``), NaN for the
+        other modes; None where no mode was so fitted.
+    exponential : ndarray of bool, shape (n,) or None
+        With the backbone fit, the modes refitted as an exponential decay and converged (no
+        peak located them and their backbone fit was not first order); None where none was
+        refitted.
     """
 
     sigma: np.ndarray
@@ -333,6 +340,7 @@ class ModalDecay:
     chirp: np.ndarray | None = None
     amplitude: np.ndarray | None = None
     shape: np.ndarray | None = None
+    peak_hz: np.ndarray | None = None
     exponential: np.ndarray | None = None
 
 
@@ -594,7 +602,7 @@ def modal_decay(data: Measurement, M: np.ndarray, K: np.ndarray, C: np.ndarray,
     extra = (np.full(n, np.nan), np.full(n, np.nan)) if backbone else (None, None)
     out = ModalDecay(*(np.full(n, np.nan) for _ in range(5)), np.zeros(n), np.zeros(n, bool),
                      *extra)
-    if not np.all(np.isfinite(freqs)) or np.linalg.cond(Phi) > 1e12:
+    if not np.all(np.isfinite(freqs)) or not np.linalg.cond(Phi) <= SHAPES_COND_MAX:
         return out
     # the measured accelerations as they are: they carry no integration drift, and a
     # high-pass (the fit band's) rings at its cut-off from the record's start and biased mode
@@ -630,6 +638,9 @@ def modal_decay(data: Measurement, M: np.ndarray, K: np.ndarray, C: np.ndarray,
                                        unlocated_band(w, k, peak_band(data, i1 - i0)[0]),
                                        nuisance, fits)
             paired = True
+            if out.peak_hz is None:
+                object.__setattr__(out, "peak_hz", np.full(n, np.nan))
+            out.peak_hz[k] = peak / (2.0 * np.pi)
             v = peak_shape(xdd[:, i0:i1], t, s, wd, nuisance, fits) if ok else None
             if v is not None:
                 if out.shape is None:
@@ -1028,15 +1039,10 @@ def decay_hold(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndarray,
         if np.any(own):
             C2, cut = _hold_couplings(M, C, K, K2, sigma, dec.taken, line)
     kept, fixed = np.flatnonzero(~dec.taken & ~own) + 1, np.flatnonzero(on) + 1
-    from_peak: dict[int, float] = {}  # modes fitted from a peak no mode took (modal_decay)
-    if free_peaks_hz is not None and unlocated is not None and not with_backbone:
-        w_fit = 2.0 * np.pi * modal(M, K)[0]
-        if data.integration == "trapezoid":  # as modal_decay compares them
-            w_fit = 2.0 * float(data.fs) * np.arctan(w_fit / (2.0 * float(data.fs)))
-        for k in np.flatnonzero(np.asarray(unlocated, bool) & dec.taken):
-            p = _free_peak(free_peaks_hz, w_fit, int(k), data, i1 - i0)
-            if p is not None:
-                from_peak[int(k) + 1] = p / (2.0 * np.pi)
+    # modes fitted from a peak no mode took (modal_decay, free_peaks_hz), and taken
+    from_peak = ({} if dec.peak_hz is None else
+                 {int(k) + 1: float(dec.peak_hz[k])
+                  for k in np.flatnonzero(np.isfinite(dec.peak_hz) & dec.taken)})
     shaped = np.zeros(M.shape[0], bool)
     if from_peak and dec.shape is not None:
         shaped = np.array([k + 1 in from_peak for k in range(M.shape[0])]) \

@@ -111,11 +111,12 @@ from typing import Any, Literal
 import numpy as np
 
 from identify._modal_damping import modal_decay
-from identify._unresolved import SHAPES_COND_MAX, place_unresolved
+from identify._unresolved import place_unresolved
 from identify.structural import (
     FIT_BAND_ORDER,
     FIT_TILT_DIFFERENCES,
     MODE_SEPARATION,
+    SHAPES_COND_MAX,
     check_physical,
     fit_band_cutoff,
     modal,
@@ -1034,7 +1035,8 @@ def lowest_peak_unpaired(M: np.ndarray, K: np.ndarray, lam_hat: np.ndarray) -> s
     if np.any(eigen_targets(M, K, lam_hat, symmetric=True) == low):
         return ""
     modes = modal(M, K)[0]
-    return (f"no mode of it lies within {MODE_SEPARATION:.0%} of the lowest measured peak "
+    return (f"the pairing (within {MODE_SEPARATION:.0%}, closest first) gives no mode of it the "
+            f"lowest measured peak "
             f"{np.sqrt(low) / (2.0 * np.pi):.4g} Hz (its modes "
             + ", ".join(f"{f:.4g}" for f in modes) + " Hz): its stiffness, not its damping, "
             "is wrong")

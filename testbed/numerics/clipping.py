@@ -237,6 +237,17 @@ def rate_contradicted_levels(a: np.ndarray, d: np.ndarray, fs: float
         # within one quantisation step (a 16-bit copy of a five-bar at rest within 1.6e-7 rad
         # of 1.78 rad: four alarms on its rate, which no signal step can confirm)
         return []
+    # the held runs of each extreme first: a float record holds none, and the record-wide
+    # figures below (two sorts, two noise estimates) are then not needed
+    held_runs = []
+    for which, y in (("signal", a), ("rate", d)):
+        for level in (float(y.max()), float(y.min())):
+            starts, lengths = _runs(y == level)
+            long = lengths >= MIN_RUN
+            if np.any(long):
+                held_runs.append((which, level, starts[long].tolist(), lengths[long].tolist()))
+    if not held_runs:
+        return []
     motion = float(np.sqrt(np.mean((a - a.mean()) ** 2)))
     qa, qd = _smallest_gap(a), _smallest_gap(d)
     # the rate's own offset (a sensor's bias, which the importer accepts up to RATE_BIAS_MAX
@@ -250,24 +261,19 @@ def rate_contradicted_levels(a: np.ndarray, d: np.ndarray, fs: float
     sa, sd = (float(noise_std(y, order=NOISE_ORDER)[0]) if n > NOISE_ORDER + 2 else 0.0
               for y in (a, d))
     out = []
-    for which, y in (("signal", a), ("rate", d)):
-        hi, lo = float(y.max()), float(y.min())
-        for level in (hi, lo):
-            starts, lengths = _runs(y == level)
-            held = runs = 0
-            for s0, m in zip(starts.tolist(), lengths.tolist(), strict=True):
-                if m < MIN_RUN:
-                    continue
-                i, j = max(s0 - 1, 0), min(s0 + m + 1, n)  # one sample past each side
-                change = float(a[j - 1] - a[i])
-                integral = float(np.sum(d[i + 1:j] + d[i:j - 1]) * 0.5 / fs)
-                integral -= bias * (j - 1 - i) / fs
-                noise = NOISE_SIGMAS * np.sqrt(2.0 * sa * sa + (j - i) * (sd / fs) ** 2)
-                tol = max(RATE_HOLD_TOL * motion, HOLD_STEPS * qa + (j - i) * qd / fs) + noise
-                if abs(change - integral) > tol:
-                    held, runs = held + m, runs + 1
-            if runs:
-                out.append((which, level, held, runs))
+    for which, level, starts, lengths in held_runs:
+        held = runs = 0
+        for s0, m in zip(starts, lengths, strict=True):
+            i, j = max(s0 - 1, 0), min(s0 + m + 1, n)  # one sample past each side
+            change = float(a[j - 1] - a[i])
+            integral = float(np.sum(d[i + 1:j] + d[i:j - 1]) * 0.5 / fs)
+            integral -= bias * (j - 1 - i) / fs
+            noise = NOISE_SIGMAS * np.sqrt(2.0 * sa * sa + (j - i) * (sd / fs) ** 2)
+            tol = max(RATE_HOLD_TOL * motion, HOLD_STEPS * qa + (j - i) * qd / fs) + noise
+            if abs(change - integral) > tol:
+                held, runs = held + m, runs + 1
+        if runs:
+            out.append((which, level, held, runs))
     return out
 
 
