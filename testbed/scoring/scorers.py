@@ -220,15 +220,15 @@ def bar_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -> dic
     """The failures a run's bars add to its scorer's: :func:`uninformative_failures`,
     :func:`out_of_band_failures`, :func:`unexcited_failures`, :func:`decayed_failures`,
     :func:`floor_failures`, :func:`sensor_failures`, :func:`equation_failures`,
-    :func:`step_failures`, :func:`sensitivity_failures`, :func:`clipping_failures` and
-    :func:`linear_model_failures`, merged (one call for
+    :func:`step_failures`, :func:`sensitivity_failures`, :func:`clipping_failures`,
+    :func:`linear_model_failures` and :func:`unscored_mode_failures`, merged (one call for
     :func:`testbed.scoring.run.run_scenario` and :func:`testbed.scoring.evaluate.score_model`)."""
     return {**uninformative_failures(scores, thresholds), **out_of_band_failures(scores, thresholds),
             **unexcited_failures(scores, thresholds), **decayed_failures(scores, thresholds),
             **floor_failures(scores, thresholds), **sensor_failures(scores, thresholds),
             **equation_failures(scores, thresholds), **step_failures(scores, thresholds),
             **sensitivity_failures(scores, thresholds), **clipping_failures(scores, thresholds),
-            **linear_model_failures(scores, thresholds)}
+            **linear_model_failures(scores, thresholds), **unscored_mode_failures(scores, thresholds)}
 
 
 def rig_declaration(dataset: Dataset, attribute: str) -> dict[str, Any]:
@@ -961,6 +961,44 @@ def sensor_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -> 
         f"{REDUCED_TRUTH_GAP:g}): the sensors' readings are linearly dependent (two on a rigid "
         "segment of the model with one degree of freedom, e.g. the clamped beam's first), so no "
         "regular model of that size exists for this record (rig.sensors, rig.n_segments)")}
+
+
+def unscored_mode_failures(scores: Scores, thresholds: dict[str, dict[str, float]]
+                           ) -> dict[str, str]:
+    """A failed bar on a mode the record cannot score: ``{"unscored": reason}``.
+
+    A structural model in sensor coordinates has one degree of freedom per sensor, so the
+    scorer scores modes ``1 .. details["scored_modes"]`` (one per sensor, at most the truth's
+    modes: :func:`scored_modes`); a per-mode bar on a mode above them has no score (NaN, never a
+    pass).  Round 22's ``b22_st_s1tip`` (the shipped beam read by one sensor, at the tip) under
+    the families' bars: both identifiers met mode 1 and TRAC (frequency 3e-7 off, TRAC 1.000)
+    and failed ``mac_mode2`` / ``freq_error_mode2`` (NaN) with no reason.  Only a failed bar is
+    explained, so no verdict changes.
+
+    Parameters
+    ----------
+    scores : Scores
+        With ``details["scored_modes"]`` (:func:`score_structural`); without it, nothing to say.
+    thresholds : dict
+        The run's bars, ``{metric: {"min"|"max": value}}``.
+    """
+    m = scores.details.get("scored_modes")
+    if m is None:
+        return {}
+    held: dict[int, list[str]] = {}
+    for c in check_thresholds(scores.values, thresholds):
+        found = _MODE_SCORE.fullmatch(c.metric)
+        if found and found[2] and int(found[2]) > int(m) and not c.passed and np.isnan(c.value):
+            held.setdefault(int(found[2]), []).append(f"{c.metric} {c.bound} {c.threshold:g}")
+    if not held:
+        return {}
+    modes = sorted(held)
+    which = ", ".join(f"mode {k} ({', '.join(held[k])})" for k in modes)
+    scored = "mode 1 only" if int(m) == 1 else f"modes 1-{int(m)} only"
+    return {"unscored": (f"unscored mode: the bars on {which} cannot be met: this record scores "
+                         f"{scored}, one per sensor (a model in sensor coordinates has one degree "
+                         "of freedom per sensor) and at most the truth's modes; a bar on mode "
+                         f"{modes[0]} needs at least {modes[0]} sensors (rig.sensors)")}
 
 
 def missed_cubic_share(freq_bar: float) -> float:

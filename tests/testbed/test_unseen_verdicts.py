@@ -31,6 +31,7 @@ from testbed.scoring.scorers import (
     sensitivity_failures,
     sensor_failures,
     step_failures,
+    unscored_mode_failures,
 )
 from testbed.studies.statistics import failure_kind
 from testbed.studies.study import load_study
@@ -884,3 +885,25 @@ def test_a_linear_model_of_a_strongly_cubic_base_names_the_missing_term():
     assert "run's 0.026 bar" in linear_model_failures(s, bars)["cubic"]
     for failed in ("fit", "model", "simulation"):
         assert linear_model_failures(Scores(s.values, s.details, {failed: "x"}), bars) == {}
+
+
+def test_a_bar_on_a_mode_the_sensors_cannot_score_names_it():
+    """Round 22's b22_st_s1tip (the shipped beam read by one sensor, at the tip), clean, seed
+    131, under the families' bars: ls_sindy met mode 1 and TRAC (frequency 3e-7 off, TRAC
+    1.000) and failed mac_mode2 / freq_error_mode2 (NaN: one sensor scores one mode) with no
+    reason (the sweep's row: status "ok", error "")."""
+    sc = load_scenario(_root() / "benchmarks" / "unseen" / "round22" / "b22_st_s1tip.toml")
+    r = run_scenario(dataclasses.replace(sc, seed=131, identify={**sc.identify, "method": "ls_sindy"}))
+    assert r.verdict == FAIL and r.scores.details["scored_modes"] == 1
+    assert r.scores.values["trac"] > 0.99 and r.scores.values["freq_error_mode1"] < 1e-4
+    why = r.scores.failures["unscored"]
+    assert why.startswith("unscored mode: the bars on mode 2 (freq_error_mode2 max 0.026, mac_mode2 "
+                          "min 0.9) cannot be met: this record scores mode 1 only")
+    assert "unscored mode" in failure_kind(r.scores.failure)
+    # only a failed bar on a mode above the scored ones, whose score is missing, is explained
+    two = Scores({"mac_mode1": float("nan"), "mac_mode2": 0.5}, {"scored_modes": 2})
+    assert unscored_mode_failures(two, {"mac_mode1": {"min": 0.9}, "mac_mode2": {"min": 0.9}}) == {}
+    one = Scores({"mac_mode1": 1.0}, {"scored_modes": 1})
+    assert unscored_mode_failures(one, {"mac_mode1": {"min": 0.9}, "trac": {"min": 0.9}}) == {}
+    assert set(unscored_mode_failures(one, {"damping_error_mode3": {"max": 0.1}})) == {"unscored"}
+    assert unscored_mode_failures(Scores({}, {}), {"mac_mode2": {"min": 0.9}}) == {}  # other kinds
