@@ -22,8 +22,14 @@ implicitfast integrator; soft bases on new draws of the families' range (5 EI/L 
 12 EI/L with 0.4 under 20 N, 2.5 EI/L with 0.1 under 80 N hit at 0.9 L); magnesium at 1.8 kHz with two
 sensors (the 'auto' low-pass at 0.95 of the Nyquist frequency, mode 3 aliased by the ideal sampler to
 370 Hz, between modes 1 and 2; a 1 ms hammer: at 1.2 kHz the scenario refuses the 0.3 ms one, no sample
-falls inside it, and the 'auto' low-pass, above Nyquist); a 4 s record under 20 N. Noise 0.5 / 1.5 / 3 /
-5 % and seeds 131-135 are the studies' (round22_beams*.toml).
+falls inside it, and the 'auto' low-pass, above Nyquist); a 4 s record under 20 N. A second batch
+(round22_beams_extra.toml): the hammer at 0.78 L near mode 2's node (sensors 0.39 / 0.78 / 1 L), copper
+0.65 m x 8 mm (mode 1 near 11 Hz), thin magnesium (0.5 m x 5 mm, 16 segments) read at 0.1 and 1 L,
+damping_beta 2e-4 s (modes 1-3 near 5 / 33 / 92 %), bases of 20 EI/L with cubic fraction 0.5 under 80 N
+and of 2 EI/L with 0.5 read at 0.1 and 1 L, the shipped soft base by implicitfast, gravity on in 12
+segments over 4 s, a 1e-5 s integration step (the soft base hinged at the wall is refused by the
+scenario in one line). Noise 0.5 / 1.5 / 2 / 3 / 5 % and seeds 131-136 are the studies'
+(round22_beams*.toml).
 """
 
 from __future__ import annotations
@@ -45,6 +51,7 @@ _CU_LONG = {**CU, "length": 0.6, "thickness": 0.008, "n_segments": 15}
 _S1 = sensors((1.0,))
 _S4 = sensors((0.25, 0.5, 0.75, 1.0))
 _SRT = sensors((0.1, 1.0))
+_SN2 = sensors((0.39, 0.78, 1.0))
 _S02 = sensors((0.2, 0.6, 1.0))
 _S09 = sensors((0.45, 0.9, 1.0))
 _F20, _F80 = {"peak_force": 20.0}, {"peak_force": 80.0}
@@ -98,6 +105,27 @@ CASES: dict[str, tuple[str, dict, dict, dict, dict]] = {
         "copper 0.6 m x 30 x 8 mm in 15 segments on k1 = 3 EI/L, cubic fraction 0.3, 2 s",
         {**_CU_LONG, **soft(3.0, 0.3, _CU_LONG)}, {"duration": 2.0}, {}, {},
     ),
+    # a second batch (round22_beams_extra.toml)
+    "b22_st_hit_node2": ("the shipped beam, sensors 0.39 / 0.78 / 1 L, the hammer at 0.78 L (near mode 2's "
+                         "node)", {"sensors": _SN2}, {}, {"location": _SN2[1]}, {}),
+    "b22_cu_L0p65_t8_n15": ("copper 0.65 m x 30 x 8 mm in 15 segments (mode 1 near 11 Hz)",
+                            {**CU, "length": 0.65, "thickness": 0.008, "n_segments": 15}, {}, {}, {}),
+    "b22_mg_L0p5_t5_s2roottip": ("magnesium 0.5 m x 30 x 5 mm in 16 segments, sensors 0.1 / 1 L",
+                                 {**MG, "length": 0.5, "thickness": 0.005, "n_segments": 16,
+                                  "sensors": sensors((0.1, 1.0), 0.5)}, {}, {}, {}),
+    "b22_st_beta2e-4": ("the shipped beam, damping_beta 2e-4 s (modes 1-3 near 5 / 33 / 92 %)",
+                        {"damping_ratio": 0.0, "damping_beta": 2e-4}, {}, {}, {}),
+    # (the shipped soft base with joint_offset 0 is refused in one line: "allowed: > 0 with base = 'soft'")
+    "b22_soft_r20_cf0p5_f80": ("the shipped beam on k1 = 20 EI/L, cubic fraction 0.5 at 80 N, under 80 N",
+                               {**soft(20.0, 0.5, {}, _F80)}, {}, {**_F80}, {}),
+    "b22_soft_r2_cf0p5_s2roottip": ("the shipped beam on k1 = 2 EI/L, cubic fraction 0.5, sensors 0.1 / 1 L",
+                                    {**soft(2.0, 0.5, {}), "sensors": _SRT}, {}, {}, {}),
+    "b22_soft_implicitfast": ("the shipped soft base integrated by implicitfast", {**SOFT},
+                              {"integrator": "implicitfast"}, {}, {}),
+    "b22_st_grav_n12_4s": ("the shipped beam in 12 segments with gravity on, a 4 s record",
+                           {"n_segments": 12}, {**_GRAV, "duration": 4.0}, {}, {}),
+    "b22_st_dt1e-5": ("the shipped beam integrated at a 1e-5 s step (timestep given)", {},
+                      {"timestep": 1e-5}, {}, {}),
 }
 
 
