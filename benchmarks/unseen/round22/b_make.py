@@ -28,8 +28,9 @@ falls inside it, and the 'auto' low-pass, above Nyquist); a 4 s record under 20 
 damping_beta 2e-4 s (modes 1-3 near 5 / 33 / 92 %), bases of 20 EI/L with cubic fraction 0.5 under 80 N
 and of 2 EI/L with 0.5 read at 0.1 and 1 L, the shipped soft base by implicitfast, gravity on in 12
 segments over 4 s, a 1e-5 s integration step (the soft base hinged at the wall is refused by the
-scenario in one line). Noise 0.5 / 1.5 / 2 / 3 / 5 % and seeds 131-136 are the studies'
-(round22_beams*.toml).
+scenario in one line). A fourth batch (round22_beams_last.toml): the shipped beam in 3 and 4 segments (2
+segments under three sensors is refused by the scenario in one line). Noise 0.5 / 1.5 / 2 / 3 / 5 % and
+seeds 131-136 are the studies' (round22_beams*.toml).
 """
 
 from __future__ import annotations
@@ -126,6 +127,9 @@ CASES: dict[str, tuple[str, dict, dict, dict, dict]] = {
                            {"n_segments": 12}, {**_GRAV, "duration": 4.0}, {}, {}),
     "b22_st_dt1e-5": ("the shipped beam integrated at a 1e-5 s step (timestep given)", {},
                       {"timestep": 1e-5}, {}, {}),
+    # a fourth batch (round22_beams_last.toml): chains of 2-4 segments (rounds drew 5-45)
+    **{f"b22_st_n{n}": (f"the shipped beam in {n} segments (three sensors)", {"n_segments": n}, {}, {}, {})
+       for n in (2, 3, 4)},
 }
 
 
