@@ -48,6 +48,14 @@ h5shape csvcells jitter paramedge fitedge latethreads interrupts):
     one shared dataset cache (real processes): each must end with its own cells, the cache
     entries verified.
 
+``paramshape``
+    Every declared hyperparameter of every registered identifier through ``testbed identify
+    --param`` in another shape or type than it declares (rounds 20-21 tried values and bounds):
+    a list, a boolean or a quoted text where a number is; a number, a list or a text where a
+    boolean is; a number, a boolean or a one-item list where a text is; a table, a boolean or
+    a scalar of its items' type where a list is.  Anything but one refusal line naming the key
+    is a finding.
+
 Prints one line a finding and the counts; exits 1 if any finding.
 """
 
@@ -799,6 +807,62 @@ def studyedit_cases(work: Path) -> list[tuple[str, object]]:
     return out
 
 
+# ------------------------------------------------------------------ paramshape
+
+
+def _wrong_shapes(field) -> list[str]:
+    """``--param`` values (TOML) of another shape or type than ``field`` declares: a list or a
+    boolean where a number is, a number or a list where a boolean or a text is, a scalar or a
+    table where a list is (a form the field's ``also`` accepts left out)."""
+    if field.type in (int, float):
+        out = ["[1]", "true", '"1"']
+    elif field.type is bool:
+        out = ["1", "[true]", '"true"']
+    elif field.type is str:
+        first = json.dumps(str(field.default if field.default not in (None, "") else "x"))
+        out = ["1", "true", f"[{first}]"]
+    elif field.type is list:
+        item = field.item_type
+        out = ["{a = 1}", "true"] + (["0.1"] if item in (int, float) else ['"x"'] if item is str else [])
+    else:
+        out = []
+    also = getattr(field, "also", None)
+    if also is not None and also.type is list:
+        out = [v for v in out if not v.startswith("[")]
+    return out
+
+
+def paramshape_cases(work: Path) -> list[tuple[str, object]]:
+    from testbed.pipeline.plugins import IDENTIFIERS
+
+    record = {"dynamical": MM, "structural": BEAM, "mechanical": FIVEBAR}
+
+    def case(method: str, kind: str, key: str, text: str):
+        def run():
+            path = _generated(work, record[kind])
+            status, out, err = _identify(path, kind, method, "--param", f"{key}={text}")
+            found = judged(status, out, err, refuse=True)
+            if found:
+                return found
+            if key not in err:
+                return f"refused without naming {key!r}: {err.strip()[:200]}"
+            return None
+
+        return run
+
+    out = []
+    for method in IDENTIFIERS.names():
+        cls = IDENTIFIERS.get(method)
+        if cls.kind not in record:
+            continue
+        for key, field in cls.declared_hyperparameters().items():
+            out += [
+                (f"paramshape {method} {key}={text}", case(method, cls.kind, key, text))
+                for text in _wrong_shapes(field)
+            ]
+    return out
+
+
 # ------------------------------------------------------------------ main
 
 FAMILIES = _hostile.families(
@@ -808,6 +872,7 @@ FAMILIES = _hostile.families(
         "argorder": argorder_cases,
         "targets": targets_cases,
         "studyedit": studyedit_cases,
+        "paramshape": paramshape_cases,
     },
     TIMEOUT_S,
 )
