@@ -22,7 +22,8 @@ h5shape csvcells jitter paramedge fitedge latethreads interrupts):
 ``tinyrec``
     Records of 1, 2, 3, 4, 5, 8 and 16 samples (the dataset file of a shipped scenario cut,
     its content hash made anew; the beam's cut from the hammer's impact on) and CSV files of
-    1-3 rows, through ``testbed identify`` for every identifier of the kind.  A traceback, an
+    1-3 rows, through ``testbed identify`` for every identifier of the kind; and records left
+    with 1-4 samples by the identifier's own edge trim, stride, split or weak windows.  A traceback, an
     internal error, a status other than 0 / 1 / 2, or a refusal in more than one line, is a
     finding.
 ``argorder``
@@ -388,6 +389,40 @@ def tinyrec_cases(work: Path) -> list[tuple[str, object]]:
             for method in methods:
                 out.append((f"tinyrec {kind} {n} sample(s) {method}", case(kind, method, n)))
     out += [(f"tinyrec CSV of {r} row(s)", csv_case(r)) for r in (1, 2, 3)]
+
+    def trimmed(kind: str, method: str, n: int, *params: str):
+        """A record of ``n`` samples left with 1-4 after the identifier's own trim, stride
+        or split."""
+
+        def run():
+            scenario, start, _ = records[kind]
+            path = _cut(_generated(work, scenario), work / f"{kind}_{n}.h5", start, n)
+            more = [x for p in params for x in ("--param", p)]
+            return judged(*_identify(path, kind, method, *more))
+
+        return run
+
+    for method, params in (
+        ("sindy_pi", ("edge_trim=0.0499",)),
+        ("sindy_pi", ("edge_trim=0.04985",)),
+        ("pysindy_pi", ("edge_trim=0.0499",)),
+        ("pysindy_pi", ("stride=999",)),
+        ("sindy_pi", ("val_fraction=0.99",)),
+        ("sindy_pi", ('formulation="weak"', "weak_window_s=0.099")),
+    ):
+        out.append(
+            (
+                f"tinyrec mechanical 1000 samples, {method} {' '.join(params)}",
+                trimmed("mechanical", method, 1000, *params),
+            )
+        )
+    for params in (("val_fraction=0.995",), ('formulation="weak"', "weak_window_s=3.99")):
+        out.append(
+            (
+                f"tinyrec dynamical 400 samples, sindy_pi_dynamical {' '.join(params)}",
+                trimmed("dynamical", "sindy_pi_dynamical", 400, *params),
+            )
+        )
     return out
 
 
