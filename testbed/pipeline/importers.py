@@ -312,8 +312,12 @@ def read_measured(path: str | os.PathLike, *, format: str | None = None, fs: flo
     if format is None:
         format = SUFFIXES.get(path.suffix.lower())
         if format is None:
-            raise MeasuredDataError(path, f"cannot tell the format from the suffix {path.suffix!r}; "
-                                          f"pass format= one of {', '.join(FORMATS)}")
+            # the command line's user passes --format, not format= (round 22: `testbed export
+            # --format sep005 -o d.sep005` then `identify d.sep005` was told "pass format=")
+            raise MeasuredDataError(path, f"cannot tell the format from the suffix {path.suffix!r} "
+                                          f"(known: {', '.join(SUFFIXES)}); pass format= "
+                                          f"(--format on the command line) one of "
+                                          f"{', '.join(FORMATS)}")
     if format not in FORMATS:
         raise MeasuredDataError(path, f"unknown format {format!r}; allowed: {', '.join(FORMATS)}")
     check_selection(path, units, channels)

@@ -174,3 +174,17 @@ def test_an_unknown_option_between_names_is_still_refused(capsys):
         cli.build_parser().parse_args(["run", "a", "--bogus", "b"])
     assert e.value.code == 2
     assert "unrecognized arguments: --bogus b" in _one_error_line(capsys.readouterr().err)
+
+
+def test_an_unknown_suffix_names_the_command_lines_option(cli_in_process, tmp_path):
+    """``export --format sep005 -o d.sep005`` then ``identify d.sep005`` was told "pass
+    format=", the Python API's word, not the option to give."""
+    data = saved_record(tmp_path)
+    out = tmp_path / "d.sep005"
+    assert cli_in_process("export", str(data), "--format", "sep005", "-o", str(out),
+                          cwd=tmp_path).returncode == 0
+    p = cli_in_process("identify", str(out), "--kind", "structural", "--method", "ls_sindy",
+                       "-o", str(tmp_path / "m.json"), cwd=tmp_path)
+    assert p.returncode == 2
+    line = _one_error_line(p.stderr)
+    assert "--format on the command line" in line and ".json" in line
