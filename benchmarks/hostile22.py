@@ -57,6 +57,11 @@ h5shape csvcells jitter paramedge fitedge latethreads interrupts):
     a scalar of its items' type where a list is.  Anything but one refusal line naming the key
     is a finding.
 
+``unicodetrip``
+    ``generate`` -> ``export`` (UFF, SEP-005 as ``.json`` and as ``.sep005`` with ``--format``)
+    -> ``identify`` in a folder of accents, CJK letters and spaces, and through a link: a read
+    whose equations differ from the dataset file's, or any refusal, is a finding.
+
 Prints one line a finding and the counts; exits 1 if any finding.
 """
 
@@ -898,6 +903,71 @@ def paramshape_cases(work: Path) -> list[tuple[str, object]]:
     return out
 
 
+# ------------------------------------------------------------------ unicodetrip
+
+
+def unicodetrip_cases(work: Path) -> list[tuple[str, object]]:
+    """generate -> export (UFF, SEP-005) -> identify in a folder of accents, CJK letters and
+    spaces, through a link too: each read must give the dataset file's equations (the UFF and
+    SEP-005 files carry no prior: the dataset's reduced mass trace is given as ``--prior``)."""
+    import h5py
+
+    folder = work / "dossier é ü 漢字 sp"
+    h5 = folder / "beam é.h5"
+    method = ["--kind", "structural", "--method", "ls_sindy"]
+
+    def equations(path: Path, *more: str) -> tuple[object, str | None]:
+        status, out, err = cli_inprocess(["identify", str(path), *method, "-o", f"{path}.model.json", *more])
+        found = judged(status, out, err, refuse=False)
+        if found or status != 0:
+            return None, found or f"status {status}: {err.strip()[:200]}"
+        return json.loads(Path(f"{path}.model.json").read_text()).get("equations"), None
+
+    def base() -> tuple[object, list[str]]:
+        if not h5.exists():
+            folder.mkdir(parents=True, exist_ok=True)
+            status, _, err = cli_inprocess(["generate", BEAM, "-o", str(h5), "--cache", str(CACHE)])
+            if status != 0:
+                raise RuntimeError(err)
+        with h5py.File(h5, "r") as f:
+            trace = float(f["prior"].attrs["reduced_mass_trace"])
+        eq, found = equations(h5)
+        if found:
+            raise RuntimeError(found)
+        return eq, ["--prior", f"reduced_mass_trace={trace!r}"]
+
+    def case(fmt: str, name: str, *more: str, link: bool = False):
+        def run():
+            want, prior = base()
+            out = folder / name
+            status, stdout, err = cli_inprocess(["export", str(h5), "--format", fmt, "-o", str(out)])
+            found = judged(status, stdout, err, refuse=False)
+            if found:
+                return f"export: {found}"
+            path = out
+            if link:
+                path = folder / f"lien vers {name}"
+                if not path.is_symlink():
+                    path.symlink_to(out)
+            got, found = equations(path, *prior, *more)
+            if found:
+                return f"identify: {found}"
+            return None if got == want else "the equations differ from the dataset file's"
+
+        return run
+
+    return [
+        ("unicodetrip UFF", case("uff", "sortie é.uff")),
+        ("unicodetrip SEP-005 (.json)", case("sep005", "sortie é.json")),
+        (
+            "unicodetrip SEP-005 as .sep005, --format sep005",
+            case("sep005", "sortie é.sep005", "--format", "sep005"),
+        ),
+        ("unicodetrip UFF through a link", case("uff", "lié é.uff", link=True)),
+        ("unicodetrip SEP-005 through a link", case("sep005", "lié é.json", link=True)),
+    ]
+
+
 # ------------------------------------------------------------------ main
 
 FAMILIES = _hostile.families(
@@ -908,6 +978,7 @@ FAMILIES = _hostile.families(
         "targets": targets_cases,
         "studyedit": studyedit_cases,
         "paramshape": paramshape_cases,
+        "unicodetrip": unicodetrip_cases,
     },
     TIMEOUT_S,
 )
