@@ -90,6 +90,13 @@ class _Parser(argparse.ArgumentParser):
     def parse_known_args(self, args=None, namespace=None):
         ns, rest = super().parse_known_args(args, namespace)
         ns.__dict__.pop(_GIVEN, None)
+        # `run A --no-figures B`: argparse takes the names of a list positional (nargs "+")
+        # in one run only, and B was refused as "unrecognized arguments" (round 22); names
+        # left over are the list's when nothing else is left over
+        many = [a for a in self._actions if not a.option_strings and a.nargs in ("+", "*")]
+        if rest and len(many) == 1 and not any(r.startswith("-") for r in rest):
+            setattr(ns, many[0].dest, [*(getattr(ns, many[0].dest) or []), *rest])
+            rest = []
         return ns, rest
 
     def error(self, message: str) -> None:  # type: ignore[override]
@@ -226,7 +233,8 @@ def _writable_in(path: Path, option: str, start: Path) -> None:
     its nearest existing parent folder.
 
     Probed by creating (and removing) a temporary file there: permission bits alone do not
-    tell root that ``/proc`` or a read-only mount refuses it.
+    tell root that ``/proc`` or a read-only mount refuses it.  A folder without a write
+    permission bit is refused too: root's probe passes there (round 22).
     """
     import tempfile
 
@@ -236,6 +244,10 @@ def _writable_in(path: Path, option: str, start: Path) -> None:
     if not folder.is_dir():
         raise InputError(f"{option} {path}: {folder} is a file, not a folder; expected a path in "
                          "a folder you can write")
+    if not folder.stat().st_mode & 0o222:  # as root the probe passes: chmod a-w was no guard
+        raise InputError(f"{option} {path}: {folder} is read-only (mode "
+                         f"{stat.S_IMODE(folder.stat().st_mode):04o}); expected a path in a "
+                         "folder you can write")
     try:
         with tempfile.TemporaryFile(dir=folder):
             pass
@@ -245,17 +257,35 @@ def _writable_in(path: Path, option: str, start: Path) -> None:
                          "can write") from None
 
 
-def _output_file(path: Path, option: str, *, inputs: tuple[Path, ...] = ()) -> Path:
+def _output_file(path: str | os.PathLike, option: str, *, inputs: tuple[Path, ...] = ()) -> Path:
     """A file a command will write, checked before any work: not a folder, not a device or
     FIFO (written atomically, the file would replace it: as root, ``--results /dev/full``
     replaced the device node), not one of its ``inputs`` (nothing the user gave is
-    overwritten), in a folder that can be written."""
+    overwritten), in a folder that can be written.
+
+    Round 22: not a text ending in a path separator (``-o out/`` wrote a file named ``out``),
+    not a symbolic link to nothing (it was replaced by the file, the link lost), not a file
+    without a write permission bit (as root, ``chmod a-w`` was no guard: the file was
+    replaced and its mode with it).  A link to a regular file is written through
+    (:func:`~testbed.core.atomic.atomic_write`)."""
+    text = os.fspath(path)
+    if isinstance(text, str) and text.endswith(("/", os.sep)):
+        raise InputError(f"{option} {text}: ends in a path separator, which names a folder; "
+                         "expected a file path")
+    path = Path(path)
     st = _stat(path, option)
+    if st is None and path.is_symlink():
+        raise InputError(f"{option} {path}: a symbolic link to {os.readlink(path)}, which does not "
+                         "exist; expected a file path (or a link to an existing file)")
     if st is not None and stat.S_ISDIR(st.st_mode):
         raise InputError(f"{option} {path}: is a folder; expected a file path")
     if st is not None and not stat.S_ISREG(st.st_mode):
         raise InputError(f"{option} {path}: exists and is not a regular file (a FIFO, socket or "
                          "device, which the written file would replace); expected a file path")
+    if st is not None and not st.st_mode & 0o222:
+        raise InputError(f"{option} {path}: exists and is read-only (mode "
+                         f"{stat.S_IMODE(st.st_mode):04o}), which the written file would "
+                         "replace; expected a writable file or a new path")
     for given in inputs:
         if path.resolve() == given.resolve():
             raise InputError(f"{option} {path}: is the input file; expected another path (the "
@@ -571,7 +601,7 @@ def cmd_generate(args: argparse.Namespace) -> int:
         sc = sc.replace(seed=args.seed)
     # -o the scenario file itself (or a file it extends, or a plugin) replaced it with the
     # dataset, status 0 (round 17)
-    out = _output_file(Path(args.output or f"{sc.name}-seed{sc.seed}.h5"), "--output",
+    out = _output_file(args.output or f"{sc.name}-seed{sc.seed}.h5", "--output",
                        inputs=_given_files(read, plugins))
     with _progress()(f"generating {sc.name}") as bar:
         # through the run cache unless --no-cache: a later `testbed run` of it simulates nothing
@@ -665,7 +695,7 @@ def cmd_export(args: argparse.Namespace) -> int:
 
     data = _dataset_file(Path(args.dataset))
     default = data.with_suffix(".uff" if args.format == "uff" else ".sep005.json")
-    out = _output_file(Path(args.output) if args.output else default, "--output", inputs=(data,))
+    out = _output_file(args.output or default, "--output", inputs=(data,))
     for p in export_dataset(data, args.format, out, note=print):
         print(f"wrote {terminal_safe(str(p))}")
     return 0
@@ -682,7 +712,7 @@ def cmd_sweep(args: argparse.Namespace) -> int:
 
     extra = _load_plugins(args)
     if args.results:  # before the study's load, which simulates nothing but takes seconds
-        _output_file(Path(args.results), "--results")
+        _output_file(args.results, "--results")
     study = load_study(args.study, progress=_stderr_line)
     if extra:  # the workers import them too
         study = dataclasses.replace(study, plugins=tuple(dict.fromkeys(study.plugins + extra)))
@@ -787,7 +817,7 @@ def cmd_identify(args: argparse.Namespace) -> int:
         with recording_reads() as read:
             load_scenario(args.scenario)
     given = (data, *_given_files(read, plugins))
-    out = _output_file(Path(args.output or f"{data.stem}.model.json"), "--output", inputs=given)
+    out = _output_file(args.output or f"{data.stem}.model.json", "--output", inputs=given)
     if out.suffix.lower() == ".md":  # the report replaced the model it reports (round 17; .MD:
         # the same file where names ignore case, as on macOS and Windows)
         raise InputError(f"--output {terminal_safe(str(out))}: its report goes to the same path "
@@ -910,9 +940,12 @@ def build_parser() -> argparse.ArgumentParser:
     g.add_argument("scenario", help="scenario name or .toml path")
     g.add_argument("-o", "--output", type=_path_text, help="output file (default <scenario>-seed<N>.h5)")
     g.add_argument("--seed", type=_seed, help="override the scenario's seed")
-    g.add_argument("--cache", type=_path_text,
-                   help="dataset cache folder it also fills (default .cache/datasets)")
-    g.add_argument("--no-cache", action="store_true", help="generate afresh, fill no cache")
+    # one or the other: with both, --no-cache won without a word (the cache named was not
+    # filled; round 22)
+    gc = g.add_mutually_exclusive_group()
+    gc.add_argument("--cache", type=_path_text,
+                    help="dataset cache folder it also fills (default .cache/datasets)")
+    gc.add_argument("--no-cache", action="store_true", help="generate afresh, fill no cache")
     g.add_argument("--plugin", action="append", metavar="FILE.py", type=_path_text, help=plugin_help)
     g.set_defaults(fn=cmd_generate)
 
@@ -921,9 +954,10 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("-o", "--out", default="out/runs", type=_path_text,
                    help="folder for run results (default out/runs)")
     r.add_argument("--seed", type=_seed, help="override the scenario's seed")
-    r.add_argument("--cache", type=_path_text,
-                   help="dataset cache folder (default .cache/datasets or $TESTBED_CACHE)")
-    r.add_argument("--no-cache", action="store_true", help="generate afresh, store nothing")
+    rc = r.add_mutually_exclusive_group()  # one or the other (round 22, as `generate`)
+    rc.add_argument("--cache", type=_path_text,
+                    help="dataset cache folder (default .cache/datasets or $TESTBED_CACHE)")
+    rc.add_argument("--no-cache", action="store_true", help="generate afresh, store nothing")
     r.add_argument("--no-figures", action="store_true", help="skip the figures")
     r.add_argument("--plugin", action="append", metavar="FILE.py", type=_path_text, help=plugin_help)
     r.set_defaults(fn=cmd_run)

@@ -105,19 +105,30 @@ def not_regular(path: Path) -> None:
                          "which the written file would replace); expected a file path")
 
 
+def _replaced_mode(path: Path) -> int:
+    """The permission bits a written file gets: those of the file it replaces (a private
+    file, mode 0600, had come back world-readable: round 22), else ``0666`` less the umask."""
+    try:
+        return stat.S_IMODE(os.stat(path).st_mode)
+    except OSError:
+        return 0o666 & ~_UMASK
+
+
 def atomic_write(path: str | os.PathLike, write: Callable[[str], None]) -> Path:
     """Call ``write(tmp)`` on a temporary path next to ``path``, then rename it to ``path``.
 
     Parameters
     ----------
     path : path-like
-        The file to create or replace; its folder is created if missing.
+        The file to create or replace; its folder is created if missing.  A symbolic link to
+        a file is written through: the file it names is replaced, the link kept.
     write : callable
         Writes the whole content to the path it is given (a str).
 
     Returns
     -------
     Path
+        ``path`` as given.
 
     Raises
     ------
@@ -125,9 +136,17 @@ def atomic_write(path: str | os.PathLike, write: Callable[[str], None]) -> Path:
         If ``path`` exists and is not a regular file (a device, FIFO or socket): the rename
         would replace the node itself.  As root, the drawing process's warm-up figure, saved
         to ``os.devnull`` through this function, replaced ``/dev/null`` with a regular file
-        for every process of the machine (round 13).
+        for every process of the machine (round 13).  Or if it is a symbolic link to nothing.
     """
-    path = Path(path)
+    path = given = Path(path)
+    if path.is_symlink():
+        # written through the link: the rename had replaced the link itself with the file, the
+        # file it named left as it was (round 22); a link to nothing is no place to write
+        target = Path(os.path.realpath(path))
+        if not target.exists():
+            raise InputError(f"{path}: a symbolic link to {os.readlink(path)}, which does not "
+                             "exist; expected a file path (or a link to an existing file)")
+        path = target
     not_regular(path)
     if path.is_dir():  # the rename's IsADirectoryError named the temporary file (round 17)
         raise InputError(f"{path}: is a folder; expected a file path")
@@ -139,7 +158,7 @@ def atomic_write(path: str | os.PathLike, write: Callable[[str], None]) -> Path:
             write(tmp)
             with open(tmp, "rb") as fh:
                 os.fsync(fh.fileno())
-            os.chmod(tmp, 0o666 & ~_UMASK)
+            os.chmod(tmp, _replaced_mode(path))
             os.replace(tmp, path)
     except BaseException as e:
         Path(tmp).unlink(missing_ok=True)
@@ -147,7 +166,7 @@ def atomic_write(path: str | os.PathLike, write: Callable[[str], None]) -> Path:
         if full is not None:
             raise full from None
         raise
-    return path
+    return given
 
 
 #: The codec error handler of :func:`_file_name_bytes`: text naming files, encoded.

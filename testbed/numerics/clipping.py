@@ -80,6 +80,12 @@ RATIO = 4.0
 #: rate-pair records of the dataset cache (2,709 channel pairs) and their 16-bit copies give no
 #: alarm (``benchmarks/clip_ends21.py``, docs/known-gaps.md)
 RATE_HOLD_TOL = 0.05
+#: ... or, taken step by step, more than this many times the run's steps times the largest
+#: misfit of one step (the signal's step less the rate's trapezoid, less their mean) on the
+#: steps no held run touches [-]: the trapezoid rule errs by h^3 |third derivative| / 12 a
+#: step, and a rate held at its extreme holds where that derivative peaks; a sine's outside the
+#: run is cos(phase) of its peak, so 4 covers runs to +-75 degrees of phase
+LOCAL_STEPS = 4.0
 #: Standard deviations of the channels' white noise (:func:`testbed.numerics.noise.noise_std`,
 #: of differences of this order) the held run's change and the rate's integral may differ by
 #: on top: a Gaussian's chance beyond 5 sigma is 6e-7 a run
@@ -260,17 +266,36 @@ def rate_contradicted_levels(a: np.ndarray, d: np.ndarray, fs: float
     # gyro noise of 20 % of the rate's RMS alarmed on 19-24 of 50 draws)
     sa, sd = (float(noise_std(y, order=NOISE_ORDER)[0]) if n > NOISE_ORDER + 2 else 0.0
               for y in (a, d))
+    # round 21's open item (b): the pair's misfit step by step (the signal's step less the
+    # rate's trapezoid) on the steps no held run touches, its mean (the rate's offset, free of
+    # what a clip took away) out; a run of k steps that was not clipped misfits by at most
+    # LOCAL_STEPS x k x the largest of these beside that offset
+    steps = np.diff(a) - (d[1:] + d[:-1]) * 0.5 / fs
+    free = np.ones(n - 1, dtype=bool)
+    for _, _, starts, lengths in held_runs:
+        for s0, m in zip(starts, lengths, strict=True):
+            free[max(s0 - 1, 0):min(s0 + m, n - 1)] = False
+    offset = float(np.mean(steps[free])) if np.any(free) else 0.0
+    step_misfit = float(np.max(np.abs(steps[free] - offset))) if np.any(free) else np.inf
     out = []
     for which, level, starts, lengths in held_runs:
         held = runs = 0
         for s0, m in zip(starts, lengths, strict=True):
             i, j = max(s0 - 1, 0), min(s0 + m + 1, n)  # one sample past each side
             change = float(a[j - 1] - a[i])
-            integral = float(np.sum(d[i + 1:j] + d[i:j - 1]) * 0.5 / fs)
-            integral -= bias * (j - 1 - i) / fs
+            raw = float(np.sum(d[i + 1:j] + d[i:j - 1]) * 0.5 / fs)
+            integral = raw - bias * (j - 1 - i) / fs
             noise = NOISE_SIGMAS * np.sqrt(2.0 * sa * sa + (j - i) * (sd / fs) ** 2)
-            tol = max(RATE_HOLD_TOL * motion, HOLD_STEPS * qa + (j - i) * qd / fs) + noise
-            if abs(change - integral) > tol:
+            floor = HOLD_STEPS * qa + (j - i) * qd / fs + noise
+            tol = max(RATE_HOLD_TOL * motion + noise, floor)
+            # step by step over the run's own steps: the trapezoid errs on a step by at most
+            # half its rate's change (a rest joined to a motion whose rate jumps, a dose given
+            # at once), allowed twice; a rate held at a rail changes by nothing there
+            k = m - 1
+            local = abs(float(np.sum(steps[s0:s0 + k])) - offset * k)
+            jumps = float(np.sum(np.abs(np.diff(d[s0:s0 + m])))) / fs
+            if abs(change - integral) > tol or (k > 0 and local > max(
+                    LOCAL_STEPS * k * step_misfit + jumps + noise, floor)):
                 held, runs = held + m, runs + 1
         if runs:
             out.append((which, level, held, runs))
