@@ -31,7 +31,7 @@ import numpy as np
 from identify import IDENTIFIERS
 from identify._implicit import Sweep, _errors
 from identify.sindy_pi import COMMON_HYPERPARAMETERS, _ImplicitMechanical, ordered_fields
-from testbed.core.errors import IdentificationError
+from testbed.core.errors import HyperparameterError, IdentificationError, ScenarioError
 from testbed.core.schema import Field, KeyUse
 
 #: Training samples pysindy's SINDyPI is given when ``stride`` is left to the rule: one OSQP
@@ -219,6 +219,15 @@ class PySINDyPI(_ImplicitMechanical):
             raise ValueError(f"stride must be a positive integer, got {self.stride}")
         self.stride_, self.stride_rule_ = stride_rule(X.shape[0], self.stride, self.qr)
         X = np.linalg.qr(X, mode="r") if self.qr else np.ascontiguousarray(X[::self.stride_])
+        if X.shape[0] < X.shape[1]:
+            # fewer rows than library columns: each candidate's regression (p - 1 unknowns) is
+            # underdetermined, so the model would be the optimizer's choice, not the record's
+            # (a 1000-sample record at stride 999 gave a model from 2 samples, status 0)
+            most = max(1, Theta_train.shape[0] // X.shape[1])
+            raise HyperparameterError(str(ScenarioError(
+                type(self).__name__, f"{self.name or 'params'}.stride", self.stride_,
+                f"leaves {X.shape[0]} of {Theta_train.shape[0]} training samples, fewer than the "
+                f"library's {X.shape[1]} terms; at most {most}")))
         xi = pysindy_pi_coef(X, cand, self.reg_weight_lam, self.tol, self.max_iter)
         idx = np.arange(cand.size)
         w = -xi

@@ -15,11 +15,20 @@ from identify._mechsim import LoopClosure
 from identify.pysindy_pi import PySINDyPI
 from identify.sindy_pi import SINDyPI
 from identify.sindy_pi_linear import SINDyPILinear
-from testbed.core.errors import IdentificationError
+from testbed.core.errors import HyperparameterError, IdentificationError
 from testbed.core.measurement import Measurement
 
 ROOT = Path(__file__).resolve().parents[2]
 
+
+
+def test_pysindy_stride_leaving_fewer_rows_than_terms_is_refused(pendulum):
+    # 10 s at 1 kHz, 8 library terms: a stride leaving fewer training rows than terms makes every
+    # candidate's regression underdetermined (round 22's malformed-input finding: a model fitted
+    # from 2 samples, status 0); refused naming the stride and the largest it allows
+    lib = ["ddth1", "ddth2", "dth1", "dth2", "sin(th1)", "sin(th2)", "u1", "u2"]
+    with pytest.raises(HyperparameterError, match=r"stride.*fewer than the library's 8 terms"):
+        PySINDyPI(library=lib, stride=5000).fit(pendulum.data)
 
 
 P = sindy_pi_problems
