@@ -284,6 +284,13 @@ def _read_parquet(path: Path) -> list[dict[str, Any]]:
     meta = table.schema.metadata or {}
     fmt = meta.get(b"format", b"").decode()
     if fmt not in READ_FORMATS:
+        name, _, version = fmt.rpartition("/")
+        if name == FORMAT.rpartition("/")[0] and version.isdigit() \
+                and int(version) > int(FORMAT.rpartition("/")[2]):
+            # say it is newer: "not a results file" read as damage, where a newer version's file
+            # is whole and only this version cannot read it
+            raise ResultsError(f"{path}: a {fmt} file, written by a newer sysid-testbed; this "
+                               f"version reads {', '.join(READ_FORMATS)}")
         raise ResultsError(f"{path}: not a {FORMAT} file")
     verified = fmt == FORMAT  # a /1 file has no checksums: read as it was written
     _check_columns(path, table.schema, verified)

@@ -75,6 +75,18 @@ def test_empty_and_foreign_files(tmp_path):
         read_results(other)
 
 
+def test_a_newer_versions_results_file_says_it_is_newer(tmp_path):
+    # a whole file of a later format is not damage: the message says which version reads it
+    res = tmp_path / "r.parquet"
+    write_rows(res, [row("c1", trac=0.1)])
+    table = pq.read_table(res)
+    newer = FORMAT.rpartition("/")[0] + "/" + str(int(FORMAT.rpartition("/")[2]) + 1)
+    pq.write_table(table.replace_schema_metadata({**table.schema.metadata,
+                                                  b"format": newer.encode()}), res)
+    with pytest.raises(ValueError, match="written by a newer sysid-testbed"):
+        read_results(res)
+
+
 # ------------------------------------------------------------------ the row checksum
 
 def test_a_row_edited_within_its_types_is_refused_in_a_part_and_in_the_parquet_file(tmp_path):
