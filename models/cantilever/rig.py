@@ -46,6 +46,7 @@ from models.cantilever.simulate import (
     MUJOCO_MAX_CONTROL,
     RK4_ACCURACY,
     half_sine,
+    implicit_accurate,
     implicit_unfit,
     mode_errors,
     rollout_sensors,
@@ -156,9 +157,8 @@ def fewest_substeps(simulation: dict[str, Any], nv: int) -> tuple[int, float]:
         n = max(1, round(min(period / simulation["timestep"], 2**62)))
         integs = [integrator]
         if integrator == "auto":
-            # the accuracy half of implicit_unfit, the same comparison (its 1e-12 of rounding)
-            fits = math.pi * float(simulation["sample_rate"]) * (period / n) \
-                <= IMPLICIT_ACCURACY * (1 + 1e-12)
+            # the accuracy half of implicit_unfit (its stability half needs the model)
+            fits = implicit_accurate(float(simulation["sample_rate"]), period / n)
             integs = ["RK4", "implicitfast"] if fits else ["RK4"]
         return n, min(n * step_seconds(nv, i) for i in integs)
     options = []

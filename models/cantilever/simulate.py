@@ -223,6 +223,12 @@ def implicit_step_bound(M: np.ndarray, C: np.ndarray, K: np.ndarray, fs: float) 
                IMPLICIT_ACCURACY / (math.pi * fs))
 
 
+def implicit_accurate(fs: float, timestep: float) -> bool:
+    """Whether an implicitfast step [s] meets ``auto``'s accuracy rule at sample rate ``fs`` [Hz],
+    ``omega_Ny dt <= IMPLICIT_ACCURACY`` (1e-12 of rounding allowed)."""
+    return math.pi * fs * timestep <= IMPLICIT_ACCURACY * (1 + 1e-12)
+
+
 def implicit_unfit(M: np.ndarray, C: np.ndarray, K: np.ndarray, fs: float,
                    timestep: float) -> str | None:
     """Why ``auto`` would not integrate a requested ``timestep`` [s] with implicitfast, or None.
@@ -232,7 +238,7 @@ def implicit_unfit(M: np.ndarray, C: np.ndarray, K: np.ndarray, fs: float,
     error ``(omega_Ny dt)^2 / 24`` at the Nyquist frequency of at most 5e-4.
     """
     w_ny_dt = math.pi * fs * timestep
-    if w_ny_dt > IMPLICIT_ACCURACY * (1 + 1e-12):
+    if not implicit_accurate(fs, timestep):
         return (f"implicitfast is not accurate there (omega_Nyquist dt = {w_ny_dt:.3g} > "
                 f"{IMPLICIT_ACCURACY:g}: frequency error {w_ny_dt**2 / 24:.2%} at the Nyquist "
                 f"frequency, auto's bound {IMPLICIT_ACCURACY**2 / 24:.2%}; it needs dt <= "
