@@ -46,6 +46,8 @@ from models.cantilever.simulate import (
     MUJOCO_MAX_CONTROL,
     RK4_ACCURACY,
     half_sine,
+    implicit_accurate,
+    implicit_unfit,
     mode_errors,
     rollout_sensors,
     static_equilibrium,
@@ -126,7 +128,11 @@ def fewest_substeps(simulation: dict[str, Any], nv: int) -> tuple[int, float]:
     """The least work :func:`models.cantilever.simulate.choose_stepping` could choose, from the
     sample rate alone (no model): lower bounds of a run's steps and CPU time per sample.
 
-    A requested ``timestep`` fixes the substeps (RK4 under ``auto``).  Otherwise each
+    A requested ``timestep`` fixes the substeps; under ``auto`` it is integrated with RK4, or
+    with implicitfast where RK4 is unstable there and implicitfast meets ``auto``'s rule
+    (:func:`models.cantilever.simulate.implicit_unfit`), which from the sample rate alone is
+    possible only where ``omega_Ny dt <= IMPLICIT_ACCURACY``: the time bound is then the
+    cheaper of the two.  Otherwise each
     integrator needs at least its accuracy limit, ``ceil(pi / RK4_ACCURACY) = 7`` (RK4) or
     ``ceil(pi / IMPLICIT_ACCURACY) = 29`` (implicitfast) steps per sample; stability can only
     ask more.  ``auto`` may take either, so each bound is the smaller over both.
@@ -146,11 +152,15 @@ def fewest_substeps(simulation: dict[str, Any], nv: int) -> tuple[int, float]:
     period = 1.0 / float(simulation["sample_rate"])
     integrator = simulation["integrator"]
     if simulation["timestep"] > 0:
-        integ = "RK4" if integrator == "auto" else integrator
         # capped before rounding: a subnormal timestep (5e-324 s) makes the ratio inf, which
         # round() cannot take; the budget then refuses the steps by simulation.timestep
         n = max(1, round(min(period / simulation["timestep"], 2**62)))
-        return n, n * step_seconds(nv, integ)
+        integs = [integrator]
+        if integrator == "auto":
+            # the accuracy half of implicit_unfit (its stability half needs the model)
+            fits = implicit_accurate(float(simulation["sample_rate"]), period / n)
+            integs = ["RK4", "implicitfast"] if fits else ["RK4"]
+        return n, min(n * step_seconds(nv, i) for i in integs)
     options = []
     if integrator in ("auto", "RK4"):
         options.append(("RK4", math.ceil(math.pi / RK4_ACCURACY)))
@@ -196,7 +206,9 @@ SIMULATION_SCHEMA = {
                          doc="sample rate of every signal"),
     "integrator": Field(str, "auto", choices=("auto", "RK4", "implicitfast"),
                         doc="MuJoCo integrator; auto = RK4 while it costs at most twice "
-                            "implicitfast, else implicitfast (models/cantilever/simulate.py)"),
+                            "implicitfast, else implicitfast; at a given timestep RK4 where it "
+                            "is stable, else implicitfast where stable and accurate "
+                            "(models/cantilever/simulate.py)"),
     "timestep": Field(float, 0.0, unit="s", min=0.0,
                       doc="integration step, rounded to sample period / integer; 0 = chosen "
                           "from the model's fastest mode"),
@@ -743,8 +755,14 @@ class CantileverRig(Rig):
         if sc.simulation["timestep"] > 0:  # a requested step: refuse it if the linear model blows up
             why = unstable_modes(b.M, b.C, b.K, st.integrator, st.timestep)
             if why:
-                raise RigError(f"cantilever: unstable {where}: {why}; set simulation.timestep = 0 "
-                               "(automatic) or a smaller one")
+                other = ""
+                if sc.simulation["integrator"] == "auto":  # auto kept RK4: implicitfast did not fit
+                    other = (f"; auto cannot take implicitfast instead: "
+                             f"{implicit_unfit(b.M, b.C, b.K, fs, st.timestep)}")
+                raise RigError(f"cantilever: unstable {where}: {why}{other}; set simulation.timestep "
+                               "= 0 (automatic) or a smaller one"
+                               + (", or name simulation.integrator" if other else ""),
+                               key="simulation.timestep", value=sc.simulation["timestep"])
         LOG.info("cantilever %s: %s", sc.name, st.rule)
         peak: list[tuple[float, float, int]] = []
         sens = rollout_sensors(b.model, q0, control, st.substeps, progress, peak_angle=peak)

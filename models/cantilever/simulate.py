@@ -34,6 +34,19 @@ the rig stores it.
 default 10-segment beams stay on RK4 (17 and 7 substeps); from about 20 segments
 the RK4 step falls as N^-2 (N = 60 would need 22,000 substeps, implicitfast 29).
 
+``auto`` at a requested ``timestep`` (rounded to the sample period over an integer)
+takes RK4 wherever RK4 is stable there (the exact test of :func:`unstable_modes`;
+as before, so those runs keep their data bit for bit).  Where RK4 is unstable it
+takes implicitfast if the step meets the rule ``auto`` applies to its own
+implicitfast step (:func:`implicit_step_bound`: within :data:`IMPLICIT_MARGIN` of
+the tightest mode's stability limit and ``omega_Ny dt <= IMPLICIT_ACCURACY``), and
+says so in the stored rule; otherwise it keeps RK4 and the rig refuses the step in
+one line naming both integrators' reasons (:func:`implicit_unfit`).  A stable RK4
+step is never swapped for accuracy's sake: RK4's accuracy bound
+(``omega_Ny dt <= 0.49``) is 4.5 x looser than implicitfast's, so a step too coarse
+for RK4's accuracy is too coarse for implicitfast's as well.  To take a step
+implicitfast integrates but ``auto`` would not choose, name the integrator.
+
 Impact
 ------
 A half-sine ``F(t) = P sin(pi (t - t0) / Tp)`` on ``[t0, t0 + Tp]`` drives the
@@ -199,6 +212,45 @@ def unstable_modes(M: np.ndarray, C: np.ndarray, K: np.ndarray, integrator: str,
     return None
 
 
+def implicit_step_bound(M: np.ndarray, C: np.ndarray, K: np.ndarray, fs: float) -> float:
+    """Largest implicitfast step ``auto`` accepts at sample rate ``fs`` [Hz], in s.
+
+    ``min(IMPLICIT_MARGIN * min_i limit_i, IMPLICIT_ACCURACY / omega_Ny)`` with the
+    per-mode limits of :func:`implicit_limits` and ``omega_Ny = pi fs`` [rad/s].
+    """
+    omega, zeta = modal_damping(M, C, K)
+    return min(IMPLICIT_MARGIN * float(implicit_limits(omega, zeta).min()),
+               IMPLICIT_ACCURACY / (math.pi * fs))
+
+
+def implicit_accurate(fs: float, timestep: float) -> bool:
+    """Whether an implicitfast step [s] meets ``auto``'s accuracy rule at sample rate ``fs`` [Hz],
+    ``omega_Ny dt <= IMPLICIT_ACCURACY`` (1e-12 of rounding allowed)."""
+    return math.pi * fs * timestep <= IMPLICIT_ACCURACY * (1 + 1e-12)
+
+
+def implicit_unfit(M: np.ndarray, C: np.ndarray, K: np.ndarray, fs: float,
+                   timestep: float) -> str | None:
+    """Why ``auto`` would not integrate a requested ``timestep`` [s] with implicitfast, or None.
+
+    The step must meet :func:`implicit_step_bound` (the rule ``auto`` applies to its own
+    implicitfast step): stable with a 20 % margin on every mode, and an undamped frequency
+    error ``(omega_Ny dt)^2 / 24`` at the Nyquist frequency of at most 5e-4.
+    """
+    w_ny_dt = math.pi * fs * timestep
+    if not implicit_accurate(fs, timestep):
+        return (f"implicitfast is not accurate there (omega_Nyquist dt = {w_ny_dt:.3g} > "
+                f"{IMPLICIT_ACCURACY:g}: frequency error {w_ny_dt**2 / 24:.2%} at the Nyquist "
+                f"frequency, auto's bound {IMPLICIT_ACCURACY**2 / 24:.2%}; it needs dt <= "
+                f"{IMPLICIT_ACCURACY / (math.pi * fs):.3g} s)")
+    bound = implicit_step_bound(M, C, K, fs)
+    if timestep > bound * (1 + 1e-12):
+        why = unstable_modes(M, C, K, "implicitfast", timestep)
+        return (f"implicitfast is {'unstable' if why else 'within 20 % of its stability limit'} "
+                f"there ({why or f'auto needs dt <= {bound:.3g} s'})")
+    return None
+
+
 def choose_stepping(M: np.ndarray, C: np.ndarray, K: np.ndarray, fs: float, integrator: str,
                     timestep: float = 0.0) -> Stepping:
     """Integrator and timestep for sample rate ``fs`` [Hz] (see the module docstring).
@@ -212,8 +264,10 @@ def choose_stepping(M: np.ndarray, C: np.ndarray, K: np.ndarray, fs: float, inte
     integrator : str
         ``"auto"``, ``"RK4"`` or ``"implicitfast"``.  ``auto`` compares both
         choices' costs (RK4 while it costs at most :data:`AUTO_RK4_PREMIUM` times
-        implicitfast; an RK4 step counts :data:`RK4_STEP_COST`); with a requested
-        ``timestep`` it means RK4.
+        implicitfast; an RK4 step counts :data:`RK4_STEP_COST`); at a requested
+        ``timestep`` it takes RK4 where RK4 is stable there, else implicitfast where
+        :func:`implicit_unfit` finds nothing against it, else RK4 (which the rig then
+        refuses, naming both reasons).
     timestep : float
         Requested step [s]; 0 chooses it.  A requested step is rounded to the
         sample period over the nearest integer substep count.
@@ -222,8 +276,18 @@ def choose_stepping(M: np.ndarray, C: np.ndarray, K: np.ndarray, fs: float, inte
     if timestep > 0:
         integ = "RK4" if integrator == "auto" else integrator
         substeps = max(1, round(period / timestep))
-        return Stepping(integ, period / substeps, substeps,
-                        f"{integ}, requested timestep {timestep:.4g} s -> {substeps} per sample")
+        dt = period / substeps
+        rule = f"{integ}, requested timestep {timestep:.4g} s -> {substeps} per sample"
+        if integrator == "auto":
+            rk4_why = unstable_modes(M, C, K, "RK4", dt)
+            if rk4_why and implicit_unfit(M, C, K, fs, dt) is None:
+                integ = "implicitfast"
+                rule = (f"auto at the requested timestep {timestep:.4g} s ({substeps} per sample, "
+                        f"dt = {dt:.4g} s): RK4 is unstable there ({rk4_why}); implicitfast is "
+                        f"stable and accurate there (omega_Nyquist dt = {math.pi * fs * dt:.3g} <= "
+                        f"{IMPLICIT_ACCURACY:g}, dt <= {IMPLICIT_MARGIN:g} of its stability "
+                        "limit) -> implicitfast")
+        return Stepping(integ, dt, substeps, rule)
     w_ny = math.pi * fs
 
     def count(dt: float) -> int:
@@ -234,9 +298,7 @@ def choose_stepping(M: np.ndarray, C: np.ndarray, K: np.ndarray, fs: float, inte
         eig_max = float(np.abs(np.linalg.eigvals(state_matrix(M, C, K))).max())
         rk4 = count(min(RK4_STABILITY / eig_max, RK4_ACCURACY / w_ny))
     if integrator in ("auto", "implicitfast"):
-        omega, zeta = modal_damping(M, C, K)
-        imp = count(min(IMPLICIT_MARGIN * float(implicit_limits(omega, zeta).min()),
-                        IMPLICIT_ACCURACY / w_ny))
+        imp = count(implicit_step_bound(M, C, K, fs))
     if integrator == "auto":
         use_rk4 = RK4_STEP_COST * rk4 <= AUTO_RK4_PREMIUM * imp
         why = (f"auto: RK4 needs {rk4}, implicitfast {imp} steps per sample; an RK4 step costs "

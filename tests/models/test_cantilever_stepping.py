@@ -6,6 +6,8 @@ import numpy as np
 import pytest
 
 from models.cantilever import CantileverRig
+from models.cantilever.model import build_model
+from models.cantilever.rig import fewest_substeps, step_seconds
 from models.cantilever.simulate import (
     Stepping,
     choose_stepping,
@@ -15,7 +17,7 @@ from models.cantilever.simulate import (
     rollout_sensors,
 )
 from testbed.core.errors import RigError
-from testbed.pipeline.scenario import scenario_from_dict
+from testbed.pipeline.scenario import list_scenarios, scenario_from_dict
 
 
 def scenario(rig=None, simulation=None, excitation=None):
@@ -186,3 +188,57 @@ def test_rollout_chunks_do_not_change_the_data(monkeypatch):
     monkeypatch.setattr(simulate, "CHUNK_BYTES", 1)
     pieces = rollout_sensors(b.model, np.zeros(b.model.nq), force, b.stepping.substeps)
     np.testing.assert_array_equal(whole, pieces)
+
+
+def test_auto_at_a_requested_step_takes_implicitfast_where_rk4_is_unstable():
+    # 60 segments at 12.8 kHz: auto's own step is implicitfast's (29 substeps, RK4 would need
+    # 22,000).  Asking that very step under 'auto' took RK4 and was refused ("unstable with RK4");
+    # now auto takes implicitfast there, says so in the stored rule, and the data are those of
+    # the automatic step bit for bit (same integrator, same step).
+    own = CantileverRig(scenario({"n_segments": 60}, {"duration": 0.01}))
+    asked = CantileverRig(scenario({"n_segments": 60},
+                                   {"duration": 0.01, "timestep": own.built.stepping.timestep}))
+    st = asked.built.stepping
+    assert own.built.stepping.integrator == st.integrator == "implicitfast"
+    assert st.substeps == own.built.stepping.substeps == 29
+    assert "RK4 is unstable there" in st.rule and st.rule.endswith("-> implicitfast")
+    ds, ref = asked.simulate(), own.simulate()
+    assert ds.attrs["integrator"] == "implicitfast" and ds.attrs["stepping"] == st.rule
+    np.testing.assert_array_equal(ds.measured["acceleration"].data, ref.measured["acceleration"].data)
+    # the budget's lower bound agrees with the choice: implicitfast's time, not RK4's
+    nv = 60
+    substeps, per_sample_s = fewest_substeps(asked.scenario.simulation, nv)
+    assert substeps == 29
+    assert per_sample_s <= st.substeps * step_seconds(nv, st.integrator) * (1 + 1e-12)
+
+
+def test_auto_at_a_step_neither_integrator_takes_is_refused_naming_both():
+    # round 22's b22_st_dt1e-5: the shipped beam at a 1e-5 s step (8 per sample, 9.766e-6 s).
+    # RK4 is unstable there (its limit ~4.8e-6 s); implicitfast is stable but omega_Ny dt =
+    # 0.393 > 0.109, a 0.64 % frequency error at the Nyquist frequency against auto's 0.05 %.
+    rig = CantileverRig(scenario(None, {"duration": 0.01, "timestep": 1e-5}))
+    with pytest.raises(RigError, match=r"unstable with RK4 at timestep 9\.766e-06 s.*"
+                                       r"implicitfast is not accurate there.*0\.393 > 0\.109"
+                                       r".*simulation\.timestep") as e:
+        rig.simulate()
+    assert "\n" not in str(e.value)
+    assert e.value.key == "simulation.timestep" and e.value.value == 1e-5
+    # named explicitly, implicitfast takes that step (stable: the user's choice of accuracy)
+    asked = CantileverRig(scenario(None, {"duration": 0.01, "timestep": 1e-5,
+                                          "integrator": "implicitfast"}))
+    assert asked.simulate().attrs["substeps"] == 8
+
+
+def test_auto_at_a_requested_step_is_rk4_wherever_rk4_is_stable():
+    # The old rule ('auto' at a requested step means RK4) wherever RK4 is stable there: the
+    # same Stepping as RK4 named, rule text included, so those runs keep their data bit for
+    # bit.  On every shipped cantilever scenario at its own automatic step and at half of it.
+    shipped = [sc for sc in list_scenarios() if sc.rig == "cantilever"]
+    assert len(shipped) >= 3
+    for sc in shipped:
+        b = build_model(sc.rig_params, sc.simulation, sc.excitation)
+        fs = sc.simulation["sample_rate"]
+        for dt in (b.stepping.timestep, b.stepping.timestep / 2):
+            auto = choose_stepping(b.M, b.C, b.K, fs, "auto", dt)
+            assert auto == choose_stepping(b.M, b.C, b.K, fs, "RK4", dt), sc.name
+            assert auto.integrator == "RK4", sc.name
