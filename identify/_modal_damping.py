@@ -1289,6 +1289,59 @@ def peak_offset(sigma: np.ndarray, lam: np.ndarray) -> np.ndarray:
     return np.where(np.isfinite(z2), wn / (2.0 * np.pi) * g, np.nan)
 
 
+def hardened_reach(freqs_hz: np.ndarray, peak_hz: np.ndarray, dec: ModalDecay,
+                   sigma: np.ndarray, line_hz: float, duration_s: float
+                   ) -> tuple[np.ndarray, np.ndarray]:
+    """The highest linear frequency of each mode that a hardening record allows [Hz].
+
+    In a structure whose restoring force hardens, a mode rings at or above its linear
+    frequency while any mode still moves: its own amplitude and the others' stiffen it, never
+    soften it.  So two measurements of a mode bound its linear frequency from above, each to
+    one line ``line_hz`` (the window's resolution):
+
+    - its accepted spectral peak, plus the damped decay's spectral-peak offset
+      (:func:`peak_offset`: an acceleration spectrum's peak may lie that far above the undamped
+      frequency without any stiffening);
+    - its backbone decay fit's linear limit ``wd`` (``lam_model``), where that fit is taken and
+      its limit read from the record (the squared amplitude falls to
+      :data:`BACKBONE_MIN_FALL` or less over the window, as the decay hold reads it): the
+      limit removes the mode's own stiffening, not the other modes' (module docstring,
+      "Cubic library"), so it still lies at or above the linear frequency.
+
+    Parameters
+    ----------
+    freqs_hz : ndarray, shape (n,)
+        The model's frequencies [Hz] (ascending; the fits' domain).
+    peak_hz : ndarray, shape (n,)
+        The accepted peak each mode is paired with [Hz] (same domain), 0 where none.
+    dec : ModalDecay
+        The backbone decay fits of the model's modes (``chirp`` set).
+    sigma : ndarray, shape (n,)
+        Each mode's decay rate [1/s] for the peak offset: the measured one where taken.
+    line_hz : float
+        One line of the window's transform [Hz].
+    duration_s : float
+        The fit window's length [s].
+
+    Returns
+    -------
+    reach : ndarray, shape (n,)
+        The smaller of the two bounds [Hz]; inf where neither applies.
+    limit : ndarray, shape (n,)
+        The read backbone limit [Hz] where it bounds the mode, NaN elsewhere.
+    """
+    n = np.size(freqs_hz)
+    pk = np.asarray(peak_hz, dtype=float)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        off = peak_offset(np.asarray(sigma, dtype=float), (2.0 * np.pi * pk) ** 2)
+        by_peak = np.where((pk > 0) & ~np.isnan(off), pk + line_hz + off, np.inf)
+        read = (dec.taken & np.isfinite(dec.lam_model)
+                & (np.exp(-2.0 * dec.sigma * duration_s) <= BACKBONE_MIN_FALL))
+    limit = np.where(read, np.sqrt(np.where(read, dec.lam_model, 0.0)) / (2.0 * np.pi), np.nan)
+    reach = np.fmin(by_peak, np.where(read, limit + line_hz, np.inf))
+    return reach.reshape(n), limit.reshape(n)
+
+
 def backbone_shift(M: np.ndarray, K: np.ndarray, K3: np.ndarray, dec: ModalDecay) -> np.ndarray:
     """The model's own first-order backbone shift of each mode at the measured amplitude.
 

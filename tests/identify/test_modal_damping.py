@@ -7,10 +7,14 @@ import pytest
 
 from benchmarks import bench_sgd_sindy as bench
 from identify._modal_damping import (
+    BACKBONE_MIN_FALL,
+    ModalDecay,
     chain_transients,
     coupling_moves,
+    hardened_reach,
     hold_modal_damping,
     modal_decay,
+    peak_offset,
     peak_shape,
     set_shapes,
 )
@@ -300,8 +304,6 @@ def test_chain_transients_remove_the_low_pass_bias():
 
 
 def test_peak_offset_is_zeta_squared():
-    from identify._modal_damping import peak_offset
-
     w = 2 * np.pi * 814.0
     off = peak_offset(np.array([0.02 * w, 0.137 * w, 0.75 * w, np.nan]), np.full(4, w * w))
     assert off[0] == pytest.approx(814.0 * 0.02**2, rel=1e-3)  # zeta^2 f_n for light damping
@@ -639,3 +641,28 @@ def test_decay_agreeing_with_the_modes_peak_moves_it_beyond_one_line(chain):
     far = decay_hold(data, M, C, K_off, win, set_f,
                      peaks_hz=np.array([f_true[0] - 2 * line, 0.0, 0.0]))
     assert modal(M, far.K)[0][0] == pytest.approx(f_off, rel=1e-9)
+
+
+def test_hardened_reach_is_the_peak_or_the_read_backbone_limit_plus_one_line():
+    """The highest linear frequency a hardening record allows: each mode's paired peak + one
+    line + the damped peak's offset, or its backbone limit + one line where that fit is taken
+    and read (the squared amplitude falls to BACKBONE_MIN_FALL or less), the smaller."""
+    line, T = 2.0, 0.5
+    f = np.array([22.0, 216.0, 640.0, 900.0])  # model [Hz]
+    peak = np.array([22.7, 205.2, 0.0, 0.0])  # paired peaks [Hz]; modes 3-4 none
+    wd = np.array([22.2, 204.2, 630.0, 880.0])  # backbone limits [Hz]
+    sigma = np.array([2.0, 157.6, 0.3, 50.0])  # [1/s]; mode 3's squared amplitude keeps 0.74
+    taken = np.array([True, True, True, False])
+    nan = np.full(4, np.nan)
+    dec = ModalDecay(sigma=sigma, omega_d=2 * np.pi * wd, sigma_model=sigma,
+                     lam_model=np.where(taken, (2 * np.pi * wd) ** 2, np.nan), shift=nan,
+                     r2=nan, taken=taken, chirp=np.array([7.1, 91.5, 1.0, np.nan]), amplitude=nan)
+    assert np.exp(-2 * sigma[2] * T) > BACKBONE_MIN_FALL  # mode 3's limit is not read
+    reach, limit = hardened_reach(f, peak, dec, sigma, line, T)
+    by_peak = peak[:2] + line + peak_offset(sigma[:2], (2 * np.pi * peak[:2]) ** 2)
+    assert reach[0] == pytest.approx(min(by_peak[0], wd[0] + line), rel=1e-12)
+    assert reach[1] == pytest.approx(wd[1] + line, rel=1e-12)  # 206.2 < the peak's 210.4
+    assert by_peak[1] > wd[1] + line
+    assert limit[:2] == pytest.approx(wd[:2], rel=1e-12)
+    assert np.isinf(reach[2]) and np.isnan(limit[2])  # no peak, its limit not read: no bound
+    assert np.isinf(reach[3]) and np.isnan(limit[3])  # no peak, no decay taken
