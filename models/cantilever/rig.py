@@ -258,9 +258,11 @@ SLENDER_MAX_DEPTH = 0.113
 #: at ``(4.730 / 1.875)^2 / sqrt(1 - nu^2) (L / b)^2 f_1 = 6.67 (L / b)^2 f_1`` (the clamp only
 #: stiffens it), which reaches mode 2 (``6.27 f_1``, barred by every shipped scenario) at
 #: ``b / L = 1.03``.  Torsion (antisymmetric: neither excited nor read on the centre line) and
-#: the plate's Poisson stiffening of mode 1 (up to +4.1 % at b = L: the square cantilever
-#: plate's 3.492 against the beam's 3.354 in plate units, Leissa) are not what the bound is
-#: set by; docs/known-gaps.md (2026-11-28) records the latter as open.
+#: the plate's Poisson stiffening of mode 1 are not what the bound is set by.  The latter
+#: (Kirchhoff plate by Ritz, ``tests/models/test_cantilever_slender.py``) is +0.65 % on the
+#: shipped beam (b / L 0.0945), +1.5 % at the families' widest member (0.24), +3.5 % at b = L:
+#: a bound at the 1 % bar (b / L ~0.15) would refuse family members; docs/known-gaps.md
+#: (2026-11-28) records it as open.
 SLENDER_MAX_WIDTH = 1.0
 
 
