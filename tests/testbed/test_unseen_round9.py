@@ -69,11 +69,31 @@ def test_hammer_at_mode_2s_node_fails_named_unexcited():
 
 
 # ------------------------------------------- the round's studies load
-@pytest.mark.parametrize(("name", "cells"), [("round9_beams", 72), ("round9_beams_noise", 48)])
+# round9_beams held 72 cells; its three thick clamped beams are refused since session 23 (below)
+# and left out of it: 66
+@pytest.mark.parametrize(("name", "cells"), [("round9_beams", 66), ("round9_beams_noise", 48)])
 def test_round9_studies_load(name, cells):
     from testbed.studies.study import load_study
     from testbed.studies.sweep import expand
     assert len(expand(load_study(UNSEEN / f"{name}.toml"))) == cells
+
+
+# ------------------------------------------- the thick beams: refused, not simulated as beams
+@pytest.mark.parametrize(("name", "ratio"), [("b9_thick_L0p2_h40_s2", "0.2"),
+                                             ("b9_thick_L0p3_h40_s2", "0.1333"),
+                                             ("b9_thick_L0p25_h30_s3", "0.12")])
+def test_round9_thick_beams_are_refused_as_not_slender(name, ratio):
+    # the round ran them (both identifiers passed) as Euler-Bernoulli chains; a real beam 30-40
+    # mm deep on 0.2-0.3 m has mode 1 1.1-3.0 % lower (Timoshenko, tests/models/
+    # test_cantilever_slender.py), beyond the 1 % bar: the rig refuses them in one line since
+    # session 23 (models/cantilever/rig.py SLENDER_MAX_DEPTH 0.113)
+    from testbed.core.errors import ScenarioError
+    from testbed.pipeline.scenario import load_scenario
+    with pytest.raises(ScenarioError) as e:
+        load_scenario(UNSEEN / "round9" / f"{name}.toml")
+    msg = str(e.value)
+    assert "\n" not in msg and f"{name}.toml: key 'rig.thickness'" in msg
+    assert f"thickness / length at most 0.113, here {ratio} " in msg
 
 
 # ------------------------------------------- a failed fit on a mode out of reach says so
