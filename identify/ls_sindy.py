@@ -307,7 +307,8 @@ class LeastSquaresSINDy(StructuralIdentifier):
     eigen_hold : bool
         Hold each mode paired with a measured peak within one spectral line [Hz] of it (step 2);
         with the cubic library, only bound each mode's linear frequency from above by its
-        peak and its backbone limit where the record hardens (:meth:`_cap_at_reach`).
+        peak and its backbone limit where the record hardens (:meth:`_cap_at_reach`), which
+        needs ``decay_hold`` and ``decay_backbone`` on and an accepted peak.
     decay_hold : bool
         Give each mode the damping, and within one line the frequency, of its measured free
         decay (step 3); not with a continuous input.
@@ -411,7 +412,10 @@ class LeastSquaresSINDy(StructuralIdentifier):
                                           "(a linear one after the holds)"),
         "eigen_hold": Field(bool, True, doc="hold the identified frequencies within one "
                                             "spectral line of the measured peaks they pair "
-                                            "with (sgd_sindy's rule)"),
+                                            "with (sgd_sindy's rule); with the cubic library, "
+                                            "move a mode down to what the hardening record "
+                                            "allows (needs decay_hold, decay_backbone and an "
+                                            "accepted peak)"),
         "decay_hold": DECAY_HOLD_FIELD,
         "decay_backbone": DECAY_BACKBONE_FIELD,
         "lower_modes": LOWER_MODES_FIELD,
