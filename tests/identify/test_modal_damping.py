@@ -648,7 +648,7 @@ def test_hardened_reach_is_the_peak_or_the_read_backbone_limit_plus_one_line():
     line + the damped peak's offset, or its backbone limit + one line where that fit is taken
     and read (the squared amplitude falls to BACKBONE_MIN_FALL or less), the smaller.  The
     limit is the undamped ``|p| / (2 pi)`` of the fit's linear pole (``lam_model = |p|^2 =
-    wd^2 + sigma^2``), not its damped ``wd``: mode 2 (15 % damped) tells them apart by 0.74 %,
+    wd^2 + sigma^2``), not its damped ``wd``: mode 2 (12 % damped) tells them apart by 0.75 %,
     1.5 Hz, against the 1e-12 the test asks."""
     line, T = 2.0, 0.5
     peak = np.array([22.7, 205.2, 0.0, 0.0])  # paired peaks [Hz]; modes 3-4 none
