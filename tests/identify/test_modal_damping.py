@@ -662,7 +662,7 @@ def test_hardened_reach_is_the_peak_or_the_read_backbone_limit_plus_one_line():
                      r2=nan, taken=taken, chirp=np.array([7.1, 91.5, 1.0, np.nan]), amplitude=nan)
     assert np.exp(-2 * sigma[2] * T) > BACKBONE_MIN_FALL  # mode 3's limit is not read
     reach, limit = hardened_reach(peak, dec, sigma, line, T)
-    undamped = np.sqrt(lam[:2]) / (2 * np.pi)  # 22.2001, 205.71 Hz
+    undamped = np.sqrt(lam[:2]) / (2 * np.pi)  # 22.2002, 205.73 Hz
     assert undamped[1] - wd[1] > 1.5  # the damped value would fail the checks below
     by_peak = peak[:2] + line + peak_offset(sigma[:2], (2 * np.pi * peak[:2]) ** 2)
     assert reach[0] == pytest.approx(min(by_peak[0], undamped[0] + line), rel=1e-12)
