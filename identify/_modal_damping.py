@@ -1289,9 +1289,8 @@ def peak_offset(sigma: np.ndarray, lam: np.ndarray) -> np.ndarray:
     return np.where(np.isfinite(z2), wn / (2.0 * np.pi) * g, np.nan)
 
 
-def hardened_reach(freqs_hz: np.ndarray, peak_hz: np.ndarray, dec: ModalDecay,
-                   sigma: np.ndarray, line_hz: float, duration_s: float
-                   ) -> tuple[np.ndarray, np.ndarray]:
+def hardened_reach(peak_hz: np.ndarray, dec: ModalDecay, sigma: np.ndarray, line_hz: float,
+                   duration_s: float) -> tuple[np.ndarray, np.ndarray]:
     """The highest linear frequency of each mode that a hardening record allows [Hz].
 
     In a structure whose restoring force hardens, a mode rings at or above its linear
@@ -1302,18 +1301,19 @@ def hardened_reach(freqs_hz: np.ndarray, peak_hz: np.ndarray, dec: ModalDecay,
     - its accepted spectral peak, plus the damped decay's spectral-peak offset
       (:func:`peak_offset`: an acceleration spectrum's peak may lie that far above the undamped
       frequency without any stiffening);
-    - its backbone decay fit's linear limit ``wd`` (``lam_model``), where that fit is taken and
-      its limit read from the record (the squared amplitude falls to
+    - its backbone decay fit's linear limit, the undamped frequency ``|p| / (2 pi)`` of the
+      fit's linear pole ``p`` (``sqrt(lam_model) / (2 pi)``, ``|p|^2 = wd^2 + sigma^2``: the
+      quantity comparable with the model's undamped frequencies, not the damped ``wd``), where
+      that fit is taken and its limit read from the record (the squared amplitude falls to
       :data:`BACKBONE_MIN_FALL` or less over the window, as the decay hold reads it): the
       limit removes the mode's own stiffening, not the other modes' (module docstring,
       "Cubic library"), so it still lies at or above the linear frequency.
 
     Parameters
     ----------
-    freqs_hz : ndarray, shape (n,)
-        The model's frequencies [Hz] (ascending; the fits' domain).
     peak_hz : ndarray, shape (n,)
-        The accepted peak each mode is paired with [Hz] (same domain), 0 where none.
+        The accepted peak each mode (ascending) is paired with [Hz] (the fits' domain), 0
+        where none.
     dec : ModalDecay
         The backbone decay fits of the model's modes (``chirp`` set).
     sigma : ndarray, shape (n,)
@@ -1328,10 +1328,10 @@ def hardened_reach(freqs_hz: np.ndarray, peak_hz: np.ndarray, dec: ModalDecay,
     reach : ndarray, shape (n,)
         The smaller of the two bounds [Hz]; inf where neither applies.
     limit : ndarray, shape (n,)
-        The read backbone limit [Hz] where it bounds the mode, NaN elsewhere.
+        The read backbone limit ``|p| / (2 pi)`` [Hz] where it bounds the mode, NaN elsewhere.
     """
-    n = np.size(freqs_hz)
     pk = np.asarray(peak_hz, dtype=float)
+    n = pk.size
     with np.errstate(invalid="ignore", divide="ignore"):
         off = peak_offset(np.asarray(sigma, dtype=float), (2.0 * np.pi * pk) ** 2)
         by_peak = np.where((pk > 0) & ~np.isnan(off), pk + line_hz + off, np.inf)

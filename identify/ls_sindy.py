@@ -307,7 +307,8 @@ class LeastSquaresSINDy(StructuralIdentifier):
     eigen_hold : bool
         Hold each mode paired with a measured peak within one spectral line [Hz] of it (step 2);
         with the cubic library, only bound each mode's linear frequency from above by its
-        peak and its backbone limit where the record hardens (:meth:`_cap_at_reach`).
+        peak and its backbone limit where the record hardens (:meth:`_cap_at_reach`), which
+        needs ``decay_hold`` and ``decay_backbone`` on and an accepted peak.
     decay_hold : bool
         Give each mode the damping, and within one line the frequency, of its measured free
         decay (step 3); not with a continuous input.
@@ -411,7 +412,10 @@ class LeastSquaresSINDy(StructuralIdentifier):
                                           "(a linear one after the holds)"),
         "eigen_hold": Field(bool, True, doc="hold the identified frequencies within one "
                                             "spectral line of the measured peaks they pair "
-                                            "with (sgd_sindy's rule)"),
+                                            "with (sgd_sindy's rule); with the cubic library, "
+                                            "move a mode down to what the hardening record "
+                                            "allows (needs decay_hold, decay_backbone and an "
+                                            "accepted peak)"),
         "decay_hold": DECAY_HOLD_FIELD,
         "decay_backbone": DECAY_BACKBONE_FIELD,
         "lower_modes": LOWER_MODES_FIELD,
@@ -632,52 +636,82 @@ class LeastSquaresSINDy(StructuralIdentifier):
         """Step 2 with the cubic library (class docstring): a linear frequency above what the
         hardening record allows is moved down to it, and the cubic refitted around it.
 
-        Acts where the eigenvalue hold is on and the record hardens (the lowest mode's taken
-        backbone decay fit chirps up by more than
+        Acts where the eigenvalue hold is on, a peak was accepted, the decay hold ran with its
+        backbone fit (``decay_hold`` and ``decay_backbone``) and the record hardens (the lowest
+        mode's taken backbone decay fit chirps up by more than
         :data:`identify._cubic_rule.CUBIC_CHIRP_MIN` of its frequency).  Each mode's reach is
         :func:`identify._modal_damping.hardened_reach` (its paired accepted peak, paired as the
-        eigenvalue hold pairs, and its read backbone limit); a mode above it moves to its
-        backbone limit where that bounds it, else to the reach, and only to a frequency nearer
-        its own mode's than any other's (the decay hold's rule), shapes kept
+        eigenvalue hold pairs, and its read backbone limit); which modes move and where is
+        :func:`reach_moves` (to the backbone limit where that bounds the mode, else to the
+        reach, and only to a frequency nearer its own mode's than any other's), shapes kept
         (:func:`identify._modal_damping.set_eigenvalues`).  Then the cubic, input and drift
         columns of ``rows`` (the regression the model was solved on) are fitted again by
         least squares with the held damping and stiffness fixed (:meth:`_refit_cubic`), so
         that the model's cubic carries what the record's amplitude adds to the moved
-        frequency.  ``eigen_rule_`` says what moved.
+        frequency.  The moved and refitted model is checked as a fit is: physical
+        (:meth:`_check_physical`), its cubic not softening a mode the record shows hardening
+        (:meth:`_cubic_softens`) and its simulation bounded (:meth:`_cubic_diverges`); if any
+        check objects the model is restored as it stood before the move ("not moved").  A
+        moved mode's ``eigen_targets_`` is its paired peak (0 if none) and ``eigen_shift_``
+        the largest relative move.  ``eigen_rule_`` says what moved, or why nothing did.
         """
+        if not self.eigen_hold:
+            return  # eigen_rule_ says so already
         dec = getattr(self, "modal_decay_", None)
-        if not self.eigen_hold or peaks.size == 0 or dec is None or dec.chirp is None:
+        if peaks.size == 0:
+            self.eigen_rule_ += "; no measured peak: no reach, nothing moved"
+            return
+        if dec is None or dec.chirp is None:
+            self.eigen_rule_ += ("; no backbone decay fit (decay_hold and decay_backbone needed): "
+                                 "no reach, nothing moved")
             return
         freqs, Phi = modal(self.M_, self.K_)  # ascending: mode 1 first
         if not np.all(np.isfinite(freqs)) or not np.linalg.cond(Phi) < SHAPES_COND_MAX:
+            self.eigen_rule_ += ("; the model's modes not resolved (a non-finite frequency or "
+                                 "singular shapes): nothing moved")
             return
-        if not (dec.taken[0] and dec.chirp[0] > CUBIC_CHIRP_MIN * dec.omega_d[0]):
-            return  # the record is not seen hardening: its peaks and limits bound nothing
         i0, i1 = fit_window(data, 0.0)
         fs = float(data.fs)
         f = warp_frequency(peaks, fs) if data.integration == "trapezoid" else peaks
         paired = np.sqrt(eigen_targets(self.M_, self.K_, (2.0 * np.pi * f) ** 2)) / (2.0 * np.pi)
         own = 0.5 * np.diag(np.linalg.solve(Phi, np.linalg.solve(self.M_, self.C_) @ Phi)).real
-        reach, limit = hardened_reach(freqs, paired, dec, np.where(dec.taken, dec.sigma_model, own),
+        reach, limit = hardened_reach(paired, dec, np.where(dec.taken, dec.sigma_model, own),
                                       fs / (i1 - i0), (i1 - i0) / fs)
-        to = np.where(limit <= reach, limit, reach)
-        gap = np.abs(to[:, None] - freqs[None, :])
-        move = (freqs > reach) & np.all(gap >= np.diag(gap)[:, None], axis=1)
+        chirp1 = float(dec.chirp[0]) if dec.taken[0] else np.nan
+        move, to, why = reach_moves(freqs, reach, limit, chirp1, float(dec.omega_d[0]))
         if not np.any(move):
+            self.eigen_rule_ += f"; {why}"
             return
+        saved = {k: (v.copy() if isinstance(v, np.ndarray) else v) for k, v in self.__dict__.items()}
+        k = np.flatnonzero(move)
+        what = ("the record hardens (mode 1's backbone chirp c / wd "
+                f"{chirp1 / float(dec.omega_d[0]):.3g} > {CUBIC_CHIRP_MIN:g}): modes "
+                f"{(k + 1).tolist()} stood above the highest linear frequency it allows (the "
+                "paired peak + one line + the decay's spectral-peak offset, or the read backbone "
+                "limit + one line): "
+                + ", ".join(f"{freqs[j]:.4g} > {reach[j]:.4g} Hz, to {to[j]:.4g} Hz ("
+                            + ("its backbone limit" if limit[j] <= reach[j] else "that reach") + ")"
+                            for j in k))
         m = masses[:, None]
         self._set_stiffness(set_eigenvalues(
             self.M_, self.K_, np.where(move, (2.0 * np.pi * to) ** 2, np.nan)), m, rows.blocks["d"])
         self._refit_cubic(data, rows, masses)
-        k = np.flatnonzero(move)
-        self.eigen_rule_ += (
-            f"; the record hardens: modes {(k + 1).tolist()} stood above the highest linear "
-            "frequency it allows (the paired peak + one line + the decay's spectral-peak offset, "
-            "or the read backbone limit + one line): "
-            + ", ".join(f"{freqs[j]:.4g} > {reach[j]:.4g} Hz, moved to {to[j]:.4g} Hz ("
-                        + ("its backbone limit" if limit[j] <= reach[j] else "that reach") + ")"
-                        for j in k)
-            + "; the cubic refitted with the held damping and stiffness")
+        try:
+            self._check_physical()
+            objection = self._cubic_softens() or self._cubic_diverges(data)
+        except (IdentificationError, np.linalg.LinAlgError) as e:
+            objection = str(e)
+        if objection:  # the move is undone, the fit kept as it stood
+            self.__dict__.clear()
+            self.__dict__.update(saved)
+            self.eigen_rule_ += (f"; {what}; not moved: the moved model with its cubic refitted "
+                                 f"was refused ({objection})")
+            return
+        self.eigen_targets_ = np.where(move, paired, self.eigen_targets_)
+        self.eigen_shift_ = float(np.max(np.abs(to[move] / freqs[move] - 1.0)))
+        self.eigen_rule_ = (f"cubic library, bounded from above where {what}, moved; the cubic "
+                            "refitted with the held damping and stiffness"
+                            + (f"; {why}" if why else ""))
 
     def _refit_cubic(self, data: Measurement, rows: Library, masses: np.ndarray) -> None:
         """Least squares of ``rows``' targets on its cubic, input and drift columns with the
@@ -890,3 +924,60 @@ class LeastSquaresSINDy(StructuralIdentifier):
         ``M^-1 C`` (M is ``m_hat / n I``, positive definite by construction), and on noisy data
         it can return negative damping."""
         check_physical(self.M_, self.C_, self.K_)
+
+
+def reach_moves(freqs_hz: np.ndarray, reach_hz: np.ndarray, limit_hz: np.ndarray,
+                chirp1: float, omega_d1: float) -> tuple[np.ndarray, np.ndarray, str]:
+    """Which modes of a cubic model the hardening record moves down, and to where
+    (:meth:`LeastSquaresSINDy._cap_at_reach`).
+
+    Three conditions, each needed: (1) the record hardens: mode 1's backbone chirp exceeds
+    :data:`identify._cubic_rule.CUBIC_CHIRP_MIN` of its damped frequency (else its peaks and
+    limits bound nothing); (2) the mode stands above its reach; (3) its target, the read
+    backbone limit where that is at or below the reach, else the reach, lies at least as near
+    its own mode's frequency as any other mode's (the decay hold's rule: a target nearer
+    another mode followed that mode).
+
+    Parameters
+    ----------
+    freqs_hz : ndarray, shape (n,)
+        The model's frequencies [Hz], ascending.
+    reach_hz, limit_hz : ndarray, shape (n,)
+        :func:`identify._modal_damping.hardened_reach`'s reach (inf: no bound) and read
+        backbone limit (NaN: none) [Hz].
+    chirp1 : float
+        Mode 1's backbone chirp ``c`` [rad/s]; NaN where its backbone fit was not taken.
+    omega_d1 : float
+        Mode 1's fitted damped frequency ``wd`` [rad/s].
+
+    Returns
+    -------
+    move : ndarray of bool, shape (n,)
+        The modes to move.
+    to : ndarray, shape (n,)
+        Each mode's target [Hz] (meaningful where ``move``).
+    why : str
+        What was left and why ("" when every mode above its reach moves).
+    """
+    f = np.asarray(freqs_hz, dtype=float)
+    reach, limit = np.asarray(reach_hz, dtype=float), np.asarray(limit_hz, dtype=float)
+    to = np.where(limit <= reach, limit, reach)
+    none = np.zeros(f.shape, dtype=bool)
+    if not chirp1 > CUBIC_CHIRP_MIN * omega_d1:
+        said = ("mode 1's backbone decay fit not taken" if np.isnan(chirp1) else
+                f"mode 1's backbone chirp c / wd {chirp1 / omega_d1:.3g} <= {CUBIC_CHIRP_MIN:g}")
+        return none, to, f"the record is not seen hardening ({said}): nothing moved"
+    above = f > reach
+    if not np.any(above):
+        return none, to, ("the record hardens, every mode within its reach ("
+                          + ", ".join(f"{a:.4g} <= {r:.4g} Hz" for a, r in zip(f, reach, strict=True))
+                          + "): nothing moved")
+    gap = np.abs(to[:, None] - f[None, :])
+    nearest = np.all(gap >= np.diag(gap)[:, None], axis=1)
+    move = above & nearest
+    left = np.flatnonzero(above & ~nearest)
+    why = "; ".join(
+        f"mode {j + 1} above its reach ({f[j]:.4g} > {reach[j]:.4g} Hz) left: its target "
+        f"{to[j]:.4g} Hz lies nearer mode {int(np.argmin(gap[j])) + 1}'s {f[np.argmin(gap[j])]:.4g} Hz"
+        for j in left)
+    return move, to, why

@@ -13,12 +13,13 @@ import pytest
 
 from benchmarks import bench_sgd_sindy as bench
 from identify import IDENTIFIERS
+from identify._cubic_rule import CUBIC_CHIRP_MIN
 from identify._structural_sim import simulate_structural
-from identify.ls_sindy import LeastSquaresSINDy
-from identify.structural import modal
+from identify.ls_sindy import LeastSquaresSINDy, reach_moves
+from identify.structural import check_physical, modal
 from testbed.pipeline.scenario import load_scenario
 from testbed.pipeline.signal_chain import measure
-from testbed.scoring.run import run_scenario
+from testbed.scoring.run import make_identifier, run_scenario
 from testbed.studies.study import load_study
 from testbed.studies.sweep import expand
 
@@ -584,3 +585,109 @@ def test_a_cubic_models_mode_above_what_the_hardening_record_allows_is_moved_and
         assert v["freq_error_mode1"] <= 0.01  # unchanged, 0.58 / 0.02 %
         # measured 0.990 / 0.943 (old code 0.987 / 0.934; moved without the refit 0.958 / 0.857)
         assert v["trac"] >= trac_min
+
+
+# reach_moves (the cubic library's move selection): synthetic arrays, mode 1's damped
+# frequency 22.2 Hz; the chirp just above / below CUBIC_CHIRP_MIN x wd
+_WD1 = 2 * np.pi * 22.2
+_HARDENS = 1.01 * CUBIC_CHIRP_MIN * _WD1
+
+
+def test_reach_moves_acts_only_where_the_record_is_seen_hardening():
+    """A mode above its reach moves only where mode 1's backbone chirp exceeds CUBIC_CHIRP_MIN
+    of its frequency; below it, or with mode 1's fit not taken (NaN), nothing moves and the
+    reason names mode 1's c / wd against the bound."""
+    f, reach, limit = np.array([22.0, 216.0]), np.array([23.0, 206.2]), np.array([np.nan, 204.2])
+    move, to, why = reach_moves(f, reach, limit, _HARDENS, _WD1)
+    assert move.tolist() == [False, True] and to[1] == 204.2 and why == ""
+    move, _, why = reach_moves(f, reach, limit, 0.99 * CUBIC_CHIRP_MIN * _WD1, _WD1)
+    assert not move.any() and "not seen hardening" in why and "c / wd 0.00693 <= 0.007" in why
+    move, _, why = reach_moves(f, reach, limit, np.nan, _WD1)
+    assert not move.any() and "mode 1's backbone decay fit not taken" in why
+
+
+def test_reach_moves_leaves_a_mode_within_its_reach():
+    """Only a mode above its reach moves: both targets here lie nearest their own modes, so
+    without that condition both would move (mode 2 up from 200 to 204.2 Hz)."""
+    f, reach, limit = np.array([22.0, 200.0]), np.array([23.0, 206.2]), np.array([22.2, 204.2])
+    move, _, why = reach_moves(f, reach, limit, _HARDENS, _WD1)
+    assert not move.any()
+    assert "every mode within its reach (22 <= 23 Hz, 200 <= 206.2 Hz)" in why
+
+
+def test_reach_moves_goes_to_the_limit_where_it_bounds_else_to_the_reach():
+    """The target is the read backbone limit where it lies at or below the reach (it set the
+    reach: limit + one line), else the reach (the peak's bound was lower), never above it."""
+    f = np.array([22.0, 216.0, 900.0])
+    reach, limit = np.array([23.0, 206.2, 880.0]), np.array([np.nan, 204.2, 885.0])
+    move, to, _ = reach_moves(f, reach, limit, _HARDENS, _WD1)
+    assert move.tolist() == [False, True, True]
+    assert to[1] == 204.2 and to[2] == 880.0
+
+
+def test_reach_moves_refuses_a_target_nearer_another_mode():
+    """A mode whose target lies nearer another mode's frequency than its own is left (that
+    limit followed the other mode: round 21's spurious 466 Hz mode 3 moved to mode 2's 424 Hz
+    limit), and the reason says which; a mode beside it still moves."""
+    f = np.array([22.0, 440.0, 466.0])
+    reach, limit = np.array([23.0, 430.0, 445.0]), np.array([np.nan, np.nan, 424.0])
+    move, to, why = reach_moves(f, reach, limit, _HARDENS, _WD1)
+    assert move.tolist() == [False, True, False] and to[1] == 430.0
+    assert "mode 3 above its reach (466 > 445 Hz) left: its target 424 Hz lies nearer mode 2's" in why
+
+
+def _moved_soft_002(dataset_cache, monkeypatch, spoil, cubic):
+    """Soft-base member 002 clean (the reach rule moves its mode 2, 216.3 -> 204.2 Hz) fitted
+    with ``cubic`` and the refit after the move followed by ``spoil(model)``."""
+    refit = LeastSquaresSINDy._refit_cubic
+
+    def spoiled(self, data, rows, masses):
+        refit(self, data, rows, masses)
+        spoil(self)
+
+    monkeypatch.setattr(LeastSquaresSINDy, "_refit_cubic", spoiled)
+    sc = _family_cell("beams_soft__002", 0.0)
+    model = make_identifier(sc)
+    model.cubic = cubic
+    return run_scenario(sc, dataset=dataset_cache.get(sc), model=model)
+
+
+def test_a_move_whose_refitted_model_grows_is_undone(dataset_cache, monkeypatch):
+    """A forced case (the refit's damping negated: a move that makes the model grow, as 13 of
+    20,000 random 2-DOF models with coupled damping do; the review's grow.py).  The moved model
+    is checked: it grows, so the fit is restored as it stood before the move (mode 2 at 216.3
+    Hz, 6.5 % off the truth) and kept with its cubic; the rule says "not moved" and why.  Old
+    code: the growing model went on, the rule's cubic was then refused whole (its simulation
+    leaves the record).  Unspoilt, the move sets eigen_targets_ (mode 2's paired peak) and
+    eigen_shift_ (216.3 -> 204.2 Hz: 5.6 %), which the old code left at 0."""
+    res = _moved_soft_002(dataset_cache, monkeypatch, lambda m: None, None)
+    m = res.model
+    assert "the cubic refitted" in m.eigen_rule_ and "the fit's frequencies" not in m.eigen_rule_
+    assert m.eigen_targets_[0] == 0 and 204.0 < m.eigen_targets_[1] < 206.2  # peak 205.2 Hz
+    assert m.eigen_shift_ == pytest.approx(1 - 204.2 / 216.3, abs=1e-3)
+
+    def grow(model):
+        model.C_ = -model.C_
+
+    res = _moved_soft_002(dataset_cache, monkeypatch, grow, None)
+    m = res.model
+    assert m.cubic_ and "not moved" in m.eigen_rule_ and "grows" in m.eigen_rule_
+    check_physical(m.M_, m.C_, m.K_)  # restored: physical
+    assert m.eigen_shift_ == 0.0 and not np.any(m.eigen_targets_)
+    assert res.scores.values["freq_error_mode2"] > 0.05  # the unmoved 6.50 %
+
+
+def test_a_move_whose_refitted_cubic_softens_or_leaves_the_record_is_undone(dataset_cache,
+                                                                         monkeypatch):
+    """With the user's ``cubic = True`` the refitted cubic is checked too (the old code checked
+    only a cubic the rule chose, and never after the move).  Forced case: the refit's cubic
+    negated and scaled 1000 x, a softening cubic that the record's hardening decays contradict
+    and whose simulation escapes; the move is undone (mode 2 back at 216.3 Hz, 6.5 % off) and
+    the rule says why."""
+    def soften(model):
+        model.K3_ = -1e3 * model.K3_
+
+    res = _moved_soft_002(dataset_cache, monkeypatch, soften, True)
+    m = res.model
+    assert m.cubic_ and "not moved" in m.eigen_rule_ and "refused" in m.eigen_rule_
+    assert res.scores.values["freq_error_mode2"] > 0.05  # the unmoved 6.50 %

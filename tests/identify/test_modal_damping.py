@@ -646,23 +646,28 @@ def test_decay_agreeing_with_the_modes_peak_moves_it_beyond_one_line(chain):
 def test_hardened_reach_is_the_peak_or_the_read_backbone_limit_plus_one_line():
     """The highest linear frequency a hardening record allows: each mode's paired peak + one
     line + the damped peak's offset, or its backbone limit + one line where that fit is taken
-    and read (the squared amplitude falls to BACKBONE_MIN_FALL or less), the smaller."""
+    and read (the squared amplitude falls to BACKBONE_MIN_FALL or less), the smaller.  The
+    limit is the undamped ``|p| / (2 pi)`` of the fit's linear pole (``lam_model = |p|^2 =
+    wd^2 + sigma^2``), not its damped ``wd``: mode 2 (12 % damped) tells them apart by 0.75 %,
+    1.5 Hz, against the 1e-12 the test asks."""
     line, T = 2.0, 0.5
-    f = np.array([22.0, 216.0, 640.0, 900.0])  # model [Hz]
     peak = np.array([22.7, 205.2, 0.0, 0.0])  # paired peaks [Hz]; modes 3-4 none
-    wd = np.array([22.2, 204.2, 630.0, 880.0])  # backbone limits [Hz]
+    wd = np.array([22.2, 204.2, 630.0, 880.0])  # backbone limits, damped [Hz]
     sigma = np.array([2.0, 157.6, 0.3, 50.0])  # [1/s]; mode 3's squared amplitude keeps 0.74
     taken = np.array([True, True, True, False])
     nan = np.full(4, np.nan)
+    lam = (2 * np.pi * wd) ** 2 + sigma**2  # |p|^2 of the pole -sigma + i 2 pi wd
     dec = ModalDecay(sigma=sigma, omega_d=2 * np.pi * wd, sigma_model=sigma,
-                     lam_model=np.where(taken, (2 * np.pi * wd) ** 2, np.nan), shift=nan,
+                     lam_model=np.where(taken, lam, np.nan), shift=nan,
                      r2=nan, taken=taken, chirp=np.array([7.1, 91.5, 1.0, np.nan]), amplitude=nan)
     assert np.exp(-2 * sigma[2] * T) > BACKBONE_MIN_FALL  # mode 3's limit is not read
-    reach, limit = hardened_reach(f, peak, dec, sigma, line, T)
+    reach, limit = hardened_reach(peak, dec, sigma, line, T)
+    undamped = np.sqrt(lam[:2]) / (2 * np.pi)  # 22.2002, 205.73 Hz
+    assert undamped[1] - wd[1] > 1.5  # the damped value would fail the checks below
     by_peak = peak[:2] + line + peak_offset(sigma[:2], (2 * np.pi * peak[:2]) ** 2)
-    assert reach[0] == pytest.approx(min(by_peak[0], wd[0] + line), rel=1e-12)
-    assert reach[1] == pytest.approx(wd[1] + line, rel=1e-12)  # 206.2 < the peak's 210.4
-    assert by_peak[1] > wd[1] + line
-    assert limit[:2] == pytest.approx(wd[:2], rel=1e-12)
+    assert reach[0] == pytest.approx(min(by_peak[0], undamped[0] + line), rel=1e-12)
+    assert reach[1] == pytest.approx(undamped[1] + line, rel=1e-12)  # 207.7 < the peak's 210.4
+    assert by_peak[1] > undamped[1] + line
+    assert limit[:2] == pytest.approx(undamped, rel=1e-12)
     assert np.isinf(reach[2]) and np.isnan(limit[2])  # no peak, its limit not read: no bound
     assert np.isinf(reach[3]) and np.isnan(limit[3])  # no peak, no decay taken
