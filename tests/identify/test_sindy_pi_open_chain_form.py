@@ -7,8 +7,8 @@ only where its segmented rollout error is smaller beyond the rollout selection's
 The cases are cells of the unseen rounds' studies (benchmarks/unseen/), run as the sweep runs
 them: round 11's ``cp11_near_rest`` at 3 % (seed 21), which the strong form failed (the cart
 drifted: 0.054 m) and the weak form passes, and round 5's family cart-pole ``cpchain__000`` at
-3 % (seed 0), a 4.3 s record whose weak fit scores 12.3 rad while the strong one passes: the
-comparison keeps the strong one there."""
+3 % (seed 0), a 4.3 s record whose weak fit scores 12.3 rad while the strong one passes its
+rollout bar: the comparison keeps the strong one there."""
 
 import dataclasses
 from pathlib import Path
@@ -50,14 +50,15 @@ def test_strong_form_kept_where_the_weak_rollout_is_larger(dataset_cache):
     m = r.model
     assert m.formulation_ == "strong"
     assert "strong form kept (the weak not smaller beyond the tie)" in m.formulation_rule_
-    # the rollout as before the comparison (measured 0.0131); since round 14 the cart-pole's law
-    # bar fails the cell: the heavy cart's (3.8 kg under 0.064 kg) identified cart equation is
-    # 0.287 off over the record's state box (models/cartpole/rig.py EQUATION_BARS): its cart
-    # row holds no force term at all.  The figure is a 3 %-noise fit's: compared with a margin
-    # (0.2867 sits 2e-4 from where its printed digits would change), not as printed digits
+    # the rollout as before the comparison (measured 0.0131; 0.0063 since session 23).  From
+    # round 14 to session 22 the cart-pole's law bar failed the cell (law_error 0.287, models/
+    # cartpole/rig.py EQUATION_BARS): the pole's selected row was the identity of nearly equal
+    # columns 0.98 ddth1 - cos(th2)*ddth1 (the pole swings little under the heavy cart), ranked
+    # first per unit of its left-hand side; tested per unit of the part holding ddth2
+    # (identify._implicit.select_passive_models) it is refuted: law_error 0.166, the cell passes
     assert r.scores.values["angle_rmse"] < 0.0501
-    assert 0.25 < r.scores.values["law_error"] < 0.35
-    assert not r.passed and "wrong equation: law_error" in r.scores.failure
+    assert r.scores.values["law_error"] < 0.25
+    assert r.passed, r.scores.failures
     # nothing of the weak trial stays on the strong model (review: its weak-only attributes did)
     assert not hasattr(m, "weak_strong_columns_") and not hasattr(m, "_weak_trial")
 

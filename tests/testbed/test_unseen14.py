@@ -25,16 +25,20 @@ def test_round14_studies_load(name, cells):
     assert len(expand(load_study(UNSEEN / f"{name}.toml"))) == cells
 
 
-def test_round6s_heavy_cart_passes_its_rollout_with_a_wrong_law_and_fails_on_it():
-    """cp_heavy_cart_10 (a 10 kg cart under a 0.05 kg pole) at 1 %: the rollout meets the bar
-    (0.029 < 0.0501) while the identified cart equation has lost the force u1 and pushes the
-    cart with a spring th1 the rig lacks: its accelerations over the record's state box are
-    62 % off.  Before the rig's law bar it passed; now a scored failure naming the law."""
+def test_round6s_heavy_cart_gets_the_law_its_rollout_passed_with():
+    """cp_heavy_cart_10 (a 10 kg cart under a 0.05 kg pole) at 1 %: the rollout met the bar
+    (0.029 < 0.0501) while the identified law was 62 % off over the record's state box (a
+    scored failure naming the law since the rig's law bar; the naming itself:
+    tests/testbed/scoring/test_law.py).  The pole's selected row was the identity of nearly
+    equal columns ``ddth2 - cos(th2)*ddth2`` (the light pole swings little), ranked first per
+    unit of its left-hand side; tested per unit of the part holding ddth2
+    (identify._implicit.select_passive_models, session 23) it is refuted and the pole's own
+    equation taken: law_error 0.015, angle_rmse 0.0026, the cell passes."""
     import testbed
     from testbed import load_scenario
 
     sc = load_scenario(UNSEEN / "round6" / "cp_heavy_cart_10.toml")
     res = testbed.run_scenario(dataclasses.replace(sc, noise={**sc.noise, "rms_percent": 1.0}))
     assert res.scores.values["angle_rmse"] < 0.0501
-    assert res.scores.values["law_error"] > 0.5
-    assert res.verdict == "FAIL" and "wrong equation: law_error" in res.scores.failure
+    assert res.scores.values["law_error"] < 0.25  # the rig's law bar (was 0.62)
+    assert res.passed, res.scores.failures
