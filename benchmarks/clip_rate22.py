@@ -4,7 +4,9 @@ step by step (``testbed.numerics.clipping.LOCAL_STEPS``): this prints, over ever
 dataset cache(s) given (default ``.cache/datasets``) of a kind with rate pairs, the alarms on
 the records as stored and on their 16-bit copies, and by kind the share told of their
 channels clipped at 10 % and 50 % of their range from the extreme the record starts or ends
-nearer and at +-(1 - share) of the peak about the mean (``benchmarks/clip_ends21.py``'s copies)::
+nearer and at +-(1 - share) of the peak about the mean (``benchmarks/clip_ends21.py``'s copies),
+and the alarms on records at rest then moving as ``s**p`` (review 23a: a constant jerk, p = 3,
+makes every moving step misfit alike, and its rest was called clipped)::
 
     python -m benchmarks.clip_rate22 [cache folder ...]
 """
@@ -29,7 +31,31 @@ from testbed.pipeline.importers import RATE_PAIRS  # noqa: E402
 SHARES = (0.1, 0.5)
 
 
+#: The rest-then-power records: sample rates [Hz], the share of the record at rest [-] and
+#: the powers of the motion ``s**p`` after it
+REST_FS, REST_SHARES, REST_POWERS = (100.0, 1000.0, 12800.0), (0.1, 0.3, 0.6), (2, 3, 4, 5)
+
+
+def rest_then_power() -> tuple[list[str], int]:
+    """The alarms (as "fs share p float|16 bit") on noise-free records of 4 s at rest, then
+    ``a = s**p``, ``d = p s**(p-1)``, as floats and quantised to 16 bits, and their count."""
+    alarms, n = [], 0
+    for fs in REST_FS:
+        t = np.arange(int(4 * fs)) / fs
+        for share in REST_SHARES:
+            s = np.maximum(t - share * t[-1], 0.0)
+            for p in REST_POWERS:
+                a, d = s ** p, p * s ** (p - 1)
+                for how, aa, dd in (("float", a, d), ("16 bit", quantised(a, 16), quantised(d, 16))):
+                    n += 1
+                    if rate_contradicted_levels(aa, dd, fs):
+                        alarms.append(f"{fs:g} Hz {share:g} p={p} {how}")
+    return alarms, n
+
+
 def main(folders: list[str]) -> int:
+    rest_alarms, n_rest = rest_then_power()
+    print(f"alarms on {n_rest} records at rest then s**p: {len(rest_alarms)} {rest_alarms[:6]}")
     alarms: dict[str, list[str]] = {"float": [], "16 bit": []}
     told: dict[tuple[str, str], list[bool]] = {}
     n_records = n_channels = 0

@@ -257,6 +257,39 @@ def _writable_in(path: Path, option: str, start: Path) -> None:
                          "can write") from None
 
 
+#: The most symbolic links an output path is followed through (the kernel's MAXSYMLINKS).
+MAX_LINKS = 40
+
+
+def _link_target(path: Path, option: str) -> Path:
+    """The path ``path`` names through its own symbolic links (``path`` if it is none).
+
+    A link is followed only where it is owned by the current user or by the owner of the
+    folder it lies in (the rule of the kernel's ``fs.protected_symlinks``, which a link read
+    by the program itself bypasses): as root, ``generate -o`` a link another user planted in a
+    shared folder had overwritten the root-only file it named (review 23a).  The folders on
+    the way are the kernel's to follow (and to refuse).
+
+    Raises
+    ------
+    InputError
+        For a link of another user in another user's folder, or more than :data:`MAX_LINKS`.
+    """
+    me = os.geteuid() if hasattr(os, "geteuid") else None  # (Windows: no owners to compare)
+    for _ in range(MAX_LINKS):
+        if not path.is_symlink():
+            return path
+        owner, folder_owner = os.lstat(path).st_uid, os.stat(path.parent).st_uid
+        if me is not None and owner not in (me, folder_owner):
+            raise InputError(f"{option} {path}: a symbolic link of user {owner} in a folder of "
+                             f"user {folder_owner}, which another user may have planted; "
+                             f"expected a file path, or a link of yours (user {me}) or of the "
+                             "folder's owner")
+        path = path.parent / os.readlink(path)  # (a link's relative target: from its folder)
+    raise InputError(f"{option} {path}: more than {MAX_LINKS} symbolic links on the way; "
+                     "expected a file path")
+
+
 def _output_file(path: str | os.PathLike, option: str, *, inputs: tuple[Path, ...] = ()) -> Path:
     """A file a command will write, checked before any work: not a folder, not a device or
     FIFO (written atomically, the file would replace it: as root, ``--results /dev/full``
@@ -266,12 +299,23 @@ def _output_file(path: str | os.PathLike, option: str, *, inputs: tuple[Path, ..
     Round 22: not a text ending in a path separator (``-o out/`` wrote a file named ``out``),
     not a symbolic link to nothing (it was replaced by the file, the link lost), not a file
     without a write permission bit (as root, ``chmod a-w`` was no guard: the file was
-    replaced and its mode with it).  A link to a regular file is written through
-    (:func:`~testbed.core.atomic.atomic_write`)."""
+    replaced and its mode with it).  Review 23a: nor a text ending in ``.`` or ``..``
+    (``-o newdir/.`` wrote a file named ``newdir``).
+
+    Returns
+    -------
+    Path
+        The file to write: ``path``, or for a symbolic link the file it names
+        (:func:`_link_target`; :func:`~testbed.core.atomic.atomic_write` replaces a link
+        itself), whose folder is the one checked.
+    """
     text = os.fspath(path)
     if isinstance(text, str) and text.endswith(("/", os.sep)):
         raise InputError(f"{option} {text}: ends in a path separator, which names a folder; "
                          "expected a file path")
+    if isinstance(text, str) and os.path.basename(text) in (".", ".."):
+        raise InputError(f"{option} {text}: ends in '{os.path.basename(text)}', which names a "
+                         "folder; expected a file path")
     path = Path(path)
     st = _stat(path, option)
     if st is None and path.is_symlink():
@@ -290,8 +334,11 @@ def _output_file(path: str | os.PathLike, option: str, *, inputs: tuple[Path, ..
         if path.resolve() == given.resolve():
             raise InputError(f"{option} {path}: is the input file; expected another path (the "
                              "input would be overwritten)")
-    _writable_in(path, option, path.parent)
-    return path
+    target = _link_target(path, option)
+    # the folder written: a link's target's (a link to a file in a 0555 folder had passed, the
+    # write then failing on its temporary file; the reverse refused: review 23a)
+    _writable_in(path, option, target.parent)
+    return target
 
 
 def _given_files(*groups: Any) -> tuple[Path, ...]:
@@ -711,8 +758,9 @@ def cmd_sweep(args: argparse.Namespace) -> int:
     from testbed.studies.sweep import SweepStats, run_sweep
 
     extra = _load_plugins(args)
+    results = None
     if args.results:  # before the study's load, which simulates nothing but takes seconds
-        _output_file(args.results, "--results")
+        results = _output_file(args.results, "--results")  # (a link: the file it names)
     study = load_study(args.study, progress=_stderr_line)
     if extra:  # the workers import them too
         study = dataclasses.replace(study, plugins=tuple(dict.fromkeys(study.plugins + extra)))
@@ -724,7 +772,7 @@ def cmd_sweep(args: argparse.Namespace) -> int:
         check_dask_address(args.dask)
     try:
         results = run_sweep(study, jobs=args.jobs or 1, dask_address=args.dask,
-                            results=Path(args.results) if args.results else None,
+                            results=results,
                             cache_dir=_cache_folder(args.cache), retry_failed=args.retry_failed,
                             stats=stats)
     except (OSError, TimeoutError) as e:
@@ -817,13 +865,20 @@ def cmd_identify(args: argparse.Namespace) -> int:
         with recording_reads() as read:
             load_scenario(args.scenario)
     given = (data, *_given_files(read, plugins))
-    out = _output_file(args.output or f"{data.stem}.model.json", "--output", inputs=given)
-    if out.suffix.lower() == ".md":  # the report replaced the model it reports (round 17; .MD:
-        # the same file where names ignore case, as on macOS and Windows)
-        raise InputError(f"--output {terminal_safe(str(out))}: its report goes to the same path "
+    named = Path(args.output or f"{data.stem}.model.json")
+    out = _output_file(named, "--output", inputs=given)  # (a link: the file it names)
+    # the report beside the path named (a link's too); the same file as the model (round 17:
+    # `-o m.md`; .MD: the same file where names ignore case, as on macOS and Windows; review
+    # 23a: a link to its own report's path) replaced the model it reports
+    if named.suffix.lower() == ".md":
+        raise InputError(f"--output {terminal_safe(str(named))}: its report goes to the same path "
                          "with the suffix .md, so the report would replace the model; expected a "
                          "path not ending in .md (e.g. the default, <data>.model.json)")
-    _output_file(out.with_suffix(".md"), "--output (its .md report)", inputs=given)
+    md = _output_file(named.with_suffix(".md"), "--output (its .md report)", inputs=given)
+    if md.resolve() == out.resolve():
+        raise InputError(f"--output {terminal_safe(str(named))}: names the file of its own report "
+                         f"{terminal_safe(str(named.with_suffix('.md')))}, which would replace the "
+                         "model; expected another path")
     with run_progress(data.name) as phase:
         result = identify_file(data, scenario=args.scenario, kind=args.kind, method=args.method,
                                params=_key_values(args.param, "--param", numbers=False),
@@ -838,9 +893,9 @@ def cmd_identify(args: argparse.Namespace) -> int:
     text = json.dumps(summary, indent=1, allow_nan=True) + "\n"
     report = render_identified(summary)
     atomic_write_text(out, text)
-    atomic_write_text(out.with_suffix(".md"), report)
+    atomic_write_text(md, report)
     print(report, end="")
-    print(f"model written to {terminal_safe(str(out))} (report {terminal_safe(str(out.with_suffix('.md')))})")
+    print(f"model written to {terminal_safe(str(out))} (report {terminal_safe(str(md))})")
     if failures:
         what = ("unusable model" if set(failures) <= {"coefficients", "prediction"}
                 else "physically impossible model")

@@ -105,13 +105,30 @@ def not_regular(path: Path) -> None:
                          "which the written file would replace); expected a file path")
 
 
-def _replaced_mode(path: Path) -> int:
-    """The permission bits a written file gets: those of the file it replaces (a private
-    file, mode 0600, had come back world-readable: round 22), else ``0666`` less the umask."""
+def _replaced(path: Path) -> os.stat_result | None:
+    """The status of the regular file ``path`` names itself (not through a link), else None."""
     try:
-        return stat.S_IMODE(os.stat(path).st_mode)
-    except OSError:
-        return 0o666 & ~_UMASK
+        st = os.lstat(path)
+    except (OSError, ValueError):
+        return None
+    return st if stat.S_ISREG(st.st_mode) else None
+
+
+def _replaced_mode(st: os.stat_result | None) -> int:
+    """The permission bits a written file gets: the read / write / execute bits of the file it
+    replaces (``st``; a private file, mode 0600, had come back world-readable: round 22), else
+    ``0666`` less the umask.  Never its setuid, setgid or sticky bit (review 23a: a setuid
+    file's bit was carried onto the new content, its owner not)."""
+    return 0o666 & ~_UMASK if st is None else stat.S_IMODE(st.st_mode) & 0o777
+
+
+def _keep_owner(tmp: str, st: os.stat_result | None) -> None:
+    """Give ``tmp`` the owner and group of the file it replaces (``st``), where allowed: root
+    may, a user may set a group of theirs; else the writer's own stay (in silence)."""
+    if st is None or not hasattr(os, "chown"):
+        return
+    with contextlib.suppress(PermissionError):
+        os.chown(tmp, st.st_uid, st.st_gid)
 
 
 def atomic_write(path: str | os.PathLike, write: Callable[[str], None]) -> Path:
@@ -120,33 +137,33 @@ def atomic_write(path: str | os.PathLike, write: Callable[[str], None]) -> Path:
     Parameters
     ----------
     path : path-like
-        The file to create or replace; its folder is created if missing.  A symbolic link to
-        a file is written through: the file it names is replaced, the link kept.
+        The file to create or replace; its folder is created if missing.  A symbolic link
+        there is replaced itself (the file it names is left as it was): a caller that means to
+        write through a link resolves it first (``testbed.cli._output_file``, for ``-o``).
+        A replaced file's owner, group and permission bits (less setuid, setgid and sticky)
+        are kept where the writer may set them.
     write : callable
         Writes the whole content to the path it is given (a str).
 
     Returns
     -------
     Path
-        ``path`` as given.
+        ``path``.
 
     Raises
     ------
     InputError
-        If ``path`` exists and is not a regular file (a device, FIFO or socket): the rename
+        If ``path`` exists and is not a regular file (a device, FIFO or socket, or a folder;
+        through a link too): the rename
         would replace the node itself.  As root, the drawing process's warm-up figure, saved
         to ``os.devnull`` through this function, replaced ``/dev/null`` with a regular file
-        for every process of the machine (round 13).  Or if it is a symbolic link to nothing.
+        for every process of the machine (round 13).
     """
-    path = given = Path(path)
-    if path.is_symlink():
-        # written through the link: the rename had replaced the link itself with the file, the
-        # file it named left as it was (round 22); a link to nothing is no place to write
-        target = Path(os.path.realpath(path))
-        if not target.exists():
-            raise InputError(f"{path}: a symbolic link to {os.readlink(path)}, which does not "
-                             "exist; expected a file path (or a link to an existing file)")
-        path = target
+    path = Path(path)
+    # a link is replaced itself (what it names is left as it was): a link planted in a shared
+    # cache folder had made root overwrite the file it named (review 23a); `-o` writes through
+    # a link the CLI vets (testbed.cli._output_file).  A link to a device or a folder is still
+    # refused, as before round 22 (a link to /dev/zero at the index's path is left as it was)
     not_regular(path)
     if path.is_dir():  # the rename's IsADirectoryError named the temporary file (round 17)
         raise InputError(f"{path}: is a folder; expected a file path")
@@ -158,7 +175,9 @@ def atomic_write(path: str | os.PathLike, write: Callable[[str], None]) -> Path:
             write(tmp)
             with open(tmp, "rb") as fh:
                 os.fsync(fh.fileno())
-            os.chmod(tmp, _replaced_mode(path))
+            replaced = _replaced(path)
+            _keep_owner(tmp, replaced)  # before the mode: chown clears setuid / setgid bits
+            os.chmod(tmp, _replaced_mode(replaced))
             os.replace(tmp, path)
     except BaseException as e:
         Path(tmp).unlink(missing_ok=True)
@@ -166,7 +185,7 @@ def atomic_write(path: str | os.PathLike, write: Callable[[str], None]) -> Path:
         if full is not None:
             raise full from None
         raise
-    return given
+    return path
 
 
 #: The codec error handler of :func:`_file_name_bytes`: text naming files, encoded.

@@ -81,10 +81,11 @@ RATIO = 4.0
 #: alarm (``benchmarks/clip_ends21.py``, docs/known-gaps.md)
 RATE_HOLD_TOL = 0.05
 #: ... or, taken step by step, more than this many times the run's steps times the largest
-#: misfit of one step (the signal's step less the rate's trapezoid, less their mean) on the
-#: steps no held run touches [-]: the trapezoid rule errs by h^3 |third derivative| / 12 a
-#: step, and a rate held at its extreme holds where that derivative peaks; a sine's outside the
-#: run is cos(phase) of its peak, so 4 covers runs to +-75 degrees of phase
+#: misfit of one step (the signal's step less the rate's trapezoid, less their mean or not,
+#: whichever is larger) on the steps no held run touches [-]: the trapezoid rule errs by
+#: h^3 |third derivative| / 12 a step, and a rate held at its extreme holds where that
+#: derivative peaks; a sine's outside the run is cos(phase) of its peak, so 4 covers runs to
+#: +-75 degrees of phase
 LOCAL_STEPS = 4.0
 #: Standard deviations of the channels' white noise (:func:`testbed.numerics.noise.noise_std`,
 #: of differences of this order) the held run's change and the rate's integral may differ by
@@ -269,14 +270,18 @@ def rate_contradicted_levels(a: np.ndarray, d: np.ndarray, fs: float
     # round 21's open item (b): the pair's misfit step by step (the signal's step less the
     # rate's trapezoid) on the steps no held run touches, its mean (the rate's offset, free of
     # what a clip took away) out; a run of k steps that was not clipped misfits by at most
-    # LOCAL_STEPS x k x the largest of these beside that offset
+    # LOCAL_STEPS x k x the largest of these beside that offset, or beside nothing: the mean
+    # may be the trapezoid rule's own error in motion, which a run at rest does not make
+    # (review 23a: a record at rest, then a = s^3 (constant jerk: every free step misfits
+    # alike, their spread ~0), was called clipped on both channels by |offset| k)
     steps = np.diff(a) - (d[1:] + d[:-1]) * 0.5 / fs
     free = np.ones(n - 1, dtype=bool)
     for _, _, starts, lengths in held_runs:
         for s0, m in zip(starts, lengths, strict=True):
             free[max(s0 - 1, 0):min(s0 + m, n - 1)] = False
     offset = float(np.mean(steps[free])) if np.any(free) else 0.0
-    step_misfit = float(np.max(np.abs(steps[free] - offset))) if np.any(free) else np.inf
+    step_misfit = float(np.max(np.maximum(np.abs(steps[free] - offset), np.abs(steps[free])))) \
+        if np.any(free) else np.inf
     out = []
     for which, level, starts, lengths in held_runs:
         held = runs = 0

@@ -1,10 +1,19 @@
 """testbed.core.atomic: all or nothing, and ordinary permissions."""
 
 import os
+import stat
 
 import pytest
 
 from testbed.core.atomic import atomic_write, atomic_write_text
+from testbed.core.dataset import Dataset
+from tests.testbed._saved_record import saved_record
+
+
+def _umask() -> int:
+    umask = os.umask(0)
+    os.umask(umask)
+    return umask
 
 
 def test_writes_and_replaces(tmp_path):
@@ -29,3 +38,64 @@ def test_failed_write_leaves_the_old_file_and_no_temporary(tmp_path):
         atomic_write(p, boom)
     assert p.read_text() == "old"
     assert [x.name for x in tmp_path.iterdir()] == ["a.txt"]
+
+
+# ------------------------------------------------------------------ review 23a
+
+def test_a_link_is_replaced_itself_and_what_it_names_kept(tmp_path):
+    """Round 22 wrote through any link (``realpath``), for every caller: a link planted in a
+    shared cache folder under an entry's name made root overwrite the file it named."""
+    victim = tmp_path / "victim.conf"
+    victim.write_text("keep")
+    victim.chmod(0o600)
+    link = tmp_path / "entry.h5"
+    link.symlink_to(victim)
+    assert atomic_write_text(link, "new") == link
+    assert not link.is_symlink() and link.read_text() == "new"
+    assert victim.read_text() == "keep"
+    # the new file's mode is the default, not the named file's
+    assert stat.S_IMODE(link.stat().st_mode) == 0o666 & ~_umask()
+    dangling = tmp_path / "dangling.h5"
+    dangling.symlink_to(tmp_path / "gone" / "x.h5")
+    atomic_write_text(dangling, "new")
+    assert dangling.read_text() == "new" and not (tmp_path / "gone").exists()
+
+
+def test_a_planted_cache_entry_link_is_replaced_not_followed(tmp_path):
+    """The reviewer's path: `Dataset.save` of a cache entry whose name is a link (to a
+    root-only file): the entry is written, the file it named kept."""
+    victim = tmp_path / "rootonly.conf"
+    victim.write_text("keep")
+    entry = tmp_path / "cache" / "michaelis_menten-0.h5"
+    entry.parent.mkdir()
+    entry.symlink_to(victim)
+    ds = Dataset.load(saved_record(tmp_path))
+    ds.save(entry)
+    assert victim.read_text() == "keep" and not entry.is_symlink()
+    assert Dataset.load(entry).content_hash() == ds.content_hash()
+
+
+def test_a_replaced_file_loses_setuid_setgid_and_sticky(tmp_path):
+    """Its permission bits were copied whole (``S_IMODE``): a setuid file kept its bit while
+    the new content got the writer as owner."""
+    p = tmp_path / "tool"
+    p.write_text("old")
+    p.chmod(0o6755 | stat.S_ISVTX)
+    if not stat.S_IMODE(p.stat().st_mode) & stat.S_ISUID:
+        pytest.skip("this file system keeps no setuid bit")
+    atomic_write_text(p, "new")
+    assert stat.S_IMODE(p.stat().st_mode) == 0o755 and p.read_text() == "new"
+
+
+@pytest.mark.skipif(not hasattr(os, "geteuid") or os.geteuid() != 0,
+                    reason="only root can give a file to another user")
+def test_a_replaced_file_keeps_its_owner_and_group(tmp_path):
+    """As root, a user's file came back root's (its bits kept: a 0600 file of theirs was
+    then unreadable to them)."""
+    p = tmp_path / "theirs.json"
+    p.write_text("old")
+    p.chmod(0o600)
+    os.chown(p, 65534, 65534)
+    atomic_write_text(p, "new")
+    st = p.stat()
+    assert (st.st_uid, st.st_gid, stat.S_IMODE(st.st_mode)) == (65534, 65534, 0o600)

@@ -188,3 +188,22 @@ def test_a_rate_with_a_bias_or_noise_does_not_make_a_held_rest_clipped():
     a = -np.cos(w * t)
     d = w * np.sin(w * t)
     assert [r[0] for r in rate_contradicted_levels(np.maximum(a, -0.5), d, fs)] == ["signal"]
+
+
+@pytest.mark.parametrize("fs", [100.0, 1000.0])
+@pytest.mark.parametrize("rest", [0.1, 0.3])
+def test_a_rest_then_constant_jerk_is_no_clip_and_its_clipped_rate_is_told(fs, rest):
+    """Review 23a: at rest, then ``a = s**3`` (noise-free floats): the trapezoid rule errs by
+    the same h^3/2 on every step in motion, so the free steps' spread about their mean is ~0,
+    while the run at rest, which makes no such error, differs from that mean by |mean| k: both
+    channels were called clipped.  The allowance now covers a run misfitting like the free
+    steps either beside their mean or beside nothing; the rate clipped at 5 % of its range
+    from its start is still told."""
+    t = np.arange(int(4 * fs)) / fs
+    s = np.maximum(t - rest * t[-1], 0.0)
+    a, d = s ** 3, 3.0 * s ** 2
+    assert rate_contradicted_levels(a, d, fs) == []
+    assert rate_contradicted_levels(_quantised(a, 16), _quantised(d, 16), fs) == []
+    rail = d.min() + 0.05 * (d.max() - d.min())
+    assert ("rate", rail) in [(w, lv) for w, lv, *_ in
+                              rate_contradicted_levels(a, np.maximum(d, rail), fs)]
