@@ -266,6 +266,14 @@ SLENDER_MAX_DEPTH = 0.113
 SLENDER_MAX_WIDTH = 1.0
 
 
+def _round_sig(x: float, direction: Callable[[float], float], digits: int = 4) -> float:
+    """``x`` to ``digits`` significant figures, rounded by ``direction`` (``math.floor`` for a
+    largest allowed value, ``math.ceil`` for a smallest), so the value a refusal suggests is
+    itself accepted (review 23d: "thickness at most 0.03588 m" refused 0.03588)."""
+    scale = 10.0 ** (digits - 1 - math.floor(math.log10(abs(x))))
+    return direction(x * scale) / scale
+
+
 def _check_slender(rig: dict[str, Any], error: ErrorFn) -> None:
     """Refuse a beam the Euler-Bernoulli hinge chain does not stand for: deeper than
     :data:`SLENDER_MAX_DEPTH` or wider than :data:`SLENDER_MAX_WIDTH` times its length.
@@ -286,20 +294,22 @@ def _check_slender(rig: dict[str, Any], error: ErrorFn) -> None:
         key = furthest_from_default(rig, ("thickness", "length"), RIG_SCHEMA)
         error(f"rig.{key}", rig[key],
               f"a slender beam: thickness / length at most {SLENDER_MAX_DEPTH:g}, here "
-              f"{depth:.4g} ({rig['thickness']:g} / {length:g} m): beyond it shear deformation and "
-              "rotary inertia, which the Euler-Bernoulli hinge chain neglects, lower mode 1 by "
-              f"more than {SLENDER_FREQ_BAR * 100:g} % (Timoshenko; models/cantilever/rig.py "
-              f"SLENDER_MAX_DEPTH); allowed: thickness at most {SLENDER_MAX_DEPTH * length:.4g} m "
-              f"on this length, or length at least {rig['thickness'] / SLENDER_MAX_DEPTH:.4g} m")
+              f"{depth:.6g} ({rig['thickness']:g} / {length:g} m): beyond it shear deformation and "
+              "rotary inertia, which the Euler-Bernoulli hinge chain neglects, lower a clamped "
+              f"beam's mode 1 by more than {SLENDER_FREQ_BAR * 100:g} % (Timoshenko; the bound "
+              "of every base, models/cantilever/rig.py SLENDER_MAX_DEPTH); allowed: thickness at "
+              f"most {_round_sig(SLENDER_MAX_DEPTH * length, math.floor):g} m on this length, or "
+              f"length at least {_round_sig(rig['thickness'] / SLENDER_MAX_DEPTH, math.ceil):g} m")
     elif width > SLENDER_MAX_WIDTH:
         key = furthest_from_default(rig, ("width", "length"), RIG_SCHEMA)
         error(f"rig.{key}", rig[key],
               f"a beam, not a plate: width / length at most {SLENDER_MAX_WIDTH:g}, here "
-              f"{width:.4g} ({rig['width']:g} / {length:g} m): wider, the plate's first mode "
+              f"{width:.6g} ({rig['width']:g} / {length:g} m): wider, the plate's first mode "
               "bending across the width (struck and read on the centre line) lies below mode 2, "
               "and the chain of rigid sections cannot hold it (models/cantilever/rig.py "
-              f"SLENDER_MAX_WIDTH); allowed: width at most {SLENDER_MAX_WIDTH * length:.4g} m on "
-              f"this length, or length at least {rig['width'] / SLENDER_MAX_WIDTH:.4g} m")
+              f"SLENDER_MAX_WIDTH); allowed: width at most "
+              f"{_round_sig(SLENDER_MAX_WIDTH * length, math.floor):g} m on this length, or length "
+              f"at least {_round_sig(rig['width'] / SLENDER_MAX_WIDTH, math.ceil):g} m")
 
 
 #: Least stiffness-proportional damping coefficient ``beta`` [s] a beam may have: float64's
@@ -832,13 +842,17 @@ class CantileverRig(Rig):
         if sc.simulation["timestep"] > 0:  # a requested step: refuse it if the linear model blows up
             why = unstable_modes(b.M, b.C, b.K, st.integrator, st.timestep)
             if why:
-                other = ""
+                other, name_it = "", False
                 if sc.simulation["integrator"] == "auto":  # auto kept RK4: implicitfast did not fit
                     other = (f"; auto cannot take implicitfast instead: "
                              f"{implicit_unfit(b.M, b.C, b.K, fs, st.timestep)}")
+                    # naming implicitfast helps only where it is stable at that step (review 23d:
+                    # the advice was also given where implicitfast is unstable there)
+                    name_it = unstable_modes(b.M, b.C, b.K, "implicitfast", st.timestep) is None
                 raise RigError(f"cantilever: unstable {where}: {why}{other}; set simulation.timestep "
                                "= 0 (automatic) or a smaller one"
-                               + (", or name simulation.integrator" if other else ""),
+                               + (", or name simulation.integrator = \"implicitfast\" (stable "
+                                  "there, less accurate than auto's bound)" if name_it else ""),
                                key="simulation.timestep", value=sc.simulation["timestep"])
         LOG.info("cantilever %s: %s", sc.name, st.rule)
         peak: list[tuple[float, float, int]] = []

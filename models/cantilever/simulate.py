@@ -46,6 +46,11 @@ step is never swapped for accuracy's sake: RK4's accuracy bound
 (``omega_Ny dt <= 0.49``) is 4.5 x looser than implicitfast's, so a step too coarse
 for RK4's accuracy is too coarse for implicitfast's as well.  To take a step
 implicitfast integrates but ``auto`` would not choose, name the integrator.
+So asking ``auto`` for the step it would choose itself reproduces its data only where
+that step is one RK4 cannot take: where RK4 is stable there but ``auto``'s own cost
+rule took implicitfast (40 segments at 1e-4 damping: implicitfast at 61 substeps),
+the requested step is integrated with RK4 (the promise above: a step the old code
+accepted keeps its data).
 
 Impact
 ------

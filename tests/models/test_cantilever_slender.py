@@ -7,6 +7,7 @@ every family member of the repository's studies is still accepted, drawn as befo
 from __future__ import annotations
 
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -126,8 +127,8 @@ def beam(**rig):
 
 @pytest.mark.parametrize(("rig", "key", "words"), [
     # benchmarks/hostile22.py physcombo (round 22's two findings): both were simulated and scored
-    ({"thickness": 0.5}, "rig.thickness", "thickness / length at most 0.113, here 1.575"),
-    ({"width": 1.0}, "rig.width", "width / length at most 1, here 3.15"),
+    ({"thickness": 0.5}, "rig.thickness", "thickness / length at most 0.113, here 1.5748"),
+    ({"width": 1.0}, "rig.width", "width / length at most 1, here 3.14961"),
     # just beyond the bound; a short beam of the default section names its length
     ({"thickness": 0.114 * 0.3175}, "rig.thickness", "a slender beam"),
     ({"length": 0.08}, "rig.length", "or length at least 0.0885 m"),
@@ -175,3 +176,17 @@ def test_no_family_draw_is_refused_for_its_slenderness(path):
             refusals: list[str] = []
             draw_member(fam, k, refusals)
             assert not [r for r in refusals if "slender" in r or "not a plate" in r], (fam.name, k)
+
+
+@pytest.mark.parametrize(("rig", "what"), [({"thickness": 0.036}, "thickness"),
+                                           ({"thickness": 0.0125, "length": 0.1}, "thickness"),
+                                           ({"width": 0.33}, "width")])
+def test_the_values_a_refusal_suggests_are_accepted(rig, what):
+    # review 23d: "thickness at most 0.03588 m" (rounded up to four figures) was itself refused
+    with pytest.raises(ScenarioError) as e:
+        scenario_from_dict(beam(**rig))
+    msg = str(e.value)
+    most = float(re.search(rf"{what} at most ([0-9.e+-]+) m", msg)[1])
+    least = float(re.search(r"length at least ([0-9.e+-]+) m", msg)[1])
+    scenario_from_dict(beam(**{**rig, what: most}))
+    scenario_from_dict(beam(**{**rig, "length": least}))
