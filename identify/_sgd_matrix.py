@@ -110,7 +110,7 @@ from typing import Any, Literal
 
 import numpy as np
 
-from identify._modal_damping import modal_decay
+from identify._modal_damping import backbone_shift, modal_decay
 from identify._unresolved import place_unresolved
 from identify.structural import (
     FIT_BAND_ORDER,
@@ -381,8 +381,8 @@ def cross_stiffening(data: Measurement, M: np.ndarray, K: np.ndarray, K3: np.nda
 
 
 def backbone_targets(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndarray,
-                     window: tuple[int, int], lam_hat: np.ndarray, K3: np.ndarray | None = None
-                     ) -> tuple[np.ndarray, np.ndarray, str]:
+                     window: tuple[int, int], lam_hat: np.ndarray, K3: np.ndarray | None = None,
+                     cross_out: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, str]:
     """The eigenvalue penalty's targets with each hardening mode's peak replaced by its
     backbone's linear frequency (``sgd_sindy``'s ``eigen_backbone``, cubic library).
 
@@ -398,7 +398,10 @@ def backbone_targets(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndar
     decay rates below its own: their stiffening is near-constant over its life, no part of its
     chirp), is then lowered by the stiffening the other located modes' motion adds over that
     mode's life (:func:`cross_stiffening`), which the model's own cubic adds back when
-    simulated (where the target stays positive).
+    simulated (where the target stays positive); not where the warm start's cubic
+    contradicts another located mode's measured decay (its own first-order shift of that
+    mode, :func:`identify._modal_damping.backbone_shift`, of the opposite sign to the
+    measured chirp): that cubic's cross term is no measurement (families' soft member 019).
 
     Parameters
     ----------
@@ -411,6 +414,13 @@ def backbone_targets(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndar
         Measured eigenvalues ``(2 pi f)^2`` [rad^2/s^2] of the spectral peaks.
     K3 : ndarray, shape (n, n), optional
         The warm start's cubic stiffness [N/m^3] (None: no cross stiffening subtracted).
+    cross_out : ndarray, shape (k,), optional
+        Filled in place, for the decay hold (``MatrixSGDResult.eigen_cross``), with the cross
+        stiffening [rad^2/s^2] subtracted from each entry of ``lam`` whose mode the other
+        located modes outlive (0 elsewhere): only such a mode's measured decay rings stiffened
+        by their motion over its whole life; a mode that outlives them is read by its decay
+        where they have died (soft member 005: mode 1, the slowest, lowered 0.36 Hz there
+        went 0.18 -> 0.70 % off).
 
     Returns
     -------
@@ -460,21 +470,45 @@ def backbone_targets(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndar
         outlived = {k for k, j in slot.items()
                     if len(slot) > 1 and lam[j] <= peaks[j] and np.isfinite(sigma[k])
                     and all(np.isfinite(sigma[m]) and sigma[m] < sigma[k] for m in slot if m != k)}
+        # The cross stiffening is the warm start's cubic's prediction; the record tests that
+        # cubic on the other modes' own decays: where a located mode's backbone decay fit is
+        # taken and the cubic's own first-order shift of it (backbone_shift) has the opposite
+        # sign of its measured chirp, the cubic does not act on the record as fitted and its
+        # cross stiffening is not subtracted from any other mode (families' soft member 019,
+        # clean: mode 1's decay hardens, chirp +5.1 rad/s, the cubic's shift of it -0.088
+        # rad/s, yet its cross term lowered mode 2's target 9.58 Hz: 3.75 % low)
+        own = backbone_shift(M, K, K3, dec)
+        chirp = np.asarray(dec.chirp, dtype=float)
+        contradicted = {int(m) for m in slot if dec.taken[m] and np.isfinite(own[m])
+                        and np.isfinite(chirp[m]) and chirp[m] != 0.0
+                        and not own[m] * chirp[m] > 0.0}
         lowered = [k for k, j in slot.items()
-                   if (k in still or k in outlived) and 0.0 < shift[k] < lam[j]]
+                   if (k in still or k in outlived) and 0.0 < shift[k] < lam[j]
+                   and not (contradicted - {k})]
         hz = []
         for k in lowered:
             j = slot[k]
             hz.append((np.sqrt(lam[j]) - np.sqrt(lam[j] - shift[k])) / (2.0 * np.pi))
             lam[j] -= shift[k]
             moved[j] = True
+            if cross_out is not None and k in outlived:
+                cross_out[j] = shift[k]
         if lowered:
             cross = (f"; less the cubic's stiffening by the other modes' motion over each mode's "
                      f"life: modes {[k + 1 for k in lowered]} by "
                      + ", ".join(f"{h:.3g}" for h in hz) + " Hz")
             modes = sorted(set(modes) | {k + 1 for k in lowered})
+        gated = [k + 1 for k, j in slot.items()
+                 if (k in still or k in outlived) and 0.0 < shift[k] < lam[j]
+                 and contradicted - {k}]
+        if gated:
+            cross += (f"; no cross stiffening subtracted from modes {gated}: the cubic's own "
+                      "shift of modes " + str(sorted(m + 1 for m in contradicted))
+                      + " (" + ", ".join(f"{own[m]:.3g}" for m in sorted(contradicted))
+                      + " rad/s) has the opposite sign of their measured chirp ("
+                      + ", ".join(f"{chirp[m]:.3g}" for m in sorted(contradicted)) + " rad/s)")
     if not modes:
-        return lam, moved, "no paired mode's backbone decay fit hardens: the peaks"
+        return lam, moved, "no paired mode's backbone decay fit hardens: the peaks" + cross
     f0 = np.sqrt(peaks[moved]) / (2.0 * np.pi)
     f1 = np.sqrt(lam[moved]) / (2.0 * np.pi)
     return lam, moved, (f"modes {modes}: peak -> backbone linear frequency "
@@ -887,6 +921,10 @@ class MatrixSGDResult:
         Frequency [Hz] each mode (ascending) was held at (:func:`eigen_targets`); 0 = none.
     eigen_shift : float
         Largest relative frequency change a hold made (0 without holding).
+    eigen_cross : ndarray, shape (n,) or (0,)
+        The cross stiffening [rad^2/s^2] :func:`backbone_targets` subtracted from each mode's
+        target (ascending modes; 0 = none): the decay hold subtracts it from that mode's
+        measured decay frequency too (:meth:`identify.sgd_sindy.SGDSINDy._hold_decay`).
     fit_tilt : bool
         Whether the fit was tilted; ``fit_tilt_rule`` (str) says why.
     input_map_record : ndarray, shape (n, n_inputs) or None
@@ -927,6 +965,7 @@ class MatrixSGDResult:
     drift_coef: np.ndarray
     eigen_targets: np.ndarray
     eigen_shift: float
+    eigen_cross: np.ndarray = dataclasses.field(default_factory=lambda: np.zeros(0))
     fit_tilt: bool = False
     fit_tilt_rule: str = ""
     input_map_record: np.ndarray | None = None
@@ -1296,6 +1335,7 @@ def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
     # the target of each mode (ascending; 0 = none), paired on the current modes (eigen_targets)
     lam_meas = lam_peaks = np.asarray(lam_hat, dtype=float)
     moved = np.zeros(lam_meas.size, bool)
+    cross_meas = np.zeros(lam_meas.size)  # the cross stiffening taken off each target
     ceiling = (np.zeros(lam_meas.size, bool) if ceiling is None
                else np.asarray(ceiling, dtype=bool).reshape(lam_meas.shape))
     backbone_rule = "eigen_backbone = False" if not est.eigen_backbone else (
@@ -1305,7 +1345,7 @@ def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
             backbone_rule = "the warm start kept no cubic term: the peaks"
         else:
             lam_meas, moved, backbone_rule = backbone_targets(data, M0, C0, K0, (i0, i1),
-                                                              lam_meas, K30)
+                                                              lam_meas, K30, cross_meas)
             lam_peaks = np.sort(lam_peaks)
     target = eigen_targets(m0 * (L @ L.T), k0 * _sym(P), lam_meas, True)
     lam_hat = np.ascontiguousarray(target)
@@ -1497,6 +1537,9 @@ def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
                                guard=guard, history=hist,
                                input_map=input_map, drift_coef=G[:, n_u:],
                                eigen_targets=np.sqrt(target) / (2.0 * np.pi), eigen_shift=held,
+                               eigen_cross=np.array([cross_meas[lam_meas == t][0]
+                                                     if t > 0 and np.any(lam_meas == t) else 0.0
+                                                     for t in np.ravel(target)]),
                                fit_tilt=tilted, fit_tilt_rule=tilt_rule,
                                input_map_record=input_map_record, backbone_rule=rule,
                                ceiling_held=bool(np.any(upper)),

@@ -1413,7 +1413,7 @@ class SGDSINDy(SGDSINDyBase):
             np.linalg.cholesky(M)
         except np.linalg.LinAlgError:
             raise IdentificationError("identified M is not positive definite (L L^T lost rank)") from None
-        self._hold_decay(data, est, m, bl["v"], bl["d"])  # before the trapezoid map (_modal_damping)
+        self._hold_decay(data, est, m, bl["v"], bl["d"], out.eigen_cross)  # before the trapezoid map
         self._finish_fit(data)
 
     def _unlocated(self) -> np.ndarray | None:
@@ -1432,7 +1432,7 @@ class SGDSINDy(SGDSINDyBase):
         return t if t.size == self.M_.shape[0] and np.any(t > 0) else None
 
     def _hold_decay(self, data: Measurement, est: MatrixSGDSettings, m: np.ndarray,
-                    v_block: slice, d_block: slice) -> None:
+                    v_block: slice, d_block: slice, cross: np.ndarray | None = None) -> None:
         """With ``decay_hold``, give each mode the pole of its measured free decay
         (:mod:`identify._modal_damping`) on the fitted model, before :meth:`_finish_fit`: its
         damping always, its frequency when that lies within one line (``fs / N``) of the
@@ -1447,9 +1447,24 @@ class SGDSINDy(SGDSINDyBase):
             Diagonal masses [kg] that ``coef_`` divides by.
         v_block, d_block : slice
             The velocity and displacement columns of ``coef_``.
+        cross : ndarray, shape (n,), optional
+            The cross stiffening [rad^2/s^2] the eigenvalue targets were lowered by
+            (``MatrixSGDResult.eigen_cross``, ascending modes).  A mode's measured decay rings
+            stiffened by the same motion of the modes that outlive it as its peak does (the
+            backbone's linear limit removes only what decays with its own amplitude), so a
+            frequency the hold takes from it is lowered by the same shift: otherwise the hold
+            undoes the target (families' soft member 012, clean: target 235.3 Hz, decay 238.1
+            Hz, truth 234.3 Hz).
         """
+        lowered: list[int] = []
+
         def set_frequencies(on: np.ndarray, lam: np.ndarray) -> np.ndarray:
             K = self.K_.copy()
+            lam = np.asarray(lam, dtype=float)
+            if cross is not None and np.size(cross) == lam.size:
+                less = on & (np.asarray(cross) > 0.0) & (lam > np.asarray(cross))
+                lam = np.where(less, lam - np.where(less, cross, 0.0), lam)
+                lowered[:] = [int(k) + 1 for k in np.flatnonzero(less)]
             hold_eigenvalues(np.linalg.cholesky(self.M_), K, 1.0, 1.0, np.where(on, lam, 0.0))
             return K
 
@@ -1462,3 +1477,6 @@ class SGDSINDy(SGDSINDyBase):
         self.coef_[:, d_block] -= (held.K - self.K_) / m
         self.C_, self.K_ = held.C, held.K
         self.decay_rule_ = held.rule
+        if lowered:
+            self.decay_rule_ += (f"; modes {lowered}' decay frequencies less the cross stiffening "
+                                 "their eigenvalue targets were lowered by (eigen_backbone_rule_)")

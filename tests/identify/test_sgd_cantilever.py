@@ -224,3 +224,42 @@ def test_a_projected_warm_start_whose_modes_miss_the_peaks_falls_back_flat(datas
     assert max(v["freq_error_mode1"], v["freq_error_mode2"]) <= 0.01
     assert "its stiffness, not its damping, is wrong" in model.fit_tilt_rule_
     assert model.fit_tilt_rule_.endswith("refit kept") and not model.fit_tilt_
+
+
+def _family_member(dataset_cache, name: str):
+    """A member of ``studies/families.toml``, clean: dataset, measurement, noise-free measurement."""
+    study = load_study(ROUND16.parents[2] / "studies" / "families.toml")
+    sc = {m.name: m for m in study.scenarios}[name]
+    ds = dataset_cache.get(sc)
+    return ds, measure(ds, sc.signal, "structural"), measure(noise_free(ds), sc.signal, "structural")
+
+
+def test_a_decay_frequency_of_an_outlived_mode_is_lowered_by_its_target_s_cross_stiffening(
+        dataset_cache):
+    """Families' soft member 012, clean, ``cubic = true`` (the shipped soft scenario's table):
+    mode 2's target was its backbone less the cross stiffening mode 1's motion adds over its
+    life (235.3 Hz; truth 234.30), and the decay hold then moved mode 2 onto its measured decay
+    frequency, which rings with that same stiffening (238.1 Hz): 1.60 % high, the issue's 1 %
+    missed.  Now the decay hold's frequency of a mode the others outlive is lowered by the same
+    shift: measured 0.67 %, TRAC 0.981 -> 0.990."""
+    ds, data, clean = _family_member(dataset_cache, "beams_soft__012")
+    model = SGDSINDy(cubic=True).fit(data)
+    assert "decay frequencies less the cross stiffening" in model.decay_rule_
+    v = score_structural(ds, data, clean, model).values
+    # issue #15's bars (the old code: mode 2 1.60 %)
+    assert v["trac"] >= 0.95 and min(v["mac_mode1"], v["mac_mode2"]) >= 0.95
+    assert max(v["freq_error_mode1"], v["freq_error_mode2"]) <= 0.01
+
+
+def test_a_cubic_contradicting_the_record_s_chirp_does_not_lower_mode_2(dataset_cache):
+    """Families' soft member 019, clean, ``cubic = true``: the warm start's cubic shifts mode 1
+    by -0.088 rad/s where its measured decay hardens (+5.1 rad/s), yet its cross term lowered
+    mode 2's target 9.58 Hz (mode 2 25 % damped, no decay fit of its own): 3.75 % low.  Now no
+    cross stiffening is subtracted on that cubic's word: mode 2 0.96 % (TRAC 0.868 -> 0.861,
+    below the issue's 0.95 before and after: the cubic the scenario asks for is the record's
+    worst fit, open)."""
+    ds, data, clean = _family_member(dataset_cache, "beams_soft__019")
+    model = SGDSINDy(cubic=True).fit(data)
+    assert "no cross stiffening subtracted from modes [2]" in model.eigen_backbone_rule_
+    v = score_structural(ds, data, clean, model).values
+    assert abs(v["freq_error_mode2"]) <= 0.01 and abs(v["freq_error_mode1"]) <= 0.01
