@@ -110,7 +110,7 @@ from typing import Any, Literal
 
 import numpy as np
 
-from identify._modal_damping import backbone_shift, modal_decay
+from identify._modal_damping import modal_decay
 from identify._unresolved import place_unresolved
 from identify.structural import (
     FIT_BAND_ORDER,
@@ -398,10 +398,7 @@ def backbone_targets(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndar
     decay rates below its own: their stiffening is near-constant over its life, no part of its
     chirp), is then lowered by the stiffening the other located modes' motion adds over that
     mode's life (:func:`cross_stiffening`), which the model's own cubic adds back when
-    simulated (where the target stays positive); not where the warm start's cubic
-    contradicts another located mode's measured decay (its own first-order shift of that
-    mode, :func:`identify._modal_damping.backbone_shift`, of the opposite sign to the
-    measured chirp): that cubic's cross term is no measurement (families' soft member 019).
+    simulated (where the target stays positive).
 
     Parameters
     ----------
@@ -470,21 +467,8 @@ def backbone_targets(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndar
         outlived = {k for k, j in slot.items()
                     if len(slot) > 1 and lam[j] <= peaks[j] and np.isfinite(sigma[k])
                     and all(np.isfinite(sigma[m]) and sigma[m] < sigma[k] for m in slot if m != k)}
-        # The cross stiffening is the warm start's cubic's prediction; the record tests that
-        # cubic on the other modes' own decays: where a located mode's backbone decay fit is
-        # taken and the cubic's own first-order shift of it (backbone_shift) has the opposite
-        # sign of its measured chirp, the cubic does not act on the record as fitted and its
-        # cross stiffening is not subtracted from any other mode (families' soft member 019,
-        # clean: mode 1's decay hardens, chirp +5.1 rad/s, the cubic's shift of it -0.088
-        # rad/s, yet its cross term lowered mode 2's target 9.58 Hz: 3.75 % low)
-        own = backbone_shift(M, K, K3, dec)
-        chirp = np.asarray(dec.chirp, dtype=float)
-        contradicted = {int(m) for m in slot if dec.taken[m] and np.isfinite(own[m])
-                        and np.isfinite(chirp[m]) and chirp[m] != 0.0
-                        and not own[m] * chirp[m] > 0.0}
         lowered = [k for k, j in slot.items()
-                   if (k in still or k in outlived) and 0.0 < shift[k] < lam[j]
-                   and not (contradicted - {k})]
+                   if (k in still or k in outlived) and 0.0 < shift[k] < lam[j]]
         hz = []
         for k in lowered:
             j = slot[k]
@@ -498,17 +482,8 @@ def backbone_targets(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndar
                      f"life: modes {[k + 1 for k in lowered]} by "
                      + ", ".join(f"{h:.3g}" for h in hz) + " Hz")
             modes = sorted(set(modes) | {k + 1 for k in lowered})
-        gated = [k + 1 for k, j in slot.items()
-                 if (k in still or k in outlived) and 0.0 < shift[k] < lam[j]
-                 and contradicted - {k}]
-        if gated:
-            cross += (f"; no cross stiffening subtracted from modes {gated}: the cubic's own "
-                      "shift of modes " + str(sorted(m + 1 for m in contradicted))
-                      + " (" + ", ".join(f"{own[m]:.3g}" for m in sorted(contradicted))
-                      + " rad/s) has the opposite sign of their measured chirp ("
-                      + ", ".join(f"{chirp[m]:.3g}" for m in sorted(contradicted)) + " rad/s)")
     if not modes:
-        return lam, moved, "no paired mode's backbone decay fit hardens: the peaks" + cross
+        return lam, moved, "no paired mode's backbone decay fit hardens: the peaks"
     f0 = np.sqrt(peaks[moved]) / (2.0 * np.pi)
     f1 = np.sqrt(lam[moved]) / (2.0 * np.pi)
     return lam, moved, (f"modes {modes}: peak -> backbone linear frequency "
