@@ -138,11 +138,15 @@ def cubic_diverges(note: str) -> bool:
     families, which pass scored, :func:`record_rule`) or one simulated to the end.
 
     Rule (:meth:`SGDSINDy.fit`): a cubic model (``cubic_``, by rule or by the user's
-    ``cubic = true``) whose SGD result and held warm start both fail that way is refused and
-    the linear library fitted in its place, stated in ``cubic_rule_`` (``ls_sindy``'s step 4
-    (b), :meth:`identify.ls_sindy.LSSINDy._cubic_diverges`, where the cubic came in by rule).
-    Both, because the keep rule already keeps a warm start that runs where the SGD's result
-    does not (:func:`keep_sgd_rule`).  Why: such a model has no simulated response to score
+    ``cubic = true``) whose SGD result fails that way and whose held warm start has no record
+    agreement either (it fails too, or is not simulated) is refused and the linear library
+    fitted in its place, stated in ``cubic_rule_`` (``ls_sindy``'s step 4 (b),
+    :meth:`identify.ls_sindy.LSSINDy._cubic_diverges`, where the cubic came in by rule).  Not
+    where the warm start has an agreement: the keep rule then keeps the warm start that runs
+    (:func:`keep_sgd_rule`).  A warm start not simulated (a linear pole past RK4's bound) offers
+    no model to keep: round 21's ``b21_soft_root3`` clean, SGD diverged at 18.6 ms, was kept
+    and scored "diverged" (TRAC NaN); refused, the linear model scores 0.995 (measured).
+    Why: such a model has no simulated response to score
     (the scorer's simulation diverges too: "diverged", TRAC NaN), while the linear part of the
     record is what the linear library fits.  Round 20's soft family (``round20_families.toml``,
     3-30 EI/L bases, cubic fractions 0.6-1.2): members 004 clean, 006 and 007 at 1 % diverged
@@ -1295,7 +1299,7 @@ class SGDSINDy(SGDSINDyBase):
                                                           sgd["alphas_"])
         self.keep_sgd_, self.keep_sgd_rule_ = keep, rule
         self.record_agreement_ = {"sgd": a_sgd, "warm_start": a_warm}
-        if self.cubic_ and cubic_diverges(note_sgd) and cubic_diverges(note_warm):
+        if self.cubic_ and cubic_diverges(note_sgd) and not np.isfinite(a_warm):
             self._cubic_diverged = (f"its simulation from the record's own start fails, the "
                                     f"SGD's ({note_sgd}) and its warm start's ({note_warm})")
         self.record_rule_ = record_rule(a_sgd if keep else a_warm, self.M_, self.C_, self.K_)
