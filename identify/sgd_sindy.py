@@ -138,11 +138,15 @@ def cubic_diverges(note: str) -> bool:
     families, which pass scored, :func:`record_rule`) or one simulated to the end.
 
     Rule (:meth:`SGDSINDy.fit`): a cubic model (``cubic_``, by rule or by the user's
-    ``cubic = true``) whose SGD result and held warm start both fail that way is refused and
-    the linear library fitted in its place, stated in ``cubic_rule_`` (``ls_sindy``'s step 4
-    (b), :meth:`identify.ls_sindy.LSSINDy._cubic_diverges`, where the cubic came in by rule).
-    Both, because the keep rule already keeps a warm start that runs where the SGD's result
-    does not (:func:`keep_sgd_rule`).  Why: such a model has no simulated response to score
+    ``cubic = true``) whose SGD result fails that way and whose held warm start has no record
+    agreement either (it fails too, or is not simulated) is refused and the linear library
+    fitted in its place, stated in ``cubic_rule_`` (``ls_sindy``'s step 4 (b),
+    :meth:`identify.ls_sindy.LSSINDy._cubic_diverges`, where the cubic came in by rule).  Not
+    where the warm start has an agreement: the keep rule then keeps the warm start that runs
+    (:func:`keep_sgd_rule`).  A warm start not simulated (a linear pole past RK4's bound) offers
+    no model to keep: round 21's ``b21_soft_root3`` clean, SGD diverged at 18.6 ms, was kept
+    and scored "diverged" (TRAC NaN); refused, the linear model scores 0.995 (measured).
+    Why: such a model has no simulated response to score
     (the scorer's simulation diverges too: "diverged", TRAC NaN), while the linear part of the
     record is what the linear library fits.  Round 20's soft family (``round20_families.toml``,
     3-30 EI/L bases, cubic fractions 0.6-1.2): members 004 clean, 006 and 007 at 1 % diverged
@@ -1295,7 +1299,7 @@ class SGDSINDy(SGDSINDyBase):
                                                           sgd["alphas_"])
         self.keep_sgd_, self.keep_sgd_rule_ = keep, rule
         self.record_agreement_ = {"sgd": a_sgd, "warm_start": a_warm}
-        if self.cubic_ and cubic_diverges(note_sgd) and cubic_diverges(note_warm):
+        if self.cubic_ and cubic_diverges(note_sgd) and not np.isfinite(a_warm):
             self._cubic_diverged = (f"its simulation from the record's own start fails, the "
                                     f"SGD's ({note_sgd}) and its warm start's ({note_warm})")
         self.record_rule_ = record_rule(a_sgd if keep else a_warm, self.M_, self.C_, self.K_)
@@ -1413,7 +1417,7 @@ class SGDSINDy(SGDSINDyBase):
             np.linalg.cholesky(M)
         except np.linalg.LinAlgError:
             raise IdentificationError("identified M is not positive definite (L L^T lost rank)") from None
-        self._hold_decay(data, est, m, bl["v"], bl["d"])  # before the trapezoid map (_modal_damping)
+        self._hold_decay(data, est, m, bl["v"], bl["d"], out.eigen_cross)  # before the trapezoid map
         self._finish_fit(data)
 
     def _unlocated(self) -> np.ndarray | None:
@@ -1432,7 +1436,7 @@ class SGDSINDy(SGDSINDyBase):
         return t if t.size == self.M_.shape[0] and np.any(t > 0) else None
 
     def _hold_decay(self, data: Measurement, est: MatrixSGDSettings, m: np.ndarray,
-                    v_block: slice, d_block: slice) -> None:
+                    v_block: slice, d_block: slice, cross: np.ndarray | None = None) -> None:
         """With ``decay_hold``, give each mode the pole of its measured free decay
         (:mod:`identify._modal_damping`) on the fitted model, before :meth:`_finish_fit`: its
         damping always, its frequency when that lies within one line (``fs / N``) of the
@@ -1447,9 +1451,24 @@ class SGDSINDy(SGDSINDyBase):
             Diagonal masses [kg] that ``coef_`` divides by.
         v_block, d_block : slice
             The velocity and displacement columns of ``coef_``.
+        cross : ndarray, shape (n,), optional
+            The cross stiffening [rad^2/s^2] the eigenvalue targets were lowered by
+            (``MatrixSGDResult.eigen_cross``, ascending modes).  A mode's measured decay rings
+            stiffened by the same motion of the modes that outlive it as its peak does (the
+            backbone's linear limit removes only what decays with its own amplitude), so a
+            frequency the hold takes from it is lowered by the same shift: otherwise the hold
+            undoes the target (families' soft member 012, clean: target 235.3 Hz, decay 238.1
+            Hz, truth 234.3 Hz).
         """
+        lowered: list[int] = []
+
         def set_frequencies(on: np.ndarray, lam: np.ndarray) -> np.ndarray:
             K = self.K_.copy()
+            lam = np.asarray(lam, dtype=float)
+            if cross is not None and np.size(cross) == lam.size:
+                less = on & (np.asarray(cross) > 0.0) & (lam > np.asarray(cross))
+                lam = np.where(less, lam - np.where(less, cross, 0.0), lam)
+                lowered[:] = [int(k) + 1 for k in np.flatnonzero(less)]
             hold_eigenvalues(np.linalg.cholesky(self.M_), K, 1.0, 1.0, np.where(on, lam, 0.0))
             return K
 
@@ -1462,3 +1481,6 @@ class SGDSINDy(SGDSINDyBase):
         self.coef_[:, d_block] -= (held.K - self.K_) / m
         self.C_, self.K_ = held.C, held.K
         self.decay_rule_ = held.rule
+        if lowered:
+            self.decay_rule_ += (f"; modes {lowered}' decay frequencies less the cross stiffening "
+                                 "their eigenvalue targets were lowered by (eigen_backbone_rule_)")

@@ -72,3 +72,16 @@ def test_backbone_targets_lower_a_peak_by_the_cross_stiffening(record):
     assert np.sqrt(lam[1]) / (2 * np.pi) == pytest.approx(f[1], abs=0.1 * (peak_hz - f[1]))
     lam0, _, _ = backbone_targets(data, M, C, K, (0, data.n_samples), peaks)
     assert lam0[1] > lam[1]  # without the cubic: the peak or its backbone limit, as before
+
+
+def test_the_cross_stiffening_subtracted_is_returned_for_an_outlived_mode(record):
+    """``cross_out`` holds the shift subtracted from mode 2 (outlived by mode 1: damped 1 %
+    against 0.1 %), which the decay hold takes off mode 2's measured decay frequency too."""
+    f, Phi, data = record
+    q2 = np.linalg.solve(Phi, data.x)[1]
+    peaks = (2 * np.pi * np.array([f[0], _peak_hz(q2, 30.0, 70.0)])) ** 2
+    cross = np.zeros(2)
+    backbone_targets(data, M, np.zeros((2, 2)), K, (0, data.n_samples), peaks,
+                                     K3, cross)
+    shift = cross_stiffening(data, M, K, K3, (0, data.n_samples))
+    assert cross[0] == 0.0 and cross[1] == pytest.approx(shift[1], rel=1e-12)

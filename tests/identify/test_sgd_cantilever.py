@@ -25,6 +25,7 @@ from testbed.studies.study import load_study
 ROUND16 = Path(__file__).resolve().parents[2] / "benchmarks" / "unseen" / "round16"
 ROUND19 = ROUND16.parent / "round19"
 ROUND20 = ROUND16.parent / "round20"
+ROUND21 = ROUND16.parent / "round21"
 
 
 @pytest.fixture(scope="module")
@@ -224,3 +225,51 @@ def test_a_projected_warm_start_whose_modes_miss_the_peaks_falls_back_flat(datas
     assert max(v["freq_error_mode1"], v["freq_error_mode2"]) <= 0.01
     assert "its stiffness, not its damping, is wrong" in model.fit_tilt_rule_
     assert model.fit_tilt_rule_.endswith("refit kept") and not model.fit_tilt_
+
+
+def _family_member(dataset_cache, name: str):
+    """A member of ``studies/families.toml``, clean: dataset, measurement, noise-free measurement."""
+    study = load_study(ROUND16.parents[2] / "studies" / "families.toml")
+    sc = {m.name: m for m in study.scenarios}[name]
+    ds = dataset_cache.get(sc)
+    return ds, measure(ds, sc.signal, "structural"), measure(noise_free(ds), sc.signal, "structural")
+
+
+def test_a_decay_frequency_of_an_outlived_mode_is_lowered_by_its_target_s_cross_stiffening(
+        dataset_cache):
+    """Families' soft member 012, clean, ``cubic = true`` (the shipped soft scenario's table):
+    mode 2's target was its backbone less the cross stiffening mode 1's motion adds over its
+    life (235.3 Hz; truth 234.30), and the decay hold then moved mode 2 onto its measured decay
+    frequency, which rings with that same stiffening (238.1 Hz): 1.60 % high, the issue's 1 %
+    missed.  Now the decay hold's frequency of a mode the others outlive is lowered by the same
+    shift: measured 0.67 %, TRAC 0.981 -> 0.990."""
+    ds, data, clean = _family_member(dataset_cache, "beams_soft__012")
+    model = SGDSINDy(cubic=True).fit(data)
+    assert "decay frequencies less the cross stiffening" in model.decay_rule_
+    v = score_structural(ds, data, clean, model).values
+    # issue #15's bars (the old code: mode 2 1.60 %)
+    assert v["trac"] >= 0.95 and min(v["mac_mode1"], v["mac_mode2"]) >= 0.95
+    assert max(v["freq_error_mode1"], v["freq_error_mode2"]) <= 0.01
+
+
+def test_a_diverging_cubic_whose_warm_start_is_not_simulated_is_refused_for_the_linear(
+        dataset_cache):
+    """Round 21's b21_soft_root3 (a soft base read at 0.15 / 0.25 / 0.35 L), clean, default
+    settings (the cubic in by rule): the SGD's cubic model diverges from the record's own start
+    (18.6 ms) and its held warm start is not simulated (a linear pole past RK4's bound at the
+    sample rate), so neither has a record agreement; the refusal asked both to *fail*, the keep
+    rule kept the SGD's result, scored "diverged" (TRAC NaN).  Now a diverging SGD result whose
+    warm start has no agreement either is refused and the linear library fitted: measured TRAC
+    0.995, modes 1-2 1.43 / 1.90 % (the study's bars, 2.6 %; the issue's 1 % open)."""
+    sc = load_scenario(ROUND21 / "b21_soft_root3.toml")
+    ds = dataset_cache.get(sc)
+    data = measure(ds, sc.signal, "structural")
+    model = SGDSINDy().fit(data)
+    assert "the fitted cubic model refused (its simulation from the record's own start fails" \
+        in model.cubic_rule_
+    assert not model.cubic_ and model.K3_ is None
+    v = score_structural(ds, data, measure(noise_free(ds), sc.signal, "structural"), model).values
+    # the round's bars (the families': TRAC and MAC of modes 1-2 > 0.90, modes 1-2 within 2.6
+    # %); the old code: TRAC NaN
+    assert v["trac"] > 0.90 and min(v["mac_mode1"], v["mac_mode2"]) > 0.90
+    assert max(abs(v["freq_error_mode1"]), abs(v["freq_error_mode2"])) < 0.026
