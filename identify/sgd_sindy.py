@@ -1087,7 +1087,12 @@ class SGDSINDy(SGDSINDyBase):
             self.learning_rate_, self.learning_rate_rule_ = learning_rate_for(False,
                                                                               self.learning_rate)
             begun = dict(self.__dict__)
-            self._fit_banded(data, lam_hat, band_peaks, m_hat, False)
+            try:
+                self._fit_banded(data, lam_hat, band_peaks, m_hat, False)
+            except (IdentificationError, np.linalg.LinAlgError) as e:
+                # review 23e: the refusal's reason is part of what went wrong
+                raise IdentificationError(f"cubic refused ({why}); the linear refit failed: "
+                                          f"{e}") from e
             self.__dict__.pop("_cubic_diverged", None)
             self.cubic_rule_ = refused
         unpaired = self.__dict__.pop("_lowest_unpaired", "")
@@ -1300,8 +1305,11 @@ class SGDSINDy(SGDSINDyBase):
         self.keep_sgd_, self.keep_sgd_rule_ = keep, rule
         self.record_agreement_ = {"sgd": a_sgd, "warm_start": a_warm}
         if self.cubic_ and cubic_diverges(note_sgd) and not np.isfinite(a_warm):
-            self._cubic_diverged = (f"its simulation from the record's own start fails, the "
-                                    f"SGD's ({note_sgd}) and its warm start's ({note_warm})")
+            # review 23e: a warm start that was not simulated did not fail: say which it was
+            warm = (f"and its warm start's ({note_warm})" if cubic_diverges(note_warm) else
+                    f"and its warm start has no record agreement ({note_warm})")
+            self._cubic_diverged = (f"its simulation from the record's own start fails: the "
+                                    f"SGD's ({note_sgd}) {warm}")
         self.record_rule_ = record_rule(a_sgd if keep else a_warm, self.M_, self.C_, self.K_)
 
     def _hardened_peak_ceiling(self, lam_hat: np.ndarray) -> np.ndarray:

@@ -69,8 +69,8 @@ def test_stiff_targets_at_reduced_budget(stiff):
     assert model.n_steps_ == 2000
     v = score_structural(ds, data, clean, model).values
     # the issue's targets are the paper's modes 1-2 (mode 3 is scored and reported too)
-    assert v["trac"] >= 0.95 and min(v["mac_mode1"], v["mac_mode2"]) >= 0.95
-    assert max(v["freq_error_mode1"], v["freq_error_mode2"]) <= 0.01
+    assert v["trac"] >= 0.95 and np.min([v["mac_mode1"], v["mac_mode2"]]) >= 0.95
+    assert np.max([v["freq_error_mode1"], v["freq_error_mode2"]]) <= 0.01
     assert np.all(np.linalg.eigvalsh(model.M_) > 0)  # symmetric positive definite by construction
     np.testing.assert_allclose(np.trace(model.M_), data.prior["reduced_mass_trace"], rtol=1e-12)
 
@@ -120,8 +120,8 @@ def test_a_placed_warm_start_whose_damping_grows_is_projected_not_fitted_flat(da
     v = score_structural(ds, data, measure(noise_free(ds), sc.signal, "structural"), model).values
     # issue #15's bars (TRAC and MAC >= 0.95, modes 1-2 within 1 %); the old code: TRAC 0.024,
     # mode 1 MAC 0.28
-    assert v["trac"] >= 0.95 and min(v["mac_mode1"], v["mac_mode2"]) >= 0.95
-    assert max(v["freq_error_mode1"], v["freq_error_mode2"]) <= 0.01
+    assert v["trac"] >= 0.95 and np.min([v["mac_mode1"], v["mac_mode2"]]) >= 0.95
+    assert np.max([v["freq_error_mode1"], v["freq_error_mode2"]]) <= 0.01
 
 
 def test_a_mode_1_the_band_removed_is_refitted_without_the_band(dataset_cache):
@@ -176,7 +176,7 @@ def test_a_warm_start_whose_stiffness_has_a_complex_pair_is_fitted_flat_not_a_br
     assert not model.fit_tilt_
     check_physical(model.M_, model.C_, model.K_)
     v = score_structural(ds, data, measure(noise_free(ds), sc.signal, "structural"), model).values
-    assert max(v["freq_error_mode1"], v["freq_error_mode2"]) <= 0.01  # measured 7e-5, 1.3e-4
+    assert np.max([v["freq_error_mode1"], v["freq_error_mode2"]]) <= 0.01  # measured 7e-5, 1.3e-4
     assert np.isfinite(v["trac"])
 
 
@@ -201,8 +201,8 @@ def test_a_cubic_model_whose_simulation_and_warm_start_diverge_is_refused_for_th
     assert not model.cubic_ and model.K3_ is None
     v = score_structural(ds, data, measure(noise_free(ds), sc.signal, "structural"), model).values
     # issue #15's bars (TRAC and MAC >= 0.95, modes 1-2 within 1 %); the old code: TRAC NaN
-    assert v["trac"] >= 0.95 and min(v["mac_mode1"], v["mac_mode2"]) >= 0.95
-    assert max(v["freq_error_mode1"], v["freq_error_mode2"]) <= 0.01
+    assert v["trac"] >= 0.95 and np.min([v["mac_mode1"], v["mac_mode2"]]) >= 0.95
+    assert np.max([v["freq_error_mode1"], v["freq_error_mode2"]]) <= 0.01
 
 
 def test_a_projected_warm_start_whose_modes_miss_the_peaks_falls_back_flat(dataset_cache):
@@ -221,8 +221,8 @@ def test_a_projected_warm_start_whose_modes_miss_the_peaks_falls_back_flat(datas
     model = SGDSINDy().fit(data)
     v = score_structural(ds, data, measure(noise_free(ds), sc.signal, "structural"), model).values
     # issue #15's bars; the old code: mode 1 213 % off, TRAC 0.28
-    assert v["trac"] >= 0.95 and min(v["mac_mode1"], v["mac_mode2"]) >= 0.95
-    assert max(v["freq_error_mode1"], v["freq_error_mode2"]) <= 0.01
+    assert v["trac"] >= 0.95 and np.min([v["mac_mode1"], v["mac_mode2"]]) >= 0.95
+    assert np.max([v["freq_error_mode1"], v["freq_error_mode2"]]) <= 0.01
     assert "its stiffness, not its damping, is wrong" in model.fit_tilt_rule_
     assert model.fit_tilt_rule_.endswith("refit kept") and not model.fit_tilt_
 
@@ -248,8 +248,8 @@ def test_a_decay_frequency_of_an_outlived_mode_is_lowered_by_its_target_s_cross_
     assert "decay frequencies less the cross stiffening" in model.decay_rule_
     v = score_structural(ds, data, clean, model).values
     # issue #15's bars (the old code: mode 2 1.60 %)
-    assert v["trac"] >= 0.95 and min(v["mac_mode1"], v["mac_mode2"]) >= 0.95
-    assert max(v["freq_error_mode1"], v["freq_error_mode2"]) <= 0.01
+    assert v["trac"] >= 0.95 and np.min([v["mac_mode1"], v["mac_mode2"]]) >= 0.95
+    assert np.max([v["freq_error_mode1"], v["freq_error_mode2"]]) <= 0.01
 
 
 def test_a_diverging_cubic_whose_warm_start_is_not_simulated_is_refused_for_the_linear(
@@ -271,5 +271,5 @@ def test_a_diverging_cubic_whose_warm_start_is_not_simulated_is_refused_for_the_
     v = score_structural(ds, data, measure(noise_free(ds), sc.signal, "structural"), model).values
     # the round's bars (the families': TRAC and MAC of modes 1-2 > 0.90, modes 1-2 within 2.6
     # %); the old code: TRAC NaN
-    assert v["trac"] > 0.90 and min(v["mac_mode1"], v["mac_mode2"]) > 0.90
-    assert max(abs(v["freq_error_mode1"]), abs(v["freq_error_mode2"])) < 0.026
+    assert v["trac"] > 0.90 and np.min([v["mac_mode1"], v["mac_mode2"]]) > 0.90
+    assert np.max(np.abs([v["freq_error_mode1"], v["freq_error_mode2"]])) < 0.026
