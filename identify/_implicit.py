@@ -549,12 +549,21 @@ def select_passive_models(sw: Sweep, input_cols: Sequence[np.ndarray],
         if G_val is not None and cols.size and order.size:
             # the held-out ranking stands unless the record refutes its first pick per unit
             # of p's acceleration part: beyond the tie of the best there
+            # (the first pick is the first entry whose support no earlier coordinate took, as
+            # the loop below picks it; models of a taken support are not offered as the best)
             acc_err = input_errors(sw, G_val, cols, n_val)
-            elig = (free & has_acc) & np.isfinite(acc_err)
+            offered = np.ones_like(free)
+            if taken:
+                supp = (sw.W != 0).reshape(-1, sw.W.shape[-1])
+                offered = np.array([np.flatnonzero(r).tobytes() not in taken for r in supp]
+                                   ).reshape(free.shape)
+            ok = free & has_acc & np.isfinite(sw.val_error)
+            elig = ok & offered & np.isfinite(acc_err)
             best = acc_err[elig].min() if elig.any() else np.inf
-            first = acc_err.ravel()[order[0]]
-            if not first <= best * (1.0 + rtol) + atol:
-                order = rank_models(replace(sw, val_error=acc_err), free & has_acc, rtol, atol)
+            firsts = [f for f in order if offered.ravel()[f]]
+            first = acc_err.ravel()[firsts[0]] if firsts else np.inf
+            if firsts and not first <= best * (1.0 + rtol) + atol:
+                order = rank_models(replace(sw, val_error=acc_err), ok, rtol, atol)
         picked: list[tuple[int, int]] = []
         seen: set[bytes] = set()
         for flat in order:

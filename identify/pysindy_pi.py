@@ -147,6 +147,9 @@ class PySINDyPI(_ImplicitMechanical):
     """
 
     name = "pysindy_pi"
+    #: The reference peer keeps its passive equations ranked as measured (per unit of the
+    #: left-hand side), as it keeps the selection without the inertia rule.
+    _passive_acc_rule_on = False
     deterministic = True  # OSQP, single-threaded; refitted to the bit in test_conformance
     hyperparameters: ClassVar[dict[str, Field]] = ordered_fields({
         **COMMON_HYPERPARAMETERS,

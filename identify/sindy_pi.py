@@ -987,6 +987,10 @@ class _ImplicitMechanical(Identifier):
     #: The inertia rule of the rollout selection (:meth:`_inertia_rule`): SINDy-PI's own; the
     #: pysindy peer keeps the selection it was measured with.
     _inertia_rule_on: ClassVar[bool] = False
+    #: An open chain's passive equation tested per unit of its acceleration's part
+    #: (:func:`identify._implicit.select_passive_models` with ``G_val``): SINDy-PI's own; the
+    #: pysindy peer keeps the selection it was measured with (per unit of the left-hand side).
+    _passive_acc_rule_on: ClassVar[bool] = False
 
     def _sweep(self, G_train: np.ndarray, G_val: np.ndarray, cand: np.ndarray,
                Theta_train: np.ndarray) -> Sweep:
@@ -1172,7 +1176,8 @@ class _ImplicitMechanical(Identifier):
             picks += select_passive_models(sw, loc_cols, [np.flatnonzero(acc == p) for p in passive],
                                            self.selection_rtol, self.selection_atol, top,
                                            [f"{i + 1} ({data.channels[i]})" for i in passive],
-                                           G_v[np.ix_(kidx, kidx)], Theta.shape[0] - n_tr)
+                                           G_v[np.ix_(kidx, kidx)] if self._passive_acc_rule_on
+                                           else None, Theta.shape[0] - n_tr)
             solved = np.concatenate([actuated, passive])
         self.feature_names_ = list(lib.names)
         self.actuated_ = solved
@@ -1737,6 +1742,7 @@ class SINDyPI(_ImplicitMechanical):
 
     name = "sindy_pi"
     _inertia_rule_on = True
+    _passive_acc_rule_on = True
     #: The record rule's wider search (:meth:`_wide_record`); a switch for probes that
     #: measure it against the rule without it.
     _wide_record_on: ClassVar[bool] = True
