@@ -80,7 +80,7 @@ def test_round9_studies_load(name, cells):
 
 # ------------------------------------------- the thick beams: refused, not simulated as beams
 @pytest.mark.parametrize(("name", "ratio"), [("b9_thick_L0p2_h40_s2", "0.2"),
-                                             ("b9_thick_L0p3_h40_s2", "0.1333"),
+                                             ("b9_thick_L0p3_h40_s2", "0.133333"),
                                              ("b9_thick_L0p25_h30_s3", "0.12")])
 def test_round9_thick_beams_are_refused_as_not_slender(name, ratio):
     # the round ran them (both identifiers passed) as Euler-Bernoulli chains; a real beam 30-40
