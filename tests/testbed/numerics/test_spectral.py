@@ -5,7 +5,14 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from testbed.numerics.spectral import amplitude_spectrum, fft_resolution, peak_frequencies
+from testbed.numerics.spectral import (
+    amplitude_spectrum,
+    band_power_fall,
+    fft_resolution,
+    noise_lock_bar,
+    own_lock,
+    peak_frequencies,
+)
 
 FS = 12800.0
 T = np.arange(int(2 * FS)) / FS  # 2 s record: resolution 0.5 Hz
@@ -110,3 +117,38 @@ def test_harmonic_lock_tells_a_driven_harmonic_from_a_mode_off_by_a_few_hertz():
     # measured 0.9995 (locked) and 0.13 (|sinc| of the 4 Hz offset over the record, docstring)
     assert harmonic_lock(fund + harm, fs, 30.0, 90.0, 3, one, one) > 0.99
     assert harmonic_lock(fund + mode, fs, 30.0, 94.0, 3, one, one) < 0.3
+
+
+def test_band_power_fall_tells_a_decaying_mode_from_white_noise():
+    """White noise (two channels, 1.8 kHz, 1760 samples, a 40-sample lead, 171 Hz, 300
+    draws) passes noise's bar at k = 3 rarely (at most 1 %) and at k = 1 often (the bar is no
+    loose bound); a mode decaying at 5 % damping under that noise falls far past it."""
+    rng = np.random.default_rng(7)
+    fs, n, f, s = 1800.0, 1800, 171.0, 40
+    shape = np.array([1.0, 0.5])
+    over3 = over1 = 0
+    for _ in range(300):
+        x = rng.standard_normal((2, n))
+        r, bar = band_power_fall(x, fs, f, shape, s)
+        over3 += r >= bar
+        over1 += r >= band_power_fall(x, fs, f, shape, s, k=1.0)[1]
+    assert over3 <= 3
+    assert 20 <= over1 <= 120
+    t = np.arange(n) / fs
+    ring = np.exp(-2 * np.pi * 0.05 * f * t) * np.sin(2 * np.pi * f * t) * shape[:, None]
+    r, bar = band_power_fall(30.0 * ring + rng.standard_normal((2, n)), fs, f, shape, s)
+    assert r >= 3.0 * bar
+    assert np.isnan(band_power_fall(x[:, :30], fs, f, shape, 0)[0])  # nothing left
+
+
+def test_noise_lock_bar_is_what_white_noise_rarely_passes():
+    """White noise's :func:`own_lock` at 171 Hz (two channels, 1.8 kHz, 1760 samples, 300
+    draws) passes the bar at k = 3 at most 1 % of the time and at k = 1 often (0.45-0.49
+    measured on 400 draws: the bar is no loose bound)."""
+    rng = np.random.default_rng(7)
+    fs, n, f = 1800.0, 1760, 171.0
+    shape = np.array([1.0, 0.5])
+    locks = np.array([own_lock(rng.standard_normal((2, n)), fs, f, shape) for _ in range(300)])
+    assert np.mean(locks > noise_lock_bar(f, fs, n)) <= 0.01
+    assert 0.3 <= np.mean(locks > noise_lock_bar(f, fs, n, k=1.0)) <= 0.6
+    assert noise_lock_bar(f, fs, 10) == np.inf  # nothing left after the ends
