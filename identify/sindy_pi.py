@@ -789,6 +789,26 @@ RULE_KNOBS = ("column_lowpass_hz", "edge_trim", "ridge", "formulation", "weak_wi
 LHS_INPUT_TERMS = "inputs"
 
 
+def regression_inputs(data: Measurement, hold: str) -> np.ndarray | None:
+    """The inputs paired with the samples of the regression [their units], shape (m, N).
+
+    A held input (``hold == "zoh"``) acts as ``u[k]`` over ``[t_k, t_k+1)``.  Accelerations a
+    signal chain derived from the sampled angles (a declared pass band, ``data.passband``)
+    are central differences of a filtered record: at ``t_k`` they average the motion over
+    ``[t_k-1, t_k+1]``, under ``u[k-1]`` and ``u[k]`` for half of it each, so the input
+    paired with them is ``(u[k-1] + u[k]) / 2`` (``u[0]`` at the first sample): the held
+    signal delayed by half a sample, the simulator's ``"zoh"`` convention
+    (:meth:`identify._mechsim.ImplicitModel.simulate`).  Otherwise (a linear input, or
+    recorded accelerations, which the engine evaluates under ``u[k]``) the samples as given.
+    """
+    u = data.u
+    if u is None or hold != "zoh" or data.passband is None or u.shape[1] < 2:
+        return u
+    out = np.array(u, dtype=float)
+    out[:, 1:] = 0.5 * (u[:, 1:] + u[:, :-1])
+    return out
+
+
 def excitation_trim(u: np.ndarray, fs: float, keep: float | None = None) -> float:
     """The longest edge trim [s] (the same at each end) whose span keeps at least ``keep`` of
     the inputs' power about their mean (summed over inputs); the half record where the inputs
@@ -1022,7 +1042,7 @@ class _ImplicitMechanical(Identifier):
         x, xd, xdd = data.x, data.xd, data.xdd
         if self.reconcile and self.closure_ is not None:
             x, xd, xdd = self.closure_.reconcile(x, xd, xdd)
-        Theta = lib.evaluate(x, xd, xdd, data.u)
+        Theta = lib.evaluate(x, xd, xdd, regression_inputs(data, self.input_hold_))
         cut = self._knob("column_lowpass_hz")
         if cut:
             Theta = lowpass(np.ascontiguousarray(Theta.T), data.fs, cut,
