@@ -229,7 +229,9 @@ def test_wider_search_where_no_shortlisted_pair_replays_the_record(dataset_cache
                     2.0, 63)
     assert old.model.record_rule_.endswith("first fit kept (no wider search: off for this "
                                            "identifier)")
-    assert not old.passed and "no assembly" in old.scores.failures["simulation"]
+    # how it diverges is decided by rounding: the loop's closure lost ("no assembly") on one
+    # BLAS kernel, the state not finite at 0.32 s under OPENBLAS_CORETYPE=Haswell
+    assert not old.passed and old.scores.failures["simulation"].startswith("diverged")
 
 
 def test_wider_search_not_for_open_chains_nor_ensembles():
