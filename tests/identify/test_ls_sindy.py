@@ -7,6 +7,7 @@ The synthetic 3-DOF chain and its exact data come from ``benchmarks/bench_sgd_si
 from __future__ import annotations
 
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -16,7 +17,7 @@ from identify import IDENTIFIERS
 from identify._cubic_rule import CUBIC_CHIRP_MIN
 from identify._structural_sim import simulate_structural
 from identify.ls_sindy import LeastSquaresSINDy, reach_moves
-from identify.structural import check_physical, modal, modal_peaks
+from identify.structural import _decaying_only, check_physical, modal, modal_peaks
 from testbed.pipeline.scenario import load_scenario
 from testbed.pipeline.signal_chain import measure
 from testbed.scoring.run import make_identifier, run_scenario
@@ -733,3 +734,18 @@ def test_the_noise_rule_keeps_a_fast_decaying_mode_and_a_lightly_damped_one(data
         data = run_scenario(sc, dataset=dataset_cache.get(sc)).data
         ps = modal_peaks(data, ringing=True)
         assert np.any(np.abs(ps.peaks - f) < 1.0), name
+
+
+def test_a_candidate_the_noise_rule_cannot_test_is_kept():
+    """Review 23f: rule 4b rejected a clean 1 %-damped 30 Hz mode (half mode 1's amplitude)
+    on a 0.2 s record, its lock not finite (the window too short for the frequency): a test
+    that cannot decide keeps the candidate."""
+    fs, n = 1800.0, 360
+    t = np.arange(n) / fs
+    sh1, sh2 = np.array([1.0, 0.6]), np.array([1.0, -0.8])
+    x = (np.sin(2 * np.pi * 80 * t) * np.exp(-2 * np.pi * 0.01 * 80 * t))[None] * sh1[:, None] \
+        + 0.5 * (np.sin(2 * np.pi * 30 * t) * np.exp(-2 * np.pi * 0.01 * 30 * t))[None] * sh2[:, None]
+    rejected: list = []
+    kept = _decaying_only(SimpleNamespace(xdd=x, fs=fs), 0, np.array([80.0, 30.0]),
+                          np.array([sh1, sh2]).astype(complex), [0, 1], rejected, 20.0)
+    assert kept == [0, 1] and rejected == []

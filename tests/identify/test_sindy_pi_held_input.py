@@ -20,6 +20,7 @@ import numpy as np
 import testbed
 from identify.sindy_pi import regression_inputs
 from testbed.core.measurement import Measurement
+from testbed.numerics.derivatives import lowpass_differentiate
 
 UNSEEN = Path(__file__).resolve().parents[2] / "benchmarks" / "unseen"
 #: The study's bar (benchmarks/unseen/round22_linkages_inputs.toml): the paper's figure [rad].
@@ -42,14 +43,29 @@ def _held_double_integrator(fs: float, passband):
     return data, u
 
 
-def test_a_held_input_is_paired_with_the_differenced_acceleration():
-    """The central difference of a held input's motion is (u[k-1] + u[k]) / 2 exactly (to
-    round-off: 1e-9 of u's scale at h = 1 ms, the differences' cancellation)."""
-    data, u = _held_double_integrator(1000.0, (0.0, 100.0))
-    paired = regression_inputs(data, "zoh")
-    assert np.allclose(paired[0, 1:-1], data.xdd[0, 1:-1], rtol=0, atol=1e-6)
-    # the sample itself is half a sample off: the old pairing
-    assert not np.allclose(u[0, 1:-1], data.xdd[0, 1:-1], rtol=0, atol=1e-2)
+def test_a_held_input_is_paired_with_the_chains_differenced_acceleration():
+    """Through the chain's own differentiator (a zero-phase Butterworth, then np.gradient
+    twice: weights (1, 3, 3, 1) / 8 over [t_k-2, t_k+2] on a held input, centred half a sample
+    back), a smooth held input's acceleration is matched by (u[k-1] + u[k]) / 2 far better than
+    by u[k] (review 23g: the 3-point stencil the first version of this test used gives the
+    pairing exactly by algebra, so it could not fail).  Measured at 1 kHz, 3 and 7.3 Hz: relative
+    residual 1.3e-2 against 2.5e-4; the bar asks a tenth, far from either."""
+    fs, n = 1000.0, 2000
+    h = 1.0 / fs
+    t = np.arange(n) * h
+    u = (np.sin(2 * np.pi * 3.0 * t) + 0.5 * np.sin(2 * np.pi * 7.3 * t))[None]
+    q, v = np.zeros(n), 0.0
+    for k in range(1, n):  # exact over each held interval
+        q[k] = q[k - 1] + v * h + 0.5 * u[0, k - 1] * h * h
+        v += u[0, k - 1] * h
+    _, xd, xdd = lowpass_differentiate(q[None], fs, 100.0)
+    data = Measurement(fs=fs, x=q[None], xd=xd, xdd=xdd, channels=("q",), u=u, inputs=("u",),
+                       input_map=np.ones((1, 1)), passband=(0.0, 100.0))
+    inner = slice(200, n - 200)  # clear of the record's edge fits (0.1 s each)
+    scale = np.abs(xdd[0, inner]).max()
+    shifted = np.abs(regression_inputs(data, "zoh")[0, inner] - xdd[0, inner]).max() / scale
+    sampled = np.abs(u[0, inner] - xdd[0, inner]).max() / scale
+    assert shifted < 0.1 * sampled
 
 
 def test_recorded_accelerations_and_linear_inputs_keep_their_samples():
