@@ -507,7 +507,7 @@ class Identifier:
 
     def is_fitted(self) -> bool:
         """Whether :meth:`fit` has set a learned attribute (a public name ending in ``_``)."""
-        return any(k.endswith("_") and not k.startswith("_") for k in vars(self))
+        return bool(_learned(self))
 
     def __repr__(self) -> str:
         args = ", ".join(f"{k}={v!r}" for k, v in self.get_params().items())
@@ -524,6 +524,11 @@ FITTED_ONLY = ("score", "predict_acceleration", "equations", "simulate")
 #: into a deep copy, whose later fits then never removed an earlier fit's attributes); an id
 #: is unique while its object lives, which it does for the whole fit.
 _FITTING: set[int] = set()
+
+
+def _learned(model: Identifier) -> list[str]:
+    """The model's learned attributes: public names ending in ``_`` (scikit-learn's mark)."""
+    return [k for k in vars(model) if k.endswith("_") and not k.startswith("_")]
 
 
 def _guard_fit(fit: Callable[..., Identifier]) -> Callable[..., Identifier]:
@@ -558,7 +563,7 @@ def _guard_fit(fit: Callable[..., Identifier]) -> Callable[..., Identifier]:
         # that calls its parent's (SINDyPI's super().fit) keeps what it has set
         outermost = id(self) not in _FITTING
         if outermost:
-            for k in [k for k in vars(self) if k.endswith("_") and not k.startswith("_")]:
+            for k in _learned(self):
                 delattr(self, k)
         self.check_params_for_data(data)
         free = data.n_samples - data.free_start

@@ -1002,7 +1002,7 @@ def decay_hold(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndarray,
         return move & np.all(gap >= np.diag(gap)[:, None], axis=1)
 
     if with_backbone:  # a cubic model's mode no peak located, whose decay showed no backbone
-        free = free & (np.zeros_like(free) if dec.exponential is None else dec.exponential)
+        free = np.zeros_like(free) if dec.exponential is None else free & dec.exponential
     if np.any(free):
         free = own_nearest(free)
     # the peak offset widens the bound where the model's frequency stands at a spectral peak
@@ -1414,7 +1414,7 @@ def set_shapes(M: np.ndarray, C: np.ndarray, K: np.ndarray, shapes: np.ndarray
     if not np.linalg.cond(new) <= SHAPES_COND_MAX:
         return None
     lam = np.diag(np.linalg.solve(Phi, np.linalg.solve(M, K @ Phi))).real
-    D = np.linalg.solve(Phi, np.linalg.solve(M, C @ Phi)).real
+    D = _modal_damping_matrix(M, C, Phi, False).real
     inv = np.linalg.inv(new)
     return M @ new @ D @ inv, M @ new @ np.diag(lam) @ inv
 

@@ -529,7 +529,6 @@ class LeastSquaresSINDy(StructuralIdentifier):
                    f"{1.0 - a_fit:.3g} and {1.0 - a_none:.3g}")
         if np.isfinite(a_none) and (not np.isfinite(a_fit)
                                     or INPUT_DROP_RATIO * (1.0 - a_none) <= 1.0 - a_fit):
-            self.input_map_ = np.zeros_like(fitted)
             cols = getattr(self, "_input_columns", None)
             if cols is not None and cols.size == self.coef_.shape[1]:
                 self.coef_ = self.coef_.copy()
@@ -674,8 +673,7 @@ class LeastSquaresSINDy(StructuralIdentifier):
             return
         i0, i1 = fit_window(data, 0.0)
         fs = float(data.fs)
-        f = warp_frequency(peaks, fs) if data.integration == "trapezoid" else peaks
-        paired = np.sqrt(eigen_targets(self.M_, self.K_, (2.0 * np.pi * f) ** 2)) / (2.0 * np.pi)
+        paired = np.sqrt(self._peak_targets(data, peaks)) / (2.0 * np.pi)
         own = 0.5 * np.diag(np.linalg.solve(Phi, np.linalg.solve(self.M_, self.C_) @ Phi)).real
         reach, limit = hardened_reach(paired, dec, np.where(dec.taken, dec.sigma_model, own),
                                       fs / (i1 - i0), (i1 - i0) / fs)
@@ -866,8 +864,7 @@ class LeastSquaresSINDy(StructuralIdentifier):
         elif peaks.size == 0:
             self.eigen_rule_ = "no measured peak: the fit's frequencies"
         else:
-            f = warp_frequency(peaks, float(data.fs)) if data.integration == "trapezoid" else peaks
-            target = eigen_targets(self.M_, self.K_, (2.0 * np.pi * f) ** 2)
+            target = self._peak_targets(data, peaks)
             on = target > 0
             freqs = modal(self.M_, self.K_)[0]
             f_hat = np.sqrt(np.where(on, target, 0.0)) / (2.0 * np.pi)
@@ -901,9 +898,15 @@ class LeastSquaresSINDy(StructuralIdentifier):
         if not self.eigen_hold or peaks.size == 0:
             return None
         if self.K3_ is not None:  # not held, but paired as the hold pairs (class docstring)
-            f = warp_frequency(peaks, float(data.fs)) if data.integration == "trapezoid" else peaks
-            return eigen_targets(self.M_, self.K_, (2.0 * np.pi * f) ** 2) == 0
+            return self._peak_targets(data, peaks) == 0
         return self.eigen_targets_ == 0
+
+    def _peak_targets(self, data: Measurement, peaks: np.ndarray) -> np.ndarray:
+        """The eigenvalue targets [rad^2/s^2] the accepted ``peaks`` [Hz] give the current linear
+        model's modes (:func:`identify._sgd_matrix.eigen_targets`; 0 where a mode is paired with
+        no peak), the peaks warped as a trapezoid-integrated record's are."""
+        f = warp_frequency(peaks, float(data.fs)) if data.integration == "trapezoid" else peaks
+        return eigen_targets(self.M_, self.K_, (2.0 * np.pi * f) ** 2)
 
     def _free_peaks(self, data: Measurement, peaks: np.ndarray) -> np.ndarray | None:
         """Accepted peaks [Hz] the eigenvalue hold paired with no mode (as measured), when it

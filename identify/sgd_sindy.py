@@ -1475,7 +1475,7 @@ class SGDSINDy(SGDSINDyBase):
             lam = np.asarray(lam, dtype=float)
             if cross is not None and np.size(cross) == lam.size:
                 less = on & (np.asarray(cross) > 0.0) & (lam > np.asarray(cross))
-                lam = np.where(less, lam - np.where(less, cross, 0.0), lam)
+                lam = lam - np.where(less, cross, 0.0)
                 lowered[:] = [int(k) + 1 for k in np.flatnonzero(less)]
             hold_eigenvalues(np.linalg.cholesky(self.M_), K, 1.0, 1.0, np.where(on, lam, 0.0))
             return K

@@ -1162,8 +1162,8 @@ class _ImplicitMechanical(Identifier):
             if missing:
                 raise IdentificationError(f"lhs terms not in the (pruned) library: {missing}")
             cand = np.array([pos[w] for w in wanted])
-        sw = self._sweep(G_tr[np.ix_(kidx, kidx)], G_v[np.ix_(kidx, kidx)], cand,
-                         Theta[:n_tr][:, kidx])
+        G_vk, n_val = G_v[np.ix_(kidx, kidx)], Theta.shape[0] - n_tr  # read-only below
+        sw = self._sweep(G_tr[np.ix_(kidx, kidx)], G_vk, cand, Theta[:n_tr][:, kidx])
         loc_cols = [np.flatnonzero(np.isin(kidx, c)) for c in in_cols]
         selection = self._knob("selection")
         top = self.n_rollout if selection == "rollout" else 1
@@ -1187,8 +1187,7 @@ class _ImplicitMechanical(Identifier):
         # equation plus a small input admixture is an exact combination whose residual per unit
         # of its left-hand side falls as the admixture squared (identify._implicit.input_errors)
         picks = select_models(sw, loc_cols, self.selection_rtol, self.selection_atol, top,
-                              G_v[np.ix_(kidx, kidx)] if open_chain else None,
-                              Theta.shape[0] - n_tr)
+                              G_vk if open_chain else None, n_val)
         solved = actuated
         if open_chain:
             acc = lib.acc_index[kidx]
@@ -1198,8 +1197,7 @@ class _ImplicitMechanical(Identifier):
             picks += select_passive_models(sw, loc_cols, [np.flatnonzero(acc == p) for p in passive],
                                            self.selection_rtol, self.selection_atol, top,
                                            [f"{i + 1} ({data.channels[i]})" for i in passive],
-                                           G_v[np.ix_(kidx, kidx)] if self._passive_acc_rule_on
-                                           else None, Theta.shape[0] - n_tr)
+                                           G_vk if self._passive_acc_rule_on else None, n_val)
             solved = np.concatenate([actuated, passive])
         self.feature_names_ = list(lib.names)
         self.actuated_ = solved
@@ -1255,7 +1253,7 @@ class _ImplicitMechanical(Identifier):
                 raise IdentificationError("ensemble: bagging refits each equation on every column, "
                                           "which would put inputs into the passive coordinates' "
                                           "equations of an open chain; set ensemble = 0")
-            self._bag(Theta[:n_tr][:, kidx], G_v[np.ix_(kidx, kidx)], best, sw, kidx, len(lib))
+            self._bag(Theta[:n_tr][:, kidx], G_vk, best, sw, kidx, len(lib))
         self._adopt(best, sw, kidx, solved, data)
         return self
 

@@ -244,9 +244,10 @@ def _writable_in(path: Path, option: str, start: Path) -> None:
     if not folder.is_dir():
         raise InputError(f"{option} {path}: {folder} is a file, not a folder; expected a path in "
                          "a folder you can write")
-    if not folder.stat().st_mode & 0o222:  # as root the probe passes: chmod a-w was no guard
+    mode = folder.stat().st_mode
+    if not mode & 0o222:  # as root the probe passes: chmod a-w was no guard
         raise InputError(f"{option} {path}: {folder} is read-only (mode "
-                         f"{stat.S_IMODE(folder.stat().st_mode):04o}); expected a path in a "
+                         f"{stat.S_IMODE(mode):04o}); expected a path in a "
                          "folder you can write")
     try:
         with tempfile.TemporaryFile(dir=folder):

@@ -97,7 +97,7 @@ def _guarded_exit(code: object = 0) -> None:
         late = not guarded and (this in _LEFTOVER or (this not in _BEFORE
                                                       and this is not threading.main_thread()))
         if late:  # after every guard ended: a thread a guarded block left running
-            _LATE.append((threading.current_thread().name, code))
+            _LATE.append((this.name, code))
     if guarded or late:
         raise SystemExit(code)
     real(code)  # type: ignore[arg-type]  # a thread of the caller's own (not left by a guard)
@@ -134,18 +134,10 @@ def _forget_parents_guards() -> None:
     """In a child forked inside a guard: the parent's guarded threads do not exist here; put
     ``os._exit`` back and start with no guard (called under the lock)."""
     if _PID and _PID[0] != os.getpid():
-        real = _REAL[0]
-        os._exit = real
-        posix = _posix()
-        if posix is not None:
-            posix._exit = real  # type: ignore[attr-defined]
+        _restore()
         _GUARDED.clear()
-        _PENDING.clear()
-        _REAL.clear()
-        _PID.clear()
         _LEFTOVER.clear()
         _LATE.clear()
-        _BEFORE.clear()
 
 
 @contextlib.contextmanager

@@ -193,7 +193,7 @@ def clipped_levels(y: np.ndarray) -> list[tuple[float, int, int]]:
     hi, lo = float(finite.max()), float(finite.min())
     if hi == lo:
         return []  # a constant channel: said elsewhere (a dead sensor), not a clip
-    step = float(np.diff(np.unique(finite)).min())  # a quantiser's step (on_lattice)
+    step = _smallest_gap(finite)  # a quantiser's step (on_lattice)
     for level, inside in ((hi, finite[finite < hi]), (lo, finite[finite > lo])):
         starts, lengths = _runs(y == level)
         keep = (starts > 0) & (starts + lengths < n)  # not at the record's ends

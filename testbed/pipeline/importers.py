@@ -425,11 +425,11 @@ def measurement_and_clipping(path: str | os.PathLike, kind: str,
     _check_units(data.source, ds, kind)
     if kind == "mechanical" and RESPONSE_SIGNAL[kind] in ds.measured:  # after the units: in rad
         _check_unwrapped(data.source, ds.measured[RESPONSE_SIGNAL[kind]], RESPONSE_SIGNAL[kind])
-    if (signal or {}).get("derivatives", "recorded") == "recorded":  # the rates the fit reads
+    # the rates the fit reads; they judge a held extreme (below) only where this check vouched
+    checked = (signal or {}).get("derivatives", "recorded") == "recorded"
+    if checked:
         _check_rates(data.source, ds, kind)
     try:
-        # the rates judge a held extreme only where the rate check above vouched for them
-        checked = (signal or {}).get("derivatives", "recorded") == "recorded"
         return (measure(ds, dict(signal or {}), kind),
                 measured_clipping(ds.measured, ds.fs, RATE_PAIRS.get(kind, ()) if checked else ()))
     except TestbedError:

@@ -1461,7 +1461,7 @@ def score(kind: str, dataset: Dataset, data: Measurement, clean: Measurement, mo
                        f"{', '.join(SCORERS) or '(none)'}") from None
     scores = scorer(dataset, data, clean, model)
     if kind != "structural":  # the structural scorer keeps its record's details itself
-        scores.details.update(clipping_details(kind, dataset))
+        scores.details.update(record_details(kind, dataset, data))
     return scores
 
 

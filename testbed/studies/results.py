@@ -285,8 +285,8 @@ def _read_parquet(path: Path) -> list[dict[str, Any]]:
     fmt = meta.get(b"format", b"").decode()
     if fmt not in READ_FORMATS:
         name, _, version = fmt.rpartition("/")
-        if name == FORMAT.rpartition("/")[0] and version.isdigit() \
-                and int(version) > int(FORMAT.rpartition("/")[2]):
+        ours, _, our_version = FORMAT.rpartition("/")
+        if name == ours and version.isdigit() and int(version) > int(our_version):
             # say it is newer: "not a results file" read as damage, where a newer version's file
             # is whole and only this version cannot read it
             raise ResultsError(f"{path}: a {fmt} file, written by a newer sysid-testbed; this "
