@@ -33,7 +33,7 @@ from round6 import b_make as _ROUND6  # noqa: E402
 from round13.b_make import soft  # noqa: E402
 from round14.b_make import sensors  # noqa: E402
 
-SOFT, TI, BRASS = _ROUND6.SOFT, _ROUND6.TI, _ROUND6.BRASS
+SOFT, TI, BRASS, GFRP = _ROUND6.SOFT, _ROUND6.TI, _ROUND6.BRASS, _ROUND6.GFRP
 #: materials no round drew: E [Pa], rho [kg/m^3]
 BE = {"E": 287e9, "rho": 1850.0}
 PB = {"E": 16e9, "rho": 11340.0}
@@ -42,7 +42,9 @@ _S_UNEVEN = sensors((0.15, 0.8, 1.0))
 _S07 = sensors((0.35, 0.7, 1.0))
 _S_NEARTIP = sensors((0.8, 0.95))
 _S03 = sensors((0.3, 0.65, 1.0))
-_F10, _F120 = {"peak_force": 10.0}, {"peak_force": 120.0}
+_S_TIP2 = sensors((0.9, 0.95))
+_S2 = sensors((0.5, 1.0))
+_F10, _F40, _F120 = {"peak_force": 10.0}, {"peak_force": 40.0}, {"peak_force": 120.0}
 _TI04 = {**TI, "length": 0.4, "n_segments": 14}
 
 #: name -> (description, rig, simulation, excitation, signal)
@@ -88,6 +90,25 @@ CASES: dict[str, tuple[str, dict, dict, dict, dict]] = {
         {**BRASS, **soft(1.0, 0.4, BRASS, {"location": _S03[0]}), "sensors": _S03}, {}, {"location": _S03[0]},
         {},
     ),
+    # a second batch (round23_beams_extra.toml)
+    # (with three sensors at 6.4 and 3.2 kHz the scenario refuses the 'auto' low-pass in one line: between
+    # modes 3 and 4, 4.9 kHz, above the Nyquist frequency)
+    "b23_be_fs6k4_s2": ("the beryllium-like beam at 6.4 kHz, two sensors 0.5 / 1 L (mode 3 near 3.5 kHz "
+                        "above the Nyquist frequency, folded near 2.9 kHz above the 'auto' low-pass)",
+                        {**BE, "sensors": _S2}, {"sample_rate": 6400.0}, {}, {}),
+    "b23_be_fs3k2_s2_lp1k5": ("the beryllium-like beam at 3.2 kHz, two sensors 0.5 / 1 L, a 1.5 kHz "
+                              "low-pass (mode 2 near 1.27 kHz, mode 3 folded near 360 Hz, between modes 1 "
+                              "and 2), a 1 ms hammer", {**BE, "sensors": _S2}, {"sample_rate": 3200.0},
+                              {"pulse_duration": 1e-3}, {"lowpass_hz": 1500.0}),
+    "b23_st_s2_0p9_0p95": ("the shipped beam read by two sensors 16 mm apart near the tip, 0.9 / 0.95 L, the "
+                           "hammer at 0.95 L", {"sensors": _S_TIP2}, {}, {"location": _S_TIP2[1]}, {}),
+    "b23_st_3s_z0p3_f40": ("the shipped beam at 0.3 % damping under 40 N, a 3 s record",
+                           {"damping_ratio": 0.003}, {"duration": 3.0}, {**_F40}, {}),
+    "b23_soft_r2_cf0p3_fs6k4_0p6s": ("the shipped beam on k1 = 2 EI/L, cubic fraction 0.3 at 40 N, under "
+                                     "40 N, 0.6 s at 6.4 kHz", {**soft(2.0, 0.3, {}, _F40)},
+                                     {"sample_rate": 6400.0, "duration": 0.6}, {**_F40}, {}),
+    "b23_gf_n9_s3uneven": ("glass-epoxy in 9 segments, sensors 0.15 / 0.8 / 1 L",
+                           {**GFRP, "n_segments": 9, "sensors": _S_UNEVEN}, {}, {}, {}),
 }
 
 
