@@ -109,6 +109,19 @@ CASES: dict[str, tuple[str, dict, dict, dict, dict]] = {
                                      {"sample_rate": 6400.0, "duration": 0.6}, {**_F40}, {}),
     "b23_gf_n9_s3uneven": ("glass-epoxy in 9 segments, sensors 0.15 / 0.8 / 1 L",
                            {**GFRP, "n_segments": 9, "sensors": _S_UNEVEN}, {}, {}, {}),
+    # a third batch (round23_beams_more.toml)
+    "b23_pb_soft_r3_cf0p3_2s": ("the lead-like beam on k1 = 3 EI/L, cubic fraction 0.3 (mode 1 near 12.6 Hz, "
+                                "just above the 10 Hz high-pass), 2 s", {**PB, **soft(3.0, 0.3, PB)},
+                                {"duration": 2.0}, {}, {}),
+    "b23_pb_soft_r2_cf0p1_2s": ("the lead-like beam on k1 = 2 EI/L, cubic fraction 0.1 (mode 1 near the 10 "
+                                "Hz high-pass), 2 s", {**PB, **soft(2.0, 0.1, PB)}, {"duration": 2.0}, {},
+                                {}),
+    "b23_soft_r0p7_z2p5_hit0p3": ("the shipped beam on k1 = 0.7 EI/L, cubic fraction 0.3 at 0.3 L, 2.5 % "
+                                  "damping, sensors 0.3 / 0.65 / 1 L, the hammer at 0.3 L",
+                                  {**soft(0.7, 0.3, {}, {"location": _S03[0]}), "damping_ratio": 0.025,
+                                   "sensors": _S03}, {}, {"location": _S03[0]}, {}),
+    "b23_st_n9_s4uneven": ("the shipped beam in 9 segments, four sensors 0.2 / 0.45 / 0.8 / 1 L",
+                           {"n_segments": 9, "sensors": sensors((0.2, 0.45, 0.8, 1.0))}, {}, {}, {}),
 }
 
 

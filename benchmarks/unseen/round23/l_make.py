@@ -14,9 +14,9 @@ and its 1.5, which the rig refused). Cart-poles under ``cartpole_noise1``'s chai
 m, carts of 0.5 and 2 kg, the multisine on a new phase seed (3). Kinetics (``michaelis_menten_noise1``'s
 weak setup; Km 0.3, Vmax 1.5, influx 0.6 mM/s, x0 2 mM, 4 s at 1 kHz): Km 3 mM from doses of 0.5 and 5
 mM (x* 2 mM; from the base 2 mM dose, its steady state, the scenario refuses it in one line), Vmax 2
-mM/s, Vmax 0.5 under an influx of 0.3 (x* 0.45 mM), an influx of 0.9 (x* 0.45 mM), a 0.5 mM dose (a decay
-to x* 0.2 from close above it), 2 kHz, a 1.5 s record (1 s is refused: the weak window is 1 s). Noise levels
-and seeds 141-149 are the studies' (round23_linkages_*.toml).
+mM/s, Vmax 0.5 under an influx of 0.3 (x* 0.45 mM), an influx of 0.9 (x* 0.45 mM), a 0.5 mM dose (a
+decay to x* 0.2 from close above it), 2 kHz, a 1.5 s record (1 s is refused: the weak window is 1 s).
+Noise levels and seeds 141-149 are the studies' (round23_linkages_*.toml).
 """
 
 from __future__ import annotations
@@ -56,6 +56,10 @@ _FB_BAR = "angle_rmse_max = 0.0501       # the paper's figure"
 FULL: dict[str, tuple[str, str, dict[str, dict], str]] = {
     "fb23_sine_down": ("the paper's sine on the down branch (the mirror assembly, the rig's own start pose)",
                        "fivebar_sine_replay_noise1", {"rig": {"branch": "down"}}, _FB_BAR),
+    # a second batch (round23_linkages_more.toml)
+    "fb23_ms_down_0p5": ("the multisine at 0.5 N m on the down branch (the mirror assembly, the rig's own "
+                         "start pose)", "fivebar_multisine_noise1",
+                         {"rig": {"branch": "down"}, "excitation": {"amplitude": 0.5}}, _FB_BAR),
 }
 
 #: name -> (description, {table: keys changed from cartpole_noise1 (its multisine kept)})
@@ -91,7 +95,8 @@ _write = _ROUND12.writer_for(HERE, 23)
 
 
 def _write_full(name: str, description: str, base: str, tables: dict[str, dict], score: str) -> None:
-    """Write ``round23/<name>.toml``: the shipped scenario ``base`` with ``tables``' keys changed and
+    """Write ``round23/<name>.toml``: the shipped scenario ``base`` with ``tables``' keys changed (the
+    input's keys over its own: the same input type) and
     the start pose left to the rig (``th1_0`` / ``th4_0`` dropped: the paper's pose is an up-branch
     assembly), written out in full, with the ``[score]`` line."""
     sc = load_scenario(base)  # a bare name: the shipped scenario
@@ -99,6 +104,7 @@ def _write_full(name: str, description: str, base: str, tables: dict[str, dict],
     rig = {k: v for k, v in {**sc.rig_params, **tables.get("rig", {})}.items() if k not in ("th1_0", "th4_0")}
     sc = dataclasses.replace(
         sc, name=name, description=text, tags=("unseen", "round23"), score={}, rig_params=rig,
+        excitation={**sc.excitation, **tables.get("excitation", {})},
         simulation={**sc.simulation, **tables.get("simulation", {})},
     )
     body = scenario_toml(sc).split("\n", 1)[1]
