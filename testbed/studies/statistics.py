@@ -190,6 +190,19 @@ def failed_cells_line(rows: list[dict[str, Any]]) -> str | None:
             f"reasons){again}")
 
 
+def missed_bars_line(rows: list[dict[str, Any]]) -> str | None:
+    """One line on the cells of a sweep that finished and missed bars the scorer gives no reason
+    for (:func:`failed_bars`), which :func:`failed_cells_line` does not count (their status is
+    "ok"): ``None`` when there are none.  Round 23's ``round23_beams_noise`` ended with its
+    results line alone where ``ls_sindy`` missed mode 2's bar on one cell."""
+    n = sum(1 for r, j in zip(rows, _judged(rows), strict=True)
+            if r.get("status") == "ok" and j and not r.get("passed") and failed_bars(r))
+    if not n:
+        return None
+    return (f"{n} finished cell(s) missed bars the scorer gives no reason for (the identified "
+            "model's scores; `testbed summary` names the bars)")
+
+
 def _judged(rows: list[dict[str, Any]]) -> list[bool]:
     """Whether each row was held to thresholds.
 

@@ -57,7 +57,7 @@ from testbed.pipeline.plugins import IDENTIFIERS, RIGS
 from testbed.pipeline.scenario import Scenario
 from testbed.scoring.run import run_scenario
 from testbed.studies.results import ResultsError, consolidate, parts_dir, read_results, write_part
-from testbed.studies.statistics import failed_cells_line
+from testbed.studies.statistics import failed_cells_line, missed_bars_line
 from testbed.studies.study import Study, import_plugins, load_study
 
 DEFAULT_RESULTS_DIR = Path("out") / "studies"
@@ -899,7 +899,7 @@ def _run_locked(study: Study, jobs: int, dask_address: str | None, results: Path
         _say(f"dropped {dropped} row(s) of cells no longer in study {study.name}", verbose)
     final = read_results(results)
     stats.failed_total = sum(r["status"] != "ok" for r in final)
-    line = failed_cells_line(final)
-    if line:
-        _say(line, verbose)
+    for line in (failed_cells_line(final), missed_bars_line(final)):
+        if line:
+            _say(line, verbose)
     return results

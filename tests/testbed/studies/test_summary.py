@@ -13,6 +13,7 @@ from testbed.studies.results import write_part, write_rows
 from testbed.studies.statistics import (
     failed_cells_line,
     failure_kind,
+    missed_bars_line,
     print_summary,
     scored,
     summarize,
@@ -157,6 +158,9 @@ def test_a_cell_that_missed_a_bar_with_no_reason_is_counted_by_the_bar_it_missed
     assert "2 cell(s) missed bars the scorer gives no reason for" in out
     assert "s noise=2 seed=142 ls: freq_error_mode2 0.109 above 0.026" in out
     assert "s noise=2 seed=144 ls: trac nan below 0.75" in out
+    # and the sweep's last lines say so (the sweep said nothing: its results line alone)
+    assert missed_bars_line(rows).startswith("2 finished cell(s) missed bars the scorer gives no reason")
+    assert missed_bars_line(rows[1:2]) is None and failed_cells_line(rows) is None
 
 
 def test_a_clipped_sensors_reason_is_a_named_kind():
