@@ -497,7 +497,8 @@ def _check_stem(path: Path, what: str, directory: Path) -> None:
     if problem is not None and path.parent == directory:
         known = sorted(p.stem for p in directory.glob("*.toml"))
         raise ScenarioError(str(path), allowed=f"no {what} named {path.stem!r}; known: "
-                                               + (", ".join(known) or f"(none in {directory})"))
+                                               + (", ".join(known) or f"(none in {directory})")
+                                               + unknown_key_hint(path.stem, known))
 
 
 def load_scenario(name_or_path: str | os.PathLike, *, standalone: bool = True,
@@ -789,7 +790,8 @@ def _validate_identify(table: Any, file: str, *, kind: str | None = None,
                             + near_miss(table, "method"))
     if not isinstance(method, str) or method not in IDENTIFIERS:
         raise ScenarioError(file, "identify.method", method,
-                            "expected one of " + ", ".join(IDENTIFIERS.names()))
+                            "expected one of " + ", ".join(IDENTIFIERS.names())
+                            + unknown_key_hint(method, IDENTIFIERS.names()))
     cls = IDENTIFIERS.get(method)
     if kind is not None and cls.kind != kind:
         same = [n for n in IDENTIFIERS.names() if IDENTIFIERS.get(n).kind == kind]
