@@ -54,10 +54,12 @@ Families (what rounds 1-22 did not try; their families are listed in ``hostile21
     finished run the run index does not list, is a finding.
 ``sigwrite``
     SIGINT / SIGTERM 0.8, 2 and 4 s into ``generate`` (the beam simulated into a fresh cache)
-    and ``sweep --jobs 1`` / ``--jobs 2`` (fresh cache and results), then the command again: a
-    process left in its session, a traceback, more than one error line, a temporary file, a
-    dataset file that does not verify, or a resumed sweep whose summary is not its whole grid,
-    is a finding.
+    and ``sweep --jobs 1`` / ``--jobs 2`` (fresh cache and results), 1.5 and 3 s into ``identify
+    -o`` (``sgd_sindy`` on the beam) and 0.8 and 1.5 s into ``report`` of a sweep's results,
+    then the command again: a process left in its session, a traceback, more than one error
+    line, a temporary file, a file torn (empty, a model that does not parse, a PNG or HTML
+    page cut short), a dataset file that does not verify, or a resumed sweep whose summary is
+    not its whole grid, is a finding.
 
 Prints one line a finding and the counts; exits 1 if any finding.
 """
@@ -672,6 +674,11 @@ def sigwrite_cases(work: Path) -> list[tuple[str, object]]:
             d.mkdir()
             if what == "generate":
                 argv = ["generate", BEAM, "-o", str(d / "beam.h5"), "--cache", str(d / "cache")]
+            elif what == "identify":
+                argv = ["identify", str(_generated(work, BEAM)), "--kind", "structural", "--method",
+                        "sgd_sindy", "-o", str(d / "model.json")]
+            elif what == "report":
+                argv = ["report", str(_swept(work)), "-o", str(d / "rep")]
             else:
                 jobs = what.split("-")[1]
                 argv = ["sweep", str(_mini_study(work)), "--jobs", jobs, "--cache", str(d / "cache"),
@@ -709,13 +716,16 @@ def sigwrite_cases(work: Path) -> list[tuple[str, object]]:
                     Dataset.load(h5)
                 except Exception as e:
                     return f"a partial file left: {h5.name}: {str(e)[:120]}"
+            torn = _torn_outputs(d)
+            if torn:
+                return f"partial outputs left: {torn[:4]}"
             again = _hostile.testbed_cli(argv, d, TIMEOUT_S)
             found = _hostile.cli_finding(again)
             if found:
                 return f"again: {found}"
             if again.returncode not in (0, 1):
                 return f"again: status {again.returncode}: {again.stderr[-160:]!r}"
-            if what != "generate":
+            if what.startswith("sweep"):
                 status, out_, err_ = cli_inprocess(["summary", str(d / "res.parquet")])
                 if status != 0 or "2 cells from" not in out_:  # the grid: 1 noise x 2 seeds
                     return f"summary after the resumed sweep: status {status} {err_[:120]!r}"
@@ -723,8 +733,40 @@ def sigwrite_cases(work: Path) -> list[tuple[str, object]]:
         return run
 
     return [(f"sigwrite {what} {signal.Signals(sig).name} at {delay} s", case(what, sig, delay))
-            for what in ("generate", "sweep-1", "sweep-2") for sig in (signal.SIGINT, signal.SIGTERM)
-            for delay in (0.8, 2.0, 4.0)]
+            for what, delays in (("generate", (0.8, 2.0, 4.0)), ("sweep-1", (0.8, 2.0, 4.0)),
+                                 ("sweep-2", (0.8, 2.0, 4.0)), ("identify", (1.5, 3.0)),
+                                 ("report", (0.8, 1.5)))
+            for sig in (signal.SIGINT, signal.SIGTERM) for delay in delays]
+
+
+def _swept(work: Path) -> Path:
+    """The results file of :func:`_mini_study` (swept once, on the shared cache)."""
+    path = work / "h23mini.parquet"
+    if not path.exists():
+        status, _, err = cli_inprocess(["sweep", str(_mini_study(work)), "--cache", str(hostile19.CACHE),
+                                        "--results", str(path)])
+        if status not in (0, 1):
+            raise RuntimeError(f"sweep: {err[-300:]}")
+    return path
+
+
+def _torn_outputs(folder: Path) -> list[str]:
+    """Files under ``folder`` a reader would take for whole that are not: empty files, a JSON
+    model that does not parse, a PNG without its signature, an HTML page without its end."""
+    torn = []
+    for p in folder.rglob("*"):
+        if not p.is_file() or p.name in (".lock", ".runs.lock"):
+            continue
+        data = p.read_bytes()
+        if not data or (p.suffix == ".png" and not data.startswith(b"\x89PNG")) \
+                or (p.suffix == ".html" and b"</html>" not in data[-200:]):
+            torn.append(str(p.relative_to(folder)))
+        elif p.suffix == ".json":
+            try:
+                json.loads(data)
+            except ValueError:
+                torn.append(str(p.relative_to(folder)))
+    return torn
 
 
 # ------------------------------------------------------------------ main
