@@ -49,9 +49,10 @@ Families (what rounds 1-22 did not try; their families are listed in ``hostile21
     whose name ends in an invisible character, made in silence, is a finding.
 ``runrace``
     Two ``run`` (one runs folder, one fresh cache), ``generate -o``, ``export -o`` or ``identify
-    -o`` commands on one target started together or 0.3 s apart (real processes): a traceback,
-    both refused, a temporary file left, a cache entry or output that does not verify, or a
-    finished run the run index does not list, is a finding.
+    -o`` commands on one target started together or 0.3 s apart (real processes), and ``cache
+    clear`` 1-4 s into a ``run`` simulating the beam into that cache: a traceback, both
+    refused, a run without its verdict, a temporary file left, a cache entry or output that
+    does not verify, or a finished run the run index does not list, is a finding.
 ``sigwrite``
     SIGINT / SIGTERM 0.8, 2 and 4 s into ``generate`` (the beam simulated into a fresh cache)
     and ``sweep --jobs 1`` / ``--jobs 2`` (fresh cache and results), 1.5 and 3 s into ``identify
@@ -648,8 +649,40 @@ def runrace_cases(work: Path) -> list[tuple[str, object]]:
             return None
         return run
 
+    def clear_during_run(delay: float):
+        """``cache clear`` while ``run`` simulates the beam into that cache: the run must end
+        in its verdict, the cache hold only entries that verify, no temporary left."""
+        def run():
+            d = work / f"clear_{delay}"
+            shutil.rmtree(d, ignore_errors=True)
+            d.mkdir()
+            p = _start(["run", BEAM, "--no-figures", "-o", str(d / "runs"), "--cache", str(d / "cache")], d)
+            time.sleep(delay)
+            status, _, err = cli_inprocess(["cache", "clear", "--cache", str(d / "cache")])
+            found = judged(status, "", err)
+            try:
+                out_, err_ = p.communicate(timeout=TIMEOUT_S)
+            except Exception:
+                p.kill()
+                return "hang"
+            if found:
+                return f"cache clear: {found}"
+            if p.returncode not in (0, 1) or "run written to" not in out_:
+                return f"run: status {p.returncode} without its verdict: {err_[-160:]!r}"
+            temps = _temporaries(d)
+            if temps:
+                return f"temporary files left: {temps[:4]}"
+            from testbed.core.dataset import Dataset
+
+            for h5 in (d / "cache").glob("*.h5"):
+                Dataset.load(h5)
+            return None
+        return run
+
     return [(f"runrace two {what} at once ({stagger} s apart)", case(what, stagger))
-            for what in ("run", "generate", "export", "identify") for stagger in (0.0, 0.3)]
+            for what in ("run", "generate", "export", "identify") for stagger in (0.0, 0.3)] + \
+        [(f"runrace cache clear {delay} s into a simulating run", clear_during_run(delay))
+         for delay in (1.0, 2.5, 4.0)]
 
 
 # ------------------------------------------------------------------ sigwrite
