@@ -154,6 +154,16 @@ def _path_text(text: str) -> str:
     datasets (a script's `--out "$DIR"` with the variable unset)."""
     if not text:
         raise argparse.ArgumentTypeError("an empty path; expected a file or folder name")
+    if text[-1].isspace() and not os.path.lexists(text):
+        # round 23: `--cache "c\n"` (a name pasted with its line end), `--out "runs "` or
+        # `--cache " "` made a folder whose name ends in an invisible character, in silence; the
+        # next command without it used another folder (the data simulated again, the runs
+        # listed elsewhere).  A path that exists so is the user's own, and is taken.
+        from testbed.core.errors import _one_line as escaped
+
+        raise argparse.ArgumentTypeError(f"{escaped(repr(text))} ends in a blank or line end and "
+                                         "names nothing yet; expected a name without trailing "
+                                         "whitespace (or one that exists)")
     return text
 
 

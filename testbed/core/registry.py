@@ -38,6 +38,7 @@ from testbed.core.errors import TestbedError, UnknownNameError, show_value
 from testbed.core.exit_guard import no_process_exit
 from testbed.core.lazy import configure_loaded
 from testbed.core.process_state import kept_process_state
+from testbed.core.schema import unknown_key_hint
 
 #: Entry-point group of identifiers from other distributions.
 IDENTIFIER_ENTRY_POINTS = "sysid_testbed.identifiers"
@@ -253,7 +254,7 @@ class Registry:
         except (KeyError, TypeError):  # TypeError: an unhashable name (a list)
             allowed = ", ".join(sorted(self._entries)) or "(none registered)"
             raise UnknownNameError(f"unknown {self.kind} {show_value(name)}; allowed: {allowed}"
-                                   ) from None
+                                   + unknown_key_hint(name, self._entries)) from None
 
     def names(self, tag: str | None = None) -> list[str]:
         """Sorted names, optionally only those carrying ``tag``."""

@@ -13,7 +13,7 @@ import difflib
 import math
 import re
 import sys
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, replace
 from typing import Any
 
@@ -210,15 +210,58 @@ def near_miss(table: Mapping[str, Any], key: str) -> str:
     return f"; given instead: {given[close[0]]!r} (misspelt?)" if close else ""
 
 
+def unknown_key_hint(key: Any, known: Iterable[str],
+                     elsewhere: Mapping[str, Iterable[str]] | None = None) -> str:
+    """What an unknown ``key`` was probably meant as, for its refusal: ``" (did you mean
+    'Vmax'?)"`` when one of ``known`` is spelt like it (case ignored; difflib's ratio >= 0.7,
+    :func:`near_miss`'s), and ``" ('sample_rate' is a key of [simulation])"`` when it is one
+    of the keys ``elsewhere`` maps a place (``"[simulation]"``, ``"sgd_sindy"``) to (both
+    when both hold); ``""`` when neither does.
+
+    Malformed-input round 23: ``vmax`` for ``Vmax``, ``threshold`` for ``thresholds``,
+    ``sample_rate`` under ``[rig]`` and ``--param lr=...`` for an identifier that has no
+    learning rate were each refused with the whole list of allowed keys, naming neither the
+    key meant nor where the given one belongs.
+    """
+    if not isinstance(key, str):
+        return ""
+    known = list(known)
+    if key.lower() in {k.lower() for k in known}:
+        same = next(k for k in known if k.lower() == key.lower())
+        return f" (did you mean {same!r}?)"
+    lowered = {k.lower(): k for k in known}
+    close = difflib.get_close_matches(key.lower(), list(lowered), n=1, cutoff=0.7) \
+        or sorted(k for k in lowered if _one_edit(key.lower(), k))[:1]
+    said = [f"did you mean {lowered[close[0]]!r}?"] if close else []
+    homes = [place for place, keys in (elsewhere or {}).items() if key in keys]
+    if homes:
+        said.append(f"{key!r} is a key of {', '.join(homes)}")
+    return f" ({'; '.join(said)})" if said else ""
+
+
+def _one_edit(a: str, b: str) -> bool:
+    """Whether ``a`` and ``b`` differ by one letter changed, added or dropped (``xo`` and
+    ``x0``: short keys difflib's ratio leaves at 0.5)."""
+    if abs(len(a) - len(b)) > 1 or a == b:
+        return False
+    if len(a) == len(b):
+        return sum(x != y for x, y in zip(a, b, strict=True)) == 1
+    short, long_ = sorted((a, b), key=len)
+    return any(long_[:i] + long_[i + 1:] == short for i in range(len(long_)))
+
+
 def validate_table(table: Mapping[str, Any], schema: Mapping[str, Field], *, file: str,
-                   section: str) -> dict[str, Any]:
+                   section: str, elsewhere: Mapping[str, Iterable[str]] | None = None) -> dict[str, Any]:
     """Validate ``table`` against ``schema``; return a new dict with defaults filled in.
+
+    ``elsewhere`` maps other places (``"[simulation]"``) to their keys: an unknown key found
+    there is named so (:func:`unknown_key_hint`).
 
     Raises
     ------
     ScenarioError
-        For an unknown key (listing the allowed ones), a missing required key,
-        or a value of the wrong type or out of bounds.
+        For an unknown key (listing the allowed ones, and the one probably meant), a missing
+        required key, or a value of the wrong type or out of bounds.
     """
     if not isinstance(table, Mapping):
         raise ScenarioError(file, section, table, "expected a table")
@@ -226,8 +269,9 @@ def validate_table(table: Mapping[str, Any], schema: Mapping[str, Field], *, fil
     for key in table:
         if key not in schema:
             allowed = ", ".join(sorted(schema)) or "(no keys)"
+            hint = unknown_key_hint(key, schema, elsewhere)
             raise ScenarioError(file, f"{section}.{key}", table[key],
-                                f"unknown key; allowed keys in [{section}]: {allowed}")
+                                f"unknown key; allowed keys in [{section}]: {allowed}{hint}")
     for key, f in schema.items():
         if key in table:
             out[key] = check_value(table[key], f, file=file, key=f"{section}.{key}")

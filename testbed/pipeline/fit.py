@@ -25,11 +25,12 @@ from testbed.core.errors import IdentificationError, InputError, ScenarioError, 
 from testbed.core.exit_guard import no_process_exit
 from testbed.core.measurement import Measurement
 from testbed.core.process_state import kept_process_state
+from testbed.core.schema import unknown_key_hint
 from testbed.numerics.clipping import Clipping
 from testbed.numerics.shapes import modal_from_matrices
 from testbed.pipeline import plugins
 from testbed.pipeline.importers import measurement_and_clipping
-from testbed.pipeline.scenario import check_identifier_for_record, load_scenario
+from testbed.pipeline.scenario import check_identifier_for_record, load_scenario, other_identifiers
 from testbed.pipeline.signal_chain import SIGNAL_SCHEMAS
 
 
@@ -241,6 +242,16 @@ def identify_file(path: str | os.PathLike, *, scenario: str | os.PathLike | None
                          f"prior; it reads: {', '.join(declared) or 'none'}")
     hyper = {k: v for k, v in identify.items() if k != "method"} | dict(params or {})
     where = str(scenario or "<command line>")
+    declared = cls.declared_hyperparameters()
+    for key, value in hyper.items():
+        if key not in declared:  # named with the key probably meant, or the identifier it is
+            # a hyperparameter of (round 23: `--param lr=0.1` for sindy_pi_dynamical listed
+            # its 15 keys, not that lr is sgd_sindy's)
+            hint = unknown_key_hint(key, declared, other_identifiers(identify["method"]))
+            raise ScenarioError("<command line>" if key in (params or {}) else where,
+                                f"identify.{key}", value,
+                                "unknown key; allowed keys in [identify]: "
+                                + (", ".join(sorted(declared)) or "(no keys)") + hint)
     with _named_source(params, scenario):
         hyper = cls.validate_hyperparameters(hyper, file=where)
     phase = phase or _no_phase

@@ -66,6 +66,7 @@ from testbed.core.measurement import MIN_FREE_SAMPLES, Measurement
 from testbed.core.rate_attrs import fs_attribute_problem
 from testbed.numerics.clipping import Clipping, measured_clipping
 from testbed.numerics.noise import noise_std
+from testbed.pipeline.plugins import rig_class
 from testbed.pipeline.signal_chain import SIGNAL_CHAINS, SIGNAL_SCHEMAS, measure, pulse_span
 
 FORMATS = ("uff", "sep005", "csv", "hdf5")
@@ -105,6 +106,8 @@ RESPONSE_SIGNAL = {"structural": "acceleration", "mechanical": "theta", "dynamic
 TIME_NAMES = ("t", "time")
 #: a time column's steps may differ from their median by this fraction
 TIME_TOLERANCE = 0.01
+#: The ``layout`` attribute of a dataset file's signal arrays (what ``Dataset.save`` writes).
+LAYOUT = "channels x samples"
 #: a rate declared twice (``--fs`` and the file's; a SEP-005 channel's ``fs`` and ``time``) may
 #: differ by this fraction: a time printed to 4 significant digits over a record of 1,000
 #: samples (t[-1] to +-5e-4 relative) stays within it; a wrong rate (2x, 1.5 %) does not
@@ -972,6 +975,7 @@ def _finish(raw: _Raw, fs: float | None, units: str | Mapping[str, str] | None,
                                           f"expected at most {max_magnitude:g} (larger values "
                                           "overflow the identifiers' sums of sixth powers)")
         signals[n] = (si, x)
+    _check_direction_signs(path, {n: raw.directions[n] for n in names if raw.directions.get(n)})
     for key, value in raw.prior.items():  # a dataset file's own (an edited attribute)
         check_prior(path, key, value)
     keep = set(names)
@@ -1005,6 +1009,26 @@ def _check_direction(path: Path, name: str, direction: int, si: str) -> None:
                                       f"is a {'rotation' if turns else 'translation'} but its unit "
                                       f"{si!r} is a {'rotation' if unit_turns else 'translation'}'s; "
                                       "expected a direction and a unit of one kind")
+
+
+def _check_direction_signs(path: Path, directions: Mapping[str, int]) -> None:
+    """Refuse channels that point opposite ways along one axis (``+Z`` and ``-Z``, UFF codes
+    3 and -3).  The testbed reads every channel in one frame and never flips a sign: a sensor
+    declared ``-Z`` beside others declared ``+Z`` was read as if it pointed along ``+Z``, its
+    mode shape's sign (and the model's coupling terms through it) reversed in silence
+    (malformed-input round 23).  Channels all along one signed axis (every one ``-Z``) are one
+    frame and are read as they are."""
+    first: dict[int, str] = {}
+    for name, code in directions.items():
+        other = first.setdefault(abs(code), name)
+        if directions[other] != code:
+            def said(c: int) -> str:
+                return f"{'-' if c < 0 else '+'}{'XYZ'[(abs(c) - 1) % 3]}{' rotation' if abs(c) > 3 else ''}"
+            raise MeasuredDataError(path, f"channel {name!r} points {said(code)} (direction code "
+                                          f"{code}) but channel {other!r} {said(directions[other])} "
+                                          f"({directions[other]}); the testbed reads every channel in "
+                                          "one frame and flips no sign: negate the samples of the "
+                                          "channels that point the other way and declare one direction")
 
 
 def _check_starts(path: Path, starts: Mapping[str, float], fs: float,
@@ -1177,6 +1201,7 @@ def check_recorded(ds: Dataset, path: str | os.PathLike) -> None:
 
 def _raw_from_dataset(path: Path, ds: Dataset) -> _Raw:
     """The measured signals of a loaded dataset file as a reader's raw record."""
+    _check_scenario_rate(path, ds)
     raw = _Raw(path, "hdf5", float(ds.fs), {}, {}, prior=dict(ds.prior),
                own_units=ds.attrs.get("kind") == "dynamical")
     for g, s in ds.measured.items():
@@ -1211,6 +1236,35 @@ def _raw_from_dataset(path: Path, ds: Dataset) -> _Raw:
                 if target in node:
                     raw.nodes[f"{g}/{ch}"] = node[target]
     return raw
+
+
+#: How far [relative] a dataset file's ``fs`` may lie from the rate its stored scenario records
+#: at: the cache's own allowance (``testbed.pipeline.cache._load_entry``: a plugin rig may write
+#: a derived rate 1 / (k dt) an ulp or so from its scenario's).
+SCENARIO_RATE_RTOL = 1e-12
+
+
+def _check_scenario_rate(path: Path, ds: Dataset) -> None:
+    """Refuse a dataset file whose ``fs`` is not the rate its own stored scenario records at
+    (``Rig.record`` of its ``[simulation]`` table, where its rig is registered here and declares
+    one).  The cache refuses such an entry; ``identify`` and ``export`` read one (an edit of
+    ``fs`` or of the scenario's ``sample_rate`` by 1 %, its content hash made anew) with status
+    0, every frequency 1 % off (malformed-input round 23).  A file without a scenario (a lab's
+    record written as a dataset) or of a rig not registered here states no rate to check."""
+    scenario = ds.attrs.get("scenario")
+    simulation = scenario.get("simulation") if isinstance(scenario, Mapping) else None
+    rig = ds.attrs.get("rig")
+    if not isinstance(simulation, Mapping) or not isinstance(rig, str):
+        return
+    try:
+        record = rig_class(rig).record(dict(simulation))
+        rate = None if record is None else float(record[0])
+    except Exception:  # an unregistered rig, or a table its rig cannot read: nothing stated
+        return
+    if rate is not None and not abs(float(ds.fs) - rate) <= SCENARIO_RATE_RTOL * abs(rate):
+        raise MeasuredDataError(path, f"attribute fs={float(ds.fs)!r} Hz but its scenario "
+                                      f"(attribute scenario, [simulation]) records at {rate!r} Hz; "
+                                      "the file contradicts itself (expected equal rates)")
 
 
 def check_hdf5_rate(path: str | os.PathLike) -> None:
@@ -1256,6 +1310,15 @@ def check_hdf5_storage(path: str | os.PathLike) -> None:
 
     def visit(name: str, obj: Any) -> None:
         if found or not isinstance(obj, h5py.Dataset):
+            return
+        layout = obj.attrs.get("layout")
+        layout = layout.decode(errors="replace") if isinstance(layout, bytes) else layout
+        if layout is not None and layout != LAYOUT:
+            # the reader takes rows as channels whatever this says: a file whose arrays claim
+            # "samples x channels" was read as channels x samples in silence (round 23)
+            shown = layout.item() if isinstance(layout, np.generic) else layout
+            found.append(f"/{name}: attribute layout={shown!r}; expected {LAYOUT!r} (each row "
+                         "one channel, as the reader takes it)")
             return
         plist = obj.id.get_create_plist()
         if obj.is_virtual:

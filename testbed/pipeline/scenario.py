@@ -62,6 +62,7 @@ from testbed.core.schema import (
     ONE_LINE_DOC,
     Field,
     near_miss,
+    unknown_key_hint,
     validate_header,
     validate_table,
     validate_variant,
@@ -357,7 +358,7 @@ def read_toml_file(path: Path, what: str) -> dict:
     try:
         raw = tomllib.loads(text)
     except tomllib.TOMLDecodeError as e:
-        raise ScenarioError(file, allowed=f"not valid TOML: {e}") from None
+        raise ScenarioError(file, allowed=f"not valid TOML: {_given_twice(text, str(e)) or e}") from None
     except RecursionError:
         raise ScenarioError(file, allowed=f"not a {what} file: TOML nested too deeply") from None
     except ValueError as e:  # an integer beyond Python's str-to-int limit: an internal error before
@@ -366,6 +367,32 @@ def read_toml_file(path: Path, what: str) -> dict:
         raise ScenarioError(file, allowed=f"not a {what} file: tables or lists nested deeper "
                                           f"than {MAX_DEPTH}")
     return raw
+
+
+_AT_LINE = re.compile(r"\(at (?:line (\d+), column \d+|end of document)\)$")
+_TABLE_HEADER = re.compile(r"^\s*\[\[?\s*([^\[\]#]+?)\s*\]\]?\s*(?:#.*)?$")
+
+
+def _given_twice(text: str, message: str) -> str | None:
+    """tomllib's "Cannot overwrite a value (at line 18, column 9)" as the key given twice,
+    with its table and line (``"key 'rig.Km' is given twice (line 18); give each key once"``),
+    or None where the message is another or the line holds no key.  Round 23: a key repeated
+    in its table was refused naming a line and column, not the key."""
+    m = _AT_LINE.search(message)
+    if not message.startswith("Cannot overwrite a value") or m is None:
+        return None
+    lines = text.splitlines()
+    if m.group(1):
+        n = int(m.group(1))
+    else:  # the last line holding something
+        n = max((k for k, ln in enumerate(lines, 1) if ln.strip()), default=0)
+    if not 1 <= n <= len(lines) or "=" not in lines[n - 1]:
+        return None
+    key = lines[n - 1].split("=", 1)[0].strip()
+    table = next((h.group(1) for ln in reversed(lines[:n - 1])
+                  if (h := _TABLE_HEADER.match(ln)) is not None), "")
+    dotted = f"{table}.{key}" if table else key
+    return f"key {dotted!r} is given twice (line {n}); give each key once"
 
 
 def _long_integer(text: str) -> str | None:
@@ -470,7 +497,8 @@ def _check_stem(path: Path, what: str, directory: Path) -> None:
     if problem is not None and path.parent == directory:
         known = sorted(p.stem for p in directory.glob("*.toml"))
         raise ScenarioError(str(path), allowed=f"no {what} named {path.stem!r}; known: "
-                                               + (", ".join(known) or f"(none in {directory})"))
+                                               + (", ".join(known) or f"(none in {directory})")
+                                               + unknown_key_hint(path.stem, known))
 
 
 def load_scenario(name_or_path: str | os.PathLike, *, standalone: bool = True,
@@ -547,12 +575,23 @@ def scenario_from_dict(raw: dict[str, Any], *, file: str = "<dict>", stem: str |
     except KeyError as e:
         raise ScenarioError(file, "scenario.rig", head["rig"], str(e.args[0])) from None
 
-    rig_params = validate_table(raw.get("rig", {}), rig_cls.rig_schema, file=file, section="rig")
+    # each table's keys, to name the table an unknown key belongs in (round 23: `sample_rate`
+    # under [rig] was refused listing [rig]'s keys only)
+    tables = {"[scenario]": HEADER_SCHEMA, "[rig]": rig_cls.rig_schema,
+              "[simulation]": rig_cls.simulation_schema, "[noise]": NOISE_SCHEMA,
+              "[signal]": SIGNAL_SCHEMAS[rig_cls.kind]}
+
+    def others(section: str) -> dict[str, Any]:
+        return {t: keys for t, keys in tables.items() if t != f"[{section}]"}
+
+    rig_params = validate_table(raw.get("rig", {}), rig_cls.rig_schema, file=file, section="rig",
+                                elsewhere=others("rig"))
     simulation = validate_table(raw.get("simulation", {}), rig_cls.simulation_schema, file=file,
-                                section="simulation")
+                                section="simulation", elsewhere=others("simulation"))
     excitation = validate_variant(raw.get("excitation", {"type": rig_cls.default_excitation}),
                                   rig_cls.excitation_schemas, file=file, section="excitation")
-    noise = validate_table(raw.get("noise", {}), NOISE_SCHEMA, file=file, section="noise")
+    noise = validate_table(raw.get("noise", {}), NOISE_SCHEMA, file=file, section="noise",
+                           elsewhere=others("noise"))
     if noise["signals"] is None:
         noise["signals"] = list(rig_cls.noisy_signals)
     for i, s in enumerate(noise["signals"]):
@@ -572,7 +611,7 @@ def scenario_from_dict(raw: dict[str, Any], *, file: str = "<dict>", stem: str |
         # sample count is capped at 2**62)
         check_rig_cost(rig_cls, rig_params, simulation, excitation, file=file)
     signal = validate_table(raw.get("signal", {}), SIGNAL_SCHEMAS[rig_cls.kind], file=file,
-                            section="signal")
+                            section="signal", elsewhere=others("signal"))
     rules = resolve_auto_signal(rig_cls, rig_params, signal, file)
 
     def chain_error(key: str, value: Any, allowed: str) -> None:
@@ -719,6 +758,20 @@ def check_identifier_for_record(cls: Any, full: dict[str, Any], shape: tuple[int
         check_steps(steps, file, f"{section}.{key}", value)
 
 
+def other_identifiers(method: str) -> dict[str, Any]:
+    """Every registered identifier but ``method``, by name, mapped to its
+    declared hyperparameters: where an unknown hyperparameter of ``method`` belongs
+    (:func:`~testbed.core.schema.unknown_key_hint`)."""
+    out: dict[str, Any] = {}
+    for name in IDENTIFIERS.names():
+        if name != method:
+            try:
+                out[name] = IDENTIFIERS.get(name).declared_hyperparameters()
+            except Exception:  # a plugin's broken declaration: it is no place to name
+                continue
+    return out
+
+
 def _validate_identify(table: Any, file: str, *, kind: str | None = None,
                        rig_kind_source: str = "the rig") -> dict[str, Any] | None:
     """``method`` and the given hyperparameters, checked against the identifier's declaration.
@@ -737,7 +790,8 @@ def _validate_identify(table: Any, file: str, *, kind: str | None = None,
                             + near_miss(table, "method"))
     if not isinstance(method, str) or method not in IDENTIFIERS:
         raise ScenarioError(file, "identify.method", method,
-                            "expected one of " + ", ".join(IDENTIFIERS.names()))
+                            "expected one of " + ", ".join(IDENTIFIERS.names())
+                            + unknown_key_hint(method, IDENTIFIERS.names()))
     cls = IDENTIFIERS.get(method)
     if kind is not None and cls.kind != kind:
         same = [n for n in IDENTIFIERS.names() if IDENTIFIERS.get(n).kind == kind]
@@ -750,7 +804,8 @@ def _validate_identify(table: Any, file: str, *, kind: str | None = None,
         if key not in declared:
             raise ScenarioError(file, f"identify.{key}", value,
                                 f"unknown hyperparameter of {method}; allowed: "
-                                + ", ".join(sorted(declared)))
+                                + ", ".join(sorted(declared))
+                                + unknown_key_hint(key, declared, other_identifiers(method)))
     full = cls.validate_hyperparameters(params, file=file, section="identify")
     return {"method": method, **{k: full[k] for k in params}}
 

@@ -20,7 +20,8 @@ def test_defaults_filled_and_ints_widened():
 
 
 @pytest.mark.parametrize(("table", "key", "fragment"), [
-    ({"lenght": 1.0}, "rig.lenght", "unknown key; allowed keys in [rig]: base, length, n, where"),
+    ({"lenght": 1.0}, "rig.lenght",
+     "unknown key; allowed keys in [rig]: base, length, n, where (did you mean 'length'?)"),
     ({"length": -1.0}, "rig.length", "> 0 [m]"),
     ({"length": 0.0}, "rig.length", "> 0 [m]"),
     ({"length": "long"}, "rig.length", "expected a number"),
