@@ -446,24 +446,33 @@ def stored_checks(row: dict[str, Any]) -> list[Any] | None:
     return checks if isinstance(checks, list) else None
 
 
-def _checks_hold(row: dict[str, Any]) -> bool:
-    """Whether every check stored in ``row["checks"]`` passes, judged again from its value and
-    threshold, a value that differs from the row's score column counting as NaN (never a
-    pass): a row edited to ``passed`` over a NaN score counted in the pass rate."""
+def judged_checks(row: dict[str, Any]) -> list[Check] | None:
+    """The checks stored in ``row["checks"]``, judged again from their values and thresholds,
+    a value that differs from the row's score column counting as NaN (never a pass: a row
+    edited to ``passed`` over a NaN score counted in the pass rate); ``None`` where they
+    cannot be read (not a list of checks).  A check without its value is judged from the
+    score column alone."""
     checks = stored_checks(row)
-    if checks is None:  # not a list of checks: nothing holds
-        return False
+    if checks is None:
+        return None
     try:
         judged = []
-        for c in checks:  # (a check without its value is judged from the score column alone)
+        for c in checks:
             score = float(row.get(c["metric"], math.nan))
             value = float(c["value"]) if "value" in c else score
             same = value == score or (math.isnan(value) and math.isnan(score))
             judged.append(Check(str(c["metric"]), value if same else math.nan, str(c["bound"]),
-                                float(c["threshold"])).passed)
-    except (TypeError, ValueError, KeyError):  # not a list of checks: nothing holds
-        return False
-    return bool(judged) and all(judged)
+                                float(c["threshold"])))
+    except (TypeError, ValueError, KeyError):  # not a list of checks
+        return None
+    return judged
+
+
+def _checks_hold(row: dict[str, Any]) -> bool:
+    """Whether every check stored in ``row["checks"]`` passes (:func:`judged_checks`; none, or
+    unreadable ones, hold nothing)."""
+    checks = judged_checks(row)
+    return bool(checks) and all(c.passed for c in checks)
 
 
 def consolidate(path: str | os.PathLike, *, keep: set[str] | None = None,

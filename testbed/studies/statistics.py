@@ -36,7 +36,7 @@ from testbed.core.terminal import make_console
 from testbed.numerics.quantiles import quartiles
 from testbed.scoring.scorers import Check
 from testbed.studies.family import family_of
-from testbed.studies.results import read_results, score_columns, stored_checks
+from testbed.studies.results import judged_checks, read_results, score_columns, stored_checks
 
 GROUP_KEYS = ("identifier", "noise")
 #: Groupings of :func:`summarize`: the extra key before identifier and noise.
@@ -110,9 +110,10 @@ FAILED_BAR = "failed bar"
 
 
 def failed_bars(row: dict[str, Any]) -> list[Check]:
-    """The bars a results row missed, judged again from its stored checks (a check's ``value``,
-    else the row's score column; NaN never passes): empty for a row whose checks all hold or
-    cannot be read (:func:`~testbed.studies.results.stored_checks` None: no bar to name).
+    """The bars a results row missed, judged again from its stored checks as the pass rate
+    judges them (:func:`~testbed.studies.results.judged_checks`: a check's ``value``, NaN where
+    it differs from the row's score column; NaN never passes): empty for a row whose checks
+    all hold or cannot be read (no bar to name).
 
     A cell that finished ("ok") and missed a bar the scorer explains by none of its reasons
     (an identified mode off its bar on a record that holds it) has an empty ``error``: its
@@ -120,31 +121,25 @@ def failed_bars(row: dict[str, Any]) -> list[Check]:
     list left it out (round 23's ``b23_soft_s2neartip`` at 2 %, ``ls_sindy``: mode 2 10.9 %
     off the 2.6 % bar, named nowhere in ``testbed summary``).
     """
-    out = []
-    for c in stored_checks(row) or []:
-        try:
-            value = float(c["value"]) if "value" in c else float(row.get(c["metric"], math.nan))
-            check = Check(str(c["metric"]), value, str(c["bound"]), float(c["threshold"]))
-        except (TypeError, ValueError, KeyError):  # not a check: nothing to name
-            continue
-        if not check.passed:
-            out.append(check)
-    return out
+    return [c for c in judged_checks(row) or [] if not c.passed]
 
 
 def row_failure_kinds(row: dict[str, Any], judged: bool) -> list[str]:
     """The failure kinds of a results row: :func:`failure_kind` of its ``error``, or, for a row
     held to bars (``judged``) that finished without passing and without a reason,
-    ``"failed bar <metric>"`` per bar it missed (:func:`failed_bars`)."""
+    ``"failed bar <metric>"`` per bar it missed (:func:`failed_bars`), or ``"failed bar
+    (checks unreadable)"`` where no stored check names one (a hand-edited or older file whose
+    checks cannot be judged: not passed, and counted)."""
     kinds = failure_kind(row.get("error") or "")
     if kinds or not judged or row.get("passed"):
         return kinds
-    return [f"{FAILED_BAR} {c.metric}" for c in failed_bars(row)]
+    return ([f"{FAILED_BAR} {c.metric}" for c in failed_bars(row)]
+            or [f"{FAILED_BAR} (checks unreadable)"])
 
 
 def _bar_text(c: Check) -> str:
     """``"<metric> <value> above <max>"`` (or below a min): one missed bar in words."""
-    return f"{c.metric} {c.value:.3g} {'above' if c.bound == 'max' else 'below'} {c.threshold:g}"
+    return f"{c.metric} {c.value:.3g} {'below' if c.bound == 'min' else 'above'} {c.threshold:g}"
 
 
 def scored(row: dict[str, Any]) -> bool:
@@ -195,12 +190,18 @@ def missed_bars_line(rows: list[dict[str, Any]]) -> str | None:
     for (:func:`failed_bars`), which :func:`failed_cells_line` does not count (their status is
     "ok"): ``None`` when there are none.  Round 23's ``round23_beams_noise`` ended with its
     results line alone where ``ls_sindy`` missed mode 2's bar on one cell."""
-    n = sum(1 for r, j in zip(rows, _judged(rows), strict=True)
-            if r.get("status") == "ok" and j and not r.get("passed") and failed_bars(r))
+    n = len(_missed_bar_rows(rows))
     if not n:
         return None
     return (f"{n} finished cell(s) missed bars the scorer gives no reason for (the identified "
             "model's scores; `testbed summary` names the bars)")
+
+
+def _missed_bar_rows(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """The rows of cells that finished ("ok"), were held to bars and did not pass: each missed
+    a bar (:func:`failed_bars`) or holds checks that cannot be judged (not a pass either)."""
+    return [r for r, j in zip(rows, _judged(rows), strict=True)
+            if r.get("status") == "ok" and j and not r.get("passed")]
 
 
 def _judged(rows: list[dict[str, Any]]) -> list[bool]:
@@ -360,13 +361,13 @@ def print_summary(path: str | os.PathLike, console: Any = None,
             console.print(f"  {r['scenario']} noise={r['noise']:g} seed={r['seed']} "
                           f"{r['identifier']}: {r['error']}", markup=False, highlight=False,
                           soft_wrap=True)
-    missed = [(r, bars) for r, j in zip(rows, _judged(rows), strict=True)
-              if r["status"] == "ok" and j and not r["passed"] and (bars := failed_bars(r))]
+    missed = [(r, failed_bars(r)) for r in _missed_bar_rows(rows)]
     if missed:
         console.print(f"{len(missed)} cell(s) missed bars the scorer gives no reason for (the "
                       "identified model's scores); first:", highlight=False)
         for r, bars in missed[:5]:
             console.print(f"  {r['scenario']} noise={r['noise']:g} seed={r['seed']} "
-                          f"{r['identifier']}: {'; '.join(map(_bar_text, bars))}", markup=False,
+                          f"{r['identifier']}: "
+                          f"{'; '.join(map(_bar_text, bars)) or 'checks unreadable'}", markup=False,
                           highlight=False, soft_wrap=True)
     return summary

@@ -163,6 +163,32 @@ def test_a_cell_that_missed_a_bar_with_no_reason_is_counted_by_the_bar_it_missed
     assert missed_bars_line(rows[1:2]) is None and failed_cells_line(rows) is None
 
 
+def test_a_finished_cell_whose_checks_cannot_be_judged_is_still_counted(tmp_path):
+    # review 24b: the pass rate judges a stored check whose value differs from the row's score
+    # column as NaN (and an unreadable check as holding nothing), while the missed-bar count
+    # trusted the stored value: such rows showed a pass rate under 100 % beside "failure
+    # reasons -" and were named nowhere (older or hand-written results files)
+    res = tmp_path / "r.parquet"
+    edited = '[{"metric": "trac", "value": 0.95, "bound": "min", "threshold": 0.75}]'
+    null = '[{"metric": "trac", "value": null, "bound": "min", "threshold": 0.75}]'
+    upper = '[{"metric": "trac", "value": 0.9, "bound": "MAX", "threshold": 0.5}]'
+    rows = [row("e0", "ls", 1.0, 1, passed=False, checks=edited, trac=0.5),
+            row("e1", "ls", 1.0, 2, passed=False, checks=null, trac=0.5),
+            row("e2", "ls", 1.0, 3, passed=False, checks=upper, trac=0.9),
+            row("e3", "ls", 1.0, 4, passed=True, trac=0.9)]
+    write_rows(res, rows)
+    (s,) = summarize(res)
+    assert s["pass_rate"] == 1 / 4
+    assert s["failures"] == {"failed bar trac": 2, "failed bar (checks unreadable)": 1}
+    assert missed_bars_line(rows).startswith("3 finished cell(s) missed bars")
+    buf = io.StringIO()
+    print_summary(res, console=Console(file=buf, width=200))
+    out = buf.getvalue()
+    assert "seed=1 ls: trac nan below 0.75" in out  # the edited value judged as NaN
+    assert "seed=2 ls: checks unreadable" in out
+    assert "seed=3 ls: trac 0.9 above 0.5" in out  # any bound but "min" is a maximum
+
+
 def test_a_clipped_sensors_reason_is_a_named_kind():
     # session 21: a failed bar on a record with a clipped sensor reads "clipped: ..." (the
     # scorer's clipping_failures); counted as "other" it named nothing
