@@ -749,3 +749,25 @@ def test_a_candidate_the_noise_rule_cannot_test_is_kept():
     kept = _decaying_only(SimpleNamespace(xdd=x, fs=fs), 0, np.array([80.0, 30.0]),
                           np.array([sh1, sh2]).astype(complex), [0, 1], rejected, 20.0)
     assert kept == [0, 1] and rejected == []
+
+
+HELDOUT = Path(__file__).resolve().parents[2] / "benchmarks" / "heldout" / "families_heldout.toml"
+
+
+@pytest.mark.parametrize("name", ["beams_stiff__011", "beams_stiff__017"])
+def test_a_free_peaks_fit_that_failed_beside_an_unfitted_stronger_decay_is_tried_again(
+        dataset_cache, name):
+    """Held-out clamped 011 and 017 at 1 % noise (families_heldout.toml, seed 0): the tilted
+    fit put modes 1-2 beyond the pairing distance of both accepted peaks (011: 93.9 / 217.4 Hz
+    against peaks 44.78 / 283.7 Hz), so both were fitted from their free peaks, mode 1 first;
+    mode 2 (11 % damped, the strongest peak) was not yet profiled out, mode 1's fit ran to its
+    band's top and was not taken, and mode 1 kept the fit's 93.9 Hz (110 % off; 017: 106 %).
+    Tried again with mode 2's taken decay profiled out it converges at 44.74 Hz, 1.8 % damped
+    (measured 0.11 % / 0.003 % off), within the issue's 1 % of the engine's truth."""
+    member = {m.name: m for m in load_study(HELDOUT).scenarios}[name]
+    sc = member.with_noise(1.0).replace(seed=0)
+    ds = dataset_cache.get(sc)
+    model = LeastSquaresSINDy().fit(measure(ds, sc.signal, sc.kind))
+    assert "modes [1, 2] fitted from the accepted peak" in model.decay_rule_
+    f_true = np.asarray(ds.truth["frequencies_hz"])[:2]
+    np.testing.assert_allclose(model.natural_frequencies_, f_true, rtol=0.01)  # the issue's bar
