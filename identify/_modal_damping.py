@@ -118,6 +118,25 @@ sensors, mode 1 at 10.79 Hz, 0.19 % damped; the tilted fit put mode 1 at 29.83 H
 peak's fit on both channels gives 0.9999.  Not taken where the shapes would not span the
 space, or where the held model would then grow and did not before.
 
+A free peak's fit retried
+-------------------------
+The modes are fitted in turn (located ones first, then unlocated ones by index), each with the
+decays already taken profiled out.  A fit from a free peak that failed (no convergence or a
+bound reached) before a later mode's decay was taken is tried once more, from the same peak,
+with every taken decay profiled out: a stronger, heavily damped decay not yet profiled out
+can draw a weak mode's fit to its band's edge.  Held-out clamped 011 at 1 % noise
+(benchmarks/heldout/families_heldout.toml; the tilted fit's modes 93.9 / 217.4 Hz, peaks 44.78
+/ 283.7 Hz, neither paired): mode 1's fit from 44.78 Hz, with the 11 % damped mode 2 (the
+strongest peak) still in the record, ran to its band's top, 155.5 Hz, and mode 1 kept the
+fit's 93.9 Hz (110 % off); tried again with mode 2's decay profiled out it converges at 44.74
+Hz, 1.8 % damped (truth 44.81 Hz, 1.8 %).  Measured (2026-11-28, 703 ``ls_sindy`` beam cells:
+beam24/25's 624 and round 22's 79; the retry acted on 11): study passes 605 -> 610, none lost
+(held-out clamped 011, 017, 020 at 1 %, ``b20_soft_r1p2_cf0p3_root2`` 5 %, ``b21_soft_root3``
+4 %); on the issue's bars held-out 1 % 43 -> 45, one lost (``b20_soft_r1p2_cf0p3_root2`` 1 %,
+a soft base: mode 1 0.94 -> 1.19 %, its record-long peak above the linear frequency; the
+tilted fit is now kept physical after the holds where it was refused).  ``sgd_sindy`` passes
+no free peaks: unchanged.
+
 Measured (2026-11-27, the 60 beams of studies/families.toml, member by member against the
 previous rule, this form and the first alike; issue bars: TRAC, MAC >= 0.95, modes 1-2
 within 1 %; study bars 0.90 / 2.6 %):
@@ -619,8 +638,10 @@ def modal_decay(data: Measurement, M: np.ndarray, K: np.ndarray, C: np.ndarray,
     d = np.einsum("ik,ij,jk->k", Phi, C, Phi)  # modal damping 2 zeta_k w_k [1/s]
     nuisance = chain_transients(getattr(data, "chain_poles", None), t)
     free = np.zeros(n, bool) if unlocated is None else np.asarray(unlocated, bool)
-    fits = {}
-    for k in np.concatenate([np.flatnonzero(~free), np.flatnonzero(free)]):
+    fits: dict[int, tuple[float, float]] = {}
+    retry: list[int] = []  # modes fitted from a free peak whose fit failed (see below)
+    order = np.concatenate([np.flatnonzero(~free), np.flatnonzero(free)])
+    for k in order:
         s, wd, r2, ok, c, amp = _decay_fit(q[k], t, 0.5 * d[k], w[k], backbone, nuisance)
         if backbone and ok and abs(c) > BACKBONE_MAX_SHIFT * wd and free[k]:
             # no peak located it and its decay holds no first-order backbone: the exponential
@@ -634,18 +655,11 @@ def modal_decay(data: Measurement, M: np.ndarray, K: np.ndarray, C: np.ndarray,
         peak = _free_peak(free_peaks_hz, w, k, data, i1 - i0) if free[k] and not backbone \
             else None
         if peak is not None:  # from the measured peak no mode took (free_peaks_hz)
-            s, wd, ok = _unlocated_fit(xdd[:, i0:i1], t, (0.5 * abs(d[k]), peak),
-                                       unlocated_band(w, k, peak_band(data, i1 - i0)[0]),
-                                       nuisance, fits)
+            s, wd, ok = _from_free_peak(out, k, peak, xdd[:, i0:i1], t, w, d, nuisance, fits,
+                                        data, i1 - i0)
             paired = True
-            if out.peak_hz is None:
-                object.__setattr__(out, "peak_hz", np.full(n, np.nan))
-            out.peak_hz[k] = peak / (2.0 * np.pi)
-            v = peak_shape(xdd[:, i0:i1], t, s, wd, nuisance, fits) if ok else None
-            if v is not None:
-                if out.shape is None:
-                    object.__setattr__(out, "shape", np.full((xdd.shape[0], n), np.nan))
-                out.shape[:, k] = v
+            if not ok:
+                retry.append(k)
         elif free[k] and not backbone and not (ok and paired):
             # no peak located it and its modal coordinate's fit is not taken: every channel's
             # record, between its neighbours (module docstring, "Unlocated modes")
@@ -656,16 +670,60 @@ def modal_decay(data: Measurement, M: np.ndarray, K: np.ndarray, C: np.ndarray,
         first_order = not backbone or abs(c) <= BACKBONE_MAX_SHIFT * wd
         if ok and first_order and paired:
             fits[k] = (s, wd)
-            out.sigma[k], out.omega_d[k], out.taken[k] = s, wd, True
-            pole = complex(-s, wd)
-            if trap:
-                pole = 2.0 * fs * np.tanh(pole / (2.0 * fs))
-            out.sigma_model[k] = -pole.real
-            out.lam_model[k] = abs(pole) ** 2
-            out.shift[k] = abs(abs(pole) - w_model[k]) / (2.0 * np.pi)
+            _take(out, k, s, wd, fs if trap else None, w_model[k])
             if backbone:
                 out.chirp[k], out.amplitude[k] = c, amp
+    # a fit from a free peak that failed before some later mode's decay was taken is tried
+    # once more with every taken decay profiled out (module docstring, "A free peak's fit
+    # retried"); a linear model's modes only (``retry`` holds no backbone fit)
+    position = {int(k): i for i, k in enumerate(order)}
+    for k in retry:
+        if not any(position[j] > position[k] for j in fits):  # nothing new to profile out
+            continue
+        s, wd, ok = _from_free_peak(out, k, 2.0 * np.pi * float(out.peak_hz[k]),
+                                    xdd[:, i0:i1], t, w, d, nuisance, fits, data, i1 - i0)
+        if ok:
+            fits[k] = (s, wd)
+            _take(out, k, s, wd, fs if trap else None, w_model[k])
     return out
+
+
+def _take(out: ModalDecay, k: int, s: float, wd: float, trap_fs: float | None,
+          w_model: float) -> None:
+    """Store mode ``k``'s taken decay (rate ``s`` [1/s], damped frequency ``wd`` [rad/s]) in
+    ``out``, its pole mapped into the model's domain (``trap_fs`` [Hz]: trapezoid integrals at
+    that rate; None: none) and its shift [Hz] from the model's frequency ``w_model`` [rad/s]."""
+    out.sigma[k], out.omega_d[k], out.taken[k] = s, wd, True
+    pole = complex(-s, wd)
+    if trap_fs is not None:
+        pole = 2.0 * trap_fs * np.tanh(pole / (2.0 * trap_fs))
+    out.sigma_model[k] = -pole.real
+    out.lam_model[k] = abs(pole) ** 2
+    out.shift[k] = abs(abs(pole) - w_model) / (2.0 * np.pi)
+
+
+def _from_free_peak(out: ModalDecay, k: int, peak: float, x: np.ndarray, t: np.ndarray,
+                    w: np.ndarray, d: np.ndarray, nuisance: np.ndarray | None,
+                    fits: dict[int, tuple[float, float]], data: Measurement, n_window: int
+                    ) -> tuple[float, float, bool]:
+    """Mode ``k``'s decay fitted on every channel of the window ``x`` [m/s^2] (times ``t``
+    [s]) from the accepted peak ``peak`` [rad/s] no mode took (:func:`_unlocated_fit`, within
+    :func:`unlocated_band` of the model's frequencies ``w`` [rad/s], started at half its modal
+    damping ``d[k]`` [1/s]), the decays ``fits`` profiled out; the peak [Hz] and, where the
+    fit converged, its shape (:func:`peak_shape`) stored in ``out``.  Returns
+    ``(sigma, omega_d, ok)`` as :func:`_unlocated_fit`."""
+    n = out.sigma.size
+    s, wd, ok = _unlocated_fit(x, t, (0.5 * abs(d[k]), peak),
+                               unlocated_band(w, k, peak_band(data, n_window)[0]), nuisance, fits)
+    if out.peak_hz is None:
+        object.__setattr__(out, "peak_hz", np.full(n, np.nan))
+    out.peak_hz[k] = peak / (2.0 * np.pi)
+    v = peak_shape(x, t, s, wd, nuisance, fits) if ok else None
+    if v is not None:
+        if out.shape is None:
+            object.__setattr__(out, "shape", np.full((x.shape[0], n), np.nan))
+        out.shape[:, k] = v
+    return s, wd, ok
 
 
 def _free_peak(free_peaks_hz: np.ndarray | None, w: np.ndarray, k: int, data: Measurement,

@@ -749,3 +749,63 @@ def test_a_candidate_the_noise_rule_cannot_test_is_kept():
     kept = _decaying_only(SimpleNamespace(xdd=x, fs=fs), 0, np.array([80.0, 30.0]),
                           np.array([sh1, sh2]).astype(complex), [0, 1], rejected, 20.0)
     assert kept == [0, 1] and rejected == []
+
+
+HELDOUT = Path(__file__).resolve().parents[2] / "benchmarks" / "heldout" / "families_heldout.toml"
+
+
+@pytest.mark.parametrize("name", ["beams_stiff__011", "beams_stiff__017"])
+def test_a_free_peaks_fit_that_failed_beside_an_unfitted_stronger_decay_is_tried_again(
+        dataset_cache, name):
+    """Held-out clamped 011 and 017 at 1 % noise (families_heldout.toml, seed 0): the tilted
+    fit put modes 1-2 beyond the pairing distance of both accepted peaks (011: 93.9 / 217.4 Hz
+    against peaks 44.78 / 283.7 Hz), so both were fitted from their free peaks, mode 1 first;
+    mode 2 (11 % damped, the strongest peak) was not yet profiled out, mode 1's fit ran to its
+    band's top and was not taken, and mode 1 kept the fit's 93.9 Hz (110 % off; 017: 106 %).
+    Tried again with mode 2's taken decay profiled out it converges at 44.74 Hz, 1.8 % damped
+    (measured 0.11 % / 0.003 % off), within the issue's 1 % of the engine's truth."""
+    member = {m.name: m for m in load_study(HELDOUT).scenarios}[name]
+    sc = member.with_noise(1.0).replace(seed=0)
+    ds = dataset_cache.get(sc)
+    model = LeastSquaresSINDy().fit(measure(ds, sc.signal, sc.kind))
+    assert "modes [1, 2] fitted from the accepted peak" in model.decay_rule_
+    f_true = np.asarray(ds.truth["frequencies_hz"])[:2]
+    np.testing.assert_allclose(model.natural_frequencies_, f_true, rtol=0.01)  # the issue's bar
+
+
+def _round22(study: str, name: str, noise: float, seed: int, dataset_cache):
+    member = {m.name: m for m in load_study(UNSEEN / study).scenarios}[name]
+    sc = member.with_noise(noise).replace(seed=seed)
+    ds = dataset_cache.get(sc)
+    return ds, measure(ds, sc.signal, sc.kind)
+
+
+def test_noise_in_the_chains_ringing_zone_does_not_take_a_modes_place(dataset_cache):
+    """Round 22's ``b22_st_jo0`` at 5 % noise, seed 133 (three sensors; modes 82.5, 511.3,
+    1417 Hz): a 12.42 Hz candidate below 2 x the 10 Hz high-pass, -31 dB, locked 0.28 at
+    most 0.46 within 15 % of it (noise's own bar there, 1.46, above 2 / pi) and losing no band
+    power (0.71 under noise's 3.4), was kept as one of three peaks and pushed mode 3 out (the
+    fit's 1417 Hz mode paired with nothing: 98.7 % off).  Now rejected as noise; mode 3's peak
+    is kept and every scored mode lies within the issue's 1 % (measured 0.76 %)."""
+    ds, data = _round22("round22_beams_noise_s133.toml", "b22_st_jo0", 5.0, 133, dataset_cache)
+    ps = modal_peaks(data, ringing=True)
+    assert ps.peaks.min() > 2.0 * data.passband[0]
+    assert any(abs(f - 12.42) < 0.1 and "noise, not a mode" in why for f, why in ps.rejected)
+    model = LeastSquaresSINDy().fit(data)
+    f_true = np.asarray(ds.truth["frequencies_hz"])[:3]
+    np.testing.assert_allclose(model.natural_frequencies_, f_true, rtol=0.01)
+
+
+def test_a_mode_the_high_pass_bends_keeps_its_place_in_the_ringing_zone(dataset_cache):
+    """Round 22's ``b22_cu_L0p65_t8_n15`` at 2 % noise, seed 136: mode 1 at 11.05 Hz (1.1 x
+    the high-pass) peaks at 12.58 Hz, where it locks 0.24 only (its phase drifts 1.5 Hz
+    against that frequency); at 10.94 Hz, within 15 %, it locks 1.000.  The ringing zone's
+    noise test takes the largest lock there and keeps it (a lock at the peak alone rejected it:
+    mode 1 0.95 -> 567 % off)."""
+    ds, data = _round22("round22_beams_extra.toml", "b22_cu_L0p65_t8_n15", 2.0, 136,
+                        dataset_cache)
+    ps = modal_peaks(data, ringing=True)
+    assert np.any(np.abs(ps.peaks - 12.58) < 0.1)
+    model = LeastSquaresSINDy().fit(data)
+    f_true = np.asarray(ds.truth["frequencies_hz"])[0]
+    assert model.natural_frequencies_[0] == pytest.approx(f_true, rel=0.026)  # the study's bar
