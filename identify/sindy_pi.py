@@ -171,7 +171,7 @@ from identify._implicit import (
     stlsq_sweep,
 )
 from identify._mechsim import CLOSURE_RTOL, ImplicitModel, LoopClosure, band_whiteness
-from identify._weak import check_window, weak_matrix
+from identify._weak import check_window, held_midpoints, weak_matrix
 from identify.library import Library, fivebar_library, generic_mechanical_library
 from testbed.core.errors import IdentificationError
 from testbed.core.measurement import Measurement, Trajectory
@@ -804,11 +804,9 @@ def regression_inputs(data: Measurement, hold: str) -> np.ndarray | None:
     recorded accelerations, which the engine evaluates under ``u[k]``) the samples as given.
     """
     u = data.u
-    if u is None or hold != "zoh" or data.passband is None or u.shape[1] < 2:
+    if u is None or hold != "zoh" or data.passband is None:
         return u
-    out = np.array(u, dtype=float)
-    out[:, 1:] = 0.5 * (u[:, 1:] + u[:, :-1])
-    return out
+    return held_midpoints(u)
 
 
 def excitation_trim(u: np.ndarray, fs: float, keep: float | None = None) -> float:
@@ -1088,7 +1086,7 @@ class _ImplicitMechanical(Identifier):
         u = None if data.u is None else data.u[:, sl]
         xdd = None if xdd is None else xdd[:, sl]
         wf = weak_matrix(lib, x[:, sl], xd[:, sl], xdd, u, data.fs, self._knob("weak_window_s"),
-                         self.weak_n_windows, self.weak_degree)
+                         self.weak_n_windows, self.weak_degree, self.input_hold_)
         split = split_index(n, self.val_fraction)
         tr = wf.starts + wf.length <= split
         va = wf.starts >= split
