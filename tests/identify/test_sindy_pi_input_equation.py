@@ -44,7 +44,8 @@ def run(request):
 
 def test_the_cart_equation_is_not_the_poles_with_an_input_admixture(run):
     """Was law_error 0.855 (cp16_3s) / 1140 (cp17_kp1_kd1), the input's equation with lhs
-    sin(th2) (the pole's); now 0.0073 / 0.0028."""
+    sin(th2) (the pole's); 0.0073 / 0.0028 (session 18); 1.8e-5 / 2.5e-5 (session 24, the
+    chain's noise-floor cut-off on clean angles)."""
     run, pole_checked = run
     law = run.scores.values["law_error"]
     assert np.isfinite(law) and law <= LAW_BAR
@@ -53,9 +54,19 @@ def test_the_cart_equation_is_not_the_poles_with_an_input_admixture(run):
     u = [i for i, n in enumerate(names) if "u1" in n]
     # the input's equation attributes a force to its input that is not a near-cancelling
     # remainder: its input terms' coefficients, relative to its largest, above 0.1 (the
-    # admixture's were 0.005 against sin(th2)'s 1)
-    row = np.abs(m.coef_[0])
-    assert row[u].max() / row.max() > 0.1
+    # admixture's were 0.005 against sin(th2)'s 1).  Measured in the span of the two equations
+    # (as the law is scored): the input-free equation's multiple is removed first (least
+    # squares), since with the chain's exact-band recipe (session 24) cp16_3s's input equation
+    # is the cart's plus the pole's whole (sin(th2) 1, u1 0.061, ddth1 0.091: law 1.8e-5), whose
+    # row maximum is the pole's.  The remainder must also carry input-free terms of its own
+    # (above 0.1 of its largest): the admixture's remainder was its input terms alone.
+    w, p = m.coef_[0], m.coef_[1]
+    if not np.any(np.abs(p)[u] > 0):
+        w = w - (w @ p) / (p @ p) * p
+    row = np.abs(w)
+    free = np.ones(row.size, dtype=bool)
+    free[u] = False
+    assert row[u].max() / row.max() > 0.1 and row[free].max() / row.max() > 0.1
     if pole_checked:  # the two equations differ: the pole's has no input term
         assert not np.any(np.abs(m.coef_[1])[u] > 0)
     assert run.passed, run.scores.failures
