@@ -672,7 +672,9 @@ def test_a_rollout_failed_on_a_sensitive_record_is_named():
     # the rollout's value on this record is decided by round-off (the point of the rule): its
     # size only, 11.5 rad measured
     assert why.startswith("sensitive record: angle_rmse ") and r.scores.values["angle_rmse"] > 1.0
-    assert "law_error 0.00304" in why
+    # the reason quotes the cell's own law error (0.00304 before session 24's weak-form held
+    # input, 0.00301 after: the verdict, not its digits, is what this test is about)
+    assert f"law_error {r.scores.values['law_error']:.3g}" in why
     assert "scaled by 1 +/- 0.0025 " in why and r.scores.details["law_off"] == 0.0025
     assert r.scores.details["angle_rmse_true_law"] < 1e-5  # [rad]: the witness's own floor
     assert r.scores.details["angle_rmse_law_off"] > 1.0  # [rad]: 11.7 measured
