@@ -19,8 +19,9 @@ Families (what rounds 1-22 did not try; their families are listed in ``hostile21
     one position, beyond its root (negative: read, see known-gaps), unsorted, the force all
     zero (a named failure), in kN and the accelerations in mm/s^2 (the same model, the scale
     read), an acceleration labelled ``quantity = "force"``, one sensor's direction ``-Z``
-    beside ``+Z`` ones (refused: the testbed flips no sign), every channel ``-Z`` (one frame:
-    the same model).  ``testbed identify``.  A
+    beside ``+Z`` ones (its samples negated to the others' frame, as the code's meaning asks:
+    the same model where the file's samples are the -Z sensor's, review 24a), every channel
+    ``-Z`` (one frame: the same model).  ``testbed identify``.  A
     traceback, more than one error line, an inconsistent record fitted with status 0, or a
     consistent one read to another model, is a finding.
 ``h5consist``
@@ -279,9 +280,11 @@ def sepmix_cases(work: Path) -> list[tuple[str, object]]:
          both(*(scaled(a, 1e3, "mm/s^2") for a in ("acc1", "acc2", "acc3"))), "same"),
         ("acc2 labelled quantity 'force'", "beam", setitem("acc2", "quantity", "force"), "verdict"),
         ("acc2 direction -Z, its samples negated", "beam",
-         both(setitem("acc2", "direction", "-Z"), data("acc2", lambda d: [-v for v in d])), "refuse"),
+         both(setitem("acc2", "direction", "-Z"), data("acc2", lambda d: [-v for v in d])), "same"),
         ("acc2 direction -Z, its samples as they were", "beam", setitem("acc2", "direction", "-Z"),
-         "refuse"),
+         "verdict"),
+        ("the force direction -Z, its samples negated", "beam",
+         both(setitem("force", "direction", "-Z"), data("force", lambda d: [-v for v in d])), "same"),
         ("every channel -Z, its samples as they were", "beam",
          both(*(setitem(c, "direction", "-Z") for c in ("acc1", "acc2", "acc3", "force"))), "same"),
         ("the force's first sample NaN", "beam", data("force", lambda d: [float("nan"), *d[1:]]),

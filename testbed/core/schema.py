@@ -229,20 +229,20 @@ def unknown_key_hint(key: Any, known: Iterable[str],
     if key.lower() in {k.lower() for k in known}:
         same = next(k for k in known if k.lower() == key.lower())
         return f" (did you mean {same!r}?)"
+    homes = [place for place, keys in (elsewhere or {}).items() if key in keys]
+    if homes:  # the key exists, elsewhere: a near spelling here would be another meaning
+        return f" ({key!r} is a key of {', '.join(homes)})"   # ('ridge' -> 'stride', review 24a)
     lowered = {k.lower(): k for k in known}
     close = difflib.get_close_matches(key.lower(), list(lowered), n=1, cutoff=0.7) \
         or sorted(k for k in lowered if _one_edit(key.lower(), k))[:1]
-    said = [f"did you mean {lowered[close[0]]!r}?"] if close else []
-    homes = [place for place, keys in (elsewhere or {}).items() if key in keys]
-    if homes:
-        said.append(f"{key!r} is a key of {', '.join(homes)}")
-    return f" ({'; '.join(said)})" if said else ""
+    return f" (did you mean {lowered[close[0]]!r}?)" if close else ""
 
 
 def _one_edit(a: str, b: str) -> bool:
     """Whether ``a`` and ``b`` differ by one letter changed, added or dropped (``xo`` and
-    ``x0``: short keys difflib's ratio leaves at 0.5)."""
-    if abs(len(a) - len(b)) > 1 or a == b:
+    ``x0``: short keys difflib's ratio leaves at 0.5); never for a one-letter key, which is one
+    letter from every other (``G`` is not a misspelt ``E``, review 24a)."""
+    if abs(len(a) - len(b)) > 1 or a == b or min(len(a), len(b)) < 2:
         return False
     if len(a) == len(b):
         return sum(x != y for x, y in zip(a, b, strict=True)) == 1

@@ -975,13 +975,15 @@ def _finish(raw: _Raw, fs: float | None, units: str | Mapping[str, str] | None,
                                           f"expected at most {max_magnitude:g} (larger values "
                                           "overflow the identifiers' sums of sixth powers)")
         signals[n] = (si, x)
-    _check_direction_signs(path, {n: raw.directions[n] for n in names if raw.directions.get(n)})
+    directions = _honour_direction_signs(
+        {n: raw.directions[n] for n in names if raw.directions.get(n)}, signals)
     for key, value in raw.prior.items():  # a dataset file's own (an edited attribute)
         check_prior(path, key, value)
     keep = set(names)
     return ImportedData(float(rate), signals, path, raw.format,
                         nodes={k: v for k, v in raw.nodes.items() if k in keep},
-                        directions={k: v for k, v in raw.directions.items() if k in keep},
+                        directions={k: directions.get(k, v) for k, v in raw.directions.items()
+                                    if k in keep},
                         positions={k: v for k, v in raw.positions.items() if k in keep},
                         prior=dict(raw.prior))
 
@@ -1011,24 +1013,27 @@ def _check_direction(path: Path, name: str, direction: int, si: str) -> None:
                                       "expected a direction and a unit of one kind")
 
 
-def _check_direction_signs(path: Path, directions: Mapping[str, int]) -> None:
-    """Refuse channels that point opposite ways along one axis (``+Z`` and ``-Z``, UFF codes
-    3 and -3).  The testbed reads every channel in one frame and never flips a sign: a sensor
-    declared ``-Z`` beside others declared ``+Z`` was read as if it pointed along ``+Z``, its
-    mode shape's sign (and the model's coupling terms through it) reversed in silence
-    (malformed-input round 23).  Channels all along one signed axis (every one ``-Z``) are one
-    frame and are read as they are."""
-    first: dict[int, str] = {}
+def _honour_direction_signs(directions: Mapping[str, int],
+                            signals: dict[str, tuple[str, np.ndarray]]) -> dict[str, int]:
+    """Read channels that point opposite ways along one axis in one frame: where an axis holds
+    both signs (UFF codes 3 and -3, SEP-005 ``+Z`` and ``-Z``), each channel declared along its
+    negative direction has its samples negated in ``signals`` (in place) and its direction made
+    positive; the directions returned.  A code says which way the transducer points (UFF 58's
+    and SEP-005's meaning), so a sensor mounted upside down, or a hammer's force declared
+    ``-Z`` beside ``+Z`` accelerometers, reads to the frame of the others.  Before round 23 a
+    ``-Z`` sensor beside ``+Z`` ones was read as if it pointed along ``+Z`` (its mode shape's
+    sign, and the model's coupling through it, reversed in silence); its first mend refused
+    such files, which refused valid ones (review 24a).  Channels all along one signed axis (every
+    one ``-Z``) are one frame, read as they are: the structural and mechanical models are odd
+    in their signals, so a frame flipped as a whole is the same model."""
+    positive = {c for c in directions.values() if c > 0}
+    out = dict(directions)
     for name, code in directions.items():
-        other = first.setdefault(abs(code), name)
-        if directions[other] != code:
-            def said(c: int) -> str:
-                return f"{'-' if c < 0 else '+'}{'XYZ'[(abs(c) - 1) % 3]}{' rotation' if abs(c) > 3 else ''}"
-            raise MeasuredDataError(path, f"channel {name!r} points {said(code)} (direction code "
-                                          f"{code}) but channel {other!r} {said(directions[other])} "
-                                          f"({directions[other]}); the testbed reads every channel in "
-                                          "one frame and flips no sign: negate the samples of the "
-                                          "channels that point the other way and declare one direction")
+        if code < 0 and -code in positive:
+            si, x = signals[name]
+            signals[name] = (si, -x)
+            out[name] = -code
+    return out
 
 
 def _check_starts(path: Path, starts: Mapping[str, float], fs: float,

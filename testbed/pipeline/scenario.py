@@ -759,14 +759,22 @@ def check_identifier_for_record(cls: Any, full: dict[str, Any], shape: tuple[int
 
 
 def other_identifiers(method: str) -> dict[str, Any]:
-    """Every registered identifier but ``method``, by name, mapped to its
+    """Every registered identifier of ``method``'s kind but ``method``, by name, mapped to its
     declared hyperparameters: where an unknown hyperparameter of ``method`` belongs
-    (:func:`~testbed.core.schema.unknown_key_hint`)."""
+    (:func:`~testbed.core.schema.unknown_key_hint`).  Identifiers of another kind are no
+    place to name: they cannot fit the record (review 24a: ``n_modes`` for
+    ``sindy_pi_dynamical`` pointed to the structural ``sgd_sindy``)."""
     out: dict[str, Any] = {}
+    try:
+        kind = IDENTIFIERS.get(method).kind
+    except Exception:  # an unknown method: its own refusal names it
+        return out
     for name in IDENTIFIERS.names():
         if name != method:
             try:
-                out[name] = IDENTIFIERS.get(name).declared_hyperparameters()
+                cls = IDENTIFIERS.get(name)
+                if cls.kind == kind:
+                    out[name] = cls.declared_hyperparameters()
             except Exception:  # a plugin's broken declaration: it is no place to name
                 continue
     return out
