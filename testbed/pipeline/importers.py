@@ -1317,8 +1317,10 @@ def check_hdf5_storage(path: str | os.PathLike) -> None:
         if found or not isinstance(obj, h5py.Dataset):
             return
         layout = obj.attrs.get("layout")
+        if isinstance(layout, np.ndarray) and layout.size == 1:  # a one-element array of text
+            layout = layout.item()
         layout = layout.decode(errors="replace") if isinstance(layout, bytes) else layout
-        if layout is not None and layout != LAYOUT:
+        if layout is not None and not (isinstance(layout, str) and layout == LAYOUT):
             # the reader takes rows as channels whatever this says: a file whose arrays claim
             # "samples x channels" was read as channels x samples in silence (round 23)
             shown = layout.item() if isinstance(layout, np.generic) else layout

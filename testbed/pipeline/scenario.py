@@ -381,7 +381,7 @@ def _given_twice(text: str, message: str) -> str | None:
     m = _AT_LINE.search(message)
     if not message.startswith("Cannot overwrite a value") or m is None:
         return None
-    lines = text.splitlines()
+    lines = text.split("\n")  # (TOML's lines: splitlines also breaks at U+2028, review 24a)
     if m.group(1):
         n = int(m.group(1))
     else:  # the last line holding something
