@@ -119,35 +119,3 @@ def test_auto_edge_fit_keeps_more_samples_than_coefficients_at_the_highest_cutof
     assert round(edge * ds.fs) == EDGE_FIT_MIN_SAMPLES_PER_COEF * 6
     m = measure(ds, {"derivatives": "lowpass", "cutoff_hz": cut}, "mechanical")  # edge "auto"
     assert np.all(np.isfinite(m.xd)) and np.all(np.isfinite(m.xdd))
-
-
-
-def test_auto_cutoff_keeps_a_clean_records_band():
-    """The noise-floor rule (session 24, issue #15): on clean angles the cut-off passes the
-    band where the angles stand above their noise floor with a droop below their relative
-    noise, far above the harmonic rule's (which noisy angles keep: AUTO_CLEAN_REL).  Before, a
-    clean record got the harmonic rule's 2.7 x band (round 22's down-branch multisine: 4.26
-    Hz, whose residual of the true equations, 1.9e-4 of their scale, hid the joints' damping)."""
-    from testbed.pipeline.signal_chain import AUTO_REL_FLOOR, NOISE_BAND_SHARE
-
-    for rel in (0.0, 1e-4, 0.01, 0.05):
-        ds = dataset(rel)
-        raw, fs = ds.measured["theta"].data, ds.fs
-        sig = noise_std(raw)
-        harmonic = der.harmonic_cutoff(signal_band(raw, fs, AUTO_BAND_SHARE, sig).max(), 8)
-        cut = auto_cutoff(raw, fs, 8)
-        # the chain's measurement uses the same rule
-        assert measure(ds, {"derivatives": "lowpass", "cutoff_hz": "auto"},
-                       "mechanical").passband[1] == cut
-        if rel > 0:  # noisy (above AUTO_CLEAN_REL): the harmonic rule
-            assert cut == harmonic
-            continue
-        assert cut > 5 * harmonic
-        # the rule's property: at each channel's noise-floor band F the zero-phase droop,
-        # (F / fc)^(2 order) to first order, is at most the channel's relative noise (the
-        # float's resolution here); compared in logs (a droop of 1e-16 is below the
-        # resolution of a gain near 1); the largest channel binds, within rounding
-        floor_band = signal_band(raw, fs, NOISE_BAND_SHARE, sig)
-        margins = [16 * np.log(f / cut) - np.log(max(s / r, AUTO_REL_FLOOR))
-                   for f, s, r in zip(floor_band, sig, raw.std(axis=1), strict=True)]
-        assert max(margins) == pytest.approx(0.0, abs=1e-9)
