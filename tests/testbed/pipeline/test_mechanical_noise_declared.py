@@ -166,10 +166,10 @@ def test_auto_cutoff_counts_an_encoders_quantisation_as_noise(bits):
     are exactly 0, the noise estimate is 0, and the clean-record rule of session 24 put the
     cut-off at 0.45 fs (4500 Hz; 12-bit: the accelerations' error 2700 x their RMS, review
     24d q4.py).  The cut-off must be the float record's within the spectrum's resolution, and
-    the accelerations derived with it within 2 % of the truth's RMS (measured: 12-bit 0.6 %;
-    the quantisation step 1.5e-3 rad is 2e-2 of the angles' RMS, white-ish, and the 4.8 Hz
-    low-pass keeps ~1e-3 of its power, times (2 pi 4.8 / 2 pi 1.5)^2 in the second
-    derivative)."""
+    the accelerations derived with it within 2 % of the truth's RMS.  Measured 0.50 / 0.085 %
+    (12 / 14-bit); white quantisation noise (q / sqrt 12) through the low-pass predicts 0.13 /
+    0.033 % (lowpass_differentiate's Notes), but the rounding error of a slow motion is not
+    white, so the bound is 4 x the 12-bit figure (the taken-back rule: 2700 x, 2.7e5 %)."""
     fs = 1e4
     th = _multisine(fs)
     q = 2 * np.pi / 2**bits
