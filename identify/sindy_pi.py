@@ -746,22 +746,6 @@ RIDGE_PER_NOISE_VAR = 0.012
 #: gets the ridge 1 % noise gets (1.2e-6) instead of the exact-data 1e-14, whose fits lost
 #: the input terms or diverged (13/30 within 0.0501 rad before).
 CHAIN_REL_FLOOR = 0.01
-#: A declared chain passes clean angles exactly (:func:`noise_knobs`, item 4) when its cut-off
-#: lies at least this many times above the angles' band: an order-8 zero-phase Butterworth's
-#: droop there is 10^-16 (order 4: 10^-8).  The chain's harmonic rule puts its cut-off at
-#: 2.7x the band (twice the band at 99 % gain), where its own error on exact angles is the
-#: CHAIN_REL_FLOOR measured; its noise-floor rule on clean angles (testbed/pipeline/
-#: signal_chain.py auto_cutoff) puts it at 28-260x: round 22's down-branch multisine 111 Hz on
-#: a 1.6 Hz band, the paper's sine 78 Hz on 0.3 Hz, the shipped cart-pole 51 Hz on 1.8 Hz.
-EXACT_CHAIN_BAND_RATIO = 10.0
-#: Such a chain's columns are low-passed at this share of its cut-off, where an order-n chain's
-#: zero-phase gain is ``1 / (1 + 2^-2n)`` (order 8: 1 - 1.5e-5): the column filter removes the
-#: transition band in which the derived rates and accelerations are the chain's, not the
-#: motion's.  Measured clean, chain 40 / 112 Hz, ridge RIDGE_EXACT (angle RMSE, rad): round
-#: 22's down-branch multisine, column 2.4 Hz (1.5x band) 0.015, 10 Hz (chain 20 Hz) 0.013,
-#: 20 Hz 5.0e-5, 56 Hz 5.0e-5, none 0.0020; fivebar_multisine_noise1 20 / 56 Hz 4.7e-7 /
-#: 2.5e-5.
-EXACT_CHAIN_COLUMN_SHARE = 0.5
 #: Replay check of exact-data fits (:meth:`SINDyPI._replay_check`): the held-out choice must
 #: replay the whole record from its measured first state within 1e-4 rad [rad], else the
 #: record left the equations non-unique and they are chosen again by rollout.  Measured
@@ -974,17 +958,7 @@ def noise_knobs(x: np.ndarray, fs: float, val_fraction: float, user: dict[str, A
         # undeclared smoother (ends of unknown quality): the weak form
         form = user.get("formulation") or ("weak" if smoothed is not None and not filtered
                                            else "strong")
-        # clean angles through a chain that passes their band exactly: the chain's own error
-        # floor does not apply (see EXACT_CHAIN_BAND_RATIO)
-        exact_chain = (filtered and smoothed is None and noise_rel <= NOISE_FREE_REL
-                       and float(passband[1]) >= EXACT_CHAIN_BAND_RATIO * band)
-        if form == "strong" and exact_chain:
-            chain_cut = EXACT_CHAIN_COLUMN_SHARE * float(passband[1])
-            cut = user.get("column_lowpass_hz") or min(chain_cut, 0.45 * fs)
-            branch = (f"noisy: strong form, column low-pass {EXACT_CHAIN_COLUMN_SHARE:g} x the "
-                      f"chain's = {chain_cut:.3g} Hz (the chain passes the band exactly: "
-                      f">= {EXACT_CHAIN_BAND_RATIO:g} x band)")
-        elif form == "strong":
+        if form == "strong":
             cut = user.get("column_lowpass_hz") or min(CUTOFF_FACTOR * band, 0.45 * fs)
             branch = (f"noisy: strong form, column low-pass {CUTOFF_FACTOR:g} x band = "
                       f"{CUTOFF_FACTOR * band:.3g} Hz")
@@ -1002,7 +976,7 @@ def noise_knobs(x: np.ndarray, fs: float, val_fraction: float, user: dict[str, A
                 trim = keep_trim
                 capped = (f" (capped to keep {EDGE_KEEP_EXCITATION:g} of the inputs' power "
                           "about their mean)")
-        level = max(noise_rel, CHAIN_REL_FLOOR) if filtered and not exact_chain else noise_rel
+        level = max(noise_rel, CHAIN_REL_FLOOR) if filtered else noise_rel
         ridge = max(RIDGE_PER_NOISE_VAR * level**2, RIDGE_EXACT) if derived else RIDGE_EXACT
         lhs = LHS_INPUT_TERMS if derived else None
         # a declared chain's derived rates: the held-out equation error ranks alike candidates
@@ -1013,7 +987,7 @@ def noise_knobs(x: np.ndarray, fs: float, val_fraction: float, user: dict[str, A
                 "weak_window_s": window if form == "weak" else None, "lhs": lhs,
                 "selection": selection}
         branch += f", edge trim {trim:.3g} s{capped}, ridge {ridge:.3g}"
-        if filtered and noise_rel < CHAIN_REL_FLOOR and not exact_chain:
+        if filtered and noise_rel < CHAIN_REL_FLOOR:
             branch += f" (noise below the chain's own error floor {CHAIN_REL_FLOOR:g})"
         if lhs is not None:
             branch += ", LHS the input terms"

@@ -110,9 +110,7 @@ MECHANICAL_SIGNAL_SCHEMA: dict[str, Field] = {
                        doc="'lowpass': -3 dB frequency of one pass of the zero-phase "
                            "Butterworth; just above the band of the motion (noise in the "
                            "acceleration grows as cutoff^2.5); 'auto': the lowest that passes "
-                           "twice the angles' 99.9 % band with 99 % amplitude; on clean "
-                           "angles, if higher, the band where they stand above their noise "
-                           "floor with a droop below the noise (they keep their band; see "
+                           "twice the angles' 99.9 % band with 99 % amplitude (see "
                            "auto_cutoff)"),
     "filter_order": Field(int, 8, min=1, max=16,
                           doc="'lowpass': Butterworth order of one pass"),
@@ -765,24 +763,6 @@ def drift_basis(n_samples: int, fs: float, rest_from: int | None,
 #: (1.5 Hz on the five-bar multisine of 0.1-1.5 Hz tones, at 0-5 % noise alike); 99 % misses
 #: the top tones (0.8-1.1 Hz there).
 AUTO_BAND_SHARE = 0.999
-#: Share that makes :func:`testbed.numerics.noise.signal_band` the significance test alone:
-#: the largest float below 1, so the band ends where the power left above it is no longer
-#: significant against the noise floor's fluctuation (or below the float resolution of the
-#: total): where the angles' spectrum meets their noise floor.
-NOISE_BAND_SHARE = float(np.nextafter(1.0, 0.0))
-#: Smallest relative noise the noise-floor rule of :func:`auto_cutoff` assumes: the float
-#: resolution of a sample (a record cannot hold a smaller relative error).
-AUTO_REL_FLOOR = float(np.finfo(float).eps)
-#: Largest relative noise (white-noise std over the channel's RMS about its mean) of a channel
-#: the noise-floor rule of :func:`auto_cutoff` serves: clean angles.  1e-6 is SINDy-PI's
-#: exact-data level (identify/sindy_pi.py NOISE_FREE_REL: 1e4 x the estimator's floor on clean
-#: angles, 1e4 x below 1 %).  Measured with the rule on noisy angles too (session 24,
-#: benchmarks/heldout/pi25_cells.tsv, 105 noisy cells whose cut-off it moved, 0.5-3 %): five-bars
-#: 39 -> 39 within their bars (6 closer, 4 farther by over 20 %), cart-poles 57 -> 55 (cpv_0 1 %
-#: 0.020 -> 0.058 rad at 6.5 Hz for 5.4 Hz, cp17_fmax5 2 % 0.047 -> 0.093; 17 closer, 15
-#: farther): the noise the higher cut-off passes costs the cart-poles' steps and chirps more
-#: than the band it keeps gains them, so noisy angles keep the harmonic rule.
-AUTO_CLEAN_REL = 1e-6
 #: Highest automatic cut-off as a share of the sample rate: a digital filter needs its cut-off
 #: below the Nyquist frequency (0.5); 0.45 leaves the design a margin.
 AUTO_CUTOFF_MAX_SHARE = 0.45
@@ -792,30 +772,12 @@ def auto_cutoff(theta: np.ndarray, fs: float, order: int, noise: np.ndarray | No
                 ) -> float:
     """``cutoff_hz = "auto"``: the derivative low-pass's cut-off from the raw angles.
 
-    Rule: the larger of two cut-offs, at most ``AUTO_CUTOFF_MAX_SHARE fs``:
-
-    1. *The harmonic rule*: the band ``B`` = the largest over channels of the frequency
-       holding ``AUTO_BAND_SHARE`` of the angle's power above its white-noise floor
-       (:func:`testbed.numerics.noise.signal_band`); the lowest cut-off that passes ``2 B``
-       (the linkage's second harmonics) with 99 % amplitude
-       (:func:`testbed.numerics.derivatives.harmonic_cutoff`).  Five-bar multisine (band
-       1.5 Hz), order 8: 4.0 Hz, the hand-found value.
-    2. *The noise-floor rule*, for clean channels (relative noise at most
-       ``AUTO_CLEAN_REL``): per channel, ``F`` = the frequency above which the angle holds
-       no power significant against its noise floor (``signal_band`` at
-       ``NOISE_BAND_SHARE``: where its spectrum meets the floor), and ``r`` = its noise std
-       over its RMS about the mean (at least ``AUTO_REL_FLOOR``); the lowest cut-off whose
-       zero-phase gain at ``F``, ``1 / (1 + (F / fc)^(2 order))``, falls short of 1 by no more
-       than ``r``: ``fc = F r^(-1 / (2 order))``.  Up to ``F`` the filter's droop is below the
-       noise, and above ``F`` there is nothing but noise to pass.  The largest over channels.
-
-    Noisy records keep the harmonic rule's cut-off (see ``AUTO_CLEAN_REL`` for the measured
-    cost of the second rule there); on clean angles (``r`` ~1e-14, ``F`` 9-15 Hz on the
-    five-bars, where the spectrum meets the float's floor) the second gives 25-450 Hz (the
-    clean five-bars of rounds 14-22 58-285 Hz, the cart-poles 25-450 Hz), so the
-    chain keeps the band the angles carry: at 4.3 Hz the true equations of round 22's
-    down-branch multisine were left a residual of 1.9e-4 of their scale, above the joints'
-    damping share (1.5e-4), and the fit dropped the damping (0.0475 rad; 111 Hz: 5.0e-5).
+    Rule: the band ``B`` = the largest over channels of the frequency holding
+    ``AUTO_BAND_SHARE`` of the angle's power above its white-noise floor
+    (:func:`testbed.numerics.noise.signal_band`); the cut-off is the lowest that passes
+    ``2 B`` (the linkage's second harmonics) with 99 % amplitude
+    (:func:`testbed.numerics.derivatives.harmonic_cutoff`), at most ``AUTO_CUTOFF_MAX_SHARE
+    fs``.  Five-bar multisine (band 1.5 Hz), order 8: 4.0 Hz, the hand-found value.
 
     Parameters
     ----------
@@ -838,22 +800,10 @@ def auto_cutoff(theta: np.ndarray, fs: float, order: int, noise: np.ndarray | No
     ValueError
         If no channel has signal power above its noise floor (no band to pass).
     """
-    theta = np.atleast_2d(np.asarray(theta, dtype=float))
-    noise = noise_est.noise_std(theta) if noise is None else np.asarray(noise, dtype=float)
     band = float(noise_est.signal_band(theta, fs, AUTO_BAND_SHARE, noise).max(initial=0.0))
     if not band > 0:
         raise ValueError("cutoff_hz = 'auto': the angles hold no power above their noise floor")
-    cut = derivatives.harmonic_cutoff(band, order)
-    floor_band = noise_est.signal_band(theta, fs, NOISE_BAND_SHARE, noise)
-    rms = np.std(theta, axis=1)
-    for f_ch, sig_ch, rms_ch in zip(floor_band, np.broadcast_to(noise, rms.shape), rms,
-                                    strict=True):
-        if f_ch > 0 and rms_ch > 0 and sig_ch <= AUTO_CLEAN_REL * rms_ch:
-            rel = max(float(sig_ch / rms_ch), AUTO_REL_FLOOR)
-            # harmonic_cutoff's formula (harmonic 1) with 1 / gain - 1 = rel, written without
-            # forming a gain within rounding of 1
-            cut = max(cut, float(f_ch) / rel ** (1.0 / (2 * int(order))))
-    return min(cut, AUTO_CUTOFF_MAX_SHARE * fs)
+    return min(derivatives.harmonic_cutoff(band, order), AUTO_CUTOFF_MAX_SHARE * fs)
 
 
 #: ``edge_fit_s = "auto"``: the end fits span EDGE_FIT_PERIODS periods of the low-pass cut-off.

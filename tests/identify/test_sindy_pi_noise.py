@@ -281,28 +281,3 @@ def test_declared_chain_trims_a_column_filter_period_up_to_a_quarter_of_the_reco
     assert knobs["edge_trim"] > sp.EDGE_MAX_SHARE * 10.0
     rec, _, _ = sp.noise_knobs(x, fs, 0.2, {}, None, declared, None)
     assert rec["edge_trim"] == pytest.approx(sp.EDGE_MAX_SHARE * 10.0)
-
-
-def test_clean_angles_through_a_chain_that_passes_their_band_exactly(clean):
-    """A declared chain whose cut-off lies EXACT_CHAIN_BAND_RATIO x above the angles' band (the
-    chain's noise-floor rule on clean angles, testbed/pipeline/signal_chain.py auto_cutoff)
-    passes the band exactly: its own error floor does not apply, the ridge is the exact data's
-    and the columns are low-passed at half the chain's cut-off.  Before (session 24), every
-    declared chain took CHAIN_REL_FLOOR's ridge and the 1.5 x band column filter, which on
-    round 22's down-branch multisine dropped the joints' damping (0.0475 rad; now 5.0e-5)."""
-    band = sp.noise_knobs(clean.x, clean.fs, 0.2, {})[2]["band_hz"]
-    cut = sp.EXACT_CHAIN_BAND_RATIO * band * 1.5
-    data = _chain_smoothed(clean, 0.0, cut)
-    knobs, rule, est = sp.noise_knobs(data.x, data.fs, 0.2, {}, None, data.noise_std,
-                                      data.passband)
-    assert est["noise_rel"] <= sp.NOISE_FREE_REL and cut >= sp.EXACT_CHAIN_BAND_RATIO * est["band_hz"]
-    assert knobs["ridge"] == sp.RIDGE_EXACT and "error floor" not in rule
-    assert knobs["column_lowpass_hz"] == pytest.approx(sp.EXACT_CHAIN_COLUMN_SHARE * cut)
-    assert "the chain passes the band exactly" in rule
-    assert knobs["formulation"] == "strong" and knobs["selection"] == "rollout"
-    assert knobs["lhs"] == sp.LHS_INPUT_TERMS
-    # noisy angles through the same chain keep the noisy recipe (the rule needs clean angles)
-    noisy = _chain_smoothed(clean, 1.0, cut)
-    k1, r1, e1 = sp.noise_knobs(noisy.x, noisy.fs, 0.2, {}, None, noisy.noise_std, noisy.passband)
-    assert k1["column_lowpass_hz"] == pytest.approx(sp.CUTOFF_FACTOR * e1["band_hz"])
-    assert "exactly" not in r1
