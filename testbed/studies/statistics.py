@@ -52,7 +52,7 @@ SCORED_REASONS = ("fit failed", "diverged", "simulation failed", "non-physical",
 #: The scorer's explanations of a failed bar (testbed.scoring.scorers: uninformative_failures,
 #: out_of_band_failures, unexcited_failures, decayed_failures, floor_failures, sensor_failures,
 #: equation_failures, step_failures, sensitivity_failures, clipping_failures,
-#: linear_model_failures, unscored_mode_failures), each the head of its reason
+#: linear_model_failures, unscored_mode_failures, channel_failures), each the head of its reason
 #: (``<head>: ...``).  Matched only at a
 #: reason's start (the text's or after ``"; "``, as ``Scores.failure`` joins them): their words
 #: occur inside other reasons ("at the sensors").  Without them a floor or an unexcited mode
@@ -60,7 +60,8 @@ SCORED_REASONS = ("fit failed", "diverged", "simulation failed", "non-physical",
 EXPLAINED_REASONS = ("uninformative", "out of band", "unexcited", "decayed", "floor", "sensors",
                      "wrong equation", "equation not determined",
                      "equation not shown determined", "rollout step",
-                     "sensitive record", "clipped", "linear model", "unscored mode")
+                     "sensitive record", "clipped", "linear model", "unscored mode",
+                     "TRAC by channel")
 _EXPLAINED = re.compile(r"(?:^|; )(" + "|".join(map(re.escape, EXPLAINED_REASONS)) + r")\b")
 
 

@@ -197,6 +197,16 @@ def test_a_clipped_sensors_reason_is_a_named_kind():
     assert failure_kind("clipped: sensor acc1 is clipped at +23.1 m/s^2: ...") == ["clipped"]
 
 
+def test_a_trac_failure_named_by_channel_is_a_named_kind():
+    # session 24 (score24): a failed TRAC bar with one channel at the record's floor and another
+    # off it is named channel by channel; without its head it was counted as "other"
+    from testbed.studies.statistics import failure_kind
+
+    why = ("TRAC by channel against the bar 0.9: the identified model's own failure on acc2 0.541 "
+           "(the truth's own 0.973)")
+    assert failure_kind(why) == ["TRAC by channel"]
+
+
 REFUSED = ("RigError: key 'excitation.amplitude, excitation.f_max, excitation.kp, excitation.kd': "
            "value [1.5, 1.5, 10.0, 2.0]: the motion under excitation 'multisine' is not usable "
            "(found only by simulating it): fivebar (pinocchio): at t = 6.6170 s the transmission "
