@@ -295,3 +295,20 @@ def test_a_bump_of_noise_on_a_stronger_modes_leakage_is_no_eigenvalue_target(dat
     assert v["trac"] >= 0.99  # measured 0.9996 (old 0.9955)
     assert not np.any(np.abs(res.model.measured_frequencies_ - 171.1) < 1.0)
 
+
+def test_every_projected_warm_start_is_compared_with_the_flat_fit(dataset_cache):
+    """Families' clamped member 009, clean: the tilted warm start grew (a pole at +1304 1/s)
+    and, its damping projected, carried the lowest peak, so it was kept without a comparison;
+    the SGD from it explained 0.847 of its record (modes within 0.06 %, the study's TRAC 0.90
+    missed).  The projection is a repair the record did not choose: every projected warm
+    start is now fitted flat too, and the flat model kept where the projected fit leaves more
+    than ``SGD_AGREEMENT_RATIO`` (2) x its unexplained share of the record (here 0.153 against
+    0.063, 2.4 x: measured TRAC 0.937, modes 1-2 within 0.13 %)."""
+    ds, data, clean = _family_member(dataset_cache, "beams_stiff__009")
+    model = SGDSINDy().fit(data)
+    v = score_structural(ds, data, clean, model).values
+    # the families study's bar (old code: TRAC 0.847); issue #15's 0.95 is open
+    assert v["trac"] >= 0.90 and np.min([v["mac_mode1"], v["mac_mode2"]]) >= 0.95
+    assert np.max([v["freq_error_mode1"], v["freq_error_mode2"]]) <= 0.01
+    assert "the projection is a repair the record did not choose" in model.fit_tilt_rule_
+    assert model.fit_tilt_rule_.endswith("refit kept") and not model.fit_tilt_
