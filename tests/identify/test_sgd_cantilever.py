@@ -18,9 +18,10 @@ from identify.sgd_sindy import SGDSINDy
 from identify.structural import check_physical, measured_frequencies
 from testbed.pipeline.scenario import load_scenario
 from testbed.pipeline.signal_chain import measure
-from testbed.scoring.run import noise_free
+from testbed.scoring.run import noise_free, run_scenario
 from testbed.scoring.scorers import score_structural
 from testbed.studies.study import load_study
+from testbed.studies.sweep import expand
 
 ROUND16 = Path(__file__).resolve().parents[2] / "benchmarks" / "unseen" / "round16"
 ROUND19 = ROUND16.parent / "round19"
@@ -273,3 +274,41 @@ def test_a_diverging_cubic_whose_warm_start_is_not_simulated_is_refused_for_the_
     # %); the old code: TRAC NaN
     assert v["trac"] > 0.90 and np.min([v["mac_mode1"], v["mac_mode2"]]) > 0.90
     assert np.max(np.abs([v["freq_error_mode1"], v["freq_error_mode2"]])) < 0.026
+
+
+def test_a_bump_of_noise_on_a_stronger_modes_leakage_is_no_eigenvalue_target(dataset_cache):
+    """Round 22's magnesium at 1.8 kHz, two sensors, 5 % noise, seed 139 (the truth is the
+    engine's: mode 2 508.7 Hz, 6.25 % damped).  The SGD's peak search took a 171.1 Hz bump of
+    noise on mode 1's leakage as mode 2, and the eigenvalue target put mode 2 there: 172 Hz,
+    66.2 % off with MAC 0.9996, TRAC 0.9955 (old code).  Its search now has ``ls_sindy``'s
+    rule 4b (``modal_peaks(..., ringing=True)``): the bump neither rings nor decays beyond
+    noise, and mode 2 is the 489.6 Hz peak's; measured 0.74 %, TRAC 0.9996."""
+    study = load_study(ROUND16.parent / "round22_beams_more.toml")
+    cells = [c for c in expand(study) if c.identifier == "sgd_sindy"
+             and c.scenario.name == "b22_mg_fs1k8_s2" and c.noise == 5.0 and c.scenario.seed == 139]
+    assert len(cells) == 1
+    sc = cells[0].scenario
+    res = run_scenario(sc, dataset=dataset_cache.get(sc))
+    v = res.scores.values
+    assert v["freq_error_mode2"] <= 0.026  # measured 0.74 % (old code 66.2 %); the study's bar
+    assert v["freq_error_mode1"] <= 0.001  # measured 0.004 %: mode 1 untouched
+    assert v["trac"] >= 0.99  # measured 0.9996 (old 0.9955)
+    assert not np.any(np.abs(res.model.measured_frequencies_ - 171.1) < 1.0)
+
+
+def test_every_projected_warm_start_is_compared_with_the_flat_fit(dataset_cache):
+    """Families' clamped member 009, clean: the tilted warm start grew (a pole at +1304 1/s)
+    and, its damping projected, carried the lowest peak, so it was kept without a comparison;
+    the SGD from it explained 0.847 of its record (modes within 0.06 %, the study's TRAC 0.90
+    missed).  The projection is a repair the record did not choose: every projected warm
+    start is now fitted flat too, and the flat model kept where the projected fit leaves more
+    than ``SGD_AGREEMENT_RATIO`` (2) x its unexplained share of the record (here 0.153 against
+    0.063, 2.4 x: measured TRAC 0.937, modes 1-2 within 0.13 %)."""
+    ds, data, clean = _family_member(dataset_cache, "beams_stiff__009")
+    model = SGDSINDy().fit(data)
+    v = score_structural(ds, data, clean, model).values
+    # the families study's bar (old code: TRAC 0.847); issue #15's 0.95 is open
+    assert v["trac"] >= 0.90 and np.min([v["mac_mode1"], v["mac_mode2"]]) >= 0.95
+    assert np.max([v["freq_error_mode1"], v["freq_error_mode2"]]) <= 0.01
+    assert "the projection is a repair the record did not choose" in model.fit_tilt_rule_
+    assert model.fit_tilt_rule_.endswith("refit kept") and not model.fit_tilt_
