@@ -1240,6 +1240,11 @@ def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
                 tilt_rule = (f"rule: the tilted warm start had a growing pole ({e}), not "
                              "removed by projecting its damping; kept with its unresolved "
                              "modes placed (physical then)")
+                if unpaired:  # the caller's second fit: the projection did make it physical
+                    tilt_rule = (f"rule: the tilted warm start had a growing pole ({e}); with "
+                                 f"its damping projected it is physical, but {unpaired}: "
+                                 "refused; kept with its unresolved modes placed (physical "
+                                 "then)")
             else:
                 tilted = False
                 tilt_rule = f"rule: the tilted warm start was refused ({e}); fitted flat"
