@@ -111,3 +111,33 @@ def test_rewrite_ahead_writes_what_pytest_would_and_pytest_reads_it(request, tmp
     assert written == own and written.co_filename == own.co_filename == str(src)
     src.write_text(src.read_text() + "\n# edited\n")
     assert not ahead.up_to_date(src)
+
+
+def test_the_conformance_group_is_dealt_first_and_the_sgd_fits_after_the_wheel_and_server():
+    """The first work units (conftest ``_DEALT_FIRST``): the conformance group, which compiles
+    numba's SGD-SINDy kernels, then on the other worker the wheel and server groups, then the
+    scored ``cantilever_soft_impact_150N`` (an ``sgd_sindy`` fit, dealt by its length alone next to
+    the conformance group: both workers compiled the SGD kernels).  Each name is a real work unit
+    of the suite, and the rest follow longest first."""
+    import importlib.util
+    import tomllib
+
+    here = Path(__file__).resolve().parent
+    spec = importlib.util.spec_from_file_location("_cold_conftest", here / "conftest.py")
+    conf = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(conf)
+    first = conf._DEALT_FIRST
+    assert first == ("tests/identify/test_conformance.py", "tests/test_wheel.py", "server",
+                     f"{conf._SCORED}cantilever_soft_impact_150N]")
+    others = sorted(conf._COLD_SECONDS, key=lambda unit: -conf._COLD_SECONDS[unit])
+    units = [u for u in others if u not in first] + list(reversed(first)) + ["tests/not_listed.py"]
+    order = sorted(units, key=conf._deal_rank)
+    assert order[:4] == list(first), order[:6]
+    rest = [conf._COLD_SECONDS.get(u, 0.0) for u in order[4:]]
+    assert rest == sorted(rest, reverse=True) and order[-1] == "tests/not_listed.py"
+    # the names are the suite's work units: two modules, test_server's group, a scored scenario
+    # that fits SGD-SINDy
+    assert (here / "identify" / "test_conformance.py").is_file() and (here / "test_wheel.py").is_file()
+    assert 'pytest.mark.xdist_group("server")' in (here / "testbed" / "test_server.py").read_text()
+    scenario = tomllib.loads((here.parent / "scenarios" / "cantilever_soft_impact_150N.toml").read_text())
+    assert scenario["identify"]["method"] == "sgd_sindy" and scenario.get("score")
