@@ -141,3 +141,41 @@ def test_the_conformance_group_is_dealt_first_and_the_sgd_fits_after_the_wheel_a
     assert 'pytest.mark.xdist_group("server")' in (here / "testbed" / "test_server.py").read_text()
     scenario = tomllib.loads((here.parent / "scenarios" / "cantilever_soft_impact_150N.toml").read_text())
     assert scenario["identify"]["method"] == "sgd_sindy" and scenario.get("score")
+
+
+def test_compile_venv_writes_what_compileall_writes(tmp_path):
+    """tests/_compile_venv.py (the install's byte-compile, run as the Makefile runs it) writes the
+    files ``compileall -qq -j 0 -x '/tests?/'`` writes, byte for byte: not a dependency's test
+    folder, not ``__pycache__``, not through a symlinked folder, and a file that does not compile
+    stops nothing."""
+    import compileall
+    import marshal
+    import re
+    import shutil
+    import subprocess
+    import sys
+
+    files = {"pkg/__init__.py": "", "pkg/mod.py": "X = 1\n", "pkg/sub/deep.py": "def f():\n    return 2\n",
+             "pkg/tests/test_x.py": "Y = 1\n", "pkg/test/t.py": "Y = 2\n", "broken.py": "def (\n",
+             "notes.txt": "x\n", "pkg/__pycache__/stray.py": "Z = 3\n"}
+    src = tmp_path / "a" / "lib"
+    for rel, text in files.items():
+        (src / rel).parent.mkdir(parents=True, exist_ok=True)
+        (src / rel).write_text(text)
+    (src / "linked").symlink_to(src / "pkg", target_is_directory=True)
+    other = tmp_path / "b" / "lib"
+    shutil.copytree(src, other, symlinks=True)  # copy2: the same mtimes, so the same .pyc bytes
+
+    r = subprocess.run([sys.executable, str(Path(__file__).parent / "_compile_venv.py"), str(src)],
+                       capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0 and not r.stdout and not r.stderr, r
+    compileall.compile_dir(str(other), quiet=2, rx=re.compile(r"/tests?/"), workers=2)
+
+    def written(root):
+        # the header (magic, flags, source mtime and size) and the code object; code objects
+        # compare without their file name, which names each copy's own folder
+        return {str(p.relative_to(root)): (p.read_bytes()[:16], marshal.loads(p.read_bytes()[16:]))
+                for p in root.rglob("*.pyc")}
+
+    mine, theirs = written(src), written(other)
+    assert mine == theirs and len(mine) == 3, sorted(mine)  # __init__, mod, deep
