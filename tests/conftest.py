@@ -200,7 +200,7 @@ _COLD_SECONDS = {
 
 
 #: The first work units, in this order.  The conformance group compiles numba's SGD-SINDy
-#: kernels (``window_loss_grad``, ``eig_loss_grad``, ``sgd_steps``) 8-27 s into its run; dealt by
+#: kernels (``window_loss_grad``, ``eig_loss_grad``, ``sgd_steps``) 10-30 s into its run; dealt by
 #: length alone, the scored ``cantilever_soft_impact_150N`` (an ``sgd_sindy`` fit 7 s in) went to
 #: the other worker at the same time and both compiled them (cold run of 2026-11-28: 6.6 + 1.9 s
 #: of CPU on one worker, 3.6 + 3.7 + 0.5 s on the other, the same signatures).  While one worker
