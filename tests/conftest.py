@@ -79,10 +79,10 @@ def pytest_configure(config):
     # (xdist's default ``--loadscope-reorder``).
     if getattr(config.option, "dist", "no") == "loadgroup":
         config.option.loadscopereorder = False
-    # numba's cache=True kernels: measured on two cold runs (2026-11-26, with the order of
-    # _COLD_SECONDS), every kernel was compiled by one worker only (58 s of CPU in all), so
-    # nothing locks their compiles (a lock would wrap numba's Dispatcher, which an upgrade could
-    # break in CI).  A new order can change that: count the compile events per worker again.
+    # numba's cache=True kernels: nothing locks their compiles (a lock would wrap numba's
+    # Dispatcher, which an upgrade could break in CI, and would leave the waiting worker's core
+    # idle); the order of the first units (_DEALT_FIRST) keeps the two workers from compiling
+    # the SGD kernels at once.  A new order can change that: count the compile events per worker.
 
 
 @pytest.hookimpl(tryfirst=True)  # before xdist reads the xdist_group marks
@@ -105,9 +105,10 @@ def pytest_collection_modifyitems(config, items):
         if any(fd.scope in ("module", "class") and fd.baseid.split("::")[0] == module
                for defs in item._fixtureinfo.name2fixturedefs.values() for fd in defs):
             item.add_marker(pytest.mark.xdist_group(module))
-    # longest work first (the order xdist deals the work units in: see pytest_configure)
-    rank = {id(item): _COLD_SECONDS.get(_work_unit(item), 0.0) for item in items}
-    items.sort(key=lambda item: -rank[id(item)])  # stable: a module's tests keep their order
+    # :data:`_DEALT_FIRST` first, then longest work first (the order xdist deals the work units
+    # in: see pytest_configure)
+    rank = {id(item): _deal_rank(_work_unit(item)) for item in items}
+    items.sort(key=lambda item: rank[id(item)])  # stable: a module's tests keep their order
 
 
 def pytest_collection_finish(session):
@@ -196,6 +197,26 @@ _COLD_SECONDS = {
     "tests/identify/test_sindy_pi_kernels.py::test_fresh_cholesky_kernel_matches_reference[0]": 4.8,
     "tests/test_third_rig.py": 4.7,
 }
+
+
+#: The first work units, in this order.  The conformance group compiles numba's SGD-SINDy
+#: kernels (``window_loss_grad``, ``eig_loss_grad``, ``sgd_steps``) 10-30 s into its run; dealt by
+#: length alone, the scored ``cantilever_soft_impact_150N`` (an ``sgd_sindy`` fit 7 s in) went to
+#: the other worker at the same time and both compiled them (cold run of 2026-11-28: 6.6 + 1.9 s
+#: of CPU on one worker, 3.6 + 3.7 + 0.5 s on the other, the same signatures).  While one worker
+#: runs the conformance group the other takes the units that follow: the wheel and the server
+#: groups first, which fit no SGD-SINDy model in the worker (22 + 21 s of CPU), then the scored
+#: scenarios, which then load the kernels from numba's cache.  Every other unit follows, longest
+#: first (the conformance module's one-test units, under 0.1 s each, are dealt with its group).
+_DEALT_FIRST = ("tests/identify/test_conformance.py", "tests/test_wheel.py", "server",
+                f"{_SCORED}cantilever_soft_impact_150N]")
+
+
+def _deal_rank(unit: str) -> tuple[int, float]:
+    """Sort key of a work unit: its place in :data:`_DEALT_FIRST`, then its cold seconds
+    (:data:`_COLD_SECONDS`, longest first)."""
+    first = _DEALT_FIRST.index(unit) if unit in _DEALT_FIRST else len(_DEALT_FIRST)
+    return first, -_COLD_SECONDS.get(unit, 0.0)
 
 
 def _work_unit(item) -> str:

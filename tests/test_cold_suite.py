@@ -111,3 +111,71 @@ def test_rewrite_ahead_writes_what_pytest_would_and_pytest_reads_it(request, tmp
     assert written == own and written.co_filename == own.co_filename == str(src)
     src.write_text(src.read_text() + "\n# edited\n")
     assert not ahead.up_to_date(src)
+
+
+def test_the_conformance_group_is_dealt_first_and_the_sgd_fits_after_the_wheel_and_server():
+    """The first work units (conftest ``_DEALT_FIRST``): the conformance group, which compiles
+    numba's SGD-SINDy kernels, then on the other worker the wheel and server groups, then the
+    scored ``cantilever_soft_impact_150N`` (an ``sgd_sindy`` fit, dealt by its length alone next to
+    the conformance group: both workers compiled the SGD kernels).  Each name is a real work unit
+    of the suite, and the rest follow longest first."""
+    import importlib.util
+    import tomllib
+
+    here = Path(__file__).resolve().parent
+    spec = importlib.util.spec_from_file_location("_cold_conftest", here / "conftest.py")
+    conf = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(conf)
+    first = conf._DEALT_FIRST
+    assert first == ("tests/identify/test_conformance.py", "tests/test_wheel.py", "server",
+                     f"{conf._SCORED}cantilever_soft_impact_150N]")
+    others = sorted(conf._COLD_SECONDS, key=lambda unit: -conf._COLD_SECONDS[unit])
+    units = [u for u in others if u not in first] + list(reversed(first)) + ["tests/not_listed.py"]
+    order = sorted(units, key=conf._deal_rank)
+    assert order[:4] == list(first), order[:6]
+    rest = [conf._COLD_SECONDS.get(u, 0.0) for u in order[4:]]
+    assert rest == sorted(rest, reverse=True) and order[-1] == "tests/not_listed.py"
+    # the names are the suite's work units: two modules, test_server's group, a scored scenario
+    # that fits SGD-SINDy
+    assert (here / "identify" / "test_conformance.py").is_file() and (here / "test_wheel.py").is_file()
+    assert 'pytest.mark.xdist_group("server")' in (here / "testbed" / "test_server.py").read_text()
+    scenario = tomllib.loads((here.parent / "scenarios" / "cantilever_soft_impact_150N.toml").read_text())
+    assert scenario["identify"]["method"] == "sgd_sindy" and scenario.get("score")
+
+
+def test_compile_venv_writes_what_compileall_writes(tmp_path):
+    """tests/_compile_venv.py (the install's byte-compile, run as the Makefile runs it) writes the
+    files ``compileall -qq -j 0 -x '/tests?/'`` writes, byte for byte: not a dependency's test
+    folder, not ``__pycache__``, not through a symlinked folder, and a file that does not compile
+    stops nothing."""
+    import compileall
+    import marshal
+    import re
+    import shutil
+    import subprocess
+    import sys
+
+    files = {"pkg/__init__.py": "", "pkg/mod.py": "X = 1\n", "pkg/sub/deep.py": "def f():\n    return 2\n",
+             "pkg/tests/test_x.py": "Y = 1\n", "pkg/test/t.py": "Y = 2\n", "broken.py": "def (\n",
+             "notes.txt": "x\n", "pkg/__pycache__/stray.py": "Z = 3\n"}
+    src = tmp_path / "a" / "lib"
+    for rel, text in files.items():
+        (src / rel).parent.mkdir(parents=True, exist_ok=True)
+        (src / rel).write_text(text)
+    (src / "linked").symlink_to(src / "pkg", target_is_directory=True)
+    other = tmp_path / "b" / "lib"
+    shutil.copytree(src, other, symlinks=True)  # copy2: the same mtimes, so the same .pyc bytes
+
+    r = subprocess.run([sys.executable, str(Path(__file__).parent / "_compile_venv.py"), str(src)],
+                       capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0 and not r.stdout and not r.stderr, r
+    compileall.compile_dir(str(other), quiet=2, rx=re.compile(r"/tests?/"), workers=2)
+
+    def written(root):
+        # the header (magic, flags, source mtime and size) and the code object; code objects
+        # compare without their file name, which names each copy's own folder
+        return {str(p.relative_to(root)): (p.read_bytes()[:16], marshal.loads(p.read_bytes()[16:]))
+                for p in root.rglob("*.pyc")}
+
+    mine, theirs = written(src), written(other)
+    assert mine == theirs and len(mine) == 3, sorted(mine)  # __init__, mod, deep
