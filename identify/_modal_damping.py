@@ -639,7 +639,8 @@ def modal_decay(data: Measurement, M: np.ndarray, K: np.ndarray, C: np.ndarray,
     nuisance = chain_transients(getattr(data, "chain_poles", None), t)
     free = np.zeros(n, bool) if unlocated is None else np.asarray(unlocated, bool)
     fits: dict[int, tuple[float, float]] = {}
-    retry: list[int] = []  # modes fitted from a free peak whose fit failed (see below)
+    retry: dict[int, set] = {}  # modes fitted from a free peak whose fit failed: the decays
+    #                              taken when it was tried (see below)
     order = np.concatenate([np.flatnonzero(~free), np.flatnonzero(free)])
     for k in order:
         s, wd, r2, ok, c, amp = _decay_fit(q[k], t, 0.5 * d[k], w[k], backbone, nuisance)
@@ -659,7 +660,7 @@ def modal_decay(data: Measurement, M: np.ndarray, K: np.ndarray, C: np.ndarray,
                                         data, i1 - i0)
             paired = True
             if not ok:
-                retry.append(k)
+                retry[k] = set(fits)
         elif free[k] and not backbone and not (ok and paired):
             # no peak located it and its modal coordinate's fit is not taken: every channel's
             # record, between its neighbours (module docstring, "Unlocated modes")
@@ -676,10 +677,9 @@ def modal_decay(data: Measurement, M: np.ndarray, K: np.ndarray, C: np.ndarray,
     # a fit from a free peak that failed before some later mode's decay was taken is tried
     # once more with every taken decay profiled out (module docstring, "A free peak's fit
     # retried"); a linear model's modes only (``retry`` holds no backbone fit)
-    position = {int(k): i for i, k in enumerate(order)}
-    for k in retry:
-        if not any(position[j] > position[k] for j in fits):  # nothing new to profile out
-            continue
+    for k, before in retry.items():
+        if not set(fits) - before:  # nothing new to profile out (a decay taken after its try,
+            continue                # by a later mode or an earlier retry: review 24c)
         s, wd, ok = _from_free_peak(out, k, 2.0 * np.pi * float(out.peak_hz[k]),
                                     xdd[:, i0:i1], t, w, d, nuisance, fits, data, i1 - i0)
         if ok:

@@ -17,7 +17,7 @@ from identify import IDENTIFIERS
 from identify._cubic_rule import CUBIC_CHIRP_MIN
 from identify._structural_sim import simulate_structural
 from identify.ls_sindy import LeastSquaresSINDy, reach_moves
-from identify.structural import _decaying_only, check_physical, modal, modal_peaks
+from identify.structural import _decaying_only, check_physical, deflection_shapes, modal, modal_peaks
 from testbed.pipeline.scenario import load_scenario
 from testbed.pipeline.signal_chain import measure
 from testbed.scoring.run import make_identifier, run_scenario
@@ -809,3 +809,22 @@ def test_a_mode_the_high_pass_bends_keeps_its_place_in_the_ringing_zone(dataset_
     model = LeastSquaresSINDy().fit(data)
     f_true = np.asarray(ds.truth["frequencies_hz"])[0]
     assert model.natural_frequencies_[0] == pytest.approx(f_true, rel=0.026)  # the study's bar
+
+
+def test_a_weak_mode_in_the_ringing_zone_locked_above_noise_is_kept_on_a_long_record():
+    """Review 24c: in the chain's ringing zone (at most 2 x the 10 Hz high-pass) the lock's bar
+    was 2 / pi even where noise's own bar is lower (a long window: 0.500 over 4 s at 15 Hz), so
+    a weak, lightly damped 15 Hz mode locked at 0.58 (above noise's bar, under 2 / pi) whose
+    power barely falls was rejected as noise; above the zone the same candidate is kept.  Now
+    the zone's bar is capped by noise's, as above it.  Synthetic record (4 s at 2 kHz, a strong
+    80 Hz mode, the 15 Hz one at 1 % of its amplitude, white noise 10 % of the strong mode)."""
+    fs, t = 2000.0, np.arange(8000) / 2000.0
+    rng = np.random.default_rng(2)
+    s1 = 5.0 * np.exp(-0.002 * 2 * np.pi * 80.0 * t) * np.sin(2 * np.pi * 80.0 * t)
+    s2 = 0.05 * np.exp(-0.002 * 2 * np.pi * 15.0 * t) * np.sin(2 * np.pi * 15.0 * t + 0.3)
+    x = np.vstack([s1 + s2, 0.6 * s1 - 0.8 * s2]) + 0.5 * rng.standard_normal((2, t.size))
+    freqs = np.array([80.0, 15.0])
+    shapes = deflection_shapes(x, fs, freqs, pad=8)
+    data = SimpleNamespace(xdd=x, fs=fs)
+    rejected: list = []
+    assert _decaying_only(data, 0, freqs, shapes, [0, 1], rejected, 20.0) == [0, 1], rejected
