@@ -639,8 +639,8 @@ def modal_decay(data: Measurement, M: np.ndarray, K: np.ndarray, C: np.ndarray,
     nuisance = chain_transients(getattr(data, "chain_poles", None), t)
     free = np.zeros(n, bool) if unlocated is None else np.asarray(unlocated, bool)
     fits: dict[int, tuple[float, float]] = {}
-    retry: dict[int, set] = {}  # modes fitted from a free peak whose fit failed: the decays
-    #                              taken when it was tried (see below)
+    retry: dict[int, int] = {}  # modes fitted from a free peak whose fit failed: how many
+    #                              decays were taken when it was tried (see below)
     order = np.concatenate([np.flatnonzero(~free), np.flatnonzero(free)])
     for k in order:
         s, wd, r2, ok, c, amp = _decay_fit(q[k], t, 0.5 * d[k], w[k], backbone, nuisance)
@@ -660,7 +660,7 @@ def modal_decay(data: Measurement, M: np.ndarray, K: np.ndarray, C: np.ndarray,
                                         data, i1 - i0)
             paired = True
             if not ok:
-                retry[k] = set(fits)
+                retry[k] = len(fits)
         elif free[k] and not backbone and not (ok and paired):
             # no peak located it and its modal coordinate's fit is not taken: every channel's
             # record, between its neighbours (module docstring, "Unlocated modes")
@@ -678,8 +678,8 @@ def modal_decay(data: Measurement, M: np.ndarray, K: np.ndarray, C: np.ndarray,
     # once more with every taken decay profiled out (module docstring, "A free peak's fit
     # retried"); a linear model's modes only (``retry`` holds no backbone fit)
     for k, before in retry.items():
-        if not set(fits) - before:  # nothing new to profile out (a decay taken after its try,
-            continue                # by a later mode or an earlier retry: review 24c)
+        if len(fits) == before:  # nothing new to profile out (``fits`` only gains: a decay
+            continue             # taken after its try, by a later mode or a retry; review 24c)
         s, wd, ok = _from_free_peak(out, k, 2.0 * np.pi * float(out.peak_hz[k]),
                                     xdd[:, i0:i1], t, w, d, nuisance, fits, data, i1 - i0)
         if ok:

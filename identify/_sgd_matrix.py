@@ -1237,14 +1237,12 @@ def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
                 # 12.8 kHz: mode 5 fitted with a negative stiffness; flat, the SGD diverged,
                 # TRAC 4.6e-8; placed, 0.9946)
                 M0, C0, K0, unresolved_rule = placed
-                tilt_rule = (f"rule: the tilted warm start had a growing pole ({e}), not "
-                             "removed by projecting its damping; kept with its unresolved "
-                             "modes placed (physical then)")
-                if unpaired:  # the caller's second fit: the projection did make it physical
-                    tilt_rule = (f"rule: the tilted warm start had a growing pole ({e}); with "
-                                 f"its damping projected it is physical, but {unpaired}: "
-                                 "refused; kept with its unresolved modes placed (physical "
-                                 "then)")
+                tilt_rule = (f"rule: the tilted warm start had a growing pole ({e})"
+                             # (the caller's second fit: the projection did make it physical)
+                             + (f"; with its damping projected it is physical, but {unpaired}: "
+                                "refused" if unpaired else
+                                ", not removed by projecting its damping")
+                             + "; kept with its unresolved modes placed (physical then)")
             else:
                 tilted = False
                 tilt_rule = f"rule: the tilted warm start was refused ({e}); fitted flat"

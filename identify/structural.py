@@ -1006,6 +1006,10 @@ def _decaying_only(data: Measurement, s: int, freqs: np.ndarray, shapes: np.ndar
     x = np.asarray(data.xdd, dtype=float)
     out = list(kept[:1])
     for i in kept[1:]:
+        ratio, bar = band_power_fall(x, data.fs, float(freqs[i]), shapes[i], s)
+        if np.isfinite(ratio) and np.isfinite(bar) and ratio >= bar:  # decays: kept, whatever
+            out.append(i)                                               # its lock (no lock run)
+            continue
         zone = freqs[i] <= ring_top
         if zone:  # the chain's ringing zone: the lock where it rings nearest (RING_ZONE_LOCK)
             lock, at = _ringing_zone_lock(x[:, s:], data.fs, float(freqs[i]))
@@ -1015,7 +1019,6 @@ def _decaying_only(data: Measurement, s: int, freqs: np.ndarray, shapes: np.ndar
         # (capped by noise's own bar in the zone too: on a long window noise's bar falls
         # below 2 / pi, and a mode locked above it is no noise; review 24c)
         lock_bar = min(RING_ZONE_LOCK if zone else LOWER_MODE_LOCK, noise_bar)
-        ratio, bar = band_power_fall(x, data.fs, float(freqs[i]), shapes[i], s)
         # a test that cannot decide keeps the candidate (review 23f): a window too short for
         # the frequency (lock or fall not finite), or, above the ringing zone, one where noise
         # alone may lock above LOWER_MODE_LOCK (3 x noise's lock capped: the lock test has no

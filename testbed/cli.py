@@ -159,9 +159,7 @@ def _path_text(text: str) -> str:
         # `--cache " "` made a folder whose name ends in an invisible character, in silence; the
         # next command without it used another folder (the data simulated again, the runs
         # listed elsewhere).  A path that exists so is the user's own, and is taken.
-        from testbed.core.errors import _one_line as escaped
-
-        raise argparse.ArgumentTypeError(f"{escaped(repr(text))} ends in a blank or line end and "
+        raise argparse.ArgumentTypeError(f"{text!r} ends in a blank or line end and "
                                          "names nothing yet; expected a name without trailing "
                                          "whitespace (or one that exists)")
     return text

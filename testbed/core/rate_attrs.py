@@ -19,6 +19,12 @@ from testbed.core.lazy import lazy_module
 
 h5py = lazy_module("h5py")
 
+#: How far [relative] a dataset file's ``fs`` may lie from the rate its stored scenario records
+#: at, for the cache (``testbed.pipeline.cache``) and the importers alike: a plugin rig may write
+#: a derived rate 1 / (k dt) an ulp or so from its scenario's; an exact comparison would refuse
+#: every read of its cache.
+SCENARIO_RATE_RTOL = 1e-12
+
 
 def fs_attribute_problem(path: str | os.PathLike) -> str | None:
     """What is wrong with a dataset file's root ``fs`` (not one real number) or ``fs_unit`` (not

@@ -40,7 +40,7 @@ from testbed.core import arguments
 from testbed.core.dataset import Dataset, DatasetError
 from testbed.core.errors import InputError
 from testbed.core.provenance import versions
-from testbed.core.rate_attrs import fs_attribute_problem
+from testbed.core.rate_attrs import SCENARIO_RATE_RTOL, fs_attribute_problem
 from testbed.pipeline.generate import derive, noise_free_scenario, simulate_clean
 from testbed.pipeline.plugins import rig_class
 from testbed.pipeline.scenario import Scenario
@@ -178,9 +178,9 @@ def _load_entry(path: Path, scenario: Scenario) -> Dataset:
         raise DatasetError(path, problem)
     ds = Dataset.load(path)
     record = rig_class(scenario.rig).record(noise_free_scenario(scenario).simulation)
-    # within 1e-12 relative: a plugin rig may write a derived rate (1 / (k dt)) an ulp or so
-    # from its scenario's; an exact comparison would refuse every read of its cache (NaN fails)
-    if record is not None and not (abs(ds.fs - float(record[0])) <= 1e-12 * abs(float(record[0]))):
+    # within SCENARIO_RATE_RTOL relative (NaN fails)
+    if record is not None and not (abs(ds.fs - float(record[0]))
+                                   <= SCENARIO_RATE_RTOL * abs(float(record[0]))):
         raise DatasetError(path, f"attribute fs={ds.fs!r} Hz; its scenario records at "
                                  f"{float(record[0])!r} Hz")
     return ds

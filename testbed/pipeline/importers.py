@@ -63,7 +63,7 @@ from testbed.core.budget import IDENTIFY_BYTES_PER_VALUE, IDENTIFY_TEXT_BUDGET_B
 from testbed.core.dataset import Dataset, DatasetError, Signal
 from testbed.core.errors import TestbedError, is_control, show_names
 from testbed.core.measurement import MIN_FREE_SAMPLES, Measurement
-from testbed.core.rate_attrs import fs_attribute_problem
+from testbed.core.rate_attrs import SCENARIO_RATE_RTOL, fs_attribute_problem
 from testbed.numerics.clipping import Clipping, measured_clipping
 from testbed.numerics.noise import noise_std
 from testbed.pipeline.plugins import rig_class
@@ -1241,12 +1241,6 @@ def _raw_from_dataset(path: Path, ds: Dataset) -> _Raw:
                 if target in node:
                     raw.nodes[f"{g}/{ch}"] = node[target]
     return raw
-
-
-#: How far [relative] a dataset file's ``fs`` may lie from the rate its stored scenario records
-#: at: the cache's own allowance (``testbed.pipeline.cache._load_entry``: a plugin rig may write
-#: a derived rate 1 / (k dt) an ulp or so from its scenario's).
-SCENARIO_RATE_RTOL = 1e-12
 
 
 def _check_scenario_rate(path: Path, ds: Dataset) -> None:

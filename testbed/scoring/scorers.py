@@ -167,6 +167,12 @@ def verdict(checks: list[Check], failures: dict[str, str] | None = None) -> str:
     return PASS if checks else NO_VERDICT
 
 
+def bar_text(c: Check) -> str:
+    """``"<metric> <value> above <max>"`` (or below a min): one missed bar in words (any bound
+    but ``"min"`` is a maximum, as :attr:`Check.passed` judges it)."""
+    return f"{c.metric} {c.value:.3g} {'below' if c.bound == 'min' else 'above'} {c.threshold:g}"
+
+
 def check_thresholds(values: dict[str, float], thresholds: dict[str, dict[str, float]]) -> list[Check]:
     """Compare scores with ``{metric: {"min"|"max": threshold}}``; a missing score fails."""
     return [Check(m, float(values.get(m, np.nan)), b, t)
@@ -428,8 +434,7 @@ def equation_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -
     def not_finite(metric: str) -> str:  # the scorer's own reason first (law_error_reason)
         return scores.details.get(f"{metric}_reason") or NOT_FINITE.get(metric, "not computable")
 
-    said = "; ".join(f"{c.metric} {c.value:.3g} {'below' if c.bound == 'min' else 'above'} "
-                     f"{c.threshold:g}" if np.isfinite(c.value) else
+    said = "; ".join(bar_text(c) if np.isfinite(c.value) else
                      f"{c.metric} not finite ({not_finite(c.metric)}; bar "
                      f"{c.threshold:g})" for c in missed)
     why = ("the rig's own bars on the identified equation: its question is the law, which a "

@@ -34,7 +34,7 @@ from typing import Any
 from testbed.core import errors
 from testbed.core.terminal import make_console
 from testbed.numerics.quantiles import quartiles
-from testbed.scoring.scorers import Check
+from testbed.scoring.scorers import Check, bar_text
 from testbed.studies.family import family_of
 from testbed.studies.results import judged_checks, read_results, score_columns, stored_checks
 
@@ -136,11 +136,6 @@ def row_failure_kinds(row: dict[str, Any], judged: bool) -> list[str]:
         return kinds
     return ([f"{FAILED_BAR} {c.metric}" for c in failed_bars(row)]
             or [f"{FAILED_BAR} (checks unreadable)"])
-
-
-def _bar_text(c: Check) -> str:
-    """``"<metric> <value> above <max>"`` (or below a min): one missed bar in words."""
-    return f"{c.metric} {c.value:.3g} {'below' if c.bound == 'min' else 'above'} {c.threshold:g}"
 
 
 def scored(row: dict[str, Any]) -> bool:
@@ -369,6 +364,6 @@ def print_summary(path: str | os.PathLike, console: Any = None,
         for r, bars in missed[:5]:
             console.print(f"  {r['scenario']} noise={r['noise']:g} seed={r['seed']} "
                           f"{r['identifier']}: "
-                          f"{'; '.join(map(_bar_text, bars)) or 'checks unreadable'}", markup=False,
+                          f"{'; '.join(map(bar_text, bars)) or 'checks unreadable'}", markup=False,
                           highlight=False, soft_wrap=True)
     return summary
