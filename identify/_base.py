@@ -175,15 +175,19 @@ class Identifier:
 
     @classmethod
     def validate_hyperparameters(cls, params: dict[str, Any], *, file: str = "<identifier>",
-                                 section: str = "identify") -> dict[str, Any]:
+                                 section: str = "identify",
+                                 elsewhere: Mapping[str, Any] | None = None) -> dict[str, Any]:
         """Field and cross-key checks of ``params`` (a partial dict); return it complete.
+        ``elsewhere`` maps other identifiers to their keys, named where an unknown key is one
+        of theirs (:func:`testbed.core.schema.unknown_key_hint`).
 
         Raises
         ------
         ScenarioError
             Naming ``file``, ``section.<name>``, the value and what is allowed.
         """
-        full = validate_table(params, cls.declared_hyperparameters(), file=file, section=section)
+        full = validate_table(params, cls.declared_hyperparameters(), file=file, section=section,
+                              elsewhere=elsewhere)
 
         def error(name: str, value: Any, allowed: str) -> None:
             raise ScenarioError(file, f"{section}.{name}", value, allowed)
@@ -236,12 +240,11 @@ class Identifier:
                 # silence (hostile round 20)
                 f_type = getattr(f, "type", None)
                 want = getattr(f_type, "__name__", "value of its declared type")
-                raise HyperparameterError(str(ScenarioError(
-                    type(self).__name__, f"{self.name or 'params'}.{k}", v,
-                    f"expected a Python {want}, as a scenario file gives it (a "
+                raise self._param_error(
+                    k, v, f"expected a Python {want}, as a scenario file gives it (a "
                     f"{type(v).__name__} is not read as one"
                     + ("; an array: pass .tolist(); a set or an iterator: a list in its order)"
-                       if f_type is list else ")"))))
+                       if f_type is list else ")"))
             else:
                 complete = False
         try:
@@ -250,6 +253,13 @@ class Identifier:
         except ScenarioError as e:
             raise HyperparameterError(str(e)) from None
         return full, complete
+
+    def _param_error(self, name: str, value: Any, allowed: str) -> HyperparameterError:
+        """The refusal of this estimator's hyperparameter ``name`` at ``value``: what is
+        ``allowed``, named as a scenario's key (``<class>: key '<name or params>.<name>'``)."""
+        return HyperparameterError(str(ScenarioError(type(self).__name__,
+                                                     f"{self.name or 'params'}.{name}", value,
+                                                     allowed)))
 
     def check_params_for_data(self, data: Measurement) -> None:
         """:meth:`check_params`, then :meth:`check_data_shape` against ``data`` (channels,
@@ -264,11 +274,9 @@ class Identifier:
         full, complete = self._checked_params()
         if not complete:
             return
-        section = self.name or "params"
 
         def error(name: str, value: Any, allowed: str) -> None:
-            raise HyperparameterError(str(ScenarioError(type(self).__name__, f"{section}.{name}",
-                                                        value, allowed)))
+            raise self._param_error(name, value, allowed)
 
         n_inputs = 0 if data.u is None else data.u.shape[0]
         self.check_data_shape(full, data.n_channels, n_inputs, data.fs, data.n_samples, error)

@@ -560,9 +560,8 @@ def select_passive_models(sw: Sweep, input_cols: Sequence[np.ndarray],
             ok = free & has_acc & np.isfinite(sw.val_error)
             elig = ok & offered & np.isfinite(acc_err)
             best = acc_err[elig].min() if elig.any() else np.inf
-            firsts = [f for f in order if offered.ravel()[f]]
-            first = acc_err.ravel()[firsts[0]] if firsts else np.inf
-            if firsts and not first <= best * (1.0 + rtol) + atol:
+            first = next((f for f in order if offered.ravel()[f]), None)
+            if first is not None and not acc_err.ravel()[first] <= best * (1.0 + rtol) + atol:
                 order = rank_models(replace(sw, val_error=acc_err), ok, rtol, atol)
         picked: list[tuple[int, int]] = []
         seen: set[bytes] = set()

@@ -962,6 +962,14 @@ class DecayHold:
     rule: str
 
 
+def nearer_own(target: np.ndarray, freqs: np.ndarray) -> np.ndarray:
+    """Whether each mode's ``target`` lies at least as near its own frequency as any other
+    mode's (``freqs``, the same units, mode k's at index k): a move to it does not carry the
+    mode across another.  Shape (n_modes,), bool."""
+    gap = np.abs(np.asarray(target)[:, None] - np.asarray(freqs)[None, :])
+    return np.all(gap >= np.diag(gap)[:, None], axis=1)
+
+
 def decay_hold(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndarray,
                window: tuple[int, int],
                set_frequencies: Callable[[np.ndarray, np.ndarray], np.ndarray],
@@ -1055,9 +1063,7 @@ def decay_hold(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndarray,
     def own_nearest(move: np.ndarray) -> np.ndarray:
         # only to a frequency nearer its own mode's than any other's (a decay that is another
         # mode's leakage must not carry a mode across it)
-        w = 2.0 * np.pi * modal(M, K)[0]
-        gap = np.abs(np.sqrt(dec.lam_model)[:, None] - w[None, :])
-        return move & np.all(gap >= np.diag(gap)[:, None], axis=1)
+        return move & nearer_own(np.sqrt(dec.lam_model), 2.0 * np.pi * modal(M, K)[0])
 
     if with_backbone:  # a cubic model's mode no peak located, whose decay showed no backbone
         free = np.zeros_like(free) if dec.exponential is None else free & dec.exponential

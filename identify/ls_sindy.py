@@ -15,6 +15,7 @@ from identify._modal_damping import (
     backbone_shift,
     decay_hold,
     hardened_reach,
+    nearer_own,
     set_eigenvalues,
 )
 from identify._record import record_agreement
@@ -630,9 +631,9 @@ class LeastSquaresSINDy(StructuralIdentifier):
                     return
         self._hold(*hold)
         if self.K3_ is not None:
-            self._cap_at_reach(data, tilt_library(lib) if self.fit_tilt_ else lib, peaks, masses)
+            self._cap_at_reach(data, lib, peaks, masses)
 
-    def _cap_at_reach(self, data: Measurement, rows: Library, peaks: np.ndarray,
+    def _cap_at_reach(self, data: Measurement, lib: Library, peaks: np.ndarray,
                       masses: np.ndarray) -> None:
         """Step 2 with the cubic library (class docstring): a linear frequency above what the
         hardening record allows is moved down to it, and the cubic refitted around it.
@@ -646,7 +647,8 @@ class LeastSquaresSINDy(StructuralIdentifier):
         :func:`reach_moves` (to the backbone limit where that bounds the mode, else to the
         reach, and only to a frequency nearer its own mode's than any other's), shapes kept
         (:func:`identify._modal_damping.set_eigenvalues`).  Then the cubic, input and drift
-        columns of ``rows`` (the regression the model was solved on) are fitted again by
+        columns of the regression the model was solved on (``lib``, tilted where the fit is) are
+        fitted again by
         least squares with the held damping and stiffness fixed (:meth:`_refit_cubic`), so
         that the model's cubic carries what the record's amplitude adds to the moved
         frequency.  The moved and refitted model is checked as a fit is: physical
@@ -692,10 +694,9 @@ class LeastSquaresSINDy(StructuralIdentifier):
                 + ", ".join(f"{freqs[j]:.4g} > {reach[j]:.4g} Hz, to {to[j]:.4g} Hz ("
                             + ("its backbone limit" if limit[j] <= reach[j] else "that reach") + ")"
                             for j in k))
-        m = masses[:, None]
-        self._set_stiffness(set_eigenvalues(
-            self.M_, self.K_, np.where(move, (2.0 * np.pi * to) ** 2, np.nan)), m, rows.blocks["d"])
-        self._refit_cubic(data, rows, masses)
+        # (K_ alone: the refit's _take replaces coef_ whole)
+        self.K_ = set_eigenvalues(self.M_, self.K_, np.where(move, (2.0 * np.pi * to) ** 2, np.nan))
+        self._refit_cubic(data, tilt_library(lib) if self.fit_tilt_ else lib, masses)
         try:
             self._check_physical()
             objection = self._cubic_softens() or self._cubic_diverges(data)
@@ -977,8 +978,8 @@ def reach_moves(freqs_hz: np.ndarray, reach_hz: np.ndarray, limit_hz: np.ndarray
         return none, to, ("the record hardens, every mode within its reach ("
                           + ", ".join(f"{a:.4g} <= {r:.4g} Hz" for a, r in zip(f, reach, strict=True))
                           + "): nothing moved")
-    gap = np.abs(to[:, None] - f[None, :])
-    nearest = np.all(gap >= np.diag(gap)[:, None], axis=1)
+    gap = np.abs(to[:, None] - f[None, :])  # (the message names the nearer mode)
+    nearest = nearer_own(to, f)
     move = above & nearest
     left = np.flatnonzero(above & ~nearest)
     why = "; ".join(

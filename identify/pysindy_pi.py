@@ -31,7 +31,7 @@ import numpy as np
 from identify import IDENTIFIERS
 from identify._implicit import Sweep, _errors
 from identify.sindy_pi import COMMON_HYPERPARAMETERS, _ImplicitMechanical, ordered_fields
-from testbed.core.errors import HyperparameterError, IdentificationError, ScenarioError
+from testbed.core.errors import IdentificationError
 from testbed.core.schema import Field, KeyUse
 
 #: Training samples pysindy's SINDyPI is given when ``stride`` is left to the rule: one OSQP
@@ -147,9 +147,6 @@ class PySINDyPI(_ImplicitMechanical):
     """
 
     name = "pysindy_pi"
-    #: The reference peer keeps its passive equations ranked as measured (per unit of the
-    #: left-hand side), as it keeps the selection without the inertia rule.
-    _passive_acc_rule_on = False
     deterministic = True  # OSQP, single-threaded; refitted to the bit in test_conformance
     hyperparameters: ClassVar[dict[str, Field]] = ordered_fields({
         **COMMON_HYPERPARAMETERS,
@@ -227,10 +224,10 @@ class PySINDyPI(_ImplicitMechanical):
             # underdetermined, so the model would be the optimizer's choice, not the record's
             # (a 1000-sample record at stride 999 gave a model from 2 samples, status 0)
             most = max(1, Theta_train.shape[0] // X.shape[1])
-            raise HyperparameterError(str(ScenarioError(
-                type(self).__name__, f"{self.name or 'params'}.stride", self.stride_,
+            raise self._param_error(
+                "stride", self.stride_,
                 f"leaves {X.shape[0]} of {Theta_train.shape[0]} training samples, fewer than the "
-                f"library's {X.shape[1]} terms; at most {most}")))
+                f"library's {X.shape[1]} terms; at most {most}")
         xi = pysindy_pi_coef(X, cand, self.reg_weight_lam, self.tol, self.max_iter)
         idx = np.arange(cand.size)
         w = -xi

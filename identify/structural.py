@@ -1026,7 +1026,7 @@ def _decaying_only(data: Measurement, s: int, freqs: np.ndarray, shapes: np.ndar
         # noise with lock NaN
         untestable = (not (np.isfinite(lock) and np.isfinite(ratio) and np.isfinite(bar))
                       or (noise_bar > LOWER_MODE_LOCK and not zone))
-        if untestable or lock >= lock_bar or ratio >= bar:
+        if untestable or lock >= lock_bar:  # (a finite fall at its bar kept the candidate above)
             out.append(i)
         else:
             where = f" at {at:.4g} Hz, the most within {MODE_SEPARATION:.0%}" if zone else ""

@@ -26,6 +26,12 @@ h5py = lazy_module("h5py")
 SCENARIO_RATE_RTOL = 1e-12
 
 
+def off_scenario_rate(fs: float, rate: float) -> bool:
+    """Whether a file's ``fs`` [Hz] lies further than :data:`SCENARIO_RATE_RTOL` from the
+    ``rate`` [Hz] its scenario records at (NaN counts as off)."""
+    return not abs(fs - rate) <= SCENARIO_RATE_RTOL * abs(rate)
+
+
 def fs_attribute_problem(path: str | os.PathLike) -> str | None:
     """What is wrong with a dataset file's root ``fs`` (not one real number) or ``fs_unit`` (not
     ``"Hz"``), or None; None too for a file that cannot be opened (its reader names that).

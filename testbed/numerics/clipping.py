@@ -279,9 +279,11 @@ def rate_contradicted_levels(a: np.ndarray, d: np.ndarray, fs: float
     for _, _, starts, lengths in held_runs:
         for s0, m in zip(starts, lengths, strict=True):
             free[max(s0 - 1, 0):min(s0 + m, n - 1)] = False
-    offset = float(np.mean(steps[free])) if np.any(free) else 0.0
-    step_misfit = float(np.max(np.maximum(np.abs(steps[free] - offset), np.abs(steps[free])))) \
-        if np.any(free) else np.inf
+    sf = steps[free]
+    offset, step_misfit = 0.0, np.inf
+    if sf.size:
+        offset = float(np.mean(sf))
+        step_misfit = float(np.max(np.maximum(np.abs(sf - offset), np.abs(sf))))
     out = []
     for which, level, starts, lengths in held_runs:
         held = runs = 0

@@ -269,6 +269,13 @@ def harmonic_amplitude_law(x: np.ndarray, fs: float, f_fund: float, k: int, n_se
     return slope, float((fs_seg[0] - fs_seg[-1]) / fs_seg[-1]), float((f_axis[1] - f_axis[0]) / fs_seg[-1])
 
 
+def band_trim(fs: float, f: float, rel_band: float) -> int:
+    """Samples dropped at a demodulated band's end, where its cut rings: ``1 / (rel_band f)``
+    s at ``fs`` [Hz], rounded up (:func:`harmonic_lock`, :func:`own_lock`,
+    :func:`band_power_fall`, :func:`noise_lock_bar`)."""
+    return int(np.ceil(fs / (rel_band * f)))
+
+
 def band_analytic(x: np.ndarray, fs: float, lo: float, hi: float,
                   weights: np.ndarray | None = None) -> np.ndarray:
     """Analytic signal of the band ``[lo, hi]`` of ``x``, channels combined by ``weights``.
@@ -342,7 +349,7 @@ def harmonic_lock(x: np.ndarray, fs: float, f_fund: float, f_cand: float, k: int
     x = np.atleast_2d(np.asarray(x, dtype=float))
     zp = band_analytic(x, fs, f_fund * (1 - rel_band), f_fund * (1 + rel_band), np.conj(w_fund))
     zc = band_analytic(x, fs, f_cand * (1 - rel_band), f_cand * (1 + rel_band), np.conj(w_cand))
-    trim = int(np.ceil(fs / (rel_band * f_fund)))
+    trim = band_trim(fs, f_fund, rel_band)
     zp, zc = zp[trim:x.shape[-1] - trim], zc[trim:x.shape[-1] - trim]
     # zc conj(zp)^k has angle psi and modulus |z_c| |z_p|^k
     prod = zc * np.conj(zp) ** int(k)
@@ -381,7 +388,7 @@ def own_lock(x: np.ndarray, fs: float, f: float, shape: np.ndarray, rel_band: fl
     """
     x = np.atleast_2d(np.asarray(x, dtype=float))
     z = band_analytic(x, fs, f * (1 - rel_band), f * (1 + rel_band), np.conj(shape))
-    trim = int(np.ceil(fs / (rel_band * f)))
+    trim = band_trim(fs, f, rel_band)
     z = z[trim:x.shape[-1] - trim]
     tot = np.abs(z).sum()
     t = (trim + np.arange(z.size)) / fs
@@ -432,7 +439,7 @@ def band_power_fall(x: np.ndarray, fs: float, f: float, shape: np.ndarray, start
     """
     x = np.atleast_2d(np.asarray(x, dtype=float))
     z = band_analytic(x, fs, f * (1.0 - rel_band), f * (1.0 + rel_band), np.conj(shape))[int(start):]
-    z = z[: max(z.size - int(np.ceil(fs / (rel_band * f))), 0)]
+    z = z[: max(z.size - band_trim(fs, f, rel_band), 0)]
     h = z.size // 2
     if h < 1:
         return float("nan"), float("inf")
@@ -470,6 +477,6 @@ def noise_lock_bar(f: float, fs: float, n_samples: int, rel_band: float = 1.0 / 
     float
         The bar ``k / sqrt(n)`` [-]; ``inf`` where the window keeps nothing.
     """
-    trim = int(np.ceil(fs / (rel_band * f)))
+    trim = band_trim(fs, f, rel_band)
     n = 2.0 * rel_band * f * (int(n_samples) - 2 * trim) / fs
     return float(k / np.sqrt(n)) if n > 0 else float("inf")

@@ -40,7 +40,7 @@ from testbed.core import arguments
 from testbed.core.dataset import Dataset, DatasetError
 from testbed.core.errors import InputError
 from testbed.core.provenance import versions
-from testbed.core.rate_attrs import SCENARIO_RATE_RTOL, fs_attribute_problem
+from testbed.core.rate_attrs import fs_attribute_problem, off_scenario_rate
 from testbed.pipeline.generate import derive, noise_free_scenario, simulate_clean
 from testbed.pipeline.plugins import rig_class
 from testbed.pipeline.scenario import Scenario
@@ -178,9 +178,7 @@ def _load_entry(path: Path, scenario: Scenario) -> Dataset:
         raise DatasetError(path, problem)
     ds = Dataset.load(path)
     record = rig_class(scenario.rig).record(noise_free_scenario(scenario).simulation)
-    # within SCENARIO_RATE_RTOL relative (NaN fails)
-    if record is not None and not (abs(ds.fs - float(record[0]))
-                                   <= SCENARIO_RATE_RTOL * abs(float(record[0]))):
+    if record is not None and off_scenario_rate(ds.fs, float(record[0])):
         raise DatasetError(path, f"attribute fs={ds.fs!r} Hz; its scenario records at "
                                  f"{float(record[0])!r} Hz")
     return ds

@@ -25,7 +25,6 @@ from testbed.core.errors import IdentificationError, InputError, ScenarioError, 
 from testbed.core.exit_guard import no_process_exit
 from testbed.core.measurement import Measurement
 from testbed.core.process_state import kept_process_state
-from testbed.core.schema import unknown_key_hint
 from testbed.numerics.clipping import Clipping
 from testbed.numerics.shapes import modal_from_matrices
 from testbed.pipeline import plugins
@@ -242,18 +241,12 @@ def identify_file(path: str | os.PathLike, *, scenario: str | os.PathLike | None
                          f"prior; it reads: {', '.join(declared) or 'none'}")
     hyper = {k: v for k, v in identify.items() if k != "method"} | dict(params or {})
     where = str(scenario or "<command line>")
-    declared = cls.declared_hyperparameters()
-    for key, value in hyper.items():
-        if key not in declared:  # named with the key probably meant, or the identifier it is
-            # a hyperparameter of (round 23: `--param lr=0.1` for sindy_pi_dynamical listed
-            # its 15 keys, not that lr is sgd_sindy's)
-            hint = unknown_key_hint(key, declared, other_identifiers(identify["method"]))
-            raise ScenarioError("<command line>" if key in (params or {}) else where,
-                                f"identify.{key}", value,
-                                "unknown key; allowed keys in [identify]: "
-                                + (", ".join(sorted(declared)) or "(no keys)") + hint)
     with _named_source(params, scenario):
-        hyper = cls.validate_hyperparameters(hyper, file=where)
+        # an unknown key named with the key probably meant, or the identifier it is a
+        # hyperparameter of (round 23: `--param lr=0.1` for sindy_pi_dynamical listed its 15
+        # keys, not that lr is sgd_sindy's)
+        hyper = cls.validate_hyperparameters(hyper, file=where,
+                                             elsewhere=other_identifiers(identify["method"]))
     phase = phase or _no_phase
     with phase("read and signal chain"):
         data, clipped = measurement_and_clipping(path, kind, signal, format=format, fs=fs,
@@ -284,7 +277,8 @@ def _named_source(params: Mapping[str, Any] | None, scenario: Any) -> Iterator[N
     try:
         yield
     except ScenarioError as e:
-        name = re.split(r"[.\[]", (e.key or "").removeprefix("identify."), maxsplit=1)[0]
+        key = (e.key or "").removeprefix("identify.")
+        name = key if key in (params or {}) else re.split(r"[.\[]", key, maxsplit=1)[0]
         if scenario is None or not params or name not in params:
             raise
         raise type(e)("<command line>", e.key, e.value, e.allowed) from None

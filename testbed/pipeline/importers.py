@@ -63,7 +63,7 @@ from testbed.core.budget import IDENTIFY_BYTES_PER_VALUE, IDENTIFY_TEXT_BUDGET_B
 from testbed.core.dataset import Dataset, DatasetError, Signal
 from testbed.core.errors import TestbedError, is_control, show_names
 from testbed.core.measurement import MIN_FREE_SAMPLES, Measurement
-from testbed.core.rate_attrs import SCENARIO_RATE_RTOL, fs_attribute_problem
+from testbed.core.rate_attrs import fs_attribute_problem, off_scenario_rate
 from testbed.numerics.clipping import Clipping, measured_clipping
 from testbed.numerics.noise import noise_std
 from testbed.pipeline.plugins import rig_class
@@ -1260,7 +1260,7 @@ def _check_scenario_rate(path: Path, ds: Dataset) -> None:
         rate = None if record is None else float(record[0])
     except Exception:  # an unregistered rig, or a table its rig cannot read: nothing stated
         return
-    if rate is not None and not abs(float(ds.fs) - rate) <= SCENARIO_RATE_RTOL * abs(rate):
+    if rate is not None and off_scenario_rate(float(ds.fs), rate):
         raise MeasuredDataError(path, f"attribute fs={float(ds.fs)!r} Hz but its scenario "
                                       f"(attribute scenario, [simulation]) records at {rate!r} Hz; "
                                       "the file contradicts itself (expected equal rates)")
@@ -1311,14 +1311,13 @@ def check_hdf5_storage(path: str | os.PathLike) -> None:
         if found or not isinstance(obj, h5py.Dataset):
             return
         layout = obj.attrs.get("layout")
-        if isinstance(layout, np.ndarray) and layout.size == 1:  # a one-element array of text
-            layout = layout.item()
+        if isinstance(layout, np.generic) or (isinstance(layout, np.ndarray) and layout.size == 1):
+            layout = layout.item()  # a numpy scalar or a one-element array of text
         layout = layout.decode(errors="replace") if isinstance(layout, bytes) else layout
         if layout is not None and not (isinstance(layout, str) and layout == LAYOUT):
             # the reader takes rows as channels whatever this says: a file whose arrays claim
             # "samples x channels" was read as channels x samples in silence (round 23)
-            shown = layout.item() if isinstance(layout, np.generic) else layout
-            found.append(f"/{name}: attribute layout={shown!r}; expected {LAYOUT!r} (each row "
+            found.append(f"/{name}: attribute layout={layout!r}; expected {LAYOUT!r} (each row "
                          "one channel, as the reader takes it)")
             return
         plist = obj.id.get_create_plist()
