@@ -470,7 +470,10 @@ def equation_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -
                              f"the law lacks, are not determined at the record's noise "
                              f"(determinacy_ {max(bound[k] for k in undetermined):.3g}), which "
                              f"does not show the record short of the law ({why})")}
-    return {"equation": f"wrong equation: {said} ({why})"}
+    # a missed support bar: the terms that differ are named (round 24's mm24_3s at 1 %: x^2
+    # kept and the law's dx dropped, determinacy_ 0.0017, said only "support_f1 0.75")
+    changed = term_changes(scores.details) if any(c.metric == "support_f1" for c in missed) else ""
+    return {"equation": f"wrong equation: {said}{changed} ({why})"}
 
 
 def spurious_terms(details: dict[str, Any]) -> list[list[str]]:
@@ -485,6 +488,33 @@ def spurious_terms(details: dict[str, Any]) -> list[list[str]]:
     return [[names[j] for j in range(len(names)) if ci[k, j] != 0.0 and ct[k, j] == 0.0]
             for k in range(ct.shape[0])]
 
+
+
+def dropped_terms(details: dict[str, Any]) -> list[list[str]]:
+    """Per identified equation, the true one's terms it lacks (from the scorer's ``terms`` /
+    ``coef_true`` / ``coef_id``, rows paired to the truth's); [] without them."""
+    names, ct, ci = details.get("terms"), details.get("coef_true"), details.get("coef_id")
+    if names is None or ct is None or ci is None:
+        return []
+    ct, ci = np.atleast_2d(np.asarray(ct, dtype=float)), np.atleast_2d(np.asarray(ci, dtype=float))
+    if ct.shape != ci.shape or ct.shape[1] != len(names):
+        return []
+    return [[names[j] for j in range(len(names)) if ci[k, j] == 0.0 and ct[k, j] != 0.0]
+            for k in range(ct.shape[0])]
+
+
+def term_changes(details: dict[str, Any]) -> str:
+    """``"; it holds x^2 that the law lacks and lacks the law's dx"`` (per equation, the
+    terms :func:`spurious_terms` and :func:`dropped_terms` find; the equation named where
+    there are several), or "" where the scorer's details name none."""
+    extra, lost = spurious_terms(details), dropped_terms(details)
+    parts = []
+    for k, (more, less) in enumerate(zip(extra, lost, strict=True)):
+        said = ([f"holds {', '.join(more)} that the law lacks"] if more else []) + \
+               ([f"lacks the law's {', '.join(less)}"] if less else [])
+        if said:
+            parts.append(("it " if len(extra) == 1 else f"equation {k + 1} ") + " and ".join(said))
+    return "".join(f"; {p}" for p in parts)
 
 
 def _failed_modes(scores: Scores, thresholds: dict[str, dict[str, float]], n_modes: int,
