@@ -19,8 +19,11 @@ on a 1 EI/L base with cubic fraction 0.5; one sensor at mid-span only (the hamme
 2 s; a 0.3 s record; seven sensors on 0.5 m titanium; the shipped soft base at 8 and 16 kHz, read by five
 sensors hit at 0.2 L; soft bases at 0.6 EI/L (cubic fraction 0.05) under 2 kN, 2.7 (0.45) at 0.2 % damping,
 1 (0.7, just outside the families' 0.6) at 3 % damping, 0.45 (just below the families' 0.5, cubic 0.6), 3.3
-(just above the families' 3, 0.02). Noise 1 / 3 / 5 % and seeds 151-153 are the studies'
-(round24_beams*.toml).
+(just above the families' 3, 0.02). A second batch at the families' own corners, every edge at once:
+titanium 0.5 m x 6 mm on 0.5 EI/L with cubic fraction 0.6 under 100 N (beams_soft's), brass 0.5 m x 20 x 6
+mm read by six sensors at 3 % damping and steel 0.2 m x 50 x 15 mm read by two under 10 N (beams_stiff's),
+glass-epoxy 0.25 m x 20 x 6 mm; the tin-like beam on a 1.2 EI/L base (0.4) on 2 s. Noise 1 / 3 / 5 % and
+seeds 151-154 are the studies' (round24_beams*.toml).
 """
 
 from __future__ import annotations
@@ -48,6 +51,13 @@ _SHORT_S2 = {**_SHORT, "sensors": sensors((0.5, 1.0), 0.2)}
 _TI05_S7 = {**TI, "length": 0.5, "n_segments": 20,
             "sensors": sensors((1 / 7, 2 / 7, 3 / 7, 4 / 7, 5 / 7, 6 / 7, 1.0), 0.5)}
 _F2K = {"peak_force": 2000.0}
+_F10, _F100 = {"peak_force": 10.0}, {"peak_force": 100.0}
+_TI_CORNER = {**TI, "length": 0.5, "thickness": 0.006, "n_segments": 20}
+_BR_CORNER = {**BRASS, "length": 0.5, "width": 0.02, "thickness": 0.006, "n_segments": 20,
+              "damping_ratio": 0.03, "sensors": sensors((1 / 6, 2 / 6, 3 / 6, 4 / 6, 5 / 6, 1.0), 0.5)}
+_ST_CORNER = {"length": 0.2, "width": 0.05, "thickness": 0.015, "n_segments": 8,
+              "sensors": sensors((0.5, 1.0), 0.2)}
+_GF_CORNER = {**_ROUND6.GFRP, "length": 0.25, "width": 0.02, "thickness": 0.006}
 _HIT02 = {"location": _S5[0]}
 
 #: name -> (description, rig, simulation, excitation, signal)
@@ -100,6 +110,18 @@ CASES: dict[str, tuple[str, dict, dict, dict, dict]] = {
                              "fraction 0.6", {**soft(0.45, 0.6, {})}, {}, {}, {}),
     "b24_soft_r3p3_cf0p02": ("the shipped beam on k1 = 3.3 EI/L (just above the families' 3), cubic fraction "
                              "0.02", {**soft(3.3, 0.02, {})}, {}, {}, {}),
+    # a second batch (round24_beams_extra.toml): the families' own corners, every edge at once
+    "b24_ti_L0p5_t6_soft_r0p5_cf0p6_f100": ("titanium 0.5 m x 30 x 6 mm in 20 segments on k1 = 0.5 EI/L, "
+                                            "cubic fraction 0.6 at 100 N, under 100 N (beams_soft's corner)",
+                                            {**_TI_CORNER, **soft(0.5, 0.6, _TI_CORNER, _F100)}, {},
+                                            {**_F100}, {}),
+    "b24_br_L0p5_w20_t6_s6_z3": ("brass 0.5 m x 20 x 6 mm in 20 segments read by six sensors at 3 % damping "
+                                 "(beams_stiff's corner)", {**_BR_CORNER}, {}, {}, {}),
+    "b24_st_L0p2_w50_t15_s2_f10": ("steel 0.2 m x 50 x 15 mm in 8 segments read at 0.5 / 1 L under 10 N "
+                                   "(beams_stiff's other corner)", {**_ST_CORNER}, {}, {**_F10}, {}),
+    "b24_gf_L0p25_w20_t6": ("glass-epoxy 0.25 m x 20 x 6 mm in 10 segments", {**_GF_CORNER}, {}, {}, {}),
+    "b24_sn_soft_r1p2_cf0p4_2s": ("the tin-like beam on k1 = 1.2 EI/L, cubic fraction 0.4, 2 s",
+                                  {**SN, **soft(1.2, 0.4, SN)}, {"duration": 2.0}, {}, {}),
 }
 
 
