@@ -22,8 +22,11 @@ sensors hit at 0.2 L; soft bases at 0.6 EI/L (cubic fraction 0.05) under 2 kN, 2
 (just above the families' 3, 0.02). A second batch at the families' own corners, every edge at once:
 titanium 0.5 m x 6 mm on 0.5 EI/L with cubic fraction 0.6 under 100 N (beams_soft's), brass 0.5 m x 20 x 6
 mm read by six sensors at 3 % damping and steel 0.2 m x 50 x 15 mm read by two under 10 N (beams_stiff's),
-glass-epoxy 0.25 m x 20 x 6 mm; the tin-like beam on a 1.2 EI/L base (0.4) on 2 s. Noise 1 / 3 / 5 % and
-seeds 151-154 are the studies' (round24_beams*.toml).
+glass-epoxy 0.25 m x 20 x 6 mm; the tin-like beam on a 1.2 EI/L base (0.4) on 2 s. A third batch: 0.8 EI/L
+(0.5) under 5 N, 1.2 EI/L (0.4) hit at 0.6 L under 300 N, 2 EI/L (0.3) at 1.5 % damping read by two sensors,
+steel 1.8 m in 36 segments read by five under the high-pass 'auto', the nickel-like beam at 16 kHz read by
+five hit at 0.4 L, the tin-like beam 0.25 m at 0.1 % damping on 4 s. Noise 1 / 3 / 5 % and seeds 151-155
+are the studies' (round24_beams*.toml).
 """
 
 from __future__ import annotations
@@ -59,6 +62,11 @@ _ST_CORNER = {"length": 0.2, "width": 0.05, "thickness": 0.015, "n_segments": 8,
               "sensors": sensors((0.5, 1.0), 0.2)}
 _GF_CORNER = {**_ROUND6.GFRP, "length": 0.25, "width": 0.02, "thickness": 0.006}
 _HIT02 = {"location": _S5[0]}
+_F5, _F300 = {"peak_force": 5.0}, {"peak_force": 300.0}
+_S06 = sensors((0.3, 0.6, 1.0))
+_HIT06 = {"location": _S06[1]}
+_S2 = sensors((0.5, 1.0))
+_L18 = {"length": 1.8, "n_segments": 36, "sensors": sensors((0.2, 0.4, 0.6, 0.8, 1.0), 1.8)}
 
 #: name -> (description, rig, simulation, excitation, signal)
 CASES: dict[str, tuple[str, dict, dict, dict, dict]] = {
@@ -122,6 +130,25 @@ CASES: dict[str, tuple[str, dict, dict, dict, dict]] = {
     "b24_gf_L0p25_w20_t6": ("glass-epoxy 0.25 m x 20 x 6 mm in 10 segments", {**_GF_CORNER}, {}, {}, {}),
     "b24_sn_soft_r1p2_cf0p4_2s": ("the tin-like beam on k1 = 1.2 EI/L, cubic fraction 0.4, 2 s",
                                   {**SN, **soft(1.2, 0.4, SN)}, {"duration": 2.0}, {}, {}),
+    # a third batch (round24_beams_more.toml): forces, hammer spots, damping, a longer beam, a rate
+    "b24_soft_r0p8_cf0p5_f5": ("the shipped beam on k1 = 0.8 EI/L, cubic fraction 0.5 at 5 N, under 5 N",
+                               {**soft(0.8, 0.5, {}, _F5)}, {}, {**_F5}, {}),
+    "b24_soft_r1p2_cf0p4_hit0p6_f300": ("the shipped beam on k1 = 1.2 EI/L, cubic fraction 0.4 at 300 N on "
+                                        "0.6 L, sensors 0.3 / 0.6 / 1 L, a 300 N hit at 0.6 L",
+                                        {**soft(1.2, 0.4, {}, {**_F300, **_HIT06}), "sensors": _S06},
+                                        {}, {**_F300, **_HIT06}, {}),
+    "b24_soft_r2_cf0p3_z1p5_s2": ("the shipped beam on k1 = 2 EI/L, cubic fraction 0.3, 1.5 % damping, two "
+                                  "sensors 0.5 / 1 L", {**soft(2.0, 0.3, {}), "damping_ratio": 0.015,
+                                                        "sensors": _S2}, {}, {}, {}),
+    "b24_st_L1p8_s5_hpauto": ("steel 1.8 m in 36 segments (mode 1 near 2.5 Hz) read by five sensors under "
+                              "the high-pass 'auto', the hammer at 0.5 s, 5.5 s", {**_L18}, {"duration": 5.5},
+                              {"start": 0.5}, {"highpass_hz": "auto"}),
+    "b24_ni_fs16k_s5_hit0p4": ("the nickel-like beam at 16 kHz read by five sensors 0.2-1 L, the hammer at "
+                               "0.4 L", {**NI, "sensors": _S5}, {"sample_rate": 16000.0},
+                               {"location": _S5[1]}, {}),
+    "b24_sn_L0p25_z0p1_4s": ("the tin-like beam 0.25 m at 0.1 % damping, 4 s",
+                             {**SN, "length": 0.25, "sensors": sensors((1 / 3, 2 / 3, 1.0), 0.25),
+                              "damping_ratio": 0.001}, {"duration": 4.0}, {}, {}),
 }
 
 

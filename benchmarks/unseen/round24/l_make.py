@@ -13,7 +13,10 @@ on phase seed 5. Cart-poles under ``cartpole_noise1``'s chain: a 1 kg pole (twic
 cart, the multisine at twice its amplitude (2 N) on the shipped cart-pole, a 0.7 m pole on the 1.5 kg cart.
 Kinetics (``michaelis_menten_noise1``'s weak setup; Km 0.3, Vmax 1.5, influx 0.6 mM/s, x0 2 mM, 4 s at 1
 kHz): Km 0.7 under Vmax 1.2 (x* 0.7 mM), Km 2 under Vmax 3 from a 4 mM dose (x* 0.5 mM), Km 0.5 under
-Vmax 3 (x* 0.125 mM), an influx of 0.45 (x* 0.13 mM), a 1.5 mM dose, 400 Hz, a 3 s record.
+Vmax 3 (x* 0.125 mM), an influx of 0.45 (x* 0.13 mM), a 1.5 mM dose, 400 Hz, a 3 s record. A second
+batch: five-bars on a 0.5 m ground under 2 kg couplers and with 0.3 m cranks on 12 s, the multisine at 0.8
+N m on 0.5 kg couplers, the 1 kg pole under the 2 N multisine, kinetics on 6 s, Km 2 from a 4 mM dose
+(x* 1.33 mM), a 1 mM dose on 3 s.
 Noise levels and seeds 151-159 are the studies' (round24_linkages_*.toml).
 """
 
@@ -35,6 +38,11 @@ FIVEBARS: dict[str, tuple[str, dict[str, dict]]] = {
     "fb24_ground_0p2": ("a 0.2 m ground under four 1 m links", {"rig": {"L0": 0.2}}),
     "fb24_couplers_m0p7_1p5": ("couplers of 0.7 and 1.5 kg (cranks 1 kg)", {"rig": {"m2": 0.7, "m3": 1.5}}),
     "fb24_9s": ("the paper's sine, a 9 s record", {"simulation": {"duration": 9.0}}),
+    # a second batch (round24_linkages_more.toml)
+    "fb24_ground_0p5_couplers_m2": ("a 0.5 m ground under couplers of 2 kg (cranks 1 kg, links 1 m)",
+                                    {"rig": {"L0": 0.5, "m2": 2.0, "m3": 2.0}}),
+    "fb24_cranks_0p3_12s": ("cranks of 0.3 m (couplers and ground 1 m), a 12 s record",
+                            {"rig": {"l1": 0.3, "l4": 0.3}, "simulation": {"duration": 12.0}}),
 }
 
 #: name -> (description, {table: keys changed from fivebar_multisine_noise1})
@@ -42,6 +50,8 @@ MULTISINES: dict[str, tuple[str, dict[str, dict]]] = {
     "fb24_ms_amp0p8": ("the multisine at 0.8 N m", {"excitation": {"amplitude": 0.8}}),
     "fb24_ms_amp0p8_ph5": ("the multisine at 0.8 N m on phase seed 5",
                            {"excitation": {"amplitude": 0.8, "phase_seed": 5}}),
+    "fb24_ms_amp0p8_couplers_m0p5": ("the multisine at 0.8 N m on couplers of 0.5 kg",
+                                     {"rig": {"m2": 0.5, "m3": 0.5}, "excitation": {"amplitude": 0.8}}),
 }
 
 #: name -> (description, {table: keys changed from cartpole_noise1 (its multisine kept)})
@@ -52,6 +62,8 @@ CARTPOLES: dict[str, tuple[str, dict[str, dict]]] = {
                   {"excitation": {"amplitude": 2.0}}),
     "cp24_L0p7_cart1p5": ("a 0.7 m pole (0.5 kg) on a 1.5 kg cart",
                           {"rig": {"pole_length": 0.7, "cart_mass": 1.5}}),
+    "cp24_pole_m1_amp2": ("a 1 kg pole (0.6 m) on the 1 kg cart under the multisine at 2 N",
+                          {"rig": {"pole_mass": 1.0}, "excitation": {"amplitude": 2.0}}),
 }
 
 #: name -> (description, {table: keys changed from michaelis_menten_noise1}); Km 0.3, Vmax 1.5,
@@ -65,6 +77,10 @@ KINETICS: dict[str, tuple[str, dict[str, dict]]] = {
     "mm24_x1p5": ("a 1.5 mM dose (x* 0.2 mM)", {"rig": {"x0": 1.5}}),
     "mm24_fs400": ("the weak setup at 400 Hz", {"simulation": {"sample_rate": 400.0}}),
     "mm24_3s": ("the weak setup on a 3 s record", {"simulation": {"duration": 3.0}}),
+    # a second batch (round24_linkages_more.toml)
+    "mm24_6s": ("the weak setup on a 6 s record", {"simulation": {"duration": 6.0}}),
+    "mm24_km2_x4": ("Km 2 mM from a 4 mM dose (x* 1.33 mM)", {"rig": {"Km": 2.0, "x0": 4.0}}),
+    "mm24_x1_3s": ("a 1 mM dose on a 3 s record", {"rig": {"x0": 1.0}, "simulation": {"duration": 3.0}}),
 }
 
 
