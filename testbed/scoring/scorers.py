@@ -1371,7 +1371,7 @@ def stable_blowup(why: str, M: np.ndarray, C: np.ndarray, K: np.ndarray, dt: flo
     "diverged".  A linear model whose poles all lie in the left half-plane cannot grow: what
     went beyond the bar is its response from the fitted start, driven by poles the record
     cannot resolve.  Round 24's ``b24_br_L0p5_w20_t6_s6_z3`` (brass read by six sensors at 3 %
-    damping, mode 6 231 % damped), ``sgd_sindy`` clean, seed 154: every pole stable, the
+    damping, mode 6 254 % damped), ``sgd_sindy`` clean, seed 154: every pole stable, the
     fastest at -8.0e10 1/s (6.3e6 per sample at 12.8 kHz), acceleration 3500 x the record's
     largest one sample after the start, was "diverged: blew up".
 
