@@ -15,8 +15,8 @@ method that crashes or returns NaN did not meet its thresholds.  A group with no
 has no pass rate (NaN): an identifier is never measured against bars declared for another.
 
 Failure reasons are counted per group (:func:`row_failure_kinds`): a scored failure's reason
-("fit failed", "diverged", "non-physical", "unstable", "non-finite scores"), the scorer's
-explanation of a failed bar ("floor", "unexcited", "out of band", ...), ``failed bar
+("fit failed", "diverged", "response blew up", "non-physical", "unstable", "non-finite
+scores"), the scorer's explanation of a failed bar ("floor", "unexcited", "out of band", ...), ``failed bar
 <metric>`` for a bar a finished cell missed with no such explanation, or, for a cell that
 raised, ``refused: <ExceptionType>`` (a scenario its rig or loader refused, one line naming the
 keys) or ``crash: <ExceptionType>`` (anything else).
@@ -47,8 +47,8 @@ CRASH_PATTERN = re.compile(
     r"^([A-Za-z_][A-Za-z0-9_.]*(?:Error|Exception|Exit|Interrupt)): .*\([^()]+\.py:\d+\)$", re.DOTALL)
 #: Scored failure reasons (testbed.scoring.scorers, testbed.studies.sweep.run_cell), in the order
 #: they are looked for in a reason text.
-SCORED_REASONS = ("fit failed", "diverged", "simulation failed", "non-physical", "unstable",
-                  "non-finite scores", "no scores")
+SCORED_REASONS = ("fit failed", "diverged", "response blew up", "simulation failed", "non-physical",
+                  "unstable", "non-finite scores", "no scores")
 #: The scorer's explanations of a failed bar (testbed.scoring.scorers: uninformative_failures,
 #: out_of_band_failures, unexcited_failures, decayed_failures, floor_failures, sensor_failures,
 #: equation_failures, step_failures, sensitivity_failures, clipping_failures,

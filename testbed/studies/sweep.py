@@ -462,6 +462,11 @@ def _run_cell(cell: Cell, cache_dir: str, plugins: tuple[str, ...], parent: int 
         held = {c.metric for c in result.checks}
         if held and not held & set(bad) and not result.failure:
             bad = []
+        # a failed fit leaves every score undefined and its reason says why: listing them
+        # again named some 40 scores after it and counted the cell a second time
+        # ("non-finite scores") in the summary (round 24's b24_br_L0p5_w20_t6_s6_z3, ls_sindy 1 %)
+        if "fit" in result.scores.failures:
+            bad = []
         reasons = [result.failure, bad and "non-finite scores: " + ", ".join(bad),
                    not result.scores.values and "no scores"]
         reason = "; ".join(r for r in reasons if r)

@@ -14,10 +14,14 @@ from testbed.scoring.run import noise_free
 from testbed.scoring.scorers import (
     BOUND_RTOL,
     FAIL,
+    STABLE_BLOWUP,
     bound_failures,
     score_dynamical,
+    score_structural,
+    stable_blowup,
     verdict,
 )
+from testbed.studies.statistics import failure_kind
 
 _CONC = {"x": (0.0, "a concentration")}
 
@@ -87,3 +91,60 @@ def test_score_dynamical_names_a_negative_concentration_and_keeps_the_scores(rec
     # a rig that declares nothing (data of a rig not registered here) is scored as before
     other = replace(ds, attrs={**ds.attrs, "rig": "not_a_registered_rig"})
     assert "bounds" not in score_dynamical(other, data, clean, _Fixed(coef, went_negative)).failures
+
+
+# ------------------------------------------- a stable model's blow-up is not a divergence
+_BLOWUP = "diverged: blew up (beyond 1000 x the reference's largest value) simulation (at t = 7.813e-05 s)"
+
+
+def test_a_stable_models_blowup_names_its_fastest_pole_not_a_divergence():
+    """Round 24's ``b24_br_L0p5_w20_t6_s6_z3`` (brass read by six sensors at 3 % damping),
+    ``sgd_sindy`` clean, seed 154: every pole of the identified model stable (the fastest
+    -8.0e10 1/s), its acceleration 3500 x the record's one sample after the start, was
+    "diverged: blew up".  A 1-DOF model with the same kind of overdamped direction (poles
+    -1e9 and -1e-9 1/s) stands for it; an unstable one keeps "diverged"."""
+    dt = 1.0 / 12800.0
+    why = stable_blowup(_BLOWUP, np.eye(1), np.array([[1e9]]), np.eye(1), dt)
+    assert why.startswith(f"{STABLE_BLOWUP}: every pole of the model is stable, the fastest at -1e+09")
+    assert "|lambda| dt = 7.81e+04 per sample: faster than the record's sample interval resolves" in why
+    assert "beyond 1000 x the reference's largest value (at t = 7.813e-05 s): no divergence" in why
+    assert failure_kind(why) == ["response blew up"]
+    # a pole the record resolves is named without the clause
+    slow = stable_blowup(_BLOWUP, np.eye(1), np.array([[100.0]]), np.eye(1), dt)
+    assert slow.startswith(STABLE_BLOWUP) and "resolves" not in slow
+    # growth is a divergence; a non-finite state too, whatever the poles
+    assert stable_blowup(_BLOWUP, np.eye(1), np.array([[-1.0]]), np.eye(1), dt) == _BLOWUP
+    nonfinite = "diverged: non-finite simulation (at t = 0.1 s)"
+    assert stable_blowup(nonfinite, np.eye(1), np.array([[1e9]]), np.eye(1), dt) == nonfinite
+
+
+class _Huge:
+    """A fitted structural model of given matrices whose response is a million times the
+    record's: the blow-up the scorer sees (the matrices decide its name)."""
+
+    def __init__(self, M, C, K, ref):
+        self.M_, self.C_, self.K_, self._ref = M, C, K, ref
+
+    def simulate(self, x0, xd0, t, u):
+        y = 1e6 * self._ref[:, : t.size]
+        return Trajectory(y, y, y)
+
+
+@pytest.fixture(scope="module")
+def beam_record():
+    sc = load_scenario("cantilever_stiff_impact")
+    sc = replace(sc, simulation={**sc.simulation, "duration": 0.1})
+    ds = generate(sc)
+    return ds, measure(ds, sc.signal, "structural"), measure(noise_free(ds), sc.signal, "structural")
+
+
+def test_the_structural_scorer_names_a_stable_models_blowup(beam_record):
+    ds, data, clean = beam_record
+    n = data.n_channels
+    ref = clean.xdd[:, data.free_start:]
+    M, K = 0.05 * np.eye(n), 1e4 * np.eye(n)
+    stable = score_structural(ds, data, clean, _Huge(M, 1e8 * np.eye(n), K, ref))
+    assert stable.failures["simulation"].startswith(STABLE_BLOWUP)
+    assert verdict([], stable.failures) == FAIL and np.isnan(stable.values["trac"])
+    grows = score_structural(ds, data, clean, _Huge(M, -1.0 * np.eye(n), K, ref))
+    assert grows.failures["simulation"].startswith("diverged: blew up")

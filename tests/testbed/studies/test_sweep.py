@@ -20,6 +20,7 @@ from pathlib import Path
 import pytest
 
 from testbed.studies.results import parts_dir, read_results
+from testbed.studies.statistics import failure_kind
 from testbed.studies.study import load_study
 from testbed.studies.sweep import (
     SweepStats,
@@ -288,6 +289,11 @@ def test_failing_cells_are_recorded_and_the_rest_goes_on(toy_dir, tmp_path):
     assert by["toy_raise"]["error"].startswith("fit failed: identifier toy_raise (from file ")
     assert "toys.py) raised ValueError: toy identifier told to fail" in by["toy_raise"]["error"]
     assert by["toy_raise"]["fit_time"] >= 0.0 and by["toy_raise"]["dataset_hash"]
+    # its scores are undefined because the fit failed, which its reason says: not listed again
+    # as "non-finite scores" (round 24: some 40 names after "fit failed", and the summary
+    # counted the cell under both kinds)
+    assert "non-finite scores" not in by["toy_raise"]["error"]
+    assert failure_kind(by["toy_raise"]["error"]) == ["fit failed"]
     assert by["toy_nan"]["status"] == "failed" and "non-finite scores" in by["toy_nan"]["error"]
     assert "angle_rmse" in by["toy_nan"]["error"]
     assert not by["toy_raise"]["passed"] and not by["toy_nan"]["passed"]
