@@ -16,6 +16,7 @@ from testbed.scoring.scorers import (
     FAIL,
     STABLE_BLOWUP,
     bound_failures,
+    physical_failures,
     score_dynamical,
     score_structural,
     stable_blowup,
@@ -104,18 +105,36 @@ def test_a_stable_models_blowup_names_its_fastest_pole_not_a_divergence():
     "diverged: blew up".  A 1-DOF model with the same kind of overdamped direction (poles
     -1e9 and -1e-9 1/s) stands for it; an unstable one keeps "diverged"."""
     dt = 1.0 / 12800.0
-    why = stable_blowup(_BLOWUP, np.eye(1), np.array([[1e9]]), np.eye(1), dt)
-    assert why.startswith(f"{STABLE_BLOWUP}: every pole of the model is stable, the fastest at -1e+09")
+    why = stable_blowup(_BLOWUP, np.eye(1), np.array([[1e9]]), np.eye(1), dt, 1.0)
+    assert why.startswith(f"{STABLE_BLOWUP}: no pole of the model grows over the record")
+    assert "the fastest at -1e+09" in why
     assert "|lambda| dt = 7.81e+04 per sample: faster than the record's sample interval resolves" in why
     assert "beyond 1000 x the reference's largest value (at t = 7.813e-05 s): no divergence" in why
     assert failure_kind(why) == ["response blew up"]
     # a pole the record resolves is named without the clause
-    slow = stable_blowup(_BLOWUP, np.eye(1), np.array([[100.0]]), np.eye(1), dt)
+    slow = stable_blowup(_BLOWUP, np.eye(1), np.array([[100.0]]), np.eye(1), dt, 1.0)
     assert slow.startswith(STABLE_BLOWUP) and "resolves" not in slow
     # growth is a divergence; a non-finite state too, whatever the poles
-    assert stable_blowup(_BLOWUP, np.eye(1), np.array([[-1.0]]), np.eye(1), dt) == _BLOWUP
+    assert stable_blowup(_BLOWUP, np.eye(1), np.array([[-1.0]]), np.eye(1), dt, 1.0) == _BLOWUP
     nonfinite = "diverged: non-finite simulation (at t = 0.1 s)"
-    assert stable_blowup(nonfinite, np.eye(1), np.array([[1e9]]), np.eye(1), dt) == nonfinite
+    assert stable_blowup(nonfinite, np.eye(1), np.array([[1e9]]), np.eye(1), dt, 1.0) == nonfinite
+
+
+def test_a_blowup_with_a_growing_slow_pole_or_a_cubic_stays_a_divergence():
+    """Review 25b: beside a -1e11 1/s pole, :func:`physical_failures`' relative bar (1e-9 x
+    the fastest pole) passes a +10 1/s one, whose response grows as exp(10 t) and blows up
+    within the second: still "diverged".  A cubic model's linear poles do not bound its
+    response (a softening cubic escapes from a stable linear part): "diverged" too."""
+    dt = 1.0 / 12800.0
+    M, C, K = np.eye(2), np.diag([1e11, 0.0]), np.diag([1.0, -100.0])
+    assert physical_failures(M, C, K) == {}  # the relative bar alone passes it
+    assert stable_blowup(_BLOWUP, M, C, K, dt, 1.0) == _BLOWUP
+    # the same poles on a record too short for the slow pole to grow 0.1 %: no growth there
+    assert stable_blowup(_BLOWUP, M, C, K, dt, 1e-5).startswith(STABLE_BLOWUP)
+    soft = stable_blowup(_BLOWUP, np.eye(1), np.array([[1e-3]]), np.eye(1), dt, 10.0, -np.eye(1))
+    assert soft == _BLOWUP
+    linear = stable_blowup(_BLOWUP, np.eye(1), np.array([[1e-3]]), np.eye(1), dt, 10.0, np.zeros((1, 1)))
+    assert linear.startswith(STABLE_BLOWUP)
 
 
 class _Huge:
