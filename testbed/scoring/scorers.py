@@ -476,31 +476,38 @@ def equation_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -
     return {"equation": f"wrong equation: {said}{changed} ({why})"}
 
 
-def spurious_terms(details: dict[str, Any]) -> list[list[str]]:
-    """Per identified equation, the terms it holds that the true one lacks (from the scorer's
-    ``terms`` / ``coef_true`` / ``coef_id``, rows paired to the truth's); [] without them."""
+def _term_differences(details: dict[str, Any], spurious: bool) -> list[list[str]]:
+    """Per identified equation, the terms it holds that the true one lacks (``spurious``) or
+    the true one's terms it lacks (from the scorer's ``terms`` / ``coef_true`` / ``coef_id``,
+    rows paired to the truth's); [] without them.  A row with a non-finite coefficient (the
+    equation basis's all-NaN row of an equation it could not pair) names nothing: NaN is
+    neither a held nor a lacked term (review 25b)."""
     names, ct, ci = details.get("terms"), details.get("coef_true"), details.get("coef_id")
     if names is None or ct is None or ci is None:
         return []
     ct, ci = np.atleast_2d(np.asarray(ct, dtype=float)), np.atleast_2d(np.asarray(ci, dtype=float))
     if ct.shape != ci.shape or ct.shape[1] != len(names):
         return []
-    return [[names[j] for j in range(len(names)) if ci[k, j] != 0.0 and ct[k, j] == 0.0]
-            for k in range(ct.shape[0])]
+    out = []
+    for k in range(ct.shape[0]):
+        if not (np.all(np.isfinite(ci[k])) and np.all(np.isfinite(ct[k]))):
+            out.append([])
+            continue
+        held, true = ci[k] != 0.0, ct[k] != 0.0
+        pick = held & ~true if spurious else true & ~held
+        out.append([names[j] for j in np.flatnonzero(pick)])
+    return out
 
+
+def spurious_terms(details: dict[str, Any]) -> list[list[str]]:
+    """Per identified equation, the terms it holds that the true one lacks
+    (:func:`_term_differences`)."""
+    return _term_differences(details, spurious=True)
 
 
 def dropped_terms(details: dict[str, Any]) -> list[list[str]]:
-    """Per identified equation, the true one's terms it lacks (from the scorer's ``terms`` /
-    ``coef_true`` / ``coef_id``, rows paired to the truth's); [] without them."""
-    names, ct, ci = details.get("terms"), details.get("coef_true"), details.get("coef_id")
-    if names is None or ct is None or ci is None:
-        return []
-    ct, ci = np.atleast_2d(np.asarray(ct, dtype=float)), np.atleast_2d(np.asarray(ci, dtype=float))
-    if ct.shape != ci.shape or ct.shape[1] != len(names):
-        return []
-    return [[names[j] for j in range(len(names)) if ci[k, j] == 0.0 and ct[k, j] != 0.0]
-            for k in range(ct.shape[0])]
+    """Per identified equation, the true one's terms it lacks (:func:`_term_differences`)."""
+    return _term_differences(details, spurious=False)
 
 
 def term_changes(details: dict[str, Any]) -> str:

@@ -7,10 +7,12 @@ import pytest
 from testbed.scoring.scorers import (
     Scores,
     determinacy_entry,
+    dropped_terms,
     equation_failures,
     noise_free_ratio,
     shown_undetermined,
     spurious_terms,
+    term_changes,
 )
 
 BARS = {"support_f1": {"min": 1.0}, "coef_error": {"max": 0.05}}
@@ -120,3 +122,14 @@ def test_a_missed_support_bar_names_the_terms_kept_and_dropped():
     assert why == ("wrong equation: coef_error 0.11 above 0.05 (the rig's own bars on the identified "
                    "equation: its question is the law, which a state that simulates well does not "
                    "prove)")
+
+
+def test_an_unpaired_equations_nan_row_names_no_terms():
+    """Review 25b: the equation basis returns an all-NaN row for an identified equation it
+    could not pair with the law; ``NaN != 0`` is true, so every library term not in the law
+    was named as held (and the law's lacked terms never).  A non-finite row names nothing."""
+    details = {"terms": NAMES, "coef_true": np.vstack([TRUE, TRUE]),
+               "coef_id": np.array([[np.nan] * 5, [0.005, 0.1, -0.003, 1.0, 0.2]])}
+    assert spurious_terms(details) == [[], ["x^2"]]
+    assert dropped_terms(details) == [[], []]
+    assert term_changes(details) == "; equation 2 holds x^2 that the law lacks"
