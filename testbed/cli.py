@@ -476,14 +476,16 @@ def _results_file(path: Path) -> Path:
 
 
 def _run_folder(path: Path) -> Path:
-    """A run folder :func:`testbed.studies.runstore.load_run` can read, else InputError."""
-    from testbed.studies.runstore import load_run
+    """A run folder :func:`testbed.reporting.report.read_run` can read, else InputError."""
+    from testbed.reporting.report import read_run
 
     try:
-        load_run(path)
+        read_run(path)
     except ValueError as e:  # load_run's own checks (a JSONDecodeError is one too) say what
+        # (the folder's path once: said again inside, it ate the 200 characters of the reason)
+        why = _one_line(e).replace(f"{path}{os.sep}", "").removeprefix(f"{path}: ")
         raise InputError(f"{path}: not a run folder written by `testbed run` "
-                         f"({type(e).__name__}: {_one_line(e)[:200]})") from None
+                         f"({type(e).__name__}: {why[:300]})") from None
     except Exception as e:  # any failure to read the user's folder is a property of the folder
         raise InputError(f"{path}: not a run folder written by `testbed run` "
                          f"({type(e).__name__})") from None

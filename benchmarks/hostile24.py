@@ -1,0 +1,738 @@
+"""Twenty-fourth malformed-input round: generated hostile inputs, counted by family (docs/history.md).
+
+Each case ends ``ok`` or as a *finding* (the harness, ``benchmarks/_hostile.py``): anything but a
+verdict, an output, or one error line naming what is wrong.  Run from the repository root::
+
+    python -m benchmarks.hostile24 [family ...]      # all families when none is named
+
+Families (what rounds 1-23 did not try; their families are listed in ``hostile21.py``,
+``hostile22.py`` and ``hostile23.py``):
+
+``uffmix``
+    UFF files whose records are each valid but of mixed types that disagree with each other:
+    a node given two positions (twice in one UFF2411 record, in two 2411 records, by a 2411
+    and a UFF15 record), the same position twice (accepted), a node's coordinate NaN, a
+    sensor's node missing from the geometry; two UFF164 records (both SI: accepted; the second
+    in mm), a non-SI 164 after the 58 records; a UFF151 header, a UFF2412 element record, the
+    truth's UFF55 records dropped, the records in another order (each accepted: the clean
+    model); a UFF58 frequency response or complex record among the time responses; a record
+    stored with an explicit abscissa (spacing 0) that is uniform (accepted), has a gap, is
+    logarithmic, runs 1 % fast; a channel given twice (same name, or another name at the same
+    node and direction); a sensor pointing along ``+Y`` beside ``+Z`` ones.  ``testbed
+    identify``.  A traceback, anything but one refusal line for a file that contradicts
+    itself, or an accepted equivalent file read to another model, is a finding.
+``kindswap``
+    A record of one rig kind fed as another: each of the four rigs' dataset files (``.h5``) and
+    their SEP-005 exports (``.json``) through ``testbed identify --kind K`` for every other
+    kind K (with K's default identifier), with ``--method`` of another kind than ``--kind``,
+    and with ``--scenario`` of another rig.  Anything but one refusal line is a finding.
+``h5meta``
+    A dataset file whose groups or declarative attributes say something the reader does not
+    read (content hash made anew): an attribute on the ``/measured``, ``/truth`` or
+    ``/reference`` group itself, ``positions_unit`` of ``"mm"`` / ``"in"`` / a number / an
+    array, ``positions`` in millimetres declared as such, ``layout`` as a one-item list
+    (accepted), a ``unit`` as bytes (accepted) or a two-item array, ``acts_on`` an integer;
+    and a cached dataset whose truth was edited without its hash, then ``testbed run``.  An
+    attribute that changes the meaning of the numbers read in silence, or anything but one
+    refusal line, is a finding.
+``famdraw``
+    ``testbed family write`` of a study whose family draws are hostile in ways round 12's
+    ``family`` and round 15's ``studies`` did not try: a uniform range spanning +-1.7e308 (its
+    width overflows to inf), a log range of 300 decades, ``choices`` of tables, of booleans, of
+    mixed types, of one NaN-free number (accepted), a draw of the rig's text key
+    (``excitation.type``), a range for a key the rig has not, every draw refused by the rig
+    (a cart of negative mass), members 10**9, ``integers`` over [2**62, 2**63 - 1].  A hang, a
+    traceback, anything but one refusal line, or a member written that its own scenario
+    loader refuses, is a finding.
+
+Prints one line a finding and the counts; exits 1 if any finding.
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+import sys
+from pathlib import Path
+
+import numpy as np
+
+try:
+    from benchmarks import _hostile, hostile19
+except ImportError:  # run as a script
+    sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
+    from benchmarks import _hostile, hostile19
+
+ROOT = Path(__file__).resolve().parent.parent
+TIMEOUT_S = 240
+MM = hostile19.MM
+LAB = "cantilever_stiff_impact_lab"
+
+cli_inprocess = _hostile.cli_inprocess
+judged = _hostile.judged
+_generated = hostile19._generated
+_rehash = hostile19._rehash
+_safe = hostile19._safe
+
+
+def _numbers(obj) -> list[float]:
+    if isinstance(obj, bool):
+        return []
+    if isinstance(obj, (int, float)):
+        return [obj]
+    if isinstance(obj, dict):
+        return [x for k in sorted(obj) for x in _numbers(obj[k])]
+    if isinstance(obj, list):
+        return [x for v in obj for x in _numbers(v)]
+    return []
+
+
+def _model(out: Path) -> dict | None:
+    """The equations / matrices of a written model (None if none was written)."""
+    if not out.exists():
+        return None
+    model = json.loads(out.read_text())
+    return {k: v for k, v in model.items() if k not in ("source", "fit_time_s")}
+
+
+def _same(a: dict | None, b: dict | None, rtol: float, reordered: bool = False) -> bool:
+    """Two written models equal up to ``rtol`` in every number (the same record read); with
+    ``reordered``, their numbers as sorted multisets (the channels read in another order
+    permute the matrices' rows and columns)."""
+    if a is None or b is None:
+        return False
+    fa, fb = np.array(_numbers(a), dtype=float), np.array(_numbers(b), dtype=float)
+    if reordered:
+        fa, fb = np.sort(fa), np.sort(fb)
+    return fa.shape == fb.shape and bool(np.all(np.abs(fa - fb) <= rtol * np.abs(fb)
+                                                + 1e-12 * np.max(np.abs(fb), initial=0)))
+
+
+# ------------------------------------------------------------------ uffmix
+
+def uffmix_cases(work: Path) -> list[tuple[str, object]]:
+    import pyuff
+
+    beam = ["--kind", "structural", "--method", "ls_sindy"]
+
+    def exported() -> tuple[Path, list[str]]:
+        src = _generated(work, LAB)
+        out = work / "lab.uff"
+        prior_file = work / "lab.prior"
+        if not out.exists():
+            status, stdout, err = cli_inprocess(["export", str(src), "--format", "uff", "-o", str(out)])
+            if status != 0:
+                raise RuntimeError(f"export: {err[-300:]}")
+            prior_file.write_text(json.dumps([a for a in (stdout + err).split()
+                                              if "=" in a and not a.startswith("-")]))
+        return out, [x for p in json.loads(prior_file.read_text()) for x in ("--prior", p)]
+
+    def identify(path: Path, prior: list[str]) -> tuple[int, str, str]:
+        return cli_inprocess(["identify", str(path), "-o", f"{path}.model.json", *prior, *beam])
+
+    def clean_model() -> dict | None:
+        src, prior = exported()
+        clean = work / "clean.uff"
+        if not clean.exists():
+            shutil.copy(src, clean)
+            found = judged(*identify(clean, prior))
+            if found:
+                raise RuntimeError(f"clean file: {found}")
+        return _model(Path(f"{clean}.model.json"))
+
+    def case(label: str, edit, expect: str):
+        """``expect``: "refuse", "same" (the clean file's model), "permuted" (the clean file's
+        model, channels in another order) or "verdict"."""
+        def run():
+            src, prior = exported()
+            sets = pyuff.UFF(str(src)).read_sets()
+            sets = sets if isinstance(sets, list) else [sets]
+            edit(sets)
+            path = work / f"{_safe(label)}.uff"
+            path.unlink(missing_ok=True)
+            pyuff.UFF(str(path)).write_sets(sets, mode="add")
+            status, out, err = identify(path, prior)
+            found = judged(status, out, err, refuse=expect == "refuse")
+            if found:
+                return found
+            if expect in ("same", "permuted"):
+                if status == 2:
+                    return f"refused an equivalent file: {err.strip()[:200]!r}"
+                if not _same(_model(Path(f"{path}.model.json")), clean_model(), 1e-9,
+                             reordered=expect == "permuted"):
+                    return "read to another model than the clean file's"
+            return None
+        return run
+
+    def of_type(sets, t):
+        return [s for s in sets if s["type"] == t]
+
+    def geometry(sets):
+        return of_type(sets, 2411)[0]
+
+    def node_twice_in_one(sets):
+        g = geometry(sets)
+        for k in ("node_nums", "def_cs", "disp_cs", "color", "x", "y", "z"):
+            g[k] = np.append(g[k], g[k][1])
+        g["x"][-1] = g["x"][1] + 0.05
+
+    def second_geometry(dx: float):
+        def edit(sets):
+            g = json.loads(json.dumps({k: (v.tolist() if hasattr(v, "tolist") else v)
+                                       for k, v in geometry(sets).items()}))
+            g = {k: (np.array(v) if isinstance(v, list) else v) for k, v in g.items()}
+            g["x"] = g["x"] + dx
+            sets.insert(2, g)
+        return edit
+
+    def uff15(dx: float):
+        def edit(sets):
+            g = geometry(sets)
+            sets.insert(2, {"type": 15, "node_nums": g["node_nums"].copy(), "def_cs": g["def_cs"].copy(),
+                            "disp_cs": g["disp_cs"].copy(), "color": g["color"].copy(),
+                            "x": g["x"] + dx, "y": g["y"].copy(), "z": g["z"].copy()})
+        return edit
+
+    def nan_coordinate(sets):
+        geometry(sets)["x"][1] = np.nan
+
+    def drop_node(k: int):
+        def edit(sets):
+            g = geometry(sets)
+            for key in ("node_nums", "def_cs", "disp_cs", "color", "x", "y", "z"):
+                g[key] = np.delete(g[key], k)
+        return edit
+
+    def units(length: float, where: str = "after"):
+        def edit(sets):
+            u = dict(of_type(sets, 164)[0])
+            u.update(length=length, units_code=1 if length == 1 else 5,
+                     units_description="SI" if length == 1 else "mm")
+            if where == "after":
+                sets.append(u)
+            else:
+                sets.insert(1, u)
+        return edit
+
+    def header(sets):
+        sets.insert(0, {"type": 151, "model_name": "beam", "description": "lab", "db_app": "x",
+                        "date_db_created": "", "time_db_created": "", "version_db1": 0,
+                        "version_db2": 0, "file_type": 0, "date_db_saved": "",
+                        "time_db_saved": "", "program": "sysid", "date_file_written": "",
+                        "time_file_written": ""})
+
+    def elements(sets):
+        sets.insert(2, {"type": 2412, "element_nums": np.array([1, 2]),
+                        "fe_descriptor": np.array([21, 21]), "phys_table": np.array([1, 1]),
+                        "mat_table": np.array([1, 1]), "color": np.array([1, 1]),
+                        "num_nodes": np.array([2, 2]), "nodes_nums": np.array([[1, 2], [2, 3]])})
+
+    def drop_truth(sets):
+        sets[:] = [s for s in sets if s["type"] != 55]
+
+    def reorder(sets):
+        recs = of_type(sets, 58)
+        rest = [s for s in sets if s["type"] != 58]
+        sets[:] = rest[:2] + recs[::-1] + rest[2:]
+
+    def extra58(change: dict, data=None):
+        def edit(sets):
+            s = dict(of_type(sets, 58)[1])
+            s.update(change)
+            if data is not None:
+                s["data"] = data(s["data"])
+            sets.append(s)
+        return edit
+
+    def explicit_x(which, make_x):
+        def edit(sets):
+            for k, s in enumerate(of_type(sets, 58)):
+                if which is None or k == which:
+                    n = len(s["data"])
+                    s["abscissa_spacing"] = 0
+                    s["x"] = make_x(n, s["abscissa_inc"])
+                    s["id5"] = "sysid-testbed"  # the rate read from the abscissa
+        return edit
+
+    def uniform(n, inc):
+        return np.arange(n) * inc
+
+    def gap(n, inc):
+        x = np.arange(n) * inc
+        x[n // 2:] += 10 * inc
+        return x
+
+    def logarithmic(n, inc):
+        return np.geomspace(inc, n * inc, n)
+
+    def fast(n, inc):
+        return np.arange(n) * inc * 0.99
+
+    def binary(flag: int):
+        def edit(sets):
+            for s in of_type(sets, 58):
+                s["binary"] = flag
+        return edit
+
+    def direction(k: int, d: int):
+        def edit(sets):
+            of_type(sets, 58)[k]["rsp_dir"] = d
+        return edit
+
+    cases = [
+        ("a node twice in one UFF2411 record, 5 cm apart", node_twice_in_one, "refuse"),
+        ("two UFF2411 records placing the sensors 5 cm apart", second_geometry(0.05), "refuse"),
+        ("two UFF2411 records of the same positions", second_geometry(0.0), "same"),
+        ("a UFF15 record disagreeing with the UFF2411 one by 5 cm", uff15(0.05), "refuse"),
+        ("a UFF15 record agreeing with the UFF2411 one", uff15(0.0), "same"),
+        ("a node's x coordinate NaN", nan_coordinate, "refuse"),
+        ("the first sensor's node missing from the geometry", drop_node(0), "refuse"),
+        ("two UFF164 records, both SI", units(1.0, "before"), "same"),
+        ("a second UFF164 record in mm after the responses", units(1000.0), "refuse"),
+        ("a second UFF164 record in mm before the responses", units(1000.0, "before"), "refuse"),
+        ("a UFF151 header", header, "same"),
+        ("a UFF2412 element record", elements, "same"),
+        ("the truth's UFF55 records dropped", drop_truth, "same"),
+        ("the UFF58 records in reverse order", reorder, "permuted"),
+        ("a UFF58 frequency response among the time responses",
+         extra58({"func_type": 4, "id1": "frf/acc2"}), "refuse"),
+        ("a UFF58 complex record among the time responses",
+         extra58({"ord_data_type": 6, "id1": "acceleration/acc2c"}, lambda d: d + 0j), "refuse"),
+        ("every record with an explicit uniform abscissa", explicit_x(None, uniform), "same"),
+        ("one record with an explicit uniform abscissa", explicit_x(1, uniform), "same"),
+        ("one record's explicit abscissa with a gap of 10 samples", explicit_x(1, gap), "refuse"),
+        ("one record's explicit abscissa logarithmic", explicit_x(1, logarithmic), "refuse"),
+        ("one record's explicit abscissa 1 % fast", explicit_x(1, fast), "refuse"),
+        ("every record in ASCII (binary 0)", binary(0), "verdict"),
+        ("a channel given twice under its name", extra58({}), "refuse"),
+        ("a second channel at one node and direction, another name",
+         extra58({"id1": "acceleration/acc2b", "rsp_ent_name": "acc2b"}, lambda d: d * 1.01), "refuse"),
+        ("a sensor along +Y beside +Z ones", direction(1, 2), "refuse"),
+        ("every sensor and the force along +Y (one frame)",
+         lambda sets: [s.__setitem__("rsp_dir", 2) for s in of_type(sets, 58)], "same"),
+    ]
+    return [(f"uffmix {label}", case(label, edit, expect)) for label, edit, expect in cases]
+
+
+# ------------------------------------------------------------------ kindswap
+
+RECORDS = {"structural": LAB, "mechanical": "fivebar_multisine", "cartpole": "cartpole", "dynamical": MM}
+KIND_OF = {"structural": "structural", "mechanical": "mechanical", "cartpole": "mechanical",
+           "dynamical": "dynamical"}
+METHOD_OF = {"structural": "ls_sindy", "mechanical": "sindy_pi", "dynamical": "sindy_pi_dynamical"}
+
+
+def kindswap_cases(work: Path) -> list[tuple[str, object]]:
+    def record(rig: str, form: str) -> Path:
+        h5 = _generated(work, RECORDS[rig])
+        if form == "h5":
+            return h5
+        out = work / f"{RECORDS[rig]}.json"
+        if not out.exists():
+            status, _, err = cli_inprocess(["export", str(h5), "--format", "sep005", "-o", str(out)])
+            if status != 0:
+                raise RuntimeError(f"export {rig}: {err[-300:]}")
+        return out
+
+    def case(rig: str, form: str, args: list[str]):
+        def run():
+            path = record(rig, form)
+            out = work / f"{_safe(rig + form + ' '.join(args))}.model.json"
+            return judged(*cli_inprocess(["identify", str(path), *args, "-o", str(out)]), refuse=True)
+        return run
+
+    cases = []
+    for rig in RECORDS:
+        own = KIND_OF[rig]
+        for form in ("h5", "json"):
+            for kind in ("structural", "mechanical", "dynamical"):
+                if kind != own:
+                    cases.append((f"kindswap {RECORDS[rig]}.{form} as {kind}",
+                                  case(rig, form, ["--kind", kind, "--method", METHOD_OF[kind]])))
+        other = next(k for k in ("dynamical", "structural", "mechanical") if k != own)
+        cases.append((f"kindswap {RECORDS[rig]}.h5 --kind {own} --method {METHOD_OF[other]}",
+                      case(rig, "h5", ["--kind", own, "--method", METHOD_OF[other]])))
+        foreign = next(RECORDS[r] for r in RECORDS if KIND_OF[r] != own)
+        cases.append((f"kindswap {RECORDS[rig]}.h5 --scenario {foreign}",
+                      case(rig, "h5", ["--scenario", foreign])))
+
+    def same_kind(rig: str, form: str, scenario: str):
+        """A record under a scenario of another rig of its own kind: a model or a named
+        failure, not judged further (a lab's own record is read by any scenario of its kind)."""
+        def run():
+            path = record(rig, form)
+            out = work / f"{_safe(rig + form + scenario)}.model.json"
+            return judged(*cli_inprocess(["identify", str(path), "--scenario", scenario, "-o", str(out)]))
+        return run
+
+    cases += [(f"kindswap {RECORDS[r]}.{f} --scenario {sc} (same kind)", same_kind(r, f, sc))
+              for r, f, sc in (("cartpole", "h5", "fivebar_multisine"),
+                               ("mechanical", "h5", "cartpole"),
+                               ("cartpole", "json", "fivebar_multisine"),
+                               ("structural", "h5", "cantilever_soft_impact"))]
+    return cases
+
+
+# ------------------------------------------------------------------ h5meta
+
+def h5meta_cases(work: Path) -> list[tuple[str, object]]:
+    import h5py
+
+    def case(label: str, scenario: str, edit, expect: str, command: str = "identify"):
+        def run():
+            src = _generated(work, scenario)
+            path = work / f"{_safe(label)}_{command}.h5"
+            shutil.copy(src, path)
+            with h5py.File(path, "r+") as f:
+                edit(f)
+            _rehash(path)
+            if command == "identify":
+                kind, method = {MM: ("dynamical", "sindy_pi_dynamical"),
+                                LAB: ("structural", "ls_sindy"),
+                                "cartpole": ("mechanical", "sindy_pi")}[scenario]
+                got = cli_inprocess(["identify", str(path), "--kind", kind, "--method", method,
+                                     "-o", f"{path}.model.json"])
+            else:
+                got = cli_inprocess(["export", str(path), "--format", "sep005",
+                                     "-o", str(path.with_suffix(".json"))])
+            return judged(*got, refuse=expect == "refuse")
+        return run
+
+    def attr(where: str, key: str, value):
+        def edit(f):
+            f[where].attrs[key] = value
+        return edit
+
+    def mm_positions(f):
+        d = f["measured/acceleration"]
+        d.attrs["positions"] = np.asarray(d.attrs["positions"]) * 1000
+        d.attrs["positions_unit"] = "mm"
+
+    acc = "measured/acceleration"
+    text = h5py.string_dtype()
+    cases = []
+    for cmd in ("identify", "export"):
+        cases += [
+            (f"an attribute fs on the /measured group ({cmd})", MM, attr("measured", "fs", 1.0),
+             "refuse", cmd),
+            (f"an attribute unit on the /truth group ({cmd})", MM, attr("truth", "unit", "mM"),
+             "refuse", cmd),
+            (f"an attribute on the /reference group ({cmd})", MM, attr("reference", "scale", 2.0),
+             "refuse", cmd),
+            (f"positions_unit 'mm', positions unchanged ({cmd})", LAB, attr(acc, "positions_unit", "mm"),
+             "refuse", cmd),
+            (f"positions_unit 'in' ({cmd})", LAB, attr(acc, "positions_unit", "in"), "refuse", cmd),
+            (f"positions_unit a number ({cmd})", LAB, attr(acc, "positions_unit", 1.0), "refuse", cmd),
+            (f"positions_unit an array ({cmd})", LAB,
+             attr(acc, "positions_unit", np.array(["m", "m"], dtype=text)), "refuse", cmd),
+            (f"positions in mm declared 'mm' ({cmd})", LAB, mm_positions, "refuse", cmd),
+            (f"positions_unit 'm' on a signal without positions ({cmd})", MM,
+             attr("measured/x", "positions_unit", "m"), "verdict", cmd),
+            (f"a channel name as fixed-length bytes ({cmd})", MM,
+             attr("measured/x", "channels", np.array([b"x"], dtype="S1")), "refuse", cmd),
+            (f"unit a two-item array ({cmd})", MM,
+             attr("measured/x", "unit", np.array(["mM", "s"], dtype=text)), "refuse", cmd),
+        ]
+    cases += [
+        ("layout a one-item list (identify)", MM,
+         attr("measured/x", "layout", np.array(["channels x samples"], dtype=text)), "verdict"),
+        ("unit as fixed-length bytes (identify)", MM, attr("measured/x", "unit", np.bytes_(b"mM")),
+         "refuse"),
+        ("acts_on an integer (identify)", "cartpole", attr("measured/torque", "acts_on", 3), "refuse"),
+    ]
+    out = [(f"h5meta {label}", case(label, sc, edit, expect, command))
+           for label, sc, edit, expect, *more in cases for command in [more[0] if more else "identify"]]
+
+    def cached_truth_edited():
+        """A cached dataset's truth edited in place (its hash not made anew), then ``run``:
+        the cache verifies on read, so the run regenerates or refuses; never scores against
+        the edited truth."""
+        from testbed.pipeline.cache import DatasetCache
+        from testbed.pipeline.scenario import load_scenario
+
+        cache = work / "cache"
+        status, _, err = cli_inprocess(["generate", MM, "--cache", str(cache), "-o", str(work / "mm_c.h5")])
+        if status != 0:
+            return f"generate: {err.strip()[-200:]}"
+        sc = load_scenario(MM)
+        entry = DatasetCache(cache).path_for(sc, sc.seed) if hasattr(DatasetCache, "path_for") else None
+        files = [entry] if entry else sorted(cache.rglob("*.h5"))
+        if not files:
+            return "no cache entry written"
+        with h5py.File(files[0], "r+") as f:
+            name = next(iter(f["truth"]))
+            d = f["truth"][name]
+            if d.dtype.kind == "f":
+                d[...] = d[()] * 2.0
+        status, out_, err = cli_inprocess(["run", MM, "--cache", str(cache), "-o", str(work / "runs"),
+                                           "--no-figures"])
+        found = judged(status, out_, err)
+        if found:
+            return found
+        from testbed.core.dataset import Dataset
+        try:
+            Dataset.load(files[0])
+        except Exception as e:
+            return f"the cache entry left unverifiable after run: {e}"
+        return None
+
+    out.append(("h5meta a cached dataset's truth edited in place, then run", cached_truth_edited))
+    return out
+
+
+# ------------------------------------------------------------------ famdraw
+
+FAMILY_STUDY = """
+[study]
+name = "fd"
+description = "hostile family draws"
+noise = [0.0]
+seeds = [0]
+identifiers = ["sindy_pi"]
+
+[families.f]
+base = "cartpole"
+members = {members}
+seed = 0
+description = "drawn"
+
+[families.f.{table}]
+{key} = {spec}
+"""
+
+
+def famdraw_cases(work: Path) -> list[tuple[str, object]]:
+    def case(label: str, table: str, key: str, spec: str, expect: str, members: str = "2"):
+        def run():
+            folder = work / _safe(label)
+            folder.mkdir(exist_ok=True)
+            study = folder / "fd.toml"
+            study.write_text(FAMILY_STUDY.format(members=members, table=table, key=key, spec=spec))
+            out = folder / "members"
+            status, stdout, err = cli_inprocess(["family", "write", str(study), "-o", str(out)])
+            found = judged(status, stdout, err, refuse=expect == "refuse")
+            if found:
+                return found
+            if status == 0:
+                from testbed.pipeline.scenario import load_scenario
+
+                written = sorted(out.glob("*.toml"))
+                if not written:
+                    return "status 0 and no member written"
+                for p in written:
+                    try:
+                        load_scenario(p)
+                    except Exception as e:
+                        return f"wrote {p.name}, which its loader refuses: {str(e)[:160]}"
+                if expect == "refuse":
+                    return f"wrote {len(written)} members"
+            return None
+        return run
+
+    cases = [
+        ("a uniform range over +-1.7e308 (its width overflows)", "rig", "x0",
+         "{uniform = [-1.7e308, 1.7e308]}", "refuse"),
+        ("a uniform range [0, 1.7e308]", "rig", "cart_mass", "{uniform = [0.0, 1.7e308]}", "verdict"),
+        ("a log range of 300 decades", "rig", "cart_mass", "{log_uniform = [1e-150, 1e150]}", "verdict"),
+        ("choices of inline tables", "rig", "cart_mass", "{choices = [{a = 1}, {b = 2}]}", "refuse"),
+        ("choices of booleans", "rig", "cart_mass", "{choices = [true, false]}", "refuse"),
+        ("choices of a number and a text", "rig", "cart_mass", "{choices = [1.0, \"heavy\"]}", "refuse"),
+        ("choices of one number (accepted)", "rig", "cart_mass", "{choices = [2.0]}", "verdict"),
+        ("choices of nested lists", "rig", "cart_mass", "{choices = [[1.0, 2.0]]}", "refuse"),
+        ("a draw of the excitation's type", "excitation", "type",
+         "{choices = [\"multisine\", \"impact\"]}", "verdict"),
+        ("a range for a key the rig has not", "rig", "spring_rate", "{uniform = [1.0, 2.0]}", "refuse"),
+        ("every draw refused by the rig (negative mass)", "rig", "cart_mass",
+         "{uniform = [-2.0, -1.0]}", "refuse"),
+        ("members 10**9", "rig", "cart_mass", "{uniform = [1.0, 2.0]}", "refuse", "1000000000"),
+        ("integers over [2**62, 2**63 - 1] for a float key (a heavy cart: no bound)", "rig",
+         "cart_mass", "{integers = [4611686018427387904, 9223372036854775807]}", "verdict"),
+        ("log_integers over [1, 2**62] for the phase seed", "excitation", "phase_seed",
+         "{log_integers = [1, 4611686018427387904]}", "verdict"),
+        ("uniform of integers for an integer key", "excitation", "n_tones",
+         "{uniform = [2, 9]}", "refuse"),
+        ("integers for a float key (accepted)", "rig", "cart_mass", "{integers = [1, 3]}", "verdict"),
+        ("a range as a text", "rig", "cart_mass", "{uniform = \"1, 2\"}", "refuse"),
+        ("a range of three numbers", "rig", "cart_mass", "{uniform = [1.0, 2.0, 3.0]}", "refuse"),
+        ("a NaN bound", "rig", "cart_mass", "{uniform = [1.0, nan]}", "refuse"),
+        ("subnormal log bounds", "rig", "cart_mass", "{log_uniform = [5e-324, 1e-323]}", "refuse"),
+    ]
+    return [(f"famdraw {c[0]}", case(*c)) for c in cases]
+
+
+# ------------------------------------------------------------------ npzform
+
+class _Marker:
+    """Unpickled, makes the folder ``path``: a pickle that ran leaves its trace."""
+
+    def __init__(self, path: str) -> None:
+        self.path = path
+
+    def __reduce__(self):
+        import os
+
+        return (os.mkdir, (self.path,))
+
+
+def npzform_cases(work: Path) -> list[tuple[str, object]]:
+    """A run folder's ``run.npz`` replaced by a crafted one and the run sealed anew (its npz
+    checksum and ``run.json``'s own), then ``testbed report`` of the run and ``testbed runs
+    ls``: one refusal line (or the same report for the same numbers), and never a pickle
+    loaded."""
+    import io
+    import pickle
+    import zipfile
+
+    from testbed.studies import runstore
+
+    def base_run() -> Path:
+        runs = work / "runs"
+        done = sorted(runs.glob(f"{MM}/*/run.json"))
+        if not done:
+            status, _, err = cli_inprocess(["run", MM, "-o", str(runs), "--no-figures",
+                                            "--cache", str(work / "cache")])
+            if status not in (0, 1):
+                raise RuntimeError(f"run: {err[-300:]}")
+            done = sorted(runs.glob(f"{MM}/*/run.json"))
+        return done[0].parent
+
+    def reseal(run: Path) -> None:
+        meta = json.loads((run / "run.json").read_text())
+        meta[runstore.NPZ_DIGEST] = runstore._file_digest(run / "run.npz")
+        meta[runstore.DIGEST] = runstore.meta_digest(meta)
+        (run / "run.json").write_text(json.dumps(meta))
+
+    def arrays(run: Path) -> dict[str, np.ndarray]:
+        with np.load(run / "run.npz", allow_pickle=False) as z:
+            return {k: z[k] for k in z.files}
+
+    def case(label: str, make, expect: str):
+        """``make(arrays, marker) -> bytes`` of the new run.npz; ``expect`` "refuse" or "same"."""
+        def run():
+            src = base_run()
+            folder = work / "cases" / _safe(label)
+            shutil.rmtree(folder, ignore_errors=True)
+            target = folder / MM / src.name
+            shutil.copytree(src, target)
+            marker = folder / "PICKLE_RAN"
+            (target / "run.npz").write_bytes(make(arrays(src), str(marker)))
+            reseal(target)
+            status, out, err = cli_inprocess(["report", str(target), "-o", str(folder / "report")])
+            if marker.exists():
+                return "a pickle in run.npz was loaded (its code ran)"
+            found = judged(status, out, err, refuse=expect == "refuse")
+            if found:
+                return f"report: {found}"
+            if expect == "same" and status != 0:
+                return f"report refused an equivalent run.npz: {err.strip()[:200]!r}"
+            status, out, err = cli_inprocess(["runs", "ls", "-o", str(folder), "--plain"])
+            found = judged(status, out, err)
+            if found:
+                return f"runs ls: {found}"
+            return None
+        return run
+
+    def saved(a: dict[str, np.ndarray]) -> bytes:
+        buf = io.BytesIO()
+        np.savez(buf, **a)
+        return buf.getvalue()
+
+    def with_member(fn):
+        def make(a, marker):
+            b = dict(a)
+            fn(b, marker)
+            return saved(b)
+        return make
+
+    def first_float(a: dict[str, np.ndarray]) -> str:
+        return next(k for k, v in a.items() if v.dtype.kind == "f" and v.ndim >= 1 and v.size > 1)
+
+    def object_member(b, marker):
+        b[first_float(b)] = np.array([_Marker(marker), 1.0], dtype=object)
+
+    def object_extra(b, marker):
+        b["details/evil"] = np.array([_Marker(marker)], dtype=object)
+
+    def whole_pickle(a, marker):
+        return pickle.dumps({"model/x": _Marker(marker)})
+
+    def pickle_in_zip(a, marker):
+        buf = io.BytesIO()
+        with zipfile.ZipFile(buf, "w") as z:
+            z.writestr("model/x.pkl", pickle.dumps(_Marker(marker)))
+        return buf.getvalue()
+
+    def big_endian(b, marker):
+        k = first_float(b)
+        b[k] = b[k].astype(">f8")
+
+    def structured(b, marker):
+        k = first_float(b)
+        b[k] = np.zeros(b[k].shape, dtype=[("a", "f8"), ("b", "i4")])
+
+    def text_member(b, marker):
+        k = first_float(b)
+        b[k] = np.array(["1.0"] * b[k].size)
+
+    def complex_member(b, marker):
+        k = first_float(b)
+        b[k] = b[k] + 1j
+
+    def float16(b, marker):
+        k = first_float(b)
+        b[k] = b[k].astype(np.float16)
+
+    def empty_zip(a, marker):
+        buf = io.BytesIO()
+        with zipfile.ZipFile(buf, "w"):
+            pass
+        return buf.getvalue()
+
+    def npy_not_npz(a, marker):
+        buf = io.BytesIO()
+        np.save(buf, np.arange(3.0))
+        return buf.getvalue()
+
+    cases = [
+        ("a float member replaced by an object array holding a pickle", with_member(object_member), "refuse"),
+        ("an extra object member holding a pickle", with_member(object_extra), "refuse"),
+        ("the whole run.npz a pickle", whole_pickle, "refuse"),
+        ("a zip holding a .pkl member", pickle_in_zip, "refuse"),
+        ("a float member big-endian (the same numbers)", with_member(big_endian), "same"),
+        ("a float member of a structured dtype", with_member(structured), "refuse"),
+        # (text and complex are kinds a run.npz holds: which member holds which is the
+        # run's, not read from a schema; not judged further)
+        ("a float member as text", with_member(text_member), "verdict"),
+        ("a float member complex", with_member(complex_member), "verdict"),
+        ("a float member float16", with_member(float16), "verdict"),
+        ("an empty zip (no member: a run without arrays)", empty_zip, "verdict"),
+        ("a member of datetimes", with_member(lambda b, m: b.__setitem__(
+            first_float(b), np.zeros(b[first_float(b)].size, dtype="M8[s]"))), "refuse"),
+        ("a member of fixed-length bytes", with_member(lambda b, m: b.__setitem__(
+            "details/extra", np.array([b"x"]))), "refuse"),
+        ("run.npz a text file", lambda a, m: b"not a zip\n", "refuse"),
+        ("a .npy file under the name run.npz", npy_not_npz, "refuse"),
+    ]
+    return [(f"npzform {label}", case(label, make, expect)) for label, make, expect in cases]
+
+
+# ------------------------------------------------------------------ main
+
+FAMILIES = _hostile.families(
+    {
+        "uffmix": uffmix_cases,
+        "kindswap": kindswap_cases,
+        "h5meta": h5meta_cases,
+        "famdraw": famdraw_cases,
+        "npzform": npzform_cases,
+    },
+    TIMEOUT_S,
+)
+
+
+def main(argv: list[str]) -> int:
+    return _hostile.main(argv, FAMILIES, "hostile24-")
+
+
+if __name__ == "__main__":
+    raise SystemExit(main(sys.argv[1:]))
