@@ -716,6 +716,177 @@ def npzform_cases(work: Path) -> list[tuple[str, object]]:
     return [(f"npzform {label}", case(label, make, expect)) for label, make, expect in cases]
 
 
+# ------------------------------------------------------------------ rigedge
+
+#: The shipped scenario each rig's cases start from: (name, duration [s]).
+EDGE_BASES = {
+    "stiff": ("cantilever_stiff_impact_lsq", 0.3),
+    "soft": ("cantilever_soft_impact_lsq", 0.3),
+    "fivebar": ("fivebar_multisine", 2.0),
+    "cartpole": ("cartpole", 4.0),
+    "kinetics": (MM, 4.0),
+}
+
+
+def _toml_value(v) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, str):
+        return json.dumps(v)
+    if isinstance(v, list):
+        return "[" + ", ".join(_toml_value(x) for x in v) + "]"
+    if isinstance(v, dict):
+        return "{" + ", ".join(f"{k} = {_toml_value(x)}" for k, x in v.items()) + "}"
+    return repr(v)
+
+
+def _toml(raw: dict) -> str:
+    return "".join(f"[{section}]\n" + "".join(f"{k} = {_toml_value(v)}\n" for k, v in table.items())
+                   for section, table in raw.items())
+
+
+def rigedge_cases(work: Path) -> list[tuple[str, object]]:
+    """Scenarios each of whose numbers lies within its bounds, at an edge rounds 14 (``bounds``)
+    and 22 (``physcombo``) did not try: no excitation (a torque or force amplitude of 0), a
+    beam of 2 segments (its fewest), a joint offset of 0 and 0.5, damping at 0 and 0.999 of
+    critical, a soft base of k3 = 0 (a linear base declared soft), a soft base 1e-6 as stiff
+    as the beam, kinetics with Vmax = 0 (no reaction) or Km = 1e12 (linear), a cart-pole
+    without gravity (no restoring force on the pole), a five-bar without damping: run and
+    scored (``run_scenario``).  A traceback, anything but one refusal line, a pass with NaN
+    scores, or NaN scores without a failure naming why, is a finding."""
+    from testbed.pipeline.cache import DatasetCache
+    from testbed.pipeline.scenario import load_scenario
+    from testbed.scoring.run import run_scenario
+
+    def case(label: str, base: str, edits: dict):
+        def run():
+            _, raw = _hostile.base_scenario(EDGE_BASES, base)
+            for section, table in edits.items():
+                raw.setdefault(section, {}).update(table)
+            raw["scenario"]["name"] = f"h24_{_safe(label)}"[:100]
+            path = work / f"{raw['scenario']['name']}.toml"
+            path.write_text(_toml(raw))
+            result = run_scenario(load_scenario(path), cache=DatasetCache(work / "cache"))
+            return _hostile.scored_finding(result)
+        return run
+
+    rows = [
+        ("five-bar torque amplitude 0 (no excitation)", "fivebar", {"excitation": {"amplitude": 0.0}}),
+        ("five-bar 1e-9 N m of torque", "fivebar", {"excitation": {"amplitude": 1e-9}}),
+        ("five-bar without damping", "fivebar", {"rig": {"damping": 0.0}}),
+        ("five-bar one tone", "fivebar", {"excitation": {"n_tones": 1}}),
+        ("cart-pole force amplitude 0 (no excitation)", "cartpole", {"excitation": {"amplitude": 0.0}}),
+        ("cart-pole without gravity", "cartpole", {"rig": {"gravity": 0.0}}),
+        ("cart-pole without damping", "cartpole", {"rig": {"cart_damping": 0.0, "pole_damping": 0.0}}),
+        ("cart-pole one tone", "cartpole", {"excitation": {"n_tones": 1}}),
+        ("cart-pole no centring (kp = kd = 0)", "cartpole", {"excitation": {"kp": 0.0, "kd": 0.0}}),
+        ("kinetics Vmax = 0 (no reaction)", "kinetics", {"rig": {"Vmax": 0.0}}),
+        ("kinetics Km = 1e12 (linear kinetics)", "kinetics", {"rig": {"Km": 1e12}}),
+        ("kinetics no influx, started empty", "kinetics", {"rig": {"jx": 0.0, "x0": 0.0}}),
+        ("beam of 2 segments", "stiff", {"rig": {"n_segments": 2, "sensors": [0.3175]}}),
+        ("beam joint offset 0", "stiff", {"rig": {"joint_offset": 0.0}}),
+        ("beam joint offset 0.5", "stiff", {"rig": {"joint_offset": 0.5}}),
+        ("beam undamped", "stiff", {"rig": {"damping_ratio": 0.0}}),
+        ("beam damped 0.999 of critical", "stiff", {"rig": {"damping_ratio": 0.999}}),
+        ("soft base of k3 = 0 (linear, declared soft)", "soft", {"rig": {"base_k3": 0.0}}),
+        ("soft base 1e-6 as stiff as declared", "soft", {"rig": {"base_k1": 2e-3}}),
+        ("beam one sensor at the tip", "stiff", {"rig": {"sensors": [0.3175]}}),
+        ("beam sensors at the first joint only", "stiff", {"rig": {"sensors": [0.03175]}}),
+    ]
+    return [(f"rigedge {label}", case(label, base, edits)) for label, base, edits in rows]
+
+
+# ------------------------------------------------------------------ cliunits
+
+def cliunits_cases(work: Path) -> list[tuple[str, object]]:
+    """``testbed identify --units`` given in ways round 18's three cases did not try: one
+    channel twice (the same unit, another), a unit for all beside one for a channel, an empty
+    channel or unit, blanks around ``=``, a channel without its signal's name, a unit of
+    another quantity for the force, a unit of the same quantity contradicting the file's,
+    Unicode and upper-case spellings, on the beam's SEP-005 record (units declared); and on
+    the kinetics record as CSV without units (``x`` and ``dx``): a rate given the state's unit,
+    each unit given per channel (accepted: the clean model), a rate per minute.  A refusal in
+    more than one line, a contradiction accepted, or an accepted equivalent read to another
+    model, is a finding."""
+    from testbed.core.dataset import Dataset
+
+    def beam() -> Path:
+        out = work / "beam.json"
+        if not out.exists():
+            status, _, err = cli_inprocess(["export", str(_generated(work, LAB)), "--format",
+                                            "sep005", "-o", str(out)])
+            if status != 0:
+                raise RuntimeError(f"export: {err[-300:]}")
+        return out
+
+    def kinetics_csv() -> Path:
+        out = work / "mm.csv"
+        if not out.exists():
+            ds = Dataset.load(_generated(work, MM))
+            x, dx = ds.measured["x"].data[0], ds.measured["dx"].data[0]
+            rows = [f"{k / ds.fs!r},{a!r},{b!r}" for k, (a, b) in
+                    enumerate(zip(x.tolist(), dx.tolist(), strict=True))]
+            out.write_text("time [s],x,dx\n" + "\n".join(rows) + "\n")
+        return out
+
+    def identify(path: Path, tag: str, args: list[str]) -> tuple[int, str, str]:
+        kind = (["--kind", "structural", "--method", "ls_sindy", "--prior", "total_mass=0.7477125",
+                 "--prior", "reduced_mass_trace=0.5157578642106304"] if path.suffix == ".json"
+                else ["--kind", "dynamical", "--method", "sindy_pi_dynamical"])
+        return cli_inprocess(["identify", str(path), *kind, *args, "-o", str(work / f"{tag}.model.json")])
+
+    def case(label: str, record, args: list[str], expect: str):
+        def run():
+            path = record()
+            tag = "clean_" + path.stem
+            if expect == "same" and not (work / f"{tag}.model.json").exists():
+                base = ["--units", "x=mM", "--units", "dx=mM/s"] if path.suffix == ".csv" else []
+                found = judged(*identify(path, tag, base))
+                if found:
+                    return f"clean: {found}"
+            status, out, err = identify(path, _safe(label), args)
+            found = judged(status, out, err, refuse=expect == "refuse")
+            if found:
+                return found
+            if expect == "same":
+                if status == 2:
+                    return f"refused an equivalent reading: {err.strip()[:200]!r}"
+                if not _same(_model(work / f"{_safe(label)}.model.json"), _model(work / f"{tag}.model.json"),
+                             1e-9):
+                    return "read to another model than the clean reading's"
+            return None
+        return run
+
+    a1 = "acceleration/acc1"
+    rows = [
+        ("a channel twice, two units", beam, ["--units", f"{a1}=g", "--units", f"{a1}=m/s^2"], "refuse"),
+        ("a channel twice, one unit (the file's)", beam,
+         ["--units", f"{a1}=m/s^2", "--units", f"{a1}=m/s^2"], "verdict"),
+        ("a unit for all beside one for a channel", beam, ["--units", "m/s^2", "--units", f"{a1}=g"],
+         "refuse"),
+        ("an empty channel", beam, ["--units", "=m/s^2"], "refuse"),
+        ("an empty unit", beam, ["--units", f"{a1}="], "refuse"),
+        ("blanks around =", beam, ["--units", f"{a1} = m/s^2"], "verdict"),
+        ("a channel without its signal's name", beam, ["--units", "acc1=m/s^2"], "refuse"),
+        ("the force in m/s^2", beam, ["--units", "force/force=m/s^2"], "refuse"),
+        ("the force in kN on a file declaring N", beam, ["--units", "force/force=kN"], "refuse"),
+        ("an acceleration in g on a file declaring m/s^2", beam, ["--units", f"{a1}=g"], "refuse"),
+        ("m/s with a superscript two", beam, ["--units", f"{a1}=m/s\u00b2"], "refuse"),
+        ("upper-case G", beam, ["--units", f"{a1}=G"], "refuse"),
+        ("an unknown channel", beam, ["--units", "acceleration/acc9=m/s^2"], "refuse"),
+        ("kinetics without units", kinetics_csv, [], "refuse"),
+        ("kinetics one unit for both (the rate in mM)", kinetics_csv, ["--units", "mM"], "refuse"),
+        ("kinetics each unit per channel", kinetics_csv, ["--units", "x=mM", "--units", "dx=mM/s"], "same"),
+        ("kinetics the rate per minute", kinetics_csv, ["--units", "x=mM", "--units", "dx=mM/min"], "refuse"),
+        ("kinetics the state in m (a length)", kinetics_csv, ["--units", "x=m", "--units", "dx=m/s"], "verdict"),
+        ("kinetics the time column given a unit", kinetics_csv,
+         ["--units", "x=mM", "--units", "dx=mM/s", "--units", "time=s"], "verdict"),
+        ("kinetics the time column in ms", kinetics_csv,
+         ["--units", "x=mM", "--units", "dx=mM/s", "--units", "time=ms"], "refuse"),
+    ]
+    return [(f"cliunits {label}", case(label, rec, args, expect)) for label, rec, args, expect in rows]
+
+
 # ------------------------------------------------------------------ main
 
 FAMILIES = _hostile.families(
@@ -725,6 +896,8 @@ FAMILIES = _hostile.families(
         "h5meta": h5meta_cases,
         "famdraw": famdraw_cases,
         "npzform": npzform_cases,
+        "rigedge": rigedge_cases,
+        "cliunits": cliunits_cases,
     },
     TIMEOUT_S,
 )

@@ -837,6 +837,8 @@ def _key_values(items: list[str] | None, option: str, *, numbers: bool) -> dict:
         key, sep, text = item.partition("=")
         if not sep or not key.strip():
             raise InputError(f"{option} {show_value(item)}: expected KEY=VALUE")
+        if not text.strip():  # `--units acc1=` overrode the file's unit with none: "has no unit"
+            raise InputError(f"{option} {show_value(item)}: no value after '='; expected KEY=VALUE")
         try:
             value = tomllib.loads(f"v = {text}")["v"]
         except (tomllib.TOMLDecodeError, ValueError):  # ValueError: over 4300 digits
@@ -869,6 +871,9 @@ def cmd_identify(args: argparse.Namespace) -> int:
             raise InputError(f"--units {' '.join(args.units)}: expected one unit for every channel "
                              "(--units g) or one CHANNEL=UNIT per option, not both or several units")
         units = _key_values(args.units, "--units", numbers=False) if per_channel[0] else args.units[0]
+        if isinstance(units, str) and not units.strip():
+            raise InputError(f"--units {show_value(units)}: no unit; expected a unit for every "
+                             "channel (--units g) or CHANNEL=UNIT")
     data = _existing_file(Path(args.data), "a measured-data file (UFF58, SEP-005 JSON, CSV or HDF5)")
     # nor the --scenario file or a plugin (-o s.toml replaced the scenario: round 17)
     read: list[str] = []

@@ -8,6 +8,7 @@ import io
 import json
 import os
 import pickle
+import re
 import zipfile
 from pathlib import Path
 
@@ -274,3 +275,18 @@ def test_a_plain_run_npz_still_reports(cli_in_process, mm_run, tmp_path):
     check_run_npz(run)
     p = cli_in_process("report", str(run), "-o", str(tmp_path / "report"), cwd=tmp_path)
     assert p.returncode == 0, p.stderr
+
+
+# ------------------------------------------------------------------ --units with no unit
+
+@pytest.mark.parametrize("units", [["x="], ["x= "], [""], [" "]])
+def test_units_with_no_unit_are_refused_as_such(cli_in_process, mm_file, tmp_path, units):
+    """Round 24: `--units acceleration/acc1=` replaced the file's declared unit by none and was
+    refused as "channel ... has no unit; declare it with units=" (the option that had just
+    declared it)."""
+    p = cli_in_process("identify", str(mm_file), "--kind", "dynamical", "--method", "sindy_pi_dynamical",
+                       *[a for u in units for a in ("--units", u)], "-o", str(tmp_path / "m.json"),
+                       cwd=tmp_path)
+    assert p.returncode == 2
+    line = _one_error_line(p.stderr)
+    assert re.search(r"--units .*: no (value after '='|unit)", line), line
