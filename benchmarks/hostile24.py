@@ -310,6 +310,18 @@ def uffmix_cases(work: Path) -> list[tuple[str, object]]:
         ("a sensor along +Y beside +Z ones", direction(1, 2), "refuse"),
         ("every sensor and the force along +Y (one frame)",
          lambda sets: [s.__setitem__("rsp_dir", 2) for s in of_type(sets, 58)], "same"),
+        ("every record starting 0.5 s later (one clock)",
+         lambda sets: [s.__setitem__("abscissa_min", 0.5) for s in of_type(sets, 58)], "same"),
+        ("ordinates in single precision",
+         lambda sets: [s.update(ord_data_type=2, data=s["data"].astype(np.float32))
+                       for s in of_type(sets, 58)], "verdict"),
+        ("every ID line 1 empty (channels named by node)",
+         lambda sets: [s.__setitem__("id1", "") for s in of_type(sets, 58)], "verdict"),
+        ("one sensor without a direction beside +Z ones", direction(1, 0), "verdict"),
+        ("one sensor's node 0 (no node)", lambda sets: of_type(sets, 58)[1].__setitem__("rsp_node", 0),
+         "refuse"),
+        ("the force's node absent from the geometry",
+         lambda sets: of_type(sets, 58)[3].__setitem__("rsp_node", 9), "refuse"),
     ]
     return [(f"uffmix {label}", case(label, edit, expect)) for label, edit, expect in cases]
 
@@ -835,7 +847,8 @@ def cliunits_cases(work: Path) -> list[tuple[str, object]]:
                 else ["--kind", "dynamical", "--method", "sindy_pi_dynamical"])
         return cli_inprocess(["identify", str(path), *kind, *args, "-o", str(work / f"{tag}.model.json")])
 
-    def case(label: str, record, args: list[str], expect: str):
+    def case(label: str, record, args: list[str], expect: str, said: str = ""):
+        """``said``: text the refusal must hold (the option at fault, not another)."""
         def run():
             path = record()
             tag = "clean_" + path.stem
@@ -848,6 +861,8 @@ def cliunits_cases(work: Path) -> list[tuple[str, object]]:
             found = judged(status, out, err, refuse=expect == "refuse")
             if found:
                 return found
+            if said and said not in err:
+                return f"refused without naming {said!r}: {err.strip()[:200]!r}"
             if expect == "same":
                 if status == 2:
                     return f"refused an equivalent reading: {err.strip()[:200]!r}"
@@ -865,7 +880,8 @@ def cliunits_cases(work: Path) -> list[tuple[str, object]]:
         ("a unit for all beside one for a channel", beam, ["--units", "m/s^2", "--units", f"{a1}=g"],
          "refuse"),
         ("an empty channel", beam, ["--units", "=m/s^2"], "refuse"),
-        ("an empty unit", beam, ["--units", f"{a1}="], "refuse"),
+        ("an empty unit", beam, ["--units", f"{a1}="], "refuse", "--units"),
+        ("an empty unit for every channel", beam, ["--units", ""], "refuse", "--units"),
         ("blanks around =", beam, ["--units", f"{a1} = m/s^2"], "verdict"),
         ("a channel without its signal's name", beam, ["--units", "acc1=m/s^2"], "refuse"),
         ("the force in m/s^2", beam, ["--units", "force/force=m/s^2"], "refuse"),
@@ -878,13 +894,242 @@ def cliunits_cases(work: Path) -> list[tuple[str, object]]:
         ("kinetics one unit for both (the rate in mM)", kinetics_csv, ["--units", "mM"], "refuse"),
         ("kinetics each unit per channel", kinetics_csv, ["--units", "x=mM", "--units", "dx=mM/s"], "same"),
         ("kinetics the rate per minute", kinetics_csv, ["--units", "x=mM", "--units", "dx=mM/min"], "refuse"),
-        ("kinetics the state in m (a length)", kinetics_csv, ["--units", "x=m", "--units", "dx=m/s"], "verdict"),
+        ("kinetics the state in m (a length)", kinetics_csv, ["--units", "x=m", "--units", "dx=m/s"],
+         "verdict"),
         ("kinetics the time column given a unit", kinetics_csv,
          ["--units", "x=mM", "--units", "dx=mM/s", "--units", "time=s"], "verdict"),
         ("kinetics the time column in ms", kinetics_csv,
          ["--units", "x=mM", "--units", "dx=mM/s", "--units", "time=ms"], "refuse"),
     ]
-    return [(f"cliunits {label}", case(label, rec, args, expect)) for label, rec, args, expect in rows]
+    return [(f"cliunits {label}", case(label, *how)) for label, *how in rows]
+
+
+# ------------------------------------------------------------------ sweepresume
+
+#: Columns of a results row that name when, where or how long, not what was found.
+NOT_FOUND = ("fit_time", "data_time", "cell_time", "commit", "versions")
+
+
+def _sweep_study(work: Path) -> Path:
+    """A kinetics study: 3 noise levels x 3 seeds x 1 identifier (9 cells)."""
+    path = work / "h24resume.toml"
+    if not path.exists():
+        path.write_text('[study]\nname = "h24resume"\nscenarios = ["michaelis_menten"]\n'
+                        'noise = [0.0, 1.0, 5.0]\nseeds = [0, 1, 2]\n'
+                        'identifiers = ["sindy_pi_dynamical"]\n')
+    return path
+
+
+def _found(path: Path) -> dict[str, dict]:
+    """A results file's rows by cell, less :data:`NOT_FOUND` (NaN as the text 'nan')."""
+    from testbed.studies.results import read_results
+
+    def plain(v):
+        return "nan" if isinstance(v, float) and v != v else v
+
+    return {str(r["cell"]): {k: plain(v) for k, v in r.items() if k not in NOT_FOUND}
+            for r in read_results(path)}
+
+
+def sweepresume_cases(work: Path) -> list[tuple[str, object]]:
+    """``testbed sweep`` (``--jobs 1`` and ``2``: loky workers) sent SIGINT or SIGTERM 1.5-6 s
+    after its start, then resumed: round 23's ``sigwrite`` asked the resumed sweep for its
+    whole grid; here each row must equal, bit for bit but for times and provenance, the row of
+    the same cell in an uninterrupted sweep (reproducible: same scenario + seed = same data,
+    the same fit).  And ``testbed summary`` / ``report`` of the results file while the sweep
+    writes it: a table of the rows so far, or one refusal line.  A process left in the sweep's
+    session, a traceback, a row that differs from the uninterrupted one, or a reader's
+    traceback, is a finding."""
+    import contextlib
+    import os
+    import signal
+    import subprocess
+    import time
+
+    from benchmarks import hostile23
+
+    def reference() -> dict[str, dict]:
+        ref = work / "reference.parquet"
+        if not ref.exists():
+            status, _, err = cli_inprocess(["sweep", str(_sweep_study(work)), "--jobs", "2", "--cache",
+                                            str(work / "cache"), "--results", str(ref)])
+            if status not in (0, 1):
+                raise RuntimeError(f"reference sweep: {err[-300:]}")
+        return _found(ref)
+
+    def stop(p, sig: int) -> str | None:
+        p.send_signal(sig)
+        try:
+            _, err = p.communicate(timeout=90)
+        except subprocess.TimeoutExpired:
+            os.killpg(p.pid, signal.SIGKILL)
+            p.communicate()
+            return f"still running 90 s after {signal.Signals(sig).name}"
+        left = hostile23._left_in_session(p.pid)
+        if left:
+            for ln in left:
+                with contextlib.suppress(ProcessLookupError):
+                    os.kill(int(ln.split()[0]), signal.SIGKILL)
+            return f"processes left in its session: {left[:3]}"
+        lines = [ln for ln in err.splitlines() if ln.strip()]
+        if "Traceback" in err or "internal error" in err or p.returncode not in (0, 1, 2, 130, 143, -sig):
+            return f"status {p.returncode}: {(lines or [''])[-1][:200]}"
+        return None
+
+    def case(jobs: str, sig: int, delay: float):
+        def run():
+            want = reference()
+            d = work / f"j{jobs}_{signal.Signals(sig).name}_{delay}"
+            shutil.rmtree(d, ignore_errors=True)
+            d.mkdir()
+            argv = ["sweep", str(_sweep_study(work)), "--jobs", jobs, "--cache", str(work / "cache"),
+                    "--results", str(d / "res.parquet")]
+            p = hostile23._start(argv, d)
+            time.sleep(delay)
+            found = stop(p, sig)
+            if found:
+                return found
+            again = _hostile.testbed_cli(argv, d, TIMEOUT_S)
+            found = _hostile.cli_finding(again)
+            if found or again.returncode not in (0, 1):
+                return f"resumed: {found or again.returncode}"
+            got = _found(d / "res.parquet")
+            if sorted(got) != sorted(want):
+                return f"resumed sweep holds cells {sorted(got)}, the grid {sorted(want)}"
+            for cell, row in want.items():
+                diff = sorted(k for k in set(row) | set(got[cell]) if row.get(k) != got[cell].get(k))
+                if diff:
+                    return (f"cell {cell}: {diff[:4]} differ from the uninterrupted sweep's "
+                            f"({[row.get(k) for k in diff[:2]]} -> {[got[cell].get(k) for k in diff[:2]]})")
+            return None
+        return run
+
+    def reading(what: str, delay: float):
+        def run():
+            reference()  # the cache filled: the sweep fits, it does not simulate
+            d = work / f"read_{what}_{delay}"
+            shutil.rmtree(d, ignore_errors=True)
+            d.mkdir()
+            res = d / "res.parquet"
+            p = hostile23._start(["sweep", str(_sweep_study(work)), "--jobs", "2", "--cache",
+                                  str(work / "cache"), "--results", str(res)], d)
+            try:
+                time.sleep(delay)
+                argv = (["summary", str(res)] if what == "summary"
+                        else ["report", str(res), "-o", str(d / "rep")])
+                status, out, err = cli_inprocess(argv)
+                found = judged(status, out, err)
+            finally:
+                try:
+                    p.communicate(timeout=TIMEOUT_S)
+                except subprocess.TimeoutExpired:
+                    os.killpg(p.pid, signal.SIGKILL)
+                    p.communicate()
+            if found:
+                return f"{what} while the sweep writes: {found}"
+            if p.returncode not in (0, 1):
+                return f"the sweep read while it wrote ended with status {p.returncode}"
+            return None
+        return run
+
+    cases = [(f"sweepresume --jobs {jobs} {signal.Signals(sig).name} at {delay} s", case(jobs, sig, delay))
+             for jobs in ("1", "2") for sig in (signal.SIGINT, signal.SIGTERM) for delay in (1.5, 3.0, 6.0)]
+    cases += [(f"sweepresume {what} while the sweep writes, at {delay} s", reading(what, delay))
+              for what in ("summary", "report") for delay in (1.0, 3.0, 5.0)]
+    return cases
+
+
+# ------------------------------------------------------------------ repro
+
+def repro_cases(work: Path) -> list[tuple[str, object]]:
+    """Reproducible data (the project's standard: same scenario + seed = bit-identical data):
+    ``testbed generate`` twice into fresh caches, without a cache, from a cache it filled,
+    with ``--seed`` equal to the scenario's own; and a scenario file written another way that
+    TOML reads to the same numbers (integers for floats, exponents, keys reordered, comments,
+    another name and description).  Each pair must give one content hash; two noise seeds,
+    two.  A pair of one content that differs, or a pair of different contents that agrees,
+    is a finding."""
+    import re
+
+    from testbed.pipeline.scenario import SCENARIO_DIR
+
+    def generate(tag: str, scenario: str, *more: str) -> str:
+        out = work / f"{tag}.h5"
+        out.unlink(missing_ok=True)
+        status, stdout, err = cli_inprocess(["generate", scenario, "-o", str(out), *more])
+        if status != 0:
+            raise RuntimeError(f"generate {tag}: {err.strip()[-300:]}")
+        m = re.search(r"content hash ([0-9a-f]+)", stdout + err)
+        if not m:
+            raise RuntimeError(f"generate {tag}: no content hash printed")
+        return m.group(1)
+
+    def written(name: str, edit) -> str:
+        text = (SCENARIO_DIR / f"{name}.toml").read_text()
+        new = edit(text)
+        if new == text:
+            raise RuntimeError(f"the edit changed nothing in {name}.toml")
+        stem = re.search(r'^name = "([^"]+)"', new, re.M).group(1)  # a file is named as its scenario
+        path = work / f"v{len(list(work.glob('v*')))}" / f"{stem}.toml"
+        path.parent.mkdir()
+        path.write_text(new)
+        return str(path)
+
+    def pair(label: str, a, b, same: bool = True):
+        def run():
+            ha, hb = a(), b()
+            if (ha == hb) != same:
+                return f"content hashes {ha} and {hb}: expected {'one' if same else 'two'}"
+            return None
+        return run
+
+    NOISY = "cantilever_stiff_impact_noise1"
+    n = 0
+
+    def gen(scenario_fn, *more: str, cache: str | None = "fresh"):
+        def make() -> str:
+            nonlocal n
+            n += 1
+            scenario = scenario_fn() if callable(scenario_fn) else scenario_fn
+            args = list(more)
+            if cache == "fresh":
+                args += ["--cache", str(work / f"cache{n}")]
+            elif cache is None:
+                args += ["--no-cache"]
+            else:
+                args += ["--cache", str(work / cache)]
+            return generate(f"g{n}", scenario, *args)
+        return make
+
+    def mm_edit(fn):
+        return lambda: written(MM, fn)
+
+    cases = [
+        ("kinetics into two fresh caches", gen(MM), gen(MM), True),
+        ("kinetics without a cache and with one", gen(MM, cache=None), gen(MM), True),
+        ("kinetics into a cache, then from it", gen(MM, cache="shared"), gen(MM, cache="shared"), True),
+        ("kinetics --seed 0 and its own seed 0", gen(MM, "--seed", "0"), gen(MM), True),
+        ("the noisy beam seed 3 twice", gen(NOISY, "--seed", "3"), gen(NOISY, "--seed", "3"), True),
+        ("the noisy beam seed 3 from its cache", gen(NOISY, "--seed", "3", cache="beam"),
+         gen(NOISY, "--seed", "3", cache="beam"), True),
+        ("the noisy beam seeds 3 and 4", gen(NOISY, "--seed", "3"), gen(NOISY, "--seed", "4"), False),
+        ("kinetics with another name and description",
+         gen(mm_edit(lambda t: t.replace('name = "michaelis_menten"', 'name = "mm_copy"')
+                     .replace("description = ", 'description = "another" # ', 1))), gen(MM), True),
+        ("kinetics duration 4 (an integer) for 4.0",
+         gen(mm_edit(lambda t: re.sub(r"duration = [0-9.]+", "duration = 4", t, count=1))), gen(MM), True),
+        ("kinetics sample rate 1e2 for 100.0",
+         gen(mm_edit(lambda t: re.sub(r"sample_rate = [0-9.]+", "sample_rate = 1e2", t, count=1))),
+         gen(MM), True),
+        ("kinetics with comments and blank lines added",
+         gen(mm_edit(lambda t: t.replace("[rig]\n", "# a comment\n\n[rig]   # the rig\n", 1))), gen(MM),
+         True),
+        ("kinetics with [rig] keys reordered",
+         gen(mm_edit(lambda t: re.sub(r"(\[rig\]\n)((?:[^\[\n][^\n]*\n)+)",
+                                      lambda m: m.group(1) + "".join(reversed(m.group(2).splitlines(True))),
+                                      t, count=1))), gen(MM), True),
+    ]
+    return [(f"repro {label}", pair(label, a, b, same)) for label, a, b, same in cases]
 
 
 # ------------------------------------------------------------------ main
@@ -898,6 +1143,8 @@ FAMILIES = _hostile.families(
         "npzform": npzform_cases,
         "rigedge": rigedge_cases,
         "cliunits": cliunits_cases,
+        "sweepresume": sweepresume_cases,
+        "repro": repro_cases,
     },
     TIMEOUT_S,
 )
