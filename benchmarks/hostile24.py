@@ -44,6 +44,37 @@ Families (what rounds 1-23 did not try; their families are listed in ``hostile21
     (a cart of negative mass), members 10**9, ``integers`` over [2**62, 2**63 - 1].  A hang, a
     traceback, anything but one refusal line, or a member written that its own scenario
     loader refuses, is a finding.
+``npzform``
+    A run folder's ``run.npz`` replaced by a crafted one and the run sealed anew (both
+    checksums): an object member holding a pickle (whose code would make a marker folder),
+    the whole file a pickle, a zip of a ``.pkl`` member, a lone ``.npy``, a text file; a
+    member of a structured dtype, datetimes, fixed-length bytes; big-endian, float16, text or
+    complex members and an empty zip (read: kinds a run writes).  ``testbed report`` and
+    ``runs ls``.  A pickle loaded, a traceback, an internal error, or anything but one refusal
+    line where one is due, is a finding.
+``rigedge``
+    Scenarios whose numbers lie within their bounds at edges rounds 14 and 22 did not try: no
+    excitation, one tone, no damping, no gravity, no centring, Vmax = 0, Km = 1e12, a beam of
+    2 segments, joint offsets 0 and 0.5, damping 0 and 0.999 of critical, a soft base of
+    k3 = 0 or 1e-6 of its stiffness, one sensor: run and scored (``run_scenario``).
+``cliunits``
+    ``testbed identify --units`` given twice for a channel, for all beside one channel, with
+    no channel or no unit, with blanks, without the signal's name, of another quantity, of
+    the same quantity against the file's, in Unicode or upper case; the kinetics CSV without
+    units, with one for both channels, per channel (the clean model), per minute, and the
+    time column given a unit.
+``sweepresume``
+    ``testbed sweep --jobs 1 / 2`` sent SIGINT / SIGTERM 1.5-6 s in, then resumed: every row
+    must equal the uninterrupted sweep's bit for bit (but times and provenance); ``summary``
+    and ``report`` of the results while the sweep writes them.
+``repro``
+    Same scenario + seed = one content hash: two fresh caches, no cache, a cache it filled,
+    ``--seed`` equal to the scenario's own, and a scenario file spelled another way (integers
+    for floats, exponents, comments, keys reordered, another name); two noise seeds, two.
+``envrun``
+    ``TESTBED_CACHE`` / ``TESTBED_SCENARIOS`` / ``TESTBED_STUDIES`` a file, a FIFO, a path
+    under a file, ``/proc/self``, ``/sys`` or ``/dev/full`` for ``run``, ``sweep``, ``cache
+    ls`` and ``runs ls`` (round 14's ``envvars`` ran ``list`` and ``generate``).
 
 Prints one line a finding and the counts; exits 1 if any finding.
 """
@@ -1132,6 +1163,64 @@ def repro_cases(work: Path) -> list[tuple[str, object]]:
     return [(f"repro {label}", pair(label, a, b, same)) for label, a, b, same in cases]
 
 
+# ------------------------------------------------------------------ envrun
+
+def envrun_cases(work: Path) -> list[tuple[str, object]]:
+    """``TESTBED_CACHE`` / ``TESTBED_SCENARIOS`` / ``TESTBED_STUDIES`` naming a file, a FIFO, a
+    path under a file, ``/proc/self``, ``/sys`` (a read-only file system: root writes
+    anywhere else) or ``/dev/full`` for the commands round 14's ``envvars`` did not run:
+    ``run``, ``sweep``, ``cache ls`` and ``runs ls`` (real processes).  A traceback, a status
+    other than 0 / 1 / 2, more than one error line, or a run / sweep that ends without its
+    verdict line and reports no reason, is a finding."""
+    import os
+    import subprocess
+
+    (work / "afile").write_text("x")
+    if not (work / "fifo").exists():
+        os.mkfifo(work / "fifo")
+    study = work / "h24env.toml"
+    study.write_text('[study]\nname = "h24env"\nscenarios = ["michaelis_menten"]\nnoise = [0.0]\n'
+                     'seeds = [0]\nidentifiers = ["sindy_pi_dynamical"]\n')
+    values = {"a file": str(work / "afile"), "a FIFO": str(work / "fifo"),
+              "a path under a file": str(work / "afile" / "x"), "/proc/self": "/proc/self",
+              "/sys (read-only)": "/sys/h24", "/dev/full": "/dev/full"}
+    commands = {
+        "run": ["run", MM, "--no-figures", "-o", "runs"],
+        "sweep": ["sweep", str(study), "--results", "res.parquet"],
+        "cache ls": ["cache", "ls"],
+        "runs ls": ["runs", "ls", "-o", "runs", "--plain"],
+    }
+
+    def case(var: str, label: str, value: str, cmd: str):
+        def run():
+            d = work / _safe(f"{var}_{label}_{cmd}")
+            shutil.rmtree(d, ignore_errors=True)
+            d.mkdir()
+            env = {**_hostile.ENV, var: value}
+            try:
+                p = subprocess.run([sys.executable, "-m", "testbed.cli", *commands[cmd]], cwd=d, env=env,
+                                   capture_output=True, text=True, timeout=180, stdin=subprocess.DEVNULL)
+            except subprocess.TimeoutExpired:
+                return "hang > 180 s"
+            found = _hostile.cli_finding(p)
+            if found:
+                return found
+            if cmd in ("run", "sweep") and p.returncode in (0, 1) and not p.stdout.strip():
+                return f"status {p.returncode} and nothing on stdout: {p.stderr.strip()[-200:]!r}"
+            return None
+        return run
+
+    cases = [(f"envrun TESTBED_CACHE {label}: {cmd}", case("TESTBED_CACHE", label, value, cmd))
+             for label, value in values.items() for cmd in ("run", "sweep", "cache ls")]
+    cases += [(f"envrun TESTBED_SCENARIOS {label}: run", case("TESTBED_SCENARIOS", label, value, "run"))
+              for label, value in list(values.items())[:3]]
+    cases += [(f"envrun TESTBED_STUDIES {label}: sweep", case("TESTBED_STUDIES", label, value, "sweep"))
+              for label, value in list(values.items())[:3]]
+    cases += [(f"envrun TESTBED_CACHE {label}: runs ls", case("TESTBED_CACHE", label, value, "runs ls"))
+              for label, value in list(values.items())[:2]]
+    return cases
+
+
 # ------------------------------------------------------------------ main
 
 FAMILIES = _hostile.families(
@@ -1145,6 +1234,7 @@ FAMILIES = _hostile.families(
         "cliunits": cliunits_cases,
         "sweepresume": sweepresume_cases,
         "repro": repro_cases,
+        "envrun": envrun_cases,
     },
     TIMEOUT_S,
 )

@@ -1761,10 +1761,10 @@ def _read_uff(path: Path) -> _Raw:
     return raw
 
 
-#: Relative difference [-] within which two geometry records' coordinates of one node agree: a
-#: UFF15 record writes them with 6 significant digits (E13.5, rounding within 5e-6 of the
-#: value), so a UFF15 and a UFF2411 record (16 digits) of one node, or two UFF15 records each
-#: rounded, differ by up to 1e-5 of the coordinate.
+#: Relative difference [-] within which two geometry records' coordinates of one node agree
+#: (relative to the node's largest coordinate): a UFF15 record writes them with 6 significant
+#: digits (E13.5, rounding within 5e-6 of the value), so a UFF15 and a UFF2411 record (16
+#: digits) of one node, or two UFF15 records each rounded, differ by up to 1e-5 of it.
 NODE_RTOL = 1e-5
 
 
@@ -1791,7 +1791,10 @@ def _add_nodes(path: Path, k: int, kind: int, s: Mapping[str, Any], coords: dict
         node = int(node)
         if node in placed:
             before, said = placed[node]
-            if not np.all(np.abs(at - before) <= NODE_RTOL * np.maximum(np.abs(at), np.abs(before))):
+            # relative to the node's distance from the origin: a coordinate written 0 in one
+            # record and 1e-17 in another is one place
+            scale = max(float(np.max(np.abs(at))), float(np.max(np.abs(before))))
+            if not np.all(np.abs(at - before) <= NODE_RTOL * scale):
                 def show(v: np.ndarray) -> str:
                     return "(" + ", ".join(f"{c:.9g}" for c in v) + ")"
 

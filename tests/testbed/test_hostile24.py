@@ -290,3 +290,10 @@ def test_units_with_no_unit_are_refused_as_such(cli_in_process, mm_file, tmp_pat
     assert p.returncode == 2
     line = _one_error_line(p.stderr)
     assert re.search(r"--units .*: no (value after '='|unit)", line), line
+
+
+def test_a_coordinate_zero_in_one_record_and_float_noise_in_another_is_one_place(tmp_path):
+    """The tolerance is relative to the node's place, not to each coordinate (0 against 1e-17)."""
+    other = _geometry(2411, X)
+    other["y"] = other["y"] + 1e-17
+    assert _positions(_uff(tmp_path, [_geometry(2411, X), other])) == list(X)
