@@ -476,14 +476,16 @@ def _results_file(path: Path) -> Path:
 
 
 def _run_folder(path: Path) -> Path:
-    """A run folder :func:`testbed.studies.runstore.load_run` can read, else InputError."""
-    from testbed.studies.runstore import load_run
+    """A run folder :func:`testbed.reporting.report.read_run` can read, else InputError."""
+    from testbed.reporting.report import read_run
 
     try:
-        load_run(path)
+        read_run(path)
     except ValueError as e:  # load_run's own checks (a JSONDecodeError is one too) say what
+        # (the folder's path once: said again inside, it ate the 200 characters of the reason)
+        why = _one_line(e).replace(f"{path}{os.sep}", "").removeprefix(f"{path}: ")
         raise InputError(f"{path}: not a run folder written by `testbed run` "
-                         f"({type(e).__name__}: {_one_line(e)[:200]})") from None
+                         f"({type(e).__name__}: {why[:300]})") from None
     except Exception as e:  # any failure to read the user's folder is a property of the folder
         raise InputError(f"{path}: not a run folder written by `testbed run` "
                          f"({type(e).__name__})") from None
@@ -835,6 +837,8 @@ def _key_values(items: list[str] | None, option: str, *, numbers: bool) -> dict:
         key, sep, text = item.partition("=")
         if not sep or not key.strip():
             raise InputError(f"{option} {show_value(item)}: expected KEY=VALUE")
+        if not text.strip():  # `--units acc1=` overrode the file's unit with none: "has no unit"
+            raise InputError(f"{option} {show_value(item)}: no value after '='; expected KEY=VALUE")
         try:
             value = tomllib.loads(f"v = {text}")["v"]
         except (tomllib.TOMLDecodeError, ValueError):  # ValueError: over 4300 digits
@@ -867,6 +871,9 @@ def cmd_identify(args: argparse.Namespace) -> int:
             raise InputError(f"--units {' '.join(args.units)}: expected one unit for every channel "
                              "(--units g) or one CHANNEL=UNIT per option, not both or several units")
         units = _key_values(args.units, "--units", numbers=False) if per_channel[0] else args.units[0]
+        if isinstance(units, str) and not units.strip():
+            raise InputError(f"--units {show_value(units)}: no unit; expected a unit for every "
+                             "channel (--units g) or CHANNEL=UNIT")
     data = _existing_file(Path(args.data), "a measured-data file (UFF58, SEP-005 JSON, CSV or HDF5)")
     # nor the --scenario file or a plugin (-o s.toml replaced the scenario: round 17)
     read: list[str] = []

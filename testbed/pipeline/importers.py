@@ -422,6 +422,8 @@ def measurement_and_clipping(path: str | os.PathLike, kind: str,
                                       "a [signal] table (a mapping) or None")
     data = read_measured(path, format=format, fs=fs, units=units, channels=channels,
                          own_units=kind == "dynamical")
+    if kind == "structural":
+        _check_one_axis(data.source, data.directions)
     ds = data.to_dataset(groups, prior)
     _check_read(data.source, ds, kind)
     _check_response(data.source, ds, kind)
@@ -440,6 +442,35 @@ def measurement_and_clipping(path: str | os.PathLike, kind: str,
     except ValueError as e:  # the chain's own checks: signal names, channel counts, positions
         raise MeasuredDataError(data.source, f"cannot run the {kind} signal chain: {e}; "
                                              f"signals {show_names(ds.measured)}") from None
+
+
+def _check_one_axis(path: Path, directions: Mapping[str, int]) -> None:
+    """Refuse a structural record whose channels point along different axes.
+
+    The structural chain reads every acceleration and the force as one coordinate each of a
+    planar chain, all along the axis it bends in; round 24: a sensor declared ``+Y`` beside
+    ``+Z`` ones (UFF ``rsp_dir`` 2 beside 3, SEP-005 ``direction``) was fitted with status 0 as
+    if it measured along Z.  Channels along one axis with either sign are one frame
+    (:func:`_honour_direction_signs`); channels without a direction are not judged.
+
+    Raises
+    ------
+    MeasuredDataError
+        Naming a channel of each of two axes.
+    """
+    first: dict[int, str] = {}
+    for name, code in directions.items():
+        if code:
+            first.setdefault(abs(code), name)
+    if len(first) > 1:
+        (a, na), (b, nb) = sorted(first.items())[:2]
+
+        def said(code: int) -> str:
+            return f"{'XYZ'[(code - 1) % 3]}{' rotation' if code > 3 else ''} (code {code})"
+
+        raise MeasuredDataError(path, f"channel {na!r} points along {said(a)} and channel {nb!r} "
+                                      f"along {said(b)}; a structural record is one planar "
+                                      "chain: expected every sensor and the force along one axis")
 
 
 def _check_read(path: Path, ds: Dataset, kind: str) -> None:
@@ -1131,6 +1162,7 @@ def _read_hdf5(path: Path) -> _Raw:
     _check_hdf5_size(path)
     check_hdf5_rate(path)
     check_hdf5_storage(path)
+    check_hdf5_declarations(path)
     ds = load_dataset(path)
     return _raw_from_dataset(path, ds)
 
@@ -1357,6 +1389,89 @@ def check_hdf5_storage(path: str | os.PathLike) -> None:
                 break
     if found:
         raise MeasuredDataError(path, found[0])
+
+
+#: The unit of a dataset file's ``positions`` attributes, the only one the reader takes
+#: (:meth:`Dataset.save` writes ``positions_unit = "m"``).
+POSITIONS_UNIT = "m"
+
+
+def check_hdf5_declarations(path: str | os.PathLike) -> None:
+    """Refuse a dataset file one of whose declarations the reader would not read as it says.
+
+    Round 24, each with the content hash made anew: an attribute on the ``/measured``,
+    ``/reference`` or ``/truth`` group itself (``fs = 1.0`` on ``/measured``; the writer puts
+    none there, the hash covers none, nothing reads it) was kept in silence;
+    ``positions_unit = "mm"`` (or ``"in"``, or a number) was read as metres, and a file whose
+    positions were in millimetres and said so was exported as metres; a ``unit`` or channel
+    name stored as fixed-length bytes (``np.bytes_``, as many HDF5 writers store text) was read
+    as the text ``"b'mM'"`` and refused for another reason ("expected b'mM'/s").  A file that
+    cannot be opened, or whose layout is not a dataset file's, is left to
+    :meth:`Dataset.load`.
+
+    Raises
+    ------
+    MeasuredDataError
+        Naming ``path``, the group or array, the attribute, its value and what is allowed.
+    """
+    import h5py
+
+    try:
+        h = h5py.File(path, "r")
+    except Exception:
+        return
+    with h:
+        for group in ("measured", "reference", "truth"):
+            g = h.get(group)
+            if not isinstance(g, h5py.Group):
+                continue
+            for key in g.attrs:
+                raise MeasuredDataError(path, f"/{group}: attribute {key!r} on the group itself "
+                                              "(read by nothing, outside the content hash); a "
+                                              f"dataset file's /{group} group carries no attribute")
+            if group == "truth":
+                continue
+            for name in g:
+                d = g.get(name)
+                if not isinstance(d, h5py.Dataset):
+                    continue
+                where = f"/{group}/{name}"
+                for key in ("unit", "positions_unit"):
+                    if key not in d.attrs:
+                        continue
+                    v = d.attrs[key]
+                    if not isinstance(v, str):
+                        raise MeasuredDataError(path, f"{where}: attribute {key}={_shown(v)} "
+                                                      f"({type(v).__name__}); expected a text "
+                                                      "(a variable-length UTF-8 string)")
+                    if key == "positions_unit" and v != POSITIONS_UNIT:
+                        raise MeasuredDataError(path, f"{where}: attribute positions_unit={v!r}; "
+                                                      f"expected {POSITIONS_UNIT!r} (positions are "
+                                                      "read in metres)")
+                for key in ("channels", "acts_on"):
+                    names = d.attrs.get(key)
+                    if key == "acts_on" and names is not None and not isinstance(names, np.ndarray):
+                        # an integer was "unreadable dataset file (TypeError: 'numpy.int64'
+                        # object is not iterable)", naming no attribute
+                        raise MeasuredDataError(path, f"{where}: attribute acts_on={_shown(names)} "
+                                                      f"({type(names).__name__}); expected a list "
+                                                      "of coordinate names, one per channel")
+                    if isinstance(names, np.ndarray) and names.dtype.kind in "OS":
+                        odd = next((c for c in names.ravel() if not isinstance(c, str)), None)
+                        if odd is not None:
+                            raise MeasuredDataError(path, f"{where}: name {_shown(odd)} "
+                                                          f"({type(odd).__name__}) in attribute "
+                                                          f"{key}; expected texts (variable-length "
+                                                          "UTF-8 strings)")
+
+
+def _shown(v: Any) -> str:
+    """An attribute's value for an error line: bytes and short arrays as Python writes them,
+    long ones cut."""
+    if isinstance(v, np.ndarray):
+        v = v.tolist()
+    text = repr(v.item() if isinstance(v, np.generic) else v)
+    return text if len(text) <= 80 else text[:77] + "..."
 
 
 def _check_hdf5_size(path: Path) -> None:
@@ -1624,6 +1739,7 @@ def _read_uff(path: Path) -> _Raw:
     if not any(int(t) == 58 for t in types):
         raise MeasuredDataError(path, "no UFF58 (function at nodal DOF) record")
     coords: dict[int, float] = {}
+    placed: dict[int, tuple[np.ndarray, str]] = {}
     raw = _Raw(path, "uff", None, {}, {})
     rates: dict[str, float] = {}
     for k, s in enumerate(sets):
@@ -1634,8 +1750,7 @@ def _read_uff(path: Path) -> _Raw:
                 raise MeasuredDataError(path, f"units record (164, code {s.get('units_code')}) is not SI: "
                                               f"length factor {factors[0]:g}, force factor {factors[1]:g}")
         elif kind in (15, 2411):
-            for node, x in zip(s["node_nums"], s["x"], strict=True):
-                coords[int(node)] = float(x)
+            _add_nodes(path, k, kind, s, coords, placed)
         elif kind == 58:
             name, rate = _uff58_channel(path, k, s, raw)
             rates[name] = rate
@@ -1644,6 +1759,52 @@ def _read_uff(path: Path) -> _Raw:
             raw.positions[name] = check_position(path, name, coords[node], f"node {node} x")
     raw.fs = _common_rate(path, rates, 1e-5)
     return raw
+
+
+#: Relative difference [-] within which two geometry records' coordinates of one node agree
+#: (relative to the node's largest coordinate): a UFF15 record writes them with 6 significant
+#: digits (E13.5, rounding within 5e-6 of the value), so a UFF15 and a UFF2411 record (16
+#: digits) of one node, or two UFF15 records each rounded, differ by up to 1e-5 of it.
+NODE_RTOL = 1e-5
+
+
+def _add_nodes(path: Path, k: int, kind: int, s: Mapping[str, Any], coords: dict[int, float],
+               placed: dict[int, tuple[np.ndarray, str]]) -> None:
+    """Add the nodes of one geometry record (UFF15 or UFF2411, the ``k``-th record) to
+    ``coords`` (node -> x [m]) and ``placed`` (node -> (x, y, z), where it was given).
+
+    Round 24: a node given twice at different places (twice in one UFF2411 record, in two
+    geometry records, by a UFF2411 and a UFF15 record) was read at the last place in silence,
+    and the sensor's position with it.  A node given twice at one place (within
+    :data:`NODE_RTOL`) is read once.
+
+    Raises
+    ------
+    MeasuredDataError
+        Naming the node, both places and the records that give them.
+    """
+    where = f"record {k + 1} (UFF{kind})"
+    xyz = np.column_stack([np.atleast_1d(np.asarray(s.get(c, np.zeros(len(s["node_nums"]))),
+                                                    dtype=float))
+                           for c in ("x", "y", "z")])
+    for node, at in zip(s["node_nums"], xyz, strict=True):
+        node = int(node)
+        if node in placed:
+            before, said = placed[node]
+            # relative to the node's distance from the origin: a coordinate written 0 in one
+            # record and 1e-17 in another is one place
+            scale = max(float(np.max(np.abs(at))), float(np.max(np.abs(before))))
+            if not np.all(np.abs(at - before) <= NODE_RTOL * scale):
+                def show(v: np.ndarray) -> str:
+                    return "(" + ", ".join(f"{c:.9g}" for c in v) + ")"
+
+                raise MeasuredDataError(path, f"node {node} is placed twice: at {show(before)} m by "
+                                              f"{said} and at {show(at)} m by {where}; expected one "
+                                              "place per node (coordinates within a relative "
+                                              f"{NODE_RTOL:g})")
+            continue
+        placed[node] = (at, where)
+        coords[node] = float(at[0])
 
 
 #: The block delimiter as pyuff finds it: ``    -1`` then a line end, the file's end, or blanks

@@ -55,7 +55,13 @@ from testbed.core.atomic import atomic_write, atomic_write_text
 from testbed.core.dataset import Dataset, Signal
 from testbed.core.errors import ArgumentError
 from testbed.core.truth import StructuralTruth
-from testbed.pipeline.importers import check_hdf5_rate, check_hdf5_storage, check_recorded, load_dataset
+from testbed.pipeline.importers import (
+    check_hdf5_declarations,
+    check_hdf5_rate,
+    check_hdf5_storage,
+    check_recorded,
+    load_dataset,
+)
 from testbed.pipeline.plugins import RIGS
 from testbed.pipeline.signal_chain import measure
 
@@ -414,6 +420,7 @@ def export_dataset(path: str | os.PathLike, fmt: str, out: str | os.PathLike | N
     path = Path(path)
     check_hdf5_rate(path)
     check_hdf5_storage(path)
+    check_hdf5_declarations(path)
     ds = load_dataset(path)  # naming a damaged array (round 22)
     check_recorded(ds, path)  # an edited, rehashed file: NaN rate or samples, cut channels
     if fmt == "uff":
