@@ -400,8 +400,8 @@ def make_library(spec: Any, data: Measurement) -> Library:
 
 
 def check_terms(params: dict[str, Any], n_channels: int, n_inputs: int, error: ErrorFn) -> None:
-    """``library`` and ``lhs`` against the data's shape: every term known, every ``lhs`` term in
-    the library (before data-dependent pruning)."""
+    """``library`` and ``lhs`` against the data's shape: every term known, each input held by a
+    term, every ``lhs`` term in the library (before data-dependent pruning)."""
     try:
         lib = library_for(params["library"], n_channels, n_inputs)
     except (ValueError, TypeError) as e:
@@ -413,6 +413,12 @@ def check_terms(params: dict[str, Any], n_channels: int, n_inputs: int, error: E
               f"a library of the data's {n_channels} coordinates and {n_inputs} inputs (a list of "
               f"terms, or 'generic'); its terms use {lib.n_coords} coordinates and "
               f"{lib.n_inputs} inputs")
+        return
+    bare = [k + 1 for k in range(n_inputs) if lib.input_columns(k).size == 0]
+    if bare:  # each input's own equation is selected (_implicit.select_models): none could hold it
+        error("library", params["library"],
+              f"a library with a term on each of the data's {n_inputs} inputs (every input gets "
+              f"its own implicit equation); no term holds {', '.join(f'u{k}' for k in bare)}")
         return
     if params.get("lhs") is None:
         return

@@ -237,3 +237,13 @@ def test_input_errors_score_a_passive_equations_admixture_as_the_inputs_own():
     ein = input_errors(sw, G_val, np.array([3]))
     assert ein[0, 0] == pytest.approx(ein[0, 1], rel=0.05)  # same misfit per unit of input
     assert select_models(sw, [np.array([3])], G_val=G_val) == [[(0, 1)]]
+
+
+def test_a_library_with_no_term_on_one_of_the_datas_inputs_is_refused_before_the_fit(pendulum):
+    # fuzz25 (c): a cart-pole's library on a two-input record (`identify fivebar.h5 --scenario
+    # cartpole`) ran the whole sweep to end in "no implicit model contains input 2": every input
+    # gets its own equation, so a library with no u2 term cannot fit; refused naming the input
+    lib = ["ddth1", "ddth2", "dth1", "dth2", "sin(th1)", "sin(th2)", "u1"]
+    said = r"'sindy_pi.library'.*each of the data's 2 inputs.*no term holds u2"
+    with pytest.raises(HyperparameterError, match=said):
+        SINDyPI(library=lib).fit(pendulum.data)
