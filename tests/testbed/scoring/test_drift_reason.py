@@ -1,9 +1,13 @@
 """A failed rollout bar missed only by a free coordinate's drift (testbed/scoring/scorers.py
 ``drift_failures``)."""
 
+from pathlib import Path
+
 import numpy as np
 
+from testbed.pipeline.scenario import load_scenario
 from testbed.scoring import metrics
+from testbed.scoring.run import run_scenario
 from testbed.scoring.scorers import FAIL, Scores, bar_failures, drift_failures, verdict
 from testbed.studies.statistics import failure_kind
 
@@ -57,3 +61,18 @@ def test_no_drift_where_the_error_is_no_quadratic_a_coordinate_is_held_or_the_la
     sc.failures["simulation"] = "diverged: ..."
     assert drift_failures(sc, BARS) == {}
     assert drift_failures(run(drift), {}) == {}  # no bar, no verdict to explain
+
+
+def test_the_one_kg_pole_of_round_24_misses_its_bar_by_the_carts_drift(dataset_cache):
+    """``round24/cp24_pole_m1`` at 1.5 % s151 (``sindy_pi``): the cart 0.0620 m against 0.0501,
+    the pole 0.0018 rad, law_error 0.0080; the cart's error +0.088 m at 10 s and 0.0030 m about
+    a quadratic in time.  No reason before (a failed bar alone); the verdict stays FAIL."""
+    root = Path(__file__).resolve().parents[3]
+    sc = load_scenario(root / "benchmarks" / "unseen" / "round24" / "cp24_pole_m1.toml")
+    r = run_scenario(sc.with_noise(1.5).replace(seed=151), cache=dataset_cache)
+    assert r.verdict == FAIL and r.scores.values["angle_rmse"] > 0.0501
+    assert r.scores.values["law_error"] < 0.25 and r.scores.details["free_coordinates"] == [0]
+    assert set(r.scores.failures) == {"drift"}
+    why = r.scores.failures["drift"]
+    assert why.startswith("drift: angle_rmse ") and "off the bar only x " in why
+    assert "; th " in why and why.endswith("within it")
