@@ -23,7 +23,7 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
-from testbed.scoring.equation_basis import evaluate_terms
+from testbed.scoring.equation_basis import evaluate_terms, term_plan
 
 #: States drawn in the record's box: the RMS error of 4096 draws has a sampling spread of about
 #: 1 / sqrt(2 x 4096) = 1.1 % of itself, far below any bar set on it.
@@ -263,3 +263,37 @@ def law_errors(id_names: Sequence[str], id_coef: np.ndarray, true_names: Sequenc
         # a coordinate the true law never accelerates in the box (0 / 0 was NaN, read as a
         # singular law): 0 where the identified law agrees, inf where it accelerates it
         return np.where(den > 0, num / den, np.where(num == 0, 0.0, np.where(np.isnan(num), num, np.inf)))
+
+
+def free_coordinates(names: Sequence[str], coef: np.ndarray, n: int) -> list[int]:
+    """The coordinates a law does not depend on, only on their rates and accelerations: no term
+    it uses holds the coordinate itself (``thk``, or ``sin`` / ``cos`` of an angle holding it).
+
+    Nothing restores such a coordinate (a cart on its rail): shifting it leaves every
+    acceleration unchanged, so a rollout integrates any error of its acceleration twice, with
+    nothing to pull it back (:func:`testbed.scoring.scorers.drift_failures`).
+
+    Parameters
+    ----------
+    names, coef : sequence of str, ndarray (n_equations, p)
+        The law's terms (:mod:`testbed.core.terms` syntax) and equations; a term with no
+        nonzero coefficient is not used.
+    n : int
+        Number of coordinates.
+
+    Returns
+    -------
+    list of int
+        0-based, ascending.
+    """
+    used = np.any(np.atleast_2d(np.asarray(coef, dtype=float)) != 0.0, axis=0)
+    held: set[int] = set()
+    for factors, u in zip(term_plan(tuple(names)), used, strict=True):
+        if not u:
+            continue
+        for spec, _ in factors:
+            if spec[0] in ("sin", "cos"):
+                held.update(i for i in spec[1:] if i is not None)
+            elif spec[1] == "th":
+                held.add(spec[2])
+    return [k for k in range(n) if k not in held]

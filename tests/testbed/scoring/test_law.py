@@ -6,7 +6,15 @@ import pytest
 from models.cartpole.equations import CartPoleParams, true_equations
 from testbed.pipeline.scenario import load_scenario
 from testbed.scoring.equation_basis import compare_equations, evaluate_terms
-from testbed.scoring.law import accelerations, law_error, law_errors, law_rollout, linear_split, state_box
+from testbed.scoring.law import (
+    accelerations,
+    free_coordinates,
+    law_error,
+    law_errors,
+    law_rollout,
+    linear_split,
+    state_box,
+)
 
 P = CartPoleParams(cart_mass=1.0, pole_mass=0.5, pole_length=0.6, cart_damping=0.1,
                    pole_damping=0.005, gravity=9.81)
@@ -161,3 +169,14 @@ def test_the_true_law_rolled_out_follows_the_engine_and_a_scaled_one_does_not(da
     assert x.shape == (2, 2, 2000)
     assert np.max(np.abs(x[0] - th)) < 1e-9
     assert np.max(np.abs(x[1] - th)) > 0.01
+
+
+def test_the_cart_is_the_true_laws_free_coordinate_and_the_pole_is_not():
+    """The cart-pole's true law holds the cart's rate and acceleration, never its position; the
+    pole's angle is in its sines and cosines.  A term with no coefficient does not count."""
+    names, coef, _ = true_equations(P)
+    assert free_coordinates(names, coef, 2) == [0]
+    held = np.hstack([coef, np.array([[0.0], [1.0]])])
+    assert free_coordinates([*names, "th1"], held, 2) == []
+    assert free_coordinates([*names, "th1"], np.hstack([coef, np.zeros((2, 1))]), 2) == [0]
+    assert free_coordinates(["sin(th1-th3)*ddth2"], np.array([[1.0]]), 3) == [1]
