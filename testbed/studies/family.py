@@ -296,12 +296,15 @@ def _check_spec(spec: Any, file: str, key: str) -> None:
         ok = ok and all(isinstance(a, int) and INT64_MIN <= a <= INT64_MAX for a in arg)
     if dist in ("log_uniform", "log_integers"):
         ok = ok and arg[0] > 0
+    if dist == "uniform":  # numpy draws lo + (hi - lo) u: a width beyond float64 overflowed
+        ok = ok and math.isfinite(float(arg[1]) - float(arg[0]))
     if not ok:
         raise ScenarioError(file, f"{key}.{dist}", arg,
                             "[lo, hi] with lo <= hi"
                             + (", integers within int64 (-2**63 to 2**63 - 1)"
                                if dist in ("integers", "log_integers") else "")
-                            + (", lo > 0" if dist in ("log_uniform", "log_integers") else ""))
+                            + (", lo > 0" if dist in ("log_uniform", "log_integers") else "")
+                            + (", hi - lo finite in float64" if dist == "uniform" else ""))
 
 
 def _check_cantilever_keys(fam: Family, file: str, key: str) -> None:

@@ -22,6 +22,7 @@ from testbed.studies.family import (
     MATERIALS,
     MIN_SEGMENTS_PER_MODE,
     MIN_SENSOR_GAP,
+    _check_spec,
     draw_member,
     eb_frequencies,
     family_of,
@@ -310,3 +311,11 @@ def test_failed_cells_line_tells_crashes_from_scored_failures():
     assert "--retry-failed" in line
     assert failed_cells_line(rows[:1]) is None
     assert "1 with another error" in failed_cells_line([{"status": "failed", "error": "odd"}])
+
+
+def test_a_uniform_range_whose_width_overflows_float64_is_refused_naming_it():
+    # fuzz25's famdraw: {uniform = [-1.7e308, 1.7e308]} (each end finite, the width inf) was an
+    # internal error (OverflowError, status 3) when numpy drew lo + (hi - lo) u
+    with pytest.raises(ScenarioError, match=r"'x0.uniform'.*hi - lo finite in float64"):
+        _check_spec({"uniform": [-1.7e308, 1.7e308]}, "f.toml", "x0")
+    _check_spec({"uniform": [-8e307, 8e307]}, "f.toml", "x0")  # a width float64 holds
