@@ -1739,7 +1739,7 @@ def _read_uff(path: Path) -> _Raw:
     if not any(int(t) == 58 for t in types):
         raise MeasuredDataError(path, "no UFF58 (function at nodal DOF) record")
     coords: dict[int, float] = {}
-    placed: dict[int, tuple[np.ndarray, str]] = {}
+    placed: dict[int, tuple[np.ndarray, str, int]] = {}
     raw = _Raw(path, "uff", None, {}, {})
     rates: dict[str, float] = {}
     for k, s in enumerate(sets):
@@ -1762,21 +1762,28 @@ def _read_uff(path: Path) -> _Raw:
 
 
 #: Relative difference [-] within which two geometry records' coordinates of one node agree
-#: (relative to the node's largest coordinate): a UFF15 record writes them with 6 significant
+#: (relative to the model's largest coordinate): a UFF15 record writes them with 6 significant
 #: digits (E13.5, rounding within 5e-6 of the value), so a UFF15 and a UFF2411 record (16
 #: digits) of one node, or two UFF15 records each rounded, differ by up to 1e-5 of it.
 NODE_RTOL = 1e-5
 
 
 def _add_nodes(path: Path, k: int, kind: int, s: Mapping[str, Any], coords: dict[int, float],
-               placed: dict[int, tuple[np.ndarray, str]]) -> None:
+               placed: dict[int, tuple[np.ndarray, str, int]]) -> None:
     """Add the nodes of one geometry record (UFF15 or UFF2411, the ``k``-th record) to
-    ``coords`` (node -> x [m]) and ``placed`` (node -> (x, y, z), where it was given).
+    ``coords`` (node -> x [m]) and ``placed`` (node -> ((x, y, z), where it was given, the
+    record's kind)).
 
     Round 24: a node given twice at different places (twice in one UFF2411 record, in two
     geometry records, by a UFF2411 and a UFF15 record) was read at the last place in silence,
     and the sensor's position with it.  A node given twice at one place (within
-    :data:`NODE_RTOL`) is read once.
+    :data:`NODE_RTOL` of the model's largest coordinate, over every node placed so far and
+    this record's) is read once, at its UFF2411 place where one record is a UFF2411 (16
+    digits) and the other a UFF15 (6 digits), whichever comes first.
+
+    Review 25a: the tolerance was relative to the node's own coordinates, so a node at the
+    origin written 0 in one record and -1.2e-16 in another (``L cos(pi/2)``) was refused as
+    placed twice; and a UFF15 record before a UFF2411 one gave its 6 digits.
 
     Raises
     ------
@@ -1787,23 +1794,24 @@ def _add_nodes(path: Path, k: int, kind: int, s: Mapping[str, Any], coords: dict
     xyz = np.column_stack([np.atleast_1d(np.asarray(s.get(c, np.zeros(len(s["node_nums"]))),
                                                     dtype=float))
                            for c in ("x", "y", "z")])
+    # the model's size [m]: its largest coordinate over the nodes placed so far and this record's
+    scale = max([float(np.max(np.abs(xyz), initial=0.0))]
+                + [float(np.max(np.abs(at))) for at, _, _ in placed.values()])
     for node, at in zip(s["node_nums"], xyz, strict=True):
         node = int(node)
         if node in placed:
-            before, said = placed[node]
-            # relative to the node's distance from the origin: a coordinate written 0 in one
-            # record and 1e-17 in another is one place
-            scale = max(float(np.max(np.abs(at))), float(np.max(np.abs(before))))
+            before, said, said_kind = placed[node]
             if not np.all(np.abs(at - before) <= NODE_RTOL * scale):
                 def show(v: np.ndarray) -> str:
                     return "(" + ", ".join(f"{c:.9g}" for c in v) + ")"
 
                 raise MeasuredDataError(path, f"node {node} is placed twice: at {show(before)} m by "
                                               f"{said} and at {show(at)} m by {where}; expected one "
-                                              "place per node (coordinates within a relative "
-                                              f"{NODE_RTOL:g})")
-            continue
-        placed[node] = (at, where)
+                                              "place per node (coordinates within "
+                                              f"{NODE_RTOL:g} of the model's largest, {scale:.6g} m)")
+            if not (kind == 2411 and said_kind == 15):
+                continue  # the first place stays, unless a UFF2411 record gives more digits
+        placed[node] = (at, where, kind)
         coords[node] = float(at[0])
 
 
