@@ -61,7 +61,7 @@ import numpy as np
 
 from testbed.core.budget import IDENTIFY_BYTES_PER_VALUE, IDENTIFY_TEXT_BUDGET_BYTES, IDENTIFY_VALUE_BUDGET
 from testbed.core.dataset import Dataset, DatasetError, Signal
-from testbed.core.errors import TestbedError, is_control, show_names
+from testbed.core.errors import TestbedError, is_control, show_names, show_value
 from testbed.core.measurement import MIN_FREE_SAMPLES, Measurement
 from testbed.core.rate_attrs import fs_attribute_problem, off_scenario_rate
 from testbed.numerics.clipping import Clipping, measured_clipping
@@ -441,7 +441,30 @@ def measurement_and_clipping(path: str | os.PathLike, kind: str,
         raise
     except ValueError as e:  # the chain's own checks: signal names, channel counts, positions
         raise MeasuredDataError(data.source, f"cannot run the {kind} signal chain: {e}; "
-                                             f"signals {show_names(ds.measured)}") from None
+                                             f"signals {show_names(ds.measured)}"
+                                             f"{_unnamed_hint(data) if groups is None else ''}") from None
+
+
+#: Where each format names a channel, for :func:`_unnamed_hint`.
+_NAMED_IN = {"uff": "in its UFF58 record's ID line 1 (a record without one is named "
+                    "node<node>:<direction>)",
+             "sep005": "as its SEP-005 name", "csv": "as its column's header",
+             "hdf5": "as its signal and channel"}
+
+
+def _unnamed_hint(data: ImportedData) -> str:
+    """A clause naming the channels that name no signal (no ``"/"``: each is a signal of its
+    own, which no chain reads) and how to name them, or "" where every channel names one.
+
+    fuzz25's open (d): a UFF file whose records have no ID line 1 (channels ``node1:3``, ...)
+    was refused "dataset has no measured signal 'acceleration' (has node1:3, ...)", naming no
+    way to say which record is which."""
+    unnamed = [n for n in data.signals if "/" not in n]
+    if not unnamed:
+        return ""
+    return (f"; channel(s) {show_names(unnamed)} name no signal: name each channel "
+            f"'<signal>/<channel>' (acceleration/acc1, force/hammer) "
+            f"{_NAMED_IN.get(data.format, '')}".rstrip())
 
 
 def _check_one_axis(path: Path, directions: Mapping[str, int]) -> None:
@@ -1162,9 +1185,7 @@ def _read_hdf5(path: Path) -> _Raw:
     _check_hdf5_size(path)
     check_hdf5_rate(path)
     check_hdf5_storage(path)
-    check_hdf5_declarations(path)
-    ds = load_dataset(path)
-    return _raw_from_dataset(path, ds)
+    return _raw_from_dataset(path, read_dataset_file(path))
 
 
 def unreadable_array(path: str | os.PathLike) -> str | None:
@@ -1391,23 +1412,52 @@ def check_hdf5_storage(path: str | os.PathLike) -> None:
         raise MeasuredDataError(path, found[0])
 
 
-#: The unit of a dataset file's ``positions`` attributes, the only one the reader takes
-#: (:meth:`Dataset.save` writes ``positions_unit = "m"``).
+#: The unit of a dataset file's ``positions`` attributes: :meth:`Dataset.save` writes
+#: ``positions_unit = "m"``; another length unit of :func:`si_unit` (``"mm"``) is read and
+#: its positions converted to it.
 POSITIONS_UNIT = "m"
 
 
-def check_hdf5_declarations(path: str | os.PathLike) -> None:
-    """Refuse a dataset file one of whose declarations the reader would not read as it says.
+def _attr_text(v: Any) -> str | None:
+    """An HDF5 attribute as the text it holds, or None: a text, fixed-length bytes (as many
+    HDF5 writers store text, decoded as UTF-8), or a one-element array of either."""
+    if isinstance(v, np.ndarray) and v.size == 1 and v.dtype.kind in "OSU":
+        v = v.reshape(-1)[0]
+    if isinstance(v, (bytes, np.bytes_)):
+        try:
+            return bytes(v).decode("utf-8")
+        except UnicodeDecodeError:
+            return None
+    return str(v) if isinstance(v, str) else None
+
+
+def _plain(v: Any) -> Any:
+    """A numpy attribute value as Python's (``1.0``, not ``np.float64(1.0)``), for
+    :func:`~testbed.core.errors.show_value`."""
+    return v.tolist() if isinstance(v, np.ndarray) else v.item() if isinstance(v, np.generic) else v
+
+
+def check_hdf5_declarations(path: str | os.PathLike) -> dict[tuple[str, str], tuple[str | None, float]]:
+    """Refuse a dataset file one of whose declarations the reader would not read as it says;
+    return how to read the others that :meth:`Dataset.load` reads otherwise.
 
     Round 24, each with the content hash made anew: an attribute on the ``/measured``,
     ``/reference`` or ``/truth`` group itself (``fs = 1.0`` on ``/measured``; the writer puts
     none there, the hash covers none, nothing reads it) was kept in silence;
-    ``positions_unit = "mm"`` (or ``"in"``, or a number) was read as metres, and a file whose
-    positions were in millimetres and said so was exported as metres; a ``unit`` or channel
-    name stored as fixed-length bytes (``np.bytes_``, as many HDF5 writers store text) was read
-    as the text ``"b'mM'"`` and refused for another reason ("expected b'mM'/s").  A file that
-    cannot be opened, or whose layout is not a dataset file's, is left to
-    :meth:`Dataset.load`.
+    ``positions_unit = "mm"`` was read as metres, and a file whose positions were in
+    millimetres and said so was exported as metres; a ``unit`` stored as fixed-length bytes
+    (``np.bytes_``, as many HDF5 writers store text) was read as the text ``"b'mM'"`` and
+    refused for another reason ("expected b'mM'/s").  Review 25a: those are valid spellings,
+    read as they say (:func:`apply_hdf5_declarations`): a ``unit`` or ``positions_unit`` of
+    bytes or a one-element text array is decoded, and positions in a length unit of
+    :func:`si_unit` are converted to metres.  A file that cannot be opened, or whose layout
+    is not a dataset file's, is left to :meth:`Dataset.load`.
+
+    Returns
+    -------
+    dict of (group, name) to (str or None, float)
+        For each signal read otherwise than :meth:`Dataset.load` does: its unit decoded (None:
+        as loaded) and the factor [m per positions unit] of its positions.
 
     Raises
     ------
@@ -1416,19 +1466,20 @@ def check_hdf5_declarations(path: str | os.PathLike) -> None:
     """
     import h5py
 
+    reads: dict[tuple[str, str], tuple[str | None, float]] = {}
     try:
         h = h5py.File(path, "r")
     except Exception:
-        return
+        return reads
     with h:
         for group in ("measured", "reference", "truth"):
             g = h.get(group)
             if not isinstance(g, h5py.Group):
                 continue
             for key in g.attrs:
-                raise MeasuredDataError(path, f"/{group}: attribute {key!r} on the group itself "
-                                              "(read by nothing, outside the content hash); a "
-                                              f"dataset file's /{group} group carries no attribute")
+                raise MeasuredDataError(path, f"/{group}: attribute {show_value(key)} on the group "
+                                              "itself (read by nothing, outside the content hash); "
+                                              f"a dataset file's /{group} group carries no attribute")
             if group == "truth":
                 continue
             for name in g:
@@ -1436,42 +1487,72 @@ def check_hdf5_declarations(path: str | os.PathLike) -> None:
                 if not isinstance(d, h5py.Dataset):
                     continue
                 where = f"/{group}/{name}"
+                unit, factor = None, 1.0
                 for key in ("unit", "positions_unit"):
                     if key not in d.attrs:
                         continue
                     v = d.attrs[key]
-                    if not isinstance(v, str):
-                        raise MeasuredDataError(path, f"{where}: attribute {key}={_shown(v)} "
+                    text = _attr_text(v)
+                    if text is None:
+                        raise MeasuredDataError(path, f"{where}: attribute {key}={show_value(_plain(v))} "
                                                       f"({type(v).__name__}); expected a text "
-                                                      "(a variable-length UTF-8 string)")
-                    if key == "positions_unit" and v != POSITIONS_UNIT:
-                        raise MeasuredDataError(path, f"{where}: attribute positions_unit={v!r}; "
-                                                      f"expected {POSITIONS_UNIT!r} (positions are "
-                                                      "read in metres)")
+                                                      "(a UTF-8 string, or its bytes)")
+                    if key == "unit" and not isinstance(v, str):
+                        unit = text
+                    if key == "positions_unit" and text != POSITIONS_UNIT:
+                        si, factor = si_unit(text)
+                        if si != POSITIONS_UNIT:
+                            raise MeasuredDataError(path, f"{where}: attribute positions_unit="
+                                                          f"{show_value(text)}; expected a length "
+                                                          f"unit ({POSITIONS_UNIT!r}, 'mm')")
+                if unit is not None or factor != 1.0:
+                    reads[(group, name)] = (unit, factor)
                 for key in ("channels", "acts_on"):
                     names = d.attrs.get(key)
                     if key == "acts_on" and names is not None and not isinstance(names, np.ndarray):
                         # an integer was "unreadable dataset file (TypeError: 'numpy.int64'
                         # object is not iterable)", naming no attribute
-                        raise MeasuredDataError(path, f"{where}: attribute acts_on={_shown(names)} "
+                        raise MeasuredDataError(path, f"{where}: attribute acts_on="
+                                                      f"{show_value(_plain(names))} "
                                                       f"({type(names).__name__}); expected a list "
                                                       "of coordinate names, one per channel")
                     if isinstance(names, np.ndarray) and names.dtype.kind in "OS":
                         odd = next((c for c in names.ravel() if not isinstance(c, str)), None)
                         if odd is not None:
-                            raise MeasuredDataError(path, f"{where}: name {_shown(odd)} "
+                            raise MeasuredDataError(path, f"{where}: name {show_value(_plain(odd))} "
                                                           f"({type(odd).__name__}) in attribute "
                                                           f"{key}; expected texts (variable-length "
                                                           "UTF-8 strings)")
+    return reads
 
 
-def _shown(v: Any) -> str:
-    """An attribute's value for an error line: bytes and short arrays as Python writes them,
-    long ones cut."""
-    if isinstance(v, np.ndarray):
-        v = v.tolist()
-    text = repr(v.item() if isinstance(v, np.generic) else v)
-    return text if len(text) <= 80 else text[:77] + "..."
+def apply_hdf5_declarations(ds: Dataset, reads: Mapping[tuple[str, str], tuple[str | None, float]]
+                            ) -> Dataset:
+    """``ds`` with its signals read as their file declares (:func:`check_hdf5_declarations`):
+    each listed signal's unit decoded and its positions converted to metres.  The content hash
+    in ``ds.attrs`` stays the file's (it names the file read)."""
+    for (group, name), (unit, factor) in reads.items():
+        signals = ds.measured if group == "measured" else ds.reference
+        s = signals.get(name)
+        if s is None:
+            continue
+        if unit is not None:
+            s.unit = unit
+        if s.positions is not None:
+            s.positions = s.positions * factor
+    return ds
+
+
+def read_dataset_file(path: str | os.PathLike) -> Dataset:
+    """A dataset file read as it declares: :func:`check_hdf5_declarations`,
+    :func:`load_dataset` (content hash verified), :func:`apply_hdf5_declarations`.
+
+    Raises
+    ------
+    MeasuredDataError
+    """
+    reads = check_hdf5_declarations(path)
+    return apply_hdf5_declarations(load_dataset(path), reads)
 
 
 def _check_hdf5_size(path: Path) -> None:

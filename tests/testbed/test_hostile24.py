@@ -128,6 +128,17 @@ def test_a_node_placed_at_two_places_is_refused(tmp_path, geometry, node, record
         read_measured(_uff(tmp_path, geometry))
 
 
+def test_a_uff_without_id_line_1_is_refused_saying_how_to_name_its_channels(tmp_path):
+    """fuzz25's open (d): records without ID line 1 (channels named node1:3, ...) were refused
+    "dataset has no measured signal 'acceleration' (has node1:3, ...)" naming no way out."""
+    path = tmp_path / "beam.uff"
+    sets = [_geometry(2411, X), *({**_response(k), "id1": ""} for k in (1, 2, 3))]
+    pyuff.UFF(str(path)).write_sets(sets, mode="add")
+    with pytest.raises(MeasuredDataError, match=r"channel\(s\) node1:3, node2:3, node3:3 name no signal: "
+                                                r"name each channel '<signal>/<channel>' .* ID line 1"):
+        measurement_from_file(path, "structural")
+
+
 # ------------------------------------------------------------------ one axis for a structural record
 
 def _sep005(directions: list[str]) -> list[dict]:
@@ -147,11 +158,26 @@ def test_a_structural_record_along_two_axes_is_refused(tmp_path):
         measurement_from_file(path, "structural")
 
 
-def test_mixed_axes_are_read_where_the_kind_allows_them():
-    """The rule is the structural kind's: the reader keeps each channel's axis (a cart's
-    translation beside its pole's rotation is a mechanical record)."""
-    data = from_sep005(_sep005(["+Z", "+Y", "+Z"]))
-    assert data.directions == {"acceleration/acc1": 3, "acceleration/acc2": 2, "acceleration/acc3": 3}
+@pytest.fixture(scope="module")
+def cartpole_sep005(tmp_path_factory) -> Path:
+    """A cart-pole record exported as SEP-005: the cart's channels +Z (code 3), the pole's
+    +Z rotation (code 6)."""
+    from testbed import cli
+
+    d = tmp_path_factory.mktemp("cartpole")
+    assert cli.main(["generate", "cartpole", "-o", str(d / "cp.h5"), "--cache", str(d / "c")]) == 0
+    [out] = export_dataset(d / "cp.h5", "sep005", d / "cp.json")
+    return out
+
+
+def test_mixed_axes_are_read_where_the_kind_allows_them(cartpole_sep005):
+    """The rule is the structural kind's: a cart's translation beside its pole's rotation is a
+    mechanical record, read through the mechanical chain (review 25a: the test called only
+    the reader, so it would pass with the one-axis check applied to every kind)."""
+    data = from_sep005(json.loads(cartpole_sep005.read_text()))
+    assert {abs(c) for c in data.directions.values()} == {3, 6}  # two axes, as the test needs
+    m = measurement_from_file(cartpole_sep005, "mechanical")
+    assert m.channels == ("x", "th") and m.x.shape[0] == 2
 
 
 # ------------------------------------------------------------------ dataset files' declarations
@@ -189,17 +215,19 @@ def _attrs(where: str, **attrs):
     (_attrs("measured", fs=1.0), r"/measured: attribute 'fs' on the group itself"),
     (_attrs("truth", unit="mM"), r"/truth: attribute 'unit' on the group itself"),
     (_attrs("reference", scale=2.0), r"/reference: attribute 'scale' on the group itself"),
-    (_attrs("measured/x", positions=np.array([100.0]), positions_unit="mm"),
-     r"/measured/x: attribute positions_unit='mm'; expected 'm'"),
+    (_attrs("measured/x", positions=np.array([100.0]), positions_unit="in"),
+     r"/measured/x: attribute positions_unit='in'; expected a length unit"),
+    (_attrs("measured/x", positions=np.array([100.0]), positions_unit="rad"),
+     r"/measured/x: attribute positions_unit='rad'; expected a length unit"),
     (_attrs("measured/x", positions=np.array([0.1]), positions_unit=1.0),
      r"/measured/x: attribute positions_unit=1\.0 \(float64\); expected a text"),
-    (_attrs("measured/x", unit=np.bytes_(b"mM")),
-     r"/measured/x: attribute unit=b'mM' \(bytes_\); expected a text"),
+    (_attrs("measured/x", unit=np.bytes_(b"\xff")),
+     r"/measured/x: attribute unit=b'\\xff' \(bytes_\); expected a text"),
     (_attrs("measured/x", channels=np.array([b"x"], dtype="S1")),
      r"/measured/x: name b'x' \(bytes_\) in attribute channels"),
     (_attrs("measured/x", acts_on=3), r"/measured/x: attribute acts_on=3 \(int64\); expected a list"),
-], ids=["measured-group", "truth-group", "reference-group", "positions-mm", "positions-unit-number",
-        "unit-bytes", "channel-bytes", "acts-on-integer"])
+], ids=["measured-group", "truth-group", "reference-group", "positions-in", "positions-rad",
+        "positions-unit-number", "unit-not-utf8", "channel-bytes", "acts-on-integer"])
 def test_a_declaration_the_reader_would_not_read_as_it_says_is_refused(mm_file, tmp_path, edit, said):
     """Round 24 (content hash made anew): a group's attribute was kept in silence, positions in
     mm read as metres (export wrote them so), a unit stored as fixed-length bytes read as the
@@ -211,10 +239,47 @@ def test_a_declaration_the_reader_would_not_read_as_it_says_is_refused(mm_file, 
         export_dataset(path, "sep005", tmp_path / "out.json")
 
 
+@pytest.mark.parametrize("edit", [_attrs("measured", **{"a" * 5000: 1.0}),
+                                  _attrs("measured/x", positions=np.array([0.1]), positions_unit="q" * 5000)],
+                         ids=["group-attribute-name", "positions-unit"])
+def test_a_long_declaration_is_cut_in_the_message(mm_file, tmp_path, edit):
+    """Review 25a: the group's attribute name and positions_unit's value went uncut into the
+    line (show_value's cut now, as everywhere)."""
+    path = _edited(mm_file, tmp_path / "long.h5", edit)
+    with pytest.raises(MeasuredDataError) as e:
+        read_measured(path)
+    assert len(str(e.value)) < 600 and "..." in str(e.value), str(e.value)[:300]
+
+
 def test_positions_in_metres_still_read(mm_file, tmp_path):
     path = _edited(mm_file, tmp_path / "m.h5",
                    _attrs("measured/x", positions=np.array([0.1]), positions_unit="m"))
     assert read_measured(path).positions == {"x/x": 0.1}
+
+
+@pytest.mark.parametrize("unit", ["mm", np.bytes_(b"mm"), np.array(["mm"], dtype=h5py.string_dtype())],
+                         ids=["text", "bytes", "one-element-array"])
+def test_positions_in_millimetres_are_read_in_metres(mm_file, tmp_path, unit):
+    """Review 25a: `positions_unit = "mm"` (a length unit si_unit knows) was refused; it is
+    read, and exported, as metres (100 mm = 0.1 m; 1e-3 is exact to a rounding of 0.1)."""
+    path = _edited(mm_file, tmp_path / "mm.h5",
+                   _attrs("measured/x", positions=np.array([100.0]), positions_unit=unit))
+    assert read_measured(path).positions == {"x/x": 100.0 * 1e-3}
+    [out] = export_dataset(path, "sep005", tmp_path / "out.json")
+    [x] = [c for c in json.loads(out.read_text()) if c["name"] == "x/x"]
+    assert x["position_m"] == 100.0 * 1e-3
+
+
+@pytest.mark.parametrize("unit", [np.bytes_(b"mM"), np.array(["mM"], dtype=h5py.string_dtype()),
+                                  np.array([b"mM"], dtype="S2")],
+                         ids=["bytes", "one-element-text", "one-element-bytes"])
+def test_a_unit_stored_as_bytes_or_in_a_one_element_array_is_decoded(mm_file, tmp_path, unit):
+    """Review 25a: a `unit` of fixed-length bytes (as many HDF5 writers store text) was refused
+    (and before round 24 read as the text "b'mM'"); it is decoded, here to the file's own mM."""
+    path = _edited(mm_file, tmp_path / "u.h5", _attrs("measured/x", unit=unit))
+    data = read_measured(path)
+    assert data.signals["x/x"][0] == "mM"
+    assert measurement_from_file(path, "dynamical") is not None
 
 
 # ------------------------------------------------------------------ run.npz
