@@ -445,26 +445,23 @@ def measurement_and_clipping(path: str | os.PathLike, kind: str,
                                              f"{_unnamed_hint(data) if groups is None else ''}") from None
 
 
-#: Where each format names a channel, for :func:`_unnamed_hint`.
-_NAMED_IN = {"uff": "in its UFF58 record's ID line 1 (a record without one is named "
-                    "node<node>:<direction>)",
-             "sep005": "as its SEP-005 name", "csv": "as its column's header",
-             "hdf5": "as its signal and channel"}
+#: A UFF58 record's channel name where its ID line 1 is empty: node and direction code.
+_UFF_NODE_NAME = re.compile(r"node-?\d+:-?\d+(#\d+)?")
 
 
 def _unnamed_hint(data: ImportedData) -> str:
-    """A clause naming the channels that name no signal (no ``"/"``: each is a signal of its
-    own, which no chain reads) and how to name them, or "" where every channel names one.
+    """A clause saying how to name the channels of UFF58 records without ID line 1 (named by
+    the reader ``node<node>:<direction>``: a signal of its own each, which no chain reads), or
+    "" where there is none.  Other formats' names without ``"/"`` are signals (a kinetics
+    CSV's columns ``x``, ``dx``).
 
-    fuzz25's open (d): a UFF file whose records have no ID line 1 (channels ``node1:3``, ...)
-    was refused "dataset has no measured signal 'acceleration' (has node1:3, ...)", naming no
-    way to say which record is which."""
-    unnamed = [n for n in data.signals if "/" not in n]
+    fuzz25's open (d): such a file was refused "dataset has no measured signal 'acceleration'
+    (has node1:3, ...)", naming no way to say which record is which."""
+    unnamed = [n for n in data.signals if _UFF_NODE_NAME.fullmatch(n)] if data.format == "uff" else []
     if not unnamed:
         return ""
-    return (f"; channel(s) {show_names(unnamed)} name no signal: name each channel "
-            f"'<signal>/<channel>' (acceleration/acc1, force/hammer) "
-            f"{_NAMED_IN.get(data.format, '')}".rstrip())
+    return (f"; {len(unnamed)} UFF58 record(s) have no ID line 1 (named node<node>:<direction>): "
+            "write each channel's '<signal>/<channel>' there (acceleration/acc1, force/hammer)")
 
 
 def _check_one_axis(path: Path, directions: Mapping[str, int]) -> None:

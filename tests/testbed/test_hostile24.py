@@ -134,8 +134,9 @@ def test_a_uff_without_id_line_1_is_refused_saying_how_to_name_its_channels(tmp_
     path = tmp_path / "beam.uff"
     sets = [_geometry(2411, X), *({**_response(k), "id1": ""} for k in (1, 2, 3))]
     pyuff.UFF(str(path)).write_sets(sets, mode="add")
-    with pytest.raises(MeasuredDataError, match=r"channel\(s\) node1:3, node2:3, node3:3 name no signal: "
-                                                r"name each channel '<signal>/<channel>' .* ID line 1"):
+    with pytest.raises(MeasuredDataError, match=r"has node1:3, .*; 3 UFF58 record\(s\) have no ID line 1 "
+                                                r"\(named node<node>:<direction>\): write each "
+                                                r"channel's '<signal>/<channel>' there"):
         measurement_from_file(path, "structural")
 
 
