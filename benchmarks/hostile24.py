@@ -198,6 +198,17 @@ def uffmix_cases(work: Path) -> list[tuple[str, object]]:
     def of_type(sets, t):
         return [s for s in sets if s["type"] == t]
 
+    def origin_noise(sets):
+        """The clamp's node (one past the sensors', no record's) added at the origin, and a
+        UFF2411 twin of the geometry placing it at z = -1.2e-16 m."""
+        [g] = [s for s in sets if s["type"] in (15, 2411)][:1]
+        clamp = int(np.max(g["node_nums"])) + 1
+        for k in ("node_nums", "def_cs", "disp_cs", "color", "x", "y", "z"):
+            g[k] = np.append(g[k], clamp if k == "node_nums" else 0.0 if k in "xyz" else g[k][0])
+        twin = {k: (np.array(v, copy=True) if isinstance(v, np.ndarray) else v) for k, v in g.items()}
+        twin["type"], twin["z"][-1] = 2411, -1.2e-16
+        sets.insert(sets.index(g) + 1, twin)
+
     def geometry(sets):
         return of_type(sets, 2411)[0]
 
@@ -348,6 +359,8 @@ def uffmix_cases(work: Path) -> list[tuple[str, object]]:
                        for s in of_type(sets, 58)], "verdict"),
         ("every ID line 1 empty (channels named by node)",
          lambda sets: [s.__setitem__("id1", "") for s in of_type(sets, 58)], "verdict"),
+        # review 25a: a node at the origin written 0 and -1.2e-16 (L cos(pi/2)) is one place
+        ("a UFF2411 twin with float noise at the origin node", origin_noise, "same"),
         ("one sensor without a direction beside +Z ones", direction(1, 0), "verdict"),
         ("one sensor's node 0 (no node)", lambda sets: of_type(sets, 58)[1].__setitem__("rsp_node", 0),
          "refuse"),
@@ -438,7 +451,21 @@ def h5meta_cases(work: Path) -> list[tuple[str, object]]:
             else:
                 got = cli_inprocess(["export", str(path), "--format", "sep005",
                                      "-o", str(path.with_suffix(".json"))])
-            return judged(*got, refuse=expect == "refuse")
+            found = judged(*got, refuse=expect == "refuse")
+            if found or expect not in ("metres", "read"):
+                return found
+            # review 25a: a valid spelling is read (positions declared in mm in metres)
+            if got[0] == 2:
+                return f"refused a valid declaration: {got[2].strip()[:200]!r}"
+            if command == "export":
+                with h5py.File(src, "r") as f:
+                    want = np.asarray(f["measured/acceleration"].attrs["positions"], float)
+                read = [c["position_m"] for c in json.loads(path.with_suffix(".json").read_text())
+                        if c["name"].startswith("acceleration/")]
+                # x 1000 then x 1e-3: a rounding of each (2 ulp)
+                if not np.allclose(read, want, rtol=4e-16, atol=0):
+                    return f"exported positions {read} m, the source's {want.tolist()} m"
+            return None
         return run
 
     def attr(where: str, key: str, value):
@@ -451,6 +478,10 @@ def h5meta_cases(work: Path) -> list[tuple[str, object]]:
         d.attrs["positions"] = np.asarray(d.attrs["positions"]) * 1000
         d.attrs["positions_unit"] = "mm"
 
+    def mm_positions_bytes(f):
+        mm_positions(f)
+        f["measured/acceleration"].attrs["positions_unit"] = np.bytes_(b"mm")
+
     acc = "measured/acceleration"
     text = h5py.string_dtype()
     cases = []
@@ -462,13 +493,16 @@ def h5meta_cases(work: Path) -> list[tuple[str, object]]:
              "refuse", cmd),
             (f"an attribute on the /reference group ({cmd})", MM, attr("reference", "scale", 2.0),
              "refuse", cmd),
+            # review 25a: a length unit is read as it says (positions 1000 x closer: a verdict)
             (f"positions_unit 'mm', positions unchanged ({cmd})", LAB, attr(acc, "positions_unit", "mm"),
-             "refuse", cmd),
+             "verdict", cmd),
             (f"positions_unit 'in' ({cmd})", LAB, attr(acc, "positions_unit", "in"), "refuse", cmd),
             (f"positions_unit a number ({cmd})", LAB, attr(acc, "positions_unit", 1.0), "refuse", cmd),
             (f"positions_unit an array ({cmd})", LAB,
              attr(acc, "positions_unit", np.array(["m", "m"], dtype=text)), "refuse", cmd),
-            (f"positions in mm declared 'mm' ({cmd})", LAB, mm_positions, "refuse", cmd),
+            (f"positions in mm declared 'mm' ({cmd})", LAB, mm_positions, "metres", cmd),
+            (f"positions in mm declared 'mm' as fixed-length bytes ({cmd})", LAB,
+             mm_positions_bytes, "metres", cmd),
             (f"positions_unit 'm' on a signal without positions ({cmd})", MM,
              attr("measured/x", "positions_unit", "m"), "verdict", cmd),
             (f"a channel name as fixed-length bytes ({cmd})", MM,
@@ -479,8 +513,12 @@ def h5meta_cases(work: Path) -> list[tuple[str, object]]:
     cases += [
         ("layout a one-item list (identify)", MM,
          attr("measured/x", "layout", np.array(["channels x samples"], dtype=text)), "verdict"),
+        # review 25a: valid spellings of a text, decoded
         ("unit as fixed-length bytes (identify)", MM, attr("measured/x", "unit", np.bytes_(b"mM")),
-         "refuse"),
+         "read"),
+        ("unit a one-item text array (identify)", MM,
+         attr("measured/x", "unit", np.array(["mM"], dtype=text)), "read"),
+        ("unit not UTF-8 bytes (identify)", MM, attr("measured/x", "unit", np.bytes_(b"\xff")), "refuse"),
         ("acts_on an integer (identify)", "cartpole", attr("measured/torque", "acts_on", 3), "refuse"),
     ]
     out = [(f"h5meta {label}", case(label, sc, edit, expect, command))
@@ -649,8 +687,9 @@ def npzform_cases(work: Path) -> list[tuple[str, object]]:
         with np.load(run / "run.npz", allow_pickle=False) as z:
             return {k: z[k] for k in z.files}
 
-    def case(label: str, make, expect: str):
-        """``make(arrays, marker) -> bytes`` of the new run.npz; ``expect`` "refuse" or "same"."""
+    def case(label: str, make, expect: str, said: str = ""):
+        """``make(arrays, marker) -> bytes`` of the new run.npz; ``expect`` "refuse" or "same";
+        ``said``: text the refusal must hold."""
         def run():
             src = base_run()
             folder = work / "cases" / _safe(label)
@@ -666,6 +705,8 @@ def npzform_cases(work: Path) -> list[tuple[str, object]]:
             found = judged(status, out, err, refuse=expect == "refuse")
             if found:
                 return f"report: {found}"
+            if said and said not in err:
+                return f"report refused without naming {said!r}: {err.strip()[-200:]!r}"
             if expect == "same" and status != 0:
                 return f"report refused an equivalent run.npz: {err.strip()[:200]!r}"
             status, out, err = cli_inprocess(["runs", "ls", "-o", str(folder), "--plain"])
@@ -755,8 +796,14 @@ def npzform_cases(work: Path) -> list[tuple[str, object]]:
             "details/extra", np.array([b"x"]))), "refuse"),
         ("run.npz a text file", lambda a, m: b"not a zip\n", "refuse"),
         ("a .npy file under the name run.npz", npy_not_npz, "refuse"),
+        # review 25a: zipfile finds a zip by its end, numpy.load by its first bytes
+        # (before: "not a run folder written by `testbed run` (TypeError)", naming nothing)
+        ("a .npy with the run's zip appended", lambda a, m: npy_not_npz(a, m) + saved(a), "refuse",
+         "run.npz: starts with the bytes"),
+        ("a pickle with the run's zip appended", lambda a, m: whole_pickle(a, m) + saved(a), "refuse",
+         "run.npz: starts with the bytes"),
     ]
-    return [(f"npzform {label}", case(label, make, expect)) for label, make, expect in cases]
+    return [(f"npzform {label}", case(label, *how)) for label, *how in cases]
 
 
 # ------------------------------------------------------------------ rigedge
@@ -913,6 +960,9 @@ def cliunits_cases(work: Path) -> list[tuple[str, object]]:
         ("an empty channel", beam, ["--units", "=m/s^2"], "refuse"),
         ("an empty unit", beam, ["--units", f"{a1}="], "refuse", "--units"),
         ("an empty unit for every channel", beam, ["--units", ""], "refuse", "--units"),
+        # review 25a: blank after TOML parsing
+        ("an empty quoted unit", beam, ["--units", f'{a1}=""'], "refuse", "--units"),
+        ("a blank quoted unit", beam, ["--units", f"{a1}=' '"], "refuse", "--units"),
         ("blanks around =", beam, ["--units", f"{a1} = m/s^2"], "verdict"),
         ("a channel without its signal's name", beam, ["--units", "acc1=m/s^2"], "refuse"),
         ("the force in m/s^2", beam, ["--units", "force/force=m/s^2"], "refuse"),

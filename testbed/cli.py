@@ -874,6 +874,13 @@ def cmd_identify(args: argparse.Namespace) -> int:
         if isinstance(units, str) and not units.strip():
             raise InputError(f"--units {show_value(units)}: no unit; expected a unit for every "
                              "channel (--units g) or CHANNEL=UNIT")
+        # after TOML parsing (review 25a): `x/x=""` is an empty text and `x/x=' '` a blank one,
+        # which the raw text's check above let through to "channel ... has no unit"
+        for name, unit in (units.items() if isinstance(units, dict) else ()):
+            if isinstance(unit, str) and not unit.strip():
+                raise InputError(f"--units {show_value(name)[1:-1]}={show_value(unit)}: no unit for channel "
+                                 f"{show_value(name)}; expected CHANNEL=UNIT (--units "
+                                 "acceleration/acc1=g)")
     data = _existing_file(Path(args.data), "a measured-data file (UFF58, SEP-005 JSON, CSV or HDF5)")
     # nor the --scenario file or a plugin (-o s.toml replaced the scenario: round 17)
     read: list[str] = []

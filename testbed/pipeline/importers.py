@@ -61,7 +61,7 @@ import numpy as np
 
 from testbed.core.budget import IDENTIFY_BYTES_PER_VALUE, IDENTIFY_TEXT_BUDGET_BYTES, IDENTIFY_VALUE_BUDGET
 from testbed.core.dataset import Dataset, DatasetError, Signal
-from testbed.core.errors import TestbedError, is_control, show_names
+from testbed.core.errors import TestbedError, is_control, show_names, show_value
 from testbed.core.measurement import MIN_FREE_SAMPLES, Measurement
 from testbed.core.rate_attrs import fs_attribute_problem, off_scenario_rate
 from testbed.numerics.clipping import Clipping, measured_clipping
@@ -441,7 +441,27 @@ def measurement_and_clipping(path: str | os.PathLike, kind: str,
         raise
     except ValueError as e:  # the chain's own checks: signal names, channel counts, positions
         raise MeasuredDataError(data.source, f"cannot run the {kind} signal chain: {e}; "
-                                             f"signals {show_names(ds.measured)}") from None
+                                             f"signals {show_names(ds.measured)}"
+                                             f"{_unnamed_hint(data) if groups is None else ''}") from None
+
+
+#: A UFF58 record's channel name where its ID line 1 is empty: node and direction code.
+_UFF_NODE_NAME = re.compile(r"node-?\d+:-?\d+(#\d+)?")
+
+
+def _unnamed_hint(data: ImportedData) -> str:
+    """A clause saying how to name the channels of UFF58 records without ID line 1 (named by
+    the reader ``node<node>:<direction>``: a signal of its own each, which no chain reads), or
+    "" where there is none.  Other formats' names without ``"/"`` are signals (a kinetics
+    CSV's columns ``x``, ``dx``).
+
+    fuzz25's open (d): such a file was refused "dataset has no measured signal 'acceleration'
+    (has node1:3, ...)", naming no way to say which record is which."""
+    unnamed = [n for n in data.signals if _UFF_NODE_NAME.fullmatch(n)] if data.format == "uff" else []
+    if not unnamed:
+        return ""
+    return (f"; {len(unnamed)} UFF58 record(s) have no ID line 1 (named node<node>:<direction>): "
+            "write each channel's '<signal>/<channel>' there (acceleration/acc1, force/hammer)")
 
 
 def _check_one_axis(path: Path, directions: Mapping[str, int]) -> None:
@@ -1162,9 +1182,7 @@ def _read_hdf5(path: Path) -> _Raw:
     _check_hdf5_size(path)
     check_hdf5_rate(path)
     check_hdf5_storage(path)
-    check_hdf5_declarations(path)
-    ds = load_dataset(path)
-    return _raw_from_dataset(path, ds)
+    return _raw_from_dataset(path, read_dataset_file(path))
 
 
 def unreadable_array(path: str | os.PathLike) -> str | None:
@@ -1391,23 +1409,52 @@ def check_hdf5_storage(path: str | os.PathLike) -> None:
         raise MeasuredDataError(path, found[0])
 
 
-#: The unit of a dataset file's ``positions`` attributes, the only one the reader takes
-#: (:meth:`Dataset.save` writes ``positions_unit = "m"``).
+#: The unit of a dataset file's ``positions`` attributes: :meth:`Dataset.save` writes
+#: ``positions_unit = "m"``; another length unit of :func:`si_unit` (``"mm"``) is read and
+#: its positions converted to it.
 POSITIONS_UNIT = "m"
 
 
-def check_hdf5_declarations(path: str | os.PathLike) -> None:
-    """Refuse a dataset file one of whose declarations the reader would not read as it says.
+def _attr_text(v: Any) -> str | None:
+    """An HDF5 attribute as the text it holds, or None: a text, fixed-length bytes (as many
+    HDF5 writers store text, decoded as UTF-8), or a one-element array of either."""
+    if isinstance(v, np.ndarray) and v.size == 1 and v.dtype.kind in "OSU":
+        v = v.reshape(-1)[0]
+    if isinstance(v, (bytes, np.bytes_)):
+        try:
+            return bytes(v).decode("utf-8")
+        except UnicodeDecodeError:
+            return None
+    return str(v) if isinstance(v, str) else None
+
+
+def _plain(v: Any) -> Any:
+    """A numpy attribute value as Python's (``1.0``, not ``np.float64(1.0)``), for
+    :func:`~testbed.core.errors.show_value`."""
+    return v.tolist() if isinstance(v, np.ndarray) else v.item() if isinstance(v, np.generic) else v
+
+
+def check_hdf5_declarations(path: str | os.PathLike) -> dict[tuple[str, str], tuple[str | None, float]]:
+    """Refuse a dataset file one of whose declarations the reader would not read as it says;
+    return how to read the others that :meth:`Dataset.load` reads otherwise.
 
     Round 24, each with the content hash made anew: an attribute on the ``/measured``,
     ``/reference`` or ``/truth`` group itself (``fs = 1.0`` on ``/measured``; the writer puts
     none there, the hash covers none, nothing reads it) was kept in silence;
-    ``positions_unit = "mm"`` (or ``"in"``, or a number) was read as metres, and a file whose
-    positions were in millimetres and said so was exported as metres; a ``unit`` or channel
-    name stored as fixed-length bytes (``np.bytes_``, as many HDF5 writers store text) was read
-    as the text ``"b'mM'"`` and refused for another reason ("expected b'mM'/s").  A file that
-    cannot be opened, or whose layout is not a dataset file's, is left to
-    :meth:`Dataset.load`.
+    ``positions_unit = "mm"`` was read as metres, and a file whose positions were in
+    millimetres and said so was exported as metres; a ``unit`` stored as fixed-length bytes
+    (``np.bytes_``, as many HDF5 writers store text) was read as the text ``"b'mM'"`` and
+    refused for another reason ("expected b'mM'/s").  Review 25a: those are valid spellings,
+    read as they say (:func:`apply_hdf5_declarations`): a ``unit`` or ``positions_unit`` of
+    bytes or a one-element text array is decoded, and positions in a length unit of
+    :func:`si_unit` are converted to metres.  A file that cannot be opened, or whose layout
+    is not a dataset file's, is left to :meth:`Dataset.load`.
+
+    Returns
+    -------
+    dict of (group, name) to (str or None, float)
+        For each signal read otherwise than :meth:`Dataset.load` does: its unit decoded (None:
+        as loaded) and the factor [m per positions unit] of its positions.
 
     Raises
     ------
@@ -1416,19 +1463,20 @@ def check_hdf5_declarations(path: str | os.PathLike) -> None:
     """
     import h5py
 
+    reads: dict[tuple[str, str], tuple[str | None, float]] = {}
     try:
         h = h5py.File(path, "r")
     except Exception:
-        return
+        return reads
     with h:
         for group in ("measured", "reference", "truth"):
             g = h.get(group)
             if not isinstance(g, h5py.Group):
                 continue
             for key in g.attrs:
-                raise MeasuredDataError(path, f"/{group}: attribute {key!r} on the group itself "
-                                              "(read by nothing, outside the content hash); a "
-                                              f"dataset file's /{group} group carries no attribute")
+                raise MeasuredDataError(path, f"/{group}: attribute {show_value(key)} on the group "
+                                              "itself (read by nothing, outside the content hash); "
+                                              f"a dataset file's /{group} group carries no attribute")
             if group == "truth":
                 continue
             for name in g:
@@ -1436,42 +1484,72 @@ def check_hdf5_declarations(path: str | os.PathLike) -> None:
                 if not isinstance(d, h5py.Dataset):
                     continue
                 where = f"/{group}/{name}"
+                unit, factor = None, 1.0
                 for key in ("unit", "positions_unit"):
                     if key not in d.attrs:
                         continue
                     v = d.attrs[key]
-                    if not isinstance(v, str):
-                        raise MeasuredDataError(path, f"{where}: attribute {key}={_shown(v)} "
+                    text = _attr_text(v)
+                    if text is None:
+                        raise MeasuredDataError(path, f"{where}: attribute {key}={show_value(_plain(v))} "
                                                       f"({type(v).__name__}); expected a text "
-                                                      "(a variable-length UTF-8 string)")
-                    if key == "positions_unit" and v != POSITIONS_UNIT:
-                        raise MeasuredDataError(path, f"{where}: attribute positions_unit={v!r}; "
-                                                      f"expected {POSITIONS_UNIT!r} (positions are "
-                                                      "read in metres)")
+                                                      "(a UTF-8 string, or its bytes)")
+                    if key == "unit" and not isinstance(v, str):
+                        unit = text
+                    if key == "positions_unit" and text != POSITIONS_UNIT:
+                        si, factor = si_unit(text)
+                        if si != POSITIONS_UNIT:
+                            raise MeasuredDataError(path, f"{where}: attribute positions_unit="
+                                                          f"{show_value(text)}; expected a length "
+                                                          f"unit ({POSITIONS_UNIT!r}, 'mm')")
+                if unit is not None or factor != 1.0:
+                    reads[(group, name)] = (unit, factor)
                 for key in ("channels", "acts_on"):
                     names = d.attrs.get(key)
                     if key == "acts_on" and names is not None and not isinstance(names, np.ndarray):
                         # an integer was "unreadable dataset file (TypeError: 'numpy.int64'
                         # object is not iterable)", naming no attribute
-                        raise MeasuredDataError(path, f"{where}: attribute acts_on={_shown(names)} "
+                        raise MeasuredDataError(path, f"{where}: attribute acts_on="
+                                                      f"{show_value(_plain(names))} "
                                                       f"({type(names).__name__}); expected a list "
                                                       "of coordinate names, one per channel")
                     if isinstance(names, np.ndarray) and names.dtype.kind in "OS":
                         odd = next((c for c in names.ravel() if not isinstance(c, str)), None)
                         if odd is not None:
-                            raise MeasuredDataError(path, f"{where}: name {_shown(odd)} "
+                            raise MeasuredDataError(path, f"{where}: name {show_value(_plain(odd))} "
                                                           f"({type(odd).__name__}) in attribute "
                                                           f"{key}; expected texts (variable-length "
                                                           "UTF-8 strings)")
+    return reads
 
 
-def _shown(v: Any) -> str:
-    """An attribute's value for an error line: bytes and short arrays as Python writes them,
-    long ones cut."""
-    if isinstance(v, np.ndarray):
-        v = v.tolist()
-    text = repr(v.item() if isinstance(v, np.generic) else v)
-    return text if len(text) <= 80 else text[:77] + "..."
+def apply_hdf5_declarations(ds: Dataset, reads: Mapping[tuple[str, str], tuple[str | None, float]]
+                            ) -> Dataset:
+    """``ds`` with its signals read as their file declares (:func:`check_hdf5_declarations`):
+    each listed signal's unit decoded and its positions converted to metres.  The content hash
+    in ``ds.attrs`` stays the file's (it names the file read)."""
+    for (group, name), (unit, factor) in reads.items():
+        signals = ds.measured if group == "measured" else ds.reference
+        s = signals.get(name)
+        if s is None:
+            continue
+        if unit is not None:
+            s.unit = unit
+        if s.positions is not None:
+            s.positions = s.positions * factor
+    return ds
+
+
+def read_dataset_file(path: str | os.PathLike) -> Dataset:
+    """A dataset file read as it declares: :func:`check_hdf5_declarations`,
+    :func:`load_dataset` (content hash verified), :func:`apply_hdf5_declarations`.
+
+    Raises
+    ------
+    MeasuredDataError
+    """
+    reads = check_hdf5_declarations(path)
+    return apply_hdf5_declarations(load_dataset(path), reads)
 
 
 def _check_hdf5_size(path: Path) -> None:
@@ -1739,7 +1817,7 @@ def _read_uff(path: Path) -> _Raw:
     if not any(int(t) == 58 for t in types):
         raise MeasuredDataError(path, "no UFF58 (function at nodal DOF) record")
     coords: dict[int, float] = {}
-    placed: dict[int, tuple[np.ndarray, str]] = {}
+    placed: dict[int, tuple[np.ndarray, str, int]] = {}
     raw = _Raw(path, "uff", None, {}, {})
     rates: dict[str, float] = {}
     for k, s in enumerate(sets):
@@ -1762,21 +1840,28 @@ def _read_uff(path: Path) -> _Raw:
 
 
 #: Relative difference [-] within which two geometry records' coordinates of one node agree
-#: (relative to the node's largest coordinate): a UFF15 record writes them with 6 significant
+#: (relative to the model's largest coordinate): a UFF15 record writes them with 6 significant
 #: digits (E13.5, rounding within 5e-6 of the value), so a UFF15 and a UFF2411 record (16
 #: digits) of one node, or two UFF15 records each rounded, differ by up to 1e-5 of it.
 NODE_RTOL = 1e-5
 
 
 def _add_nodes(path: Path, k: int, kind: int, s: Mapping[str, Any], coords: dict[int, float],
-               placed: dict[int, tuple[np.ndarray, str]]) -> None:
+               placed: dict[int, tuple[np.ndarray, str, int]]) -> None:
     """Add the nodes of one geometry record (UFF15 or UFF2411, the ``k``-th record) to
-    ``coords`` (node -> x [m]) and ``placed`` (node -> (x, y, z), where it was given).
+    ``coords`` (node -> x [m]) and ``placed`` (node -> ((x, y, z), where it was given, the
+    record's kind)).
 
     Round 24: a node given twice at different places (twice in one UFF2411 record, in two
     geometry records, by a UFF2411 and a UFF15 record) was read at the last place in silence,
     and the sensor's position with it.  A node given twice at one place (within
-    :data:`NODE_RTOL`) is read once.
+    :data:`NODE_RTOL` of the model's largest coordinate, over every node placed so far and
+    this record's) is read once, at its UFF2411 place where one record is a UFF2411 (16
+    digits) and the other a UFF15 (6 digits), whichever comes first.
+
+    Review 25a: the tolerance was relative to the node's own coordinates, so a node at the
+    origin written 0 in one record and -1.2e-16 in another (``L cos(pi/2)``) was refused as
+    placed twice; and a UFF15 record before a UFF2411 one gave its 6 digits.
 
     Raises
     ------
@@ -1787,23 +1872,24 @@ def _add_nodes(path: Path, k: int, kind: int, s: Mapping[str, Any], coords: dict
     xyz = np.column_stack([np.atleast_1d(np.asarray(s.get(c, np.zeros(len(s["node_nums"]))),
                                                     dtype=float))
                            for c in ("x", "y", "z")])
+    # the model's size [m]: its largest coordinate over the nodes placed so far and this record's
+    scale = max([float(np.max(np.abs(xyz), initial=0.0))]
+                + [float(np.max(np.abs(at))) for at, _, _ in placed.values()])
     for node, at in zip(s["node_nums"], xyz, strict=True):
         node = int(node)
         if node in placed:
-            before, said = placed[node]
-            # relative to the node's distance from the origin: a coordinate written 0 in one
-            # record and 1e-17 in another is one place
-            scale = max(float(np.max(np.abs(at))), float(np.max(np.abs(before))))
+            before, said, said_kind = placed[node]
             if not np.all(np.abs(at - before) <= NODE_RTOL * scale):
                 def show(v: np.ndarray) -> str:
                     return "(" + ", ".join(f"{c:.9g}" for c in v) + ")"
 
                 raise MeasuredDataError(path, f"node {node} is placed twice: at {show(before)} m by "
                                               f"{said} and at {show(at)} m by {where}; expected one "
-                                              "place per node (coordinates within a relative "
-                                              f"{NODE_RTOL:g})")
-            continue
-        placed[node] = (at, where)
+                                              "place per node (coordinates within "
+                                              f"{NODE_RTOL:g} of the model's largest, {scale:.6g} m)")
+            if not (kind == 2411 and said_kind == 15):
+                continue  # the first place stays, unless a UFF2411 record gives more digits
+        placed[node] = (at, where, kind)
         coords[node] = float(at[0])
 
 

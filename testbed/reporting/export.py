@@ -56,11 +56,10 @@ from testbed.core.dataset import Dataset, Signal
 from testbed.core.errors import ArgumentError
 from testbed.core.truth import StructuralTruth
 from testbed.pipeline.importers import (
-    check_hdf5_declarations,
     check_hdf5_rate,
     check_hdf5_storage,
     check_recorded,
-    load_dataset,
+    read_dataset_file,
 )
 from testbed.pipeline.plugins import RIGS
 from testbed.pipeline.signal_chain import measure
@@ -420,8 +419,9 @@ def export_dataset(path: str | os.PathLike, fmt: str, out: str | os.PathLike | N
     path = Path(path)
     check_hdf5_rate(path)
     check_hdf5_storage(path)
-    check_hdf5_declarations(path)
-    ds = load_dataset(path)  # naming a damaged array (round 22)
+    # naming a damaged array (round 22); a unit stored as bytes decoded and positions in mm
+    # converted to metres, as the file declares them (review 25a)
+    ds = read_dataset_file(path)
     check_recorded(ds, path)  # an edited, rehashed file: NaN rate or samples, cut channels
     if fmt == "uff":
         written = [write_uff(ds, out or path.with_suffix(".uff"))]

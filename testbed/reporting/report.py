@@ -34,6 +34,7 @@ import numpy as np
 
 from testbed.core.atomic import atomic_write_text
 from testbed.core.kinds import METRICS
+from testbed.core.run_arrays import RUN_ARRAY_KINDS, ZIP_SIGNATURES
 from testbed.numerics.quantiles import quartiles
 from testbed.pipeline.plugins import RIGS
 from testbed.pipeline.scenario import NOISE_SCHEMA
@@ -799,11 +800,6 @@ def runs_index_html(runs: Sequence[dict[str, Any]], out_dir: str | os.PathLike) 
             "each run links to its report.</p>\n" + body + "\n</body></html>\n")
 
 
-#: The dtype kinds a run's ``run.npz`` holds (:func:`testbed.studies.runstore.build_arrays`
-#: stores numbers and text only): bool, signed and unsigned integers, floats, complex, text.
-RUN_ARRAY_KINDS = "biufcU"
-
-
 def check_run_npz(run_dir: str | os.PathLike) -> None:
     """Refuse a run folder's ``run.npz`` that is not a zip of plain ``.npy`` arrays, reading
     each member's header only (no array is loaded, no pickle unpickled).
@@ -815,6 +811,11 @@ def check_run_npz(run_dir: str | os.PathLike) -> None:
     ``run.npz`` as an array ("(TypeError)"), both naming nothing.  A missing ``run.npz`` is
     :func:`~testbed.studies.runstore.load_run`'s to judge.
 
+    The first bytes decide, as they do for :func:`numpy.load` (:data:`ZIP_SIGNATURES`):
+    :class:`zipfile.ZipFile` finds a zip by its directory at the file's end, so a ``.npy`` or
+    a pickle with a real run's zip appended passed (review 25a) and :func:`numpy.load` read
+    the ``.npy`` ("(TypeError)" again) or unpickled.
+
     Raises
     ------
     ValueError
@@ -824,6 +825,14 @@ def check_run_npz(run_dir: str | os.PathLike) -> None:
     if not npz.is_file():
         return
     allowed = "a run.npz is a zip of .npy arrays of numbers or text"
+    try:
+        with open(npz, "rb") as fh:
+            head = fh.read(4)
+    except OSError as e:
+        raise ValueError(f"{npz}: cannot be read ({' '.join(str(e).split())}); {allowed}") from None
+    if not head.startswith(ZIP_SIGNATURES):
+        raise ValueError(f"{npz}: starts with the bytes {head!r}, not a zip's "
+                         f"({' or '.join(map(repr, ZIP_SIGNATURES))}); {allowed}")
     try:
         archive = zipfile.ZipFile(npz)
     except (zipfile.BadZipFile, OSError, ValueError) as e:
