@@ -476,11 +476,11 @@ def _results_file(path: Path) -> Path:
 
 
 def _run_folder(path: Path) -> Path:
-    """A run folder :func:`testbed.reporting.report.read_run` can read, else InputError."""
-    from testbed.reporting.report import read_run
+    """A run folder :func:`testbed.studies.runstore.load_run` can read, else InputError."""
+    from testbed.studies.runstore import load_run
 
     try:
-        read_run(path)
+        load_run(path)
     except ValueError as e:  # load_run's own checks (a JSONDecodeError is one too) say what
         # (the folder's path once: said again inside, it ate the 200 characters of the reason)
         why = _one_line(e).replace(f"{path}{os.sep}", "").removeprefix(f"{path}: ")

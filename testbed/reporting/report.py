@@ -25,7 +25,6 @@ import math
 import os
 import re
 import shutil
-import zipfile
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
@@ -34,7 +33,6 @@ import numpy as np
 
 from testbed.core.atomic import atomic_write_text
 from testbed.core.kinds import METRICS
-from testbed.core.run_arrays import RUN_ARRAY_KINDS, ZIP_SIGNATURES
 from testbed.numerics.quantiles import quartiles
 from testbed.pipeline.plugins import RIGS
 from testbed.pipeline.scenario import NOISE_SCHEMA
@@ -696,7 +694,7 @@ def write_report(source: str | os.PathLike, out_dir: str | os.PathLike) -> Path:
     """
     source = Path(source)
     if source.is_dir():
-        return run_report(read_run(resolve_run(source)), out_dir)
+        return run_report(load_run(resolve_run(source)), out_dir)
     if not source.is_file() and not parts_dir(source).is_dir():  # (parts: a sweep killed at once)
         raise FileNotFoundError(f"{source}: neither a run folder nor a results file")
 
@@ -798,74 +796,3 @@ def runs_index_html(runs: Sequence[dict[str, Any]], out_dir: str | os.PathLike) 
             "<body>\n<h1>Runs</h1>\n"
             f'<p class="muted">{len(runs)} run(s) in {html.escape(str(out_dir))}, newest first; '
             "each run links to its report.</p>\n" + body + "\n</body></html>\n")
-
-
-def check_run_npz(run_dir: str | os.PathLike) -> None:
-    """Refuse a run folder's ``run.npz`` that is not a zip of plain ``.npy`` arrays, reading
-    each member's header only (no array is loaded, no pickle unpickled).
-
-    Round 24, each run sealed anew (its npz checksum and ``run.json``'s own): a member of a
-    structured dtype was "internal error ... TypeError: Cannot cast array data" in ``testbed
-    report``; a zip member that is no ``.npy`` (``model/x.pkl``) came back from
-    :func:`numpy.load` as bytes ("(AttributeError)"), and a lone ``.npy`` under the name
-    ``run.npz`` as an array ("(TypeError)"), both naming nothing.  A missing ``run.npz`` is
-    :func:`~testbed.studies.runstore.load_run`'s to judge.
-
-    The first bytes decide, as they do for :func:`numpy.load` (:data:`ZIP_SIGNATURES`):
-    :class:`zipfile.ZipFile` finds a zip by its directory at the file's end, so a ``.npy`` or
-    a pickle with a real run's zip appended passed (review 25a) and :func:`numpy.load` read
-    the ``.npy`` ("(TypeError)" again) or unpickled.
-
-    Raises
-    ------
-    ValueError
-        Naming the file, the member and what a run.npz holds.
-    """
-    npz = Path(run_dir) / "run.npz"
-    if not npz.is_file():
-        return
-    allowed = "a run.npz is a zip of .npy arrays of numbers or text"
-    try:
-        with open(npz, "rb") as fh:
-            head = fh.read(4)
-    except OSError as e:
-        raise ValueError(f"{npz}: cannot be read ({' '.join(str(e).split())}); {allowed}") from None
-    if not head.startswith(ZIP_SIGNATURES):
-        raise ValueError(f"{npz}: starts with the bytes {head!r}, not a zip's "
-                         f"({' or '.join(map(repr, ZIP_SIGNATURES))}); {allowed}")
-    try:
-        archive = zipfile.ZipFile(npz)
-    except (zipfile.BadZipFile, OSError, ValueError) as e:
-        raise ValueError(f"{npz}: not a zip archive ({' '.join(str(e).split())}); {allowed}") from None
-    with archive:
-        for info in archive.infolist():
-            name = info.filename
-            if not name.endswith(".npy"):
-                raise ValueError(f"{npz}: member {name!r} is not a .npy array; {allowed}")
-            try:
-                with archive.open(info) as fh:
-                    version = np.lib.format.read_magic(fh)
-                    read = (np.lib.format.read_array_header_1_0 if version == (1, 0)
-                            else np.lib.format.read_array_header_2_0)
-                    _shape, _fortran, dtype = read(fh)
-            except Exception as e:  # a damaged header, an unknown version, a bad zip entry
-                raise ValueError(f"{npz}: member {name!r} has no readable .npy header "
-                                 f"({type(e).__name__}: {' '.join(str(e).split())[:120]}); "
-                                 f"{allowed}") from None
-            if dtype.kind not in RUN_ARRAY_KINDS or dtype.fields is not None or dtype.hasobject:
-                what = "objects: pickled data, not loaded" if dtype.hasobject else f"kind {dtype.kind!r}"
-                raise ValueError(f"{npz}: member {name!r} has dtype {dtype} ({what}); {allowed} "
-                                 f"(dtype kinds {', '.join(RUN_ARRAY_KINDS)})")
-
-
-def read_run(run_dir: str | os.PathLike) -> SavedRun:
-    """:func:`~testbed.studies.runstore.load_run` after :func:`check_run_npz`: a run folder
-    whose arrays are plain numbers or text, verified against its checksums.
-
-    Raises
-    ------
-    ValueError
-        As :func:`check_run_npz` and :func:`~testbed.studies.runstore.load_run`.
-    """
-    check_run_npz(run_dir)
-    return load_run(run_dir)

@@ -70,6 +70,7 @@ except ImportError:  # Windows
 from testbed.core.atomic import atomic_write_text, begin_in_flight, end_in_flight, no_room
 from testbed.core.errors import TestbedError, is_control
 from testbed.core.provenance import git_commit, versions
+from testbed.core.run_arrays import RUN_ARRAY_KINDS, check_run_npz
 from testbed.pipeline.plugins import RIGS
 from testbed.scoring.scorers import PASS, Check, verdict
 
@@ -251,7 +252,7 @@ def _as_array(v: Any) -> np.ndarray | None:
         a = np.asarray(v)
     except (ValueError, TypeError):
         return None
-    return a if a.dtype.kind in "biufcU" else None
+    return a if a.dtype.kind in RUN_ARRAY_KINDS else None
 
 
 def _flatten(d: dict[str, Any], prefix: str) -> dict[str, np.ndarray]:
@@ -786,6 +787,7 @@ def load_run(run_dir: str | os.PathLike) -> SavedRun:
             raise ValueError(f"{npz}: its bytes do not match the checksum in run.json "
                              f"({NPZ_DIGEST!r}): damaged or replaced after the run wrote it")
     if npz.is_file():
+        check_run_npz(run_dir)  # plain .npy members of numbers or text, judged by headers alone
         with np.load(npz, allow_pickle=False) as z:
             arrays = {k: z[k] for k in z.files}
     model = _unflatten(arrays, "model")

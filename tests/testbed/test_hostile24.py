@@ -18,9 +18,9 @@ import pytest
 import pyuff
 
 from testbed.core.dataset import Dataset, DatasetError
+from testbed.core.run_arrays import check_run_npz
 from testbed.pipeline.importers import MeasuredDataError, from_sep005, measurement_from_file, read_measured
 from testbed.reporting.export import export_dataset
-from testbed.reporting.report import check_run_npz
 from testbed.studies import runstore
 
 
@@ -365,6 +365,8 @@ def test_a_run_npz_of_other_than_plain_arrays_is_refused_unloaded(cli_in_process
     run = _resealed(mm_run, tmp_path / "runs" / "michaelis_menten" / mm_run.name, make(mm_run, str(marker)))
     with pytest.raises(ValueError, match=said):
         check_run_npz(run)
+    with pytest.raises(ValueError, match=said):  # the store's own reader too (fuzz25's open (b):
+        runstore.load_run(run)  # AttributeError / TypeError for the .pkl member and the lone pickle)
     p = cli_in_process("report", str(run), "-o", str(tmp_path / "report"), cwd=tmp_path)
     assert p.returncode == 2
     line = _one_error_line(p.stderr)
