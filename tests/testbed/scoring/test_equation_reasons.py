@@ -130,6 +130,16 @@ def test_an_unpaired_equations_nan_row_names_no_terms():
     was named as held (and the law's lacked terms never).  A non-finite row names nothing."""
     details = {"terms": NAMES, "coef_true": np.vstack([TRUE, TRUE]),
                "coef_id": np.array([[np.nan] * 5, [0.005, 0.1, -0.003, 1.0, 0.2]])}
-    assert spurious_terms(details) == [[], ["x^2"]]
-    assert dropped_terms(details) == [[], []]
+    assert spurious_terms(details) == [None, ["x^2"]]
+    assert dropped_terms(details) == [None, []]
     assert term_changes(details) == "; equation 2 holds x^2 that the law lacks"
+
+
+def test_an_unpaired_equation_is_not_shown_undetermined_as_true_terms_alone():
+    """Review 25c: the NaN row (its terms unknown) entered "equation not determined by the
+    record", an explained reason, where the equation is a wrong one of unknown terms."""
+    details = {"equation_bars": BARS, "determinacy": np.array([1.3]), "terms": NAMES,
+               "coef_true": TRUE, "coef_id": np.array([[np.nan] * 5])}
+    s = Scores({"coef_error": float("inf"), "support_f1": 0.5, "state_rmse": 1e-3}, details)
+    why = equation_failures(s, {"state_rmse": {"max": 0.01}})["equation"]
+    assert why.startswith("wrong equation: ") and "not determined by the record" not in why

@@ -129,8 +129,12 @@ def test_a_blowup_with_a_growing_slow_pole_or_a_cubic_stays_a_divergence():
     M, C, K = np.eye(2), np.diag([1e11, 0.0]), np.diag([1.0, -100.0])
     assert physical_failures(M, C, K) == {}  # the relative bar alone passes it
     assert stable_blowup(_BLOWUP, M, C, K, dt, 1.0) == _BLOWUP
-    # the same poles on a record too short for the slow pole to grow 0.1 %: no growth there
-    assert stable_blowup(_BLOWUP, M, C, K, dt, 1e-5).startswith(STABLE_BLOWUP)
+    # a pole growing at 1e-3 1/s beside the same fast one: no growth over 0.5 s (5e-4 <= 1e-3),
+    # growth over 10 s (1e-2); no record at all claims nothing
+    slow_growth = np.diag([1.0, -1e-6])
+    assert stable_blowup(_BLOWUP, M, C, slow_growth, dt, 0.5).startswith(STABLE_BLOWUP)
+    assert stable_blowup(_BLOWUP, M, C, slow_growth, dt, 10.0) == _BLOWUP
+    assert stable_blowup(_BLOWUP, np.eye(1), np.array([[1e9]]), np.eye(1), dt, 0.0) == _BLOWUP
     soft = stable_blowup(_BLOWUP, np.eye(1), np.array([[1e-3]]), np.eye(1), dt, 10.0, -np.eye(1))
     assert soft == _BLOWUP
     linear = stable_blowup(_BLOWUP, np.eye(1), np.array([[1e-3]]), np.eye(1), dt, 10.0, np.zeros((1, 1)))
