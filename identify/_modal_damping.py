@@ -1510,6 +1510,44 @@ def hardened_reach(peak_hz: np.ndarray, dec: ModalDecay, sigma: np.ndarray, line
     return reach.reshape(n), limit.reshape(n)
 
 
+def hardened_floor(dec: ModalDecay, limit_hz: np.ndarray, line_hz: float) -> np.ndarray:
+    """The lowest linear frequency of each mode a hardening record allows [Hz].
+
+    A mode's read backbone limit (:func:`hardened_reach`'s ``limit``) removes its own
+    stiffening, not the other modes' (module docstring, "Cubic library"): the linear frequency
+    lies below it by the stiffening the other modes' amplitudes add.  That is bounded here by
+    the largest relative stiffening the record shows on any other mode, ``max_j c_j / wd_j``
+    over the other modes' taken backbone fits that harden (``c_j > 0``): for one cubic spring
+    at ``x_b = sum b_j q_j`` mode ``j``'s amplitude stiffens mode ``k`` by
+    ``2 (b_k / b_j)^2 (w_j / w_k)^2`` of its own relative stiffening, measured 0.27-0.50 on
+    the soft-base family (members 002, 003, 010, 012, clean, through the true modes).  So the
+    floor is ``limit (1 - max_j c_j / wd_j) - line_hz`` (one line: the window's resolution).
+
+    Parameters
+    ----------
+    dec : ModalDecay
+        The backbone decay fits of the model's modes (``chirp`` set).
+    limit_hz : ndarray, shape (n,)
+        :func:`hardened_reach`'s read backbone limits [Hz] (NaN where none).
+    line_hz : float
+        One line of the window's transform [Hz].
+
+    Returns
+    -------
+    ndarray, shape (n,)
+        The floor [Hz]; NaN where the mode has no read limit or no other mode's fit shows the
+        record hardening.
+    """
+    limit = np.asarray(limit_hz, dtype=float)
+    rel = np.where(dec.taken & (dec.chirp > 0), dec.chirp / dec.omega_d, np.nan)
+    floor = np.full(limit.shape, np.nan)
+    for k in np.flatnonzero(np.isfinite(limit)):
+        others = np.delete(rel, k)
+        if np.any(np.isfinite(others)):
+            floor[k] = limit[k] * (1.0 - np.nanmax(others)) - line_hz
+    return floor
+
+
 def backbone_shift(M: np.ndarray, K: np.ndarray, K3: np.ndarray, dec: ModalDecay) -> np.ndarray:
     """The model's own first-order backbone shift of each mode at the measured amplitude.
 

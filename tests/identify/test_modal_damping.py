@@ -13,6 +13,7 @@ from identify._modal_damping import (
     ModalDecay,
     chain_transients,
     coupling_moves,
+    hardened_floor,
     hardened_reach,
     hold_modal_damping,
     modal_decay,
@@ -692,3 +693,22 @@ def test_the_unseen_band_is_the_part_of_a_modes_band_above_the_peak_band():
     assert unseen_band(w3, 1, data, 3200) is None
     assert unseen_band(w, 1, SimpleNamespace(fs=3200.0, passband=(10.0, 1600.0)), 3200) is None
     assert unseen_band(w, 1, SimpleNamespace(fs=3200.0, passband=None), 3200) is None
+
+
+def test_the_hardened_floor_is_the_limit_less_the_other_modes_largest_stiffening():
+    """Mode k's floor: its read backbone limit times (1 - the largest c / wd of the other modes'
+    taken, hardening fits) less one line; NaN without a limit or without another hardening
+    mode (a softening fit, c < 0, or one not taken, counts for nothing)."""
+    two_pi = 2.0 * np.pi
+    n = 3
+    dec = ModalDecay(*(np.full(n, np.nan) for _ in range(5)), np.zeros(n),
+                     np.array([True, True, False]), np.full(n, np.nan), np.full(n, np.nan))
+    dec.omega_d[:] = two_pi * np.array([40.0, 390.0, 900.0])
+    dec.chirp[:] = two_pi * np.array([1.6, 30.0, 200.0])  # mode 3's not taken: no weight
+    limit = np.array([40.0, 390.0, np.nan])
+    floor = hardened_floor(dec, limit, 1.0)
+    assert floor[0] == pytest.approx(40.0 * (1 - 30.0 / 390.0) - 1.0, rel=1e-12)
+    assert floor[1] == pytest.approx(390.0 * (1 - 1.6 / 40.0) - 1.0, rel=1e-12)
+    assert np.isnan(floor[2])
+    dec.chirp[0] = -two_pi * 1.6  # mode 1 softening: mode 2 has no other hardening mode
+    assert np.isnan(hardened_floor(dec, limit, 1.0)[1])
