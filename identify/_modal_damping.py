@@ -94,6 +94,34 @@ non-physical fit).  At 0 % noise the
 same fit gives mode 2 of member 013 within 0.14 %; at 1 % 2.5 % (784.5 / 797.2 against 777.7
 Hz, zeta 18 %: the noise, the fit's minimum is unique from starts 0.6-2 x the model's).
 
+An unlocated mode's starts
+--------------------------
+The modal coordinate's fit of such a mode (linear model, no free peak in its band) starts
+from the model's frequency, which for a mode no peak located may be anything: round 23's
+beryllium at 3.2 kHz with a 1.5 kHz low-pass (``b23_be_fs3k2_s2_lp1k5``) at 2 % noise, seed
+144, has mode 2 at 1246 Hz (6.25 % damped) above the peak band's 0.8 x the low-pass, the fit's
+mode 2 an unstable 360 Hz pole, and the decay fit started there stopped in a local minimum at
+346 Hz (r2 0.060), within the pairing distance, and was taken: 72 % off.  The rule: where part
+of the mode's band lies where the peak search could not look (:func:`unseen_band`: above the
+peak band's top, up to the chain's declared low-pass, within the midpoints to the
+neighbouring modes), the fit is also started one pairing distance (15 %, in ratio) apart
+across that part, each start bounded to it, and the converged fit of least residual is taken
+where it explains more of the modal coordinate than the first fit, converged or not (there
+1244 Hz, r2 0.074 against 0.060; the every-channel fit, its band's top then at the low-pass,
+gives 1242.7 Hz, 0.21 % off).  Not where the first fit explains more, even at its bound: on
+round 22's magnesium at 1.8 kHz (``b22_mg_fs1k8_s2``, 5 %, seed 139, ``sgd_sindy``) the first
+fit from 194 Hz stopped at its bound (r2 0.199) and the spread's 806.7 Hz (r2 0.085) would
+have put mode 2 (508.7 Hz) 58.6 % off.  There a decay fit is the only
+evidence a mode can have: the peak band stops at 0.8 x the cut-off because the filter's
+roll-off bends a peak, which a decay fitted beside the chain's declared transients does not
+suffer.  Inside the peak band the search looked and located nothing, and a spread start's
+minimum there is as likely a spurious mode's: spread over a middle mode's whole band (the
+first form, beam27) it took an undamped 28.8 Hz minimum for the unstable mode 2 of a tilted
+fit whose modes all lay low (``b21_soft_root3`` 4 %, seed 123: mode 1 1.7 -> 27.1 % off) and
+moved modes of fits holding a spurious mode between true ones (``b19_st_L0p95_n16_2s`` 2 %:
+mode 1 2.7 -> 894 %).  The rule adds no parameter; the grid is fixed by the band and the
+pairing distance (deterministic).
+
 In a cubic model (backbone fits) a mode no accepted peak located (``unlocated``, paired as
 the eigenvalue hold pairs, although the hold does not act on a cubic model) whose backbone
 fit converged with ``|c| > BACKBONE_MAX_SHIFT wd`` (no first-order backbone, so not taken) is
@@ -602,7 +630,9 @@ def modal_decay(data: Measurement, M: np.ndarray, K: np.ndarray, C: np.ndarray,
         Without ``backbone`` their decay is then refitted on every channel at once
         (:func:`_unlocated_fit`, after the located modes, whose decays it profiles out) between
         the midpoints to the neighbouring modes (:func:`unlocated_band`): module docstring,
-        "Unlocated modes".  Default none.
+        "Unlocated modes".  Where part of that band lies above the peak band
+        (:func:`unseen_band`), the modal coordinate's fit is also started across that part, the
+        least residual taken: module docstring, "An unlocated mode's starts".  Default none.
     free_peaks_hz : ndarray, shape (m,), optional
         Accepted spectral peaks [Hz] (as measured, not warped) no mode was paired with.  An
         unlocated mode (without ``backbone``) whose :func:`unlocated_band` holds exactly one of
@@ -651,10 +681,20 @@ def modal_decay(data: Measurement, M: np.ndarray, K: np.ndarray, C: np.ndarray,
             if out.exponential is None:
                 object.__setattr__(out, "exponential", np.zeros(n, bool))
             out.exponential[k] = ok
-        out.r2[k] = r2
-        paired = abs(np.log(wd / w[k])) <= np.log1p(MODE_SEPARATION)
         peak = _free_peak(free_peaks_hz, w, k, data, i1 - i0) if free[k] and not backbone \
             else None
+        band_k = unlocated_band(w, k, peak_band(data, i1 - i0)[0])
+        unseen = unseen_band(w, k, data, i1 - i0) if free[k] and not backbone and peak is None \
+            else None
+        if unseen is not None:
+            # no peak located it and part of its band lies above the peak band: its modal
+            # coordinate's fit also from starts across that part, the least residual taken
+            # (module docstring, "An unlocated mode's starts")
+            s, wd, r2, ok = _spread_fit(q[k], t, 0.5 * d[k], (s, wd, r2, ok), unseen, nuisance)
+            if ok and wd >= unseen[0]:  # its band's top raised to the low-pass, as the spread's
+                band_k = unlocated_band(w, k, decay_band(data, i1 - i0))
+        out.r2[k] = r2
+        paired = abs(np.log(wd / w[k])) <= np.log1p(MODE_SEPARATION)
         if peak is not None:  # from the measured peak no mode took (free_peaks_hz)
             s, wd, ok = _from_free_peak(out, k, peak, xdd[:, i0:i1], t, w, d, nuisance, fits,
                                         data, i1 - i0)
@@ -665,8 +705,7 @@ def modal_decay(data: Measurement, M: np.ndarray, K: np.ndarray, C: np.ndarray,
             # no peak located it and its modal coordinate's fit is not taken: every channel's
             # record, between its neighbours (module docstring, "Unlocated modes")
             s, wd, ok = _unlocated_fit(xdd[:, i0:i1], t, (s, wd) if ok else (0.5 * d[k], w[k]),
-                                       unlocated_band(w, k, peak_band(data, i1 - i0)[0]),
-                                       nuisance, fits)
+                                       band_k, nuisance, fits)
             paired = True  # bounded to the band nearer its own mode than any other
         first_order = not backbone or abs(c) <= BACKBONE_MAX_SHIFT * wd
         if ok and first_order and paired:
@@ -850,6 +889,71 @@ def unlocated_band(w: np.ndarray, k: int, peak_band_hz: tuple[float, float]) -> 
     hi = (0.5 * (w[k] + w[k + 1]) if k + 1 < len(w)
           else max(1.5 * w[k], 2.0 * np.pi * peak_band_hz[1]))
     return float(lo), float(hi)
+
+
+def decay_band(data: Measurement, n_window: int) -> tuple[float, float]:
+    """The band [Hz] an unlocated mode's decay is searched in: the peak band
+    (:func:`identify.structural.peak_band`) with its top raised to the chain's declared
+    low-pass cut-off where that lies below the Nyquist frequency.
+
+    The peak band stops at 0.8 x the low-pass because a peak there is bent by the filter's
+    roll-off; a decay fitted beside the chain's declared transients is not, and a mode between
+    0.8 x and 1 x the cut-off is still in the record (round 23's beryllium at 3.2 kHz, low-pass
+    1.5 kHz: mode 2 at 1246 Hz, no peak searched there).  Module docstring, "An unlocated
+    mode's starts".
+
+    Parameters
+    ----------
+    data : Measurement
+    n_window : int
+        Samples in the fit window.
+
+    Returns
+    -------
+    (float, float)
+        Lower and upper edge [Hz].
+    """
+    (lo, hi), _ = peak_band(data, n_window)
+    if data.passband is not None and float(data.passband[1]) < data.fs / 2.0:
+        hi = max(hi, float(data.passband[1]))
+    return lo, hi
+
+
+def unseen_band(w: np.ndarray, k: int, data: Measurement, n_window: int
+                ) -> tuple[float, float] | None:
+    """The part of mode ``k``'s :func:`unlocated_band` the peak search could not see [rad/s]:
+    above the peak band's top (:func:`identify.structural.peak_band`) up to the band's top
+    with the chain's declared low-pass as its edge (:func:`decay_band`); None where that part
+    is empty (no declared low-pass below the Nyquist frequency, or the mode's band ends below
+    the peak band's top).  ``w`` the model's undamped frequencies [rad/s], ascending;
+    ``n_window`` the fit window's samples.  Module docstring, "An unlocated mode's starts"."""
+    (_, top), _ = peak_band(data, n_window)
+    lo, hi = unlocated_band(w, k, decay_band(data, n_window))
+    lo = max(lo, 2.0 * np.pi * top)
+    return (lo, hi) if lo < hi else None
+
+
+def _spread_fit(q: np.ndarray, t: np.ndarray, sigma0: float,
+                first: tuple[float, float, float, bool], band: tuple[float, float],
+                nuisance: np.ndarray | None) -> tuple[float, float, float, bool]:
+    """An unlocated mode's modal-coordinate decay fit (:func:`_decay_fit` on ``q``, shape (N,),
+    times ``t`` [s]) from starts one :data:`~identify.structural.MODE_SEPARATION` apart (in
+    ratio) across ``band`` [rad/s] (:func:`unseen_band`), each bounded to ``band``; the
+    converged fit of least residual (largest ``r2``; ``first`` on a tie, then the lowest start)
+    is taken where it explains more than ``first`` (``(sigma, omega_d, r2, ok)`` of the fit
+    from the model's frequency), converged or not: a fit at its bound that explains more says
+    the decay lies outside ``band``.  ``sigma0`` [1/s] is every start's decay rate.  Returns
+    ``(sigma, omega_d, r2, ok)``; ``first`` where no spread fit explains more.  Module
+    docstring, "An unlocated mode's starts"."""
+    lo, hi = band
+    best = first
+    n = max(int(np.ceil(np.log(hi / lo) / np.log1p(MODE_SEPARATION))), 1)
+    edges = np.geomspace(lo, hi, n + 1)
+    for w0 in np.sqrt(edges[:-1] * edges[1:]):  # each step's geometric middle
+        s, wd, r2, ok, _, _ = _decay_fit(q, t, sigma0, float(w0), False, nuisance, band)
+        if ok and r2 > best[2]:
+            best = (s, wd, r2, ok)
+    return best
 
 
 def chain_transients(poles: np.ndarray | None, t: np.ndarray) -> np.ndarray | None:
@@ -1404,6 +1508,44 @@ def hardened_reach(peak_hz: np.ndarray, dec: ModalDecay, sigma: np.ndarray, line
     limit = np.where(read, np.sqrt(np.where(read, dec.lam_model, 0.0)) / (2.0 * np.pi), np.nan)
     reach = np.fmin(by_peak, np.where(read, limit + line_hz, np.inf))
     return reach.reshape(n), limit.reshape(n)
+
+
+def hardened_floor(dec: ModalDecay, limit_hz: np.ndarray, line_hz: float) -> np.ndarray:
+    """The lowest linear frequency of each mode a hardening record allows [Hz].
+
+    A mode's read backbone limit (:func:`hardened_reach`'s ``limit``) removes its own
+    stiffening, not the other modes' (module docstring, "Cubic library"): the linear frequency
+    lies below it by the stiffening the other modes' amplitudes add.  That is bounded here by
+    the largest relative stiffening the record shows on any other mode, ``max_j c_j / wd_j``
+    over the other modes' taken backbone fits that harden (``c_j > 0``): for one cubic spring
+    at ``x_b = sum b_j q_j`` mode ``j``'s amplitude stiffens mode ``k`` by
+    ``2 (b_k / b_j)^2 (w_j / w_k)^2`` of its own relative stiffening, measured 0.27-0.50 on
+    the soft-base family (members 002, 003, 010, 012, clean, through the true modes).  So the
+    floor is ``limit (1 - max_j c_j / wd_j) - line_hz`` (one line: the window's resolution).
+
+    Parameters
+    ----------
+    dec : ModalDecay
+        The backbone decay fits of the model's modes (``chirp`` set).
+    limit_hz : ndarray, shape (n,)
+        :func:`hardened_reach`'s read backbone limits [Hz] (NaN where none).
+    line_hz : float
+        One line of the window's transform [Hz].
+
+    Returns
+    -------
+    ndarray, shape (n,)
+        The floor [Hz]; NaN where the mode has no read limit or no other mode's fit shows the
+        record hardening.
+    """
+    limit = np.asarray(limit_hz, dtype=float)
+    rel = np.where(dec.taken & (dec.chirp > 0), dec.chirp / dec.omega_d, np.nan)
+    floor = np.full(limit.shape, np.nan)
+    for k in np.flatnonzero(np.isfinite(limit)):
+        others = np.delete(rel, k)
+        if np.any(np.isfinite(others)):
+            floor[k] = limit[k] * (1.0 - np.nanmax(others)) - line_hz
+    return floor
 
 
 def backbone_shift(M: np.ndarray, K: np.ndarray, K3: np.ndarray, dec: ModalDecay) -> np.ndarray:

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from types import SimpleNamespace
+
 import numpy as np
 import pytest
 
@@ -11,12 +13,14 @@ from identify._modal_damping import (
     ModalDecay,
     chain_transients,
     coupling_moves,
+    hardened_floor,
     hardened_reach,
     hold_modal_damping,
     modal_decay,
     peak_offset,
     peak_shape,
     set_shapes,
+    unseen_band,
 )
 from identify.sgd_sindy import SGDSINDy
 from identify.structural import modal
@@ -671,3 +675,40 @@ def test_hardened_reach_is_the_peak_or_the_read_backbone_limit_plus_one_line():
     assert limit[:2] == pytest.approx(undamped, rel=1e-12)
     assert np.isinf(reach[2]) and np.isnan(limit[2])  # no peak, its limit not read: no bound
     assert np.isinf(reach[3]) and np.isnan(limit[3])  # no peak, no decay taken
+
+
+def test_the_unseen_band_is_the_part_of_a_modes_band_above_the_peak_band():
+    """An unlocated mode's spread starts cover only what the peak search could not see: above
+    the peak band's top (0.8 x a declared low-pass) up to the low-pass, within the mode's own
+    band (midpoints to its neighbours).  The top mode of round 23's beryllium (fs 3.2 kHz,
+    low-pass 1.5 kHz, 1 s window) gets [1200, 1500] Hz; a mode whose band ends below 1200 Hz,
+    a chain without a low-pass below Nyquist, and one without a pass band get none."""
+    two_pi = 2.0 * np.pi
+    data = SimpleNamespace(fs=3200.0, passband=(10.0, 1500.0))
+    w = two_pi * np.array([120.0, 360.0])
+    lo, hi = unseen_band(w, 1, data, 3200)
+    assert (lo / two_pi, hi / two_pi) == pytest.approx((1200.0, 1500.0), rel=1e-12)
+    assert unseen_band(w, 0, data, 3200) is None  # its band ends at the midpoint, 240 Hz
+    w3 = two_pi * np.array([120.0, 360.0, 2000.0])  # mode 2's band ends at 1180 Hz
+    assert unseen_band(w3, 1, data, 3200) is None
+    assert unseen_band(w, 1, SimpleNamespace(fs=3200.0, passband=(10.0, 1600.0)), 3200) is None
+    assert unseen_band(w, 1, SimpleNamespace(fs=3200.0, passband=None), 3200) is None
+
+
+def test_the_hardened_floor_is_the_limit_less_the_other_modes_largest_stiffening():
+    """Mode k's floor: its read backbone limit times (1 - the largest c / wd of the other modes'
+    taken, hardening fits) less one line; NaN without a limit or without another hardening
+    mode (a softening fit, c < 0, or one not taken, counts for nothing)."""
+    two_pi = 2.0 * np.pi
+    n = 3
+    dec = ModalDecay(*(np.full(n, np.nan) for _ in range(5)), np.zeros(n),
+                     np.array([True, True, False]), np.full(n, np.nan), np.full(n, np.nan))
+    dec.omega_d[:] = two_pi * np.array([40.0, 390.0, 900.0])
+    dec.chirp[:] = two_pi * np.array([1.6, 30.0, 200.0])  # mode 3's not taken: no weight
+    limit = np.array([40.0, 390.0, np.nan])
+    floor = hardened_floor(dec, limit, 1.0)
+    assert floor[0] == pytest.approx(40.0 * (1 - 30.0 / 390.0) - 1.0, rel=1e-12)
+    assert floor[1] == pytest.approx(390.0 * (1 - 1.6 / 40.0) - 1.0, rel=1e-12)
+    assert np.isnan(floor[2])
+    dec.chirp[0] = -two_pi * 1.6  # mode 1 softening: mode 2 has no other hardening mode
+    assert np.isnan(hardened_floor(dec, limit, 1.0)[1])
