@@ -692,7 +692,7 @@ def modal_decay(data: Measurement, M: np.ndarray, K: np.ndarray, C: np.ndarray,
             # (module docstring, "An unlocated mode's starts")
             s, wd, r2, ok = _spread_fit(q[k], t, 0.5 * d[k], (s, wd, r2, ok), unseen, nuisance)
             if ok and wd >= unseen[0]:  # its band's top raised to the low-pass, as the spread's
-                band_k = unlocated_band(w, k, decay_band(data, i1 - i0))
+                band_k = (unlocated_band(w, k, decay_band(data, i1 - i0))[0], unseen[1])
         out.r2[k] = r2
         paired = abs(np.log(wd / w[k])) <= np.log1p(MODE_SEPARATION)
         if peak is not None:  # from the measured peak no mode took (free_peaks_hz)
@@ -927,9 +927,13 @@ def unseen_band(w: np.ndarray, k: int, data: Measurement, n_window: int
     is empty (no declared low-pass below the Nyquist frequency, or the mode's band ends below
     the peak band's top).  ``w`` the model's undamped frequencies [rad/s], ascending;
     ``n_window`` the fit window's samples.  Module docstring, "An unlocated mode's starts"."""
+    if data.passband is None or not float(data.passband[1]) < data.fs / 2.0:
+        return None  # no declared low-pass below Nyquist: nothing the chain passes goes unseen
     (_, top), _ = peak_band(data, n_window)
     lo, hi = unlocated_band(w, k, decay_band(data, n_window))
-    lo = max(lo, 2.0 * np.pi * top)
+    # clipped to the low-pass: above it (and above Nyquist) a decay fit cannot tell a
+    # frequency from its alias (review 25d: the top mode's 1.5 w_k reached past both)
+    lo, hi = max(lo, 2.0 * np.pi * top), min(hi, 2.0 * np.pi * float(data.passband[1]))
     return (lo, hi) if lo < hi else None
 
 
@@ -1516,12 +1520,16 @@ def hardened_floor(dec: ModalDecay, limit_hz: np.ndarray, line_hz: float) -> np.
     A mode's read backbone limit (:func:`hardened_reach`'s ``limit``) removes its own
     stiffening, not the other modes' (module docstring, "Cubic library"): the linear frequency
     lies below it by the stiffening the other modes' amplitudes add.  That is bounded here by
-    the largest relative stiffening the record shows on any other mode, ``max_j c_j / wd_j``
-    over the other modes' taken backbone fits that harden (``c_j > 0``): for one cubic spring
+    the largest relative stiffening the record shows on a LOWER mode, ``max_{j<k} c_j / wd_j``
+    over those modes' taken backbone fits that harden (``c_j > 0``): for one cubic spring
     at ``x_b = sum b_j q_j`` mode ``j``'s amplitude stiffens mode ``k`` by
-    ``2 (b_k / b_j)^2 (w_j / w_k)^2`` of its own relative stiffening, measured 0.27-0.50 on
-    the soft-base family (members 002, 003, 010, 012, clean, through the true modes).  So the
-    floor is ``limit (1 - max_j c_j / wd_j) - line_hz`` (one line: the window's resolution).
+    ``r_kj = 2 (b_k / b_j)^2 (w_j / w_k)^2`` of its own relative stiffening, measured 0.27-0.50
+    for mode 1 on mode 2 on the soft-base family (members 002, 003, 010, 012, clean, through
+    the true modes).  The reverse direction is not bounded so: ``r_kj r_jk = 4`` exactly (mode
+    2 on mode 1 is 8-15 there), so a higher mode's stiffening bounds nothing of a lower one's
+    and mode 1 has no floor (review 25d).  The floor is ``limit (1 - max_{j<k} c_j / wd_j) -
+    line_hz`` (one line: the window's resolution); with several lower modes their shares add,
+    which the largest alone does not bound: measured for mode 2 (one lower mode) only.
 
     Parameters
     ----------
@@ -1535,14 +1543,14 @@ def hardened_floor(dec: ModalDecay, limit_hz: np.ndarray, line_hz: float) -> np.
     Returns
     -------
     ndarray, shape (n,)
-        The floor [Hz]; NaN where the mode has no read limit or no other mode's fit shows the
-        record hardening.
+        The floor [Hz]; NaN where the mode has no read limit or no lower mode's fit shows the
+        record hardening (mode 1 always).
     """
     limit = np.asarray(limit_hz, dtype=float)
     rel = np.where(dec.taken & (dec.chirp > 0), dec.chirp / dec.omega_d, np.nan)
     floor = np.full(limit.shape, np.nan)
     for k in np.flatnonzero(np.isfinite(limit)):
-        others = np.delete(rel, k)
+        others = rel[:k]
         if np.any(np.isfinite(others)):
             floor[k] = limit[k] * (1.0 - np.nanmax(others)) - line_hz
     return floor

@@ -1007,7 +1007,10 @@ def reach_moves(freqs_hz: np.ndarray, reach_hz: np.ndarray, limit_hz: np.ndarray
     if not np.any(above | below):
         return none, to, ("the record hardens, every mode within its reach ("
                           + ", ".join(f"{a:.4g} <= {r:.4g} Hz" for a, r in zip(f, reach, strict=True))
-                          + ")" + ("" if floor_hz is None else " and above its floor") + ": nothing moved")
+                          + ")" + ("" if floor_hz is None else " and above its floor" + "".join(
+                              f", {a:.4g} >= {lo:.4g} Hz" for a, lo in zip(f, np.asarray(floor_hz, float),
+                                                                          strict=True) if np.isfinite(lo)))
+                          + ": nothing moved")
     gap = np.abs(to[:, None] - f[None, :])  # (the message names the nearer mode)
     nearest = nearer_own(to, f)
     move = (above | below) & nearest

@@ -693,12 +693,21 @@ def test_the_unseen_band_is_the_part_of_a_modes_band_above_the_peak_band():
     assert unseen_band(w3, 1, data, 3200) is None
     assert unseen_band(w, 1, SimpleNamespace(fs=3200.0, passband=(10.0, 1600.0)), 3200) is None
     assert unseen_band(w, 1, SimpleNamespace(fs=3200.0, passband=None), 3200) is None
+    # review 25d: a top mode whose 1.5 w_k reaches past the low-pass (and Nyquist) is clipped
+    # to the low-pass; without one declared below Nyquist nothing is unseen
+    wh = two_pi * np.array([120.0, 1300.0])
+    lo, hi = unseen_band(wh, 1, data, 3200)
+    assert (lo / two_pi, hi / two_pi) == pytest.approx((1200.0, 1500.0), rel=1e-12)
+    w_top = two_pi * np.array([120.0, 1000.0])
+    assert unseen_band(w_top, 1, SimpleNamespace(fs=3200.0, passband=None), 3200) is None
+    assert unseen_band(w_top, 1, SimpleNamespace(fs=3200.0, passband=(10.0, 1600.0)), 3200) is None
 
 
-def test_the_hardened_floor_is_the_limit_less_the_other_modes_largest_stiffening():
-    """Mode k's floor: its read backbone limit times (1 - the largest c / wd of the other modes'
-    taken, hardening fits) less one line; NaN without a limit or without another hardening
-    mode (a softening fit, c < 0, or one not taken, counts for nothing)."""
+def test_the_hardened_floor_is_the_limit_less_the_lower_modes_largest_stiffening():
+    """Mode k's floor: its read backbone limit times (1 - the largest c / wd of the lower modes'
+    taken, hardening fits) less one line; NaN without a limit or without a lower hardening
+    mode (a softening fit, c < 0, or one not taken, counts for nothing); mode 1 has none (a
+    higher mode stiffens a lower one by 4 / r of r the other way: review 25d)."""
     two_pi = 2.0 * np.pi
     n = 3
     dec = ModalDecay(*(np.full(n, np.nan) for _ in range(5)), np.zeros(n),
@@ -707,7 +716,7 @@ def test_the_hardened_floor_is_the_limit_less_the_other_modes_largest_stiffening
     dec.chirp[:] = two_pi * np.array([1.6, 30.0, 200.0])  # mode 3's not taken: no weight
     limit = np.array([40.0, 390.0, np.nan])
     floor = hardened_floor(dec, limit, 1.0)
-    assert floor[0] == pytest.approx(40.0 * (1 - 30.0 / 390.0) - 1.0, rel=1e-12)
+    assert np.isnan(floor[0])
     assert floor[1] == pytest.approx(390.0 * (1 - 1.6 / 40.0) - 1.0, rel=1e-12)
     assert np.isnan(floor[2])
     dec.chirp[0] = -two_pi * 1.6  # mode 1 softening: mode 2 has no other hardening mode
