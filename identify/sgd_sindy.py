@@ -48,6 +48,7 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+from collections.abc import Callable
 from typing import Any, ClassVar
 
 import numpy as np
@@ -354,7 +355,8 @@ class SGDSINDyBase(StructuralIdentifier):
         if fr is not None and not fr[1] <= fs / 2:
             error("freq_range", fr, f"expected high <= the Nyquist frequency {fs / 2:g} Hz")
 
-    def _start_fit(self, data: Measurement) -> tuple[np.ndarray, np.ndarray | None]:
+    def _start_fit(self, data: Measurement, search: Callable[[], PeakSearch] | None = None
+                   ) -> tuple[np.ndarray, np.ndarray | None]:
         """Validate the hyperparameters, set ``learning_rate_`` and ``learning_rate_rule_``, and
         find the eigenvalue penalty's targets.
 
@@ -363,6 +365,14 @@ class SGDSINDyBase(StructuralIdentifier):
         cut-off, :func:`identify.structural.fit_band_cutoff`, and the eigenvalue targets when
         neither ``n_modes`` nor ``freq_range`` is set) runs once per fit, not once per use
         (it was run four times, 0.1-0.2 s of a fit).
+
+        Parameters
+        ----------
+        data : Measurement
+        search : callable, optional
+            ``search()``: the default peak search of ``data``, searched on its first call and
+            remembered (:meth:`_default_search`); the caller passes the same one to its refits
+            on the same ``data`` (:meth:`SGDSINDy._fit_banded`).  None: made here.
 
         Returns
         -------
@@ -374,7 +384,8 @@ class SGDSINDyBase(StructuralIdentifier):
             :func:`identify.structural.fit_band_cutoff`); None without ``fit_band``.
         """
         self.check_params()
-        search = functools.cache(lambda: self._search(data))
+        if search is None:
+            search = self._default_search(data)
         self.cubic_, self.cubic_rule_ = cubic_rule(
             data, self.cubic, None, None if self.cubic is not None else search().peaks,
             search() if self.cubic is None and self._lower_modes() else None)
@@ -390,6 +401,14 @@ class SGDSINDyBase(StructuralIdentifier):
             # frequency; the fitted poles are mapped back at the end (_finish_fit)
             f = warp_frequency(f, float(data.fs))
         return (2.0 * np.pi * f) ** 2, search().peaks if getattr(self, "fit_band", False) else None
+
+    def _default_search(self, data: Measurement) -> Callable[[], PeakSearch]:
+        """The default peak search of ``data`` (:meth:`_search`, every argument at its
+        default) as a callable that searches on its first call and returns that same result
+        after: one search per fit and record, shared by the first fit and its refits (the
+        search is a function of ``data`` and ``lower_modes`` alone, so a refit on the same
+        record would find the same peaks; issue #13)."""
+        return functools.cache(functools.partial(self._search, data))
 
     def _search(self, data: Measurement, n_modes: int | None = None,
                 freq_range: tuple[float, float] | None = None) -> PeakSearch:
@@ -1093,11 +1112,12 @@ class SGDSINDy(SGDSINDyBase):
         """
         for k in ("_lowest_unpaired", "_cubic_diverged"):  # an earlier fit's markers
             self.__dict__.pop(k, None)
-        lam_hat, band_peaks = self._start_fit(data)
+        search = self._default_search(data)  # one default peak search for every refit below
+        lam_hat, band_peaks = self._start_fit(data, search)
         m_hat = mass_prior_value(data, self.mass_prior)
         begun = dict(self.__dict__)
         refused = ""
-        self._fit_banded(data, lam_hat, band_peaks, m_hat, self.cubic)
+        self._fit_banded(data, lam_hat, band_peaks, m_hat, self.cubic, search)
         why = self.__dict__.pop("_cubic_diverged", "")
         if why:
             # A cubic model that neither the SGD nor its warm start can run from the record's
@@ -1113,7 +1133,7 @@ class SGDSINDy(SGDSINDyBase):
                                                                               self.learning_rate)
             begun = dict(self.__dict__)
             try:
-                self._fit_banded(data, lam_hat, band_peaks, m_hat, False)
+                self._fit_banded(data, lam_hat, band_peaks, m_hat, False, search)
             except (IdentificationError, np.linalg.LinAlgError) as e:
                 # review 23e: the refusal's reason is part of what went wrong
                 raise IdentificationError(f"cubic refused ({why}); the linear refit failed: "
@@ -1122,12 +1142,14 @@ class SGDSINDy(SGDSINDyBase):
             self.cubic_rule_ = refused
         unpaired = self.__dict__.pop("_lowest_unpaired", "")
         if unpaired:
-            self._lowest_peak_refit(data, lam_hat, band_peaks, m_hat, begun, refused, unpaired)
+            self._lowest_peak_refit(data, lam_hat, band_peaks, m_hat, begun, refused, unpaired,
+                                    search)
         return self
 
     def _lowest_peak_refit(self, data: Measurement, lam_hat: np.ndarray,
                            band_peaks: np.ndarray | None, m_hat: float, begun: dict[str, Any],
-                           refused: str, unpaired: str) -> None:
+                           refused: str, unpaired: str,
+                           search: Callable[[], PeakSearch]) -> None:
         """The kept warm start was the tilted one with its damping projected, a repair the
         record did not choose (``unpaired``: :func:`identify._sgd_matrix.lowest_peak_unpaired`'s
         statement where it missed the lowest measured peak, else
@@ -1161,7 +1183,7 @@ class SGDSINDy(SGDSINDyBase):
         self.__dict__.update(begun)
         try:
             self._fit_banded(data, lam_hat, band_peaks, m_hat,
-                             self.cubic if not refused else False, lowest_flat=True)
+                             self.cubic if not refused else False, search, lowest_flat=True)
         except (IdentificationError, np.linalg.LinAlgError, FloatingPointError) as e:
             self.__dict__.clear()
             self.__dict__.update(first)
@@ -1212,12 +1234,15 @@ class SGDSINDy(SGDSINDyBase):
                 + f" (record agreement {show(a_flat)} against {show(a_first)}): first fit kept")
 
     def _fit_banded(self, data: Measurement, lam_hat: np.ndarray, band_peaks: np.ndarray | None,
-                    m_hat: float, cubic: bool | None, lowest_flat: bool = False) -> None:
+                    m_hat: float, cubic: bool | None, search: Callable[[], PeakSearch],
+                    lowest_flat: bool = False) -> None:
         """The fit with the fit band's refusals (:meth:`fit`'s body before the cubic's refusal),
         from the state :meth:`_start_fit` left; ``cubic``: the cubic setting a refit without
         the band chooses the library by (``self.cubic``, or False for the linear refit);
-        ``lowest_flat``: a projected tilted warm start is refused (it misses the lowest
-        measured peak, or carries every one: ``PROJECTED_DOUBT``;
+        ``search``: :meth:`_start_fit`'s default peak search of ``data`` (the cubic rule of a
+        refit without the band reads it, searched once a fit, not once a refit, and not at all
+        where the library is set); ``lowest_flat``: a projected tilted warm start is refused
+        (it misses the lowest measured peak, or carries every one: ``PROJECTED_DOUBT``;
         ``MatrixSGDSettings.lowest_peak_flat``)."""
         begun = dict(self.__dict__)
 
@@ -1225,10 +1250,10 @@ class SGDSINDy(SGDSINDyBase):
             if cut is not None:  # the refit without the band, from the state _start_fit left
                 self.__dict__.clear()
                 self.__dict__.update(begun)
-                ps = self._search(data)
+                ps = search() if cubic is None else None  # a set library reads no peaks
                 self.cubic_, self.cubic_rule_ = cubic_rule(
-                    data, cubic, cut, None if cubic is not None else ps.peaks,
-                    ps if cubic is None and self._lower_modes() else None)
+                    data, cubic, cut, None if ps is None else ps.peaks,
+                    ps if ps is not None and self._lower_modes() else None)
                 self.learning_rate_, self.learning_rate_rule_ = learning_rate_for(
                     self.cubic_, self.learning_rate)
             self._fit_in_band(data, lam_hat, band_peaks, m_hat, cut, lowest_flat)
