@@ -1094,7 +1094,7 @@ def _physical_placed(sig: list[np.ndarray], m_hat: float, top_hz: float, peaks: 
     return placed
 
 
-def _kept_cubic(K3: np.ndarray | None) -> bool:
+def kept_cubic(K3: np.ndarray | None) -> bool:
     """Whether a warm start's cubic stiffness [N/m^3] has a nonzero entry (its lasso kept an
     ``x^3`` term)."""
     return K3 is not None and bool(np.any(K3 != 0.0))
@@ -1252,7 +1252,7 @@ def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
                 sig = fit_signals(False)
                 (M0, C0, K0, K30), pr = start(sig)
     if (not tilted and est.cubic and est.fit_tilt is None and est.init == "lstsq"
-            and not _kept_cubic(K30)):
+            and not kept_cubic(K30)):
         # The tilted cubic warm start was refused.  A flat warm start whose lasso kept no x^3
         # term is a linear model: its linear columns are fitted again tilted (the linear rule;
         # the x^3 columns the lasso removed stay out, K3 = 0 and off the SGD's support), unless

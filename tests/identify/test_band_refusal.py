@@ -24,8 +24,8 @@ def test_sgd_sindy_refuses_a_band_that_removed_its_mode_1(chain, monkeypatch):
     code kept the band (fit_band_hz_ 164 Hz)."""
     real = SGDSINDy._start_fit
 
-    def start(self, data):
-        lam, peaks = real(self, data)
+    def start(self, data, search=None):
+        lam, peaks = real(self, data, search)
         return lam, None if peaks is None else peaks[1:]  # mode 1's peak not accepted
 
     monkeypatch.setattr(SGDSINDy, "_start_fit", start)
