@@ -487,8 +487,13 @@ class SGDSINDy(SGDSINDyBase):
         library's fit.  Why the user's ``True`` is not honoured there, where ``fit_tilt``'s is
         (refused, an error): such a model has no response to score, while the rig's record
         still has a linear part to fit; the scorer names the missing cubic where the truth's
-        cubic force would move a frequency past its bar ("linear model").  The shipped soft
-        scenario's table, and so the families' soft members, set ``True``.
+        cubic force would move a frequency past its bar ("linear model").  With ``l1 =
+        'cubic'`` (the default) ``True`` offers the cubic library and the data select its terms:
+        the lasso may zero them, and a kept cubic whose own backbone contradicts a measured
+        decay is compared with the linear fit, the model explaining more of its record kept
+        (:meth:`_linear_if_it_explains_more`, stated in ``cubic_rule_``); ``True`` with ``l1 =
+        'none'`` keeps the cubic model asked for.  The shipped soft scenario's table, and so
+        the families' soft members, set ``True`` (with ``l1 = 'cubic'``).
     l1 : {"cubic", "none"}
         ``"cubic"``: the lasso on the standardised cubic coefficients, then debiasing (acts
         only with ``cubic=True``); ``"none"``: no L1, the cubic block is plain least squares.
@@ -1127,7 +1132,11 @@ class SGDSINDy(SGDSINDyBase):
         refused = ""
         self._fit_banded(data, lam_hat, band_peaks, m_hat, self.cubic, search)
         why = self.__dict__.pop("_cubic_diverged", "")
-        doubt = "" if why else self._cubic_contradicts_decay()
+        # the doubt compares the libraries where the cubic terms are the data's to select (by
+        # rule, or cubic = true with the lasso on them); cubic = true with l1 = 'none' asks for
+        # the cubic model itself, which is kept (review 25e)
+        chosen_by_data = self.cubic is None or self.l1 == "cubic"
+        doubt = "" if why or not chosen_by_data else self._cubic_contradicts_decay()
         if why:
             # A cubic model that neither the SGD nor its warm start can run from the record's
             # own start is refused and the linear library fitted (ls_sindy's step 4 (b)):
@@ -1188,14 +1197,29 @@ class SGDSINDy(SGDSINDyBase):
         a_first = self._kept_agreement()
         if not (np.isfinite(a_first) and 1.0 - a_first > SGD_AGREEMENT_FLOOR):
             return
-        trial = self.clone().set_params(cubic=True, l1="none")
+        declared = type(self).declared_hyperparameters()
+        # the lasso's keys at their defaults: a user's l1_threshold / l1_debias are read only
+        # with l1 = 'cubic' and would refuse the trial (review 25e)
+        trial = self.clone().set_params(cubic=True, l1="none",
+                                        l1_threshold=declared["l1_threshold"].default,
+                                        l1_debias=declared["l1_debias"].default)
+        callback = self.__dict__.get("_progress_callback")
+        if callback is not None:  # the trial reports as the fit does (review 25e)
+            trial.__dict__["_progress_callback"] = callback
+        first = f"that model (no cubic term) leaves {1.0 - a_first:.2g} of its record unexplained"
         try:
             trial._fit_with(data, search)  # (the same record and lower_modes: the same peaks)
-        except (IdentificationError, np.linalg.LinAlgError, FloatingPointError):
-            return  # (the first fit stands; nothing it states changes)
+        except Exception as e:  # a trial the record never needed must not fail the fit
+            self.cubic_rule_ += (f"; {first}, the whole cubic library's fit failed "
+                                 f"({type(e).__name__}: {e}): no cubic")
+            return
         a_cubic = trial._kept_agreement()
         if not (kept_cubic(trial.K3_) and np.isfinite(a_cubic)
                 and 1.0 - a_first > SGD_AGREEMENT_RATIO * (1.0 - a_cubic)):
+            said = (f"{1.0 - a_cubic:.2g}" if np.isfinite(a_cubic) else "not measured") \
+                if kept_cubic(trial.K3_) else "no cubic term either"
+            self.cubic_rule_ += (f"; {first}, the whole cubic library's fit {said}, not under 1 / "
+                                 f"{SGD_AGREEMENT_RATIO:g} of it: no cubic")
             return
         peaks = np.asarray(getattr(self, "measured_frequencies_", np.empty(0)), dtype=float)
         if peaks.size:
@@ -1204,12 +1228,18 @@ class SGDSINDy(SGDSINDyBase):
             # 31.7 / 227.7 / 362.6 Hz, mode 2 then paired 4.1 % off; the linear 1.5 %)
             modes = np.asarray(trial.natural_frequencies_, dtype=float)
             if np.count_nonzero(modes < peaks.max() * (1.0 + MODE_SEPARATION)) > peaks.size:
+                self.cubic_rule_ += (f"; {first}, the whole cubic library's fit "
+                                     f"{1.0 - a_cubic:.2g}, but it puts more modes among the "
+                                     f"measured peaks than were located ({peaks.size}): no cubic")
                 return
-        user = {k: getattr(self, k) for k in ("cubic", "l1")}
+        user = {k: getattr(self, k) for k in ("cubic", "l1", "l1_threshold", "l1_debias")}
         rule = self.cubic_rule_
         self.__dict__.clear()
         self.__dict__.update(trial.__dict__)
         self.__dict__.update(user)
+        self.hardened_peak_rule_ = ("every measured peak holds its mode from both sides (the whole "
+                                    "cubic library's refit, cubic = true inside it: the lowest "
+                                    "peak's third-harmonic bound not applied)")
         self.cubic_rule_ = (
             f"{rule}; but that model (no cubic term) leaves {1.0 - a_first:.2g} of its record "
             f"unexplained, the whole cubic library's fit (l1 = 'none') {1.0 - a_cubic:.2g}, under "

@@ -389,3 +389,23 @@ def test_a_model_with_no_cubic_term_that_leaves_its_record_unexplained_tries_the
     f_true = np.asarray(ds.truth["frequencies_hz"])[:1]
     # issue #15's 1 % on mode 1 (the old code: 2.33 % high)
     np.testing.assert_allclose(model.natural_frequencies_[:1], f_true, rtol=0.01)
+    # review 25e: a user's lasso key (read only with l1 = 'cubic') refused the trial's
+    # l1 = 'none' in silence: the trial takes the lasso's defaults, the user's value stays
+    tuned = SGDSINDy(l1_debias=0.49).fit(measure(ds, sc.signal, "structural"))
+    assert tuned.cubic_ and tuned.l1_debias == 0.49
+    np.testing.assert_allclose(tuned.natural_frequencies_[:1], f_true, rtol=0.01)
+
+
+def test_a_users_cubic_without_the_lasso_is_never_doubted(dataset_cache, monkeypatch):
+    """Review 25e: the doubt (a cubic contradicting a measured decay compared with the linear
+    fit) overrode a user's ``cubic = true``.  It compares the libraries where the data select
+    the cubic terms (by rule, or ``cubic = true`` with the lasso, ``l1 = 'cubic'``); ``cubic =
+    true`` with ``l1 = 'none'`` asks for the cubic model itself.  Every cubic is made doubted
+    here (the test's own stand-in for the decay test) on round 23's brass at 0.7 %."""
+    sc = load_scenario(ROUND16.parent / "round23" / "b23_br_soft_r1_cf0p4_hit0p3.toml"
+                       ).with_noise(0.7).replace(seed=142)
+    data = measure(dataset_cache.get(sc), sc.signal, "structural")
+    monkeypatch.setattr(SGDSINDy, "_cubic_contradicts_decay", lambda self: "doubted by the test")
+    assert "the fitted cubic model doubted" in SGDSINDy(cubic=True).fit(data).cubic_rule_
+    asked = SGDSINDy(cubic=True, l1="none").fit(data)
+    assert asked.cubic_ and asked.cubic_rule_ == "user setting"
