@@ -119,7 +119,7 @@ class _SpringOnTheCart:
         self.coef_[0, -1] = k * truth.equation_coef[0, self.feature_names_.index("ddth1")]
 
     def simulate(self, x0, xd0, t, u):
-        x = law_rollout(self.feature_names_, self.coef_, x0, xd0, u, t[1] - t[0], [1.0], 4)[0]
+        x = law_rollout(self.feature_names_, self.coef_, x0, xd0, u, t[1] - t[0], [1.0])[0]
         xd = np.gradient(x, t, axis=1)
         return Trajectory(x, xd, np.gradient(xd, t, axis=1))
 
