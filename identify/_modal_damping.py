@@ -672,6 +672,7 @@ def modal_decay(data: Measurement, M: np.ndarray, K: np.ndarray, C: np.ndarray,
     retry: dict[int, int] = {}  # modes fitted from a free peak whose fit failed: how many
     #                              decays were taken when it was tried (see below)
     order = np.concatenate([np.flatnonzero(~free), np.flatnonzero(free)])
+    pband = peak_band(data, i1 - i0)[0]  # [Hz]
     for k in order:
         s, wd, r2, ok, c, amp = _decay_fit(q[k], t, 0.5 * d[k], w[k], backbone, nuisance)
         if backbone and ok and abs(c) > BACKBONE_MAX_SHIFT * wd and free[k]:
@@ -683,7 +684,7 @@ def modal_decay(data: Measurement, M: np.ndarray, K: np.ndarray, C: np.ndarray,
             out.exponential[k] = ok
         peak = _free_peak(free_peaks_hz, w, k, data, i1 - i0) if free[k] and not backbone \
             else None
-        band_k = unlocated_band(w, k, peak_band(data, i1 - i0)[0])
+        band_k = unlocated_band(w, k, pband)
         unseen = unseen_band(w, k, data, i1 - i0) if free[k] and not backbone and peak is None \
             else None
         if unseen is not None:
@@ -692,7 +693,7 @@ def modal_decay(data: Measurement, M: np.ndarray, K: np.ndarray, C: np.ndarray,
             # (module docstring, "An unlocated mode's starts")
             s, wd, r2, ok = _spread_fit(q[k], t, 0.5 * d[k], (s, wd, r2, ok), unseen, nuisance)
             if ok and wd >= unseen[0]:  # its band's top raised to the low-pass, as the spread's
-                band_k = (unlocated_band(w, k, decay_band(data, i1 - i0))[0], unseen[1])
+                band_k = (band_k[0], unseen[1])
         out.r2[k] = r2
         paired = abs(np.log(wd / w[k])) <= np.log1p(MODE_SEPARATION)
         if peak is not None:  # from the measured peak no mode took (free_peaks_hz)
@@ -891,49 +892,27 @@ def unlocated_band(w: np.ndarray, k: int, peak_band_hz: tuple[float, float]) -> 
     return float(lo), float(hi)
 
 
-def decay_band(data: Measurement, n_window: int) -> tuple[float, float]:
-    """The band [Hz] an unlocated mode's decay is searched in: the peak band
-    (:func:`identify.structural.peak_band`) with its top raised to the chain's declared
-    low-pass cut-off where that lies below the Nyquist frequency.
+def unseen_band(w: np.ndarray, k: int, data: Measurement, n_window: int
+                ) -> tuple[float, float] | None:
+    """The part of mode ``k``'s :func:`unlocated_band` the peak search could not see [rad/s]:
+    above the peak band's top (:func:`identify.structural.peak_band`) up to the band's top,
+    the chain's declared low-pass its edge; None where that part is empty (no declared
+    low-pass below the Nyquist frequency, or the mode's band ends below the peak band's top).
+    ``w`` the model's undamped frequencies [rad/s], ascending; ``n_window`` the fit window's
+    samples.  Module docstring, "An unlocated mode's starts".
 
     The peak band stops at 0.8 x the low-pass because a peak there is bent by the filter's
     roll-off; a decay fitted beside the chain's declared transients is not, and a mode between
     0.8 x and 1 x the cut-off is still in the record (round 23's beryllium at 3.2 kHz, low-pass
-    1.5 kHz: mode 2 at 1246 Hz, no peak searched there).  Module docstring, "An unlocated
-    mode's starts".
-
-    Parameters
-    ----------
-    data : Measurement
-    n_window : int
-        Samples in the fit window.
-
-    Returns
-    -------
-    (float, float)
-        Lower and upper edge [Hz].
-    """
-    (lo, hi), _ = peak_band(data, n_window)
-    if data.passband is not None and float(data.passband[1]) < data.fs / 2.0:
-        hi = max(hi, float(data.passband[1]))
-    return lo, hi
-
-
-def unseen_band(w: np.ndarray, k: int, data: Measurement, n_window: int
-                ) -> tuple[float, float] | None:
-    """The part of mode ``k``'s :func:`unlocated_band` the peak search could not see [rad/s]:
-    above the peak band's top (:func:`identify.structural.peak_band`) up to the band's top
-    with the chain's declared low-pass as its edge (:func:`decay_band`); None where that part
-    is empty (no declared low-pass below the Nyquist frequency, or the mode's band ends below
-    the peak band's top).  ``w`` the model's undamped frequencies [rad/s], ascending;
-    ``n_window`` the fit window's samples.  Module docstring, "An unlocated mode's starts"."""
+    1.5 kHz: mode 2 at 1246 Hz, no peak searched there).  Above the low-pass (and above
+    Nyquist) a decay fit cannot tell a frequency from its alias: the band is clipped there
+    (review 25d: the top mode's 1.5 w_k reached past both)."""
     if data.passband is None or not float(data.passband[1]) < data.fs / 2.0:
         return None  # no declared low-pass below Nyquist: nothing the chain passes goes unseen
-    (_, top), _ = peak_band(data, n_window)
-    lo, hi = unlocated_band(w, k, decay_band(data, n_window))
-    # clipped to the low-pass: above it (and above Nyquist) a decay fit cannot tell a
-    # frequency from its alias (review 25d: the top mode's 1.5 w_k reached past both)
-    lo, hi = max(lo, 2.0 * np.pi * top), min(hi, 2.0 * np.pi * float(data.passband[1]))
+    (plo, top), _ = peak_band(data, n_window)
+    lp = float(data.passband[1])
+    lo, hi = unlocated_band(w, k, (plo, max(top, lp)))
+    lo, hi = max(lo, 2.0 * np.pi * top), min(hi, 2.0 * np.pi * lp)
     return (lo, hi) if lo < hi else None
 
 

@@ -994,6 +994,7 @@ def reach_moves(freqs_hz: np.ndarray, reach_hz: np.ndarray, limit_hz: np.ndarray
     """
     f = np.asarray(freqs_hz, dtype=float)
     reach, limit = np.asarray(reach_hz, dtype=float), np.asarray(limit_hz, dtype=float)
+    floor = None if floor_hz is None else np.asarray(floor_hz, dtype=float)
     to = np.where(limit <= reach, limit, reach)
     none = np.zeros(f.shape, dtype=bool)
     if not chirp1 > CUBIC_CHIRP_MIN * omega_d1:
@@ -1001,15 +1002,14 @@ def reach_moves(freqs_hz: np.ndarray, reach_hz: np.ndarray, limit_hz: np.ndarray
                 f"mode 1's backbone chirp c / wd {chirp1 / omega_d1:.3g} <= {CUBIC_CHIRP_MIN:g}")
         return none, to, f"the record is not seen hardening ({said}): nothing moved"
     above = f > reach
-    below = np.zeros(f.shape, dtype=bool) if floor_hz is None else \
-        ~above & (f < np.asarray(floor_hz, dtype=float))  # NaN compares False
+    below = np.zeros(f.shape, dtype=bool) if floor is None else ~above & (f < floor)  # NaN: False
     to = np.where(below, limit, to)
     if not np.any(above | below):
         return none, to, ("the record hardens, every mode within its reach ("
                           + ", ".join(f"{a:.4g} <= {r:.4g} Hz" for a, r in zip(f, reach, strict=True))
-                          + ")" + ("" if floor_hz is None else " and above its floor" + "".join(
-                              f", {a:.4g} >= {lo:.4g} Hz" for a, lo in zip(f, np.asarray(floor_hz, float),
-                                                                          strict=True) if np.isfinite(lo)))
+                          + ")" + ("" if floor is None else " and above its floor" + "".join(
+                              f", {a:.4g} >= {lo:.4g} Hz" for a, lo in zip(f, floor, strict=True)
+                              if np.isfinite(lo)))
                           + ": nothing moved")
     gap = np.abs(to[:, None] - f[None, :])  # (the message names the nearer mode)
     nearest = nearer_own(to, f)
@@ -1017,7 +1017,7 @@ def reach_moves(freqs_hz: np.ndarray, reach_hz: np.ndarray, limit_hz: np.ndarray
     left = np.flatnonzero((above | below) & ~nearest)
     why = "; ".join(
         f"mode {j + 1} {'above its reach' if above[j] else 'below its floor'} ({f[j]:.4g} "
-        f"{'>' if above[j] else '<'} {reach[j] if above[j] else floor_hz[j]:.4g} Hz) left: its target "
+        f"{'>' if above[j] else '<'} {reach[j] if above[j] else floor[j]:.4g} Hz) left: its target "
         f"{to[j]:.4g} Hz lies nearer mode {int(np.argmin(gap[j])) + 1}'s {f[np.argmin(gap[j])]:.4g} Hz"
         for j in left)
     return move, to, why

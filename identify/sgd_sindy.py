@@ -1144,12 +1144,7 @@ class SGDSINDy(SGDSINDyBase):
             # shipped soft scenario's table) were scored "diverged" (TRAC NaN); linear, TRAC
             # 0.967 / 0.976 / 0.939 with modes 1-2 within 2.2 %
             refused = f"{self.cubic_rule_}; the fitted cubic model refused ({why}): cubic terms out"
-            self.__dict__.clear()
-            self.__dict__.update(begun)
-            self.cubic_ = False
-            self.learning_rate_, self.learning_rate_rule_ = learning_rate_for(False,
-                                                                              self.learning_rate)
-            begun = dict(self.__dict__)
+            begun = self._linear_begun(begun)
             try:
                 self._fit_banded(data, lam_hat, band_peaks, m_hat, False, search)
             except (IdentificationError, np.linalg.LinAlgError) as e:
@@ -1168,6 +1163,15 @@ class SGDSINDy(SGDSINDyBase):
         if self.cubic is None:
             self._cubic_if_it_explains_more(data, search)
         return self
+
+    def _linear_begun(self, begun: dict[str, Any]) -> dict[str, Any]:
+        """The state before the fit (``begun``) set for the linear library's fit (its learning
+        rate with it); returns that state (a later refit's start)."""
+        self.__dict__.clear()
+        self.__dict__.update(begun)
+        self.cubic_ = False
+        self.learning_rate_, self.learning_rate_rule_ = learning_rate_for(False, self.learning_rate)
+        return dict(self.__dict__)
 
     def _cubic_if_it_explains_more(self, data: Measurement,
                                    search: Callable[[], PeakSearch]) -> None:
@@ -1288,12 +1292,7 @@ class SGDSINDy(SGDSINDyBase):
         """
         first, a_cubic = dict(self.__dict__), self._kept_agreement()
         rule = self.cubic_rule_
-        self.__dict__.clear()
-        self.__dict__.update(begun)
-        self.cubic_ = False
-        self.learning_rate_, self.learning_rate_rule_ = learning_rate_for(False,
-                                                                          self.learning_rate)
-        linear_begun = dict(self.__dict__)
+        linear_begun = self._linear_begun(begun)
         try:
             self._fit_banded(data, lam_hat, band_peaks, m_hat, False, search)
         except (IdentificationError, np.linalg.LinAlgError, FloatingPointError) as e:

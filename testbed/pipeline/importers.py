@@ -1180,8 +1180,6 @@ def uniform_rate(path: Path, t: np.ndarray, what: str = "time column") -> float:
 # --------------------------------------------------------------------------- readers
 def _read_hdf5(path: Path) -> _Raw:
     _check_hdf5_size(path)
-    check_hdf5_rate(path)
-    check_hdf5_storage(path)
     return _raw_from_dataset(path, read_dataset_file(path))
 
 
@@ -1541,13 +1539,16 @@ def apply_hdf5_declarations(ds: Dataset, reads: Mapping[tuple[str, str], tuple[s
 
 
 def read_dataset_file(path: str | os.PathLike) -> Dataset:
-    """A dataset file read as it declares: :func:`check_hdf5_declarations`,
-    :func:`load_dataset` (content hash verified), :func:`apply_hdf5_declarations`.
+    """A dataset file read as it declares: :func:`check_hdf5_rate`, :func:`check_hdf5_storage`,
+    :func:`check_hdf5_declarations`, :func:`load_dataset` (content hash verified),
+    :func:`apply_hdf5_declarations`.
 
     Raises
     ------
     MeasuredDataError
     """
+    check_hdf5_rate(path)
+    check_hdf5_storage(path)
     reads = check_hdf5_declarations(path)
     return apply_hdf5_declarations(load_dataset(path), reads)
 
@@ -1816,7 +1817,6 @@ def _read_uff(path: Path) -> _Raw:
         raise MeasuredDataError(path, f"unreadable UFF file ({type(e).__name__}: {e})") from None
     if not any(int(t) == 58 for t in types):
         raise MeasuredDataError(path, "no UFF58 (function at nodal DOF) record")
-    coords: dict[int, float] = {}
     placed: dict[int, tuple[np.ndarray, str, int]] = {}
     raw = _Raw(path, "uff", None, {}, {})
     rates: dict[str, float] = {}
@@ -1828,13 +1828,14 @@ def _read_uff(path: Path) -> _Raw:
                 raise MeasuredDataError(path, f"units record (164, code {s.get('units_code')}) is not SI: "
                                               f"length factor {factors[0]:g}, force factor {factors[1]:g}")
         elif kind in (15, 2411):
-            _add_nodes(path, k, kind, s, coords, placed)
+            _add_nodes(path, k, kind, s, placed)
         elif kind == 58:
             name, rate = _uff58_channel(path, k, s, raw)
             rates[name] = rate
     for name, node in raw.nodes.items():
-        if node in coords:
-            raw.positions[name] = check_position(path, name, coords[node], f"node {node} x")
+        if node in placed:
+            raw.positions[name] = check_position(path, name, float(placed[node][0][0]),
+                                                 f"node {node} x")
     raw.fs = _common_rate(path, rates, 1e-5)
     return raw
 
@@ -1846,11 +1847,10 @@ def _read_uff(path: Path) -> _Raw:
 NODE_RTOL = 1e-5
 
 
-def _add_nodes(path: Path, k: int, kind: int, s: Mapping[str, Any], coords: dict[int, float],
+def _add_nodes(path: Path, k: int, kind: int, s: Mapping[str, Any],
                placed: dict[int, tuple[np.ndarray, str, int]]) -> None:
     """Add the nodes of one geometry record (UFF15 or UFF2411, the ``k``-th record) to
-    ``coords`` (node -> x [m]) and ``placed`` (node -> ((x, y, z), where it was given, the
-    record's kind)).
+    ``placed`` (node -> ((x, y, z) [m], where it was given, the record's kind)).
 
     Round 24: a node given twice at different places (twice in one UFF2411 record, in two
     geometry records, by a UFF2411 and a UFF15 record) was read at the last place in silence,
@@ -1890,7 +1890,6 @@ def _add_nodes(path: Path, k: int, kind: int, s: Mapping[str, Any], coords: dict
             if not (kind == 2411 and said_kind == 15):
                 continue  # the first place stays, unless a UFF2411 record gives more digits
         placed[node] = (at, where, kind)
-        coords[node] = float(at[0])
 
 
 #: The block delimiter as pyuff finds it: ``    -1`` then a line end, the file's end, or blanks

@@ -56,8 +56,6 @@ from testbed.core.dataset import Dataset, Signal
 from testbed.core.errors import ArgumentError
 from testbed.core.truth import StructuralTruth
 from testbed.pipeline.importers import (
-    check_hdf5_rate,
-    check_hdf5_storage,
     check_recorded,
     read_dataset_file,
 )
@@ -417,10 +415,8 @@ def export_dataset(path: str | os.PathLike, fmt: str, out: str | os.PathLike | N
             raise ArgumentError("export_dataset", name, value, f"of type {type(value).__name__}; "
                                                                "expected a file path (str or os.PathLike)")
     path = Path(path)
-    check_hdf5_rate(path)
-    check_hdf5_storage(path)
-    # naming a damaged array (round 22); a unit stored as bytes decoded and positions in mm
-    # converted to metres, as the file declares them (review 25a)
+    # its rate and storage checked, naming a damaged array (round 22); a unit stored as bytes
+    # decoded and positions in mm converted to metres, as the file declares them (review 25a)
     ds = read_dataset_file(path)
     check_recorded(ds, path)  # an edited, rehashed file: NaN rate or samples, cut channels
     if fmt == "uff":

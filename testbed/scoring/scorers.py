@@ -2180,7 +2180,8 @@ def drift_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -> d
     is missed, every coordinate off the bar is free in the true law and in the identified one
     and its rollout error about its own least-squares quadratic in time (``a + b t + c t^2``:
     an offset, a rate error and a constant acceleration error integrated; more than three
-    samples) is within the bar and smaller than the quadratic itself (RMS).  Reasons only: the bar's failure stands (no verdict changes).
+    samples) is within the bar and smaller than the quadratic itself (RMS).  Reasons only: the
+    bar's failure stands (no verdict changes).
     Round 24's ``cp24_pole_m1`` (a 1 kg pole on the 1 kg cart) at 3 % s159: law_error 0.0122
     (bar 0.25), the cart 0.0578 m against 0.0501 (the pole 0.0024 rad), its error -0.135 m at
     10 s and 0.0055 m about a quadratic; at 1.5 % s151 0.0620 m, 0.0030 about a quadratic; no
@@ -2208,7 +2209,8 @@ def drift_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -> d
         return {}  # another bar missed too: the drift would hide it (review 25c)
     per = np.asarray(d[score], dtype=float)
     off = np.flatnonzero(~(per <= bar))
-    if off.size == 0 or not set(off.tolist()) <= set(free):
+    offs = set(off.tolist())
+    if off.size == 0 or not offs <= set(free):
         return {}
     t = np.asarray(d["t"], dtype=float)
     if t.size <= 3:  # a quadratic fits three samples exactly: no evidence of a drift
@@ -2228,7 +2230,7 @@ def drift_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -> d
     ch = list(d.get("channels") or [f"q{k + 1}" for k in range(per.size)])
     drifts = ", ".join(f"{ch[k]} {per[k]:.3g} ({a:.3g} about a quadratic in time, {err[j, -1]:+.3g} "
                        "at the end)" for j, (k, a) in enumerate(zip(off, about, strict=True)))
-    rest = [k for k in range(per.size) if k not in set(off.tolist())]
+    rest = [k for k in range(per.size) if k not in offs]
     held = ("; " + ", ".join(f"{ch[k]} {per[k]:.3g}" for k in rest) + " within it") if rest else ""
     return {"drift": (f"drift: {score} {got:.3g} against the bar {bar:g} with the law within "
                       f"law_error {law:.3g} (bar {law_bar:g}): off the bar only {drifts}, a "
