@@ -135,8 +135,10 @@ def test_a_mode_1_the_band_removed_is_refitted_without_the_band(dataset_cache, m
 
     The refit without the band reads the default peak search the first fit made of the same
     record (issue #13: it searched again for each refit, three searches, 0.014 s of CPU each
-    here): one search a fit, and the model bit for bit the one a fresh search for every use
-    gives (the search is a function of the record and ``lower_modes`` alone)."""
+    here): one search a fit.  The model is bit for bit the one a fresh search for every use
+    gives (the search is a function of the record and ``lower_modes`` alone): measured on 411
+    ``sgd_sindy`` cells, M, C, K, K3 hashed (docs/known-gaps.md, sgd25); a second fit here to
+    show it again cost 14 s of the suite's tail and is left to that measurement."""
     sc = load_scenario(ROUND19 / "b19_ti_L0p9_n18_s5_2s.toml").with_noise(2.0).replace(seed=102)
     ds = dataset_cache.get(sc)
     data = measure(ds, sc.signal, "structural")
@@ -154,13 +156,6 @@ def test_a_mode_1_the_band_removed_is_refitted_without_the_band(dataset_cache, m
     f_true = np.asarray(ds.truth["frequencies_hz"])[:2]
     np.testing.assert_allclose(model.natural_frequencies_[:2], f_true, rtol=0.01)  # issue #15
     assert len(searched) == 1  # the old code: 3 (the same default search for each refit)
-    # every use searching afresh (the old path, and more) gives the same model, bit for bit
-    monkeypatch.setattr(SGDSINDy, "_default_search", lambda self, d: lambda: self._search(d))
-    fresh = SGDSINDy().fit(data)
-    assert len(searched) > 2
-    for a in ("M_", "C_", "K_"):
-        np.testing.assert_array_equal(getattr(fresh, a), getattr(model, a))
-    assert (fresh.fit_band_rule_, fresh.cubic_rule_) == (model.fit_band_rule_, model.cubic_rule_)
 
 
 def test_a_mode_the_others_outlive_has_its_target_lowered_by_their_stiffening(dataset_cache):
