@@ -669,8 +669,9 @@ def modal_decay(data: Measurement, M: np.ndarray, K: np.ndarray, C: np.ndarray,
     nuisance = chain_transients(getattr(data, "chain_poles", None), t)
     free = np.zeros(n, bool) if unlocated is None else np.asarray(unlocated, bool)
     fits: dict[int, tuple[float, float]] = {}
-    retry: dict[int, int] = {}  # modes fitted from a free peak whose fit failed: how many
-    #                              decays were taken when it was tried (see below)
+    # modes fitted from a free peak whose fit failed: (how many decays were taken when it was
+    # tried, its band)
+    retry: dict[int, tuple[int, tuple[float, float]]] = {}
     order = np.concatenate([np.flatnonzero(~free), np.flatnonzero(free)])
     pband = peak_band(data, i1 - i0)[0]  # [Hz]
     for k in order:
@@ -682,9 +683,8 @@ def modal_decay(data: Measurement, M: np.ndarray, K: np.ndarray, C: np.ndarray,
             if out.exponential is None:
                 object.__setattr__(out, "exponential", np.zeros(n, bool))
             out.exponential[k] = ok
-        peak = _free_peak(free_peaks_hz, w, k, data, i1 - i0) if free[k] and not backbone \
-            else None
         band_k = unlocated_band(w, k, pband)
+        peak = _free_peak(free_peaks_hz, band_k) if free[k] and not backbone else None
         unseen = unseen_band(w, k, data, i1 - i0) if free[k] and not backbone and peak is None \
             else None
         if unseen is not None:
@@ -697,11 +697,11 @@ def modal_decay(data: Measurement, M: np.ndarray, K: np.ndarray, C: np.ndarray,
         out.r2[k] = r2
         paired = abs(np.log(wd / w[k])) <= np.log1p(MODE_SEPARATION)
         if peak is not None:  # from the measured peak no mode took (free_peaks_hz)
-            s, wd, ok = _from_free_peak(out, k, peak, xdd[:, i0:i1], t, w, d, nuisance, fits,
-                                        data, i1 - i0)
+            s, wd, ok = _from_free_peak(out, k, peak, band_k, xdd[:, i0:i1], t, 0.5 * abs(d[k]),
+                                        nuisance, fits)
             paired = True
-            if not ok:
-                retry[k] = len(fits)
+            if not ok:  # (band_k is never widened on this path: the spread needs no peak)
+                retry[k] = (len(fits), band_k)
         elif free[k] and not backbone and not (ok and paired):
             # no peak located it and its modal coordinate's fit is not taken: every channel's
             # record, between its neighbours (module docstring, "Unlocated modes")
@@ -717,11 +717,11 @@ def modal_decay(data: Measurement, M: np.ndarray, K: np.ndarray, C: np.ndarray,
     # a fit from a free peak that failed before some later mode's decay was taken is tried
     # once more with every taken decay profiled out (module docstring, "A free peak's fit
     # retried"); a linear model's modes only (``retry`` holds no backbone fit)
-    for k, before in retry.items():
+    for k, (before, band) in retry.items():
         if len(fits) == before:  # nothing new to profile out (``fits`` only gains: a decay
             continue             # taken after its try, by a later mode or a retry; review 24c)
-        s, wd, ok = _from_free_peak(out, k, 2.0 * np.pi * float(out.peak_hz[k]),
-                                    xdd[:, i0:i1], t, w, d, nuisance, fits, data, i1 - i0)
+        s, wd, ok = _from_free_peak(out, k, 2.0 * np.pi * float(out.peak_hz[k]), band,
+                                    xdd[:, i0:i1], t, 0.5 * abs(d[k]), nuisance, fits)
         if ok:
             fits[k] = (s, wd)
             _take(out, k, s, wd, fs if trap else None, w_model[k])
@@ -742,19 +742,17 @@ def _take(out: ModalDecay, k: int, s: float, wd: float, trap_fs: float | None,
     out.shift[k] = abs(abs(pole) - w_model) / (2.0 * np.pi)
 
 
-def _from_free_peak(out: ModalDecay, k: int, peak: float, x: np.ndarray, t: np.ndarray,
-                    w: np.ndarray, d: np.ndarray, nuisance: np.ndarray | None,
-                    fits: dict[int, tuple[float, float]], data: Measurement, n_window: int
-                    ) -> tuple[float, float, bool]:
+def _from_free_peak(out: ModalDecay, k: int, peak: float, band: tuple[float, float],
+                    x: np.ndarray, t: np.ndarray, sigma0: float, nuisance: np.ndarray | None,
+                    fits: dict[int, tuple[float, float]]) -> tuple[float, float, bool]:
     """Mode ``k``'s decay fitted on every channel of the window ``x`` [m/s^2] (times ``t``
     [s]) from the accepted peak ``peak`` [rad/s] no mode took (:func:`_unlocated_fit`, within
-    :func:`unlocated_band` of the model's frequencies ``w`` [rad/s], started at half its modal
-    damping ``d[k]`` [1/s]), the decays ``fits`` profiled out; the peak [Hz] and, where the
-    fit converged, its shape (:func:`peak_shape`) stored in ``out``.  Returns
-    ``(sigma, omega_d, ok)`` as :func:`_unlocated_fit`."""
+    its :func:`unlocated_band` ``band`` [rad/s], started at the decay rate ``sigma0`` [1/s]),
+    the decays ``fits`` profiled out; the peak [Hz] and, where the fit converged, its shape
+    (:func:`peak_shape`) stored in ``out``.  Returns ``(sigma, omega_d, ok)`` as
+    :func:`_unlocated_fit`."""
     n = out.sigma.size
-    s, wd, ok = _unlocated_fit(x, t, (0.5 * abs(d[k]), peak),
-                               unlocated_band(w, k, peak_band(data, n_window)[0]), nuisance, fits)
+    s, wd, ok = _unlocated_fit(x, t, (sigma0, peak), band, nuisance, fits)
     if out.peak_hz is None:
         object.__setattr__(out, "peak_hz", np.full(n, np.nan))
     out.peak_hz[k] = peak / (2.0 * np.pi)
@@ -766,13 +764,12 @@ def _from_free_peak(out: ModalDecay, k: int, peak: float, x: np.ndarray, t: np.n
     return s, wd, ok
 
 
-def _free_peak(free_peaks_hz: np.ndarray | None, w: np.ndarray, k: int, data: Measurement,
-               n_window: int) -> float | None:
-    """The one accepted peak no mode took inside mode ``k``'s :func:`unlocated_band` [rad/s]
-    (``w`` the model's undamped frequencies [rad/s]), or None (none, or more than one)."""
+def _free_peak(free_peaks_hz: np.ndarray | None, band: tuple[float, float]) -> float | None:
+    """The one accepted peak no mode took inside a mode's :func:`unlocated_band` ``band``
+    [rad/s], or None (none, or more than one)."""
     if free_peaks_hz is None or len(free_peaks_hz) == 0:
         return None
-    lo, hi = unlocated_band(w, k, peak_band(data, n_window)[0])
+    lo, hi = band
     p = 2.0 * np.pi * np.asarray(free_peaks_hz, dtype=float)
     inside = p[(p >= lo) & (p <= hi)]
     return float(inside[0]) if inside.size == 1 else None

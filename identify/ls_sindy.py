@@ -185,8 +185,8 @@ class LeastSquaresSINDy(StructuralIdentifier):
     (002 TRAC 0.987 -> 0.958, 010 0.934 -> 0.857): its old cubic still pulled mode 2 where the
     fit had put it.  The record bounds a linear frequency from below too: the read backbone
     limit removes the mode's own stiffening, not the other modes', and that is bounded by the
-    largest relative stiffening ``c / wd`` the record shows on another mode
-    (:func:`identify._modal_damping.hardened_floor`, floor ``limit (1 - max c_j / wd_j)`` less
+    largest relative stiffening ``c / wd`` the record shows on a lower mode
+    (:func:`identify._modal_damping.hardened_floor`, floor ``limit (1 - max_{j<k} c_j / wd_j)`` less
     one line); a mode below its floor is moved up to its limit, the cubic refitted the same
     way.  Round 23's ``b23_soft_s2neartip`` (the shipped soft base, two sensors near the tip)
     at 2 % noise, seed 142: errors-in-variables put the cubic fit's mode 2 at 344.3 Hz (true
@@ -711,7 +711,7 @@ class LeastSquaresSINDy(StructuralIdentifier):
                                + ")" for j in k) if k.size else "")
                 + ("; " if k.size and up.size else "")
                 + (f"modes {(up + 1).tolist()} stood below the lowest it allows (the read "
-                   "backbone limit less the other modes' largest measured stiffening c / wd, "
+                   "backbone limit less the lower modes' largest measured stiffening c / wd, "
                    "less one line): "
                    + ", ".join(f"{freqs[j]:.4g} < {floor[j]:.4g} Hz, to {to[j]:.4g} Hz (its "
                                "backbone limit)" for j in up) if up.size else ""))

@@ -176,6 +176,12 @@ def cubic_diverges(note: str) -> bool:
     return note.startswith((SIMULATION_FAILED, SIMULATION_NOT_FINITE))
 
 
+def _clearly_more(a_new: float, a_old: float) -> bool:
+    """Whether a record agreement ``a_new`` explains clearly more than ``a_old``: it leaves under
+    1 / :data:`SGD_AGREEMENT_RATIO` of the other's unexplained share (NaN: False)."""
+    return 1.0 - a_old > SGD_AGREEMENT_RATIO * (1.0 - a_new)
+
+
 def keep_sgd_rule(agree_sgd: float, agree_warm: float | None,
                   notes: tuple[str, str] = ("", "")) -> tuple[bool, str]:
     """Whether the SGD's result is kept rather than the held warm start's, and why.
@@ -1219,7 +1225,7 @@ class SGDSINDy(SGDSINDyBase):
             return
         a_cubic = trial._kept_agreement()
         if not (kept_cubic(trial.K3_) and np.isfinite(a_cubic)
-                and 1.0 - a_first > SGD_AGREEMENT_RATIO * (1.0 - a_cubic)):
+                and _clearly_more(a_cubic, a_first)):
             said = (f"{1.0 - a_cubic:.2g}" if np.isfinite(a_cubic) else "not measured") \
                 if kept_cubic(trial.K3_) else "no cubic term either"
             self.cubic_rule_ += (f"; {first}, the whole cubic library's fit {said}, not under 1 / "
@@ -1387,7 +1393,7 @@ class SGDSINDy(SGDSINDyBase):
         # between modes 1 and 2); above it families' clamped 009 clean (0.937 against 0.847,
         # 2.4 x) and held-out clamped 032 at 1 % (5.3 x; mode 2 10.2 -> 0.23 %).
         if clear:
-            better = (1.0 - a_first) > SGD_AGREEMENT_RATIO * (1.0 - a_flat)
+            better = _clearly_more(a_flat, a_first)
             more = (f"explains clearly more of its record than the projected tilted one's "
                     f"(its unexplained share under 1 / {SGD_AGREEMENT_RATIO:g} of the other's; ")
         else:

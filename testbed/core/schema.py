@@ -215,8 +215,9 @@ def unknown_key_hint(key: Any, known: Iterable[str],
     """What an unknown ``key`` was probably meant as, for its refusal: ``" (did you mean
     'Vmax'?)"`` when one of ``known`` is spelt like it (case ignored; difflib's ratio >= 0.7,
     :func:`near_miss`'s), and ``" ('sample_rate' is a key of [simulation])"`` when it is one
-    of the keys ``elsewhere`` maps a place (``"[simulation]"``, ``"sgd_sindy"``) to (both
-    when both hold); ``""`` when neither does.
+    of the keys ``elsewhere`` maps a place (``"[simulation]"``, ``"sgd_sindy"``) to (a key
+    known here but for its case first, then a place elsewhere, then a near spelling: the
+    first that holds); ``""`` when none does.
 
     Malformed-input round 23: ``vmax`` for ``Vmax``, ``threshold`` for ``thresholds``,
     ``sample_rate`` under ``[rig]`` and ``--param lr=...`` for an identifier that has no

@@ -1026,15 +1026,15 @@ def _finish(raw: _Raw, fs: float | None, units: str | Mapping[str, str] | None,
                                           f"expected at most {max_magnitude:g} (larger values "
                                           "overflow the identifiers' sums of sixth powers)")
         signals[n] = (si, x)
+    keep = set(names)
+    # (a direction is stored only where it is not 0: the kept channels' own, their signs honoured)
     directions = _honour_direction_signs(
-        {n: raw.directions[n] for n in names if raw.directions.get(n)}, signals)
+        {k: v for k, v in raw.directions.items() if k in keep}, signals)
     for key, value in raw.prior.items():  # a dataset file's own (an edited attribute)
         check_prior(path, key, value)
-    keep = set(names)
     return ImportedData(float(rate), signals, path, raw.format,
                         nodes={k: v for k, v in raw.nodes.items() if k in keep},
-                        directions={k: directions.get(k, v) for k, v in raw.directions.items()
-                                    if k in keep},
+                        directions=directions,
                         positions={k: v for k, v in raw.positions.items() if k in keep},
                         prior=dict(raw.prior))
 
@@ -1358,11 +1358,10 @@ def check_hdf5_storage(path: str | os.PathLike) -> None:
     def visit(name: str, obj: Any) -> None:
         if found or not isinstance(obj, h5py.Dataset):
             return
-        layout = obj.attrs.get("layout")
-        if isinstance(layout, np.generic) or (isinstance(layout, np.ndarray) and layout.size == 1):
-            layout = layout.item()  # a numpy scalar or a one-element array of text
-        layout = layout.decode(errors="replace") if isinstance(layout, bytes) else layout
-        if layout is not None and not (isinstance(layout, str) and layout == LAYOUT):
+        raw_layout = obj.attrs.get("layout")
+        layout = _attr_text(raw_layout)  # text, bytes or a one-element array of either
+        if raw_layout is not None and layout != LAYOUT:
+            layout = layout if layout is not None else _plain(raw_layout)
             # the reader takes rows as channels whatever this says: a file whose arrays claim
             # "samples x channels" was read as channels x samples in silence (round 23)
             found.append(f"/{name}: attribute layout={layout!r}; expected {LAYOUT!r} (each row "

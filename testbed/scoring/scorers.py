@@ -959,7 +959,9 @@ def failed_trac(scores: Scores, thresholds: dict[str, dict[str, float]]
     -------
     tuple (ndarray, ndarray, float) or None
         ``(trac, truth_trac, bar)``, each TRAC of shape (n_channels,) [-]; None when the run has
-        no TRAC bar, the bar is met, or the details lack either TRAC (or their sizes differ).
+        no TRAC bar, the bar is met, the details lack either TRAC (or their sizes differ), or a
+        channel's TRAC is not finite (a diverged or non-physical model has no TRAC to compare:
+        the simulation's failure says why).
     """
     floor, bar = scores.details.get("truth_trac"), thresholds.get("trac", {}).get("min")
     trac = scores.details.get("trac")
@@ -967,7 +969,10 @@ def failed_trac(scores: Scores, thresholds: dict[str, dict[str, float]]
         return None
     if not [c for c in check_thresholds(scores.values, {"trac": thresholds["trac"]}) if not c.passed]:
         return None
-    return np.asarray(trac, dtype=float), np.asarray(floor, dtype=float), float(bar)
+    trac = np.asarray(trac, dtype=float)
+    if not np.all(np.isfinite(trac)):
+        return None
+    return trac, np.asarray(floor, dtype=float), float(bar)
 
 
 def floor_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -> dict[str, str]:
@@ -1003,10 +1008,9 @@ def floor_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -> d
         return {}
     trac, floor, bar = judged
     failing = ~(trac >= bar)
-    # every failing channel: finite (a diverged or non-physical model has no TRAC to compare),
-    # the truth below the bar there, and the model at the truth's floor (within FLOOR_MARGIN)
-    if not (failing.any() and np.all(np.isfinite(trac))
-            and np.all(at_floor(trac, floor, bar)[failing])):
+    # every failing channel (finite: failed_trac): the truth below the bar there, and the model
+    # at the truth's floor (within FLOOR_MARGIN)
+    if not (failing.any() and np.all(at_floor(trac, floor, bar)[failing])):
         return {}
     worst_floor = float(np.min(floor[failing]))
     got = float(scores.values.get("trac", float("nan")))
@@ -1054,8 +1058,6 @@ def channel_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) ->
     if judged is None:
         return {}
     trac, floor, bar = judged
-    if not np.all(np.isfinite(trac)):  # no TRAC to compare: the simulation's failure says why
-        return {}
     failing, low = ~(trac >= bar), at_floor(trac, floor, bar)
     if not (low.any() and (failing & ~low).any()):  # all at the floor, or none: nothing hidden
         return {}

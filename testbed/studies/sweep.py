@@ -459,13 +459,11 @@ def _run_cell(cell: Cell, cache_dir: str, plugins: tuple[str, ...], parent: int 
         # reported score that is infinite by definition (the five-bar's coef_error when the
         # identified row lacks the truth's largest term): it was marked failed and passed at
         # once, and left out of the score medians
-        held = {c.metric for c in result.checks}
-        if held and not held & set(bad) and not result.failure:
-            bad = []
-        # a failed fit leaves every score undefined and its reason says why: listing them
+        # A failed fit leaves every score undefined and its reason says why: listing them
         # again named some 40 scores after it and counted the cell a second time
         # ("non-finite scores") in the summary (round 24's b24_br_L0p5_w20_t6_s6_z3, ls_sindy 1 %)
-        if "fit" in result.scores.failures:
+        held = {c.metric for c in result.checks}
+        if "fit" in result.scores.failures or (held and not held & set(bad) and not result.failure):
             bad = []
         reasons = [result.failure, bad and "non-finite scores: " + ", ".join(bad),
                    not result.scores.values and "no scores"]
