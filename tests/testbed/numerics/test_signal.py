@@ -365,18 +365,21 @@ def test_lowpass_differentiate_pads_about_zero_not_about_the_end_sample():
     # off by 1 mrad (about twice the 1 % noise std there).  Padding by odd reflection about that
     # sample (scipy's padtype="odd") puts the whole pad 2 mrad off: a step the filter turns into
     # a rate error of 3.3e-3 rad/s (measured; 5 % of the rate amplitude) spread over seconds.
-    # Reflected about zero, the remainder's end value, the sample only moves the end fits:
-    # measured 1.6e-4 rad/s at the ends and 2e-6 rad/s 2 s in; bounds 2x and 5x
+    # Reflected about zero, the remainder's end value, the sample only moves the end fits and
+    # raises the level against which the filter's end transients are read (the clean record's
+    # are removed, derivatives._end_transients; here partly kept): rate error against the
+    # truth measured 4.1e-4 rad/s at the ends and 1.8e-5 rad/s 2 s in (before the transients'
+    # removal 5.0e-4 and 2.6e-5; the clean record's now 3e-8); bounds 2x
     fs = 1e3
     t = np.arange(int(10 * fs)) / fs
     x = 0.07 * np.cos(t)[None]
     y = x.copy()
     y[:, 0] += 1e-3
     y[:, -1] -= 1e-3
-    a = der.lowpass_differentiate(x, fs, 0.8, 8, 2.0, 5)[1]
     b = der.lowpass_differentiate(y, fs, 0.8, 8, 2.0, 5)[1]
-    assert np.abs(a - b).max() < 3.3e-4
-    assert np.abs(a - b)[:, int(2 * fs):-int(2 * fs)].max() < 1e-5
+    err = np.abs(b + 0.07 * np.sin(t)[None])
+    assert err.max() < 8.2e-4
+    assert err[:, int(2 * fs):-int(2 * fs)].max() < 3.6e-5
     r = np.arange(1.0, 6.0)[None]
     np.testing.assert_array_equal(der._odd_about_zero(r, 2), [[-3, -2, 1, 2, 3, 4, 5, -4, -3]])
 
