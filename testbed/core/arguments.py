@@ -41,21 +41,32 @@ def integer(where: str, name: str, value: Any, *, low: int | None = None,
     return value
 
 
+def finite_real(value: Any) -> float | None:
+    """``value`` as a finite ``float`` if it is a real number (not a boolean) that float64 holds,
+    else None: an integer beyond float64's range (a JSON ``10**400``) is None, where ``float``
+    raised OverflowError (round 25: an internal error of ``identify`` on a SEP-005 ``fs``)."""
+    if not isinstance(value, numbers.Real) or isinstance(value, (bool, np.bool_)):
+        return None
+    try:
+        x = float(value)
+    except OverflowError:
+        return None
+    return x if math.isfinite(x) else None
+
+
 def real(where: str, name: str, value: Any, *, low: float | None = None,
          high: float | None = None, low_open: bool = False) -> float:
     """``value`` as a finite ``float`` in ``[low, high]`` (``(low, high]`` when ``low_open``)."""
-    ok = isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_))
-    if ok:
-        value = float(value)
-        ok = math.isfinite(value) and (low is None or (value > low if low_open else value >= low)) \
-            and (high is None or value <= high)
+    x = finite_real(value)
+    ok = x is not None and (low is None or (x > low if low_open else x >= low)) \
+        and (high is None or x <= high)
     if not ok:
         left = "(" if low_open else "["
         bounds = f" in {left}{low:g}, {high:g}]" if low is not None and high is not None else (
             f" {'>' if low_open else '>='} {low:g}" if low is not None else
             f" <= {high:g}" if high is not None else "")
         raise ArgumentError(where, name, value, f"expected a finite number{bounds}")
-    return value
+    return x
 
 
 def choice(where: str, name: str, value: Any, allowed: Sequence[Any]) -> Any:

@@ -1,0 +1,131 @@
+"""Twenty-fifth malformed-input round: the findings of ``benchmarks/hostile25.py``
+(docs/known-gaps.md, "Malformed-input round 25"), each fixed in the layer that owns it.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from testbed import cli
+from testbed.core.arguments import finite_real, real
+from testbed.core.errors import ArgumentError, ScenarioError
+from testbed.pipeline.importers import MeasuredDataError, from_sep005
+from testbed.pipeline.scenario import SCENARIO_DIR, _read_toml, scenario_from_dict
+
+FS = 100.0
+N = 200
+
+
+def _channels(**change) -> list[dict]:
+    """Two SEP-005 channels of one plain record (a sine and its rate), ``change`` applied to
+    the first."""
+    t = np.arange(N) / FS
+    a = {"name": "a", "data": np.sin(2 * np.pi * 3 * t).tolist(), "unit_str": "m", "fs": FS,
+         "direction": "+Z"}
+    b = {"name": "b", "data": np.cos(2 * np.pi * 5 * t).tolist(), "unit_str": "m", "fs": FS,
+         "direction": "+Z"}
+    a.update(change)
+    return [a, b]
+
+
+def _refused(chans: list[dict], *words: str) -> str:
+    with pytest.raises(MeasuredDataError) as e:
+        from_sep005(chans, source="rec.json")
+    text = str(e.value)
+    assert "\n" not in text and all(w in text for w in words), text
+    return text
+
+
+# ------------------------------------------------------------------ numbers beyond float64
+
+@pytest.mark.parametrize("big", [10 ** 400, 2 ** 1024], ids=["10**400", "2**1024"])
+def test_sep005_fs_integer_beyond_float64_refused_naming_fs(big):
+    # old: OverflowError ("internal error ... int too large to convert to float") from
+    # math.isfinite(fs)
+    _refused(_channels(fs=big), "'a'", "fs=", "rate > 0 Hz")
+
+
+def test_sep005_position_integer_beyond_float64_refused_naming_it():
+    # old: OverflowError from check_position's math.isfinite
+    _refused(_channels(position_m=10 ** 400), "'a'", "position_m=", "finite number [m]")
+
+
+def test_finite_real_and_real_refuse_integers_beyond_float64():
+    assert finite_real(10 ** 400) is None and finite_real(2 ** 1024) is None
+    assert finite_real(True) is None and finite_real(math.nan) is None and finite_real("1") is None
+    assert finite_real(2 ** 1023) == 2.0 ** 1023 and finite_real(3) == 3.0
+    with pytest.raises(ArgumentError):  # old: OverflowError from float(value)
+        real("f()", "x", 10 ** 400)
+    assert real("f()", "x", 7) == 7.0 and isinstance(real("f()", "x", 7), float)
+
+
+# ------------------------------------------------------------------ SEP-005 time as texts
+
+def test_sep005_time_as_texts_refused_like_data():
+    # old: np.asarray(["0.0", "0.01", ...], dtype=float) read the texts as numbers in silence
+    # (data as texts were refused)
+    t = [repr(k / FS) for k in range(N)]
+    _refused(_channels(time=t), "'a'", "time values are not numbers")
+    _refused(_channels(time=[bool(k % 2) for k in range(N)]), "time values are not numbers")
+    _refused(_channels(time=[10 ** 400 + k for k in range(N)]), "time values are not numbers")
+
+
+def test_sep005_data_messages_kept():
+    _refused(_channels(data=["1.5"] * N), "data are not numbers")
+    _refused(_channels(data=[10 ** 400] * N), "data are not numbers")
+
+
+# ------------------------------------------------------------------ SEP-005 direction
+
+@pytest.mark.parametrize("direction", [3.0, True, "up", [3], {"axis": "Z"}, "", "+Z axis"])
+def test_sep005_unreadable_direction_refused(direction):
+    # old: read as "no direction" in silence (the channel's sign and axis dropped)
+    _refused(_channels(direction=direction), "'a'", "direction=", "'+Z'")
+
+
+@pytest.mark.parametrize("direction, code", [("+z", 3), (3, 3), (None, 0), (" -X rotation ", -4)])
+def test_sep005_readable_directions_kept(direction, code):
+    if code == -4:  # a rotation needs a rotation's unit
+        chans = _channels(direction=direction, unit_str="rad")
+        chans[1].update(unit_str="rad", direction="-X rotation")
+    else:
+        chans = _channels(direction=direction)
+    data = from_sep005(chans, source="rec.json")
+    assert data.directions.get("a", 0) == code
+
+
+# ------------------------------------------------------------------ runs ls of no scenario
+
+@pytest.mark.parametrize("name", ["", " ", "a\nb", "/dev/null", "-", "x/y"])
+def test_runs_ls_of_a_text_that_is_no_scenario_name_refused(tmp_path, capsys, name):
+    # old: status 0 and an empty table, nothing said
+    assert cli.main(["runs", "ls", name, "-o", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    lines = [ln for ln in err.splitlines() if ln.strip()]
+    assert len(lines) == 1 and lines[0].startswith("error: runs ls ") and "not a scenario name" in err
+
+
+def test_runs_ls_of_a_scenario_without_runs_says_so(tmp_path, capsys):
+    assert cli.main(["runs", "ls", "michaelis_menten", "-o", str(tmp_path), "--plain"]) == 0
+    out, err = capsys.readouterr()
+    assert out.splitlines() == ["scenario\tseed\ttime (UTC)\tidentifier\tverdict\tpath"]
+    assert err.strip() == f"no runs of scenario 'michaelis_menten' in {tmp_path}"
+
+
+# ------------------------------------------------------------------ blank tags
+
+@pytest.mark.parametrize("tags", [[""], [" "], ["beam", "\u00a0"]])
+def test_blank_scenario_tag_refused_naming_it(tags):
+    raw = _read_toml(SCENARIO_DIR / "michaelis_menten.toml")
+    raw["scenario"]["tags"] = tags
+    with pytest.raises(ScenarioError, match=r"scenario\.tags\[\d\]"):
+        scenario_from_dict(raw, file="m.toml", stem="michaelis_menten")
+
+
+def test_tags_with_inner_blanks_kept():
+    raw = _read_toml(SCENARIO_DIR / "michaelis_menten.toml")
+    raw["scenario"]["tags"] = ["two words", "x"]
+    assert scenario_from_dict(raw, file="m.toml", stem="michaelis_menten").tags == ("two words", "x")
