@@ -1718,8 +1718,8 @@ def _sep005_numbers(path: Path, name: str, values: Any, key: str) -> np.ndarray:
     except (TypeError, ValueError):
         raise MeasuredDataError(path, f"{what} not numbers") from None
     except OverflowError:  # a JSON integer such as 10**400: no float64 holds it
-        raise MeasuredDataError(path, f"{what} not numbers of float64's range (an integer beyond "
-                                      "1.8e308)") from None
+        raise MeasuredDataError(path, f"{what} not numbers of float64's range (an integer "
+                                      "beyond float64's range, 1.8e308)") from None
 
 
 def _common_rate(path: Path, rates: dict[str, float], rtol: float) -> float:
