@@ -38,6 +38,25 @@ Families (what rounds 1-24 did not try; their families are listed in ``hostile21
     (:func:`testbed.pipeline.scenario.load_scenario`).  A traceback, anything but one refusal
     line naming the key, or a value of the wrong kind accepted, is a finding.
 
+``edgesamples``
+    A non-finite or overflowing sample (NaN, +inf, -inf, 1e308) at the *last* sample only (rounds
+    17-23 tried the first, the middle and the Michaelis-Menten dataset's end), and at the first
+    and the last together: the Michaelis-Menten record as CSV (``x`` and the time column), the
+    stiff beam's UFF58 export (an acceleration and the force, written in ASCII with the value's
+    text: pyuff's writer turns NaN into 0) and SEP-005 export, and the beam's dataset file
+    (rehashed); and every UFF58 record cut to two or three samples.  ``testbed
+    identify``.  A traceback, anything but one refusal line, or a model fitted with status 0, is
+    a finding.
+
+``measapi``
+    The Python API's :class:`~testbed.core.measurement.Measurement` (what a user builds by hand
+    or edits with ``dataclasses.replace``) fitted by ``ls_sindy``: a declared prior
+    (``reduced_mass_trace``, the one it reads) of an integer of 400 digits, a text ``"0.7"``,
+    ``True``, ``[0.7]``, ``None``, a complex, 5e-324, 1e-300 and 1e308 kg (the command line's
+    ``--prior`` refuses each); a prior the identifier does not read as a text; ``x`` and ``u`` as
+    masked arrays with a masked sample; a channel or an input name holding a newline or an
+    ESC.  A raw exception, or a fit of a value the command line refuses, is a finding.
+
 Prints one line a finding and the counts; exits 1 if any finding.
 """
 
@@ -351,6 +370,223 @@ def tomllists_cases(work: Path) -> list[tuple[str, object]]:
             for base, tab, key, value, expect in table]
 
 
+# ------------------------------------------------------------------ edgesamples
+
+LAB = "cantilever_stiff_impact_lab"
+
+
+def edgesamples_cases(work: Path) -> list[tuple[str, object]]:
+    import h5py
+    import numpy as np
+    import pyuff
+
+    from testbed.core.dataset import Dataset
+
+    beam = ["--kind", "structural", "--method", "ls_sindy"]
+
+    def uff_export() -> tuple[Path, list[str]]:
+        out, prior_file = work / "lab.uff", work / "lab.prior"
+        if not out.exists():
+            status, stdout, err = cli_inprocess(["export", str(_generated(work, LAB)), "--format",
+                                                 "uff", "-o", str(out)])
+            if status != 0:
+                raise RuntimeError(f"export: {err[-300:]}")
+            prior_file.write_text(json.dumps([a for a in (stdout + err).split()
+                                              if "=" in a and not a.startswith("-")]))
+        return out, [x for p in json.loads(prior_file.read_text()) for x in ("--prior", p)]
+
+    def sep_export() -> Path:
+        out = work / "lab.json"
+        if not out.exists():
+            status, _, err = cli_inprocess(["export", str(_generated(work, LAB)), "--format",
+                                            "sep005", "-o", str(out)])
+            if status != 0:
+                raise RuntimeError(f"export: {err[-300:]}")
+        return out
+
+    def at(where: str, value: float):
+        def edit(a: np.ndarray) -> np.ndarray:
+            a = np.array(a, dtype=float)
+            if where in ("last", "both"):
+                a[-1] = value
+            if where in ("first", "both"):
+                a[0] = value
+            return a
+        return edit
+
+    def refused(argv: list[str]) -> str | None:
+        return judged(*cli_inprocess(argv), refuse=True)
+
+    def csv_case(column: str, edit):
+        def run():
+            ds = Dataset.load(_generated(work, MM))
+            x, dx = ds.measured["x"].data[0], ds.measured["dx"].data[0]
+            t = np.arange(x.size) / ds.fs
+            cols = {"t": t, "x": x, "dx": dx}
+            cols[column] = edit(cols[column])
+            path = work / f"mm_{_safe(repr((column, edit.__qualname__, id(edit))))}.csv"
+            path.write_text("time [s],x [mM],dx [mM/s]\n" + "".join(
+                f"{a!r},{b!r},{c!r}\n" for a, b, c in zip(cols["t"].tolist(), cols["x"].tolist(),
+                                                       cols["dx"].tolist(), strict=True)))
+            return refused(["identify", str(path), "--scenario", MM, "-o", f"{path}.model.json"])
+        return run
+
+    def uff_case(label: str, edit_sets, tokens: dict[str, str] | None = None):
+        """The UFF58 export rewritten in ASCII (pyuff's writer turns NaN into 0 and inf into
+        1.8e308: a sentinel sample is written and its text replaced by ``tokens``' text)."""
+        def run():
+            src, prior = uff_export()
+            sets = pyuff.UFF(str(src)).read_sets()
+            sets = sets if isinstance(sets, list) else [sets]
+            for r in sets:
+                if r.get("type") == 58:
+                    r["binary"] = 0
+            edit_sets([s for s in sets if s.get("type") == 58])
+            path = work / f"{_safe(label)}.uff"
+            path.unlink(missing_ok=True)
+            pyuff.UFF(str(path)).write_sets(sets, mode="add")
+            text = path.read_text()
+            for sentinel, token in (tokens or {}).items():
+                if text.count(sentinel) != 1:
+                    raise RuntimeError(f"sentinel {sentinel} written {text.count(sentinel)} times")
+                text = text.replace(sentinel, token.rjust(len(sentinel)))
+            path.write_text(text)
+            return refused(["identify", str(path), "-o", f"{path}.model.json", *prior, *beam])
+        return run
+
+    #: sentinels of the first and the last sample, as pyuff's ASCII UFF58 writer prints them
+    first_s, last_s = 2424.2424, 4242.4242
+    first_t, last_t = "2.42424240000e+03", "4.24242420000e+03"
+
+    def uff_sample(channel: str, where: str):
+        def edit_sets(records):
+            for r in records:
+                if r["id1"].strip().endswith(channel):
+                    r["data"] = np.array(r["data"], dtype=float)
+                    if where in ("last", "both"):
+                        r["data"][-1] = last_s
+                    if where in ("first", "both"):
+                        r["data"][0] = first_s
+        return edit_sets
+
+    def uff_tokens(where: str, token: str) -> dict[str, str]:
+        return {**({last_t: token} if where in ("last", "both") else {}),
+                **({first_t: token} if where in ("first", "both") else {})}
+
+    def uff_cut(n: int):
+        def edit_sets(records):
+            for r in records:
+                r["data"], r["x"], r["num_pts"] = r["data"][:n], r["x"][:n], n
+        return edit_sets
+
+    def sep_case(label: str, channel: str, edit):
+        def run():
+            doc = json.loads(sep_export().read_text())
+            for c in doc:
+                if c["name"].endswith(channel):
+                    c["data"] = edit(c["data"]).tolist()
+            path = work / f"{_safe(label)}.json"
+            # json writes NaN / Infinity tokens, as Python's own json and numpy-based writers do
+            path.write_text(json.dumps(doc))
+            _, prior = uff_export()
+            return refused(["identify", str(path), "-o", f"{path}.model.json", *prior, *beam])
+        return run
+
+    def h5_case(label: str, signal: str, edit):
+        def run():
+            path = work / f"{_safe(label)}.h5"
+            shutil.copy(_generated(work, LAB), path)
+            with h5py.File(path, "r+") as f:
+                d = f[f"measured/{signal}"]
+                a = d[()].astype(float)
+                a[0] = edit(a[0])
+                d[...] = a
+            hostile19._rehash(path)
+            return refused(["identify", str(path), "-o", f"{path}.model.json", *beam])
+        return run
+
+    values = {"NaN": float("nan"), "+inf": float("inf"), "-inf": -float("inf"), "1e308": 1e308}
+    tokens = {"NaN": "NaN", "+inf": "inf", "-inf": "-inf", "1e308": "1e308"}  # as C's printf
+    cases: list[tuple[str, object]] = []
+    for vlabel, v in values.items():
+        for where in ("last", "both"):
+            for column in ("x", "t"):
+                cases.append((f"edgesamples CSV {column} {vlabel} at the {where} sample",
+                              csv_case(column, at(where, v))))
+            for channel in ("acc2", "force"):
+                cases.append((f"edgesamples UFF58 {channel} {vlabel} at the {where} sample",
+                              uff_case(f"uff {channel} {vlabel} {where}", uff_sample(channel, where),
+                                       uff_tokens(where, tokens[vlabel]))))
+        cases.append((f"edgesamples SEP-005 acc3 {vlabel} at the last sample",
+                      sep_case(f"sep acc3 {vlabel}", "acc3", at("last", v))))
+        cases.append((f"edgesamples dataset acceleration row 0 {vlabel} at the last sample",
+                      h5_case(f"h5 acc {vlabel}", "acceleration", at("last", v))))
+        cases.append((f"edgesamples dataset force {vlabel} at the last sample",
+                      h5_case(f"h5 force {vlabel}", "force", at("last", v))))
+    # (pyuff's writer fails on records of one sample or none: two and three are the least)
+    cases += [("edgesamples UFF58 every record of two samples", uff_case("uff two", uff_cut(2))),
+              ("edgesamples UFF58 every record of three samples", uff_case("uff three", uff_cut(3)))]
+    return cases
+
+
+# ------------------------------------------------------------------ measapi
+
+def measapi_cases(work: Path) -> list[tuple[str, object]]:
+    import dataclasses
+
+    import numpy as np
+
+    state: dict = {}
+
+    def measured():
+        if "m" not in state:
+            import testbed
+            from testbed.core.dataset import Dataset
+            from testbed.pipeline.scenario import load_scenario
+
+            sc = load_scenario(LAB)
+            state["m"] = testbed.measure(Dataset.load(_generated(work, LAB)), sc.signal, sc.kind)
+        return state["m"]
+
+    def fit(change):
+        def run():
+            from testbed.pipeline.plugins import identifier_class
+
+            m = measured()
+            data = dataclasses.replace(m, **change(m))
+            model = identifier_class("ls_sindy")().fit(data)
+            return f"fitted (mass trace {np.trace(model.M_):.4g} kg)"
+        return run
+
+    def prior(key, value):
+        return lambda m: {"prior": {**m.prior, key: value}}
+
+    def masked(field):
+        def change(m):
+            a = np.ma.masked_array(np.array(getattr(m, field)), mask=False)
+            a.mask[0, 5], a.data[0, 5] = True, 1e3
+            return {field: a}
+        return change
+
+    def renamed(field, name):
+        return lambda m: {field: (name, *getattr(m, field)[1:])}
+
+    cases = [(f"measapi prior reduced_mass_trace = {v!r:.24}", fit(prior("reduced_mass_trace", v)))
+             for v in (10 ** 400, "0.7", True, [0.7], None, 0.7 + 0j, 5e-324, 1e-300, 1e308)]
+    cases += [("measapi prior total_mass (not read by ls_sindy) a text",
+               fit(prior("total_mass", "0.75 kg"))),
+              ("measapi prior of an unknown key an integer of 400 digits",
+               fit(prior("whatever", 10 ** 400))),
+              ("measapi x masked at one sample", fit(masked("x"))),
+              ("measapi xdd masked at one sample", fit(masked("xdd"))),
+              ("measapi u masked at one sample", fit(masked("u"))),
+              ("measapi a channel named with a newline", fit(renamed("channels", "acc1\nacc9"))),
+              ("measapi a channel named with an ESC sequence",
+               fit(renamed("channels", "\x1b[2Jacc1"))),
+              ("measapi an input named with a newline", fit(renamed("inputs", "force\nx")))]
+    return cases
+
+
 # ------------------------------------------------------------------ main
 
 FAMILIES = _hostile.families(
@@ -359,6 +595,8 @@ FAMILIES = _hostile.families(
         "optgrid": optgrid_cases,
         "serveopts": serveopts_cases,
         "tomllists": tomllists_cases,
+        "edgesamples": edgesamples_cases,
+        "measapi": measapi_cases,
     },
     TIMEOUT_S,
 )

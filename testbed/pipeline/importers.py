@@ -63,7 +63,7 @@ from testbed.core.arguments import finite_real
 from testbed.core.budget import IDENTIFY_BYTES_PER_VALUE, IDENTIFY_TEXT_BUDGET_BYTES, IDENTIFY_VALUE_BUDGET
 from testbed.core.dataset import Dataset, DatasetError, Signal
 from testbed.core.errors import TestbedError, is_control, show_names, show_value
-from testbed.core.measurement import MIN_FREE_SAMPLES, Measurement
+from testbed.core.measurement import MIN_FREE_SAMPLES, PRIOR_RANGE, Measurement, prior_number
 from testbed.core.rate_attrs import fs_attribute_problem, off_scenario_rate
 from testbed.numerics.clipping import Clipping, measured_clipping
 from testbed.numerics.noise import noise_std
@@ -1111,13 +1111,6 @@ def _check_starts(path: Path, starts: Mapping[str, float], fs: float,
                                       "give every channel a time, or none)")
 
 
-#: Range of a declared prior (a mass [kg] or a length [m]).  A prior scales the identified
-#: matrices (M from a mass, then K = M w^2 with w^2 up to (pi fs)^2 ~ 1e9 rad^2/s^2, M^-1 K, and
-#: the eigen-solvers' products of them), which must stay inside float64's 1e-308 .. 1e308:
-#: ``total_mass`` 5e-324 kg made M singular, 1e-320 kg overflowed M^-1 K and 1e308 kg
-#: overflowed K (round 15: internal errors).  1e-100 .. 1e100 leaves a factor of 1e100 to each
-#: end, and holds every physical rig (an electron is 9e-31 kg, the Earth 6e24 kg).
-PRIOR_RANGE = (1e-100, 1e100)
 
 
 def check_prior(source: str | os.PathLike, key: str, value: Any) -> None:
@@ -1126,10 +1119,8 @@ def check_prior(source: str | os.PathLike, key: str, value: Any) -> None:
     in a dataset file, whose ``prior`` attributes a user may have edited: NaN, -1 or text were
     read in silence)."""
     lo, hi = PRIOR_RANGE
-    # an int beyond float64 (10**400) is refused by its size: math.isfinite raised OverflowError
-    huge = isinstance(value, int) and not isinstance(value, bool) and abs(value) > hi
-    if huge or isinstance(value, bool) or not isinstance(value, (int, float)) \
-            or not (math.isfinite(value) and lo <= value <= hi):
+    # (an int beyond float64, 10**400, is refused: math.isfinite raised OverflowError)
+    if not isinstance(value, (int, float)) or prior_number(value) is None:
         raise MeasuredDataError(source, f"prior {key}={value!r}: expected a finite number from "
                                         f"{lo:g} to {hi:g} (a mass [kg] or a length [m]; beyond, "
                                         "the identified matrices leave float64's range)")

@@ -10,8 +10,9 @@ import numpy as np
 import pytest
 
 from testbed import cli
-from testbed.core.arguments import finite_real, real
+from testbed.core.arguments import finite_real, mapping, real
 from testbed.core.errors import ArgumentError, ScenarioError
+from testbed.core.measurement import PRIOR_RANGE, Measurement, prior_number
 from testbed.pipeline.importers import MeasuredDataError, from_sep005
 from testbed.pipeline.scenario import SCENARIO_DIR, _read_toml, scenario_from_dict
 
@@ -129,3 +130,72 @@ def test_tags_with_inner_blanks_kept():
     raw = _read_toml(SCENARIO_DIR / "michaelis_menten.toml")
     raw["scenario"]["tags"] = ["two words", "x"]
     assert scenario_from_dict(raw, file="m.toml", stem="michaelis_menten").tags == ("two words", "x")
+
+
+# ------------------------------------------------------------------ the API's Measurement
+
+def _measurement(**change) -> Measurement:
+    t = np.arange(50) / FS
+    x = np.vstack([np.sin(2 * np.pi * 3 * t), np.cos(2 * np.pi * 3 * t)])
+    kw = {"fs": FS, "x": x, "xd": x, "xdd": x, "channels": ("a", "b"), "prior": {"total_mass": 0.7}}
+    kw.update(change)
+    return Measurement(**kw)
+
+
+@pytest.mark.parametrize("value", [10 ** 400, "0.7", True, None, 0.7 + 0j, 5e-324, 1e-300, 1e308,
+                                   -1.0, 0.0, [], ["0.7"], [0.1, np.nan], np.ones((2, 2))],
+                         ids=["10**400", "text", "True", "None", "complex", "5e-324", "1e-300",
+                              "1e308", "-1", "0", "empty list", "list of text", "list with NaN",
+                              "2-D array"])
+def test_measurement_prior_of_a_value_the_command_line_refuses_is_refused(value):
+    # old: 10**400 OverflowError; "0.7" fitted as 0.7 kg, True as 1 kg; None / complex TypeError
+    # and 5e-324 / 1e308 LinAlgError inside ls_sindy's fit
+    with pytest.raises(ArgumentError, match=r"prior\['total_mass'\].*expected a finite number"):
+        _measurement(prior={"total_mass": value})
+
+
+@pytest.mark.parametrize("value", [0.7, np.float64(0.7), 7, 1e-100, 1e100, [0.1, 0.2, 0.15, 0.2],
+                                   np.array([0.1, 0.2, 0.15, 0.2])])
+def test_measurement_prior_numbers_and_lists_of_them_kept(value):
+    m = _measurement(prior={"total_mass": value})
+    assert m.prior["total_mass"] is value
+
+
+def test_importers_prior_rule_is_the_measurements():
+    from testbed.pipeline import importers
+
+    assert importers.PRIOR_RANGE is PRIOR_RANGE
+    for bad in (10 ** 400, "0.7", True, 5e-324):
+        with pytest.raises(MeasuredDataError):
+            importers.check_prior("f.json", "total_mass", bad)
+    assert prior_number(0.7) == 0.7 and prior_number(np.float32(2.0)) == 2.0
+
+
+def test_mapping_value_beyond_float64_refused():
+    with pytest.raises(ArgumentError):  # old: OverflowError from float(10**400)
+        mapping("f()", "prior", {"k": 10 ** 400})
+
+
+@pytest.mark.parametrize("field", ["x", "xd", "xdd"])
+def test_measurement_masked_sample_refused(field):
+    # old: np.asarray dropped the mask; the value under it was fitted
+    a = np.ma.masked_array(_measurement().x.copy(), mask=False)
+    a.mask[0, 5], a.data[0, 5] = True, 1e3
+    with pytest.raises(ArgumentError, match=r"1 masked sample"):
+        _measurement(**{field: a})
+
+
+def test_measurement_masked_array_without_a_masked_sample_kept():
+    a = np.ma.masked_array(_measurement().x.copy(), mask=False)
+    assert np.array_equal(_measurement(x=a).x, np.asarray(a))
+
+
+@pytest.mark.parametrize("name", ["a\nb", "\x1b[2Ja", "a\tb", "a\u2028b", "a\x00"])
+def test_measurement_channel_name_with_a_control_character_refused(name):
+    # old: fitted; the equations printed the name over two lines (or the terminal obeyed it)
+    with pytest.raises(ArgumentError, match="without control characters"):
+        _measurement(channels=(name, "b"))
+
+
+def test_measurement_channel_names_of_blanks_and_letters_kept():
+    assert _measurement(channels=("acc 1", "\u00e9\u540d")).channels == ("acc 1", "\u00e9\u540d")
