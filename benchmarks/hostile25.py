@@ -57,6 +57,15 @@ Families (what rounds 1-24 did not try; their families are listed in ``hostile21
     masked arrays with a masked sample; a channel or an input name holding a newline or an
     ESC.  A raw exception, or a fit of a value the command line refuses, is a finding.
 
+``fittedapi``
+    A fitted structural model's ``score``, ``predict_acceleration`` and ``simulate`` (``ls_sindy``
+    and ``sgd_sindy`` on the stiff beam's lab record) given arguments of the right type but the
+    wrong extent: inputs of two rows for a model of one, ``free_start`` at or past the record's
+    end, a record of one sample, a cross-validation window that ends before the impact's
+    end; ``simulate``'s ``u`` of five rows or seven samples for two times, ``xd0`` of two
+    channels, NaN, None or a text.  A raw exception, or a number returned for a window that
+    holds no sample to score, is a finding.
+
 Prints one line a finding and the counts; exits 1 if any finding.
 """
 
@@ -531,6 +540,18 @@ def edgesamples_cases(work: Path) -> list[tuple[str, object]]:
 
 # ------------------------------------------------------------------ measapi
 
+def measapi_measurement(work: Path, state: dict):
+    """The stiff beam's lab record through its scenario's signal chain, made once per family."""
+    if "m" not in state:
+        import testbed
+        from testbed.core.dataset import Dataset
+        from testbed.pipeline.scenario import load_scenario
+
+        sc = load_scenario(LAB)
+        state["m"] = testbed.measure(Dataset.load(_generated(work, LAB)), sc.signal, sc.kind)
+    return state["m"]
+
+
 def measapi_cases(work: Path) -> list[tuple[str, object]]:
     import dataclasses
 
@@ -538,21 +559,11 @@ def measapi_cases(work: Path) -> list[tuple[str, object]]:
 
     state: dict = {}
 
-    def measured():
-        if "m" not in state:
-            import testbed
-            from testbed.core.dataset import Dataset
-            from testbed.pipeline.scenario import load_scenario
-
-            sc = load_scenario(LAB)
-            state["m"] = testbed.measure(Dataset.load(_generated(work, LAB)), sc.signal, sc.kind)
-        return state["m"]
-
     def fit(change):
         def run():
             from testbed.pipeline.plugins import identifier_class
 
-            m = measured()
+            m = measapi_measurement(work, state)
             data = dataclasses.replace(m, **change(m))
             model = identifier_class("ls_sindy")().fit(data)
             return f"fitted (mass trace {np.trace(model.M_):.4g} kg)"
@@ -587,6 +598,76 @@ def measapi_cases(work: Path) -> list[tuple[str, object]]:
     return cases
 
 
+# ------------------------------------------------------------------ fittedapi
+
+def fittedapi_cases(work: Path) -> list[tuple[str, object]]:
+    import dataclasses
+
+    import numpy as np
+
+    state: dict = {}
+
+    def fitted(method: str):
+        key = f"model {method}"
+        if key not in state:
+            from testbed.pipeline.plugins import identifier_class
+
+            measured = measapi_measurement(work, state)
+            state[key] = identifier_class(method)().fit(measured)
+        return state[key], measapi_measurement(work, state)
+
+    def call(method: str, how):
+        def run():
+            model, m = fitted(method)
+            out = how(model, m)
+            return f"returned {type(out).__name__} {out if np.ndim(out) == 0 else ''}"
+        return run
+
+    def scored(change):
+        return lambda model, m: model.score(dataclasses.replace(m, **change(m)))
+
+    def predicted(change):
+        return lambda model, m: model.predict_acceleration(dataclasses.replace(m, **change(m)))
+
+    def simulated(x0=None, xd0=None, u=None, nt=2):
+        def how(model, m):
+            n = m.n_channels
+            return model.simulate(np.zeros(n) if x0 is None else x0,
+                                  np.zeros(n) if xd0 is None else (None if xd0 is _DROP else xd0),
+                                  np.arange(nt) / m.fs, u)
+        return how
+
+    def two_inputs(m):
+        return {"u": np.vstack([m.u, m.u]), "inputs": ("force", "f2"),
+                "input_map": np.hstack([m.input_map, m.input_map])}
+
+    def one_sample(m):
+        return {"x": m.x[:, :1], "xd": m.xd[:, :1], "xdd": m.xdd[:, :1], "u": m.u[:, :1],
+                "free_start": 0, "drift_basis": None}
+
+    def cv_window_before_impact(model, m):
+        from identify._base import MeasurementSamples
+
+        return model.score(MeasurementSamples.of(m)[20:40])
+
+    hows = {
+        "score with inputs of two rows": scored(two_inputs),
+        "predict_acceleration with inputs of two rows": predicted(two_inputs),
+        "score with free_start at the end": scored(lambda m: {"free_start": m.n_samples}),
+        "score with free_start past the end": scored(lambda m: {"free_start": m.n_samples + 5}),
+        "score of a one-sample record": scored(one_sample),
+        "score of a CV window ending before the impact's end": cv_window_before_impact,
+        "simulate with u of five rows": simulated(u=np.ones((5, 2))),
+        "simulate with u of seven samples for two times": simulated(u=np.ones((1, 7))),
+        "simulate with xd0 of two channels": simulated(xd0=np.zeros(2)),
+        "simulate with xd0 NaN": simulated(xd0=np.full(3, np.nan)),
+        "simulate with xd0 None": simulated(xd0=_DROP),
+        "simulate with xd0 a text": simulated(xd0="0 0 0"),
+    }
+    return [(f"fittedapi {method} {label}", call(method, how))
+            for method in ("ls_sindy", "sgd_sindy") for label, how in hows.items()]
+
+
 # ------------------------------------------------------------------ main
 
 FAMILIES = _hostile.families(
@@ -597,6 +678,7 @@ FAMILIES = _hostile.families(
         "tomllists": tomllists_cases,
         "edgesamples": edgesamples_cases,
         "measapi": measapi_cases,
+        "fittedapi": fittedapi_cases,
     },
     TIMEOUT_S,
 )

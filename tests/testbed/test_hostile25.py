@@ -4,11 +4,14 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
 import pytest
 
+import testbed
+from identify._base import MeasurementSamples
 from testbed import cli
 from testbed.core.arguments import finite_real, mapping, real
 from testbed.core.errors import ArgumentError, ScenarioError
@@ -199,3 +202,56 @@ def test_measurement_channel_name_with_a_control_character_refused(name):
 
 def test_measurement_channel_names_of_blanks_and_letters_kept():
     assert _measurement(channels=("acc 1", "\u00e9\u540d")).channels == ("acc 1", "\u00e9\u540d")
+
+
+# ------------------------------------------------------------------ a fitted model's methods
+
+@pytest.fixture(scope="module")
+def chain_fit():
+    from benchmarks import bench_sgd_sindy
+
+    data = bench_sgd_sindy.chain_measurement(bench_sgd_sindy.chain_system(), duration=0.3)
+    return testbed.IDENTIFIERS.get("ls_sindy")().fit(data), data
+
+
+@pytest.mark.parametrize("start", ["end", "past", "last"])
+def test_score_of_a_window_with_fewer_than_two_samples_refused(chain_fit, start):
+    # old: R^2 = 1.0 for an empty window (a perfect fit of nothing), -inf for one sample
+    model, data = chain_fit
+    n = data.n_samples
+    fs = {"end": n, "past": n + 5, "last": n - 1}[start]
+    with pytest.raises(ArgumentError, match="at least 2 samples from free_start"):
+        model.score(dataclasses.replace(data, free_start=fs))
+    assert model.score(dataclasses.replace(data, free_start=n - 2)) <= 1.0  # two: scored
+
+
+def test_score_of_a_cv_window_before_the_free_decay_refused(chain_fit):
+    # old: a test window ending before free_start scored 1.0 in GridSearchCV
+    model, data = chain_fit
+    m = MeasurementSamples.of(dataclasses.replace(data, free_start=60))
+    with pytest.raises(ArgumentError, match="free_start"):
+        model.score(m[20:40])
+
+
+def test_inputs_of_another_count_than_the_input_map_refused(chain_fit):
+    # old: numpy's matmul ValueError
+    model, data = chain_fit
+    u = np.ones((2, data.n_samples))
+    two = dataclasses.replace(data, u=u, input_map=np.hstack([data.input_map, data.input_map]))
+    for method in (model.score, model.predict_acceleration):
+        with pytest.raises(ArgumentError, match="input row"):
+            method(two)
+    assert np.isfinite(model.score(data))  # no inputs: free motion, as documented
+
+
+@pytest.mark.parametrize("xd0, u, words", [
+    (np.zeros(2), None, "'xd0'"), (np.full(3, np.nan), None, "'xd0'"), (None, None, "'xd0'"),
+    ("0 0 0", None, "'xd0'"), (np.zeros(3), np.ones((5, 4)), "'u'"),
+    (np.zeros(3), np.ones((1, 7)), "'u'")])
+def test_simulate_checks_xd0_and_u(chain_fit, xd0, u, words):
+    # old: "cannot reshape", "array must not contain infs or NaNs", "u must have shape" (raw
+    # ValueErrors from inside)
+    model, _ = chain_fit
+    with pytest.raises(ArgumentError, match=words):
+        model.simulate(np.zeros(3), xd0, np.arange(4) / 1e3, u)
+    assert model.simulate(np.zeros(3), np.zeros(3), np.arange(4) / 1e3, np.ones((1, 4))).x.shape == (3, 4)
