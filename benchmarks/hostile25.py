@@ -63,7 +63,10 @@ Families (what rounds 1-24 did not try; their families are listed in ``hostile21
     wrong extent: inputs of two rows for a model of one, ``free_start`` at or past the record's
     end, a record of one sample, a cross-validation window that ends before the impact's
     end; ``simulate``'s ``u`` of five rows or seven samples for two times, ``xd0`` of two
-    channels, NaN, None or a text.  A raw exception, or a number returned for a window that
+    channels, NaN, None or a text; and a mechanical (``sindy_pi`` on the cart-pole) and a
+    dynamical model's (``sindy_pi_dynamical``) ``simulate`` given ``x0`` of a channel more,
+    ``u`` of other rows or length, NaN or a text, ``xd0`` of a channel more, NaN or None,
+    ``t`` of one sample or spanning 1e308 s.  A raw exception, or a number returned for a window that
     holds no sample to score, is a finding.
 
 Prints one line a finding and the counts; exits 1 if any finding.
@@ -664,8 +667,56 @@ def fittedapi_cases(work: Path) -> list[tuple[str, object]]:
         "simulate with xd0 None": simulated(xd0=_DROP),
         "simulate with xd0 a text": simulated(xd0="0 0 0"),
     }
-    return [(f"fittedapi {method} {label}", call(method, how))
-            for method in ("ls_sindy", "sgd_sindy") for label, how in hows.items()]
+    cases = [(f"fittedapi {method} {label}", call(method, how))
+             for method in ("ls_sindy", "sgd_sindy") for label, how in hows.items()]
+
+    def other(scenario: str):
+        """The scenario's identifier fitted to its record (a mechanical or dynamical model)."""
+        key = f"other {scenario}"
+        if key not in state:
+            import testbed
+            from testbed.core.dataset import Dataset
+            from testbed.pipeline.plugins import identifier_class
+            from testbed.pipeline.scenario import load_scenario
+
+            sc = load_scenario(scenario)
+            m = testbed.measure(Dataset.load(_generated(work, scenario)), sc.signal, sc.kind)
+            cfg = dict(sc.identify)
+            state[key] = (identifier_class(cfg.pop("method"))(**cfg).fit(m), m)
+        return state[key]
+
+    def sim(scenario: str, nx=0, xd0="zeros", u="fit", nt=5, t=None):
+        def run():
+            model, m = other(scenario)
+            n = m.n_channels
+            x0 = np.full(n + nx, 0.1)
+            tt = np.arange(nt) / m.fs if t is None else t
+            xd = {"zeros": np.zeros(n), "n+1": np.zeros(n + 1), "NaN": np.full(n, np.nan),
+                  "None": None}[xd0]
+            uu = (None if m.u is None else np.ones((m.u.shape[0], tt.size))) if isinstance(u, str) \
+                and u == "fit" else u
+            out = model.simulate(x0, xd, tt, uu)
+            return None if (nx == 0 and xd0 == "zeros" and isinstance(u, str)) else \
+                f"returned {type(out).__name__}"
+        return run
+
+    for scenario, kind in (("cartpole", "mechanical"), (MM, "dynamical")):
+        cases += [(f"fittedapi {kind} simulate {label}", sim(scenario, **kw)) for label, kw in {
+            "as fitted (accepted)": {},
+            "x0 of one channel more": {"nx": 1},
+            "u of three rows": {"u": np.ones((3, 5))},
+            "u of nine samples for five times": {"u": np.ones((1, 9))},
+            "u NaN": {"u": np.full((1, 5), np.nan)},
+            "u a text": {"u": "1"},
+        }.items()]
+    cases += [(f"fittedapi mechanical simulate {label}", sim("cartpole", **kw)) for label, kw in {
+        "xd0 of one channel more": {"xd0": "n+1"},
+        "xd0 NaN": {"xd0": "NaN"},
+        "xd0 None": {"xd0": "None"},
+        "t of one sample": {"nt": 1},
+        "t spanning 1e308 s": {"t": np.array([0.0, 1e308])},
+    }.items()]
+    return cases
 
 
 # ------------------------------------------------------------------ main

@@ -573,6 +573,7 @@ def _guard_fit(fit: Callable[..., Identifier]) -> Callable[..., Identifier]:
         if outermost:
             for k in _learned(self):
                 delattr(self, k)
+            self.__dict__.pop("_fit_shape", None)
         self.check_params_for_data(data)
         free = data.n_samples - data.free_start
         if self.kind == "structural" and free < MIN_FREE_SAMPLES:
@@ -593,6 +594,8 @@ def _guard_fit(fit: Callable[..., Identifier]) -> Callable[..., Identifier]:
                 f"{where} returned {'None' if out is None else args.describe(out)}, not the "
                 "identifier itself; an identifier's fit returns self (the scikit-learn "
                 "contract: model = Id().fit(data))")
+        if outermost:  # what simulate's x0, xd0 and u are checked against (_check_simulate_args)
+            self.__dict__["_fit_shape"] = (data.n_channels, 0 if data.u is None else data.u.shape[0])
         return out
 
     guarded._api_guard = True  # type: ignore[attr-defined]
@@ -685,21 +688,28 @@ def _check_fitted_inputs(model: Identifier, where: str, data: Measurement) -> No
 
 def _check_simulate_args(model: Identifier, where: str, x0: Any = None, xd0: Any = None,
                          t: Any = None, u: Any = None, *rest: Any, **kw: Any) -> None:
-    """The arguments every ``simulate(x0, xd0, t, u)`` shares (see :func:`_guard_fitted`)."""
+    """The arguments every ``simulate(x0, xd0, t, u)`` shares (see :func:`_guard_fitted`):
+    ``x0`` (and a structural or mechanical model's ``xd0``) finite, one value per channel of
+    the fit; ``t`` finite and increasing; ``u`` None or finite, one row per input of the fit
+    (a structural model's input map's) and one column per time.  A mechanical model took an
+    ``x0`` or ``u`` of other sizes in silence and was IndexError, ValueError or TypeError on
+    ``xd0`` None, ``u`` of other length or text (round 25)."""
     x0, xd0, t, u = kw.get("x0", x0), kw.get("xd0", xd0), kw.get("t", t), kw.get("u", u)
+    shape = model.__dict__.get("_fit_shape")  # (channels, inputs) of the last fit
     structural = model.kind == "structural" and hasattr(model, "channels_")
-    n = len(model.channels_) if structural else None
+    n = len(model.channels_) if structural else (shape[0] if shape else None)
     args.array(where, "x0", x0, (n,))
     tt = args.array(where, "t", t, (None,))
     if tt.size < 1 or np.any(np.diff(tt) <= 0):
         raise ArgumentError(where, "t", args.describe(tt), "expected sample times [s], at least "
                             "one, increasing", described=True)
-    if structural:  # (a dynamical model's xd0 is unused; a mechanical one's checks its own)
-        # xd0 of another length was "cannot reshape array", NaN scipy's ValueError (round 25)
+    if model.kind in ("structural", "mechanical") and n is not None:
+        # the second-order kinds' rates (a first-order model's xd0 is unused: a dynamical one's,
+        # a plugin kind's such as tests/thermal_kind.py's)
         args.array(where, "xd0", xd0, (n,))
-        n_in = _fitted_inputs(model)
-        if u is not None and n_in is not None:  # (None: free motion)
-            args.array(where, "u", u, (n_in, tt.size))
+    if u is not None:  # (None: free motion)
+        n_in = (_fitted_inputs(model) if structural else None) or (shape[1] if shape else None)
+        args.array(where, "u", u, (n_in, tt.size))
 
 
 def _install_guards(cls: type) -> None:

@@ -11,11 +11,12 @@ import numpy as np
 import pytest
 
 import testbed
-from identify._base import MeasurementSamples
+from benchmarks import bench_sgd_sindy
+from identify._base import Identifier, MeasurementSamples
 from testbed import cli
 from testbed.core.arguments import finite_real, mapping, real
 from testbed.core.errors import ArgumentError, ScenarioError
-from testbed.core.measurement import PRIOR_RANGE, Measurement, prior_number
+from testbed.core.measurement import PRIOR_RANGE, Measurement, Trajectory, prior_number
 from testbed.pipeline.importers import MeasuredDataError, from_sep005
 from testbed.pipeline.scenario import SCENARIO_DIR, _read_toml, scenario_from_dict
 
@@ -208,8 +209,6 @@ def test_measurement_channel_names_of_blanks_and_letters_kept():
 
 @pytest.fixture(scope="module")
 def chain_fit():
-    from benchmarks import bench_sgd_sindy
-
     data = bench_sgd_sindy.chain_measurement(bench_sgd_sindy.chain_system(), duration=0.3)
     return testbed.IDENTIFIERS.get("ls_sindy")().fit(data), data
 
@@ -255,3 +254,45 @@ def test_simulate_checks_xd0_and_u(chain_fit, xd0, u, words):
     with pytest.raises(ArgumentError, match=words):
         model.simulate(np.zeros(3), xd0, np.arange(4) / 1e3, u)
     assert model.simulate(np.zeros(3), np.zeros(3), np.arange(4) / 1e3, np.ones((1, 4))).x.shape == (3, 4)
+
+
+class _Mechanical(Identifier):
+    """A mechanical identifier of the least kind: what the API's guards check is generic."""
+
+    kind = "mechanical"
+
+    def fit(self, data: Measurement, y: None = None) -> _Mechanical:
+        self.coef_ = np.zeros(1)
+        return self
+
+    def simulate(self, x0, xd0, t, u=None) -> Trajectory:
+        z = np.zeros((len(x0), len(t)))
+        return Trajectory(z, z, z)
+
+
+@pytest.fixture(scope="module")
+def mechanical_fit():
+    u = np.ones((1, 50))
+    return _Mechanical().fit(_measurement(u=u, inputs=("torque",)))
+
+
+@pytest.mark.parametrize("x0, xd0, u, words", [
+    (np.zeros(3), np.zeros(2), None, "'x0'"), (np.zeros(2), np.zeros(3), None, "'xd0'"),
+    (np.zeros(2), np.full(2, np.nan), None, "'xd0'"), (np.zeros(2), None, None, "'xd0'"),
+    (np.zeros(2), np.zeros(2), np.ones((3, 5)), "'u'"), (np.zeros(2), np.zeros(2), np.ones((1, 9)), "'u'"),
+    (np.zeros(2), np.zeros(2), np.full((1, 5), np.nan), "'u'"), (np.zeros(2), np.zeros(2), "1", "'u'")])
+def test_a_mechanical_models_simulate_checks_x0_xd0_and_u_against_the_fit(mechanical_fit, x0, xd0, u,
+                                                                          words):
+    # old: sindy_pi took x0 / xd0 / u of other sizes in silence; xd0 None IndexError, u of other
+    # length ValueError, a text TypeError
+    with pytest.raises(ArgumentError, match=words):
+        mechanical_fit.simulate(x0, xd0, np.arange(5) / FS, u)
+
+
+def test_a_mechanical_models_simulate_as_fitted_and_refitted(mechanical_fit):
+    t = np.arange(5) / FS
+    assert mechanical_fit.simulate(np.zeros(2), np.zeros(2), t, np.ones((1, 5))).x.shape == (2, 5)
+    assert mechanical_fit.simulate(np.zeros(2), np.zeros(2), t, None).x.shape == (2, 5)  # free
+    refit = _Mechanical().fit(_measurement(channels=("a", "b")))  # no inputs now
+    with pytest.raises(ArgumentError, match="'u'"):
+        refit.simulate(np.zeros(2), np.zeros(2), t, np.ones((1, 5)))
