@@ -69,6 +69,15 @@ Families (what rounds 1-24 did not try; their families are listed in ``hostile21
     ``t`` of one sample or spanning 1e308 s.  A raw exception, or a number returned for a window that
     holds no sample to score, is a finding.
 
+``dsapi``
+    The Python API's :class:`~testbed.core.dataset.Dataset` and ``Signal`` built by hand from the
+    Michaelis-Menten record, then :func:`testbed.measure`: ``fs`` a text, 10**400 or True, a prior
+    as a text, a signal's samples masked (one sample), complex or boolean, its
+    channels one text instead of a tuple, its unit 5, a measured table of bare arrays or
+    empty, a signal named ``x/y``, NaN at the last sample.  A raw exception, or a value of the
+    wrong kind measured in silence (a masked sample read as its value, a complex one's imaginary
+    part dropped), is a finding.
+
 Prints one line a finding and the counts; exits 1 if any finding.
 """
 
@@ -719,6 +728,61 @@ def fittedapi_cases(work: Path) -> list[tuple[str, object]]:
     return cases
 
 
+# ------------------------------------------------------------------ dsapi
+
+def dsapi_cases(work: Path) -> list[tuple[str, object]]:
+    import numpy as np
+
+    def case(make):
+        def run():
+            import testbed
+            from testbed.core.dataset import Dataset, Signal
+            from testbed.pipeline.scenario import load_scenario
+
+            base = Dataset.load(_generated(work, MM))
+            x, dx = base.measured["x"], base.measured["dx"]
+            sc = load_scenario(MM)
+            ds = make(Dataset, Signal, base, x, dx)
+            m = testbed.measure(ds, sc.signal, sc.kind)
+            return f"measured (x of shape {m.x.shape})"
+        return run
+
+    def sig(data=None, channels=None, unit="keep"):
+        def make(Dataset, Signal, base, x, dx):
+            return Dataset(base.fs, {"x": Signal(x.data if data is None else data(x.data),
+                                                 x.channels if channels is None else channels,
+                                                 x.unit if unit == "keep" else unit), "dx": dx})
+        return make
+
+    def masked(a):
+        out = np.ma.masked_array(a, mask=False)
+        out.mask[0, 3] = True
+        return out
+
+    def last_nan(a):
+        a = a.copy()
+        a[0, -1] = np.nan
+        return a
+
+    table = {
+        "fs a text": lambda D, S, b, x, dx: D("100", {"x": x, "dx": dx}),
+        "fs an integer of 400 digits": lambda D, S, b, x, dx: D(10 ** 400, {"x": x, "dx": dx}),
+        "fs True": lambda D, S, b, x, dx: D(True, {"x": x, "dx": dx}),
+        "a prior as a text": lambda D, S, b, x, dx: D(b.fs, {"x": x, "dx": dx},
+                                                      prior={"total_mass": "0.7"}),
+        "a masked sample": sig(masked),
+        "complex samples": sig(lambda a: a.astype(complex) + 1j),
+        "boolean samples": sig(lambda a: a > np.median(a)),
+        "channels one text instead of a tuple": sig(channels="x"),
+        "a unit of 5": sig(unit=5),
+        "a measured table of bare arrays": lambda D, S, b, x, dx: D(b.fs, {"x": x.data, "dx": dx}),
+        "an empty measured table": lambda D, S, b, x, dx: D(b.fs, {}),
+        "a signal named x/y": lambda D, S, b, x, dx: D(b.fs, {"x/y": x, "dx": dx}),
+        "NaN at the last sample": sig(last_nan),
+    }
+    return [(f"dsapi {label}", case(make)) for label, make in table.items() if make is not None]
+
+
 # ------------------------------------------------------------------ main
 
 FAMILIES = _hostile.families(
@@ -730,6 +794,7 @@ FAMILIES = _hostile.families(
         "edgesamples": edgesamples_cases,
         "measapi": measapi_cases,
         "fittedapi": fittedapi_cases,
+        "dsapi": dsapi_cases,
     },
     TIMEOUT_S,
 )
