@@ -689,11 +689,11 @@ def _check_fitted_inputs(model: Identifier, where: str, data: Measurement) -> No
 def _check_simulate_args(model: Identifier, where: str, x0: Any = None, xd0: Any = None,
                          t: Any = None, u: Any = None, *rest: Any, **kw: Any) -> None:
     """The arguments every ``simulate(x0, xd0, t, u)`` shares (see :func:`_guard_fitted`):
-    ``x0`` (and a structural or mechanical model's ``xd0``) finite, one value per channel of
-    the fit; ``t`` finite and increasing; ``u`` None or finite, one row per input of the fit
-    (a structural model's input map's) and one column per time.  A mechanical model took an
-    ``x0`` or ``u`` of other sizes in silence and was IndexError, ValueError or TypeError on
-    ``xd0`` None, ``u`` of other length or text (round 25)."""
+    ``x0`` finite, one value per channel of the fit; ``t`` finite and increasing; for a
+    structural or mechanical model ``xd0`` as ``x0``, and ``u`` None or finite, one row per
+    input of the fit (a structural model's input map's) and one column per time.  A mechanical
+    model took an ``x0`` or ``u`` of other sizes in silence and was IndexError, ValueError or
+    TypeError on ``xd0`` None, ``u`` of other length or text (round 25)."""
     x0, xd0, t, u = kw.get("x0", x0), kw.get("xd0", xd0), kw.get("t", t), kw.get("u", u)
     shape = model.__dict__.get("_fit_shape")  # (channels, inputs) of the last fit
     structural = model.kind == "structural" and hasattr(model, "channels_")
@@ -703,9 +703,12 @@ def _check_simulate_args(model: Identifier, where: str, x0: Any = None, xd0: Any
     if tt.size < 1 or np.any(np.diff(tt) <= 0):
         raise ArgumentError(where, "t", args.describe(tt), "expected sample times [s], at least "
                             "one, increasing", described=True)
-    if model.kind in ("structural", "mechanical") and n is not None:
-        # the second-order kinds' rates (a first-order model's xd0 is unused: a dynamical one's,
-        # a plugin kind's such as tests/thermal_kind.py's)
+    if model.kind not in ("structural", "mechanical"):
+        # a first-order model's xd0 is unused (a dynamical one's, a plugin kind's such as
+        # tests/thermal_kind.py's), and sindy_pi_dynamical checks its u against its law's inputs
+        # itself, naming both shapes
+        return
+    if n is not None:  # the second-order kinds' rates
         args.array(where, "xd0", xd0, (n,))
     if u is not None:  # (None: free motion)
         n_in = (_fitted_inputs(model) if structural else None) or (shape[1] if shape else None)
