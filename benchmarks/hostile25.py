@@ -529,13 +529,14 @@ def edgesamples_cases(work: Path) -> list[tuple[str, object]]:
     values = {"NaN": float("nan"), "+inf": float("inf"), "-inf": -float("inf"), "1e308": 1e308}
     tokens = {"NaN": "NaN", "+inf": "inf", "-inf": "-inf", "1e308": "1e308"}  # as C's printf
     cases: list[tuple[str, object]] = []
+    said = {"last": "the last sample", "both": "the first and the last samples"}
     for vlabel, v in values.items():
         for where in ("last", "both"):
             for column in ("x", "t"):
-                cases.append((f"edgesamples CSV {column} {vlabel} at the {where} sample",
+                cases.append((f"edgesamples CSV {column} {vlabel} at {said[where]}",
                               csv_case(column, at(where, v))))
             for channel in ("acc2", "force"):
-                cases.append((f"edgesamples UFF58 {channel} {vlabel} at the {where} sample",
+                cases.append((f"edgesamples UFF58 {channel} {vlabel} at {said[where]}",
                               uff_case(f"uff {channel} {vlabel} {where}", uff_sample(channel, where),
                                        uff_tokens(where, tokens[vlabel]))))
         cases.append((f"edgesamples SEP-005 acc3 {vlabel} at the last sample",
