@@ -78,6 +78,12 @@ Families (what rounds 1-24 did not try; their families are listed in ``hostile21
     wrong kind measured in silence (a masked sample read as its value, a complex one's imaginary
     part dropped), is a finding.
 
+``fileapi``
+    :func:`testbed.identify_file` (the Python API's ``testbed identify``) given ``params`` as a
+    list, ``prior`` as a list of pairs, ``phase`` a number, ``kind`` a number, ``method`` a
+    number or empty: a raw exception, or a value read as something else (a list of pairs as
+    prior keys), is a finding.
+
 Prints one line a finding and the counts; exits 1 if any finding.
 """
 
@@ -784,6 +790,25 @@ def dsapi_cases(work: Path) -> list[tuple[str, object]]:
     return [(f"dsapi {label}", case(make)) for label, make in table.items() if make is not None]
 
 
+# ------------------------------------------------------------------ fileapi
+
+def fileapi_cases(work: Path) -> list[tuple[str, object]]:
+    def case(**kw):
+        def run():
+            import testbed
+
+            testbed.identify_file(_generated(work, MM), scenario=MM, **kw)
+            return "fitted"
+        return run
+
+    table = {"params a list": {"params": [1]}, "params a text": {"params": "degree=2"},
+             "prior a list of pairs": {"prior": [("total_mass", 1.0)]},
+             "prior a number": {"prior": 0.7}, "phase a number": {"phase": 5},
+             "kind a number": {"kind": 5}, "method a number": {"method": 5},
+             "method empty": {"method": ""}}
+    return [(f"fileapi {label}", case(**kw)) for label, kw in table.items()]
+
+
 # ------------------------------------------------------------------ main
 
 FAMILIES = _hostile.families(
@@ -796,6 +821,7 @@ FAMILIES = _hostile.families(
         "measapi": measapi_cases,
         "fittedapi": fittedapi_cases,
         "dsapi": dsapi_cases,
+        "fileapi": fileapi_cases,
     },
     TIMEOUT_S,
 )

@@ -296,3 +296,15 @@ def test_a_mechanical_models_simulate_as_fitted_and_refitted(mechanical_fit):
     refit = _Mechanical().fit(_measurement(channels=("a", "b")))  # no inputs now
     with pytest.raises(ArgumentError, match="'u'"):
         refit.simulate(np.zeros(2), np.zeros(2), t, np.ones((1, 5)))
+
+
+# ------------------------------------------------------------------ identify_file's arguments
+
+@pytest.mark.parametrize("kw, name", [
+    ({"params": [1]}, "params"), ({"prior": [("total_mass", 1.0)]}, "prior"), ({"phase": 5}, "phase"),
+    ({"kind": 5}, "kind"), ({"method": 5}, "method"), ({"method": ""}, "method")])
+def test_identify_file_checks_its_arguments_where_the_call_enters(tmp_path, kw, name):
+    # old: params=[1] and phase=5 TypeErrors from inside; prior=[(k, v)] read as a list of keys
+    # ("--prior ('total_mass', 1.0): ... reads no such prior"); kind=5 refused as "--kind 5"
+    with pytest.raises(ArgumentError, match=rf"identify_file: argument '{name}'"):
+        testbed.identify_file(tmp_path / "absent.csv", **{"kind": "dynamical", **kw})
