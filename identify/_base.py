@@ -573,6 +573,7 @@ def _guard_fit(fit: Callable[..., Identifier]) -> Callable[..., Identifier]:
         if outermost:
             for k in _learned(self):
                 delattr(self, k)
+            self.__dict__.pop("_fit_shape", None)
         self.check_params_for_data(data)
         free = data.n_samples - data.free_start
         if self.kind == "structural" and free < MIN_FREE_SAMPLES:
@@ -593,6 +594,8 @@ def _guard_fit(fit: Callable[..., Identifier]) -> Callable[..., Identifier]:
                 f"{where} returned {'None' if out is None else args.describe(out)}, not the "
                 "identifier itself; an identifier's fit returns self (the scikit-learn "
                 "contract: model = Id().fit(data))")
+        if outermost:  # what simulate's x0, xd0 and u are checked against (_check_simulate_args)
+            self.__dict__["_fit_shape"] = (data.n_channels, 0 if data.u is None else data.u.shape[0])
         return out
 
     guarded._api_guard = True  # type: ignore[attr-defined]
@@ -645,23 +648,71 @@ def _guard_fitted(name: str, method: Callable[..., Any]) -> Callable[..., Any]:
             if fitted is not None and tuple(data.channels) != tuple(fitted):
                 raise ArgumentError(where, "data.channels", data.channels,
                                     f"expected the fitted channels {tuple(fitted)}")
+            _check_fitted_inputs(self, where, data)
+            if name == "score" and data.n_samples - data.free_start < MIN_SCORED_SAMPLES:
+                # an empty window (free_start at or past the end: a CV test window before the
+                # impact's end) scored R^2 = 1.0, a perfect fit of nothing; one sample has no
+                # variance (round 25: -inf or -2e305)
+                raise ArgumentError(where, "data.free_start", data.free_start,
+                                    f"expected at least {MIN_SCORED_SAMPLES} samples from "
+                                    f"free_start to the end (the record has {data.n_samples}): "
+                                    "R^2 needs the measured accelerations' variance")
         return _called(self, where, method, *a, **kw)
 
     guarded._api_guard = True  # type: ignore[attr-defined]
     return guarded
 
 
+#: Fewest samples from ``free_start`` on that :meth:`Identifier.score` scores: R^2 divides by
+#: the measured accelerations' variance about their mean, which one sample has not.
+MIN_SCORED_SAMPLES = 2
+
+
+def _fitted_inputs(model: Identifier) -> int | None:
+    """How many inputs a structural model was fitted with (its ``input_map_``'s columns), or
+    None if it keeps no input map."""
+    bmap = getattr(model, "input_map_", None)
+    return None if bmap is None or np.ndim(bmap) != 2 else int(np.shape(bmap)[1])
+
+
+def _check_fitted_inputs(model: Identifier, where: str, data: Measurement) -> None:
+    """``data``'s inputs against the fitted model's input map: rows of another count were
+    numpy's matmul ValueError (round 25).  No inputs is free motion (a model fitted to a free
+    decay keeps the record's declared input map), as documented."""
+    n_in = _fitted_inputs(model)
+    if n_in is not None and data.u is not None and data.u.shape[0] != n_in:
+        raise ArgumentError(where, "data.u", args.describe(data.u),
+                            f"expected the {n_in} input row(s) of the model's input map "
+                            "(n_inputs x n_samples), or none (free motion)", described=True)
+
+
 def _check_simulate_args(model: Identifier, where: str, x0: Any = None, xd0: Any = None,
-                         t: Any = None, *rest: Any, **kw: Any) -> None:
-    """The arguments every ``simulate(x0, xd0, t, u)`` shares (see :func:`_guard_fitted`)."""
-    x0 = kw.get("x0", x0)
-    t = kw.get("t", t)
-    n = len(model.channels_) if model.kind == "structural" and hasattr(model, "channels_") else None
+                         t: Any = None, u: Any = None, *rest: Any, **kw: Any) -> None:
+    """The arguments every ``simulate(x0, xd0, t, u)`` shares (see :func:`_guard_fitted`):
+    ``x0`` finite, one value per channel of the fit; ``t`` finite and increasing; for a
+    structural or mechanical model ``xd0`` as ``x0``, and ``u`` None or finite, one row per
+    input of the fit (a structural model's input map's) and one column per time.  A mechanical
+    model took an ``x0`` or ``u`` of other sizes in silence and was IndexError, ValueError or
+    TypeError on ``xd0`` None, ``u`` of other length or text (round 25)."""
+    x0, xd0, t, u = kw.get("x0", x0), kw.get("xd0", xd0), kw.get("t", t), kw.get("u", u)
+    shape = model.__dict__.get("_fit_shape")  # (channels, inputs) of the last fit
+    structural = model.kind == "structural" and hasattr(model, "channels_")
+    n = len(model.channels_) if structural else (shape[0] if shape else None)
     args.array(where, "x0", x0, (n,))
     tt = args.array(where, "t", t, (None,))
     if tt.size < 1 or np.any(np.diff(tt) <= 0):
         raise ArgumentError(where, "t", args.describe(tt), "expected sample times [s], at least "
                             "one, increasing", described=True)
+    if model.kind not in ("structural", "mechanical"):
+        # a first-order model's xd0 is unused (a dynamical one's, a plugin kind's such as
+        # tests/thermal_kind.py's), and sindy_pi_dynamical checks its u against its law's inputs
+        # itself, naming both shapes
+        return
+    if n is not None:  # the second-order kinds' rates
+        args.array(where, "xd0", xd0, (n,))
+    if u is not None:  # (None: free motion)
+        n_in = (_fitted_inputs(model) if structural else None) or (shape[1] if shape else None)
+        args.array(where, "u", u, (n_in, tt.size))
 
 
 def _install_guards(cls: type) -> None:

@@ -165,7 +165,11 @@ RULES: dict[str, dict[str, Rule]] = {
     "score": {"model": _fitted, "dataset": _instance("Dataset"), "scenario": _or_path("Scenario")},
     "split_measurement": {"data": _instance("Measurement"), "n_windows": _windows},
     "model_summary": {"model": _fitted, "data": _opt(_instance("Measurement"))},
-    "identify_file": {"path": _path, "scenario": _opt(_path), "fs": _opt(_fs)},
+    # (round 25: params=[1] and phase=5 were TypeErrors from inside, prior=[(k, v)] was read
+    # as a list of keys, kind=5 refused as "--kind 5")
+    "identify_file": {"path": _path, "scenario": _opt(_path), "fs": _opt(_fs), "kind": _opt(_kind),
+                      "method": _opt(_text), "params": _opt(_mapping), "prior": _opt(_mapping),
+                      "phase": _opt(_callable)},
     "measurement_from_file": {"path": _path, "kind": _kind, "signal": _opt(_mapping),
                               "fs": _opt(_fs)},
     "read_measured": {"path": _path, "fs": _opt(_fs), "own_units": _flag},

@@ -42,6 +42,7 @@ from testbed.core.errors import (
     terminal_safe,
 )
 from testbed.core.exit_guard import late_exit_calls
+from testbed.core.registry import REGISTERED_NAME, REGISTERED_NAME_DOC
 
 #: Status when the reader of standard output went away: a shell's for a command ended by SIGPIPE.
 EXIT_BROKEN_PIPE = 128 + 13
@@ -938,11 +939,21 @@ def cmd_runs(args: argparse.Namespace) -> int:
     if Path(args.out).exists() and not Path(args.out).is_dir():
         raise InputError(f"--out {args.out}: not a folder; expected the folder of runs "
                          "(from `testbed run --out`)")
+    if args.scenario is not None and not re.fullmatch(REGISTERED_NAME, args.scenario):
+        # "", a blank, a path or a newline named no scenario and listed an empty table in
+        # silence (round 25)
+        raise InputError(f"runs ls {show_value(args.scenario)}: not a scenario name; expected "
+                         f"{REGISTERED_NAME_DOC} (the scenario's name, as `testbed runs ls` lists it)")
     damaged: list[Path] = []
     runs = list_runs(args.out, scenario=args.scenario, damaged=damaged)
     if damaged:  # left out of the table, but never silently
         print(f"warning: {len(damaged)} run folder(s) left out, their run.json is damaged, missing or of "
               f"another format: {', '.join(map(str, damaged))}", file=sys.stderr)
+    if args.scenario is not None and not runs:
+        # a name that matches no run (a typo, or a scenario not run yet) said so, not an empty
+        # table alone (round 25); the listing on standard output stays as it was
+        print(f"no runs of scenario {show_value(args.scenario)} in {terminal_safe(args.out)}",
+              file=sys.stderr)
     cols = ("scenario", "seed", "time (UTC)", "identifier", "verdict", "path")
     rows = [(r["scenario"], str(r["seed"]), r["created"].replace("+00:00", "Z"), r["identifier"],
              r["verdict"], str(r["path"])) for r in runs]

@@ -26,7 +26,7 @@ from typing import Any
 
 import numpy as np
 
-from testbed.core.errors import ArgumentError
+from testbed.core.errors import ArgumentError, is_control
 
 
 def integer(where: str, name: str, value: Any, *, low: int | None = None,
@@ -41,21 +41,32 @@ def integer(where: str, name: str, value: Any, *, low: int | None = None,
     return value
 
 
+def finite_real(value: Any) -> float | None:
+    """``value`` as a finite ``float`` if it is a real number (not a boolean) that float64 holds,
+    else None: an integer beyond float64's range (a JSON ``10**400``) is None, where ``float``
+    raised OverflowError (round 25: an internal error of ``identify`` on a SEP-005 ``fs``)."""
+    if not isinstance(value, numbers.Real) or isinstance(value, (bool, np.bool_)):
+        return None
+    try:
+        x = float(value)
+    except OverflowError:
+        return None
+    return x if math.isfinite(x) else None
+
+
 def real(where: str, name: str, value: Any, *, low: float | None = None,
          high: float | None = None, low_open: bool = False) -> float:
     """``value`` as a finite ``float`` in ``[low, high]`` (``(low, high]`` when ``low_open``)."""
-    ok = isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_))
-    if ok:
-        value = float(value)
-        ok = math.isfinite(value) and (low is None or (value > low if low_open else value >= low)) \
-            and (high is None or value <= high)
+    x = finite_real(value)
+    ok = x is not None and (low is None or (x > low if low_open else x >= low)) \
+        and (high is None or x <= high)
     if not ok:
         left = "(" if low_open else "["
         bounds = f" in {left}{low:g}, {high:g}]" if low is not None and high is not None else (
             f" {'>' if low_open else '>='} {low:g}" if low is not None else
             f" <= {high:g}" if high is not None else "")
         raise ArgumentError(where, name, value, f"expected a finite number{bounds}")
-    return value
+    return x
 
 
 def choice(where: str, name: str, value: Any, allowed: Sequence[Any]) -> Any:
@@ -69,12 +80,15 @@ def choice(where: str, name: str, value: Any, allowed: Sequence[Any]) -> Any:
 def names(where: str, name: str, value: Any, *, count: int | None = None) -> tuple[str, ...]:
     """``value`` (a list or tuple of distinct non-empty texts, ``count`` of them if given) as a
     tuple; a single text is refused (it would be read as one name per character)."""
-    ok = isinstance(value, (list, tuple)) and all(isinstance(v, str) and v for v in value) \
+    # a control character (a newline, ESC) split the equations and tables that show the name
+    # (round 25: a channel "a\nb" was fitted and printed on two lines)
+    ok = isinstance(value, (list, tuple)) and all(
+        isinstance(v, str) and v and not any(is_control(c) for c in v) for v in value) \
         and len(set(value)) == len(value)
     if not ok or (count is not None and len(value) != count):
         many = f"{count} " if count is not None else ""
-        raise ArgumentError(where, name, value,
-                            f"expected a tuple of {many}distinct non-empty names (text)")
+        raise ArgumentError(where, name, value, f"expected a tuple of {many}distinct non-empty "
+                            "names (text without control characters)")
     return tuple(value)
 
 
@@ -106,6 +120,12 @@ def array(where: str, name: str, value: Any, shape: tuple[int | None, ...], *,
     allowed = f"expected a finite {want} array of shape ({dims})"
     if not isinstance(value, (np.ndarray, list, tuple)):
         raise ArgumentError(where, name, describe(value), allowed, described=True)
+    if np.ma.isMaskedArray(value) and np.ma.getmaskarray(value).any():
+        # np.asarray dropped the mask: a masked (missing) sample was fitted as the value under
+        # it (round 25; the SEP-005 reader's rule since round 17)
+        masked = int(np.ma.getmaskarray(value).sum())
+        raise ArgumentError(where, name, describe(value), f"{allowed} ({masked} masked sample(s) "
+                            "given: fill or cut them)", described=True)
     try:
         a = np.asarray(value)
     except (ValueError, TypeError):  # a ragged list
@@ -130,7 +150,8 @@ def mapping(where: str, name: str, value: Any) -> dict[str, Any]:
     if not isinstance(value, Mapping) or not all(isinstance(k, str) for k in value):
         raise ArgumentError(where, name, value, "expected a dict with text keys")
     for k, v in value.items():
-        if isinstance(v, numbers.Real) and not isinstance(v, bool) and not math.isfinite(float(v)):
+        # (finite_real: float(10**400) raised OverflowError, round 25)
+        if isinstance(v, numbers.Real) and not isinstance(v, bool) and finite_real(v) is None:
             raise ArgumentError(where, f"{name}[{k!r}]", v, "expected a finite number")
     return dict(value)
 

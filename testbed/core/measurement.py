@@ -10,6 +10,30 @@ import numpy as np
 from testbed.core import arguments as args
 from testbed.core.errors import ArgumentError
 
+#: Range of a declared prior (a mass [kg] or a length [m]): a file's, ``--prior``'s and a
+#: :class:`Measurement`'s.  A prior scales the identified matrices (M from a mass, then K = M w^2
+#: with w^2 up to (pi fs)^2 ~ 1e9 rad^2/s^2, M^-1 K, and the eigen-solvers' products of them),
+#: which must stay inside float64's 1e-308 .. 1e308:
+#: ``total_mass`` 5e-324 kg made M singular, 1e-320 kg overflowed M^-1 K and 1e308 kg
+#: overflowed K (round 15: internal errors).  1e-100 .. 1e100 leaves a factor of 1e100 to each
+#: end, and holds every physical rig (an electron is 9e-31 kg, the Earth 6e24 kg).
+PRIOR_RANGE = (1e-100, 1e100)
+
+
+def prior_number(value: Any) -> float | None:
+    """A declared prior's value as a float if it is a finite number (not a boolean, not a
+    text) within :data:`PRIOR_RANGE`, else None."""
+    x = args.finite_real(value.item() if isinstance(value, np.generic) else value)
+    return x if x is not None and PRIOR_RANGE[0] <= x <= PRIOR_RANGE[1] else None
+
+
+def _prior_ok(value: Any) -> bool:
+    """A number :func:`prior_number` takes, or a non-empty flat list, tuple or 1-D array of
+    them (``link_lengths``, which :class:`identify._mechsim.LoopClosure` reads)."""
+    if isinstance(value, (list, tuple)) or (isinstance(value, np.ndarray) and value.ndim == 1):
+        return len(value) > 0 and all(prior_number(v) is not None for v in value)
+    return prior_number(value) is not None
+
 
 @dataclass(frozen=True)
 class Measurement:
@@ -142,6 +166,15 @@ class Measurement:
         if self.input_map is not None:
             put(self, "input_map", args.array(where, "input_map", self.input_map, (n_ch, n_in)))
         put(self, "prior", args.mapping(where, "prior", self.prior))
+        for k, v in self.prior.items():
+            # the command line refuses these in a file or --prior (check_prior); the API read a
+            # text "0.7" as 0.7 kg and True as 1 kg, and [0.7], None, a complex, 5e-324 or
+            # 1e308 were raw errors inside the fit (round 25)
+            if not _prior_ok(v):
+                lo, hi = PRIOR_RANGE
+                raise ArgumentError(where, f"prior[{k!r}]", v, f"expected a finite number from "
+                                    f"{lo:g} to {hi:g} (a mass [kg] or a length [m]), or a list of "
+                                    "them")
         # no upper bound: a window cut before the excitation ends keeps the record's free_start
         # (MeasurementSamples.window), a record that ends before its free decay starts
         put(self, "free_start", args.integer(where, "free_start", self.free_start, low=0))

@@ -59,10 +59,11 @@ from typing import Any
 
 import numpy as np
 
+from testbed.core.arguments import finite_real
 from testbed.core.budget import IDENTIFY_BYTES_PER_VALUE, IDENTIFY_TEXT_BUDGET_BYTES, IDENTIFY_VALUE_BUDGET
 from testbed.core.dataset import Dataset, DatasetError, Signal
 from testbed.core.errors import TestbedError, is_control, show_names, show_value
-from testbed.core.measurement import MIN_FREE_SAMPLES, Measurement
+from testbed.core.measurement import MIN_FREE_SAMPLES, PRIOR_RANGE, Measurement, prior_number
 from testbed.core.rate_attrs import fs_attribute_problem, off_scenario_rate
 from testbed.numerics.clipping import Clipping, measured_clipping
 from testbed.numerics.noise import noise_std
@@ -1110,13 +1111,6 @@ def _check_starts(path: Path, starts: Mapping[str, float], fs: float,
                                       "give every channel a time, or none)")
 
 
-#: Range of a declared prior (a mass [kg] or a length [m]).  A prior scales the identified
-#: matrices (M from a mass, then K = M w^2 with w^2 up to (pi fs)^2 ~ 1e9 rad^2/s^2, M^-1 K, and
-#: the eigen-solvers' products of them), which must stay inside float64's 1e-308 .. 1e308:
-#: ``total_mass`` 5e-324 kg made M singular, 1e-320 kg overflowed M^-1 K and 1e308 kg
-#: overflowed K (round 15: internal errors).  1e-100 .. 1e100 leaves a factor of 1e100 to each
-#: end, and holds every physical rig (an electron is 9e-31 kg, the Earth 6e24 kg).
-PRIOR_RANGE = (1e-100, 1e100)
 
 
 def check_prior(source: str | os.PathLike, key: str, value: Any) -> None:
@@ -1125,10 +1119,8 @@ def check_prior(source: str | os.PathLike, key: str, value: Any) -> None:
     in a dataset file, whose ``prior`` attributes a user may have edited: NaN, -1 or text were
     read in silence)."""
     lo, hi = PRIOR_RANGE
-    # an int beyond float64 (10**400) is refused by its size: math.isfinite raised OverflowError
-    huge = isinstance(value, int) and not isinstance(value, bool) and abs(value) > hi
-    if huge or isinstance(value, bool) or not isinstance(value, (int, float)) \
-            or not (math.isfinite(value) and lo <= value <= hi):
+    # (an int beyond float64, 10**400, is refused: math.isfinite raised OverflowError)
+    if not isinstance(value, (int, float)) or prior_number(value) is None:
         raise MeasuredDataError(source, f"prior {key}={value!r}: expected a finite number from "
                                         f"{lo:g} to {hi:g} (a mass [kg] or a length [m]; beyond, "
                                         "the identified matrices leave float64's range)")
@@ -1139,11 +1131,11 @@ def check_position(source: str | os.PathLike, channel: str, value: Any, key: str
     it: SEP-005's ``position_m``, a dataset's ``positions``, a UFF node's coordinate) unless a
     finite number: a NaN position was kept in silence and placed the sensor nowhere."""
     value = value.item() if isinstance(value, np.generic) else value  # named as 'nan', not
-    if isinstance(value, bool) or not isinstance(value, (int, float)) \
-            or not math.isfinite(value):  # 'np.float64(nan)'
-        raise MeasuredDataError(source, f"channel {channel!r}: {key}={value!r}; expected a finite "
-                                        f"number [m] (or no {key})")
-    return float(value)
+    x = finite_real(value) if isinstance(value, (int, float)) else None  # 'np.float64(nan)'
+    if x is None:  # (an integer of 400 digits was float()'s OverflowError: round 25)
+        raise MeasuredDataError(source, f"channel {channel!r}: {key}={show_value(value)}; expected "
+                                        f"a finite number [m] (or no {key})")
+    return x
 
 
 def check_record_size(path: Path, n_samples: int, n_channels: int) -> None:
@@ -1625,33 +1617,19 @@ def _parse_sep005(path: Path, content: Any) -> _Raw:
             raise MeasuredDataError(path, f"SEP-005 channel {name!r}: data are a masked array "
                                           f"with {int(np.ma.getmaskarray(values).sum())} masked "
                                           "sample(s); fill or cut them")
-        # JSON strings and booleans are not samples (np.asarray would read "1.5" and true as
-        # numbers); an array given in memory must hold real numbers (complex lost its
-        # imaginary part)
-        if (isinstance(values, np.ndarray) and values.dtype.kind not in "fiu") or (
-                isinstance(values, (list, tuple)) and any(isinstance(v, (bool, str)) for v in values)):
-            raise MeasuredDataError(path, f"SEP-005 channel {name!r}: data are not numbers")
-        try:
-            data = np.asarray(values, dtype=float)
-        except (TypeError, ValueError):
-            raise MeasuredDataError(path, f"SEP-005 channel {name!r}: data are not numbers") from None
-        except OverflowError:  # a JSON integer such as 10**400: no float64 holds it
-            raise MeasuredDataError(path, f"SEP-005 channel {name!r}: data hold an integer beyond "
-                                          "float64's range (1.8e308)") from None
+        data = _sep005_numbers(path, name, values, "data")
         if data.ndim != 1:
             raise MeasuredDataError(path, f"SEP-005 channel {name!r}: data of shape {data.shape}; "
                                           "only 1-D channels are supported")
         if "fs" in c:
             f = c["fs"]
-            if isinstance(f, bool) or not isinstance(f, (int, float)) or not (math.isfinite(f) and f > 0):
-                raise MeasuredDataError(path, f"SEP-005 channel {name!r}: fs={f!r} is not a rate > 0 Hz")
-            rates[name] = float(f)
+            rate = finite_real(f) if isinstance(f, (int, float)) else None
+            if rate is None or rate <= 0:  # (an integer of 400 digits: OverflowError, round 25)
+                raise MeasuredDataError(path, f"SEP-005 channel {name!r}: fs={show_value(f)} is not "
+                                              "a rate > 0 Hz")
+            rates[name] = rate
         if "time" in c:
-            try:
-                t = np.asarray(c["time"], dtype=float)
-            except (TypeError, ValueError, OverflowError):
-                raise MeasuredDataError(path, f"SEP-005 channel {name!r}: time values are not "
-                                              "numbers of float64's range") from None
+            t = _sep005_numbers(path, name, c["time"], "time")
             if t.shape != data.shape:
                 raise MeasuredDataError(path, f"SEP-005 channel {name!r}: time of shape {t.shape} "
                                               f"for data of shape {data.shape}; expected one time "
@@ -1678,7 +1656,7 @@ def _parse_sep005(path: Path, content: Any) -> _Raw:
                 raise MeasuredDataError(path, f"SEP-005 channel {name!r}: node={node!r}; expected "
                                               "an integer >= 1 (or no node key)")
             raw.nodes[name] = node
-        direction = _direction(c.get("direction"))
+        direction = _direction(path, name, c.get("direction"))
         if direction:
             raw.directions[name] = direction
         pos = c.get("position_m")
@@ -1700,15 +1678,39 @@ def _parse_sep005(path: Path, content: Any) -> _Raw:
 _DIRECTION = re.compile(r"^\s*([-+]?)\s*([XYZ])\s*(rotation)?\s*$", re.IGNORECASE)
 
 
-def _direction(value: Any) -> int:
-    """UFF direction code of an int or a text such as ``"+Z"`` / ``"-X rotation"``; 0 if none."""
+def _direction(path: Path, name: str, value: Any) -> int:
+    """UFF direction code of an int or a text such as ``"+Z"`` / ``"-X rotation"``; 0 if none
+    (``None``).  Anything else is refused: a direction of ``3.0``, ``true``, ``"up"``, ``[3]`` or
+    ``"+Z axis"`` was read as none in silence (round 25), its channel's sign with it."""
+    if value is None:
+        return 0
     if isinstance(value, int) and not isinstance(value, bool):
         return value
     m = _DIRECTION.match(value) if isinstance(value, str) else None
     if m is None:
-        return 0
+        raise MeasuredDataError(path, f"SEP-005 channel {name!r}: direction={show_value(value)}; "
+                                      "expected a text such as '+Z' or '-X rotation', an integer "
+                                      "code -6 to 6, or no direction key")
     code = "XYZ".index(m.group(2).upper()) + 1 + (3 if m.group(3) else 0)
     return -code if m.group(1) == "-" else code
+
+
+def _sep005_numbers(path: Path, name: str, values: Any, key: str) -> np.ndarray:
+    """A SEP-005 channel's ``data`` or ``time`` as floats, or refused naming the channel and the
+    key: JSON strings and booleans are not numbers (``np.asarray`` read ``"1.5"`` and ``true`` as
+    numbers: time stamps as texts were read so in silence, round 25), nor is a ``null``; an array
+    given in memory must hold real numbers (complex lost its imaginary part)."""
+    what = f"SEP-005 channel {name!r}: {'data are' if key == 'data' else key + ' values are'}"
+    if (isinstance(values, np.ndarray) and values.dtype.kind not in "fiu") or (
+            isinstance(values, (list, tuple)) and any(isinstance(v, (bool, str)) for v in values)):
+        raise MeasuredDataError(path, f"{what} not numbers")
+    try:
+        return np.asarray(values, dtype=float)
+    except (TypeError, ValueError):
+        raise MeasuredDataError(path, f"{what} not numbers") from None
+    except OverflowError:  # a JSON integer such as 10**400: no float64 holds it
+        raise MeasuredDataError(path, f"{what} not numbers of float64's range (an integer "
+                                      "beyond float64's range, 1.8e308)") from None
 
 
 def _common_rate(path: Path, rates: dict[str, float], rtol: float) -> float:

@@ -114,8 +114,10 @@ HEADER_SCHEMA = {
     "rig": Field(str, doc="registered rig name (see `testbed list`)"),
     "seed": Field(int, 0, min=0, max=MAX_SEED, doc="seed of the measurement noise"),
     "description": Field(str, "", pattern=ONE_LINE, pattern_doc=ONE_LINE_DOC, doc="one line for listings"),
-    "tags": Field(list, [], item_type=str, pattern=ONE_LINE,
-                  pattern_doc=ONE_LINE_DOC, doc="free tags for selecting scenarios"),
+    # a tag "" or of blanks alone (a no-break space too) selects nothing and lists as a gap
+    # (round 25: accepted)
+    "tags": Field(list, [], item_type=str, pattern=r"(?=.*\S)" + ONE_LINE,
+                  pattern_doc="not blank, " + ONE_LINE_DOC, doc="free tags for selecting scenarios"),
     "extends": Field(str, "", doc="scenario file this one starts from (relative path)"),
 }
 
