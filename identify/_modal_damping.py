@@ -1565,6 +1565,46 @@ def backbone_shift(M: np.ndarray, K: np.ndarray, K3: np.ndarray, dec: ModalDecay
     return 3.0 * g * a * a / (8.0 * w)
 
 
+def cubic_softens(M: np.ndarray, K: np.ndarray, K3: np.ndarray | None,
+                  dec: ModalDecay | None) -> str:
+    """Why a model's cubic contradicts the measured decays (``""`` if it does not).
+
+    On a mode whose backbone decay fit was taken (``dec.taken``), the model's own first-order
+    backbone shift (:func:`backbone_shift`) is opposite to the measured one (``dec.chirp``) and
+    at least :data:`BACKBONE_SHARE` of it in size (the decay hold's share for a cubic that
+    accounts for a shift): the model's cubic softens a mode that the record shows hardening,
+    or the reverse.  A smaller opposite shift is left alone: a mode 2 stiffened by mode 1's
+    amplitude shows a shift no diagonal cubic gives (soft-base member 002: measured +14.9 Hz,
+    the model's -0.71 Hz; refused, TRAC 0.94 -> 0.88).  One test for every identifier that
+    fits a cubic structural model (``ls_sindy`` refuses such a cubic, ``sgd_sindy`` compares it
+    with the linear fit).
+
+    Parameters
+    ----------
+    M, K : ndarray, shape (n, n)
+        The model's mass [kg] and stiffness [N/m].
+    K3 : ndarray, shape (n, n), or None
+        The model's cubic stiffness [N/m^3]; ``None`` (a linear model) answers ``""``.
+    dec : ModalDecay or None
+        The backbone decay fits (:func:`modal_decay`); ``None`` or no ``chirp`` answers ``""``.
+
+    Returns
+    -------
+    str
+        The first contradicted mode and both shifts [Hz], or ``""``.
+    """
+    if dec is None or dec.chirp is None or K3 is None:
+        return ""
+    own = backbone_shift(M, K, K3, dec)
+    bad = (dec.taken & np.isfinite(dec.chirp) & (own * dec.chirp < 0.0)
+           & (np.abs(own) >= BACKBONE_SHARE * np.abs(dec.chirp)))
+    if not np.any(bad):
+        return ""
+    k = int(np.flatnonzero(bad)[0])
+    return (f"its cubic shifts mode {k + 1} by {own[k] / (2 * np.pi):+.3g} Hz at the measured "
+            f"amplitude, the measured decay by {dec.chirp[k] / (2 * np.pi):+.3g} Hz")
+
+
 def _is_symmetric(*mats: np.ndarray) -> bool:
     """Whether every matrix equals its transpose to rounding (``rtol`` 1e-12)."""
     return all(np.allclose(a, a.T, rtol=1e-12, atol=0.0) for a in mats)

@@ -11,8 +11,7 @@ from identify import IDENTIFIERS
 from identify._band_refusal import fit_with_band_refusal, lowest_mode_hz
 from identify._cubic_rule import CUBIC_CHIRP_MIN, cubic_rule
 from identify._modal_damping import (
-    BACKBONE_SHARE,
-    backbone_shift,
+    cubic_softens,
     decay_hold,
     hardened_floor,
     hardened_reach,
@@ -780,26 +779,10 @@ class LeastSquaresSINDy(StructuralIdentifier):
         return True
 
     def _cubic_softens(self) -> str:
-        """Why the fitted cubic contradicts the measured decays ("" if it does not): on a mode
-        whose backbone decay fit was taken (``modal_decay_``), the model's own first-order
-        backbone shift (:func:`identify._modal_damping.backbone_shift`) is opposite to the
-        measured one (``chirp``) and at least
-        :data:`~identify._modal_damping.BACKBONE_SHARE` of it in size (the decay hold's share
-        for a cubic that accounts for a shift): the model's cubic softens a mode that the
-        record shows hardening, or the reverse.  A smaller opposite shift is left alone: a
-        mode 2 stiffened by mode 1's amplitude shows a shift no diagonal cubic gives (soft-base
-        member 002: measured +14.9 Hz, the model's -0.71 Hz; refused, TRAC 0.94 -> 0.88)."""
-        dec = getattr(self, "modal_decay_", None)
-        if dec is None or dec.chirp is None or self.K3_ is None:
-            return ""
-        own = backbone_shift(self.M_, self.K_, self.K3_, dec)
-        bad = (dec.taken & np.isfinite(dec.chirp) & (own * dec.chirp < 0.0)
-               & (np.abs(own) >= BACKBONE_SHARE * np.abs(dec.chirp)))
-        if not np.any(bad):
-            return ""
-        k = int(np.flatnonzero(bad)[0])
-        return (f"its cubic shifts mode {k + 1} by {own[k] / (2 * np.pi):+.3g} Hz at the measured "
-                f"amplitude, the measured decay by {dec.chirp[k] / (2 * np.pi):+.3g} Hz")
+        """Why the fitted cubic contradicts the measured decays ("" if it does not):
+        :func:`identify._modal_damping.cubic_softens` on this model's ``M_``, ``K_``, ``K3_``
+        and ``modal_decay_`` (a thin wrapper kept while ``sgd_sindy`` calls it)."""
+        return cubic_softens(self.M_, self.K_, self.K3_, getattr(self, "modal_decay_", None))
 
     def _cubic_diverges(self, data: Measurement) -> str:
         """Why the fitted cubic model does not stay bounded in its own simulation over the fit

@@ -283,12 +283,12 @@ def test_cubic_refused_when_it_contradicts_the_measured_backbone(hardening, monk
     measured decay chirp (soft-base member 014: the cubic softened mode 2, -0.99 Hz, which
     the decay showed hardening, +1.66 Hz; the model diverged in the scorer's simulation) is
     refused and the linear library fitted; the user's cubic=True keeps it."""
-    import identify.ls_sindy as ls
+    import identify._modal_damping as md
 
     _, data = hardening
     kept = LeastSquaresSINDy().fit(data)  # the real cubic: its backbone agrees with the decays
     assert kept.cubic_ is True and "refused" not in kept.cubic_rule_
-    monkeypatch.setattr(ls, "backbone_shift", lambda M, K, K3, dec: -dec.chirp)
+    monkeypatch.setattr(md, "backbone_shift", lambda M, K, K3, dec: -dec.chirp)
     model = LeastSquaresSINDy().fit(data)
     assert model.cubic_ is False and model.K3_ is None
     assert "cubic terms in; the fitted cubic model refused (its cubic shifts mode" in model.cubic_rule_
