@@ -12,6 +12,7 @@ from identify._modal_damping import (
     BACKBONE_MIN_FALL,
     ModalDecay,
     backbone_shift,
+    beyond_limit,
     chain_transients,
     coupling_moves,
     cubic_softens,
@@ -764,3 +765,22 @@ def test_a_cubic_that_softens_a_hardening_decay_is_one_function_of_the_model_and
     assert cubic_softens(M, K, soft, no_backbone) == ""
     model = SimpleNamespace(M_=M, K_=K, K3_=soft, modal_decay_=dec)
     assert LeastSquaresSINDy._cubic_softens(model) == said
+
+
+def test_a_beyond_first_order_fits_limit_is_read_where_the_record_reaches_it():
+    """beyond_limit: |p| / (2 pi) of each ``beyond`` pole whose squared amplitude falls to
+    BACKBONE_MIN_FALL or less over the window; NaN where the pole is NaN, where the record
+    does not reach the limit, and everywhere without ``beyond``."""
+    two_pi = 2.0 * np.pi
+    n = 3
+    dec = ModalDecay(*(np.full(n, np.nan) for _ in range(5)), np.zeros(n), np.zeros(n, bool))
+    assert np.all(np.isnan(beyond_limit(dec, 1.0)))
+    p = np.array([np.nan, complex(-328.8, two_pi * 397.88), complex(-0.2, two_pi * 900.0)])
+    dec = ModalDecay(*(np.full(n, np.nan) for _ in range(5)), np.zeros(n), np.zeros(n, bool),
+                     beyond=p)
+    lim = beyond_limit(dec, 1.0)
+    assert np.isnan(lim[0])
+    assert lim[1] == pytest.approx(abs(p[1]) / two_pi, rel=1e-15)
+    assert np.isnan(lim[2])  # exp(-0.4) = 0.67 left: the limit is not reached
+    T = np.log(1.0 / BACKBONE_MIN_FALL) / (2.0 * 0.2)
+    assert np.isfinite(beyond_limit(dec, 1.0001 * T)[2]) and np.isnan(beyond_limit(dec, 0.999 * T)[2])
