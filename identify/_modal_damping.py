@@ -217,7 +217,9 @@ frequency ``wd + c exp(-2 sigma t)``, whose small-amplitude limit ``wd`` is the 
 Then, as without the cubic, every taken mode gets its measured damping and, within one line,
 its measured linear frequency, with more checks:
 
-* a fit with ``|c| > BACKBONE_MAX_SHIFT wd`` is not taken (beyond the first order);
+* a fit with ``|c| > BACKBONE_MAX_SHIFT wd`` is not taken (beyond the first order); a
+  located mode's such fit keeps its linear pole in ``beyond`` of :class:`ModalDecay`, whose
+  limit (:func:`beyond_limit`) ``ls_sindy`` uses as a lower bound only (its floor);
 * a frequency moves only when the record reaches the limit it is read at: the squared
   amplitude falls to :data:`BACKBONE_MIN_FALL` of its start or less over the window
   (otherwise ``wd`` is an extrapolation beyond the measured span);
