@@ -217,7 +217,9 @@ frequency ``wd + c exp(-2 sigma t)``, whose small-amplitude limit ``wd`` is the 
 Then, as without the cubic, every taken mode gets its measured damping and, within one line,
 its measured linear frequency, with more checks:
 
-* a fit with ``|c| > BACKBONE_MAX_SHIFT wd`` is not taken (beyond the first order);
+* a fit with ``|c| > BACKBONE_MAX_SHIFT wd`` is not taken (beyond the first order); a
+  located mode's such fit keeps its linear pole in ``beyond`` of :class:`ModalDecay`, whose
+  limit (:func:`beyond_limit`) ``ls_sindy`` uses as a lower bound only (its floor);
 * a frequency moves only when the record reaches the limit it is read at: the squared
   amplitude falls to :data:`BACKBONE_MIN_FALL` of its start or less over the window
   (otherwise ``wd`` is an extrapolation beyond the measured span);
@@ -375,6 +377,13 @@ class ModalDecay:
         With the backbone fit, the modes refitted as an exponential decay and converged (no
         peak located them and their backbone fit was not first order); None where none was
         refitted.
+    beyond : ndarray of complex, shape (n,) or None
+        With the backbone fit, the linear pole ``-sigma + i wd`` [1/s] (mapped into the
+        model's domain as ``sigma_model`` / ``lam_model`` are) of each located mode whose
+        backbone fit converged near its model mode but was not taken for its shift ``|c| >
+        BACKBONE_MAX_SHIFT wd`` (NaN for the other modes); None where there is none.  Its
+        damping and frequency are not the model's (beyond the first order), but its linear
+        limit still bounds the mode from below (:func:`beyond_limit`).
     """
 
     sigma: np.ndarray
@@ -389,6 +398,7 @@ class ModalDecay:
     shape: np.ndarray | None = None
     peak_hz: np.ndarray | None = None
     exponential: np.ndarray | None = None
+    beyond: np.ndarray | None = None
 
 
 def _two_column_qr(A: np.ndarray) -> tuple[float, np.ndarray, float, float, np.ndarray | None]:
@@ -714,6 +724,12 @@ def modal_decay(data: Measurement, M: np.ndarray, K: np.ndarray, C: np.ndarray,
             _take(out, k, s, wd, fs if trap else None, w_model[k])
             if backbone:
                 out.chirp[k], out.amplitude[k] = c, amp
+        elif backbone and ok and paired and not free[k]:
+            # a located mode's converged backbone fit beyond the first order: not taken, its
+            # linear pole kept as a lower bound only (``beyond``, :func:`beyond_limit`)
+            if out.beyond is None:
+                object.__setattr__(out, "beyond", np.full(n, np.nan, dtype=complex))
+            out.beyond[k] = _model_pole(s, wd, fs if trap else None)
     # a fit from a free peak that failed before some later mode's decay was taken is tried
     # once more with every taken decay profiled out (module docstring, "A free peak's fit
     # retried"); a linear model's modes only (``retry`` holds no backbone fit)
@@ -734,12 +750,19 @@ def _take(out: ModalDecay, k: int, s: float, wd: float, trap_fs: float | None,
     ``out``, its pole mapped into the model's domain (``trap_fs`` [Hz]: trapezoid integrals at
     that rate; None: none) and its shift [Hz] from the model's frequency ``w_model`` [rad/s]."""
     out.sigma[k], out.omega_d[k], out.taken[k] = s, wd, True
-    pole = complex(-s, wd)
-    if trap_fs is not None:
-        pole = 2.0 * trap_fs * np.tanh(pole / (2.0 * trap_fs))
+    pole = _model_pole(s, wd, trap_fs)
     out.sigma_model[k] = -pole.real
     out.lam_model[k] = abs(pole) ** 2
     out.shift[k] = abs(abs(pole) - w_model) / (2.0 * np.pi)
+
+
+def _model_pole(s: float, wd: float, trap_fs: float | None) -> complex:
+    """The measured pole ``-s + i wd`` [1/s] in the model's domain: as measured, or with
+    trapezoid integrals at ``trap_fs`` [Hz] mapped by ``p = 2 fs tanh(p / (2 fs))``."""
+    pole = complex(-s, wd)
+    if trap_fs is not None:
+        pole = 2.0 * trap_fs * np.tanh(pole / (2.0 * trap_fs))
+    return pole
 
 
 def _from_free_peak(out: ModalDecay, k: int, peak: float, band: tuple[float, float],
@@ -1512,7 +1535,9 @@ def hardened_floor(dec: ModalDecay, limit_hz: np.ndarray, line_hz: float) -> np.
     dec : ModalDecay
         The backbone decay fits of the model's modes (``chirp`` set).
     limit_hz : ndarray, shape (n,)
-        :func:`hardened_reach`'s read backbone limits [Hz] (NaN where none).
+        :func:`hardened_reach`'s read backbone limits [Hz] (NaN where none); ``ls_sindy``
+        fills a NaN with :func:`beyond_limit` (a fit not taken for its shift bounds from
+        below only).
     line_hz : float
         One line of the window's transform [Hz].
 
@@ -1530,6 +1555,38 @@ def hardened_floor(dec: ModalDecay, limit_hz: np.ndarray, line_hz: float) -> np.
         if np.any(np.isfinite(others)):
             floor[k] = limit[k] * (1.0 - np.nanmax(others)) - line_hz
     return floor
+
+
+def beyond_limit(dec: ModalDecay, duration_s: float) -> np.ndarray:
+    """The linear limit [Hz] of each located mode's backbone fit not taken for its shift
+    beyond the first order (``dec.beyond``), where the record reaches it.
+
+    Such a fit's damping and frequency are not given to the model (``|c| > BACKBONE_MAX_SHIFT
+    wd``: the backbone's first order does not hold at the window's start), but its limit, the
+    undamped frequency ``|p| / (2 pi)`` of the fit's linear pole, is read where the mode's
+    amplitude is small, as a taken fit's is (:func:`hardened_reach`: the squared amplitude
+    falls to :data:`BACKBONE_MIN_FALL` or less over the window, here by the pole's own decay
+    rate in the model's domain).  It is used as a lower bound only (:func:`hardened_floor`).
+
+    Parameters
+    ----------
+    dec : ModalDecay
+        The backbone decay fits.
+    duration_s : float
+        The fit window's length [s].
+
+    Returns
+    -------
+    ndarray, shape (n,)
+        The limit [Hz]; NaN where there is no such fit or the record does not reach it.
+    """
+    n = dec.sigma.size
+    if dec.beyond is None:
+        return np.full(n, np.nan)
+    p = np.asarray(dec.beyond, dtype=complex)
+    with np.errstate(invalid="ignore", over="ignore"):
+        read = np.isfinite(p) & (np.exp(2.0 * p.real * duration_s) <= BACKBONE_MIN_FALL)
+    return np.where(read, np.abs(np.where(read, p, 0.0)) / (2.0 * np.pi), np.nan)
 
 
 def backbone_shift(M: np.ndarray, K: np.ndarray, K3: np.ndarray, dec: ModalDecay) -> np.ndarray:
@@ -1563,6 +1620,46 @@ def backbone_shift(M: np.ndarray, K: np.ndarray, K3: np.ndarray, dec: ModalDecay
     g = np.einsum("kj,jk->k", np.linalg.solve(Phi, np.linalg.solve(M, K3)), Phi**3)
     a = dec.amplitude / (dec.omega_d + dec.chirp) ** 2
     return 3.0 * g * a * a / (8.0 * w)
+
+
+def cubic_softens(M: np.ndarray, K: np.ndarray, K3: np.ndarray | None,
+                  dec: ModalDecay | None) -> str:
+    """Why a model's cubic contradicts the measured decays (``""`` if it does not).
+
+    On a mode whose backbone decay fit was taken (``dec.taken``), the model's own first-order
+    backbone shift (:func:`backbone_shift`) is opposite to the measured one (``dec.chirp``) and
+    at least :data:`BACKBONE_SHARE` of it in size (the decay hold's share for a cubic that
+    accounts for a shift): the model's cubic softens a mode that the record shows hardening,
+    or the reverse.  A smaller opposite shift is left alone: a mode 2 stiffened by mode 1's
+    amplitude shows a shift no diagonal cubic gives (soft-base member 002: measured +14.9 Hz,
+    the model's -0.71 Hz; refused, TRAC 0.94 -> 0.88).  One test for every identifier that
+    fits a cubic structural model (``ls_sindy`` refuses such a cubic, ``sgd_sindy`` compares it
+    with the linear fit).
+
+    Parameters
+    ----------
+    M, K : ndarray, shape (n, n)
+        The model's mass [kg] and stiffness [N/m].
+    K3 : ndarray, shape (n, n), or None
+        The model's cubic stiffness [N/m^3]; ``None`` (a linear model) answers ``""``.
+    dec : ModalDecay or None
+        The backbone decay fits (:func:`modal_decay`); ``None`` or no ``chirp`` answers ``""``.
+
+    Returns
+    -------
+    str
+        The first contradicted mode and both shifts [Hz], or ``""``.
+    """
+    if dec is None or dec.chirp is None or K3 is None:
+        return ""
+    own = backbone_shift(M, K, K3, dec)
+    bad = (dec.taken & np.isfinite(dec.chirp) & (own * dec.chirp < 0.0)
+           & (np.abs(own) >= BACKBONE_SHARE * np.abs(dec.chirp)))
+    if not np.any(bad):
+        return ""
+    k = int(np.flatnonzero(bad)[0])
+    return (f"its cubic shifts mode {k + 1} by {own[k] / (2 * np.pi):+.3g} Hz at the measured "
+            f"amplitude, the measured decay by {dec.chirp[k] / (2 * np.pi):+.3g} Hz")
 
 
 def _is_symmetric(*mats: np.ndarray) -> bool:

@@ -11,8 +11,11 @@ from benchmarks import bench_sgd_sindy as bench
 from identify._modal_damping import (
     BACKBONE_MIN_FALL,
     ModalDecay,
+    backbone_shift,
+    beyond_limit,
     chain_transients,
     coupling_moves,
+    cubic_softens,
     hardened_floor,
     hardened_reach,
     hold_modal_damping,
@@ -22,6 +25,7 @@ from identify._modal_damping import (
     set_shapes,
     unseen_band,
 )
+from identify.ls_sindy import LeastSquaresSINDy
 from identify.sgd_sindy import SGDSINDy
 from identify.structural import modal
 from testbed.scoring.metrics import modal_from_matrices
@@ -721,3 +725,62 @@ def test_the_hardened_floor_is_the_limit_less_the_lower_modes_largest_stiffening
     assert np.isnan(floor[2])
     dec.chirp[0] = -two_pi * 1.6  # mode 1 softening: mode 2 has no other hardening mode
     assert np.isnan(hardened_floor(dec, limit, 1.0)[1])
+
+
+def test_a_cubic_that_softens_a_hardening_decay_is_one_function_of_the_model_and_the_decays():
+    """cubic_softens(M, K, K3, dec): a taken mode whose model backbone shift is opposite to the
+    measured chirp and at least BACKBONE_SHARE of it is named; a hardening cubic, a smaller
+    opposite shift, a mode not taken, a linear model (K3 None) and a decay without the backbone
+    fit answer ""; ls_sindy's _cubic_softens is this function on its attributes, to the
+    character (review 25e: sgd_sindy called the unbound method on its own model)."""
+    two_pi = 2.0 * np.pi
+    M = np.diag([1.0, 0.5])
+    K = np.array([[3.0e5, -1.0e5], [-1.0e5, 2.0e6]])
+    w = two_pi * modal(M, K)[0]
+    n = 2
+    dec = ModalDecay(*(np.full(n, np.nan) for _ in range(5)), np.zeros(n),
+                     np.array([True, False]), two_pi * np.array([1.0, 3.0]), np.array([50.0, 80.0]))
+    dec.omega_d[:] = w - two_pi * np.array([1.0, 3.0])
+    soft = -1.0e12 * np.eye(n)  # mode 1 about -3 Hz at these amplitudes
+    own = backbone_shift(M, K, soft, dec)
+    assert np.all(own < 0.0)  # the softening cubic lowers each mode
+    said = cubic_softens(M, K, soft, dec)
+    assert said == (f"its cubic shifts mode 1 by {own[0] / two_pi:+.3g} Hz at the measured "
+                    f"amplitude, the measured decay by {1.0:+.3g} Hz")
+    assert cubic_softens(M, K, -soft, dec) == ""  # a hardening cubic agrees
+    big = ModalDecay(*(getattr(dec, f) for f in ("sigma", "omega_d", "sigma_model", "lam_model",
+                                                 "shift", "r2", "taken")),
+                     2.1 * np.abs(own) / 1.0, dec.amplitude)
+    # the chirp enters A's denominator too: the model's shift against it, under half of it
+    assert np.all(np.abs(backbone_shift(M, K, soft, big)) < 0.5 * big.chirp)
+    assert cubic_softens(M, K, soft, big) == ""
+    untaken = ModalDecay(*(getattr(dec, f) for f in ("sigma", "omega_d", "sigma_model",
+                                                     "lam_model", "shift", "r2")),
+                         np.array([False, False]), dec.chirp, dec.amplitude)
+    assert cubic_softens(M, K, soft, untaken) == ""
+    assert cubic_softens(M, K, None, dec) == ""
+    assert cubic_softens(M, K, soft, None) == ""
+    no_backbone = ModalDecay(*(getattr(dec, f) for f in ("sigma", "omega_d", "sigma_model",
+                                                         "lam_model", "shift", "r2", "taken")))
+    assert cubic_softens(M, K, soft, no_backbone) == ""
+    model = SimpleNamespace(M_=M, K_=K, K3_=soft, modal_decay_=dec)
+    assert LeastSquaresSINDy._cubic_softens(model) == said
+
+
+def test_a_beyond_first_order_fits_limit_is_read_where_the_record_reaches_it():
+    """beyond_limit: |p| / (2 pi) of each ``beyond`` pole whose squared amplitude falls to
+    BACKBONE_MIN_FALL or less over the window; NaN where the pole is NaN, where the record
+    does not reach the limit, and everywhere without ``beyond``."""
+    two_pi = 2.0 * np.pi
+    n = 3
+    dec = ModalDecay(*(np.full(n, np.nan) for _ in range(5)), np.zeros(n), np.zeros(n, bool))
+    assert np.all(np.isnan(beyond_limit(dec, 1.0)))
+    p = np.array([np.nan, complex(-328.8, two_pi * 397.88), complex(-0.2, two_pi * 900.0)])
+    dec = ModalDecay(*(np.full(n, np.nan) for _ in range(5)), np.zeros(n), np.zeros(n, bool),
+                     beyond=p)
+    lim = beyond_limit(dec, 1.0)
+    assert np.isnan(lim[0])
+    assert lim[1] == pytest.approx(abs(p[1]) / two_pi, rel=1e-15)
+    assert np.isnan(lim[2])  # exp(-0.4) = 0.67 left: the limit is not reached
+    T = np.log(1.0 / BACKBONE_MIN_FALL) / (2.0 * 0.2)
+    assert np.isfinite(beyond_limit(dec, 1.0001 * T)[2]) and np.isnan(beyond_limit(dec, 0.999 * T)[2])
