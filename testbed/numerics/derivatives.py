@@ -9,6 +9,8 @@ whose cut-off :func:`harmonic_cutoff` can choose from the signal's band.
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 from testbed.numerics.filters import _as_signal, _check_cutoff, _lowpass_sos
@@ -198,9 +200,11 @@ def _quintic_bridge(start: np.ndarray, end: np.ndarray, n: int, fs: float) -> np
 
 #: An end transient's coefficient (:func:`_end_transients`) counts by
 #: ``max(0, 1 - (TRANSIENT_Z s / |a|)^2)``, ``s`` the RMS of what the filter removed beyond the
-#: transients (noise, quantisation, motion above the cut-off): white noise of that level gives
-#: a coefficient on a unit vector a std of at most ``s`` (measured 0.12-1 x), so 10 is 10 of
-#: those stds.  Measured (automatic cut-off and end fits; pi27's 104 records at 0.5-3 % angle
+#: transients (noise, quantisation, motion above the cut-off) weighed by the coefficient's own
+#: column (``s^2 = sum_i q_i^2 e_i^2``: white noise of that local level gives a coefficient on
+#: the unit vector ``q`` a std of ``s``), so 10 is 10 of those stds.  Measured with the
+#: whole record's RMS for ``s`` (pi28; the column's weighing, review 26a, equals it on white
+#: noise) with automatic cut-off and end fits, pi27's 104 records at 0.5-3 % angle
 #: noise, 41 five-bars and 63 cart-poles): 100 bit-identical to the filter without the removal,
 #: 4 five-bars at 0.5 % moved by at most 2.2e-3 of the accelerations' peak (fb20_chirp_2nm);
 #: clean five-bars' largest |a| / s 278-9400.  At 3 (a least-squares coefficient's usual
@@ -210,16 +214,24 @@ def _quintic_bridge(start: np.ndarray, end: np.ndarray, n: int, fs: float) -> np
 TRANSIENT_Z = 10.0
 
 
-def _transient_basis(sos: np.ndarray, n: int) -> np.ndarray:
+@functools.lru_cache(maxsize=4)
+def _transient_basis(sos_bytes: bytes, sos_shape: tuple[int, int], n: int) -> np.ndarray:
     """Orthonormal basis of the forward-backward filter's end transients over ``n`` samples.
 
     The output of ``sosfiltfilt`` over the record depends on what lies beyond its ends (the
     pad) only through the forward pass's state at the first sample and the backward pass's
     state at the last: its free responses, the forward ones carried through the backward pass.
-    Returns shape ``(n, k)``, ``k`` <= twice the filter's order (the columns' rank).
+    Returns shape ``(n, k)``, ``k`` <= twice the filter's order (the columns' rank), read-only
+    (cached per filter and length: a record's channels and a run's chains share it).
+    Directions whose singular value is below 1e-10 of the largest are dropped: the columns'
+    rank is twice the order of the filter's poles (an odd order's real pole gives one state
+    less, its extra column a combination of the others at ~1e-14), and a direction that small
+    carries 1e-10 of any transient's content, far below the record's float64 precision after
+    the gain ``(2 pi fc)^2`` of the second derivative.
     """
     from scipy import signal as ss
 
+    sos = np.frombuffer(sos_bytes, dtype=float).reshape(sos_shape).copy()
     m = 2 * sos.shape[0]
     zi = np.zeros((sos.shape[0], m, 2))
     zi[np.arange(m) // 2, np.arange(m), np.arange(m) % 2] = 1.0
@@ -227,7 +239,9 @@ def _transient_basis(sos: np.ndarray, n: int) -> np.ndarray:
     cols = np.concatenate([ss.sosfilt(sos, free[:, ::-1], axis=-1)[:, ::-1], free[:, ::-1]])
     cols = cols / np.linalg.norm(cols, axis=1, keepdims=True)
     u, sv, _ = np.linalg.svd(cols.T, full_matrices=False)
-    return u[:, sv > sv[0] * 1e-10]
+    q = u[:, sv > sv[0] * 1e-10]
+    q.flags.writeable = False
+    return q
 
 
 def _end_transients(r: np.ndarray, ys: np.ndarray, sos: np.ndarray) -> np.ndarray:
@@ -237,8 +251,9 @@ def _end_transients(r: np.ndarray, ys: np.ndarray, sos: np.ndarray) -> np.ndarra
     difference into transients that decay with the slowest pole's time constant ``0.81 /
     fc`` (order 8) from each end.  They lie in the span of :func:`_transient_basis`; their
     coefficients ``a`` are read by least squares from ``r - ys`` and each kept in proportion
-    ``max(0, 1 - (TRANSIENT_Z s / |a|)^2)`` (continuous in the noise: no switch), ``s`` the
-    RMS of ``r - ys`` beyond them.
+    ``max(0, 1 - (TRANSIENT_Z s / |a|)^2)`` (continuous in the noise: no switch), ``s^2`` the
+    mean square of ``r - ys`` beyond them weighed by the coefficient's column (where it
+    lives: a step or kink near an end counts against the coefficients it would feed).
 
     Parameters
     ----------
@@ -256,10 +271,14 @@ def _end_transients(r: np.ndarray, ys: np.ndarray, sos: np.ndarray) -> np.ndarra
     n = r.shape[-1]
     if n < 8 * sos.shape[0] * 2:
         return np.zeros_like(ys)
-    q = _transient_basis(sos, n)
+    q = _transient_basis(sos.tobytes(), sos.shape, n)
     e = r - ys
     a = e @ q                                                    # (n_channels, k)
-    s2 = np.mean((e - a @ q.T) ** 2, axis=-1, keepdims=True)
+    # Each coefficient's own noise variance: white noise of local variance s_i^2 gives a
+    # coefficient on the unit vector q a variance of sum_i q_i^2 s_i^2, so the residual is
+    # weighed where its column lives (a step or kink near an end, which the whole-record RMS
+    # would dilute, counts against the coefficients it feeds: review 26a).
+    s2 = ((e - a @ q.T) ** 2) @ (q**2)                           # (n_channels, k)
     with np.errstate(divide="ignore", invalid="ignore"):
         keep = np.where(a != 0, np.clip(1.0 - TRANSIENT_Z**2 * s2 / a**2, 0.0, 1.0), 0.0)
     return (keep * a) @ q.T

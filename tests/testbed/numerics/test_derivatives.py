@@ -83,4 +83,36 @@ def test_the_removal_never_makes_the_ends_worse_and_has_no_switch(monkeypatch):
     # 1e-12: equal up to round-off where nothing is applied (1 %)
     assert all(n <= o * (1 + 1e-12) for n, o in zip(new, old, strict=True)), (new, old)
     assert new[0] < 1e-3 * old[0]
-    assert all(b >= a_ * (1 - 1e-6) for a_, b in itertools.pairwise(new)), new
+    # From 1e-6 on the noise, not the record's round-off, sets what is kept, so the error
+    # rises with it; at 0 and 1e-8 the round-off does (the error equal within 1 %, the
+    # draw deciding its last digits: review 26a).
+    assert abs(new[1] / new[0] - 1) < 1e-2, new
+    assert all(b > a_ for a_, b in itertools.pairwise(new[1:])), new
+
+
+@pytest.mark.parametrize("where", ["after the start", "before the end"])
+def test_a_step_near_an_end_is_not_read_as_the_filters_transient(monkeypatch, where):
+    """A 1 mrad position step 0.1 s from an end of a clean 1 kHz record (an encoder's slip):
+    its removed content sits in the end coefficients, which the whole record's residual RMS
+    judged far above the noise, so the removal fitted the step (review 26a: the ends' RMS
+    error against the filter of the continued record 6.5 / 2.9 x the filter's own).  Each
+    coefficient is now judged by the residual where its column lives: measured 1.03 / 0.46 x.
+    Bound 1.5 x: the removal may not make the ends worse than the step's own ringing by more
+    than half (the old code's 6.5 / 2.9 x fail it)."""
+    fs, e = 1e3, 5.0
+    tl = np.arange(int(20.0 * fs)) / fs - e
+    w = 2 * np.pi * np.array([[1.0], [0.37]])
+    xl = 1.8 + np.array([[0.3], [0.5]]) * np.sin(w * tl + np.array([[1.0], [2.0]]))
+    p, n = int(e * fs), int(10.0 * fs)
+    cut = tl < 0.1 if where == "after the start" else tl > tl[p + n - 1] - 0.1
+    xl = xl + 1e-3 * cut
+    ideal = _without_transients(monkeypatch, xl, fs, 4.0, 8, 0.4, 5)[2][:, p:p + n]
+    x = xl[:, p:p + n]
+    got = der.lowpass_differentiate(x, fs, 4.0, 8, 0.4, 5)[2]
+    old = _without_transients(monkeypatch, x, fs, 4.0, 8, 0.4, 5)[2]
+    k = int(fs)
+
+    def ends_rms(a):
+        return float(np.sqrt(np.mean(np.concatenate([(a - ideal)[:, :k], (a - ideal)[:, -k:]]) ** 2)))
+
+    assert ends_rms(got) < 1.5 * ends_rms(old), (ends_rms(got), ends_rms(old))
