@@ -67,7 +67,7 @@ from testbed.core.errors import (
     UnsupportedError,
 )
 from testbed.core.exit_guard import ProcessExitCalled, no_process_exit
-from testbed.core.measurement import MIN_FREE_SAMPLES, Measurement, Trajectory
+from testbed.core.measurement import MIN_FREE_SAMPLES, Measurement, Trajectory, check_prior_values
 from testbed.core.process_state import kept_process_state
 from testbed.core.schema import ErrorFn, Field, KeyUse, check_keys_used, validate_table
 
@@ -556,6 +556,7 @@ def _guard_fit(fit: Callable[..., Identifier]) -> Callable[..., Identifier]:
         if y is not None:
             raise ArgumentError(where, "y", args.describe(y), "expected None (the targets are in "
                                 "data)", described=True)
+        check_prior_values(where, data.prior)  # its dict may have changed since it was made
         made = getattr(data, "kind", None)
         if made is not None and self.kind and made != self.kind:
             # the command line refuses the pairing by kind; the API had fitted it silently
@@ -712,7 +713,13 @@ def _check_simulate_args(model: Identifier, where: str, x0: Any = None, xd0: Any
         args.array(where, "xd0", xd0, (n,))
     if u is not None:  # (None: free motion)
         n_in = (_fitted_inputs(model) if structural else None) or (shape[1] if shape else None)
-        args.array(where, "u", u, (n_in, tt.size))
+        try:
+            one_row = np.ndim(u) == 1 and n_in in (None, 1)
+        except ValueError:  # a ragged list: args.array names it
+            one_row = False
+        # a single input's samples as one flat row: the identifiers read u by np.atleast_2d,
+        # and users pass it so (review 26b)
+        args.array(where, "u", np.asarray(u)[None] if one_row else u, (n_in, tt.size))
 
 
 def _install_guards(cls: type) -> None:

@@ -120,10 +120,15 @@ def array(where: str, name: str, value: Any, shape: tuple[int | None, ...], *,
     allowed = f"expected a finite {want} array of shape ({dims})"
     if not isinstance(value, (np.ndarray, list, tuple)):
         raise ArgumentError(where, name, describe(value), allowed, described=True)
-    if np.ma.isMaskedArray(value) and np.ma.getmaskarray(value).any():
+    try:  # a list of masked rows too (review 26b)
+        mask = (np.ma.getmaskarray(np.ma.asarray(value))
+                if np.ma.isMaskedArray(value) or isinstance(value, (list, tuple)) else None)
+    except (ValueError, TypeError):  # a ragged list: refused below
+        mask = None
+    if mask is not None and mask.any():
         # np.asarray dropped the mask: a masked (missing) sample was fitted as the value under
         # it (round 25; the SEP-005 reader's rule since round 17)
-        masked = int(np.ma.getmaskarray(value).sum())
+        masked = int(mask.sum())
         raise ArgumentError(where, name, describe(value), f"{allowed} ({masked} masked sample(s) "
                             "given: fill or cut them)", described=True)
     try:

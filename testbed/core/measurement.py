@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any, NamedTuple
 
@@ -27,12 +28,37 @@ def prior_number(value: Any) -> float | None:
     return x if x is not None and PRIOR_RANGE[0] <= x <= PRIOR_RANGE[1] else None
 
 
-def _prior_ok(value: Any) -> bool:
-    """A number :func:`prior_number` takes, or a non-empty flat list, tuple or 1-D array of
-    them (``link_lengths``, which :class:`identify._mechsim.LoopClosure` reads)."""
-    if isinstance(value, (list, tuple)) or (isinstance(value, np.ndarray) and value.ndim == 1):
+#: The one prior a list of numbers is given for (one length per link [m]), which
+#: :class:`identify._mechsim.LoopClosure` reads; every other prior is one number.
+LIST_PRIORS = frozenset({"link_lengths"})
+
+
+def prior_ok(key: str, value: Any) -> bool:
+    """A number :func:`prior_number` takes (a 0-d array's too), or for a key of
+    :data:`LIST_PRIORS` a non-empty flat list, tuple or 1-D array of them (review 26b: a
+    ``total_mass`` of ``[0.7]`` was taken and a TypeError inside the fit)."""
+    if isinstance(value, np.ndarray) and value.ndim == 0:
+        value = value.item()
+    if key in LIST_PRIORS and (isinstance(value, (list, tuple))
+                               or (isinstance(value, np.ndarray) and value.ndim == 1)):
         return len(value) > 0 and all(prior_number(v) is not None for v in value)
     return prior_number(value) is not None
+
+
+def check_prior_values(where: str, prior: Mapping[str, Any]) -> None:
+    """Refuse a prior value :func:`prior_ok` does not take, naming its key and value.
+
+    The command line refuses these in a file or ``--prior`` (``check_prior``); the API read a
+    text "0.7" as 0.7 kg and True as 1 kg, and [0.7], None, a complex, 5e-324 or 1e308 were raw
+    errors inside the fit (round 25).  Run when a :class:`Measurement` is made and again when
+    it is fitted (its ``prior`` is a plain dict a caller may change in between: review 26b).
+    """
+    for k, v in prior.items():
+        if not prior_ok(k, v):
+            lo, hi = PRIOR_RANGE
+            listed = " (link_lengths: a list of them)" if k in LIST_PRIORS else ""
+            raise ArgumentError(where, f"prior[{k!r}]", v, f"expected a finite number from "
+                                f"{lo:g} to {hi:g} (a mass [kg] or a length [m]){listed}")
 
 
 @dataclass(frozen=True)
@@ -166,15 +192,7 @@ class Measurement:
         if self.input_map is not None:
             put(self, "input_map", args.array(where, "input_map", self.input_map, (n_ch, n_in)))
         put(self, "prior", args.mapping(where, "prior", self.prior))
-        for k, v in self.prior.items():
-            # the command line refuses these in a file or --prior (check_prior); the API read a
-            # text "0.7" as 0.7 kg and True as 1 kg, and [0.7], None, a complex, 5e-324 or
-            # 1e308 were raw errors inside the fit (round 25)
-            if not _prior_ok(v):
-                lo, hi = PRIOR_RANGE
-                raise ArgumentError(where, f"prior[{k!r}]", v, f"expected a finite number from "
-                                    f"{lo:g} to {hi:g} (a mass [kg] or a length [m]), or a list of "
-                                    "them")
+        check_prior_values(where, self.prior)
         # no upper bound: a window cut before the excitation ends keeps the record's free_start
         # (MeasurementSamples.window), a record that ends before its free decay starts
         put(self, "free_start", args.integer(where, "free_start", self.free_start, low=0))

@@ -63,7 +63,7 @@ from testbed.core.arguments import finite_real
 from testbed.core.budget import IDENTIFY_BYTES_PER_VALUE, IDENTIFY_TEXT_BUDGET_BYTES, IDENTIFY_VALUE_BUDGET
 from testbed.core.dataset import Dataset, DatasetError, Signal
 from testbed.core.errors import TestbedError, is_control, show_names, show_value
-from testbed.core.measurement import MIN_FREE_SAMPLES, PRIOR_RANGE, Measurement, prior_number
+from testbed.core.measurement import MIN_FREE_SAMPLES, PRIOR_RANGE, Measurement, prior_ok
 from testbed.core.rate_attrs import fs_attribute_problem, off_scenario_rate
 from testbed.numerics.clipping import Clipping, measured_clipping
 from testbed.numerics.noise import noise_std
@@ -1120,7 +1120,8 @@ def check_prior(source: str | os.PathLike, key: str, value: Any) -> None:
     read in silence)."""
     lo, hi = PRIOR_RANGE
     # (an int beyond float64, 10**400, is refused: math.isfinite raised OverflowError)
-    if not isinstance(value, (int, float)) or prior_number(value) is None:
+    # one rule with the API's Measurement (review 26b: numpy scalars and link_lengths' list)
+    if not prior_ok(key, value):
         raise MeasuredDataError(source, f"prior {key}={value!r}: expected a finite number from "
                                         f"{lo:g} to {hi:g} (a mass [kg] or a length [m]; beyond, "
                                         "the identified matrices leave float64's range)")
@@ -1622,7 +1623,7 @@ def _parse_sep005(path: Path, content: Any) -> _Raw:
             raise MeasuredDataError(path, f"SEP-005 channel {name!r}: data of shape {data.shape}; "
                                           "only 1-D channels are supported")
         if "fs" in c:
-            f = c["fs"]
+            f = c["fs"].item() if isinstance(c["fs"], np.generic) else c["fs"]  # (review 26b)
             rate = finite_real(f) if isinstance(f, (int, float)) else None
             if rate is None or rate <= 0:  # (an integer of 400 digits: OverflowError, round 25)
                 raise MeasuredDataError(path, f"SEP-005 channel {name!r}: fs={show_value(f)} is not "
@@ -1651,6 +1652,7 @@ def _parse_sep005(path: Path, content: Any) -> _Raw:
         # the optional keys: a value of the wrong kind was dropped in silence (position_m NaN
         # or "0.3", node 1.5), or kept (node -1)
         node = c.get("node")
+        node = node.item() if isinstance(node, np.generic) else node  # (review 26b)
         if node is not None:
             if not (isinstance(node, int) and not isinstance(node, bool) and node >= 1):
                 raise MeasuredDataError(path, f"SEP-005 channel {name!r}: node={node!r}; expected "
@@ -1684,6 +1686,7 @@ def _direction(path: Path, name: str, value: Any) -> int:
     ``"+Z axis"`` was read as none in silence (round 25), its channel's sign with it."""
     if value is None:
         return 0
+    value = value.item() if isinstance(value, np.generic) else value  # np.int64(3) (review 26b)
     if isinstance(value, int) and not isinstance(value, bool):
         return value
     m = _DIRECTION.match(value) if isinstance(value, str) else None

@@ -161,8 +161,24 @@ def test_measurement_prior_of_a_value_the_command_line_refuses_is_refused(value)
 @pytest.mark.parametrize("value", [0.7, np.float64(0.7), 7, 1e-100, 1e100, [0.1, 0.2, 0.15, 0.2],
                                    np.array([0.1, 0.2, 0.15, 0.2])])
 def test_measurement_prior_numbers_and_lists_of_them_kept(value):
-    m = _measurement(prior={"total_mass": value})
-    assert m.prior["total_mass"] is value
+    key = "total_mass" if np.ndim(value) == 0 else "link_lengths"  # the one list prior
+    m = _measurement(prior={key: value})
+    assert m.prior[key] is value
+
+
+@pytest.mark.parametrize("value", [[0.7], np.array([0.7])])
+def test_a_list_for_a_one_number_prior_is_refused(value):
+    # review 26b: total_mass=[0.7] was taken, a TypeError inside ls_sindy's fit
+    with pytest.raises(ArgumentError, match=r"prior\['total_mass'\]"):
+        _measurement(prior={"total_mass": value})
+
+
+def test_a_prior_changed_after_the_measurement_was_made_is_refused_at_fit():
+    # review 26b: the check ran only when the Measurement was made; its prior is a plain dict
+    m = _measurement(prior={"total_mass": 0.7})
+    m.prior["total_mass"] = "0.7"
+    with pytest.raises(ArgumentError, match=r"prior\['total_mass'\]"):
+        _Mechanical().fit(m)
 
 
 def test_importers_prior_rule_is_the_measurements():
@@ -173,6 +189,10 @@ def test_importers_prior_rule_is_the_measurements():
         with pytest.raises(MeasuredDataError):
             importers.check_prior("f.json", "total_mass", bad)
     assert prior_number(0.7) == 0.7 and prior_number(np.float32(2.0)) == 2.0
+    # one rule with the Measurement's (review 26b): numpy scalars and link_lengths' list kept
+    for good in (np.float32(0.7), np.int64(2), np.array(0.7)):
+        importers.check_prior("f.json", "total_mass", good)
+    importers.check_prior("f.json", "link_lengths", [0.1, 0.2, 0.15, 0.2])
 
 
 def test_mapping_value_beyond_float64_refused():
@@ -187,6 +207,22 @@ def test_measurement_masked_sample_refused(field):
     a.mask[0, 5], a.data[0, 5] = True, 1e3
     with pytest.raises(ArgumentError, match=r"1 masked sample"):
         _measurement(**{field: a})
+
+
+def test_measurement_list_of_masked_rows_refused():
+    # review 26b: a list of masked rows passed the check, the value under the mask fitted
+    a = np.ma.masked_array(_measurement().x.copy(), mask=False)
+    a.mask[0, 5], a.data[0, 5] = True, 1e3
+    with pytest.raises(ArgumentError, match=r"1 masked sample"):
+        _measurement(x=[a[0], a[1]])
+
+
+@pytest.mark.parametrize("change", [{"fs": np.float64(FS)}, {"fs": np.int64(int(FS))},
+                                    {"direction": np.int64(3)}, {"node": np.int64(3)}])
+def test_sep005_numpy_scalars_read_as_numbers(change):
+    # review 26b: an in-memory SEP-005 record's numpy scalars were refused (fs, node) or the
+    # direction refused with a message naming the integers it is one of
+    assert from_sep005(_channels(**change), source="rec.json") is not None
 
 
 def test_measurement_masked_array_without_a_masked_sample_kept():
@@ -254,6 +290,8 @@ def test_simulate_checks_xd0_and_u(chain_fit, xd0, u, words):
     with pytest.raises(ArgumentError, match=words):
         model.simulate(np.zeros(3), xd0, np.arange(4) / 1e3, u)
     assert model.simulate(np.zeros(3), np.zeros(3), np.arange(4) / 1e3, np.ones((1, 4))).x.shape == (3, 4)
+    # review 26b: one input's samples as a flat row, as before round 25
+    assert model.simulate(np.zeros(3), np.zeros(3), np.arange(4) / 1e3, np.ones(4)).x.shape == (3, 4)
 
 
 class _Mechanical(Identifier):
@@ -293,7 +331,14 @@ def test_a_mechanical_models_simulate_as_fitted_and_refitted(mechanical_fit):
     t = np.arange(5) / FS
     assert mechanical_fit.simulate(np.zeros(2), np.zeros(2), t, np.ones((1, 5))).x.shape == (2, 5)
     assert mechanical_fit.simulate(np.zeros(2), np.zeros(2), t, None).x.shape == (2, 5)  # free
-    refit = _Mechanical().fit(_measurement(channels=("a", "b")))  # no inputs now
+    # review 26b: a single input's samples as one flat row (an array or a list), as the
+    # identifiers' np.atleast_2d reads them and users pass them
+    assert mechanical_fit.simulate(np.zeros(2), np.zeros(2), t, np.ones(5)).x.shape == (2, 5)
+    assert mechanical_fit.simulate(np.zeros(2), np.zeros(2), t, [1.0] * 5).x.shape == (2, 5)
+    with pytest.raises(ArgumentError, match="'u'"):
+        mechanical_fit.simulate(np.zeros(2), np.zeros(2), t, np.ones(4))
+    refit = _Mechanical().fit(_measurement(u=np.ones((1, 50)), inputs=("torque",)))
+    refit.fit(_measurement(channels=("a", "b")))  # the same model refitted: no inputs now
     with pytest.raises(ArgumentError, match="'u'"):
         refit.simulate(np.zeros(2), np.zeros(2), t, np.ones((1, 5)))
 
