@@ -10,13 +10,15 @@ copper, beryllium-, lead-, tin- and nickel-like beams and zinc of 0.15-1.2 m (ro
 steel; round 24: steel 1.6 / 1.8 m, a 1.35 m soft beam, each under 'auto' or the 10 Hz high-pass), 3-45
 segments, 1-7 sensors, the hammer at 0.1-0.9 L and the tip, 1 N-2 kN, 0.02-8 % damping, records of 0.3-15 s
 at 1-25.6 kHz, soft bases at 0.2-300 EI/L with cubic fractions 0.001-3. Round 25 goes between and beside
-them: long beams of other materials than steel, aluminium 1.1 m (mode 1 near 6.8 Hz) under the default
-10 Hz high-pass and aluminium 1.2 m under 'auto', brass 1.1 m read by four uneven sensors under 'auto',
-titanium 1.4 m at 10 kHz under 'auto' (the hammer at 0.5 s, 3 s records); soft bases between the drawn
-ones, 0.55 EI/L (cubic fraction 0.15) hit at 0.9 L, 0.9 (0.65) hit at 0.1 L under 200 N, 1.6 (0.05) at 20
-kHz on 0.6 s, 2.3 (0.4) read by four uneven sensors on 1.5 s, 4 (0.15) under 1 kN, 0.55 (0.4) under 20 N,
-brass on 1.6 EI/L (0.65) at 10 kHz; the clamped beam read by three uneven sensors at 20 kHz on 0.6 s and
-hit at 0.1 L under 1 kN. Noise 0.5 / 2 / 4 % and seeds 161-169 are the studies' (round25_beams*.toml).
+them: long beams of other materials than steel, aluminium 1.1 m (mode 1 near 6.8 Hz) under the default 10 Hz
+high-pass and aluminium 1.2 m under 'auto', brass 1.1 m read by four uneven sensors under 'auto', titanium
+1.4 m at 10 kHz under 'auto' (the hammer at 0.5 s, 3 s records); soft bases between the drawn ones, 0.55
+EI/L (cubic fraction 0.15) hit at 0.9 L, 0.9 (0.65) hit at 0.1 L under 200 N, 1.6 (0.05) at 20 kHz on 0.6 s,
+2.3 (0.4) read by four uneven sensors on 1.5 s, 4 (0.15) under 1 kN, 0.55 (0.4) under 20 N, brass on 1.6
+EI/L (0.65) at 10 kHz; the clamped beam read by three uneven sensors at 20 kHz on 0.6 s and hit at 0.1 L
+under 1 kN. A second batch: aluminium 1.5 m (mode 1 near 3.6 Hz) under 'auto', brass 1.3 m on a 1 EI/L base
+(0.3) under 'auto', 1.6 EI/L (0.15) under 500 N read by four uneven sensors, the clamped beam at 0.5 %
+damping under 20 N on 3 s. Noise 0.5 / 2 / 4 % and seeds 161-169 are the studies' (round25_beams*.toml).
 """
 
 from __future__ import annotations
@@ -43,6 +45,9 @@ _HIT01 = {"location": _S01[0]}
 _S4U = sensors((0.2, 0.35, 0.8, 1.0))
 _S3U = sensors((0.25, 0.55, 0.9))
 _F20, _F200, _F1K = {"peak_force": 20.0}, {"peak_force": 200.0}, {"peak_force": 1000.0}
+_AL15 = {**AL, "length": 1.5, "n_segments": 30, "sensors": sensors((1 / 3, 2 / 3, 1.0), 1.5)}
+_BR13 = {**BRASS, "length": 1.3, "n_segments": 26, "sensors": sensors((1 / 3, 2 / 3, 1.0), 1.3)}
+_F500 = {"peak_force": 500.0}
 
 #: name -> (description, rig, simulation, excitation, signal)
 CASES: dict[str, tuple[str, dict, dict, dict, dict]] = {
@@ -85,6 +90,17 @@ CASES: dict[str, tuple[str, dict, dict, dict, dict]] = {
                               {"duration": 0.6, "sample_rate": 20000.0}, {"location": _S3U[2]}, {}),
     "b25_st_hit0p1_f1k": ("the shipped beam read at 0.1 / 0.5 / 1 L, a 1 kN hit at 0.1 L", {"sensors": _S01},
                           {}, {**_F1K, **_HIT01}, {}),
+    # a second batch (round25_beams_more.toml)
+    "b25_al_L1p5_hpauto": ("aluminium 1.5 m in 30 segments (mode 1 near 3.6 Hz) under the high-pass 'auto', "
+                           "the hammer at 0.5 s, 3 s", {**_AL15}, *_LONG),
+    "b25_br_L1p3_soft_r1_cf0p3_hpauto": ("brass 1.3 m in 26 segments on k1 = 1 EI/L, cubic fraction 0.3, "
+                                         "under the high-pass 'auto', the hammer at 0.5 s, 3 s",
+                                         {**_BR13, **soft(1.0, 0.3, _BR13, {"start": 0.5})}, *_LONG),
+    "b25_soft_r1p6_cf0p15_s4u_f500": ("the shipped beam on k1 = 1.6 EI/L, cubic fraction 0.15 at 500 N, four "
+                                      "sensors at 0.2 / 0.35 / 0.8 / 1 L, under 500 N",
+                                      {**soft(1.6, 0.15, {}, _F500), "sensors": _S4U}, {}, {**_F500}, {}),
+    "b25_st_z0p5_f20_3s": ("the shipped beam at 0.5 % damping under 20 N, 3 s", {"damping_ratio": 0.005},
+                           {"duration": 3.0}, {**_F20}, {}),
 }
 
 
