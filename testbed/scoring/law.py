@@ -288,12 +288,38 @@ def free_coordinates(names: Sequence[str], coef: np.ndarray, n: int) -> list[int
     """
     used = np.any(np.atleast_2d(np.asarray(coef, dtype=float)) != 0.0, axis=0)
     held: set[int] = set()
-    for factors, u in zip(term_plan(tuple(names)), used, strict=True):
-        if not u:
-            continue
+    for coords, u in zip(_held_coordinates(names), used, strict=True):
+        if u:
+            held |= coords
+    return [k for k in range(n) if k not in held]
+
+
+def holding_terms(names: Sequence[str], coef: np.ndarray, coordinates: Sequence[int]) -> list[int]:
+    """The terms a law uses that hold any of ``coordinates`` itself (:func:`free_coordinates`'
+    sense: ``thk``, or ``sin`` / ``cos`` of an angle holding it), by column index, ascending.
+
+    Parameters
+    ----------
+    names, coef : sequence of str, ndarray (n_equations, p)
+        The law's terms and equations; a term with no nonzero coefficient is not used.
+    coordinates : sequence of int
+        0-based coordinates.
+    """
+    used = np.any(np.atleast_2d(np.asarray(coef, dtype=float)) != 0.0, axis=0)
+    want = set(coordinates)
+    return [j for j, (coords, u) in enumerate(zip(_held_coordinates(names), used, strict=True))
+            if u and coords & want]
+
+
+def _held_coordinates(names: Sequence[str]) -> list[set[int]]:
+    """Per term, the coordinates it holds itself (not through their rates or accelerations)."""
+    out = []
+    for factors in term_plan(tuple(names)):
+        held: set[int] = set()
         for spec, _ in factors:
             if spec[0] in ("sin", "cos"):
                 held.update(i for i in spec[1:] if i is not None)
             elif spec[1] == "th":
                 held.add(spec[2])
-    return [k for k in range(n) if k not in held]
+        out.append(held)
+    return out

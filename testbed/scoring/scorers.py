@@ -36,7 +36,7 @@ from testbed.pipeline.signal_chain import pulse_end, pulse_span
 from testbed.scoring import metrics
 from testbed.scoring.equation_basis import compare_equations
 from testbed.scoring.initial_state import fit_initial_state
-from testbed.scoring.law import free_coordinates, law_errors, law_rollout
+from testbed.scoring.law import free_coordinates, holding_terms, law_errors, law_rollout
 from testbed.scoring.metrics import worst
 
 #: Modes whose MAC, frequency and damping are scored: every mode the sensors can resolve,
@@ -231,7 +231,8 @@ def bar_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -> dic
     :func:`floor_failures`, :func:`channel_failures`, :func:`sensor_failures`,
     :func:`equation_failures`,
     :func:`step_failures`, :func:`sensitivity_failures`, :func:`drift_failures`,
-    :func:`clipping_failures`, :func:`linear_model_failures` and :func:`unscored_mode_failures`,
+    :func:`held_failures`, :func:`clipping_failures`, :func:`linear_model_failures` and
+    :func:`unscored_mode_failures`,
     merged (one call for :func:`testbed.scoring.run.run_scenario` and
     :func:`testbed.scoring.evaluate.score_model`)."""
     return {**uninformative_failures(scores, thresholds), **out_of_band_failures(scores, thresholds),
@@ -240,6 +241,7 @@ def bar_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -> dic
             **sensor_failures(scores, thresholds),
             **equation_failures(scores, thresholds), **step_failures(scores, thresholds),
             **sensitivity_failures(scores, thresholds), **drift_failures(scores, thresholds),
+            **held_failures(scores, thresholds),
             **clipping_failures(scores, thresholds),
             **linear_model_failures(scores, thresholds), **unscored_mode_failures(scores, thresholds)}
 
@@ -1169,6 +1171,27 @@ def missed_cubic_share(freq_bar: float) -> float:
     return (1.0 + float(freq_bar)) ** 2 - 1.0
 
 
+def cubic_shift_reach(share: float) -> float:
+    """The largest relative frequency shift [-] a missing cubic base force of ``share`` (the
+    truth's ``K3_force_ratio``, :func:`missed_cubic_share`) can explain: a cubic force
+    ``k3 q^3`` at ``r`` of the linear force ``k1 q`` stiffens by its tangent ``3 k3 q^2 = 3 r
+    k1``, so a linear stiffness standing in for both is off by at most ``3 r`` of ``k1`` and a
+    frequency by ``sqrt(1 + 3 r) - 1`` (the share 0.531 of round 25's brass on 1 EI/L: 0.61).
+    A failed frequency bar beyond it is not the missing term's (:func:`linear_model_failures`).
+
+    Parameters
+    ----------
+    share : float
+        The truth's cubic force share [-].
+
+    Returns
+    -------
+    float
+        The reach [-] (NaN for a NaN share).
+    """
+    return float(np.sqrt(1.0 + 3.0 * float(share)) - 1.0)
+
+
 def linear_model_failures(scores: Scores, thresholds: dict[str, dict[str, float]]
                           ) -> dict[str, str]:
     """A failed frequency bar of a linear model on a truth whose cubic force is not small:
@@ -1181,7 +1204,10 @@ def linear_model_failures(scores: Scores, thresholds: dict[str, dict[str, float]
     was named by its bars alone.  Only a frequency bar (``freq_error_*``, what the share's
     derivation is about) that already failed is explained, from the run's own smallest such
     bar (:func:`missed_cubic_share`), so no verdict changes; nothing where the fit, the
-    model or its simulation failed (that failure says why).
+    model or its simulation failed (that failure says why), nor where a failed frequency bar
+    lies beyond what the truth's cubic force can move (:func:`cubic_shift_reach`): round 25's
+    ``b25_br_L1p3_soft_r1_cf0p3_hpauto`` at 2 % s163 (``ls_sindy``: mode 1 1773 % off, MAC
+    0.686, TRAC 0.30, the share 0.531, reach 0.61) was named "linear model".
 
     Parameters
     ----------
@@ -1204,6 +1230,8 @@ def linear_model_failures(scores: Scores, thresholds: dict[str, dict[str, float]
     least = missed_cubic_share(bar)
     if not share >= least:
         return {}
+    if not all(c.value <= cubic_shift_reach(share) for c in missed):
+        return {}  # a frequency further off than the whole cubic force can move it: not its
     return {"cubic": (f"linear model: the identified model has no cubic term, where the truth's "
                       f"cubic base force is {share:.3g} x its linear force over the free decay "
                       f"(norms; from {least:.3g} on, such a force left to a linear stiffness "
@@ -2182,8 +2210,12 @@ def drift_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -> d
     is missed, every coordinate off the bar is free in the true law and in the identified one
     and its rollout error about its own least-squares quadratic in time (``a + b t + c t^2``:
     an offset, a rate error and a constant acceleration error integrated; more than three
-    samples) is within the bar and smaller than the quadratic itself (RMS).  Reasons only: the
-    bar's failure stands (no verdict changes).
+    samples) is within the bar and smaller than the quadratic itself (RMS).  A coordinate the
+    identified law holds (review 25c) counts only where the same law without its holding terms
+    (:func:`unheld_witness`) misses the bar there too, by a drift as well: round 23's
+    ``cp23_cart0p5`` at 4 % s149 (the cart 0.0904 m, 0.0059 about a quadratic, its model holding
+    ``th1`` at -0.0011; without it 0.0922) had no reason since review 25c's mend.  Reasons only:
+    the bar's failure stands (no verdict changes).
     Round 24's ``cp24_pole_m1`` (a 1 kg pole on the 1 kg cart) at 3 % s159: law_error 0.0122
     (bar 0.25), the cart 0.0578 m against 0.0501 (the pole 0.0024 rad), its error -0.135 m at
     10 s and 0.0055 m about a quadratic; at 1.5 % s151 0.0620 m, 0.0030 about a quadratic; no
@@ -2212,24 +2244,38 @@ def drift_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -> d
     per = np.asarray(d[score], dtype=float)
     off = np.flatnonzero(~(per <= bar))
     offs = set(off.tolist())
-    if off.size == 0 or not offs <= set(free):
+    held_by_model = set(d.get("held_coordinates") or ())
+    if off.size == 0 or not offs <= set(free) | held_by_model:
         return {}
     t = np.asarray(d["t"], dtype=float)
     if t.size <= 3:  # a quadratic fits three samples exactly: no evidence of a drift
         return {}
-    err = np.asarray(d["simulated_x"], dtype=float)[off] - np.asarray(d["reference_x"], dtype=float)[off]
-    if not np.all(np.isfinite(err)):
-        return {}
-    tau = t / t[-1] if t[-1] > 0 else t  # the quadratic in the record's own time [-]: conditioning
-    basis = np.vstack([np.ones_like(tau), tau, tau**2]).T
-    fitted = (basis @ np.linalg.lstsq(basis, err.T, rcond=None)[0]).T
-    about = np.sqrt(np.mean((err - fitted) ** 2, axis=1))
-    drift = np.sqrt(np.mean(fitted**2, axis=1))
-    # within the bar about the quadratic, and the quadratic the larger part of the error (a
-    # swing with a small drift beside it is no drift; review 25c)
-    if not (np.all(about <= bar) and np.all(drift >= about)):
+    ref = np.asarray(d["reference_x"], dtype=float)
+    err = np.asarray(d["simulated_x"], dtype=float)[off] - ref[off]
+    about = _drift_about(t, err, bar)
+    if about is None:
         return {}
     ch = list(d.get("channels") or [f"q{k + 1}" for k in range(per.size)])
+    unheld_text = ""
+    held_off = sorted(offs & held_by_model)
+    if held_off:
+        # held by the identified law alone (review 25c): a drift only where the same law without
+        # its holding terms misses the bar there too, by a drift as well (the hold neither
+        # causes nor cures it; where it alone misses the bar, held_failures says so)
+        if not _unheld_measured(d, score):
+            return {}
+        unheld = np.asarray(d[f"{score}_unheld"], dtype=float)
+        ux = np.asarray(d[f"{score}_unheld_x"], dtype=float)
+        if not (np.all(unheld[held_off] > bar) and np.all(np.isfinite(ux))):
+            return {}
+        about_u = _drift_about(t, ux[held_off] - ref[held_off], bar)
+        if about_u is None:
+            return {}
+        unheld_text = "; " + ", ".join(
+            f"the identified law holds {ch[k]} through {', '.join(d['holding_terms'])} (the true law "
+            f"does not), and without it rolls out at {unheld[k]:.3g}, a drift too ({a:.3g} about "
+            "its quadratic): the hold neither causes nor cures it"
+            for k, a in zip(held_off, about_u, strict=True))
     drifts = ", ".join(f"{ch[k]} {per[k]:.3g} ({a:.3g} about a quadratic in time, {err[j, -1]:+.3g} "
                        "at the end)" for j, (k, a) in enumerate(zip(off, about, strict=True)))
     rest = [k for k in range(per.size) if k not in offs]
@@ -2238,7 +2284,153 @@ def drift_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -> d
                       f"law_error {law:.3g} (bar {law_bar:g}): off the bar only {drifts}, a "
                       "coordinate the true law does not depend on (nothing restores it), so the "
                       "rollout integrates its acceleration's error twice and that error is a "
-                      f"drift, within the bar about its quadratic{held}")}
+                      f"drift, within the bar about its quadratic{held}{unheld_text}")}
+
+
+def _drift_about(t: np.ndarray, err: np.ndarray, bar: float) -> np.ndarray | None:
+    """Per row of ``err`` (rollout errors over times ``t`` [s]), its RMS about its own
+    least-squares quadratic in time, where each is within ``bar`` and no larger than the
+    quadratic's RMS (a drift: :func:`drift_failures`); None where any is not, or not finite."""
+    if not np.all(np.isfinite(err)):
+        return None
+    tau = t / t[-1] if t[-1] > 0 else t  # the quadratic in the record's own time [-]: conditioning
+    basis = np.vstack([np.ones_like(tau), tau, tau**2]).T
+    fitted = (basis @ np.linalg.lstsq(basis, err.T, rcond=None)[0]).T
+    about = np.sqrt(np.mean((err - fitted) ** 2, axis=1))
+    drift = np.sqrt(np.mean(fitted**2, axis=1))
+    # within the bar about the quadratic, and the quadratic the larger part of the error (a
+    # swing with a small drift beside it is no drift; review 25c)
+    return about if np.all(about <= bar) and np.all(drift >= about) else None
+
+
+def _unheld_measured(d: dict[str, Any], score: str, witness: Any = None) -> bool:
+    """Whether ``d`` holds :func:`unheld_witness`'s scores, simulating its callable (removed
+    from ``d``, or ``witness`` where a caller removed it) the first time it is asked for."""
+    witness = d.pop(f"{score}{UNHELD_WITNESS}", None) or witness
+    if f"{score}_unheld" not in d:
+        if witness is None:
+            return False
+        d.update(witness())
+    return True
+
+
+#: Suffix of the details key holding a rollout score's unheld witness (:func:`unheld_witness`,
+#: a callable) until :func:`held_failures` reads it, simulating it only where it can act.
+UNHELD_WITNESS = "_unheld_witness"
+
+
+def unheld_witness(score: str, names: list[str], coef: np.ndarray, held: list[int],
+                   x0: np.ndarray, xd0: np.ndarray, data: Measurement, reference_x: np.ndarray,
+                   substeps: int) -> dict[str, Any]:
+    """The identified law rolled out as the scorer rolls out a law, as identified and without
+    the terms holding ``held``: coordinates the true law leaves free and the identified one
+    holds (:func:`~testbed.scoring.law.free_coordinates`).
+
+    The scorer's own RK4 (:func:`testbed.scoring.law.law_rollout`) in ``substeps`` steps per
+    sample under the measured inputs held over each sample, from the true initial state, as
+    :func:`law_witness` rolls out the true law.  A witness, not a score
+    (:func:`held_failures`).
+
+    Parameters
+    ----------
+    score : str
+        The rollout score (``"angle_rmse"``).
+    names, coef : list of str, ndarray (n, p)
+        The identified equations (one per coordinate: an open chain).
+    held : list of int
+        0-based coordinates free in the true law and held by the identified one.
+    x0, xd0 : ndarray, shape (n,)
+        True initial coordinates and rates.
+    data : Measurement
+        Its sample rate [Hz] and inputs ``u`` (m, N).
+    reference_x : ndarray, shape (n, N)
+        The noise-free coordinates the model's rollout was scored against.
+    substeps : int
+        RK4 steps per sample step.
+
+    Returns
+    -------
+    dict
+        ``{score + "_as_identified": per-coordinate RMSE of the identified law,
+        score + "_unheld": the same without the holding terms (NaN where a rollout failed),
+        score + "_unheld_x": that rollout (n, N), "holding_terms": their names}``.
+    """
+    u = np.zeros((0, reference_x.shape[1])) if data.u is None else data.u
+    coef = np.atleast_2d(np.asarray(coef, dtype=float))
+    cols = holding_terms(names, coef, held)
+    unheld = coef.copy()
+    unheld[:, cols] = 0.0
+
+    def per(xj: np.ndarray) -> np.ndarray:
+        return np.asarray(metrics.rmse(reference_x, xj), dtype=float) if np.all(np.isfinite(xj)) \
+            else np.full(reference_x.shape[0], np.nan)
+
+    x = [law_rollout(names, c, x0, xd0, u, 1.0 / data.fs, (1.0,), substeps)[0] for c in (coef, unheld)]
+    return {f"{score}_as_identified": per(x[0]), f"{score}_unheld": per(x[1]),
+            f"{score}_unheld_x": x[1], "holding_terms": [names[j] for j in cols]}
+
+
+def held_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -> dict[str, str]:
+    """A failed rollout bar that the identified law meets without its terms holding a
+    coordinate the true law leaves free, under a law within the rig's law bar:
+    ``{"held free coordinate": reason}``.
+
+    A cart on its rail is free in the true law (:func:`~testbed.scoring.law.free_coordinates`);
+    an identified law with a term holding it (a spurious ``th1``: a spring on the cart) pulls
+    the cart where the truth never does.  Claimed only where the run's rollout bar
+    (``angle_rmse``) failed at a finite value, the identified law meets the rig's own bar on it
+    (``law_error``), no other bar of the run is missed, a coordinate off the bar is held by the
+    identified law and free in the true one, and :func:`unheld_witness` finds the identified
+    law, rolled out by the scorer's RK4, failing the bar as the scored rollout did while the
+    same law without its holding terms meets it on every coordinate.  Reasons only: the bar's
+    failure stands (no verdict changes).
+    Round 25's ``cp25_L0p8_m0p3`` (a 0.8 m pole of 0.3 kg) at 2 % s165 (``sindy_pi``): law_error
+    0.0070 (bar 0.25), the cart 0.0578 m against 0.0501 (the pole 0.0013 rad), its model holding
+    ``th1`` at -8.4e-4 (the pole's ``sin(th2)`` at -1) where the true law has no ``th1``; without
+    that term the same law rolls out at 0.0491 m.  No reason was given ("drift" does not apply:
+    the model holds the cart).
+
+    Parameters
+    ----------
+    scores : Scores
+        With ``details[score + UNHELD_WITNESS]`` (a callable: :func:`unheld_witness`, removed
+        here), ``["angle_rmse"]`` (per coordinate), ``["held_coordinates"]``,
+        ``["channels"]`` and ``["equation_bars"]`` (:func:`score_mechanical`, an open chain);
+        without them, nothing to check.
+    thresholds : dict
+        The run's bars, ``{metric: {"min"|"max": value}}``.
+    """
+    score, d = "angle_rmse", scores.details
+    witness = d.pop(f"{score}{UNHELD_WITNESS}", None)  # removed here whether or not it acts
+    bar = thresholds.get(score, {}).get("max")
+    got, law = scores.values.get(score), scores.values.get("law_error")
+    law_bar = (d.get("equation_bars") or {}).get("law_error", {}).get("max")
+    held = d.get("held_coordinates")
+    if (not held or bar is None or law_bar is None
+            or got is None or law is None or not np.isfinite(got) or got <= bar
+            or not np.isfinite(law) or law > law_bar
+            or {"fit", "model", "simulation"} & set(scores.failures)):
+        return {}
+    if any(not c.passed for c in check_thresholds(scores.values, thresholds) if c.metric != score):
+        return {}  # another bar missed too: the held term would hide it (as drift_failures)
+    per = np.asarray(d[score], dtype=float)
+    off = set(np.flatnonzero(~(per <= bar)).tolist())
+    if not off & set(held) or not _unheld_measured(d, score, witness):
+        return {}
+    ident, unheld = d[f"{score}_as_identified"], d[f"{score}_unheld"]
+    # the scorer's RK4 must replay the scored failure, and the unheld law meet the bar everywhere
+    if not (np.nanmax(ident) > bar and np.all(unheld <= bar)):
+        return {}
+    ch = list(d.get("channels") or [f"q{k + 1}" for k in range(per.size)])
+    coords = ", ".join(ch[k] for k in sorted(held))
+    terms = ", ".join(d["holding_terms"])
+    after = ", ".join(f"{ch[k]} {unheld[k]:.3g}" for k in range(per.size))
+    return {"held free coordinate": (
+        f"held free coordinate: {score} {got:.3g} against the bar {bar:g} with the law within "
+        f"law_error {law:.3g} (bar {law_bar:g}): the identified law holds {coords}, which the "
+        f"true law leaves free, through {terms} (terms the true law lacks); the same law "
+        f"without them, rolled out by the scorer's RK4 from the true start, scores {after}, "
+        f"within the bar (as identified {np.nanmax(ident):.3g})")}
 
 
 def equation_scores(cmp: dict[str, Any]) -> dict[str, float]:
@@ -2314,13 +2506,20 @@ def score_mechanical(dataset: Dataset, data: Measurement, clean: Measurement, mo
         # free in the true law and in the identified one: a term of the model holding the
         # coordinate (a spurious spring on the cart) pulls it back, no drift (review 25c)
         n_q = np.shape(theta)[0]
-        d["free_coordinates"] = sorted(
-            set(free_coordinates(truth.equation_terms, truth.equation_coef, n_q))
-            & set(free_coordinates(list(model.feature_names_), coef, n_q)))
+        truth_free = set(free_coordinates(truth.equation_terms, truth.equation_coef, n_q))
+        model_free = set(free_coordinates(list(model.feature_names_), coef, n_q))
+        d["free_coordinates"] = sorted(truth_free & model_free)
+        # free in the truth, held by the model: its holding terms judged by held_failures
+        d["held_coordinates"] = sorted(truth_free - model_free)
         if np.isfinite(v["law_error"]):  # simulated only where it can act (sensitivity_failures)
             d[f"angle_rmse{LAW_WITNESS}"] = functools.partial(
                 law_witness, "angle_rmse", list(truth.equation_terms), truth.equation_coef,
                 x0, xd0, data, theta, witness_substeps(data.fs, model_step(model)))
+            if d["held_coordinates"]:
+                d[f"angle_rmse{UNHELD_WITNESS}"] = functools.partial(
+                    unheld_witness, "angle_rmse", list(model.feature_names_), coef,
+                    d["held_coordinates"], x0, xd0, data, theta,
+                    witness_substeps(data.fs, model_step(model)))
     elif np.shape(truth.equation_coef)[0] == np.shape(theta)[0]:
         # an open chain whose identified set has another number of equations: no law to solve
         v["law_error"] = float("nan")

@@ -52,7 +52,8 @@ SCORED_REASONS = ("fit failed", "diverged", "response blew up", "simulation fail
 #: The scorer's explanations of a failed bar (testbed.scoring.scorers: uninformative_failures,
 #: out_of_band_failures, unexcited_failures, decayed_failures, floor_failures, sensor_failures,
 #: equation_failures, step_failures, sensitivity_failures, clipping_failures,
-#: linear_model_failures, unscored_mode_failures, channel_failures, drift_failures), each the
+#: linear_model_failures, unscored_mode_failures, channel_failures, drift_failures,
+#: held_failures), each the
 #: head of its reason
 #: (``<head>: ...``).  Matched only at a
 #: reason's start (the text's or after ``"; "``, as ``Scores.failure`` joins them): their words
@@ -62,7 +63,7 @@ EXPLAINED_REASONS = ("uninformative", "out of band", "unexcited", "decayed", "fl
                      "wrong equation", "equation not determined",
                      "equation not shown determined", "rollout step",
                      "sensitive record", "clipped", "linear model", "unscored mode",
-                     "TRAC by channel", "drift")
+                     "TRAC by channel", "drift", "held free coordinate")
 _EXPLAINED = re.compile(r"(?:^|; )(" + "|".join(map(re.escape, EXPLAINED_REASONS)) + r")\b")
 
 
