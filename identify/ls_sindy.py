@@ -728,8 +728,11 @@ class LeastSquaresSINDy(StructuralIdentifier):
                 + (f"modes {(up + 1).tolist()} stood below the lowest it allows (the read "
                    "backbone limit less the lower modes' largest measured stiffening c / wd, "
                    "less one line): "
-                   + ", ".join(f"{freqs[j]:.4g} < {floor[j]:.4g} Hz, to {to[j]:.4g} Hz (its "
-                               "backbone limit)" for j in up) if up.size else ""))
+                   + ", ".join(f"{freqs[j]:.4g} < {floor[j]:.4g} Hz, to {to[j]:.4g} Hz ("
+                               + ("its reach" if to[j] >= reach[j] else "its backbone limit"
+                                  if np.isfinite(limit[j]) else "its backbone fit's limit, the "
+                                  "fit not taken for its shift beyond the first order")
+                               + ")" for j in up) if up.size else ""))
         # (K_ alone: the refit's _take replaces coef_ whole)
         self.K_ = set_eigenvalues(self.M_, self.K_, np.where(move, (2.0 * np.pi * to) ** 2, np.nan))
         self._refit_cubic(data, tilt_library(lib) if self.fit_tilt_ else lib, masses)
@@ -1006,7 +1009,9 @@ def reach_moves(freqs_hz: np.ndarray, reach_hz: np.ndarray, limit_hz: np.ndarray
         return none, to, f"the record is not seen hardening ({said}): nothing moved"
     above = f > reach
     below = np.zeros(f.shape, dtype=bool) if floor is None else ~above & (f < floor)  # NaN: False
-    to = np.where(below, limit if floor_limit_hz is None else np.asarray(floor_limit_hz, float), to)
+    lifted = limit if floor_limit_hz is None else np.asarray(floor_limit_hz, float)
+    over = below & (lifted > reach)  # a floor's target above the mode's reach: the reach, the
+    to = np.where(below, np.minimum(lifted, reach), to)  # upper bound, holds (review 26c)
     if not np.any(above | below):
         return none, to, ("the record hardens, every mode within its reach ("
                           + ", ".join(f"{a:.4g} <= {r:.4g} Hz" for a, r in zip(f, reach, strict=True))
@@ -1023,4 +1028,6 @@ def reach_moves(freqs_hz: np.ndarray, reach_hz: np.ndarray, limit_hz: np.ndarray
         f"{'>' if above[j] else '<'} {reach[j] if above[j] else floor[j]:.4g} Hz) left: its target "
         f"{to[j]:.4g} Hz lies nearer mode {int(np.argmin(gap[j])) + 1}'s {f[np.argmin(gap[j])]:.4g} Hz"
         for j in left)
-    return move, to, why
+    capped = "; ".join(f"mode {j + 1}'s floor target {lifted[j]:.4g} Hz lies above its reach "
+                       f"{reach[j]:.4g} Hz: moved to the reach" for j in np.flatnonzero(over & move))
+    return move, to, "; ".join(t for t in (why, capped) if t)

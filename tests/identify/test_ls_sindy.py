@@ -891,6 +891,11 @@ def test_reach_moves_raises_a_mode_below_its_floor_to_the_floors_own_limit():
     assert move.tolist() == [False, True] and to[1] == 402.57 and why == ""
     move, _, why = reach_moves(f, reach, limit, _HARDENS, _WD1, np.array([np.nan, 370.0]), low)
     assert not move.any() and "and above its floor" in why
+    # review 26c: a floor's target above the mode's reach moves it to the reach (the upper
+    # bound holds), said (the old code moved it to 402.57 Hz, above its own 395 Hz bound)
+    capped = np.array([48.55, 395.0])
+    move, to, why = reach_moves(f, capped, limit, _HARDENS, _WD1, np.array([np.nan, 382.8]), low)
+    assert move.tolist() == [False, True] and to[1] == 395.0 and "moved to the reach" in why
 
 
 def test_a_located_modes_limit_beyond_the_first_order_still_bounds_it_from_below(dataset_cache):
