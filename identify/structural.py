@@ -33,7 +33,7 @@ from identify._base import Identifier
 from identify._structural_sim import simulate_structural, state_matrix
 from testbed.core.errors import IdentificationError
 from testbed.core.lazy import lazy_module
-from testbed.core.measurement import Measurement, Trajectory
+from testbed.core.measurement import PRIOR_RANGE, Measurement, Trajectory, prior_number
 from testbed.core.schema import ErrorFn, Field
 from testbed.numerics.filters import cutoff_problem, elliptic_highpass
 from testbed.numerics.shapes import mac_matrix
@@ -609,7 +609,13 @@ def mass_prior_value(data: Measurement, key: str) -> float:
     if key not in data.prior:
         raise IdentificationError(f"Measurement.prior has no {key!r} (has: {sorted(data.prior)}); the mass "
                          f"scale cannot be identified from free vibration without it")
-    val = float(data.prior[key])
+    # a Measurement admits a list of numbers as a prior (``link_lengths``); a mass scale is one
+    # number: float([0.7]) was a TypeError inside the fit (fuzz26, round 25)
+    val = prior_number(data.prior[key])
+    if val is None:
+        lo, hi = PRIOR_RANGE
+        raise IdentificationError(f"prior {key!r} must be one number (a mass [kg]) from {lo:g} to "
+                                  f"{hi:g}, got {data.prior[key]!r:.60}")
     if not val > 0:
         raise IdentificationError(f"prior {key!r} must be > 0 kg, got {val}")
     return val

@@ -180,3 +180,14 @@ def test_a_mode_fitted_below_the_fit_band_is_fitted_again_without_it(dataset_cac
     assert r.scores.values["freq_error_mode1"] < 0.01
     assert r.scores.values["freq_error_mode2"] < 0.01
     assert r.passed, r.scores.failures
+
+
+@pytest.mark.parametrize("value", [[0.7], (0.7,), np.array([0.7])])
+def test_a_mass_prior_given_as_a_list_is_refused_in_one_line(value):
+    """A :class:`Measurement` admits a list of numbers as a prior (``link_lengths``); a mass
+    scale is one number.  ``float([0.7])`` was a TypeError inside the fit (fuzz26's round 25,
+    ``benchmarks.hostile25 measapi``); it is refused naming the key."""
+    data = bench.chain_measurement(bench.chain_system(coupled=False, damping="proportional"))
+    data = Measurement(**{**data.__dict__, "prior": {**data.prior, "reduced_mass_trace": value}})
+    with pytest.raises(IdentificationError, match=r"prior 'reduced_mass_trace' must be one number"):
+        LeastSquaresSINDy().fit(data)
