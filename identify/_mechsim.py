@@ -24,13 +24,43 @@ from typing import Any, ClassVar
 import numpy as np
 
 from identify.library import Library
-from testbed.core.errors import DivergenceError, IdentificationError
+from testbed.core import arguments as args
+from testbed.core.errors import ArgumentError, DivergenceError, IdentificationError
 from testbed.core.measurement import Trajectory
 
 #: A closure fitted or declared must close the measured loop to this fraction of the longest
 #: link: 1e-3 covers angle noise of about 1e-3 rad, while a wrong sign convention or a wrong
 #: link length leaves a residual of order one.
 CLOSURE_RTOL = 1e-3
+
+#: Most RK4 steps one :meth:`ImplicitModel.simulate` takes: its state arrays hold
+#: 3 x (steps + 1) x n_coordinates float64 (1.2 GB at 1e7 steps and five coordinates), and 1e7
+#: steps of the 1 ms default are 2.8 h of motion, 670 x the longest record the studies run (15 s).
+MAX_SIM_STEPS = 10 ** 7
+
+
+def sim_steps(t: Any, dt: float, where: str = "ImplicitModel.simulate") -> int:
+    """RK4 steps of at most ``dt`` [s] spanning the sample times ``t`` [s], after checking them.
+
+    Raises
+    ------
+    ArgumentError
+        ``t`` is not a finite increasing 1-D array of at least 2 times (one sample spans no
+        interval: was scipy's "`x` must be strictly increasing sequence", hostile round 25), or
+        spans more than :data:`MAX_SIM_STEPS` steps (``[0, 1e308]`` was an OverflowError in the
+        step count, round 25).
+    """
+    tt = args.array(where, "t", t, (None,))
+    if tt.size < 2 or np.any(np.diff(tt) <= 0):
+        raise ArgumentError(where, "t", args.describe(tt), "expected at least 2 sample times [s], "
+                            "increasing (a simulation spans an interval)", described=True)
+    with np.errstate(over="ignore"):
+        steps = (tt[-1] - tt[0]) / dt
+    if not steps <= MAX_SIM_STEPS:
+        raise ArgumentError(where, "t", f"times spanning {tt[-1] - tt[0]:.6g} s",
+                            f"expected a span of at most {MAX_SIM_STEPS:.0e} RK4 steps of "
+                            f"{dt:.6g} s ({MAX_SIM_STEPS * dt:.6g} s)", described=True)
+    return max(1, int(np.ceil(steps - 1e-9)))
 
 
 def band_whiteness(f: float) -> float:
@@ -374,6 +404,9 @@ class ImplicitModel:
 
         Raises
         ------
+        ArgumentError
+            ``t`` is not at least 2 increasing finite times or spans more than
+            :data:`MAX_SIM_STEPS` steps (:func:`sim_steps`).
         DivergenceError
             The state became non-finite, the loop closure lost assembly (Newton did not
             converge) or became singular, or the equations became singular in the
@@ -381,8 +414,8 @@ class ImplicitModel:
         """
         from scipy.interpolate import CubicHermiteSpline  # lazy: only when simulating
 
+        n_steps = sim_steps(t, dt)
         t = np.asarray(t, dtype=float)
-        n_steps = max(1, int(np.ceil((t[-1] - t[0]) / dt - 1e-9)))
         h = (t[-1] - t[0]) / n_steps
         tt = t[0] + 0.5 * h * np.arange(2 * n_steps + 1)
         if input_hold not in ("linear", "zoh"):

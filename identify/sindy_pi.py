@@ -170,7 +170,7 @@ from identify._implicit import (
     split_index,
     stlsq_sweep,
 )
-from identify._mechsim import CLOSURE_RTOL, ImplicitModel, LoopClosure, band_whiteness
+from identify._mechsim import CLOSURE_RTOL, ImplicitModel, LoopClosure, band_whiteness, sim_steps
 from identify._weak import check_window, held_midpoints, weak_matrix
 from identify.library import Library, fivebar_library, generic_mechanical_library
 from testbed.core.errors import IdentificationError
@@ -1590,9 +1590,12 @@ class _ImplicitMechanical(Identifier):
 
     def simulate(self, x0: np.ndarray, xd0: np.ndarray, t: np.ndarray,
                  u: np.ndarray | None = None) -> Trajectory:
-        """Free simulation from (x0, xd0) under inputs u (n_inputs, len(t)) at times t [s]."""
+        """Free simulation from (x0, xd0) under inputs u (n_inputs, len(t)) at times t [s]
+        (at least 2, increasing, spanning at most :data:`~identify._mechsim.MAX_SIM_STEPS`
+        steps: ArgumentError otherwise)."""
         if not hasattr(self, "model_"):
             raise IdentificationError(f"{self.name}: fit before simulate")
+        sim_steps(t, self._step(), f"{type(self).__name__}.simulate")
         return self.model_.simulate(x0, xd0, t, u, self._step(), self.input_hold_)
 
     def equations(self, precision: int = 4) -> list[str]:

@@ -65,7 +65,7 @@ from identify.structural import (
     symmetric_least_squares,
     unwarp_rule,
 )
-from testbed.core.errors import IdentificationError
+from testbed.core.errors import ArgumentError, IdentificationError
 from testbed.core.lazy import lazy_module
 from testbed.core.measurement import Measurement, Trajectory
 from testbed.core.schema import Field
@@ -275,9 +275,12 @@ class SINDyPILinear(Identifier):
         if not hasattr(self, "M_"):
             raise IdentificationError("sindy_pi_linear: fit before simulate")
         t = np.asarray(t, dtype=float)
+        if t.ndim != 1 or t.size < 2 or not np.allclose(np.diff(t), t[1] - t[0], rtol=1e-9, atol=0):
+            # one sample was numpy's IndexError and a non-uniform grid a plain ValueError
+            raise ArgumentError(f"{type(self).__name__}.simulate", "t", f"{t.size} time(s)",
+                                "expected at least 2 uniformly spaced sample times [s] (the "
+                                "zero-order-hold step is their spacing)", described=True)
         dt = t[1] - t[0]
-        if not np.allclose(np.diff(t), dt, rtol=1e-9, atol=0):
-            raise ValueError("simulate needs a uniform time grid")
         n = self.M_.shape[0]
         Minv = np.linalg.inv(self.M_)
         A = np.block([[np.zeros((n, n)), np.eye(n)], [-Minv @ self.K_, -Minv @ self.C_]])

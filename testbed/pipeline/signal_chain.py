@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 
 from testbed.core import arguments as args
-from testbed.core.dataset import Dataset
+from testbed.core.dataset import Dataset, Signal
 from testbed.core.errors import ArgumentError, RegistrationError, ScenarioError, show_names
 from testbed.core.measurement import (
     MIN_FREE_SAMPLES,
@@ -380,10 +380,36 @@ def measure(dataset: Dataset, signal_cfg: Mapping[str, Any], kind: str) -> Measu
             raise ArgumentError("measure", "dataset.fs", fs, f"a rate at which the record's {n} "
                                 "samples last a finite time (the duration overflows)")
     chain = _chain(kind)
+    if isinstance(dataset, Dataset):
+        _check_measured_table(dataset, chain)
     cfg = validate_table(dict(signal_cfg), chain.schema, file="<signal config>", section="signal")
     m = chain.measure(dataset, cfg)
     # the kind whose chain made it, for an identifier of another kind to refuse
     return dataclasses.replace(m, kind=kind) if isinstance(m, Measurement) and m.kind is None else m
+
+
+def _check_measured_table(dataset: Dataset, chain: SignalChain) -> None:
+    """Refuse a hand-built Dataset's ``measured`` table that no chain can read: not a mapping
+    of :class:`~testbed.core.dataset.Signal`, empty, or with a signal name holding ``"/"``
+    (the files' ``<signal>/<channel>``: the channel belongs in ``Signal.channels``).  Round 25
+    (the API): a bare array was AttributeError inside the chain, an empty table and a signal
+    named ``x/y`` a raw "dataset has no measured signal 'x'"."""
+    reads = f"the {chain.kind} chain reads {', '.join(chain.signals or ()) or 'its own signals'}"
+    table = dataset.measured
+    if not isinstance(table, Mapping):
+        raise ArgumentError("measure", "dataset.measured", args.describe(table),
+                            f"expected a mapping of signal names to Signal ({reads})", described=True)
+    if not table:
+        raise ArgumentError("measure", "dataset.measured", "an empty table",
+                            f"expected the measured signals ({reads})", described=True)
+    for name, signal in table.items():
+        if not isinstance(signal, Signal):
+            raise ArgumentError("measure", f"dataset.measured[{name!r}]", args.describe(signal),
+                                "expected a Signal(data, channels, unit)", described=True)
+        if not isinstance(name, str) or "/" in name:
+            raise ArgumentError("measure", "dataset.measured", f"a signal named {name!r}",
+                                "expected signal names without '/' (a file's '<signal>/<channel>' "
+                                f"is Signal.channels' business; {reads})", described=True)
 
 
 def _get(dataset: Dataset, name: str, rows: int | None = None) -> np.ndarray:

@@ -7,14 +7,20 @@ import pytest
 
 from benchmarks import sindy_pi_problems
 from identify.sindy_pi import SINDyPI
-from testbed.core.errors import DivergenceError
+from testbed.core.errors import ArgumentError, DivergenceError
 from tests.identify import mechsim_reference as ref
 
 
 @pytest.fixture(scope="module")
-def fivebar():
+def fitted():
     fb = sindy_pi_problems.fivebar(duration=4.0, fs=1e3, amp=1.0)
-    return fb.data, SINDyPI().fit(fb.data).model_
+    return fb.data, SINDyPI().fit(fb.data)
+
+
+@pytest.fixture(scope="module")
+def fivebar(fitted):
+    d, est = fitted
+    return d, est.model_
 
 
 def _reference(model):
@@ -58,3 +64,27 @@ def test_singular_model_raises_divergence_with_time(fivebar):
     with pytest.raises(DivergenceError, match="singular") as err:
         bad.simulate(d.x[:, 0], d.xd[:, 0], d.t[:101], d.u[:, :101], 1e-3)
     assert err.value.time == pytest.approx(0.0)
+
+
+@pytest.mark.parametrize("t, words", [
+    # hostile round 25: one sample was scipy's "`x` must be strictly increasing sequence" (the
+    # output spline), [0, 1e308] an OverflowError converting the step count to an integer
+    (np.array([0.0]), "at least 2 sample times"),
+    (np.array([0.0, 1e308]), r"times spanning 1e\+308 s: expected a span of at most 1e\+07 RK4 steps"),
+    # 1e7 steps of 1 ms and one more: the bound is the step count's, not the span's
+    (np.array([0.0, 1.0001e4]), "at most 1e\\+07 RK4 steps"),
+])
+def test_simulate_refuses_times_it_cannot_step_in_one_line(fitted, t, words):
+    d, est = fitted
+    u = None if t.size < 2 else d.u[:, :2]
+    for where, call in (("SINDyPI.simulate", lambda: est.simulate(d.x[:, 0], d.xd[:, 0], t, u)),
+                        ("ImplicitModel.simulate",
+                         lambda: est.model_.simulate(d.x[:, 0], d.xd[:, 0], t, u, 1e-3))):
+        with pytest.raises(ArgumentError, match=rf"^{where}: argument 't': .*{words}") as e:
+            call()
+        assert "\n" not in str(e.value)
+
+
+def test_simulate_of_two_samples_still_runs(fitted):
+    d, est = fitted
+    assert est.simulate(d.x[:, 0], d.xd[:, 0], d.t[:2], d.u[:, :2]).x.shape == (d.n_channels, 2)

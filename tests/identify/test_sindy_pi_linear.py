@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 from identify.sindy_pi_linear import SINDyPILinear
+from testbed.core.errors import ArgumentError
 from testbed.pipeline.scenario import load_scenario
 from testbed.pipeline.signal_chain import measure
 from testbed.scoring.run import noise_free
@@ -71,3 +72,13 @@ def test_soft_cantilever_fits(dataset_cache):
     assert np.min([v["mac_mode1"], v["mac_mode2"]]) >= 0.99 and v["trac"] >= 0.5
     assert np.max([v["freq_error_mode1"], v["freq_error_mode2"]]) <= 0.035  # modes 1-2, as measured
     assert v["Mr_error"] <= 0.3 and np.all(np.linalg.eigvalsh(m.M_) > 0)
+
+
+@pytest.mark.parametrize("t", [np.array([0.0]), np.array([0.0, 1e-3, 3e-3])], ids=["one", "non-uniform"])
+def test_simulate_refuses_times_it_cannot_hold_in_one_line(stiff, t):
+    # old: one time was numpy's IndexError (t[1]), a non-uniform grid a plain ValueError
+    _, data, _ = stiff
+    m = SINDyPILinear().fit(data)
+    n = data.n_channels
+    with pytest.raises(ArgumentError, match=r"^SINDyPILinear\.simulate: argument 't': .*uniformly spaced"):
+        m.simulate(np.zeros(n), np.zeros(n), t)

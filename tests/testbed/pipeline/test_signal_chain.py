@@ -33,3 +33,21 @@ def test_a_dataset_rate_that_is_no_rate_is_refused_in_one_line(fs, allowed):
 @pytest.mark.parametrize("fs", [100.0, 100, np.float32(100.0), np.int64(100)])
 def test_a_real_rate_of_any_numeric_type_is_measured(fs):
     assert measure(_kinetics(fs), {}, "dynamical").fs == 100.0
+
+
+@pytest.mark.parametrize(("measured", "words"), [
+    # hostile round 25 (the API): a bare array was AttributeError inside the chain; an empty
+    # table and a signal named "x/y" a raw "dataset has no measured signal 'x'"
+    (lambda x, dx: {"x": x.data, "dx": dx}, r"argument 'dataset\.measured\['x'\]': array of shape "
+                                             r"\(1, 400\).*expected a Signal"),
+    (lambda x, dx: {}, r"argument 'dataset\.measured': an empty table: expected the measured signals "
+                       r"\(the dynamical chain reads x, "),
+    (lambda x, dx: {"x/y": x, "dx": dx}, r"argument 'dataset\.measured': a signal named 'x/y': "
+                                         r"expected signal names without '/'"),
+], ids=["bare-array", "empty-table", "x/y"])
+def test_a_measured_table_no_chain_can_read_is_refused_in_one_line(measured, words):
+    ds = _kinetics(100.0)
+    bad = Dataset(ds.fs, measured(ds.measured["x"], ds.measured["dx"]))
+    with pytest.raises(ArgumentError, match=r"^measure: " + words) as e:
+        measure(bad, {}, "dynamical")
+    assert "\n" not in str(e.value)
