@@ -10,7 +10,9 @@ import pytest
 from benchmarks import bench_sgd_sindy as bench
 from identify import IDENTIFIERS
 from identify.structural import PEAK_BAND_LINES, modal_peaks
+from testbed import load_scenario
 from testbed.core.errors import IdentificationError
+from testbed.pipeline.signal_chain import measure
 
 
 @pytest.fixture(scope="module")
@@ -53,12 +55,11 @@ def test_a_band_the_chain_closes_is_named(chain):
         modal_peaks(dataclasses.replace(chain, passband=(3000.0, 4000.0)))
 
 
-def _beam_record(n_sensors: int):
-    """The shipped clamped beam (0.1 s) with ``n_sensors`` evenly spaced, hammer at the last."""
-    from testbed import load_scenario
-    from testbed.pipeline.generate import generate
-    from testbed.pipeline.signal_chain import measure
+def _beam_record(n_sensors: int, dataset_cache):
+    """The shipped clamped beam (0.1 s) with ``n_sensors`` evenly spaced, hammer at the last.
 
+    Read through the shared test cache: the two 5-sensor cases are one record (simulated once,
+    0.9 s of CPU, instead of once a case)."""
     sc = load_scenario("cantilever_stiff_impact")
     length = sc.rig_params["length"]
     pos = [round(length * (k + 1) / n_sensors, 6) for k in range(n_sensors)]
@@ -66,7 +67,7 @@ def _beam_record(n_sensors: int):
                     excitation={**sc.excitation, "location": pos[-1]},
                     simulation={**sc.simulation, "duration": 0.1,
                                 "sample_rate": 51200.0 if n_sensors > 3 else 12800.0})
-    return measure(generate(sc), sc.signal, sc.kind)
+    return measure(dataset_cache.get(sc), sc.signal, sc.kind)
 
 
 @pytest.mark.parametrize(("n_sensors", "name", "k"), [
@@ -75,9 +76,9 @@ def _beam_record(n_sensors: int):
     (5, "sgd_sindy", 140),  # was LinAlgError from eigh: the warm start's M not positive definite
 ])
 def test_a_short_free_decay_after_a_long_record_ends_in_a_model_or_a_named_refusal(
-        n_sensors, name, k):
+        n_sensors, name, k, dataset_cache):
     """free_start k samples before the end of a 0.1 s record (the probe of session 16)."""
-    data = _beam_record(n_sensors)
+    data = _beam_record(n_sensors, dataset_cache)
     short = dataclasses.replace(data, free_start=data.n_samples - k)
     try:
         model = IDENTIFIERS.get(name)().fit(short)
