@@ -2,6 +2,7 @@
 ``drift_failures``), or by the identified law's hold on a coordinate the true law leaves free
 (``held_failures``)."""
 
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -211,3 +212,88 @@ def test_a_drift_the_models_hold_neither_causes_nor_cures_is_named_drift(dataset
     why = r.scores.failures["drift"]
     assert "off the bar only x " in why and "the identified law holds x through th1" in why
     assert r.scores.details["angle_rmse_unheld"][0] > 0.0501
+
+
+class _Witness:
+    """A stand-in for :func:`~testbed.scoring.scorers.unheld_witness`: the law without its
+    holding terms scores ``unheld`` (rollout ``unheld_x``), as identified ``ident``; records
+    which rollouts were asked for."""
+
+    def __init__(self, unheld, unheld_x, ident):
+        self.unheld, self.unheld_x, self.ident, self.calls = unheld, unheld_x, ident, []
+
+    def __call__(self, as_identified=False):
+        self.calls.append(as_identified)
+        if as_identified:
+            return {"angle_rmse_as_identified": np.asarray(self.ident, dtype=float)}
+        return {"angle_rmse_unheld": np.asarray(self.unheld, dtype=float),
+                "angle_rmse_unheld_x": self.unheld_x, "holding_terms": ["th1"]}
+
+
+def held(error: np.ndarray, witness: _Witness) -> Scores:
+    """:func:`run`'s stand-in with the cart held by the identified law (a ``th1``) and free in
+    the true one, and ``witness`` as its unheld witness."""
+    sc = run(error, free=())
+    sc.details.update(held_coordinates=[0], angle_rmse_unheld_witness=witness)
+    return sc
+
+
+def test_a_held_cart_drifting_gets_no_reason_where_its_unheld_law_meets_the_bar_or_diverges():
+    """Review 26d: a drift on a held coordinate is "drift" only where the law without its hold
+    drifts off the bar too.  Where that law meets the bar (the hold alone misses it), no drift;
+    where its rollout diverges (NaN), no drift either; and neither is "held free coordinate"
+    when the law as identified, replayed, does not fail the bar on the scored coordinates."""
+    drift = -0.0014 * T**2 + 0.005 * np.sin(3.0 * T)
+    ref = run(drift).details["reference_x"]
+    meets = _Witness([0.01, 0.002], ref + 0.01, [0.0578, 0.002])
+    assert drift_failures(held(drift, meets), BARS) == {}
+    assert meets.calls == [False]  # drift never reads the law as identified
+    nan_x = np.full_like(ref, np.nan)
+    diverges = _Witness([np.nan, np.nan], nan_x, [0.0578, 0.002])
+    assert drift_failures(held(drift, diverges), BARS) == {}
+    assert bar_failures(held(drift, _Witness([np.nan, np.nan], nan_x, [0.0578, 0.002])),
+                        BARS) == {}
+    # the hold alone misses the bar and the replay agrees: "held free coordinate"
+    assert set(bar_failures(held(drift, _Witness([0.01, 0.002], ref + 0.01, [0.0578, 0.002])),
+                            BARS)) == {"held free coordinate"}
+    # and the unheld law drifting off the bar too: "drift", naming the hold
+    sim = ref + np.vstack([drift, 0.002 * np.sin(5.0 * T)])
+    both = bar_failures(held(drift, _Witness([0.06, 0.002], sim, [0.0578, 0.002])), BARS)
+    assert set(both) == {"drift"} and "neither causes nor cures it" in both["drift"]
+
+
+def test_held_free_coordinate_needs_the_replay_to_fail_on_the_scored_coordinates():
+    """Review 26d: the replay of the law as identified was taken as reproducing the scored
+    failure wherever any coordinate missed the bar (``nanmax``), and an all-NaN replay warned
+    ("All-NaN slice encountered").  It must miss the bar on the same coordinates (here the
+    cart alone), finite."""
+    drift = -0.0014 * T**2 + 0.005 * np.sin(3.0 * T)
+    ref = run(drift).details["reference_x"]
+    elsewhere = _Witness([0.01, 0.002], ref, [0.01, 0.3])  # the pole off, not the cart
+    assert held_failures(held(drift, elsewhere), BARS) == {}
+    more = _Witness([0.01, 0.002], ref, [0.0578, 0.3])  # the cart and the pole off
+    assert held_failures(held(drift, more), BARS) == {}
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        blown = _Witness([0.01, 0.002], ref, [np.nan, np.nan])
+        assert held_failures(held(drift, blown), BARS) == {}
+    same = _Witness([0.01, 0.002], ref, [0.0578, 0.002])
+    why = held_failures(held(drift, same), BARS)
+    assert set(why) == {"held free coordinate"} and "(as identified 0.0578)" in why[
+        "held free coordinate"]
+
+
+def test_the_law_as_identified_is_rolled_out_only_where_the_unheld_law_meets_the_bar():
+    """Review 26d: two sequential rollouts for every held cart; the unheld law is rolled out
+    first and the law as identified only once it meets the bar (measured on round 24's
+    cp24_pole_m1 at 1.5 % s151 with the spring on a law 10 % off: bar_failures 21.2 -> 13.5 s)."""
+    drift = -0.0014 * T**2 + 0.005 * np.sin(3.0 * T)
+    ref = run(drift).details["reference_x"]
+    misses = _Witness([0.2, 0.1], ref + 0.2, [0.0578, 0.002])
+    assert held_failures(held(drift, misses), BARS) == {}
+    assert misses.calls == [False]
+    meets = _Witness([0.01, 0.002], ref, [0.0578, 0.002])
+    sc = held(drift, meets)
+    assert set(bar_failures(sc, BARS)) == {"held free coordinate"}
+    assert meets.calls == [False, True]
+    assert "angle_rmse_unheld_witness" not in sc.details  # removed: nothing left to simulate
