@@ -408,7 +408,7 @@ def test_kinetics_far_from_the_shipped_fail_on_their_equation_not_their_state():
 
 # ------------------------------------------- round 6 beams
 @pytest.mark.parametrize("lowpass, passed", [(0.0, False), ("auto", True)])
-def test_two_sensor_beam_passes_with_the_auto_lowpass(lowpass, passed):
+def test_two_sensor_beam_passes_with_the_auto_lowpass(lowpass, passed, dataset_cache):
     """Round 5's open case (benchmarks/unseen/round5/g_L0p5_n6_s2.toml with ``ls_sindy``): a
     two-sensor 0.5 m beam without a low-pass fails TRAC (0.859, measured), as does the truth's
     own two-mode SEREP reduction on that record (0.86: mode 3 rings at the sensors after the
@@ -424,7 +424,7 @@ def test_two_sensor_beam_passes_with_the_auto_lowpass(lowpass, passed):
     sc = scenario_from_dict(raw, file="two.toml")
     assert (sc.signal["lowpass_hz"], "signal.lowpass_hz" in sc.rules) == (
         (350.5, True) if lowpass == "auto" else (0.0, False))
-    result = run_scenario(sc)
+    result = run_scenario(sc, cache=dataset_cache)  # one simulation for both cases
     assert result.passed is passed
     assert {c.metric for c in result.checks if not c.passed} == (set() if passed else {"trac"})
 
@@ -834,14 +834,16 @@ def test_a_floor_is_claimed_for_the_exact_model_not_for_every_model_of_its_size(
     assert "any model" not in why  # a model of that size meets it: ls_sindy above
 
 
-def test_a_mode_above_the_nyquist_frequency_with_no_low_pass_is_named_folded_not_attenuated():
+def test_a_mode_above_the_nyquist_frequency_with_no_low_pass_is_named_folded_not_attenuated(
+        dataset_cache):
     """Round 20's b20_st_fs1k_s2_nolp (the shipped beam at 1 kHz, no low-pass, sensors 0.5 / 1
     L): mode 2 (517.4 Hz) is sampled above the 500 Hz Nyquist frequency and the record holds it
     folded to 482.6 Hz at full amplitude; the reason said the chain "attenuates it in every
     signal the identifier is given"."""
     from testbed.scoring.scorers import aliased_frequency
     sc = load_scenario(_root() / "benchmarks" / "unseen" / "round20" / "b20_st_fs1k_s2_nolp.toml")
-    r = run_scenario(dataclasses.replace(sc, seed=111, identify={**sc.identify, "method": "ls_sindy"}))
+    r = run_scenario(dataclasses.replace(sc, seed=111, identify={**sc.identify, "method": "ls_sindy"}),
+                     cache=dataset_cache)
     assert r.verdict == FAIL and r.scores.values["freq_error_mode2"] > 0.026
     why = r.scores.failures["band"]
     assert why.startswith("out of band: mode 2 (517.4 Hz) lies above the Nyquist frequency (500 Hz) "
