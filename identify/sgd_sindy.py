@@ -182,6 +182,15 @@ def _clearly_more(a_new: float, a_old: float) -> bool:
     return 1.0 - a_old > SGD_AGREEMENT_RATIO * (1.0 - a_new)
 
 
+def _agreement_text(a: float, failed: str = "none (its simulation failed)",
+                    unexplained: bool = False) -> str:
+    """A record agreement ``a`` [-] as the rules quote it: 4 significant figures, with its
+    unexplained share ``1 - a`` where ``unexplained``; ``failed`` where it is not finite."""
+    if not np.isfinite(a):
+        return failed
+    return f"{a:.4g} (unexplained {1.0 - a:.2g})" if unexplained else f"{a:.4g}"
+
+
 def keep_sgd_rule(agree_sgd: float, agree_warm: float | None,
                   notes: tuple[str, str] = ("", "")) -> tuple[bool, str]:
     """Whether the SGD's result is kept rather than the held warm start's, and why.
@@ -394,11 +403,7 @@ class SGDSINDyBase(StructuralIdentifier):
         self.check_params()
         if search is None:
             search = self._default_search(data)
-        self.cubic_, self.cubic_rule_ = cubic_rule(
-            data, self.cubic, None, None if self.cubic is not None else search().peaks,
-            search() if self.cubic is None and self._lower_modes() else None)
-        self.learning_rate_, self.learning_rate_rule_ = learning_rate_for(self.cubic_,
-                                                                          self.learning_rate)
+        self._set_library(data, self.cubic, None, search)
         if self.eigen:
             self._peaks(data, search() if self.n_modes is None and self.freq_range is None else None)
         else:
@@ -409,6 +414,21 @@ class SGDSINDyBase(StructuralIdentifier):
             # frequency; the fitted poles are mapped back at the end (_finish_fit)
             f = warp_frequency(f, float(data.fs))
         return (2.0 * np.pi * f) ** 2, search().peaks if getattr(self, "fit_band", False) else None
+
+    def _set_library(self, data: Measurement, cubic: bool | None, cut: float | None,
+                     search: Callable[[], PeakSearch]) -> None:
+        """Set ``cubic_`` and ``cubic_rule_`` by :func:`cubic_rule` (``cubic``: the setting the
+        library is chosen by; ``cut``: the fit band's cut-off [Hz], None: by ``fit_band``, 0.0:
+        none) and the step size it takes (``learning_rate_``, ``learning_rate_rule_``,
+        :func:`learning_rate_for`); ``search``: the default peak search of ``data``, read only
+        where the library is the rule's (``cubic`` None), its lowest modes only with
+        ``lower_modes``."""
+        ps = search() if cubic is None else None  # a set library reads no peaks
+        self.cubic_, self.cubic_rule_ = cubic_rule(
+            data, cubic, cut, None if ps is None else ps.peaks,
+            ps if ps is not None and self._lower_modes() else None)
+        self.learning_rate_, self.learning_rate_rule_ = learning_rate_for(self.cubic_,
+                                                                          self.learning_rate)
 
     def _default_search(self, data: Measurement) -> Callable[[], PeakSearch]:
         """The default peak search of ``data`` (:meth:`_search`, every argument at its
@@ -1309,21 +1329,17 @@ class SGDSINDy(SGDSINDyBase):
             return "", begun
         self.__dict__.pop("_cubic_diverged", None)
         a_linear = self._kept_agreement()
-
-        def show(a: float) -> str:
-            return f"{a:.4g}" if np.isfinite(a) else "none (its simulation failed)"
-
         if a_linear > a_cubic or (np.isnan(a_cubic) and np.isfinite(a_linear)):
             refused = (f"{rule}; the fitted cubic model doubted ({doubt}), the linear refit "
-                       f"explains more of its record (record agreement {show(a_linear)} "
-                       f"against {show(a_cubic)}): cubic terms out")
+                       f"explains more of its record (record agreement {_agreement_text(a_linear)} "
+                       f"against {_agreement_text(a_cubic)}): cubic terms out")
             self.cubic_rule_ = refused
             return refused, linear_begun
         self.__dict__.clear()
         self.__dict__.update(first)
         self.cubic_rule_ = (f"{rule}; the fitted cubic model doubted ({doubt}), but the linear "
                             f"refit explains no more of its record (record agreement "
-                            f"{show(a_linear)} against {show(a_cubic)}): cubic kept")
+                            f"{_agreement_text(a_linear)} against {_agreement_text(a_cubic)}): cubic kept")
         return "", begun
 
     def _lowest_peak_refit(self, data: Measurement, lam_hat: np.ndarray,
@@ -1376,9 +1392,7 @@ class SGDSINDy(SGDSINDyBase):
         a_flat = self._kept_agreement()
 
         def show(a: float) -> str:  # (the unexplained share where that decides: review 24e)
-            if not np.isfinite(a):
-                return "none (its simulation failed)"
-            return f"{a:.4g} (unexplained {1.0 - a:.2g})" if clear else f"{a:.4g}"
+            return _agreement_text(a, unexplained=clear)
 
         # the refit's kept model: flat, or the tilted fit with the unresolved mode placed
         # (_physical_placed keeps the tilt where the placement makes it physical)
@@ -1430,12 +1444,7 @@ class SGDSINDy(SGDSINDyBase):
             if cut is not None:  # the refit without the band, from the state _start_fit left
                 self.__dict__.clear()
                 self.__dict__.update(begun)
-                ps = search() if cubic is None else None  # a set library reads no peaks
-                self.cubic_, self.cubic_rule_ = cubic_rule(
-                    data, cubic, cut, None if ps is None else ps.peaks,
-                    ps if ps is not None and self._lower_modes() else None)
-                self.learning_rate_, self.learning_rate_rule_ = learning_rate_for(
-                    self.cubic_, self.learning_rate)
+                self._set_library(data, cubic, cut, search)
             self._fit_in_band(data, lam_hat, band_peaks, m_hat, cut, lowest_flat)
 
         # the fit band's refusal (identify._band_refusal), as ls_sindy's: round 15's aluminium
@@ -1461,7 +1470,7 @@ class SGDSINDy(SGDSINDyBase):
             a_none = self._kept_agreement()
 
             def show(a: float) -> str:
-                return f"{a:.4g}" if np.isfinite(a) else "none"
+                return _agreement_text(a, failed="none")
 
             if a_none > a_band:  # False where the fit without the band has none (NaN)
                 self.fit_band_rule_ = (
