@@ -516,10 +516,10 @@ class SGDSINDy(SGDSINDyBase):
         cubic force would move a frequency past its bar ("linear model").  With ``l1 =
         'cubic'`` (the default) ``True`` offers the cubic library and the data select its terms:
         the lasso may zero them, and a kept cubic whose own backbone contradicts a measured
-        decay is compared with the linear fit, the model explaining more of its record kept
-        (:meth:`_linear_if_it_explains_more`, stated in ``cubic_rule_``); ``True`` with ``l1 =
-        'none'`` keeps the cubic model asked for.  The shipped soft scenario's table, and so
-        the families' soft members, set ``True`` (with ``l1 = 'cubic'``).
+        decay is compared with the linear fit and stays only where it explains clearly more of
+        its record (:meth:`_linear_if_it_explains_more`, stated in ``cubic_rule_``); ``True``
+        with ``l1 = 'none'`` keeps the cubic model asked for.  The shipped soft scenario's
+        table, and so the families' soft members, set ``True`` (with ``l1 = 'cubic'``).
     l1 : {"cubic", "none"}
         ``"cubic"``: the lasso on the standardised cubic coefficients, then debiasing (acts
         only with ``cubic=True``); ``"none"``: no L1, the cubic block is plain least squares.
@@ -1298,11 +1298,29 @@ class SGDSINDy(SGDSINDyBase):
                                     ) -> tuple[str, dict[str, Any]]:
         """A kept cubic that contradicts a measured decay (``doubt``,
         :meth:`_cubic_contradicts_decay`) is doubted, not refused: the linear library is fitted
-        too, from the state before the fit (``begun``), and the model whose kept record
-        agreement (:func:`record_agreement`) is higher is kept, stated in ``cubic_rule_`` (a
-        candidate with an agreement beats one without, as in :func:`keep_sgd_rule`; a linear
-        refit that fails keeps the cubic).  Over the user's ``cubic = true`` too: the model
-        asked for is fitted and compared, the library chosen by its own record.
+        too, from the state before the fit (``begun``), and the cubic stays only where its kept
+        record agreement (:func:`record_agreement`) explains clearly more of the record than
+        the linear refit's (:func:`_clearly_more`: under 1 / :data:`SGD_AGREEMENT_RATIO` of its
+        unexplained share, the margin the cubic's trial fit must clear over a linear model,
+        :meth:`_cubic_if_it_explains_more`), stated in ``cubic_rule_`` (a candidate with an
+        agreement beats one without, as in :func:`keep_sgd_rule`; a linear refit that fails
+        keeps the cubic).  Where the cubic libraries' terms are the data's to select (by rule,
+        or ``cubic = true`` with ``l1 = 'cubic'``): the library chosen by its own record.
+
+        Why the margin, and on the cubic's side: the doubt is measured evidence against the
+        cubic (its own backbone contradicts the decay), so a tie goes to the model without the
+        contradicted terms; plain "higher" let 1e-3 decide (review 25e; round 20's
+        ``r20_soft__001`` at 1 %: cubic 0.997 against 0.996, now linear, modes 1-2 0.19 / 0.77
+        % off, TRAC 0.9972 -> 0.9962).  The margin on the linear's side (the linear must
+        explain clearly more) would have kept the cubic where the doubt gained: round 20's
+        ``r20_soft__007`` clean (1.57 x: modes 1-2 2.14 / 3.66 % with the cubic) and
+        ``soft_v22__018`` clean (1.15 x, mode 1 1.87 % with the cubic).  The agreements
+        compared may be of 1 and 3 start-fit iterations (:data:`FLOOR_CHECK_ITERATIONS`; one
+        is exact for the linear model, whose response is linear in its start); a cubic's
+        one-iteration unexplained share was 0.98-1.02 x its three-iteration one on six kept
+        cubic models of the gate's soft cells and 1.41 x on round 24's
+        ``b24_soft_r2p7_cf0p45_z0p2`` at 1 % (0.0085 against 0.0060): inside the 2 x margin,
+        which plain "higher" was not (measured; it leans against the cubic by at most that).
 
         Families' soft member 019 clean (``cubic = true``, the shipped soft scenario's table):
         the cubic shifts mode 1 by -0.69 Hz where its decay hardens +0.80 Hz; the cubic model
@@ -1329,17 +1347,29 @@ class SGDSINDy(SGDSINDyBase):
             return "", begun
         self.__dict__.pop("_cubic_diverged", None)
         a_linear = self._kept_agreement()
-        if a_linear > a_cubic or (np.isnan(a_cubic) and np.isfinite(a_linear)):
-            refused = (f"{rule}; the fitted cubic model doubted ({doubt}), the linear refit "
-                       f"explains more of its record (record agreement {_agreement_text(a_linear)} "
-                       f"against {_agreement_text(a_cubic)}): cubic terms out")
+        figures = (f"record agreement {_agreement_text(a_linear)} against "
+                   f"{_agreement_text(a_cubic)}")
+        # The doubted cubic stays only where it explains clearly more of its record than the
+        # linear refit (_clearly_more, the trial's margin for a cubic over a linear model):
+        # a tie (round 20's r20_soft__001 at 1 %: 0.997 against the linear's 0.996) no longer
+        # decides by 1e-3 for the model whose cubic contradicts the measured decay (review
+        # 25e); a cubic's one-iteration agreement (FLOOR_CHECK_ITERATIONS) left 0.98-1.41 x
+        # its three-iteration unexplained share on the gate's kept cubics, inside the 2 x
+        if np.isfinite(a_linear) and not (np.isfinite(a_cubic) and _clearly_more(a_cubic, a_linear)):
+            why = (f"the linear refit explains more of its record ({figures})"
+                   if not a_linear <= a_cubic else
+                   f"the cubic model does not explain clearly more of its record than the "
+                   f"linear refit (its unexplained share not under 1 / {SGD_AGREEMENT_RATIO:g} "
+                   f"of the linear's; {figures})")
+            refused = f"{rule}; the fitted cubic model doubted ({doubt}), {why}: cubic terms out"
             self.cubic_rule_ = refused
             return refused, linear_begun
         self.__dict__.clear()
         self.__dict__.update(first)
-        self.cubic_rule_ = (f"{rule}; the fitted cubic model doubted ({doubt}), but the linear "
-                            f"refit explains no more of its record (record agreement "
-                            f"{_agreement_text(a_linear)} against {_agreement_text(a_cubic)}): cubic kept")
+        self.cubic_rule_ = (f"{rule}; the fitted cubic model doubted ({doubt}), but it explains "
+                            f"clearly more of its record than the linear refit (the linear's "
+                            f"unexplained share over {SGD_AGREEMENT_RATIO:g} x its; {figures}): "
+                            "cubic kept")
         return "", begun
 
     def _lowest_peak_refit(self, data: Measurement, lam_hat: np.ndarray,

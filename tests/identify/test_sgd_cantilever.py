@@ -404,3 +404,26 @@ def test_a_users_cubic_without_the_lasso_is_never_doubted(dataset_cache, monkeyp
     assert "the fitted cubic model doubted" in SGDSINDy(cubic=True).fit(data).cubic_rule_
     asked = SGDSINDy(cubic=True, l1="none").fit(data)
     assert asked.cubic_ and asked.cubic_rule_ == "user setting"
+
+
+def test_a_doubted_cubic_stays_only_where_it_explains_clearly_more(dataset_cache):
+    """Review 25e: a cubic contradicting a measured decay was compared with the linear refit
+    by the higher record agreement alone, so a 1e-3 tie decided the library.  Round 20's
+    ``r20_soft__001`` at 1 % noise, seed 117 (``cubic = true``, the shipped soft table): the
+    cubic shifts mode 2 by +0.066 Hz where the decay softens it by 0.014 Hz; the cubic explains
+    0.997 of its record, the linear refit 0.996, and the cubic was kept.  Now the doubted cubic
+    stays only where it leaves under 1 / ``SGD_AGREEMENT_RATIO`` of the linear's unexplained
+    share (``_clearly_more``, the trial's margin for a cubic over a linear model): the linear
+    model (measured: TRAC 0.996, modes 1-2 within 0.19 / 0.77 %, issue #15's bars held)."""
+    member = {m.name: m for m in load_study(ROUND20.parent / "round20_families.toml").scenarios}[
+        "r20_soft__001"]
+    sc = member.with_noise(1.0).replace(seed=117)
+    ds = dataset_cache.get(sc)
+    data = measure(ds, sc.signal, "structural")
+    model = SGDSINDy(cubic=True).fit(data)
+    assert "the fitted cubic model doubted" in model.cubic_rule_
+    assert "the cubic model does not explain clearly more of its record" in model.cubic_rule_
+    assert not model.cubic_  # the old code: the cubic kept on 0.997 against 0.996
+    v = score_structural(ds, data, measure(noise_free(ds), sc.signal, "structural"), model).values
+    assert v["trac"] >= 0.95 and np.min([v["mac_mode1"], v["mac_mode2"]]) >= 0.95
+    assert np.max([v["freq_error_mode1"], v["freq_error_mode2"]]) <= 0.01
