@@ -182,6 +182,15 @@ def _clearly_more(a_new: float, a_old: float) -> bool:
     return 1.0 - a_old > SGD_AGREEMENT_RATIO * (1.0 - a_new)
 
 
+def _agreement_text(a: float, failed: str = "none (its simulation failed)",
+                    unexplained: bool = False) -> str:
+    """A record agreement ``a`` [-] as the rules quote it: 4 significant figures, with its
+    unexplained share ``1 - a`` where ``unexplained``; ``failed`` where it is not finite."""
+    if not np.isfinite(a):
+        return failed
+    return f"{a:.4g} (unexplained {1.0 - a:.2g})" if unexplained else f"{a:.4g}"
+
+
 def keep_sgd_rule(agree_sgd: float, agree_warm: float | None,
                   notes: tuple[str, str] = ("", "")) -> tuple[bool, str]:
     """Whether the SGD's result is kept rather than the held warm start's, and why.
@@ -394,11 +403,7 @@ class SGDSINDyBase(StructuralIdentifier):
         self.check_params()
         if search is None:
             search = self._default_search(data)
-        self.cubic_, self.cubic_rule_ = cubic_rule(
-            data, self.cubic, None, None if self.cubic is not None else search().peaks,
-            search() if self.cubic is None and self._lower_modes() else None)
-        self.learning_rate_, self.learning_rate_rule_ = learning_rate_for(self.cubic_,
-                                                                          self.learning_rate)
+        self._set_library(data, self.cubic, None, search)
         if self.eigen:
             self._peaks(data, search() if self.n_modes is None and self.freq_range is None else None)
         else:
@@ -409,6 +414,21 @@ class SGDSINDyBase(StructuralIdentifier):
             # frequency; the fitted poles are mapped back at the end (_finish_fit)
             f = warp_frequency(f, float(data.fs))
         return (2.0 * np.pi * f) ** 2, search().peaks if getattr(self, "fit_band", False) else None
+
+    def _set_library(self, data: Measurement, cubic: bool | None, cut: float | None,
+                     search: Callable[[], PeakSearch]) -> None:
+        """Set ``cubic_`` and ``cubic_rule_`` by :func:`cubic_rule` (``cubic``: the setting the
+        library is chosen by; ``cut``: the fit band's cut-off [Hz], None: by ``fit_band``, 0.0:
+        none) and the step size it takes (``learning_rate_``, ``learning_rate_rule_``,
+        :func:`learning_rate_for`); ``search``: the default peak search of ``data``, read only
+        where the library is the rule's (``cubic`` None), its lowest modes only with
+        ``lower_modes``."""
+        ps = search() if cubic is None else None  # a set library reads no peaks
+        self.cubic_, self.cubic_rule_ = cubic_rule(
+            data, cubic, cut, None if ps is None else ps.peaks,
+            ps if ps is not None and self._lower_modes() else None)
+        self.learning_rate_, self.learning_rate_rule_ = learning_rate_for(self.cubic_,
+                                                                          self.learning_rate)
 
     def _default_search(self, data: Measurement) -> Callable[[], PeakSearch]:
         """The default peak search of ``data`` (:meth:`_search`, every argument at its
@@ -496,10 +516,10 @@ class SGDSINDy(SGDSINDyBase):
         cubic force would move a frequency past its bar ("linear model").  With ``l1 =
         'cubic'`` (the default) ``True`` offers the cubic library and the data select its terms:
         the lasso may zero them, and a kept cubic whose own backbone contradicts a measured
-        decay is compared with the linear fit, the model explaining more of its record kept
-        (:meth:`_linear_if_it_explains_more`, stated in ``cubic_rule_``); ``True`` with ``l1 =
-        'none'`` keeps the cubic model asked for.  The shipped soft scenario's table, and so
-        the families' soft members, set ``True`` (with ``l1 = 'cubic'``).
+        decay is compared with the linear fit and stays only where it explains clearly more of
+        its record (:meth:`_linear_if_it_explains_more`, stated in ``cubic_rule_``); ``True``
+        with ``l1 = 'none'`` keeps the cubic model asked for.  The shipped soft scenario's
+        table, and so the families' soft members, set ``True`` (with ``l1 = 'cubic'``).
     l1 : {"cubic", "none"}
         ``"cubic"``: the lasso on the standardised cubic coefficients, then debiasing (acts
         only with ``cubic=True``); ``"none"``: no L1, the cubic block is plain least squares.
@@ -1278,11 +1298,29 @@ class SGDSINDy(SGDSINDyBase):
                                     ) -> tuple[str, dict[str, Any]]:
         """A kept cubic that contradicts a measured decay (``doubt``,
         :meth:`_cubic_contradicts_decay`) is doubted, not refused: the linear library is fitted
-        too, from the state before the fit (``begun``), and the model whose kept record
-        agreement (:func:`record_agreement`) is higher is kept, stated in ``cubic_rule_`` (a
-        candidate with an agreement beats one without, as in :func:`keep_sgd_rule`; a linear
-        refit that fails keeps the cubic).  Over the user's ``cubic = true`` too: the model
-        asked for is fitted and compared, the library chosen by its own record.
+        too, from the state before the fit (``begun``), and the cubic stays only where its kept
+        record agreement (:func:`record_agreement`) explains clearly more of the record than
+        the linear refit's (:func:`_clearly_more`: under 1 / :data:`SGD_AGREEMENT_RATIO` of its
+        unexplained share, the margin the cubic's trial fit must clear over a linear model,
+        :meth:`_cubic_if_it_explains_more`), stated in ``cubic_rule_`` (a candidate with an
+        agreement beats one without, as in :func:`keep_sgd_rule`; a linear refit that fails
+        keeps the cubic).  Where the cubic libraries' terms are the data's to select (by rule,
+        or ``cubic = true`` with ``l1 = 'cubic'``): the library chosen by its own record.
+
+        Why the margin, and on the cubic's side: the doubt is measured evidence against the
+        cubic (its own backbone contradicts the decay), so a tie goes to the model without the
+        contradicted terms; plain "higher" let 1e-3 decide (review 25e; round 20's
+        ``r20_soft__001`` at 1 %: cubic 0.997 against 0.996, now linear, modes 1-2 0.19 / 0.77
+        % off, TRAC 0.9972 -> 0.9962).  The margin on the linear's side (the linear must
+        explain clearly more) would have kept the cubic where the doubt gained: round 20's
+        ``r20_soft__007`` clean (1.57 x: modes 1-2 2.14 / 3.66 % with the cubic) and
+        ``soft_v22__018`` clean (1.15 x, mode 1 1.87 % with the cubic).  The agreements
+        compared may be of 1 and 3 start-fit iterations (:data:`FLOOR_CHECK_ITERATIONS`; one
+        is exact for the linear model, whose response is linear in its start); a cubic's
+        one-iteration unexplained share was 0.98-1.02 x its three-iteration one on six kept
+        cubic models of the gate's soft cells and 1.41 x on round 24's
+        ``b24_soft_r2p7_cf0p45_z0p2`` at 1 % (0.0085 against 0.0060): inside the 2 x margin,
+        which plain "higher" was not (measured; it leans against the cubic by at most that).
 
         Families' soft member 019 clean (``cubic = true``, the shipped soft scenario's table):
         the cubic shifts mode 1 by -0.69 Hz where its decay hardens +0.80 Hz; the cubic model
@@ -1309,21 +1347,29 @@ class SGDSINDy(SGDSINDyBase):
             return "", begun
         self.__dict__.pop("_cubic_diverged", None)
         a_linear = self._kept_agreement()
-
-        def show(a: float) -> str:
-            return f"{a:.4g}" if np.isfinite(a) else "none (its simulation failed)"
-
-        if a_linear > a_cubic or (np.isnan(a_cubic) and np.isfinite(a_linear)):
-            refused = (f"{rule}; the fitted cubic model doubted ({doubt}), the linear refit "
-                       f"explains more of its record (record agreement {show(a_linear)} "
-                       f"against {show(a_cubic)}): cubic terms out")
+        figures = (f"record agreement {_agreement_text(a_linear)} against "
+                   f"{_agreement_text(a_cubic)}")
+        # The doubted cubic stays only where it explains clearly more of its record than the
+        # linear refit (_clearly_more, the trial's margin for a cubic over a linear model):
+        # a tie (round 20's r20_soft__001 at 1 %: 0.997 against the linear's 0.996) no longer
+        # decides by 1e-3 for the model whose cubic contradicts the measured decay (review
+        # 25e); a cubic's one-iteration agreement (FLOOR_CHECK_ITERATIONS) left 0.98-1.41 x
+        # its three-iteration unexplained share on the gate's kept cubics, inside the 2 x
+        if np.isfinite(a_linear) and not (np.isfinite(a_cubic) and _clearly_more(a_cubic, a_linear)):
+            why = (f"the linear refit explains more of its record ({figures})"
+                   if not a_linear <= a_cubic else
+                   f"the cubic model does not explain clearly more of its record than the "
+                   f"linear refit (its unexplained share not under 1 / {SGD_AGREEMENT_RATIO:g} "
+                   f"of the linear's; {figures})")
+            refused = f"{rule}; the fitted cubic model doubted ({doubt}), {why}: cubic terms out"
             self.cubic_rule_ = refused
             return refused, linear_begun
         self.__dict__.clear()
         self.__dict__.update(first)
-        self.cubic_rule_ = (f"{rule}; the fitted cubic model doubted ({doubt}), but the linear "
-                            f"refit explains no more of its record (record agreement "
-                            f"{show(a_linear)} against {show(a_cubic)}): cubic kept")
+        self.cubic_rule_ = (f"{rule}; the fitted cubic model doubted ({doubt}), but it explains "
+                            f"clearly more of its record than the linear refit (the linear's "
+                            f"unexplained share over {SGD_AGREEMENT_RATIO:g} x its; {figures}): "
+                            "cubic kept")
         return "", begun
 
     def _lowest_peak_refit(self, data: Measurement, lam_hat: np.ndarray,
@@ -1376,9 +1422,7 @@ class SGDSINDy(SGDSINDyBase):
         a_flat = self._kept_agreement()
 
         def show(a: float) -> str:  # (the unexplained share where that decides: review 24e)
-            if not np.isfinite(a):
-                return "none (its simulation failed)"
-            return f"{a:.4g} (unexplained {1.0 - a:.2g})" if clear else f"{a:.4g}"
+            return _agreement_text(a, unexplained=clear)
 
         # the refit's kept model: flat, or the tilted fit with the unresolved mode placed
         # (_physical_placed keeps the tilt where the placement makes it physical)
@@ -1392,7 +1436,17 @@ class SGDSINDy(SGDSINDyBase):
         # 0.9716 flat against 0.9714, the flat model with spare modes at 14.2 and 28.3 Hz
         # between modes 1 and 2); above it families' clamped 009 clean (0.937 against 0.847,
         # 2.4 x) and held-out clamped 032 at 1 % (5.3 x; mode 2 10.2 -> 0.23 %).
-        if clear:
+        if clear and first.get("cubic_"):
+            # A cubic warm start is projected only where its growth is one the record does not
+            # resolve (_sgd_matrix.UNRESOLVED_GROWTH), and the flat fit was its fallback until
+            # then: the projected fit is kept only where it explains clearly more than the flat
+            # refit (round 24's b24_soft_r2p7_cf0p45_z0p2 at 1 %: 0.9915 against 0.779);
+            # round 24's b24_soft_L1p35_hpauto at 3 % (s156), 0.954 against the flat 0.976
+            # (1.9 x), lost issue #15's 1 % on mode 1 (2.35 %) with the projected fit kept
+            better = np.isfinite(a_flat) and not _clearly_more(a_first, a_flat)
+            more = (f"is not clearly bettered by the projected cubic one's (whose unexplained "
+                    f"share is not under 1 / {SGD_AGREEMENT_RATIO:g} of the flat's; ")
+        elif clear:
             better = _clearly_more(a_flat, a_first)
             more = (f"explains clearly more of its record than the projected tilted one's "
                     f"(its unexplained share under 1 / {SGD_AGREEMENT_RATIO:g} of the other's; ")
@@ -1408,7 +1462,10 @@ class SGDSINDy(SGDSINDyBase):
             self.__dict__.update(first)
             self.fit_tilt_rule_ += (
                 f"; {unpaired}, but the refit's {which} model "
-                + (f"does not leave under 1 / {SGD_AGREEMENT_RATIO:g} of the first's "
+                + ("explains clearly less of its record than the projected cubic one's (its "
+                   f"unexplained share over {SGD_AGREEMENT_RATIO:g} x the other's, or none)"
+                   if clear and first.get("cubic_") else
+                   f"does not leave under 1 / {SGD_AGREEMENT_RATIO:g} of the first's "
                    "unexplained share of its record" if clear
                    else "explains no more of its record")
                 + f" (record agreement {show(a_flat)} against {show(a_first)}): first fit kept")
@@ -1430,12 +1487,7 @@ class SGDSINDy(SGDSINDyBase):
             if cut is not None:  # the refit without the band, from the state _start_fit left
                 self.__dict__.clear()
                 self.__dict__.update(begun)
-                ps = search() if cubic is None else None  # a set library reads no peaks
-                self.cubic_, self.cubic_rule_ = cubic_rule(
-                    data, cubic, cut, None if ps is None else ps.peaks,
-                    ps if ps is not None and self._lower_modes() else None)
-                self.learning_rate_, self.learning_rate_rule_ = learning_rate_for(
-                    self.cubic_, self.learning_rate)
+                self._set_library(data, cubic, cut, search)
             self._fit_in_band(data, lam_hat, band_peaks, m_hat, cut, lowest_flat)
 
         # the fit band's refusal (identify._band_refusal), as ls_sindy's: round 15's aluminium
@@ -1461,7 +1513,7 @@ class SGDSINDy(SGDSINDyBase):
             a_none = self._kept_agreement()
 
             def show(a: float) -> str:
-                return f"{a:.4g}" if np.isfinite(a) else "none"
+                return _agreement_text(a, failed="none")
 
             if a_none > a_band:  # False where the fit without the band has none (NaN)
                 self.fit_band_rule_ = (

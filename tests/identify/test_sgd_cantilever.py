@@ -404,3 +404,52 @@ def test_a_users_cubic_without_the_lasso_is_never_doubted(dataset_cache, monkeyp
     assert "the fitted cubic model doubted" in SGDSINDy(cubic=True).fit(data).cubic_rule_
     asked = SGDSINDy(cubic=True, l1="none").fit(data)
     assert asked.cubic_ and asked.cubic_rule_ == "user setting"
+
+
+def test_a_cubic_tilted_warm_start_with_a_growing_pole_has_its_damping_projected(dataset_cache):
+    """Round 24's ``b24_soft_r2p7_cf0p45_z0p2`` (a 2.7 EI/L soft base, cubic fraction 0.45,
+    0.2 % damping) at 1 % noise, seed 152: the cubic came in by rule and the tilted cubic warm
+    start had mode 1's pole at +0.40 +329j 1/s (a damping ratio of -0.12 %, the 0.2 % truth's
+    sign lost to the noise).  The damping projection that repairs a linear tilted warm start
+    was not tried on a cubic one: refused, fitted flat, mode 3 at 982 Hz for the 1256 Hz peak
+    (20 % off, TRAC 0.779).  Now a cubic warm start's damping is projected too where its growth
+    is one the record does not resolve (+0.40 1/s over the 0.99 s free decay, under e-fold:
+    ``_sgd_matrix.UNRESOLVED_GROWTH``), and the projected fit kept where it explains clearly
+    more than the flat refit (record agreement 0.9915 against 0.779).  Measured TRAC 0.994,
+    modes 1-3 within 0.55 / 0.62 / 1.6 %."""
+    sc = load_scenario(ROUND16.parent / "round24" / "b24_soft_r2p7_cf0p45_z0p2.toml"
+                       ).with_noise(1.0).replace(seed=152)
+    ds = dataset_cache.get(sc)
+    data = measure(ds, sc.signal, "structural")
+    model = SGDSINDy().fit(data)
+    assert model.cubic_ and "cubic terms in" in model.cubic_rule_
+    assert "kept with its damping projected onto the positive semi-definite cone" \
+        in model.fit_tilt_rule_
+    v = score_structural(ds, data, measure(noise_free(ds), sc.signal, "structural"), model).values
+    # the round's TRAC bar 0.9 and issue #15's 0.95 (the old code: 0.779, mode 3 20 % off);
+    # mode 3 within 3 %: its peak itself lies 2.1 % above the truth (1256 against 1230 Hz)
+    assert v["trac"] >= 0.95
+    assert v["freq_error_mode3"] <= 0.03
+
+
+def test_a_doubted_cubic_stays_only_where_it_explains_clearly_more(dataset_cache):
+    """Review 25e: a cubic contradicting a measured decay was compared with the linear refit
+    by the higher record agreement alone, so a 1e-3 tie decided the library.  Round 20's
+    ``r20_soft__001`` at 1 % noise, seed 117 (``cubic = true``, the shipped soft table): the
+    cubic shifts mode 2 by +0.066 Hz where the decay softens it by 0.014 Hz; the cubic explains
+    0.997 of its record, the linear refit 0.996, and the cubic was kept.  Now the doubted cubic
+    stays only where it leaves under 1 / ``SGD_AGREEMENT_RATIO`` of the linear's unexplained
+    share (``_clearly_more``, the trial's margin for a cubic over a linear model): the linear
+    model (measured: TRAC 0.996, modes 1-2 within 0.19 / 0.77 %, issue #15's bars held)."""
+    member = {m.name: m for m in load_study(ROUND20.parent / "round20_families.toml").scenarios}[
+        "r20_soft__001"]
+    sc = member.with_noise(1.0).replace(seed=117)
+    ds = dataset_cache.get(sc)
+    data = measure(ds, sc.signal, "structural")
+    model = SGDSINDy(cubic=True).fit(data)
+    assert "the fitted cubic model doubted" in model.cubic_rule_
+    assert "the cubic model does not explain clearly more of its record" in model.cubic_rule_
+    assert not model.cubic_  # the old code: the cubic kept on 0.997 against 0.996
+    v = score_structural(ds, data, measure(noise_free(ds), sc.signal, "structural"), model).values
+    assert v["trac"] >= 0.95 and np.min([v["mac_mode1"], v["mac_mode2"]]) >= 0.95
+    assert np.max([v["freq_error_mode1"], v["freq_error_mode2"]]) <= 0.01
