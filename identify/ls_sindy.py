@@ -800,7 +800,7 @@ class LeastSquaresSINDy(StructuralIdentifier):
     def _cubic_softens(self) -> str:
         """Why the fitted cubic contradicts the measured decays ("" if it does not):
         :func:`identify._modal_damping.cubic_softens` on this model's ``M_``, ``K_``, ``K3_``
-        and ``modal_decay_`` (a thin wrapper kept while ``sgd_sindy`` calls it)."""
+        and ``modal_decay_``."""
         return cubic_softens(self.M_, self.K_, self.K3_, getattr(self, "modal_decay_", None))
 
     def _cubic_diverges(self, data: Measurement) -> str:

@@ -56,7 +56,7 @@ import numpy as np
 from identify import IDENTIFIERS
 from identify._band_refusal import fit_with_band_refusal, lowest_mode_hz
 from identify._cubic_rule import THIRD_HARMONIC_IN, cubic_rule
-from identify._modal_damping import decay_hold
+from identify._modal_damping import cubic_softens, decay_hold
 from identify._record import SIMULATION_FAILED, SIMULATION_NOT_FINITE, record_agreement
 from identify._sgd_matrix import (
     PROJECTED_DOUBT,
@@ -68,7 +68,7 @@ from identify._sgd_matrix import (
     hold_eigenvalues,
     kept_cubic,
 )
-from identify.ls_sindy import MASS_PRIOR_FIELD, LeastSquaresSINDy
+from identify.ls_sindy import MASS_PRIOR_FIELD
 from identify.structural import (
     DECAY_BACKBONE_FIELD,
     DECAY_HOLD_FIELD,
@@ -1280,7 +1280,7 @@ class SGDSINDy(SGDSINDyBase):
 
     def _cubic_contradicts_decay(self) -> str:
         """Why the kept cubic contradicts a measured backbone decay, or ``""``:
-        ``ls_sindy``'s test (:meth:`identify.ls_sindy.LeastSquaresSINDy._cubic_softens`: the
+        the beam identifiers' one test (:func:`identify._modal_damping.cubic_softens`: the
         model's own first-order backbone shift of a mode whose decay fit was taken is opposite
         to the measured chirp and at least :data:`identify._modal_damping.BACKBONE_SHARE` of
         it), on this model's ``M_``, ``K_``, ``K3_`` and ``modal_decay_``; ``""`` where the keep
@@ -1289,7 +1289,7 @@ class SGDSINDy(SGDSINDyBase):
             return ""
         if not kept_cubic(getattr(self, "K3_", None)):
             return ""
-        return LeastSquaresSINDy._cubic_softens(self)
+        return cubic_softens(self.M_, self.K_, self.K3_, getattr(self, "modal_decay_", None))
 
     def _linear_if_it_explains_more(self, data: Measurement, lam_hat: np.ndarray,
                                     band_peaks: np.ndarray | None, m_hat: float,
