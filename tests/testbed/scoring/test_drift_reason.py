@@ -297,3 +297,16 @@ def test_the_law_as_identified_is_rolled_out_only_where_the_unheld_law_meets_the
     assert set(bar_failures(sc, BARS)) == {"held free coordinate"}
     assert meets.calls == [False, True]
     assert "angle_rmse_unheld_witness" not in sc.details  # removed: nothing left to simulate
+
+
+def test_held_free_coordinate_is_not_undone_by_round_off_at_the_bar():
+    """Review 26e: the replay had to miss the bar on exactly the scored coordinates, so a
+    coordinate a hair under the bar when scored and a hair over it when replayed (0.05009 /
+    0.05011 against 0.0501) withdrew a right reason.  The replay must miss it wherever the
+    scored rollout did, within REPLAY_FACTOR of it on every coordinate."""
+    drift = -0.0014 * T**2 + 0.005 * np.sin(3.0 * T)
+    ref = run(drift).details["reference_x"]
+    cart = float(run(drift).details["angle_rmse"][0])
+    sc = held(drift, _Witness([0.01, 0.002], ref, [cart, 0.05011]))
+    sc.details["angle_rmse"] = np.array([cart, 0.05009])
+    assert set(held_failures(sc, BARS)) == {"held free coordinate"}
