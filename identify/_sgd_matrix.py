@@ -982,23 +982,27 @@ BREAKDOWN_AVERAGED_RULE = ("the SGD's steps of epoch {epoch} left a non-finite i
 #: TRAC 0.9999, flat 0.64).
 PROJECTED_DOUBT = "the projection is a repair the record did not choose"
 #: A cubic tilted warm start's growing pole is a damping the record does not resolve where it
-#: grows by less than e over the free decay (``max Re(lambda) T < 1``, ``T`` the free decay's
-#: length [s]): a decay rate finer than ``1 / T`` is below what a record of length ``T``
-#: resolves, so its sign is the noise's and projecting the damping repairs nothing measured.
-#: Round 24's ``b24_soft_r2p7_cf0p45_z0p2`` at 1 % (0.2 % damping): +0.40 1/s over 0.99 s
-#: (0.40).  Faster growth is a fit the record contradicts; projected there, families' soft
-#: 014 clean (+5.4e4 1/s) kept a projected fit of 0.785 where the flat fit's refused cubic
-#: gave 0.984, and soft 007 clean (+2.9 1/s, 1.45) and 019 clean lost issue #15's 1 %
-#: (measured): those keep the flat fit.  A linear warm start's damping is projected whatever
-#: its growth (round 7's ``b_s6``: +7122 1/s, an indefinite ``C`` on unexcited modes).
+#: grows by less than e over the fit window (``max Re(lambda) T < 1``, ``T`` the window's length
+#: [s], the free decay's by default): a decay rate finer than ``1 / T`` is below what a record of
+#: length ``T`` resolves, so its sign is the noise's and projecting the damping repairs nothing
+#: measured.  Round 24's ``b24_soft_r2p7_cf0p45_z0p2`` at 1 % (0.2 % damping): +0.40 1/s over 0.99
+#: s (0.40).  Faster growth is a fit the record contradicts; projected there, families' soft 014
+#: clean (+5.4e4 1/s) kept a projected fit of 0.785 where the flat fit's refused cubic gave
+#: 0.984, and soft 007 clean (+2.9 1/s, 1.45) and 019 clean lost issue #15's 1 % (measured):
+#: those keep the flat fit.  A linear warm start's damping is projected whatever its growth (round
+#: 7's ``b_s6``: +7122 1/s, an indefinite ``C`` on unexcited modes).
 UNRESOLVED_GROWTH = 1.0
 
 
 def growth_unresolved(M: np.ndarray, C: np.ndarray, K: np.ndarray, duration: float) -> bool:
     """Whether the fastest pole of ``M x'' + C x' + K x`` grows by less than e over
-    ``duration`` [s] (:data:`UNRESOLVED_GROWTH`); False where the poles are not finite."""
-    with np.errstate(all="ignore"):
-        poles = np.linalg.eigvals(state_matrix(M, C, K))
+    ``duration`` [s] (:data:`UNRESOLVED_GROWTH`); False where the poles cannot be computed or
+    are not finite (a singular or non-finite ``M``: review 26f)."""
+    try:
+        with np.errstate(all="ignore"):
+            poles = np.linalg.eigvals(state_matrix(M, C, K))
+    except (np.linalg.LinAlgError, ValueError):
+        return False
     if not np.all(np.isfinite(poles)):
         return False
     return bool(np.max(poles.real) * duration < UNRESOLVED_GROWTH)
@@ -1246,8 +1250,10 @@ def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
                 raise
             # a cubic warm start's damping is projected only where its growth is one the
             # record does not resolve (UNRESOLVED_GROWTH); a linear one's whatever its growth
+            # (over the fit window the warm start was fitted on: the whole free decay by
+            # default, fit_duration's where set: review 26f)
             C_psd = (psd_damping_warm_start(M0, C0, K0) if not est.cubic or growth_unresolved(
-                M0, C0, K0, (data.n_samples - data.free_start) / float(data.fs)) else None)
+                M0, C0, K0, (i1 - i0) / float(data.fs)) else None)
             unpaired = "" if C_psd is None else (lowest_peak_unpaired(M0, K0, lam_hat)
                                                  or PROJECTED_DOUBT)
             if unpaired and est.lowest_peak_flat:  # the caller's second fit: flat

@@ -1366,10 +1366,11 @@ class SGDSINDy(SGDSINDyBase):
             return refused, linear_begun
         self.__dict__.clear()
         self.__dict__.update(first)
-        self.cubic_rule_ = (f"{rule}; the fitted cubic model doubted ({doubt}), but it explains "
-                            f"clearly more of its record than the linear refit (the linear's "
-                            f"unexplained share over {SGD_AGREEMENT_RATIO:g} x its; {figures}): "
-                            "cubic kept")
+        self.cubic_rule_ = (f"{rule}; the fitted cubic model doubted ({doubt}), but " + (
+            f"it explains clearly more of its record than the linear refit (the linear's "
+            f"unexplained share over {SGD_AGREEMENT_RATIO:g} x its; {figures})"
+            if np.isfinite(a_linear) else
+            f"the linear refit has no record agreement ({figures})") + ": cubic kept")
         return "", begun
 
     def _lowest_peak_refit(self, data: Measurement, lam_hat: np.ndarray,
@@ -1385,7 +1386,11 @@ class SGDSINDy(SGDSINDyBase):
         (round 20's ``b20_soft_r1p2_cf0p3_root2`` at 1 %: 0.275 -> 0.993).  With
         :data:`identify._sgd_matrix.PROJECTED_DOUBT` (the lowest peak carried) the refit must
         leave under 1 / :data:`SGD_AGREEMENT_RATIO` of the first fit's unexplained share
-        (families' clamped 009 clean: 0.847 -> 0.937, 2.4 x).
+        (families' clamped 009 clean: 0.847 -> 0.937, 2.4 x).  A projected cubic warm start
+        (projected only where its growth is unresolved) is kept only where it explains clearly
+        more than the flat refit, whichever peaks it carries; one that leaves at most
+        :data:`PROJECTED_REFIT_FLOOR` of its record unexplained with every peak carried is kept
+        without a refit, as a linear one is.
 
         A candidate with an agreement beats one without (NaN: its simulation failed), as in
         :func:`keep_sgd_rule`; where the first fit's agreement was not measured (the keep rule
@@ -1399,6 +1404,9 @@ class SGDSINDy(SGDSINDyBase):
                                     "record agreement is measured")
             return
         clear = unpaired == PROJECTED_DOUBT
+        # (the floor holds for a projected cubic warm start too: one that leaves at most
+        # PROJECTED_REFIT_FLOOR of its record unexplained is kept without a flat refit, which
+        # could not clearly better it; review 26f)
         if clear and 1.0 - a_first <= PROJECTED_REFIT_FLOOR:
             self.fit_tilt_rule_ += (f"; {unpaired}, but the first fit leaves {1.0 - a_first:.2g} "
                                     "of its record unexplained, within "
@@ -1436,7 +1444,9 @@ class SGDSINDy(SGDSINDyBase):
         # 0.9716 flat against 0.9714, the flat model with spare modes at 14.2 and 28.3 Hz
         # between modes 1 and 2); above it families' clamped 009 clean (0.937 against 0.847,
         # 2.4 x) and held-out clamped 032 at 1 % (5.3 x; mode 2 10.2 -> 0.23 %).
-        if clear and first.get("cubic_"):
+        if first.get("cubic_"):
+            # (whether or not it carries every located peak: one that misses the lowest is
+            # doubted more, never held to a weaker test: review 26f)
             # A cubic warm start is projected only where its growth is one the record does not
             # resolve (_sgd_matrix.UNRESOLVED_GROWTH), and the flat fit was its fallback until
             # then: the projected fit is kept only where it explains clearly more than the flat
