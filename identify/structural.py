@@ -609,8 +609,8 @@ def mass_prior_value(data: Measurement, key: str) -> float:
     if key not in data.prior:
         raise IdentificationError(f"Measurement.prior has no {key!r} (has: {sorted(data.prior)}); the mass "
                          f"scale cannot be identified from free vibration without it")
-    # a Measurement admits a list of numbers as a prior (``link_lengths``); a mass scale is one
-    # number: float([0.7]) was a TypeError inside the fit (fuzz26, round 25)
+    # a mass scale is one number: float([0.7]) was a TypeError inside the fit (fuzz26, round
+    # 25); a Measurement refuses a list here too (prior_ok), a caller's own object may not
     val = prior_number(data.prior[key])
     if val is None:
         lo, hi = PRIOR_RANGE

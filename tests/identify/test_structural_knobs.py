@@ -7,14 +7,16 @@ Synthetic signals with a known answer: decaying sinusoids for the peak rules
 
 from __future__ import annotations
 
+from types import SimpleNamespace
+
 import numpy as np
 import pytest
 
 from benchmarks import bench_sgd_sindy as bench
 from identify.ls_sindy import LeastSquaresSINDy
 from identify.sgd_sindy import LR_CUBIC, LR_LINEAR, SGDSINDy
-from identify.structural import HIGHPASS_MARGIN, modal_peaks, peak_band
-from testbed.core.errors import IdentificationError
+from identify.structural import HIGHPASS_MARGIN, mass_prior_value, modal_peaks, peak_band
+from testbed.core.errors import ArgumentError, IdentificationError
 from testbed.core.measurement import Measurement
 
 FS = 2000.0
@@ -184,10 +186,13 @@ def test_a_mode_fitted_below_the_fit_band_is_fitted_again_without_it(dataset_cac
 
 @pytest.mark.parametrize("value", [[0.7], (0.7,), np.array([0.7])])
 def test_a_mass_prior_given_as_a_list_is_refused_in_one_line(value):
-    """A :class:`Measurement` admits a list of numbers as a prior (``link_lengths``); a mass
-    scale is one number.  ``float([0.7])`` was a TypeError inside the fit (fuzz26's round 25,
-    ``benchmarks.hostile25 measapi``); it is refused naming the key."""
+    """A mass scale is one number.  ``float([0.7])`` was a TypeError inside the fit (fuzz26's
+    round 25, ``benchmarks.hostile25 measapi``).  A :class:`Measurement` refuses a list for any
+    prior but ``link_lengths`` (review 26b), and ``mass_prior_value`` itself refuses it naming
+    the key, for a measurement-like object that did not pass that check."""
     data = bench.chain_measurement(bench.chain_system(coupled=False, damping="proportional"))
-    data = Measurement(**{**data.__dict__, "prior": {**data.prior, "reduced_mass_trace": value}})
+    with pytest.raises(ArgumentError, match=r"prior\['reduced_mass_trace'\]"):
+        Measurement(**{**data.__dict__, "prior": {**data.prior, "reduced_mass_trace": value}})
+    loose = SimpleNamespace(prior={"reduced_mass_trace": value})
     with pytest.raises(IdentificationError, match=r"prior 'reduced_mass_trace' must be one number"):
-        LeastSquaresSINDy().fit(data)
+        mass_prior_value(loose, "reduced_mass_trace")
