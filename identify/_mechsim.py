@@ -384,7 +384,8 @@ class ImplicitModel:
         return q, self.closure.velocity(q, dq)
 
     def simulate(self, x0: np.ndarray, xd0: np.ndarray, t: np.ndarray, u: np.ndarray | None,
-                 dt: float, input_hold: str = "linear", angles_only: bool = False) -> Trajectory:
+                 dt: float, input_hold: str = "linear", angles_only: bool = False,
+                 where: str = "ImplicitModel.simulate") -> Trajectory:
         """Free simulation by RK4 with step <= dt [s]; output at the times t (cubic Hermite).
 
         With ``angles_only`` only ``x`` is computed at the times t (the passive angles by the
@@ -401,6 +402,7 @@ class ImplicitModel:
         adds an impulse ``u(0) / (2 fs)`` at the start; on the five-bar multisine record
         (10 kHz) the exact equations then drift by 5e-4 rad over 10 s; with ``"zoh"`` they stay
         within 6e-7 rad at dt = 1 ms (8e-8 rad at 0.25 ms: what is left is RK4 sampling the input).
+        ``where`` names the caller in a refusal of ``t`` (:func:`sim_steps`).
 
         Raises
         ------
@@ -414,13 +416,13 @@ class ImplicitModel:
         """
         from scipy.interpolate import CubicHermiteSpline  # lazy: only when simulating
 
-        n_steps = sim_steps(t, dt)
+        n_steps = sim_steps(t, dt, where)
         t = np.asarray(t, dtype=float)
         h = (t[-1] - t[0]) / n_steps
         tt = t[0] + 0.5 * h * np.arange(2 * n_steps + 1)
         if input_hold not in ("linear", "zoh"):
             raise ValueError(f"input_hold must be 'linear' or 'zoh', got {input_hold!r}")
-        delay = 0.5 * (t[1] - t[0]) if input_hold == "zoh" and t.size > 1 else 0.0
+        delay = 0.5 * (t[1] - t[0]) if input_hold == "zoh" else 0.0  # (sim_steps: >= 2 times)
         uu = None if u is None else np.stack([np.interp(tt - delay, t, row) for row in np.atleast_2d(u)])
         act = self.actuated
         q, dq = self.complete(np.array(x0, float)[:, None], np.array(xd0, float)[:, None])

@@ -738,7 +738,8 @@ def modal_decay(data: Measurement, M: np.ndarray, K: np.ndarray, C: np.ndarray,
             _take(out, k, s, wd, fs if trap else None, w_model[k])
             if backbone:
                 out.chirp[k], out.amplitude[k] = c, amp
-        elif backbone and ok and paired and not free[k] and abs(c) <= BEYOND_MAX_SHIFT * wd:
+        elif ok and paired and not free[k] and abs(c) <= BEYOND_MAX_SHIFT * wd:
+            # (first_order is False only for a backbone fit)
             # a located mode's converged backbone fit beyond the first order (up to
             # BEYOND_MAX_SHIFT): not taken, its linear pole kept as a lower bound only
             # (``beyond``, :func:`beyond_limit`)

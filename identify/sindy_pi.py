@@ -170,7 +170,7 @@ from identify._implicit import (
     split_index,
     stlsq_sweep,
 )
-from identify._mechsim import CLOSURE_RTOL, ImplicitModel, LoopClosure, band_whiteness, sim_steps
+from identify._mechsim import CLOSURE_RTOL, ImplicitModel, LoopClosure, band_whiteness
 from identify._weak import check_window, held_midpoints, weak_matrix
 from identify.library import Library, fivebar_library, generic_mechanical_library
 from testbed.core.errors import IdentificationError
@@ -1595,8 +1595,8 @@ class _ImplicitMechanical(Identifier):
         steps: ArgumentError otherwise)."""
         if not hasattr(self, "model_"):
             raise IdentificationError(f"{self.name}: fit before simulate")
-        sim_steps(t, self._step(), f"{type(self).__name__}.simulate")
-        return self.model_.simulate(x0, xd0, t, u, self._step(), self.input_hold_)
+        return self.model_.simulate(x0, xd0, t, u, self._step(), self.input_hold_,
+                                    where=f"{type(self).__name__}.simulate")
 
     def equations(self, precision: int = 4) -> list[str]:
         """One line per identified implicit equation, ``0 = c1*term1 + ...``."""

@@ -275,7 +275,7 @@ class SINDyPILinear(Identifier):
         if not hasattr(self, "M_"):
             raise IdentificationError("sindy_pi_linear: fit before simulate")
         t = np.asarray(t, dtype=float)
-        if t.ndim != 1 or t.size < 2 or not np.allclose(np.diff(t), t[1] - t[0], rtol=1e-9, atol=0):
+        if t.size < 2 or not np.allclose(np.diff(t), t[1] - t[0], rtol=1e-9, atol=0):
             # one sample was numpy's IndexError and a non-uniform grid a plain ValueError
             raise ArgumentError(f"{type(self).__name__}.simulate", "t", f"{t.size} time(s)",
                                 "expected at least 2 uniformly spaced sample times [s] (the "

@@ -616,8 +616,6 @@ def mass_prior_value(data: Measurement, key: str) -> float:
         lo, hi = PRIOR_RANGE
         raise IdentificationError(f"prior {key!r} must be one number (a mass [kg]) from {lo:g} to "
                                   f"{hi:g}, got {data.prior[key]!r:.60}")
-    if not val > 0:
-        raise IdentificationError(f"prior {key!r} must be > 0 kg, got {val}")
     return val
 
 

@@ -24,7 +24,7 @@ PRIOR_RANGE = (1e-100, 1e100)
 def prior_number(value: Any) -> float | None:
     """A declared prior's value as a float if it is a finite number (not a boolean, not a
     text) within :data:`PRIOR_RANGE`, else None."""
-    x = args.finite_real(value.item() if isinstance(value, np.generic) else value)
+    x = args.finite_real(value)  # (numpy reals are numbers.Real: read 26b)
     return x if x is not None and PRIOR_RANGE[0] <= x <= PRIOR_RANGE[1] else None
 
 

@@ -1111,8 +1111,6 @@ def _check_starts(path: Path, starts: Mapping[str, float], fs: float,
                                       "give every channel a time, or none)")
 
 
-
-
 def check_prior(source: str | os.PathLike, key: str, value: Any) -> None:
     """Refuse a declared prior that is not a finite number in :data:`PRIOR_RANGE`: every prior
     an identifier reads is a size, a mass [kg] or a length [m] (given with ``--prior`` or stored

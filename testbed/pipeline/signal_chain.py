@@ -373,15 +373,14 @@ def measure(dataset: Dataset, signal_cfg: Mapping[str, Any], kind: str) -> Measu
     # the file's fs with float(); its content hash can be made anew): ZeroDivisionError,
     # TypeError or a plain ValueError from inside the filters, or 1 Hz / 100 Hz in silence
     # (hostile round 19)
+    chain = _chain(kind)
     if isinstance(dataset, Dataset):
+        _check_measured_table(dataset, chain)  # (before the table is read: read 26b)
         fs = args.real("measure", "dataset.fs", dataset.fs, low=0.0, low_open=True)
         n = max((np.shape(s.data)[-1] for s in dataset.measured.values()), default=0)
         if not math.isfinite(max(n - 1, 0) / fs):
             raise ArgumentError("measure", "dataset.fs", fs, f"a rate at which the record's {n} "
                                 "samples last a finite time (the duration overflows)")
-    chain = _chain(kind)
-    if isinstance(dataset, Dataset):
-        _check_measured_table(dataset, chain)
     cfg = validate_table(dict(signal_cfg), chain.schema, file="<signal config>", section="signal")
     m = chain.measure(dataset, cfg)
     # the kind whose chain made it, for an identifier of another kind to refuse

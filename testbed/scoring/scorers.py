@@ -1223,12 +1223,13 @@ def cubic_mode_reach(Mr: np.ndarray, Kr: np.ndarray, k3: float, cubic_map: np.nd
     if not (np.isfinite(k3) and np.all(np.isfinite(x))):
         return np.full(w2.shape, np.nan)  # no reach: the reason is withheld (review 26e)
     q0 = c @ x
-    s = 3.0 * k3 * float(np.max(q0**2, initial=0.0)) * (phi.T @ dvec) * (phi.T @ c) / w2
+    q2 = float(np.max(q0**2, initial=0.0))  # the record's largest (c . x)^2
+    s = 3.0 * k3 * q2 * (phi.T @ dvec) * (phi.T @ c) / w2
     # the tangent's own eigenvalues (review 26e: the Rayleigh quotient is first order; a
     # rank-one update moves the top mode more) and the least-squares linear stand-in of the
     # whole record on every coordinate, as the identifiers fit K (review 26e: mode by mode it
     # counted the force another mode drives as this mode's stiffness)
-    tangent = Kr + 3.0 * k3 * float(np.max(q0**2, initial=0.0)) * np.outer(dvec, c)
+    tangent = Kr + 3.0 * k3 * q2 * np.outer(dvec, c)
     force = np.outer(dvec, k3 * q0**3)  # the cubic force in sensor coordinates (m, N)
     with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
         try:
@@ -2295,6 +2296,25 @@ def sensitivity_failures(scores: Scores, thresholds: dict[str, dict[str, float]]
     return {}
 
 
+def _rollout_bar_alone(scores: Scores, thresholds: dict[str, dict[str, float]], score: str
+                       ) -> tuple[float, float, float, float] | None:
+    """``(bar, got, law, law_bar)`` where the run's rollout bar ``score`` failed at a finite
+    value, the identified law met the rig's own law bar, nothing failed earlier (fit, model,
+    simulation) and no other bar of the run was missed; else None (:func:`drift_failures`,
+    :func:`held_failures`: a reason for the rollout alone would hide another failure)."""
+    d = scores.details
+    bar = thresholds.get(score, {}).get("max")
+    got, law = scores.values.get(score), scores.values.get("law_error")
+    law_bar = (d.get("equation_bars") or {}).get("law_error", {}).get("max")
+    if (bar is None or law_bar is None or got is None or law is None
+            or not np.isfinite(got) or got <= bar or not np.isfinite(law) or law > law_bar
+            or {"fit", "model", "simulation"} & set(scores.failures)):
+        return None
+    if any(not c.passed for c in check_thresholds(scores.values, thresholds) if c.metric != score):
+        return None
+    return bar, got, law, law_bar
+
+
 def drift_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -> dict[str, str]:
     """A failed rollout bar that only a drift of coordinates the true law leaves free misses,
     under a law within the rig's law bar: ``{"drift": reason}``.
@@ -2328,16 +2348,11 @@ def drift_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -> d
         The run's bars, ``{metric: {"min"|"max": value}}``.
     """
     score, d = "angle_rmse", scores.details
-    bar = thresholds.get(score, {}).get("max")
-    got, law = scores.values.get(score), scores.values.get("law_error")
-    law_bar = (d.get("equation_bars") or {}).get("law_error", {}).get("max")
     free = d.get("free_coordinates")
-    if (free is None or bar is None or law_bar is None or got is None or law is None
-            or not np.isfinite(got) or got <= bar or not np.isfinite(law) or law > law_bar
-            or {"fit", "model", "simulation"} & set(scores.failures)):
+    found = None if free is None else _rollout_bar_alone(scores, thresholds, score)
+    if found is None:  # (another bar missed too: the drift would hide it, review 25c)
         return {}
-    if any(not c.passed for c in check_thresholds(scores.values, thresholds) if c.metric != score):
-        return {}  # another bar missed too: the drift would hide it (review 25c)
+    bar, got, law, law_bar = found
     per = np.asarray(d[score], dtype=float)
     off = np.flatnonzero(~(per <= bar))
     offs = set(off.tolist())
@@ -2510,17 +2525,11 @@ def held_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -> di
     """
     score, d = "angle_rmse", scores.details
     witness = d.pop(f"{score}{UNHELD_WITNESS}", None)  # removed here whether or not it acts
-    bar = thresholds.get(score, {}).get("max")
-    got, law = scores.values.get(score), scores.values.get("law_error")
-    law_bar = (d.get("equation_bars") or {}).get("law_error", {}).get("max")
     held = d.get("held_coordinates")
-    if (not held or bar is None or law_bar is None
-            or got is None or law is None or not np.isfinite(got) or got <= bar
-            or not np.isfinite(law) or law > law_bar
-            or {"fit", "model", "simulation"} & set(scores.failures)):
+    found = _rollout_bar_alone(scores, thresholds, score) if held else None
+    if found is None:  # (another bar missed too: the held term would hide it)
         return {}
-    if any(not c.passed for c in check_thresholds(scores.values, thresholds) if c.metric != score):
-        return {}  # another bar missed too: the held term would hide it (as drift_failures)
+    bar, got, law, law_bar = found
     per = np.asarray(d[score], dtype=float)
     off = set(np.flatnonzero(~(per <= bar)).tolist())
     if not off & set(held) or not _unheld_measured(d, score, witness):
@@ -2632,14 +2641,14 @@ def score_mechanical(dataset: Dataset, data: Measurement, clean: Measurement, mo
         # free in the truth, held by the model: its holding terms judged by held_failures
         d["held_coordinates"] = sorted(truth_free - model_free)
         if np.isfinite(v["law_error"]):  # simulated only where it can act (sensitivity_failures)
+            substeps = witness_substeps(data.fs, model_step(model))
             d[f"angle_rmse{LAW_WITNESS}"] = functools.partial(
                 law_witness, "angle_rmse", list(truth.equation_terms), truth.equation_coef,
-                x0, xd0, data, theta, witness_substeps(data.fs, model_step(model)))
+                x0, xd0, data, theta, substeps)
             if d["held_coordinates"]:
                 d[f"angle_rmse{UNHELD_WITNESS}"] = functools.partial(
                     unheld_witness, "angle_rmse", list(model.feature_names_), coef,
-                    d["held_coordinates"], x0, xd0, data, theta,
-                    witness_substeps(data.fs, model_step(model)))
+                    d["held_coordinates"], x0, xd0, data, theta, substeps)
     elif np.shape(truth.equation_coef)[0] == np.shape(theta)[0]:
         # an open chain whose identified set has another number of equations: no law to solve
         v["law_error"] = float("nan")
