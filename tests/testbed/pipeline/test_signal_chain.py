@@ -44,7 +44,12 @@ def test_a_real_rate_of_any_numeric_type_is_measured(fs):
                        r"\(the dynamical chain reads x, "),
     (lambda x, dx: {"x/y": x, "dx": dx}, r"argument 'dataset\.measured': a signal named 'x/y': "
                                          r"expected signal names without '/'"),
-], ids=["bare-array", "empty-table", "x/y"])
+    # the read of session 26: the table was read (for the record's length) before its check, so
+    # a table that is no mapping, or a list for a Signal, was still an AttributeError
+    (lambda x, dx: np.zeros((2, 400)), r"argument 'dataset\.measured': array of shape \(2, 400\)"),
+    (lambda x, dx: {"x": [0.0, 1.0], "dx": dx}, r"argument 'dataset\.measured\['x'\]': a list: "
+                                                r"expected a Signal"),
+], ids=["bare-array", "empty-table", "x/y", "not-a-mapping", "list"])
 def test_a_measured_table_no_chain_can_read_is_refused_in_one_line(measured, words):
     ds = _kinetics(100.0)
     bad = Dataset(ds.fs, measured(ds.measured["x"], ds.measured["dx"]))
