@@ -1602,7 +1602,7 @@ def beyond_limit(dec: ModalDecay, duration_s: float) -> np.ndarray:
     p = np.asarray(dec.beyond, dtype=complex)
     with np.errstate(invalid="ignore", over="ignore"):
         read = np.isfinite(p) & (np.exp(2.0 * p.real * duration_s) <= BACKBONE_MIN_FALL)
-    return np.where(read, np.abs(np.where(read, p, 0.0)) / (2.0 * np.pi), np.nan)
+    return np.where(read, np.abs(p) / (2.0 * np.pi), np.nan)
 
 
 def backbone_shift(M: np.ndarray, K: np.ndarray, K3: np.ndarray, dec: ModalDecay) -> np.ndarray:

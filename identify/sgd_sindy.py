@@ -1355,7 +1355,7 @@ class SGDSINDy(SGDSINDyBase):
         # decides by 1e-3 for the model whose cubic contradicts the measured decay (review
         # 25e); a cubic's one-iteration agreement (FLOOR_CHECK_ITERATIONS) left 0.98-1.41 x
         # its three-iteration unexplained share on the gate's kept cubics, inside the 2 x
-        if np.isfinite(a_linear) and not (np.isfinite(a_cubic) and _clearly_more(a_cubic, a_linear)):
+        if np.isfinite(a_linear) and not _clearly_more(a_cubic, a_linear):
             why = (f"the linear refit explains more of its record ({figures})"
                    if not a_linear <= a_cubic else
                    f"the cubic model does not explain clearly more of its record than the "
@@ -1430,7 +1430,7 @@ class SGDSINDy(SGDSINDyBase):
         a_flat = self._kept_agreement()
 
         def show(a: float) -> str:  # (the unexplained share where that decides: review 24e)
-            return _agreement_text(a, unexplained=clear)
+            return _agreement_text(a, unexplained=clear or bool(first.get("cubic_")))
 
         # the refit's kept model: flat, or the tilted fit with the unresolved mode placed
         # (_physical_placed keeps the tilt where the placement makes it physical)
@@ -1474,7 +1474,7 @@ class SGDSINDy(SGDSINDyBase):
                 f"; {unpaired}, but the refit's {which} model "
                 + ("explains clearly less of its record than the projected cubic one's (its "
                    f"unexplained share over {SGD_AGREEMENT_RATIO:g} x the other's, or none)"
-                   if clear and first.get("cubic_") else
+                   if first.get("cubic_") else
                    f"does not leave under 1 / {SGD_AGREEMENT_RATIO:g} of the first's "
                    "unexplained share of its record" if clear
                    else "explains no more of its record")

@@ -23,7 +23,9 @@ PRIOR_RANGE = (1e-100, 1e100)
 
 def prior_number(value: Any) -> float | None:
     """A declared prior's value as a float if it is a finite number (not a boolean, not a
-    text) within :data:`PRIOR_RANGE`, else None."""
+    text; a 0-d array's number too) within :data:`PRIOR_RANGE`, else None."""
+    if isinstance(value, np.ndarray) and value.ndim == 0:
+        value = value.item()
     x = args.finite_real(value)  # (numpy reals are numbers.Real: read 26b)
     return x if x is not None and PRIOR_RANGE[0] <= x <= PRIOR_RANGE[1] else None
 
@@ -34,11 +36,9 @@ LIST_PRIORS = frozenset({"link_lengths"})
 
 
 def prior_ok(key: str, value: Any) -> bool:
-    """A number :func:`prior_number` takes (a 0-d array's too), or for a key of
-    :data:`LIST_PRIORS` a non-empty flat list, tuple or 1-D array of them (review 26b: a
-    ``total_mass`` of ``[0.7]`` was taken and a TypeError inside the fit)."""
-    if isinstance(value, np.ndarray) and value.ndim == 0:
-        value = value.item()
+    """A number :func:`prior_number` takes, or for a key of :data:`LIST_PRIORS` a non-empty
+    flat list, tuple or 1-D array of them (review 26b: a ``total_mass`` of ``[0.7]`` was taken
+    and a TypeError inside the fit)."""
     if key in LIST_PRIORS and (isinstance(value, (list, tuple))
                                or (isinstance(value, np.ndarray) and value.ndim == 1)):
         return len(value) > 0 and all(prior_number(v) is not None for v in value)

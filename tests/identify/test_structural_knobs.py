@@ -196,3 +196,9 @@ def test_a_mass_prior_given_as_a_list_is_refused_in_one_line(value):
     loose = SimpleNamespace(prior={"reduced_mass_trace": value})
     with pytest.raises(IdentificationError, match=r"prior 'reduced_mass_trace' must be one number"):
         mass_prior_value(loose, "reduced_mass_trace")
+
+
+def test_a_mass_prior_given_as_a_0d_array_is_its_number():
+    """The Measurement takes a 0-d array as a prior's number; the fit's mass prior read refused
+    it after the one-number check (the read of sessions 25-26): one rule, ``prior_number``."""
+    assert mass_prior_value(SimpleNamespace(prior={"total_mass": np.array(0.7)}), "total_mass") == 0.7
