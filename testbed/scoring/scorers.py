@@ -143,7 +143,9 @@ class Scores:
         (a rollout below a state's declared lower bound: :func:`bound_failures`), ``"cubic"`` (a
         failed bar of a linear model on a truth whose cubic force is not small:
         :func:`linear_model_failures`), ``"drift"`` (a failed rollout bar missed only by the
-        drift of coordinates the true law leaves free: :func:`drift_failures`).  Empty for a
+        drift of coordinates the true law leaves free: :func:`drift_failures`), ``"held free
+        coordinate"`` (a failed rollout bar the identified law would meet without the terms
+        holding a coordinate the true law leaves free: :func:`held_failures`).  Empty for a
         physically admissible model whose simulation ran.
     """
 
@@ -2260,14 +2262,10 @@ def sensitivity_failures(scores: Scores, thresholds: dict[str, dict[str, float]]
     score = "angle_rmse"
     witness = scores.details.pop(f"{score}{LAW_WITNESS}", None)
     done = f"{score}_true_law" in scores.details  # measured by an earlier call
-    bar = thresholds.get(score, {}).get("max")
-    got = scores.values.get(score)
-    law = scores.values.get("law_error")
-    law_bar = (scores.details.get("equation_bars") or {}).get("law_error", {}).get("max")
-    if ((witness is None and not done) or bar is None or law_bar is None or got is None
-            or law is None or not np.isfinite(got) or got <= bar or not np.isfinite(law)
-            or law > law_bar):
+    found = _rollout_failed_within_law(scores, thresholds, score)
+    if found is None or (witness is None and not done):
         return {}
+    bar, got, law, law_bar = found
     if not done:
         scores.details.update(witness(min(law, SENSITIVE_LAW_SHARE * law_bar), bar))
     exact, off = scores.details[f"{score}_true_law"], scores.details[f"{score}_law_off"]
@@ -2296,23 +2294,31 @@ def sensitivity_failures(scores: Scores, thresholds: dict[str, dict[str, float]]
     return {}
 
 
-def _rollout_bar_alone(scores: Scores, thresholds: dict[str, dict[str, float]], score: str
-                       ) -> tuple[float, float, float, float] | None:
+def _rollout_failed_within_law(scores: Scores, thresholds: dict[str, dict[str, float]],
+                               score: str) -> tuple[float, float, float, float] | None:
     """``(bar, got, law, law_bar)`` where the run's rollout bar ``score`` failed at a finite
-    value, the identified law met the rig's own law bar, nothing failed earlier (fit, model,
-    simulation) and no other bar of the run was missed; else None (:func:`drift_failures`,
-    :func:`held_failures`: a reason for the rollout alone would hide another failure)."""
-    d = scores.details
+    value and the identified law met the rig's own law bar; else None."""
     bar = thresholds.get(score, {}).get("max")
     got, law = scores.values.get(score), scores.values.get("law_error")
-    law_bar = (d.get("equation_bars") or {}).get("law_error", {}).get("max")
+    law_bar = (scores.details.get("equation_bars") or {}).get("law_error", {}).get("max")
     if (bar is None or law_bar is None or got is None or law is None
-            or not np.isfinite(got) or got <= bar or not np.isfinite(law) or law > law_bar
-            or {"fit", "model", "simulation"} & set(scores.failures)):
+            or not np.isfinite(got) or got <= bar or not np.isfinite(law) or law > law_bar):
+        return None
+    return bar, got, law, law_bar
+
+
+def _rollout_bar_alone(scores: Scores, thresholds: dict[str, dict[str, float]], score: str
+                       ) -> tuple[float, float, float, float] | None:
+    """:func:`_rollout_failed_within_law`'s figures where besides nothing failed earlier (fit,
+    model, simulation) and no other bar of the run was missed; else None
+    (:func:`drift_failures`, :func:`held_failures`: a reason for the rollout alone would hide
+    another failure)."""
+    found = _rollout_failed_within_law(scores, thresholds, score)
+    if found is None or {"fit", "model", "simulation"} & set(scores.failures):
         return None
     if any(not c.passed for c in check_thresholds(scores.values, thresholds) if c.metric != score):
         return None
-    return bar, got, law, law_bar
+    return found
 
 
 def drift_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -> dict[str, str]:
@@ -2374,11 +2380,11 @@ def drift_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -> d
         # held by the identified law alone (review 25c): a drift only where the same law without
         # its holding terms misses the bar there too, by a drift as well (the hold neither
         # causes nor cures it; where it alone misses the bar, held_failures says so)
-        if not _unheld_measured(d, score):
+        if not _witnessed(d, f"{score}_unheld", d.get(f"{score}{UNHELD_WITNESS}")):
             return {}
         unheld = np.asarray(d[f"{score}_unheld"], dtype=float)
         ux = np.asarray(d[f"{score}_unheld_x"], dtype=float)
-        if not (np.all(unheld[held_off] > bar) and np.all(np.isfinite(ux))):
+        if not np.all(unheld[held_off] > bar):  # (a non-finite rollout scores NaN everywhere)
             return {}
         about_u = _drift_about(t, ux[held_off] - ref[held_off], bar)
         if about_u is None:
@@ -2415,15 +2421,14 @@ def _drift_about(t: np.ndarray, err: np.ndarray, bar: float) -> np.ndarray | Non
     return about if np.all(about <= bar) and np.all(drift >= about) else None
 
 
-def _unheld_measured(d: dict[str, Any], score: str, witness: Any = None) -> bool:
-    """Whether ``d`` holds :func:`unheld_witness`'s scores of the law without its holding
-    terms, simulating its callable (in ``d``, or ``witness`` where :func:`held_failures`
-    removed it) the first time they are asked for."""
-    witness = d.get(f"{score}{UNHELD_WITNESS}") or witness
-    if f"{score}_unheld" not in d:
+def _witnessed(d: dict[str, Any], key: str, witness: Any, **kw: Any) -> bool:
+    """Whether ``d`` holds ``key``, simulating ``witness(**kw)`` (:func:`unheld_witness`'s
+    callable) the first time it is asked for; False where it is missing and no witness is
+    given."""
+    if key not in d:
         if witness is None:
             return False
-        d.update(witness())
+        d.update(witness(**kw))
     return True
 
 
@@ -2532,23 +2537,20 @@ def held_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -> di
     bar, got, law, law_bar = found
     per = np.asarray(d[score], dtype=float)
     off = set(np.flatnonzero(~(per <= bar)).tolist())
-    if not off & set(held) or not _unheld_measured(d, score, witness):
+    if not off & set(held) or not _witnessed(d, f"{score}_unheld", witness):
         return {}
     unheld = np.asarray(d[f"{score}_unheld"], dtype=float)
     if not np.all(unheld <= bar):  # the unheld law must meet the bar everywhere (NaN does not)
         return {}
-    if f"{score}_as_identified" not in d:
-        if witness is None:
-            return {}
-        d.update(witness(as_identified=True))
+    if not _witnessed(d, f"{score}_as_identified", witness, as_identified=True):
+        return {}
     ident = np.asarray(d[f"{score}_as_identified"], dtype=float)
     # the scorer's RK4 must replay the scored failure: missing the bar on every coordinate the
     # scored rollout missed it on (review 26d; not the same set, which round-off at the bar
     # flips: review 26e) and within REPLAY_FACTOR of the scored error on each coordinate
     with np.errstate(divide="ignore", invalid="ignore"):
         near = np.abs(np.log(ident / per)) <= np.log(REPLAY_FACTOR)
-    if not (np.all(np.isfinite(ident)) and np.all(near)
-            and off <= set(np.flatnonzero(~(ident <= bar)).tolist())):
+    if not (np.all(near) and off <= set(np.flatnonzero(~(ident <= bar)).tolist())):
         return {}
     ch = list(d.get("channels") or [f"q{k + 1}" for k in range(per.size)])
     coords = ", ".join(ch[k] for k in sorted(held))
