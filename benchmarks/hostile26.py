@@ -61,6 +61,15 @@ Families (what rounds 1-25 did not try; their families are listed in ``hostile21
     list of names) round-tripped.  A raw exception, or a file written that its own load refuses
     or reads back to another content hash, is a finding.
 
+``samefile``
+    Every command's output aimed at its own input: ``export`` / ``identify`` of a dataset, a
+    SEP-005 file and a CSV written over that file, ``generate`` over its scenario file, ``sweep
+    --results`` over its study file, ``family write -o`` at the study file, ``report -o`` at
+    the results file, ``run --out`` at the scenario file; each path as given, through
+    ``dir/../``, through a symbolic link and through a hard link.  A traceback, more than one
+    error line, or an input file whose bytes changed, is a finding (a hard link's name
+    replaced by the new file, its input's bytes kept, is not).
+
 Prints one line a finding and the counts; exits 1 if any finding.
 """
 
@@ -723,6 +732,106 @@ def dssave_cases(work: Path) -> list[tuple[str, object]]:
     return [(f"dssave {label}", case(label, expect, **kw)) for label, expect, kw in table]
 
 
+# ------------------------------------------------------------------ samefile
+
+def samefile_cases(work: Path) -> list[tuple[str, object]]:
+    import hashlib
+
+    from testbed.pipeline.scenario import SCENARIO_DIR
+
+    state: dict = {}
+
+    def inputs() -> dict[str, Path]:
+        """The inputs, made once: a dataset, its SEP-005 export, a CSV, a scenario file, a study
+        file and a finished sweep's results."""
+        if not state:
+            data = _generated(work, MM)
+            sep = work / "mm.json"
+            cli_inprocess(["export", str(data), "--format", "sep005", "-o", str(sep)])
+            csv = work / "mm.csv"
+            ds = json.loads(sep.read_text())
+            x = next(c for c in ds if c["name"] == "x/x")
+            dx = next(c for c in ds if c["name"] == "dx/dx")
+            rows = [f"{k / x['fs']!r},{a!r},{b!r}" for k, (a, b) in enumerate(zip(x["data"], dx["data"],
+                                                                                 strict=True))]
+            csv.write_text("t [s],x [mM],dx [mM/s]\n" + "\n".join(rows) + "\n")
+            folder = work / "local"
+            folder.mkdir(exist_ok=True)
+            scen = folder / f"{MM}.toml"
+            shutil.copy(SCENARIO_DIR / f"{MM}.toml", scen)
+            study = folder / "st.toml"
+            study.write_text(f'[study]\nname = "st"\nscenarios = ["{MM}"]\nnoise = [0.0]\n'
+                             'seeds = [0]\nidentifiers = ["sindy_pi_dynamical"]\n')
+            results = work / "st.parquet"
+            status, _, err = cli_inprocess(["sweep", str(study), "--results", str(results),
+                                            "--jobs", "1"])
+            if status not in (0, 1):
+                raise RuntimeError(f"sweep: {err[-300:]}")
+            state.update(data=data, sep=sep, csv=csv, scen=scen, study=study, results=results)
+        return state
+
+    def digest(p: Path) -> str:
+        return hashlib.sha256(p.read_bytes()).hexdigest()
+
+    def spelled(path: Path, how: str, label: str) -> str:
+        if how == "as given":
+            return str(path)
+        if how == "through dir/../":
+            sub = path.parent / "sub"
+            sub.mkdir(exist_ok=True)
+            return str(sub / ".." / path.name)
+        link = work / f"{_safe(label)}{path.suffix}"
+        if link.exists() or link.is_symlink():
+            link.unlink()
+        if how == "through a symbolic link":
+            link.symlink_to(path)
+        else:
+            os.link(path, link)
+        return str(link)
+
+    commands = {
+        "export a dataset over itself": ("data", lambda i, o: ["export", str(i["data"]), "--format",
+                                                               "uff", "-o", o]),
+        "identify a dataset over itself": ("data", lambda i, o: ["identify", str(i["data"]),
+                                                                 "--scenario", MM, "-o", o]),
+        "identify a SEP-005 file over itself": ("sep", lambda i, o: ["identify", str(i["sep"]),
+                                                                     "--scenario", MM, "-o", o]),
+        "identify a CSV file over itself": ("csv", lambda i, o: ["identify", str(i["csv"]),
+                                                                 "--scenario", MM, "-o", o]),
+        "generate over its scenario file": ("scen", lambda i, o: ["generate", str(i["scen"]),
+                                                                  "-o", o]),
+        "sweep --results over its study file": ("study", lambda i, o: ["sweep", str(i["study"]),
+                                                                        "--results", o]),
+        "family write -o at its study file": ("study", lambda i, o: ["family", "write",
+                                                                     str(i["study"]), "-o", o]),
+        "report -o at its results file": ("results", lambda i, o: ["report", str(i["results"]),
+                                                                   "-o", o]),
+        "run --out at its scenario file": ("scen", lambda i, o: ["run", str(i["scen"]), "--out", o,
+                                                                 "--no-figures"]),
+    }
+
+    def case(label: str, key: str, argv, how: str):
+        def run():
+            i = inputs()
+            before = {k: digest(p) for k, p in i.items()}
+            target = spelled(i[key], how, label)
+            status, out, err = cli_inprocess(argv(i, target))
+            found = judged(status, out, err)
+            if found:
+                return found
+            changed = [k for k, p in i.items() if digest(p) != before[k]]
+            if changed:
+                return f"status {status}: the input {changed} changed"
+            if how != "through a hard link" and status == 0:
+                return f"status 0 writing over the input: {out.strip()[-160:]!r}"
+            return None
+        return run
+
+    hows = ("as given", "through dir/../", "through a symbolic link", "through a hard link")
+    return [(f"samefile {label} {how}", case(f"{label} {how}", key, argv, how))
+            for label, (key, argv) in commands.items() for how in hows]
+
+
 # ------------------------------------------------------------------ main
 
 FAMILIES = _hostile.families(
@@ -734,6 +843,7 @@ FAMILIES = _hostile.families(
         "studyvals": studyvals_cases,
         "textenc": textenc_cases,
         "dssave": dssave_cases,
+        "samefile": samefile_cases,
     },
     TIMEOUT_S,
 )
