@@ -127,7 +127,7 @@ class Signal:
         where = "Signal"
         data = self.data
         if (isinstance(data, np.ndarray) and data.ndim == 1) or (
-                isinstance(data, (list, tuple)) and not any(np.ndim(v) for v in data)):
+                isinstance(data, (list, tuple)) and _flat(data)):
             data = data[None, :] if isinstance(data, np.ndarray) else [list(data)]
         # C order always: a reduction over a row (e.g. the noise's RMS) then sums in one fixed
         # order whether the array came from a rig (often a transposed view) or from a file
@@ -522,6 +522,14 @@ class Dataset:
 
 #: Attributes of a dataset file's root that :meth:`Dataset.save` writes itself.
 _FILE_ATTRS = ("format", "fs", "fs_unit", "json_attrs")
+
+
+def _flat(v: list | tuple) -> bool:
+    """Whether a list is one flat row of values (a ragged one is not: ``args.array`` names it)."""
+    try:
+        return np.ndim(v) == 1
+    except (ValueError, TypeError):
+        return False
 
 
 def _shaped(v: Any) -> bool:
