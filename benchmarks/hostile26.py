@@ -47,7 +47,8 @@ Families (what rounds 1-25 did not try; their families are listed in ``hostile21
     UTF-16 with its byte-order mark, UTF-32, old Mac line ends (CR only), a DOS end-of-file
     (Ctrl-Z), a form feed or a line separator (U+2028) inside a row, a Latin-1 unit, a unit
     nobody knows, numbers with digit underscores, in Arabic-Indic or full-width digits; the
-    SEP-005 export as UTF-16, with CRLF and with a key in full-width letters.  ``testbed
+    SEP-005 export as UTF-16, with CRLF and with a key in full-width letters; the stiff beam's
+    UFF export rewritten in ASCII UFF58 with CRLF, CR, a BOM, a BOM and CRLF.  ``testbed
     identify``.  A traceback, anything but one refusal line, or a file read to another model
     than the clean one's (numbers of another script read as ours included), is a finding.
 
@@ -94,6 +95,7 @@ ROOT = Path(__file__).resolve().parent.parent
 TIMEOUT_S = 240
 MM = hostile19.MM
 CARTPOLE = "cartpole"
+LAB = "cantilever_stiff_impact_lab"
 
 cli_inprocess = _hostile.cli_inprocess
 judged = _hostile.judged
@@ -653,6 +655,61 @@ def textenc_cases(work: Path) -> list[tuple[str, object]]:
                 raise RuntimeError(f"export: {err[-300:]}")
         return out
 
+    def uff_ascii() -> tuple[Path, list[str]]:
+        """The stiff beam's lab record exported as UFF and rewritten with ASCII UFF58 records
+        (the export writes binary 58b ones, whose data bytes a line-end edit would change), and
+        the prior the export printed."""
+        import pyuff
+
+        out = work / "lab_ascii.uff"
+        if "uff prior" not in state:
+            src = work / "lab.uff"
+            status, stdout, err = cli_inprocess(["export", str(_generated(work, LAB)), "--format",
+                                                 "uff", "-o", str(src)])
+            if status != 0:
+                raise RuntimeError(f"export: {err[-300:]}")
+            sets = pyuff.UFF(str(src)).read_sets()
+            for r in sets if isinstance(sets, list) else [sets]:
+                if r.get("type") == 58:
+                    r["binary"] = 0
+            out.unlink(missing_ok=True)
+            pyuff.UFF(str(out)).write_sets(sets, mode="add")
+            state["uff prior"] = [x for a in (stdout + err).split() if "=" in a and not a.startswith("-")
+                                  for x in ("--prior", a)]
+        return out, state["uff prior"]
+
+    def uff_case(label: str, edit, expect: str):
+        def run():
+            src, prior = uff_ascii()
+            beam = ["--kind", "structural", "--method", "ls_sindy", *prior]
+            clean_out = Path(f"{src}.model.json")
+            if not clean_out.exists():
+                found = judged(*cli_inprocess(["identify", str(src), "-o", str(clean_out), *beam]))
+                if found:
+                    raise RuntimeError(f"clean UFF: {found}")
+            path = work / f"{_safe(label)}.uff"
+            path.write_bytes(edit(src.read_bytes()))
+            status, out, err = cli_inprocess(["identify", str(path), "-o", f"{path}.model.json", *beam])
+            found = judged(status, out, err)
+            if found:
+                return found
+            if status == 0 and not _same(_model(Path(f"{path}.model.json")), _model(clean_out), 1e-9):
+                return "read to another model than the clean file's"
+            if expect == "same" and status == 2:
+                return f"refused an equivalent file: {err.strip()[:200]!r}"
+            return None
+        return run
+
+    bom = b"\xef\xbb\xbf"
+    cases += [
+        ("textenc UFF58 ASCII with CRLF (accepted)",
+         uff_case("uff crlf", lambda d: d.replace(b"\n", b"\r\n"), "same")),
+        ("textenc UFF58 ASCII with CR line ends (accepted)",
+         uff_case("uff cr", lambda d: d.replace(b"\n", b"\r"), "same")),
+        ("textenc UFF58 ASCII with a BOM", uff_case("uff bom", lambda d: bom + d, "any")),
+        ("textenc UFF58 ASCII with a BOM and CRLF",
+         uff_case("uff bom crlf", lambda d: bom + d.replace(b"\n", b"\r\n"), "any")),
+    ]
     cases += [
         ("textenc SEP-005 as UTF-16", case("sep utf16",
                                            lambda: sep_export().read_text().encode("utf-16"),
