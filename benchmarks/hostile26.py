@@ -28,8 +28,9 @@ Families (what rounds 1-25 did not try; their families are listed in ``hostile21
     is a finding.
 ``simargs``
     A fitted model's ``simulate`` (``sindy_pi_dynamical`` on the kinetics, ``sindy_pi`` on the
-    cart-pole) given ``x0`` and ``t`` of those kinds, and ``t`` reversed, with a repeated time,
-    non-monotonic, 2-D, starting at -1 s (accepted), of integers (accepted).  A raw exception,
+    cart-pole, ``ls_sindy`` on the stiff beam) given ``x0`` and ``t`` of those kinds, and ``t``
+    reversed, with a repeated time, non-monotonic, 2-D, starting at -1 s (accepted), of
+    integers (accepted).  A raw exception,
     a non-finite trajectory returned, or a time grid that is no grid taken, is a finding.
 ``tomlvals``
     Every scalar key of four shipped scenarios (one per rig) given each value of one table: a
@@ -96,6 +97,7 @@ TIMEOUT_S = 240
 MM = hostile19.MM
 CARTPOLE = "cartpole"
 LAB = "cantilever_stiff_impact_lab"
+LSQ = "cantilever_stiff_impact_lsq"
 
 cli_inprocess = _hostile.cli_inprocess
 judged = _hostile.judged
@@ -356,10 +358,9 @@ def simargs_cases(work: Path) -> list[tuple[str, object]]:
             xx = m.x[:, 0].copy() if x0 is None else x0(m.x[:, 0].copy())
             nt = np.size(tt) if np.ndim(tt) == 1 else 20
             u = None if m.u is None else np.zeros((m.u.shape[0], nt))
-            xd = np.zeros(n) if scenario == CARTPOLE else None
+            xd = None if scenario == MM else np.zeros(n)  # (a dynamical model has no rates)
             try:
-                out = model.simulate(xx, xd, tt, u) if scenario == CARTPOLE else \
-                    model.simulate(xx, None, tt, u)
+                out = model.simulate(xx, xd, tt, u)
             except Exception as e:
                 found = _one_line_refusal(e)
                 if found:
@@ -374,7 +375,7 @@ def simargs_cases(work: Path) -> list[tuple[str, object]]:
         return run
 
     cases = []
-    for scenario in (MM, CARTPOLE):
+    for scenario in (MM, CARTPOLE, LSQ):
         x0s = {
             "x0 of integers (accepted)": (lambda x: np.round(x).astype(int), "any"),
             "x0 a list (accepted)": (lambda x: x.tolist(), "any"),
