@@ -14,7 +14,8 @@ drawn: a short thin copper strip (0.25 m x 6 mm at 25.6 kHz on 0.5 s), stainless
 magnesium 2 m x 20 mm in 30 segments at 6.4 kHz under 'auto' (5 s, the hammer at 0.5 s), a thick bronze
 bar (20 mm) at 25.6 kHz on 0.5 s, thin stainless (4 mm) read by two sensors on 2 s, molybdenum 0.45 m read
 by five uneven sensors and hit at the one at 0.8 L; the clamped beam read by seven uneven sensors under 2 N
-hit at the one at 0.6 L at 25.6 kHz, under 3 kN at 0.1 % damping hit at 0.5 L (read at 0.25 / 0.5 / 1 L), at 3 % damping at 6.4 kHz on 0.25 s; soft bases
+hit at the one at 0.6 L at 25.6 kHz, under 3 kN at 0.1 % damping hit at 0.5 L (read at 0.25 / 0.5 / 1 L),
+at 3 % damping at 6.4 kHz on 0.25 s; soft bases
 at 0.35 EI/L (cubic fraction 0.01, 0.3 % damping, 2 s), 0.75 (0.8, two sensors, hit at the inner one), 1.3
 (0.25, five uneven sensors, hit at the one at 0.55 L), 3 (0.05 under 2 kN at 25.6 kHz on 0.5 s), 5 (0.5 under
 5 N), 6 EI/L (0.3 at 6.4 kHz), copper 0.5 m on 2 EI/L (0.7), stainless on 1.2 EI/L (0.35) on a 0.25 s
@@ -63,7 +64,8 @@ _HIT055 = {"location": _S5U[2]}
 _S2_05 = sensors((0.5, 1.0))
 _HIT05 = {"location": _S2_05[0]}
 _CU05 = {**CU, "length": 0.5, "n_segments": 14, "sensors": sensors((1 / 3, 2 / 3, 1.0), 0.5)}
-_F2, _F5, _F2K, _F3K = {"peak_force": 2.0}, {"peak_force": 5.0}, {"peak_force": 2000.0}, {"peak_force": 3000.0}
+_F2, _F5 = {"peak_force": 2.0}, {"peak_force": 5.0}
+_F2K, _F3K = {"peak_force": 2000.0}, {"peak_force": 3000.0}
 _FAST, _SLOW = {"sample_rate": 25600.0}, {"sample_rate": 6400.0}
 _HP = {"highpass_hz": "auto"}
 
@@ -77,7 +79,8 @@ CASES: dict[str, tuple[str, dict, dict, dict, dict]] = {
                            {**_HP}),
     "b26_mg_L2_t20_fs6k4_hpauto": ("magnesium 2 m x 30 x 20 mm in 30 segments (mode 1 near 4 Hz), sensors "
                                    "0.3 / 0.65 / 1 L, at 6.4 kHz under the high-pass 'auto', the hammer at "
-                                   "0.5 s, 5 s", {**_MG2}, {"duration": 5.0, **_SLOW}, {"start": 0.5}, {**_HP}),
+                                   "0.5 s, 5 s", {**_MG2}, {"duration": 5.0, **_SLOW}, {"start": 0.5},
+                                   {**_HP}),
     "b26_bz_t20_fs25k6": ("phosphor bronze in the shipped length, 20 mm thick (mode 1 near 113 Hz), at 25.6 "
                           "kHz on 0.5 s", {**_BZ_THICK}, {"duration": 0.5, **_FAST}, {}, {}),
     "b26_ss_t4_s2_2s": ("stainless steel 4 mm thin (mode 1 near 32 Hz) read by two sensors at 0.4 / 1 L, 2 s",
@@ -86,23 +89,28 @@ CASES: dict[str, tuple[str, dict, dict, dict, dict]] = {
                                  "/ 0.8 / 1 L, hit at the sensor at 0.8 L", {**_MO045}, {}, {**_HIT_MO},
                                  {}),
     # the clamped beam: seven uneven sensors, a hard hit, heavy damping on a short record
-    "b26_st_s7u_f2_hit0p6_fs25k6": ("the shipped beam read by seven sensors at 0.1 / 0.2 / 0.35 / 0.5 / 0.6 / "
-                              "0.85 / 1 L, a 2 N hit at the sensor at 0.6 L, at 25.6 kHz", {"sensors": _S7U}, {**_FAST},
+    "b26_st_s7u_f2_hit0p6_fs25k6": ("the shipped beam read by seven sensors at 0.1 / 0.2 / 0.35 / 0.5 / "
+                                    "0.6 / 0.85 / 1 L, a 2 N hit at the sensor at 0.6 L, at 25.6 kHz",
+                                    {"sensors": _S7U}, {**_FAST},
                               {**_F2, **_HIT06}, {}),
     "b26_st_f3k_z0p1_hit0p5": ("the shipped beam at 0.1 % damping read at 0.25 / 0.5 / 1 L, a 3 kN hit at "
                                "0.5 L", {"damping_ratio": 0.001, "sensors": _S3H}, {},
                                {**_F3K, "location": _S3H[1]}, {}),
-    "b26_st_z3_fs6k4_0p25s": ("the shipped beam at 3 % damping, at 6.4 kHz on 0.25 s", {"damping_ratio": 0.03},
+    "b26_st_z3_fs6k4_0p25s": ("the shipped beam at 3 % damping, at 6.4 kHz on 0.25 s",
+                              {"damping_ratio": 0.03},
                               {"duration": 0.25, **_SLOW}, {}, {}),
     # soft bases between and beyond the drawn ones
     "b26_soft_r0p35_cf0p01_z0p3_2s": ("the shipped beam on k1 = 0.35 EI/L, cubic fraction 0.01, 0.3 % "
                                       "damping, 2 s", {**soft(0.35, 0.01, {}), "damping_ratio": 0.003},
                                       {"duration": 2.0}, {}, {}),
-    "b26_soft_r0p75_cf0p8_s2_hit0p5": ("the shipped beam on k1 = 0.75 EI/L, cubic fraction 0.8 at the hit, two "
+    "b26_soft_r0p75_cf0p8_s2_hit0p5": ("the shipped beam on k1 = 0.75 EI/L, cubic fraction 0.8 at the hit, "
+                                       "two "
                                        "sensors at 0.5 / 1 L, hit at the inner one",
-                                       {**soft(0.75, 0.8, {}, _HIT05), "sensors": _S2_05}, {}, {**_HIT05}, {}),
+                                       {**soft(0.75, 0.8, {}, _HIT05), "sensors": _S2_05}, {}, {**_HIT05},
+                                       {}),
     "b26_soft_r1p3_cf0p25_s5u_hit0p55": ("the shipped beam on k1 = 1.3 EI/L, cubic fraction 0.25 at the hit, "
-                                         "five sensors at 0.15 / 0.3 / 0.55 / 0.8 / 1 L, hit at the sensor at "
+                                         "five sensors at 0.15 / 0.3 / 0.55 / 0.8 / 1 L, hit at the sensor "
+                                         "at "
                                          "0.55 L",
                                          {**soft(1.3, 0.25, {}, _HIT055), "sensors": _S5U}, {}, {**_HIT055},
                                          {}),

@@ -76,10 +76,12 @@ DOWN: dict[str, tuple[str, str, dict[str, dict], str]] = {
 CARTPOLES: dict[str, tuple[str, dict[str, dict]]] = {
     "cp26_L0p5_m0p25": ("a 0.5 m pole of 0.25 kg on the 1 kg cart",
                         {"rig": {"pole_length": 0.5, "pole_mass": 0.25}}),
-    "cp26_L1_m0p6": ("a 1 m pole of 0.6 kg on the 1 kg cart", {"rig": {"pole_length": 1.0, "pole_mass": 0.6}}),
+    "cp26_L1_m0p6": ("a 1 m pole of 0.6 kg on the 1 kg cart",
+                     {"rig": {"pole_length": 1.0, "pole_mass": 0.6}}),
     "cp26_cart1p3": ("a 1.3 kg cart under the 0.5 kg pole", {"rig": {"cart_mass": 1.3}}),
     "cp26_amp0p6": ("the shipped cart-pole under the multisine at 0.6 N", {"excitation": {"amplitude": 0.6}}),
-    "cp26_ph4": ("the shipped cart-pole under the multisine on phase seed 4", {"excitation": {"phase_seed": 4}}),
+    "cp26_ph4": ("the shipped cart-pole under the multisine on phase seed 4",
+                 {"excitation": {"phase_seed": 4}}),
 }
 
 #: name -> (description, {table: keys changed from michaelis_menten_noise1}); Km 0.3, Vmax 1.5,
@@ -89,7 +91,8 @@ KINETICS: dict[str, tuple[str, dict[str, dict]]] = {
     "mm26_km2_vmax3": ("Km 2 mM under Vmax 3 mM/s (x* 0.5 mM)", {"rig": {"Km": 2.0, "Vmax": 3.0}}),
     "mm26_vmax1p1": ("Vmax 1.1 mM/s (x* 0.36 mM)", {"rig": {"Vmax": 1.1}}),
     "mm26_jx0p4": ("an influx of 0.4 mM/s (x* 0.11 mM)", {"rig": {"jx": 0.4}}),
-    "mm26_x1p5_fs500": ("a 1.5 mM dose at 500 Hz", {"rig": {"x0": 1.5}, "simulation": {"sample_rate": 500.0}}),
+    "mm26_x1p5_fs500": ("a 1.5 mM dose at 500 Hz",
+                        {"rig": {"x0": 1.5}, "simulation": {"sample_rate": 500.0}}),
     "mm26_6s_fs2k": ("a 6 s record at 2 kHz", {"simulation": {"duration": 6.0, "sample_rate": 2000.0}}),
 }
 
