@@ -220,7 +220,8 @@ def check_two_samples(simulation: dict[str, Any], error: ErrorFn) -> None:
 
 
 def furthest_from_default(rig: dict[str, Any], keys: tuple[str, ...],
-                          schema: dict[str, Field]) -> str:
+                          schema: dict[str, Field],
+                          exponents: dict[str, float] | None = None) -> str:
     """The key of ``keys`` whose value lies furthest from its schema default by ratio
     (``|ln(value / default)|``, a ratio that over- or underflows counting as infinitely far;
     the first such key on a tie): the one a refusal of their combination names.
@@ -228,14 +229,24 @@ def furthest_from_default(rig: dict[str, Any], keys: tuple[str, ...],
     Parameters
     ----------
     rig : dict
-        The validated ``[rig]`` table.
+        The validated ``[rig]`` table (or any table of ``keys``' values).
     keys : tuple of str
         Keys with positive values and positive defaults.
     schema : dict of str to Field
         The rig's schema (the defaults).
+    exponents : dict of str to float, optional
+        Where the refused figure is a product of the keys' powers (``duration Vmax / Km``:
+        ``{"duration": 1, "Vmax": 1, "Km": -1}``), the key whose factor ``ratio ** exponent``
+        is largest, signed (the one that drives the figure up, ``e ln(ratio)``); a ratio that
+        over- or underflows counts as infinitely far in its exponent's direction.
     """
     def distance(k: str) -> float:
         r = rig[k] / schema[k].default
-        return abs(math.log(r)) if 0.0 < r < math.inf else math.inf
+        if exponents is None:
+            return abs(math.log(r)) if 0.0 < r < math.inf else math.inf
+        e = exponents[k]
+        if not 0.0 < r < math.inf:  # underflow to 0 or overflow: infinitely far, signed
+            return math.copysign(math.inf, e if r > 0.0 else -e)
+        return e * math.log(r)
 
     return max(keys, key=distance)

@@ -35,7 +35,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from models import RIGS
-from models._base import ErrorFn, Rig, check_two_samples
+from models._base import ErrorFn, Rig, check_two_samples, furthest_from_default
 from testbed.core.budget import Cost
 from testbed.core.dataset import Dataset, Signal
 from testbed.core.errors import RigError
@@ -128,12 +128,6 @@ def implicit_equation(jx: float, vmax: float, km: float) -> tuple[list[str], np.
     return list(TERMS), (raw / scale)[None, :], scale
 
 
-def _driver(*factors: tuple[str, float]) -> str:
-    """The key of the factor that drives a product: the largest ratio to its default [-]
-    (an ``inf`` ratio included; ties to the first given)."""
-    return max(factors, key=lambda kv: kv[1])[0]
-
-
 @RIGS.register("michaelis_menten", tags=("dynamical", "autonomous", "rational", "sindy-pi"))
 class MichaelisMentenRig(Rig):
     """Michaelis-Menten kinetics with constant influx, one trajectory (see the module docs)."""
@@ -220,23 +214,26 @@ class MichaelisMentenRig(Rig):
         ``h |lambda| <= STIFF_STEP_LIMIT``, and the rate's Jacobian ``-Vmax Km / (Km + x)^2``
         is largest, ``Vmax / Km``, at ``x = 0``.
 
-        Each figure is named by the factor that drives it, as the cantilever and the five-bar
-        do: of a product (or ratio), the factor further above (below, for a divisor) its
-        schema default by the larger log ratio, ties to the first (``simulation.duration``
-        of the sample count, ``rig.Vmax`` of the stiffness).  Hostile round 26: ``Km =
-        5e-324`` was named as ``rig.Vmax = 1.5``, ``sample_rate = 1e308`` as ``duration``."""
-        sim, defaults = cls.simulation_schema, cls.rig_schema
+        Each figure is named by the factor that drives it
+        (:func:`models._base.furthest_from_default` with the product's exponents: the factor
+        ``(value / default) ** exponent`` that is largest, ties to the first): ``duration`` or
+        ``sample_rate`` of the sample count, ``duration``, ``Vmax`` or ``Km`` (exponent -1) of
+        the stiffness.  Hostile round 26: ``Km = 5e-324`` was named as ``rig.Vmax = 1.5``,
+        ``sample_rate = 1e308`` as ``duration``."""
         samples = simulation["duration"] * float(simulation["sample_rate"])
         accuracy = max(samples, 25.0 * simulation["duration"])
         stiff = simulation["duration"] * rig["Vmax"] / rig["Km"] / STIFF_STEP_LIMIT
-        sample_key = _driver(("simulation.duration", simulation["duration"] / sim["duration"].default),
-                             ("simulation.sample_rate",
-                              simulation["sample_rate"] / sim["sample_rate"].default))
-        stiff_key = _driver(("rig.Vmax", rig["Vmax"] / defaults["Vmax"].default),
-                            ("rig.Km", defaults["Km"].default / rig["Km"]))
-        steps, key = (stiff, stiff_key) if stiff > accuracy else (accuracy, sample_key)
         value = {**{f"rig.{k}": v for k, v in rig.items()},
                  **{f"simulation.{k}": v for k, v in simulation.items()}}
+        schema = {**{f"rig.{k}": f for k, f in cls.rig_schema.items()},
+                  **{f"simulation.{k}": f for k, f in cls.simulation_schema.items()}}
+        sample_key = furthest_from_default(value, ("simulation.duration", "simulation.sample_rate"),
+                                           schema, {"simulation.duration": 1.0,
+                                                    "simulation.sample_rate": 1.0})
+        stiff_key = furthest_from_default(value, ("simulation.duration", "rig.Vmax", "rig.Km"),
+                                          schema, {"simulation.duration": 1.0, "rig.Vmax": 1.0,
+                                                   "rig.Km": -1.0})
+        steps, key = (stiff, stiff_key) if stiff > accuracy else (accuracy, sample_key)
         return Cost(memory_bytes=samples * BYTES_PER_SAMPLE, steps=steps, samples=samples,
                     memory_key=sample_key, steps_key=key, samples_key=sample_key,
                     memory_value=value[sample_key], steps_value=value[key],

@@ -288,8 +288,11 @@ class Dataset:
         # verification (round 26); a scalar prior, every rig's, is hashed as before
         prior = {k: (str(np.asarray(v)) if isinstance(v, (list, tuple)) else v)
                  for k, v in self.prior.items()}
-        h.update(json.dumps({"fs": self.fs, "prior": prior, "attrs": meta},
-                            sort_keys=True, default=str).encode())
+        # fs as the float the file stores, numpy scalars as the Python numbers a load reads
+        # back (review 27a: fs = 100, attrs {"n": np.int64(3)} saved files whose own load
+        # failed its hash check)
+        h.update(json.dumps({"fs": float(self.fs), "prior": prior, "attrs": meta},
+                            sort_keys=True, default=_json_scalar).encode())
         for group, signals in (("measured", self.measured), ("reference", self.reference)):
             for name in sorted(signals):
                 s = signals[name]
@@ -312,8 +315,9 @@ class Dataset:
         """Refuse, naming the field, key and value, what :meth:`save` would write as a file that
         :meth:`load` refuses or reads back otherwise, or fail on inside the HDF5 library.
 
-        The rules: ``fs`` a finite rate > 0; at least one measured signal; every signal's
-        name a non-empty text without ``/`` (HDF5 makes it a path of groups), ``.`` or NUL,
+        The rules: ``fs`` a finite rate > 0; at least one measured signal; every signal's,
+        truth's and prior's name a non-empty text without ``/`` (HDF5 makes it a path of
+        groups) or NUL, and not ``.``; truth texts and units without NUL;
         and its channel names and unit without NUL (HDF5's texts end at one); ``attrs`` keys
         texts other than the file's own (``format``, ``fs``, ``fs_unit``, ``json_attrs``),
         values a text, a number within int64 / float64 or JSON; the prior as
@@ -337,10 +341,7 @@ class Dataset:
             if not isinstance(signals, dict):
                 raise ArgumentError(where, group, signals, "expected a dict of signal name to Signal")
             for name, sig in signals.items():
-                if not isinstance(name, str) or not name or name == "." or "/" in name \
-                        or "\x00" in name:
-                    raise ArgumentError(where, f"{group} name", name, "expected a non-empty text "
-                                        "without '/' or NUL, not '.' (an HDF5 member's name)")
+                _member_name(where, f"{group} name", name)
                 if not isinstance(sig, Signal):
                     raise ArgumentError(where, f"{group}[{name!r}]", args.describe(sig),
                                         "expected a Signal(data, channels, unit)", described=True)
@@ -349,9 +350,19 @@ class Dataset:
                                         "expected texts without NUL (HDF5's texts end at one)")
         for k, v in self.attrs.items():
             _check_attr(where, k, v)
+        for name in self.prior:
+            _member_name(where, "prior name", name)
         check_prior_values(where, self.prior)
         for name, v in self.truth.items():
+            _member_name(where, "truth name", name)
+            unit = self.truth_units.get(name, "")
+            if not isinstance(unit, str) or "\x00" in unit:
+                raise ArgumentError(where, f"truth_units[{name!r}]", unit,
+                                    "expected a text without NUL (HDF5's texts end at one)")
             text = isinstance(v, (list, tuple)) and v and all(isinstance(x, str) for x in v)
+            if text and any("\x00" in x for x in v):
+                raise ArgumentError(where, f"truth[{name!r}]", v,
+                                    "expected texts without NUL (HDF5's texts end at one)")
             number = isinstance(v, (numbers.Real, np.number)) and not isinstance(v, (bool, np.bool_))
             if not (text or number):
                 args.array(where, f"truth[{name!r}]", v, (None,) * np.ndim(v) if _shaped(v) else
@@ -392,7 +403,7 @@ class Dataset:
         f.attrs["fs_unit"] = "Hz"
         json_keys = []
         for k, v in self.attrs.items():
-            if isinstance(v, (str, int, float, np.integer, np.floating)):
+            if isinstance(v, (str, int, float, np.integer, np.floating, np.bool_)):
                 f.attrs[k] = v
             else:
                 f.attrs[k] = json.dumps(v, sort_keys=True)
@@ -539,6 +550,20 @@ def _shaped(v: Any) -> bool:
     except (ValueError, TypeError):
         return False
     return True
+
+
+def _json_scalar(value: Any) -> Any:
+    """``json.dumps``' fallback in the content hash: a numpy scalar as its Python number (as a
+    load reads it back), anything else as its text."""
+    return value.item() if isinstance(value, np.generic) else str(value)
+
+
+def _member_name(where: str, label: str, name: Any) -> None:
+    """Refuse a name HDF5 cannot hold as one member of a group (a text, non-empty, no ``/``
+    (a path of groups) or NUL (texts end at one), not ``.``)."""
+    if not isinstance(name, str) or not name or name == "." or "/" in name or "\x00" in name:
+        raise ArgumentError(where, label, name, "expected a non-empty text without '/' or NUL, "
+                            "not '.' (an HDF5 member's name)")
 
 
 def _check_attr(where: str, key: Any, value: Any) -> None:

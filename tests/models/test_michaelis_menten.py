@@ -108,10 +108,14 @@ def test_a_stiff_rate_law_is_refused_by_the_step_budget_naming_vmax():
     ({"Vmax": 1e12, "Km": 0.1}, {}, r"rig\.Vmax"),        # 6.7e11 against 3: Vmax
     ({}, {"sample_rate": 1e308}, r"simulation\.sample_rate"),
     ({}, {"duration": 1e7}, r"simulation\.duration"),
+    # the stiffness duration Vmax / Km: duration 2.5e4 x its default against Vmax's 2e3 x
+    ({"Vmax": 3000.0}, {"duration": 1e5, "sample_rate": 1.0}, r"simulation\.duration"),
+    ({"Vmax": 3e7}, {"duration": 40.0, "sample_rate": 1.0}, r"rig\.Vmax"),
 ])
 def test_a_cost_refusal_names_the_factor_that_drives_it(rig, simulation, key):
     """Hostile round 26: ``Km = 5e-324`` was refused as ``rig.Vmax = 1.5`` and ``sample_rate =
-    1e308`` as ``simulation.duration``; each figure names the factor furthest from its default."""
+    1e308`` as ``simulation.duration``; each figure names the factor that drives it furthest
+    from its default (review 27a: the stiffness's duration is one of them)."""
     from testbed.core.errors import BudgetError
 
     with pytest.raises(BudgetError, match=rf"key '{key}'"):

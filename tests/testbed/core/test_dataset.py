@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 
 from testbed.core.dataset import Dataset, Signal
+from testbed.core.errors import ArgumentError
 
 
 def _dataset(seed=0):
@@ -128,3 +129,35 @@ def test_format_1_file_still_loads_and_is_verified_with_its_own_hash(tmp_path):
         f.attrs["content_hash"] = "0" * 64
     with pytest.raises(DatasetError, match="does not match its stored content hash"):
         Dataset.load(p)
+
+
+@pytest.mark.parametrize("fields", [
+    {"fs": 100},                                    # an int rate: hashed as the stored float
+    {"fs": np.float32(100.0)},
+    {"attrs": {"n": np.int64(3)}},                  # numpy scalars: hashed as load reads them
+    {"attrs": {"g": np.float32(0.1)}},
+    {"attrs": {"b": np.bool_(True)}},               # was a raw TypeError inside the write
+    {"prior": {"total_mass": np.float32(0.7)}},
+])
+def test_a_dataset_saved_with_python_or_numpy_numbers_verifies_on_load(tmp_path, fields):
+    """Review 27a: each of these saved a file whose own load refused it as "altered or damaged"
+    (its hash taken over ``100`` / a numpy scalar's text, the load's over ``100.0`` / the number)."""
+    kw = {"fs": 100.0, "measured": {"a": Signal(np.arange(10.0), ("x",), "m")}, **fields}
+    path = Dataset(**kw).save(tmp_path / "d.h5")
+    loaded = Dataset.load(path)
+    assert loaded.fs == 100.0 and loaded.content_hash() == loaded.attrs["content_hash"]
+
+
+@pytest.mark.parametrize(("fields", "label"), [
+    ({"truth": {"a/b": [1.0]}}, "truth name"),      # saved; its load refused '/truth/a'
+    ({"truth": {"": [1.0]}}, "truth name"),         # raw TypeError from h5py
+    ({"truth": {5: [1.0]}}, "truth name"),
+    ({"prior": {"a\x00b": 1.0}}, "prior name"),     # saved; failed its own hash check
+    ({"truth": {"t": ["a\x00b"]}}, r"truth\['t'\]"),  # raw ValueError (VLEN NUL)
+    ({"truth": {"t": [1.0]}, "truth_units": {"t": "m\x00"}}, r"truth_units\['t'\]"),
+])
+def test_save_refuses_truth_and_prior_names_hdf5_cannot_hold(tmp_path, fields, label):
+    kw = {"fs": 100.0, "measured": {"a": Signal(np.arange(10.0), ("x",), "m")}, **fields}
+    with pytest.raises(ArgumentError, match=label):
+        Dataset(**kw).save(tmp_path / "d.h5")
+    assert not (tmp_path / "d.h5").exists()
