@@ -1,6 +1,7 @@
 """How the testbed reads a number written as text: one rule for the command line's options and
 a CSV file's cells (a scenario file's TOML and a SEP-005 file's JSON are read by their own
-grammars: TOML reads ``1_5`` and ``0x10``, JSON refuses ``.5`` and ``+1``).  No numpy here: the command line imports it before it loads numpy.
+grammars: TOML reads ``1_5`` and ``0x10``, JSON refuses ``.5`` and ``+1``).  No numpy here:
+the command line imports it before it loads numpy.
 """
 
 from __future__ import annotations
