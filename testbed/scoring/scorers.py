@@ -1035,11 +1035,17 @@ def floor_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -> d
     ----------
     scores : Scores
         With ``details["truth_trac"]`` (:func:`truth_trac`) and ``details["trac"]`` (per
-        channel); without them, nothing to check.
+        channel); without them, nothing to check.  For a linear model of a cubic truth whose
+        force share cannot move a frequency by the run's bar (:func:`cubic_share_matters`
+        False), ``details["truth_linear_trac"]`` stands for the truth's.
     thresholds : dict
         The run's bars, ``{metric: {"min"|"max": value}}``.
     """
-    judged = failed_trac(scores, thresholds)
+    # a cubic truth whose force share cannot move a frequency by the run's bar: its linear
+    # part is the floor (continuous in k3 -> 0, where truth_trac is the linear part's)
+    negligible = ("truth_trac" not in scores.details and scores.values.get("K3_norm") == 0.0
+                  and cubic_share_matters(scores, thresholds) is False)
+    judged = failed_trac(scores, thresholds, "truth_linear_trac" if negligible else "truth_trac")
     if judged is None:
         return {}
     trac, floor, bar = judged
@@ -1203,6 +1209,29 @@ def missed_cubic_share(freq_bar: float) -> float:
         The share [-].
     """
     return (1.0 + float(freq_bar)) ** 2 - 1.0
+
+
+#: The frequency bar [-] a cubic share is judged against where a run has none
+#: (:func:`cubic_share_matters`): the paper's mode-2 figure of merit, 2.6 %, the families' bar.
+PAPER_FREQ_BAR = 0.026
+
+
+def cubic_share_matters(scores: Scores, thresholds: dict[str, dict[str, float]]) -> bool | None:
+    """Whether the truth's cubic force share could move a frequency by the run's smallest
+    frequency bar (``share >= missed_cubic_share(bar)``): True / False, or None where there
+    is no claim (a linear truth, or the share is NaN).  A run without a frequency bar is
+    judged at :data:`PAPER_FREQ_BAR`.
+
+    Below it, the truth's linear part stands for the truth (:func:`floor_failures` judges a
+    linear model against it as the floor) and a linear model's failed TRAC is no missing
+    term's (:func:`linear_trac_failures`); review 27b: a hammer by the clamp with ``base_k3``
+    1000 (a share of 3e-21) was named "linear model" where ``base_k3 = 0`` was "floor".
+    """
+    share = scores.details.get("truth_cubic_share")
+    if share is None or not np.isfinite(share):
+        return None
+    bars = [b["max"] for m, b in thresholds.items() if m.startswith("freq_error") and "max" in b]
+    return bool(share >= missed_cubic_share(min(bars, default=PAPER_FREQ_BAR)))
 
 
 def cubic_mode_reach(Mr: np.ndarray, Kr: np.ndarray, k3: float, cubic_map: np.ndarray,
@@ -1372,9 +1401,11 @@ def linear_trac_failures(scores: Scores, thresholds: dict[str, dict[str, float]]
     not that the cubic truth meets the bar (the scorer does not simulate the reduced cubic
     truth: known-gaps, score25's open item 3); a channel the linear part meets, or one the
     model misses by more than the margin below it, is the model's own failure (no reason).
-    Nothing where the model has a cubic term, or the fit, the model or its simulation failed
-    (that failure says why).  Only a bar that already failed is explained, so no verdict
-    changes.
+    Nothing where the model has a cubic term, or the fit, the model or its simulation failed,
+    or the simulation grows or a mode has no stiffness (that failure says why), and nothing
+    where the share cannot move a frequency by the run's bar (:func:`cubic_share_matters`:
+    there the linear part is the floor, :func:`floor_failures`; review 27b).  Only a bar that
+    already failed is explained, so no verdict changes.
 
     Parameters
     ----------
@@ -1392,8 +1423,8 @@ def linear_trac_failures(scores: Scores, thresholds: dict[str, dict[str, float]]
         Empty, or the reason naming each failing channel, its TRAC and the linear part's there.
     """
     share = scores.details.get("truth_cubic_share")
-    if (share is None or scores.values.get("K3_norm") != 0.0
-            or {"fit", "model", "simulation"} & set(scores.failures)):
+    if (not cubic_share_matters(scores, thresholds) or scores.values.get("K3_norm") != 0.0
+            or {"fit", "model", "simulation", "growth", "stiffness"} & set(scores.failures)):
         return {}
     judged = failed_trac(scores, thresholds, "truth_linear_trac")
     if judged is None:

@@ -58,10 +58,25 @@ def test_no_claim_where_the_linear_part_meets_the_bar_or_the_model_is_not_linear
     assert failures([0.941, float("nan"), 0.935], [0.806, 0.671, 0.790]) == {}
     assert failures([0.941, 0.899, 0.935], [0.806, 0.671, 0.790],
                     simulation="diverged: ...") == {}
+    # a cubic share that cannot move a frequency by the run's bar (review 27b: 3e-21 by the
+    # clamp was named "linear model"): no claim, and the linear part is the floor instead
+    assert set(failures([0.941, 0.899, 0.935], [0.806, 0.671, 0.790], share=1e-6)) == {"floor"}
+    assert failures([0.941, 0.899, 0.935], [0.806, 0.671, 0.790], share=0.04,
+                    bars={**BARS, "freq_error": {"max": 0.01}}) != {}  # 0.04 >= 0.0201
+    assert failures([0.941, 0.899, 0.935], [0.806, 0.671, 0.790],
+                    growth="non-physical: ...") == {}
     # the bar met, or no TRAC bar: nothing to explain
     assert failures([0.95, 0.96, 0.97], [0.806, 0.671, 0.790]) == {}
     assert failures([0.941, 0.899, 0.935], [0.806, 0.671, 0.790],
                     bars={"mac": {"min": 0.9}}) == {}
+
+
+def test_below_the_share_that_matters_the_linear_part_is_the_floor():
+    """Continuous in k3 -> 0 (review 27b): a linear model at the linear part's TRAC, under a cubic
+    share too small to move a frequency by the bar, is named "floor" as with ``base_k3 = 0``."""
+    got = failures([0.564, 1.0, 1.0], [0.564, 1.0, 1.0], share=3e-21)
+    assert set(got) == {"floor"} and failure_kind(got["floor"]) == ["floor"]
+    assert set(failures([0.564, 1.0, 1.0], [0.564, 1.0, 1.0], share=0.3)) == {"cubic_trac"}
 
 
 def test_the_truths_linear_part_scored_on_a_round_26_record_is_named_linear_model(dataset_cache):
