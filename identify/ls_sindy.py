@@ -259,7 +259,9 @@ class LeastSquaresSINDy(StructuralIdentifier):
        at most); rounds 24-25's 116 soft-base cells: it acts on 32, issue bars 8 -> 19 of them,
        none lost, their studies' bars +3 -3 (``b24_soft_fs16k`` 3 % s152 / s156 and
        ``b24_soft_r2_cf0p3_z1p5_s2`` 3 % s157 lose mode 2 to the noisy cubic fit's open
-       classes, a spurious mode beside it and errors in variables; docs/known-gaps.md).
+       classes, a spurious mode beside it and errors in variables; docs/known-gaps.md); the
+       validation draws (benchmarks/heldout/families_soft_validation.toml, 80 cells): it acts
+       on 17, issue bars 46 -> 47 (``soft_v22__013`` clean, mode 1 7.32 -> 0.82 %), none lost.
 
     5. *Unresolved modes placed* (linear library, ``fit_tilt`` by rule; only where the model
        would be refused: tilted, held and flat all grow): in the tilted fit, a mode whose
