@@ -591,6 +591,24 @@ def test_a_cubic_models_mode_above_what_the_hardening_record_allows_is_moved_and
         assert v["trac"] >= trac_min
 
 
+def test_a_hardening_record_whose_cubic_the_rule_left_out_gets_it_where_it_explains_clearly_more(
+        dataset_cache):
+    """Soft-base family member 013 at 1 % noise (issue #15; the truth is the engine's): the
+    noise drowns the cubic rule's partial correlations (0.41 flat, 0.626 tilted, under 0.65)
+    and the linear model held mode 1 at its amplitude-hardened frequency, 2.41 % high.  Mode
+    1's backbone decay chirps +3.7 % (above CUBIC_CHIRP_MIN), so step 4b fits the cubic
+    library too; its record agreement 0.9938 against the linear 0.9869 leaves 2.1 x less of
+    the record unexplained, so it is kept: mode 1 0.29 %, TRAC 0.994 (old code: linear,
+    2.41 %, 0.987)."""
+    sc = _family_cell("beams_soft__013", 1.0)
+    res = run_scenario(sc, dataset=dataset_cache.get(sc))
+    v, m = res.scores.values, res.model
+    assert m.cubic_ and "trial (step 4b)" in m.cubic_rule_ and ": kept" in m.cubic_rule_
+    assert v["freq_error_mode1"] <= 0.01  # issue #15's bar: measured 0.29 % (old 2.41 %)
+    assert v["freq_error_mode2"] <= 0.01  # measured 0.78 % (old 0.83 %)
+    assert v["trac"] >= 0.95  # issue #15's bar: measured 0.994 (old 0.987)
+
+
 # reach_moves (the cubic library's move selection): synthetic arrays, mode 1's damped
 # frequency 22.2 Hz; the chirp just above / below CUBIC_CHIRP_MIN x wd
 _WD1 = 2 * np.pi * 22.2
