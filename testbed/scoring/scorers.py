@@ -1011,6 +1011,11 @@ def failed_trac(scores: Scores, thresholds: dict[str, dict[str, float]], floor_k
     return trac, np.asarray(floor, dtype=float), float(bar)
 
 
+def channel_names(scores: Scores, n: int) -> list[str]:
+    """The scored channels' names (``details["channels"]``), or ``channel 1 .. n``."""
+    return list(scores.details.get("channels") or [f"channel {k + 1}" for k in range(n)])
+
+
 def floor_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -> dict[str, str]:
     """A failed TRAC bar the truth's own reduced model fails too: ``{"floor": reason}``.
 
@@ -1103,7 +1108,7 @@ def channel_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) ->
     failing, low = ~(trac >= bar), at_floor(trac, floor, bar)
     if not (low.any() and (failing & ~low).any()):  # all at the floor, or none: nothing hidden
         return {}
-    names = list(scores.details.get("channels") or [f"channel {k + 1}" for k in range(trac.size)])
+    names = channel_names(scores, trac.size)
 
     def listed(mask: np.ndarray) -> str:
         return ", ".join(f"{names[k]} {trac[k]:.3g} (the truth's own {floor[k]:.3g})"
@@ -1235,7 +1240,8 @@ def cubic_share_matters(scores: Scores, thresholds: dict[str, dict[str, float]])
 
 
 def cubic_mode_reach(Mr: np.ndarray, Kr: np.ndarray, k3: float, cubic_map: np.ndarray,
-                     cubic_direction: np.ndarray, x: np.ndarray) -> np.ndarray:
+                     cubic_direction: np.ndarray, x: np.ndarray,
+                     force: np.ndarray | None = None) -> np.ndarray:
     """The largest relative frequency error [-] of each true mode that the truth's missing
     cubic base force can explain in a linear model (:func:`linear_model_failures`), from the
     truth alone.
@@ -1274,6 +1280,8 @@ def cubic_mode_reach(Mr: np.ndarray, Kr: np.ndarray, k3: float, cubic_map: np.nd
         ``c`` and ``d`` of the cubic term [rad/m].
     x : ndarray, shape (m, N)
         The noise-free sensor displacements [m] over the free decay.
+    force : ndarray, shape (m, N), optional
+        The truth's cubic force ``d k3 (c . x)^3`` over ``x`` [N], where the caller has it.
 
     Returns
     -------
@@ -1292,7 +1300,8 @@ def cubic_mode_reach(Mr: np.ndarray, Kr: np.ndarray, k3: float, cubic_map: np.nd
     # whole record on every coordinate, as the identifiers fit K (review 26e: mode by mode it
     # counted the force another mode drives as this mode's stiffness)
     tangent = Kr + 3.0 * k3 * q2 * np.outer(dvec, c)
-    force = np.outer(dvec, k3 * q0**3)  # the cubic force in sensor coordinates (m, N)
+    if force is None:  # the cubic force in sensor coordinates (m, N)
+        force = np.outer(dvec, k3 * q0**3)
     with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
         try:
             stand_in = Kr + force @ x.T @ np.linalg.inv(x @ x.T)
@@ -1433,7 +1442,7 @@ def linear_trac_failures(scores: Scores, thresholds: dict[str, dict[str, float]]
     failing = ~(trac >= bar)
     if not (failing.any() and np.all(at_floor(trac, lin, bar)[failing])):
         return {}
-    names = list(scores.details.get("channels") or [f"channel {k + 1}" for k in range(trac.size)])
+    names = channel_names(scores, trac.size)
     listed = ", ".join(f"{names[k]} {trac[k]:.3g} (the linear part {lin[k]:.3g})"
                        for k in np.flatnonzero(failing))
     got = float(scores.values.get("trac", float("nan")))
@@ -2057,7 +2066,7 @@ def score_structural(dataset: Dataset, data: Measurement, clean: Measurement, mo
         d["truth_cubic_share"] = (float(np.linalg.norm(f_true)) / lin_true if lin_true > 0.0
                                   else float("nan"))
         d["truth_cubic_reach"] = cubic_mode_reach(Mr, Kr, k3, truth.cubic_map,
-                                                  truth.cubic_direction, x_ref)
+                                                  truth.cubic_direction, x_ref, f_true)
         if v["K3_norm"] == 0.0:  # a linear model: what the truth's own linear part scores
             lin = linear_part_trac(truth, data, t, u, ref)
             if lin is not None:

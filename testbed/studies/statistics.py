@@ -52,10 +52,8 @@ SCORED_REASONS = ("fit failed", "diverged", "response blew up", "simulation fail
 #: The scorer's explanations of a failed bar (testbed.scoring.scorers: uninformative_failures,
 #: out_of_band_failures, unexcited_failures, decayed_failures, floor_failures, sensor_failures,
 #: equation_failures, step_failures, sensitivity_failures, clipping_failures,
-#: linear_model_failures, unscored_mode_failures, channel_failures, drift_failures,
-#: held_failures), each the
-#: head of its reason
-#: (``<head>: ...``).  Matched only at a
+#: linear_model_failures, linear_trac_failures, unscored_mode_failures, channel_failures,
+#: drift_failures, held_failures), each the head of its reason (``<head>: ...``).  Matched only at a
 #: reason's start (the text's or after ``"; "``, as ``Scores.failure`` joins them): their words
 #: occur inside other reasons ("at the sensors").  Without them a floor or an unexcited mode
 #: was counted as "other" (held-out families, 2026-11-28).
