@@ -215,8 +215,13 @@ def test_a_cubic_model_whose_simulation_and_warm_start_diverge_is_refused_for_th
     ds = dataset_cache.get(sc)
     data = measure(ds, sc.signal, "structural")
     model = SGDSINDy(cubic=True).fit(data)
-    assert "the fitted cubic model refused (its simulation from the record's own start fails" \
-        in model.cubic_rule_
+    # which test meets the failing cubic first (refused for its simulation, or doubted against
+    # the measured decay and then outexplained by the linear refit, whose rival's simulation
+    # failed) is decided by the SGD's last bits: numba compiles for the host CPU (FMA or not),
+    # and an AMD EPYC took the second route (speed27, 2026-11-29); the outcome is the claim
+    rule = model.cubic_rule_
+    assert rule.endswith("cubic terms out") and ("its simulation from the record's own start "
+                                                  "fails" in rule or "(its simulation failed)" in rule)
     assert not model.cubic_ and model.K3_ is None
     v = score_structural(ds, data, measure(noise_free(ds), sc.signal, "structural"), model).values
     # issue #15's bars (TRAC and MAC >= 0.95, modes 1-2 within 1 %); the old code: TRAC NaN
@@ -284,8 +289,13 @@ def test_a_diverging_cubic_whose_warm_start_is_not_simulated_is_refused_for_the_
     ds = dataset_cache.get(sc)
     data = measure(ds, sc.signal, "structural")
     model = SGDSINDy().fit(data)
-    assert "the fitted cubic model refused (its simulation from the record's own start fails" \
-        in model.cubic_rule_
+    # which test meets the failing cubic first (refused for its simulation, or doubted against
+    # the measured decay and then outexplained by the linear refit, whose rival's simulation
+    # failed) is decided by the SGD's last bits: numba compiles for the host CPU (FMA or not),
+    # and an AMD EPYC took the second route (speed27, 2026-11-29); the outcome is the claim
+    rule = model.cubic_rule_
+    assert rule.endswith("cubic terms out") and ("its simulation from the record's own start "
+                                                  "fails" in rule or "(its simulation failed)" in rule)
     assert not model.cubic_ and model.K3_ is None
     v = score_structural(ds, data, measure(noise_free(ds), sc.signal, "structural"), model).values
     # the round's bars (the families': TRAC and MAC of modes 1-2 > 0.90, modes 1-2 within 2.6
