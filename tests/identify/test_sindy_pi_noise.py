@@ -193,17 +193,26 @@ def test_declared_noise_fit_writes_equations_for_the_input_terms(clean):
 def test_clean_angles_through_a_declared_chain_get_the_chain_recipe(clean):
     # noise-free angles, rates and accelerations derived by the declared 4 Hz chain: the rates
     # are still estimates (the chain's own error), so the noise estimate of ~0 must not send
-    # them to the exact-data recipe (ridge 1e-14: the family's clean members lost their input
-    # terms or diverged, 13/30 within 0.0501 rad)
+    # them to the exact-data recipe (no column filter, no trim, the held-out choice: the
+    # family's clean members lost their input terms or diverged, 13/30 within 0.0501 rad);
+    # they take the chain's strong form, input-term LHS and rollout with the clean ends of its
+    # continuous settings: ridge RIDGE_EXACT, columns a decade down at the chain's cut-off
+    # (order 4: 0.75 x 4 Hz), ties within the chain's clean droop (1e-3 x ROLLOUT_ATOL)
     data = _chain_smoothed(clean, 0.0)
     knobs, rule, est = sp.noise_knobs(data.x, data.fs, 0.2, {}, None, data.noise_std,
                                       data.passband)
     assert est["noise_rel"] <= sp.NOISE_FREE_REL and "exact data" not in rule
-    assert knobs["formulation"] == "strong" and knobs["column_lowpass_hz"] > 0
-    assert knobs["ridge"] == pytest.approx(sp.RIDGE_PER_NOISE_VAR * sp.CHAIN_REL_FLOOR ** 2)
-    assert f"error floor {sp.CHAIN_REL_FLOOR:g}" in rule
+    assert knobs["formulation"] == "strong"
+    assert knobs["column_lowpass_hz"] == pytest.approx(4.0 / 10 ** (1 / 8))
+    assert knobs["ridge"] == sp.RIDGE_EXACT and knobs["rollout_atol"] == pytest.approx(1e-7)
     assert "clean angles, rates derived by a low-pass: strong form" in rule
     assert knobs["lhs"] == sp.LHS_INPUT_TERMS and knobs["selection"] == "rollout"
+    # the noisy ends are the rule before, bit for bit: 1 % (and anything from NOISY_NOISE_REL)
+    one = _chain_smoothed(clean, 1.0)
+    k1, _, e1 = sp.noise_knobs(one.x, one.fs, 0.2, {}, None, one.noise_std, one.passband)
+    assert k1["column_lowpass_hz"] == sp.CUTOFF_FACTOR * e1["band_hz"]
+    assert k1["ridge"] == sp.RIDGE_PER_NOISE_VAR * max(e1["noise_rel"], sp.CHAIN_REL_FLOOR) ** 2
+    assert k1["rollout_atol"] == sp.ROLLOUT_ATOL
     # the floor is a floor: 5 % noise keeps its own ridge (25 x the floor's)
     noisy = _chain_smoothed(clean, 5.0)
     assert sp.noise_knobs(noisy.x, noisy.fs, 0.2, {}, None, noisy.noise_std,
@@ -213,6 +222,26 @@ def test_clean_angles_through_a_declared_chain_get_the_chain_recipe(clean):
     # clean pick simulates at least as well as the 1 % one's bar (a fifth of 0.0501 rad)
     assert "smoothed noise" not in m.noise_rule_ and m.ridge_ == knobs["ridge"]
     assert m.selection_ == "rollout" and m.rollout_rmse_ < 0.0501 / 5
+
+
+def test_the_clean_chain_recipe_is_continuous_in_the_declared_noise(clean):
+    """Between the clean and the noisy ends the column cut-off, ridge and tie band move
+    geometrically with the noise weight: on the same smoothed angles with the declared level
+    stepped by 10 % from 1e-6 to 1e-2, no setting moves by more than its two ends' ratio
+    times the weight's largest step (log(1.1) / log(100)), and each is monotone."""
+    from testbed.numerics import derivatives as der
+    data = _chain_smoothed(clean, 0.0)
+    std = data.x.std(axis=1)
+    rels = np.exp(np.arange(np.log(1e-6), np.log(1e-2), np.log(1.1)))
+    ks = [sp.noise_knobs(data.x, data.fs, 0.2, {}, None, r * std, data.passband)[0]
+          for r in rels]
+    step = np.log(1.1) / np.log(der.NOISY_NOISE_REL / der.CLEAN_NOISE_REL)
+    for key in ("column_lowpass_hz", "ridge", "rollout_atol"):
+        v = np.log([k[key] for k in ks])
+        span = abs(v[-1] - v[0])
+        assert np.max(np.abs(np.diff(v))) <= span * step * 1.01 + 1e-12, key
+        assert np.all(np.diff(v) >= -1e-12) or np.all(np.diff(v) <= 1e-12), key
+    assert ks[0]["ridge"] == sp.RIDGE_EXACT and ks[-1]["rollout_atol"] == sp.ROLLOUT_ATOL
 
 
 def test_declared_chain_rollout_selection_is_overridden_by_the_user(clean):
