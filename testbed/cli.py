@@ -42,6 +42,7 @@ from testbed.core.errors import (
     terminal_safe,
 )
 from testbed.core.exit_guard import late_exit_calls
+from testbed.core.numbertext import plain_number
 from testbed.core.registry import REGISTERED_NAME, REGISTERED_NAME_DOC
 
 #: Status when the reader of standard output went away: a shell's for a command ended by SIGPIPE.
@@ -105,21 +106,13 @@ class _Parser(argparse.ArgumentParser):
         sys.exit(EXIT_USAGE)
 
 
-#: A number as the command line takes it: ASCII digits, an optional sign, point and exponent
-#: (and the words inf / nan, which the options' own checks refuse where they must).
-_PLAIN_NUMBER = re.compile(r"\s*[+-]?((\d+(\.\d*)?|\.\d+)([eE][+-]?\d+)?|inf|infinity|nan)\s*",
-                           re.IGNORECASE | re.ASCII)
-
-
 def _plain_number(text: str) -> str:
-    """``text`` if it is a number written in ASCII, else ValueError.
-
-    Python's ``int()`` and ``float()`` also read other scripts' digits and underscores:
-    ``--seed ３`` (a fullwidth digit) ran seed 3 and ``--fs 1_000`` read 1000 Hz (hostile round
-    19), where a scenario file's TOML refuses both."""
-    if not _PLAIN_NUMBER.fullmatch(text):
+    """``text`` if it is a number written in ASCII (:func:`testbed.core.numbertext.plain_number`:
+    ``--seed \uff13`` ran seed 3 and ``--fs 1_000`` read 1000 Hz, round 19), else ValueError."""
+    core = plain_number(text)
+    if core is None:
         raise ValueError(text)
-    return text
+    return core
 
 
 def _float(text: str) -> float:

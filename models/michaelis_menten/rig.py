@@ -128,6 +128,12 @@ def implicit_equation(jx: float, vmax: float, km: float) -> tuple[list[str], np.
     return list(TERMS), (raw / scale)[None, :], scale
 
 
+def _driver(*factors: tuple[str, float]) -> str:
+    """The key of the factor that drives a product: the largest ratio to its default [-]
+    (an ``inf`` ratio included; ties to the first given)."""
+    return max(factors, key=lambda kv: kv[1])[0]
+
+
 @RIGS.register("michaelis_menten", tags=("dynamical", "autonomous", "rational", "sindy-pi"))
 class MichaelisMentenRig(Rig):
     """Michaelis-Menten kinetics with constant influx, one trajectory (see the module docs)."""
@@ -212,16 +218,29 @@ class MichaelisMentenRig(Rig):
         second; counted as 25 per second (2x room), and at least one per output sample (the
         budget's convention).  A stiff rate law needs more: DOP853 is explicit, stable only for
         ``h |lambda| <= STIFF_STEP_LIMIT``, and the rate's Jacobian ``-Vmax Km / (Km + x)^2``
-        is largest, ``Vmax / Km``, at ``x = 0``; such a run is named by ``rig.Vmax``."""
+        is largest, ``Vmax / Km``, at ``x = 0``.
+
+        Each figure is named by the factor that drives it, as the cantilever and the five-bar
+        do: of a product (or ratio), the factor further above (below, for a divisor) its
+        schema default by the larger log ratio, ties to the first (``simulation.duration``
+        of the sample count, ``rig.Vmax`` of the stiffness).  Hostile round 26: ``Km =
+        5e-324`` was named as ``rig.Vmax = 1.5``, ``sample_rate = 1e308`` as ``duration``."""
+        sim, defaults = cls.simulation_schema, cls.rig_schema
         samples = simulation["duration"] * float(simulation["sample_rate"])
         accuracy = max(samples, 25.0 * simulation["duration"])
         stiff = simulation["duration"] * rig["Vmax"] / rig["Km"] / STIFF_STEP_LIMIT
-        steps, key, value = ((stiff, "rig.Vmax", rig["Vmax"]) if stiff > accuracy
-                             else (accuracy, "simulation.duration", simulation["duration"]))
+        sample_key = _driver(("simulation.duration", simulation["duration"] / sim["duration"].default),
+                             ("simulation.sample_rate",
+                              simulation["sample_rate"] / sim["sample_rate"].default))
+        stiff_key = _driver(("rig.Vmax", rig["Vmax"] / defaults["Vmax"].default),
+                            ("rig.Km", defaults["Km"].default / rig["Km"]))
+        steps, key = (stiff, stiff_key) if stiff > accuracy else (accuracy, sample_key)
+        value = {**{f"rig.{k}": v for k, v in rig.items()},
+                 **{f"simulation.{k}": v for k, v in simulation.items()}}
         return Cost(memory_bytes=samples * BYTES_PER_SAMPLE, steps=steps, samples=samples,
-                    memory_key="simulation.duration", steps_key=key,
-                    samples_key="simulation.duration", memory_value=simulation["duration"],
-                    steps_value=value, samples_value=simulation["duration"])
+                    memory_key=sample_key, steps_key=key, samples_key=sample_key,
+                    memory_value=value[sample_key], steps_value=value[key],
+                    samples_value=value[sample_key])
 
     def simulate(self, progress: Callable[[float], None] | None = None) -> Dataset:
         from scipy.integrate import solve_ivp  # lazy: scipy.integrate costs ~0.1 s of import

@@ -107,17 +107,19 @@ def describe(a: Any) -> str:
 
 
 def array(where: str, name: str, value: Any, shape: tuple[int | None, ...], *,
-          complex_ok: bool = False) -> np.ndarray:
+          complex_ok: bool = False, finite: bool = True) -> np.ndarray:
     """``value`` as a finite float64 array (complex128 if ``complex_ok``) of ``shape``
     (``None``: any length along that axis).
 
-    An ndarray or a nested list of numbers is accepted; boolean, object and text dtypes are
-    refused, and so is complex unless ``complex_ok``.  A float64 array is returned as it is
-    (not copied), a non-contiguous one too.
+    An ndarray or a nested list of numbers is accepted; boolean, object, text, datetime and
+    structured dtypes are refused, and so is complex unless ``complex_ok``, and a masked array
+    with a masked value.  A float64 array is returned as it is (not copied), a non-contiguous
+    one too.  ``finite=False`` lets NaN and inf through (a recorded signal, whose non-finite
+    samples its reader names by channel and sample).
     """
-    want = "complex" if complex_ok else "real"
+    want = ("finite " if finite else "") + ("complex" if complex_ok else "real")
     dims = " x ".join("any" if n is None else str(n) for n in shape)
-    allowed = f"expected a finite {want} array of shape ({dims})"
+    allowed = f"expected a {want} array of shape ({dims})"
     if not isinstance(value, (np.ndarray, list, tuple)):
         raise ArgumentError(where, name, describe(value), allowed, described=True)
     try:  # a list of masked rows too (review 26b)
@@ -143,7 +145,7 @@ def array(where: str, name: str, value: Any, shape: tuple[int | None, ...], *,
     if a.ndim != len(shape) or any(n is not None and m != n for m, n in zip(a.shape, shape, strict=True)):
         raise ArgumentError(where, name, describe(a), allowed, described=True)
     a = a.astype(complex if a.dtype.kind == "c" else float, copy=False)
-    if a.size and not np.all(np.isfinite(a)):
+    if finite and a.size and not np.all(np.isfinite(a)):
         bad = int(a.size - np.count_nonzero(np.isfinite(a)))
         raise ArgumentError(where, name, describe(a), f"{allowed}; {bad} value(s) are NaN or "
                             "infinite", described=True)

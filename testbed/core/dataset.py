@@ -22,6 +22,7 @@ from __future__ import annotations
 import hashlib
 import io
 import json
+import numbers
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -29,9 +30,11 @@ from typing import Any, TypeVar
 
 import numpy as np
 
+from testbed.core import arguments as args
 from testbed.core.atomic import atomic_write
-from testbed.core.errors import TestbedError
+from testbed.core.errors import ArgumentError, TestbedError
 from testbed.core.lazy import lazy_module
+from testbed.core.measurement import check_prior_values
 from testbed.core.truth import Truth, TruthError, truth_type
 
 h5py = lazy_module("h5py")  # imported on first use: `testbed list` does not pay for it
@@ -103,20 +106,60 @@ class Signal:
         return units if len(units) == len(self.channels) else [self.unit] * len(self.channels)
 
     def __post_init__(self) -> None:
+        """Check every field where a signal is made (the API's, a rig's and a reader's), by the
+        shared rules of :mod:`testbed.core.arguments`: ``data`` a real array of one row per
+        channel (a flat one is one channel), read as float64 in C order; NaN and inf are let
+        through (the signal chain names a non-finite sample by channel and sample); ``channels``
+        a list or tuple of texts, one per row; ``unit`` a text; ``positions`` real numbers (their
+        count and finiteness named by the readers that use them); ``acts_on`` texts, one per
+        row.
+
+        The API's ``Signal`` took a masked array (the value under a mask measured), complex
+        samples (the imaginary part dropped with a warning), booleans (read as 0 / 1), object,
+        text and datetime arrays, ``channels="x"`` (read per character) and a ``unit`` of 5
+        (round 25's open (c), round 26): each is refused in one line.
+
+        Raises
+        ------
+        ArgumentError
+            Naming the field, its value (an array by shape and dtype) and what is allowed.
+        """
+        where = "Signal"
+        data = self.data
+        if (isinstance(data, np.ndarray) and data.ndim == 1) or (
+                isinstance(data, (list, tuple)) and _flat(data)):
+            data = data[None, :] if isinstance(data, np.ndarray) else [list(data)]
         # C order always: a reduction over a row (e.g. the noise's RMS) then sums in one fixed
         # order whether the array came from a rig (often a transposed view) or from a file
-        self.data = np.ascontiguousarray(self.data, dtype=float)
-        if self.data.ndim == 1:
-            self.data = self.data[None, :]
-        self.channels = tuple(self.channels)
-        if self.data.shape[0] != len(self.channels):
-            raise ValueError(f"{self.data.shape[0]} rows but {len(self.channels)} channel names")
+        self.data = np.ascontiguousarray(args.array(where, "data", data, (None, None),
+                                                    finite=False))
+        rows = self.data.shape[0]
+        self.channels = _texts(where, "channels", self.channels, rows)
+        if not isinstance(self.unit, str):
+            raise ArgumentError(where, "unit", self.unit, "expected a text (an SI unit, e.g. "
+                                "'m/s^2', or one per channel, comma-separated)")
         if self.positions is not None:
-            self.positions = np.asarray(self.positions, dtype=float)
+            # real numbers (not text, complex, boolean), as float64; their count and finiteness
+            # are the readers' to name where a chain reads them (a dynamical record has none to
+            # read), in their words ("positions of shape (1,) for 3 channel(s)", round 8)
+            dims = (None,) * np.ndim(self.positions) if _shaped(self.positions) else (None,)
+            self.positions = args.array(where, "positions", self.positions, dims, finite=False)
         if self.acts_on is not None:
-            self.acts_on = tuple(str(c) for c in self.acts_on)
-            if len(self.acts_on) != self.data.shape[0]:
-                raise ValueError(f"{self.data.shape[0]} rows but {len(self.acts_on)} acts_on names")
+            self.acts_on = _texts(where, "acts_on", self.acts_on, rows)
+
+
+def _texts(where: str, name: str, value: Any, rows: int) -> tuple[str, ...]:
+    """``value`` (a list or tuple of ``rows`` texts, or a 1-D array of them) as a tuple; a
+    single text is refused (it would be read as one name per character).  Whether the names
+    are distinct and printable is the :class:`~testbed.core.measurement.Measurement`'s rule
+    (a reader names a file's duplicate or blank channel in its own words)."""
+    if isinstance(value, np.ndarray) and value.ndim == 1:
+        value = value.tolist()
+    if not isinstance(value, (list, tuple)) or not all(isinstance(v, str) for v in value) \
+            or len(value) != rows:
+        raise ArgumentError(where, name, value, f"expected a tuple of {rows} text(s), one per "
+                            "row of data")
+    return tuple(value)
 
 
 @dataclass
@@ -240,7 +283,12 @@ class Dataset:
 
     def _hash(self, meta: dict[str, Any]) -> str:
         h = hashlib.sha256()
-        h.update(json.dumps({"fs": self.fs, "prior": self.prior, "attrs": meta},
+        # a list prior (``link_lengths``) is stored as an HDF5 array and read back as one: it is
+        # hashed as that array is (``default=str``), or a saved dataset failed its own load's
+        # verification (round 26); a scalar prior, every rig's, is hashed as before
+        prior = {k: (str(np.asarray(v)) if isinstance(v, (list, tuple)) else v)
+                 for k, v in self.prior.items()}
+        h.update(json.dumps({"fs": self.fs, "prior": prior, "attrs": meta},
                             sort_keys=True, default=str).encode())
         for group, signals in (("measured", self.measured), ("reference", self.reference)):
             for name in sorted(signals):
@@ -260,6 +308,55 @@ class Dataset:
                 h.update(np.ascontiguousarray(np.asarray(v, dtype=float), dtype="<f8").tobytes())
         return h.hexdigest()
 
+    def check_saveable(self) -> None:
+        """Refuse, naming the field, key and value, what :meth:`save` would write as a file that
+        :meth:`load` refuses or reads back otherwise, or fail on inside the HDF5 library.
+
+        The rules: ``fs`` a finite rate > 0; at least one measured signal; every signal's
+        name a non-empty text without ``/`` (HDF5 makes it a path of groups), ``.`` or NUL,
+        and its channel names and unit without NUL (HDF5's texts end at one); ``attrs`` keys
+        texts other than the file's own (``format``, ``fs``, ``fs_unit``, ``json_attrs``),
+        values a text, a number within int64 / float64 or JSON; the prior as
+        :func:`~testbed.core.measurement.prior_ok` takes it; a truth value real numbers or a
+        list of texts.  Before round 26 a hand-made dataset's save was TypeError, ValueError
+        or OverflowError from inside (an attribute of a set, 10**400, a signal named ""), or
+        wrote a file its own load refused (a signal named ``a/b``, an attribute ``fs``, a prior
+        ``[1, 2]``, ``fs = "100"``, a complex truth).
+
+        Raises
+        ------
+        ArgumentError
+        """
+        where = "Dataset.save"
+        args.real(where, "fs", self.fs, low=0.0, low_open=True)
+        if not isinstance(self.measured, dict) or not self.measured:
+            raise ArgumentError(where, "measured", self.measured, "expected a dict of at least "
+                                "one signal name to Signal")
+        for group in ("measured", "reference"):
+            signals = getattr(self, group)
+            if not isinstance(signals, dict):
+                raise ArgumentError(where, group, signals, "expected a dict of signal name to Signal")
+            for name, sig in signals.items():
+                if not isinstance(name, str) or not name or name == "." or "/" in name \
+                        or "\x00" in name:
+                    raise ArgumentError(where, f"{group} name", name, "expected a non-empty text "
+                                        "without '/' or NUL, not '.' (an HDF5 member's name)")
+                if not isinstance(sig, Signal):
+                    raise ArgumentError(where, f"{group}[{name!r}]", args.describe(sig),
+                                        "expected a Signal(data, channels, unit)", described=True)
+                if any("\x00" in t for t in (*sig.channels, sig.unit, *(sig.acts_on or ()))):
+                    raise ArgumentError(where, f"{group}[{name!r}] names", (*sig.channels, sig.unit),
+                                        "expected texts without NUL (HDF5's texts end at one)")
+        for k, v in self.attrs.items():
+            _check_attr(where, k, v)
+        check_prior_values(where, self.prior)
+        for name, v in self.truth.items():
+            text = isinstance(v, (list, tuple)) and v and all(isinstance(x, str) for x in v)
+            number = isinstance(v, (numbers.Real, np.number)) and not isinstance(v, (bool, np.bool_))
+            if not (text or number):
+                args.array(where, f"truth[{name!r}]", v, (None,) * np.ndim(v) if _shaped(v) else
+                           (None,), finite=False)
+
     # ------------------------------------------------------------------ HDF5
     def save(self, path: str | os.PathLike) -> Path:
         """Write atomically to ``path`` (a temporary file in the same folder, then rename).
@@ -268,7 +365,11 @@ class Dataset:
         ------
         TruthError
             If the dataset records a kind and its truth does not fit it (nothing is written).
+        ArgumentError
+            If a field cannot be written as :meth:`load` reads it back (:meth:`check_saveable`;
+            nothing is written).
         """
+        self.check_saveable()
         self.check_truth()
         self.attrs["content_hash"] = self.content_hash()
 
@@ -417,6 +518,49 @@ class Dataset:
             ds = cls(float(f.attrs["fs"]), groups["measured"], groups["reference"], truth, units,
                      prior, attrs)
             return ds, fmt
+
+
+#: Attributes of a dataset file's root that :meth:`Dataset.save` writes itself.
+_FILE_ATTRS = ("format", "fs", "fs_unit", "json_attrs")
+
+
+def _flat(v: list | tuple) -> bool:
+    """Whether a list is one flat row of values (a ragged one is not: ``args.array`` names it)."""
+    try:
+        return np.ndim(v) == 1
+    except (ValueError, TypeError):
+        return False
+
+
+def _shaped(v: Any) -> bool:
+    """Whether ``np.ndim`` can read ``v``'s dimensions (a ragged list cannot)."""
+    try:
+        np.ndim(v)
+    except (ValueError, TypeError):
+        return False
+    return True
+
+
+def _check_attr(where: str, key: Any, value: Any) -> None:
+    """Refuse an ``attrs`` entry :meth:`Dataset.save` cannot write as :meth:`Dataset.load` reads it."""
+    if not isinstance(key, str) or not key or key in _FILE_ATTRS or "\x00" in key:
+        raise ArgumentError(where, "attrs key", key, "expected a non-empty text without NUL, none "
+                            f"of the file's own {', '.join(_FILE_ATTRS)}")
+    if isinstance(value, (bool, np.bool_)) or isinstance(value, (float, np.floating)):
+        return
+    if isinstance(value, (int, np.integer)):
+        if not -2**63 <= int(value) < 2**63:
+            raise ArgumentError(where, f"attrs[{key!r}]", value, "expected an integer within int64")
+        return
+    if isinstance(value, str):
+        if "\x00" in value:
+            raise ArgumentError(where, f"attrs[{key!r}]", value, "expected a text without NUL")
+        return
+    try:
+        json.dumps(value, sort_keys=True)
+    except (TypeError, ValueError) as e:
+        raise ArgumentError(where, f"attrs[{key!r}]", value, "expected a text, a number or a "
+                            f"JSON value ({e})") from None
 
 
 #: The groups at a dataset file's root (the module docstring's layout); nothing else is read.

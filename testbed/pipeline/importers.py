@@ -64,6 +64,7 @@ from testbed.core.budget import IDENTIFY_BYTES_PER_VALUE, IDENTIFY_TEXT_BUDGET_B
 from testbed.core.dataset import Dataset, DatasetError, Signal
 from testbed.core.errors import TestbedError, is_control, show_names, show_value
 from testbed.core.measurement import MIN_FREE_SAMPLES, PRIOR_RANGE, Measurement, prior_ok
+from testbed.core.numbertext import plain_number
 from testbed.core.rate_attrs import fs_attribute_problem, off_scenario_rate
 from testbed.numerics.clipping import Clipping, measured_clipping
 from testbed.numerics.noise import noise_std
@@ -1772,10 +1773,12 @@ def _read_csv(path: Path) -> _Raw:
         if len(cells) != len(names):
             raise MeasuredDataError(path, f"line {lineno} has {len(cells)} fields, the header {len(names)}")
         try:
-            rows.append([float(c) for c in cells])
+            rows.append([_csv_number(c) for c in cells])
         except ValueError:
             bad = next(c for c in cells if not _is_float(c))
-            hint = " (a decimal comma? write a point)" if _is_float(bad.replace(",", ".")) else ""
+            hint = (" (a decimal comma? write a point)" if _is_float(bad.replace(",", ".")) else
+                    " (write it in ASCII digits, without underscores)" if _is_python_float(bad)
+                    else "")
             raise MeasuredDataError(path, f"line {lineno}: {bad.strip()!r} is not a number{hint}") from None
     table = np.array(rows, dtype=float).T
     raw = _Raw(path, "csv", None, {}, {})
@@ -1792,7 +1795,23 @@ def _read_csv(path: Path) -> _Raw:
     return raw
 
 
+def _csv_number(cell: str) -> float:
+    """A CSV cell's number (:func:`~testbed.core.numbertext.plain_number`'s rule), else
+    ValueError: ``float()`` alone read ``1_5`` as 15 and Arabic-Indic or other scripts' digits as
+    ours (round 26)."""
+    core = plain_number(cell)
+    if core is None:
+        raise ValueError(cell)
+    return float(core)
+
+
 def _is_float(s: str) -> bool:
+    """Whether ``s`` is a CSV cell's number (:func:`_csv_number`)."""
+    return plain_number(s) is not None
+
+
+def _is_python_float(s: str) -> bool:
+    """Whether Python's ``float()`` reads ``s`` (other scripts' digits, underscores)."""
     try:
         float(s)
     except ValueError:

@@ -234,8 +234,8 @@ def bar_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -> dic
     :func:`floor_failures`, :func:`channel_failures`, :func:`sensor_failures`,
     :func:`equation_failures`,
     :func:`step_failures`, :func:`sensitivity_failures`, :func:`drift_failures`,
-    :func:`held_failures`, :func:`clipping_failures`, :func:`linear_model_failures` and
-    :func:`unscored_mode_failures`,
+    :func:`held_failures`, :func:`clipping_failures`, :func:`linear_model_failures`,
+    :func:`linear_trac_failures` and :func:`unscored_mode_failures`,
     merged (one call for :func:`testbed.scoring.run.run_scenario` and
     :func:`testbed.scoring.evaluate.score_model`)."""
     return {**uninformative_failures(scores, thresholds), **out_of_band_failures(scores, thresholds),
@@ -246,7 +246,8 @@ def bar_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -> dic
             **sensitivity_failures(scores, thresholds), **drift_failures(scores, thresholds),
             **held_failures(scores, thresholds),
             **clipping_failures(scores, thresholds),
-            **linear_model_failures(scores, thresholds), **unscored_mode_failures(scores, thresholds)}
+            **linear_model_failures(scores, thresholds), **linear_trac_failures(scores, thresholds),
+            **unscored_mode_failures(scores, thresholds)}
 
 
 def rig_declaration(dataset: Dataset, attribute: str) -> dict[str, Any]:
@@ -900,14 +901,43 @@ def truth_trac(truth: StructuralTruth, data: Measurement, t: np.ndarray, u: np.n
     -------
     ndarray, shape (n,), or None
         None (no claim) for a nonlinear truth (``k3`` not 0: the reduced truth's cubic is
-        not the identifiers' form), a record without an input or a truth without a force map
-        or damping, a reduced truth that does not hold the true modes it was reduced to
+        not the identifiers' form; its linear part alone is :func:`linear_part_trac`), and
+        where :func:`linear_part_trac` makes none.
+    """
+    if truth.k3 is not None and float(truth.k3) != 0.0:
+        return None
+    return linear_part_trac(truth, data, t, u, ref)
+
+
+def linear_part_trac(truth: StructuralTruth, data: Measurement, t: np.ndarray,
+                     u: np.ndarray | None, ref: np.ndarray) -> np.ndarray | None:
+    """TRAC per channel [-] of the truth's reduced linear part ``Mr, Cr, Kr`` (a cubic ``k3``
+    term left out), simulated and scored as :func:`truth_trac` says: the truth's own floor for
+    a linear truth, and for a cubic one what the exact linear part of that size scores
+    (:func:`linear_trac_failures`).
+
+    Parameters
+    ----------
+    truth : StructuralTruth
+        ``Mr``, ``Cr``, ``Kr`` (m, m), ``force_map`` (m,), ``frequencies_hz``.
+    data : Measurement
+        The measured record (its ``free_start``, ``x`` and ``xd`` [m, m/s] start the fit).
+    t : ndarray, shape (N,)
+        Time from the free decay's start [s].
+    u : ndarray, shape (1, N), or None
+        The measured force [N] from there.
+    ref : ndarray, shape (m, N)
+        The noise-free reference accelerations [m/s^2] through the chain.
+
+    Returns
+    -------
+    ndarray, shape (m,), or None
+        None (no claim) for a record without an input or a truth without a force map or
+        damping, a reduced truth that does not hold the true modes it was reduced to
         (:data:`REDUCED_TRUTH_GAP`: sensors whose readings are dependent), or a simulation
         that does not give finite accelerations.
     """
     if truth.force_map is None or truth.Cr is None or u is None or u.shape[0] != 1:
-        return None
-    if truth.k3 is not None and float(truth.k3) != 0.0:
         return None
     Mr, Cr, Kr = (np.asarray(a, dtype=float) for a in (truth.Mr, truth.Cr, truth.Kr))
     if not reduced_truth_gap(Mr, Kr, truth.frequencies_hz)[0] <= REDUCED_TRUTH_GAP:
@@ -955,10 +985,11 @@ def at_floor(trac: np.ndarray, floor: np.ndarray, bar: float) -> np.ndarray:
         return (~(trac >= bar)) & (floor < bar) & (trac >= floor - FLOOR_MARGIN)
 
 
-def failed_trac(scores: Scores, thresholds: dict[str, dict[str, float]]
+def failed_trac(scores: Scores, thresholds: dict[str, dict[str, float]], floor_key: str = "truth_trac"
                 ) -> tuple[np.ndarray, np.ndarray, float] | None:
     """A failed TRAC bar's per-channel TRAC, the truth's own and the bar, for
-    :func:`floor_failures` and :func:`channel_failures` to judge.
+    :func:`floor_failures` and :func:`channel_failures` to judge (``floor_key``
+    ``"truth_linear_trac"``: the truth's linear part's, for :func:`linear_trac_failures`).
 
     Returns
     -------
@@ -968,7 +999,7 @@ def failed_trac(scores: Scores, thresholds: dict[str, dict[str, float]]
         channel's TRAC is not finite (a diverged or non-physical model has no TRAC to compare:
         the simulation's failure says why).
     """
-    floor, bar = scores.details.get("truth_trac"), thresholds.get("trac", {}).get("min")
+    floor, bar = scores.details.get(floor_key), thresholds.get("trac", {}).get("min")
     trac = scores.details.get("trac")
     if floor is None or bar is None or trac is None or np.size(floor) != np.size(trac):
         return None
@@ -1322,6 +1353,66 @@ def linear_model_failures(scores: Scores, thresholds: dict[str, dict[str, float]
                       f"can move a frequency by the run's {bar:.3g} bar): the failed frequency "
                       f"bars may be the missing term's, each within what it can move its mode "
                       f"({within}){aside}")}
+
+
+def linear_trac_failures(scores: Scores, thresholds: dict[str, dict[str, float]]
+                         ) -> dict[str, str]:
+    """A failed TRAC bar of a linear model on a cubic truth whose own linear part fails it too,
+    on every failing channel: ``{"cubic_trac": reason}``.
+
+    A cubic truth has no floor (:func:`truth_trac` makes no claim), so a linear model's failed
+    TRAC was a failed bar with no reason even where the frequency bars were met (round 26's
+    ``b26_soft_r1p3_cf0p25_s5u_hit0p55`` at 2 % s172, ``sgd_sindy``: TRAC 0.899 on the 0.8 L
+    sensor, modes 1-2 within 1.8 %, the truth's cubic force 0.26 of its linear one).  The
+    witness is the truth's reduced model without its cubic (:func:`linear_part_trac`, ``details
+    ["truth_linear_trac"]``), judged per channel as the floor is (:func:`at_floor`): the
+    reason is given where, on every failing channel (finite), that linear part fails the bar
+    too and the model lies within :data:`FLOOR_MARGIN` of it or above it (there: 0.671 against
+    the model's 0.899).  The claim is the exact linear part's, not every linear model's, and
+    not that the cubic truth meets the bar (the scorer does not simulate the reduced cubic
+    truth: known-gaps, score25's open item 3); a channel the linear part meets, or one the
+    model misses by more than the margin below it, is the model's own failure (no reason).
+    Nothing where the model has a cubic term, or the fit, the model or its simulation failed
+    (that failure says why).  Only a bar that already failed is explained, so no verdict
+    changes.
+
+    Parameters
+    ----------
+    scores : Scores
+        With ``values["K3_norm"]`` (0 for a model without a cubic term),
+        ``details["truth_cubic_share"]`` [-], ``details["truth_linear_trac"]`` and
+        ``details["trac"]`` (per channel, shape (m,)) and ``details["channels"]`` (their
+        names); without the first three, nothing to say.
+    thresholds : dict
+        The run's bars, ``{metric: {"min"|"max": value}}``.
+
+    Returns
+    -------
+    dict of str to str
+        Empty, or the reason naming each failing channel, its TRAC and the linear part's there.
+    """
+    share = scores.details.get("truth_cubic_share")
+    if (share is None or scores.values.get("K3_norm") != 0.0
+            or {"fit", "model", "simulation"} & set(scores.failures)):
+        return {}
+    judged = failed_trac(scores, thresholds, "truth_linear_trac")
+    if judged is None:
+        return {}
+    trac, lin, bar = judged
+    failing = ~(trac >= bar)
+    if not (failing.any() and np.all(at_floor(trac, lin, bar)[failing])):
+        return {}
+    names = list(scores.details.get("channels") or [f"channel {k + 1}" for k in range(trac.size)])
+    listed = ", ".join(f"{names[k]} {trac[k]:.3g} (the linear part {lin[k]:.3g})"
+                       for k in np.flatnonzero(failing))
+    got = float(scores.values.get("trac", float("nan")))
+    return {"cubic_trac": (
+        f"linear model: TRAC {got:.3g} against the bar {bar:g} with no cubic term, where the "
+        f"truth's cubic base force is {share:.3g} x its linear force over the free decay and "
+        "the truth's own reduced model without it (its linear part, one degree of freedom per "
+        f"sensor) fails the bar too on every failing channel: {listed}: a linear model of "
+        "that size is not shown able to meet the bar on this record (the missing term's, or "
+        "the record's floor: the reduced cubic truth is not simulated)")}
 
 
 def clipping_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -> dict[str, str]:
@@ -1936,6 +2027,10 @@ def score_structural(dataset: Dataset, data: Measurement, clean: Measurement, mo
                                   else float("nan"))
         d["truth_cubic_reach"] = cubic_mode_reach(Mr, Kr, k3, truth.cubic_map,
                                                   truth.cubic_direction, x_ref)
+        if v["K3_norm"] == 0.0:  # a linear model: what the truth's own linear part scores
+            lin = linear_part_trac(truth, data, t, u, ref)
+            if lin is not None:
+                d["truth_linear_trac"] = lin
     if K3 is not None and k3 != 0.0:
         f_id = K3 @ x_ref**3
         v["K3_force_error"] = float(np.linalg.norm(f_id - f_true) / np.linalg.norm(f_true))

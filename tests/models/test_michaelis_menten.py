@@ -103,6 +103,23 @@ def test_a_stiff_rate_law_is_refused_by_the_step_budget_naming_vmax():
 
 
 @pytest.mark.parametrize(("rig", "simulation", "key"), [
+    ({"Km": 5e-324}, {}, r"rig\.Km"),                     # the divisor drives Vmax / Km
+    ({"Km": 1e-9, "Vmax": 3.0}, {}, r"rig\.Km"),          # 3e9 / 2 against 2: Km
+    ({"Vmax": 1e12, "Km": 0.1}, {}, r"rig\.Vmax"),        # 6.7e11 against 3: Vmax
+    ({}, {"sample_rate": 1e308}, r"simulation\.sample_rate"),
+    ({}, {"duration": 1e7}, r"simulation\.duration"),
+])
+def test_a_cost_refusal_names_the_factor_that_drives_it(rig, simulation, key):
+    """Hostile round 26: ``Km = 5e-324`` was refused as ``rig.Vmax = 1.5`` and ``sample_rate =
+    1e308`` as ``simulation.duration``; each figure names the factor furthest from its default."""
+    from testbed.core.errors import BudgetError
+
+    with pytest.raises(BudgetError, match=rf"key '{key}'"):
+        scenario_from_dict({"scenario": {"name": "x", "rig": "michaelis_menten"}, "rig": rig,
+                            "simulation": simulation})
+
+
+@pytest.mark.parametrize(("rig", "simulation", "key"), [
     ({"jx": 1e200}, {}, "rig.jx"), ({"jx": 1e308}, {}, "rig.jx"),
     ({"x0": 1e200, "jx": 0.0}, {}, "rig.x0"), ({}, {"duration": 1e200}, "simulation.duration")])
 def test_a_record_whose_concentration_squared_overflows_is_refused(rig, simulation, key):

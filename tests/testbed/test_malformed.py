@@ -988,8 +988,10 @@ def test_identify_refuses_a_text_file_over_its_size_budget(tmp_path, monkeypatch
 @pytest.mark.parametrize(("grid", "key", "cells"), [
     # 1000 seeds x 1000 noise levels expanded for minutes in silence before the sweep began
     (f'scenarios = ["michaelis_menten"]\nnoise = {[k / 1000 for k in range(1000)]}\n'
-     f"seeds = {list(range(1000))}\n", "study.noise", "1000000 cells (1 scenario-identifier pairs "
-                                                       "x 1000 noise levels x 1000 seeds)"),
+     # (refused from the lists' lengths before any item is checked since round 26)
+     f"seeds = {list(range(1000))}\n", "study.noise", "at least 1000000 cells (1000 noise levels x "
+                                                       "1000 seeds, each with one scenario-identifier "
+                                                       "pair or more)"),
     # a family's members named as the key that drives the count
     ("noise = [0.0]\nseeds = [0, 1]\n[families.mms]\nbase = \"michaelis_menten\"\n"
      "members = 1000\n[families.mms.rig]\nVmax = {uniform = [0.5, 2.0]}\n", "families.mms.members",
