@@ -176,8 +176,9 @@ from identify.library import Library, fivebar_library, generic_mechanical_librar
 from testbed.core.errors import IdentificationError
 from testbed.core.measurement import Measurement, Trajectory
 from testbed.core.schema import ErrorFn, Field, KeyUse
-from testbed.numerics.derivatives import CUTOFF_GAIN, harmonic_gain, noise_weight, relative_noise
-from testbed.numerics.filters import cutoff_problem, lowpass
+from testbed.numerics.derivatives import (CLEAN_DROOP, CUTOFF_GAIN, harmonic_gain, noise_weight,
+                                          relative_noise)
+from testbed.numerics.filters import cutoff_problem, lowpass, mismatch_cutoff
 from testbed.numerics.gram import normalized_gram, ordered_independent
 from testbed.numerics.noise import noise_std, signal_band
 
@@ -805,6 +806,60 @@ def chain_column_cutoff(chain_cutoff_hz: float, column_order: int) -> float:
     return float(chain_cutoff_hz / 10.0 ** (CLEAN_COLUMN_DECADES / (2 * int(column_order))))
 
 
+#: Butterworth order taken for a declared chain when its inputs' mismatch is read
+#: (:func:`input_column_cutoff`): the mechanical chain's default ``filter_order``; the
+#: measurement declares the chain's pass band, not its order.  A chain of lower order droops
+#: more below its cut-off than this reads.
+CHAIN_ORDER = 8
+#: Largest share of the inputs' column-filtered power that may be the chain's mismatch
+#: (:func:`testbed.numerics.filters.chain_mismatch_share`) on clean angles: the square of the
+#: clean droop (``CLEAN_DROOP``, 1e-5 in amplitude), the error the clean chain is allowed on
+#: the motion's second harmonic, so that the input columns carry no more of the chain's
+#: transition band than the derived columns do.
+INPUT_MISMATCH_SHARE = CLEAN_DROOP**2
+
+
+def input_column_cutoff(inputs: np.ndarray | None, fs: float, chain_cutoff_hz: float,
+                        column_order: int, low_hz: float, high_hz: float) -> float:
+    """The clean column cut-off [Hz] held down to what the measured inputs allow.
+
+    The chain derives the rates and accelerations from the angles, but the inputs enter the
+    columns as measured: a column ``f(theta) u`` is paired with accelerations the chain
+    low-passed, and differs from them by ``f (1 - G_chain) u``.  An input whose spectrum
+    falls off within the band (a multisine, a chirp, a sine replay) has nothing there; a step,
+    square wave or impact carries a ``1/f`` tail through the chain's transition band, which a
+    column filter a decade down at the chain's cut-off still passes.  Rule: the highest column
+    cut-off in ``[low_hz, high_hz]`` whose :func:`testbed.numerics.filters.chain_mismatch_share`
+    of the inputs (chain order ``CHAIN_ORDER``) is at most ``INPUT_MISMATCH_SHARE``
+    (:func:`testbed.numerics.filters.mismatch_cutoff`: continuous in the inputs, never below
+    ``low_hz``, the noisy rule's columns).  Measured: round 16's 2 N steps held 0.5 s share
+    1.9e-5 at the clean 5.13 Hz, 1e-10 near 2.4 Hz; the five-bars' multisines and chirps
+    3.5e-14 - 3.4e-12 at theirs (kept).
+
+    Parameters
+    ----------
+    inputs : ndarray, shape (n_inputs, n_samples), or None
+        The measured inputs [their units]; None (no input): ``high_hz``.
+    fs : float
+        Sample rate [Hz].
+    chain_cutoff_hz : float
+        The chain's declared cut-off [Hz].
+    column_order : int
+        Order of the column low-pass.
+    low_hz, high_hz : float
+        The noisy rule's and the clean rule's column cut-offs [Hz].
+
+    Returns
+    -------
+    float
+        Column cut-off [Hz].
+    """
+    if inputs is None:
+        return float(high_hz)
+    return mismatch_cutoff(np.atleast_2d(np.asarray(inputs, dtype=float)), fs, chain_cutoff_hz,
+                           CHAIN_ORDER, column_order, low_hz, high_hz, INPUT_MISMATCH_SHARE)
+
+
 #: Replay check of exact-data fits (:meth:`SINDyPI._replay_check`): the held-out choice must
 #: replay the whole record from its measured first state within 1e-4 rad [rad], else the
 #: record left the equations non-unique and they are chosen again by rollout.  Measured
@@ -934,8 +989,10 @@ def noise_knobs(x: np.ndarray, fs: float, val_fraction: float, user: dict[str, A
        noise dominates.  Clean angles under a declared chain move towards the clean recipe
        with the weight ``w`` = :func:`testbed.numerics.derivatives.noise_weight` of
        ``noise_rel`` (0 below 1e-5, 1 from 1e-3, log-linear between; the chain's cut-off moves
-       with it): column cut-off ``(CUTOFF_FACTOR band)^w (chain_column_cutoff)^(1 - w)``
-       (:func:`chain_column_cutoff`: a decade down at the chain's cut-off), ridge
+       with it): column cut-off ``(CUTOFF_FACTOR band)^w (clean)^(1 - w)``, ``clean`` a
+       decade down at the chain's cut-off (:func:`chain_column_cutoff`) unless the measured
+       inputs' spectrum reaches the chain's transition band (steps, square waves, impacts:
+       :func:`input_column_cutoff` then holds it down, never below ``CUTOFF_FACTOR band``), ridge
        ``ridge^w RIDGE_EXACT^(1 - w)``, rollout ties within :func:`rollout_atol` (the chain's
        droop x ``ROLLOUT_ATOL`` / 1 %); from 1e-3 up exactly the settings above.
        For a declared chain (``passband``) the models are chosen by rollout
@@ -1033,11 +1090,15 @@ def noise_knobs(x: np.ndarray, fs: float, val_fraction: float, user: dict[str, A
             branch = (f"noisy: strong form, column low-pass {CUTOFF_FACTOR:g} x band = "
                       f"{CUTOFF_FACTOR * band:.3g} Hz")
             if w < 1.0:
-                clean_cut = chain_column_cutoff(float(passband[1]), column_order)
+                decade_cut = chain_column_cutoff(float(passband[1]), column_order)
+                clean_cut = input_column_cutoff(inputs, fs, float(passband[1]), column_order,
+                                                auto_cut, decade_cut)
+                held = (f"; the inputs' chain mismatch holds it to {clean_cut:.3g} Hz"
+                        if clean_cut < decade_cut else "")
                 auto_cut = auto_cut**w * clean_cut ** (1.0 - w)
                 branch = (f"noisy: strong form, column low-pass {auto_cut:.3g} Hz ({CUTOFF_FACTOR:g}"
                           f" x band)^{w:.3g} x ({CLEAN_COLUMN_DECADES:g} decade at the chain's "
-                          f"cut-off, {clean_cut:.3g} Hz)^{1 - w:.3g}")
+                          f"cut-off, {decade_cut:.3g} Hz{held})^{1 - w:.3g}")
             cut = user.get("column_lowpass_hz") or auto_cut
         else:
             cut = WEAK_PERIODS / window

@@ -244,6 +244,27 @@ def test_the_clean_chain_recipe_is_continuous_in_the_declared_noise(clean):
     assert ks[0]["ridge"] == sp.RIDGE_EXACT and ks[-1]["rollout_atol"] == sp.ROLLOUT_ATOL
 
 
+def test_a_step_input_holds_the_clean_columns_down_and_a_smooth_one_does_not(clean):
+    """The clean column cut-off (a decade down at the chain's) is held down where the
+    measured inputs carry the chain's transition band (round 16's step-input cart-pole lost
+    0.188 rad to it): the same clean angles with their multisine inputs keep it; with 2 N
+    steps held 0.5 s in their place it falls strictly below it, never below the noisy rule's
+    ``CUTOFF_FACTOR`` x band, and the rule says why.  Noisy angles (1 %) are untouched."""
+    data = _chain_smoothed(clean, 0.0)
+    args = (data.x, data.fs, 0.2, {}, None, data.noise_std, data.passband)
+    k_ms, rule_ms, est = sp.noise_knobs(*args, inputs=data.u)
+    decade = sp.chain_column_cutoff(data.passband[1], 4)
+    assert k_ms["column_lowpass_hz"] == pytest.approx(decade) and "holds it" not in rule_ms
+    t = np.arange(data.u.shape[1]) / data.fs
+    steps = np.tile(2.0 * np.where(np.floor(t / 0.5) % 2 == 0, 1.0, -1.0), (data.u.shape[0], 1))
+    k_st, rule_st, _ = sp.noise_knobs(*args, inputs=steps)
+    assert sp.CUTOFF_FACTOR * est["band_hz"] <= k_st["column_lowpass_hz"] < 0.99 * decade
+    assert "the inputs' chain mismatch holds it" in rule_st
+    one = _chain_smoothed(clean, 1.0)
+    a1 = (one.x, one.fs, 0.2, {}, None, one.noise_std, one.passband)
+    assert sp.noise_knobs(*a1, inputs=steps)[0] == sp.noise_knobs(*a1, inputs=one.u)[0]
+
+
 def test_declared_chain_rollout_selection_is_overridden_by_the_user(clean):
     data = _chain_smoothed(clean, 1.0)
     m = SINDyPI(selection="holdout").fit(data)
