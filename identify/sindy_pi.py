@@ -860,6 +860,11 @@ def input_column_cutoff(inputs: np.ndarray | None, fs: float, chain_cutoff_hz: f
                            CHAIN_ORDER, column_order, low_hz, high_hz, INPUT_MISMATCH_SHARE)
 
 
+#: The rule text of :meth:`SINDyPI.fit`'s refit with the noisy rule's settings.
+NOISY_REFIT_TEXT = ("the clean recipe's fit failed: fitted again with the noisy rule's "
+                    "settings (weight 1)")
+
+
 #: Replay check of exact-data fits (:meth:`SINDyPI._replay_check`): the held-out choice must
 #: replay the whole record from its measured first state within 1e-4 rad [rad], else the
 #: record left the equations non-unique and they are chosen again by rollout.  Measured
@@ -952,8 +957,8 @@ def excitation_trim(u: np.ndarray, fs: float, keep: float | None = None) -> floa
 def noise_knobs(x: np.ndarray, fs: float, val_fraction: float, user: dict[str, Any],
                 smoothed: float | None = None, declared: np.ndarray | None = None,
                 passband: tuple[float, float] | None = None, ruled: tuple[str, ...] = (),
-                *, inputs: np.ndarray | None = None, column_order: int = 4
-                ) -> tuple[dict[str, Any], str, dict[str, Any]]:
+                *, inputs: np.ndarray | None = None, column_order: int = 4,
+                clean: bool = True) -> tuple[dict[str, Any], str, dict[str, Any]]:
     """SINDy-PI's noise-dependent settings from the angles, and the rule that chose them.
 
     Rule (each setting the user gave is kept as given):
@@ -1038,6 +1043,9 @@ def noise_knobs(x: np.ndarray, fs: float, val_fraction: float, user: dict[str, A
         trimmed span keeps ``EDGE_KEEP_EXCITATION`` of their power (:func:`excitation_trim`).
     column_order : int
         Order of the column low-pass (the clean chain's column cut-off, :func:`chain_column_cutoff`).
+    clean : bool
+        False: the noisy rule's settings (weight 1) whatever the noise (the refit of
+        :meth:`SINDyPI.fit` where the clean recipe's fit failed).
 
     Returns
     -------
@@ -1047,7 +1055,8 @@ def noise_knobs(x: np.ndarray, fs: float, val_fraction: float, user: dict[str, A
     rule : str
         One line: the estimates, the branch taken and which settings the user overrode.
     estimates : dict
-        ``noise_std`` (per channel [rad]), ``noise_rel``, ``band_hz``.
+        ``noise_std`` (per channel [rad]), ``noise_rel``, ``band_hz``, and ``noise_weight``,
+        the noisy rule's weight used (1 unless a declared chain's clean recipe entered).
     """
     sig_x = noise_std(x)
     sig = sig_x if declared is None else np.asarray(declared, dtype=float)
@@ -1055,7 +1064,7 @@ def noise_knobs(x: np.ndarray, fs: float, val_fraction: float, user: dict[str, A
     # the band of the angles as given: their own floor (a chain's smoothing removed the rest)
     band = float(signal_band(x, fs, BAND_SHARE, sig_x).max(initial=0.0))
     record_s = x.shape[1] / fs
-    est = {"noise_std": sig, "noise_rel": noise_rel, "band_hz": band}
+    est = {"noise_std": sig, "noise_rel": noise_rel, "band_hz": band, "noise_weight": 1.0}
     source = "differences" if declared is None else "declared by the signal chain"
     head = (f"noise {100 * noise_rel:.3g} % of RMS ({source}), band {band:.3g} Hz "
             f"({BAND_SHARE:g} of power)")
@@ -1084,7 +1093,8 @@ def noise_knobs(x: np.ndarray, fs: float, val_fraction: float, user: dict[str, A
                                            else "strong")
         # the noisy rule's weight (1 unless a declared chain derived the rates of angles
         # whose noise is below NOISY_NOISE_REL): the clean recipe's share is 1 - w
-        w = noise_weight(noise_rel) if filtered else 1.0
+        w = noise_weight(noise_rel) if filtered and clean else 1.0
+        est["noise_weight"] = w
         if form == "strong":
             auto_cut = min(CUTOFF_FACTOR * band, 0.45 * fs)
             branch = (f"noisy: strong form, column low-pass {CUTOFF_FACTOR:g} x band = "
@@ -1126,7 +1136,7 @@ def noise_knobs(x: np.ndarray, fs: float, val_fraction: float, user: dict[str, A
                 "edge_trim": trim, "ridge": ridge,
                 "weak_window_s": window if form == "weak" else None, "lhs": lhs,
                 "selection": selection,
-                "rollout_atol": rollout_atol(noise_rel) if filtered else ROLLOUT_ATOL}
+                "rollout_atol": rollout_atol(noise_rel) if w < 1.0 else ROLLOUT_ATOL}
         branch += f", edge trim {trim:.3g} s{capped}, ridge {ridge:.3g}"
         if filtered and noise_rel < CHAIN_REL_FLOOR:
             branch += f" (noise below the chain's own error floor {CHAIN_REL_FLOOR:g})"
@@ -2088,7 +2098,11 @@ class SINDyPI(_ImplicitMechanical):
         knobs, rule, est = noise_knobs(data.x, data.fs, self.val_fraction, user,
                                        getattr(self, "_smoothed", None), data.noise_std,
                                        data.passband, ruled, inputs=data.u,
-                                       column_order=self.column_lowpass_order)
+                                       column_order=self.column_lowpass_order,
+                                       clean=not getattr(self, "_noisy_refit", False))
+        self._noise_weight = est["noise_weight"]
+        if getattr(self, "_noisy_refit", False):
+            rule += "; " + NOISY_REFIT_TEXT
         if ruled:
             rule += "; weak form: the open chain's form comparison (formulation_rule_)"
         if knobs["lhs"] == LHS_INPUT_TERMS:
@@ -2121,7 +2135,41 @@ class SINDyPI(_ImplicitMechanical):
         return knobs
 
     def fit(self, data: Measurement) -> SINDyPI:
-        """Fit (see the class docs); data the noise rule took for exact whose fit leaves a
+        """Fit (see the class docs and :meth:`_fit_recipe`); where the fit under a declared
+        chain's clean recipe (the noise rule's weight below 1, :func:`noise_knobs`) fails, it is
+        done again with the noisy rule's settings (weight 1: the settings that hold from
+        ``NOISY_NOISE_REL`` of noise up, under the same chain), which the rule text then
+        names; if that fails too, the first failure is raised with the second's reason.
+
+        Why: the clean recipe's exact-data ridge (``RIDGE_EXACT``) leaves equations the record
+        does not make unique to the round-off's choice; where that choice fails a fit-time
+        check (round 26's ``fb26_ground_0p55``, clean: no model with input 1 dominant, largest
+        share 0.993 of input 2's; with ridge 1.2e-10, the columns at 1.5 x band or the noisy
+        rule's trim alone it fits and scores 2.4e-7 / 1.9e-6 / 3.3e-7 rad), the noisy rule's
+        settings are the measured fallback (the rule before the clean recipe: 9.2e-4 rad).
+        Nothing changes where the first fit succeeds.
+        """
+        self._noisy_refit = False
+        self._noise_weight = 1.0
+        start = dict(self.__dict__)
+        try:
+            return self._fit_recipe(data)
+        except IdentificationError as exc:
+            if not getattr(self, "_noise_weight", 1.0) < 1.0:
+                raise
+            first = exc
+        self.__dict__.clear()  # nothing the failed fit learned decides the refit's rules
+        self.__dict__.update(start)
+        self._noisy_refit = True
+        try:
+            return self._fit_recipe(data)
+        except IdentificationError as exc:
+            raise IdentificationError(f"{first} ({NOISY_REFIT_TEXT}: {exc})") from None
+        finally:
+            self._noisy_refit = False
+
+    def _fit_recipe(self, data: Measurement) -> SINDyPI:
+        """One fit under the noise rule; data the noise rule took for exact whose fit leaves a
         held-out error above ``EXACT_HOLDOUT_MAX`` are fitted again with the noisy recipe;
         a held-out choice that fails the replay rule, or finds no model for an input, is
         chosen again by rollout (:meth:`_replay_check`)."""

@@ -10,7 +10,7 @@ import pytest
 from benchmarks import sindy_pi_problems as P
 from identify import sindy_pi as sp
 from identify.sindy_pi import SINDyPI
-from testbed.core.errors import HyperparameterError
+from testbed.core.errors import HyperparameterError, IdentificationError
 from testbed.numerics.derivatives import lowpass_differentiate
 from testbed.numerics.noise import noise_std
 from testbed.pipeline.signal_chain import auto_edge_fit
@@ -263,6 +263,31 @@ def test_a_step_input_holds_the_clean_columns_down_and_a_smooth_one_does_not(cle
     one = _chain_smoothed(clean, 1.0)
     a1 = (one.x, one.fs, 0.2, {}, None, one.noise_std, one.passband)
     assert sp.noise_knobs(*a1, inputs=steps)[0] == sp.noise_knobs(*a1, inputs=one.u)[0]
+
+
+def test_a_failed_clean_recipe_fit_is_done_again_with_the_noisy_rules_settings(clean, monkeypatch):
+    """Clean angles under a declared chain: where the clean recipe's fit fails, the fit is
+    done again at the noisy rule's weight 1 (columns CUTOFF_FACTOR x band, the chain's floor
+    ridge) and the rule says so; noisy angles (weight 1 already) raise the failure as it is."""
+    orig = SINDyPI._fit_recipe
+    calls = []
+
+    def clean_fails(self, d):
+        calls.append(self._noisy_refit)
+        if not self._noisy_refit:
+            self._choose_knobs(d)
+            raise IdentificationError("the clean recipe's choice failed")
+        return orig(self, d)
+
+    monkeypatch.setattr(SINDyPI, "_fit_recipe", clean_fails)
+    m = SINDyPI().fit(_chain_smoothed(clean, 0.0))
+    assert calls == [False, True] and sp.NOISY_REFIT_TEXT in m.noise_rule_
+    assert m.column_lowpass_hz_ == pytest.approx(sp.CUTOFF_FACTOR * m.band_hz_)
+    assert m.ridge_ == pytest.approx(sp.RIDGE_PER_NOISE_VAR * sp.CHAIN_REL_FLOOR**2)
+    calls.clear()
+    with pytest.raises(IdentificationError, match="the clean recipe's choice failed$"):
+        SINDyPI().fit(_chain_smoothed(clean, 1.0))
+    assert calls == [False]
 
 
 def test_declared_chain_rollout_selection_is_overridden_by_the_user(clean):
