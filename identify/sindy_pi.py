@@ -176,8 +176,7 @@ from identify.library import Library, fivebar_library, generic_mechanical_librar
 from testbed.core.errors import IdentificationError
 from testbed.core.measurement import Measurement, Trajectory
 from testbed.core.schema import ErrorFn, Field, KeyUse
-from testbed.numerics.derivatives import (CLEAN_DROOP, CUTOFF_GAIN, harmonic_gain, noise_weight,
-                                          relative_noise)
+from testbed.numerics.derivatives import CLEAN_DROOP, CUTOFF_GAIN, harmonic_gain, noise_weight, relative_noise
 from testbed.numerics.filters import cutoff_problem, lowpass, mismatch_cutoff
 from testbed.numerics.gram import normalized_gram, ordered_independent
 from testbed.numerics.noise import noise_std, signal_band

@@ -285,7 +285,7 @@ def test_a_failed_clean_recipe_fit_is_done_again_with_the_noisy_rules_settings(c
     assert m.column_lowpass_hz_ == pytest.approx(sp.CUTOFF_FACTOR * m.band_hz_)
     assert m.ridge_ == pytest.approx(sp.RIDGE_PER_NOISE_VAR * sp.CHAIN_REL_FLOOR**2)
     calls.clear()
-    with pytest.raises(IdentificationError, match="the clean recipe's choice failed$"):
+    with pytest.raises(IdentificationError, match=r"the clean recipe's choice failed$"):
         SINDyPI().fit(_chain_smoothed(clean, 1.0))
     assert calls == [False]
 
