@@ -297,6 +297,89 @@ CUTOFF_HARMONIC = 2.0
 #: the motion's acceleration keeps ~1e-4 of its energy (five-bar multisine), biases the
 #: acceleration by well under 1 % of its RMS.
 CUTOFF_GAIN = 0.99
+#: Droop (1 - zero-phase amplitude gain) at that harmonic asked of the low-pass on clean angles:
+#: with no noise to pass, the cut-off need not stop at ``1 - CUTOFF_GAIN`` (1 %); a droop of
+#: 1e-5 keeps the chain's error on the harmonic to 1e-5 of its amplitude, a tenth of the clean
+#: five-bar bar (1e-4 rad) on a motion of 1 rad.  Order 8: the cut-off ``(1e-2 / 1e-5)^(1/16)
+#: = 1.54`` x the noisy rule's.  (Session 26, pi29: the clean chain-derived five-bars' SINDy-PI
+#: fits miss 1e-4 rad at the 99 % cut-off whatever the identifier's recipe, and reach it with
+#: the cut-off 1.5-1.6 x higher.)
+CLEAN_DROOP = 1e-5
+#: Relative noise (white-noise std / channel RMS about its mean) at or below which the clean
+#: droop holds: the noise is then at most the droop itself, which sets the chain's error.
+CLEAN_NOISE_REL = CLEAN_DROOP
+#: Relative noise from which the droop is ``1 - CUTOFF_GAIN`` unchanged (the rule measured on
+#: 0.5-5 % noise): a tenth of the 1 % noise asked of the identifiers, which keeps the estimate
+#: of the lowest noisy level studied (0.5 %) five-fold clear of it.
+NOISY_NOISE_REL = 1e-3
+
+
+def relative_noise(x: np.ndarray, sigma: np.ndarray) -> float:
+    """Largest over channels of the white-noise std over the channel's RMS about its mean.
+
+    Parameters
+    ----------
+    x : ndarray, shape (n_channels, n_samples)
+        The record [U].
+    sigma : ndarray, shape (n_channels,)
+        White-noise std of each channel [U].
+
+    Returns
+    -------
+    float
+        The relative noise (0 on channels that do not move).
+    """
+    rms = np.std(x, axis=1)
+    rel_ch = np.where(rms > 0, np.asarray(sigma, dtype=float) / np.where(rms > 0, rms, 1.0), 0.0)
+    return float(rel_ch.max(initial=0.0))
+
+
+def noise_weight(noise_rel: float) -> float:
+    """Weight of the noisy rule, from the relative noise: 0 at or below ``CLEAN_NOISE_REL``, 1
+    at or above ``NOISY_NOISE_REL`` (and for a NaN level: the noisy rule is the safe one),
+    linear in ``log(noise_rel)`` between, so that nothing the chain or an identifier chooses
+    from it jumps with the noise level.
+
+    Parameters
+    ----------
+    noise_rel : float
+        Largest over channels of the white-noise std over the channel's RMS about its mean.
+
+    Returns
+    -------
+    float
+        In [0, 1].
+    """
+    rel = float(noise_rel)
+    if not rel < NOISY_NOISE_REL:
+        return 1.0
+    if rel <= CLEAN_NOISE_REL:
+        return 0.0
+    return float(np.log(rel / CLEAN_NOISE_REL) / np.log(NOISY_NOISE_REL / CLEAN_NOISE_REL))
+
+
+def harmonic_gain(noise_rel: float) -> float:
+    """The zero-phase gain :func:`harmonic_cutoff` asks at the harmonic, from the relative noise.
+
+    The droop ``1 - gain`` is ``CLEAN_DROOP^(1 - w) (1 - CUTOFF_GAIN)^w``, ``w`` =
+    :func:`noise_weight`: ``CLEAN_DROOP`` on clean angles, ``1 - CUTOFF_GAIN`` (exactly
+    ``CUTOFF_GAIN``) from ``NOISY_NOISE_REL`` up, geometric between (the cut-off then moves by a
+    constant factor per decade of noise).
+
+    Parameters
+    ----------
+    noise_rel : float
+        Relative noise, as :func:`noise_weight`.
+
+    Returns
+    -------
+    float
+        Gain in (0, 1).
+    """
+    w = noise_weight(noise_rel)
+    if w >= 1.0:
+        return CUTOFF_GAIN
+    return float(1.0 - CLEAN_DROOP ** (1.0 - w) * (1.0 - CUTOFF_GAIN) ** w)
 
 
 def harmonic_cutoff(band_hz: float, order: int, harmonic: float = CUTOFF_HARMONIC,

@@ -800,9 +800,13 @@ def auto_cutoff(theta: np.ndarray, fs: float, order: int, noise: np.ndarray | No
     Rule: the band ``B`` = the largest over channels of the frequency holding
     ``AUTO_BAND_SHARE`` of the angle's power above its white-noise floor
     (:func:`testbed.numerics.noise.signal_band`); the cut-off is the lowest that passes
-    ``2 B`` (the linkage's second harmonics) with 99 % amplitude
+    ``2 B`` (the linkage's second harmonics) with the zero-phase gain
+    :func:`testbed.numerics.derivatives.harmonic_gain` of the angles' relative noise
+    (:func:`testbed.numerics.derivatives.relative_noise` of ``noise``): 99 % from 0.1 %
+    noise up, ``1 - 1e-5`` on clean angles (``CLEAN_DROOP``; order 8: 1.54 x the 99 %
+    cut-off), geometric in the droop between, so continuous in the noise
     (:func:`testbed.numerics.derivatives.harmonic_cutoff`), at most ``AUTO_CUTOFF_MAX_SHARE
-    fs``.  Five-bar multisine (band 1.5 Hz), order 8: 4.0 Hz, the hand-found value.
+    fs``.  Five-bar multisine (band 1.5 Hz), order 8, 1 % noise: 4.0 Hz, the hand-found value.
 
     Parameters
     ----------
@@ -825,10 +829,12 @@ def auto_cutoff(theta: np.ndarray, fs: float, order: int, noise: np.ndarray | No
     ValueError
         If no channel has signal power above its noise floor (no band to pass).
     """
-    band = float(noise_est.signal_band(theta, fs, AUTO_BAND_SHARE, noise).max(initial=0.0))
+    sigma = noise_est.noise_std(theta) if noise is None else noise
+    band = float(noise_est.signal_band(theta, fs, AUTO_BAND_SHARE, sigma).max(initial=0.0))
     if not band > 0:
         raise ValueError("cutoff_hz = 'auto': the angles hold no power above their noise floor")
-    return min(derivatives.harmonic_cutoff(band, order), AUTO_CUTOFF_MAX_SHARE * fs)
+    gain = derivatives.harmonic_gain(derivatives.relative_noise(theta, sigma))
+    return min(derivatives.harmonic_cutoff(band, order, gain=gain), AUTO_CUTOFF_MAX_SHARE * fs)
 
 
 #: ``edge_fit_s = "auto"``: the end fits span EDGE_FIT_PERIODS periods of the low-pass cut-off.

@@ -10,7 +10,7 @@ import pytest
 from benchmarks import sindy_pi_problems as P
 from identify import sindy_pi as sp
 from identify.sindy_pi import SINDyPI
-from testbed.core.errors import HyperparameterError
+from testbed.core.errors import HyperparameterError, IdentificationError
 from testbed.numerics.derivatives import lowpass_differentiate
 from testbed.numerics.noise import noise_std
 from testbed.pipeline.signal_chain import auto_edge_fit
@@ -193,17 +193,26 @@ def test_declared_noise_fit_writes_equations_for_the_input_terms(clean):
 def test_clean_angles_through_a_declared_chain_get_the_chain_recipe(clean):
     # noise-free angles, rates and accelerations derived by the declared 4 Hz chain: the rates
     # are still estimates (the chain's own error), so the noise estimate of ~0 must not send
-    # them to the exact-data recipe (ridge 1e-14: the family's clean members lost their input
-    # terms or diverged, 13/30 within 0.0501 rad)
+    # them to the exact-data recipe (no column filter, no trim, the held-out choice: the
+    # family's clean members lost their input terms or diverged, 13/30 within 0.0501 rad);
+    # they take the chain's strong form, input-term LHS and rollout with the clean ends of its
+    # continuous settings: ridge RIDGE_EXACT, columns a decade down at the chain's cut-off
+    # (order 4: 0.75 x 4 Hz), ties within the chain's clean droop (1e-3 x ROLLOUT_ATOL)
     data = _chain_smoothed(clean, 0.0)
     knobs, rule, est = sp.noise_knobs(data.x, data.fs, 0.2, {}, None, data.noise_std,
                                       data.passband)
     assert est["noise_rel"] <= sp.NOISE_FREE_REL and "exact data" not in rule
-    assert knobs["formulation"] == "strong" and knobs["column_lowpass_hz"] > 0
-    assert knobs["ridge"] == pytest.approx(sp.RIDGE_PER_NOISE_VAR * sp.CHAIN_REL_FLOOR ** 2)
-    assert f"error floor {sp.CHAIN_REL_FLOOR:g}" in rule
+    assert knobs["formulation"] == "strong"
+    assert knobs["column_lowpass_hz"] == pytest.approx(4.0 / 10 ** (1 / 8))
+    assert knobs["ridge"] == sp.RIDGE_EXACT and knobs["rollout_atol"] == pytest.approx(1e-7)
     assert "clean angles, rates derived by a low-pass: strong form" in rule
     assert knobs["lhs"] == sp.LHS_INPUT_TERMS and knobs["selection"] == "rollout"
+    # the noisy ends are the rule before, bit for bit: 1 % (and anything from NOISY_NOISE_REL)
+    one = _chain_smoothed(clean, 1.0)
+    k1, _, e1 = sp.noise_knobs(one.x, one.fs, 0.2, {}, None, one.noise_std, one.passband)
+    assert k1["column_lowpass_hz"] == sp.CUTOFF_FACTOR * e1["band_hz"]
+    assert k1["ridge"] == sp.RIDGE_PER_NOISE_VAR * max(e1["noise_rel"], sp.CHAIN_REL_FLOOR) ** 2
+    assert k1["rollout_atol"] == sp.ROLLOUT_ATOL
     # the floor is a floor: 5 % noise keeps its own ridge (25 x the floor's)
     noisy = _chain_smoothed(clean, 5.0)
     assert sp.noise_knobs(noisy.x, noisy.fs, 0.2, {}, None, noisy.noise_std,
@@ -213,6 +222,72 @@ def test_clean_angles_through_a_declared_chain_get_the_chain_recipe(clean):
     # clean pick simulates at least as well as the 1 % one's bar (a fifth of 0.0501 rad)
     assert "smoothed noise" not in m.noise_rule_ and m.ridge_ == knobs["ridge"]
     assert m.selection_ == "rollout" and m.rollout_rmse_ < 0.0501 / 5
+
+
+def test_the_clean_chain_recipe_is_continuous_in_the_declared_noise(clean):
+    """Between the clean and the noisy ends the column cut-off, ridge and tie band move
+    geometrically with the noise weight: on the same smoothed angles with the declared level
+    stepped by 10 % from 1e-6 to 1e-2, no setting moves by more than its two ends' ratio
+    times the weight's largest step (log(1.1) / log(100)), and each is monotone."""
+    from testbed.numerics import derivatives as der
+    data = _chain_smoothed(clean, 0.0)
+    std = data.x.std(axis=1)
+    rels = np.exp(np.arange(np.log(1e-6), np.log(1e-2), np.log(1.1)))
+    ks = [sp.noise_knobs(data.x, data.fs, 0.2, {}, None, r * std, data.passband)[0]
+          for r in rels]
+    step = np.log(1.1) / np.log(der.NOISY_NOISE_REL / der.CLEAN_NOISE_REL)
+    for key in ("column_lowpass_hz", "ridge", "rollout_atol"):
+        v = np.log([k[key] for k in ks])
+        span = abs(v[-1] - v[0])
+        assert np.max(np.abs(np.diff(v))) <= span * step * 1.01 + 1e-12, key
+        assert np.all(np.diff(v) >= -1e-12) or np.all(np.diff(v) <= 1e-12), key
+    assert ks[0]["ridge"] == sp.RIDGE_EXACT and ks[-1]["rollout_atol"] == sp.ROLLOUT_ATOL
+
+
+def test_a_step_input_holds_the_clean_columns_down_and_a_smooth_one_does_not(clean):
+    """The clean column cut-off (a decade down at the chain's) is held down where the
+    measured inputs carry the chain's transition band (round 16's step-input cart-pole lost
+    0.188 rad to it): the same clean angles with their multisine inputs keep it; with 2 N
+    steps held 0.5 s in their place it falls strictly below it, never below the noisy rule's
+    ``CUTOFF_FACTOR`` x band, and the rule says why.  Noisy angles (1 %) are untouched."""
+    data = _chain_smoothed(clean, 0.0)
+    args = (data.x, data.fs, 0.2, {}, None, data.noise_std, data.passband)
+    k_ms, rule_ms, est = sp.noise_knobs(*args, inputs=data.u)
+    decade = sp.chain_column_cutoff(data.passband[1], 4)
+    assert k_ms["column_lowpass_hz"] == pytest.approx(decade) and "holds it" not in rule_ms
+    t = np.arange(data.u.shape[1]) / data.fs
+    steps = np.tile(2.0 * np.where(np.floor(t / 0.5) % 2 == 0, 1.0, -1.0), (data.u.shape[0], 1))
+    k_st, rule_st, _ = sp.noise_knobs(*args, inputs=steps)
+    assert sp.CUTOFF_FACTOR * est["band_hz"] <= k_st["column_lowpass_hz"] < 0.99 * decade
+    assert "the inputs' chain mismatch holds it" in rule_st
+    one = _chain_smoothed(clean, 1.0)
+    a1 = (one.x, one.fs, 0.2, {}, None, one.noise_std, one.passband)
+    assert sp.noise_knobs(*a1, inputs=steps)[0] == sp.noise_knobs(*a1, inputs=one.u)[0]
+
+
+def test_a_failed_clean_recipe_fit_is_done_again_with_the_noisy_rules_settings(clean, monkeypatch):
+    """Clean angles under a declared chain: where the clean recipe's fit fails, the fit is
+    done again at the noisy rule's weight 1 (columns CUTOFF_FACTOR x band, the chain's floor
+    ridge) and the rule says so; noisy angles (weight 1 already) raise the failure as it is."""
+    orig = SINDyPI._fit_recipe
+    calls = []
+
+    def clean_fails(self, d):
+        calls.append(self._noisy_refit)
+        if not self._noisy_refit:
+            self._choose_knobs(d)
+            raise IdentificationError("the clean recipe's choice failed")
+        return orig(self, d)
+
+    monkeypatch.setattr(SINDyPI, "_fit_recipe", clean_fails)
+    m = SINDyPI().fit(_chain_smoothed(clean, 0.0))
+    assert calls == [False, True] and sp.NOISY_REFIT_TEXT in m.noise_rule_
+    assert m.column_lowpass_hz_ == pytest.approx(sp.CUTOFF_FACTOR * m.band_hz_)
+    assert m.ridge_ == pytest.approx(sp.RIDGE_PER_NOISE_VAR * sp.CHAIN_REL_FLOOR**2)
+    calls.clear()
+    with pytest.raises(IdentificationError, match=r"the clean recipe's choice failed$"):
+        SINDyPI().fit(_chain_smoothed(clean, 1.0))
+    assert calls == [False]
 
 
 def test_declared_chain_rollout_selection_is_overridden_by_the_user(clean):

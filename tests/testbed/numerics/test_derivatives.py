@@ -116,3 +116,42 @@ def test_a_step_near_an_end_is_not_read_as_the_filters_transient(monkeypatch, wh
         return float(np.sqrt(np.mean(np.concatenate([(a - ideal)[:, :k], (a - ideal)[:, -k:]]) ** 2)))
 
     assert ends_rms(got) < 1.5 * ends_rms(old), (ends_rms(got), ends_rms(old))
+
+
+def test_the_clean_cutoff_factor_is_the_droops():
+    """On clean angles the cut-off passes the second harmonic with droop ``CLEAN_DROOP``
+    instead of ``1 - CUTOFF_GAIN``: the zero-phase Butterworth's ``(f / fc)^(2 n) = 1 / g - 1``
+    gives the factor ``((1 / g_noisy - 1) / (1 / g_clean - 1))^(1 / (2 n))``, 1.54 at order 8.
+    From ``NOISY_NOISE_REL`` up (and for an unknown level) the gain is ``CUTOFF_GAIN`` itself,
+    so the noisy rule's cut-offs are unchanged bit for bit."""
+    g = der.harmonic_gain(0.0)
+    assert g == pytest.approx(1.0 - der.CLEAN_DROOP, abs=1e-15)
+    for order in (2, 4, 8):
+        f = der.harmonic_cutoff(1.5, order, gain=g) / der.harmonic_cutoff(1.5, order)
+        want = ((1 / der.CUTOFF_GAIN - 1) / (1 / g - 1)) ** (1 / (2 * order))
+        assert f == pytest.approx(want, rel=1e-12)
+    assert der.harmonic_cutoff(1.0, 8, gain=g) / der.harmonic_cutoff(1.0, 8) == pytest.approx(
+        1.54, abs=0.005)
+    for rel in (der.NOISY_NOISE_REL, 5e-3, 0.01, 0.5, np.nan, np.inf):
+        assert der.harmonic_gain(rel) == der.CUTOFF_GAIN
+
+
+def test_the_noise_weight_is_continuous_and_monotone_in_the_noise():
+    """No switch: on a grid of relative noise 1e-8..1 with neighbours 0.5 % apart the weight
+    never falls and never moves by more than its log-linear slope allows (one grid step of
+    ``log(1.005) / log(NOISY_NOISE_REL / CLEAN_NOISE_REL)``, plus round-off); 0 on clean
+    angles, 1 from ``NOISY_NOISE_REL``; the droop between is geometric."""
+    rel = np.exp(np.arange(np.log(1e-8), 0.0, np.log(1.005)))
+    w = np.array([der.noise_weight(r) for r in rel])
+    step = np.log(1.005) / np.log(der.NOISY_NOISE_REL / der.CLEAN_NOISE_REL)
+    assert np.all(np.diff(w) >= 0) and np.max(np.diff(w)) <= step * (1 + 1e-9)
+    assert np.all(w[rel <= der.CLEAN_NOISE_REL] == 0) and np.all(w[rel >= der.NOISY_NOISE_REL] == 1)
+    mid = np.sqrt(der.CLEAN_NOISE_REL * der.NOISY_NOISE_REL)
+    droop = 1 - der.harmonic_gain(mid)
+    assert droop == pytest.approx(np.sqrt(der.CLEAN_DROOP * (1 - der.CUTOFF_GAIN)), rel=1e-9)
+
+
+def test_relative_noise_is_the_largest_channels_and_zero_on_a_still_channel():
+    x = np.vstack([np.sin(np.linspace(0, 6, 400)), np.full(400, 2.0)])
+    rel = der.relative_noise(x, np.array([0.01, 0.3]))
+    assert rel == pytest.approx(0.01 / np.std(x[0]))

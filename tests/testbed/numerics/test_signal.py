@@ -410,3 +410,64 @@ def test_a_filter_design_is_computed_once_and_handed_out_as_a_copy(monkeypatch):
     lp[:] = 0.0
     assert np.array_equal(sig._lowpass_sos(12800.0, 450.0, 8),
                           ss.butter(8, 450.0, btype="lowpass", output="sos", fs=12800.0))
+
+
+def _steps_and_multisine(fs=1000.0, seconds=3.0):
+    """A 2-level step input held 0.5 s (a 1/f spectrum through any band) and a 3-tone
+    multisine to 1.5 Hz (nothing above its band), both [N]."""
+    t = np.arange(int(seconds * fs)) / fs
+    steps = 2.0 * np.where(np.floor(t / 0.5) % 2 == 0, 1.0, -1.0)
+    ms = sum(np.sin(2 * np.pi * f * t + p) for f, p in ((0.5, 0.3), (1.0, 1.1), (1.5, 2.0)))
+    return t, steps, ms
+
+
+def test_zero_phase_gain_is_the_lowpass_response():
+    """The forward-backward Butterworth's gain on a tone (mid-record, clear of the ends) is
+    :func:`zero_phase_gain` to the digital design's warping, ``O((f / fs)^2)``: 1e-4 here."""
+    fs, fc = 1000.0, 6.85
+    t = np.arange(20000) / fs
+    for f in (2.0, 5.0, 6.8, 9.0):  # whole periods in the 10 s read
+        y = sig.lowpass(np.sin(2 * np.pi * f * t), fs, fc, 8)[5000:15000]
+        amp = np.sqrt(2.0 * np.mean(y**2))
+        assert amp == pytest.approx(sig.zero_phase_gain(f, fc, 8), abs=1e-4), f
+
+
+def test_chain_mismatch_share_rises_with_the_column_cutoff_and_reads_steps():
+    """The share never falls as the column cut-off rises; a step input's is orders above a
+    multisine's at the clean column cut-off (0.75 x a 6.85 Hz chain): the steps carry the
+    chain's transition band, the tones' leakage through the window stays below 1e-12."""
+    fs = 1000.0
+    _, steps, ms = _steps_and_multisine(fs)
+    cuts = np.geomspace(1.0, 6.0, 40)
+    for u in (steps, ms):
+        f, p = sig.input_power(u, fs)
+        share = [sig.chain_mismatch_share(f, p, 6.85, 8, c, 4) for c in cuts]
+        assert np.all(np.diff(share) >= 0), share
+    f, p = sig.input_power(steps, fs)
+    assert sig.chain_mismatch_share(f, p, 6.85, 8, 5.13, 4) > 1e-6
+    f, p = sig.input_power(ms, fs)
+    assert sig.chain_mismatch_share(f, p, 6.85, 8, 5.13, 4) < 1e-12
+    # two rows: the larger share counts (units of one input never hide another's tail)
+    f, p = sig.input_power(np.vstack([100.0 * ms, steps]), fs)
+    assert sig.chain_mismatch_share(f, p, 6.85, 8, 5.13, 4) == pytest.approx(
+        sig.chain_mismatch_share(*sig.input_power(steps, fs), 6.85, 8, 5.13, 4))
+
+
+def test_mismatch_cutoff_holds_steps_down_and_keeps_smooth_inputs():
+    """Between the bounds: a multisine keeps the high cut-off; steps get the crossing of the
+    bound (their share there equals it to the bisection's width), strictly inside; a bound no
+    cut-off meets gives the low one, as does a NaN input; the cut-off moves little when the
+    input moves little (continuity: a 1e-3 change of the step level times a slow ramp)."""
+    fs, bound = 1000.0, 1e-10
+    t, steps, ms = _steps_and_multisine(fs)
+    assert sig.mismatch_cutoff(ms, fs, 6.85, 8, 4, 2.5, 5.13, bound) == 5.13
+    c = sig.mismatch_cutoff(steps, fs, 6.85, 8, 4, 1.0, 5.13, bound)
+    assert 1.0 < c < 5.13
+    assert sig.chain_mismatch_share(*sig.input_power(steps, fs), 6.85, 8, c, 4) == pytest.approx(
+        bound, rel=1e-6)
+    assert sig.mismatch_cutoff(steps, fs, 6.85, 8, 4, 4.0, 5.13, bound) == 4.0
+    bad = steps.copy()
+    bad[10] = np.nan
+    assert sig.mismatch_cutoff(bad, fs, 6.85, 8, 4, 2.5, 5.13, bound) == 2.5
+    c2 = sig.mismatch_cutoff(steps * (1 + 1e-3 * t / t[-1]), fs, 6.85, 8, 4, 1.0, 5.13, bound)
+    assert abs(np.log(c2 / c)) < 1e-2

@@ -150,8 +150,9 @@ def test_auto_cutoff_is_continuous_in_the_noise_level():
     cut-off where the spectrum meets its noise floor) made the cut-off jump with the noise
     level on one record: 112 / 32 / 4500 / 4.8 / 4.8 Hz at relative noise 0 / 5e-7 / 9e-7 /
     2e-6 / 1e-5 (and on round 22's down-branch multisine, 9e-7, 4500 Hz and a failed fit).
-    The chain's cut-off must not depend on noise this far below the motion: here 4.80 Hz at
-    every level (the harmonic rule on the 1.5 Hz top tone)."""
+    The chain's cut-off must not depend on noise this far below the motion: here 7.39 Hz at
+    every level (the harmonic rule on the 1.5 Hz top tone with the clean droop, 1.54 x 4.80 Hz;
+    at 1e-5, the estimate just above ``CLEAN_NOISE_REL``, 7.392 Hz)."""
     th = _multisine()
     z = np.random.default_rng(1).standard_normal(th.shape)
     cuts = [auto_cutoff(th + rel * th.std(axis=1)[:, None] * z, 1e4, 8)
@@ -223,3 +224,26 @@ def test_auto_cutoff_on_the_down_branch_multisine_near_clean():
     cuts = [auto_cutoff(raw, ds.fs, 8)] + [auto_cutoff(clean[:, : n // m], ds.fs, 8)
                                            for m in (1, 2, 4)]
     assert _within_resolution(cuts, n // 4, ds.fs), cuts
+
+
+def test_auto_cutoff_passes_the_clean_harmonic_with_the_clean_droop():
+    """Clean angles: the cut-off passes twice the band with droop ``CLEAN_DROOP`` (order 8:
+    1.54 x the 99 % cut-off of the same band); from ``NOISY_NOISE_REL`` of declared noise up it
+    is the 99 % rule's bit for bit; between, it falls monotonically with the declared level."""
+    ds = dataset(0.0)
+    th = ds.measured["theta"].data
+    std = th.std(axis=1)
+    band = signal_band(th, ds.fs, AUTO_BAND_SHARE, noise_std(th)).max()
+    clean = auto_cutoff(th, ds.fs, 8)
+    assert clean == pytest.approx(der.harmonic_cutoff(band, 8, gain=1 - der.CLEAN_DROOP))
+    assert clean / der.harmonic_cutoff(band, 8) == pytest.approx(1.54, abs=0.005)
+    for rel in (der.NOISY_NOISE_REL, 0.01):
+        noise = rel * std
+        b = signal_band(th, ds.fs, AUTO_BAND_SHARE, noise).max()
+        assert auto_cutoff(th, ds.fs, 8, noise) == der.harmonic_cutoff(b, 8)
+    # between: the factor over the 99 % rule's cut-off of the same band falls with the level
+    facs = []
+    for rel in (1e-6, 1e-5, 3e-5, 1e-4, 3e-4, 1e-3):
+        b = signal_band(th, ds.fs, AUTO_BAND_SHARE, rel * std).max()
+        facs.append(auto_cutoff(th, ds.fs, 8, rel * std) / der.harmonic_cutoff(b, 8))
+    assert facs[0] == facs[1] and np.all(np.diff(facs[1:]) < 0) and facs[-1] == 1.0
