@@ -99,6 +99,15 @@ class _Parser(argparse.ArgumentParser):
         if rest and len(many) == 1 and not any(r.startswith("-") for r in rest):
             setattr(ns, many[0].dest, [*(getattr(ns, many[0].dest) or []), *rest])
             rest = []
+        # `runs ls -o out/runs cantilever`: the same for an optional positional (nargs "?")
+        # left empty when the positional before it was taken alone (round 27: "unrecognized
+        # arguments: cantilever"); one name left over is its value
+        maybe = [a for a in self._actions if not a.option_strings and a.nargs == "?"]
+        if (len(rest) == 1 and not rest[0].startswith("-") and len(maybe) == 1
+                and getattr(ns, maybe[0].dest, None) is None):
+            value = self._get_values(maybe[0], rest)
+            setattr(ns, maybe[0].dest, value)
+            rest = []
         return ns, rest
 
     def error(self, message: str) -> None:  # type: ignore[override]
@@ -1069,10 +1078,10 @@ def build_parser() -> argparse.ArgumentParser:
     i.set_defaults(fn=cmd_identify)
 
     rep = sub.add_parser("report", help="HTML + markdown report of a run folder or sweep results")
-    rep.add_argument("source", help="a run folder (from `testbed run`), a scenario's folder of runs "
+    rep.add_argument("source", type=_path_text, help="a run folder (from `testbed run`), a scenario's folder of runs "
                                     "or a scenario name (its latest run), or a sweep results file")
     rep.add_argument("-o", "--output", required=True, type=_path_text, help="report folder")
-    rep.add_argument("--runs", default="out/runs",
+    rep.add_argument("--runs", default="out/runs", type=_path_text,
                      help="where a scenario name's runs are (default out/runs)")
     rep.set_defaults(fn=cmd_report)
 
