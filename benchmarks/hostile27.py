@@ -20,7 +20,8 @@ Families (what rounds 1-26 did not try; their families are listed in ``hostile21
     :func:`serve`, replaced by a stub: their options and checks are the subject, not a demo
     run or a resident server); the values ``""`` and the long word as processes too.  A
     traceback, an internal error, a refusal in more than one line, a refusal that names neither
-    the option nor its value, or a number option (``--seed``, ``--fs``, ``--jobs``,
+    the option nor its value, a declared argument refused as "unrecognized", the PNG replaced
+    by a command's output (nothing is lost), or a number option (``--seed``, ``--fs``, ``--jobs``,
     ``--idle``) accepting NaN / inf / 1e400 / "", is a finding.
 ``stores``
     A sweep's results file (Parquet) and a run folder corrupted in each way: cut short, zero
@@ -31,6 +32,31 @@ Families (what rounds 1-26 did not try; their families are listed in ``hostile21
     removed, then ``report`` and ``runs ls``.  A traceback, a refusal in more than one line, or
     a report / summary / sweep that goes on over a file it could not verify (status 0 with the
     damaged row counted), is a finding.
+``cache``
+    The Michaelis-Menten clean cache entry (a private copy of the cache) cut in half, emptied,
+    its stored content hash edited, a sample edited, ``fs`` edited, the entry or its folder
+    read-only, the entry a folder, a dangling link or a JSON file; then ``generate`` and
+    ``run``.  A traceback, a dataset written whose content hash differs from a fresh
+    ``--no-cache`` one, or a refusal where the entry could be simulated again (not a folder
+    that is the user's), is a finding.
+``kill``
+    ``generate`` and a 4-cell ``sweep`` in their own session sent SIGKILL, SIGINT or SIGTERM
+    after 0.3-7 s, then rerun.  A process of the session left (/proc), an output that does
+    not load whole, a temporary file after SIGINT / SIGTERM, a traceback, or a rerun that does
+    not report exactly the rows on disk as "already done" or ends with other than 4 cells once
+    each, is a finding.
+``served``
+    A ``testbed serve`` on a private socket sent damaged requests (a header only, half a
+    request, a length of 2**32 - 1, not JSON, JSON nested 100,000 deep, no or two descriptors,
+    fields of the wrong type, 100,000 arguments), two clients at once, a client killed
+    mid-command.  A real command not served in 5 s after each, two outputs that differ, or
+    the server's command children left after their client died, is a finding.
+``roundtrip``
+    The kinetics record exported as SEP-005 and UFF and identified back: another model than the
+    dataset's own is a finding; the SEP-005 export with its metadata edited (``fs`` 0 / -100 /
+    a text / null, one channel's ``fs`` or length changed, a null sample, a name twice, an
+    unknown unit): anything but a one-line refusal is a finding (an unknown key, the
+    ``content_hash`` or ``group`` edited: the same model).
 
 Prints one line a finding and the counts; exits 1 if any finding.
 """
@@ -79,6 +105,9 @@ NOT_A_NUMBER = {"empty", "NaN", "inf", "1e400"}
 #: Options whose value is a number (their type's function names).
 NUMBER_TYPES = {"_float", "_seed", "_jobs", "_int_at_least"}
 
+#: The file of the wrong kind: a PNG's signature and bytes.
+PICTURE = b"\x89PNG\r\n\x1a\n" + bytes(range(256)) * 4
+
 STUDY = f"""[study]
 name = "h27"
 scenarios = ["{MM}"]
@@ -91,7 +120,7 @@ identifiers = ["sindy_pi_dynamical"]
 def _fixtures(w: Path) -> dict[str, Path]:
     """The scratch folder's inputs: a record, a one-cell study and its results, a run."""
     (w / "adir").mkdir(exist_ok=True)
-    (w / "picture.png").write_bytes(b"\x89PNG\r\n\x1a\n" + bytes(range(256)) * 4)
+    (w / "picture.png").write_bytes(PICTURE)
     study = w / "h27.toml"
     study.write_text(STUDY)
     h5 = hostile19._generated(w, MM)
@@ -151,13 +180,13 @@ def _with_value(base: list[str], action: argparse.Action, positional_index: int,
         return argv
     long = max(action.option_strings, key=len)
     if action.nargs == 0:
-        return argv + [f"{long}={value}"]
+        return [*argv, f"{long}={value}"]
     for i, a in enumerate(argv):
         if a in action.option_strings and i + 1 < len(argv):
             argv[i + 1] = value
             return argv
     # a value starting with '-' is read as an option when separate: give it as --opt=value
-    return argv + [f"{long}={value}"]
+    return [*argv, f"{long}={value}"]
 
 
 def _names(action: argparse.Action) -> list[str]:
@@ -173,6 +202,10 @@ def _flag_finding(status: int, out: str, err: str, action: argparse.Action, labe
     number = any(kind.startswith(t) for t in NUMBER_TYPES) or "_int_at_least" in repr(action.type)
     if number and label in NOT_A_NUMBER and status != 2:
         return f"number option accepted {value!r} with status {status}"
+    if status == 2 and "unrecognized arguments" in err:
+        # the value went to the option or positional it was given for: argparse's own
+        # ordering rule refused a command a user may write (`runs ls -o DIR NAME`)
+        return f"a declared argument refused as unrecognized: {err.strip()[:160]!r}"
     if status == 2:
         line = err.strip()
         shown = value[:40] or "''"
@@ -224,6 +257,10 @@ def flags_cases(work: Path) -> list[tuple[str, object]]:
                 if label == "a folder":  # a command may have written into it
                     shutil.rmtree(work / "adir", ignore_errors=True)
                     (work / "adir").mkdir()
+            picture = work / "picture.png"
+            if picture.read_bytes() != PICTURE:  # the user's file replaced (nothing is lost)
+                picture.write_bytes(PICTURE)
+                return f"status {status}: a file of another kind (a PNG) replaced"
             if os.environ.get("HOSTILE27_TRACE"):
                 print(f"  {cmd} {action.dest} {label}: {status} "
                       f"{(err.strip().splitlines() or [''])[-1][:150]!r}", flush=True)
@@ -656,12 +693,14 @@ def kill_cases(work: Path) -> list[tuple[str, object]]:
 # ------------------------------------------------------------------ roundtrip
 
 def roundtrip_cases(work: Path) -> list[tuple[str, object]]:
-    """Every export format identified back: the same model as the dataset's own."""
+    """Every export format identified back: the same model as the dataset's own; the SEP-005
+    export with its metadata edited: refused in one line, or (an unknown key, the source
+    dataset's hash, which no importer can verify without the truth) the same model."""
     state: dict = {}
 
     def model_of(path, *more):
         out = path.with_suffix(path.suffix + ".model.json")
-        status, o, err = cli_inprocess(["identify", str(path), "--scenario", MM, "-o", str(out),
+        status, _, err = cli_inprocess(["identify", str(path), "--scenario", MM, "-o", str(out),
                                         *more])
         if status not in (0, 1):
             raise RuntimeError(f"identify {path.name}: {err.strip()[:200]}")
@@ -693,11 +732,232 @@ def roundtrip_cases(work: Path) -> list[tuple[str, object]]:
             return None
         return run
 
-    return [(f"export {fmt} then identify", case(fmt)) for fmt in ("sep005", "uff")]
+    def edit(change, expect):
+        """The SEP-005 export with ``change(channels)`` applied, identified: ``expect`` "refuse"
+        (one line) or "same" (the clean model)."""
+        def run():
+            h5 = hostile19._generated(work, MM)
+            src = work / "base.sep005.json"
+            if not src.exists():
+                status, _, err = cli_inprocess(["export", str(h5), "--format", "sep005", "-o",
+                                                str(src)])
+                if status != 0:
+                    return f"export: {err.strip()[:160]}"
+            if "ref" not in state:
+                state["ref"] = model_of(h5)
+            channels = json.loads(src.read_text())
+            change(channels)
+            state["n"] = state.get("n", 0) + 1
+            path = work / f"edit{state['n']}.json"
+            path.write_text(json.dumps(channels))
+            out = path.with_suffix(".model.json")
+            status, o, err = cli_inprocess(["identify", str(path), "--scenario", MM, "-o",
+                                            str(out)])
+            finding = judged(status, o, err, refuse=expect == "refuse")
+            if finding or expect == "refuse":
+                return finding
+            got = json.loads(out.read_text()).get("coefficients")
+            if got != state["ref"].get("coefficients"):
+                return f"accepted, another model: {got}"
+            return None
+        return run
+
+    def each(key, value):
+        def change(chs):
+            for c in chs:
+                c[key] = value
+        return change
+
+    def first(key, value):
+        def change(chs):
+            chs[0][key] = value
+        return change
+
+    def cut(chs):
+        chs[0]["data"] = chs[0]["data"][:200]
+
+    def null_sample(chs):
+        chs[0]["data"][5] = None
+
+    def twice(chs):
+        chs[1]["name"] = chs[0]["name"]
+
+    edits = [("fs 0 everywhere", each("fs", 0.0), "refuse"),
+             ("fs -100 everywhere", each("fs", -100.0), "refuse"),
+             ("fs a text everywhere", each("fs", "100"), "refuse"),
+             ("fs null everywhere", each("fs", None), "refuse"),
+             ("fs of one channel halved", first("fs", 50.0), "refuse"),
+             ("one channel cut to half its samples", cut, "refuse"),
+             ("a null sample", null_sample, "refuse"),
+             ("two channels of one name", twice, "refuse"),
+             ("unit_str of one channel unknown", first("unit_str", "furlong"), "refuse"),
+             ("unit_str a number", first("unit_str", 5), "refuse"),
+             ("an unknown key", first("colour", "red"), "same"),
+             ("content_hash edited", each("content_hash", "0" * 64), "same"),
+             # `group` is the export's note of where a channel came from ("measured": only
+             # measured signals are exported); SEP-005 does not define it and other tools
+             # write their own words there, so the importer reads past it
+             ("group another", first("group", "truth"), "same")]
+    return [(f"export {fmt} then identify", case(fmt)) for fmt in ("sep005", "uff")] + [
+        (f"sep005 edited: {label}", edit(change, expect)) for label, change, expect in edits]
+
+
+# ------------------------------------------------------------------ served
+
+def _children(pid: int) -> list[int]:
+    """Live (not zombie) processes whose parent is ``pid`` (from /proc)."""
+    out = []
+    for d in Path("/proc").iterdir():
+        if d.name.isdigit():
+            try:
+                fields = (d / "stat").read_text().rsplit(")", 1)[1].split()
+            except OSError:
+                continue
+            if fields[0] != "Z" and int(fields[1]) == pid:
+                out.append(int(d.name))
+    return out
+
+
+def served_cases(work: Path) -> list[tuple[str, object]]:
+    import array
+    import socket
+    import struct
+    import subprocess
+    import threading
+    import time
+
+    from testbed.server import server_key
+
+    folder = work / "srv"
+    folder.mkdir(mode=0o700, exist_ok=True)
+    sock = folder / "s.sock"
+    env = {**_hostile.ENV, "TESTBED_SERVER_SOCKET": str(sock)}
+    env.pop("TESTBED_NO_SERVER")
+    state: dict = {}
+
+    def client(argv, timeout=120):
+        return subprocess.run([sys.executable, "-m", "testbed.cli", *argv], cwd=work, env=env,
+                              capture_output=True, text=True, timeout=timeout)
+
+    def start():
+        log = open(folder / "log", "w")
+        state["proc"] = subprocess.Popen([sys.executable, "-m", "testbed.cli", "serve", "--idle",
+                                          "300", "--warm-up", "none"], env=env, stderr=log,
+                                         stdout=subprocess.DEVNULL, start_new_session=True)
+        t0 = time.monotonic()
+        while not sock.exists():
+            if state["proc"].poll() is not None or time.monotonic() - t0 > 120:
+                return "the server did not start"
+            time.sleep(0.2)
+        return None
+
+    def still_serves(after):
+        """A real command after ``after``: served (the log grows), status 0, within 5 s."""
+        def run():
+            if "proc" not in state:
+                return "no server"
+            note = after()
+            t0 = time.monotonic()
+            p = client(["list", "--plain"])
+            dt = time.monotonic() - t0
+            if p.returncode != 0:
+                return f"status {p.returncode} after it: {p.stderr.strip()[:160]!r}"
+            if state["proc"].poll() is not None:
+                return f"the server ended ({state['proc'].returncode})"
+            return note or (f"a real command waited {dt:.1f} s" if dt > 5.0 else None)
+        return run
+
+    def raw(head: bytes, body: bytes, fds=(0, 1, 2), close_early=False):
+        def send():
+            with socket.socket(socket.AF_UNIX) as c:
+                c.connect(str(sock))
+                c.sendmsg([head + body], [(socket.SOL_SOCKET, socket.SCM_RIGHTS,
+                                           array.array("i", fds))] if fds else [])
+                if close_early:
+                    return None
+                c.settimeout(30)
+                with contextlib.suppress(OSError):
+                    reply = c.recv(4096)
+                    if reply and b"refused" not in reply and b"status" not in reply:
+                        return f"reply {reply[:120]!r}"
+            return None
+        return send
+
+    def request(**change):
+        r = {"argv": ["list", "--plain"], "cwd": str(work), "env": dict(env), "umask": 0o022,
+             "key": server_key(env)}
+        r.update(change)
+        data = json.dumps(r).encode()
+        return struct.pack("!I", len(data)), data
+
+    def both_at_once():
+        outs = {}
+
+        def one(i):
+            outs[i] = client(["export", str(state["h5"]), "--format", "sep005", "-o",
+                              str(work / f"two{i}.json")])
+        state.setdefault("h5", hostile19._generated(work, MM))
+        ts = [threading.Thread(target=one, args=(i,)) for i in range(2)]
+        for t in ts:
+            t.start()
+        for t in ts:
+            t.join(120)
+        if any(outs[i].returncode != 0 for i in outs):
+            return f"statuses {[outs[i].returncode for i in outs]}: {outs[0].stderr[:120]!r}"
+        if (work / "two0.json").read_bytes() != (work / "two1.json").read_bytes():
+            return "two clients at once wrote different exports"
+        return None
+
+    def client_killed():
+        server = state["proc"].pid
+        p = subprocess.Popen([sys.executable, "-m", "testbed.cli", "generate", MM, "--no-cache",
+                              "-o", str(work / "killed.h5")], cwd=work, env=env,
+                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        time.sleep(1.0)
+        p.kill()
+        p.wait(30)
+        for _ in range(100):
+            if not _children(server):
+                return None
+            time.sleep(0.1)
+        return f"the server's command children left after its client was killed: {_children(server)}"
+
+    def stop():
+        proc = state.get("proc")
+        if proc is None:
+            return None
+        proc.terminate()
+        proc.wait(30)
+        return None if not sock.exists() else "the socket was left"
+
+    head, body = request()
+    big = struct.pack("!I", 2**32 - 1)
+    cases = [("start", start)]
+    for label, after in [
+            ("a header only, then gone", raw(head, b"", close_early=True)),
+            ("half a request, then gone", raw(head, body[: len(body) // 2], close_early=True)),
+            ("a length of 2**32 - 1", raw(big, b"{}")),
+            ("a length of 2**32 - 1, then gone", raw(big, b"{", close_early=True)),
+            ("not JSON", raw(struct.pack("!I", 9), b"not json!")),
+            ("JSON nested 100,000 deep", raw(struct.pack("!I", 200000), b"[" * 100000 + b"]" * 100000)),
+            ("no descriptors", raw(head, body, fds=())),
+            ("two descriptors", raw(head, body, fds=(1, 2))),
+            ("argv a text", raw(*request(argv="list --plain"))),
+            ("argv of numbers", raw(*request(argv=[1, 2]))),
+            ("argv of 100,000 words", raw(*request(argv=["list"] + ["--plain"] * 100000))),
+            ("env a list", raw(*request(env=["A=B"]))),
+            ("umask a float", raw(*request(umask=18.0))),
+            ("key missing", raw(*request(key=None))),
+            ("two clients at once", both_at_once),
+            ("a client killed mid-command", client_killed)]:
+        cases.append((f"server: {label}", still_serves(after)))
+    cases.append(("stop", stop))
+    return cases
 
 
 FAMILIES = _hostile.families({"flags": flags_cases, "stores": stores_cases, "cache": cache_cases,
-                              "kill": kill_cases, "roundtrip": roundtrip_cases}, TIMEOUT_S)
+                              "kill": kill_cases, "roundtrip": roundtrip_cases,
+                              "served": served_cases}, TIMEOUT_S)
 
 if __name__ == "__main__":
     raise SystemExit(_hostile.main(sys.argv[1:], FAMILIES, "hostile27-"))

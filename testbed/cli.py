@@ -103,7 +103,8 @@ class _Parser(argparse.ArgumentParser):
         # left empty when the positional before it was taken alone (round 27: "unrecognized
         # arguments: cantilever"); one name left over is its value
         maybe = [a for a in self._actions if not a.option_strings and a.nargs == "?"]
-        if (len(rest) == 1 and not rest[0].startswith("-") and len(maybe) == 1
+        # ("-" and "-1" too: argparse's own test, as it reads them in the first place)
+        if (len(rest) == 1 and self._parse_optional(rest[0]) is None and len(maybe) == 1
                 and getattr(ns, maybe[0].dest, None) is None):
             value = self._get_values(maybe[0], rest)
             setattr(ns, maybe[0].dest, value)
@@ -302,7 +303,39 @@ def _link_target(path: Path, option: str) -> Path:
                      "expected a file path")
 
 
-def _output_file(path: str | os.PathLike, option: str, *, inputs: tuple[Path, ...] = ()) -> Path:
+#: What each command writes, as ``(description, leading bytes)``: an existing output file that
+#: begins otherwise is someone else's and is refused, not replaced (:func:`_foreign_output`).
+#: Text formats are compared after leading blanks (and a UTF-8 byte-order mark).
+HDF5_FILE = ("an HDF5 dataset", (b"\x89HDF\r\n\x1a\n",))
+JSON_FILE = ("a JSON file", (b"{", b"["))
+UFF_FILE = ("a UFF file", (b"-1",))
+MARKDOWN_FILE = ("a markdown report", (b"#",))
+
+
+def _foreign_output(path: Path, option: str, kind: tuple[str, tuple[bytes, ...]]) -> None:
+    """Refuse an existing, non-empty ``path`` that does not begin as ``kind`` does.
+
+    Round 27: ``generate -o photo.png`` (a typo, a tab-completed name) replaced the user's
+    picture by a dataset in silence, as ``identify -o`` and ``export -o`` replaced any file;
+    ``sweep --results`` already refused a file that is not Parquet (the file left as it is).
+    A file of the kind written (an earlier run's output) and an empty file are replaced, as
+    before.  Reads 64 bytes.
+    """
+    what, heads = kind
+    try:
+        with path.open("rb") as fh:
+            head = fh.read(64)
+    except OSError:  # unreadable: the write's own checks and errors name it
+        return
+    text = head.removeprefix(b"\xef\xbb\xbf").lstrip() if heads != HDF5_FILE[1] else head
+    if head and not text.startswith(heads):
+        raise InputError(f"{option} {terminal_safe(str(path))}: exists and is not {what} (it "
+                         f"begins with {head[:8]!r}); expected a new path or {what} this "
+                         "command wrote (the file is left as it is)")
+
+
+def _output_file(path: str | os.PathLike, option: str, *, inputs: tuple[Path, ...] = (),
+                 kind: tuple[str, tuple[bytes, ...]] | None = None) -> Path:
     """A file a command will write, checked before any work: not a folder, not a device or
     FIFO (written atomically, the file would replace it: as root, ``--results /dev/full``
     replaced the device node), not one of its ``inputs`` (nothing the user gave is
@@ -350,6 +383,8 @@ def _output_file(path: str | os.PathLike, option: str, *, inputs: tuple[Path, ..
     # the folder written: a link's target's (a link to a file in a 0555 folder had passed, the
     # write then failing on its temporary file; the reverse refused: review 23a)
     _writable_in(path, option, target.parent)
+    if kind is not None:  # last: the checks above name a link or a folder more precisely
+        _foreign_output(target, option, kind)
     return target
 
 
@@ -663,7 +698,7 @@ def cmd_generate(args: argparse.Namespace) -> int:
     # -o the scenario file itself (or a file it extends, or a plugin) replaced it with the
     # dataset, status 0 (round 17)
     out = _output_file(args.output or f"{sc.name}-seed{sc.seed}.h5", "--output",
-                       inputs=_given_files(read, plugins))
+                       inputs=_given_files(read, plugins), kind=HDF5_FILE)
     with _progress()(f"generating {sc.name}") as bar:
         # through the run cache unless --no-cache: a later `testbed run` of it simulates nothing
         cache = None if args.no_cache else DatasetCache(_cache_folder(args.cache))
@@ -756,7 +791,8 @@ def cmd_export(args: argparse.Namespace) -> int:
 
     data = _dataset_file(Path(args.dataset))
     default = data.with_suffix(".uff" if args.format == "uff" else ".sep005.json")
-    out = _output_file(args.output or default, "--output", inputs=(data,))
+    out = _output_file(args.output or default, "--output", inputs=(data,),
+                       kind=UFF_FILE if args.format == "uff" else JSON_FILE)
     for p in export_dataset(data, args.format, out, note=print):
         print(f"wrote {terminal_safe(str(p))}")
     return 0
@@ -905,6 +941,8 @@ def cmd_identify(args: argparse.Namespace) -> int:
         raise InputError(f"--output {terminal_safe(str(named))}: names the file of its own report "
                          f"{terminal_safe(str(named.with_suffix('.md')))}, which would replace the "
                          "model; expected another path")
+    _foreign_output(out, "--output", JSON_FILE)
+    _foreign_output(md, "--output (its .md report)", MARKDOWN_FILE)
     with run_progress(data.name) as phase:
         result = identify_file(data, scenario=args.scenario, kind=args.kind, method=args.method,
                                params=_key_values(args.param, "--param", numbers=False),
@@ -1078,8 +1116,9 @@ def build_parser() -> argparse.ArgumentParser:
     i.set_defaults(fn=cmd_identify)
 
     rep = sub.add_parser("report", help="HTML + markdown report of a run folder or sweep results")
-    rep.add_argument("source", type=_path_text, help="a run folder (from `testbed run`), a scenario's folder of runs "
-                                    "or a scenario name (its latest run), or a sweep results file")
+    rep.add_argument("source", type=_path_text,
+                     help="a run folder (from `testbed run`), a scenario's folder of runs "
+                          "or a scenario name (its latest run), or a sweep results file")
     rep.add_argument("-o", "--output", required=True, type=_path_text, help="report folder")
     rep.add_argument("--runs", default="out/runs", type=_path_text,
                      help="where a scenario name's runs are (default out/runs)")

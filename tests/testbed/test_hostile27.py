@@ -29,6 +29,10 @@ def test_runs_ls_takes_its_scenario_after_an_option():
     assert args.scenario == "michaelis_menten" and args.out == "out/runs"
     assert _parse("runs", "ls", "michaelis_menten", "-o", "x").scenario == "michaelis_menten"
     assert _parse("runs", "ls", "-o", "x").scenario is None
+    # what argparse reads as a positional where it stands first, it reads so here too (the
+    # command then names it: not a scenario name)
+    assert _parse("runs", "ls", "-o", "x", "-1").scenario == "-1"
+    assert _parse("runs", "ls", "-o", "x", "-").scenario == "-"
 
 
 def test_runs_ls_still_refuses_two_scenarios_and_a_stray_option(capsys):
@@ -43,3 +47,46 @@ def test_report_refuses_an_empty_source_or_runs_folder(capsys, argv):
     # `--runs ""` looked for the scenario's runs there (a script's "$RUN" unset)
     line = _refusal(capsys, *argv)
     assert "an empty path" in line and ("source" in line or "--runs" in line)
+
+
+PNG = b"\x89PNG\r\n\x1a\n" + bytes(range(64))
+
+
+@pytest.mark.parametrize("kind", [cli.HDF5_FILE, cli.JSON_FILE, cli.UFF_FILE, cli.MARKDOWN_FILE])
+def test_an_output_of_another_kind_is_refused_and_left_as_it_is(tmp_path, kind):
+    # `generate -o photo.png` replaced the picture by a dataset, status 0 (as identify / export)
+    photo = tmp_path / "photo.png"
+    photo.write_bytes(PNG)
+    with pytest.raises(cli.InputError, match=r"--output .*photo\.png: exists and is not "):
+        cli._output_file(photo, "--output", kind=kind)
+    assert photo.read_bytes() == PNG
+
+
+@pytest.mark.parametrize("kind, head", [
+    (cli.HDF5_FILE, b"\x89HDF\r\n\x1a\n\x00\x00"), (cli.JSON_FILE, b"\xef\xbb\xbf \n{\"a\": 1}"),
+    (cli.JSON_FILE, b"[1]"), (cli.UFF_FILE, b"    -1\n   58\n"), (cli.MARKDOWN_FILE, b"# model\n"),
+    (cli.JSON_FILE, b"")])
+def test_an_output_of_its_own_kind_or_empty_is_replaced_as_before(tmp_path, kind, head):
+    earlier = tmp_path / "earlier.out"
+    earlier.write_bytes(head)
+    assert cli._output_file(earlier, "--output", kind=kind) == earlier
+
+
+def test_identify_refuses_a_report_path_holding_another_file(cli_in_process, tmp_path):
+    from tests.testbed._saved_record import saved_record
+
+    data = saved_record(tmp_path)
+    (tmp_path / "m.md").write_bytes(PNG)
+    p = cli_in_process("identify", str(data), "--kind", "structural", "--method", "ls_sindy",
+                       "-o", "m.json", cwd=tmp_path)
+    lines = [ln for ln in p.stderr.splitlines() if ln.strip()]
+    assert p.returncode == 2 and len(lines) == 1 and "(its .md report) m.md" in lines[0]
+    assert (tmp_path / "m.md").read_bytes() == PNG and not (tmp_path / "m.json").exists()
+
+
+def test_generate_refuses_to_replace_a_file_of_another_kind(cli_in_process, tmp_path):
+    (tmp_path / "photo.png").write_bytes(PNG)
+    p = cli_in_process("generate", "michaelis_menten", "--no-cache", "-o", "photo.png",
+                       cwd=tmp_path)
+    assert p.returncode == 2 and "is not an HDF5 dataset" in p.stderr
+    assert (tmp_path / "photo.png").read_bytes() == PNG
