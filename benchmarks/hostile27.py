@@ -56,7 +56,9 @@ Families (what rounds 1-26 did not try; their families are listed in ``hostile21
     dataset's own is a finding; the SEP-005 export with its metadata edited (``fs`` 0 / -100 /
     a text / null, one channel's ``fs`` or length changed, a null sample, a name twice, an
     unknown unit): anything but a one-line refusal is a finding (an unknown key, the
-    ``content_hash`` or ``group`` edited: the same model).
+    ``content_hash`` or ``group`` edited: the same model); the UFF export's ID line 5 rate
+    (``fs 100.0 Hz``) replaced by no number, NaN, -inf, 1e999, 0, another rate (refused) or
+    1e+02 / free text (the same model).
 
 Prints one line a finding and the counts; exits 1 if any finding.
 """
@@ -798,7 +800,43 @@ def roundtrip_cases(work: Path) -> list[tuple[str, object]]:
              # measured signals are exported); SEP-005 does not define it and other tools
              # write their own words there, so the importer reads past it
              ("group another", first("group", "truth"), "same")]
+    def uff_edit(stated, expect):
+        """The UFF export with every ID line 5's ``fs 100.0 Hz`` replaced by ``stated`` (the
+        same length: the binary records keep their layout)."""
+        def run():
+            h5 = hostile19._generated(work, MM)
+            src = work / "base.uff"
+            if not src.exists():
+                status, _, err = cli_inprocess(["export", str(h5), "--format", "uff", "-o",
+                                                str(src)])
+                if status != 0:
+                    return f"export: {err.strip()[:160]}"
+            if "ref" not in state:
+                state["ref"] = model_of(h5)
+            data = src.read_bytes()
+            if b"fs 100.0 Hz" not in data or len(stated) != len(b"fs 100.0 Hz"):
+                return "the export's ID line 5 is not 'fs 100.0 Hz'"
+            state["n"] = state.get("n", 0) + 1
+            path = work / f"edit{state['n']}.uff"
+            path.write_bytes(data.replace(b"fs 100.0 Hz", stated))
+            out = path.with_suffix(".model.json")
+            status, o, err = cli_inprocess(["identify", str(path), "--scenario", MM, "-o",
+                                            str(out)])
+            finding = judged(status, o, err, refuse=expect == "refuse")
+            if finding or expect == "refuse":
+                return finding
+            got = json.loads(out.read_text()).get("coefficients")
+            return None if got == state["ref"].get("coefficients") else f"another model: {got}"
+        return run
+
+    uff_edits = [(b"fs ..... Hz", "refuse"), (b"fs nan   Hz", "refuse"), (b"fs -inf  Hz", "refuse"),
+                 (b"fs 1e999 Hz", "refuse"), (b"fs 0.000 Hz", "refuse"), (b"fs 900.0 Hz", "refuse"),
+                 (b"fs 100.1 Hz", "refuse"), (b"fs 1e+02 Hz", "same"),
+                 # free text another tool may write there: no rate stated, the header's taken
+                 (b"fs about Hz", "same")]
     return [(f"export {fmt} then identify", case(fmt)) for fmt in ("sep005", "uff")] + [
+        (f"uff ID line 5 {stated.decode()!r}", uff_edit(stated, expect))
+        for stated, expect in uff_edits] + [
         (f"sep005 edited: {label}", edit(change, expect)) for label, change, expect in edits]
 
 

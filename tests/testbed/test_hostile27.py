@@ -90,3 +90,25 @@ def test_generate_refuses_to_replace_a_file_of_another_kind(cli_in_process, tmp_
                        cwd=tmp_path)
     assert p.returncode == 2 and "is not an HDF5 dataset" in p.stderr
     assert (tmp_path / "photo.png").read_bytes() == PNG
+
+
+@pytest.mark.parametrize("stated, refused", [
+    (b"fs ...... Hz", True), (b"fs nan    Hz", True), (b"fs -inf   Hz", True),
+    (b"fs 1e999  Hz", True), (b"fs 0.0000 Hz", True), (b"fs 1e+03  Hz", False),
+    (b"fs 1000.0 Hz", False)])
+def test_a_uff_id_line_rate_that_is_no_positive_number_is_refused(tmp_path, stated, refused):
+    # "fs ..... Hz" was float()'s ValueError (an internal error); "fs nan Hz" was read past
+    from testbed.pipeline.importers import MeasuredDataError, read_measured
+    from testbed.reporting.export import export_dataset
+    from tests.testbed._saved_record import saved_record
+
+    uff = tmp_path / "d.uff"
+    export_dataset(saved_record(tmp_path), "uff", uff)
+    data = uff.read_bytes()
+    assert data.count(b"fs 1000.0 Hz") >= 1  # the export states the exact rate (1000 Hz)
+    uff.write_bytes(data.replace(b"fs 1000.0 Hz", stated))
+    if refused:
+        with pytest.raises(MeasuredDataError, match="its ID line states the rate"):
+            read_measured(uff)
+    else:
+        assert read_measured(uff).fs == 1000.0
