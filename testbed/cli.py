@@ -29,6 +29,14 @@ from typing import Any
 from urllib.parse import urlsplit
 
 from testbed.core import interrupts  # armed on import by testbed/__init__.py, before this module
+from testbed.core.atomic import (
+    HDF5_FILE,
+    JSON_FILE,
+    MARKDOWN_FILE,
+    UFF_FILE,
+    FileKind,
+    foreign_head,
+)
 from testbed.core.errors import (
     EXIT_FAIL,
     EXIT_INTERNAL,
@@ -303,39 +311,21 @@ def _link_target(path: Path, option: str) -> Path:
                      "expected a file path")
 
 
-#: What each command writes, as ``(description, leading bytes)``: an existing output file that
-#: begins otherwise is someone else's and is refused, not replaced (:func:`_foreign_output`).
-#: Text formats are compared after leading blanks (and a UTF-8 byte-order mark).
-HDF5_FILE = ("an HDF5 dataset", (b"\x89HDF\r\n\x1a\n",))
-JSON_FILE = ("a JSON file", (b"{", b"["))
-UFF_FILE = ("a UFF file", (b"-1",))
-MARKDOWN_FILE = ("a markdown report", (b"#",))
-
-
-def _foreign_output(path: Path, option: str, kind: tuple[str, tuple[bytes, ...]]) -> None:
-    """Refuse an existing, non-empty ``path`` that does not begin as ``kind`` does.
-
-    Round 27: ``generate -o photo.png`` (a typo, a tab-completed name) replaced the user's
-    picture by a dataset in silence, as ``identify -o`` and ``export -o`` replaced any file;
-    ``sweep --results`` already refused a file that is not Parquet (the file left as it is).
-    A file of the kind written (an earlier run's output) and an empty file are replaced, as
-    before.  Reads 64 bytes.
-    """
-    what, heads = kind
-    try:
-        with path.open("rb") as fh:
-            head = fh.read(64)
-    except OSError:  # unreadable: the write's own checks and errors name it
-        return
-    text = head.removeprefix(b"\xef\xbb\xbf").lstrip() if heads != HDF5_FILE[1] else head
-    if head and not text.startswith(heads):
+def _foreign_output(path: Path, option: str, kind: FileKind) -> None:
+    """Refuse an existing, non-empty ``path`` that does not begin as ``kind`` does
+    (:func:`~testbed.core.atomic.foreign_head`; ``sweep --results`` already refused a file that
+    is not Parquet).  A file of the kind (an earlier run's output) or an empty one is replaced,
+    as before."""
+    head = foreign_head(path, kind)
+    if head is not None:
+        what = kind[0]
         raise InputError(f"{option} {terminal_safe(str(path))}: exists and is not {what} (it "
                          f"begins with {head[:8]!r}); expected a new path or {what} this "
                          "command wrote (the file is left as it is)")
 
 
 def _output_file(path: str | os.PathLike, option: str, *, inputs: tuple[Path, ...] = (),
-                 kind: tuple[str, tuple[bytes, ...]] | None = None) -> Path:
+                 kind: FileKind | None = None) -> Path:
     """A file a command will write, checked before any work: not a folder, not a device or
     FIFO (written atomically, the file would replace it: as root, ``--results /dev/full``
     replaced the device node), not one of its ``inputs`` (nothing the user gave is

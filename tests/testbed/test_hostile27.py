@@ -112,3 +112,20 @@ def test_a_uff_id_line_rate_that_is_no_positive_number_is_refused(tmp_path, stat
             read_measured(uff)
     else:
         assert read_measured(uff).fs == 1000.0
+
+
+def test_family_write_refuses_a_members_path_holding_the_users_file_and_writes_nothing(tmp_path):
+    # `family write -o mine/` replaced the user's own mine/<member>.toml (or any file there)
+    from testbed.core.errors import InputError
+    from testbed.pipeline.scenario import load_scenario
+    from testbed.studies.family import write_members
+
+    a = load_scenario("michaelis_menten")
+    b = a.replace(name="kinetics_b")
+    (tmp_path / "kinetics_b.toml").write_text('[scenario]\nname = "kinetics_b"\n')
+    with pytest.raises(InputError, match="kinetics_b.toml: exists and is not a member file"):
+        write_members([a, b], tmp_path)
+    assert not (tmp_path / "michaelis_menten.toml").exists()  # checked before any write
+    (tmp_path / "kinetics_b.toml").unlink()
+    first = write_members([a, b], tmp_path)
+    assert write_members([a, b], tmp_path) == first  # its own files: replaced as before
