@@ -31,6 +31,7 @@ from urllib.parse import urlsplit
 from testbed.core import interrupts  # armed on import by testbed/__init__.py, before this module
 from testbed.core.atomic import (
     HDF5_FILE,
+    HTML_FILE,
     JSON_FILE,
     MARKDOWN_FILE,
     UFF_FILE,
@@ -771,6 +772,9 @@ def cmd_report(args: argparse.Namespace) -> int:
                 raise InputError(f"{source}: no such run folder or results file (nor a scenario "
                                  f"with runs in {args.runs})") from None
             raise InputError(f"{source}: not a run folder written by `testbed run`") from None
+    for name, kind in (("report.html", HTML_FILE), ("report.md", MARKDOWN_FILE)):
+        # the user's own file of that name in the folder named (round 27: replaced in silence)
+        _foreign_output(Path(args.output) / name, "--output", kind)
     html = write_report(source, Path(args.output))
     print(f"report: {terminal_safe(str(html.resolve()))}")
     return 0

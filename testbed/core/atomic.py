@@ -112,6 +112,7 @@ HDF5_FILE: FileKind = ("an HDF5 dataset", (b"\x89HDF\r\n\x1a\n",))
 JSON_FILE: FileKind = ("a JSON file", (b"{", b"["))
 UFF_FILE: FileKind = ("a UFF file", (b"-1",))
 MARKDOWN_FILE: FileKind = ("a markdown report", (b"#",))
+HTML_FILE: FileKind = ("an HTML report", (b"<",))
 
 
 def foreign_head(path: Path, kind: FileKind) -> bytes | None:

@@ -129,3 +129,22 @@ def test_family_write_refuses_a_members_path_holding_the_users_file_and_writes_n
     (tmp_path / "kinetics_b.toml").unlink()
     first = write_members([a, b], tmp_path)
     assert write_members([a, b], tmp_path) == first  # its own files: replaced as before
+
+
+@pytest.mark.parametrize("name", ["report.html", "report.md"])
+def test_report_refuses_a_folder_holding_the_users_file_of_its_name(cli_in_process, tmp_path,
+                                                                    name):
+    from benchmarks._hostile import results_row
+    from testbed.studies.results import write_rows
+
+    res = write_rows(tmp_path / "r.parquet", [results_row()], study="s")
+    out = tmp_path / "rep"
+    out.mkdir()
+    (out / name).write_bytes(PNG)
+    p = cli_in_process("report", str(res), "-o", str(out), cwd=tmp_path)
+    assert p.returncode == 2 and f"{name}: exists and is not a" in p.stderr
+    assert (out / name).read_bytes() == PNG
+    (out / name).unlink()
+    assert cli_in_process("report", str(res), "-o", str(out), cwd=tmp_path).returncode == 0
+    # its own earlier report is replaced, as before
+    assert cli_in_process("report", str(res), "-o", str(out), cwd=tmp_path).returncode == 0
