@@ -113,6 +113,7 @@ JSON_FILE: FileKind = ("a JSON file", (b"{", b"["))
 UFF_FILE: FileKind = ("a UFF file", (b"-1",))
 MARKDOWN_FILE: FileKind = ("a markdown report", (b"#",))
 HTML_FILE: FileKind = ("an HTML report", (b"<",))
+PNG_FILE: FileKind = ("a PNG figure", (b"\x89PNG\r\n\x1a\n",))
 
 
 def foreign_head(path: Path, kind: FileKind) -> bytes | None:
@@ -129,7 +130,7 @@ def foreign_head(path: Path, kind: FileKind) -> bytes | None:
             head = fh.read(64)
     except (OSError, ValueError):
         return None
-    binary = kind[1] == HDF5_FILE[1]
+    binary = kind[1] in (HDF5_FILE[1], PNG_FILE[1])
     text = head if binary else head.removeprefix(b"\xef\xbb\xbf").lstrip()
     return head if head and not text.startswith(kind[1]) else None
 

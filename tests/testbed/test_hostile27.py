@@ -148,3 +148,18 @@ def test_report_refuses_a_folder_holding_the_users_file_of_its_name(cli_in_proce
     assert cli_in_process("report", str(res), "-o", str(out), cwd=tmp_path).returncode == 0
     # its own earlier report is replaced, as before
     assert cli_in_process("report", str(res), "-o", str(out), cwd=tmp_path).returncode == 0
+
+
+def test_report_refuses_a_folder_holding_the_users_file_of_a_figures_name(cli_in_process,
+                                                                          tmp_path):
+    from benchmarks._hostile import results_row
+    from testbed.studies.results import write_rows
+
+    res = write_rows(tmp_path / "r.parquet", [results_row()], study="s")
+    out = tmp_path / "rep"
+    out.mkdir()
+    (out / "fit_time.png").write_bytes(b"my notes, not a picture")
+    p = cli_in_process("report", str(res), "-o", str(out), cwd=tmp_path)
+    lines = [ln for ln in p.stderr.splitlines() if ln.strip()]
+    assert p.returncode == 2 and len(lines) == 1 and "fit_time.png: exists and is not a PNG" in lines[0]
+    assert (out / "fit_time.png").read_bytes() == b"my notes, not a picture"
