@@ -29,6 +29,15 @@ from typing import Any
 from urllib.parse import urlsplit
 
 from testbed.core import interrupts  # armed on import by testbed/__init__.py, before this module
+from testbed.core.atomic import (
+    HDF5_FILE,
+    HTML_FILE,
+    JSON_FILE,
+    MARKDOWN_FILE,
+    UFF_FILE,
+    FileKind,
+    foreign_head,
+)
 from testbed.core.errors import (
     EXIT_FAIL,
     EXIT_INTERNAL,
@@ -98,6 +107,16 @@ class _Parser(argparse.ArgumentParser):
         many = [a for a in self._actions if not a.option_strings and a.nargs in ("+", "*")]
         if rest and len(many) == 1 and not any(r.startswith("-") for r in rest):
             setattr(ns, many[0].dest, [*(getattr(ns, many[0].dest) or []), *rest])
+            rest = []
+        # `runs ls -o out/runs cantilever`: the same for an optional positional (nargs "?")
+        # left empty when the positional before it was taken alone (round 27: "unrecognized
+        # arguments: cantilever"); one name left over is its value
+        maybe = [a for a in self._actions if not a.option_strings and a.nargs == "?"]
+        # ("-" and "-1" too: argparse's own test, as it reads them in the first place)
+        if (len(rest) == 1 and self._parse_optional(rest[0]) is None and len(maybe) == 1
+                and getattr(ns, maybe[0].dest, None) is None):
+            value = self._get_values(maybe[0], rest)
+            setattr(ns, maybe[0].dest, value)
             rest = []
         return ns, rest
 
@@ -293,7 +312,21 @@ def _link_target(path: Path, option: str) -> Path:
                      "expected a file path")
 
 
-def _output_file(path: str | os.PathLike, option: str, *, inputs: tuple[Path, ...] = ()) -> Path:
+def _foreign_output(path: Path, option: str, kind: FileKind) -> None:
+    """Refuse an existing, non-empty ``path`` that does not begin as ``kind`` does
+    (:func:`~testbed.core.atomic.foreign_head`; ``sweep --results`` already refused a file that
+    is not Parquet).  A file of the kind (an earlier run's output) or an empty one is replaced,
+    as before."""
+    head = foreign_head(path, kind)
+    if head is not None:
+        what = kind[0]
+        raise InputError(f"{option} {terminal_safe(str(path))}: exists and is not {what} (it "
+                         f"begins with {head[:8]!r}); expected a new path or {what} this "
+                         "command wrote (the file is left as it is)")
+
+
+def _output_file(path: str | os.PathLike, option: str, *, inputs: tuple[Path, ...] = (),
+                 kind: FileKind | None = None) -> Path:
     """A file a command will write, checked before any work: not a folder, not a device or
     FIFO (written atomically, the file would replace it: as root, ``--results /dev/full``
     replaced the device node), not one of its ``inputs`` (nothing the user gave is
@@ -341,6 +374,8 @@ def _output_file(path: str | os.PathLike, option: str, *, inputs: tuple[Path, ..
     # the folder written: a link's target's (a link to a file in a 0555 folder had passed, the
     # write then failing on its temporary file; the reverse refused: review 23a)
     _writable_in(path, option, target.parent)
+    if kind is not None:  # last: the checks above name a link or a folder more precisely
+        _foreign_output(target, option, kind)
     return target
 
 
@@ -654,7 +689,7 @@ def cmd_generate(args: argparse.Namespace) -> int:
     # -o the scenario file itself (or a file it extends, or a plugin) replaced it with the
     # dataset, status 0 (round 17)
     out = _output_file(args.output or f"{sc.name}-seed{sc.seed}.h5", "--output",
-                       inputs=_given_files(read, plugins))
+                       inputs=_given_files(read, plugins), kind=HDF5_FILE)
     with _progress()(f"generating {sc.name}") as bar:
         # through the run cache unless --no-cache: a later `testbed run` of it simulates nothing
         cache = None if args.no_cache else DatasetCache(_cache_folder(args.cache))
@@ -737,6 +772,9 @@ def cmd_report(args: argparse.Namespace) -> int:
                 raise InputError(f"{source}: no such run folder or results file (nor a scenario "
                                  f"with runs in {args.runs})") from None
             raise InputError(f"{source}: not a run folder written by `testbed run`") from None
+    for name, kind in (("report.html", HTML_FILE), ("report.md", MARKDOWN_FILE)):
+        # the user's own file of that name in the folder named (round 27: replaced in silence)
+        _foreign_output(Path(args.output) / name, "--output", kind)
     html = write_report(source, Path(args.output))
     print(f"report: {terminal_safe(str(html.resolve()))}")
     return 0
@@ -747,7 +785,8 @@ def cmd_export(args: argparse.Namespace) -> int:
 
     data = _dataset_file(Path(args.dataset))
     default = data.with_suffix(".uff" if args.format == "uff" else ".sep005.json")
-    out = _output_file(args.output or default, "--output", inputs=(data,))
+    out = _output_file(args.output or default, "--output", inputs=(data,),
+                       kind=UFF_FILE if args.format == "uff" else JSON_FILE)
     for p in export_dataset(data, args.format, out, note=print):
         print(f"wrote {terminal_safe(str(p))}")
     return 0
@@ -896,6 +935,8 @@ def cmd_identify(args: argparse.Namespace) -> int:
         raise InputError(f"--output {terminal_safe(str(named))}: names the file of its own report "
                          f"{terminal_safe(str(named.with_suffix('.md')))}, which would replace the "
                          "model; expected another path")
+    _foreign_output(out, "--output", JSON_FILE)
+    _foreign_output(md, "--output (its .md report)", MARKDOWN_FILE)
     with run_progress(data.name) as phase:
         result = identify_file(data, scenario=args.scenario, kind=args.kind, method=args.method,
                                params=_key_values(args.param, "--param", numbers=False),
@@ -1069,10 +1110,11 @@ def build_parser() -> argparse.ArgumentParser:
     i.set_defaults(fn=cmd_identify)
 
     rep = sub.add_parser("report", help="HTML + markdown report of a run folder or sweep results")
-    rep.add_argument("source", help="a run folder (from `testbed run`), a scenario's folder of runs "
-                                    "or a scenario name (its latest run), or a sweep results file")
+    rep.add_argument("source", type=_path_text,
+                     help="a run folder (from `testbed run`), a scenario's folder of runs "
+                          "or a scenario name (its latest run), or a sweep results file")
     rep.add_argument("-o", "--output", required=True, type=_path_text, help="report folder")
-    rep.add_argument("--runs", default="out/runs",
+    rep.add_argument("--runs", default="out/runs", type=_path_text,
                      help="where a scenario name's runs are (default out/runs)")
     rep.set_defaults(fn=cmd_report)
 

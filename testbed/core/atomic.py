@@ -105,6 +105,36 @@ def not_regular(path: Path) -> None:
                          "which the written file would replace); expected a file path")
 
 
+#: A kind of file a command writes, as ``(description, leading bytes)``: an existing file at the
+#: path written that begins otherwise is someone else's (:func:`foreign_head`).
+FileKind = tuple[str, tuple[bytes, ...]]
+HDF5_FILE: FileKind = ("an HDF5 dataset", (b"\x89HDF\r\n\x1a\n",))
+JSON_FILE: FileKind = ("a JSON file", (b"{", b"["))
+UFF_FILE: FileKind = ("a UFF file", (b"-1",))
+MARKDOWN_FILE: FileKind = ("a markdown report", (b"#",))
+HTML_FILE: FileKind = ("an HTML report", (b"<",))
+PNG_FILE: FileKind = ("a PNG figure", (b"\x89PNG\r\n\x1a\n",))
+
+
+def foreign_head(path: Path, kind: FileKind) -> bytes | None:
+    """The first bytes of an existing, non-empty file at ``path`` that does not begin as
+    ``kind``'s files do, else None (no file, an empty one, one of the kind, or unreadable: the
+    write's own checks name that).
+
+    Round 27: ``generate -o photo.png`` replaced the user's picture by a dataset in silence, as
+    ``identify`` / ``export -o`` and ``family write`` (a member's name) replaced any file.  Text
+    kinds are compared after leading blanks and a UTF-8 byte-order mark.  Reads 64 bytes.
+    """
+    try:
+        with open(path, "rb") as fh:
+            head = fh.read(64)
+    except (OSError, ValueError):
+        return None
+    binary = kind[1] in (HDF5_FILE[1], PNG_FILE[1])
+    text = head if binary else head.removeprefix(b"\xef\xbb\xbf").lstrip()
+    return head if head and not text.startswith(kind[1]) else None
+
+
 def _replaced(path: Path) -> os.stat_result | None:
     """The status of the regular file ``path`` names itself (not through a link), else None."""
     try:

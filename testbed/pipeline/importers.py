@@ -1947,7 +1947,21 @@ def _check_uff_blocks(path: Path, data: bytes) -> None:
                                           "next one's start '-1'); a UFF file holds only blocks")
 
 
-_FS_ID = re.compile(r"\bfs\s+([-+0-9.eE]+)\s*Hz")
+#: ``fs <rate> Hz`` in a UFF58 record's ID line 5 (this project's exports state the exact rate
+#: there): the rate's characters of a number, or NaN / inf spelled out (round 27: "fs nan Hz"
+#: was read past, the header's rounded increment taken; "fs ..... Hz" was float()'s
+#: ValueError, an internal error).
+_FS_ID = re.compile(r"\bfs\s+([-+0-9.eE]+|[-+]?(?i:nan|inf(?:inity)?))\s*Hz")
+
+
+def _id_rate(path: Path, where: str, text: str) -> float:
+    """The rate [Hz] an ID line states as ``text``: a finite number > 0, else refused."""
+    number = plain_number(text)
+    rate = float(number) if number is not None else math.nan
+    if not (math.isfinite(rate) and rate > 0):
+        raise MeasuredDataError(path, f"{where}: its ID line states the rate 'fs {text} Hz'; "
+                                      "expected a finite number of Hz > 0")
+    return rate
 
 
 def _uff58_channel(path: Path, k: int, s: dict[str, Any], raw: _Raw) -> tuple[str, float]:
@@ -1973,7 +1987,7 @@ def _uff58_channel(path: Path, k: int, s: dict[str, Any], raw: _Raw) -> tuple[st
         if not inc > 0:  # (a testbed file's exact rate in its ID line hid an increment of 0 or NaN)
             raise MeasuredDataError(path, f"{where}: abscissa increment {inc!r} s is not > 0")
     if m is not None:
-        rate = float(m.group(1))
+        rate = _id_rate(path, where, m.group(1))
         # the increment is written with 6 significant digits (rounding within 5e-6)
         if even and not abs(inc * rate - 1.0) <= 1e-5:
             raise MeasuredDataError(path, f"{where}: abscissa increment {inc!r} s disagrees with "

@@ -27,8 +27,9 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from testbed.core.atomic import atomic_write
+from testbed.core.atomic import PNG_FILE, atomic_write, foreign_head
 from testbed.core.dataset import Dataset
+from testbed.core.errors import InputError
 from testbed.core.truth import StructuralTruth, Truth, TruthError, truth_type
 from testbed.pipeline.cache import DatasetCache
 from testbed.pipeline.scenario import Scenario
@@ -136,8 +137,15 @@ def save_figure(fig: Figure, path: str | os.PathLike) -> Path:
     A report written on a full disk left a PNG of 0 bytes and ended in an internal error
     (OSError 28, naming no file; round 12): the write is now :func:`atomic_write`'s, which
     leaves the old file or the new one and names ``path`` in one line for want of room.
+    A file at ``path`` that is not a PNG (the user's own, in a folder given to ``report -o``)
+    is refused, not replaced (round 27; :func:`~testbed.core.atomic.foreign_head`).
     """
     import matplotlib as mpl
+
+    head = foreign_head(Path(path), PNG_FILE)
+    if head is not None:
+        raise InputError(f"{path}: exists and is not {PNG_FILE[0]} (it begins with {head[:8]!r}); "
+                         "expected a folder without it, or remove the file (it is left as it is)")
 
     def write(tmp: str) -> None:
         with mpl.rc_context(STYLE):

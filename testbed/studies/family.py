@@ -54,8 +54,8 @@ from typing import Any
 
 import numpy as np
 
-from testbed.core.atomic import atomic_write_text
-from testbed.core.errors import ScenarioError
+from testbed.core.atomic import atomic_write_text, foreign_head
+from testbed.core.errors import InputError, ScenarioError
 from testbed.core.schema import ONE_LINE, ONE_LINE_DOC, Field, check_value, validate_table
 from testbed.pipeline.plugins import RIGS
 from testbed.pipeline.scenario import (
@@ -582,15 +582,37 @@ def scenario_toml(sc: Scenario) -> str:
     return "\n".join(lines) + "\n"
 
 
+#: The first line of every member file (:func:`scenario_toml`): a file at a member's path that
+#: begins otherwise is the user's and is not replaced (:func:`write_members`).
+MEMBER_FILE = ("a member file written by `testbed family write`",
+               (b"# Written by testbed.studies.study.write_family",))
+
+
 def write_members(members: list[Scenario], out_dir: str | os.PathLike) -> list[Path]:
     """Write scenarios as ``<out_dir>/<name>.toml`` (atomically; the folder is created).
+
+    A file at a member's path that is not a member file (:data:`MEMBER_FILE`: the user's own
+    scenario of that name, or any other file) is refused before anything is written (round
+    27: it was replaced); an earlier member file is replaced, as before.
 
     Returns
     -------
     list of Path
         The written files, in the given order; each reloads to a Scenario equal to its member.
+
+    Raises
+    ------
+    InputError
+        A member's path holds another file.
     """
     out = Path(out_dir)
+    for sc in members:
+        p = out / f"{sc.name}.toml"
+        head = foreign_head(p, MEMBER_FILE)
+        if head is not None:
+            raise InputError(f"{p}: exists and is not {MEMBER_FILE[0]} (it begins with "
+                             f"{head[:16]!r}); expected another --out folder, or remove the file "
+                             "(it is left as it is)")
     out.mkdir(parents=True, exist_ok=True)
     written = []
     for sc in members:
