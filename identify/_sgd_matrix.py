@@ -989,8 +989,11 @@ PROJECTED_DOUBT = "the projection is a repair the record did not choose"
 #: s (0.40).  Faster growth is a fit the record contradicts; projected there, families' soft 014
 #: clean (+5.4e4 1/s) kept a projected fit of 0.785 where the flat fit's refused cubic gave
 #: 0.984, and soft 007 clean (+2.9 1/s, 1.45) and 019 clean lost issue #15's 1 % (measured):
-#: those keep the flat fit.  A linear warm start's damping is projected whatever its growth (round
-#: 7's ``b_s6``: +7122 1/s, an indefinite ``C`` on unexcited modes).
+#: those keep the flat fit.  A growing pole at a mode a measured peak locates is projected
+#: whatever its growth (:func:`growing_mode_located`, session 27: soft 007 clean's is mode 1,
+#: and the flat refit, which the projected fit must clearly better, stays kept there; 014's
+#: and 019's are real poles).  A linear warm start's damping is projected whatever its growth
+#: (round 7's ``b_s6``: +7122 1/s, an indefinite ``C`` on unexcited modes).
 UNRESOLVED_GROWTH = 1.0
 
 
@@ -1006,6 +1009,53 @@ def growth_unresolved(M: np.ndarray, C: np.ndarray, K: np.ndarray, duration: flo
     if not np.all(np.isfinite(poles)):
         return False
     return bool(np.max(poles.real) * duration < UNRESOLVED_GROWTH)
+
+
+def growing_mode_located(M: np.ndarray, C: np.ndarray, K: np.ndarray, lam_hat: np.ndarray
+                         ) -> bool:
+    """Whether the fastest-growing pole of ``M x'' + C x' + K x`` is an oscillating mode that a
+    measured peak locates: ``|lambda|`` within :data:`~identify.structural.MODE_SEPARATION` of
+    one of ``sqrt(lam_hat)`` (the eigenvalue penalty's targets, warped as the fit's signals
+    are); False where the poles cannot be computed, no pole grows, the fastest-growing pole is
+    real or no peak was measured.
+
+    Rule (with :func:`growth_unresolved`, for a cubic tilted warm start): the record holds that
+    mode's ringing at the peak, so a growth there is the fit's damping contradicting a measured
+    mode, not a mode the record does not hold, and the damping's projection
+    (:func:`psd_damping_warm_start`) repairs the mode the record measures; ``sgd_sindy`` keeps
+    the projected fit only where it explains clearly more of its record than the flat refit,
+    the cubic warm start's fallback.  Round 24's ``b24_soft_r2p7_cf0p45_z0p2`` (0.2 % damping)
+    at 3 %, s152: mode 1's pole +1.52 +328.5j 1/s (growth 1.5 over the window, not under
+    :data:`UNRESOLVED_GROWTH`), fitted flat mode 3 72 % off (TRAC 0.493); projected, 0.993,
+    the flat refit's 0.493 (measured, session 27).  A real growing pole (families' soft 014
+    clean, +5.4e4 1/s; soft 019 clean, +326 1/s) or one at no peak is no located mode: flat as
+    before.
+
+    Parameters
+    ----------
+    M, C, K : ndarray, shape (n, n)
+        The warm start's symmetric mass [kg], damping [N s/m] and stiffness [N/m].
+    lam_hat : ndarray, shape (k,)
+        Measured eigenvalues ``(2 pi f)^2`` [rad^2/s^2].
+
+    Returns
+    -------
+    bool
+    """
+    lam_hat = np.asarray(lam_hat, dtype=float).ravel()
+    lam_hat = lam_hat[np.isfinite(lam_hat) & (lam_hat > 0)]
+    try:
+        with np.errstate(all="ignore"):
+            poles = np.linalg.eigvals(state_matrix(M, C, K))
+    except (np.linalg.LinAlgError, ValueError):
+        return False
+    if not (lam_hat.size and np.all(np.isfinite(poles))):
+        return False
+    p = poles[np.argmax(poles.real)]
+    if not (p.real > 0.0 and p.imag != 0.0):
+        return False
+    w, w_peak = abs(p), np.sqrt(lam_hat)
+    return bool(np.any(np.abs(w - w_peak) <= MODE_SEPARATION * w_peak))
 
 
 def psd_damping_warm_start(M: np.ndarray, C: np.ndarray, K: np.ndarray) -> np.ndarray | None:
@@ -1252,8 +1302,11 @@ def fit_matrix_sgd(data: Measurement, est: MatrixSGDSettings, m_hat: float,
             # record does not resolve (UNRESOLVED_GROWTH); a linear one's whatever its growth
             # (over the fit window the warm start was fitted on: the whole free decay by
             # default, fit_duration's where set: review 26f)
+            # (or where the growing pole is a mode a measured peak locates: the record holds
+            # its ringing, growing_mode_located)
             C_psd = (psd_damping_warm_start(M0, C0, K0) if not est.cubic or growth_unresolved(
-                M0, C0, K0, (i1 - i0) / float(data.fs)) else None)
+                M0, C0, K0, (i1 - i0) / float(data.fs))
+                or growing_mode_located(M0, C0, K0, lam_hat) else None)
             unpaired = "" if C_psd is None else (lowest_peak_unpaired(M0, K0, lam_hat)
                                                  or PROJECTED_DOUBT)
             if unpaired and est.lowest_peak_flat:  # the caller's second fit: flat

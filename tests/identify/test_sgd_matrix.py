@@ -430,3 +430,20 @@ def test_near_coalesced_modes_are_decided_on_the_shapes_the_placement_uses():
         repeated = W @ np.diag(np.diag(J)) @ np.linalg.inv(W)
         assert complex_stiffness_pair(repeated) == "", seed
     assert raised == 0
+
+
+def test_a_growing_pole_is_a_located_mode_only_where_a_measured_peak_locates_it():
+    """``growing_mode_located``: the fastest-growing pole, oscillating, within MODE_SEPARATION
+    of a measured peak (the record holds that mode's ringing); a real growing pole, one at no
+    peak, a stable model or no peak at all is not."""
+    from identify._sgd_matrix import growing_mode_located
+
+    M, K = np.diag([1.0, 1.0]), np.diag([(2 * np.pi * 50.0) ** 2, (2 * np.pi * 400.0) ** 2])
+    grows_1 = np.diag([-2.0, 10.0])  # mode 1 (50 Hz) grows at +1 1/s, mode 2 decays
+    peaks = (2 * np.pi * np.array([52.0, 405.0])) ** 2  # mode 1 4 % from its peak
+    assert growing_mode_located(M, grows_1, K, peaks)
+    assert not growing_mode_located(M, grows_1, K, (2 * np.pi * np.array([405.0])) ** 2)
+    assert not growing_mode_located(M, grows_1, K, np.empty(0))
+    assert not growing_mode_located(M, np.diag([2.0, 10.0]), K, peaks)  # stable: grows nowhere
+    # a negative stiffness: a real growing pole, no ringing mode
+    assert not growing_mode_located(M, np.diag([2.0, 10.0]), np.diag([-100.0, K[1, 1]]), peaks)
