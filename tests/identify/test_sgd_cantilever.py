@@ -217,8 +217,8 @@ def test_a_cubic_model_whose_simulation_and_warm_start_diverge_is_refused_for_th
     model = SGDSINDy(cubic=True).fit(data)
     # which test meets the failing cubic first (refused for its simulation, or doubted against
     # the measured decay and then outexplained by the linear refit, whose rival's simulation
-    # failed) is decided by the SGD's last bits: numba compiles for the host CPU (FMA or not),
-    # and an AMD EPYC took the second route (speed27, 2026-11-29); the outcome is the claim
+    # failed) is decided by the SGD's last bits (numba compiles for the host CPU: round 21's
+    # b21_soft_root3 below took the second route on a Zen 5 EPYC); the outcome is the claim
     rule = model.cubic_rule_
     assert rule.endswith("cubic terms out") and ("its simulation from the record's own start "
                                                   "fails" in rule or "(its simulation failed)" in rule)
