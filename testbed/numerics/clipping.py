@@ -51,7 +51,7 @@ from typing import Any
 
 import numpy as np
 
-from testbed.numerics.noise import noise_std
+from testbed.numerics.noise import LATTICE_TOL, noise_std, on_lattice, smallest_gap  # noqa: F401
 
 #: A clip level is held on at least one run of this many consecutive samples [samples]: a
 #: smooth float record meets each value once.
@@ -62,11 +62,6 @@ MIN_RUN = 2
 #: twice by chance with probability ~0; a 16-bit code is met twice at a fast apex: measured on
 #: the test records, 11 alarms of 1566 channels without the codes' test)
 RESOLVED = 8
-#: Gaps between codes are integer multiples of the record's smallest gap to this [-]: a
-#: quantised float record's codes ``k q`` carry a rounding error ~ eps |y| / q (5e-7 at 32
-#: bits); a float record's gaps are integers to it by chance with probability 2e-4 each (7
-#: gaps: ~1e-26)
-LATTICE_TOL = 1e-4
 #: Otherwise (a quantised record) the extreme is held by at least this many samples in all (runs
 #: touching the record's ends left out) [samples]
 MIN_HELD = 3
@@ -151,25 +146,6 @@ def _runs(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return starts, np.flatnonzero(d == -1) - starts
 
 
-def on_lattice(values: np.ndarray, step: float) -> bool:
-    """Whether distinct values lie on a quantiser's lattice of ``step``: every gap between
-    them is an integer multiple of ``step`` to :data:`LATTICE_TOL`.
-
-    Parameters
-    ----------
-    values : ndarray, shape (n,)
-        Distinct values (any order; fewer than 2: False).
-    step : float
-        The record's smallest gap between two of its distinct values (a quantised record's
-        step, a float record's chance closest pair).
-    """
-    gaps = np.diff(np.sort(np.asarray(values, dtype=float)))
-    if gaps.size < 1 or not step > 0:
-        return False
-    r = gaps / step
-    return bool(np.all(np.abs(r - np.round(r)) <= LATTICE_TOL))
-
-
 def clipped_levels(y: np.ndarray) -> list[tuple[float, int, int]]:
     """The clip levels of one channel by the module's rule.
 
@@ -193,7 +169,7 @@ def clipped_levels(y: np.ndarray) -> list[tuple[float, int, int]]:
     hi, lo = float(finite.max()), float(finite.min())
     if hi == lo:
         return []  # a constant channel: said elsewhere (a dead sensor), not a clip
-    step = _smallest_gap(finite)  # a quantiser's step (on_lattice)
+    step = smallest_gap(finite)  # a quantiser's step (on_lattice)
     for level, inside in ((hi, finite[finite < hi]), (lo, finite[finite > lo])):
         starts, lengths = _runs(y == level)
         keep = (starts > 0) & (starts + lengths < n)  # not at the record's ends
@@ -209,11 +185,6 @@ def clipped_levels(y: np.ndarray) -> list[tuple[float, int, int]]:
         if resolved or (held >= MIN_HELD and held > RATIO * near[0]):
             out.append((level, held, int(lengths.size)))
     return out
-
-
-def _smallest_gap(y: np.ndarray) -> float:
-    u = np.unique(y[np.isfinite(y)])
-    return float(np.diff(u).min()) if u.size > 1 else 0.0
 
 
 def rate_contradicted_levels(a: np.ndarray, d: np.ndarray, fs: float
@@ -256,7 +227,7 @@ def rate_contradicted_levels(a: np.ndarray, d: np.ndarray, fs: float
     if not held_runs:
         return []
     motion = float(np.sqrt(np.mean((a - a.mean()) ** 2)))
-    qa, qd = _smallest_gap(a), _smallest_gap(d)
+    qa, qd = smallest_gap(a), smallest_gap(d)
     # the rate's own offset (a sensor's bias, which the importer accepts up to RATE_BIAS_MAX
     # of its RMS) from the whole record's drift: a run of tau seconds then drifts bias * tau
     # (session 22's review: an angle at rest at its lowest, its gyro offset by 2 % of its RMS,

@@ -169,3 +169,74 @@ def window_var(w: np.ndarray) -> float:
     """
     w2 = np.asarray(w, dtype=float) ** 2
     return float(w2.size * np.sum(w2**2) / np.sum(w2) ** 2)
+
+
+#: Gaps between codes are integer multiples of the record's smallest gap to this [-]: a
+#: quantised float record's codes ``k q`` carry a rounding error ~ eps |y| / q (5e-7 at 32
+#: bits); a float record's gaps are integers to it by chance with probability 2e-4 each (7
+#: gaps: ~1e-26)
+LATTICE_TOL = 1e-4
+
+
+def on_lattice(values: np.ndarray, step: float) -> bool:
+    """Whether distinct values lie on a quantiser's lattice of ``step``: every gap between
+    them is an integer multiple of ``step`` to :data:`LATTICE_TOL`.
+
+    Parameters
+    ----------
+    values : ndarray, shape (n,)
+        Distinct values (any order; fewer than 2: False).
+    step : float
+        The record's smallest gap between two of its distinct values (a quantised record's
+        step, a float record's chance closest pair).
+    """
+    gaps = np.diff(np.sort(np.asarray(values, dtype=float)))
+    if gaps.size < 1 or not step > 0:
+        return False
+    r = gaps / step
+    return bool(np.all(np.abs(r - np.round(r)) <= LATTICE_TOL))
+
+
+def smallest_gap(y: np.ndarray) -> float:
+    """The smallest gap between a record's distinct finite values (0 with fewer than two)."""
+    u = np.unique(y[np.isfinite(y)])
+    return float(np.diff(u).min()) if u.size > 1 else 0.0
+
+
+def quantisation_std(x: np.ndarray) -> np.ndarray:
+    """The white-noise std of a quantiser's rounding in each row of ``x``: ``q / sqrt(12)``
+    where the row's distinct values lie on one lattice of step ``q`` (:func:`on_lattice` with
+    the row's :func:`smallest_gap`), else 0.
+
+    An encoder sampled far above its motion repeats its codes, so most ``k``-th differences are
+    exactly 0 and :func:`noise_std` reads 0 (review 27d: a 12-bit encoder at 10 kHz, 0.52 % of
+    RMS of rounding, read as clean angles); a float record's gaps are no lattice's (the chance
+    is ~0, :data:`LATTICE_TOL`).
+
+    Parameters
+    ----------
+    x : ndarray, shape (n_channels, n_samples) or (n_samples,)
+        The record (any unit; the result has the same unit).
+
+    Returns
+    -------
+    ndarray, shape (n_channels,)
+    """
+    out = []
+    for row in _rows(x):
+        values = np.unique(row[np.isfinite(row)])
+        step = smallest_gap(values)
+        out.append(step / np.sqrt(12.0) if values.size > 2 and on_lattice(values, step) else 0.0)
+    return np.asarray(out, dtype=float)
+
+
+def record_noise_std(x: np.ndarray) -> np.ndarray:
+    """The white-noise std a record shows in each row [x's unit]: :func:`noise_std`'s robust
+    estimate, at least the quantiser's rounding (:func:`quantisation_std`).
+
+    Raises
+    ------
+    ValueError
+        As :func:`noise_std`.
+    """
+    return np.maximum(noise_std(x), quantisation_std(x))

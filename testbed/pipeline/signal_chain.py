@@ -110,8 +110,8 @@ MECHANICAL_SIGNAL_SCHEMA: dict[str, Field] = {
                        doc="'lowpass': -3 dB frequency of one pass of the zero-phase "
                            "Butterworth; just above the band of the motion (noise in the "
                            "acceleration grows as cutoff^2.5); 'auto': the lowest that passes "
-                           "twice the angles' 99.9 % band with 99 % amplitude (see "
-                           "auto_cutoff)"),
+                           "twice the angles' 99.9 % band with 99 % amplitude on noisy angles, "
+                           "1 - 1e-5 on clean ones, continuous between (see auto_cutoff)"),
     "filter_order": Field(int, 8, min=1, max=16,
                           doc="'lowpass': Butterworth order of one pass"),
     "edge_fit_s": Field(float, "auto", unit="s", min=0.0, min_inclusive=False,
@@ -817,7 +817,8 @@ def auto_cutoff(theta: np.ndarray, fs: float, order: int, noise: np.ndarray | No
     order : int
         Butterworth order of one pass of the derivative filter.
     noise : ndarray, shape (n_joints,), optional
-        White-noise std of each angle [rad]; default :func:`testbed.numerics.noise.noise_std`.
+        White-noise std of each angle [rad]; default
+        :func:`testbed.numerics.noise.record_noise_std` (an encoder's rounding counted).
 
     Returns
     -------
@@ -829,7 +830,7 @@ def auto_cutoff(theta: np.ndarray, fs: float, order: int, noise: np.ndarray | No
     ValueError
         If no channel has signal power above its noise floor (no band to pass).
     """
-    sigma = noise_est.noise_std(theta) if noise is None else noise
+    sigma = noise_est.record_noise_std(theta) if noise is None else noise
     band = float(noise_est.signal_band(theta, fs, AUTO_BAND_SHARE, sigma).max(initial=0.0))
     if not band > 0:
         raise ValueError("cutoff_hz = 'auto': the angles hold no power above their noise floor")
@@ -940,7 +941,8 @@ def measure_mechanical(dataset: Dataset, cfg: Mapping[str, Any]) -> Measurement:
         input_map[channels.index(name), j] = 1.0
     # declared only for finite records (the estimator refuses NaN; the identifier then
     # sees an undeclared level, as for any chain that does not know it)
-    noise = noise_est.noise_std(theta) if np.all(np.isfinite(theta)) else None
+    # (an encoder's rounding counted: review 27d, a 12-bit encoder read as clean angles)
+    noise = noise_est.record_noise_std(theta) if np.all(np.isfinite(theta)) else None
     passband = None
     if cfg["derivatives"] == "recorded":
         x, xd, xdd = theta, _get(dataset, "dtheta", n_joints), _get(dataset, "ddtheta", n_joints)
@@ -1001,7 +1003,7 @@ def measure_dynamical(dataset: Dataset, cfg: Mapping[str, Any]) -> Measurement:
     n = x.shape[0]
     channels = tuple(dataset.measured["x"].channels)
     # the raw states' white noise, before the smoothing below hides it (as measure_mechanical)
-    noise = (noise_est.noise_std(x) if x.shape[1] >= 6 and np.all(np.isfinite(x)) else None)
+    noise = (noise_est.record_noise_std(x) if x.shape[1] >= 6 and np.all(np.isfinite(x)) else None)
     if cfg["derivatives"] == "recorded":
         xd = _get(dataset, "dx", n)
         xdd = np.gradient(xd, 1.0 / fs, axis=1)

@@ -435,7 +435,7 @@ def test_an_input_map_is_dropped_only_where_the_record_is_clearly_better_without
     member 009) is dropped, and the rule states both agreements."""
     import identify.sgd_sindy as ss
 
-    sysd, data = forced
+    _, data = forced
     kept = SGDSINDy(epochs=4).fit(data)
     assert "rule: kept" in kept.input_map_rule_ and np.any(kept.input_map_ != 0.0)
     real = ss.SGDSINDy._fit_with

@@ -213,6 +213,13 @@ def test_clean_angles_through_a_declared_chain_get_the_chain_recipe(clean):
     assert k1["column_lowpass_hz"] == sp.CUTOFF_FACTOR * e1["band_hz"]
     assert k1["ridge"] == sp.RIDGE_PER_NOISE_VAR * max(e1["noise_rel"], sp.CHAIN_REL_FLOOR) ** 2
     assert k1["rollout_atol"] == sp.ROLLOUT_ATOL
+    # an undeclared level (the API's noise_std=None) is read off smoothed angles, which look
+    # near-exact at any noise: the noisy rule, never the clean recipe (review 27d: a 2 % record
+    # got ridge 1e-14 and rolled out 0.0169 rad against 0.0093)
+    two = _chain_smoothed(clean, 2.0)
+    k2, _, e2 = sp.noise_knobs(two.x, two.fs, 0.2, {}, None, None, two.passband)
+    assert e2["noise_weight"] == 1.0 and k2["ridge"] > sp.RIDGE_EXACT
+    assert k2["rollout_atol"] == sp.ROLLOUT_ATOL
     # the floor is a floor: 5 % noise keeps its own ridge (25 x the floor's)
     noisy = _chain_smoothed(clean, 5.0)
     assert sp.noise_knobs(noisy.x, noisy.fs, 0.2, {}, None, noisy.noise_std,

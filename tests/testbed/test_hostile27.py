@@ -123,7 +123,7 @@ def test_family_write_refuses_a_members_path_holding_the_users_file_and_writes_n
     a = load_scenario("michaelis_menten")
     b = a.replace(name="kinetics_b")
     (tmp_path / "kinetics_b.toml").write_text('[scenario]\nname = "kinetics_b"\n')
-    with pytest.raises(InputError, match="kinetics_b.toml: exists and is not a member file"):
+    with pytest.raises(InputError, match=r"kinetics_b\.toml: exists and is not a member file"):
         write_members([a, b], tmp_path)
     assert not (tmp_path / "michaelis_menten.toml").exists()  # checked before any write
     (tmp_path / "kinetics_b.toml").unlink()

@@ -14,7 +14,7 @@ import testbed
 from testbed.core.dataset import Dataset, Signal
 from testbed.core.errors import ScenarioError
 from testbed.numerics import derivatives as der
-from testbed.numerics.noise import noise_std, signal_band
+from testbed.numerics.noise import noise_std, record_noise_std, signal_band
 from testbed.pipeline.signal_chain import AUTO_BAND_SHARE, auto_cutoff, measure
 
 UNSEEN = Path(__file__).resolve().parents[3] / "benchmarks" / "unseen"
@@ -164,19 +164,24 @@ def test_auto_cutoff_is_continuous_in_the_noise_level():
 @pytest.mark.parametrize("bits", [12, 14])
 def test_auto_cutoff_counts_an_encoders_quantisation_as_noise(bits):
     """A 12- or 14-bit encoder's angles sampled far above their motion: most 4th differences
-    are exactly 0, the noise estimate is 0, and the clean-record rule of session 24 put the
-    cut-off at 0.45 fs (4500 Hz; 12-bit: the accelerations' error 2700 x their RMS, review
-    24d q4.py).  The cut-off must be the float record's within the spectrum's resolution, and
-    the accelerations derived with it within 2 % of the truth's RMS.  Measured 0.50 / 0.085 %
-    (12 / 14-bit); white quantisation noise (q / sqrt 12) through the low-pass predicts 0.13 /
-    0.033 % (lowpass_differentiate's Notes), but the rounding error of a slow motion is not
-    white, so the bound is 4 x the 12-bit figure (the taken-back rule: 2700 x, 2.7e5 %)."""
+    are exactly 0 and the differences' noise estimate is 0; the clean-record rule of session
+    24 put the cut-off at 0.45 fs (4500 Hz; 12-bit: the accelerations' error 2700 x their
+    RMS, review 24d q4.py), and session 27's clean droop read the encoder as clean angles
+    (review 27d: 0.50 -> 1.27 % at 12 bits).  The encoder's rounding, ``q / sqrt 12``, is
+    counted (:func:`testbed.numerics.noise.record_noise_std`): the cut-off must be the float
+    record's at that declared noise within the spectrum's resolution, and the accelerations
+    derived with it within 2 % of the truth's RMS.  Measured 0.50 / 0.085 % (12 / 14-bit);
+    white quantisation noise through the low-pass predicts 0.13 / 0.033 %
+    (lowpass_differentiate's Notes), but the rounding error of a slow motion is not white, so
+    the bound is 4 x the 12-bit figure."""
     fs = 1e4
     th = _multisine(fs)
     q = 2 * np.pi / 2**bits
     enc = np.round(th / q) * q
     assert np.all(noise_std(enc) == 0.0)  # the degenerate estimate the rule must survive
-    cut, ref = auto_cutoff(enc, fs, 8), auto_cutoff(th, fs, 8)
+    assert np.allclose(record_noise_std(enc), q / np.sqrt(12.0))
+    cut = auto_cutoff(enc, fs, 8)
+    ref = auto_cutoff(th, fs, 8, np.full(th.shape[0], q / np.sqrt(12.0)))
     assert _within_resolution([cut, ref], th.shape[1], fs), (cut, ref)
     acc = np.gradient(np.gradient(th, 1 / fs, axis=1), 1 / fs, axis=1)
     xdd = der.lowpass_differentiate(enc, fs, cut, 8, 0.3, 3)[2]
