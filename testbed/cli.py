@@ -32,6 +32,7 @@ from testbed.core import interrupts  # armed on import by testbed/__init__.py, b
 from testbed.core.atomic import (
     HDF5_FILE,
     HTML_FILE,
+    IDENTIFIED_MARKDOWN_FILE,
     JSON_FILE,
     MARKDOWN_FILE,
     UFF_FILE,
@@ -936,7 +937,7 @@ def cmd_identify(args: argparse.Namespace) -> int:
                          f"{terminal_safe(str(named.with_suffix('.md')))}, which would replace the "
                          "model; expected another path")
     _foreign_output(out, "--output", JSON_FILE)
-    _foreign_output(md, "--output (its .md report)", MARKDOWN_FILE)
+    _foreign_output(md, "--output (its .md report)", IDENTIFIED_MARKDOWN_FILE)
     with run_progress(data.name) as phase:
         result = identify_file(data, scenario=args.scenario, kind=args.kind, method=args.method,
                                params=_key_values(args.param, "--param", numbers=False),

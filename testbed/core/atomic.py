@@ -112,24 +112,39 @@ HDF5_FILE: FileKind = ("an HDF5 dataset", (b"\x89HDF\r\n\x1a\n",))
 JSON_FILE: FileKind = ("a JSON file", (b"{", b"["))
 UFF_FILE: FileKind = ("a UFF file", (b"-1",))
 MARKDOWN_FILE: FileKind = ("a markdown report", (b"#",))
-HTML_FILE: FileKind = ("an HTML report", (b"<",))
+#: an identified model's report (``testbed.reporting.identified``: its first line since it was
+#: written): a user's own ``notes.md`` beside ``identify -o notes.json`` is not ours (review 27e)
+IDENTIFIED_MARKDOWN_FILE: FileKind = ("an identified model's markdown report",
+                                      (b"# Identified model: ",))
+#: every HTML report begins so (``testbed.reporting.report``); a user's own page does not
+HTML_FILE: FileKind = ("an HTML report", (b'<!DOCTYPE html>\n<html lang="en">',))
 PNG_FILE: FileKind = ("a PNG figure", (b"\x89PNG\r\n\x1a\n",))
 
 
 def foreign_head(path: Path, kind: FileKind) -> bytes | None:
     """The first bytes of an existing, non-empty file at ``path`` that does not begin as
-    ``kind``'s files do, else None (no file, an empty one, one of the kind, or unreadable: the
-    write's own checks name that).
+    ``kind``'s files do, else None (no file, an empty one, one of the kind, no regular file (a
+    FIFO, socket or device: :func:`not_regular` names it) or unreadable: the write's own
+    checks name that).
 
     Round 27: ``generate -o photo.png`` replaced the user's picture by a dataset in silence, as
     ``identify`` / ``export -o`` and ``family write`` (a member's name) replaced any file.  Text
     kinds are compared after leading blanks and a UTF-8 byte-order mark.  Reads 64 bytes.
     """
     try:
-        with open(path, "rb") as fh:
-            head = fh.read(64)
+        # without blocking: a FIFO nobody writes to hung a plain open for good (review 27e);
+        # anything but a regular file is left to not_regular (the write's own check) to name
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK)
     except (OSError, ValueError):
         return None
+    try:
+        if not stat.S_ISREG(os.fstat(fd).st_mode):
+            return None
+        head = os.read(fd, 64)
+    except OSError:
+        return None
+    finally:
+        os.close(fd)
     binary = kind[1] in (HDF5_FILE[1], PNG_FILE[1])
     text = head if binary else head.removeprefix(b"\xef\xbb\xbf").lstrip()
     return head if head and not text.startswith(kind[1]) else None

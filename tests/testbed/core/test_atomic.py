@@ -99,3 +99,34 @@ def test_a_replaced_file_keeps_its_owner_and_group(tmp_path):
     atomic_write_text(p, "new")
     st = p.stat()
     assert (st.st_uid, st.st_gid, stat.S_IMODE(st.st_mode)) == (65534, 65534, 0o600)
+
+
+def test_a_fifo_at_an_output_path_is_refused_at_once_not_read(tmp_path):
+    """Review 27e: foreign_head opened a FIFO nobody writes to and hung for good (``report -o``,
+    ``family write``); it is now no regular file, left to not_regular to name in one line."""
+    from testbed.core.atomic import MARKDOWN_FILE, foreign_head, not_regular
+    from testbed.core.errors import InputError
+
+    fifo = tmp_path / "report.md"
+    os.mkfifo(fifo)
+    assert foreign_head(fifo, MARKDOWN_FILE) is None  # returns at once (O_NONBLOCK)
+    with pytest.raises(InputError, match="not a regular file"):
+        not_regular(fifo)
+    (tmp_path / "mine.md").write_bytes(b"\x89PNG\r\n\x1a\n")
+    assert foreign_head(tmp_path / "mine.md", MARKDOWN_FILE) == b"\x89PNG\r\n\x1a\n"
+
+
+def test_a_users_own_page_or_notes_of_the_same_format_are_foreign(tmp_path):
+    """Review 27e: any ``<`` / ``#`` file passed as ours, so ``report -o`` replaced the user's own
+    ``report.html`` and ``identify -o notes.json`` their ``notes.md``; the testbed's own files
+    begin with a fixed prefix (the HTML report's doctype line, the identified model's title)."""
+    from testbed.core.atomic import HTML_FILE, IDENTIFIED_MARKDOWN_FILE, foreign_head
+
+    page, notes = tmp_path / "report.html", tmp_path / "notes.md"
+    page.write_text("<p>my page</p>\n")
+    notes.write_text("# My lab notes\n")
+    assert foreign_head(page, HTML_FILE) and foreign_head(notes, IDENTIFIED_MARKDOWN_FILE)
+    page.write_text('<!DOCTYPE html>\n<html lang="en"><head>')
+    notes.write_text("# Identified model: ls_sindy\n")
+    assert foreign_head(page, HTML_FILE) is None
+    assert foreign_head(notes, IDENTIFIED_MARKDOWN_FILE) is None
