@@ -136,6 +136,16 @@ whose backbone fit fails the first order lost 11 passes of 326 (the shipped soft
 frequency for every backbone fit lost soft member 008 (its 20.6 % damped mode 2 moved
 +3.3 %, clean and at 1 %).
 
+``ls_sindy`` (``exponential_if_failed``) so refits also an unlocated mode whose backbone fit
+failed (not converged, or not passing its checks): that decay shows no first-order backbone
+either, and the fit's frequency of a mode no peak located and no decay measured has nothing
+behind it.  Soft-base family member 000 at 1 % noise (mode 2 319.7 Hz, 31.8 % damped, no
+peak; its backbone fit failed at ``c / wd`` 0.46): the noisy cubic fit's 279.4 Hz had stood,
+12.6 % low; the exponential decay gives 322.1 Hz, 0.74 % (branch ``beam32``, 2026-11-29; the
+gate in docs/known-gaps.md).  Such a decay carries the stiffening mode 1's amplitude adds
+("Cubic library" below, "Mode 2's shift by mode 1's amplitude"): clean member 000 moves 3.25 -> 4.38 %
+(failing either way).  ``sgd_sindy`` does not pass it (default False): not measured there.
+
 A mode fitted from the accepted peak no mode took (``free_peaks_hz``) also takes that fit's
 shape (:func:`peak_shape`, :func:`set_shapes`; ``decay_rule_`` says "shaped by that fit"):
 each channel's amplitudes of the one decay, their common phase, at the model's norm and sign,
@@ -389,8 +399,8 @@ class ModalDecay:
         other modes; None where no mode was so fitted.
     exponential : ndarray of bool, shape (n,) or None
         With the backbone fit, the modes refitted as an exponential decay and converged (no
-        peak located them and their backbone fit was not first order); None where none was
-        refitted.
+        peak located them and their backbone fit was not first order, or with
+        ``exponential_if_failed`` failed); None where none was refitted.
     beyond : ndarray of complex, shape (n,) or None
         With the backbone fit, the linear pole ``-sigma + i wd`` [1/s] (mapped into the
         model's domain as ``sigma_model`` / ``lam_model`` are) of each located mode whose
@@ -631,7 +641,8 @@ def _decay_fit(q: np.ndarray, t: np.ndarray, sigma0: float, w: float, backbone: 
 def modal_decay(data: Measurement, M: np.ndarray, K: np.ndarray, C: np.ndarray,
                 window: tuple[int, int], backbone: bool = False,
                 unlocated: np.ndarray | None = None,
-                free_peaks_hz: np.ndarray | None = None) -> ModalDecay:
+                free_peaks_hz: np.ndarray | None = None,
+                exponential_if_failed: bool = False) -> ModalDecay:
     """Each mode's decay rate and damped frequency fitted to its measured free decay.
 
     Parameters
@@ -665,6 +676,12 @@ def modal_decay(data: Measurement, M: np.ndarray, K: np.ndarray, C: np.ndarray,
         found wrong (round 20's ``r20_stiff__002`` at 1 %: mode 1 10.79 Hz, peak 10.81 Hz, the
         tilted fit's 29.83 Hz; the modal coordinate's decay fit converged at 29.14 Hz and was
         taken).  None: no such start.
+
+    exponential_if_failed : bool
+        With ``backbone``: an unlocated mode whose backbone fit failed (not converged or not
+        passing its checks) is refitted as an exponential decay too, as one whose converged
+        backbone fit lies beyond the first order is (module docstring, "Cubic library";
+        ``ls_sindy`` only, measured there).  Default False.
 
     Returns
     -------
@@ -700,7 +717,8 @@ def modal_decay(data: Measurement, M: np.ndarray, K: np.ndarray, C: np.ndarray,
     pband = peak_band(data, i1 - i0)[0]  # [Hz]
     for k in order:
         s, wd, r2, ok, c, amp = _decay_fit(q[k], t, 0.5 * d[k], w[k], backbone, nuisance)
-        if backbone and ok and abs(c) > BACKBONE_MAX_SHIFT * wd and free[k]:
+        beyond_first = ok and abs(c) > BACKBONE_MAX_SHIFT * wd
+        if backbone and free[k] and (beyond_first or (exponential_if_failed and not ok)):
             # no peak located it and its decay holds no first-order backbone: the exponential
             # decay ("Cubic library")
             s, wd, r2, ok, c, amp = _decay_fit(q[k], t, 0.5 * d[k], w[k], False, nuisance)
@@ -1099,7 +1117,8 @@ def decay_hold(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndarray,
                enabled: bool = True, K3: np.ndarray | None = None,
                backbone: bool = True, unlocated: np.ndarray | None = None,
                peaks_hz: np.ndarray | None = None,
-               free_peaks_hz: np.ndarray | None = None) -> DecayHold:
+               free_peaks_hz: np.ndarray | None = None,
+               exponential_if_failed: bool = False) -> DecayHold:
     """The decay hold of ``sgd_sindy`` and ``ls_sindy`` on a fitted linear model.
 
     Each mode gets the damping of its measured free decay (:func:`modal_decay`,
@@ -1163,6 +1182,10 @@ def decay_hold(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndarray,
     free_peaks_hz : ndarray, shape (m,), optional
         Accepted peaks [Hz] no mode was paired with (:func:`modal_decay`; ``ls_sindy`` only).
 
+    exponential_if_failed : bool
+        Passed to :func:`modal_decay` (a cubic model's unlocated mode whose backbone fit
+        failed is refitted as an exponential decay); ``ls_sindy`` only.  Default False.
+
     Returns
     -------
     DecayHold
@@ -1177,7 +1200,8 @@ def decay_hold(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndarray,
     if i0 == 0 and forced:  # free_start = 0 with an input: a continuous excitation
         return DecayHold(C, K, None, "continuous input (free_start = 0): the fit's")
     with_backbone = K3 is not None  # a cubic model's decay: the backbone fit
-    dec = modal_decay(data, M, K, C, window, with_backbone, unlocated, free_peaks_hz)
+    dec = modal_decay(data, M, K, C, window, with_backbone, unlocated, free_peaks_hz,
+                      exponential_if_failed)
     if not np.any(dec.taken):
         return DecayHold(C, K, dec, "modal decay fits: none taken, the fit's")
     line = float(data.fs) / (i1 - i0)
@@ -1266,7 +1290,8 @@ def decay_hold(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndarray,
                if np.any(shaped) else "")
             + (f"; modes {(np.flatnonzero(dec.exponential & on) + 1).tolist()}, which no measured "
                f"peak located and whose decay holds no first-order backbone (|c| > "
-               f"{BACKBONE_MAX_SHIFT:g} wd), from an exponential decay fit, wherever it lies"
+               f"{BACKBONE_MAX_SHIFT:g} wd, or its backbone fit failed), from an exponential "
+               f"decay fit, wherever it lies"
                if dec.exponential is not None and np.any(dec.exponential & on) else "")
             + (f"; modes {(np.flatnonzero(beyond) + 1).tolist()} kept the fit's frequency (the "
                f"decay's lies beyond one line of it, within the spectral-peak offset: a cubic "

@@ -222,7 +222,9 @@ class LeastSquaresSINDy(StructuralIdentifier):
     "Cubic library".  A mode no accepted peak locates (paired as step 2 pairs, the hold not
     applied) whose decay holds no first-order backbone is fitted as an exponential decay and
     takes its frequency wherever it lies (``r20_soft__003`` clean: mode 2 10.4 -> 0.99 %;
-    326 beam cells: passes 281 -> 282, none lost).
+    326 beam cells: passes 281 -> 282, none lost); so too one whose backbone fit failed
+    (``exponential_if_failed`` of :func:`identify._modal_damping.decay_hold`; soft member 000
+    at 1 %, mode 2 31.8 % damped: 12.62 -> 0.74 %; docs/known-gaps.md, beam32).
 
     4. *Cubic refused* (``cubic=None`` only): the cubic model is replaced by the linear
        library's fit when (a) on a mode whose backbone decay fit was taken, the model's own
@@ -1006,7 +1008,8 @@ class LeastSquaresSINDy(StructuralIdentifier):
         held = decay_hold(data, self.M_, self.C_, self.K_, (i0, i1),
                           lambda on, lam: set_eigenvalues(self.M_, self.K_, np.where(on, lam, np.nan)),
                           self.decay_hold, self.K3_, self.decay_backbone,
-                          self._unlocated(data, peaks), self.eigen_targets_, self._free_peaks(data, peaks))
+                          self._unlocated(data, peaks), self.eigen_targets_, self._free_peaks(data, peaks),
+                          exponential_if_failed=True)
         if held.decay is not None:
             self.modal_decay_ = held.decay
         self.coef_[:, v_block] -= (held.C - self.C_) / m
