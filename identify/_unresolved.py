@@ -105,7 +105,12 @@ def place_unresolved(M: np.ndarray, C: np.ndarray, K: np.ndarray, top_hz: float,
         The peak band's lower edge [Hz].  Given, where no mode reaches beyond the top, the
         modes of :func:`unlocated_growing` inside ``[band_low_hz, top_hz]`` are the unresolved
         ones (module docstring; ``ls_sindy``'s step 5).  None (``sgd_sindy``'s warm start):
-        beyond the top only.
+        beyond the top only.  Given, where those rules place nothing, a fit with exactly one mode
+        of non-positive stiffness eigenvalue (or of :func:`unlocated_growing`'s kind) has it
+        placed, on the direction the other modes' shapes leave (the unit vector orthogonal to
+        their span), the accepted peaks still checked: a mode with no frequency shows no peak,
+        and its fitted shape is what rounding left in directions the record does not excite
+        (diag27: round 26's clean seven-sensor beam, modes 4-7 gone before the free window).
 
     Returns
     -------
@@ -125,11 +130,24 @@ def place_unresolved(M: np.ndarray, C: np.ndarray, K: np.ndarray, top_hz: float,
         return None
     lam, Phi = stiffness_eigenvalues(M, K)
     bad = modal_pole_reach(M, C, K) > 2.0 * np.pi * top_hz
+    orth = False
     where = f"a pole beyond the peak band's top {top_hz:.4g} Hz) placed at that top"
     if band_low_hz is not None and not np.any(bad):
         bad = unlocated_growing(M, C, K, peaks, (float(band_low_hz), top_hz))
         where = ("negative own damping inside the band, where no accepted peak located it) "
                  f"placed at the peak band's top {top_hz:.4g} Hz")
+    if band_low_hz is not None and (np.count_nonzero(bad) != 1 or np.any(lam[~bad] <= 0.0)):
+        # a fit with no fit band (ls_sindy's step 5 only) whose one growing mode is a negative
+        # stiffness: no accepted peak can locate a mode without a frequency, and the record's
+        # free decay is carried by the other modes (the accepted peaks checked below), so the
+        # record does not hold it (diag27: b26_st_s7u_f2_hit0p6_fs25k6 clean, seven sensors,
+        # modes 4-7 34-116 % damped, gone before the free decay: least squares fits the
+        # directions the record leaves unexcited with whatever rounding gives them)
+        neg = (lam <= 0.0) | unlocated_growing(M, C, K, peaks, (float(band_low_hz), top_hz))
+        if np.count_nonzero(neg) == 1:
+            bad, orth = neg, True
+            where = ("no frequency for any peak to locate, in a fit with no fit band) placed at the "
+                     f"peak band's top {top_hz:.4g} Hz on the direction the other modes' shapes leave")
     # one mode only: two or more placed at the one top would be a repeated eigenvalue whose
     # shapes round-off decides (on a non-symmetric warm start, 7 of 200 random 4-DOF models
     # with two modes above the top ended in a singular eigenvector matrix: session 18's review)
@@ -141,7 +159,17 @@ def place_unresolved(M: np.ndarray, C: np.ndarray, K: np.ndarray, top_hz: float,
             return None
     w2 = (2.0 * np.pi * top_hz) ** 2
     d = np.where(bad, w2 - lam, 0.0)
-    K2 = K + (M @ Phi) @ np.linalg.solve(Phi.T, np.diag(d)).T
+    if orth:
+        # its shape is not the record's either: the direction the other modes' shapes leave
+        # (least squares put it nearly parallel to mode 1's, cond(Phi) ~1e9)
+        others = Phi[:, ~bad]
+        q, _ = np.linalg.qr(np.hstack([others, np.eye(lam.size)]))
+        Phi2 = Phi.copy()
+        Phi2[:, bad] = q[:, others.shape[1]:others.shape[1] + 1]
+        lam2 = np.where(bad, w2, lam)
+        K2 = M @ Phi2 @ np.diag(lam2) @ np.linalg.inv(Phi2)
+    else:
+        K2 = K + (M @ Phi) @ np.linalg.solve(Phi.T, np.diag(d)).T
     if np.allclose(M, M.T) and np.allclose(K, K.T):
         K2 = 0.5 * (K2 + K2.T)
     # the placed modes are now the highest (every resolved one lies at or below the top)
@@ -157,7 +185,8 @@ def place_unresolved(M: np.ndarray, C: np.ndarray, K: np.ndarray, top_hz: float,
                      for v in lam[bad])
     rule = (f"{n_bad} mode(s) the record cannot resolve (fitted with {what}, {where}, "
             f"damping ratio "
-            f"{UNRESOLVED_ZETA:g}, shapes kept; the {lam.size - n_bad} resolved modes carry "
+            f"{UNRESOLVED_ZETA:g}, " + ("the other shapes kept" if orth else "shapes kept")
+            + f"; the {lam.size - n_bad} resolved modes carry "
             f"every accepted peak")
     return C2, K2, rule
 

@@ -11,9 +11,10 @@ not place (it places only a mode beyond the peak band's top, or an unlocated one
 frequency), so the model was refused clean while every noisy copy passes (noise fills those
 directions and least squares puts lightly damped modes there, which the decay hold damps).
 
-The first two tests state the record's facts (hold now and after any fix).  The third is the
-fix's (``/tmp/diag27/fix.patch`` at the time, for ``identify/_unresolved.py``'s owner): marked
-``xfail(strict=True)`` until it is applied, when it passes and the mark must go.
+The first two tests state the record's facts.  The third is the fix's
+(:func:`identify._unresolved.place_unresolved`: in a fit with no fit band, one mode of
+non-positive stiffness is placed at the peak band's top on the direction the other modes'
+shapes leave).
 """
 
 from __future__ import annotations
@@ -98,9 +99,6 @@ def test_least_squares_determines_modes_1_to_3(record):
         assert abs((-got.real / abs(got)) / (-true.real / abs(true)) - 1.0) < 0.05, (got, true)
 
 
-@pytest.mark.xfail(strict=True, reason="diag27's fix (identify/_unresolved.py: a negative "
-                   "stiffness in a no-band fit placed on the direction the other modes leave) "
-                   "not applied; docs/known-gaps.md, 'diag27'")
 def test_the_negative_stiffness_is_placed_and_modes_1_to_3_kept(record):
     """With the fix, ``ls_sindy``'s step 5 (no fit band, so the band's lower edge is given)
     places the fit's one negative stiffness at the peak band's top on the direction the other
