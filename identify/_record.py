@@ -2,8 +2,10 @@
 
 One routine, :func:`record_agreement`, shared by the identifiers that judge a fitted model by
 its own record: ``sgd_sindy`` (the SGD's result against its held warm start,
-:func:`identify.sgd_sindy.keep_sgd_rule`) and ``ls_sindy`` (the free window's fitted input map
-against none, :func:`identify.ls_sindy.LeastSquaresSINDy.fit`).
+:func:`identify.sgd_sindy.keep_sgd_rule`, its cubic trial, its input map) and ``ls_sindy`` (the
+free window's fitted input map against none, its cubic trial: step 4b); and the two tests their
+rules share: :func:`clearly_more` (the margin of a real difference) and :func:`extra_modes` (a
+model mode no measured peak located among them).
 """
 
 from __future__ import annotations
@@ -11,11 +13,38 @@ from __future__ import annotations
 import numpy as np
 
 from identify._structural_sim import RK4_STABILITY_BOUND, sample_rate_pole
-from identify.structural import StructuralIdentifier
+from identify.structural import MODE_SEPARATION, StructuralIdentifier
 from testbed.core.errors import TestbedError
 from testbed.core.measurement import Measurement, Trajectory
 from testbed.numerics.initial_state import MAX_ITERATIONS, fit_initial_state
 from testbed.numerics.shapes import trac
+
+#: The margin of a real difference between two models' record agreements: the one explains
+#: clearly more where it leaves under 1 / this of the other's unexplained share (``1 - a``); a
+#: smaller difference is within what the start fit and the noise move (session 22's review: the
+#: stiff beam's input map decided by 1.5e-7 of TRAC).  One margin for every rule that compares
+#: two fits by their records (``sgd_sindy``'s keep rule and cubic trial, both identifiers'
+#: input-map drop, ``ls_sindy``'s step 4b).
+AGREEMENT_RATIO = 2.0
+
+
+def clearly_more(a_new: float, a_old: float, ratio: float = AGREEMENT_RATIO) -> bool:
+    """Whether a record agreement ``a_new`` [-] explains clearly more than ``a_old``: it leaves
+    under ``1 / ratio`` of the other's unexplained share (a NaN on either side: False)."""
+    return bool(1.0 - a_old > ratio * (1.0 - a_new))
+
+
+def extra_modes(modes_hz: np.ndarray, peaks_hz: np.ndarray) -> bool:
+    """Whether a model puts more modes among the measured peaks (below the highest, and
+    :data:`identify.structural.MODE_SEPARATION` above it) than peaks were located [Hz]: a mode
+    no peak located among them is the fit's, not the record's (False without peaks; a NaN
+    frequency, a non-positive stiffness, is no mode among them)."""
+    peaks = np.asarray(peaks_hz, dtype=float)
+    if not peaks.size:
+        return False
+    modes = np.asarray(modes_hz, dtype=float)
+    return bool(np.count_nonzero(modes < peaks.max() * (1.0 + MODE_SEPARATION)) > peaks.size)
+
 
 #: The openings of :func:`record_agreement`'s notes for a simulation from the record's own start
 #: that failed: written there and read by :func:`identify.sgd_sindy.cubic_diverges`, one

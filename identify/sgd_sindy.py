@@ -57,7 +57,14 @@ from identify import IDENTIFIERS
 from identify._band_refusal import fit_with_band_refusal, lowest_mode_hz
 from identify._cubic_rule import THIRD_HARMONIC_IN, cubic_rule
 from identify._modal_damping import cubic_softens, decay_hold
-from identify._record import SIMULATION_FAILED, SIMULATION_NOT_FINITE, record_agreement
+from identify._record import (
+    AGREEMENT_RATIO,
+    SIMULATION_FAILED,
+    SIMULATION_NOT_FINITE,
+    clearly_more,
+    extra_modes,
+    record_agreement,
+)
 from identify._sgd_matrix import (
     PROJECTED_DOUBT,
     MatrixSGDResult,
@@ -73,7 +80,6 @@ from identify.structural import (
     DECAY_BACKBONE_FIELD,
     DECAY_HOLD_FIELD,
     LOWER_MODES_FIELD,
-    MODE_SEPARATION,
     PeakSearch,
     StructuralIdentifier,
     build_library,
@@ -109,7 +115,7 @@ LR_CUBIC = 1.5e-5
 #: clean 1.5x); a wandering SGD leaves 7.8-9.5x (soft 016 clean 7.8x, 006 clean 7.9x: frequency
 #: error 1773 %, 003 at 1 % 9.5x).  Nearest the bound: soft 012 at 1 % noise, replaced with
 #: scored TRACs 0.980 / 0.990 (about 2x; both fail on mode 2, 1.6 %).
-SGD_AGREEMENT_RATIO = 2.0
+SGD_AGREEMENT_RATIO = AGREEMENT_RATIO  # 2: identify._record's one margin
 #: ... unless the SGD's result leaves at most this share of the record unexplained: then it
 #: reproduces the record and the ratio compares residues (exact synthetic Duffing chain:
 #: 5.9e-5 against the warm start's 1.2e-5, 4.8x, where the warm start's cubic is the lasso's,
@@ -174,12 +180,6 @@ def cubic_diverges(note: str) -> bool:
     bool
     """
     return note.startswith((SIMULATION_FAILED, SIMULATION_NOT_FINITE))
-
-
-def _clearly_more(a_new: float, a_old: float) -> bool:
-    """Whether a record agreement ``a_new`` explains clearly more than ``a_old``: it leaves under
-    1 / :data:`SGD_AGREEMENT_RATIO` of the other's unexplained share (NaN: False)."""
-    return 1.0 - a_old > SGD_AGREEMENT_RATIO * (1.0 - a_new)
 
 
 def _agreement_text(a: float, failed: str = "none (its simulation failed)",
@@ -1318,7 +1318,7 @@ class SGDSINDy(SGDSINDyBase):
             return
         a_cubic = trial._kept_agreement()
         if not (kept_cubic(trial.K3_) and np.isfinite(a_cubic)
-                and _clearly_more(a_cubic, a_first)):
+                and clearly_more(a_cubic, a_first)):
             said = (f"{1.0 - a_cubic:.2g}" if np.isfinite(a_cubic) else "not measured") \
                 if kept_cubic(trial.K3_) else "no cubic term either"
             self.cubic_rule_ += (f"; {first}, the whole cubic library's fit {said}, not under 1 / "
@@ -1329,8 +1329,7 @@ class SGDSINDy(SGDSINDyBase):
             # a mode among the measured ones that no peak located is not the record's (round
             # 23's b23_soft_r0p7_z2p5_hit0p3 at 2 %, s145: peaks 31.9 / 364.6 Hz, the cubic fit
             # 31.7 / 227.7 / 362.6 Hz, mode 2 then paired 4.1 % off; the linear 1.5 %)
-            modes = np.asarray(trial.natural_frequencies_, dtype=float)
-            if np.count_nonzero(modes < peaks.max() * (1.0 + MODE_SEPARATION)) > peaks.size:
+            if extra_modes(trial.natural_frequencies_, peaks):
                 self.cubic_rule_ += (f"; {first}, the whole cubic library's fit "
                                      f"{1.0 - a_cubic:.2g}, but it puts more modes among the "
                                      f"measured peaks than were located ({peaks.size}): no cubic")
@@ -1428,7 +1427,7 @@ class SGDSINDy(SGDSINDyBase):
         # decides by 1e-3 for the model whose cubic contradicts the measured decay (review
         # 25e); a cubic's one-iteration agreement (FLOOR_CHECK_ITERATIONS) left 0.98-1.41 x
         # its three-iteration unexplained share on the gate's kept cubics, inside the 2 x
-        if np.isfinite(a_linear) and not _clearly_more(a_cubic, a_linear):
+        if np.isfinite(a_linear) and not clearly_more(a_cubic, a_linear):
             why = (f"the linear refit explains more of its record ({figures})"
                    if not a_linear <= a_cubic else
                    f"the cubic model does not explain clearly more of its record than the "
@@ -1526,11 +1525,11 @@ class SGDSINDy(SGDSINDyBase):
             # refit (round 24's b24_soft_r2p7_cf0p45_z0p2 at 1 %: 0.9915 against 0.779);
             # round 24's b24_soft_L1p35_hpauto at 3 % (s156), 0.954 against the flat 0.976
             # (1.9 x), lost issue #15's 1 % on mode 1 (2.35 %) with the projected fit kept
-            better = np.isfinite(a_flat) and not _clearly_more(a_first, a_flat)
+            better = np.isfinite(a_flat) and not clearly_more(a_first, a_flat)
             more = (f"is not clearly bettered by the projected cubic one's (whose unexplained "
                     f"share is not under 1 / {SGD_AGREEMENT_RATIO:g} of the flat's; ")
         elif clear:
-            better = _clearly_more(a_flat, a_first)
+            better = clearly_more(a_flat, a_first)
             more = (f"explains clearly more of its record than the projected tilted one's "
                     f"(its unexplained share under 1 / {SGD_AGREEMENT_RATIO:g} of the other's; ")
         else:
