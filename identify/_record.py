@@ -34,16 +34,22 @@ def clearly_more(a_new: float, a_old: float, ratio: float = AGREEMENT_RATIO) -> 
     return bool(1.0 - a_old > ratio * (1.0 - a_new))
 
 
-def extra_modes(modes_hz: np.ndarray, peaks_hz: np.ndarray) -> bool:
+def extra_modes(modes_hz: np.ndarray, peaks_hz: np.ndarray,
+                baseline_hz: np.ndarray | None = None) -> bool:
     """Whether a model puts more modes among the measured peaks (below the highest, and
     :data:`identify.structural.MODE_SEPARATION` above it) than peaks were located [Hz]: a mode
     no peak located among them is the fit's, not the record's (False without peaks; a NaN
-    frequency, a non-positive stiffness, is no mode among them)."""
+    frequency, a non-positive stiffness, is no mode among them).  With ``baseline_hz`` (the
+    model it would replace), more than the larger of the peaks and the baseline's own count
+    there: a real mode no peak located (a heavily damped one between the peaks, one below the
+    band) is the record's in both and refuses neither (review 27f)."""
     peaks = np.asarray(peaks_hz, dtype=float)
     if not peaks.size:
         return False
-    modes = np.asarray(modes_hz, dtype=float)
-    return bool(np.count_nonzero(modes < peaks.max() * (1.0 + MODE_SEPARATION)) > peaks.size)
+    top = peaks.max() * (1.0 + MODE_SEPARATION)
+    allowed = peaks.size if baseline_hz is None else max(
+        peaks.size, int(np.count_nonzero(np.asarray(baseline_hz, dtype=float) < top)))
+    return bool(np.count_nonzero(np.asarray(modes_hz, dtype=float) < top) > allowed)
 
 
 #: The openings of :func:`record_agreement`'s notes for a simulation from the record's own start

@@ -1325,15 +1325,14 @@ class SGDSINDy(SGDSINDyBase):
                                  f"{SGD_AGREEMENT_RATIO:g} of it: no cubic")
             return
         peaks = np.asarray(getattr(self, "measured_frequencies_", np.empty(0)), dtype=float)
-        if peaks.size:
-            # a mode among the measured ones that no peak located is not the record's (round
-            # 23's b23_soft_r0p7_z2p5_hit0p3 at 2 %, s145: peaks 31.9 / 364.6 Hz, the cubic fit
-            # 31.7 / 227.7 / 362.6 Hz, mode 2 then paired 4.1 % off; the linear 1.5 %)
-            if extra_modes(trial.natural_frequencies_, peaks):
-                self.cubic_rule_ += (f"; {first}, the whole cubic library's fit "
-                                     f"{1.0 - a_cubic:.2g}, but it puts more modes among the "
-                                     f"measured peaks than were located ({peaks.size}): no cubic")
-                return
+        # a mode among the measured ones that no peak located is not the record's (round 23's
+        # b23_soft_r0p7_z2p5_hit0p3 at 2 %, s145: peaks 31.9 / 364.6 Hz, the cubic fit 31.7 /
+        # 227.7 / 362.6 Hz, mode 2 then paired 4.1 % off; the linear 1.5 %)
+        if extra_modes(trial.natural_frequencies_, peaks):
+            self.cubic_rule_ += (f"; {first}, the whole cubic library's fit "
+                                 f"{1.0 - a_cubic:.2g}, but it puts more modes among the "
+                                 f"measured peaks than were located ({peaks.size}): no cubic")
+            return
         user = {k: getattr(self, k) for k in ("cubic", "l1", "l1_threshold", "l1_debias")}
         rule = self.cubic_rule_
         self.__dict__.clear()
@@ -1372,8 +1371,9 @@ class SGDSINDy(SGDSINDyBase):
         :meth:`_cubic_contradicts_decay`) is doubted, not refused: the linear library is fitted
         too, from the state before the fit (``begun``), and the cubic stays only where its kept
         record agreement (:func:`record_agreement`) explains clearly more of the record than
-        the linear refit's (:func:`_clearly_more`: under 1 / :data:`SGD_AGREEMENT_RATIO` of its
-        unexplained share, the margin the cubic's trial fit must clear over a linear model,
+        the linear refit's (:func:`identify._record.clearly_more`: under 1 /
+        :data:`SGD_AGREEMENT_RATIO` of its unexplained share, the margin the cubic's trial fit
+        must clear over a linear model,
         :meth:`_cubic_if_it_explains_more`), stated in ``cubic_rule_`` (a candidate with an
         agreement beats one without, as in :func:`keep_sgd_rule`; a linear refit that fails
         keeps the cubic).  Where the cubic libraries' terms are the data's to select (by rule,
@@ -1422,7 +1422,7 @@ class SGDSINDy(SGDSINDyBase):
         figures = (f"record agreement {_agreement_text(a_linear)} against "
                    f"{_agreement_text(a_cubic)}")
         # The doubted cubic stays only where it explains clearly more of its record than the
-        # linear refit (_clearly_more, the trial's margin for a cubic over a linear model):
+        # linear refit (clearly_more, the trial's margin for a cubic over a linear model):
         # a tie (round 20's r20_soft__001 at 1 %: 0.997 against the linear's 0.996) no longer
         # decides by 1e-3 for the model whose cubic contradicts the measured decay (review
         # 25e); a cubic's one-iteration agreement (FLOOR_CHECK_ITERATIONS) left 0.98-1.41 x

@@ -24,7 +24,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from identify._unresolved import place_unresolved
+from identify._unresolved import UNRESOLVED_ZETA, place_unresolved
 from identify.structural import (
     build_library,
     check_physical,
@@ -108,8 +108,15 @@ def test_the_negative_stiffness_is_placed_and_modes_1_to_3_kept(record):
     M, C, K = _tilted_fit(data)
     placed = place_unresolved(M, C, K, float(ps.band[1]), ps.peaks, band_low_hz=float(ps.band[0]))
     assert placed is not None
-    C2, K2, _ = placed
+    C2, K2, rule = placed
     check_physical(M, C2, K2)
+    # the placed mode carries the damping (review 27f: it went to the highest mode, one of the
+    # three the fit left beyond the top, which the rule now names)
+    poles = np.linalg.eigvals(state_matrix(M, C2, K2))
+    at_top = poles[np.argmin(np.abs(np.abs(poles) - 2 * np.pi * float(ps.band[1])))]
+    assert abs(abs(at_top) / (2 * np.pi * float(ps.band[1])) - 1.0) < 1e-6
+    assert abs(-at_top.real / abs(at_top) - UNRESOLVED_ZETA) < 1e-6
+    assert "beyond the top left as fitted" in rule
     fitted = np.linalg.eigvals(state_matrix(M, C, K))
     held = np.linalg.eigvals(state_matrix(M, C2, K2))
     for true in _reduced_poles(truth)[:3]:
