@@ -57,7 +57,9 @@ def evaluate_terms(names: Sequence[str], signals: Mapping[str, np.ndarray]) -> n
     """Evaluate product terms (:mod:`testbed.core.terms` syntax) on samples.
 
     An implementation independent of the identifiers' library code, so that the scorer checks
-    it rather than trusting it.
+    it rather than trusting it.  Each distinct factor (``sin`` / ``cos`` of an angle or a
+    difference, or a signal, to its power) is evaluated once, and each term is the product of
+    its factors in written order (:func:`term_program`).
 
     Parameters
     ----------
@@ -70,26 +72,71 @@ def evaluate_terms(names: Sequence[str], signals: Mapping[str, np.ndarray]) -> n
     -------
     ndarray, shape (n, len(names))
     """
-    n = np.shape(signals["th"])[1]
-    cache: dict[tuple, np.ndarray] = {}
+    return term_program(tuple(names))(signals)
 
-    def factor(spec: tuple) -> np.ndarray:
-        if spec not in cache:
-            if spec[0] in ("sin", "cos"):
-                fn, i, j = spec
-                arg = signals["th"][i] - (signals["th"][j] if j is not None else 0.0)
-                cache[spec] = np.sin(arg) if fn == "sin" else np.cos(arg)
+
+class TermProgram:
+    """Product terms compiled once for repeated evaluation (a rollout's every stage).
+
+    The distinct ``(factor, power)`` pairs of the terms are evaluated once a call, stacked
+    under a row of ones, and each term is the product of its pairs' rows in written order,
+    padded with the ones row: ``x * 1 == x`` exactly, so a term's value is the same
+    floating-point product as factor by factor (``((f1 ** p1) * (f2 ** p2)) * ...``) and
+    ``"1"`` is the ones row.
+
+    Parameters
+    ----------
+    names : tuple of str
+        Terms, length p (:func:`term_plan` syntax).
+    """
+
+    def __init__(self, names: tuple[str, ...]):
+        pairs: list[tuple[tuple, int]] = []
+        rows = []
+        for factors in term_plan(names):
+            row = []
+            for pair in factors:
+                if pair not in pairs:
+                    pairs.append(pair)
+                row.append(1 + pairs.index(pair))  # row 0: the ones
+            rows.append(row)
+        width = max([len(r) for r in rows] + [1])
+        self.pairs = tuple(pairs)
+        #: (width, p) rows of each term's factors, in written order, padded with 0 (the ones)
+        self.index = np.array([r + [0] * (width - len(r)) for r in rows], dtype=np.intp
+                              ).reshape(len(rows), width).T
+        specs = list(dict.fromkeys(spec for spec, _ in pairs))
+        #: per distinct factor: (kind, i, j) with kind "sin", "cos" or a signal's name
+        self.specs = tuple((spec[0], spec[1], spec[2]) if spec[0] in ("sin", "cos")
+                           else (spec[1], spec[2], None) for spec in specs)
+        #: per pair: its factor's place in ``specs`` and its power
+        self.powers = tuple((specs.index(spec), power) for spec, power in pairs)
+
+    def __call__(self, signals: Mapping[str, np.ndarray]) -> np.ndarray:
+        """The terms on ``signals`` (:func:`evaluate_terms`): ndarray (n, p)."""
+        th = signals["th"]
+        value = []
+        for kind, i, j in self.specs:
+            if kind == "sin" or kind == "cos":
+                arg = th[i] - (th[j] if j is not None else 0.0)
+                value.append(np.sin(arg) if kind == "sin" else np.cos(arg))
             else:
-                cache[spec] = np.asarray(signals[spec[1]][spec[2]], dtype=float)
-        return cache[spec]
+                value.append(np.asarray(signals[kind][i], dtype=float))
+        rows = np.empty((1 + len(self.powers), np.shape(th)[1]))
+        rows[0] = 1.0
+        for r, (f, power) in enumerate(self.powers, start=1):
+            rows[r] = value[f] if power == 1 else value[f] ** power  # x ** 1 == x exactly
+        index = self.index
+        out = rows[index[0]]  # (p, n)
+        for k in range(1, index.shape[0]):
+            out *= rows[index[k]]
+        return out.T
 
-    out = np.empty((len(names), n))
-    for c, factors in enumerate(term_plan(tuple(names))):
-        col = np.ones(n)
-        for spec, power in factors:
-            col = col * factor(spec) ** power
-        out[c] = col
-    return out.T
+
+@functools.lru_cache(maxsize=256)
+def term_program(names: tuple[str, ...]) -> TermProgram:
+    """:class:`TermProgram` of ``names``, compiled once per tuple of terms."""
+    return TermProgram(names)
 
 
 @functools.lru_cache(maxsize=256)

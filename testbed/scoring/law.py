@@ -23,7 +23,7 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
-from testbed.scoring.equation_basis import evaluate_terms, term_plan
+from testbed.scoring.equation_basis import term_plan, term_program
 
 #: States drawn in the record's box: the RMS error of 4096 draws has a sampling spread of about
 #: 1 / sqrt(2 x 4096) = 1.1 % of itself, far below any bar set on it.
@@ -116,29 +116,37 @@ def accelerations(names: Sequence[str], coef: np.ndarray, states: Mapping[str, n
 
 
 def _law_parts(names: Sequence[str], coef: np.ndarray, n: int) -> tuple:
-    """The law's terms without their accelerations, and the coefficients of ``b`` and of each
-    column of ``A`` (:func:`accelerations`) with the terms they take, for ``n`` coordinates."""
+    """The law's terms without their accelerations (compiled once: :func:`term_program`), and
+    the coefficients of ``b`` and of each column of ``A`` (:func:`accelerations`) with the terms
+    they take, for ``n`` coordinates."""
     coef = np.atleast_2d(np.asarray(coef, dtype=float))
     rest, which = linear_split(tuple(names))
     cols = [np.flatnonzero(which == k) for k in range(-1, n)]  # b's, then A's columns
-    return list(rest), [(c, coef[:, c].T) for c in cols]
+    return term_program(rest), [(c, coef[:, c].T) for c in cols]
 
 
 def _solve_law(parts: tuple, states: Mapping[str, np.ndarray]) -> np.ndarray:
     """Accelerations (N, n) of the law ``parts`` (:func:`_law_parts`) at ``states``."""
-    rest, cols = parts
-    G = evaluate_terms(rest, states)  # (N, p)
     with np.errstate(all="ignore"):
-        b = G[:, cols[0][0]] @ cols[0][1]  # (N, n_eq)
-        A = np.stack([G[:, c] @ w for c, w in cols[1:]], axis=2)  # (N, n_eq, n)
-        try:  # one solve where every state's A is regular (the rollout's many small calls)
-            out = np.linalg.solve(A, -b[..., None])[..., 0]
-        except np.linalg.LinAlgError:  # some singular: those states say nothing (NaN)
-            det_ok = np.abs(np.linalg.det(A)) > 0
-            out = np.full((G.shape[0], A.shape[2]), np.nan)
-            if np.any(det_ok):
-                out[det_ok] = np.linalg.solve(A[det_ok], -b[det_ok][..., None])[..., 0]
-    return out
+        return _solve_law_quiet(parts, states)
+
+
+def _solve_law_quiet(parts: tuple, states: Mapping[str, np.ndarray]) -> np.ndarray:
+    """:func:`_solve_law` without setting numpy's error state (the caller ignores all)."""
+    program, cols = parts
+    G = program(states)  # (N, p)
+    b = G[:, cols[0][0]] @ cols[0][1]  # (N, n_eq)
+    A = np.empty((G.shape[0], b.shape[1], len(cols) - 1))  # (N, n_eq, n)
+    for k, (c, w) in enumerate(cols[1:]):
+        A[:, :, k] = G[:, c] @ w
+    try:  # one solve where every state's A is regular (the rollout's many small calls)
+        return np.linalg.solve(A, -b[..., None])[..., 0]
+    except np.linalg.LinAlgError:  # some singular: those states say nothing (NaN)
+        det_ok = np.abs(np.linalg.det(A)) > 0
+        out = np.full((G.shape[0], A.shape[2]), np.nan)
+        if np.any(det_ok):
+            out[det_ok] = np.linalg.solve(A[det_ok], -b[det_ok][..., None])[..., 0]
+        return out
 
 
 def law_rollout(names: Sequence[str], coef: np.ndarray, x0: np.ndarray, xd0: np.ndarray,
@@ -180,21 +188,28 @@ def law_rollout(names: Sequence[str], coef: np.ndarray, x0: np.ndarray, xd0: np.
     out[:, :, 0] = q.T
 
     parts = _law_parts(names, coef, q.shape[0])
+    # the inputs held over each sample step, one column per rollout: (N, m, K)
+    U = np.repeat(np.asarray(u, dtype=float).T[:, :, None], K, axis=2)
 
     def acc(a: np.ndarray, b: np.ndarray, uk: np.ndarray) -> np.ndarray:
-        return _solve_law(parts, {"th": a, "dth": b, "u": uk}).T * s
+        return _solve_law_quiet(parts, {"th": a, "dth": b, "u": uk}).T * s
 
     h = dt / substeps if substeps > 1 else dt
+    h2 = h / 2
+    h6 = h / 6
     with np.errstate(all="ignore"):
         for k in range(N - 1):
-            uk = np.repeat(np.asarray(u, dtype=float)[:, k:k + 1], K, axis=1)
+            uk = U[k]
             for _ in range(substeps):
                 a1 = acc(q, qd, uk)
-                a2 = acc(q + h / 2 * qd, qd + h / 2 * a1, uk)
-                a3 = acc(q + h / 2 * (qd + h / 2 * a1), qd + h / 2 * a2, uk)
-                a4 = acc(q + h * (qd + h / 2 * a2), qd + h * a3, uk)
-                q = q + h / 6 * (qd + 2 * (qd + h / 2 * a1) + 2 * (qd + h / 2 * a2) + qd + h * a3)
-                qd = qd + h / 6 * (a1 + 2 * a2 + 2 * a3 + a4)
+                v2 = qd + h2 * a1
+                a2 = acc(q + h2 * qd, v2, uk)
+                v3 = qd + h2 * a2
+                a3 = acc(q + h2 * v2, v3, uk)
+                v4 = qd + h * a3
+                a4 = acc(q + h * v3, v4, uk)
+                q = q + h6 * (qd + 2 * v2 + 2 * v3 + qd + h * a3)
+                qd = qd + h6 * (a1 + 2 * a2 + 2 * a3 + a4)
             out[:, :, k + 1] = q.T
             if not np.any(np.isfinite(q)):
                 break

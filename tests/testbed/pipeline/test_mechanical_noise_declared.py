@@ -213,7 +213,7 @@ def test_auto_cutoff_of_a_float_angle_with_a_large_offset():
     assert _within_resolution(cuts, t.size, fs), cuts
 
 
-def test_auto_cutoff_on_the_down_branch_multisine_near_clean():
+def test_auto_cutoff_on_the_down_branch_multisine_near_clean(dataset_cache):
     """Review 24d (q7.py, q10.py): round 22's down-branch multisine, seed 133, with angle noise
     rms_percent 9e-5 (relative 9e-7): the clean-record rule of session 24 put the cut-off at
     4500 Hz (its clean angles: 111 Hz; half / quarter of them 186 / 285 Hz) and the fit failed
@@ -221,8 +221,10 @@ def test_auto_cutoff_on_the_down_branch_multisine_near_clean():
     angles, and the first half and quarter of the clean ones, must get one cut-off within the
     quarter's spectral resolution (4.27 Hz each, measured)."""
     sc = testbed.load_scenario(UNSEEN / "round22" / "fb22_ms_down.toml")
-    ds = testbed.generate(dataclasses.replace(sc, seed=133,
-                                              noise={**sc.noise, "rms_percent": 9e-5}))
+    # the cache's clean simulation, shared with tests/identify/test_sindy_pi_held_input.py
+    # (bit-identical to testbed.generate: testbed/pipeline/cache.py)
+    ds = dataset_cache.get(dataclasses.replace(sc, seed=133,
+                                               noise={**sc.noise, "rms_percent": 9e-5}))
     raw, clean = ds.measured["theta"].data, ds.reference["theta"].data
     n = clean.shape[1]
     assert 0 < np.max(np.abs(raw - clean)) < 1e-5  # the noise is there, and tiny
