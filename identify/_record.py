@@ -52,6 +52,39 @@ def extra_modes(modes_hz: np.ndarray, peaks_hz: np.ndarray,
     return bool(np.count_nonzero(np.asarray(modes_hz, dtype=float) < top) > allowed)
 
 
+def without_input_map(model: StructuralIdentifier, data: Measurement, a_fit: float,
+                      note_fit: str = "", ratio: float = AGREEMENT_RATIO
+                      ) -> tuple[bool, float, str]:
+    """Whether a fitted model's input map goes: the model with it explains ``a_fit`` of its
+    record (:func:`record_agreement`), the same model with a zero map is judged here, and the map
+    is dropped where the model without it leaves at most ``1 / ratio`` of what the model with it
+    leaves unexplained, or where only it has an agreement (``ls_sindy``'s step 6 and
+    ``sgd_sindy``'s kept model: one rule).
+
+    Returns
+    -------
+    (bool, float, str)
+        Whether the map was dropped (``model.input_map_`` left zero; else restored as it was),
+        the agreement without it [-] (NaN: not simulated) and the figures: both agreements and
+        unexplained shares, with their notes.
+    """
+    fitted = model.input_map_
+    model.input_map_ = np.zeros_like(np.asarray(fitted, dtype=float))
+    a_none, note_none = record_agreement(model, data)
+
+    def show(a: float, note: str) -> str:
+        return f"{a:.6g}" + (f" ({note})" if note else "")
+
+    figures = (f"record agreement (TRAC) with the map {show(a_fit, note_fit)}, without "
+               f"{show(a_none, note_none)}; unexplained shares {1.0 - a_fit:.3g} and "
+               f"{1.0 - a_none:.3g}")
+    drop = bool(np.isfinite(a_none) and (not np.isfinite(a_fit)
+                                         or ratio * (1.0 - a_none) <= 1.0 - a_fit))
+    if not drop:
+        model.input_map_ = fitted
+    return drop, float(a_none), figures
+
+
 #: The openings of :func:`record_agreement`'s notes for a simulation from the record's own start
 #: that failed: written there and read by :func:`identify.sgd_sindy.cubic_diverges`, one
 #: spelling for both.

@@ -20,7 +20,13 @@ from identify._modal_damping import (
     nearer_own,
     set_eigenvalues,
 )
-from identify._record import AGREEMENT_RATIO, clearly_more, extra_modes, record_agreement
+from identify._record import (
+    AGREEMENT_RATIO,
+    clearly_more,
+    extra_modes,
+    record_agreement,
+    without_input_map,
+)
 from identify._sgd_matrix import eigen_targets, fit_window
 from identify._unresolved import place_unresolved
 from identify.structural import (
@@ -576,19 +582,9 @@ class LeastSquaresSINDy(StructuralIdentifier):
             self.input_map_rule_ = ("fitted on the window; kept (a record with no free window: "
                                     "the input drives the whole record)")
             return
-        fitted = self.input_map_
         a_fit, note_fit = record_agreement(self, data)
-        self.input_map_ = np.zeros_like(fitted)
-        a_none, note_none = record_agreement(self, data)
-
-        def show(a: float, note: str) -> str:
-            return f"{a:.6g}" + (f" ({note})" if note else "")
-
-        figures = (f"record agreement (TRAC) with the fitted input {show(a_fit, note_fit)}, "
-                   f"without {show(a_none, note_none)}; unexplained shares "
-                   f"{1.0 - a_fit:.3g} and {1.0 - a_none:.3g}")
-        if np.isfinite(a_none) and (not np.isfinite(a_fit)
-                                    or INPUT_DROP_RATIO * (1.0 - a_none) <= 1.0 - a_fit):
+        drop, a_none, figures = without_input_map(self, data, a_fit, note_fit, INPUT_DROP_RATIO)
+        if drop:
             cols = getattr(self, "_input_columns", None)
             if cols is not None and cols.size == self.coef_.shape[1]:
                 self.coef_ = self.coef_.copy()
@@ -598,7 +594,6 @@ class LeastSquaresSINDy(StructuralIdentifier):
                 f"most 1 / {INPUT_DROP_RATIO:g} of the record unexplained that it leaves with it "
                 f"({figures})")
             return
-        self.input_map_ = fitted
         if not (np.isfinite(a_fit) or np.isfinite(a_none)):
             self.input_map_rule_ = ("rule: the free window's fitted input term kept, neither "
                                     f"model simulated from the record's start ({figures})")

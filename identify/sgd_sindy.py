@@ -64,6 +64,7 @@ from identify._record import (
     clearly_more,
     extra_modes,
     record_agreement,
+    without_input_map,
 )
 from identify._sgd_matrix import (
     PROJECTED_DOUBT,
@@ -1197,22 +1198,12 @@ class SGDSINDy(SGDSINDyBase):
         note_fit = ""
         if not np.isfinite(a_fit):
             a_fit, note_fit = record_agreement(self, data)
-        self.input_map_ = np.zeros_like(np.asarray(B, dtype=float))
-        a_none, note_none = record_agreement(self, data)
-
-        def show(a: float, note: str) -> str:
-            return f"{a:.6g}" + (f" ({note})" if note else "")
-
-        figures = (f"record agreement (TRAC) with the map {show(a_fit, note_fit)}, without "
-                   f"{show(a_none, note_none)}; unexplained shares {1.0 - a_fit:.3g} and "
-                   f"{1.0 - a_none:.3g}")
-        if np.isfinite(a_none) and (not np.isfinite(a_fit)
-                                    or INPUT_DROP_RATIO * (1.0 - a_none) <= 1.0 - a_fit):
+        drop, a_none, figures = without_input_map(self, data, a_fit, note_fit, INPUT_DROP_RATIO)
+        if drop:
             self.input_map_rule_ += (
                 "; rule: then dropped, the model without it leaves at most 1 / "
                 f"{INPUT_DROP_RATIO:g} of the record unexplained that it leaves with it ({figures})")
             return
-        self.input_map_ = B
         self.input_map_rule_ += (
             "; rule: kept, " + (f"neither model simulated from the record's start ({figures})"
                                 if not (np.isfinite(a_fit) or np.isfinite(a_none)) else
