@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import copy
 from collections.abc import Callable
 from dataclasses import replace
 from typing import ClassVar
@@ -248,10 +249,12 @@ class LeastSquaresSINDy(StructuralIdentifier):
     4b. *Cubic trial* (``cubic=None`` only; :meth:`_cubic_trial`): where the rule left the
        cubic out (not refused) but the lowest mode's backbone decay chirp exceeds
        :data:`identify._cubic_rule.CUBIC_CHIRP_MIN` (the record hardens with amplitude), the
-       cubic library is fitted too, refused as in step 4, and kept only where its simulated
-       response leaves at most 1 / :data:`CUBIC_TRIAL_RATIO` of the record unexplained that
-       the linear model's leaves (:func:`identify._record.record_agreement`); otherwise the
-       linear model stands as fitted.  Why: at 1 % noise the partial correlations that decide
+       cubic library is fitted too, refused as in step 4 or where it puts more modes among the
+       measured peaks than the linear model (:func:`identify._record.extra_modes`), and kept
+       only where its simulated response leaves under 1 / :data:`CUBIC_TRIAL_RATIO` of the
+       record unexplained that the linear model's leaves
+       (:func:`identify._record.record_agreement`); otherwise the linear model stands as
+       fitted.  Why: at 1 % noise the partial correlations that decide
        the rule are drowned (soft-base family members 002-016 at 1 %: 0.06-0.63 flat and
        tilted, where clean they choose the cubic), while the chirp is a decay fitted in
        physical time; alone as the rule it had gained 3 and lost 2 of the 80 soft family
@@ -649,7 +652,8 @@ class LeastSquaresSINDy(StructuralIdentifier):
         cubic would be (:meth:`_fit_library`: tilt rule, holds, :meth:`_cap_at_reach`) and
         refused as step 4 refuses one (non-physical, softening a hardening decay, diverging);
         a cubic not refused, and not putting more modes among the measured peaks than were
-        located (:func:`identify._record.extra_modes`, as ``sgd_sindy``'s cubic trial), is kept
+        located or the linear model has there (:func:`identify._record.extra_modes` with the
+        linear model as baseline; ``sgd_sindy``'s trial counts the peaks alone), is kept
         where its record agreement (:func:`identify._record.record_agreement`) leaves under 1 /
         :data:`CUBIC_TRIAL_RATIO` of the record unexplained that the linear model leaves.
         Otherwise the linear model stands exactly as fitted.  ``cubic_rule_`` says what was
@@ -671,7 +675,6 @@ class LeastSquaresSINDy(StructuralIdentifier):
         if not (np.isfinite(chirp) and chirp > CUBIC_CHIRP_MIN):
             return
         saved = {k: (v.copy() if isinstance(v, np.ndarray) else v) for k, v in self.__dict__.items()}
-        a_lin, note_lin = record_agreement(self, data)
         head = (f"; trial (step 4b): the lowest mode's ({f_hz:.4g} Hz) backbone chirp c / wd "
                 f"{chirp:+.3g} > {CUBIC_CHIRP_MIN:g} (it hardens with amplitude), the cubic "
                 "library fitted too")
@@ -692,6 +695,11 @@ class LeastSquaresSINDy(StructuralIdentifier):
             why = (f"it puts more modes among the measured peaks than were located "
                    f"({np.asarray(peaks).size}) or the linear model has there")
         a_cub, note_cub = (np.nan, "") if why else record_agreement(self, data)
+        a_lin, note_lin = np.nan, ""
+        if not why:  # the linear model's agreement, read only where a cubic is to be compared
+            linear = copy.copy(self)
+            linear.__dict__ = dict(saved)
+            a_lin, note_lin = record_agreement(linear, data)
         figures = (f"record agreement (TRAC) linear {a_lin:.6g}"
                    + (f" ({note_lin})" if note_lin else "") + f", cubic {a_cub:.6g}"
                    + (f" ({note_cub})" if note_cub else ""))

@@ -34,7 +34,7 @@ from testbed.core.atomic import (
     HTML_FILE,
     IDENTIFIED_MARKDOWN_FILE,
     JSON_FILE,
-    MARKDOWN_FILE,
+    REPORT_MARKDOWN_FILE,
     UFF_FILE,
     FileKind,
     foreign_head,
@@ -773,7 +773,7 @@ def cmd_report(args: argparse.Namespace) -> int:
                 raise InputError(f"{source}: no such run folder or results file (nor a scenario "
                                  f"with runs in {args.runs})") from None
             raise InputError(f"{source}: not a run folder written by `testbed run`") from None
-    for name, kind in (("report.html", HTML_FILE), ("report.md", MARKDOWN_FILE)):
+    for name, kind in (("report.html", HTML_FILE), ("report.md", REPORT_MARKDOWN_FILE)):
         # the user's own file of that name in the folder named (round 27: replaced in silence)
         _foreign_output(Path(args.output) / name, "--output", kind)
     html = write_report(source, Path(args.output))

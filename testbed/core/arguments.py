@@ -108,8 +108,8 @@ def describe(a: Any) -> str:
 
 def array(where: str, name: str, value: Any, shape: tuple[int | None, ...], *,
           complex_ok: bool = False, finite: bool = True) -> np.ndarray:
-    """``value`` as a finite float64 array (complex128 if ``complex_ok``) of ``shape``
-    (``None``: any length along that axis).
+    """``value`` as a float64 array (complex128 if ``complex_ok``; finite unless ``finite`` is
+    False) of ``shape`` (``None``: any length along that axis).
 
     An ndarray or a nested list of numbers is accepted; boolean, object, text, datetime and
     structured dtypes are refused, and so is complex unless ``complex_ok``, and a masked array

@@ -112,6 +112,9 @@ HDF5_FILE: FileKind = ("an HDF5 dataset", (b"\x89HDF\r\n\x1a\n",))
 JSON_FILE: FileKind = ("a JSON file", (b"{", b"["))
 UFF_FILE: FileKind = ("a UFF file", (b"-1",))
 MARKDOWN_FILE: FileKind = ("a markdown report", (b"#",))
+#: a run's or a study's markdown report (``testbed.reporting.report``: its title line), so a
+#: user's own ``report.md`` of notes is refused, not replaced (read 27b)
+REPORT_MARKDOWN_FILE: FileKind = ("a markdown report", (b"# Run ", b"# Study "))
 #: an identified model's report (``testbed.reporting.identified``: its first line since it was
 #: written): a user's own ``notes.md`` beside ``identify -o notes.json`` is not ours (review 27e)
 IDENTIFIED_MARKDOWN_FILE: FileKind = ("an identified model's markdown report",
@@ -145,7 +148,7 @@ def foreign_head(path: Path, kind: FileKind) -> bytes | None:
         return None
     finally:
         os.close(fd)
-    binary = kind[1] in (HDF5_FILE[1], PNG_FILE[1])
+    binary = not kind[1][0].isascii()  # a binary format's signature (HDF5, PNG) opens with 0x89
     text = head if binary else head.removeprefix(b"\xef\xbb\xbf").lstrip()
     return head if head and not text.startswith(kind[1]) else None
 

@@ -291,8 +291,13 @@ class Dataset:
         # fs as the float the file stores, numpy scalars as the Python numbers a load reads
         # back (review 27a: fs = 100, attrs {"n": np.int64(3)} saved files whose own load
         # failed its hash check)
-        h.update(json.dumps({"fs": float(self.fs), "prior": prior, "attrs": meta},
-                            sort_keys=True, default=_json_scalar).encode())
+        # under numpy's default print options: a list or array prior is hashed by its printed
+        # form, which a session's np.set_printoptions changed (a file saved under the defaults
+        # failed its load's check after precision=3: read 27b); the same bytes as before
+        with np.printoptions(precision=8, threshold=1000, edgeitems=3, linewidth=75,
+                             suppress=False, floatmode="maxprec", sign="-", legacy=False):
+            h.update(json.dumps({"fs": float(self.fs), "prior": prior, "attrs": meta},
+                                sort_keys=True, default=_json_scalar).encode())
         for group, signals in (("measured", self.measured), ("reference", self.reference)):
             for name in sorted(signals):
                 s = signals[name]
@@ -317,8 +322,8 @@ class Dataset:
 
         The rules: ``fs`` a finite rate > 0; at least one measured signal; every signal's,
         truth's and prior's name a non-empty text without ``/`` (HDF5 makes it a path of
-        groups) or NUL, and not ``.``; truth texts and units without NUL;
-        and its channel names and unit without NUL (HDF5's texts end at one); ``attrs`` keys
+        groups) or NUL, and not ``.``; a signal's channel names, unit and ``acts_on``, truth
+        texts and truth units without NUL (HDF5's texts end at one); ``attrs`` keys
         texts other than the file's own (``format``, ``fs``, ``fs_unit``, ``json_attrs``),
         values a text, a number within int64 / float64 or JSON; the prior as
         :func:`~testbed.core.measurement.prior_ok` takes it; a truth value real numbers or a

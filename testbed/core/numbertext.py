@@ -30,6 +30,8 @@ def plain_number(text: str) -> str | None:
 
     Give the result to ``float()`` (or ``int()``, which refuses a point or an exponent).
     """
+    if PLAIN_NUMBER.fullmatch(text):  # the common cell: no blank to strip (read 27b: 27 x)
+        return text
     core = text.strip("".join(c for c in set(text) if _blank(c)))
     return core if PLAIN_NUMBER.fullmatch(core) else None
 

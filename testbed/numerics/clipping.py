@@ -51,7 +51,7 @@ from typing import Any
 
 import numpy as np
 
-from testbed.numerics.noise import LATTICE_TOL, noise_std, on_lattice, smallest_gap  # noqa: F401
+from testbed.numerics.noise import noise_std, on_lattice, smallest_gap
 
 #: A clip level is held on at least one run of this many consecutive samples [samples]: a
 #: smooth float record meets each value once.

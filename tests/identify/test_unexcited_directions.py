@@ -6,9 +6,9 @@ ends at sample 162), so the record's state moves in the subspace of modes 1-3 al
 chain's rounding).  Least squares of the 7-DOF regression (``ls_sindy``'s library, no fit band,
 tilted) then returns modes 1-3 exactly (the record determines them) and the other four modes
 from what rounding leaves in the unexcited directions: on this record a negative stiffness (a
-real pole pair, one growing), which no hold of ``ls_sindy`` repairs and which its step 5 does
-not place (it places only a mode beyond the peak band's top, or an unlocated one with a
-frequency), so the model was refused clean while every noisy copy passes (noise fills those
+real pole pair, one growing), which no hold of ``ls_sindy`` repairs and which its step 5 did
+not place before session 27 (it placed only a mode beyond the peak band's top, or an unlocated
+one with a frequency), so the model was refused clean while every noisy copy passes (noise fills those
 directions and least squares puts lightly damped modes there, which the decay hold damps).
 
 The first two tests state the record's facts.  The third is the fix's

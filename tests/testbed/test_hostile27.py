@@ -8,6 +8,7 @@ import argparse
 import pytest
 
 from testbed import cli
+from testbed.core.atomic import MARKDOWN_FILE
 
 
 def _parse(*argv: str) -> argparse.Namespace:
@@ -52,7 +53,7 @@ def test_report_refuses_an_empty_source_or_runs_folder(capsys, argv):
 PNG = b"\x89PNG\r\n\x1a\n" + bytes(range(64))
 
 
-@pytest.mark.parametrize("kind", [cli.HDF5_FILE, cli.JSON_FILE, cli.UFF_FILE, cli.MARKDOWN_FILE])
+@pytest.mark.parametrize("kind", [cli.HDF5_FILE, cli.JSON_FILE, cli.UFF_FILE, MARKDOWN_FILE])
 def test_an_output_of_another_kind_is_refused_and_left_as_it_is(tmp_path, kind):
     # `generate -o photo.png` replaced the picture by a dataset, status 0 (as identify / export)
     photo = tmp_path / "photo.png"
@@ -64,7 +65,7 @@ def test_an_output_of_another_kind_is_refused_and_left_as_it_is(tmp_path, kind):
 
 @pytest.mark.parametrize("kind, head", [
     (cli.HDF5_FILE, b"\x89HDF\r\n\x1a\n\x00\x00"), (cli.JSON_FILE, b"\xef\xbb\xbf \n{\"a\": 1}"),
-    (cli.JSON_FILE, b"[1]"), (cli.UFF_FILE, b"    -1\n   58\n"), (cli.MARKDOWN_FILE, b"# model\n"),
+    (cli.JSON_FILE, b"[1]"), (cli.UFF_FILE, b"    -1\n   58\n"), (MARKDOWN_FILE, b"# model\n"),
     (cli.JSON_FILE, b"")])
 def test_an_output_of_its_own_kind_or_empty_is_replaced_as_before(tmp_path, kind, head):
     earlier = tmp_path / "earlier.out"
