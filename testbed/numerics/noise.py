@@ -224,12 +224,9 @@ def quantisation_std(x: np.ndarray) -> np.ndarray:
     """
     out = []
     for row in _rows(x):
-        values = np.unique(row[np.isfinite(row)])  # sorted: its gaps once (read 27a)
-        gaps = np.diff(values)
-        step = float(gaps.min()) if gaps.size else 0.0
-        lattice = values.size > 2 and step > 0 and bool(
-            np.all(np.abs(gaps / step - np.round(gaps / step)) <= LATTICE_TOL))
-        out.append(step / np.sqrt(12.0) if lattice else 0.0)
+        values = np.unique(row[np.isfinite(row)])  # sorted and distinct
+        step = float(np.diff(values).min()) if values.size > 1 else 0.0
+        out.append(step / np.sqrt(12.0) if values.size > 2 and on_lattice(values, step) else 0.0)
     return np.asarray(out, dtype=float)
 
 
