@@ -1326,7 +1326,27 @@ def cubic_mode_reach(Mr: np.ndarray, Kr: np.ndarray, k3: float, cubic_map: np.nd
 def linear_model_failures(scores: Scores, thresholds: dict[str, dict[str, float]]
                           ) -> dict[str, str]:
     """A failed frequency bar of a linear model on a truth whose cubic force is not small:
-    ``{"cubic": reason}``.
+    ``{"cubic": reason}`` (:func:`_linear_model_reason`), unless another failed bar is left
+    that the missing cubic is not shown to explain (:func:`hidden_by_frequency`: a MAC bar, or
+    a TRAC bar :func:`linear_trac_failures` does not name): a reason for the frequencies alone
+    would hide it and count the cell as the missing term's (round 27, as
+    :func:`hidden_by_trac`).
+
+    Parameters
+    ----------
+    scores : Scores
+        As :func:`_linear_model_reason`.
+    thresholds : dict
+        The run's bars, ``{metric: {"min"|"max": value}}``.
+    """
+    found = _linear_model_reason(scores, thresholds)
+    return {} if found and hidden_by_frequency(scores, thresholds) else found
+
+
+def _linear_model_reason(scores: Scores, thresholds: dict[str, dict[str, float]]
+                         ) -> dict[str, str]:
+    """A failed frequency bar of a linear model on a truth whose cubic force is not small:
+    ``{"cubic": reason}``, whatever else failed (:func:`linear_model_failures` judges that).
 
     Round 21's ``b21_soft_f300`` (the shipped soft base under 300 N, cubic fraction about 8 at
     the peak base rotation), clean: both identifiers kept the cubic terms out (``ls_sindy``'s
@@ -1399,7 +1419,7 @@ def hidden_by_trac(scores: Scores, thresholds: dict[str, dict[str, float]]) -> l
     (:func:`linear_trac_failures`).
 
     Every failed check but ``trac``, unless each of them is a frequency bar and
-    :func:`linear_model_failures` names them all (each failed mode within what the truth's
+    :func:`_linear_model_reason` names them all (each failed mode within what the truth's
     cubic force can move it).
 
     Parameters
@@ -1417,7 +1437,35 @@ def hidden_by_trac(scores: Scores, thresholds: dict[str, dict[str, float]]) -> l
     rest = [c for c in check_thresholds(scores.values, thresholds)
             if not c.passed and c.metric != "trac"]
     if rest and all(c.metric.startswith("freq_error") for c in rest) \
-            and linear_model_failures(scores, thresholds):
+            and _linear_model_reason(scores, thresholds):
+        return []
+    return rest
+
+
+def hidden_by_frequency(scores: Scores, thresholds: dict[str, dict[str, float]]) -> list[Check]:
+    """The failed bars besides the frequency bars of a linear model on a cubic truth that the
+    missing cubic term is not shown to explain, which a reason for the frequencies alone would
+    hide (:func:`linear_model_failures`).
+
+    Every failed check but the frequency bars (``freq_error*``), unless the only one is the
+    TRAC bar and :func:`_linear_trac_reason` names it (every failing channel at the truth's
+    linear part).
+
+    Parameters
+    ----------
+    scores : Scores
+        The run's scores (:func:`score_structural`).
+    thresholds : dict
+        The run's bars, ``{metric: {"min"|"max": value}}``.
+
+    Returns
+    -------
+    list of Check
+        The failed checks left unexplained (empty: nothing hidden).
+    """
+    rest = [c for c in check_thresholds(scores.values, thresholds)
+            if not c.passed and not c.metric.startswith("freq_error")]
+    if rest and all(c.metric == "trac" for c in rest) and _linear_trac_reason(scores, thresholds):
         return []
     return rest
 
@@ -1466,12 +1514,19 @@ def linear_trac_failures(scores: Scores, thresholds: dict[str, dict[str, float]]
     dict of str to str
         Empty, or the reason naming each failing channel, its TRAC and the linear part's there.
     """
+    found = _linear_trac_reason(scores, thresholds)
+    return {} if found and hidden_by_trac(scores, thresholds) else found
+
+
+def _linear_trac_reason(scores: Scores, thresholds: dict[str, dict[str, float]]
+                        ) -> dict[str, str]:
+    """:func:`linear_trac_failures`' reason, whatever else failed (that function judges it)."""
     share = scores.details.get("truth_cubic_share")
     if (not cubic_share_matters(scores, thresholds) or scores.values.get("K3_norm") != 0.0
             or {"fit", "model", "simulation", "growth", "stiffness"} & set(scores.failures)):
         return {}
     judged = failed_trac(scores, thresholds, "truth_linear_trac")
-    if judged is None or hidden_by_trac(scores, thresholds):
+    if judged is None:
         return {}
     trac, lin, bar = judged
     failing = ~(trac >= bar)

@@ -104,7 +104,7 @@ def test_the_truths_linear_part_scored_on_a_round_26_record_is_named_linear_mode
     assert set(why) == {"cubic_trac"} and why["cubic_trac"].startswith("linear model: TRAC")
 
 
-def soft_r1p4(freq2: float, mac1: float = 1.0) -> dict[str, str]:
+def soft_r1p4(freq2: float, mac1: float = 1.0, linear3: float = 0.321) -> dict[str, str]:
     """Round 27's ``b27_soft_r1p4_cf0p55_s4u_hit0p45`` clean s181, ``ls_sindy`` (four sensors, a
     linear model): TRAC 0.859 on acc3 (the truth's linear part 0.321 there), mode 1 3.06 % off
     (within the cubic's reach, 0.329), mode 2 ``freq2`` off; the families' bars."""
@@ -113,7 +113,7 @@ def soft_r1p4(freq2: float, mac1: float = 1.0) -> dict[str, str]:
     values = {"trac": 0.859, "K3_norm": 0.0, "mac_mode1": mac1, "freq_error_mode1": 0.0306,
               "freq_error_mode2": freq2}
     details = {"trac": np.array([0.95, 0.93, 0.859, 0.92]),
-               "truth_linear_trac": np.array([0.90, 0.80, 0.321, 0.85]),
+               "truth_linear_trac": np.array([0.90, 0.80, linear3, 0.85]),
                "channels": ["acc1", "acc2", "acc3", "acc4"], "truth_cubic_share": 0.355,
                "truth_cubic_reach": np.array([0.329, 0.1, 0.05, 0.05]),
                "freq_error_per_mode": np.array([0.0306, freq2, 0.29, 0.84])}
@@ -132,3 +132,14 @@ def test_no_trac_reason_that_would_hide_a_bar_the_missing_term_does_not_explain(
     assert set(soft_r1p4(0.01)) == {"cubic", "cubic_trac"}
     # a failed MAC bar, which no cubic reason explains: nothing claimed for the TRAC
     assert "cubic_trac" not in soft_r1p4(0.01, mac1=0.85)
+
+
+def test_no_frequency_reason_that_would_hide_a_bar_the_missing_term_does_not_explain():
+    # the same cell with the truth's linear part meeting the TRAC bar on acc3: that channel's
+    # failure is the model's own (linear_trac_failures), which "linear model" for mode 1 alone
+    # (within its reach) would hide
+    assert soft_r1p4(0.01, linear3=0.95) == {}
+    # a failed MAC bar beside it: nothing claimed for the frequencies either
+    assert soft_r1p4(0.01, mac1=0.85) == {}
+    # the TRAC named the missing term's: the frequencies too
+    assert set(soft_r1p4(0.01)) == {"cubic", "cubic_trac"}
