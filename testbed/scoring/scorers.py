@@ -1418,9 +1418,9 @@ def hidden_by_trac(scores: Scores, thresholds: dict[str, dict[str, float]]) -> l
     term is not shown to explain, which a reason for the TRAC alone would hide
     (:func:`linear_trac_failures`).
 
-    Every failed check but ``trac``, unless each of them is a frequency bar and
-    :func:`_linear_model_reason` names them all (each failed mode within what the truth's
-    cubic force can move it).
+    Every failed check but ``trac``, unless each of them is a frequency bar (or the MAC bar of
+    a mode with no partner, :func:`_unpaired_mac`) and :func:`_linear_model_reason` names them
+    all (each failed mode within what the truth's cubic force can move it, or unpaired).
 
     Parameters
     ----------
@@ -1436,10 +1436,21 @@ def hidden_by_trac(scores: Scores, thresholds: dict[str, dict[str, float]]) -> l
     """
     rest = [c for c in check_thresholds(scores.values, thresholds)
             if not c.passed and c.metric != "trac"]
-    if rest and all(c.metric.startswith("freq_error") for c in rest) \
+    if rest and all(c.metric.startswith("freq_error") or _unpaired_mac(c, scores) for c in rest) \
             and _linear_model_reason(scores, thresholds):
         return []
     return rest
+
+
+def _unpaired_mac(check: Check, scores: Scores) -> bool:
+    """Whether ``check`` is a MAC bar (``mac`` or ``mac_mode<k>``) missed by a true mode with no
+    partner: its MAC and its frequency error both NaN (:func:`_per_mode`), a mode the frequency
+    reason names as unpaired (:func:`_linear_model_reason`) rather than one it hides."""
+    found = _MODE_SCORE.fullmatch(check.metric)
+    if not found or found[1] != "mac" or np.isfinite(check.value):
+        return False
+    freq = "freq_error" + (f"_mode{found[2]}" if found[2] else "")
+    return not np.isfinite(scores.values.get(freq, np.nan))
 
 
 def hidden_by_frequency(scores: Scores, thresholds: dict[str, dict[str, float]]) -> list[Check]:
@@ -1447,9 +1458,10 @@ def hidden_by_frequency(scores: Scores, thresholds: dict[str, dict[str, float]])
     missing cubic term is not shown to explain, which a reason for the frequencies alone would
     hide (:func:`linear_model_failures`).
 
-    Every failed check but the frequency bars (``freq_error*``), unless the only one is the
-    TRAC bar and :func:`_linear_trac_reason` names it (every failing channel at the truth's
-    linear part).
+    Every failed check but the frequency bars (``freq_error*``) and the MAC bars of modes with
+    no partner (:func:`_unpaired_mac`: the frequency reason names them), unless the only one
+    left is the TRAC bar and :func:`_linear_trac_reason` names it (every failing channel at the
+    truth's linear part).
 
     Parameters
     ----------
@@ -1464,7 +1476,8 @@ def hidden_by_frequency(scores: Scores, thresholds: dict[str, dict[str, float]])
         The failed checks left unexplained (empty: nothing hidden).
     """
     rest = [c for c in check_thresholds(scores.values, thresholds)
-            if not c.passed and not c.metric.startswith("freq_error")]
+            if not c.passed and not c.metric.startswith("freq_error")
+            and not _unpaired_mac(c, scores)]
     if rest and all(c.metric == "trac" for c in rest) and _linear_trac_reason(scores, thresholds):
         return []
     return rest

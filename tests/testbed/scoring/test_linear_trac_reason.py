@@ -143,3 +143,19 @@ def test_no_frequency_reason_that_would_hide_a_bar_the_missing_term_does_not_exp
     assert soft_r1p4(0.01, mac1=0.85) == {}
     # the TRAC named the missing term's: the frequencies too
     assert set(soft_r1p4(0.01)) == {"cubic", "cubic_trac"}
+
+
+def test_an_unpaired_modes_mac_is_named_by_the_frequency_reason_not_hidden():
+    """Review 26d's unpaired mode (NaN MAC and frequency error) under the families' MAC bars:
+    the frequency reason names it ("no partner"), so its failed MAC hides nothing."""
+    bars = {"mac_mode1": {"min": 0.9}, "mac_mode2": {"min": 0.9},
+            "freq_error_mode1": {"max": 0.026}, "freq_error_mode2": {"max": 0.026}}
+    details = {"truth_cubic_share": 0.531, "truth_cubic_reach": np.array([0.27, 0.033])}
+    nan = float("nan")
+    s = Scores({"K3_norm": 0.0, "mac_mode1": nan, "freq_error_mode1": nan, "mac_mode2": 0.99,
+                "freq_error_mode2": 0.03}, details)
+    why = bar_failures(s, bars)
+    assert set(why) == {"cubic"} and "mode 1 has no partner" in why["cubic"]
+    # a paired mode's failed MAC is no frequency's: withheld
+    s = Scores({**s.values, "mac_mode1": 0.5, "freq_error_mode1": 0.01}, details)
+    assert bar_failures(s, bars) == {}
