@@ -20,14 +20,15 @@ CHANNELS = ["acc1", "acc2", "acc3"]
 
 
 def failures(trac: list[float], linear: list[float] | None, k3_norm: float = 0.0,
-             share: float | None = 0.26, bars: dict = BARS, **failed: str) -> dict[str, str]:
+             share: float | None = 0.26, bars: dict = BARS, values: dict | None = None,
+             **failed: str) -> dict[str, str]:
     details = {"trac": np.array(trac), "channels": CHANNELS}
     if linear is not None:
         details["truth_linear_trac"] = np.array(linear)
     if share is not None:
         details["truth_cubic_share"] = share
-    return bar_failures(Scores({"trac": float(np.min(trac)), "K3_norm": k3_norm}, details,
-                               dict(failed)), bars)
+    return bar_failures(Scores({"trac": float(np.min(trac)), "K3_norm": k3_norm, **(values or {})},
+                               details, dict(failed)), bars)
 
 
 def test_a_linear_models_failed_trac_under_the_truths_linear_part_is_named():
@@ -62,7 +63,8 @@ def test_no_claim_where_the_linear_part_meets_the_bar_or_the_model_is_not_linear
     # clamp was named "linear model"): no claim, and the linear part is the floor instead
     assert set(failures([0.941, 0.899, 0.935], [0.806, 0.671, 0.790], share=1e-6)) == {"floor"}
     assert failures([0.941, 0.899, 0.935], [0.806, 0.671, 0.790], share=0.04,
-                    bars={**BARS, "freq_error": {"max": 0.01}}) != {}  # 0.04 >= 0.0201
+                    bars={**BARS, "freq_error": {"max": 0.01}},
+                    values={"freq_error": 0.005}) != {}  # 0.04 >= 0.0201 (the bar met)
     assert failures([0.941, 0.899, 0.935], [0.806, 0.671, 0.790],
                     growth="non-physical: ...") == {}
     # the bar met, or no TRAC bar: nothing to explain
@@ -100,3 +102,60 @@ def test_the_truths_linear_part_scored_on_a_round_26_record_is_named_linear_mode
     assert s.values["trac"] < 0.9  # the cubic matters here (measured 0.945 / 0.924 / 0.806 / 0.671 / 0.790)
     why = bar_failures(s, bars)
     assert set(why) == {"cubic_trac"} and why["cubic_trac"].startswith("linear model: TRAC")
+
+
+def soft_r1p4(freq2: float, mac1: float = 1.0, linear3: float = 0.321) -> dict[str, str]:
+    """Round 27's ``b27_soft_r1p4_cf0p55_s4u_hit0p45`` clean s181, ``ls_sindy`` (four sensors, a
+    linear model): TRAC 0.859 on acc3 (the truth's linear part 0.321 there), mode 1 3.06 % off
+    (within the cubic's reach, 0.329), mode 2 ``freq2`` off; the families' bars."""
+    bars = {**BARS, "mac_mode1": {"min": 0.9}, "freq_error_mode1": {"max": 0.026},
+            "freq_error_mode2": {"max": 0.026}}
+    values = {"trac": 0.859, "K3_norm": 0.0, "mac_mode1": mac1, "freq_error_mode1": 0.0306,
+              "freq_error_mode2": freq2}
+    details = {"trac": np.array([0.95, 0.93, 0.859, 0.92]),
+               "truth_linear_trac": np.array([0.90, 0.80, linear3, 0.85]),
+               "channels": ["acc1", "acc2", "acc3", "acc4"], "truth_cubic_share": 0.355,
+               "truth_cubic_reach": np.array([0.329, 0.1, 0.05, 0.05]),
+               "freq_error_per_mode": np.array([0.0306, freq2, 0.29, 0.84])}
+    return bar_failures(Scores(values, details, {}), bars)
+
+
+def test_no_trac_reason_that_would_hide_a_bar_the_missing_term_does_not_explain():
+    # measured: mode 2 86 % off (MAC 1.000), beyond what the cubic force moves it: the model's
+    # own failure, which "linear model" for the TRAC alone hid (and counted as the term's)
+    assert soft_r1p4(0.8595) == {}
+    # mode 2 within its reach: both frequency bars and the TRAC are named the missing term's
+    got = soft_r1p4(0.05)
+    assert set(got) == {"cubic", "cubic_trac"}
+    assert failure_kind("; ".join(got.values())) == ["linear model"]
+    # mode 2 met, mode 1 within its reach: the same
+    assert set(soft_r1p4(0.01)) == {"cubic", "cubic_trac"}
+    # a failed MAC bar, which no cubic reason explains: nothing claimed for the TRAC
+    assert "cubic_trac" not in soft_r1p4(0.01, mac1=0.85)
+
+
+def test_no_frequency_reason_that_would_hide_a_bar_the_missing_term_does_not_explain():
+    # the same cell with the truth's linear part meeting the TRAC bar on acc3: that channel's
+    # failure is the model's own (linear_trac_failures), which "linear model" for mode 1 alone
+    # (within its reach) would hide
+    assert soft_r1p4(0.01, linear3=0.95) == {}
+    # a failed MAC bar beside it: nothing claimed for the frequencies either
+    assert soft_r1p4(0.01, mac1=0.85) == {}
+    # the TRAC named the missing term's: the frequencies too
+    assert set(soft_r1p4(0.01)) == {"cubic", "cubic_trac"}
+
+
+def test_an_unpaired_modes_mac_is_named_by_the_frequency_reason_not_hidden():
+    """Review 26d's unpaired mode (NaN MAC and frequency error) under the families' MAC bars:
+    the frequency reason names it ("no partner"), so its failed MAC hides nothing."""
+    bars = {"mac_mode1": {"min": 0.9}, "mac_mode2": {"min": 0.9},
+            "freq_error_mode1": {"max": 0.026}, "freq_error_mode2": {"max": 0.026}}
+    details = {"truth_cubic_share": 0.531, "truth_cubic_reach": np.array([0.27, 0.033])}
+    nan = float("nan")
+    s = Scores({"K3_norm": 0.0, "mac_mode1": nan, "freq_error_mode1": nan, "mac_mode2": 0.99,
+                "freq_error_mode2": 0.03}, details)
+    why = bar_failures(s, bars)
+    assert set(why) == {"cubic"} and "mode 1 has no partner" in why["cubic"]
+    # a paired mode's failed MAC is no frequency's: withheld
+    s = Scores({**s.values, "mac_mode1": 0.5, "freq_error_mode1": 0.01}, details)
+    assert bar_failures(s, bars) == {}
