@@ -272,29 +272,45 @@ def test_a_step_input_holds_the_clean_columns_down_and_a_smooth_one_does_not(cle
     assert sp.noise_knobs(*a1, inputs=steps)[0] == sp.noise_knobs(*a1, inputs=one.u)[0]
 
 
-def test_a_failed_clean_recipe_fit_is_done_again_with_the_noisy_rules_settings(clean, monkeypatch):
+def test_a_failed_clean_recipe_fit_is_done_again_nearest_the_clean_recipe_first(clean, monkeypatch):
     """Clean angles under a declared chain: where the clean recipe's fit fails, the fit is
-    done again at the noisy rule's weight 1 (columns CUTOFF_FACTOR x band, the chain's floor
-    ridge) and the rule says so; noisy angles (weight 1 already) raise the failure as it is."""
-    orig = SINDyPI._fit_recipe
+    done again at the noisy rule's weights ``REFIT_WEIGHTS`` in turn (0.25 first), and the
+    first that fits is kept and named in the rule; where every weight fails, the first
+    failure is raised with the last's reason; noisy angles (weight 1 already) raise the
+    failure as it is."""
     calls = []
 
-    def clean_fails(self, d):
-        calls.append(self._noisy_refit)
-        if not self._noisy_refit:
+    def fails_below(w_ok):  # the recipe's settings only: what the ladder decides (no fit's cost)
+        def fit(self, d):
+            calls.append(self._refit_weight)
             self._choose_knobs(d)
-            raise IdentificationError("the clean recipe's choice failed")
-        return orig(self, d)
+            if self._refit_weight < w_ok:
+                raise IdentificationError(f"failed at {self._refit_weight}")
+            return self
+        return fit
 
-    monkeypatch.setattr(SINDyPI, "_fit_recipe", clean_fails)
-    m = SINDyPI().fit(_chain_smoothed(clean, 0.0))
-    assert calls == [False, True] and sp.NOISY_REFIT_TEXT in m.noise_rule_
-    assert m.column_lowpass_hz_ == pytest.approx(sp.CUTOFF_FACTOR * m.band_hz_)
-    assert m.ridge_ == pytest.approx(sp.RIDGE_PER_NOISE_VAR * sp.CHAIN_REL_FLOOR**2)
+    monkeypatch.setattr(SINDyPI, "_fit_recipe", fails_below(0.25))
+    data = _chain_smoothed(clean, 0.0)
+    m = SINDyPI().fit(data)
+    assert calls == [0.0, 0.25] and f"{sp.NOISY_REFIT_TEXT} 0.25" in m.noise_rule_
+    noisy_cut, noisy_ridge = sp.CUTOFF_FACTOR * m.band_hz_, sp.RIDGE_PER_NOISE_VAR * sp.CHAIN_REL_FLOOR**2
+    # a quarter of the way to the noisy rule, geometrically: strictly between the two recipes
+    assert sp.RIDGE_EXACT < m.ridge_ == pytest.approx(noisy_ridge**0.25 * sp.RIDGE_EXACT**0.75)
+    assert noisy_cut < m.column_lowpass_hz_ < sp.chain_column_cutoff(data.passband[1], 4)
     calls.clear()
-    with pytest.raises(IdentificationError, match=r"the clean recipe's choice failed$"):
+    monkeypatch.setattr(SINDyPI, "_fit_recipe", fails_below(1.0))
+    m = SINDyPI().fit(data)
+    assert calls == [0.0, 0.25, 0.5, 0.75, 1.0] and f"{sp.NOISY_REFIT_TEXT} 1" in m.noise_rule_
+    assert m.column_lowpass_hz_ == pytest.approx(noisy_cut)
+    assert m.ridge_ == pytest.approx(noisy_ridge)
+    calls.clear()
+    monkeypatch.setattr(SINDyPI, "_fit_recipe", fails_below(2.0))
+    with pytest.raises(IdentificationError, match=r"^failed at 0.0 \(.*up to 1: failed at 1.0\)$"):
+        SINDyPI().fit(data)
+    calls.clear()
+    with pytest.raises(IdentificationError, match=r"^failed at 0.0$"):
         SINDyPI().fit(_chain_smoothed(clean, 1.0))
-    assert calls == [False]
+    assert calls == [0.0]
 
 
 def test_declared_chain_rollout_selection_is_overridden_by_the_user(clean):
