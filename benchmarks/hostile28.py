@@ -83,10 +83,35 @@ def _odd_values(work: Path) -> dict[str, object]:
     }
 
 
-#: A plain valid value for a required parameter, by name (the rest: the odd value's case skipped).
 def _valid_values(work: Path) -> dict[str, object]:
-    return {"name": MM, "scenario": MM, "source": MM, "path": str(hostile19._generated(work, MM)),
-            "study": str(ROOT / "studies" / "smoke.toml"), "kind": "dynamical"}
+    """A plain valid value for a required parameter, by name (a parameter without one: the
+    odd value's case is not tried), from one run of the kinetics."""
+
+    import testbed
+    from testbed.pipeline.scenario import SCENARIO_DIR, _read_toml
+
+    h5 = str(hostile19._generated(work, MM))
+    result = testbed.run_scenario(MM, cache=str(CACHE))
+    data = result.data
+    return {"name": MM, "scenario": MM, "source": MM, "path": h5, "name_or_path": MM,
+            "study": str(ROOT / "studies" / "smoke.toml"), "kind": "dynamical",
+            "out_dir": str(work / "runs"), "plugins": [], "raw": _read_toml(SCENARIO_DIR / f"{MM}.toml"),
+            "result": result, "dataset": result.dataset, "data": data, "model": result.model,
+            "scores": result.scores, "checks": [], "fit_time": 0.1, "values": {"x": 1.0},
+            "fs": data.fs, "measured": result.dataset.measured, "x": data.x, "xd": data.xd,
+            "xdd": data.xdd, "channels": list(data.channels), "signal_cfg": {}, "n_windows": 2,
+            "rig": MM, "scenarios": [MM], "noise": [0.0], "seeds": [0],
+            "identifiers": ["sindy_pi_dynamical"], "type": float, "shape": (1,), "unit": "m",
+            "doc": "a length"}
+
+
+#: Valid values that differ by callable (a Signal's ``data`` is its samples, not a Measurement).
+def _valid_for(name: str, valid: dict[str, object]) -> dict[str, object]:
+    import numpy as np
+
+    if name == "Signal":
+        return {**valid, "data": np.zeros((1, 8)), "channels": ["a"]}
+    return valid
 
 
 def apiwalk_cases(work: Path) -> list[tuple[str, object]]:
@@ -114,9 +139,10 @@ def apiwalk_cases(work: Path) -> list[tuple[str, object]]:
                 if p.name == param:
                     kwargs[p.name] = odd[label]
                 elif p.default is p.empty:
-                    if p.name not in valid():
+                    given = _valid_for(name, valid())
+                    if p.name not in given:
                         return None  # no plain value to give: not tried
-                    kwargs[p.name] = valid()[p.name]
+                    kwargs[p.name] = given[p.name]
             here = os.getcwd()
             os.chdir(work)
             try:

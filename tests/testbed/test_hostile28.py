@@ -113,12 +113,26 @@ def test_the_refusal_of_a_foreign_output_is_one_text_everywhere(tmp_path):
     lambda: testbed.run_scenario("michaelis_menten", cache="x" * 5000),
     lambda: testbed.read_measured("data.csv", format=np.array([np.nan, 1.0])),
     lambda: testbed.measurement_from_file("data.csv", "dynamical", format=5),
+    lambda: testbed.load_scenario("michaelis_menten", check_cost=np.array([1.0, 2.0])),
+    lambda: testbed.scenario_from_dict({}, stem=np.array([1.0, 2.0])),
+    lambda: testbed.truth_field(("n",), "m", "a length", required=np.array([1.0, 2.0])),
+    lambda: testbed.Scenario(name="s", rig="michaelis_menten", kind=np.array([1.0, 2.0])),
 ])
 def test_the_apis_odd_arguments_are_refused_naming_them(call):
     # round 28 (apiwalk): TypeError / OSError 36 / numpy's "truth value ... ambiguous" from inside
     with pytest.raises(ArgumentError) as e:
         call()
     assert "\n" not in str(e.value) and len(str(e.value)) < 600
+
+
+@pytest.mark.parametrize("arg", ["figures", "index"])
+def test_save_new_run_refuses_a_writer_that_is_not_callable(tmp_path, arg):
+    # round 28 (apiwalk): figures=5 / index="x" were TypeErrors "... is not callable" from inside
+    from tests.testbed import _synthetic_runs as synth
+
+    with pytest.raises(ArgumentError, match=f"argument '{arg}'"):
+        testbed.save_new_run(synth.structural_result(n_samples=400), tmp_path, **{arg: 5})
+    assert not any(tmp_path.iterdir())  # refused before anything was written
 
 
 def test_a_long_unit_is_shown_cut(tmp_path):
