@@ -11,9 +11,11 @@ Families (what rounds 1-27 did not try; their families are listed in ``hostile21
 ``apiwalk``
     Every public callable of the Python API (``testbed.__all__``, *walked*, so a name added later
     is tried without an edit here) called with one odd value in each of its parameters in turn,
-    the others left at their defaults or, where required, given a plain valid value: None,
-    True, 0, -1, NaN, "", a 5,000-character text, bytes, a list, a dict, an ``object()``, a
-    missing path, a folder, a NaN array.  An exception other than the testbed's one-line
+    the others left at their defaults or, where required, given a plain valid value from one
+    kinetics run (:func:`_valid_values`; a case whose callable needs a value it has none for is
+    not tried: the truth classes, ``SignalChain``): None, True, 0, -1, NaN, "", a
+    5,000-character text, bytes, a list, a dict, an ``object()``, a missing path, a folder, a
+    NaN array.  An exception other than the testbed's one-line
     errors (``TestbedError``: ``ArgumentError``, ``InputError``, ...) is a finding; so is a
     refusal of more than one line.  Registering functions (``register_*``, a registry's
     ``register``) are called on a throw-away name only.
