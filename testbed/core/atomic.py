@@ -122,8 +122,15 @@ REPORT_MARKDOWN_FILE: FileKind = ("a markdown report", (REPORT_MARKDOWN_MARK.enc
 #: written): a user's own ``notes.md`` beside ``identify -o notes.json`` is not ours (review 27e)
 IDENTIFIED_MARKDOWN_FILE: FileKind = ("an identified model's markdown report",
                                       (b"# Identified model: ",))
-#: every HTML report begins so (``testbed.reporting.report``); a user's own page does not
-HTML_FILE: FileKind = ("an HTML report", (b'<!DOCTYPE html>\n<html lang="en">',))
+#: the Content-Security-Policy of every page the testbed writes (no network, no script)
+REPORT_CSP = "default-src 'none'; img-src data:; style-src 'unsafe-inline'"
+#: every HTML page the testbed writes begins so (``testbed.reporting.report``).  The doctype
+#: line alone is any HTML5 page's boilerplate (a user's own ``report.html`` passed as ours);
+#: with the policy it is the testbed's, as every report written since the policy was (review
+#: 27e M2, the HTML's part)
+HTML_REPORT_HEAD = ('<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8">'
+                    f'<meta http-equiv="Content-Security-Policy" content="{REPORT_CSP}">')
+HTML_FILE: FileKind = ("an HTML report", (HTML_REPORT_HEAD.encode(),))
 PNG_FILE: FileKind = ("a PNG figure", (b"\x89PNG\r\n\x1a\n",))
 #: a sweep's results file (Apache Parquet's magic number)
 PARQUET_FILE: FileKind = ("a Parquet results file", (b"PAR1",))

@@ -32,7 +32,9 @@ import numpy as np
 
 from testbed.core.atomic import (
     HTML_FILE,
+    HTML_REPORT_HEAD,
     PNG_FILE,
+    REPORT_CSP,
     REPORT_MARKDOWN_FILE,
     REPORT_MARKDOWN_MARK,
     atomic_write,
@@ -70,7 +72,7 @@ text-indent:-2em}
 .grid figure{margin:.3em 0}.grid figure.wide{grid-column:1/-1}
 td.fails{font-size:.85em;color:#8a1c1c;max-width:28em}
 """
-CSP = "default-src 'none'; img-src data:; style-src 'unsafe-inline'"
+CSP = REPORT_CSP
 #: Captions of the run figures, by file stem.
 CAPTIONS = {
     "reconstruction": "Accelerations per sensor: noise-free truth vs the identified model simulated "
@@ -205,9 +207,7 @@ class Page:
         Path
             The HTML file.
         """
-        doc = ("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
-               f'<meta http-equiv="Content-Security-Policy" content="{CSP}">'
-               '<meta name="viewport" content="width=device-width, initial-scale=1">'
+        doc = (HTML_REPORT_HEAD + '<meta name="viewport" content="width=device-width, initial-scale=1">'
                f"<title>{html.escape(self.title)}</title><style>{CSS}</style></head>\n<body>\n"
                f"<h1>{html.escape(self.title)}</h1>\n" + "\n".join(self.html) + "\n</body></html>\n")
         out = self.out_dir / "report.html"
@@ -819,9 +819,7 @@ def runs_index_html(runs: Sequence[dict[str, Any]], out_dir: str | os.PathLike) 
                                              "verdict", "key scores"))
     body = (f"<table><thead><tr>{head}</tr></thead><tbody>{''.join(rows)}</tbody></table>" if rows
             else "<p>No runs yet: <code>testbed run SCENARIO</code> adds one.</p>")
-    return ("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
-            f'<meta http-equiv="Content-Security-Policy" content="{CSP}">'
-            '<meta name="viewport" content="width=device-width, initial-scale=1">'
+    return (HTML_REPORT_HEAD + '<meta name="viewport" content="width=device-width, initial-scale=1">'
             f"<title>Runs</title><style>{CSS}td.nowrap,.ks{{white-space:nowrap}}.ks{{font-size:.85em}}"
             "body{max-width:1500px}"
             "</style></head>\n"
