@@ -198,9 +198,11 @@ class Page:
         self.md += [*md_code_block(lines), ""]
 
     def write(self) -> Path:
-        """Write ``report.html`` (self-contained: CSS inline, figures embedded, a
-        Content-Security-Policy forbidding network requests) and ``report.md`` into ``out_dir``,
-        each atomically.
+        """Write the kept PNGs (:meth:`png`), ``report.html`` (self-contained: CSS inline,
+        figures embedded, a Content-Security-Policy forbidding network requests) and
+        ``report.md`` into ``out_dir``, each atomically, after checking every one of them
+        (:func:`~testbed.core.atomic.refuse_foreign`): a file there that is not the kind the
+        report writes is refused in one line before any output is written.
 
         Returns
         -------
