@@ -10,6 +10,7 @@ import codecs
 import contextlib
 import errno
 import os
+import re
 import shutil
 import stat
 import tempfile
@@ -106,8 +107,11 @@ def not_regular(path: Path) -> None:
 
 
 #: A kind of file a command writes, as ``(description, leading bytes)``: an existing file at the
-#: path written that begins otherwise is someone else's (:func:`foreign_head`).
-FileKind = tuple[str, tuple[bytes, ...]]
+#: path written that begins otherwise is someone else's (:func:`foreign_head`).  A leading part
+#: may be a pattern of bytes, matched at the start (of the first :data:`PATTERN_READ` bytes).
+FileKind = tuple[str, tuple["bytes | re.Pattern[bytes]", ...]]
+#: How many bytes a :data:`FileKind`'s pattern is matched in [bytes].
+PATTERN_READ = 1024
 HDF5_FILE: FileKind = ("an HDF5 dataset", (b"\x89HDF\r\n\x1a\n",))
 JSON_FILE: FileKind = ("a JSON file", (b"{", b"["))
 UFF_FILE: FileKind = ("a UFF file", (b"-1",))
@@ -117,7 +121,13 @@ MARKDOWN_FILE: FileKind = ("a markdown report", (b"#",))
 #: user's own ``# Study notes`` be replaced (review 27e M2); a report written before this line
 #: existed is refused once, naming it
 REPORT_MARKDOWN_MARK = "<!-- sysid-testbed report -->"
-REPORT_MARKDOWN_FILE: FileKind = ("a markdown report", (REPORT_MARKDOWN_MARK.encode(),))
+#: a report written before the mark: its title and the fixed first paragraph under it (a run's
+#: verdict line, a study's cell count), which no one's notes repeat; it is replaced as before
+LEGACY_REPORT_MARKDOWN = re.compile(
+    rb"# Run [^\n]*\n\n(PASS|FAIL|NO VERDICT): [^\n]*; identifier [^\n]*, fit [^\n]* s\.\n"
+    rb"|# Study [^\n]*\n\n\d+ cells: \d+ scenario\(s\), \d+ identifier\(s\) \(")
+REPORT_MARKDOWN_FILE: FileKind = ("a markdown report", (REPORT_MARKDOWN_MARK.encode(),
+                                                       LEGACY_REPORT_MARKDOWN))
 #: an identified model's report (``testbed.reporting.identified``: its first line since it was
 #: written): a user's own ``notes.md`` beside ``identify -o notes.json`` is not ours (review 27e)
 IDENTIFIED_MARKDOWN_FILE: FileKind = ("an identified model's markdown report",
@@ -145,7 +155,7 @@ def foreign_head(path: Path, kind: FileKind) -> bytes | None:
     Round 27: ``generate -o photo.png`` replaced the user's picture by a dataset in silence, as
     ``identify`` / ``export -o`` and ``family write`` (a member's name) replaced any file.  Text
     kinds are compared after leading blanks and a UTF-8 byte-order mark.  Reads 64 bytes (or
-    the kind's longest prefix).
+    the kind's longest prefix, or :data:`PATTERN_READ` for a pattern); returns at most 64.
     """
     try:
         # without blocking: a FIFO nobody writes to hung a plain open for good (review 27e);
@@ -156,14 +166,16 @@ def foreign_head(path: Path, kind: FileKind) -> bytes | None:
     try:
         if not stat.S_ISREG(os.fstat(fd).st_mode):
             return None
-        head = os.read(fd, max(64, *map(len, kind[1])))
+        head = os.read(fd, max(64, *(len(p) if isinstance(p, bytes) else PATTERN_READ
+                                      for p in kind[1])))
     except OSError:
         return None
     finally:
         os.close(fd)
     binary = not kind[1][0].isascii()  # a binary format's signature (HDF5, PNG) opens with 0x89
     text = head if binary else head.removeprefix(b"\xef\xbb\xbf").lstrip()
-    return head if head and not text.startswith(kind[1]) else None
+    ours = any(text.startswith(p) if isinstance(p, bytes) else p.match(text) for p in kind[1])
+    return head[:64] if head and not ours else None
 
 
 def _unreadable(path: Path) -> bool:

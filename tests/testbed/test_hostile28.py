@@ -69,6 +69,23 @@ def test_a_users_markdown_titled_as_a_report_is_not_taken_for_one(tmp_path, note
     assert (page.out_dir / "report.md").read_text().splitlines()[1] == "# Study s"
 
 
+@pytest.mark.parametrize("legacy", [
+    "# Study leg\n\n2 cells: 2 scenario(s), 1 identifier(s) (sindy_pi_dynamical), noise levels 0 %",
+    "# Run michaelis_menten: sindy_pi_dynamical\n\nPASS: 3 of 3 threshold(s) met; identifier "
+    "sindy_pi_dynamical, fit 0.792 s.\n\n## Scores\n",
+    "# Run m: x\n\nNO VERDICT: no thresholds declared in the scenario's [score] table (not a "
+    "pass); identifier x, fit 1e+03 s.\n",
+])
+def test_a_report_written_before_the_mark_is_still_replaced(tmp_path, legacy):
+    # (the first lines of reports written by the code before, 50cdb26): their title and the
+    # fixed paragraph under it, which a user's "# Study notes" does not repeat
+    (tmp_path / "report.md").write_text(legacy + "\nmore\n")
+    refuse_foreign(tmp_path / "report.md", REPORT_MARKDOWN_FILE)
+    (tmp_path / "report.md").write_text(legacy.replace("\n\n", "\n\nmine: ", 1))
+    with pytest.raises(InputError):
+        refuse_foreign(tmp_path / "report.md", REPORT_MARKDOWN_FILE)
+
+
 def test_an_unreadable_output_is_refused_not_replaced(tmp_path, monkeypatch):
     # review 27e low: foreign_head passed a file it could not read, which was then replaced
     # (as root every file reads: the refusal is simulated by os.open's PermissionError)
