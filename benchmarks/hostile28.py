@@ -195,6 +195,7 @@ class P(Base):
         out = super().fit(data, *args, **kwargs)
         #AFTER
         return out
+#METHODS
 """
 
 
@@ -218,6 +219,7 @@ def _same(a: dict, b: dict) -> bool:
 
 def plugstate_cases(work: Path) -> list[tuple[str, object]]:
     import testbed
+    from testbed.core.errors import exception_text
 
     state: dict = {}
 
@@ -228,7 +230,7 @@ def plugstate_cases(work: Path) -> list[tuple[str, object]]:
         return state["plain"]
 
     def case(k: int, label: str, before: str = "", after: str = "", leak: bool = False,
-             same_scores: bool = False, sweep: bool = False):
+             same_scores: bool = False, sweep: bool = False, methods: str = ""):
         def run():
             import warnings
 
@@ -237,12 +239,17 @@ def plugstate_cases(work: Path) -> list[tuple[str, object]]:
             name = f"h28_p{k}"
             plugin = work / f"{name}.py"
             plugin.write_text(_PLUGIN.replace("NAME", name).replace("#BEFORE", before)
-                              .replace("#AFTER", after))
+                              .replace("#AFTER", after).replace("#METHODS", methods))
             testbed.load_plugins([str(plugin)])
             saved = (warnings.filters[:], np.get_printoptions(), dict(os.environ),
                      sys.getrecursionlimit())
             try:
-                r = testbed.run_scenario(str(_scenario(work, name)), cache=str(CACHE))
+                try:
+                    r = testbed.run_scenario(str(_scenario(work, name)), cache=str(CACHE))
+                except testbed.TestbedError:
+                    raise
+                except Exception as e:  # (named here: the harness's str(e) would raise)
+                    return f"{type(e).__name__}: {exception_text(e)[:200]}"
                 found = _hostile.scored_finding(r)
                 if found:
                     return found
@@ -305,6 +312,13 @@ def plugstate_cases(work: Path) -> list[tuple[str, object]]:
          {"after": "self.coef_ = np.asarray(self.coef_, float) + 1j"}),
         ("raises with a 100,000-character multi-line message",
          {"before": "raise ValueError('line\\n' * 12500)"}),
+        ("its simulate raises a plain Exception (open: identify/_base.py's _called)",
+         {"methods": "    def simulate(self, *a, **k):\n        raise Exception('mine')\n"}),
+        ("its simulate raises an exception whose str() raises (open: identify/_base.py, "
+         "testbed/scoring/scorers.py)",
+         {"methods": "    def simulate(self, *a, **k):\n        class E(Exception):\n"
+                     "            def __str__(self):\n                raise RuntimeError('x')\n"
+                     "        raise E()\n"}),
         ("raises an exception whose str() raises",
          {"before": "class E(Exception):\n            def __str__(self):\n"
                     "                raise RuntimeError('no text')\n        raise E()"}),

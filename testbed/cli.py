@@ -47,6 +47,7 @@ from testbed.core.errors import (
     InputError,
     ScenarioError,
     TestbedError,
+    exception_text,
     printable,
     show_value,
     terminal_safe,
@@ -1577,7 +1578,9 @@ def _internal(e: BaseException, args: argparse.Namespace) -> int:
     """One line for a bug (status 3); with ``--debug`` re-raise it for its traceback."""
     if args.debug:
         raise e
-    print(f"internal error (a bug, not your input): {type(e).__name__}: {_one_line(e)[:300]}; "
+    # (exception_text: an exception whose __str__ raises ended here in a traceback, round 28)
+    print(f"internal error (a bug, not your input): {type(e).__name__}: "
+          f"{_one_line(exception_text(e))[:300]}; "
           f"rerun as `testbed --debug {args.command} ...` for the traceback, and please report it",
           file=sys.stderr)
     return EXIT_INTERNAL

@@ -193,3 +193,16 @@ def test_a_double_dash_ends_the_options_before_a_positional():
     assert parse(["run", "a", "--no-figures", "--", "-b"]).scenario == ["a", "-b"]
     with pytest.raises(SystemExit):
         parse(["runs", "ls", "-o", "x", "--", "a", "b"])  # two names: still refused
+
+
+def test_an_internal_error_whose_message_cannot_be_shown_is_still_one_line(capsys):
+    # round 28: the internal-error line itself called str(e), so a plugin's exception whose
+    # __str__ raises (from its simulate, through the scorer) ended `testbed run` in a traceback
+    import argparse
+
+    from testbed import cli
+
+    status = cli._internal(_Unprintable(), argparse.Namespace(debug=False, command="run"))
+    err = capsys.readouterr().err
+    assert status == cli.EXIT_INTERNAL and len(err.strip().splitlines()) == 1
+    assert "_Unprintable: (no message: _Unprintable.__str__ failed)" in err
