@@ -143,7 +143,7 @@ def _fitted(where: str, name: str, v: Any, r: Resolve) -> Any:
 def _cache(where: str, name: str, v: Any, r: Resolve) -> Any:
     if isinstance(v, bool) or isinstance(v, r("DatasetCache")):
         return v
-    return _or_path("DatasetCache")(where, name, v, r)
+    return _path(where, name, _or_path("DatasetCache")(where, name, v, r), r)
 
 
 def _plugins(where: str, name: str, v: Any, r: Resolve) -> Any:
@@ -155,8 +155,13 @@ def _plugins(where: str, name: str, v: Any, r: Resolve) -> Any:
 
 #: Public name -> {argument: rule}.  Arguments not listed are passed as given.
 RULES: dict[str, dict[str, Rule]] = {
-    "load_scenario": {"name_or_path": _path},
-    "scenario_from_dict": {"raw": _mapping},
+    # (round 28: a flag given an array was numpy's "truth value ... is ambiguous" from inside,
+    # save_new_run's figures / index a TypeError "... is not callable" from inside)
+    "load_scenario": {"name_or_path": _path, "standalone": _flag, "check_cost": _flag},
+    # (round 28: directory=True / 5 / a 5,000-character name were TypeErrors and OSErrors)
+    "list_scenarios": {"directory": _opt(_path), "check_cost": _flag},
+    "scenario_from_dict": {"raw": _mapping, "file": _text, "stem": _opt(_text),
+                           "standalone": _flag, "check_cost": _flag},
     "generate": {"scenario": _instance("Scenario"), "progress": _opt(_callable),
                  "clean": _opt(_instance("Dataset"))},
     "measure": {"dataset": _instance("Dataset"), "signal_cfg": _mapping, "kind": _kind},
@@ -170,9 +175,10 @@ RULES: dict[str, dict[str, Rule]] = {
     "identify_file": {"path": _path, "scenario": _opt(_path), "fs": _opt(_fs), "kind": _opt(_kind),
                       "method": _opt(_text), "params": _opt(_mapping), "prior": _opt(_mapping),
                       "phase": _opt(_callable)},
+    # (round 28: format=<an array> was numpy's "truth value ... is ambiguous" from inside)
     "measurement_from_file": {"path": _path, "kind": _kind, "signal": _opt(_mapping),
-                              "fs": _opt(_fs)},
-    "read_measured": {"path": _path, "fs": _opt(_fs), "own_units": _flag},
+                              "format": _opt(_text), "fs": _opt(_fs)},
+    "read_measured": {"path": _path, "format": _opt(_text), "fs": _opt(_fs), "own_units": _flag},
     "load_study": {"name_or_path": _path},
     "run_sweep": {"study": _or_path("Study"), "jobs": _jobs, "dask_address": _opt(_text),
                   "results": _opt(_path), "cache_dir": _opt(_path), "retry_failed": _flag,
@@ -180,7 +186,9 @@ RULES: dict[str, dict[str, Rule]] = {
     "read_results": {"path": _path, "set_aside": _flag, "resuming": _flag},
     "list_runs": {"out_dir": _path, "scenario": _opt(_text)},
     "resolve_run": {"source": _path, "out_dir": _path},
-    "save_new_run": {"result": _instance("RunResult"), "out_dir": _path},
+    "save_new_run": {"result": _instance("RunResult"), "out_dir": _path,
+                     "figures": _opt(_callable), "index": _opt(_callable)},
+    "truth_field": {"required": _flag, "text": _flag},
     "load_plugins": {"plugins": _plugins},
     "register_scorer": {"kind": _kind, "scorer": _callable},
     "register_signal_chain": {"chain": _instance("SignalChain")},

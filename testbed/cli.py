@@ -37,7 +37,7 @@ from testbed.core.atomic import (
     REPORT_MARKDOWN_FILE,
     UFF_FILE,
     FileKind,
-    foreign_head,
+    refuse_foreign,
 )
 from testbed.core.errors import (
     EXIT_FAIL,
@@ -47,9 +47,11 @@ from testbed.core.errors import (
     InputError,
     ScenarioError,
     TestbedError,
+    exception_text,
     printable,
     show_value,
     terminal_safe,
+    unusable_path,
 )
 from testbed.core.exit_guard import late_exit_calls
 from testbed.core.numbertext import plain_number
@@ -105,18 +107,22 @@ class _Parser(argparse.ArgumentParser):
         # `run A --no-figures B`: argparse takes the names of a list positional (nargs "+")
         # in one run only, and B was refused as "unrecognized arguments" (round 22); names
         # left over are the list's when nothing else is left over
+        # after a `--` every word is a positional's, as argparse reads it where no option came
+        # before (review 27e: `runs ls -o DIR -- NAME` was "unrecognized arguments: -- NAME")
+        literal = rest[:1] == ["--"]
+        words = rest[1:] if literal else rest
         many = [a for a in self._actions if not a.option_strings and a.nargs in ("+", "*")]
-        if rest and len(many) == 1 and not any(r.startswith("-") for r in rest):
-            setattr(ns, many[0].dest, [*(getattr(ns, many[0].dest) or []), *rest])
-            rest = []
+        if words and len(many) == 1 and (literal or not any(r.startswith("-") for r in words)):
+            setattr(ns, many[0].dest, [*(getattr(ns, many[0].dest) or []), *words])
+            rest = words = []
         # `runs ls -o out/runs cantilever`: the same for an optional positional (nargs "?")
         # left empty when the positional before it was taken alone (round 27: "unrecognized
         # arguments: cantilever"); one name left over is its value
         maybe = [a for a in self._actions if not a.option_strings and a.nargs == "?"]
         # ("-" and "-1" too: argparse's own test, as it reads them in the first place)
-        if (len(rest) == 1 and self._parse_optional(rest[0]) is None and len(maybe) == 1
-                and getattr(ns, maybe[0].dest, None) is None):
-            value = self._get_values(maybe[0], rest)
+        if (len(words) == 1 and (literal or self._parse_optional(words[0]) is None)
+                and len(maybe) == 1 and getattr(ns, maybe[0].dest, None) is None):
+            value = self._get_values(maybe[0], words)
             setattr(ns, maybe[0].dest, value)
             rest = []
         return ns, rest
@@ -228,15 +234,11 @@ def _stat(path: Path, option: str = "") -> os.stat_result | None:
     where = escaped(f"{option} {path}" if option else str(path))
     try:
         return path.stat()
-    except ValueError:
-        raise InputError(f"{where}: not a usable path (it contains a NUL byte)") from None
-    except OSError as e:
-        if e.errno in (errno.ENOENT, errno.ENOTDIR):
+    except (OSError, ValueError) as e:
+        why = unusable_path(e)
+        if why is None:
             return None
-        what = {errno.ELOOP: "a symbolic link that loops",
-                errno.ENAMETOOLONG: "a file name too long for the file system"}.get(e.errno)
-        raise InputError(f"{where}: not a usable path ({what or e.strerror or type(e).__name__})") \
-            from None
+        raise InputError(f"{where}: not a usable path ({why})") from None
 
 
 def _existing_file(path: Path, what: str) -> Path:
@@ -314,16 +316,10 @@ def _link_target(path: Path, option: str) -> Path:
 
 
 def _foreign_output(path: Path, option: str, kind: FileKind) -> None:
-    """Refuse an existing, non-empty ``path`` that does not begin as ``kind`` does
-    (:func:`~testbed.core.atomic.foreign_head`; ``sweep --results`` already refused a file that
-    is not Parquet).  A file of the kind (an earlier run's output) or an empty one is replaced,
-    as before."""
-    head = foreign_head(path, kind)
-    if head is not None:
-        what = kind[0]
-        raise InputError(f"{option} {terminal_safe(str(path))}: exists and is not {what} (it "
-                         f"begins with {head[:8]!r}); expected a new path or {what} this "
-                         "command wrote (the file is left as it is)")
+    """Refuse an existing file at ``path`` that is not ``kind`` or cannot be read
+    (:func:`~testbed.core.atomic.refuse_foreign`, the one such check), naming ``option``.  A
+    file of the kind (an earlier run's output) or an empty one is replaced, as before."""
+    refuse_foreign(path, kind, f"{option} {terminal_safe(str(path))}")
 
 
 def _output_file(path: str | os.PathLike, option: str, *, inputs: tuple[Path, ...] = (),
@@ -1582,7 +1578,9 @@ def _internal(e: BaseException, args: argparse.Namespace) -> int:
     """One line for a bug (status 3); with ``--debug`` re-raise it for its traceback."""
     if args.debug:
         raise e
-    print(f"internal error (a bug, not your input): {type(e).__name__}: {_one_line(e)[:300]}; "
+    # (exception_text: an exception whose __str__ raises ended here in a traceback, round 28)
+    print(f"internal error (a bug, not your input): {type(e).__name__}: "
+          f"{_one_line(exception_text(e))[:300]}; "
           f"rerun as `testbed --debug {args.command} ...` for the traceback, and please report it",
           file=sys.stderr)
     return EXIT_INTERNAL

@@ -26,7 +26,7 @@ from typing import Any
 
 import numpy as np
 
-from testbed.core.errors import ArgumentError, is_control
+from testbed.core.errors import ArgumentError, is_control, unusable_path
 
 
 def integer(where: str, name: str, value: Any, *, low: int | None = None,
@@ -93,9 +93,16 @@ def names(where: str, name: str, value: Any, *, count: int | None = None) -> tup
 
 
 def path(where: str, name: str, value: Any) -> str | os.PathLike:
-    """``value`` if it is a non-empty text or an ``os.PathLike``."""
+    """``value`` if it is a non-empty text or an ``os.PathLike`` the system can name
+    (:func:`~testbed.core.errors.unusable_path`; a missing file passes: the function says so)."""
     if not isinstance(value, (str, os.PathLike)) or not os.fspath(value):
         raise ArgumentError(where, name, value, "expected a path (text or os.PathLike), not empty")
+    try:
+        os.stat(value)
+    except (OSError, ValueError) as e:
+        why = unusable_path(e)
+        if why is not None:
+            raise ArgumentError(where, name, value, f"expected a usable path, not {why}") from None
     return value
 
 

@@ -10,13 +10,14 @@ import codecs
 import contextlib
 import errno
 import os
+import re
 import shutil
 import stat
 import tempfile
 from collections.abc import Callable, Iterator
 from pathlib import Path
 
-from testbed.core.errors import InputError
+from testbed.core.errors import InputError, terminal_safe
 
 # mkstemp creates 0600 files; the result gets the permissions a plain open() would give
 # (read once at import: os.umask can only be read by setting it)
@@ -106,33 +107,55 @@ def not_regular(path: Path) -> None:
 
 
 #: A kind of file a command writes, as ``(description, leading bytes)``: an existing file at the
-#: path written that begins otherwise is someone else's (:func:`foreign_head`).
-FileKind = tuple[str, tuple[bytes, ...]]
+#: path written that begins otherwise is someone else's (:func:`foreign_head`).  A leading part
+#: may be a pattern of bytes, matched at the start (of the first :data:`PATTERN_READ` bytes).
+FileKind = tuple[str, tuple["bytes | re.Pattern[bytes]", ...]]
+#: How many bytes a :data:`FileKind`'s pattern is matched in [bytes].
+PATTERN_READ = 1024
 HDF5_FILE: FileKind = ("an HDF5 dataset", (b"\x89HDF\r\n\x1a\n",))
 JSON_FILE: FileKind = ("a JSON file", (b"{", b"["))
 UFF_FILE: FileKind = ("a UFF file", (b"-1",))
 MARKDOWN_FILE: FileKind = ("a markdown report", (b"#",))
-#: a run's or a study's markdown report (``testbed.reporting.report``: its title line), so a
-#: user's own ``report.md`` of notes is refused, not replaced (read 27b)
-REPORT_MARKDOWN_FILE: FileKind = ("a markdown report", (b"# Run ", b"# Study "))
+#: the first line of a run's or a study's markdown report (``testbed.reporting.report``): an
+#: HTML comment no renderer shows.  Its title alone (``# Run `` / ``# Study ``, read 27b) let a
+#: user's own ``# Study notes`` be replaced (review 27e M2); a report written before this line
+#: existed is refused once, naming it
+REPORT_MARKDOWN_MARK = "<!-- sysid-testbed report -->"
+#: a report written before the mark: its title and the fixed first paragraph under it (a run's
+#: verdict line, a study's cell count), which no one's notes repeat; it is replaced as before
+LEGACY_REPORT_MARKDOWN = re.compile(
+    rb"# Run [^\n]*\n\n(PASS|FAIL|NO VERDICT): [^\n]*; identifier [^\n]*, fit [^\n]* s\.\n"
+    rb"|# Study [^\n]*\n\n\d+ cells: \d+ scenario\(s\), \d+ identifier\(s\) \(")
+REPORT_MARKDOWN_FILE: FileKind = ("a markdown report", (REPORT_MARKDOWN_MARK.encode(),
+                                                       LEGACY_REPORT_MARKDOWN))
 #: an identified model's report (``testbed.reporting.identified``: its first line since it was
 #: written): a user's own ``notes.md`` beside ``identify -o notes.json`` is not ours (review 27e)
 IDENTIFIED_MARKDOWN_FILE: FileKind = ("an identified model's markdown report",
                                       (b"# Identified model: ",))
-#: every HTML report begins so (``testbed.reporting.report``); a user's own page does not
-HTML_FILE: FileKind = ("an HTML report", (b'<!DOCTYPE html>\n<html lang="en">',))
+#: the Content-Security-Policy of every page the testbed writes (no network, no script)
+REPORT_CSP = "default-src 'none'; img-src data:; style-src 'unsafe-inline'"
+#: every HTML page the testbed writes begins so (``testbed.reporting.report``).  The doctype
+#: line alone is any HTML5 page's boilerplate (a user's own ``report.html`` passed as ours);
+#: with the policy it is the testbed's, as every report written since the policy was (review
+#: 27e M2, the HTML's part)
+HTML_REPORT_HEAD = ('<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8">'
+                    f'<meta http-equiv="Content-Security-Policy" content="{REPORT_CSP}">')
+HTML_FILE: FileKind = ("an HTML report", (HTML_REPORT_HEAD.encode(),))
 PNG_FILE: FileKind = ("a PNG figure", (b"\x89PNG\r\n\x1a\n",))
+#: a sweep's results file (Apache Parquet's magic number)
+PARQUET_FILE: FileKind = ("a Parquet results file", (b"PAR1",))
 
 
 def foreign_head(path: Path, kind: FileKind) -> bytes | None:
     """The first bytes of an existing, non-empty file at ``path`` that does not begin as
     ``kind``'s files do, else None (no file, an empty one, one of the kind, no regular file (a
-    FIFO, socket or device: :func:`not_regular` names it) or unreadable: the write's own
-    checks name that).
+    FIFO, socket or device: :func:`not_regular` names it) or unreadable: :func:`refuse_foreign`
+    names that).
 
     Round 27: ``generate -o photo.png`` replaced the user's picture by a dataset in silence, as
     ``identify`` / ``export -o`` and ``family write`` (a member's name) replaced any file.  Text
-    kinds are compared after leading blanks and a UTF-8 byte-order mark.  Reads 64 bytes.
+    kinds are compared after leading blanks and a UTF-8 byte-order mark.  Reads 64 bytes (or
+    the kind's longest prefix, or :data:`PATTERN_READ` for a pattern); returns at most 64.
     """
     try:
         # without blocking: a FIFO nobody writes to hung a plain open for good (review 27e);
@@ -143,14 +166,52 @@ def foreign_head(path: Path, kind: FileKind) -> bytes | None:
     try:
         if not stat.S_ISREG(os.fstat(fd).st_mode):
             return None
-        head = os.read(fd, 64)
+        head = os.read(fd, max(64, *(len(p) if isinstance(p, bytes) else PATTERN_READ
+                                      for p in kind[1])))
     except OSError:
         return None
     finally:
         os.close(fd)
     binary = not kind[1][0].isascii()  # a binary format's signature (HDF5, PNG) opens with 0x89
     text = head if binary else head.removeprefix(b"\xef\xbb\xbf").lstrip()
-    return head if head and not text.startswith(kind[1]) else None
+    ours = any(text.startswith(p) if isinstance(p, bytes) else p.match(text) for p in kind[1])
+    return head[:64] if head and not ours else None
+
+
+def _unreadable(path: Path) -> bool:
+    """True for an existing regular file this process may not read (its kind cannot be told)."""
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK)
+    except PermissionError:
+        return os.path.isfile(path)
+    except (OSError, ValueError):
+        return False
+    os.close(fd)
+    return False
+
+
+def refuse_foreign(path: str | os.PathLike, kind: FileKind, name: str | None = None,
+                   expected: str | None = None) -> None:
+    """Raise InputError if an existing file at ``path`` is not ``kind`` (:func:`foreign_head`)
+    or cannot be read (its kind cannot be told: review 27e, such a file was replaced though
+    :func:`foreign_head`'s docstring said the write would name it); nothing else passes.
+
+    The one refusal of a file a command would replace that is not its own (``generate`` /
+    ``identify`` / ``export -o``, ``report``'s every output, ``family write``'s members,
+    ``sweep --results``; review 27e: four copies of this text).  ``name`` is how the path is
+    shown (default: the path; e.g. ``"--output out.h5"``), ``expected`` what is allowed (default:
+    a new path or a file of the kind the command wrote).
+    """
+    shown = name or terminal_safe(os.fspath(path))
+    what = kind[0]
+    allowed = expected or f"a new path or {what} this command wrote"
+    head = foreign_head(Path(path), kind)
+    if head is not None:
+        raise InputError(f"{shown}: exists and is not {what} (it begins with {head[:16]!r}); "
+                         f"expected {allowed} (the file is left as it is)")
+    if _unreadable(Path(path)):
+        raise InputError(f"{shown}: exists and cannot be read, so whether it is {what} cannot be "
+                         f"told; expected {allowed} (the file is left as it is)")
 
 
 def _replaced(path: Path) -> os.stat_result | None:

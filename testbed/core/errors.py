@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import errno
 import unicodedata
 from typing import Any
 
@@ -49,6 +50,39 @@ def terminal_safe(text: str) -> str:
 def _cut(text: str) -> str:
     """``text`` cut to :data:`MAX_VALUE_CHARS` characters, the cut marked ``[...]``."""
     return text if len(text) <= MAX_VALUE_CHARS else text[:MAX_VALUE_CHARS - 5] + "[...]"
+
+
+def unusable_path(e: BaseException) -> str | None:
+    """Why a path whose ``os.stat`` raised ``e`` can name nothing (a name too long for the file
+    system, a NUL byte, a symbolic-link loop, ...), or None where nothing is there (the caller
+    says what is missing).  The command line's and the API's one reading (hostile round 28:
+    ``testbed.read_results("x" * 5000)`` was OSError 36 from inside)."""
+    if isinstance(e, ValueError):
+        return "it contains a NUL byte"
+    code = getattr(e, "errno", None)
+    if code in (errno.ENOENT, errno.ENOTDIR):
+        return None
+    return ({errno.ELOOP: "a symbolic link that loops",
+             errno.ENAMETOOLONG: "a file name too long for the file system"}.get(code)
+            or getattr(e, "strerror", None) or type(e).__name__)
+
+
+def exception_text(e: BaseException) -> str:
+    """``str(e)`` on one line (blanks collapsed), or a stand-in naming its type where the
+    exception's own ``__str__`` raises: a plugin's exception whose ``__str__`` raised turned a
+    failed fit into an internal error (hostile round 28)."""
+    try:
+        text = str(e)
+    except Exception:
+        return f"(no message: {type(e).__name__}.__str__ failed)"
+    return " ".join(text.split())
+
+
+def show_text(text: str) -> str:
+    """``text`` as it is (unquoted: a unit, a file's own word) on one line, cut to
+    :data:`MAX_VALUE_CHARS` characters.  A unit of 5,000 characters was shown three times in
+    one 15,000-character refusal (hostile round 28)."""
+    return _cut(_one_line(str(text)[:MAX_VALUE_CHARS + 1]))
 
 
 def show_value(value: Any) -> str:

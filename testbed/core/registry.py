@@ -34,7 +34,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from testbed.core.errors import TestbedError, UnknownNameError, show_value
+from testbed.core.errors import TestbedError, UnknownNameError, exception_text, show_value
 from testbed.core.exit_guard import no_process_exit
 from testbed.core.lazy import configure_loaded
 from testbed.core.process_state import kept_process_state
@@ -85,8 +85,9 @@ def import_plugin(spec: str) -> Any:
         except BaseException as e:  # (sys.exit(0) in a plugin ended a run with status 0)
             if isinstance(e, KeyboardInterrupt):  # the user's Ctrl-C stays an interrupt
                 raise
-            raise PluginError(f"plugin {spec}: cannot import it: {type(e).__name__}: {e}; expected "
-                              "a .py file or an importable dotted module name") from e
+            raise PluginError(f"plugin {spec}: cannot import it: {type(e).__name__}: "
+                              f"{exception_text(e)}; expected a .py file or an importable dotted "
+                              "module name") from e
         configure_loaded()  # a plugin importing MuJoCo itself: its C-level log silenced too
         return module
     try:
@@ -115,7 +116,8 @@ def import_plugin(spec: str) -> Any:
         # BaseException but the user's Ctrl-C (GeneratorExit, pytest's Skipped from a plugin
         # written as a test helper) was a traceback with status 1 (hostile round 19)
         if not isinstance(e, KeyboardInterrupt):
-            raise PluginError(f"plugin {spec}: importing it failed: {type(e).__name__}: {e}") from e
+            raise PluginError(f"plugin {spec}: importing it failed: {type(e).__name__}: "
+                              f"{exception_text(e)}") from e
         raise
     configure_loaded()  # a plugin importing MuJoCo itself: its C-level log silenced too
     return module
@@ -194,7 +196,7 @@ class Registry:
                             raise
                         except Exception as e:
                             raise PluginError(f"{self.kind} module {module} failed to import: "
-                                              f"{type(e).__name__}: {e}") from e
+                                              f"{type(e).__name__}: {exception_text(e)}") from e
             if self.entry_points is not None:
                 self._load_entry_points()
         except BaseException:
@@ -241,7 +243,7 @@ class Registry:
                 # (SystemExit: an entry point's sys.exit(0) at import ended `testbed list` and
                 # `testbed run` with status 0 and no output, round 14; as a plugin file's)
                 raise PluginError(f"{self.kind} entry point {ep.name} = {ep.value} "
-                                  f"({self.entry_points}): {type(e).__name__}: {e}") from e
+                                  f"({self.entry_points}): {type(e).__name__}: {exception_text(e)}") from e
             finally:
                 self._loading_entry_point = None
 

@@ -21,7 +21,13 @@ from typing import Any
 
 import numpy as np
 
-from testbed.core.errors import IdentificationError, InputError, ScenarioError, TestbedError
+from testbed.core.errors import (
+    IdentificationError,
+    InputError,
+    ScenarioError,
+    TestbedError,
+    exception_text,
+)
 from testbed.core.exit_guard import no_process_exit
 from testbed.core.measurement import Measurement
 from testbed.core.process_state import kept_process_state
@@ -102,7 +108,7 @@ def fit_or_fail(model: Any, data: Measurement, method: str | None = None) -> Non
             model.fit(data)
     except NUMERICAL_BREAKDOWN as e:
         raise IdentificationError(f"numerical breakdown ({type(e).__name__}: "
-                                  f"{' '.join(str(e).split()) or 'no message'})") from None
+                                  f"{exception_text(e) or 'no message'})") from None
     except TestbedError:
         raise
     except BaseException as e:  # a plugin's sys.exit(0) ended a run with exit 0, no verdict;
@@ -110,7 +116,7 @@ def fit_or_fail(model: Any, data: Measurement, method: str | None = None) -> Non
         if origin == "builtin" or isinstance(e, KeyboardInterrupt):
             raise
         raise IdentificationError(f"identifier {method} (from {origin}) raised "
-                                  f"{type(e).__name__}: {' '.join(str(e).split())}") from None
+                                  f"{type(e).__name__}: {exception_text(e)}") from None
     if origin != "builtin":
         problem = fitted_shape_problem(model)
         if problem is not None:

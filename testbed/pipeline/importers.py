@@ -62,7 +62,7 @@ import numpy as np
 from testbed.core.arguments import finite_real
 from testbed.core.budget import IDENTIFY_BYTES_PER_VALUE, IDENTIFY_TEXT_BUDGET_BYTES, IDENTIFY_VALUE_BUDGET
 from testbed.core.dataset import Dataset, DatasetError, Signal
-from testbed.core.errors import TestbedError, is_control, show_names, show_value
+from testbed.core.errors import TestbedError, is_control, show_names, show_text, show_value
 from testbed.core.measurement import MIN_FREE_SAMPLES, PRIOR_RANGE, Measurement, prior_ok
 from testbed.core.numbertext import plain_number
 from testbed.core.rate_attrs import fs_attribute_problem, off_scenario_rate
@@ -766,8 +766,9 @@ def _check_units(path: Path, ds: Dataset, kind: str) -> None:
         for ch, unit in zip(sig.channels, sig.channel_units(), strict=True):
             if SAME_ORDER.get(unit) != want:
                 allowed = ", ".join(u for u, o in SAME_ORDER.items() if o == want)
-                raise MeasuredDataError(path, f"signal {g!r} channel {ch!r} is in {unit}; the "
-                                              f"{kind} chain reads {g!r} as a {want} ({allowed})")
+                raise MeasuredDataError(path, f"signal {g!r} channel {show_value(ch)} is in "
+                                              f"{show_text(unit)}; the {kind} chain reads {g!r} "
+                                              f"as a {want} ({allowed})")
     if kind == "mechanical":
         _check_mechanical_units(path, ds)
     if kind == "dynamical" and "x" in ds.measured and "dx" in ds.measured:
@@ -777,8 +778,9 @@ def _check_units(path: Path, ds: Dataset, kind: str) -> None:
         for ch, ux, ud in zip(dx.channels, x.channel_units(), dx.channel_units(), strict=True):
             rate = RATE_OF.get(ux, f"{ux}/s")
             if ud != rate:
-                raise MeasuredDataError(path, f"signal 'dx' channel {ch!r} is in {ud}; expected "
-                                              f"{rate}, the rate of its state's {ux}")
+                raise MeasuredDataError(path, f"signal 'dx' channel {show_value(ch)} is in {show_text(ud)}; "
+                                              f"expected {show_text(rate)}, the rate of its state's "
+                                              f"{show_text(ux)}")
 
 
 #: The load that drives a coordinate of each SI unit: a force a translation, a moment a rotation.
@@ -798,16 +800,18 @@ def _check_mechanical_units(path: Path, ds: Dataset) -> None:
         for ch, dch, u, du in zip(m[g].channels, m[dg].channels, m[g].channel_units(),
                                   m[dg].channel_units(), strict=True):
             if u in RATE_OF and du != RATE_OF[u]:
-                raise MeasuredDataError(path, f"signal {dg!r} channel {dch!r} is in {du}; expected "
-                                              f"{RATE_OF[u]}, the rate of {g!r} channel {ch!r} in {u}")
+                raise MeasuredDataError(path, f"signal {dg!r} channel {show_value(dch)} is in "
+                                              f"{show_text(du)}; expected {RATE_OF[u]}, the rate of "
+                                              f"{g!r} channel {show_value(ch)} in {u}")
     coords = dict(zip(m["theta"].channels, m["theta"].channel_units(), strict=True)) \
         if "theta" in m else {}
     for g, sig in m.items():
         for ch, unit, target in zip(sig.channels, sig.channel_units(), sig.acts_on or (), strict=False):
             want = LOAD_ON.get(coords.get(target, ""))
             if want is not None and unit != want:
-                raise MeasuredDataError(path, f"signal {g!r} channel {ch!r} is in {unit} but acts on "
-                                              f"'theta' channel {target!r} in {coords[target]}; "
+                raise MeasuredDataError(path, f"signal {g!r} channel {show_value(ch)} is in "
+                                              f"{show_text(unit)} but acts on 'theta' channel "
+                                              f"{show_value(target)} in {show_text(coords[target])}; "
                                               f"expected {want} (a force drives a translation, a "
                                               "moment a rotation)")
 
@@ -886,10 +890,10 @@ def check_selection(source: str | os.PathLike, units: Any, channels: Any) -> Non
     if units is not None and not (isinstance(units, str) or (
             isinstance(units, Mapping) and all(isinstance(k, str) and isinstance(v, str)
                                                for k, v in units.items()))):
-        raise MeasuredDataError(source, f"units={units!r}: expected a unit (str) or a mapping of "
-                                        "channel name to unit (str to str)")
+        raise MeasuredDataError(source, f"units={show_value(units)}: expected a unit (str) or a "
+                                        "mapping of channel name to unit (str to str)")
     if channels is not None and (not _names(channels) or not list(channels)):
-        raise MeasuredDataError(source, f"channels={channels!r}: expected a non-empty list of "
+        raise MeasuredDataError(source, f"channels={show_value(channels)}: expected a non-empty list of "
                                         "channel names (str)")
 
 

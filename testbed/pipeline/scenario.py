@@ -176,6 +176,10 @@ class Scenario:
                                 f"an integer in [0, {MAX_SEED}]") from None
         if not 0 <= self.seed <= MAX_SEED:
             raise ArgumentError("Scenario", "seed", seed, f"expected an integer in [0, {MAX_SEED}]")
+        if not isinstance(self.kind, str):  # (round 28: an array was numpy's "truth value ...
+            # is ambiguous" below)
+            raise ArgumentError("Scenario", "kind", self.kind, "expected a rig kind (text), or "
+                                "empty: the rig's own")
         try:
             rig_kind = RIGS.get(self.rig).kind
         except KeyError as e:

@@ -24,7 +24,7 @@ import tempfile
 from pathlib import Path
 
 from testbed.core.atomic import begin_in_flight, end_in_flight
-from testbed.core.errors import show_value
+from testbed.core.errors import exception_text, show_value
 
 __all__ = ["ensure_config_dir", "usable_folder"]
 
@@ -112,7 +112,8 @@ def backend_refusal(error: BaseException) -> str | None:
     in the drawing process's error re-raised in the command or in the command itself.
     """
     backend = os.environ.get("MPLBACKEND")
-    if backend is None or not isinstance(error, ValueError) or "valid value for backend" not in str(error):
+    if (backend is None or not isinstance(error, ValueError)
+            or "valid value for backend" not in exception_text(error)):
         return None
     return (f"$MPLBACKEND {show_value(backend)}: matplotlib refuses it as a backend; unset it (the "
             "testbed draws on Agg canvases, never in a window) or name one matplotlib has "

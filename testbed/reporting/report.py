@@ -24,14 +24,23 @@ import json
 import math
 import os
 import re
-import shutil
 from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from testbed.core.atomic import atomic_write_text
+from testbed.core.atomic import (
+    HTML_FILE,
+    HTML_REPORT_HEAD,
+    PNG_FILE,
+    REPORT_CSP,
+    REPORT_MARKDOWN_FILE,
+    REPORT_MARKDOWN_MARK,
+    atomic_write,
+    atomic_write_text,
+    refuse_foreign,
+)
 from testbed.core.kinds import METRICS
 from testbed.numerics.quantiles import quartiles
 from testbed.pipeline.plugins import RIGS
@@ -63,7 +72,7 @@ text-indent:-2em}
 .grid figure{margin:.3em 0}.grid figure.wide{grid-column:1/-1}
 td.fails{font-size:.85em;color:#8a1c1c;max-width:28em}
 """
-CSP = "default-src 'none'; img-src data:; style-src 'unsafe-inline'"
+CSP = REPORT_CSP
 #: Captions of the run figures, by file stem.
 CAPTIONS = {
     "reconstruction": "Accelerations per sensor: noise-free truth vs the identified model simulated "
@@ -105,7 +114,16 @@ class Page:
     def __init__(self, title: str, out_dir: Path) -> None:
         self.title, self.out_dir = title, out_dir
         self.html: list[str] = []
-        self.md: list[str] = [f"# {md_text(title)}", ""]
+        # the mark first: a user's own "# Study notes" is not taken for a report (review 27e M2)
+        self.md: list[str] = [REPORT_MARKDOWN_MARK, f"# {md_text(title)}", ""]
+        #: the PNGs to write beside the report (file name -> bytes), in :meth:`write`
+        self.pngs: dict[str, bytes] = {}
+
+    def png(self, name: str, data: bytes) -> str:
+        """Keep the PNG ``data`` to be written as ``name`` beside the report (by :meth:`write`,
+        with the report's other files); return ``name``."""
+        self.pngs[name] = data
+        return name
 
     def heading(self, text: str, level: int = 2) -> None:
         """A heading of ``level`` (2: a section) in both texts."""
@@ -139,26 +157,23 @@ class Page:
         self.md += ["| " + " | ".join(md_text(c) for c in head) + " |", "|" + "---|" * len(head)]
         self.md += ["| " + " | ".join(r) + " |" for r in esc] + [""]
 
-    def figure_html(self, png: Path, caption: str, cls: str = "") -> str:
-        """``<figure>`` of ``png`` embedded as base64 (copied beside the markdown as well)."""
-        name = png.name
-        if png.resolve() != (self.out_dir / name).resolve():
-            shutil.copyfile(png, self.out_dir / name)
-        data = base64.b64encode(png.read_bytes()).decode("ascii")
+    def figure_html(self, name: str, caption: str, cls: str = "") -> str:
+        """``<figure>`` of the kept PNG ``name`` (:meth:`png`) embedded as base64."""
+        data = base64.b64encode(self.pngs[name]).decode("ascii")
         alt = html.escape(caption, quote=True)
         attr = f' class="{cls}"' if cls else ""
         return (f'<figure{attr}><img src="data:image/png;base64,{data}" alt="{alt}">'
                 f"<figcaption>{html.escape(caption)}</figcaption></figure>")
 
     @staticmethod
-    def figure_md(png: Path, caption: str) -> str:
-        """Markdown of ``png`` (by file name, beside the markdown) with its caption in italics."""
-        return f"![{md_text(png.stem)}]({png.name})\n\n*{md_text(caption)}*"
+    def figure_md(name: str, caption: str) -> str:
+        """Markdown of the PNG ``name`` (beside the markdown) with its caption in italics."""
+        return f"![{md_text(Path(name).stem)}]({name})\n\n*{md_text(caption)}*"
 
-    def figure(self, png: Path, caption: str) -> None:
-        """Embed ``png`` (base64) in the HTML; copy it beside the markdown."""
-        self.html.append(self.figure_html(png, caption))
-        self.md += [self.figure_md(png, caption), ""]
+    def figure(self, name: str, caption: str) -> None:
+        """Embed the kept PNG ``name`` (base64) in the HTML; link it from the markdown."""
+        self.html.append(self.figure_html(name, caption))
+        self.md += [self.figure_md(name, caption), ""]
 
     def bullets(self, items: Sequence[str]) -> None:
         """A bulleted list of plain-text items."""
@@ -183,24 +198,41 @@ class Page:
         self.md += [*md_code_block(lines), ""]
 
     def write(self) -> Path:
-        """Write ``report.html`` (self-contained: CSS inline, figures embedded, a
-        Content-Security-Policy forbidding network requests) and ``report.md`` into ``out_dir``,
-        each atomically.
+        """Write the kept PNGs (:meth:`png`), ``report.html`` (self-contained: CSS inline,
+        figures embedded, a Content-Security-Policy forbidding network requests) and
+        ``report.md`` into ``out_dir``, each atomically, after checking every one of them
+        (:func:`~testbed.core.atomic.refuse_foreign`): a file there that is not the kind the
+        report writes is refused in one line before any output is written.
 
         Returns
         -------
         Path
             The HTML file.
         """
-        doc = ("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
-               f'<meta http-equiv="Content-Security-Policy" content="{CSP}">'
-               '<meta name="viewport" content="width=device-width, initial-scale=1">'
+        doc = (HTML_REPORT_HEAD + '<meta name="viewport" content="width=device-width, initial-scale=1">'
                f"<title>{html.escape(self.title)}</title><style>{CSS}</style></head>\n<body>\n"
                f"<h1>{html.escape(self.title)}</h1>\n" + "\n".join(self.html) + "\n</body></html>\n")
         out = self.out_dir / "report.html"
+        pngs = {self.out_dir / name: data for name, data in self.pngs.items()}
+        # every output checked before any is written: a foreign fit_time.png had been refused
+        # after the score figures were replaced (review 27e M1)
+        for path, kind in [*((p, PNG_FILE) for p in pngs), (out, HTML_FILE),
+                           (self.out_dir / "report.md", REPORT_MARKDOWN_FILE)]:
+            refuse_foreign(path, kind)
+        for path, data in pngs.items():
+            if not _holds(path, data):  # (a run's own figures, reported into its own folder)
+                atomic_write(path, lambda tmp, data=data: Path(tmp).write_bytes(data))
         atomic_write_text(out, doc)
         atomic_write_text(self.out_dir / "report.md", "\n".join(self.md).rstrip() + "\n")
         return out
+
+
+def _holds(path: Path, data: bytes) -> bool:
+    """True if the file ``path`` holds exactly ``data`` (nothing to write)."""
+    try:
+        return path.stat().st_size == len(data) and path.read_bytes() == data
+    except OSError:
+        return False
 
 
 # ----------------------------------------------------------------------------- run report
@@ -429,12 +461,14 @@ def run_report(run: SavedRun, out_dir: str | os.PathLike) -> Path:
     _settings_section(page, run)
     _truth_section(page, run)
     page.heading("Figures")
-    pngs = {p.stem: p for p in run.figures}
+    # the run's own figures, copied beside the report with the report's other files (they had
+    # been copied over a user's file of that name at once: hostile round 28)
+    pngs = {p.stem: page.png(p.name, p.read_bytes()) for p in run.figures}
     wanted = list(figs.run_figures_available(run))
     missing = [s for s in wanted if s not in pngs]
     if missing:  # a run saved by an older version, or without figures: draw what it lacks
         drawn = figs.run_figures(run, only=missing)
-        pngs.update({stem: figs.save_figure(f, out_dir / f"{stem}.png") for stem, f in drawn.items()})
+        pngs.update({stem: page.png(f"{stem}.png", figs.png_bytes(f)) for stem, f in drawn.items()})
     for stem in [s for s in ORDER if s in pngs] + [s for s in pngs if s not in ORDER]:
         page.figure(pngs[stem], CAPTIONS.get(stem, stem))
     page.heading("Provenance")
@@ -649,7 +683,7 @@ def sweep_report(rows: Sequence[dict[str, Any]], out_dir: str | os.PathLike,
         if fig is None:
             continue
         wide = len({r["scenario"] for r in ok if _finite(r.get(m))}) > 1
-        png = figs.save_figure(fig, out_dir / f"score_{m}.png")
+        png = page.png(f"score_{m}.png", figs.png_bytes(fig))
         cap = f"{m}: {_doc(m) or 'score'}"
         figures_html.append(page.figure_html(png, cap, "wide" if wide else ""))
         figures_md.append(page.figure_md(png, cap))
@@ -662,8 +696,8 @@ def sweep_report(rows: Sequence[dict[str, Any]], out_dir: str | os.PathLike,
                [[i, len(t), float(np.median(t)) if t else None, float(np.max(t)) if t else None]
                 for i in idents for t in [[float(r["fit_time"]) for r in rows if r["identifier"] == i
                                            and _ok(r) and _finite(r.get("fit_time"))]]])
-    page.figure(figs.save_figure(figs.fit_times([r for r in rows if _ok(r)]),  # as the table
-                                 out_dir / "fit_time.png"),
+    page.figure(page.png("fit_time.png",  # as the table
+                         figs.png_bytes(figs.fit_times([r for r in rows if _ok(r)]))),
                 "Fit time per identifier over all cells that ran.")
     if errors:
         page.heading("Cells that failed to run")
@@ -787,9 +821,7 @@ def runs_index_html(runs: Sequence[dict[str, Any]], out_dir: str | os.PathLike) 
                                              "verdict", "key scores"))
     body = (f"<table><thead><tr>{head}</tr></thead><tbody>{''.join(rows)}</tbody></table>" if rows
             else "<p>No runs yet: <code>testbed run SCENARIO</code> adds one.</p>")
-    return ("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
-            f'<meta http-equiv="Content-Security-Policy" content="{CSP}">'
-            '<meta name="viewport" content="width=device-width, initial-scale=1">'
+    return (HTML_REPORT_HEAD + '<meta name="viewport" content="width=device-width, initial-scale=1">'
             f"<title>Runs</title><style>{CSS}td.nowrap,.ks{{white-space:nowrap}}.ks{{font-size:.85em}}"
             "body{max-width:1500px}"
             "</style></head>\n"

@@ -54,8 +54,8 @@ from typing import Any
 
 import numpy as np
 
-from testbed.core.atomic import atomic_write_text, foreign_head
-from testbed.core.errors import InputError, ScenarioError
+from testbed.core.atomic import atomic_write_text, refuse_foreign
+from testbed.core.errors import ScenarioError
 from testbed.core.schema import ONE_LINE, ONE_LINE_DOC, Field, check_value, validate_table
 from testbed.pipeline.plugins import RIGS
 from testbed.pipeline.scenario import (
@@ -608,11 +608,7 @@ def write_members(members: list[Scenario], out_dir: str | os.PathLike) -> list[P
     out = Path(out_dir)
     for sc in members:
         p = out / f"{sc.name}.toml"
-        head = foreign_head(p, MEMBER_FILE)
-        if head is not None:
-            raise InputError(f"{p}: exists and is not {MEMBER_FILE[0]} (it begins with "
-                             f"{head[:16]!r}); expected another --out folder, or remove the file "
-                             "(it is left as it is)")
+        refuse_foreign(p, MEMBER_FILE, expected="another --out folder, or remove the file")
     out.mkdir(parents=True, exist_ok=True)
     written = []
     for sc in members:

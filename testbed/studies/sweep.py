@@ -48,8 +48,15 @@ except ImportError:  # (not on Windows)
 from joblib import Parallel, delayed, parallel_config
 
 from testbed.core import errors
-from testbed.core.atomic import atomic_write_text, begin_in_flight, end_in_flight, not_regular
-from testbed.core.errors import IdentificationError, InputError, show_value
+from testbed.core.atomic import (
+    PARQUET_FILE,
+    atomic_write_text,
+    begin_in_flight,
+    end_in_flight,
+    not_regular,
+    refuse_foreign,
+)
+from testbed.core.errors import IdentificationError, InputError, exception_text, show_value
 from testbed.core.provenance import git_commit, versions
 from testbed.pipeline.cache import DatasetCache
 from testbed.pipeline.generate import noise_free_scenario
@@ -235,7 +242,7 @@ def error_name(e: BaseException) -> str:
 def _error_text(e: BaseException) -> str:
     tb = traceback.extract_tb(e.__traceback__)
     where = f" ({Path(tb[-1].filename).name}:{tb[-1].lineno})" if tb else ""
-    return f"{error_name(e)}: {e}{where}"
+    return f"{error_name(e)}: {exception_text(e)}{where}"
 
 
 _WORKER_LOCK = threading.Lock()
@@ -755,12 +762,9 @@ def _run_locked(study: Study, jobs: int, dask_address: str | None, results: Path
     try:
         previous = read_results(results, set_aside=True, resuming=True)
     except ResultsError as e:  # a damaged consolidated file: keep it aside, rerun its cells
-        with results.open("rb") as fh:
-            head = fh.read(4)
-        if head and head != b"PAR1":  # not Parquet at all (a dataset was renamed *.bad): not ours
-            raise InputError(f"results {results}: not a Parquet results file (it begins with "
-                             f"{head!r}); expected a results file of study {study.name!r} or a "
-                             "new path (the file is left as it is)") from None
+        # not Parquet at all (a dataset was renamed *.bad): not ours, refused, not set aside
+        refuse_foreign(results, PARQUET_FILE, f"results {results}",
+                       f"a results file of study {study.name!r} or a new path")
         bad = results.with_name(results.name + ".bad")
         os.replace(results, bad)
         log.warning("%s; set aside as %s, its cells will run again", e, bad.name)

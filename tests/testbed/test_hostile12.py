@@ -154,19 +154,23 @@ def test_a_csv_channel_the_chain_does_not_read_is_refused(tmp_path):
 # ------------------------------------------------------------------ figures on a full disk
 
 def test_a_figure_on_a_full_disk_is_one_line_and_leaves_no_file(tmp_path, monkeypatch):
+    from pathlib import Path
+
     from matplotlib.figure import Figure
 
     from testbed.reporting.figures import save_figure
 
     # `testbed report` on a full disk left a PNG of 0 bytes and ended in an internal error
-    # (OSError 28 naming no file)
-    def full(fname, **kw):
-        with open(fname, "wb") as fh:
-            fh.write(b"\x89PNG")
+    # (OSError 28 naming no file).  The figure is encoded in memory (png_bytes, round 28: a
+    # report checks all its outputs before writing any), so the disk fills at the file's write
+
+    def full(self, data):
+        with open(self, "wb") as fh:
+            fh.write(data[:4])
         raise OSError(errno.ENOSPC, "No space left on device")
 
     fig = Figure()
-    monkeypatch.setattr(fig, "savefig", full)
+    monkeypatch.setattr(Path, "write_bytes", full)
     with pytest.raises(TestbedError, match=r"score\.png: cannot be written: No space left"):
         save_figure(fig, tmp_path / "score.png")
     assert list(tmp_path.iterdir()) == []

@@ -120,13 +120,15 @@ def test_a_users_own_page_or_notes_of_the_same_format_are_foreign(tmp_path):
     """Review 27e: any ``<`` / ``#`` file passed as ours, so ``report -o`` replaced the user's own
     ``report.html`` and ``identify -o notes.json`` their ``notes.md``; the testbed's own files
     begin with a fixed prefix (the HTML report's doctype line, the identified model's title)."""
-    from testbed.core.atomic import HTML_FILE, IDENTIFIED_MARKDOWN_FILE, foreign_head
+    from testbed.core.atomic import HTML_FILE, HTML_REPORT_HEAD, IDENTIFIED_MARKDOWN_FILE, foreign_head
 
     page, notes = tmp_path / "report.html", tmp_path / "notes.md"
     page.write_text("<p>my page</p>\n")
     notes.write_text("# My lab notes\n")
     assert foreign_head(page, HTML_FILE) and foreign_head(notes, IDENTIFIED_MARKDOWN_FILE)
-    page.write_text('<!DOCTYPE html>\n<html lang="en"><head>')
+    page.write_text('<!DOCTYPE html>\n<html lang="en"><head>')  # any HTML5 page's first line:
+    assert foreign_head(page, HTML_FILE)  # not enough (hostile round 28)
+    page.write_text(HTML_REPORT_HEAD + "<title>Run x</title>")
     notes.write_text("# Identified model: ls_sindy\n")
     assert foreign_head(page, HTML_FILE) is None
     assert foreign_head(notes, IDENTIFIED_MARKDOWN_FILE) is None
