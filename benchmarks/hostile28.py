@@ -312,10 +312,9 @@ def plugstate_cases(work: Path) -> list[tuple[str, object]]:
          {"after": "self.coef_ = np.asarray(self.coef_, float) + 1j"}),
         ("raises with a 100,000-character multi-line message",
          {"before": "raise ValueError('line\\n' * 12500)"}),
-        ("its simulate raises a plain Exception (open: identify/_base.py's _called)",
+        ("its simulate raises a plain Exception",
          {"methods": "    def simulate(self, *a, **k):\n        raise Exception('mine')\n"}),
-        ("its simulate raises an exception whose str() raises (open: identify/_base.py, "
-         "testbed/scoring/scorers.py)",
+        ("its simulate raises an exception whose str() raises",
          {"methods": "    def simulate(self, *a, **k):\n        class E(Exception):\n"
                      "            def __str__(self):\n                raise RuntimeError('x')\n"
                      "        raise E()\n"}),

@@ -63,8 +63,11 @@ from testbed.core.errors import (
     HyperparameterError,
     IdentificationError,
     NotFittedError,
+    PluginMethodError,
     ScenarioError,
+    TestbedError,
     UnsupportedError,
+    exception_text,
 )
 from testbed.core.exit_guard import ProcessExitCalled, no_process_exit
 from testbed.core.measurement import MIN_FREE_SAMPLES, Measurement, Trajectory, check_prior_values
@@ -617,6 +620,11 @@ def _called(model: Identifier, where: str, method: Callable[..., Any], *a: Any,
             return method(model, *a, **kw)  # (under the caller's own errstate)
     except ProcessExitCalled as e:
         raise IdentificationError(f"{where}: {e}") from None
+    except (TestbedError, NotImplementedError, KeyboardInterrupt):
+        raise  # the testbed's own refusals; NotImplementedError: a method the model lacks
+    except BaseException as e:  # the plugin's own code failed (hostile round 28: its simulate's
+        # Exception was "internal error ... please report it", status 3)
+        raise PluginMethodError(f"{where} raised {type(e).__name__}: {exception_text(e)}") from None
 
 
 def _guard_fitted(name: str, method: Callable[..., Any]) -> Callable[..., Any]:

@@ -181,6 +181,13 @@ class IdentificationError(TestbedError):
     """An identifier could not produce a model from the data given."""
 
 
+class PluginMethodError(IdentificationError):
+    """A method of a user's plugin identifier (a class outside ``identify``) raised an
+    exception of its own (not one of the testbed's): the user's code failed, so the run scores
+    it (a failed simulation, a failed equation listing) instead of calling it an internal error
+    of the testbed.  Its text names the method and the exception's type."""
+
+
 class HyperparameterError(IdentificationError, ValueError):
     """An identifier was constructed with a hyperparameter its declaration refuses (checked
     at fit time for estimators built in Python; scenario files are checked at load).  A

@@ -20,6 +20,7 @@ from testbed.core.dataset import Dataset
 from testbed.core.errors import (
     DivergenceError,
     IdentificationError,
+    PluginMethodError,
     RegistrationError,
     UnresolvedModelError,
     show_value,
@@ -1974,6 +1975,8 @@ def simulate_scored(sim: Callable[[], Trajectory], t: np.ndarray, check: str,
         return None, f"diverged: {e}", e.time
     except UnresolvedModelError as e:
         return None, f"not simulated: {e}", float("nan")
+    except PluginMethodError as e:  # a user's plugin's own simulate raised: it failed, not diverged
+        return None, f"simulation failed: {e}", float("nan")
     except IdentificationError as e:
         return None, f"diverged: {e}", float("nan")
     except np.linalg.LinAlgError as e:  # e.g. a singular identified M

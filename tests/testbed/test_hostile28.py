@@ -206,3 +206,39 @@ def test_an_internal_error_whose_message_cannot_be_shown_is_still_one_line(capsy
     err = capsys.readouterr().err
     assert status == cli.EXIT_INTERNAL and len(err.strip().splitlines()) == 1
     assert "_Unprintable: (no message: _Unprintable.__str__ failed)" in err
+
+
+@pytest.mark.parametrize("body", [
+    "raise Exception('mine')",
+    "class E(Exception):\n        def __str__(self):\n            raise RuntimeError('x')\n"
+    "    raise E()",
+])
+def test_a_plugins_simulate_that_raises_is_a_scored_failure(tmp_path, body):
+    # round 28 (plugstate): a plugin's simulate raising its own exception was "internal error
+    # ... please report it" (status 3); its fit's was already a scored failed fit
+    from identify._base import _called
+    from identify.ls_sindy import LeastSquaresSINDy
+    from testbed.core.errors import PluginMethodError
+    from testbed.scoring.scorers import simulate_scored
+
+    ns: dict = {}
+    exec(f"class Mine(LeastSquaresSINDy):\n    pass\n\ndef simulate(self, *a, **k):\n    {body}\n",
+         {"LeastSquaresSINDy": LeastSquaresSINDy, "__name__": "h28_plugin"}, ns)
+    model = ns["Mine"]()  # a class outside identify: a plugin's
+    with pytest.raises(PluginMethodError, match=r"^Mine\.simulate raised (Exception: mine|E)"):
+        _called(model, "Mine.simulate", ns["simulate"])
+    t = np.linspace(0.0, 1.0, 5)
+    traj, why, _ = simulate_scored(lambda: _called(model, "Mine.simulate", ns["simulate"]),
+                                   t, "x", np.zeros((1, 5)))
+    assert traj is None and why.startswith("simulation failed: Mine.simulate raised ")
+
+
+def test_a_builtin_identifiers_own_exception_is_not_relabelled():
+    # the wrap is for plugins only: a built-in's exception is a testbed bug and stays one
+    from identify._base import _called
+    from identify.ls_sindy import LeastSquaresSINDy
+
+    def boom(self):
+        raise RuntimeError("bug")
+    with pytest.raises(RuntimeError, match="bug"):
+        _called(LeastSquaresSINDy(), "LeastSquaresSINDy.simulate", boom)
