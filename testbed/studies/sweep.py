@@ -407,6 +407,35 @@ def _base_row(cell: Cell) -> dict[str, Any]:
     }
 
 
+def unexplained_nonfinite(values: dict[str, float], held: set[str], fit_failed: bool) -> list[str]:
+    """The non-finite scores a cell's reason must name, sorted; [] where nothing is left to say.
+
+    A scored failure (fit failed, diverged, non-physical) keeps its own reason; non-finite
+    scores are named only where they say something it does not.  A failed fit leaves every
+    score undefined and its reason says why: listing them again named some 40 scores after it
+    and counted the cell a second time ("non-finite scores") in the summary (round 24's
+    ``b24_br_L0p5_w20_t6_s6_z3``, ``ls_sindy`` 1 %).  A score no bar holds is not a reason
+    when every held score is finite: the five-bar's ``coef_error`` is infinite by definition
+    where the identified row lacks the truth's largest term; it failed a passing cell (marked
+    failed and passed at once) and, after another failure such as "uninformative", counted it
+    a second time (round 27's ``fb27_sine_amp0p014`` at 3 %).  Held non-finite scores are
+    always named.
+
+    Parameters
+    ----------
+    values : dict
+        The cell's scores by name.
+    held : set of str
+        The metrics its checks hold.
+    fit_failed : bool
+        Whether its fit failed.
+    """
+    bad = sorted(k for k, v in values.items() if not math.isfinite(v))
+    if fit_failed or (held and not held & set(bad)):
+        return []
+    return bad
+
+
 def run_cell(cell: Cell, cache_dir: str, plugins: tuple[str, ...],
              parent: int | None = None, provenance: dict[str, str] | None = None,
              same_as: dict[str, Any] | None = None,
@@ -460,18 +489,8 @@ def _run_cell(cell: Cell, cache_dir: str, plugins: tuple[str, ...], parent: int 
         row["fit_time"] = result.fit_time
         row.update({k: float(v) for k, v in result.scores.values.items()})
         row["checks"] = json.dumps([{**asdict(c), "passed": c.passed} for c in result.checks])
-        bad = sorted(k for k, v in result.scores.values.items() if not math.isfinite(v))
-        # a scored failure (fit failed, diverged, non-physical) keeps its reason; non-finite
-        # scores without one are named.  A cell judged on finite held scores is not failed by a
-        # reported score that is infinite by definition (the five-bar's coef_error when the
-        # identified row lacks the truth's largest term): it was marked failed and passed at
-        # once, and left out of the score medians
-        # A failed fit leaves every score undefined and its reason says why: listing them
-        # again named some 40 scores after it and counted the cell a second time
-        # ("non-finite scores") in the summary (round 24's b24_br_L0p5_w20_t6_s6_z3, ls_sindy 1 %)
-        held = {c.metric for c in result.checks}
-        if "fit" in result.scores.failures or (held and not held & set(bad) and not result.failure):
-            bad = []
+        bad = unexplained_nonfinite(result.scores.values, {c.metric for c in result.checks},
+                                    "fit" in result.scores.failures)
         reasons = [result.failure, bad and "non-finite scores: " + ", ".join(bad),
                    not result.scores.values and "no scores"]
         reason = "; ".join(r for r in reasons if r)

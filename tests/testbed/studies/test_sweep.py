@@ -590,3 +590,21 @@ def test_a_resumed_sweep_refuses_a_row_edited_to_another_cell(toy_dir, tmp_path,
     run_sweep(study, results=res, cache_dir=cache, verbose=False, stats=stats)
     assert stats.run == 1 and res.with_name(res.name + ".bad").read_bytes() == before
     assert [r[column] for r in read_results(res)] != [value]
+
+
+def test_an_unheld_infinite_score_is_no_second_reason_after_a_failure():
+    # round 27's fb27_sine_amp0p014 at 3 %: "uninformative; non-finite scores: coef_error, ..."
+    # named scores no bar holds (coef_error is infinite by definition where the identified row
+    # lacks the truth's largest term) after the cell's own reason
+    from testbed.studies.sweep import unexplained_nonfinite
+
+    values = {"angle_rmse": 0.2, "coef_error": float("inf"), "f1": float("nan")}
+    assert unexplained_nonfinite(values, {"angle_rmse"}, fit_failed=False) == []
+    # a held score that is not finite is always named ...
+    assert unexplained_nonfinite({**values, "angle_rmse": float("nan")}, {"angle_rmse"},
+                                 fit_failed=False) == ["angle_rmse", "coef_error", "f1"]
+    # ... unless the fit failed, whose reason says why every score is undefined
+    assert unexplained_nonfinite({**values, "angle_rmse": float("nan")}, {"angle_rmse"},
+                                 fit_failed=True) == []
+    # with no checks at all, non-finite scores are the only thing to say
+    assert unexplained_nonfinite(values, set(), fit_failed=False) == ["coef_error", "f1"]
