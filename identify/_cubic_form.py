@@ -17,6 +17,10 @@ by the diagnosis scripts ``tests/identify/soft_cubic_rank_one_floor.py`` and
 ``K3_`` (simulation, residuals, scores, figures) still take the diagonal ``K3_ @ x**3`` (the
 form was measured not to be the soft base's floor: ``docs/known-gaps.md``).  Should a model
 carry ``A``, every such consumer is to compute its cubic with :func:`cubic_force`.
+
+:func:`one_mode_cubic` is a rank-one ``K3`` on the diagonal features (a cubic acting on one
+mode's equation alone, a Duffing along that mode's motion), which every consumer reads as it
+is: ``ls_sindy``'s step 4c (:mod:`identify._structural_backbone`) sizes it by output error.
 """
 
 from __future__ import annotations
