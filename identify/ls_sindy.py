@@ -291,8 +291,15 @@ class LeastSquaresSINDy(StructuralIdentifier):
        chirp (fam11: TRAC collapsed) carries the record's hardening; the output error sizes it
        on the response itself (004: mode 1 0.21 %, record agreement 0.9975 -> 0.9979).
        Mode 2 is not moved: its linear model's frequency also carries mode 1's amplitude
-       (the cross ratio, docs/known-gaps.md), which no record rule gives.  Measured
-       2026-11-29 (branch ``beam33``): docs/known-gaps.md, "Mode 1 at its backbone limit".
+       (the cross ratio, docs/known-gaps.md), which no record rule gives.  The limit must be
+       read (the squared amplitude falls to
+       :data:`identify._modal_damping.BACKBONE_MIN_FALL` or less over the window): held-out
+       soft 013, a fall to 0.60, had its limit 1.8 % under the truth.  Measured 2026-11-29
+       (branch ``beam33``) on the 80 soft family cells (both draws, 0 / 1 %): issue #15's bars
+       44 -> 46 (004 clean; 002 at 1 %, mode 1 1.46 % -> within), study bars 62 -> 67, none
+       lost, it acts on 24; never on the 40 clamped members; rounds 24-26's 38 soft cells
+       with a linear model: issue bars 18 -> 20, study bars 27 -> 33, none lost
+       (docs/known-gaps.md, "Mode 1 at its backbone limit").
 
     5. *Unresolved modes placed* (linear library, ``fit_tilt`` by rule; only where the model
        would be refused: tilted, held and flat all grow): in the tilted fit, a mode whose
