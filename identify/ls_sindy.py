@@ -298,8 +298,11 @@ class LeastSquaresSINDy(StructuralIdentifier):
        (branch ``beam33``) on the 80 soft family cells (both draws, 0 / 1 %): issue #15's bars
        44 -> 46 (004 clean; 002 at 1 %, mode 1 1.46 % -> within), study bars 62 -> 67, none
        lost, it acts on 24; never on the 40 clamped members; rounds 24-26's 38 soft cells
-       with a linear model: issue bars 18 -> 20, study bars 27 -> 33, none lost
-       (docs/known-gaps.md, "Mode 1 at its backbone limit").
+       with a linear model: issue bars 18 -> 20, study bars 27 -> 33, none lost; the
+       validation draws' 24 such cells: issue bars 15 -> 16, study bars 22 -> 21
+       (``soft_v21__008`` at 1 %, TRAC 0.945 -> 0.8998, its record agreement 0.940 -> 0.899
+       inside the margin; failing issue #15's bars either way) (docs/known-gaps.md, "Mode 1
+       at its backbone limit").
 
     5. *Unresolved modes placed* (linear library, ``fit_tilt`` by rule; only where the model
        would be refused: tilted, held and flat all grow): in the tilted fit, a mode whose
