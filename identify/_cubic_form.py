@@ -17,6 +17,10 @@ by the diagnosis scripts ``tests/identify/soft_cubic_rank_one_floor.py`` and
 ``K3_`` (simulation, residuals, scores, figures) still take the diagonal ``K3_ @ x**3`` (the
 form was measured not to be the soft base's floor: ``docs/known-gaps.md``).  Should a model
 carry ``A``, every such consumer is to compute its cubic with :func:`cubic_force`.
+
+:func:`one_mode_cubic` is a rank-one ``K3`` on the diagonal features (a cubic acting on one
+mode's equation alone, a Duffing along that mode's motion), which every consumer reads as it
+is: ``ls_sindy``'s step 4c (:mod:`identify._structural_backbone`) sizes it by output error.
 """
 
 from __future__ import annotations
@@ -209,3 +213,49 @@ def fit_rank_one(x: np.ndarray, y: np.ndarray, Q: np.ndarray | None = None,
     if symmetric:
         b = a * float(a @ b)
     return canonical_sign(a, b)
+
+
+def one_mode_cubic(M: np.ndarray, Phi: np.ndarray, k: int, g: float) -> np.ndarray:
+    """The diagonal library's ``K3`` of a cubic spring acting on mode ``k``'s equation alone.
+
+    ``K3 = g M phi_k u^T`` with ``u . phi_j^3 = delta_kj`` (``phi_j`` the columns of ``Phi``):
+    in the modal coordinates ``q = Phi^-1 x`` only mode ``k``'s equation gets a cubic term,
+    and along that mode's own motion (``x = phi_k q_k``) it is the Duffing ``q_k'' + lam_k q_k +
+    g q_k^3 = 0``.  A rank-one ``K3`` on the features ``x_j^3``, so every consumer of ``K3_``
+    reads it as it reads the fitted diagonal library.
+
+    Parameters
+    ----------
+    M : ndarray, shape (n, n)
+        Mass [kg].
+    Phi : ndarray, shape (n, n)
+        Mode shapes, one per column (:func:`identify.structural.modal`) [-].
+    k : int
+        The mode the cubic acts on.
+    g : float
+        Its modal cubic coefficient [1 / (s^2 (modal units)^2)].
+
+    Returns
+    -------
+    ndarray, shape (n, n)
+        ``K3`` [N/m^3].
+    """
+    Phi = np.asarray(Phi, dtype=float)
+    u = np.linalg.solve((Phi**3).T, np.eye(Phi.shape[1])[k])
+    return float(g) * np.outer(np.asarray(M, dtype=float) @ Phi[:, k], u)
+
+
+def duffing_by_balance(lam_heard: float, lam_linear: float, amplitude: float) -> float:
+    """The Duffing coefficient ``g`` whose first harmonic balance at ``amplitude`` rings at the
+    eigenvalue ``lam_heard``: ``lam_heard = lam_linear + 3/4 g amplitude^2`` [1 / (s^2 units^2)].
+
+    Parameters
+    ----------
+    lam_heard : float
+        The squared frequency heard at that amplitude [rad^2/s^2].
+    lam_linear : float
+        The linear (small-amplitude) one [rad^2/s^2].
+    amplitude : float
+        The modal coordinate's amplitude [its units], positive.
+    """
+    return (float(lam_heard) - float(lam_linear)) / (0.75 * float(amplitude) ** 2)

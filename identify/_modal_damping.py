@@ -1237,7 +1237,7 @@ def decay_hold(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndarray,
         on &= ~unexplained
         # a limit the record does not reach is not read (BACKBONE_MIN_FALL); NaN (not taken)
         # compares False
-        unread = on & (np.exp(-2.0 * dec.sigma * (i1 - i0) / float(data.fs)) > BACKBONE_MIN_FALL)
+        unread = on & ~limit_reached(dec.sigma, (i1 - i0) / float(data.fs))
         on &= ~unread
         # what the peak offset alone would move: kept, and said so in the rule
         beyond = (dec.taken & ~near & ~free & explained
@@ -1501,6 +1501,21 @@ def peak_offset(sigma: np.ndarray, lam: np.ndarray) -> np.ndarray:
     return np.where(np.isfinite(z2), wn / (2.0 * np.pi) * g, np.nan)
 
 
+def limit_reached(sigma: np.ndarray, duration_s: float) -> np.ndarray:
+    """Whether the record reaches a backbone fit's linear limit: the squared amplitude
+    ``exp(-2 sigma T)`` of a decay at rate ``sigma`` [1/s] falls to :data:`BACKBONE_MIN_FALL`
+    of its start or less over the window's ``T = duration_s`` [s] (module docstring, "Cubic
+    library"; else the limit is an extrapolation beyond the measured span).  The one test of
+    the decay hold, :func:`hardened_reach` and :func:`beyond_limit`; a NaN rate: False.
+
+    Returns
+    -------
+    ndarray of bool, shape of ``sigma``
+    """
+    with np.errstate(invalid="ignore", over="ignore"):
+        return np.exp(-2.0 * np.asarray(sigma, dtype=float) * duration_s) <= BACKBONE_MIN_FALL
+
+
 def hardened_reach(peak_hz: np.ndarray, dec: ModalDecay, sigma: np.ndarray, line_hz: float,
                    duration_s: float) -> tuple[np.ndarray, np.ndarray]:
     """The highest linear frequency of each mode that a hardening record allows [Hz].
@@ -1547,8 +1562,7 @@ def hardened_reach(peak_hz: np.ndarray, dec: ModalDecay, sigma: np.ndarray, line
     with np.errstate(invalid="ignore", divide="ignore"):
         off = peak_offset(np.asarray(sigma, dtype=float), (2.0 * np.pi * pk) ** 2)
         by_peak = np.where((pk > 0) & ~np.isnan(off), pk + line_hz + off, np.inf)
-        read = (dec.taken & np.isfinite(dec.lam_model)
-                & (np.exp(-2.0 * dec.sigma * duration_s) <= BACKBONE_MIN_FALL))
+        read = dec.taken & np.isfinite(dec.lam_model) & limit_reached(dec.sigma, duration_s)
     limit = np.where(read, np.sqrt(np.where(read, dec.lam_model, 0.0)) / (2.0 * np.pi), np.nan)
     reach = np.fmin(by_peak, np.where(read, limit + line_hz, np.inf))
     return reach.reshape(n), limit.reshape(n)
@@ -1625,8 +1639,7 @@ def beyond_limit(dec: ModalDecay, duration_s: float) -> np.ndarray:
     if dec.beyond is None:
         return np.full(n, np.nan)
     p = np.asarray(dec.beyond, dtype=complex)
-    with np.errstate(invalid="ignore", over="ignore"):
-        read = np.isfinite(p) & (np.exp(2.0 * p.real * duration_s) <= BACKBONE_MIN_FALL)
+    read = np.isfinite(p) & limit_reached(-p.real, duration_s)
     return np.where(read, np.abs(p) / (2.0 * np.pi), np.nan)
 
 

@@ -165,3 +165,54 @@ def record_agreement(model: StructuralIdentifier, data: Measurement,
     if not np.all(np.isfinite(tr)):
         return float("nan"), SIMULATION_NOT_FINITE
     return float(np.min(tr)), ""
+
+
+#: The scales :func:`best_scale` tries first, ascending from 0 (the term left out) to 3 x its
+#: first estimate: a grid wide enough for a harmonic-balance size off by its first order
+#: (soft-base members 001 / 004 clean: best at 1.19 / 0.85 x), then refined between the best
+#: grid point's neighbours.
+SCALE_GRID = (0.0, 0.03, 0.1, 0.3, 0.6, 1.0, 1.5, 2.0, 3.0)
+
+
+def best_scale(agreement, grid: tuple[float, ...] = SCALE_GRID, xatol: float = 0.01
+               ) -> tuple[float, float]:
+    """The scale ``s`` of a model's term that maximises its record agreement (output error).
+
+    ``agreement(s)`` is evaluated on ``grid`` (a NaN, a failed simulation, counts as -1), then
+    maximised by bounded Brent between the best grid point's neighbours (to ``xatol``); the
+    best value seen wins, ties to the smaller scale (the smaller term).
+
+    Parameters
+    ----------
+    agreement : callable
+        ``agreement(s) -> float`` [-], e.g. :func:`record_agreement` of the model with the term
+        scaled by ``s``.
+    grid : tuple of float
+        Scales tried first, ascending [-].
+    xatol : float
+        Brent's tolerance on ``s`` [-].
+
+    Returns
+    -------
+    (float, float)
+        The best scale and its agreement (NaN where every simulation failed).
+    """
+    from scipy.optimize import minimize_scalar
+
+    seen: dict[float, float] = {}
+
+    def loss(s: float) -> float:
+        s = float(s)
+        if s not in seen:
+            a = float(agreement(s))
+            seen[s] = a if np.isfinite(a) else -1.0
+        return 1.0 - seen[s]
+
+    values = [loss(s) for s in grid]
+    k = int(np.argmin(values))
+    lo, hi = grid[max(k - 1, 0)], grid[min(k + 1, len(grid) - 1)]
+    if hi > lo:
+        minimize_scalar(loss, bounds=(lo, hi), method="bounded", options={"xatol": xatol})
+    best = max(seen.values())
+    s = min(q for q, a in seen.items() if a == best)
+    return s, (best if best > -1.0 else float("nan"))

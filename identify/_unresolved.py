@@ -88,6 +88,12 @@ def modal_pole_reach(M: np.ndarray, C: np.ndarray, K: np.ndarray) -> np.ndarray:
     return np.maximum(np.abs(-0.5 * d + disc), np.abs(-0.5 * d - disc))
 
 
+def _one_resolvable(bad: np.ndarray, lam: np.ndarray) -> bool:
+    """Whether exactly one mode is marked unresolved (``bad``) and every other has a positive
+    stiffness eigenvalue ``lam`` [rad^2/s^2]: what :func:`place_unresolved` can place."""
+    return not (np.count_nonzero(bad) != 1 or np.any(lam[~bad] <= 0.0))
+
+
 def place_unresolved(M: np.ndarray, C: np.ndarray, K: np.ndarray, top_hz: float,
                      peaks: np.ndarray, band_low_hz: float | None = None
                      ) -> tuple[np.ndarray, np.ndarray, str] | None:
@@ -137,7 +143,7 @@ def place_unresolved(M: np.ndarray, C: np.ndarray, K: np.ndarray, top_hz: float,
         bad = unlocated_growing(M, C, K, peaks, (float(band_low_hz), top_hz))
         where = ("negative own damping inside the band, where no accepted peak located it) "
                  f"placed at the peak band's top {top_hz:.4g} Hz")
-    if band_low_hz is not None and (np.count_nonzero(bad) != 1 or np.any(lam[~bad] <= 0.0)):
+    if band_low_hz is not None and not _one_resolvable(bad, lam):
         # a fit with no fit band (ls_sindy's step 5 only) whose one growing mode is a negative
         # stiffness: no accepted peak can locate a mode without a frequency, and the record's
         # free decay is carried by the other modes (the accepted peaks checked below), so the
@@ -154,7 +160,7 @@ def place_unresolved(M: np.ndarray, C: np.ndarray, K: np.ndarray, top_hz: float,
     # one mode only: two or more placed at the one top would be a repeated eigenvalue whose
     # shapes round-off decides (on a non-symmetric warm start, 7 of 200 random 4-DOF models
     # with two modes above the top ended in a singular eigenvector matrix: session 18's review)
-    if np.count_nonzero(bad) != 1 or np.any(lam[~bad] <= 0.0):  # (Phi's span checked above)
+    if not _one_resolvable(bad, lam):  # (Phi's span checked above)
         return None
     f_ok = np.sqrt(lam[~bad]) / (2.0 * np.pi)
     for p in np.asarray(peaks, dtype=float):

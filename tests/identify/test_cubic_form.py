@@ -7,7 +7,9 @@ from identify._cubic_form import (
     cubic_features,
     cubic_force,
     cubic_jacobian,
+    duffing_by_balance,
     fit_rank_one,
+    one_mode_cubic,
 )
 
 
@@ -90,3 +92,35 @@ def test_transform_and_the_sign_rule():
     a2, b2 = canonical_sign(-2.0 * a, -b / 8.0)  # the same force: (-2a . x)^3 (-b / 8)
     np.testing.assert_allclose(a2, a, rtol=0, atol=1e-15)
     np.testing.assert_allclose(b2, b, rtol=1e-15)
+
+
+def test_the_one_mode_cubic_acts_on_its_modes_equation_alone_as_a_duffing():
+    """``one_mode_cubic``: in the modal coordinates ``q = Phi^-1 x`` only mode k's equation
+    gets a cubic term, and along mode k's own motion it is ``g q_k^3``; mode j's motion alone
+    puts no cubic force on any equation (``u . phi_j^3 = 0``)."""
+    rng = np.random.default_rng(3)
+    M = np.diag([0.3, 0.2, 0.25])
+    Phi = np.eye(3) + 0.3 * rng.standard_normal((3, 3))
+    for k in range(3):
+        K3 = one_mode_cubic(M, Phi, k, 2.5e6)
+        modal_force = np.linalg.solve(Phi, np.linalg.solve(M, K3))  # (Phi^-1 M^-1 K3)
+        x = rng.standard_normal((3, 50))
+        fq = modal_force @ x**3
+        others = [j for j in range(3) if j != k]
+        assert np.allclose(fq[others], 0.0, atol=1e-9 * np.abs(fq[k]).max())
+        for j in range(3):  # along mode j's shape: g q^3 on mode k if j == k, else nothing
+            q = np.linspace(-1e-3, 1e-3, 7)
+            fj = modal_force @ np.outer(Phi[:, j], q) ** 3
+            want = np.zeros((3, 7))
+            if j == k:
+                want[k] = 2.5e6 * q**3
+            assert np.allclose(fj, want, atol=1e-9 * 2.5e6 * 1e-9)
+
+
+def test_the_duffing_by_balance_rings_at_the_heard_frequency():
+    """``duffing_by_balance``: ``lam_lin + 3/4 g A^2`` gives back the heard eigenvalue; a heard
+    frequency below the linear one gives a softening (negative) ``g``."""
+    lam_lin, lam_heard, A = (2 * np.pi * 28.0) ** 2, (2 * np.pi * 29.0) ** 2, 2e-3
+    g = duffing_by_balance(lam_heard, lam_lin, A)
+    assert g > 0 and np.isclose(lam_lin + 0.75 * g * A**2, lam_heard, rtol=1e-14)
+    assert duffing_by_balance(lam_lin, lam_heard, A) < 0
