@@ -11,7 +11,10 @@ sites' Jacobians and ``Phi_m`` the first m mass-normalised modes,
 ``Cr = T^T C T``.  The reduced model has exactly the first m frequencies and
 mode shapes (at the sensors) of the full model, and a force ``F`` at a beam point
 with vertical Jacobian row ``j`` enters as ``T^T j^T F`` (a unit vector for a
-force at a sensor, since ``Js T = I``).
+force at a sensor, since ``Js T = I``).  A load that varies slowly against the
+truncated modes (the soft base's cubic moment) also moves them statically, which the
+sensors read: :func:`residual_flexibility` and :func:`truncated_static_load` give the
+term that adds to its ``T^T`` projection.
 """
 
 from __future__ import annotations
