@@ -11,7 +11,10 @@ sites' Jacobians and ``Phi_m`` the first m mass-normalised modes,
 ``Cr = T^T C T``.  The reduced model has exactly the first m frequencies and
 mode shapes (at the sensors) of the full model, and a force ``F`` at a beam point
 with vertical Jacobian row ``j`` enters as ``T^T j^T F`` (a unit vector for a
-force at a sensor, since ``Js T = I``).
+force at a sensor, since ``Js T = I``).  A load that varies slowly against the
+truncated modes (the soft base's cubic moment) also moves them statically, which the
+sensors read: :func:`residual_flexibility` and :func:`truncated_static_load` give the
+term that adds to its ``T^T`` projection.
 """
 
 from __future__ import annotations
@@ -120,6 +123,58 @@ def serep(M: np.ndarray, C: np.ndarray, K: np.ndarray, Js: np.ndarray, modes: np
     T = phi @ np.linalg.inv(pa)
     sym = lambda a: 0.5 * (a + a.T)  # noqa: E731 - remove round-off asymmetry only
     return Serep(T=T, Mr=sym(T.T @ M @ T), Cr=sym(T.T @ C @ T), Kr=sym(T.T @ K @ T), Pa=pa)
+
+
+def residual_flexibility(K: np.ndarray, modes: np.ndarray, m: int) -> np.ndarray:
+    """The full model's static flexibility beyond its first ``m`` modes [rad/(N m)], shape (n, n).
+
+    ``R = K^-1 - Phi_m Omega_m^-2 Phi_m^T = Phi_t Omega_t^-2 Phi_t^T``: the static joint-angle
+    response to a unit joint moment of the truncated modes ``m+1 .. n`` alone, which a
+    reduction to the first ``m`` modes leaves out (``Phi`` mass-normalised, so
+    ``Omega_m^2 = diag(Phi_m^T K Phi_m)``).
+
+    Parameters
+    ----------
+    K : ndarray, shape (n, n)
+        Joint-space stiffness [N m/rad], positive definite.
+    modes : ndarray, shape (n, n)
+        Mass-normalised modes in columns, ascending frequency.
+    m : int
+        Number of modes kept.
+    """
+    phi = modes[:, :m]
+    omega2 = np.einsum("ij,ik,kj->j", phi, K, phi)
+    R = np.linalg.inv(K) - (phi / omega2) @ phi.T
+    return 0.5 * (R + R.T)  # remove round-off asymmetry only
+
+
+def truncated_static_load(Kr: np.ndarray, Js: np.ndarray, R: np.ndarray,
+                          load: np.ndarray) -> np.ndarray:
+    """The reduced load that stands for the truncated modes' static response, ``Kr Js R l``.
+
+    A joint load ``l g(t)`` varying slowly against the truncated modes moves them
+    quasi-statically, ``q_t = R l g``, which the sensors read as ``s = Js R l g``: the sensed
+    displacement is ``u = Pa eta + s``.  Written in ``u``, the modes' equations gain
+    ``Kr s`` (and ``Mr s'' + Cr s'``, neglected: small where ``g`` is slow against the
+    truncated modes), so the reduced load becomes ``T^T l + Kr Js R l``.
+
+    Parameters
+    ----------
+    Kr : ndarray, shape (m, m)
+        Reduced stiffness [N/m].
+    Js : ndarray, shape (m, n)
+        Vertical Jacobian rows of the sensors [m/rad].
+    R : ndarray, shape (n, n)
+        :func:`residual_flexibility` [rad/(N m)].
+    load : ndarray, shape (n,)
+        Joint load per unit of ``g`` (e.g. ``e0`` for a moment at the root joint).
+
+    Returns
+    -------
+    ndarray, shape (m,)
+        In the units of ``T^T load`` (rad/m for a moment).
+    """
+    return Kr @ (Js @ (R @ np.asarray(load, float)))
 
 
 def simulate_reduced(Mr: np.ndarray, Cr: np.ndarray, Kr: np.ndarray, force_map: np.ndarray,
