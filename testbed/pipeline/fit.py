@@ -24,6 +24,7 @@ import numpy as np
 from testbed.core.errors import (
     IdentificationError,
     InputError,
+    PluginMethodError,
     ScenarioError,
     TestbedError,
     exception_text,
@@ -396,6 +397,6 @@ def model_summary(model: Any, data: Measurement | None = None) -> dict[str, Any]
     if data is not None:
         try:
             out["r2"] = float(model.score(data))
-        except NotImplementedError:
-            out["r2"] = None
+        except (NotImplementedError, PluginMethodError):  # none, or a plugin's own failed: the
+            out["r2"] = None  # scored prediction says so (scorers.prediction_r2)
     return out

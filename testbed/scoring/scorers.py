@@ -551,6 +551,60 @@ def _failed_modes(scores: Scores, thresholds: dict[str, dict[str, float]], n_mod
             held |= set(range(1, n_modes + 1))
     return held
 
+def _out_of_band(scores: Scores, k: int) -> str | None:
+    """Where true mode ``k`` (1-based) lies against the signal chain's pass band: ``"below"``
+    the high-pass, ``"folded"`` (above the Nyquist frequency, aliased into the band),
+    ``"above"`` the band, or None (inside it, or nothing recorded)."""
+    band, f_true = scores.details.get("passband"), scores.details.get("f_true")
+    if band is None or f_true is None or k > len(f_true):
+        return None
+    lo, hi = (float(x) for x in band)
+    fs = scores.details.get("fs")  # [Hz]; None (no claim about folding) where not recorded
+    f = float(f_true[k - 1])
+    alias = aliased_frequency(f, float(fs)) if fs is not None else None
+    if f < lo:
+        return "below"
+    if alias is not None and lo <= alias <= hi:
+        return "folded"
+    return "above" if f > hi else None
+
+
+def _unexcited(scores: Scores, k: int) -> tuple[float, float] | None:
+    """True mode ``k``'s (1-based) hammer participation and pulse-spectrum share ``(p, s)``
+    where their product is below :data:`UNEXCITED_RATIO` (``s`` NaN where not recorded), else
+    None."""
+    part, f_true = scores.details.get("force_participation"), scores.details.get("f_true")
+    if part is None or f_true is None or k > min(len(part), len(f_true)):
+        return None
+    spec = scores.details.get("pulse_spectrum")
+    p = float(part[k - 1])
+    s = float(spec[k - 1]) if spec is not None and k <= len(spec) else float("nan")
+    if not (p * (s if np.isfinite(s) else 1.0)) < UNEXCITED_RATIO:  # NaN: no claim
+        return None
+    return p, s
+
+
+def _decayed(scores: Scores, k: int) -> bool:
+    """Whether true mode ``k`` (1-based) keeps less than :data:`DECAYED_RATIO` of its amplitude
+    where the free decay begins."""
+    left, f_true = scores.details.get("window_decay"), scores.details.get("f_true")
+    return (left is not None and f_true is not None and k <= min(len(left), len(f_true))
+            and float(left[k - 1]) < DECAYED_RATIO)
+
+
+def _named_by_mode_reason(check: Check, scores: Scores) -> bool:
+    """Whether failed ``check`` is a per-mode bar (``<score>_mode<k>``) whose mode another
+    reason already names: out of band (:func:`out_of_band_failures`), unexcited
+    (:func:`unexcited_failures`) or decayed (:func:`decayed_failures`); the linear-model
+    reasons do not count such a bar as one they would hide (review 28a)."""
+    found = _MODE_SCORE.fullmatch(check.metric)
+    if not found or not found[2]:
+        return False
+    k = int(found[2])
+    return _out_of_band(scores, k) is not None or _unexcited(scores, k) is not None \
+        or _decayed(scores, k)
+
+
 def out_of_band_failures(scores: Scores, thresholds: dict[str, dict[str, float]]
                          ) -> dict[str, str]:
     """A failed bar on a true mode that the signal chain's pass band leaves out: ``{"band": reason}``.
@@ -590,20 +644,21 @@ def out_of_band_failures(scores: Scores, thresholds: dict[str, dict[str, float]]
     held = _failed_modes(scores, thresholds, n_modes, responses=True)
     out, cut, folded = [], 0, 0
     for k in sorted(held):
-        if k > len(f_true):
+        where = _out_of_band(scores, k)
+        if where is None:
             continue
         f = float(f_true[k - 1])
-        alias = aliased_frequency(f, float(fs)) if fs is not None else None
-        if f < lo:
+        if where == "below":
             out.append(f"mode {k} ({f:.4g} Hz) lies below the signal chain's high-pass cut-off "
                        f"({lo:.4g} Hz; signal.highpass_hz)")
             cut += 1
-        elif alias is not None and lo <= alias <= hi:  # above Nyquist, folded into the band
+        elif where == "folded":
             out.append(f"mode {k} ({f:.4g} Hz) lies above the Nyquist frequency "
                        f"({float(fs) / 2:.4g} Hz) and the record holds it folded to "
-                       f"{alias:.4g} Hz, inside the pass band (simulation.sample_rate)")
+                       f"{aliased_frequency(f, float(fs)):.4g} Hz, inside the pass band "
+                       "(simulation.sample_rate)")
             folded += 1
-        elif f > hi:
+        else:
             out.append(f"mode {k} ({f:.4g} Hz) lies above the signal chain's pass band, which "
                        f"ends at {hi:.4g} Hz (the low-pass, or the Nyquist frequency)")
             cut += 1
@@ -683,17 +738,14 @@ def unexcited_failures(scores: Scores, thresholds: dict[str, dict[str, float]]
     part, f_true = scores.details.get("force_participation"), scores.details.get("f_true")
     if part is None or f_true is None:
         return {}
-    spec = scores.details.get("pulse_spectrum")
     n_modes = int(scores.details.get("scored_modes", len(part)))
     held = _failed_modes(scores, thresholds, n_modes)
     out, where, when = [], False, False
     for k in sorted(held):
-        if k > min(len(part), len(f_true)):
+        low = _unexcited(scores, k)
+        if low is None:
             continue
-        p = float(part[k - 1])
-        s = float(spec[k - 1]) if spec is not None and k <= len(spec) else float("nan")
-        if not (p * (s if np.isfinite(s) else 1.0)) < UNEXCITED_RATIO:  # NaN: no claim
-            continue
+        p, s = low
         head = f"mode {k} ({float(f_true[k - 1]):.4g} Hz)"
         if not np.isfinite(s) or p <= s:  # the smaller factor is the cause named
             out.append(f"{head} meets the hammer at {p:.2g} of its largest amplitude at the "
@@ -826,7 +878,7 @@ def decayed_failures(scores: Scores, thresholds: dict[str, dict[str, float]]
     held = _failed_modes(scores, thresholds, n_modes)
     out = []
     for k in sorted(held):
-        if k > min(len(left), len(f_true)) or not float(left[k - 1]) < DECAYED_RATIO:
+        if not _decayed(scores, k):
             continue
         zeta = (f", {100 * float(z_true[k - 1]):.3g} % damped"
                 if z_true is not None and k <= len(z_true) else "")
@@ -1436,7 +1488,7 @@ def hidden_by_trac(scores: Scores, thresholds: dict[str, dict[str, float]]) -> l
         The failed checks left unexplained (empty: nothing hidden).
     """
     rest = [c for c in check_thresholds(scores.values, thresholds)
-            if not c.passed and c.metric != "trac"]
+            if not c.passed and c.metric != "trac" and not _named_by_mode_reason(c, scores)]
     if rest and all(c.metric.startswith("freq_error") or _unpaired_mac(c, scores) for c in rest) \
             and _linear_model_reason(scores, thresholds):
         return []
@@ -1478,7 +1530,7 @@ def hidden_by_frequency(scores: Scores, thresholds: dict[str, dict[str, float]])
     """
     rest = [c for c in check_thresholds(scores.values, thresholds)
             if not c.passed and not c.metric.startswith("freq_error")
-            and not _unpaired_mac(c, scores)]
+            and not _unpaired_mac(c, scores) and not _named_by_mode_reason(c, scores)]
     if rest and all(c.metric == "trac" for c in rest) and _linear_trac_reason(scores, thresholds):
         return []
     return rest
@@ -1816,14 +1868,16 @@ def prediction_r2(model: Any, data: Any) -> float | None:
     Returns
     -------
     float or None
-        R^2 [-] (NaN if a prediction is not finite or the record has no variance); None for a
-        model without a structural prediction.
+        R^2 [-] (NaN if a prediction is not finite, a plugin's own prediction raised, or the
+        record has no variance); None for a model without a structural prediction.
     """
     if not hasattr(model, "M_") or not hasattr(model, "predict_acceleration"):
         return None
     s = slice(data.free_start, None)
     try:
         pred = np.asarray(model.predict_acceleration(data), dtype=float)[:, s]
+    except PluginMethodError:  # a plugin's own prediction failed: a failed prediction, scored
+        return float("nan")
     except (NotImplementedError, np.linalg.LinAlgError, ValueError):
         return None
     meas = np.asarray(data.xdd, dtype=float)[:, s]
@@ -1869,7 +1923,10 @@ def fitted_model_failures(model: Any, r2: float | None = None) -> dict[str, str]
         out = {"coefficients": f"{bad} identified coefficient(s) are NaN or infinite"} if bad else {}
     else:
         return None
-    if r2 is not None and not r2 >= 0.0:  # NaN fails too
+    if r2 is not None and not np.isfinite(r2):
+        out["prediction"] = ("R^2 of the predicted accelerations is not finite: the prediction "
+                             "failed or is not finite (expected 0 to 1)")
+    elif r2 is not None and r2 < 0.0:
         out["prediction"] = (f"R^2 of the predicted accelerations {r2:.4g} < 0: the model predicts "
                              "its own record worse than the record's mean (expected 0 to 1)")
     return out

@@ -407,19 +407,20 @@ def _base_row(cell: Cell) -> dict[str, Any]:
     }
 
 
-def unexplained_nonfinite(values: dict[str, float], held: set[str], fit_failed: bool) -> list[str]:
+def unexplained_nonfinite(values: dict[str, float], held: set[str],
+                          failures: dict[str, str] | set[str]) -> list[str]:
     """The non-finite scores a cell's reason must name, sorted; [] where nothing is left to say.
 
-    A scored failure (fit failed, diverged, non-physical) keeps its own reason; non-finite
-    scores are named only where they say something it does not.  A failed fit leaves every
-    score undefined and its reason says why: listing them again named some 40 scores after it
-    and counted the cell a second time ("non-finite scores") in the summary (round 24's
-    ``b24_br_L0p5_w20_t6_s6_z3``, ``ls_sindy`` 1 %).  A score no bar holds is not a reason
-    when every held score is finite: the five-bar's ``coef_error`` is infinite by definition
-    where the identified row lacks the truth's largest term; it failed a passing cell (marked
-    failed and passed at once) and, after another failure such as "uninformative", counted it
-    a second time (round 27's ``fb27_sine_amp0p014`` at 3 %).  Held non-finite scores are
-    always named.
+    A failed fit or a failed simulation leaves the scores undefined by definition and its own
+    reason says why: listing them again named some 40 scores after "fit failed" and counted the
+    cell a second time ("non-finite scores") in the summary (round 24's
+    ``b24_br_L0p5_w20_t6_s6_z3``, ``ls_sindy`` 1 %), and "diverged" with its NaN TRAC
+    (``beams_stiff__019``, ``__025``).  A score no bar holds is not a reason when every held
+    score is finite: the five-bar's ``coef_error`` is infinite by definition where the
+    identified row lacks the truth's largest term; it failed a passing cell (marked failed and
+    passed at once) and, after another failure such as "uninformative", counted it a second
+    time (round 27's ``fb27_sine_amp0p014`` at 3 %).  Otherwise every non-finite score is
+    named: a held score that is not finite (or missing) with no failure that explains it.
 
     Parameters
     ----------
@@ -427,11 +428,19 @@ def unexplained_nonfinite(values: dict[str, float], held: set[str], fit_failed: 
         The cell's scores by name.
     held : set of str
         The metrics its checks hold.
-    fit_failed : bool
-        Whether its fit failed.
+    failures : dict or set
+        The names of its scored failures (``Scores.failures``: ``"fit"``, ``"simulation"``, ...).
+
+    Returns
+    -------
+    list of str
+        The scores to name after "non-finite scores: ".
     """
+    if "fit" in failures or "simulation" in failures:
+        return []
     bad = sorted(k for k, v in values.items() if not math.isfinite(v))
-    if fit_failed or (held and not held & set(bad)):
+    held_bad = any(not math.isfinite(values.get(m, math.nan)) for m in held)
+    if held and not held_bad:
         return []
     return bad
 
@@ -490,7 +499,7 @@ def _run_cell(cell: Cell, cache_dir: str, plugins: tuple[str, ...], parent: int 
         row.update({k: float(v) for k, v in result.scores.values.items()})
         row["checks"] = json.dumps([{**asdict(c), "passed": c.passed} for c in result.checks])
         bad = unexplained_nonfinite(result.scores.values, {c.metric for c in result.checks},
-                                    "fit" in result.scores.failures)
+                                    result.scores.failures)
         reasons = [result.failure, bad and "non-finite scores: " + ", ".join(bad),
                    not result.scores.values and "no scores"]
         reason = "; ".join(r for r in reasons if r)

@@ -242,3 +242,20 @@ def test_a_builtin_identifiers_own_exception_is_not_relabelled():
         raise RuntimeError("bug")
     with pytest.raises(RuntimeError, match="bug"):
         _called(LeastSquaresSINDy(), "LeastSquaresSINDy.simulate", boom)
+
+
+def test_a_plugins_failed_prediction_is_a_scored_prediction_failure():
+    # review 28a: prediction_r2 took a built-in's LinAlgError as "no R^2" (None) but let a
+    # plugin's, wrapped by _called, end `testbed identify` with no verdict
+    from types import SimpleNamespace
+
+    from testbed.core.errors import PluginMethodError
+    from testbed.scoring.scorers import fitted_model_failures, prediction_r2
+
+    def fails(data):
+        raise PluginMethodError("Mine.predict_acceleration raised LinAlgError: Singular matrix")
+    eye = np.eye(2)
+    model = SimpleNamespace(M_=eye, C_=0.01 * eye, K_=eye, predict_acceleration=fails)
+    r2 = prediction_r2(model, SimpleNamespace(free_start=0, xdd=np.ones((2, 4))))
+    assert np.isnan(r2)
+    assert "not finite" in fitted_model_failures(model, r2)["prediction"]

@@ -159,3 +159,22 @@ def test_an_unpaired_modes_mac_is_named_by_the_frequency_reason_not_hidden():
     # a paired mode's failed MAC is no frequency's: withheld
     s = Scores({**s.values, "mac_mode1": 0.5, "freq_error_mode1": 0.01}, details)
     assert bar_failures(s, bars) == {}
+
+
+def test_a_bar_another_reason_names_does_not_withhold_the_linear_model_reason():
+    # review 28a: mode 2's failed MAC, named "unexcited" (the hammer at 0.001 of its largest
+    # amplitude) or "band" (above the low-pass), withheld the cubic reason for mode 1's
+    # frequency, which nothing then named
+    bars = {"freq_error_mode1": {"max": 0.026}, "freq_error_mode2": {"max": 0.026},
+            "mac_mode1": {"min": 0.9}, "mac_mode2": {"min": 0.9}, "trac": {"min": 0.9}}
+    values = {"K3_norm": 0.0, "freq_error_mode1": 0.05, "freq_error_mode2": 0.01,
+              "mac_mode1": 0.99, "mac_mode2": 0.5, "trac": 0.95}
+    common = {"truth_cubic_share": 0.5, "truth_cubic_reach": np.array([0.10, 0.10]),
+              "freq_error_per_mode": np.array([0.05, 0.01]), "scored_modes": 2,
+              "f_true": np.array([10.0, 60.0])}
+    unexcited = {**common, "force_participation": np.array([1.0, 0.001])}
+    assert sorted(bar_failures(Scores(dict(values), unexcited), bars)) == ["cubic", "unexcited"]
+    band = {**common, "passband": (1.0, 40.0)}
+    assert sorted(bar_failures(Scores(dict(values), band), bars)) == ["band", "cubic"]
+    # a MAC no other reason names still withholds it (the change's own rule)
+    assert sorted(bar_failures(Scores(dict(values), dict(common)), bars)) == []

@@ -599,12 +599,15 @@ def test_an_unheld_infinite_score_is_no_second_reason_after_a_failure():
     from testbed.studies.sweep import unexplained_nonfinite
 
     values = {"angle_rmse": 0.2, "coef_error": float("inf"), "f1": float("nan")}
-    assert unexplained_nonfinite(values, {"angle_rmse"}, fit_failed=False) == []
-    # a held score that is not finite is always named ...
-    assert unexplained_nonfinite({**values, "angle_rmse": float("nan")}, {"angle_rmse"},
-                                 fit_failed=False) == ["angle_rmse", "coef_error", "f1"]
-    # ... unless the fit failed, whose reason says why every score is undefined
-    assert unexplained_nonfinite({**values, "angle_rmse": float("nan")}, {"angle_rmse"},
-                                 fit_failed=True) == []
+    assert unexplained_nonfinite(values, {"angle_rmse"}, {"uninformative"}) == []
+    # a held score that is not finite is named ...
+    nan_held = {**values, "angle_rmse": float("nan")}
+    assert unexplained_nonfinite(nan_held, {"angle_rmse"}, set()) == ["angle_rmse", "coef_error", "f1"]
+    # ... unless the fit or the simulation failed, whose reason says why the scores are
+    # undefined (review 28a: "diverged; non-finite scores: trac" counted a cell twice)
+    assert unexplained_nonfinite(nan_held, {"angle_rmse"}, {"fit"}) == []
+    assert unexplained_nonfinite(nan_held, {"angle_rmse"}, {"simulation": "diverged"}) == []
+    # a held metric with no score at all is not finite either
+    assert unexplained_nonfinite({"coef_error": float("inf")}, {"angle_rmse"}, set()) == ["coef_error"]
     # with no checks at all, non-finite scores are the only thing to say
-    assert unexplained_nonfinite(values, set(), fit_failed=False) == ["coef_error", "f1"]
+    assert unexplained_nonfinite(values, set(), set()) == ["coef_error", "f1"]
