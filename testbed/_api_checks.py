@@ -71,7 +71,7 @@ def _or_path(*types: str) -> Rule:
             raise ArgumentError(where, name, args.describe(v), "expected " + " or ".join(
                 f"a {t}" for t in types) + ", a shipped name or a path (text or os.PathLike)",
                 described=True)
-        return v
+        return args.path(where, name, v)  # a path too long to open, or with a NUL, named here
     return check
 
 
@@ -141,9 +141,7 @@ def _fitted(where: str, name: str, v: Any, r: Resolve) -> Any:
 
 
 def _cache(where: str, name: str, v: Any, r: Resolve) -> Any:
-    if isinstance(v, bool) or isinstance(v, r("DatasetCache")):
-        return v
-    return _path(where, name, _or_path("DatasetCache")(where, name, v, r), r)
+    return v if isinstance(v, bool) else _or_path("DatasetCache")(where, name, v, r)
 
 
 def _plugins(where: str, name: str, v: Any, r: Resolve) -> Any:

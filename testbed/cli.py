@@ -726,6 +726,8 @@ def cmd_run(args: argparse.Namespace) -> int:
             if args.seed is not None:
                 sc = sc.replace(seed=args.seed)
             scenario_folder(args.out, sc.name)  # refused before the work, not after
+            refuse_foreign(Path(args.out) / INDEX, HTML_FILE,
+                           expected="another --out folder, or remove the file")  # likewise
             if figures is not None:  # its frames made while the run computes
                 figures.prepare(args.out, sc.name)
             with run_progress(sc.name) as phase:

@@ -119,7 +119,7 @@ MARKDOWN_FILE: FileKind = ("a markdown report", (b"#",))
 #: the first line of a run's or a study's markdown report (``testbed.reporting.report``): an
 #: HTML comment no renderer shows.  Its title alone (``# Run `` / ``# Study ``, read 27b) let a
 #: user's own ``# Study notes`` be replaced (review 27e M2); a report written before this line
-#: existed is refused once, naming it
+#: existed is still recognised, by :data:`LEGACY_REPORT_MARKDOWN`
 REPORT_MARKDOWN_MARK = "<!-- sysid-testbed report -->"
 #: a report written before the mark: its title and the fixed first paragraph under it (a run's
 #: verdict line, a study's cell count), which no one's notes repeat; it is replaced as before

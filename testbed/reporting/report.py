@@ -121,7 +121,9 @@ class Page:
 
     def png(self, name: str, data: bytes) -> str:
         """Keep the PNG ``data`` to be written as ``name`` beside the report (by :meth:`write`,
-        with the report's other files); return ``name``."""
+        with the report's other files); return ``name``, a plain file name (not a path)."""
+        if Path(name).name != name or name.startswith("."):
+            raise ValueError(f"a figure's name must be a plain file name, not {name!r}")
         self.pngs[name] = data
         return name
 
@@ -218,7 +220,7 @@ class Page:
         # after the score figures were replaced (review 27e M1)
         for path, kind in [*((p, PNG_FILE) for p in pngs), (out, HTML_FILE),
                            (self.out_dir / "report.md", REPORT_MARKDOWN_FILE)]:
-            refuse_foreign(path, kind)
+            refuse_foreign(path, kind, expected="another --output folder, or remove the file")
         for path, data in pngs.items():
             if not _holds(path, data):  # (a run's own figures, reported into its own folder)
                 atomic_write(path, lambda tmp, data=data: Path(tmp).write_bytes(data))

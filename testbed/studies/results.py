@@ -327,8 +327,15 @@ def _check_columns(path: Path, schema: pa.Schema, verified: bool = True) -> None
         if types[name] != want:
             raise ResultsError(f"{path}: column {name!r} holds {types[name]}; expected {want}")
     for name, typ in types.items():
-        if name not in BASE_COLUMNS and name not in TAIL_COLUMNS and typ != pa.float64():
+        if name in BASE_COLUMNS or name in TAIL_COLUMNS:
+            continue
+        if typ != pa.float64():
             raise ResultsError(f"{path}: score column {name!r} holds {typ}; expected double")
+        if not name or name.startswith(".") or any(c in name for c in "/\\\0"):
+            # a score names its figure (`report`'s score_<name>.png): "x/../../y" wrote outside
+            # the -o folder (review 28b)
+            raise ResultsError(f"{path}: score column {name!r}; expected a name without a path "
+                               "separator or a leading '.'")
 
 
 def _row_problem(row: dict[str, Any], seen: set[str]) -> str:

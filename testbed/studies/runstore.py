@@ -67,7 +67,14 @@ try:
 except ImportError:  # Windows
     fcntl = None  # type: ignore[assignment]
 
-from testbed.core.atomic import atomic_write_text, begin_in_flight, end_in_flight, no_room
+from testbed.core.atomic import (
+    HTML_FILE,
+    atomic_write_text,
+    begin_in_flight,
+    end_in_flight,
+    no_room,
+    refuse_foreign,
+)
 from testbed.core.errors import TestbedError, is_control
 from testbed.core.provenance import git_commit, versions
 from testbed.core.run_arrays import RUN_ARRAY_KINDS, check_run_npz
@@ -549,6 +556,8 @@ def save_new_run(result: Any, out_dir: str | os.PathLike,
         If the scenario's name is not a plain folder name, or its folder is not a folder.
     """
     out = Path(out_dir)
+    if index is not None:  # a user's own page of that name was replaced (review 28b)
+        refuse_foreign(out / INDEX, HTML_FILE, expected="another --out folder, or remove the file")
     folder = scenario_folder(out, result.scenario.name)
     folder.mkdir(parents=True, exist_ok=True)
     tmp, meta = _write_temporary(result, folder, "run", figures)

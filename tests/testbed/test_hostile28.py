@@ -259,3 +259,22 @@ def test_a_plugins_failed_prediction_is_a_scored_prediction_failure():
     r2 = prediction_r2(model, SimpleNamespace(free_start=0, xdd=np.ones((2, 4))))
     assert np.isnan(r2)
     assert "not finite" in fitted_model_failures(model, r2)["prediction"]
+
+
+def test_a_score_column_that_is_a_path_is_refused_on_read(tmp_path):
+    # review 28b: a score column "x/../../../escaped" made `testbed report` write its figure
+    # outside the -o folder (score_<name>.png)
+    from benchmarks._hostile import results_row
+    from testbed.reporting.report import Page
+    from testbed.studies.results import ResultsError, read_results, write_rows
+
+    row = results_row()
+    row["x/../../../escaped"] = 1.5
+    try:
+        path = write_rows(tmp_path / "r.parquet", [row], study="s")
+    except ResultsError:
+        return  # refused on write: nothing to read
+    with pytest.raises(ResultsError, match="expected a name without a path separator"):
+        read_results(path)
+    with pytest.raises(ValueError, match="plain file name"):
+        Page("t", tmp_path).png("score_x/../../escaped.png", b"")

@@ -299,3 +299,19 @@ def test_a_run_json_edited_to_pass_over_a_nan_is_listed_as_failed(structural, tm
         (row,) = list_runs(tmp_path)
         assert row["verdict"] == expected and row["checks"][0]["passed"] == (expected == "pass")
         assert load_run(path).passed == (expected == "pass")
+
+
+def test_a_users_own_index_page_is_refused_before_any_run_is_written(structural, tmp_path):
+    # review 28b: `testbed run --out D` replaced a user's own D/index.html with the runs index
+    from testbed.core.errors import InputError
+
+    (tmp_path / "index.html").write_text("<p>my own site</p>\n")
+    with pytest.raises(InputError, match=r"index\.html: exists and is not an HTML report"):
+        save_new_run(structural, tmp_path, index=runs_index_html)
+    assert (tmp_path / "index.html").read_text() == "<p>my own site</p>\n"
+    assert not (tmp_path / structural.scenario.name).exists()
+    # its own earlier index is replaced as before
+    (tmp_path / "index.html").unlink()
+    save_new_run(structural, tmp_path, index=runs_index_html)
+    save_new_run(structural, tmp_path, index=runs_index_html)
+    assert len(list_runs(tmp_path)) == 2
