@@ -753,15 +753,13 @@ def _start(st: _Server, conn: socket.socket, request: dict, fds: list[int]) -> N
     with contextlib.suppress(OSError):
         os.setpgid(pid, pid)  # (also done by the child: whichever runs first)
     st.running[pid] = conn
+    st.log(f"testbed server: {' '.join(request['argv'])} (pid {pid})")
     try:
         _send(conn, {"pid": pid})
     except OSError:  # the client went away meanwhile (killed, Ctrl-C): so does its command
         with contextlib.suppress(ProcessLookupError):
             os.killpg(pid, signal.SIGKILL)
         return
-    # logged once the client has its pid (in its socket's buffer): a server killed on seeing
-    # this line left a client without it, which then ran the command alone (speed29)
-    st.log(f"testbed server: {' '.join(request['argv'])} (pid {pid})")
     st.sel.register(conn, selectors.EVENT_READ, ("running", pid))
 
 
