@@ -176,7 +176,7 @@ from identify.library import Library, fivebar_library, generic_mechanical_librar
 from testbed.core.errors import IdentificationError
 from testbed.core.measurement import Measurement, Trajectory
 from testbed.core.schema import ErrorFn, Field, KeyUse
-from testbed.numerics.derivatives import CLEAN_DROOP, CUTOFF_GAIN, harmonic_gain, noise_weight, relative_noise
+from testbed.numerics.derivatives import CUTOFF_GAIN, harmonic_gain, noise_weight, relative_noise
 from testbed.numerics.filters import cutoff_problem, lowpass, mismatch_cutoff
 from testbed.numerics.gram import normalized_gram, ordered_independent
 from testbed.numerics.noise import noise_std, signal_band
@@ -194,8 +194,9 @@ def rollout_atol(noise_rel: float) -> float:
     The rollouts are compared with the chain's smoothed angles, whose own error scales with
     the chain's droop at the second harmonic (:func:`testbed.numerics.derivatives.harmonic_gain`
     of the relative noise): ``ROLLOUT_ATOL`` at the noisy rule's ``1 - CUTOFF_GAIN`` (1 %),
-    narrowed in proportion to the droop below it: on clean angles (droop ``CLEAN_DROOP`` 1e-5)
-    1e-7 rad, the order of the simulator's own step error (6e-7 rad at 1 ms on the five-bar);
+    narrowed in proportion to the droop below it: on clean angles (droop ``CLEAN_DROOP`` 1e-12)
+    1e-14 rad, so the relative tie (``selection_rtol``, 10 %) alone decides there (1e-7 rad
+    at session 27's droop 1e-5, the order of the simulator's step error, 6e-7 rad at 1 ms);
     exactly ``ROLLOUT_ATOL`` from ``NOISY_NOISE_REL`` up.  With 1e-4 rad on clean records the
     band was as wide as the clean bar, and a sparser combination 10-100x worse in rollout won the
     tie (round 20's short-crank multisine: 2.7e-5 against 1.0e-6 rad on the record).
@@ -783,17 +784,16 @@ RIDGE_PER_NOISE_VAR = 0.012
 #: the input terms or diverged (13/30 within 0.0501 rad before).
 CHAIN_REL_FLOOR = 0.01
 #: Clean angles under a declared low-pass chain (relative noise below
-#: ``testbed.numerics.derivatives.NOISY_NOISE_REL``): the chain then raised its cut-off to pass
-#: the second harmonic with the clean droop (``CLEAN_DROOP``, 1.54 x the noisy rule's cut-off at
-#: order 8), and the columns are filtered where the column low-pass (order ``n``) takes this many
-#: decades off the power ratio at the chain's cut-off: zero-phase gain ``1 / (1 + 10^D)`` there,
-#: so a column cut-off ``f_chain / 10^(D / (2 n))`` (order 4: 0.750 x the chain's).  The
-#: products the columns form of the chain's transition band (its gain 1/2 at its cut-off, each
-#: column distorted differently) are cut tenfold; the band below, which every column holds
-#: alike, passes.  Session 26 (pi29) measured hand-set fractions of the chain's cut-off 0.5 /
-#: 0.7 / 0.75 / 0.8 / 1.0 (x the 1.6 x raised chain): 1 / 4 / 4 / 3 / 1 of its five clean records
-#: within 1e-4 rad; the clean ridge is ``RIDGE_EXACT`` (there 1e-14 / 1.2e-10 / 1.2e-8 /
-#: 1.2e-6: 4 / 2 / 1 / 0 of 5).  Between clean and noisy both move geometrically with
+#: ``testbed.numerics.derivatives.NOISY_NOISE_REL``): the chain then raised its cut-off to pass the second
+#: harmonic with the clean droop (``CLEAN_DROOP``, 4.22 x the noisy rule's cut-off at order 8; 1.54 x before
+#: session 29), and the columns are filtered where the column low-pass (order ``n``) takes this many decades
+#: off the power ratio at the chain's cut-off: zero-phase gain ``1 / (1 + 10^D)`` there, so a column cut-off
+#: ``f_chain / 10^(D / (2 n))`` (order 4: 0.750 x the chain's).  The products the columns form of the chain's
+#: transition band (its gain 1/2 at its cut-off, each column distorted differently) are cut tenfold; the band
+#: below, which every column holds alike, passes.  Session 26 (pi29) measured hand-set fractions of the
+#: chain's cut-off 0.5 / 0.7 / 0.75 / 0.8 / 1.0 (x the 1.6 x raised chain): 1 / 4 / 4 / 3 / 1 of its five
+#: clean records within 1e-4 rad; the clean ridge is ``RIDGE_EXACT`` (there 1e-14 / 1.2e-10 / 1.2e-8 / 1.2e-6:
+#: 4 / 2 / 1 / 0 of 5).  Between clean and noisy both move geometrically with
 #: ``testbed.numerics.derivatives.noise_weight``.
 CLEAN_COLUMN_DECADES = 1.0
 
@@ -811,11 +811,14 @@ def chain_column_cutoff(chain_cutoff_hz: float, column_order: int) -> float:
 #: more below its cut-off than this reads.
 CHAIN_ORDER = 8
 #: Largest share of the inputs' column-filtered power that may be the chain's mismatch
-#: (:func:`testbed.numerics.filters.chain_mismatch_share`) on clean angles: the square of the
-#: clean droop (``CLEAN_DROOP``, 1e-5 in amplitude), the error the clean chain is allowed on
-#: the motion's second harmonic, so that the input columns carry no more of the chain's
-#: transition band than the derived columns do.
-INPUT_MISMATCH_SHARE = CLEAN_DROOP**2
+#: (:func:`testbed.numerics.filters.chain_mismatch_share`) on clean angles: 1e-10, the square
+#: of the clean droop of session 27 (1e-5 in amplitude, the error the clean chain was then
+#: allowed on the motion's second harmonic).  Kept when the droop fell to 1e-12 (session 29,
+#: pi33): the square of that, 1e-24, lies far below the shares read on five-bar multisines
+#: (3.5e-14 - 3.4e-12, near the Blackman-Harris periodogram's leakage), so it would hold most
+#: clean column cut-offs at their ``1.5 x band`` floor (not measured); the droop's gate was
+#: measured with 1e-10.
+INPUT_MISMATCH_SHARE = 1e-10
 
 
 def input_column_cutoff(inputs: np.ndarray | None, fs: float, chain_cutoff_hz: float,
