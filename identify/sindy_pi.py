@@ -786,7 +786,7 @@ CHAIN_REL_FLOOR = 0.01
 #: Clean angles under a declared low-pass chain (relative noise below
 #: ``testbed.numerics.derivatives.NOISY_NOISE_REL``): the chain then raised its cut-off to pass the second
 #: harmonic with the clean droop (``CLEAN_DROOP``, 4.22 x the noisy rule's cut-off at order 8; 1.54 x before
-#: session 29), and the columns are filtered where the column low-pass (order ``n``) takes this many decades
+#: session 28), and the columns are filtered where the column low-pass (order ``n``) takes this many decades
 #: off the power ratio at the chain's cut-off: zero-phase gain ``1 / (1 + 10^D)`` there, so a column cut-off
 #: ``f_chain / 10^(D / (2 n))`` (order 4: 0.750 x the chain's).  The products the columns form of the chain's
 #: transition band (its gain 1/2 at its cut-off, each column distorted differently) are cut tenfold; the band
@@ -813,7 +813,7 @@ CHAIN_ORDER = 8
 #: Largest share of the inputs' column-filtered power that may be the chain's mismatch
 #: (:func:`testbed.numerics.filters.chain_mismatch_share`) on clean angles: 1e-10, the square
 #: of the clean droop of session 27 (1e-5 in amplitude, the error the clean chain was then
-#: allowed on the motion's second harmonic).  Kept when the droop fell to 1e-12 (session 29,
+#: allowed on the motion's second harmonic).  Kept when the droop fell to 1e-12 (session 28,
 #: pi33): the square of that, 1e-24, lies far below the shares read on five-bar multisines
 #: (3.5e-14 - 3.4e-12, near the Blackman-Harris periodogram's leakage), so it would hold most
 #: clean column cut-offs at their ``1.5 x band`` floor (not measured); the droop's gate was

@@ -305,7 +305,7 @@ CUTOFF_GAIN = 0.99
 #: perturbed by 1e-5 simulate 7e-7 - 3.6e-5 rad off), so the droop must lie far below 1e-5.
 #: 1e-12: order 8, the cut-off
 #: ``(1e-2 / 1e-12)^(1/16) = 4.22`` x the noisy rule's (on a 1.2 Hz band 13.5 Hz at 10 kHz,
-#: far below ``AUTO_CUTOFF_MAX_SHARE fs``).  Measured (session 29, pi33, SINDy-PI's clean
+#: far below ``AUTO_CUTOFF_MAX_SHARE fs``).  Measured (session 28, pi33, SINDy-PI's clean
 #: chain-derived five-bars, angle RMSE within 1e-4 rad): the 30 held-out members of
 #: ``benchmarks/heldout/fivebar_noise_validation.toml`` 19 at 1e-5 (session 27's value, 1.54 x),
 #: 22 at 1e-6 (pi32), 28 / 29 / 30 / 29 at 1e-8 / 1e-10 / 1e-12 / 1e-14; every droop from 1e-8
@@ -321,7 +321,7 @@ CLEAN_DROOP = 1e-12
 #: a record in 1e-12 - 1e-5 passes its noise up to 4.22 x the 99 % cut-off (accelerations'
 #: noise ``~ fc^2.5``), what an 18-20-bit encoder would see: on 15 five-bars and cart-poles at
 #: relative noise 1e-6 / 1e-5, within 1e-4 rad 11 -> 14 / 6 -> 8 against droop 1e-5, one lost at
-#: 1e-5 (``cp23_L0p8`` 1.5e-5 -> 1.2e-4 rad; docs/known-gaps.md, session 29).
+#: 1e-5 (``cp23_L0p8`` 1.5e-5 -> 1.2e-4 rad; docs/known-gaps.md, session 28).
 CLEAN_NOISE_REL = 1e-5
 #: Relative noise from which the droop is ``1 - CUTOFF_GAIN`` unchanged (the rule measured on
 #: 0.5-5 % noise): a tenth of the 1 % noise asked of the identifiers, which keeps the estimate

@@ -803,8 +803,8 @@ def auto_cutoff(theta: np.ndarray, fs: float, order: int, noise: np.ndarray | No
     ``2 B`` (the linkage's second harmonics) with the zero-phase gain
     :func:`testbed.numerics.derivatives.harmonic_gain` of the angles' relative noise
     (:func:`testbed.numerics.derivatives.relative_noise` of ``noise``): 99 % from 0.1 %
-    noise up, ``1 - 1e-5`` on clean angles (``CLEAN_DROOP``; order 8: 1.54 x the 99 %
-    cut-off), geometric in the droop between, so continuous in the noise
+    noise up, ``1 - 1e-12`` on clean angles (``CLEAN_DROOP``; order 8: 4.22 x the 99 %
+    cut-off; 1e-5 and 1.54 x before session 28), geometric in the droop between, so continuous in the noise
     (:func:`testbed.numerics.derivatives.harmonic_cutoff`), at most ``AUTO_CUTOFF_MAX_SHARE
     fs``.  Five-bar multisine (band 1.5 Hz), order 8, 1 % noise: 4.0 Hz, the hand-found value.
 
