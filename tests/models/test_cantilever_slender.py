@@ -198,7 +198,8 @@ def test_no_family_draw_is_refused_for_its_slenderness(path, monkeypatch):
     for fam in beams:
         for k in range(fam.members):
             assert (fam.name, k) in refused, (fam.name, k)  # each member was drawn
-            assert not [r for r in refused[fam.name, k] if "slender" in r or "not a plate" in r], (fam.name, k)
+            shape = [r for r in refused[fam.name, k] if "slender" in r or "not a plate" in r]
+            assert not shape, (fam.name, k)
 
 
 @pytest.mark.parametrize(("rig", "what"), [({"thickness": 0.036}, "thickness"),

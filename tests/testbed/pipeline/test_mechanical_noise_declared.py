@@ -238,8 +238,9 @@ def test_auto_cutoff_on_the_down_branch_multisine_near_clean(dataset_cache):
 
 def test_auto_cutoff_passes_the_clean_harmonic_with_the_clean_droop():
     """Clean angles: the cut-off passes twice the band with droop ``CLEAN_DROOP`` (order 8:
-    4.22 x the 99 % cut-off of the same band; 1.54 with session 27's droop 1e-5); from ``NOISY_NOISE_REL`` of declared noise up it
-    is the 99 % rule's bit for bit; between, it falls monotonically with the declared level."""
+    4.22 x the 99 % cut-off of the same band; 1.54 with session 27's droop 1e-5); from
+    ``NOISY_NOISE_REL`` of declared noise up it is the 99 % rule's bit for bit; between, it
+    falls monotonically with the declared level."""
     ds = dataset(0.0)
     th = ds.measured["theta"].data
     std = th.std(axis=1)
