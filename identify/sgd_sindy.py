@@ -1772,7 +1772,7 @@ class SGDSINDy(SGDSINDyBase):
         elif est.cubic:
             self.cubic_direction_rule_ = "diagonal: the n features x_j^3 (full K3)"
         (M, C, K, K3, B), self.mass_scaling_rule_ = driving_point_scaling(
-            out.M, out.C, out.K, out.K3, out.input_map, data.input_map)
+            out.M, out.C, out.K, out.K3, out.input_map, data.input_map, data)
         self.input_map_rule_ = "fitted on the window (the force's tail)"
         if M is out.M and out.input_map_record is not None:
             # The window holds only the chain-filtered tail of an impact (0.7-1.2 % of its
@@ -1784,7 +1784,7 @@ class SGDSINDy(SGDSINDyBase):
             # free_start; 016's record gain is refused too and it keeps 0.910; beams family
             # clamped 36 -> 37/40 on the issue's bars, none lost).
             (M2, C2, K2, K32, B2), rule2 = driving_point_scaling(
-                out.M, out.C, out.K, out.K3, out.input_map_record, data.input_map)
+                out.M, out.C, out.K, out.K3, out.input_map_record, data.input_map, data)
             if M2 is not out.M:
                 self.input_map_rule_ = ("fitted on the record to the window's end (the impact "
                                         f"pulse): the window's was refused ({self.mass_scaling_rule_})")
