@@ -172,7 +172,8 @@ def foreign_head(path: Path, kind: FileKind) -> bytes | None:
         return None
     finally:
         os.close(fd)
-    binary = not kind[1][0].isascii()  # a binary format's signature (HDF5, PNG) opens with 0x89
+    # a binary format's signature (HDF5, PNG) opens with 0x89; a pattern is a text kind's
+    binary = any(isinstance(p, bytes) and not p.isascii() for p in kind[1])
     text = head if binary else head.removeprefix(b"\xef\xbb\xbf").lstrip()
     ours = any(text.startswith(p) if isinstance(p, bytes) else p.match(text) for p in kind[1])
     return head[:64] if head and not ours else None
