@@ -864,7 +864,7 @@ def input_column_cutoff(inputs: np.ndarray | None, fs: float, chain_cutoff_hz: f
 
 #: The rule text of :meth:`SINDyPI.fit`'s refit towards the noisy rule's settings (followed by
 #: the weight that fitted).
-NOISY_REFIT_TEXT = "the clean recipe's fit failed: fitted again with the noisy rule's weight at least"
+NOISY_REFIT_TEXT = "the clean recipe's fit failed: fitted again at the noisy rule's weight"
 #: The noisy rule's weights :meth:`SINDyPI.fit` tries, in order, where the clean recipe's fit
 #: (weight below 1) failed: quarters of the way to the noisy rule, so that the refit keeps the
 #: nearest recipe to the clean one that fits (ridge, column cut-off and trim geometric in the
@@ -2152,7 +2152,7 @@ class SINDyPI(_ImplicitMechanical):
     def fit(self, data: Measurement) -> SINDyPI:
         """Fit (see the class docs and :meth:`_fit_recipe`); where the fit under a declared
         chain's clean recipe (the noise rule's weight ``w`` below 1, :func:`noise_knobs`) fails,
-        it is done again with the noisy rule's weight at least each of ``REFIT_WEIGHTS`` above
+        it is done again at each of the noisy rule's weights ``REFIT_WEIGHTS`` above
         ``w`` in turn (0.25, 0.5, 0.75, 1: ridge, column cut-off and trim a quarter, half, ...
         of the way, geometrically, to the noisy rule's under the same chain, the tie band still
         the chain's), the first that fits kept and named in the rule text; if every one fails,
@@ -2191,8 +2191,9 @@ class SINDyPI(_ImplicitMechanical):
                     return self._fit_recipe(data)
                 except IdentificationError as exc:
                     last = exc
-            raise IdentificationError(f"{first} ({NOISY_REFIT_TEXT} {clean_w:.3g}, up to 1: "
-                                      f"{last})") from None
+            tried = ", ".join(f"{w:.3g}" for w in REFIT_WEIGHTS if w > clean_w)
+            raise IdentificationError(f"{first} (the clean recipe's fit failed and so did the "
+                                      f"noisy rule's weights {tried}; the last: {last})") from None
         finally:
             self._refit_weight = 0.0
 

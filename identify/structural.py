@@ -416,7 +416,7 @@ def free_decay_gain(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndarr
         return None
     period = 2 * np.pi / np.sqrt(w2[w2 > 0].min())
     i0 = int(data.free_start)
-    i1 = min(data.n_samples, i0 + int(round(FREE_GAIN_PERIODS * period * data.fs)))
+    i1 = min(data.n_samples, i0 + round(FREE_GAIN_PERIODS * period * data.fs))
     if i1 - i0 < n:
         return None
     t = np.arange(i1) / data.fs

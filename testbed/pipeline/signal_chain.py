@@ -111,7 +111,7 @@ MECHANICAL_SIGNAL_SCHEMA: dict[str, Field] = {
                            "Butterworth; just above the band of the motion (noise in the "
                            "acceleration grows as cutoff^2.5); 'auto': the lowest that passes "
                            "twice the angles' 99.9 % band with 99 % amplitude on noisy angles, "
-                           "1 - 1e-5 on clean ones, continuous between (see auto_cutoff)"),
+                           "1 - 1e-12 on clean ones, continuous between (see auto_cutoff)"),
     "filter_order": Field(int, 8, min=1, max=16,
                           doc="'lowpass': Butterworth order of one pass"),
     "edge_fit_s": Field(float, "auto", unit="s", min=0.0, min_inclusive=False,

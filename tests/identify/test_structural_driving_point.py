@@ -29,8 +29,8 @@ DECLARED = np.array([[0.0], [0.0], [1.0]])   # the force at sensor 3
 def _record(fs: float = FS, K3: np.ndarray | None = None) -> Measurement:
     """The exact response to a 2 ms pulse from rest, plus a feedthrough during the pulse
     (with ``K3``: the cubic model's RK4 response)."""
-    pulse = int(round(PULSE * fs / FS))
-    n = int(round(0.5 * fs))
+    pulse = round(PULSE * fs / FS)
+    n = round(0.5 * fs)
     t = np.arange(n) / fs
     u = np.zeros((1, n))
     u[0, 1:pulse + 1] = 40.0 * np.sin(np.pi * np.arange(1, pulse + 1) / (pulse + 1))
