@@ -1300,12 +1300,15 @@ def cubic_mode_reach(Mr: np.ndarray, Kr: np.ndarray, k3: float, cubic_map: np.nd
     truth alone.
 
     Derivation.  The truth is ``Mr x'' + Cr x' + Kr x + d k3 (c . x)^3 = f``; its tangent
-    stiffness at a state ``x`` is ``Kt = Kr + 3 k3 (c . x)^2 d c^T``.  For a true mode ``phi_j``
-    (``Kr phi_j = w_j^2 Mr phi_j``, ``phi_j^T Mr phi_j = 1``) the Rayleigh quotient of ``Kt``
-    is ``w_j^2 + 3 k3 (c . x)^2 (phi_j . d)(c . phi_j)``, so a linear stiffness standing in for
-    the record lies, in that mode, between ``Kr`` and the tangent at the record's largest
-    ``(c . x)^2``: the tangent shift ``sqrt(1 + s_j) - 1`` with ``s_j = 3 k3 max_t (c . x)^2
-    (phi_j . d)(c . phi_j) / w_j^2`` (first order), and the tangent's own eigenvalues (a rank-one
+    stiffness at a state ``x`` is ``Kt = Kr + 3 k3 (c . x)^2 d c^T``.  ``d`` adds to the
+    Galerkin map ``c`` the truncated modes' static response, right for the slow cubic force but
+    not at a mode's own frequency, where it cancels (``phi_j^T (Kr - w_j^2 Mr) = 0``): the
+    tangent is taken with ``c c^T``, the full model's.  For a true mode ``phi_j`` (``Kr phi_j =
+    w_j^2 Mr phi_j``, ``phi_j^T Mr phi_j = 1``) its Rayleigh quotient is ``w_j^2 + 3 k3 (c .
+    x)^2 (c . phi_j)^2``, so a linear stiffness standing in for the record lies, in that mode,
+    between ``Kr`` and the tangent at the record's largest ``(c . x)^2``: the tangent shift
+    ``sqrt(1 + s_j) - 1`` with ``s_j = 3 k3 max_t (c . x)^2 (c . phi_j)^2 / w_j^2`` (first
+    order), and the tangent's own eigenvalues (a rank-one
     update moves the top mode more than its Rayleigh quotient: review 26e).  A mode is not
     alone: the cubic force driven by the other modes projects on mode ``j`` too, and a
     least-squares linear stand-in of the whole record, fitted on every coordinate as the
@@ -1347,12 +1350,17 @@ def cubic_mode_reach(Mr: np.ndarray, Kr: np.ndarray, k3: float, cubic_map: np.nd
         return np.full(w2.shape, np.nan)  # no reach: the reason is withheld (review 26e)
     q0 = c @ x
     q2 = float(np.max(q0**2, initial=0.0))  # the record's largest (c . x)^2
-    s = 3.0 * k3 * q2 * (phi.T @ dvec) * (phi.T @ c) / w2
+    # at a mode's own frequency the tangent acts through the Galerkin map c (the backbone of
+    # the full model, (phi_j . c)^2): the truncated modes' static response d - c carries to
+    # mode j as (w_g / w_j)^2 of it and cancels at w_j (phi_j^T (Kr - w_j^2 Mr) = 0; review
+    # 28c: d there moved mode 3's reach 0.0226 -> 0.0167 on the shipped soft base); d stays
+    # the force of the slow record in the least-squares stand-in below
+    s = 3.0 * k3 * q2 * (phi.T @ c) ** 2 / w2
     # the tangent's own eigenvalues (review 26e: the Rayleigh quotient is first order; a
     # rank-one update moves the top mode more) and the least-squares linear stand-in of the
     # whole record on every coordinate, as the identifiers fit K (review 26e: mode by mode it
     # counted the force another mode drives as this mode's stiffness)
-    tangent = Kr + 3.0 * k3 * q2 * np.outer(dvec, c)
+    tangent = Kr + 3.0 * k3 * q2 * np.outer(c, c)
     if force is None:  # the cubic force in sensor coordinates (m, N)
         force = np.outer(dvec, k3 * q0**3)
     with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
