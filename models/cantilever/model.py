@@ -116,7 +116,9 @@ class CantileverModel:
         The full equations carry the base's moment ``k3 theta^3`` on the root joint
         (``theta = e0 . q``): ``M q'' + C q' + K q + e0 k3 theta^3 = j_hit F``.  In modal terms
         ``q = Phi_m eta + Phi_t eta_t``; the cubic moment varies at the kept modes'
-        frequencies (and their sums), slowly against the truncated modes, so these follow it
+        frequencies (and their sums), slowly against the truncated modes (and against the
+        kept modes the added load mostly lands on: the highest, see
+        :func:`~models.cantilever.truth.truncated_static_load`), so these follow it
         statically, ``Phi_t eta_t = -R e0 g`` with ``g = k3 theta^3`` and ``R`` the
         :func:`~models.cantilever.truth.residual_flexibility` beyond the ``m`` sensed modes.
         The sensors read ``u = Pa eta + s``, ``s = -Js R e0 g``.  The kept modes obey
