@@ -1235,8 +1235,8 @@ def decay_hold(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndarray,
         explained = backbone_shift(M, K, K3, dec) >= BACKBONE_SHARE * dec.chirp
         unexplained = on & ~explained
         on &= ~unexplained
-        # a limit the record does not reach is not read (BACKBONE_MIN_FALL); NaN (not taken)
-        # compares False
+        # a limit the record does not reach is not read (BACKBONE_MIN_FALL); a NaN decay (not
+        # taken) counts as unreached, and is off already (``on`` lies within the taken ones)
         unread = on & ~limit_reached(dec.sigma, (i1 - i0) / float(data.fs))
         on &= ~unread
         # what the peak offset alone would move: kept, and said so in the rule

@@ -103,18 +103,13 @@ def _die_with_parent(parent: int) -> None:
 
 def _warm_up() -> None:
     """Import what drawing needs and draw one small figure (fonts, text layout, PNG encoder)."""
-    import io
-
-    import matplotlib as mpl
-
     fig = figs._fig(1.0, 2.0)
     ax = figs._axes(fig)[0, 0]
     ax.plot([0.0, 1.0], [0.0, 1.0])
     ax.set(title="warm-up", xlabel="x [-]")
     # into memory: saved to os.devnull through the atomic write, the PNG replaced /dev/null
     # itself with a regular file when run as root (round 13)
-    with mpl.rc_context(figs.STYLE):
-        fig.savefig(io.BytesIO(), format="png", pil_kwargs={"compress_level": figs.PNG_COMPRESS_LEVEL})
+    figs.png_bytes(fig)
 
 
 def prepare_frames(folder: str | os.PathLike) -> int:
