@@ -310,7 +310,10 @@ class LeastSquaresSINDy(StructuralIdentifier):
        validation draws' 24 such cells: issue bars 15 -> 16, study bars 22 -> 21
        (``soft_v21__008`` at 1 %, TRAC 0.945 -> 0.8998, its record agreement 0.940 -> 0.899
        inside the margin; failing issue #15's bars either way) (docs/known-gaps.md, "Mode 1
-       at its backbone limit").
+       at its backbone limit").  The pairing and the scale-0 rule (2026-11-29, branch
+       ``beam34``) on the 62 cells where it had acted: issue bars 32 -> 32, study bars 55 -> 55;
+       keeping only moves whose agreement does not fall would lose 2 issue and 3 study bars
+       for ``soft_v21__008``'s one (docs/known-gaps.md, "step 4c, review 28c").
 
     5. *Unresolved modes placed* (linear library, ``fit_tilt`` by rule; only where the model
        would be refused: tilted, held and flat all grow): in the tilted fit, a mode whose
