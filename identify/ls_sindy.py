@@ -276,8 +276,13 @@ class LeastSquaresSINDy(StructuralIdentifier):
        on 17, issue bars 46 -> 47 (``soft_v22__013`` clean, mode 1 7.32 -> 0.82 %), none lost.
 
     4c. *Mode 1 at its backbone limit, its hardening carried by a cubic sized by output error*
-       (``cubic=None`` only; :meth:`_backbone_cubic`): where a linear model stands after steps
-       4 and 4b while the lowest mode's backbone decay fit chirps up by more than
+       (``cubic=None`` only; :meth:`_backbone_cubic`; numbered by what it acts on, it runs
+       last of the fit's steps: after step 5 and the fit band's refusal
+       (:func:`identify._band_refusal.fit_with_band_refusal`) have settled the linear model,
+       before the input term's step 6): where a linear model stands after steps 4 and 4b
+       while the lowest mode a measured peak locates (the eigenvalue hold's pairing, within
+       :data:`~identify.structural.MODE_SEPARATION`) has a backbone decay fit that chirps up
+       by more than
        :data:`identify._cubic_rule.CUBIC_CHIRP_MIN` and puts its linear limit under the
        model's frequency, that mode is moved to the limit and given a cubic on its own
        equation (:func:`identify._cubic_form.one_mode_cubic`: the Duffing ``g q_k^3`` in its
@@ -285,7 +290,10 @@ class LeastSquaresSINDy(StructuralIdentifier):
        harmonic balance at the record's modal amplitude chosen to maximise the record
        agreement (the model's simulation from the record's start against the measured
        accelerations, :func:`identify._record.best_scale`); kept unless the linear model
-       explains clearly more of the record (the margin :data:`CUBIC_TRIAL_RATIO`).  Why: the
+       explains clearly more of the record (the margin :data:`CUBIC_TRIAL_RATIO`), and at
+       scale 0 (no cubic: a bare move of the frequency) only where the moved model explains
+       clearly more (review 28c: round 24's ``b24_ti_..._f100`` clean, 0.8847 -> 0.8726, had
+       been kept).  Why: the
        linear model hears the amplitude-averaged, hardened frequency (soft member 004 clean
        +1.54 %), and neither the equation error's cubic (refused there) nor one sized from the
        chirp (fam11: TRAC collapsed) carries the record's hardening; the output error sizes it
@@ -302,7 +310,10 @@ class LeastSquaresSINDy(StructuralIdentifier):
        validation draws' 24 such cells: issue bars 15 -> 16, study bars 22 -> 21
        (``soft_v21__008`` at 1 %, TRAC 0.945 -> 0.8998, its record agreement 0.940 -> 0.899
        inside the margin; failing issue #15's bars either way) (docs/known-gaps.md, "Mode 1
-       at its backbone limit").
+       at its backbone limit").  The pairing and the scale-0 rule (2026-11-29, branch
+       ``beam34``) on the 62 cells where it had acted: issue bars 32 -> 32, study bars 55 -> 55;
+       keeping only moves whose agreement does not fall would lose 2 issue and 3 study bars
+       for ``soft_v21__008``'s one (docs/known-gaps.md, "step 4c, review 28c").
 
     5. *Unresolved modes placed* (linear library, ``fit_tilt`` by rule; only where the model
        would be refused: tilted, held and flat all grow): in the tilted fit, a mode whose
@@ -753,7 +764,8 @@ class LeastSquaresSINDy(StructuralIdentifier):
 
     def _backbone_cubic(self, data: Measurement, peaks: np.ndarray, m_hat: float) -> None:
         """Step 4c of the class docstring (:func:`identify._structural_backbone.backbone_cubic`):
-        on the linear model the cubic rule chose (``cubic`` None, after steps 4 and 4b), with
+        on the linear model the cubic rule chose (``cubic`` None, after steps 4, 4b and 5 and
+        the fit band's refusal: it runs on the model :func:`fit_with_band_refusal` settled), with
         the decay hold's backbone fit on (``decay_hold``, ``decay_backbone``), the lowest mode
         moved to its read backbone limit with a cubic on that mode alone sized by output error,
         where the record calls for it.  ``coef_``'s displacement block follows ``K_``; the cubic
@@ -765,7 +777,8 @@ class LeastSquaresSINDy(StructuralIdentifier):
         if not (self.decay_hold and self.decay_backbone):
             self.backbone_cubic_rule_ = "not tried (decay_hold and decay_backbone needed)"
             return
-        K, K3, self.backbone_cubic_rule_ = backbone_cubic(self, data, peaks, CUBIC_TRIAL_RATIO)
+        K, K3, self.backbone_cubic_rule_ = backbone_cubic(self, data, self._held_peaks(data, peaks),
+                                                          CUBIC_TRIAL_RATIO)
         if K is None:
             return
         self._set_stiffness(K, np.full((self.M_.shape[0], 1), m_hat / self.M_.shape[0]),
@@ -1103,15 +1116,20 @@ class LeastSquaresSINDy(StructuralIdentifier):
         """The eigenvalue targets [rad^2/s^2] the accepted ``peaks`` [Hz] give the current linear
         model's modes (:func:`identify._sgd_matrix.eigen_targets`; 0 where a mode is paired with
         no peak), the peaks warped as a trapezoid-integrated record's are."""
-        f = warp_frequency(peaks, float(data.fs)) if data.integration == "trapezoid" else peaks
-        return eigen_targets(self.M_, self.K_, (2.0 * np.pi * f) ** 2)
+        return eigen_targets(self.M_, self.K_, (2.0 * np.pi * self._held_peaks(data, peaks)) ** 2)
+
+    @staticmethod
+    def _held_peaks(data: Measurement, peaks: np.ndarray) -> np.ndarray:
+        """The accepted ``peaks`` [Hz] in the fit's domain, as the eigenvalue hold pairs them:
+        warped (:func:`warp_frequency`) for a trapezoid-integrated record, else as measured."""
+        return warp_frequency(peaks, float(data.fs)) if data.integration == "trapezoid" else peaks
 
     def _free_peaks(self, data: Measurement, peaks: np.ndarray) -> np.ndarray | None:
         """Accepted peaks [Hz] the eigenvalue hold paired with no mode (as measured), when it
         paired at all (:meth:`_unlocated`); else None."""
         if self.K3_ is not None or self._unlocated(data, peaks) is None:
             return None
-        f = warp_frequency(peaks, float(data.fs)) if data.integration == "trapezoid" else peaks
+        f = self._held_peaks(data, peaks)
         taken = self.eigen_targets_[self.eigen_targets_ > 0]
         used = np.array([np.any(np.isclose(v, taken, rtol=1e-9)) for v in f], dtype=bool)
         return np.asarray(peaks, dtype=float)[~used]
