@@ -386,11 +386,12 @@ def free_decay_gain(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndarr
     the pulse only the kept modes ring, each with the amplitude and phase its share of the
     impulse gave it.  The model's equation ``M x'' + C x' + K x = B u - K3 x^3``, its cubic
     force evaluated on the *measured* displacement (so that the hardening modes' shifting
-    phase is the model's, not left to the gain), is linear in ``g``: the response to ``u[j]``
-    with the gain ``e_i`` (``n`` columns) plus the response to ``-K3 x^3`` (zero initial state
-    at the record's start), and ``g`` is the least-squares fit of the measured accelerations
-    on the samples from ``data.free_start`` over :data:`FREE_GAIN_PERIODS` periods of the
-    model's lowest mode.
+    phase is the model's, not left to the gain), is linear in the gains: the response to
+    each input ``u[m]`` with the gain ``e_i`` (``n`` columns per input, so that another
+    input's ringing is not put down to ``u[j]``'s gain) plus the response to ``-K3 x^3`` (zero
+    initial state at the record's start), fitted by least squares to the measured
+    accelerations on the samples from ``data.free_start`` over :data:`FREE_GAIN_PERIODS`
+    periods of the model's lowest mode; ``g`` is input ``j``'s row.
 
     Parameters
     ----------
@@ -407,8 +408,9 @@ def free_decay_gain(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndarr
     Returns
     -------
     ndarray, shape (n,) or None
-        The gain [1/kg]; None when the window is too short, the model has no oscillating mode
-        or the fit is not finite.
+        The gain [1/kg]; None when ``data.free_start`` is 0 (a continuous input, or a window
+        cut after the pulse: no free decay), the window is too short, the model has no
+        oscillating mode or the fit is not finite.
     """
     n = M.shape[0]
     w2 = np.linalg.eigvals(np.linalg.solve(M, K)).real
@@ -416,19 +418,24 @@ def free_decay_gain(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndarr
         return None
     period = 2 * np.pi / np.sqrt(w2[w2 > 0].min())
     i0 = int(data.free_start)
+    if i0 <= 0:  # a continuous input or a window cut after the pulse: no free decay to read
+        return None
+    U = np.asarray(data.u, dtype=float)
     i1 = min(data.n_samples, i0 + round(FREE_GAIN_PERIODS * period * data.fs))
-    if i1 - i0 < n:
+    if i1 - i0 < max(n, U.shape[0]):
         return None
     t = np.arange(i1) / data.fs
-    u = np.asarray(data.u, dtype=float)[j:j + 1, :i1]
     z = np.zeros(n)
     target = np.asarray(data.xdd, dtype=float)[:, i0:i1]
     if K3 is not None and np.any(K3 != 0):
         cubic = -np.asarray(K3, dtype=float) @ np.asarray(data.x, dtype=float)[:, :i1] ** 3
         target = target - simulate_structural(M, C, K, None, np.eye(n), z, z, t, cubic).xdd[:, i0:]
-    cols = [simulate_structural(M, C, K, None, M[:, [i]], z, z, t, u).xdd[:, i0:].ravel()
-            for i in range(n)]
-    g = np.linalg.lstsq(np.stack(cols, axis=1), target.ravel(), rcond=None)[0]
+    # every input's response has its n columns in the one least squares (each input's gain
+    # M^-1 B[:, m] free): another hammer's ringing is not put down to input j's gain
+    cols = [simulate_structural(M, C, K, None, M[:, [i]], z, z, t, U[m:m + 1, :i1]).xdd[:, i0:].ravel()
+            for m in range(U.shape[0]) for i in range(n)]
+    G = np.linalg.lstsq(np.stack(cols, axis=1), target.ravel(), rcond=None)[0]
+    g = G.reshape(U.shape[0], n)[j]
     return g if np.all(np.isfinite(g)) else None
 
 

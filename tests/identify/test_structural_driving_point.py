@@ -92,3 +92,42 @@ def test_cubic_model_shares_its_mass_by_the_free_decay():
     np.testing.assert_allclose(np.linalg.solve(M2, B2), np.linalg.solve(Mf, B_pulse), rtol=1e-9)
     # without its record a cubic model keeps the prior's scale
     assert driving_point_scaling(Mf, Cf, Kf, K3f, B_pulse, DECLARED)[0][0] is Mf
+
+
+def test_free_decay_gain_fits_every_inputs_response():
+    """A second hammer (at sensor 1, before ``free_start``) rings in the same free decay; its
+    response gets its own columns, so input 0's gain is read as with one hammer (review 28e
+    M1: with input 0's columns alone it was 25 % off)."""
+    fs = 16000.0
+    n_t, pulse = 8000, 32
+    t = np.arange(n_t) / fs
+    shape = 40.0 * np.sin(np.pi * np.arange(1, pulse + 1) / (pulse + 1))
+    u = np.zeros((2, n_t))
+    u[0, 1:pulse + 1] = shape
+    u[1, 60:60 + pulse] = 0.7 * shape
+    D = np.array([[0.0, 1.0], [0.0, 0.0], [1.0, 0.0]])
+    z = np.zeros(3)
+    traj = simulate_structural(M3, C3, K3M, None, D, z, z, t, u)
+    data = Measurement(fs=fs, x=traj.x, xd=traj.xd, xdd=traj.xdd, channels=("s1", "s2", "s3"),
+                       u=u, inputs=("A", "B"), input_map=D,
+                       prior={"reduced_mass_trace": float(np.trace(M3))}, free_start=60 + pulse + 2)
+    Mf, Cf, Kf = _wrong_sharing()
+    for j in (0, 1):
+        want = np.linalg.solve(M3, D[:, j])
+        g = free_decay_gain(data, Mf, Cf, Kf, None, j)
+        # the model's exact response: least-squares rounding only
+        np.testing.assert_allclose(g, want, rtol=1e-6, atol=1e-6 * np.abs(want).max())
+
+
+def test_free_decay_gain_needs_a_free_decay():
+    """``free_start`` 0 (a continuous input, or a window cut after the pulse) holds no free
+    decay: no gain is read (review 28e L2), and a cubic model keeps the prior's scale."""
+    data = _record(16000.0, np.diag([0.0, 0.0, 3e12]))
+    data0 = Measurement(fs=data.fs, x=data.x, xd=data.xd, xdd=data.xdd, channels=data.channels,
+                        u=data.u, inputs=data.inputs, input_map=data.input_map,
+                        prior=data.prior, free_start=0)
+    Mf, Cf, Kf = _wrong_sharing()
+    K3f = Mf @ np.linalg.solve(M3, np.diag([0.0, 0.0, 3e12]))
+    assert free_decay_gain(data0, Mf, Cf, Kf, K3f, 0) is None
+    (M2, *_), rule = driving_point_scaling(Mf, Cf, Kf, K3f, Mf @ DECLARED, DECLARED, data0)
+    assert M2 is Mf and "no free decay" in rule
