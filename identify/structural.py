@@ -376,9 +376,10 @@ def fit_band_cutoff(data: Measurement, cutoff_hz: float | None = None,
 FREE_GAIN_PERIODS = 5.0
 
 
-def free_decay_gain(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndarray,
-                    K3: np.ndarray | None, j: int) -> np.ndarray | None:
-    """The input gain ``g = M^-1 B[:, j]`` that best explains the free decay after the pulse.
+def free_decay_fit(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndarray,
+                   K3: np.ndarray | None, j: int) -> tuple[np.ndarray, np.ndarray] | None:
+    """The input gain ``g = M^-1 B[:, j]`` that best explains the free decay after the pulse,
+    with its covariance.
 
     An impact's samples hold, besides the kept modes' response, the quasi-static response of
     the modes the model leaves out (it ends with the pulse); a gain fitted on them carries it
@@ -386,11 +387,12 @@ def free_decay_gain(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndarr
     the pulse only the kept modes ring, each with the amplitude and phase its share of the
     impulse gave it.  The model's equation ``M x'' + C x' + K x = B u - K3 x^3``, its cubic
     force evaluated on the *measured* displacement (so that the hardening modes' shifting
-    phase is the model's, not left to the gain), is linear in ``g``: the response to ``u[j]``
-    with the gain ``e_i`` (``n`` columns) plus the response to ``-K3 x^3`` (zero initial state
-    at the record's start), and ``g`` is the least-squares fit of the measured accelerations
-    on the samples from ``data.free_start`` over :data:`FREE_GAIN_PERIODS` periods of the
-    model's lowest mode.
+    phase is the model's, not left to the gain), is linear in the gains: the response to
+    each input ``u[m]`` with the gain ``e_i`` (``n`` columns per input, so that another
+    input's ringing is not put down to ``u[j]``'s gain) plus the response to ``-K3 x^3`` (zero
+    initial state at the record's start), fitted by least squares to the measured
+    accelerations on the samples from ``data.free_start`` over :data:`FREE_GAIN_PERIODS`
+    periods of the model's lowest mode; ``g`` is input ``j``'s row.
 
     Parameters
     ----------
@@ -406,9 +408,12 @@ def free_decay_gain(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndarr
 
     Returns
     -------
-    ndarray, shape (n,) or None
-        The gain [1/kg]; None when the window is too short, the model has no oscillating mode
-        or the fit is not finite.
+    (g, cov) or None
+        The gain [1/kg], shape (n,), and its least-squares covariance ``s^2 (A^T A)^-1``
+        [1/kg^2], shape (n, n) (``s^2`` the residual variance over the free samples); None
+        when ``data.free_start`` is 0 (a continuous input, or a window
+        cut after the pulse: no free decay), the window is too short, the model has no
+        oscillating mode or the fit is not finite.
     """
     n = M.shape[0]
     w2 = np.linalg.eigvals(np.linalg.solve(M, K)).real
@@ -416,20 +421,76 @@ def free_decay_gain(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndarr
         return None
     period = 2 * np.pi / np.sqrt(w2[w2 > 0].min())
     i0 = int(data.free_start)
+    if i0 <= 0:  # a continuous input or a window cut after the pulse: no free decay to read
+        return None
+    U = np.asarray(data.u, dtype=float)
     i1 = min(data.n_samples, i0 + round(FREE_GAIN_PERIODS * period * data.fs))
-    if i1 - i0 < n:
+    if i1 - i0 < max(n, U.shape[0]):
         return None
     t = np.arange(i1) / data.fs
-    u = np.asarray(data.u, dtype=float)[j:j + 1, :i1]
     z = np.zeros(n)
     target = np.asarray(data.xdd, dtype=float)[:, i0:i1]
     if K3 is not None and np.any(K3 != 0):
         cubic = -np.asarray(K3, dtype=float) @ np.asarray(data.x, dtype=float)[:, :i1] ** 3
         target = target - simulate_structural(M, C, K, None, np.eye(n), z, z, t, cubic).xdd[:, i0:]
-    cols = [simulate_structural(M, C, K, None, M[:, [i]], z, z, t, u).xdd[:, i0:].ravel()
-            for i in range(n)]
-    g = np.linalg.lstsq(np.stack(cols, axis=1), target.ravel(), rcond=None)[0]
-    return g if np.all(np.isfinite(g)) else None
+    # every input's response has its n columns in the one least squares (each input's gain
+    # M^-1 B[:, m] free): another hammer's ringing is not put down to input j's gain
+    cols = [simulate_structural(M, C, K, None, M[:, [i]], z, z, t, U[m:m + 1, :i1]).xdd[:, i0:].ravel()
+            for m in range(U.shape[0]) for i in range(n)]
+    A, b = np.stack(cols, axis=1), target.ravel()
+    G = np.linalg.lstsq(A, b, rcond=None)[0]
+    g = G.reshape(U.shape[0], n)[j]
+    if not np.all(np.isfinite(g)):
+        return None
+    # the least squares' covariance, s^2 (A^T A)^-1 (residual variance over the free samples)
+    dof = max(b.size - A.shape[1], 1)
+    s2 = float(np.sum((b - A @ G) ** 2)) / dof
+    cov = s2 * np.linalg.pinv(A.T @ A)
+    rows = slice(j * n, (j + 1) * n)
+    return g, cov[rows, rows]
+
+
+def free_decay_gain(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndarray,
+                    K3: np.ndarray | None, j: int) -> np.ndarray | None:
+    """The input gain ``g = M^-1 B[:, j]`` read from the free decay after the pulse
+    (:func:`free_decay_fit` without its covariance); None where that gives none."""
+    fit = free_decay_fit(data, M, C, K, K3, j)
+    return None if fit is None else fit[0]
+
+
+def modal_spread(phi: np.ndarray, cov: np.ndarray, col: np.ndarray) -> np.ndarray:
+    """Standard error of each mode's ``1 / mu_r = (Phi^-1 g)_r / Phi[k, r]`` from ``g``'s
+    covariance ``cov`` (shape (n, n), [1/kg^2]); ``phi`` (n, n) mass-normalised shapes,
+    ``col`` = ``phi[k, :]``.  Returns shape (n,), dimensionless (modal masses relative to
+    the fitted ``M``'s)."""
+    P = np.linalg.inv(phi) / col[:, None]
+    return np.sqrt(np.maximum(np.diag(P @ cov @ P.T), 0.0))
+
+
+def held_share(inv_mu: np.ndarray, spread: np.ndarray) -> np.ndarray:
+    """Each mode's read ``1 / mu`` weighted by how well the free decay holds it.
+
+    A mode the free decay barely holds (heavily damped, gone within the window's first
+    samples) has a reading whose standard error ``spread`` is of the order of the reading
+    itself; taken as it is, its error is spread over the other modes by the trace
+    normalisation (review 28e M2).  The rule, continuous: ``w = a^2 / (a^2 + s^2)`` (the
+    reading's signal-to-error share), ``1 / mu = w a + (1 - w) * 1``, ``1`` being the fitted
+    model's own modal mass (``Phi`` mass-normalised to it: the mass prior's sharing).
+
+    Parameters
+    ----------
+    inv_mu : ndarray, shape (n,)
+        The read ``1 / mu`` relative to the fitted model's modal masses.
+    spread : ndarray, shape (n,)
+        Their standard errors (:func:`modal_spread`).
+
+    Returns
+    -------
+    ndarray, shape (n,)
+    """
+    a2 = inv_mu**2
+    w = np.divide(a2, a2 + spread**2, out=np.zeros_like(a2), where=(a2 + spread**2) > 0)
+    return w * inv_mu + (1.0 - w)
 
 
 def driving_point_scaling(M: np.ndarray, C: np.ndarray, K: np.ndarray, K3: np.ndarray | None,
@@ -458,7 +519,10 @@ def driving_point_scaling(M: np.ndarray, C: np.ndarray, K: np.ndarray, K3: np.nd
     truth, branch ``mass28``: ``cantilever_soft_impact`` cubic force error 0.213 with the
     prior's scale, 0.075 with ``B``'s gain (the 150 N base then fails: 0.48), 0.088 with the free
     decay's (150 N 0.123 -> 0.121); figures in
-    docs/known-gaps.md).  A linear model keeps ``B``'s gain.
+    docs/known-gaps.md).  Each mode's reading is weighted by its standard error from that fit
+    (:func:`held_share`): a mode the free decay barely holds keeps the fitted model's own modal
+    mass in proportion, rather than spreading its error over the others through the trace
+    normalisation.  A linear model keeps ``B``'s gain.
 
     Parameters
     ----------
@@ -498,16 +562,23 @@ def driving_point_scaling(M: np.ndarray, C: np.ndarray, K: np.ndarray, K3: np.nd
     k = int(np.flatnonzero(D[:, j])[0])
     lam, phi = linalg.eigh(K, M)  # phi^T M phi = I
     g = np.linalg.solve(M, B[:, j])
+    cov = None
     if K3 is not None:
-        g = free_decay_gain(data, M, C, K, K3, j)
-        if g is None:
+        fit = free_decay_fit(data, M, C, K, K3, j)
+        if fit is None:
             return same, "cubic model: no free decay to read the gain from, the prior's scale kept"
+        g, cov = fit
     col = phi[k, :]
     if np.any(np.abs(col) < 1e-6 * np.abs(phi).max()):
         return same, f"a mode has a node at the driving point (sensor {k + 1}): the prior's scale kept"
     inv_mu = np.linalg.solve(phi, g) / col
     if not (np.all(np.isfinite(inv_mu)) and np.all(inv_mu > 0)):
         return same, f"driving point (sensor {k + 1}) gives a non-positive modal mass: the prior's scale kept"
+    if cov is not None:
+        # weighted after the refusal, not before: a reading no passive structure has is refused
+        # whatever its spread (measured, branch mass29: weighting first turned four refusals
+        # into acceptances, b25_br_soft_r1p6_cf0p65_fs10k cubic force 0.104 -> 0.583)
+        inv_mu = held_share(inv_mu, modal_spread(phi, cov, col))
     pinv = np.linalg.inv(phi)
     # the sharing from the force, the total from the fit (its trace is the mass prior, the
     # paper's Eq. 4 constraint): M' is linear in mu, so one factor sets trace(M') = trace(M)

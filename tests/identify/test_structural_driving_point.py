@@ -15,7 +15,13 @@ import numpy as np
 from scipy import linalg
 
 from identify._structural_sim import simulate_structural
-from identify.structural import driving_point_scaling, free_decay_gain
+from identify.structural import (
+    driving_point_scaling,
+    free_decay_fit,
+    free_decay_gain,
+    held_share,
+    modal_spread,
+)
 from testbed.core.measurement import Measurement
 
 FS = 4000.0                    # Hz: the modes (about 33-150 Hz) well resolved
@@ -92,3 +98,76 @@ def test_cubic_model_shares_its_mass_by_the_free_decay():
     np.testing.assert_allclose(np.linalg.solve(M2, B2), np.linalg.solve(Mf, B_pulse), rtol=1e-9)
     # without its record a cubic model keeps the prior's scale
     assert driving_point_scaling(Mf, Cf, Kf, K3f, B_pulse, DECLARED)[0][0] is Mf
+
+
+def test_free_decay_gain_fits_every_inputs_response():
+    """A second hammer (at sensor 1, before ``free_start``) rings in the same free decay; its
+    response gets its own columns, so input 0's gain is read as with one hammer (review 28e
+    M1: with input 0's columns alone it was 25 % off)."""
+    fs = 16000.0
+    n_t, pulse = 8000, 32
+    t = np.arange(n_t) / fs
+    shape = 40.0 * np.sin(np.pi * np.arange(1, pulse + 1) / (pulse + 1))
+    u = np.zeros((2, n_t))
+    u[0, 1:pulse + 1] = shape
+    u[1, 60:60 + pulse] = 0.7 * shape
+    D = np.array([[0.0, 1.0], [0.0, 0.0], [1.0, 0.0]])
+    z = np.zeros(3)
+    traj = simulate_structural(M3, C3, K3M, None, D, z, z, t, u)
+    data = Measurement(fs=fs, x=traj.x, xd=traj.xd, xdd=traj.xdd, channels=("s1", "s2", "s3"),
+                       u=u, inputs=("A", "B"), input_map=D,
+                       prior={"reduced_mass_trace": float(np.trace(M3))}, free_start=60 + pulse + 2)
+    Mf, Cf, Kf = _wrong_sharing()
+    for j in (0, 1):
+        want = np.linalg.solve(M3, D[:, j])
+        g = free_decay_gain(data, Mf, Cf, Kf, None, j)
+        # the model's exact response: least-squares rounding only
+        np.testing.assert_allclose(g, want, rtol=1e-6, atol=1e-6 * np.abs(want).max())
+
+
+def test_free_decay_gain_needs_a_free_decay():
+    """``free_start`` 0 (a continuous input, or a window cut after the pulse) holds no free
+    decay: no gain is read (review 28e L2), and a cubic model keeps the prior's scale."""
+    data = _record(16000.0, np.diag([0.0, 0.0, 3e12]))
+    data0 = Measurement(fs=data.fs, x=data.x, xd=data.xd, xdd=data.xdd, channels=data.channels,
+                        u=data.u, inputs=data.inputs, input_map=data.input_map,
+                        prior=data.prior, free_start=0)
+    Mf, Cf, Kf = _wrong_sharing()
+    K3f = Mf @ np.linalg.solve(M3, np.diag([0.0, 0.0, 3e12]))
+    assert free_decay_gain(data0, Mf, Cf, Kf, K3f, 0) is None
+    (M2, *_), rule = driving_point_scaling(Mf, Cf, Kf, K3f, Mf @ DECLARED, DECLARED, data0)
+    assert M2 is Mf and "no free decay" in rule
+
+
+def test_held_share_weights_a_reading_by_its_standard_error():
+    """A reading with no spread is taken, one whose spread dwarfs it falls back to the fitted
+    model's own modal mass (1), continuously in between (review 28e M2)."""
+    a = np.array([0.5, 2.0, 0.3])
+    np.testing.assert_allclose(held_share(a, np.zeros(3)), a, rtol=1e-15)
+    np.testing.assert_allclose(held_share(a, 1e6 * np.ones(3)), np.ones(3), rtol=1e-9)
+    # equal signal and error: halfway, w = 1/2
+    np.testing.assert_allclose(held_share(a, np.abs(a)), 0.5 * a + 0.5, rtol=1e-12)
+    path = [held_share(a[:1], np.array([s]))[0] for s in np.linspace(0.0, 5.0, 51)]
+    assert np.all(np.diff(path) > 0)   # 0.5 rises monotonically towards 1 as the error grows
+
+
+def test_free_decay_spread_follows_the_noise():
+    """The gain's standard error is the least squares' (residual variance over the free
+    samples): on the model's own response it is rounding, with white noise on the
+    accelerations it scales with the noise."""
+    data = _record()
+    Mf, Cf, Kf = _wrong_sharing()
+    _, phi = linalg.eigh(Kf, Mf)
+    spreads = []
+    for level in (0.0, 1e-3, 1e-2):
+        rng = np.random.default_rng(3)
+        xdd = data.xdd + level * data.xdd.std(axis=1, keepdims=True) * rng.standard_normal(data.xdd.shape)
+        noisy = Measurement(fs=data.fs, x=data.x, xd=data.xd, xdd=xdd, channels=data.channels,
+                            u=data.u, inputs=data.inputs, input_map=data.input_map,
+                            prior=data.prior, free_start=data.free_start)
+        _, cov = free_decay_fit(noisy, Mf, Cf, Kf, None, 0)
+        spreads.append(modal_spread(phi, cov, phi[2]))
+    assert np.all(spreads[0] < 1e-6)
+    # tenfold noise, tenfold error (the same seed's draw scaled: exact up to the rounding)
+    np.testing.assert_allclose(spreads[2], 10.0 * spreads[1], rtol=0.01)
+    assert np.all(spreads[2] > 1e-5) and np.all(spreads[2] < 0.05)   # read, not lost
