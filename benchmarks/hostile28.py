@@ -17,8 +17,8 @@ Families (what rounds 1-27 did not try; their families are listed in ``hostile21
     5,000-character text, bytes, a list, a dict, an ``object()``, a missing path, a folder, a
     NaN array.  An exception other than the testbed's one-line
     errors (``TestbedError``: ``ArgumentError``, ``InputError``, ...) is a finding; so is a
-    refusal of more than one line.  Registering functions (``register_*``, a registry's
-    ``register``) are called on a throw-away name only.
+    refusal of more than one line.  Not called: the registering functions (``register_*``),
+    the registries, ``run_sweep`` and the error classes.
 ``plugstate``
     A ``--plugin`` identifier of the kinetics (a subclass of ``sindy_pi_dynamical``) that, in
     its ``fit``, writes into the measurement it was given (before or after fitting), into its

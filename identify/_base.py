@@ -612,7 +612,10 @@ def _called(model: Identifier, where: str, method: Callable[..., Any], *a: Any,
     :func:`~testbed.core.exit_guard.no_process_exit` and its process state kept: the scorer and
     the run's report call these methods as the pipeline calls its fit, and its ``os._exit(0)``
     in ``simulate`` (hostile round 20) or ``equations`` (review, session 21) ended `testbed run`
-    with status 0 and no verdict."""
+    with status 0 and no verdict.  Any other exception of the plugin's own (not the testbed's,
+    not ``NotImplementedError`` or ``KeyboardInterrupt``; a ``sys.exit`` included) becomes a
+    :class:`~testbed.core.errors.PluginMethodError` naming the method and the exception's type,
+    which scoring turns into a failure (hostile round 28)."""
     if type(model).__module__.partition(".")[0] == "identify":
         return method(model, *a, **kw)
     try:

@@ -132,13 +132,15 @@ def backbone_cubic(model: StructuralIdentifier, data: Measurement, peaks: np.nda
         check_physical(model.M_, model.C_, K_b)
     except IdentificationError as e:
         return None, None, f"{head}: not moved ({e})"
-    Phi_b = modal(model.M_, K_b)[1]
-    q = np.linalg.solve(Phi_b, np.asarray(data.x, dtype=float)[:, i0:i1])[k]
+    # K_b keeps the model's shapes (set_eigenvalues), so Phi holds them in the same order;
+    # the moved model's own modal() re-sorts them where the limit falls below a lower
+    # (unlocated) mode, and its column k would be that mode (read 28a)
+    q = np.linalg.solve(Phi, np.asarray(data.x, dtype=float)[:, i0:i1])[k]
     g_hb = duffing_by_balance((2.0 * np.pi * freqs[k]) ** 2, lam[k],
                               float(np.sqrt(2.0 * np.mean(q**2))))
 
     def cubic(s: float) -> np.ndarray | None:
-        return one_mode_cubic(model.M_, Phi_b, k, s * g_hb) if s > 0 else None
+        return one_mode_cubic(model.M_, Phi, k, s * g_hb) if s > 0 else None
 
     def candidate(s: float) -> StructuralIdentifier:
         new = copy.copy(model)
@@ -161,5 +163,6 @@ def backbone_cubic(model: StructuralIdentifier, data: Measurement, peaks: np.nda
         return None, None, f"{head}: not moved ({why}; {figures})"
     K3 = cubic(s)
     return K_b, K3, (f"{head}: moved to its limit, "
-                     + ("with a cubic on that mode alone" if K3 is not None else "no cubic")
-                     + f" sized by output error ({figures})")
+                     + ("with a cubic on that mode alone sized by output error"
+                        if K3 is not None else "no cubic (output error chose scale 0)")
+                     + f" ({figures})")

@@ -1774,7 +1774,8 @@ class SGDSINDy(SGDSINDyBase):
         (M, C, K, K3, B), self.mass_scaling_rule_ = driving_point_scaling(
             out.M, out.C, out.K, out.K3, out.input_map, data.input_map, data)
         self.input_map_rule_ = "fitted on the window (the force's tail)"
-        if M is out.M and out.input_map_record is not None:
+        if M is out.M and out.K3 is None and out.input_map_record is not None:
+            # (a linear model: a cubic model's gain is read from the free decay, whatever B)
             # The window holds only the chain-filtered tail of an impact (0.7-1.2 % of its
             # peak on clamped members 016 and 009 of the beams family): its gain can be one no
             # passive structure has (a non-positive modal mass at the driving point, refused

@@ -967,7 +967,7 @@ def noise_knobs(x: np.ndarray, fs: float, val_fraction: float, user: dict[str, A
                 smoothed: float | None = None, declared: np.ndarray | None = None,
                 passband: tuple[float, float] | None = None, ruled: tuple[str, ...] = (),
                 *, inputs: np.ndarray | None = None, column_order: int = 4,
-                clean: bool = True, min_weight: float = 0.0
+                min_weight: float = 0.0
                 ) -> tuple[dict[str, Any], str, dict[str, Any]]:
     """SINDy-PI's noise-dependent settings from the angles, and the rule that chose them.
 
@@ -1053,8 +1053,6 @@ def noise_knobs(x: np.ndarray, fs: float, val_fraction: float, user: dict[str, A
         trimmed span keeps ``EDGE_KEEP_EXCITATION`` of their power (:func:`excitation_trim`).
     column_order : int
         Order of the column low-pass (the clean chain's column cut-off, :func:`chain_column_cutoff`).
-    clean : bool
-        False: the noisy rule's settings (weight 1) whatever the noise.
     min_weight : float
         The noisy rule's weight is at least this, in [0, 1] (the refits of :meth:`SINDyPI.fit`
         where the clean recipe's fit failed: ``REFIT_WEIGHTS``).
@@ -1107,7 +1105,7 @@ def noise_knobs(x: np.ndarray, fs: float, val_fraction: float, user: dict[str, A
         # whose noise is below NOISY_NOISE_REL): the clean recipe's share is 1 - w
         # (declared: an undeclared level is read off angles the chain smoothed, which always
         # look near-exact: review 27d, a 2 % record read as clean; the noisy rule is the safe one)
-        w = noise_weight(noise_rel) if filtered and clean and declared is not None else 1.0
+        w = noise_weight(noise_rel) if filtered and declared is not None else 1.0
         w = max(w, min(float(min_weight), 1.0))
         est["noise_weight"] = w
         if form == "strong":
@@ -2154,8 +2152,9 @@ class SINDyPI(_ImplicitMechanical):
         chain's clean recipe (the noise rule's weight ``w`` below 1, :func:`noise_knobs`) fails,
         it is done again at each of the noisy rule's weights ``REFIT_WEIGHTS`` above
         ``w`` in turn (0.25, 0.5, 0.75, 1: ridge, column cut-off and trim a quarter, half, ...
-        of the way, geometrically, to the noisy rule's under the same chain, the tie band still
-        the chain's), the first that fits kept and named in the rule text; if every one fails,
+        of the way, geometrically, to the noisy rule's under the same chain, the tie band the
+        clean chain's up to 0.75 and the noisy rule's ``ROLLOUT_ATOL`` at 1), the first that
+        fits kept and named in the rule text; if every one fails,
         the first failure is raised with the last's reason.
 
         Why: the clean recipe's exact-data ridge (``RIDGE_EXACT``) leaves equations the record
@@ -2183,7 +2182,8 @@ class SINDyPI(_ImplicitMechanical):
             first, clean_w = exc, self._noise_weight
         last = first
         try:
-            for w in (w for w in REFIT_WEIGHTS if w > clean_w):
+            ladder = [w for w in REFIT_WEIGHTS if w > clean_w]
+            for w in ladder:
                 self.__dict__.clear()  # nothing a failed fit learned decides the refit's rules
                 self.__dict__.update(start)
                 self._refit_weight = w
@@ -2191,7 +2191,7 @@ class SINDyPI(_ImplicitMechanical):
                     return self._fit_recipe(data)
                 except IdentificationError as exc:
                     last = exc
-            tried = ", ".join(f"{w:.3g}" for w in REFIT_WEIGHTS if w > clean_w)
+            tried = ", ".join(f"{w:.3g}" for w in ladder)
             raise IdentificationError(f"{first} (the clean recipe's fit failed and so did the "
                                       f"noisy rule's weights {tried}; the last: {last})") from None
         finally:

@@ -367,7 +367,7 @@ def fit_band_cutoff(data: Measurement, cutoff_hz: float | None = None,
     return fc, rule
 
 
-#: Length of the free decay :func:`free_decay_gain` reads, in periods of the model's lowest mode:
+#: Length of the free decay :func:`free_decay_fit` reads, in periods of the model's lowest mode:
 #: the slowest mode completes five cycles, enough for the modes' amplitudes to separate in one
 #: least-squares fit.  With the cubic force on the right-hand side the reading does not depend
 #: on it (measured, branch ``mass28``: 1, 2 and 5 periods agree within 2 % on the shipped soft
@@ -512,7 +512,7 @@ def driving_point_scaling(M: np.ndarray, C: np.ndarray, K: np.ndarray, K3: np.nd
     symmetric part otherwise), ``B' = M' g``: the same ``M^-1 K``
     (frequencies and mode shapes), the same modal damping, the mass shared as the force says.
 
-    A cubic model reads ``g`` from the free decay after the pulse (:func:`free_decay_gain`),
+    A cubic model reads ``g`` from the free decay after the pulse (:func:`free_decay_fit`),
     not from ``B``: an impact's samples hold the quasi-static response of the modes the model
     leaves out, which a gain fitted on them takes as the kept modes' and which the cubic force
     ``K3 x^3``, read in newtons, would carry (measured, issue #15 against the corrected cubic
@@ -536,7 +536,7 @@ def driving_point_scaling(M: np.ndarray, C: np.ndarray, K: np.ndarray, K3: np.nd
         The measurement's ``input_map``: a column with a single 1 is a force at that sensor.
     data : Measurement, optional
         The record; required for a cubic model, whose gain is read from the free decay after
-        the pulse (:func:`free_decay_gain`) rather than taken from ``B``.
+        the pulse (:func:`free_decay_fit`) rather than taken from ``B``.
 
     Returns
     -------

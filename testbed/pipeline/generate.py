@@ -20,7 +20,7 @@ from collections.abc import Callable
 import numpy as np
 
 from testbed.core.dataset import Dataset, Signal
-from testbed.core.errors import RigError, TestbedError
+from testbed.core.errors import RigError, TestbedError, exception_text
 from testbed.core.provenance import git_commit, versions
 from testbed.core.truth import TruthError
 from testbed.pipeline.plugins import RIGS
@@ -80,7 +80,7 @@ def _simulate_rig(scenario: Scenario, progress: Callable[[float], None] | None) 
         if origin == "builtin":
             raise
         raise RigError(f"rig {scenario.rig} (from {origin}) raised {type(e).__name__}: "
-                       f"{' '.join(str(e).split())}") from None
+                       f"{exception_text(e)}") from None
 
 
 def simulate_clean(scenario: Scenario, progress: Callable[[float], None] | None = None) -> Dataset:

@@ -592,17 +592,20 @@ def _decayed(scores: Scores, k: int) -> bool:
             and float(left[k - 1]) < DECAYED_RATIO)
 
 
-def _named_by_mode_reason(check: Check, scores: Scores) -> bool:
-    """Whether failed ``check`` is a per-mode bar (``<score>_mode<k>``) whose mode another
-    reason already names: out of band (:func:`out_of_band_failures`), unexcited
-    (:func:`unexcited_failures`) or decayed (:func:`decayed_failures`); the linear-model
-    reasons do not count such a bar as one they would hide (review 28a)."""
-    found = _MODE_SCORE.fullmatch(check.metric)
-    if not found or not found[2]:
-        return False
-    k = int(found[2])
+def _named_mode(scores: Scores, k: int) -> bool:
+    """Whether true mode ``k`` (1-based) is one another reason names when its bars fail: out
+    of band (:func:`out_of_band_failures`), unexcited (:func:`unexcited_failures`) or decayed
+    (:func:`decayed_failures`)."""
     return _out_of_band(scores, k) is not None or _unexcited(scores, k) is not None \
         or _decayed(scores, k)
+
+
+def _named_by_mode_reason(check: Check, scores: Scores) -> bool:
+    """Whether failed ``check`` is a per-mode bar (``<score>_mode<k>``) whose mode another
+    reason already names (:func:`_named_mode`); the linear-model reasons neither count such a
+    bar as one they would hide (review 28a) nor let it veto them (read 28b)."""
+    found = _MODE_SCORE.fullmatch(check.metric)
+    return bool(found and found[2]) and _named_mode(scores, int(found[2]))
 
 
 def out_of_band_failures(scores: Scores, thresholds: dict[str, dict[str, float]]
@@ -1439,8 +1442,11 @@ def _linear_model_reason(scores: Scores, thresholds: dict[str, dict[str, float]]
             or {"fit", "model", "simulation"} & set(scores.failures)):
         return {}
     reach = np.asarray(reach, dtype=float)
+    # a mode another reason names (out of band, unexcited, decayed) is that reason's, not
+    # the missing cubic's to explain, nor to veto it (read 28b)
     missed = [c for c in check_thresholds(scores.values, thresholds)
-              if not c.passed and c.metric.startswith("freq_error") and c.bound == "max"]
+              if not c.passed and c.metric.startswith("freq_error") and c.bound == "max"
+              and not _named_by_mode_reason(c, scores)]
     if not missed:
         return {}
     bar = min(c.threshold for c in missed)
@@ -1455,7 +1461,7 @@ def _linear_model_reason(scores: Scores, thresholds: dict[str, dict[str, float]]
             modes[int(found[2])] = float(c.value)
         else:  # the worst over the modes: each mode above that bar
             modes.update({j + 1: float(e) for j, e in enumerate(per_mode)
-                          if not e <= c.threshold})
+                          if not e <= c.threshold and not _named_mode(scores, j + 1)})
     finite = {j: e for j, e in modes.items() if np.isfinite(e)}
     if not finite:
         return {}  # no frequency to move: an unpaired mode is not a shift

@@ -11,6 +11,8 @@ accelerations during the pulse (what the truncated modes would add).
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 from scipy import linalg
 
@@ -129,9 +131,7 @@ def test_free_decay_gain_needs_a_free_decay():
     """``free_start`` 0 (a continuous input, or a window cut after the pulse) holds no free
     decay: no gain is read (review 28e L2), and a cubic model keeps the prior's scale."""
     data = _record(16000.0, np.diag([0.0, 0.0, 3e12]))
-    data0 = Measurement(fs=data.fs, x=data.x, xd=data.xd, xdd=data.xdd, channels=data.channels,
-                        u=data.u, inputs=data.inputs, input_map=data.input_map,
-                        prior=data.prior, free_start=0)
+    data0 = dataclasses.replace(data, free_start=0)
     Mf, Cf, Kf = _wrong_sharing()
     K3f = Mf @ np.linalg.solve(M3, np.diag([0.0, 0.0, 3e12]))
     assert free_decay_gain(data0, Mf, Cf, Kf, K3f, 0) is None
@@ -162,9 +162,7 @@ def test_free_decay_spread_follows_the_noise():
     for level in (0.0, 1e-3, 1e-2):
         rng = np.random.default_rng(3)
         xdd = data.xdd + level * data.xdd.std(axis=1, keepdims=True) * rng.standard_normal(data.xdd.shape)
-        noisy = Measurement(fs=data.fs, x=data.x, xd=data.xd, xdd=xdd, channels=data.channels,
-                            u=data.u, inputs=data.inputs, input_map=data.input_map,
-                            prior=data.prior, free_start=data.free_start)
+        noisy = dataclasses.replace(data, xdd=xdd)
         _, cov = free_decay_fit(noisy, Mf, Cf, Kf, None, 0)
         spreads.append(modal_spread(phi, cov, phi[2]))
     assert np.all(spreads[0] < 1e-6)

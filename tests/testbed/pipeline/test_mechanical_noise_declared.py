@@ -151,8 +151,8 @@ def test_auto_cutoff_is_continuous_in_the_noise_level():
     cut-off where the spectrum meets its noise floor) made the cut-off jump with the noise
     level on one record: 112 / 32 / 4500 / 4.8 / 4.8 Hz at relative noise 0 / 5e-7 / 9e-7 /
     2e-6 / 1e-5 (and on round 22's down-branch multisine, 9e-7, 4500 Hz and a failed fit).
-    The chain's cut-off must not depend on noise this far below the motion: here 7.39 Hz at
-    every level (the harmonic rule on the 1.5 Hz top tone with the clean droop, 4.22 x 4.80 Hz =
+    The chain's cut-off must not depend on noise this far below the motion: here 20.24 Hz at
+    every level (the harmonic rule on the 1.8 Hz read band with the clean droop, 4.22 x 4.80 Hz =
     20.24 Hz since session 28's droop 1e-12; 1.54 x, 7.39 Hz, with session 27's 1e-5)."""
     th = _multisine()
     z = np.random.default_rng(1).standard_normal(th.shape)

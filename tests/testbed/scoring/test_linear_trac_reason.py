@@ -178,3 +178,8 @@ def test_a_bar_another_reason_names_does_not_withhold_the_linear_model_reason():
     assert sorted(bar_failures(Scores(dict(values), band), bars)) == ["band", "cubic"]
     # a MAC no other reason names still withholds it (the change's own rule)
     assert sorted(bar_failures(Scores(dict(values), dict(common)), bars)) == []
+    # mode 2 beyond its reach but named unexcited: it neither hides nor vetoes mode 1's
+    # cubic reason (read 28b: the shared reason still counted it)
+    far = {**values, "freq_error_mode2": 0.3}
+    far_details = {**unexcited, "freq_error_per_mode": np.array([0.05, 0.3])}
+    assert sorted(bar_failures(Scores(dict(far), far_details), bars)) == ["cubic", "unexcited"]
