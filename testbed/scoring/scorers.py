@@ -1501,10 +1501,22 @@ def hidden_by_trac(scores: Scores, thresholds: dict[str, dict[str, float]]) -> l
     list of Check
         The failed checks left unexplained (empty: nothing hidden).
     """
+    return _left_unexplained(
+        scores, thresholds, lambda c: c.metric == "trac",
+        lambda c: c.metric.startswith("freq_error") or _unpaired_mac(c, scores),
+        _linear_model_reason)
+
+
+def _left_unexplained(scores: Scores, thresholds: dict[str, dict[str, float]],
+                      own: Callable[[Check], bool], other: Callable[[Check], bool],
+                      other_reason: Callable[..., dict[str, str]]) -> list[Check]:
+    """The failed checks a linear-model reason for its ``own`` bars would leave unexplained:
+    every failed check but its own and those a mode-level reason names
+    (:func:`_named_by_mode_reason`), unless each is one of the ``other`` reason's bars and
+    ``other_reason`` names them (:func:`hidden_by_trac`, :func:`hidden_by_frequency`)."""
     rest = [c for c in check_thresholds(scores.values, thresholds)
-            if not c.passed and c.metric != "trac" and not _named_by_mode_reason(c, scores)]
-    if rest and all(c.metric.startswith("freq_error") or _unpaired_mac(c, scores) for c in rest) \
-            and _linear_model_reason(scores, thresholds):
+            if not c.passed and not own(c) and not _named_by_mode_reason(c, scores)]
+    if rest and all(other(c) for c in rest) and other_reason(scores, thresholds):
         return []
     return rest
 
@@ -1542,12 +1554,9 @@ def hidden_by_frequency(scores: Scores, thresholds: dict[str, dict[str, float]])
     list of Check
         The failed checks left unexplained (empty: nothing hidden).
     """
-    rest = [c for c in check_thresholds(scores.values, thresholds)
-            if not c.passed and not c.metric.startswith("freq_error")
-            and not _unpaired_mac(c, scores) and not _named_by_mode_reason(c, scores)]
-    if rest and all(c.metric == "trac" for c in rest) and _linear_trac_reason(scores, thresholds):
-        return []
-    return rest
+    return _left_unexplained(
+        scores, thresholds, lambda c: c.metric.startswith("freq_error") or _unpaired_mac(c, scores),
+        lambda c: c.metric == "trac", _linear_trac_reason)
 
 
 def linear_trac_failures(scores: Scores, thresholds: dict[str, dict[str, float]]
