@@ -32,9 +32,10 @@ from testbed.core import interrupts  # armed on import by testbed/__init__.py, b
 from testbed.core.atomic import (
     HDF5_FILE,
     HTML_FILE,
+    IDENTIFIED_JSON_FILE,
     IDENTIFIED_MARKDOWN_FILE,
-    JSON_FILE,
     REPORT_MARKDOWN_FILE,
+    SEP005_FILE,
     UFF_FILE,
     FileKind,
     refuse_foreign,
@@ -785,7 +786,7 @@ def cmd_export(args: argparse.Namespace) -> int:
     data = _dataset_file(Path(args.dataset))
     default = data.with_suffix(".uff" if args.format == "uff" else ".sep005.json")
     out = _output_file(args.output or default, "--output", inputs=(data,),
-                       kind=UFF_FILE if args.format == "uff" else JSON_FILE)
+                       kind=UFF_FILE if args.format == "uff" else SEP005_FILE)
     for p in export_dataset(data, args.format, out, note=print):
         print(f"wrote {terminal_safe(str(p))}")
     return 0
@@ -934,7 +935,7 @@ def cmd_identify(args: argparse.Namespace) -> int:
         raise InputError(f"--output {terminal_safe(str(named))}: names the file of its own report "
                          f"{terminal_safe(str(named.with_suffix('.md')))}, which would replace the "
                          "model; expected another path")
-    _foreign_output(out, "--output", JSON_FILE)
+    _foreign_output(out, "--output", IDENTIFIED_JSON_FILE)
     _foreign_output(md, "--output (its .md report)", IDENTIFIED_MARKDOWN_FILE)
     with run_progress(data.name) as phase:
         result = identify_file(data, scenario=args.scenario, kind=args.kind, method=args.method,

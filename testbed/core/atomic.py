@@ -16,6 +16,7 @@ import stat
 import tempfile
 from collections.abc import Callable, Iterator
 from pathlib import Path
+from typing import NamedTuple
 
 from testbed.core.errors import InputError, terminal_safe
 
@@ -106,16 +107,125 @@ def not_regular(path: Path) -> None:
                          "which the written file would replace); expected a file path")
 
 
-#: A kind of file a command writes, as ``(description, leading bytes)``: an existing file at the
-#: path written that begins otherwise is someone else's (:func:`foreign_head`).  A leading part
-#: may be a pattern of bytes, matched at the start (of the first :data:`PATTERN_READ` bytes).
-FileKind = tuple[str, tuple["bytes | re.Pattern[bytes]", ...]]
+class FileKind(NamedTuple):
+    """A kind of file a command writes: an existing file at the path written that is not of the
+    kind is someone else's (:func:`foreign_head`).
+
+    ``heads``: the leading parts a file of the kind may begin with; a part may be a pattern of
+    bytes, matched at the start (of the first :data:`PATTERN_READ` bytes).  ``text``: compared
+    after leading blanks and a UTF-8 byte-order mark (a text format); a binary one (HDF5, PNG,
+    Parquet) byte for byte (review 28: Parquet's ``PAR1``, all ASCII, was read as a text kind,
+    so a file of blanks then ``PAR1`` passed).  ``ours``: where a format is anyone's (PNG,
+    JSON, HDF5, UFF), the marker the testbed writes in its own files of the kind, read from the
+    open file (review 28b M2: a user's own ``fit_time.png`` in a report folder, or a
+    ``settings.json`` given to ``identify -o``, was replaced because it was a PNG / JSON).
+    """
+
+    what: str
+    heads: tuple[bytes | re.Pattern[bytes], ...]
+    text: bool = False
+    ours: Callable[[int], bool] | None = None
+
+
 #: How many bytes a :data:`FileKind`'s pattern is matched in [bytes].
 PATTERN_READ = 1024
-HDF5_FILE: FileKind = ("an HDF5 dataset", (b"\x89HDF\r\n\x1a\n",))
-JSON_FILE: FileKind = ("a JSON file", (b"{", b"["))
-UFF_FILE: FileKind = ("a UFF file", (b"-1",))
-MARKDOWN_FILE: FileKind = ("a markdown report", (b"#",))
+#: The PNG text chunk every figure the testbed writes carries (``reporting.figures.png_bytes``):
+#: the keyword ``Software`` and this value, before the image data (review 28b M2)
+PNG_SOFTWARE = "sysid-testbed"
+#: The first bytes of a UFF file that :func:`_uff_ours` reads for its first record's marker
+#: [bytes]: a structural dataset's geometry records (about 160 bytes a node) come first
+UFF_MARK_READ = 1 << 20
+#: Every UFF58 record the testbed writes states its rate on ID line 5 as ``fs <rate> Hz,
+#: sysid-testbed`` (``reporting.export``, since the line was written)
+_UFF_MARK = re.compile(rb"\n\s*-1\n\s*58b?[ \t][^\n]*\n(?:[^\n]*\n){4}fs [^\n]*Hz, sysid-testbed\b")
+#: The largest JSON output :func:`_json_document` parses to find its marker [bytes]
+JSON_MARK_READ = 256 << 20
+#: The keys every model summary ``identify`` writes holds (``testbed.pipeline.fit``), which no
+#: one else's JSON holds together: the identified model's marker
+IDENTIFIED_KEYS = frozenset({"source", "kind", "method", "fs_hz", "n_samples", "identifier"})
+#: The keys every channel of a SEP-005 export holds besides SEP-005's own (``reporting.export``)
+SEP005_KEYS = frozenset({"name", "data", "fs", "content_hash", "group"})
+
+
+def _read_at(fd: int, size: int, pos: int = 0) -> bytes:
+    """Up to ``size`` bytes of the open file ``fd`` from byte ``pos`` (``os.pread`` is POSIX's
+    alone)."""
+    os.lseek(fd, pos, os.SEEK_SET)
+    return os.read(fd, size)
+
+
+def _png_ours(fd: int) -> bool:
+    """True for a PNG whose text chunks before its image data hold ``Software`` =
+    :data:`PNG_SOFTWARE` (the chunks walked by their lengths, at most 64 of them)."""
+    pos = 8
+    for _ in range(64):
+        head = _read_at(fd, 8, pos)
+        if len(head) < 8:
+            return False
+        size, tag = int.from_bytes(head[:4], "big"), head[4:]
+        if tag in (b"IDAT", b"IEND"):
+            return False
+        if tag == b"tEXt" and size < 4096:
+            key, _, value = _read_at(fd, size, pos + 8).partition(b"\0")
+            if key == b"Software" and value == PNG_SOFTWARE.encode():
+                return True
+        pos += 12 + size
+    return False
+
+
+def _hdf5_ours(fd: int) -> bool:
+    """True for an HDF5 file whose root attribute ``format`` is the testbed's dataset format
+    (``sysid-testbed-dataset/<n>``: every dataset written since the attribute was)."""
+    import h5py
+
+    try:
+        with os.fdopen(os.dup(fd), "rb") as fh, h5py.File(fh, "r") as f:
+            value = f.attrs.get("format")
+    except Exception:
+        return False
+    if isinstance(value, bytes):
+        value = value.decode("utf-8", "replace")
+    return isinstance(value, str) and value.startswith("sysid-testbed-dataset/")
+
+
+def _json_document(fd: int) -> object:
+    """The JSON document of the open file, or None (too large, not UTF-8, not JSON)."""
+    import json
+
+    if os.fstat(fd).st_size > JSON_MARK_READ:
+        return None
+    try:
+        return json.loads(_read_at(fd, JSON_MARK_READ).decode("utf-8-sig"))
+    except ValueError:
+        return None
+
+
+def _identified_ours(fd: int) -> bool:
+    """True for a model summary ``identify`` wrote (a table holding :data:`IDENTIFIED_KEYS`)."""
+    doc = _json_document(fd)
+    return isinstance(doc, dict) and IDENTIFIED_KEYS <= doc.keys()
+
+
+def _sep005_ours(fd: int) -> bool:
+    """True for a SEP-005 export of the testbed (channels holding :data:`SEP005_KEYS`)."""
+    doc = _json_document(fd)
+    return (isinstance(doc, list) and bool(doc)
+            and all(isinstance(c, dict) and SEP005_KEYS <= c.keys() for c in doc))
+
+
+def _uff_ours(fd: int) -> bool:
+    """True for a UFF file whose UFF58 records carry the testbed's ID line 5 (:data:`_UFF_MARK`)."""
+    return _UFF_MARK.search(b"\n" + _read_at(fd, UFF_MARK_READ)) is not None
+
+
+HDF5_FILE = FileKind("an HDF5 dataset of the testbed", (b"\x89HDF\r\n\x1a\n",), ours=_hdf5_ours)
+#: any JSON (the kind a caller with no marker of its own names)
+JSON_FILE = FileKind("a JSON file", (b"{", b"["), text=True)
+IDENTIFIED_JSON_FILE = FileKind("a model summary written by `testbed identify`", (b"{",),
+                                text=True, ours=_identified_ours)
+SEP005_FILE = FileKind("a SEP-005 export of the testbed", (b"[",), text=True, ours=_sep005_ours)
+UFF_FILE = FileKind("a UFF export of the testbed", (b"-1",), text=True, ours=_uff_ours)
+MARKDOWN_FILE = FileKind("a markdown report", (b"#",), text=True)
 #: the first line of a run's or a study's markdown report (``testbed.reporting.report``): an
 #: HTML comment no renderer shows.  Its title alone (``# Run `` / ``# Study ``, read 27b) let a
 #: user's own ``# Study notes`` be replaced (review 27e M2); a report written before this line
@@ -126,12 +236,12 @@ REPORT_MARKDOWN_MARK = "<!-- sysid-testbed report -->"
 LEGACY_REPORT_MARKDOWN = re.compile(
     rb"# Run [^\n]*\n\n(PASS|FAIL|NO VERDICT): [^\n]*; identifier [^\n]*, fit [^\n]* s\.\n"
     rb"|# Study [^\n]*\n\n\d+ cells: \d+ scenario\(s\), \d+ identifier\(s\) \(")
-REPORT_MARKDOWN_FILE: FileKind = ("a markdown report", (REPORT_MARKDOWN_MARK.encode(),
-                                                       LEGACY_REPORT_MARKDOWN))
+REPORT_MARKDOWN_FILE = FileKind("a markdown report", (REPORT_MARKDOWN_MARK.encode(),
+                                                     LEGACY_REPORT_MARKDOWN), text=True)
 #: an identified model's report (``testbed.reporting.identified``: its first line since it was
 #: written): a user's own ``notes.md`` beside ``identify -o notes.json`` is not ours (review 27e)
-IDENTIFIED_MARKDOWN_FILE: FileKind = ("an identified model's markdown report",
-                                      (b"# Identified model: ",))
+IDENTIFIED_MARKDOWN_FILE = FileKind("an identified model's markdown report",
+                                    (b"# Identified model: ",), text=True)
 #: the Content-Security-Policy of every page the testbed writes (no network, no script)
 REPORT_CSP = "default-src 'none'; img-src data:; style-src 'unsafe-inline'"
 #: every HTML page the testbed writes begins so (``testbed.reporting.report``).  The doctype
@@ -140,55 +250,60 @@ REPORT_CSP = "default-src 'none'; img-src data:; style-src 'unsafe-inline'"
 #: 27e M2, the HTML's part)
 HTML_REPORT_HEAD = ('<!DOCTYPE html>\n<html lang="en"><head><meta charset="utf-8">'
                     f'<meta http-equiv="Content-Security-Policy" content="{REPORT_CSP}">')
-HTML_FILE: FileKind = ("an HTML report", (HTML_REPORT_HEAD.encode(),))
-PNG_FILE: FileKind = ("a PNG figure", (b"\x89PNG\r\n\x1a\n",))
+HTML_FILE = FileKind("an HTML report", (HTML_REPORT_HEAD.encode(),), text=True)
+PNG_FILE = FileKind("a PNG figure of the testbed", (b"\x89PNG\r\n\x1a\n",), ours=_png_ours)
 #: a sweep's results file (Apache Parquet's magic number)
-PARQUET_FILE: FileKind = ("a Parquet results file", (b"PAR1",))
+PARQUET_FILE = FileKind("a Parquet results file", (b"PAR1",))
 
 
-def foreign_head(path: Path, kind: FileKind) -> bytes | None:
-    """The first bytes of an existing, non-empty file at ``path`` that does not begin as
-    ``kind``'s files do, else None (no file, an empty one, one of the kind, no regular file (a
-    FIFO, socket or device: :func:`not_regular` names it) or unreadable: :func:`refuse_foreign`
-    names that).
+#: What :func:`_inspect` finds at a path: nothing to refuse, a foreign file's head, unreadable
+_UNREADABLE = object()
 
-    Round 27: ``generate -o photo.png`` replaced the user's picture by a dataset in silence, as
-    ``identify`` / ``export -o`` and ``family write`` (a member's name) replaced any file.  Text
-    kinds are compared after leading blanks and a UTF-8 byte-order mark.  Reads 64 bytes (or
-    the kind's longest prefix, or :data:`PATTERN_READ` for a pattern); returns at most 64.
-    """
+
+def _inspect(path: Path, kind: FileKind) -> bytes | object | None:
+    """One opening of ``path``: None (no file, an empty one, one of the kind, or no regular
+    file: :func:`not_regular` names that), the first bytes (at most 64) of a file not of the
+    kind, or :data:`_UNREADABLE` for a regular file this process may not read."""
     try:
         # without blocking: a FIFO nobody writes to hung a plain open for good (review 27e);
         # anything but a regular file is left to not_regular (the write's own check) to name
         fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK)
+    except PermissionError:
+        return _UNREADABLE if os.path.isfile(path) else None
     except (OSError, ValueError):
         return None
     try:
         if not stat.S_ISREG(os.fstat(fd).st_mode):
             return None
         head = os.read(fd, max(64, *(len(p) if isinstance(p, bytes) else PATTERN_READ
-                                      for p in kind[1])))
+                                      for p in kind.heads)))
+        if not head:
+            return None
+        text = head.removeprefix(b"\xef\xbb\xbf").lstrip() if kind.text else head
+        ours = any(text.startswith(p) if isinstance(p, bytes) else p.match(text)
+                   for p in kind.heads)
+        if ours and kind.ours is not None:
+            ours = kind.ours(fd)
     except OSError:
         return None
     finally:
         os.close(fd)
-    # a binary format's signature (HDF5, PNG) opens with 0x89; a pattern is a text kind's
-    binary = any(isinstance(p, bytes) and not p.isascii() for p in kind[1])
-    text = head if binary else head.removeprefix(b"\xef\xbb\xbf").lstrip()
-    ours = any(text.startswith(p) if isinstance(p, bytes) else p.match(text) for p in kind[1])
-    return head[:64] if head and not ours else None
+    return None if ours else head[:64]
 
 
-def _unreadable(path: Path) -> bool:
-    """True for an existing regular file this process may not read (its kind cannot be told)."""
-    try:
-        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK)
-    except PermissionError:
-        return os.path.isfile(path)
-    except (OSError, ValueError):
-        return False
-    os.close(fd)
-    return False
+def foreign_head(path: Path, kind: FileKind) -> bytes | None:
+    """The first bytes (at most 64) of an existing, non-empty file at ``path`` that is not
+    ``kind``'s, else None (no file, an empty one, one of the kind, no regular file (a FIFO,
+    socket or device: :func:`not_regular` names it) or unreadable: :func:`refuse_foreign` names
+    that).
+
+    Round 27: ``generate -o photo.png`` replaced the user's picture by a dataset in silence, as
+    ``identify`` / ``export -o`` and ``family write`` (a member's name) replaced any file.  A
+    file is of the kind if it begins as :attr:`FileKind.heads` says and, for a format anyone
+    writes, carries the testbed's marker (:attr:`FileKind.ours`; review 28b M2).
+    """
+    found = _inspect(path, kind)
+    return found if isinstance(found, bytes) else None
 
 
 def refuse_foreign(path: str | os.PathLike, kind: FileKind, name: str | None = None,
@@ -201,16 +316,17 @@ def refuse_foreign(path: str | os.PathLike, kind: FileKind, name: str | None = N
     ``identify`` / ``export -o``, ``report``'s every output, ``family write``'s members,
     ``sweep --results``; review 27e: four copies of this text).  ``name`` is how the path is
     shown (default: the path; e.g. ``"--output out.h5"``), ``expected`` what is allowed (default:
-    a new path or a file of the kind the command wrote).
+    a new path or a file of the kind the command wrote).  The file is opened once (review 28:
+    twice, the second reading a file the first had not).
     """
     shown = name or terminal_safe(os.fspath(path))
-    what = kind[0]
+    what = kind.what
     allowed = expected or f"a new path or {what} this command wrote"
-    head = foreign_head(Path(path), kind)
-    if head is not None:
-        raise InputError(f"{shown}: exists and is not {what} (it begins with {head[:16]!r}); "
+    found = _inspect(Path(path), kind)
+    if isinstance(found, bytes):
+        raise InputError(f"{shown}: exists and is not {what} (it begins with {found[:16]!r}); "
                          f"expected {allowed} (the file is left as it is)")
-    if _unreadable(Path(path)):
+    if found is _UNREADABLE:
         raise InputError(f"{shown}: exists and cannot be read, so whether it is {what} cannot be "
                          f"told; expected {allowed} (the file is left as it is)")
 

@@ -54,7 +54,7 @@ from typing import Any
 
 import numpy as np
 
-from testbed.core.atomic import atomic_write_text, refuse_foreign
+from testbed.core.atomic import FileKind, atomic_write_text, refuse_foreign
 from testbed.core.errors import ScenarioError
 from testbed.core.schema import ONE_LINE, ONE_LINE_DOC, Field, check_value, validate_table
 from testbed.pipeline.plugins import RIGS
@@ -584,8 +584,8 @@ def scenario_toml(sc: Scenario) -> str:
 
 #: The first line of every member file (:func:`scenario_toml`): a file at a member's path that
 #: begins otherwise is the user's and is not replaced (:func:`write_members`).
-MEMBER_FILE = ("a member file written by `testbed family write`",
-               (b"# Written by testbed.studies.study.write_family",))
+MEMBER_FILE = FileKind("a member file written by `testbed family write`",
+                       (b"# Written by testbed.studies.study.write_family",), text=True)
 
 
 def write_members(members: list[Scenario], out_dir: str | os.PathLike) -> list[Path]:

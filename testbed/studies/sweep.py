@@ -788,14 +788,17 @@ def _run_locked(study: Study, jobs: int, dask_address: str | None, results: Path
         for tmp in parts_dir(results).glob(".*.tmp"):
             tmp.unlink(missing_ok=True)
     try:
-        previous = read_results(results, set_aside=True, resuming=True)
+        previous, damaged = read_results(results, set_aside=True, resuming=True), None
     except ResultsError as e:  # a damaged consolidated file: keep it aside, rerun its cells
-        # not Parquet at all (a dataset was renamed *.bad): not ours, refused, not set aside
+        previous, damaged = [], e
+    if damaged is not None:
+        # not Parquet at all (a dataset was renamed *.bad): not ours, refused, not set aside;
+        # outside the handler, so the refusal is not chained to the ResultsError (review 28)
         refuse_foreign(results, PARQUET_FILE, f"results {results}",
                        f"a results file of study {study.name!r} or a new path")
         bad = results.with_name(results.name + ".bad")
         os.replace(results, bad)
-        log.warning("%s; set aside as %s, its cells will run again", e, bad.name)
+        log.warning("%s; set aside as %s, its cells will run again", damaged, bad.name)
         previous = read_results(results, set_aside=True, resuming=True)
     others = sorted({str(r.get("study")) for r in previous if r.get("study") not in (None, "", study.name)})
     if others:  # consolidating would drop every row of the other study: refused, nothing touched

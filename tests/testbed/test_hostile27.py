@@ -53,7 +53,8 @@ def test_report_refuses_an_empty_source_or_runs_folder(capsys, argv):
 PNG = b"\x89PNG\r\n\x1a\n" + bytes(range(64))
 
 
-@pytest.mark.parametrize("kind", [cli.HDF5_FILE, cli.JSON_FILE, cli.UFF_FILE, MARKDOWN_FILE])
+@pytest.mark.parametrize("kind", [cli.HDF5_FILE, cli.IDENTIFIED_JSON_FILE, cli.SEP005_FILE,
+                                  cli.UFF_FILE, MARKDOWN_FILE])
 def test_an_output_of_another_kind_is_refused_and_left_as_it_is(tmp_path, kind):
     # `generate -o photo.png` replaced the picture by a dataset, status 0 (as identify / export)
     photo = tmp_path / "photo.png"
@@ -63,13 +64,30 @@ def test_an_output_of_another_kind_is_refused_and_left_as_it_is(tmp_path, kind):
     assert photo.read_bytes() == PNG
 
 
+#: An earlier UFF export's first record and the head of its first UFF58 (ID line 5 the marker)
+UFF_HEAD = (b"    -1\n   164\n         1  SI\n    -1\n    -1\n    58b     1     2\n"
+            b"x/x\ngeneral [mM]\nscenario s seed 0\ncontent hash 00\nfs 100.0 Hz, sysid-testbed\n")
+
+
+def _earlier_h5(path):
+    import h5py
+    with h5py.File(path, "w") as f:
+        f.attrs["format"] = "sysid-testbed-dataset/2"
+    return path.read_bytes()
+
+
 @pytest.mark.parametrize("kind, head", [
-    (cli.HDF5_FILE, b"\x89HDF\r\n\x1a\n\x00\x00"), (cli.JSON_FILE, b"\xef\xbb\xbf \n{\"a\": 1}"),
-    (cli.JSON_FILE, b"[1]"), (cli.UFF_FILE, b"    -1\n   58\n"), (MARKDOWN_FILE, b"# model\n"),
-    (cli.JSON_FILE, b"")])
+    (cli.HDF5_FILE, _earlier_h5),
+    (cli.IDENTIFIED_JSON_FILE, b'\xef\xbb\xbf \n{"source": "d.h5", "kind": "dynamical", '
+                               b'"method": "m", "fs_hz": 1, "n_samples": 2, "identifier": {}}'),
+    (cli.SEP005_FILE, b'[{"name": "x/x", "data": [1], "fs": 1, "content_hash": "0", "group": "measured"}]'),
+    (cli.UFF_FILE, UFF_HEAD), (MARKDOWN_FILE, b"# model\n"), (cli.IDENTIFIED_JSON_FILE, b"")])
 def test_an_output_of_its_own_kind_or_empty_is_replaced_as_before(tmp_path, kind, head):
     earlier = tmp_path / "earlier.out"
-    earlier.write_bytes(head)
+    if callable(head):
+        head(earlier)
+    else:
+        earlier.write_bytes(head)
     assert cli._output_file(earlier, "--output", kind=kind) == earlier
 
 
