@@ -72,6 +72,7 @@ from testbed.core.errors import (
 from testbed.core.exit_guard import ProcessExitCalled, no_process_exit
 from testbed.core.measurement import MIN_FREE_SAMPLES, Measurement, Trajectory, check_prior_values
 from testbed.core.process_state import kept_process_state
+from testbed.core.registry import builtin_class
 from testbed.core.schema import ErrorFn, Field, KeyUse, check_keys_used, validate_table
 
 #: Types of a hyperparameter's value that are a number, a text or a sequence no scenario file
@@ -616,7 +617,7 @@ def _called(model: Identifier, where: str, method: Callable[..., Any], *a: Any,
     not ``NotImplementedError`` or ``KeyboardInterrupt``; a ``sys.exit`` included) becomes a
     :class:`~testbed.core.errors.PluginMethodError` naming the method and the exception's type,
     which scoring turns into a failure (hostile round 28)."""
-    if type(model).__module__.partition(".")[0] == "identify":
+    if builtin_class(type(model)):
         return method(model, *a, **kw)
     try:
         with no_process_exit(), kept_process_state(defaults=False):
@@ -669,7 +670,13 @@ def _guard_fitted(name: str, method: Callable[..., Any]) -> Callable[..., Any]:
                                     f"expected at least {MIN_SCORED_SAMPLES} samples from "
                                     f"free_start to the end (the record has {data.n_samples}): "
                                     "R^2 needs the measured accelerations' variance")
-        return _called(self, where, method, *a, **kw)
+        out = _called(self, where, method, *a, **kw)
+        if name == "simulate" and not isinstance(out, Trajectory) and not builtin_class(type(self)):
+            # a plugin's simulate returning an array, a list or a generator ended `testbed run`
+            # in AttributeError "... has no attribute 'x'" (hostile round 29): its failure
+            raise PluginMethodError(f"{where} returned {args.describe(out)}, not a Trajectory "
+                                    "(x, xd, xdd: each channels x times)")
+        return out
 
     guarded._api_guard = True  # type: ignore[attr-defined]
     return guarded

@@ -67,15 +67,26 @@ def unusable_path(e: BaseException) -> str | None:
             or getattr(e, "strerror", None) or type(e).__name__)
 
 
+#: Characters of an exception's text :func:`exception_text` keeps: a plugin's 100,000-character
+#: message made a failed fit's reason, and every table and report holding it, that long
+#: (review 28a L6); the head says what failed
+MAX_EXCEPTION_CHARS = 1000
+
+
 def exception_text(e: BaseException) -> str:
-    """``str(e)`` on one line (blanks collapsed), or a stand-in naming its type where the
-    exception's own ``__str__`` raises: a plugin's exception whose ``__str__`` raised turned a
-    failed fit into an internal error (hostile round 28)."""
+    """``str(e)`` on one line (blanks collapsed) and cut to :data:`MAX_EXCEPTION_CHARS`
+    characters (the cut marked ``[... N more characters]``), or a stand-in naming its type where
+    the exception's own ``__str__`` raises: a plugin's exception whose ``__str__`` raised turned
+    a failed fit into an internal error (hostile round 28).  The one reading of an exception
+    not the testbed's own (a plugin's fit, simulate, import; a sweep cell's error)."""
     try:
         text = str(e)
     except Exception:
         return f"(no message: {type(e).__name__}.__str__ failed)"
-    return " ".join(text.split())
+    text = " ".join(text.split())
+    if len(text) <= MAX_EXCEPTION_CHARS:
+        return text
+    return f"{text[:MAX_EXCEPTION_CHARS]}[... {len(text) - MAX_EXCEPTION_CHARS} more characters]"
 
 
 def show_text(text: str) -> str:

@@ -277,3 +277,14 @@ class Registry:
     def __contains__(self, name: str) -> bool:
         self._load()
         return name in self._entries
+
+
+def builtin_class(cls: type) -> bool:
+    """True for an identifier class of the testbed's own (defined in the ``identify`` package),
+    whose exceptions are the testbed's bugs; any other (a plugin's, a subclass of a built-in
+    defined elsewhere) is a user's, whose exceptions are its failures.  The one rule of both
+    wrappers of an identifier's methods, :func:`identify._base._called` and
+    :func:`testbed.pipeline.fit.fit_or_fail` (review 28a L5: ``_called`` decided by module,
+    ``fit_or_fail`` by registry origin, so a built-in class registered again through the API under a name of the user's was
+    a plugin to one and a built-in to the other)."""
+    return cls.__module__.partition(".")[0] == "identify"
