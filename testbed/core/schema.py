@@ -28,6 +28,14 @@ REQUIRED = object()
 #: paragraph separators.
 ONE_LINE = "[^\\x00-\\x1f\\x7f-\\x9f\\u2028\\u2029]*"
 ONE_LINE_DOC = "of one line without control characters (newline, tab, escape)"
+#: A lookahead for a text holding at least one visible character: not blanks alone (a no-break
+#: space included, round 25) nor invisible format characters alone (a zero-width space or
+#: joiner, a direction mark, a soft hyphen, a variation selector, the Hangul fillers, a
+#: byte-order mark: a tag of one zero-width space listed as a gap and selected nothing, hostile
+#: round 29)
+VISIBLE = ("(?=.*[^\\s\u00ad\u034f\u061c\u115f\u1160\u17b4\u17b5\u180b-\u180f\u200b-\u200f"
+           "\u202a-\u202e\u2060-\u206f\u3164\ufe00-\ufe0f\ufeff\uffa0])")
+VISIBLE_DOC = "not blank or invisible characters alone"
 
 _TYPE_NAMES = {bool: "a boolean", int: "an integer", float: "a number", str: "a string",
                list: "a list", dict: "a table", object: "any value"}

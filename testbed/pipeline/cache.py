@@ -158,8 +158,10 @@ _UNWRITABLE_WARNED: set[str] = set()
 
 def _load_entry(path: Path, scenario: Scenario) -> Dataset:
     """A cache entry, verified: its content hash (:meth:`Dataset.load`), its rate attributes
-    (:func:`~testbed.core.rate_attrs.fs_attribute_problem`) and its rate against the record its
-    scenario asks for (:meth:`Rig.record`, where the rig declares one).
+    (:func:`~testbed.core.rate_attrs.fs_attribute_problem`) and its rate and number of samples
+    against the record its scenario asks for (:meth:`Rig.record`, where the rig declares one).
+    An edit made with the content hash anew that keeps the rate and length (samples scaled, a
+    channel renamed) is not seen: the hash guards against damage, not against a forger.
 
     :meth:`Dataset.load` reads ``fs`` with ``float()`` and no unit (round 17, open item 2 of
     round 18: the text ``"12800"``, ``True`` or ``fs_unit = "kHz"`` were read as rates); checking
@@ -181,6 +183,12 @@ def _load_entry(path: Path, scenario: Scenario) -> Dataset:
     if record is not None and off_scenario_rate(ds.fs, float(record[0])):
         raise DatasetError(path, f"attribute fs={ds.fs!r} Hz; its scenario records at "
                                  f"{float(record[0])!r} Hz")
+    if record is not None and ds.n_samples != int(record[1]):
+        # an entry cut and its content hash made anew was served as its scenario's record
+        # (hostile round 29): the windows, the chain and the scores' time axis then belong to
+        # a shorter record
+        raise DatasetError(path, f"holds {ds.n_samples} samples; its scenario records "
+                                 f"{int(record[1])}")
     return ds
 
 

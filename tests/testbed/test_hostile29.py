@@ -1,0 +1,254 @@
+"""Round 29's findings (``benchmarks/hostile29.py``) and review 28's open items: outputs known
+for the testbed's own by a marker it writes (28b M2), one opening of a file to tell its kind,
+a plugin's simulate returning no trajectory, one rule of what is built-in, a cut exception
+text, a cache entry cut with its hash made anew, an invisible tag."""
+
+from __future__ import annotations
+
+import io
+
+import numpy as np
+import pytest
+
+import testbed
+from testbed.core import atomic
+from testbed.core.atomic import (
+    HDF5_FILE,
+    IDENTIFIED_JSON_FILE,
+    PARQUET_FILE,
+    PNG_FILE,
+    SEP005_FILE,
+    UFF_FILE,
+    foreign_head,
+    refuse_foreign,
+)
+from testbed.core.errors import (
+    MAX_EXCEPTION_CHARS,
+    IdentificationError,
+    InputError,
+    PluginMethodError,
+    exception_text,
+)
+from testbed.core.measurement import Measurement
+from testbed.core.registry import builtin_class
+from tests.testbed._saved_record import saved_record
+
+
+def _matplotlib_png() -> bytes:
+    """A PNG as anyone's matplotlib writes it (a user's own figure)."""
+    import matplotlib.pyplot as plt
+
+    fig = plt.figure(figsize=(1, 1))
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png")
+    plt.close(fig)
+    return buf.getvalue()
+
+
+def test_a_users_matplotlib_png_is_refused_where_a_report_figure_goes(tmp_path):
+    # review 28b M2: any PNG passed for a report's own figure, so a user's fit_time.png in the
+    # folder named was replaced; now the figure's text chunk Software=sysid-testbed is asked
+    import matplotlib.pyplot as plt
+
+    from testbed.reporting.figures import save_figure
+
+    mine = tmp_path / "fit_time.png"
+    mine.write_bytes(_matplotlib_png())
+    before = mine.read_bytes()
+    with pytest.raises(InputError, match=r"fit_time\.png: exists and is not a PNG figure of the testbed"):
+        save_figure(plt.figure(figsize=(1, 1)), mine)
+    assert mine.read_bytes() == before
+    ours = tmp_path / "ours.png"
+    save_figure(plt.figure(figsize=(1, 1)), ours)
+    save_figure(plt.figure(figsize=(1, 1)), ours)  # its own earlier figure: replaced
+    plt.close("all")
+    assert foreign_head(ours, PNG_FILE) is None
+
+
+def test_a_report_keeps_a_users_png_through_write_report(tmp_path):
+    # 28b L4: driven through the caller (write_report of a results file), not Page directly
+    from benchmarks._hostile import results_row
+    from testbed.reporting.report import write_report
+    from testbed.studies.results import write_rows
+
+    res = write_rows(tmp_path / "r.parquet", [results_row()]) or tmp_path / "r.parquet"
+    out = tmp_path / "rep"
+    out.mkdir()
+    (out / "fit_time.png").write_bytes(_matplotlib_png())
+    kept = {p.name: p.read_bytes() for p in out.iterdir()}
+    with pytest.raises(InputError, match=r"fit_time\.png: exists and is not a PNG figure"):
+        write_report(res, out)
+    assert {p.name: p.read_bytes() for p in out.iterdir()} == kept  # nothing written
+
+
+def test_a_users_json_given_to_identify_is_refused(cli_in_process, tmp_path):
+    # review 28b M2: `identify -o settings.json` replaced the user's settings (any JSON passed)
+    data = saved_record(tmp_path)
+    settings = tmp_path / "settings.json"
+    settings.write_text('{"theme": "dark"}\n')
+    p = cli_in_process("identify", str(data), "--kind", "structural", "-o", str(settings),
+                       cwd=tmp_path)
+    assert p.returncode == 2 and "settings.json: exists and is not a model summary" in p.stderr
+    assert settings.read_text() == '{"theme": "dark"}\n'
+
+
+def test_exports_of_the_testbed_are_replaced_and_anyone_elses_refused(cli_in_process, tmp_path):
+    data = saved_record(tmp_path)
+    for fmt, name in (("uff", "d.uff"), ("sep005", "d.json")):
+        out = tmp_path / name
+        for _ in range(2):  # written, then its own earlier export replaced
+            p = cli_in_process("export", str(data), "--format", fmt, "-o", str(out), cwd=tmp_path)
+            assert p.returncode == 0, p.stderr
+    assert foreign_head(tmp_path / "d.uff", UFF_FILE) is None
+    assert foreign_head(tmp_path / "d.json", SEP005_FILE) is None
+    other = tmp_path / "other.json"
+    other.write_text('[{"name": "a", "data": [1, 2], "fs": 10}]')  # someone's SEP-005
+    p = cli_in_process("export", str(data), "--format", "sep005", "-o", str(other), cwd=tmp_path)
+    assert p.returncode == 2 and "is not a SEP-005 export of the testbed" in p.stderr
+    uff = tmp_path / "other.uff"
+    uff.write_text("    -1\n   151\nmodel\n    -1\n")  # someone's UFF (a header record)
+    with pytest.raises(InputError, match="is not a UFF export of the testbed"):
+        refuse_foreign(uff, UFF_FILE)
+
+
+def test_an_hdf5_file_of_another_tool_is_refused_and_a_dataset_replaced(tmp_path):
+    import h5py
+
+    other = tmp_path / "other.h5"
+    with h5py.File(other, "w") as f:
+        f.attrs["format"] = "netcdf"
+    assert foreign_head(other, HDF5_FILE) is not None
+    assert foreign_head(saved_record(tmp_path), HDF5_FILE) is None  # format sysid-testbed-dataset/2
+    cut = tmp_path / "cut.h5"
+    cut.write_bytes(saved_record(tmp_path).read_bytes()[:200])  # the signature, then cut
+    assert foreign_head(cut, HDF5_FILE) is not None
+
+
+def test_the_identified_json_marker_is_its_keys(tmp_path):
+    p = tmp_path / "m.json"
+    p.write_text('{"source": "d.h5", "kind": "structural", "method": "ls_sindy", "fs_hz": 1.0, '
+                 '"n_samples": 2, "identifier": {"name": "ls_sindy"}}')
+    assert foreign_head(p, IDENTIFIED_JSON_FILE) is None
+    p.write_text('{"source": "d.h5"}')
+    assert foreign_head(p, IDENTIFIED_JSON_FILE) == b'{"source": "d.h5"}'
+
+
+def test_a_binary_kind_is_compared_byte_for_byte(tmp_path):
+    # review 28: Parquet's ASCII magic number was read as a text kind's, after blanks
+    p = tmp_path / "r.parquet"
+    p.write_bytes(b"  \nPAR1 and more")
+    assert foreign_head(p, PARQUET_FILE) == b"  \nPAR1 and more"
+    p.write_bytes(b"PAR1 and more")
+    assert foreign_head(p, PARQUET_FILE) is None
+
+
+def test_refuse_foreign_opens_the_file_once(tmp_path, monkeypatch):
+    p = tmp_path / "x.png"
+    p.write_bytes(_matplotlib_png())
+    opened = []
+    real = atomic.os.open
+    monkeypatch.setattr(atomic.os, "open", lambda path, *a, **k: opened.append(path) or real(path, *a, **k))
+    with pytest.raises(InputError):
+        refuse_foreign(p, PNG_FILE)
+    assert len(opened) == 1
+
+
+def test_sweeps_refusal_of_a_foreign_results_file_is_not_chained(tmp_path):
+    # review 28: raised inside the ResultsError's handler, it carried that error as context
+    from testbed.studies.study import load_study
+
+    study = tmp_path / "s.toml"
+    study.write_text('[study]\nname = "s"\nscenarios = ["michaelis_menten"]\nnoise = [0.0]\n'
+                     'seeds = [0]\nidentifiers = ["sindy_pi_dynamical"]\n')
+    res = tmp_path / "r.parquet"
+    res.write_bytes(b"\x89HDF\r\n\x1a\n" + bytes(16))
+    with pytest.raises(InputError, match="is not a Parquet results file") as e:
+        testbed.run_sweep(load_study(study), results=res, cache_dir=tmp_path / "c")
+    assert e.value.__context__ is None and e.value.__cause__ is None
+    assert res.read_bytes() == b"\x89HDF\r\n\x1a\n" + bytes(16)
+
+
+class _Returns(testbed.Identifier):
+    """A plugin identifier (defined outside ``identify``) whose simulate returns ``ret``."""
+
+    name, kind = "returns", "structural"
+    ret: object = None
+
+    def fit(self, data):
+        n = data.n_channels
+        self.M_, self.C_, self.K_ = np.eye(n), np.zeros((n, n)), np.eye(n)
+        self.channels_ = tuple(data.channels)
+        return self
+
+    def simulate(self, x0, xd0, t, u=None):
+        return self.ret
+
+
+@pytest.mark.parametrize("ret", [np.zeros((1, 5)), [[0.0] * 5], None, (r for r in [])])
+def test_a_plugins_simulate_returning_no_trajectory_is_its_failure(ret):
+    # hostile round 29: AttributeError "'numpy.ndarray' object has no attribute 'x'" from the
+    # scorer ended `testbed run`; now a PluginMethodError, which scoring calls a failed simulation
+    x = np.sin(np.arange(50) / 5.0)[None, :]
+    model = _Returns().fit(Measurement(100.0, x, x, x, ("x1",)))
+    model.ret = ret
+    with pytest.raises(PluginMethodError, match=r"_Returns\.simulate returned .*not a Trajectory"):
+        model.simulate(np.zeros(1), np.zeros(1), np.arange(5) / 100.0)
+
+
+def test_one_rule_says_which_identifier_is_built_in():
+    # review 28a L5: fit_or_fail went by registry origin (method None: "builtin"), _called by
+    # module; a test's plugin fitted without a registered name was the testbed's bug to one
+    from testbed.pipeline.fit import fit_or_fail
+
+    assert builtin_class(testbed.IDENTIFIERS.get("sindy_pi_dynamical"))
+    assert not builtin_class(_Returns)
+
+    class Raises(_Returns):
+        def fit(self, data):
+            raise ValueError("mine")
+
+    x = np.sin(np.arange(50) / 5.0)[None, :]
+    with pytest.raises(IdentificationError, match=r"identifier Raises \(from module .*\) raised "
+                                                  r"ValueError: mine"):
+        fit_or_fail(Raises(), Measurement(100.0, x, x, x, ("x1",)))
+
+
+def test_an_exception_text_is_cut():
+    # review 28a L6: a plugin's 100,000-character message was carried whole
+    text = exception_text(ValueError("line\n" * 20000))
+    assert len(text) < MAX_EXCEPTION_CHARS + 40 and text.endswith("more characters]")
+    assert exception_text(ValueError("short  text\n")) == "short text"
+
+
+def test_a_cache_entry_cut_with_its_hash_anew_is_simulated_again(tmp_path, caplog):
+    # hostile round 29: an entry holding half its samples, its content hash made anew, was
+    # served as its scenario's record (the rate was checked, the length not)
+    import h5py
+
+    from benchmarks.hostile19 import _rehash
+    from testbed.pipeline.cache import DatasetCache
+
+    sc = testbed.load_scenario("michaelis_menten")
+    cache = DatasetCache(tmp_path)
+    n = cache.clean(sc).n_samples
+    entry = cache.path(sc)
+    with h5py.File(entry, "r+") as f:  # every array along time cut to its first half
+        names = []
+        f.visititems(lambda k, o: names.append(k) if isinstance(o, h5py.Dataset) and o.ndim
+                     and o.shape[-1] == n else None)
+        for k in names:
+            a, attrs = f[k][()], dict(f[k].attrs)
+            del f[k]
+            f.create_dataset(k, data=a[..., : n // 2])
+            f[k].attrs.update(attrs)
+    _rehash(entry)
+    with caplog.at_level("WARNING"):
+        again = cache.clean(sc)
+    assert again.n_samples == n and f"samples; its scenario records {n}" in caplog.text
+
+
+@pytest.mark.parametrize("tag", ["\u200b", "\ufeff", "\u200d\u2060"])
+def test_a_tag_of_invisible_characters_alone_is_refused(tag):
+    with pytest.raises(testbed.TestbedError, match=r"scenario\.tags"):
+        testbed.scenario_from_dict({"scenario": {"name": "x", "rig": "michaelis_menten",
+                                                 "tags": ["a", tag]}})
