@@ -753,13 +753,23 @@ def _start(st: _Server, conn: socket.socket, request: dict, fds: list[int]) -> N
     with contextlib.suppress(OSError):
         os.setpgid(pid, pid)  # (also done by the child: whichever runs first)
     st.running[pid] = conn
-    st.log(f"testbed server: {' '.join(request['argv'])} (pid {pid})")
+    command = " ".join(request["argv"])
+    # The "(pid N)" line is written after the send, in both outcomes.  Before it (speed29's
+    # find), a server killed on seeing the line could leave its client without the pid; that
+    # client read the end of the connection as "no server took it" and ran the command alone.
+    # Written only after a send that succeeded (1912d47, reverted), it was never written for a
+    # client that had closed its end before the reply: on a Unix socket the send then fails at
+    # once (EPIPE), so under load, where the close came first, a watcher of the log waited in
+    # vain (test_server's "client gone before the reply" test, intermittently)
     try:
         _send(conn, {"pid": pid})
     except OSError:  # the client went away meanwhile (killed, Ctrl-C): so does its command
         with contextlib.suppress(ProcessLookupError):
             os.killpg(pid, signal.SIGKILL)
+        st.log(f"testbed server: {command}: its client left before its pid was sent, so the "
+               f"command was stopped (pid {pid})")
         return
+    st.log(f"testbed server: {command} (pid {pid})")
     st.sel.register(conn, selectors.EVENT_READ, ("running", pid))
 
 

@@ -3,6 +3,7 @@ dies leaves no process behind, a server of other sources or environment is not u
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import re
@@ -390,3 +391,62 @@ def test_another_scenario_folder_runs_alone(sleeper):
         assert r.returncode == cli.EXIT_USAGE and "invalid choice: 'sleep'" in r.stderr, r.stderr
     assert not _pids(tmp)
     assert sum("refused a command from another key" in ln for ln in _served_lines(tmp)) == 2
+
+
+def _start_with(monkeypatch, peer_open: bool):
+    """``server._start`` of a request whose forked child is a stand-in (a ``sleep`` in its own
+    group), its client one end of a socket pair (closed when not ``peer_open``); returns the
+    log lines, each with whether the client's end held the pid reply when it was written, the
+    stand-in's pid, and its status if ``_start`` stopped it (else None)."""
+    import selectors
+
+    from testbed import server
+
+    stand_in = subprocess.Popen(["sleep", "30"], start_new_session=True)
+    monkeypatch.setattr(server.os, "fork", lambda: stand_in.pid)
+    conn, client = socket.socketpair(socket.AF_UNIX, socket.SOCK_STREAM)
+    if not peer_open:
+        client.close()
+    lines: list[tuple[str, bool]] = []
+
+    def log(text):
+        held = False
+        if peer_open:
+            try:
+                held = bool(client.recv(64, socket.MSG_PEEK | socket.MSG_DONTWAIT))
+            except BlockingIOError:
+                pass
+        lines.append((text, held))
+
+    st = server._Server.__new__(server._Server)
+    st.log, st.running, st.sel = log, {}, selectors.DefaultSelector()
+    try:
+        server._start(st, conn, {"argv": ["sleep", "60"]}, [])
+        ended = None  # the stand-in's status if _start stopped it (within 5 s), else None
+        with contextlib.suppress(subprocess.TimeoutExpired):
+            ended = stand_in.wait(timeout=0.05 if peer_open else 5)
+        return lines, stand_in.pid, ended
+    finally:
+        st.sel.close()
+        conn.close()
+        if peer_open:
+            client.close()
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(stand_in.pid, signal.SIGKILL)
+        stand_in.wait()
+
+
+def test_a_commands_pid_line_is_logged_once_its_client_holds_the_pid(monkeypatch):
+    # speed29: logged before the send, a server killed on seeing the line left its client
+    # without the pid, and the client ran the command alone
+    lines, pid, ended = _start_with(monkeypatch, peer_open=True)
+    assert lines == [(f"testbed server: sleep 60 (pid {pid})", True)] and ended is None
+
+
+def test_a_commands_pid_line_is_logged_when_its_client_left_before_the_reply(monkeypatch):
+    # the reverted fix (1912d47) logged only after a send that succeeded: a client that closed
+    # first (EPIPE on a Unix socket) left no line, and test_server's watcher of the log waited
+    lines, pid, ended = _start_with(monkeypatch, peer_open=False)
+    assert [t for t, _ in lines] == [f"testbed server: sleep 60: its client left before its pid "
+                                     f"was sent, so the command was stopped (pid {pid})"]
+    assert ended == -signal.SIGKILL
