@@ -33,7 +33,9 @@ Families (what rounds 1-28 did not try; their families are listed in ``hostile21
     A ``--plugin`` identifier of the kinetics whose coefficients, after its own fit, are a masked
     array (some masked), a ``np.matrix``, float32, float16, an object array of floats, a
     read-only array, a list, a ``ndarray`` subclass, complex with zero imaginary part, or whose
-    ``simulate`` returns one of those: a verdict, never a traceback or NaN passing.
+    ``simulate`` returns one of those, or a ``Trajectory`` whose fields are float32, masked,
+    complex, object, lists, text, of half the times, transposed, 1-D, None, all NaN, with an
+    inf, ``np.matrix``, or a plain tuple: a verdict, never a traceback or NaN passing.
 ``apiforms``
     The API given numpy scalars (``np.float64`` noise, ``np.int64`` seed, ``np.str_`` names),
     ``pathlib.Path`` where a text is documented and the reverse, generators and tuples where a
@@ -471,6 +473,26 @@ _ODD_SIMULATE = {
 }
 
 
+#: A plugin's simulate returning a Trajectory whose fields are odd (``t`` its own trajectory)
+_ODD_FIELDS = {
+    "float32 fields": "Trajectory(*(np.asarray(f, np.float32) for f in t))",
+    "masked fields, one sample masked": "Trajectory(*(np.ma.masked_array(f, np.eye(1, f.size, f.size // 2, dtype=bool).reshape(f.shape)) for f in t))",
+    "complex fields": "Trajectory(*(np.asarray(f).astype(complex) for f in t))",
+    "complex fields with an imaginary part": "Trajectory(*(np.asarray(f) + 1j for f in t))",
+    "object fields": "Trajectory(*(np.asarray(f).astype(object) for f in t))",
+    "list fields": "Trajectory(*(np.asarray(f).tolist() for f in t))",
+    "fields of half the times": "Trajectory(*(np.asarray(f)[..., : np.shape(f)[-1] // 2] for f in t))",
+    "fields transposed": "Trajectory(*(np.asarray(f).T for f in t))",
+    "fields 1-D": "Trajectory(*(np.asarray(f).ravel() for f in t))",
+    "x None": "Trajectory(None, t.xd, t.xdd)",
+    "fields of text": "Trajectory(*(np.asarray(f).astype(str) for f in t))",
+    "fields all NaN": "Trajectory(*(np.full(np.shape(f), np.nan) for f in t))",
+    "fields with one inf": "Trajectory(*(np.where(np.arange(np.size(f)).reshape(np.shape(f)) == 3, np.inf, f) for f in t))",
+    "np.matrix fields": "Trajectory(*(np.asmatrix(np.atleast_2d(f)) for f in t))",
+    "a plain tuple of the fields": "tuple(t)",
+}
+
+
 def plugarray_cases(work: Path) -> list[tuple[str, object]]:
     import testbed
     from testbed.core.errors import exception_text
@@ -498,6 +520,12 @@ def plugarray_cases(work: Path) -> list[tuple[str, object]]:
                                  "        out = super().simulate(*a, **k)\n"
                                  f"        return {code}\n")))
         for k, (label, code) in enumerate(_ODD_SIMULATE.items())]
+    cases += [(f"plugarray simulate returns a Trajectory of {label}", case(
+        200 + k, label, methods=("    def simulate(self, *a, **k):\n"
+                                 "        from testbed.core.measurement import Trajectory\n"
+                                 "        t = super().simulate(*a, **k)\n"
+                                 f"        return {code}\n")))
+        for k, (label, code) in enumerate(_ODD_FIELDS.items())]
     return cases
 
 

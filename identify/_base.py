@@ -671,15 +671,61 @@ def _guard_fitted(name: str, method: Callable[..., Any]) -> Callable[..., Any]:
                                     f"free_start to the end (the record has {data.n_samples}): "
                                     "R^2 needs the measured accelerations' variance")
         out = _called(self, where, method, *a, **kw)
-        if name == "simulate" and not isinstance(out, Trajectory) and not builtin_class(type(self)):
-            # a plugin's simulate returning an array, a list or a generator ended `testbed run`
-            # in AttributeError "... has no attribute 'x'" (hostile round 29): its failure
-            raise PluginMethodError(f"{where} returned {args.describe(out)}, not a Trajectory "
-                                    "(x, xd, xdd: each channels x times)")
+        if name == "simulate" and not builtin_class(type(self)):
+            t = kw.get("t", a[2] if len(a) > 2 else None)
+            return _plugin_trajectory(where, out, len(np.ravel(t)))
         return out
 
     guarded._api_guard = True  # type: ignore[attr-defined]
     return guarded
+
+
+def _plugin_trajectory(where: str, out: Any, n_times: int) -> Trajectory:
+    """A plugin's ``simulate`` result as a Trajectory of real float arrays, or its failure.
+
+    Hostile round 29: an array, a list or a generator returned ended `testbed run` in
+    AttributeError "... has no attribute 'x'"; a Trajectory of half the times, or with ``x``
+    None, in a ValueError / IndexError of the scorer; complex samples were cast to real with a
+    warning, their imaginary part dropped.  Each field given (``xd`` and ``xdd`` may be None,
+    as the built-in mechanical simulation's are) must be real numbers of shape (n_rows,
+    ``n_times``), ``xd`` and ``xdd`` of ``x``'s shape; a masked sample is an unknown value
+    (NaN, which the scorer's divergence check names).
+
+    Raises
+    ------
+    PluginMethodError
+        Naming the method and what it returned.
+    """
+    if not isinstance(out, Trajectory):
+        raise PluginMethodError(f"{where} returned {args.describe(out)}, not a Trajectory "
+                                "(x, xd, xdd: each channels x times)")
+    fields = []
+    for label, value in zip(out._fields, out, strict=True):
+        if value is None and label != "x":
+            fields.append(None)
+            continue
+        try:
+            if value is None or np.asarray(value).dtype.kind in "USVM":  # (text, bytes, dates)
+                raise TypeError("no numbers")
+            arr = np.ma.filled(np.ma.asarray(value).astype(complex if np.iscomplexobj(value)
+                                                           else float), np.nan)
+        except (TypeError, ValueError) as e:
+            what = "None" if value is None else f"{args.describe(value)} ({exception_text(e)})"
+            raise PluginMethodError(f"{where} returned a Trajectory whose {label} is {what}, "
+                                    "not numbers") from None
+        if np.iscomplexobj(arr):
+            if np.any(arr.imag[np.isfinite(arr.imag)] != 0):
+                raise PluginMethodError(f"{where} returned a Trajectory whose {label} is complex "
+                                        "(a nonzero imaginary part): not a physical response")
+            arr = arr.real
+        arr = np.asarray(arr, dtype=float)  # (np.matrix and other subclasses: a plain array)
+        shape = fields[0].shape if fields else (None, n_times)
+        if arr.ndim != 2 or arr.shape[1] != n_times or (fields and arr.shape != shape):
+            want = (f"{shape}, x's" if fields else f"(n_channels, {n_times}): one column a time")
+            raise PluginMethodError(f"{where} returned a Trajectory whose {label} has shape "
+                                    f"{arr.shape}; expected {want}")
+        fields.append(arr)
+    return Trajectory(*fields)
 
 
 #: Fewest samples from ``free_start`` on that :meth:`Identifier.score` scores: R^2 divides by

@@ -252,3 +252,39 @@ def test_a_tag_of_invisible_characters_alone_is_refused(tag):
     with pytest.raises(testbed.TestbedError, match=r"scenario\.tags"):
         testbed.scenario_from_dict({"scenario": {"name": "x", "rig": "michaelis_menten",
                                                  "tags": ["a", tag]}})
+
+
+def _traj(*fields):
+    from testbed.core.measurement import Trajectory
+
+    return Trajectory(*fields)
+
+
+Z = np.zeros((1, 5))
+
+
+@pytest.mark.parametrize("ret, said", [
+    (_traj(Z[:, :2], Z[:, :2], Z[:, :2]), r"x has shape \(1, 2\); expected \(n_channels, 5\)"),
+    (_traj(None, Z, Z), r"x is None, not numbers"),
+    (_traj(Z + 1j, Z, Z), r"x is complex \(a nonzero imaginary part\)"),
+    (_traj(Z, Z.astype(str), Z), r"xd is .*, not numbers"),
+    (_traj(Z, np.zeros((2, 5)), Z), r"xd has shape \(2, 5\); expected \(1, 5\), x's"),
+])
+def test_a_plugins_trajectory_of_odd_fields_is_its_failure(ret, said):
+    # hostile round 29: half the times or x None were a ValueError / IndexError of the scorer,
+    # complex samples cast to real with a warning (their imaginary part dropped)
+    x = np.sin(np.arange(50) / 5.0)[None, :]
+    model = _Returns().fit(Measurement(100.0, x, x, x, ("x1",)))
+    model.ret = ret
+    with pytest.raises(PluginMethodError, match=said):
+        model.simulate(np.zeros(1), np.zeros(1), np.arange(5) / 100.0)
+
+
+def test_a_plugins_trajectory_is_read_as_real_float_arrays():
+    x = np.sin(np.arange(50) / 5.0)[None, :]
+    model = _Returns().fit(Measurement(100.0, x, x, x, ("x1",)))
+    masked = np.ma.masked_array(np.ones((1, 5)), [[0, 0, 1, 0, 0]])
+    model.ret = _traj(masked, np.ones((1, 5), np.float32) + 0j, None)
+    got = model.simulate(np.zeros(1), np.zeros(1), np.arange(5) / 100.0)
+    assert got.x.dtype == got.xd.dtype == np.float64 and got.xdd is None
+    assert np.isnan(got.x[0, 2]) and np.isfinite(np.delete(got.x, 2)).all()  # masked: unknown
