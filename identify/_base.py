@@ -60,6 +60,7 @@ import numpy as np
 from testbed.core import arguments as args
 from testbed.core.errors import (
     ArgumentError,
+    DivergenceError,
     HyperparameterError,
     IdentificationError,
     NotFittedError,
@@ -68,6 +69,7 @@ from testbed.core.errors import (
     TestbedError,
     UnsupportedError,
     exception_text,
+    numeric_blow_up,
 )
 from testbed.core.exit_guard import ProcessExitCalled, no_process_exit
 from testbed.core.measurement import MIN_FREE_SAMPLES, Measurement, Trajectory, check_prior_values
@@ -628,6 +630,10 @@ def _called(model: Identifier, where: str, method: Callable[..., Any], *a: Any,
         raise  # the testbed's own refusals; NotImplementedError: a method the model lacks
     except BaseException as e:  # the plugin's own code failed (hostile round 28: its simulate's
         # Exception was "internal error ... please report it", status 3)
+        if getattr(method, "__name__", "") == "simulate" and numeric_blow_up(e):
+            # its integrator's state ran off: diverged, as a built-in's (review 28a L7)
+            raise DivergenceError(f"{where} raised {type(e).__name__}: {exception_text(e)}"
+                                  ) from None
         raise PluginMethodError(f"{where} raised {type(e).__name__}: {exception_text(e)}") from None
 
 

@@ -211,6 +211,17 @@ class UnresolvedModelError(IdentificationError):
     simulated") with its reason."""
 
 
+def numeric_blow_up(e: BaseException) -> bool:
+    """True for an exception by which a simulation's state ran off: a float overflow or
+    invalid operation raised (``OverflowError``, ``FloatingPointError``), or scipy's refusal of
+    a non-finite state (``ValueError`` "array must not contain infs or NaNs", which the
+    scorer's ``simulate_scored`` reads as a divergence of a built-in model's integrator).  A
+    plugin's simulate raising one of these has diverged, as a built-in's (review 28a L7: it
+    was "simulation failed")."""
+    return isinstance(e, (OverflowError, FloatingPointError)) or (
+        isinstance(e, ValueError) and "infs or NaNs" in exception_text(e))
+
+
 class DivergenceError(IdentificationError):
     """A simulation of an identified model failed: non-finite state, blow-up, or a loop closure
     that no longer solves.  Scoring turns it into a failed score with its reason and time.

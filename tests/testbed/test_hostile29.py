@@ -288,3 +288,28 @@ def test_a_plugins_trajectory_is_read_as_real_float_arrays():
     got = model.simulate(np.zeros(1), np.zeros(1), np.arange(5) / 100.0)
     assert got.x.dtype == got.xd.dtype == np.float64 and got.xdd is None
     assert np.isnan(got.x[0, 2]) and np.isfinite(np.delete(got.x, 2)).all()  # masked: unknown
+
+
+@pytest.mark.parametrize("raised, kind", [
+    (OverflowError("(34, 'Numerical result out of range')"), "DivergenceError"),
+    (FloatingPointError("overflow encountered in multiply"), "DivergenceError"),
+    (ValueError("array must not contain infs or NaNs"), "DivergenceError"),
+    (ValueError("my own bug"), "PluginMethodError"),
+    (ZeroDivisionError("division by zero"), "PluginMethodError"),
+])
+def test_a_plugins_integrator_blow_up_is_a_divergence(raised, kind):
+    # review 28a L7: a built-in's blow-up is "diverged", a plugin's was "simulation failed"
+    from testbed.scoring.scorers import simulate_scored
+
+    class BlowsUp(_Returns):
+        def simulate(self, x0, xd0, t, u=None):
+            raise raised
+
+    x = np.sin(np.arange(50) / 5.0)[None, :]
+    model = BlowsUp().fit(Measurement(100.0, x, x, x, ("x1",)))
+    t = np.arange(5) / 100.0
+    with pytest.raises(IdentificationError) as e:
+        model.simulate(np.zeros(1), np.zeros(1), t)
+    assert type(e.value).__name__ == kind
+    _, why, _ = simulate_scored(lambda: model.simulate(np.zeros(1), np.zeros(1), t), t, "x", x[:, :5])
+    assert why.startswith("diverged: " if kind == "DivergenceError" else "simulation failed: ")
