@@ -26,7 +26,8 @@ Families (what rounds 1-28 did not try; their families are listed in ``hostile21
     full-width letters; a tag of one zero-width space.
 ``envodd``
     Environment oddities, as processes: ``HOME`` unset, empty, a file; ``TESTBED_CACHE`` a file, a
-    symbolic-link loop, a missing folder; ``-o`` a symbolic-link loop; the file size limit
+    symbolic-link loop, a missing folder; ``-o``, ``--plugin`` and the scenario file a
+    symbolic-link loop; the file size limit
     (``RLIMIT_FSIZE``, a full disk's quota) at 4 kB and 200 kB for ``generate`` and ``run``; the
     working folder removed under the process.
 ``plugarray``
@@ -403,6 +404,12 @@ def envodd_cases(work: Path) -> list[tuple[str, object]]:
         os.symlink(d / "oB.h5", d / "oA.h5")
         os.symlink(d / "oA.h5", d / "oB.h5")
 
+    def plugin_loop(d, env):
+        os.symlink(d / "p.py", d / "p.py")
+
+    def scenario_loop(d, env):
+        os.symlink(d / "s.toml", d / "s.toml")
+
     gen = lambda d: ["generate", MM, "-o", str(d / "o.h5"), "--cache", str(CACHE)]  # noqa: E731
     gen_nocache = lambda d: ["generate", MM, "-o", str(d / "o.h5")]  # noqa: E731
     run = lambda d: ["run", MM, "-o", str(d / "runs"), "--cache", str(CACHE)]  # noqa: E731
@@ -418,6 +425,11 @@ def envodd_cases(work: Path) -> list[tuple[str, object]]:
          gen_nocache, None, False, has_h5),
         ("-o a link loop", out_loop, lambda d: ["generate", MM, "-o", str(d / "oA.h5"), "--cache",
                                                 str(CACHE)], None, True, None),
+        ("--plugin a symbolic link to itself", plugin_loop,
+         lambda d: ["run", MM, "--plugin", str(d / "p.py"), "--no-figures", "-o", str(d / "r")],
+         None, True, None),
+        ("a scenario file that is a symbolic link to itself", scenario_loop,
+         lambda d: ["run", str(d / "s.toml"), "--no-figures", "-o", str(d / "r")], None, True, None),
         ("generate, files limited to 4 kB", lambda d, env: None, gen, _fsize(4096), True, has_h5),
         ("generate, files limited to 200 kB", lambda d, env: None, gen, _fsize(200_000), True, has_h5),
         ("run, files limited to 4 kB", lambda d, env: None, run, _fsize(4096), True, None),

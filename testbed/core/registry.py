@@ -25,8 +25,10 @@ from __future__ import annotations
 import importlib
 import importlib.metadata
 import importlib.util
+import os
 import pkgutil
 import re
+import stat
 import sys
 import types
 from collections.abc import Callable, Iterable
@@ -34,7 +36,13 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from testbed.core.errors import TestbedError, UnknownNameError, exception_text, show_value
+from testbed.core.errors import (
+    TestbedError,
+    UnknownNameError,
+    exception_text,
+    show_value,
+    unusable_path,
+)
 from testbed.core.exit_guard import no_process_exit
 from testbed.core.lazy import configure_loaded
 from testbed.core.process_state import kept_process_state
@@ -91,14 +99,18 @@ def import_plugin(spec: str) -> Any:
         configure_loaded()  # a plugin importing MuJoCo itself: its C-level log silenced too
         return module
     try:
-        path = Path(spec).resolve()
-        is_file = path.is_file()
-    except OSError as e:  # a name of 100,000 characters: ENAMETOOLONG, an internal error of
-        # `run --plugin` (round 14)
-        raise PluginError(f"plugin {spec}: not a usable path ({e.strerror or type(e).__name__}); "
-                          "expected a .py file or an importable dotted module name") from None
+        is_file = stat.S_ISREG(os.stat(spec).st_mode)  # before resolve(), whose RuntimeError
+        path = Path(spec).resolve()  # "Symlink loop" was an internal error (hostile round 29)
+    except (OSError, ValueError) as e:  # a name of 100,000 characters: ENAMETOOLONG, an internal
+        # error of `run --plugin` (round 14)
+        why = unusable_path(e)  # the one reading of such a path (review 28b L7: its own here)
+        if why is None:
+            raise PluginError(f"plugin {spec}: no such file") from None
+        raise PluginError(f"plugin {spec}: not a usable path ({why}); expected a .py file or an "
+                          "importable dotted module name") from None
     if not is_file:
-        raise PluginError(f"plugin {spec}: no such file")
+        raise PluginError(f"plugin {spec}: not a regular file (a folder, FIFO or device); "
+                          "expected a .py file or an importable dotted module name")
     modname = plugin_module_name(path)
     if modname in sys.modules:
         return sys.modules[modname]
@@ -285,6 +297,6 @@ def builtin_class(cls: type) -> bool:
     defined elsewhere) is a user's, whose exceptions are its failures.  The one rule of both
     wrappers of an identifier's methods, :func:`identify._base._called` and
     :func:`testbed.pipeline.fit.fit_or_fail` (review 28a L5: ``_called`` decided by module,
-    ``fit_or_fail`` by registry origin, so a built-in class registered again through the API under a name of the user's was
-    a plugin to one and a built-in to the other)."""
+    ``fit_or_fail`` by registry origin, so a built-in class registered again through the API
+    under a name of the user's was a plugin to one and a built-in to the other)."""
     return cls.__module__.partition(".")[0] == "identify"

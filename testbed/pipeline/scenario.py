@@ -38,7 +38,6 @@ from __future__ import annotations
 import contextlib
 import copy
 import dataclasses
-import errno
 import hashlib
 import json
 import math
@@ -54,7 +53,7 @@ from pathlib import Path
 from typing import Any
 
 from testbed.core.budget import check_cost, check_steps
-from testbed.core.errors import ArgumentError, BudgetError, RigError, ScenarioError
+from testbed.core.errors import ArgumentError, BudgetError, RigError, ScenarioError, unusable_path
 from testbed.core.kinds import metric_names, metric_range
 from testbed.core.registry import REGISTERED_NAME, REGISTERED_NAME_DOC
 from testbed.core.schema import (
@@ -259,21 +258,14 @@ def file_problem(path: Path, what: str) -> str | None:
     """
     try:
         st = path.stat()
-    except ValueError:  # an embedded NUL byte
-        return "not a usable file name (it contains a NUL byte)"
-    except OSError as e:
-        if e.errno == errno.ELOOP:
-            return "a symbolic link that loops (it never reaches a file)"
-        if e.errno == errno.ENAMETOOLONG:
-            return "a file name too long for the file system"
-        if e.errno in (errno.ENOENT, errno.ENOTDIR):
-            try:
-                if path.is_symlink():
-                    return f"a symbolic link to {os.readlink(path)!r}, which does not exist"
-            except OSError:
-                pass
-            return f"no such {what} file"
-        return f"cannot be read: {e.strerror or type(e).__name__}"
+    except (OSError, ValueError) as e:  # (ValueError: an embedded NUL byte)
+        why = unusable_path(e)  # the one reading of such a path (review 28b L7: its own here)
+        if why is not None:
+            return f"not a usable path ({why})"
+        with contextlib.suppress(OSError):
+            if path.is_symlink():
+                return f"a symbolic link to {os.readlink(path)!r}, which does not exist"
+        return f"no such {what} file"
     if stat.S_ISDIR(st.st_mode):
         return f"is a folder; expected a {what} .toml file"
     if not stat.S_ISREG(st.st_mode):

@@ -313,3 +313,18 @@ def test_a_plugins_integrator_blow_up_is_a_divergence(raised, kind):
     assert type(e.value).__name__ == kind
     _, why, _ = simulate_scored(lambda: model.simulate(np.zeros(1), np.zeros(1), t), t, "x", x[:, :5])
     assert why.startswith("diverged: " if kind == "DivergenceError" else "simulation failed: ")
+
+
+def test_a_plugin_path_that_names_nothing_is_read_as_every_path(tmp_path):
+    # review 28b L7: import_plugin read such a path on its own (a link loop was "no such file")
+    from testbed.core.registry import PluginError, import_plugin
+
+    loop = tmp_path / "loop.py"
+    loop.symlink_to(tmp_path / "loop.py")
+    with pytest.raises(PluginError, match=r"not a usable path \(a symbolic link that loops\)"):
+        import_plugin(str(loop))
+    (tmp_path / "folder.py").mkdir()
+    with pytest.raises(PluginError, match=r"not a regular file"):
+        import_plugin(str(tmp_path / "folder.py"))
+    with pytest.raises(PluginError, match=r"no such file"):
+        import_plugin(str(tmp_path / "none.py"))
