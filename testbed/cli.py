@@ -34,7 +34,6 @@ from testbed.core.atomic import (
     HTML_FILE,
     IDENTIFIED_JSON_FILE,
     IDENTIFIED_MARKDOWN_FILE,
-    REPORT_MARKDOWN_FILE,
     SEP005_FILE,
     UFF_FILE,
     FileKind,
@@ -747,7 +746,7 @@ def cmd_run(args: argparse.Namespace) -> int:
 
 
 def cmd_report(args: argparse.Namespace) -> int:
-    from testbed.reporting.report import write_report
+    from testbed.reporting.report import refuse_foreign_outputs, write_report
     from testbed.studies.results import parts_dir
     from testbed.studies.runstore import RunStoreError, resolve_run
 
@@ -772,9 +771,8 @@ def cmd_report(args: argparse.Namespace) -> int:
                 raise InputError(f"{source}: no such run folder or results file (nor a scenario "
                                  f"with runs in {args.runs})") from None
             raise InputError(f"{source}: not a run folder written by `testbed run`") from None
-    for name, kind in (("report.html", HTML_FILE), ("report.md", REPORT_MARKDOWN_FILE)):
-        # the user's own file of that name in the folder named (round 27: replaced in silence)
-        _foreign_output(Path(args.output) / name, "--output", kind)
+    # the user's own file of a report's name in the folder named (round 27: replaced in silence)
+    refuse_foreign_outputs(args.output, option="--output")
     html = write_report(source, Path(args.output))
     print(f"report: {terminal_safe(str(html.resolve()))}")
     return 0

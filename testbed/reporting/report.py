@@ -24,7 +24,7 @@ import json
 import math
 import os
 import re
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -41,6 +41,7 @@ from testbed.core.atomic import (
     atomic_write_text,
     refuse_foreign,
 )
+from testbed.core.errors import terminal_safe
 from testbed.core.kinds import METRICS
 from testbed.numerics.quantiles import quartiles
 from testbed.pipeline.plugins import RIGS
@@ -222,14 +223,31 @@ class Page:
         # figures, reported into its own folder (those of a run written before figures carried
         # the testbed's marker too)
         pngs = {p: data for p, data in pngs.items() if not _holds(p, data)}
-        for path, kind in [*((p, PNG_FILE) for p in pngs), (out, HTML_FILE),
-                           (self.out_dir / "report.md", REPORT_MARKDOWN_FILE)]:
-            refuse_foreign(path, kind, expected="another --output folder, or remove the file")
+        refuse_foreign_outputs(self.out_dir, pngs)
         for path, data in pngs.items():
             atomic_write(path, lambda tmp, data=data: Path(tmp).write_bytes(data))
         atomic_write_text(out, doc)
         atomic_write_text(self.out_dir / "report.md", "\n".join(self.md).rstrip() + "\n")
         return out
+
+
+#: The outputs every report writes, by name, and their kinds (its figures vary with its source)
+REPORT_FILES = (("report.html", HTML_FILE), ("report.md", REPORT_MARKDOWN_FILE))
+
+
+def refuse_foreign_outputs(out_dir: str | os.PathLike, pngs: Iterable[Path] = (),
+                           option: str = "") -> None:
+    """Refuse, before any is written, a file in ``out_dir`` that a report would replace and
+    that is not of the kind the report writes there (:data:`REPORT_FILES`, and the figures
+    ``pngs``): :func:`~testbed.core.atomic.refuse_foreign` for each.  The one list of a
+    report's outputs: ``testbed report`` checks it before the work (``option`` names the
+    folder's option in its message), :meth:`Page.write` again with its figures before it
+    writes (review 28b L1: two lists before)."""
+    out_dir = Path(out_dir)
+    for path, kind in [*((Path(p), PNG_FILE) for p in pngs),
+                       *((out_dir / name, kind) for name, kind in REPORT_FILES)]:
+        refuse_foreign(path, kind, f"{option} {terminal_safe(str(path))}" if option else None,
+                       expected="another --output folder, or remove the file")
 
 
 def _holds(path: Path, data: bytes) -> bool:
