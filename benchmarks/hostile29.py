@@ -49,12 +49,28 @@ Families (what rounds 1-28 did not try; their families are listed in ``hostile21
     NaN score, ``passed`` with ``status`` "error", or an unknown ``status``: ``summary`` and
     ``report`` must not show a pass for them.
 
+``ownmark``
+    A file of the user's in the format a command writes, at the path it writes (review 28b
+    M2): a matplotlib ``fit_time.png`` in a report's folder, a ``settings.json`` given to
+    ``identify -o``, another tool's SEP-005 JSON, UFF (a header record) or HDF5 given to
+    ``export`` / ``generate -o``, a dataset cut to its first 300 bytes: refused in one line and
+    left byte for byte.
+``sigint``
+    Ctrl-C (SIGINT to the command's process group) at 5-95 % of the command's own span (timed
+    once, uninterrupted) for ``report`` into the folder of an earlier report, ``export`` (UFF,
+    SEP-005) and ``identify -o`` over an earlier output: a process left, a traceback, an
+    interrupted command whose last line is not ``error: interrupted``, a temporary file left,
+    an output changed but incomplete (PNG without IEND, HTML without its closing tag, JSON that
+    does not parse, UFF without its last delimiter) or an earlier output removed is a finding.
+
 Prints one line a finding and the counts; exits 1 if any finding.
 """
 # ruff: noqa: E501 (the case tables: one case a line)
 
 from __future__ import annotations
 
+import contextlib
+import json
 import math
 import os
 import resource
@@ -765,10 +781,186 @@ def rehashed_cases(work: Path) -> list[tuple[str, object]]:
     return cases
 
 
+# ------------------------------------------------------------------ ownmark
+
+def ownmark_cases(work: Path) -> list[tuple[str, object]]:
+    """A file of the user's in the format a command writes, at the path it writes (review 28b
+    M2): refused in one line and left byte for byte, or a finding."""
+    import io
+
+    def user_png() -> bytes:
+        import matplotlib.pyplot as plt
+
+        fig = plt.figure(figsize=(1, 1))
+        buf = io.BytesIO()
+        fig.savefig(buf, format="png")
+        plt.close(fig)
+        return buf.getvalue()
+
+    def user_h5(path: Path) -> None:
+        import h5py
+
+        with h5py.File(path, "w") as f:
+            f.attrs["title"] = "my measurement"
+            f["x"] = [1.0, 2.0]
+
+    def case(label: str, name: str, make, argv_of):
+        def run():
+            src = _sources(work)
+            d = work / hostile19._safe(label)
+            shutil.rmtree(d, ignore_errors=True)
+            d.mkdir()
+            target = d / name
+            target.parent.mkdir(parents=True, exist_ok=True)
+            if callable(make):
+                make(target)
+            else:
+                target.write_bytes(make)
+            before = target.read_bytes()
+            status, o, err = cli_inprocess(argv_of(d, src))
+            found = judged(status, o, err, refuse=True)
+            if found:
+                return found
+            return None if target.read_bytes() == before else "refused, but the user's file changed"
+        return run
+
+    cases = [
+        ("a user's matplotlib fit_time.png in the report folder", "rep/fit_time.png", lambda p: p.write_bytes(user_png()),
+         lambda d, src: ["report", str(src["parquet"]), "-o", str(d / "rep")]),
+        ("a user's settings.json given to identify -o", "settings.json", b'{"theme": "dark"}\n',
+         lambda d, src: ["identify", str(src["hdf5"]), "--scenario", MM, "-o", str(d / "settings.json")]),
+        ("someone's SEP-005 JSON given to export -o", "x.json", b'[{"name": "a", "data": [1, 2], "fs": 10}]',
+         lambda d, src: ["export", str(src["hdf5"]), "--format", "sep005", "-o", str(d / "x.json")]),
+        ("someone's UFF given to export -o", "x.uff", b"    -1\n   151\nmodel\n    -1\n",
+         lambda d, src: ["export", str(src["hdf5"]), "--format", "uff", "-o", str(d / "x.uff")]),
+        ("another tool's HDF5 given to generate -o", "x.h5", user_h5,
+         lambda d, src: ["generate", MM, "--cache", str(CACHE), "-o", str(d / "x.h5")]),
+        ("a dataset cut to its first 300 bytes given to generate -o", "cut.h5",
+         lambda p: p.write_bytes(_sources(work)["hdf5"].read_bytes()[:300]),
+         lambda d, src: ["generate", MM, "--cache", str(CACHE), "-o", str(d / "cut.h5")]),
+    ]
+    return [(f"ownmark {label}", case(label, name, make, argv)) for label, name, make, argv in cases]
+
+
+# ------------------------------------------------------------------ sigint
+
+def _whole(path: Path) -> bool:
+    """Whether an output file is complete by its format's end (PNG's IEND chunk, the HTML's
+    closing tag, JSON that parses, a UFF's last record delimiter, an HDF5 that opens)."""
+    data = path.read_bytes()
+    if path.suffix == ".png":
+        return data.endswith(b"IEND\xaeB`\x82")
+    if path.suffix == ".html":
+        return data.rstrip().endswith(b"</html>")
+    if path.suffix == ".json":
+        try:
+            json.loads(data)
+        except ValueError:
+            return False
+        return True
+    if path.suffix == ".uff":
+        return data.rstrip().endswith(b"-1")
+    if path.suffix == ".md":
+        return data.endswith(b"\n")
+    return True
+
+
+def sigint_cases(work: Path) -> list[tuple[str, object]]:
+    import time
+
+    state: dict = {}
+
+    def setup():
+        if "src" not in state:
+            src = _sources(work)
+            rep = work / "rep0"
+            status, _, err = cli_inprocess(["report", str(src["parquet"]), "-o", str(rep)])
+            if status != 0:
+                raise RuntimeError(err[-300:])
+            state["src"], state["rep"] = src, rep
+        return state["src"]
+
+    commands = {
+        "report over an earlier report": lambda d, src: ["report", str(src["parquet"]), "-o", str(d / "rep")],
+        "export uff over an earlier export": lambda d, src: ["export", str(src["hdf5"]), "--format", "uff", "-o", str(d / "x.uff")],
+        "export sep005 over an earlier export": lambda d, src: ["export", str(src["hdf5"]), "--format", "sep005", "-o", str(d / "x.json")],
+        "identify over an earlier model": lambda d, src: ["identify", str(src["hdf5"]), "--scenario", MM, "-o", str(d / "m.json")],
+    }
+
+    def prepare(label: str, d: Path, src: dict) -> None:
+        shutil.rmtree(d, ignore_errors=True)
+        d.mkdir(parents=True)
+        if label.startswith("report"):
+            shutil.copytree(state["rep"], d / "rep")
+        else:  # the earlier output: the command run once, to completion
+            status, _, err = cli_inprocess(commands[label](d, src))
+            if status != 0:
+                raise RuntimeError(err[-300:])
+
+    def snapshot(d: Path) -> dict[str, bytes]:
+        return {str(p.relative_to(d)): p.read_bytes() for p in sorted(d.rglob("*")) if p.is_file()}
+
+    def case(label: str, fraction: float):
+        def run():
+            src = setup()
+            d = work / hostile19._safe(label) / f"{fraction:.2f}"
+            if (label, "span") not in state:  # the command's own span, timed once
+                prepare(label, d, src)
+                t0 = time.perf_counter()
+                p = subprocess.run([sys.executable, "-m", "testbed.cli", *commands[label](d, src)],
+                                   cwd=d, env=_hostile.ENV, capture_output=True, text=True, timeout=200)
+                state[(label, "span")] = time.perf_counter() - t0
+                if p.returncode != 0:
+                    return f"the uninterrupted command: status {p.returncode}: {p.stderr[-200:]!r}"
+                state[(label, "after")] = snapshot(d)
+            prepare(label, d, src)
+            before = snapshot(d)
+            log = d.parent / f"{fraction:.2f}.err"
+            with open(log, "w") as err:
+                p = subprocess.Popen([sys.executable, "-m", "testbed.cli", *commands[label](d, src)],
+                                     cwd=d, env=_hostile.ENV, stdout=subprocess.DEVNULL, stderr=err,
+                                     start_new_session=True)
+                time.sleep(fraction * state[(label, "span")])
+                with contextlib.suppress(ProcessLookupError):
+                    os.killpg(p.pid, signal.SIGINT)  # Ctrl-C: the whole foreground group
+                try:
+                    p.wait(timeout=60)
+                except subprocess.TimeoutExpired:
+                    os.killpg(p.pid, signal.SIGKILL)
+                    p.wait()
+                    return "still running 60 s after SIGINT"
+            time.sleep(0.2)
+            left = hostile27._session_alive(p.pid)
+            if left:
+                return f"processes left behind: {left}"
+            text = log.read_text()
+            lines = [ln for ln in text.splitlines() if ln.strip()]
+            if "Traceback" in text or p.returncode not in (0, 1, 130):
+                return f"status {p.returncode}: {(lines or [''])[-1][:200]!r}"
+            if p.returncode == 130 and lines[-1:] != ["error: interrupted"]:
+                return f"interrupted, its last line {lines[-1:]!r}"
+            now = snapshot(d)
+            tmp = [k for k in now if k.rsplit("/", 1)[-1].startswith(".") and k.endswith(".tmp")]
+            if tmp:
+                return f"temporary files left: {tmp[:3]}"
+            for k, data in now.items():
+                if data != before.get(k) and not _whole(d / k):
+                    return f"{k} left incomplete ({len(data)} bytes)"
+            lost = [k for k in before if k not in now]
+            if lost:
+                return f"earlier outputs removed: {lost[:3]}"
+            return None
+        return run
+
+    return [(f"sigint {label} at {f:.0%} of its span", case(label, f))
+            for label in commands for f in (0.05, 0.2, 0.35, 0.5, 0.6, 0.7, 0.8, 0.9, 0.95)]
+
+
 FAMILIES = _hostile.families({"truncate": truncate_cases, "edges": edges_cases,
                               "names": names_cases, "envodd": envodd_cases,
                               "plugarray": plugarray_cases, "apiforms": apiforms_cases,
-                              "rehashed": rehashed_cases}, TIMEOUT_S)
+                              "rehashed": rehashed_cases, "ownmark": ownmark_cases,
+                              "sigint": sigint_cases}, TIMEOUT_S)
 
 if __name__ == "__main__":
     sys.exit(_hostile.main(sys.argv[1:], FAMILIES, "hostile29_"))

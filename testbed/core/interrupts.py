@@ -40,12 +40,39 @@ NAMES = {signal.SIGINT: "SIGINT", signal.SIGTERM: "SIGTERM", signal.SIGHUP: "SIG
 armed = False
 
 
+#: Options of the interpreter's command line that take the next word as their value
+_VALUED_OPTIONS = ("-W", "-X", "--check-hash-based-pycs")
+
+
+def _run_as_module() -> str | None:
+    """The module named by ``python -m NAME`` on the interpreter's own command line
+    (``sys.orig_argv``), or None (a script, ``-c``, the console script)."""
+    words = list(getattr(sys, "orig_argv", ())[1:])
+    while words:
+        word = words.pop(0)
+        if word == "-m":
+            return words[0] if words else None
+        if word in _VALUED_OPTIONS:
+            words = words[1:]
+        elif word == "-c" or word == "-" or not word.startswith("-"):
+            return None  # (a script's or -c's own words are not the interpreter's)
+    return None
+
+
 def _console_program() -> bool:
-    """Whether this process is the ``testbed`` command (its console script, or ``python -m``)."""
+    """Whether this process is the ``testbed`` command (its console script, or ``python -m``).
+
+    Under ``python -m testbed.cli`` the package is imported before runpy makes the module
+    ``__main__`` (whose ``__spec__`` names it only then, and ``sys.argv[0]`` is ``"-m"``
+    meanwhile), so the interpreter's own command line is read (hostile round 29: such a
+    command was never armed, and a Ctrl-C in its first 0.2 s or at its exit was Python's
+    traceback, status -2)."""
     main = sys.modules.get("__main__")
     spec = getattr(main, "__spec__", None)
-    if spec is not None:  # python -m NAME
+    if spec is not None:  # python -m NAME, once runpy has made it __main__
         return spec.name in ("testbed.cli", "testbed.__main__")
+    if _run_as_module() in ("testbed.cli", "testbed"):
+        return True
     return os.path.basename(sys.argv[0] if sys.argv else "").removesuffix(".exe") == "testbed"
 
 
@@ -56,9 +83,11 @@ def exit_now(signum: int) -> None:
     Written with ``os.write`` (no buffered stream: the signal may land inside a ``print``) and
     ended with ``os._exit`` (no Python code of a half-imported module, of the interpreter's
     shutdown or of a stuck main thread runs again)."""
-    atomic = sys.modules.get("testbed.core.atomic")  # not imported yet: nothing is being written
-    if atomic is not None:
-        atomic.remove_in_flight()
+    # not imported yet, or half imported (a signal during its import: its remove_in_flight not
+    # defined yet was an AttributeError, status 1, hostile round 29): nothing is being written
+    remove = getattr(sys.modules.get("testbed.core.atomic"), "remove_in_flight", None)
+    if remove is not None:
+        remove()
     line = "interrupted" if signum == signal.SIGINT else f"interrupted by {NAMES[signum]}"
     try:
         os.write(2, f"error: {line}\n".encode())

@@ -328,3 +328,38 @@ def test_a_plugin_path_that_names_nothing_is_read_as_every_path(tmp_path):
         import_plugin(str(tmp_path / "folder.py"))
     with pytest.raises(PluginError, match=r"no such file"):
         import_plugin(str(tmp_path / "none.py"))
+
+
+@pytest.mark.parametrize("orig, armed", [
+    (["python", "-m", "testbed.cli", "run", "x"], True),
+    (["python", "-X", "importtime", "-W", "error", "-m", "testbed", "list"], True),
+    (["python", "-m", "pytest", "-m", "testbed.cli"], False),
+    (["python", "script.py", "-m", "testbed.cli"], False),
+    (["python", "-c", "import testbed", "-m", "testbed.cli"], False),
+])
+def test_python_dash_m_testbed_is_the_console_program_from_its_first_import(monkeypatch, orig, armed):
+    # hostile round 29: under `python -m testbed.cli` the package is imported before runpy makes
+    # the module __main__, so it was never armed: a Ctrl-C in its first 0.2 s or at its exit was
+    # Python's traceback, status -2
+    import types
+
+    from testbed.core import interrupts
+
+    monkeypatch.setattr(interrupts.sys, "orig_argv", orig, raising=False)
+    monkeypatch.setattr(interrupts.sys, "argv", ["-m"])
+    monkeypatch.setitem(interrupts.sys.modules, "__main__", types.ModuleType("__main__"))
+    assert interrupts._console_program() is armed
+
+
+def test_an_interrupt_during_the_import_of_atomic_ends_in_one_line(monkeypatch, capfd):
+    # hostile round 29: `testbed` (the console script) interrupted while testbed.core.atomic
+    # was half imported ended in AttributeError (no remove_in_flight yet), status 1
+    import types
+
+    from testbed.core import interrupts
+
+    monkeypatch.setitem(interrupts.sys.modules, "testbed.core.atomic", types.ModuleType("half"))
+    monkeypatch.setattr(interrupts.os, "_exit", lambda status: (_ for _ in ()).throw(SystemExit(status)))
+    with pytest.raises(SystemExit) as e:
+        interrupts.exit_now(interrupts.signal.SIGINT)
+    assert e.value.code == 130 and capfd.readouterr().err == "error: interrupted\n"
