@@ -1309,7 +1309,13 @@ def _redeliver_interrupt(hook: Callable[[Any], None], unraisable: Any) -> None:
     signum = getattr(unraisable.exc_value, "signum", signal.SIGINT)
     timer = threading.Timer(REDELIVER_S, os.kill, (os.getpid(), signum))
     timer.daemon = True
+    _REDELIVERIES.append(timer)
     timer.start()
+
+
+#: Redeliveries of an interrupt not yet sent (:func:`_redeliver_interrupt`), cancelled once the
+#: command has handled one (:func:`_interrupted`)
+_REDELIVERIES: list[threading.Timer] = []
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -1519,7 +1525,15 @@ def _stdout_failed(e: OSError) -> bool:
 
 
 def _interrupted(e: KeyboardInterrupt) -> int:
-    """One line for Ctrl-C (status 130), SIGTERM or SIGHUP (128 + its number)."""
+    """One line for Ctrl-C (status 130), SIGTERM or SIGHUP (128 + its number).
+
+    A redelivery still pending (:data:`_REDELIVERIES`) is cancelled: the interrupt it carries
+    is this one, handled.  An import interrupted inside its module lock's callback both
+    scheduled one and failed with the KeyboardInterrupt within; the second delivery, 10 ms
+    later, came after "error: interrupted" and ended the process by SIGINT in the
+    interpreter's shutdown (status -2), or printed the line twice (hostile round 29)."""
+    while _REDELIVERIES:
+        _REDELIVERIES.pop().cancel()
     if isinstance(e, Terminated):
         print(f"error: interrupted by {signal.Signals(e.signum).name}", file=sys.stderr)
         return 128 + e.signum

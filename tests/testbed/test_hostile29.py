@@ -363,3 +363,21 @@ def test_an_interrupt_during_the_import_of_atomic_ends_in_one_line(monkeypatch, 
     with pytest.raises(SystemExit) as e:
         interrupts.exit_now(interrupts.signal.SIGINT)
     assert e.value.code == 130 and capfd.readouterr().err == "error: interrupted\n"
+
+
+def test_a_handled_interrupt_cancels_its_pending_redelivery(monkeypatch, capsys):
+    # hostile round 29: an import interrupted inside a module lock's callback scheduled a
+    # redelivery and failed with the KeyboardInterrupt within; the command said "interrupted",
+    # and the redelivery 10 ms later ended the process by SIGINT in its shutdown (status -2)
+    import time
+    import types
+
+    from testbed import cli
+
+    sent = []
+    monkeypatch.setattr(cli, "REDELIVER_S", 0.2)
+    monkeypatch.setattr(cli.os, "kill", lambda pid, signum: sent.append(signum))
+    cli._redeliver_interrupt(lambda u: None, types.SimpleNamespace(exc_value=KeyboardInterrupt()))
+    assert cli._interrupted(KeyboardInterrupt()) == 130
+    time.sleep(0.4)
+    assert sent == [] and capsys.readouterr().err == "error: interrupted\n"
