@@ -49,6 +49,10 @@ Families (what rounds 1-28 did not try; their families are listed in ``hostile21
     NaN score, ``passed`` with ``status`` "error", or an unknown ``status``: ``summary`` and
     ``report`` must not show a pass for them.
 
+``apiwalk``
+    Round 28's walk of the public API, with review 28b L8's mend: a ``TypeError`` raised inside
+    the callable is a finding even when its text reads like a signature's ("positional
+    argument"); only one raised by the call itself is the signature's refusal.
 ``ownmark``
     A file of the user's in the format a command writes, at the path it writes (review 28b
     M2): a matplotlib ``fit_time.png`` in a report's folder, a ``settings.json`` given to
@@ -781,6 +785,72 @@ def rehashed_cases(work: Path) -> list[tuple[str, object]]:
     return cases
 
 
+# ------------------------------------------------------------------ apiwalk
+
+def apiwalk_cases(work: Path) -> list[tuple[str, object]]:
+    """Round 28's walk of the public API (``hostile28.apiwalk_cases``: each parameter of each
+    callable given each odd value in turn), with review 28b L8's mend: a ``TypeError`` is set
+    aside as the signature's own refusal only when it was raised by the call itself (its
+    traceback ends in the calling frame), not when a text like "positional argument" came from
+    inside the callable."""
+    import inspect
+
+    import testbed
+    from testbed.core.errors import TestbedError
+
+    odd = hostile28._odd_values(work)
+    state: dict = {}
+    skip = {"run_sweep", "TestbedError", "IdentificationError", "ArgumentError", "NotFittedError"}
+
+    def case(name: str, param: str, label: str):
+        def run():
+            if "v" not in state:
+                state["v"] = hostile28._valid_values(work)
+            fn = getattr(testbed, name)
+            kwargs = {}
+            for p in inspect.signature(fn).parameters.values():
+                if p.kind in (p.VAR_POSITIONAL, p.VAR_KEYWORD):
+                    continue
+                if p.name == param:
+                    kwargs[p.name] = odd[label]
+                elif p.default is p.empty:
+                    given = hostile28._valid_for(name, state["v"])
+                    if p.name not in given:
+                        return None  # no plain value to give: not tried
+                    kwargs[p.name] = given[p.name]
+            here = os.getcwd()
+            os.chdir(work)
+            try:
+                fn(**kwargs)
+            except TestbedError:
+                raise
+            except TypeError as e:
+                if e.__traceback__ is not None and e.__traceback__.tb_next is None:
+                    return None  # the signature's own refusal, raised by the call itself
+                raise
+            finally:
+                os.chdir(here)
+            return None
+        return run
+
+    cases = []
+    for name in testbed.__all__:
+        if name in skip or name.startswith("_"):
+            continue
+        obj = getattr(testbed, name)
+        if not callable(obj) or name.startswith("register") or name in ("IDENTIFIERS", "RIGS"):
+            continue
+        try:
+            sig = inspect.signature(obj)
+        except (TypeError, ValueError):
+            continue
+        for p in sig.parameters.values():
+            if p.kind in (p.VAR_POSITIONAL, p.VAR_KEYWORD) or p.name in ("self", "cls"):
+                continue
+            cases += [(f"apiwalk {name}({p.name}={label})", case(name, p.name, label)) for label in odd]
+    return cases
+
+
 # ------------------------------------------------------------------ ownmark
 
 def ownmark_cases(work: Path) -> list[tuple[str, object]]:
@@ -960,6 +1030,7 @@ FAMILIES = _hostile.families({"truncate": truncate_cases, "edges": edges_cases,
                               "names": names_cases, "envodd": envodd_cases,
                               "plugarray": plugarray_cases, "apiforms": apiforms_cases,
                               "rehashed": rehashed_cases, "ownmark": ownmark_cases,
+                              "apiwalk": apiwalk_cases,
                               "sigint": sigint_cases}, TIMEOUT_S)
 
 if __name__ == "__main__":
