@@ -219,8 +219,6 @@ def _uff_ours(fd: int) -> bool:
 
 
 HDF5_FILE = FileKind("an HDF5 dataset of the testbed", (b"\x89HDF\r\n\x1a\n",), ours=_hdf5_ours)
-#: any JSON (the kind a caller with no marker of its own names)
-JSON_FILE = FileKind("a JSON file", (b"{", b"["), text=True)
 IDENTIFIED_JSON_FILE = FileKind("a model summary written by `testbed identify`", (b"{",),
                                 text=True, ours=_identified_ours)
 SEP005_FILE = FileKind("a SEP-005 export of the testbed", (b"[",), text=True, ours=_sep005_ours)
