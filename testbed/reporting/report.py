@@ -39,6 +39,7 @@ from testbed.core.atomic import (
     REPORT_MARKDOWN_MARK,
     atomic_write,
     atomic_write_text,
+    foreign_head,
     refuse_foreign,
 )
 from testbed.core.errors import terminal_safe
@@ -244,10 +245,29 @@ def refuse_foreign_outputs(out_dir: str | os.PathLike, pngs: Iterable[Path] = ()
     folder's option in its message), :meth:`Page.write` again with its figures before it
     writes (review 28b L1: two lists before)."""
     out_dir = Path(out_dir)
-    for path, kind in [*((Path(p), PNG_FILE) for p in pngs),
+    pngs = [Path(p) for p in pngs if not _earlier_figure(Path(p))]
+    for path, kind in [*((p, PNG_FILE) for p in pngs),
                        *((out_dir / name, kind) for name, kind in REPORT_FILES)]:
         refuse_foreign(path, kind, f"{option} {terminal_safe(str(path))}" if option else None,
                        expected="another --output folder, or remove the file")
+
+
+def _earlier_figure(path: Path) -> bool:
+    """True for a figure an earlier report wrote before figures carried the testbed's PNG
+    marker (:data:`~testbed.core.atomic.PNG_SOFTWARE`, review 28b M2): a PNG whose bytes the
+    folder's ``report.html`` of the testbed's (:data:`~testbed.core.atomic.HTML_FILE`) embeds,
+    as every report page embeds its figures (base64 data URIs).  Such a folder is replaced as
+    before the marker; a PNG of the user's, which no page of the testbed's embeds byte for
+    byte, is still refused."""
+    page = path.parent / "report.html"
+    try:
+        if not page.is_file() or page.stat().st_size == 0 or foreign_head(page, HTML_FILE):
+            return False
+        # the whole data URI, quotes included: a prefix of another figure's does not match
+        uri = b'src="data:image/png;base64,' + base64.b64encode(path.read_bytes()) + b'"'
+        return uri in page.read_bytes()
+    except OSError:
+        return False
 
 
 def _holds(path: Path, data: bytes) -> bool:

@@ -381,3 +381,23 @@ def test_a_handled_interrupt_cancels_its_pending_redelivery(monkeypatch, capsys)
     assert cli._interrupted(KeyboardInterrupt()) == 130
     time.sleep(0.4)
     assert sent == [] and capsys.readouterr().err == "error: interrupted\n"
+
+
+def test_a_report_written_before_the_png_marker_is_replaced_as_before(tmp_path):
+    # its figures carry no marker, but its page embeds them byte for byte: the earlier report's
+    from testbed.reporting.report import Page
+
+    old = _matplotlib_png()  # as figures were encoded before the marker
+    first = Page("Study s", tmp_path)
+    first.figure(first.png("fit_time.png", old), "fit_time")
+    first.write()
+    assert foreign_head(tmp_path / "fit_time.png", PNG_FILE) is not None  # unmarked
+    again = Page("Study s", tmp_path)
+    again.figure(again.png("fit_time.png", old[: len(old) // 3 * 3] + b"\0\0\0"), "fit_time")
+    again.write()  # not refused
+    assert (tmp_path / "fit_time.png").read_bytes().endswith(b"\0\0\0")
+    # the user's own (here: the page's figure less its last byte, whose base64 is a prefix of
+    # the page's when its length is a multiple of 3), which the page does not embed
+    (tmp_path / "fit_time.png").write_bytes(old[: len(old) // 3 * 3])
+    with pytest.raises(InputError, match=r"fit_time\.png: exists and is not a PNG figure"):
+        again.write()
