@@ -65,9 +65,9 @@ _HP = {"highpass_hz": "auto"}
 #: name -> (description, rig, simulation, excitation, signal)
 CASES: dict[str, tuple[str, dict, dict, dict, dict]] = {
     # lengths, materials and sections no round drew
-    "b28_ss_L2p2_t28_hpauto_fs5k12": ("stainless steel 2.2 m x 30 x 28 mm in 44 segments (mode 1 near 4.6 Hz), "
-                                      "sensors 0.3 / 0.65 / 1 L, under the high-pass 'auto', the hammer at "
-                                      "0.5 s, 4 s at 5.12 kHz",
+    "b28_ss_L2p2_t28_hpauto_fs5k12": ("stainless steel 2.2 m x 30 x 28 mm in 44 segments (mode 1 near "
+                                      "4.6 Hz), sensors 0.3 / 0.65 / 1 L, under the high-pass 'auto', the "
+                                      "hammer at 0.5 s, 4 s at 5.12 kHz",
                                       {**_SS22}, {"duration": 4.0, "sample_rate": 5120.0}, {"start": 0.5},
                                       {**_HP}),
     "b28_zr_L0p6_s6u_hit0p3": ("a zirconium beam (E 88 GPa, 6520 kg/m^3) 0.6 m in 14 segments read by six "
@@ -78,9 +78,9 @@ CASES: dict[str, tuple[str, dict, dict, dict, dict]] = {
                            {}, {}),
     "b28_ta_L0p35_t20_fs16k": ("tantalum (E 186 GPa, 16650 kg/m^3) 0.35 m x 30 x 20 mm at 16 kHz on 0.6 s",
                                {**_TA035}, {"duration": 0.6, "sample_rate": 16000.0}, {}, {}),
-    "b28_inc_L1_t15_s7u_hpauto_fs25k6": ("an Inconel-like beam (E 205 GPa, 8440 kg/m^3) 1 m x 30 x 15 mm in 20 "
-                                         "segments (mode 1 near 12 Hz) read by seven uneven sensors, under "
-                                         "the high-pass 'auto', the hammer at 0.3 s, 2 s at 25.6 kHz",
+    "b28_inc_L1_t15_s7u_hpauto_fs25k6": ("an Inconel-like beam (E 205 GPa, 8440 kg/m^3) 1 m x 30 x 15 mm "
+                                         "in 20 segments (mode 1 near 12 Hz) read by seven uneven sensors, "
+                                         "under the high-pass 'auto', the hammer at 0.3 s, 2 s at 25.6 kHz",
                                          {**_INC1}, {"duration": 2.0, "sample_rate": 25600.0}, {"start": 0.3},
                                          {**_HP}),
     "b28_peek_L0p2_t5_z3": ("PEEK (E 3.6 GPa, 1320 kg/m^3) 0.2 m x 30 x 5 mm at 3 % damping (mode 1 near "

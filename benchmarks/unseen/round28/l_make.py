@@ -45,7 +45,8 @@ FIVEBARS: dict[str, tuple[str, dict[str, dict]]] = {
     "fb28_cranks_I0p03": ("cranks with their own inertia, 0.03 kg m^2 about the centre of mass",
                           {"rig": {"I1": 0.03, "I4": 0.03}}),
     "fb28_2p5s": ("the paper's sine, a 2.5 s record", {"simulation": {"duration": 2.5}}),
-    "fb28_sine_amp0p2": ("the paper's sine at 0.2 rad (2.9 x the paper's)", {"excitation": {"amplitude": 0.2}}),
+    "fb28_sine_amp0p2": ("the paper's sine at 0.2 rad (2.9 x the paper's)",
+                         {"excitation": {"amplitude": 0.2}}),
     "fb28_sine_amp0p04": ("the paper's sine at 0.04 rad", {"excitation": {"amplitude": 0.04}}),
     "fb28_sine_0p5hz": ("the paper's sine at 0.5 Hz (3.14 x the paper's frequency)",
                         {"excitation": {"frequency": 0.5}}),
@@ -92,7 +93,8 @@ DOWN: dict[str, tuple[str, str, dict[str, dict], str]] = {
 
 #: name -> (description, {table: keys changed from cartpole_noise1 (its multisine kept)})
 CARTPOLES: dict[str, tuple[str, dict[str, dict]]] = {
-    "cp28_L1_m0p6": ("a 1 m pole of 0.6 kg on the 1 kg cart", {"rig": {"pole_length": 1.0, "pole_mass": 0.6}}),
+    "cp28_L1_m0p6": ("a 1 m pole of 0.6 kg on the 1 kg cart",
+                     {"rig": {"pole_length": 1.0, "pole_mass": 0.6}}),
     "cp28_L0p5_m0p25": ("a 0.5 m pole of 0.25 kg on the 1 kg cart",
                         {"rig": {"pole_length": 0.5, "pole_mass": 0.25}}),
     "cp28_cart2p5": ("a 2.5 kg cart under the 0.5 kg pole", {"rig": {"cart_mass": 2.5}}),
