@@ -235,8 +235,9 @@ def bar_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -> dic
     :func:`floor_failures`, :func:`channel_failures`, :func:`sensor_failures`,
     :func:`equation_failures`,
     :func:`step_failures`, :func:`sensitivity_failures`, :func:`drift_failures`,
-    :func:`held_failures`, :func:`clipping_failures`, :func:`linear_model_failures`,
-    :func:`linear_trac_failures` and :func:`unscored_mode_failures`,
+    :func:`held_failures`, :func:`clipping_failures`, :func:`linear_failures` (the
+    linear-model reasons, :func:`linear_model_failures` and :func:`linear_trac_failures`, each
+    computed once) and :func:`unscored_mode_failures`,
     merged (one call for :func:`testbed.scoring.run.run_scenario` and
     :func:`testbed.scoring.evaluate.score_model`)."""
     return {**uninformative_failures(scores, thresholds), **out_of_band_failures(scores, thresholds),
@@ -247,7 +248,7 @@ def bar_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -> dic
             **sensitivity_failures(scores, thresholds), **drift_failures(scores, thresholds),
             **held_failures(scores, thresholds),
             **clipping_failures(scores, thresholds),
-            **linear_model_failures(scores, thresholds), **linear_trac_failures(scores, thresholds),
+            **linear_failures(scores, thresholds),
             **unscored_mode_failures(scores, thresholds)}
 
 
@@ -1369,7 +1370,7 @@ def cubic_mode_reach(Mr: np.ndarray, Kr: np.ndarray, k3: float, cubic_map: np.nd
     with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
         try:
             stand_in = Kr + force @ x.T @ np.linalg.inv(x @ x.T)
-            lam = [np.sort_complex(scipy.linalg.eigvals(k, Mr)) for k in (tangent, stand_in)]
+            lam = [paired_eigenvalues(k, Mr, phi, w2) for k in (tangent, stand_in)]
         except (np.linalg.LinAlgError, ValueError):
             lam = [np.full(w2.shape, np.nan + 0j)] * 2
 
@@ -1387,10 +1388,48 @@ def cubic_mode_reach(Mr: np.ndarray, Kr: np.ndarray, k3: float, cubic_map: np.nd
     return np.fmax(np.fmax(shift(s), moved(lam[0])), moved(lam[1]))
 
 
+def paired_eigenvalues(K: np.ndarray, Mr: np.ndarray, phi: np.ndarray, w2: np.ndarray
+                       ) -> np.ndarray:
+    """The eigenvalue of ``(K, Mr)`` paired with each true mode, as the scorer pairs an
+    identified model's modes (:func:`testbed.scoring.metrics.pair_modes` by shape and
+    frequency), not by rank.
+
+    Round 28's ``b28_soft_r1p25_cf0p65_s5u_hit0p35`` (five sensors, clean): the least-squares
+    stand-in of :func:`cubic_mode_reach` (``X X^T`` of condition 4.4e9: the record's higher
+    modes barely displace) has one eigenvalue at -424 ``w_1^2`` whose shape is no true mode's
+    (MAC 0.01-0.55); sorted by value it took mode 1's place and shifted every pairing by one
+    (mode 1 reach 1, mode 2 compared with mode 1's eigenvalue: reach 0.897), where paired by
+    shape modes 1-3 move 0.25 / 2.1 / 7 % (MAC 1.000 / 1.000 / 0.986).  An eigenvalue that is
+    not real and positive gives its mode no frequency, so it is no match in the pairing; a
+    true mode left with it keeps the "may go anywhere" reach of :func:`cubic_mode_reach`.
+
+    Parameters
+    ----------
+    K : ndarray, shape (m, m)
+        A stiffness [N/m] in sensor coordinates (the tangent or the stand-in).
+    Mr : ndarray, shape (m, m)
+        The truth's mass [kg].
+    phi : ndarray, shape (m, m)
+        The truth's mode shapes (columns), ascending frequency.
+    w2 : ndarray, shape (m,)
+        Their squared circular frequencies [rad^2/s^2].
+
+    Returns
+    -------
+    ndarray of complex, shape (m,)
+        The paired eigenvalue [rad^2/s^2] of each true mode.
+    """
+    ev, vec = scipy.linalg.eig(K, Mr)
+    real = (np.abs(ev.imag) <= 1e-9 * np.abs(ev.real)) & (ev.real > 0.0)
+    f = np.where(real, np.sqrt(np.where(real, ev.real, 1.0)), np.nan)  # rad/s; NaN: no match
+    pair = metrics.pair_modes(metrics.mac_matrix(phi, vec), np.sqrt(w2), f)
+    return ev[pair]
+
+
 def linear_model_failures(scores: Scores, thresholds: dict[str, dict[str, float]]
                           ) -> dict[str, str]:
     """A failed frequency bar of a linear model on a truth whose cubic force is not small:
-    ``{"cubic": reason}`` (:func:`_linear_model_reason`), unless another failed bar is left
+    ``{"cubic": reason}`` (:func:`_linear_model_claim`), unless another failed bar is left
     that the missing cubic is not shown to explain (:func:`hidden_by_frequency`: a MAC bar, or
     a TRAC bar :func:`linear_trac_failures` does not name): a reason for the frequencies alone
     would hide it and count the cell as the missing term's (round 27, as
@@ -1399,18 +1438,46 @@ def linear_model_failures(scores: Scores, thresholds: dict[str, dict[str, float]
     Parameters
     ----------
     scores : Scores
-        As :func:`_linear_model_reason`.
+        As :func:`_linear_model_claim`.
     thresholds : dict
         The run's bars, ``{metric: {"min"|"max": value}}``.
     """
-    found = _linear_model_reason(scores, thresholds)
-    return {} if found and hidden_by_frequency(scores, thresholds) else found
+    return {k: v for k, v in linear_failures(scores, thresholds).items() if k == "cubic"}
 
 
-def _linear_model_reason(scores: Scores, thresholds: dict[str, dict[str, float]]
-                         ) -> dict[str, str]:
+def linear_failures(scores: Scores, thresholds: dict[str, dict[str, float]]) -> dict[str, str]:
+    """:func:`linear_model_failures` and :func:`linear_trac_failures` merged, each reason
+    computed once (28a L9: each judge recomputed the other's reason, so both ran twice per
+    :func:`bar_failures`).
+
+    Parameters
+    ----------
+    scores : Scores
+        As :func:`_linear_model_claim` and :func:`_linear_trac_reason`.
+    thresholds : dict
+        The run's bars, ``{metric: {"min"|"max": value}}``.
+
+    Returns
+    -------
+    dict of str to str
+        Empty, ``{"cubic": ...}``, ``{"cubic_trac": ...}`` or both.
+    """
+    freq, unpaired = _linear_model_claim(scores, thresholds)
+    trac = _linear_trac_reason(scores, thresholds)
+    out: dict[str, str] = {}
+    if freq and not _hidden_by_frequency(scores, thresholds, unpaired, trac):
+        out.update(freq)
+    if trac and not _hidden_by_trac(scores, thresholds, unpaired, freq):
+        out.update(trac)
+    return out
+
+
+def _linear_model_claim(scores: Scores, thresholds: dict[str, dict[str, float]]
+                        ) -> tuple[dict[str, str], frozenset[int]]:
     """A failed frequency bar of a linear model on a truth whose cubic force is not small:
-    ``{"cubic": reason}``, whatever else failed (:func:`linear_model_failures` judges that).
+    ``({"cubic": reason}, unpaired)``, whatever else failed (:func:`linear_failures` judges
+    that), ``unpaired`` the 1-based true modes with no partner the reason names (empty with no
+    reason: a mode it does not name is one it would hide, 28a L1).
 
     Round 21's ``b21_soft_f300`` (the shipped soft base under 300 N, cubic fraction about 8 at
     the peak base rotation), clean: both identifiers kept the cubic terms out (``ls_sindy``'s
@@ -1436,11 +1503,12 @@ def _linear_model_reason(scores: Scores, thresholds: dict[str, dict[str, float]]
     thresholds : dict
         The run's bars, ``{metric: {"min"|"max": value}}``.
     """
+    none: tuple[dict[str, str], frozenset[int]] = ({}, frozenset())
     share = scores.details.get("truth_cubic_share")
     reach = scores.details.get("truth_cubic_reach")
     if (share is None or reach is None or scores.values.get("K3_norm") != 0.0
             or {"fit", "model", "simulation"} & set(scores.failures)):
-        return {}
+        return none
     reach = np.asarray(reach, dtype=float)
     # a mode another reason names (out of band, unexcited, decayed) is that reason's, not
     # the missing cubic's to explain, nor to veto it (read 28b)
@@ -1448,11 +1516,11 @@ def _linear_model_reason(scores: Scores, thresholds: dict[str, dict[str, float]]
               if not c.passed and c.metric.startswith("freq_error") and c.bound == "max"
               and not _named_by_mode_reason(c, scores)]
     if not missed:
-        return {}
+        return none
     bar = min(c.threshold for c in missed)
     least = missed_cubic_share(bar)
     if not share >= least:
-        return {}
+        return none
     per_mode = np.asarray(scores.details.get("freq_error_per_mode", []), dtype=float)
     modes: dict[int, float] = {}  # 1-based mode -> its failed frequency error
     for c in missed:
@@ -1464,9 +1532,9 @@ def _linear_model_reason(scores: Scores, thresholds: dict[str, dict[str, float]]
                           if not e <= c.threshold and not _named_mode(scores, j + 1)})
     finite = {j: e for j, e in modes.items() if np.isfinite(e)}
     if not finite:
-        return {}  # no frequency to move: an unpaired mode is not a shift
+        return none  # no frequency to move: an unpaired mode is not a shift
     if not all(j <= reach.size and e <= reach[j - 1] for j, e in finite.items()):
-        return {}  # a mode further off than the cubic force can move it: not its
+        return none  # a mode further off than the cubic force can move it: not its
     unpaired = sorted(set(modes) - set(finite))
     aside = (f"; mode {', '.join(map(str, unpaired))} has no partner (no frequency), not judged"
              if unpaired else "")
@@ -1477,7 +1545,7 @@ def _linear_model_reason(scores: Scores, thresholds: dict[str, dict[str, float]]
                       f"(norms; from {least:.3g} on, such a force left to a linear stiffness "
                       f"can move a frequency by the run's {bar:.3g} bar): the failed frequency "
                       f"bars may be the missing term's, each within what it can move its mode "
-                      f"({within}){aside}")}
+                      f"({within}){aside}")}, frozenset(unpaired)
 
 
 def hidden_by_trac(scores: Scores, thresholds: dict[str, dict[str, float]]) -> list[Check]:
@@ -1486,8 +1554,9 @@ def hidden_by_trac(scores: Scores, thresholds: dict[str, dict[str, float]]) -> l
     (:func:`linear_trac_failures`).
 
     Every failed check but ``trac``, unless each of them is a frequency bar (or the MAC bar of
-    a mode with no partner, :func:`_unpaired_mac`) and :func:`_linear_model_reason` names them
-    all (each failed mode within what the truth's cubic force can move it, or unpaired).
+    a mode with no partner that the frequency reason names, :func:`_unpaired_mac`) and
+    :func:`_linear_model_claim` names them all (each failed mode within what the truth's cubic
+    force can move it, or unpaired).
 
     Parameters
     ----------
@@ -1501,35 +1570,52 @@ def hidden_by_trac(scores: Scores, thresholds: dict[str, dict[str, float]]) -> l
     list of Check
         The failed checks left unexplained (empty: nothing hidden).
     """
+    freq, unpaired = _linear_model_claim(scores, thresholds)
+    return _hidden_by_trac(scores, thresholds, unpaired, freq)
+
+
+def _hidden_by_trac(scores: Scores, thresholds: dict[str, dict[str, float]],
+                    unpaired: frozenset[int], freq: dict[str, str]) -> list[Check]:
+    """:func:`hidden_by_trac` given the frequency reason ``freq`` and the unpaired modes it
+    names (:func:`_linear_model_claim`)."""
     return _left_unexplained(
         scores, thresholds, lambda c: c.metric == "trac",
-        lambda c: c.metric.startswith("freq_error") or _unpaired_mac(c, scores),
-        _linear_model_reason)
+        lambda c: c.metric.startswith("freq_error") or _unpaired_mac(c, scores, unpaired),
+        bool(freq))
 
 
 def _left_unexplained(scores: Scores, thresholds: dict[str, dict[str, float]],
                       own: Callable[[Check], bool], other: Callable[[Check], bool],
-                      other_reason: Callable[..., dict[str, str]]) -> list[Check]:
+                      other_named: bool) -> list[Check]:
     """The failed checks a linear-model reason for its ``own`` bars would leave unexplained:
     every failed check but its own and those a mode-level reason names
     (:func:`_named_by_mode_reason`), unless each is one of the ``other`` reason's bars and
-    ``other_reason`` names them (:func:`hidden_by_trac`, :func:`hidden_by_frequency`)."""
+    that reason is given (``other_named``; :func:`hidden_by_trac`,
+    :func:`hidden_by_frequency`)."""
     rest = [c for c in check_thresholds(scores.values, thresholds)
             if not c.passed and not own(c) and not _named_by_mode_reason(c, scores)]
-    if rest and all(other(c) for c in rest) and other_reason(scores, thresholds):
+    if rest and all(other(c) for c in rest) and other_named:
         return []
     return rest
 
 
-def _unpaired_mac(check: Check, scores: Scores) -> bool:
-    """Whether ``check`` is a MAC bar (``mac`` or ``mac_mode<k>``) missed by a true mode with no
-    partner: its MAC and its frequency error both NaN (:func:`_per_mode`), a mode the frequency
-    reason names as unpaired (:func:`_linear_model_reason`) rather than one it hides."""
+def _unpaired_mac(check: Check, scores: Scores, named: frozenset[int]) -> bool:
+    """Whether ``check`` is a MAC bar (``mac`` or ``mac_mode<k>``) missed by true modes with no
+    partner (NaN MAC and frequency error, :func:`_per_mode`) that the frequency reason names
+    as unpaired (``named``, 1-based: :func:`_linear_model_claim`) rather than ones it hides.
+    28a L1: the NaN pair alone was taken as named, so a ``mac_mode2`` bar with no
+    ``freq_error_mode2`` bar beside it (the reason never names mode 2) was exempted.  The
+    worst-over-modes ``mac`` bar counts where every mode of NaN ``details["mac_per_mode"]`` is
+    named (none known: not exempted)."""
     found = _MODE_SCORE.fullmatch(check.metric)
     if not found or found[1] != "mac" or np.isfinite(check.value):
         return False
-    freq = "freq_error" + (f"_mode{found[2]}" if found[2] else "")
-    return not np.isfinite(scores.values.get(freq, np.nan))
+    if found[2]:
+        k = int(found[2])
+        return k in named and not np.isfinite(scores.values.get(f"freq_error_mode{k}", np.nan))
+    per_mode = np.asarray(scores.details.get("mac_per_mode", []), dtype=float)
+    modes = {j + 1 for j in np.flatnonzero(~np.isfinite(per_mode))}
+    return bool(modes) and modes <= named
 
 
 def hidden_by_frequency(scores: Scores, thresholds: dict[str, dict[str, float]]) -> list[Check]:
@@ -1538,8 +1624,8 @@ def hidden_by_frequency(scores: Scores, thresholds: dict[str, dict[str, float]])
     hide (:func:`linear_model_failures`).
 
     Every failed check but the frequency bars (``freq_error*``) and the MAC bars of modes with
-    no partner (:func:`_unpaired_mac`: the frequency reason names them), unless the only one
-    left is the TRAC bar and :func:`_linear_trac_reason` names it (every failing channel at the
+    no partner the frequency reason names (:func:`_unpaired_mac`), unless the only one left is
+    the TRAC bar and :func:`_linear_trac_reason` names it (every failing channel at the
     truth's linear part).
 
     Parameters
@@ -1554,9 +1640,18 @@ def hidden_by_frequency(scores: Scores, thresholds: dict[str, dict[str, float]])
     list of Check
         The failed checks left unexplained (empty: nothing hidden).
     """
+    _, unpaired = _linear_model_claim(scores, thresholds)
+    return _hidden_by_frequency(scores, thresholds, unpaired, _linear_trac_reason(scores, thresholds))
+
+
+def _hidden_by_frequency(scores: Scores, thresholds: dict[str, dict[str, float]],
+                         unpaired: frozenset[int], trac: dict[str, str]) -> list[Check]:
+    """:func:`hidden_by_frequency` given the unpaired modes the frequency reason names and the
+    TRAC reason ``trac`` (:func:`_linear_trac_reason`)."""
     return _left_unexplained(
-        scores, thresholds, lambda c: c.metric.startswith("freq_error") or _unpaired_mac(c, scores),
-        lambda c: c.metric == "trac", _linear_trac_reason)
+        scores, thresholds,
+        lambda c: c.metric.startswith("freq_error") or _unpaired_mac(c, scores, unpaired),
+        lambda c: c.metric == "trac", bool(trac))
 
 
 def linear_trac_failures(scores: Scores, thresholds: dict[str, dict[str, float]]
@@ -1603,8 +1698,7 @@ def linear_trac_failures(scores: Scores, thresholds: dict[str, dict[str, float]]
     dict of str to str
         Empty, or the reason naming each failing channel, its TRAC and the linear part's there.
     """
-    found = _linear_trac_reason(scores, thresholds)
-    return {} if found and hidden_by_trac(scores, thresholds) else found
+    return {k: v for k, v in linear_failures(scores, thresholds).items() if k == "cubic_trac"}
 
 
 def _linear_trac_reason(scores: Scores, thresholds: dict[str, dict[str, float]]

@@ -25,7 +25,7 @@ def _sources_only(folder: str, names: list[str]) -> list[str]:
 
 @pytest.mark.parametrize("round_name", ["round14", "round15", "round16", "round17", "round18", "round19",
                                         "round20", "round21", "round22", "round23",
-                                        "round24", "round25", "round26", "round27"])
+                                        "round24", "round25", "round26", "round27", "round28"])
 def test_the_writers_reproduce_their_rounds_files(tmp_path, round_name):
     src = UNSEEN / round_name
     work = tmp_path / "unseen"
