@@ -23,6 +23,7 @@ from testbed.core.errors import (
     PluginMethodError,
     RegistrationError,
     UnresolvedModelError,
+    numeric_blow_up,
     show_value,
 )
 from testbed.core.kinds import MAX_MODE_SCORES, METRICS
@@ -2155,11 +2156,12 @@ def simulate_scored(sim: Callable[[], Trajectory], t: np.ndarray, check: str,
         return None, f"diverged: {e}", float("nan")
     except np.linalg.LinAlgError as e:  # e.g. a singular identified M
         return None, f"simulation failed: {e}", float("nan")
-    except ValueError as e:
+    except (ValueError, OverflowError, FloatingPointError) as e:
         # A model with a fast unstable pole overflows inside the integrator (e.g. the matrix
         # exponential of a step turns inf, and scipy refuses to decompose it): a divergence.
-        # Only that message is taken; any other ValueError is a bug and propagates.
-        if "infs or NaNs" not in str(e):
+        # Only a numeric blow-up is taken (the one rule a plugin's simulate is read by,
+        # ``core.errors.numeric_blow_up``); any other exception is a bug and propagates.
+        if not numeric_blow_up(e):
             raise
         return None, f"diverged: non-finite state inside the simulation ({e})", float("nan")
     found = None

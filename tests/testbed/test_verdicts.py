@@ -140,6 +140,25 @@ def test_divergence_error_keeps_its_time():
     assert "Newton" in why and math.isnan(when)
 
 
+def test_a_numeric_blow_up_raised_by_a_simulation_is_a_divergence_and_any_other_error_a_bug():
+    """The scorer reads a raised exception by the one rule plugins are read by
+    (``numeric_blow_up``): an overflow or scipy's non-finite refusal is "diverged"; any other
+    ValueError propagates (an internal error, not a verdict)."""
+    t = np.linspace(0.0, 1.0, 11)
+    for err in (OverflowError("(34, 'Numerical result out of range')"),
+                FloatingPointError("overflow encountered in multiply"),
+                ValueError("array must not contain infs or NaNs")):
+        def boom(err=err):
+            raise err
+        traj, why, when = simulate_scored(boom, t, "x", np.ones((1, 11)))
+        assert traj is None and why.startswith("diverged:") and math.isnan(when)
+
+    def bug():
+        raise ValueError("operands could not be broadcast together")
+    with pytest.raises(ValueError, match="broadcast"):
+        simulate_scored(bug, t, "x", np.ones((1, 11)))
+
+
 def test_blow_up_and_nonfinite_are_found_with_their_time():
     t = np.arange(10) * 0.1
     ref = np.ones((2, 10))
