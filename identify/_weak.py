@@ -62,7 +62,7 @@ def check_window(window_s: float, fs: float, n_samples: int, error: ErrorFn) -> 
     a test function (:data:`MIN_WINDOW_SAMPLES`); ``error(key, value, allowed)`` otherwise."""
     samples = window_samples(window_s, fs)
     if samples > n_samples:
-        error("weak_window_s", window_s, f"shorter than the record ({n_samples / fs:g} s)")
+        error("weak_window_s", window_s, f"expected shorter than the record ({n_samples / fs:g} s)")
     if samples < MIN_WINDOW_SAMPLES:
         error("weak_window_s", window_s,
               f"at least {MIN_WINDOW_SAMPLES - 1} sample steps ({(MIN_WINDOW_SAMPLES - 1) / fs:g} s "

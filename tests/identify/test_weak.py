@@ -116,3 +116,13 @@ def test_a_held_input_is_integrated_as_held():
         rest[hold] = np.abs(wf.V @ np.array([1.0, -1.0])).max() / np.abs(wf.V[:, 1]).max()
     assert rest["zoh"] < (2 * np.pi * 7.3 * h) ** 2 / 12
     assert rest["linear"] > 10 * rest["zoh"]
+
+
+def test_a_window_longer_than_the_record_names_what_is_expected():
+    """The refusal reads as what is allowed ("expected shorter than the record"), as every
+    other refusal does, not as a description of the value (round 28's reading)."""
+    from identify._weak import check_window
+
+    said = []
+    check_window(2.0, 100.0, 101, lambda key, value, allowed: said.append((key, value, allowed)))
+    assert said == [("weak_window_s", 2.0, "expected shorter than the record (1.01 s)")]

@@ -220,7 +220,7 @@ HAND = {
     "score_min_above_max.toml": ("score.trac_min", "no score could pass"),
     "lowpass_below_highpass.toml": ("signal.highpass_hz", "pass band"),
     "fivebar_amplitude_zero.toml": ("excitation.amplitude", "nothing to identify"),
-    "weak_window_too_long.toml": ("identify.weak_window_s", "record"),
+    "weak_window_too_long.toml": ("identify.weak_window_s", "expected shorter than the"),
     "rig_as_array_of_tables.toml": ("rig", "expected a table"),
 }
 
