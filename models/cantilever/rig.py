@@ -634,7 +634,13 @@ class CantileverRig(Rig):
         _check_segment_inertia(rig, error)
         _check_mode1_sampled(rig, simulation, error)
         _check_sensors_per_segment(rig, sensors, x0, error)
-        if len(sensor_positions(rig)) > n_dof:
+        n_sensors = len(sensor_positions(rig))
+        if n_sensors > n_dof and not sensors:  # the default stands for L/3, 2L/3, L
+            error("rig.n_segments", rig["n_segments"],
+                  f"allowed: a model of at least {n_sensors} degrees of freedom for the default "
+                  f"sensors (L/3, 2L/3, L; this one has {n_dof}, for the SEREP reduction), or "
+                  f"at most {n_dof} positions in rig.sensors")
+        elif n_sensors > n_dof:
             error("rig.sensors", sensors, f"allowed: at most {n_dof} sensors (the model's degrees "
                                           "of freedom, for the SEREP reduction)")
         if rig["damping_ratio"] == 0 and rig["damping_beta"] == 0:

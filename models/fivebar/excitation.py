@@ -28,8 +28,10 @@ EXCITATION_SCHEMAS: dict[str, dict[str, Field]] = {
         "amplitude": Field(float, 0.0698, unit="rad", min=0.0, max=0.5,
                            doc="amplitude A of the prescribed motion th = th_0 + A sin(2 pi f t + phase) "
                                "of both actuated joints (the paper: 0.0698 rad = 4 deg)"),
-        "frequency": Field(float, 1.0 / (2.0 * math.pi), unit="Hz", min=0.0, max=20.0,
-                           doc="frequency f of the prescribed motion (the paper: 1 rad/s)"),
+        "frequency": Field(float, 1.0 / (2.0 * math.pi), unit="Hz", min=0.0, min_inclusive=False,
+                           max=20.0,
+                           doc="frequency f of the prescribed motion (the paper: 1 rad/s); > 0: at "
+                               "0 Hz both joints rest at th_0 + A sin(phase), nothing to identify"),
         "phase": Field(float, math.pi / 2.0, unit="rad",
                        doc="phase of the prescribed motion (the paper: pi/2, so it starts at "
                            "th_0 + A at rest)"),
