@@ -179,3 +179,31 @@ def test_compile_venv_writes_what_compileall_writes(tmp_path):
 
     mine, theirs = written(src), written(other)
     assert mine == theirs and len(mine) == 3, sorted(mine)  # __init__, mod, deep
+
+
+def test_the_install_puts_the_build_systems_requirements_in_the_venv():
+    """The Makefile's install adds pyproject's ``[build-system] requires`` to the venv in both of
+    its branches (uv, pip), so tests/test_wheel.py builds with ``--no-build-isolation`` instead
+    of pip making an isolated build environment and fetching setuptools on each run; and the
+    command that reads them names exactly those requirements."""
+    import re
+    import subprocess
+    import sys
+    import tomllib
+
+    root = Path(__file__).resolve().parent.parent
+    text = (root / "Makefile").read_text()
+    define = re.search(r"^BUILD_REQUIRES := \$\(BIN\)/python ((?:[^\n]*\\\n)*[^\n]*)$", text, re.M)
+    assert define, "Makefile defines no BUILD_REQUIRES"
+    recipe = re.search(r"^\$\(STAMP\):.*\n((?:\t.*\n)+)", text, re.M)
+    assert recipe, "Makefile has no install recipe"
+    installs = [ln for ln in recipe.group(1).splitlines() if "install" in ln and '-e ".[dev]"' in ln]
+    assert len(installs) == 2 and all("$$($(BUILD_REQUIRES))" in ln for ln in installs), installs
+    # the variable's command as make hands it to the shell (a backslash-newline is one space)
+    command = re.sub(r"\\\n\s*", " ", define.group(1)).strip()
+    assert command.startswith("-c "), command
+    code = command[3:].strip().strip('"')
+    out = subprocess.run([sys.executable, "-c", code], cwd=root, capture_output=True, text=True,
+                         check=True).stdout.split()
+    want = tomllib.loads((root / "pyproject.toml").read_text())["build-system"]["requires"]
+    assert out == want and out, out

@@ -992,9 +992,13 @@ def test_a_signal_while_the_main_thread_is_in_compiled_code_ends_the_command_pro
     # a SIGTERM or Ctrl-C while an identifier's numba kernel (compiled, nogil) held the main
     # thread was acted on when the kernel returned: `testbed run` of a plugin whose fit is one
     # long kernel said "interrupted" 28 s after the SIGTERM (45 s with a hashlib loop, which
-    # also releases the GIL and checks no signal; that loop stands in for the kernel here, as
-    # numba's compilation would take seconds): now within the watchdog's grace, one line, the
-    # signal's status and no temporary file left
+    # also releases the GIL and checks no signal): now within the watchdog's grace, one line, the
+    # signal's status and no temporary file left.  The kernel's stand-in here (numba's compilation
+    # would take seconds) is a second lock of a POSIX mutex the main thread holds, called
+    # through ctypes: compiled code that releases the GIL, checks no signal and never returns,
+    # as the hashlib loop was, without burning a core meanwhile (that loop spent 1 s + the grace,
+    # 3 s of CPU, before the watchdog ended it).  Where the second lock returns (a mutex type that
+    # checks for deadlock), the hashlib loop stands in as before.
     from testbed.core.interrupts import GRACE_S
 
     mark, tmp = tmp_path / "in-kernel", tmp_path / ".run.json.abc.tmp"
@@ -1003,7 +1007,7 @@ def test_a_signal_while_the_main_thread_is_in_compiled_code_ends_the_command_pro
     # Python code, whose handler then raised outside any command's reporting (a traceback and
     # status 1 on a loaded machine: session 19's suite)
     code = textwrap.dedent(f"""
-        import hashlib, pathlib, threading, time
+        import ctypes, hashlib, pathlib, threading, time
         from testbed import cli
         from testbed.core.atomic import begin_in_flight
 
@@ -1015,6 +1019,9 @@ def test_a_signal_while_the_main_thread_is_in_compiled_code_ends_the_command_pro
             pathlib.Path({str(tmp)!r}).write_text("half")
             begin_in_flight({str(tmp)!r})
             threading.Thread(target=mark, daemon=True).start()
+            libc, mutex = ctypes.CDLL(None), ctypes.create_string_buffer(256)
+            if libc.pthread_mutex_init(mutex, None) == 0 and libc.pthread_mutex_lock(mutex) == 0:
+                libc.pthread_mutex_lock(mutex)  # blocks for good (a default mutex)
             hashlib.pbkdf2_hmac("sha256", b"k", b"s", 10**9)  # minutes
         print("the kernel returned")
     """)
