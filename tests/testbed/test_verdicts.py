@@ -502,3 +502,19 @@ def test_the_score_table_is_drawn_on_a_terminal_reporting_no_width(monkeypatch, 
     assert console.width == width
     console.print("PASS: all 1 threshold(s) met")
     assert buf.getvalue() == "PASS: all 1 threshold(s) met\n" if width >= 30 else "PASS" in buf.getvalue()
+
+
+def test_a_linkage_at_rest_through_the_automatic_low_pass_is_a_scored_failure(tmp_path):
+    """A record with no motion above its noise floor has no band for ``cutoff_hz = "auto"``:
+    it was an internal error (a ValueError out of the chain) on inputs the schema allows (a
+    PD reference at 0 Hz, review 29b); now the run ends in a verdict with its reason."""
+    base = (Path(__file__).resolve().parents[2] / "scenarios" / "fivebar_sine_replay.toml")
+    path = tmp_path / "pd_at_rest.toml"
+    path.write_text(
+        f'[scenario]\nname = "pd_at_rest"\nextends = "{base.as_posix()}"\n'
+        '[simulation]\nduration = 1.0\ndt = 1e-3\nsample_rate = 1000.0\n'
+        '[excitation]\ntype = "pd"\nfrequency = 0.0\n'
+        '[identify]\nmethod = "sindy_pi"\nlibrary = "fivebar"\ninput_hold = "zoh"\nsim_dt = 1e-3\n'
+        '[signal]\nderivatives = "lowpass"\n')
+    result = run_scenario(load_scenario(path))
+    assert not result.passed and result.failure.startswith(("fit failed:", "uninformative:"))

@@ -15,7 +15,7 @@ from testbed.core.dataset import Dataset, Signal
 from testbed.core.errors import ScenarioError
 from testbed.numerics import derivatives as der
 from testbed.numerics.noise import noise_std, record_noise_std, signal_band
-from testbed.pipeline.signal_chain import AUTO_BAND_SHARE, auto_cutoff, measure
+from testbed.pipeline.signal_chain import AUTO_BAND_SHARE, AUTO_CUTOFF_MAX_SHARE, auto_cutoff, measure
 
 UNSEEN = Path(__file__).resolve().parents[3] / "benchmarks" / "unseen"
 
@@ -76,8 +76,9 @@ def test_auto_cutoff_from_the_angles_band():
     assert 1.0 <= band <= 1.5
     assert m.passband == (0.0, pytest.approx(der.harmonic_cutoff(band, 8)))
     assert auto_cutoff(raw, ds.fs, 8) == m.passband[1]
-    with pytest.raises(ValueError, match="no power above"):
-        auto_cutoff(np.zeros((2, 1000)) + np.arange(2)[:, None], ds.fs, 8)
+    # no band to keep (angles at rest): the widest cut-off, not an exception (review 29b)
+    assert auto_cutoff(np.zeros((2, 1000)) + np.arange(2)[:, None], ds.fs, 8) == \
+        AUTO_CUTOFF_MAX_SHARE * ds.fs
 
 
 def test_auto_is_the_only_word_cutoff_takes():
