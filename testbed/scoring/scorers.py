@@ -10,7 +10,7 @@ import copy
 import functools
 import re
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -1379,14 +1379,20 @@ def cubic_mode_reach(Mr: np.ndarray, Kr: np.ndarray, k3: float, cubic_map: np.nd
         return np.where(1.0 + z > 0.0, np.abs(np.sqrt(np.fmax(1.0 + z, 0.0)) - 1.0), 1.0)
 
     def moved(ev: np.ndarray) -> np.ndarray:
-        # a complex or non-positive eigenvalue: the mode may go anywhere (reach 1); "real" up to
-        # 1e-9 of its size (the round-off of a non-symmetric real pencil's eigenvalues, far
-        # below any frequency the bars read); a non-finite one (a record whose X X^T is
-        # singular) adds nothing beyond the tangent's first order
-        real = (np.abs(ev.imag) <= 1e-9 * np.abs(ev.real)) & (ev.real > 0.0)
+        # a complex or non-positive eigenvalue: the mode may go anywhere (reach 1); a
+        # non-finite one (a record whose X X^T is singular) adds nothing beyond the tangent's
+        # first order
+        real = _real_positive(ev)
         return np.where(real, shift(ev.real / w2 - 1.0), np.where(np.isfinite(ev), 1.0, 0.0))
 
     return np.fmax(np.fmax(shift(s), moved(lam[0])), moved(lam[1]))
+
+
+def _real_positive(ev: np.ndarray) -> np.ndarray:
+    """Which eigenvalues [rad^2/s^2] of a stiffness pencil are a real, positive square of a
+    frequency: "real" up to 1e-9 of their size (the round-off of a non-symmetric real pencil's
+    eigenvalues, far below any frequency the bars read)."""
+    return (np.abs(ev.imag) <= 1e-9 * np.abs(ev.real)) & (ev.real > 0.0)
 
 
 def paired_eigenvalues(K: np.ndarray, Mr: np.ndarray, phi: np.ndarray, w2: np.ndarray
@@ -1421,7 +1427,7 @@ def paired_eigenvalues(K: np.ndarray, Mr: np.ndarray, phi: np.ndarray, w2: np.nd
         The paired eigenvalue [rad^2/s^2] of each true mode.
     """
     ev, vec = scipy.linalg.eig(K, Mr)
-    real = (np.abs(ev.imag) <= 1e-9 * np.abs(ev.real)) & (ev.real > 0.0)
+    real = _real_positive(ev)
     f = np.where(real, np.sqrt(np.where(real, ev.real, 1.0)), np.nan)  # rad/s; NaN: no match
     pair = metrics.pair_modes(metrics.mac_matrix(phi, vec), np.sqrt(w2), f)
     return ev[pair]
@@ -1607,7 +1613,9 @@ def _unpaired_mac(check: Check, scores: Scores, named: frozenset[int]) -> bool:
     28a L1: the NaN pair alone was taken as named, so a ``mac_mode2`` bar with no
     ``freq_error_mode2`` bar beside it (the reason never names mode 2) was exempted.  The
     worst-over-modes ``mac`` bar counts where every mode of NaN ``details["mac_per_mode"]`` is
-    named (none known: not exempted)."""
+    named (none known: not exempted) or named by another reason (:func:`_named_mode`: review
+    29b M1, a mode out of band withheld the cubic reason of another) and every finite
+    per-mode MAC meets the bar (review 29b M2: the NaN hid a mode's failed MAC)."""
     found = _MODE_SCORE.fullmatch(check.metric)
     if not found or found[1] != "mac" or np.isfinite(check.value):
         return False
@@ -1615,8 +1623,10 @@ def _unpaired_mac(check: Check, scores: Scores, named: frozenset[int]) -> bool:
         k = int(found[2])
         return k in named and not np.isfinite(scores.values.get(f"freq_error_mode{k}", np.nan))
     per_mode = np.asarray(scores.details.get("mac_per_mode", []), dtype=float)
-    modes = {j + 1 for j in np.flatnonzero(~np.isfinite(per_mode))}
-    return bool(modes) and modes <= named
+    unpaired = ~np.isfinite(per_mode)
+    modes = {int(j) + 1 for j in np.flatnonzero(unpaired)}
+    paired_meet = all(replace(check, value=float(v)).passed for v in per_mode[~unpaired])
+    return bool(modes) and paired_meet and all(k in named or _named_mode(scores, k) for k in modes)
 
 
 def hidden_by_frequency(scores: Scores, thresholds: dict[str, dict[str, float]]) -> list[Check]:

@@ -18,11 +18,11 @@ C, D, K3 = np.array([1.0, 0.0, 0.0]), np.array([1.0, 0.0, 1.0]), 10.0
 def test_a_spurious_stand_in_eigenvalue_takes_no_other_modes_place():
     reach = cubic_mode_reach(MR, KR, K3, C, D, X)
     # mode 1: the tangent's first order (3 k3 max x1^2 = 0.3: sqrt(1.3) - 1) and the stand-in's
-    # own mode 1 (1.075: +3.7 %); mode 2 untouched; mode 3's partner is the spurious
-    # eigenvalue (-241, along its shape): "may go anywhere"
+    # own mode 1 (eigenvalue 0.9975: -0.12 %); mode 2 untouched; mode 3's partner is the
+    # spurious eigenvalue (-240.9, along its shape): "may go anywhere"
     np.testing.assert_allclose(reach, [np.sqrt(1.3) - 1.0, 0.0, 1.0], atol=1e-6)
-    # by rank (the old rule) mode 1 read -241 (reach 1), mode 2 1.075 against 4 (0.48) and
-    # mode 3 4 against 9 (0.33): a mode 2 48 % off was "within what the cubic can move"
+    # by rank (the old rule) mode 1 read -240.9 (reach 1), mode 2 0.9975 against 4 (0.50) and
+    # mode 3 4 against 9 (0.33): a mode 2 50 % off was "within what the cubic can move"
     assert reach[1] < 0.01
 
 

@@ -67,3 +67,27 @@ def test_each_linear_reason_is_computed_once_per_bar_failures(monkeypatch):
     why = bar_failures(Scores({**VALUES, "trac": 0.85}, details), bars)
     assert set(why) == {"cubic", "cubic_trac"}  # both given, each judged against the other
     assert calls == {"claim": 1, "trac": 1}  # was 2 and 2
+
+
+def test_the_worst_mac_bar_is_exempted_only_where_every_paired_mode_meets_it():
+    """Review 29b M2: a paired mode's failed MAC (0.30) under the worst-over-modes bar, whose
+    value the unpaired mode 3 makes NaN, was hidden and the cell given "cubic"."""
+    details = dict(DETAILS, mac_per_mode=np.array([0.99, 0.30, NAN]),
+                   freq_error_per_mode=np.array([0.03, 0.01, NAN]),
+                   truth_cubic_reach=np.array([0.27, 0.05, 0.03]))
+    values = dict(VALUES, freq_error_mode2=0.01, mac_mode2=0.30, freq_error_mode3=NAN,
+                  mac_mode3=NAN)
+    s = Scores(values, details)
+    worst = {"freq_error": {"max": 0.026}, "mac": {"min": 0.9}}
+    assert [c.metric for c in hidden_by_frequency(s, worst)] == ["mac"]
+    assert bar_failures(s, worst) == {}
+
+
+def test_an_unpaired_mode_another_reason_names_does_not_withhold_the_cubic_reason():
+    """Review 29b M1: true mode 2 unpaired and above the low-pass (the band reason names it);
+    the worst-over-modes MAC bar is then explained, so mode 1's 3 % keeps its cubic reason."""
+    details = dict(DETAILS, passband=(1.0, 100.0), f_true=np.array([20.0, 400.0]))
+    s = Scores(dict(VALUES), details)
+    worst = {"freq_error": {"max": 0.026}, "mac": {"min": 0.9}}
+    assert hidden_by_frequency(s, worst) == []
+    assert set(bar_failures(s, worst)) == {"band", "cubic"}
