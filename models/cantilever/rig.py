@@ -636,10 +636,11 @@ class CantileverRig(Rig):
         _check_sensors_per_segment(rig, sensors, x0, error)
         n_sensors = len(sensor_positions(rig))
         if n_sensors > n_dof and not sensors:  # the default stands for L/3, 2L/3, L
+            need = n_sensors - (rig["base"] == "soft")
             error("rig.n_segments", rig["n_segments"],
-                  f"allowed: a model of at least {n_sensors} degrees of freedom for the default "
-                  f"sensors (L/3, 2L/3, L; this one has {n_dof}, for the SEREP reduction), or "
-                  f"at most {n_dof} positions in rig.sensors")
+                  f"allowed: at least {need} with the default sensors (L/3, 2L/3, L: the SEREP "
+                  f"reduction needs a degree of freedom per sensor), or at most {n_dof} "
+                  "positions in rig.sensors")
         elif n_sensors > n_dof:
             error("rig.sensors", sensors, f"allowed: at most {n_dof} sensors (the model's degrees "
                                           "of freedom, for the SEREP reduction)")
