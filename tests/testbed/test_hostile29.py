@@ -247,11 +247,22 @@ def test_a_cache_entry_cut_with_its_hash_anew_is_simulated_again(tmp_path, caplo
     assert again.n_samples == n and f"samples; its scenario records {n}" in caplog.text
 
 
-@pytest.mark.parametrize("tag", ["\u200b", "\ufeff", "\u200d\u2060"])
+@pytest.mark.parametrize("tag", ["\u200b", "\ufeff", "\u200d\u2060",
+                                 # review 29a L4: outside the hand-made list, so they passed
+                                 "\U000E0020", "\uFFF9", "\u3000\U000E0001", "\u0301\ufe0f",
+                                 "\u3164", "\u2000\u205f"])
 def test_a_tag_of_invisible_characters_alone_is_refused(tag):
     with pytest.raises(testbed.TestbedError, match=r"scenario\.tags"):
         testbed.scenario_from_dict({"scenario": {"name": "x", "rig": "michaelis_menten",
                                                  "tags": ["a", tag]}})
+
+
+@pytest.mark.parametrize("tag", ["a\u200b", "\u00e9t\u00e9", "e\u0301", "\u0915\u093f",
+                                 "\U0001F600", "\u4e2d"])
+def test_a_tag_with_a_visible_character_is_kept(tag):
+    sc = testbed.scenario_from_dict({"scenario": {"name": "x", "rig": "michaelis_menten",
+                                                  "tags": [tag]}})
+    assert sc.tags == (tag,) or list(sc.tags) == [tag]
 
 
 def _traj(*fields):
