@@ -438,6 +438,23 @@ def test_a_handled_interrupt_cancels_its_pending_redelivery(monkeypatch, capsys)
     assert sent == [] and capsys.readouterr().err == "error: interrupted\n"
 
 
+def test_a_sent_redelivery_is_no_longer_pending(monkeypatch):
+    # review 29a L7: a redelivery timer that had fired stayed in _REDELIVERIES
+    import signal
+    import types
+
+    from testbed import cli
+
+    sent = []
+    monkeypatch.setattr(cli, "REDELIVER_S", 0.05)  # read below before it fires
+    monkeypatch.setattr(cli.os, "kill", lambda pid, signum: sent.append(signum))
+    monkeypatch.setattr(cli, "_REDELIVERIES", [])
+    cli._redeliver_interrupt(lambda u: None, types.SimpleNamespace(exc_value=KeyboardInterrupt()))
+    (timer,) = cli._REDELIVERIES
+    timer.join(5.0)
+    assert sent == [signal.SIGINT] and cli._REDELIVERIES == []
+
+
 def test_a_report_written_before_the_png_marker_is_replaced_as_before(tmp_path):
     # its figures carry no marker, but its page embeds them byte for byte: the earlier report's
     from testbed.reporting.report import Page
