@@ -618,7 +618,9 @@ def _called(model: Identifier, where: str, method: Callable[..., Any], *a: Any,
     with status 0 and no verdict.  Any other exception of the plugin's own (not the testbed's,
     not ``NotImplementedError`` or ``KeyboardInterrupt``; a ``sys.exit`` included) becomes a
     :class:`~testbed.core.errors.PluginMethodError` naming the method and the exception's type,
-    which scoring turns into a failure (hostile round 28)."""
+    which scoring turns into a failure (hostile round 28).  ``where`` is
+    ``"<class>.<method>"``; its method part (``simulate``) decides whether a numeric blow-up is
+    a divergence."""
     if builtin_class(type(model)):
         return method(model, *a, **kw)
     try:
@@ -630,7 +632,9 @@ def _called(model: Identifier, where: str, method: Callable[..., Any], *a: Any,
         raise  # the testbed's own refusals; NotImplementedError: a method the model lacks
     except BaseException as e:  # the plugin's own code failed (hostile round 28: its simulate's
         # Exception was "internal error ... please report it", status 3)
-        if getattr(method, "__name__", "") == "simulate" and numeric_blow_up(e):
+        if where.rpartition(".")[2] == "simulate" and numeric_blow_up(e):  # the guard's known
+            # name, not ``method.__name__`` (a plugin's decorator without functools.wraps
+            # renames it: review 29a L2)
             # its integrator's state ran off: diverged, as a built-in's (review 28a L7)
             raise DivergenceError(f"{where} raised {type(e).__name__}: {exception_text(e)}"
                                   ) from None
@@ -692,9 +696,14 @@ def _plugin_trajectory(where: str, out: Any, n_times: int) -> Trajectory:
     Hostile round 29: an array, a list or a generator returned ended `testbed run` in
     AttributeError "... has no attribute 'x'"; a Trajectory of half the times, or with ``x``
     None, in a ValueError / IndexError of the scorer; complex samples were cast to real with a
-    warning, their imaginary part dropped.  Each field given (``xd`` and ``xdd`` may be None,
-    as the built-in mechanical simulation's are) must be real numbers of shape (n_rows,
-    ``n_times``), ``xd`` and ``xdd`` of ``x``'s shape; a masked sample is an unknown value
+    warning, their imaginary part dropped.  All three fields are required (review 29a H1: an
+    ``xd`` or ``xdd`` None was accepted and the scorer's divergence check then failed on it
+    with an IndexError; the public ``simulate`` of every built-in identifier returns all
+    three): each must be numbers (integer, float or complex dtype; an object array is
+    converted; booleans, dates, durations and text are not numbers, review 29a L7) of shape
+    (n_rows, ``n_times``), ``xd`` and ``xdd`` of ``x``'s shape.  A complex sample is accepted
+    only with an imaginary part of exactly zero (a non-finite imaginary part is not zero:
+    review 29a M3, ``complex(1, nan)`` read as 1.0); a masked sample is an unknown value
     (NaN, which the scorer's divergence check names).
 
     Raises
@@ -707,22 +716,12 @@ def _plugin_trajectory(where: str, out: Any, n_times: int) -> Trajectory:
                                 "(x, xd, xdd: each channels x times)")
     fields = []
     for label, value in zip(out._fields, out, strict=True):
-        if value is None and label != "x":
-            fields.append(None)
-            continue
-        try:
-            if value is None or np.asarray(value).dtype.kind in "USVM":  # (text, bytes, dates)
-                raise TypeError("no numbers")
-            arr = np.ma.filled(np.ma.asarray(value).astype(complex if np.iscomplexobj(value)
-                                                           else float), np.nan)
-        except (TypeError, ValueError) as e:
-            what = "None" if value is None else f"{args.describe(value)} ({exception_text(e)})"
-            raise PluginMethodError(f"{where} returned a Trajectory whose {label} is {what}, "
-                                    "not numbers") from None
+        arr = _plugin_numbers(where, label, value)
         if np.iscomplexobj(arr):
-            if np.any(arr.imag[np.isfinite(arr.imag)] != 0):
+            if np.any(arr.imag != 0):  # NaN != 0: a non-finite imaginary part is refused too
                 raise PluginMethodError(f"{where} returned a Trajectory whose {label} is complex "
-                                        "(a nonzero imaginary part): not a physical response")
+                                        "(an imaginary part not exactly zero): not a physical "
+                                        "response")
             arr = arr.real
         arr = np.asarray(arr, dtype=float)  # (np.matrix and other subclasses: a plain array)
         shape = fields[0].shape if fields else (None, n_times)
@@ -732,6 +731,38 @@ def _plugin_trajectory(where: str, out: Any, n_times: int) -> Trajectory:
                                     f"{arr.shape}; expected {want}")
         fields.append(arr)
     return Trajectory(*fields)
+
+
+#: dtype kinds a plugin's trajectory field may have: signed and unsigned integers, floats,
+#: complex (checked for a zero imaginary part).  Booleans ("b"), dates and durations ("M",
+#: "m"), text and bytes ("U", "S"), void ("V") are not samples of a response (review 29a L7);
+#: an object array ("O") is converted first and judged by the kind it converts to.
+_NUMBER_KINDS = "iufc"
+
+
+def _plugin_numbers(where: str, label: str, value: Any) -> np.ndarray:
+    """One field of a plugin's Trajectory as a float or complex array, masked samples NaN.
+
+    Raises
+    ------
+    PluginMethodError
+        If the field is None or not numbers (see :data:`_NUMBER_KINDS`).
+    """
+    try:
+        if value is None:
+            raise TypeError("no numbers")
+        arr = np.ma.asarray(value)
+        if arr.dtype.kind == "O":  # a list of Python numbers mixed with None, Fractions, ...
+            arr = np.ma.asarray(arr.astype(complex if any(isinstance(v, complex) for v in
+                                                          np.ravel(arr.filled(0))) else float))
+        if arr.dtype.kind not in _NUMBER_KINDS:
+            raise TypeError(f"dtype {arr.dtype}")
+        arr = np.ma.filled(arr.astype(complex if arr.dtype.kind == "c" else float), np.nan)
+    except (TypeError, ValueError) as e:
+        what = "None" if value is None else f"{args.describe(value)} ({exception_text(e)})"
+        raise PluginMethodError(f"{where} returned a Trajectory whose {label} is {what}, "
+                                "not numbers") from None
+    return np.asarray(arr)
 
 
 #: Fewest samples from ``free_start`` on that :meth:`Identifier.score` scores: R^2 divides by

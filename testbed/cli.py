@@ -1307,7 +1307,14 @@ def _redeliver_interrupt(hook: Callable[[Any], None], unraisable: Any) -> None:
         hook(unraisable)
         return
     signum = getattr(unraisable.exc_value, "signum", signal.SIGINT)
-    timer = threading.Timer(REDELIVER_S, os.kill, (os.getpid(), signum))
+
+    def send() -> None:  # sent: no longer pending (review 29a L7: a timer that had fired stayed
+        # in the list, one more each interrupt of a long-lived process)
+        with contextlib.suppress(ValueError):
+            _REDELIVERIES.remove(timer)
+        os.kill(os.getpid(), signum)
+
+    timer = threading.Timer(REDELIVER_S, send)
     timer.daemon = True
     _REDELIVERIES.append(timer)
     timer.start()

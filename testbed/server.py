@@ -766,11 +766,15 @@ def _start(st: _Server, conn: socket.socket, request: dict, fds: list[int]) -> N
     except OSError:  # the client went away meanwhile (killed, Ctrl-C): so does its command
         with contextlib.suppress(ProcessLookupError):
             os.killpg(pid, signal.SIGKILL)
-        st.log(f"testbed server: {command}: its client left before its pid was sent, so the "
-               f"command was stopped (pid {pid})")
+        with contextlib.suppress(OSError):
+            st.log(f"testbed server: {command}: its client left before its pid was sent, so "
+                   f"the command was stopped (pid {pid})")
         return
-    st.log(f"testbed server: {command} (pid {pid})")
+    # registered before the line: a log that raised (a full disk, a log file removed) left the
+    # command unregistered, never stopped when its client died (review 29a L1)
     st.sel.register(conn, selectors.EVENT_READ, ("running", pid))
+    with contextlib.suppress(OSError):
+        st.log(f"testbed server: {command} (pid {pid})")
 
 
 def _reap(st: _Server) -> None:

@@ -18,6 +18,7 @@ from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import NamedTuple
 
+from testbed.core.budget import IDENTIFY_TEXT_BUDGET_BYTES
 from testbed.core.errors import InputError, terminal_safe
 
 # mkstemp creates 0600 files; the result gets the permissions a plain open() would give
@@ -132,14 +133,18 @@ PATTERN_READ = 1024
 #: The PNG text chunk every figure the testbed writes carries (``reporting.figures.png_bytes``):
 #: the keyword ``Software`` and this value, before the image data (review 28b M2)
 PNG_SOFTWARE = "sysid-testbed"
-#: The first bytes of a UFF file that :func:`_uff_ours` reads for its first record's marker
-#: [bytes]: a structural dataset's geometry records (about 160 bytes a node) come first
-UFF_MARK_READ = 1 << 20
+#: How much of a UFF file :func:`_uff_ours` reads at a time [bytes]
+UFF_CHUNK = 1 << 20
+#: The start of a UFF58 record (``58`` ASCII, ``58b`` binary) after its ``-1`` delimiter
+_UFF58_START = re.compile(rb"\n\s*-1\n\s*58b?[ \t]")
 #: Every UFF58 record the testbed writes states its rate on ID line 5 as ``fs <rate> Hz,
 #: sysid-testbed`` (``reporting.export``, since the line was written)
 _UFF_MARK = re.compile(rb"\n\s*-1\n\s*58b?[ \t][^\n]*\n(?:[^\n]*\n){4}fs [^\n]*Hz, sysid-testbed\b")
-#: The largest JSON output :func:`_json_document` parses to find its marker [bytes]
-JSON_MARK_READ = 256 << 20
+#: The largest JSON output :func:`_json_document` parses, and the farthest :func:`_uff_ours`
+#: looks for a UFF file's first UFF58 record [bytes]: the largest text file ``identify`` reads
+#: (``testbed.core.budget.IDENTIFY_TEXT_BUDGET_BYTES``, review 29a L5: a second, unexplained
+#: 256 MiB); a larger one could not be read back by the testbed, so it is not one it wrote
+JSON_MARK_READ = IDENTIFY_TEXT_BUDGET_BYTES
 #: The keys every model summary ``identify`` writes holds (``testbed.pipeline.fit``), which no
 #: one else's JSON holds together: the identified model's marker
 IDENTIFIED_KEYS = frozenset({"source", "kind", "method", "fs_hz", "n_samples", "identifier"})
@@ -196,7 +201,8 @@ def _json_document(fd: int) -> object:
         return None
     try:
         return json.loads(_read_at(fd, JSON_MARK_READ).decode("utf-8-sig"))
-    except ValueError:
+    except (ValueError, RecursionError):  # RecursionError: a user's deeply nested document
+        # ('[' * 100000) is not ours either (review 29a M2: it was "internal error")
         return None
 
 
@@ -214,8 +220,24 @@ def _sep005_ours(fd: int) -> bool:
 
 
 def _uff_ours(fd: int) -> bool:
-    """True for a UFF file whose UFF58 records carry the testbed's ID line 5 (:data:`_UFF_MARK`)."""
-    return _UFF_MARK.search(b"\n" + _read_at(fd, UFF_MARK_READ)) is not None
+    """True for a UFF file whose first UFF58 record carries the testbed's ID line 5
+    (:data:`_UFF_MARK`).
+
+    The file is read in :data:`UFF_CHUNK` pieces up to that record's start only, at most
+    :data:`JSON_MARK_READ` bytes: the testbed's export writes its geometry (about 160 bytes a
+    node) before it, so a fixed first MiB refused its own export of more than ~6,500 nodes
+    (review 29a L5)."""
+    tail, pos = b"\n", 0
+    while pos < JSON_MARK_READ:
+        chunk = _read_at(fd, UFF_CHUNK, pos)
+        if not chunk:
+            return False
+        buf, pos = tail + chunk, pos + len(chunk)
+        found = _UFF58_START.search(buf)
+        if found:  # its six ID lines (80 characters each) follow within PATTERN_READ bytes
+            return _UFF_MARK.match(buf + _read_at(fd, PATTERN_READ, pos), found.start()) is not None
+        tail = buf[-PATTERN_READ:]  # a record start cut by the chunk's end is found next time
+    return False
 
 
 HDF5_FILE = FileKind("an HDF5 dataset of the testbed", (b"\x89HDF\r\n\x1a\n",), ours=_hdf5_ours)

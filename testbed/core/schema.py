@@ -13,6 +13,7 @@ import difflib
 import math
 import re
 import sys
+import unicodedata
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, replace
 from typing import Any
@@ -28,13 +29,26 @@ REQUIRED = object()
 #: paragraph separators.
 ONE_LINE = "[^\\x00-\\x1f\\x7f-\\x9f\\u2028\\u2029]*"
 ONE_LINE_DOC = "of one line without control characters (newline, tab, escape)"
-#: A lookahead for a text holding at least one visible character: not blanks alone (a no-break
-#: space included, round 25) nor invisible format characters alone (a zero-width space or
-#: joiner, a direction mark, a soft hyphen, a variation selector, the Hangul fillers, a
-#: byte-order mark: a tag of one zero-width space listed as a gap and selected nothing, hostile
-#: round 29)
-VISIBLE = ("(?=.*[^\\s\u00ad\u034f\u061c\u115f\u1160\u17b4\u17b5\u180b-\u180f\u200b-\u200f"
-           "\u202a-\u202e\u2060-\u206f\u3164\ufe00-\ufe0f\ufeff\uffa0])")
+#: Unicode categories of characters that show nothing on their own: controls (Cc), format
+#: characters (Cf: zero-width space and joiners, direction marks, the byte-order mark, the
+#: interlinear annotation marks, the tag characters), spaces of every width (Zs), line and
+#: paragraph separators (Zl, Zp), and marks that combine with a character before them (Mn,
+#: Me: a variation selector, the combining grapheme joiner), which alone have none to show on
+UNSEEN_CATEGORIES = frozenset({"Cc", "Cf", "Zs", "Zl", "Zp", "Mn", "Me"})
+#: Letters (category Lo) drawn as nothing: the Hangul fillers
+HANGUL_FILLERS = frozenset("\u115f\u1160\u3164\uffa0")
+
+
+def visible(text: str) -> bool:
+    """Whether ``text`` holds a character that shows: one outside :data:`UNSEEN_CATEGORIES`
+    and not a Hangul filler.  A tag of one zero-width space was listed as a gap and selected
+    nothing (hostile round 29); its hand-made list let ``\\U000E0020`` (a tag space) or
+    ``\\uFFF9`` (an annotation anchor) alone pass (review 29a L4): the rule is now Unicode's
+    categories (``unicodedata``)."""
+    return any(unicodedata.category(c) not in UNSEEN_CATEGORIES and c not in HANGUL_FILLERS
+               for c in text)
+
+
 VISIBLE_DOC = "not blank or invisible characters alone"
 
 _TYPE_NAMES = {bool: "a boolean", int: "an integer", float: "a number", str: "a string",
@@ -69,6 +83,9 @@ class Field:
         Regular expression a string (or every string item of a list) must match whole.
     pattern_doc : str
         The pattern in words, for messages and the guide.
+    visible : bool
+        A string (or every string item of a list) must hold a character that shows
+        (:func:`visible`); say so in ``pattern_doc`` (:data:`VISIBLE_DOC`).
     also : Field, optional
         An alternative form that is accepted too (e.g. a named library or a list of term
         names); the value is accepted if it satisfies this field or ``also``.
@@ -94,6 +111,7 @@ class Field:
     pattern: str | None = None
     pattern_doc: str = ""
     also: Field | None = None
+    visible: bool = False
 
     @property
     def required(self) -> bool:
@@ -197,9 +215,11 @@ def _check_own(value: Any, f: Field, *, file: str, key: str) -> Any:
         if f.item_type is not None:
             item = Field(f.item_type, min=f.min, max=f.max, min_inclusive=f.min_inclusive,
                          max_inclusive=f.max_inclusive, unit=f.unit, pattern=f.pattern,
-                         pattern_doc=f.pattern_doc)
+                         pattern_doc=f.pattern_doc, visible=f.visible)
             value = [check_value(v, item, file=file, key=f"{key}[{i}]") for i, v in enumerate(value)]
     if f.type is str and f.pattern is not None and not re.fullmatch(f.pattern, value):
+        raise ScenarioError(file, key, value, f"expected {f.describe()}")
+    if f.type is str and f.visible and not visible(value):
         raise ScenarioError(file, key, value, f"expected {f.describe()}")
     if f.type is float:
         # + 0.0: -0.0 is 0.0 (IEEE -0.0 + 0.0 = +0.0, every other value unchanged); a scenario's

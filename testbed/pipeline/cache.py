@@ -40,8 +40,8 @@ from testbed.core import arguments
 from testbed.core.dataset import Dataset, DatasetError
 from testbed.core.errors import InputError
 from testbed.core.provenance import versions
-from testbed.core.rate_attrs import fs_attribute_problem, off_scenario_rate
-from testbed.pipeline.generate import derive, noise_free_scenario, simulate_clean
+from testbed.core.rate_attrs import fs_attribute_problem
+from testbed.pipeline.generate import derive, noise_free_scenario, record_problem, simulate_clean
 from testbed.pipeline.plugins import rig_class
 from testbed.pipeline.scenario import Scenario
 
@@ -179,16 +179,13 @@ def _load_entry(path: Path, scenario: Scenario) -> Dataset:
     if problem:
         raise DatasetError(path, problem)
     ds = Dataset.load(path)
-    record = rig_class(scenario.rig).record(noise_free_scenario(scenario).simulation)
-    if record is not None and off_scenario_rate(ds.fs, float(record[0])):
-        raise DatasetError(path, f"attribute fs={ds.fs!r} Hz; its scenario records at "
-                                 f"{float(record[0])!r} Hz")
-    if record is not None and ds.n_samples != int(record[1]):
-        # an entry cut and its content hash made anew was served as its scenario's record
-        # (hostile round 29): the windows, the chain and the scores' time axis then belong to
-        # a shorter record
-        raise DatasetError(path, f"holds {ds.n_samples} samples; its scenario records "
-                                 f"{int(record[1])}")
+    problem = record_problem(ds, scenario)
+    if problem:
+        # simulate_clean refuses a rig whose dataset is not its record (review 29a M1), so an
+        # entry of another rate or length was edited after it was written: one cut and its
+        # content hash made anew was served as its scenario's record (hostile round 29), its
+        # windows, chain and time axis then belonging to a shorter record
+        raise DatasetError(path, problem)
     return ds
 
 

@@ -22,8 +22,9 @@ import numpy as np
 from testbed.core.dataset import Dataset, Signal
 from testbed.core.errors import RigError, TestbedError, exception_text
 from testbed.core.provenance import git_commit, versions
+from testbed.core.rate_attrs import off_scenario_rate
 from testbed.core.truth import TruthError
-from testbed.pipeline.plugins import RIGS
+from testbed.pipeline.plugins import RIGS, rig_class
 from testbed.pipeline.scenario import Scenario
 
 
@@ -83,6 +84,39 @@ def _simulate_rig(scenario: Scenario, progress: Callable[[float], None] | None) 
                        f"{exception_text(e)}") from None
 
 
+def record_problem(ds: Dataset, scenario: Scenario) -> str | None:
+    """How ``ds``'s rate or length differs from the record ``scenario`` asks for, or None.
+
+    The record is :meth:`Rig.record` of the rig's noise-free ``[simulation]`` table (rate [Hz]
+    and number of samples; the default ``round(duration * sample_rate)`` samples); a rig that
+    declares none is not checked.  The rate is compared within
+    :data:`~testbed.core.rate_attrs.SCENARIO_RATE_RTOL` (a rate written as a float), the
+    number of samples exactly (a count).  One rule for both places a dataset is read:
+    :func:`simulate_clean` (the rig's contract) and the dataset cache (an edited entry).
+
+    Parameters
+    ----------
+    ds : Dataset
+        A clean dataset of ``scenario``'s rig.
+    scenario : Scenario
+        The scenario it records.
+
+    Returns
+    -------
+    str or None
+        E.g. ``"holds 1001 samples; its scenario records 1000"``.
+    """
+    record = rig_class(scenario.rig).record(noise_free_scenario(scenario).simulation)
+    if record is None:
+        return None
+    fs, n = float(record[0]), int(record[1])
+    if off_scenario_rate(float(ds.fs), fs):
+        return f"has fs={ds.fs!r} Hz; its scenario records at {fs!r} Hz"
+    if ds.measured and ds.n_samples != n:
+        return f"holds {ds.n_samples} samples; its scenario records {n}"
+    return None
+
+
 def simulate_clean(scenario: Scenario, progress: Callable[[float], None] | None = None) -> Dataset:
     """The rig's noise-free dataset of ``scenario``: the clean dataset :func:`derive` starts from.
 
@@ -94,11 +128,19 @@ def simulate_clean(scenario: Scenario, progress: Callable[[float], None] | None 
     Raises
     ------
     RigError
-        If the rig's truth has a missing, unknown or misshapen key (named).
+        If the rig's truth has a missing, unknown or misshapen key (named), or its dataset's
+        rate or number of samples is not the record :meth:`Rig.record` declares
+        (:func:`record_problem`; review 29a M1: a plugin rig of ``round(duration * fs) + 1``
+        samples was accepted here, then its cache entry refused on every read).
     """
 
     clean_sc = noise_free_scenario(scenario)
     ds = _simulate_rig(clean_sc, progress)
+    problem = record_problem(ds, clean_sc)
+    if problem:  # the Rig.simulate contract: the record Rig.record declares, sample for sample
+        raise RigError(f"rig {clean_sc.rig!r} (from {RIGS.origin(clean_sc.rig)}) simulated a "
+                       f"dataset that {problem} "
+                       "(Rig.simulate must record Rig.record's rate and number of samples)")
     ds.attrs["kind"] = clean_sc.kind
     # one order whichever path made the dataset: HDF5 hands groups back sorted by name, a rig
     # writes them in its own (a run's npz and report tables listed truth and prior keys in one

@@ -245,7 +245,10 @@ def refuse_foreign_outputs(out_dir: str | os.PathLike, pngs: Iterable[Path] = ()
     folder's option in its message), :meth:`Page.write` again with its figures before it
     writes (review 28b L1: two lists before)."""
     out_dir = Path(out_dir)
-    pngs = [Path(p) for p in pngs if not _earlier_figure(Path(p))]
+    # an earlier report's unmarked figure is looked for (its bytes read and encoded, the page
+    # read) only where the marker check would refuse: not for every marked figure (review 29a L6)
+    pngs = [Path(p) for p in pngs
+            if not (foreign_head(Path(p), PNG_FILE) and _earlier_figure(Path(p)))]
     for path, kind in [*((p, PNG_FILE) for p in pngs),
                        *((out_dir / name, kind) for name, kind in REPORT_FILES)]:
         refuse_foreign(path, kind, f"{option} {terminal_safe(str(path))}" if option else None,

@@ -247,11 +247,22 @@ def test_a_cache_entry_cut_with_its_hash_anew_is_simulated_again(tmp_path, caplo
     assert again.n_samples == n and f"samples; its scenario records {n}" in caplog.text
 
 
-@pytest.mark.parametrize("tag", ["\u200b", "\ufeff", "\u200d\u2060"])
+@pytest.mark.parametrize("tag", ["\u200b", "\ufeff", "\u200d\u2060",
+                                 # review 29a L4: outside the hand-made list, so they passed
+                                 "\U000E0020", "\uFFF9", "\u3000\U000E0001", "\u0301\ufe0f",
+                                 "\u3164", "\u2000\u205f"])
 def test_a_tag_of_invisible_characters_alone_is_refused(tag):
     with pytest.raises(testbed.TestbedError, match=r"scenario\.tags"):
         testbed.scenario_from_dict({"scenario": {"name": "x", "rig": "michaelis_menten",
                                                  "tags": ["a", tag]}})
+
+
+@pytest.mark.parametrize("tag", ["a\u200b", "\u00e9t\u00e9", "e\u0301", "\u0915\u093f",
+                                 "\U0001F600", "\u4e2d"])
+def test_a_tag_with_a_visible_character_is_kept(tag):
+    sc = testbed.scenario_from_dict({"scenario": {"name": "x", "rig": "michaelis_menten",
+                                                  "tags": [tag]}})
+    assert sc.tags == (tag,) or list(sc.tags) == [tag]
 
 
 def _traj(*fields):
@@ -266,8 +277,15 @@ Z = np.zeros((1, 5))
 @pytest.mark.parametrize("ret, said", [
     (_traj(Z[:, :2], Z[:, :2], Z[:, :2]), r"x has shape \(1, 2\); expected \(n_channels, 5\)"),
     (_traj(None, Z, Z), r"x is None, not numbers"),
-    (_traj(Z + 1j, Z, Z), r"x is complex \(a nonzero imaginary part\)"),
+    (_traj(Z, None, Z), r"xd is None, not numbers"),      # review 29a H1
+    (_traj(Z, Z, None), r"xdd is None, not numbers"),
+    (_traj(Z + 1j, Z, Z), r"x is complex \(an imaginary part not exactly zero\)"),
+    (_traj(Z + complex(0, np.nan), Z, Z), r"x is complex"),  # review 29a M3: NaN passed as 0
+    (_traj(Z + complex(0, np.inf), Z, Z), r"x is complex"),
     (_traj(Z, Z.astype(str), Z), r"xd is .*, not numbers"),
+    (_traj(Z, Z.astype(bool), Z), r"xd is .*dtype bool.*, not numbers"),  # review 29a L7
+    (_traj(Z, Z.astype("timedelta64[s]"), Z), r"xd is .*, not numbers"),
+    (_traj(Z, np.full((1, 5), "a", dtype=object), Z), r"xd is .*, not numbers"),
     (_traj(Z, np.zeros((2, 5)), Z), r"xd has shape \(2, 5\); expected \(1, 5\), x's"),
 ])
 def test_a_plugins_trajectory_of_odd_fields_is_its_failure(ret, said):
@@ -284,10 +302,27 @@ def test_a_plugins_trajectory_is_read_as_real_float_arrays():
     x = np.sin(np.arange(50) / 5.0)[None, :]
     model = _Returns().fit(Measurement(100.0, x, x, x, ("x1",)))
     masked = np.ma.masked_array(np.ones((1, 5)), [[0, 0, 1, 0, 0]])
-    model.ret = _traj(masked, np.ones((1, 5), np.float32) + 0j, None)
+    objects = np.array([[1, 2.5, None, 0, 1]], dtype=object)  # None in a list: unknown
+    model.ret = _traj(masked, np.ones((1, 5), np.float32) + 0j, objects)
     got = model.simulate(np.zeros(1), np.zeros(1), np.arange(5) / 100.0)
-    assert got.x.dtype == got.xd.dtype == np.float64 and got.xdd is None
+    assert got.x.dtype == got.xd.dtype == got.xdd.dtype == np.float64
     assert np.isnan(got.x[0, 2]) and np.isfinite(np.delete(got.x, 2)).all()  # masked: unknown
+    assert np.isnan(got.xdd[0, 2]) and got.xdd[0, 1] == 2.5
+
+
+@pytest.mark.parametrize("fields", [(None, None), (Z, None), (None, Z)])
+def test_a_plugins_trajectory_without_rates_is_scored_end_to_end(fields):
+    # review 29a H1: xd or xdd None was accepted, then simulate_scored's divergence check
+    # failed on the 0-d array (IndexError: an internal error, status 3); now a scored failure
+    from testbed.scoring.scorers import simulate_scored
+
+    x = np.sin(np.arange(50) / 5.0)[None, :]
+    model = _Returns().fit(Measurement(100.0, x, x, x, ("x1",)))
+    model.ret = _traj(Z, *fields)
+    t = np.arange(5) / 100.0
+    traj, why, _ = simulate_scored(lambda: model.simulate(np.zeros(1), np.zeros(1), t), t,
+                                   "x", Z)
+    assert traj is None and why.startswith("simulation failed: ") and "None, not numbers" in why
 
 
 @pytest.mark.parametrize("raised, kind", [
@@ -313,6 +348,26 @@ def test_a_plugins_integrator_blow_up_is_a_divergence(raised, kind):
     assert type(e.value).__name__ == kind
     _, why, _ = simulate_scored(lambda: model.simulate(np.zeros(1), np.zeros(1), t), t, "x", x[:, :5])
     assert why.startswith("diverged: " if kind == "DivergenceError" else "simulation failed: ")
+
+
+def test_a_plugins_decorated_simulate_blow_up_is_still_a_divergence():
+    # review 29a L2: routing read method.__name__, so a simulate wrapped by a decorator
+    # without functools.wraps ("inner") was "simulation failed", not "diverged"
+    def logged(f):
+        def inner(*a, **kw):
+            return f(*a, **kw)
+        return inner
+
+    class Decorated(_Returns):
+        @logged
+        def simulate(self, x0, xd0, t, u=None):
+            raise OverflowError("(34, 'Numerical result out of range')")
+
+    x = np.sin(np.arange(50) / 5.0)[None, :]
+    model = Decorated().fit(Measurement(100.0, x, x, x, ("x1",)))
+    with pytest.raises(IdentificationError) as e:
+        model.simulate(np.zeros(1), np.zeros(1), np.arange(5) / 100.0)
+    assert type(e.value).__name__ == "DivergenceError"
 
 
 def test_a_plugin_path_that_names_nothing_is_read_as_every_path(tmp_path):
@@ -381,6 +436,23 @@ def test_a_handled_interrupt_cancels_its_pending_redelivery(monkeypatch, capsys)
     assert cli._interrupted(KeyboardInterrupt()) == 130
     time.sleep(0.4)
     assert sent == [] and capsys.readouterr().err == "error: interrupted\n"
+
+
+def test_a_sent_redelivery_is_no_longer_pending(monkeypatch):
+    # review 29a L7: a redelivery timer that had fired stayed in _REDELIVERIES
+    import signal
+    import types
+
+    from testbed import cli
+
+    sent = []
+    monkeypatch.setattr(cli, "REDELIVER_S", 0.05)  # read below before it fires
+    monkeypatch.setattr(cli.os, "kill", lambda pid, signum: sent.append(signum))
+    monkeypatch.setattr(cli, "_REDELIVERIES", [])
+    cli._redeliver_interrupt(lambda u: None, types.SimpleNamespace(exc_value=KeyboardInterrupt()))
+    (timer,) = cli._REDELIVERIES
+    timer.join(5.0)
+    assert sent == [signal.SIGINT] and cli._REDELIVERIES == []
 
 
 def test_a_report_written_before_the_png_marker_is_replaced_as_before(tmp_path):

@@ -393,10 +393,12 @@ def test_another_scenario_folder_runs_alone(sleeper):
     assert sum("refused a command from another key" in ln for ln in _served_lines(tmp)) == 2
 
 
-def _start_with(monkeypatch, peer_open: bool):
+def _start_with(monkeypatch, peer_open: bool, log_fails: bool = False):
     """``server._start`` of a request whose forked child is a stand-in (a ``sleep`` in its own
     group), its client one end of a socket pair (closed when not ``peer_open``); returns the
-    log lines, each with whether the client's end held the pid reply when it was written, the
+    log lines, each with whether the client's end held the pid reply when it was written (with
+    ``log_fails``, a log that raises OSError: whether the connection was registered at each
+    call, in place of the lines), the
     stand-in's pid, and its status if ``_start`` stopped it (else None)."""
     import selectors
 
@@ -408,8 +410,12 @@ def _start_with(monkeypatch, peer_open: bool):
     if not peer_open:
         client.close()
     lines: list[tuple[str, bool]] = []
+    registered: list[bool] = []
 
     def log(text):
+        registered.append(conn.fileno() in {k.fd for k in st.sel.get_map().values()})
+        if log_fails:
+            raise OSError(28, "No space left on device")
         held = False
         if peer_open:
             try:
@@ -425,7 +431,7 @@ def _start_with(monkeypatch, peer_open: bool):
         ended = None  # the stand-in's status if _start stopped it (within 5 s), else None
         with contextlib.suppress(subprocess.TimeoutExpired):
             ended = stand_in.wait(timeout=0.05 if peer_open else 5)
-        return lines, stand_in.pid, ended
+        return (registered if log_fails else lines), stand_in.pid, ended
     finally:
         st.sel.close()
         conn.close()
@@ -450,3 +456,10 @@ def test_a_commands_pid_line_is_logged_when_its_client_left_before_the_reply(mon
     assert [t for t, _ in lines] == [f"testbed server: sleep 60: its client left before its pid "
                                      f"was sent, so the command was stopped (pid {pid})"]
     assert ended == -signal.SIGKILL
+
+
+def test_a_commands_connection_is_registered_before_its_pid_line_is_logged(monkeypatch):
+    # review 29a L1: logged first, a log that raised OSError (a full disk) left the command
+    # unregistered, never stopped when its client died; the OSError no longer escapes _start
+    registered, pid, ended = _start_with(monkeypatch, peer_open=True, log_fails=True)
+    assert registered == [True] and ended is None

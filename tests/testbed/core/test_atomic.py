@@ -104,16 +104,16 @@ def test_a_replaced_file_keeps_its_owner_and_group(tmp_path):
 def test_a_fifo_at_an_output_path_is_refused_at_once_not_read(tmp_path):
     """Review 27e: foreign_head opened a FIFO nobody writes to and hung for good (``report -o``,
     ``family write``); it is now no regular file, left to not_regular to name in one line."""
-    from testbed.core.atomic import MARKDOWN_FILE, foreign_head, not_regular
+    from testbed.core.atomic import REPORT_MARKDOWN_FILE, foreign_head, not_regular
     from testbed.core.errors import InputError
 
     fifo = tmp_path / "report.md"
     os.mkfifo(fifo)
-    assert foreign_head(fifo, MARKDOWN_FILE) is None  # returns at once (O_NONBLOCK)
+    assert foreign_head(fifo, REPORT_MARKDOWN_FILE) is None  # returns at once (O_NONBLOCK)
     with pytest.raises(InputError, match="not a regular file"):
         not_regular(fifo)
     (tmp_path / "mine.md").write_bytes(b"\x89PNG\r\n\x1a\n")
-    assert foreign_head(tmp_path / "mine.md", MARKDOWN_FILE) == b"\x89PNG\r\n\x1a\n"
+    assert foreign_head(tmp_path / "mine.md", REPORT_MARKDOWN_FILE) == b"\x89PNG\r\n\x1a\n"
 
 
 def test_a_users_own_page_or_notes_of_the_same_format_are_foreign(tmp_path):
@@ -132,3 +132,37 @@ def test_a_users_own_page_or_notes_of_the_same_format_are_foreign(tmp_path):
     notes.write_text("# Identified model: ls_sindy\n")
     assert foreign_head(page, HTML_FILE) is None
     assert foreign_head(notes, IDENTIFIED_MARKDOWN_FILE) is None
+
+
+@pytest.mark.parametrize("kind", ["IDENTIFIED_JSON_FILE", "SEP005_FILE"])
+def test_a_deeply_nested_json_at_an_output_path_is_foreign_not_an_internal_error(tmp_path, kind):
+    # review 29a M2: json's RecursionError escaped _json_document ("internal error")
+    from testbed.core import atomic
+    from testbed.core.errors import InputError
+
+    p = tmp_path / "out.json"
+    nested = "[" * 100000 + "]" * 100000  # a table's head for a model summary, a list's else
+    p.write_text('{"a": ' + nested + "}" if kind == "IDENTIFIED_JSON_FILE" else nested)
+    with pytest.raises(InputError, match="out.json"):
+        atomic.refuse_foreign(p, getattr(atomic, kind))
+
+
+#: A UFF58 record's head as reporting.export writes it (ID line 5 the testbed's marker)
+_UFF58 = (b"    -1\n    58b     1     2\nx/x\ngeneral [mM]\nscenario s seed 0\ncontent hash 00\n"
+          b"fs 100.0 Hz, sysid-testbed\n")
+
+
+@pytest.mark.parametrize("geometry_bytes", [0, 3 << 20, (1 << 20) - 7])
+def test_our_uff_export_of_many_nodes_is_ours(tmp_path, geometry_bytes):
+    # review 29a L5: the marker was looked for in the first MiB only, so an export of more than
+    # ~6,500 nodes (geometry first, ~160 bytes a node) was refused as foreign by its own writer
+    from testbed.core.atomic import UFF_FILE, foreign_head
+
+    node = b"         1         0         0        11\n   0.0000000000000e+00   0.0e+00   0.0e+00\n"
+    head = b"    -1\n   164\n         1  SI\n    -1\n    -1\n  2411\n"
+    geometry = (node * (geometry_bytes // len(node) + 1))[:geometry_bytes]
+    p = tmp_path / "out.uff"
+    p.write_bytes(head + geometry + b"\n    -1\n" + _UFF58)
+    assert foreign_head(p, UFF_FILE) is None
+    p.write_bytes(head + geometry + b"\n    -1\n" + _UFF58.replace(b"sysid-testbed", b"my-logger"))
+    assert foreign_head(p, UFF_FILE)  # a UFF whose first 58 record is someone else's

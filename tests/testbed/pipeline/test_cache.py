@@ -84,3 +84,27 @@ def test_a_cache_entry_whose_rate_was_edited_is_simulated_again(tmp_path, caplog
     assert any("fs" in r.getMessage() and "simulating it again" in r.getMessage()
                for r in caplog.records), caplog.text
     assert Dataset.load(path).fs == 100.0 and "kHz" not in str(h5py.File(path).attrs.get("fs_unit"))
+
+
+@pytest.mark.parametrize("fs, n, said", [
+    (100.0, 401, "simulated a dataset that holds 401 samples; its scenario records 400"),
+    (100.0, 399, "holds 399 samples; its scenario records 400"),
+    (50.0, 400, "has fs=50.0 Hz; its scenario records at 100.0 Hz"),
+])
+def test_a_rig_whose_dataset_is_not_its_record_is_refused_where_it_is_made(monkeypatch, fs, n,
+                                                                          said):
+    # review 29a M1: a (plugin) rig recording round(duration * fs) + 1 samples was accepted
+    # when simulated, then its cache entry refused on every read (simulated again every run);
+    # now simulate_clean refuses it once, naming the rig and both counts.  No simulation runs:
+    # the rig's output is a hand-made dataset of michaelis_menten's rig (4 s at 100 Hz)
+    from testbed.core.dataset import Signal
+    from testbed.core.errors import RigError
+    from testbed.pipeline import generate as gen
+
+    made = Dataset(fs, {"conc": Signal(np.zeros((1, n)), ("s",), "mol/L")})
+    monkeypatch.setattr(gen, "_simulate_rig", lambda sc, progress: made)
+    with pytest.raises(RigError, match=rf"rig 'michaelis_menten' \(from builtin\) .*{said}"):
+        gen.simulate_clean(load_scenario("michaelis_menten"))
+    assert gen.record_problem(Dataset(100.0, {"conc": Signal(np.zeros((1, 400)), ("s",),
+                                                             "mol/L")}),
+                              load_scenario("michaelis_menten")) is None

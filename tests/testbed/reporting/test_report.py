@@ -235,3 +235,31 @@ def test_the_sweep_reports_summary_shows_a_scored_failures_scores(tmp_path):
     html = sweep_report(rows, tmp_path / "r", "s").read_text()
     summary = _table(html, "Scenario mm20_x0_20")
     assert re.search(r">0\.885</td>", summary) and "1e+09" not in summary
+
+
+def _png(text: bytes) -> bytes:
+    """A PNG's signature and one tEXt chunk (enough for the marker check: it stops at IDAT)."""
+    import zlib
+
+    chunk = b"tEXt" + text
+    return (b"\x89PNG\r\n\x1a\n" + len(text).to_bytes(4, "big") + chunk
+            + zlib.crc32(chunk).to_bytes(4, "big") + b"\0\0\0\0IEND\xaeB`\x82")
+
+
+def test_a_marked_figure_is_not_searched_for_in_the_earlier_page(tmp_path, monkeypatch):
+    # review 29a L6: every figure was read, base64-encoded and searched for in report.html,
+    # marked ones too; only a figure the marker check would refuse is now
+    from testbed.core.atomic import PNG_SOFTWARE
+    from testbed.core.errors import InputError
+    from testbed.reporting import report
+
+    searched = []
+    monkeypatch.setattr(report, "_earlier_figure", lambda p: searched.append(p.name) or False)
+    ours, theirs = tmp_path / "fit.png", tmp_path / "photo.png"
+    ours.write_bytes(_png(b"Software\0" + PNG_SOFTWARE.encode()))
+    theirs.write_bytes(_png(b"Software\0my camera"))
+    report.refuse_foreign_outputs(tmp_path, [ours])
+    assert searched == []
+    with pytest.raises(InputError, match="photo.png"):
+        report.refuse_foreign_outputs(tmp_path, [ours, theirs])
+    assert searched == ["photo.png"]
