@@ -245,7 +245,6 @@ IDENTIFIED_JSON_FILE = FileKind("a model summary written by `testbed identify`",
                                 text=True, ours=_identified_ours)
 SEP005_FILE = FileKind("a SEP-005 export of the testbed", (b"[",), text=True, ours=_sep005_ours)
 UFF_FILE = FileKind("a UFF export of the testbed", (b"-1",), text=True, ours=_uff_ours)
-MARKDOWN_FILE = FileKind("a markdown report", (b"#",), text=True)
 #: the first line of a run's or a study's markdown report (``testbed.reporting.report``): an
 #: HTML comment no renderer shows.  Its title alone (``# Run `` / ``# Study ``, read 27b) let a
 #: user's own ``# Study notes`` be replaced (review 27e M2); a report written before this line

@@ -8,7 +8,7 @@ import argparse
 import pytest
 
 from testbed import cli
-from testbed.core.atomic import MARKDOWN_FILE
+from testbed.core.atomic import IDENTIFIED_MARKDOWN_FILE
 
 
 def _parse(*argv: str) -> argparse.Namespace:
@@ -54,7 +54,7 @@ PNG = b"\x89PNG\r\n\x1a\n" + bytes(range(64))
 
 
 @pytest.mark.parametrize("kind", [cli.HDF5_FILE, cli.IDENTIFIED_JSON_FILE, cli.SEP005_FILE,
-                                  cli.UFF_FILE, MARKDOWN_FILE])
+                                  cli.UFF_FILE, IDENTIFIED_MARKDOWN_FILE])
 def test_an_output_of_another_kind_is_refused_and_left_as_it_is(tmp_path, kind):
     # `generate -o photo.png` replaced the picture by a dataset, status 0 (as identify / export)
     photo = tmp_path / "photo.png"
@@ -81,7 +81,8 @@ def _earlier_h5(path):
     (cli.IDENTIFIED_JSON_FILE, b'\xef\xbb\xbf \n{"source": "d.h5", "kind": "dynamical", '
                                b'"method": "m", "fs_hz": 1, "n_samples": 2, "identifier": {}}'),
     (cli.SEP005_FILE, b'[{"name": "x/x", "data": [1], "fs": 1, "content_hash": "0", "group": "measured"}]'),
-    (cli.UFF_FILE, UFF_HEAD), (MARKDOWN_FILE, b"# model\n"), (cli.IDENTIFIED_JSON_FILE, b"")])
+    (cli.UFF_FILE, UFF_HEAD), (IDENTIFIED_MARKDOWN_FILE, b"# Identified model: m\n"),
+    (cli.IDENTIFIED_JSON_FILE, b"")])
 def test_an_output_of_its_own_kind_or_empty_is_replaced_as_before(tmp_path, kind, head):
     earlier = tmp_path / "earlier.out"
     if callable(head):
