@@ -372,12 +372,21 @@ def fit_band_cutoff(data: Measurement, cutoff_hz: float | None = None,
 #: least-squares fit.  With the cubic force on the right-hand side the reading does not depend
 #: on it (measured, branch ``mass28``: 1, 2 and 5 periods agree within 2 % on the shipped soft
 #: base at 50 and 150 N; without the cubic force the hardening mode's amplitude fell with the
-#: window, 0.81 -> 0.35 -> -0.16 of ``1 / mu`` at 150 N).
+#: window, 0.81 -> 0.35 -> -0.16 of ``1 / mu`` at 150 N).  The trade-off (review 28e): a
+#: shorter window separates the slowest mode from the others less well (under one period its
+#: amplitude and phase trade against theirs) and leaves fewer samples per column; a longer one
+#: lets the model's frequency and decay-rate errors drift the simulated modes out of phase
+#: with the record and weights the lightly damped modes' late samples, where the model's
+#: cubic errors accumulate.  A mode's reading depends on where the window *starts* (its
+#: amplitude is carried from the pulse to ``free_start`` by ``exp(sigma t)``), not on its
+#: length (branch ``mass29``: 0.25-5 periods within 6 % of the cubic force error, 1 / mu within
+#: 3 %); five periods sit on that plateau, with margin from both ends.
 FREE_GAIN_PERIODS = 5.0
 
 
 def free_decay_fit(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndarray,
-                   K3: np.ndarray | None, j: int) -> tuple[np.ndarray, np.ndarray] | None:
+                   K3: np.ndarray | None, j: int, lam: np.ndarray | None = None
+                   ) -> tuple[np.ndarray, np.ndarray] | None:
     """The input gain ``g = M^-1 B[:, j]`` that best explains the free decay after the pulse,
     with its covariance.
 
@@ -405,6 +414,9 @@ def free_decay_fit(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndarra
         The fitted cubic stiffness [N/m^3] (None: a linear model).
     j : int
         The input (row of ``data.u``) at the driving point.
+    lam : ndarray, shape (n,), optional
+        The eigenvalues of ``(K, M)`` [rad^2/s^2] where the caller has them
+        (:func:`driving_point_scaling`: not computed twice); None: computed here.
 
     Returns
     -------
@@ -416,7 +428,7 @@ def free_decay_fit(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndarra
         oscillating mode or the fit is not finite.
     """
     n = M.shape[0]
-    w2 = np.linalg.eigvals(np.linalg.solve(M, K)).real
+    w2 = np.linalg.eigvals(np.linalg.solve(M, K)).real if lam is None else np.asarray(lam, float)
     if not np.all(np.isfinite(w2)) or not np.any(w2 > 0) or data.u is None:
         return None
     period = 2 * np.pi / np.sqrt(w2[w2 > 0].min())
@@ -509,8 +521,13 @@ def driving_point_scaling(M: np.ndarray, C: np.ndarray, K: np.ndarray, K3: np.nd
     mass is shared among the modes, the prior its total), and the model becomes
     ``M' = Phi^-T diag(mu) Phi^-1``, ``K' = Phi^-T diag(mu omega^2) Phi^-1``,
     ``C' = Phi^-T (mu^1/2 D mu^1/2) Phi^-1`` (``D = Phi^T C Phi``; exact for modal damping, the
-    symmetric part otherwise), ``B' = M' g``: the same ``M^-1 K``
-    (frequencies and mode shapes), the same modal damping, the mass shared as the force says.
+    symmetric part otherwise), ``B' = M' M^-1 B``: the same ``M^-1 K``
+    (frequencies and mode shapes), the same modal damping, the same ``M^-1 B`` (so the model
+    simulates as before), the mass shared as the force says.  For a linear model ``M^-1 B``
+    is the gain read, ``B' = M' g``; a cubic model's ``B'`` keeps its fitted gain, not the
+    free decay's ``g`` (review 28e L3: the fitted map also carries the unmodelled modes'
+    quasi-static response under the pulse, which the scored simulation needs, and the
+    reading ``g`` only shares the mass).
 
     A cubic model reads ``g`` from the free decay after the pulse (:func:`free_decay_fit`),
     not from ``B``: an impact's samples hold the quasi-static response of the modes the model
@@ -522,7 +539,9 @@ def driving_point_scaling(M: np.ndarray, C: np.ndarray, K: np.ndarray, K3: np.nd
     docs/known-gaps.md).  Each mode's reading is weighted by its standard error from that fit
     (:func:`held_share`): a mode the free decay barely holds keeps the fitted model's own modal
     mass in proportion, rather than spreading its error over the others through the trace
-    normalisation.  A linear model keeps ``B``'s gain.
+    normalisation.  A linear model keeps ``B``'s gain, and so does a model whose ``K3`` is all
+    zero (a cubic library whose every term was dropped: no cubic force to carry the pulse's
+    quasi-static response, review 28e L6).
 
     Parameters
     ----------
@@ -550,7 +569,8 @@ def driving_point_scaling(M: np.ndarray, C: np.ndarray, K: np.ndarray, K3: np.nd
         What was done, for ``mass_scaling_rule_``.
     """
     same = (M, C, K, K3, B)
-    if K3 is not None and data is None:
+    cubic = K3 is not None and bool(np.any(np.asarray(K3) != 0.0))
+    if cubic and data is None:
         return same, "cubic model without its record: the mass prior's scale kept"
     if B is None or declared is None:
         return same, "no measured input: the mass prior's scale kept"
@@ -563,8 +583,8 @@ def driving_point_scaling(M: np.ndarray, C: np.ndarray, K: np.ndarray, K3: np.nd
     lam, phi = linalg.eigh(K, M)  # phi^T M phi = I
     g = np.linalg.solve(M, B[:, j])
     cov = None
-    if K3 is not None:
-        fit = free_decay_fit(data, M, C, K, K3, j)
+    if cubic:
+        fit = free_decay_fit(data, M, C, K, K3, j, lam)
         if fit is None:
             return same, "cubic model: no free decay to read the gain from, the prior's scale kept"
         g, cov = fit
@@ -590,8 +610,8 @@ def driving_point_scaling(M: np.ndarray, C: np.ndarray, K: np.ndarray, K3: np.nd
     K2 = pinv.T @ np.diag(mu * lam) @ pinv
     C2 = pinv.T @ (r[:, None] * _sym(Dm) * r[None, :]) @ pinv
     B2 = M2 @ np.linalg.solve(M, B)
-    if K3 is None:
-        return ((_sym(M2), _sym(C2), _sym(K2), None, B2),
+    if not cubic:
+        return ((_sym(M2), _sym(C2), _sym(K2), None if K3 is None else np.zeros_like(K3), B2),
                 f"modal masses from the input gain at the driving point (sensor {k + 1})")
     return ((_sym(M2), _sym(C2), _sym(K2), M2 @ np.linalg.solve(M, K3), B2),
             f"modal masses from the free decay's gain at the driving point (sensor {k + 1})")

@@ -169,3 +169,26 @@ def test_free_decay_spread_follows_the_noise():
     # tenfold noise, tenfold error (the same seed's draw scaled: exact up to the rounding)
     np.testing.assert_allclose(spreads[2], 10.0 * spreads[1], rtol=0.01)
     assert np.all(spreads[2] > 1e-5) and np.all(spreads[2] < 0.05)   # read, not lost
+
+
+def test_a_model_whose_cubic_is_all_zero_is_shared_as_a_linear_one():
+    """Review 28e L6: a cubic library whose every term was dropped (``K3`` all zero) has no
+    cubic force; it is shared by ``B``'s gain as a linear model is (before, by the free decay),
+    and gives back a zero ``K3``.  The free decay's fit with the caller's eigenvalues (L5: not
+    computed twice) is the fit without them."""
+    data = _record()
+    Mf, Cf, Kf = _wrong_sharing()
+    B = Mf @ np.linalg.solve(M3, DECLARED)  # the gain a linear fit would give (M^-1 B kept)
+    lin, rule_lin = driving_point_scaling(Mf, Cf, Kf, None, B, DECLARED, data)
+    zero, rule_zero = driving_point_scaling(Mf, Cf, Kf, np.zeros((3, 3)), B, DECLARED, data)
+    assert rule_zero == rule_lin and "input gain" in rule_zero
+    for a, b in zip(lin[:3] + lin[4:], zero[:3] + zero[4:], strict=True):
+        np.testing.assert_array_equal(a, b)
+    assert zero[3] is not None and not np.any(zero[3])
+    lam = linalg.eigh(Kf, Mf, eigvals_only=True)
+    g0, cov0 = free_decay_fit(data, Mf, Cf, Kf, None, 0)
+    g1, cov1 = free_decay_fit(data, Mf, Cf, Kf, None, 0, lam)
+    # the window's length rounds the same period (eigvals against eigh: 1e-12 relative), so
+    # the same columns; rounding of the least squares only
+    np.testing.assert_allclose(g1, g0, rtol=1e-9, atol=1e-12 * np.abs(g0).max())
+    np.testing.assert_allclose(cov1, cov0, rtol=1e-6, atol=1e-9 * np.abs(cov0).max())
