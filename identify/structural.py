@@ -422,7 +422,9 @@ def free_decay_fit(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndarra
     -------
     (g, cov) or None
         The gain [1/kg], shape (n,), and its least-squares covariance ``s^2 (A^T A)^-1``
-        [1/kg^2], shape (n, n) (``s^2`` the residual variance over the free samples); None
+        [1/kg^2], shape (n, n) (``s^2`` the residual variance over the free samples), times
+        the residual's :func:`correlation_factor` (a correlated residual holds fewer
+        independent samples than it has); None
         when ``data.free_start`` is 0 (a continuous input, or a window
         cut after the pulse: no free decay), the window is too short, the model has no
         oscillating mode or the fit is not finite.
@@ -454,12 +456,51 @@ def free_decay_fit(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndarra
     g = G.reshape(U.shape[0], n)[j]
     if not np.all(np.isfinite(g)):
         return None
-    # the least squares' covariance, s^2 (A^T A)^-1 (residual variance over the free samples)
+    # the least squares' covariance, s^2 (A^T A)^-1 (residual variance over the free samples),
+    # times the residual's correlation factor (review 28e M2: a clean record's residual is
+    # model error, correlated from sample to sample, not white)
     dof = max(b.size - A.shape[1], 1)
-    s2 = float(np.sum((b - A @ G) ** 2)) / dof
-    cov = s2 * np.linalg.pinv(A.T @ A)
+    r = b - A @ G
+    s2 = float(np.sum(r**2)) / dof
+    cov = s2 * np.linalg.pinv(A.T @ A) * correlation_factor(r.reshape(n, -1))
     rows = slice(j * n, (j + 1) * n)
     return g, cov[rows, rows]
+
+
+def correlation_factor(r: np.ndarray) -> float:
+    """How many times a least squares' white-noise variance understates its coefficients'
+    variance when its residual ``r`` is correlated from sample to sample.
+
+    Rule (the AR(1) effective sample size, Bartlett): ``rho`` the lag-1 autocorrelation of
+    the residual pooled over its channels (``sum r_t r_{t+1} / sum r_t^2``), the factor
+    ``(1 + rho) / (1 - rho)``, held between 1 (a residual no more correlated than white noise
+    is not read as less uncertain) and the number of samples per channel (no fewer than one
+    independent sample).  Continuous in ``rho``.  Why (review 28e M2): on a clean record the
+    free decay's residual is the model's error, smooth at the sample rate (``rho`` 0.83-0.98 on
+    the shipped soft scenarios and round 24's soft cells), so the white spread, 0.3-0.7 % of a
+    mode's reading on the shipped soft base, underrated how loosely a heavily damped mode is
+    held (:func:`held_share`).
+
+    Parameters
+    ----------
+    r : ndarray, shape (n_channels, n_t)
+        The residual, each row one channel's samples in time order.
+
+    Returns
+    -------
+    float
+        The factor [-], in ``[1, n_t]``; 1 for a residual of fewer than 2 samples or zero.
+    """
+    r = np.asarray(r, dtype=float)
+    if r.ndim != 2 or r.shape[1] < 2:
+        return 1.0
+    e = float(np.sum(r**2))
+    if not e > 0.0:
+        return 1.0
+    rho = float(np.sum(r[:, 1:] * r[:, :-1])) / e
+    if not rho < 1.0:
+        return float(r.shape[1])
+    return float(np.clip((1.0 + rho) / (1.0 - rho), 1.0, r.shape[1]))
 
 
 def free_decay_gain(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndarray,
@@ -537,11 +578,12 @@ def driving_point_scaling(M: np.ndarray, C: np.ndarray, K: np.ndarray, K3: np.nd
     prior's scale, 0.075 with ``B``'s gain (the 150 N base then fails: 0.48), 0.088 with the free
     decay's (150 N 0.123 -> 0.121); figures in
     docs/known-gaps.md).  Each mode's reading is weighted by its standard error from that fit
-    (:func:`held_share`): a mode the free decay barely holds keeps the fitted model's own modal
-    mass in proportion, rather than spreading its error over the others through the trace
-    normalisation.  A linear model keeps ``B``'s gain, and so does a model whose ``K3`` is all
-    zero (a cubic library whose every term was dropped: no cubic force to carry the pulse's
-    quasi-static response, review 28e L6).
+    (:func:`held_share`; the least squares' spread times the residual's
+    :func:`correlation_factor`, review 28e M2): a mode the free decay barely holds keeps
+    the fitted model's own modal mass in proportion, rather than spreading its error over
+    the others through the trace normalisation.  A linear model keeps ``B``'s gain, and so
+    does a model whose ``K3`` is all zero (a cubic library whose every term was dropped: no
+    cubic force to carry the pulse's quasi-static response, review 28e L6).
 
     Parameters
     ----------

@@ -18,6 +18,7 @@ from scipy import linalg
 
 from identify._structural_sim import simulate_structural
 from identify.structural import (
+    correlation_factor,
     driving_point_scaling,
     free_decay_fit,
     free_decay_gain,
@@ -192,3 +193,21 @@ def test_a_model_whose_cubic_is_all_zero_is_shared_as_a_linear_one():
     # the same columns; rounding of the least squares only
     np.testing.assert_allclose(g1, g0, rtol=1e-9, atol=1e-12 * np.abs(g0).max())
     np.testing.assert_allclose(cov1, cov0, rtol=1e-6, atol=1e-9 * np.abs(cov0).max())
+
+
+def test_a_correlated_residual_widens_the_spread_by_its_effective_sample_size():
+    """Review 28e M2: the free decay's residual on a clean record is model error, smooth at
+    the sample rate.  ``correlation_factor``: an AR(1) residual with ``rho`` 0.9 widens the
+    variance by about ``(1 + rho) / (1 - rho)`` = 19; white noise by 1 (never under 1); a
+    residual of one value per channel, or none, by its length and by 1."""
+    rng = np.random.default_rng(7)
+    e = rng.standard_normal((3, 20000))
+    ar = np.zeros_like(e)
+    for t in range(1, e.shape[1]):
+        ar[:, t] = 0.9 * ar[:, t - 1] + e[:, t]
+    # the sample lag-1 autocorrelation of 60,000 samples: within 0.01 of 0.9, so 19 within 2
+    assert abs(correlation_factor(ar) - 19.0) <= 2.0
+    assert 1.0 <= correlation_factor(e) <= 1.05  # white: rho within 0.01 of 0
+    assert correlation_factor(np.ones((2, 50))) == 50.0
+    assert correlation_factor(np.zeros((2, 50))) == 1.0
+    assert correlation_factor(-ar[:, ::1] * (-1.0) ** np.arange(20000)) == 1.0  # alternating
