@@ -372,12 +372,21 @@ def fit_band_cutoff(data: Measurement, cutoff_hz: float | None = None,
 #: least-squares fit.  With the cubic force on the right-hand side the reading does not depend
 #: on it (measured, branch ``mass28``: 1, 2 and 5 periods agree within 2 % on the shipped soft
 #: base at 50 and 150 N; without the cubic force the hardening mode's amplitude fell with the
-#: window, 0.81 -> 0.35 -> -0.16 of ``1 / mu`` at 150 N).
+#: window, 0.81 -> 0.35 -> -0.16 of ``1 / mu`` at 150 N).  The trade-off (review 28e): a
+#: shorter window separates the slowest mode from the others less well (under one period its
+#: amplitude and phase trade against theirs) and leaves fewer samples per column; a longer one
+#: lets the model's frequency and decay-rate errors drift the simulated modes out of phase
+#: with the record and weights the lightly damped modes' late samples, where the model's
+#: cubic errors accumulate.  A mode's reading depends on where the window *starts* (its
+#: amplitude is carried from the pulse to ``free_start`` by ``exp(sigma t)``), not on its
+#: length (branch ``mass29``: 0.25-5 periods within 6 % of the cubic force error, 1 / mu within
+#: 3 %); five periods sit on that plateau, with margin from both ends.
 FREE_GAIN_PERIODS = 5.0
 
 
 def free_decay_fit(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndarray,
-                   K3: np.ndarray | None, j: int) -> tuple[np.ndarray, np.ndarray] | None:
+                   K3: np.ndarray | None, j: int, lam: np.ndarray | None = None
+                   ) -> tuple[np.ndarray, np.ndarray] | None:
     """The input gain ``g = M^-1 B[:, j]`` that best explains the free decay after the pulse,
     with its covariance.
 
@@ -405,18 +414,23 @@ def free_decay_fit(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndarra
         The fitted cubic stiffness [N/m^3] (None: a linear model).
     j : int
         The input (row of ``data.u``) at the driving point.
+    lam : ndarray, shape (n,), optional
+        The eigenvalues of ``(K, M)`` [rad^2/s^2] where the caller has them
+        (:func:`driving_point_scaling`: not computed twice); None: computed here.
 
     Returns
     -------
     (g, cov) or None
         The gain [1/kg], shape (n,), and its least-squares covariance ``s^2 (A^T A)^-1``
-        [1/kg^2], shape (n, n) (``s^2`` the residual variance over the free samples); None
+        [1/kg^2], shape (n, n) (``s^2`` the residual variance over the free samples), times
+        the residual's :func:`correlation_factor` (a correlated residual holds fewer
+        independent samples than it has); None
         when ``data.free_start`` is 0 (a continuous input, or a window
         cut after the pulse: no free decay), the window is too short, the model has no
         oscillating mode or the fit is not finite.
     """
     n = M.shape[0]
-    w2 = np.linalg.eigvals(np.linalg.solve(M, K)).real
+    w2 = np.linalg.eigvals(np.linalg.solve(M, K)).real if lam is None else np.asarray(lam, float)
     if not np.all(np.isfinite(w2)) or not np.any(w2 > 0) or data.u is None:
         return None
     period = 2 * np.pi / np.sqrt(w2[w2 > 0].min())
@@ -442,12 +456,51 @@ def free_decay_fit(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndarra
     g = G.reshape(U.shape[0], n)[j]
     if not np.all(np.isfinite(g)):
         return None
-    # the least squares' covariance, s^2 (A^T A)^-1 (residual variance over the free samples)
+    # the least squares' covariance, s^2 (A^T A)^-1 (residual variance over the free samples),
+    # times the residual's correlation factor (review 28e M2: a clean record's residual is
+    # model error, correlated from sample to sample, not white)
     dof = max(b.size - A.shape[1], 1)
-    s2 = float(np.sum((b - A @ G) ** 2)) / dof
-    cov = s2 * np.linalg.pinv(A.T @ A)
+    r = b - A @ G
+    s2 = float(np.sum(r**2)) / dof
+    cov = s2 * np.linalg.pinv(A.T @ A) * correlation_factor(r.reshape(n, -1))
     rows = slice(j * n, (j + 1) * n)
     return g, cov[rows, rows]
+
+
+def correlation_factor(r: np.ndarray) -> float:
+    """How many times a least squares' white-noise variance understates its coefficients'
+    variance when its residual ``r`` is correlated from sample to sample.
+
+    Rule (the AR(1) effective sample size, Bartlett): ``rho`` the lag-1 autocorrelation of
+    the residual pooled over its channels (``sum r_t r_{t+1} / sum r_t^2``), the factor
+    ``(1 + rho) / (1 - rho)``, held between 1 (a residual no more correlated than white noise
+    is not read as less uncertain) and the number of samples per channel (no fewer than one
+    independent sample).  Continuous in ``rho``.  Why (review 28e M2): on a clean record the
+    free decay's residual is the model's error, smooth at the sample rate (``rho`` 0.83-0.98 on
+    the shipped soft scenarios and round 24's soft cells), so the white spread, 0.3-0.7 % of a
+    mode's reading on the shipped soft base, underrated how loosely a heavily damped mode is
+    held (:func:`held_share`).
+
+    Parameters
+    ----------
+    r : ndarray, shape (n_channels, n_t)
+        The residual, each row one channel's samples in time order.
+
+    Returns
+    -------
+    float
+        The factor [-], in ``[1, n_t]``; 1 for a residual of fewer than 2 samples or zero.
+    """
+    r = np.asarray(r, dtype=float)
+    if r.ndim != 2 or r.shape[1] < 2:
+        return 1.0
+    e = float(np.sum(r**2))
+    if not e > 0.0:
+        return 1.0
+    rho = float(np.sum(r[:, 1:] * r[:, :-1])) / e
+    if not rho < 1.0:
+        return float(r.shape[1])
+    return float(np.clip((1.0 + rho) / (1.0 - rho), 1.0, r.shape[1]))
 
 
 def free_decay_gain(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndarray,
@@ -509,8 +562,13 @@ def driving_point_scaling(M: np.ndarray, C: np.ndarray, K: np.ndarray, K3: np.nd
     mass is shared among the modes, the prior its total), and the model becomes
     ``M' = Phi^-T diag(mu) Phi^-1``, ``K' = Phi^-T diag(mu omega^2) Phi^-1``,
     ``C' = Phi^-T (mu^1/2 D mu^1/2) Phi^-1`` (``D = Phi^T C Phi``; exact for modal damping, the
-    symmetric part otherwise), ``B' = M' g``: the same ``M^-1 K``
-    (frequencies and mode shapes), the same modal damping, the mass shared as the force says.
+    symmetric part otherwise), ``B' = M' M^-1 B``: the same ``M^-1 K``
+    (frequencies and mode shapes), the same modal damping, the same ``M^-1 B`` (so the model
+    simulates as before), the mass shared as the force says.  For a linear model ``M^-1 B``
+    is the gain read, ``B' = M' g``; a cubic model's ``B'`` keeps its fitted gain, not the
+    free decay's ``g`` (review 28e L3: the fitted map also carries the unmodelled modes'
+    quasi-static response under the pulse, which the scored simulation needs, and the
+    reading ``g`` only shares the mass).
 
     A cubic model reads ``g`` from the free decay after the pulse (:func:`free_decay_fit`),
     not from ``B``: an impact's samples hold the quasi-static response of the modes the model
@@ -520,9 +578,12 @@ def driving_point_scaling(M: np.ndarray, C: np.ndarray, K: np.ndarray, K3: np.nd
     prior's scale, 0.075 with ``B``'s gain (the 150 N base then fails: 0.48), 0.088 with the free
     decay's (150 N 0.123 -> 0.121); figures in
     docs/known-gaps.md).  Each mode's reading is weighted by its standard error from that fit
-    (:func:`held_share`): a mode the free decay barely holds keeps the fitted model's own modal
-    mass in proportion, rather than spreading its error over the others through the trace
-    normalisation.  A linear model keeps ``B``'s gain.
+    (:func:`held_share`; the least squares' spread times the residual's
+    :func:`correlation_factor`, review 28e M2): a mode the free decay barely holds keeps
+    the fitted model's own modal mass in proportion, rather than spreading its error over
+    the others through the trace normalisation.  A linear model keeps ``B``'s gain, and so
+    does a model whose ``K3`` is all zero (a cubic library whose every term was dropped: no
+    cubic force to carry the pulse's quasi-static response, review 28e L6).
 
     Parameters
     ----------
@@ -550,7 +611,8 @@ def driving_point_scaling(M: np.ndarray, C: np.ndarray, K: np.ndarray, K3: np.nd
         What was done, for ``mass_scaling_rule_``.
     """
     same = (M, C, K, K3, B)
-    if K3 is not None and data is None:
+    cubic = K3 is not None and bool(np.any(np.asarray(K3) != 0.0))
+    if cubic and data is None:
         return same, "cubic model without its record: the mass prior's scale kept"
     if B is None or declared is None:
         return same, "no measured input: the mass prior's scale kept"
@@ -563,8 +625,8 @@ def driving_point_scaling(M: np.ndarray, C: np.ndarray, K: np.ndarray, K3: np.nd
     lam, phi = linalg.eigh(K, M)  # phi^T M phi = I
     g = np.linalg.solve(M, B[:, j])
     cov = None
-    if K3 is not None:
-        fit = free_decay_fit(data, M, C, K, K3, j)
+    if cubic:
+        fit = free_decay_fit(data, M, C, K, K3, j, lam)
         if fit is None:
             return same, "cubic model: no free decay to read the gain from, the prior's scale kept"
         g, cov = fit
@@ -590,8 +652,8 @@ def driving_point_scaling(M: np.ndarray, C: np.ndarray, K: np.ndarray, K3: np.nd
     K2 = pinv.T @ np.diag(mu * lam) @ pinv
     C2 = pinv.T @ (r[:, None] * _sym(Dm) * r[None, :]) @ pinv
     B2 = M2 @ np.linalg.solve(M, B)
-    if K3 is None:
-        return ((_sym(M2), _sym(C2), _sym(K2), None, B2),
+    if not cubic:
+        return ((_sym(M2), _sym(C2), _sym(K2), None if K3 is None else np.zeros_like(K3), B2),
                 f"modal masses from the input gain at the driving point (sensor {k + 1})")
     return ((_sym(M2), _sym(C2), _sym(K2), M2 @ np.linalg.solve(M, K3), B2),
             f"modal masses from the free decay's gain at the driving point (sensor {k + 1})")

@@ -18,6 +18,7 @@ from scipy import linalg
 
 from identify._structural_sim import simulate_structural
 from identify.structural import (
+    correlation_factor,
     driving_point_scaling,
     free_decay_fit,
     free_decay_gain,
@@ -169,3 +170,44 @@ def test_free_decay_spread_follows_the_noise():
     # tenfold noise, tenfold error (the same seed's draw scaled: exact up to the rounding)
     np.testing.assert_allclose(spreads[2], 10.0 * spreads[1], rtol=0.01)
     assert np.all(spreads[2] > 1e-5) and np.all(spreads[2] < 0.05)   # read, not lost
+
+
+def test_a_model_whose_cubic_is_all_zero_is_shared_as_a_linear_one():
+    """Review 28e L6: a cubic library whose every term was dropped (``K3`` all zero) has no
+    cubic force; it is shared by ``B``'s gain as a linear model is (before, by the free decay),
+    and gives back a zero ``K3``.  The free decay's fit with the caller's eigenvalues (L5: not
+    computed twice) is the fit without them."""
+    data = _record()
+    Mf, Cf, Kf = _wrong_sharing()
+    B = Mf @ np.linalg.solve(M3, DECLARED)  # the gain a linear fit would give (M^-1 B kept)
+    lin, rule_lin = driving_point_scaling(Mf, Cf, Kf, None, B, DECLARED, data)
+    zero, rule_zero = driving_point_scaling(Mf, Cf, Kf, np.zeros((3, 3)), B, DECLARED, data)
+    assert rule_zero == rule_lin and "input gain" in rule_zero
+    for a, b in zip(lin[:3] + lin[4:], zero[:3] + zero[4:], strict=True):
+        np.testing.assert_array_equal(a, b)
+    assert zero[3] is not None and not np.any(zero[3])
+    lam = linalg.eigh(Kf, Mf, eigvals_only=True)
+    g0, cov0 = free_decay_fit(data, Mf, Cf, Kf, None, 0)
+    g1, cov1 = free_decay_fit(data, Mf, Cf, Kf, None, 0, lam)
+    # the window's length rounds the same period (eigvals against eigh: 1e-12 relative), so
+    # the same columns; rounding of the least squares only
+    np.testing.assert_allclose(g1, g0, rtol=1e-9, atol=1e-12 * np.abs(g0).max())
+    np.testing.assert_allclose(cov1, cov0, rtol=1e-6, atol=1e-9 * np.abs(cov0).max())
+
+
+def test_a_correlated_residual_widens_the_spread_by_its_effective_sample_size():
+    """Review 28e M2: the free decay's residual on a clean record is model error, smooth at
+    the sample rate.  ``correlation_factor``: an AR(1) residual with ``rho`` 0.9 widens the
+    variance by about ``(1 + rho) / (1 - rho)`` = 19; white noise by 1 (never under 1); a
+    residual of one value per channel, or none, by its length and by 1."""
+    rng = np.random.default_rng(7)
+    e = rng.standard_normal((3, 20000))
+    ar = np.zeros_like(e)
+    for t in range(1, e.shape[1]):
+        ar[:, t] = 0.9 * ar[:, t - 1] + e[:, t]
+    # the sample lag-1 autocorrelation of 60,000 samples: within 0.01 of 0.9, so 19 within 2
+    assert abs(correlation_factor(ar) - 19.0) <= 2.0
+    assert 1.0 <= correlation_factor(e) <= 1.05  # white: rho within 0.01 of 0
+    assert correlation_factor(np.ones((2, 50))) == 50.0
+    assert correlation_factor(np.zeros((2, 50))) == 1.0
+    assert correlation_factor(-ar[:, ::1] * (-1.0) ** np.arange(20000)) == 1.0  # alternating
