@@ -321,9 +321,10 @@ class LeastSquaresSINDy(StructuralIdentifier):
        part (frequencies and shapes), and the cubic :func:`identify._cubic_form.one_mode_cubic`
        on the lowest mode a measured peak locates, ``g = s |g_k|`` (``g_k`` the fitted cubic's
        own coefficient along that mode's motion; hardening), ``s`` by the record agreement
-       with the regression's fitted input map and with none, replaces the fitted cubic unless
-       that explains clearly more of the record (the margin :data:`CUBIC_TRIAL_RATIO`, as step
-       4c keeps its output-error cubic; :func:`identify._structural_backbone.mode_cubic`).
+       with the regression's fitted input map and with none, replaces the fitted cubic where
+       it explains more of the record (a plain "higher": two estimates of one term, the
+       equation error's and the output error's; step 4c's margin convention lost a study bar,
+       :func:`identify._structural_backbone.mode_cubic`).
        Why: the equation error sizes the diagonal ``x_j^3`` of a soft base from columns of
        ~1e-13 m^3, collinear with the linear ones; on a sensor beside the base (soft member
        010 clean: 0.0191 m, the hammer's point) the fitted cubic softens mode 1 along its own
@@ -814,8 +815,8 @@ class LeastSquaresSINDy(StructuralIdentifier):
         """Step 4d of the class docstring (:func:`identify._structural_backbone.mode_cubic`):
         on the cubic model the cubic rule chose (``cubic`` None; not step 4c's), after step 6,
         the fitted cubic replaced by one on the lowest located mode alone sized by output
-        error, with the regression's input map or none, unless the fitted cubic explains
-        clearly more of the record.  ``coef_``'s cubic and input columns follow; ``mode_cubic_rule_`` says what was
+        error, with the regression's input map or none, where that explains more of the
+        record.  ``coef_``'s cubic and input columns follow; ``mode_cubic_rule_`` says what was
         done with both record agreements, or why not."""
         self.mode_cubic_rule_ = "not tried (a linear model, or cubic set by the user)"
         if self.cubic is not None or self.K3_ is None or self._c_block is None:
@@ -825,8 +826,7 @@ class LeastSquaresSINDy(StructuralIdentifier):
             return
         fitted = getattr(self, "_fitted_map", None)
         K3, B, self.mode_cubic_rule_ = mode_cubic(
-            self, data, self._held_peaks(data, peaks), None if fitted is None else fitted[0],
-            CUBIC_TRIAL_RATIO)
+            self, data, self._held_peaks(data, peaks), None if fitted is None else fitted[0])
         if K3 is None:
             return
         m = np.diag(self.M_)[:, None]
