@@ -819,7 +819,7 @@ class LeastSquaresSINDy(StructuralIdentifier):
         record.  ``coef_``'s cubic and input columns follow; ``mode_cubic_rule_`` says what was
         done with both record agreements, or why not."""
         self.mode_cubic_rule_ = "not tried (a linear model, or cubic set by the user)"
-        if self.cubic is not None or self.K3_ is None or self._c_block is None:
+        if self.cubic is not None or self.K3_ is None or getattr(self, "_c_block", None) is None:
             return
         if not self.backbone_cubic_rule_.startswith("not tried"):
             self.mode_cubic_rule_ = "not tried (step 4c's cubic)"
@@ -835,8 +835,8 @@ class LeastSquaresSINDy(StructuralIdentifier):
         cols = getattr(self, "_input_columns", None)
         if fitted is not None and cols is not None and cols.size == self.coef_.shape[1]:
             self.coef_[:, cols] = fitted[1][:, cols] if np.any(B) else 0.0
-            self.input_map_rule_ += ("; step 4d's cubic " + ("with the fitted input map"
-                                                              if np.any(B) else "with no input map"))
+            which = "with the fitted input map" if np.any(B) else "with no input map"
+            self.input_map_rule_ += f"; step 4d's cubic {which}"
         self.K3_, self.input_map_ = K3, B
 
     def _fit_library(self, data: Measurement, lib: Library, masses: np.ndarray,
