@@ -29,7 +29,7 @@ from identify._record import (
     without_input_map,
 )
 from identify._sgd_matrix import eigen_targets, fit_window
-from identify._structural_backbone import backbone_cubic
+from identify._structural_backbone import backbone_cubic, mode_cubic
 from identify._unresolved import place_unresolved
 from identify.structural import (
     DECAY_BACKBONE_FIELD,
@@ -315,6 +315,23 @@ class LeastSquaresSINDy(StructuralIdentifier):
        keeping only moves whose agreement does not fall would lose 2 issue and 3 study bars
        for ``soft_v21__008``'s one (docs/known-gaps.md, "step 4c, review 28c").
 
+    4d. *A fitted cubic replaced by one on the lowest located mode, sized by output error*
+       (``cubic=None`` only, on a cubic model the rule chose, not step 4c's; :meth:`_mode_cubic`;
+       it runs after step 6, whose input map it judges again): the model keeps its linear
+       part (frequencies and shapes), and the cubic :func:`identify._cubic_form.one_mode_cubic`
+       on the lowest mode a measured peak locates, ``g = s |g_k|`` (``g_k`` the fitted cubic's
+       own coefficient along that mode's motion; hardening), ``s`` by the record agreement
+       with the regression's fitted input map and with none, replaces the fitted cubic where
+       it explains more of the record (a plain "higher": two estimates of one term, the
+       equation error's and the output error's; step 4c's margin convention lost a study bar,
+       :func:`identify._structural_backbone.mode_cubic`).
+       Why: the equation error sizes the diagonal ``x_j^3`` of a soft base from columns of
+       ~1e-13 m^3, collinear with the linear ones; on a sensor beside the base (soft member
+       010 clean: 0.0191 m, the hammer's point) the fitted cubic softens mode 1 along its own
+       motion (``g_1 = -1.6e14``) while the record hardens, and the failing channel's TRAC is
+       0.943 without the input map, 0.870 with it; with a hardening cubic on mode 1 alone and
+       the map, 0.963.  Measured (docs/known-gaps.md, beam35): see the gate there.
+
     5. *Unresolved modes placed* (linear library, ``fit_tilt`` by rule; only where the model
        would be refused: tilted, held and flat all grow): in the tilted fit, a mode whose
        pole reaches beyond the peak search's band top (:func:`identify.structural.peak_band`:
@@ -445,6 +462,9 @@ class LeastSquaresSINDy(StructuralIdentifier):
     backbone_cubic_rule_ : str
         Step 4c: the lowest mode moved to its backbone limit with its output-error cubic (both
         record agreements and the scale), or why not.
+    mode_cubic_rule_ : str
+        Step 4d: the fitted cubic replaced by the lowest located mode's output-error cubic
+        (both record agreements, the scale and the input map), kept, or why not tried.
     eigen_targets_ : ndarray, shape (n,)
         Measured peak [Hz] each mode (ascending) was paired with, in the fit's domain (warped
         for trapezoid integrals); 0 = none.  ``eigen_rule_`` (str) says what the hold did.
@@ -464,7 +484,9 @@ class LeastSquaresSINDy(StructuralIdentifier):
         ``M_ = (m_hat / n) I`` [kg], ``C_ = -M_ Xi_v`` [N s/m], ``K_ = -M_ Xi_d`` [N/m].
     K3_ : ndarray, shape (n, n) or None
         ``-M_ Xi_c`` [N/m^3] if ``cubic``; where step 4c moved a linear model's lowest mode,
-        its rank-one cubic on that mode (no column of ``coef_``).
+        its rank-one cubic on that mode (no column of ``coef_``); where step 4d replaced the
+        fitted cubic, its rank-one cubic on the lowest located mode (in ``coef_``'s cubic
+        columns).
     coef_ : ndarray, shape (n, n_features)
         Regression coefficients in SI units, row i predicts ``x''_i`` (the model's features
         only).
@@ -604,6 +626,7 @@ class LeastSquaresSINDy(StructuralIdentifier):
         self._backbone_cubic(data, ps.peaks, m_hat)
         self._finish_fit(data)
         self._choose_input_map(data)
+        self._mode_cubic(data, ps.peaks)
         return self
 
     def _choose_input_map(self, data: Measurement) -> None:
@@ -623,6 +646,7 @@ class LeastSquaresSINDy(StructuralIdentifier):
         simulations from the record's start with their start fits (a cubic model's RK4 about
         0.9 s each on the shipped soft base's 25,600 samples; a linear one's 0.03-0.07 s).
         """
+        self._fitted_map = None
         if not getattr(self, "input_map_fitted_", False):
             self.input_map_rule_ = ("no input column in the regression (the fit window holds "
                                     "no input): data.input_map")
@@ -631,6 +655,8 @@ class LeastSquaresSINDy(StructuralIdentifier):
             self.input_map_rule_ = ("fitted on the window; kept (a record with no free window: "
                                     "the input drives the whole record)")
             return
+        # the fitted map and its coef_ columns, for step 4d to judge beside its own cubic
+        self._fitted_map = (np.array(self.input_map_, dtype=float), self.coef_.copy())
         a_fit, note_fit = record_agreement(self, data)
         drop, a_none, figures = without_input_map(self, data, a_fit, note_fit, INPUT_DROP_RATIO)
         if drop:
@@ -784,6 +810,34 @@ class LeastSquaresSINDy(StructuralIdentifier):
         self._set_stiffness(K, np.full((self.M_.shape[0], 1), m_hat / self.M_.shape[0]),
                             self._d_block)
         self.K3_ = K3
+
+    def _mode_cubic(self, data: Measurement, peaks: np.ndarray) -> None:
+        """Step 4d of the class docstring (:func:`identify._structural_backbone.mode_cubic`):
+        on the cubic model the cubic rule chose (``cubic`` None; not step 4c's), after step 6,
+        the fitted cubic replaced by one on the lowest located mode alone sized by output
+        error, with the regression's input map or none, where that explains more of the
+        record.  ``coef_``'s cubic and input columns follow; ``mode_cubic_rule_`` says what was
+        done with both record agreements, or why not."""
+        self.mode_cubic_rule_ = "not tried (a linear model, or cubic set by the user)"
+        if self.cubic is not None or self.K3_ is None or getattr(self, "_c_block", None) is None:
+            return
+        if not self.backbone_cubic_rule_.startswith("not tried"):
+            self.mode_cubic_rule_ = "not tried (step 4c's cubic)"
+            return
+        fitted = getattr(self, "_fitted_map", None)
+        K3, B, self.mode_cubic_rule_ = mode_cubic(
+            self, data, self._held_peaks(data, peaks), None if fitted is None else fitted[0])
+        if K3 is None:
+            return
+        m = np.diag(self.M_)[:, None]
+        self.coef_ = self.coef_.copy()
+        self.coef_[:, self._c_block] = -K3 / m
+        cols = getattr(self, "_input_columns", None)
+        if fitted is not None and cols is not None and cols.size == self.coef_.shape[1]:
+            self.coef_[:, cols] = fitted[1][:, cols] if np.any(B) else 0.0
+            which = "with the fitted input map" if np.any(B) else "with no input map"
+            self.input_map_rule_ += f"; step 4d's cubic {which}"
+        self.K3_, self.input_map_ = K3, B
 
     def _fit_library(self, data: Measurement, lib: Library, masses: np.ndarray,
                      peaks: np.ndarray) -> None:
@@ -1042,6 +1096,7 @@ class LeastSquaresSINDy(StructuralIdentifier):
         self.channels_ = tuple(data.channels)
         self.M_, self.C_, self.K_, self.K3_ = matrices_from_coef(coef, lib.blocks, masses)
         self._d_block = lib.blocks["d"]  # coef_'s displacement columns (step 4c moves them)
+        self._c_block = lib.blocks.get("c")  # coef_'s cubic columns (step 4d replaces them)
         self.input_map_ = None if data.input_map is None else np.asarray(data.input_map, dtype=float)
         self.input_map_fitted_ = "f" in lib.blocks and self.input_map_ is not None
         if self.input_map_fitted_:

@@ -199,3 +199,59 @@ def test_step_4c_keeps_a_move_with_no_cubic_only_where_it_explains_clearly_more(
     monkeypatch.setattr(sb, "best_scale", lambda f: (0.8, 0.8726))  # a cubic, inside the margin
     K_b, K3, rule = sb.backbone_cubic(model, data, peaks, 2.0)
     assert K_b is not None and np.linalg.matrix_rank(K3) == 1 and "with a cubic" in rule
+
+
+def test_step_4d_replaces_a_cubic_that_softens_mode_1_by_a_hardening_one_where_the_record_agrees_more(
+        monkeypatch):
+    """Step 4d (:func:`identify._structural_backbone.mode_cubic`): a fitted diagonal cubic whose
+    own coefficient along mode 1 is negative (soft-base member 010 clean: ``g_1 = -1.6e14``) is
+    replaced by a cubic on mode 1's equation alone, hardening (``s |g_1|``), with the input map
+    (fitted or none) whose output-error scale explains more (ties to no map), where it explains
+    more than the fitted cubic.  The record agreement is stood in for by a function
+    of the candidate's modal cubic and map, so only the rule is under test."""
+    from types import SimpleNamespace
+
+    import identify._structural_backbone as sb
+
+    w = 2.0 * np.pi * np.array([20.0, 120.0])
+    M = np.diag([2.0, 1.0])
+    Phi = np.array([[1.0, 1.0], [2.0, -1.0]])  # M-orthogonal: 2 - 2 = 0
+    Phi = Phi / np.sqrt(np.einsum("ik,ij,jk->k", Phi, M, Phi))
+    K = M @ Phi @ np.diag(w**2) @ Phi.T @ M
+    K3 = np.array([[-3e10, 1e9], [2e9, -1e10]])
+    g1 = float(Phi[:, 0] @ K3 @ Phi[:, 0] ** 3)
+    assert g1 < 0.0
+    fitted = np.array([[0.5], [1.0]])
+    model = SimpleNamespace(M_=M, C_=0.01 * K, K_=K, K3_=K3, input_map_=np.zeros((2, 1)))
+
+    def agreement(m, data, best=(0.7, 0.96, 0.95)):
+        if m.K3_ is K3:
+            return (0.94,)
+        if m.K3_ is None:  # no cubic: under either map's best
+            return (min(best[1:]) - 0.05,)
+        modal_k3 = np.linalg.solve(Phi, np.linalg.solve(M, m.K3_)) @ Phi**3  # Phi^-1 M^-1 K3 Phi^3
+        assert np.allclose(modal_k3[1], 0.0, atol=1e-9 * abs(modal_k3[0, 0]))  # mode 1 alone
+        s = modal_k3[0, 0] / abs(g1)
+        assert s > 0.0  # hardening
+        top = best[1] if np.any(m.input_map_) else best[2]
+        return (top - (s - best[0]) ** 2,)
+
+    monkeypatch.setattr(sb, "record_agreement", agreement)
+    peaks = np.array([20.0, 120.0])
+    K3_new, B, rule = sb.mode_cubic(model, None, peaks, fitted)
+    assert K3_new is not None and np.array_equal(B, fitted), rule
+    assert "replaced by a cubic on that mode alone" in rule and "the fitted input map" in rule
+    # no more than the fitted cubic's 0.94 (0.935 at best): the model stands
+    monkeypatch.setattr(sb, "record_agreement",
+                        lambda m, d: agreement(m, d, (0.7, 0.93, 0.935)))
+    K3_new, B, rule = sb.mode_cubic(model, None, peaks, fitted)
+    assert K3_new is None and B is None and ": kept, the cubic on that mode alone" in rule
+    # equal agreements with and without the map: no map
+    monkeypatch.setattr(sb, "record_agreement",
+                        lambda m, d: agreement(m, d, (0.7, 0.96, 0.96)))
+    K3_new, B, rule = sb.mode_cubic(model, None, peaks, fitted)
+    assert K3_new is not None and not np.any(B) and "with no input map" in rule
+    # a linear model, and no peak near a mode: not tried
+    assert sb.mode_cubic(SimpleNamespace(**{**vars(model), "K3_": None}), None, peaks,
+                         fitted)[2].startswith("not tried")
+    assert sb.mode_cubic(model, None, np.array([60.0]), fitted)[2].startswith("not tried (no mode")

@@ -586,14 +586,16 @@ def test_a_cubic_models_mode_above_what_the_hardening_record_allows_is_moved_and
     around the held stiffness the model's response follows: TRAC 0.987 -> 0.990 (002), 0.934
     -> 0.943 (010); moved without the refit, 0.958 and 0.857, the model's diagonal cubic still
     pulling mode 2 where the fit had put it."""
-    for name, trac_min in (("beams_soft__002", 0.98), ("beams_soft__010", 0.94)):
+    # 010's bar is issue #15's 0.95 since step 4d (beam35: 0.963; without it 0.943)
+    for name, trac_min in (("beams_soft__002", 0.98), ("beams_soft__010", 0.95)):
         sc = _family_cell(name, 0.0)
         res = run_scenario(sc, dataset=dataset_cache.get(sc))
         v = res.scores.values
         assert res.model.cubic_ and "the cubic refitted" in res.model.eigen_rule_
         assert v["freq_error_mode2"] <= 0.01  # measured 0.52 / 0.10 % (old 6.50 / 1.74 %)
         assert v["freq_error_mode1"] <= 0.01  # unchanged, 0.58 / 0.02 %
-        # measured 0.990 / 0.943 (old code 0.987 / 0.934; moved without the refit 0.958 / 0.857)
+        # measured 0.990 / 0.943 (old code 0.987 / 0.934; moved without the refit 0.958 / 0.857);
+        # with step 4d's cubic on mode 1 alone (beam35) 0.992 / 0.963
         assert v["trac"] >= trac_min
 
 
