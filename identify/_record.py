@@ -26,6 +26,13 @@ from testbed.numerics.shapes import trac
 #: two fits by their records (``sgd_sindy``'s keep rule and cubic trial, both identifiers'
 #: input-map drop, ``ls_sindy``'s step 4b).
 AGREEMENT_RATIO = 2.0
+#: The tie band of a plain "higher" between two record agreements (``ls_sindy``'s step 4d):
+#: one must leave under ``1 / AGREEMENT_TIE`` of the other's unexplained share, one part in a
+#: million.  Far above the agreement's rounding (a float64 sum over the record of an RK4
+#: simulation: ~1e-12 relative, what a BLAS kernel can move), far below the differences a rule
+#: reads (the gate's near ties 1e-4 of TRAC); a tie keeps the model as it stands, so no choice
+#: is decided by the kernel's rounding.
+AGREEMENT_TIE = 1.0 + 1e-6
 
 
 def clearly_more(a_new: float, a_old: float, ratio: float = AGREEMENT_RATIO) -> bool:

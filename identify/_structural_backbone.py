@@ -13,7 +13,13 @@ import numpy as np
 from identify._cubic_form import duffing_by_balance, one_mode_cubic
 from identify._cubic_rule import CUBIC_CHIRP_MIN
 from identify._modal_damping import BACKBONE_MIN_FALL, limit_reached, modal_decay, set_eigenvalues
-from identify._record import AGREEMENT_RATIO, best_scale, clearly_more, record_agreement
+from identify._record import (
+    AGREEMENT_RATIO,
+    AGREEMENT_TIE,
+    best_scale,
+    clearly_more,
+    record_agreement,
+)
 from identify._sgd_matrix import eigen_targets, fit_window
 from identify.structural import (
     MODE_SEPARATION,
@@ -185,14 +191,16 @@ def mode_cubic(model: StructuralIdentifier, data: Measurement, peaks: np.ndarray
     once with the regression's fitted input map ``fitted_map`` and once with none (step 6
     judged that map beside the fitted cubic, not beside this one).  The candidate with the
     higher agreement (ties: no map) replaces the fitted cubic where it explains more of the
-    record than the model as it stands (a plain "higher": two estimates of one term, the
+    record than the model as it stands (a plain "higher", within the tie band
+    :data:`identify._record.AGREEMENT_TIE`: two estimates of one term, the
     equation error's and the output error's, the record choosing, as ``sgd_sindy`` chooses
     between its libraries where the decays contradict its cubic).  Not step 4c's convention
     (the new term kept unless the old explains clearly more, margin 2): measured, that
     replaced held-out soft 012 at 1 % within the margin (0.912 -> 0.828, 0.52 x) and lost its
     study bar.  Near ties (held-out 000 / 001 / 004 / 005 / 008 / 015 at 1 %: equal to 1e-4,
-    cubics that barely act) go either way by rounding, with the same verdicts and frequencies
-    (the linear part is not touched).  Scale 0 (no cubic) or nothing simulated: the model
+    cubics that barely act) are decided by the record beyond the tie band, not by a kernel's
+    rounding; the verdicts and frequencies are the same either way (the linear part is not
+    touched).  Scale 0 (no cubic) or nothing simulated: the model
     stands.  Only the record enters.
 
     Why: the equation error sizes the diagonal cubic ``x_j^3`` of a soft base from columns of
@@ -256,11 +264,14 @@ def mode_cubic(model: StructuralIdentifier, data: Measurement, peaks: np.ndarray
     a_old = record_agreement(model, data)[0]
     tried = [(name, B, *best_scale(lambda s, B=B: record_agreement(candidate(s, B), data)[0]))
              for name, B in maps]
-    # the higher agreement (NaN lowest), ties to the first tried (no map)
-    name, B, s, a_new = max(tried, key=lambda t: (np.nan_to_num(t[3], nan=-1.0), t is tried[0]))
+    # the higher agreement (NaN lowest); within AGREEMENT_TIE, the first tried (no map)
+    name, B, s, a_new = tried[0]
+    for t in tried[1:]:
+        if (np.isnan(a_new) and np.isfinite(t[3])) or clearly_more(t[3], a_new, AGREEMENT_TIE):
+            name, B, s, a_new = t
     figures = (f"record agreement (TRAC) fitted cubic {a_old:.6g}, on mode {k + 1} alone x "
                f"{s:.3g} of |g_k| with {name} {a_new:.6g}")
-    if not (s > 0 and a_new > a_old):  # NaN on either side: the model stands
+    if not (s > 0 and clearly_more(a_new, a_old, AGREEMENT_TIE)):  # NaN or a tie: it stands
         return None, None, (f"{head}: kept, the cubic on that mode alone explains no more "
                             f"({figures})")
     return candidate(s, B).K3_, B, f"{head}: replaced by a cubic on that mode alone ({figures})"

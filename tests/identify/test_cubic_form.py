@@ -251,6 +251,17 @@ def test_step_4d_replaces_a_cubic_that_softens_mode_1_by_a_hardening_one_where_t
                         lambda m, d: agreement(m, d, (0.7, 0.96, 0.96)))
     K3_new, B, rule = sb.mode_cubic(model, None, peaks, fitted)
     assert K3_new is not None and not np.any(B) and "with no input map" in rule
+    # within the tie band (AGREEMENT_TIE, 1e-6 of the unexplained share: a kernel's rounding is
+    # ~1e-12) the map's 1e-9 more is a tie: no map; and a cubic 1e-9 above the fitted one's
+    # 0.94 is a tie: the model stands (these were decided by rounding)
+    monkeypatch.setattr(sb, "record_agreement",
+                        lambda m, d: agreement(m, d, (0.7, 0.96 + 1e-9, 0.96)))
+    K3_new, B, rule = sb.mode_cubic(model, None, peaks, fitted)
+    assert K3_new is not None and not np.any(B) and "with no input map" in rule
+    monkeypatch.setattr(sb, "record_agreement",
+                        lambda m, d: agreement(m, d, (0.7, 0.94 + 1e-9, 0.94 + 1e-9)))
+    K3_new, B, rule = sb.mode_cubic(model, None, peaks, fitted)
+    assert K3_new is None and B is None and ": kept, the cubic on that mode alone" in rule
     # a linear model, and no peak near a mode: not tried
     assert sb.mode_cubic(SimpleNamespace(**{**vars(model), "K3_": None}), None, peaks,
                          fitted)[2].startswith("not tried")
