@@ -839,12 +839,16 @@ def chain_column_cutoff(chain_cutoff_hz: float, column_order: int) -> float:
 CHAIN_ORDER = 8
 #: Largest share of the inputs' column-filtered power that may be the chain's mismatch
 #: (:func:`testbed.numerics.filters.chain_mismatch_share`) on clean angles: 1e-10, the square
-#: of the clean droop of session 27 (1e-5 in amplitude, the error the clean chain was then
-#: allowed on the motion's second harmonic).  Kept when the droop fell to 1e-12 (session 28,
-#: pi33): the square of that, 1e-24, lies far below the shares read on five-bar multisines
-#: (3.5e-14 - 3.4e-12, near the Blackman-Harris periodogram's leakage), so it would hold most
-#: clean column cut-offs at their ``1.5 x band`` floor (not measured); the droop's gate was
-#: measured with 1e-10.
+#: of 1e-5.  The mismatch ``f (1 - G_chain) u`` is an error in an input column of relative
+#: amplitude up to the share's square root, and so biases that column's coefficient by up to
+#: as much; a five-bar model must hold its coefficients to about 1e-5 relative for 1e-4 rad
+#: (session 28, pi32: the true equations perturbed by 1e-5 simulate 7e-7 - 3.6e-5 rad off;
+#: ``testbed.numerics.derivatives.CLEAN_DROOP``).  (Chosen in session 27 as the square of
+#: that session's clean droop, also 1e-5; kept when the droop fell to 1e-12 in session 28: the
+#: droop's square, 1e-24, lies far below the shares read on five-bar multisines, 3.5e-14 -
+#: 3.4e-12, near the Blackman-Harris periodogram's leakage, and would hold most clean column
+#: cut-offs at their ``1.5 x band`` floor, not measured; the droop's gate was measured with
+#: 1e-10.)
 INPUT_MISMATCH_SHARE = 1e-10
 
 
