@@ -422,7 +422,15 @@ def select_models(sw: Sweep, input_cols: Sequence[np.ndarray], rtol: float = 0.1
 
     Models eligible for input k are those whose input-k terms carry a larger normalised
     coefficient than every other input's terms (so a sparse model contains u_k and no other
-    input, and the equations picked for different inputs are distinct).  They are ranked by
+    input), or one within the tie ``rtol`` of theirs (``share_k (1 + rtol) > share_other``):
+    a dense equation that mixes the inputs' equations about equally counts for each of them,
+    since its shares are round-off's where the record leaves directions of the Gram matrix
+    undetermined (session 29, pi34: round 20's ``fb20_ms_short_cranks`` clean, the 26-term
+    equation on input 2's term carried input 1's at 0.967 of input 2's share under OpenBLAS's
+    Haswell kernel and 1.059 under SkylakeX: eligible on one machine only, 1.8e-6 against
+    1.2e-4 rad).  The first pick of an earlier input is not offered again (the same equation up
+    to scale, ``PARALLEL_RTOL``), so the equations picked for different inputs stay distinct.
+    They are ranked by
     :func:`rank_models`, by their held-out error (``sw.val_error``, per unit of the left-hand
     side) or, where ``G_val`` is given, per unit of the input's part (:func:`input_errors`;
     what ``sindy_pi`` passes for open chains, docs/known-gaps.md "SINDy-PI: the cart-pole's
@@ -457,9 +465,16 @@ def select_models(sw: Sweep, input_cols: Sequence[np.ndarray], rtol: float = 0.1
         other = others.max(axis=0) if others.size else np.zeros_like(shares[k])
         ranked = sw if G_val is None else replace(sw, val_error=input_errors(
             sw, G_val, input_cols[k], n_val))
-        order = rank_models(ranked, (shares[k] > 0) & (shares[k] > other), rtol, atol)
+        dominant = (shares[k] > 0) & (shares[k] * (1.0 + rtol) > other)
+        elig = dominant.copy()
+        for p in out:  # an earlier input's first pick, up to scale, is not offered again
+            elig &= ~_parallel(sw.W, sw.W[p[0]])
+        order = rank_models(ranked, elig, rtol, atol)
         if order.size == 0:
-            raise NoModelError(no_model_reason(sw, shares, k))
+            if rank_models(ranked, dominant, rtol, atol).size == 0:
+                raise NoModelError(no_model_reason(sw, shares, k))
+            raise NoModelError(f"no implicit model contains input {k + 1} as its dominant input "
+                               "other than the equation picked for an earlier input")
         picked: list[tuple[int, int]] = []
         seen: set[bytes] = set()
         for flat in order:
@@ -473,6 +488,20 @@ def select_models(sw: Sweep, input_cols: Sequence[np.ndarray], rtol: float = 0.1
         out.append(picked)
     return out
 
+
+#: Two implicit equations are one up to scale where their normalised coefficient vectors'
+#: cosine is within this of 1 [-]: 1e-9, an angle of 4.5e-5 rad, far above the round-off of a
+#: unit vector's products (1e-16); two equations closer than that, taken for two inputs, leave
+#: the input gain as near singular as that angle.
+PARALLEL_RTOL = 1e-9
+
+
+def _parallel(W: np.ndarray, w: np.ndarray) -> np.ndarray:
+    """Whether each model of ``W`` (T, C, p) is ``w`` (p,) up to scale, shape (T, C)."""
+    nw = np.linalg.norm(W, axis=-1) * np.linalg.norm(w)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        cos = np.abs(np.einsum("tcp,p->tc", W, w)) / np.where(nw > 0, nw, 1.0)
+    return (nw > 0) & (cos >= 1.0 - PARALLEL_RTOL)
 
 
 def select_passive_models(sw: Sweep, input_cols: Sequence[np.ndarray],

@@ -176,8 +176,14 @@ from identify.library import Library, fivebar_library, generic_mechanical_librar
 from testbed.core.errors import IdentificationError
 from testbed.core.measurement import Measurement, Trajectory
 from testbed.core.schema import ErrorFn, Field, KeyUse
-from testbed.numerics.derivatives import CUTOFF_GAIN, harmonic_gain, noise_weight, relative_noise
-from testbed.numerics.filters import cutoff_problem, lowpass, mismatch_cutoff
+from testbed.numerics.derivatives import (
+    CUTOFF_GAIN,
+    CUTOFF_HARMONIC,
+    harmonic_droop,
+    noise_weight,
+    relative_noise,
+)
+from testbed.numerics.filters import cutoff_problem, lowpass, mismatch_cutoff, zero_phase_droop
 from testbed.numerics.gram import normalized_gram, ordered_independent
 from testbed.numerics.noise import noise_std, signal_band
 
@@ -188,23 +194,43 @@ from testbed.numerics.noise import noise_std, signal_band
 ROLLOUT_ATOL = 1e-4
 
 
-def rollout_atol(noise_rel: float) -> float:
+def chain_droop(band_hz: float, chain_cutoff_hz: float) -> float:
+    """The droop [-] a declared low-pass chain applied at the motion's second harmonic: ``1 -``
+    the zero-phase gain of an order-``CHAIN_ORDER`` Butterworth with the chain's cut-off
+    ``chain_cutoff_hz`` [Hz] at ``CUTOFF_HARMONIC x band_hz`` [Hz]
+    (:func:`testbed.numerics.filters.zero_phase_droop`).  The chain's automatic cut-off
+    applies the droop it asked (:func:`testbed.numerics.derivatives.harmonic_droop`; the
+    band here is read on the smoothed angles, the chain's on the raw ones: alike on clean
+    angles); a user's ``cutoff_hz`` applies its own.  The measurement declares the pass band,
+    not the order (``CHAIN_ORDER``, as :func:`input_column_cutoff`)."""
+    return float(zero_phase_droop(CUTOFF_HARMONIC * float(band_hz), float(chain_cutoff_hz),
+                                  CHAIN_ORDER))
+
+
+def rollout_atol(noise_rel: float, droop: float = 0.0) -> float:
     """The rollout selection's tie band [rad] where a declared low-pass chain derived the rates.
 
     The rollouts are compared with the chain's smoothed angles, whose own error scales with
-    the chain's droop at the second harmonic (:func:`testbed.numerics.derivatives.harmonic_gain`
-    of the relative noise): ``ROLLOUT_ATOL`` at the noisy rule's ``1 - CUTOFF_GAIN`` (1 %),
-    narrowed in proportion to the droop below it: on clean angles (droop ``CLEAN_DROOP`` 1e-12)
-    1e-14 rad, so the relative tie (``selection_rtol``, 10 %) alone decides there (1e-7 rad
-    at session 27's droop 1e-5, the order of the simulator's step error, 6e-7 rad at 1 ms);
-    exactly ``ROLLOUT_ATOL`` from ``NOISY_NOISE_REL`` up.  With 1e-4 rad on clean records the
-    band was as wide as the clean bar, and a sparser combination 10-100x worse in rollout won the
-    tie (round 20's short-crank multisine: 2.7e-5 against 1.0e-6 rad on the record).
+    the chain's droop at the second harmonic: ``ROLLOUT_ATOL`` at the noisy rule's ``1 -
+    CUTOFF_GAIN`` (1 %), narrowed in proportion to the droop below it.  The droop is the larger
+    of the one the chain applied (``droop``, :func:`chain_droop`: a user's ``cutoff_hz`` below
+    the automatic one droops more, review 28d M1) and the one the automatic chain asks at the
+    angles' noise (:func:`testbed.numerics.derivatives.harmonic_droop` of ``noise_rel``), at
+    most 1 %: on clean angles under the automatic chain (droop ``CLEAN_DROOP`` 1e-12) 1e-14
+    rad, so the relative tie (``selection_rtol``, 10 %) alone decides there (1e-7 rad at
+    session 27's droop 1e-5, the order of the simulator's step error, 6e-7 rad at 1 ms);
+    exactly ``ROLLOUT_ATOL`` from ``NOISY_NOISE_REL`` up; continuous in the noise and in the
+    cut-off.  With 1e-4 rad on clean records the band was as wide as the clean bar, and a
+    sparser combination 10-100x worse in rollout won the tie (round 20's short-crank
+    multisine: 2.7e-5 against 1.0e-6 rad on the record).
 
     Parameters
     ----------
     noise_rel : float
         Relative noise of the angles (:func:`testbed.numerics.derivatives.relative_noise`).
+    droop : float
+        The droop the chain applied at the second harmonic [-] (:func:`chain_droop`); 0: the
+        automatic chain's.
 
     Returns
     -------
@@ -213,7 +239,8 @@ def rollout_atol(noise_rel: float) -> float:
     """
     if noise_weight(noise_rel) >= 1.0:
         return ROLLOUT_ATOL
-    return float(ROLLOUT_ATOL * (1.0 - harmonic_gain(noise_rel)) / (1.0 - CUTOFF_GAIN))
+    share = max(harmonic_droop(noise_rel), float(droop)) / (1.0 - CUTOFF_GAIN)
+    return float(ROLLOUT_ATOL * min(share, 1.0))
 
 #: The record rule's rest baseline [-]: a combination whose simulation of the whole record
 #: leaves some coordinate farther (RMSE) from the measured angles than that coordinate's RMSE
@@ -812,12 +839,16 @@ def chain_column_cutoff(chain_cutoff_hz: float, column_order: int) -> float:
 CHAIN_ORDER = 8
 #: Largest share of the inputs' column-filtered power that may be the chain's mismatch
 #: (:func:`testbed.numerics.filters.chain_mismatch_share`) on clean angles: 1e-10, the square
-#: of the clean droop of session 27 (1e-5 in amplitude, the error the clean chain was then
-#: allowed on the motion's second harmonic).  Kept when the droop fell to 1e-12 (session 28,
-#: pi33): the square of that, 1e-24, lies far below the shares read on five-bar multisines
-#: (3.5e-14 - 3.4e-12, near the Blackman-Harris periodogram's leakage), so it would hold most
-#: clean column cut-offs at their ``1.5 x band`` floor (not measured); the droop's gate was
-#: measured with 1e-10.
+#: of 1e-5.  The mismatch ``f (1 - G_chain) u`` is an error in an input column of relative
+#: amplitude up to the share's square root, and so biases that column's coefficient by up to
+#: as much; a five-bar model must hold its coefficients to about 1e-5 relative for 1e-4 rad
+#: (session 28, pi32: the true equations perturbed by 1e-5 simulate 7e-7 - 3.6e-5 rad off;
+#: ``testbed.numerics.derivatives.CLEAN_DROOP``).  (Chosen in session 27 as the square of
+#: that session's clean droop, also 1e-5; kept when the droop fell to 1e-12 in session 28: the
+#: droop's square, 1e-24, lies far below the shares read on five-bar multisines, 3.5e-14 -
+#: 3.4e-12, near the Blackman-Harris periodogram's leakage, and would hold most clean column
+#: cut-offs at their ``1.5 x band`` floor, not measured; the droop's gate was measured with
+#: 1e-10.)
 INPUT_MISMATCH_SHARE = 1e-10
 
 
@@ -872,6 +903,16 @@ NOISY_REFIT_TEXT = "the clean recipe's fit failed: fitted again at the noisy rul
 #: clean, whose clean fit fails on a near tie of its inputs' shares (0.993), fitted at the noisy
 #: rule's weight 1 scores 9.2e-4 rad, at 0.25 (the first it fits at) 4.7e-7 rad.
 REFIT_WEIGHTS = (0.25, 0.5, 0.75, 1.0)
+
+
+def _same_settings(a: dict[str, Any], b: dict[str, Any]) -> bool:
+    """Whether two :func:`noise_knobs` settings are the same recipe (every value equal, floats
+    exactly), so the same fit; values that do not compare as one truth value count as
+    different (the fit is then done)."""
+    try:
+        return bool(a == b)
+    except ValueError:
+        return False
 
 
 #: Replay check of exact-data fits (:meth:`SINDyPI._replay_check`): the held-out choice must
@@ -1008,8 +1049,9 @@ def noise_knobs(x: np.ndarray, fs: float, val_fraction: float, user: dict[str, A
        decade down at the chain's cut-off (:func:`chain_column_cutoff`) unless the measured
        inputs' spectrum reaches the chain's transition band (steps, square waves, impacts:
        :func:`input_column_cutoff` then holds it down, never below ``CUTOFF_FACTOR band``), ridge
-       ``ridge^w RIDGE_EXACT^(1 - w)``, rollout ties within :func:`rollout_atol` (the chain's
-       droop x ``ROLLOUT_ATOL`` / 1 %); from 1e-3 up exactly the settings above.
+       ``ridge^w RIDGE_EXACT^(1 - w)``, rollout ties within :func:`rollout_atol` (the droop the
+       chain applied at ``2 band``, :func:`chain_droop`, or the automatic chain's at this noise
+       if larger, x ``ROLLOUT_ATOL`` / 1 %); from 1e-3 up exactly the settings above.
        For a declared chain (``passband``) the models are chosen by rollout
        (``selection="rollout"``: ``n_rollout`` shortlisted per input by held-out error, the
        combination that simulates the measured angles best over ``rollout_segments`` segments
@@ -1149,7 +1191,8 @@ def noise_knobs(x: np.ndarray, fs: float, val_fraction: float, user: dict[str, A
                 "edge_trim": trim, "ridge": ridge,
                 "weak_window_s": window if form == "weak" else None, "lhs": lhs,
                 "selection": selection,
-                "rollout_atol": rollout_atol(noise_rel) if w < 1.0 else ROLLOUT_ATOL}
+                "rollout_atol": (rollout_atol(noise_rel, chain_droop(band, float(passband[1])))
+                                 if w < 1.0 else ROLLOUT_ATOL)}
         branch += f", edge trim {trim:.3g} s{capped}, ridge {ridge:.3g}"
         if filtered and noise_rel < CHAIN_REL_FLOOR:
             branch += f" (noise below the chain's own error floor {CHAIN_REL_FLOOR:g})"
@@ -2101,22 +2144,27 @@ class SINDyPI(_ImplicitMechanical):
         for line in self.summary(precision):
             print(line, file=file or sys.stdout)
 
-    def _choose_knobs(self, data: Measurement) -> dict[str, Any]:
-        """The noise rule (:func:`noise_knobs`) on the measured angles; stored as fitted
-        attributes and ``noise_rule_``."""
+    def _rule_settings(self, data: Measurement, weight: float
+                       ) -> tuple[dict[str, Any], str, dict[str, Any]]:
+        """:func:`noise_knobs` on the measured angles with this instance's settings, the
+        noisy rule's weight at least ``weight`` (the refits of :meth:`fit`)."""
         user = {k: getattr(self, k) for k in RULE_KNOBS}
         ruled: tuple[str, ...] = ()
         if getattr(self, "_weak_trial", False):  # the open chain's form comparison (see fit)
             user["formulation"], ruled = "weak", ("formulation",)
-        knobs, rule, est = noise_knobs(data.x, data.fs, self.val_fraction, user,
-                                       getattr(self, "_smoothed", None), data.noise_std,
-                                       data.passband, ruled, inputs=data.u,
-                                       column_order=self.column_lowpass_order,
-                                       min_weight=getattr(self, "_refit_weight", 0.0))
+        return noise_knobs(data.x, data.fs, self.val_fraction, user,
+                           getattr(self, "_smoothed", None), data.noise_std, data.passband,
+                           ruled, inputs=data.u, column_order=self.column_lowpass_order,
+                           min_weight=weight)
+
+    def _choose_knobs(self, data: Measurement) -> dict[str, Any]:
+        """The noise rule (:func:`noise_knobs`) on the measured angles; stored as fitted
+        attributes and ``noise_rule_``."""
+        knobs, rule, est = self._rule_settings(data, getattr(self, "_refit_weight", 0.0))
         self._noise_weight = est["noise_weight"]
         if getattr(self, "_refit_weight", 0.0) > 0.0:
             rule += f"; {NOISY_REFIT_TEXT} {self._refit_weight:.3g}"
-        if ruled:
+        if getattr(self, "_weak_trial", False):
             rule += "; weak form: the open chain's form comparison (formulation_rule_)"
         if knobs["lhs"] == LHS_INPUT_TERMS:
             imap = np.abs(np.asarray(data.input_map)) > 0
@@ -2154,8 +2202,9 @@ class SINDyPI(_ImplicitMechanical):
         ``w`` in turn (0.25, 0.5, 0.75, 1: ridge, column cut-off and trim a quarter, half, ...
         of the way, geometrically, to the noisy rule's under the same chain, the tie band the
         clean chain's up to 0.75 and the noisy rule's ``ROLLOUT_ATOL`` at 1), the first that
-        fits kept and named in the rule text; if every one fails,
-        the first failure is raised with the last's reason.
+        fits kept and named in the rule text; a weight whose settings equal those of a fit
+        already tried (what the user fixed does not move: :meth:`_refit_ladder`) is not fitted
+        again; if every one fails, the first failure is raised with the last's reason.
 
         Why: the clean recipe's exact-data ridge (``RIDGE_EXACT``) leaves equations the record
         does not make unique to the round-off's choice; where that choice fails a fit-time
@@ -2182,7 +2231,7 @@ class SINDyPI(_ImplicitMechanical):
             first, clean_w = exc, self._noise_weight
         last = first
         try:
-            ladder = [w for w in REFIT_WEIGHTS if w > clean_w]
+            ladder, same = self._refit_ladder(data, start, clean_w)
             for w in ladder:
                 self.__dict__.clear()  # nothing a failed fit learned decides the refit's rules
                 self.__dict__.update(start)
@@ -2191,11 +2240,40 @@ class SINDyPI(_ImplicitMechanical):
                     return self._fit_recipe(data)
                 except IdentificationError as exc:
                     last = exc
+            skipped = (f"; {', '.join(f'{w:.3g}' for w in same)} change no setting the fit "
+                       "already tried: not fitted again" if same else "")
+            if not ladder:
+                raise IdentificationError(f"{first} (the clean recipe's fit failed; the noisy "
+                                          f"rule's weights{skipped[1:]})") from None
             tried = ", ".join(f"{w:.3g}" for w in ladder)
             raise IdentificationError(f"{first} (the clean recipe's fit failed and so did the "
-                                      f"noisy rule's weights {tried}; the last: {last})") from None
+                                      f"noisy rule's weights {tried}{skipped}; the last: "
+                                      f"{last})") from None
         finally:
             self._refit_weight = 0.0
+
+    def _refit_ladder(self, data: Measurement, start: dict[str, Any], clean_w: float
+                      ) -> tuple[list[float], list[float]]:
+        """The weights of ``REFIT_WEIGHTS`` above ``clean_w`` that :meth:`fit` fits again, and
+        those it skips: a weight whose rule settings (:func:`noise_knobs`, with the settings
+        the user fixed: ``start``, the instance before the first fit) equal those of a fit
+        already tried would repeat that fit (review 28d M2: with the user's ``ridge`` and
+        ``column_lowpass_hz`` the weights 0.25-0.75 move nothing, the tie band moves at 1)."""
+        seen = []
+        ladder, same = [], []
+        for w in [clean_w, *(w for w in REFIT_WEIGHTS if w > clean_w)]:
+            self.__dict__.clear()
+            self.__dict__.update(start)
+            knobs = self._rule_settings(data, w)[0]
+            if any(_same_settings(knobs, k) for k in seen):
+                same.append(w)
+            else:
+                seen.append(knobs)
+                if w != clean_w:
+                    ladder.append(w)
+        self.__dict__.clear()
+        self.__dict__.update(start)
+        return ladder, same
 
     def _fit_recipe(self, data: Measurement) -> SINDyPI:
         """One fit under the noise rule; data the noise rule took for exact whose fit leaves a

@@ -373,13 +373,33 @@ def noise_weight(noise_rel: float) -> float:
     return float(np.log(rel / CLEAN_NOISE_REL) / np.log(NOISY_NOISE_REL / CLEAN_NOISE_REL))
 
 
-def harmonic_gain(noise_rel: float) -> float:
-    """The zero-phase gain :func:`harmonic_cutoff` asks at the harmonic, from the relative noise.
+def harmonic_droop(noise_rel: float) -> float:
+    """The droop ``1 -`` gain that :func:`harmonic_cutoff` asks at the harmonic, from the
+    relative noise: ``CLEAN_DROOP^(1 - w) (1 - CUTOFF_GAIN)^w``, ``w`` = :func:`noise_weight`:
+    ``CLEAN_DROOP`` on clean angles, ``1 - CUTOFF_GAIN`` from ``NOISY_NOISE_REL`` up, geometric
+    between (the cut-off then moves by a constant factor per decade of noise).  Carried as a
+    droop, not a gain: ``1 - (1 - 1e-12)`` is 8.9e-5 relative off in double precision.
 
-    The droop ``1 - gain`` is ``CLEAN_DROOP^(1 - w) (1 - CUTOFF_GAIN)^w``, ``w`` =
-    :func:`noise_weight`: ``CLEAN_DROOP`` on clean angles, ``1 - CUTOFF_GAIN`` (exactly
-    ``CUTOFF_GAIN``) from ``NOISY_NOISE_REL`` up, geometric between (the cut-off then moves by a
-    constant factor per decade of noise).
+    Parameters
+    ----------
+    noise_rel : float
+        Relative noise, as :func:`noise_weight`.
+
+    Returns
+    -------
+    float
+        Droop in (0, 1).
+    """
+    w = noise_weight(noise_rel)
+    if w >= 1.0:
+        return float(1.0 - CUTOFF_GAIN)
+    return float(CLEAN_DROOP ** (1.0 - w) * (1.0 - CUTOFF_GAIN) ** w)
+
+
+def harmonic_gain(noise_rel: float) -> float:
+    """The zero-phase gain :func:`harmonic_cutoff` asks at the harmonic, from the relative noise:
+    ``1 -`` :func:`harmonic_droop` (exactly ``CUTOFF_GAIN`` from ``NOISY_NOISE_REL`` up).  Where
+    the droop is far below 1 pass :func:`harmonic_droop` itself (``harmonic_cutoff(droop=)``).
 
     Parameters
     ----------
@@ -391,14 +411,13 @@ def harmonic_gain(noise_rel: float) -> float:
     float
         Gain in (0, 1).
     """
-    w = noise_weight(noise_rel)
-    if w >= 1.0:
+    if noise_weight(noise_rel) >= 1.0:
         return CUTOFF_GAIN
-    return float(1.0 - CLEAN_DROOP ** (1.0 - w) * (1.0 - CUTOFF_GAIN) ** w)
+    return float(1.0 - harmonic_droop(noise_rel))
 
 
 def harmonic_cutoff(band_hz: float, order: int, harmonic: float = CUTOFF_HARMONIC,
-                    gain: float = CUTOFF_GAIN) -> float:
+                    gain: float = CUTOFF_GAIN, *, droop: float | None = None) -> float:
     """Lowest -3 dB cut-off of a zero-phase Butterworth that passes ``harmonic x band_hz``.
 
     The forward-backward filter's amplitude gain is ``1 / (1 + (f / fc)^(2 order))``; the
@@ -417,6 +436,10 @@ def harmonic_cutoff(band_hz: float, order: int, harmonic: float = CUTOFF_HARMONI
         Multiple of the band that must pass (>= 1).
     gain : float
         Least amplitude gain of the zero-phase filter there, in (0, 1).
+    droop : float, optional
+        ``1 - gain`` given as such, in (0, 1) (then ``gain`` is not read): ``1 / gain - 1`` is
+        taken as ``droop / (1 - droop)``, exact where the droop is far below 1
+        (:func:`harmonic_droop`).
 
     Returns
     -------
@@ -425,10 +448,17 @@ def harmonic_cutoff(band_hz: float, order: int, harmonic: float = CUTOFF_HARMONI
     """
     if not band_hz > 0:
         raise ValueError(f"band must be positive, got {band_hz}")
-    if int(order) < 1 or not harmonic >= 1 or not 0 < gain < 1:
-        raise ValueError(f"need order >= 1, harmonic >= 1, 0 < gain < 1; got {order}, "
-                         f"{harmonic}, {gain}")
-    return float(harmonic * band_hz / (1.0 / gain - 1.0) ** (1.0 / (2 * int(order))))
+    if droop is not None:
+        if not 0 < droop < 1:
+            raise ValueError(f"need 0 < droop < 1; got {droop}")
+        ratio = droop / (1.0 - droop)
+    else:
+        if not 0 < gain < 1:
+            raise ValueError(f"need 0 < gain < 1; got {gain}")
+        ratio = 1.0 / gain - 1.0
+    if int(order) < 1 or not harmonic >= 1:
+        raise ValueError(f"need order >= 1, harmonic >= 1; got {order}, {harmonic}")
+    return float(harmonic * band_hz / ratio ** (1.0 / (2 * int(order))))
 
 
 def lowpass_differentiate(x: np.ndarray, fs: float, cutoff_hz: float, order: int = 8,

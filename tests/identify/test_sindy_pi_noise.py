@@ -197,15 +197,17 @@ def test_clean_angles_through_a_declared_chain_get_the_chain_recipe(clean):
     # family's clean members lost their input terms or diverged, 13/30 within 0.0501 rad);
     # they take the chain's strong form, input-term LHS and rollout with the clean ends of its
     # continuous settings: ridge RIDGE_EXACT, columns a decade down at the chain's cut-off
-    # (order 4: 0.75 x 4 Hz), ties within the chain's clean droop (1e-10 x ROLLOUT_ATOL: the
-    # relative tie alone decides)
+    # (order 4: 0.75 x 4 Hz), ties within the droop this chain applied at the motion's second
+    # harmonic (4 Hz is the noisy rule's cut-off, not the clean one: review 28d M1)
     data = _chain_smoothed(clean, 0.0)
     knobs, rule, est = sp.noise_knobs(data.x, data.fs, 0.2, {}, None, data.noise_std,
                                       data.passband)
     assert est["noise_rel"] <= sp.NOISE_FREE_REL and "exact data" not in rule
     assert knobs["formulation"] == "strong"
     assert knobs["column_lowpass_hz"] == pytest.approx(4.0 / 10 ** (1 / 8))
-    assert knobs["ridge"] == sp.RIDGE_EXACT and knobs["rollout_atol"] == pytest.approx(1e-14, rel=1e-3, abs=0)
+    assert knobs["ridge"] == sp.RIDGE_EXACT
+    r = (2 * est["band_hz"] / 4.0) ** 16  # order-8 zero-phase Butterworth: gain 1 / (1 + r)
+    assert knobs["rollout_atol"] == pytest.approx(sp.ROLLOUT_ATOL * r / (1 + r) / 0.01, rel=1e-9)
     assert "clean angles, rates derived by a low-pass: strong form" in rule
     assert knobs["lhs"] == sp.LHS_INPUT_TERMS and knobs["selection"] == "rollout"
     # the noisy ends are the rule before, bit for bit: 1 % (and anything from NOISY_NOISE_REL)
@@ -238,7 +240,10 @@ def test_the_clean_chain_recipe_is_continuous_in_the_declared_noise(clean):
     stepped by 10 % from 1e-6 to 1e-2, no setting moves by more than its two ends' ratio
     times the weight's largest step (log(1.1) / log(100)), and each is monotone."""
     from testbed.numerics import derivatives as der
-    data = _chain_smoothed(clean, 0.0)
+    # a chain at the automatic clean cut-off's height (12 Hz on this 0.87 Hz band: droop 4e-14
+    # at 2 band, below the clean one): the tie band is then the automatic chain's at each
+    # level (a lower chain's own droop holds its foot flat: the test above)
+    data = _chain_smoothed(clean, 0.0, 12.0)
     std = data.x.std(axis=1)
     rels = np.exp(np.arange(np.log(1e-6), np.log(1e-2), np.log(1.1)))
     ks = [sp.noise_knobs(data.x, data.fs, 0.2, {}, None, r * std, data.passband)[0]
@@ -250,6 +255,28 @@ def test_the_clean_chain_recipe_is_continuous_in_the_declared_noise(clean):
         assert np.max(np.abs(np.diff(v))) <= span * step * 1.01 + 1e-12, key
         assert np.all(np.diff(v) >= -1e-12) or np.all(np.diff(v) <= 1e-12), key
     assert ks[0]["ridge"] == sp.RIDGE_EXACT and ks[-1]["rollout_atol"] == sp.ROLLOUT_ATOL
+
+
+def test_the_clean_tie_band_follows_the_droop_the_chain_applied(clean):
+    """Review 28d M1: on clean angles the rollout tie band is the droop the declared chain
+    applied at the motion's second harmonic x ``ROLLOUT_ATOL`` / 1 %, not the droop the
+    automatic chain would have asked.  The same clean angles with the chain's cut-off as a
+    user might set it: 4 Hz (the noisy rule's, droop ~1e-6 here) and 6 Hz tie within that
+    droop, the lower cut-off wider; a cut-off above the automatic clean one (20 Hz, droop
+    ~1e-17) keeps the clean chain's 1e-14 rad (the automatic chain's droop at this noise, the
+    floor); a cut-off at the band's second harmonic (droop 1/2) at most ``ROLLOUT_ATOL``."""
+    atol = {}
+    for cut in (1.7, 4.0, 6.0, 20.0):
+        data = _chain_smoothed(clean, 0.0, cut)
+        knobs, _, est = sp.noise_knobs(data.x, data.fs, 0.2, {}, None, data.noise_std,
+                                       data.passband)
+        assert est["noise_weight"] == 0.0
+        r = (2 * est["band_hz"] / cut) ** 16
+        atol[cut] = knobs["rollout_atol"]
+        assert atol[cut] == pytest.approx(
+            min(sp.ROLLOUT_ATOL, max(sp.ROLLOUT_ATOL * r / (1 + r) / 0.01, 1e-14)), rel=1e-9)
+    assert atol[1.7] == sp.ROLLOUT_ATOL > atol[4.0] > 100 * atol[6.0] > atol[20.0]
+    assert atol[20.0] == pytest.approx(1e-14, rel=1e-9)
 
 
 def test_a_step_input_holds_the_clean_columns_down_and_a_smooth_one_does_not(clean):
@@ -314,6 +341,36 @@ def test_a_failed_clean_recipe_fit_is_done_again_nearest_the_clean_recipe_first(
     with pytest.raises(IdentificationError, match=r"^failed at 0.0$"):
         SINDyPI().fit(_chain_smoothed(clean, 1.0))
     assert calls == [0.0]
+
+
+def test_the_refit_skips_the_weights_that_change_no_setting(clean, monkeypatch):
+    """Review 28d M2: with the user's ``ridge`` and ``column_lowpass_hz`` the weights 0.25-0.75
+    change no setting of the clean recipe (its tie band moves only at weight 1): a failed clean
+    fit is fitted again once, at 1, not three times the same; where weight 1 changes nothing
+    either (a chain whose own droop already gives ``ROLLOUT_ATOL``), the first failure is
+    raised after one fit.  The rule alone (``ridge`` without the cut-off) keeps every step."""
+    calls = []
+
+    def fails(self, d):  # the recipe's settings only: what the ladder decides (no fit's cost)
+        calls.append(self._refit_weight)
+        self._choose_knobs(d)
+        raise IdentificationError(f"failed at {self._refit_weight}")
+
+    monkeypatch.setattr(SINDyPI, "_fit_recipe", fails)
+    user = dict(ridge=1e-8, column_lowpass_hz=3.0)
+    with pytest.raises(IdentificationError,
+                       match=r"weights 1; 0.25, 0.5, 0.75 change no setting .*: failed at 1.0\)$"):
+        SINDyPI(**user).fit(_chain_smoothed(clean, 0.0))
+    assert calls == [0.0, 1.0]
+    calls.clear()
+    with pytest.raises(IdentificationError, match=r"^failed at 0.0 \(the clean recipe's fit "
+                                                  r"failed; the noisy rule's weights 0.25, 0.5"):
+        SINDyPI(**user).fit(_chain_smoothed(clean, 0.0, 1.7))
+    assert calls == [0.0]
+    calls.clear()
+    with pytest.raises(IdentificationError):
+        SINDyPI(ridge=1e-8).fit(_chain_smoothed(clean, 0.0))
+    assert calls == [0.0, 0.25, 0.5, 0.75, 1.0]
 
 
 def test_declared_chain_rollout_selection_is_overridden_by_the_user(clean):

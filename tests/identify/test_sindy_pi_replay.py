@@ -126,6 +126,42 @@ def test_no_eligible_model_is_a_typed_error():
     assert issubclass(NoModelError, IdentificationError)
 
 
+def _sweep_of(rows, errs, candidates):
+    """A one-threshold Sweep of the given normalised equations (rows) and held-out errors."""
+    W = np.array(rows, dtype=float)[None]
+    return Sweep(scale=np.ones(W.shape[2]), candidates=np.array(candidates),
+                 thresholds=np.array([0.0]), W=W, val_error=np.array([errs], dtype=float),
+                 train_error=np.array([errs], dtype=float), nnz=np.count_nonzero(W, axis=2))
+
+
+@pytest.mark.parametrize("share_1", [0.967, 1.059])
+def test_a_near_tie_of_input_shares_is_eligible_for_both_inputs(share_1):
+    """Session 29 (pi34): a dense equation that mixes both inputs' equations carried input 1's
+    terms at 0.967 of input 2's share under one BLAS kernel and 1.059 under another (round 20's
+    fb20_ms_short_cranks, clean: 1.8e-6 against 1.2e-4 rad).  Within the tie ``rtol`` it is
+    eligible for either input, so input 2's pick (the mix, held-out error at the round-off
+    floor, against a sparse equation 1e-9 off) does not depend on which side of 1 the
+    round-off put the ratio; input 1 keeps its sparse exact equation (parsimony)."""
+    cols = [np.array([2]), np.array([3])]  # input 1's term: column 2; input 2's: column 3
+    rows = [[1, 0, 1, 0, 0],               # input 1's equation
+            [0, 1, share_1, 1, 0.3],       # the mix, written on column 1
+            [0, 0, 0, 0.8, 1]]             # input 2's sparse equation, farther held out
+    sw = _sweep_of(rows, [1e-14, 1e-14, 1e-9], [0, 1, 4])
+    assert select_models(sw, cols) == [[(0, 0)], [(0, 1)]]
+
+
+def test_one_equation_is_not_picked_for_two_inputs():
+    """The mix eligible for both inputs and the best held out for input 1 is input 1's pick;
+    input 2 then takes its next eligible equation, and without one it has none (a typed
+    error), never the same equation twice."""
+    cols = [np.array([2]), np.array([3])]
+    sw = _sweep_of([[0, 1, 1.059, 1, 0.3], [0, 0, 0, 0.8, 1]], [1e-14, 1e-9], [1, 4])
+    assert select_models(sw, cols) == [[(0, 0)], [(0, 1)]]
+    alone = _sweep_of([[0, 1, 1.059, 1, 0.3]], [1e-14], [1])
+    with pytest.raises(NoModelError, match=r"input 2 .*earlier input"):
+        select_models(alone, cols)
+
+
 def test_cartpole_with_a_barely_excited_pole_gets_its_equations(dataset_cache):
     """benchmarks/unseen/unseen_other.toml, cartpoles__000 (3.8 kg cart, 64 g pole), clean: the
     fit ends with the exact pair on every CPU, by the replay rule where the held-out choice does

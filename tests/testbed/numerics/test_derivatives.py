@@ -137,6 +137,29 @@ def test_the_clean_cutoff_factor_is_the_droops():
         assert der.harmonic_gain(rel) == der.CUTOFF_GAIN
 
 
+def test_the_clean_droop_is_carried_as_a_droop():
+    """Review 28d L7: ``1 - (1 - 1e-12)`` is 8.9e-5 relative off in double precision, so the
+    clean droop is carried as such: ``harmonic_droop(0)`` is ``CLEAN_DROOP`` to the last bit
+    and ``harmonic_cutoff(droop=)`` is ``2 B / (d / (1 - d))^(1 / (2 n))`` to round-off (the
+    gain's route is ~5e-6 relative off there: 8.9e-5 / 16); from ``NOISY_NOISE_REL`` up the
+    droop is ``1 - CUTOFF_GAIN`` and both routes give the noisy cut-off."""
+    d = der.harmonic_droop(0.0)
+    assert d == der.CLEAN_DROOP
+    assert abs((1 - der.harmonic_gain(0.0)) / d - 1) > 1e-6  # what the gain loses
+    want = 2 * 1.5 / (d / (1 - d)) ** (1 / 16)
+    assert der.harmonic_cutoff(1.5, 8, droop=d) == pytest.approx(want, rel=1e-14)
+    assert der.harmonic_cutoff(1.5, 8, gain=der.harmonic_gain(0.0)) != pytest.approx(want, rel=1e-7)
+    for rel in (der.NOISY_NOISE_REL, 0.5, np.nan):
+        assert der.harmonic_droop(rel) == 1 - der.CUTOFF_GAIN
+        assert der.harmonic_cutoff(1.5, 8, droop=der.harmonic_droop(rel)) == pytest.approx(
+            der.harmonic_cutoff(1.5, 8), rel=1e-14)
+    mid = np.sqrt(der.CLEAN_NOISE_REL * der.NOISY_NOISE_REL)
+    assert der.harmonic_droop(mid) == pytest.approx(np.sqrt(der.CLEAN_DROOP * 0.01), rel=1e-12)
+    for bad in (0.0, 1.0, -1e-3, np.nan):
+        with pytest.raises(ValueError, match="droop"):
+            der.harmonic_cutoff(1.5, 8, droop=bad)
+
+
 def test_the_noise_weight_is_continuous_and_monotone_in_the_noise():
     """No switch: on a grid of relative noise 1e-8..1 with neighbours 0.5 % apart the weight
     never falls and never moves by more than its log-linear slope allows (one grid step of

@@ -432,6 +432,17 @@ def test_zero_phase_gain_is_the_lowpass_response():
         assert amp == pytest.approx(sig.zero_phase_gain(f, fc, 8), abs=1e-4), f
 
 
+def test_zero_phase_droop_keeps_what_one_minus_the_gain_rounds_away():
+    """``zero_phase_droop`` is ``1 - zero_phase_gain`` where that is exact, and keeps a droop far
+    below the double's resolution of 1: a decade below an order-8 cut-off it is
+    ``10^-16 / (1 + 10^-16)``, where ``1 - gain`` rounds to 0."""
+    f = np.array([0.0, 2.0, 4.0, 8.0, 40.0])
+    np.testing.assert_allclose(sig.zero_phase_droop(f, 4.0, 8), 1 - sig.zero_phase_gain(f, 4.0, 8),
+                               rtol=1e-12, atol=0)
+    assert 1 - sig.zero_phase_gain(np.array([0.4]), 4.0, 8)[0] == 0.0
+    assert sig.zero_phase_droop(np.array([0.4]), 4.0, 8)[0] == pytest.approx(1e-16, rel=1e-12)
+
+
 def test_chain_mismatch_share_rises_with_the_column_cutoff_and_reads_steps():
     """The share never falls as the column cut-off rises; a step input's is orders above a
     multisine's at the clean column cut-off (0.75 x a 6.85 Hz chain): the steps carry the

@@ -174,7 +174,8 @@ def test_auto_cutoff_counts_an_encoders_quantisation_as_noise(bits):
     (review 27d: 0.50 -> 1.27 % at 12 bits).  The encoder's rounding, ``q / sqrt 12``, is
     counted (:func:`testbed.numerics.noise.record_noise_std`): the cut-off must be the float
     record's at that declared noise within the spectrum's resolution, and the accelerations
-    derived with it within 2 % of the truth's RMS.  Measured 0.50 / 0.085 % (12 / 14-bit);
+    derived with it within 2 % of the truth's RMS.  Measured 0.50 / 0.038 % (12 / 14-bit; cut-off
+    4.80 Hz both, session 29);
     white quantisation noise through the low-pass predicts 0.13 / 0.033 %
     (lowpass_differentiate's Notes), but the rounding error of a slow motion is not white, so
     the bound is 4 x the 12-bit figure."""
@@ -198,7 +199,8 @@ def test_auto_cutoff_does_not_depend_on_the_records_length():
     """Review 24d: the clean-record rule's band end came from summation round-off (the power
     left above a frequency as a difference of 1e7-sized sums) and gave 112 / 199 / 442 Hz on
     the full / half / quarter of one clean record.  The cut-off must agree within the
-    quarter's spectral resolution (here 4.80 / 4.80 / 5.33 Hz; the step 1.07 Hz)."""
+    quarter's spectral resolution (here 20.24 / 20.24 / 22.49 Hz with the clean droop, the step
+    4.50 Hz; 4.80 / 4.80 / 5.33 Hz and 1.07 Hz with the 99 % rule before session 28)."""
     fs = 1e4
     th = _multisine(fs)
     n = th.shape[1]
@@ -223,7 +225,8 @@ def test_auto_cutoff_on_the_down_branch_multisine_near_clean(dataset_cache):
     4500 Hz (its clean angles: 111 Hz; half / quarter of them 186 / 285 Hz) and the fit failed
     ("every candidate model's reduced inertia vanishes").  The measured and the engine's clean
     angles, and the first half and quarter of the clean ones, must get one cut-off within the
-    quarter's spectral resolution (4.27 Hz each, measured)."""
+    quarter's spectral resolution of the 99 % rule (17.99 Hz each, measured in session 29 with
+    the clean droop; 4.27 Hz each with the 99 % rule)."""
     sc = testbed.load_scenario(UNSEEN / "round22" / "fb22_ms_down.toml")
     # the cache's clean simulation, shared with tests/identify/test_sindy_pi_held_input.py
     # (bit-identical to testbed.generate: testbed/pipeline/cache.py)
