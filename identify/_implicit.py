@@ -429,7 +429,8 @@ def select_models(sw: Sweep, input_cols: Sequence[np.ndarray], rtol: float = 0.1
     equation on input 2's term carried input 1's at 0.967 of input 2's share under OpenBLAS's
     Haswell kernel and 1.059 under SkylakeX: eligible on one machine only, 1.8e-6 against
     1.2e-4 rad).  The first pick of an earlier input is not offered again (the same equation up
-    to scale, ``PARALLEL_RTOL``), so the equations picked for different inputs stay distinct.
+    to scale, ``PARALLEL_RTOL``), so the inputs' first picks stay distinct (an equation
+    further down one input's list may still stand in another's).
     They are ranked by
     :func:`rank_models`, by their held-out error (``sw.val_error``, per unit of the left-hand
     side) or, where ``G_val`` is given, per unit of the input's part (:func:`input_errors`;
@@ -444,6 +445,7 @@ def select_models(sw: Sweep, input_cols: Sequence[np.ndarray], rtol: float = 0.1
     rtol : float
         Relative tolerance on the held-out error; 0.1 because the held-out residual of models
         differing by noise-level terms varies by about that much between validation windows.
+        Also the tie of two inputs' shares in one equation (above).
     atol : float
         Absolute floor of the normalised squared residual: 1e-12 (a relative residual norm
         of 1e-6) is where the Gram-based residual of an exact model loses its digits.

@@ -175,7 +175,7 @@ def backbone_cubic(model: StructuralIdentifier, data: Measurement, peaks: np.nda
 
 
 def mode_cubic(model: StructuralIdentifier, data: Measurement, peaks: np.ndarray,
-               fitted_map: np.ndarray | None
+               fitted_map: np.ndarray | None, a_old: float | None = None
                ) -> tuple[np.ndarray | None, np.ndarray | None, str]:
     """A fitted cubic model's cubic replaced by one on its lowest located mode alone, sized by
     output error, where that explains more of the record.
@@ -217,10 +217,15 @@ def mode_cubic(model: StructuralIdentifier, data: Measurement, peaks: np.ndarray
     data : Measurement
         The record it was fitted on.
     peaks : ndarray, shape (p,)
-        Accepted spectral peaks [Hz] in the fit's domain, as :func:`backbone_cubic` takes them.
+        Accepted spectral peaks [Hz] as the caller holds them (``ls_sindy`` passes its held
+        peaks, on a trapezoid record 2e-5 relative off the measured ones, far inside the
+        pairing's :data:`identify.structural.MODE_SEPARATION`).
     fitted_map : ndarray, shape (n, n_inputs), or None
         The regression's fitted input map before step 6 judged it; None where the regression
         fitted none (the model's own map, the data's or None, is then the only one tried).
+    a_old : float, optional
+        The model's own record agreement [-] where the caller has it (``ls_sindy``'s step 6
+        computed it for the model as it stands: not simulated again); computed when None.
 
     Returns
     -------
@@ -261,7 +266,7 @@ def mode_cubic(model: StructuralIdentifier, data: Measurement, peaks: np.ndarray
         new.input_map_ = B
         return new
 
-    a_old = record_agreement(model, data)[0]
+    a_old = record_agreement(model, data)[0] if a_old is None else a_old
     tried = [(name, B, *best_scale(lambda s, B=B: record_agreement(candidate(s, B), data)[0]))
              for name, B in maps]
     # the higher agreement (NaN lowest); within AGREEMENT_TIE, the first tried (no map)

@@ -646,7 +646,7 @@ class LeastSquaresSINDy(StructuralIdentifier):
         simulations from the record's start with their start fits (a cubic model's RK4 about
         0.9 s each on the shipped soft base's 25,600 samples; a linear one's 0.03-0.07 s).
         """
-        self._fitted_map = None
+        self._fitted_map = self._step6_agreement = None
         if not getattr(self, "input_map_fitted_", False):
             self.input_map_rule_ = ("no input column in the regression (the fit window holds "
                                     "no input): data.input_map")
@@ -655,10 +655,14 @@ class LeastSquaresSINDy(StructuralIdentifier):
             self.input_map_rule_ = ("fitted on the window; kept (a record with no free window: "
                                     "the input drives the whole record)")
             return
-        # the fitted map and its coef_ columns, for step 4d to judge beside its own cubic
-        self._fitted_map = (np.array(self.input_map_, dtype=float), self.coef_.copy())
+        # the fitted map and its coef_ input columns, for step 4d to judge beside its own cubic
+        cols = getattr(self, "_input_columns", None)
+        self._fitted_map = (np.array(self.input_map_, dtype=float),
+                            None if cols is None or cols.size != self.coef_.shape[1]
+                            else self.coef_[:, cols].copy())
         a_fit, note_fit = record_agreement(self, data)
         drop, a_none, figures = without_input_map(self, data, a_fit, note_fit, INPUT_DROP_RATIO)
+        self._step6_agreement = a_none if drop else a_fit  # the kept model's, for step 4d
         if drop:
             cols = getattr(self, "_input_columns", None)
             if cols is not None and cols.size == self.coef_.shape[1]:
@@ -818,23 +822,24 @@ class LeastSquaresSINDy(StructuralIdentifier):
         error, with the regression's input map or none, where that explains more of the
         record.  ``coef_``'s cubic and input columns follow; ``mode_cubic_rule_`` says what was
         done with both record agreements, or why not."""
-        self.mode_cubic_rule_ = "not tried (a linear model, or cubic set by the user)"
+        self.mode_cubic_rule_ = ("not tried (a linear library, step 4c's cubic included, or "
+                                 "cubic set by the user)")
+        fitted = self.__dict__.pop("_fitted_map", None)
+        a_old = self.__dict__.pop("_step6_agreement", None)
+        # a library with no cubic block: linear, or step 4c's cubic (which only a linear fit gets)
         if self.cubic is not None or self.K3_ is None or getattr(self, "_c_block", None) is None:
             return
-        if not self.backbone_cubic_rule_.startswith("not tried"):
-            self.mode_cubic_rule_ = "not tried (step 4c's cubic)"
-            return
-        fitted = getattr(self, "_fitted_map", None)
         K3, B, self.mode_cubic_rule_ = mode_cubic(
-            self, data, self._held_peaks(data, peaks), None if fitted is None else fitted[0])
+            self, data, self._held_peaks(data, peaks), None if fitted is None else fitted[0],
+            a_old=a_old)
         if K3 is None:
             return
         m = np.diag(self.M_)[:, None]
         self.coef_ = self.coef_.copy()
         self.coef_[:, self._c_block] = -K3 / m
         cols = getattr(self, "_input_columns", None)
-        if fitted is not None and cols is not None and cols.size == self.coef_.shape[1]:
-            self.coef_[:, cols] = fitted[1][:, cols] if np.any(B) else 0.0
+        if fitted is not None and fitted[1] is not None:
+            self.coef_[:, cols] = fitted[1] if np.any(B) else 0.0
             which = "with the fitted input map" if np.any(B) else "with no input map"
             self.input_map_rule_ += f"; step 4d's cubic {which}"
         self.K3_, self.input_map_ = K3, B

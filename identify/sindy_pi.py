@@ -199,9 +199,10 @@ def chain_droop(band_hz: float, chain_cutoff_hz: float) -> float:
     the zero-phase gain of an order-``CHAIN_ORDER`` Butterworth with the chain's cut-off
     ``chain_cutoff_hz`` [Hz] at ``CUTOFF_HARMONIC x band_hz`` [Hz]
     (:func:`testbed.numerics.filters.zero_phase_droop`).  The chain's automatic cut-off
-    applies the droop it asked (:func:`testbed.numerics.derivatives.harmonic_droop`; the
-    band here is read on the smoothed angles, the chain's on the raw ones: alike on clean
-    angles); a user's ``cutoff_hz`` applies its own.  The measurement declares the pass band,
+    applies about the droop it asked (:func:`testbed.numerics.derivatives.harmonic_droop`,
+    to 9e-5 relative: the chain asks it as a gain, ``1 - droop``; the band here is read on the
+    smoothed angles, the chain's on the raw ones: alike on clean angles); a user's
+    ``cutoff_hz`` applies its own.  The measurement declares the pass band,
     not the order (``CHAIN_ORDER``, as :func:`input_column_cutoff`)."""
     return float(zero_phase_droop(CUTOFF_HARMONIC * float(band_hz), float(chain_cutoff_hz),
                                   CHAIN_ORDER))

@@ -153,7 +153,7 @@ def test_a_near_tie_of_input_shares_is_eligible_for_both_inputs(share_1):
 def test_one_equation_is_not_picked_for_two_inputs():
     """The mix eligible for both inputs and the best held out for input 1 is input 1's pick;
     input 2 then takes its next eligible equation, and without one it has none (a typed
-    error), never the same equation twice."""
+    error), never the same first pick twice."""
     cols = [np.array([2]), np.array([3])]
     sw = _sweep_of([[0, 1, 1.059, 1, 0.3], [0, 0, 0, 0.8, 1]], [1e-14, 1e-9], [1, 4])
     assert select_models(sw, cols) == [[(0, 0)], [(0, 1)]]
