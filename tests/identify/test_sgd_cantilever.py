@@ -302,6 +302,11 @@ def test_a_diverging_cubic_whose_warm_start_is_not_simulated_is_refused_for_the_
     assert not model.cubic_  # the linear library; its only cubic is step 4c's, on mode 1
     assert "moved to its limit, with a cubic on that mode alone" in model.backbone_cubic_rule_
     assert np.linalg.matrix_rank(model.K3_) == 1
+    # review 29c M1: the record rule states the moved model's own agreement (0.9945), not the
+    # keep rule's of the unmoved one (0.9954); the input map kept, so the delivered model is it
+    assert "; rule: kept," in model.input_map_rule_
+    a_moved, _ = sgd_module.record_agreement(model, data)  # (0.2 s: one linear-plus-cubic run)
+    assert f"(TRAC) {a_moved:.4g} >=" in model.record_rule_
     v = score_structural(ds, data, measure(noise_free(ds), sc.signal, "structural"), model).values
     # the round's bars (the families': TRAC and MAC of modes 1-2 > 0.90, modes 1-2 within 2.6
     # %); the old code: TRAC NaN
