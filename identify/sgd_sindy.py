@@ -77,7 +77,7 @@ from identify._sgd_matrix import (
     kept_cubic,
 )
 from identify._structural_backbone import backbone_cubic
-from identify.ls_sindy import INPUT_DROP_RATIO, MASS_PRIOR_FIELD
+from identify.ls_sindy import CUBIC_TRIAL_RATIO, INPUT_DROP_RATIO, MASS_PRIOR_FIELD
 from identify.structural import (
     DECAY_BACKBONE_FIELD,
     DECAY_HOLD_FIELD,
@@ -1153,11 +1153,10 @@ class SGDSINDy(SGDSINDyBase):
         """
         # one default peak search for every refit of this record (and the cubic's trial fit)
         self._fit_with(data, self._default_search(data))
-        self._backbone_cubic(data)
-        self._choose_input_map(data)
+        self._choose_input_map(data, self._backbone_cubic(data))
         return self
 
-    def _backbone_cubic(self, data: Measurement) -> None:
+    def _backbone_cubic(self, data: Measurement) -> tuple[float, str] | None:
         """``ls_sindy``'s step 4c on the kept model (:func:`identify._structural_backbone.
         backbone_cubic`, called as it is): the lowest mode moved to its read backbone limit with
         a cubic on that mode alone sized by output error, where the record calls for it (that
@@ -1187,31 +1186,55 @@ class SGDSINDy(SGDSINDyBase):
         linear library has no cubic column; a cubic library's zero block takes ``-K3 / m``),
         ``coef_``'s displacement block follows ``K_``, and ``natural_frequencies_``,
         ``modes_`` follow the moved model.  The keep rule's record agreements
-        (``record_agreement_``) stay the unmoved models'; the input map's choice
-        (:meth:`_choose_input_map`) simulates the moved one.
+        (``record_agreement_``) stay the unmoved models'; ``record_rule_`` is stated again on
+        the moved model's agreement (review 29c M1), which the input map's choice
+        (:meth:`_choose_input_map`) reads.  The margin is ``ls_sindy``'s,
+        :data:`identify.ls_sindy.CUBIC_TRIAL_RATIO` (review 29c L4).
+
+        Returns
+        -------
+        (float, str) or None
+            The moved model's record agreement [-] and its note
+            (:func:`identify._record.record_agreement`); None where nothing moved.
         """
         self.backbone_cubic_rule_ = ("not tried (a cubic model, or the cubic terms not the "
                                      "data's to select: cubic = false, or true with l1 = 'none')")
-        if ((self.K3_ is not None and np.any(self.K3_ != 0.0))
-                or not (self.cubic is None or (self.cubic and self.l1 == "cubic"))):
-            return
+        if kept_cubic(self.K3_) or not self._cubic_is_the_datas():
+            return None
         if not (self.decay_hold and self.decay_backbone):
             self.backbone_cubic_rule_ = "not tried (decay_hold and decay_backbone needed)"
-            return
+            return None
         peaks = np.asarray(getattr(self, "peaks_", np.empty(0)), dtype=float)
-        K, K3, self.backbone_cubic_rule_ = backbone_cubic(self, data, peaks)
+        K, K3, self.backbone_cubic_rule_ = backbone_cubic(self, data, peaks, CUBIC_TRIAL_RATIO)
         if K is None:
-            return
+            return None
         m = np.diag(self.M_)[:, None]
-        blocks = build_library(data, coupled_mass=True, cubic=bool(self.cubic_)).blocks
-        self.coef_[:, blocks["d"]] -= (K - self.K_) / m
-        if K3 is not None and "c" in blocks:  # a cubic library whose every term was dropped
-            self.coef_[:, blocks["c"]] = -K3 / m
-        self.K_, self.K3_ = K, K3
+        self._set_stiffness(K, m)
+        if K3 is not None and self._c_block is not None:  # a cubic library, every term dropped
+            self.coef_[:, self._c_block] = -K3 / m
+        self.K3_ = K3
         self.natural_frequencies_, self.modes_ = modal(self.M_, self.K_)
-        self._backbone_moved = True  # the keep rule's agreements are the unmoved model's
+        # the keep rule's agreement described the unmoved model: the moved one's, simulated
+        # as the scorer does (identify._record.record_agreement), states record_rule_
+        a_new, note = record_agreement(self, data)
+        self.record_rule_ = record_rule(a_new, self.M_, self.C_, self.K_) + (
+            "" if np.isfinite(a_new) else f" (after the backbone step: {note})")
+        return a_new, note
 
-    def _choose_input_map(self, data: Measurement) -> None:
+    def _cubic_is_the_datas(self) -> bool:
+        """Whether the cubic terms are the data's to select: ``cubic`` None (the cubic rule's
+        choice) or ``cubic`` true with ``l1 = 'cubic'`` (the lasso's); ``cubic`` true with
+        ``l1 = 'none'`` asks for the cubic model itself (review 25e), ``cubic`` false for none."""
+        return self.cubic is None or (bool(self.cubic) and self.l1 == "cubic")
+
+    def _set_stiffness(self, K: np.ndarray, m: np.ndarray) -> None:
+        """Replace ``K_`` by ``K`` [N/m], shape (n, n), and ``coef_``'s displacement block
+        with it (``m`` [kg], shape (n, 1): the diagonal masses ``coef_`` divides by)."""
+        self.coef_[:, self._d_block] -= (K - self.K_) / m
+        self.K_ = K
+
+    def _choose_input_map(self, data: Measurement, moved: tuple[float, str] | None = None
+                          ) -> None:
         """The kept model's input map dropped only where the model explains its record clearly
         better without it (``ls_sindy``'s step 6, its :data:`identify.ls_sindy.INPUT_DROP_RATIO`),
         stated in ``input_map_rule_``.
@@ -1241,8 +1264,14 @@ class SGDSINDy(SGDSINDyBase):
         iterations), and the model with it too unless the keep rule measured its agreement
         with the same iterations (read then); a linear model's simulation is exact, a cubic's
         by RK4 (about 0.9 s each on the shipped soft base's 25,600 samples).
+
+        Parameters
+        ----------
+        data : Measurement
+        moved : (float, str), optional
+            The model's record agreement [-] and note where :meth:`_backbone_cubic` moved it
+            (measured there on the moved model; the keep rule's are the unmoved model's).
         """
-        moved = self.__dict__.pop("_backbone_moved", False)
         B = getattr(self, "input_map_", None)
         if B is None or data.u is None:
             self.input_map_rule_ = getattr(self, "input_map_rule_", "") + (
@@ -1255,12 +1284,12 @@ class SGDSINDy(SGDSINDyBase):
             return
         measured = getattr(self, "record_agreement_", None)
         # the keep rule's comparison measured the kept model with the scorer's iterations
-        # (the floor check alone takes one): read, not simulated again
-        # (not after the backbone step moved the model: they are the unmoved model's)
-        a_fit = (self._kept_agreement() if isinstance(measured, dict) and "warm_start" in measured
-                 and not moved else float("nan"))
-        note_fit = ""
-        if not np.isfinite(a_fit):
+        # (the floor check alone takes one): read, not simulated again; after the backbone
+        # step, the moved model's, measured there
+        a_fit, note_fit = (moved if moved is not None else
+                           (self._kept_agreement(), "") if isinstance(measured, dict)
+                           and "warm_start" in measured else (float("nan"), ""))
+        if moved is None and not np.isfinite(a_fit):
             a_fit, note_fit = record_agreement(self, data)
         drop, a_none, figures = without_input_map(self, data, a_fit, note_fit, INPUT_DROP_RATIO)
         if drop:
@@ -1289,8 +1318,7 @@ class SGDSINDy(SGDSINDyBase):
         # the doubt compares the libraries where the cubic terms are the data's to select (by
         # rule, or cubic = true with the lasso on them); cubic = true with l1 = 'none' asks for
         # the cubic model itself, which is kept (review 25e)
-        chosen_by_data = self.cubic is None or self.l1 == "cubic"
-        doubt = "" if why or not chosen_by_data else self._cubic_contradicts_decay()
+        doubt = "" if why or not self._cubic_is_the_datas() else self._cubic_contradicts_decay()
         if why:
             # A cubic model that neither the SGD nor its warm start can run from the record's
             # own start is refused and the linear library fitted (ls_sindy's step 4 (b)):
@@ -1867,6 +1895,7 @@ class SGDSINDy(SGDSINDyBase):
         xa = -M / m
         np.fill_diagonal(xa, 0.0)
         coef[:, bl["a"]], coef[:, bl["v"]], coef[:, bl["d"]] = xa, -C / m, -K / m
+        self._d_block, self._c_block = bl["d"], bl.get("c")
         if K3 is not None:
             coef[:, bl["c"]] = -K3 / m
         self.coef_, self.feature_names_ = coef, lib.names
@@ -1885,7 +1914,7 @@ class SGDSINDy(SGDSINDyBase):
             np.linalg.cholesky(M)
         except np.linalg.LinAlgError:
             raise IdentificationError("identified M is not positive definite (L L^T lost rank)") from None
-        self._hold_decay(data, est, m, bl["v"], bl["d"], out.eigen_cross)  # before the trapezoid map
+        self._hold_decay(data, est, m, bl["v"], out.eigen_cross)  # before the trapezoid map
         self._finish_fit(data)
 
     def _unlocated(self) -> np.ndarray | None:
@@ -1904,7 +1933,7 @@ class SGDSINDy(SGDSINDyBase):
         return t if t.size == self.M_.shape[0] and np.any(t > 0) else None
 
     def _hold_decay(self, data: Measurement, est: MatrixSGDSettings, m: np.ndarray,
-                    v_block: slice, d_block: slice, cross: np.ndarray | None = None) -> None:
+                    v_block: slice, cross: np.ndarray | None = None) -> None:
         """With ``decay_hold``, give each mode the pole of its measured free decay
         (:mod:`identify._modal_damping`) on the fitted model, before :meth:`_finish_fit`: its
         damping always, its frequency when that lies within one line (``fs / N``) of the
@@ -1917,8 +1946,8 @@ class SGDSINDy(SGDSINDyBase):
             The fit's settings (its window).
         m : ndarray, shape (n, 1)
             Diagonal masses [kg] that ``coef_`` divides by.
-        v_block, d_block : slice
-            The velocity and displacement columns of ``coef_``.
+        v_block : slice
+            The velocity columns of ``coef_`` (the displacement's: ``_d_block``).
         cross : ndarray, shape (n,), optional
             The cross stiffening [rad^2/s^2] the eigenvalue targets were lowered by
             (``MatrixSGDResult.eigen_cross``, ascending modes).  A mode's measured decay rings
@@ -1946,8 +1975,8 @@ class SGDSINDy(SGDSINDyBase):
         if held.decay is not None:
             self.modal_decay_ = held.decay
         self.coef_[:, v_block] -= (held.C - self.C_) / m
-        self.coef_[:, d_block] -= (held.K - self.K_) / m
-        self.C_, self.K_ = held.C, held.K
+        self._set_stiffness(held.K, m)
+        self.C_ = held.C
         self.decay_rule_ = held.rule
         if lowered:
             self.decay_rule_ += (f"; modes {lowered}' decay frequencies less the cross stiffening "

@@ -385,8 +385,7 @@ FREE_GAIN_PERIODS = 5.0
 
 
 def free_decay_fit(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndarray,
-                   K3: np.ndarray | None, j: int, lam: np.ndarray | None = None
-                   ) -> tuple[np.ndarray, np.ndarray] | None:
+                   K3: np.ndarray | None, j: int) -> tuple[np.ndarray, np.ndarray] | None:
     """The input gain ``g = M^-1 B[:, j]`` that best explains the free decay after the pulse,
     with its covariance.
 
@@ -414,9 +413,6 @@ def free_decay_fit(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndarra
         The fitted cubic stiffness [N/m^3] (None: a linear model).
     j : int
         The input (row of ``data.u``) at the driving point.
-    lam : ndarray, shape (n,), optional
-        The eigenvalues of ``(K, M)`` [rad^2/s^2] where the caller has them
-        (:func:`driving_point_scaling`: not computed twice); None: computed here.
 
     Returns
     -------
@@ -430,7 +426,7 @@ def free_decay_fit(data: Measurement, M: np.ndarray, C: np.ndarray, K: np.ndarra
         oscillating mode or the fit is not finite.
     """
     n = M.shape[0]
-    w2 = np.linalg.eigvals(np.linalg.solve(M, K)).real if lam is None else np.asarray(lam, float)
+    w2 = np.linalg.eigvals(np.linalg.solve(M, K)).real
     if not np.all(np.isfinite(w2)) or not np.any(w2 > 0) or data.u is None:
         return None
     period = 2 * np.pi / np.sqrt(w2[w2 > 0].min())
@@ -480,6 +476,18 @@ def correlation_factor(r: np.ndarray) -> float:
     the shipped soft scenarios and round 24's soft cells), so the white spread, 0.3-0.7 % of a
     mode's reading on the shipped soft base, underrated how loosely a heavily damped mode is
     held (:func:`held_share`).
+
+    A conservative bound (review 29c M3): for a least-squares coefficient the AR(1) factor is
+    about ``(1 + rho rho_x) / (1 - rho rho_x)`` with ``rho_x`` its regressor's lag-1
+    autocorrelation (Bretherton et al. 1999), and the mean's factor used here, ``rho_x = 1``,
+    is the largest.  Measured (branch sgd30, free decay of the kept model, clean): it
+    overstates the per-column variance 1.2-1.7x on the shipped soft scenarios, 1.0-2.2x on
+    16 of the 19 families' soft members read (clean), 4.5x on 013, 8.6x on 008 and 21x on 017
+    (``rho`` 0.9996).  Scaled per column instead (``cov_ij sqrt(f_i f_j)``, ``f_i`` in
+    ``[1, n_t]``), no verdict moved on the four shipped cubic scenarios and the 20 soft
+    members (issue #15's bars and the scenarios' own) and the cubic force error moved by -0.011 to
+    +0.0003 (000 0.063 -> 0.053, its Mr error 0.011 -> 0.014): not adopted, a change with
+    losses and no verdict gained (docs/known-gaps.md, sgd30).
 
     Parameters
     ----------
@@ -626,7 +634,7 @@ def driving_point_scaling(M: np.ndarray, C: np.ndarray, K: np.ndarray, K3: np.nd
     g = np.linalg.solve(M, B[:, j])
     cov = None
     if cubic:
-        fit = free_decay_fit(data, M, C, K, K3, j, lam)
+        fit = free_decay_fit(data, M, C, K, K3, j)
         if fit is None:
             return same, "cubic model: no free decay to read the gain from, the prior's scale kept"
         g, cov = fit

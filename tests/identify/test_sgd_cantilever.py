@@ -302,6 +302,11 @@ def test_a_diverging_cubic_whose_warm_start_is_not_simulated_is_refused_for_the_
     assert not model.cubic_  # the linear library; its only cubic is step 4c's, on mode 1
     assert "moved to its limit, with a cubic on that mode alone" in model.backbone_cubic_rule_
     assert np.linalg.matrix_rank(model.K3_) == 1
+    # review 29c M1: the record rule states the moved model's own agreement (0.9945), not the
+    # keep rule's of the unmoved one (0.9954); the input map kept, so the delivered model is it
+    assert "; rule: kept," in model.input_map_rule_
+    a_moved, _ = sgd_module.record_agreement(model, data)  # (0.2 s: one linear-plus-cubic run)
+    assert f"(TRAC) {a_moved:.4g} >=" in model.record_rule_
     v = score_structural(ds, data, measure(noise_free(ds), sc.signal, "structural"), model).values
     # the round's bars (the families': TRAC and MAC of modes 1-2 > 0.90, modes 1-2 within 2.6
     # %); the old code: TRAC NaN
@@ -499,25 +504,61 @@ def test_a_doubted_cubic_stays_only_where_it_explains_clearly_more(dataset_cache
     assert np.max([v["freq_error_mode1"], v["freq_error_mode2"]]) <= 0.01
 
 
-def test_a_linear_model_of_a_hardening_record_takes_mode_1s_backbone_limit_and_a_cubic(
-        dataset_cache):
-    """Soft-base family member 001 clean (issue #15; ``cubic = true`` with the lasso, the
-    shipped soft table; the truth is the engine's).  The SGD's cubic result explained 0.136 of
-    its record, the held warm start (every cubic term dropped: ``K3_`` all zero) 0.937, with
-    mode 1 at its amplitude-averaged frequency, 2.95 % high, and was scored "linear model".
-    ``ls_sindy``'s step 4c (:func:`identify._structural_backbone.backbone_cubic`, the same
-    function) moves mode 1 to its backbone decay's linear limit with a cubic on that mode
-    alone sized by the record's own simulation: mode 1 0.88 %, TRAC 0.980 (measured)."""
-    study = load_study(ROUND16.parents[2] / "studies" / "families.toml")
-    sc = next(c.scenario for c in expand(study) if c.identifier == "sgd_sindy"
-              and c.scenario.name == "beams_soft__001" and c.noise == 0.0)
-    res = run_scenario(sc, dataset=dataset_cache.get(sc))
-    v, m = res.scores.values, res.model
-    assert "moved to its limit, with a cubic on that mode alone" in m.backbone_cubic_rule_
-    assert m.K3_ is not None and np.linalg.matrix_rank(m.K3_) == 1
-    assert np.allclose(m.K_, m.K_.T, rtol=0.0, atol=1e-12 * np.abs(m.K_).max())  # symmetric
-    check_physical(m.M_, m.C_, m.K_)
-    assert res.failure is None or res.failure == ""
-    assert v["freq_error_mode1"] <= 0.01  # issue #15's bar: measured 0.88 % (old 2.95 %)
-    assert v["freq_error_mode2"] <= 0.01  # unchanged 0.79 % (the step moves mode 1 alone)
-    assert v["trac"] >= 0.95  # issue #15's bar: measured 0.980 (old 0.937)
+def test_step_4c_acts_on_a_linear_model_whose_cubic_terms_were_the_datas(monkeypatch):
+    """``ls_sindy``'s step 4c in ``sgd_sindy`` (:meth:`SGDSINDy._backbone_cubic`; review 29c
+    L8, the rule alone, in milliseconds: ``b21_soft_root3``'s end-to-end test is the check
+    that it fires on a real record).  It acts on a model with no kept cubic whose cubic terms
+    were the data's to select (``cubic`` None, or true with ``l1 = 'cubic'`` and ``K3_`` all
+    zero: families' soft member 001 clean, mode 1 2.95 -> 0.88 %, TRAC 0.937 -> 0.980,
+    measured on branch sgd29), with ``ls_sindy``'s margin (L4); not with ``l1 = 'none'``, a
+    nonzero ``K3_`` or ``cubic`` false.  Where it acts, ``coef_`` follows the moved ``K_`` and
+    ``K3_``, and ``record_rule_`` is stated on the moved model's agreement (M1).  The step's
+    own function and the record's simulation are stood in for (known symmetric ``K``,
+    rank-one ``K3``, an agreement of 0.98)."""
+    from testbed.core.measurement import Measurement
+
+    m = np.array([2.0, 1.0])
+    K0 = np.array([[3.0e4, -1.0e4], [-1.0e4, 2.0e4]])
+    K_new = np.array([[2.9e4, -1.0e4], [-1.0e4, 2.0e4]])
+    K3_new = np.outer([1.0, -0.5], [2.0e9, -1.0e9])
+    ratios: list[float] = []
+
+    def backbone(model, data, peaks, ratio):
+        ratios.append(ratio)
+        return K_new, K3_new, "mode 1 moved to its limit, with a cubic on that mode alone"
+
+    monkeypatch.setattr(sgd_module, "backbone_cubic", backbone)
+    monkeypatch.setattr(sgd_module, "record_agreement", lambda model, data: (0.98, ""))
+    data = Measurement(fs=100.0, x=np.zeros((2, 8)), xd=np.zeros((2, 8)), xdd=np.zeros((2, 8)),
+                       channels=("s1", "s2"))
+
+    def fitted(cubic: bool | None, l1: str, K3: np.ndarray | None) -> SGDSINDy:
+        est = SGDSINDy(cubic=cubic, l1=l1)
+        lib = 8 if K3 is not None else 6  # a, v, d (and c) blocks of two columns
+        est.M_, est.C_, est.K_, est.K3_ = np.diag(m), 1e-3 * K0, K0.copy(), K3
+        est.coef_ = np.zeros((2, lib))
+        est.coef_[:, 4:6] = -K0 / m[:, None]
+        est.peaks_, est.cubic_ = np.array([10.0, 30.0]), K3 is not None
+        est._d_block, est._c_block = slice(4, 6), (slice(6, 8) if K3 is not None else None)
+        est.record_rule_ = "stale"
+        return est
+
+    for cubic, l1, K3, fires in ((True, "cubic", np.zeros((2, 2)), True),
+                                 (None, "cubic", None, True),
+                                 (True, "none", np.zeros((2, 2)), False),
+                                 (True, "cubic", 1e9 * np.eye(2), False),
+                                 (False, "cubic", None, False)):
+        est = fitted(cubic, l1, K3)
+        moved = est._backbone_cubic(data)
+        assert (moved is not None) == fires, (cubic, l1)
+        assert ("moved to its limit" in est.backbone_cubic_rule_) == fires
+        if not fires:
+            assert est.record_rule_ == "stale" and np.array_equal(est.K_, K0)
+            continue
+        assert moved == (0.98, "") and ratios[-1] == sgd_module.CUBIC_TRIAL_RATIO
+        assert "explains its record (record agreement (TRAC) 0.98" in est.record_rule_
+        assert np.array_equal(est.K_, K_new) and np.array_equal(est.K3_, K3_new)
+        # (the displacement block is updated by the difference: rounding of one subtraction)
+        np.testing.assert_allclose(est.coef_[:, 4:6], -K_new / m[:, None], rtol=1e-12)
+        if K3 is not None:
+            np.testing.assert_array_equal(est.coef_[:, 6:8], -K3_new / m[:, None])
