@@ -152,26 +152,19 @@ IDENTIFIED_KEYS = frozenset({"source", "kind", "method", "fs_hz", "n_samples", "
 SEP005_KEYS = frozenset({"name", "data", "fs", "content_hash", "group"})
 
 
-def _read_at(fd: int, size: int, pos: int = 0) -> bytes:
-    """Up to ``size`` bytes of the open file ``fd`` from byte ``pos`` (``os.pread`` is POSIX's
-    alone)."""
-    os.lseek(fd, pos, os.SEEK_SET)
-    return os.read(fd, size)
-
-
 def _png_ours(fd: int) -> bool:
     """True for a PNG whose text chunks before its image data hold ``Software`` =
     :data:`PNG_SOFTWARE` (the chunks walked by their lengths, at most 64 of them)."""
     pos = 8
     for _ in range(64):
-        head = _read_at(fd, 8, pos)
+        head = os.pread(fd, 8, pos)
         if len(head) < 8:
             return False
         size, tag = int.from_bytes(head[:4], "big"), head[4:]
         if tag in (b"IDAT", b"IEND"):
             return False
         if tag == b"tEXt" and size < 4096:
-            key, _, value = _read_at(fd, size, pos + 8).partition(b"\0")
+            key, _, value = os.pread(fd, size, pos + 8).partition(b"\0")
             if key == b"Software" and value == PNG_SOFTWARE.encode():
                 return True
         pos += 12 + size
@@ -200,7 +193,7 @@ def _json_document(fd: int) -> object:
     if os.fstat(fd).st_size > JSON_MARK_READ:
         return None
     try:
-        return json.loads(_read_at(fd, JSON_MARK_READ).decode("utf-8-sig"))
+        return json.loads(os.pread(fd, JSON_MARK_READ, 0).decode("utf-8-sig"))
     except (ValueError, RecursionError):  # RecursionError: a user's deeply nested document
         # ('[' * 100000) is not ours either (review 29a M2: it was "internal error")
         return None
@@ -229,13 +222,13 @@ def _uff_ours(fd: int) -> bool:
     (review 29a L5)."""
     tail, pos = b"\n", 0
     while pos < JSON_MARK_READ:
-        chunk = _read_at(fd, UFF_CHUNK, pos)
+        chunk = os.pread(fd, UFF_CHUNK, pos)
         if not chunk:
             return False
         buf, pos = tail + chunk, pos + len(chunk)
         found = _UFF58_START.search(buf)
         if found:  # its six ID lines (80 characters each) follow within PATTERN_READ bytes
-            return _UFF_MARK.match(buf + _read_at(fd, PATTERN_READ, pos), found.start()) is not None
+            return _UFF_MARK.match(buf + os.pread(fd, PATTERN_READ, pos), found.start()) is not None
         tail = buf[-PATTERN_READ:]  # a record start cut by the chunk's end is found next time
     return False
 
