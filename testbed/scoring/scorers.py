@@ -2166,11 +2166,12 @@ def simulate_scored(sim: Callable[[], Trajectory], t: np.ndarray, check: str,
         return None, f"diverged: {e}", float("nan")
     except np.linalg.LinAlgError as e:  # e.g. a singular identified M
         return None, f"simulation failed: {e}", float("nan")
-    except (ValueError, OverflowError, FloatingPointError) as e:
+    except Exception as e:
         # A model with a fast unstable pole overflows inside the integrator (e.g. the matrix
         # exponential of a step turns inf, and scipy refuses to decompose it): a divergence.
-        # Only a numeric blow-up is taken (the one rule a plugin's simulate is read by,
-        # ``core.errors.numeric_blow_up``); any other exception is a bug and propagates.
+        # Only a numeric blow-up is taken (the one rule, and the one list of its exception
+        # types, a plugin's simulate is read by too: ``core.errors.numeric_blow_up``); any
+        # other exception is a bug and propagates.
         if not numeric_blow_up(e):
             raise
         return None, f"diverged: non-finite state inside the simulation ({e})", float("nan")
