@@ -140,11 +140,12 @@ _UFF58_START = re.compile(rb"\n\s*-1\n\s*58b?[ \t]")
 #: Every UFF58 record the testbed writes states its rate on ID line 5 as ``fs <rate> Hz,
 #: sysid-testbed`` (``reporting.export``, since the line was written)
 _UFF_MARK = re.compile(rb"\n\s*-1\n\s*58b?[ \t][^\n]*\n(?:[^\n]*\n){4}fs [^\n]*Hz, sysid-testbed\b")
-#: The largest JSON output :func:`_json_document` parses, and the farthest :func:`_uff_ours`
-#: looks for a UFF file's first UFF58 record [bytes]: the largest text file ``identify`` reads
+#: The most of a file a marker check reads [bytes]: the largest JSON output
+#: :func:`_json_document` parses, and the farthest :func:`_uff_ours` looks for a UFF file's
+#: first UFF58 record.  The largest text file ``identify`` reads
 #: (``testbed.core.budget.IDENTIFY_TEXT_BUDGET_BYTES``, review 29a L5: a second, unexplained
 #: 256 MiB); a larger one could not be read back by the testbed, so it is not one it wrote
-JSON_MARK_READ = IDENTIFY_TEXT_BUDGET_BYTES
+MARK_READ = IDENTIFY_TEXT_BUDGET_BYTES
 #: The keys every model summary ``identify`` writes holds (``testbed.pipeline.fit``), which no
 #: one else's JSON holds together: the identified model's marker
 IDENTIFIED_KEYS = frozenset({"source", "kind", "method", "fs_hz", "n_samples", "identifier"})
@@ -152,26 +153,19 @@ IDENTIFIED_KEYS = frozenset({"source", "kind", "method", "fs_hz", "n_samples", "
 SEP005_KEYS = frozenset({"name", "data", "fs", "content_hash", "group"})
 
 
-def _read_at(fd: int, size: int, pos: int = 0) -> bytes:
-    """Up to ``size`` bytes of the open file ``fd`` from byte ``pos`` (``os.pread`` is POSIX's
-    alone)."""
-    os.lseek(fd, pos, os.SEEK_SET)
-    return os.read(fd, size)
-
-
 def _png_ours(fd: int) -> bool:
     """True for a PNG whose text chunks before its image data hold ``Software`` =
     :data:`PNG_SOFTWARE` (the chunks walked by their lengths, at most 64 of them)."""
     pos = 8
     for _ in range(64):
-        head = _read_at(fd, 8, pos)
+        head = os.pread(fd, 8, pos)
         if len(head) < 8:
             return False
         size, tag = int.from_bytes(head[:4], "big"), head[4:]
         if tag in (b"IDAT", b"IEND"):
             return False
         if tag == b"tEXt" and size < 4096:
-            key, _, value = _read_at(fd, size, pos + 8).partition(b"\0")
+            key, _, value = os.pread(fd, size, pos + 8).partition(b"\0")
             if key == b"Software" and value == PNG_SOFTWARE.encode():
                 return True
         pos += 12 + size
@@ -197,10 +191,11 @@ def _json_document(fd: int) -> object:
     """The JSON document of the open file, or None (too large, not UTF-8, not JSON)."""
     import json
 
-    if os.fstat(fd).st_size > JSON_MARK_READ:
+    size = os.fstat(fd).st_size
+    if size > MARK_READ:
         return None
-    try:
-        return json.loads(_read_at(fd, JSON_MARK_READ).decode("utf-8-sig"))
+    try:  # the file's size, not the limit: a small file is not given a 256 MiB buffer
+        return json.loads(os.pread(fd, size, 0).decode("utf-8-sig"))
     except (ValueError, RecursionError):  # RecursionError: a user's deeply nested document
         # ('[' * 100000) is not ours either (review 29a M2: it was "internal error")
         return None
@@ -224,18 +219,18 @@ def _uff_ours(fd: int) -> bool:
     (:data:`_UFF_MARK`).
 
     The file is read in :data:`UFF_CHUNK` pieces up to that record's start only, at most
-    :data:`JSON_MARK_READ` bytes: the testbed's export writes its geometry (about 160 bytes a
+    :data:`MARK_READ` bytes: the testbed's export writes its geometry (about 160 bytes a
     node) before it, so a fixed first MiB refused its own export of more than ~6,500 nodes
     (review 29a L5)."""
     tail, pos = b"\n", 0
-    while pos < JSON_MARK_READ:
-        chunk = _read_at(fd, UFF_CHUNK, pos)
+    while pos < MARK_READ:
+        chunk = os.pread(fd, UFF_CHUNK, pos)
         if not chunk:
             return False
         buf, pos = tail + chunk, pos + len(chunk)
         found = _UFF58_START.search(buf)
         if found:  # its six ID lines (80 characters each) follow within PATTERN_READ bytes
-            return _UFF_MARK.match(buf + _read_at(fd, PATTERN_READ, pos), found.start()) is not None
+            return _UFF_MARK.match(buf + os.pread(fd, PATTERN_READ, pos), found.start()) is not None
         tail = buf[-PATTERN_READ:]  # a record start cut by the chunk's end is found next time
     return False
 

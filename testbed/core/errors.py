@@ -47,9 +47,18 @@ def terminal_safe(text: str) -> str:
     return "".join(repr(c)[1:-1] if is_control(c) else c for c in text)
 
 
-def _cut(text: str) -> str:
-    """``text`` cut to :data:`MAX_VALUE_CHARS` characters, the cut marked ``[...]``."""
-    return text if len(text) <= MAX_VALUE_CHARS else text[:MAX_VALUE_CHARS - 5] + "[...]"
+def _cut(text: str, limit: int = MAX_VALUE_CHARS, marker: str = "[...]") -> str:
+    """``text`` as it is up to ``limit`` characters, else cut, the cut marked by ``marker``.
+
+    A marker holding ``{n}`` is formatted with the number of characters cut and follows the
+    first ``limit`` characters (the count says what is missing: :func:`exception_text`'s
+    ``[... N more characters]``); any other takes the place of its own length in them, so the
+    text stays ``limit`` characters long (a value shown in a message: ``[...]``)."""
+    if len(text) <= limit:
+        return text
+    if "{n}" in marker:
+        return text[:limit] + marker.format(n=len(text) - limit)
+    return text[:limit - len(marker)] + marker
 
 
 def unusable_path(e: BaseException) -> str | None:
@@ -83,10 +92,7 @@ def exception_text(e: BaseException) -> str:
         text = str(e)
     except Exception:
         return f"(no message: {type(e).__name__}.__str__ failed)"
-    text = " ".join(text.split())
-    if len(text) <= MAX_EXCEPTION_CHARS:
-        return text
-    return f"{text[:MAX_EXCEPTION_CHARS]}[... {len(text) - MAX_EXCEPTION_CHARS} more characters]"
+    return _cut(" ".join(text.split()), MAX_EXCEPTION_CHARS, "[... {n} more characters]")
 
 
 def show_text(text: str) -> str:

@@ -40,22 +40,42 @@ NAMES = {signal.SIGINT: "SIGINT", signal.SIGTERM: "SIGTERM", signal.SIGHUP: "SIG
 armed = False
 
 
-#: Options of the interpreter's command line that take the next word as their value
-_VALUED_OPTIONS = ("-W", "-X", "--check-hash-based-pycs")
+#: The interpreter's long options that take the next word as their value
+_VALUED_LONG_OPTIONS = ("--check-hash-based-pycs",)
+#: The interpreter's one-letter options that take a value: the rest of their word, or else the
+#: next word (``-Wdefault`` / ``-W default``; ``-m`` and ``-c`` end the options)
+_VALUED_LETTERS = "WX"
 
 
 def _run_as_module() -> str | None:
     """The module named by ``python -m NAME`` on the interpreter's own command line
-    (``sys.orig_argv``), or None (a script, ``-c``, the console script)."""
+    (``sys.orig_argv``), or None (a script, ``-c``, the console script).
+
+    A word beginning with a single ``-`` is read as the interpreter does, a cluster of
+    one-letter options (``-Im NAME``, ``-mNAME``, ``-Xdev``; reader 29: only ``-m NAME`` as its
+    own word was read): ``m`` takes the rest of the word or else the next word as the module,
+    ``c`` ends the options (no module), ``W`` / ``X`` take the rest or else the next word as
+    their value; any other letter takes none."""
     words = list(getattr(sys, "orig_argv", ())[1:])
     while words:
         word = words.pop(0)
-        if word == "-m":
-            return words[0] if words else None
-        if word in _VALUED_OPTIONS:
+        if word in _VALUED_LONG_OPTIONS:
             words = words[1:]
-        elif word == "-c" or word == "-" or not word.startswith("-"):
-            return None  # (a script's or -c's own words are not the interpreter's)
+            continue
+        if word == "--" or word == "-" or not word.startswith("-"):
+            return None  # (a script's own words are not the interpreter's)
+        if word.startswith("--"):
+            continue  # a long option without a value (--help, --version)
+        for i, letter in enumerate(word[1:], start=2):
+            rest = word[i:]
+            if letter == "m":
+                return rest or (words[0] if words else None)
+            if letter == "c":
+                return None  # (-c's own words are not the interpreter's)
+            if letter in _VALUED_LETTERS:
+                if not rest:
+                    words = words[1:]
+                break
     return None
 
 

@@ -85,7 +85,8 @@ class Field:
         The pattern in words, for messages and the guide.
     visible : bool
         A string (or every string item of a list) must hold a character that shows
-        (:func:`visible`); say so in ``pattern_doc`` (:data:`VISIBLE_DOC`).
+        (:func:`visible`); :meth:`describe` says so (:data:`VISIBLE_DOC`, in front of
+        ``pattern_doc``).
     also : Field, optional
         An alternative form that is accepted too (e.g. a named library or a list of term
         names); the value is accepted if it satisfies this field or ``also``.
@@ -137,10 +138,15 @@ class Field:
             bounds.append(f"with at least {self.min_items} item(s)")
         if self.type is list and self.max_items is not None:
             bounds.append(f"with at most {self.max_items} item(s)")
+        # the visible rule in front of the pattern's words, said here for every visible field
+        # (reader 29: each caller had to add VISIBLE_DOC to its pattern_doc by hand)
+        words = [VISIBLE_DOC] if self.visible else []
         if self.pattern is not None and self.pattern_doc.startswith(("a ", "an ")):
             what = self.pattern_doc  # "expected a string a name of letters ..." read badly
         elif self.pattern is not None:
-            bounds.append(self.pattern_doc or f"matching {self.pattern}")
+            words.append(self.pattern_doc or f"matching {self.pattern}")
+        if words:
+            bounds.append(", ".join(words))
         unit = f" [{self.unit}]" if self.unit else ""
         return what + (" " + " and ".join(bounds) if bounds else "") + unit
 

@@ -99,10 +99,7 @@ def fit_or_fail(model: Any, data: Measurement, method: str | None = None) -> Non
     user's own code failed, and a run scores it as a failed fit instead of calling it an
     internal error of the testbed.
     """
-    origin = plugins.IDENTIFIERS.origin(method) if method is not None else "builtin"
     builtin = builtin_class(type(model))  # (the rule of identify._base._called too: 28a L5)
-    if not builtin and origin == "builtin":
-        origin = f"module {type(model).__module__}"
     try:
         # a plugin's os._exit(0) in fit ended a run with status 0 and no verdict (round 19)
         # under numpy's own float error state (a caller's or an earlier plugin's
@@ -120,13 +117,23 @@ def fit_or_fail(model: Any, data: Measurement, method: str | None = None) -> Non
         # its GeneratorExit (any BaseException but Ctrl-C) was a traceback, status 1 (round 19)
         if builtin or isinstance(e, KeyboardInterrupt):
             raise
-        raise IdentificationError(f"identifier {method or type(model).__name__} (from {origin}) raised "
+        raise IdentificationError(f"{_plugin_named(model, method)} raised "
                                   f"{type(e).__name__}: {exception_text(e)}") from None
     if not builtin:
         problem = fitted_shape_problem(model)
         if problem is not None:
-            raise IdentificationError(f"identifier {method or type(model).__name__} (from {origin}) "
-                                      f"fitted {problem}")
+            raise IdentificationError(f"{_plugin_named(model, method)} fitted {problem}")
+
+
+def _plugin_named(model: Any, method: str | None) -> str:
+    """A plugin identifier as :func:`fit_or_fail`'s failures name it: ``identifier NAME (from
+    ORIGIN)``, ``NAME`` the registered ``method`` (else the class's name), ``ORIGIN`` where
+    the registry says it came from (a class registered under a built-in's name, or none:
+    its module)."""
+    origin = plugins.IDENTIFIERS.origin(method) if method is not None else "builtin"
+    if origin == "builtin":
+        origin = f"module {type(model).__module__}"
+    return f"identifier {method or type(model).__name__} (from {origin})"
 
 
 def fitted_shape_problem(model: Any) -> str | None:

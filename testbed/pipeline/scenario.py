@@ -59,7 +59,6 @@ from testbed.core.registry import REGISTERED_NAME, REGISTERED_NAME_DOC
 from testbed.core.schema import (
     ONE_LINE,
     ONE_LINE_DOC,
-    VISIBLE_DOC,
     Field,
     near_miss,
     unknown_key_hint,
@@ -117,7 +116,7 @@ HEADER_SCHEMA = {
     # a tag "" or of blanks alone (a no-break space too) selects nothing and lists as a gap
     # (round 25: accepted)
     "tags": Field(list, [], item_type=str, pattern=ONE_LINE, visible=True,
-                  pattern_doc=f"{VISIBLE_DOC}, {ONE_LINE_DOC}", doc="free tags for selecting scenarios"),
+                  pattern_doc=ONE_LINE_DOC, doc="free tags for selecting scenarios"),
     "extends": Field(str, "", doc="scenario file this one starts from (relative path)"),
 }
 

@@ -42,7 +42,7 @@ from testbed.core.atomic import (
     foreign_head,
     refuse_foreign,
 )
-from testbed.core.errors import terminal_safe
+from testbed.core.errors import InputError, terminal_safe
 from testbed.core.kinds import METRICS
 from testbed.numerics.quantiles import quartiles
 from testbed.pipeline.plugins import RIGS
@@ -245,32 +245,55 @@ def refuse_foreign_outputs(out_dir: str | os.PathLike, pngs: Iterable[Path] = ()
     folder's option in its message), :meth:`Page.write` again with its figures before it
     writes (review 28b L1: two lists before)."""
     out_dir = Path(out_dir)
-    # an earlier report's unmarked figure is looked for (its bytes read and encoded, the page
-    # read) only where the marker check would refuse: not for every marked figure (review 29a L6)
-    pngs = [Path(p) for p in pngs
-            if not (foreign_head(Path(p), PNG_FILE) and _earlier_figure(Path(p)))]
-    for path, kind in [*((p, PNG_FILE) for p in pngs),
-                       *((out_dir / name, kind) for name, kind in REPORT_FILES)]:
-        refuse_foreign(path, kind, f"{option} {terminal_safe(str(path))}" if option else None,
-                       expected="another --output folder, or remove the file")
+    expected = "another --output folder, or remove the file"
+
+    def shown(path: Path) -> str | None:
+        return f"{option} {terminal_safe(str(path))}" if option else None
+
+    # each figure opened once, by the marker check; an earlier report's unmarked figure is
+    # looked for (its bytes read and encoded) only where that check refuses, and the page is
+    # read once, at the first such figure: not for every marked figure (review 29a L6)
+    page: list[bytes] = []
+    for p in map(Path, pngs):
+        try:
+            refuse_foreign(p, PNG_FILE, shown(p), expected=expected)
+        except InputError:
+            if not page:
+                page.append(_earlier_page(out_dir))
+            if not _earlier_figure(p, page[0]):
+                raise
+    for name, kind in REPORT_FILES:
+        refuse_foreign(out_dir / name, kind, shown(out_dir / name), expected=expected)
 
 
-def _earlier_figure(path: Path) -> bool:
-    """True for a figure an earlier report wrote before figures carried the testbed's PNG
-    marker (:data:`~testbed.core.atomic.PNG_SOFTWARE`, review 28b M2): a PNG whose bytes the
-    folder's ``report.html`` of the testbed's (:data:`~testbed.core.atomic.HTML_FILE`) embeds,
-    as every report page embeds its figures (base64 data URIs).  Such a folder is replaced as
-    before the marker; a PNG of the user's, which no page of the testbed's embeds byte for
-    byte, is still refused."""
-    page = path.parent / "report.html"
+def _earlier_page(out_dir: Path) -> bytes:
+    """The bytes of the folder's ``report.html`` if it is the testbed's
+    (:data:`~testbed.core.atomic.HTML_FILE`), else ``b""`` (none, empty, foreign or
+    unreadable): the page :func:`_earlier_figure` searches."""
+    page = out_dir / "report.html"
     try:
         if not page.is_file() or page.stat().st_size == 0 or foreign_head(page, HTML_FILE):
-            return False
+            return b""
+        return page.read_bytes()
+    except OSError:
+        return b""
+
+
+def _earlier_figure(path: Path, page: bytes) -> bool:
+    """True for a figure an earlier report wrote before figures carried the testbed's PNG
+    marker (:data:`~testbed.core.atomic.PNG_SOFTWARE`, review 28b M2): a PNG whose bytes the
+    folder's ``report.html`` of the testbed's (``page``, :func:`_earlier_page`) embeds, as
+    every report page embeds its figures (base64 data URIs).  Such a folder is replaced as
+    before the marker; a PNG of the user's, which no page of the testbed's embeds byte for
+    byte, is still refused."""
+    if not page:
+        return False
+    try:
         # the whole data URI, quotes included: a prefix of another figure's does not match
         uri = b'src="data:image/png;base64,' + base64.b64encode(path.read_bytes()) + b'"'
-        return uri in page.read_bytes()
     except OSError:
         return False
+    return uri in page
 
 
 def _holds(path: Path, data: bytes) -> bool:

@@ -1560,10 +1560,14 @@ def hidden_by_trac(scores: Scores, thresholds: dict[str, dict[str, float]]) -> l
     term is not shown to explain, which a reason for the TRAC alone would hide
     (:func:`linear_trac_failures`).
 
-    Every failed check but ``trac``, unless each of them is a frequency bar (or the MAC bar of
-    a mode with no partner that the frequency reason names, :func:`_unpaired_mac`) and
+    Every failed check but ``trac`` and the per-mode bars of a mode another reason names (out
+    of band, unexcited, decayed: :func:`_named_mode`), unless each of them is a frequency bar
+    or a MAC bar missed by modes with no partner (:func:`_unpaired_mac`) and
     :func:`_linear_model_claim` names them all (each failed mode within what the truth's cubic
-    force can move it, or unpaired).
+    force can move it, or unpaired).  A mode's ``mac_mode<k>`` bar is such a MAC bar where the
+    frequency reason names mode k unpaired; the worst-over-modes ``mac`` bar is where each of
+    its unpaired modes is named, by the frequency reason or by another reason
+    (:func:`_named_mode`), and every paired mode's MAC meets the bar.
 
     Parameters
     ----------
@@ -1595,10 +1599,15 @@ def _left_unexplained(scores: Scores, thresholds: dict[str, dict[str, float]],
                       own: Callable[[Check], bool], other: Callable[[Check], bool],
                       other_named: bool) -> list[Check]:
     """The failed checks a linear-model reason for its ``own`` bars would leave unexplained:
-    every failed check but its own and those a mode-level reason names
+    every failed check but its own and the per-mode bars whose mode a mode-level reason names
     (:func:`_named_by_mode_reason`), unless each is one of the ``other`` reason's bars and
     that reason is given (``other_named``; :func:`hidden_by_trac`,
-    :func:`hidden_by_frequency`)."""
+    :func:`hidden_by_frequency`).
+
+    The worst-over-modes ``mac`` bar names no mode, so it is not dropped here: the callers'
+    ``other`` takes it (:func:`_unpaired_mac`) where it is missed by unpaired modes only, each
+    named by the frequency reason or by another reason (:func:`_named_mode`), and every
+    paired mode's MAC meets the bar."""
     rest = [c for c in check_thresholds(scores.values, thresholds)
             if not c.passed and not own(c) and not _named_by_mode_reason(c, scores)]
     if rest and all(other(c) for c in rest) and other_named:
@@ -2166,11 +2175,12 @@ def simulate_scored(sim: Callable[[], Trajectory], t: np.ndarray, check: str,
         return None, f"diverged: {e}", float("nan")
     except np.linalg.LinAlgError as e:  # e.g. a singular identified M
         return None, f"simulation failed: {e}", float("nan")
-    except (ValueError, OverflowError, FloatingPointError) as e:
+    except Exception as e:
         # A model with a fast unstable pole overflows inside the integrator (e.g. the matrix
         # exponential of a step turns inf, and scipy refuses to decompose it): a divergence.
-        # Only a numeric blow-up is taken (the one rule a plugin's simulate is read by,
-        # ``core.errors.numeric_blow_up``); any other exception is a bug and propagates.
+        # Only a numeric blow-up is taken (the one rule, and the one list of its exception
+        # types, a plugin's simulate is read by too: ``core.errors.numeric_blow_up``); any
+        # other exception is a bug and propagates.
         if not numeric_blow_up(e):
             raise
         return None, f"diverged: non-finite state inside the simulation ({e})", float("nan")

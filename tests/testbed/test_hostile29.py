@@ -391,6 +391,16 @@ def test_a_plugin_path_that_names_nothing_is_read_as_every_path(tmp_path):
     (["python", "-m", "pytest", "-m", "testbed.cli"], False),
     (["python", "script.py", "-m", "testbed.cli"], False),
     (["python", "-c", "import testbed", "-m", "testbed.cli"], False),
+    # reader 29: a word of clustered letters, as the interpreter reads it
+    (["python", "-Im", "testbed.cli", "run", "x"], True),
+    (["python", "-mtestbed.cli", "run", "x"], True),
+    (["python", "-Xdev", "-IWerror", "-mtestbed", "list"], True),
+    (["python", "-IX", "importtime", "-m", "testbed.cli"], True),
+    (["python", "-Imtestbed.cli"], True),
+    (["python", "-Im", "pytest", "-m", "testbed.cli"], False),
+    (["python", "-Ic", "import testbed", "-m", "testbed.cli"], False),
+    (["python", "-W", "-m", "testbed.cli"], False),
+    (["python", "-Wdefault", "script.py", "-m", "testbed.cli"], False),
 ])
 def test_python_dash_m_testbed_is_the_console_program_from_its_first_import(monkeypatch, orig, armed):
     # hostile round 29: under `python -m testbed.cli` the package is imported before runpy makes

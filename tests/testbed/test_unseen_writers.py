@@ -28,7 +28,7 @@ def _sources_only(folder: str, names: list[str]) -> list[str]:
 @contextlib.contextmanager
 def _as_a_script() -> Iterator[None]:
     """Run a writer in this process as ``python <script>`` would (its process was not the
-    subject: 1.5 s of CPU for the rounds against 8.3 s in a process each): ``sys.path``,
+    subject: 1.6 s of CPU for the rounds against 8.3 s in a process each): ``sys.path``,
     ``sys.argv`` and the sibling rounds' modules it imports (``round6.b_make``, ...: each
     writer reads its own copy's) restored afterwards, and its printout swallowed."""
     path, argv = list(sys.path), list(sys.argv)

@@ -96,3 +96,15 @@ def test_unknown_section_does_not_echo_its_content():
         validate_header({"study": {"secret": "content"}}, sections=("scenario",), header="scenario",
                         schema={}, file="f", stem=None)
     assert "secret" not in str(e.value) and "unknown section" in str(e.value)
+
+
+def test_a_visible_field_says_so_without_its_caller_adding_the_words():
+    # reader 29: Field.visible relied on each caller putting VISIBLE_DOC into pattern_doc by
+    # hand; a field that did not refused a blank tag with a message not saying why
+    from testbed.core.schema import ONE_LINE, ONE_LINE_DOC, VISIBLE_DOC
+
+    assert Field(str, visible=True).describe() == f"a string {VISIBLE_DOC}"
+    tag = Field(str, pattern=ONE_LINE, pattern_doc=ONE_LINE_DOC, visible=True)
+    assert tag.describe() == f"a string {VISIBLE_DOC}, {ONE_LINE_DOC}"
+    with pytest.raises(ScenarioError, match=VISIBLE_DOC):
+        validate_table({"tag": "\u200b"}, {"tag": tag}, file="f.toml", section="s")

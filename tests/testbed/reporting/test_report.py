@@ -254,7 +254,7 @@ def test_a_marked_figure_is_not_searched_for_in_the_earlier_page(tmp_path, monke
     from testbed.reporting import report
 
     searched = []
-    monkeypatch.setattr(report, "_earlier_figure", lambda p: searched.append(p.name) or False)
+    monkeypatch.setattr(report, "_earlier_figure", lambda p, page: searched.append(p.name) or False)
     ours, theirs = tmp_path / "fit.png", tmp_path / "photo.png"
     ours.write_bytes(_png(b"Software\0" + PNG_SOFTWARE.encode()))
     theirs.write_bytes(_png(b"Software\0my camera"))
