@@ -461,5 +461,5 @@ def test_a_commands_pid_line_is_logged_when_its_client_left_before_the_reply(mon
 def test_a_commands_connection_is_registered_before_its_pid_line_is_logged(monkeypatch):
     # review 29a L1: logged first, a log that raised OSError (a full disk) left the command
     # unregistered, never stopped when its client died; the OSError no longer escapes _start
-    registered, pid, ended = _start_with(monkeypatch, peer_open=True, log_fails=True)
+    registered, _pid, ended = _start_with(monkeypatch, peer_open=True, log_fails=True)
     assert registered == [True] and ended is None

@@ -143,7 +143,7 @@ def test_a_deeply_nested_json_at_an_output_path_is_foreign_not_an_internal_error
     p = tmp_path / "out.json"
     nested = "[" * 100000 + "]" * 100000  # a table's head for a model summary, a list's else
     p.write_text('{"a": ' + nested + "}" if kind == "IDENTIFIED_JSON_FILE" else nested)
-    with pytest.raises(InputError, match="out.json"):
+    with pytest.raises(InputError, match=r"out\.json"):
         atomic.refuse_foreign(p, getattr(atomic, kind))
 
 

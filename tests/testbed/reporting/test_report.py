@@ -260,6 +260,6 @@ def test_a_marked_figure_is_not_searched_for_in_the_earlier_page(tmp_path, monke
     theirs.write_bytes(_png(b"Software\0my camera"))
     report.refuse_foreign_outputs(tmp_path, [ours])
     assert searched == []
-    with pytest.raises(InputError, match="photo.png"):
+    with pytest.raises(InputError, match=r"photo\.png"):
         report.refuse_foreign_outputs(tmp_path, [ours, theirs])
     assert searched == ["photo.png"]
