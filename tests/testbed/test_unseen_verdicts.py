@@ -535,12 +535,15 @@ def test_a_growing_free_response_is_a_named_non_physical_failure():
     """Round 17's b17_soft_r1p2_cf0p3_f300_uneven at 5 % (ls_sindy, seed 81): the model's cubic
     K3 (no potential's) pumps energy; its simulated response grows after 0.3 s to 770x the
     record's largest value (under the 1e3 blow-up bar) and the run failed by its bars alone
-    (TRAC 1.3e-6, mode 2 88 % off), never named non-physical."""
+    (TRAC 1.3e-6, mode 2 88 % off), never named non-physical.  ``cubic = true`` keeps that
+    fitted cubic: with the cubic rule's own choice, step 4d (session 29) now replaces it by a
+    hardening cubic on mode 1 alone (TRAC 0.985; mode 2 still 88 % off)."""
     sc = load_scenario(_root() / "benchmarks" / "unseen" / "round17"
                        / "b17_soft_r1p2_cf0p3_f300_uneven.toml")
     sc = dataclasses.replace(sc, seed=81)
     sc.noise["rms_percent"] = 5.0
     sc.identify["method"] = "ls_sindy"
+    sc.identify["cubic"] = True
     r = run_scenario(sc)
     assert r.verdict == FAIL
     why = r.scores.failures["growth"]
