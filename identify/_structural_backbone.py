@@ -34,7 +34,7 @@ from testbed.core.measurement import Measurement
 
 def backbone_cubic(model: StructuralIdentifier, data: Measurement, peaks: np.ndarray,
                    ratio: float = AGREEMENT_RATIO
-                   ) -> tuple[np.ndarray | None, np.ndarray | None, str]:
+                   ) -> tuple[np.ndarray | None, np.ndarray | None, str, float]:
     """A fitted linear model's lowest mode moved to its backbone limit, with a cubic on that
     mode alone sized by output error, where the record calls for it.
 
@@ -103,19 +103,22 @@ def backbone_cubic(model: StructuralIdentifier, data: Measurement, peaks: np.nda
         The cubic [N/m^3] (None: none, also where ``s = 0``).
     rule : str
         What was done, with both record agreements and the scale, or why not.
+    agreement : float
+        The moved model's record agreement [-] (:func:`identify._record.record_agreement`, at
+        the chosen scale; the caller need not simulate it again); NaN where nothing moves.
     """
     if np.size(peaks) == 0:
-        return None, None, "not tried (no measured peak)"
+        return None, None, "not tried (no measured peak)", float("nan")
     freqs, Phi = modal(model.M_, model.K_)
     if not np.all(np.isfinite(freqs)) or not np.linalg.cond(Phi) < SHAPES_COND_MAX:
-        return None, None, "not tried (the model's modes not resolved)"
+        return None, None, "not tried (the model's modes not resolved)", float("nan")
     if not np.linalg.cond(Phi**3) < SHAPES_COND_MAX:
         return None, None, ("not tried (the cubes of the model's mode shapes are not resolved: "
-                            "no cubic acts on one mode alone)")
+                            "no cubic acts on one mode alone)"), float("nan")
     targets = eigen_targets(model.M_, model.K_, (2.0 * np.pi * np.asarray(peaks, dtype=float)) ** 2)
     if not np.any(targets > 0):
         return None, None, (f"not tried (no mode of the model within {MODE_SEPARATION:.0%} of "
-                            "a measured peak)")
+                            "a measured peak)"), float("nan")
     k = int(np.flatnonzero(targets > 0)[0])
     peak = float(np.sqrt(targets[k]) / (2.0 * np.pi))
     i0, i1 = fit_window(data, 0.0)
@@ -130,14 +133,14 @@ def backbone_cubic(model: StructuralIdentifier, data: Measurement, peaks: np.nda
             and limit_reached(dec.sigma[k], duration)):
         return None, None, (f"{head}: not moved (it needs a chirp above {CUBIC_CHIRP_MIN:g}, "
                             "the limit under the model's frequency and read, the squared "
-                            f"amplitude falling to {BACKBONE_MIN_FALL:g} or less)")
+                            f"amplitude falling to {BACKBONE_MIN_FALL:g} or less)"), float("nan")
     lam = np.full(freqs.size, np.nan)
     lam[k] = float(dec.lam_model[k])
     K_b = set_eigenvalues(model.M_, model.K_, lam)
     try:
         check_physical(model.M_, model.C_, K_b)
     except IdentificationError as e:
-        return None, None, f"{head}: not moved ({e})"
+        return None, None, f"{head}: not moved ({e})", float("nan")
     # K_b keeps the model's shapes (set_eigenvalues), so Phi holds them in the same order;
     # the moved model's own modal() re-sorts them where the limit falls below a lower
     # (unlocated) mode, and its column k would be that mode (read 28a)
@@ -166,12 +169,12 @@ def backbone_cubic(model: StructuralIdentifier, data: Measurement, peaks: np.nda
         why = (f"no cubic (scale 0): a bare move of the frequency is kept only where it leaves "
                f"under 1 / {ratio:g} of what the linear model leaves unexplained")
     if why:
-        return None, None, f"{head}: not moved ({why}; {figures})"
+        return None, None, f"{head}: not moved ({why}; {figures})", float("nan")
     K3 = cubic(s)
     return K_b, K3, (f"{head}: moved to its limit, "
                      + ("with a cubic on that mode alone sized by output error"
                         if K3 is not None else "no cubic (output error chose scale 0)")
-                     + f" ({figures})")
+                     + f" ({figures})"), float(a_new)
 
 
 def mode_cubic(model: StructuralIdentifier, data: Measurement, peaks: np.ndarray,

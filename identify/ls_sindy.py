@@ -664,8 +664,7 @@ class LeastSquaresSINDy(StructuralIdentifier):
         drop, a_none, figures = without_input_map(self, data, a_fit, note_fit, INPUT_DROP_RATIO)
         self._step6_agreement = a_none if drop else a_fit  # the kept model's, for step 4d
         if drop:
-            cols = getattr(self, "_input_columns", None)
-            if cols is not None and cols.size == self.coef_.shape[1]:
+            if self._fitted_map[1] is not None:  # the input columns read above
                 self.coef_ = self.coef_.copy()
                 self.coef_[:, cols] = 0.0  # coef_ describes the model returned
             self.input_map_rule_ = (
@@ -807,8 +806,8 @@ class LeastSquaresSINDy(StructuralIdentifier):
         if not (self.decay_hold and self.decay_backbone):
             self.backbone_cubic_rule_ = "not tried (decay_hold and decay_backbone needed)"
             return
-        K, K3, self.backbone_cubic_rule_ = backbone_cubic(self, data, self._held_peaks(data, peaks),
-                                                          CUBIC_TRIAL_RATIO)
+        K, K3, self.backbone_cubic_rule_, _ = backbone_cubic(
+            self, data, self._held_peaks(data, peaks), CUBIC_TRIAL_RATIO)
         if K is None:
             return
         self._set_stiffness(K, np.full((self.M_.shape[0], 1), m_hat / self.M_.shape[0]),

@@ -1205,7 +1205,8 @@ class SGDSINDy(SGDSINDyBase):
             self.backbone_cubic_rule_ = "not tried (decay_hold and decay_backbone needed)"
             return None
         peaks = np.asarray(getattr(self, "peaks_", np.empty(0)), dtype=float)
-        K, K3, self.backbone_cubic_rule_ = backbone_cubic(self, data, peaks, CUBIC_TRIAL_RATIO)
+        K, K3, self.backbone_cubic_rule_, a_new = backbone_cubic(self, data, peaks,
+                                                                 CUBIC_TRIAL_RATIO)
         if K is None:
             return None
         m = np.diag(self.M_)[:, None]
@@ -1214,12 +1215,11 @@ class SGDSINDy(SGDSINDyBase):
             self.coef_[:, self._c_block] = -K3 / m
         self.K3_ = K3
         self.natural_frequencies_, self.modes_ = modal(self.M_, self.K_)
-        # the keep rule's agreement described the unmoved model: the moved one's, simulated
-        # as the scorer does (identify._record.record_agreement), states record_rule_
-        a_new, note = record_agreement(self, data)
-        self.record_rule_ = record_rule(a_new, self.M_, self.C_, self.K_) + (
-            "" if np.isfinite(a_new) else f" (after the backbone step: {note})")
-        return a_new, note
+        # the keep rule's agreement described the unmoved model: the moved one's (what
+        # backbone_cubic measured at the chosen scale, finite where it moves: the same
+        # simulation as identify._record.record_agreement of this model) states record_rule_
+        self.record_rule_ = record_rule(a_new, self.M_, self.C_, self.K_)
+        return a_new, ""
 
     def _cubic_is_the_datas(self) -> bool:
         """Whether the cubic terms are the data's to select: ``cubic`` None (the cubic rule's

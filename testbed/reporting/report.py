@@ -253,14 +253,14 @@ def refuse_foreign_outputs(out_dir: str | os.PathLike, pngs: Iterable[Path] = ()
     # each figure opened once, by the marker check; an earlier report's unmarked figure is
     # looked for (its bytes read and encoded) only where that check refuses, and the page is
     # read once, at the first such figure: not for every marked figure (review 29a L6)
-    page: list[bytes] = []
+    page: bytes | None = None
     for p in map(Path, pngs):
         try:
             refuse_foreign(p, PNG_FILE, shown(p), expected=expected)
         except InputError:
-            if not page:
-                page.append(_earlier_page(out_dir))
-            if not _earlier_figure(p, page[0]):
+            if page is None:
+                page = _earlier_page(out_dir)
+            if not _earlier_figure(p, page):
                 raise
     for name, kind in REPORT_FILES:
         refuse_foreign(out_dir / name, kind, shown(out_dir / name), expected=expected)

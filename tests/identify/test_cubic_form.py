@@ -138,7 +138,7 @@ def test_mode_shapes_whose_cubes_are_singular_are_a_verdict_not_a_crash():
     Phi = np.array([[1.0, 0.0, 1.0], [0.0, 1.0, 1.0], [1.0, 1.0, 2.0 ** (1.0 / 3.0)]]).T
     K = Phi @ np.diag((2.0 * np.pi * np.array([10.0, 50.0, 200.0])) ** 2) @ np.linalg.inv(Phi)
     model = SimpleNamespace(M_=np.eye(3), C_=np.zeros((3, 3)), K_=K)
-    K_b, K3, rule = backbone_cubic(model, None, np.array([10.0]))
+    K_b, K3, rule, _ = backbone_cubic(model, None, np.array([10.0]))
     assert K_b is None and K3 is None
     assert rule.startswith("not tried (the cubes of the model's mode shapes are not resolved")
 
@@ -163,7 +163,7 @@ def test_step_4c_takes_the_lowest_mode_a_peak_locates(monkeypatch):
     monkeypatch.setattr(sb, "fit_window", fit_window)
     model = SimpleNamespace(M_=np.eye(2), C_=np.zeros((2, 2)),
                             K_=np.diag((2.0 * np.pi * np.array([20.0, 120.0])) ** 2))
-    K_b, K3, rule = sb.backbone_cubic(model, None, np.array([20.0 / 1.21, 120.0 * 1.21]))
+    K_b, K3, rule, _ = sb.backbone_cubic(model, None, np.array([20.0 / 1.21, 120.0 * 1.21]))
     assert K_b is None and K3 is None
     assert rule == "not tried (no mode of the model within 15% of a measured peak)"
     with pytest.raises(ReadsTheRecord):
@@ -192,12 +192,12 @@ def test_step_4c_keeps_a_move_with_no_cubic_only_where_it_explains_clearly_more(
     peaks = np.array([20.0, 120.0])
     for a_new, kept in ((0.8726, False), (0.9, False), (0.95, True)):  # 0.95: 0.05 < 0.1153 / 2
         monkeypatch.setattr(sb, "best_scale", lambda f, a=a_new: (0.0, a))
-        K_b, K3, rule = sb.backbone_cubic(model, data, peaks, 2.0)
+        K_b, K3, rule, _ = sb.backbone_cubic(model, data, peaks, 2.0)
         assert K3 is None and (K_b is not None) == kept, rule
         assert ("moved to its limit, no cubic" in rule) == kept
         assert ("no cubic (scale 0): a bare move" in rule) != kept
     monkeypatch.setattr(sb, "best_scale", lambda f: (0.8, 0.8726))  # a cubic, inside the margin
-    K_b, K3, rule = sb.backbone_cubic(model, data, peaks, 2.0)
+    K_b, K3, rule, _ = sb.backbone_cubic(model, data, peaks, 2.0)
     assert K_b is not None and np.linalg.matrix_rank(K3) == 1 and "with a cubic" in rule
 
 
