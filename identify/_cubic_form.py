@@ -20,7 +20,8 @@ carry ``A``, every such consumer is to compute its cubic with :func:`cubic_force
 
 :func:`one_mode_cubic` is a rank-one ``K3`` on the diagonal features (a cubic acting on one
 mode's equation alone, a Duffing along that mode's motion), which every consumer reads as it
-is: ``ls_sindy``'s step 4c (:mod:`identify._structural_backbone`) sizes it by output error.
+is: ``ls_sindy``'s steps 4c and 4d and ``sgd_sindy``'s backbone step
+(:mod:`identify._structural_backbone`) size it by output error.
 """
 
 from __future__ import annotations

@@ -1,7 +1,9 @@
 """A linear model of a hardening record: its lowest mode at the backbone decay's linear limit,
 the hardening carried by a cubic on that mode alone whose strength is fitted to the record by
-simulation (output error).  ``ls_sindy``'s step 4c (:func:`backbone_cubic`); a structural
-identifier with ``M_``, ``C_``, ``K_``, ``input_map_`` and ``simulate`` may call it the same way.
+simulation (output error): ``ls_sindy``'s step 4c and ``sgd_sindy``'s backbone step
+(:func:`backbone_cubic`), and ``ls_sindy``'s step 4d (:func:`mode_cubic`, a fitted cubic
+replaced by one on that mode alone); a structural identifier with ``M_``, ``C_``, ``K_``,
+``input_map_`` and ``simulate`` may call them the same way.
 """
 
 from __future__ import annotations

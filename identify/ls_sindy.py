@@ -277,7 +277,7 @@ class LeastSquaresSINDy(StructuralIdentifier):
 
     4c. *Mode 1 at its backbone limit, its hardening carried by a cubic sized by output error*
        (``cubic=None`` only; :meth:`_backbone_cubic`; numbered by what it acts on, it runs
-       last of the fit's steps: after step 5 and the fit band's refusal
+       last of the linear fit's steps, before step 6 and step 4d: after step 5 and the fit band's refusal
        (:func:`identify._band_refusal.fit_with_band_refusal`) have settled the linear model,
        before the input term's step 6): where a linear model stands after steps 4 and 4b
        while the lowest mode a measured peak locates (the eigenvalue hold's pairing, within
@@ -623,7 +623,7 @@ class LeastSquaresSINDy(StructuralIdentifier):
             lambda: lowest_mode_hz(self.M_, self.K_), self.fit_band_hz is None)
         if refused is not None:
             self.fit_band_rule_ = refused
-        self._backbone_cubic(data, ps.peaks, m_hat)
+        self._backbone_cubic(data, ps.peaks)
         self._finish_fit(data)
         self._choose_input_map(data)
         self._mode_cubic(data, ps.peaks)
@@ -791,7 +791,7 @@ class LeastSquaresSINDy(StructuralIdentifier):
             f": not kept, it does not leave 1 / {CUBIC_TRIAL_RATIO:g} or less of what the linear "
             f"model leaves of its record unexplained ({figures}): cubic terms out")
 
-    def _backbone_cubic(self, data: Measurement, peaks: np.ndarray, m_hat: float) -> None:
+    def _backbone_cubic(self, data: Measurement, peaks: np.ndarray) -> None:
         """Step 4c of the class docstring (:func:`identify._structural_backbone.backbone_cubic`):
         on the linear model the cubic rule chose (``cubic`` None, after steps 4, 4b and 5 and
         the fit band's refusal: it runs on the model :func:`fit_with_band_refusal` settled), with
@@ -810,8 +810,7 @@ class LeastSquaresSINDy(StructuralIdentifier):
             self, data, self._held_peaks(data, peaks), CUBIC_TRIAL_RATIO)
         if K is None:
             return
-        self._set_stiffness(K, np.full((self.M_.shape[0], 1), m_hat / self.M_.shape[0]),
-                            self._d_block)
+        self._set_stiffness(K, np.diag(self.M_)[:, None], self._d_block)
         self.K3_ = K3
 
     def _mode_cubic(self, data: Measurement, peaks: np.ndarray) -> None:
@@ -1192,11 +1191,6 @@ class LeastSquaresSINDy(StructuralIdentifier):
         taken = self.eigen_targets_[self.eigen_targets_ > 0]
         used = np.array([np.any(np.isclose(v, taken, rtol=1e-9)) for v in f], dtype=bool)
         return np.asarray(peaks, dtype=float)[~used]
-
-    def _set_stiffness(self, K: np.ndarray, m: np.ndarray, d_block: slice) -> None:
-        """Replace ``K_`` by ``K`` [N/m] and ``coef_``'s displacement block with it."""
-        self.coef_[:, d_block] -= (K - self.K_) / m
-        self.K_ = K
 
     def _check_physical(self) -> None:
         """Raise :class:`IdentificationError` for a model with a growing mode

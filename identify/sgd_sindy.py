@@ -1210,7 +1210,7 @@ class SGDSINDy(SGDSINDyBase):
         if K is None:
             return None
         m = np.diag(self.M_)[:, None]
-        self._set_stiffness(K, m)
+        self._set_stiffness(K, m, self._d_block)
         if K3 is not None and self._c_block is not None:  # a cubic library, every term dropped
             self.coef_[:, self._c_block] = -K3 / m
         self.K3_ = K3
@@ -1226,12 +1226,6 @@ class SGDSINDy(SGDSINDyBase):
         choice) or ``cubic`` true with ``l1 = 'cubic'`` (the lasso's); ``cubic`` true with
         ``l1 = 'none'`` asks for the cubic model itself (review 25e), ``cubic`` false for none."""
         return self.cubic is None or (bool(self.cubic) and self.l1 == "cubic")
-
-    def _set_stiffness(self, K: np.ndarray, m: np.ndarray) -> None:
-        """Replace ``K_`` by ``K`` [N/m], shape (n, n), and ``coef_``'s displacement block
-        with it (``m`` [kg], shape (n, 1): the diagonal masses ``coef_`` divides by)."""
-        self.coef_[:, self._d_block] -= (K - self.K_) / m
-        self.K_ = K
 
     def _choose_input_map(self, data: Measurement, moved: tuple[float, str] | None = None
                           ) -> None:
@@ -1975,7 +1969,7 @@ class SGDSINDy(SGDSINDyBase):
         if held.decay is not None:
             self.modal_decay_ = held.decay
         self.coef_[:, v_block] -= (held.C - self.C_) / m
-        self._set_stiffness(held.K, m)
+        self._set_stiffness(held.K, m, self._d_block)
         self.C_ = held.C
         self.decay_rule_ = held.rule
         if lowered:

@@ -1661,6 +1661,13 @@ class StructuralIdentifier(Identifier):
         if not hasattr(self, "M_"):
             raise RuntimeError(f"{type(self).__name__} is not fitted; call fit(data) first")
 
+    def _set_stiffness(self, K: np.ndarray, m: np.ndarray, d_block: slice) -> None:
+        """Replace ``K_`` by ``K`` [N/m], shape (n, n), and ``coef_``'s displacement block
+        ``d_block`` with it (``m`` [kg], shape (n, 1): the diagonal masses ``coef_`` divides
+        by); the rules that move a fitted stiffness (``ls_sindy``'s, ``sgd_sindy``'s) share it."""
+        self.coef_[:, d_block] -= (K - self.K_) / m
+        self.K_ = K
+
     def simulate(self, x0: np.ndarray, xd0: np.ndarray, t: np.ndarray,
                  u: np.ndarray | None = None) -> Trajectory:
         """Integrate the identified model (see :func:`simulate_structural`).

@@ -144,7 +144,9 @@ _UFF_MARK = re.compile(rb"\n\s*-1\n\s*58b?[ \t][^\n]*\n(?:[^\n]*\n){4}fs [^\n]*H
 #: :func:`_json_document` parses, and the farthest :func:`_uff_ours` looks for a UFF file's
 #: first UFF58 record.  The largest text file ``identify`` reads
 #: (``testbed.core.budget.IDENTIFY_TEXT_BUDGET_BYTES``, review 29a L5: a second, unexplained
-#: 256 MiB); a larger one could not be read back by the testbed, so it is not one it wrote
+#: 256 MiB).  A larger file is told as not the testbed's: a SEP-005 export of its own over
+#: 256 MiB (about 3e7 samples; the scenario budget allows more) is then refused as a target of
+#: another export (not measured in practice: docs/known-gaps.md)
 MARK_READ = IDENTIFY_TEXT_BUDGET_BYTES
 #: The keys every model summary ``identify`` writes holds (``testbed.pipeline.fit``), which no
 #: one else's JSON holds together: the identified model's marker
@@ -324,7 +326,8 @@ def refuse_foreign(path: str | os.PathLike, kind: FileKind, name: str | None = N
                    expected: str | None = None) -> None:
     """Raise InputError if an existing file at ``path`` is not ``kind`` (:func:`foreign_head`)
     or cannot be read (its kind cannot be told: review 27e, such a file was replaced though
-    :func:`foreign_head`'s docstring said the write would name it); nothing else passes.
+    :func:`foreign_head`'s docstring said the write would name it); a missing path, an empty
+    file or one that is not a regular file passes (the write's own checks name those).
 
     The one refusal of a file a command would replace that is not its own (``generate`` /
     ``identify`` / ``export -o``, ``report``'s every output, ``family write``'s members,

@@ -272,7 +272,7 @@ def _earlier_page(out_dir: Path) -> bytes:
     unreadable): the page :func:`_earlier_figure` searches."""
     page = out_dir / "report.html"
     try:
-        if not page.is_file() or page.stat().st_size == 0 or foreign_head(page, HTML_FILE):
+        if not page.is_file() or foreign_head(page, HTML_FILE):  # a FIFO never read
             return b""
         return page.read_bytes()
     except OSError:

@@ -554,6 +554,8 @@ def save_new_run(result: Any, out_dir: str | os.PathLike,
     ------
     RunStoreError
         If the scenario's name is not a plain folder name, or its folder is not a folder.
+    InputError
+        With ``index``: an ``index.html`` in ``out_dir`` that the testbed did not write.
     """
     out = Path(out_dir)
     if index is not None:  # a user's own page of that name was replaced (review 28b)
